@@ -1,0 +1,47 @@
+"""Validators used at the public boundary: they return clean float64 arrays or raise one-line errors."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .exceptions import ShapeError
+
+
+def check_trajectory_array(x, n_dof: int, name: str = "q") -> np.ndarray:
+    """Return ``x`` as a C-contiguous float64 array of shape (N, n_dof).
+
+    Raises
+    ------
+    ShapeError
+        If ``x`` is not 2-D with ``n_dof`` columns or holds non-finite values.
+    """
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    if a.ndim == 1 and n_dof == 1:
+        a = a[:, None]
+    if a.ndim != 2 or a.shape[1] != n_dof:
+        hint = ""
+        if a.ndim == 2 and a.shape[0] == n_dof:
+            hint = ": joints-first data? transpose it"
+        raise ShapeError(f"expected {name} with shape (N, {n_dof}), got {a.shape}{hint}")
+    if not np.all(np.isfinite(a)):
+        row = int(np.argwhere(~np.isfinite(a))[0, 0])
+        raise ShapeError(f"{name} holds a NaN or infinite value at sample {row}")
+    return a
+
+
+def check_same_length(**arrays: np.ndarray) -> int:
+    """Check that all arrays have the same number of samples (axis 0); return it."""
+    lengths = {k: len(v) for k, v in arrays.items()}
+    if len(set(lengths.values())) > 1:
+        raise ShapeError(f"expected the same number of samples, got {lengths}")
+    return next(iter(lengths.values()))
+
+
+def check_vector(x, n: int, name: str) -> np.ndarray:
+    """Return ``x`` as a float64 vector of length ``n`` (a scalar is broadcast)."""
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise ShapeError(f"expected {name} with shape ({n},), got {a.shape}")
+    return a

@@ -1,0 +1,149 @@
+"""Compiled kernel of the batched joint-torque regressor (see :mod:`dynid.dynamics.regressor`).
+
+One pass per sample: forward Newton–Euler recursion in link frames, then for every link ``j`` and
+joint ``i <= j`` the ten closed-form columns ``tau_i = z·n_j + l·f_j``. Samples are split into chunks
+run in parallel; no allocation per sample.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+CHUNK = 256
+
+
+@nb.njit(cache=True, fastmath=False, boundscheck=False)
+def _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
+    n = q.shape[1]
+    nd = drive_codes.shape[0]
+    for k in range(start, stop):
+        # ---- zero entries that stay zero: links j < i, and other joints' drive columns -----
+        for i in range(n):
+            for col in range(i * npj):
+                out[k, i, col] = 0.0
+            for col in range(i * npj + 10, n * npj):
+                out[k, i, col] = 0.0
+            # drive terms of joint i (eq. 3): Ia·ddq, fc·sign(dq), fv·dq, offset
+            for t in range(nd):
+                code = drive_codes[t]
+                if code == 0:
+                    val = ddq[k, i]
+                elif code == 1:
+                    val = 1.0 if dq[k, i] > 0 else (-1.0 if dq[k, i] < 0 else 0.0)
+                elif code == 2:
+                    val = dq[k, i]
+                else:
+                    val = 1.0
+                out[k, i, i * npj + 10 + t] = val
+        # ---- forward recursion -------------------------------------------------------------
+        for j in range(n):
+            ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
+            c = np.cos(q[k, j])
+            s = np.sin(q[k, j])
+            v = 1.0 - c
+            # Rodrigues rotation about the joint axis
+            m00 = c + v * ax0 * ax0
+            m01 = v * ax0 * ax1 - s * ax2
+            m02 = v * ax0 * ax2 + s * ax1
+            m10 = v * ax0 * ax1 + s * ax2
+            m11 = c + v * ax1 * ax1
+            m12 = v * ax1 * ax2 - s * ax0
+            m20 = v * ax0 * ax2 - s * ax1
+            m21 = v * ax1 * ax2 + s * ax0
+            m22 = c + v * ax2 * ax2
+            for a in range(3):  # rl = rp_j @ rot
+                rl[a, 0] = rp[j, a, 0] * m00 + rp[j, a, 1] * m10 + rp[j, a, 2] * m20
+                rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
+                rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
+            px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
+            if j == 0:
+                wpx = wpy = wpz = 0.0
+                dwx = dwy = dwz = 0.0
+                apx, apy, apz = -gravity[0], -gravity[1], -gravity[2]
+                for a in range(3):
+                    o[0, a] = pp[0, a]
+                    for b in range(3):
+                        r0[0, a, b] = rl[a, b]
+            else:
+                wpx, wpy, wpz = w[j - 1, 0], w[j - 1, 1], w[j - 1, 2]
+                dwx, dwy, dwz = dw[j - 1, 0], dw[j - 1, 1], dw[j - 1, 2]
+                apx, apy, apz = acc[j - 1, 0], acc[j - 1, 1], acc[j - 1, 2]
+                for a in range(3):
+                    o[j, a] = o[j - 1, a] + r0[j - 1, a, 0] * px + r0[j - 1, a, 1] * py + r0[j - 1, a, 2] * pz
+                    for b in range(3):
+                        r0[j, a, b] = r0[j - 1, a, 0] * rl[0, b] + r0[j - 1, a, 1] * rl[1, b] + r0[j - 1, a, 2] * rl[2, b]
+            # acceleration of the new origin, parent frame: a + dw×p + w×(w×p)
+            cx = wpy * pz - wpz * py
+            cy = wpz * px - wpx * pz
+            cz = wpx * py - wpy * px
+            hx = apx + (dwy * pz - dwz * py) + (wpy * cz - wpz * cy)
+            hy = apy + (dwz * px - dwx * pz) + (wpz * cx - wpx * cz)
+            hz = apz + (dwx * py - dwy * px) + (wpx * cy - wpy * cx)
+            qd, qdd = dq[k, j], ddq[k, j]
+            for b in range(3):  # rotate into link j frame (rl^T)
+                wi = rl[0, b] * wpx + rl[1, b] * wpy + rl[2, b] * wpz
+                w[j, b] = wi
+                dw[j, b] = rl[0, b] * dwx + rl[1, b] * dwy + rl[2, b] * dwz + qdd * axes[j, b]
+                acc[j, b] = rl[0, b] * hx + rl[1, b] * hy + rl[2, b] * hz
+            # dw += w_in × (qd axis), then w += qd axis
+            wix, wiy, wiz = w[j, 0], w[j, 1], w[j, 2]
+            dw[j, 0] += qd * (wiy * ax2 - wiz * ax1)
+            dw[j, 1] += qd * (wiz * ax0 - wix * ax2)
+            dw[j, 2] += qd * (wix * ax1 - wiy * ax0)
+            w[j, 0] += qd * ax0
+            w[j, 1] += qd * ax1
+            w[j, 2] += qd * ax2
+            for a in range(3):
+                z0[j, a] = r0[j, a, 0] * ax0 + r0[j, a, 1] * ax1 + r0[j, a, 2] * ax2
+        # ---- regressor columns -------------------------------------------------------------
+        for j in range(n):
+            wx, wy, wz = w[j, 0], w[j, 1], w[j, 2]
+            ex, ey, ez = dw[j, 0], dw[j, 1], dw[j, 2]
+            gx, gy, gz = acc[j, 0], acc[j, 1], acc[j, 2]
+            w2 = wx * wx + wy * wy + wz * wz
+            col = j * npj
+            for i in range(j + 1):
+                # axis of joint i and o_j - o_i, in frame j
+                dx = o[j, 0] - o[i, 0]
+                dy = o[j, 1] - o[i, 1]
+                dz = o[j, 2] - o[i, 2]
+                zx = r0[j, 0, 0] * z0[i, 0] + r0[j, 1, 0] * z0[i, 1] + r0[j, 2, 0] * z0[i, 2]
+                zy = r0[j, 0, 1] * z0[i, 0] + r0[j, 1, 1] * z0[i, 1] + r0[j, 2, 1] * z0[i, 2]
+                zz = r0[j, 0, 2] * z0[i, 0] + r0[j, 1, 2] * z0[i, 1] + r0[j, 2, 2] * z0[i, 2]
+                rx = r0[j, 0, 0] * dx + r0[j, 1, 0] * dy + r0[j, 2, 0] * dz
+                ry = r0[j, 0, 1] * dx + r0[j, 1, 1] * dy + r0[j, 2, 1] * dz
+                rz = r0[j, 0, 2] * dx + r0[j, 1, 2] * dy + r0[j, 2, 2] * dz
+                lx = zy * rz - zz * ry
+                ly = zz * rx - zx * rz
+                lz = zx * ry - zy * rx
+                ux = zy * wz - zz * wy
+                uy = zz * wx - zx * wz
+                uz = zx * wy - zy * wx
+                out[k, i, col + 0] = zx * ex + ux * wx
+                out[k, i, col + 1] = zx * ey + zy * ex + ux * wy + uy * wx
+                out[k, i, col + 2] = zx * ez + zz * ex + ux * wz + uz * wx
+                out[k, i, col + 3] = zy * ey + uy * wy
+                out[k, i, col + 4] = zy * ez + zz * ey + uy * wz + uz * wy
+                out[k, i, col + 5] = zz * ez + uz * wz
+                lw = lx * wx + ly * wy + lz * wz
+                out[k, i, col + 6] = (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy)
+                out[k, i, col + 7] = (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz)
+                out[k, i, col + 8] = (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx)
+                out[k, i, col + 9] = lx * gx + ly * gy + lz * gz
+
+
+@nb.njit(cache=True, parallel=True)
+def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj):
+    """Fill every entry of ``out`` (N, n, n*npj); ``drive_codes`` lists the drive terms (0 Ia, 1 fc, 2 fv, 3 offset)."""
+    n_s, n = q.shape
+    n_chunks = (n_s + CHUNK - 1) // CHUNK
+    for c in nb.prange(n_chunks):
+        r0 = np.empty((n, 3, 3))
+        o = np.empty((n, 3))
+        w = np.empty((n, 3))
+        dw = np.empty((n, 3))
+        acc = np.empty((n, 3))
+        z0 = np.empty((n, 3))
+        rl = np.empty((3, 3))
+        _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, c * CHUNK, min((c + 1) * CHUNK, n_s), r0, o, w, dw, acc, z0, rl)

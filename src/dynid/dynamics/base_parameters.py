@@ -1,0 +1,137 @@
+"""Base (minimal) parameters by QR decomposition of the observation matrix on random samples.
+
+Columns of ``W`` are taken in the standard-parameter order (link 1 first, eq. 5 order inside a
+link). A QR decomposition *without* pivoting keeps a column when it is independent of the columns
+before it, so each dependent parameter is regrouped into earlier ones — the same choice as Khalil's
+symbolic rules (e.g. ``ZZ1R = ZZ1 + YY2 + YY3 + …``, ``XX2R = XX2 - YY2``). Refs: Gautier, "Numerical
+calculation of the base inertial parameters of robots", J. Robot. Syst. 8(4), 1991; Khalil &
+Dombre, "Modeling, Identification and Control of Robots", 2002, ch. 12.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from ..exceptions import IdentifiabilityError
+from ..model.robot import Robot
+from .regressor import observation_matrix
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """Selection and regrouping of the standard parameters into the base parameters.
+
+    Invariant: ``W @ phi == W[:, independent] @ (regrouping @ phi)`` for every observation matrix
+    ``W`` of the robot.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Base parameter names; an ``R`` suffix marks a regrouped one (``"ZZ1R"``).
+    standard_names : tuple of str
+    independent : (n_base,) int array
+        Columns of ``W`` kept (the base regressor is ``W[:, independent]``).
+    regrouping : (n_base, n_params) array
+        ``beta = regrouping @ phi``.
+    expressions : tuple of str
+        Readable regroupings, e.g. ``"ZZ1R = ZZ1 + YY2 + 0.4624·M3"``.
+    """
+
+    names: tuple[str, ...]
+    standard_names: tuple[str, ...]
+    independent: np.ndarray
+    regrouping: np.ndarray
+    expressions: tuple[str, ...]
+
+    @property
+    def n_base(self) -> int:
+        return len(self.names)
+
+    def base_from_standard(self, phi: np.ndarray) -> np.ndarray:
+        """``beta = regrouping @ phi`` (n_base,)."""
+        return self.regrouping @ np.asarray(phi, dtype=float)
+
+    def standard_from_base(self, beta: np.ndarray) -> np.ndarray:
+        """A standard vector with these base parameters: ``beta`` on the kept columns, 0 elsewhere."""
+        phi = np.zeros(len(self.standard_names))
+        phi[self.independent] = beta
+        return phi
+
+    def base_observation(self, w: np.ndarray) -> np.ndarray:
+        """Base regressor: the kept columns of ``W`` (..., n_params) -> (..., n_base)."""
+        return w[..., self.independent]
+
+    def to_dict(self) -> dict:
+        return {"names": list(self.names), "expressions": list(self.expressions)}
+
+
+def _format_term(coef: float, name: str, first: bool) -> str:
+    sign = "-" if coef < 0 else "+"
+    mag = abs(coef)
+    body = name if abs(mag - 1.0) < 1e-9 else f"{mag:.6g}·{name}"
+    if first:
+        return body if sign == "+" else f"-{body}"
+    return f" {sign} {body}"
+
+
+def base_parameters(robot: Robot, rng: np.random.Generator | int | None = 0, n_samples: int = 400,
+                    tol: float = 1e-8) -> BaseParameters:
+    """Compute the base parameters of ``robot`` numerically.
+
+    Parameters
+    ----------
+    robot : Robot
+    rng : Generator or int seed
+        Random states are drawn uniformly within the joint limits (±π where unlimited).
+    n_samples : int
+        Number of random states; ``n_samples * n_dof`` must exceed the number of parameters.
+    tol : float
+        Relative threshold on ``|R_ii| / max|R_ii|`` under which a column is dependent.
+
+    Returns
+    -------
+    BaseParameters
+
+    Raises
+    ------
+    IdentifiabilityError
+        If the rank found by QR disagrees with the SVD rank (numerically ill-posed chain).
+    """
+    rng = np.random.default_rng(rng)
+    n = robot.n_dof
+    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
+    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
+    q = rng.uniform(lo, hi, (n_samples, n))
+    dq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 2.0
+    ddq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 5.0
+    w = observation_matrix(robot, q, dq, ddq)
+    r = scipy.linalg.qr(w, mode="r")[0]
+    diag = np.abs(np.diag(r))
+    keep = diag > tol * diag.max()
+    indep = np.flatnonzero(keep)
+    dep = np.flatnonzero(~keep)
+    sv = np.linalg.svd(w, compute_uv=False)
+    rank = int(np.sum(sv > tol * sv[0]))
+    if rank != indep.size:
+        raise IdentifiabilityError(f"base parameters of {robot.name!r}: QR kept {indep.size} columns but the SVD rank is {rank}")
+    w1, w2 = w[:, indep], w[:, dep]
+    coef = np.linalg.lstsq(w1, w2, rcond=None)[0] if dep.size else np.zeros((indep.size, 0))
+    coef[np.abs(coef) < 1e-9] = 0.0
+    resid = np.abs(w1 @ coef - w2).max() if dep.size else 0.0
+    if resid > 1e-6 * max(1.0, np.abs(w).max()):
+        raise IdentifiabilityError(f"base parameters of {robot.name!r}: regrouping residual {resid:.3g} is too large")
+    names_std = robot.parameter_names
+    regroup = np.zeros((indep.size, len(names_std)))
+    regroup[np.arange(indep.size), indep] = 1.0
+    regroup[:, dep] = coef
+    names, exprs = [], []
+    for b, col in enumerate(indep):
+        others = [(coef[b, d], names_std[c]) for d, c in enumerate(dep) if coef[b, d] != 0.0]
+        name = names_std[col] + ("R" if others else "")
+        names.append(name)
+        expr = names_std[col] + "".join(_format_term(cf, nm, False) for cf, nm in others)
+        exprs.append(f"{name} = {expr}")
+    return BaseParameters(tuple(names), names_std, indep, regroup, tuple(exprs))

@@ -1,0 +1,53 @@
+"""Independent torques from Pinocchio's recursive Newton–Euler algorithm (RNEA).
+
+dynid's own regressor is checked against these, and the simulator uses them, so that simulated
+measurements never come from the model being identified.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.robot import Robot
+from ..model.urdf import pinocchio_from_inertial
+from .regressor import friction_torques
+
+
+def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
+    """A ``pinocchio.Model`` of the chain with the given (n_dof, 10) inertial parameters.
+
+    Parameters may be physically inconsistent (e.g. a base-parameter embedding); RNEA stays linear.
+    """
+    import pinocchio as pin
+
+    inertial = robot.inertial if inertial is None else inertial
+    model = pin.Model()
+    model.gravity.linear = np.asarray(robot.gravity, dtype=float)
+    parent = 0
+    for j, jt in enumerate(robot.joints):
+        placement = pin.SE3(np.asarray(jt.rotation), np.asarray(jt.translation))
+        ax = np.asarray(jt.axis, dtype=float)
+        if np.allclose(ax, [0, 0, 1]):
+            jm = pin.JointModelRZ()
+        elif np.allclose(ax, [1, 0, 0]):
+            jm = pin.JointModelRX()
+        elif np.allclose(ax, [0, 1, 0]):
+            jm = pin.JointModelRY()
+        else:
+            jm = pin.JointModelRevoluteUnaligned(ax)
+        parent = model.addJoint(parent, jm, placement, jt.name)
+        model.appendBodyToJoint(parent, pin.Inertia.FromDynamicParameters(pinocchio_from_inertial(inertial[j])), pin.SE3.Identity())
+    return model
+
+
+def rnea_torques(robot: Robot, q, dq, ddq, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
+    """Joint torques (N, n_dof) [N·m]: Pinocchio's RNEA for the rigid bodies plus the drive terms."""
+    import pinocchio as pin
+
+    model = pinocchio_model(robot, inertial)
+    data = model.createData()
+    q, dq, ddq = (np.ascontiguousarray(x, dtype=float) for x in (q, dq, ddq))
+    tau = np.empty_like(q)
+    for k in range(q.shape[0]):
+        tau[k] = pin.rnea(model, data, q[k], dq[k], ddq[k])
+    return tau + friction_torques(robot, dq, ddq, drive)

@@ -1,0 +1,25 @@
+"""Exceptions of dynid. Every error a user can cause is a :class:`DynIdError`.
+
+The CLI prints ``str(error)`` on one line and exits with code 1; messages say what was expected,
+what was found and, where possible, how to fix it.
+"""
+
+
+class DynIdError(Exception):
+    """Base class of all errors raised by dynid for bad input or data."""
+
+
+class ConfigError(DynIdError, ValueError):
+    """A robot description or experiment configuration is invalid (names the file and field)."""
+
+
+class ShapeError(DynIdError, ValueError):
+    """An array has the wrong shape (says expected vs got)."""
+
+
+class DataError(DynIdError, ValueError):
+    """Measured data is unusable (names the file, row or column)."""
+
+
+class IdentifiabilityError(DynIdError, ValueError):
+    """The data do not excite the parameters enough (rank-deficient observation matrix)."""

@@ -1,0 +1,200 @@
+"""Robot descriptions in TOML: DH table (modified or standard) or URDF, plus what a URDF does not say.
+
+Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``"-pi"``, ``"3*pi/4"``)::
+
+    name = "er16"
+    convention = "modified"        # "modified" (Khalil/Craig) | "standard" | "urdf"
+    urdf = "robot.urdf"            # with convention = "urdf", relative to this file
+    gravity = [0.0, 0.0, -9.81]    # m/s², base frame
+    drive_terms = ["fc", "fv"]     # identified per joint, subset of Ia, fc, fv, offset
+    notes = "where the numbers come from"
+
+    [tool]                         # flange in the last link frame (optional)
+    translation = [0.0, 0.0, 0.1]
+
+    [[joints]]                     # one table per joint, base to tip
+    name = "joint1"
+    alpha = "pi"                   # DH: alpha (alpha_{i-1} for modified), a, d, theta_offset
+    a = 0.0
+    d = 0.0
+    theta_offset = 0.0
+    q_min = -2.9                   # rad
+    q_max = 2.9
+    dq_max = 3.0                   # rad/s
+    ddq_max = 15.0                 # rad/s²
+    tau_max = 800.0                # N·m
+    drive_gain = 20.0              # N·m/A, eq. 16
+    mass = 60.0                    # kg (DH conventions; a URDF brings its own)
+    com = [0.0, 0.0, -0.1]         # m, link frame (standard DH: DH frame i)
+    inertia = [2.0, 2.0, 1.5, 0.0, 0.0, 0.0]   # about the COM: Ixx, Iyy, Izz, Ixy, Ixz, Iyz
+    fc = 8.0                       # one value per drive term
+    fv = 5.0
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..conventions import DEFAULT_DRIVE_TERMS, DRIVE_TERMS
+from ..exceptions import ConfigError
+from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
+from .robot import Limits, Robot
+from .spatial import inertial_from_physical, transform_inertial
+
+_ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
+
+
+def builtin_robots() -> list[str]:
+    """Names of the robots shipped with dynid."""
+    folder = resources.files("dynid.model") / "robots"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_robot(name_or_path: str | Path) -> Robot:
+    """A built-in robot by name (``"er16"``) or a robot description TOML file.
+
+    Raises
+    ------
+    ConfigError
+        Unknown robot, unreadable file, or a field with a wrong type or value (the message names the
+        file and the field).
+    """
+    text = str(name_or_path)
+    if text in builtin_robots():
+        res = resources.files("dynid.model") / "robots" / f"{text}.toml"
+        return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=None)
+    path = Path(text)
+    if not path.suffix == ".toml" or not path.is_file():
+        raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}) or a .toml description file")
+    return robot_from_toml_text(path.read_text(encoding="utf-8"), source=str(path), base=path.parent)
+
+
+def _angle(value, where: str) -> float:
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if isinstance(value, str):
+        m = _ANGLE.match(value)
+        if m:
+            sign = -1.0 if m.group(1) == "-" else 1.0
+            num = float(m.group(2)) if m.group(2) not in ("", ".") else 1.0
+            den = float(m.group(3)) if m.group(3) else 1.0
+            return sign * num * np.pi / den
+    raise ConfigError(f"{where}: expected a number or an angle like 'pi/2', got {value!r}")
+
+
+def _number(table: dict, key: str, where: str, default=None) -> float:
+    if key not in table:
+        if default is None:
+            raise ConfigError(f"{where}: missing field {key!r}")
+        return float(default)
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f"{where}.{key}: expected a number, got {value!r}")
+    return float(value)
+
+
+def _vector(table: dict, key: str, n: int, where: str, default=None) -> np.ndarray:
+    if key not in table:
+        if default is None:
+            raise ConfigError(f"{where}: missing field {key!r}")
+        return np.asarray(default, dtype=float)
+    value = table[key]
+    if not isinstance(value, list) or len(value) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+        raise ConfigError(f"{where}.{key}: expected a list of {n} numbers, got {value!r}")
+    return np.asarray(value, dtype=float)
+
+
+def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
+    """Parse a robot description (see the module docstring for the layout)."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: invalid TOML ({exc})") from None
+    name = doc.get("name", Path(source).stem)
+    convention = doc.get("convention", "modified")
+    if convention not in ("modified", "standard", "urdf"):
+        raise ConfigError(f"{source}: convention: expected 'modified', 'standard' or 'urdf', got {convention!r}")
+    terms = tuple(doc.get("drive_terms", DEFAULT_DRIVE_TERMS))
+    bad = [t for t in terms if t not in DRIVE_TERMS]
+    if bad:
+        raise ConfigError(f"{source}: drive_terms: unknown term(s) {bad}, expected a subset of {list(DRIVE_TERMS)}")
+    terms = tuple(t for t in DRIVE_TERMS if t in terms)
+    rows = doc.get("joints")
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        raise ConfigError(f"{source}: expected one or more [[joints]] tables")
+    n = len(rows)
+    where = [f"{source}: joints[{i}]" for i in range(n)]
+    names = [str(r.get("name", f"joint{i + 1}")) for i, r in enumerate(rows)]
+
+    tool = doc.get("tool", {})
+    tool_t = _vector(tool, "translation", 3, f"{source}: tool", default=[0.0, 0.0, 0.0])
+    tool_r = np.eye(3)
+
+    if convention == "urdf":
+        from .urdf import joints_from_urdf
+
+        if "urdf" not in doc:
+            raise ConfigError(f"{source}: convention 'urdf' needs a field 'urdf' with the file path")
+        upath = Path(doc["urdf"])
+        if not upath.is_absolute() and base is not None:
+            upath = base / upath
+        joints, inertial, _ = joints_from_urdf(upath)
+        if len(joints) != n:
+            raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
+    else:
+        alpha = [_angle(r.get("alpha", 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
+        a = [_number(r, "a", w, 0.0) for r, w in zip(rows, where)]
+        d = [_number(r, "d", w, 0.0) for r, w in zip(rows, where)]
+        off = [_angle(r.get("theta_offset", 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
+        if convention == "modified":
+            joints = joints_from_modified_dh(alpha, a, d, off, names)
+        else:
+            joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, d, off, names)
+            tool_t = tool_t0 + tool_r0 @ tool_t
+            tool_r = tool_r0
+        inertial = np.zeros((n, 10))
+        for i, (r, w) in enumerate(zip(rows, where)):
+            mass = _number(r, "mass", w)
+            com = _vector(r, "com", 3, w)
+            ixx, iyy, izz, ixy, ixz, iyz = _vector(r, "inertia", 6, w)
+            inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+            _check_physical(mass, inertia, w)
+            phi = inertial_from_physical(mass, com, inertia)
+            if convention == "standard":  # given in DH frame i: express in dynid's link frame
+                rr, pp = standard_dh_link_offset(alpha[i], a[i], d[i])
+                phi = transform_inertial(phi, rr, pp)
+            inertial[i] = phi
+
+    drive = np.array([[_number(r, t, w, 0.0) for t in terms] for r, w in zip(rows, where)]).reshape(n, len(terms))
+    gains = np.array([_number(r, "drive_gain", w, 1.0) for r, w in zip(rows, where)])
+    if np.any(gains <= 0):
+        i = int(np.argmax(gains <= 0))
+        raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
+    inf = np.inf
+    lim = {k: np.array([_number(r, k, w, dflt) for r, w in zip(rows, where)])
+           for k, dflt in (("q_min", -inf), ("q_max", inf), ("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
+    for i in range(n):
+        if not lim["q_min"][i] < lim["q_max"][i]:
+            raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")
+        for k in ("dq_max", "ddq_max", "tau_max"):
+            if not lim[k][i] > 0:
+                raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
+    gravity = _vector(doc, "gravity", 3, source, default=[0.0, 0.0, -9.81])
+    return Robot(
+        name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
+        drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
+        notes=str(doc.get("notes", "")),
+    )
+
+
+def _check_physical(mass: float, inertia: np.ndarray, where: str) -> None:
+    if not mass > 0:
+        raise ConfigError(f"{where}.mass: expected a positive mass (kg), got {mass}")
+    ev = np.linalg.eigvalsh(inertia)
+    if ev.min() <= 0 or 2 * ev.max() > ev.sum() * (1 + 1e-9):
+        raise ConfigError(f"{where}.inertia: expected a positive definite inertia about the COM that meets the triangle inequality, got principal moments {np.round(ev, 6).tolist()}")

@@ -1,0 +1,191 @@
+"""What a robot is: an immutable serial chain of revolute joints with its parameters.
+
+Every joint ``j`` has a fixed placement ``(R_j, p_j)`` of its frame in the frame of link ``j-1``
+(the base for ``j = 0``) and a unit rotation axis in its own frame; link ``j``'s frame is the joint
+frame after the rotation by ``q_j``. Modified DH (Khalil/Craig, the paper's Table 1), standard DH
+and URDF chains all reduce to this form (see :mod:`dynid.model.dh` and :mod:`dynid.model.urdf`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..conventions import DEFAULT_DRIVE_TERMS, DRIVE_TERMS, INERTIAL_TERMS, parameter_name
+from ..exceptions import ConfigError
+from .spatial import transform_inertial
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One revolute joint: placement in the parent link frame and rotation axis.
+
+    Attributes
+    ----------
+    name : str
+    rotation : (3, 3) array
+        Orientation of the joint frame in the parent link frame (``parent_R_joint``) at ``q = 0``.
+    translation : (3,) array
+        Origin of the joint frame in the parent link frame [m].
+    axis : (3,) array
+        Unit rotation axis in the joint frame (``(0, 0, 1)`` for DH chains).
+    """
+
+    name: str
+    rotation: np.ndarray
+    translation: np.ndarray
+    axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Joint limits, each of shape (n_dof,): positions [rad], |velocity| [rad/s],
+    |acceleration| [rad/s²] and |torque| [N·m]. Unknown limits are ``inf``."""
+
+    q_min: np.ndarray
+    q_max: np.ndarray
+    dq_max: np.ndarray
+    ddq_max: np.ndarray
+    tau_max: np.ndarray
+
+    def subset(self, k: int) -> "Limits":
+        return Limits(*(getattr(self, f)[:k].copy() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")))
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A serial robot arm with revolute joints (immutable).
+
+    Attributes
+    ----------
+    name : str
+    joints : tuple of Joint
+    gravity : (3,) array
+        Gravity acceleration in the base frame [m/s²], e.g. ``(0, 0, -9.81)``.
+    inertial : (n_dof, 10) array
+        Standard inertial parameters of each link (eq. 5 order, about the link frame origin): the
+        nominal values, used as simulation truth by the paper experiment.
+    drive_terms : tuple of str
+        Drive/friction terms identified for every joint, a subset of ``DRIVE_TERMS`` (eq. 3).
+    drive : (n_dof, len(drive_terms)) array
+        Nominal values of those terms.
+    drive_gains : (n_dof,) array
+        Drive gains ``K`` of eq. 16, joint torque per motor current [N·m/A].
+    limits : Limits
+    tool_rotation, tool_translation : arrays
+        Tool (flange) frame in the last link frame.
+    notes : str
+        Provenance of the numbers (e.g. which values are assumed).
+    """
+
+    name: str
+    joints: tuple[Joint, ...]
+    gravity: np.ndarray
+    inertial: np.ndarray
+    drive_terms: tuple[str, ...]
+    drive: np.ndarray
+    drive_gains: np.ndarray
+    limits: Limits
+    tool_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    tool_translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    notes: str = ""
+
+    def __post_init__(self) -> None:
+        n = len(self.joints)
+        if n == 0:
+            raise ConfigError(f"robot {self.name!r}: expected at least one joint, got none")
+        if self.inertial.shape != (n, 10):
+            raise ConfigError(f"robot {self.name!r}: expected inertial parameters of shape ({n}, 10), got {self.inertial.shape}")
+        unknown = [t for t in self.drive_terms if t not in DRIVE_TERMS]
+        if unknown:
+            raise ConfigError(f"robot {self.name!r}: unknown drive term(s) {unknown}, expected a subset of {list(DRIVE_TERMS)}")
+        if self.drive.shape != (n, len(self.drive_terms)):
+            raise ConfigError(f"robot {self.name!r}: expected drive parameters of shape ({n}, {len(self.drive_terms)}), got {self.drive.shape}")
+        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation):
+            a.setflags(write=False)
+
+    @property
+    def n_dof(self) -> int:
+        return len(self.joints)
+
+    @property
+    def n_params_per_joint(self) -> int:
+        return len(INERTIAL_TERMS) + len(self.drive_terms)
+
+    @property
+    def n_params(self) -> int:
+        """Number of standard parameters (``n_dof * (10 + len(drive_terms))``)."""
+        return self.n_dof * self.n_params_per_joint
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        """Names of the standard parameters, joint by joint (eq. 5 order, then drive terms)."""
+        terms = INERTIAL_TERMS + self.drive_terms
+        return tuple(parameter_name(t, j) for j in range(self.n_dof) for t in terms)
+
+    def standard_parameters(self) -> np.ndarray:
+        """Nominal standard parameter vector (n_params,), in :attr:`parameter_names` order."""
+        return np.concatenate([self.inertial, self.drive], axis=1).ravel()
+
+    def with_parameters(self, phi: np.ndarray) -> "Robot":
+        """A copy of this robot whose nominal parameters are ``phi`` (n_params,)."""
+        phi = np.asarray(phi, dtype=float).reshape(self.n_dof, self.n_params_per_joint)
+        return replace(self, inertial=phi[:, :10].copy(), drive=phi[:, 10:].copy())
+
+    def link_transform(self, j: int, qj: float) -> tuple[np.ndarray, np.ndarray]:
+        """Pose (R, p) of link ``j``'s frame in link ``j-1``'s frame at joint angle ``qj``."""
+        from .spatial import rot_axis
+
+        jt = self.joints[j]
+        return jt.rotation @ rot_axis(jt.axis, np.array([qj]))[0], jt.translation.copy()
+
+    def submodel(self, k: int, q_rest: np.ndarray | None = None) -> "Robot":
+        """The first ``k`` joints, the others held still at ``q_rest`` (default 0).
+
+        Links ``k+1 .. n`` become rigidly attached to link ``k``: their inertial parameters are
+        expressed in link ``k``'s frame and added to it, so link ``k`` carries the wrist (the paper's
+        three-joint model, §4.1). The tool frame moves with them.
+
+        Raises
+        ------
+        ConfigError
+            If ``k`` is not in ``1..n_dof`` or ``q_rest`` has the wrong length.
+        """
+        n = self.n_dof
+        if not 1 <= k <= n:
+            raise ConfigError(f"joints must be between 1 and {n} for robot {self.name!r}, got {k}")
+        q_rest = np.zeros(n - k) if q_rest is None else np.asarray(q_rest, dtype=float)
+        if q_rest.shape != (n - k,):
+            raise ConfigError(f"expected {n - k} rest angles for the held joints, got {q_rest.shape}")
+        inertial = self.inertial[:k].copy()
+        rot, pos = np.eye(3), np.zeros(3)  # pose of link j in link k-1's... accumulated in link k
+        for j in range(k, n):
+            r, p = self.link_transform(j, q_rest[j - k])
+            pos = pos + rot @ p
+            rot = rot @ r
+            inertial[k - 1] += transform_inertial(self.inertial[j], rot, pos)
+        tool_t = pos + rot @ self.tool_translation
+        tool_r = rot @ self.tool_rotation
+        return Robot(
+            name=self.name if k == n else f"{self.name}[1-{k}]",
+            joints=self.joints[:k],
+            gravity=self.gravity.copy(),
+            inertial=inertial,
+            drive_terms=self.drive_terms,
+            drive=self.drive[:k].copy(),
+            drive_gains=self.drive_gains[:k].copy(),
+            limits=self.limits.subset(k),
+            tool_rotation=tool_r,
+            tool_translation=tool_t,
+            notes=self.notes,
+        )
+
+
+def default_limits(n: int) -> Limits:
+    """Limits that constrain nothing (``±inf``)."""
+    inf = np.full(n, np.inf)
+    return Limits(-inf, inf.copy(), inf.copy(), inf.copy(), inf.copy())
+
+
+__all__ = ["Joint", "Limits", "Robot", "default_limits", "DEFAULT_DRIVE_TERMS"]

@@ -1,0 +1,96 @@
+"""Rigid-body helpers: rotations and the change of frame of the ten inertial parameters."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    """Skew-symmetric matrix S(v) with S(v) @ w == cross(v, w); v has shape (3,)."""
+    x, y, z = v
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_axis(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Batched Rodrigues rotation about a fixed unit ``axis`` (3,) by ``angle`` (N,) -> (N, 3, 3)."""
+    angle = np.asarray(angle, dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    k = skew(axis)
+    k2 = k @ k
+    return np.eye(3) + s[:, None, None] * k + (1.0 - c)[:, None, None] * k2
+
+
+def inertia_matrix(p: np.ndarray) -> np.ndarray:
+    """3x3 inertia matrix from (XX, XY, XZ, YY, YZ, ZZ)."""
+    xx, xy, xz, yy, yz, zz = p
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+
+def inertia_vector(m: np.ndarray) -> np.ndarray:
+    """(XX, XY, XZ, YY, YZ, ZZ) from a 3x3 inertia matrix."""
+    return np.array([m[0, 0], m[0, 1], m[0, 2], m[1, 1], m[1, 2], m[2, 2]])
+
+
+def inertial_from_physical(mass: float, com: np.ndarray, inertia_com: np.ndarray) -> np.ndarray:
+    """Ten standard inertial parameters (eq. 5 order) about the frame origin.
+
+    Parameters
+    ----------
+    mass : float
+        Link mass [kg].
+    com : (3,) array
+        Centre of mass in the link frame [m].
+    inertia_com : (3, 3) array
+        Inertia tensor about the centre of mass, link frame axes [kg·m²].
+
+    Returns
+    -------
+    (10,) array ``[XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M]`` (parallel-axis theorem).
+    """
+    com = np.asarray(com, dtype=float)
+    s = skew(com)
+    inertia_origin = np.asarray(inertia_com, dtype=float) + mass * (s.T @ s)
+    return np.concatenate([inertia_vector(inertia_origin), mass * com, [mass]])
+
+
+def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """Inverse of :func:`inertial_from_physical`: (mass, com, inertia about the com)."""
+    mass = float(phi[9])
+    com = phi[6:9] / mass if mass != 0 else np.zeros(3)
+    s = skew(com)
+    return mass, com, inertia_matrix(phi[:6]) - mass * (s.T @ s)
+
+
+def transform_inertial(phi: np.ndarray, rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
+    """Express a body's ten inertial parameters in another frame A.
+
+    ``phi`` is given in frame B; ``rotation`` and ``translation`` are ``A_R_B`` and the origin of B
+    in A. Returns the parameters about the origin of A, in A's axes:
+    ``I_A = R I_B R^T - m S(p)S(p) - S(p)S(c) - S(c)S(p)`` with ``c = R·MS_B``, ``MS_A = c + m p``.
+    """
+    r = np.asarray(rotation, dtype=float)
+    p = np.asarray(translation, dtype=float)
+    m = phi[9]
+    c = r @ phi[6:9]
+    sp, sc = skew(p), skew(c)
+    inertia = r @ inertia_matrix(phi[:6]) @ r.T - m * sp @ sp - sp @ sc - sc @ sp
+    return np.concatenate([inertia_vector(inertia), c + m * p, [m]])
+
+
+def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
+    """True when the pseudo-inertia matrix of ``phi`` is positive semidefinite (Wensing et al. 2017)."""
+    inertia = inertia_matrix(phi[:6])
+    sigma = 0.5 * np.trace(inertia) * np.eye(3) - inertia
+    h = phi[6:9]
+    pseudo = np.block([[sigma, h[:, None]], [h[None, :], np.array([[phi[9]]])]])
+    return bool(np.linalg.eigvalsh(pseudo).min() >= -tol * max(1.0, abs(phi[9])))
