@@ -1,1 +1,7 @@
-"""dynid.estimators."""
+"""Estimators of the base parameters from (W, tau): they never see robots, only the linear problem."""
+
+from .base import Estimator, paper_objective
+from .bee_colony import BeeColonyEstimator
+from .least_squares import OrdinaryLeastSquares
+
+__all__ = ["Estimator", "paper_objective", "BeeColonyEstimator", "OrdinaryLeastSquares"]

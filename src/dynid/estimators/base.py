@@ -1,0 +1,67 @@
+"""Shared estimator contract (scikit-learn style) and the paper's objective (eq. 9)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..exceptions import ShapeError
+
+
+def check_observations(w, tau) -> tuple[np.ndarray, np.ndarray]:
+    """Validate an observation matrix ``W`` (M, p) and torques ``tau`` (M,) or (N, n_dof) with N·n_dof = M."""
+    w = np.asarray(w, dtype=np.float64)
+    tau = np.asarray(tau, dtype=np.float64).reshape(-1)
+    if w.ndim != 2:
+        raise ShapeError(f"expected W with shape (N*n_dof, n_params), got {w.shape}")
+    if w.shape[0] != tau.shape[0]:
+        raise ShapeError(f"W has {w.shape[0]} rows but tau has {tau.shape[0]} values")
+    if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
+        raise ShapeError("W or tau holds NaN or infinite values")
+    return w, tau
+
+
+def paper_objective(residual: np.ndarray, n_dof: int, weights: np.ndarray | None = None) -> np.ndarray:
+    """Objective ``F`` of eq. 9: ``(1/N) sum_i sum_j delta_j |tau_ji - tau_pji|``.
+
+    Parameters
+    ----------
+    residual : (N*n_dof,) or (N*n_dof, K) array
+        Measured minus predicted torques, rows ordered sample-major (row ``k·n_dof + j``).
+    n_dof : int
+    weights : (n_dof,) array, optional
+        ``delta_j`` in [0, 1] (default 1).
+
+    Returns
+    -------
+    float or (K,) array [N·m]
+    """
+    r = np.abs(np.asarray(residual, dtype=float))
+    n_s = r.shape[0] // n_dof
+    r = r.reshape((n_s, n_dof) + r.shape[1:])
+    d = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
+    return np.tensordot(d, r.sum(axis=0), axes=(0, 0)) / n_s
+
+
+class Estimator:
+    """Base class: ``fit(W, tau)`` sets ``params_`` and returns self; ``predict(W)``; ``score``.
+
+    Subclasses store only keyword hyper-parameters in ``__init__`` and set learned attributes
+    ending in ``_``.
+    """
+
+    params_: np.ndarray
+
+    def fit(self, w, tau):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def predict(self, w) -> np.ndarray:
+        """Predicted torques ``W @ params_`` (M,)."""
+        if not hasattr(self, "params_"):
+            raise AttributeError(f"{type(self).__name__} is not fitted yet: call fit(W, tau) first")
+        return np.asarray(w, dtype=float) @ self.params_
+
+    def score(self, w, tau) -> float:
+        """Coefficient of determination R² of the prediction on (W, tau)."""
+        w, tau = check_observations(w, tau)
+        res = tau - self.predict(w)
+        return 1.0 - float(res @ res) / float(((tau - tau.mean()) ** 2).sum())
