@@ -54,11 +54,16 @@ class BaseParameters:
         """``beta = regrouping @ phi`` (n_base,)."""
         return self.regrouping @ np.asarray(phi, dtype=float)
 
-    def standard_from_base(self, beta: np.ndarray) -> np.ndarray:
-        """A standard vector with these base parameters: ``beta`` on the kept columns, 0 elsewhere."""
-        phi = np.zeros(len(self.standard_names))
-        phi[self.independent] = beta
-        return phi
+    def standard_from_base(self, beta: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
+        """A standard vector whose base parameters are ``beta``.
+
+        Without ``reference``: ``beta`` on the kept columns, 0 elsewhere. With a reference standard
+        vector (e.g. nominal values): ``reference + E (beta - regrouping @ reference)``, which keeps the
+        reference's masses and other unidentifiable parameters (so a rigid-body simulator can use it).
+        """
+        ref = np.zeros(len(self.standard_names)) if reference is None else np.asarray(reference, dtype=float).copy()
+        ref[self.independent] += np.asarray(beta, dtype=float) - self.regrouping @ ref
+        return ref
 
     def base_observation(self, w: np.ndarray) -> np.ndarray:
         """Base regressor: the kept columns of ``W`` (..., n_params) -> (..., n_base)."""

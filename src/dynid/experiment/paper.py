@@ -246,7 +246,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         if missing:
             raise ConfigError(f"--plant paper: no Table 2 value for {', '.join(missing)}")
         truth = np.array([ref.TABLE2[ref.paper_symbol(n)] for n in base.names])
-        phi_true = base.standard_from_base(truth)
+        phi_true = base.standard_from_base(truth, reference=robot.standard_parameters())
     else:
         phi_true = robot.standard_parameters()
         truth = base.base_from_standard(phi_true)
