@@ -271,7 +271,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     ols_seconds = time.perf_counter() - t1
 
     use_table3 = config.abc_bounds == "table3" or (
-        config.abc_bounds == "auto" and all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names) and robot.name.startswith("er16") and k == 3)
+        config.abc_bounds == "auto" and all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names) and robot.name == "er16" and k == 3)
     if config.abc_bounds == "table3" and not all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names):
         raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")
     if use_table3:

@@ -168,7 +168,7 @@ class Robot:
         tool_t = pos + rot @ self.tool_translation
         tool_r = rot @ self.tool_rotation
         return Robot(
-            name=self.name if k == n else f"{self.name}[1-{k}]",
+            name=self.name,
             joints=self.joints[:k],
             gravity=self.gravity.copy(),
             inertial=inertial,

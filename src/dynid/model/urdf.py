@@ -62,7 +62,7 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
         if short.startswith("JointModelR") and short[-2:] in _AXES and "Unbounded" not in short:
             axis = np.array(_AXES[short[-2:]])
         elif short == "JointModelRevoluteUnaligned":
-            axis = np.asarray(jm.axis, dtype=float).ravel()
+            axis = np.asarray(jm.extract().axis, dtype=float).ravel()
         else:
             raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute joint")
         placement = model.jointPlacements[j]

@@ -1,0 +1,49 @@
+import json
+import subprocess
+import sys
+
+import pytest
+
+FAST = ["--duration", "8", "--rate", "100", "--abc-iterations", "3"]
+
+
+def dynid(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "dynid", *args], capture_output=True, text=True, cwd=cwd, timeout=600)
+
+
+def test_run_writes_results_and_figures(tmp_path):
+    out = tmp_path / "run"
+    p = dynid("run", "--out", str(out), *FAST)
+    assert p.returncode == 0, p.stderr
+    assert "Correlation coefficient" in p.stdout and "0.3182" in p.stdout
+    data = json.loads((out / "results.json").read_text())
+    assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
+    assert set(data["methods"]) == {"abc", "ols"}
+    assert len(list(out.glob("fig*.png"))) == 6
+    assert not list(out.glob(".*tmp"))
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--robot", "nosuch"], "unknown robot"),
+    (["--joints", "9"], "between 1 and 6"),
+    (["--rate", "-5"], "rate"),
+    (["--weights", "1,x"], "weights"),
+])
+def test_bad_options_get_one_line_errors(tmp_path, args, message):
+    p = dynid("run", "--out", str(tmp_path / "o"), *FAST, *args)
+    assert p.returncode == 1
+    assert message in p.stderr and "Traceback" not in p.stderr + p.stdout
+    assert len(p.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "o" / "results.json").exists()
+
+
+def test_usage_error_exit_2():
+    p = dynid("run", "--no-such-option")
+    assert p.returncode == 2
+
+
+def test_out_is_a_file(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    p = dynid("run", "--out", str(f), *FAST)
+    assert p.returncode == 1 and "not a folder" in p.stderr

@@ -1,0 +1,47 @@
+import os
+
+import numpy as np
+import pytest
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+TEST_URDF = """<?xml version="1.0"?>
+<robot name="testarm">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0.01 0.02 0.1" rpy="0.1 0 0.2"/><mass value="4.0"/>
+    <inertia ixx="0.05" ixy="0.001" ixz="0.002" iyy="0.04" iyz="0.003" izz="0.03"/></inertial></link>
+  <link name="l2"><inertial><origin xyz="0.2 0.0 0.03" rpy="0 0.3 0"/><mass value="3.0"/>
+    <inertia ixx="0.01" ixy="0.0" ixz="0.0" iyy="0.08" iyz="0.0" izz="0.08"/></inertial></link>
+  <link name="l2b"><inertial><origin xyz="0.05 0.01 0.0" rpy="0 0 0"/><mass value="0.7"/>
+    <inertia ixx="0.002" ixy="0.0" ixz="0.0" iyy="0.002" iyz="0.0" izz="0.002"/></inertial></link>
+  <link name="l3"><inertial><origin xyz="0.1 0.02 -0.01" rpy="0 0 0"/><mass value="1.5"/>
+    <inertia ixx="0.004" ixy="0.0002" ixz="0.0" iyy="0.02" iyz="0.0" izz="0.02"/></inertial></link>
+  <link name="l4"><inertial><origin xyz="0.0 0.0 0.05" rpy="0 0 0"/><mass value="0.5"/>
+    <inertia ixx="0.001" ixy="0.0" ixz="0.0" iyy="0.001" iyz="0.0" izz="0.0005"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3" rpy="0 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.05 0 0.1" rpy="1.5707963 0.2 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+  <joint name="fixed" type="fixed"><parent link="l2"/><child link="l2b"/><origin xyz="0.3 0 0" rpy="0 0 0.4"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2b"/><child link="l3"/><origin xyz="0.1 0.02 0" rpy="0 0 0.3"/>
+    <axis xyz="0 0.6 0.8"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="0.25 0 0" rpy="0 1.5707963 0"/>
+    <axis xyz="1 0 0"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+</robot>
+"""
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(12345)
+
+
+@pytest.fixture
+def urdf_path(tmp_path):
+    p = tmp_path / "testarm.urdf"
+    p.write_text(TEST_URDF)
+    return p
+
+
+def random_states(rng, n_samples, n_dof, scale=2.0):
+    return tuple(rng.uniform(-scale, scale, (n_samples, n_dof)) for _ in range(3))

@@ -1,0 +1,82 @@
+import numpy as np
+import pytest
+
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.regressor import observation_matrix
+from dynid.estimators import BeeColonyEstimator, OrdinaryLeastSquares, paper_objective
+from dynid.exceptions import IdentifiabilityError, ShapeError
+from dynid.model.description import load_robot
+
+from ..conftest import random_states
+
+
+@pytest.fixture(scope="module")
+def problem():
+    rng = np.random.default_rng(5)
+    robot = load_robot("er16").submodel(3)
+    bp = base_parameters(robot, rng=0)
+    q, dq, ddq = random_states(rng, 600, 3)
+    w = bp.base_observation(observation_matrix(robot, q, dq, ddq))
+    beta = bp.base_from_standard(robot.standard_parameters())
+    return w, beta
+
+
+def make(kind, beta):
+    if kind == "ols":
+        return OrdinaryLeastSquares()
+    bounds = np.stack([beta - 1.0, beta + 1.0], axis=1)
+    return BeeColonyEstimator(bounds=bounds, n_dof=3, maxiter=5, rng=0)
+
+
+@pytest.mark.parametrize("kind", ["ols", "abc"])
+def test_shared_contract(problem, kind):
+    w, beta = problem
+    est = make(kind, beta)
+    with pytest.raises(AttributeError, match="not fitted"):
+        est.predict(w)
+    assert est.fit(w, w @ beta) is est
+    assert est.params_.shape == beta.shape
+    assert est.predict(w).shape == (w.shape[0],)
+    assert est.score(w, w @ beta) <= 1.0
+    with pytest.raises(ShapeError):
+        est.fit(w, (w @ beta)[:-1])
+
+
+def test_ols_recovers_truth_exactly_from_noise_free_data(problem):
+    w, beta = problem
+    ols = OrdinaryLeastSquares().fit(w, w @ beta)
+    np.testing.assert_allclose(ols.params_, beta, rtol=1e-9, atol=1e-9)
+
+
+def test_ols_within_3_sigma_on_noisy_data(problem):
+    w, beta = problem
+    rng = np.random.default_rng(11)
+    ols = OrdinaryLeastSquares().fit(w, w @ beta + rng.normal(0, 2.0, w.shape[0]))
+    z = np.abs(ols.params_ - beta) / ols.params_std_
+    assert np.all(z < 4.0) and np.mean(z < 3.0) > 0.9
+    assert ols.residual_std_ == pytest.approx(2.0, rel=0.05)
+    assert ols.condition_number_ > 1
+
+
+def test_ols_rank_deficient_raises(problem):
+    w, beta = problem
+    with pytest.raises(IdentifiabilityError, match="rank-deficient"):
+        OrdinaryLeastSquares().fit(np.hstack([w, w[:, :1]]), w @ beta)
+
+
+def test_paper_objective_is_eq9():
+    r = np.array([1.0, -2.0, 3.0, -4.0])  # 2 samples x 2 joints
+    assert paper_objective(r, 2) == pytest.approx((1 + 2 + 3 + 4) / 2)
+    assert paper_objective(r, 2, np.array([1.0, 0.5])) == pytest.approx((1 + 1 + 3 + 2) / 2)
+
+
+def test_abc_never_worse_than_its_start_and_is_seeded(problem):
+    w, beta = problem
+    tau = w @ beta
+    a = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=30, rng=3).fit(w, tau)
+    b = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=30, rng=3).fit(w, tau)
+    np.testing.assert_array_equal(a.params_, b.params_)
+    assert a.objective_ == pytest.approx(paper_objective(tau - w @ a.params_, 3))
+    assert a.history_[-1] < a.history_[0]
+    with pytest.raises(ShapeError, match="bounds"):
+        BeeColonyEstimator(bounds=[(0, 1)], n_dof=3).fit(w, tau)

@@ -1,0 +1,63 @@
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.experiment import PaperExperimentConfig, run_paper_experiment
+from dynid.experiment import paper_reference as ref
+
+FAST = dict(duration=10.0, rate=200.0, maxiter=5)
+
+
+def test_ols_recovers_truth_exactly_from_noise_free_pipeline():
+    cfg = PaperExperimentConfig(current_noise=0.0, encoder_resolution=0.0, smoothing_passes=0, **FAST)
+    r = run_paper_experiment(cfg)
+    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-8, atol=1e-8)
+    assert r.methods["ols"].objective < 1e-8
+
+
+def test_noisy_run_is_reproducible_and_sane():
+    cfg = PaperExperimentConfig(**FAST)
+    a, b = run_paper_experiment(cfg), run_paper_experiment(cfg)
+    for k in ("abc", "ols"):
+        np.testing.assert_array_equal(a.methods[k].params, b.methods[k].params)
+    ols = a.methods["ols"]
+    assert np.all(ols.metrics["correlation"]["validation"] > 0.99)
+    assert a.methods["abc"].objective >= ols.objective * 0.5  # ABC's F is not magically below OLS's L2 fit
+    d = a.to_dict()
+    for key in ("robot", "joints", "parameters", "truth", "methods"):
+        assert key in d
+    for m in ("abc", "ols"):
+        assert set(d["methods"][m]) >= {"params", "objective", "correlation", "rmse", "seconds"}
+        assert len(d["methods"][m]["correlation"]["validation"]) == 3
+    assert len(d["methods"]["abc"]["history"]) == 5
+
+
+def test_paper_plant_uses_table2():
+    r = run_paper_experiment(PaperExperimentConfig(plant="paper", current_noise=0.0, encoder_resolution=0.0,
+                                                   smoothing_passes=0, **FAST))
+    truth = dict(zip(r.base.names, r.truth))
+    assert truth["ZZ1R"] == ref.TABLE2["I_zz1"] and truth["fv3"] == ref.TABLE2["f_v3"]
+    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-7, atol=1e-7)
+    assert any("fc2" in w for w in r.warnings)  # Table 2's f_c2 = 11.02 lies outside Table 3's [-10, 10]
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(robot="nosuch"), "unknown robot"),
+    (dict(joints=7), "between 1 and 6"),
+    (dict(joints=0), "between 1 and 6"),
+    (dict(rate=-5.0), "rate"),
+    (dict(plant="real"), "plant"),
+    (dict(plant="paper", joints=2), "Table 2"),
+    (dict(weights=(1.0, 2.0, 1.0)), "weights"),
+    (dict(abc_bounds="wide"), "abc-bounds"),
+    (dict(joints=6, abc_bounds="table3"), "table3"),
+])
+def test_bad_settings(kwargs, message):
+    with pytest.raises(ConfigError, match=message):
+        run_paper_experiment(PaperExperimentConfig(**{**FAST, **kwargs}))
+
+
+def test_six_joints_run_with_scaled_bounds():
+    r = run_paper_experiment(PaperExperimentConfig(joints=6, **FAST))
+    assert r.base.n_base == 48
+    assert np.all(r.methods["ols"].metrics["correlation"]["identification"] > 0.9)

@@ -1,0 +1,98 @@
+import numpy as np
+import pytest
+
+from dynid.dynamics.kinematics import forward_kinematics
+from dynid.exceptions import ConfigError
+from dynid.model.description import builtin_robots, load_robot
+
+TABLE1 = [  # alpha_{i-1}, a_{i-1}, d_i, theta offset (paper Table 1)
+    (np.pi, 0.0, 0.0, 0.0), (np.pi / 2, 0.16, 0.0, -np.pi / 2), (0.0, 0.68, 0.0, 0.0),
+    (np.pi / 2, 0.13, -0.75, 0.0), (-np.pi / 2, 0.0, 0.0, 0.0), (np.pi / 2, 0.0, 0.0, 0.0),
+]
+
+
+def modified_dh_matrix(alpha, a, d, theta):
+    """Craig's modified DH transform written out as one 4x4 matrix."""
+    ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(theta), np.sin(theta)
+    return np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -sa * d], [st * sa, ct * sa, ca, ca * d], [0, 0, 0, 1]])
+
+
+def test_er16_geometry_is_table1(rng):
+    robot = load_robot("er16")
+    assert robot.n_dof == 6 and "er16" in builtin_robots()
+    q = rng.uniform(-2, 2, (5, 6))
+    rots, orig = forward_kinematics(robot, q)
+    for k in range(5):
+        t = np.eye(4)
+        for j, (al, a, d, off) in enumerate(TABLE1):
+            t = t @ modified_dh_matrix(al, a, d, q[k, j] + off)
+            np.testing.assert_allclose(rots[k, j], t[:3, :3], atol=1e-12)
+            np.testing.assert_allclose(orig[k, j], t[:3, 3], atol=1e-12)
+
+
+def test_er16_assumed_values_are_documented_and_consistent():
+    from dynid.model.spatial import is_physically_consistent
+
+    robot = load_robot("er16")
+    assert "assumed" in robot.notes
+    assert all(is_physically_consistent(p) for p in robot.inertial)
+
+
+def test_standard_dh_matches_explicit_product(tmp_path, rng):
+    # UR10e standard DH table of shared/data/ur10e_mamedov2020/SOURCE.md
+    rows = [(0, 0.181, "pi/2"), (-0.613, 0, 0), (-0.571, 0, 0), (0, 0.174, "pi/2"), (0, 0.120, "-pi/2"), (0, 0.117, 0)]
+    text = 'name = "ur"\nconvention = "standard"\n'
+    for a, d, al in rows:
+        al_s = f'"{al}"' if isinstance(al, str) else al
+        text += f"[[joints]]\na = {a}\nd = {d}\nalpha = {al_s}\nmass = 1.0\ncom = [0.0, 0.0, 0.0]\ninertia = [0.01, 0.01, 0.01, 0, 0, 0]\n"
+    p = tmp_path / "ur.toml"
+    p.write_text(text)
+    robot = load_robot(p)
+    q = rng.uniform(-2, 2, (3, 6))
+    from dynid.dynamics.kinematics import tool_positions
+
+    alphas = [np.pi / 2, 0, 0, np.pi / 2, -np.pi / 2, 0]
+    for k in range(3):
+        t = np.eye(4)
+        for j, (a, d, _) in enumerate(rows):
+            ct, st, ca, sa = np.cos(q[k, j]), np.sin(q[k, j]), np.cos(alphas[j]), np.sin(alphas[j])
+            t = t @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
+        np.testing.assert_allclose(tool_positions(robot, q[k:k + 1])[0], t[:3, 3], atol=1e-12)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("q_min", "5.0", "q_min < q_max"),
+    ("mass", "-1.0", "mass"),
+    ("alpha", '"half pi"', "alpha"),
+    ("drive_gain", "0.0", "drive_gain"),
+    ("dq_max", "-2.0", "dq_max"),
+    ("inertia", "[1.0, 1.0, 5.0, 0, 0, 0]", "triangle"),
+    ("com", "[0.0, 1.0]", "com"),
+])
+def test_bad_fields_name_file_and_field(tmp_path, field, value, message):
+    base = {"alpha": "0.0", "mass": "1.0", "com": "[0.0, 0.0, 0.0]", "inertia": "[0.1, 0.1, 0.1, 0, 0, 0]",
+            "q_min": "-1.0", "q_max": "1.0", "drive_gain": "2.0", "dq_max": "1.0"}
+    base[field] = value
+    p = tmp_path / "bad.toml"
+    p.write_text("[[joints]]\n" + "\n".join(f"{k} = {v}" for k, v in base.items()) + "\n")
+    with pytest.raises(ConfigError, match=message) as err:
+        load_robot(p)
+    assert "bad.toml" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_unknown_robot_and_bad_toml(tmp_path):
+    with pytest.raises(ConfigError, match="unknown robot 'nosuch'"):
+        load_robot("nosuch")
+    p = tmp_path / "x.toml"
+    p.write_text("[[joints]\n")
+    with pytest.raises(ConfigError, match="invalid TOML"):
+        load_robot(p)
+    p.write_text('convention = "weird"\n[[joints]]\n')
+    with pytest.raises(ConfigError, match="convention"):
+        load_robot(p)
+    p.write_text('drive_terms = ["stiction"]\n[[joints]]\n')
+    with pytest.raises(ConfigError, match="stiction"):
+        load_robot(p)
+    p.write_text('name = "x"\n')
+    with pytest.raises(ConfigError, match="joints"):
+        load_robot(p)

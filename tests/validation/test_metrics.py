@@ -1,0 +1,23 @@
+import numpy as np
+import pytest
+
+from dynid.exceptions import ShapeError
+from dynid.validation import correlation_coefficient, relative_error, rmse
+
+
+def test_eq18_equals_pearson(rng):
+    m = rng.normal(size=(500, 3))
+    p = m + rng.normal(0, 0.3, m.shape)
+    rho = correlation_coefficient(m, p)
+    for j in range(3):
+        assert rho[j] == pytest.approx(np.corrcoef(m[:, j], p[:, j])[0, 1], abs=1e-12)
+    np.testing.assert_allclose(correlation_coefficient(m, 2 * m + 1), 1.0)
+
+
+def test_rmse_and_relative_error():
+    m = np.array([[3.0], [4.0]])
+    p = np.array([[3.0], [3.0]])
+    assert rmse(m, p)[0] == pytest.approx(np.sqrt(0.5))
+    assert relative_error(m, p)[0] == pytest.approx(100 * 1 / 5)
+    with pytest.raises(ShapeError, match="differ in shape"):
+        rmse(m, p[:1])
