@@ -61,3 +61,20 @@ def test_six_joints_run_with_scaled_bounds():
     r = run_paper_experiment(PaperExperimentConfig(joints=6, **FAST))
     assert r.base.n_base == 48
     assert np.all(r.methods["ols"].metrics["correlation"]["identification"] > 0.9)
+
+
+def test_trajectories_within_er16_limits():
+    """β1 and β2 respect every joint limit of the built-in er16 (positions, speeds, accelerations, torques)."""
+    r = run_paper_experiment(PaperExperimentConfig(**FAST))
+    assert not [w for w in r.warnings if "limits" in w or "tau_max" in w]
+
+
+def test_limit_violations_are_reported(tmp_path):
+    from importlib import resources
+
+    text = (resources.files("dynid.model") / "robots" / "er16.toml").read_text()
+    p = tmp_path / "weak.toml"
+    p.write_text(text.replace("tau_max = 1800.0", "tau_max = 50.0").replace("dq_max = 2.9", "dq_max = 0.5", 1))
+    r = run_paper_experiment(PaperExperimentConfig(robot=str(p), **FAST))
+    assert any("tau_max on joint(s) 2" in w for w in r.warnings)
+    assert any("leaves the joint limits" in w for w in r.warnings)

@@ -263,6 +263,10 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t_sim = time.perf_counter()
     ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes)
     valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes)
+    for label, ds in (("identification (β1)", ident), ("validation (β2)", valid)):
+        over = np.flatnonzero(np.abs(ds.tau_true).max(axis=0) > robot.limits.tau_max)
+        if over.size:
+            warnings.append(f"the {label} trajectory needs more than tau_max on joint(s) {', '.join(str(j + 1) for j in over)}")
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
