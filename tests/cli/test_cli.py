@@ -18,7 +18,7 @@ def test_run_writes_results_and_figures(tmp_path):
     assert "Correlation coefficient" in p.stdout and "0.3182" in p.stdout
     data = json.loads((out / "results.json").read_text())
     assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
-    assert set(data["methods"]) == {"abc", "ols"}
+    assert set(data["methods"]) == {"abc", "lad", "ols"}
     assert len(list(out.glob("fig*.png"))) == 6
     assert not list(out.glob(".*tmp"))
 

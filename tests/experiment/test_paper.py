@@ -22,11 +22,12 @@ def test_noisy_run_is_reproducible_and_sane():
         np.testing.assert_array_equal(a.methods[k].params, b.methods[k].params)
     ols = a.methods["ols"]
     assert np.all(ols.metrics["correlation"]["validation"] > 0.99)
-    assert a.methods["abc"].objective >= ols.objective * 0.5  # ABC's F is not magically below OLS's L2 fit
+    lad = a.methods["lad"]
+    assert lad.objective <= a.methods["abc"].objective + 1e-9  # LAD is the exact minimum of eq. 9 in the box
     d = a.to_dict()
     for key in ("robot", "joints", "parameters", "truth", "methods"):
         assert key in d
-    for m in ("abc", "ols"):
+    for m in ("abc", "lad", "ols"):
         assert set(d["methods"][m]) >= {"params", "objective", "correlation", "rmse", "seconds"}
         assert len(d["methods"][m]["correlation"]["validation"]) == 3
     assert len(d["methods"]["abc"]["history"]) == 5

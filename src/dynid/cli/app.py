@@ -12,6 +12,7 @@ from typing import Optional
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich import box
 from rich.table import Table
 
 from ..exceptions import DynIdError
@@ -19,6 +20,8 @@ from ..exceptions import DynIdError
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="dynid: dynamic model identification of industrial robot arms.")
 console = Console()
+if not console.is_terminal:  # logs and pipes: wide enough for every table
+    console = Console(width=120)
 err_console = Console(stderr=True)
 
 
@@ -78,45 +81,56 @@ def run(
     _print_run(result, paths)
 
 
+METHOD_LABELS = {"abc": "ABC", "lad": "LAD", "ols": "OLS"}
+
+
 def _print_run(result, paths) -> None:
     from ..conventions import unit_of
     from ..experiment import paper_reference as ref
 
     d = result.to_dict()
-    abc, ols = d["methods"]["abc"], d["methods"]["ols"]
+    methods = {METHOD_LABELS[k]: v for k, v in d["methods"].items()}
     cfg = result.config
     console.print(f"\n[bold]dynid run[/] — robot {result.robot.name}, joints 1-{cfg.joints}, plant '{cfg.plant}', "
                   f"seed {cfg.seed}: {len(d['parameters'])} base parameters "
                   f"({len(d['parameters']) - 2 * cfg.joints} inertial + {2 * cfg.joints} friction)")
-    t = Table(title="Base parameters: truth and estimates", show_lines=False)
-    for col, just in (("name", "left"), ("paper", "left"), ("unit", "left"), ("truth", "right"), ("ABC", "right"),
-                      ("OLS", "right"), ("OLS ±σ", "right"), ("paper Table 2", "right")):
-        t.add_column(col, justify=just)
+    t = Table(title="Base parameters: truth and estimates (OLS standard deviations in results.json)",
+              box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("name (paper)", "unit", "truth", *methods, "Table 2"):
+        t.add_column(col, justify="left" if col in ("name (paper)", "unit") else "right", no_wrap=True)
     for n in d["parameters"]:
         sym = d["paper_symbols"][n]
-        t.add_row(n, sym, unit_of(n), f"{d['truth'][n]:.4f}", f"{abc['params'][n]:.4f}", f"{ols['params'][n]:.4f}",
-                  f"{ols['params_std'][n]:.4f}", f"{ref.TABLE2[sym]:.4f}" if sym in ref.TABLE2 else "")
+        t.add_row(f"{n} ({sym})" if sym else n, unit_of(n), f"{d['truth'][n]:.3f}",
+                  *(f"{m['params'][n]:.3f}" for m in methods.values()), f"{ref.TABLE2[sym]:.3f}" if sym in ref.TABLE2 else "")
     console.print(t)
-    t = Table(title="Objective F (eq. 9) on the identification data")
+    t = Table(title="Objective F (eq. 9) on the identification data", box=box.SIMPLE_HEAD)
     for col in ("method", "F [N·m]", "evaluations", "time [s]"):
         t.add_column(col, justify="right")
-    t.add_row("ABC", f"{abc['objective']:.4f}", str(abc["n_evaluations"]), f"{abc['seconds']:.2f}")
-    t.add_row("OLS", f"{ols['objective']:.4f}", "1 solve", f"{ols['seconds']:.3f}")
+    for label, m in methods.items():
+        t.add_row(label, f"{m['objective']:.4f}", str(m["n_evaluations"]) if label == "ABC" else "1 solve", f"{m['seconds']:.3f}")
     t.add_row("paper (ABC)", f"{ref.OBJECTIVE:.4f}", "", "")
     console.print(t)
-    for key, paper_vals in (("identification", ref.CORRELATION_IDENTIFICATION), ("validation", ref.CORRELATION_VALIDATION)):
-        t = Table(title=f"Correlation coefficient (eq. 18), RMSE and relative error — {key} trajectory")
-        for col in ("joint", "ρ ABC", "ρ OLS", "ρ paper", "RMSE ABC [N·m]", "RMSE OLS [N·m]", "rel. err ABC [%]", "rel. err OLS [%]"):
+    for key, beta, paper_vals in (("identification", "β1", ref.CORRELATION_IDENTIFICATION),
+                                  ("validation", "β2", ref.CORRELATION_VALIDATION)):
+        t = Table(title=f"Correlation coefficient ρ (eq. 18), {key} trajectory {beta}", box=box.SIMPLE_HEAD)
+        for col in ("joint", *methods, "paper"):
             t.add_column(col, justify="right")
         for j in range(cfg.joints):
-            t.add_row(str(j + 1), f"{abc['correlation'][key][j]:.4f}", f"{ols['correlation'][key][j]:.4f}",
-                      f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "",
-                      f"{abc['rmse'][key][j]:.3f}", f"{ols['rmse'][key][j]:.3f}",
-                      f"{abc['relative_error'][key][j]:.2f}", f"{ols['relative_error'][key][j]:.2f}")
+            t.add_row(str(j + 1), *(f"{m['correlation'][key][j]:.4f}" for m in methods.values()),
+                      f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—")
+        console.print(t)
+        t = Table(title=f"RMSE [N·m] and relative error [%], {key} trajectory {beta}", box=box.SIMPLE_HEAD)
+        t.add_column("joint", justify="right")
+        for metric in ("RMSE", "err %"):
+            for label in methods:
+                t.add_column(f"{metric} {label}", justify="right")
+        for j in range(cfg.joints):
+            t.add_row(str(j + 1), *(f"{m['rmse'][key][j]:.3f}" for m in methods.values()),
+                      *(f"{m['relative_error'][key][j]:.2f}" for m in methods.values()))
         console.print(t)
     tm = d["timings"]
-    console.print(f"timings: simulation + preprocessing {tm['simulation_and_preprocessing']:.2f} s, OLS {tm['ols']:.3f} s, "
-                  f"ABC {tm['abc']:.2f} s, total {tm['total']:.2f} s")
+    console.print(f"timings: simulation + preprocessing {tm['simulation_and_preprocessing']:.2f} s, ABC {tm['abc']:.2f} s, "
+                  f"LAD {tm['lad']:.2f} s, OLS {tm['ols']:.3f} s, total {tm['total']:.2f} s")
     for w in d["warnings"]:
         console.print(f"[yellow]warning:[/] {w}")
     console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")

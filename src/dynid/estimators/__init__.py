@@ -2,6 +2,7 @@
 
 from .base import Estimator, paper_objective
 from .bee_colony import BeeColonyEstimator
-from .least_squares import OrdinaryLeastSquares
+from .least_absolute import LeastAbsoluteDeviations
+from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
 
-__all__ = ["Estimator", "paper_objective", "BeeColonyEstimator", "OrdinaryLeastSquares"]
+__all__ = ["Estimator", "paper_objective", "BeeColonyEstimator", "LeastAbsoluteDeviations", "OrdinaryLeastSquares", "WeightedLeastSquares"]

@@ -52,3 +52,46 @@ class OrdinaryLeastSquares(Estimator):
         self.condition_number_ = float(sv[0] / sv[-1])
         self.residual_std_ = float(np.sqrt(sigma2))
         return self
+
+
+class WeightedLeastSquares(Estimator):
+    """WLS with one weight per joint: each joint's rows are divided by that joint's residual standard
+    deviation from a first OLS fit (Gautier & Poignet 2001, the paper's ref. [6]).
+
+    Parameters
+    ----------
+    n_dof : int
+        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``).
+
+    Learned attributes
+    ------------------
+    params_, covariance_, params_std_, relative_std_, condition_number_ (of the weighted W),
+    joint_std_ : (n_dof,) residual standard deviation of each joint [N·m].
+    """
+
+    def __init__(self, *, n_dof: int, rcond: float | None = None):
+        self.n_dof = n_dof
+        self.rcond = rcond
+
+    def fit(self, w, tau) -> "WeightedLeastSquares":
+        from ..exceptions import ShapeError
+
+        w, tau = check_observations(w, tau)
+        m, p = w.shape
+        if m % self.n_dof:
+            raise ShapeError(f"W has {m} rows, not a multiple of n_dof = {self.n_dof}")
+        ols = OrdinaryLeastSquares(rcond=self.rcond).fit(w, tau)
+        res = (tau - w @ ols.params_).reshape(-1, self.n_dof)
+        n_s = res.shape[0]
+        dof_per_joint = max(n_s - p / self.n_dof, 1.0)
+        std = np.sqrt((res**2).sum(axis=0) / dof_per_joint)
+        std = np.where(std > 0, std, 1.0)
+        scale = np.tile(1.0 / std, n_s)
+        weighted = OrdinaryLeastSquares(rcond=self.rcond).fit(w * scale[:, None], tau * scale)
+        self.params_ = weighted.params_
+        self.covariance_ = weighted.covariance_
+        self.params_std_ = weighted.params_std_
+        self.relative_std_ = weighted.relative_std_
+        self.condition_number_ = weighted.condition_number_
+        self.joint_std_ = std
+        return self

@@ -50,18 +50,19 @@ def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
     except OSError as exc:
         raise ConfigError(f"--out {out}: cannot create the folder ({exc.strerror})") from None
     ident, valid, lim = result.identification, result.validation, result.robot.limits
-    abc, ols = result.methods["abc"], result.methods["ols"]
+    abc, lad, ols = result.methods["abc"], result.methods["lad"], result.methods["ols"]
     paths = [out / name for name in FIGURES]
     _save(figures.plot_joint_trajectories(ident.t, ident.q, lim.q_min, lim.q_max,
                                           title="Fig. 4 — identification trajectory β1 (dashed: limits)"), paths[0])
     _save(figures.plot_tool_path(ident.tool, title="Fig. 5 — tool path of β1"), paths[1])
-    _save(figures.plot_convergence(abc.history, reference={"OLS F": ols.objective, f"paper F = {ref.OBJECTIVE}": ref.OBJECTIVE},
+    _save(figures.plot_convergence(abc.history, reference={"LAD F (exact minimum, same box)": lad.objective, "OLS F": ols.objective,
+                                                              f"paper F = {ref.OBJECTIVE}": ref.OBJECTIVE},
                                    title="Fig. 6 — ABC convergence (eq. 9)"), paths[2])
-    _save(figures.plot_torque_comparison(ident.t, ident.tau, {"ABC": abc.tau_identification, "OLS": ols.tau_identification},
+    _save(figures.plot_torque_comparison(ident.t, ident.tau, {"ABC": abc.tau_identification, "LAD": lad.tau_identification, "OLS": ols.tau_identification},
                                          title="Fig. 7 — identification trajectory: measured vs predicted"), paths[3])
     _save(figures.plot_joint_trajectories(valid.t, valid.q, lim.q_min, lim.q_max,
                                           title="Fig. 8 — validation trajectory β2 (dashed: limits)"), paths[4])
-    _save(figures.plot_torque_comparison(valid.t, valid.tau, {"ABC": abc.tau_validation, "OLS": ols.tau_validation},
+    _save(figures.plot_torque_comparison(valid.t, valid.tau, {"ABC": abc.tau_validation, "LAD": lad.tau_validation, "OLS": ols.tau_validation},
                                          title="Fig. 9 — validation trajectory: measured vs predicted"), paths[5])
     json_path = out / "results.json"
     write_json(json_path, result.to_dict())
