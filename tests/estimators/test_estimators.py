@@ -139,3 +139,10 @@ def test_wls_recovers_truth_and_weights_joints(problem):
     z = np.abs(wls.params_ - beta) / wls.params_std_
     assert np.all(z < 4.5)
     np.testing.assert_allclose(WeightedLeastSquares(n_dof=3).fit(w, w @ beta).params_, beta, rtol=1e-8, atol=1e-8)
+
+
+@pytest.mark.parametrize("kind", ["wls", "lad"])
+def test_rows_must_be_whole_samples(problem, kind):
+    w, beta = problem
+    with pytest.raises(ShapeError, match="multiple of n_dof"):
+        make(kind, beta).fit(w[:-1], (w @ beta)[:-1])

@@ -7,8 +7,11 @@ import numpy as np
 from ..exceptions import ShapeError
 
 
-def check_observations(w, tau) -> tuple[np.ndarray, np.ndarray]:
-    """Validate an observation matrix ``W`` (M, p) and torques ``tau`` (M,) or (N, n_dof) with N·n_dof = M."""
+def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Validate an observation matrix ``W`` (M, p) and torques ``tau`` (M,) or (N, n_dof) with N·n_dof = M.
+
+    With ``n_dof``, also check that ``M`` is a whole number of samples.
+    """
     w = np.asarray(w, dtype=np.float64)
     tau = np.asarray(tau, dtype=np.float64).reshape(-1)
     if w.ndim != 2:
@@ -17,6 +20,8 @@ def check_observations(w, tau) -> tuple[np.ndarray, np.ndarray]:
         raise ShapeError(f"W has {w.shape[0]} rows but tau has {tau.shape[0]} values")
     if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
         raise ShapeError("W or tau holds NaN or infinite values")
+    if n_dof is not None and w.shape[0] % n_dof:
+        raise ShapeError(f"W has {w.shape[0]} rows, not a multiple of n_dof = {n_dof}")
     return w, tau
 
 

@@ -42,10 +42,8 @@ class LeastAbsoluteDeviations(Estimator):
         self.bounds = bounds
 
     def fit(self, w, tau) -> "LeastAbsoluteDeviations":
-        w, tau = check_observations(w, tau)
+        w, tau = check_observations(w, tau, self.n_dof)
         m, p = w.shape
-        if m % self.n_dof:
-            raise ShapeError(f"W has {m} rows, not a multiple of n_dof = {self.n_dof}")
         delta = np.ones(self.n_dof) if self.weights is None else np.asarray(self.weights, dtype=float)
         row_w = np.tile(delta, m // self.n_dof) / (m // self.n_dof)
         if self.bounds is None:

@@ -74,12 +74,8 @@ class WeightedLeastSquares(Estimator):
         self.rcond = rcond
 
     def fit(self, w, tau) -> "WeightedLeastSquares":
-        from ..exceptions import ShapeError
-
-        w, tau = check_observations(w, tau)
+        w, tau = check_observations(w, tau, self.n_dof)
         m, p = w.shape
-        if m % self.n_dof:
-            raise ShapeError(f"W has {m} rows, not a multiple of n_dof = {self.n_dof}")
         ols = OrdinaryLeastSquares(rcond=self.rcond).fit(w, tau)
         res = (tau - w @ ols.params_).reshape(-1, self.n_dof)
         n_s = res.shape[0]
