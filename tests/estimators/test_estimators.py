@@ -44,6 +44,7 @@ def test_shared_contract(problem, kind):
     assert est.params_.shape == beta.shape
     assert est.predict(w).shape == (w.shape[0],)
     assert est.score(w, w @ beta) <= 1.0
+    assert est.score(w, est.predict(w)) == pytest.approx(1.0)  # R² of a perfect prediction
     with pytest.raises(ShapeError):
         est.fit(w, (w @ beta)[:-1])
 

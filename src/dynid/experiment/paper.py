@@ -198,11 +198,24 @@ def _trajectory(rows: np.ndarray, joints: int, omega_f: float) -> FourierTraject
     return FourierTrajectory.from_rows(rows[[j % 3 for j in range(joints)]], omega_f)
 
 
-def _dataset(robot, base, traj, t, noise, rng, phi_true, passes) -> Dataset:
+def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
+    """Which limits the commanded motion (and the torques it needs) exceeds."""
+    lim = robot.limits
+    out = []
+    if np.any(q < lim.q_min) or np.any(q > lim.q_max) or np.any(np.abs(dq) > lim.dq_max) or np.any(np.abs(ddq) > lim.ddq_max):
+        out.append(f"the {label} trajectory leaves the joint limits of {robot.name}")
+    over = np.flatnonzero(np.abs(tau).max(axis=0) > lim.tau_max)
+    if over.size:
+        out.append(f"the {label} trajectory needs more than tau_max on joint(s) {', '.join(str(j + 1) for j in over)}")
+    return out
+
+
+def _dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings) -> Dataset:
     q, dq, ddq = traj.evaluate(t)
     n = robot.n_dof
     phi = phi_true.reshape(n, robot.n_params_per_joint)
     meas = simulate_measurements(robot, t, q, dq, ddq, noise, rng, inertial=phi[:, :10], drive=phi[:, 10:])
+    warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
     tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
     q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
     w_base = base.base_observation(observation_matrix(robot, q_f, dq_f, ddq_f))
@@ -256,18 +269,9 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
     traj_id = _trajectory(BETA1_ROWS, k, config.omega_f)
     traj_val = _trajectory(BETA2_ROWS, k, config.omega_f)
-    for label, traj in (("identification (β1)", traj_id), ("validation (β2)", traj_val)):
-        q, dq, ddq = traj.evaluate(t)
-        lim = robot.limits
-        if np.any(q < lim.q_min) or np.any(q > lim.q_max) or np.any(np.abs(dq) > lim.dq_max) or np.any(np.abs(ddq) > lim.ddq_max):
-            warnings.append(f"the {label} trajectory leaves the joint limits of {robot.name}")
     t_sim = time.perf_counter()
-    ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes)
-    valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes)
-    for label, ds in (("identification (β1)", ident), ("validation (β2)", valid)):
-        over = np.flatnonzero(np.abs(ds.tau_true).max(axis=0) > robot.limits.tau_max)
-        if over.size:
-            warnings.append(f"the {label} trajectory needs more than tau_max on joint(s) {', '.join(str(j + 1) for j in over)}")
+    ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings)
+    valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
@@ -275,10 +279,10 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     ols = OrdinaryLeastSquares().fit(ident.w_base, y)
     ols_seconds = time.perf_counter() - t1
 
-    use_table3 = config.abc_bounds == "table3" or (
-        config.abc_bounds == "auto" and all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names) and robot.name == "er16" and k == 3)
-    if config.abc_bounds == "table3" and not all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names):
+    has_table3 = all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names)
+    if config.abc_bounds == "table3" and not has_table3:
         raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")
+    use_table3 = config.abc_bounds == "table3" or (config.abc_bounds == "auto" and has_table3 and robot.name == "er16" and k == 3)
     if use_table3:
         bounds = np.array([ref.TABLE3[ref.paper_symbol(n)] for n in base.names], dtype=float)
     else:
@@ -305,7 +309,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
                                 ("ols", ols, ols_seconds, 1)):
         p_id = (ident.w_base @ est.params_).reshape(-1, k)
         p_val = (valid.w_base @ est.params_).reshape(-1, k)
-        obj = float(paper_objective(y - ident.w_base @ est.params_, k, config.weights))
+        obj = float(paper_objective(y - p_id.ravel(), k, config.weights))
         metrics = {}
         for name, tau, pred in (("identification", ident.tau, p_id), ("validation", valid.tau, p_val)):
             for mk, mv in _metrics(tau, pred).items():

@@ -63,14 +63,6 @@ def inertial_from_physical(mass: float, com: np.ndarray, inertia_com: np.ndarray
     return np.concatenate([inertia_vector(inertia_origin), mass * com, [mass]])
 
 
-def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Inverse of :func:`inertial_from_physical`: (mass, com, inertia about the com)."""
-    mass = float(phi[9])
-    com = phi[6:9] / mass if mass != 0 else np.zeros(3)
-    s = skew(com)
-    return mass, com, inertia_matrix(phi[:6]) - mass * (s.T @ s)
-
-
 def transform_inertial(phi: np.ndarray, rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
     """Express a body's ten inertial parameters in another frame A.
 
