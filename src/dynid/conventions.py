@@ -17,6 +17,10 @@ INERTIAL_TERMS: tuple[str, ...] = ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY
 DRIVE_TERMS: tuple[str, ...] = ("Ia", "fc", "fv", "offset")
 """Per-joint drive terms: rotor inertia, Coulomb friction, viscous friction, torque offset (eq. 3)."""
 
+COUPLING_TERMS: tuple[str, ...] = ("Iam", "fvm", "fcm")
+"""Parameters of a motor that turns with several joints (coupled wrist): inertia, viscous and Coulomb
+friction, in joint units (see :mod:`dynid.model.transmission`). Named after the motor: ``Iam6``."""
+
 DEFAULT_DRIVE_TERMS: tuple[str, ...] = ("fc", "fv")
 """The paper's friction model (eq. 3): Coulomb and viscous friction."""
 
@@ -24,7 +28,15 @@ UNITS: dict[str, str] = {
     "XX": "kg·m²", "XY": "kg·m²", "XZ": "kg·m²", "YY": "kg·m²", "YZ": "kg·m²", "ZZ": "kg·m²",
     "MX": "kg·m", "MY": "kg·m", "MZ": "kg·m", "M": "kg",
     "Ia": "kg·m²", "fc": "N·m", "fv": "N·m·s/rad", "offset": "N·m",
+    "Iam": "kg·m²", "fvm": "N·m·s/rad", "fcm": "N·m",
 }
+
+ALIASES: dict[str, str] = {
+    "Ixx": "XX", "Ixy": "XY", "Ixz": "XZ", "Iyy": "YY", "Iyz": "YZ", "Izz": "ZZ",
+    "mx": "MX", "my": "MY", "mz": "MZ", "m": "M", "fs": "fc", "f0": "offset", "off": "offset",
+    "Fc": "fc", "Fv": "fv", "fsm": "fcm",
+}
+"""Other spellings of the terms found in published parameter sets (FIGAROH, MATLAB toolboxes)."""
 
 
 def parameter_name(term: str, joint: int) -> str:
@@ -39,6 +51,31 @@ def split_name(name: str) -> tuple[str, int]:
     while i > 0 and stem[i - 1].isdigit():
         i -= 1
     return stem[:i], int(stem[i:]) - 1
+
+
+def canonical_name(name: str) -> str:
+    """dynid's name of a parameter written in another common spelling: ``"Ixx2" -> "XX2"``,
+    ``"m3" -> "M3"``, ``"fs1" -> "fc1"``, ``"off4"``/``"f04" -> "offset4"``; dynid names pass unchanged.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a term followed by a 1-based joint number.
+    """
+    text = name.strip()
+    i = len(text)
+    while i > 0 and text[i - 1].isdigit():
+        i -= 1
+    if i == len(text) or i == 0:
+        raise ValueError(f"expected a parameter name like 'XX1' or 'Ixx1', got {name!r}")
+    term, joint = text[:i], text[i:]
+    if term == "f" and joint.startswith("0"):
+        return f"offset{int(joint[1:])}"
+    term = ALIASES.get(term, term)
+    known = set(INERTIAL_TERMS) | set(DRIVE_TERMS) | set(COUPLING_TERMS)
+    if term not in known:
+        raise ValueError(f"unknown parameter term {text[:i]!r} in {name!r}")
+    return f"{term}{int(joint)}"
 
 
 def unit_of(name: str) -> str:

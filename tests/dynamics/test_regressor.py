@@ -31,7 +31,7 @@ def test_random_parameters_and_all_drive_terms(rng):
     robot = load_robot("er16")
     from dataclasses import replace
 
-    robot = replace(robot, drive_terms=("Ia", "fc", "fv", "offset"), drive=rng.uniform(0.1, 3, (6, 4)))
+    robot = replace(robot, drive_terms=("Ia", "fc", "fv", "offset"), drive=rng.uniform(0.1, 3, (6, 4)), drive_mask=None)
     phi = rng.normal(size=robot.n_params)
     phi[9::robot.n_params_per_joint] = rng.uniform(1.0, 5.0, robot.n_dof)  # masses away from 0 for Pinocchio's lever = h/m
     robot = robot.with_parameters(phi)

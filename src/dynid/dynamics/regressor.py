@@ -63,14 +63,25 @@ def _fill(robot: Robot, q, dq, ddq, out) -> None:
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     codes = np.array([DRIVE_TERMS.index(t) for t in robot.drive_terms], dtype=np.int64)
-    joint_torque_regressor(rp, pp, axes, gravity, codes, q, dq, ddq, out, robot.n_params_per_joint)
+    npj = robot.n_params_per_joint
+    joint_torque_regressor(rp, pp, axes, gravity, codes, q, dq, ddq, out, npj)
+    for i, t in zip(*np.nonzero(~robot.drive_mask)):  # terms a joint does not have
+        out[:, i, i * npj + 10 + t] = 0.0
+    n_joint = robot.n_dof * npj
+    if out.shape[2] > n_joint:  # coupled motors (see dynid.model.transmission)
+        out[:, :, n_joint:] = robot.transmission.coupling_columns(dq, ddq)
 
 
-def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None) -> np.ndarray:
-    """Torques of the drive terms alone (rotor inertia, eq. 3 friction, offset), (N, n_dof) [N·m]."""
+def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None,
+                     coupled: np.ndarray | None = None) -> np.ndarray:
+    """Torques of the drive terms alone (rotor inertia, eq. 3 friction, offset, coupled motors),
+    (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values."""
     drive = robot.drive if drive is None else drive
+    coupled = robot.transmission.coupled_values if coupled is None else coupled
     columns = {"Ia": ddq, "fc": np.sign(dq), "fv": dq, "offset": np.ones_like(dq)}
     tau = np.zeros_like(dq)
     for k, term in enumerate(robot.drive_terms):
-        tau += drive[:, k] * columns[term]
+        tau += (drive[:, k] * robot.drive_mask[:, k]) * columns[term]
+    if robot.transmission.n_coupled_params:
+        tau += robot.transmission.coupling_columns(dq, ddq) @ np.ravel(coupled)
     return tau

@@ -12,6 +12,11 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     [tool]                         # flange in the last link frame (optional)
     translation = [0.0, 0.0, 0.1]
 
+    [transmission]                 # optional; default: joint-side data, no coupling
+    gear_ratios = [32, 32, 45, -48, 45, 32]          # motor angle = ratio · joint angle
+    coupling = [{motor = 6, joint = 5, ratio = 32}]  # motor 6 also turns with joint 5 (coupled wrist)
+    coupled_terms = ["Iam", "fvm", "fcm"]            # identified per coupled motor
+
     [[joints]]                     # one table per joint, base to tip
     name = "joint1"
     alpha = "pi"                   # DH: alpha (alpha_{i-1} for modified), a, d, theta_offset
@@ -23,7 +28,9 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     dq_max = 3.0                   # rad/s
     ddq_max = 15.0                 # rad/s²
     tau_max = 800.0                # N·m
-    drive_gain = 20.0              # N·m/A, eq. 16
+    drive_gain = 20.0              # N·m/A, eq. 16: joint torque per measured current
+    drive_terms = ["fv"]           # optional: this joint has only these of the robot's drive terms
+    position_offset = "-pi/2"      # optional: added to measured angles to get the model's angles
     mass = 60.0                    # kg (DH conventions; a URDF brings its own)
     com = [0.0, 0.0, -0.1]         # m, link frame (standard DH: DH frame i)
     inertia = [2.0, 2.0, 1.5, 0.0, 0.0, 0.0]   # about the COM: Ixx, Iyy, Izz, Ixy, Ixz, Iyz
@@ -40,10 +47,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import DEFAULT_DRIVE_TERMS, DRIVE_TERMS
+from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS, DRIVE_TERMS
 from ..exceptions import ConfigError
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot
+from .transmission import Transmission
 from .spatial import inertial_from_physical, transform_inertial
 
 _ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
@@ -170,7 +178,16 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
                 phi = transform_inertial(phi, rr, pp)
             inertial[i] = phi
 
-    drive = np.array([[_number(r, t, w, 0.0) for t in terms] for r, w in zip(rows, where)]).reshape(n, len(terms))
+    mask = np.ones((n, len(terms)), dtype=bool)
+    for i, (r, w) in enumerate(zip(rows, where)):
+        if "drive_terms" in r:
+            own = r["drive_terms"]
+            if not isinstance(own, list) or any(t not in terms for t in own):
+                raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, got {own!r}")
+            mask[i] = [t in own for t in terms]
+    drive = np.array([[_number(r, t, w, 0.0) for t in terms] for r, w in zip(rows, where)]).reshape(n, len(terms)) * mask
+    offsets = np.array([_angle(r.get("position_offset", 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
+    transmission = _transmission(doc.get("transmission", {}), n, offsets, source)
     gains = np.array([_number(r, "drive_gain", w, 1.0) for r, w in zip(rows, where)])
     if np.any(gains <= 0):
         i = int(np.argmax(gains <= 0))
@@ -188,8 +205,33 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
-        notes=str(doc.get("notes", "")),
+        notes=str(doc.get("notes", "")), transmission=transmission, drive_mask=mask,
     )
+
+
+def _transmission(table, n: int, offsets: np.ndarray, source: str) -> Transmission:
+    where = f"{source}: transmission"
+    if not isinstance(table, dict):
+        raise ConfigError(f"{where}: expected a table")
+    ratios = _vector(table, "gear_ratios", n, where, default=np.ones(n))
+    if np.any(ratios == 0):
+        raise ConfigError(f"{where}.gear_ratios: expected non-zero ratios, got {ratios.tolist()}")
+    r = np.diag(ratios)
+    coupling = table.get("coupling", [])
+    if not isinstance(coupling, list):
+        raise ConfigError(f"{where}.coupling: expected a list of {{motor, joint, ratio}} tables")
+    for c, entry in enumerate(coupling):
+        w = f"{where}.coupling[{c}]"
+        if not isinstance(entry, dict):
+            raise ConfigError(f"{w}: expected a table {{motor = 6, joint = 5, ratio = 32}}")
+        motor, joint = (int(_number(entry, key, w)) for key in ("motor", "joint"))
+        if not (1 <= motor <= n and 1 <= joint <= n) or motor == joint:
+            raise ConfigError(f"{w}: expected two different joint numbers in 1..{n}, got motor {motor}, joint {joint}")
+        r[motor - 1, joint - 1] = _number(entry, "ratio", w)
+    terms = table.get("coupled_terms", list(COUPLING_TERMS) if coupling else [])
+    if not isinstance(terms, list) or any(t not in COUPLING_TERMS for t in terms):
+        raise ConfigError(f"{where}.coupled_terms: expected a subset of {list(COUPLING_TERMS)}, got {terms!r}")
+    return Transmission(r, offsets, tuple(t for t in COUPLING_TERMS if t in terms))
 
 
 def _check_physical(mass: float, inertia: np.ndarray, where: str) -> None:

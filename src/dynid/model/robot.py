@@ -15,6 +15,7 @@ import numpy as np
 from ..conventions import DEFAULT_DRIVE_TERMS, DRIVE_TERMS, INERTIAL_TERMS, parameter_name
 from ..exceptions import ConfigError
 from .spatial import transform_inertial
+from .transmission import Transmission
 
 
 @dataclass(frozen=True)
@@ -77,6 +78,12 @@ class Robot:
         Tool (flange) frame in the last link frame.
     notes : str
         Provenance of the numbers (e.g. which values are assumed).
+    transmission : Transmission
+        Gear ratios, coupling and encoder zeros (default: identity, no coupling). Coupled motors add
+        parameters after the joint blocks (``Iam6``, ``fvm6``, ``fcm6``).
+    drive_mask : (n_dof, len(drive_terms)) bool array
+        Which drive terms each joint has (default all); a joint without a term has a zero column,
+        so the term drops out of the base parameters.
     """
 
     name: str
@@ -90,9 +97,19 @@ class Robot:
     tool_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     tool_translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
     notes: str = ""
+    transmission: Transmission | None = None
+    drive_mask: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joints)
+        if self.transmission is None:
+            object.__setattr__(self, "transmission", Transmission.identity(n))
+        if self.transmission.n_dof != n:
+            raise ConfigError(f"robot {self.name!r}: transmission is for {self.transmission.n_dof} joints, the chain has {n}")
+        mask = np.ones((n, len(self.drive_terms)), dtype=bool) if self.drive_mask is None else np.asarray(self.drive_mask, dtype=bool)
+        if mask.shape != (n, len(self.drive_terms)):
+            raise ConfigError(f"robot {self.name!r}: expected a drive mask of shape ({n}, {len(self.drive_terms)}), got {mask.shape}")
+        object.__setattr__(self, "drive_mask", mask)
         if n == 0:
             raise ConfigError(f"robot {self.name!r}: expected at least one joint, got none")
         if self.inertial.shape != (n, 10):
@@ -102,7 +119,9 @@ class Robot:
             raise ConfigError(f"robot {self.name!r}: unknown drive term(s) {unknown}, expected a subset of {list(DRIVE_TERMS)}")
         if self.drive.shape != (n, len(self.drive_terms)):
             raise ConfigError(f"robot {self.name!r}: expected drive parameters of shape ({n}, {len(self.drive_terms)}), got {self.drive.shape}")
-        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation):
+        if np.any(self.drive[~mask] != 0):
+            raise ConfigError(f"robot {self.name!r}: a drive term a joint does not have must have the value 0")
+        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask):
             a.setflags(write=False)
 
     @property
@@ -115,23 +134,31 @@ class Robot:
 
     @property
     def n_params(self) -> int:
-        """Number of standard parameters (``n_dof * (10 + len(drive_terms))``)."""
-        return self.n_dof * self.n_params_per_joint
+        """Number of standard parameters: ``n_dof * (10 + len(drive_terms))`` plus the coupling ones."""
+        return self.n_dof * self.n_params_per_joint + self.transmission.n_coupled_params
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
-        """Names of the standard parameters, joint by joint (eq. 5 order, then drive terms)."""
+        """Names of the standard parameters, joint by joint (eq. 5 order, then drive terms), then the
+        coupled motors' parameters."""
         terms = INERTIAL_TERMS + self.drive_terms
-        return tuple(parameter_name(t, j) for j in range(self.n_dof) for t in terms)
+        joint = tuple(parameter_name(t, j) for j in range(self.n_dof) for t in terms)
+        return joint + self.transmission.coupled_parameter_names
 
     def standard_parameters(self) -> np.ndarray:
         """Nominal standard parameter vector (n_params,), in :attr:`parameter_names` order."""
-        return np.concatenate([self.inertial, self.drive], axis=1).ravel()
+        blocks = np.concatenate([self.inertial, self.drive], axis=1).ravel()
+        return np.concatenate([blocks, self.transmission.coupled_values.ravel()])
 
     def with_parameters(self, phi: np.ndarray) -> "Robot":
         """A copy of this robot whose nominal parameters are ``phi`` (n_params,)."""
-        phi = np.asarray(phi, dtype=float).reshape(self.n_dof, self.n_params_per_joint)
-        return replace(self, inertial=phi[:, :10].copy(), drive=phi[:, 10:].copy())
+        phi = np.asarray(phi, dtype=float)
+        n_joint = self.n_dof * self.n_params_per_joint
+        blocks = phi[:n_joint].reshape(self.n_dof, self.n_params_per_joint)
+        tr = self.transmission
+        coupled = phi[n_joint:].reshape(tr.coupled_values.shape)
+        return replace(self, inertial=blocks[:, :10].copy(), drive=blocks[:, 10:] * self.drive_mask,
+                       transmission=replace(tr, coupled_values=coupled.copy()))
 
     def link_transform(self, j: int, qj: float) -> tuple[np.ndarray, np.ndarray]:
         """Pose (R, p) of link ``j``'s frame in link ``j-1``'s frame at joint angle ``qj``."""
@@ -179,6 +206,8 @@ class Robot:
             tool_rotation=tool_r,
             tool_translation=tool_t,
             notes=self.notes,
+            transmission=self.transmission.subset(k),
+            drive_mask=self.drive_mask[:k].copy(),
         )
 
 
