@@ -1,0 +1,131 @@
+"""Least squares accumulated chunk by chunk (incremental QR), so memory does not grow with the data.
+
+For each joint ``j`` the rows of ``[W | tau]`` that belong to it are folded into an upper-triangular
+factor ``R_j`` of size (p+1, p+1): ``R_j ← qr([R_j; W_j | tau_j])``. Since ``Q`` is orthogonal, every
+least-squares quantity follows from the factors alone: stacking ``R_j / sigma_j`` and one more QR
+gives the OLS (all ``sigma_j = 1``) or WLS solution, its residual sum of squares (the last diagonal
+entry squared), its covariance, and each joint's residual ``||R_j [theta; -1]||``.
+Ref.: Golub & Van Loan, "Matrix Computations", §6.5 (updating QR); Gautier & Poignet 2001 (WLS).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..exceptions import IdentifiabilityError, ShapeError
+
+
+@dataclass(frozen=True)
+class LeastSquaresSolution:
+    """Solution of an accumulated (weighted) least-squares problem.
+
+    Attributes
+    ----------
+    params : (p,) array
+    covariance : (p, p) array
+        ``sigma² (WᵀW)⁻¹`` of the (weighted) problem, ``sigma² = ||r||² / (M - p)``.
+    params_std : (p,) array
+    relative_std : (p,) array [%]
+    condition_number : float
+        cond of the (weighted) observation matrix.
+    residual_std : float
+        ``sigma`` of the (weighted) residual.
+    n_rows : int
+    """
+
+    params: np.ndarray
+    covariance: np.ndarray
+    params_std: np.ndarray
+    relative_std: np.ndarray
+    condition_number: float
+    residual_std: float
+    n_rows: int
+
+
+class LeastSquaresAccumulator:
+    """Incremental QR of ``[W | tau]``, one triangular factor per joint.
+
+    Parameters
+    ----------
+    n_params : int
+    n_dof : int
+        Rows of ``W`` come in groups of ``n_dof`` (row ``k·n_dof + j`` is sample ``k``, joint ``j``).
+    """
+
+    def __init__(self, n_params: int, n_dof: int = 1):
+        self.n_params = int(n_params)
+        self.n_dof = int(n_dof)
+        self.factors = np.zeros((self.n_dof, self.n_params + 1, self.n_params + 1))
+        self.rows = np.zeros(self.n_dof, dtype=np.int64)
+        self.tau_sumsq = np.zeros(self.n_dof)
+
+    def add(self, w, tau, mask=None) -> None:
+        """Fold in a chunk: ``w`` (M, p), ``tau`` (M,), optional ``mask`` (M,) of rows to keep.
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, rows not a whole number of samples, or non-finite values.
+        """
+        w = np.asarray(w, dtype=float)
+        tau = np.asarray(tau, dtype=float).reshape(-1)
+        if w.ndim != 2 or w.shape[1] != self.n_params or w.shape[0] != tau.shape[0] or w.shape[0] % self.n_dof:
+            raise ShapeError(f"expected W (M, {self.n_params}) and tau (M,) with M a multiple of {self.n_dof}, got {w.shape} and {tau.shape}")
+        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
+            raise ShapeError("W or tau holds NaN or infinite values")
+        keep = np.ones(tau.shape[0], dtype=bool) if mask is None else np.asarray(mask, dtype=bool).reshape(-1)
+        for j in range(self.n_dof):
+            sel = keep[j::self.n_dof]
+            if not sel.any():
+                continue
+            block = np.column_stack([w[j::self.n_dof][sel], tau[j::self.n_dof][sel]])
+            self.factors[j] = _triangular(np.vstack([self.factors[j], block]), self.n_params + 1)
+            self.rows[j] += int(sel.sum())
+            self.tau_sumsq[j] += float(block[:, -1] @ block[:, -1])
+
+    def joint_residual_sumsq(self, params: np.ndarray) -> np.ndarray:
+        """``||tau_j - W_j params||²`` of each joint (n_dof,)."""
+        x = np.append(np.asarray(params, dtype=float), -1.0)
+        return np.array([float(np.sum((f @ x) ** 2)) for f in self.factors])
+
+    def joint_residual_std(self, params: np.ndarray) -> np.ndarray:
+        """Residual standard deviation of each joint, ``sqrt(||r_j||² / (M_j - p/n_dof))`` (n_dof,)."""
+        dof = np.maximum(self.rows - self.n_params / self.n_dof, 1.0)
+        return np.sqrt(self.joint_residual_sumsq(params) / dof)
+
+    def solve(self, joint_weights=None, rcond: float | None = None) -> LeastSquaresSolution:
+        """OLS (default) or WLS with one weight per joint (rows of joint ``j`` multiplied by ``joint_weights[j]``).
+
+        Raises
+        ------
+        IdentifiabilityError
+            Fewer rows than parameters, or a rank-deficient observation matrix.
+        """
+        p = self.n_params
+        m = int(self.rows.sum())
+        if m <= p:
+            raise IdentifiabilityError(f"least squares needs more equations than parameters, got {m} rows for {p} parameters")
+        wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
+        r_all = _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), p + 1)
+        r, rhs, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
+        sv = np.linalg.svd(r, compute_uv=False)
+        tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps
+        if sv[-1] <= tol * sv[0]:
+            raise IdentifiabilityError(f"observation matrix is rank-deficient (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): use base parameters or a richer excitation")
+        params = np.linalg.solve(r, rhs)
+        sigma2 = rho**2 / (m - p)
+        rinv = np.linalg.inv(r)
+        cov = sigma2 * (rinv @ rinv.T)
+        std = np.sqrt(np.diag(cov))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = 100.0 * std / np.abs(params)
+        return LeastSquaresSolution(params, cov, std, rel, float(sv[0] / sv[-1]), float(np.sqrt(sigma2)), m)
+
+
+def _triangular(a: np.ndarray, size: int) -> np.ndarray:
+    r = np.linalg.qr(a, mode="r")
+    out = np.zeros((size, size))
+    out[: r.shape[0]] = r[:size]
+    return out

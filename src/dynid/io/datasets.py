@@ -1,0 +1,280 @@
+"""Measured datasets: which columns of which CSV files hold time, positions, velocities, currents or
+torques, on which side of the transmission and in which units — and their conversion to SI joint
+quantities on a uniform time grid.
+
+A dataset is described by a table of the experiment config (TOML)::
+
+    preset = "ur-rtde"               # optional: fills in the fields below (see PRESETS)
+    file = "log.csv"                 # default file of every signal, relative to the data root
+    header = false                   # first line holds column names
+    rows = [635, 3510]               # 1-based inclusive data rows (header excluded)
+    time = { column = 1 }            # time stamps [s] …
+    rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
+    resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
+    side = "joint"                   # "joint" or "motor" (motor-side values go through the transmission)
+    positions = { columns = [2, 3, 4, 5, 6, 7], unit = "rad" }         # or "deg"
+    velocities = { columns = [8, 9, 10, 11, 12, 13], unit = "rad/s" }  # optional
+    currents = { columns = [14, 15, 16, 17, 18, 19] }  # A; torque = drive gain · current (eq. 16)
+    torques = { file = "tau.csv", columns = ["Joint_1", …] }           # N·m, instead of currents
+
+Columns are 1-based numbers or header names. Drive gains multiply currents on the side where they
+are measured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import ConfigError, DataError
+from ..model.robot import Robot
+from .tables import read_table
+
+PRESETS: dict[str, dict] = {
+    "ur-rtde": {
+        "header": False, "n_columns": 31, "time": {"column": 1}, "side": "joint",
+        "positions": {"columns": [2, 3, 4, 5, 6, 7]}, "velocities": {"columns": [8, 9, 10, 11, 12, 13]},
+        "currents": {"columns": [14, 15, 16, 17, 18, 19]},
+    },
+    "ur-rtde-19": {
+        "header": False, "n_columns": 19, "time": {"column": 1}, "side": "joint",
+        "positions": {"columns": [2, 3, 4, 5, 6, 7]}, "velocities": {"columns": [8, 9, 10, 11, 12, 13]},
+        "currents": {"columns": [14, 15, 16, 17, 18, 19]},
+    },
+    "motor-side": {
+        "header": True, "side": "motor",
+        "positions": {"columns": ["Joint_1", "Joint_2", "Joint_3", "Joint_4", "Joint_5", "Joint_6"]},
+        "torques": {"columns": ["Joint_1", "Joint_2", "Joint_3", "Joint_4", "Joint_5", "Joint_6"]},
+    },
+}
+"""Column maps of common logs: Universal Robots RTDE logs (31 columns: t, q, qd, i, i_target,
+tau_target; or the 19-column variant), and motor-side logs with one file per signal and a header
+``Joint_1..Joint_6`` but no time column (e.g. the Stäubli TX40 recordings of FIGAROH; give ``rate``)."""
+
+_UNITS = {
+    "positions": {"rad": 1.0, "deg": np.pi / 180},
+    "velocities": {"rad/s": 1.0, "deg/s": np.pi / 180},
+    "currents": {"A": 1.0, "mA": 1e-3},
+    "torques": {"N*m": 1.0, "N·m": 1.0, "Nm": 1.0},
+}
+_SIGNALS = tuple(_UNITS)
+
+
+@dataclass(frozen=True)
+class SignalSpec:
+    file: Path
+    columns: tuple
+    scale: float
+
+
+@dataclass(frozen=True)
+class DatasetSpec:
+    """Where a dataset's signals are and how to read them (see the module docstring)."""
+
+    name: str
+    signals: dict
+    time: SignalSpec | None = None
+    rate: float | None = None
+    resample: float | None = None
+    side: str = "joint"
+    header: bool = False
+    n_columns: int | None = None
+    rows: tuple[int, int] | None = None
+    delimiter: str = ","
+
+
+@dataclass(frozen=True)
+class Recording:
+    """A measured dataset in SI joint quantities on a uniform time grid.
+
+    Attributes
+    ----------
+    name : str
+    t : (N,) array [s], uniform
+    q : (N, n_dof) [rad], model joint angles (transmission and encoder zeros applied)
+    dq : (N, n_dof) [rad/s] or None when not measured
+    tau : (N, n_dof) [N·m], joint torques (from currents through the drive gains, eq. 16)
+    rate : float [Hz]
+    warnings : tuple of str
+    """
+
+    name: str
+    t: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray | None
+    tau: np.ndarray
+    rate: float
+    warnings: tuple[str, ...] = field(default=())
+
+    @property
+    def n_samples(self) -> int:
+        return self.t.shape[0]
+
+    def between(self, start: float, stop: float) -> "Recording":
+        """The samples with ``start <= t - t[0] < stop`` [s]."""
+        rel = self.t - self.t[0]
+        keep = (rel >= start) & (rel < stop)
+        if keep.sum() < 2:
+            raise DataError(f"{self.name}: no samples between {start} s and {stop} s (the recording lasts {rel[-1]:.3f} s)")
+        return Recording(self.name, self.t[keep], self.q[keep], None if self.dq is None else self.dq[keep],
+                         self.tau[keep], self.rate, self.warnings)
+
+
+def _rows(value, where: str):
+    if value is None:
+        return None
+    if (not isinstance(value, list) or len(value) != 2 or not all(isinstance(v, int) and not isinstance(v, bool) for v in value)
+            or value[0] < 1 or value[1] < value[0]):
+        raise ConfigError(f"{where}.rows: expected [first, last] 1-based data rows with first <= last, got {value!r}")
+    return (value[0], value[1])
+
+
+def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
+    """Parse a dataset table of a config (module docstring); paths are relative to ``base``.
+
+    Raises
+    ------
+    ConfigError
+        Unknown preset, unit or side, a missing signal or file, a column list of the wrong length;
+        the message names the config field.
+    """
+    if not isinstance(table, dict):
+        raise ConfigError(f"{where}: expected a table describing the dataset")
+    merged: dict = {}
+    preset = table.get("preset")
+    if preset is not None:
+        if preset not in PRESETS:
+            raise ConfigError(f"{where}.preset: unknown preset {preset!r}, expected one of {', '.join(PRESETS)}")
+        merged.update({k: (dict(v) if isinstance(v, dict) else v) for k, v in PRESETS[preset].items()})
+    for k, v in table.items():
+        if isinstance(v, dict) and isinstance(merged.get(k), dict):
+            merged[k] = {**merged[k], **v}
+        else:
+            merged[k] = v
+    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "delimiter", "name", *_SIGNALS}
+    unknown = sorted(set(merged) - known)
+    if unknown:
+        raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(known)}")
+    default_file = merged.get("file")
+
+    def path_of(sig: dict, w: str) -> Path:
+        f = sig.get("file", default_file)
+        if not isinstance(f, str) or not f:
+            raise ConfigError(f"{w}: expected a 'file' (here or for the whole dataset)")
+        p = Path(f)
+        return p if p.is_absolute() else base / p
+
+    signals = {}
+    for kind in _SIGNALS:
+        if kind not in merged:
+            continue
+        sig = merged[kind]
+        w = f"{where}.{kind}"
+        if not isinstance(sig, dict) or "columns" not in sig:
+            raise ConfigError(f"{w}: expected a table with 'columns' (1-based numbers or header names)")
+        cols = sig["columns"]
+        if not isinstance(cols, list) or len(cols) != n_dof:
+            raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {cols!r}")
+        units = _UNITS[kind]
+        unit = sig.get("unit", next(iter(units)))
+        if unit not in units:
+            raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
+        signals[kind] = SignalSpec(path_of(sig, w), tuple(cols), units[unit])
+    if "positions" not in signals:
+        raise ConfigError(f"{where}: expected 'positions' (columns of the joint or motor angles)")
+    if ("currents" in signals) == ("torques" in signals):
+        raise ConfigError(f"{where}: expected exactly one of 'currents' (with drive gains) or 'torques'")
+    time = None
+    if "time" in merged:
+        tm = merged["time"]
+        if not isinstance(tm, dict) or "column" not in tm:
+            raise ConfigError(f"{where}.time: expected a table {{ column = 1 }}")
+        time = SignalSpec(path_of(tm, f"{where}.time"), (tm["column"],), 1.0)
+    rate = merged.get("rate")
+    if (time is None) == (rate is None):
+        raise ConfigError(f"{where}: expected either a 'time' column or a sampling 'rate' [Hz]")
+    for key in ("rate", "resample"):
+        v = merged.get(key)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0):
+            raise ConfigError(f"{where}.{key}: expected a positive number [Hz], got {v!r}")
+    side = merged.get("side", "joint")
+    if side not in ("joint", "motor"):
+        raise ConfigError(f"{where}.side: expected 'joint' or 'motor', got {side!r}")
+    return DatasetSpec(
+        name=str(merged.get("name", name)), signals=signals, time=time,
+        rate=None if rate is None else float(rate), resample=None if merged.get("resample") is None else float(merged["resample"]),
+        side=side, header=bool(merged.get("header", False)), n_columns=merged.get("n_columns"),
+        rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")))
+
+
+def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
+    """Read a dataset and convert it to SI joint quantities on a uniform time grid.
+
+    Steps: read the columns (:func:`dynid.io.tables.read_table`), scale units, check the time stamps,
+    resample jittered time stamps linearly onto a uniform grid, convert motor-side signals through
+    the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``), currents to torques with the
+    drive gains (eq. 16).
+
+    Raises
+    ------
+    DataError
+        Unreadable or damaged files, non-increasing time stamps (names file and line), files of
+        different lengths.
+    """
+    warnings: list[str] = []
+    requests: dict[Path, list] = {}
+    for s in list(spec.signals.values()) + ([spec.time] if spec.time else []):
+        requests.setdefault(s.file, [])
+        for c in s.columns:
+            if c not in requests[s.file]:
+                requests[s.file].append(c)
+    tables = {}
+    for path, cols in requests.items():
+        tb = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows)
+        tables[path] = (tb, cols)
+        warnings.extend(tb.warnings)
+    lengths = {p: tb.data.shape[0] for p, (tb, _) in tables.items()}
+    n_s = min(lengths.values())
+    if len(set(lengths.values())) > 1:
+        if not warnings:  # only a skipped truncated line may make the files differ
+            raise DataError(f"{spec.name}: files have different numbers of rows: " + ", ".join(f"{p} {n}" for p, n in lengths.items()))
+        warnings.append(f"{spec.name}: the files are cut to the shortest one ({n_s} rows)")
+
+    def get(s: SignalSpec) -> np.ndarray:
+        tb, cols = tables[s.file]
+        return tb.data[:n_s, [cols.index(c) for c in s.columns]] * s.scale
+
+    if spec.time is not None:
+        t = get(spec.time)[:, 0]
+        steps = np.diff(t)
+        if np.any(steps <= 0):
+            k = int(np.argmax(steps <= 0))
+            tb, _ = tables[spec.time.file]
+            raise DataError(f"{spec.time.file}: line {tb.first_line + k + 1}: time stamps must increase, got {t[k + 1]!r} after {t[k]!r}")
+    else:
+        t = np.arange(n_s) / spec.rate
+    if n_s < 2:
+        raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
+    raw = {kind: get(s) for kind, s in spec.signals.items()}
+    median = float(np.median(np.diff(t)))
+    uniform = spec.time is None or np.ptp(np.diff(t)) <= 1e-6 * median
+    rate = spec.rate if spec.time is None else (spec.resample or float(f"{1.0 / median:.6g}"))
+    if spec.time is not None and (not uniform or spec.resample is not None):
+        grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
+        raw = {kind: np.column_stack([np.interp(grid, t, x[:, j]) for j in range(x.shape[1])]) for kind, x in raw.items()}
+        t = grid
+    tr = robot.transmission
+    if spec.side == "motor":
+        q = tr.joint_positions(raw["positions"])
+        dq = tr.joint_velocities(raw["velocities"]) if "velocities" in raw else None
+    else:
+        q = raw["positions"] + tr.position_offset
+        dq = raw.get("velocities")
+    if "currents" in raw:
+        motor_or_joint = raw["currents"] * robot.drive_gains
+    else:
+        motor_or_joint = raw["torques"]
+    tau = tr.joint_torques(motor_or_joint) if spec.side == "motor" else motor_or_joint
+    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings))

@@ -1,0 +1,167 @@
+"""Reading numeric columns of delimited text logs, block by block, with errors that name file and line.
+
+Logs of real robots are long (an hour at 1 kHz is 3.6 million lines) and sometimes damaged: the
+reader parses blocks of lines with NumPy's C parser, keeps only the requested columns, and on any
+problem reports the file, the line number (1-based, counting header lines) and the column.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import DataError
+
+BLOCK = 100_000
+
+
+@dataclass(frozen=True)
+class Table:
+    """Columns read from a delimited file.
+
+    Attributes
+    ----------
+    data : (N, n_columns) array
+        The requested columns, in the requested order.
+    first_line : int
+        File line number (1-based) of the first returned row.
+    warnings : tuple of str
+        Problems that were fixed (e.g. a truncated last line skipped).
+    """
+
+    data: np.ndarray
+    first_line: int
+    warnings: tuple[str, ...] = ()
+
+
+def _split_header(line: str, delimiter: str) -> list[str]:
+    return [f.strip().strip('"') for f in line.rstrip("\r\n").split(delimiter)]
+
+
+def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
+    """0-based indices of ``columns`` given as 1-based numbers or header names."""
+    out = []
+    for c in columns:
+        if isinstance(c, str):
+            if header is None:
+                raise DataError(f"{path}: column {c!r} is a name but the file has no header; give 1-based column numbers")
+            if c not in header:
+                raise DataError(f"{path}: no column named {c!r} in the header (found {', '.join(header)})")
+            out.append(header.index(c))
+        else:
+            if int(c) < 1:
+                raise DataError(f"{path}: column numbers are 1-based, got {c}")
+            out.append(int(c) - 1)
+    return out
+
+
+def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
+               n_columns: int | None = None, rows: tuple[int, int] | None = None) -> Table:
+    """Read numeric columns from a delimited text file.
+
+    Parameters
+    ----------
+    path : path
+    columns : sequence of int or str
+        1-based column numbers, or header names when ``header`` is true.
+    header : bool
+        Whether the first line holds column names.
+    delimiter : str
+    n_columns : int, optional
+        Number of fields every line must have (default: that of the first data line).
+    rows : (first, last), optional
+        1-based, inclusive range of data rows (header excluded) to read; default all.
+
+    Returns
+    -------
+    Table
+
+    Raises
+    ------
+    DataError
+        Missing file; a line with the wrong number of fields (except a truncated last line without a
+        newline, which is skipped with a warning); a field that is not a number; NaN or infinity;
+        an empty selection. The message names the file, the line and, where it applies, the column.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: file not found")
+    first, last = rows if rows is not None else (1, None)
+    if first < 1 or (last is not None and last < first):
+        raise DataError(f"{path}: rows: expected 1 <= first <= last, got {list(rows)}")
+    warnings: list[str] = []
+    blocks: list[np.ndarray] = []
+    line_no = 0
+    names = None
+    cols: list[int] | None = None
+    expected = n_columns
+    first_line = None
+    with open(path, "r", encoding="utf-8", errors="replace", newline="") as fh:
+        if header:
+            line = fh.readline()
+            line_no = 1
+            if not line:
+                raise DataError(f"{path}: empty file, expected a header line")
+            names = _split_header(line, delimiter)
+        cols = resolve_columns(path, columns, names)
+        pending: list[str] = []
+        pending_start = None
+        data_row = 0
+
+        def flush():
+            if pending:
+                blocks.append(_parse_block(path, pending, pending_start, cols, delimiter))
+                pending.clear()
+
+        for line in fh:
+            line_no += 1
+            if not line.strip():
+                continue
+            data_row += 1
+            if data_row < first:
+                continue
+            if last is not None and data_row > last:
+                break
+            n_fields = line.count(delimiter) + 1
+            if expected is None:
+                expected = n_fields
+            if n_fields != expected:
+                if not line.endswith("\n"):  # only the last line can lack a newline
+                    warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
+                    break
+                raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}")
+            if max(cols) >= n_fields:
+                raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the line has {n_fields} columns")
+            if first_line is None:
+                first_line = line_no
+            if not pending:
+                pending_start = line_no
+            pending.append(line)
+            if len(pending) >= BLOCK:
+                flush()
+        flush()
+    if not blocks:
+        raise DataError(f"{path}: no data rows in the selected range {list(rows) if rows else 'all'}")
+    data = np.concatenate(blocks, axis=0)
+    return Table(data, int(first_line), tuple(warnings))
+
+
+def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str) -> np.ndarray:
+    try:
+        block = np.loadtxt(lines, delimiter=delimiter, usecols=cols, ndmin=2, dtype=np.float64, comments=None)
+    except ValueError:
+        for k, line in enumerate(lines):  # find the culprit for a precise message
+            fields = line.rstrip("\r\n").split(delimiter)
+            for c in cols:
+                try:
+                    float(fields[c])
+                except ValueError:
+                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {fields[c].strip()!r}") from None
+        raise DataError(f"{path}: lines {start}-{start + len(lines) - 1}: cannot parse as numbers") from None
+    bad = ~np.isfinite(block)
+    if bad.any():
+        k, c = np.argwhere(bad)[0]
+        raise DataError(f"{path}: line {start + int(k)}, column {cols[int(c)] + 1}: NaN or infinite value")
+    return block

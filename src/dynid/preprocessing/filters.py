@@ -1,0 +1,102 @@
+"""Zero-phase filtering, differentiation and parallel decimation of logs that are not one known
+Fourier trajectory (Gautier's identification practice; SciPy's ``butter`` and ``sosfiltfilt``).
+
+References: M. Gautier, "Dynamic identification of robots with power model", ICRA 1997 (parallel
+decimation of the observation matrix and the torques); Khalil & Dombre 2002, §12.5.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Iterator
+
+import numpy as np
+from scipy import signal
+
+from ..exceptions import ConfigError
+
+
+def _check_cutoff(rate: float, cutoff: float, what: str) -> None:
+    if not (rate > 0 and 0 < cutoff < rate / 2):
+        raise ConfigError(f"{what}: expected 0 < cutoff < rate/2 = {rate / 2:g} Hz, got cutoff {cutoff:g} Hz at {rate:g} Hz")
+
+
+def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int = 4) -> np.ndarray:
+    """Zero-phase low-pass Butterworth filter along time (axis 0).
+
+    Parameters
+    ----------
+    x : (N, ...) array
+    rate : float
+        Sampling rate [Hz].
+    cutoff : float
+        -3 dB frequency of the single pass [Hz] (the forward-backward pass squares the gain).
+    order : int
+
+    Raises
+    ------
+    ConfigError
+        If ``cutoff`` is not in (0, rate/2).
+    """
+    _check_cutoff(rate, cutoff, "Butterworth filter")
+    sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    return signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=0)
+
+
+def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
+    """Time derivative by central differences (one-sided at the ends), (N, ...)."""
+    return np.gradient(np.asarray(x, dtype=float), 1.0 / rate, axis=0)
+
+
+def decimation_cutoff(rate: float, factor: int) -> float:
+    """Cutoff of the anti-aliasing filter of a decimation by ``factor``: 0.8 × the new Nyquist [Hz]."""
+    return 0.8 * rate / (2 * factor)
+
+
+def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,
+                        order: int = 4, chunk: int = 20_000) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Low-pass filter and down-sample a signal that is computed chunk by chunk.
+
+    Used for the observation matrix and the torques together (Gautier's parallel decimation): both
+    go through the same zero-phase low-pass filter, then every ``factor``-th sample is kept. Chunks
+    overlap by a margin so that memory stays bounded by ``chunk`` samples whatever the log's length,
+    while the result matches filtering the whole signal at once (to the decay of the filter's
+    transient over the margin).
+
+    Parameters
+    ----------
+    block : callable ``(start, stop) -> (stop - start, ...) array``
+        Computes samples ``start .. stop-1`` of the signal.
+    n_samples : int
+    rate : float [Hz]
+    factor : int
+        Decimation factor (1: no filtering, just chunks).
+    order : int
+        Order of the Butterworth anti-aliasing filter, cutoff :func:`decimation_cutoff`.
+    chunk : int
+        Samples computed per step (before the margins).
+
+    Yields
+    ------
+    index : (M,) int array
+        Indices of the kept samples in the original signal.
+    values : (M, ...) array
+        Filtered signal at those samples.
+    """
+    if factor < 1:
+        raise ConfigError(f"decimation factor: expected an integer >= 1, got {factor}")
+    chunk = max(chunk - chunk % factor, factor)
+    if factor == 1:
+        for start in range(0, n_samples, chunk):
+            stop = min(start + chunk, n_samples)
+            yield np.arange(start, stop), block(start, stop)
+        return
+    sos = signal.butter(order, decimation_cutoff(rate, factor), btype="low", fs=rate, output="sos")
+    margin = 10 * factor * order
+    for start in range(0, n_samples, chunk):
+        stop = min(start + chunk, n_samples)
+        lo, hi = max(0, start - margin), min(n_samples, stop + margin)
+        values = block(lo, hi)
+        filtered = signal.sosfiltfilt(sos, values, axis=0, padlen=min(3 * (2 * len(sos) + 1), hi - lo - 1))
+        index = np.arange(start, stop)
+        index = index[index % factor == 0]
+        yield index, filtered[index - lo]

@@ -1,0 +1,51 @@
+import numpy as np
+import pytest
+
+from dynid.estimators.accumulate import LeastSquaresAccumulator
+from dynid.exceptions import IdentifiabilityError, ShapeError
+
+
+def _problem(rng, n_s=300, n=3, p=7):
+    w = rng.normal(size=(n_s * n, p))
+    theta = rng.normal(size=p)
+    noise = rng.normal(size=(n_s, n)) * np.array([0.1, 1.0, 3.0])
+    return w, w @ theta + noise.ravel(), theta
+
+
+def test_chunked_equals_one_shot_least_squares(rng):
+    w, tau, _ = _problem(rng)
+    acc = LeastSquaresAccumulator(w.shape[1], 3)
+    for a in range(0, w.shape[0], 3 * 37):  # chunks of 37 samples
+        acc.add(w[a:a + 111], tau[a:a + 111])
+    sol = acc.solve()
+    ref, res, *_ = np.linalg.lstsq(w, tau, rcond=None)
+    np.testing.assert_allclose(sol.params, ref, rtol=1e-10, atol=1e-12)
+    sigma2 = res[0] / (w.shape[0] - w.shape[1])
+    np.testing.assert_allclose(sol.covariance, sigma2 * np.linalg.inv(w.T @ w), rtol=1e-8)
+    np.testing.assert_allclose(sol.condition_number, np.linalg.cond(w), rtol=1e-8)
+    r = (tau - w @ ref).reshape(-1, 3)
+    np.testing.assert_allclose(acc.joint_residual_sumsq(ref), (r**2).sum(0), rtol=1e-8)
+
+
+def test_weighted_and_masked_rows_match_explicit_lstsq(rng):
+    w, tau, _ = _problem(rng)
+    mask = rng.uniform(size=tau.shape) > 0.2
+    acc = LeastSquaresAccumulator(w.shape[1], 3)
+    acc.add(w[:450], tau[:450], mask[:450])
+    acc.add(w[450:], tau[450:], mask[450:])
+    wts = np.array([10.0, 1.0, 0.3])
+    scale = np.tile(wts, w.shape[0] // 3)[mask]
+    ref = np.linalg.lstsq(w[mask] * scale[:, None], tau[mask] * scale, rcond=None)[0]
+    np.testing.assert_allclose(acc.solve(wts).params, ref, rtol=1e-10, atol=1e-12)
+    assert acc.rows.sum() == mask.sum()
+
+
+def test_accumulator_errors(rng):
+    acc = LeastSquaresAccumulator(4, 2)
+    with pytest.raises(ShapeError, match="multiple of 2"):
+        acc.add(np.zeros((3, 4)), np.zeros(3))
+    with pytest.raises(IdentifiabilityError, match="more equations"):
+        acc.solve()
+    acc.add(np.column_stack([np.ones(20), np.ones(20), rng.normal(size=(20, 2))]), rng.normal(size=20))
+    with pytest.raises(IdentifiabilityError, match="rank-deficient"):
+        acc.solve()

@@ -1,0 +1,42 @@
+import numpy as np
+import pytest
+from scipy import signal
+
+from dynid.exceptions import ConfigError
+from dynid.preprocessing.filters import butterworth_filtfilt, decimation_cutoff, differentiate, parallel_decimation
+
+
+def test_filtfilt_keeps_slow_sine_without_phase_lag_and_removes_fast_one():
+    rate = 1000.0
+    t = np.arange(5000) / rate
+    slow = np.sin(2 * np.pi * 1.0 * t)
+    y = butterworth_filtfilt(slow + 0.5 * np.sin(2 * np.pi * 150.0 * t), rate, cutoff=20.0)
+    inner = slice(500, -500)
+    np.testing.assert_allclose(y[inner], slow[inner], atol=2e-3)
+
+
+def test_differentiate_sine():
+    rate = 500.0
+    t = np.arange(2000) / rate
+    np.testing.assert_allclose(differentiate(np.sin(3 * t), rate)[1:-1], 3 * np.cos(3 * t)[1:-1], atol=1e-4)
+
+
+@pytest.mark.parametrize("factor", [1, 7])
+def test_chunked_parallel_decimation_equals_whole_signal(rng, factor):
+    x = rng.normal(size=(30000, 2, 3)).cumsum(0)
+    rate = 1000.0
+    parts = list(parallel_decimation(lambda a, b: x[a:b], x.shape[0], rate, factor, chunk=4000))
+    index = np.concatenate([i for i, _ in parts])
+    values = np.concatenate([v for _, v in parts])
+    np.testing.assert_array_equal(index, np.arange(0, x.shape[0], factor))
+    if factor == 1:
+        np.testing.assert_array_equal(values, x)
+    else:  # the same as SciPy's filtfilt on the whole signal, then every factor-th sample
+        sos = signal.butter(4, decimation_cutoff(rate, factor), fs=rate, output="sos")
+        whole = signal.sosfiltfilt(sos, x, axis=0, padlen=3 * (2 * len(sos) + 1))[::factor]
+        np.testing.assert_allclose(values, whole, rtol=0, atol=1e-9 * np.abs(whole).max())
+
+
+def test_bad_cutoff_is_a_config_error():
+    with pytest.raises(ConfigError, match="cutoff < rate/2"):
+        butterworth_filtfilt(np.zeros((100, 1)), 100.0, 60.0)
