@@ -75,7 +75,7 @@ def load_robot(name_or_path: str | Path) -> Robot:
     text = str(name_or_path)
     if text in builtin_robots():
         res = resources.files("dynid.model") / "robots" / f"{text}.toml"
-        return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=None)
+        return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=Path(str(res)).parent)
     path = Path(text)
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}) or a .toml description file")
@@ -194,7 +194,9 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
         raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
     inf = np.inf
     lim = {k: np.array([_number(r, k, w, dflt) for r, w in zip(rows, where)])
-           for k, dflt in (("q_min", -inf), ("q_max", inf), ("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
+           for k, dflt in (("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
+    for k, dflt in (("q_min", -inf), ("q_max", inf)):  # angles may be written like "-2*pi"
+        lim[k] = np.array([_angle(r.get(k, dflt), f"{w}.{k}") for r, w in zip(rows, where)])
     for i in range(n):
         if not lim["q_min"][i] < lim["q_max"][i]:
             raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")

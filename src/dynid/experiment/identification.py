@@ -1,0 +1,315 @@
+"""Identification of a real robot from its logs, and validation on other logs.
+
+Recording (CSV, :mod:`dynid.io.datasets`) → zero-phase Butterworth filtering of positions, velocities
+and torques → derivatives by central differences → base regressor and torques, low-pass filtered and
+decimated together (Gautier's parallel decimation), chunk by chunk → optional removal of the rows of
+joints moving slower than a threshold (Coulomb friction is undefined at rest) → OLS/WLS accumulated by
+incremental QR (memory independent of the log's length) → validation: relative error, RMSE and
+correlation coefficient (eq. 18) per joint, for dynid's parameters and each reference set.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from ..conventions import unit_of
+from ..dynamics.base_parameters import BaseParameters
+from ..dynamics.regressor import regressor
+from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
+from ..exceptions import ConfigError, DataError
+from ..io.datasets import Recording
+from ..io.references import ReferenceSet
+from ..model.robot import Robot
+from ..preprocessing.filters import butterworth_filtfilt, differentiate, parallel_decimation
+from ..validation import correlation_coefficient, relative_error, rmse
+
+METHODS = ("ols", "wls")
+
+
+@dataclass(frozen=True)
+class Preprocessing:
+    """Preprocessing settings; ``None`` means the default for the sampling rate (:meth:`resolved`).
+
+    Attributes
+    ----------
+    order : int
+        Order of the Butterworth filters.
+    position_cutoff, velocity_cutoff, torque_cutoff : float or None [Hz]
+        Zero-phase low-pass cutoffs; 0 switches a filter off. Defaults: ``min(0.15·f_N, 20 Hz)`` for
+        positions and velocities, ``min(0.2·f_N, 25 Hz)`` for torques (``f_N`` = Nyquist frequency).
+    decimation : int or None
+        Parallel decimation factor. Default: ``max(1, rate // (10·velocity_cutoff))``.
+    min_speed : float or tuple [rad/s]
+        Rows of joint ``j`` where ``|dq_j| < min_speed_j`` are left out of the estimation (0: keep all).
+    trim : float [s]
+        Removed at both ends after filtering (filter edge effects).
+    chunk : int
+        Samples per chunk of the regressor.
+    """
+
+    order: int = 4
+    position_cutoff: float | None = None
+    velocity_cutoff: float | None = None
+    torque_cutoff: float | None = None
+    decimation: int | None = None
+    min_speed: float | tuple = 0.0
+    trim: float = 0.0
+    chunk: int = 20_000
+
+    def resolved(self, rate: float) -> "Preprocessing":
+        nyq = rate / 2
+        vel = self.velocity_cutoff if self.velocity_cutoff is not None else min(0.15 * nyq, 20.0)
+        pos = self.position_cutoff if self.position_cutoff is not None else vel
+        tq = self.torque_cutoff if self.torque_cutoff is not None else min(0.2 * nyq, 25.0)
+        dec = self.decimation if self.decimation is not None else max(1, int(rate // (10 * vel)) if vel > 0 else 1)
+        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), torque_cutoff=float(tq), decimation=int(dec))
+
+    def to_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
+
+
+@dataclass(frozen=True)
+class PreparedData:
+    """Filtered joint signals on a uniform grid, ready for the regressor (N, n_dof) each."""
+
+    name: str
+    t: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+    tau: np.ndarray
+    rate: float
+    settings: Preprocessing
+    warnings: tuple[str, ...] = ()
+
+
+def prepare(recording: Recording, settings: Preprocessing) -> PreparedData:
+    """Filter and differentiate a recording (positions, velocities: measured or from positions;
+    accelerations: derivative of the filtered velocities).
+
+    Raises
+    ------
+    ConfigError
+        A cutoff at or above the Nyquist frequency.
+    DataError
+        Too few samples left after trimming.
+    """
+    s = settings.resolved(recording.rate)
+    rate = recording.rate
+
+    def lowpass(x, cutoff, what):
+        if cutoff <= 0:
+            return x
+        try:
+            return butterworth_filtfilt(x, rate, cutoff, s.order)
+        except ConfigError as exc:
+            raise ConfigError(f"preprocessing.{what}_cutoff: {exc}") from None
+
+    if recording.n_samples < 3 * (2 * s.order + 1) + 1:
+        raise DataError(f"{recording.name}: {recording.n_samples} samples are too few to filter")
+    q = lowpass(recording.q, s.position_cutoff, "position")
+    dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
+    ddq = differentiate(dq, rate)
+    tau = lowpass(recording.tau, s.torque_cutoff, "torque")
+    t = recording.t
+    cut = int(round(s.trim * rate))
+    if cut:
+        if 2 * cut >= t.shape[0] - 2:
+            raise DataError(f"{recording.name}: trim = {s.trim} s leaves no samples of the {t[-1]:.3f} s recording")
+        t, q, dq, ddq, tau = (x[cut:-cut] for x in (t, q, dq, ddq, tau))
+    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, s, recording.warnings)
+
+
+def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
+    v = np.broadcast_to(np.asarray(settings.min_speed, dtype=float), (n,)) if np.ndim(settings.min_speed) == 0 else np.asarray(settings.min_speed, dtype=float)
+    if v.shape != (n,) or np.any(v < 0):
+        raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
+    return v
+
+
+def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
+                progress: Callable[[int, int], None] | None = None):
+    """Parallel-decimated base regressor and torques, chunk by chunk.
+
+    Yields
+    ------
+    index : (M,) int array
+        Sample indices kept (every ``decimation``-th).
+    y_base : (M, n_dof, n_base) array
+    tau : (M, n_dof) array [N·m]
+    keep : (M, n_dof) bool array
+        Rows fast enough for the estimation (``|dq_j| >= min_speed_j``).
+    """
+    n, nb = robot.n_dof, base.n_base
+    s = data.settings
+    vmin = _min_speed(s, n)
+    n_s = data.t.shape[0]
+
+    def block(a, b):
+        y = base.base_observation(regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b]))
+        return np.concatenate([y.reshape(b - a, n * nb), data.tau[a:b]], axis=1)
+
+    for index, values in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk):
+        y = values[:, : n * nb].reshape(-1, n, nb)
+        keep = np.abs(data.dq[index]) >= vmin
+        if progress is not None:
+            progress(int(index[-1]) + 1, n_s)
+        yield index, y, values[:, n * nb:], keep
+
+
+@dataclass(frozen=True)
+class TorqueComparison:
+    """Measured and predicted torques of one dataset (decimated), with per-joint metrics.
+
+    Attributes
+    ----------
+    name : str
+    t : (M,) array [s]
+    measured : (M, n_dof) array [N·m]
+    predicted : dict label -> (M, n_dof) array
+    """
+
+    name: str
+    t: np.ndarray
+    measured: np.ndarray
+    predicted: dict
+
+    def metrics(self) -> dict:
+        """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,)."""
+        return {label: {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
+                        "correlation": correlation_coefficient(self.measured, p)}
+                for label, p in self.predicted.items()}
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "n_samples": int(self.t.shape[0]),
+                "rms_torque": np.sqrt((self.measured**2).mean(axis=0)), "metrics": self.metrics()}
+
+
+def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
+                    progress=None) -> TorqueComparison:
+    """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
+    (n_base,)), on the same parallel-decimated samples as the estimation."""
+    ts, meas, preds = [], [], {k: [] for k in parameter_sets}
+    for index, y, tau, _ in base_chunks(robot, base, data, progress):
+        ts.append(data.t[index])
+        meas.append(tau)
+        for label, beta in parameter_sets.items():
+            preds[label].append(y @ beta)
+    return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
+                            {k: np.concatenate(v) for k, v in preds.items()})
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """Identified base parameters with their uncertainty, fit, validations and reference sets.
+
+    Attributes
+    ----------
+    robot : str
+    base : BaseParameters
+    method : str
+        "ols" or "wls".
+    solution : LeastSquaresSolution
+        Parameters, covariance, std, relative std [%], condition number of the (weighted) base
+        observation matrix.
+    joint_std : (n_dof,) array [N·m]
+        Residual standard deviation of each joint (OLS residuals; the WLS weights are their inverses).
+    references : tuple of ReferenceSet
+    fit : TorqueComparison
+        On the identification data.
+    validations : tuple of TorqueComparison
+    n_rows : int
+        Equations used (after decimation and the speed threshold).
+    settings : dict
+    warnings : tuple of str
+    """
+
+    robot: str
+    base: BaseParameters
+    method: str
+    solution: LeastSquaresSolution
+    joint_std: np.ndarray
+    references: tuple[ReferenceSet, ...]
+    fit: TorqueComparison
+    validations: tuple[TorqueComparison, ...] = ()
+    n_rows: int = 0
+    settings: dict = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def label(self) -> str:
+        return f"dynid {self.method.upper()}"
+
+    def parameter_sets(self) -> dict:
+        """label -> base parameter vector: dynid's estimate, then each reference set."""
+        out = {self.label: self.solution.params}
+        out.update({r.name: r.beta for r in self.references})
+        return out
+
+    def reference_agreement(self, ref: ReferenceSet) -> dict:
+        """Differences to a reference that states relative standard deviations: ``z = |Δ| / σ_ref``."""
+        sigma = np.abs(ref.beta) * ref.relative_std / 100.0
+        diff = self.solution.params - ref.beta
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.abs(diff) / sigma
+        ok = np.isfinite(z)
+        return {"z": z, "within_1_sigma": int(np.sum(z[ok] <= 1)), "within_2_sigma": int(np.sum(z[ok] <= 2)),
+                "within_3_sigma": int(np.sum(z[ok] <= 3)), "compared": int(ok.sum())}
+
+    def to_dict(self) -> dict:
+        sol = self.solution
+        params = [{"name": n, "value": float(v), "std": float(s), "relative_std_percent": float(r), "unit": unit_of(n),
+                   "expression": e.split(" = ", 1)[1]}
+                  for n, v, s, r, e in zip(self.base.names, sol.params, sol.params_std, sol.relative_std, self.base.expressions)]
+        refs = []
+        for r in self.references:
+            entry = {"name": r.name, "source": r.source, "values": dict(zip(self.base.names, r.beta.tolist()))}
+            if r.relative_std is not None:
+                agree = self.reference_agreement(r)
+                entry["agreement"] = {k: v for k, v in agree.items() if k != "z"}
+                entry["z"] = dict(zip(self.base.names, agree["z"].tolist()))
+            refs.append(entry)
+        return {
+            "robot": self.robot, "method": self.method, "base_parameters": params,
+            "condition_number": sol.condition_number, "residual_std": sol.residual_std,
+            "joint_residual_std": self.joint_std, "n_rows": self.n_rows, "settings": self.settings,
+            "identification": self.fit.to_dict(), "validation": [v.to_dict() for v in self.validations],
+            "references": refs, "warnings": list(self.warnings),
+        }
+
+
+def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str = "wls",
+             references: tuple[ReferenceSet, ...] = (), progress=None) -> IdentificationResult:
+    """Estimate the base parameters from one prepared recording by OLS or WLS (chunked).
+
+    Raises
+    ------
+    ConfigError
+        Unknown method.
+    IdentifiabilityError
+        Too few rows or a rank-deficient base observation matrix (the log does not excite every
+        base parameter).
+    """
+    if method not in METHODS:
+        raise ConfigError(f"estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
+    n = robot.n_dof
+    acc = LeastSquaresAccumulator(base.n_base, n)
+    for _, y, tau, keep in base_chunks(robot, base, data, progress):
+        acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
+    ols = acc.solve()
+    joint_std = acc.joint_residual_std(ols.params)
+    sol = ols if method == "ols" else acc.solve(1.0 / np.where(joint_std > 0, joint_std, 1.0))
+    warnings = list(data.warnings)
+    dropped = 1.0 - acc.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation)))
+    if dropped > 0.5:
+        warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
+    for r in references:
+        warnings.extend(r.warnings)
+    result = IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references),
+                                  TorqueComparison(data.name, np.zeros(0), np.zeros((0, n)), {}), n_rows=int(acc.rows.sum()),
+                                  settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings))
+    fit = compare_torques(robot, base, data, result.parameter_sets())
+    return replace(result, fit=fit)

@@ -1,0 +1,209 @@
+"""Experiment configs of ``dynid identify`` / ``dynid validate`` (TOML), and the runs they describe.
+
+Layout (paths relative to the config file; data paths relative to ``data_root``)::
+
+    robot = "ur10e"                      # built-in robot name or description TOML
+    data_root = "../../shared/data/ur10e_mamedov2020"   # overridden by --data-root / DYNID_DATA_ROOT
+
+    [identification]                     # a dataset table (dynid.io.datasets)
+    preset = "ur-rtde"
+    file = "identification_data/ur-20_02_10-30sec_12harm.csv"
+    rows = [635, 3510]
+
+    [preprocessing]                      # dynid.experiment.identification.Preprocessing; all optional
+    order = 5
+    velocity_cutoff = 7.5                # Hz
+    torque_cutoff = 10.0                 # Hz
+    decimation = 1
+    min_speed = 0.0                      # rad/s, one value or one per joint
+
+    [estimation]
+    method = "wls"                       # "ols" or "wls"
+
+    [[validation]]                       # dataset tables, each with a name
+    name = "ptp_10_points"
+    preset = "ur-rtde"
+    file = "validation_data/ur-20_01_17-ptp_10_points.csv"
+    rows = [700, 4200]
+
+    [[references]]                       # published parameter sets (dynid.io.references)
+    name = "Mamedov & Mikhel 2020"
+    file = "ur10e_reference_parameters.csv"
+    header = true
+    names = "name"
+    values = "value"
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..dynamics.base_parameters import base_parameters
+from ..exceptions import ConfigError, DataError
+from ..io.datasets import DatasetSpec, dataset_spec, load_recording
+from ..io.references import load_reference
+from ..model.description import builtin_robots, load_robot
+from ..model.robot import Robot
+from .identification import METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify, prepare
+
+DATA_ROOT_ENV = "DYNID_DATA_ROOT"
+
+
+@dataclass(frozen=True)
+class IdentificationConfig:
+    """A parsed identification config (module docstring)."""
+
+    path: Path
+    robot: Robot
+    identification: DatasetSpec
+    validation: tuple[DatasetSpec, ...]
+    preprocessing: Preprocessing
+    method: str
+    references: tuple[dict, ...]
+    data_root: Path
+
+
+_PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "torque_cutoff": float,
+             "decimation": int, "min_speed": None, "trim": float, "chunk": int}
+
+
+def _preprocessing(table, where: str, n: int) -> Preprocessing:
+    if not isinstance(table, dict):
+        raise ConfigError(f"{where}: expected a table")
+    unknown = sorted(set(table) - set(_PRE_KEYS))
+    if unknown:
+        raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(_PRE_KEYS)}")
+    values = {}
+    for key, kind in _PRE_KEYS.items():
+        if key not in table:
+            continue
+        v = table[key]
+        if key == "min_speed":
+            ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0) or (
+                isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in v))
+            if not ok:
+                raise ConfigError(f"{where}.min_speed: expected a non-negative number or a list of {n}, got {v!r}")
+            values[key] = tuple(float(x) for x in v) if isinstance(v, list) else float(v)
+            continue
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or (kind is int and v != int(v)) or v < 0:
+            raise ConfigError(f"{where}.{key}: expected a non-negative {'integer' if kind is int else 'number'}, got {v!r}")
+        if key in ("order", "decimation", "chunk") and v < 1:
+            raise ConfigError(f"{where}.{key}: expected an integer >= 1, got {v!r}")
+        values[key] = kind(v)
+    return Preprocessing(**values)
+
+
+def load_identification_config(path: str | Path, data_root: str | Path | None = None) -> IdentificationConfig:
+    """Parse an identification config.
+
+    Parameters
+    ----------
+    path : path of the TOML file
+    data_root : path, optional
+        Folder the data paths are relative to; default: the environment variable ``DYNID_DATA_ROOT``,
+        else the config's ``data_root`` (relative to the config file), else the config's folder.
+
+    Raises
+    ------
+    ConfigError
+        Unreadable file, invalid TOML, unknown or malformed fields (the message names file and field).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: config file not found")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: invalid TOML ({exc})") from None
+    known = {"robot", "data_root", "identification", "validation", "preprocessing", "estimation", "references", "name", "notes"}
+    unknown = sorted(set(doc) - known)
+    if unknown:
+        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known)}")
+    here = path.parent
+    robot_ref = doc.get("robot")
+    if not isinstance(robot_ref, str):
+        raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
+    robot = load_robot(robot_ref if robot_ref in builtin_robots() or Path(robot_ref).is_absolute() else here / robot_ref)
+    root = data_root or os.environ.get(DATA_ROOT_ENV) or doc.get("data_root", ".")
+    root = Path(root)
+    root = root if root.is_absolute() or data_root or os.environ.get(DATA_ROOT_ENV) else here / root
+    if not root.is_dir():
+        raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root, --data-root or {DATA_ROOT_ENV})")
+    n = robot.n_dof
+    if "identification" not in doc:
+        raise ConfigError(f"{path}: expected an [identification] table describing the identification dataset")
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n)
+    vals = doc.get("validation", [])
+    if not isinstance(vals, list):
+        raise ConfigError(f"{path}: validation: expected [[validation]] tables")
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n) for i, v in enumerate(vals))
+    names = [v.name for v in validation]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
+    pre = _preprocessing(doc.get("preprocessing", {}), f"{path}: preprocessing", n)
+    est = doc.get("estimation", {})
+    method = est.get("method", "wls") if isinstance(est, dict) else None
+    if method not in METHODS:
+        raise ConfigError(f"{path}: estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
+    refs = doc.get("references", [])
+    if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
+        raise ConfigError(f"{path}: references: expected [[references]] tables")
+    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root)
+
+
+def _references(config: IdentificationConfig, base):
+    return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base) for i, r in enumerate(config.references))
+
+
+def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...], progress=None) -> tuple[TorqueComparison, ...]:
+    out = []
+    for spec in datasets:
+        data = prepare(load_recording(spec, config.robot), config.preprocessing)
+        out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
+    return tuple(out)
+
+
+def run_identification(config: IdentificationConfig, progress=None, validate: bool = True) -> IdentificationResult:
+    """Identify the base parameters from the config's identification dataset, then validate them on
+    each validation dataset beside the reference sets."""
+    base = base_parameters(config.robot, rng=0)
+    refs = _references(config, base)
+    data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
+    result = identify(config.robot, base, data, config.method, refs, progress)
+    if not validate or not config.validation:
+        return result
+    validations = _validate(config, base, result.parameter_sets(), config.validation, progress)
+    return replace(result, validations=validations)
+
+
+def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
+                   progress=None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
+    """Validate identified base parameters (``identified``: results.json of ``dynid identify``) and the
+    config's reference sets on the config's validation datasets (or on ``datasets``).
+
+    Raises
+    ------
+    DataError
+        The results do not belong to this robot (different base parameters).
+    """
+    base = base_parameters(config.robot, rng=0)
+    try:
+        names = [p["name"] for p in identified["base_parameters"]]
+        values = np.array([float(p["value"]) for p in identified["base_parameters"]])
+        label = f"dynid {str(identified.get('method', 'ls')).upper()}"
+    except (KeyError, TypeError, ValueError):
+        raise DataError("results: expected the results.json of dynid identify (a list base_parameters of {name, value})") from None
+    if tuple(names) != base.names:
+        raise DataError(f"results: its base parameters ({len(names)}) are not those of robot {config.robot.name!r} ({base.n_base}); was it identified with this config?")
+    refs = _references(config, base)
+    sets = {label: values, **{r.name: r.beta for r in refs}}
+    datasets = config.validation if datasets is None else datasets
+    if not datasets:
+        raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
+    warnings = tuple(w for r in refs for w in r.warnings)
+    return _validate(config, base, sets, datasets, progress), warnings
