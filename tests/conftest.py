@@ -45,3 +45,30 @@ def urdf_path(tmp_path):
 
 def random_states(rng, n_samples, n_dof, scale=2.0):
     return tuple(rng.uniform(-scale, scale, (n_samples, n_dof)) for _ in range(3))
+
+
+def shared_data(name: str):
+    """Folder of a real data set in the workplace's shared/data (``DYNID_SHARED_DATA`` overrides).
+
+    These data sets are not part of the repository (the UR10e one has no license). The CI machine has
+    them; elsewhere the tests that need them are skipped, with the reason.
+    """
+    from pathlib import Path
+
+    roots = [os.environ.get("DYNID_SHARED_DATA"), Path(__file__).resolve().parents[2] / "shared" / "data", "/work/shared/data"]
+    for root in roots:
+        if root and (Path(root) / name).is_dir():
+            return Path(root) / name
+    pytest.skip(f"real data set {name} not found (set DYNID_SHARED_DATA to the shared/data folder)")
+
+
+def sine_motion(rng, t, n_dof, n_harmonics=4, omega=2 * np.pi * 0.2, amplitude=0.4):
+    """A smooth multi-sine joint motion with exact derivatives: q, dq, ddq (N, n_dof)."""
+    a = rng.uniform(-1, 1, (n_harmonics, n_dof)) * amplitude / np.arange(1, n_harmonics + 1)[:, None]
+    phase = rng.uniform(0, 2 * np.pi, (n_harmonics, n_dof))
+    k = np.arange(1, n_harmonics + 1)[:, None, None] * omega
+    arg = k * t[None, :, None] + phase[:, None, :]
+    q = (a[:, None, :] * np.sin(arg)).sum(0)
+    dq = (a[:, None, :] * k * np.cos(arg)).sum(0)
+    ddq = -(a[:, None, :] * k**2 * np.sin(arg)).sum(0)
+    return q, dq, ddq

@@ -136,6 +136,137 @@ def _print_run(result, paths) -> None:
     console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
 
 
+def _progress(label: str):
+    return Progress(TextColumn(f"[bold]{label}[/]"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                    TimeElapsedColumn(), console=console, transient=True)
+
+
+def _comparison_tables(comparisons, n_dof: int) -> None:
+    """Per dataset: relative error, RMSE and correlation coefficient per joint for every parameter set."""
+    for cmp in comparisons:
+        rms = (cmp.measured**2).mean(axis=0) ** 0.5
+        t = Table(title=f"{cmp.name}: {cmp.t.shape[0]} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + " N·m",
+                  box=box.SIMPLE_HEAD, padding=(0, 1))
+        t.add_column("parameters", no_wrap=True)
+        t.add_column("metric", no_wrap=True)
+        for j in range(n_dof):
+            t.add_column(f"J{j + 1}", justify="right")
+        for label, m in cmp.metrics().items():
+            t.add_row(label, "error %", *(f"{x:.1f}" for x in m["relative_error"]))
+            t.add_row("", "RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]))
+            t.add_row("", "ρ (eq. 18)", *(f"{x:.4f}" for x in m["correlation"]), end_section=True)
+        console.print(t)
+
+
+def _print_identification(result, paths) -> None:
+    sol, base = result.solution, result.base
+    console.print(f"\n[bold]dynid identify[/] — robot {result.robot}, {result.method.upper()} on {result.fit.name}: "
+                  f"{base.n_base} base parameters from {result.n_rows} equations, cond = {sol.condition_number:.4g}")
+    refs = result.references
+    t = Table(title="Base parameters (σ: standard deviation; reference values beside)", box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("name", "unit", "value", "σ", "σ %", *(r.name for r in refs)):
+        t.add_column(col, justify="left" if col in ("name", "unit") else "right", no_wrap=True)
+    from ..conventions import unit_of
+
+    for i, name in enumerate(base.names):
+        t.add_row(name, unit_of(name), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
+                  *(f"{r.beta[i]:.4g}" for r in refs))
+    console.print(t)
+    for r in refs:
+        if r.relative_std is not None:
+            a = result.reference_agreement(r)
+            console.print(f"{r.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
+                          f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters")
+    console.print("residual σ per joint [N·m]: " + ", ".join(f"{x:.3g}" for x in result.joint_std))
+    _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
+    for w in result.warnings:
+        console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
+    console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+
+
+@app.command()
+def identify(
+    config: Path = typer.Argument(..., help="Identification config (TOML), e.g. configs/ur10e.toml."),
+    out: Path = typer.Option(Path("dynid-identify"), help="Output folder for results.json and figures."),
+    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    validate: bool = typer.Option(True, help="Also validate on the config's [[validation]] datasets."),
+) -> None:
+    """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
+    from ..experiment.identification_config import load_identification_config, run_identification
+    from ..report.identification_run import save_identification
+
+    try:
+        cfg = load_identification_config(config, data_root)
+        with _progress("regressor") as progress:
+            task = progress.add_task("x", total=1)
+            result = run_identification(cfg, progress=lambda done, total: progress.update(task, completed=done, total=total),
+                                        validate=validate)
+        paths = save_identification(result, out)
+    except DynIdError as exc:
+        _fail(exc)
+    _print_identification(result, paths)
+
+
+def _parse_rows(text: Optional[str]):
+    if text is None:
+        return None
+    try:
+        first, last = (int(x) for x in text.split(","))
+    except ValueError:
+        raise DynIdError(f"--rows: expected two 1-based row numbers like 700,4200, got {text!r}") from None
+    return [first, last]
+
+
+@app.command()
+def validate(
+    config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
+    results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
+    file: Optional[Path] = typer.Option(None, help="Validate on this log instead (same column map as the identification data)."),
+    rows: Optional[str] = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
+    out: Path = typer.Option(Path("dynid-validate"), help="Output folder for validation.json and figures."),
+    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+) -> None:
+    """Validate identified parameters (and the config's reference sets) on other logs."""
+    import json
+    from dataclasses import replace
+
+    from ..exceptions import DataError
+    from ..experiment.identification_config import load_identification_config, run_validation
+    from ..io.datasets import SignalSpec
+    from ..report.identification_run import save_validation
+
+    try:
+        cfg = load_identification_config(config, data_root)
+        try:
+            identified = json.loads(results.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
+        except (OSError, json.JSONDecodeError) as exc:
+            raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
+        datasets = None
+        if file is not None:
+            spec = cfg.identification
+            files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
+            if len(files) > 1:
+                raise DataError("--file: the identification dataset reads several files; add a [[validation]] table to the config instead")
+            sig = {k: SignalSpec(file, s.columns, s.scale) for k, s in spec.signals.items()}
+            time = SignalSpec(file, spec.time.columns, 1.0) if spec.time else None
+            datasets = (replace(spec, name=file.name, signals=sig, time=time, rows=_parse_rows(rows)),)
+        elif rows is not None:
+            raise DataError("--rows needs --file")
+        with _progress("validation") as progress:
+            task = progress.add_task("x", total=1)
+            comparisons, warnings = run_validation(cfg, identified, datasets,
+                                                   progress=lambda d, t: progress.update(task, completed=d, total=t))
+        paths = save_validation(comparisons, warnings, out)
+    except DynIdError as exc:
+        _fail(exc)
+    _comparison_tables(comparisons, cfg.robot.n_dof)
+    for w in warnings:
+        console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
+    console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

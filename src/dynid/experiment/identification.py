@@ -44,8 +44,10 @@ class Preprocessing:
         Parallel decimation factor. Default: ``max(1, rate // (10·velocity_cutoff))``.
     min_speed : float or tuple [rad/s]
         Rows of joint ``j`` where ``|dq_j| < min_speed_j`` are left out of the estimation (0: keep all).
-    trim : float [s]
-        Removed at both ends after filtering (filter edge effects).
+    trim : float or None [s]
+        Removed at both ends after filtering, where the filters' edge effects corrupt the derivatives.
+        Default: ``3 / cutoff`` of the slowest filter the derivatives go through (positions, and
+        velocities when they are measured), 0 when those filters are off.
     chunk : int
         Samples per chunk of the regressor.
     """
@@ -56,16 +58,19 @@ class Preprocessing:
     torque_cutoff: float | None = None
     decimation: int | None = None
     min_speed: float | tuple = 0.0
-    trim: float = 0.0
+    trim: float | None = None
     chunk: int = 20_000
 
-    def resolved(self, rate: float) -> "Preprocessing":
+    def resolved(self, rate: float, measured_velocity: bool = True) -> "Preprocessing":
         nyq = rate / 2
         vel = self.velocity_cutoff if self.velocity_cutoff is not None else min(0.15 * nyq, 20.0)
         pos = self.position_cutoff if self.position_cutoff is not None else vel
         tq = self.torque_cutoff if self.torque_cutoff is not None else min(0.2 * nyq, 25.0)
         dec = self.decimation if self.decimation is not None else max(1, int(rate // (10 * vel)) if vel > 0 else 1)
-        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), torque_cutoff=float(tq), decimation=int(dec))
+        on = [c for c in ((pos, vel) if measured_velocity else (pos,)) if c > 0]
+        trim = self.trim if self.trim is not None else (3.0 / min(on) if on else 0.0)
+        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), torque_cutoff=float(tq),
+                       decimation=int(dec), trim=float(trim))
 
     def to_dict(self) -> dict:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
@@ -97,7 +102,7 @@ def prepare(recording: Recording, settings: Preprocessing) -> PreparedData:
     DataError
         Too few samples left after trimming.
     """
-    s = settings.resolved(recording.rate)
+    s = settings.resolved(recording.rate, recording.dq is not None)
     rate = recording.rate
 
     def lowpass(x, cutoff, what):

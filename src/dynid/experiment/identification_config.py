@@ -160,12 +160,14 @@ def _references(config: IdentificationConfig, base):
     return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base) for i, r in enumerate(config.references))
 
 
-def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...], progress=None) -> tuple[TorqueComparison, ...]:
-    out = []
+def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
+              progress=None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
+    out, warnings = [], []
     for spec in datasets:
         data = prepare(load_recording(spec, config.robot), config.preprocessing)
         out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
-    return tuple(out)
+        warnings.extend(data.warnings)
+    return tuple(out), tuple(warnings)
 
 
 def run_identification(config: IdentificationConfig, progress=None, validate: bool = True) -> IdentificationResult:
@@ -177,8 +179,8 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     result = identify(config.robot, base, data, config.method, refs, progress)
     if not validate or not config.validation:
         return result
-    validations = _validate(config, base, result.parameter_sets(), config.validation, progress)
-    return replace(result, validations=validations)
+    validations, warnings = _validate(config, base, result.parameter_sets(), config.validation, progress)
+    return replace(result, validations=validations, warnings=result.warnings + warnings)
 
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
@@ -205,5 +207,5 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
-    warnings = tuple(w for r in refs for w in r.warnings)
-    return _validate(config, base, sets, datasets, progress), warnings
+    comparisons, warnings = _validate(config, base, sets, datasets, progress)
+    return comparisons, tuple(w for r in refs for w in r.warnings) + warnings

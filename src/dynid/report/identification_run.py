@@ -1,0 +1,55 @@
+"""Write an identification or validation run to a folder: results.json and torque figures."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from ..experiment.identification import IdentificationResult, TorqueComparison
+from ..io import write_json
+from . import figures
+from .output import output_folder, save_figure
+
+
+def _slug(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_").lower() or "dataset"
+
+
+def _torque_figure(cmp: TorqueComparison, path: Path, title: str) -> None:
+    save_figure(figures.plot_torque_comparison(cmp.t, cmp.measured, cmp.predicted, title=title), path)
+
+
+def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list[Path]:
+    """One PNG per dataset: measured vs predicted torques of every parameter set."""
+    paths = []
+    for cmp in comparisons:
+        path = out / f"{prefix}_{_slug(cmp.name)}.png"
+        _torque_figure(cmp, path, f"{prefix} — {cmp.name}: measured vs predicted torques")
+        paths.append(path)
+    return paths
+
+
+def save_identification(result: IdentificationResult, out: str | Path) -> list[Path]:
+    """Write ``results.json``, the identification fit figure and one figure per validation dataset.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    out = output_folder(out)
+    paths = [out / "identification_fit.png"]
+    _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
+    paths += save_comparisons(result.validations, out)
+    json_path = out / "results.json"
+    write_json(json_path, result.to_dict())
+    return [json_path] + paths
+
+
+def save_validation(comparisons, warnings, out: str | Path) -> list[Path]:
+    """Write ``validation.json`` (per-joint metrics of every parameter set) and one figure per dataset."""
+    out = output_folder(out)
+    paths = save_comparisons(comparisons, out)
+    json_path = out / "validation.json"
+    write_json(json_path, {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)})
+    return [json_path] + paths

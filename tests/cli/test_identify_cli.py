@@ -1,0 +1,71 @@
+"""`dynid identify` and `dynid validate` as a user runs them."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ..conftest import shared_data
+from .test_cli import dynid
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
+    root = shared_data("ur10e_mamedov2020")
+    out = tmp_path / "ur"
+    p = dynid("identify", str(REPO / "configs" / "ur10e.toml"), "--out", str(out), "--data-root", str(root))
+    assert p.returncode == 0, p.stderr
+    assert "Mamedov & Mikhel 2020" in p.stdout and "ptp_10_points" in p.stdout and "error %" in p.stdout
+    res = json.loads((out / "results.json").read_text())
+    assert len(res["base_parameters"]) == 58 and {"name", "value", "std", "relative_std_percent"} <= set(res["base_parameters"][0])
+    assert (out / "identification_fit.png").is_file() and (out / "validation_ptp_10_points.png").is_file()
+    assert len(list(out.glob("validation_p*.png"))) == 11
+    # validate the result on another log given on the command line: the truncated-line log
+    log = root / "identification_data" / "ur-20_02_19_15harm50secLoad.csv"
+    p = dynid("validate", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--file", str(log),
+              "--rows", "11,999999", "--out", str(tmp_path / "val"), "--data-root", str(root))
+    assert p.returncode == 0, p.stderr
+    assert "line 6107 is truncated" in p.stdout and "ur-20_02_19_15harm50secLoad.csv" in p.stdout
+    val = json.loads((tmp_path / "val" / "validation.json").read_text())
+    assert set(val["validation"][0]["metrics"]) == {"dynid OLS", "Mamedov & Mikhel 2020"}
+
+
+def test_identify_tx40(tmp_path):
+    root = shared_data("staubli_tx40_figaroh")
+    p = dynid("identify", str(REPO / "configs" / "tx40.toml"), "--out", str(tmp_path / "tx"), "--data-root", str(root))
+    assert p.returncode == 0, p.stderr
+    assert "FIGAROH OLS: dynid's values lie within 1σ / 2σ / 3σ" in p.stdout and "time split" in p.stdout
+
+
+def _ur_config(tmp_path, csv_text):
+    (tmp_path / "log.csv").write_text(csv_text)
+    (tmp_path / "c.toml").write_text('robot = "ur10e"\n[identification]\npreset = "ur-rtde"\nfile = "log.csv"\n')
+    return tmp_path / "c.toml"
+
+
+_ROW = ",".join(["0.5"] * 30)
+
+
+@pytest.mark.parametrize("csv_text, message", [
+    ("".join(f"{t},{_ROW}\n" for t in (0.0, 0.01)) + "0.02,1,2\n", "log.csv: line 3: expected 31 columns, got 3"),
+    ("".join(f"{t},{_ROW}\n" for t in (0.0, 0.01, 0.005, 0.02)), "log.csv: line 3: time stamps must increase"),
+    (f"0.0,{_ROW}\n0.01,nan{_ROW[3:]}\n", "log.csv: line 2, column 2: NaN or infinite value"),
+])
+def test_damaged_logs_get_one_line_errors_and_leave_nothing_behind(tmp_path, csv_text, message):
+    cfg = _ur_config(tmp_path, csv_text)
+    out = tmp_path / "out"
+    p = dynid("identify", str(cfg), "--out", str(out))
+    assert p.returncode == 1, p.stdout
+    assert message in p.stderr and "Traceback" not in p.stderr + p.stdout
+    assert len(p.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_validate_needs_results_of_the_same_robot(tmp_path):
+    cfg = _ur_config(tmp_path, "".join(f"{t / 100},{_ROW}\n" for t in range(200)))
+    (tmp_path / "r.json").write_text(json.dumps({"base_parameters": [{"name": "ZZ1R", "value": 1.0}]}))
+    p = dynid("validate", str(cfg), "--results", str(tmp_path / "r.json"), "--file", str(tmp_path / "log.csv"), "--out", str(tmp_path / "v"))
+    assert p.returncode == 1 and "are not those of robot 'ur10e'" in p.stderr
+    p = dynid("validate", str(cfg), "--results", str(tmp_path / "missing.json"))
+    assert p.returncode == 1 and "run dynid identify first" in p.stderr

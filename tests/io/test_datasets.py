@@ -1,0 +1,79 @@
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError, DataError
+from dynid.io.datasets import dataset_spec, load_recording
+from dynid.model.description import load_robot
+
+
+def _ur_row(t, q, dq, i):
+    return ",".join(f"{x:.6f}" for x in [t, *q, *dq, *i, *np.zeros(12)]) + "\n"
+
+
+def test_ur_rtde_preset_resamples_jittered_time_onto_a_uniform_grid(tmp_path, rng):
+    robot = load_robot("ur10e")
+    t = 1000.0 + np.cumsum(rng.uniform(0.006, 0.014, 300))
+    q = np.outer(t - t[0], np.arange(1, 7) * 0.1)  # linear in time: interpolation is exact
+    cur = np.outer(np.ones_like(t), np.arange(1, 7))
+    (tmp_path / "ur.csv").write_text("".join(_ur_row(tk, qk, qk * 0 + 0.5, ik) for tk, qk, ik in zip(t, q, cur)))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "resample": 100.0}, tmp_path, "cfg", "ident", 6)
+    rec = load_recording(spec, robot)
+    assert rec.rate == 100.0
+    np.testing.assert_allclose(np.diff(rec.t), 0.01, atol=1e-9)
+    np.testing.assert_allclose(rec.q, np.outer(rec.t, np.arange(1, 7) * 0.1), atol=1e-5)
+    np.testing.assert_allclose(rec.tau, np.tile(np.arange(1, 7) * robot.drive_gains, (rec.n_samples, 1)), rtol=1e-9)
+
+
+def test_non_increasing_time_names_file_and_line(tmp_path):
+    rows = [_ur_row(t, np.zeros(6), np.zeros(6), np.zeros(6)) for t in (0.0, 0.01, 0.02, 0.02, 0.03)]
+    (tmp_path / "ur.csv").write_text("".join(rows))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv"}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(DataError, match=r"ur.csv: line 4: time stamps must increase"):
+        load_recording(spec, load_robot("ur10e"))
+
+
+def test_wrong_column_count_for_the_preset(tmp_path):
+    (tmp_path / "ur.csv").write_text("1,2,3\n")
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv"}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(DataError, match=r"ur.csv: line 1: expected 31 columns, got 3"):
+        load_recording(spec, load_robot("ur10e"))
+
+
+def test_motor_side_dataset_goes_through_the_transmission(tmp_path, rng):
+    robot = load_robot("tx40")
+    tr = robot.transmission
+    q = rng.uniform(-1, 1, (50, 6))
+    tau = rng.uniform(-5, 5, (50, 6))
+    header = ",".join(f"Joint_{j + 1}" for j in range(6))
+    np.savetxt(tmp_path / "p.csv", (q - tr.position_offset) @ tr.motor_from_joint.T, delimiter=",", header=header, comments="")
+    np.savetxt(tmp_path / "c.csv", np.linalg.solve(tr.motor_from_joint.T, tau.T).T, delimiter=",", header=header, comments="")
+    spec = dataset_spec({"preset": "motor-side", "rate": 200.0, "positions": {"file": "p.csv"}, "torques": {"file": "c.csv"}},
+                        tmp_path, "cfg", "ident", 6)
+    rec = load_recording(spec, robot)
+    np.testing.assert_allclose(rec.q, q, atol=1e-12)
+    np.testing.assert_allclose(rec.tau, tau, atol=1e-10)
+    np.testing.assert_allclose(rec.t[1], 1 / 200.0)
+
+
+@pytest.mark.parametrize("table, message", [
+    ({"file": "x.csv", "rate": 10, "positions": {"columns": [1, 2, 3, 4, 5, 6]}}, "exactly one of 'currents'"),
+    ({"preset": "ur-rtde", "file": "x.csv", "rate": 10}, "either a 'time' column or a sampling 'rate'"),
+    ({"preset": "ur-rtde", "file": "x.csv", "positions": {"unit": "grad"}}, r"positions.unit: expected one of rad, deg"),
+    ({"preset": "ur-rtde", "file": "x.csv", "side": "both"}, r"side: expected 'joint' or 'motor'"),
+    ({"preset": "ur-rtde", "file": "x.csv", "rows": [10, 5]}, r"rows: expected \[first, last\]"),
+    ({"preset": "ur-rtde", "file": "x.csv", "colums": 3}, r"unknown field\(s\) \['colums'\]"),
+])
+def test_dataset_config_errors(tmp_path, table, message):
+    with pytest.raises(ConfigError, match=message):
+        dataset_spec(table, tmp_path, "cfg: identification", "ident", 6)
+
+
+def test_real_ur_log_with_a_truncated_last_line_is_read_with_a_warning():
+    from ..conftest import shared_data
+
+    root = shared_data("ur10e_mamedov2020")
+    spec = dataset_spec({"preset": "ur-rtde", "file": "identification_data/ur-20_02_19_15harm50secLoad.csv", "rows": [11, 10**7]},
+                        root, "cfg", "ident", 6)
+    rec = load_recording(spec, load_robot("ur10e"))
+    assert any("ur-20_02_19_15harm50secLoad.csv: line 6107 is truncated" in w for w in rec.warnings)
+    assert rec.n_samples > 6000
