@@ -21,6 +21,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_regressor.py
+	$(BIN)/python benchmarks/bench_identify_memory.py
 
 clean:
 	rm -rf $(VENV) dynid-run

@@ -162,7 +162,7 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         keep = np.abs(data.dq[index]) >= vmin
         if progress is not None:
             progress(int(index[-1]) + 1, n_s)
-        yield index, y, values[:, n * nb:], keep
+        yield index, y, values[:, n * nb:].copy(), keep  # a copy: a view would keep the whole block alive
 
 
 @dataclass(frozen=True)
