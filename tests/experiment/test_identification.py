@@ -93,20 +93,30 @@ def test_ur10e_real_logs_against_the_published_parameters():
 
 
 def test_tx40_real_logs_against_figaroh():
-    """TX40 (FIGAROH recording): every FIGAROH base parameter matches one of dynid's regroupings exactly,
-    the main friction and inertia values agree within 3 of FIGAROH's stated standard deviations, and the
-    fit and time-split validation errors are close to those of FIGAROH's own parameters."""
+    """TX40 (FIGAROH recording), identified on the whole motion as FIGAROH did: every FIGAROH base
+    parameter matches one of dynid's regroupings exactly, and dynid's values agree with FIGAROH's OLS
+    values within 3 of its stated standard deviations."""
     root = shared_data("staubli_tx40_figaroh")
-    cfg = load_identification_config(REPO / "configs" / "tx40.toml", data_root=root)
+    cfg = load_identification_config(REPO / "configs" / "tx40-full.toml", data_root=root)
     result = run_identification(cfg)
     figaroh = next(r for r in result.references if r.name == "FIGAROH OLS")
     assert not np.isnan(figaroh.relative_std).any()  # all 60 expressions matched
-    z = dict(zip(result.base.names, result.reference_agreement(figaroh)["z"]))
-    for name in ("ZZ1R", "fv1", "fc1", "ZZ2R", "fc2", "fv3", "Ia3", "Ia4", "fv4", "fv5", "fcm6"):
-        assert z[name] <= 3, (name, z[name])
-    for cmp in (result.fit, *result.validations):
-        m = cmp.metrics()
-        assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 5.0)
+    agreement = result.reference_agreement(figaroh)
+    assert agreement["compared"] == 60 and agreement["within_3_sigma"] >= 58 and agreement["within_1_sigma"] >= 40
+    m = result.fit.metrics()
+    assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 1.0)
+
+
+def test_tx40_time_split_validation():
+    """Identified on 0.1-5.6 s, validated on 5.6-7.6 s: errors close to those of FIGAROH's parameters
+    (which were fitted on the whole motion, validation part included)."""
+    root = shared_data("staubli_tx40_figaroh")
+    cfg = load_identification_config(REPO / "configs" / "tx40.toml", data_root=root)
+    result = run_identification(cfg)
+    (val,) = result.validations
+    m = val.metrics()
+    assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 5.0)
+    assert m["dynid WLS"]["correlation"].min() > 0.95
 
 
 def test_config_errors_name_file_and_field(tmp_path):
