@@ -228,11 +228,9 @@ def validate(
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
     import json
-    from dataclasses import replace
 
     from ..exceptions import DataError
-    from ..experiment.identification_config import load_identification_config, run_validation
-    from ..io.datasets import SignalSpec
+    from ..experiment.identification_config import dataset_for_file, load_identification_config, run_validation
     from ..report.identification_run import save_validation
 
     try:
@@ -245,13 +243,7 @@ def validate(
             raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
         datasets = None
         if file is not None:
-            spec = cfg.identification
-            files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
-            if len(files) > 1:
-                raise DataError("--file: the identification dataset reads several files; add a [[validation]] table to the config instead")
-            sig = {k: SignalSpec(file, s.columns, s.scale) for k, s in spec.signals.items()}
-            time = SignalSpec(file, spec.time.columns, 1.0) if spec.time else None
-            datasets = (replace(spec, name=file.name, signals=sig, time=time, rows=_parse_rows(rows)),)
+            datasets = (dataset_for_file(cfg, file, _parse_rows(rows)),)
         elif rows is not None:
             raise DataError("--rows needs --file")
         with _progress("validation") as progress:

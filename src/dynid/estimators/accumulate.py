@@ -59,7 +59,6 @@ class LeastSquaresAccumulator:
         self.n_dof = int(n_dof)
         self.factors = np.zeros((self.n_dof, self.n_params + 1, self.n_params + 1))
         self.rows = np.zeros(self.n_dof, dtype=np.int64)
-        self.tau_sumsq = np.zeros(self.n_dof)
 
     def add(self, w, tau, mask=None) -> None:
         """Fold in a chunk: ``w`` (M, p), ``tau`` (M,), optional ``mask`` (M,) of rows to keep.
@@ -83,7 +82,6 @@ class LeastSquaresAccumulator:
             block = np.column_stack([w[j::self.n_dof][sel], tau[j::self.n_dof][sel]])
             self.factors[j] = _triangular(np.vstack([self.factors[j], block]), self.n_params + 1)
             self.rows[j] += int(sel.sum())
-            self.tau_sumsq[j] += float(block[:, -1] @ block[:, -1])
 
     def joint_residual_sumsq(self, params: np.ndarray) -> np.ndarray:
         """``||tau_j - W_j params||²`` of each joint (n_dof,)."""

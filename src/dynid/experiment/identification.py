@@ -129,7 +129,9 @@ def prepare(recording: Recording, settings: Preprocessing) -> PreparedData:
 
 
 def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
-    v = np.broadcast_to(np.asarray(settings.min_speed, dtype=float), (n,)) if np.ndim(settings.min_speed) == 0 else np.asarray(settings.min_speed, dtype=float)
+    v = np.asarray(settings.min_speed, dtype=float)
+    if v.ndim == 0:
+        v = np.full(n, float(v))
     if v.shape != (n,) or np.any(v < 0):
         raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
     return v
@@ -207,6 +209,16 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
                             {k: np.concatenate(v) for k, v in preds.items()})
 
 
+def estimate_label(method: str) -> str:
+    """How dynid's estimate is labelled in tables, figures and JSON: ``"dynid WLS"``."""
+    return f"dynid {method.upper()}"
+
+
+def parameter_sets(method: str, params: np.ndarray, references=()) -> dict:
+    """label -> base parameter vector: dynid's estimate, then each reference set."""
+    return {estimate_label(method): params, **{r.name: r.beta for r in references}}
+
+
 @dataclass(frozen=True)
 class IdentificationResult:
     """Identified base parameters with their uncertainty, fit, validations and reference sets.
@@ -246,13 +258,11 @@ class IdentificationResult:
 
     @property
     def label(self) -> str:
-        return f"dynid {self.method.upper()}"
+        return estimate_label(self.method)
 
     def parameter_sets(self) -> dict:
         """label -> base parameter vector: dynid's estimate, then each reference set."""
-        out = {self.label: self.solution.params}
-        out.update({r.name: r.beta for r in self.references})
-        return out
+        return parameter_sets(self.method, self.solution.params, self.references)
 
     def reference_agreement(self, ref: ReferenceSet) -> dict:
         """Differences to a reference that states relative standard deviations: ``z = |Δ| / σ_ref``."""
@@ -313,8 +323,6 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
     for r in references:
         warnings.extend(r.warnings)
-    result = IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references),
-                                  TorqueComparison(data.name, np.zeros(0), np.zeros((0, n)), {}), n_rows=int(acc.rows.sum()),
-                                  settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings))
-    fit = compare_torques(robot, base, data, result.parameter_sets())
-    return replace(result, fit=fit)
+    fit = compare_torques(robot, base, data, parameter_sets(method, sol.params, references))
+    return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
+                                settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings))

@@ -45,11 +45,12 @@ import numpy as np
 
 from ..dynamics.base_parameters import base_parameters
 from ..exceptions import ConfigError, DataError
-from ..io.datasets import DatasetSpec, dataset_spec, load_recording
+from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
 from ..io.references import load_reference
 from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
-from .identification import METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify, prepare
+from .identification import (METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify,
+                             parameter_sets, prepare)
 
 DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
@@ -129,9 +130,10 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     if not isinstance(robot_ref, str):
         raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
     robot = load_robot(robot_ref if robot_ref in builtin_robots() or Path(robot_ref).is_absolute() else here / robot_ref)
-    root = data_root or os.environ.get(DATA_ROOT_ENV) or doc.get("data_root", ".")
-    root = Path(root)
-    root = root if root.is_absolute() or data_root or os.environ.get(DATA_ROOT_ENV) else here / root
+    override = data_root or os.environ.get(DATA_ROOT_ENV)
+    if override is None and not isinstance(doc.get("data_root", "."), str):
+        raise ConfigError(f"{path}: data_root: expected a folder path, got {doc['data_root']!r}")
+    root = Path(override) if override else here / doc.get("data_root", ".")  # an absolute path stays as is
     if not root.is_dir():
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root, --data-root or {DATA_ROOT_ENV})")
     n = robot.n_dof
@@ -170,6 +172,24 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
     return tuple(out), tuple(warnings)
 
 
+def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> DatasetSpec:
+    """The identification dataset's column map applied to another log ``file`` (optional ``rows``).
+
+    Raises
+    ------
+    DataError
+        If the identification dataset reads several files (add a [[validation]] table instead).
+    """
+    spec = config.identification
+    files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
+    if len(files) > 1:
+        raise DataError("--file: the identification dataset reads several files; add a [[validation]] table to the config instead")
+    signals = {k: SignalSpec(Path(file), s.columns, s.scale) for k, s in spec.signals.items()}
+    time = SignalSpec(Path(file), spec.time.columns, 1.0) if spec.time else None
+    return replace(spec, name=Path(file).name, signals=signals, time=time,
+                   rows=None if rows is None else tuple(rows))
+
+
 def run_identification(config: IdentificationConfig, progress=None, validate: bool = True) -> IdentificationResult:
     """Identify the base parameters from the config's identification dataset, then validate them on
     each validation dataset beside the reference sets."""
@@ -197,13 +217,13 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     try:
         names = [p["name"] for p in identified["base_parameters"]]
         values = np.array([float(p["value"]) for p in identified["base_parameters"]])
-        label = f"dynid {str(identified.get('method', 'ls')).upper()}"
+        method = str(identified.get("method", "ls"))
     except (KeyError, TypeError, ValueError):
         raise DataError("results: expected the results.json of dynid identify (a list base_parameters of {name, value})") from None
     if tuple(names) != base.names:
         raise DataError(f"results: its base parameters ({len(names)}) are not those of robot {config.robot.name!r} ({base.n_base}); was it identified with this config?")
     refs = _references(config, base)
-    sets = {label: values, **{r.name: r.beta for r in refs}}
+    sets = parameter_sets(method, values, refs)
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")

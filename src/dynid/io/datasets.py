@@ -112,15 +112,6 @@ class Recording:
     def n_samples(self) -> int:
         return self.t.shape[0]
 
-    def between(self, start: float, stop: float) -> "Recording":
-        """The samples with ``start <= t - t[0] < stop`` [s]."""
-        rel = self.t - self.t[0]
-        keep = (rel >= start) & (rel < stop)
-        if keep.sum() < 2:
-            raise DataError(f"{self.name}: no samples between {start} s and {stop} s (the recording lasts {rel[-1]:.3f} s)")
-        return Recording(self.name, self.t[keep], self.q[keep], None if self.dq is None else self.dq[keep],
-                         self.tau[keep], self.rate, self.warnings)
-
 
 def _rows(value, where: str):
     if value is None:

@@ -127,13 +127,13 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             n_fields = line.count(delimiter) + 1
             if expected is None:
                 expected = n_fields
+                if max(cols) >= expected:
+                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the line has {n_fields} columns")
             if n_fields != expected:
                 if not line.endswith("\n"):  # only the last line can lack a newline
                     warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
                     break
                 raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}")
-            if max(cols) >= n_fields:
-                raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the line has {n_fields} columns")
             if first_line is None:
                 first_line = line_no
             if not pending:
