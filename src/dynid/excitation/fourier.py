@@ -70,9 +70,66 @@ class FourierTrajectory:
         ddq = -(s * wk**2) @ self.a.T - (c * wk**2) @ self.b.T
         return q, dq, ddq
 
-    def to_dict(self) -> dict:
-        return {"form": "paper eq. 14", "omega_f": self.omega_f, "q0": self.q0.tolist(),
+    @classmethod
+    def from_swevers(cls, q0, a, b, omega_f: float) -> "FourierTrajectory":
+        """From the Swevers form ``q_i = q_i0 + Σ_l a_il/(l w_f) sin(l w_f t) - b_il/(l w_f) cos(l w_f t)``
+        (Swevers, Ganseman, Tükel, de Schutter, Van Brussel, IEEE TRA 13(5), 1997), where ``a, b``
+        are velocity amplitudes [rad/s]."""
+        a, b = np.atleast_2d(np.asarray(a, dtype=float)), np.atleast_2d(np.asarray(b, dtype=float))
+        lw = omega_f * np.arange(1, a.shape[1] + 1)
+        return cls(float(omega_f), np.asarray(q0, dtype=float).copy(), a / lw, -b / lw)
+
+    def to_swevers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Inverse of :meth:`from_swevers`: ``(q0, a, b)`` with velocity amplitudes [rad/s]."""
+        lw = self.omega_f * np.arange(1, self.n_harmonics + 1)
+        return self.q0.copy(), self.a * lw, -self.b * lw
+
+    def to_dict(self, form: str = "paper") -> dict:
+        """JSON-ready coefficients in the paper's form (eq. 14) or the Swevers form; see :func:`trajectory_from_dict`."""
+        if form == "swevers":
+            q0, a, b = self.to_swevers()
+            return {"form": "swevers", "omega_f": self.omega_f, "q0": q0.tolist(), "a": a.tolist(), "b": b.tolist()}
+        if form != "paper":
+            raise ConfigError(f"trajectory form must be 'paper' or 'swevers', got {form!r}")
+        return {"form": "paper", "omega_f": self.omega_f, "q0": self.q0.tolist(),
                 "a": self.a.tolist(), "b": self.b.tolist()}
+
+
+FORMS = ("paper", "swevers")
+
+
+def trajectory_from_dict(d: dict, source: str = "trajectory") -> FourierTrajectory:
+    """A trajectory from :meth:`FourierTrajectory.to_dict` output (``form`` "paper" — eq. 14 — or "swevers").
+
+    Raises
+    ------
+    ConfigError
+        A missing or malformed field, named with ``source``.
+    """
+    if not isinstance(d, dict):
+        raise ConfigError(f"{source}: expected an object with form, omega_f, q0, a, b")
+    form = d.get("form", "paper")
+    if form == "paper eq. 14":  # results.json of earlier `dynid run`s
+        form = "paper"
+    if form not in FORMS:
+        raise ConfigError(f"{source}: form must be one of {', '.join(FORMS)}, got {form!r}")
+    for key in ("omega_f", "q0", "a", "b"):
+        if key not in d:
+            raise ConfigError(f"{source}: missing field {key!r}")
+    try:
+        omega_f = float(d["omega_f"])
+        q0 = np.asarray(d["q0"], dtype=float).reshape(-1)
+        a, b = (np.asarray(d[k], dtype=float) for k in ("a", "b"))
+    except (TypeError, ValueError):
+        raise ConfigError(f"{source}: omega_f, q0, a and b must be numbers (a, b: one list per joint)") from None
+    if a.ndim != 2 or a.shape != b.shape or a.shape[0] != q0.size or a.shape[1] < 1:
+        raise ConfigError(f"{source}: expected a and b of shape (n_dof, n_harmonics) with n_dof = {q0.size} "
+                          f"(the length of q0), got {a.shape} and {b.shape}")
+    if not all(np.all(np.isfinite(x)) for x in (q0, a, b)):
+        raise ConfigError(f"{source}: coefficients must be finite")
+    if form == "swevers":
+        return FourierTrajectory.from_swevers(q0, a, b, omega_f)
+    return FourierTrajectory(omega_f, q0, a, b)
 
 
 def sample_times(duration: float, rate: float) -> np.ndarray:

@@ -1,0 +1,162 @@
+"""Constraints of the excitation design (paper eq. 15) and their margins on a time grid.
+
+``q_min <= q(t) <= q_max``, ``|dq(t)| <= dq_max``, ``|ddq(t)| <= ddq_max``, ``|tau(t)| <= tau_max`` with the
+nominal parameters, and the tool point in the workspace ``W_o`` (a box and/or above a floor plane).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..dynamics.kinematics import tool_positions
+from ..dynamics.regressor import regressor
+from ..exceptions import ConfigError
+from ..model.robot import Limits, Robot
+from .fourier import FourierTrajectory
+
+AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """Where the tool point may go (``W_o`` of eq. 15), in the base frame [m].
+
+    Attributes
+    ----------
+    box_min, box_max : (3,) arrays
+        Axis-aligned box; ``±inf`` leaves a side open.
+    floor : float
+        Height of a horizontal floor plane; the tool point stays at ``z >= floor`` (``-inf``: none).
+    """
+
+    box_min: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
+    box_max: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    floor: float = -np.inf
+
+    def __post_init__(self) -> None:
+        for name in ("box_min", "box_max"):
+            v = np.asarray(getattr(self, name), dtype=float)
+            if v.shape != (3,) or np.any(np.isnan(v)):
+                raise ConfigError(f"workspace.{name}: expected three numbers [x, y, z] in metres, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, v)
+        bad = [AXES[i] for i in range(3) if not self.box_min[i] < self.box_max[i]]
+        if bad:
+            raise ConfigError(f"workspace: box_min must be below box_max, not on axis {', '.join(bad)} "
+                              f"(box_min {self.box_min.tolist()}, box_max {self.box_max.tolist()})")
+        if np.isnan(self.floor) or self.floor == np.inf:
+            raise ConfigError(f"workspace.floor: expected a height in metres, got {self.floor}")
+
+    def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """``G p <= h`` for the finite sides: G (m, 3), h (m,), and a label per row."""
+        rows, h, labels = [], [], []
+        for i in range(3):
+            if np.isfinite(self.box_min[i]):
+                rows.append(-np.eye(3)[i]); h.append(-self.box_min[i]); labels.append(f"{AXES[i]} >= {self.box_min[i]:g} m")
+            if np.isfinite(self.box_max[i]):
+                rows.append(np.eye(3)[i]); h.append(self.box_max[i]); labels.append(f"{AXES[i]} <= {self.box_max[i]:g} m")
+        if np.isfinite(self.floor):
+            rows.append(-np.eye(3)[2]); h.append(-self.floor); labels.append(f"z >= floor {self.floor:g} m")
+        return np.array(rows).reshape(-1, 3), np.array(h, dtype=float), labels
+
+    def to_dict(self) -> dict:
+        fin = lambda v: [float(x) if np.isfinite(x) else None for x in v]  # noqa: E731
+        return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
+                "floor": float(self.floor) if np.isfinite(self.floor) else None}
+
+
+@dataclass(frozen=True)
+class ConstraintMargin:
+    """How close a trajectory comes to one constraint: ``margin = limit - worst`` (≥ 0 when satisfied).
+
+    ``relative`` is the margin divided by the limit (by the range for positions), in [0, 1] when satisfied.
+    """
+
+    constraint: str
+    where: str
+    limit: float
+    worst: float
+    margin: float
+    relative: float
+
+    @property
+    def satisfied(self) -> bool:
+        return self.margin >= 0.0
+
+    def to_dict(self) -> dict:
+        return {k: getattr(self, k) for k in ("constraint", "where", "limit", "worst", "margin", "relative")}
+
+
+def check_limits(limits: Limits, n_dof: int, source: str = "limits") -> None:
+    """Raise a one-line :class:`ConfigError` for limits no trajectory can satisfy.
+
+    Raises
+    ------
+    ConfigError
+        ``q_max <= q_min`` for a joint, or a velocity, acceleration or torque limit that is not positive.
+    """
+    for name in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max"):
+        v = getattr(limits, name)
+        if v.shape != (n_dof,) or np.any(np.isnan(v)):
+            raise ConfigError(f"{source}.{name}: expected {n_dof} numbers, got shape {v.shape}")
+    bad = np.flatnonzero(~(limits.q_max > limits.q_min))
+    if bad.size:
+        j = bad[0]
+        raise ConfigError(f"{source}: joint {j + 1} has q_max = {limits.q_max[j]:g} rad not above q_min = {limits.q_min[j]:g} rad")
+    for name, unit in (("dq_max", "rad/s"), ("ddq_max", "rad/s²"), ("tau_max", "N·m")):
+        v = getattr(limits, name)
+        bad = np.flatnonzero(~(v > 0))
+        if bad.size:
+            raise ConfigError(f"{source}.{name}: joint {bad[0] + 1} has {v[bad[0]]:g} {unit}, expected a positive limit")
+
+
+def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarray, limits: Limits,
+                       workspace: Workspace, phi: np.ndarray | None = None) -> list[ConstraintMargin]:
+    """Margin of every finite constraint of eq. 15, per joint (per side for the workspace), on times ``t``.
+
+    Parameters
+    ----------
+    robot : Robot
+    trajectory : FourierTrajectory
+    t : (N,) array [s]
+        Time grid the constraints are checked on.
+    limits : Limits
+    workspace : Workspace
+    phi : (n_params,) array, optional
+        Parameters the torques are computed with (default: the robot's nominal ones).
+
+    Returns
+    -------
+    list of ConstraintMargin
+        Positions (lower and upper), velocities, accelerations, torques, then workspace sides.
+    """
+    q, dq, ddq = trajectory.evaluate(t)
+    phi = robot.standard_parameters() if phi is None else phi
+    tau = regressor(robot, q, dq, ddq) @ phi
+    out = []
+    span = limits.q_max - limits.q_min
+    for j in range(robot.n_dof):
+        lbl = f"joint {j + 1}"
+        if np.isfinite(limits.q_min[j]):
+            worst = float(q[:, j].min())
+            m = worst - limits.q_min[j]
+            out.append(ConstraintMargin("q_min [rad]", lbl, float(limits.q_min[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
+        if np.isfinite(limits.q_max[j]):
+            worst = float(q[:, j].max())
+            m = limits.q_max[j] - worst
+            out.append(ConstraintMargin("q_max [rad]", lbl, float(limits.q_max[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
+    for name, values, lim in (("|dq| [rad/s]", dq, limits.dq_max), ("|ddq| [rad/s²]", ddq, limits.ddq_max),
+                              ("|tau| [N·m]", tau, limits.tau_max)):
+        for j in range(robot.n_dof):
+            if np.isfinite(lim[j]):
+                worst = float(np.abs(values[:, j]).max())
+                out.append(ConstraintMargin(name, f"joint {j + 1}", float(lim[j]), worst, float(lim[j] - worst), float((lim[j] - worst) / lim[j])))
+    g, h, labels = workspace.inequalities()
+    if len(h):
+        p = tool_positions(robot, q)
+        for gi, hi, lbl in zip(g, h, labels):
+            m = float(hi - (p @ gi).max())
+            sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
+            out.append(ConstraintMargin("workspace [m]", f"tool {lbl}", sign * float(hi), sign * float(hi) - sign * m, m, np.nan))
+    return out

@@ -1,0 +1,55 @@
+"""Design criteria of an excitation trajectory and their derivatives with respect to the base regressor.
+
+Both take the stacked base observation matrix ``W_b`` (N·n_dof, n_base) and return the value and
+``M = ∂f/∂W_b`` (same shape), from which the chain rule gives the gradient in any parametrisation:
+``df = Σ M ∘ dW_b``.
+
+- ``cond``: ``log cond(W_b) = log σ_max - log σ_min`` (paper eq. 15 minimises cond(Φ)); with the singular
+  triplets, ``dσ = u^T dW v``, here from the eigenpairs of ``W_b^T W_b`` (Gautier & Khalil 1992; Swevers et al. 1997).
+- ``d-optimal``: ``-log det(W_b^T W_b / N)``, the D-optimality criterion of the information matrix
+  (Swevers et al., IEEE TRA 13(5), 1997); ``M = -2 W_b (W_b^T W_b)^{-1}``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..exceptions import ConfigError
+
+CRITERIA = ("cond", "d-optimal")
+
+
+def log_condition_number(w: np.ndarray) -> tuple[float, np.ndarray]:
+    """``log cond(W)`` and its derivative with respect to ``W`` (same shape as ``W``).
+
+    From the extreme eigenpairs ``(λ, v)`` of ``W^T W`` (``σ² = λ``): ``d log σ = (W v)^T dW v / λ``.
+    """
+    lam, v = np.linalg.eigh(w.T @ w)
+    if lam[0] <= lam[-1] * 1e-24:
+        return float(np.log(1e12)), np.zeros_like(w)  # rank-deficient: flat, the constraints move on
+    grad = np.outer(w @ v[:, -1], v[:, -1]) / lam[-1] - np.outer(w @ v[:, 0], v[:, 0]) / lam[0]
+    return float(0.5 * np.log(lam[-1] / lam[0])), grad
+
+
+def neg_log_det_information(w: np.ndarray) -> tuple[float, np.ndarray]:
+    """``-log det(W^T W / N)`` (N rows) and its derivative with respect to ``W``."""
+    info = w.T @ w
+    sign, logdet = np.linalg.slogdet(info / w.shape[0])
+    if sign <= 0:
+        return float(np.log(1e14) * w.shape[1]), np.zeros_like(w)
+    return float(-logdet), -2.0 * np.linalg.solve(info, w.T).T
+
+
+def criterion_function(name: str):
+    """The criterion function for ``"cond"`` or ``"d-optimal"``.
+
+    Raises
+    ------
+    ConfigError
+        For another name.
+    """
+    if name == "cond":
+        return log_condition_number
+    if name == "d-optimal":
+        return neg_log_det_information
+    raise ConfigError(f"design.criterion must be one of {', '.join(CRITERIA)}, got {name!r}")

@@ -1,0 +1,499 @@
+"""Optimal excitation trajectories (paper §3.2, eq. 15): Fourier coefficients minimising cond(W_base).
+
+The design variables are the coefficients of eq. 14 (and the offsets q_o when they are free). Positions,
+velocities and accelerations are linear in them, so their limits are linear constraints with exact
+Jacobians. The criterion (:mod:`dynid.excitation.criteria`), the torques and the tool point are not; their
+gradients follow by the chain rule from the per-sample derivatives of the regressor and of the tool point
+with respect to the joint state (:mod:`dynid.dynamics.sensitivity`): one batched regressor call of
+``5·n_dof + 1`` blocks per iterate, instead of one finite difference of the whole problem per coefficient.
+
+SciPy's SLSQP solves the constrained problem from several starts drawn with a seeded ``rng``. The
+constraints are imposed on a grid of ``grid_points`` samples per period with limits tightened by
+``safety``; the returned design is checked on a grid ten times finer with the true limits, and only
+designs that pass are kept.
+
+References: Swevers, Ganseman, Tükel, de Schutter, Van Brussel, "Optimal robot excitation and
+identification", IEEE TRA 13(5), 1997; Gautier & Khalil, "Exciting trajectories for the identification of
+base inertial parameters of robots", IJRR 11(4), 1992.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import minimize
+
+from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..dynamics.kinematics import tool_positions
+from ..dynamics.regressor import regressor
+from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
+from ..exceptions import ConfigError, DynIdError
+from ..model.robot import Limits, Robot
+from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
+from .criteria import CRITERIA, criterion_function
+from .fourier import FourierTrajectory
+
+VERIFY_REFINEMENT = 10
+"""The verification grid is this many times finer than the design grid."""
+
+
+class InfeasibleDesignError(DynIdError, ValueError):
+    """No trajectory satisfying every constraint was found (the message says which constraint)."""
+
+
+@dataclass(frozen=True)
+class ExcitationProblem:
+    """What to design: robot, Fourier series, criterion and the constraints of eq. 15.
+
+    Attributes
+    ----------
+    robot : Robot
+        The identified model (e.g. ``er16.submodel(3)``).
+    omega_f : float
+        Fundamental pulsation [rad/s]; the trajectory is periodic with period ``2π/omega_f``.
+    n_harmonics : int
+        Harmonics per joint (N of eq. 14).
+    limits : Limits, optional
+        Joint limits of eq. 15 (default: the robot's). Infinite entries are not constrained.
+    workspace : Workspace
+        ``W_o``: box and floor for the tool point.
+    offsets : (n_dof,) array, optional
+        Fixed offsets q_o [rad]; ``None`` optimises them (starting from the middle of the position limits).
+    rest : bool
+        Start and end at rest at the offset pose: ``q(0) = q_o``, ``dq(0) = ddq(0) = 0`` (linear
+        equalities; the trajectory is periodic, so the end equals the start).
+    criterion : {"cond", "d-optimal"}
+    grid_points : int
+        Samples per period of the design grid.
+    safety : float
+        Limits are tightened by this fraction during the optimisation (of the range for positions, of
+        the robot's reach for the workspace), so that the design holds between grid points.
+    phi : (n_params,) array, optional
+        Standard parameters for the torque constraints (default: the robot's nominal values).
+    base : BaseParameters, optional
+        Base parameters of ``robot`` (computed when omitted).
+    """
+
+    robot: Robot
+    omega_f: float
+    n_harmonics: int
+    limits: Limits | None = None
+    workspace: Workspace = field(default_factory=Workspace)
+    offsets: np.ndarray | None = None
+    rest: bool = False
+    criterion: str = "cond"
+    grid_points: int = 100
+    safety: float = 0.02
+    phi: np.ndarray | None = None
+    base: BaseParameters | None = None
+
+    def __post_init__(self) -> None:
+        robot = self.robot
+        if self.limits is None:
+            object.__setattr__(self, "limits", robot.limits)
+        if self.phi is None:
+            object.__setattr__(self, "phi", robot.standard_parameters())
+        if self.base is None:
+            object.__setattr__(self, "base", base_parameters(robot))
+        if not (np.isfinite(self.omega_f) and self.omega_f > 0):
+            raise ConfigError(f"trajectory.omega_f must be a positive pulsation in rad/s, got {self.omega_f}")
+        if int(self.n_harmonics) != self.n_harmonics or self.n_harmonics < 1:
+            raise ConfigError(f"trajectory.harmonics must be a positive integer, got {self.n_harmonics}")
+        if self.criterion not in CRITERIA:
+            raise ConfigError(f"design.criterion must be one of {', '.join(CRITERIA)}, got {self.criterion!r}")
+        if self.grid_points < 4 * self.n_harmonics:
+            raise ConfigError(f"design.grid_points must be at least 4 per harmonic ({4 * self.n_harmonics}), got {self.grid_points}")
+        if not 0 <= self.safety < 0.5:
+            raise ConfigError(f"design.safety must be in [0, 0.5), got {self.safety}")
+        check_limits(self.limits, robot.n_dof)
+        if self.offsets is not None:
+            off = np.asarray(self.offsets, dtype=float)
+            if off.shape != (robot.n_dof,) or not np.all(np.isfinite(off)):
+                raise ConfigError(f"trajectory.offsets: expected {robot.n_dof} finite angles in rad, got {self.offsets!r}")
+            object.__setattr__(self, "offsets", off)
+        self._check_start_pose()
+
+    @property
+    def period(self) -> float:
+        return 2.0 * np.pi / self.omega_f
+
+    def start_pose(self) -> np.ndarray:
+        """The offsets: the fixed ones, or the middle of the position limits (0 where unlimited)."""
+        if self.offsets is not None:
+            return self.offsets.copy()
+        lim = self.limits
+        mid = 0.5 * (lim.q_min + lim.q_max)
+        return np.where(np.isfinite(mid), mid, 0.0)
+
+    def _check_start_pose(self) -> None:
+        """The offset (start) pose must satisfy every constraint at rest, or no trajectory can."""
+        q0 = self.start_pose()
+        lim = self.limits
+        bad = np.flatnonzero((q0 <= lim.q_min) | (q0 >= lim.q_max))
+        if bad.size:
+            j = bad[0]
+            raise ConfigError(f"trajectory.offsets: joint {j + 1} offset {q0[j]:g} rad is not inside its limits "
+                              f"[{lim.q_min[j]:g}, {lim.q_max[j]:g}] rad")
+        p = tool_positions(self.robot, q0[None])[0]
+        g, h, labels = self.workspace.inequalities()
+        out = [lbl for gi, hi, lbl in zip(g, h, labels) if gi @ p > hi]
+        if out:
+            raise ConfigError(f"workspace excludes the start pose: at the offsets q_o = {np.round(q0, 4).tolist()} rad the tool "
+                              f"point is at {np.round(p, 3).tolist()} m, which violates {', '.join(out)}")
+        zero = np.zeros((1, self.robot.n_dof))
+        tau = (regressor(self.robot, q0[None], zero, zero) @ self.phi)[0]
+        bad = np.flatnonzero(np.abs(tau) > lim.tau_max)
+        if bad.size:
+            j = bad[0]
+            raise ConfigError(f"limits.tau_max: holding the start pose needs {abs(tau[j]):.1f} N·m on joint {j + 1}, "
+                              f"above its limit {lim.tau_max[j]:g} N·m")
+
+    def design_grid(self) -> np.ndarray:
+        """One period sampled with ``grid_points`` samples [s]."""
+        return np.arange(self.grid_points) * (self.period / self.grid_points)
+
+    def verification_grid(self) -> np.ndarray:
+        """The design grid refined :data:`VERIFY_REFINEMENT` times [s]."""
+        n = self.grid_points * VERIFY_REFINEMENT
+        return np.arange(n) * (self.period / n)
+
+    def margins(self, trajectory: FourierTrajectory, t: np.ndarray | None = None) -> list[ConstraintMargin]:
+        """Margins of every constraint on ``t`` (default: the verification grid)."""
+        t = self.verification_grid() if t is None else t
+        return constraint_margins(self.robot, trajectory, t, self.limits, self.workspace, self.phi)
+
+    def criterion_value(self, trajectory: FourierTrajectory) -> float:
+        """cond(W_base) or −log det of the information matrix on the design grid."""
+        w = _base_observation(self, trajectory, self.design_grid())
+        value, _ = criterion_function(self.criterion)(w)
+        return float(np.exp(value)) if self.criterion == "cond" else value
+
+
+def condition_number(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray | None = None) -> float:
+    """cond(W_base) of ``trajectory`` on ``t`` (default: the design grid)."""
+    t = problem.design_grid() if t is None else t
+    return float(np.linalg.cond(_base_observation(problem, trajectory, t)))
+
+
+def _base_observation(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray) -> np.ndarray:
+    if trajectory.n_dof != problem.robot.n_dof:
+        raise ConfigError(f"trajectory has {trajectory.n_dof} joints, the robot model {problem.robot.n_dof}")
+    y = regressor(problem.robot, *trajectory.evaluate(t))
+    return problem.base.base_observation(y).reshape(-1, problem.base.n_base)
+
+
+@dataclass(frozen=True)
+class ExcitationDesign:
+    """An optimised excitation trajectory and how good it is (``to_dict`` is JSON-ready).
+
+    Attributes
+    ----------
+    trajectory : FourierTrajectory
+    initial : FourierTrajectory
+        The start the design came from (the given initial trajectory when one was given).
+    cond, initial_cond : float
+        cond(W_base) on the design grid after and before the optimisation.
+    cond_verification : float
+        cond(W_base) on the verification grid.
+    log_det, initial_log_det : float
+        ``log det(W_b^T W_b / N)`` after and before.
+    margins : list of ConstraintMargin
+        On the verification grid, with the true limits.
+    success : bool
+        SLSQP's own flag for the kept start.
+    message : str
+    nit, nfev : int
+        Iterations and criterion evaluations over all starts.
+    start_values : list of float
+        cond(W_base) reached from every start (``inf`` when the start's result failed verification).
+    seconds : float
+    """
+
+    trajectory: FourierTrajectory
+    initial: FourierTrajectory
+    criterion: str
+    cond: float
+    initial_cond: float
+    cond_verification: float
+    log_det: float
+    initial_log_det: float
+    margins: list
+    success: bool
+    message: str
+    nit: int
+    nfev: int
+    start_values: list
+    seconds: float
+
+    @property
+    def feasible(self) -> bool:
+        return all(m.satisfied for m in self.margins)
+
+    def to_dict(self, form: str = "paper") -> dict:
+        return {"criterion": self.criterion, "cond": self.cond, "initial_cond": self.initial_cond,
+                "cond_verification_grid": self.cond_verification, "log_det_information": self.log_det,
+                "initial_log_det_information": self.initial_log_det, "success": self.success,
+                "message": self.message, "nit": self.nit, "nfev": self.nfev, "start_values": self.start_values,
+                "seconds": self.seconds, "feasible": self.feasible, "margins": [m.to_dict() for m in self.margins],
+                "trajectory": self.trajectory.to_dict(form), "initial_trajectory": self.initial.to_dict(form)}
+
+
+class _Layout:
+    """Design variables ``x = [q_o (when free), a (n·H), b (n·H)]`` and the linear maps to the joint states."""
+
+    def __init__(self, problem: ExcitationProblem, t: np.ndarray):
+        n, h = problem.robot.n_dof, problem.n_harmonics
+        self.n, self.h, self.omega_f = n, h, problem.omega_f
+        self.free_offsets = problem.offsets is None
+        self.n_off = n if self.free_offsets else 0
+        self.nx = self.n_off + 2 * n * h
+        wk = problem.omega_f * np.arange(1, h + 1)
+        s, c = np.sin(np.outer(t, wk)), np.cos(np.outer(t, wk))
+        per_a = (s, c * wk, -s * wk**2)
+        per_b = (c, -s * wk, -c * wk**2)
+        lin = np.zeros((3, t.size, n, self.nx))  # state c of joint i at sample k = lin[c, k, i] @ x + const
+        for i in range(n):
+            ia = self.n_off + i * h + np.arange(h)
+            ib = self.n_off + n * h + i * h + np.arange(h)
+            for kind in range(3):
+                lin[kind, :, i, ia] = per_a[kind].T
+                lin[kind, :, i, ib] = per_b[kind].T
+            if self.free_offsets:
+                lin[0, :, i, i] = 1.0
+        self.lin = lin
+        self.const = np.zeros((3, t.size, n))
+        if not self.free_offsets:
+            self.const[0] += problem.offsets
+
+    def states(self, x: np.ndarray) -> np.ndarray:
+        """(3, N, n): q, dq, ddq on the grid."""
+        return self.lin @ x + self.const
+
+    def to_x(self, traj: FourierTrajectory) -> np.ndarray:
+        parts = [traj.q0] if self.free_offsets else []
+        return np.concatenate(parts + [traj.a.ravel(), traj.b.ravel()])
+
+    def to_trajectory(self, x: np.ndarray, offsets: np.ndarray | None) -> FourierTrajectory:
+        n, h = self.n, self.h
+        q0 = x[:n].copy() if self.free_offsets else np.asarray(offsets, dtype=float).copy()
+        a = x[self.n_off:self.n_off + n * h].reshape(n, h).copy()
+        b = x[self.n_off + n * h:].reshape(n, h).copy()
+        return FourierTrajectory(self.omega_f, q0, a, b)
+
+
+class _Objective:
+    """Criterion and nonlinear constraints with their gradients at one iterate (cached per ``x``)."""
+
+    def __init__(self, problem: ExcitationProblem, layout: _Layout):
+        self.p, self.lay = problem, layout
+        self._x, self._xg = None, None
+        self.nfev = 0
+        lim, s = problem.limits, problem.safety
+        self.tau_idx = np.flatnonzero(np.isfinite(lim.tau_max))
+        self.tau_lim = lim.tau_max[self.tau_idx] * (1 - s)
+        g, h, _ = problem.workspace.inequalities()
+        reach = sum(float(np.linalg.norm(jt.translation)) for jt in problem.robot.joints) + float(np.linalg.norm(problem.robot.tool_translation))
+        self.ws_g, self.ws_h = g, h - s * reach
+        self.crit = criterion_function(problem.criterion)
+
+    def _eval(self, x: np.ndarray) -> None:
+        """Values only: one regressor call (SLSQP's line search needs no more)."""
+        if self._x is not None and np.array_equal(x, self._x):
+            return
+        p, lay = self.p, self.lay
+        self.q, self.dq, self.ddq = lay.states(x)
+        y = regressor(p.robot, self.q, self.dq, self.ddq)
+        idx = p.base.independent
+        self.value, self.m = self.crit(y[..., idx].reshape(-1, idx.size))
+        self.tau = y[:, self.tau_idx, :] @ p.phi
+        if self.ws_h.size:
+            self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
+        self.nfev += 1
+        self._x, self._xg = x.copy(), None
+
+    def _eval_gradients(self, x: np.ndarray) -> None:
+        """Gradients by the chain rule through the regressor's state derivatives."""
+        self._eval(x)
+        if self._xg is not None:
+            return
+        p, lay = self.p, self.lay
+        _, dy = regressor_state_derivatives(p.robot, self.q, self.dq, self.ddq)
+        idx = p.base.independent
+        m = self.m.reshape(self.q.shape[0], lay.n, idx.size)
+        g = np.einsum("cikjp,kjp->cik", dy[..., idx], m)
+        self.grad = np.einsum("cik,ckix->x", g, lay.lin)
+        tau_sens = dy[..., self.tau_idx, :] @ p.phi  # (3, n, N, n_tau)
+        self.tau_jac = np.einsum("cikj,ckix->kjx", tau_sens, lay.lin)
+        if self.ws_h.size:
+            _, jac = tool_jacobian(p.robot, self.q)
+            self.ws_jac = -np.einsum("md,kdi,kix->kmx", self.ws_g, jac, lay.lin[0])
+        self._xg = True
+
+    def fun(self, x):
+        self._eval(x)
+        return self.value
+
+    def jac(self, x):
+        self._eval_gradients(x)
+        return self.grad
+
+    def cons(self, x):
+        self._eval(x)
+        lim = self.tau_lim
+        parts = [((lim - self.tau) / lim).ravel(), ((lim + self.tau) / lim).ravel()]
+        if self.ws_h.size:
+            parts.append(self.ws.ravel())
+        return np.concatenate(parts)
+
+    def cons_jac(self, x):
+        self._eval_gradients(x)
+        lim = self.tau_lim[None, :, None]
+        parts = [(-self.tau_jac / lim).reshape(-1, x.size), (self.tau_jac / lim).reshape(-1, x.size)]
+        if self.ws_h.size:
+            parts.append(self.ws_jac.reshape(-1, x.size))
+        return np.concatenate(parts)
+
+
+def _linear_constraints(problem: ExcitationProblem, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
+    """``A x + c >= 0`` for positions, velocities and accelerations (tightened, scaled by their limit)."""
+    lim, s = problem.limits, problem.safety
+    rows, consts = [], []
+    span = lim.q_max - lim.q_min
+    for j in range(lay.n):
+        lq, cq = lay.lin[0][:, j], lay.const[0][:, j]
+        if np.isfinite(lim.q_max[j]):
+            hi = lim.q_max[j] - s * span[j] if np.isfinite(span[j]) else lim.q_max[j]
+            scale = span[j] if np.isfinite(span[j]) else 1.0
+            rows.append(-lq / scale); consts.append((hi - cq) / scale)
+        if np.isfinite(lim.q_min[j]):
+            lo = lim.q_min[j] + s * span[j] if np.isfinite(span[j]) else lim.q_min[j]
+            scale = span[j] if np.isfinite(span[j]) else 1.0
+            rows.append(lq / scale); consts.append((cq - lo) / scale)
+        for kind, vmax in ((1, lim.dq_max[j]), (2, lim.ddq_max[j])):
+            if np.isfinite(vmax):
+                l_ = lay.lin[kind][:, j] / vmax
+                rows += [-l_, l_]
+                consts += [np.full(l_.shape[0], 1 - s)] * 2
+    if not rows:
+        return np.zeros((0, lay.nx)), np.zeros(0)
+    return np.concatenate(rows), np.concatenate(consts)
+
+
+def _rest_equalities(lay: _Layout) -> np.ndarray:
+    """Rows ``E`` with ``E x = 0``: ``q(0) - q_o``, ``dq(0)`` and ``ddq(0)`` of every joint (t = 0 is grid sample 0)."""
+    e = lay.lin[:, 0].reshape(3 * lay.n, lay.nx).copy()
+    if lay.free_offsets:
+        e[:lay.n, :lay.n] = 0.0
+    return e
+
+
+def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
+    """Random amplitudes decaying as 1/k, projected on the rest equalities, scaled into the limits."""
+    n, h = lay.n, lay.h
+    k = np.arange(1, h + 1)
+    amp = np.concatenate([(rng.standard_normal((n, h)) / k).ravel(), (rng.standard_normal((n, h)) / k).ravel()])
+    x0 = np.zeros(lay.nx)
+    if lay.free_offsets:
+        x0[:n] = problem.start_pose()
+    d = np.concatenate([np.zeros(lay.n_off), amp])
+    if eq is not None:
+        d -= np.linalg.pinv(eq) @ (eq @ d)
+    slope = a_lin @ d
+    room = a_lin @ x0 + c_lin
+    neg = slope < -1e-15
+    scale = 0.8 * float(np.min(room[neg] / -slope[neg])) if np.any(neg) else 1.0
+    for _ in range(12):  # shrink until torques and workspace hold too
+        x = x0 + scale * d
+        if np.all(objective.cons(x) >= 0):
+            return x
+        scale *= 0.6
+    return x
+
+
+def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
+                      initial: FourierTrajectory | None = None, maxiter: int = 150,
+                      callback: Callable[[int, int, float], None] | None = None) -> ExcitationDesign:
+    """Optimise an excitation trajectory for ``problem`` (paper eq. 15).
+
+    Parameters
+    ----------
+    problem : ExcitationProblem
+    n_starts : int
+        Number of SLSQP starts (the ``initial`` trajectory, when given, is the first).
+    rng : Generator or int seed
+        Draws the random starts.
+    initial : FourierTrajectory, optional
+        A trajectory to start from and to compare with (e.g. the paper's β1); its harmonics must match.
+    maxiter : int
+        SLSQP iterations per start.
+    callback : callable, optional
+        ``callback(done_starts, n_starts, best_cond)`` after every start.
+
+    Returns
+    -------
+    ExcitationDesign
+
+    Raises
+    ------
+    ConfigError
+        Invalid settings or an ``initial`` trajectory of another shape.
+    InfeasibleDesignError
+        If no start ends with every constraint satisfied on the verification grid.
+    """
+    t0 = time.perf_counter()
+    if n_starts < 1:
+        raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
+    rng = np.random.default_rng(rng)
+    lay = _Layout(problem, problem.design_grid())
+    objective = _Objective(problem, lay)
+    a_lin, c_lin = _linear_constraints(problem, lay)
+    eq = _rest_equalities(lay) if problem.rest else None
+    constraints = [{"type": "ineq", "fun": lambda x: a_lin @ x + c_lin, "jac": lambda x: a_lin},
+                   {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
+    if eq is not None:
+        constraints.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
+    if initial is not None:
+        if (initial.n_dof, initial.n_harmonics) != (lay.n, lay.h):
+            raise ConfigError(f"initial trajectory has {initial.n_dof} joints and {initial.n_harmonics} harmonics, "
+                              f"the design {lay.n} and {lay.h}")
+        initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets else problem.offsets, initial.a, initial.b)
+    best, best_cond, first, values = None, np.inf, None, []
+    nit = 0
+    for i in range(n_starts):
+        x0 = lay.to_x(initial) if (i == 0 and initial is not None) else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng)
+        if first is None:
+            first = lay.to_trajectory(x0, problem.offsets)
+        res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=constraints,
+                       options={"maxiter": maxiter, "ftol": 1e-7})
+        nit += int(res.nit)
+        traj = lay.to_trajectory(res.x, problem.offsets)
+        margins = problem.margins(traj)
+        value = condition_number(problem, traj) if all(m.satisfied for m in margins) else np.inf
+        values.append(value)
+        if value < best_cond:
+            best, best_cond, best_res, best_margins = traj, value, res, margins
+        if callback is not None:
+            callback(i + 1, n_starts, best_cond)
+    if best is None:
+        worst = min(problem.margins(traj), key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
+        raise InfeasibleDesignError(
+            f"no start satisfied every constraint on the verification grid (last start: {worst.constraint} on "
+            f"{worst.where} reaches {worst.worst:.4g} against {worst.limit:.4g}); raise design.safety, "
+            f"design.grid_points or design.starts, or relax the limits")
+    ref = initial if initial is not None else first
+    return ExcitationDesign(
+        trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
+        initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
+        log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins, success=bool(best_res.success),
+        message=str(best_res.message), nit=nit, nfev=objective.nfev, start_values=[float(v) for v in values],
+        seconds=time.perf_counter() - t0)
+
+
+def _log_det(problem: ExcitationProblem, traj: FourierTrajectory) -> float:
+    """``log det(W_b^T W_b / N)`` on the design grid (``-inf`` when singular)."""
+    w = _base_observation(problem, traj, problem.design_grid())
+    sign, value = np.linalg.slogdet(w.T @ w / w.shape[0])
+    return float(value) if sign > 0 else -np.inf

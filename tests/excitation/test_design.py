@@ -1,0 +1,100 @@
+"""Excitation design (paper eq. 15): gradients, constraints on a finer grid, criterion, errors."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.kinematics import tool_positions
+from dynid.dynamics.rnea import rnea_torques
+from dynid.exceptions import ConfigError
+from dynid.excitation.constraints import Workspace
+from dynid.excitation.design import (ExcitationProblem, _Layout, _Objective, condition_number, design_excitation)
+from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
+from dynid.model.description import load_robot
+
+
+@pytest.fixture(scope="module")
+def er16_3():
+    return load_robot("er16").submodel(3)
+
+
+def _finite_difference(f, x, h=1e-5):
+    cols = []
+    for i in range(x.size):
+        e = np.zeros_like(x)
+        e[i] = h
+        cols.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+@pytest.mark.parametrize("criterion", ["cond", "d-optimal"])
+def test_gradients_equal_finite_differences_of_the_whole_problem(er16_3, rng, criterion):
+    """The chain-rule gradients (criterion, torque and workspace constraints) against central differences."""
+    ws = Workspace(box_min=np.array([-3.0, -3.0, -3.0]), box_max=np.array([3.0, 3.0, 3.0]), floor=-1.5)
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 2, workspace=ws, criterion=criterion, grid_points=24)
+    lay = _Layout(prob, prob.design_grid())
+    obj = _Objective(prob, lay)
+    x = np.concatenate([prob.start_pose(), 0.3 * rng.standard_normal(lay.nx - 3)])
+    np.testing.assert_allclose(obj.jac(x), _finite_difference(obj.fun, x), rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(obj.cons_jac(x), _finite_difference(obj.cons, x).reshape(-1, x.size), rtol=1e-5, atol=1e-6)
+
+
+def _check_every_constraint_independently(robot, prob, traj):
+    """Positions, velocities, accelerations, Pinocchio RNEA torques and tool point on a 10× finer grid."""
+    t = np.linspace(0, traj.period, 10 * prob.grid_points, endpoint=False)
+    q, dq, ddq = traj.evaluate(t)
+    lim = prob.limits
+    assert np.all(q >= lim.q_min) and np.all(q <= lim.q_max)
+    assert np.all(np.abs(dq) <= lim.dq_max) and np.all(np.abs(ddq) <= lim.ddq_max)
+    assert np.all(np.abs(rnea_torques(robot, q, dq, ddq)) <= lim.tau_max)
+    p = tool_positions(robot, q)
+    ws = prob.workspace
+    assert np.all(p >= ws.box_min) and np.all(p <= ws.box_max) and np.all(p[:, 2] >= ws.floor)
+
+
+def test_er16_design_halves_cond_of_beta1_and_satisfies_every_constraint(er16_3):
+    beta1 = paper_identification_trajectory()
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0)
+    assert not [m for m in prob.margins(beta1) if not m.satisfied]  # β1 satisfies the robot's limits
+    design = design_excitation(prob, n_starts=2, rng=0, initial=beta1)
+    assert design.initial_cond == pytest.approx(condition_number(prob, beta1))
+    assert design.cond <= 0.5 * design.initial_cond
+    assert design.cond == pytest.approx(condition_number(prob, design.trajectory))
+    np.testing.assert_array_equal(design.trajectory.q0, beta1.q0)
+    assert design.feasible
+    _check_every_constraint_independently(er16_3, prob, design.trajectory)
+
+
+def test_rest_workspace_and_torque_constraints_hold_and_seed_reproduces(er16_3):
+    """Tight torque limits, a floor and a box that bind; start and end at rest; same seed, same design."""
+    tau_max = np.array([300.0, 600.0, 250.0])
+    ws = Workspace(box_min=np.array([-1.5, -1.5, -0.6]), box_max=np.array([1.5, 1.5, 1.5]), floor=-0.3)
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 3, limits=replace(er16_3.limits, tau_max=tau_max),
+                             workspace=ws, rest=True, grid_points=60)
+    a = design_excitation(prob, n_starts=2, rng=3)
+    b = design_excitation(prob, n_starts=2, rng=3)
+    np.testing.assert_array_equal(a.trajectory.a, b.trajectory.a)
+    assert a.cond < a.initial_cond
+    _check_every_constraint_independently(er16_3, prob, a.trajectory)
+    q, dq, ddq = a.trajectory.evaluate(np.array([0.0, a.trajectory.period]))
+    np.testing.assert_allclose(q, np.tile(a.trajectory.q0, (2, 1)), atol=1e-8)
+    np.testing.assert_allclose(dq, 0.0, atol=1e-8)
+    np.testing.assert_allclose(ddq, 0.0, atol=1e-7)
+    binding = [m for m in a.margins if m.constraint.startswith(("|tau|", "workspace")) and m.margin < 0.1 * abs(m.limit) + 0.05]
+    assert binding, "expected the torque or workspace limits to shape the design"
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda lim: dict(limits=replace(lim, q_min=lim.q_max.copy(), q_max=lim.q_min.copy())),
+     "joint 1 has q_max = -2.96 rad not above q_min = 2.96 rad"),
+    (lambda lim: dict(workspace=Workspace(floor=2.0)), "workspace excludes the start pose"),
+    (lambda lim: dict(workspace=Workspace(box_min=np.zeros(3), box_max=np.array([0.0, 1.0, 1.0]))), "box_min must be below box_max"),
+    (lambda lim: dict(limits=replace(lim, tau_max=np.array([1200.0, 10.0, 700.0]))), "holding the start pose needs"),
+    (lambda lim: dict(limits=replace(lim, dq_max=np.array([0.0, 1.0, 1.0]))), "dq_max: joint 1 has 0 rad/s"),
+    (lambda lim: dict(offsets=np.array([0.0, 2.0, 0.0])), "joint 2 offset 2 rad is not inside its limits"),
+    (lambda lim: dict(criterion="a-optimal"), "design.criterion must be one of cond, d-optimal"),
+])
+def test_infeasible_settings_get_a_clear_error(er16_3, change, message):
+    with pytest.raises(ConfigError, match=message):
+        ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, **change(er16_3.limits))
