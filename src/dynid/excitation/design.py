@@ -202,6 +202,8 @@ class ExcitationDesign:
         ``log det(W_b^T W_b / N)`` after and before.
     margins : list of ConstraintMargin
         On the verification grid, with the true limits.
+    initial_violations : list of ConstraintMargin
+        The constraints the initial trajectory violates on the verification grid (empty: it satisfies all).
     success : bool
         SLSQP's own flag for the kept start.
     message : str
@@ -221,6 +223,7 @@ class ExcitationDesign:
     log_det: float
     initial_log_det: float
     margins: list
+    initial_violations: list
     success: bool
     message: str
     nit: int
@@ -238,6 +241,7 @@ class ExcitationDesign:
                 "initial_log_det_information": self.initial_log_det, "success": self.success,
                 "message": self.message, "nit": self.nit, "nfev": self.nfev, "start_values": self.start_values,
                 "seconds": self.seconds, "feasible": self.feasible, "margins": [m.to_dict() for m in self.margins],
+                "initial_violations": [m.to_dict() for m in self.initial_violations],
                 "trajectory": self.trajectory.to_dict(form), "initial_trajectory": self.initial.to_dict(form)}
 
 
@@ -487,7 +491,8 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
     return ExcitationDesign(
         trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
-        log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins, success=bool(best_res.success),
+        log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins,
+        initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(best_res.success),
         message=str(best_res.message), nit=nit, nfev=objective.nfev, start_values=[float(v) for v in values],
         seconds=time.perf_counter() - t0)
 

@@ -82,7 +82,8 @@ def load_robot(name_or_path: str | Path) -> Robot:
     return robot_from_toml_text(path.read_text(encoding="utf-8"), source=str(path), base=path.parent)
 
 
-def _angle(value, where: str) -> float:
+def parse_angle(value, where: str) -> float:
+    """A number, or an angle written like ``"pi/2"``, ``"-pi"``, ``"3*pi/4"`` [rad]; ``where`` names the field in errors."""
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value)
     if isinstance(value, str):
@@ -155,10 +156,10 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
     else:
-        alpha = [_angle(r.get("alpha", 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
+        alpha = [parse_angle(r.get("alpha", 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
         a = [_number(r, "a", w, 0.0) for r, w in zip(rows, where)]
         d = [_number(r, "d", w, 0.0) for r, w in zip(rows, where)]
-        off = [_angle(r.get("theta_offset", 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
+        off = [parse_angle(r.get("theta_offset", 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
         if convention == "modified":
             joints = joints_from_modified_dh(alpha, a, d, off, names)
         else:
@@ -186,7 +187,7 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
                 raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, got {own!r}")
             mask[i] = [t in own for t in terms]
     drive = np.array([[_number(r, t, w, 0.0) for t in terms] for r, w in zip(rows, where)]).reshape(n, len(terms)) * mask
-    offsets = np.array([_angle(r.get("position_offset", 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
+    offsets = np.array([parse_angle(r.get("position_offset", 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(doc.get("transmission", {}), n, offsets, source)
     gains = np.array([_number(r, "drive_gain", w, 1.0) for r, w in zip(rows, where)])
     if np.any(gains <= 0):
@@ -196,7 +197,7 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     lim = {k: np.array([_number(r, k, w, dflt) for r, w in zip(rows, where)])
            for k, dflt in (("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
     for k, dflt in (("q_min", -inf), ("q_max", inf)):  # angles may be written like "-2*pi"
-        lim[k] = np.array([_angle(r.get(k, dflt), f"{w}.{k}") for r, w in zip(rows, where)])
+        lim[k] = np.array([parse_angle(r.get(k, dflt), f"{w}.{k}") for r, w in zip(rows, where)])
     for i in range(n):
         if not lim["q_min"][i] < lim["q_max"][i]:
             raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")

@@ -32,11 +32,30 @@ def plot_joint_trajectories(t, q, q_min=None, q_max=None, ax=None, title="Excita
     return axes
 
 
-def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory"):
-    """3-D path of the tool point (paper Fig. 5); ``xyz`` (N, 3) [m] in the base frame."""
+def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory", others=None, box=None, floor=None):
+    """3-D path of the tool point (paper Fig. 5); ``xyz`` (N, 3) [m] in the base frame.
+
+    ``others`` maps a label to another (M, 3) path (drawn dashed); ``box = (box_min, box_max)`` draws the
+    workspace box's finite edges and ``floor`` a floor plane under the paths.
+    """
     ax = _axes(ax, projection="3d", figsize=(7, 6))
-    ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], lw=1.0)
+    for label, path in (others or {}).items():
+        ax.plot(path[:, 0], path[:, 1], path[:, 2], lw=0.8, ls="--", color="gray", label=label)
+    ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], lw=1.0, label="tool path" if others else None)
     ax.scatter(*xyz[0], color="tab:green", label="start")
+    pts = np.concatenate([xyz] + list((others or {}).values()))
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    if box is not None and np.any(np.isfinite(np.asarray(box))):
+        bmin = np.where(np.isfinite(box[0]), box[0], lo)
+        bmax = np.where(np.isfinite(box[1]), box[1], hi)
+        corners = np.array([[x, y, z] for x in (bmin[0], bmax[0]) for y in (bmin[1], bmax[1]) for z in (bmin[2], bmax[2])])
+        for i in range(8):
+            for k in range(i + 1, 8):
+                if np.sum(corners[i] != corners[k]) == 1:
+                    ax.plot(*corners[[i, k]].T, color="tab:red", lw=0.6, ls=":")
+    if floor is not None and np.isfinite(floor):
+        xx, yy = np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]])
+        ax.plot_surface(xx, yy, np.full_like(xx, floor), color="tab:brown", alpha=0.2)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
@@ -75,3 +94,34 @@ def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measure
     np.atleast_1d(axes)[0].legend(loc="upper right", fontsize="small")
     np.atleast_1d(axes)[-1].set_xlabel("t [s]")
     return axes
+
+
+def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation trajectory and its limits"):
+    """Positions, velocities, accelerations and torques of each joint with their limits (paper Fig. 4).
+
+    ``states`` maps a label to ``(q, dq, ddq, tau)``, each (N, n); the first is drawn solid, the others
+    dashed. ``limits`` has ``q_min, q_max, dq_max, ddq_max, tau_max`` (n,) each; infinite ones are omitted.
+    """
+    import matplotlib.pyplot as plt
+
+    first = next(iter(states.values()))[0]
+    n = first.shape[1]
+    if ax is None:
+        fig = plt.figure(figsize=(13, 2.0 * n + 0.6), constrained_layout=True)
+        ax = fig.subplots(n, 4, sharex=True, squeeze=False)
+    columns = (("q [rad]", limits.q_min, limits.q_max), ("dq [rad/s]", -limits.dq_max, limits.dq_max),
+               ("ddq [rad/s²]", -limits.ddq_max, limits.ddq_max), ("τ [N·m]", -limits.tau_max, limits.tau_max))
+    for c, (unit, lo, hi) in enumerate(columns):
+        for j in range(n):
+            a = ax[j, c]
+            for i, (label, values) in enumerate(states.items()):
+                a.plot(t, values[c][:, j], lw=1.1 if i == 0 else 0.8, ls="-" if i == 0 else "--", label=label)
+            for lim in (lo[j], hi[j]):
+                if np.isfinite(lim):
+                    a.axhline(lim, color="tab:red", ls=":", lw=0.9)
+            a.set_ylabel(f"joint {j + 1}: {unit}" if c == 0 else unit)
+            a.grid(alpha=0.3)
+        ax[-1, c].set_xlabel("t [s]")
+    ax[0, 0].legend(loc="upper right", fontsize="small")
+    ax[0, 0].figure.suptitle(title)
+    return ax

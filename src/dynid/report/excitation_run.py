@@ -1,0 +1,50 @@
+"""Write a ``dynid excite`` run to a folder: coefficients (JSON), set-points (CSV) and the figures."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..dynamics.kinematics import tool_positions
+from ..dynamics.regressor import regressor
+from ..experiment.excitation_config import ExcitationRun
+from ..io import write_json
+from ..io.trajectories import write_trajectory_csv
+from . import figures
+from .output import output_folder, save_figure
+
+FIGURES = {
+    "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
+    "excitation_tool_path.png": "3-D tool path in the workspace (cf. paper Fig. 5)",
+}
+
+
+def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
+    """Write ``excitation.json``, ``excitation.csv`` and the figures into ``out``; return the paths.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    out = output_folder(out)
+    problem, design = run.config.problem, run.design
+    robot = problem.robot
+    t = problem.verification_grid()
+    states = {}
+    for label, traj in (("optimised", design.trajectory), (f"initial ({run.config.initial_label})", design.initial)):
+        q, dq, ddq = traj.evaluate(t)
+        states[label] = (q, dq, ddq, regressor(robot, q, dq, ddq) @ problem.phi)
+    paths = [out / name for name in FIGURES]
+    save_figure(figures.plot_excitation_states(
+        t, states, problem.limits, title=f"{robot.name}: optimised excitation, cond(W_base) {design.initial_cond:.1f} → "
+                                          f"{design.cond:.1f} (dotted: limits)"), paths[0])
+    box = (problem.workspace.box_min, problem.workspace.box_max)
+    paths_xyz = {label: tool_positions(robot, s[0]) for label, s in states.items()}
+    optimised = paths_xyz.pop("optimised")
+    save_figure(figures.plot_tool_path(optimised, others=paths_xyz, box=box, floor=problem.workspace.floor,
+                                       title=f"{robot.name}: tool path of the optimised excitation"), paths[1])
+    csv_path = out / "excitation.csv"
+    write_trajectory_csv(csv_path, run.t, run.q, run.dq, run.ddq)
+    json_path = out / "excitation.json"
+    write_json(json_path, run.to_dict())
+    return [json_path, csv_path] + paths
