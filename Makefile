@@ -22,6 +22,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_regressor.py
 	$(BIN)/python benchmarks/bench_identify_memory.py
+	$(BIN)/python benchmarks/bench_excitation_design.py
 
 clean:
 	rm -rf $(VENV) dynid-run

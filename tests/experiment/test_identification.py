@@ -137,3 +137,48 @@ def test_config_errors_name_file_and_field(tmp_path):
     cfg.write_text('robot = "ur10e"\ndata_root = "missing"\n[identification]\npreset = "ur-rtde"\nfile = "x.csv"\n')
     with pytest.raises(ConfigError, match=r"data_root .*missing is not a folder"):
         load_identification_config(cfg)
+
+
+def test_identify_with_the_excitation_json_uses_fourier_fit_derivatives(tmp_path):
+    """A UR10e log of a designed excitation (noisy positions, RNEA torques): with [preprocessing]
+    excitation = the design's JSON, derivatives come from the Fourier fit and the parameters are recovered."""
+    from dynid.excitation.constraints import Workspace
+    from dynid.excitation.design import ExcitationProblem, design_excitation
+    from dynid.io import write_json
+
+    robot = load_robot("ur10e")
+    home = np.array([0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+    prob = ExcitationProblem(robot, 2 * np.pi * 0.1, 4, offsets=home, workspace=Workspace(floor=0.1), grid_points=80)
+    design = design_excitation(prob, n_starts=1, rng=0)
+    write_json(tmp_path / "excitation.json", {"trajectory": design.trajectory.to_dict("swevers")})
+    rng = np.random.default_rng(5)
+    rate = 250.0
+    t = np.arange(int(3 * design.trajectory.period * rate)) / rate  # three periods
+    q, dq, ddq = design.trajectory.evaluate(t)
+    tau = rnea_torques(robot, q, dq, ddq) + rng.normal(0, 0.05, q.shape)
+    q_meas = q + rng.normal(0, 2e-4, q.shape)
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, q_meas, tau]), delimiter=",", fmt="%.12g")
+    text = f'''robot = "ur10e"
+data_root = "{tmp_path}"
+[identification]
+file = "log.csv"
+time = {{ column = 1 }}
+positions = {{ columns = [2, 3, 4, 5, 6, 7] }}
+torques = {{ columns = [8, 9, 10, 11, 12, 13] }}
+[preprocessing]
+torque_cutoff = 0
+decimation = 1
+trim = 0
+excitation = "excitation.json"
+[estimation]
+method = "ols"
+'''
+    (tmp_path / "c.toml").write_text(text)
+    result = run_identification(load_identification_config(tmp_path / "c.toml"))
+    truth = base_parameters(robot, rng=0).base_from_standard(robot.standard_parameters())
+    est = result.solution.params
+    assert np.all(np.abs(est - truth) <= np.maximum(5 * result.solution.params_std, 0.01 * np.abs(truth).max()))
+    assert np.linalg.norm(est - truth) / np.linalg.norm(truth) < 0.02
+    (tmp_path / "c.toml").write_text(text.replace('excitation = "excitation.json"', 'excitation = "nosuch.json"'))
+    with pytest.raises(ConfigError, match=r"c.toml: preprocessing.excitation: .*nosuch.json: trajectory file not found"):
+        load_identification_config(tmp_path / "c.toml")

@@ -178,11 +178,26 @@ def condition_number(problem: ExcitationProblem, trajectory: FourierTrajectory, 
     return float(np.linalg.cond(_base_observation(problem, trajectory, t)))
 
 
+def base_condition_number(robot: Robot, base: BaseParameters, trajectory: FourierTrajectory, n_samples: int = 100) -> float:
+    """cond(W_base) of ``trajectory`` sampled ``n_samples`` times over one period (no limits involved).
+
+    Raises
+    ------
+    ConfigError
+        If the trajectory's number of joints is not the robot's.
+    """
+    t = np.arange(n_samples) * (trajectory.period / n_samples)
+    return float(np.linalg.cond(_stacked_base_observation(robot, base, trajectory, t)))
+
+
+def _stacked_base_observation(robot: Robot, base: BaseParameters, trajectory: FourierTrajectory, t: np.ndarray) -> np.ndarray:
+    if trajectory.n_dof != robot.n_dof:
+        raise ConfigError(f"trajectory has {trajectory.n_dof} joints, the robot model {robot.n_dof}")
+    return base.base_observation(regressor(robot, *trajectory.evaluate(t))).reshape(-1, base.n_base)
+
+
 def _base_observation(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray) -> np.ndarray:
-    if trajectory.n_dof != problem.robot.n_dof:
-        raise ConfigError(f"trajectory has {trajectory.n_dof} joints, the robot model {problem.robot.n_dof}")
-    y = regressor(problem.robot, *trajectory.evaluate(t))
-    return problem.base.base_observation(y).reshape(-1, problem.base.n_base)
+    return _stacked_base_observation(problem.robot, problem.base, trajectory, t)
 
 
 @dataclass(frozen=True)

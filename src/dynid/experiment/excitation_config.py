@@ -188,7 +188,10 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
                 raise ConfigError(f"{path}: design.initial = \"paper\" is β1 with 5 harmonics, the design has {harmonics}")
             initial, initial_label = paper_initial(k, omega_f), "paper β1 (eq. A.1)"
         elif isinstance(init, str):
-            initial, initial_label = load_trajectory(here / init), init
+            try:
+                initial, initial_label = load_trajectory(here / init), init
+            except ConfigError as exc:
+                raise ConfigError(f"{path}: design.initial: {exc}") from None
         else:
             raise ConfigError(f"{path}: design.initial: expected \"paper\" or an excitation JSON file, got {init!r}")
 

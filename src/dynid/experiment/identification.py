@@ -24,6 +24,7 @@ from ..io.datasets import Recording
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..preprocessing.filters import butterworth_filtfilt, differentiate, parallel_decimation
+from ..preprocessing.fourier_fit import fourier_fit_derivatives
 from ..validation import correlation_coefficient, relative_error, rmse
 
 METHODS = ("ols", "wls")
@@ -50,6 +51,11 @@ class Preprocessing:
         velocities when they are measured), 0 when those filters are off.
     chunk : int
         Samples per chunk of the regressor.
+    fourier : (omega_f, n_harmonics) or None
+        When the robot ran a known periodic excitation (eq. 14, e.g. from ``dynid excite``): positions,
+        velocities and accelerations come from a least-squares fit of the measured positions on its
+        harmonics (paper §3.3; :func:`dynid.preprocessing.fourier_fit_derivatives`) instead of filtering
+        and differentiating; torques are still low-pass filtered.
     """
 
     order: int = 4
@@ -60,6 +66,7 @@ class Preprocessing:
     min_speed: float | tuple = 0.0
     trim: float | None = None
     chunk: int = 20_000
+    fourier: tuple[float, int] | None = None
 
     def resolved(self, rate: float, measured_velocity: bool = True) -> "Preprocessing":
         nyq = rate / 2
@@ -115,9 +122,12 @@ def prepare(recording: Recording, settings: Preprocessing) -> PreparedData:
 
     if recording.n_samples < 3 * (2 * s.order + 1) + 1:
         raise DataError(f"{recording.name}: {recording.n_samples} samples are too few to filter")
-    q = lowpass(recording.q, s.position_cutoff, "position")
-    dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
-    ddq = differentiate(dq, rate)
+    if s.fourier is not None:
+        q, dq, ddq, _ = fourier_fit_derivatives(recording.t, recording.q, *s.fourier)
+    else:
+        q = lowpass(recording.q, s.position_cutoff, "position")
+        dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
+        ddq = differentiate(dq, rate)
     tau = lowpass(recording.tau, s.torque_cutoff, "torque")
     t = recording.t
     cut = int(round(s.trim * rate))

@@ -16,6 +16,8 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     torque_cutoff = 10.0                 # Hz
     decimation = 1
     min_speed = 0.0                      # rad/s, one value or one per joint
+    excitation = "excitation.json"       # the robot ran this trajectory of dynid excite: derivatives
+                                         # by a Fourier fit on its harmonics instead of filters
 
     [estimation]
     method = "wls"                       # "ols" or "wls"
@@ -47,6 +49,7 @@ from ..dynamics.base_parameters import base_parameters
 from ..exceptions import ConfigError, DataError
 from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
 from ..io.references import load_reference
+from ..io.trajectories import load_trajectory
 from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
 from .identification import (METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify,
@@ -70,10 +73,10 @@ class IdentificationConfig:
 
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "torque_cutoff": float,
-             "decimation": int, "min_speed": None, "trim": float, "chunk": int}
+             "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None}
 
 
-def _preprocessing(table, where: str, n: int) -> Preprocessing:
+def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
     if not isinstance(table, dict):
         raise ConfigError(f"{where}: expected a table")
     unknown = sorted(set(table) - set(_PRE_KEYS))
@@ -84,6 +87,17 @@ def _preprocessing(table, where: str, n: int) -> Preprocessing:
         if key not in table:
             continue
         v = table[key]
+        if key == "excitation":
+            if not isinstance(v, str):
+                raise ConfigError(f"{where}.excitation: expected the excitation.json of dynid excite, got {v!r}")
+            try:
+                traj = load_trajectory(here / v)
+            except ConfigError as exc:
+                raise ConfigError(f"{where}.excitation: {exc}") from None
+            if traj.n_dof != n:
+                raise ConfigError(f"{where}.excitation: the trajectory has {traj.n_dof} joints, the robot {n}")
+            values["fourier"] = (traj.omega_f, traj.n_harmonics)
+            continue
         if key == "min_speed":
             ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0) or (
                 isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in v))
@@ -147,7 +161,7 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     names = [v.name for v in validation]
     if len(set(names)) != len(names):
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
-    pre = _preprocessing(doc.get("preprocessing", {}), f"{path}: preprocessing", n)
+    pre = _preprocessing(doc.get("preprocessing", {}), f"{path}: preprocessing", n, here)
     est = doc.get("estimation", {})
     method = est.get("method", "wls") if isinstance(est, dict) else None
     if method not in METHODS:
@@ -165,8 +179,9 @@ def _references(config: IdentificationConfig, base):
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
               progress=None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
     out, warnings = [], []
+    settings = replace(config.preprocessing, fourier=None)  # the excitation's harmonics fit only its own log
     for spec in datasets:
-        data = prepare(load_recording(spec, config.robot), config.preprocessing)
+        data = prepare(load_recording(spec, config.robot), settings)
         out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)

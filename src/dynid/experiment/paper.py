@@ -20,7 +20,9 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import observation_matrix
 from ..estimators import BeeColonyEstimator, LeastAbsoluteDeviations, OrdinaryLeastSquares, paper_objective
 from ..exceptions import ConfigError
+from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import FourierTrajectory, sample_times
+from ..io.trajectories import load_trajectory
 from ..excitation.paper_trajectories import BETA1_ROWS, BETA2_ROWS, PAPER_DURATION, PAPER_OMEGA_F, PAPER_RATE
 from ..model.description import load_robot
 from ..model.robot import Robot
@@ -65,6 +67,10 @@ class PaperExperimentConfig:
     abc_bounds : {"auto", "table3", "scaled"}
         Search box: the paper's Table 3, or ``±(2|β_OLS| + 1)`` around zero ("scaled"); "auto"
         takes Table 3 when every base parameter has an entry there.
+    excitation : str
+        Identification trajectory: "paper" (β1, eq. A.1), "optimized" (designed for this run by
+        :func:`dynid.excitation.design.design_excitation`: 5 harmonics at ``omega_f``, β1's offsets, the
+        robot's limits, starting from β1) or the path of an ``excitation.json`` written by ``dynid excite``.
     """
 
     robot: str = "er16"
@@ -82,6 +88,7 @@ class PaperExperimentConfig:
     maxiter: int = 50
     weights: tuple[float, ...] | None = None
     abc_bounds: str = "auto"
+    excitation: str = "paper"
 
     def validate(self, robot: Robot) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
@@ -178,7 +185,8 @@ class PaperRunResult:
         for key, m in self.methods.items():
             d = {"params": dict(zip(names, m.params.tolist())), "objective": m.objective, "seconds": m.seconds,
                  "n_evaluations": m.n_evaluations,
-                 "parameter_error_percent": dict(zip(names, _percent_error(m.params, self.truth).tolist()))}
+                 "parameter_error_percent": dict(zip(names, _percent_error(m.params, self.truth).tolist())),
+                 "parameter_error_norm_percent": float(100 * np.linalg.norm(m.params - self.truth) / np.linalg.norm(self.truth))}
             d.update({k: {s: v.tolist() for s, v in val.items()} for k, val in m.metrics.items()})
             if m.params_std is not None:
                 d["params_std"] = dict(zip(names, m.params_std.tolist()))
@@ -196,6 +204,26 @@ def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
 def _trajectory(rows: np.ndarray, joints: int, omega_f: float) -> FourierTrajectory:
     # joints beyond the paper's three reuse rows 1-3 (the paper gives no wrist trajectory)
     return FourierTrajectory.from_rows(rows[[j % 3 for j in range(joints)]], omega_f)
+
+
+def _identification_trajectory(config: PaperExperimentConfig, robot: Robot, base: BaseParameters):
+    """The identification trajectory of ``config.excitation`` and what is known of it (cond(W_base) …)."""
+    k = config.joints
+    beta1 = _trajectory(BETA1_ROWS, k, config.omega_f)
+    if config.excitation == "paper":
+        traj, label = beta1, "paper β1 (eq. A.1)"
+    elif config.excitation == "optimized":
+        problem = ExcitationProblem(robot, config.omega_f, beta1.n_harmonics, offsets=beta1.q0, base=base)
+        design = design_excitation(problem, n_starts=4, rng=np.random.default_rng([config.seed, 3]), initial=beta1)
+        traj, label = design.trajectory, "optimized (min cond(W_base) under the robot's limits; 4 starts: β1 and random)"
+    else:
+        traj, label = load_trajectory(config.excitation), config.excitation
+        if traj.n_dof != k:
+            raise ConfigError(f"--excitation {config.excitation}: the trajectory has {traj.n_dof} joints, the run identifies {k}")
+    info = {"trajectory": label, "cond_base_regressor": base_condition_number(robot, base, traj),
+            "cond_base_regressor_beta1": base_condition_number(robot, base, beta1),
+            "grid": "100 samples over one period"}
+    return traj, info
 
 
 def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
@@ -267,7 +295,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
 
     t = sample_times(config.duration, config.rate)
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
-    traj_id = _trajectory(BETA1_ROWS, k, config.omega_f)
+    traj_id, excitation_info = _identification_trajectory(config, robot, base)
     traj_val = _trajectory(BETA2_ROWS, k, config.omega_f)
     t_sim = time.perf_counter()
     ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings)
@@ -303,7 +331,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     lad_seconds = time.perf_counter() - t3
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
-                            {"identification": traj_id.to_dict(), "validation": traj_val.to_dict()},
+                            {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
+                             "excitation": excitation_info},
                             warnings=warnings)
     for key, est, secs, nev in (("abc", abc, abc_seconds, abc.n_evaluations_), ("lad", lad, lad_seconds, 1),
                                 ("ols", ols, ols_seconds, 1)):

@@ -32,9 +32,10 @@ def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
     ident, valid, lim = result.identification, result.validation, result.robot.limits
     abc, lad, ols = result.methods["abc"], result.methods["lad"], result.methods["ols"]
     paths = [out / name for name in FIGURES]
+    ident_name = "β1" if result.config.excitation == "paper" else "(optimized)" if result.config.excitation == "optimized" else "(from file)"
     save_figure(figures.plot_joint_trajectories(ident.t, ident.q, lim.q_min, lim.q_max,
-                                          title="Fig. 4 — identification trajectory β1 (dashed: limits)"), paths[0])
-    save_figure(figures.plot_tool_path(ident.tool, title="Fig. 5 — tool path of β1"), paths[1])
+                                          title=f"Fig. 4 — identification trajectory {ident_name} (dashed: limits)"), paths[0])
+    save_figure(figures.plot_tool_path(ident.tool, title=f"Fig. 5 — tool path of {ident_name}"), paths[1])
     save_figure(figures.plot_convergence(abc.history, reference={"LAD F (exact minimum, same box)": lad.objective, "OLS F": ols.objective,
                                                               f"paper F = {ref.OBJECTIVE}": ref.OBJECTIVE},
                                    title="Fig. 6 — ABC convergence (eq. 9)"), paths[2])

@@ -1,0 +1,97 @@
+"""`dynid excite` as a user runs it, and `dynid run --excitation` on its output."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.kinematics import tool_positions
+from dynid.dynamics.rnea import rnea_torques
+from dynid.experiment.excitation_config import load_excitation_config
+from dynid.io.trajectories import load_trajectory
+from dynid.model.description import load_robot
+
+from .test_cli import FAST, dynid
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _small(tmp_path, source: str, replace: dict) -> Path:
+    text = (REPO / "configs" / source).read_text()
+    for old, new in replace.items():
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / source
+    path.write_text(text)
+    return path
+
+
+def test_excite_ur10e_satisfies_every_constraint_on_a_10x_finer_grid(tmp_path):
+    """The README's UR10e config, fewer starts and harmonics: JSON, CSV, figures; limits checked independently."""
+    cfg = _small(tmp_path, "excite-ur10e.toml", {"harmonics = 5": "harmonics = 3", "starts = 4": "starts = 2"})
+    out = tmp_path / "ur"
+    p = dynid("excite", str(cfg), "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    assert "Before / after" in p.stdout and "Constraint margins" in p.stdout and "q_min [rad]" in p.stdout
+    doc = json.loads((out / "excitation.json").read_text())
+    assert doc["trajectory"]["form"] == "swevers" and doc["design"]["feasible"]
+    assert doc["design"]["cond"] < doc["design"]["initial_cond"]
+    traj = load_trajectory(out / "excitation.json")
+    config = load_excitation_config(cfg)
+    lim, ws = config.problem.limits, config.problem.workspace
+    robot = load_robot("ur10e")
+    t = np.linspace(0, traj.period, 10 * config.problem.grid_points, endpoint=False)
+    q, dq, ddq = traj.evaluate(t)
+    assert np.all((q >= lim.q_min) & (q <= lim.q_max))
+    assert np.all(np.abs(dq) <= lim.dq_max) and np.all(np.abs(ddq) <= lim.ddq_max)
+    assert np.all(np.abs(rnea_torques(robot, q, dq, ddq)) <= lim.tau_max)
+    xyz = tool_positions(robot, q)
+    assert np.all(xyz[:, 2] >= ws.floor) and np.all(np.abs(xyz[:, :2]) <= 1.2)
+    # the CSV for the controller: 500 Hz over one period, starting and ending at rest at the home pose
+    csv = np.loadtxt(out / "excitation.csv", delimiter=",", skiprows=1)
+    assert csv.shape == (int(round(traj.period * 500)) + 1, 19)
+    np.testing.assert_allclose(csv[[0, -1], 1:7], np.tile([0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0], (2, 1)), atol=1e-7)
+    np.testing.assert_allclose(csv[[0, -1], 7:], 0.0, atol=1e-7)
+    assert (out / "excitation_joints.png").is_file() and (out / "excitation_tool_path.png").is_file()
+
+
+def test_excite_er16_then_run_on_the_designed_trajectory(tmp_path):
+    cfg = _small(tmp_path, "excite-er16.toml", {"starts = 6": "starts = 1"})
+    out = tmp_path / "ex"
+    p = dynid("excite", str(cfg), "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    doc = json.loads((out / "excitation.json").read_text())
+    assert doc["design"]["cond"] <= 0.5 * doc["design"]["initial_cond"]
+    assert doc["settings"]["initial"] == "paper β1 (eq. A.1)" and not doc["design"]["initial_violations"]
+    p = dynid("run", "--out", str(tmp_path / "run"), *FAST, "--excitation", str(out / "excitation.json"))
+    assert p.returncode == 0, p.stderr
+    res = json.loads((tmp_path / "run" / "results.json").read_text())
+    ex = res["trajectories"]["excitation"]
+    assert ex["cond_base_regressor"] == pytest.approx(doc["design"]["cond"], rel=1e-6)
+    assert ex["cond_base_regressor_beta1"] == pytest.approx(doc["design"]["initial_cond"], rel=1e-6)
+
+
+@pytest.mark.parametrize("replace, message", [
+    ({'offsets = [-0.3857, 0.0011, 0.0]': 'offsets = [-0.3857, 0.0011, 0.0]\n[limits]\nq_min = [-1, 2, -1]\nq_max = [1, 1, 1]'},
+     "limits: joint 2 has q_max = 1 rad not above q_min = 2 rad"),
+    ({"floor = -0.5": "floor = 1.5"}, "workspace excludes the start pose"),
+    ({"harmonics = 5": "harmonics = 0"}, "trajectory.harmonics: expected a positive integer, got 0"),
+    ({"frequency = 0.05": "omega_f = 0.3\nfrequency = 0.05"}, "give exactly one of frequency"),
+    ({"[design]": "[design]\ncolour = 1"}, "design: unknown field(s) ['colour']"),
+    ({'initial = "paper"': 'initial = "nosuch.json"'}, "nosuch.json: trajectory file not found"),
+])
+def test_bad_configs_get_one_line_errors_and_no_output(tmp_path, replace, message):
+    cfg = _small(tmp_path, "excite-er16.toml", replace)
+    p = dynid("excite", str(cfg), "--out", str(tmp_path / "o"))
+    assert p.returncode == 1, p.stdout
+    assert message in p.stderr and str(cfg) in p.stderr and "Traceback" not in p.stderr + p.stdout
+    assert len(p.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_run_excitation_file_with_wrong_joint_count(tmp_path):
+    f = tmp_path / "t.json"
+    f.write_text(json.dumps({"form": "paper", "omega_f": 0.5, "q0": [0, 0], "a": [[0.1], [0.1]], "b": [[0.0], [0.0]]}))
+    p = dynid("run", "--out", str(tmp_path / "o"), *FAST, "--excitation", str(f))
+    assert p.returncode == 1 and "the trajectory has 2 joints, the run identifies 3" in p.stderr
