@@ -79,3 +79,13 @@ def test_limit_violations_are_reported(tmp_path):
     r = run_paper_experiment(PaperExperimentConfig(robot=str(p), **FAST))
     assert any("tau_max on joint(s) 2" in w for w in r.warnings)
     assert any("leaves the joint limits" in w for w in r.warnings)
+
+
+def test_optimized_excitation_run_has_at_most_half_the_cond_of_beta1_and_is_reproducible():
+    cfg = PaperExperimentConfig(excitation="optimized", **FAST)
+    a, b = run_paper_experiment(cfg), run_paper_experiment(cfg)
+    ex = a.to_dict()["trajectories"]["excitation"]
+    assert ex["trajectory"].startswith("optimized")
+    assert ex["cond_base_regressor"] <= 0.5 * ex["cond_base_regressor_beta1"]
+    assert not [w for w in a.warnings if "limits" in w or "tau_max" in w]  # within the er16's limits
+    np.testing.assert_array_equal(a.methods["ols"].params, b.methods["ols"].params)

@@ -311,7 +311,7 @@ def _print_excitation(run, paths) -> None:
     else:
         console.print("the initial trajectory satisfies every constraint too (same limits for both)")
     console.print(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
-                  f"{d.cond / d.initial_cond:.3f}; starts: " + ", ".join(f"{v:.2f}" for v in d.start_values)
+                  f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)") + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
                   + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s")
     t = Table(title="Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)", box=box.SIMPLE_HEAD,
               padding=(0, 1))

@@ -9,8 +9,8 @@ with respect to the joint state (:mod:`dynid.dynamics.sensitivity`): one batched
 
 SciPy's SLSQP solves the constrained problem from several starts drawn with a seeded ``rng``. The
 constraints are imposed on a grid of ``grid_points`` samples per period with limits tightened by
-``safety``; the returned design is checked on a grid ten times finer with the true limits, and only
-designs that pass are kept.
+``safety``; each start's design is checked on a grid ten times finer with the true limits; one that fails
+is solved again (at most :data:`RETRIES` times, see there), and only designs that pass are kept.
 
 References: Swevers, Ganseman, Tükel, de Schutter, Van Brussel, "Optimal robot excitation and
 identification", IEEE TRA 13(5), 1997; Gautier & Khalil, "Exciting trajectories for the identification of
@@ -20,7 +20,7 @@ base inertial parameters of robots", IJRR 11(4), 1992.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -38,6 +38,10 @@ from .fourier import FourierTrajectory
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
+
+RETRIES = 2
+"""How often a start whose design fails the verification grid is solved again: from its result with the
+safety doubled when SLSQP converged, else from the start with half its amplitudes."""
 
 
 class InfeasibleDesignError(DynIdError, ValueError):
@@ -225,7 +229,8 @@ class ExcitationDesign:
     nit, nfev : int
         Iterations and criterion evaluations over all starts.
     start_values : list of float
-        cond(W_base) reached from every start (``inf`` when the start's result failed verification).
+        Criterion reached from every start (cond(W_base), or −log det for "d-optimal"; ``inf`` when the
+        start's result failed verification even after :data:`RETRIES` more solves).
     seconds : float
     """
 
@@ -467,48 +472,68 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
         raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
     rng = np.random.default_rng(rng)
     lay = _Layout(problem, problem.design_grid())
-    objective = _Objective(problem, lay)
-    a_lin, c_lin = _linear_constraints(problem, lay)
     eq = _rest_equalities(lay) if problem.rest else None
-    constraints = [{"type": "ineq", "fun": lambda x: a_lin @ x + c_lin, "jac": lambda x: a_lin},
-                   {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
-    if eq is not None:
-        constraints.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
+    solvers = {}
+
+    def solver(safety: float):
+        """Objective and constraints with the limits tightened by ``safety`` (built once per value)."""
+        if safety not in solvers:
+            tightened = replace(problem, safety=safety)
+            objective = _Objective(tightened, lay)
+            a_lin, c_lin = _linear_constraints(tightened, lay)
+            cons = [{"type": "ineq", "fun": lambda x: a_lin @ x + c_lin, "jac": lambda x: a_lin},
+                    {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
+            if eq is not None:
+                cons.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
+            solvers[safety] = (objective, a_lin, c_lin, cons)
+        return solvers[safety]
+
     if initial is not None:
         if (initial.n_dof, initial.n_harmonics) != (lay.n, lay.h):
             raise ConfigError(f"initial trajectory has {initial.n_dof} joints and {initial.n_harmonics} harmonics, "
                               f"the design {lay.n} and {lay.h}")
         initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets else problem.offsets, initial.a, initial.b)
-    best, best_cond, first, values = None, np.inf, None, []
+    best, best_score, first, values = None, np.inf, None, []
     nit = 0
     for i in range(n_starts):
+        objective, a_lin, c_lin, _ = solver(problem.safety)
         x0 = lay.to_x(initial) if (i == 0 and initial is not None) else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng)
         if first is None:
             first = lay.to_trajectory(x0, problem.offsets)
-        res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=constraints,
-                       options={"maxiter": maxiter, "ftol": 1e-7})
-        nit += int(res.nit)
-        traj = lay.to_trajectory(res.x, problem.offsets)
-        margins = problem.margins(traj)
-        value = condition_number(problem, traj) if all(m.satisfied for m in margins) else np.inf
-        values.append(value)
-        if value < best_cond:
-            best, best_cond, best_res, best_margins = traj, value, res, margins
+        safety = problem.safety
+        for attempt in range(RETRIES + 1):
+            objective, _, _, cons = solver(safety)
+            res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=cons,
+                           options={"maxiter": maxiter, "ftol": 1e-7})
+            nit += int(res.nit)
+            traj = lay.to_trajectory(res.x, problem.offsets)
+            margins = problem.margins(traj)
+            if all(m.satisfied for m in margins):
+                break
+            if res.status == 0:  # converged, but violates between grid points: polish with tighter limits
+                x0, safety = res.x, min(0.45, 2 * max(safety, 0.01))
+            else:  # SLSQP lost its way (e.g. incompatible linearised constraints): again from half the amplitudes
+                x0 = x0.copy()
+                x0[lay.n_off:] *= 0.5
+        score = problem.criterion_value(traj) if all(m.satisfied for m in margins) else np.inf
+        values.append(score)
+        if score < best_score:
+            best, best_score, best_res, best_margins = traj, score, res, margins
         if callback is not None:
-            callback(i + 1, n_starts, best_cond)
+            callback(i + 1, n_starts, condition_number(problem, best) if best is not None else np.inf)
     if best is None:
-        worst = min(problem.margins(traj), key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
+        worst = min(margins, key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
         raise InfeasibleDesignError(
             f"no start satisfied every constraint on the verification grid (last start: {worst.constraint} on "
             f"{worst.where} reaches {worst.worst:.4g} against {worst.limit:.4g}); raise design.safety, "
             f"design.grid_points or design.starts, or relax the limits")
     ref = initial if initial is not None else first
     return ExcitationDesign(
-        trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
+        trajectory=best, initial=ref, criterion=problem.criterion, cond=condition_number(problem, best),
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
         log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins,
         initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(best_res.success),
-        message=str(best_res.message), nit=nit, nfev=objective.nfev, start_values=[float(v) for v in values],
+        message=str(best_res.message), nit=nit, nfev=sum(v[0].nfev for v in solvers.values()), start_values=[float(v) for v in values],
         seconds=time.perf_counter() - t0)
 
 
