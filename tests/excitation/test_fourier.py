@@ -35,3 +35,28 @@ def test_errors():
     with pytest.raises(ConfigError, match="duration"):
         sample_times(0.0, 100.0)
     assert sample_times(25.0, 1000.0).size == 25000
+
+
+def test_swevers_form_is_the_same_trajectory_and_dicts_round_trip():
+    import numpy as np
+    import pytest
+
+    from dynid.exceptions import ConfigError
+    from dynid.excitation.fourier import FourierTrajectory, trajectory_from_dict
+
+    rng = np.random.default_rng(7)
+    q0, a, b = rng.normal(size=2), rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
+    w = 0.7
+    sw = FourierTrajectory.from_swevers(q0, a, b, w)
+    t = np.linspace(0, 9, 50)
+    k = np.arange(1, 4)
+    # Swevers et al. 1997: q = q0 + Σ a_l/(l w) sin(l w t) - b_l/(l w) cos(l w t)
+    expected = q0 + np.sin(np.outer(t, k * w)) @ (a / (k * w)).T - np.cos(np.outer(t, k * w)) @ (b / (k * w)).T
+    np.testing.assert_allclose(sw.evaluate(t)[0], expected, atol=1e-12)
+    for form in ("paper", "swevers"):
+        back = trajectory_from_dict(sw.to_dict(form))
+        np.testing.assert_allclose(back.evaluate(t)[1], sw.evaluate(t)[1], atol=1e-12)
+    with pytest.raises(ConfigError, match="x.json: expected a and b of shape"):
+        trajectory_from_dict({"omega_f": 1.0, "q0": [0, 0], "a": [[1.0]], "b": [[1.0]]}, "x.json")
+    with pytest.raises(ConfigError, match="form must be one of paper, swevers"):
+        trajectory_from_dict({"form": "cheb", "omega_f": 1.0, "q0": [0], "a": [[1.0]], "b": [[1.0]]})
