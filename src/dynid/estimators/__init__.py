@@ -4,5 +4,7 @@ from .base import Estimator, paper_objective
 from .bee_colony import BeeColonyEstimator
 from .least_absolute import LeastAbsoluteDeviations
 from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+from .physically_consistent import PhysicallyConsistentLeastSquares
 
-__all__ = ["Estimator", "paper_objective", "BeeColonyEstimator", "LeastAbsoluteDeviations", "OrdinaryLeastSquares", "WeightedLeastSquares"]
+__all__ = ["Estimator", "paper_objective", "BeeColonyEstimator", "LeastAbsoluteDeviations", "OrdinaryLeastSquares", "WeightedLeastSquares",
+           "PhysicallyConsistentLeastSquares"]

@@ -1,0 +1,115 @@
+"""Physically consistent least squares: a semidefinite program over the standard parameters.
+
+``min ||W φ - τ||² + λ ||φ - φ_prior||²`` subject to, for every link, the pseudo-inertia matrix
+``J(φ_link) = [[½ tr(I)·1 - I, h], [hᵀ, m]] ⪰ ε·1`` (``I`` the inertia about the link origin, ``h`` the first
+moments ``MX, MY, MZ``, ``m`` the mass), which holds exactly when the parameters are those of a real
+mass distribution (Wensing, Kim & Slotine, "Linear matrix inequalities for physically consistent inertial
+parameter identification", IEEE RA-L 3(1), 2018), and non-negative friction coefficients and rotor
+inertias. The least-squares term is reduced to ``||R φ - Qᵀτ||²`` by a QR factorisation of ``W`` first,
+so the SDP's size does not grow with the number of samples. Solved by cvxpy with Clarabel.
+
+The estimator sees only ``(W, τ)`` and the parameter layout (which columns form each link's ten inertial
+parameters, which must be non-negative); :func:`dynid.dynamics.layout.consistency_layout` builds it for a robot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..exceptions import DynIdError, ShapeError
+from .base import Estimator, check_observations
+
+
+def pseudo_inertia(phi10: np.ndarray) -> np.ndarray:
+    """4×4 pseudo-inertia matrix of ten inertial parameters (eq. 5 order), Wensing et al. 2018."""
+    xx, xy, xz, yy, yz, zz, mx, my, mz, m = phi10
+    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    sigma = 0.5 * np.trace(inertia) * np.eye(3) - inertia
+    h = np.array([mx, my, mz])
+    return np.block([[sigma, h[:, None]], [h[None, :], np.array([[m]])]])
+
+
+class PhysicallyConsistentLeastSquares(Estimator):
+    """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
+
+    Parameters
+    ----------
+    links : (n_links, 10) int array
+        Columns of ``W`` holding each link's ``XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M``.
+    nonnegative : sequence of int
+        Columns constrained ``>= 0`` (viscous and Coulomb friction, rotor inertias).
+    prior : (p,) array, optional
+        Parameters the unidentifiable directions are pulled towards (nominal/CAD values).
+    prior_weight : float
+        ``λ`` relative to the mean squared column norm of ``W``: 1e-6 barely moves the identifiable
+        directions and fixes the unidentifiable ones at the prior's values.
+    epsilon : float
+        Smallest eigenvalue allowed for each pseudo-inertia [kg·m², kg].
+
+    Learned attributes
+    ------------------
+    params_ : (p,) array
+        Standard parameters.
+    pseudo_inertia_min_eig_ : (n_links,) array
+        Smallest eigenvalue of each link's pseudo-inertia at the solution.
+    status_ : str
+        Solver status.
+
+    Raises
+    ------
+    DynIdError
+        If the solver fails.
+    ShapeError
+        If the layout does not fit ``W``.
+    """
+
+    def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0):
+        self.links = links
+        self.nonnegative = nonnegative
+        self.prior = prior
+        self.prior_weight = prior_weight
+        self.epsilon = epsilon
+
+    def fit(self, w, tau) -> "PhysicallyConsistentLeastSquares":
+        import cvxpy as cp
+
+        w, tau = check_observations(w, tau)
+        m, p = w.shape
+        links = np.asarray(self.links, dtype=int).reshape(-1, 10)
+        nonneg = np.asarray(self.nonnegative, dtype=int)
+        if links.size and (links.min() < 0 or links.max() >= p) or (nonneg.size and (nonneg.min() < 0 or nonneg.max() >= p)):
+            raise ShapeError(f"parameter layout refers to columns outside W's {p}")
+        scale = np.sqrt(m)
+        r, z = _reduced_least_squares(w / scale, tau / scale)
+        phi = cp.Variable(p)
+        cost = cp.sum_squares(r @ phi - z)
+        if self.prior is not None:
+            prior = np.asarray(self.prior, dtype=float)
+            if prior.shape != (p,):
+                raise ShapeError(f"expected a prior of shape ({p},), got {prior.shape}")
+            cost = cost + self.prior_weight * float(np.mean(r**2) * r.shape[0]) * cp.sum_squares(phi - prior)
+        cons = []
+        for idx in links:
+            xx, xy, xz, yy, yz, zz, mx, my, mz, mass = (phi[int(i)] for i in idx)
+            tr = 0.5 * (xx + yy + zz)
+            j = cp.bmat([[tr - xx, -xy, -xz, mx], [-xy, tr - yy, -yz, my], [-xz, -yz, tr - zz, mz], [mx, my, mz, mass]])
+            cons.append(0.5 * (j + j.T) >> self.epsilon * np.eye(4))
+        if nonneg.size:
+            cons.append(phi[nonneg] >= 0)
+        problem = cp.Problem(cp.Minimize(cost), cons)
+        try:
+            problem.solve(solver=cp.CLARABEL)
+        except cp.error.SolverError as exc:
+            raise DynIdError(f"physically consistent least squares: the SDP solver failed ({exc})") from None
+        if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
+            raise DynIdError(f"physically consistent least squares: solver status {problem.status}")
+        self.params_ = np.asarray(phi.value, dtype=float)
+        self.status_ = problem.status
+        self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])
+        return self
+
+
+def _reduced_least_squares(w: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(R, Qᵀτ)`` with ``W = QR``: ``||Wφ - τ||² = ||Rφ - Qᵀτ||² + const``."""
+    q, r = np.linalg.qr(w, mode="reduced")
+    return r, q.T @ tau

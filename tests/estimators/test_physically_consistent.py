@@ -1,0 +1,56 @@
+"""Physically consistent least squares (SDP): consistency of the result and recovery of known parameters."""
+
+import numpy as np
+
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.layout import consistency_layout
+from dynid.dynamics.regressor import observation_matrix
+from dynid.dynamics.rnea import rnea_torques
+from dynid.estimators.physically_consistent import PhysicallyConsistentLeastSquares, pseudo_inertia
+from dynid.model.description import load_robot
+from dynid.model.spatial import is_physically_consistent
+
+from ..conftest import random_states
+
+
+def _data(robot, rng, noise, n=300):
+    q, dq, ddq = random_states(rng, n, robot.n_dof)
+    w = observation_matrix(robot, q, dq, ddq)
+    tau = rnea_torques(robot, q, dq, ddq) + rng.normal(0, noise, q.shape)
+    return w, tau.ravel()
+
+
+def test_pseudo_inertia_is_psd_exactly_for_physical_links(rng):
+    robot = load_robot("er16")
+    for phi in robot.inertial:
+        assert np.linalg.eigvalsh(pseudo_inertia(phi)).min() > 0 and is_physically_consistent(phi)
+    bad = robot.inertial[1].copy()
+    bad[0] = -bad[3] - bad[5]  # XX < 0 beyond the triangle inequality
+    assert np.linalg.eigvalsh(pseudo_inertia(bad)).min() < 0 and not is_physically_consistent(bad)
+
+
+def test_sdp_is_physically_consistent_and_recovers_the_base_parameters(rng):
+    robot = load_robot("er16")
+    w, tau = _data(robot, rng, noise=0.5)
+    links, nonneg = consistency_layout(robot)
+    assert [robot.parameter_names[k] for k in nonneg][:2] == ["fc1", "fv1"]
+    prior = robot.standard_parameters() * rng.uniform(0.7, 1.3, robot.n_params)  # a rough CAD guess
+    est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=prior).fit(w, tau)
+    for idx in links:
+        assert is_physically_consistent(est.params_[idx], tol=1e-7)
+    assert np.all(est.params_[nonneg] >= -1e-9)
+    base = base_parameters(robot, rng=0)
+    truth, got = base.base_from_standard(robot.standard_parameters()), base.base_from_standard(est.params_)
+    assert np.linalg.norm(got - truth) / np.linalg.norm(truth) < 0.01
+
+
+def test_constraints_bind_when_the_data_ask_for_negative_friction(rng):
+    """Viscous friction of joint 2 set to -3 in the data: the SDP keeps it at 0, OLS would not."""
+    robot = load_robot("er16")
+    drive = robot.drive.copy()
+    drive[1, robot.drive_terms.index("fv")] = -3.0
+    w, tau = _data(robot.with_parameters(np.concatenate([np.concatenate([robot.inertial, drive], 1).ravel()])), rng, noise=0.0)
+    links, nonneg = consistency_layout(robot)
+    est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters()).fit(w, tau)
+    assert abs(est.params_[robot.parameter_names.index("fv2")]) < 1e-6
+    assert est.pseudo_inertia_min_eig_.min() >= -1e-7
