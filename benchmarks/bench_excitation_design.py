@@ -13,21 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
+from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
+
 from dynid.excitation.design import _Layout, _Objective
 from dynid.experiment.excitation_config import load_excitation_config, run_excitation
 
 CONFIG = Path(__file__).resolve().parents[1] / "configs" / "excite-er16-6dof.toml"
 TARGET_SECONDS = 60.0
-
-
-def best_of(fn, repeats=5):
-    fn()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

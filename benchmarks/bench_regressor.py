@@ -7,10 +7,11 @@ Each side is timed as the best of several repeats after a warm-up (JIT compilati
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import pinocchio as pin
+
+from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
 
 from dynid.dynamics.regressor import regressor
 from dynid.dynamics.rnea import pinocchio_model
@@ -18,16 +19,6 @@ from dynid.model.description import load_robot
 
 N = 25_000
 REPEATS = 5
-
-
-def best_of(fn, repeats=REPEATS):
-    fn()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:
@@ -56,8 +47,8 @@ def main() -> None:
     tau_dyn = y_dyn @ robot.standard_parameters() - friction_torques(robot, dq[:200], ddq[:200])
     assert np.allclose(tau_ref, tau_dyn, atol=1e-8), "regressors disagree"
 
-    t_ref = best_of(reference)
-    t_dyn = best_of(batched)
+    t_ref = best_of(reference, REPEATS)
+    t_dyn = best_of(batched, REPEATS)
     print(f"samples: {N}, robot: {robot.name} ({robot.n_dof} DOF), best of {REPEATS}")
     print(f"pinocchio computeJointTorqueRegressor loop: {1e6 * t_ref / N:8.3f} µs/sample ({t_ref:.3f} s)")
     print(f"dynid batched regressor (with friction):    {1e6 * t_dyn / N:8.3f} µs/sample ({t_dyn:.3f} s)")

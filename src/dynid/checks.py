@@ -45,3 +45,17 @@ def check_vector(x, n: int, name: str) -> np.ndarray:
     if a.shape != (n,):
         raise ShapeError(f"expected {name} with shape ({n},), got {a.shape}")
     return a
+
+
+def check_states(q, dq, ddq, n_dof: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Joint positions, velocities and accelerations as (N, n_dof) float64 arrays of one length, and N.
+
+    Raises
+    ------
+    ShapeError
+        If an input is not (N, n_dof), holds NaN, or the lengths differ.
+    """
+    q = check_trajectory_array(q, n_dof, "q")
+    dq = check_trajectory_array(dq, n_dof, "dq")
+    ddq = check_trajectory_array(ddq, n_dof, "ddq")
+    return q, dq, ddq, check_same_length(q=q, dq=dq, ddq=ddq)

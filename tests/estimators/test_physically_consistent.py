@@ -6,9 +6,9 @@ from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.layout import consistency_layout
 from dynid.dynamics.regressor import observation_matrix
 from dynid.dynamics.rnea import rnea_torques
-from dynid.estimators.physically_consistent import PhysicallyConsistentLeastSquares, pseudo_inertia
+from dynid.estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from dynid.model.description import load_robot
-from dynid.model.spatial import is_physically_consistent
+from dynid.model.spatial import is_physically_consistent, pseudo_inertia
 
 from ..conftest import random_states
 

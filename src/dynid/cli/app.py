@@ -5,6 +5,7 @@ Exit codes: 0 success, 1 user or data error (one-line message), 2 usage error.
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Optional
@@ -318,7 +319,7 @@ def _print_excitation(run, paths) -> None:
     for col in ("constraint", "where", "limit", "worst", "margin", "margin %"):
         t.add_column(col, justify="left" if col in ("constraint", "where") else "right", no_wrap=True)
     for m in d.margins:
-        rel = f"{100 * m.relative:.1f}" if m.relative == m.relative else ""
+        rel = "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}"
         t.add_row(escape(m.constraint), escape(m.where), f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}", rel)
     console.print(t)
     console.print(f"wrote {paths[0]}, {paths[1]} ({run.t.size} set-points at {run.config.rate:g} Hz) and "

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_same_length, check_trajectory_array
+from ..checks import check_states
 from ..model.robot import Robot
 from ..conventions import DRIVE_TERMS
 from ._regressor_kernel import joint_torque_regressor
@@ -42,10 +42,7 @@ def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
         If an input is not (N, n_dof) or holds NaN.
     """
     n = robot.n_dof
-    q = check_trajectory_array(q, n, "q")
-    dq = check_trajectory_array(dq, n, "dq")
-    ddq = check_trajectory_array(ddq, n, "ddq")
-    n_s = check_same_length(q=q, dq=dq, ddq=ddq)
+    q, dq, ddq, n_s = check_states(q, dq, ddq, n)
     out = np.empty((n_s, n, robot.n_params))
     _fill(robot, q, dq, ddq, out)
     return out

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_same_length, check_trajectory_array
+from ..checks import check_states, check_trajectory_array
 from ..model.robot import Robot
 from .kinematics import forward_kinematics
 from .regressor import regressor
@@ -51,10 +51,7 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
         If an input is not (N, n_dof) or holds NaN.
     """
     n = robot.n_dof
-    q = check_trajectory_array(q, n, "q")
-    dq = check_trajectory_array(dq, n, "dq")
-    ddq = check_trajectory_array(ddq, n, "ddq")
-    n_s = check_same_length(q=q, dq=dq, ddq=ddq)
+    q, dq, ddq, n_s = check_states(q, dq, ddq, n)
     eye = np.eye(n)
     # one batched regressor call: base state, q ± h e_i, dq ± e_i, ddq + e_i
     blocks_q = [q] + [q + s * Q_STEP * eye[i] for i in range(n) for s in (1, -1)] + [q] * (3 * n)

@@ -17,16 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..exceptions import DynIdError, ShapeError
+from ..model.spatial import pseudo_inertia
 from .base import Estimator, check_observations
-
-
-def pseudo_inertia(phi10: np.ndarray) -> np.ndarray:
-    """4×4 pseudo-inertia matrix of ten inertial parameters (eq. 5 order), Wensing et al. 2018."""
-    xx, xy, xz, yy, yz, zz, mx, my, mz, m = phi10
-    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    sigma = 0.5 * np.trace(inertia) * np.eye(3) - inertia
-    h = np.array([mx, my, mz])
-    return np.block([[sigma, h[:, None]], [h[None, :], np.array([[m]])]])
 
 
 class PhysicallyConsistentLeastSquares(Estimator):

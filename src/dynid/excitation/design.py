@@ -171,7 +171,7 @@ class ExcitationProblem:
 
     def criterion_value(self, trajectory: FourierTrajectory) -> float:
         """cond(W_base) or −log det of the information matrix on the design grid."""
-        w = _base_observation(self, trajectory, self.design_grid())
+        w = _stacked_base_observation(self.robot, self.base, trajectory, self.design_grid())
         value, _ = criterion_function(self.criterion)(w)
         return float(np.exp(value)) if self.criterion == "cond" else value
 
@@ -179,7 +179,7 @@ class ExcitationProblem:
 def condition_number(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray | None = None) -> float:
     """cond(W_base) of ``trajectory`` on ``t`` (default: the design grid)."""
     t = problem.design_grid() if t is None else t
-    return float(np.linalg.cond(_base_observation(problem, trajectory, t)))
+    return float(np.linalg.cond(_stacked_base_observation(problem.robot, problem.base, trajectory, t)))
 
 
 def base_condition_number(robot: Robot, base: BaseParameters, trajectory: FourierTrajectory, n_samples: int = 100) -> float:
@@ -198,10 +198,6 @@ def _stacked_base_observation(robot: Robot, base: BaseParameters, trajectory: Fo
     if trajectory.n_dof != robot.n_dof:
         raise ConfigError(f"trajectory has {trajectory.n_dof} joints, the robot model {robot.n_dof}")
     return base.base_observation(regressor(robot, *trajectory.evaluate(t))).reshape(-1, base.n_base)
-
-
-def _base_observation(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray) -> np.ndarray:
-    return _stacked_base_observation(problem.robot, problem.base, trajectory, t)
 
 
 @dataclass(frozen=True)
@@ -493,7 +489,7 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
             raise ConfigError(f"initial trajectory has {initial.n_dof} joints and {initial.n_harmonics} harmonics, "
                               f"the design {lay.n} and {lay.h}")
         initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets else problem.offsets, initial.a, initial.b)
-    best, best_score, first, values = None, np.inf, None, []
+    best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
     nit = 0
     for i in range(n_starts):
         objective, a_lin, c_lin, _ = solver(problem.safety)
@@ -508,19 +504,21 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
             nit += int(res.nit)
             traj = lay.to_trajectory(res.x, problem.offsets)
             margins = problem.margins(traj)
-            if all(m.satisfied for m in margins):
+            feasible = all(m.satisfied for m in margins)
+            if feasible:
                 break
             if res.status == 0:  # converged, but violates between grid points: polish with tighter limits
                 x0, safety = res.x, min(0.45, 2 * max(safety, 0.01))
             else:  # SLSQP lost its way (e.g. incompatible linearised constraints): again from half the amplitudes
                 x0 = x0.copy()
                 x0[lay.n_off:] *= 0.5
-        score = problem.criterion_value(traj) if all(m.satisfied for m in margins) else np.inf
+        score = problem.criterion_value(traj) if feasible else np.inf
         values.append(score)
         if score < best_score:
             best, best_score, best_res, best_margins = traj, score, res, margins
+            best_cond = condition_number(problem, best)
         if callback is not None:
-            callback(i + 1, n_starts, condition_number(problem, best) if best is not None else np.inf)
+            callback(i + 1, n_starts, best_cond)
     if best is None:
         worst = min(margins, key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
         raise InfeasibleDesignError(
@@ -529,7 +527,7 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
             f"design.grid_points or design.starts, or relax the limits")
     ref = initial if initial is not None else first
     return ExcitationDesign(
-        trajectory=best, initial=ref, criterion=problem.criterion, cond=condition_number(problem, best),
+        trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
         log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins,
         initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(best_res.success),
@@ -539,6 +537,6 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
 
 def _log_det(problem: ExcitationProblem, traj: FourierTrajectory) -> float:
     """``log det(W_b^T W_b / N)`` on the design grid (``-inf`` when singular)."""
-    w = _base_observation(problem, traj, problem.design_grid())
+    w = _stacked_base_observation(problem.robot, problem.base, traj, problem.design_grid())
     sign, value = np.linalg.slogdet(w.T @ w / w.shape[0])
     return float(value) if sign > 0 else -np.inf

@@ -35,11 +35,11 @@ BETA2_ROWS = np.array([
 """Appendix A, eq. A.2: three-harmonic validation trajectory."""
 
 
-def paper_identification_trajectory(omega_f: float = PAPER_OMEGA_F) -> FourierTrajectory:
-    """β1 (eq. A.1), joints 1-3, five harmonics."""
-    return FourierTrajectory.from_rows(BETA1_ROWS, omega_f)
+def paper_identification_trajectory(omega_f: float = PAPER_OMEGA_F, n_dof: int = 3) -> FourierTrajectory:
+    """β1 (eq. A.1), five harmonics; joints beyond three reuse rows 1-3 (the paper gives no wrist trajectory)."""
+    return FourierTrajectory.from_rows(BETA1_ROWS[[j % 3 for j in range(n_dof)]], omega_f)
 
 
-def paper_validation_trajectory(omega_f: float = PAPER_OMEGA_F) -> FourierTrajectory:
-    """β2 (eq. A.2), joints 1-3, three harmonics."""
-    return FourierTrajectory.from_rows(BETA2_ROWS, omega_f)
+def paper_validation_trajectory(omega_f: float = PAPER_OMEGA_F, n_dof: int = 3) -> FourierTrajectory:
+    """β2 (eq. A.2), three harmonics; joints beyond three reuse rows 1-3."""
+    return FourierTrajectory.from_rows(BETA2_ROWS[[j % 3 for j in range(n_dof)]], omega_f)

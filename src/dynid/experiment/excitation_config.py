@@ -36,7 +36,6 @@ Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to t
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
@@ -47,9 +46,10 @@ from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationDesign, ExcitationProblem, design_excitation
 from ..excitation.fourier import FORMS, FourierTrajectory
-from ..excitation.paper_trajectories import BETA1_ROWS
+from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..io.trajectories import load_trajectory
-from ..model.description import builtin_robots, load_robot, parse_angle
+from ..io.configs import config_robot, read_config
+from ..model.description import parse_angle
 from ..model.robot import Robot
 
 _SECTIONS = {"robot", "joints", "name", "notes", "trajectory", "limits", "workspace", "design", "output"}
@@ -77,11 +77,6 @@ class ExcitationConfig:
     initial_label: str
     rate: float
     periods: int
-
-
-def paper_initial(n_dof: int, omega_f: float) -> FourierTrajectory:
-    """The paper's β1 (eq. A.1) for ``n_dof`` joints; joints beyond three reuse rows 1-3, as `dynid run`."""
-    return FourierTrajectory.from_rows(BETA1_ROWS[[j % 3 for j in range(n_dof)]], omega_f)
 
 
 def _number(v, where: str, *, positive=False, integer=False):
@@ -119,20 +114,9 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         and the field.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: config file not found")
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: invalid TOML ({exc})") from None
-    unknown = sorted(set(doc) - _SECTIONS)
-    if unknown:
-        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(_SECTIONS)}")
+    doc = read_config(path, _SECTIONS)
     here = path.parent
-    robot_ref = doc.get("robot")
-    if not isinstance(robot_ref, str):
-        raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
-    full = load_robot(robot_ref if robot_ref in builtin_robots() or Path(robot_ref).is_absolute() else here / robot_ref)
+    full = config_robot(doc, path)
     k = _number(doc.get("joints", full.n_dof), f"{path}: joints", positive=True, integer=True)
     if k > full.n_dof:
         raise ConfigError(f"{path}: joints: robot {full.name!r} has {full.n_dof} joints, got {k}")
@@ -186,7 +170,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         if init == "paper":
             if harmonics != 5:
                 raise ConfigError(f"{path}: design.initial = \"paper\" is β1 with 5 harmonics, the design has {harmonics}")
-            initial, initial_label = paper_initial(k, omega_f), "paper β1 (eq. A.1)"
+            initial, initial_label = paper_identification_trajectory(omega_f, k), "paper β1 (eq. A.1)"
         elif isinstance(init, str):
             try:
                 initial, initial_label = load_trajectory(here / init), init

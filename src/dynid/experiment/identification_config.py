@@ -39,7 +39,6 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 from __future__ import annotations
 
 import os
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -48,9 +47,9 @@ import numpy as np
 from ..dynamics.base_parameters import base_parameters
 from ..exceptions import ConfigError, DataError
 from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
+from ..io.configs import config_robot, read_config
 from ..io.references import load_reference
 from ..io.trajectories import load_trajectory
-from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
 from .identification import (METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify,
                              parameter_sets, prepare)
@@ -129,21 +128,10 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         Unreadable file, invalid TOML, unknown or malformed fields (the message names file and field).
     """
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: config file not found")
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: invalid TOML ({exc})") from None
-    known = {"robot", "data_root", "identification", "validation", "preprocessing", "estimation", "references", "name", "notes"}
-    unknown = sorted(set(doc) - known)
-    if unknown:
-        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known)}")
+    doc = read_config(path, {"robot", "data_root", "identification", "validation", "preprocessing", "estimation",
+                             "references", "name", "notes"})
     here = path.parent
-    robot_ref = doc.get("robot")
-    if not isinstance(robot_ref, str):
-        raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
-    robot = load_robot(robot_ref if robot_ref in builtin_robots() or Path(robot_ref).is_absolute() else here / robot_ref)
+    robot = config_robot(doc, path)
     override = data_root or os.environ.get(DATA_ROOT_ENV)
     if override is None and not isinstance(doc.get("data_root", "."), str):
         raise ConfigError(f"{path}: data_root: expected a folder path, got {doc['data_root']!r}")

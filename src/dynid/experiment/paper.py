@@ -21,9 +21,10 @@ from ..dynamics.regressor import observation_matrix
 from ..estimators import BeeColonyEstimator, LeastAbsoluteDeviations, OrdinaryLeastSquares, paper_objective
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
-from ..excitation.fourier import FourierTrajectory, sample_times
+from ..excitation.fourier import sample_times
 from ..io.trajectories import load_trajectory
-from ..excitation.paper_trajectories import BETA1_ROWS, BETA2_ROWS, PAPER_DURATION, PAPER_OMEGA_F, PAPER_RATE
+from ..excitation.paper_trajectories import (PAPER_DURATION, PAPER_OMEGA_F, PAPER_RATE, paper_identification_trajectory,
+                                            paper_validation_trajectory)
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing import five_point_cubic_smoothing, fourier_fit_derivatives
@@ -201,15 +202,10 @@ def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
         return 100.0 * np.abs(est - truth) / np.abs(truth)
 
 
-def _trajectory(rows: np.ndarray, joints: int, omega_f: float) -> FourierTrajectory:
-    # joints beyond the paper's three reuse rows 1-3 (the paper gives no wrist trajectory)
-    return FourierTrajectory.from_rows(rows[[j % 3 for j in range(joints)]], omega_f)
-
-
 def _identification_trajectory(config: PaperExperimentConfig, robot: Robot, base: BaseParameters):
     """The identification trajectory of ``config.excitation`` and what is known of it (cond(W_base) …)."""
     k = config.joints
-    beta1 = _trajectory(BETA1_ROWS, k, config.omega_f)
+    beta1 = paper_identification_trajectory(config.omega_f, k)
     if config.excitation == "paper":
         traj, label = beta1, "paper β1 (eq. A.1)"
     elif config.excitation == "optimized":
@@ -220,8 +216,9 @@ def _identification_trajectory(config: PaperExperimentConfig, robot: Robot, base
         traj, label = load_trajectory(config.excitation), config.excitation
         if traj.n_dof != k:
             raise ConfigError(f"--excitation {config.excitation}: the trajectory has {traj.n_dof} joints, the run identifies {k}")
-    info = {"trajectory": label, "cond_base_regressor": base_condition_number(robot, base, traj),
-            "cond_base_regressor_beta1": base_condition_number(robot, base, beta1),
+    cond_beta1 = base_condition_number(robot, base, beta1)
+    info = {"trajectory": label, "cond_base_regressor": cond_beta1 if traj is beta1 else base_condition_number(robot, base, traj),
+            "cond_base_regressor_beta1": cond_beta1,
             "grid": "100 samples over one period"}
     return traj, info
 
@@ -296,7 +293,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t = sample_times(config.duration, config.rate)
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
     traj_id, excitation_info = _identification_trajectory(config, robot, base)
-    traj_val = _trajectory(BETA2_ROWS, k, config.omega_f)
+    traj_val = paper_validation_trajectory(config.omega_f, k)
     t_sim = time.perf_counter()
     ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings)
     valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)

@@ -79,10 +79,15 @@ def transform_inertial(phi: np.ndarray, rotation: np.ndarray, translation: np.nd
     return np.concatenate([inertia_vector(inertia), c + m * p, [m]])
 
 
-def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
-    """True when the pseudo-inertia matrix of ``phi`` is positive semidefinite (Wensing et al. 2017)."""
+def pseudo_inertia(phi: np.ndarray) -> np.ndarray:
+    """4×4 pseudo-inertia ``[[½ tr(I)·1 - I, h], [hᵀ, m]]`` of ten inertial parameters (eq. 5 order);
+    positive semidefinite exactly for a real mass distribution (Wensing, Kim & Slotine, IEEE RA-L 3(1), 2018)."""
     inertia = inertia_matrix(phi[:6])
     sigma = 0.5 * np.trace(inertia) * np.eye(3) - inertia
-    h = phi[6:9]
-    pseudo = np.block([[sigma, h[:, None]], [h[None, :], np.array([[phi[9]]])]])
-    return bool(np.linalg.eigvalsh(pseudo).min() >= -tol * max(1.0, abs(phi[9])))
+    h = np.asarray(phi[6:9], dtype=float)
+    return np.block([[sigma, h[:, None]], [h[None, :], np.array([[phi[9]]])]])
+
+
+def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
+    """True when the pseudo-inertia matrix of ``phi`` is positive semidefinite (Wensing et al. 2017)."""
+    return bool(np.linalg.eigvalsh(pseudo_inertia(phi)).min() >= -tol * max(1.0, abs(phi[9])))

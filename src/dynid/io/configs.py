@@ -1,0 +1,44 @@
+"""Reading experiment configs (TOML): the file, its top-level fields and the robot it names."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from ..exceptions import ConfigError
+from ..model.description import builtin_robots, load_robot
+from ..model.robot import Robot
+
+
+def read_config(path: Path, known: set[str]) -> dict:
+    """The TOML document at ``path``, whose top-level fields must be among ``known``.
+
+    Raises
+    ------
+    ConfigError
+        Missing file, invalid TOML or text, or an unknown top-level field (the message names the file).
+    """
+    if not path.is_file():
+        raise ConfigError(f"{path}: config file not found")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: invalid TOML ({exc})") from None
+    unknown = sorted(set(doc) - known)
+    if unknown:
+        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known)}")
+    return doc
+
+
+def config_robot(doc: dict, path: Path) -> Robot:
+    """The robot of a config's ``robot`` field: a built-in name, or a description TOML relative to the config.
+
+    Raises
+    ------
+    ConfigError
+        A missing or non-string field, or an unknown robot.
+    """
+    ref = doc.get("robot")
+    if not isinstance(ref, str):
+        raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
+    return load_robot(ref if ref in builtin_robots() or Path(ref).is_absolute() else path.parent / ref)
