@@ -3,7 +3,8 @@ import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import observation_matrix
-from dynid.estimators import BeeColonyEstimator, OrdinaryLeastSquares, paper_objective
+from dynid.estimators import (BeeColonyEstimator, DifferentialEvolutionEstimator, IterativelyReweightedLeastSquares,
+                              OrdinaryLeastSquares, ParticleSwarmEstimator, paper_objective)
 from dynid.exceptions import IdentifiabilityError, ShapeError
 from dynid.model.description import load_robot
 
@@ -30,14 +31,40 @@ def make(kind, beta):
         return WeightedLeastSquares(n_dof=3)
     if kind == "lad":
         return LeastAbsoluteDeviations(n_dof=3)
+    if kind == "irls":
+        return IterativelyReweightedLeastSquares(n_dof=3)
     bounds = np.stack([beta - 1.0, beta + 1.0], axis=1)
+    if kind == "de":
+        return DifferentialEvolutionEstimator(bounds=bounds, n_dof=3, popsize=2, maxiter=5, rng=0)
+    if kind == "pso":
+        return ParticleSwarmEstimator(bounds=bounds, n_dof=3, maxiter=5, rng=0)
     return BeeColonyEstimator(bounds=bounds, n_dof=3, maxiter=5, rng=0)
 
 
-@pytest.mark.parametrize("kind", ["ols", "wls", "lad", "abc"])
-def test_shared_contract(problem, kind):
-    w, beta = problem
-    est = make(kind, beta)
+BOX_SEARCHES = ["abc", "de", "pso"]
+
+
+@pytest.fixture(scope="module")
+def standard_problem():
+    """The physically consistent estimator works on the standard parameters: W (M, 3·13) and the robot's φ."""
+    from dynid.dynamics.layout import consistency_layout
+    from dynid.estimators import PhysicallyConsistentLeastSquares
+
+    robot = load_robot("er16").submodel(3)
+    q, dq, ddq = random_states(np.random.default_rng(6), 400, 3)
+    links, nonneg = consistency_layout(robot)
+    return (observation_matrix(robot, q, dq, ddq), robot.standard_parameters(),
+            lambda: PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters()))
+
+
+@pytest.mark.parametrize("kind", ["ols", "wls", "lad", "irls", *BOX_SEARCHES, "sdp"])
+def test_shared_contract(problem, standard_problem, kind):
+    if kind == "sdp":
+        w, beta, factory = standard_problem
+        est = factory()
+    else:
+        w, beta = problem
+        est = make(kind, beta)
     with pytest.raises(AttributeError, match="not fitted"):
         est.predict(w)
     assert est.fit(w, w @ beta) is est
@@ -114,8 +141,9 @@ def test_lad_matches_primal_linear_program(rng, bounded):
         assert np.all(lad.params_ >= bounds[:, 0]) and np.all(lad.params_ <= bounds[:, 1])
 
 
-def test_lad_objective_never_above_abc(problem):
-    """LAD minimises eq. 9 exactly over the same box, so ABC can never beat it."""
+@pytest.mark.parametrize("kind", BOX_SEARCHES)
+def test_lad_objective_never_above_box_searches(problem, kind):
+    """LAD minimises eq. 9 exactly over the same box, so neither ABC, DE nor PSO can beat it."""
     from dynid.estimators import LeastAbsoluteDeviations
 
     w, beta = problem
@@ -123,9 +151,112 @@ def test_lad_objective_never_above_abc(problem):
     tau = w @ beta + rng.normal(0, 1.0, w.shape[0])
     bounds = np.stack([beta - 3, beta + 3], 1)
     lad = LeastAbsoluteDeviations(n_dof=3, bounds=bounds).fit(w, tau)
+    cls = {"abc": BeeColonyEstimator, "de": DifferentialEvolutionEstimator, "pso": ParticleSwarmEstimator}[kind]
     for seed in range(3):
-        abc = BeeColonyEstimator(bounds=bounds, n_dof=3, maxiter=20, rng=seed).fit(w, tau)
-        assert lad.objective_ <= abc.objective_ + 1e-9
+        est = cls(bounds=bounds, n_dof=3, maxiter=20, rng=seed).fit(w, tau)
+        assert lad.objective_ <= est.objective_ + 1e-9
+        assert est.objective_ == pytest.approx(paper_objective(tau - w @ est.params_, 3))
+
+
+@pytest.mark.parametrize("kind", BOX_SEARCHES)
+def test_box_searches_are_seeded_and_improve(problem, kind):
+    w, beta = problem
+    tau = w @ beta
+    a, b = make(kind, beta).fit(w, tau), make(kind, beta).fit(w, tau)
+    np.testing.assert_array_equal(a.params_, b.params_)
+    assert a.n_evaluations_ > 0 and a.history_[-1] <= a.history_[0]
+    assert np.all(a.params_ >= beta - 1.0) and np.all(a.params_ <= beta + 1.0)
+
+
+def test_box_searches_approach_the_minimum_with_budget(problem):
+    """With a realistic budget DE and PSO get close to the exact minimiser (LAD) of eq. 9."""
+    from dynid.estimators import LeastAbsoluteDeviations
+
+    w, beta = problem
+    tau = w @ beta + np.random.default_rng(4).normal(0, 0.5, w.shape[0])
+    bounds = np.stack([beta - 0.5, beta + 0.5], 1)
+    f_lad = LeastAbsoluteDeviations(n_dof=3, bounds=bounds).fit(w, tau).objective_
+    f_start = paper_objective(tau - w @ bounds.mean(axis=1), 3)
+    de = DifferentialEvolutionEstimator(bounds=bounds, n_dof=3, popsize=5, maxiter=400, rng=1).fit(w, tau)
+    pso = ParticleSwarmEstimator(bounds=bounds, n_dof=3, swarm_size=40, maxiter=500, rng=1).fit(w, tau)
+    for est in (de, pso):
+        assert est.objective_ - f_lad < 0.1 * (f_start - f_lad)
+
+
+def test_irls_ignores_outliers_that_pull_ols(problem):
+    w, beta = problem
+    rng = np.random.default_rng(12)
+    tau = w @ beta + rng.normal(0, 0.5, w.shape[0])
+    spikes = rng.choice(w.shape[0], w.shape[0] // 20, replace=False)
+    tau[spikes] += rng.choice([-1, 1], spikes.size) * 40.0
+    ols = OrdinaryLeastSquares().fit(w, tau)
+    irls = IterativelyReweightedLeastSquares(n_dof=3).fit(w, tau)
+    assert irls.converged_
+    assert np.linalg.norm(irls.params_ - beta) < 0.2 * np.linalg.norm(ols.params_ - beta)
+    assert np.median(irls.row_weights_[spikes]) < 0.1
+    clean = IterativelyReweightedLeastSquares(n_dof=3).fit(w, w @ beta + rng.normal(0, 0.5, w.shape[0]))
+    np.testing.assert_allclose(clean.joint_scale_, 0.5, rtol=0.15)
+
+
+def test_irls_covariance_matches_spread_over_realisations(problem):
+    """Huber's sandwich covariance predicts the scatter of IRLS estimates over noise realisations."""
+    w, beta = problem
+    rng = np.random.default_rng(13)
+    fits = [IterativelyReweightedLeastSquares(n_dof=3).fit(w, w @ beta + rng.standard_t(3, w.shape[0]))
+            for _ in range(60)]
+    spread = np.std([f.params_ for f in fits], axis=0, ddof=1)
+    predicted = np.mean([f.params_std_ for f in fits], axis=0)
+    ratio = spread / predicted
+    assert 0.7 < np.median(ratio) < 1.3
+
+
+def test_bootstrap_std_matches_covariance_and_is_seeded(problem):
+    from dynid.estimators import bootstrap_intervals
+
+    w, beta = problem
+    tau = w @ beta + np.random.default_rng(14).normal(0, 1.0, w.shape[0])
+    ols = OrdinaryLeastSquares().fit(w, tau)
+    bs = bootstrap_intervals(OrdinaryLeastSquares, w, tau, 3, n_resamples=300, block_length=1, rng=2)
+    ratio = bs.std / ols.params_std_
+    assert 0.75 < np.median(ratio) < 1.25
+    assert np.all(bs.lower < bs.upper)
+    inside = (bs.lower <= beta) & (beta <= bs.upper)
+    assert inside.mean() >= 0.8
+    again = bootstrap_intervals(OrdinaryLeastSquares, w, tau, 3, n_resamples=300, block_length=1, rng=2)
+    np.testing.assert_array_equal(bs.samples, again.samples)
+
+
+def test_block_bootstrap_follows_the_true_spread_under_correlated_noise():
+    """Smooth regressors and noise correlated over 10 samples: the OLS covariance formula (i.i.d. noise)
+    understates the spread over realisations; the block bootstrap (blocks of 50) follows it."""
+    from dynid.estimators import bootstrap_intervals
+
+    n = 3000
+    t = np.linspace(0, 1, n)
+    w = np.column_stack([np.ones(n)] + [f(2 * np.pi * k * t) for k in (1, 2) for f in (np.sin, np.cos)])
+    beta = np.array([1.0, -2.0, 0.5, 3.0, 1.5])
+    rng = np.random.default_rng(15)
+
+    def noise():
+        e = rng.normal(0, 1.0, n + 9)
+        return np.convolve(e, np.ones(10), mode="valid") / np.sqrt(10)
+
+    truth_spread = np.std([OrdinaryLeastSquares().fit(w, w @ beta + noise()).params_ for _ in range(200)], axis=0, ddof=1)
+    tau = w @ beta + noise()
+    ols = OrdinaryLeastSquares().fit(w, tau)
+    blocks = bootstrap_intervals(OrdinaryLeastSquares, w, tau, 1, n_resamples=300, block_length=50, rng=3)
+    assert np.median(ols.params_std_ / truth_spread) < 0.5
+    assert 0.6 < np.median(blocks.std / truth_spread) < 1.4
+
+
+def test_bootstrap_rejects_bad_settings(problem):
+    from dynid.estimators import bootstrap_intervals
+    from dynid.exceptions import ConfigError
+
+    w, beta = problem
+    for kwargs in ({"n_resamples": 1}, {"level": 1.0}, {"block_length": 0}):
+        with pytest.raises(ConfigError):
+            bootstrap_intervals(OrdinaryLeastSquares, w, w @ beta, 3, **kwargs)
 
 
 def test_wls_recovers_truth_and_weights_joints(problem):
@@ -142,7 +273,7 @@ def test_wls_recovers_truth_and_weights_joints(problem):
     np.testing.assert_allclose(WeightedLeastSquares(n_dof=3).fit(w, w @ beta).params_, beta, rtol=1e-8, atol=1e-8)
 
 
-@pytest.mark.parametrize("kind", ["wls", "lad"])
+@pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
 def test_rows_must_be_whole_samples(problem, kind):
     w, beta = problem
     with pytest.raises(ShapeError, match="multiple of n_dof"):

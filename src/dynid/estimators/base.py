@@ -70,3 +70,35 @@ class Estimator:
         w, tau = check_observations(w, tau)
         res = tau - self.predict(w)
         return 1.0 - float(res @ res) / float(((tau - tau.mean()) ** 2).sum())
+
+
+class BoxSearchEstimator(Estimator):
+    """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
+
+    Subclasses set ``bounds`` (p, 2), ``n_dof`` and ``weights`` and call :meth:`_objectives`.
+    """
+
+    bounds: object
+    n_dof: int
+    weights: object
+
+    def _objectives(self, w, tau):
+        """Checked ``(W, tau, bounds)`` and eq. 9 as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
+        w, tau = check_observations(w, tau, self.n_dof)
+        bounds = np.asarray(self.bounds, dtype=float)
+        if bounds.shape != (w.shape[1], 2):
+            raise ShapeError(f"expected {type(self).__name__} bounds of shape ({w.shape[1]}, 2), got {bounds.shape}")
+
+        def objective(x):
+            x = np.asarray(x, dtype=float)
+            r = (tau - w @ x) if x.ndim == 1 else (tau[:, None] - w @ x)
+            return paper_objective(r, self.n_dof, self.weights)
+
+        return w, tau, bounds, objective
+
+    def _set_search_result(self, res) -> None:
+        self.params_ = np.asarray(res.x, dtype=float)
+        self.objective_ = float(res.fun)
+        self.history_ = getattr(res, "history", None)
+        self.n_evaluations_ = int(res.nfev)
+        self.result_ = res

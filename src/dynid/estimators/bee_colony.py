@@ -4,14 +4,11 @@ from __future__ import annotations
 
 from typing import Callable
 
-import numpy as np
-
-from ..exceptions import ShapeError
 from ..optim.bee_colony import minimize_bee_colony
-from .base import Estimator, check_observations, paper_objective
+from .base import BoxSearchEstimator
 
 
-class BeeColonyEstimator(Estimator):
+class BeeColonyEstimator(BoxSearchEstimator):
     """ABC identification (paper §3.1, eqs. 7-13), defaults from §4.1.
 
     Parameters
@@ -45,19 +42,8 @@ class BeeColonyEstimator(Estimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "BeeColonyEstimator":
-        w, tau = check_observations(w, tau)
-        bounds = np.asarray(self.bounds, dtype=float)
-        if bounds.shape != (w.shape[1], 2):
-            raise ShapeError(f"expected ABC bounds of shape ({w.shape[1]}, 2), got {bounds.shape}")
-
-        def objective(x):
-            return paper_objective(tau - w @ x, self.n_dof, self.weights)
-
+        w, tau, bounds, objective = self._objectives(w, tau)
         res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)
-        self.params_ = res.x
-        self.objective_ = float(res.fun)
-        self.history_ = res.history
-        self.n_evaluations_ = int(res.nfev)
-        self.result_ = res
+        self._set_search_result(res)
         return self

@@ -1,0 +1,110 @@
+"""Differential evolution and particle swarm on the paper's objective (eq. 9), for comparison with the ABC.
+
+Both minimise the same ``F`` over the same search box as :class:`~dynid.estimators.BeeColonyEstimator`, and
+report the same learned attributes (``params_``, ``objective_``, ``history_``, ``n_evaluations_``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import differential_evolution
+
+from ..optim.particle_swarm import minimize_particle_swarm
+from .base import BoxSearchEstimator
+
+
+class DifferentialEvolutionEstimator(BoxSearchEstimator):
+    """SciPy's differential evolution (Storn & Price 1997, ``best1bin``) on eq. 9 over a box.
+
+    Parameters
+    ----------
+    bounds : (p, 2) array
+        Search box (the ABC's).
+    n_dof : int
+        Joints per sample in ``W``'s rows.
+    weights : (n_dof,) array, optional
+        ``delta`` of eq. 9 (default 1).
+    popsize : int
+        Population size as a multiple of ``p`` (SciPy's convention).
+    maxiter : int
+        Generations; at most ``popsize · p · (maxiter + 1)`` evaluations.
+    tol : float
+        SciPy's relative convergence tolerance on the population's objective spread.
+    polish : bool
+        Finish with L-BFGS-B (off by default: eq. 9 is not differentiable).
+    rng : Generator or seed
+
+    Learned attributes
+    ------------------
+    params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
+    """
+
+    def __init__(self, *, bounds, n_dof: int, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
+                 polish: bool = False, rng=None, callback: Callable[[int, float], None] | None = None):
+        self.bounds = bounds
+        self.n_dof = n_dof
+        self.weights = weights
+        self.popsize = popsize
+        self.maxiter = maxiter
+        self.tol = tol
+        self.polish = polish
+        self.rng = rng
+        self.callback = callback
+
+    def fit(self, w, tau) -> "DifferentialEvolutionEstimator":
+        w, tau, bounds, objective = self._objectives(w, tau)
+        history = []
+
+        def record(intermediate_result):
+            history.append(float(intermediate_result.fun))
+            if self.callback is not None:
+                self.callback(len(history), history[-1])
+
+        res = differential_evolution(objective, bounds, popsize=self.popsize, maxiter=self.maxiter, tol=self.tol,
+                                     polish=self.polish, vectorized=True, updating="deferred",
+                                     rng=np.random.default_rng(self.rng), callback=record)
+        res.history = np.array(history)
+        self._set_search_result(res)
+        return self
+
+
+class ParticleSwarmEstimator(BoxSearchEstimator):
+    """Global-best particle swarm with Clerc's constriction (:func:`dynid.optim.particle_swarm.minimize_particle_swarm`)
+    on eq. 9 over a box.
+
+    Parameters
+    ----------
+    bounds : (p, 2) array
+    n_dof : int
+    weights : (n_dof,) array, optional
+    swarm_size : int
+        Particles (default 30, the ABC's colony size).
+    maxiter : int
+        Iterations; ``swarm_size · (maxiter + 1)`` evaluations.
+    rng : Generator or seed
+    callback : callable, optional
+        ``callback(iteration, best_objective)``.
+
+    Learned attributes
+    ------------------
+    params_, objective_ (eq. 9), history_, n_evaluations_, result_.
+    """
+
+    def __init__(self, *, bounds, n_dof: int, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
+                 callback: Callable[[int, float], None] | None = None):
+        self.bounds = bounds
+        self.n_dof = n_dof
+        self.weights = weights
+        self.swarm_size = swarm_size
+        self.maxiter = maxiter
+        self.rng = rng
+        self.callback = callback
+
+    def fit(self, w, tau) -> "ParticleSwarmEstimator":
+        w, tau, bounds, objective = self._objectives(w, tau)
+        res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
+                                      rng=self.rng, callback=self.callback)
+        self._set_search_result(res)
+        return self
