@@ -15,11 +15,13 @@ def test_run_writes_results_and_figures(tmp_path):
     out = tmp_path / "run"
     p = dynid("run", "--out", str(out), *FAST)
     assert p.returncode == 0, p.stderr
-    assert "Correlation coefficient" in p.stdout and "0.3182" in p.stdout
+    assert "correlation coefficient" in p.stdout and "0.3182" in p.stdout
     data = json.loads((out / "results.json").read_text())
     assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
-    assert set(data["methods"]) == {"abc", "lad", "ols"}
-    assert len(list(out.glob("fig*.png"))) == 6
+    assert set(data["methods"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
+    assert "Estimator comparison" in p.stdout and "ABC×10" in p.stdout and "physically consistent" in p.stdout
+    assert "Uncertainty" in p.stdout and set(data["methods"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
+    assert len(list(out.glob("fig*.png"))) == 6 and len(list(out.glob("methods_*.png"))) == 2
     assert not list(out.glob(".*tmp"))
 
 
@@ -28,6 +30,8 @@ def test_run_writes_results_and_figures(tmp_path):
     (["--joints", "9"], "between 1 and 6"),
     (["--rate", "-5"], "rate"),
     (["--weights", "1,x"], "weights"),
+    (["--methods", "ols,bogus"], "--methods"),
+    (["--bootstrap", "1"], "--bootstrap"),
 ])
 def test_bad_options_get_one_line_errors(tmp_path, args, message):
     p = dynid("run", "--out", str(tmp_path / "o"), *FAST, *args)
@@ -35,6 +39,15 @@ def test_bad_options_get_one_line_errors(tmp_path, args, message):
     assert message in p.stderr and "Traceback" not in p.stderr + p.stdout
     assert len(p.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "o" / "results.json").exists()
+
+
+def test_methods_subset_without_abc(tmp_path):
+    out = tmp_path / "run"
+    p = dynid("run", "--out", str(out), *FAST, "--methods", "ols,lad", "--bootstrap", "0")
+    assert p.returncode == 0, p.stderr
+    data = json.loads((out / "results.json").read_text())
+    assert list(data["methods"]) == ["ols", "lad"] and "bootstrap" not in data["methods"]["ols"]
+    assert not (out / "fig6_abc_convergence.png").exists() and (out / "methods_comparison.png").exists()
 
 
 def test_usage_error_exit_2():

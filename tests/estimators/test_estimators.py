@@ -165,6 +165,9 @@ def test_box_searches_are_seeded_and_improve(problem, kind):
     a, b = make(kind, beta).fit(w, tau), make(kind, beta).fit(w, tau)
     np.testing.assert_array_equal(a.params_, b.params_)
     assert a.n_evaluations_ > 0 and a.history_[-1] <= a.history_[0]
+    population = {"abc": None, "de": 2 * beta.size, "pso": 30}[kind]
+    if population:  # evaluations count points, not calls of the vectorised objective
+        assert a.n_evaluations_ == population * (len(a.history_) + 1)
     assert np.all(a.params_ >= beta - 1.0) and np.all(a.params_ <= beta + 1.0)
 
 

@@ -33,6 +33,30 @@ def test_noisy_run_is_reproducible_and_sane():
     assert len(d["methods"]["abc"]["history"]) == 5
 
 
+def test_all_methods_compared_honestly_and_reproducibly():
+    """Every box search is bounded below by LAD's exact minimum of eq. 9; the SDP result is physically
+    consistent; the same seed gives identical results, whichever other methods run beside."""
+    from dynid.experiment.methods import METHODS
+
+    cfg = PaperExperimentConfig(bootstrap=20, **FAST)
+    a = run_paper_experiment(cfg)
+    assert tuple(a.methods) == METHODS
+    lad = a.methods["lad"].objective
+    for k in ("abc", "abc10", "de", "pso"):
+        assert lad <= a.methods[k].objective + 1e-9
+        assert a.methods[k].n_evaluations > 0
+    assert a.methods["abc10"].n_evaluations > 5 * a.methods["abc"].n_evaluations
+    assert a.methods["sdp"].pseudo_inertia_min_eig.min() >= -1e-8
+    truth_norm = np.linalg.norm(a.truth)
+    assert np.linalg.norm(a.methods["sdp"].params - a.truth) / truth_norm < 0.05
+    ols = a.methods["ols"]
+    assert np.all(ols.bootstrap["lower"] < ols.params) and np.all(ols.params < ols.bootstrap["upper"])
+    b = run_paper_experiment(PaperExperimentConfig(bootstrap=20, methods=("pso", "ols"), **FAST))
+    for k in ("pso", "ols"):
+        np.testing.assert_array_equal(a.methods[k].params, b.methods[k].params)
+    np.testing.assert_array_equal(a.methods["ols"].bootstrap["std"], b.methods["ols"].bootstrap["std"])
+
+
 def test_paper_plant_uses_table2():
     r = run_paper_experiment(PaperExperimentConfig(plant="paper", current_noise=0.0, encoder_resolution=0.0,
                                                    smoothing_passes=0, **FAST))
@@ -52,6 +76,8 @@ def test_paper_plant_uses_table2():
     (dict(weights=(1.0, 2.0, 1.0)), "weights"),
     (dict(abc_bounds="wide"), "abc-bounds"),
     (dict(joints=6, abc_bounds="table3"), "table3"),
+    (dict(methods=("ols", "nope")), "methods"),
+    (dict(bootstrap=1), "bootstrap"),
 ])
 def test_bad_settings(kwargs, message):
     with pytest.raises(ConfigError, match=message):

@@ -23,7 +23,7 @@ app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="dynid: dynamic model identification of industrial robot arms.")
 console = Console()
 if not console.is_terminal:  # logs and pipes: wide enough for every table
-    console = Console(width=120)
+    console = Console(width=140)
 err_console = Console(stderr=True)
 
 
@@ -63,9 +63,13 @@ def run(
     abc_bounds: str = typer.Option("auto", help="ABC search box: auto, table3 (paper Table 3) or scaled (±(2|β_OLS|+1))."),
     weights: Optional[str] = typer.Option(None, help="Eq. 9 weights per joint, comma separated (default all 1)."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized (designed for the run, min cond), or an excitation.json of dynid excite."),
+    methods: str = typer.Option("all", help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default all)."),
+    bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
 ) -> None:
-    """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)."""
+    """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
+    and compare the estimators on it."""
     from ..experiment import PaperExperimentConfig, run_paper_experiment
+    from ..experiment.methods import LABELS, parse_methods
     from ..report.paper_run import save_paper_run
 
     try:
@@ -73,27 +77,29 @@ def run(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
-            excitation=excitation)
-        with Progress(TextColumn("[bold]ABC[/]"), BarColumn(), TextColumn("{task.completed}/{task.total} it"),
+            excitation=excitation, methods=parse_methods(methods), bootstrap=bootstrap)
+        with Progress(TextColumn("[bold]{task.description}[/]"), TextColumn("iteration {task.fields[it]}"),
                       TextColumn("best F = {task.fields[best]}"), TimeElapsedColumn(), console=console,
-                      transient=False) as progress:
-            task = progress.add_task("abc", total=abc_iterations if abc_iterations > 0 else None, best="—")
-            result = run_paper_experiment(config, progress=lambda i, f: progress.update(task, completed=i, best=f"{f:.4g}"))
+                      transient=True) as progress:
+            task = progress.add_task("estimating", it="—", best="—")
+            result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
+                task, description=LABELS[k], it=str(i), best=f"{f:.4g}"))
         paths = save_paper_run(result, out)
     except DynIdError as exc:
         _fail(exc)
     _print_run(result, paths)
 
 
-METHOD_LABELS = {"abc": "ABC", "lad": "LAD", "ols": "OLS"}
+def _joined(values, fmt: str) -> str:
+    return " / ".join(format(v, fmt) for v in values)
 
 
 def _print_run(result, paths) -> None:
-    from ..conventions import unit_of
     from ..experiment import paper_reference as ref
+    from ..experiment.methods import DESCRIPTIONS, LABELS
 
     d = result.to_dict()
-    methods = {METHOD_LABELS[k]: v for k, v in d["methods"].items()}
+    methods = {LABELS[k]: v for k, v in d["methods"].items()}
     cfg = result.config
     console.print(f"\n[bold]dynid run[/] — robot {result.robot.name}, joints 1-{cfg.joints}, plant '{cfg.plant}', "
                   f"seed {cfg.seed}: {len(d['parameters'])} base parameters "
@@ -101,49 +107,77 @@ def _print_run(result, paths) -> None:
     ex = d["trajectories"]["excitation"]
     console.print(f"identification trajectory: {ex['trajectory']}; cond(W_base) {ex['cond_base_regressor']:.2f} "
                   f"(β1: {ex['cond_base_regressor_beta1']:.2f})", soft_wrap=True)
-    t = Table(title="Base parameters: truth and estimates (OLS standard deviations in results.json)",
-              box=box.SIMPLE_HEAD, padding=(0, 1))
-    for col in ("name (paper)", "unit", "truth", *methods, "Table 2"):
-        t.add_column(col, justify="left" if col in ("name (paper)", "unit") else "right", no_wrap=True)
+    console.print("methods: " + "; ".join(f"{LABELS[k]} = {DESCRIPTIONS[k]}" for k in d["methods"]), soft_wrap=True, highlight=False)
+    t = Table(title="Base parameters: truth and estimates (units in results.json)", box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("name (paper)", "truth", *methods, "Table 2"):
+        t.add_column(col, justify="left" if col == "name (paper)" else "right", no_wrap=True)
     for n in d["parameters"]:
         sym = d["paper_symbols"][n]
-        t.add_row(f"{n} ({sym})" if sym else n, unit_of(n), f"{d['truth'][n]:.3f}",
-                  *(f"{m['params'][n]:.3f}" for m in methods.values()), f"{ref.TABLE2[sym]:.3f}" if sym in ref.TABLE2 else "")
+        t.add_row(f"{n} ({sym})" if sym else n, f"{d['truth'][n]:.4g}",
+                  *(f"{m['params'][n]:.4g}" for m in methods.values()), f"{ref.TABLE2[sym]:.4g}" if sym in ref.TABLE2 else "")
     console.print(t)
-    t = Table(title="Objective F (eq. 9) on the identification data; parameter error against the truth", box=box.SIMPLE_HEAD)
-    for col in ("method", "F [N·m]", "evaluations", "time [s]", "‖β̂−β‖/‖β‖ %", "median |β̂ᵢ−βᵢ|/|βᵢ| %"):
-        t.add_column(col, justify="right")
+    t = Table(title="Estimator comparison: objective F (eq. 9) on the identification data, error against the true base "
+                    "parameters, mean over joints of ρ (eq. 18), RMSE and relative error", box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("method", "F (N·m)", "evaluations", "time (s)", "‖β̂−β‖/‖β‖ %", "ρ ident.", "ρ valid.", "RMSE valid. (N·m)",
+                "error valid. %"):
+        t.add_column(col, justify="left" if col == "method" else "right")
     for label, m in methods.items():
-        err = m["parameter_error_percent"]
-        finite = sorted(v for v in err.values() if v is not None and v == v and v != float("inf"))
-        t.add_row(label, f"{m['objective']:.4f}", str(m["n_evaluations"]) if label == "ABC" else "1 solve", f"{m['seconds']:.3f}",
-                  f"{m['parameter_error_norm_percent']:.2f}", f"{finite[len(finite) // 2]:.2f}" if finite else "")
-    t.add_row("paper (ABC)", f"{ref.OBJECTIVE:.4f}", "", "", "", "")
+        t.add_row(label, f"{m['objective']:.4f}", str(m["n_evaluations"]) if m["n_evaluations"] else "solve",
+                  f"{m['seconds']:.2f}", f"{m['parameter_error_norm_percent']:.3g}",
+                  *(f"{sum(m[k][s]) / cfg.joints:{f}}" for k, s, f in (("correlation", "identification", ".4f"),
+                    ("correlation", "validation", ".4f"), ("rmse", "validation", ".3g"), ("relative_error", "validation", ".3g"))))
+    t.add_row("paper (ABC)", f"{ref.OBJECTIVE:.4f}", "", "", "", f"{sum(ref.CORRELATION_IDENTIFICATION) / 3:.4f}",
+              f"{sum(ref.CORRELATION_VALIDATION) / 3:.4f}", "", "")
     console.print(t)
     for key, beta, paper_vals in (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
                                   ("validation", "β2", ref.CORRELATION_VALIDATION)):
-        t = Table(title=f"Correlation coefficient ρ (eq. 18), {key} trajectory {beta}", box=box.SIMPLE_HEAD)
-        for col in ("joint", *methods, "paper"):
+        t = Table(title=f"Per joint, {key} trajectory {beta}: correlation coefficient ρ (eq. 18) and relative error %",
+                  box=box.SIMPLE_HEAD, padding=(0, 1))
+        for col in ("joint", "", *methods, "paper"):
             t.add_column(col, justify="right")
         for j in range(cfg.joints):
-            t.add_row(str(j + 1), *(f"{m['correlation'][key][j]:.4f}" for m in methods.values()),
+            t.add_row(str(j + 1), "ρ", *(f"{m['correlation'][key][j]:.4f}" for m in methods.values()),
                       f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—")
+            t.add_row("", "error %", *(f"{m['relative_error'][key][j]:.3g}" for m in methods.values()), "", end_section=True)
         console.print(t)
-        t = Table(title=f"RMSE [N·m] and relative error [%], {key} trajectory {beta}", box=box.SIMPLE_HEAD)
-        t.add_column("joint", justify="right")
-        for metric in ("RMSE", "err %"):
-            for label in methods:
-                t.add_column(f"{metric} {label}", justify="right")
-        for j in range(cfg.joints):
-            t.add_row(str(j + 1), *(f"{m['rmse'][key][j]:.3f}" for m in methods.values()),
-                      *(f"{m['relative_error'][key][j]:.2f}" for m in methods.values()))
-        console.print(t)
+    _print_uncertainty(d, methods)
+    if "sdp" in d["methods"]:
+        eig = d["methods"]["sdp"]["pseudo_inertia_min_eig"]
+        verdict = "physically consistent" if min(eig) >= -1e-8 else "NOT physically consistent"
+        console.print(f"SDP: smallest pseudo-inertia eigenvalue per link {_joined(eig, '.3g')} → {verdict}; "
+                      "the other methods estimate base parameters only", soft_wrap=True)
     tm = d["timings"]
-    console.print(f"timings: simulation + preprocessing {tm['simulation_and_preprocessing']:.2f} s, ABC {tm['abc']:.2f} s, "
-                  f"LAD {tm['lad']:.2f} s, OLS {tm['ols']:.3f} s, total {tm['total']:.2f} s")
+    console.print("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in tm.items()), soft_wrap=True)
     for w in d["warnings"]:
         console.print(f"[yellow]warning:[/] {w}")
     console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+
+
+def _print_uncertainty(d: dict, methods: dict) -> None:
+    """Standard deviations from the covariance beside the bootstrap's, with the bootstrap interval."""
+    boot = {label: m for label, m in methods.items() if "bootstrap" in m}
+    if not boot:
+        return
+    first = next(iter(boot.values()))["bootstrap"]
+    t = Table(title=f"Uncertainty: σ from the covariance, σ and {100 * first['level']:.0f} % interval from the moving-block "
+                    f"bootstrap ({first['resamples']} resamples, blocks of {first['block_length_samples']} samples)",
+              box=box.SIMPLE_HEAD, padding=(0, 1))
+    t.add_column("name")
+    t.add_column("truth", justify="right")
+    for label in boot:
+        for col in ("σ cov.", "σ boot.", "interval"):
+            t.add_column(f"{label} {col}", justify="right", no_wrap=True)
+    covered = {label: 0 for label in boot}
+    for n in d["parameters"]:
+        row = [n, f"{d['truth'][n]:.3f}"]
+        for label, m in boot.items():
+            b = m["bootstrap"]
+            lo, hi = b["lower"][n], b["upper"][n]
+            covered[label] += lo <= d["truth"][n] <= hi
+            row += [f"{m['params_std'][n]:.3g}", f"{b['std'][n]:.3g}", f"[{lo:.3f}, {hi:.3f}]"]
+        t.add_row(*row)
+    console.print(t)
+    console.print("intervals holding the truth: " + ", ".join(f"{label} {c}/{len(d['parameters'])}" for label, c in covered.items()))
 
 
 def _progress(label: str):

@@ -56,16 +56,23 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     def fit(self, w, tau) -> "DifferentialEvolutionEstimator":
         w, tau, bounds, objective = self._objectives(w, tau)
         history = []
+        evaluations = 0
+
+        def counted(x):  # SciPy's nfev counts calls of the vectorised objective, not points
+            nonlocal evaluations
+            evaluations += x.shape[1] if x.ndim == 2 else 1
+            return objective(x)
 
         def record(intermediate_result):
             history.append(float(intermediate_result.fun))
             if self.callback is not None:
                 self.callback(len(history), history[-1])
 
-        res = differential_evolution(objective, bounds, popsize=self.popsize, maxiter=self.maxiter, tol=self.tol,
+        res = differential_evolution(counted, bounds, popsize=self.popsize, maxiter=self.maxiter, tol=self.tol,
                                      polish=self.polish, vectorized=True, updating="deferred",
                                      rng=np.random.default_rng(self.rng), callback=record)
         res.history = np.array(history)
+        res.nfev = evaluations
         self._set_search_result(res)
         return self
 

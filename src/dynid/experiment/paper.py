@@ -1,9 +1,10 @@
 """The paper's identification experiment, end to end (§3-4), on a simulated robot.
 
 Model → base parameters → excitation β1 (eq. 14) → simulated currents (eq. 16) → eq. 17 smoothing and
-Fourier-fit derivatives → ABC (eqs. 7-13), LAD (the exact minimiser of eq. 9 over the same search box)
-and OLS → correlation coefficient (eq. 18), RMSE and relative error on β1 and on the validation
-trajectory β2.
+Fourier-fit derivatives → the estimators of :mod:`dynid.experiment.methods` (ABC of eqs. 7-13 at the paper's
+budget and 10× it, DE and PSO on the same objective and box, LAD = the exact minimiser of eq. 9 in that box,
+OLS, WLS, IRLS, physically consistent least squares) → correlation coefficient (eq. 18), RMSE and relative
+error on β1 and on the validation trajectory β2, parameter error against the truth, bootstrap intervals.
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ import numpy as np
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
+from ..dynamics.layout import consistency_layout
 from ..dynamics.regressor import observation_matrix
-from ..estimators import BeeColonyEstimator, LeastAbsoluteDeviations, OrdinaryLeastSquares, paper_objective
+from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, paper_objective
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import sample_times
@@ -31,6 +33,7 @@ from ..preprocessing import five_point_cubic_smoothing, fourier_fit_derivatives
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
+from .methods import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
 
 PLANTS = ("assumed", "paper")
 BOUNDS = ("auto", "table3", "scaled")
@@ -72,6 +75,10 @@ class PaperExperimentConfig:
         Identification trajectory: "paper" (β1, eq. A.1), "optimized" (designed for this run by
         :func:`dynid.excitation.design.design_excitation`: 5 harmonics at ``omega_f``, β1's offsets, the
         robot's limits, starting from β1) or the path of an ``excitation.json`` written by ``dynid excite``.
+    methods : tuple of str
+        Estimators compared (keys of :data:`dynid.experiment.methods.METHODS`; default all).
+    bootstrap : int
+        Moving-block bootstrap resamples for the least-squares methods (0: none).
     """
 
     robot: str = "er16"
@@ -90,6 +97,8 @@ class PaperExperimentConfig:
     weights: tuple[float, ...] | None = None
     abc_bounds: str = "auto"
     excitation: str = "paper"
+    methods: tuple[str, ...] = METHODS
+    bootstrap: int = 100
 
     def validate(self, robot: Robot) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
@@ -109,6 +118,9 @@ class PaperExperimentConfig:
             raise ConfigError(f"noise levels must be non-negative, got current noise {self.current_noise}, encoder resolution {self.encoder_resolution}")
         if self.smoothing_passes < 0:
             raise ConfigError(f"--smoothing-passes must be >= 0, got {self.smoothing_passes}")
+        parse_methods(self.methods)
+        if self.bootstrap != 0 and self.bootstrap < 2:
+            raise ConfigError(f"--bootstrap must be 0 (none) or at least 2 resamples, got {self.bootstrap}")
         if self.weights is not None:
             w = np.asarray(self.weights, dtype=float)
             if w.shape != (self.joints,) or np.any(w < 0) or np.any(w > 1):
@@ -127,21 +139,24 @@ class Dataset:
     tau_true: np.ndarray     # noise-free torques, (N, n)
     w_base: np.ndarray       # (N*n, n_base)
     tool: np.ndarray         # (N, 3)
+    w_standard: np.ndarray | None = None  # (N*n, p), kept for the physically consistent estimator
 
 
 @dataclass
 class MethodResult:
-    """What one estimator gave."""
+    """What one estimator gave (``n_evaluations`` of eq. 9 is None for the solvers)."""
 
     params: np.ndarray
     objective: float
     seconds: float
-    n_evaluations: int
+    n_evaluations: int | None
     tau_identification: np.ndarray
     tau_validation: np.ndarray
     metrics: dict
     params_std: np.ndarray | None = None
     history: np.ndarray | None = None
+    bootstrap: dict | None = None
+    pseudo_inertia_min_eig: np.ndarray | None = None
 
 
 @dataclass
@@ -184,7 +199,8 @@ class PaperRunResult:
             "warnings": self.warnings,
         }
         for key, m in self.methods.items():
-            d = {"params": dict(zip(names, m.params.tolist())), "objective": m.objective, "seconds": m.seconds,
+            d = {"label": LABELS[key], "description": DESCRIPTIONS[key],
+                 "params": dict(zip(names, m.params.tolist())), "objective": m.objective, "seconds": m.seconds,
                  "n_evaluations": m.n_evaluations,
                  "parameter_error_percent": dict(zip(names, _percent_error(m.params, self.truth).tolist())),
                  "parameter_error_norm_percent": float(100 * np.linalg.norm(m.params - self.truth) / np.linalg.norm(self.truth))}
@@ -193,6 +209,12 @@ class PaperRunResult:
                 d["params_std"] = dict(zip(names, m.params_std.tolist()))
             if m.history is not None:
                 d["history"] = m.history.tolist()
+            if m.bootstrap is not None:
+                b = m.bootstrap
+                d["bootstrap"] = {"resamples": b["resamples"], "block_length_samples": b["block_length"], "level": b["level"],
+                                  **{k: dict(zip(names, b[k].tolist())) for k in ("lower", "upper", "std")}}
+            if m.pseudo_inertia_min_eig is not None:
+                d["pseudo_inertia_min_eig"] = m.pseudo_inertia_min_eig.tolist()
             out["methods"][key] = d
         return out
 
@@ -235,7 +257,7 @@ def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
     return out
 
 
-def _dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings) -> Dataset:
+def _dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, keep_standard=False) -> Dataset:
     q, dq, ddq = traj.evaluate(t)
     n = robot.n_dof
     phi = phi_true.reshape(n, robot.n_params_per_joint)
@@ -243,8 +265,9 @@ def _dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings
     warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
     tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
     q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
-    w_base = base.base_observation(observation_matrix(robot, q_f, dq_f, ddq_f))
-    return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, w_base, tool_positions(robot, q))
+    w_std = observation_matrix(robot, q_f, dq_f, ddq_f)
+    return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, base.base_observation(w_std), tool_positions(robot, q),
+                   w_std if keep_standard else None)
 
 
 def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
@@ -253,14 +276,14 @@ def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
 
 
 def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig(),
-                         progress: Callable[[int, float], None] | None = None) -> PaperRunResult:
-    """Run the paper's experiment (§4) on a simulated robot and compare ABC with OLS.
+                         progress: Callable[[str, int, float], None] | None = None) -> PaperRunResult:
+    """Run the paper's experiment (§4) on a simulated robot and compare the estimators of ``config.methods``.
 
     Parameters
     ----------
     config : PaperExperimentConfig
     progress : callable, optional
-        ``progress(iteration, best_objective)`` during the ABC.
+        ``progress(method_key, iteration, best_objective)`` during the box searches (ABC, DE, PSO).
 
     Returns
     -------
@@ -274,6 +297,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t0 = time.perf_counter()
     full = load_robot(config.robot)
     config.validate(full)
+    methods = parse_methods(config.methods)
     robot = full.submodel(config.joints) if config.joints < full.n_dof else full
     k = config.joints
     rng = np.random.default_rng(config.seed)
@@ -295,55 +319,62 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     traj_id, excitation_info = _identification_trajectory(config, robot, base)
     traj_val = paper_validation_trajectory(config.omega_f, k)
     t_sim = time.perf_counter()
-    ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings)
+    ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
+                     keep_standard="sdp" in methods)
     valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
-    t1 = time.perf_counter()
-    ols = OrdinaryLeastSquares().fit(ident.w_base, y)
-    ols_seconds = time.perf_counter() - t1
-
-    has_table3 = all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names)
-    if config.abc_bounds == "table3" and not has_table3:
-        raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")
-    use_table3 = config.abc_bounds == "table3" or (config.abc_bounds == "auto" and has_table3 and robot.name == "er16" and k == 3)
-    if use_table3:
-        bounds = np.array([ref.TABLE3[ref.paper_symbol(n)] for n in base.names], dtype=float)
-    else:
-        half = 2.0 * np.abs(ols.params_) + 1.0
-        bounds = np.stack([-half, half], axis=1)
+    bounds = _search_box(config, robot, base, ident.w_base, y)
     outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
     if outside:
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
-
-    t2 = time.perf_counter()
-    abc = BeeColonyEstimator(bounds=bounds, n_dof=k, weights=config.weights, colony_size=config.colony_size,
-                             limit=config.limit, maxiter=config.maxiter,
-                             rng=np.random.default_rng([config.seed, 2]), callback=progress).fit(ident.w_base, y)
-    abc_seconds = time.perf_counter() - t2
-
-    t3 = time.perf_counter()
-    lad = LeastAbsoluteDeviations(n_dof=k, weights=config.weights, bounds=bounds).fit(ident.w_base, y)
-    lad_seconds = time.perf_counter() - t3
+    data = FitData(ident.w_base, y, k, bounds, base, weights=config.weights)
+    if "sdp" in methods:
+        data.w_standard, data.layout = ident.w_standard, consistency_layout(robot)
+        data.prior = robot.standard_parameters() * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
+    budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
                             {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
                              "excitation": excitation_info},
                             warnings=warnings)
-    for key, est, secs, nev in (("abc", abc, abc_seconds, abc.n_evaluations_), ("lad", lad, lad_seconds, 1),
-                                ("ols", ols, ols_seconds, 1)):
-        p_id = (ident.w_base @ est.params_).reshape(-1, k)
-        p_val = (valid.w_base @ est.params_).reshape(-1, k)
-        obj = float(paper_objective(y - p_id.ravel(), k, config.weights))
+    for key in methods:
+        idx = METHODS.index(key)
+        callback = None if progress is None else (lambda i, f, key=key: progress(key, i, f))
+        fit = fit_method(key, data, budget, np.random.default_rng([config.seed, 2, idx]), callback)
+        timings[key] = fit.seconds
+        p_id = (ident.w_base @ fit.params).reshape(-1, k)
+        p_val = (valid.w_base @ fit.params).reshape(-1, k)
         metrics = {}
         for name, tau, pred in (("identification", ident.tau, p_id), ("validation", valid.tau, p_val)):
             for mk, mv in _metrics(tau, pred).items():
                 metrics.setdefault(mk, {})[name] = mv
+        est = fit.estimator
+        boot = None
+        if key in BOOTSTRAPPED and config.bootstrap:
+            t_b = time.perf_counter()
+            bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
+                                     n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, idx]))
+            boot = {"resamples": config.bootstrap, "block_length": bs.block_length, "level": bs.level,
+                    "lower": bs.lower, "upper": bs.upper, "std": bs.std}
+            timings[f"{key}_bootstrap"] = time.perf_counter() - t_b
         result.methods[key] = MethodResult(
-            params=est.params_, objective=obj, seconds=secs, n_evaluations=nev, tau_identification=p_id,
-            tau_validation=p_val, metrics=metrics, params_std=getattr(est, "params_std_", None),
-            history=getattr(est, "history_", None))
-    timings.update({"ols": ols_seconds, "abc": abc_seconds, "lad": lad_seconds, "total": time.perf_counter() - t0})
+            params=fit.params, objective=float(paper_objective(y - p_id.ravel(), k, config.weights)), seconds=fit.seconds,
+            n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
+            params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
+            pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None))
+    timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
+
+
+def _search_box(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The ABC's search box (n_base, 2): the paper's Table 3, or ``±(2|β_OLS| + 1)``."""
+    has_table3 = all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names)
+    if config.abc_bounds == "table3" and not has_table3:
+        raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")
+    if config.abc_bounds == "table3" or (config.abc_bounds == "auto" and has_table3 and robot.name == "er16" and config.joints == 3):
+        return np.array([ref.TABLE3[ref.paper_symbol(n)] for n in base.names], dtype=float)
+    half = 2.0 * np.abs(OrdinaryLeastSquares().fit(w_base, y).params_) + 1.0
+    return np.stack([-half, half], axis=1)

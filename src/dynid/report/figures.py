@@ -64,20 +64,61 @@ def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory",
     return ax
 
 
-def plot_convergence(history, ax=None, reference=None, title="ABC convergence"):
-    """Best objective F (eq. 9) per iteration (paper Fig. 6); optional horizontal reference values."""
+def plot_convergence(histories, ax=None, reference=None, title="ABC convergence", xlabel="iteration"):
+    """Best objective F (eq. 9) against iterations or evaluations (paper Fig. 6).
+
+    ``histories`` maps a label to ``(x, best_F)``; a bare array is the ABC's best F per iteration.
+    ``reference`` maps a label to a horizontal line.
+    """
     axes = _axes(ax, figsize=(7, 4))
     a = np.atleast_1d(axes)[0]
-    a.plot(np.arange(1, len(history) + 1), history, marker=".", label="ABC best F")
+    if not isinstance(histories, dict):
+        h = np.asarray(histories)
+        histories = {"ABC best F": (np.arange(1, len(h) + 1), h)}
+    for label, (x, y) in histories.items():
+        a.plot(x, y, marker="." if len(x) <= 100 else None, label=label)
+    colors = iter(["black", "tab:purple", "tab:brown", "tab:olive"])
     for label, value in (reference or {}).items():
-        a.axhline(value, ls="--", lw=1.0, color="gray" if "paper" in label else "tab:orange", label=label)
-    a.set_xlabel("iteration")
+        a.axhline(value, ls="--", lw=1.0, color="gray" if "paper" in label else next(colors, "tab:orange"), label=label)
+    a.set_xlabel(xlabel)
     a.set_ylabel("objective F (eq. 9) [N·m]")
     a.set_yscale("log")
     a.grid(alpha=0.3, which="both")
-    a.legend()
+    a.legend(fontsize="small")
     a.set_title(title)
     return a
+
+
+def plot_method_comparison(labels, validation_error, parameter_error, ax=None,
+                           title="Estimators on the validation trajectory"):
+    """Relative validation error per joint (grouped bars, log scale) and parameter error per method.
+
+    ``validation_error`` (n_methods, n_dof) [%]; ``parameter_error`` (n_methods,) ``‖β̂−β‖/‖β‖`` [%].
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig = plt.figure(figsize=(9, 6), constrained_layout=True)
+        ax = fig.subplots(2, 1)
+    a, b = ax
+    err = np.asarray(validation_error, dtype=float)
+    m, n = err.shape
+    width = 0.8 / n
+    x = np.arange(m)
+    for j in range(n):
+        a.bar(x + (j - (n - 1) / 2) * width, err[:, j], width, label=f"joint {j + 1}")
+    a.set_xticks(x, labels)
+    a.set_yscale("log")
+    a.set_ylabel("validation error [%]")
+    a.legend(fontsize="small", ncol=n)
+    a.grid(alpha=0.3, axis="y", which="both")
+    a.set_title(title)
+    b.bar(x, parameter_error, color="tab:gray")
+    b.set_xticks(x, labels)
+    b.set_yscale("log")
+    b.set_ylabel("‖β̂−β‖/‖β‖ [%]")
+    b.grid(alpha=0.3, axis="y", which="both")
+    return ax
 
 
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..experiment import paper_reference as ref
+from ..experiment.methods import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
 from ..io import write_json
 from . import figures
@@ -13,11 +16,15 @@ from .output import output_folder, save_figure
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",
     "fig5_tool_path.png": "3-D tool path of β1",
-    "fig6_abc_convergence.png": "ABC objective per iteration",
+    "fig6_abc_convergence.png": "ABC objective per iteration (when the run has ABC)",
     "fig7_torques_identification.png": "measured vs predicted torques on β1",
     "fig8_validation_trajectory.png": "joint trajectories of β2",
     "fig9_torques_validation.png": "measured vs predicted torques on β2",
+    "methods_convergence.png": "best objective against evaluations for ABC, ABC×10, DE and PSO (when the run has them)",
+    "methods_comparison.png": "validation error per joint and parameter error of every method",
 }
+TORQUE_PLOT_METHODS = ("abc", "lad", "ols", "sdp")
+"""Methods drawn in Figs. 7 and 9 (those the run has), so the curves stay readable."""
 
 
 def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
@@ -30,21 +37,42 @@ def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
     """
     out = output_folder(out)
     ident, valid, lim = result.identification, result.validation, result.robot.limits
-    abc, lad, ols = result.methods["abc"], result.methods["lad"], result.methods["ols"]
-    paths = [out / name for name in FIGURES]
+    methods = result.methods
     ident_name = "β1" if result.config.excitation == "paper" else "(optimized)" if result.config.excitation == "optimized" else "(from file)"
-    save_figure(figures.plot_joint_trajectories(ident.t, ident.q, lim.q_min, lim.q_max,
-                                          title=f"Fig. 4 — identification trajectory {ident_name} (dashed: limits)"), paths[0])
-    save_figure(figures.plot_tool_path(ident.tool, title=f"Fig. 5 — tool path of {ident_name}"), paths[1])
-    save_figure(figures.plot_convergence(abc.history, reference={"LAD F (exact minimum, same box)": lad.objective, "OLS F": ols.objective,
-                                                              f"paper F = {ref.OBJECTIVE}": ref.OBJECTIVE},
-                                   title="Fig. 6 — ABC convergence (eq. 9)"), paths[2])
-    save_figure(figures.plot_torque_comparison(ident.t, ident.tau, {"ABC": abc.tau_identification, "LAD": lad.tau_identification, "OLS": ols.tau_identification},
-                                         title="Fig. 7 — identification trajectory: measured vs predicted"), paths[3])
-    save_figure(figures.plot_joint_trajectories(valid.t, valid.q, lim.q_min, lim.q_max,
-                                          title="Fig. 8 — validation trajectory β2 (dashed: limits)"), paths[4])
-    save_figure(figures.plot_torque_comparison(valid.t, valid.tau, {"ABC": abc.tau_validation, "LAD": lad.tau_validation, "OLS": ols.tau_validation},
-                                         title="Fig. 9 — validation trajectory: measured vs predicted"), paths[5])
+    shown = {LABELS[k]: methods[k] for k in TORQUE_PLOT_METHODS if k in methods} or {LABELS[k]: m for k, m in list(methods.items())[:3]}
+    references = {f"{LABELS[k]} F": methods[k].objective for k in ("lad", "ols") if k in methods}
+    references[f"paper F = {ref.OBJECTIVE}"] = ref.OBJECTIVE
+    figs = {
+        "fig4_identification_trajectory.png": lambda: figures.plot_joint_trajectories(
+            ident.t, ident.q, lim.q_min, lim.q_max, title=f"Fig. 4 — identification trajectory {ident_name} (dashed: limits)"),
+        "fig5_tool_path.png": lambda: figures.plot_tool_path(ident.tool, title=f"Fig. 5 — tool path of {ident_name}"),
+        "fig7_torques_identification.png": lambda: figures.plot_torque_comparison(
+            ident.t, ident.tau, {k: m.tau_identification for k, m in shown.items()},
+            title="Fig. 7 — identification trajectory: measured vs predicted"),
+        "fig8_validation_trajectory.png": lambda: figures.plot_joint_trajectories(
+            valid.t, valid.q, lim.q_min, lim.q_max, title="Fig. 8 — validation trajectory β2 (dashed: limits)"),
+        "fig9_torques_validation.png": lambda: figures.plot_torque_comparison(
+            valid.t, valid.tau, {k: m.tau_validation for k, m in shown.items()},
+            title="Fig. 9 — validation trajectory: measured vs predicted"),
+        "methods_comparison.png": lambda: figures.plot_method_comparison(
+            [LABELS[k] for k in methods], [m.metrics["relative_error"]["validation"] for m in methods.values()],
+            [100 * np.linalg.norm(m.params - result.truth) / np.linalg.norm(result.truth) for m in methods.values()],
+            title="Estimators on the validation trajectory β2 (top) and against the true base parameters (bottom)"),
+    }
+    if "abc" in methods:
+        figs["fig6_abc_convergence.png"] = lambda: figures.plot_convergence(
+            methods["abc"].history, reference=references, title="Fig. 6 — ABC convergence (eq. 9)")
+    searches = {LABELS[k]: methods[k] for k in BOX_SEARCHES if k in methods}
+    if searches:
+        figs["methods_convergence.png"] = lambda: figures.plot_convergence(
+            {label: (np.linspace(m.n_evaluations / len(m.history), m.n_evaluations, len(m.history)), m.history)
+             for label, m in searches.items()},
+            reference=references, xlabel="evaluations of eq. 9", title="Box searches on eq. 9 (LAD: the exact minimum in the box)")
+    paths = []
+    for name in FIGURES:
+        if name in figs:
+            paths.append(out / name)
+            save_figure(figs[name](), paths[-1])
     json_path = out / "results.json"
     write_json(json_path, result.to_dict())
     return [json_path] + paths

@@ -1,0 +1,179 @@
+"""The estimators compared on simulated experiments (``dynid run --methods``, ``dynid montecarlo``).
+
+Each method has a short key, a label for tables and one way to be built from a :class:`FitData`:
+
+- ``ols``, ``wls``, ``irls``: least squares, per-joint weighted least squares, Huber IRLS;
+- ``lad``: the exact minimiser of eq. 9 over the search box (a linear program);
+- ``sdp``: physically consistent least squares over the standard parameters, reported as base parameters;
+- ``abc``: the artificial bee colony at the paper's budget (Ns = 30, limit = 15, Tmax = 50);
+- ``abc10``: the same with 10× the iterations;
+- ``de``, ``pso``: differential evolution and particle swarm on eq. 9 over the same box, each given the
+  evaluation budget of ``abc10`` (``10 · Ns · Tmax``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..dynamics.base_parameters import BaseParameters
+from ..estimators import (BeeColonyEstimator, DifferentialEvolutionEstimator, Estimator, IterativelyReweightedLeastSquares,
+                          LeastAbsoluteDeviations, OrdinaryLeastSquares, ParticleSwarmEstimator,
+                          PhysicallyConsistentLeastSquares, WeightedLeastSquares)
+from ..exceptions import ConfigError
+
+METHODS = ("ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso")
+LABELS = {"ols": "OLS", "wls": "WLS", "irls": "IRLS", "lad": "LAD", "sdp": "SDP", "abc": "ABC", "abc10": "ABC×10",
+          "de": "DE", "pso": "PSO"}
+DESCRIPTIONS = {
+    "ols": "ordinary least squares",
+    "wls": "weighted least squares, one weight per joint",
+    "irls": "iteratively reweighted least squares (Huber)",
+    "lad": "least absolute deviations: exact minimum of eq. 9 in the search box (HiGHS)",
+    "sdp": "physically consistent least squares (SDP, cvxpy + Clarabel), prior: nominal parameters × U(0.7, 1.3)",
+    "abc": "artificial bee colony, the paper's budget",
+    "abc10": "artificial bee colony, 10× the paper's iterations",
+    "de": "differential evolution (SciPy), the budget of ABC×10",
+    "pso": "particle swarm (constriction), the budget of ABC×10",
+}
+BOX_SEARCHES = ("abc", "abc10", "de", "pso")
+"""Methods that search the box for the minimum of eq. 9 and count objective evaluations."""
+BOOTSTRAPPED = ("ols", "wls")
+"""Methods cheap enough to refit on every bootstrap resample (IRLS reports Huber's sandwich covariance)."""
+
+
+def parse_methods(text: str | tuple | list | None) -> tuple[str, ...]:
+    """Method keys from ``"ols,abc"`` (or a sequence); ``None`` or ``"all"`` gives :data:`METHODS`.
+
+    Raises
+    ------
+    ConfigError
+        Unknown or repeated method.
+    """
+    if text is None or text == "all":
+        return METHODS
+    keys = [k.strip().lower() for k in (text.split(",") if isinstance(text, str) else text)]
+    unknown = [k for k in keys if k not in METHODS]
+    if unknown or not keys:
+        raise ConfigError(f"--methods: expected a comma-separated subset of {', '.join(METHODS)} (or all), got {text!r}")
+    if len(set(keys)) != len(keys):
+        raise ConfigError(f"--methods: each method once, got {text!r}")
+    return tuple(keys)
+
+
+@dataclass(frozen=True)
+class SearchBudget:
+    """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations."""
+
+    colony_size: int = 30
+    limit: int = 15
+    maxiter: int = 50
+
+    @property
+    def evaluations(self) -> int:
+        return 10 * self.colony_size * self.maxiter
+
+
+@dataclass
+class FitData:
+    """What the estimators see of one identification recording.
+
+    Attributes
+    ----------
+    w_base : (N·n_dof, n_base) array
+        Base observation matrix, rows sample-major.
+    tau : (N·n_dof,) array
+        Measured torques [N·m].
+    n_dof : int
+    bounds : (n_base, 2) array
+        Search box of the box searches and LAD.
+    base : BaseParameters
+    w_standard : (N·n_dof, p) array, optional
+        Standard observation matrix (needed by ``sdp`` only).
+    layout : tuple, optional
+        ``(links, nonnegative)`` of :func:`dynid.dynamics.layout.consistency_layout` (``sdp``).
+    prior : (p,) array, optional
+        Standard parameters the SDP pulls unidentifiable directions towards.
+    weights : (n_dof,) array, optional
+        ``delta`` of eq. 9.
+    """
+
+    w_base: np.ndarray
+    tau: np.ndarray
+    n_dof: int
+    bounds: np.ndarray
+    base: BaseParameters
+    w_standard: np.ndarray | None = None
+    layout: tuple | None = None
+    prior: np.ndarray | None = None
+    weights: np.ndarray | None = None
+
+
+@dataclass
+class Fitted:
+    """One method's fit: base parameters, the fitted estimator, wall time and evaluations of eq. 9."""
+
+    key: str
+    params: np.ndarray
+    estimator: Estimator
+    seconds: float
+    n_evaluations: int | None
+
+
+def make_estimator(key: str, data: FitData, budget: SearchBudget, rng: np.random.Generator,
+                   callback: Callable[[int, float], None] | None = None) -> Estimator:
+    """An unfitted estimator of method ``key`` for ``data`` (``rng`` seeds the box searches)."""
+    n, wts, box = data.n_dof, data.weights, data.bounds
+    if key == "ols":
+        return OrdinaryLeastSquares()
+    if key == "wls":
+        return WeightedLeastSquares(n_dof=n)
+    if key == "irls":
+        return IterativelyReweightedLeastSquares(n_dof=n)
+    if key == "lad":
+        return LeastAbsoluteDeviations(n_dof=n, weights=wts, bounds=box)
+    if key == "sdp":
+        links, nonneg = data.layout
+        return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior)
+    if key in ("abc", "abc10"):
+        iters = budget.maxiter * (10 if key == "abc10" else 1)
+        return BeeColonyEstimator(bounds=box, n_dof=n, weights=wts, colony_size=budget.colony_size, limit=budget.limit,
+                                  maxiter=iters, rng=rng, callback=callback)
+    if key == "pso":
+        return ParticleSwarmEstimator(bounds=box, n_dof=n, weights=wts, swarm_size=budget.colony_size,
+                                      maxiter=max(1, budget.evaluations // budget.colony_size - 1), rng=rng, callback=callback)
+    if key == "de":
+        p = box.shape[0]
+        popsize = max(1, math.ceil(budget.colony_size / p))
+        return DifferentialEvolutionEstimator(bounds=box, n_dof=n, weights=wts, popsize=popsize,
+                                              maxiter=max(1, budget.evaluations // (popsize * p) - 1), rng=rng, callback=callback)
+    raise ConfigError(f"unknown method {key!r}; expected one of {', '.join(METHODS)}")
+
+
+def fit_method(key: str, data: FitData, budget: SearchBudget, rng: np.random.Generator,
+               callback: Callable[[int, float], None] | None = None) -> Fitted:
+    """Fit method ``key`` and return its base parameters (the SDP's standard set mapped to the base).
+
+    Raises
+    ------
+    ConfigError
+        ``sdp`` without ``w_standard`` and ``layout``, or an unknown key.
+    DynIdError
+        From the estimator (rank deficiency, solver failure).
+    """
+    est = make_estimator(key, data, budget, rng, callback)
+    t0 = time.perf_counter()
+    if key == "sdp":
+        if data.w_standard is None or data.layout is None:
+            raise ConfigError("method sdp needs the standard observation matrix and the parameter layout")
+        est.fit(data.w_standard, data.tau)
+        params = data.base.base_from_standard(est.params_)
+    else:
+        est.fit(data.w_base, data.tau)
+        params = est.params_
+    seconds = time.perf_counter() - t0
+    return Fitted(key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
