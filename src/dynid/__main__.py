@@ -1,3 +1,4 @@
 from .cli.app import main
 
-main()
+if __name__ == "__main__":  # worker processes (Dask, multiprocessing) import this module under another name
+    main()

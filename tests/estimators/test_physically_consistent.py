@@ -54,3 +54,21 @@ def test_constraints_bind_when_the_data_ask_for_negative_friction(rng):
     est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters()).fit(w, tau)
     assert abs(est.params_[robot.parameter_names.index("fv2")]) < 1e-6
     assert est.pseudo_inertia_min_eig_.min() >= -1e-7
+
+
+def test_consistency_margin_tells_realisable_base_parameters_from_impossible_ones():
+    """The true parameters' base projection is realisable (margin > 0); a negative viscous friction or a
+    base inertia far below what any mass distribution allows is not."""
+    from dynid.estimators import consistency_margin
+
+    robot = load_robot("er16").submodel(3)
+    base = base_parameters(robot, rng=0)
+    links, nonneg = consistency_layout(robot)
+    beta = base.base_from_standard(robot.standard_parameters())
+    assert consistency_margin(base.regrouping, beta, links, nonneg) > 0
+    bad = beta.copy()
+    bad[base.names.index("fv2")] = -0.5
+    assert consistency_margin(base.regrouping, bad, links, nonneg) < 0
+    bad = beta.copy()
+    bad[base.names.index("ZZ1R")] = -10.0  # ZZ1R collects the inertias about axis 1: never negative
+    assert consistency_margin(base.regrouping, bad, links, nonneg) < 0

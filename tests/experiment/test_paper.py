@@ -47,6 +47,7 @@ def test_all_methods_compared_honestly_and_reproducibly():
         assert a.methods[k].n_evaluations > 0
     assert a.methods["abc10"].n_evaluations > 5 * a.methods["abc"].n_evaluations
     assert a.methods["sdp"].pseudo_inertia_min_eig.min() >= -1e-8
+    assert a.truth_consistency_margin > 0 and a.methods["sdp"].consistency_margin >= -1e-7
     truth_norm = np.linalg.norm(a.truth)
     assert np.linalg.norm(a.methods["sdp"].params - a.truth) / truth_norm < 0.05
     ols = a.methods["ols"]

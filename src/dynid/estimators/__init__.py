@@ -6,10 +6,10 @@ from .bootstrap import BootstrapIntervals, bootstrap_intervals
 from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
 from .least_absolute import LeastAbsoluteDeviations
 from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
-from .physically_consistent import PhysicallyConsistentLeastSquares
+from .physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin
 from .robust import IterativelyReweightedLeastSquares
 
 __all__ = ["Estimator", "BoxSearchEstimator", "paper_objective", "BeeColonyEstimator", "BootstrapIntervals",
            "bootstrap_intervals", "DifferentialEvolutionEstimator", "ParticleSwarmEstimator", "LeastAbsoluteDeviations",
            "OrdinaryLeastSquares", "WeightedLeastSquares", "PhysicallyConsistentLeastSquares",
-           "IterativelyReweightedLeastSquares"]
+           "IterativelyReweightedLeastSquares", "consistency_margin"]

@@ -82,10 +82,7 @@ class PhysicallyConsistentLeastSquares(Estimator):
             cost = cost + self.prior_weight * float(np.mean(r**2) * r.shape[0]) * cp.sum_squares(phi - prior)
         cons = []
         for idx in links:
-            xx, xy, xz, yy, yz, zz, mx, my, mz, mass = (phi[int(i)] for i in idx)
-            tr = 0.5 * (xx + yy + zz)
-            j = cp.bmat([[tr - xx, -xy, -xz, mx], [-xy, tr - yy, -yz, my], [-xz, -yz, tr - zz, mz], [mx, my, mz, mass]])
-            cons.append(0.5 * (j + j.T) >> self.epsilon * np.eye(4))
+            cons.append(_pseudo_inertia_expression(phi, idx) >> self.epsilon * np.eye(4))
         if nonneg.size:
             cons.append(phi[nonneg] >= 0)
         problem = cp.Problem(cp.Minimize(cost), cons)
@@ -105,3 +102,66 @@ def _reduced_least_squares(w: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, 
     """``(R, Qᵀτ)`` with ``W = QR``: ``||Wφ - τ||² = ||Rφ - Qᵀτ||² + const``."""
     q, r = np.linalg.qr(w, mode="reduced")
     return r, q.T @ tau
+
+
+def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1.0) -> float:
+    """Largest ``t <= bound`` such that some standard parameters ``φ`` with ``regrouping @ φ = beta`` have every
+    link's pseudo-inertia ``⪰ t·1`` and the ``nonnegative`` columns ``>= 0``: a feasibility SDP.
+
+    ``t >= 0`` means the base parameters ``beta`` are those of a physically consistent robot (Sousa & Cortesão,
+    "Physical feasibility of robot base inertial parameter identification: a linear matrix inequality approach",
+    IJRR 33(6), 2014); ``t < 0`` means no mass distribution gives them.
+
+    Parameters
+    ----------
+    regrouping : (n_base, p) array
+        ``beta = regrouping @ φ`` (:attr:`dynid.dynamics.base_parameters.BaseParameters.regrouping`).
+    beta : (n_base,) array
+    links : (n_links, 10) int array
+    nonnegative : sequence of int
+    bound : float
+        Cap on ``t`` that keeps the problem bounded [kg·m², kg].
+
+    Returns
+    -------
+    float
+        ``t*``, or ``-inf`` when even ``t`` very negative is infeasible (non-finite input).
+
+    Raises
+    ------
+    DynIdError
+        If the solver fails.
+    """
+    import cvxpy as cp
+
+    k = np.asarray(regrouping, dtype=float)
+    b = np.asarray(beta, dtype=float)
+    if not np.all(np.isfinite(b)):
+        return float("-inf")
+    phi, t = cp.Variable(k.shape[1]), cp.Variable()
+    cons = [k @ phi == b, t <= bound]
+    for idx in np.asarray(links, dtype=int).reshape(-1, 10):
+        cons.append(_pseudo_inertia_expression(phi, idx) >> t * np.eye(4))
+    nonneg = np.asarray(nonnegative, dtype=int)
+    if nonneg.size:
+        cons.append(phi[nonneg] >= 0)
+    problem = cp.Problem(cp.Maximize(t), cons)
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError as exc:
+        raise DynIdError(f"consistency check: the SDP solver failed ({exc})") from None
+    if problem.status in ("infeasible", "infeasible_inaccurate"):
+        return float("-inf")
+    if t.value is None:
+        raise DynIdError(f"consistency check: solver status {problem.status}")
+    return float(t.value)
+
+
+def _pseudo_inertia_expression(phi, idx):
+    """cvxpy expression of a link's pseudo-inertia from its ten parameters (symmetrised)."""
+    import cvxpy as cp
+
+    xx, xy, xz, yy, yz, zz, mx, my, mz, mass = (phi[int(i)] for i in idx)
+    tr = 0.5 * (xx + yy + zz)
+    j = cp.bmat([[tr - xx, -xy, -xz, mx], [-xy, tr - yy, -yz, my], [-xz, -yz, tr - zz, mz], [mx, my, mz, mass]])
+    return 0.5 * (j + j.T)

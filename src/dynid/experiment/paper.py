@@ -20,7 +20,7 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..dynamics.regressor import observation_matrix
-from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, paper_objective
+from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import sample_times
@@ -36,6 +36,8 @@ from . import paper_reference as ref
 from .methods import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
 
 PLANTS = ("assumed", "paper")
+CONSISTENCY_TOL = 1e-7
+"""Base parameters count as physically consistent when their consistency margin is >= -1e-7 (solver accuracy)."""
 BOUNDS = ("auto", "table3", "scaled")
 
 
@@ -157,6 +159,7 @@ class MethodResult:
     history: np.ndarray | None = None
     bootstrap: dict | None = None
     pseudo_inertia_min_eig: np.ndarray | None = None
+    consistency_margin: float | None = None
 
 
 @dataclass
@@ -174,6 +177,7 @@ class PaperRunResult:
     methods: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    truth_consistency_margin: float | None = None
 
     def to_dict(self) -> dict:
         names = list(self.base.names)
@@ -188,6 +192,7 @@ class PaperRunResult:
             "paper_symbols": {n: ref.paper_symbol(n) for n in names},
             "regrouping": list(self.base.expressions),
             "truth": dict(zip(names, self.truth.tolist())),
+            "truth_consistency_margin": self.truth_consistency_margin,
             "abc_bounds": {n: b.tolist() for n, b in zip(names, self.bounds)},
             "trajectories": self.trajectories,
             "methods": {},
@@ -215,6 +220,9 @@ class PaperRunResult:
                                   **{k: dict(zip(names, b[k].tolist())) for k in ("lower", "upper", "std")}}
             if m.pseudo_inertia_min_eig is not None:
                 d["pseudo_inertia_min_eig"] = m.pseudo_inertia_min_eig.tolist()
+            if m.consistency_margin is not None:
+                d["consistency_margin"] = m.consistency_margin
+                d["physically_consistent"] = bool(m.consistency_margin >= -CONSISTENCY_TOL)
             out["methods"][key] = d
         return out
 
@@ -224,7 +232,7 @@ def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
         return 100.0 * np.abs(est - truth) / np.abs(truth)
 
 
-def _identification_trajectory(config: PaperExperimentConfig, robot: Robot, base: BaseParameters):
+def identification_trajectory(config: PaperExperimentConfig, robot: Robot, base: BaseParameters):
     """The identification trajectory of ``config.excitation`` and what is known of it (cond(W_base) …)."""
     k = config.joints
     beta1 = paper_identification_trajectory(config.omega_f, k)
@@ -257,7 +265,12 @@ def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
     return out
 
 
-def _dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, keep_standard=False) -> Dataset:
+def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, keep_standard=False) -> Dataset:
+    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16), smooth the torques with eq. 17
+    ``passes`` times, fit the Fourier series for the derivatives and build the observation matrices.
+
+    Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
+    """
     q, dq, ddq = traj.evaluate(t)
     n = robot.n_dof
     phi = phi_true.reshape(n, robot.n_params_per_joint)
@@ -316,16 +329,16 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
 
     t = sample_times(config.duration, config.rate)
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
-    traj_id, excitation_info = _identification_trajectory(config, robot, base)
+    traj_id, excitation_info = identification_trajectory(config, robot, base)
     traj_val = paper_validation_trajectory(config.omega_f, k)
     t_sim = time.perf_counter()
-    ident = _dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
+    ident = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
                      keep_standard="sdp" in methods)
-    valid = _dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
+    valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
-    bounds = _search_box(config, robot, base, ident.w_base, y)
+    bounds = search_box(config, robot, base, ident.w_base, y)
     outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
     if outside:
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
@@ -334,6 +347,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         data.w_standard, data.layout = ident.w_standard, consistency_layout(robot)
         data.prior = robot.standard_parameters() * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
     budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
+    layout = consistency_layout(robot)
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
                             {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
@@ -363,14 +377,22 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
             params=fit.params, objective=float(paper_objective(y - p_id.ravel(), k, config.weights)), seconds=fit.seconds,
             n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
             params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
-            pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None))
+            pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None),
+            consistency_margin=consistency_margin(base.regrouping, fit.params, *layout))
+    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
 
 
-def _search_box(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """The ABC's search box (n_base, 2): the paper's Table 3, or ``±(2|β_OLS| + 1)``."""
+def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The ABC's search box (n_base, 2) of ``config.abc_bounds``: the paper's Table 3, or ``±(2|β_OLS| + 1)``.
+
+    Raises
+    ------
+    ConfigError
+        "table3" asked for a model whose base parameters are not the paper's.
+    """
     has_table3 = all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names)
     if config.abc_bounds == "table3" and not has_table3:
         raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")

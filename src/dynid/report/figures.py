@@ -121,6 +121,56 @@ def plot_method_comparison(labels, validation_error, parameter_error, ax=None,
     return ax
 
 
+def plot_std_over_bound(levels, labels, ratios, ax=None,
+                        title="Monte Carlo: std / √CRB of every base parameter"):
+    """One panel per noise level: ``std/√CRB`` of every parameter (dots) for each method; 1 = efficient.
+
+    ``ratios`` is a list over methods of (n_levels, n_params) arrays.
+    """
+    import matplotlib.pyplot as plt
+
+    n_levels = len(levels)
+    if ax is None:
+        fig = plt.figure(figsize=(max(6, 1.1 * len(labels) + 2), 2.6 * n_levels), constrained_layout=True)
+        ax = fig.subplots(n_levels, 1, sharex=True, squeeze=False)[:, 0]
+    rng = np.random.default_rng(0)  # horizontal jitter of the dots only
+    for li, a in enumerate(ax):
+        for m, r in enumerate(ratios):
+            y = np.asarray(r[li], dtype=float)
+            a.plot(m + rng.uniform(-0.2, 0.2, y.size), y, ".", alpha=0.7)
+            a.plot([m - 0.3, m + 0.3], [np.nanmedian(y)] * 2, color="black", lw=1.5)
+        a.axhline(1.0, color="gray", ls="--", lw=1.0)
+        a.set_yscale("log")
+        a.set_ylabel(f"σ = {levels[li]:g} A\nstd / √CRB")
+        a.grid(alpha=0.3, axis="y", which="both")
+    ax[-1].set_xticks(np.arange(len(labels)), labels)
+    ax[0].set_title(title + " (bars: medians)")
+    return ax
+
+
+def plot_noise_level_study(levels, labels, std_ratios, bias_ratios, ax=None,
+                           title="Monte Carlo: spread and bias against the current noise level"):
+    """Median over the parameters of ``std/√CRB`` (left) and ``|bias|/√CRB`` (right) against the noise level."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig = plt.figure(figsize=(10, 4), constrained_layout=True)
+        ax = fig.subplots(1, 2)
+    for label, s, b in zip(labels, std_ratios, bias_ratios):
+        ax[0].plot(levels, np.nanmedian(s, axis=1), marker="o", label=label)
+        ax[1].plot(levels, np.nanmedian(b, axis=1), marker="o", label=label)
+    for a, name in zip(ax, ("median std / √CRB", "median |bias| / √CRB")):
+        a.axhline(1.0, color="gray", ls="--", lw=1.0)
+        a.set_xscale("log")
+        a.set_yscale("log")
+        a.set_xlabel("current noise σ [A]")
+        a.set_ylabel(name)
+        a.grid(alpha=0.3, which="both")
+    ax[0].legend(fontsize="small")
+    ax[0].figure.suptitle(title)
+    return ax
+
+
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):
     """Measured against predicted joint torques (paper Figs. 7 and 9). ``predicted`` maps a label to (N, n)."""
     n = measured.shape[1]

@@ -1,0 +1,46 @@
+"""Write a Monte Carlo study to a folder: montecarlo.json, every estimate as CSV, and two figures."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from ..experiment.methods import LABELS
+from ..experiment.montecarlo import MonteCarloResult
+from ..io import atomic_write_text, write_json
+from . import figures
+from .output import output_folder, save_figure
+
+FIGURES = {
+    "montecarlo_std_vs_crb.png": "per noise level: standard deviation / Cramér–Rao bound of every base parameter, per method",
+    "montecarlo_noise_levels.png": "median over the parameters of std/CRB and |bias|/CRB against the noise level",
+}
+
+
+def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
+    """Write ``montecarlo.json``, ``montecarlo_estimates.csv`` and the figures into ``out``; return the paths.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    out = output_folder(out)
+    stats = result.statistics()
+    labels = [LABELS[k] for k in result.config.methods]
+    levels = np.asarray(result.config.noise_levels, dtype=float)
+    paths = [out / "montecarlo.json", out / "montecarlo_estimates.csv", *(out / name for name in FIGURES)]
+    save_figure(figures.plot_std_over_bound(levels, labels, [stats[k]["std_over_crb"] for k in result.config.methods]), paths[2])
+    save_figure(figures.plot_noise_level_study(levels, labels, [stats[k]["std_over_crb"] for k in result.config.methods],
+                                               [stats[k]["bias_over_crb"] for k in result.config.methods]), paths[3])
+    buf = io.StringIO()
+    buf.write(",".join(["noise_level_A", "realisation", "method", *result.names]) + "\n")
+    for li, level in enumerate(levels):
+        for r in range(result.estimates.shape[1]):
+            for m, key in enumerate(result.config.methods):
+                buf.write(f"{level:.6g},{r},{key}," + ",".join(f"{v:.10g}" for v in result.estimates[li, r, m]) + "\n")
+    atomic_write_text(paths[1], buf.getvalue())
+    write_json(paths[0], result.to_dict())
+    return paths
