@@ -63,6 +63,7 @@ decimation = 10
 chunk = 3000
 [estimation]
 method = "ols"
+physically_consistent = true
 ''')
     cfg = load_identification_config(tmp_path / "c.toml")
     result = run_identification(cfg)
@@ -74,6 +75,12 @@ method = "ols"
     # every parameter within 4 standard deviations or 1 % of the largest one
     assert np.all(np.abs(est - truth) <= np.maximum(4 * result.solution.params_std, 0.01 * np.abs(truth).max()))
     assert result.fit.metrics()["dynid OLS"]["relative_error"].max() < 1.0
+    # the physically consistent estimate: consistent links, same base parameters, every set checked
+    sdp = result.consistent
+    assert sdp.pseudo_inertia_min_eig.min() >= -1e-7
+    np.testing.assert_allclose(sdp.base[big], truth[big], rtol=0.01)
+    assert set(result.consistency) == {"dynid OLS", "dynid SDP"} and result.consistency["dynid SDP"] >= -1e-7
+    assert result.fit.metrics()["dynid SDP"]["relative_error"].max() < 1.0
 
 
 def test_ur10e_real_logs_against_the_published_parameters():
@@ -90,6 +97,10 @@ def test_ur10e_real_logs_against_the_published_parameters():
     assert m["dynid OLS"]["correlation"][:5].min() > 0.99
     assert {v.name for v in result.validations} == {"ptp_10_points", *(f"p{i}" for i in range(1, 11))}
     assert result.solution.condition_number < 1e3 and np.all(np.isfinite(result.solution.relative_std))
+    # physically consistent least squares beside OLS: consistent, and as good on the validation run
+    assert result.consistency["dynid SDP"] >= -1e-7 and result.consistency["Mamedov & Mikhel 2020"] >= -1e-7
+    assert result.consistent.pseudo_inertia_min_eig.min() >= -1e-7
+    assert np.all(m["dynid SDP"]["relative_error"][:5] <= m["dynid OLS"]["relative_error"][:5] + 1.0)
 
 
 def test_tx40_real_logs_against_figaroh():
@@ -117,6 +128,8 @@ def test_tx40_time_split_validation():
     m = val.metrics()
     assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 5.0)
     assert m["dynid WLS"]["correlation"].min() > 0.95
+    assert result.consistency["dynid SDP"] >= -1e-7 and m["dynid SDP"]["correlation"].min() > 0.95
+    assert np.all(m["dynid SDP"]["relative_error"] <= m["dynid WLS"]["relative_error"] + 5.0)
 
 
 def test_config_errors_name_file_and_field(tmp_path):

@@ -223,7 +223,15 @@ def _print_identification(result, paths) -> None:
             a = result.reference_agreement(r)
             console.print(f"{r.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
                           f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters")
-    console.print("residual σ per joint [N·m]: " + ", ".join(f"{x:.3g}" for x in result.joint_std))
+    console.print("residual σ per joint (N·m): " + ", ".join(f"{x:.3g}" for x in result.joint_std))
+    if result.consistent is not None:
+        console.print(f"dynid SDP: physically consistent least squares, prior: {result.consistent.prior}; "
+                      "smallest pseudo-inertia eigenvalue per link " + ", ".join(f"{x:.3g}" for x in result.consistent.pseudo_inertia_min_eig),
+                      soft_wrap=True)
+    if result.consistency:
+        console.print("physically consistent (some mass distribution with friction, rotor inertia ≥ 0 has these base parameters; "
+                      "margin ≥ 0): " + "; ".join(f"{escape(label)} {'yes' if m >= -1e-7 else 'no'} ({m:.3g})"
+                                                   for label, m in result.consistency.items()), soft_wrap=True)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)

@@ -93,6 +93,12 @@ class LeastSquaresAccumulator:
         dof = np.maximum(self.rows - self.n_params / self.n_dof, 1.0)
         return np.sqrt(self.joint_residual_sumsq(params) / dof)
 
+    def reduced(self, joint_weights=None) -> np.ndarray:
+        """Triangular ``[R | z]`` (p+1, p+1) of the (weighted) problem: ``||D(τ - Wθ)||² = ||z - Rθ||² + ρ²``
+        with ``R = [:p, :p]``, ``z = [:p, p]`` and ``ρ = [p, p]``; valid for rank-deficient ``W`` too."""
+        wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
+        return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
+
     def solve(self, joint_weights=None, rcond: float | None = None) -> LeastSquaresSolution:
         """OLS (default) or WLS with one weight per joint (rows of joint ``j`` multiplied by ``joint_weights[j]``).
 
@@ -105,8 +111,7 @@ class LeastSquaresAccumulator:
         m = int(self.rows.sum())
         if m <= p:
             raise IdentifiabilityError(f"least squares needs more equations than parameters, got {m} rows for {p} parameters")
-        wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
-        r_all = _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), p + 1)
+        r_all = self.reduced(joint_weights)
         r, rhs, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
         sv = np.linalg.svd(r, compute_uv=False)
         tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps

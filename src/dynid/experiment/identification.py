@@ -18,7 +18,9 @@ import numpy as np
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
+from ..dynamics.layout import consistency_layout
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
+from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin
 from ..exceptions import ConfigError, DataError
 from ..io.datasets import Recording
 from ..io.references import ReferenceSet
@@ -148,25 +150,28 @@ def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
 
 
 def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
-                progress: Callable[[int, int], None] | None = None):
-    """Parallel-decimated base regressor and torques, chunk by chunk.
+                progress: Callable[[int, int], None] | None = None, standard: bool = False):
+    """Parallel-decimated base (or standard) regressor and torques, chunk by chunk.
 
     Yields
     ------
     index : (M,) int array
         Sample indices kept (every ``decimation``-th).
-    y_base : (M, n_dof, n_base) array
+    y : (M, n_dof, n_base) array, or (M, n_dof, n_params) with ``standard``
+        (the base regressor is then ``base.base_observation(y)``: decimation commutes with selecting columns).
     tau : (M, n_dof) array [N·m]
     keep : (M, n_dof) bool array
         Rows fast enough for the estimation (``|dq_j| >= min_speed_j``).
     """
-    n, nb = robot.n_dof, base.n_base
+    n = robot.n_dof
+    nb = robot.n_params if standard else base.n_base
     s = data.settings
     vmin = _min_speed(s, n)
     n_s = data.t.shape[0]
 
     def block(a, b):
-        y = base.base_observation(regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b]))
+        y = regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b])
+        y = y if standard else base.base_observation(y)
         return np.concatenate([y.reshape(b - a, n * nb), data.tau[a:b]], axis=1)
 
     for index, values in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk):
@@ -224,9 +229,35 @@ def estimate_label(method: str) -> str:
     return f"dynid {method.upper()}"
 
 
-def parameter_sets(method: str, params: np.ndarray, references=()) -> dict:
-    """label -> base parameter vector: dynid's estimate, then each reference set."""
-    return {estimate_label(method): params, **{r.name: r.beta for r in references}}
+SDP_LABEL = "dynid SDP"
+"""Label of the physically consistent estimate."""
+
+
+def parameter_sets(method: str, params: np.ndarray, references=(), consistent: np.ndarray | None = None) -> dict:
+    """label -> base parameter vector: dynid's estimate, its physically consistent estimate if any, then each
+    reference set."""
+    sdp = {} if consistent is None else {SDP_LABEL: consistent}
+    return {estimate_label(method): params, **sdp, **{r.name: r.beta for r in references}}
+
+
+@dataclass(frozen=True)
+class ConsistentEstimate:
+    """Physically consistent least squares on a real log (same row weights as the OLS/WLS estimate).
+
+    Attributes
+    ----------
+    standard : (n_params,) array
+        Standard parameters (each link's pseudo-inertia ⪰ 0, friction and rotor inertias ≥ 0).
+    base : (n_base,) array
+    pseudo_inertia_min_eig : (n_dof,) array
+    prior : str
+        What the unidentifiable directions were pulled towards.
+    """
+
+    standard: np.ndarray
+    base: np.ndarray
+    pseudo_inertia_min_eig: np.ndarray
+    prior: str = "the robot model's nominal parameters"
 
 
 @dataclass(frozen=True)
@@ -252,6 +283,11 @@ class IdentificationResult:
         Equations used (after decimation and the speed threshold).
     settings : dict
     warnings : tuple of str
+    consistent : ConsistentEstimate or None
+        The physically consistent estimate, when asked for.
+    consistency : dict
+        label -> consistency margin of each parameter set (``>= 0``: some mass distribution with non-negative
+        friction and rotor inertias has these base parameters; :func:`dynid.estimators.consistency_margin`).
     """
 
     robot: str
@@ -265,14 +301,17 @@ class IdentificationResult:
     n_rows: int = 0
     settings: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    consistent: ConsistentEstimate | None = None
+    consistency: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
         return estimate_label(self.method)
 
     def parameter_sets(self) -> dict:
-        """label -> base parameter vector: dynid's estimate, then each reference set."""
-        return parameter_sets(self.method, self.solution.params, self.references)
+        """label -> base parameter vector: dynid's estimate(s), then each reference set."""
+        return parameter_sets(self.method, self.solution.params, self.references,
+                              None if self.consistent is None else self.consistent.base)
 
     def reference_agreement(self, ref: ReferenceSet) -> dict:
         """Differences to a reference that states relative standard deviations: ``z = |Δ| / σ_ref``."""
@@ -303,12 +342,21 @@ class IdentificationResult:
             "joint_residual_std": self.joint_std, "n_rows": self.n_rows, "settings": self.settings,
             "identification": self.fit.to_dict(), "validation": [v.to_dict() for v in self.validations],
             "references": refs, "warnings": list(self.warnings),
+            "consistency_margin": self.consistency,
+            **({} if self.consistent is None else {"physically_consistent": {
+                "label": SDP_LABEL, "prior": self.consistent.prior,
+                "values": dict(zip(self.base.names, self.consistent.base.tolist())),
+                "standard_values": dict(zip(self.base.standard_names, self.consistent.standard.tolist())),
+                "pseudo_inertia_min_eig": self.consistent.pseudo_inertia_min_eig.tolist()}}),
         }
 
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str = "wls",
-             references: tuple[ReferenceSet, ...] = (), progress=None) -> IdentificationResult:
-    """Estimate the base parameters from one prepared recording by OLS or WLS (chunked).
+             references: tuple[ReferenceSet, ...] = (), progress=None, physically_consistent: bool = False) -> IdentificationResult:
+    """Estimate the base parameters from one prepared recording by OLS or WLS (chunked), and with
+    ``physically_consistent`` also by physically consistent least squares over the standard parameters
+    (same row weights; prior: the robot model's nominal parameters). Every parameter set gets its
+    consistency margin.
 
     Raises
     ------
@@ -322,17 +370,37 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
         raise ConfigError(f"estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
     n = robot.n_dof
     acc = LeastSquaresAccumulator(base.n_base, n)
-    for _, y, tau, keep in base_chunks(robot, base, data, progress):
+    acc_std = LeastSquaresAccumulator(robot.n_params, n) if physically_consistent else None
+    for _, y, tau, keep in base_chunks(robot, base, data, progress, standard=physically_consistent):
+        if acc_std is not None:
+            acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
+            y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
     ols = acc.solve()
     joint_std = acc.joint_residual_std(ols.params)
-    sol = ols if method == "ols" else acc.solve(1.0 / np.where(joint_std > 0, joint_std, 1.0))
+    row_weights = None if method == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
+    sol = ols if method == "ols" else acc.solve(row_weights)
+    consistent = None if acc_std is None else _consistent_estimate(robot, base, acc_std, row_weights)
     warnings = list(data.warnings)
     dropped = 1.0 - acc.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
     for r in references:
         warnings.extend(r.warnings)
-    fit = compare_torques(robot, base, data, parameter_sets(method, sol.params, references))
+    sets = parameter_sets(method, sol.params, references, None if consistent is None else consistent.base)
+    links, nonneg = consistency_layout(robot)
+    margins = {label: consistency_margin(base.regrouping, beta, links, nonneg) for label, beta in sets.items()}
+    fit = compare_torques(robot, base, data, sets)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
-                                settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings))
+                                settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
+                                consistent=consistent, consistency=margins)
+
+
+def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAccumulator, row_weights) -> ConsistentEstimate:
+    """The SDP on the accumulated triangular factor of the standard problem (weighted like the estimate)."""
+    p = robot.n_params
+    reduced = acc.reduced(row_weights)
+    links, nonneg = consistency_layout(robot)
+    est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters())
+    est.fit(reduced[:, :p], reduced[:, p])
+    return ConsistentEstimate(est.params_, base.base_from_standard(est.params_), est.pseudo_inertia_min_eig_)

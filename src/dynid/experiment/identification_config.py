@@ -21,6 +21,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 
     [estimation]
     method = "wls"                       # "ols" or "wls"
+    physically_consistent = true         # also physically consistent least squares (SDP), default false
 
     [[validation]]                       # dataset tables, each with a name
     name = "ptp_10_points"
@@ -69,6 +70,7 @@ class IdentificationConfig:
     method: str
     references: tuple[dict, ...]
     data_root: Path
+    physically_consistent: bool = False
 
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "torque_cutoff": float,
@@ -154,10 +156,16 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     method = est.get("method", "wls") if isinstance(est, dict) else None
     if method not in METHODS:
         raise ConfigError(f"{path}: estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
+    unknown = sorted(set(est) - {"method", "physically_consistent"})
+    if unknown:
+        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected method, physically_consistent")
+    consistent = est.get("physically_consistent", False)
+    if not isinstance(consistent, bool):
+        raise ConfigError(f"{path}: estimation.physically_consistent: expected true or false, got {consistent!r}")
     refs = doc.get("references", [])
     if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
         raise ConfigError(f"{path}: references: expected [[references]] tables")
-    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root)
+    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent)
 
 
 def _references(config: IdentificationConfig, base):
@@ -199,7 +207,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     base = base_parameters(config.robot, rng=0)
     refs = _references(config, base)
     data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
-    result = identify(config.robot, base, data, config.method, refs, progress)
+    result = identify(config.robot, base, data, config.method, refs, progress, config.physically_consistent)
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(config, base, result.parameter_sets(), config.validation, progress)
@@ -226,7 +234,12 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     if tuple(names) != base.names:
         raise DataError(f"results: its base parameters ({len(names)}) are not those of robot {config.robot.name!r} ({base.n_base}); was it identified with this config?")
     refs = _references(config, base)
-    sets = parameter_sets(method, values, refs)
+    consistent = identified.get("physically_consistent")
+    try:
+        sdp = None if consistent is None else np.array([float(consistent["values"][n]) for n in base.names])
+    except (KeyError, TypeError, ValueError):
+        raise DataError("results: physically_consistent.values must give every base parameter") from None
+    sets = parameter_sets(method, values, refs, sdp)
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
