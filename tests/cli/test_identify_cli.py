@@ -28,7 +28,7 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     assert p.returncode == 0, p.stderr
     assert "line 6107 is truncated" in p.stdout and "ur-20_02_19_15harm50secLoad.csv" in p.stdout
     val = json.loads((tmp_path / "val" / "validation.json").read_text())
-    assert set(val["validation"][0]["metrics"]) == {"dynid OLS", "Mamedov & Mikhel 2020"}
+    assert set(val["validation"][0]["metrics"]) == {"dynid OLS", "dynid SDP", "Mamedov & Mikhel 2020"}
 
 
 def test_identify_tx40(tmp_path):
