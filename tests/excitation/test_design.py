@@ -98,3 +98,10 @@ def test_rest_workspace_and_torque_constraints_hold_and_seed_reproduces(er16_3):
 def test_infeasible_settings_get_a_clear_error(er16_3, change, message):
     with pytest.raises(ConfigError, match=message):
         ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, **change(er16_3.limits))
+
+
+def test_initial_trajectory_at_another_fundamental_pulsation_is_refused(er16_3):
+    beta1 = paper_identification_trajectory(2 * PAPER_OMEGA_F)
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0)
+    with pytest.raises(ConfigError, match="fundamental pulsation"):
+        design_excitation(prob, n_starts=1, rng=0, initial=beta1)

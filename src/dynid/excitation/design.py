@@ -459,7 +459,7 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
     Raises
     ------
     ConfigError
-        Invalid settings or an ``initial`` trajectory of another shape.
+        Invalid settings, or an ``initial`` trajectory of another shape or fundamental pulsation.
     InfeasibleDesignError
         If no start ends with every constraint satisfied on the verification grid.
     """
@@ -488,6 +488,9 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
         if (initial.n_dof, initial.n_harmonics) != (lay.n, lay.h):
             raise ConfigError(f"initial trajectory has {initial.n_dof} joints and {initial.n_harmonics} harmonics, "
                               f"the design {lay.n} and {lay.h}")
+        if not np.isclose(initial.omega_f, problem.omega_f, rtol=1e-9, atol=0.0):
+            raise ConfigError(f"initial trajectory has the fundamental pulsation {initial.omega_f:.6g} rad/s, the design "
+                              f"{problem.omega_f:.6g} rad/s: its harmonics would be re-timed; design at its omega_f or start elsewhere")
         initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets else problem.offsets, initial.a, initial.b)
     best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
     nit = 0
