@@ -70,3 +70,13 @@ def test_bad_settings(kwargs, message):
 def test_unreachable_scheduler_is_a_one_line_error():
     with pytest.raises(ConfigError, match="cannot reach the Dask scheduler"):
         run_montecarlo(SMALL, scheduler="tcp://127.0.0.1:9")
+
+
+def test_scheduler_address_path_gives_the_same_study(study):
+    """The --scheduler path: a client to an already running cluster, given by its address."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
+        remote = run_montecarlo(MonteCarloConfig(**{**SMALL.__dict__, "realisations": 2}), scheduler=cluster.scheduler_address)
+    assert cluster.scheduler_address in remote.cluster
+    np.testing.assert_array_equal(remote.estimates, study.estimates[:, :2])
