@@ -95,6 +95,7 @@ def _joined(values, fmt: str) -> str:
 
 
 def _print_run(result, paths) -> None:
+    from ..estimators.physically_consistent import CONSISTENCY_TOL
     from ..experiment import paper_reference as ref
     from ..experiment.methods import DESCRIPTIONS, LABELS
 
@@ -144,7 +145,7 @@ def _print_run(result, paths) -> None:
     _print_uncertainty(d, methods)
     if "sdp" in d["methods"]:
         eig = d["methods"]["sdp"]["pseudo_inertia_min_eig"]
-        verdict = "physically consistent" if min(eig) >= -1e-8 else "NOT physically consistent"
+        verdict = "physically consistent" if min(eig) >= -CONSISTENCY_TOL else "NOT physically consistent"
         console.print(f"SDP: smallest pseudo-inertia eigenvalue per link {_joined(eig, '.3g')} → {verdict}", soft_wrap=True)
     console.print("consistent: some mass distribution with non-negative friction and rotor inertias has these base parameters "
                   "(feasibility SDP; the truth's margin is " f"{d['truth_consistency_margin']:.3g})", soft_wrap=True)
@@ -205,6 +206,8 @@ def _comparison_tables(comparisons, n_dof: int) -> None:
 
 
 def _print_identification(result, paths) -> None:
+    from ..estimators.physically_consistent import CONSISTENCY_TOL
+
     sol, base = result.solution, result.base
     console.print(f"\n[bold]dynid identify[/] — robot {result.robot}, {result.method.upper()} on {result.fit.name}: "
                   f"{base.n_base} base parameters from {result.n_rows} equations, cond = {sol.condition_number:.4g}")
@@ -230,7 +233,7 @@ def _print_identification(result, paths) -> None:
                       soft_wrap=True)
     if result.consistency:
         console.print("physically consistent (some mass distribution with friction, rotor inertia ≥ 0 has these base parameters; "
-                      "margin ≥ 0): " + "; ".join(f"{escape(label)} {'yes' if m >= -1e-7 else 'no'} ({m:.3g})"
+                      "margin ≥ 0): " + "; ".join(f"{escape(label)} {'yes' if m >= -CONSISTENCY_TOL else 'no'} ({m:.3g})"
                                                    for label, m in result.consistency.items()), soft_wrap=True)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
@@ -383,8 +386,8 @@ def montecarlo(
     joints: int = typer.Option(3, help="Number of joints identified."),
     noise_levels: str = typer.Option("0.02,0.05,0.1", help="Motor current noise standard deviations [A], comma separated."),
     realisations: int = typer.Option(100, help="Noise realisations per level."),
-    methods: str = typer.Option(",".join(("ols", "wls", "irls", "lad", "sdp", "abc")),
-                                help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (or all)."),
+    methods: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
+                                                     "or all (default: ols,wls,irls,lad,sdp,abc)."),
     seed: int = typer.Option(0, help="Seed of every random number of the study."),
     duration: float = typer.Option(25.0, help="Recording length [s]."),
     rate: float = typer.Option(200.0, help="Sampling rate [Hz] (the paper: 1000)."),
@@ -396,12 +399,12 @@ def montecarlo(
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
     from ..experiment.methods import parse_methods
-    from ..experiment.montecarlo import MonteCarloConfig, run_montecarlo
+    from ..experiment.montecarlo import DEFAULT_METHODS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 
     try:
         cfg = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
-                               methods=parse_methods(methods), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
+                               methods=DEFAULT_METHODS if methods is None else parse_methods(methods), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
                                excitation=excitation)
         with Progress(TextColumn("[bold]realisations[/]"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                       TimeElapsedColumn(), console=console, transient=True) as progress:

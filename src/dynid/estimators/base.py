@@ -83,7 +83,7 @@ class BoxSearchEstimator(Estimator):
     weights: object
 
     def _objectives(self, w, tau):
-        """Checked ``(W, tau, bounds)`` and eq. 9 as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
+        """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
         w, tau = check_observations(w, tau, self.n_dof)
         bounds = np.asarray(self.bounds, dtype=float)
         if bounds.shape != (w.shape[1], 2):
@@ -94,7 +94,7 @@ class BoxSearchEstimator(Estimator):
             r = (tau - w @ x) if x.ndim == 1 else (tau[:, None] - w @ x)
             return paper_objective(r, self.n_dof, self.weights)
 
-        return w, tau, bounds, objective
+        return bounds, objective
 
     def _set_search_result(self, res) -> None:
         self.params_ = np.asarray(res.x, dtype=float)

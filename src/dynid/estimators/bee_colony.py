@@ -42,7 +42,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "BeeColonyEstimator":
-        w, tau, bounds, objective = self._objectives(w, tau)
+        bounds, objective = self._objectives(w, tau)
         res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)
         self._set_search_result(res)

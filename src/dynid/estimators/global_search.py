@@ -54,7 +54,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "DifferentialEvolutionEstimator":
-        w, tau, bounds, objective = self._objectives(w, tau)
+        bounds, objective = self._objectives(w, tau)
         history = []
         evaluations = 0
 
@@ -110,7 +110,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "ParticleSwarmEstimator":
-        w, tau, bounds, objective = self._objectives(w, tau)
+        bounds, objective = self._objectives(w, tau)
         res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
                                       rng=self.rng, callback=self.callback)
         self._set_search_result(res)

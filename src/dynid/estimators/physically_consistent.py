@@ -20,6 +20,10 @@ from ..exceptions import DynIdError, ShapeError
 from ..model.spatial import pseudo_inertia
 from .base import Estimator, check_observations
 
+CONSISTENCY_TOL = 1e-7
+"""Base parameters count as physically consistent when their :func:`consistency_margin` is >= -1e-7
+(the solver's accuracy), and an SDP result when its smallest pseudo-inertia eigenvalue is."""
+
 
 class PhysicallyConsistentLeastSquares(Estimator):
     """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
@@ -80,16 +84,8 @@ class PhysicallyConsistentLeastSquares(Estimator):
             if prior.shape != (p,):
                 raise ShapeError(f"expected a prior of shape ({p},), got {prior.shape}")
             cost = cost + self.prior_weight * float(np.mean(r**2) * r.shape[0]) * cp.sum_squares(phi - prior)
-        cons = []
-        for idx in links:
-            cons.append(_pseudo_inertia_expression(phi, idx) >> self.epsilon * np.eye(4))
-        if nonneg.size:
-            cons.append(phi[nonneg] >= 0)
-        problem = cp.Problem(cp.Minimize(cost), cons)
-        try:
-            problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError as exc:
-            raise DynIdError(f"physically consistent least squares: the SDP solver failed ({exc})") from None
+        problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
+                         "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
             raise DynIdError(f"physically consistent least squares: solver status {problem.status}")
         self.params_ = np.asarray(phi.value, dtype=float)
@@ -139,22 +135,33 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
     if not np.all(np.isfinite(b)):
         return float("-inf")
     phi, t = cp.Variable(k.shape[1]), cp.Variable()
-    cons = [k @ phi == b, t <= bound]
-    for idx in np.asarray(links, dtype=int).reshape(-1, 10):
-        cons.append(_pseudo_inertia_expression(phi, idx) >> t * np.eye(4))
-    nonneg = np.asarray(nonnegative, dtype=int)
-    if nonneg.size:
-        cons.append(phi[nonneg] >= 0)
-    problem = cp.Problem(cp.Maximize(t), cons)
-    try:
-        problem.solve(solver=cp.CLARABEL)
-    except cp.error.SolverError as exc:
-        raise DynIdError(f"consistency check: the SDP solver failed ({exc})") from None
+    cons = [k @ phi == b, t <= bound, *_consistency_constraints(phi, links, nonnegative, t)]
+    problem = _solve(cp.Problem(cp.Maximize(t), cons), "consistency check")
     if problem.status in ("infeasible", "infeasible_inaccurate"):
         return float("-inf")
     if t.value is None:
         raise DynIdError(f"consistency check: solver status {problem.status}")
     return float(t.value)
+
+
+def _consistency_constraints(phi, links, nonnegative, margin) -> list:
+    """Every link's pseudo-inertia ``⪰ margin·1`` and the ``nonnegative`` columns ``>= 0``."""
+    cons = [_pseudo_inertia_expression(phi, idx) >> margin * np.eye(4) for idx in np.asarray(links, dtype=int).reshape(-1, 10)]
+    nonneg = np.asarray(nonnegative, dtype=int)
+    if nonneg.size:
+        cons.append(phi[nonneg] >= 0)
+    return cons
+
+
+def _solve(problem, what: str):
+    """Solve with Clarabel; a solver failure becomes a one-line :class:`DynIdError` naming ``what``."""
+    import cvxpy as cp
+
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError as exc:
+        raise DynIdError(f"{what}: the SDP solver failed ({exc})") from None
+    return problem
 
 
 def _pseudo_inertia_expression(phi, idx):

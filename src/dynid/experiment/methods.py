@@ -137,6 +137,8 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget, rng: np.random
     if key == "lad":
         return LeastAbsoluteDeviations(n_dof=n, weights=wts, bounds=box)
     if key == "sdp":
+        if data.w_standard is None or data.layout is None:
+            raise ConfigError("method sdp needs the standard observation matrix and the parameter layout")
         links, nonneg = data.layout
         return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior)
     if key in ("abc", "abc10"):
@@ -168,8 +170,6 @@ def fit_method(key: str, data: FitData, budget: SearchBudget, rng: np.random.Gen
     est = make_estimator(key, data, budget, rng, callback)
     t0 = time.perf_counter()
     if key == "sdp":
-        if data.w_standard is None or data.layout is None:
-            raise ConfigError("method sdp needs the standard observation matrix and the parameter layout")
         est.fit(data.w_standard, data.tau)
         params = data.base.base_from_standard(est.params_)
     else:

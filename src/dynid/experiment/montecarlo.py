@@ -25,21 +25,20 @@ import contextlib
 import logging
 import os
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from typing import Callable
 
 import numpy as np
 
 from ..dynamics.base_parameters import base_parameters
-from ..dynamics.layout import consistency_layout
 from ..dynamics.regressor import observation_matrix
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..exceptions import ConfigError, DynIdError
 from ..model.description import load_robot
 from ..simulation.measurements import NoiseModel
-from .methods import LABELS, METHODS, FitData, SearchBudget, fit_method, parse_methods
-from .paper import PaperExperimentConfig, identification_trajectory, search_box, simulate_dataset
+from .methods import LABELS, METHODS, SearchBudget, fit_method, parse_methods
+from .paper import PaperExperimentConfig, fit_data, identification_trajectory, search_box, simulate_dataset
 
 DEFAULT_METHODS = ("ols", "wls", "irls", "lad", "sdp", "abc")
 """The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with methods."""
@@ -126,8 +125,6 @@ class _Setup:
     phi_true: np.ndarray
     trajectory: object
     t: np.ndarray
-    layout: tuple
-    prior: np.ndarray
     unit_crb: np.ndarray  # Cramér–Rao covariance for σ = 1 A, (n_base, n_base)
 
 
@@ -145,9 +142,7 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     w = base.base_observation(observation_matrix(robot, q, dq, ddq)).reshape(t.size, robot.n_dof, -1)
     gains = np.asarray(robot.drive_gains, dtype=float)
     info = np.einsum("kjp,kjq,j->pq", w, w, 1.0 / gains**2)
-    prior = phi_true * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
-    return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t,
-                  consistency_layout(robot), prior, np.linalg.inv(info))
+    return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info))
 
 
 def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> dict:
@@ -162,14 +157,10 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     cfg = setup.config
     level = float(cfg.noise_levels[level_index])
     rng = np.random.default_rng([cfg.seed, 10, level_index, realisation])
-    keep_standard = "sdp" in cfg.methods
     ds = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t, NoiseModel(level, cfg.encoder_resolution), rng,
-                          setup.phi_true, cfg.smoothing_passes, "identification", [], keep_standard=keep_standard)
-    y = ds.tau.ravel()
-    run = replace(setup.run, current_noise=level)
-    data = FitData(ds.w_base, y, cfg.joints, search_box(run, setup.robot, setup.base, ds.w_base, y), setup.base)
-    if keep_standard:
-        data.w_standard, data.layout, data.prior = ds.w_standard, setup.layout, setup.prior
+                          setup.phi_true, cfg.smoothing_passes, "identification", [], keep_standard="sdp" in cfg.methods)
+    bounds = search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
+    data = fit_data(setup.run, setup.robot, setup.base, ds, bounds)
     budget = SearchBudget(cfg.colony_size, cfg.limit, cfg.maxiter)
     params = np.full((len(cfg.methods), setup.base.n_base), np.nan)
     seconds = np.zeros(len(cfg.methods))

@@ -21,6 +21,7 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..dynamics.regressor import observation_matrix
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
+from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import sample_times
@@ -36,8 +37,6 @@ from . import paper_reference as ref
 from .methods import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
 
 PLANTS = ("assumed", "paper")
-CONSISTENCY_TOL = 1e-7
-"""Base parameters count as physically consistent when their consistency margin is >= -1e-7 (solver accuracy)."""
 BOUNDS = ("auto", "table3", "scaled")
 
 
@@ -342,12 +341,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
     if outside:
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
-    data = FitData(ident.w_base, y, k, bounds, base, weights=config.weights)
-    if "sdp" in methods:
-        data.w_standard, data.layout = ident.w_standard, consistency_layout(robot)
-        data.prior = robot.standard_parameters() * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
+    data = fit_data(config, robot, base, ident, bounds)
     budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
-    layout = consistency_layout(robot)
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
                             {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
@@ -378,11 +373,21 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
             n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
             params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
             pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None),
-            consistency_margin=consistency_margin(base.regrouping, fit.params, *layout))
-    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
+            consistency_margin=consistency_margin(base.regrouping, fit.params, *data.layout))
+    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *data.layout)
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
+
+
+def fit_data(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, dataset: Dataset, bounds: np.ndarray) -> FitData:
+    """What the estimators of ``config.methods`` see of ``dataset``: the observation matrices, the search box,
+    the parameter layout and, for ``sdp``, a rough CAD guess as prior (nominal parameters × U(0.7, 1.3), seeded)."""
+    prior = None
+    if "sdp" in config.methods:
+        prior = robot.standard_parameters() * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
+    return FitData(dataset.w_base, dataset.tau.ravel(), config.joints, bounds, base, dataset.w_standard,
+                   consistency_layout(robot), prior, config.weights)
 
 
 def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:

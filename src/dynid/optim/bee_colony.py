@@ -26,6 +26,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from ..exceptions import ConfigError
+from .box import check_box
 
 
 def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_size: int = 30, limit: int = 15,
@@ -60,9 +61,7 @@ def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_si
     ConfigError
         If the settings or bounds are invalid.
     """
-    bounds = np.asarray(bounds, dtype=float)
-    if bounds.ndim != 2 or bounds.shape[1] != 2 or not np.all(bounds[:, 0] < bounds[:, 1]):
-        raise ConfigError(f"ABC bounds must be (D, 2) with lower < upper, got shape {bounds.shape}")
+    bounds = check_box(bounds, "ABC")
     if colony_size < 4 or colony_size % 2:
         raise ConfigError(f"ABC colony size must be an even number >= 4, got {colony_size}")
     if limit < 1:

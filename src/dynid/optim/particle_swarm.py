@@ -18,6 +18,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult
 
 from ..exceptions import ConfigError
+from .box import check_box
 
 INERTIA = 0.7298
 ACCELERATION = 0.7298 * 2.05
@@ -56,9 +57,7 @@ def minimize_particle_swarm(fun: Callable[[np.ndarray], np.ndarray], bounds, *, 
     ConfigError
         If the settings or bounds are invalid.
     """
-    bounds = np.asarray(bounds, dtype=float)
-    if bounds.ndim != 2 or bounds.shape[1] != 2 or not np.all(bounds[:, 0] < bounds[:, 1]):
-        raise ConfigError(f"PSO bounds must be (D, 2) with lower < upper, got shape {bounds.shape}")
+    bounds = check_box(bounds, "PSO")
     if swarm_size < 2:
         raise ConfigError(f"PSO swarm size must be >= 2, got {swarm_size}")
     if maxiter < 1:
