@@ -58,7 +58,6 @@ positions = {{ file = "pos.csv" }}
 torques = {{ file = "tau.csv" }}
 [preprocessing]
 position_cutoff = 40.0
-torque_cutoff = 0
 decimation = 10
 chunk = 3000
 [estimation]
@@ -84,16 +83,19 @@ physically_consistent = true
 
 
 def test_ur10e_real_logs_against_the_published_parameters():
-    """UR10e (Mamedov & Mikhel 2020 logs): the published parameters reproduce the validation torques with
-    the errors measured independently in the data's SOURCE.md (10, 5, 4, 11, 13, 55 %), and dynid's own
-    estimate does as well on the same samples."""
+    """UR10e (Mamedov & Mikhel 2020 logs), default preprocessing: the published parameters reproduce the
+    validation torques at most with the errors measured independently on the unfiltered samples in the
+    data's SOURCE.md (10, 5, 4, 11, 13, 55 %: the parallel filter removes noise, never adds error), and
+    dynid's own estimate does as well on the same samples."""
     root = shared_data("ur10e_mamedov2020")
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
     result = run_identification(cfg)
     ptp = next(v for v in result.validations if v.name == "ptp_10_points")
     m = ptp.metrics()
-    np.testing.assert_allclose(m["Mamedov & Mikhel 2020"]["relative_error"], [10, 5, 4, 11, 13, 55], atol=1.5)
-    assert np.all(m["dynid OLS"]["relative_error"][:5] <= m["Mamedov & Mikhel 2020"]["relative_error"][:5] + 1.0)
+    published = m["Mamedov & Mikhel 2020"]["relative_error"]
+    assert np.all(published <= np.array([10, 5, 4, 11, 13, 55]) + 1.5) and np.all(published >= 0.5 * np.array([10, 5, 4, 11, 13, 55]))
+    assert np.all(m["dynid OLS"]["relative_error"][:5] <= published[:5] + 1.0)
+    assert m["dynid OLS"]["global_relative_error"] <= m["Mamedov & Mikhel 2020"]["global_relative_error"]
     assert m["dynid OLS"]["correlation"][:5].min() > 0.99
     assert {v.name for v in result.validations} == {"ptp_10_points", *(f"p{i}" for i in range(1, 11))}
     assert result.solution.condition_number < 1e3 and np.all(np.isfinite(result.solution.relative_std))
@@ -179,7 +181,7 @@ time = {{ column = 1 }}
 positions = {{ columns = [2, 3, 4, 5, 6, 7] }}
 torques = {{ columns = [8, 9, 10, 11, 12, 13] }}
 [preprocessing]
-torque_cutoff = 0
+parallel_cutoff = 0
 decimation = 1
 trim = 0
 excitation = "excitation.json"

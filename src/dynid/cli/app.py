@@ -198,19 +198,40 @@ def _comparison_tables(comparisons, n_dof: int) -> None:
         t.add_column("metric", no_wrap=True)
         for j in range(n_dof):
             t.add_column(f"J{j + 1}", justify="right")
+        t.add_column("all", justify="right")
         for label, m in cmp.metrics().items():
-            t.add_row(label, "error %", *(f"{x:.1f}" for x in m["relative_error"]))
-            t.add_row("", "RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]))
-            t.add_row("", "ρ (eq. 18)", *(f"{x:.4f}" for x in m["correlation"]), end_section=True)
+            t.add_row(label, "error %", *(f"{x:.1f}" for x in m["relative_error"]), f"{m['global_relative_error']:.2f}")
+            t.add_row("", "RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), "")
+            t.add_row("", "ρ (eq. 18)", *(f"{x:.4f}" for x in m["correlation"]), "", end_section=True)
         console.print(t)
 
 
+def _print_coulomb_choice(cv: dict) -> None:
+    """The candidates of the Coulomb smoothing velocity and their out-of-fold errors, per joint."""
+    cand, err = cv["candidates"], cv["out_of_fold_rms_error"]
+    n = len(cv["velocity"])
+    t = Table(title=f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m), {cv['folds']} contiguous folds; "
+                    "chosen: *", box=box.SIMPLE_HEAD, padding=(0, 1))
+    t.add_column("v_s / RMS speed", justify="right")
+    for j in range(n):
+        t.add_column(f"J{j + 1}", justify="right")
+    for frac, vs_row, e_row in zip(cv["grid_fraction_of_rms_speed"], cand, err):
+        t.add_row("sign" if frac == 0 else f"{frac:g}",
+                  *(f"{e:.4g}{'*' if v == c else ''}" for e, v, c in zip(e_row, vs_row, cv["velocity"])))
+    console.print(t)
+
+
 def _print_identification(result, paths) -> None:
-    from ..estimators.physically_consistent import CONSISTENCY_TOL
 
     sol, base = result.solution, result.base
     console.print(f"\n[bold]dynid identify[/] — robot {result.robot}, {result.method.upper()} on {result.fit.name}: "
                   f"{base.n_base} base parameters from {result.n_rows} equations, cond = {sol.condition_number:.4g}")
+    pre = result.settings.get("preprocessing", {})
+    if pre.get("derivation"):
+        console.print(escape("preprocessing: " + pre["derivation"]), soft_wrap=True)
+    cv = result.settings.get("coulomb_cross_validation")
+    if cv is not None:
+        _print_coulomb_choice(cv)
     refs = result.references
     t = Table(title="Base parameters (σ: standard deviation; reference values beside)", box=box.SIMPLE_HEAD, padding=(0, 1))
     for col in ("name", "unit", "value", "σ", "σ %", *(r.name for r in refs)):
@@ -231,10 +252,10 @@ def _print_identification(result, paths) -> None:
         console.print(f"dynid SDP: physically consistent least squares, prior: {result.consistent.prior}; "
                       "smallest pseudo-inertia eigenvalue per link " + ", ".join(f"{x:.3g}" for x in result.consistent.pseudo_inertia_min_eig),
                       soft_wrap=True)
-    if result.consistency:
-        console.print("physically consistent (some mass distribution with friction, rotor inertia ≥ 0 has these base parameters; "
-                      "margin ≥ 0): " + "; ".join(f"{escape(label)} {'yes' if m >= -CONSISTENCY_TOL else 'no'} ({m:.3g})"
-                                                   for label, m in result.consistency.items()), soft_wrap=True)
+    if result.consistency_verdicts:
+        console.print("physically consistent (some mass distribution with friction and rotor inertias ≥ 0 has these base "
+                      "parameters)? " + "; ".join(f"{escape(label)}: {escape(v)}" for label, v in result.consistency_verdicts.items()),
+                      soft_wrap=True)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)

@@ -14,7 +14,7 @@ CHUNK = 256
 
 
 @nb.njit(cache=True, fastmath=False, boundscheck=False)
-def _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
+def _chunk(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
     n = q.shape[1]
     nd = drive_codes.shape[0]
     for k in range(start, stop):
@@ -24,17 +24,22 @@ def _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, start, stop
                 out[k, i, col] = 0.0
             for col in range(i * npj + 10, n * npj):
                 out[k, i, col] = 0.0
-            # drive terms of joint i (eq. 3): Ia·ddq, fc·sign(dq), fv·dq, offset
+            # drive terms of joint i (eq. 3): Ia·ddq, fc·sign(dq) (or tanh(dq/v_s)), fv·dq, offset
             for t in range(nd):
                 code = drive_codes[t]
                 if code == 0:
                     val = ddq[k, i]
                 elif code == 1:
-                    val = 1.0 if dq[k, i] > 0 else (-1.0 if dq[k, i] < 0 else 0.0)
+                    if coulomb_velocity[i] > 0:
+                        val = np.tanh(dq[k, i] / coulomb_velocity[i])
+                    else:
+                        val = 1.0 if dq[k, i] > 0 else (-1.0 if dq[k, i] < 0 else 0.0)
                 elif code == 2:
                     val = dq[k, i]
-                else:
+                elif code == 3:
                     val = 1.0
+                else:
+                    val = np.nan  # unknown term: never silently an offset
                 out[k, i, i * npj + 10 + t] = val
         # ---- forward recursion -------------------------------------------------------------
         for j in range(n):
@@ -134,8 +139,9 @@ def _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, start, stop
 
 
 @nb.njit(cache=True, parallel=True)
-def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj):
-    """Fill every entry of ``out`` (N, n, n*npj); ``drive_codes`` lists the drive terms (0 Ia, 1 fc, 2 fv, 3 offset)."""
+def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj):
+    """Fill every entry of ``out`` (N, n, n*npj); ``drive_codes`` lists the drive terms (0 Ia, 1 fc, 2 fv, 3 offset),
+    ``coulomb_velocity`` (n,) the Coulomb smoothing velocities (0: sign)."""
     n_s, n = q.shape
     n_chunks = (n_s + CHUNK - 1) // CHUNK
     for c in nb.prange(n_chunks):
@@ -146,4 +152,4 @@ def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, 
         acc = np.empty((n, 3))
         z0 = np.empty((n, 3))
         rl = np.empty((3, 3))
-        _chunk(rp, pp, axes, gravity, drive_codes, q, dq, ddq, out, npj, c * CHUNK, min((c + 1) * CHUNK, n_s), r0, o, w, dw, acc, z0, rl)
+        _chunk(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj, c * CHUNK, min((c + 1) * CHUNK, n_s), r0, o, w, dw, acc, z0, rl)

@@ -19,6 +19,7 @@ from ..checks import check_states
 from ..model.robot import Robot
 from ..conventions import DRIVE_TERMS
 from ._regressor_kernel import joint_torque_regressor
+from .friction import coulomb_column
 
 
 def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
@@ -61,7 +62,8 @@ def _fill(robot: Robot, q, dq, ddq, out) -> None:
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     codes = np.array([DRIVE_TERMS.index(t) for t in robot.drive_terms], dtype=np.int64)
     npj = robot.n_params_per_joint
-    joint_torque_regressor(rp, pp, axes, gravity, codes, q, dq, ddq, out, npj)
+    vs = np.ascontiguousarray(robot.coulomb_velocity, dtype=np.float64)
+    joint_torque_regressor(rp, pp, axes, gravity, codes, vs, q, dq, ddq, out, npj)
     for i, t in zip(*np.nonzero(~robot.drive_mask)):  # terms a joint does not have
         out[:, i, i * npj + 10 + t] = 0.0
     n_joint = robot.n_dof * npj
@@ -75,7 +77,7 @@ def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.nd
     (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values."""
     drive = robot.drive if drive is None else drive
     coupled = robot.transmission.coupled_values if coupled is None else coupled
-    columns = {"Ia": ddq, "fc": np.sign(dq), "fv": dq, "offset": np.ones_like(dq)}
+    columns = {"Ia": ddq, "fc": coulomb_column(dq, robot.coulomb_velocity), "fv": dq, "offset": np.ones_like(dq)}
     tau = np.zeros_like(dq)
     for k, term in enumerate(robot.drive_terms):
         tau += (drive[:, k] * robot.drive_mask[:, k]) * columns[term]

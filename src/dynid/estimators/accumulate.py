@@ -83,6 +83,16 @@ class LeastSquaresAccumulator:
             self.factors[j] = _triangular(np.vstack([self.factors[j], block]), self.n_params + 1)
             self.rows[j] += int(sel.sum())
 
+    @classmethod
+    def merged(cls, accumulators) -> "LeastSquaresAccumulator":
+        """One accumulator holding the rows of all of ``accumulators`` (same sizes)."""
+        first = accumulators[0]
+        out = cls(first.n_params, first.n_dof)
+        for j in range(out.n_dof):
+            out.factors[j] = _triangular(np.vstack([a.factors[j] for a in accumulators]), out.n_params + 1)
+        out.rows = sum(a.rows for a in accumulators)
+        return out
+
     def joint_residual_sumsq(self, params: np.ndarray) -> np.ndarray:
         """``||tau_j - W_j params||²`` of each joint (n_dof,)."""
         x = np.append(np.asarray(params, dtype=float), -1.0)

@@ -144,6 +144,30 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
     return float(t.value)
 
 
+def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), nonnegative=()) -> str:
+    """A margin of :func:`consistency_margin` in words: "yes", or "no" with the reason.
+
+    Margins within ``CONSISTENCY_TOL`` of 0 are "yes" (the solver's round-off). An infeasible problem
+    (margin -inf) names the base parameters that are a non-negative term alone (friction, rotor inertia)
+    and are negative, e.g. ``no: fv4 = -0.02 < 0``; other negative margins give the margin: how far the
+    closest mass distribution's smallest pseudo-inertia eigenvalue is below 0 [kg·m²].
+    """
+    if margin >= -CONSISTENCY_TOL:
+        return "yes"
+    if np.isfinite(margin):
+        return f"no: some link's pseudo-inertia has an eigenvalue {margin:.3g} < 0 at best"
+    if regrouping is not None and beta is not None:
+        k = np.asarray(regrouping, dtype=float)
+        nonneg = set(int(i) for i in np.asarray(nonnegative, dtype=int).ravel())
+        bad = [f"{names[i]} = {float(b):.3g} < 0" for i, (row, b) in enumerate(zip(k, np.asarray(beta, dtype=float)))
+               if b < 0 and np.all(row >= 0) and set(np.flatnonzero(row).tolist()) <= nonneg and np.any(row)]
+        if not np.all(np.isfinite(beta)):
+            return "no: some value is not finite"
+        if bad:
+            return "no: " + ", ".join(bad)
+    return "no: no mass distribution with non-negative friction and rotor inertias has these base parameters"
+
+
 def _consistency_constraints(phi, links, nonnegative, margin) -> list:
     """Every link's pseudo-inertia ``⪰ margin·1`` and the ``nonnegative`` columns ``>= 0``."""
     cons = [_pseudo_inertia_expression(phi, idx) >> margin * np.eye(4) for idx in np.asarray(links, dtype=int).reshape(-1, 10)]

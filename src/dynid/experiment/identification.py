@@ -1,11 +1,11 @@
 """Identification of a real robot from its logs, and validation on other logs.
 
-Recording (CSV, :mod:`dynid.io.datasets`) → zero-phase Butterworth filtering of positions, velocities
-and torques → derivatives by central differences → base regressor and torques, low-pass filtered and
-decimated together (Gautier's parallel decimation), chunk by chunk → optional removal of the rows of
-joints moving slower than a threshold (Coulomb friction is undefined at rest) → OLS/WLS accumulated by
-incremental QR (memory independent of the log's length) → validation: relative error, RMSE and
-correlation coefficient (eq. 18) per joint, for dynid's parameters and each reference set.
+Recording (CSV, :mod:`dynid.io.datasets`) → the preprocessing pipeline (:mod:`dynid.preprocessing.pipeline`:
+filtered positions and derivatives, base regressor and torques filtered in parallel and decimated,
+chunk by chunk, cutoffs derived from the excitation band) → OLS/WLS accumulated by incremental QR
+(memory independent of the log's length) → validation: relative error, RMSE and correlation
+coefficient (eq. 18) per joint and the global relative error, for dynid's parameters and each
+reference set.
 """
 
 from __future__ import annotations
@@ -17,169 +17,19 @@ import numpy as np
 
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
-from ..dynamics.regressor import regressor
 from ..dynamics.layout import consistency_layout
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
-from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin
-from ..exceptions import ConfigError, DataError
-from ..io.datasets import Recording
+from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
+from ..exceptions import ConfigError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
-from ..preprocessing.filters import butterworth_filtfilt, differentiate, parallel_decimation
-from ..preprocessing.fourier_fit import fourier_fit_derivatives
-from ..validation import correlation_coefficient, relative_error, rmse
+from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
+from ..validation import correlation_coefficient, global_relative_error, relative_error, rmse
+
+__all__ = ["METHODS", "PreparedData", "Preprocessing", "base_chunks", "prepare", "TorqueComparison", "compare_torques",
+           "IdentificationResult", "identify"]
 
 METHODS = ("ols", "wls")
-
-
-@dataclass(frozen=True)
-class Preprocessing:
-    """Preprocessing settings; ``None`` means the default for the sampling rate (:meth:`resolved`).
-
-    Attributes
-    ----------
-    order : int
-        Order of the Butterworth filters.
-    position_cutoff, velocity_cutoff, torque_cutoff : float or None [Hz]
-        Zero-phase low-pass cutoffs; 0 switches a filter off. Defaults: ``min(0.15·f_N, 20 Hz)`` for
-        positions and velocities, ``min(0.2·f_N, 25 Hz)`` for torques (``f_N`` = Nyquist frequency).
-    decimation : int or None
-        Parallel decimation factor. Default: ``max(1, rate // (10·velocity_cutoff))``.
-    min_speed : float or tuple [rad/s]
-        Rows of joint ``j`` where ``|dq_j| < min_speed_j`` are left out of the estimation (0: keep all).
-    trim : float or None [s]
-        Removed at both ends after filtering, where the filters' edge effects corrupt the derivatives.
-        Default: ``3 / cutoff`` of the slowest filter the derivatives go through (positions, and
-        velocities when they are measured), 0 when those filters are off.
-    chunk : int
-        Samples per chunk of the regressor.
-    fourier : (omega_f, n_harmonics) or None
-        When the robot ran a known periodic excitation (eq. 14, e.g. from ``dynid excite``): positions,
-        velocities and accelerations come from a least-squares fit of the measured positions on its
-        harmonics (paper §3.3; :func:`dynid.preprocessing.fourier_fit_derivatives`) instead of filtering
-        and differentiating; torques are still low-pass filtered.
-    """
-
-    order: int = 4
-    position_cutoff: float | None = None
-    velocity_cutoff: float | None = None
-    torque_cutoff: float | None = None
-    decimation: int | None = None
-    min_speed: float | tuple = 0.0
-    trim: float | None = None
-    chunk: int = 20_000
-    fourier: tuple[float, int] | None = None
-
-    def resolved(self, rate: float, measured_velocity: bool = True) -> "Preprocessing":
-        nyq = rate / 2
-        vel = self.velocity_cutoff if self.velocity_cutoff is not None else min(0.15 * nyq, 20.0)
-        pos = self.position_cutoff if self.position_cutoff is not None else vel
-        tq = self.torque_cutoff if self.torque_cutoff is not None else min(0.2 * nyq, 25.0)
-        dec = self.decimation if self.decimation is not None else max(1, int(rate // (10 * vel)) if vel > 0 else 1)
-        on = [c for c in ((pos, vel) if measured_velocity else (pos,)) if c > 0]
-        trim = self.trim if self.trim is not None else (3.0 / min(on) if on else 0.0)
-        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), torque_cutoff=float(tq),
-                       decimation=int(dec), trim=float(trim))
-
-    def to_dict(self) -> dict:
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
-
-
-@dataclass(frozen=True)
-class PreparedData:
-    """Filtered joint signals on a uniform grid, ready for the regressor (N, n_dof) each."""
-
-    name: str
-    t: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    ddq: np.ndarray
-    tau: np.ndarray
-    rate: float
-    settings: Preprocessing
-    warnings: tuple[str, ...] = ()
-
-
-def prepare(recording: Recording, settings: Preprocessing) -> PreparedData:
-    """Filter and differentiate a recording (positions, velocities: measured or from positions;
-    accelerations: derivative of the filtered velocities).
-
-    Raises
-    ------
-    ConfigError
-        A cutoff at or above the Nyquist frequency.
-    DataError
-        Too few samples left after trimming.
-    """
-    s = settings.resolved(recording.rate, recording.dq is not None)
-    rate = recording.rate
-
-    def lowpass(x, cutoff, what):
-        if cutoff <= 0:
-            return x
-        try:
-            return butterworth_filtfilt(x, rate, cutoff, s.order)
-        except ConfigError as exc:
-            raise ConfigError(f"preprocessing.{what}_cutoff: {exc}") from None
-
-    if recording.n_samples < 3 * (2 * s.order + 1) + 1:
-        raise DataError(f"{recording.name}: {recording.n_samples} samples are too few to filter")
-    if s.fourier is not None:
-        q, dq, ddq, _ = fourier_fit_derivatives(recording.t, recording.q, *s.fourier)
-    else:
-        q = lowpass(recording.q, s.position_cutoff, "position")
-        dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
-        ddq = differentiate(dq, rate)
-    tau = lowpass(recording.tau, s.torque_cutoff, "torque")
-    t = recording.t
-    cut = int(round(s.trim * rate))
-    if cut:
-        if 2 * cut >= t.shape[0] - 2:
-            raise DataError(f"{recording.name}: trim = {s.trim} s leaves no samples of the {t[-1]:.3f} s recording")
-        t, q, dq, ddq, tau = (x[cut:-cut] for x in (t, q, dq, ddq, tau))
-    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, s, recording.warnings)
-
-
-def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
-    v = np.asarray(settings.min_speed, dtype=float)
-    if v.ndim == 0:
-        v = np.full(n, float(v))
-    if v.shape != (n,) or np.any(v < 0):
-        raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
-    return v
-
-
-def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
-                progress: Callable[[int, int], None] | None = None, standard: bool = False):
-    """Parallel-decimated base (or standard) regressor and torques, chunk by chunk.
-
-    Yields
-    ------
-    index : (M,) int array
-        Sample indices kept (every ``decimation``-th).
-    y : (M, n_dof, n_base) array, or (M, n_dof, n_params) with ``standard``
-        (the base regressor is then ``base.base_observation(y)``: decimation commutes with selecting columns).
-    tau : (M, n_dof) array [N·m]
-    keep : (M, n_dof) bool array
-        Rows fast enough for the estimation (``|dq_j| >= min_speed_j``).
-    """
-    n = robot.n_dof
-    nb = robot.n_params if standard else base.n_base
-    s = data.settings
-    vmin = _min_speed(s, n)
-    n_s = data.t.shape[0]
-
-    def block(a, b):
-        y = regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b])
-        y = y if standard else base.base_observation(y)
-        return np.concatenate([y.reshape(b - a, n * nb), data.tau[a:b]], axis=1)
-
-    for index, values in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk):
-        y = values[:, : n * nb].reshape(-1, n, nb)
-        keep = np.abs(data.dq[index]) >= vmin
-        if progress is not None:
-            progress(int(index[-1]) + 1, n_s)
-        yield index, y, values[:, n * nb:].copy(), keep  # a copy: a view would keep the whole block alive
 
 
 @dataclass(frozen=True)
@@ -200,9 +50,11 @@ class TorqueComparison:
     predicted: dict
 
     def metrics(self) -> dict:
-        """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,)."""
+        """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,), and
+        global_relative_error [%] over all joints and samples (a float)."""
         return {label: {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
-                        "correlation": correlation_coefficient(self.measured, p)}
+                        "correlation": correlation_coefficient(self.measured, p),
+                        "global_relative_error": global_relative_error(self.measured, p)}
                 for label, p in self.predicted.items()}
 
     def to_dict(self) -> dict:
@@ -288,6 +140,8 @@ class IdentificationResult:
     consistency : dict
         label -> consistency margin of each parameter set (``>= 0``: some mass distribution with non-negative
         friction and rotor inertias has these base parameters; :func:`dynid.estimators.consistency_margin`).
+    consistency_verdicts : dict
+        label -> "yes" or "no: reason" (:func:`dynid.estimators.physically_consistent.consistency_verdict`).
     """
 
     robot: str
@@ -303,6 +157,7 @@ class IdentificationResult:
     warnings: tuple[str, ...] = ()
     consistent: ConsistentEstimate | None = None
     consistency: dict = field(default_factory=dict)
+    consistency_verdicts: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -342,7 +197,7 @@ class IdentificationResult:
             "joint_residual_std": self.joint_std, "n_rows": self.n_rows, "settings": self.settings,
             "identification": self.fit.to_dict(), "validation": [v.to_dict() for v in self.validations],
             "references": refs, "warnings": list(self.warnings),
-            "consistency_margin": self.consistency,
+            "consistency_margin": self.consistency, "physically_consistent_verdict": self.consistency_verdicts,
             **({} if self.consistent is None else {"physically_consistent": {
                 "label": SDP_LABEL, "prior": self.consistent.prior,
                 "values": dict(zip(self.base.names, self.consistent.base.tolist())),
@@ -390,10 +245,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     sets = parameter_sets(method, sol.params, references, None if consistent is None else consistent.base)
     links, nonneg = consistency_layout(robot)
     margins = {label: consistency_margin(base.regrouping, beta, links, nonneg) for label, beta in sets.items()}
+    verdicts = {label: consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg) for label, beta in sets.items()}
     fit = compare_torques(robot, base, data, sets)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
-                                consistent=consistent, consistency=margins)
+                                consistent=consistent, consistency=margins, consistency_verdicts=verdicts)
 
 
 def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAccumulator, row_weights) -> ConsistentEstimate:

@@ -10,12 +10,17 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     file = "identification_data/ur-20_02_10-30sec_12harm.csv"
     rows = [635, 3510]
 
-    [preprocessing]                      # dynid.experiment.identification.Preprocessing; all optional
-    order = 5
-    velocity_cutoff = 7.5                # Hz
-    torque_cutoff = 10.0                 # Hz
-    decimation = 1
-    min_speed = 0.0                      # rad/s, one value or one per joint
+    [preprocessing]                      # dynid.preprocessing.Preprocessing; all optional: by default every
+                                         # cutoff derives from the excitation band found in the data
+    order = 4
+    band = 0.5                           # Hz, the excitation band (default: from the positions' spectrum)
+    position_cutoff = 5.0                # Hz, positions and measured velocities (default 10× band)
+    parallel_cutoff = 2.5                # Hz, torques AND every regressor column (default 5× band)
+    decimation = 16                      # default: down to the parallel band
+    min_speed = 0.0                      # rad/s, one value or one per joint; "auto" (default): 5 % of
+                                         # each joint's RMS speed
+    coulomb_velocity = 0.0               # rad/s, Coulomb term tanh(dq/v) per joint; 0 (default): sign(dq);
+                                         # "auto": chosen per joint by blocked cross-validation
     excitation = "excitation.json"       # the robot ran this trajectory of dynid excite: derivatives
                                          # by a Fourier fit on its harmonics instead of filters
 
@@ -40,7 +45,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +57,9 @@ from ..io.configs import config_robot, read_config
 from ..io.references import load_reference
 from ..io.trajectories import load_trajectory
 from ..model.robot import Robot
-from .identification import (METHODS, IdentificationResult, Preprocessing, TorqueComparison, compare_torques, identify,
-                             parameter_sets, prepare)
+from ..preprocessing.pipeline import Preprocessing, prepare
+from ..validation.cross_validation import choose_coulomb_velocity
+from .identification import METHODS, IdentificationResult, TorqueComparison, compare_torques, identify, parameter_sets
 
 DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
@@ -73,13 +79,18 @@ class IdentificationConfig:
     physically_consistent: bool = False
 
 
-_PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "torque_cutoff": float,
-             "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None}
+_PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
+             "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None,
+             "coulomb_velocity": None}
 
 
 def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
     if not isinstance(table, dict):
         raise ConfigError(f"{where}: expected a table")
+    if "torque_cutoff" in table:
+        raise ConfigError(f"{where}.torque_cutoff: no longer exists, because a filter on the torques alone biases the "
+                          "estimate near velocity reversals; use parallel_cutoff (torques and every regressor column), "
+                          "or leave it out for the data-derived default")
     unknown = sorted(set(table) - set(_PRE_KEYS))
     if unknown:
         raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(_PRE_KEYS)}")
@@ -99,17 +110,23 @@ def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preproc
                 raise ConfigError(f"{where}.excitation: the trajectory has {traj.n_dof} joints, the robot {n}")
             values["fourier"] = (traj.omega_f, traj.n_harmonics)
             continue
-        if key == "min_speed":
+        if key in ("min_speed", "coulomb_velocity"):
+            if v == "auto":
+                values[key] = v
+                continue
             ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0) or (
                 isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in v))
             if not ok:
-                raise ConfigError(f"{where}.min_speed: expected a non-negative number or a list of {n}, got {v!r}")
+                auto = '"auto", '
+                raise ConfigError(f"{where}.{key}: expected {auto}a non-negative number or a list of {n} (rad/s), got {v!r}")
             values[key] = tuple(float(x) for x in v) if isinstance(v, list) else float(v)
             continue
         if isinstance(v, bool) or not isinstance(v, (int, float)) or (kind is int and v != int(v)) or v < 0:
             raise ConfigError(f"{where}.{key}: expected a non-negative {'integer' if kind is int else 'number'}, got {v!r}")
         if key in ("order", "decimation", "chunk") and v < 1:
             raise ConfigError(f"{where}.{key}: expected an integer >= 1, got {v!r}")
+        if key == "band" and v <= 0:
+            raise ConfigError(f"{where}.band: expected a positive frequency in Hz, got {v!r}")
         values[key] = kind(v)
     return Preprocessing(**values)
 
@@ -168,14 +185,36 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent)
 
 
+def _stored_preprocessing(identified: dict) -> Preprocessing | None:
+    """The identification's resolved preprocessing as results.json stores it (None if absent)."""
+    stored = identified.get("settings", {}).get("preprocessing") if isinstance(identified.get("settings"), dict) else None
+    if not isinstance(stored, dict):
+        return None
+    known = {f.name for f in fields(Preprocessing)}
+    try:
+        values = {k: (tuple(v) if isinstance(v, list) else v) for k, v in stored.items() if k in known}
+        return Preprocessing(**values)
+    except TypeError:
+        return None
+
+
 def _references(config: IdentificationConfig, base):
     return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base) for i, r in enumerate(config.references))
 
 
+def validation_settings(given: Preprocessing, resolved: Preprocessing | None) -> Preprocessing:
+    """Preprocessing of validation logs: the identification's filters (in Hz, resolved on its data) so
+    both are scored through the same filters; decimation and trim derived again for each log (its rate
+    may differ), and no Fourier fit (the excitation's harmonics fit only its own log)."""
+    if resolved is None:
+        return replace(given, fourier=None)
+    return replace(resolved, fourier=None, decimation=given.decimation, trim=given.trim, derivation="")
+
+
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
-              progress=None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
+              progress=None, resolved: Preprocessing | None = None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
     out, warnings = [], []
-    settings = replace(config.preprocessing, fourier=None)  # the excitation's harmonics fit only its own log
+    settings = validation_settings(config.preprocessing, resolved)
     for spec in datasets:
         data = prepare(load_recording(spec, config.robot), settings)
         out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
@@ -207,10 +246,16 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     base = base_parameters(config.robot, rng=0)
     refs = _references(config, base)
     data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
-    result = identify(config.robot, base, data, config.method, refs, progress, config.physically_consistent)
+    vs = config.preprocessing.coulomb_velocity
+    choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
+    robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
+    result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent)
+    result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
+                                       **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()})})
     if not validate or not config.validation:
         return result
-    validations, warnings = _validate(config, base, result.parameter_sets(), config.validation, progress)
+    validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,
+                                      data.settings)
     return replace(result, validations=validations, warnings=result.warnings + warnings)
 
 
@@ -243,5 +288,11 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
-    comparisons, warnings = _validate(config, base, sets, datasets, progress)
+    stored_vs = identified.get("settings", {}).get("coulomb_velocity") if isinstance(identified.get("settings"), dict) else None
+    if stored_vs is not None:
+        try:
+            config = replace(config, robot=replace(config.robot, coulomb_velocity=np.asarray(stored_vs, dtype=float)))
+        except (TypeError, ValueError, ConfigError):
+            raise DataError("results: settings.coulomb_velocity must give one non-negative velocity per joint") from None
+    comparisons, warnings = _validate(config, base, sets, datasets, progress, _stored_preprocessing(identified))
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings

@@ -19,7 +19,7 @@ from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
-from ..dynamics.regressor import observation_matrix
+from ..dynamics.regressor import regressor
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..exceptions import ConfigError
@@ -265,8 +265,10 @@ def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
 
 
 def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, keep_standard=False) -> Dataset:
-    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16), smooth the torques with eq. 17
-    ``passes`` times, fit the Fourier series for the derivatives and build the observation matrices.
+    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16), fit the Fourier series for the
+    derivatives, build the observation matrices, and smooth the torques **and every column of the
+    observation matrices** with eq. 17 ``passes`` times (parallel filtering: smoothing the torques alone
+    makes measured and modelled torque differ at each velocity reversal, where the Coulomb column steps).
 
     Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
     """
@@ -277,7 +279,8 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
     tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
     q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
-    w_std = observation_matrix(robot, q_f, dq_f, ddq_f)
+    y = five_point_cubic_smoothing(regressor(robot, q_f, dq_f, ddq_f), passes)  # eq. 17 along time, every column
+    w_std = y.reshape(-1, y.shape[2])
     return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, base.base_observation(w_std), tool_positions(robot, q),
                    w_std if keep_standard else None)
 

@@ -84,6 +84,9 @@ class Robot:
     drive_mask : (n_dof, len(drive_terms)) bool array
         Which drive terms each joint has (default all); a joint without a term has a zero column,
         so the term drops out of the base parameters.
+    coulomb_velocity : (n_dof,) array [rad/s]
+        Smoothing velocity ``v_s`` of each joint's Coulomb term: its column is ``tanh(dq/v_s)`` (still
+        linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.dynamics.friction`.
     """
 
     name: str
@@ -99,9 +102,14 @@ class Robot:
     notes: str = ""
     transmission: Transmission | None = None
     drive_mask: np.ndarray | None = None
+    coulomb_velocity: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.joints)
+        vs = np.zeros(n) if self.coulomb_velocity is None else np.array(self.coulomb_velocity, dtype=float).reshape(-1)
+        if vs.shape != (n,) or not np.all(np.isfinite(vs)) or np.any(vs < 0):
+            raise ConfigError(f"robot {self.name!r}: coulomb_velocity: expected {n} non-negative velocities (rad/s), got {self.coulomb_velocity!r}")
+        object.__setattr__(self, "coulomb_velocity", vs)
         if self.transmission is None:
             object.__setattr__(self, "transmission", Transmission.identity(n))
         if self.transmission.n_dof != n:
@@ -121,7 +129,7 @@ class Robot:
             raise ConfigError(f"robot {self.name!r}: expected drive parameters of shape ({n}, {len(self.drive_terms)}), got {self.drive.shape}")
         if np.any(self.drive[~mask] != 0):
             raise ConfigError(f"robot {self.name!r}: a drive term a joint does not have must have the value 0")
-        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask):
+        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask, vs):
             a.setflags(write=False)
 
     @property

@@ -53,7 +53,8 @@ def decimation_cutoff(rate: float, factor: int) -> float:
 
 
 def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,
-                        order: int = 4, chunk: int = 20_000) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+                        order: int = 4, chunk: int = 20_000,
+                        cutoff: float | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Low-pass filter and down-sample a signal that is computed chunk by chunk.
 
     Used for the observation matrix and the torques together (Gautier's parallel decimation): both
@@ -69,9 +70,12 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     n_samples : int
     rate : float [Hz]
     factor : int
-        Decimation factor (1: no filtering, just chunks).
+        Decimation factor.
     order : int
-        Order of the Butterworth anti-aliasing filter, cutoff :func:`decimation_cutoff`.
+        Order of the zero-phase Butterworth low-pass.
+    cutoff : float or None [Hz]
+        Its cutoff; default :func:`decimation_cutoff` (``factor`` 1 and no cutoff: no filtering, just
+        chunks). A cutoff above the decimation's own would alias.
     chunk : int
         Samples computed per step (before the margins).
 
@@ -85,13 +89,18 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     if factor < 1:
         raise ConfigError(f"decimation factor: expected an integer >= 1, got {factor}")
     chunk = max(chunk - chunk % factor, factor)
-    if factor == 1:
+    if factor == 1 and cutoff is None:
         for start in range(0, n_samples, chunk):
             stop = min(start + chunk, n_samples)
             yield np.arange(start, stop), block(start, stop)
         return
-    sos = signal.butter(order, decimation_cutoff(rate, factor), btype="low", fs=rate, output="sos")
-    margin = 10 * factor * order
+    cutoff = decimation_cutoff(rate, factor) if cutoff is None else cutoff
+    if cutoff > decimation_cutoff(rate, factor) * (1 + 1e-9):
+        raise ConfigError(f"parallel filter: a cutoff of {cutoff:g} Hz aliases when decimating by {factor} "
+                          f"(at most {decimation_cutoff(rate, factor):g} Hz)")
+    _check_cutoff(rate, cutoff, "parallel filter")
+    sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    margin = int(np.ceil(10 * order * 0.4 * rate / cutoff))  # the filter's transient, as 10·factor·order at the decimation's cutoff
     for start in range(0, n_samples, chunk):
         stop = min(start + chunk, n_samples)
         lo, hi = max(0, start - margin), min(n_samples, stop + margin)

@@ -41,3 +41,11 @@ def relative_error(measured, predicted) -> np.ndarray:
     """Relative error per joint ``100·||tau - tau_p|| / ||tau||``, (n_dof,) [%]."""
     m, p = _pair(measured, predicted)
     return 100.0 * np.linalg.norm(m - p, axis=0) / np.linalg.norm(m, axis=0)
+
+
+def global_relative_error(measured, predicted) -> float:
+    """Relative error over all joints and samples, ``100·||tau - tau_p||_F / ||tau||_F`` [%].
+
+    Joints with large torques weigh more than in the per-joint :func:`relative_error`."""
+    m, p = _pair(measured, predicted)
+    return float(100.0 * np.linalg.norm(m - p) / np.linalg.norm(m))
