@@ -72,3 +72,13 @@ def test_consistency_margin_tells_realisable_base_parameters_from_impossible_one
     bad = beta.copy()
     bad[base.names.index("ZZ1R")] = -10.0  # ZZ1R collects the inertias about axis 1: never negative
     assert consistency_margin(base.regrouping, bad, links, nonneg) < 0
+
+
+def test_consistency_verdict_names_the_violated_condition():
+    from dynid.estimators.physically_consistent import CONSISTENCY_TOL, consistency_verdict
+
+    regrouping = np.array([[1.0, 0.0, 1.0], [0.0, 1.0, 0.0]])  # beta0 = a + c (a inertial), beta1 = fv4 alone
+    names = ("ZZ1R", "fv4")
+    assert consistency_verdict(-0.5 * CONSISTENCY_TOL) == "yes"
+    assert consistency_verdict(float("-inf"), regrouping, np.array([1.0, -0.02]), names, [1]) == "no: fv4 = -0.02 < 0"
+    assert consistency_verdict(-0.24).startswith("no: some link's pseudo-inertia has an eigenvalue -0.24")

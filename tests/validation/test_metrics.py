@@ -21,3 +21,11 @@ def test_rmse_and_relative_error():
     assert relative_error(m, p)[0] == pytest.approx(100 * 1 / 5)
     with pytest.raises(ShapeError, match="differ in shape"):
         rmse(m, p[:1])
+
+
+def test_global_relative_error_weighs_every_sample_and_joint():
+    from dynid.validation import global_relative_error
+
+    m = np.array([[3.0, 0.1], [4.0, 0.0]])
+    p = np.array([[3.0, 0.0], [4.0, 0.1]])
+    assert global_relative_error(m, p) == pytest.approx(100 * np.sqrt(0.02) / np.sqrt(25.01))

@@ -210,6 +210,7 @@ class Robot:
             drive_terms=self.drive_terms,
             drive=self.drive[:k].copy(),
             drive_gains=self.drive_gains[:k].copy(),
+            coulomb_velocity=self.coulomb_velocity[:k].copy(),
             limits=self.limits.subset(k),
             tool_rotation=tool_r,
             tool_translation=tool_t,
