@@ -77,3 +77,16 @@ def test_real_ur_log_with_a_truncated_last_line_is_read_with_a_warning():
     rec = load_recording(spec, load_robot("ur10e"))
     assert any("ur-20_02_19_15harm50secLoad.csv: line 6107 is truncated" in w for w in rec.warnings)
     assert rec.n_samples > 6000
+
+
+def test_time_range_selects_seconds_and_is_checked(tmp_path):
+    rows = [_ur_row(0.01 * k, np.full(6, 0.01 * k), np.zeros(6), np.zeros(6)) for k in range(300)]
+    (tmp_path / "ur.csv").write_text("".join(rows))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "time_range": [0.5, 1.5]}, tmp_path, "cfg", "ident", 6)
+    rec = load_recording(spec, load_robot("ur10e"))
+    assert rec.n_samples == 101 and rec.q[0, 0] == pytest.approx(0.5) and rec.q[-1, 0] == pytest.approx(1.5)
+    with pytest.raises(ConfigError, match=r"cfg.time_range: expected \[start, stop\] in seconds"):
+        dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "time_range": [2.0, 1.0]}, tmp_path, "cfg", "ident", 6)
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "time_range": [10.0, 11.0]}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(DataError, match=r"time_range \[10, 11\] s holds fewer than 2 samples of the 2.990 s recording"):
+        load_recording(spec, load_robot("ur10e"))

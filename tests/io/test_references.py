@@ -41,3 +41,15 @@ def test_base_set_matched_to_dynid_regrouping(tmp_path):
     (tmp_path / "bp.csv").write_text("\n".join(lines[1:]) + "\n")
     with pytest.raises(DataError, match=f"do not determine the base parameter.*{base.names[0]}"):
         load_reference({"name": "r", "file": "bp.csv", "format": "base", "names": 1, "values": 2}, tmp_path, "cfg", base)
+
+
+def test_nominal_reference_is_the_descriptions_own_values(tmp_path):
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.io.references import load_reference
+    from dynid.model.description import load_robot
+
+    robot = load_robot("er16")
+    base = base_parameters(robot, rng=0)
+    ref = load_reference({"name": "nominal", "format": "nominal"}, tmp_path, "cfg: references[0]", base,
+                         robot.standard_parameters())
+    np.testing.assert_allclose(ref.beta, base.regrouping @ robot.standard_parameters())

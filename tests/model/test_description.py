@@ -66,7 +66,6 @@ def test_standard_dh_matches_explicit_product(tmp_path, rng):
     ("alpha", '"half pi"', "alpha"),
     ("drive_gain", "0.0", "drive_gain"),
     ("dq_max", "-2.0", "dq_max"),
-    ("inertia", "[1.0, 1.0, 5.0, 0, 0, 0]", "triangle"),
     ("com", "[0.0, 1.0]", "com"),
 ])
 def test_bad_fields_name_file_and_field(tmp_path, field, value, message):
@@ -96,3 +95,43 @@ def test_unknown_robot_and_bad_toml(tmp_path):
     p.write_text('name = "x"\n')
     with pytest.raises(ConfigError, match="joints"):
         load_robot(p)
+
+
+def _one_link(tmp_path, mass, inertia, urdf=False):
+    if not urdf:
+        p = tmp_path / "arm.toml"
+        p.write_text(f"[[joints]]\nmass = {mass}\ncom = [0.1, 0.0, 0.0]\ninertia = {inertia}\n")
+        return p
+    ixx, iyy, izz = inertia[:3]
+    (tmp_path / "arm.urdf").write_text(f"""<?xml version="1.0"?><robot name="arm"><link name="base"/>
+<link name="l1"><inertial><origin xyz="0.1 0 0"/><mass value="{mass}"/>
+<inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial></link>
+<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+<limit lower="-3" upper="3" effort="10" velocity="2"/></joint></robot>""")
+    p = tmp_path / "arm.toml"
+    p.write_text('convention = "urdf"\nurdf = "arm.urdf"\n[[joints]]\n')
+    return p
+
+
+@pytest.mark.parametrize("urdf", [False, True])
+@pytest.mark.parametrize("mass, inertia, rule, realisable", [
+    (1.0, [1.0, 1.0, 5.0, 0, 0, 0], "triangle inequality", False),
+    (1.0, [0.1, 0.1, -0.01, 0, 0, 0], "not positive definite", False),
+    (0.0, [0.0, 0.0, 0.0, 0, 0, 0], "mass 0 kg is not positive", True),   # a massless link
+    (1.0, [0.0, 0.0, 0.0, 0, 0, 0], "not positive definite", True),       # a point mass
+])
+def test_unphysical_nominal_values_are_accepted_with_a_warning_and_refused_where_used(tmp_path, urdf, mass, inertia, rule,
+                                                                                      realisable):
+    """The same rules for DH descriptions and URDFs: least squares does not use the nominal values, so
+    the robot loads and says which link breaks which rule; where they are used (simulation truth, SDP
+    prior) values that no mass distribution has are refused, degenerate but real ones pass."""
+    from dynid.exceptions import ConfigError
+
+    robot = load_robot(_one_link(tmp_path, mass, inertia, urdf))
+    assert len(robot.nominal_problems) == 1 and "link 1" in robot.nominal_problems[0] and rule in robot.nominal_problems[0]
+    if realisable:
+        robot.require_physical_nominal("the simulation truth")
+    else:
+        with pytest.raises(ConfigError, match=f"link 1 .*{rule}.*the simulation truth needs physically consistent"):
+            robot.require_physical_nominal("the simulation truth")
+    assert not load_robot("er16").nominal_problems

@@ -236,7 +236,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     row_weights = None if method == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     sol = ols if method == "ols" else acc.solve(row_weights)
     consistent = None if acc_std is None else _consistent_estimate(robot, base, acc_std, row_weights)
-    warnings = list(data.warnings)
+    warnings = list(robot.nominal_problems) + list(data.warnings)
     dropped = 1.0 - acc.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
@@ -254,6 +254,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
 
 def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAccumulator, row_weights) -> ConsistentEstimate:
     """The SDP on the accumulated triangular factor of the standard problem (weighted like the estimate)."""
+    robot.require_physical_nominal("estimation.physically_consistent (its prior is the description's nominal values)")
     p = robot.n_params
     reduced = acc.reduced(row_weights)
     links, nonneg = consistency_layout(robot)

@@ -199,7 +199,9 @@ def _stored_preprocessing(identified: dict) -> Preprocessing | None:
 
 
 def _references(config: IdentificationConfig, base):
-    return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base) for i, r in enumerate(config.references))
+    nominal = config.robot.standard_parameters()
+    return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base, nominal)
+                 for i, r in enumerate(config.references))
 
 
 def validation_settings(given: Preprocessing, resolved: Preprocessing | None) -> Preprocessing:

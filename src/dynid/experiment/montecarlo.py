@@ -135,6 +135,7 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     run.validate(full)
     robot = full.submodel(config.joints) if config.joints < full.n_dof else full
     base = base_parameters(robot, rng=np.random.default_rng([config.seed, 1]))
+    robot.require_physical_nominal("the simulation truth of dynid montecarlo")
     phi_true = robot.standard_parameters()
     traj, _ = identification_trajectory(run, robot, base)
     t = sample_times(config.duration, config.rate)

@@ -326,6 +326,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         truth = np.array([ref.TABLE2[ref.paper_symbol(n)] for n in base.names])
         phi_true = base.standard_from_base(truth, reference=robot.standard_parameters())
     else:
+        robot.require_physical_nominal("the simulation truth of dynid run")
         phi_true = robot.standard_parameters()
         truth = base.base_from_standard(phi_true)
 

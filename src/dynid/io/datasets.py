@@ -8,6 +8,7 @@ A dataset is described by a table of the experiment config (TOML)::
     file = "log.csv"                 # default file of every signal, relative to the data root
     header = false                   # first line holds column names
     rows = [635, 3510]               # 1-based inclusive data rows (header excluded)
+    time_range = [6.3, 35.1]         # seconds from the first row read (after rows), inclusive
     time = { column = 1 }            # time stamps [s] …
     rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
     resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
@@ -83,6 +84,7 @@ class DatasetSpec:
     n_columns: int | None = None
     rows: tuple[int, int] | None = None
     delimiter: str = ","
+    time_range: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -122,6 +124,16 @@ def _rows(value, where: str):
     return (value[0], value[1])
 
 
+def _time_range(value, where: str):
+    if value is None:
+        return None
+    if (not isinstance(value, list) or len(value) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in value)
+            or value[0] < 0 or value[1] <= value[0]):
+        raise ConfigError(f"{where}.time_range: expected [start, stop] in seconds with 0 <= start < stop, got {value!r}")
+    return (float(value[0]), float(value[1]))
+
+
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring); paths are relative to ``base``.
 
@@ -144,7 +156,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             merged[k] = {**merged[k], **v}
         else:
             merged[k] = v
-    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "delimiter", "name", *_SIGNALS}
+    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "delimiter", "name", *_SIGNALS}
     unknown = sorted(set(merged) - known)
     if unknown:
         raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(known)}")
@@ -197,7 +209,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         name=str(merged.get("name", name)), signals=signals, time=time,
         rate=None if rate is None else float(rate), resample=None if merged.get("resample") is None else float(merged["resample"]),
         side=side, header=bool(merged.get("header", False)), n_columns=merged.get("n_columns"),
-        rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")))
+        rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")),
+        time_range=_time_range(merged.get("time_range"), where))
 
 
 def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
@@ -249,6 +262,15 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
     if n_s < 2:
         raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
     raw = {kind: get(s) for kind, s in spec.signals.items()}
+    if spec.time_range is not None:
+        start, stop = spec.time_range
+        inside = (t - t[0] >= start - 1e-9) & (t - t[0] <= stop + 1e-9)
+        if inside.sum() < 2:
+            raise DataError(f"{spec.name}: time_range [{start:g}, {stop:g}] s holds fewer than 2 samples of the "
+                            f"{t[-1] - t[0]:.3f} s recording")
+        if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
+            warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
+        t, raw = t[inside], {kind: x[inside] for kind, x in raw.items()}
     median = float(np.median(np.diff(t)))
     uniform = spec.time is None or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = spec.rate if spec.time is None else (spec.resample or float(f"{1.0 / median:.6g}"))

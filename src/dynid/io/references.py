@@ -19,6 +19,15 @@ Two formats, declared in the config::
     values = 2
     rel_std = 3                # optional column: relative standard deviation [%]
 
+    [[references]]
+    name = "nominal"
+    format = "nominal"         # the robot description's own (nominal) values, no file
+
+A standard set is read in dynid's link frames: link ``j``'s frame has its z axis on joint ``j`` (modified
+DH, Khalil & Kleinfinger); for a URDF, the frame of the joint that moves link ``j``. For a description in
+standard DH, these are not the DH frames ``i`` in which its ``com`` and ``inertia`` are written: convert
+such a set first. First moments (MX, MY, MZ) and inertias are about the frame's origin (eq. 5).
+
 A standard set becomes base parameters through the robot's regrouping. A base set is matched row by
 row to dynid's base parameters by comparing the expressions' coefficients, so a set computed by
 another tool (FIGAROH, SymPyBotics) is checked against dynid's regrouping as it is read.
@@ -102,8 +111,10 @@ def _column(header: list[str] | None, col, path: Path, key: str) -> int:
     return header.index(col)
 
 
-def load_reference(table: dict, base: Path, where: str, basep: BaseParameters) -> ReferenceSet:
+def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, nominal=None) -> ReferenceSet:
     """Read a reference set (module docstring) and express it as base parameters.
+
+    ``nominal`` (n_params,) gives the values of ``format = "nominal"``.
 
     Raises
     ------
@@ -113,13 +124,17 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters) -
         Unreadable file, a value that is not a number, a standard set that lacks parameters, a base
         set whose expressions do not determine dynid's base parameters (names file and line).
     """
-    if not isinstance(table, dict) or "file" not in table or "name" not in table:
-        raise ConfigError(f"{where}: expected a table with 'name' and 'file'")
+    if not isinstance(table, dict) or "name" not in table or ("file" not in table and table.get("format") != "nominal"):
+        raise ConfigError(f"{where}: expected a table with 'name' and 'file' (or format = \"nominal\")")
+    fmt = table.get("format", "standard")
+    if fmt not in ("standard", "base", "nominal"):
+        raise ConfigError(f"{where}.format: expected 'standard', 'base' or 'nominal', got {fmt!r}")
+    if fmt == "nominal":
+        if nominal is None:
+            raise ConfigError(f"{where}.format: 'nominal' needs the robot's nominal parameters")
+        return ReferenceSet(str(table["name"]), basep.base_from_standard(nominal), None, "the robot description's nominal values")
     path = Path(table["file"])
     path = path if path.is_absolute() else base / path
-    fmt = table.get("format", "standard")
-    if fmt not in ("standard", "base"):
-        raise ConfigError(f"{where}.format: expected 'standard' or 'base', got {fmt!r}")
     if not path.is_file():
         raise DataError(f"{path}: reference file not found")
     with open(path, newline="", encoding="utf-8") as fh:

@@ -52,7 +52,7 @@ from ..exceptions import ConfigError
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot
 from .transmission import Transmission
-from .spatial import inertial_from_physical, transform_inertial
+from .spatial import inertial_from_physical, physical_problems, transform_inertial
 
 _ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
 
@@ -172,7 +172,8 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
             com = _vector(r, "com", 3, w)
             ixx, iyy, izz, ixy, ixz, iyz = _vector(r, "inertia", 6, w)
             inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-            _check_physical(mass, inertia, w)
+            if not np.isfinite(mass) or mass < 0:
+                raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
             phi = inertial_from_physical(mass, com, inertia)
             if convention == "standard":  # given in DH frame i: express in dynid's link frame
                 rr, pp = standard_dh_link_offset(alpha[i], a[i], d[i])
@@ -205,10 +206,13 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
             if not lim[k][i] > 0:
                 raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
     gravity = _vector(doc, "gravity", 3, source, default=[0.0, 0.0, -9.81])
+    link_names = [r.get("name", f"joint{i + 1}") for i, r in enumerate(rows)]
+    problems = tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(n)
+                     for p in physical_problems(inertial[i]))
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
-        notes=str(doc.get("notes", "")), transmission=transmission, drive_mask=mask,
+        notes=str(doc.get("notes", "")), transmission=transmission, drive_mask=mask, nominal_problems=problems,
     )
 
 
@@ -235,11 +239,3 @@ def _transmission(table, n: int, offsets: np.ndarray, source: str) -> Transmissi
     if not isinstance(terms, list) or any(t not in COUPLING_TERMS for t in terms):
         raise ConfigError(f"{where}.coupled_terms: expected a subset of {list(COUPLING_TERMS)}, got {terms!r}")
     return Transmission(r, offsets, tuple(t for t in COUPLING_TERMS if t in terms))
-
-
-def _check_physical(mass: float, inertia: np.ndarray, where: str) -> None:
-    if not mass > 0:
-        raise ConfigError(f"{where}.mass: expected a positive mass (kg), got {mass}")
-    ev = np.linalg.eigvalsh(inertia)
-    if ev.min() <= 0 or 2 * ev.max() > ev.sum() * (1 + 1e-9):
-        raise ConfigError(f"{where}.inertia: expected a positive definite inertia about the COM that meets the triangle inequality, got principal moments {np.round(ev, 6).tolist()}")

@@ -84,6 +84,10 @@ class Robot:
     drive_mask : (n_dof, len(drive_terms)) bool array
         Which drive terms each joint has (default all); a joint without a term has a zero column,
         so the term drops out of the base parameters.
+    nominal_problems : tuple of str
+        Physical-consistency rules the nominal inertial parameters break (one line each, naming the
+        link and the rule). Identification by least squares does not use the nominal values, so such a
+        description is accepted; :meth:`require_physical_nominal` refuses it where they are used.
     coulomb_velocity : (n_dof,) array [rad/s]
         Smoothing velocity ``v_s`` of each joint's Coulomb term: its column is ``tanh(dq/v_s)`` (still
         linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.dynamics.friction`.
@@ -103,6 +107,20 @@ class Robot:
     transmission: Transmission | None = None
     drive_mask: np.ndarray | None = None
     coulomb_velocity: np.ndarray | None = None
+    nominal_problems: tuple[str, ...] = ()
+
+    def require_physical_nominal(self, use: str) -> None:
+        """Raise :class:`ConfigError` naming link and rule when the nominal inertial parameters, needed
+        for ``use`` (e.g. "the simulation truth"), are those of no real mass distribution (a pseudo-inertia
+        that is not positive semidefinite). Degenerate but realisable links (a massless link, a point
+        mass, a thin rod) pass: they only have a warning in :attr:`nominal_problems`."""
+        from .spatial import is_physically_consistent
+
+        bad = [j for j in range(self.n_dof) if not is_physically_consistent(self.inertial[j])]
+        if bad:
+            lines = [p for p in self.nominal_problems if f"link {bad[0] + 1} " in p] or [f"link {bad[0] + 1}: nominal inertial parameters"]
+            more = f" (and {len(bad) - 1} more link(s))" if len(bad) > 1 else ""
+            raise ConfigError(f"{lines[0]}{more}: {use} needs physically consistent nominal values")
 
     def __post_init__(self) -> None:
         n = len(self.joints)
@@ -217,6 +235,7 @@ class Robot:
             notes=self.notes,
             transmission=self.transmission.subset(k),
             drive_mask=self.drive_mask[:k].copy(),
+            nominal_problems=self.nominal_problems,
         )
 
 

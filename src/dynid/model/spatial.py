@@ -91,3 +91,32 @@ def pseudo_inertia(phi: np.ndarray) -> np.ndarray:
 def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
     """True when the pseudo-inertia matrix of ``phi`` is positive semidefinite (Wensing et al. 2017)."""
     return bool(np.linalg.eigvalsh(pseudo_inertia(phi)).min() >= -tol * max(1.0, abs(phi[9])))
+
+
+def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
+    """The physical-consistency rules that ten inertial parameters (eq. 5 order, about the link origin)
+    break: positive mass, inertia about the centre of mass positive definite, and its principal moments
+    meeting the triangle inequality (each at most the sum of the other two). Empty when none.
+
+    A zero mass with zero first moments and inertia (a massless link lumped into its neighbour) breaks
+    the first rule but no other.
+    """
+    phi = np.asarray(phi, dtype=float)
+    mass, h = float(phi[9]), phi[6:9]
+    inertia = inertia_matrix(phi[:6])
+    if not mass > 0:
+        return [f"mass {mass:.6g} kg is not positive"]
+    c = h / mass
+    s = np.array([[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]])
+    ev = np.linalg.eigvalsh(inertia - mass * (s.T @ s))
+    scale = max(abs(ev).max(), 1e-12)
+    out = []
+    if ev.min() <= tol * scale:
+        out.append(f"inertia about the COM is not positive definite (principal moments {_fmt(ev)} kg·m²)")
+    elif 2 * ev.max() > ev.sum() * (1 + 1e-9):
+        out.append(f"principal moments {_fmt(ev)} kg·m² break the triangle inequality")
+    return out
+
+
+def _fmt(values) -> str:
+    return "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
