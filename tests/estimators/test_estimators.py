@@ -74,6 +74,24 @@ def test_shared_contract(problem, standard_problem, kind):
     assert est.score(w, est.predict(w)) == pytest.approx(1.0)  # R² of a perfect prediction
     with pytest.raises(ShapeError):
         est.fit(w, (w @ beta)[:-1])
+    # scikit-learn contract: hyper-parameters only, a clone is unfitted and refits to the same result
+    twin = est.clone()
+    assert type(twin) is type(est) and not hasattr(twin, "params_")
+    assert twin.get_params().keys() == est.get_params().keys()
+    with pytest.raises(ValueError, match="has no parameter 'nonsense'"):
+        twin.set_params(nonsense=1)
+
+
+@pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
+def test_n_dof_is_inferred_from_tau_given_per_joint(problem, kind):
+    w, beta = problem
+    given = make(kind, beta).fit(w, w @ beta)
+    inferred = make(kind, beta).set_params(n_dof=None)
+    inferred.fit(w, (w @ beta).reshape(-1, 3))
+    assert inferred.n_dof_ == 3
+    np.testing.assert_allclose(inferred.params_, given.params_, rtol=1e-9, atol=1e-12)
+    with pytest.raises(ShapeError, match=r"pass tau as \(N, n_dof\) or set n_dof"):
+        make(kind, beta).set_params(n_dof=None).fit(w, w @ beta)
 
 
 def test_ols_recovers_truth_exactly_from_noise_free_data(problem):

@@ -221,6 +221,24 @@ def _print_coulomb_choice(cv: dict) -> None:
     console.print(t)
 
 
+def _print_estimators(result) -> None:
+    """Every estimator on the identification rows: F of eq. 9, evaluations, time; then the box's rule."""
+    from ..experiment.identification import BOX_FRACTION, BOX_SIGMAS
+
+    t = Table(title=f"Estimators on {result.fit.name} (the validation tables follow)", box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("parameters", "F eq. 9 (N·m)", "evaluations", "time (s)"):
+        t.add_column(col, justify="left" if col == "parameters" else "right", no_wrap=True)
+    others = {o.label: o for o in result.others}
+    for label, f in result.objective.items():
+        o = others.get(label)
+        t.add_row(escape(label), f"{f:.4f}", "" if o is None else (str(o.n_evaluations) if o.n_evaluations else "solve"),
+                  "" if o is None else f"{o.seconds:.2f}")
+    console.print(t)
+    console.print(f"LAD, ABC, DE and PSO search the box {result.label} ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|value|); "
+                  "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations",
+                  soft_wrap=True)
+
+
 def _print_identification(result, paths) -> None:
 
     sol, base = result.solution, result.base
@@ -256,6 +274,8 @@ def _print_identification(result, paths) -> None:
         console.print("physically consistent (some mass distribution with friction and rotor inertias ≥ 0 has these base "
                       "parameters)? " + "; ".join(f"{escape(label)}: {escape(v)}" for label, v in result.consistency_verdicts.items()),
                       soft_wrap=True)
+    if result.others:
+        _print_estimators(result)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)

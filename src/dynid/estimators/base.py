@@ -47,14 +47,53 @@ def paper_objective(residual: np.ndarray, n_dof: int, weights: np.ndarray | None
     return np.tensordot(d, r.sum(axis=0), axes=(0, 0)) / n_s
 
 
+def infer_n_dof(n_dof: int | None, tau) -> int:
+    """Joints per sample: ``n_dof`` when given, else the second axis of ``tau`` given as (N, n_dof).
+
+    Raises
+    ------
+    ShapeError
+        Neither says it.
+    """
+    if n_dof is not None:
+        return int(n_dof)
+    shape = np.shape(tau)
+    if len(shape) == 2:
+        return int(shape[1])
+    raise ShapeError(f"cannot tell the joints of tau with shape {shape}: pass tau as (N, n_dof) or set n_dof")
+
+
 class Estimator:
-    """Base class: ``fit(W, tau)`` sets ``params_`` and returns self; ``predict(W)``; ``score``.
+    """Base class (scikit-learn contract): ``fit(W, tau)`` sets ``params_`` and returns self; ``predict(W)``;
+    ``score``; ``get_params``, ``set_params`` and ``clone``.
 
     Subclasses store only keyword hyper-parameters in ``__init__`` and set learned attributes
-    ending in ``_``.
+    ending in ``_``. Those that split rows by joint take ``n_dof=None`` and infer it in ``fit`` from
+    ``tau`` given as (N, n_dof) (attribute ``n_dof_``).
     """
 
     params_: np.ndarray
+
+    def get_params(self) -> dict:
+        """The keyword hyper-parameters of ``__init__`` and their values."""
+        import inspect
+
+        names = [p.name for p in inspect.signature(type(self).__init__).parameters.values()
+                 if p.kind == p.KEYWORD_ONLY]
+        return {n: getattr(self, n) for n in names}
+
+    def set_params(self, **params) -> "Estimator":
+        """Set hyper-parameters by name; an unknown name is a ``ValueError``."""
+        known = self.get_params()
+        for name, value in params.items():
+            if name not in known:
+                raise ValueError(f"{type(self).__name__} has no parameter {name!r}; expected one of {sorted(known)}")
+            setattr(self, name, value)
+        return self
+
+    def clone(self) -> "Estimator":
+        """An unfitted estimator with the same hyper-parameters."""
+        return type(self)(**self.get_params())
 
     def fit(self, w, tau):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -75,7 +114,7 @@ class Estimator:
 class BoxSearchEstimator(Estimator):
     """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
 
-    Subclasses set ``bounds`` (p, 2), ``n_dof`` and ``weights`` and call :meth:`_objectives`.
+    Subclasses set ``bounds`` (p, 2), ``n_dof`` (or None: inferred) and ``weights`` and call :meth:`_objectives`.
     """
 
     bounds: object
@@ -84,7 +123,8 @@ class BoxSearchEstimator(Estimator):
 
     def _objectives(self, w, tau):
         """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
-        w, tau = check_observations(w, tau, self.n_dof)
+        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        w, tau = check_observations(w, tau, self.n_dof_)
         bounds = np.asarray(self.bounds, dtype=float)
         if bounds.shape != (w.shape[1], 2):
             raise ShapeError(f"expected {type(self).__name__} bounds of shape ({w.shape[1]}, 2), got {bounds.shape}")
@@ -92,7 +132,7 @@ class BoxSearchEstimator(Estimator):
         def objective(x):
             x = np.asarray(x, dtype=float)
             r = (tau - w @ x) if x.ndim == 1 else (tau[:, None] - w @ x)
-            return paper_objective(r, self.n_dof, self.weights)
+            return paper_objective(r, self.n_dof_, self.weights)
 
         return bounds, objective
 

@@ -15,7 +15,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
     ----------
     bounds : (p, 2) array
         Search box of the parameters (the paper's Table 3).
-    n_dof : int
+    n_dof : int or None
+        Joints per sample; None: inferred from tau given as (N, n_dof).
         Joints per sample in ``W``'s rows, for eq. 9.
     weights : (n_dof,) array, optional
         ``delta`` of eq. 9 (default 1).
@@ -30,7 +31,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per iteration), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int, weights=None, colony_size: int = 30, limit: int = 15,
+    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, colony_size: int = 30, limit: int = 15,
                  maxiter: int = 50, rng=None, callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof

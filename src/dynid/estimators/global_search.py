@@ -22,7 +22,8 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     ----------
     bounds : (p, 2) array
         Search box (the ABC's).
-    n_dof : int
+    n_dof : int or None
+        Joints per sample; None: inferred from tau given as (N, n_dof).
         Joints per sample in ``W``'s rows.
     weights : (n_dof,) array, optional
         ``delta`` of eq. 9 (default 1).
@@ -41,7 +42,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
+    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
                  polish: bool = False, rng=None, callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof
@@ -84,7 +85,8 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     Parameters
     ----------
     bounds : (p, 2) array
-    n_dof : int
+    n_dof : int or None
+        Joints per sample; None: inferred from tau given as (N, n_dof).
     weights : (n_dof,) array, optional
     swarm_size : int
         Particles (default 30, the ABC's colony size).
@@ -99,7 +101,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_, n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
+    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
                  callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof

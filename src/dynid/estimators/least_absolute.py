@@ -6,7 +6,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..exceptions import DynIdError, ShapeError
-from .base import Estimator, check_observations, paper_objective
+from .base import Estimator, check_observations, infer_n_dof, paper_objective
 
 
 class LeastAbsoluteDeviations(Estimator):
@@ -20,7 +20,8 @@ class LeastAbsoluteDeviations(Estimator):
 
     Parameters
     ----------
-    n_dof : int
+    n_dof : int or None
+        Joints per sample; None: inferred from tau given as (N, n_dof).
         Joints per sample in ``W``'s rows.
     weights : (n_dof,) array, optional
         ``delta`` of eq. 9 (default 1).
@@ -36,16 +37,17 @@ class LeastAbsoluteDeviations(Estimator):
         If HiGHS reports the problem infeasible or fails.
     """
 
-    def __init__(self, *, n_dof: int, weights=None, bounds=None):
+    def __init__(self, *, n_dof: int | None = None, weights=None, bounds=None):
         self.n_dof = n_dof
         self.weights = weights
         self.bounds = bounds
 
     def fit(self, w, tau) -> "LeastAbsoluteDeviations":
-        w, tau = check_observations(w, tau, self.n_dof)
+        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape
-        delta = np.ones(self.n_dof) if self.weights is None else np.asarray(self.weights, dtype=float)
-        row_w = np.tile(delta, m // self.n_dof) / (m // self.n_dof)
+        delta = np.ones(self.n_dof_) if self.weights is None else np.asarray(self.weights, dtype=float)
+        row_w = np.tile(delta, m // self.n_dof_) / (m // self.n_dof_)
         if self.bounds is None:
             lo, hi = np.full(p, -np.inf), np.full(p, np.inf)
         else:
@@ -67,6 +69,6 @@ class LeastAbsoluteDeviations(Estimator):
         if res.status != 0:
             raise DynIdError(f"LAD linear program failed: {res.message}")
         self.params_ = np.clip(-res.eqlin.marginals, lo, hi)
-        self.objective_ = float(paper_objective(tau - w @ self.params_, self.n_dof, delta))
+        self.objective_ = float(paper_objective(tau - w @ self.params_, self.n_dof_, delta))
         self.result_ = res
         return self

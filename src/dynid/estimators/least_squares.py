@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .accumulate import LeastSquaresAccumulator
-from .base import Estimator, check_observations
+from .base import Estimator, check_observations, infer_n_dof
 
 
 class OrdinaryLeastSquares(Estimator):
@@ -56,8 +56,9 @@ class WeightedLeastSquares(Estimator):
 
     Parameters
     ----------
-    n_dof : int
-        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``).
+    n_dof : int or None
+        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau
+        given as (N, n_dof).
 
     Learned attributes
     ------------------
@@ -65,13 +66,14 @@ class WeightedLeastSquares(Estimator):
     joint_std_ : (n_dof,) residual standard deviation of each joint [N·m].
     """
 
-    def __init__(self, *, n_dof: int, rcond: float | None = None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None):
         self.n_dof = n_dof
         self.rcond = rcond
 
     def fit(self, w, tau) -> "WeightedLeastSquares":
-        w, tau = check_observations(w, tau, self.n_dof)
-        acc = LeastSquaresAccumulator(w.shape[1], self.n_dof)
+        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        w, tau = check_observations(w, tau, self.n_dof_)
+        acc = LeastSquaresAccumulator(w.shape[1], self.n_dof_)
         acc.add(w, tau)
         ols = acc.solve(rcond=self.rcond)
         std = acc.joint_residual_std(ols.params)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..exceptions import ConfigError, IdentifiabilityError
-from .base import Estimator, check_observations
+from .base import Estimator, check_observations, infer_n_dof
 
 HUBER_C = 1.345
 MAD_TO_STD = 1.4826
@@ -24,8 +24,9 @@ class IterativelyReweightedLeastSquares(Estimator):
 
     Parameters
     ----------
-    n_dof : int
-        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``).
+    n_dof : int or None
+        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau
+        given as (N, n_dof).
     tuning : float
         Huber's ``c`` (default 1.345); ``inf`` gives per-joint weighted least squares.
     max_iter : int
@@ -51,7 +52,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         If ``W`` is rank-deficient.
     """
 
-    def __init__(self, *, n_dof: int, tuning: float = HUBER_C, max_iter: int = 50, tol: float = 1e-8):
+    def __init__(self, *, n_dof: int | None = None, tuning: float = HUBER_C, max_iter: int = 50, tol: float = 1e-8):
         self.n_dof = n_dof
         self.tuning = tuning
         self.max_iter = max_iter
@@ -60,7 +61,8 @@ class IterativelyReweightedLeastSquares(Estimator):
     def fit(self, w, tau) -> "IterativelyReweightedLeastSquares":
         if not self.tuning > 0:
             raise ConfigError(f"IRLS tuning constant must be positive, got {self.tuning}")
-        w, tau = check_observations(w, tau, self.n_dof)
+        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape
         if m <= p:
             raise IdentifiabilityError(f"IRLS needs more equations than parameters, got {m} rows for {p} parameters")
@@ -68,7 +70,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         self.converged_ = False
         for it in range(1, self.max_iter + 1):
             u, scale = self._standardised(tau - w @ params)
-            new = _weighted_solve(w, tau, self._huber_weights(u) / np.tile(scale, m // self.n_dof) ** 2)
+            new = _weighted_solve(w, tau, self._huber_weights(u) / np.tile(scale, m // self.n_dof_) ** 2)
             step = np.linalg.norm(new - params)
             params = new
             if step <= self.tol * max(np.linalg.norm(params), 1e-300):
@@ -76,7 +78,7 @@ class IterativelyReweightedLeastSquares(Estimator):
                 break
         self.n_iter_ = it
         u, scale = self._standardised(tau - w @ params)
-        s_rows = np.tile(scale, m // self.n_dof)
+        s_rows = np.tile(scale, m // self.n_dof_)
         psi = np.clip(u, -self.tuning, self.tuning)
         dpsi = (np.abs(u) <= self.tuning).astype(float)
         a = (w * (dpsi / s_rows**2)[:, None]).T @ w
@@ -97,7 +99,7 @@ class IterativelyReweightedLeastSquares(Estimator):
 
     def _standardised(self, residual: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Residuals divided by their joint's robust scale, and the scales (n_dof,)."""
-        r = residual.reshape(-1, self.n_dof)
+        r = residual.reshape(-1, self.n_dof_)
         scale = MAD_TO_STD * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
         scale = np.where(scale > 0, scale, np.maximum(np.abs(r).max(axis=0), 1e-12))
         return (r / scale).ravel(), scale

@@ -18,6 +18,7 @@ import numpy as np
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
+from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
 from ..exceptions import ConfigError
@@ -77,19 +78,58 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
 
 
 def estimate_label(method: str) -> str:
-    """How dynid's estimate is labelled in tables, figures and JSON: ``"dynid WLS"``."""
-    return f"dynid {method.upper()}"
+    """How dynid's estimate is labelled in tables, figures and JSON: ``"dynid WLS"``, ``"dynid ABC×10"``."""
+    from .methods import LABELS
+
+    return f"dynid {LABELS.get(method, method.upper())}"
 
 
 SDP_LABEL = "dynid SDP"
 """Label of the physically consistent estimate."""
 
 
-def parameter_sets(method: str, params: np.ndarray, references=(), consistent: np.ndarray | None = None) -> dict:
-    """label -> base parameter vector: dynid's estimate, its physically consistent estimate if any, then each
-    reference set."""
+def parameter_sets(method: str, params: np.ndarray, references=(), consistent: np.ndarray | None = None,
+                   others: dict | None = None) -> dict:
+    """label -> base parameter vector: dynid's estimate, its physically consistent estimate if any, the
+    other estimators' (``others``: label -> vector), then each reference set."""
     sdp = {} if consistent is None else {SDP_LABEL: consistent}
-    return {estimate_label(method): params, **sdp, **{r.name: r.beta for r in references}}
+    return {estimate_label(method): params, **sdp, **(others or {}), **{r.name: r.beta for r in references}}
+
+
+BOX_SIGMAS = 5.0
+BOX_FRACTION = 0.5
+"""Search box of the box searches (ABC, DE, PSO) and LAD on real logs: ``β̂ ± (5·σ + 0.5·|β̂|)`` around the
+OLS/WLS estimate ``β̂`` with its standard deviation ``σ``: wide enough to hold the true parameters when σ
+is underestimated severalfold, narrow enough to be searched."""
+
+
+def search_box(params: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """(n_base, 2) box ``params ± (BOX_SIGMAS·std + BOX_FRACTION·|params|)`` (a zero width gets 1e-6)."""
+    half = np.maximum(BOX_SIGMAS * np.asarray(std) + BOX_FRACTION * np.abs(params), 1e-6)
+    return np.column_stack([params - half, params + half])
+
+
+@dataclass(frozen=True)
+class OtherEstimate:
+    """An estimator of :mod:`dynid.experiment.methods` run on the stacked, parallel-filtered rows.
+
+    Attributes
+    ----------
+    key : str
+    params : (n_base,) array
+    seconds : float
+    n_evaluations : int or None
+        Evaluations of eq. 9 (box searches only).
+    """
+
+    key: str
+    params: np.ndarray
+    seconds: float
+    n_evaluations: int | None
+
+    @property
+    def label(self) -> str:
+        return estimate_label(self.key)
 
 
 @dataclass(frozen=True)
@@ -142,6 +182,12 @@ class IdentificationResult:
         friction and rotor inertias has these base parameters; :func:`dynid.estimators.consistency_margin`).
     consistency_verdicts : dict
         label -> "yes" or "no: reason" (:func:`dynid.estimators.physically_consistent.consistency_verdict`).
+    others : tuple of OtherEstimate
+        The other estimators asked for (``[estimation] methods``).
+    objective : dict
+        label -> F of eq. 9 on the identification rows [N·m] (when other estimators ran).
+    box : (n_base, 2) array or None
+        The box searches' box (:func:`search_box`).
     """
 
     robot: str
@@ -158,6 +204,9 @@ class IdentificationResult:
     consistent: ConsistentEstimate | None = None
     consistency: dict = field(default_factory=dict)
     consistency_verdicts: dict = field(default_factory=dict)
+    others: tuple = ()
+    objective: dict = field(default_factory=dict)
+    box: np.ndarray | None = None
 
     @property
     def label(self) -> str:
@@ -166,7 +215,8 @@ class IdentificationResult:
     def parameter_sets(self) -> dict:
         """label -> base parameter vector: dynid's estimate(s), then each reference set."""
         return parameter_sets(self.method, self.solution.params, self.references,
-                              None if self.consistent is None else self.consistent.base)
+                              None if self.consistent is None else self.consistent.base,
+                              {o.label: o.params for o in self.others})
 
     def reference_agreement(self, ref: ReferenceSet) -> dict:
         """Differences to a reference that states relative standard deviations: ``z = |Δ| / σ_ref``."""
@@ -198,6 +248,11 @@ class IdentificationResult:
             "identification": self.fit.to_dict(), "validation": [v.to_dict() for v in self.validations],
             "references": refs, "warnings": list(self.warnings),
             "consistency_margin": self.consistency, "physically_consistent_verdict": self.consistency_verdicts,
+            "methods": {o.label: {"key": o.key, "values": dict(zip(self.base.names, o.params.tolist())),
+                                  "seconds": o.seconds, "n_evaluations": o.n_evaluations} for o in self.others},
+            "objective_eq9": self.objective,
+            **({} if self.box is None else {"search_box": {"rule": f"estimate ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|estimate|)",
+                                                            "bounds": dict(zip(self.base.names, self.box.tolist()))}}),
             **({} if self.consistent is None else {"physically_consistent": {
                 "label": SDP_LABEL, "prior": self.consistent.prior,
                 "values": dict(zip(self.base.names, self.consistent.base.tolist())),
@@ -207,11 +262,17 @@ class IdentificationResult:
 
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str = "wls",
-             references: tuple[ReferenceSet, ...] = (), progress=None, physically_consistent: bool = False) -> IdentificationResult:
+             references: tuple[ReferenceSet, ...] = (), progress=None, physically_consistent: bool = False,
+             methods: tuple[str, ...] = (), rng=0) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording by OLS or WLS (chunked), and with
     ``physically_consistent`` also by physically consistent least squares over the standard parameters
     (same row weights; prior: the robot model's nominal parameters). Every parameter set gets its
     consistency margin.
+
+    ``methods`` adds estimators of :mod:`dynid.experiment.methods` other than OLS/WLS/SDP (IRLS, LAD, ABC,
+    ABC×10, DE, PSO) on the same parallel-filtered rows, stacked in memory (rows below ``min_speed`` set
+    to 0, so that they count for no method); LAD and the box searches search :func:`search_box`, seeded
+    by ``rng``.
 
     Raises
     ------
@@ -226,11 +287,17 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     n = robot.n_dof
     acc = LeastSquaresAccumulator(base.n_base, n)
     acc_std = LeastSquaresAccumulator(robot.n_params, n) if physically_consistent else None
+    extra = tuple(k for k in methods if k not in (method, "sdp"))
+    stacked_w, stacked_tau = [], []
     for _, y, tau, keep in base_chunks(robot, base, data, progress, standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
             y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
+        if extra:
+            k = keep.reshape(-1)
+            stacked_w.append(y.reshape(-1, base.n_base) * k[:, None])
+            stacked_tau.append(tau.reshape(-1) * k)
     ols = acc.solve()
     joint_std = acc.joint_residual_std(ols.params)
     row_weights = None if method == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
@@ -242,14 +309,37 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
     for r in references:
         warnings.extend(r.warnings)
-    sets = parameter_sets(method, sol.params, references, None if consistent is None else consistent.base)
+    others, objective, box = (), {}, None
+    if extra:
+        w_all, tau_all = np.concatenate(stacked_w), np.concatenate(stacked_tau)
+        others, box = _other_estimates(extra, base, w_all, tau_all, n, sol, rng)
+    sets = parameter_sets(method, sol.params, references, None if consistent is None else consistent.base,
+                          {o.label: o.params for o in others})
+    if extra:
+        objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
     links, nonneg = consistency_layout(robot)
     margins = {label: consistency_margin(base.regrouping, beta, links, nonneg) for label, beta in sets.items()}
     verdicts = {label: consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg) for label, beta in sets.items()}
     fit = compare_torques(robot, base, data, sets)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
-                                consistent=consistent, consistency=margins, consistency_verdicts=verdicts)
+                                consistent=consistent, consistency=margins, consistency_verdicts=verdicts,
+                                others=others, objective=objective, box=box)
+
+
+def _other_estimates(keys, base, w, tau, n_dof, sol, rng) -> tuple[tuple[OtherEstimate, ...], np.ndarray]:
+    """Fit each of ``keys`` on the stacked rows; the box from the OLS/WLS solution ``sol``."""
+    from .methods import FitData, SearchBudget, fit_method
+
+    from .methods import METHODS as ALL
+
+    box = search_box(sol.params, sol.params_std)
+    data = FitData(w, tau, n_dof, box, base)
+    out = []
+    for key in keys:  # each method seeded by (seed, method): the same whatever else is asked for
+        fitted = fit_method(key, data, SearchBudget(), np.random.default_rng([int(rng), ALL.index(key)]))
+        out.append(OtherEstimate(key, fitted.params, fitted.seconds, fitted.n_evaluations))
+    return tuple(out), box
 
 
 def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAccumulator, row_weights) -> ConsistentEstimate:

@@ -25,8 +25,10 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
                                          # by a Fourier fit on its harmonics instead of filters
 
     [estimation]
-    method = "wls"                       # "ols" or "wls"
+    method = "wls"                       # "ols" or "wls": the estimate with σ
     physically_consistent = true         # also physically consistent least squares (SDP), default false
+    methods = ["wls", "sdp", "lad", "abc", "de", "pso", "irls"]   # optional: every estimator side by side
+    seed = 0                             # seeds the box searches (ABC, ABC×10, DE, PSO)
 
     [[validation]]                       # dataset tables, each with a name
     name = "ptp_10_points"
@@ -59,6 +61,7 @@ from ..io.trajectories import load_trajectory
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare
 from ..validation.cross_validation import choose_coulomb_velocity
+from .methods import parse_methods
 from .identification import METHODS, IdentificationResult, TorqueComparison, compare_torques, identify, parameter_sets
 
 DATA_ROOT_ENV = "DYNID_DATA_ROOT"
@@ -77,6 +80,8 @@ class IdentificationConfig:
     references: tuple[dict, ...]
     data_root: Path
     physically_consistent: bool = False
+    methods: tuple[str, ...] = ()
+    seed: int = 0
 
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
@@ -170,19 +175,34 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
     pre = _preprocessing(doc.get("preprocessing", {}), f"{path}: preprocessing", n, here)
     est = doc.get("estimation", {})
-    method = est.get("method", "wls") if isinstance(est, dict) else None
+    if not isinstance(est, dict):
+        raise ConfigError(f"{path}: estimation: expected a table")
+    unknown = sorted(set(est) - {"method", "physically_consistent", "methods", "seed"})
+    if unknown:
+        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected method, methods, "
+                          "physically_consistent, seed")
+    methods = est.get("methods", [])
+    if not isinstance(methods, list) or not all(isinstance(m, str) for m in methods):
+        raise ConfigError(f"{path}: estimation.methods: expected a list of method names, got {methods!r}")
+    try:
+        methods = parse_methods(methods) if methods else ()
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: estimation.methods: {str(exc).split(': ', 1)[1]}") from None
+    primary = next((m for m in methods if m in METHODS), "wls")
+    method = est.get("method", primary)
     if method not in METHODS:
         raise ConfigError(f"{path}: estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
-    unknown = sorted(set(est) - {"method", "physically_consistent"})
-    if unknown:
-        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected method, physically_consistent")
-    consistent = est.get("physically_consistent", False)
+    consistent = est.get("physically_consistent", "sdp" in methods)
     if not isinstance(consistent, bool):
         raise ConfigError(f"{path}: estimation.physically_consistent: expected true or false, got {consistent!r}")
+    seed = est.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ConfigError(f"{path}: estimation.seed: expected a non-negative integer, got {seed!r}")
     refs = doc.get("references", [])
     if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
         raise ConfigError(f"{path}: references: expected [[references]] tables")
-    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent)
+    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent or "sdp" in methods,
+                                methods, seed)
 
 
 def _stored_preprocessing(identified: dict) -> Preprocessing | None:
@@ -251,7 +271,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     vs = config.preprocessing.coulomb_velocity
     choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
-    result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent)
+    result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()})})
     if not validate or not config.validation:
@@ -286,7 +306,12 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
         sdp = None if consistent is None else np.array([float(consistent["values"][n]) for n in base.names])
     except (KeyError, TypeError, ValueError):
         raise DataError("results: physically_consistent.values must give every base parameter") from None
-    sets = parameter_sets(method, values, refs, sdp)
+    stored = identified.get("methods", {})
+    try:
+        others = {str(label): np.array([float(m["values"][n]) for n in base.names]) for label, m in stored.items()}
+    except (KeyError, TypeError, ValueError, AttributeError):
+        raise DataError("results: methods.*.values must give every base parameter") from None
+    sets = parameter_sets(method, values, refs, sdp, others)
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")

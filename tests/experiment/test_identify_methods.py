@@ -1,0 +1,56 @@
+"""Every estimator on a log (the paper's ABC included): one registry for run and identify."""
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.experiment.identification_config import load_identification_config, run_identification, run_validation
+from dynid.report.identification_run import save_identification
+
+from ..simulated_logs import simulated_case
+
+ALL = ["wls", "ols", "sdp", "irls", "lad", "abc", "abc10", "de", "pso"]
+
+
+def test_identify_runs_every_estimator_side_by_side(tmp_path):
+    cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
+    cfg.write_text(cfg.read_text().replace('method = "ols"\n', f'methods = {json.dumps(ALL)}\nseed = 3\n'))
+    config = load_identification_config(cfg)
+    assert config.method == "wls" and config.physically_consistent
+    result = run_identification(config)
+    labels = ["dynid WLS", "dynid SDP", "dynid OLS", "dynid IRLS", "dynid LAD", "dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"]
+    assert list(result.parameter_sets())[:9] == labels
+    for cmp in (result.fit, *result.validations):
+        assert set(labels) <= set(cmp.metrics())
+    # LAD is the exact minimiser of eq. 9 in the box: no box search goes below it
+    f = result.objective
+    assert all(f["dynid LAD"] <= f[k] + 1e-9 for k in ("dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"))
+    lo, hi = result.box.T
+    for o in result.others:
+        if o.key in ("lad", "abc", "abc10", "de", "pso"):
+            assert np.all(o.params >= lo - 1e-9) and np.all(o.params <= hi + 1e-9)
+    # the least-squares family recovers the truth on this simulated log
+    truth = result.base.base_from_standard(truth_robot.standard_parameters())
+    for o in result.others:
+        if o.key in ("ols", "irls", "lad"):
+            assert np.linalg.norm(o.params - truth) / np.linalg.norm(truth) < 0.02, o.key
+    # the same seed gives the same box searches
+    again = run_identification(config, validate=False)
+    for a, b in zip(result.others, again.others):
+        np.testing.assert_array_equal(a.params, b.params)
+    # dynid validate reads every set back from results.json
+    save_identification(result, tmp_path / "out")
+    stored = json.loads((tmp_path / "out" / "results.json").read_text())
+    comparisons, _ = run_validation(config, stored)
+    assert set(labels) <= set(comparisons[0].metrics())
+    np.testing.assert_allclose(comparisons[0].metrics()["dynid ABC"]["relative_error"],
+                               result.validations[0].metrics()["dynid ABC"]["relative_error"], rtol=1e-9)
+
+
+def test_unknown_method_in_the_config_names_the_field(tmp_path):
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('method = "ols"\n', 'methods = ["wls", "magic"]\n'))
+    with pytest.raises(ConfigError, match=r"config.toml: estimation.methods: expected .*got \['wls', 'magic'\]"):
+        load_identification_config(cfg)
