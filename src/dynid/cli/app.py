@@ -221,6 +221,28 @@ def _print_coulomb_choice(cv: dict) -> None:
     console.print(t)
 
 
+def _print_drive_gains(gp) -> None:
+    """Identified drive gains beside the description's, and the payload."""
+    g = gp.gains
+    t = Table(title=f"Drive gains K (eq. 16) from the runs without and with the {g.payload_mass:g} kg payload "
+                    f"(Gautier & Briot; {g.n_rows} equations)", box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("joint", "K identified (N·m/A)", "σ", "robot description", "difference %"):
+        t.add_column(col, justify="right", no_wrap=True)
+    for j, (k, s_, d) in enumerate(zip(g.gains, g.gains_std, gp.description_gains)):
+        if math.isfinite(k):
+            t.add_row(f"J{j + 1}", f"{k:.4g}", f"{s_:.2g}", f"{d:.4g}", f"{100 * (k - d) / d:+.1f}")
+        else:
+            t.add_row(f"J{j + 1}", "not observable", "", f"{d:.4g}", "")
+    console.print(t)
+    p = gp.payload
+    vals = dict(zip(p.names, zip(p.values, p.std)))
+    line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"
+    if "M" in vals and all(k in vals for k in ("MX", "MY", "MZ")):
+        com = [vals[k][0] / p.mass for k in ("MX", "MY", "MZ")]
+        line += ", centre of mass in the last link's frame (" + ", ".join(f"{c:.3g}" for c in com) + ") m"
+    console.print(line, soft_wrap=True)
+
+
 def _print_estimators(result) -> None:
     """Every estimator on the identification rows: F of eq. 9, evaluations, time; then the box's rule."""
     from ..experiment.identification import BOX_FRACTION, BOX_SIGMAS
@@ -276,6 +298,8 @@ def _print_identification(result, paths) -> None:
                       soft_wrap=True)
     if result.others:
         _print_estimators(result)
+    if result.drive_gains is not None:
+        _print_drive_gains(result.drive_gains)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)

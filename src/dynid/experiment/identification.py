@@ -188,6 +188,8 @@ class IdentificationResult:
         label -> F of eq. 9 on the identification rows [N·m] (when other estimators ran).
     box : (n_base, 2) array or None
         The box searches' box (:func:`search_box`).
+    drive_gains : dynid.experiment.drive_gains.GainsAndPayload or None
+        Drive gains and payload from ``[drive_gains]``.
     """
 
     robot: str
@@ -207,6 +209,7 @@ class IdentificationResult:
     others: tuple = ()
     objective: dict = field(default_factory=dict)
     box: np.ndarray | None = None
+    drive_gains: object = None
 
     @property
     def label(self) -> str:
@@ -251,6 +254,7 @@ class IdentificationResult:
             "methods": {o.label: {"key": o.key, "values": dict(zip(self.base.names, o.params.tolist())),
                                   "seconds": o.seconds, "n_evaluations": o.n_evaluations} for o in self.others},
             "objective_eq9": self.objective,
+            **({} if self.drive_gains is None else {"drive_gains": self.drive_gains.to_dict()}),
             **({} if self.box is None else {"search_box": {"rule": f"estimate ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|estimate|)",
                                                             "bounds": dict(zip(self.base.names, self.box.tolist()))}}),
             **({} if self.consistent is None else {"physically_consistent": {

@@ -30,6 +30,17 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     methods = ["wls", "sdp", "lad", "abc", "de", "pso", "irls"]   # optional: every estimator side by side
     seed = 0                             # seeds the box searches (ABC, ABC×10, DE, PSO)
 
+    [drive_gains]                        # optional: drive gains K (eq. 16) from a run without and one with a
+    payload_mass = 2.805                 # payload of known mass [kg] on the last link (Gautier & Briot), and
+    [drive_gains.unloaded]               # the payload's inertial parameters; both dataset tables hold currents
+    preset = "ur-rtde"
+    file = "identification_data/ur-20_02_19_14harm50sec.csv"
+    rows = [195, 4966]
+    [drive_gains.loaded]
+    preset = "ur-rtde"
+    file = "identification_data/ur-20_02_19_14harm50secLoad.csv"
+    rows = [308, 5071]
+
     [[validation]]                       # dataset tables, each with a name
     name = "ptp_10_points"
     preset = "ur-rtde"
@@ -61,6 +72,7 @@ from ..io.trajectories import load_trajectory
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare
 from ..validation.cross_validation import choose_coulomb_velocity
+from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
 from .methods import parse_methods
 from .identification import METHODS, IdentificationResult, TorqueComparison, compare_torques, identify, parameter_sets
 
@@ -82,6 +94,7 @@ class IdentificationConfig:
     physically_consistent: bool = False
     methods: tuple[str, ...] = ()
     seed: int = 0
+    drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
 
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
@@ -153,7 +166,7 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     """
     path = Path(path)
     doc = read_config(path, {"robot", "data_root", "identification", "validation", "preprocessing", "estimation",
-                             "references", "name", "notes"})
+                             "references", "name", "notes", "drive_gains"})
     here = path.parent
     robot = config_robot(doc, path)
     override = data_root or os.environ.get(DATA_ROOT_ENV)
@@ -201,8 +214,31 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     refs = doc.get("references", [])
     if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
         raise ConfigError(f"{path}: references: expected [[references]] tables")
+    gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent or "sdp" in methods,
-                                methods, seed)
+                                methods, seed, gains)
+
+
+def _drive_gains(table, root: Path, where: str, n: int):
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ConfigError(f"{where}: expected a table with payload_mass, [unloaded] and [loaded]")
+    unknown = sorted(set(table) - {"payload_mass", "unloaded", "loaded"})
+    missing = sorted({"payload_mass", "unloaded", "loaded"} - set(table))
+    if unknown or missing:
+        raise ConfigError(f"{where}: expected payload_mass, unloaded and loaded; "
+                          + (f"unknown {', '.join(unknown)}" if unknown else f"missing {', '.join(missing)}"))
+    mass = table["payload_mass"]
+    if isinstance(mass, bool) or not isinstance(mass, (int, float)) or not mass > 0:
+        raise ConfigError(f"{where}.payload_mass: expected a positive mass in kg, got {mass!r}")
+    specs = []
+    for key in ("unloaded", "loaded"):
+        spec = dataset_spec(table[key], root, f"{where}.{key}", key, n)
+        if "currents" not in spec.signals:
+            raise ConfigError(f"{where}.{key}: expected motor currents (a currents column map or a preset with currents)")
+        specs.append(spec)
+    return float(mass), specs[0], specs[1]
 
 
 def _stored_preprocessing(identified: dict) -> Preprocessing | None:
@@ -222,6 +258,18 @@ def _references(config: IdentificationConfig, base):
     nominal = config.robot.standard_parameters()
     return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base, nominal)
                  for i, r in enumerate(config.references))
+
+
+def _gains_and_payload(config: IdentificationConfig, robot, base):
+    """Drive gains from the two runs, then the payload from the loaded run with those gains."""
+    mass, unloaded, loaded = config.drive_gains
+    unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
+    pre_u = prepare(load_recording(unloaded, unit), config.preprocessing)
+    pre_l = prepare(load_recording(loaded, unit), config.preprocessing)
+    gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
+    k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
+    payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
+    return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
 def validation_settings(given: Preprocessing, resolved: Preprocessing | None) -> Preprocessing:
@@ -274,6 +322,8 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()})})
+    if config.drive_gains is not None:
+        result = replace(result, drive_gains=_gains_and_payload(config, robot, base))
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,
