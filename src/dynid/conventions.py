@@ -11,31 +11,40 @@ followed by the drive terms the robot declares (a subset of ``DRIVE_TERMS``, in 
 
 from __future__ import annotations
 
+from . import friction
+
 INERTIAL_TERMS: tuple[str, ...] = ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M")
 """Inertial parameters of one link, paper eq. 5 order (inertia about the link origin, first moments, mass)."""
 
-DRIVE_TERMS: tuple[str, ...] = ("Ia", "fc", "fv", "offset")
-"""Per-joint drive terms: rotor inertia, Coulomb friction, viscous friction, torque offset (eq. 3)."""
+DRIVE_TERMS: tuple[str, ...] = friction.term_names()
+"""Per-joint drive terms (:data:`dynid.friction.TERMS`): rotor inertia, Coulomb, viscous, offset, Stribeck."""
 
 COUPLING_TERMS: tuple[str, ...] = ("Iam", "fvm", "fcm")
 """Parameters of a motor that turns with several joints (coupled wrist): inertia, viscous and Coulomb
 friction, in joint units (see :mod:`dynid.model.transmission`). Named after the motor: ``Iam6``."""
 
-DEFAULT_DRIVE_TERMS: tuple[str, ...] = ("fc", "fv")
+DEFAULT_DRIVE_TERMS: tuple[str, ...] = friction.DEFAULT_TERMS
 """The paper's friction model (eq. 3): Coulomb and viscous friction."""
 
 UNITS: dict[str, str] = {
     "XX": "kg·m²", "XY": "kg·m²", "XZ": "kg·m²", "YY": "kg·m²", "YZ": "kg·m²", "ZZ": "kg·m²",
     "MX": "kg·m", "MY": "kg·m", "MZ": "kg·m", "M": "kg",
-    "Ia": "kg·m²", "fc": "N·m", "fv": "N·m·s/rad", "offset": "N·m",
     "Iam": "kg·m²", "fvm": "N·m·s/rad", "fcm": "N·m",
 }
+"""Units of the inertial and coupled-motor terms; drive terms take theirs from :data:`dynid.friction.TERMS`."""
 
 ALIASES: dict[str, str] = {
     "Ixx": "XX", "Ixy": "XY", "Ixz": "XZ", "Iyy": "YY", "Iyz": "YZ", "Izz": "ZZ",
-    "mx": "MX", "my": "MY", "mz": "MZ", "m": "M", "fs": "fc", "f0": "offset", "off": "offset",
-    "Fc": "fc", "Fv": "fv", "fsm": "fcm",
+    "mx": "MX", "my": "MY", "mz": "MZ", "m": "M", "fsm": "fcm",
 }
+"""Other spellings of the inertial and coupled-motor terms; drive terms' come from :data:`dynid.friction.TERMS`."""
+
+
+def _alias(term: str) -> str:
+    for t in friction.TERMS.values():
+        if term in t.aliases:
+            return t.name
+    return ALIASES.get(term, term)
 """Other spellings of the terms found in published parameter sets (FIGAROH, MATLAB toolboxes)."""
 
 
@@ -71,8 +80,8 @@ def canonical_name(name: str) -> str:
     term, joint = text[:i], text[i:]
     if term == "f" and joint.startswith("0"):
         return f"offset{int(joint[1:])}"
-    term = ALIASES.get(term, term)
-    known = set(INERTIAL_TERMS) | set(DRIVE_TERMS) | set(COUPLING_TERMS)
+    term = _alias(term)
+    known = set(INERTIAL_TERMS) | set(friction.TERMS) | set(COUPLING_TERMS)
     if term not in known:
         raise ValueError(f"unknown parameter term {text[:i]!r} in {name!r}")
     return f"{term}{int(joint)}"
@@ -81,4 +90,4 @@ def canonical_name(name: str) -> str:
 def unit_of(name: str) -> str:
     """Unit of a (standard or base) parameter from its leading term, e.g. ``"ZZ1R" -> "kg·m²"``."""
     term, _ = split_name(name)
-    return UNITS.get(term, "")
+    return friction.TERMS[term].unit if term in friction.TERMS else UNITS.get(term, "")

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dynid.dynamics.friction import coulomb_column
+from dynid.friction import coulomb_column
 from dynid.dynamics.regressor import regressor
 from dynid.dynamics.rnea import pinocchio_model
 from dynid.model.description import load_robot
@@ -33,3 +33,79 @@ def test_regressor_with_smooth_coulomb_equals_rnea_plus_friction(rng):
     smooth = np.where(vs > 0, np.tanh(dq / np.where(vs > 0, vs, 1.0)), np.sign(dq))
     expect = rb + drive[:, 0] * ddq + drive[:, 1] * smooth + drive[:, 2] * dq + drive[:, 3]
     np.testing.assert_allclose(regressor(robot, q, dq, ddq) @ robot.standard_parameters(), expect, atol=1e-9)
+
+
+def test_smooth_coulomb_and_stribeck_derivatives_match_finite_differences(rng):
+    from dynid.dynamics.sensitivity import regressor_state_derivatives
+
+    robot = load_robot("er16").submodel(3)
+    robot = replace(robot, drive_terms=("Ia", "fc", "fv", "fst"), drive=np.ones((3, 4)), drive_mask=None,
+                    coulomb_velocity=np.array([0.0, 0.05, 0.2]), stribeck_velocity=np.array([0.1, 0.2, 0.3]))
+    q, dq, ddq = (rng.uniform(-0.5, 0.5, (6, 3)) for _ in range(3))
+    y, d = regressor_state_derivatives(robot, q, dq, ddq)
+    h = 1e-6
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = h
+        fd = (regressor(robot, q, dq + e, ddq) - regressor(robot, q, dq - e, ddq)) / (2 * h)
+        np.testing.assert_allclose(d[1, i], fd, atol=1e-6)
+
+
+def test_adding_a_friction_term_is_one_table_entry(monkeypatch, rng):
+    """A new term registered in dynid.friction.TERMS alone (here quadratic drag fq·dq·|dq|) reaches the
+    description parser, the names and units, the regressor (checked against RNEA + the formula), the
+    simulator's friction torques, the constrained estimators' layout and the sensitivities."""
+    import pinocchio as pin
+
+    from dynid import friction
+    from dynid.conventions import canonical_name, unit_of
+    from dynid.dynamics.layout import consistency_layout
+    from dynid.dynamics.regressor import friction_torques
+    from dynid.dynamics.sensitivity import regressor_state_derivatives
+    from dynid.model.description import robot_from_toml_text
+
+    term = friction.FrictionTerm("fq", "N·m·s²/rad²", True, lambda dq, ddq, v: dq * np.abs(dq),
+                                 lambda dq, v: 2 * np.abs(dq), 0.0, ("Fq",), "quadratic drag")
+    monkeypatch.setitem(friction.TERMS, "fq", term)
+    text = """drive_terms = ["fv", "fq"]
+[[joints]]
+alpha = 0.0
+mass = 2.0
+com = [0.1, 0.0, 0.0]
+inertia = [0.01, 0.02, 0.02, 0, 0, 0]
+fv = 0.5
+fq = 0.3
+[[joints]]
+alpha = "pi/2"
+a = 0.3
+mass = 1.0
+com = [0.1, 0.0, 0.0]
+inertia = [0.01, 0.01, 0.01, 0, 0, 0]
+fv = 0.2
+fq = 0.1
+"""
+    robot = robot_from_toml_text(text, "arm.toml", None)
+    assert robot.parameter_names[10:12] == ("fv1", "fq1") and unit_of("fq2") == "N·m·s²/rad²"
+    assert canonical_name("Fq2") == "fq2"
+    q, dq, ddq = (rng.uniform(-1, 1, (20, 2)) for _ in range(3))
+    model = pinocchio_model(robot)
+    data = model.createData()
+    rb = np.array([pin.rnea(model, data, a, b, c) for a, b, c in zip(q, dq, ddq)])
+    drag = np.array([0.5, 0.2]) * dq + np.array([0.3, 0.1]) * dq * np.abs(dq)
+    np.testing.assert_allclose(regressor(robot, q, dq, ddq) @ robot.standard_parameters(), rb + drag, atol=1e-10)
+    np.testing.assert_allclose(friction_torques(robot, dq, ddq), drag, atol=1e-12)
+    _, nonneg = consistency_layout(robot)
+    assert [robot.parameter_names[k] for k in nonneg] == ["fv1", "fq1", "fv2", "fq2"]
+    _, d = regressor_state_derivatives(robot, q, dq, ddq)
+    np.testing.assert_allclose(d[1, 0, :, 0, 11], 2 * np.abs(dq[:, 0]))
+
+
+def test_an_unknown_term_is_an_error_never_an_offset():
+    import pytest
+
+    from dynid.exceptions import ConfigError
+    from dynid.model.description import robot_from_toml_text
+
+    with pytest.raises(ConfigError, match=r"arm.toml: drive_terms: unknown drive term\(s\) \['stiction'\]"):
+        robot_from_toml_text('drive_terms = ["fc", "stiction"]\n[[joints]]\nmass = 1.0\ncom = [0, 0, 0]\n'
+                             'inertia = [0.1, 0.1, 0.1, 0, 0, 0]\n', "arm.toml", None)

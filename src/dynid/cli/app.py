@@ -69,7 +69,7 @@ def run(
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
     from ..experiment import PaperExperimentConfig, run_paper_experiment
-    from ..experiment.methods import LABELS, parse_methods
+    from ..experiment.method_names import LABELS, parse_methods
     from ..report.paper_run import save_paper_run
 
     try:
@@ -97,7 +97,7 @@ def _joined(values, fmt: str) -> str:
 def _print_run(result, paths) -> None:
     from ..estimators.physically_consistent import CONSISTENCY_TOL
     from ..experiment import paper_reference as ref
-    from ..experiment.methods import DESCRIPTIONS, LABELS
+    from ..experiment.method_names import DESCRIPTIONS, LABELS
 
     d = result.to_dict()
     methods = {LABELS[k]: v for k, v in d["methods"].items()}
@@ -315,10 +315,10 @@ def identify(
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
     from ..experiment.identification_config import load_identification_config, run_identification
-    from ..report.identification_run import save_identification
 
     try:
-        cfg = load_identification_config(config, data_root)
+        cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
+        from ..report.identification_run import save_identification
         with _progress("regressor") as progress:
             task = progress.add_task("x", total=1)
             result = run_identification(cfg, progress=lambda done, total: progress.update(task, completed=done, total=total),
@@ -353,10 +353,10 @@ def validate(
 
     from ..exceptions import DataError
     from ..experiment.identification_config import dataset_for_file, load_identification_config, run_validation
-    from ..report.identification_run import save_validation
 
     try:
         cfg = load_identification_config(config, data_root)
+        from ..report.identification_run import save_validation
         try:
             identified = json.loads(results.read_text(encoding="utf-8"))
         except FileNotFoundError:
@@ -392,10 +392,10 @@ def excite(
     from dataclasses import replace
 
     from ..experiment.excitation_config import load_excitation_config, run_excitation
-    from ..report.excitation_run import save_excitation
 
     try:
         cfg = load_excitation_config(config)
+        from ..report.excitation_run import save_excitation
         cfg = replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
         with Progress(TextColumn("[bold]design[/]"), BarColumn(), TextColumn("{task.completed}/{task.total} starts"),
                       TextColumn("best cond = {task.fields[best]}"), TimeElapsedColumn(), console=console) as progress:
@@ -463,7 +463,7 @@ def montecarlo(
     out: Path = typer.Option(Path("dynid-montecarlo"), help="Output folder for montecarlo.json, the estimates CSV and figures."),
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
-    from ..experiment.methods import parse_methods
+    from ..experiment.method_names import parse_methods
     from ..experiment.montecarlo import DEFAULT_METHODS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 

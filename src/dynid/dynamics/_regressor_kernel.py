@@ -14,33 +14,16 @@ CHUNK = 256
 
 
 @nb.njit(cache=True, fastmath=False, boundscheck=False)
-def _chunk(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
+def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
     n = q.shape[1]
-    nd = drive_codes.shape[0]
     for k in range(start, stop):
-        # ---- zero entries that stay zero: links j < i, and other joints' drive columns -----
+        # ---- zero entries that stay zero: links j < i, and every drive column (filled by the caller
+        #      from the friction table, dynid.friction) -----
         for i in range(n):
             for col in range(i * npj):
                 out[k, i, col] = 0.0
             for col in range(i * npj + 10, n * npj):
                 out[k, i, col] = 0.0
-            # drive terms of joint i (eq. 3): Ia·ddq, fc·sign(dq) (or tanh(dq/v_s)), fv·dq, offset
-            for t in range(nd):
-                code = drive_codes[t]
-                if code == 0:
-                    val = ddq[k, i]
-                elif code == 1:
-                    if coulomb_velocity[i] > 0:
-                        val = np.tanh(dq[k, i] / coulomb_velocity[i])
-                    else:
-                        val = 1.0 if dq[k, i] > 0 else (-1.0 if dq[k, i] < 0 else 0.0)
-                elif code == 2:
-                    val = dq[k, i]
-                elif code == 3:
-                    val = 1.0
-                else:
-                    val = np.nan  # unknown term: never silently an offset
-                out[k, i, i * npj + 10 + t] = val
         # ---- forward recursion -------------------------------------------------------------
         for j in range(n):
             ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
@@ -139,9 +122,9 @@ def _chunk(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out
 
 
 @nb.njit(cache=True, parallel=True)
-def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj):
-    """Fill every entry of ``out`` (N, n, n*npj); ``drive_codes`` lists the drive terms (0 Ia, 1 fc, 2 fv, 3 offset),
-    ``coulomb_velocity`` (n,) the Coulomb smoothing velocities (0: sign)."""
+def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj):
+    """Fill every entry of ``out`` (N, n, n*npj): the ten inertial columns of each link, and 0 in the
+    drive columns (the caller fills those from :mod:`dynid.friction`)."""
     n_s, n = q.shape
     n_chunks = (n_s + CHUNK - 1) // CHUNK
     for c in nb.prange(n_chunks):
@@ -152,4 +135,4 @@ def joint_torque_regressor(rp, pp, axes, gravity, drive_codes, coulomb_velocity,
         acc = np.empty((n, 3))
         z0 = np.empty((n, 3))
         rl = np.empty((3, 3))
-        _chunk(rp, pp, axes, gravity, drive_codes, coulomb_velocity, q, dq, ddq, out, npj, c * CHUNK, min((c + 1) * CHUNK, n_s), r0, o, w, dw, acc, z0, rl)
+        _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, c * CHUNK, min((c + 1) * CHUNK, n_s), r0, o, w, dw, acc, z0, rl)

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..friction import nonnegative_terms
 from ..model.robot import Robot
 
-NONNEGATIVE_TERMS = ("Ia", "fc", "fv", "Iam", "fcm", "fvm")
-"""Drive terms that are physically non-negative: rotor inertias, Coulomb and viscous friction."""
+COUPLED_NONNEGATIVE = ("Iam", "fcm", "fvm")
+"""Coupled-motor terms that are physically non-negative (the drive terms' flags are in dynid.friction)."""
 
 
 def consistency_layout(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
@@ -17,7 +18,8 @@ def consistency_layout(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     -------
     links : (n_dof, 10) int array
     nonnegative : (k,) int array
-        Columns of the drive terms in :data:`NONNEGATIVE_TERMS` that the joint has.
+        Columns of the non-negative drive terms (:func:`dynid.friction.nonnegative_terms`) that the joint
+        has, and of the coupled motors' (:data:`COUPLED_NONNEGATIVE`).
     """
     npj = robot.n_params_per_joint
     links = np.array([np.arange(10) + j * npj for j in range(robot.n_dof)], dtype=int)
@@ -25,7 +27,7 @@ def consistency_layout(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     nonneg = []
     for k, name in enumerate(names):
         term = name.rstrip("0123456789")
-        if term in NONNEGATIVE_TERMS:
+        if term in nonnegative_terms() or term in COUPLED_NONNEGATIVE:
             j = int(name[len(term):]) - 1
             if k >= robot.n_dof * npj or robot.drive_mask[j, robot.drive_terms.index(term)]:
                 nonneg.append(k)

@@ -17,9 +17,8 @@ import numpy as np
 
 from ..checks import check_states
 from ..model.robot import Robot
-from ..conventions import DRIVE_TERMS
+from ..friction import drive_columns
 from ._regressor_kernel import joint_torque_regressor
-from .friction import coulomb_column
 
 
 def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
@@ -60,12 +59,12 @@ def _fill(robot: Robot, q, dq, ddq, out) -> None:
     pp = np.ascontiguousarray([jt.translation for jt in robot.joints], dtype=np.float64)
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
-    codes = np.array([DRIVE_TERMS.index(t) for t in robot.drive_terms], dtype=np.int64)
     npj = robot.n_params_per_joint
-    vs = np.ascontiguousarray(robot.coulomb_velocity, dtype=np.float64)
-    joint_torque_regressor(rp, pp, axes, gravity, codes, vs, q, dq, ddq, out, npj)
-    for i, t in zip(*np.nonzero(~robot.drive_mask)):  # terms a joint does not have
-        out[:, i, i * npj + 10 + t] = 0.0
+    joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj)
+    if robot.drive_terms:  # each joint's own drive terms, from the friction table
+        cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
+        for i in range(robot.n_dof):
+            out[:, i, i * npj + 10:(i + 1) * npj] = cols[:, i]
     n_joint = robot.n_dof * npj
     if out.shape[2] > n_joint:  # coupled motors (see dynid.model.transmission)
         out[:, :, n_joint:] = robot.transmission.coupling_columns(dq, ddq)
@@ -77,10 +76,8 @@ def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.nd
     (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values."""
     drive = robot.drive if drive is None else drive
     coupled = robot.transmission.coupled_values if coupled is None else coupled
-    columns = {"Ia": ddq, "fc": coulomb_column(dq, robot.coulomb_velocity), "fv": dq, "offset": np.ones_like(dq)}
-    tau = np.zeros_like(dq)
-    for k, term in enumerate(robot.drive_terms):
-        tau += (drive[:, k] * robot.drive_mask[:, k]) * columns[term]
+    cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities)
+    tau = np.einsum("njt,jt->nj", cols, drive * robot.drive_mask) if robot.drive_terms else np.zeros_like(np.asarray(dq, dtype=float))
     if robot.transmission.n_coupled_params:
         tau += robot.transmission.coupling_columns(dq, ddq) @ np.ravel(coupled)
     return tau

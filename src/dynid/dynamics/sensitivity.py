@@ -7,8 +7,8 @@ finite differences of the whole design problem per coefficient.
 
 The regressor is linear in ``ddq`` (difference of step 1, exact) and quadratic in ``dq`` (central
 difference, exact up to round-off); in ``q`` it is smooth, and a central difference of step
-``1e-6 rad`` has a relative error of about 1e-9. Coulomb columns ``sign(dq)`` get derivative 0, their
-derivative almost everywhere.
+``1e-6 rad`` has a relative error of about 1e-9. The drive/friction columns take their analytic
+derivatives from :mod:`dynid.friction` (``sign(dq)``: 0, its derivative almost everywhere).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import numpy as np
 from ..checks import check_states, check_trajectory_array
 from ..model.robot import Robot
 from .kinematics import forward_kinematics
+from ..friction import drive_column_derivatives
 from .regressor import regressor
 
 Q_STEP = 1e-6
@@ -25,8 +26,8 @@ Q_STEP = 1e-6
 
 
 def coulomb_columns(robot: Robot) -> np.ndarray:
-    """Indices of the standard parameters multiplying ``sign(dq)`` (``fc#`` and coupled ``fcm#``)."""
-    return np.array([k for k, n in enumerate(robot.parameter_names) if n.startswith("fc")], dtype=int)
+    """Indices of the standard parameters multiplying ``sign`` of a coupled motor's velocity (``fcm#``)."""
+    return np.array([k for k, n in enumerate(robot.parameter_names) if n.startswith("fcm")], dtype=int)
 
 
 def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, np.ndarray]:
@@ -66,6 +67,14 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
     d[2] = y_all[4 * n + 1:] - y
     fc = coulomb_columns(robot)
     d[:2, ..., fc] = 0.0
+    if robot.drive_terms:  # drive columns: analytic derivatives from the friction table
+        d_dq, d_ddq = drive_column_derivatives(robot.drive_terms, dq, robot.friction_velocities)
+        npj = robot.n_params_per_joint
+        for i in range(n):
+            block = slice(i * npj + 10, (i + 1) * npj)
+            d[:, :, :, i, block] = 0.0
+            d[1, i, :, i, block] = d_dq[:, i] * robot.drive_mask[i]
+            d[2, i, :, i, block] = d_ddq[:, i] * robot.drive_mask[i]
     return y, d
 
 

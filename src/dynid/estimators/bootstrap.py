@@ -16,7 +16,12 @@ from typing import Callable
 import numpy as np
 
 from ..exceptions import ConfigError
+from .accumulate import LeastSquaresAccumulator
 from .base import Estimator, check_observations
+from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+
+GRAM_CHUNK = 4096
+"""Samples per step when the per-sample Gram matrices are weighted by the resample counts."""
 
 
 @dataclass(frozen=True)
@@ -88,13 +93,49 @@ def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: 
     rng = np.random.default_rng(rng)
     n_blocks = -(-n // length)
     w3, tau2 = w.reshape(n, n_dof, -1), tau.reshape(n, n_dof)
-    samples = []
+    resamples = []
     for _ in range(n_resamples):
         starts = rng.integers(0, n - length + 1, n_blocks)
-        idx = (starts[:, None] + np.arange(length)).ravel()[:n]
-        est = make_estimator().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel())
-        samples.append(est.params_)
-    samples = np.array(samples)
+        resamples.append((starts[:, None] + np.arange(length)).ravel()[:n])
+    template = make_estimator()
+    if type(template) in (OrdinaryLeastSquares, WeightedLeastSquares):
+        samples = _least_squares_resamples(template, w3, tau2, resamples)
+    else:
+        samples = np.array([make_estimator().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel()).params_
+                            for idx in resamples])
     alpha = 100 * (1 - level) / 2
     lower, upper = np.percentile(samples, [alpha, 100 - alpha], axis=0)
     return BootstrapIntervals(samples, lower, upper, samples.std(axis=0, ddof=1), level, length)
+
+
+def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resamples) -> np.ndarray:
+    """OLS/WLS refits of every resample without refactorising it: a resample repeats sample ``s`` ``c_s``
+    times, so each joint's Gram matrix of ``[W | τ]`` is ``Σ_s c_s G_s``; all resamples at once are one
+    matrix product of the counts (B, N) with the per-sample Grams (N, ·), chunk by chunk. Its Cholesky
+    factor is the triangular factor the incremental QR would reach (:class:`LeastSquaresAccumulator`),
+    so the solve, its rank check and the WLS weights are those of the estimator itself (to round-off)."""
+    n, n_dof, p = w3.shape
+    counts = np.array([np.bincount(idx, minlength=n) for idx in resamples], dtype=float)  # (B, N)
+    aug = np.concatenate([w3, tau2[..., None]], axis=2)  # (N, n_dof, p+1)
+    grams = np.zeros((len(resamples), n_dof * (p + 1) ** 2))
+    for a in range(0, n, GRAM_CHUNK):
+        block = aug[a:a + GRAM_CHUNK]
+        per_sample = np.einsum("sjp,sjq->sjpq", block, block).reshape(block.shape[0], -1)
+        grams += counts[:, a:a + GRAM_CHUNK] @ per_sample
+    grams = grams.reshape(len(resamples), n_dof, p + 1, p + 1)
+    out = []
+    for g, idx in zip(grams, resamples):
+        acc = LeastSquaresAccumulator(p, n_dof)
+        try:
+            acc.factors[:] = [np.linalg.cholesky(gj).T for gj in g]
+        except np.linalg.LinAlgError:  # a residual of exactly zero: refactorise this resample
+            est = template.clone().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel())
+            out.append(est.params_)
+            continue
+        acc.rows[:] = n
+        ols = acc.solve(rcond=template.rcond)
+        if isinstance(template, WeightedLeastSquares):
+            std = acc.joint_residual_std(ols.params)
+            ols = acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=template.rcond)
+        out.append(ols.params)
+    return np.array(out)

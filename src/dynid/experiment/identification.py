@@ -79,7 +79,7 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
 
 def estimate_label(method: str) -> str:
     """How dynid's estimate is labelled in tables, figures and JSON: ``"dynid WLS"``, ``"dynid ABC×10"``."""
-    from .methods import LABELS
+    from .method_names import LABELS
 
     return f"dynid {LABELS.get(method, method.upper())}"
 

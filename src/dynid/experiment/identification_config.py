@@ -63,18 +63,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.base_parameters import base_parameters
 from ..exceptions import ConfigError, DataError
-from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
 from ..io.configs import config_robot, read_config
-from ..io.references import load_reference
+from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
 from ..io.trajectories import load_trajectory
 from ..model.robot import Robot
-from ..preprocessing.pipeline import Preprocessing, prepare
-from ..validation.cross_validation import choose_coulomb_velocity
-from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
-from .methods import parse_methods
-from .identification import METHODS, IdentificationResult, TorqueComparison, compare_torques, identify, parameter_sets
+from ..preprocessing.settings import Preprocessing
+from .method_names import parse_methods
+
+# Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
+# is reported at once; the identification itself imports them when it runs.
+
+METHODS = ("ols", "wls")
+"""The least-squares estimate that carries σ (``[estimation] method``)."""
 
 DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
@@ -255,6 +256,8 @@ def _stored_preprocessing(identified: dict) -> Preprocessing | None:
 
 
 def _references(config: IdentificationConfig, base):
+    from ..io.references import load_reference
+
     nominal = config.robot.standard_parameters()
     return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base, nominal)
                  for i, r in enumerate(config.references))
@@ -262,6 +265,9 @@ def _references(config: IdentificationConfig, base):
 
 def _gains_and_payload(config: IdentificationConfig, robot, base):
     """Drive gains from the two runs, then the payload from the loaded run with those gains."""
+    from ..preprocessing.pipeline import prepare
+    from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
+
     mass, unloaded, loaded = config.drive_gains
     unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
     pre_u = prepare(load_recording(unloaded, unit), config.preprocessing)
@@ -282,7 +288,10 @@ def validation_settings(given: Preprocessing, resolved: Preprocessing | None) ->
 
 
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
-              progress=None, resolved: Preprocessing | None = None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
+              progress=None, resolved: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
+    from ..preprocessing.pipeline import prepare
+    from .identification import compare_torques
+
     out, warnings = [], []
     settings = validation_settings(config.preprocessing, resolved)
     for spec in datasets:
@@ -310,9 +319,19 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
                    rows=None if rows is None else tuple(rows))
 
 
-def run_identification(config: IdentificationConfig, progress=None, validate: bool = True) -> IdentificationResult:
+def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
     """Identify the base parameters from the config's identification dataset, then validate them on
-    each validation dataset beside the reference sets."""
+    each validation dataset beside the reference sets.
+
+    Returns
+    -------
+    dynid.experiment.identification.IdentificationResult
+    """
+    from ..dynamics.base_parameters import base_parameters
+    from ..preprocessing.pipeline import prepare
+    from ..validation.cross_validation import choose_coulomb_velocity
+    from .identification import identify
+
     base = base_parameters(config.robot, rng=0)
     refs = _references(config, base)
     data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
@@ -332,7 +351,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
 
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
-                   progress=None) -> tuple[tuple[TorqueComparison, ...], tuple[str, ...]]:
+                   progress=None) -> tuple[tuple, tuple[str, ...]]:
     """Validate identified base parameters (``identified``: results.json of ``dynid identify``) and the
     config's reference sets on the config's validation datasets (or on ``datasets``).
 
@@ -341,6 +360,9 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     DataError
         The results do not belong to this robot (different base parameters).
     """
+    from ..dynamics.base_parameters import base_parameters
+    from .identification import parameter_sets
+
     base = base_parameters(config.robot, rng=0)
     try:
         names = [p["name"] for p in identified["base_parameters"]]

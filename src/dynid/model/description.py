@@ -6,7 +6,7 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     convention = "modified"        # "modified" (Khalil/Craig) | "standard" | "urdf"
     urdf = "robot.urdf"            # with convention = "urdf", relative to this file
     gravity = [0.0, 0.0, -9.81]    # m/s², base frame
-    drive_terms = ["fc", "fv"]     # identified per joint, subset of Ia, fc, fv, offset
+    drive_terms = ["fc", "fv"]     # identified per joint: names of dynid.friction.TERMS (Ia, fc, fv, offset, fst)
     notes = "where the numbers come from"
 
     [tool]                         # flange in the last link frame (optional)
@@ -36,6 +36,7 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     inertia = [2.0, 2.0, 1.5, 0.0, 0.0, 0.0]   # about the COM: Ixx, Iyy, Izz, Ixy, Ixz, Iyz
     fc = 8.0                       # one value per drive term
     fv = 5.0
+    stribeck_velocity = 0.01       # rad/s, for the Stribeck term fst (default 0.01)
 """
 
 from __future__ import annotations
@@ -47,7 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS, DRIVE_TERMS
+from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS
+from ..friction import DEFAULT_STRIBECK_VELOCITY, check_terms
 from ..exceptions import ConfigError
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot
@@ -128,11 +130,13 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     convention = doc.get("convention", "modified")
     if convention not in ("modified", "standard", "urdf"):
         raise ConfigError(f"{source}: convention: expected 'modified', 'standard' or 'urdf', got {convention!r}")
-    terms = tuple(doc.get("drive_terms", DEFAULT_DRIVE_TERMS))
-    bad = [t for t in terms if t not in DRIVE_TERMS]
-    if bad:
-        raise ConfigError(f"{source}: drive_terms: unknown term(s) {bad}, expected a subset of {list(DRIVE_TERMS)}")
-    terms = tuple(t for t in DRIVE_TERMS if t in terms)
+    terms = doc.get("drive_terms", DEFAULT_DRIVE_TERMS)
+    if not isinstance(terms, (list, tuple)) or not all(isinstance(t, str) for t in terms):
+        raise ConfigError(f"{source}: drive_terms: expected a list of term names, got {terms!r}")
+    try:
+        terms = check_terms(terms, f"{source}: drive_terms")
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
     rows = doc.get("joints")
     if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
         raise ConfigError(f"{source}: expected one or more [[joints]] tables")
@@ -213,7 +217,16 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
         notes=str(doc.get("notes", "")), transmission=transmission, drive_mask=mask, nominal_problems=problems,
+        stribeck_velocity=_positive([_number(r, "stribeck_velocity", w, DEFAULT_STRIBECK_VELOCITY) for r, w in zip(rows, where)],
+                                    [f"{w}.stribeck_velocity" for w in where]),
     )
+
+
+def _positive(values, fields) -> np.ndarray:
+    for v, f in zip(values, fields):
+        if not v > 0:
+            raise ConfigError(f"{f}: expected a positive velocity (rad/s), got {v}")
+    return np.array(values)
 
 
 def _transmission(table, n: int, offsets: np.ndarray, source: str) -> Transmission:

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..conventions import DEFAULT_DRIVE_TERMS, DRIVE_TERMS, INERTIAL_TERMS, parameter_name
+from ..conventions import DEFAULT_DRIVE_TERMS, INERTIAL_TERMS, parameter_name
+from ..friction import DEFAULT_STRIBECK_VELOCITY, Velocities, check_terms
 from ..exceptions import ConfigError
 from .spatial import transform_inertial
 from .transmission import Transmission
@@ -90,7 +91,9 @@ class Robot:
         description is accepted; :meth:`require_physical_nominal` refuses it where they are used.
     coulomb_velocity : (n_dof,) array [rad/s]
         Smoothing velocity ``v_s`` of each joint's Coulomb term: its column is ``tanh(dq/v_s)`` (still
-        linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.dynamics.friction`.
+        linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.friction`.
+    stribeck_velocity : (n_dof,) array [rad/s]
+        Stribeck velocity of the ``fst`` term (default :data:`dynid.friction.DEFAULT_STRIBECK_VELOCITY`).
     """
 
     name: str
@@ -108,6 +111,12 @@ class Robot:
     drive_mask: np.ndarray | None = None
     coulomb_velocity: np.ndarray | None = None
     nominal_problems: tuple[str, ...] = ()
+    stribeck_velocity: np.ndarray | None = None
+
+    @property
+    def friction_velocities(self) -> Velocities:
+        """The per-joint velocities the friction columns use (:mod:`dynid.friction`)."""
+        return Velocities(self.coulomb_velocity, self.stribeck_velocity)
 
     def require_physical_nominal(self, use: str) -> None:
         """Raise :class:`ConfigError` naming link and rule when the nominal inertial parameters, needed
@@ -128,6 +137,10 @@ class Robot:
         if vs.shape != (n,) or not np.all(np.isfinite(vs)) or np.any(vs < 0):
             raise ConfigError(f"robot {self.name!r}: coulomb_velocity: expected {n} non-negative velocities (rad/s), got {self.coulomb_velocity!r}")
         object.__setattr__(self, "coulomb_velocity", vs)
+        vst = np.full(n, DEFAULT_STRIBECK_VELOCITY) if self.stribeck_velocity is None else np.array(self.stribeck_velocity, dtype=float).reshape(-1)
+        if vst.shape != (n,) or not np.all(np.isfinite(vst)) or np.any(vst <= 0):
+            raise ConfigError(f"robot {self.name!r}: stribeck_velocity: expected {n} positive velocities (rad/s), got {self.stribeck_velocity!r}")
+        object.__setattr__(self, "stribeck_velocity", vst)
         if self.transmission is None:
             object.__setattr__(self, "transmission", Transmission.identity(n))
         if self.transmission.n_dof != n:
@@ -140,14 +153,15 @@ class Robot:
             raise ConfigError(f"robot {self.name!r}: expected at least one joint, got none")
         if self.inertial.shape != (n, 10):
             raise ConfigError(f"robot {self.name!r}: expected inertial parameters of shape ({n}, 10), got {self.inertial.shape}")
-        unknown = [t for t in self.drive_terms if t not in DRIVE_TERMS]
-        if unknown:
-            raise ConfigError(f"robot {self.name!r}: unknown drive term(s) {unknown}, expected a subset of {list(DRIVE_TERMS)}")
+        try:
+            check_terms(self.drive_terms, f"robot {self.name!r}")
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
         if self.drive.shape != (n, len(self.drive_terms)):
             raise ConfigError(f"robot {self.name!r}: expected drive parameters of shape ({n}, {len(self.drive_terms)}), got {self.drive.shape}")
         if np.any(self.drive[~mask] != 0):
             raise ConfigError(f"robot {self.name!r}: a drive term a joint does not have must have the value 0")
-        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask, vs):
+        for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask, vs, vst):
             a.setflags(write=False)
 
     @property
@@ -229,6 +243,7 @@ class Robot:
             drive=self.drive[:k].copy(),
             drive_gains=self.drive_gains[:k].copy(),
             coulomb_velocity=self.coulomb_velocity[:k].copy(),
+            stribeck_velocity=self.stribeck_velocity[:k].copy(),
             limits=self.limits.subset(k),
             tool_rotation=tool_r,
             tool_translation=tool_t,

@@ -16,6 +16,11 @@ University, 2005; the paper's Steps 1-7:
 
 Details the paper leaves open follow Karaboga's reference implementation: candidates are clipped to
 the search box, and the trial counter of a source resets when it improves.
+
+Every candidate differs from its source in one coordinate. When ``fun`` also offers ``start(x) -> (F,
+state)`` and ``move(state, j, delta) -> (F, state)`` (e.g. eq. 9, whose residual changes by one column
+times ``delta``: :class:`dynid.estimators.base.LinearAbsoluteObjective`), each candidate costs one column
+instead of the whole product; the candidates and the random draws are the same.
 """
 
 from __future__ import annotations
@@ -74,16 +79,24 @@ def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_si
     n_food = colony_size // 2
     nfev = 0
 
+    incremental = hasattr(fun, "start") and hasattr(fun, "move")
+
     def evaluate(x):
+        """F(x) and the state a coordinate move starts from (None without the incremental interface)."""
         nonlocal nfev
         nfev += 1
-        return float(fun(x))
+        if incremental:
+            f, state = fun.start(x)
+            return float(f), state
+        return float(fun(x)), None
 
     # Steps 1-2: Ns random solutions (eq. 7), keep the Ne best as food sources
     init = lo + rng.random((colony_size, dim)) * (hi - lo)
-    init_f = np.array([evaluate(x) for x in init])
+    evaluated = [evaluate(x) for x in init]
+    init_f = np.array([f for f, _ in evaluated])
     order = np.argsort(init_f, kind="stable")[:n_food]
     foods, obj = init[order].copy(), init_f[order].copy()
+    states = [evaluated[k][1] for k in order]
     trials = np.zeros(n_food, dtype=int)
     best = int(np.argmin(obj))
     best_x, best_f = foods[best].copy(), obj[best]
@@ -96,11 +109,16 @@ def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_si
         j = rng.integers(dim)
         k = rng.integers(n_food - 1)
         k = k + 1 if k >= i else k  # k != i
+        nonlocal nfev
         v = foods[i].copy()
         v[j] = np.clip(foods[i, j] + rng.uniform(-1.0, 1.0) * (foods[i, j] - foods[k, j]), lo[j], hi[j])  # eq. 10
-        fv = evaluate(v)
+        if incremental:
+            nfev += 1
+            fv, sv = fun.move(states[i], j, v[j] - foods[i, j])
+        else:
+            fv, sv = evaluate(v)
         if fitness(fv) > fitness(obj[i]):  # eq. 11, greedy selection
-            foods[i], obj[i], trials[i] = v, fv, 0
+            foods[i], obj[i], trials[i], states[i] = v, fv, 0, sv
         else:
             trials[i] += 1
 
@@ -116,7 +134,7 @@ def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_si
             best_x, best_f = foods[cur].copy(), obj[cur]
         for i in np.flatnonzero(trials > limit):  # Step 6: scouts (eq. 13)
             foods[i] = lo + rng.random(dim) * (hi - lo)
-            obj[i] = evaluate(foods[i])
+            obj[i], states[i] = evaluate(foods[i])
             trials[i] = 0
             if obj[i] < best_f:
                 best_x, best_f = foods[i].copy(), obj[i]

@@ -47,6 +47,11 @@ NYQUIST_CAP = 0.8
 """No cutoff above this fraction of the Nyquist frequency."""
 
 
+def decimation_cutoff(rate: float, factor: int) -> float:
+    """Cutoff of the anti-aliasing filter of a decimation by ``factor``: 0.8 × the new Nyquist [Hz]."""
+    return 0.8 * rate / (2 * factor)
+
+
 def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION) -> float:
     """Frequency below which ``fraction`` of the joint velocities' energy lies, from the positions.
 

@@ -13,6 +13,7 @@ import numpy as np
 from scipy import signal
 
 from ..exceptions import ConfigError
+from .bands import decimation_cutoff
 
 
 def _check_cutoff(rate: float, cutoff: float, what: str) -> None:
@@ -45,11 +46,6 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
     """Time derivative by central differences (one-sided at the ends), (N, ...)."""
     return np.gradient(np.asarray(x, dtype=float), 1.0 / rate, axis=0)
-
-
-def decimation_cutoff(rate: float, factor: int) -> float:
-    """Cutoff of the anti-aliasing filter of a decimation by ``factor``: 0.8 × the new Nyquist [Hz]."""
-    return 0.8 * rate / (2 * factor)
 
 
 def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,

@@ -7,7 +7,7 @@ Information Sciences 191, 2012): the parameters are fitted on all blocks but one
 accumulated per block (:class:`dynid.estimators.accumulate.LeastSquaresAccumulator`), and the torque
 error is measured on the block left out, joint by joint.
 
-Used to choose each joint's Coulomb smoothing velocity ``v_s`` (:mod:`dynid.dynamics.friction`).
+Used to choose each joint's Coulomb smoothing velocity ``v_s`` (:mod:`dynid.friction`).
 """
 
 from __future__ import annotations
