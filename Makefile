@@ -20,6 +20,7 @@ test: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
 bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_table.py
 	$(BIN)/python benchmarks/bench_regressor.py
 	$(BIN)/python benchmarks/bench_identify_memory.py
 	$(BIN)/python benchmarks/bench_excitation_design.py

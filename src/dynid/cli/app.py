@@ -32,6 +32,11 @@ def _fail(exc: Exception) -> None:
     raise typer.Exit(1)
 
 
+def _count(n: int, noun: str) -> str:
+    """``"no figures"``, ``"1 figure"``, ``"3 figures"``."""
+    return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
+
+
 def _parse_weights(text: Optional[str]):
     if text is None:
         return None
@@ -65,6 +70,7 @@ def run(
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized (designed for the run, min cond), or an excitation.json of dynid excite."),
     methods: str = typer.Option("all", help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default all)."),
     bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
+    figures: bool = typer.Option(True, help="Write the figures (--no-figures: results.json only)."),
 ) -> None:
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
@@ -84,7 +90,7 @@ def run(
             task = progress.add_task("estimating", it="—", best="—")
             result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
                 task, description=LABELS[k], it=str(i), best=f"{f:.4g}"))
-        paths = save_paper_run(result, out)
+        paths = save_paper_run(result, out, figures)
     except DynIdError as exc:
         _fail(exc)
     _print_run(result, paths)
@@ -153,7 +159,7 @@ def _print_run(result, paths) -> None:
     console.print("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in tm.items()), soft_wrap=True)
     for w in d["warnings"]:
         console.print(f"[yellow]warning:[/] {w}")
-    console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
 
 
 def _print_uncertainty(d: dict, methods: dict) -> None:
@@ -303,7 +309,7 @@ def _print_identification(result, paths) -> None:
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
-    console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
 
 
 @app.command()
@@ -312,6 +318,7 @@ def identify(
     out: Path = typer.Option(Path("dynid-identify"), help="Output folder for results.json and figures."),
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     validate: bool = typer.Option(True, help="Also validate on the config's [[validation]] datasets."),
+    figures: bool = typer.Option(True, help="Write the torque figures (--no-figures: results.json only)."),
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
     from ..experiment.identification_config import load_identification_config, run_identification
@@ -323,7 +330,7 @@ def identify(
             task = progress.add_task("x", total=1)
             result = run_identification(cfg, progress=lambda done, total: progress.update(task, completed=done, total=total),
                                         validate=validate)
-        paths = save_identification(result, out)
+        paths = save_identification(result, out, figures)
     except DynIdError as exc:
         _fail(exc)
     _print_identification(result, paths)
@@ -378,7 +385,7 @@ def validate(
     _comparison_tables(comparisons, cfg.robot.n_dof)
     for w in warnings:
         console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
-    console.print(f"wrote {paths[0]} and {len(paths) - 1} figures in {paths[0].parent}/")
+    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
 
 
 @app.command()
@@ -435,7 +442,7 @@ def _print_excitation(run, paths) -> None:
         t.add_row(escape(m.constraint), escape(m.where), f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}", rel)
     console.print(t)
     console.print(f"wrote {paths[0]}, {paths[1]} ({run.t.size} set-points at {run.config.rate:g} Hz) and "
-                  f"{len(paths) - 2} figures in {paths[0].parent}/")
+                  f"{_count(len(paths) - 2, 'figure')} in {paths[0].parent}/")
 
 
 def _parse_levels(text: str):
@@ -509,7 +516,7 @@ def _print_montecarlo(result, paths) -> None:
     console.print(t)
     if result.errors:
         console.print(f"[yellow]warning:[/] {len(result.errors)} fits failed; the first: " + escape(result.errors[0]["error"]), soft_wrap=True)
-    console.print(f"wrote {paths[0]}, {paths[1]} and {len(paths) - 2} figures in {paths[0].parent}/")
+    console.print(f"wrote {paths[0]}, {paths[1]} and {_count(len(paths) - 2, 'figure')} in {paths[0].parent}/")
 
 
 def main() -> None:

@@ -16,12 +16,11 @@ from typing import Callable
 import numpy as np
 
 from ..exceptions import ConfigError
-from .accumulate import LeastSquaresAccumulator
 from .base import Estimator, check_observations
 from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
 
 GRAM_CHUNK = 4096
-"""Samples per step when the per-sample Gram matrices are weighted by the resample counts."""
+"""Samples per step when the per-sample Gram matrices are formed."""
 
 
 @dataclass(frozen=True)
@@ -99,7 +98,7 @@ def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: 
         resamples.append((starts[:, None] + np.arange(length)).ravel()[:n])
     template = make_estimator()
     if type(template) in (OrdinaryLeastSquares, WeightedLeastSquares):
-        samples = _least_squares_resamples(template, w3, tau2, resamples)
+        samples = _least_squares_resamples(template, w3, tau2, resamples, length)
     else:
         samples = np.array([make_estimator().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel()).params_
                             for idx in resamples])
@@ -108,34 +107,44 @@ def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: 
     return BootstrapIntervals(samples, lower, upper, samples.std(axis=0, ddof=1), level, length)
 
 
-def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resamples) -> np.ndarray:
-    """OLS/WLS refits of every resample without refactorising it: a resample repeats sample ``s`` ``c_s``
-    times, so each joint's Gram matrix of ``[W | τ]`` is ``Σ_s c_s G_s``; all resamples at once are one
-    matrix product of the counts (B, N) with the per-sample Grams (N, ·), chunk by chunk. Its Cholesky
-    factor is the triangular factor the incremental QR would reach (:class:`LeastSquaresAccumulator`),
-    so the solve, its rank check and the WLS weights are those of the estimator itself (to round-off)."""
+def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resamples, length: int) -> np.ndarray:
+    """OLS/WLS refits of every resample without refactorising it. A resample is a sequence of blocks of
+    consecutive samples, so each joint's Gram matrix of ``[W | τ]`` is a sum of block Grams, and a block
+    Gram is the difference of two prefix sums of the per-sample Grams: ``P[s + L] − P[s]``. Each resample
+    then costs one gather of ``2·N/L`` rows instead of a QR of all of its rows. The Cholesky factor of the
+    Gram gives the least-squares solution, and the joints' residual sums of squares (the quadratic form of
+    each joint's Gram) give the WLS weights as :class:`WeightedLeastSquares` computes them (to round-off)."""
     n, n_dof, p = w3.shape
-    counts = np.array([np.bincount(idx, minlength=n) for idx in resamples], dtype=float)  # (B, N)
+    iu = np.triu_indices(p + 1)
     aug = np.concatenate([w3, tau2[..., None]], axis=2)  # (N, n_dof, p+1)
-    grams = np.zeros((len(resamples), n_dof * (p + 1) ** 2))
+    prefix = np.zeros((n + 1, n_dof, iu[0].size))
     for a in range(0, n, GRAM_CHUNK):
         block = aug[a:a + GRAM_CHUNK]
-        per_sample = np.einsum("sjp,sjq->sjpq", block, block).reshape(block.shape[0], -1)
-        grams += counts[:, a:a + GRAM_CHUNK] @ per_sample
-    grams = grams.reshape(len(resamples), n_dof, p + 1, p + 1)
+        prefix[a + 1:a + 1 + block.shape[0]] = block[:, :, iu[0]] * block[:, :, iu[1]]
+    np.cumsum(prefix, axis=0, out=prefix)
     out = []
-    for g, idx in zip(grams, resamples):
-        acc = LeastSquaresAccumulator(p, n_dof)
+    for idx in resamples:
+        starts = idx[::length]
+        ends = np.minimum(starts + length, starts + (n - np.arange(starts.size) * length))
+        packed = prefix[ends].sum(axis=0) - prefix[starts].sum(axis=0)  # (n_dof, T)
+        g = np.zeros((n_dof, p + 1, p + 1))
+        g[:, iu[0], iu[1]] = packed
+        g = g + np.triu(g, 1).transpose(0, 2, 1)
         try:
-            acc.factors[:] = [np.linalg.cholesky(gj).T for gj in g]
-        except np.linalg.LinAlgError:  # a residual of exactly zero: refactorise this resample
-            est = template.clone().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel())
-            out.append(est.params_)
-            continue
-        acc.rows[:] = n
-        ols = acc.solve(rcond=template.rcond)
-        if isinstance(template, WeightedLeastSquares):
-            std = acc.joint_residual_std(ols.params)
-            ols = acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=template.rcond)
-        out.append(ols.params)
+            theta = _gram_solve(g.sum(axis=0), p)
+            if isinstance(template, WeightedLeastSquares):  # as WeightedLeastSquares.fit: 1/σ_j of the OLS residual
+                x = np.append(theta, -1.0)
+                ss = np.maximum(np.einsum("i,jik,k->j", x, g, x), 0.0)  # round-off may make an exact fit negative
+                std = np.sqrt(ss / np.maximum(n - p / n_dof, 1.0))
+                wts = 1.0 / np.where(std > 0, std, 1.0)
+                theta = _gram_solve(np.tensordot(wts**2, g, axes=1), p)
+        except np.linalg.LinAlgError:  # not numerically positive definite: refactorise this resample
+            theta = template.clone().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel()).params_
+        out.append(theta)
     return np.array(out)
+
+
+def _gram_solve(g: np.ndarray, p: int) -> np.ndarray:
+    """Least-squares parameters from the Gram matrix of ``[W | τ]`` (Cholesky; LinAlgError if singular)."""
+    c = np.linalg.cholesky(g[:p, :p])
+    return np.linalg.solve(c.T, np.linalg.solve(c, g[:p, p]))

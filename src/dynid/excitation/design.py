@@ -35,6 +35,7 @@ from ..model.robot import Limits, Robot
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
+from ..threads import with_single_blas_thread
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -433,6 +434,7 @@ def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
     return x
 
 
+@with_single_blas_thread
 def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
                       initial: FourierTrajectory | None = None, maxiter: int = 150,
                       callback: Callable[[int, int, float], None] | None = None) -> ExcitationDesign:

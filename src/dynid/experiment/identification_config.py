@@ -70,6 +70,7 @@ from ..io.trajectories import load_trajectory
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from .method_names import parse_methods
+from ..threads import with_single_blas_thread
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.
@@ -319,6 +320,7 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
                    rows=None if rows is None else tuple(rows))
 
 
+@with_single_blas_thread
 def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
     """Identify the base parameters from the config's identification dataset, then validate them on
     each validation dataset beside the reference sets.

@@ -39,6 +39,7 @@ from ..model.description import load_robot
 from ..simulation.measurements import NoiseModel
 from .methods import LABELS, METHODS, SearchBudget, fit_method, parse_methods
 from .paper import PaperExperimentConfig, fit_data, identification_trajectory, search_box, simulate_dataset
+from ..threads import with_single_blas_thread
 
 DEFAULT_METHODS = ("ols", "wls", "irls", "lad", "sdp", "abc")
 """The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with methods."""
@@ -146,6 +147,7 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info))
 
 
+@with_single_blas_thread
 def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> dict:
     """Simulate realisation ``realisation`` at noise level ``level_index`` and fit every method.
 

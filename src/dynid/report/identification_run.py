@@ -29,8 +29,9 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list
     return paths
 
 
-def save_identification(result: IdentificationResult, out: str | Path) -> list[Path]:
-    """Write ``results.json``, the identification fit figure and one figure per validation dataset.
+def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True) -> list[Path]:
+    """Write ``results.json``, the identification fit figure and one figure per validation dataset
+    (figures unless ``figures_too`` is false).
 
     Raises
     ------
@@ -38,9 +39,11 @@ def save_identification(result: IdentificationResult, out: str | Path) -> list[P
         If ``out`` exists and is not a folder, or cannot be created.
     """
     out = output_folder(out)
-    paths = [out / "identification_fit.png"]
-    _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
-    paths += save_comparisons(result.validations, out)
+    paths = []
+    if figures_too:
+        paths = [out / "identification_fit.png"]
+        _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
+        paths += save_comparisons(result.validations, out)
     json_path = out / "results.json"
     write_json(json_path, result.to_dict())
     return [json_path] + paths

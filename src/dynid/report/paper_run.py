@@ -27,8 +27,9 @@ TORQUE_PLOT_METHODS = ("abc", "lad", "ols", "sdp")
 """Methods drawn in Figs. 7 and 9 (those the run has), so the curves stay readable."""
 
 
-def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
-    """Write ``results.json`` and the figures into ``out`` (created if needed); return the paths.
+def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = True) -> list[Path]:
+    """Write ``results.json`` and (unless ``figures_too`` is false) the figures into ``out`` (created if
+    needed); return the paths.
 
     Raises
     ------
@@ -69,7 +70,7 @@ def save_paper_run(result: PaperRunResult, out: str | Path) -> list[Path]:
              for label, m in searches.items()},
             reference=references, xlabel="evaluations of eq. 9", title="Box searches on eq. 9 (LAD: the exact minimum in the box)")
     paths = []
-    for name in FIGURES:
+    for name in FIGURES if figures_too else ():
         if name in figs:
             paths.append(out / name)
             save_figure(figs[name](), paths[-1])

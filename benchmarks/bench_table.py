@@ -1,0 +1,117 @@
+"""One table of dynid's speed targets (issue "Fast on two cores"), each measured in this run.
+
+Whole commands are timed as child processes (wall time and peak memory from ``os.wait4``); the
+regressor and the bootstrap are timed in this process against their references. Each row prints the
+figure, its reference measured in the same run where one exists, the target and "met" / "NOT met".
+Run from the repository root after ``make test`` or ``make demo`` created ``.venv``: ``make bench``.
+The real-data rows need ``../shared/data`` (or ``DYNID_DATA_ROOT``'s parent); they are skipped without.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from timing import best_of  # benchmarks/timing.py
+
+REPO = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+DATA = Path(os.environ.get("DYNID_SHARED_DATA", REPO.parent / "shared" / "data"))
+ENV = {**os.environ, "MPLBACKEND": "Agg"}
+
+
+def command(args, repeats: int = 1) -> tuple[float, float]:
+    """Best wall time [s] and the peak memory [MB] of ``args`` run as a child process."""
+    best, peak = np.inf, 0.0
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(args, cwd=tempfile.gettempdir(), env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        _, status, usage = os.wait4(proc.pid, 0)
+        best = min(best, time.perf_counter() - t0)
+        peak = max(peak, usage.ru_maxrss / 1024)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    return best, peak
+
+
+ROWS = []
+
+
+def row(what: str, value: float, unit: str, target: float, reference: str = "—", smaller_is_better: bool = True) -> None:
+    ok = value < target if smaller_is_better else value >= target
+    ROWS.append((what, f"{value:.3g} {unit}", reference, f"{'<' if smaller_is_better else '>='} {target:g} {unit}",
+                 "met" if ok else "NOT met"))
+
+
+def main() -> None:
+    dynid = str(BIN / "dynid")
+    out = Path(tempfile.mkdtemp())
+    load = os.getloadavg()[0]
+    t, _ = command([dynid, "--help"], repeats=3)
+    row("dynid --help", t, "s", 0.5)
+    (out / "typo.toml").write_text('robot = "ur10e"\n[identificaton]\n')
+    t, _ = command([dynid, "identify", str(out / "typo.toml")], repeats=3)
+    row("a config typo reported (dynid identify)", t, "s", 0.5)
+    t, _ = command([dynid, "run", "--out", str(out / "run1")])
+    row("dynid run (default: all methods, figures)", t, "s", 10.0)
+    t, _ = command([dynid, "run", "--methods", "ols", "--bootstrap", "0", "--out", str(out / "run2")], repeats=2)
+    row("dynid run --methods ols --bootstrap 0", t, "s", 2.0)
+    t, _ = command([dynid, "run", "--methods", "ols", "--bootstrap", "0", "--no-figures", "--out", str(out / "run3")], repeats=2)
+    row("  the same, --no-figures", t, "s", 2.0)
+
+    ur = DATA / "ur10e_mamedov2020"
+    if ur.is_dir():
+        cfg = ["--data-root", str(ur)]
+        t, _ = command([dynid, "identify", str(REPO / "configs" / "ur10e.toml"), *cfg, "--out", str(out / "u1")])
+        row("dynid identify configs/ur10e.toml (11 validation logs, drive gains, SDP, figures)", t, "s", 4.0)
+        t_ref, _ = command([str(BIN / "python"), str(REPO / "benchmarks" / "reference_ur10e_ols.py"), str(ur)], repeats=2)
+        t, _ = command([dynid, "identify", str(REPO / "configs" / "ur10e.toml"), *cfg, "--no-validate", "--no-figures",
+                        "--out", str(out / "u2")], repeats=2)
+        row("  --no-validate --no-figures, against the plain script (ratio)", t / t_ref, "x", 1.5,
+            f"script {t_ref:.2f} s, dynid {t:.2f} s")
+    tx = DATA / "staubli_tx40_figaroh"
+    if tx.is_dir():
+        t, mb = command([dynid, "identify", str(REPO / "configs" / "tx40-full.toml"), "--data-root", str(tx), "--out", str(out / "t1")])
+        row("dynid identify configs/tx40-full.toml: time", t, "s", 4.0)
+        row("  peak memory", mb, "MB", 300.0)
+
+    # regressor: dynid's batched kernel against a loop over Pinocchio's computeJointTorqueRegressor
+    import pinocchio as pin
+
+    from dynid.dynamics.regressor import regressor
+    from dynid.dynamics.rnea import pinocchio_model
+    from dynid.model.description import load_robot
+
+    robot = load_robot("er16")
+    rng = np.random.default_rng(0)
+    n = 25_000
+    q, dq, ddq = (rng.uniform(-2, 2, (n, 6)) for _ in range(3))
+    model = pinocchio_model(robot)
+    data = model.createData()
+
+    def loop():
+        for k in range(n):
+            pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k])
+
+    regressor(robot, q[:10], dq[:10], ddq[:10])
+    t_pin, t_dyn = best_of(loop, 3), best_of(lambda: regressor(robot, q, dq, ddq), 5)
+    row("regressor, er16, 25 000 samples: dynid vs Pinocchio loop (ratio)", t_pin / t_dyn, "x", 6.0,
+        f"Pinocchio {1e6 * t_pin / n:.2f} µs/sample", smaller_is_better=False)
+    row("  dynid per sample", 1e6 * t_dyn / n, "µs", 0.5)
+
+    t, _ = command([str(BIN / "python"), str(REPO / "benchmarks" / "bench_excitation_design.py")])
+    row("bench_excitation_design.py (6 joints, 5 harmonics, 4 starts)", t, "s", 15.0)
+
+    widths = [max(len(r[i]) for r in ROWS + [("what", "dynid", "reference", "target", "")]) for i in range(5)]
+    print(f"machine: {os.cpu_count()} cores, load average {load:.2f} at the start of the table")
+    for r in [("what", "dynid", "reference", "target", "")] + ROWS:
+        print("  ".join(c.ljust(w) for c, w in zip(r, widths)))
+
+
+if __name__ == "__main__":
+    main()
