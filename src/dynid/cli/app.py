@@ -19,7 +19,7 @@ from rich.table import Table
 
 from ..exceptions import DynIdError
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
                   help="dynid: dynamic model identification of industrial robot arms.")
 console = Console()
 if not console.is_terminal:  # logs and pipes: wide enough for every table
@@ -28,7 +28,7 @@ err_console = Console(stderr=True)
 
 
 def _fail(exc: Exception) -> None:
-    err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+    err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
     raise typer.Exit(1)
 
 
@@ -46,8 +46,17 @@ def _parse_weights(text: Optional[str]):
         raise DynIdError(f"--weights: expected comma-separated numbers like 1,1,0.5, got {text!r}") from None
 
 
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        console.print(f"dynid {__version__}", highlight=False)
+        raise typer.Exit()
+
+
 @app.callback()
-def _root() -> None:
+def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                       help="Print dynid's version and exit.")) -> None:
     """dynid: dynamic model identification of industrial robot arms."""
 
 
@@ -519,13 +528,28 @@ def _print_montecarlo(result, paths) -> None:
     console.print(f"wrote {paths[0]}, {paths[1]} and {_count(len(paths) - 2, 'figure')} in {paths[0].parent}/")
 
 
+class Interrupted(BaseException):
+    """Ctrl-C, raised by dynid's SIGINT handler: a BaseException that is no KeyboardInterrupt, so no library
+    on the way swallows it and the atomic writes' clean-up still runs."""
+
+
+def _interrupt(signum, frame):
+    raise Interrupted()
+
+
 def main() -> None:
-    """Console-script entry point."""
+    """Console-script entry point. Ctrl-C ends with one line and exit code 130 (128 + SIGINT)."""
+    import signal
+
+    signal.signal(signal.SIGINT, _interrupt)
     try:
         app()
     except DynIdError as exc:  # pragma: no cover - commands already catch theirs
-        err_console.print(f"error: {exc}")
+        err_console.print(f"error: {escape(str(exc))}", highlight=False)
         sys.exit(1)
+    except Interrupted:
+        err_console.print("interrupted (Ctrl-C)", highlight=False)
+        sys.exit(130)
 
 
 if __name__ == "__main__":

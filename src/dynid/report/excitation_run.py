@@ -7,10 +7,9 @@ from pathlib import Path
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import regressor
 from ..experiment.excitation_config import ExcitationRun
-from ..io import write_json
 from ..io.trajectories import write_trajectory_csv
 from . import figures
-from .output import output_folder, save_figure
+from .output import output_folder, save_figure, write_results
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
@@ -46,5 +45,5 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     csv_path = out / "excitation.csv"
     write_trajectory_csv(csv_path, run.t, run.q, run.dq, run.ddq)
     json_path = out / "excitation.json"
-    write_json(json_path, run.to_dict())
+    write_results(json_path, run.to_dict(), "excite")
     return [json_path, csv_path] + paths

@@ -6,9 +6,8 @@ import re
 from pathlib import Path
 
 from ..experiment.identification import IdentificationResult, TorqueComparison
-from ..io import write_json
 from . import figures
-from .output import output_folder, save_figure
+from .output import output_folder, save_figure, write_results
 
 
 def _slug(name: str) -> str:
@@ -45,7 +44,7 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
         paths += save_comparisons(result.validations, out)
     json_path = out / "results.json"
-    write_json(json_path, result.to_dict())
+    write_results(json_path, result.to_dict(), "identify")
     return [json_path] + paths
 
 
@@ -54,5 +53,5 @@ def save_validation(comparisons, warnings, out: str | Path) -> list[Path]:
     out = output_folder(out)
     paths = save_comparisons(comparisons, out)
     json_path = out / "validation.json"
-    write_json(json_path, {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)})
+    write_results(json_path, {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)}, "validate")
     return [json_path] + paths

@@ -9,9 +9,9 @@ import numpy as np
 
 from ..experiment.methods import LABELS
 from ..experiment.montecarlo import MonteCarloResult
-from ..io import atomic_write_text, write_json
+from ..io import atomic_write_text
 from . import figures
-from .output import output_folder, save_figure
+from .output import output_folder, save_figure, write_results
 
 FIGURES = {
     "montecarlo_std_vs_crb.png": "per noise level: standard deviation / Cramér–Rao bound of every base parameter, per method",
@@ -42,5 +42,5 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
             for m, key in enumerate(result.config.methods):
                 buf.write(f"{level:.6g},{r},{key}," + ",".join(f"{v:.10g}" for v in result.estimates[li, r, m]) + "\n")
     atomic_write_text(paths[1], buf.getvalue())
-    write_json(paths[0], result.to_dict())
+    write_results(paths[0], result.to_dict(), "montecarlo")
     return paths

@@ -39,3 +39,16 @@ def save_figure(fig_or_axes, path: Path) -> None:
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
     atomic_write_bytes(path, buf.getvalue())
+
+
+SCHEMA_VERSION = 1
+"""Version of the layout of the JSON files dynid writes; raised when a field changes meaning or goes."""
+
+
+def write_results(path: Path, data: dict, kind: str) -> None:
+    """Write a results JSON atomically, headed by what wrote it: ``schema_version``, ``dynid_version`` and
+    ``kind`` (run, identify, validate, excite, montecarlo)."""
+    from .. import __version__
+    from ..io import write_json
+
+    write_json(path, {"schema_version": SCHEMA_VERSION, "dynid_version": __version__, "kind": kind, **data})

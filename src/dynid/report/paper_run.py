@@ -9,9 +9,8 @@ import numpy as np
 from ..experiment import paper_reference as ref
 from ..experiment.methods import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
-from ..io import write_json
 from . import figures
-from .output import output_folder, save_figure
+from .output import output_folder, save_figure, write_results
 
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",
@@ -75,5 +74,5 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
             paths.append(out / name)
             save_figure(figs[name](), paths[-1])
     json_path = out / "results.json"
-    write_json(json_path, result.to_dict())
+    write_results(json_path, result.to_dict(), "run")
     return [json_path] + paths
