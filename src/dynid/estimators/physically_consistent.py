@@ -128,15 +128,13 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
     DynIdError
         If the solver fails.
     """
-    import cvxpy as cp
-
     k = np.asarray(regrouping, dtype=float)
     b = np.asarray(beta, dtype=float)
     if not np.all(np.isfinite(b)):
         return float("-inf")
-    phi, t = cp.Variable(k.shape[1]), cp.Variable()
-    cons = [k @ phi == b, t <= bound, *_consistency_constraints(phi, links, nonnegative, t)]
-    problem = _solve(cp.Problem(cp.Maximize(t), cons), "consistency check")
+    problem, b_param, t = _margin_problem(k, np.asarray(links, dtype=int), np.asarray(nonnegative, dtype=int), float(bound))
+    b_param.value = b
+    problem = _solve(problem, "consistency check")
     if problem.status in ("infeasible", "infeasible_inaccurate"):
         return float("-inf")
     if t.value is None:
@@ -168,6 +166,24 @@ def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), non
     return "no: no mass distribution with non-negative friction and rotor inertias has these base parameters"
 
 
+_MARGIN_PROBLEMS: dict = {}
+
+
+def _margin_problem(k, links, nonnegative, bound):
+    """The feasibility SDP of :func:`consistency_margin` with ``beta`` as a parameter, built once per robot
+    layout: cvxpy compiles it on the first solve and only substitutes ``beta`` on the next (DPP)."""
+    import cvxpy as cp
+
+    key = (k.shape, k.tobytes(), links.tobytes(), nonnegative.tobytes(), bound)
+    if key not in _MARGIN_PROBLEMS:
+        if len(_MARGIN_PROBLEMS) >= 8:
+            _MARGIN_PROBLEMS.pop(next(iter(_MARGIN_PROBLEMS)))
+        phi, t, b = cp.Variable(k.shape[1]), cp.Variable(), cp.Parameter(k.shape[0])
+        cons = [k @ phi == b, t <= bound, *_consistency_constraints(phi, links, nonnegative, t)]
+        _MARGIN_PROBLEMS[key] = (cp.Problem(cp.Maximize(t), cons), b, t)
+    return _MARGIN_PROBLEMS[key]
+
+
 def _consistency_constraints(phi, links, nonnegative, margin) -> list:
     """Every link's pseudo-inertia ``⪰ margin·1`` and the ``nonnegative`` columns ``>= 0``."""
     cons = [_pseudo_inertia_expression(phi, idx) >> margin * np.eye(4) for idx in np.asarray(links, dtype=int).reshape(-1, 10)]
@@ -185,6 +201,10 @@ def _solve(problem, what: str):
         problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError as exc:
         raise DynIdError(f"{what}: the SDP solver failed ({exc})") from None
+    except BaseException as exc:  # Clarabel's Rust core panics on extreme values (a PanicException, not an Exception)
+        if type(exc).__name__ != "PanicException":
+            raise
+        raise DynIdError(f"{what}: the SDP solver failed on these values ({exc})") from None
     return problem
 
 

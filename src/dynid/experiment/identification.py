@@ -21,7 +21,7 @@ from ..dynamics.layout import consistency_layout
 from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
-from ..exceptions import ConfigError
+from ..exceptions import ConfigError, DynIdError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
@@ -322,8 +322,13 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     if extra:
         objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
     links, nonneg = consistency_layout(robot)
-    margins = {label: consistency_margin(base.regrouping, beta, links, nonneg) for label, beta in sets.items()}
-    verdicts = {label: consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg) for label, beta in sets.items()}
+    margins, verdicts = {}, {}
+    for label, beta in sets.items():
+        try:
+            margins[label] = consistency_margin(base.regrouping, beta, links, nonneg)
+            verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
+        except DynIdError as exc:  # a failed check never stops the identification
+            margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
     fit = compare_torques(robot, base, data, sets)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),

@@ -48,6 +48,10 @@ def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
     return np.gradient(np.asarray(x, dtype=float), 1.0 / rate, axis=0)
 
 
+COLUMN_BLOCK = 64
+"""Columns filtered at once by :func:`parallel_decimation` (bounds the filter's temporary copies)."""
+
+
 def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,
                         order: int = 4, chunk: int = 20_000,
                         cutoff: float | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
@@ -101,7 +105,11 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
         stop = min(start + chunk, n_samples)
         lo, hi = max(0, start - margin), min(n_samples, stop + margin)
         values = block(lo, hi)
-        filtered = signal.sosfiltfilt(sos, values, axis=0, padlen=min(3 * (2 * len(sos) + 1), hi - lo - 1))
         index = np.arange(start, stop)
         index = index[index % factor == 0]
-        yield index, filtered[index - lo]
+        flat = values.reshape(values.shape[0], -1)
+        out = np.empty((index.size, flat.shape[1]))
+        padlen = min(3 * (2 * len(sos) + 1), hi - lo - 1)
+        for c in range(0, flat.shape[1], COLUMN_BLOCK):  # column blocks: the filter's copies stay small
+            out[:, c:c + COLUMN_BLOCK] = signal.sosfiltfilt(sos, flat[:, c:c + COLUMN_BLOCK], axis=0, padlen=padlen)[index - lo]
+        yield index, out.reshape((index.size,) + values.shape[1:])

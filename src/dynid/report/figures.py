@@ -185,8 +185,14 @@ def plot_noise_level_study(levels, labels, std_ratios, bias_ratios, ax=None,
 
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):
     """Measured against predicted joint torques (paper Figs. 7 and 9). ``predicted`` maps a label to (N, n)."""
+    import matplotlib.pyplot as plt
+
     n = measured.shape[1]
-    axes = _axes(ax, n, figsize=(9, 2.4 * n))
+    if ax is None:  # a fixed layout: the automatic one costs more than drawing (one figure per log)
+        fig = plt.figure(figsize=(9, 2.4 * n))
+        ax = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+        fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n), bottom=0.5 / (2.4 * n), hspace=0.3)
+    axes = ax
     labels = list(predicted)
     t, measured, *preds = _thin(t, measured, *(predicted[k] for k in labels))
     predicted = dict(zip(labels, preds))

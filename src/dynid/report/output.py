@@ -36,7 +36,7 @@ def save_figure(fig_or_axes, path: Path) -> None:
 
     fig = fig_or_axes.figure if hasattr(fig_or_axes, "figure") else fig_or_axes.flat[0].figure
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
+    fig.savefig(buf, format="png", dpi=100, pil_kwargs={"compress_level": 1})  # fast zlib: 3x quicker, 1.3x larger
     plt.close(fig)
     atomic_write_bytes(path, buf.getvalue())
 
