@@ -167,7 +167,7 @@ def _print_run(result, paths) -> None:
     tm = d["timings"]
     console.print("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in tm.items()), soft_wrap=True)
     for w in d["warnings"]:
-        console.print(f"[yellow]warning:[/] {w}")
+        console.print(f"[yellow]warning:[/] {escape(w)}")
     console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
 
 
@@ -317,8 +317,10 @@ def _print_identification(result, paths) -> None:
         _print_drive_gains(result.drive_gains)
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
-        console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
-    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
+        console.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
+    pngs = [p for p in paths if p.suffix == ".png"]
+    others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
+    console.print(f"wrote {paths[0]}{others} and {_count(len(pngs), 'figure')} in {paths[0].parent}/")
 
 
 @app.command()
@@ -339,10 +341,44 @@ def identify(
             task = progress.add_task("x", total=1)
             result = run_identification(cfg, progress=lambda done, total: progress.update(task, completed=done, total=total),
                                         validate=validate)
-        paths = save_identification(result, out, figures)
+        paths = save_identification(result, out, figures, robot=cfg.robot)
     except DynIdError as exc:
         _fail(exc)
     _print_identification(result, paths)
+
+
+@app.command()
+def export(
+    config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
+    results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
+    urdf: Path = typer.Option(..., help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
+    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+) -> None:
+    """Export the physically consistent estimate as a URDF (load it in Pinocchio, a simulator, a controller)."""
+    import json
+
+    from ..exceptions import DataError
+    from ..experiment.identification_config import load_identification_config
+
+    try:
+        cfg = load_identification_config(config, data_root)
+        try:
+            identified = json.loads(results.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
+        except (OSError, json.JSONDecodeError) as exc:
+            raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
+        from ..io.export import urdf_from_results
+        from ..io.files import atomic_write_text
+
+        text = urdf_from_results(cfg.robot, identified, str(results))
+        if urdf.parent and not urdf.parent.is_dir():
+            raise DataError(f"--urdf {urdf}: its folder does not exist")
+        atomic_write_text(urdf, text)
+    except DynIdError as exc:
+        _fail(exc)
+    console.print(f"wrote {urdf} (robot {cfg.robot.name}, {cfg.robot.n_dof} joints; rotor inertias, offsets and coupled "
+                  "motors, which URDF cannot hold, are in comments on the joints)", highlight=False, soft_wrap=True)
 
 
 def _parse_rows(text: Optional[str]):
@@ -393,7 +429,7 @@ def validate(
         _fail(exc)
     _comparison_tables(comparisons, cfg.robot.n_dof)
     for w in warnings:
-        console.print(f"[yellow]warning:[/] {w}", soft_wrap=True)
+        console.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
     console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
 
 

@@ -93,6 +93,18 @@ def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
     return bool(np.linalg.eigvalsh(pseudo_inertia(phi)).min() >= -tol * max(1.0, abs(phi[9])))
 
 
+def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass [kg], centre of mass [m] and inertia about the centre of mass [kg·m²] (3×3, link frame axes)
+    of ten inertial parameters (eq. 5 order, about the link origin); the inverse of
+    :func:`inertial_from_physical`. A massless link gives a zero centre of mass.
+    """
+    phi = np.asarray(phi, dtype=float)
+    mass = float(phi[9])
+    com = phi[6:9] / mass if mass > 0 else np.zeros(3)
+    s = np.array([[0, -com[2], com[1]], [com[2], 0, -com[0]], [-com[1], com[0], 0]])
+    return mass, com, inertia_matrix(phi[:6]) - mass * (s.T @ s)
+
+
 def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
     """The physical-consistency rules that ten inertial parameters (eq. 5 order, about the link origin)
     break: positive mass, inertia about the centre of mass positive definite, and its principal moments
@@ -102,13 +114,10 @@ def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
     the first rule but no other.
     """
     phi = np.asarray(phi, dtype=float)
-    mass, h = float(phi[9]), phi[6:9]
-    inertia = inertia_matrix(phi[:6])
+    mass = float(phi[9])
     if not mass > 0:
         return [f"mass {mass:.6g} kg is not positive"]
-    c = h / mass
-    s = np.array([[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]])
-    ev = np.linalg.eigvalsh(inertia - mass * (s.T @ s))
+    ev = np.linalg.eigvalsh(physical_from_inertial(phi)[2])
     scale = max(abs(ev).max(), 1e-12)
     out = []
     if ev.min() <= tol * scale:

@@ -28,9 +28,10 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list
     return paths
 
 
-def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True) -> list[Path]:
+def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None) -> list[Path]:
     """Write ``results.json``, the identification fit figure and one figure per validation dataset
-    (figures unless ``figures_too`` is false).
+    (figures unless ``figures_too`` is false), and with ``robot`` (the identified robot) ``robot.urdf``
+    when the physically consistent estimate passed the consistency check.
 
     Raises
     ------
@@ -44,7 +45,15 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
         paths += save_comparisons(result.validations, out)
     json_path = out / "results.json"
-    write_results(json_path, result.to_dict(), "identify")
+    data = result.to_dict()
+    write_results(json_path, data, "identify")
+    sdp = data.get("physically_consistent")
+    if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp["label"]) == "yes":
+        from ..io import atomic_write_text
+        from ..io.export import urdf_from_results
+
+        paths.insert(0, out / "robot.urdf")
+        atomic_write_text(paths[0], urdf_from_results(robot, data))
     return [json_path] + paths
 
 

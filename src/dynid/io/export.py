@@ -1,0 +1,143 @@
+"""The identified model handed over: URDF of a robot with its identified inertial and friction parameters.
+
+The URDF is generated from dynid's own kinematic description (the joint frames every robot has, whether
+it came from a DH table or a URDF), so the same writer serves every robot: a chain ``base_link →
+link1 → … → linkN`` with revolute joints at dynid's joint frames and a fixed ``flange`` link at the tool
+frame. Each link's ``<inertial>`` holds the mass, the centre of mass and the inertia about it in the link
+frame (:func:`dynid.model.spatial.physical_from_inertial`); each joint's ``<dynamics>`` holds the
+viscous (``damping``) and Coulomb (``friction``) coefficients. URDF has no field for the rotor inertia,
+a torque offset, the Stribeck term or a coupled motor: they are written as XML comments on the joint,
+and the model's torques then need them added (``τ = RNEA + Ia·q̈ + fc·sign(q̇) + fv·q̇ + offset``).
+Visual and collision geometry is not copied: merge the inertials into the original URDF by link name
+if needed (dynid's link j is the link moved by joint j).
+
+Only physically consistent parameters are exported: a URDF with a negative mass or an impossible
+inertia makes simulators fail or behave wrongly.
+"""
+
+from __future__ import annotations
+
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from ..exceptions import ConfigError
+from ..model.robot import Robot
+from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
+
+CONSISTENCY_TOL = 1e-7
+"""Smallest pseudo-inertia eigenvalue tolerated (the SDP solver's accuracy) [kg·m², kg]."""
+
+
+def _rpy(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (URDF convention, R = Rz(y)·Ry(p)·Rx(r)) of a rotation matrix (Pinocchio's)."""
+    import pinocchio as pin
+
+    return np.asarray(pin.rpy.matrixToRpy(np.asarray(rotation, dtype=float)))
+
+
+def _vec(v) -> str:
+    return " ".join(f"{x:.17g}" for x in np.asarray(v, dtype=float))
+
+
+def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
+    """URDF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
+
+    Parameters
+    ----------
+    robot : Robot
+    phi : (n_params,) array, optional
+        Standard parameters (eq. 5 order per link, then the drive terms), e.g. the physically consistent
+        estimate of ``dynid identify``.
+    name : str, optional
+        Robot name in the URDF (default ``robot.name``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ConfigError
+        A link whose parameters are those of no mass distribution (named with the broken rule), or a
+        negative friction coefficient.
+    """
+    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
+    if phi.shape != (robot.n_params,):
+        raise ConfigError(f"export: expected {robot.n_params} standard parameters for robot {robot.name!r}, got {phi.shape}")
+    fitted = robot.with_parameters(phi)
+    lines = ['<?xml version="1.0"?>', f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
+             f"<robot name={quoteattr(name or robot.name)}>", '  <link name="base_link"/>']
+    for j, joint in enumerate(robot.joints):
+        if not is_physically_consistent(fitted.inertial[j], tol=CONSISTENCY_TOL):
+            rule = (physical_problems(fitted.inertial[j]) or ["a pseudo-inertia that is not positive semidefinite"])[0]
+            raise ConfigError(f"export: link {j + 1} ({joint.name}): {rule}; only physically consistent parameters can be "
+                              "exported (the physically consistent estimate of dynid identify is)")
+        mass, com, inertia = physical_from_inertial(fitted.inertial[j])
+        link = f"link{j + 1}"
+        lines += [f'  <link name="{link}">', "    <inertial>", f'      <origin xyz="{_vec(com)}" rpy="0 0 0"/>',
+                  f'      <mass value="{mass:.17g}"/>',
+                  '      <inertia ixx="{:.17g}" ixy="{:.17g}" ixz="{:.17g}" iyy="{:.17g}" iyz="{:.17g}" izz="{:.17g}"/>'.format(
+                      inertia[0, 0], inertia[0, 1], inertia[0, 2], inertia[1, 1], inertia[1, 2], inertia[2, 2]),
+                  "    </inertial>", "  </link>"]
+        terms = dict(zip(robot.drive_terms, fitted.drive[j]))
+        fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
+        if fc < 0 or fv < 0:
+            raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
+        parent = "base_link" if j == 0 else f"link{j}"
+        lines += [f"  <joint name={quoteattr(joint.name)} type=\"revolute\">", f'    <parent link="{parent}"/>', f'    <child link="{link}"/>',
+                  f'    <origin xyz="{_vec(joint.translation)}" rpy="{_vec(_rpy(joint.rotation))}"/>',
+                  f'    <axis xyz="{_vec(joint.axis)}"/>',
+                  '    <limit lower="{:.17g}" upper="{:.17g}" effort="{:.17g}" velocity="{:.17g}"/>'.format(
+                      *(_finite(x) for x in (robot.limits.q_min[j], robot.limits.q_max[j], robot.limits.tau_max[j], robot.limits.dq_max[j]))),
+                  f'    <dynamics damping="{fv:.17g}" friction="{fc:.17g}"/>']
+        extra = {k: v for k, v in terms.items() if k not in ("fc", "fv") and v != 0}
+        if extra:
+            lines.append("    <!-- dynid: drive terms URDF cannot hold, add them to the torques: "
+                         + ", ".join(f"{k}{j + 1} = {v:.17g}" for k, v in extra.items()) + " -->")
+        if robot.coulomb_velocity[j] > 0:
+            lines.append(f"    <!-- dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[j]:.6g}) instead of sign(dq) -->")
+        lines.append("  </joint>")
+    n_coupled = robot.transmission.n_coupled_params
+    if n_coupled:
+        names = robot.transmission.coupled_parameter_names
+        lines.append("  <!-- dynid: coupled motors (not representable in URDF), add their torques: "
+                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(names, phi[-n_coupled:])) + " -->")
+    lines += ['  <link name="flange"/>', '  <joint name="flange_fixed" type="fixed">', f'    <parent link="link{robot.n_dof}"/>',
+              '    <child link="flange"/>',
+              f'    <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(robot.tool_rotation))}"/>', "  </joint>", "</robot>", ""]
+    return "\n".join(lines)
+
+
+def _finite(x: float) -> float:
+    return float(x) if np.isfinite(x) else 1e6
+
+
+def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
+    """URDF of ``robot`` with the physically consistent estimate stored in a ``results.json`` of
+    ``dynid identify`` (``physically_consistent.standard_values``; Coulomb smoothing from its settings).
+
+    Raises
+    ------
+    ConfigError
+        No physically consistent estimate in the results, results of another robot, or a set that is
+        not physically consistent (the verdict says why).
+    """
+    sdp = results.get("physically_consistent") if isinstance(results, dict) else None
+    if not isinstance(sdp, dict) or not isinstance(sdp.get("standard_values"), dict):
+        raise ConfigError(f"{source}: no physically consistent estimate to export; identify with "
+                          "[estimation] physically_consistent = true (or methods including \"sdp\")")
+    verdict = results.get("physically_consistent_verdict", {}).get(sdp.get("label", ""), "yes")
+    if verdict != "yes":
+        raise ConfigError(f"{source}: the physically consistent estimate did not pass the consistency check ({verdict})")
+    values = sdp["standard_values"]
+    missing = [n for n in robot.parameter_names if n not in values]
+    if missing:
+        raise ConfigError(f"{source}: its standard parameters are not those of robot {robot.name!r} (missing {', '.join(missing[:4])})")
+    phi = np.array([float(values[n]) for n in robot.parameter_names])
+    vs = results.get("settings", {}).get("coulomb_velocity")
+    if vs is not None:
+        from dataclasses import replace
+
+        robot = replace(robot, coulomb_velocity=np.asarray(vs, dtype=float))
+    return urdf_from_robot(robot, phi)
