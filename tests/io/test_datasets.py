@@ -90,3 +90,58 @@ def test_time_range_selects_seconds_and_is_checked(tmp_path):
     spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "time_range": [10.0, 11.0]}, tmp_path, "cfg", "ident", 6)
     with pytest.raises(DataError, match=r"time_range \[10, 11\] s holds fewer than 2 samples of the 2.990 s recording"):
         load_recording(spec, load_robot("ur10e"))
+
+
+def _log(tmp_path, t, q, cur, name="ur.csv"):
+    (tmp_path / name).write_text("".join(_ur_row(tk, qk, qk * 0, ik) for tk, qk, ik in zip(t, q, cur)))
+    return dataset_spec({"preset": "ur-rtde", "file": name}, tmp_path, "cfg: identification", "ident", 6)
+
+
+def test_a_gap_in_the_time_stamps_is_refused_unless_interpolation_is_asked(tmp_path):
+    t = np.concatenate([np.arange(100) * 0.01, 3.0 + np.arange(100) * 0.01])
+    spec = _log(tmp_path, t, np.full((200, 6), 0.1), np.full((200, 6), 0.5))
+    with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps .*gaps = \"interpolate\""):
+        load_recording(spec, load_robot("ur10e"))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "interpolate"}, tmp_path, "cfg", "ident", 6)
+    assert load_recording(spec, load_robot("ur10e")).n_samples > 200
+
+
+def test_positions_in_degrees_are_refused_with_the_hint(tmp_path):
+    t = np.arange(100) * 0.01
+    q = np.outer(np.linspace(0, 90, 100), np.ones(6))
+    with pytest.raises(DataError, match=r"ur.csv: joint 1 reaches 90 rad, implausible for radians: .*unit = \"deg\""):
+        load_recording(_log(tmp_path, t, q, np.ones((100, 6))), load_robot("ur10e"))
+
+
+def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path, rng):
+    t = np.arange(300) * 0.01
+    cur = rng.normal(0, 1, (300, 6))
+    cur[100:160, 2] = 7.5  # clipped
+    q = np.full((300, 6), 0.1)
+    q[:, 1] = 7.0  # beyond the UR10e's ±2π
+    rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
+    assert any("joint 3's currents stay at their extreme 7.5 for 60 samples (t = 1.000-1.590 s)" in w for w in rec.warnings)
+    assert any("joint 2 leaves its limits" in w for w in rec.warnings)
+
+
+@pytest.mark.parametrize("content, rows, message", [
+    ("", None, r"no data lines \(an empty file"),
+    ("\x00\x01\x02garbage\n", None, r"line 1: expected 31 columns, got 1"),
+    ("1,2,3\n" * 0, [5, 9], r"no data lines"),
+])
+def test_empty_and_garbage_files_say_what_they_are(tmp_path, content, rows, message):
+    (tmp_path / "ur.csv").write_text(content)
+    table = {"preset": "ur-rtde", "file": "ur.csv", **({"rows": rows} if rows else {})}
+    with pytest.raises(DataError, match=message):
+        load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), load_robot("ur10e"))
+
+
+def test_rows_beyond_the_end_of_the_file_are_refused(tmp_path):
+    t = np.arange(50) * 0.01
+    _log(tmp_path, t, np.zeros((50, 6)), np.ones((50, 6)))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "rows": [10, 99999]}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(DataError, match=r"ur.csv: rows = \[10, 99999\] goes beyond the file's end: it has 50 data rows"):
+        load_recording(spec, load_robot("ur10e"))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "rows": [60, 70]}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(DataError, match=r"rows = \[60, 70\] selects nothing: the file has 50 data rows"):
+        load_recording(spec, load_robot("ur10e"))

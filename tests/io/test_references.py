@@ -19,12 +19,12 @@ def test_standard_set_becomes_base_parameters(tmp_path):
     robot = load_robot("er16").submodel(3)
     base = base_parameters(robot, rng=0)
     phi = np.random.default_rng(0).normal(size=robot.n_params)
-    rows = ["name,value"] + [f"{n.replace('XX', 'Ixx').replace('MX', 'mx')},{float(v)!r}" for n, v in zip(robot.parameter_names, phi)] + ["K1,3.0"]
+    rows = ["name,value"] + [f"{n.replace('XX', 'Ixx').replace('MX', 'mx')},{float(v)!r}" for n, v in zip(robot.parameter_names, phi)] + ["K1,3.0", "foo,1.0"]
     (tmp_path / "ref.csv").write_text("\n".join(rows) + "\n")
     ref = load_reference({"name": "r", "file": "ref.csv", "header": True, "names": "name", "values": "value"}, tmp_path, "cfg", base)
     np.testing.assert_allclose(ref.beta, base.base_from_standard(phi))
-    assert ref.warnings and "K1" in ref.warnings[0]
-    (tmp_path / "ref.csv").write_text("\n".join(rows[:-3]) + "\n")
+    assert ref.warnings and "foo" in ref.warnings[0] and "K1" not in ref.warnings[0]  # drive gains beside a set: no warning
+    (tmp_path / "ref.csv").write_text("\n".join(rows[:-4]) + "\n")
     with pytest.raises(DataError, match="lacks parameter"):
         load_reference({"name": "r", "file": "ref.csv", "header": True, "names": "name", "values": "value"}, tmp_path, "cfg", base)
 

@@ -29,7 +29,7 @@ def test_truncated_last_line_is_skipped_with_a_warning(tmp_path):
     ("1,2,3\n4,5\n7,8,9\n", r"log.csv: line 2: expected 3 columns, got 2"),
     ("1,2,3\n4,nan,6\n", r"log.csv: line 2, column 2: NaN or infinite value"),
     ("1,2,3\n4,x,6\n", r"log.csv: line 2, column 2: expected a number, got 'x'"),
-    ("", r"log.csv: no data rows"),
+    ("", r"log.csv: no data lines \(an empty file, or not a text table\?\)"),
 ])
 def test_damaged_files_get_one_line_errors_with_file_and_line(tmp_path, text, message):
     p = _write(tmp_path, text)

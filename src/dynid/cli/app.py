@@ -32,6 +32,13 @@ def _fail(exc: Exception) -> None:
     raise typer.Exit(1)
 
 
+def _check_out(out) -> None:
+    """An unusable --out is refused before any computation."""
+    from ..report.output import check_output_folder
+
+    check_output_folder(out)
+
+
 def _count(n: int, noun: str) -> str:
     """``"no figures"``, ``"1 figure"``, ``"3 figures"``."""
     return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
@@ -88,6 +95,7 @@ def run(
     from ..report.paper_run import save_paper_run
 
     try:
+        _check_out(out)
         config = PaperExperimentConfig(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
@@ -336,6 +344,7 @@ def identify(
 
     try:
         cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
+        _check_out(out)
         from ..report.identification_run import save_identification
         with _progress("regressor") as progress:
             task = progress.add_task("x", total=1)
@@ -408,6 +417,7 @@ def validate(
 
     try:
         cfg = load_identification_config(config, data_root)
+        _check_out(out)
         from ..report.identification_run import save_validation
         try:
             identified = json.loads(results.read_text(encoding="utf-8"))
@@ -424,7 +434,7 @@ def validate(
             task = progress.add_task("x", total=1)
             comparisons, warnings = run_validation(cfg, identified, datasets,
                                                    progress=lambda d, t: progress.update(task, completed=d, total=t))
-        paths = save_validation(comparisons, warnings, out)
+        paths = save_validation(comparisons, out, warnings)
     except DynIdError as exc:
         _fail(exc)
     _comparison_tables(comparisons, cfg.robot.n_dof)
@@ -447,6 +457,7 @@ def excite(
 
     try:
         cfg = load_excitation_config(config)
+        _check_out(out)
         from ..report.excitation_run import save_excitation
         cfg = replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
         with Progress(TextColumn("[bold]design[/]"), BarColumn(), TextColumn("{task.completed}/{task.total} starts"),
@@ -520,6 +531,7 @@ def montecarlo(
     from ..report.montecarlo_run import save_montecarlo
 
     try:
+        _check_out(out)
         cfg = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
                                methods=DEFAULT_METHODS if methods is None else parse_methods(methods), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
                                excitation=excitation)

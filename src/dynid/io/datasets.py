@@ -9,6 +9,7 @@ A dataset is described by a table of the experiment config (TOML)::
     header = false                   # first line holds column names
     rows = [635, 3510]               # 1-based inclusive data rows (header excluded)
     time_range = [6.3, 35.1]         # seconds from the first row read (after rows), inclusive
+    gaps = "refuse"                  # a time step over 5x the median: "refuse" (default) or "interpolate"
     time = { column = 1 }            # time stamps [s] …
     rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
     resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
@@ -85,6 +86,7 @@ class DatasetSpec:
     rows: tuple[int, int] | None = None
     delimiter: str = ","
     time_range: tuple[float, float] | None = None
+    gaps: str = "refuse"
 
 
 @dataclass(frozen=True)
@@ -134,6 +136,51 @@ def _time_range(value, where: str):
     return (float(value[0]), float(value[1]))
 
 
+def _gaps(value, where: str) -> str:
+    if value not in ("refuse", "interpolate"):
+        raise ConfigError(f"{where}.gaps: expected \"refuse\" or \"interpolate\", got {value!r}")
+    return value
+
+
+GAP_FACTOR = 5.0
+"""A time step longer than this many median steps is a gap in the log (a lost connection, a pause)."""
+
+SATURATION_SAMPLES = 20
+"""Consecutive samples at a joint's extreme value that count as saturation (clipped current or torque)."""
+
+
+def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, line_of, warnings: list[str]) -> None:
+    """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
+    currents or torques flat at their extreme (saturation), naming joint and time range."""
+    source = spec.signals["positions"].file
+    worst = np.abs(q).max(axis=0)
+    if np.any(worst > 4 * np.pi):
+        j = int(np.argmax(worst))
+        raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
+                        f"positions in degrees (positions = {{ ..., unit = \"deg\" }})?")
+    lim = robot.limits
+    for j in range(q.shape[1]):
+        out = (q[:, j] < lim.q_min[j] - 0.05) | (q[:, j] > lim.q_max[j] + 0.05)
+        if out.any():
+            k = np.flatnonzero(out)
+            warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
+                            f"during {k.size} samples from t = {t[k[0]]:.3f} s (units, encoder zero, position_offset?)")
+    kind = "currents" if "currents" in spec.signals else "torques"
+    for j in range(tau.shape[1]):
+        x = tau[:, j]
+        peak = np.abs(x).max()
+        if peak == 0:
+            continue
+        at = np.abs(np.abs(x) - peak) <= 1e-9 * peak
+        runs = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
+        starts, stops = np.flatnonzero(runs == 1), np.flatnonzero(runs == -1)
+        long = [(a, b) for a, b in zip(starts, stops) if b - a >= SATURATION_SAMPLES]
+        if long:
+            a, b = max(long, key=lambda r: r[1] - r[0])
+            warnings.append(f"{spec.signals[kind].file}: joint {j + 1}'s {kind} stay at their extreme {x[a]:.4g} for "
+                            f"{b - a} samples (t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? select rows or a time_range without them")
+
+
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring); paths are relative to ``base``.
 
@@ -156,7 +203,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             merged[k] = {**merged[k], **v}
         else:
             merged[k] = v
-    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "delimiter", "name", *_SIGNALS}
+    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "gaps", "delimiter", "name", *_SIGNALS}
     unknown = sorted(set(merged) - known)
     if unknown:
         raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(known)}")
@@ -210,7 +257,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         rate=None if rate is None else float(rate), resample=None if merged.get("resample") is None else float(merged["resample"]),
         side=side, header=bool(merged.get("header", False)), n_columns=merged.get("n_columns"),
         rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")),
-        time_range=_time_range(merged.get("time_range"), where))
+        time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where))
 
 
 def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
@@ -272,6 +319,14 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
             warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
         t, raw = t[inside], {kind: x[inside] for kind, x in raw.items()}
     median = float(np.median(np.diff(t)))
+    if spec.time is not None and spec.gaps == "refuse":
+        steps = np.diff(t)
+        if np.any(steps > GAP_FACTOR * median):
+            k = int(np.argmax(steps > GAP_FACTOR * median))
+            tb, _ = tables[spec.time.file]
+            raise DataError(f"{spec.time.file}: line {tb.first_line + k + 1}: a gap of {steps[k]:.3g} s in the time stamps "
+                            f"(median step {median:.3g} s) after t = {t[k] - t[0]:.3f} s; select rows or a time_range on "
+                            "one side of it, or set gaps = \"interpolate\"")
     uniform = spec.time is None or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = spec.rate if spec.time is None else (spec.resample or float(f"{1.0 / median:.6g}"))
     if spec.time is not None and (not uniform or spec.resample is not None):
@@ -290,4 +345,5 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
     else:
         motor_or_joint = raw["torques"]
     tau = tr.joint_torques(motor_or_joint) if spec.side == "motor" else motor_or_joint
+    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], None, warnings)
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings))

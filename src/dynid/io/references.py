@@ -171,6 +171,7 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
         funcs.append(f)
         values.append(value)
         stds.append(std)
+    ignored = [n for n in ignored if not re.fullmatch(r"K\d+", n)]  # drive gains K1.. beside a parameter set: not parameters
     if ignored:
         warnings.append(f"{path}: rows that are not parameters of this robot were ignored: {', '.join(ignored)}")
     if not funcs:

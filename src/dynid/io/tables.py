@@ -143,7 +143,14 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                 flush()
         flush()
     if not blocks:
-        raise DataError(f"{path}: no data rows in the selected range {list(rows) if rows else 'all'}")
+        if data_row == 0:
+            what = "only a header line" if header else "no data lines"
+            raise DataError(f"{path}: {what} (an empty file, or not a text table?)")
+        if rows is not None:
+            raise DataError(f"{path}: rows = {list(rows)} selects nothing: the file has {data_row} data rows")
+        raise DataError(f"{path}: no data rows")
+    if last is not None and data_row < last and not warnings:
+        raise DataError(f"{path}: rows = {list(rows)} goes beyond the file's end: it has {data_row} data rows")
     data = np.concatenate(blocks, axis=0)
     return Table(data, int(first_line), tuple(warnings))
 

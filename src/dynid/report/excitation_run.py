@@ -9,7 +9,7 @@ from ..dynamics.regressor import regressor
 from ..experiment.excitation_config import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
-from .output import output_folder, save_figure, write_results
+from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
@@ -17,6 +17,7 @@ FIGURES = {
 }
 
 
+@staged
 def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     """Write ``excitation.json``, ``excitation.csv`` and the figures into ``out``; return the paths.
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..experiment.identification import IdentificationResult, TorqueComparison
 from . import figures
-from .output import output_folder, save_figure, write_results
+from .output import output_folder, save_figure, write_results, staged
 
 
 def _slug(name: str) -> str:
@@ -28,6 +28,7 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list
     return paths
 
 
+@staged
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None) -> list[Path]:
     """Write ``results.json``, the identification fit figure and one figure per validation dataset
     (figures unless ``figures_too`` is false), and with ``robot`` (the identified robot) ``robot.urdf``
@@ -57,7 +58,8 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     return [json_path] + paths
 
 
-def save_validation(comparisons, warnings, out: str | Path) -> list[Path]:
+@staged
+def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
     """Write ``validation.json`` (per-joint metrics of every parameter set) and one figure per dataset."""
     out = output_folder(out)
     paths = save_comparisons(comparisons, out)

@@ -11,7 +11,7 @@ from ..experiment.methods import LABELS
 from ..experiment.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures
-from .output import output_folder, save_figure, write_results
+from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
     "montecarlo_std_vs_crb.png": "per noise level: standard deviation / Cramér–Rao bound of every base parameter, per method",
@@ -19,6 +19,7 @@ FIGURES = {
 }
 
 
+@staged
 def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
     """Write ``montecarlo.json``, ``montecarlo_estimates.csv`` and the figures into ``out``; return the paths.
 

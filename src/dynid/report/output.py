@@ -2,11 +2,75 @@
 
 from __future__ import annotations
 
+import functools
 import io
+import json
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 from ..exceptions import ConfigError
 from ..io import atomic_write_bytes
+
+
+MANIFEST = ".dynid-manifest.json"
+"""Written last into an output folder: the files of the run that is there, whole."""
+
+
+def check_output_folder(out: str | Path) -> Path:
+    """Refuse, before any computation, an ``--out`` that is a file or a folder that cannot be written.
+
+    Raises
+    ------
+    ConfigError
+        Names the path and the reason.
+    """
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out}: exists and is not a folder")
+    parent = out if out.exists() else next((p for p in out.absolute().parents if p.exists()), Path("/"))
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ConfigError(f"--out {out}: {parent} is not writable")
+    return out
+
+
+def staged(save):
+    """Decorator for ``save(result, out, ...) -> paths``: the files are written into a hidden staging folder
+    inside ``out``, then moved into ``out`` one by one; the files of an earlier run there that this one
+    does not write again are removed, and the manifest (:data:`MANIFEST`) is written last. An error or a
+    Ctrl-C while saving leaves ``out`` as it was (the staging folder is removed)."""
+
+    @functools.wraps(save)
+    def wrapper(result, out, *args, **kwargs):
+        out = output_folder(out)
+        stage = Path(tempfile.mkdtemp(prefix=".dynid-staging-", dir=out))
+        try:
+            written = save(result, stage, *args, **kwargs)
+            final = [out / p.relative_to(stage) for p in written]
+            previous = _manifest_files(out)
+            for p in previous - {f.name for f in final}:
+                (out / p).unlink(missing_ok=True)
+            for src, dst in zip(written, final):
+                os.replace(src, dst)
+            from .. import __version__
+            from ..io import atomic_write_text
+
+            atomic_write_text(out / MANIFEST, json.dumps({"dynid_version": __version__, "files": [f.name for f in final]},
+                                                          indent=2) + "\n")
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
+        return final
+
+    return wrapper
+
+
+def _manifest_files(out: Path) -> set[str]:
+    try:
+        files = json.loads((out / MANIFEST).read_text(encoding="utf-8"))["files"]
+        return {f for f in files if isinstance(f, str) and "/" not in f and f not in ("", ".", "..")}
+    except (OSError, ValueError, KeyError, TypeError):
+        return set()
 
 
 def output_folder(out: str | Path) -> Path:
@@ -20,9 +84,7 @@ def output_folder(out: str | Path) -> Path:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out}: exists and is not a folder")
+    out = check_output_folder(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

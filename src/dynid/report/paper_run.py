@@ -10,7 +10,7 @@ from ..experiment import paper_reference as ref
 from ..experiment.methods import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
 from . import figures
-from .output import output_folder, save_figure, write_results
+from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",
@@ -26,6 +26,7 @@ TORQUE_PLOT_METHODS = ("abc", "lad", "ols", "sdp")
 """Methods drawn in Figs. 7 and 9 (those the run has), so the curves stay readable."""
 
 
+@staged
 def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = True) -> list[Path]:
     """Write ``results.json`` and (unless ``figures_too`` is false) the figures into ``out`` (created if
     needed); return the paths.

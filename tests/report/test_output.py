@@ -1,0 +1,56 @@
+"""Output folders: a run lands whole or not at all, and --out is checked before any computation."""
+
+import json
+import os
+
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.report.output import MANIFEST, check_output_folder, staged
+
+
+@staged
+def _save(files, out, fail_after=None):
+    paths = []
+    for i, (name, text) in enumerate(files.items()):
+        if fail_after is not None and i == fail_after:
+            raise KeyboardInterrupt  # as Ctrl-C while saving
+        (out / name).write_text(text)
+        paths.append(out / name)
+    return paths
+
+
+def test_a_run_replaces_the_earlier_one_whole(tmp_path):
+    out = tmp_path / "run"
+    _save({"results.json": "1", "a.png": "A", "b.png": "B"}, out)
+    (out / "notes.txt").write_text("mine")  # the user's own file stays
+    paths = _save({"results.json": "2", "a.png": "A2"}, out)
+    assert paths == [out / "results.json", out / "a.png"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "a.png", "notes.txt", "results.json"]
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["results.json", "a.png"]
+    assert (out / "results.json").read_text() == "2"
+
+
+def test_an_interrupted_save_leaves_the_earlier_run_unchanged(tmp_path):
+    out = tmp_path / "run"
+    _save({"results.json": "1", "a.png": "A"}, out)
+    before = {p.name: p.read_text() for p in out.iterdir()}
+    with pytest.raises(KeyboardInterrupt):
+        _save({"results.json": "2", "a.png": "A2", "b.png": "B2"}, out, fail_after=2)
+    assert {p.name: p.read_text() for p in out.iterdir()} == before  # no staging folder left, nothing mixed
+
+
+def test_unusable_out_is_refused_before_computing(tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ConfigError, match=r"--out .*file: exists and is not a folder"):
+        check_output_folder(tmp_path / "file")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    os.chmod(ro, 0o500)
+    try:
+        if os.access(ro, os.W_OK):  # root ignores permissions
+            pytest.skip("running as root: permissions are not enforced")
+        with pytest.raises(ConfigError, match="is not writable"):
+            check_output_folder(ro / "sub")
+    finally:
+        os.chmod(ro, 0o700)
