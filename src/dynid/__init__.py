@@ -4,6 +4,53 @@ The package follows the procedure of Ding et al., "Dynamic Model Identification 
 Industrial Robots" (the ER-16 paper): linear model (eqs. 1-6), Fourier excitation (eq. 14-15),
 torques from currents (eq. 16), smoothing (eq. 17), artificial bee colony and least-squares
 estimation (eqs. 7-13) and validation by the correlation coefficient (eq. 18).
+
+The main entry points, importable from the package (each loads its modules on first use)::
+
+    import dynid
+    robot = dynid.load_robot("ur10e")                       # built-in name or description TOML
+    result = dynid.identify_from_arrays(robot, t, q, tau)   # or, from logs:
+    result = dynid.run_identification(dynid.load_identification_config("configs/ur10e.toml"))
+    comparisons, warnings = dynid.run_validation(config, results_json_dict)
+    design = dynid.design_excitation(dynid.ExcitationProblem(robot, omega_f, n_harmonics))
+    urdf_text = dynid.urdf_from_robot(robot, standard_parameters)
+    run = dynid.run_paper_experiment(dynid.PaperExperimentConfig(methods=("ols", "abc")))
+
+``examples/`` holds short scripts that use them.
 """
 
 __version__ = "0.1.0"
+
+_EXPORTS = {
+    "load_robot": "dynid.model.description",
+    "Robot": "dynid.model.robot",
+    "regressor": "dynid.dynamics.regressor",
+    "base_parameters": "dynid.dynamics.base_parameters",
+    "rnea_torques": "dynid.dynamics.rnea",
+    "Preprocessing": "dynid.preprocessing.settings",
+    "load_identification_config": "dynid.experiment.identification_config",
+    "run_identification": "dynid.experiment.identification_config",
+    "run_validation": "dynid.experiment.identification_config",
+    "identify_from_arrays": "dynid.experiment.identification_config",
+    "ExcitationProblem": "dynid.excitation.design",
+    "design_excitation": "dynid.excitation.design",
+    "FourierTrajectory": "dynid.excitation.fourier",
+    "urdf_from_robot": "dynid.io.export",
+    "urdf_from_results": "dynid.io.export",
+    "PaperExperimentConfig": "dynid.experiment.paper",
+    "run_paper_experiment": "dynid.experiment.paper",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        import importlib
+
+        return getattr(importlib.import_module(_EXPORTS[name]), name)
+    raise AttributeError(f"module 'dynid' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(__all__)

@@ -397,3 +397,60 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
             raise DataError("results: settings.coulomb_velocity must give one non-negative velocity per joint") from None
     comparisons, warnings = _validate(config, base, sets, datasets, progress, _stored_preprocessing(identified))
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
+
+
+@with_single_blas_thread
+def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
+                         method: str = "wls", physically_consistent: bool = False, methods: tuple[str, ...] = (),
+                         name: str = "arrays"):
+    """Identify a robot from arrays, without a config file or a CSV: the same pipeline as ``dynid identify``
+    (data-derived preprocessing, parallel filtering, OLS/WLS with σ, optionally the SDP and other estimators).
+
+    Parameters
+    ----------
+    robot : Robot
+        E.g. :func:`dynid.load_robot`.
+    t : (N,) array [s]
+        Uniformly sampled time stamps.
+    q : (N, n_dof) array [rad]
+        Joint positions.
+    tau : (N, n_dof) array [N·m]
+        Joint torques (e.g. drive gain × motor current, eq. 16).
+    dq : (N, n_dof) array [rad/s], optional
+        Measured velocities (default: differentiated from the filtered positions).
+    preprocessing : Preprocessing, optional
+        Default: every setting derived from the data.
+    method, physically_consistent, methods
+        As ``[estimation]`` of a config.
+
+    Returns
+    -------
+    dynid.experiment.identification.IdentificationResult
+
+    Raises
+    ------
+    ShapeError
+        Arrays of inconsistent shapes, not time-first, or not finite.
+    DataError
+        Time stamps that are not uniform and increasing.
+    """
+    from ..checks import check_trajectory_array
+    from ..dynamics.base_parameters import base_parameters
+    from ..exceptions import ShapeError
+    from ..io.datasets import Recording
+    from ..preprocessing.pipeline import prepare
+    from .identification import identify
+
+    t = np.asarray(t, dtype=float).reshape(-1)
+    q = check_trajectory_array(q, robot.n_dof, "q")
+    tau = check_trajectory_array(tau, robot.n_dof, "tau")
+    dq = None if dq is None else check_trajectory_array(dq, robot.n_dof, "dq")
+    if not (q.shape[0] == tau.shape[0] == t.shape[0] and (dq is None or dq.shape[0] == t.shape[0])):
+        raise ShapeError(f"expected t, q, tau (and dq) with the same number of samples, got {t.shape[0]}, {q.shape[0]}, {tau.shape[0]}")
+    steps = np.diff(t)
+    if t.size < 2 or np.any(steps <= 0) or np.ptp(steps) > 1e-6 * np.median(steps):
+        raise DataError("t: expected uniformly spaced, increasing time stamps (resample the data first)")
+    rate = 1.0 / float(np.median(steps))
+    data = prepare(Recording(name, t - t[0], q, dq, tau, rate), preprocessing or Preprocessing())
+    base = base_parameters(robot, rng=0)
+    return identify(robot, base, data, method, (), None, physically_consistent or "sdp" in methods, tuple(methods))

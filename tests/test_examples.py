@@ -1,0 +1,43 @@
+"""The scripts of examples/ run as a user runs them, and say what they promise."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _run(name: str) -> str:
+    p = subprocess.run([sys.executable, str(EXAMPLES / name)], capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "MPLBACKEND": "Agg"})
+    assert p.returncode == 0, p.stderr
+    return p.stdout
+
+
+def test_paper_experiment_example():
+    out = _run("paper_experiment.py")
+    assert "ols" in out and "abc" in out and "F (eq. 9)" in out
+
+
+def test_identify_from_arrays_example():
+    out = _run("identify_from_arrays.py")
+    assert "excitation band" in out and "base parameters" in out
+
+
+def test_export_and_simulate_example():
+    out = _run("export_and_simulate.py")
+    diff = float(out.split("dynid (N·m):")[1].split()[0])
+    assert diff < 1e-8, out
+    assert "after 0.5 s from rest" in out
+
+
+def test_package_exports_the_entry_points():
+    import dynid
+
+    for name in dynid.__all__:
+        assert getattr(dynid, name) is not None, name
+    with pytest.raises(AttributeError):
+        dynid.nonexistent
