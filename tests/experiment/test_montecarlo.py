@@ -68,8 +68,11 @@ def test_bad_settings(kwargs, message):
 
 
 def test_unreachable_scheduler_is_a_one_line_error():
+    from dynid.experiment.montecarlo import dask_client
+
     with pytest.raises(ConfigError, match="cannot reach the Dask scheduler"):
-        run_montecarlo(SMALL, scheduler="tcp://127.0.0.1:9")
+        with dask_client(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0):
+            pass
 
 
 def test_scheduler_address_path_gives_the_same_study(study):

@@ -239,9 +239,10 @@ class MonteCarloResult:
 
 
 @contextlib.contextmanager
-def dask_client(scheduler: str | None = None, workers: int | None = None):
-    """A Dask client: to ``scheduler`` (an address like ``tcp://host:8786``) if given, else to a new
-    :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: the local cores).
+def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0):
+    """A Dask client: to ``scheduler`` (an address like ``tcp://host:8786``, given ``connect_timeout`` seconds
+    to answer) if given, else to a new :class:`distributed.LocalCluster` of ``workers`` single-threaded
+    processes (default: the local cores).
 
     Raises
     ------
@@ -252,7 +253,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
 
     if scheduler:
         try:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout=f"{connect_timeout}s")
         except (OSError, TimeoutError) as exc:
             raise ConfigError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
         with client:
