@@ -229,6 +229,19 @@ def _comparison_tables(comparisons, n_dof: int) -> None:
         console.print(t)
 
 
+def _print_filter_choice(cv: dict) -> None:
+    """preprocessing = "auto": each candidate's cutoffs and out-of-fold errors on the common held-out samples."""
+    t = Table(title="preprocessing = \"auto\": out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
+              box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("positions (Hz)", "parallel (Hz)", "decimation", *(f"J{j + 1}" for j in range(len(cv["out_of_fold_rms_error"][0]))), "score"):
+        t.add_column(col, justify="right")
+    for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])):
+        mark = "*" if i == cv["chosen"] else ""
+        t.add_row(f"{c['position_cutoff']:.3g}{mark}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
+                  *(f"{x:.4g}" for x in e), f"{s:.4g}")
+    console.print(t)
+
+
 def _print_coulomb_choice(cv: dict) -> None:
     """The candidates of the Coulomb smoothing velocity and their out-of-fold errors, per joint."""
     cand, err = cv["candidates"], cv["out_of_fold_rms_error"]
@@ -292,6 +305,9 @@ def _print_identification(result, paths) -> None:
     pre = result.settings.get("preprocessing", {})
     if pre.get("derivation"):
         console.print(escape("preprocessing: " + pre["derivation"]), soft_wrap=True)
+    filters = result.settings.get("preprocessing_cross_validation")
+    if filters is not None:
+        _print_filter_choice(filters)
     cv = result.settings.get("coulomb_cross_validation")
     if cv is not None:
         _print_coulomb_choice(cv)

@@ -101,7 +101,7 @@ class IdentificationConfig:
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
              "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None,
-             "coulomb_velocity": None}
+             "coulomb_velocity": None, "auto": None}
 
 
 def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
@@ -129,6 +129,11 @@ def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preproc
             if traj.n_dof != n:
                 raise ConfigError(f"{where}.excitation: the trajectory has {traj.n_dof} joints, the robot {n}")
             values["fourier"] = (traj.omega_f, traj.n_harmonics)
+            continue
+        if key == "auto":
+            if not isinstance(v, bool):
+                raise ConfigError(f"{where}.auto: expected true or false, got {v!r}")
+            values[key] = v
             continue
         if key in ("min_speed", "coulomb_velocity"):
             if v == "auto":
@@ -188,7 +193,10 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     names = [v.name for v in validation]
     if len(set(names)) != len(names):
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
-    pre = _preprocessing(doc.get("preprocessing", {}), f"{path}: preprocessing", n, here)
+    table = doc.get("preprocessing", {})
+    if table == "auto":
+        table = {"auto": True, "coulomb_velocity": "auto"}
+    pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     est = doc.get("estimation", {})
     if not isinstance(est, dict):
         raise ConfigError(f"{path}: estimation: expected a table")
@@ -336,13 +344,22 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
 
     base = base_parameters(config.robot, rng=0)
     refs = _references(config, base)
-    data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
+    recording = load_recording(config.identification, config.robot)
+    filters = None
+    if config.preprocessing.auto:
+        from ..validation.cross_validation import choose_preprocessing
+
+        filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)
+        data = filters.data
+    else:
+        data = prepare(recording, config.preprocessing)
     vs = config.preprocessing.coulomb_velocity
     choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
     result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
-                                       **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()})})
+                                       **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
+                                       **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if config.drive_gains is not None:
         result = replace(result, drive_gains=_gains_and_payload(config, robot, base))
     if not validate or not config.validation:

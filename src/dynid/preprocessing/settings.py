@@ -49,6 +49,10 @@ class Preprocessing:
         sign. "auto": chosen per joint by blocked cross-validation on the identification log
         (:func:`dynid.validation.cross_validation.choose_coulomb_velocity`). Not the default: on the
         UR10e logs the choice made on the excitation log raised the point-to-point validation errors.
+    auto : bool
+        ``preprocessing = "auto"``: the position and parallel cutoffs (hence the decimation) are chosen
+        by blocked cross-validation (:func:`dynid.validation.cross_validation.choose_preprocessing`), and
+        the Coulomb smoothing velocity too unless given.
     derivation : str
         Filled by :meth:`resolved`: what was derived from the data, and why.
     """
@@ -64,6 +68,7 @@ class Preprocessing:
     chunk: int = 20_000
     fourier: tuple[float, int] | None = None
     coulomb_velocity: str | float | tuple = 0.0
+    auto: bool = False
     derivation: str = ""
 
     def resolved(self, rate: float, q: np.ndarray | None = None, measured_velocity: bool = True) -> "Preprocessing":

@@ -7,7 +7,10 @@ Information Sciences 191, 2012): the parameters are fitted on all blocks but one
 accumulated per block (:class:`dynid.estimators.accumulate.LeastSquaresAccumulator`), and the torque
 error is measured on the block left out, joint by joint.
 
-Used to choose each joint's Coulomb smoothing velocity ``v_s`` (:mod:`dynid.friction`).
+Used to choose each joint's Coulomb smoothing velocity ``v_s`` (:mod:`dynid.friction`), and with
+``preprocessing = "auto"`` the filters: candidates that filter differently are fitted on the same
+blocks and scored on the same held-out samples, preprocessed by the default rules, so that a candidate
+cannot look better by filtering its own test samples more.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
 
 COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
 """Candidate smoothing velocities, as fractions of each joint's RMS speed (0: sign)."""
@@ -114,3 +117,110 @@ def choose_coulomb_velocity(robot: Robot, base: BaseParameters, data: PreparedDa
     if not np.all(np.isfinite(error[best, np.arange(n)])):
         return CoulombChoice(np.zeros(n), candidates, error, folds)
     return CoulombChoice(candidates[best, np.arange(n)], candidates, error, folds)
+
+
+FILTER_FACTORS = (5.0, 10.0, 20.0)
+"""Candidate position and parallel cutoffs, as multiples of the excitation band (the default is 10)."""
+
+
+@dataclass(frozen=True)
+class PreprocessingChoice:
+    """Filters chosen by blocked cross-validation (``preprocessing = "auto"``).
+
+    Attributes
+    ----------
+    settings : Preprocessing
+        The chosen candidate (resolved on the data).
+    candidates : tuple of Preprocessing
+    error : (n_candidates, n_dof) array [N·m]
+        Out-of-fold RMS torque error of each candidate on the common held-out samples.
+    score : (n_candidates,) array
+        Mean over joints of (error / RMS torque)²: the criterion (joints weigh alike).
+    note : str
+        What was chosen, in words.
+    data : PreparedData
+        The identification log prepared with the chosen settings.
+    """
+
+    settings: Preprocessing
+    candidates: tuple
+    error: np.ndarray
+    score: np.ndarray
+    note: str = ""
+    data: PreparedData | None = None
+
+    def to_dict(self) -> dict:
+        return {"chosen": int(np.argmin(self.score)), "note": self.note,
+                "candidates": [{"position_cutoff": c.position_cutoff, "parallel_cutoff": c.parallel_cutoff,
+                                "decimation": c.decimation} for c in self.candidates],
+                "out_of_fold_rms_error": self.error, "score": self.score}
+
+
+def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: int):
+    """One accumulator per block of ``duration / folds`` seconds (blocks by time, so that candidates trimmed
+    differently share their block boundaries), and each joint's RMS torque."""
+    accs = [LeastSquaresAccumulator(base.n_base, robot.n_dof) for _ in range(folds)]
+    sumsq = np.zeros(robot.n_dof)
+    count = 0
+    for index, y, tau, keep in base_chunks(robot, base, data):
+        fold = np.minimum((data.t[index] / duration * folds).astype(int), folds - 1)
+        sumsq += (tau**2).sum(axis=0)
+        count += tau.shape[0]
+        for k in np.unique(fold):
+            sel = fold == k
+            accs[k].add(y[sel].reshape(-1, base.n_base), tau[sel].reshape(-1), keep[sel].reshape(-1))
+    return accs, np.sqrt(sumsq / max(count, 1))
+
+
+def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS,
+                         factors=FILTER_FACTORS) -> PreprocessingChoice:
+    """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation.
+
+    Each candidate sets both cutoffs to ``factor × band`` (band from the data, as by default; cutoffs the
+    config gives are kept). Its parameters are fitted on all blocks but one of its own preprocessed rows
+    and scored on the held-out block of the **default** preprocessing's rows, the same for every candidate.
+
+    Parameters
+    ----------
+    robot, base
+    recording : dynid.io.datasets.Recording
+        The raw identification log.
+    given : Preprocessing
+        The config's settings (``None`` fields are chosen).
+    folds : int
+    factors : sequence of float
+
+    Returns
+    -------
+    PreprocessingChoice
+    """
+    reference = prepare(recording, given)
+    band = reference.settings.band
+    duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
+    evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
+    candidates, errors, prepared = [], [], []
+    for f in factors:
+        settings = replace(given,
+                           position_cutoff=given.position_cutoff if given.position_cutoff is not None else min(f * band, 0.4 * recording.rate),
+                           parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else min(f * band, 0.4 * recording.rate))
+        data = prepare(recording, settings)
+        fitted, _ = _fold_accumulators(robot, base, data, duration, folds)
+        sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
+        try:
+            for k in range(folds):
+                params = LeastSquaresAccumulator.merged([a for i, a in enumerate(fitted) if i != k]).solve().params
+                sumsq += evaluation[k].joint_residual_sumsq(params)
+                rows += evaluation[k].rows
+            errors.append(np.sqrt(sumsq / np.maximum(rows, 1)))
+        except IdentifiabilityError:
+            errors.append(np.full(robot.n_dof, np.inf))
+        candidates.append(data.settings)
+        prepared.append(data)
+    error = np.array(errors)
+    score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
+    best = int(np.argmin(score))
+    note = (f"cutoffs {factors[best]:g}× band, chosen by {folds}-fold blocked cross-validation among "
+            f"{', '.join(f'{f:g}' for f in factors)}× band")
+    data = prepared[best]
+    data = replace(data, settings=replace(data.settings, derivation=f"{data.settings.derivation}; {note}"))
+    return PreprocessingChoice(data.settings, tuple(candidates), error, score, note, data)
