@@ -17,7 +17,7 @@ demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/dynid run
 
 test: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_table.py
