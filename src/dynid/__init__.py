@@ -19,6 +19,8 @@ The main entry points, importable from the package (each loads its modules on fi
 ``examples/`` holds short scripts that use them.
 """
 
+from ._lazy import lazy_exports
+
 __version__ = "0.1.0"
 
 _EXPORTS = {
@@ -43,14 +45,4 @@ _EXPORTS = {
 
 __all__ = ["__version__", *_EXPORTS]
 
-
-def __getattr__(name):
-    if name in _EXPORTS:
-        import importlib
-
-        return getattr(importlib.import_module(_EXPORTS[name]), name)
-    raise AttributeError(f"module 'dynid' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(__all__)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

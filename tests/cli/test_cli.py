@@ -15,12 +15,12 @@ def test_run_writes_results_and_figures(tmp_path):
     out = tmp_path / "run"
     p = dynid("run", "--out", str(out), *FAST)
     assert p.returncode == 0, p.stderr
-    assert "correlation coefficient" in p.stdout and "0.3182" in p.stdout
+    assert "ρ (eq. 18)" in p.stdout and "0.3182" in p.stdout
     data = json.loads((out / "results.json").read_text())
     assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
     assert set(data["methods"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
-    assert "Estimator comparison" in p.stdout and "ABC×10" in p.stdout and "physically consistent" in p.stdout
-    assert "Uncertainty" in p.stdout and set(data["methods"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
+    assert "Estimators:" in p.stdout and "ABC×10" in p.stdout and "physically consistent" in p.stdout
+    assert "moving-block" in p.stdout and set(data["methods"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
     assert len(list(out.glob("fig*.png"))) == 6 and len(list(out.glob("methods_*.png"))) == 2
     assert not list(out.glob(".*tmp"))
 

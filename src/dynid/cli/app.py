@@ -22,8 +22,10 @@ from ..exceptions import DynIdError
 app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
                   help="dynid: dynamic model identification of industrial robot arms.")
 console = Console()
-if not console.is_terminal:  # logs and pipes: wide enough for every table
-    console = Console(width=140)
+if not console.is_terminal:  # logs and pipes: the width the environment states, else 100 columns
+    import os
+
+    console = Console(width=int(os.environ["COLUMNS"]) if os.environ.get("COLUMNS", "").isdigit() else 100)
 err_console = Console(stderr=True)
 
 
@@ -132,39 +134,45 @@ def _print_run(result, paths) -> None:
     console.print(f"identification trajectory: {ex['trajectory']}; cond(W_base) {ex['cond_base_regressor']:.2f} "
                   f"(β1: {ex['cond_base_regressor_beta1']:.2f})", soft_wrap=True)
     console.print("methods: " + "; ".join(f"{LABELS[k]} = {DESCRIPTIONS[k]}" for k in d["methods"]), soft_wrap=True, highlight=False)
-    t = Table(title="Base parameters: truth and estimates (units in results.json)", box=box.SIMPLE_HEAD, padding=(0, 1))
-    for col in ("name (paper)", "truth", *methods, "Table 2"):
-        t.add_column(col, justify="left" if col == "name (paper)" else "right", no_wrap=True)
-    for n in d["parameters"]:
-        sym = d["paper_symbols"][n]
-        t.add_row(f"{n} ({sym})" if sym else n, f"{d['truth'][n]:.4g}",
-                  *(f"{m['params'][n]:.4g}" for m in methods.values()), f"{ref.TABLE2[sym]:.4g}" if sym in ref.TABLE2 else "")
-    console.print(t)
-    t = Table(title="Estimator comparison: objective F (eq. 9) on the identification data, error against the true base "
-                    "parameters, mean over joints of ρ (eq. 18), RMSE and relative error", box=box.SIMPLE_HEAD, padding=(0, 1))
-    for col in ("method", "F (N·m)", "evaluations", "time (s)", "‖β̂−β‖/‖β‖ %", "ρ ident.", "ρ valid.", "RMSE valid. (N·m)",
-                "error valid. %", "consistent"):
-        t.add_column(col, justify="left" if col == "method" else "right")
+    per_table = max(1, (console.width - 42) // 11)  # method columns that fit beside name, truth and Table 2
+    labels = list(methods)
+    for first in range(0, len(labels), per_table):
+        group = labels[first:first + per_table]
+        part = f" ({first // per_table + 1} of {-(-len(labels) // per_table)})" if len(labels) > per_table else ""
+        t = Table(title=f"Base parameters: truth and estimates{part} (units in results.json)", box=box.SIMPLE_HEAD, padding=(0, 1))
+        for col in ("name (paper)", "truth", *group, "Table 2"):
+            t.add_column(col, justify="left" if col == "name (paper)" else "right", no_wrap=True)
+        for n in d["parameters"]:
+            sym = d["paper_symbols"][n]
+            t.add_row(f"{n} ({sym})" if sym else n, f"{d['truth'][n]:.4g}",
+                      *(f"{methods[label]['params'][n]:.4g}" for label in group), f"{ref.TABLE2[sym]:.4g}" if sym in ref.TABLE2 else "")
+        console.print(t)
+    t = Table(title="Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; "
+                    "mean over joints of ρ (eq. 18), RMSE (N·m) and error % on β2; physically consistent",
+              box=box.SIMPLE_HEAD, padding=(0, 1))
+    for col in ("method", "F", "evals", "s", "Δβ %", "ρ β2", "RMSE", "err %", "cons."):
+        t.add_column(col, justify="left" if col == "method" else "right", no_wrap=True)
     for label, m in methods.items():
-        t.add_row(label, f"{m['objective']:.4f}", str(m["n_evaluations"]) if m["n_evaluations"] else "solve",
-                  f"{m['seconds']:.2f}", f"{m['parameter_error_norm_percent']:.3g}",
-                  *(f"{sum(m[k][s]) / cfg.joints:{f}}" for k, s, f in (("correlation", "identification", ".4f"),
+        t.add_row(label, f"{m['objective']:.4g}", str(m["n_evaluations"]) if m["n_evaluations"] else "—",
+                  f"{m['seconds']:.1f}", f"{m['parameter_error_norm_percent']:.3g}",
+                  *(f"{sum(m[k][s]) / cfg.joints:{f}}" for k, s, f in (
                     ("correlation", "validation", ".4f"), ("rmse", "validation", ".3g"), ("relative_error", "validation", ".3g"))),
                   "yes" if m["physically_consistent"] else "no")
-    t.add_row("paper (ABC)", f"{ref.OBJECTIVE:.4f}", "", "", "", f"{sum(ref.CORRELATION_IDENTIFICATION) / 3:.4f}",
-              f"{sum(ref.CORRELATION_VALIDATION) / 3:.4f}", "", "", "")
+    t.add_row("paper", f"{ref.OBJECTIVE:.4g}", "", "", "", f"{sum(ref.CORRELATION_VALIDATION) / 3:.4f}", "", "", "")
     console.print(t)
     for key, beta, paper_vals in (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
                                   ("validation", "β2", ref.CORRELATION_VALIDATION)):
-        t = Table(title=f"Per joint, {key} trajectory {beta}: correlation coefficient ρ (eq. 18) and relative error %",
-                  box=box.SIMPLE_HEAD, padding=(0, 1))
-        for col in ("joint", "", *methods, "paper"):
-            t.add_column(col, justify="right")
-        for j in range(cfg.joints):
-            t.add_row(str(j + 1), "ρ", *(f"{m['correlation'][key][j]:.4f}" for m in methods.values()),
-                      f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—")
-            t.add_row("", "error %", *(f"{m['relative_error'][key][j]:.3g}" for m in methods.values()), "", end_section=True)
-        console.print(t)
+        for metric, title, fmt in (("correlation", "correlation coefficient ρ (eq. 18)", ".4f"),
+                                   ("relative_error", "relative error %", ".3g")):
+            t = Table(title=f"{key.capitalize()} trajectory {beta}: {title} per joint", box=box.SIMPLE_HEAD, padding=(0, 1))
+            t.add_column("method")
+            for j in range(cfg.joints):
+                t.add_column(f"J{j + 1}", justify="right")
+            for label, m in methods.items():
+                t.add_row(label, *(format(x, fmt) for x in m[metric][key]))
+            if metric == "correlation":
+                t.add_row("paper (ABC)", *(f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—" for j in range(cfg.joints)))
+            console.print(t)
     _print_uncertainty(d, methods)
     if "sdp" in d["methods"]:
         eig = d["methods"]["sdp"]["pseudo_inertia_min_eig"]
@@ -180,30 +188,24 @@ def _print_run(result, paths) -> None:
 
 
 def _print_uncertainty(d: dict, methods: dict) -> None:
-    """Standard deviations from the covariance beside the bootstrap's, with the bootstrap interval."""
+    """Per bootstrapped method: σ from the covariance beside the bootstrap's, with the bootstrap interval."""
     boot = {label: m for label, m in methods.items() if "bootstrap" in m}
-    if not boot:
-        return
-    first = next(iter(boot.values()))["bootstrap"]
-    t = Table(title=f"Uncertainty: σ from the covariance, σ and {100 * first['level']:.0f} % interval from the moving-block "
-                    f"bootstrap ({first['resamples']} resamples, blocks of {first['block_length_samples']} samples)",
-              box=box.SIMPLE_HEAD, padding=(0, 1))
-    t.add_column("name")
-    t.add_column("truth", justify="right")
-    for label in boot:
-        for col in ("σ cov.", "σ boot.", "interval"):
-            t.add_column(f"{label} {col}", justify="right", no_wrap=True)
-    covered = {label: 0 for label in boot}
-    for n in d["parameters"]:
-        row = [n, f"{d['truth'][n]:.3f}"]
-        for label, m in boot.items():
-            b = m["bootstrap"]
+    covered = {}
+    for label, m in boot.items():
+        b = m["bootstrap"]
+        t = Table(title=f"{label}: σ from the covariance, σ and {100 * b['level']:.0f} % interval from the moving-block "
+                        f"bootstrap ({b['resamples']} resamples, blocks of {b['block_length_samples']} samples)",
+                  box=box.SIMPLE_HEAD, padding=(0, 1))
+        for col in ("name", "truth", "σ cov.", "σ boot.", "interval"):
+            t.add_column(col, justify="left" if col == "name" else "right", no_wrap=True)
+        covered[label] = 0
+        for n in d["parameters"]:
             lo, hi = b["lower"][n], b["upper"][n]
             covered[label] += lo <= d["truth"][n] <= hi
-            row += [f"{m['params_std'][n]:.3g}", f"{b['std'][n]:.3g}", f"[{lo:.3f}, {hi:.3f}]"]
-        t.add_row(*row)
-    console.print(t)
-    console.print("intervals holding the truth: " + ", ".join(f"{label} {c}/{len(d['parameters'])}" for label, c in covered.items()))
+            t.add_row(n, f"{d['truth'][n]:.4g}", f"{m['params_std'][n]:.3g}", f"{b['std'][n]:.3g}", f"[{lo:.4g}, {hi:.4g}]")
+        console.print(t)
+    if covered:
+        console.print("intervals holding the truth: " + ", ".join(f"{label} {c}/{len(d['parameters'])}" for label, c in covered.items()))
 
 
 def _progress(label: str):
@@ -380,19 +382,12 @@ def export(
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
 ) -> None:
     """Export the physically consistent estimate as a URDF (load it in Pinocchio, a simulator, a controller)."""
-    import json
-
     from ..exceptions import DataError
     from ..experiment.identification_config import load_identification_config
 
     try:
         cfg = load_identification_config(config, data_root)
-        try:
-            identified = json.loads(results.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
-        except (OSError, json.JSONDecodeError) as exc:
-            raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
+        identified = _read_results(results)
         from ..io.export import urdf_from_results
         from ..io.files import atomic_write_text
 
@@ -404,6 +399,20 @@ def export(
         _fail(exc)
     console.print(f"wrote {urdf} (robot {cfg.robot.name}, {cfg.robot.n_dof} joints; rotor inertias, offsets and coupled "
                   "motors, which URDF cannot hold, are in comments on the joints)", highlight=False, soft_wrap=True)
+
+
+def _read_results(results: Path) -> dict:
+    """The results.json of dynid identify, or a one-line DataError."""
+    import json
+
+    from ..exceptions import DataError
+
+    try:
+        return json.loads(results.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
+    except (OSError, json.JSONDecodeError) as exc:
+        raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
 
 
 def _parse_rows(text: Optional[str]):
@@ -426,8 +435,6 @@ def validate(
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
-    import json
-
     from ..exceptions import DataError
     from ..experiment.identification_config import dataset_for_file, load_identification_config, run_validation
 
@@ -435,12 +442,7 @@ def validate(
         cfg = load_identification_config(config, data_root)
         _check_out(out)
         from ..report.identification_run import save_validation
-        try:
-            identified = json.loads(results.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
-        except (OSError, json.JSONDecodeError) as exc:
-            raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
+        identified = _read_results(results)
         datasets = None
         if file is not None:
             datasets = (dataset_for_file(cfg, file, _parse_rows(rows)),)

@@ -1,6 +1,8 @@
 """Excitation trajectories: finite Fourier series (paper eq. 14, Swevers form), the paper's built-in ones,
 design criteria, the constraints of eq. 15 and the optimal design."""
 
+from .._lazy import lazy_exports
+
 _EXPORTS = {
     "ConstraintMargin": "constraints",
     "Workspace": "constraints",
@@ -18,14 +20,4 @@ __all__ = ["ConstraintMargin", "ExcitationDesign", "ExcitationProblem", "Fourier
            "Workspace", "design_excitation", "paper_identification_trajectory", "paper_validation_trajectory",
            "trajectory_from_dict"]
 
-
-def __getattr__(name):  # exports are imported on first use, so that importing a submodule stays light
-    if name in _EXPORTS:
-        import importlib
-
-        return getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(__all__)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -27,6 +27,9 @@ from ..estimators import (BeeColonyEstimator, DifferentialEvolutionEstimator, Es
 from ..exceptions import ConfigError
 from .method_names import BOOTSTRAPPED, BOX_SEARCHES, DESCRIPTIONS, LABELS, METHODS, parse_methods
 
+__all__ = ["BOOTSTRAPPED", "BOX_SEARCHES", "DESCRIPTIONS", "LABELS", "METHODS", "parse_methods", "SearchBudget", "FitData",
+           "Fitted", "make_estimator", "fit_method"]
+
 @dataclass(frozen=True)
 class SearchBudget:
     """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations."""
