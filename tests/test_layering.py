@@ -22,14 +22,35 @@ def test_no_upward_imports():
             continue
         tree = ast.parse(path.read_text())
         for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and node.level >= 1 and node.module:
-                depth = len(rel) - 1
-                if node.level > depth:  # relative import reaching the package root
-                    target = node.module.split(".")[0]
-                elif node.level == depth and depth >= 1:
-                    target = top
-                else:
-                    continue
+            for target in _targets(node, rel, top):
                 if target in LEVEL and LEVEL[target] > LEVEL[top]:
                     bad.append(f"{'/'.join(rel)} imports {target}")
     assert not bad, bad
+
+
+def _targets(node, rel, top):
+    """Top-level dynid modules an import statement reaches: relative ones (``from ..x import``, ``from .. import
+    x``, ``from . import x`` inside a subpackage) and absolute ones (``import dynid.x``, ``from dynid.x import``)."""
+    depth = len(rel) - 1
+    if isinstance(node, ast.Import):
+        return [a.name.split(".")[1] for a in node.names if a.name.startswith("dynid.")]
+    if not isinstance(node, ast.ImportFrom):
+        return []
+    if node.level == 0:
+        parts = (node.module or "").split(".")
+        if parts[0] != "dynid":
+            return []
+        return [parts[1]] if len(parts) > 1 else [a.name for a in node.names]
+    if node.level > depth:  # relative import reaching the package root
+        return [node.module.split(".")[0]] if node.module else [a.name for a in node.names]
+    if node.level == depth and depth >= 1:
+        return [top]
+    return []
+
+
+def test_the_layering_check_sees_every_kind_of_import():
+    cases = {"from ..cli.app import main": ["cli"], "from .. import cli": ["cli"], "import dynid.cli.app": ["cli"],
+             "from dynid.report import figures": ["report"], "from dynid import cli": ["cli"], "from . import x": ["model"]}
+    for code, expected in cases.items():
+        node = ast.parse(code).body[0]
+        assert _targets(node, ("model", "robot.py"), "model") == expected, code
