@@ -28,6 +28,7 @@ def test_run_writes_results_and_figures(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--robot", "nosuch"], "unknown robot"),
     (["--joints", "9"], "between 1 and 6"),
+    (["--seed", "-1"], "--seed must be a non-negative integer, got -1"),
     (["--rate", "-5"], "rate"),
     (["--weights", "1,x"], "weights"),
     (["--methods", "ols,bogus"], "--methods"),
