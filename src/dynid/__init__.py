@@ -39,6 +39,7 @@ _EXPORTS = {
     "FourierTrajectory": "dynid.excitation.fourier",
     "urdf_from_robot": "dynid.io.export",
     "urdf_from_results": "dynid.io.export",
+    "mjcf_from_robot": "dynid.io.export",
     "PaperExperimentConfig": "dynid.experiment.paper",
     "run_paper_experiment": "dynid.experiment.paper",
 }

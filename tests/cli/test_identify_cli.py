@@ -21,6 +21,15 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     assert len(res["base_parameters"]) == 58 and {"name", "value", "std", "relative_std_percent"} <= set(res["base_parameters"][0])
     assert (out / "identification_fit.png").is_file() and (out / "validation_ptp_10_points.png").is_file()
     assert len(list(out.glob("validation_p*.png"))) == 11
+    # the physically consistent estimate goes to work: URDF and MJCF beside results.json, and by dynid export
+    import mujoco
+    import pinocchio as pin
+
+    assert pin.buildModelFromUrdf(str(out / "robot.urdf")).nq == 6 and mujoco.MjModel.from_xml_path(str(out / "robot.xml")).nv == 6
+    p = dynid("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--urdf",
+              str(tmp_path / "u.urdf"), "--mjcf", str(tmp_path / "u.xml"), "--data-root", str(root))
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "u.urdf").read_text() == (out / "robot.urdf").read_text()
     # validate the result on another log given on the command line: the truncated-line log
     log = root / "identification_data" / "ur-20_02_19_15harm50secLoad.csv"
     p = dynid("validate", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--file", str(log),

@@ -378,27 +378,35 @@ def identify(
 def export(
     config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
-    urdf: Path = typer.Option(..., help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
+    urdf: Optional[Path] = typer.Option(None, help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
+    mjcf: Optional[Path] = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
 ) -> None:
-    """Export the physically consistent estimate as a URDF (load it in Pinocchio, a simulator, a controller)."""
+    """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
     from ..exceptions import DataError
     from ..experiment.identification_config import load_identification_config
 
     try:
         cfg = load_identification_config(config, data_root)
         identified = _read_results(results)
-        from ..io.export import urdf_from_results
+        from ..io.export import mjcf_from_results, urdf_from_results
         from ..io.files import atomic_write_text
 
-        text = urdf_from_results(cfg.robot, identified, str(results))
-        if urdf.parent and not urdf.parent.is_dir():
-            raise DataError(f"--urdf {urdf}: its folder does not exist")
-        atomic_write_text(urdf, text)
+        targets = [(flag, path, fn) for flag, path, fn in (("--urdf", urdf, urdf_from_results), ("--mjcf", mjcf, mjcf_from_results))
+                   if path is not None]
+        if not targets:
+            raise DataError("give --urdf FILE and/or --mjcf FILE")
+        texts = []
+        for flag, path, fn in targets:
+            if not path.parent.is_dir():
+                raise DataError(f"{flag} {path}: its folder does not exist")
+            texts.append((path, fn(cfg.robot, identified, str(results))))
+        for path, text in texts:
+            atomic_write_text(path, text)
     except DynIdError as exc:
         _fail(exc)
-    console.print(f"wrote {urdf} (robot {cfg.robot.name}, {cfg.robot.n_dof} joints; rotor inertias, offsets and coupled "
-                  "motors, which URDF cannot hold, are in comments on the joints)", highlight=False, soft_wrap=True)
+    console.print(f"wrote {', '.join(str(p) for p, _ in texts)} (robot {cfg.robot.name}, {cfg.robot.n_dof} joints; what the "
+                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)", highlight=False, soft_wrap=True)
 
 
 def _read_results(results: Path) -> dict:

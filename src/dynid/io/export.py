@@ -1,4 +1,5 @@
-"""The identified model handed over: URDF of a robot with its identified inertial and friction parameters.
+"""The identified model handed over: URDF (and MuJoCo MJCF) of a robot with its identified inertial and
+friction parameters.
 
 The URDF is generated from dynid's own kinematic description (the joint frames every robot has, whether
 it came from a DH table or a URDF), so the same writer serves every robot: a chain ``base_link →
@@ -106,6 +107,174 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
     lines += ['  <link name="flange"/>', '  <joint name="flange_fixed" type="fixed">', f'    <parent link="link{robot.n_dof}"/>',
               '    <child link="flange"/>',
               f'    <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(robot.tool_rotation))}"/>', "  </joint>", "</robot>", ""]
+    return "\n".join(lines)
+
+
+def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
+    """MuJoCo MJCF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
+
+    Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about
+    it (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping``
+    (viscous ``fv``) and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments:
+    the torque offset, the Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's
+    ``frictionloss`` is a dry-friction *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but
+    its force in ``mj_inverse`` comes from the constraint solver, so only the other terms reproduce dynid's
+    torques exactly (see the round-trip test). Massless links and point masses get MuJoCo's smallest mass
+    and inertia (``boundmass``, ``boundinertia`` of 1e-9).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`urdf_from_robot`.
+    """
+    import pinocchio as pin
+
+    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
+    urdf_from_robot(robot, phi)  # the same checks of consistency and friction signs
+    fitted = robot.with_parameters(phi)
+    g = np.asarray(robot.gravity, dtype=float)
+    lines = [f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
+             f"<mujoco model={quoteattr(name or robot.name)}>",
+             '  <compiler angle="radian" autolimits="true" boundmass="1e-9" boundinertia="1e-9"/>',
+             f'  <option gravity="{_vec(g)}"/>', "  <worldbody>"]
+    closing = []
+    for j, joint in enumerate(robot.joints):
+        indent = "    " + "  " * j
+        q = pin.Quaternion(np.asarray(joint.rotation, dtype=float))
+        mass, com, inertia = physical_from_inertial(fitted.inertial[j])
+        terms = dict(zip(robot.drive_terms, fitted.drive[j]))
+        lo, hi = robot.limits.q_min[j], robot.limits.q_max[j]
+        limit = f' range="{lo:.17g} {hi:.17g}"' if np.isfinite(lo) and np.isfinite(hi) else ""
+        lines += [f'{indent}<body name="link{j + 1}" pos="{_vec(joint.translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
+                  f'{indent}  <joint name={quoteattr(joint.name)} type="hinge" axis="{_vec(joint.axis)}"{limit} '
+                  f'armature="{terms.get("Ia", 0.0):.17g}" damping="{terms.get("fv", 0.0):.17g}" '
+                  f'frictionloss="{terms.get("fc", 0.0):.17g}"/>',
+                  f'{indent}  <inertial pos="{_vec(com)}" mass="{max(mass, 0.0):.17g}" fullinertia="{inertia[0, 0]:.17g} '
+                  f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>']
+        extra = {k: v for k, v in terms.items() if k not in ("Ia", "fc", "fv") and v != 0}
+        if extra:
+            lines.append(f"{indent}  <!-- dynid: terms MJCF cannot hold, add them to the torques: "
+                         + ", ".join(f"{k}{j + 1} = {v:.17g}" for k, v in extra.items()) + " -->")
+        if robot.coulomb_velocity[j] > 0:
+            lines.append(f"{indent}  <!-- dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[j]:.6g}) instead of sign(dq) -->")
+        closing.append(f"{indent}</body>")
+    tip = "    " + "  " * robot.n_dof
+    q = pin.Quaternion(np.asarray(robot.tool_rotation, dtype=float))
+    lines.append(f'{tip}<site name="flange" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}"/>')
+    lines += closing[::-1]
+    lines.append("  </worldbody>")
+    n_coupled = robot.transmission.n_coupled_params
+    if n_coupled:
+        lines.append("  <!-- dynid: coupled motors (not representable here), add their torques: "
+                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names, phi[-n_coupled:]))
+                     + " -->")
+    lines += ["</mujoco>", ""]
+    return "\n".join(lines)
+
+
+def _finite(x: float) -> float:
+    return float(x) if np.isfinite(x) else 1e6
+
+
+def consistent_estimate(robot: Robot, results: dict, source: str = "results") -> tuple[Robot, np.ndarray]:
+    """The robot (with the Coulomb smoothing it was identified with) and the physically consistent standard
+    parameters stored in a ``results.json`` of ``dynid identify`` (``physically_consistent.standard_values``).
+
+    Raises
+    ------
+    ConfigError
+        No physically consistent estimate in the results, results of another robot, or a set that did not
+        pass the consistency check (the verdict says why).
+    """
+    sdp = results.get("physically_consistent") if isinstance(results, dict) else None
+    if not isinstance(sdp, dict) or not isinstance(sdp.get("standard_values"), dict):
+        raise ConfigError(f"{source}: no physically consistent estimate to export; identify with "
+                          "[estimation] physically_consistent = true (or methods including \"sdp\")")
+    verdict = results.get("physically_consistent_verdict", {}).get(sdp.get("label", ""), "yes")
+    if verdict != "yes":
+        raise ConfigError(f"{source}: the physically consistent estimate did not pass the consistency check ({verdict})")
+    values = sdp["standard_values"]
+    missing = [n for n in robot.parameter_names if n not in values]
+    if missing:
+        raise ConfigError(f"{source}: its standard parameters are not those of robot {robot.name!r} (missing {', '.join(missing[:4])})")
+    phi = np.array([float(values[n]) for n in robot.parameter_names])
+    vs = results.get("settings", {}).get("coulomb_velocity")
+    if vs is not None:
+        from dataclasses import replace
+
+        robot = replace(robot, coulomb_velocity=np.asarray(vs, dtype=float))
+    return robot, phi
+
+
+def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
+    """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`)."""
+    return urdf_from_robot(*consistent_estimate(robot, results, source))
+
+
+def mjcf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
+    """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`)."""
+    return mjcf_from_robot(*consistent_estimate(robot, results, source))
+
+
+def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
+    """MuJoCo MJCF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
+
+    Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about
+    it (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping``
+    (viscous ``fv``) and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments:
+    the torque offset, the Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's
+    ``frictionloss`` is a dry-friction *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but
+    its force in ``mj_inverse`` comes from the constraint solver, so only the other terms reproduce dynid's
+    torques exactly (see the round-trip test). Massless links and point masses get MuJoCo's smallest mass
+    and inertia (``boundmass``, ``boundinertia`` of 1e-9).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`urdf_from_robot`.
+    """
+    import pinocchio as pin
+
+    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
+    urdf_from_robot(robot, phi)  # the same checks of consistency and friction signs
+    fitted = robot.with_parameters(phi)
+    g = np.asarray(robot.gravity, dtype=float)
+    lines = [f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
+             f"<mujoco model={quoteattr(name or robot.name)}>",
+             '  <compiler angle="radian" autolimits="true" boundmass="1e-9" boundinertia="1e-9"/>',
+             f'  <option gravity="{_vec(g)}"/>', "  <worldbody>"]
+    closing = []
+    for j, joint in enumerate(robot.joints):
+        indent = "    " + "  " * j
+        q = pin.Quaternion(np.asarray(joint.rotation, dtype=float))
+        mass, com, inertia = physical_from_inertial(fitted.inertial[j])
+        terms = dict(zip(robot.drive_terms, fitted.drive[j]))
+        lo, hi = robot.limits.q_min[j], robot.limits.q_max[j]
+        limit = f' range="{lo:.17g} {hi:.17g}"' if np.isfinite(lo) and np.isfinite(hi) else ""
+        lines += [f'{indent}<body name="link{j + 1}" pos="{_vec(joint.translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
+                  f'{indent}  <joint name={quoteattr(joint.name)} type="hinge" axis="{_vec(joint.axis)}"{limit} '
+                  f'armature="{terms.get("Ia", 0.0):.17g}" damping="{terms.get("fv", 0.0):.17g}" '
+                  f'frictionloss="{terms.get("fc", 0.0):.17g}"/>',
+                  f'{indent}  <inertial pos="{_vec(com)}" mass="{max(mass, 0.0):.17g}" fullinertia="{inertia[0, 0]:.17g} '
+                  f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>']
+        extra = {k: v for k, v in terms.items() if k not in ("Ia", "fc", "fv") and v != 0}
+        if extra:
+            lines.append(f"{indent}  <!-- dynid: terms MJCF cannot hold, add them to the torques: "
+                         + ", ".join(f"{k}{j + 1} = {v:.17g}" for k, v in extra.items()) + " -->")
+        if robot.coulomb_velocity[j] > 0:
+            lines.append(f"{indent}  <!-- dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[j]:.6g}) instead of sign(dq) -->")
+        closing.append(f"{indent}</body>")
+    tip = "    " + "  " * robot.n_dof
+    q = pin.Quaternion(np.asarray(robot.tool_rotation, dtype=float))
+    lines.append(f'{tip}<site name="flange" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}"/>')
+    lines += closing[::-1]
+    lines.append("  </worldbody>")
+    n_coupled = robot.transmission.n_coupled_params
+    if n_coupled:
+        lines.append("  <!-- dynid: coupled motors (not representable here), add their torques: "
+                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names, phi[-n_coupled:]))
+                     + " -->")
+    lines += ["</mujoco>", ""]
     return "\n".join(lines)
 
 

@@ -31,8 +31,8 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list
 @staged
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None) -> list[Path]:
     """Write ``results.json``, the identification fit figure and one figure per validation dataset
-    (figures unless ``figures_too`` is false), and with ``robot`` (the identified robot) ``robot.urdf``
-    when the physically consistent estimate passed the consistency check.
+    (figures unless ``figures_too`` is false), and with ``robot`` (the identified robot) ``robot.urdf`` and
+    ``robot.xml`` (MJCF) when the physically consistent estimate passed the consistency check.
 
     Raises
     ------
@@ -51,10 +51,11 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     sdp = data.get("physically_consistent")
     if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp["label"]) == "yes":
         from ..io import atomic_write_text
-        from ..io.export import urdf_from_results
+        from ..io.export import mjcf_from_results, urdf_from_results
 
-        paths.insert(0, out / "robot.urdf")
+        paths[:0] = [out / "robot.urdf", out / "robot.xml"]
         atomic_write_text(paths[0], urdf_from_results(robot, data))
+        atomic_write_text(paths[1], mjcf_from_results(robot, data))
     return [json_path] + paths
 
 

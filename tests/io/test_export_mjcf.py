@@ -1,0 +1,52 @@
+"""MJCF export: MuJoCo's inverse dynamics of the exported model reproduces dynid's torques."""
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.regressor import regressor
+from dynid.exceptions import ConfigError
+from dynid.io.export import mjcf_from_robot
+from dynid.model.description import load_robot
+
+from .test_export import _with_friction
+
+mujoco = pytest.importorskip("mujoco")
+
+
+@pytest.mark.parametrize("name", ["ur10e", "tx40", "er16"])
+def test_mujoco_inverse_dynamics_of_the_exported_model_equals_dynid(rng, name):
+    """mj_inverse on random states: MuJoCo's torques without its dry-friction constraint force (rigid bodies,
+    armature = rotor inertia, damping = viscous) plus the terms stated in comments (offset, the TX40's
+    coupled motor) equal dynid's prediction with the base parameters β = Kφ, less its Coulomb term fc·sign(q̇).
+    MuJoCo's ``frictionloss`` (= fc, checked) is a soft constraint: in inverse dynamics its force is what
+    the constraint solver finds, up to fc, so it is not compared. Tolerance 1e-8 relative; the TX40's
+    point-mass link 6 gets MuJoCo's smallest inertia (1e-9)."""
+    robot = _with_friction(load_robot(name), rng)
+    phi = robot.standard_parameters()
+    base = base_parameters(robot, rng=0)
+    model = mujoco.MjModel.from_xml_string(mjcf_from_robot(robot, phi))
+    data = mujoco.MjData(model)
+    assert model.nv == robot.n_dof
+    terms = dict(zip(robot.drive_terms, robot.drive.T))
+    np.testing.assert_allclose(model.dof_frictionloss, terms.get("fc", 0.0))
+    np.testing.assert_allclose(model.dof_damping, terms.get("fv", 0.0))
+    np.testing.assert_allclose(model.dof_armature, terms.get("Ia", 0.0))
+    for _ in range(20):
+        q, ddq = rng.uniform(-1.5, 1.5, (2, robot.n_dof))
+        dq = rng.choice([-1.0, 1.0], robot.n_dof) * rng.uniform(0.05, 1.5, robot.n_dof)
+        data.qpos[:], data.qvel[:], data.qacc[:] = q, dq, ddq
+        mujoco.mj_inverse(model, data)
+        tau = data.qfrc_inverse + data.qfrc_constraint + terms.get("fc", 0.0) * np.sign(dq) + terms.get("offset", 0.0)
+        if robot.transmission.n_coupled_params:
+            tau = tau + robot.transmission.coupling_columns(dq[None], ddq[None])[0] @ robot.transmission.coupled_values.ravel()
+        predicted = base.base_observation(regressor(robot, q[None], dq[None], ddq[None]))[0] @ base.base_from_standard(phi)
+        np.testing.assert_allclose(tau, predicted, atol=1e-8 * max(1.0, np.abs(predicted).max()))
+
+
+def test_mjcf_refuses_inconsistent_parameters():
+    robot = load_robot("er16")
+    phi = robot.standard_parameters().copy()
+    phi[robot.parameter_names.index("M3")] = -1.0
+    with pytest.raises(ConfigError, match=r"export: link 3 \(joint3\): mass -1 kg is not positive"):
+        mjcf_from_robot(robot, phi)
