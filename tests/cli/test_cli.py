@@ -61,3 +61,27 @@ def test_out_is_a_file(tmp_path):
     f.write_text("x")
     p = dynid("run", "--out", str(f), *FAST)
     assert p.returncode == 1 and "not a folder" in p.stderr
+
+
+def test_same_seed_gives_the_same_results_json_except_timings(tmp_path):
+    """Two runs with the same seed write the same results.json, but for the fields named as timings."""
+
+    def load(out):
+        data = json.loads((out / "results.json").read_text())
+
+        def strip(x):
+            if isinstance(x, dict):
+                return {k: strip(v) for k, v in x.items() if k not in ("timings", "seconds")}
+            if isinstance(x, list):
+                return [strip(v) for v in x]
+            return x
+
+        return strip(data)
+
+    args = ("--methods", "ols,wls,abc,pso,sdp", "--bootstrap", "10", "--duration", "6", "--no-figures", "--seed", "7")
+    a, b = tmp_path / "a", tmp_path / "b"
+    for out in (a, b):
+        p = dynid("run", "--out", str(out), *args)
+        assert p.returncode == 0, p.stderr
+    assert load(a) == load(b)
+    assert json.loads((a / "results.json").read_text())["methods"]["abc"]["seconds"] >= 0  # the timings are there
