@@ -41,6 +41,13 @@ def _check_out(out) -> None:
     check_output_folder(out)
 
 
+def _wrote(paths) -> None:
+    """One line: the first file, the other files by name, and how many figures, in which folder."""
+    pngs = [p for p in paths if p.suffix == ".png"]
+    others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
+    console.print(f"wrote {paths[0]}{others} and {_count(len(pngs), 'figure')} in {paths[0].parent}/")
+
+
 def _count(n: int, noun: str) -> str:
     """``"no figures"``, ``"1 figure"``, ``"3 figures"``."""
     return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
@@ -184,7 +191,7 @@ def _print_run(result, paths) -> None:
     console.print("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in tm.items()), soft_wrap=True)
     for w in d["warnings"]:
         console.print(f"[yellow]warning:[/] {escape(w)}")
-    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
+    _wrote(paths)
 
 
 def _print_uncertainty(d: dict, methods: dict) -> None:
@@ -344,9 +351,7 @@ def _print_identification(result, paths) -> None:
     _comparison_tables((result.fit,) + tuple(result.validations), len(result.joint_std))
     for w in result.warnings:
         console.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
-    pngs = [p for p in paths if p.suffix == ".png"]
-    others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
-    console.print(f"wrote {paths[0]}{others} and {_count(len(pngs), 'figure')} in {paths[0].parent}/")
+    _wrote(paths)
 
 
 @app.command()
@@ -466,7 +471,7 @@ def validate(
     _comparison_tables(comparisons, cfg.robot.n_dof)
     for w in warnings:
         console.print(f"[yellow]warning:[/] {escape(w)}", soft_wrap=True)
-    console.print(f"wrote {paths[0]} and {_count(len(paths) - 1, 'figure')} in {paths[0].parent}/")
+    _wrote(paths)
 
 
 @app.command()
@@ -523,8 +528,8 @@ def _print_excitation(run, paths) -> None:
         rel = "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}"
         t.add_row(escape(m.constraint), escape(m.where), f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}", rel)
     console.print(t)
-    console.print(f"wrote {paths[0]}, {paths[1]} ({run.t.size} set-points at {run.config.rate:g} Hz) and "
-                  f"{_count(len(paths) - 2, 'figure')} in {paths[0].parent}/")
+    console.print(f"{paths[1].name}: {run.t.size} set-points at {run.config.rate:g} Hz")
+    _wrote(paths)
 
 
 def _parse_levels(text: str):
@@ -599,7 +604,7 @@ def _print_montecarlo(result, paths) -> None:
     console.print(t)
     if result.errors:
         console.print(f"[yellow]warning:[/] {len(result.errors)} fits failed; the first: " + escape(result.errors[0]["error"]), soft_wrap=True)
-    console.print(f"wrote {paths[0]}, {paths[1]} and {_count(len(paths) - 2, 'figure')} in {paths[0].parent}/")
+    _wrote(paths)
 
 
 class Interrupted(BaseException):

@@ -9,6 +9,7 @@ from ..dynamics.regressor import regressor
 from ..experiment.excitation_config import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
+from .html import write_html_report
 from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
@@ -46,5 +47,7 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     csv_path = out / "excitation.csv"
     write_trajectory_csv(csv_path, run.t, run.q, run.dq, run.ddq)
     json_path = out / "excitation.json"
-    write_results(json_path, run.to_dict(), "excite")
-    return [json_path, csv_path] + paths
+    data = run.to_dict()
+    write_results(json_path, data, "excite")
+    write_html_report(out / "report.html", data, "excite", paths, f"dynid excite — {robot.name}")
+    return [json_path, csv_path, out / "report.html"] + paths

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..experiment.identification import IdentificationResult, TorqueComparison
 from . import figures
+from .html import write_html_report
 from .output import output_folder, save_figure, write_results, staged
 
 
@@ -48,6 +49,8 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     json_path = out / "results.json"
     data = result.to_dict()
     write_results(json_path, data, "identify")
+    write_html_report(out / "report.html", data, "identify", paths, f"dynid identify — {result.robot}")
+    paths.insert(0, out / "report.html")
     sdp = data.get("physically_consistent")
     if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp["label"]) == "yes":
         from ..io import atomic_write_text
@@ -65,5 +68,8 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
     out = output_folder(out)
     paths = save_comparisons(comparisons, out)
     json_path = out / "validation.json"
-    write_results(json_path, {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)}, "validate")
+    data = {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)}
+    write_results(json_path, data, "validate")
+    write_html_report(out / "report.html", data, "validate", paths, "dynid validate")
+    paths.insert(0, out / "report.html")
     return [json_path] + paths

@@ -11,6 +11,7 @@ from ..experiment.methods import LABELS
 from ..experiment.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures
+from .html import write_html_report
 from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
@@ -43,5 +44,8 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
             for m, key in enumerate(result.config.methods):
                 buf.write(f"{level:.6g},{r},{key}," + ",".join(f"{v:.10g}" for v in result.estimates[li, r, m]) + "\n")
     atomic_write_text(paths[1], buf.getvalue())
-    write_results(paths[0], result.to_dict(), "montecarlo")
+    data = result.to_dict()
+    write_results(paths[0], data, "montecarlo")
+    write_html_report(out / "report.html", data, "montecarlo", paths[2:], "dynid montecarlo")
+    paths.insert(2, out / "report.html")
     return paths

@@ -10,6 +10,7 @@ from ..experiment import paper_reference as ref
 from ..experiment.methods import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
 from . import figures
+from .html import write_html_report
 from .output import output_folder, save_figure, write_results, staged
 
 FIGURES = {
@@ -75,5 +76,7 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
             paths.append(out / name)
             save_figure(figs[name](), paths[-1])
     json_path = out / "results.json"
-    write_results(json_path, result.to_dict(), "run")
-    return [json_path] + paths
+    data = result.to_dict()
+    write_results(json_path, data, "run")
+    write_html_report(out / "report.html", data, "run", paths, f"dynid run — {result.robot.name}, joints 1-{result.config.joints}")
+    return [json_path, out / "report.html"] + paths

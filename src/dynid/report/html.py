@@ -1,0 +1,131 @@
+"""One-file HTML report beside results.json: settings, the tables of the terminal, the figures embedded as
+PNG data URIs (no external resource), warnings and versions, from a jinja2 template
+(``templates/report.html.j2``). Built from the results dictionaries the commands write, so the report and
+results.json always agree.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+@dataclass
+class Table:
+    caption: str
+    headers: list
+    rows: list
+    text_columns: tuple = ()
+
+
+@dataclass
+class Section:
+    title: str
+    tables: list = field(default_factory=list)
+    texts: list = field(default_factory=list)
+
+
+def _fmt(x, spec: str = ".4g") -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, int) and not isinstance(x, bool):
+        return str(x)
+    if isinstance(x, float):
+        return format(x, spec)
+    return str(x)
+
+
+def _comparison_tables(comparisons: list[dict]) -> list[Table]:
+    tables = []
+    for c in comparisons:
+        sets = c["metrics"]
+        n = len(next(iter(sets.values()))["relative_error"])
+        rows = []
+        for label, m in sets.items():
+            rows.append([label, "error %", *(_fmt(x, ".3g") for x in m["relative_error"]), _fmt(m.get("global_relative_error"), ".3g")])
+            rows.append(["", "RMSE N·m", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
+            rows.append(["", "ρ (eq. 18)", *(_fmt(x, ".4f") for x in m["correlation"]), ""])
+        tables.append(Table(f"{c['name']}: {c['n_samples']} samples", ["parameters", "metric", *(f"J{j + 1}" for j in range(n)), "all"], rows))
+    return tables
+
+
+def identify_sections(d: dict) -> tuple[dict, list[Section]]:
+    """Settings and sections of ``dynid identify`` (or ``dynid validate``) from its results dictionary."""
+    settings = {"robot": d.get("robot", ""), "method": d.get("method", ""),
+                "preprocessing": d.get("settings", {}).get("preprocessing", {}).get("derivation", ""),
+                "Coulomb smoothing velocity (rad/s)": d.get("settings", {}).get("coulomb_velocity", "")}
+    sections = []
+    if "base_parameters" in d:
+        refs = d.get("references", [])
+        rows = [[p["name"], p["unit"], _fmt(p["value"]), _fmt(p["std"], ".2g"), _fmt(p["relative_std_percent"], ".3g"),
+                 *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
+        sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations",
+                                                          ["name", "unit", "value", "σ", "σ %", *(r["name"] for r in refs), "expression"], rows,
+                                                          (5 + len(refs),))]))
+        verdicts = d.get("physically_consistent_verdict", {})
+        if verdicts:
+            sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",
+                                             ["parameters", "verdict"], [[k, v] for k, v in verdicts.items()], (1,)))
+    if d.get("objective_eq9"):
+        others = d.get("methods", {})
+        rows = [[label, _fmt(f), _fmt(others.get(label, {}).get("n_evaluations")), _fmt(others.get(label, {}).get("seconds"), ".2f")]
+                for label, f in d["objective_eq9"].items()]
+        sections.append(Section("Estimators", [Table("F (eq. 9) on the identification rows", ["parameters", "F (N·m)", "evaluations", "time (s)"], rows)]))
+    if d.get("drive_gains"):
+        g = d["drive_gains"]
+        rows = [[f"J{j + 1}", _fmt(k), _fmt(s, ".2g"), _fmt(ref)] for j, (k, s, ref) in enumerate(zip(g["gains"], g["gains_std"], g["description_gains"]))]
+        sections.append(Section("Drive gains", [Table(f"K from the runs without and with the {g['payload_mass']} kg payload",
+                                                      ["joint", "K (N·m/A)", "σ", "description"], rows)],
+                                [f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else []))
+    comparisons = ([d["identification"]] if "identification" in d else []) + list(d.get("validation", []))
+    if comparisons:
+        sections.append(Section("Measured against predicted torques", _comparison_tables(comparisons)))
+    return settings, sections
+
+
+def run_sections(d: dict) -> tuple[dict, list[Section]]:
+    """Settings and sections of ``dynid run`` from its results dictionary."""
+    settings = {k: v for k, v in d.get("settings", {}).items() if not isinstance(v, (list, dict)) or k == "methods"}
+    names = d["parameters"]
+    methods = d["methods"]
+    rows = [[n, _fmt(d["truth"][n]), *(_fmt(m["params"][n]) for m in methods.values())] for n in names]
+    params = Table("Base parameters: truth and estimates", ["name", "truth", *(m["label"] for m in methods.values())], rows)
+    rows = [[m["label"], _fmt(m["objective"]), _fmt(m["n_evaluations"]), _fmt(m["seconds"], ".2f"), _fmt(m["parameter_error_norm_percent"], ".3g"),
+             _fmt(sum(m["correlation"]["validation"]) / len(m["correlation"]["validation"]), ".4f"),
+             _fmt(sum(m["relative_error"]["validation"]) / len(m["relative_error"]["validation"]), ".3g"),
+             "yes" if m["physically_consistent"] else "no"] for m in methods.values()]
+    comparison = Table(f"Estimators (paper: F = {d['paper']['objective']})",
+                       ["method", "F (N·m)", "evaluations", "time (s)", "‖β̂−β‖/‖β‖ %", "ρ on β2", "error % on β2", "consistent"], rows)
+    return settings, [Section("Estimators", [comparison]), Section("Parameters", [params])]
+
+
+def generic_sections(d: dict) -> tuple[dict, list[Section]]:
+    """Settings and the top-level numbers of ``dynid excite`` and ``dynid montecarlo``."""
+    settings = {k: v for k, v in d.get("settings", d.get("config", {})).items()} if isinstance(d.get("settings", d.get("config")), dict) else {}
+    scalars = [[k, _fmt(v)] for k, v in d.items() if isinstance(v, (int, float, str)) and k not in ("schema_version", "dynid_version", "kind")]
+    return settings, [Section("Summary", [Table("values", ["field", "value"], scalars)])]
+
+
+SECTIONS = {"identify": identify_sections, "validate": identify_sections, "run": run_sections,
+            "excite": generic_sections, "montecarlo": generic_sections}
+
+
+def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], title: str) -> None:
+    """Write ``report.html``: one file, figures embedded, nothing fetched from elsewhere."""
+    import jinja2
+    import numpy
+    import pinocchio
+
+    from .. import __version__
+    from ..io import atomic_write_text
+
+    env = jinja2.Environment(loader=jinja2.PackageLoader("dynid.report", "templates"), autoescape=True)
+    settings, sections = SECTIONS[kind](data)
+    figs = [{"name": p.name, "data": base64.b64encode(p.read_bytes()).decode("ascii")} for p in figures if p.suffix == ".png"]
+    html = env.get_template("report.html.j2").render(
+        title=title, versions={"dynid": __version__, "numpy": numpy.__version__, "pinocchio": pinocchio.__version__},
+        written=datetime.datetime.now().isoformat(timespec="seconds"), settings=settings, sections=sections,
+        figures=figs, warnings=data.get("warnings", []))
+    atomic_write_text(path, html)
