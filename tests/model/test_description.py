@@ -135,3 +135,27 @@ def test_unphysical_nominal_values_are_accepted_with_a_warning_and_refused_where
         with pytest.raises(ConfigError, match=f"link 1 .*{rule}.*the simulation truth needs physically consistent"):
             robot.require_physical_nominal("the simulation truth")
     assert not load_robot("er16").nominal_problems
+
+
+def test_urdf_continuous_joints_are_revolute_joints_without_limits(tmp_path, rng):
+    """A URDF with continuous joints (Pinocchio's unbounded revolute joints) loads; its regressor equals
+    Pinocchio's RNEA of the same file with the angles as (cos, sin)."""
+    import pinocchio as pin
+
+    from dynid.dynamics.regressor import regressor
+
+    from ..conftest import TEST_URDF
+
+    text = TEST_URDF.replace('name="j1" type="revolute"', 'name="j1" type="continuous"').replace(
+        'name="j3" type="revolute"', 'name="j3" type="continuous"')
+    (tmp_path / "c.urdf").write_text(text)
+    (tmp_path / "c.toml").write_text('convention = "urdf"\nurdf = "c.urdf"\ndrive_terms = []\n' + "[[joints]]\n" * 4)
+    robot = load_robot(tmp_path / "c.toml")
+    model = pin.buildModelFromUrdf(str(tmp_path / "c.urdf"))
+    assert model.nq == 6 and model.nv == 4  # two joints with (cos, sin)
+    data = model.createData()
+    q, dq, ddq = (rng.uniform(-2, 2, (10, 4)) for _ in range(3))
+    for k in range(10):
+        qp = np.concatenate([[np.cos(q[k, 0]), np.sin(q[k, 0])], q[k, 1:2], [np.cos(q[k, 2]), np.sin(q[k, 2])], q[k, 3:]])
+        tau = pin.rnea(model, data, qp, dq[k], ddq[k])
+        np.testing.assert_allclose(regressor(robot, q[k:k + 1], dq[k:k + 1], ddq[k:k + 1])[0] @ robot.standard_parameters(), tau, atol=1e-10)

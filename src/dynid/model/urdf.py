@@ -30,7 +30,8 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
 def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...]]:
     """Joints and link inertial parameters of a URDF serial chain of revolute joints.
 
-    Fixed joints are merged by Pinocchio into the parent link.
+    Fixed joints are merged by Pinocchio into the parent link. Continuous joints (unbounded revolute) are
+    revolute joints without position limits: dynid's joint angle is their angle.
 
     Returns
     -------
@@ -60,9 +61,15 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
         if model.parents[j] != j - 1:
             raise ConfigError(f"{path}: joint {model.names[j]!r} does not continue a serial chain")
         if short.startswith("JointModelR") and short[-2:] in _AXES and "Unbounded" not in short:
-            axis = np.array(_AXES[short[-2:]])
+            axis = np.array(_AXES[short[-2:]])  # revolute, or continuous (RUB: unbounded, same dynamics)
+        elif short.startswith("JointModelRUB") and "R" + short[-1] in _AXES:  # continuous joint about x, y or z
+            axis = np.array(_AXES["R" + short[-1]])
         elif short == "JointModelRevoluteUnaligned":
             axis = np.asarray(jm.extract().axis, dtype=float).ravel()
+        elif short == "JointModelRevoluteUnboundedUnaligned":  # continuous, unaligned: the axis is its motion subspace
+            data = model.createData()
+            pin.forwardKinematics(model, data, pin.neutral(model))
+            axis = np.asarray(data.joints[j].S, dtype=float).ravel()[3:]
         else:
             raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute joint")
         placement = model.jointPlacements[j]
