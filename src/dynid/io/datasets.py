@@ -19,6 +19,13 @@ A dataset is described by a table of the experiment config (TOML)::
     currents = { columns = [14, 15, 16, 17, 18, 19] }  # A; torque = drive gain · current (eq. 16)
     torques = { file = "tau.csv", columns = ["Joint_1", …] }           # N·m, instead of currents
 
+or a ROS 2 bag of ``sensor_msgs/JointState`` (:mod:`dynid.io.bags`)::
+
+    bag = "run_01"                   # the bag's folder, relative to the data root
+    topic = "/joint_states"          # default
+    joint_names = ["j1", …]          # default: the robot's joint names
+    effort = "torques"               # or "currents" (through the drive gains, eq. 16)
+
 Columns are 1-based numbers or header names. Drive gains multiply currents on the side where they
 are measured.
 """
@@ -87,6 +94,28 @@ class DatasetSpec:
     delimiter: str = ","
     time_range: tuple[float, float] | None = None
     gaps: str = "refuse"
+    bag: "BagSpec | None" = None
+
+
+@dataclass(frozen=True)
+class BagSpec:
+    """A ROS 2 bag of ``sensor_msgs/JointState`` messages (read with the rosbags library).
+
+    Attributes
+    ----------
+    path : Path
+        The bag's folder (with metadata.yaml) or its storage file.
+    topic : str
+    joint_names : tuple of str or None
+        The bag's joint names, in the robot's joint order (default: the robot's joint names).
+    effort : "torques" or "currents"
+        What the messages' ``effort`` holds (currents go through the drive gains, eq. 16).
+    """
+
+    path: Path
+    topic: str = "/joint_states"
+    joint_names: tuple[str, ...] | None = None
+    effort: str = "torques"
 
 
 @dataclass(frozen=True)
@@ -149,10 +178,9 @@ SATURATION_SAMPLES = 20
 """Consecutive samples at a joint's extreme value that count as saturation (clipped current or torque)."""
 
 
-def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, line_of, warnings: list[str]) -> None:
+def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
     """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
     currents or torques flat at their extreme (saturation), naming joint and time range."""
-    source = spec.signals["positions"].file
     worst = np.abs(q).max(axis=0)
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
@@ -165,7 +193,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, line_of, warnings:
             k = np.flatnonzero(out)
             warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
                             f"during {k.size} samples from t = {t[k[0]]:.3f} s (units, encoder zero, position_offset?)")
-    kind = "currents" if "currents" in spec.signals else "torques"
+    kind = "currents" if "currents" in spec.signals or (spec.bag is not None and spec.bag.effort == "currents") else "torques"
     for j in range(tau.shape[1]):
         x = tau[:, j]
         peak = np.abs(x).max()
@@ -177,7 +205,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, line_of, warnings:
         long = [(a, b) for a, b in zip(starts, stops) if b - a >= SATURATION_SAMPLES]
         if long:
             a, b = max(long, key=lambda r: r[1] - r[0])
-            warnings.append(f"{spec.signals[kind].file}: joint {j + 1}'s {kind} stay at their extreme {x[a]:.4g} for "
+            warnings.append(f"{tau_source}: joint {j + 1}'s {kind} stay at their extreme {x[a]:.4g} for "
                             f"{b - a} samples (t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? select rows or a time_range without them")
 
 
@@ -203,6 +231,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             merged[k] = {**merged[k], **v}
         else:
             merged[k] = v
+    if "bag" in merged:
+        return _bag_spec(merged, base, where, name, n_dof)
     known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "gaps", "delimiter", "name", *_SIGNALS}
     unknown = sorted(set(merged) - known)
     if unknown:
@@ -260,21 +290,57 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where))
 
 
+def _bag_spec(merged: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
+    """A dataset read from a ROS 2 bag: ``bag = "folder"``, optional ``topic``, ``joint_names``, ``effort``."""
+    known = {"bag", "topic", "joint_names", "effort", "side", "resample", "time_range", "gaps", "name"}
+    unknown = sorted(set(merged) - known)
+    if unknown:
+        raise ConfigError(f"{where}: unknown field(s) {unknown} for a bag, expected some of {sorted(known)}")
+    bag = merged["bag"]
+    if not isinstance(bag, str) or not bag:
+        raise ConfigError(f"{where}.bag: expected the path of a ROS 2 bag folder, got {bag!r}")
+    path = Path(bag) if Path(bag).is_absolute() else base / bag
+    topic = merged.get("topic", "/joint_states")
+    if not isinstance(topic, str):
+        raise ConfigError(f"{where}.topic: expected a topic name, got {topic!r}")
+    names = merged.get("joint_names")
+    if names is not None and (not isinstance(names, list) or len(names) != n_dof or not all(isinstance(x, str) for x in names)):
+        raise ConfigError(f"{where}.joint_names: expected {n_dof} joint names, got {names!r}")
+    effort = merged.get("effort", "torques")
+    if effort not in ("torques", "currents"):
+        raise ConfigError(f"{where}.effort: expected \"torques\" or \"currents\", got {effort!r}")
+    side = merged.get("side", "joint")
+    if side not in ("joint", "motor"):
+        raise ConfigError(f"{where}.side: expected 'joint' or 'motor', got {side!r}")
+    resample = merged.get("resample")
+    if resample is not None and (isinstance(resample, bool) or not isinstance(resample, (int, float)) or not resample > 0):
+        raise ConfigError(f"{where}.resample: expected a positive number [Hz], got {resample!r}")
+    return DatasetSpec(name=str(merged.get("name", name)), signals={}, side=side,
+                       resample=None if resample is None else float(resample),
+                       time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where),
+                       bag=BagSpec(path, topic, None if names is None else tuple(names), effort))
+
+
 def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
-    Steps: read the columns (:func:`dynid.io.tables.read_table`), scale units, check the time stamps,
-    resample jittered time stamps linearly onto a uniform grid, convert motor-side signals through
-    the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``), currents to torques with the
-    drive gains (eq. 16).
+    Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages,
+    scale units, check the time stamps, resample jittered time stamps linearly onto a uniform grid,
+    convert motor-side signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``),
+    currents to torques with the drive gains (eq. 16).
 
     Raises
     ------
     DataError
         Unreadable or damaged files, non-increasing time stamps (names file and line), files of
-        different lengths.
+        different lengths, implausible values.
     """
     warnings: list[str] = []
+    if spec.bag is not None:
+        from .bags import read_joint_states
+
+        t, raw, where = read_joint_states(spec.bag, robot, spec.name)
+        return _assemble(spec, robot, t, raw, where, True, str(spec.bag.path), str(spec.bag.path), warnings)
     requests: dict[Path, list] = {}
     for s in list(spec.signals.values()) + ([spec.time] if spec.time else []):
         requests.setdefault(s.file, [])
@@ -299,16 +365,29 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
 
     if spec.time is not None:
         t = get(spec.time)[:, 0]
+        tb, _ = tables[spec.time.file]
+        where = lambda k: f"{spec.time.file}: line {tb.first_line + k}"  # noqa: E731 - sample k's place in the file
+    else:
+        t = np.arange(n_s) / spec.rate
+        where = None
+    raw = {kind: get(s) for kind, s in spec.signals.items()}
+    tau_kind = "currents" if "currents" in spec.signals else "torques"
+    return _assemble(spec, robot, t, raw, where, spec.time is not None, str(spec.signals["positions"].file),
+                     str(spec.signals[tau_kind].file), warnings)
+
+
+def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool, q_source: str, tau_source: str,
+              warnings: list[str]) -> Recording:
+    """Time checks, selection, gaps, resampling, transmission, drive gains and plausibility, shared by every
+    kind of dataset; ``where(k)`` names sample k's place in the source (file and line, bag and message)."""
+    n_s = t.shape[0]
+    if n_s < 2:
+        raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
+    if timed:
         steps = np.diff(t)
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0))
-            tb, _ = tables[spec.time.file]
-            raise DataError(f"{spec.time.file}: line {tb.first_line + k + 1}: time stamps must increase, got {t[k + 1]!r} after {t[k]!r}")
-    else:
-        t = np.arange(n_s) / spec.rate
-    if n_s < 2:
-        raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
-    raw = {kind: get(s) for kind, s in spec.signals.items()}
+            raise DataError(f"{where(k + 1)}: time stamps must increase, got {t[k + 1]!r} after {t[k]!r}")
     if spec.time_range is not None:
         start, stop = spec.time_range
         inside = (t - t[0] >= start - 1e-9) & (t - t[0] <= stop + 1e-9)
@@ -317,19 +396,21 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
                             f"{t[-1] - t[0]:.3f} s recording")
         if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
             warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
+        first = int(np.argmax(inside))
         t, raw = t[inside], {kind: x[inside] for kind, x in raw.items()}
+        if where is not None:
+            where = (lambda w, f: (lambda k: w(k + f)))(where, first)
     median = float(np.median(np.diff(t)))
-    if spec.time is not None and spec.gaps == "refuse":
+    if timed and spec.gaps == "refuse":
         steps = np.diff(t)
         if np.any(steps > GAP_FACTOR * median):
             k = int(np.argmax(steps > GAP_FACTOR * median))
-            tb, _ = tables[spec.time.file]
-            raise DataError(f"{spec.time.file}: line {tb.first_line + k + 1}: a gap of {steps[k]:.3g} s in the time stamps "
+            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps "
                             f"(median step {median:.3g} s) after t = {t[k] - t[0]:.3f} s; select rows or a time_range on "
                             "one side of it, or set gaps = \"interpolate\"")
-    uniform = spec.time is None or np.ptp(np.diff(t)) <= 1e-6 * median
-    rate = spec.rate if spec.time is None else (spec.resample or float(f"{1.0 / median:.6g}"))
-    if spec.time is not None and (not uniform or spec.resample is not None):
+    uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
+    rate = spec.rate if not timed else (spec.resample or float(f"{1.0 / median:.6g}"))
+    if timed and (not uniform or spec.resample is not None):
         grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
         raw = {kind: np.column_stack([np.interp(grid, t, x[:, j]) for j in range(x.shape[1])]) for kind, x in raw.items()}
         t = grid
@@ -345,5 +426,5 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
     else:
         motor_or_joint = raw["torques"]
     tau = tr.joint_torques(motor_or_joint) if spec.side == "motor" else motor_or_joint
-    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], None, warnings)
+    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings))

@@ -1,0 +1,67 @@
+"""ROS 2 bags of ``sensor_msgs/JointState`` as datasets (the rosbags library: no ROS installation needed).
+
+Each message gives one sample: its header stamp (seconds), and for the robot's joints, found by name,
+``position`` [rad], ``velocity`` [rad/s] when every message has it, and ``effort`` (joint torques in N·m,
+or motor currents in A with ``effort = "currents"``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..exceptions import DataError
+
+
+def read_joint_states(spec, robot, name: str):
+    """Time stamps (N,) and raw signals {positions, velocities?, torques|currents} (N, n_dof) of a bag, and a
+    function naming sample k's place (for errors).
+
+    Raises
+    ------
+    DataError
+        A missing or unreadable bag, no such topic, a topic of another type, joints missing from the messages,
+        or messages without positions or efforts.
+    """
+    from rosbags.highlevel import AnyReader
+
+    path = spec.path
+    if not path.exists():
+        raise DataError(f"{path}: ROS 2 bag not found")
+    wanted = list(spec.joint_names or [j.name for j in robot.joints])
+    stamps, pos, vel, eff = [], [], [], []
+    try:
+        with AnyReader([path]) as reader:
+            connections = [c for c in reader.connections if c.topic == spec.topic]
+            if not connections:
+                topics = sorted({c.topic for c in reader.connections})
+                raise DataError(f"{path}: no topic {spec.topic!r} in the bag (it has {', '.join(topics) or 'none'})")
+            if any(c.msgtype != "sensor_msgs/msg/JointState" for c in connections):
+                raise DataError(f"{path}: topic {spec.topic!r} holds {connections[0].msgtype}, expected sensor_msgs/msg/JointState")
+            for k, (conn, _, raw) in enumerate(reader.messages(connections=connections)):
+                msg = reader.deserialize(raw, conn.msgtype)
+                names = list(msg.name)
+                missing = [n for n in wanted if n not in names]
+                if missing:
+                    raise DataError(f"{path}: message {k + 1} on {spec.topic} lacks joint(s) {', '.join(missing)} "
+                                    f"(it has {', '.join(names)}); set joint_names")
+                idx = [names.index(n) for n in wanted]
+                if len(msg.position) != len(names) or len(msg.effort) != len(names):
+                    raise DataError(f"{path}: message {k + 1} on {spec.topic}: expected a position and an effort per joint")
+                stamps.append(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec)
+                pos.append(np.asarray(msg.position, dtype=float)[idx])
+                eff.append(np.asarray(msg.effort, dtype=float)[idx])
+                vel.append(np.asarray(msg.velocity, dtype=float)[idx] if len(msg.velocity) == len(names) else None)
+    except DataError:
+        raise
+    except Exception as exc:  # rosbags' own errors: a damaged or foreign file
+        raise DataError(f"{path}: cannot read it as a ROS 2 bag ({exc})") from None
+    if len(stamps) < 2:
+        raise DataError(f"{path}: {len(stamps)} JointState message(s) on {spec.topic}, expected at least 2")
+    raw = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}
+    if all(v is not None for v in vel):
+        raw["velocities"] = np.array(vel)
+    for kind, x in raw.items():
+        if not np.all(np.isfinite(x)):
+            k = int(np.argwhere(~np.isfinite(x))[0, 0])
+            raise DataError(f"{path}: message {k + 1} on {spec.topic}: NaN or infinite {kind}")
+    return np.array(stamps), raw, lambda k: f"{path}: message {k + 1} on {spec.topic}"

@@ -1,0 +1,59 @@
+"""ROS 2 bags of sensor_msgs/JointState as datasets: a bag written here, read back through a config."""
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError, DataError
+from dynid.io.datasets import dataset_spec, load_recording
+from dynid.model.description import load_robot
+
+rosbags = pytest.importorskip("rosbags")
+
+
+def _write_bag(path, t, names, q, dq, effort, topic="/joint_states"):
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    JointState, Header, Time = ts.types["sensor_msgs/msg/JointState"], ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    with Writer(path, version=8) as writer:
+        conn = writer.add_connection(topic, JointState.__msgtype__, typestore=ts)
+        for k, tk in enumerate(t):
+            stamp = Time(sec=int(tk), nanosec=int(round((tk - int(tk)) * 1e9)))
+            row = lambda x: np.ascontiguousarray(x[k], dtype=np.float64).copy()  # noqa: E731
+            msg = JointState(header=Header(stamp=stamp, frame_id=""), name=list(names), position=row(q), velocity=row(dq), effort=row(effort))
+            writer.write(conn, int(tk * 1e9), ts.serialize_cdr(msg, JointState.__msgtype__))
+
+
+def test_bag_of_joint_states_reads_like_a_log(tmp_path, rng):
+    robot = load_robot("ur10e")
+    names = [j.name for j in robot.joints]
+    t = 100.0 + np.arange(200) * 0.008  # 125 Hz
+    q = np.outer(np.sin(t), np.arange(1, 7) * 0.1)
+    dq = np.outer(np.cos(t), np.arange(1, 7) * 0.1)
+    tau = rng.normal(0, 1, (200, 6))
+    order = [3, 0, 5, 1, 4, 2]  # the bag lists the joints in another order
+    _write_bag(tmp_path / "bag", t, [names[i] for i in order], q[:, order], dq[:, order], tau[:, order])
+    rec = load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg: identification", "ident", 6), robot)
+    assert rec.n_samples == 200 and rec.rate == pytest.approx(125.0)
+    np.testing.assert_allclose(rec.q, q + robot.transmission.position_offset, atol=1e-12)
+    np.testing.assert_allclose(rec.dq, dq, atol=1e-12)
+    np.testing.assert_allclose(rec.tau, tau, atol=1e-12)
+    currents = load_recording(dataset_spec({"bag": "bag", "effort": "currents"}, tmp_path, "cfg", "ident", 6), robot)
+    np.testing.assert_allclose(currents.tau, tau * robot.drive_gains, atol=1e-12)
+
+
+def test_bag_errors_name_the_bag_topic_and_joint(tmp_path):
+    robot = load_robot("ur10e")
+    t = np.arange(5) * 0.01
+    _write_bag(tmp_path / "bag", t, ["a", "b", "c", "d", "e", "f"], np.zeros((5, 6)), np.zeros((5, 6)), np.zeros((5, 6)))
+    with pytest.raises(DataError, match=r"bag: message 1 on /joint_states lacks joint\(s\) shoulder_pan_joint"):
+        load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg", "ident", 6), robot)
+    with pytest.raises(DataError, match=r"no topic '/other' in the bag \(it has /joint_states\)"):
+        load_recording(dataset_spec({"bag": "bag", "topic": "/other"}, tmp_path, "cfg", "ident", 6), robot)
+    with pytest.raises(DataError, match=r"nosuch: ROS 2 bag not found"):
+        load_recording(dataset_spec({"bag": "nosuch"}, tmp_path, "cfg", "ident", 6), robot)
+    with pytest.raises(ConfigError, match=r"cfg.joint_names: expected 6 joint names"):
+        dataset_spec({"bag": "bag", "joint_names": ["a"]}, tmp_path, "cfg", "ident", 6)
+    names = dataset_spec({"bag": "bag", "joint_names": list("abcdef")}, tmp_path, "cfg", "ident", 6)
+    assert load_recording(names, robot).n_samples == 5
