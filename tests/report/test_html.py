@@ -38,7 +38,7 @@ def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
     report = _parse(tmp_path / "run" / "report.html")
     pngs = sorted((tmp_path / "run").glob("*.png"))
     assert len(report.images) == len(pngs) > 0 and all(src.startswith("data:image/png;base64,") for src in report.images)
-    assert report.tables == 2 and not report.external
+    assert report.tables == 2 + 4 + 1 and not report.external  # estimators, parameters, 4 per-joint, timings
     text = " ".join(report.text)
     assert "0.3182" in text and "ABC" in text and "numpy" in text and "Pinocchio" in text
 

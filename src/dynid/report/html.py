@@ -79,6 +79,20 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         sections.append(Section("Drive gains", [Table(f"K from the runs without and with the {g['payload_mass']} kg payload",
                                                       ["joint", "K (N·m/A)", "σ", "description"], rows)],
                                 [f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else []))
+    cv = d.get("settings", {}).get("preprocessing_cross_validation")
+    if cv:
+        rows = [[_fmt(c["position_cutoff"], ".3g") + ("*" if i == cv["chosen"] else ""), _fmt(c["parallel_cutoff"], ".3g"),
+                 _fmt(c["decimation"]), *(_fmt(x) for x in e), _fmt(sc)]
+                for i, (c, e, sc) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"]))]
+        sections.append(Section("preprocessing = \"auto\"", [Table(
+            "out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
+            ["positions (Hz)", "parallel (Hz)", "decimation", *(f"J{j + 1}" for j in range(len(cv["out_of_fold_rms_error"][0]))), "score"], rows)]))
+    cc = d.get("settings", {}).get("coulomb_cross_validation")
+    if cc:
+        rows = [["sign" if f == 0 else _fmt(f), *(_fmt(e) + ("*" if v == c else "") for e, v, c in zip(er, vr, cc["velocity"]))]
+                for f, vr, er in zip(cc["grid_fraction_of_rms_speed"], cc["candidates"], cc["out_of_fold_rms_error"])]
+        sections.append(Section("Coulomb smoothing", [Table("tanh(q̇/v_s): out-of-fold RMS torque error (N·m); chosen: *",
+                                                            ["v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cc["velocity"])))], rows)]))
     comparisons = ([d["identification"]] if "identification" in d else []) + list(d.get("validation", []))
     if comparisons:
         sections.append(Section("Measured against predicted torques", _comparison_tables(comparisons)))
@@ -98,7 +112,26 @@ def run_sections(d: dict) -> tuple[dict, list[Section]]:
              "yes" if m["physically_consistent"] else "no"] for m in methods.values()]
     comparison = Table(f"Estimators (paper: F = {d['paper']['objective']})",
                        ["method", "F (N·m)", "evaluations", "time (s)", "‖β̂−β‖/‖β‖ %", "ρ on β2", "error % on β2", "consistent"], rows)
-    return settings, [Section("Estimators", [comparison]), Section("Parameters", [params])]
+    n = d["joints"]
+    per_joint = []
+    for key, paper in (("identification", d["paper"]["correlation"]["identification"]), ("validation", d["paper"]["correlation"]["validation"])):
+        for metric, title, fmt in (("correlation", "correlation coefficient ρ (eq. 18)", ".4f"), ("relative_error", "relative error %", ".3g")):
+            rows = [[m["label"], *(_fmt(x, fmt) for x in m[metric][key])] for m in methods.values()]
+            if metric == "correlation":
+                rows.append(["paper (ABC)", *(_fmt(paper[j], ".4f") if j < len(paper) else "—" for j in range(n))])
+            per_joint.append(Table(f"{key} trajectory: {title} per joint", ["method", *(f"J{j + 1}" for j in range(n))], rows))
+    uncertainty = []
+    for m in methods.values():
+        b = m.get("bootstrap")
+        if b:
+            rows = [[p, _fmt(d["truth"][p]), _fmt(m["params_std"][p], ".3g"), _fmt(b["std"][p], ".3g"),
+                     f"[{_fmt(b['lower'][p])}, {_fmt(b['upper'][p])}]"] for p in names]
+            uncertainty.append(Table(f"{m['label']}: σ from the covariance, σ and {100 * b['level']:.0f} % interval from the "
+                                     f"moving-block bootstrap ({b['resamples']} resamples)",
+                                     ["name", "truth", "σ cov.", "σ boot.", "interval"], rows))
+    timings = Table("Timings (s)", ["step", "seconds"], [[k, _fmt(v, ".2f")] for k, v in d.get("timings", {}).items()])
+    return settings, [Section("Estimators", [comparison]), Section("Parameters", [params]), Section("Per joint", per_joint),
+                      *([Section("Uncertainty", uncertainty)] if uncertainty else []), Section("Timings", [timings])]
 
 
 def generic_sections(d: dict) -> tuple[dict, list[Section]]:
