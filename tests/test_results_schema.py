@@ -49,3 +49,5 @@ def test_excite_output_follows_the_schema(tmp_path):
     p = dynid("excite", str(repo / "configs" / "excite-er16.toml"), "--starts", "1", "--out", str(tmp_path / "ex"))
     assert p.returncode == 0, p.stderr
     _check(tmp_path / "ex" / "excitation.json", "excite")
+    html = (tmp_path / "ex" / "report.html").read_text()
+    assert "Before / after" in html and "Constraint margins" in html and html.count("data:image/png;base64,") == 2

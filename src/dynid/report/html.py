@@ -141,8 +141,23 @@ def generic_sections(d: dict) -> tuple[dict, list[Section]]:
     return settings, [Section("Summary", [Table("values", ["field", "value"], scalars)])]
 
 
+def excite_sections(d: dict) -> tuple[dict, list[Section]]:
+    """Settings, the before/after table and the constraint margins of ``dynid excite``."""
+    settings, _ = generic_sections(d)
+    g = d["design"]
+    before = Table("Before / after (design grid)", ["trajectory", "cond(W_base)", "log det(WᵀW/N)"],
+                   [["initial", _fmt(g["initial_cond"], ".2f"), _fmt(g["initial_log_det_information"], ".2f")],
+                    ["optimised", _fmt(g["cond"], ".2f"), _fmt(g["log_det_information"], ".2f")]])
+    margins = Table(f"Constraint margins on the verification grid (cond there: {g['cond_verification_grid']:.2f})",
+                    ["constraint", "where", "limit", "worst", "margin", "margin %"],
+                    [[m["constraint"], m["where"], _fmt(m["limit"]), _fmt(m["worst"]), _fmt(m["margin"]),
+                      _fmt(None if m.get("relative") is None else 100 * m["relative"], ".3g")] for m in g.get("margins", [])], (1,))
+    return settings, [Section("Design", [before], [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the "
+                                                   f"10× grid: {g['feasible']}"]), Section("Constraints", [margins])]
+
+
 SECTIONS = {"identify": identify_sections, "validate": identify_sections, "run": run_sections,
-            "excite": generic_sections, "montecarlo": generic_sections}
+            "excite": excite_sections, "montecarlo": generic_sections}
 
 
 def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], title: str) -> None:
