@@ -109,8 +109,9 @@ class LeastSquaresAccumulator:
         wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
         return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
 
-    def solve(self, joint_weights=None, rcond: float | None = None) -> LeastSquaresSolution:
-        """OLS (default) or WLS with one weight per joint (rows of joint ``j`` multiplied by ``joint_weights[j]``).
+    def solve(self, joint_weights=None, rcond: float | None = None, names=None) -> LeastSquaresSolution:
+        """OLS (default) or WLS with one weight per joint (rows of joint ``j`` multiplied by ``joint_weights[j]``);
+        ``names`` (p,) name the unexcited parameters in the error.
 
         Raises
         ------
@@ -123,10 +124,15 @@ class LeastSquaresAccumulator:
             raise IdentifiabilityError(f"least squares needs more equations than parameters, got {m} rows for {p} parameters")
         r_all = self.reduced(joint_weights)
         r, rhs, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
-        sv = np.linalg.svd(r, compute_uv=False)
+        _, sv, vt = np.linalg.svd(r)
         tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps
         if sv[-1] <= tol * sv[0]:
-            raise IdentifiabilityError(f"observation matrix is rank-deficient (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): use base parameters or a richer excitation")
+            null = np.abs(vt[sv <= tol * sv[0]])  # directions the data cannot tell apart
+            weak = np.any(null > 0.3 * null.max(axis=1, keepdims=True), axis=0)
+            what = (", ".join(str(names[i]) for i in np.flatnonzero(weak)) if names is not None
+                    else f"{int(weak.sum())} parameter(s)")
+            raise IdentifiabilityError(f"the data do not excite {what} (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): "
+                                       "a richer excitation, or a longer log, is needed")
         params = np.linalg.solve(r, rhs)
         sigma2 = rho**2 / (m - p)
         rinv = np.linalg.inv(r)

@@ -20,7 +20,7 @@ from ..dynamics.layout import consistency_layout
 from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
-from ..exceptions import ConfigError, DynIdError
+from ..exceptions import ConfigError, DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
@@ -301,7 +301,13 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             k = keep.reshape(-1)
             stacked_w.append(y.reshape(-1, base.n_base) * k[:, None])
             stacked_tau.append(tau.reshape(-1) * k)
-    ols = acc.solve()
+    try:
+        ols = acc.solve(names=base.names)
+    except IdentifiabilityError as exc:
+        speed = np.sqrt(np.mean(data.dq**2, axis=0))
+        still = [f"J{j + 1}" for j in np.flatnonzero(speed < 1e-3 * max(speed.max(), 1e-12))]
+        hint = f"; joint(s) {', '.join(still)} barely move" if still else ""
+        raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None
     joint_std = acc.joint_residual_std(ols.params)
     row_weights = None if method == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     sol = ols if method == "ols" else acc.solve(row_weights)
