@@ -41,6 +41,31 @@ def _vec(v) -> str:
     return " ".join(f"{x:.17g}" for x in np.asarray(v, dtype=float))
 
 
+def _exportable(robot: Robot, phi: np.ndarray | None) -> Robot:
+    """The robot with parameters ``phi`` (default nominal), after the checks every export needs: the right
+    number of parameters, every link realisable by a mass distribution, friction coefficients ≥ 0.
+
+    Raises
+    ------
+    ConfigError
+        Names the link or joint and the broken rule.
+    """
+    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
+    if phi.shape != (robot.n_params,):
+        raise ConfigError(f"export: expected {robot.n_params} standard parameters for robot {robot.name!r}, got {phi.shape}")
+    fitted = robot.with_parameters(phi)
+    for j, joint in enumerate(robot.joints):
+        if not is_physically_consistent(fitted.inertial[j], tol=CONSISTENCY_TOL):
+            rule = (physical_problems(fitted.inertial[j]) or ["a pseudo-inertia that is not positive semidefinite"])[0]
+            raise ConfigError(f"export: link {j + 1} ({joint.name}): {rule}; only physically consistent parameters can be "
+                              "exported (the physically consistent estimate of dynid identify is)")
+        terms = dict(zip(robot.drive_terms, fitted.drive[j]))
+        fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
+        if fc < 0 or fv < 0:
+            raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
+    return fitted
+
+
 def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
     """URDF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
 
@@ -63,17 +88,10 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
         A link whose parameters are those of no mass distribution (named with the broken rule), or a
         negative friction coefficient.
     """
-    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
-    if phi.shape != (robot.n_params,):
-        raise ConfigError(f"export: expected {robot.n_params} standard parameters for robot {robot.name!r}, got {phi.shape}")
-    fitted = robot.with_parameters(phi)
+    fitted = _exportable(robot, phi)
     lines = ['<?xml version="1.0"?>', f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
              f"<robot name={quoteattr(name or robot.name)}>", '  <link name="base_link"/>']
     for j, joint in enumerate(robot.joints):
-        if not is_physically_consistent(fitted.inertial[j], tol=CONSISTENCY_TOL):
-            rule = (physical_problems(fitted.inertial[j]) or ["a pseudo-inertia that is not positive semidefinite"])[0]
-            raise ConfigError(f"export: link {j + 1} ({joint.name}): {rule}; only physically consistent parameters can be "
-                              "exported (the physically consistent estimate of dynid identify is)")
         mass, com, inertia = physical_from_inertial(fitted.inertial[j])
         link = f"link{j + 1}"
         lines += [f'  <link name="{link}">', "    <inertial>", f'      <origin xyz="{_vec(com)}" rpy="0 0 0"/>',
@@ -83,8 +101,6 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
                   "    </inertial>", "  </link>"]
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
         fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
-        if fc < 0 or fv < 0:
-            raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
         parent = "base_link" if j == 0 else f"link{j}"
         lines += [f"  <joint name={quoteattr(joint.name)} type=\"revolute\">", f'    <parent link="{parent}"/>', f'    <child link="{link}"/>',
                   f'    <origin xyz="{_vec(joint.translation)}" rpy="{_vec(_rpy(joint.rotation))}"/>',
@@ -103,7 +119,7 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
     if n_coupled:
         names = robot.transmission.coupled_parameter_names
         lines.append("  <!-- dynid: coupled motors (not representable in URDF), add their torques: "
-                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(names, phi[-n_coupled:])) + " -->")
+                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " -->")
     lines += ['  <link name="flange"/>', '  <joint name="flange_fixed" type="fixed">', f'    <parent link="link{robot.n_dof}"/>',
               '    <child link="flange"/>',
               f'    <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(robot.tool_rotation))}"/>', "  </joint>", "</robot>", ""]
@@ -129,9 +145,7 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
     """
     import pinocchio as pin
 
-    phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
-    urdf_from_robot(robot, phi)  # the same checks of consistency and friction signs
-    fitted = robot.with_parameters(phi)
+    fitted = _exportable(robot, phi)
     g = np.asarray(robot.gravity, dtype=float)
     lines = [f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
              f"<mujoco model={quoteattr(name or robot.name)}>",
@@ -166,7 +180,8 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
     n_coupled = robot.transmission.n_coupled_params
     if n_coupled:
         lines.append("  <!-- dynid: coupled motors (not representable here), add their torques: "
-                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names, phi[-n_coupled:]))
+                     + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
+                                                                  fitted.transmission.coupled_values.ravel()))
                      + " -->")
     lines += ["</mujoco>", ""]
     return "\n".join(lines)

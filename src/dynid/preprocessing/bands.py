@@ -91,30 +91,27 @@ class DerivedCutoffs:
     Attributes
     ----------
     band : float [Hz]
-    source : str
-        Where the band comes from ("position spectrum", "excitation harmonics").
     position_cutoff, parallel_cutoff : float [Hz]
     decimation : int
     """
 
     band: float
-    source: str
     position_cutoff: float
     parallel_cutoff: float
     decimation: int
 
-    def explain(self) -> str:
-        """One line saying what was chosen and why."""
-        return (f"excitation band {self.band:.3g} Hz ({self.source}); positions/velocities low-passed at "
-                f"{POSITION_FACTOR:g}× band = {self.position_cutoff:.3g} Hz; torques and every regressor column "
-                f"filtered in parallel at {PARALLEL_FACTOR:g}× band = {self.parallel_cutoff:.3g} Hz and decimated "
-                f"by {self.decimation}")
+
+def decimation_for(rate: float, cutoff: float) -> int:
+    """The largest decimation whose anti-aliasing cutoff (:func:`decimation_cutoff`) is at or above ``cutoff``."""
+    return max(1, int(np.floor(0.8 * rate / (2 * cutoff))))
 
 
-def cutoffs_from_band(band: float, rate: float, source: str = "position spectrum") -> DerivedCutoffs:
+def capped(cutoff: float, rate: float) -> float:
+    """``cutoff`` [Hz], at most :data:`NYQUIST_CAP` × the Nyquist frequency of ``rate``."""
+    return min(cutoff, NYQUIST_CAP * rate / 2)
+
+
+def cutoffs_from_band(band: float, rate: float) -> DerivedCutoffs:
     """The rules of the module docstring for a band ``band`` [Hz] at sampling rate ``rate`` [Hz]."""
-    cap = NYQUIST_CAP * rate / 2
-    f_q = min(POSITION_FACTOR * band, cap)
-    f_p = min(PARALLEL_FACTOR * band, cap)
-    decimation = max(1, int(np.floor(0.8 * rate / (2 * f_p))))
-    return DerivedCutoffs(float(band), source, float(f_q), float(f_p), decimation)
+    f_p = capped(PARALLEL_FACTOR * band, rate)
+    return DerivedCutoffs(float(band), float(capped(POSITION_FACTOR * band, rate)), float(f_p), decimation_for(rate, f_p))

@@ -8,7 +8,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..exceptions import ConfigError
-from .bands import cutoffs_from_band, decimation_cutoff, excitation_band
+from .bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, decimation_cutoff, decimation_for, excitation_band
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ class Preprocessing:
             if q is None:
                 raise ConfigError("preprocessing.band: needed when no positions are given to estimate it")
             band, source = excitation_band(q, rate), "99 % of the velocity energy in the positions' spectrum"
-        derived = cutoffs_from_band(band, rate, source)
+        derived = cutoffs_from_band(band, rate)
         pos = self.position_cutoff if self.position_cutoff is not None else derived.position_cutoff
         vel = self.velocity_cutoff if self.velocity_cutoff is not None else pos
         if self.parallel_cutoff:
@@ -112,7 +112,7 @@ class Preprocessing:
         if self.decimation is not None:
             dec = self.decimation
         elif par > 0:
-            dec = max(1, int(np.floor(0.8 * rate / (2 * par))))
+            dec = decimation_for(rate, par)
         else:
             dec = 1
         if self.fourier is not None:
@@ -122,11 +122,11 @@ class Preprocessing:
         trim = self.trim if self.trim is not None else (3.0 / min(on) if on else 0.0)
         chosen = [f"excitation band {band:.3g} Hz ({source})"]
         if self.fourier is None:
-            chosen.append(f"positions low-passed at {pos:.3g} Hz" + ("" if self.position_cutoff is not None else " (10× band)"))
+            chosen.append(f"positions low-passed at {pos:.3g} Hz" + ("" if self.position_cutoff is not None else f" ({POSITION_FACTOR:g}× band)"))
         else:
             chosen.append("positions, velocities and accelerations from the Fourier fit")
         chosen.append(f"torques and every regressor column low-passed in parallel at {par:.3g} Hz"
-                      + ("" if self.parallel_cutoff is not None or self.decimation is not None else " (10× band)")
+                      + ("" if self.parallel_cutoff is not None or self.decimation is not None else f" ({PARALLEL_FACTOR:g}× band)")
                       if par > 0 else "no parallel filter")
         chosen.append(f"decimation by {dec}" + ("" if self.decimation is not None else " (down to the parallel band)"))
         return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),

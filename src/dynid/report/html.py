@@ -136,7 +136,8 @@ def run_sections(d: dict) -> tuple[dict, list[Section]]:
 
 def generic_sections(d: dict) -> tuple[dict, list[Section]]:
     """Settings and the top-level numbers of ``dynid excite`` and ``dynid montecarlo``."""
-    settings = {k: v for k, v in d.get("settings", d.get("config", {})).items()} if isinstance(d.get("settings", d.get("config")), dict) else {}
+    given = d.get("settings", d.get("config"))
+    settings = dict(given) if isinstance(given, dict) else {}
     scalars = [[k, _fmt(v)] for k, v in d.items() if isinstance(v, (int, float, str)) and k not in ("schema_version", "dynid_version", "kind")]
     return settings, [Section("Summary", [Table("values", ["field", "value"], scalars)])]
 

@@ -23,6 +23,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
+from ..preprocessing.bands import capped
 from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
 
 COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
@@ -200,9 +201,10 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
     candidates, errors, prepared = [], [], []
     for f in factors:
+        cutoff = capped(f * band, recording.rate)
         settings = replace(given,
-                           position_cutoff=given.position_cutoff if given.position_cutoff is not None else min(f * band, 0.4 * recording.rate),
-                           parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else min(f * band, 0.4 * recording.rate))
+                           position_cutoff=given.position_cutoff if given.position_cutoff is not None else cutoff,
+                           parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else cutoff)
         data = prepare(recording, settings)
         fitted, _ = _fold_accumulators(robot, base, data, duration, folds)
         sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
