@@ -18,7 +18,8 @@ import tracemalloc
 import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
-from dynid.experiment.identification import PreparedData, Preprocessing, identify
+from dynid.experiment.identification import identify
+from dynid.preprocessing.pipeline import PreparedData, Preprocessing
 from dynid.model.description import load_robot
 
 RATE = 1000.0

@@ -8,7 +8,7 @@ import pytest
 
 from dynid.dynamics.kinematics import tool_positions
 from dynid.dynamics.rnea import rnea_torques
-from dynid.experiment.excitation_config import load_excitation_config
+from dynid.io.excitation_config import load_excitation_config
 from dynid.io.trajectories import load_trajectory
 from dynid.model.description import load_robot
 

@@ -51,7 +51,8 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     authors' (which fix K1 = 10 and are uncertain by 10-20 %, SOURCE.md), the payload's mass within 10 %."""
     from pathlib import Path
 
-    from dynid.experiment.identification_config import load_identification_config, run_identification
+    from dynid.io.identification_config import load_identification_config
+    from dynid.experiment.identification_run import run_identification
 
     from ..conftest import shared_data
 

@@ -36,7 +36,7 @@ def test_noisy_run_is_reproducible_and_sane():
 def test_all_methods_compared_honestly_and_reproducibly():
     """Every box search is bounded below by LAD's exact minimum of eq. 9; the SDP result is physically
     consistent; the same seed gives identical results, whichever other methods run beside."""
-    from dynid.experiment.methods import METHODS
+    from dynid.estimators.registry import METHODS
 
     cfg = PaperExperimentConfig(bootstrap=20, **FAST)
     a = run_paper_experiment(cfg)

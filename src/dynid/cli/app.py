@@ -100,7 +100,7 @@ def run(
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
     from ..experiment import PaperExperimentConfig, run_paper_experiment
-    from ..experiment.method_names import LABELS, parse_methods
+    from ..estimators.names import LABELS, parse_methods
     from ..report.paper_run import save_paper_run
 
     try:
@@ -129,7 +129,7 @@ def _joined(values, fmt: str) -> str:
 def _print_run(result, paths) -> None:
     from ..estimators.physically_consistent import CONSISTENCY_TOL
     from ..experiment import paper_reference as ref
-    from ..experiment.method_names import DESCRIPTIONS, LABELS
+    from ..estimators.names import DESCRIPTIONS, LABELS
 
     d = result.to_dict()
     methods = {LABELS[k]: v for k, v in d["methods"].items()}
@@ -363,7 +363,8 @@ def identify(
     figures: bool = typer.Option(True, help="Write the torque figures (--no-figures: results.json only)."),
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
-    from ..experiment.identification_config import load_identification_config, run_identification
+    from ..experiment.identification_run import run_identification
+    from ..io.identification_config import load_identification_config
 
     try:
         cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
@@ -389,7 +390,7 @@ def export(
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
     from ..exceptions import DataError
-    from ..experiment.identification_config import load_identification_config
+    from ..io.identification_config import load_identification_config
 
     try:
         cfg = load_identification_config(config, data_root)
@@ -449,7 +450,8 @@ def validate(
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
     from ..exceptions import DataError
-    from ..experiment.identification_config import dataset_for_file, load_identification_config, run_validation
+    from ..experiment.identification_run import run_validation
+    from ..io.identification_config import dataset_for_file, load_identification_config
 
     try:
         cfg = load_identification_config(config, data_root)
@@ -484,7 +486,8 @@ def excite(
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
     from dataclasses import replace
 
-    from ..experiment.excitation_config import load_excitation_config, run_excitation
+    from ..experiment.excitation import run_excitation
+    from ..io.excitation_config import load_excitation_config
 
     try:
         cfg = load_excitation_config(config)
@@ -557,7 +560,7 @@ def montecarlo(
     out: Path = typer.Option(Path("dynid-montecarlo"), help="Output folder for montecarlo.json, the estimates CSV and figures."),
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
-    from ..experiment.method_names import parse_methods
+    from ..estimators.names import parse_methods
     from ..experiment.montecarlo import DEFAULT_METHODS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 
@@ -580,7 +583,7 @@ def montecarlo(
 def _print_montecarlo(result, paths) -> None:
     import numpy as np
 
-    from ..experiment.methods import LABELS
+    from ..estimators.names import LABELS
 
     cfg = result.config
     stats = result.statistics()

@@ -1,15 +1,22 @@
-"""Estimators of the base parameters from (W, tau): they never see robots, only the linear problem."""
+"""Estimators of the base parameters from (W, tau): they never see robots, only the linear problem.
 
-from .base import BoxSearchEstimator, Estimator, paper_objective
-from .bee_colony import BeeColonyEstimator
-from .bootstrap import BootstrapIntervals, bootstrap_intervals
-from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
-from .least_absolute import LeastAbsoluteDeviations
-from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
-from .physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin
-from .robust import IterativelyReweightedLeastSquares
+:mod:`dynid.estimators.registry` builds any of them from a method key (:mod:`dynid.estimators.names`);
+the classes load on first use, so that reading method names (a config check) imports no solver.
+"""
 
-__all__ = ["Estimator", "BoxSearchEstimator", "paper_objective", "BeeColonyEstimator", "BootstrapIntervals",
-           "bootstrap_intervals", "DifferentialEvolutionEstimator", "ParticleSwarmEstimator", "LeastAbsoluteDeviations",
-           "OrdinaryLeastSquares", "WeightedLeastSquares", "PhysicallyConsistentLeastSquares",
-           "IterativelyReweightedLeastSquares", "consistency_margin"]
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "Estimator": "base", "BoxSearchEstimator": "base", "paper_objective": "base",
+    "BeeColonyEstimator": "bee_colony",
+    "BootstrapIntervals": "bootstrap", "bootstrap_intervals": "bootstrap",
+    "DifferentialEvolutionEstimator": "global_search", "ParticleSwarmEstimator": "global_search",
+    "LeastAbsoluteDeviations": "least_absolute",
+    "OrdinaryLeastSquares": "least_squares", "WeightedLeastSquares": "least_squares",
+    "PhysicallyConsistentLeastSquares": "physically_consistent", "consistency_margin": "physically_consistent",
+    "IterativelyReweightedLeastSquares": "robust",
+}
+
+__all__ = list(_EXPORTS)
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

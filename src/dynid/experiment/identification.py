@@ -23,62 +23,16 @@ from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares,
 from ..exceptions import ConfigError, DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
-from ..validation import correlation_coefficient, global_relative_error, relative_error, rmse
+from ..estimators.names import LEAST_SQUARES as METHODS
+from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..validation.torques import TorqueComparison, compare_torques
 
-__all__ = ["METHODS", "PreparedData", "Preprocessing", "base_chunks", "prepare", "TorqueComparison", "compare_torques",
-           "IdentificationResult", "identify"]
-
-METHODS = ("ols", "wls")
-
-
-@dataclass(frozen=True)
-class TorqueComparison:
-    """Measured and predicted torques of one dataset (decimated), with per-joint metrics.
-
-    Attributes
-    ----------
-    name : str
-    t : (M,) array [s]
-    measured : (M, n_dof) array [N·m]
-    predicted : dict label -> (M, n_dof) array
-    """
-
-    name: str
-    t: np.ndarray
-    measured: np.ndarray
-    predicted: dict
-
-    def metrics(self) -> dict:
-        """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,), and
-        global_relative_error [%] over all joints and samples (a float)."""
-        return {label: {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
-                        "correlation": correlation_coefficient(self.measured, p),
-                        "global_relative_error": global_relative_error(self.measured, p)}
-                for label, p in self.predicted.items()}
-
-    def to_dict(self) -> dict:
-        return {"name": self.name, "n_samples": int(self.t.shape[0]),
-                "rms_torque": np.sqrt((self.measured**2).mean(axis=0)), "metrics": self.metrics()}
-
-
-def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
-                    progress=None) -> TorqueComparison:
-    """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
-    (n_base,)), on the same parallel-decimated samples as the estimation."""
-    ts, meas, preds = [], [], {k: [] for k in parameter_sets}
-    for index, y, tau, _ in base_chunks(robot, base, data, progress):
-        ts.append(data.t[index])
-        meas.append(tau)
-        for label, beta in parameter_sets.items():
-            preds[label].append(y @ beta)
-    return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
-                            {k: np.concatenate(v) for k, v in preds.items()})
+__all__ = ["IdentificationResult", "identify"]
 
 
 def estimate_label(method: str) -> str:
     """How dynid's estimate is labelled in tables, figures and JSON: ``"dynid WLS"``, ``"dynid ABC×10"``."""
-    from .method_names import LABELS
+    from ..estimators.names import LABELS
 
     return f"dynid {LABELS.get(method, method.upper())}"
 
@@ -110,7 +64,7 @@ def search_box(params: np.ndarray, std: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class OtherEstimate:
-    """An estimator of :mod:`dynid.experiment.methods` run on the stacked, parallel-filtered rows.
+    """An estimator of :mod:`dynid.estimators.registry` run on the stacked, parallel-filtered rows.
 
     Attributes
     ----------
@@ -272,7 +226,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     (same row weights; prior: the robot model's nominal parameters). Every parameter set gets its
     consistency margin.
 
-    ``methods`` adds estimators of :mod:`dynid.experiment.methods` other than OLS/WLS/SDP (IRLS, LAD, ABC,
+    ``methods`` adds estimators of :mod:`dynid.estimators.registry` other than OLS/WLS/SDP (IRLS, LAD, ABC,
     ABC×10, DE, PSO) on the same parallel-filtered rows, stacked in memory (rows below ``min_speed`` set
     to 0, so that they count for no method); LAD and the box searches search :func:`search_box`, seeded
     by ``rng``.
@@ -343,9 +297,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
 
 def _other_estimates(keys, base, w, tau, n_dof, sol, rng) -> tuple[tuple[OtherEstimate, ...], np.ndarray]:
     """Fit each of ``keys`` on the stacked rows; the box from the OLS/WLS solution ``sol``."""
-    from .methods import FitData, SearchBudget, fit_method
+    from ..estimators.registry import FitData, SearchBudget, fit_method
 
-    from .methods import METHODS as ALL
+    from ..estimators.names import METHODS as ALL
 
     box = search_box(sol.params, sol.params_std)
     data = FitData(w, tau, n_dof, box, base)

@@ -2,7 +2,7 @@
 
 For every current-noise level and realisation the paper's identification recording is simulated afresh
 (eq. 16 currents with Gaussian noise, encoder quantisation, eq. 17 smoothing, Fourier-fit derivatives) and
-every method of :mod:`dynid.experiment.methods` is fitted. Per level and method the study reports the
+every method of :mod:`dynid.estimators.registry` is fitted. Per level and method the study reports the
 bias, standard deviation and RMSE of each base parameter, and the ratio of the standard deviation to the
 Cramér–Rao bound.
 
@@ -37,7 +37,7 @@ from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..exceptions import ConfigError, DynIdError
 from ..model.description import load_robot
 from ..simulation.measurements import NoiseModel
-from .methods import LABELS, METHODS, SearchBudget, fit_method, parse_methods
+from ..estimators.registry import LABELS, METHODS, SearchBudget, fit_method, parse_methods
 from .paper import PaperExperimentConfig, fit_data, identification_trajectory, search_box, simulate_dataset
 from ..threads import with_single_blas_thread
 
@@ -60,7 +60,7 @@ class MonteCarloConfig:
     realisations : int
         Noise realisations per level (>= 2; the issue's study uses >= 100).
     methods : tuple of str
-        Estimators (keys of :data:`dynid.experiment.methods.METHODS`).
+        Estimators (keys of :data:`dynid.estimators.registry.METHODS`).
     seed : int
     duration, rate : float
         Recording length [s] and sampling rate [Hz] (default 25 s at 200 Hz; the paper records at 1 kHz).

@@ -1,7 +1,7 @@
 """The paper's identification experiment, end to end (§3-4), on a simulated robot.
 
 Model → base parameters → excitation β1 (eq. 14) → simulated currents (eq. 16) → eq. 17 smoothing and
-Fourier-fit derivatives → the estimators of :mod:`dynid.experiment.methods` (ABC of eqs. 7-13 at the paper's
+Fourier-fit derivatives → the estimators of :mod:`dynid.estimators.registry` (ABC of eqs. 7-13 at the paper's
 budget and 10× it, DE and PSO on the same objective and box, LAD = the exact minimiser of eq. 9 in that box,
 OLS, WLS, IRLS, physically consistent least squares) → correlation coefficient (eq. 18), RMSE and relative
 error on β1 and on the validation trajectory β2, parameter error against the truth, bootstrap intervals.
@@ -34,7 +34,7 @@ from ..preprocessing import five_point_cubic_smoothing, fourier_fit_derivatives
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
-from .methods import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
+from ..estimators.registry import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
 from ..threads import cores, with_single_blas_thread
 
 PLANTS = ("assumed", "paper")
@@ -78,7 +78,7 @@ class PaperExperimentConfig:
         :func:`dynid.excitation.design.design_excitation`: 5 harmonics at ``omega_f``, β1's offsets, the
         robot's limits, starting from β1) or the path of an ``excitation.json`` written by ``dynid excite``.
     methods : tuple of str
-        Estimators compared (keys of :data:`dynid.experiment.methods.METHODS`; default all).
+        Estimators compared (keys of :data:`dynid.estimators.registry.METHODS`; default all).
     bootstrap : int
         Moving-block bootstrap resamples for the least-squares methods (0: none).
     """

@@ -5,7 +5,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from ..experiment.identification import IdentificationResult, TorqueComparison
+from ..experiment.identification import IdentificationResult
+from ..validation.torques import TorqueComparison
 from . import figures
 from .html import write_html_report
 from .output import output_folder, save_figure, write_results, staged

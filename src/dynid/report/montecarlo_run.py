@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..experiment.methods import LABELS
+from ..estimators.names import LABELS
 from ..experiment.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures

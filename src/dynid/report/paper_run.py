@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..experiment import paper_reference as ref
-from ..experiment.methods import BOX_SEARCHES, LABELS
+from ..estimators.names import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
 from . import figures
 from .html import write_html_report

@@ -1,4 +1,5 @@
 """Configs of ``dynid excite`` (TOML): design an excitation trajectory for a robot (paper §3.2, eq. 15).
+Parsing only; :mod:`dynid.experiment.excitation` runs them.
 
 Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to the config file)::
 
@@ -38,17 +39,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
-
 import numpy as np
 
 from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
-from ..excitation.design import ExcitationDesign, ExcitationProblem, design_excitation
+from ..excitation.design import ExcitationProblem
 from ..excitation.fourier import FORMS, FourierTrajectory
 from ..excitation.paper_trajectories import paper_identification_trajectory
-from ..io.trajectories import load_trajectory
-from ..io.configs import config_robot, read_config
+from .configs import config_robot, read_config
+from .trajectories import load_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
 
@@ -188,40 +187,3 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
     return ExcitationConfig(path, full, problem, form, starts, seed, maxiter, initial, initial_label, rate, periods)
-
-
-@dataclass(frozen=True)
-class ExcitationRun:
-    """What ``dynid excite`` produced: the design and the sampled trajectory."""
-
-    config: ExcitationConfig
-    design: ExcitationDesign
-    t: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    ddq: np.ndarray
-
-    def to_dict(self) -> dict:
-        c, p = self.config, self.config.problem
-        lim = p.limits
-        return {
-            "robot": c.full_robot.name, "joints": p.robot.n_dof, "config": str(c.path),
-            "harmonics": p.n_harmonics, "omega_f": p.omega_f, "period": p.period, "rest": p.rest,
-            "base_parameters": list(p.base.names),
-            "limits": {f: getattr(lim, f).tolist() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")},
-            "workspace": p.workspace.to_dict(),
-            "settings": {"starts": c.starts, "seed": c.seed, "maxiter": c.maxiter, "grid_points": p.grid_points,
-                         "safety": p.safety, "initial": c.initial_label, "csv_rate": c.rate, "csv_periods": c.periods},
-            "trajectory": self.design.trajectory.to_dict(c.form),
-            "design": {k: v for k, v in self.design.to_dict(c.form).items() if k != "trajectory"},
-        }
-
-
-def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:
-    """Design the trajectory of ``config`` and sample it at the controller's rate."""
-    design = design_excitation(config.problem, n_starts=config.starts, rng=config.seed, initial=config.initial,
-                               maxiter=config.maxiter, callback=callback)
-    n = int(round(config.periods * config.problem.period * config.rate))
-    t = np.arange(n + 1) / config.rate  # both ends: the controller's last set-point is the start again
-    q, dq, ddq = design.trajectory.evaluate(t)
-    return ExcitationRun(config, design, t, q, dq, ddq)

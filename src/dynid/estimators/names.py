@@ -1,5 +1,5 @@
 """Keys, labels and descriptions of the estimators (light: read while a config is checked, before the
-estimators themselves are imported; :mod:`dynid.experiment.methods` builds them)."""
+estimators themselves are imported; :mod:`dynid.estimators.registry` builds them)."""
 
 from __future__ import annotations
 
@@ -19,6 +19,8 @@ DESCRIPTIONS = {
     "de": "differential evolution (SciPy), the budget of ABC×10",
     "pso": "particle swarm (constriction), the budget of ABC×10",
 }
+LEAST_SQUARES = ("ols", "wls")
+"""The least-squares estimates that carry σ (``[estimation] method`` of ``dynid identify``)."""
 BOX_SEARCHES = ("abc", "abc10", "de", "pso")
 """Methods that search the box for the minimum of eq. 9 and count objective evaluations."""
 BOOTSTRAPPED = ("ols", "wls")

@@ -1,4 +1,4 @@
-"""Experiment configs of ``dynid identify`` / ``dynid validate`` (TOML), and the runs they describe.
+"""Configs of ``dynid identify`` / ``dynid validate`` (TOML): parsing only; :mod:`dynid.experiment.identification_run` runs them.
 
 Layout (paths relative to the config file; data paths relative to ``data_root``)::
 
@@ -61,22 +61,16 @@ import os
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
-import numpy as np
-
 from ..exceptions import ConfigError, DataError
-from ..io.configs import config_robot, read_config
-from ..io.datasets import DatasetSpec, SignalSpec, dataset_spec, load_recording
-from ..io.trajectories import load_trajectory
+from .configs import config_robot, read_config
+from .datasets import DatasetSpec, SignalSpec, dataset_spec
+from .trajectories import load_trajectory
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
-from .method_names import parse_methods
-from ..threads import with_single_blas_thread
+from ..estimators.names import LEAST_SQUARES as METHODS, parse_methods
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.
-
-METHODS = ("ols", "wls")
-"""The least-squares estimate that carries σ (``[estimation] method``)."""
 
 DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
@@ -251,7 +245,7 @@ def _drive_gains(table, root: Path, where: str, n: int):
     return float(mass), specs[0], specs[1]
 
 
-def _stored_preprocessing(identified: dict) -> Preprocessing | None:
+def stored_preprocessing(identified: dict) -> Preprocessing | None:
     """The identification's resolved preprocessing as results.json stores it (None if absent)."""
     stored = identified.get("settings", {}).get("preprocessing") if isinstance(identified.get("settings"), dict) else None
     if not isinstance(stored, dict):
@@ -262,52 +256,6 @@ def _stored_preprocessing(identified: dict) -> Preprocessing | None:
         return Preprocessing(**values)
     except TypeError:
         return None
-
-
-def _references(config: IdentificationConfig, base):
-    from ..io.references import load_reference
-
-    nominal = config.robot.standard_parameters()
-    return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base, nominal)
-                 for i, r in enumerate(config.references))
-
-
-def _gains_and_payload(config: IdentificationConfig, robot, base):
-    """Drive gains from the two runs, then the payload from the loaded run with those gains."""
-    from ..preprocessing.pipeline import prepare
-    from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
-
-    mass, unloaded, loaded = config.drive_gains
-    unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
-    pre_u = prepare(load_recording(unloaded, unit), config.preprocessing)
-    pre_l = prepare(load_recording(loaded, unit), config.preprocessing)
-    gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
-    k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
-    payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
-    return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
-
-
-def validation_settings(given: Preprocessing, resolved: Preprocessing | None) -> Preprocessing:
-    """Preprocessing of validation logs: the identification's filters (in Hz, resolved on its data) so
-    both are scored through the same filters; decimation and trim derived again for each log (its rate
-    may differ), and no Fourier fit (the excitation's harmonics fit only its own log)."""
-    if resolved is None:
-        return replace(given, fourier=None)
-    return replace(resolved, fourier=None, decimation=given.decimation, trim=given.trim, derivation="")
-
-
-def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
-              progress=None, resolved: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
-    from ..preprocessing.pipeline import prepare
-    from .identification import compare_torques
-
-    out, warnings = [], []
-    settings = validation_settings(config.preprocessing, resolved)
-    for spec in datasets:
-        data = prepare(load_recording(spec, config.robot), settings)
-        out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
-        warnings.extend(data.warnings)
-    return tuple(out), tuple(warnings)
 
 
 def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> DatasetSpec:
@@ -326,148 +274,3 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
     time = SignalSpec(Path(file), spec.time.columns, 1.0) if spec.time else None
     return replace(spec, name=Path(file).name, signals=signals, time=time,
                    rows=None if rows is None else tuple(rows))
-
-
-@with_single_blas_thread
-def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
-    """Identify the base parameters from the config's identification dataset, then validate them on
-    each validation dataset beside the reference sets.
-
-    Returns
-    -------
-    dynid.experiment.identification.IdentificationResult
-    """
-    from ..dynamics.base_parameters import base_parameters
-    from ..preprocessing.pipeline import prepare
-    from ..validation.cross_validation import choose_coulomb_velocity
-    from .identification import identify
-
-    base = base_parameters(config.robot, rng=0)
-    refs = _references(config, base)
-    recording = load_recording(config.identification, config.robot)
-    filters = None
-    if config.preprocessing.auto:
-        from ..validation.cross_validation import choose_preprocessing
-
-        filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)
-        data = filters.data
-    else:
-        data = prepare(recording, config.preprocessing)
-    vs = config.preprocessing.coulomb_velocity
-    choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
-    robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
-    result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
-    result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
-                                       **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
-                                       **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
-    if config.drive_gains is not None:
-        result = replace(result, drive_gains=_gains_and_payload(config, robot, base))
-    if not validate or not config.validation:
-        return result
-    validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,
-                                      data.settings)
-    return replace(result, validations=validations, warnings=result.warnings + warnings)
-
-
-def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
-                   progress=None) -> tuple[tuple, tuple[str, ...]]:
-    """Validate identified base parameters (``identified``: results.json of ``dynid identify``) and the
-    config's reference sets on the config's validation datasets (or on ``datasets``).
-
-    Raises
-    ------
-    DataError
-        The results do not belong to this robot (different base parameters).
-    """
-    from ..dynamics.base_parameters import base_parameters
-    from .identification import parameter_sets
-
-    base = base_parameters(config.robot, rng=0)
-    try:
-        names = [p["name"] for p in identified["base_parameters"]]
-        values = np.array([float(p["value"]) for p in identified["base_parameters"]])
-        method = str(identified.get("method", "ls"))
-    except (KeyError, TypeError, ValueError):
-        raise DataError("results: expected the results.json of dynid identify (a list base_parameters of {name, value})") from None
-    if tuple(names) != base.names:
-        raise DataError(f"results: its base parameters ({len(names)}) are not those of robot {config.robot.name!r} ({base.n_base}); was it identified with this config?")
-    refs = _references(config, base)
-    consistent = identified.get("physically_consistent")
-    try:
-        sdp = None if consistent is None else np.array([float(consistent["values"][n]) for n in base.names])
-    except (KeyError, TypeError, ValueError):
-        raise DataError("results: physically_consistent.values must give every base parameter") from None
-    stored = identified.get("methods", {})
-    try:
-        others = {str(label): np.array([float(m["values"][n]) for n in base.names]) for label, m in stored.items()}
-    except (KeyError, TypeError, ValueError, AttributeError):
-        raise DataError("results: methods.*.values must give every base parameter") from None
-    sets = parameter_sets(method, values, refs, sdp, others)
-    datasets = config.validation if datasets is None else datasets
-    if not datasets:
-        raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
-    stored_vs = identified.get("settings", {}).get("coulomb_velocity") if isinstance(identified.get("settings"), dict) else None
-    if stored_vs is not None:
-        try:
-            config = replace(config, robot=replace(config.robot, coulomb_velocity=np.asarray(stored_vs, dtype=float)))
-        except (TypeError, ValueError, ConfigError):
-            raise DataError("results: settings.coulomb_velocity must give one non-negative velocity per joint") from None
-    comparisons, warnings = _validate(config, base, sets, datasets, progress, _stored_preprocessing(identified))
-    return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
-
-
-@with_single_blas_thread
-def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
-                         method: str = "wls", physically_consistent: bool = False, methods: tuple[str, ...] = (),
-                         name: str = "arrays"):
-    """Identify a robot from arrays, without a config file or a CSV: the same pipeline as ``dynid identify``
-    (data-derived preprocessing, parallel filtering, OLS/WLS with σ, optionally the SDP and other estimators).
-
-    Parameters
-    ----------
-    robot : Robot
-        E.g. :func:`dynid.load_robot`.
-    t : (N,) array [s]
-        Uniformly sampled time stamps.
-    q : (N, n_dof) array [rad]
-        Joint positions.
-    tau : (N, n_dof) array [N·m]
-        Joint torques (e.g. drive gain × motor current, eq. 16).
-    dq : (N, n_dof) array [rad/s], optional
-        Measured velocities (default: differentiated from the filtered positions).
-    preprocessing : Preprocessing, optional
-        Default: every setting derived from the data.
-    method, physically_consistent, methods
-        As ``[estimation]`` of a config.
-
-    Returns
-    -------
-    dynid.experiment.identification.IdentificationResult
-
-    Raises
-    ------
-    ShapeError
-        Arrays of inconsistent shapes, not time-first, or not finite.
-    DataError
-        Time stamps that are not uniform and increasing.
-    """
-    from ..checks import check_trajectory_array
-    from ..dynamics.base_parameters import base_parameters
-    from ..exceptions import ShapeError
-    from ..io.datasets import Recording
-    from ..preprocessing.pipeline import prepare
-    from .identification import identify
-
-    t = np.asarray(t, dtype=float).reshape(-1)
-    q = check_trajectory_array(q, robot.n_dof, "q")
-    tau = check_trajectory_array(tau, robot.n_dof, "tau")
-    dq = None if dq is None else check_trajectory_array(dq, robot.n_dof, "dq")
-    if not (q.shape[0] == tau.shape[0] == t.shape[0] and (dq is None or dq.shape[0] == t.shape[0])):
-        raise ShapeError(f"expected t, q, tau (and dq) with the same number of samples, got {t.shape[0]}, {q.shape[0]}, {tau.shape[0]}")
-    steps = np.diff(t)
-    if t.size < 2 or np.any(steps <= 0) or np.ptp(steps) > 1e-6 * np.median(steps):
-        raise DataError("t: expected uniformly spaced, increasing time stamps (resample the data first)")
-    rate = 1.0 / float(np.median(steps))
-    data = prepare(Recording(name, t - t[0], q, dq, tau, rate), preprocessing or Preprocessing())
-    base = base_parameters(robot, rng=0)
-    return identify(robot, base, data, method, (), None, physically_consistent or "sdp" in methods, tuple(methods))

@@ -1,4 +1,4 @@
-"""The estimators compared on simulated experiments (``dynid run --methods``, ``dynid montecarlo``).
+"""The one registry of estimators used by ``dynid run``, ``identify``, ``validate`` and ``montecarlo``.
 
 Each method has a short key, a label for tables and one way to be built from a :class:`FitData`:
 
@@ -21,11 +21,9 @@ from typing import Callable
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters
-from ..estimators import (BeeColonyEstimator, DifferentialEvolutionEstimator, Estimator, IterativelyReweightedLeastSquares,
-                          LeastAbsoluteDeviations, OrdinaryLeastSquares, ParticleSwarmEstimator,
-                          PhysicallyConsistentLeastSquares, WeightedLeastSquares)
+from .base import Estimator
 from ..exceptions import ConfigError
-from .method_names import BOOTSTRAPPED, BOX_SEARCHES, DESCRIPTIONS, LABELS, METHODS, parse_methods
+from .names import BOOTSTRAPPED, BOX_SEARCHES, DESCRIPTIONS, LABELS, METHODS, parse_methods
 
 __all__ = ["BOOTSTRAPPED", "BOX_SEARCHES", "DESCRIPTIONS", "LABELS", "METHODS", "parse_methods", "SearchBudget", "FitData",
            "Fitted", "make_estimator", "fit_method"]
@@ -93,23 +91,33 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget, rng: np.random
                    callback: Callable[[int, float], None] | None = None) -> Estimator:
     """An unfitted estimator of method ``key`` for ``data`` (``rng`` seeds the box searches)."""
     n, wts, box = data.n_dof, data.weights, data.bounds
-    if key == "ols":
-        return OrdinaryLeastSquares()
-    if key == "wls":
-        return WeightedLeastSquares(n_dof=n)
+    if key in ("ols", "wls"):  # each estimator's module (and its solver) is imported on first use
+        from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+
+        return OrdinaryLeastSquares() if key == "ols" else WeightedLeastSquares(n_dof=n)
     if key == "irls":
+        from .robust import IterativelyReweightedLeastSquares
+
         return IterativelyReweightedLeastSquares(n_dof=n)
     if key == "lad":
+        from .least_absolute import LeastAbsoluteDeviations
+
         return LeastAbsoluteDeviations(n_dof=n, weights=wts, bounds=box)
     if key == "sdp":
+        from .physically_consistent import PhysicallyConsistentLeastSquares
+
         if data.w_standard is None or data.layout is None:
             raise ConfigError("method sdp needs the standard observation matrix and the parameter layout")
         links, nonneg = data.layout
         return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior)
     if key in ("abc", "abc10"):
+        from .bee_colony import BeeColonyEstimator
+
         iters = budget.maxiter * (10 if key == "abc10" else 1)
         return BeeColonyEstimator(bounds=box, n_dof=n, weights=wts, colony_size=budget.colony_size, limit=budget.limit,
                                   maxiter=iters, rng=rng, callback=callback)
+    from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
+
     if key == "pso":
         return ParticleSwarmEstimator(bounds=box, n_dof=n, weights=wts, swarm_size=budget.colony_size,
                                       maxiter=max(1, budget.evaluations // budget.colony_size - 1), rng=rng, callback=callback)

@@ -1,0 +1,49 @@
+"""The run ``dynid excite`` describes: design the trajectory of a parsed config
+(:mod:`dynid.io.excitation_config`) and sample it at the controller's rate."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..excitation.design import ExcitationDesign, design_excitation
+from ..io.excitation_config import ExcitationConfig
+
+
+@dataclass(frozen=True)
+class ExcitationRun:
+    """What ``dynid excite`` produced: the design and the sampled trajectory."""
+
+    config: ExcitationConfig
+    design: ExcitationDesign
+    t: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+
+    def to_dict(self) -> dict:
+        c, p = self.config, self.config.problem
+        lim = p.limits
+        return {
+            "robot": c.full_robot.name, "joints": p.robot.n_dof, "config": str(c.path),
+            "harmonics": p.n_harmonics, "omega_f": p.omega_f, "period": p.period, "rest": p.rest,
+            "base_parameters": list(p.base.names),
+            "limits": {f: getattr(lim, f).tolist() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")},
+            "workspace": p.workspace.to_dict(),
+            "settings": {"starts": c.starts, "seed": c.seed, "maxiter": c.maxiter, "grid_points": p.grid_points,
+                         "safety": p.safety, "initial": c.initial_label, "csv_rate": c.rate, "csv_periods": c.periods},
+            "trajectory": self.design.trajectory.to_dict(c.form),
+            "design": {k: v for k, v in self.design.to_dict(c.form).items() if k != "trajectory"},
+        }
+
+
+def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:
+    """Design the trajectory of ``config`` and sample it at the controller's rate."""
+    design = design_excitation(config.problem, n_starts=config.starts, rng=config.seed, initial=config.initial,
+                               maxiter=config.maxiter, callback=callback)
+    n = int(round(config.periods * config.problem.period * config.rate))
+    t = np.arange(n + 1) / config.rate  # both ends: the controller's last set-point is the start again
+    q, dq, ddq = design.trajectory.evaluate(t)
+    return ExcitationRun(config, design, t, q, dq, ddq)
