@@ -6,7 +6,15 @@ what was found and, where possible, how to fix it.
 
 
 class DynIdError(Exception):
-    """Base class of all errors raised by dynid for bad input or data."""
+    """Base class of all errors raised by dynid for bad input or data.
+
+    ``field`` names the setting at fault when the message starts with it (``"seed must be …"``): the library
+    speaks of its settings' names, the CLI translates them to its options (``--seed``).
+    """
+
+    def __init__(self, message: str = "", field: str | None = None):
+        super().__init__(message)
+        self.field = field
 
 
 class ConfigError(DynIdError, ValueError):

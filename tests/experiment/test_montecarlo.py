@@ -56,8 +56,8 @@ def test_same_seed_same_study(study):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"noise_levels": ()}, "noise-levels"),
-    ({"noise_levels": (0.0,)}, "noise-levels"),
+    ({"noise_levels": ()}, "noise_levels"),
+    ({"noise_levels": (0.0,)}, "noise_levels"),
     ({"realisations": 1}, "realisations"),
     ({"methods": ("ols", "magic")}, "methods"),
     ({"joints": 9}, "joints"),

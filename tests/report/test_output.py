@@ -42,7 +42,7 @@ def test_an_interrupted_save_leaves_the_earlier_run_unchanged(tmp_path):
 
 def test_unusable_out_is_refused_before_computing(tmp_path):
     (tmp_path / "file").write_text("x")
-    with pytest.raises(ConfigError, match=r"--out .*file: exists and is not a folder"):
+    with pytest.raises(ConfigError, match=r"^out .*file: exists and is not a folder"):
         check_output_folder(tmp_path / "file")
     ro = tmp_path / "ro"
     ro.mkdir()

@@ -40,7 +40,7 @@ def parse_methods(text: str | tuple | list | None) -> tuple[str, ...]:
     keys = [k.strip().lower() for k in (text.split(",") if isinstance(text, str) else text)]
     unknown = [k for k in keys if k not in METHODS]
     if unknown or not keys:
-        raise ConfigError(f"--methods: expected a comma-separated subset of {', '.join(METHODS)} (or all), got {text!r}")
+        raise ConfigError(f"methods: expected a comma-separated subset of {', '.join(METHODS)} (or all), got {text!r}", field="methods")
     if len(set(keys)) != len(keys):
-        raise ConfigError(f"--methods: each method once, got {text!r}")
+        raise ConfigError(f"methods: each method once, got {text!r}", field="methods")
     return tuple(keys)

@@ -150,3 +150,29 @@ def fit_method(key: str, data: FitData, budget: SearchBudget, rng: np.random.Gen
         params = est.params_
     seconds = time.perf_counter() - t0
     return Fitted(key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
+
+
+def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress: Callable[[str, int, float], None] | None = None,
+                workers: int | None = None) -> dict:
+    """Fit every method of ``keys``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
+    and numba, which release the GIL).
+
+    Each method draws from its own generator ``rngs[key]``, so the results depend neither on the order nor
+    on the number of workers; each ``seconds`` is that method's wall time while the others ran.
+    ``progress(key, iteration, best)`` reports the box searches (and ``(key, None, None)`` as a method starts).
+    Returns key -> :class:`Fitted`, in the order of ``keys``.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..threads import cores
+
+    def fit(key):
+        if progress is not None:
+            progress(key, None, None)
+        callback = None if progress is None else (lambda i, f, key=key: progress(key, i, f))
+        return fit_method(key, data, budget, rngs[key], callback)
+
+    slow_first = sorted(keys, key=lambda m: m in ("ols", "wls", "sdp", "irls", "abc"))  # long ones start first
+    with ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(keys)))) as pool:
+        done = dict(zip(slow_first, pool.map(fit, slow_first)))
+    return {key: done[key] for key in keys}

@@ -25,7 +25,8 @@ from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..estimators.names import LEAST_SQUARES as METHODS
 from ..preprocessing.pipeline import PreparedData, base_chunks
-from ..validation.torques import TorqueComparison, compare_torques
+from ..tables import Line, TextTable, render_text
+from ..validation.torques import TorqueComparison, compare_torques, comparison_table
 
 __all__ = ["IdentificationResult", "identify"]
 
@@ -217,6 +218,69 @@ class IdentificationResult:
                 "pseudo_inertia_min_eig": self.consistent.pseudo_inertia_min_eig.tolist()}}),
         }
 
+    def summary_blocks(self) -> list:
+        """What ``dynid identify`` prints, as blocks of :mod:`dynid.tables` (lines and tables)."""
+        sol, base = self.solution, self.base
+        out = [Line(f"dynid identify — robot {self.robot}, {self.method.upper()} on {self.fit.name}: {base.n_base} base "
+                    f"parameters from {self.n_rows} equations, cond = {sol.condition_number:.4g}", "title")]
+        pre = self.settings.get("preprocessing", {})
+        if pre.get("derivation"):
+            out.append(Line("preprocessing: " + pre["derivation"]))
+        if self.settings.get("preprocessing_cross_validation") is not None:
+            out.append(filter_choice_table(self.settings["preprocessing_cross_validation"]))
+        if self.settings.get("coulomb_cross_validation") is not None:
+            out.append(coulomb_choice_table(self.settings["coulomb_cross_validation"]))
+        rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
+                      *(f"{r.beta[i]:.4g}" for r in self.references)) for i, n in enumerate(base.names))
+        out.append(TextTable("Base parameters (σ: standard deviation; reference values beside)",
+                             ("name", "unit", "value", "σ", "σ %", *(r.name for r in self.references)), rows, labels=2))
+        for r in self.references:
+            if r.relative_std is not None:
+                a = self.reference_agreement(r)
+                out.append(Line(f"{r.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
+                                f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters"))
+        out.append(Line("residual σ per joint (N·m): " + ", ".join(f"{x:.3g}" for x in self.joint_std)))
+        if self.consistent is not None:
+            out.append(Line(f"dynid SDP: physically consistent least squares, prior: {self.consistent.prior}; smallest "
+                            "pseudo-inertia eigenvalue per link " + ", ".join(f"{x:.3g}" for x in self.consistent.pseudo_inertia_min_eig)))
+        if self.consistency_verdicts:
+            out.append(Line("physically consistent (some mass distribution with friction and rotor inertias ≥ 0 has these base "
+                            "parameters)? " + "; ".join(f"{label}: {v}" for label, v in self.consistency_verdicts.items())))
+        if self.others:
+            others = {o.label: o for o in self.others}
+            rows = tuple((label, f"{f:.4f}", "" if label not in others else (str(others[label].n_evaluations) if others[label].n_evaluations else "solve"),
+                          "" if label not in others else f"{others[label].seconds:.2f}") for label, f in self.objective.items())
+            out.append(TextTable(f"Estimators on {self.fit.name} (the validation tables follow)",
+                                 ("parameters", "F eq. 9 (N·m)", "evaluations", "time (s)"), rows))
+            out.append(Line(f"LAD, ABC, DE and PSO search the box {self.label} ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|value|); "
+                            "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations"))
+        if self.drive_gains is not None:
+            out.extend(self.drive_gains.summary_blocks())
+        out.extend(comparison_table(c) for c in (self.fit, *self.validations))
+        out.extend(Line(w, "warning") for w in self.warnings)
+        return out
+
+    def summary(self, width: int = 100) -> str:
+        """Plain-text summary: parameters with σ beside the references, fit and validation metrics."""
+        return render_text(self.summary_blocks(), width)
+
+
+def filter_choice_table(cv: dict) -> TextTable:
+    """``preprocessing = "auto"``: each candidate's cutoffs and out-of-fold errors on the common held-out samples."""
+    n = len(cv["out_of_fold_rms_error"][0])
+    rows = tuple((f"{c['position_cutoff']:.3g}{'*' if i == cv['chosen'] else ''}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
+                  *(f"{x:.4g}" for x in e), f"{s:.4g}")
+                 for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
+    return TextTable('preprocessing = "auto": out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *',
+                     ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
+
+
+def coulomb_choice_table(cv: dict) -> TextTable:
+    """The candidates of the Coulomb smoothing velocity and their out-of-fold errors, per joint."""
+    rows = tuple(("sign" if frac == 0 else f"{frac:g}", *(f"{e:.4g}{'*' if v == c else ''}" for e, v, c in zip(e_row, vs_row, cv["velocity"])))
+                 for frac, vs_row, e_row in zip(cv["grid_fraction_of_rms_speed"], cv["candidates"], cv["out_of_fold_rms_error"]))
+    return TextTable(f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m), {cv['folds']} contiguous folds; chosen: *",
+                     ("v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cv["velocity"])))), rows)
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str = "wls",
              references: tuple[ReferenceSet, ...] = (), progress=None, physically_consistent: bool = False,
@@ -225,6 +289,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     ``physically_consistent`` also by physically consistent least squares over the standard parameters
     (same row weights; prior: the robot model's nominal parameters). Every parameter set gets its
     consistency margin.
+
+    ``progress(step, done, total)`` reports each step (the regressor pass chunk by chunk, the SDP, each other
+    estimator, the predicted torques).
 
     ``methods`` adds estimators of :mod:`dynid.estimators.registry` other than OLS/WLS/SDP (IRLS, LAD, ABC,
     ABC×10, DE, PSO) on the same parallel-filtered rows, stacked in memory (rows below ``min_speed`` set
@@ -246,7 +313,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     acc_std = LeastSquaresAccumulator(robot.n_params, n) if physically_consistent else None
     extra = tuple(k for k in methods if k not in (method, "sdp"))
     stacked_w, stacked_tau = [], []
-    for _, y, tau, keep in base_chunks(robot, base, data, progress, standard=physically_consistent):
+    for _, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
             y = base.base_observation(y)
@@ -265,6 +332,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     joint_std = acc.joint_residual_std(ols.params)
     row_weights = None if method == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     sol = ols if method == "ols" else acc.solve(row_weights)
+    if acc_std is not None and progress is not None:
+        progress("physically consistent SDP", 0, 1)
     consistent = None if acc_std is None else _consistent_estimate(robot, base, acc_std, row_weights)
     warnings = list(robot.nominal_problems) + list(data.warnings)
     dropped = 1.0 - acc.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation)))
@@ -275,11 +344,13 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     others, objective, box = (), {}, None
     if extra:
         w_all, tau_all = np.concatenate(stacked_w), np.concatenate(stacked_tau)
-        others, box = _other_estimates(extra, base, w_all, tau_all, n, sol, rng)
+        others, box = _other_estimates(extra, base, w_all, tau_all, n, sol, rng, progress)
     sets = parameter_sets(method, sol.params, references, None if consistent is None else consistent.base,
                           {o.label: o.params for o in others})
     if extra:
         objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
+    if progress is not None:
+        progress("consistency checks", 0, 1)
     links, nonneg = consistency_layout(robot)
     margins, verdicts = {}, {}
     for label, beta in sets.items():
@@ -288,26 +359,29 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
         except DynIdError as exc:  # a failed check never stops the identification
             margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
-    fit = compare_torques(robot, base, data, sets)
+    fit = compare_torques(robot, base, data, sets, _step(progress, f"predicted torques, {data.name}"))
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,
                                 others=others, objective=objective, box=box)
 
 
-def _other_estimates(keys, base, w, tau, n_dof, sol, rng) -> tuple[tuple[OtherEstimate, ...], np.ndarray]:
-    """Fit each of ``keys`` on the stacked rows; the box from the OLS/WLS solution ``sol``."""
-    from ..estimators.registry import FitData, SearchBudget, fit_method
+def _step(progress, label: str):
+    """``progress(label, done, total)`` as a ``(done, total)`` callback (None stays None)."""
+    return None if progress is None else (lambda done, total: progress(label, done, total))
 
-    from ..estimators.names import METHODS as ALL
+
+def _other_estimates(keys, base, w, tau, n_dof, sol, rng, progress=None) -> tuple[tuple[OtherEstimate, ...], np.ndarray]:
+    """Fit each of ``keys`` on the stacked rows; the box from the OLS/WLS solution ``sol``."""
+    from ..estimators.names import LABELS, METHODS as ALL
+    from ..estimators.registry import FitData, SearchBudget, fit_methods
 
     box = search_box(sol.params, sol.params_std)
     data = FitData(w, tau, n_dof, box, base)
-    out = []
-    for key in keys:  # each method seeded by (seed, method): the same whatever else is asked for
-        fitted = fit_method(key, data, SearchBudget(), np.random.default_rng([int(rng), ALL.index(key)]))
-        out.append(OtherEstimate(key, fitted.params, fitted.seconds, fitted.n_evaluations))
-    return tuple(out), box
+    rngs = {k: np.random.default_rng([int(rng), ALL.index(k)]) for k in keys}  # (seed, method): whatever else is asked for
+    report = None if progress is None else (lambda key, i, f: progress(f"estimators: {LABELS[key]}", 0 if i is None else i, 0))
+    fitted = fit_methods(keys, data, SearchBudget(), rngs, report)
+    return tuple(OtherEstimate(k, f.params, f.seconds, f.n_evaluations) for k, f in fitted.items()), box
 
 
 def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAccumulator, row_weights) -> ConsistentEstimate:

@@ -55,8 +55,11 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
     out, warnings = [], []
     settings = validation_settings(config.preprocessing, resolved)
     for spec in datasets:
+        if progress is not None:
+            progress(f"validation, reading {spec.name}", 0, 1)
         data = prepare(load_recording(spec, config.robot), settings)
-        out.append(compare_torques(config.robot, base, data, parameter_sets, progress))
+        out.append(compare_torques(config.robot, base, data, parameter_sets,
+                                   None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t))))
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
 
@@ -64,7 +67,7 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
 @with_single_blas_thread
 def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
     """Identify the base parameters from the config's identification dataset, then validate them on
-    each validation dataset beside the reference sets.
+    each validation dataset beside the reference sets. ``progress(step, done, total)`` reports each step.
 
     Returns
     -------
@@ -75,9 +78,16 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     from ..validation.cross_validation import choose_coulomb_velocity
     from .identification import identify
 
+    def step(label):
+        if progress is not None:
+            progress(label, 0, 1)
+
+    step("base parameters and references")
     base = base_parameters(config.robot, rng=0)
     refs = _references(config, base)
+    step(f"reading {config.identification.name}")
     recording = load_recording(config.identification, config.robot)
+    step("preprocessing" + (" (cross-validation of the cutoffs)" if config.preprocessing.auto else ""))
     filters = None
     if config.preprocessing.auto:
         from ..validation.cross_validation import choose_preprocessing
@@ -87,6 +97,8 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     else:
         data = prepare(recording, config.preprocessing)
     vs = config.preprocessing.coulomb_velocity
+    if vs == "auto":
+        step("Coulomb smoothing velocity (cross-validation)")
     choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
     result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
@@ -94,6 +106,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if config.drive_gains is not None:
+        step("drive gains and payload")
         result = replace(result, drive_gains=_gains_and_payload(config, robot, base))
     if not validate or not config.validation:
         return result
@@ -138,7 +151,7 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     sets = parameter_sets(method, values, refs, sdp, others)
     datasets = config.validation if datasets is None else datasets
     if not datasets:
-        raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (or give --file)")
+        raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
     stored_vs = identified.get("settings", {}).get("coulomb_velocity") if isinstance(identified.get("settings"), dict) else None
     if stored_vs is not None:
         try:

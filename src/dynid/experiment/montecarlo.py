@@ -39,6 +39,7 @@ from ..model.description import load_robot
 from ..simulation.measurements import NoiseModel
 from ..estimators.registry import LABELS, METHODS, SearchBudget, fit_method, parse_methods
 from .paper import PaperExperimentConfig, fit_data, identification_trajectory, search_box, simulate_dataset
+from ..tables import Line, TextTable, render_text
 from ..threads import with_single_blas_thread
 
 DEFAULT_METHODS = ("ols", "wls", "irls", "lad", "sdp", "abc")
@@ -108,9 +109,9 @@ class MonteCarloConfig:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
         levels = np.asarray(self.noise_levels, dtype=float)
         if levels.ndim != 1 or levels.size == 0 or not np.all(np.isfinite(levels)) or np.any(levels <= 0):
-            raise ConfigError(f"--noise-levels: expected positive current noise levels in A like 0.02,0.05, got {list(self.noise_levels)}")
+            raise ConfigError(f"noise_levels: expected positive current noise levels in A like 0.02,0.05, got {list(self.noise_levels)}", field="noise_levels")
         if self.realisations < 2:
-            raise ConfigError(f"--realisations must be at least 2, got {self.realisations}")
+            raise ConfigError(f"realisations must be at least 2, got {self.realisations}", field="realisations")
         parse_methods(self.methods)
 
 
@@ -237,6 +238,34 @@ class MonteCarloResult:
             "timings": self.timings,
         }
 
+    def summary_blocks(self) -> list:
+        """What ``dynid montecarlo`` prints, as blocks of :mod:`dynid.tables`."""
+        cfg, stats = self.config, self.statistics()
+        nonzero = np.abs(self.truth) > 1e-9 * np.abs(self.truth).max()
+        rows, ends = [], set()
+        for li, level in enumerate(cfg.noise_levels):
+            for key in cfg.methods:
+                s = stats[key]
+                rows.append((f"{level:g}", LABELS[key], *(f"{f(s[k][li]):.3g}" for k, f in (
+                    ("std_over_crb", np.nanmedian), ("std_over_crb", np.nanmax), ("bias_over_crb", np.nanmedian), ("bias_over_crb", np.nanmax))),
+                    f"{100 * np.nanmedian(s['rmse'][li][nonzero] / np.abs(self.truth[nonzero])):.3g}",
+                    str(int(s["failures"][li])), f"{s['seconds_median'][li]:.3g}"))
+            ends.add(len(rows) - 1)
+        out = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(self.names)} base parameters, "
+                    f"{cfg.realisations} realisations × {len(cfg.noise_levels)} noise levels, {cfg.duration:g} s at {cfg.rate:g} Hz; "
+                    f"ran on {self.cluster} in {self.timings.get('total', float('nan')):.1f} s", "title"),
+               TextTable("Spread (σ) and bias (b) of the base parameters against the Cramér–Rao bound (CRB: raw-torque Gaussian "
+                         "noise), median and worst over the parameters; RMSE/|β| median %; failed fits; median s per fit",
+                         ("noise A", "method", "σ/√CRB med", "σ/√CRB max", "|b|/√CRB med", "|b|/√CRB max", "RMSE %", "fails", "s/fit"),
+                         tuple(rows), labels=2, section_ends=frozenset(ends))]
+        if self.errors:
+            out.append(Line(f"{len(self.errors)} fits failed; the first: {self.errors[0]['error']}", "warning"))
+        return out
+
+    def summary(self, width: int = 100) -> str:
+        """Plain-text summary of the study."""
+        return render_text(self.summary_blocks(), width)
+
 
 @contextlib.contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0):
@@ -255,13 +284,13 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         try:
             client = Client(scheduler, timeout=f"{connect_timeout}s")
         except (OSError, TimeoutError) as exc:
-            raise ConfigError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
+            raise ConfigError(f"scheduler {scheduler}: cannot reach the Dask scheduler ({exc})", field="scheduler") from None
         with client:
             yield client
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
     if n < 1:
-        raise ConfigError(f"--workers must be at least 1, got {workers}")
+        raise ConfigError(f"workers must be at least 1, got {workers}", field="workers")
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         yield client

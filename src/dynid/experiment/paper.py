@@ -34,8 +34,9 @@ from ..preprocessing import five_point_cubic_smoothing, fourier_fit_derivatives
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
-from ..estimators.registry import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_method, make_estimator, parse_methods
-from ..threads import cores, with_single_blas_thread
+from ..estimators.registry import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_methods, make_estimator, parse_methods
+from ..tables import render_text
+from ..threads import with_single_blas_thread
 
 PLANTS = ("assumed", "paper")
 BOUNDS = ("auto", "table3", "scaled")
@@ -105,30 +106,30 @@ class PaperExperimentConfig:
     def validate(self, robot: Robot) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
         if self.seed < 0:
-            raise ConfigError(f"--seed must be a non-negative integer, got {self.seed}")
+            raise ConfigError(field="seed", message=f"seed must be a non-negative integer, got {self.seed}")
         if not 1 <= self.joints <= robot.n_dof:
-            raise ConfigError(f"--joints must be between 1 and {robot.n_dof} for robot {robot.name!r}, got {self.joints}")
+            raise ConfigError(field="joints", message=f"joints must be between 1 and {robot.n_dof} for robot {robot.name!r}, got {self.joints}")
         if self.plant not in PLANTS:
-            raise ConfigError(f"--plant must be one of {', '.join(PLANTS)}, got {self.plant!r}")
+            raise ConfigError(field="plant", message=f"plant must be one of {', '.join(PLANTS)}, got {self.plant!r}")
         if self.abc_bounds not in BOUNDS:
-            raise ConfigError(f"--abc-bounds must be one of {', '.join(BOUNDS)}, got {self.abc_bounds!r}")
+            raise ConfigError(field="abc_bounds", message=f"abc_bounds must be one of {', '.join(BOUNDS)}, got {self.abc_bounds!r}")
         if self.plant == "paper" and (robot.name != "er16" or self.joints != 3):
-            raise ConfigError("--plant paper uses Table 2, which exists only for robot er16 with --joints 3")
+            raise ConfigError("plant 'paper' uses Table 2, which exists only for robot er16 with 3 joints", field="plant")
         for name in ("duration", "rate", "omega_f"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
-                raise ConfigError(f"--{name.replace('_', '-')} must be positive, got {v}")
+                raise ConfigError(f"{name} must be positive, got {v}", field=name)
         if self.current_noise < 0 or self.encoder_resolution < 0:
             raise ConfigError(f"noise levels must be non-negative, got current noise {self.current_noise}, encoder resolution {self.encoder_resolution}")
         if self.smoothing_passes < 0:
-            raise ConfigError(f"--smoothing-passes must be >= 0, got {self.smoothing_passes}")
+            raise ConfigError(field="smoothing_passes", message=f"smoothing_passes must be >= 0, got {self.smoothing_passes}")
         parse_methods(self.methods)
         if self.bootstrap != 0 and self.bootstrap < 2:
-            raise ConfigError(f"--bootstrap must be 0 (none) or at least 2 resamples, got {self.bootstrap}")
+            raise ConfigError(field="bootstrap", message=f"bootstrap must be 0 (none) or at least 2 resamples, got {self.bootstrap}")
         if self.weights is not None:
             w = np.asarray(self.weights, dtype=float)
             if w.shape != (self.joints,) or np.any(w < 0) or np.any(w > 1):
-                raise ConfigError(f"--weights needs {self.joints} values in [0, 1], got {list(self.weights)}")
+                raise ConfigError(field="weights", message=f"weights needs {self.joints} values in [0, 1], got {list(self.weights)}")
 
 
 @dataclass
@@ -228,6 +229,16 @@ class PaperRunResult:
             out["methods"][key] = d
         return out
 
+    def summary_blocks(self) -> list:
+        """What ``dynid run`` prints, as blocks of :mod:`dynid.tables`."""
+        from .paper_summary import run_summary_blocks
+
+        return run_summary_blocks(self)
+
+    def summary(self, width: int = 100) -> str:
+        """Plain-text summary: parameters beside the truth and Table 2, the estimators compared, per-joint metrics."""
+        return render_text(self.summary_blocks(), width)
+
 
 def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -247,7 +258,7 @@ def identification_trajectory(config: PaperExperimentConfig, robot: Robot, base:
     else:
         traj, label = load_trajectory(config.excitation), config.excitation
         if traj.n_dof != k:
-            raise ConfigError(f"--excitation {config.excitation}: the trajectory has {traj.n_dof} joints, the run identifies {k}")
+            raise ConfigError(field="excitation", message=f"excitation {config.excitation}: the trajectory has {traj.n_dof} joints, the run identifies {k}")
     cond_beta1 = base_condition_number(robot, base, beta1)
     info = {"trajectory": label, "cond_base_regressor": cond_beta1 if traj is beta1 else base_condition_number(robot, base, traj),
             "cond_base_regressor_beta1": cond_beta1,
@@ -302,7 +313,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     ----------
     config : PaperExperimentConfig
     progress : callable, optional
-        ``progress(method_key, iteration, best_objective)`` during the box searches (ABC, DE, PSO).
+        ``progress(step, iteration, best_objective)``: each step as it starts with ``(step, None, None)``
+        (``"simulation"``, a method key, ``"bootstrap"``), and the box searches' iterations (ABC, DE, PSO).
 
     Returns
     -------
@@ -326,7 +338,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     if config.plant == "paper":
         missing = [n for n in base.names if ref.paper_symbol(n) not in ref.TABLE2]
         if missing:
-            raise ConfigError(f"--plant paper: no Table 2 value for {', '.join(missing)}")
+            raise ConfigError(field="plant", message=f"plant 'paper': no Table 2 value for {', '.join(missing)}")
         truth = np.array([ref.TABLE2[ref.paper_symbol(n)] for n in base.names])
         phi_true = base.standard_from_base(truth, reference=robot.standard_parameters())
     else:
@@ -339,6 +351,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     traj_id, excitation_info = identification_trajectory(config, robot, base)
     traj_val = paper_validation_trajectory(config.omega_f, k)
     t_sim = time.perf_counter()
+    if progress is not None:
+        progress("simulation and preprocessing", None, None)
     ident = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
                      keep_standard="sdp" in methods)
     valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
@@ -370,6 +384,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         est = fit.estimator
         boot = None
         if key in BOOTSTRAPPED and config.bootstrap:
+            if progress is not None:
+                progress(f"bootstrap of {LABELS[key]}", None, None)
             t_b = time.perf_counter()
             bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
                                      n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, idx]))
@@ -389,19 +405,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
 
 
 def _fit_methods(methods, data: FitData, budget: SearchBudget, seed: int, progress) -> dict:
-    """Fit every method, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS and numba,
-    which release the GIL). Each method has its own seed (seed, 2, method), so the results do not depend
-    on the order or the number of workers; each ``seconds`` is that method's wall time while the others ran."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    def fit(key):
-        callback = None if progress is None else (lambda i, f, key=key: progress(key, i, f))
-        return fit_method(key, data, budget, np.random.default_rng([seed, 2, METHODS.index(key)]), callback)
-
-    slow_first = sorted(methods, key=lambda m: m in ("ols", "wls", "sdp", "irls", "abc"))  # long ones start first
-    with ThreadPoolExecutor(max_workers=max(1, min(cores(), len(methods)))) as pool:
-        done = dict(zip(slow_first, pool.map(fit, slow_first)))
-    return {key: done[key] for key in methods}
+    """Every method side by side, each seeded by (seed, 2, method) (:func:`dynid.estimators.registry.fit_methods`)."""
+    return fit_methods(methods, data, budget, {k: np.random.default_rng([seed, 2, METHODS.index(k)]) for k in methods}, progress)
 
 
 def fit_data(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, dataset: Dataset, bounds: np.ndarray) -> FitData:
@@ -424,7 +429,7 @@ def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y
     """
     has_table3 = all(ref.paper_symbol(n) in ref.TABLE3 for n in base.names)
     if config.abc_bounds == "table3" and not has_table3:
-        raise ConfigError("--abc-bounds table3 needs the paper's 21 parameters (er16, --joints 3); use --abc-bounds scaled")
+        raise ConfigError("abc_bounds 'table3' needs the paper's 21 parameters (er16, 3 joints); use 'scaled'", field="abc_bounds")
     if config.abc_bounds == "table3" or (config.abc_bounds == "auto" and has_table3 and robot.name == "er16" and config.joints == 3):
         return np.array([ref.TABLE3[ref.paper_symbol(n)] for n in base.names], dtype=float)
     half = 2.0 * np.abs(OrdinaryLeastSquares().fit(w_base, y).params_) + 1.0

@@ -3,7 +3,7 @@
 Layout (paths relative to the config file; data paths relative to ``data_root``)::
 
     robot = "ur10e"                      # built-in robot name or description TOML
-    data_root = "../../shared/data/ur10e_mamedov2020"   # overridden by --data-root / DYNID_DATA_ROOT
+    data_root = "../../shared/data/ur10e_mamedov2020"   # overridden by DYNID_DATA_ROOT (dynid: --data-root)
 
     [identification]                     # a dataset table (dynid.io.datasets)
     preset = "ur-rtde"
@@ -175,7 +175,7 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         raise ConfigError(f"{path}: data_root: expected a folder path, got {doc['data_root']!r}")
     root = Path(override) if override else here / doc.get("data_root", ".")  # an absolute path stays as is
     if not root.is_dir():
-        raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root, --data-root or {DATA_ROOT_ENV})")
+        raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
     n = robot.n_dof
     if "identification" not in doc:
         raise ConfigError(f"{path}: expected an [identification] table describing the identification dataset")
@@ -269,7 +269,7 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
     spec = config.identification
     files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
     if len(files) > 1:
-        raise DataError("--file: the identification dataset reads several files; add a [[validation]] table to the config instead")
+        raise DataError("file: the identification dataset reads several files; add a [[validation]] table to the config instead", field="file")
     signals = {k: SignalSpec(Path(file), s.columns, s.scale) for k, s in spec.signals.items()}
     time = SignalSpec(Path(file), spec.time.columns, 1.0) if spec.time else None
     return replace(spec, name=Path(file).name, signals=signals, time=time,

@@ -19,7 +19,7 @@ MANIFEST = ".dynid-manifest.json"
 
 
 def check_output_folder(out: str | Path) -> Path:
-    """Refuse, before any computation, an ``--out`` that is a file or a folder that cannot be written.
+    """Refuse, before any computation, an output folder that is a file or a folder that cannot be written.
 
     Raises
     ------
@@ -28,10 +28,10 @@ def check_output_folder(out: str | Path) -> Path:
     """
     out = Path(out)
     if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out}: exists and is not a folder")
+        raise ConfigError(f"out {out}: exists and is not a folder", field="out")
     parent = out if out.exists() else next((p for p in out.absolute().parents if p.exists()), Path("/"))
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise ConfigError(f"--out {out}: {parent} is not writable")
+        raise ConfigError(f"out {out}: {parent} is not writable", field="out")
     return out
 
 
@@ -88,7 +88,7 @@ def output_folder(out: str | Path) -> Path:
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ConfigError(f"--out {out}: cannot create the folder ({exc.strerror})") from None
+        raise ConfigError(f"out {out}: cannot create the folder ({exc.strerror})", field="out") from None
     return out
 
 

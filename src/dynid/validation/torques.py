@@ -10,9 +10,10 @@ import numpy as np
 from ..dynamics.base_parameters import BaseParameters
 from ..model.robot import Robot
 from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..tables import TextTable
 from .metrics import correlation_coefficient, global_relative_error, relative_error, rmse
 
-__all__ = ["TorqueComparison", "compare_torques"]
+__all__ = ["TorqueComparison", "compare_torques", "comparison_table"]
 
 
 @dataclass(frozen=True)
@@ -57,3 +58,19 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
             preds[label].append(y @ beta)
     return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
                             {k: np.concatenate(v) for k, v in preds.items()})
+
+
+def comparison_table(cmp: TorqueComparison) -> TextTable:
+    """Relative error, RMSE and correlation coefficient per joint for every parameter set of ``cmp``: one
+    label row per set, then one row per metric (narrow enough for 80 columns with six joints)."""
+    rms = np.sqrt((cmp.measured**2).mean(axis=0))
+    n = cmp.measured.shape[1]
+    rows, ends = [], set()
+    for label, m in cmp.metrics().items():
+        rows.append((label,) + ("",) * (n + 1))
+        rows.append(("  error %", *(f"{x:.1f}" for x in m["relative_error"]), f"{m['global_relative_error']:.2f}"))
+        rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), ""))
+        rows.append(("  ρ (eq. 18)", *(f"{x:.4f}" for x in m["correlation"]), ""))
+        ends.add(len(rows) - 1)
+    return TextTable(f"{cmp.name}: {cmp.t.shape[0]} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + " N·m",
+                     ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))

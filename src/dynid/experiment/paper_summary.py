@@ -1,0 +1,82 @@
+"""What ``dynid run`` prints, as blocks of :mod:`dynid.tables`: the base parameters beside the truth and
+the paper's Table 2, the comparison of estimators, per-joint metrics beside the paper's coefficients, the
+OLS/WLS uncertainties and the timings."""
+
+from __future__ import annotations
+
+from ..estimators.names import DESCRIPTIONS, LABELS
+from ..estimators.physically_consistent import CONSISTENCY_TOL
+from ..tables import Line, TextTable
+from . import paper_reference as ref
+
+
+def _joined(values, fmt: str) -> str:
+    return " / ".join(format(v, fmt) for v in values)
+
+
+def run_summary_blocks(result) -> list:
+    """Blocks of a :class:`dynid.experiment.paper.PaperRunResult`."""
+    d = result.to_dict()
+    methods = {LABELS[k]: v for k, v in d["methods"].items()}
+    cfg = result.config
+    n_par = len(d["parameters"])
+    ex = d["trajectories"]["excitation"]
+    out = [Line(f"dynid run — robot {result.robot.name}, joints 1-{cfg.joints}, plant '{cfg.plant}', seed {cfg.seed}: "
+                f"{n_par} base parameters ({n_par - 2 * cfg.joints} inertial + {2 * cfg.joints} friction)", "title"),
+           Line(f"identification trajectory: {ex['trajectory']}; cond(W_base) {ex['cond_base_regressor']:.2f} "
+                f"(β1: {ex['cond_base_regressor_beta1']:.2f})"),
+           Line("methods: " + "; ".join(f"{LABELS[k]} = {DESCRIPTIONS[k]}" for k in d["methods"]))]
+    rows = []
+    for n in d["parameters"]:
+        sym = d["paper_symbols"][n]
+        rows.append((f"{n} ({sym})" if sym else n, f"{d['truth'][n]:.4g}", *(f"{m['params'][n]:.4g}" for m in methods.values()),
+                     f"{ref.TABLE2[sym]:.4g}" if sym in ref.TABLE2 else ""))
+    out.append(TextTable("Base parameters: truth and estimates (units in results.json)",
+                         ("name (paper)", "truth", *methods, "Table 2"), tuple(rows), labels=2))
+    rows = [(label, f"{m['objective']:.4g}", str(m["n_evaluations"]) if m["n_evaluations"] else "—", f"{m['seconds']:.1f}",
+             f"{m['parameter_error_norm_percent']:.3g}",
+             *(f"{sum(m[k]['validation']) / cfg.joints:{f}}" for k, f in (("correlation", ".4f"), ("rmse", ".3g"), ("relative_error", ".3g"))),
+             "yes" if m["physically_consistent"] else "no") for label, m in methods.items()]
+    rows.append(("paper", f"{ref.OBJECTIVE:.4g}", "", "", "", f"{sum(ref.CORRELATION_VALIDATION) / 3:.4f}", "", "", ""))
+    out.append(TextTable("Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; "
+                         "mean over joints of ρ (eq. 18), RMSE (N·m) and error % on β2; physically consistent",
+                         ("method", "F", "evals", "s", "Δβ %", "ρ β2", "RMSE", "err %", "cons."), tuple(rows)))
+    for key, beta, paper_vals in (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
+                                  ("validation", "β2", ref.CORRELATION_VALIDATION)):
+        for metric, title, fmt in (("correlation", "correlation coefficient ρ (eq. 18)", ".4f"), ("relative_error", "relative error %", ".3g")):
+            rows = [(label, *(format(x, fmt) for x in m[metric][key])) for label, m in methods.items()]
+            if metric == "correlation":
+                rows.append(("paper (ABC)", *(f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—" for j in range(cfg.joints))))
+            out.append(TextTable(f"{key.capitalize()} trajectory {beta}: {title} per joint", ("method", *(f"J{j + 1}" for j in range(cfg.joints))),
+                                 tuple(rows)))
+    out.extend(_uncertainty_blocks(d, methods))
+    if "sdp" in d["methods"]:
+        eig = d["methods"]["sdp"]["pseudo_inertia_min_eig"]
+        verdict = "physically consistent" if min(eig) >= -CONSISTENCY_TOL else "NOT physically consistent"
+        out.append(Line(f"SDP: smallest pseudo-inertia eigenvalue per link {_joined(eig, '.3g')} → {verdict}"))
+    out.append(Line("consistent: some mass distribution with non-negative friction and rotor inertias has these base parameters "
+                    f"(feasibility SDP; the truth's margin is {d['truth_consistency_margin']:.3g})"))
+    out.append(Line("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in d["timings"].items())))
+    out.extend(Line(w, "warning") for w in d["warnings"])
+    return out
+
+
+def _uncertainty_blocks(d: dict, methods: dict) -> list:
+    """Per bootstrapped method: σ from the covariance beside the bootstrap's, with the bootstrap interval."""
+    out, covered = [], {}
+    for label, m in methods.items():
+        if "bootstrap" not in m:
+            continue
+        b = m["bootstrap"]
+        covered[label] = 0
+        rows = []
+        for n in d["parameters"]:
+            lo, hi = b["lower"][n], b["upper"][n]
+            covered[label] += lo <= d["truth"][n] <= hi
+            rows.append((n, f"{d['truth'][n]:.4g}", f"{m['params_std'][n]:.3g}", f"{b['std'][n]:.3g}", f"[{lo:.4g}, {hi:.4g}]"))
+        out.append(TextTable(f"{label}: σ from the covariance, σ and {100 * b['level']:.0f} % interval from the moving-block "
+                             f"bootstrap ({b['resamples']} resamples, blocks of {b['block_length_samples']} samples)",
+                             ("name", "truth", "σ cov.", "σ boot.", "interval"), tuple(rows)))
+    if covered:
+        out.append(Line("intervals holding the truth: " + ", ".join(f"{label} {c}/{len(d['parameters'])}" for label, c in covered.items())))
+    return out

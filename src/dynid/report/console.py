@@ -1,0 +1,127 @@
+"""The terminal side of the commands: summaries (blocks of :mod:`dynid.tables`) as rich tables that fit the
+terminal, warnings, the "wrote …" line, and progress.
+
+Progress goes to standard error: on a terminal a live line (description, detail, elapsed time); when standard
+error is a pipe or a file, one plain line each time a step starts, so a log shows what ran and when. ``quiet``
+silences progress and summaries; warnings and errors are still printed (on standard error).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+from rich import box
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from ..tables import Line, TextTable
+
+DEFAULT_WIDTH = 100
+"""Columns of the output when it is not a terminal and ``COLUMNS`` is not set."""
+
+
+def make_console(stderr: bool = False) -> Console:
+    """A console of the terminal's width, or, for pipes and logs, of ``COLUMNS`` (else 100 columns)."""
+    c = Console(stderr=stderr)
+    if c.is_terminal:
+        return c
+    columns = os.environ.get("COLUMNS", "")
+    return Console(stderr=stderr, width=int(columns) if columns.isdigit() else DEFAULT_WIDTH)
+
+
+def rich_tables(table: TextTable, width: int) -> list[Table]:
+    """``table`` as rich tables no wider than ``width`` (split into parts repeating the label columns)."""
+    out = []
+    for part in table.split(width):
+        t = Table(title=escape(part.title), box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
+        for i, col in enumerate(part.columns):
+            t.add_column(escape(col), justify="left" if i < part.labels else "right", no_wrap=True)
+        for i, row in enumerate(part.rows):
+            t.add_row(*(escape(c) for c in row), end_section=i in part.section_ends)
+        out.append(t)
+    return out
+
+
+class Reporter:
+    """What a command prints: summaries and the "wrote" line on standard output, warnings and progress on
+    standard error; ``quiet`` keeps only warnings and errors."""
+
+    def __init__(self, quiet: bool = False, out: Console | None = None, err: Console | None = None):
+        self.quiet = quiet
+        self.out = out or make_console()
+        self.err = err or make_console(stderr=True)
+
+    def warning(self, text: str) -> None:
+        self.err.print(f"[yellow]warning:[/] {escape(text)}", highlight=False, soft_wrap=True)
+
+    def error(self, text: str) -> None:
+        self.err.print(f"[bold red]error:[/] {escape(text)}", highlight=False, soft_wrap=True)
+
+    def line(self, text: str) -> None:
+        if not self.quiet:
+            self.out.print(text, markup=False, highlight=False)
+
+    def blocks(self, blocks) -> None:
+        """Print a summary: tables split to the console's width, titles in bold, warnings on standard error."""
+        for b in blocks:
+            if isinstance(b, Line) and b.kind == "warning":
+                self.warning(b.text)
+            elif self.quiet:
+                continue
+            elif isinstance(b, TextTable):
+                for t in rich_tables(b, self.out.width):
+                    self.out.print(t)
+            elif b.kind == "title":
+                self.out.print("\n" + escape(b.text), style="bold", highlight=False)
+            else:
+                self.out.print(b.text, markup=False, highlight=False)
+
+    def wrote(self, paths: list[Path]) -> None:
+        """One line: the first file, the other files by name, and how many figures, in which folder."""
+        pngs = [p for p in paths if p.suffix == ".png"]
+        others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
+        self.line(f"wrote {paths[0]}{others} and {count(len(pngs), 'figure')} in {paths[0].parent}/")
+
+    def progress(self, command: str) -> Progress:
+        return Progress(command, self.err, self.quiet)
+
+
+def count(n: int, noun: str) -> str:
+    """``"no figures"``, ``"1 figure"``, ``"3 figures"``."""
+    return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
+
+
+class Progress:
+    """``with reporter.progress("identify") as p: p.update("regressor", "40 %")``: on a terminal a live line
+    on standard error; in a pipe or log one line when a step starts (with the elapsed time)."""
+
+    def __init__(self, command: str, console: Console, quiet: bool = False):
+        self.command, self.console, self.quiet = command, console, quiet
+        self.live = console.is_terminal and not quiet
+        self.seen = set()
+        self.t0 = time.perf_counter()
+        self._status = None
+
+    def __enter__(self) -> Progress:
+        if self.live:
+            self._status = self.console.status(f"{self.command}: starting", spinner="line")
+            self._status.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._status is not None:
+            self._status.__exit__(*exc)
+
+    def update(self, step: str, detail: str = "") -> None:
+        """Report that ``step`` is running (``detail``: iteration, best value, percentage…)."""
+        if self.quiet:
+            return
+        elapsed = time.perf_counter() - self.t0
+        if self.live:
+            self._status.update(escape(f"{self.command}: {step} {detail}  {elapsed:.0f} s"))
+        elif step not in self.seen:  # steps may run side by side: each is announced once
+            self.console.print(f"{self.command}: {step} (at {elapsed:.1f} s)", markup=False, highlight=False)
+        self.seen.add(step)

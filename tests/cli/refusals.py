@@ -1,0 +1,34 @@
+"""Running the CLI as a user does, and what a clean refusal is (issue "Every bad input refused cleanly")."""
+
+import os
+import re
+import subprocess
+import sys
+
+PROGRESS = re.compile(r"^dynid \w+: ")
+
+
+def dynid(*args, cwd=None, env=None, stdin=None):
+    """``dynid ARGS`` in a fresh process, output captured (a pipe: no terminal)."""
+    return subprocess.run([sys.executable, "-m", "dynid", *args], capture_output=True, text=True, cwd=cwd, timeout=600,
+                          env=None if env is None else {**os.environ, **env}, input=stdin)
+
+
+def snapshot(folder):
+    """Names and contents of the files in ``folder`` (None if it does not exist)."""
+    if not folder.exists():
+        return None
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def assert_refused(p, message, out=None, before=None):
+    """Exit code 1, no traceback, exactly one error line holding ``message`` (other lines on standard error are
+    progress lines), and ``out`` absent or as it was (``before``: :func:`snapshot` taken earlier)."""
+    assert p.returncode == 1, (p.returncode, p.stdout, p.stderr)
+    assert "Traceback" not in p.stderr + p.stdout, p.stderr
+    lines = [line for line in p.stderr.splitlines() if line.strip()]
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 1 and message in errors[0], lines
+    assert all(PROGRESS.match(line) for line in lines if not line.startswith("error: ")), lines
+    if out is not None:
+        assert snapshot(out) == before, f"{out} changed"

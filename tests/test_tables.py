@@ -1,0 +1,43 @@
+"""Result tables: split to a width without losing a cell, the same text for the library and the CLI."""
+
+from dynid.tables import EDGES, PADDING, Line, TextTable, render_text
+
+
+def _table(n_values=9):
+    rows = tuple((f"param{i}", "kg", *(f"{(i + 1) * 1.2345 * 10 ** (j % 4):.4g}" for j in range(n_values))) for i in range(5))
+    return TextTable("T", ("name", "unit", *(f"method {j}" for j in range(n_values))), rows, labels=2)
+
+
+def test_a_wide_table_splits_into_parts_that_fit_and_keep_every_cell():
+    t = _table()
+    for width in (60, 80, 100):
+        parts = t.split(width)
+        assert len(parts) > 1
+        for part in parts:
+            assert sum(w + PADDING for w in part.widths()) + EDGES <= width
+            assert part.columns[:2] == ("name", "unit")
+        values = [c for part in parts for c in part.columns[2:]]
+        assert values == list(t.columns[2:])  # every value column once, in order
+        for i, row in enumerate(t.rows):
+            assert [c for part in parts for c in part.rows[i][2:]] == list(row[2:])
+    assert t.split(10_000) == [t]
+
+
+def test_plain_text_rendering_holds_every_cell_and_warning():
+    t = _table(3)
+    text = render_text([Line("title", "title"), t, Line("careful", "warning")], width=200)
+    for row in t.rows:
+        assert all(cell in text for cell in row)
+    assert "warning: careful" in text and text.splitlines()[0] == "title"
+    assert all(len(line) <= 60 for line in render_text([_table()], width=60).splitlines())
+
+
+def test_the_rich_tables_are_as_wide_as_the_split_assumes():
+    from rich.console import Console
+
+    from dynid.report.console import rich_tables
+
+    console = Console(width=500)
+    for part in _table().split(80):
+        (table,) = rich_tables(part, 500)
+        assert console.measure(table).maximum == sum(w + PADDING for w in part.widths()) + EDGES
