@@ -114,6 +114,10 @@ def run(
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
             excitation=excitation, methods=parse_methods(methods), bootstrap=bootstrap)
+        if figures:
+            from ..report.figures import warm_up_in_background
+
+            warm_up_in_background()  # matplotlib's import and fonts, while the estimators run
         with rep.progress("dynid run") as progress:
             result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
                 LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
@@ -346,7 +350,10 @@ def _interrupt(signum, frame):
 
 def main() -> None:
     """Console-script entry point. Ctrl-C ends with one line and exit code 130 (128 + SIGINT)."""
+    import os
     import signal
+
+    os.environ.setdefault("MPLBACKEND", "Agg")  # figures go to files: no display needed, none opened
 
     signal.signal(signal.SIGINT, _interrupt)
     try:

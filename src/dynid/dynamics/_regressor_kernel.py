@@ -13,7 +13,7 @@ import numpy as np
 CHUNK = 256
 
 
-@nb.njit(cache=True, fastmath=False, boundscheck=False)
+@nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True)
 def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
     n = q.shape[1]
     for k in range(start, stop):
@@ -121,7 +121,7 @@ def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, r0, o, w, d
                 out[k, i, col + 9] = lx * gx + ly * gy + lz * gz
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, parallel=True, nogil=True)
 def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj):
     """Fill every entry of ``out`` (N, n, n*npj): the ten inertial columns of each link, and 0 in the
     drive columns (the caller fills those from :mod:`dynid.friction`)."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numba as nb
 
 
-@nb.njit(cache=True, fastmath=False)
+@nb.njit(cache=True, fastmath=False, nogil=True)
 def shifted_absolute_sum(r, column, delta, row_weights, out):
     """``out = r - delta·column`` and ``Σ row_weights·|out|`` in one pass."""
     s = 0.0

@@ -78,10 +78,26 @@ class LinearAbsoluteObjective:
         d = np.ones(n_dof) if weights is None else np.asarray(weights, dtype=float)
         self.row_weights = np.tile(d, w.shape[0] // n_dof) / (w.shape[0] // n_dof)
 
+    BLOCK = 1024
+    """Rows per block of a population's evaluation: the block's residuals (BLOCK × K) stay in cache."""
+
     def __call__(self, x):
         x = np.asarray(x, dtype=float)
-        r = (self.tau - self.w @ x) if x.ndim == 1 else (self.tau[:, None] - self.w @ x)
-        return paper_objective(r, self.n_dof, self.weights)
+        if x.ndim == 1:
+            return paper_objective(self.tau - self.w @ x, self.n_dof, self.weights)
+        # A population (p, K): one pass over W in row blocks, residuals formed, made absolute and weighted in
+        # place, instead of an (M, K) residual matrix written and read again three times (DE, PSO).
+        m, k = self.w.shape[0], x.shape[1]
+        out = np.zeros(k)
+        buf = np.empty((min(self.BLOCK, m), k))
+        for start in range(0, m, self.BLOCK):
+            stop = min(start + self.BLOCK, m)
+            b = buf[:stop - start]
+            np.matmul(self.w[start:stop], x, out=b)
+            np.subtract(self.tau[start:stop, None], b, out=b)
+            np.abs(b, out=b)
+            out += self.row_weights[start:stop] @ b
+        return out
 
     def start(self, x) -> tuple[float, np.ndarray]:
         r = self.tau - self.w @ np.asarray(x, dtype=float)

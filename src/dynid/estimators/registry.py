@@ -152,15 +152,22 @@ def fit_method(key: str, data: FitData, budget: SearchBudget, rng: np.random.Gen
     return Fitted(key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
 
 
+COST_ORDER = ("de", "pso", "abc10", "lad", "sdp", "irls", "abc", "ols", "wls")
+"""Methods from the longest to the shortest fit (measured on dynid run): the pool starts the long ones first,
+so that two cores finish together."""
+
+
 def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress: Callable[[str, int, float], None] | None = None,
-                workers: int | None = None) -> dict:
+                workers: int | None = None, extra: dict | None = None) -> dict:
     """Fit every method of ``keys``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
     and numba, which release the GIL).
 
     Each method draws from its own generator ``rngs[key]``, so the results depend neither on the order nor
     on the number of workers; each ``seconds`` is that method's wall time while the others ran.
     ``progress(key, iteration, best)`` reports the box searches (and ``(key, None, None)`` as a method starts).
-    Returns key -> :class:`Fitted`, in the order of ``keys``.
+    ``extra`` (name -> callable without arguments) adds independent tasks to the same pool, started after
+    the three longest fits (their results are returned under their names).
+    Returns key -> :class:`Fitted` in the order of ``keys``, then the extra tasks' results.
     """
     from concurrent.futures import ThreadPoolExecutor
 
@@ -172,7 +179,11 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
         callback = None if progress is None else (lambda i, f, key=key: progress(key, i, f))
         return fit_method(key, data, budget, rngs[key], callback)
 
-    slow_first = sorted(keys, key=lambda m: m in ("ols", "wls", "sdp", "irls", "abc"))  # long ones start first
-    with ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(keys)))) as pool:
-        done = dict(zip(slow_first, pool.map(fit, slow_first)))
-    return {key: done[key] for key in keys}
+    extra = extra or {}
+    rank = {k: i for i, k in enumerate(COST_ORDER)}
+    tasks = [(rank[k], k, lambda k=k: fit(k)) for k in keys] + [(2.5, name, f) for name, f in extra.items()]
+    tasks.sort(key=lambda task: task[0])
+    with ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(tasks)))) as pool:
+        futures = {name: pool.submit(f) for _, name, f in tasks}
+        done = {name: fut.result() for name, fut in futures.items()}
+    return {**{key: done[key] for key in keys}, **{name: done[name] for name in extra}}

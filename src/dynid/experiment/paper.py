@@ -370,9 +370,17 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
                             {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
                              "excitation": excitation_info},
                             warnings=warnings)
-    fits = _fit_methods(methods, data, budget, config.seed, progress)
+    def bootstrap(key):  # independent of the fit: it refits on resamples, so it runs in the same pool
+        if progress is not None:
+            progress(f"bootstrap of {LABELS[key]}", None, None)
+        t_b = time.perf_counter()
+        bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
+                                 n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, METHODS.index(key)]))
+        return bs, time.perf_counter() - t_b
+
+    boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in methods if key in BOOTSTRAPPED and config.bootstrap}
+    fits = _fit_methods(methods, data, budget, config.seed, progress, boots)
     for key in methods:
-        idx = METHODS.index(key)
         fit = fits[key]
         timings[key] = fit.seconds
         p_id = (ident.w_base @ fit.params).reshape(-1, k)
@@ -383,15 +391,10 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
                 metrics.setdefault(mk, {})[name] = mv
         est = fit.estimator
         boot = None
-        if key in BOOTSTRAPPED and config.bootstrap:
-            if progress is not None:
-                progress(f"bootstrap of {LABELS[key]}", None, None)
-            t_b = time.perf_counter()
-            bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
-                                     n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, idx]))
+        if f"{key}_bootstrap" in fits:
+            bs, timings[f"{key}_bootstrap"] = fits[f"{key}_bootstrap"]
             boot = {"resamples": config.bootstrap, "block_length": bs.block_length, "level": bs.level,
                     "lower": bs.lower, "upper": bs.upper, "std": bs.std}
-            timings[f"{key}_bootstrap"] = time.perf_counter() - t_b
         result.methods[key] = MethodResult(
             params=fit.params, objective=float(paper_objective(y - p_id.ravel(), k, config.weights)), seconds=fit.seconds,
             n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
@@ -404,9 +407,11 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     return result
 
 
-def _fit_methods(methods, data: FitData, budget: SearchBudget, seed: int, progress) -> dict:
-    """Every method side by side, each seeded by (seed, 2, method) (:func:`dynid.estimators.registry.fit_methods`)."""
-    return fit_methods(methods, data, budget, {k: np.random.default_rng([seed, 2, METHODS.index(k)]) for k in methods}, progress)
+def _fit_methods(methods, data: FitData, budget: SearchBudget, seed: int, progress, extra=None) -> dict:
+    """Every method side by side, each seeded by (seed, 2, method), with the ``extra`` tasks in the same pool
+    (:func:`dynid.estimators.registry.fit_methods`)."""
+    return fit_methods(methods, data, budget, {k: np.random.default_rng([seed, 2, METHODS.index(k)]) for k in methods}, progress,
+                       extra=extra)
 
 
 def fit_data(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, dataset: Dataset, bounds: np.ndarray) -> FitData:

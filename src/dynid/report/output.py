@@ -81,9 +81,6 @@ def output_folder(out: str | Path) -> Path:
     ConfigError
         If ``out`` exists and is not a folder, or cannot be created.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     out = check_output_folder(out)
     try:
         out.mkdir(parents=True, exist_ok=True)

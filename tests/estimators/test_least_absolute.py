@@ -1,0 +1,45 @@
+"""LAD on long problems: the banded ("globbing") LP gives the exact minimiser of the whole problem."""
+
+import numpy as np
+import pytest
+
+from dynid.estimators import least_absolute as la
+from dynid.estimators.base import paper_objective
+
+
+def _problem(m=30_000, p=8, n_dof=2, seed=0):
+    rng = np.random.default_rng(seed)
+    w = rng.standard_normal((m, p))
+    beta = rng.uniform(-2, 2, p)
+    tau = w @ beta + rng.standard_t(2, m)  # heavy tails: LAD and least squares differ
+    bounds = np.column_stack([beta - 3, beta + 3])
+    bounds[0] = [beta[0] + 0.5, beta[0] + 3]  # one bound active at the optimum
+    return w, tau, bounds, n_dof
+
+
+def _direct(w, tau, bounds, n_dof):
+    m = w.shape[0]
+    row_w = np.full(m, 1.0 / (m // n_dof))
+    none = np.array([], dtype=int)
+    beta, _ = la._dual_lp(w, tau, row_w, bounds[:, 0], bounds[:, 1], np.arange(m), none, none)
+    return beta
+
+
+@pytest.mark.parametrize("band", [la.BAND, 1])  # band 1: the first band is too narrow, the check must widen it
+def test_banded_lad_equals_the_lp_on_every_row(monkeypatch, band):
+    monkeypatch.setattr(la, "BAND", band)
+    w, tau, bounds, n_dof = _problem()
+    calls = []
+    real = la._dual_lp
+    monkeypatch.setattr(la, "_dual_lp", lambda *a: calls.append(a[5].size) or real(*a))
+    est = la.LeastAbsoluteDeviations(n_dof=n_dof, bounds=bounds).fit(w, tau)
+    if band > 1:
+        assert max(calls) < w.shape[0] // 2  # it solved on a band, not on every row
+    else:
+        assert len(calls) > 2  # the check found fixed rows across the fit and widened the band
+    monkeypatch.setattr(la, "_dual_lp", real)
+    exact = _direct(w, tau, bounds, n_dof)
+    f = lambda b: float(paper_objective(tau - w @ b, n_dof))
+    assert f(est.params_) == pytest.approx(f(exact), rel=1e-12)
+    np.testing.assert_allclose(est.params_, exact, atol=1e-8)
+    assert est.params_[0] == pytest.approx(bounds[0, 0])  # the active bound holds

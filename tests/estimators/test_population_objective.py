@@ -1,0 +1,36 @@
+"""Eq. 9 for a whole population, in row blocks: the same values as the plain formula, so DE and PSO visit the
+same candidates and return the same parameters however the rows are blocked."""
+
+import numpy as np
+
+from dynid.estimators import DifferentialEvolutionEstimator, ParticleSwarmEstimator
+from dynid.estimators.base import LinearAbsoluteObjective, paper_objective
+
+
+def _problem(m=9_000, p=6, n_dof=3, seed=1):
+    rng = np.random.default_rng(seed)
+    w = rng.standard_normal((m, p))
+    beta = rng.uniform(-1, 1, p)
+    tau = w @ beta + 0.1 * rng.standard_normal(m)
+    return w, tau, np.column_stack([beta - 1, beta + 1]), n_dof
+
+
+def test_blocked_population_objective_equals_eq_9():
+    w, tau, _, n = _problem()
+    x = np.random.default_rng(2).standard_normal((w.shape[1], 17))
+    weights = np.array([1.0, 0.5, 0.25])
+    f = LinearAbsoluteObjective(w, tau, n, weights)
+    np.testing.assert_allclose(f(x), paper_objective(tau[:, None] - w @ x, n, weights), rtol=1e-13)
+    np.testing.assert_allclose(f(x[:, 3]), paper_objective(tau - w @ x[:, 3], n, weights), rtol=1e-13)
+
+
+def test_de_and_pso_do_not_depend_on_the_blocking(monkeypatch):
+    w, tau, bounds, n = _problem()
+    results = []
+    for block in (10**9, 1000):  # one block (the plain formula's order of operations), then nine
+        monkeypatch.setattr(LinearAbsoluteObjective, "BLOCK", block)
+        de = DifferentialEvolutionEstimator(bounds=bounds, n_dof=n, popsize=3, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau)
+        pso = ParticleSwarmEstimator(bounds=bounds, n_dof=n, swarm_size=12, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau)
+        results.append((de.params_, pso.params_))
+    for a, b in zip(*results):
+        np.testing.assert_allclose(a, b, rtol=1e-12)
