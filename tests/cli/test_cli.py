@@ -42,6 +42,19 @@ def test_methods_subset_without_abc(tmp_path):
     data = json.loads((out / "results.json").read_text())
     assert list(data["methods"]) == ["ols", "lad"] and "bootstrap" not in data["methods"]["ols"]
     assert not (out / "fig6_abc_convergence.png").exists() and (out / "methods_comparison.png").exists()
+    # piped: one progress line per step on standard error, each once, the tables on standard output
+    steps = [line for line in p.stderr.splitlines() if line.startswith("dynid run: ")]
+    names = [s.split(" (at")[0].removeprefix("dynid run: ") for s in steps]
+    assert names[0] == "simulation and preprocessing" and names[-1] == "writing results and figures"
+    assert sorted(names[1:-1]) == ["LAD", "OLS"]  # side by side: in either order
+    assert "Estimators:" in p.stdout and "dynid run:" not in p.stdout
+
+
+def test_quiet_prints_nothing_but_warnings(tmp_path):
+    p = dynid("run", "--out", str(tmp_path / "q"), *FAST, "--methods", "ols,abc", "--bootstrap", "0", "--no-figures", "--quiet")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout == "" and all(line.startswith("warning: ") for line in p.stderr.splitlines())
+    assert "truth outside the ABC search box" in p.stderr and (tmp_path / "q" / "results.json").is_file()
 
 
 def test_usage_error_exit_2():

@@ -126,7 +126,7 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
 
 @pytest.mark.parametrize("content, rows, message", [
     ("", None, r"no data lines \(an empty file"),
-    ("\x00\x01\x02garbage\n", None, r"line 1: expected 31 columns, got 1"),
+    ("\x00\x01\x02garbage\n", None, r"not a UTF-8 text table \(a binary file\?\)"),
     ("1,2,3\n" * 0, [5, 9], r"no data lines"),
 ])
 def test_empty_and_garbage_files_say_what_they_are(tmp_path, content, rows, message):

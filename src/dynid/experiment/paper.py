@@ -119,8 +119,10 @@ class PaperExperimentConfig:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ConfigError(f"{name} must be positive, got {v}", field=name)
-        if self.current_noise < 0 or self.encoder_resolution < 0:
-            raise ConfigError(f"noise levels must be non-negative, got current noise {self.current_noise}, encoder resolution {self.encoder_resolution}")
+        if not self.current_noise >= 0:
+            raise ConfigError(f"current_noise must be >= 0 (A), got {self.current_noise}", field="current_noise")
+        if not self.encoder_resolution >= 0:
+            raise ConfigError(f"encoder_resolution must be >= 0 (rad), got {self.encoder_resolution}", field="encoder_resolution")
         if self.smoothing_passes < 0:
             raise ConfigError(field="smoothing_passes", message=f"smoothing_passes must be >= 0, got {self.smoothing_passes}")
         parse_methods(self.methods)

@@ -6,6 +6,7 @@ import tomllib
 from pathlib import Path
 
 from ..exceptions import ConfigError
+from .files import text_encoding_hint
 from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
 
@@ -22,7 +23,9 @@ def read_config(path: Path, known: set[str]) -> dict:
         raise ConfigError(f"{path}: config file not found")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError:
+        raise ConfigError(f"{path}: not UTF-8 text{text_encoding_hint(path)}") from None
+    except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: invalid TOML ({exc})") from None
     unknown = sorted(set(doc) - known)
     if unknown:
@@ -41,4 +44,7 @@ def config_robot(doc: dict, path: Path) -> Robot:
     ref = doc.get("robot")
     if not isinstance(ref, str):
         raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
+    if ref not in builtin_robots() and not ref.endswith((".toml", ".urdf")):
+        raise ConfigError(f"{path}: robot: unknown robot {ref!r}, expected a built-in robot ({', '.join(builtin_robots())}) "
+                          "or a description file (.toml or .urdf)")
     return load_robot(ref if ref in builtin_robots() or Path(ref).is_absolute() else path.parent / ref)

@@ -131,6 +131,8 @@ class Recording:
     tau : (N, n_dof) [N·m], joint torques (from currents through the drive gains, eq. 16)
     rate : float [Hz]
     warnings : tuple of str
+    source : str
+        The files (or bag) it was read from.
     """
 
     name: str
@@ -140,10 +142,16 @@ class Recording:
     tau: np.ndarray
     rate: float
     warnings: tuple[str, ...] = field(default=())
+    source: str = ""
 
     @property
     def n_samples(self) -> int:
         return self.t.shape[0]
+
+    @property
+    def label(self) -> str:
+        """The dataset's name and the files it was read from, for messages: ``"identification (log.csv)"``."""
+        return f"{self.name} ({self.source})" if self.source else self.name
 
 
 def _rows(value, where: str):
@@ -387,7 +395,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         steps = np.diff(t)
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0))
-            raise DataError(f"{where(k + 1)}: time stamps must increase, got {t[k + 1]!r} after {t[k]!r}")
+            what = "a repeated time stamp" if t[k + 1] == t[k] else "time going back"
+            raise DataError(f"{where(k + 1)}: time stamps must increase, got {what}: {float(t[k + 1]):.9g} s after {float(t[k]):.9g} s")
     if spec.time_range is not None:
         start, stop = spec.time_range
         inside = (t - t[0] >= start - 1e-9) & (t - t[0] <= stop + 1e-9)
@@ -427,4 +436,5 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         motor_or_joint = raw["torques"]
     tau = tr.joint_torques(motor_or_joint) if spec.side == "motor" else motor_or_joint
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
-    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings))
+    source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
+    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)

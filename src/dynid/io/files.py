@@ -49,3 +49,18 @@ def _clean(obj):
 def write_json(path: str | Path, data: dict) -> None:
     """Write ``data`` as indented JSON atomically; NaN and inf become ``null``."""
     atomic_write_text(path, json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n")
+
+
+def text_encoding_hint(path: Path) -> str:
+    """``" (UTF-16: save it as UTF-8)"`` or ``" (a binary file?)"`` from the first bytes of ``path``; ``""`` if
+    neither applies."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return ""
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or (len(head) > 3 and head[1:2] == b"\x00" and head[3:4] == b"\x00"):
+        return " (it looks like UTF-16: save it as UTF-8)"
+    if b"\x00" in head:
+        return " (a binary file?)"
+    return ""

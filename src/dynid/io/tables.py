@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError
+from .files import text_encoding_hint
 
 BLOCK = 100_000
 
@@ -88,6 +89,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: file not found")
+    hint = text_encoding_hint(path)
+    if hint:
+        raise DataError(f"{path}: not a UTF-8 text table{hint}")
     first, last = rows if rows is not None else (1, None)
     if first < 1 or (last is not None and last < first):
         raise DataError(f"{path}: rows: expected 1 <= first <= last, got {list(rows)}")
@@ -125,15 +129,17 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if last is not None and data_row > last:
                 break
             n_fields = line.count(delimiter) + 1
-            if expected is None:
-                expected = n_fields
+            if first_line is None:  # the first data line: the column map must fit it
+                expected = n_fields if expected is None else expected
                 if max(cols) >= expected:
-                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the line has {n_fields} columns")
+                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have {expected} columns")
             if n_fields != expected:
                 if not line.endswith("\n"):  # only the last line can lack a newline
                     warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
                     break
-                raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}")
+                other = next((d for d in (";", "\t", "|") if d != delimiter and d in line), None)
+                hint = f" (fields separated by {other!r}? dynid reads {delimiter!r})" if n_fields == 1 and other else ""
+                raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}{hint}")
             if first_line is None:
                 first_line = line_no
             if not pending:

@@ -67,7 +67,7 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
     """
     rate = recording.rate
     if recording.n_samples < 3 * (2 * settings.order + 1) + 1:
-        raise DataError(f"{recording.name}: {recording.n_samples} samples are too few to filter "
+        raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
                         f"(at least {3 * (2 * settings.order + 1) + 1} for preprocessing.order = {settings.order})")
     s = settings.resolved(rate, recording.q, recording.dq is not None)
 
@@ -95,7 +95,7 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
     cut = int(round(s.trim * rate))
     if cut:
         if 2 * cut >= t.shape[0] - 2:
-            raise DataError(f"{recording.name}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
+            raise DataError(f"{recording.label}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
                             f"the {t[-1] - t[0]:.3f} s recording")
         t, q, dq, ddq, tau = (x[cut:-cut] for x in (t, q, dq, ddq, tau))
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, s, tuple(recording.warnings))

@@ -1,0 +1,264 @@
+"""A corpus of bad inputs, each tried as a user would: every one gets exit code 1, no traceback, one error
+line naming the file, line, field or option and what was expected, and no output folder (issue "Every bad
+input refused cleanly"). The commands run in-process (typer's runner), which keeps the corpus fast."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from dynid.cli.app import app
+
+from .refusals import PROGRESS
+
+
+def invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def assert_refused(result, message, out: Path | None = None):
+    """Exit code 1, no traceback, exactly one ``error:`` line holding ``message``, nothing written to ``out``."""
+    assert result.exit_code == 1, (result.exit_code, result.stdout, result.stderr, result.exception)
+    assert isinstance(result.exception, SystemExit), repr(result.exception)  # a clean exit, not an escaped error
+    assert "Traceback" not in result.stdout + result.stderr
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 1 and message in errors[0], lines
+    if os.environ.get("DYNID_SHOW_REFUSALS"):  # to read the corpus's messages: DYNID_SHOW_REFUSALS=1 pytest -s
+        print("\n" + errors[0])
+    assert all(PROGRESS.match(line) or line.startswith("warning: ") for line in lines if not line.startswith("error: ")), lines
+    if out is not None:
+        assert not out.exists(), f"{out} was written"
+
+
+# --- a valid UR10e RTDE log (31 columns: t, q, qd, i, i_target, tau_target) and configs around it -----------
+
+RATE = 125.0
+
+
+def _log_rows(seconds=20.0, rate=RATE):
+    t = np.arange(int(seconds * rate)) / rate
+    phase = np.arange(6)[None, :]
+    q = 0.6 * np.sin(2 * np.pi * 0.2 * t[:, None] * (1 + 0.3 * phase) + phase)
+    dq = 0.6 * 2 * np.pi * 0.2 * (1 + 0.3 * phase) * np.cos(2 * np.pi * 0.2 * t[:, None] * (1 + 0.3 * phase) + phase)
+    i = 0.5 * np.sin(t[:, None] + phase) + 0.1 * np.sign(dq)
+    return np.column_stack([t, q, dq, i, i, 10 * i])
+
+
+def _write_log(path: Path, rows: np.ndarray):
+    path.write_text("".join(",".join(f"{x:.9g}" for x in r) + "\n" for r in rows))
+
+
+CONFIG = '''robot = "ur10e"
+data_root = "."
+[identification]
+preset = "ur-rtde"
+file = "log.csv"
+'''
+
+
+@pytest.fixture()
+def ur(tmp_path):
+    """A folder with log.csv (valid) and c.toml reading it; returns a function that rewrites either."""
+    _write_log(tmp_path / "log.csv", _log_rows())
+
+    def make(config_extra="", replace=None, log_text=None):
+        text = CONFIG + config_extra
+        for a, b in (replace or {}).items():
+            assert a in text, a
+            text = text.replace(a, b)
+        (tmp_path / "c.toml").write_text(text)
+        if log_text is not None:
+            (tmp_path / "log.csv").write_text(log_text)
+        return tmp_path / "c.toml"
+
+    make.folder = tmp_path
+    return make
+
+
+def test_the_valid_log_is_identified(ur):
+    """The corpus's base case passes, so each refusal below comes from its one change."""
+    out = ur.folder / "out"
+    result = invoke("identify", ur(), "--out", out, "--no-figures")
+    assert result.exit_code == 0, result.stderr
+    assert (out / "results.json").is_file()
+
+
+GOOD = _log_rows()
+
+
+def _text(rows):
+    return "".join(",".join(f"{x:.9g}" for x in r) + "\n" for r in rows)
+
+
+def _with(rows, fn):
+    rows = rows.copy()
+    fn(rows)
+    return rows
+
+
+LOGS = {
+    "empty file": ("", "log.csv: no data lines (an empty file, or not a text table?)"),
+    "only blank lines": ("\n\n\n", "log.csv: "),
+    "semicolons": (_text(GOOD[:50]).replace(",", ";"), "log.csv: line 1: expected 31 columns, got 1 (fields separated by ';'?"),
+    "a text cell": (_text(GOOD[:40]) + "0.5,abc" + ",1" * 29 + "\n" + _text(GOOD[41:60]), "log.csv: line 41"),
+    "NaN": (_text(_with(GOOD[:300], lambda r: r.__setitem__((5, 3), np.nan))), "log.csv: line 6, column 4: NaN or infinite value"),
+    "infinity": (_text(_with(GOOD[:300], lambda r: r.__setitem__((7, 15), np.inf))), "log.csv: line 8, column 16: NaN or infinite value"),
+    "duplicate time stamps": (_text(_with(GOOD[:300], lambda r: r.__setitem__((10, 0), r[9, 0]))), "log.csv: line 11: time stamps must increase, got a repeated time stamp"),
+    "time going back": (_text(_with(GOOD[:300], lambda r: r.__setitem__((10, 0), r[5, 0]))), "log.csv: line 11: time stamps must increase"),
+    "a time gap": (_text(_with(GOOD, lambda r: r.__setitem__((slice(1000, None), 0), r[1000:, 0] + 3.0))), "gap"),
+    "degrees written as radians": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), np.degrees(r[:, 1:7])))), 'unit = "deg"'),
+    "huge values": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), 1e300))), "positions"),
+    "three rows": (_text(GOOD[:3]), "identification (" ),
+    "a joint that never moves": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(3, 4)), 0.2) or r.__setitem__((slice(None), slice(9, 10)), 0.0))), "J3"),
+    "UTF-16": (None, "log.csv: not a UTF-8 text table (it looks like UTF-16: save it as UTF-8)"),
+    "a binary file": (None, "log.csv: not a UTF-8 text table (a binary file?)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(LOGS))
+def test_damaged_logs(ur, case):
+    text, message = LOGS[case]
+    cfg = ur()
+    if case == "UTF-16":
+        (ur.folder / "log.csv").write_text(_text(GOOD[:200]), encoding="utf-16")
+    elif case == "a binary file":
+        (ur.folder / "log.csv").write_bytes(bytes(range(256)) * 40)
+    else:
+        (ur.folder / "log.csv").write_text(text)
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), message, out)
+
+
+CONFIGS = {
+    "not TOML": ({"robot = \"ur10e\"": "robot = ur10e ="}, "c.toml"),
+    "unknown top-level field": ({"data_root = \".\"": "data_root = \".\"\ncolour = 1"}, "colour"),
+    "unknown robot": ({"\"ur10e\"": "\"ur99\""}, "c.toml: robot: unknown robot 'ur99'"),
+    "no identification table": ({"[identification]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n": ""}, "[identification]"),
+    "missing log file": ({"file = \"log.csv\"": "file = \"nosuch.csv\""}, "nosuch.csv"),
+    "unknown preset": ({"preset = \"ur-rtde\"": "preset = \"kuka\""}, "kuka"),
+    "unknown unit": ({"preset = \"ur-rtde\"": "preset = \"ur-rtde\"\npositions = { columns = [2, 3, 4, 5, 6, 7], unit = \"furlong\" }"}, "furlong"),
+    "a column past the end": ({"preset = \"ur-rtde\"": "preset = \"ur-rtde\"\npositions = { columns = [2, 3, 4, 5, 6, 40] }"}, "40"),
+    "five position columns": ({"preset = \"ur-rtde\"": "preset = \"ur-rtde\"\npositions = { columns = [2, 3, 4, 5, 6] }"}, "positions"),
+    "rows beyond the file": ({"file = \"log.csv\"": "file = \"log.csv\"\nrows = [100, 999999]"}, "999999"),
+    "rows inverted": ({"file = \"log.csv\"": "file = \"log.csv\"\nrows = [500, 100]"}, "rows"),
+    "time range outside the log": ({"file = \"log.csv\"": "file = \"log.csv\"\ntime_range = [100.0, 200.0]"}, "time_range"),
+    "data_root not a folder": ({"data_root = \".\"": "data_root = \"nowhere\""}, "--data-root"),
+    "negative filter order": ("[preprocessing]\norder = -1\n", "preprocessing.order"),
+    "zero band": ("[preprocessing]\nband = 0\n", "preprocessing.band"),
+    "torque_cutoff": ("[preprocessing]\ntorque_cutoff = 5.0\n", "preprocessing.torque_cutoff"),
+    "min_speed of the wrong length": ("[preprocessing]\nmin_speed = [0.1, 0.1]\n", "preprocessing.min_speed"),
+    "unknown preprocessing field": ("[preprocessing]\ncutof = 3\n", "cutof"),
+    "excitation file missing": ("[preprocessing]\nexcitation = \"nosuch.json\"\n", "nosuch.json"),
+    "estimation method abc": ("[estimation]\nmethod = \"abc\"\n", "estimation.method"),
+    "unknown estimator": ("[estimation]\nmethods = [\"ols\", \"magic\"]\n", "estimation.methods"),
+    "negative seed": ("[estimation]\nseed = -1\n", "estimation.seed"),
+    "physically_consistent not a boolean": ("[estimation]\nphysically_consistent = \"yes\"\n", "estimation.physically_consistent"),
+    "drive gains without the loaded run": ("[drive_gains]\npayload_mass = 2.0\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "loaded"),
+    "zero payload mass": ("[drive_gains]\npayload_mass = 0\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n"
+                          "[drive_gains.loaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "payload_mass"),
+    "two validations with one name": ("[[validation]]\nname = \"a\"\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n"
+                                      "[[validation]]\nname = \"a\"\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "unique"),
+    "reference file missing": ("[[references]]\nname = \"x\"\nfile = \"nosuch_ref.csv\"\nnames = \"name\"\nvalues = \"value\"\n", "nosuch_ref.csv"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CONFIGS))
+def test_bad_identification_configs(ur, case):
+    change, message = CONFIGS[case]
+    cfg = ur(replace=change) if isinstance(change, dict) else ur(config_extra=change)
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), message, out)
+
+
+def test_a_config_that_does_not_exist(tmp_path):
+    assert_refused(invoke("identify", tmp_path / "nosuch.toml", "--out", tmp_path / "o"), "nosuch.toml", tmp_path / "o")
+
+
+def test_a_config_in_utf16(ur):
+    cfg = ur()
+    cfg.write_text(cfg.read_text(), encoding="utf-16")
+    assert_refused(invoke("identify", cfg, "--out", ur.folder / "o"), "c.toml: not UTF-8 text (it looks like UTF-16", ur.folder / "o")
+
+
+RUN = ["--duration", "4", "--rate", "100", "--abc-iterations", "2", "--methods", "ols,abc", "--bootstrap", "0"]
+RUN_OPTIONS = {
+    "no joints": (["--joints", "0"], "--joints"),
+    "zero duration": (["--duration", "0"], "--duration must be positive"),
+    "NaN rate": (["--rate", "nan"], "--rate must be positive"),
+    "negative noise": (["--current-noise", "-1"], "--current-noise must be >= 0 (A), got -1.0"),
+    "weights of the wrong count": (["--weights", "1,1"], "--weights"),
+    "weights above one": (["--weights", "1,1,2"], "--weights"),
+    "weights not numbers": (["--weights", "a,b,c"], "--weights"),
+    "unknown plant": (["--plant", "real"], "--plant"),
+    "paper plant on two joints": (["--plant", "paper", "--joints", "2"], "--plant"),
+    "unknown box": (["--abc-bounds", "wide"], "--abc-bounds"),
+    "empty methods": (["--methods", ","], "--methods"),
+    "excitation file missing": (["--excitation", "nosuch.json"], "nosuch.json"),
+    "negative smoothing passes": (["--smoothing-passes", "-1"], "--smoothing-passes"),
+    "one bootstrap resample": (["--bootstrap", "1"], "--bootstrap"),
+    "a robot file that is not TOML": (["--robot", "{tmp}/robot.toml"], "robot.toml"),
+    "an out that is a file": (["--out", "{tmp}/file"], "--out"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(RUN_OPTIONS))
+def test_bad_run_options(tmp_path, case):
+    args, message = RUN_OPTIONS[case]
+    (tmp_path / "robot.toml").write_text("name = [unclosed\n")
+    (tmp_path / "file").write_text("x")
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    out = tmp_path / "o"
+    result = invoke("run", "--out", out, *RUN, *args)
+    assert_refused(result, message, out if "--out" not in args else None)
+
+
+MONTECARLO = {
+    "noise levels not numbers": (["--noise-levels", "a,b"], "--noise-levels"),
+    "zero noise": (["--noise-levels", "0"], "--noise-levels"),
+    "one realisation": (["--realisations", "1"], "--realisations"),
+    "no workers": (["--workers", "0"], "--workers"),
+    "unknown estimator": (["--methods", "ols,magic"], "--methods"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MONTECARLO))
+def test_bad_montecarlo_options(tmp_path, case):
+    args, message = MONTECARLO[case]
+    out = tmp_path / "o"
+    assert_refused(invoke("montecarlo", "--out", out, "--duration", "2", "--realisations", "2", *args), message, out)
+
+
+@pytest.fixture()
+def identified(ur):
+    """A config and the results.json of a successful identification."""
+    cfg = ur(config_extra="[[validation]]\nname = \"same\"\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n")
+    result = invoke("identify", cfg, "--out", ur.folder / "id", "--no-figures", "--no-validate")
+    assert result.exit_code == 0, result.stderr
+    return cfg, ur.folder / "id" / "results.json"
+
+
+def test_validate_and_export_refusals(identified, tmp_path):
+    cfg, results = identified
+    folder = cfg.parent
+    (folder / "bad.json").write_text("{not json")
+    (folder / "other.json").write_text(json.dumps({"base_parameters": [{"name": "X", "value": 1.0}]}))
+    cases = [
+        (["validate", cfg, "--results", folder / "nosuch.json", "--out", folder / "v"], "run dynid identify first"),
+        (["validate", cfg, "--results", folder / "bad.json", "--out", folder / "v"], "bad.json: cannot read it as JSON"),
+        (["validate", cfg, "--results", folder / "other.json", "--out", folder / "v"], "are not those of robot 'ur10e'"),
+        (["validate", cfg, "--results", results, "--rows", "1,10", "--out", folder / "v"], "--rows needs --file"),
+        (["validate", cfg, "--results", results, "--file", folder / "log.csv", "--rows", "a,b", "--out", folder / "v"], "--rows"),
+        (["validate", cfg, "--results", results, "--file", folder / "nosuch.csv", "--out", folder / "v"], "nosuch.csv"),
+        (["export", cfg, "--results", results], "--urdf"),
+        (["export", cfg, "--results", results, "--urdf", folder / "no" / "where.urdf"], "its folder does not exist"),
+        (["export", cfg, "--results", folder / "bad.json", "--urdf", folder / "r.urdf"], "bad.json"),
+    ]
+    for args, message in cases:
+        assert_refused(invoke(*args), message, folder / "v")
+    assert not (folder / "r.urdf").exists()
