@@ -262,3 +262,38 @@ def test_validate_and_export_refusals(identified, tmp_path):
     for args, message in cases:
         assert_refused(invoke(*args), message, folder / "v")
     assert not (folder / "r.urdf").exists()
+
+
+URDF = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0 0 0.1"/><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.01"/></inertial></link>
+  <link name="l2"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="100" velocity="3"/></joint>
+</robot>
+"""
+URDFS = {
+    "malformed XML": ({"</joint>\n</robot>": "</joint>\n</robt>"}, "r.urdf: line 8, column 3: malformed XML (mismatched tag)"),
+    "unknown joint type": ({'name="j2" type="revolute"': 'name="j2" type="hinge"'}, "r.urdf: line 7: joint 'j2' has type 'hinge'"),
+    "prismatic joint": ({'name="j2" type="revolute"': 'name="j2" type="prismatic"'}, "r.urdf: joint 'j2' is JointModelPY, expected a revolute joint"),
+    "a parent link that does not exist": ({'<parent link="l1"/>': '<parent link="nolink"/>'}, "parent link [nolink] of joint [j2] not found"),
+    "negative mass": ({'<mass value="1"/>': '<mass value="-1"/>'}, "mass"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(URDFS))
+def test_bad_urdfs_in_a_real_process(tmp_path, case):
+    """A separate process: urdfdom prints on the process's own standard error, which must stay clean."""
+    from .refusals import assert_refused as assert_refused_process, dynid
+
+    change, message = URDFS[case]
+    text = URDF
+    for a, b in change.items():
+        assert a in text
+        text = text.replace(a, b)
+    (tmp_path / "r.urdf").write_text(text)
+    (tmp_path / "r.toml").write_text('name = "r"\nconvention = "urdf"\nurdf = "r.urdf"\n[[joints]]\nname = "j1"\n[[joints]]\nname = "j2"\n')
+    out = tmp_path / "o"
+    p = dynid("run", "--robot", str(tmp_path / "r.toml"), "--joints", "2", "--out", str(out), *RUN)
+    assert_refused_process(p, message, out)

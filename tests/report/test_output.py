@@ -54,3 +54,28 @@ def test_unusable_out_is_refused_before_computing(tmp_path):
             check_output_folder(ro / "sub")
     finally:
         os.chmod(ro, 0o700)
+
+
+def test_a_kill_while_files_move_leaves_no_manifest_and_its_staging_folder_goes_later(tmp_path, monkeypatch):
+    out = tmp_path / "run"
+    _save({"results.json": "1", "a.png": "A"}, out)
+    moved = []
+    real_replace = os.replace
+
+    def replace_then_die(src, dst):  # SIGKILL after the first file moved: nothing runs after it
+        if moved:
+            raise SystemExit("killed")
+        moved.append(dst)
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace_then_die)
+    monkeypatch.setattr("shutil.rmtree", lambda *a, **k: None)  # a kill runs no clean-up
+    with pytest.raises(SystemExit):
+        _save({"results.json": "2", "a.png": "A2"}, out)
+    monkeypatch.undo()
+    assert not (out / MANIFEST).exists()  # the mix is marked: files without a manifest
+    stale = list(out.glob(".dynid-staging-*"))
+    assert stale
+    os.utime(stale[0], (0, 0))  # an hour and more later
+    _save({"results.json": "3"}, out)
+    assert not list(out.glob(".dynid-staging-*")) and json.loads((out / MANIFEST).read_text())["files"] == ["results.json"]

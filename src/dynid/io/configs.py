@@ -44,7 +44,7 @@ def config_robot(doc: dict, path: Path) -> Robot:
     ref = doc.get("robot")
     if not isinstance(ref, str):
         raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
-    if ref not in builtin_robots() and not ref.endswith((".toml", ".urdf")):
+    if ref not in builtin_robots() and not ref.endswith(".toml"):
         raise ConfigError(f"{path}: robot: unknown robot {ref!r}, expected a built-in robot ({', '.join(builtin_robots())}) "
-                          "or a description file (.toml or .urdf)")
+                          "or a description file (.toml; it may point to a URDF)")
     return load_robot(ref if ref in builtin_robots() or Path(ref).is_absolute() else path.parent / ref)

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +14,51 @@ from ..exceptions import ConfigError
 from .robot import Joint
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
+URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+
+def check_urdf_text(path: Path) -> None:
+    """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one: malformed
+    XML and joints of unknown type.
+
+    Raises
+    ------
+    ConfigError
+    """
+    from xml.parsers import expat
+
+    parser = expat.ParserCreate()
+    problems = []
+
+    def start(name, attrs):
+        if name == "joint" and "type" in attrs and attrs["type"] not in URDF_JOINT_TYPES:
+            problems.append(f"line {parser.CurrentLineNumber}: joint {attrs.get('name', '?')!r} has type {attrs['type']!r}, "
+                            f"expected one of {', '.join(URDF_JOINT_TYPES)}")
+
+    parser.StartElementHandler = start
+    try:
+        parser.Parse(path.read_bytes(), True)
+    except expat.ExpatError as exc:
+        raise ConfigError(f"{path}: line {exc.lineno}, column {exc.offset + 1}: malformed XML "
+                          f"({expat.ErrorString(exc.code)})") from None
+    if problems:
+        raise ConfigError(f"{path}: {problems[0]}")
+
+
+@contextlib.contextmanager
+def _silenced_stderr(lines: list):
+    """Keep what C++ code (urdfdom) prints on file descriptor 2 out of the terminal: it goes into ``lines``."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            lines.extend(line for line in tmp.read().decode("utf-8", "replace").splitlines() if line.strip())
 
 
 def inertial_from_pinocchio(inertia) -> np.ndarray:
@@ -50,10 +99,14 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: URDF file not found")
+    check_urdf_text(path)
+    printed: list[str] = []
     try:
-        model = pin.buildModelFromUrdf(str(path))
-    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError
-        raise ConfigError(f"{path}: cannot parse URDF ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") from None
+        with _silenced_stderr(printed):
+            model = pin.buildModelFromUrdf(str(path))
+    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError; urdfdom prints its reason
+        reason = printed[0] if printed else (str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        raise ConfigError(f"{path}: cannot parse URDF ({' '.join(reason.split())})") from None
     joints, inertial = [], []
     for j in range(1, model.njoints):
         jm = model.joints[j]

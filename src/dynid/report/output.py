@@ -39,16 +39,21 @@ def staged(save):
     """Decorator for ``save(result, out, ...) -> paths``: the files are written into a hidden staging folder
     inside ``out``, then moved into ``out`` one by one; the files of an earlier run there that this one
     does not write again are removed, and the manifest (:data:`MANIFEST`) is written last. An error or a
-    Ctrl-C while saving leaves ``out`` as it was (the staging folder is removed)."""
+    Ctrl-C while saving leaves ``out`` as it was (the staging folder is removed). The old manifest is removed
+    before the first file moves, so a folder killed while files move (SIGKILL, power loss) has no manifest:
+    files without a manifest are an incomplete run. Staging folders such a kill leaves behind are removed by
+    the next run into the same folder once they are an hour old."""
 
     @functools.wraps(save)
     def wrapper(result, out, *args, **kwargs):
         out = output_folder(out)
+        _remove_stale_staging(out)
         stage = Path(tempfile.mkdtemp(prefix=".dynid-staging-", dir=out))
         try:
             written = save(result, stage, *args, **kwargs)
             final = [out / p.relative_to(stage) for p in written]
             previous = _manifest_files(out)
+            (out / MANIFEST).unlink(missing_ok=True)  # from here until the new one: visibly incomplete
             for p in previous - {f.name for f in final}:
                 (out / p).unlink(missing_ok=True)
             for src, dst in zip(written, final):
@@ -63,6 +68,18 @@ def staged(save):
         return final
 
     return wrapper
+
+
+def _remove_stale_staging(out: Path, age: float = 3600.0) -> None:
+    """Remove staging folders of runs killed over ``age`` seconds ago (a running save's folder is younger)."""
+    import time
+
+    for folder in out.glob(".dynid-staging-*"):
+        try:
+            if folder.is_dir() and time.time() - folder.stat().st_mtime > age:
+                shutil.rmtree(folder, ignore_errors=True)
+        except OSError:
+            pass
 
 
 def _manifest_files(out: Path) -> set[str]:
