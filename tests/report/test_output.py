@@ -79,3 +79,25 @@ def test_a_kill_while_files_move_leaves_no_manifest_and_its_staging_folder_goes_
     os.utime(stale[0], (0, 0))  # an hour and more later
     _save({"results.json": "3"}, out)
     assert not list(out.glob(".dynid-staging-*")) and json.loads((out / MANIFEST).read_text())["files"] == ["results.json"]
+
+
+def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path):
+    from dynid.report.output import draw_figures
+    from dynid.threads import cores
+
+    parent = os.getpid()
+
+    def job(i, fail_in_child=False):
+        def run():
+            if fail_in_child and os.getpid() != parent:
+                raise RuntimeError("the child's drawing failed")
+            (tmp_path / f"{i}.png").write_text(str(os.getpid()))
+        return run
+
+    draw_figures([job(i) for i in range(6)])
+    writers = {(tmp_path / f"{i}.png").read_text() for i in range(6)}
+    assert len(writers) == (2 if hasattr(os, "fork") and cores() >= 2 else 1)  # both processes drew
+    for p in tmp_path.glob("*.png"):
+        p.unlink()
+    draw_figures([job(i, fail_in_child=True) for i in range(6)])
+    assert {(tmp_path / f"{i}.png").read_text() for i in range(6)} == {str(parent)}  # the parent redrew the child's half

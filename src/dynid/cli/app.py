@@ -114,10 +114,6 @@ def run(
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
             excitation=excitation, methods=parse_methods(methods), bootstrap=bootstrap)
-        if figures:
-            from ..report.figures import warm_up_in_background
-
-            warm_up_in_background()  # matplotlib's import and fonts, while the estimators run
         with rep.progress("dynid run") as progress:
             result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
                 LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))

@@ -16,31 +16,6 @@ def _thin(t, *series):
     return (np.asarray(t)[::step],) + tuple(np.asarray(x)[::step] for x in series)
 
 
-def warm_up() -> None:
-    """Import matplotlib and load its fonts (about 1 s): run in a background thread while a command computes,
-    so that its figures start at once. Draws nothing anywhere."""
-    import io
-
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(1, 1))
-    ax = fig.subplots()
-    ax.plot([0, 1], [0, 1], label="x")
-    ax.set_yscale("log")
-    ax.set_title("warm-up")
-    ax.legend()
-    fig.savefig(io.BytesIO(), format="png", dpi=20)
-
-
-def warm_up_in_background():
-    """Start :func:`warm_up` in a daemon thread and return it (join it before drawing)."""
-    import threading
-
-    thread = threading.Thread(target=warm_up, name="matplotlib warm-up", daemon=True)
-    thread.start()
-    return thread
-
-
 def fixed_layout(fig, left=0.85, right=0.25, top=0.45, bottom=0.55, hspace=0.35) -> None:
     """Margins in inches, whatever the figure's size: matplotlib's automatic (constrained) layout measures
     every tick label and costs more than drawing the figure (0.2 s each, most of dynid run's figures)."""
@@ -240,6 +215,48 @@ def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measure
     np.atleast_1d(axes)[0].legend(loc="upper right", fontsize="small")
     np.atleast_1d(axes)[-1].set_xlabel("t [s]")
     return axes
+
+
+class TorqueFigure:
+    """Measured against predicted torques of several datasets, drawn one after the other on the same figure:
+    its axes, ticks and lines are built once and only their data change (building them costs more than
+    drawing; ``dynid identify`` draws one figure per validation log). Same content as
+    :func:`plot_torque_comparison`.
+
+    Parameters
+    ----------
+    n_dof : int
+    labels : sequence of str
+        The predicted parameter sets, in the order of the ``predicted`` dicts given to :meth:`draw`.
+    """
+
+    def __init__(self, n_dof: int, labels):
+        from matplotlib.figure import Figure
+
+        self.labels = list(labels)
+        self.fig = Figure(figsize=(9, 2.4 * n_dof))
+        self.axes = self.fig.subplots(n_dof, 1, sharex=True, squeeze=False)[:, 0]
+        self.fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n_dof), bottom=0.5 / (2.4 * n_dof), hspace=0.3)
+        self.lines = []
+        for j, a in enumerate(self.axes):
+            row = [a.plot([], [], color="black", lw=1.0, label="measured")[0]]
+            row += [a.plot([], [], lw=1.0, ls="--", label=label)[0] for label in self.labels]
+            self.lines.append(row)
+            a.set_ylabel(f"τ{j + 1} [N·m]")
+            a.grid(alpha=0.3)
+        self.axes[0].legend(loc="upper right", fontsize="small")
+        self.axes[-1].set_xlabel("t [s]")
+
+    def draw(self, t, measured, predicted: dict, title: str):
+        """The figure with this dataset's curves (``predicted``: label -> (N, n_dof)); returns the Figure."""
+        t, measured, *preds = _thin(t, measured, *(predicted[k] for k in self.labels))
+        for j, (a, row) in enumerate(zip(self.axes, self.lines)):
+            for line, y in zip(row, [measured] + preds):
+                line.set_data(t, y[:, j])
+            a.relim()
+            a.autoscale_view()
+        self.axes[0].set_title(title)
+        return self.fig
 
 
 def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation trajectory and its limits"):

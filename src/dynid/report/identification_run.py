@@ -6,27 +6,32 @@ import re
 from pathlib import Path
 
 from ..experiment.identification import IdentificationResult
-from ..validation.torques import TorqueComparison
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, write_results, staged
+from .output import draw_figures, output_folder, save_figure, write_results, staged
 
 
 def _slug(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_").lower() or "dataset"
 
 
-def _torque_figure(cmp: TorqueComparison, path: Path, title: str) -> None:
-    save_figure(figures.plot_torque_comparison(cmp.t, cmp.measured, cmp.predicted, title=title), path)
+def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=None) -> list[Path]:
+    """One PNG per dataset (default name ``{prefix}_{dataset}.png``): measured vs predicted torques of every
+    parameter set, drawn on one figure that is redrawn for each dataset."""
+    paths, jobs, cache = [], [], {}
 
+    def job(cmp, path, title):
+        key = (cmp.measured.shape[1], tuple(cmp.predicted))
+        if key not in cache:  # one figure per process and layout, redrawn for each dataset
+            cache[key] = figures.TorqueFigure(*key)
+        save_figure(cache[key].draw(cmp.t, cmp.measured, cmp.predicted, title), path)
 
-def save_comparisons(comparisons, out: Path, prefix: str = "validation") -> list[Path]:
-    """One PNG per dataset: measured vs predicted torques of every parameter set."""
-    paths = []
-    for cmp in comparisons:
-        path = out / f"{prefix}_{_slug(cmp.name)}.png"
-        _torque_figure(cmp, path, f"{prefix} — {cmp.name}: measured vs predicted torques")
+    for i, cmp in enumerate(comparisons):
+        kind = prefix if names is None else names[i][0]
+        path = out / (f"{prefix}_{_slug(cmp.name)}.png" if names is None else names[i][1])
+        jobs.append(lambda c=cmp, p=path, k=kind: job(c, p, f"{k} — {c.name}: measured vs predicted torques"))
         paths.append(path)
+    draw_figures(jobs)
     return paths
 
 
@@ -44,9 +49,9 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     out = output_folder(out)
     paths = []
     if figures_too:
-        paths = [out / "identification_fit.png"]
-        _torque_figure(result.fit, paths[0], f"identification — {result.fit.name}: measured vs predicted torques")
-        paths += save_comparisons(result.validations, out)
+        names = [("identification", "identification_fit.png")] + [
+            ("validation", f"validation_{_slug(v.name)}.png") for v in result.validations]
+        paths = save_comparisons((result.fit, *result.validations), out, names=names)
     json_path = out / "results.json"
     data = result.to_dict()
     write_results(json_path, data, "identify")

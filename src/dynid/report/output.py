@@ -106,6 +106,42 @@ def output_folder(out: str | Path) -> Path:
     return out
 
 
+def draw_figures(jobs) -> None:
+    """Run figure jobs (callables without arguments, each writing its own file) on two processes where the
+    machine has two cores and the system can fork: a forked child draws every other job while this process
+    draws the rest (drawing is single-threaded Python; a fork shares the imported matplotlib and the data).
+    If the child fails, this process draws its jobs too, so every file is written or an error is raised.
+    """
+    from ..threads import cores
+
+    jobs = list(jobs)
+    if len(jobs) < 4 or cores() < 2 or not hasattr(os, "fork"):
+        for job in jobs:
+            job()
+        return
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:  # the child: its half, then leave at once (no atexit handlers, no buffers of the parent)
+        code = 0
+        try:
+            for job in jobs[1::2]:
+                job()
+        except BaseException:  # noqa: BLE001 - reported through the exit code; the parent redraws
+            code = 1
+        os._exit(code)
+    try:
+        for job in jobs[0::2]:
+            job()
+    finally:
+        _, status = os.waitpid(pid, 0)
+    if os.waitstatus_to_exitcode(status) != 0:
+        for job in jobs[1::2]:
+            job()
+
+
 def save_figure(fig_or_axes, path: Path) -> None:
     """Write the figure of ``fig_or_axes`` (a Figure, an Axes or an array of Axes) as PNG, atomically."""
     import matplotlib.pyplot as plt

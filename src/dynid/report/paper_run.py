@@ -11,7 +11,7 @@ from ..estimators.names import BOX_SEARCHES, LABELS
 from ..experiment.paper import PaperRunResult
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, write_results, staged
+from .output import draw_figures, output_folder, save_figure, write_results, staged
 
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",
@@ -70,11 +70,8 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
             {label: (np.linspace(m.n_evaluations / len(m.history), m.n_evaluations, len(m.history)), m.history)
              for label, m in searches.items()},
             reference=references, xlabel="evaluations of eq. 9", title="Box searches on eq. 9 (LAD: the exact minimum in the box)")
-    paths = []
-    for name in FIGURES if figures_too else ():
-        if name in figs:
-            paths.append(out / name)
-            save_figure(figs[name](), paths[-1])
+    paths = [out / name for name in FIGURES if figures_too and name in figs]
+    draw_figures([lambda p=p: save_figure(figs[p.name](), p) for p in paths])
     json_path = out / "results.json"
     data = result.to_dict()
     write_results(json_path, data, "run")
