@@ -254,9 +254,9 @@ class MonteCarloResult:
         out = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(self.names)} base parameters, "
                     f"{cfg.realisations} realisations × {len(cfg.noise_levels)} noise levels, {cfg.duration:g} s at {cfg.rate:g} Hz; "
                     f"ran on {self.cluster} in {self.timings.get('total', float('nan')):.1f} s", "title"),
-               TextTable("Spread (σ) and bias (b) of the base parameters against the Cramér–Rao bound (CRB: raw-torque Gaussian "
-                         "noise), median and worst over the parameters; RMSE/|β| median %; failed fits; median s per fit",
-                         ("noise A", "method", "σ/√CRB med", "σ/√CRB max", "|b|/√CRB med", "|b|/√CRB max", "RMSE %", "fails", "s/fit"),
+               TextTable("Spread σ and bias |b| of the base parameters in units of √CRB (Cramér–Rao bound, raw-torque Gaussian "
+                         "noise): median and worst over the parameters; median RMSE/|β| %; failed fits; median s per fit",
+                         ("noise A", "method", "σ med", "σ max", "|b| med", "|b| max", "RMSE %", "fails", "s/fit"),
                          tuple(rows), labels=2, section_ends=frozenset(ends))]
         if self.errors:
             out.append(Line(f"{len(self.errors)} fits failed; the first: {self.errors[0]['error']}", "warning"))
