@@ -24,7 +24,6 @@ from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
-from scipy.optimize import minimize
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
@@ -472,6 +471,8 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
     lay = _Layout(problem, problem.design_grid())
     eq = _rest_equalities(lay) if problem.rest else None
     solvers = {}
+
+    from scipy.optimize import minimize  # here: checking a config or computing cond(W_base) needs no optimiser
 
     def solver(safety: float):
         """Objective and constraints with the limits tightened by ``safety`` (built once per value)."""
