@@ -65,8 +65,9 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
 
     Parameters
     ----------
-    block : callable ``(start, stop) -> (stop - start, ...) array``
-        Computes samples ``start .. stop-1`` of the signal.
+    block : callable ``(start, stop) -> (stop - start, ...) array``, or a tuple of such arrays
+        Computes samples ``start .. stop-1`` of the signal (a tuple: several signals filtered alike, without
+        first copying them into one array).
     n_samples : int
     rate : float [Hz]
     factor : int
@@ -83,7 +84,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     ------
     index : (M,) int array
         Indices of the kept samples in the original signal.
-    values : (M, ...) array
+    values : (M, ...) array, or a tuple of them
         Filtered signal at those samples.
     """
     if factor < 1:
@@ -107,9 +108,14 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
         values = block(lo, hi)
         index = np.arange(start, stop)
         index = index[index % factor == 0]
-        flat = values.reshape(values.shape[0], -1)
-        out = np.empty((index.size, flat.shape[1]))
         padlen = min(3 * (2 * len(sos) + 1), hi - lo - 1)
-        for c in range(0, flat.shape[1], COLUMN_BLOCK):  # column blocks: the filter's copies stay small
-            out[:, c:c + COLUMN_BLOCK] = signal.sosfiltfilt(sos, flat[:, c:c + COLUMN_BLOCK], axis=0, padlen=padlen)[index - lo]
-        yield index, out.reshape((index.size,) + values.shape[1:])
+
+        def filtered(v):
+            flat = v.reshape(v.shape[0], -1)
+            out = np.empty((index.size, flat.shape[1]))
+            for c in range(0, flat.shape[1], COLUMN_BLOCK):  # column blocks: the filter's copies stay small
+                out[:, c:c + COLUMN_BLOCK] = signal.sosfiltfilt(sos, flat[:, c:c + COLUMN_BLOCK], axis=0, padlen=padlen)[index - lo]
+            return out.reshape((index.size,) + v.shape[1:])
+
+        yield index, (tuple(filtered(v) for v in values) if isinstance(values, tuple) else filtered(values))
+        del values

@@ -126,20 +126,17 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         Rows fast enough for the estimation (``|dq_j| >= min_speed_j``).
     """
     n = robot.n_dof
-    nb = robot.n_params if standard else base.n_base
     s = data.settings
     vmin = _min_speed(s, n)
     n_s = data.t.shape[0]
 
-    def block(a, b):
+    def block(a, b):  # the regressor and the torques, filtered alike but never copied into one array
         y = regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b])
-        y = y if standard else base.base_observation(y)
-        return np.concatenate([y.reshape(b - a, n * nb), data.tau[a:b]], axis=1)
+        return (y if standard else base.base_observation(y)), data.tau[a:b]
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
-    for index, values in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):
-        y = values[:, : n * nb].reshape(-1, n, nb)
+    for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):
         keep = np.abs(data.dq[index]) >= vmin
         if progress is not None:
             progress(int(index[-1]) + 1, n_s)
-        yield index, y, values[:, n * nb:].copy(), keep  # a copy: a view would keep the whole block alive
+        yield index, y, tau, keep
