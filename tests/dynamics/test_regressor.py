@@ -79,3 +79,18 @@ def test_bad_shapes_are_rejected(rng):
     q[3, 2] = np.nan
     with pytest.raises(ShapeError, match="sample 3"):
         regressor(robot, q, q, q)
+
+
+@pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])
+def test_selected_columns_are_the_same_numbers_as_the_full_regressor(name):
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.model.description import load_robot as _load
+
+    robot = _load(name)
+    rng = np.random.default_rng(3)
+    q, dq, ddq = (rng.uniform(-2, 2, (300, robot.n_dof)) for _ in range(3))
+    full = regressor(robot, q, dq, ddq)
+    cols = base_parameters(robot, rng=0).independent
+    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, cols), full[..., cols])
+    some = np.array([robot.n_params - 1, 3, 0])  # any order, drive and coupled columns included
+    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, some), full[..., some])

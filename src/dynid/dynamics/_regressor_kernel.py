@@ -11,17 +11,24 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+@nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True, inline="always")
+def _put(out, k, i, colmap, col, value):
+    """``out[k, i, colmap[col]] = value`` for a kept column (``colmap[col] >= 0``)."""
+    c = colmap[col]
+    if c >= 0:
+        out[k, i, c] = value
+
+
 @nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True)
-def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, r0, o, w, dw, acc, z0, rl):
+def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, r0, o, w, dw, acc, z0, rl):
     n = q.shape[1]
+    m = out.shape[2]
     for k in range(start, stop):
-        # ---- zero entries that stay zero: links j < i, and every drive column (filled by the caller
-        #      from the friction table, dynid.friction) -----
+        # ---- zero every entry first: links j < i stay zero, and the drive columns are filled by the caller
+        #      from the friction table (dynid.friction) -----
         for i in range(n):
-            for col in range(i * npj):
-                out[k, i, col] = 0.0
-            for col in range(i * npj + 10, n * npj):
-                out[k, i, col] = 0.0
+            for c in range(m):
+                out[k, i, c] = 0.0
         # ---- forward recursion -------------------------------------------------------------
         for j in range(n):
             ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
@@ -106,24 +113,24 @@ def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, r0, o, w, d
                 ux = zy * wz - zz * wy
                 uy = zz * wx - zx * wz
                 uz = zx * wy - zy * wx
-                out[k, i, col + 0] = zx * ex + ux * wx
-                out[k, i, col + 1] = zx * ey + zy * ex + ux * wy + uy * wx
-                out[k, i, col + 2] = zx * ez + zz * ex + ux * wz + uz * wx
-                out[k, i, col + 3] = zy * ey + uy * wy
-                out[k, i, col + 4] = zy * ez + zz * ey + uy * wz + uz * wy
-                out[k, i, col + 5] = zz * ez + uz * wz
+                _put(out, k, i, colmap, col + 0, zx * ex + ux * wx)
+                _put(out, k, i, colmap, col + 1, zx * ey + zy * ex + ux * wy + uy * wx)
+                _put(out, k, i, colmap, col + 2, zx * ez + zz * ex + ux * wz + uz * wx)
+                _put(out, k, i, colmap, col + 3, zy * ey + uy * wy)
+                _put(out, k, i, colmap, col + 4, zy * ez + zz * ey + uy * wz + uz * wy)
+                _put(out, k, i, colmap, col + 5, zz * ez + uz * wz)
                 lw = lx * wx + ly * wy + lz * wz
-                out[k, i, col + 6] = (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy)
-                out[k, i, col + 7] = (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz)
-                out[k, i, col + 8] = (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx)
-                out[k, i, col + 9] = lx * gx + ly * gy + lz * gz
+                _put(out, k, i, colmap, col + 6, (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy))
+                _put(out, k, i, colmap, col + 7, (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz))
+                _put(out, k, i, colmap, col + 8, (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx))
+                _put(out, k, i, colmap, col + 9, lx * gx + ly * gy + lz * gz)
 
 
 @nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True)
-def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop):
+def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop):
     """Samples ``start:stop`` with their own scratch arrays (releases the GIL: threads run ranges side by side)."""
     n = q.shape[1]
-    _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+    _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
            np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((3, 3)))
 
 
@@ -131,20 +138,21 @@ PARALLEL_SAMPLES = 4096
 """From this many samples on, the samples are split over the cores (threads); below, one call."""
 
 
-def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj):
-    """Fill every entry of ``out`` (N, n, n*npj): the ten inertial columns of each link, and 0 in the
-    drive columns (the caller fills those from :mod:`dynid.friction`). Every sample is computed on its own,
-    so the result does not depend on how the samples are split over threads."""
+def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
+    """Fill every entry of ``out`` (N, n, m): column ``colmap[c]`` holds standard column ``c`` (the ten
+    inertial columns of each link; skipped where ``colmap[c] < 0``), the drive columns hold 0 (the caller
+    fills them from :mod:`dynid.friction`). Every sample is computed on its own, so the result does not
+    depend on how the samples are split over threads."""
     from ..threads import cores
 
     n_s = q.shape[0]
     workers = min(cores(), max(1, n_s // PARALLEL_SAMPLES))
     if workers == 1:
-        _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, 0, n_s)
+        _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, 0, n_s)
         return
     from concurrent.futures import ThreadPoolExecutor
 
     bounds = np.linspace(0, n_s, workers + 1).astype(np.int64)
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        list(pool.map(lambda k: _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, int(bounds[k]), int(bounds[k + 1])),
+        list(pool.map(lambda k: _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, int(bounds[k]), int(bounds[k + 1])),
                       range(workers)))

@@ -21,7 +21,7 @@ from ..friction import drive_columns
 from ._regressor_kernel import joint_torque_regressor
 
 
-def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
+def regressor(robot: Robot, q, dq, ddq, columns=None) -> np.ndarray:
     """Per-sample joint-torque regressor.
 
     Parameters
@@ -29,10 +29,13 @@ def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
     robot : Robot
     q, dq, ddq : (N, n_dof) arrays
         Joint positions [rad], velocities [rad/s], accelerations [rad/s²].
+    columns : (m,) int array, optional
+        Only these columns, in this order (e.g. the base parameters' independent columns): the same
+        values as ``regressor(...)[..., columns]`` without computing the full array and copying it.
 
     Returns
     -------
-    Y : (N, n_dof, n_params) array
+    Y : (N, n_dof, n_params) array, or (N, n_dof, m) with ``columns``
         ``Y[k] @ phi`` is the joint torque vector [N·m] of sample ``k``; columns follow
         ``robot.parameter_names``.
 
@@ -43,8 +46,11 @@ def regressor(robot: Robot, q, dq, ddq) -> np.ndarray:
     """
     n = robot.n_dof
     q, dq, ddq, n_s = check_states(q, dq, ddq, n)
-    out = np.empty((n_s, n, robot.n_params))
-    _fill(robot, q, dq, ddq, out)
+    colmap = np.full(robot.n_params, -1, dtype=np.int64)
+    columns = np.arange(robot.n_params) if columns is None else np.asarray(columns, dtype=np.int64)
+    colmap[columns] = np.arange(columns.size)
+    out = np.empty((n_s, n, columns.size))
+    _fill(robot, q, dq, ddq, out, colmap)
     return out
 
 
@@ -54,20 +60,25 @@ def observation_matrix(robot: Robot, q, dq, ddq) -> np.ndarray:
     return y.reshape(-1, y.shape[2])
 
 
-def _fill(robot: Robot, q, dq, ddq, out) -> None:
+def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
     rp = np.ascontiguousarray([jt.rotation for jt in robot.joints], dtype=np.float64)
     pp = np.ascontiguousarray([jt.translation for jt in robot.joints], dtype=np.float64)
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     npj = robot.n_params_per_joint
-    joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj)
+    joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap)
     if robot.drive_terms:  # each joint's own drive terms, from the friction table
         cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
         for i in range(robot.n_dof):
-            out[:, i, i * npj + 10:(i + 1) * npj] = cols[:, i]
+            src = np.arange(i * npj + 10, (i + 1) * npj)
+            kept = colmap[src] >= 0
+            out[:, i, colmap[src[kept]]] = cols[:, i][:, kept]
     n_joint = robot.n_dof * npj
-    if out.shape[2] > n_joint:  # coupled motors (see dynid.model.transmission)
-        out[:, :, n_joint:] = robot.transmission.coupling_columns(dq, ddq)
+    if robot.n_params > n_joint:  # coupled motors (see dynid.model.transmission)
+        src = np.arange(n_joint, robot.n_params)
+        kept = colmap[src] >= 0
+        if kept.any():
+            out[:, :, colmap[src[kept]]] = robot.transmission.coupling_columns(dq, ddq)[:, :, kept]
 
 
 def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None,

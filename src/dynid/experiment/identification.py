@@ -26,7 +26,7 @@ from ..model.robot import Robot
 from ..estimators.names import LEAST_SQUARES as METHODS
 from ..preprocessing.pipeline import PreparedData, base_chunks
 from ..tables import Line, TextTable, render_text
-from ..validation.torques import TorqueComparison, compare_torques, comparison_table
+from ..validation.torques import TorqueComparison, TorqueSums, comparison_table
 
 __all__ = ["IdentificationResult", "identify"]
 
@@ -291,7 +291,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     consistency margin.
 
     ``progress(step, done, total)`` reports each step (the regressor pass chunk by chunk, the SDP, each other
-    estimator, the predicted torques).
+    estimator, the consistency checks).
 
     ``methods`` adds estimators of :mod:`dynid.estimators.registry` other than OLS/WLS/SDP (IRLS, LAD, ABC,
     ABC×10, DE, PSO) on the same parallel-filtered rows, stacked in memory (rows below ``min_speed`` set
@@ -313,11 +313,14 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     acc_std = LeastSquaresAccumulator(robot.n_params, n) if physically_consistent else None
     extra = tuple(k for k in methods if k not in (method, "sdp"))
     stacked_w, stacked_tau = [], []
-    for _, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
+    # the fit's metrics accumulate on the same pass (TorqueSums): no second pass over the log
+    sums = TorqueSums(n, base.n_base, len(range(0, data.t.shape[0], data.settings.decimation)))
+    for index, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
             y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
+        sums.add(data.t[index], y, tau)
         if extra:
             k = keep.reshape(-1)
             stacked_w.append(y.reshape(-1, base.n_base) * k[:, None])
@@ -359,7 +362,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
         except DynIdError as exc:  # a failed check never stops the identification
             margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
-    fit = compare_torques(robot, base, data, sets, _step(progress, f"predicted torques, {data.name}"))
+    fit = sums.comparison(data.name, sets)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,

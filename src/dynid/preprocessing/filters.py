@@ -112,9 +112,13 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
 
         def filtered(v):
             flat = v.reshape(v.shape[0], -1)
-            out = np.empty((index.size, flat.shape[1]))
-            for c in range(0, flat.shape[1], COLUMN_BLOCK):  # column blocks: the filter's copies stay small
-                out[:, c:c + COLUMN_BLOCK] = signal.sosfiltfilt(sos, flat[:, c:c + COLUMN_BLOCK], axis=0, padlen=padlen)[index - lo]
+            out = np.zeros((index.size, flat.shape[1]))
+            # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a
+            # regressor has many (joint i does not see the links before it), so only the others are filtered.
+            live = np.flatnonzero(np.any(flat != 0.0, axis=0))
+            for c in range(0, live.size, COLUMN_BLOCK):  # column blocks: the filter's copies stay small
+                cols = live[c:c + COLUMN_BLOCK]
+                out[:, cols] = signal.sosfiltfilt(sos, flat[:, cols], axis=0, padlen=padlen)[index - lo]
             return out.reshape((index.size,) + v.shape[1:])
 
         yield index, (tuple(filtered(v) for v in values) if isinstance(values, tuple) else filtered(values))

@@ -131,8 +131,8 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
     n_s = data.t.shape[0]
 
     def block(a, b):  # the regressor and the torques, filtered alike but never copied into one array
-        y = regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b])
-        return (y if standard else base.base_observation(y)), data.tau[a:b]
+        columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
+        return regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b], columns), data.tau[a:b]
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):

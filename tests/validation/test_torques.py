@@ -1,0 +1,28 @@
+"""Fit metrics from accumulated sums equal those of the stored torques (one pass over a log instead of two)."""
+
+import numpy as np
+
+from dynid.validation.torques import TorqueComparison, TorqueSums
+
+
+def test_metrics_from_sums_equal_metrics_from_the_samples():
+    rng = np.random.default_rng(0)
+    m, n, p = 7_000, 3, 5
+    y = rng.standard_normal((m, n, p))
+    beta = rng.standard_normal(p)
+    tau = y @ beta + 0.3 * rng.standard_normal((m, n)) + np.array([50.0, -2.0, 0.0])  # offsets: centring matters
+    t = np.arange(m) * 0.01
+    sets = {"a": beta, "b": beta + 0.1 * rng.standard_normal(p)}
+    sums = TorqueSums(n, p, m, max_points=2500)
+    for a in range(0, m, 1234):  # in chunks, as the regressor pass gives them
+        sums.add(t[a:a + 1234], y[a:a + 1234], tau[a:a + 1234])
+    got = sums.comparison("x", sets)
+    full = TorqueComparison("x", t, tau, {k: y @ b for k, b in sets.items()})
+    for label in sets:
+        for key, value in full.metrics()[label].items():
+            np.testing.assert_allclose(got.metrics()[label][key], value, rtol=1e-9)
+    assert got.n_samples == m and np.allclose(got.rms_torque, full.rms_torque)
+    step = -(-m // 2500)  # the figure's thinning: the same points as thinning all samples
+    np.testing.assert_array_equal(got.t, t[::step])
+    np.testing.assert_allclose(got.predicted["b"], (y @ sets["b"])[::step])
+    assert got.to_dict()["n_samples"] == m
