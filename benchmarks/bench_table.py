@@ -80,6 +80,16 @@ def main() -> None:
         row("dynid identify configs/tx40-full.toml: time", t, "s", 4.0)
         row("  peak memory", mb, "MB", 300.0)
 
+    # long logs, end to end from the CSV (benchmarks/long_log.py writes them once, ~1 min for the hour)
+    from long_log import long_log
+
+    short, long = long_log(6), long_log(60)
+    _, mb_short = command([dynid, "identify", str(short), "--out", str(out / "l6")])
+    t, mb_long = command([dynid, "identify", str(long), "--out", str(out / "l60")])
+    row("1 h of UR10e log at 1 kHz (700 MB CSV), dynid identify end to end", t, "s", 60.0)
+    row("  its peak memory against the 6-minute log's (flat: < 1.5)", mb_long / mb_short, "x", 1.5,
+        f"6 min {mb_short:.0f} MB, 1 h {mb_long:.0f} MB")
+
     # regressor: dynid's batched kernel against a loop over Pinocchio's computeJointTorqueRegressor
     import pinocchio as pin
 
