@@ -5,7 +5,6 @@ input refused cleanly"). The commands run in-process (typer's runner), which kee
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,7 @@ from typer.testing import CliRunner
 
 from dynid.cli.app import app
 
-from .refusals import PROGRESS
+from .refusals import check_refusal
 
 
 def invoke(*args):
@@ -22,18 +21,9 @@ def invoke(*args):
 
 
 def assert_refused(result, message, out: Path | None = None):
-    """Exit code 1, no traceback, exactly one ``error:`` line holding ``message``, nothing written to ``out``."""
-    assert result.exit_code == 1, (result.exit_code, result.stdout, result.stderr, result.exception)
-    assert isinstance(result.exception, SystemExit), repr(result.exception)  # a clean exit, not an escaped error
-    assert "Traceback" not in result.stdout + result.stderr
-    lines = [line for line in result.stderr.splitlines() if line.strip()]
-    errors = [line for line in lines if line.startswith("error: ")]
-    assert len(errors) == 1 and message in errors[0], lines
-    if os.environ.get("DYNID_SHOW_REFUSALS"):  # to read the corpus's messages: DYNID_SHOW_REFUSALS=1 pytest -s
-        print("\n" + errors[0])
-    assert all(PROGRESS.match(line) or line.startswith("warning: ") for line in lines if not line.startswith("error: ")), lines
-    if out is not None:
-        assert not out.exists(), f"{out} was written"
+    """A clean exit (not an escaped exception) and :func:`check_refusal`: one error line, nothing written."""
+    assert isinstance(result.exception, SystemExit), repr(result.exception)
+    check_refusal(result.exit_code, result.stdout, result.stderr, message, out)
 
 
 # --- a valid UR10e RTDE log (31 columns: t, q, qd, i, i_target, tau_target) and configs around it -----------
