@@ -118,7 +118,7 @@ def run(
             result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
                 LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
             progress.update("writing results" + (" and figures" if figures else ""))
-            paths = save_paper_run(result, out, figures)
+        paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(result.summary_blocks())
@@ -147,7 +147,7 @@ def identify(
             result = run_identification(cfg, progress=lambda step, done, total: progress.update(
                 step, f"{100 * done / max(total, 1):.0f} %"), validate=validate)
             progress.update("writing results" + (" and figures" if figures else ""))
-            paths = save_identification(result, out, figures, robot=cfg.robot)
+        paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(result.summary_blocks())
@@ -246,7 +246,8 @@ def validate(
         with rep.progress("dynid validate") as progress:
             comparisons, warnings = run_validation(cfg, identified, datasets, progress=lambda step, done, total: progress.update(
                 step, f"{100 * done / max(total, 1):.0f} %"))
-            paths = save_validation(comparisons, out, warnings)
+            progress.update("writing results and figures")
+        paths = save_validation(comparisons, out, warnings)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks([comparison_table(c) for c in comparisons])
@@ -280,7 +281,7 @@ def excite(
             run = run_excitation(cfg, callback=lambda i, n, c: progress.update(
                 f"design, start {min(i + 1, n)} of {n}", f"best cond = {c:.4g}"))
             progress.update("writing results and figures")
-            paths = save_excitation(run, out)
+        paths = save_excitation(run, out)
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(run.summary_blocks())
@@ -328,7 +329,7 @@ def montecarlo(
             result = run_montecarlo(cfg, scheduler=scheduler, workers=workers,
                                     progress=lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}"))
             progress.update("writing results and figures")
-            paths = save_montecarlo(result, out)
+        paths = save_montecarlo(result, out)
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(result.summary_blocks())

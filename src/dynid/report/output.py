@@ -111,6 +111,7 @@ def draw_figures(jobs) -> None:
     machine has two cores and the system can fork: a forked child draws every other job while this process
     draws the rest (drawing is single-threaded Python; a fork shares the imported matplotlib and the data).
     If the child fails, this process draws its jobs too, so every file is written or an error is raised.
+    Call it with no other thread of this process printing (the CLI ends its live progress line first).
     """
     from ..threads import cores
 
@@ -126,6 +127,8 @@ def draw_figures(jobs) -> None:
     pid = os.fork()
     if pid == 0:  # the child: its half, then leave at once (no atexit handlers, no buffers of the parent)
         code = 0
+        # fresh standard streams: a lock another thread of the parent held at the fork stays held in the child
+        sys.stdout = sys.stderr = open(os.devnull, "w")
         try:
             for job in jobs[1::2]:
                 job()
