@@ -4,14 +4,33 @@ import os
 import re
 import subprocess
 import sys
+from types import SimpleNamespace
 
 PROGRESS = re.compile(r"^dynid \w+: ")
 
 
-def dynid(*args, cwd=None, env=None, stdin=None):
-    """``dynid ARGS`` in a fresh process, output captured (a pipe: no terminal)."""
+def dynid_process(*args, cwd=None, env=None, stdin=None):
+    """``dynid ARGS`` in a fresh process, output captured (a pipe: no terminal). For what only a process shows:
+    what C++ libraries print on the process's standard error, signals, the console script itself."""
     return subprocess.run([sys.executable, "-m", "dynid", *args], capture_output=True, text=True, cwd=cwd, timeout=600,
                           env=None if env is None else {**os.environ, **env}, input=stdin)
+
+
+def dynid(*args, cwd=None, env=None, stdin=None):
+    """``dynid ARGS`` in this process (typer's runner), output captured as a pipe would: the same exit code,
+    standard output and standard error as :func:`dynid_process`, without starting Python and importing the
+    libraries again for every call. An exception that escapes a command is raised here."""
+    import contextlib
+
+    from typer.testing import CliRunner
+
+    from dynid.cli.app import app
+
+    with contextlib.chdir(cwd) if cwd is not None else contextlib.nullcontext():
+        result = CliRunner().invoke(app, [str(a) for a in args], env=env, input=stdin)
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        raise result.exception
+    return SimpleNamespace(returncode=result.exit_code, stdout=result.stdout, stderr=result.stderr)
 
 
 def snapshot(folder):

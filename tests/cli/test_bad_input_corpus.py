@@ -275,7 +275,7 @@ URDFS = {
 @pytest.mark.parametrize("case", sorted(URDFS))
 def test_bad_urdfs_in_a_real_process(tmp_path, case):
     """A separate process: urdfdom prints on the process's own standard error, which must stay clean."""
-    from .refusals import assert_refused as assert_refused_process, dynid
+    from .refusals import assert_refused as assert_refused_process, dynid_process
 
     change, message = URDFS[case]
     text = URDF
@@ -285,5 +285,5 @@ def test_bad_urdfs_in_a_real_process(tmp_path, case):
     (tmp_path / "r.urdf").write_text(text)
     (tmp_path / "r.toml").write_text('name = "r"\nconvention = "urdf"\nurdf = "r.urdf"\n[[joints]]\nname = "j1"\n[[joints]]\nname = "j2"\n')
     out = tmp_path / "o"
-    p = dynid("run", "--robot", str(tmp_path / "r.toml"), "--joints", "2", "--out", str(out), *RUN)
+    p = dynid_process("run", "--robot", str(tmp_path / "r.toml"), "--joints", "2", "--out", str(out), *RUN)
     assert_refused_process(p, message, out)
