@@ -15,8 +15,5 @@ dq, ddq = np.gradient(q, t, axis=0), np.gradient(np.gradient(q, t, axis=0), t, a
 tau = dynid.rnea_torques(robot, q, dq, ddq) + 2.0 * np.sign(dq) + 1.0 * dq + rng.normal(0, 0.05, q.shape)
 
 result = dynid.identify_from_arrays(robot, t, q, tau, method="ols")
-print(result.settings["preprocessing"]["derivation"])
-print(f"{result.base.n_base} base parameters, cond = {result.solution.condition_number:.1f}")
-for name, value, std in list(zip(result.base.names, result.solution.params, result.solution.params_std))[:8]:
-    print(f"  {name:8s} {value:10.4f} ± {std:.2g}")
+print(result.summary(width=100))  # what dynid identify prints: settings, base parameters with σ, fit per joint
 print("relative error per joint on the fit (%):", np.round(result.fit.metrics()["dynid OLS"]["relative_error"], 2))

@@ -24,7 +24,7 @@ def test_paper_experiment_example():
 
 def test_identify_from_arrays_example():
     out = _run("identify_from_arrays.py")
-    assert "excitation band" in out and "base parameters" in out
+    assert "excitation band" in out and "Base parameters" in out and "ρ (eq. 18)" in out  # result.summary()
 
 
 def test_export_and_simulate_example():

@@ -8,6 +8,7 @@ label columns, so that nothing is cut at 80 columns.
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass, field, replace
 
 __all__ = ["TextTable", "Line", "render_text"]
@@ -101,5 +102,5 @@ def render_text(blocks, width: int = 100) -> str:
         if isinstance(b, TextTable):
             out.append("\n" + b.render(width) + "\n")
         else:
-            out.append(("warning: " if b.kind == "warning" else "") + b.text)
+            out.append(textwrap.fill(("warning: " if b.kind == "warning" else "") + b.text, width, break_long_words=False))
     return "\n".join(out).strip("\n") + "\n"
