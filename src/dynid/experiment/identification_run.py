@@ -55,8 +55,8 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
     out, warnings = [], []
     settings = validation_settings(config.preprocessing, resolved)
     for spec in datasets:
-        if progress is not None:
-            progress(f"validation, reading {spec.name}", 0, 1)
+        if progress is not None:  # one step per log: reading, filtering and predicting it
+            progress(f"validation, {spec.name}", 0, 1)
         data = prepare(load_recording(spec, config.robot), settings)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
                                    None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t))))
