@@ -116,12 +116,12 @@ def draw_figures(jobs) -> None:
     from ..threads import cores
 
     jobs = list(jobs)
-    if len(jobs) < 4 or cores() < 2 or not hasattr(os, "fork"):
+    import sys
+
+    if len(jobs) < 4 or cores() < 2 or not sys.platform.startswith("linux"):  # fork with threads: Linux only
         for job in jobs:
             job()
         return
-    import sys
-
     sys.stdout.flush()
     sys.stderr.flush()
     pid = os.fork()
