@@ -26,3 +26,20 @@ def test_metrics_from_sums_equal_metrics_from_the_samples():
     np.testing.assert_array_equal(got.t, t[::step])
     np.testing.assert_allclose(got.predicted["b"], (y @ sets["b"])[::step])
     assert got.to_dict()["n_samples"] == m
+
+
+def test_metrics_from_sums_hold_for_a_log_at_rest():
+    """Almost constant rows and torques (a pose held): raw sums would cancel, the centred statistics do not."""
+    rng = np.random.default_rng(1)
+    m, n, p = 4_000, 2, 3
+    y = 100.0 + 1e-4 * rng.standard_normal((m, n, p))
+    beta = np.array([1.0, -0.5, 0.25])
+    tau = 75.0 + 1e-4 * rng.standard_normal((m, n))
+    t = np.arange(m) * 0.01
+    sums = TorqueSums(n, p, m)
+    for a in range(0, m, 1000):
+        sums.add(t[a:a + 1000], y[a:a + 1000], tau[a:a + 1000])
+    got = sums.comparison("rest", {"b": beta}).metrics()["b"]
+    full = TorqueComparison("rest", t, tau, {"b": y @ beta}).metrics()["b"]
+    for key, value in full.items():
+        np.testing.assert_allclose(got[key], value, rtol=1e-6, err_msg=key)

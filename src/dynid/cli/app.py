@@ -48,6 +48,11 @@ def _fail(exc: Exception, reporter: Reporter | None = None) -> None:
     raise typer.Exit(1)
 
 
+def _steps(progress):
+    """The library's ``progress(step, done, total)`` shown as the step and its percentage."""
+    return lambda step, done, total: progress.update(step, f"{100 * done / max(total, 1):.0f} %")
+
+
 def _check_out(out) -> None:
     """An unusable --out is refused before any computation."""
     from ..report.output import check_output_folder
@@ -144,8 +149,7 @@ def identify(
         _check_out(out)
         from ..report.identification_run import save_identification
         with rep.progress("dynid identify") as progress:
-            result = run_identification(cfg, progress=lambda step, done, total: progress.update(
-                step, f"{100 * done / max(total, 1):.0f} %"), validate=validate)
+            result = run_identification(cfg, progress=_steps(progress), validate=validate)
             progress.update("writing results" + (" and figures" if figures else ""))
         paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
     except DynIdError as exc:
@@ -229,7 +233,6 @@ def validate(
     from ..exceptions import DataError
     from ..experiment.identification_run import run_validation
     from ..io.identification_config import dataset_for_file, load_identification_config
-
     from ..validation.torques import comparison_table
 
     rep = Reporter(quiet)
@@ -244,8 +247,7 @@ def validate(
         elif rows is not None:
             raise DataError("--rows needs --file")
         with rep.progress("dynid validate") as progress:
-            comparisons, warnings = run_validation(cfg, identified, datasets, progress=lambda step, done, total: progress.update(
-                step, f"{100 * done / max(total, 1):.0f} %"))
+            comparisons, warnings = run_validation(cfg, identified, datasets, progress=_steps(progress))
             progress.update("writing results and figures")
         paths = save_validation(comparisons, out, warnings)  # after the live line ended
     except DynIdError as exc:

@@ -314,7 +314,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     extra = tuple(k for k in methods if k not in (method, "sdp"))
     stacked_w, stacked_tau = [], []
     # the fit's metrics accumulate on the same pass (TorqueSums): no second pass over the log
-    sums = TorqueSums(n, base.n_base, len(range(0, data.t.shape[0], data.settings.decimation)))
+    sums = TorqueSums.for_data(data, base.n_base)
     for index, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))

@@ -44,7 +44,10 @@ def config_robot(doc: dict, path: Path) -> Robot:
     ref = doc.get("robot")
     if not isinstance(ref, str):
         raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
-    if ref not in builtin_robots() and not ref.endswith(".toml"):
-        raise ConfigError(f"{path}: robot: unknown robot {ref!r}, expected a built-in robot ({', '.join(builtin_robots())}) "
-                          "or a description file (.toml; it may point to a URDF)")
-    return load_robot(ref if ref in builtin_robots() or Path(ref).is_absolute() else path.parent / ref)
+    local = path.parent / ref  # a description file, relative to the config (an absolute path stays as is)
+    if ref not in builtin_robots() and local.is_file():
+        return load_robot(local)
+    try:
+        return load_robot(ref)
+    except ConfigError as exc:  # an unknown name: said as the config wrote it, with the config and the field
+        raise ConfigError(f"{path}: robot: {exc}") from None

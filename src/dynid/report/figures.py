@@ -192,51 +192,47 @@ def plot_noise_level_study(levels, labels, std_ratios, bias_ratios, ax=None,
     return ax
 
 
+def _torque_axes(fig, n: int):
+    """``n`` stacked axes sharing x, with a fixed layout (the automatic one costs more than drawing)."""
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n), bottom=0.5 / (2.4 * n), hspace=0.3)
+    return axes
+
+
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):
     """Measured against predicted joint torques (paper Figs. 7 and 9). ``predicted`` maps a label to (N, n)."""
-    import matplotlib.pyplot as plt
+    if ax is None:
+        import matplotlib.pyplot as plt
 
-    n = measured.shape[1]
-    if ax is None:  # a fixed layout: the automatic one costs more than drawing (one figure per log)
-        fig = plt.figure(figsize=(9, 2.4 * n))
-        ax = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
-        fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n), bottom=0.5 / (2.4 * n), hspace=0.3)
-    axes = ax
-    labels = list(predicted)
-    t, measured, *preds = _thin(t, measured, *(predicted[k] for k in labels))
-    predicted = dict(zip(labels, preds))
-    for j, a in enumerate(np.atleast_1d(axes)):
-        a.plot(t, measured[:, j], color="black", lw=1.0, label="measured")
-        for label, p in predicted.items():
-            a.plot(t, p[:, j], lw=1.0, ls="--", label=label)
-        a.set_ylabel(f"τ{j + 1} [N·m]")
-        a.grid(alpha=0.3)
-    np.atleast_1d(axes)[0].set_title(title)
-    np.atleast_1d(axes)[0].legend(loc="upper right", fontsize="small")
-    np.atleast_1d(axes)[-1].set_xlabel("t [s]")
-    return axes
+        n = measured.shape[1]
+        ax = _torque_axes(plt.figure(figsize=(9, 2.4 * n)), n)
+    figure = TorqueFigure(measured.shape[1], list(predicted), axes=ax)
+    figure.draw(t, measured, predicted, title)
+    return figure.axes
 
 
 class TorqueFigure:
     """Measured against predicted torques of several datasets, drawn one after the other on the same figure:
     its axes, ticks and lines are built once and only their data change (building them costs more than
-    drawing; ``dynid identify`` draws one figure per validation log). Same content as
-    :func:`plot_torque_comparison`.
+    drawing; ``dynid identify`` draws one figure per validation log).
 
     Parameters
     ----------
     n_dof : int
     labels : sequence of str
         The predicted parameter sets, in the order of the ``predicted`` dicts given to :meth:`draw`.
+    axes : sequence of ``n_dof`` Axes, optional
+        Where to draw (default: a new figure, not managed by pyplot).
     """
 
-    def __init__(self, n_dof: int, labels):
-        from matplotlib.figure import Figure
+    def __init__(self, n_dof: int, labels, axes=None):
+        if axes is None:
+            from matplotlib.figure import Figure
 
+            axes = _torque_axes(Figure(figsize=(9, 2.4 * n_dof)), n_dof)
         self.labels = list(labels)
-        self.fig = Figure(figsize=(9, 2.4 * n_dof))
-        self.axes = self.fig.subplots(n_dof, 1, sharex=True, squeeze=False)[:, 0]
-        self.fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n_dof), bottom=0.5 / (2.4 * n_dof), hspace=0.3)
+        self.axes = np.atleast_1d(axes)
+        self.fig = self.axes[0].figure
         self.lines = []
         for j, a in enumerate(self.axes):
             row = [a.plot([], [], color="black", lw=1.0, label="measured")[0]]

@@ -59,11 +59,15 @@ class TorqueComparison:
 
 
 class TorqueSums:
-    """Per-joint sums of a dataset's decimated regressor rows and torques, from which the metrics of any
-    parameter vector follow exactly (to round-off) without a second pass over the log: with the joint's
-    rows ``Y``, torques ``τ`` and prediction ``Yβ``, ``‖τ - Yβ‖² = τ·τ - 2β·Yᵀτ + β·YᵀYβ``, and the sums of
-    eq. 18 are ``β·Yᵀτ``, ``β·YᵀYβ``, ``Σ Y β`` and ``Σ τ``. Memory: n_dof Gram matrices, whatever the
-    log's length, plus the rows a figure draws (every ``thin``-th).
+    """Per-joint statistics of a dataset's decimated regressor rows and torques, from which the metrics of any
+    parameter vector follow without a second pass over the log.
+
+    Per joint it keeps the mean of ``z = (Y, τ)`` and its centred Gram matrix ``Σ (z - z̄)(z - z̄)ᵀ``, merged
+    chunk by chunk with Chan, Golub & LeVeque's update (Am. Stat. 37(3), 1983), which stays accurate where
+    raw sums would cancel (a log at rest: an almost constant prediction). With ``p = Yβ``: the centred sums of
+    eq. 18 are ``βᵀS_YYβ``, ``βᵀS_Yτ`` and ``S_ττ``; ``‖τ - p‖² = S_ττ - 2βᵀS_Yτ + βᵀS_YYβ + N (τ̄ - Ȳβ)²``.
+    Memory: n_dof matrices of (n_columns + 1)², whatever the log's length, plus the rows a figure draws
+    (every ``thin``-th).
 
     Parameters
     ----------
@@ -75,46 +79,51 @@ class TorqueSums:
     """
 
     def __init__(self, n_dof: int, n_columns: int, n_rows: int, max_points: int = 2500):
-        self.gram = np.zeros((n_dof, n_columns, n_columns))
-        self.cross = np.zeros((n_dof, n_columns))
-        self.col_sum = np.zeros((n_dof, n_columns))
-        self.tau_sq = np.zeros(n_dof)
-        self.tau_sum = np.zeros(n_dof)
+        self.mean = np.zeros((n_dof, n_columns + 1))
+        self.m2 = np.zeros((n_dof, n_columns + 1, n_columns + 1))
         self.count = 0
         self.thin = max(1, -(-n_rows // max_points))
         self.kept_t, self.kept_y, self.kept_tau = [], [], []
 
+    @classmethod
+    def for_data(cls, data: PreparedData, n_columns: int) -> "TorqueSums":
+        """Statistics for the decimated samples :func:`dynid.preprocessing.pipeline.base_chunks` gives of ``data``."""
+        return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation)))
+
     def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray) -> None:
         """Rows ``y`` (M, n_dof, n_columns), torques ``tau`` (M, n_dof) at times ``t`` (M,)."""
-        self.gram += np.einsum("mjc,mjd->jcd", y, y)
-        self.cross += np.einsum("mjc,mj->jc", y, tau)
-        self.col_sum += y.sum(axis=0)
-        self.tau_sq += (tau**2).sum(axis=0)
-        self.tau_sum += tau.sum(axis=0)
-        first = (-self.count) % self.thin  # rows count, count+1, …: keep those at multiples of thin
+        m = y.shape[0]
+        z = np.concatenate([y, tau[:, :, None]], axis=2)
+        mean = z.mean(axis=0)
+        zc = z - mean
+        m2 = np.einsum("mjc,mjd->jcd", zc, zc)
+        n = self.count
+        delta = mean - self.mean
+        self.mean += delta * (m / (n + m))
+        self.m2 += m2 + np.einsum("jc,jd->jcd", delta, delta) * (n * m / (n + m))
+        first = (-n) % self.thin  # rows n, n+1, …: keep those at multiples of thin
         self.kept_t.append(t[first::self.thin])
         self.kept_y.append(y[first::self.thin])
         self.kept_tau.append(tau[first::self.thin])
-        self.count += y.shape[0]
+        self.count = n + m
 
     def comparison(self, name: str, parameter_sets: dict) -> TorqueComparison:
-        """The dataset's :class:`TorqueComparison`: metrics from the sums, curves on the kept rows."""
+        """The dataset's :class:`TorqueComparison`: metrics from the statistics, curves on the kept rows."""
         n = self.count
+        s_yy, s_yt, s_tt = self.m2[:, :-1, :-1], self.m2[:, :-1, -1], self.m2[:, -1, -1]
+        y_mean, t_mean = self.mean[:, :-1], self.mean[:, -1]
+        tau_sq = s_tt + n * t_mean**2  # Σ τ²
         metrics = {}
         for label, beta in parameter_sets.items():
             b = np.asarray(beta, dtype=float)
-            pp = np.einsum("c,jcd,d->j", b, self.gram, b)  # Σ τ̂²
-            mp = self.cross @ b  # Σ τ τ̂
-            sse = np.maximum(self.tau_sq - 2 * mp + pp, 0.0)
-            p_sum = self.col_sum @ b
-            cov = mp - self.tau_sum * p_sum / n
-            var_m = self.tau_sq - self.tau_sum**2 / n
-            var_p = pp - p_sum**2 / n
-            metrics[label] = {"relative_error": 100.0 * np.sqrt(sse / self.tau_sq), "rmse": np.sqrt(sse / n),
-                              "correlation": cov / np.sqrt(var_m * var_p),
-                              "global_relative_error": float(100.0 * np.sqrt(sse.sum() / self.tau_sq.sum()))}
+            s_pp = np.einsum("c,jcd,d->j", b, s_yy, b)
+            s_pt = s_yt @ b
+            sse = np.maximum(s_tt - 2 * s_pt + s_pp, 0.0) + n * (t_mean - y_mean @ b) ** 2
+            metrics[label] = {"relative_error": 100.0 * np.sqrt(sse / tau_sq), "rmse": np.sqrt(sse / n),
+                              "correlation": s_pt / np.sqrt(s_tt * s_pp),
+                              "global_relative_error": float(100.0 * np.sqrt(sse.sum() / tau_sq.sum()))}
         y = np.concatenate(self.kept_y)
-        summary = {"metrics": metrics, "n_samples": n, "rms_torque": np.sqrt(self.tau_sq / n)}
+        summary = {"metrics": metrics, "n_samples": n, "rms_torque": np.sqrt(tau_sq / n)}
         return TorqueComparison(name, np.concatenate(self.kept_t), np.concatenate(self.kept_tau),
                                 {label: y @ np.asarray(beta, dtype=float) for label, beta in parameter_sets.items()}, summary)
 
@@ -122,7 +131,10 @@ class TorqueSums:
 def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
                     progress=None) -> TorqueComparison:
     """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
-    (n_base,)), on the same parallel-decimated samples as the estimation."""
+    (n_base,)), on the same parallel-decimated samples as the estimation. The parameter sets are known
+    before the pass, so the predictions are stored and the metrics computed from them directly (exact also
+    for a log at rest, where a prediction is almost constant); :class:`TorqueSums` serves the fit, whose
+    parameters come out of the same pass."""
     ts, meas, preds = [], [], {k: [] for k in parameter_sets}
     for index, y, tau, _ in base_chunks(robot, base, data, progress):
         ts.append(data.t[index])
