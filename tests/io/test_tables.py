@@ -45,3 +45,15 @@ def test_column_errors(tmp_path):
         read_table(p, ["a"])
     with pytest.raises(DataError, match="file not found"):
         read_table(tmp_path / "missing.csv", [1])
+
+
+def test_blocks_are_stacked_into_the_same_array_as_one_parse(tmp_path, monkeypatch):
+    """Blocks are copied into the result one by one and released (no second copy of a long log): the data
+    equal one ``np.loadtxt`` of the whole file, with the requested columns in the requested order."""
+    import dynid.io.tables as tables
+
+    monkeypatch.setattr(tables, "BLOCK", 7)
+    values = np.random.default_rng(0).normal(size=(50, 4)).round(6)
+    p = tmp_path / "log.csv"
+    np.savetxt(p, values, delimiter=",", fmt="%.6f")
+    np.testing.assert_array_equal(read_table(p, [3, 1, 4]).data, np.loadtxt(p, delimiter=",")[:, [2, 0, 3]])

@@ -55,3 +55,15 @@ def test_parallel_filter_without_decimation_equals_scipy(rng):
     np.testing.assert_allclose(values, whole, rtol=0, atol=1e-8 * np.abs(whole).max())
     with pytest.raises(ConfigError, match="aliases when decimating by 10"):
         list(parallel_decimation(lambda a, b: x[a:b], x.shape[0], rate, 10, cutoff=100.0))
+
+
+def test_band_computed_joint_by_joint_equals_the_whole_array_formula(rng):
+    """The spectrum is summed one joint at a time (temporaries one column long): the same energy as the
+    formula of the docstring on the whole (N, n_dof) array, so the same band."""
+    rate, n = 500.0, 20011
+    q = rng.normal(size=(n, 4)).cumsum(0) * 1e-3 + np.sin(np.linspace(0.0, 40.0, n))[:, None] * [1, 2, 3, 4]
+    x = (q - q[:1] - np.linspace(0.0, 1.0, n)[:, None] * (q[-1:] - q[:1])) * np.hanning(n)[:, None]
+    f = np.fft.rfftfreq(n, 1.0 / rate)
+    energy = ((f[:, None] ** 2) * np.abs(np.fft.rfft(x, axis=0)) ** 2).sum(axis=1)
+    expected = min(max(f[min(int(np.searchsorted(np.cumsum(energy) / energy.sum(), 0.99)), f.size - 1)], 2 * rate / n), rate / 2)
+    assert excitation_band(q, rate) == expected

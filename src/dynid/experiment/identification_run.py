@@ -96,6 +96,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         data = filters.data
     else:
         data = prepare(recording, config.preprocessing)
+    del recording  # the raw positions and velocities: only the filtered ones are used from here
     vs = config.preprocessing.coulomb_velocity
     if vs == "auto":
         step("Coulomb smoothing velocity (cross-validation)")

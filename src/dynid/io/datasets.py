@@ -357,9 +357,10 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
                 requests[s.file].append(c)
     tables = {}
     for path, cols in requests.items():
-        tb = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows)
-        tables[path] = (tb, cols)
-        warnings.extend(tb.warnings)
+        table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows)
+        tables[path] = (table, cols)
+        warnings.extend(table.warnings)
+    del table
     lengths = {p: tb.data.shape[0] for p, (tb, _) in tables.items()}
     n_s = min(lengths.values())
     if len(set(lengths.values())) > 1:
@@ -369,16 +370,20 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
 
     def get(s: SignalSpec) -> np.ndarray:
         tb, cols = tables[s.file]
-        return tb.data[:n_s, [cols.index(c) for c in s.columns]] * s.scale
+        x = tb.data[:n_s, [cols.index(c) for c in s.columns]]  # a copy of its own: scaled in place
+        if s.scale != 1.0:
+            x *= s.scale
+        return x
 
     if spec.time is not None:
         t = get(spec.time)[:, 0]
-        tb, _ = tables[spec.time.file]
-        where = lambda k: f"{spec.time.file}: line {tb.first_line + k}"  # noqa: E731 - sample k's place in the file
+        first_line = tables[spec.time.file][0].first_line
+        where = lambda k: f"{spec.time.file}: line {first_line + k}"  # noqa: E731 - sample k's place in the file
     else:
         t = np.arange(n_s) / spec.rate
         where = None
     raw = {kind: get(s) for kind, s in spec.signals.items()}
+    del tables  # the files' columns are in t and raw now: a long log is not held twice
     tau_kind = "currents" if "currents" in spec.signals else "torques"
     return _assemble(spec, robot, t, raw, where, spec.time is not None, str(spec.signals["positions"].file),
                      str(spec.signals[tau_kind].file), warnings)
@@ -424,12 +429,12 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         raw = {kind: np.column_stack([np.interp(grid, t, x[:, j]) for j in range(x.shape[1])]) for kind, x in raw.items()}
         t = grid
     tr = robot.transmission
-    if spec.side == "motor":
-        q = tr.joint_positions(raw["positions"])
-        dq = tr.joint_velocities(raw["velocities"]) if "velocities" in raw else None
+    if spec.side == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
+        q = tr.joint_positions(raw.pop("positions"))
+        dq = tr.joint_velocities(raw.pop("velocities")) if "velocities" in raw else None
     else:
-        q = raw["positions"] + tr.position_offset
-        dq = raw.get("velocities")
+        q = raw.pop("positions") + tr.position_offset
+        dq = raw.pop("velocities", None)
     if "currents" in raw:
         motor_or_joint = raw["currents"] * robot.drive_gains
     else:

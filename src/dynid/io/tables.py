@@ -157,8 +157,20 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         raise DataError(f"{path}: no data rows")
     if last is not None and data_row < last and not warnings:
         raise DataError(f"{path}: rows = {list(rows)} goes beyond the file's end: it has {data_row} data rows")
-    data = np.concatenate(blocks, axis=0)
-    return Table(data, int(first_line), tuple(warnings))
+    return Table(_stack(blocks), int(first_line), tuple(warnings))
+
+
+def _stack(blocks: list[np.ndarray]) -> np.ndarray:
+    """``np.concatenate(blocks)``, each block released once copied: the peak is the result and one block,
+    not twice the log (an hour at 1 kHz of 19 columns is 550 MB)."""
+    data = np.empty((sum(b.shape[0] for b in blocks), blocks[0].shape[1]))
+    start = 0
+    while blocks:
+        block = blocks.pop(0)
+        data[start:start + block.shape[0]] = block
+        start += block.shape[0]
+        del block
+    return data
 
 
 def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str) -> np.ndarray:

@@ -71,12 +71,16 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
         At least two frequency bins (``2·rate/N``), at most the Nyquist frequency.
     """
     q = np.asarray(q, dtype=float)
+    q = q.reshape(q.shape[0], -1)
     n = q.shape[0]
-    ramp = np.linspace(0.0, 1.0, n)[:, None]
-    x = q - q[:1] - ramp * (q[-1:] - q[:1])
-    x = x * np.hanning(n)[:, None]
+    ramp = np.linspace(0.0, 1.0, n)
+    window = np.hanning(n)
     f = np.fft.rfftfreq(n, 1.0 / rate)
-    energy = ((f[:, None] ** 2) * np.abs(np.fft.rfft(x, axis=0)) ** 2).sum(axis=1)
+    f2 = f**2
+    energy = np.zeros(f.size)
+    for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
+        x = (q[:, j] - q[0, j] - ramp * (q[-1, j] - q[0, j])) * window
+        energy += f2 * np.abs(np.fft.rfft(x)) ** 2
     total = energy.sum()
     if not total > 0:
         return float(rate / 2)

@@ -40,12 +40,23 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
     """
     _check_cutoff(rate, cutoff, "Butterworth filter")
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
-    return signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=0)
+    x = np.asarray(x, dtype=float)
+    flat = x.reshape(x.shape[0], -1)
+    out = np.empty(flat.shape)
+    for c in range(flat.shape[1]):  # one column at a time: the filter's padded copies are one column, not the log
+        out[:, c] = signal.sosfiltfilt(sos, flat[:, c])
+    return out.reshape(x.shape)
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
-    """Time derivative by central differences (one-sided at the ends), (N, ...)."""
-    return np.gradient(np.asarray(x, dtype=float), 1.0 / rate, axis=0)
+    """Time derivative by central differences (one-sided at the ends), (N, ...); one column at a time, so
+    the temporaries are one column long (the same numbers as ``np.gradient`` on the whole array)."""
+    x = np.asarray(x, dtype=float)
+    flat = x.reshape(x.shape[0], -1)
+    out = np.empty(flat.shape)
+    for c in range(flat.shape[1]):
+        out[:, c] = np.gradient(flat[:, c], 1.0 / rate)
+    return out.reshape(x.shape)
 
 
 COLUMN_BLOCK = 64

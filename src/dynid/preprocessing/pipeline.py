@@ -79,18 +79,20 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
         except ConfigError as exc:
             raise ConfigError(f"preprocessing.{what}_cutoff: {exc}") from None
 
+    ddq = None
     if s.fourier is not None:
         q, dq, ddq, _ = fourier_fit_derivatives(recording.t, recording.q, *s.fourier)
     else:
         q = lowpass(recording.q, s.position_cutoff, "position")
         dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
-        ddq = differentiate(dq, rate)
     tau = np.asarray(recording.tau, dtype=float)
-    if s.min_speed == "auto":
+    if s.min_speed == "auto":  # before the accelerations exist: its temporary square adds to a smaller peak
         vmin = MIN_SPEED_FRACTION * np.sqrt(np.mean(dq**2, axis=0))
         s = replace(s, min_speed=tuple(float(v) for v in vmin),
                     derivation=s.derivation + f"; rows slower than {100 * MIN_SPEED_FRACTION:g} % of the joint's RMS speed "
                     "left out of the estimation")
+    if ddq is None:
+        ddq = differentiate(dq, rate)
     t = recording.t
     cut = int(round(s.trim * rate))
     if cut:
