@@ -90,26 +90,11 @@ def main() -> None:
     row("  its peak memory against the 6-minute log's (flat: < 1.5)", mb_long / mb_short, "x", 1.5,
         f"6 min {mb_short:.0f} MB, 1 h {mb_long:.0f} MB")
 
-    # regressor: dynid's batched kernel against a loop over Pinocchio's computeJointTorqueRegressor
-    import pinocchio as pin
+    # regressor: dynid's batched kernel against a loop over Pinocchio's computeJointTorqueRegressor, both
+    # writing the full array (benchmarks/bench_regressor.py)
+    from bench_regressor import N as n, measure
 
-    from dynid.dynamics.regressor import regressor
-    from dynid.dynamics.rnea import pinocchio_model
-    from dynid.model.description import load_robot
-
-    robot = load_robot("er16")
-    rng = np.random.default_rng(0)
-    n = 25_000
-    q, dq, ddq = (rng.uniform(-2, 2, (n, 6)) for _ in range(3))
-    model = pinocchio_model(robot)
-    data = model.createData()
-
-    def loop():
-        for k in range(n):
-            pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k])
-
-    regressor(robot, q[:10], dq[:10], ddq[:10])
-    t_pin, t_dyn = best_of(loop, 3), best_of(lambda: regressor(robot, q, dq, ddq), 5)
+    t_pin, t_dyn = measure(repeats=3)
     row("regressor, er16, 25 000 samples: dynid vs Pinocchio loop (ratio)", t_pin / t_dyn, "x", 6.0,
         f"Pinocchio {1e6 * t_pin / n:.2f} µs/sample", smaller_is_better=False)
     row("  dynid per sample", 1e6 * t_dyn / n, "µs", 0.5)

@@ -14,3 +14,14 @@ def shifted_absolute_sum(r, column, delta, row_weights, out):
         out[i] = v
         s += row_weights[i] * abs(v)
     return s
+
+
+@nb.njit(cache=True, fastmath=False, nogil=True)
+def add_absolute_residual_sums(tau, predicted, row_weights, out):
+    """``out[k] += Σ_i row_weights[i]·|tau[i] - predicted[i, k]|`` for a block of rows ``i`` and a population
+    ``k``, in one pass over the block (rows in order, so the sums do not depend on how the rows are blocked)."""
+    for i in range(predicted.shape[0]):
+        t = tau[i]
+        wi = row_weights[i]
+        for k in range(predicted.shape[1]):
+            out[k] += wi * abs(t - predicted[i, k])

@@ -85,18 +85,20 @@ class LinearAbsoluteObjective:
         x = np.asarray(x, dtype=float)
         if x.ndim == 1:
             return paper_objective(self.tau - self.w @ x, self.n_dof, self.weights)
-        # A population (p, K): one pass over W in row blocks, residuals formed, made absolute and weighted in
-        # place, instead of an (M, K) residual matrix written and read again three times (DE, PSO).
+        # A population (p, K): one pass over W in row blocks; each block's predictions (BLAS) are turned into
+        # weighted absolute residuals and summed in one compiled pass while they are in cache, instead of an
+        # (M, K) residual matrix written and read again three times (DE, PSO).
+        from ._objective_kernel import add_absolute_residual_sums
+
         m, k = self.w.shape[0], x.shape[1]
+        x = np.ascontiguousarray(x)
         out = np.zeros(k)
         buf = np.empty((min(self.BLOCK, m), k))
         for start in range(0, m, self.BLOCK):
             stop = min(start + self.BLOCK, m)
             b = buf[:stop - start]
             np.matmul(self.w[start:stop], x, out=b)
-            np.subtract(self.tau[start:stop, None], b, out=b)
-            np.abs(b, out=b)
-            out += self.row_weights[start:stop] @ b
+            add_absolute_residual_sums(self.tau[start:stop], b, self.row_weights[start:stop], out)
         return out
 
     def start(self, x) -> tuple[float, np.ndarray]:
