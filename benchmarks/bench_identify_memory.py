@@ -41,7 +41,7 @@ def prepared(robot, minutes: float) -> PreparedData:
         dq += amp / (h + 1) * w * c
         ddq -= amp / (h + 1) * w * w * s
     tau = np.random.default_rng(0).normal(size=q.shape) * 0.1 + np.sin(q) * 10 + dq
-    settings = Preprocessing(decimation=DECIMATION, trim=0.0).resolved(RATE)
+    settings = Preprocessing(decimation=DECIMATION, trim=0.0, min_speed=0.0).resolved(RATE, q)
     return PreparedData(f"{minutes:g} min", t, q, dq, ddq, tau, RATE, settings)
 
 

@@ -43,3 +43,16 @@ def test_metrics_from_sums_hold_for_a_log_at_rest():
     full = TorqueComparison("rest", t, tau, {"b": y @ beta}).metrics()["b"]
     for key, value in full.items():
         np.testing.assert_allclose(got[key], value, rtol=1e-6, err_msg=key)
+
+
+def test_the_rows_kept_for_the_figure_do_not_hold_the_chunks():
+    """The statistics keep every ``thin``-th row for the figure as copies: a view would keep each whole chunk
+    (the regressor rows of the whole log) alive, and the identification's memory would grow with the log."""
+    rng = np.random.default_rng(1)
+    sums = TorqueSums(2, 4, 40_000, max_points=100)
+    chunks = [(np.arange(4000) * 1e-3, rng.standard_normal((4000, 2, 4)), rng.standard_normal((4000, 2))) for _ in range(3)]
+    for t, y, tau in chunks:
+        sums.add(t, y, tau)
+    kept = sums.kept_t + sums.kept_y + sums.kept_tau
+    assert not any(np.shares_memory(k, c) for k in kept for chunk in chunks for c in chunk)
+    assert sum(k.nbytes for k in kept) < sum(c.nbytes for chunk in chunks for c in chunk) / 100

@@ -102,9 +102,10 @@ class TorqueSums:
         self.mean += delta * (m / (n + m))
         self.m2 += m2 + np.einsum("jc,jd->jcd", delta, delta) * (n * m / (n + m))
         first = (-n) % self.thin  # rows n, n+1, …: keep those at multiples of thin
-        self.kept_t.append(t[first::self.thin])
-        self.kept_y.append(y[first::self.thin])
-        self.kept_tau.append(tau[first::self.thin])
+        # copies of the kept rows: a slice would be a view that keeps the whole chunk alive, and the whole log with it
+        self.kept_t.append(t[first::self.thin].copy())
+        self.kept_y.append(y[first::self.thin].copy())
+        self.kept_tau.append(tau[first::self.thin].copy())
         self.count = n + m
 
     def comparison(self, name: str, parameter_sets: dict) -> TorqueComparison:
