@@ -11,6 +11,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet --only-binary=:all: -e ".[test]"
+	$(BIN)/python -m dynid.warm_up  # compiles the numba kernels into their cache, so the first run does not
 	touch $(STAMP)
 
 demo: $(STAMP)
