@@ -20,10 +20,11 @@ class LeastAbsoluteDeviations(Estimator):
 
     Long problems are solved exactly on a fraction of the rows (Portnoy & Koenker, Statistical Science
     12(4), 1997, "globbing"): a pilot fit (LAD on evenly spaced rows, or least squares in the box,
-    whichever fits every row better) predicts which rows lie far above or below the optimum; their dual variables are fixed at ±delta (their sign), so only the rows near the fit
-    remain in the LP. The solution is then checked on every fixed row: a sign that disagrees moves the
-    rows back into the LP and it is solved again, so the result is the exact minimiser of the whole
-    problem (the KKT conditions hold on every row).
+    whichever fits every row better) predicts which rows lie far above or below the optimum; their dual
+    variables are fixed at ±delta (their sign), so only the rows near the fit remain in the LP. The
+    solution is then checked on every fixed row: a sign that disagrees moves the rows back into the LP and
+    it is solved again, so the result is the exact minimiser of the whole problem (the KKT conditions hold
+    on every row).
 
     Parameters
     ----------

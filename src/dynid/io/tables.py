@@ -166,10 +166,9 @@ def _stack(blocks: list[np.ndarray]) -> np.ndarray:
     data = np.empty((sum(b.shape[0] for b in blocks), blocks[0].shape[1]))
     start = 0
     while blocks:
-        block = blocks.pop(0)
+        block = blocks.pop(0)  # the list's reference goes; the next pop releases this block
         data[start:start + block.shape[0]] = block
         start += block.shape[0]
-        del block
     return data
 
 

@@ -40,22 +40,22 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
     """
     _check_cutoff(rate, cutoff, "Butterworth filter")
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
-    x = np.asarray(x, dtype=float)
-    flat = x.reshape(x.shape[0], -1)
-    out = np.empty(flat.shape)
-    for c in range(flat.shape[1]):  # one column at a time: the filter's padded copies are one column, not the log
-        out[:, c] = signal.sosfiltfilt(sos, flat[:, c])
-    return out.reshape(x.shape)
+    return _by_column(x, lambda column: signal.sosfiltfilt(sos, column))
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
-    """Time derivative by central differences (one-sided at the ends), (N, ...); one column at a time, so
-    the temporaries are one column long (the same numbers as ``np.gradient`` on the whole array)."""
+    """Time derivative by central differences (one-sided at the ends), (N, ...)."""
+    return _by_column(x, lambda column: np.gradient(column, 1.0 / rate))
+
+
+def _by_column(x, along_time) -> np.ndarray:
+    """``along_time`` applied to each column of ``x`` (N, ...) on its own: the temporaries are one column
+    long, not the log's, and the numbers are those of the whole-array call along axis 0."""
     x = np.asarray(x, dtype=float)
     flat = x.reshape(x.shape[0], -1)
     out = np.empty(flat.shape)
     for c in range(flat.shape[1]):
-        out[:, c] = np.gradient(flat[:, c], 1.0 / rate)
+        out[:, c] = along_time(flat[:, c])
     return out.reshape(x.shape)
 
 
