@@ -117,3 +117,14 @@ def test_optimized_excitation_run_has_at_most_half_the_cond_of_beta1_and_is_repr
     assert ex["cond_base_regressor"] <= 0.5 * ex["cond_base_regressor_beta1"]
     assert not [w for w in a.warnings if "limits" in w or "tau_max" in w]  # within the er16's limits
     np.testing.assert_array_equal(a.methods["ols"].params, b.methods["ols"].params)
+
+
+def test_a_robot_with_coupled_motors_is_simulated_with_its_coupling():
+    """The TX40's wrist motors are coupled (extra standard parameters beyond the joints' own): the
+    simulation's truth includes their torques, so the noise-free pipeline's OLS recovers the truth
+    (the simulation used to reshape the parameter vector per joint and stop with a ValueError)."""
+    cfg = PaperExperimentConfig(robot="tx40", joints=6, methods=("ols",), bootstrap=0, current_noise=0.0,
+                                encoder_resolution=0.0, smoothing_passes=0, **FAST)
+    r = run_paper_experiment(cfg)
+    assert r.robot.n_params > r.robot.n_dof * r.robot.n_params_per_joint  # coupled-motor parameters present
+    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-6, atol=1e-6 * np.abs(r.truth).max())

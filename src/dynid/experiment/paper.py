@@ -289,9 +289,7 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
     """
     q, dq, ddq = traj.evaluate(t)
-    n = robot.n_dof
-    phi = phi_true.reshape(n, robot.n_params_per_joint)
-    meas = simulate_measurements(robot, t, q, dq, ddq, noise, rng, inertial=phi[:, :10], drive=phi[:, 10:])
+    meas = simulate_measurements(robot.with_parameters(phi_true), t, q, dq, ddq, noise, rng)  # coupled motors' terms too
     warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
     tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
     q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
