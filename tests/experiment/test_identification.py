@@ -212,3 +212,27 @@ def test_a_joint_that_never_moves_is_named(tmp_path):
 
     with pytest.raises(IdentifiabilityError, match=r"identification: the data do not excite .*Ia3.*fv3.*; joint\(s\) J3 barely move"):
         run_identification(load_identification_config(cfg), validate=False)
+
+
+def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch):
+    """A long log's signals are held in temporary files (dynid.column_store), read column by column and chunk
+    by chunk: on the UR10e logs spooled that way, identification and validations give the results of the
+    in-memory path, every number of results.json."""
+    from dynid.column_store import StoredColumns
+    from dynid.io import datasets
+
+    root = shared_data("ur10e_mamedov2020")
+    cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
+    memory = run_identification(cfg).to_dict()
+    read = []
+    monkeypatch.setattr(datasets, "SPOOL_BYTES", 0)
+    original = datasets._assemble
+    monkeypatch.setattr(datasets, "_assemble", lambda *a: read.append(original(*a)) or read[-1])
+    spooled = run_identification(cfg).to_dict()
+    stored = {r.name for r in read if isinstance(r.q, StoredColumns) and isinstance(r.tau, StoredColumns)}
+    assert stored == {"identification", *(v.name for v in cfg.validation)}  # the drive-gain runs stay in memory
+    # the SDP margins to the solver's tolerance: a re-solve of cvxpy's cached problem moves them by ~1e-11
+    margins = spooled.pop("consistency_margin"), memory.pop("consistency_margin")
+    np.testing.assert_allclose(list(margins[0].values()), list(margins[1].values()), rtol=1e-8)
+    as_text = lambda d: __import__("json").dumps(d, default=lambda a: a.tolist(), sort_keys=True)  # noqa: E731
+    assert as_text(spooled) == as_text(memory)

@@ -145,3 +145,39 @@ def test_rows_beyond_the_end_of_the_file_are_refused(tmp_path):
     spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "rows": [60, 70]}, tmp_path, "cfg", "ident", 6)
     with pytest.raises(DataError, match=r"rows = \[60, 70\] selects nothing: the file has 50 data rows"):
         load_recording(spec, load_robot("ur10e"))
+
+
+def _ur_jittered(tmp_path, rng):
+    t = 1000.0 + np.cumsum(rng.uniform(0.006, 0.014, 400))
+    q = 0.3 * np.sin(np.outer(t - t[0], np.arange(1, 7)))
+    (tmp_path / "ur.csv").write_text("".join(_ur_row(tk, qk, 0.1 * qk, 2 * qk) for tk, qk in zip(t, q)))
+    return load_robot("ur10e"), {"preset": "ur-rtde", "file": "ur.csv", "resample": 100.0, "time_range": [0.5, 3.0]}
+
+
+def _motor_side(tmp_path, rng):
+    robot = load_robot("tx40")  # coupled motors: the transmission mixes the columns
+    tr = robot.transmission
+    header = ",".join(f"Joint_{j + 1}" for j in range(6))
+    q = rng.uniform(-1, 1, (300, 6))
+    np.savetxt(tmp_path / "p.csv", (q - tr.position_offset) @ tr.motor_from_joint.T, delimiter=",", header=header, comments="")
+    np.savetxt(tmp_path / "c.csv", rng.uniform(-5, 5, (300, 6)), delimiter=",", header=header, comments="")
+    return robot, {"preset": "motor-side", "rate": 200.0, "positions": {"file": "p.csv", "unit": "deg"}, "torques": {"file": "c.csv"}}
+
+
+@pytest.mark.parametrize("log", [_ur_jittered, _motor_side])
+def test_a_spooled_recording_equals_the_one_in_memory(tmp_path, rng, log, monkeypatch):
+    """Read through temporary files (as a long log is), every step gives the numbers of the in-memory path."""
+    from dynid.column_store import StoredColumns
+
+    monkeypatch.setattr("dynid.column_store.ROW_CHUNK", 64)  # the transmission in several chunks
+    robot, table = log(tmp_path, rng)
+    spec = dataset_spec(table, tmp_path, "cfg", "ident", 6)
+    memory, spooled = load_recording(spec, robot, spool=False), load_recording(spec, robot, spool=True)
+    assert isinstance(spooled.q, StoredColumns) and isinstance(spooled.tau, StoredColumns)
+    np.testing.assert_array_equal(spooled.t, memory.t)
+    for name in ("q", "dq", "tau"):
+        a, b = getattr(memory, name), getattr(spooled, name)
+        assert (a is None) == (b is None)
+        if a is not None:
+            np.testing.assert_allclose(np.asarray(b), a, rtol=0, atol=1e-13, err_msg=name)  # LAPACK's solve by chunks
+    assert (spooled.rate, spooled.warnings) == (memory.rate, memory.warnings)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..column_store import root_mean_square
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
@@ -328,7 +329,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     try:
         ols = acc.solve(names=base.names)
     except IdentifiabilityError as exc:
-        speed = np.sqrt(np.mean(data.dq**2, axis=0))
+        speed = root_mean_square(data.dq)
         still = [f"J{j + 1}" for j in np.flatnonzero(speed < 1e-3 * max(speed.max(), 1e-12))]
         hint = f"; joint(s) {', '.join(still)} barely move" if still else ""
         raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None

@@ -30,8 +30,8 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 
     mass, unloaded, loaded = config.drive_gains
     unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
-    pre_u = prepare(load_recording(unloaded, unit), config.preprocessing)
-    pre_l = prepare(load_recording(loaded, unit), config.preprocessing)
+    pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
+    pre_l = prepare(load_recording(loaded, unit, spool=False), config.preprocessing)
     gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
     k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
     payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..column_store import SPOOL_BYTES, StoredColumns, by_column, select_rows
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
 from .tables import read_table
@@ -120,7 +121,8 @@ class BagSpec:
 
 @dataclass(frozen=True)
 class Recording:
-    """A measured dataset in SI joint quantities on a uniform time grid.
+    """A measured dataset in SI joint quantities on a uniform time grid. The (N, n_dof) signals are arrays,
+    or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
 
     Attributes
     ----------
@@ -189,14 +191,15 @@ SATURATION_SAMPLES = 20
 def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
     """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
     currents or torques flat at their extreme (saturation), naming joint and time range."""
-    worst = np.abs(q).max(axis=0)
+    worst = np.array([np.abs(q[:, j]).max() for j in range(q.shape[1])])  # one joint at a time: q may be stored
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
                         f"positions in degrees (positions = {{ ..., unit = \"deg\" }})?")
     lim = robot.limits
     for j in range(q.shape[1]):
-        out = (q[:, j] < lim.q_min[j] - 0.05) | (q[:, j] > lim.q_max[j] + 0.05)
+        column = q[:, j]
+        out = (column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05)
         if out.any():
             k = np.flatnonzero(out)
             warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
@@ -329,13 +332,17 @@ def _bag_spec(merged: dict, base: Path, where: str, name: str, n_dof: int) -> Da
                        bag=BagSpec(path, topic, None if names is None else tuple(names), effort))
 
 
-def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
+def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages,
     scale units, check the time stamps, resample jittered time stamps linearly onto a uniform grid,
     convert motor-side signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``),
     currents to torques with the drive gains (eq. 16).
+
+    ``spool``: hold the signals in temporary files (:mod:`dynid.column_store`) rather than in memory;
+    by default when the files hold more than :data:`dynid.column_store.SPOOL_BYTES` (an hour-long log).
+    The numbers are the same either way.
 
     Raises
     ------
@@ -355,9 +362,12 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
         for c in s.columns:
             if c not in requests[s.file]:
                 requests[s.file].append(c)
+    if spool is None:
+        spool = sum(p.stat().st_size for p in requests if p.is_file()) > SPOOL_BYTES
     tables = {}
     for path, cols in requests.items():
-        table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows)
+        table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows,
+                           spool=spool)
         tables[path] = (table, cols)
         warnings.extend(table.warnings)
     del table
@@ -370,6 +380,9 @@ def load_recording(spec: DatasetSpec, robot: Robot) -> Recording:
 
     def get(s: SignalSpec) -> np.ndarray:
         tb, cols = tables[s.file]
+        if isinstance(tb.data, StoredColumns):  # a view of the stored columns; scaled into new ones
+            x = tb.data.select([cols.index(c) for c in s.columns], n_s)
+            return x if s.scale == 1.0 else x.map_columns(lambda column, j: column * s.scale)
         x = tb.data[:n_s, [cols.index(c) for c in s.columns]]  # a copy of its own: scaled in place
         if s.scale != 1.0:
             x *= s.scale
@@ -411,7 +424,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
             warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
         first = int(np.argmax(inside))
-        t, raw = t[inside], {kind: x[inside] for kind, x in raw.items()}
+        t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
         if where is not None:
             where = (lambda w, f: (lambda k: w(k + f)))(where, first)
     median = float(np.median(np.diff(t)))
@@ -426,20 +439,31 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     rate = spec.rate if not timed else (spec.resample or float(f"{1.0 / median:.6g}"))
     if timed and (not uniform or spec.resample is not None):
         grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
-        raw = {kind: np.column_stack([np.interp(grid, t, x[:, j]) for j in range(x.shape[1])]) for kind, x in raw.items()}
+        raw = {kind: by_column(x, lambda column, j: np.interp(grid, t, column)) for kind, x in raw.items()}
         t = grid
     tr = robot.transmission
     if spec.side == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
-        q = tr.joint_positions(raw.pop("positions"))
-        dq = tr.joint_velocities(raw.pop("velocities")) if "velocities" in raw else None
+        q = _row_wise(tr.joint_positions, raw.pop("positions"))
+        dq = _row_wise(tr.joint_velocities, raw.pop("velocities")) if "velocities" in raw else None
     else:
-        q = raw.pop("positions") + tr.position_offset
+        q = _per_joint(np.add, raw.pop("positions"), tr.position_offset)
         dq = raw.pop("velocities", None)
     if "currents" in raw:
-        motor_or_joint = raw["currents"] * robot.drive_gains
+        motor_or_joint = _per_joint(np.multiply, raw["currents"], robot.drive_gains)
     else:
         motor_or_joint = raw["torques"]
-    tau = tr.joint_torques(motor_or_joint) if spec.side == "motor" else motor_or_joint
+    tau = _row_wise(tr.joint_torques, motor_or_joint) if spec.side == "motor" else motor_or_joint
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
+
+
+def _row_wise(f, x):
+    """``f(x)`` for a map that treats each sample alone (a transmission), chunk by chunk on stored columns."""
+    return x.map_rows(f) if isinstance(x, StoredColumns) else f(x)
+
+
+def _per_joint(op, x, values):
+    """``op(x, values)`` with one value per joint (an offset, a gain), column by column on stored columns."""
+    values = np.broadcast_to(np.asarray(values, dtype=float), (x.shape[1],))
+    return x.map_columns(lambda column, j: op(column, values[j])) if isinstance(x, StoredColumns) else op(x, values)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..column_store import ColumnFile, StoredColumns
 from ..exceptions import DataError
 from .files import text_encoding_hint
 
@@ -24,8 +25,8 @@ class Table:
 
     Attributes
     ----------
-    data : (N, n_columns) array
-        The requested columns, in the requested order.
+    data : (N, n_columns) array, or StoredColumns
+        The requested columns, in the requested order (stored in temporary files when read with ``spool``).
     first_line : int
         File line number (1-based) of the first returned row.
     warnings : tuple of str
@@ -59,7 +60,7 @@ def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
 
 
 def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
-               n_columns: int | None = None, rows: tuple[int, int] | None = None) -> Table:
+               n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False) -> Table:
     """Read numeric columns from a delimited text file.
 
     Parameters
@@ -74,6 +75,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         Number of fields every line must have (default: that of the first data line).
     rows : (first, last), optional
         1-based, inclusive range of data rows (header excluded) to read; default all.
+    spool : bool
+        Write each block's columns to temporary files (:mod:`dynid.column_store`) instead of holding
+        them: a long log's memory is then one block, whatever its length.
 
     Returns
     -------
@@ -97,6 +101,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         raise DataError(f"{path}: rows: expected 1 <= first <= last, got {list(rows)}")
     warnings: list[str] = []
     blocks: list[np.ndarray] = []
+    files: list[ColumnFile] | None = None
     line_no = 0
     names = None
     cols: list[int] | None = None
@@ -115,9 +120,17 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         data_row = 0
 
         def flush():
+            nonlocal files
             if pending:
-                blocks.append(_parse_block(path, pending, pending_start, cols, delimiter))
+                block = _parse_block(path, pending, pending_start, cols, delimiter)
                 pending.clear()
+                if not spool:
+                    blocks.append(block)
+                    return
+                if files is None:
+                    files = [ColumnFile() for _ in range(block.shape[1])]
+                for j, f in enumerate(files):
+                    f.append(block[:, j])
 
         for line in fh:
             line_no += 1
@@ -148,7 +161,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if len(pending) >= BLOCK:
                 flush()
         flush()
-    if not blocks:
+    if not blocks and files is None:
         if data_row == 0:
             what = "only a header line" if header else "no data lines"
             raise DataError(f"{path}: {what} (an empty file, or not a text table?)")
@@ -157,7 +170,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         raise DataError(f"{path}: no data rows")
     if last is not None and data_row < last and not warnings:
         raise DataError(f"{path}: rows = {list(rows)} goes beyond the file's end: it has {data_row} data rows")
-    return Table(_stack(blocks), int(first_line), tuple(warnings))
+    return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line), tuple(warnings))
 
 
 def _stack(blocks: list[np.ndarray]) -> np.ndarray:

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..column_store import StoredColumns
+
 ENERGY_FRACTION = 0.99
 """Fraction of the velocity energy that defines the excitation band."""
 
@@ -60,8 +62,8 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
 
     Parameters
     ----------
-    q : (N, n_dof) array [rad]
-        Measured positions on a uniform grid.
+    q : (N, n_dof) array [rad], or StoredColumns
+        Measured positions on a uniform grid (read one joint at a time).
     rate : float [Hz]
     fraction : float in (0, 1)
 
@@ -70,8 +72,9 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
     float [Hz]
         At least two frequency bins (``2·rate/N``), at most the Nyquist frequency.
     """
-    q = np.asarray(q, dtype=float)
-    q = q.reshape(q.shape[0], -1)
+    if not isinstance(q, StoredColumns):
+        q = np.asarray(q, dtype=float)
+        q = q.reshape(q.shape[0], -1)
     n = q.shape[0]
     ramp = np.linspace(0.0, 1.0, n)
     window = np.hanning(n)
@@ -79,7 +82,8 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
     f2 = f**2
     energy = np.zeros(f.size)
     for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
-        x = (q[:, j] - q[0, j] - ramp * (q[-1, j] - q[0, j])) * window
+        column = q[:, j]
+        x = (column - column[0] - ramp * (column[-1] - column[0])) * window
         energy += f2 * np.abs(np.fft.rfft(x)) ** 2
     total = energy.sum()
     if not total > 0:

@@ -12,6 +12,7 @@ from typing import Callable, Iterator
 import numpy as np
 from scipy import signal
 
+from ..column_store import by_column
 from ..exceptions import ConfigError
 from .bands import decimation_cutoff
 
@@ -26,7 +27,8 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
 
     Parameters
     ----------
-    x : (N, ...) array
+    x : (N, ...) array, or StoredColumns (:mod:`dynid.column_store`: the result is stored too)
+        Filtered one column at a time: the same numbers as the whole-array call along axis 0.
     rate : float
         Sampling rate [Hz].
     cutoff : float
@@ -40,23 +42,13 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
     """
     _check_cutoff(rate, cutoff, "Butterworth filter")
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
-    return _by_column(x, lambda column: signal.sosfiltfilt(sos, column))
+    return by_column(x, lambda column, j: signal.sosfiltfilt(sos, column))
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
-    """Time derivative by central differences (one-sided at the ends), (N, ...)."""
-    return _by_column(x, lambda column: np.gradient(column, 1.0 / rate))
-
-
-def _by_column(x, along_time) -> np.ndarray:
-    """``along_time`` applied to each column of ``x`` (N, ...) on its own: the temporaries are one column
-    long, not the log's, and the numbers are those of the whole-array call along axis 0."""
-    x = np.asarray(x, dtype=float)
-    flat = x.reshape(x.shape[0], -1)
-    out = np.empty(flat.shape)
-    for c in range(flat.shape[1]):
-        out[:, c] = along_time(flat[:, c])
-    return out.reshape(x.shape)
+    """Time derivative by central differences (one-sided at the ends), (N, ...) (or StoredColumns), one
+    column at a time."""
+    return by_column(x, lambda column, j: np.gradient(column, 1.0 / rate))
 
 
 COLUMN_BLOCK = 64

@@ -19,6 +19,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..column_store import StoredColumns, root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
@@ -33,7 +34,8 @@ __all__ = ["PreparedData", "Preprocessing", "base_chunks", "prepare"]
 
 @dataclass(frozen=True)
 class PreparedData:
-    """Filtered joint signals on a uniform grid, ready for the regressor (N, n_dof) each."""
+    """Filtered joint signals on a uniform grid, ready for the regressor (N, n_dof) each: arrays, or for a
+    spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array)."""
 
     name: str
     t: np.ndarray
@@ -85,9 +87,9 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
     else:
         q = lowpass(recording.q, s.position_cutoff, "position")
         dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
-    tau = np.asarray(recording.tau, dtype=float)
+    tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
     if s.min_speed == "auto":  # before the accelerations exist: its temporary square adds to a smaller peak
-        vmin = MIN_SPEED_FRACTION * np.sqrt(np.mean(dq**2, axis=0))
+        vmin = MIN_SPEED_FRACTION * root_mean_square(dq)
         s = replace(s, min_speed=tuple(float(v) for v in vmin),
                     derivation=s.derivation + f"; rows slower than {100 * MIN_SPEED_FRACTION:g} % of the joint's RMS speed "
                     "left out of the estimation")
@@ -134,7 +136,8 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
 
     def block(a, b):  # the regressor and the torques, filtered alike but never copied into one array
         columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
-        return regressor(robot, data.q[a:b], data.dq[a:b], data.ddq[a:b], columns), data.tau[a:b]
+        q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))  # stored columns: read here
+        return regressor(robot, q, dq, ddq, columns), tau
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):

@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..column_store import root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
@@ -99,7 +100,7 @@ def choose_coulomb_velocity(robot: Robot, base: BaseParameters, data: PreparedDa
     CoulombChoice
     """
     n = robot.n_dof
-    speed = np.sqrt(np.mean(data.dq**2, axis=0))
+    speed = root_mean_square(data.dq)
     candidates = np.outer(np.asarray(grid, dtype=float), speed)
     n_s = data.t.shape[0]
     error = np.full((len(grid), n), np.inf)
