@@ -3,6 +3,8 @@
 25,000 random samples of the 6-DOF er16 (the paper's 25 s at 1 kHz). Both sides produce the full
 (N, n_dof, n_params) array. Prints the time per sample of each and the ratio (target: >= 6x).
 Each side is timed as the best of several repeats after a warm-up (JIT compilation, page faults).
+dynid's side is its compiled kernel, loaded first (a process's first 50 000 samples would otherwise go
+through the NumPy form, timed on its own line).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import pinocchio as pin
 
 from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
 
+from dynid.dynamics import _regressor_kernel, regressor as regressor_module
 from dynid.dynamics.regressor import friction_torques, regressor
 from dynid.dynamics.rnea import pinocchio_model
 from dynid.model.description import load_robot
@@ -22,8 +25,10 @@ REPEATS = 5
 
 
 def measure(n: int = N, repeats: int = REPEATS) -> tuple[float, float]:
-    """Best wall times [s] of Pinocchio's loop and of dynid's batched regressor on ``n`` random er16
-    samples, each producing the full (n, n_dof, n_params) array; checks first that both give the same torques."""
+    """Best wall times [s] of Pinocchio's loop and of dynid's batched regressor (compiled kernel) on ``n``
+    random er16 samples, each producing the full (n, n_dof, n_params) array; checks first that both give the
+    same torques."""
+    _regressor_kernel.load_compiled()
     robot = load_robot("er16")
     rng = np.random.default_rng(0)
     q, dq, ddq = (rng.uniform(-2, 2, (n, robot.n_dof)) for _ in range(3))
@@ -48,11 +53,26 @@ def measure(n: int = N, repeats: int = REPEATS) -> tuple[float, float]:
     return best_of(reference, repeats), best_of(batched, repeats)
 
 
+def numpy_form(n: int = N, repeats: int = 3) -> float:
+    """Best wall time [s] of the regressor's NumPy form on the same samples (what a process computes before it
+    loads the compiled kernel)."""
+    robot = load_robot("er16")
+    q, dq, ddq = (np.random.default_rng(0).uniform(-2, 2, (n, robot.n_dof)) for _ in range(3))
+    out = np.empty((n, robot.n_dof, robot.n_params))
+    colmap = np.arange(robot.n_params)
+    args = (np.array([j.rotation for j in robot.joints]), np.array([j.translation for j in robot.joints]),
+            np.array([j.axis for j in robot.joints]), np.asarray(robot.gravity, dtype=float))
+    return best_of(lambda: _regressor_kernel.numpy_regressor(*args, q, dq, ddq, out, robot.n_params_per_joint, colmap), repeats)
+
+
 def main() -> None:
     t_ref, t_dyn = measure()
+    t_np = numpy_form()
     print(f"samples: {N}, robot: er16 (6 DOF), best of {REPEATS}")
     print(f"pinocchio computeJointTorqueRegressor loop: {1e6 * t_ref / N:8.3f} µs/sample ({t_ref:.3f} s)")
     print(f"dynid batched regressor (with friction):    {1e6 * t_dyn / N:8.3f} µs/sample ({t_dyn:.3f} s)")
+    print(f"its NumPy form, inertial columns (the first {regressor_module.NUMPY_SAMPLES} samples of a process): "
+          f"{1e6 * t_np / N:.3f} µs/sample")
     print(f"ratio (reference / dynid): {t_ref / t_dyn:.1f}x   target >= 6x: {'met' if t_ref / t_dyn >= 6 else 'NOT met'}")
 
 

@@ -12,6 +12,9 @@ from __future__ import annotations
 
 def warm_up() -> None:
     """Run a 2 s, 200 Hz paper experiment with every estimator (2 ABC iterations, 2 bootstrap resamples)."""
+    from .dynamics import _regressor_kernel
+
+    _regressor_kernel.load_compiled()  # compiled, the kernel computes every regressor (not the NumPy form)
     from .estimators.names import parse_methods
     from .experiment import PaperExperimentConfig, run_paper_experiment
 

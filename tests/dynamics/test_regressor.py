@@ -94,3 +94,53 @@ def test_selected_columns_are_the_same_numbers_as_the_full_regressor(name):
     np.testing.assert_array_equal(regressor(robot, q, dq, ddq, cols), full[..., cols])
     some = np.array([robot.n_params - 1, 3, 0])  # any order, drive and coupled columns included
     np.testing.assert_array_equal(regressor(robot, q, dq, ddq, some), full[..., some])
+
+
+@pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])
+def test_the_numpy_form_gives_the_compiled_kernels_numbers(name, monkeypatch):
+    """The arithmetic is written once and run two ways: compiled per sample (numba, on two threads here) and by
+    NumPy on blocks of samples. Both give the same numbers bit for bit, and equal Pinocchio's RNEA."""
+    import dynid.dynamics.regressor as module
+
+    robot = load_robot(name)
+    q, dq, ddq = random_states(np.random.default_rng(5), 5000, robot.n_dof)  # several NumPy blocks
+    some = np.arange(robot.n_params - 1, -1, -3)
+    forms = {}
+    for numpy in (True, False):
+        monkeypatch.setattr(module, "_numpy_form", lambda n, numpy=numpy: numpy)
+        forms[numpy] = regressor(robot, q, dq, ddq), regressor(robot, q, dq, ddq, some)
+    np.testing.assert_array_equal(forms[True][0], forms[False][0])
+    np.testing.assert_array_equal(forms[True][1], forms[False][1])
+    np.testing.assert_allclose(forms[True][0][:500] @ robot.standard_parameters(), rnea_torques(robot, q[:500], dq[:500], ddq[:500]),
+                               atol=1e-9, rtol=0)
+
+
+SHORT_RUN = """
+import sys
+import numpy as np
+from dynid.dynamics import regressor as module
+from dynid.experiment.identification_run import run_identification
+from dynid.io.identification_config import load_identification_config
+from dynid.model.description import load_robot
+run_identification(load_identification_config(sys.argv[1], data_root=sys.argv[2]))
+assert "numba" not in sys.modules, "numba loaded"
+module.NUMPY_SAMPLES = 0
+z = np.zeros((1, 6))
+module.regressor(load_robot("er16"), z, z, z)
+assert "numba" in sys.modules and module.kernel.compiled(), "the kernel did not take over"
+"""
+
+
+def test_a_short_identification_never_loads_numba():
+    """The TX40 log (45 000 regressor samples with the SDP's standard columns) stays within the NumPy form's
+    budget: the process never imports numba and its LLVM; past the budget, the compiled kernel takes over."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from ..conftest import shared_data
+
+    root = shared_data("staubli_tx40_figaroh")
+    config = Path(__file__).resolve().parents[2] / "configs" / "tx40-full.toml"
+    out = subprocess.run([sys.executable, "-c", SHORT_RUN, str(config), str(root)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]

@@ -1,137 +1,207 @@
-"""Compiled kernel of the batched joint-torque regressor (see :mod:`dynid.dynamics.regressor`).
+"""The batched joint-torque regressor's arithmetic (see :mod:`dynid.dynamics.regressor`), written once and
+executed two ways.
 
-One pass per sample: forward Newton–Euler recursion in link frames, then for every link ``j`` and
-joint ``i <= j`` the ten closed-form columns ``tau_i = z·n_j + l·f_j``. Samples are split into
-contiguous ranges run side by side in threads (the compiled loop releases the GIL); no allocation per
-sample. A serial kernel loads from numba's cache in a fraction of the time a ``parallel=True`` one takes.
+:func:`sample_columns` holds the arithmetic for sample ``k``: forward Newton–Euler recursion in link
+frames, then for every link ``j`` and joint ``i <= j`` the ten closed-form columns ``tau_i = z·n_j + l·f_j``.
+
+* Compiled: :func:`joint_torque_regressor` compiles it with numba on first use (numba is imported only
+  then; the machine code comes from numba's on-disk cache after the first time) and calls it for one
+  sample after another, ``k`` an integer and every quantity a float. Samples are split into contiguous
+  ranges run side by side in threads (the compiled loop releases the GIL); no allocation per sample. A
+  serial kernel loads from numba's cache in a fraction of the time a ``parallel=True`` one takes.
+* NumPy: :func:`numpy_regressor` runs the same statements in the interpreter with ``k = slice(None)`` on
+  a block of samples, each quantity then a vector of the block's samples and the scratch arrays with a
+  trailing sample axis. The operations and their order are the same, so both give the same numbers
+  (a test compares them bit for bit); it spares a short computation numba's start-up.
 """
 
 from __future__ import annotations
 
-import numba as nb
+import threading
+
 import numpy as np
 
-@nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True, inline="always")
-def _put(out, k, i, colmap, col, value):
-    """``out[k, i, colmap[col]] = value`` for a kept column (``colmap[col] >= 0``)."""
-    c = colmap[col]
-    if c >= 0:
-        out[k, i, c] = value
 
+def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o, w, dw, acc, z0, rl):
+    """Fill ``out[k]`` (n, m): column ``colmap[c]`` holds standard column ``c`` of the ten inertial columns of
+    each link (skipped where ``colmap[c] < 0``); the other columns hold 0.
 
-@nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True)
-def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, r0, o, w, dw, acc, z0, rl):
+    Parameters
+    ----------
+    k : int or slice
+        The sample (compiled) or ``slice(None)``: every sample of ``q`` at once (NumPy).
+    rp, pp, axes : (n, 3, 3), (n, 3), (n, 3) arrays
+        Each joint's fixed rotation and translation from its parent's frame, and its axis.
+    gravity : (3,) array [m/s²]
+    q, dq, ddq : (N, n) arrays [rad, rad/s, rad/s²]
+    out : (N, n, m) array
+    npj : int
+        Standard parameters per joint.
+    colmap : (n_params,) int array
+    r0, o, w, dw, acc, z0, rl : scratch arrays (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample
+        axis when ``k`` is a slice.
+    """
     n = q.shape[1]
     m = out.shape[2]
-    for k in range(start, stop):
-        # ---- zero every entry first: links j < i stay zero, and the drive columns are filled by the caller
-        #      from the friction table (dynid.friction) -----
-        for i in range(n):
-            for c in range(m):
-                out[k, i, c] = 0.0
-        # ---- forward recursion -------------------------------------------------------------
-        for j in range(n):
-            ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
-            c = np.cos(q[k, j])
-            s = np.sin(q[k, j])
-            v = 1.0 - c
-            # Rodrigues rotation about the joint axis
-            m00 = c + v * ax0 * ax0
-            m01 = v * ax0 * ax1 - s * ax2
-            m02 = v * ax0 * ax2 + s * ax1
-            m10 = v * ax0 * ax1 + s * ax2
-            m11 = c + v * ax1 * ax1
-            m12 = v * ax1 * ax2 - s * ax0
-            m20 = v * ax0 * ax2 - s * ax1
-            m21 = v * ax1 * ax2 + s * ax0
-            m22 = c + v * ax2 * ax2
-            for a in range(3):  # rl = rp_j @ rot
-                rl[a, 0] = rp[j, a, 0] * m00 + rp[j, a, 1] * m10 + rp[j, a, 2] * m20
-                rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
-                rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
-            px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
-            if j == 0:
-                wpx = wpy = wpz = 0.0
-                dwx = dwy = dwz = 0.0
-                apx, apy, apz = -gravity[0], -gravity[1], -gravity[2]
-                for a in range(3):
-                    o[0, a] = pp[0, a]
-                    for b in range(3):
-                        r0[0, a, b] = rl[a, b]
-            else:
-                wpx, wpy, wpz = w[j - 1, 0], w[j - 1, 1], w[j - 1, 2]
-                dwx, dwy, dwz = dw[j - 1, 0], dw[j - 1, 1], dw[j - 1, 2]
-                apx, apy, apz = acc[j - 1, 0], acc[j - 1, 1], acc[j - 1, 2]
-                for a in range(3):
-                    o[j, a] = o[j - 1, a] + r0[j - 1, a, 0] * px + r0[j - 1, a, 1] * py + r0[j - 1, a, 2] * pz
-                    for b in range(3):
-                        r0[j, a, b] = r0[j - 1, a, 0] * rl[0, b] + r0[j - 1, a, 1] * rl[1, b] + r0[j - 1, a, 2] * rl[2, b]
-            # acceleration of the new origin, parent frame: a + dw×p + w×(w×p)
-            cx = wpy * pz - wpz * py
-            cy = wpz * px - wpx * pz
-            cz = wpx * py - wpy * px
-            hx = apx + (dwy * pz - dwz * py) + (wpy * cz - wpz * cy)
-            hy = apy + (dwz * px - dwx * pz) + (wpz * cx - wpx * cz)
-            hz = apz + (dwx * py - dwy * px) + (wpx * cy - wpy * cx)
-            qd, qdd = dq[k, j], ddq[k, j]
-            for b in range(3):  # rotate into link j frame (rl^T)
-                wi = rl[0, b] * wpx + rl[1, b] * wpy + rl[2, b] * wpz
-                w[j, b] = wi
-                dw[j, b] = rl[0, b] * dwx + rl[1, b] * dwy + rl[2, b] * dwz + qdd * axes[j, b]
-                acc[j, b] = rl[0, b] * hx + rl[1, b] * hy + rl[2, b] * hz
-            # dw += w_in × (qd axis), then w += qd axis
-            wix, wiy, wiz = w[j, 0], w[j, 1], w[j, 2]
-            dw[j, 0] += qd * (wiy * ax2 - wiz * ax1)
-            dw[j, 1] += qd * (wiz * ax0 - wix * ax2)
-            dw[j, 2] += qd * (wix * ax1 - wiy * ax0)
-            w[j, 0] += qd * ax0
-            w[j, 1] += qd * ax1
-            w[j, 2] += qd * ax2
+    # ---- zero every entry first: links j < i stay zero, and the drive columns are filled by the caller
+    #      from the friction table (dynid.friction) -----
+    for i in range(n):
+        for c in range(m):
+            out[k, i, c] = 0.0
+    # ---- forward recursion -------------------------------------------------------------
+    for j in range(n):
+        ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
+        c = np.cos(q[k, j])
+        s = np.sin(q[k, j])
+        v = 1.0 - c
+        # Rodrigues rotation about the joint axis
+        m00 = c + v * ax0 * ax0
+        m01 = v * ax0 * ax1 - s * ax2
+        m02 = v * ax0 * ax2 + s * ax1
+        m10 = v * ax0 * ax1 + s * ax2
+        m11 = c + v * ax1 * ax1
+        m12 = v * ax1 * ax2 - s * ax0
+        m20 = v * ax0 * ax2 - s * ax1
+        m21 = v * ax1 * ax2 + s * ax0
+        m22 = c + v * ax2 * ax2
+        for a in range(3):  # rl = rp_j @ rot
+            rl[a, 0] = rp[j, a, 0] * m00 + rp[j, a, 1] * m10 + rp[j, a, 2] * m20
+            rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
+            rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
+        px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
+        if j == 0:
+            wpx = wpy = wpz = 0.0
+            dwx = dwy = dwz = 0.0
+            apx, apy, apz = -gravity[0], -gravity[1], -gravity[2]
             for a in range(3):
-                z0[j, a] = r0[j, a, 0] * ax0 + r0[j, a, 1] * ax1 + r0[j, a, 2] * ax2
-        # ---- regressor columns -------------------------------------------------------------
-        for j in range(n):
-            wx, wy, wz = w[j, 0], w[j, 1], w[j, 2]
-            ex, ey, ez = dw[j, 0], dw[j, 1], dw[j, 2]
-            gx, gy, gz = acc[j, 0], acc[j, 1], acc[j, 2]
-            w2 = wx * wx + wy * wy + wz * wz
-            col = j * npj
-            for i in range(j + 1):
-                # axis of joint i and o_j - o_i, in frame j
-                dx = o[j, 0] - o[i, 0]
-                dy = o[j, 1] - o[i, 1]
-                dz = o[j, 2] - o[i, 2]
-                zx = r0[j, 0, 0] * z0[i, 0] + r0[j, 1, 0] * z0[i, 1] + r0[j, 2, 0] * z0[i, 2]
-                zy = r0[j, 0, 1] * z0[i, 0] + r0[j, 1, 1] * z0[i, 1] + r0[j, 2, 1] * z0[i, 2]
-                zz = r0[j, 0, 2] * z0[i, 0] + r0[j, 1, 2] * z0[i, 1] + r0[j, 2, 2] * z0[i, 2]
-                rx = r0[j, 0, 0] * dx + r0[j, 1, 0] * dy + r0[j, 2, 0] * dz
-                ry = r0[j, 0, 1] * dx + r0[j, 1, 1] * dy + r0[j, 2, 1] * dz
-                rz = r0[j, 0, 2] * dx + r0[j, 1, 2] * dy + r0[j, 2, 2] * dz
-                lx = zy * rz - zz * ry
-                ly = zz * rx - zx * rz
-                lz = zx * ry - zy * rx
-                ux = zy * wz - zz * wy
-                uy = zz * wx - zx * wz
-                uz = zx * wy - zy * wx
-                _put(out, k, i, colmap, col + 0, zx * ex + ux * wx)
-                _put(out, k, i, colmap, col + 1, zx * ey + zy * ex + ux * wy + uy * wx)
-                _put(out, k, i, colmap, col + 2, zx * ez + zz * ex + ux * wz + uz * wx)
-                _put(out, k, i, colmap, col + 3, zy * ey + uy * wy)
-                _put(out, k, i, colmap, col + 4, zy * ez + zz * ey + uy * wz + uz * wy)
-                _put(out, k, i, colmap, col + 5, zz * ez + uz * wz)
-                lw = lx * wx + ly * wy + lz * wz
-                _put(out, k, i, colmap, col + 6, (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy))
-                _put(out, k, i, colmap, col + 7, (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz))
-                _put(out, k, i, colmap, col + 8, (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx))
-                _put(out, k, i, colmap, col + 9, lx * gx + ly * gy + lz * gz)
+                o[0, a] = pp[0, a]
+                for b in range(3):
+                    r0[0, a, b] = rl[a, b]
+        else:
+            wpx, wpy, wpz = w[j - 1, 0], w[j - 1, 1], w[j - 1, 2]
+            dwx, dwy, dwz = dw[j - 1, 0], dw[j - 1, 1], dw[j - 1, 2]
+            apx, apy, apz = acc[j - 1, 0], acc[j - 1, 1], acc[j - 1, 2]
+            for a in range(3):
+                o[j, a] = o[j - 1, a] + r0[j - 1, a, 0] * px + r0[j - 1, a, 1] * py + r0[j - 1, a, 2] * pz
+                for b in range(3):
+                    r0[j, a, b] = r0[j - 1, a, 0] * rl[0, b] + r0[j - 1, a, 1] * rl[1, b] + r0[j - 1, a, 2] * rl[2, b]
+        # acceleration of the new origin, parent frame: a + dw×p + w×(w×p)
+        cx = wpy * pz - wpz * py
+        cy = wpz * px - wpx * pz
+        cz = wpx * py - wpy * px
+        hx = apx + (dwy * pz - dwz * py) + (wpy * cz - wpz * cy)
+        hy = apy + (dwz * px - dwx * pz) + (wpz * cx - wpx * cz)
+        hz = apz + (dwx * py - dwy * px) + (wpx * cy - wpy * cx)
+        qd, qdd = dq[k, j], ddq[k, j]
+        for b in range(3):  # rotate into link j frame (rl^T)
+            wi = rl[0, b] * wpx + rl[1, b] * wpy + rl[2, b] * wpz
+            w[j, b] = wi
+            dw[j, b] = rl[0, b] * dwx + rl[1, b] * dwy + rl[2, b] * dwz + qdd * axes[j, b]
+            acc[j, b] = rl[0, b] * hx + rl[1, b] * hy + rl[2, b] * hz
+        # dw += w_in × (qd axis), then w += qd axis
+        wix, wiy, wiz = w[j, 0], w[j, 1], w[j, 2]
+        dw[j, 0] += qd * (wiy * ax2 - wiz * ax1)
+        dw[j, 1] += qd * (wiz * ax0 - wix * ax2)
+        dw[j, 2] += qd * (wix * ax1 - wiy * ax0)
+        w[j, 0] += qd * ax0
+        w[j, 1] += qd * ax1
+        w[j, 2] += qd * ax2
+        for a in range(3):
+            z0[j, a] = r0[j, a, 0] * ax0 + r0[j, a, 1] * ax1 + r0[j, a, 2] * ax2
+    # ---- regressor columns -------------------------------------------------------------
+    for j in range(n):
+        wx, wy, wz = w[j, 0], w[j, 1], w[j, 2]
+        ex, ey, ez = dw[j, 0], dw[j, 1], dw[j, 2]
+        gx, gy, gz = acc[j, 0], acc[j, 1], acc[j, 2]
+        w2 = wx * wx + wy * wy + wz * wz
+        col = j * npj
+        for i in range(j + 1):
+            # axis of joint i and o_j - o_i, in frame j
+            dx = o[j, 0] - o[i, 0]
+            dy = o[j, 1] - o[i, 1]
+            dz = o[j, 2] - o[i, 2]
+            zx = r0[j, 0, 0] * z0[i, 0] + r0[j, 1, 0] * z0[i, 1] + r0[j, 2, 0] * z0[i, 2]
+            zy = r0[j, 0, 1] * z0[i, 0] + r0[j, 1, 1] * z0[i, 1] + r0[j, 2, 1] * z0[i, 2]
+            zz = r0[j, 0, 2] * z0[i, 0] + r0[j, 1, 2] * z0[i, 1] + r0[j, 2, 2] * z0[i, 2]
+            rx = r0[j, 0, 0] * dx + r0[j, 1, 0] * dy + r0[j, 2, 0] * dz
+            ry = r0[j, 0, 1] * dx + r0[j, 1, 1] * dy + r0[j, 2, 1] * dz
+            rz = r0[j, 0, 2] * dx + r0[j, 1, 2] * dy + r0[j, 2, 2] * dz
+            lx = zy * rz - zz * ry
+            ly = zz * rx - zx * rz
+            lz = zx * ry - zy * rx
+            ux = zy * wz - zz * wy
+            uy = zz * wx - zx * wz
+            uz = zx * wy - zy * wx
+            c0 = zx * ex + ux * wx
+            c1 = zx * ey + zy * ex + ux * wy + uy * wx
+            c2 = zx * ez + zz * ex + ux * wz + uz * wx
+            c3 = zy * ey + uy * wy
+            c4 = zy * ez + zz * ey + uy * wz + uz * wy
+            c5 = zz * ez + uz * wz
+            lw = lx * wx + ly * wy + lz * wz
+            c6 = (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy)
+            c7 = (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz)
+            c8 = (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx)
+            c9 = lx * gx + ly * gy + lz * gz
+            values = (c0, c1, c2, c3, c4, c5, c6, c7, c8, c9)
+            for t in range(10):
+                dst = colmap[col + t]
+                if dst >= 0:
+                    out[k, i, dst] = values[t]
 
 
-@nb.njit(cache=True, fastmath=False, boundscheck=False, nogil=True)
+def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, r0, o, w, dw, acc, z0, rl):
+    for k in range(start, stop):
+        _sample(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o, w, dw, acc, z0, rl)
+
+
 def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop):
     """Samples ``start:stop`` with their own scratch arrays (releases the GIL: threads run ranges side by side)."""
     n = q.shape[1]
     _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
            np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((3, 3)))
+
+
+_sample = sample_columns  # load_compiled() binds these names to their compiled versions (numba resolves globals then)
+_compiled = False
+_compile_lock = threading.Lock()
+
+
+def compiled() -> bool:
+    """Whether the compiled kernel is loaded in this process (then it computes every regressor)."""
+    return _compiled
+
+
+def load_compiled() -> None:
+    global _sample, _chunk, _samples, _compiled
+    with _compile_lock:
+        if _compiled:
+            return
+        import numba as nb
+
+        options = {"cache": True, "fastmath": False, "boundscheck": False, "nogil": True}
+        _sample = nb.njit(inline="always", **options)(sample_columns)
+        _chunk = nb.njit(**options)(_chunk)
+        _samples = nb.njit(**options)(_samples)
+        _compiled = True
+
+
+NUMPY_BLOCK = 2048
+"""Samples per block of :func:`numpy_regressor` (its vectors stay in the cache)."""
+
+
+def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
+    """What :func:`joint_torque_regressor` computes, by :func:`sample_columns` on blocks of samples at once
+    (NumPy vectors; about 4.4 µs a sample against the kernel's 0.7 µs, but no start-up)."""
+    n_s, n = q.shape
+    for a in range(0, n_s, NUMPY_BLOCK):
+        b = min(a + NUMPY_BLOCK, n_s)
+        m = b - a
+        block = np.empty((n, out.shape[2], m))  # a column's samples side by side: written at full speed
+        sample_columns(slice(None), rp, pp, axes, gravity, q[a:b], dq[a:b], ddq[a:b], block.transpose(2, 0, 1), npj,
+                       colmap, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
+                       np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((3, 3, m)))
+        out[a:b] = block.transpose(2, 0, 1)
 
 
 PARALLEL_SAMPLES = 4096
@@ -145,6 +215,7 @@ def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
     depend on how the samples are split over threads."""
     from ..threads import cores
 
+    load_compiled()
     n_s = q.shape[0]
     workers = min(cores(), max(1, n_s // PARALLEL_SAMPLES))
     if workers == 1:

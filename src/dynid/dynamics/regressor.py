@@ -7,18 +7,31 @@ rotor inertia ``Ia·ddq``, Coulomb ``fc·sign(dq)`` and viscous ``fv·dq`` frict
 Method: Newton–Euler. The wrench of link ``j`` about its origin is linear in its parameters,
 ``f = M a + dw×MS + w×(w×MS)``, ``n = I dw + w×(I w) + MS×a``, and joint ``i <= j`` feels
 ``tau_i = z·n + l·f`` with ``z`` the axis of joint ``i`` and ``l = z × (o_j - o_i)``, both in link ``j``'s
-frame. All ten columns follow in closed form; a compiled kernel (numba) evaluates them for every
-sample, in parallel over chunks of samples, with no Python loop per sample.
+frame. All ten columns follow in closed form (:mod:`dynid.dynamics._regressor_kernel`); a compiled
+kernel (numba) evaluates them for every sample, in parallel over chunks of samples, with no Python loop
+per sample. Until a process has computed :data:`NUMPY_SAMPLES` samples, the same statements run in NumPy
+on blocks of samples instead, with the same numbers: a short identification (the UR10e or TX40 logs of
+``configs/``) then never loads numba and its LLVM (about 0.45 s and 100 MB).
 """
 
 from __future__ import annotations
+
+import threading
 
 import numpy as np
 
 from ..checks import check_states
 from ..model.robot import Robot
 from ..friction import drive_columns
-from ._regressor_kernel import joint_torque_regressor
+from . import _regressor_kernel as kernel
+
+NUMPY_SAMPLES = 60_000
+"""Samples a process computes with the NumPy form before it loads the compiled kernel (NumPy takes 2-5 µs
+a sample, the kernel under 1 µs after a start of about 0.45 s). Once the kernel is loaded, it does
+everything."""
+
+_numpy_used = 0
+_numpy_lock = threading.Lock()
 
 
 def regressor(robot: Robot, q, dq, ddq, columns=None) -> np.ndarray:
@@ -66,7 +79,8 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     npj = robot.n_params_per_joint
-    joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap)
+    fill = kernel.numpy_regressor if _numpy_form(q.shape[0]) else kernel.joint_torque_regressor
+    fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap)
     if robot.drive_terms:  # each joint's own drive terms, from the friction table
         cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
         for i in range(robot.n_dof):
@@ -79,6 +93,19 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
         kept = colmap[src] >= 0
         if kept.any():
             out[:, :, colmap[src[kept]]] = robot.transmission.coupling_columns(dq, ddq)[:, :, kept]
+
+
+def _numpy_form(n_samples: int) -> bool:
+    """Whether these samples go through the NumPy form: the kernel is not loaded yet and the process's
+    NumPy budget (:data:`NUMPY_SAMPLES`) holds them."""
+    global _numpy_used
+    if kernel.compiled():
+        return False
+    with _numpy_lock:
+        if _numpy_used + n_samples > NUMPY_SAMPLES:
+            return False
+        _numpy_used += n_samples
+        return True
 
 
 def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None,
