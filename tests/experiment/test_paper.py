@@ -128,3 +128,24 @@ def test_a_robot_with_coupled_motors_is_simulated_with_its_coupling():
     r = run_paper_experiment(cfg)
     assert r.robot.n_params > r.robot.n_dof * r.robot.n_params_per_joint  # coupled-motor parameters present
     np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-6, atol=1e-6 * np.abs(r.truth).max())
+
+
+def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_columns():
+    """Without the SDP, the simulation smooths (eq. 17) the base regressor's columns only: the same numbers,
+    to round-off in the end samples' polynomial fits, as smoothing every standard column and then keeping them."""
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.excitation.paper_trajectories import paper_validation_trajectory
+    from dynid.experiment.paper import simulate_dataset
+    from dynid.model.description import load_robot
+    from dynid.simulation import NoiseModel
+
+    robot = load_robot("er16")
+    base = base_parameters(robot, rng=0)
+    t = np.arange(2000) / 500.0
+    args = (robot, base, paper_validation_trajectory(0.1 * np.pi, 6), t, NoiseModel(0.05, 1e-5))
+    rest = (robot.standard_parameters(), 2, "validation", [])
+    alone = simulate_dataset(*args, np.random.default_rng(4), *rest)
+    kept = simulate_dataset(*args, np.random.default_rng(4), *rest, keep_standard=True)
+    assert alone.w_standard is None and kept.w_standard is not None
+    np.testing.assert_allclose(alone.w_base, kept.w_base, rtol=1e-12, atol=1e-12 * np.abs(kept.w_base).max())
+    np.testing.assert_array_equal(alone.tau, kept.tau)

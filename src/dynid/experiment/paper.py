@@ -293,10 +293,12 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
     tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
     q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
-    y = five_point_cubic_smoothing(regressor(robot, q_f, dq_f, ddq_f), passes)  # eq. 17 along time, every column
-    w_std = y.reshape(-1, y.shape[2])
-    return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, base.base_observation(w_std), tool_positions(robot, q),
-                   w_std if keep_standard else None)
+    # eq. 17 along time, every column: of the base regressor directly (its columns are some of the standard
+    # regressor's, and each column is smoothed on its own) unless the standard one is kept
+    y = five_point_cubic_smoothing(regressor(robot, q_f, dq_f, ddq_f, None if keep_standard else base.independent), passes)
+    w = y.reshape(-1, y.shape[2])
+    return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, base.base_observation(w) if keep_standard else w,
+                   tool_positions(robot, q), w if keep_standard else None)
 
 
 def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
