@@ -7,7 +7,8 @@ Prints the peak memory allocated during the identification (tracemalloc; the inp
 allocated before and not counted), the time, and the ratios: 1-hour peak / 6-minute peak, and the
 1-hour peak against the size the stacked base observation matrix would have (the reference: what a
 non-chunked least squares would hold). Targets: the peak barely grows with the length (ratio near 1,
-well below the 10x of the data), and stays far below the full matrix.
+well below the 10x of the data), and stays far below the full matrix. The compiled regressor is loaded
+first, so that both logs go through it (a process's first samples would otherwise take the NumPy form).
 """
 
 from __future__ import annotations
@@ -57,6 +58,9 @@ def measure(robot, base, minutes: float) -> tuple[float, float, int]:
 
 
 def main() -> None:
+    from dynid.dynamics import _regressor_kernel
+
+    _regressor_kernel.load_compiled()
     robot = load_robot("er16")
     base = base_parameters(robot, rng=0)
     identify(robot, base, prepared(robot, 0.2), "wls")  # warm-up (JIT compilation)
