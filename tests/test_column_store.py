@@ -68,3 +68,15 @@ def test_no_temporary_folder_is_a_one_line_error(tmp_path, monkeypatch):
     monkeypatch.setattr(column_store.tempfile, "tempdir", str(tmp_path / "missing"))
     with pytest.raises(DataError, match=r"cannot create a temporary file in .*missing for a long log.*TMPDIR"):
         ColumnFile()
+
+
+def test_a_full_disk_is_a_one_line_error(monkeypatch):
+    import errno
+    import os
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(column_store.os, "pwrite", full)
+    with pytest.raises(DataError, match=r"cannot write a long log's column to .*: No space left on device \(free some space, or set TMPDIR"):
+        ColumnFile().append(np.ones(10))
