@@ -34,6 +34,8 @@ def test_stored_columns_index_like_the_array(x, stored):
     assert rows.flags.c_contiguous  # the regressor kernel's layout
     with pytest.raises(IndexError):
         stored[np.array([1000])]
+    with pytest.raises(TypeError, match="positive step"):
+        stored[::-1]
 
 
 def test_column_and_row_maps_equal_the_array_operations(x, stored):

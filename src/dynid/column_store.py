@@ -149,6 +149,8 @@ class StoredColumns:
         n = len(self)
         if isinstance(key, slice):
             a, b, step = key.indices(n)
+            if step < 1:
+                raise TypeError("StoredColumns: rows are read forwards (a slice with a positive step)")
             if step != 1:
                 return self.rows(a, b)[::step].copy() if b > a else np.empty((0, len(self.files)))
             return StoredColumns(self.files, self.start + a, self.start + max(a, b))
