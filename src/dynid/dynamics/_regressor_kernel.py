@@ -22,9 +22,10 @@ import threading
 import numpy as np
 
 
-def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o, w, dw, acc, z0, rl):
+def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl):
     """Fill ``out[k]`` (n, m): column ``colmap[c]`` holds standard column ``c`` of the ten inertial columns of
-    each link (skipped where ``colmap[c] < 0``); the other columns hold 0.
+    each link (skipped where ``colmap[c] < 0``), column ``drive_map[i, t]`` of joint ``i`` its drive column
+    ``drive[k, i, t]`` (skipped where ``drive_map[i, t] < 0``); the other columns hold 0.
 
     Parameters
     ----------
@@ -38,16 +39,23 @@ def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o
     npj : int
         Standard parameters per joint.
     colmap : (n_params,) int array
+    drive : (N, n, T) array
+        Each joint's own drive columns (rotor inertia, friction, offset: :mod:`dynid.friction`), written here
+        while the sample's row is in the cache.
+    drive_map : (n, T) int array
     r0, o, w, dw, acc, z0, rl : scratch arrays (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample
         axis when ``k`` is a slice.
     """
     n = q.shape[1]
     m = out.shape[2]
-    # ---- zero every entry first: links j < i stay zero, and the drive columns are filled by the caller
-    #      from the friction table (dynid.friction) -----
+    # ---- zero every entry first (links j < i stay zero), then each joint's drive columns -----------
     for i in range(n):
         for c in range(m):
             out[k, i, c] = 0.0
+        for t in range(drive_map.shape[1]):
+            dst = drive_map[i, t]
+            if dst >= 0:
+                out[k, i, dst] = drive[k, i, t]
     # ---- forward recursion -------------------------------------------------------------
     for j in range(n):
         ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
@@ -150,15 +158,15 @@ def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o
                     out[k, i, dst] = values[t]
 
 
-def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, r0, o, w, dw, acc, z0, rl):
+def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop, r0, o, w, dw, acc, z0, rl):
     for k in range(start, stop):
-        _sample(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, r0, o, w, dw, acc, z0, rl)
+        _sample(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl)
 
 
-def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop):
+def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop):
     """Samples ``start:stop`` with their own scratch arrays (releases the GIL: threads run ranges side by side)."""
     n = q.shape[1]
-    _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+    _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
            np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((3, 3)))
 
 
@@ -190,7 +198,7 @@ NUMPY_BLOCK = 2048
 """Samples per block of :func:`numpy_regressor` (its vectors stay in the cache)."""
 
 
-def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
+def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map):
     """What :func:`joint_torque_regressor` computes, by :func:`sample_columns` on blocks of samples at once
     (NumPy vectors; about 4.4 µs a sample against the kernel's 0.7 µs, but no start-up)."""
     n_s, n = q.shape
@@ -199,7 +207,7 @@ def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
         m = b - a
         block = np.empty((n, out.shape[2], m))  # a column's samples side by side: written at full speed
         sample_columns(slice(None), rp, pp, axes, gravity, q[a:b], dq[a:b], ddq[a:b], block.transpose(2, 0, 1), npj,
-                       colmap, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
+                       colmap, drive[a:b], drive_map, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
                        np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((3, 3, m)))
         out[a:b] = block.transpose(2, 0, 1)
 
@@ -208,10 +216,10 @@ PARALLEL_SAMPLES = 4096
 """From this many samples on, the samples are split over the cores (threads); below, one call."""
 
 
-def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
+def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map):
     """Fill every entry of ``out`` (N, n, m): column ``colmap[c]`` holds standard column ``c`` (the ten
-    inertial columns of each link; skipped where ``colmap[c] < 0``), the drive columns hold 0 (the caller
-    fills them from :mod:`dynid.friction`). Every sample is computed on its own, so the result does not
+    inertial columns of each link; skipped where ``colmap[c] < 0``) and the drive columns of ``drive`` as
+    ``drive_map`` places them (:func:`sample_columns`). Every sample is computed on its own, so the result does not
     depend on how the samples are split over threads."""
     from ..threads import cores
 
@@ -219,11 +227,12 @@ def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap):
     n_s = q.shape[0]
     workers = min(cores(), max(1, n_s // PARALLEL_SAMPLES))
     if workers == 1:
-        _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, 0, n_s)
+        _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, 0, n_s)
         return
     from concurrent.futures import ThreadPoolExecutor
 
     bounds = np.linspace(0, n_s, workers + 1).astype(np.int64)
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        list(pool.map(lambda k: _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, int(bounds[k]), int(bounds[k + 1])),
+        list(pool.map(lambda k: _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, int(bounds[k]),
+                                         int(bounds[k + 1])),
                       range(workers)))

@@ -80,14 +80,11 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     npj = robot.n_params_per_joint
+    # each joint's own drive terms, from the friction table, written by the kernel with the sample's other columns
+    drive = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
+    drive_map = colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(drive.shape[2])]
     fill = kernel.numpy_regressor if _numpy_form(q.shape[0]) else kernel.joint_torque_regressor
-    fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap)
-    if robot.drive_terms:  # each joint's own drive terms, from the friction table
-        cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
-        for i in range(robot.n_dof):
-            src = np.arange(i * npj + 10, (i + 1) * npj)
-            kept = colmap[src] >= 0
-            out[:, i, colmap[src[kept]]] = cols[:, i][:, kept]
+    fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, np.ascontiguousarray(drive), np.ascontiguousarray(drive_map))
     n_joint = robot.n_dof * npj
     if robot.n_params > n_joint:  # coupled motors (see dynid.model.transmission)
         src = np.arange(n_joint, robot.n_params)
