@@ -144,3 +144,19 @@ def test_a_short_identification_never_loads_numba():
     config = Path(__file__).resolve().parents[2] / "configs" / "tx40-full.toml"
     out = subprocess.run([sys.executable, "-c", SHORT_RUN, str(config), str(root)], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_the_numpy_budget_counts_samples_and_calls(monkeypatch):
+    """A process's NumPy budget: each call costs its samples plus a call's fixed cost; past the budget, or once
+    the compiled kernel is loaded, the kernel computes."""
+    import dynid.dynamics.regressor as module
+
+    monkeypatch.setattr(module, "_numpy_used", 0)
+    monkeypatch.setattr(module, "NUMPY_SAMPLES", 1000)
+    monkeypatch.setattr(module, "NUMPY_CALL_SAMPLES", 400)
+    monkeypatch.setattr(module.kernel, "compiled", lambda: False)
+    assert [module._numpy_form(100) for _ in range(3)] == [True, True, False]
+    monkeypatch.setattr(module, "_numpy_used", 0)
+    assert not module._numpy_form(601)
+    monkeypatch.setattr(module.kernel, "compiled", lambda: True)
+    assert not module._numpy_form(1)

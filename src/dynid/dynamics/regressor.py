@@ -31,6 +31,11 @@ NUMPY_SAMPLES = 60_000
 holds the paper experiment's 50 500 samples and the identifications of ``configs/`` (30 000-46 000); a
 computation that needs more loads the kernel, which then does everything."""
 
+NUMPY_CALL_SAMPLES = 400
+"""What one call of the NumPy form costs beyond its samples, in samples (its 3000-odd NumPy operations take
+about 1.7 ms whatever the samples): many small calls, like the excitation design's, use up the budget
+sooner."""
+
 _numpy_used = 0
 _numpy_lock = threading.Lock()
 
@@ -95,14 +100,15 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
 
 def _numpy_form(n_samples: int) -> bool:
     """Whether these samples go through the NumPy form: the kernel is not loaded yet and the process's
-    NumPy budget (:data:`NUMPY_SAMPLES`) holds them."""
+    NumPy budget (:data:`NUMPY_SAMPLES`) holds them and the call (:data:`NUMPY_CALL_SAMPLES`)."""
     global _numpy_used
     if kernel.compiled():
         return False
     with _numpy_lock:
-        if _numpy_used + n_samples > NUMPY_SAMPLES:
+        cost = n_samples + NUMPY_CALL_SAMPLES
+        if _numpy_used + cost > NUMPY_SAMPLES:
             return False
-        _numpy_used += n_samples
+        _numpy_used += cost
         return True
 
 
