@@ -94,7 +94,7 @@ class StoredColumns:
 
     @classmethod
     def from_columns(cls, columns) -> "StoredColumns":
-        """Stored copies of the 1-D arrays ``columns`` (each released by the caller once written)."""
+        """Stored copies of the 1-D arrays ``columns`` (an iterable: a generator holds one at a time)."""
         files = []
         for c in columns:
             files.append(ColumnFile())
@@ -126,11 +126,7 @@ class StoredColumns:
 
     def map_columns(self, along_time: Callable[[np.ndarray, int], np.ndarray]) -> "StoredColumns":
         """New stored columns ``along_time(column_j, j)``, one column in memory at a time."""
-        files = []
-        for j in range(len(self.files)):
-            files.append(ColumnFile())
-            files[-1].append(along_time(self.column(j), j))
-        return StoredColumns(files)
+        return StoredColumns.from_columns(along_time(self.column(j), j) for j in range(len(self.files)))
 
     def map_rows(self, row_wise: Callable[[np.ndarray], np.ndarray], chunk: int | None = None) -> "StoredColumns":
         """New stored columns of ``row_wise(rows)`` (an (n, k) → (n, k') map that treats each row alone), chunk by
@@ -189,8 +185,8 @@ def by_column(x, along_time: Callable[[np.ndarray, int], np.ndarray]):
         if out is None:
             out = np.empty((y.shape[0], flat.shape[1]))
         out[:, c] = y
-    if out is None:
-        return np.empty((0,) + x.shape[1:]) if x.shape[0] == 0 else x.copy()
+    if out is None:  # no columns
+        return x.copy()
     return out.reshape((out.shape[0],) + x.shape[1:])
 
 

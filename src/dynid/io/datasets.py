@@ -191,19 +191,21 @@ SATURATION_SAMPLES = 20
 def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
     """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
     currents or torques flat at their extreme (saturation), naming joint and time range."""
-    worst = np.array([np.abs(q[:, j]).max() for j in range(q.shape[1])])  # one joint at a time: q may be stored
+    lim = robot.limits
+    worst, outside = np.zeros(q.shape[1]), []
+    for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
+        column = q[:, j]
+        worst[j] = np.abs(column).max()
+        k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
+        outside.append((k.size, k[0] if k.size else 0))
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
                         f"positions in degrees (positions = {{ ..., unit = \"deg\" }})?")
-    lim = robot.limits
-    for j in range(q.shape[1]):
-        column = q[:, j]
-        out = (column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05)
-        if out.any():
-            k = np.flatnonzero(out)
+    for j, (count, first) in enumerate(outside):
+        if count:
             warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
-                            f"during {k.size} samples from t = {t[k[0]]:.3f} s (units, encoder zero, position_offset?)")
+                            f"during {count} samples from t = {t[first]:.3f} s (units, encoder zero, position_offset?)")
     kind = "currents" if "currents" in spec.signals or (spec.bag is not None and spec.bag.effort == "currents") else "torques"
     for j in range(tau.shape[1]):
         x = tau[:, j]
