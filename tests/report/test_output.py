@@ -7,7 +7,9 @@ import sys
 import pytest
 
 from dynid.exceptions import ConfigError
+from dynid.report import output
 from dynid.report.output import MANIFEST, check_output_folder, staged
+from dynid.threads import cores
 
 
 @staged
@@ -82,23 +84,74 @@ def test_a_kill_while_files_move_leaves_no_manifest_and_its_staging_folder_goes_
     assert not list(out.glob(".dynid-staging-*")) and json.loads((out / MANIFEST).read_text())["files"] == ["results.json"]
 
 
-def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path):
-    from dynid.report.output import draw_figures
-    from dynid.threads import cores
-
-    parent = os.getpid()
-
-    def job(i, fail_in_child=False):
+def _writer_jobs(folder, n, parent=None):
+    """Jobs that write ``{i}.png`` holding the writer's pid; with ``parent``, they fail in any other process."""
+    def job(i):
         def run():
-            if fail_in_child and os.getpid() != parent:
-                raise RuntimeError("the child's drawing failed")
-            (tmp_path / f"{i}.png").write_text(str(os.getpid()))
+            if parent is not None and os.getpid() != parent:
+                raise RuntimeError("the drawing failed in another process")
+            (folder / f"{i}.png").write_text(str(os.getpid()))
         return run
 
-    draw_figures([job(i) for i in range(6)])
-    writers = {(tmp_path / f"{i}.png").read_text() for i in range(6)}
-    assert len(writers) == (2 if sys.platform.startswith("linux") and cores() >= 2 else 1)  # both processes drew
+    return [job(i) for i in range(n)]
+
+
+def _writers(folder, n):
+    return [(folder / f"{i}.png").read_text() for i in range(n)]
+
+
+FORKS = sys.platform.startswith("linux") and cores() >= 2
+
+
+def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path):
+    from dynid.report.output import draw_figures
+
+    parent = os.getpid()
+    draw_figures(_writer_jobs, tmp_path, 6)
+    assert len(set(_writers(tmp_path, 6))) == (2 if FORKS else 1)  # both processes drew
     for p in tmp_path.glob("*.png"):
         p.unlink()
-    draw_figures([job(i, fail_in_child=True) for i in range(6)])
-    assert {(tmp_path / f"{i}.png").read_text() for i in range(6)} == {str(parent)}  # the parent redrew the child's half
+    draw_figures(_writer_jobs, tmp_path, 6, parent)
+    assert set(_writers(tmp_path, 6)) == {str(parent)}  # the parent redrew the child's half
+
+
+@pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
+def test_the_figure_process_draws_every_figure_and_leaves(tmp_path):
+    from dynid.report.output import draw_figures, figure_process
+
+    parent = os.getpid()
+    with figure_process():
+        pid = output._waiting._pid
+        draw_figures(_writer_jobs, tmp_path, 6)
+        writers = set(_writers(tmp_path, 6))
+        assert len(writers) == 2 and str(parent) not in writers and str(pid) in writers  # it and its fork drew
+        draw_figures(_writer_jobs, tmp_path / "again", 0)  # a second call in the block draws here
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)  # it was waited for: no zombie is left
+
+
+@pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
+@pytest.mark.parametrize("failure", ["drawing", "pickling"])
+def test_when_the_figure_process_fails_this_process_draws_every_figure(tmp_path, failure):
+    from dynid.report.output import draw_figures, figure_process
+
+    parent = os.getpid()
+    with figure_process():
+        if failure == "drawing":
+            draw_figures(_writer_jobs, tmp_path, 6, parent)  # fails in the figure process
+        else:
+            draw_figures(lambda folder, n: _writer_jobs(folder, n), tmp_path, 6)  # a lambda does not pickle
+    writers = _writers(tmp_path, 6)  # every file is there
+    assert set(writers) == {str(parent)} if failure == "drawing" else str(parent) in writers
+
+
+@pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
+def test_an_unused_figure_process_leaves_with_the_block(tmp_path):
+    from dynid.report.output import figure_process
+
+    with pytest.raises(ValueError):
+        with figure_process():
+            pid = output._waiting._pid
+            raise ValueError("the computation failed")  # no figures sent
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)

@@ -109,6 +109,7 @@ def run(
     and compare the estimators on it."""
     from ..experiment import PaperExperimentConfig, run_paper_experiment
     from ..estimators.names import LABELS, parse_methods
+    from ..report.output import figure_process
     from ..report.paper_run import save_paper_run
 
     rep = Reporter(quiet)
@@ -119,11 +120,12 @@ def run(
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
             excitation=excitation, methods=parse_methods(methods), bootstrap=bootstrap)
-        with rep.progress("dynid run") as progress:
-            result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
-                LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
-            progress.update("writing results" + (" and figures" if figures else ""))
-        paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
+        with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
+            with rep.progress("dynid run") as progress:
+                result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
+                    LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
+                progress.update("writing results" + (" and figures" if figures else ""))
+            paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(result.summary_blocks())
@@ -148,10 +150,12 @@ def identify(
         cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
         _check_out(out)
         from ..report.identification_run import save_identification
-        with rep.progress("dynid identify") as progress:
-            result = run_identification(cfg, progress=_steps(progress), validate=validate)
-            progress.update("writing results" + (" and figures" if figures else ""))
-        paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
+        from ..report.output import figure_process
+        with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
+            with rep.progress("dynid identify") as progress:
+                result = run_identification(cfg, progress=_steps(progress), validate=validate)
+                progress.update("writing results" + (" and figures" if figures else ""))
+            paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks(result.summary_blocks())
@@ -240,16 +244,18 @@ def validate(
         cfg = load_identification_config(config, data_root)
         _check_out(out)
         from ..report.identification_run import save_validation
+        from ..report.output import figure_process
         identified = _read_results(results)
         datasets = None
         if file is not None:
             datasets = (dataset_for_file(cfg, file, _parse_rows(rows)),)
         elif rows is not None:
             raise DataError("--rows needs --file")
-        with rep.progress("dynid validate") as progress:
-            comparisons, warnings = run_validation(cfg, identified, datasets, progress=_steps(progress))
-            progress.update("writing results and figures")
-        paths = save_validation(comparisons, out, warnings)  # after the live line ended
+        with figure_process():  # forked before the live line's thread starts: imports pyplot meanwhile
+            with rep.progress("dynid validate") as progress:
+                comparisons, warnings = run_validation(cfg, identified, datasets, progress=_steps(progress))
+                progress.update("writing results and figures")
+            paths = save_validation(comparisons, out, warnings)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
     rep.blocks([comparison_table(c) for c in comparisons])

@@ -23,6 +23,12 @@ def fixed_layout(fig, left=0.85, right=0.25, top=0.45, bottom=0.55, hspace=0.35)
     fig.subplots_adjust(left=left / w, right=1 - right / w, top=1 - top / h, bottom=bottom / h, hspace=hspace)
 
 
+def _title(ax, title: str) -> None:
+    """Set a 2-D axes' title at a fixed height: matplotlib otherwise measures the top of the axes' tick labels
+    to place it (0.03 s a figure). dynid's axes have nothing on top, so the title lands on the same pixels."""
+    ax.set_title(title, y=1.0)
+
+
 def _axes(ax, n=1, projection=None, figsize=(8, 6)):
     import matplotlib.pyplot as plt
 
@@ -47,7 +53,7 @@ def plot_joint_trajectories(t, q, q_min=None, q_max=None, ax=None, title="Excita
                 a.axhline(lim[j], color="tab:red", ls="--", lw=0.8)
         a.set_ylabel(f"q{j + 1} [rad]")
         a.grid(alpha=0.3)
-    np.atleast_1d(axes)[0].set_title(title)
+    _title(np.atleast_1d(axes)[0], title)
     np.atleast_1d(axes)[-1].set_xlabel("t [s]")
     return axes
 
@@ -105,7 +111,7 @@ def plot_convergence(histories, ax=None, reference=None, title="ABC convergence"
     a.set_yscale("log")
     a.grid(alpha=0.3, which="both")
     a.legend(fontsize="small")
-    a.set_title(title)
+    _title(a, title)
     return a
 
 
@@ -133,7 +139,7 @@ def plot_method_comparison(labels, validation_error, parameter_error, ax=None,
     a.set_ylabel("validation error [%]")
     a.legend(fontsize="small", ncol=n)
     a.grid(alpha=0.3, axis="y", which="both")
-    a.set_title(title)
+    _title(a, title)
     b.bar(x, parameter_error, color="tab:gray")
     b.set_xticks(x, labels)
     b.set_yscale("log")
@@ -165,7 +171,7 @@ def plot_std_over_bound(levels, labels, ratios, ax=None,
         a.set_ylabel(f"σ = {levels[li]:g} A\nstd / √CRB")
         a.grid(alpha=0.3, axis="y", which="both")
     ax[-1].set_xticks(np.arange(len(labels)), labels)
-    ax[0].set_title(title + " (bars: medians)")
+    _title(ax[0], title + " (bars: medians)")
     return ax
 
 
@@ -251,7 +257,7 @@ class TorqueFigure:
                 line.set_data(t, y[:, j])
             a.relim()
             a.autoscale_view()
-        self.axes[0].set_title(title)
+        _title(self.axes[0], title)
         return self.fig
 
 

@@ -18,7 +18,19 @@ def _slug(name: str) -> str:
 def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=None) -> list[Path]:
     """One PNG per dataset (default name ``{prefix}_{dataset}.png``): measured vs predicted torques of every
     parameter set, drawn on one figure that is redrawn for each dataset."""
-    paths, jobs, cache = [], [], {}
+    paths, titles = [], []
+    for i, cmp in enumerate(comparisons):
+        kind = prefix if names is None else names[i][0]
+        paths.append(out / (f"{prefix}_{_slug(cmp.name)}.png" if names is None else names[i][1]))
+        titles.append(f"{kind} — {cmp.name}: measured vs predicted torques")
+    if paths:
+        draw_figures(_comparison_jobs, list(comparisons), paths, titles)
+    return paths
+
+
+def _comparison_jobs(comparisons, paths, titles) -> list:
+    """The jobs that write the comparison figures (:func:`dynid.report.output.draw_figures`)."""
+    cache = {}
 
     def job(cmp, path, title):
         key = (cmp.measured.shape[1], tuple(cmp.predicted))
@@ -26,13 +38,7 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=N
             cache[key] = figures.TorqueFigure(*key)
         save_figure(cache[key].draw(cmp.t, cmp.measured, cmp.predicted, title), path)
 
-    for i, cmp in enumerate(comparisons):
-        kind = prefix if names is None else names[i][0]
-        path = out / (f"{prefix}_{_slug(cmp.name)}.png" if names is None else names[i][1])
-        jobs.append(lambda c=cmp, p=path, k=kind: job(c, p, f"{k} — {c.name}: measured vs predicted torques"))
-        paths.append(path)
-    draw_figures(jobs)
-    return paths
+    return [lambda c=c, p=p, t=t: job(c, p, t) for c, p, t in zip(comparisons, paths, titles)]
 
 
 @staged

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import io
 import json
@@ -106,29 +107,33 @@ def output_folder(out: str | Path) -> Path:
     return out
 
 
-def draw_figures(jobs) -> None:
-    """Run figure jobs (callables without arguments, each writing its own file) on two processes where the
-    machine has two cores and the system can fork: a forked child draws every other job while this process
-    draws the rest (drawing is single-threaded Python; a fork shares the imported matplotlib and the data).
-    If the child fails, this process draws its jobs too, so every file is written or an error is raised.
+def draw_figures(build, *args) -> None:
+    """Draw the figure jobs ``build(*args)`` returns (callables without arguments, each writing its own
+    file): in the figure process when one waits (:func:`figure_process`), else here, on two processes
+    (:func:`_draw_jobs`). ``build`` is a module-level function and ``args`` can be pickled; if the figure
+    process fails, this process draws every job, so every file is written or an error is raised.
+    """
+    global _waiting
+    worker, _waiting = _waiting, None  # one use: the process leaves once it has drawn
+    if worker is not None and worker.draw(build, args):
+        return
+    _draw_jobs(build(*args))
+
+
+def _draw_jobs(jobs) -> None:
+    """Run figure jobs on two processes where the machine has two cores and the system can fork: a forked
+    child draws every other job while this process draws the rest (drawing is single-threaded Python; a fork
+    shares the imported matplotlib and the data). If the child fails, this process draws its jobs too.
     Call it with no other thread of this process printing (the CLI ends its live progress line first).
     """
-    from ..threads import cores
-
     jobs = list(jobs)
-    import sys
-
-    if len(jobs) < 4 or cores() < 2 or not sys.platform.startswith("linux"):  # fork with threads: Linux only
+    if len(jobs) < 4 or not _can_fork():
         for job in jobs:
             job()
         return
-    sys.stdout.flush()
-    sys.stderr.flush()
-    pid = os.fork()
+    pid = _fork()
     if pid == 0:  # the child: its half, then leave at once (no atexit handlers, no buffers of the parent)
         code = 0
-        # fresh standard streams: a lock another thread of the parent held at the fork stays held in the child
-        sys.stdout = sys.stderr = open(os.devnull, "w")
         try:
             for job in jobs[1::2]:
                 job()
@@ -143,6 +148,127 @@ def draw_figures(jobs) -> None:
     if os.waitstatus_to_exitcode(status) != 0:
         for job in jobs[1::2]:
             job()
+
+
+def _can_fork() -> bool:
+    import sys
+
+    from ..threads import cores
+
+    return cores() >= 2 and sys.platform.startswith("linux")  # fork with threads: Linux only
+
+
+def _fork() -> int:
+    """``os.fork()``; the child gets fresh standard streams on /dev/null (a lock another thread of the parent
+    held at the fork stays held in the child) and the buffers are flushed first (not written twice)."""
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        sys.stdout = sys.stderr = open(os.devnull, "w")
+    return pid
+
+
+class _FigureProcess:
+    """A forked child that imports matplotlib while its parent computes, then draws the figures the parent
+    sends it (pickled through a pipe) on two processes, and exits with 0 once every file is written."""
+
+    def __init__(self):
+        read, self._write = os.pipe()
+        self._pid = _fork()
+        if self._pid == 0:
+            os.close(self._write)
+            _figure_process_main(read)
+        os.close(read)
+
+    def draw(self, build, args) -> bool:
+        """Send the jobs; return whether the child drew them all (false: this process draws them)."""
+        import pickle
+
+        try:
+            message = pickle.dumps((build, args), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:  # noqa: BLE001 - data that do not pickle: the child leaves, this process draws
+            self.wait()
+            return False
+        fd, self._write = self._write, None
+        try:
+            with os.fdopen(fd, "wb") as pipe:
+                pipe.write(message)
+        except OSError:
+            pass  # the child died: its exit code says so
+        return self.wait() == 0
+
+    def wait(self) -> int:
+        """Close the pipe if it is still open (the child then leaves without drawing), wait for the child and
+        return its exit code."""
+        if self._write is not None:
+            os.close(self._write)
+            self._write = None
+        if self._pid is None:
+            return 1
+        _, status = os.waitpid(self._pid, 0)
+        self._pid = None
+        return os.waitstatus_to_exitcode(status)
+
+
+def _figure_process_main(read: int):
+    """The figure process: import pyplot, wait for ``(build, args)`` and draw; never returns."""
+    code = 1
+    try:
+        import pickle
+
+        _warm_up_drawing()
+        with os.fdopen(read, "rb") as pipe:
+            data = pipe.read()
+        if data:  # empty: the parent closed the pipe without figures to draw
+            build, args = pickle.loads(data)
+            _draw_jobs(build(*args))
+        code = 0
+    except BaseException:  # noqa: BLE001 - reported through the exit code; the parent draws instead
+        pass
+    os._exit(code)
+
+
+def _warm_up_drawing() -> None:
+    """What every process's first figure pays once, paid ahead of time: pyplot, the 3-D axes, the fonts, the
+    PNG writer (about 0.3 s)."""
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d import Axes3D  # noqa: F401 - registers the 3-D projection (the tool path)
+
+    fig = plt.figure(figsize=(2, 2))
+    ax = fig.add_subplot(111)
+    ax.plot([0.0, 1.0], [0.0, 1.0], label="warm-up")
+    ax.set_title("warm-up")
+    ax.legend()
+    fig.savefig(io.BytesIO(), format="png", dpi=20)
+    plt.close(fig)
+
+
+_waiting: _FigureProcess | None = None
+"""The figure process of the current :func:`figure_process` block, until :func:`draw_figures` uses it."""
+
+
+@contextlib.contextmanager
+def figure_process(enabled: bool = True):
+    """Within this block, :func:`draw_figures` hands the figures to a process forked on entry, which imports
+    matplotlib (0.25 s) while this process computes, so that the import is off the command's path. Nothing
+    is forked where ``enabled`` is false, on one core, or where fork is not safe (not Linux). Enter it with
+    no other Python thread running (before the CLI's live progress line starts its thread). On exit the
+    process is waited for (it leaves at once when nothing was sent).
+    """
+    global _waiting
+    if not enabled or not _can_fork() or _waiting is not None:
+        yield
+        return
+    _waiting = _FigureProcess()
+    try:
+        yield
+    finally:
+        worker, _waiting = _waiting, None
+        if worker is not None:  # not handed figures: it leaves at once
+            worker.wait()
 
 
 def save_figure(fig_or_axes, path: Path) -> None:

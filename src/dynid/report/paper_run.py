@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -27,17 +28,8 @@ TORQUE_PLOT_METHODS = ("abc", "lad", "ols", "sdp")
 """Methods drawn in Figs. 7 and 9 (those the run has), so the curves stay readable."""
 
 
-@staged
-def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = True) -> list[Path]:
-    """Write ``results.json`` and (unless ``figures_too`` is false) the figures into ``out`` (created if
-    needed); return the paths.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
-    """
-    out = output_folder(out)
+def _figure_drawers(result: PaperRunResult) -> dict:
+    """Each figure this run has, by file name: a callable that draws it and returns its Figure."""
     ident, valid, lim = result.identification, result.validation, result.robot.limits
     methods = result.methods
     ident_name = "β1" if result.config.excitation == "paper" else "(optimized)" if result.config.excitation == "optimized" else "(from file)"
@@ -70,8 +62,39 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
             {label: (np.linspace(m.n_evaluations / len(m.history), m.n_evaluations, len(m.history)), m.history)
              for label, m in searches.items()},
             reference=references, xlabel="evaluations of eq. 9", title="Box searches on eq. 9 (LAD: the exact minimum in the box)")
-    paths = [out / name for name in FIGURES if figures_too and name in figs]
-    draw_figures([lambda p=p: save_figure(figs[p.name](), p) for p in paths])
+    return figs
+
+
+def _for_figures(result: PaperRunResult) -> PaperRunResult:
+    """The result without its observation matrices (25 MB and more), which no figure draws: what is handed
+    to the figure process."""
+    def light(d):
+        return dataclasses.replace(d, w_base=None, w_standard=None)
+
+    return dataclasses.replace(result, identification=light(result.identification), validation=light(result.validation))
+
+
+def _figure_jobs(result: PaperRunResult, paths: list[Path]) -> list:
+    """The jobs that write the figures ``paths`` (:func:`dynid.report.output.draw_figures`)."""
+    figs = _figure_drawers(result)
+    return [lambda p=p: save_figure(figs[p.name](), p) for p in paths]
+
+
+@staged
+def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = True) -> list[Path]:
+    """Write ``results.json`` and (unless ``figures_too`` is false) the figures into ``out`` (created if
+    needed); return the paths.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    out = output_folder(out)
+    drawn = _figure_drawers(result) if figures_too else {}
+    paths = [out / name for name in FIGURES if name in drawn]
+    if paths:
+        draw_figures(_figure_jobs, _for_figures(result), paths)
     json_path = out / "results.json"
     data = result.to_dict()
     write_results(json_path, data, "run")
