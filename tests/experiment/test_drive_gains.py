@@ -64,3 +64,28 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     np.testing.assert_allclose(gp.description_gains, authors)
     assert np.all(np.abs(gp.gains.gains[1:] - authors[1:]) <= 0.2 * authors[1:])
     assert gp.payload.mass == pytest.approx(2.805, rel=0.1)
+
+
+def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed_after_it(monkeypatch, tmp_path):
+    """run_identification computes the drive gains in a forked child while it identifies (two cores): the
+    same numbers as in this process, and the same identification."""
+    import json
+    from pathlib import Path
+
+    from dynid import processes
+    from dynid.io import write_json
+    from dynid.io.identification_config import load_identification_config
+    from dynid.experiment.identification_run import run_identification
+
+    from ..conftest import shared_data
+
+    cfg = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml",
+                                      data_root=shared_data("ur10e_mamedov2020"))
+    beside = run_identification(cfg, validate=False)
+    monkeypatch.setattr(processes, "can_fork", lambda: False)
+    after = run_identification(cfg, validate=False)
+    for path, result in (("beside.json", beside), ("after.json", after)):
+        write_json(tmp_path / path, result.to_dict())
+    assert (tmp_path / "beside.json").read_text() == (tmp_path / "after.json").read_text()
+    assert "drive_gains" in json.loads((tmp_path / "after.json").read_text())
+    assert beside.drive_gains.gains.gains.tolist() == after.drive_gains.gains.gains.tolist()

@@ -12,6 +12,7 @@ from ..io.datasets import DatasetSpec, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
+from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 
 
@@ -102,13 +103,15 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         step("Coulomb smoothing velocity (cross-validation)")
     choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
+    # the drive gains need neither the identification nor its data: the second core computes them meanwhile
+    gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if config.drive_gains is not None:
         step("drive gains and payload")
-        result = replace(result, drive_gains=_gains_and_payload(config, robot, base))
+        result = replace(result, drive_gains=gains.result())
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,

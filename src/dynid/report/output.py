@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ..exceptions import ConfigError
 from ..io import atomic_write_bytes
+from ..processes import can_fork, fork, read_all
 
 
 MANIFEST = ".dynid-manifest.json"
@@ -127,11 +128,11 @@ def _draw_jobs(jobs) -> None:
     Call it with no other thread of this process printing (the CLI ends its live progress line first).
     """
     jobs = list(jobs)
-    if len(jobs) < 4 or not _can_fork():
+    if len(jobs) < 4 or not can_fork():
         for job in jobs:
             job()
         return
-    pid = _fork()
+    pid = fork()
     if pid == 0:  # the child: its half, then leave at once (no atexit handlers, no buffers of the parent)
         code = 0
         try:
@@ -150,34 +151,13 @@ def _draw_jobs(jobs) -> None:
             job()
 
 
-def _can_fork() -> bool:
-    import sys
-
-    from ..threads import cores
-
-    return cores() >= 2 and sys.platform.startswith("linux")  # fork with threads: Linux only
-
-
-def _fork() -> int:
-    """``os.fork()``; the child gets fresh standard streams on /dev/null (a lock another thread of the parent
-    held at the fork stays held in the child) and the buffers are flushed first (not written twice)."""
-    import sys
-
-    sys.stdout.flush()
-    sys.stderr.flush()
-    pid = os.fork()
-    if pid == 0:
-        sys.stdout = sys.stderr = open(os.devnull, "w")
-    return pid
-
-
 class _FigureProcess:
     """A forked child that imports matplotlib while its parent computes, then draws the figures the parent
     sends it (pickled through a pipe) on two processes, and exits with 0 once every file is written."""
 
     def __init__(self):
         read, self._write = os.pipe()
-        self._pid = _fork()
+        self._pid = fork()
         if self._pid == 0:
             os.close(self._write)
             _figure_process_main(read)
@@ -220,8 +200,7 @@ def _figure_process_main(read: int):
         import pickle
 
         _warm_up_drawing()
-        with os.fdopen(read, "rb") as pipe:
-            data = pipe.read()
+        data = read_all(read)
         if data:  # empty: the parent closed the pipe without figures to draw
             build, args = pickle.loads(data)
             _draw_jobs(build(*args))
@@ -232,14 +211,15 @@ def _figure_process_main(read: int):
 
 
 def _warm_up_drawing() -> None:
-    """What every process's first figure pays once, paid ahead of time: pyplot, the 3-D axes, the fonts, the
-    PNG writer (about 0.3 s)."""
+    """What every process's first figure pays once, paid ahead of time: pyplot, the 3-D axes, the fonts,
+    the mathtext parser, the PNG writer (about 0.3 s)."""
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401 - registers the 3-D projection (the tool path)
 
     fig = plt.figure(figsize=(2, 2))
     ax = fig.add_subplot(111)
-    ax.plot([0.0, 1.0], [0.0, 1.0], label="warm-up")
+    ax.plot([1.0, 2.0], [1e-4, 1e4], label="warm-up")
+    ax.set_yscale("log")  # its labels 10^-4 ... 10^4 are mathtext, parsed once per process (7 ms each)
     ax.set_title("warm-up")
     ax.legend()
     fig.savefig(io.BytesIO(), format="png", dpi=20)
@@ -259,7 +239,7 @@ def figure_process(enabled: bool = True):
     process is waited for (it leaves at once when nothing was sent).
     """
     global _waiting
-    if not enabled or not _can_fork() or _waiting is not None:
+    if not enabled or not can_fork() or _waiting is not None:
         yield
         return
     _waiting = _FigureProcess()

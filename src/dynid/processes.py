@@ -1,0 +1,106 @@
+"""Work on the second core in a forked process: a computation independent of the one this process is doing
+(the drive gains beside the identification), and the figures (:mod:`dynid.report.output`). A fork shares
+the imported modules and the data, so nothing is imported again and only the answer is pickled back.
+
+Forking is done only where it is safe and useful: on Linux, with two cores or more. Anywhere else, and
+whenever a child fails in a way its answer cannot tell (killed, an answer that does not pickle), the work
+is done in this process instead, so the results never depend on whether a child ran it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+
+def can_fork() -> bool:
+    """Whether work may go to a forked child: Linux (fork with threads), two cores or more."""
+    from .threads import cores
+
+    return cores() >= 2 and sys.platform.startswith("linux")
+
+
+def fork() -> int:
+    """``os.fork()``, flushing the standard streams first (not written twice); the child's standard streams
+    are fresh ones on /dev/null: a lock another thread of the parent held at the fork stays held in the child."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        sys.stdout = sys.stderr = open(os.devnull, "w")
+    return pid
+
+
+def read_all(fd: int) -> bytes:
+    """Everything written to the pipe ``fd`` until its writer closes it (then closes ``fd``)."""
+    with os.fdopen(fd, "rb") as pipe:
+        return pipe.read()
+
+
+class ForkedCall:
+    """``fn(*args)`` computed in a forked child while this process goes on; :meth:`result` returns its
+    value or raises its exception, as calling ``fn(*args)`` here would. Without a child (:func:`can_fork`
+    false) or when the child leaves no answer, :meth:`result` calls ``fn(*args)`` here.
+
+    ``fn`` must not print, warn or report progress (the child's output goes nowhere). Its value and its
+    :class:`~dynid.exceptions.DynIdError` are pickled back; any other exception is raised again by calling
+    ``fn(*args)`` here, with its traceback.
+    """
+
+    def __init__(self, fn, *args):
+        self._call = (fn, args)
+        self._pid = None
+        if not can_fork():
+            return
+        read, write = os.pipe()
+        self._pid = fork()
+        if self._pid == 0:
+            os.close(read)
+            _child(write, fn, args)
+        os.close(write)
+        self._read = read
+
+    def result(self):
+        """The value of ``fn(*args)``; raises what it raised."""
+        import pickle
+
+        fn, args = self._call
+        if self._pid is None:
+            return fn(*args)
+        answer, self._pid, pid = None, None, self._pid
+        try:
+            data = read_all(self._read)
+        finally:
+            _, status = os.waitpid(pid, 0)
+        if os.waitstatus_to_exitcode(status) == 0 and data:
+            try:
+                answer = pickle.loads(data)
+            except Exception:  # noqa: BLE001 - an answer that does not unpickle: computed here instead
+                answer = None
+        if answer is None:
+            return fn(*args)
+        ok, value = answer
+        if ok:
+            return value
+        raise value
+
+
+def _child(write: int, fn, args):
+    """The child of :class:`ForkedCall`: compute, write the pickled ``(ok, value)`` and leave; never returns."""
+    code = 1
+    try:
+        import pickle
+
+        from .exceptions import DynIdError
+
+        try:
+            answer = (True, fn(*args))
+        except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)
+            answer = (False, exc)
+        data = pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL)
+        with os.fdopen(write, "wb") as pipe:
+            pipe.write(data)
+        code = 0
+    except BaseException:  # noqa: BLE001 - no answer: the parent computes it itself
+        pass
+    os._exit(code)

@@ -1,0 +1,68 @@
+"""Work handed to a forked child gives what calling it here gives: its value, its user errors, and when the
+child leaves no answer, the value computed here."""
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+from dynid import processes
+from dynid.exceptions import ConfigError
+from dynid.processes import ForkedCall, can_fork
+
+PARENT = os.getpid()
+needs_fork = pytest.mark.skipif(not can_fork(), reason="needs fork and two cores")
+
+
+def _where_and_value(n):
+    return os.getpid(), np.arange(n) ** 2
+
+
+def _config_error():
+    raise ConfigError("estimation.method: expected ols or wls, got 'x'", field="estimation.method")
+
+
+def _fails_in_a_child():
+    if os.getpid() != PARENT:
+        raise RuntimeError("a bug that only the child meets")
+    return "computed here"
+
+
+def _dies_in_a_child():
+    if os.getpid() != PARENT:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return "computed here"
+
+
+def _unpicklable_in_a_child():
+    return (lambda: None) if os.getpid() != PARENT else "computed here"
+
+
+@needs_fork
+def test_the_value_is_computed_in_the_child_and_returned():
+    pid, value = ForkedCall(_where_and_value, 5).result()
+    assert pid != PARENT
+    np.testing.assert_array_equal(value, [0, 1, 4, 9, 16])
+
+
+@needs_fork
+def test_a_user_error_in_the_child_is_raised_here_with_its_field():
+    call = ForkedCall(_config_error)
+    with pytest.raises(ConfigError, match="expected ols or wls") as info:
+        call.result()
+    assert info.value.field == "estimation.method"
+
+
+@needs_fork
+@pytest.mark.parametrize("fn", [_fails_in_a_child, _dies_in_a_child, _unpicklable_in_a_child])
+def test_without_an_answer_from_the_child_the_call_is_made_here(fn):
+    assert ForkedCall(fn).result() == "computed here"
+
+
+def test_without_fork_the_call_is_made_here(monkeypatch):
+    monkeypatch.setattr(processes, "can_fork", lambda: False)
+    pid, value = ForkedCall(_where_and_value, 3).result()
+    assert pid == PARENT and value.tolist() == [0, 1, 4]
+    with pytest.raises(ConfigError):
+        ForkedCall(_config_error).result()
