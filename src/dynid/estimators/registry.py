@@ -168,22 +168,52 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
     ``extra`` (name -> callable without arguments) adds independent tasks to the same pool, started after
     the three longest fits (their results are returned under their names).
     Returns key -> :class:`Fitted` in the order of ``keys``, then the extra tasks' results.
+
+    When a fit fails, or this thread is interrupted (Ctrl-C), the box searches stop at their next iteration,
+    the fits not started are cancelled, and the error is raised once the running ones have ended.
     """
-    from concurrent.futures import ThreadPoolExecutor
+    import threading
+    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 
     from ..threads import cores
 
+    stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration
+
     def fit(key):
+        if stop.is_set():
+            raise _Stopped
         if progress is not None:
             progress(key, None, None)
-        callback = None if progress is None else (lambda i, f, key=key: progress(key, i, f))
+
+        def callback(i, f, key=key):
+            if stop.is_set():
+                raise _Stopped
+            if progress is not None:
+                progress(key, i, f)
+
         return fit_method(key, data, budget, rngs[key], callback)
 
     extra = extra or {}
     rank = {k: i for i, k in enumerate(COST_ORDER)}
     tasks = [(rank[k], k, lambda k=k: fit(k)) for k in keys] + [(2.5, name, f) for name, f in extra.items()]
     tasks.sort(key=lambda task: task[0])
-    with ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(tasks)))) as pool:
+    pool = ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(tasks))))
+    try:
         futures = {name: pool.submit(f) for _, name, f in tasks}
+        pending = set(futures.values())
+        while pending:  # woken ten times a second: blocked on a lock, this thread would see Ctrl-C only at the end
+            _, pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION)
+            for fut in futures.values():
+                if fut.done() and fut.exception() is not None:
+                    fut.result()  # raises the fit's error now; the other fits stop below
         done = {name: fut.result() for name, fut in futures.items()}
+    except BaseException:
+        stop.set()  # a box search would otherwise run to its end (seconds) before the interrupt is seen
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown()
     return {**{key: done[key] for key in keys}, **{name: done[name] for name in extra}}
+
+
+class _Stopped(Exception):
+    """Ends a fit of :func:`fit_methods` whose caller was interrupted (never seen by the caller)."""
