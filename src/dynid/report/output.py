@@ -212,7 +212,7 @@ def _figure_process_main(read: int):
 
 def _warm_up_drawing() -> None:
     """What every process's first figure pays once, paid ahead of time: pyplot, the 3-D axes, the fonts,
-    the mathtext parser, the PNG writer (about 0.3 s)."""
+    the mathtext parser, the PNG writer (0.42-0.45 s in all on this project's 2-core machine)."""
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401 - registers the 3-D projection (the tool path)
 
@@ -233,10 +233,10 @@ _waiting: _FigureProcess | None = None
 @contextlib.contextmanager
 def figure_process(enabled: bool = True):
     """Within this block, :func:`draw_figures` hands the figures to a process forked on entry, which imports
-    matplotlib (0.25 s) while this process computes, so that the import is off the command's path. Nothing
-    is forked where ``enabled`` is false, on one core, or where fork is not safe (not Linux). Enter it with
-    no other Python thread running (before the CLI's live progress line starts its thread). On exit the
-    process is waited for (it leaves at once when nothing was sent).
+    matplotlib and warms up drawing (:func:`_warm_up_drawing`) while this process computes, so that both
+    are off the command's path. Nothing is forked where ``enabled`` is false, on one core, or where fork
+    is not safe (not Linux). Enter it with no other Python thread running (before the CLI's live progress
+    line starts its thread). On exit the process is waited for (it leaves at once when nothing was sent).
     """
     global _waiting
     if not enabled or not can_fork() or _waiting is not None:
