@@ -3,16 +3,23 @@ child leaves no answer, the value computed here."""
 
 import os
 import signal
+import sys
 
 import numpy as np
 import pytest
 
-from dynid import processes
 from dynid.exceptions import ConfigError
-from dynid.processes import ForkedCall, can_fork
+from dynid.processes import ForkedCall, allow_forks, can_fork
+from dynid.threads import cores
 
 PARENT = os.getpid()
-needs_fork = pytest.mark.skipif(not can_fork(), reason="needs fork and two cores")
+needs_fork = pytest.mark.skipif(not (sys.platform.startswith("linux") and cores() >= 2), reason="needs fork and two cores")
+
+
+@pytest.fixture
+def forks():
+    with allow_forks():
+        yield
 
 
 def _where_and_value(n):
@@ -40,14 +47,14 @@ def _unpicklable_in_a_child():
 
 
 @needs_fork
-def test_the_value_is_computed_in_the_child_and_returned():
+def test_the_value_is_computed_in_the_child_and_returned(forks):
     pid, value = ForkedCall(_where_and_value, 5).result()
     assert pid != PARENT
     np.testing.assert_array_equal(value, [0, 1, 4, 9, 16])
 
 
 @needs_fork
-def test_a_user_error_in_the_child_is_raised_here_with_its_field():
+def test_a_user_error_in_the_child_is_raised_here_with_its_field(forks):
     call = ForkedCall(_config_error)
     with pytest.raises(ConfigError, match="expected ols or wls") as info:
         call.result()
@@ -56,13 +63,17 @@ def test_a_user_error_in_the_child_is_raised_here_with_its_field():
 
 @needs_fork
 @pytest.mark.parametrize("fn", [_fails_in_a_child, _dies_in_a_child, _unpicklable_in_a_child])
-def test_without_an_answer_from_the_child_the_call_is_made_here(fn):
+def test_without_an_answer_from_the_child_the_call_is_made_here(fn, forks):
     assert ForkedCall(fn).result() == "computed here"
 
 
-def test_without_fork_the_call_is_made_here(monkeypatch):
-    monkeypatch.setattr(processes, "can_fork", lambda: False)
+def test_outside_allow_forks_the_call_is_made_here():
+    """The library alone never forks: a caller's process may run threads whose locks a child would inherit."""
+    assert not can_fork()
     pid, value = ForkedCall(_where_and_value, 3).result()
     assert pid == PARENT and value.tolist() == [0, 1, 4]
     with pytest.raises(ConfigError):
         ForkedCall(_config_error).result()
+    with allow_forks():
+        assert can_fork() == (sys.platform.startswith("linux") and cores() >= 2)
+    assert not can_fork()

@@ -2,22 +2,40 @@
 (the drive gains beside the identification), and the figures (:mod:`dynid.report.output`). A fork shares
 the imported modules and the data, so nothing is imported again and only the answer is pickled back.
 
-Forking is done only where it is safe and useful: on Linux, with two cores or more. Anywhere else, and
-whenever a child fails in a way its answer cannot tell (killed, an answer that does not pickle), the work
-is done in this process instead, so the results never depend on whether a child ran it.
+Forking is done only where it is safe and useful: inside :func:`allow_forks` (the CLI's commands, whose
+process dynid owns: a library caller's process may run threads whose locks a child would inherit), on
+Linux, with two cores or more. Anywhere else, and whenever a child fails in a way its answer cannot tell
+(killed, an answer that does not pickle), the work is done in this process instead, so the results never
+depend on whether a child ran it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 
+_allowed = False
+
+
+@contextlib.contextmanager
+def allow_forks():
+    """Within this block, work may go to forked children (:func:`can_fork`). The CLI runs its commands in
+    it; the library alone never forks."""
+    global _allowed
+    before, _allowed = _allowed, True
+    try:
+        yield
+    finally:
+        _allowed = before
+
 
 def can_fork() -> bool:
-    """Whether work may go to a forked child: Linux (fork with threads), two cores or more."""
+    """Whether work may go to a forked child: inside :func:`allow_forks`, on Linux (fork with threads), with
+    two cores or more."""
     from .threads import cores
 
-    return cores() >= 2 and sys.platform.startswith("linux")
+    return _allowed and cores() >= 2 and sys.platform.startswith("linux")
 
 
 def fork() -> int:

@@ -70,10 +70,13 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     """run_identification computes the drive gains in a forked child while it identifies (two cores): the
     same numbers as in this process, and the same identification."""
     import json
+    import sys
     from pathlib import Path
 
     from dynid import processes
     from dynid.io import write_json
+    from dynid.processes import allow_forks
+    from dynid.threads import cores
     from dynid.io.identification_config import load_identification_config
     from dynid.experiment.identification_run import run_identification
 
@@ -81,9 +84,14 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
 
     cfg = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml",
                                       data_root=shared_data("ur10e_mamedov2020"))
-    beside = run_identification(cfg, validate=False)
-    monkeypatch.setattr(processes, "can_fork", lambda: False)
-    after = run_identification(cfg, validate=False)
+    forks = []
+    monkeypatch.setattr(processes, "fork", lambda fork=processes.fork: forks.append(1) or fork())
+    with allow_forks():  # as in the CLI
+        beside = run_identification(cfg, validate=False)
+    assert len(forks) == (1 if cores() >= 2 and sys.platform.startswith("linux") else 0)  # the gains went to a child
+    n_beside = len(forks)
+    after = run_identification(cfg, validate=False)  # the library alone computes them in its process
+    assert len(forks) == n_beside
     for path, result in (("beside.json", beside), ("after.json", after)):
         write_json(tmp_path / path, result.to_dict())
     assert (tmp_path / "beside.json").read_text() == (tmp_path / "after.json").read_text()

@@ -103,7 +103,16 @@ def _writers(folder, n):
 FORKS = sys.platform.startswith("linux") and cores() >= 2
 
 
-def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path):
+@pytest.fixture
+def forks():
+    """As in the CLI's commands, which run inside allow_forks (the library alone draws in its process)."""
+    from dynid.processes import allow_forks
+
+    with allow_forks():
+        yield
+
+
+def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path, forks):
     from dynid.report.output import draw_figures
 
     parent = os.getpid()
@@ -116,7 +125,7 @@ def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(
 
 
 @pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
-def test_the_figure_process_draws_every_figure_and_leaves(tmp_path):
+def test_the_figure_process_draws_every_figure_and_leaves(tmp_path, forks):
     from dynid.report.output import draw_figures, figure_process
 
     parent = os.getpid()
@@ -132,7 +141,7 @@ def test_the_figure_process_draws_every_figure_and_leaves(tmp_path):
 
 @pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
 @pytest.mark.parametrize("failure", ["drawing", "pickling"])
-def test_when_the_figure_process_fails_this_process_draws_every_figure(tmp_path, failure):
+def test_when_the_figure_process_fails_this_process_draws_every_figure(tmp_path, failure, forks):
     from dynid.report.output import draw_figures, figure_process
 
     parent = os.getpid()
@@ -146,7 +155,7 @@ def test_when_the_figure_process_fails_this_process_draws_every_figure(tmp_path,
 
 
 @pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")
-def test_an_unused_figure_process_leaves_with_the_block(tmp_path):
+def test_an_unused_figure_process_leaves_with_the_block(tmp_path, forks):
     from dynid.report.output import figure_process
 
     with pytest.raises(ValueError):

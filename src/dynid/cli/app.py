@@ -360,9 +360,12 @@ def main() -> None:
 
     os.environ.setdefault("MPLBACKEND", "Agg")  # figures go to files: no display needed, none opened
 
+    from ..processes import allow_forks
+
     signal.signal(signal.SIGINT, _interrupt)
     try:
-        app()
+        with allow_forks():  # this process is dynid's: figures and drive gains may go to forked children
+            app()
     except DynIdError as exc:  # pragma: no cover - commands already catch theirs
         Reporter().error(_message(exc))
         sys.exit(1)
