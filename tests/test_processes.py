@@ -77,3 +77,20 @@ def test_outside_allow_forks_the_call_is_made_here():
     with allow_forks():
         assert can_fork() == (sys.platform.startswith("linux") and cores() >= 2)
     assert not can_fork()
+
+
+def _sleeps():
+    import time
+
+    time.sleep(60)
+    return "late"
+
+
+@needs_fork
+def test_a_child_whose_answer_is_not_taken_is_stopped_when_the_block_ends(forks):
+    with pytest.raises(ValueError):
+        with ForkedCall(_sleeps) as call:
+            pid = call._pid
+            raise ValueError("the work the answer was for failed")
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)  # stopped and waited for, not left for a minute

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import sys
 
 _allowed = False
@@ -62,7 +63,8 @@ class ForkedCall:
 
     ``fn`` must not print, warn or report progress (the child's output goes nowhere). Its value and its
     :class:`~dynid.exceptions.DynIdError` are pickled back; any other exception is raised again by calling
-    ``fn(*args)`` here, with its traceback.
+    ``fn(*args)`` here, with its traceback. Used as a context manager, it stops and waits for a child whose
+    answer was not taken when the block ends (the work it was for failed).
     """
 
     def __init__(self, fn, *args):
@@ -77,6 +79,16 @@ class ForkedCall:
             _child(write, fn, args)
         os.close(write)
         self._read = read
+
+    def __enter__(self) -> "ForkedCall":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._pid is not None:  # the answer was not taken: the child is stopped, not left behind
+            os.kill(self._pid, signal.SIGKILL)
+            os.waitpid(self._pid, 0)
+            os.close(self._read)
+            self._pid = None
 
     def result(self):
         """The value of ``fn(*args)``; raises what it raised."""

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import replace
 
 import numpy as np
@@ -105,13 +106,14 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
-    result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
+    with gains or contextlib.nullcontext():
+        result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
+        if gains is not None:
+            step("drive gains and payload")
+            result = replace(result, drive_gains=gains.result())
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
-    if config.drive_gains is not None:
-        step("drive gains and payload")
-        result = replace(result, drive_gains=gains.result())
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,

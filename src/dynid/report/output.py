@@ -122,9 +122,9 @@ def draw_figures(build, *args) -> None:
 
 
 def _draw_jobs(jobs) -> None:
-    """Run figure jobs on two processes where the machine has two cores and the system can fork: a forked
-    child draws every other job while this process draws the rest (drawing is single-threaded Python; a fork
-    shares the imported matplotlib and the data). If the child fails, this process draws its jobs too.
+    """Run figure jobs on two processes where :func:`dynid.processes.can_fork`: a forked child draws every
+    other job while this process draws the rest (drawing is single-threaded Python; a fork shares the
+    imported matplotlib and the data). If the child fails, this process draws its jobs too.
     Call it with no other thread of this process printing (the CLI ends its live progress line first).
     """
     jobs = list(jobs)
@@ -234,9 +234,10 @@ _waiting: _FigureProcess | None = None
 def figure_process(enabled: bool = True):
     """Within this block, :func:`draw_figures` hands the figures to a process forked on entry, which imports
     matplotlib and warms up drawing (:func:`_warm_up_drawing`) while this process computes, so that both
-    are off the command's path. Nothing is forked where ``enabled`` is false, on one core, or where fork
-    is not safe (not Linux). Enter it with no other Python thread running (before the CLI's live progress
-    line starts its thread). On exit the process is waited for (it leaves at once when nothing was sent).
+    are off the command's path. Nothing is forked where ``enabled`` is false or
+    :func:`dynid.processes.can_fork` is (outside the CLI's commands, on one core, not on Linux). Enter it
+    with no other Python thread running (before the CLI's live progress line starts its thread). On exit
+    the process is waited for (it leaves at once when nothing was sent).
     """
     global _waiting
     if not enabled or not can_fork() or _waiting is not None:
