@@ -127,13 +127,15 @@ assert "numba" not in sys.modules, "numba loaded"
 module.NUMPY_SAMPLES = 0
 z = np.zeros((1, 6))
 module.regressor(load_robot("er16"), z, z, z)
-assert "numba" in sys.modules and module.kernel.compiled(), "the kernel did not take over"
+assert module._simd["used"], "the compiled regressor did not take over"
+assert "numba" not in sys.modules, "numba loaded for the compiled regressor"
 """
 
 
 def test_a_short_identification_never_loads_numba():
     """The TX40 log (45 000 regressor samples with the SDP's standard columns) stays within the NumPy form's
-    budget: the process never imports numba and its LLVM; past the budget, the compiled kernel takes over."""
+    budget: the process never imports numba and its LLVM; past the budget, the compiled regressor (the
+    robot's SIMD code, built by llvmlite alone) takes over, still without numba."""
     import subprocess
     import sys
     from pathlib import Path
@@ -148,15 +150,76 @@ def test_a_short_identification_never_loads_numba():
 
 def test_the_numpy_budget_counts_samples_and_calls(monkeypatch):
     """A process's NumPy budget: each call costs its samples plus a call's fixed cost; past the budget, or once
-    the compiled kernel is loaded, the kernel computes."""
+    a compiled regressor has run, the compiled one computes."""
     import dynid.dynamics.regressor as module
 
     monkeypatch.setattr(module, "_numpy_used", 0)
     monkeypatch.setattr(module, "NUMPY_SAMPLES", 1000)
     monkeypatch.setattr(module, "NUMPY_CALL_SAMPLES", 400)
     monkeypatch.setattr(module.kernel, "compiled", lambda: False)
+    monkeypatch.setattr(module, "_simd", {"used": False, "failed": False})
     assert [module._numpy_form(100) for _ in range(3)] == [True, True, False]
     monkeypatch.setattr(module, "_numpy_used", 0)
     assert not module._numpy_form(601)
-    monkeypatch.setattr(module.kernel, "compiled", lambda: True)
+    assert module._numpy_form(1)
+    monkeypatch.setattr(module, "_simd", {"used": True, "failed": False})  # once the SIMD code has run
     assert not module._numpy_form(1)
+    monkeypatch.setattr(module, "_simd", {"used": False, "failed": False})
+    monkeypatch.setattr(module.kernel, "compiled", lambda: True)  # or numba's kernel is loaded
+    assert not module._numpy_form(1)
+
+
+@pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])
+def test_the_robots_simd_code_gives_the_other_forms_numbers(name, monkeypatch):
+    """The robot's SIMD code (sample_columns traced, its constants folded, four samples a vector), the NumPy
+    form and numba's kernel: the same numbers bit for bit, for full and selected columns, a number of samples
+    that is not a multiple of the lanes, and on one thread as on two."""
+    import dynid.dynamics.regressor as module
+    from dynid.dynamics import _regressor_simd
+
+    robot = load_robot(name)
+    q, dq, ddq = random_states(np.random.default_rng(7), 9003, robot.n_dof)  # two threads, and a padded tail
+    for columns in (np.arange(robot.n_params), np.arange(robot.n_params - 1, -1, -3)):
+        colmap = np.full(robot.n_params, -1)
+        colmap[columns] = np.arange(columns.size)
+        forms = {}
+        for form in ("numpy", "compiled", "numba"):
+            forms[form] = np.full((q.shape[0], robot.n_dof, columns.size), np.nan)
+            monkeypatch.setattr(module, "_simd", {"used": False, "failed": False})
+            module._fill(robot, q, dq, ddq, forms[form], colmap, form)
+            assert module._simd["used"] == (form == "compiled")  # the SIMD code ran, not numba's kernel
+        monkeypatch.setattr(_regressor_simd, "PARALLEL_SAMPLES", 10**9)
+        forms["one thread"] = np.full_like(forms["numpy"], np.nan)
+        module._fill(robot, q, dq, ddq, forms["one thread"], colmap, "compiled")
+        monkeypatch.undo()
+        for form, y in forms.items():
+            np.testing.assert_array_equal(y, forms["numpy"], err_msg=form)
+
+
+SIMD_CACHE = """
+import numpy as np, sys
+from dynid.dynamics import regressor as module
+from dynid.model.description import load_robot
+module.NUMPY_SAMPLES = 0
+q = np.random.default_rng(1).uniform(-2, 2, (50, 3))
+np.save(sys.argv[1], module.regressor(load_robot("er16").submodel(3), q, q, q))
+"""
+
+
+def test_the_simd_code_is_cached_on_disk_and_loaded_from_there(tmp_path):
+    """The first process compiles the robot's SIMD code into $XDG_CACHE_HOME/dynid; the next one loads it."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    for run in ("first", "second"):
+        out = subprocess.run([sys.executable, "-c", SIMD_CACHE, str(tmp_path / f"{run}.npy")], env=env, capture_output=True,
+                             text=True, timeout=300)
+        assert out.returncode == 0, out.stderr[-2000:]
+        cached = list((tmp_path / "cache" / "dynid").glob("regressor-*.o"))
+        assert len(cached) == 1 and cached[0].stat().st_size > 1000
+        if run == "first":
+            stamp = cached[0].stat().st_mtime_ns
+    assert cached[0].stat().st_mtime_ns == stamp  # loaded, not written again
+    np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "second.npy"))

@@ -7,11 +7,15 @@ rotor inertia ``Ia·ddq``, Coulomb ``fc·sign(dq)`` and viscous ``fv·dq`` frict
 Method: Newton–Euler. The wrench of link ``j`` about its origin is linear in its parameters,
 ``f = M a + dw×MS + w×(w×MS)``, ``n = I dw + w×(I w) + MS×a``, and joint ``i <= j`` feels
 ``tau_i = z·n + l·f`` with ``z`` the axis of joint ``i`` and ``l = z × (o_j - o_i)``, both in link ``j``'s
-frame. All ten columns follow in closed form (:mod:`dynid.dynamics._regressor_kernel`); a compiled
-kernel (numba) evaluates them for every sample, in parallel over chunks of samples, with no Python loop
-per sample. Until a process has computed :data:`NUMPY_SAMPLES` samples, the same statements run in NumPy
-on blocks of samples instead, with the same numbers: a short identification (the UR10e or TX40 logs of
-``configs/``) then never loads numba and its LLVM (about 0.45 s and 100 MB).
+frame. All ten columns follow in closed form, written once (:mod:`dynid.dynamics._regressor_kernel`) and
+run three ways with the same numbers:
+
+* until a process has computed :data:`NUMPY_SAMPLES` samples, by NumPy on blocks of samples (no start-up
+  cost: a short identification, like the UR10e or TX40 logs of ``configs/``, compiles nothing);
+* then by the robot's own compiled code (:mod:`dynid.dynamics._regressor_simd`): the statements traced
+  once, the robot's constants folded in, four samples per SIMD vector, on the cores in parallel; compiled by
+  llvmlite in about 0.5 s and cached on disk;
+* where that code cannot be built, by numba's kernel, one sample after another.
 """
 
 from __future__ import annotations
@@ -26,10 +30,11 @@ from ..friction import drive_columns
 from . import _regressor_kernel as kernel
 
 NUMPY_SAMPLES = 60_000
-"""Samples a process computes with the NumPy form before it loads the compiled kernel: NumPy takes 1.2 µs
-(3 joints) to 4.8 µs (6 joints) a sample, the kernel under 1 µs after a start of about 0.45 s. The budget
-holds the paper experiment's 50 500 samples and the identifications of ``configs/`` (30 000-46 000); a
-computation that needs more loads the kernel, which then does everything."""
+"""Samples a process computes with the NumPy form before the compiled regressor takes over: NumPy takes
+1.2 µs (3 joints) to 4.8 µs (6 joints) a sample, the compiled code 0.5 µs after loading it (0.015 s from the
+cache, 0.5 s compiled). The budget holds the paper experiment's 50 500 samples and the identifications of
+``configs/`` (30 000-46 000); a computation that needs more loads the compiled code, which then does
+everything."""
 
 NUMPY_CALL_SAMPLES = 400
 """What one call of the NumPy form costs beyond its samples, in samples (its 3000-odd NumPy operations take
@@ -79,17 +84,36 @@ def observation_matrix(robot: Robot, q, dq, ddq) -> np.ndarray:
     return y.reshape(-1, y.shape[2])
 
 
-def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
+def compile_kernels(robots) -> None:
+    """Compile, or load from their caches, the compiled regressors: numba's kernel (where the SIMD code
+    cannot be built) and each robot's SIMD code (the install step's warm-up, :mod:`dynid.warm_up`)."""
+    for i, robot in enumerate(robots):
+        z = np.zeros((8, robot.n_dof))
+        for form in (("numba", "compiled") if i == 0 else ("compiled",)):
+            _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form)
+
+
+def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None) -> None:
+    """Fill ``out`` by the NumPy form, the compiled regressor, or numba's kernel (``form``: "numpy",
+    "compiled", "numba"; by default the NumPy form while the process's budget lasts, then the compiled one)."""
     rp = np.ascontiguousarray([jt.rotation for jt in robot.joints], dtype=np.float64)
     pp = np.ascontiguousarray([jt.translation for jt in robot.joints], dtype=np.float64)
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     npj = robot.n_params_per_joint
-    # each joint's own drive terms, from the friction table, written by the kernel with the sample's other columns
-    drive = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities) * robot.drive_mask
-    drive_map = colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(drive.shape[2])]
-    fill = kernel.numpy_regressor if _numpy_form(q.shape[0]) else kernel.joint_torque_regressor
-    fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, np.ascontiguousarray(drive), np.ascontiguousarray(drive_map))
+
+    def drive(a, b):
+        """Each joint's own drive terms (friction table) for samples a:b, written by the kernel with the sample's
+        other columns; the terms are elementwise, so any split gives the same numbers."""
+        return np.ascontiguousarray(drive_columns(robot.drive_terms, dq[a:b], ddq[a:b], robot.friction_velocities) * robot.drive_mask)
+
+    drive_map = np.ascontiguousarray(colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(len(robot.drive_terms))])
+    form = form or ("numpy" if _numpy_form(q.shape[0]) else "compiled")
+    if form == "compiled":
+        _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
+    else:
+        fill = kernel.numpy_regressor if form == "numpy" else kernel.joint_torque_regressor
+        fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
     n_joint = robot.n_dof * npj
     if robot.n_params > n_joint:  # coupled motors (see dynid.model.transmission)
         src = np.arange(n_joint, robot.n_params)
@@ -98,11 +122,30 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap) -> None:
             out[:, :, colmap[src[kept]]] = robot.transmission.coupling_columns(dq, ddq)[:, :, kept]
 
 
+_simd = {"used": False, "failed": False}
+
+
+def _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map) -> None:
+    """The compiled regressor: the robot's own SIMD code (:mod:`dynid.dynamics._regressor_simd`), or numba's
+    kernel where that code cannot be built (no LLVM for this platform). Both give the NumPy form's numbers.
+    ``drive(a, b)`` gives the drive columns of samples ``a:b``."""
+    if not _simd["failed"]:
+        try:
+            from . import _regressor_simd
+
+            _regressor_simd.simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
+            _simd["used"] = True
+            return
+        except Exception:  # noqa: BLE001 - llvmlite cannot build it here: numba's kernel computes the same numbers
+            _simd["failed"] = True
+    kernel.joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
+
+
 def _numpy_form(n_samples: int) -> bool:
-    """Whether these samples go through the NumPy form: the kernel is not loaded yet and the process's
-    NumPy budget (:data:`NUMPY_SAMPLES`) holds them and the call (:data:`NUMPY_CALL_SAMPLES`)."""
+    """Whether these samples go through the NumPy form: no compiled regressor has run in this process yet and
+    its NumPy budget (:data:`NUMPY_SAMPLES`) holds them and the call (:data:`NUMPY_CALL_SAMPLES`)."""
     global _numpy_used
-    if kernel.compiled():
+    if kernel.compiled() or _simd["used"]:
         return False
     with _numpy_lock:
         cost = n_samples + NUMPY_CALL_SAMPLES
