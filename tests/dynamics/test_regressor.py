@@ -223,3 +223,9 @@ def test_the_simd_code_is_cached_on_disk_and_loaded_from_there(tmp_path):
             stamp = cached[0].stat().st_mtime_ns
     assert cached[0].stat().st_mtime_ns == stamp  # loaded, not written again
     np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "second.npy"))
+    cached[0].write_bytes(cached[0].read_bytes()[:-100])  # cut short (a full disk, say): ignored, compiled again
+    out = subprocess.run([sys.executable, "-c", SIMD_CACHE, str(tmp_path / "third.npy")], env=env, capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert cached[0].stat().st_mtime_ns != stamp  # written again, whole
+    np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "third.npy"))

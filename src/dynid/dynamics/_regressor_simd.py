@@ -231,12 +231,42 @@ _kernels: dict = {}
 _lock = threading.Lock()
 
 
-def _cache_folder() -> Path:
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid"
+def _cache_folder() -> Path | None:
+    try:
+        return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid"
+    except RuntimeError:  # no home folder: no cache
+        return None
+
+
+_CHECK = 32
+"""Bytes of SHA-256 after each cached object: a file that does not match (cut short, damaged) is ignored."""
+
+
+def _read_cache(path: Path | None) -> bytes | None:
+    try:
+        data = path.read_bytes()
+    except (OSError, AttributeError):
+        return None
+    body, check = data[:-_CHECK], data[-_CHECK:]
+    return body if len(data) > _CHECK and hashlib.sha256(body).digest() == check else None
+
+
+def _write_cache(path: Path | None, data: bytes) -> None:
+    """Write atomically (a temporary file renamed), so that another process reads all of it or nothing."""
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_bytes(data + hashlib.sha256(data).digest())
+        os.replace(tmp, path)
+    except OSError:
+        pass  # no writable cache: compiled again next time
 
 
 def _compile(ir: str):
-    """The compiled ``kernel`` of ``ir`` as a ctypes function (the engine is kept alive with it)."""
+    """The compiled ``kernel`` of ``ir`` as a ctypes function (the engine is kept alive with it): the cached
+    machine code when there is a valid one, else compiled and cached."""
     import ctypes
 
     import llvmlite
@@ -247,28 +277,14 @@ def _compile(ir: str):
     cpu, features = llvm.get_host_cpu_name(), llvm.get_host_cpu_features().flatten()
     machine = llvm.Target.from_default_triple().create_target_machine(cpu=cpu, features=features, opt=2)
     key = hashlib.sha256("\n".join((ir, cpu, features, llvmlite.__version__)).encode()).hexdigest()[:32]
-    path = _cache_folder() / f"regressor-{key}.o"
-
-    def cached(_module):
-        try:
-            return path.read_bytes()
-        except OSError:
-            return None
-
-    def save(_module, buffer):
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_bytes(buffer)
-            os.replace(tmp, path)
-        except OSError:
-            pass  # no writable cache: compiled again next time
-
+    folder = _cache_folder()
+    path = None if folder is None else folder / f"regressor-{key}.o"
+    cached = _read_cache(path)
     module = llvm.parse_assembly(ir)
     module.verify()
     engine = llvm.create_mcjit_compiler(module, machine)
-    engine.set_object_cache(save, cached)
-    if not path.exists():
+    engine.set_object_cache(lambda _module, buffer: _write_cache(path, buffer), lambda _module: cached)
+    if cached is None:
         builder = llvm.create_pass_builder(machine, llvm.PipelineTuningOptions(speed_level=2))
         builder.getModulePassManager().run(module, builder)
     engine.finalize_object()
