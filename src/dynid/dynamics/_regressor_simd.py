@@ -3,20 +3,21 @@
 :func:`~dynid.dynamics._regressor_kernel.sample_columns` is run once on symbols instead of numbers. The
 robot's constants (joint axes, fixed rotations and translations, gravity) are folded in, and the products by
 0 or 1 and the sums with 0 are dropped. What remains is one straight-line sequence of additions, subtractions,
-multiplications and negations per sample: about 3000 for a 6-joint arm. It is written out as LLVM IR on
-vectors of :data:`LANES` doubles, one sample per lane, and compiled for this CPU by llvmlite (numba's code
-generator, already installed with it).
+multiplications and negations per sample, about 3000 for a 6-joint arm, and each joint's cosine and sine.
+It is written out as LLVM IR on vectors of :data:`LANES` doubles, one sample per lane, and compiled for this
+CPU by llvmlite (numba's code generator, already installed with it). The cosines and sines are the C
+library's, called lane by lane, as in numba's kernel.
 
 The operations are those of ``sample_columns``, in the same order, each lane on its own sample, with no
-reassociation and no fused multiply-add. So the numbers are those of the NumPy form, bit for bit, and of
-the numba kernel wherever ``np.cos`` and ``math.cos`` agree. The cosines and sines come from NumPy.
+reassociation and no fused multiply-add. So the numbers are those of numba's kernel, bit for bit, and of the
+NumPy form wherever NumPy's cosine is the C library's (tests compare the three).
 
 The columns to write (``colmap``) and the number of columns are arguments of the compiled function, so one
 function per robot serves every column selection: a column that is not selected is computed and stored
 into a scratch slot. Each block of samples is zeroed first; the entries no column writes stay zero.
 
 Machine code is cached on disk (``$XDG_CACHE_HOME/dynid`` or ``~/.cache/dynid``) under a hash of the IR, the
-CPU and llvmlite's version. Compiling takes about 0.6 s for a 6-joint arm; loading from the cache, about
+CPU and llvmlite's version. Compiling takes 0.4-0.5 s for a 6-joint arm; loading from the cache, about
 0.015 s.
 """
 
@@ -97,11 +98,11 @@ class _Sym:
         op, args = self.graph.nodes[self.id]
         return args[0] if op == "fneg" else self.graph.node("fneg", self)
 
-    def cos(self):  # np.cos(symbol): the cosine of the same input, computed by NumPy beforehand
-        return self.graph.node("load", "cq", self.graph.nodes[self.id][1][1])
+    def cos(self):  # np.cos(symbol)
+        return self.graph.node("cos", self)
 
     def sin(self):
-        return self.graph.node("load", "sq", self.graph.nodes[self.id][1][1])
+        return self.graph.node("sin", self)
 
 
 def _operand(x):
@@ -148,7 +149,7 @@ def _hex(x: float) -> str:
 
 
 def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
-    """``kernel(q, dq, ddq, drive, cq, sq, out, colmap, m, start, stop)``: samples ``start:stop`` (a multiple
+    """``kernel(q, dq, ddq, drive, out, colmap, m, start, stop)``: samples ``start:stop`` (a multiple
     of LANES apart) of ``out`` (N, n, m), C order; ``colmap`` (n·npj,) int64 (-1: not written)."""
     w = LANES
     vec = f"<{w} x double>"
@@ -167,9 +168,9 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
     def ref(a):
         return f"%t{a.id}" if isinstance(a, _Sym) else const(a)
 
-    strides = {"q": n, "dq": n, "ddq": n, "cq": n, "sq": n, "drive": n * n_drive}
-    head = ["define void @kernel(ptr noalias %q, ptr noalias %dq, ptr noalias %ddq, ptr noalias %drive, ptr noalias %cq, "
-            "ptr noalias %sq, ptr noalias %out, ptr noalias %colmap, i64 %m, i64 %start, i64 %stop) {",
+    strides = {"q": n, "dq": n, "ddq": n, "drive": n * n_drive}
+    head = ["define void @kernel(ptr noalias %q, ptr noalias %dq, ptr noalias %ddq, ptr noalias %drive, "
+            "ptr noalias %out, ptr noalias %colmap, i64 %m, i64 %start, i64 %stop) {",
             "entry:", f"  %scratch = alloca {vec}, align 32", f"  %nm = mul i64 {n}, %m",
             f"  %block = mul i64 %nm, {8 * w}"]
     body = ["loop:", "  %k = phi i64 [ %start, %entry ], [ %next, %loop ]", "  %row = mul i64 %k, %nm",
@@ -185,7 +186,16 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
     for i, (op, args) in enumerate(graph.nodes):
         if i not in live:
             continue
-        if op == "load":
+        if op in ("cos", "sin"):  # by the C library, lane by lane (as numba's kernel: math.cos is the C library's)
+            prev = "undef"
+            for lane in range(w):
+                x, y = f"%x{next(counter)}", f"%x{next(counter)}"
+                body.append(f"  {x} = extractelement {vec} {ref(args[0])}, i32 {lane}")
+                body.append(f"  {y} = call double @{op}(double {x})")
+                nxt = f"%t{i}" if lane == w - 1 else f"%x{next(counter)}"
+                body.append(f"  {nxt} = insertelement {vec} {prev}, double {y}, i32 {lane}")
+                prev = nxt
+        elif op == "load":
             name, index = args
             offset = index[0] * n_drive + index[1] if name == "drive" else index[0]
             prev = "undef"
@@ -221,7 +231,8 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
     head.append("  %empty = icmp sge i64 %start, %stop")
     head.append("  br i1 %empty, label %exit, label %loop")
     body += [f"  %next = add i64 %k, {w}", "  %done = icmp sge i64 %next, %stop", "  br i1 %done, label %exit, label %loop",
-             "exit:", "  ret void", "}", "declare void @llvm.memset.p0.i64(ptr, i8, i64, i1)"]
+             "exit:", "  ret void", "}", "declare void @llvm.memset.p0.i64(ptr, i8, i64, i1)",
+             "declare double @cos(double)", "declare double @sin(double)"]
     return "\n".join(head + body) + "\n"
 
 
@@ -289,7 +300,7 @@ def _compile(ir: str):
         builder.getModulePassManager().run(module, builder)
     engine.finalize_object()
     pointer, i64 = ctypes.c_void_p, ctypes.c_int64
-    function = ctypes.CFUNCTYPE(None, *[pointer] * 8, i64, i64, i64)(engine.get_function_address("kernel"))
+    function = ctypes.CFUNCTYPE(None, *[pointer] * 6, i64, i64, i64)(engine.get_function_address("kernel"))
     return function, engine
 
 
@@ -323,18 +334,15 @@ def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, d
     function = kernel(rp, pp, axes, gravity, npj, n_drive)
     columns = np.ascontiguousarray(colmap[:n * npj], dtype=np.int64)
     q, dq, ddq = (np.ascontiguousarray(a, dtype=float) for a in (q, dq, ddq))
-    cq, sq, drives = np.empty_like(q), np.empty_like(q), np.empty((n_s, n, n_drive))
+    drives = np.empty((n_s, n, n_drive))
 
     def run(arrays, target, start, stop):
-        # NumPy's cosines and the drive columns, computed in the thread of their samples
-        np.cos(arrays[0][start:stop], out=arrays[4][start:stop])
-        np.sin(arrays[0][start:stop], out=arrays[5][start:stop])
-        if arrays[3] is drives:
+        if arrays[3] is drives:  # the drive columns, computed in the thread of their samples
             drives[start:stop] = drive(start, stop)
         function(*(a.ctypes.data for a in arrays), target.ctypes.data, columns.ctypes.data, m, start, stop)
 
     whole = n_s - n_s % LANES
-    arrays = (q, dq, ddq, drives, cq, sq)
+    arrays = (q, dq, ddq, drives)
     workers = min(cores(), max(1, whole // PARALLEL_SAMPLES))
     bounds = [whole * i // workers // LANES * LANES for i in range(workers)] + [whole]
     if workers == 1:
