@@ -18,19 +18,20 @@ def test_an_interrupted_caller_stops_the_box_searches_instead_of_waiting_for_the
     data = FitData(w, tau, n, np.column_stack([beta - 5.0, beta + 5.0]), base=None)
     budget = SearchBudget(colony_size=30, limit=15, maxiter=5_000)
     pso_iterations = budget.evaluations // budget.colony_size - 1  # PSO runs them all: seconds
-    last, fired = {}, []
-    before = set(threading.enumerate())  # other tests' pools may still be alive in this process
+    last, fired, lock, searchers = {}, [], threading.Lock(), set()  # the lock: one interrupt, whichever reports first
 
     def progress(key, iteration, best):
         if iteration is None:
             return
-        last[key] = iteration
-        if len(last) == 2 and min(last.values()) >= 3 and not fired:  # as Ctrl-C while both search
-            fired.append(True)
-            _thread.interrupt_main()
+        with lock:
+            searchers.add(threading.current_thread())
+            last[key] = iteration
+            if len(last) == 2 and min(last.values()) >= 3 and not fired:  # as Ctrl-C while both search
+                fired.append(True)
+                _thread.interrupt_main()
 
     with pytest.raises(KeyboardInterrupt):
         fit_methods(("de", "pso"), data, budget, {"de": np.random.default_rng(1), "pso": np.random.default_rng(2)}, progress)
     assert set(last) == {"de", "pso"}  # both were searching
     assert last["pso"] < pso_iterations // 4  # stopped, not run to its end
-    assert not [t for t in set(threading.enumerate()) - before if t.name.startswith("ThreadPoolExecutor")]  # joined
+    assert searchers and not any(t.is_alive() for t in searchers)  # the threads that searched were joined

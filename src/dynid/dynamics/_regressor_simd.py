@@ -183,29 +183,37 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
         body.append(f"  %lane{lane} = mul i64 %nm, {lane}")
         body.append(f"  %b_out{lane} = getelementptr double, ptr %b_out, i64 %lane{lane}")
     counter = iter(range(10**9))
+
+    def lanes(result, scalar):
+        """``result`` = the vector of ``scalar(lane)`` (which emits its lines and names the lane's double)."""
+        prev = "undef"
+        for lane in range(w):
+            x = scalar(lane)
+            nxt = result if lane == w - 1 else f"%x{next(counter)}"
+            body.append(f"  {nxt} = insertelement {vec} {prev}, double {x}, i32 {lane}")
+            prev = nxt
+
+    def two_steps(first, second):
+        """A lane's double from two lines: ``%a = first(lane)`` then ``%b = second(%a)``."""
+        def scalar(lane):
+            a, b = f"%x{next(counter)}", f"%x{next(counter)}"
+            body.append(f"  {a} = {first(lane)}")
+            body.append(f"  {b} = {second(a)}")
+            return b
+        return scalar
+
     for i, (op, args) in enumerate(graph.nodes):
         if i not in live:
             continue
         if op in ("cos", "sin"):  # by the C library, lane by lane (as numba's kernel: math.cos is the C library's)
-            prev = "undef"
-            for lane in range(w):
-                x, y = f"%x{next(counter)}", f"%x{next(counter)}"
-                body.append(f"  {x} = extractelement {vec} {ref(args[0])}, i32 {lane}")
-                body.append(f"  {y} = call double @{op}(double {x})")
-                nxt = f"%t{i}" if lane == w - 1 else f"%x{next(counter)}"
-                body.append(f"  {nxt} = insertelement {vec} {prev}, double {y}, i32 {lane}")
-                prev = nxt
+            lanes(f"%t{i}", two_steps(lambda lane, v=ref(args[0]): f"extractelement {vec} {v}, i32 {lane}",
+                                      lambda x, f=op: f"call double @{f}(double {x})"))
         elif op == "load":
             name, index = args
             offset = index[0] * n_drive + index[1] if name == "drive" else index[0]
-            prev = "undef"
-            for lane in range(w):
-                p, x = f"%p{next(counter)}", f"%x{next(counter)}"
-                body.append(f"  {p} = getelementptr double, ptr %b_{name}, i64 {lane * strides[name] + offset}")
-                body.append(f"  {x} = load double, ptr {p}, align 8")
-                nxt = f"%t{i}" if lane == w - 1 else f"%x{next(counter)}"
-                body.append(f"  {nxt} = insertelement {vec} {prev}, double {x}, i32 {lane}")
-                prev = nxt
+            lanes(f"%t{i}", two_steps(lambda lane, b=f"%b_{name}", s=strides[name], o=offset:
+                                      f"getelementptr double, ptr {b}, i64 {lane * s + o}",
+                                      lambda p: f"load double, ptr {p}, align 8"))
         elif op == "fneg":
             body.append(f"  %t{i} = fneg {vec} {ref(args[0])}")
         else:
