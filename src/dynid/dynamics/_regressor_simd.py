@@ -64,7 +64,7 @@ class _Sym:
 
     def __add__(self, other):
         other = _operand(other)
-        return self if other == 0.0 and isinstance(other, float) else self.graph.node("fadd", self, other)
+        return self if isinstance(other, float) and other == 0.0 else self.graph.node("fadd", self, other)
 
     def __radd__(self, other):
         other = _operand(other)
@@ -72,7 +72,7 @@ class _Sym:
 
     def __sub__(self, other):
         other = _operand(other)
-        return self if other == 0.0 and isinstance(other, float) else self.graph.node("fsub", self, other)
+        return self if isinstance(other, float) and other == 0.0 else self.graph.node("fsub", self, other)
 
     def __rsub__(self, other):
         other = _operand(other)
@@ -262,9 +262,11 @@ _CHECK = 32
 
 
 def _read_cache(path: Path | None) -> bytes | None:
+    if path is None:
+        return None
     try:
         data = path.read_bytes()
-    except (OSError, AttributeError):
+    except OSError:
         return None
     body, check = data[:-_CHECK], data[-_CHECK:]
     return body if len(data) > _CHECK and hashlib.sha256(body).digest() == check else None
@@ -332,7 +334,7 @@ without the GIL); below, one call."""
 def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map) -> None:
     """What :func:`dynid.dynamics._regressor_kernel.joint_torque_regressor` computes (the same arguments, but
     ``drive(a, b)`` giving the drive columns (b - a, n, T) of samples ``a:b``; every entry of ``out``
-    (N, n, m) is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
+    (N, n, m), C-ordered, is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
     samples after the last whole group of lanes go through it padded. ``colmap`` must place the drive
     columns where ``drive_map`` does (as :func:`dynid.dynamics.regressor.regressor` builds them)."""
     from ..threads import cores
@@ -345,24 +347,25 @@ def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, d
     drives = np.empty((n_s, n, n_drive))
 
     def run(arrays, target, start, stop):
-        if arrays[3] is drives:  # the drive columns, computed in the thread of their samples
-            drives[start:stop] = drive(start, stop)
         function(*(a.ctypes.data for a in arrays), target.ctypes.data, columns.ctypes.data, m, start, stop)
 
+    def part(start, stop):  # the drive columns are computed in the thread of their samples
+        drives[start:stop] = drive(start, stop)
+        run((q, dq, ddq, drives), out, start, stop)
+
     whole = n_s - n_s % LANES
-    arrays = (q, dq, ddq, drives)
     workers = min(cores(), max(1, whole // PARALLEL_SAMPLES))
     bounds = [whole * i // workers // LANES * LANES for i in range(workers)] + [whole]
     if workers == 1:
-        run(arrays, out, 0, whole)
+        part(0, whole)
     else:
         from concurrent.futures import ThreadPoolExecutor
 
         with ThreadPoolExecutor(max_workers=workers) as pool:
-            list(pool.map(lambda i: run(arrays, out, bounds[i], bounds[i + 1]), range(workers)))
+            list(pool.map(lambda i: part(bounds[i], bounds[i + 1]), range(workers)))
     if whole < n_s:  # the last samples, padded with copies of the last one to a whole group of lanes
         pad = np.r_[np.arange(whole, n_s), np.full(LANES - (n_s - whole), n_s - 1)]
         drives[whole:] = drive(whole, n_s)
         tail = np.empty((LANES, n, m))
-        run(tuple(np.ascontiguousarray(a[pad]) for a in arrays), tail, 0, LANES)
+        run(tuple(np.ascontiguousarray(a[pad]) for a in (q, dq, ddq, drives)), tail, 0, LANES)
         out[whole:] = tail[:n_s - whole]

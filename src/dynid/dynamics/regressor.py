@@ -87,10 +87,13 @@ def observation_matrix(robot: Robot, q, dq, ddq) -> np.ndarray:
 def compile_kernels(robots) -> None:
     """Compile, or load from their caches, the compiled regressors: numba's kernel (where the SIMD code
     cannot be built) and each robot's SIMD code (the install step's warm-up, :mod:`dynid.warm_up`)."""
-    for i, robot in enumerate(robots):
+    def run(robot, form):
         z = np.zeros((8, robot.n_dof))
-        for form in (("numba", "compiled") if i == 0 else ("compiled",)):
-            _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form)
+        _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form)
+
+    run(robots[0], "numba")  # one robot is enough: numba's kernel is the same code for every robot
+    for robot in robots:
+        run(robot, "compiled")
 
 
 def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None) -> None:

@@ -202,9 +202,9 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
         futures = {name: pool.submit(f) for _, name, f in tasks}
         pending = set(futures.values())
         while pending:  # woken ten times a second: blocked on a lock, this thread would see Ctrl-C only at the end
-            _, pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION)
-            for fut in futures.values():
-                if fut.done() and fut.exception() is not None:
+            finished, pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION)
+            for fut in finished:
+                if fut.exception() is not None:
                     fut.result()  # raises the fit's error now; the other fits stop below
         done = {name: fut.result() for name, fut in futures.items()}
     except BaseException:
