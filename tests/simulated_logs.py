@@ -143,3 +143,9 @@ def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, d
     cfg = folder / "config.toml"
     cfg.write_text(config_text(toml, folder, "ident.csv", "valid.csv", robot.n_dof))
     return cfg, robot
+
+
+def truth_beta(result, truth_robot) -> np.ndarray:
+    """The truth's base parameters in the identified model's layout: the terms the truth lacks (a friction model
+    dynid chose beyond the simulated one) are 0 there."""
+    return result.base.base_from_named(dict(zip(truth_robot.parameter_names, truth_robot.standard_parameters())))

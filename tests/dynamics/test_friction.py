@@ -64,8 +64,8 @@ def test_adding_a_friction_term_is_one_table_entry(monkeypatch, rng):
     from dynid.dynamics.sensitivity import regressor_state_derivatives
     from dynid.model.description import robot_from_toml_text
 
-    term = friction.FrictionTerm("fq", "N·m·s²/rad²", True, lambda dq, ddq, v: dq * np.abs(dq),
-                                 lambda dq, v: 2 * np.abs(dq), 0.0, ("Fq",), "quadratic drag")
+    term = friction.FrictionTerm("fq", "N·m·s²/rad²", True, lambda q, dq, ddq, v: dq * np.abs(dq),
+                                 lambda q, dq, v: 2 * np.abs(dq), 0.0, ("Fq",), "quadratic drag")
     monkeypatch.setitem(friction.TERMS, "fq", term)
     text = """drive_terms = ["fv", "fq"]
 [[joints]]
@@ -109,3 +109,63 @@ def test_an_unknown_term_is_an_error_never_an_offset():
     with pytest.raises(ConfigError, match=r"arm.toml: drive_terms: unknown drive term\(s\) \['stiction'\]"):
         robot_from_toml_text('drive_terms = ["fc", "stiction"]\n[[joints]]\nmass = 1.0\ncom = [0, 0, 0]\n'
                              'inertia = [0.1, 0.1, 0.1, 0, 0, 0]\n', "arm.toml", None)
+
+
+def test_direction_is_held_at_rest_and_reverses_at_the_crossing():
+    """held_direction: the sign of the last motion while the joint rests (0 before its first), relaxing with a time
+    constant when one is given, 0 at rest with decay 0; a reversal through zero happens where the velocity
+    crosses zero, not where it leaves the rest band."""
+    from dynid.friction import held_direction
+
+    rate = 100.0
+    v = np.concatenate([np.zeros(10), np.full(20, 0.5), np.zeros(50), np.linspace(0.5, -0.5, 21), np.full(10, -0.5)])
+    held = held_direction(v[:, None], 0.1, rate=rate)[:, 0]
+    assert np.all(held[:10] == 0) and np.all(held[10:80] == 1.0)  # before the first motion, moving, resting
+    crossing = 80 + 10  # linspace(0.5, -0.5, 21) is 0 at its 11th sample
+    assert np.all(held[80:crossing] == 1.0) and np.all(held[crossing + 1:] == -1.0)
+    relaxed = held_direction(v[:, None], 0.1, decay=0.2, rate=rate)[:, 0]
+    np.testing.assert_allclose(relaxed[30:80], np.exp(-np.arange(1, 51) / (rate * 0.2)))
+    zero = held_direction(v[:, None], 0.1, decay=0.0, rate=rate)[:, 0]
+    np.testing.assert_array_equal(zero[30:80], 0.0)
+
+
+def test_a_short_move_against_the_direction_is_a_blip_and_a_long_one_a_reversal():
+    from dynid.friction import held_direction
+
+    rate = 100.0
+    blip = np.concatenate([np.full(20, 0.5), np.zeros(5), np.full(2, -0.2), np.zeros(20)])
+    z = held_direction(blip[:, None], 0.1, rate=rate, min_travel=0.01)[:, 0]
+    np.testing.assert_array_equal(z, 1.0)  # 2 samples at 0.2 rad/s travel 0.004 rad < 0.01
+    move = np.concatenate([np.full(20, 0.5), np.zeros(5), np.full(20, -0.2), np.zeros(20)])
+    z = held_direction(move[:, None], 0.1, rate=rate, min_travel=0.01)[:, 0]
+    assert np.all(z[25:] == -1.0) and np.all(z[:25] == 1.0)
+
+
+def test_dahl_presliding_reverses_over_the_distance_travelled():
+    """With a presliding distance x0 the direction follows z = σ + (z0 - σ)·exp(-s/x0) along the distance s."""
+    from dynid.friction import held_direction
+
+    rate, x0 = 1000.0, 0.002
+    v = np.concatenate([np.full(200, 0.3), np.full(200, -0.1)])
+    z = held_direction(v[:, None], 0.01, presliding=x0, rate=rate)[:, 0]
+    s = np.cumsum(np.full(200, 0.1)) / rate
+    z_end = 1 + (0 - 1) * np.exp(-np.cumsum(np.full(200, 0.3))[-1] / rate / x0)
+    np.testing.assert_allclose(z[200:], -1 + (z_end + 1) * np.exp(-s / x0))
+
+
+def test_velocity_noise_through_the_filters_matches_a_simulation(rng):
+    """The noise the pipeline's velocities carry, computed from the positions' (or velocities') white-noise level,
+    agrees with filtering and differentiating simulated noise (Butterworth and Gaussian)."""
+    from dynid.preprocessing.bands import white_noise_std
+    from dynid.preprocessing.filters import butterworth_filtfilt, differentiate, gaussian_smooth, velocity_noise_std
+
+    rate, n = 1000.0, 200_000
+    sigma = np.array([1e-4, 5e-4])
+    noise = rng.normal(size=(n, 2)) * sigma
+    np.testing.assert_allclose(white_noise_std(noise + np.sin(np.arange(n) / rate)[:, None], rate), sigma, rtol=0.05)
+    for gaussian in (False, True):
+        smooth = gaussian_smooth(noise, rate, 5.0) if gaussian else butterworth_filtfilt(noise, rate, 5.0, 4)
+        measured = differentiate(smooth, rate)[2000:-2000].std(axis=0)
+        np.testing.assert_allclose(velocity_noise_std(sigma, rate, 5.0, 4, True, gaussian), measured, rtol=0.05)
+        direct = (gaussian_smooth(noise, rate, 5.0) if gaussian else butterworth_filtfilt(noise, rate, 5.0, 4))[2000:-2000].std(axis=0)
+        np.testing.assert_allclose(velocity_noise_std(sigma, rate, 5.0, 4, False, gaussian), direct, rtol=0.05)

@@ -13,7 +13,7 @@ import pytest
 from dynid.io.identification_config import load_identification_config
 from dynid.experiment.identification_run import run_identification
 
-from ..simulated_logs import simulated_case
+from ..simulated_logs import simulated_case, truth_beta
 
 CASES = [(robot, rate, motion) for robot in ("er16", "ur10e") for rate in (1000.0, 500.0, 125.0)
          for motion in ("fourier", "ptp")]
@@ -23,7 +23,7 @@ CASES = [(robot, rate, motion) for robot in ("er16", "ur10e") for rate in (1000.
 def test_defaults_reach_the_noise_floor(tmp_path, robot, rate, motion):
     cfg, truth_robot = simulated_case(tmp_path, robot, rate, motion, seed=1, duration=60.0, current_std=0.01)
     result = run_identification(load_identification_config(cfg))
-    truth = result.base.base_from_standard(truth_robot.standard_parameters())
+    truth = truth_beta(result, truth_robot)
     m = result.validations[0].metrics()
     est, floor = m["dynid OLS"]["relative_error"], m["truth"]["relative_error"]
     print(robot, rate, motion, np.round(est / floor, 3))

@@ -64,6 +64,7 @@ chunk = 3000
 [estimation]
 method = "ols"
 physically_consistent = true
+friction = "description"
 ''')
     cfg = load_identification_config(tmp_path / "c.toml")
     result = run_identification(cfg)
@@ -96,10 +97,12 @@ def test_ur10e_real_logs_against_the_published_parameters():
     published = m["Mamedov & Mikhel 2020"]["relative_error"]
     assert np.all(published <= np.array([10, 5, 4, 11, 13, 55]) + 1.5) and np.all(published >= 0.5 * np.array([10, 5, 4, 11, 13, 55]))
     assert np.all(m["dynid OLS"]["relative_error"][:5] <= published[:5] + 1.0)
+    # the friction models chosen per joint: at least 4 of 6 joints at 0.8x the published set's error
+    assert np.sum(m["dynid OLS"]["relative_error"] <= 0.8 * published) >= 4
     assert m["dynid OLS"]["global_relative_error"] <= m["Mamedov & Mikhel 2020"]["global_relative_error"]
     assert m["dynid OLS"]["correlation"][:5].min() > 0.99
     assert {v.name for v in result.validations} == {"ptp_10_points", *(f"p{i}" for i in range(1, 11))}
-    assert result.solution.condition_number < 1e3 and np.all(np.isfinite(result.solution.relative_std))
+    assert result.solution.condition_number < 1e4 and np.all(np.isfinite(result.solution.relative_std))  # fcl columns: N·m scale
     # physically consistent least squares beside OLS: consistent, and as good on the validation run
     assert result.consistency["dynid SDP"] >= -1e-7 and result.consistency["Mamedov & Mikhel 2020"] >= -1e-7
     assert result.consistent.pseudo_inertia_min_eig.min() >= -1e-7
@@ -114,7 +117,7 @@ def test_tx40_real_logs_against_figaroh():
     cfg = load_identification_config(REPO / "configs" / "tx40-full.toml", data_root=root)
     result = run_identification(cfg)
     figaroh = next(r for r in result.references if r.name == "FIGAROH OLS")
-    assert not np.isnan(figaroh.relative_std).any()  # all 60 expressions matched
+    assert not np.isnan(figaroh.relative_std).any()  # all 60 expressions matched (the config keeps FIGAROH's model)
     agreement = result.reference_agreement(figaroh)
     assert agreement["compared"] == 60 and agreement["within_3_sigma"] >= 58 and agreement["within_1_sigma"] >= 40
     m = result.fit.metrics()
@@ -122,14 +125,15 @@ def test_tx40_real_logs_against_figaroh():
 
 
 def test_tx40_time_split_validation():
-    """Identified on 0.1-5.6 s, validated on 5.6-7.6 s: errors close to those of FIGAROH's parameters
-    (which were fitted on the whole motion, validation part included)."""
+    """Identified on 0.1-5.6 s, validated on 5.6-7.6 s: at most the error of FIGAROH's parameters (fitted on the
+    whole motion, validation part included) on 4 of the 6 joints and over all of them, on the same samples."""
     root = shared_data("staubli_tx40_figaroh")
     cfg = load_identification_config(REPO / "configs" / "tx40.toml", data_root=root)
     result = run_identification(cfg)
     (val,) = result.validations
     m = val.metrics()
-    assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 5.0)
+    assert np.sum(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"]) >= 4
+    assert m["dynid WLS"]["global_relative_error"] <= m["FIGAROH OLS"]["global_relative_error"]
     assert m["dynid WLS"]["correlation"].min() > 0.95
     assert result.consistency["dynid SDP"] >= -1e-7 and m["dynid SDP"]["correlation"].min() > 0.95
     assert np.all(m["dynid SDP"]["relative_error"] <= m["dynid WLS"]["relative_error"] + 5.0)

@@ -10,7 +10,7 @@ from dynid.io.identification_config import load_identification_config
 from dynid.experiment.identification_run import run_identification, run_validation
 from dynid.report.identification_run import save_identification
 
-from ..simulated_logs import simulated_case
+from ..simulated_logs import simulated_case, truth_beta
 
 ALL = ["wls", "ols", "sdp", "irls", "lad", "abc", "abc10", "de", "pso"]
 
@@ -33,7 +33,7 @@ def test_identify_runs_every_estimator_side_by_side(tmp_path):
         if o.key in ("lad", "abc", "abc10", "de", "pso"):
             assert np.all(o.params >= lo - 1e-9) and np.all(o.params <= hi + 1e-9)
     # the least-squares family recovers the truth on this simulated log
-    truth = result.base.base_from_standard(truth_robot.standard_parameters())
+    truth = truth_beta(result, truth_robot)
     for o in result.others:
         if o.key in ("ols", "irls", "lad"):
             assert np.linalg.norm(o.params - truth) / np.linalg.norm(truth) < 0.02, o.key

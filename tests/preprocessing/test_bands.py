@@ -5,7 +5,7 @@ import pytest
 from scipy import signal
 
 from dynid.exceptions import ConfigError
-from dynid.preprocessing.bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, excitation_band
+from dynid.preprocessing.bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, estimate_band, excitation_band
 from dynid.preprocessing.filters import decimation_cutoff, parallel_decimation
 from dynid.preprocessing.pipeline import Preprocessing
 
@@ -21,6 +21,40 @@ def test_band_of_a_multisine_is_its_highest_harmonic(rng, f_top):
     q = q + rng.normal(0, 1e-6, q.shape)  # encoder-like noise
     band = excitation_band(q, rate)
     assert abs(band - f_top) <= 3 * rate / n
+
+
+@pytest.mark.parametrize("share", [0.0, 0.01, 0.05, 0.15])
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
+def test_band_is_found_above_broadband_noise(rng, share, rate):
+    """Broadband noise holding ``share`` of the positions' velocity-weighted spectral energy (the quantity the
+    99 % rule reads) leaves the band on the excitation's highest harmonic (0.375 Hz), and the noise's share is
+    measured; without the noise floor, 1 % of noise moves the 99 % point to the noise."""
+    n = int(60 * rate)
+    t = np.arange(n) / rate
+    harmonics = 0.075 * np.arange(1, 6)
+    q = sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 6))[:, None] / f for f in harmonics) * np.array([1.0, 0.3, 2.0])
+    x = (q - q[:1] - np.linspace(0, 1, n)[:, None] * (q[-1:] - q[:1])) * np.hanning(n)[:, None]
+    f = np.fft.rfftfreq(n, 1 / rate)
+    e_signal = (f[:, None] ** 2 * np.abs(np.fft.rfft(x, axis=0)) ** 2).sum(0)
+    white = rng.normal(size=q.shape)
+    w = white * np.hanning(n)[:, None]
+    e_white = (f[:, None] ** 2 * np.abs(np.fft.rfft(w, axis=0)) ** 2).sum(0)
+    noisy = q + white * np.sqrt(share / (1 - share) * e_signal / e_white) if share else q
+    found = estimate_band(noisy, rate)
+    assert abs(found.band - 0.375) <= 3 * rate / n, found
+    assert found.noise_share == pytest.approx(share, abs=0.1 * share + 1e-3)
+    assert not found.warnings("log")
+
+
+def test_an_implausible_band_is_named_with_the_setting_that_fixes_it(rng):
+    """Positions that are all noise, or a motion close to the Nyquist frequency (an undersampled log): one warning
+    naming the dataset and preprocessing.band."""
+    rate, n = 500.0, 20000
+    t = np.arange(n) / rate
+    for q in (rng.normal(size=(n, 2)), np.sin(2 * np.pi * 0.3 * rate * t)[:, None] + 0.01 * rng.normal(size=(n, 2))):
+        found = estimate_band(q, rate)
+        lines = found.warnings("identification (log.csv)")
+        assert len(lines) == 1 and lines[0].startswith("identification (log.csv): ") and "preprocessing.band" in lines[0]
 
 
 def test_cutoffs_follow_the_stated_rules():
@@ -39,10 +73,19 @@ def test_resolved_settings_say_what_was_derived(rng):
     s = Preprocessing().resolved(rate, q, measured_velocity=False)
     assert s.band == pytest.approx(0.5, abs=0.1) and s.parallel_cutoff == pytest.approx(PARALLEL_FACTOR * s.band)
     assert "excitation band" in s.derivation and "parallel" in s.derivation
-    given = Preprocessing(decimation=4).resolved(rate, q)  # a decimation alone: filtered at its own cutoff
-    assert given.parallel_cutoff == pytest.approx(decimation_cutoff(rate, 4)) and given.decimation == 4
+    # a decimation alone keeps the derived parallel cutoff (it moves no other setting) while that cutoff
+    # cannot alias; where it would, the cutoff is lowered to the decimation's own and the derivation says so
+    given = Preprocessing(decimation=4).resolved(rate, q)
+    assert given.parallel_cutoff == pytest.approx(s.parallel_cutoff) and given.decimation == 4
+    coarse = Preprocessing(decimation=40).resolved(rate, q)
+    assert coarse.parallel_cutoff == pytest.approx(decimation_cutoff(rate, 40)) and coarse.parallel_cutoff < s.parallel_cutoff
+    assert "anti-aliasing cutoff of decimation = 40" in coarse.derivation
     with pytest.raises(ConfigError, match=r"preprocessing.parallel_cutoff: expected below the Nyquist"):
         Preprocessing(parallel_cutoff=150.0).resolved(rate, q)
+    # settings carried over to a log of another rate are lowered there, with a warning naming the log
+    other = Preprocessing(parallel_cutoff=80.0).resolved(rate * 0.99, q, name="validation 1", strict=False)
+    assert other.parallel_cutoff == pytest.approx(0.8 * rate * 0.99 / 2)
+    assert other.warnings and other.warnings[0].startswith("validation 1: preprocessing.parallel_cutoff = 80 Hz")
 
 
 def test_parallel_filter_without_decimation_equals_scipy(rng):
@@ -57,13 +100,13 @@ def test_parallel_filter_without_decimation_equals_scipy(rng):
         list(parallel_decimation(lambda a, b: x[a:b], x.shape[0], rate, 10, cutoff=100.0))
 
 
-def test_band_computed_joint_by_joint_equals_the_whole_array_formula(rng):
-    """The spectrum is summed one joint at a time (temporaries one column long): the same energy as the
-    formula of the docstring on the whole (N, n_dof) array, so the same band."""
+def test_band_of_stored_columns_equals_that_of_the_array(rng, tmp_path, monkeypatch):
+    """The spectrum is summed one joint at a time (temporaries one column long): a log held in stored columns
+    gives the same band and noise share as the same log in memory."""
+    from dynid.column_store import StoredColumns
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
     rate, n = 500.0, 20011
     q = rng.normal(size=(n, 4)).cumsum(0) * 1e-3 + np.sin(np.linspace(0.0, 40.0, n))[:, None] * [1, 2, 3, 4]
-    x = (q - q[:1] - np.linspace(0.0, 1.0, n)[:, None] * (q[-1:] - q[:1])) * np.hanning(n)[:, None]
-    f = np.fft.rfftfreq(n, 1.0 / rate)
-    energy = ((f[:, None] ** 2) * np.abs(np.fft.rfft(x, axis=0)) ** 2).sum(axis=1)
-    expected = min(max(f[min(int(np.searchsorted(np.cumsum(energy) / energy.sum(), 0.99)), f.size - 1)], 2 * rate / n), rate / 2)
-    assert excitation_band(q, rate) == expected
+    stored = StoredColumns.from_columns(q[:, j] for j in range(4))
+    assert estimate_band(stored, rate) == estimate_band(q, rate)

@@ -54,6 +54,11 @@ class BaseParameters:
         """``beta = regrouping @ phi`` (n_base,)."""
         return self.regrouping @ np.asarray(phi, dtype=float)
 
+    def base_from_named(self, values: dict) -> np.ndarray:
+        """``beta`` of the standard parameters given by name (``{"ZZ1": 0.3, …}``; a standard parameter not given is
+        0, a name this robot does not have is ignored), (n_base,)."""
+        return self.regrouping @ np.array([float(values.get(n, 0.0)) for n in self.standard_names])
+
     def standard_from_base(self, beta: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
         """A standard vector whose base parameters are ``beta``.
 
@@ -112,6 +117,8 @@ def base_parameters(robot: Robot, rng: np.random.Generator | int | None = 0, n_s
     q = rng.uniform(lo, hi, (n_samples, n))
     dq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 2.0
     ddq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 5.0
+    if "fca" in robot.drive_terms:  # asymmetric Coulomb friction differs from an offset only at rest: some states rest
+        dq[rng.uniform(size=(n_samples, n)) < 0.2] = 0.0
     w = observation_matrix(robot, q, dq, ddq)
     r = scipy.linalg.qr(w, mode="r")[0]
     diag = np.abs(np.diag(r))

@@ -45,7 +45,7 @@ _numpy_used = 0
 _numpy_lock = threading.Lock()
 
 
-def regressor(robot: Robot, q, dq, ddq, columns=None) -> np.ndarray:
+def regressor(robot: Robot, q, dq, ddq, columns=None, velocities=None) -> np.ndarray:
     """Per-sample joint-torque regressor.
 
     Parameters
@@ -56,6 +56,10 @@ def regressor(robot: Robot, q, dq, ddq, columns=None) -> np.ndarray:
     columns : (m,) int array, optional
         Only these columns, in this order (e.g. the base parameters' independent columns): the same
         values as ``regressor(...)[..., columns]`` without computing the full array and copying it.
+    velocities : dynid.friction.Velocities, optional
+        The friction columns' velocities (default ``robot.friction_velocities``; a log's rest velocity and held
+        direction of motion are properties of the log, :func:`dynid.friction.held_direction`); a direction has
+        the samples' rows (N, n_dof).
 
     Returns
     -------
@@ -74,7 +78,7 @@ def regressor(robot: Robot, q, dq, ddq, columns=None) -> np.ndarray:
     columns = np.arange(robot.n_params) if columns is None else np.asarray(columns, dtype=np.int64)
     colmap[columns] = np.arange(columns.size)
     out = np.empty((n_s, n, columns.size))
-    _fill(robot, q, dq, ddq, out, colmap)
+    _fill(robot, q, dq, ddq, out, colmap, velocities=velocities)
     return out
 
 
@@ -96,7 +100,7 @@ def compile_kernels(robots) -> None:
         run(robot, "compiled")
 
 
-def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None) -> None:
+def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None, velocities=None) -> None:
     """Fill ``out`` by the NumPy form, the compiled regressor, or numba's kernel (``form``: "numpy",
     "compiled", "numba"; by default the NumPy form while the process's budget lasts, then the compiled one)."""
     rp = np.ascontiguousarray([jt.rotation for jt in robot.joints], dtype=np.float64)
@@ -104,11 +108,16 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None) -> Non
     axes = np.ascontiguousarray([jt.axis for jt in robot.joints], dtype=np.float64)
     gravity = np.ascontiguousarray(robot.gravity, dtype=np.float64)
     npj = robot.n_params_per_joint
+    v = robot.friction_velocities if velocities is None else velocities
+    if "fcl" in robot.drive_terms and v.load is None:
+        from dataclasses import replace
+
+        v = replace(v, load=nominal_rigid_torque(robot, q, dq, ddq))
 
     def drive(a, b):
         """Each joint's own drive terms (friction table) for samples a:b, written by the kernel with the sample's
         other columns; the terms are elementwise, so any split gives the same numbers."""
-        return np.ascontiguousarray(drive_columns(robot.drive_terms, dq[a:b], ddq[a:b], robot.friction_velocities) * robot.drive_mask)
+        return np.ascontiguousarray(drive_columns(robot.drive_terms, q[a:b], dq[a:b], ddq[a:b], v.rows(a, b)) * robot.drive_mask)
 
     drive_map = np.ascontiguousarray(colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(len(robot.drive_terms))])
     form = form or ("numpy" if _numpy_form(q.shape[0]) else "compiled")
@@ -158,13 +167,29 @@ def _numpy_form(n_samples: int) -> bool:
         return True
 
 
+def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:
+    """Rigid-body torques (N, n_dof) [N·m] of the robot's nominal inertial parameters (no drive terms): the torque
+    each transmission carries, for the load-dependent Coulomb term (:mod:`dynid.friction`)."""
+    from dataclasses import replace
+
+    rigid = replace(robot, drive_terms=(), drive=np.zeros((robot.n_dof, 0)), drive_mask=None)
+    return regressor(rigid, q, dq, ddq) @ rigid.standard_parameters()
+
+
 def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None,
-                     coupled: np.ndarray | None = None) -> np.ndarray:
+                     coupled: np.ndarray | None = None, q: np.ndarray | None = None) -> np.ndarray:
     """Torques of the drive terms alone (rotor inertia, eq. 3 friction, offset, coupled motors),
-    (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values."""
+    (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values; ``q`` [rad] for the terms
+    that depend on the position (default zeros)."""
     drive = robot.drive if drive is None else drive
     coupled = robot.transmission.coupled_values if coupled is None else coupled
-    cols = drive_columns(robot.drive_terms, dq, ddq, robot.friction_velocities)
+    q = np.zeros_like(np.asarray(dq, dtype=float)) if q is None else q
+    v = robot.friction_velocities
+    if "fcl" in robot.drive_terms:
+        from dataclasses import replace
+
+        v = replace(v, load=nominal_rigid_torque(robot, q, dq, ddq))
+    cols = drive_columns(robot.drive_terms, q, dq, ddq, v)
     tau = np.einsum("njt,jt->nj", cols, drive * robot.drive_mask) if robot.drive_terms else np.zeros_like(np.asarray(dq, dtype=float))
     if robot.transmission.n_coupled_params:
         tau += robot.transmission.coupling_columns(dq, ddq) @ np.ravel(coupled)

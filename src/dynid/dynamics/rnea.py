@@ -50,4 +50,4 @@ def rnea_torques(robot: Robot, q, dq, ddq, inertial: np.ndarray | None = None, d
     tau = np.empty_like(q)
     for k in range(q.shape[0]):
         tau[k] = pin.rnea(model, data, q[k], dq[k], ddq[k])
-    return tau + friction_torques(robot, dq, ddq, drive)
+    return tau + friction_torques(robot, dq, ddq, drive, q=q)

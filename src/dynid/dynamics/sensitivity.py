@@ -68,11 +68,12 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
     fc = coulomb_columns(robot)
     d[:2, ..., fc] = 0.0
     if robot.drive_terms:  # drive columns: analytic derivatives from the friction table
-        d_dq, d_ddq = drive_column_derivatives(robot.drive_terms, dq, robot.friction_velocities)
+        d_q, d_dq, d_ddq = drive_column_derivatives(robot.drive_terms, q, dq, robot.friction_velocities)
         npj = robot.n_params_per_joint
         for i in range(n):
             block = slice(i * npj + 10, (i + 1) * npj)
             d[:, :, :, i, block] = 0.0
+            d[0, i, :, i, block] = d_q[:, i] * robot.drive_mask[i]
             d[1, i, :, i, block] = d_dq[:, i] * robot.drive_mask[i]
             d[2, i, :, i, block] = d_ddq[:, i] * robot.drive_mask[i]
     return y, d

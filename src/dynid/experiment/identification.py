@@ -145,6 +145,8 @@ class IdentificationResult:
         The box searches' box (:func:`search_box`).
     drive_gains : dynid.experiment.drive_gains.GainsAndPayload or None
         Drive gains and payload from ``[drive_gains]``.
+    model : Robot or None
+        The robot as identified: its drive terms are the friction models chosen for its joints.
     """
 
     robot: str
@@ -165,6 +167,7 @@ class IdentificationResult:
     objective: dict = field(default_factory=dict)
     box: np.ndarray | None = None
     drive_gains: object = None
+    model: Robot | None = None
 
     @property
     def label(self) -> str:
@@ -367,7 +370,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,
-                                others=others, objective=objective, box=box)
+                                others=others, objective=objective, box=box, model=robot)
 
 
 def _step(progress, label: str):

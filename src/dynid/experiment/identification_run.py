@@ -12,7 +12,7 @@ from ..exceptions import ConfigError, DataError
 from ..io.datasets import DatasetSpec, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..model.robot import Robot
-from ..preprocessing.settings import Preprocessing
+from ..preprocessing.settings import Preprocessing, carried_over
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 
@@ -40,26 +40,17 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-def validation_settings(given: Preprocessing, resolved: Preprocessing | None) -> Preprocessing:
-    """Preprocessing of validation logs: the identification's filters (in Hz, resolved on its data) so
-    both are scored through the same filters; decimation and trim derived again for each log (its rate
-    may differ), and no Fourier fit (the excitation's harmonics fit only its own log)."""
-    if resolved is None:
-        return replace(given, fourier=None)
-    return replace(resolved, fourier=None, decimation=given.decimation, trim=given.trim, derivation="")
-
-
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
               progress=None, resolved: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
 
     out, warnings = [], []
-    settings = validation_settings(config.preprocessing, resolved)
+    settings = carried_over(resolved, config.preprocessing)
     for spec in datasets:
         if progress is not None:  # one step per log: reading, filtering and predicting it
             progress(f"validation, {spec.name}", 0, 1)
-        data = prepare(load_recording(spec, config.robot), settings)
+        data = prepare(load_recording(spec, config.robot), settings, strict=False)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
                                    None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t))))
         warnings.extend(data.warnings)
@@ -86,7 +77,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
 
     step("base parameters and references")
     base = base_parameters(config.robot, rng=0)
-    refs = _references(config, base)
+    refs = _references(config, base)  # read here to report a bad reference file before any computation
     step(f"reading {config.identification.name}")
     recording = load_recording(config.identification, config.robot)
     step("preprocessing" + (" (cross-validation of the cutoffs)" if config.preprocessing.auto else ""))
@@ -104,6 +95,16 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         step("Coulomb smoothing velocity (cross-validation)")
     choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
     robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
+    friction = None
+    if config.friction == "auto":
+        from ..validation.friction_models import choose_friction
+
+        step("friction model of each joint (cross-validation)")
+        friction = choose_friction(robot, data)
+        robot = friction.robot(robot)
+        data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
+        base = base_parameters(robot, rng=0)
+        refs = _references(replace(config, robot=robot), base)
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
@@ -113,6 +114,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
             result = replace(result, drive_gains=gains.result())
     result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
+                                       **({} if friction is None else {"friction_models": friction.to_dict()}),
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if not validate or not config.validation:
         return result
@@ -132,8 +134,13 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
         The results do not belong to this robot (different base parameters).
     """
     from ..dynamics.base_parameters import base_parameters
+    from ..model.friction_model import robot_from_settings
     from .identification import parameter_sets
 
+    try:
+        config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
+    except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
+        raise DataError(f"results: settings: {exc}") from None
     base = base_parameters(config.robot, rng=0)
     try:
         names = [p["name"] for p in identified["base_parameters"]]
@@ -158,12 +165,6 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    stored_vs = identified.get("settings", {}).get("coulomb_velocity") if isinstance(identified.get("settings"), dict) else None
-    if stored_vs is not None:
-        try:
-            config = replace(config, robot=replace(config.robot, coulomb_velocity=np.asarray(stored_vs, dtype=float)))
-        except (TypeError, ValueError, ConfigError):
-            raise DataError("results: settings.coulomb_velocity must give one non-negative velocity per joint") from None
     comparisons, warnings = _validate(config, base, sets, datasets, progress, stored_preprocessing(identified))
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 

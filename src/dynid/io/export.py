@@ -215,15 +215,16 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     if verdict != "yes":
         raise ConfigError(f"{source}: the physically consistent estimate did not pass the consistency check ({verdict})")
     values = sdp["standard_values"]
+    from ..model.friction_model import robot_from_settings
+
+    try:
+        robot = robot_from_settings(robot, results.get("settings", {}))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ConfigError(f"{source}: {exc}") from None
     missing = [n for n in robot.parameter_names if n not in values]
     if missing:
         raise ConfigError(f"{source}: its standard parameters are not those of robot {robot.name!r} (missing {', '.join(missing[:4])})")
     phi = np.array([float(values[n]) for n in robot.parameter_names])
-    vs = results.get("settings", {}).get("coulomb_velocity")
-    if vs is not None:
-        from dataclasses import replace
-
-        robot = replace(robot, coulomb_velocity=np.asarray(vs, dtype=float))
     return robot, phi
 
 

@@ -21,6 +21,10 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
                                          # each joint's RMS speed
     coulomb_velocity = 0.0               # rad/s, Coulomb term tanh(dq/v) per joint; 0 (default): sign(dq);
                                          # "auto": chosen per joint by blocked cross-validation
+    rest_velocity = "auto"               # rad/s: below it a joint rests (no Coulomb friction predicted);
+                                         # "auto" (default): 3x its velocity's noise, for each log
+    rest_friction = "held"               # at rest: the friction of the last motion ("held", default) or
+                                         # none ("zero"); one value or one per joint
     excitation = "excitation.json"       # the robot ran this trajectory of dynid excite: derivatives
                                          # by a Fourier fit on its harmonics instead of filters
 
@@ -29,6 +33,8 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     physically_consistent = true         # also physically consistent least squares (SDP), default false
     methods = ["wls", "sdp", "lad", "abc", "de", "pso", "irls"]   # optional: every estimator side by side
     seed = 0                             # seeds the box searches (ABC, ABC×10, DE, PSO)
+    friction = "auto"                    # each joint's friction model and its state at rest chosen by
+                                         # cross-validation (default); "description": the description's terms
 
     [drive_gains]                        # optional: drive gains K (eq. 16) from a run without and one with a
     payload_mass = 2.805                 # payload of known mass [kg] on the last link (Gautier & Briot), and
@@ -91,11 +97,13 @@ class IdentificationConfig:
     methods: tuple[str, ...] = ()
     seed: int = 0
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
+    friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
 
 
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
              "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None,
-             "coulomb_velocity": None, "auto": None}
+             "coulomb_velocity": None, "rest_velocity": None, "rest_friction": None, "presliding": None,
+             "auto": None}
 
 
 def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
@@ -124,19 +132,27 @@ def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preproc
                 raise ConfigError(f"{where}.excitation: the trajectory has {traj.n_dof} joints, the robot {n}")
             values["fourier"] = (traj.omega_f, traj.n_harmonics)
             continue
+        if key == "rest_friction":
+            one = lambda x: x in ("held", "zero") or (isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0)  # noqa: E731
+            ok = one(v) or (isinstance(v, list) and len(v) == n and all(one(x) for x in v))
+            if not ok:
+                raise ConfigError(f'{where}.rest_friction: expected "held", "zero", a relaxation time in seconds, or a list '
+                                  f"of {n} of them, got {v!r}")
+            values[key] = tuple(v) if isinstance(v, list) else v
+            continue
         if key == "auto":
             if not isinstance(v, bool):
                 raise ConfigError(f"{where}.auto: expected true or false, got {v!r}")
             values[key] = v
             continue
-        if key in ("min_speed", "coulomb_velocity"):
-            if v == "auto":
+        if key in ("min_speed", "coulomb_velocity", "rest_velocity", "presliding"):
+            if v == "auto" and key != "presliding":
                 values[key] = v
                 continue
             ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0) or (
                 isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in v))
             if not ok:
-                auto = '"auto", '
+                auto = '"auto", ' if key != "presliding" else ""
                 raise ConfigError(f"{where}.{key}: expected {auto}a non-negative number or a list of {n} (rad/s), got {v!r}")
             values[key] = tuple(float(x) for x in v) if isinstance(v, list) else float(v)
             continue
@@ -194,10 +210,14 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     est = doc.get("estimation", {})
     if not isinstance(est, dict):
         raise ConfigError(f"{path}: estimation: expected a table")
-    unknown = sorted(set(est) - {"method", "physically_consistent", "methods", "seed"})
+    unknown = sorted(set(est) - {"method", "physically_consistent", "methods", "seed", "friction"})
     if unknown:
-        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected method, methods, "
+        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected friction, method, methods, "
                           "physically_consistent, seed")
+    friction = est.get("friction", "description" if pre.coulomb_velocity != 0.0 else "auto")
+    if friction not in ("auto", "description"):
+        raise ConfigError(f'{path}: estimation.friction: expected "auto" (each joint\'s friction model chosen by '
+                          f'cross-validation) or "description" (the robot description\'s terms), got {friction!r}')
     methods = est.get("methods", [])
     if not isinstance(methods, list) or not all(isinstance(m, str) for m in methods):
         raise ConfigError(f"{path}: estimation.methods: expected a list of method names, got {methods!r}")
@@ -220,7 +240,7 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         raise ConfigError(f"{path}: references: expected [[references]] tables")
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent or "sdp" in methods,
-                                methods, seed, gains)
+                                methods, seed, gains, friction)
 
 
 def _drive_gains(table, root: Path, where: str, n: int):

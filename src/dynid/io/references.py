@@ -180,19 +180,36 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
     g = basep.regrouping
     if fmt == "standard":
         given = v.sum(axis=0) > 0
-        missing = [std_names[i] for i in np.flatnonzero(~given) if np.any(g[:, i])]
+        missing = [std_names[i] for i in np.flatnonzero(~given) if np.any(g[:, i]) and not _friction_like(std_names[i])]
         if missing:
             raise DataError(f"{path}: the reference lacks parameter(s) {', '.join(missing)}")
         phi = np.zeros(len(std_names))
         phi[np.argmax(v, axis=1)] = b
         beta, rel = g @ phi, None
     else:
-        beta, rel = _match_base(v, b, s, g, basep.names, path)
+        beta, rel = _match_base(v, b, s, g, basep.names, path, std_names)
     return ReferenceSet(str(table["name"]), beta, rel if i_std is not None else None, str(path), tuple(warnings))
 
 
-def _match_base(v, b, s, g, names, path):
-    """Match each of dynid's base parameters (rows of ``g``) to a row of ``v``."""
+def _friction_like(name: str) -> bool:
+    """Whether a standard parameter is a friction term a published model may lack (then it has the value 0 there):
+    the Coulomb-like terms of :mod:`dynid.model.friction_model`."""
+    from ..conventions import split_name
+    from ..model.friction_model import COULOMB_LIKE
+
+    return split_name(name)[0] in COULOMB_LIKE[1:]
+
+
+def _match_base(v, b, s, g, names, path, std_names=()):
+    """Match each of dynid's base parameters (rows of ``g``) to a row of ``v``; base parameters made only of
+    friction terms the reference never mentions (:func:`_friction_like`) are 0 in it."""
+    absent = [i for i, row in enumerate(g) if std_names and all(_friction_like(std_names[c]) and not v[:, c].any()
+                                                                 for c in np.flatnonzero(row))]
+    if absent:
+        keep = np.setdiff1d(np.arange(g.shape[0]), absent)
+        beta, rel = np.zeros(g.shape[0]), np.full(g.shape[0], np.nan)
+        beta[keep], rel[keep] = _match_base(v, b, s, g[keep], [names[i] for i in keep], path)
+        return beta, rel
     beta = np.full(g.shape[0], np.nan)
     rel = np.full(g.shape[0], np.nan)
     for i, row in enumerate(g):

@@ -5,9 +5,9 @@ A user should never have to choose a cutoff. The rules below follow Gautier's id
 "Modeling, Identification and Control of Robots", 2002, §12.5.2):
 
 * the **excitation band** ``f_exc`` is where the motion lives: the frequency below which 99 % of the
-  energy of the joint velocities lies, estimated from the spectrum of the measured positions (every
-  joint together, each weighted by its own energy), or ``n_harmonics·ω_f/2π`` of a known Fourier
-  excitation (eq. 14);
+  energy of the joint velocities lies, estimated from the spectrum of the measured positions above
+  its noise floor (every joint together, each weighted by its own energy; :func:`estimate_band`), or
+  ``n_harmonics·ω_f/2π`` of a known Fourier excitation (eq. 14);
 * positions (and measured velocities) are low-passed at ``f_q = 10·f_exc`` (Gautier: ω_fq ≥ 10·ω_dyn),
   so the filter leaves the motion untouched (a 4th-order zero-phase Butterworth changes a component at
   ``f_q/5`` by less than 0.01 %) while removing the noise that differentiation amplifies;
@@ -42,6 +42,10 @@ POSITION_FACTOR = 10.0
 PARALLEL_FACTOR = 10.0
 """Parallel filter cutoff over the excitation band."""
 
+REST_FACTOR = 3.0
+"""A joint rests where its filtered velocity is below this many standard deviations of the velocity's noise
+(:func:`dynid.preprocessing.filters.velocity_noise_std`): the sign of a slower velocity is noise."""
+
 MIN_SPEED_FRACTION = 0.05
 """Rows slower than this fraction of the joint's RMS speed are left out of the estimation."""
 
@@ -54,11 +58,87 @@ def decimation_cutoff(rate: float, factor: int) -> float:
     return 0.8 * rate / (2 * factor)
 
 
-def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION) -> float:
-    """Frequency below which ``fraction`` of the joint velocities' energy lies, from the positions.
+NOISE_BIN_FACTOR = 20.0
+"""A periodogram bin counts as motion when it exceeds the noise floor this many times (white noise exceeds it
+with probability e⁻²⁰ ≈ 2·10⁻⁹ per bin)."""
 
-    The positions are detrended (a straight line through the ends, so the record is continuous at its
-    wrap-around) and windowed (Hann); the velocity spectrum is ``(2πf)²·|Q(f)|²`` summed over the joints.
+NOISE_SMOOTH_FACTOR = 5.0
+"""… or when the mean of its 9 nearest bins exceeds the floor this many times (a continuous spectrum)."""
+
+IMPLAUSIBLE_BAND = 0.25
+"""A band above this fraction of the Nyquist frequency is implausible for a robot's motion (a warning)."""
+
+
+@dataclass(frozen=True)
+class BandEstimate:
+    """The excitation band found in a log's positions, and what the noise holds.
+
+    Attributes
+    ----------
+    band : float [Hz]
+        Frequency below which :data:`ENERGY_FRACTION` of the motion's velocity energy lies (noise excluded).
+    noise_share : float in [0, 1]
+        Share of the positions' velocity-weighted spectral energy that is broadband noise (the floor).
+    rate : float [Hz]
+    motion_found : bool
+        False when no bin rose above the noise floor (the band is then the plain 99 % rule's).
+    """
+
+    band: float
+    noise_share: float
+    rate: float
+    motion_found: bool = True
+
+    def warnings(self, name: str) -> tuple[str, ...]:
+        """One line per implausible finding, naming the dataset ``name`` and the setting that fixes it."""
+        nyquist = self.rate / 2
+        out = []
+        if not self.motion_found:
+            out.append(f"{name}: no motion stands out of the positions' noise floor; the excitation band "
+                       f"{self.band:.3g} Hz is a guess: give preprocessing.band (Hz)")
+        elif self.band > IMPLAUSIBLE_BAND * nyquist:
+            out.append(f"{name}: the excitation band found, {self.band:.3g} Hz, is close to the Nyquist frequency "
+                       f"{nyquist:.4g} Hz, so filtering removes little: an undersampled log or positions that are mostly "
+                       "noise? Give preprocessing.band (Hz) if the excitation is known")
+        return tuple(out)
+
+
+def _detrended(column: np.ndarray, ramp: np.ndarray) -> np.ndarray:
+    """``column`` less its least-squares straight line (``ramp``: 0 to 1 over the samples). A line through the end
+    samples would carry their noise into a ramp whose low-frequency energy looks like motion; the Hann window
+    tapers what remains at the ends."""
+    centred = ramp - 0.5
+    slope = float(centred @ (column - column.mean()) / (centred @ centred))
+    return column - column.mean() - slope * centred
+
+
+def _noise_floor(power: np.ndarray, f: np.ndarray, nyquist: float) -> float:
+    """Mean periodogram level of broadband noise: the lowest median over octaves of the upper spectrum, divided
+    by ln 2 (the median of an exponential variable is ln 2 × its mean). Octaves, because motion raises the
+    lower ones and the resampling of jittered time stamps lowers the very top (hence nothing above 0.7 f_N)."""
+    medians = []
+    hi = 0.7 * nyquist
+    while hi > nyquist / 64:
+        sel = (f > hi / 2) & (f <= hi)
+        if sel.sum() >= 16:
+            medians.append(np.median(power[sel]))
+        hi /= 2
+    if not medians:
+        sel = f > nyquist / 4
+        medians = [np.median(power[sel])] if sel.any() else [0.0]
+    return float(min(medians) / np.log(2))
+
+
+def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION) -> BandEstimate:
+    """The excitation band of the motion, found above the positions' noise floor.
+
+    Per joint, the positions are detrended (:func:`_detrended`) and windowed (Hann), and their periodogram ``P(f)`` is compared with its noise
+    floor ``N`` (:func:`_noise_floor`, broadband encoder or sensor noise). A bin is motion when ``P``
+    exceeds ``20·N`` or its 9-bin mean exceeds ``5·N``; the motion's velocity energy is ``(2πf)²·(P − N)``
+    on those bins, summed over the joints (each weighted by its own energy), and the band is where it
+    reaches ``fraction``. Without the floor, a few percent of noise energy, which the velocity weighting
+    ``f²`` puts at the top of the spectrum, moves the 99 % point to the noise (hundreds of Hz on a 1 kHz
+    log whose motion lies below 1 Hz).
 
     Parameters
     ----------
@@ -69,8 +149,13 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
 
     Returns
     -------
-    float [Hz]
-        At least two frequency bins (``2·rate/N``), at most the Nyquist frequency.
+    BandEstimate
+        ``band`` is at least two frequency bins (``2·rate/N``) and at most the Nyquist frequency.
+
+    References
+    ----------
+    Welch-free periodogram statistics: Percival & Walden, *Spectral Analysis for Physical Applications*
+    (1993), §6.4 (the χ²₂ distribution of periodogram ordinates).
     """
     if not isinstance(q, StoredColumns):
         q = np.asarray(q, dtype=float)
@@ -80,16 +165,61 @@ def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTIO
     window = np.hanning(n)
     f = np.fft.rfftfreq(n, 1.0 / rate)
     f2 = f**2
-    energy = np.zeros(f.size)
+    total = np.zeros(f.size)
+    motion = np.zeros(f.size)
+    noise = 0.0
+    kernel = np.ones(9) / 9
     for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
-        column = q[:, j]
-        x = (column - column[0] - ramp * (column[-1] - column[0])) * window
-        energy += f2 * np.abs(np.fft.rfft(x)) ** 2
-    total = energy.sum()
-    if not total > 0:
-        return float(rate / 2)
-    k = int(np.searchsorted(np.cumsum(energy) / total, fraction))
-    return float(min(max(f[min(k, f.size - 1)], 2.0 * rate / n), rate / 2))
+        x = _detrended(np.asarray(q[:, j], dtype=float), ramp) * window
+        power = np.abs(np.fft.rfft(x)) ** 2
+        floor = _noise_floor(power, f, rate / 2)
+        total += f2 * power
+        if floor > 0:
+            smooth = np.convolve(power, kernel, mode="same")
+            above = (power > NOISE_BIN_FACTOR * floor) | (smooth > NOISE_SMOOTH_FACTOR * floor)
+            motion += np.where(above, f2 * np.maximum(power - floor, 0.0), 0.0)
+            noise += float(f2.sum() * floor)
+        else:
+            motion += f2 * power
+    lo, hi = 2.0 * rate / n, rate / 2
+    found = motion.sum() > 0
+    energy = motion if found else total
+    if not energy.sum() > 0:
+        return BandEstimate(float(hi), 0.0, float(rate), False)
+    k = int(np.searchsorted(np.cumsum(energy) / energy.sum(), fraction))
+    band = float(min(max(f[min(k, f.size - 1)], lo), hi))
+    share = float(min(noise / total.sum(), 1.0)) if total.sum() > 0 else 0.0
+    return BandEstimate(band, share, float(rate), bool(found))
+
+
+def white_noise_std(x, rate: float) -> np.ndarray:
+    """Standard deviation of the broadband (white) noise in each column of ``x``, from its periodogram's noise
+    floor (:func:`_noise_floor`): ``σ² = N / Σw²`` for the Hann window ``w``.
+
+    Parameters
+    ----------
+    x : (N, k) array or StoredColumns
+        Positions [rad] or velocities [rad/s] on a uniform grid.
+    rate : float [Hz]
+
+    Returns
+    -------
+    (k,) array, in the unit of ``x``.
+    """
+    n = x.shape[0]
+    ramp = np.linspace(0.0, 1.0, n)
+    window = np.hanning(n)
+    f = np.fft.rfftfreq(n, 1.0 / rate)
+    out = np.zeros(x.shape[1])
+    for j in range(x.shape[1]):
+        y = _detrended(np.asarray(x[:, j], dtype=float), ramp) * window
+        out[j] = np.sqrt(_noise_floor(np.abs(np.fft.rfft(y)) ** 2, f, rate / 2) / float((window**2).sum()))
+    return out
+
+
+def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION) -> float:
+    """The excitation band [Hz] of :func:`estimate_band`."""
+    return estimate_band(q, rate, fraction).band
 
 
 @dataclass(frozen=True)

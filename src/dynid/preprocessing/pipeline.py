@@ -19,13 +19,14 @@ from typing import Callable
 
 import numpy as np
 
-from ..column_store import StoredColumns, root_mean_square
+from ..column_store import StoredColumns, by_column, root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
-from .bands import MIN_SPEED_FRACTION
-from .filters import butterworth_filtfilt, differentiate, parallel_decimation
+from ..friction import Velocities, held_direction
+from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
+from .filters import butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
 from .fourier_fit import fourier_fit_derivatives
 from .settings import Preprocessing
 
@@ -46,9 +47,19 @@ class PreparedData:
     rate: float
     settings: Preprocessing
     warnings: tuple[str, ...] = ()
+    direction: np.ndarray | None = None
+    """(N, n_dof) direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`)."""
+    motion: np.ndarray | None = None
+    """(N, n_dof) the velocity [rad/s] that says where a joint moves (no overshoot where it stops)."""
+
+    def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
+        """The same samples with another rest model and presliding distance (per joint): the direction of motion
+        computed anew, the settings saying so."""
+        s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
+        return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
 
 
-def prepare(recording, settings: Preprocessing) -> PreparedData:
+def prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
     """Filter and differentiate a recording (positions, velocities: measured or from positions;
     accelerations: derivative of the filtered velocities). The torques are not filtered here: they go
     through the parallel filter with the regressor (:func:`base_chunks`).
@@ -59,6 +70,9 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
         Anything with ``name, t, q, dq (or None), tau, rate, n_samples, warnings``.
     settings : Preprocessing
         Unset values are derived from this recording (:meth:`Preprocessing.resolved`).
+    strict : bool
+        Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning:
+        settings carried over from another dataset).
 
     Raises
     ------
@@ -71,7 +85,7 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
     if recording.n_samples < 3 * (2 * settings.order + 1) + 1:
         raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
                         f"(at least {3 * (2 * settings.order + 1) + 1} for preprocessing.order = {settings.order})")
-    s = settings.resolved(rate, recording.q, recording.dq is not None)
+    s = settings.resolved(rate, recording.q, recording.dq is not None, recording.label, strict)
 
     def lowpass(x, cutoff, what):
         if cutoff <= 0:
@@ -88,11 +102,18 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
         q = lowpass(recording.q, s.position_cutoff, "position")
         dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
     tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
+    moving = _direction_velocity(recording, s, dq)
+    if s.rest_velocity == "auto":
+        rest = REST_FACTOR * _velocity_noise(recording, s)
+        s = replace(s, rest_velocity=tuple(float(v) for v in rest),
+                    derivation=s.derivation + f"; a joint rests below {REST_FACTOR:g}σ of its velocity's noise ("
+                    + ", ".join(f"{v:.2g}" for v in rest) + " rad/s), " + _rest_words(s.rest_friction))
+    rest = np.broadcast_to(np.asarray(s.rest_velocity, dtype=float), (recording.q.shape[1],))
     if s.min_speed == "auto":  # before the accelerations exist: its temporary square adds to a smaller peak
-        vmin = MIN_SPEED_FRACTION * root_mean_square(dq)
+        vmin = np.maximum(MIN_SPEED_FRACTION * root_mean_square(dq), 2 * rest)
         s = replace(s, min_speed=tuple(float(v) for v in vmin),
                     derivation=s.derivation + f"; rows slower than {100 * MIN_SPEED_FRACTION:g} % of the joint's RMS speed "
-                    "left out of the estimation")
+                    "(or than twice its rest velocity) left out of the estimation")
     if ddq is None:
         ddq = differentiate(dq, rate)
     t = recording.t
@@ -101,8 +122,86 @@ def prepare(recording, settings: Preprocessing) -> PreparedData:
         if 2 * cut >= t.shape[0] - 2:
             raise DataError(f"{recording.label}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
                             f"the {t[-1] - t[0]:.3f} s recording")
-        t, q, dq, ddq, tau = (x[cut:-cut] for x in (t, q, dq, ddq, tau))
-    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, s, tuple(recording.warnings))
+        t, q, dq, ddq, tau, moving = (x[cut:-cut] for x in (t, q, dq, ddq, tau, moving))
+    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
+                        tuple(recording.warnings) + s.warnings, direction_of_motion(dq, moving, s, rate), moving)
+
+
+
+
+def _direction_velocity(recording, s: Preprocessing, dq):
+    """The velocity that says where a joint moves and in which direction (:func:`dynid.friction.held_direction`'s
+    guide): measured velocities, or the positions' central difference, smoothed by a Gaussian at the velocity's
+    cutoff (:func:`dynid.preprocessing.filters.gaussian_smooth`: no overshoot, so no false reversal where a joint
+    stops abruptly, as a Butterworth filter's ringing gives); a Fourier fit's velocity as it is."""
+    if s.fourier is not None:
+        return dq
+    if recording.dq is not None:
+        return gaussian_smooth(recording.dq, recording.rate, s.velocity_cutoff)
+    return differentiate(gaussian_smooth(recording.q, recording.rate, s.position_cutoff), recording.rate)
+
+
+def _velocity_noise(recording, s: Preprocessing) -> np.ndarray:
+    """Standard deviation of the noise in :func:`_direction_velocity` (rad/s, per joint), from the noise floor of the
+    measured velocities or positions (:func:`dynid.preprocessing.bands.white_noise_std`)."""
+    if recording.dq is not None and s.fourier is None:
+        sigma = white_noise_std(recording.dq, recording.rate)
+        return velocity_noise_std(sigma, recording.rate, s.velocity_cutoff, s.order, False, gaussian=True)
+    sigma = white_noise_std(recording.q, recording.rate)
+    if s.fourier is not None:
+        return velocity_noise_std(sigma, recording.rate, s.band, s.order, True)
+    return velocity_noise_std(sigma, recording.rate, s.position_cutoff, s.order, True, gaussian=True)
+
+
+def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
+    v = np.asarray(value)
+    v = np.full(n, v.item()) if v.ndim == 0 else v
+    if v.shape != (n,) or (allowed is not None and not set(v.tolist()) <= allowed):
+        raise ConfigError(f"preprocessing.{where}: expected one value or {n} of them"
+                          + (f" among {sorted(allowed)}" if allowed else "") + f", got {value!r}")
+    return v
+
+
+def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
+    """Each joint's direction of motion (:func:`dynid.friction.held_direction`, velocities ``dq`` and ``guide``) with
+    the log's rest velocities, rest model and presliding distances, column by column (stored columns stay stored)."""
+    n = dq.shape[1]
+    rest = _per_joint(0.0 if s.rest_velocity == "auto" else s.rest_velocity, n, "rest_velocity").astype(float)
+    decay = rest_decay(s.rest_friction, n)
+    x0 = _per_joint(s.presliding, n, "presliding").astype(float)
+    cutoff = s.band if s.fourier is not None else (s.velocity_cutoff or s.position_cutoff or rate / 4)
+    travel = rest / cutoff  # a blip of the rest velocity's size lasts about 1/cutoff
+    return by_column(dq, lambda column, j: held_direction(column[:, None], rest[j], decay[j], x0[j], rate,
+                                                          np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
+
+
+def _rest_words(value) -> str:
+    if value == "held":
+        return "where it keeps the friction of its last motion"
+    if value == "zero":
+        return "where no friction is predicted"
+    if isinstance(value, (int, float)):
+        return f"where the friction of its last motion relaxes with a time constant of {value:g} s"
+    return "where the friction of its last motion relaxes with time constants " + ", ".join(
+        "∞" if x == "held" else "0" if x == "zero" else f"{x:g}" for x in value) + " s"
+
+
+def rest_decay(value, n: int) -> np.ndarray:
+    """``rest_friction`` ("held", "zero", seconds, or one per joint) as relaxation times [s] (inf: held)."""
+    v = _per_joint(value, n, "rest_friction")
+    try:
+        return np.array([np.inf if x == "held" else 0.0 if x == "zero" else float(x) for x in v.tolist()])
+    except (TypeError, ValueError):
+        raise ConfigError(f'preprocessing.rest_friction: expected "held", "zero" or a relaxation time in seconds, '
+                          f"got {value!r}") from None
+
+
+def rest_velocities(data: PreparedData, robot: Robot) -> Velocities:
+    """The friction columns' velocities for this log: the robot's, with the log's rest velocity and direction."""
+    v = robot.friction_velocities
+    rest = data.settings.rest_velocity
+    return Velocities(v.coulomb, v.stribeck, np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float),
+                                                               (robot.n_dof,)), None)
 
 
 def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
@@ -133,11 +232,13 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
     s = data.settings
     vmin = _min_speed(s, n)
     n_s = data.t.shape[0]
+    velocities = rest_velocities(data, robot)
 
     def block(a, b):  # the regressor and the torques, filtered alike but never copied into one array
         columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))  # stored columns: read here
-        return regressor(robot, q, dq, ddq, columns), tau
+        v = velocities if data.direction is None else replace(velocities, direction=np.asarray(data.direction[a:b]))
+        return regressor(robot, q, dq, ddq, columns, v), tau
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):

@@ -8,7 +8,11 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..exceptions import ConfigError
-from .bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, decimation_cutoff, decimation_for, excitation_band
+from .bands import PARALLEL_FACTOR, POSITION_FACTOR, capped, cutoffs_from_band, decimation_cutoff, decimation_for, estimate_band
+
+
+MIN_SAMPLES_KEPT = 200
+"""A log whose settings come from another dataset is decimated by at most ``N // MIN_SAMPLES_KEPT``."""
 
 
 @dataclass(frozen=True)
@@ -24,8 +28,9 @@ class Preprocessing:
         off. Default: ``10·band`` (velocities: the position cutoff).
     parallel_cutoff : float or None [Hz]
         Cutoff of the zero-phase low-pass applied to the torques **and** to every regressor column
-        (parallel filtering); 0: only the decimation's anti-aliasing filter. Default: ``5·band``, or
-        the decimation's own cutoff when only ``decimation`` is given.
+        (parallel filtering); 0: only the decimation's anti-aliasing filter. Default: ``10·band``
+        (:data:`dynid.preprocessing.bands.PARALLEL_FACTOR`), lowered to the decimation's own cutoff when a
+        given ``decimation`` needs it (said in :attr:`derivation`).
     decimation : int or None
         Parallel decimation factor. Default: the largest whose anti-aliasing cutoff is at or above
         ``parallel_cutoff``.
@@ -49,12 +54,31 @@ class Preprocessing:
         sign. "auto": chosen per joint by blocked cross-validation on the identification log
         (:func:`dynid.validation.cross_validation.choose_coulomb_velocity`). Not the default: on the
         UR10e logs the choice made on the excitation log raised the point-to-point validation errors.
+    rest_velocity : "auto", float or tuple [rad/s]
+        Per joint, the velocity below which the joint counts as resting: its Coulomb (and Stribeck, asymmetric
+        Coulomb) column is 0 there, with a ramp to ±1 at twice it (:func:`dynid.friction.moving_sign`), since
+        below it the velocity's sign is noise and the friction of a resting joint is whatever holds it. "auto"
+        (default): :data:`dynid.preprocessing.bands.REST_FACTOR` × the standard deviation of the noise the
+        filtered velocity carries (:func:`dynid.preprocessing.filters.velocity_noise_std`), for each log
+        anew; 0: plain sign.
+    rest_friction : "held", "zero", float [s], or a tuple of them
+        Per joint, the friction predicted while it rests: "held" (default), that of its last motion (the static
+        friction holds the link while the controller keeps the torque it had when the joint stopped); a time in
+        seconds: that, relaxing to 0 with this time constant; "zero": none (:func:`dynid.friction.held_direction`).
+    presliding : float or tuple [rad]
+        Per joint, Dahl's presliding distance over which the friction reverses with the direction of motion
+        (:func:`dynid.friction.held_direction`); 0 (default): at once.
     auto : bool
         ``preprocessing = "auto"``: the position and parallel cutoffs (hence the decimation) are chosen
         by blocked cross-validation (:func:`dynid.validation.cross_validation.choose_preprocessing`), and
         the Coulomb smoothing velocity too unless given.
     derivation : str
         Filled by :meth:`resolved`: what was derived from the data, and why.
+    noise_share : float or None
+        Filled by :meth:`resolved` when the band comes from the positions: the share of their velocity-weighted
+        spectral energy that is broadband noise (:class:`dynid.preprocessing.bands.BandEstimate`).
+    warnings : tuple of str
+        Filled by :meth:`resolved`: an implausible band, a capped cutoff (one line each, naming the dataset).
     """
 
     order: int = 4
@@ -68,11 +92,21 @@ class Preprocessing:
     chunk: int = 20_000
     fourier: tuple[float, int] | None = None
     coulomb_velocity: str | float | tuple = 0.0
+    rest_velocity: str | float | tuple = "auto"
+    rest_friction: str | float | tuple = "held"
+    presliding: float | tuple = 0.0
     auto: bool = False
     derivation: str = ""
+    noise_share: float | None = None
+    warnings: tuple[str, ...] = ()
 
-    def resolved(self, rate: float, q: np.ndarray | None = None, measured_velocity: bool = True) -> "Preprocessing":
+    def resolved(self, rate: float, q: np.ndarray | None = None, measured_velocity: bool = True,
+                 name: str = "data", strict: bool = True) -> "Preprocessing":
         """Every ``None`` replaced by its data-derived value (module :mod:`dynid.preprocessing.bands`).
+
+        Cutoffs given in Hz stay what the user wrote; a cutoff at or above :data:`~dynid.preprocessing.bands.NYQUIST_CAP`
+        of this log's Nyquist frequency (another dataset's rate) is lowered to it, and a parallel cutoff above a
+        given decimation's anti-aliasing cutoff is lowered to that, each with a line in :attr:`warnings`.
 
         Parameters
         ----------
@@ -81,40 +115,68 @@ class Preprocessing:
             Measured positions, for the excitation band when neither ``band`` nor ``fourier`` gives it.
         measured_velocity : bool
             Whether the log has velocities (then filtered at ``velocity_cutoff``).
+        name : str
+            The dataset, for the warnings.
+        strict : bool
+            Refuse a given cutoff at or above this log's Nyquist frequency (the config's own log: a mistake) rather
+            than lowering it (settings carried over to a log of another rate).
 
         Raises
         ------
         ConfigError
-            A cutoff at or above the Nyquist frequency, or no way to find the band.
+            A band (or with ``strict`` a given cutoff) at or above the Nyquist frequency, or no way to find the band.
         """
         nyq = rate / 2
-        for name in ("position_cutoff", "velocity_cutoff", "parallel_cutoff", "band"):
-            v = getattr(self, name)
+        for key in (("position_cutoff", "velocity_cutoff", "parallel_cutoff", "band") if strict else ("band",)):
+            v = getattr(self, key)
             if v is not None and v >= nyq:
-                raise ConfigError(f"preprocessing.{name}: expected below the Nyquist frequency {nyq:g} Hz of the "
-                                  f"{rate:g} Hz log, got {v:g} Hz")
-        band, source = self.band, "given by preprocessing.band"
+                raise ConfigError(f"preprocessing.{key}: expected below the Nyquist frequency {nyq:g} Hz of {name} "
+                                  f"({rate:.6g} Hz), got {v:g} Hz")
+        warnings = list(self.warnings)
+        band, source, share = self.band, "given by preprocessing.band", self.noise_share
         if band is None and self.fourier is not None:
             band, source = self.fourier[0] * self.fourier[1] / (2 * np.pi), "the excitation's highest harmonic"
         if band is None:
             if q is None:
                 raise ConfigError("preprocessing.band: needed when no positions are given to estimate it")
-            band, source = excitation_band(q, rate), "99 % of the velocity energy in the positions' spectrum"
+            found = estimate_band(q, rate)
+            band, share = found.band, found.noise_share
+            source = (f"99 % of the motion's velocity energy, above a noise floor holding {100 * share:.2g} % of the "
+                      "positions' spectrum" if found.motion_found else "99 % of the velocity energy: no motion above the noise")
+            warnings.extend(found.warnings(name))
         derived = cutoffs_from_band(band, rate)
-        pos = self.position_cutoff if self.position_cutoff is not None else derived.position_cutoff
-        vel = self.velocity_cutoff if self.velocity_cutoff is not None else pos
-        if self.parallel_cutoff:
-            par = self.parallel_cutoff
-        elif self.decimation is not None or self.parallel_cutoff == 0:
-            par = decimation_cutoff(rate, self.decimation) if (self.decimation or 1) > 1 else 0.0
-        else:
+
+        def given(key: str, value: float | None) -> float | None:  # a cutoff in Hz, capped for this log's rate
+            if value is None or value <= 0:
+                return value
+            cap = capped(value, rate)
+            if cap < value:
+                warnings.append(f"{name}: preprocessing.{key} = {value:g} Hz lies above {100 * cap / nyq:.0f} % of this "
+                                f"log's Nyquist frequency ({rate:.6g} Hz): filtered at {cap:.4g} Hz")
+            return cap
+
+        pos = given("position_cutoff", self.position_cutoff)
+        pos = derived.position_cutoff if pos is None else pos
+        vel = given("velocity_cutoff", self.velocity_cutoff)
+        vel = pos if vel is None else vel
+        par = given("parallel_cutoff", self.parallel_cutoff)
+        lowered = False
+        if par is None:
             par = derived.parallel_cutoff
+        if self.decimation is not None and self.decimation > 1 and par > decimation_cutoff(rate, self.decimation):
+            limit = decimation_cutoff(rate, self.decimation)
+            if self.parallel_cutoff:  # both given and they contradict: say so
+                warnings.append(f"{name}: preprocessing.parallel_cutoff = {par:.4g} Hz would alias when decimating by "
+                                f"{self.decimation} (at most {limit:.4g} Hz): filtered at {limit:.4g} Hz")
+            par, lowered = limit, True
         if self.decimation is not None:
             dec = self.decimation
         elif par > 0:
             dec = decimation_for(rate, par)
         else:
             dec = 1
+        if not strict and self.decimation is None and q is not None:  # a short log keeps enough samples to judge it
+            dec = max(1, min(dec, q.shape[0] // MIN_SAMPLES_KEPT))
         if self.fourier is not None:
             on = []
         else:
@@ -125,13 +187,30 @@ class Preprocessing:
             chosen.append(f"positions low-passed at {pos:.3g} Hz" + ("" if self.position_cutoff is not None else f" ({POSITION_FACTOR:g}× band)"))
         else:
             chosen.append("positions, velocities and accelerations from the Fourier fit")
-        chosen.append(f"torques and every regressor column low-passed in parallel at {par:.3g} Hz"
-                      + ("" if self.parallel_cutoff is not None or self.decimation is not None else f" ({PARALLEL_FACTOR:g}× band)")
-                      if par > 0 else "no parallel filter")
+        if par > 0:
+            why = (f" (the anti-aliasing cutoff of decimation = {dec})" if lowered else
+                   "" if self.parallel_cutoff is not None else f" ({PARALLEL_FACTOR:g}× band)")
+            chosen.append(f"torques and every regressor column low-passed in parallel at {par:.3g} Hz{why}")
+        else:
+            chosen.append("no parallel filter")
         chosen.append(f"decimation by {dec}" + ("" if self.decimation is not None else " (down to the parallel band)"))
-        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),
-                       decimation=int(dec), band=float(band), trim=float(trim), derivation="; ".join(chosen))
+        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),  # noqa: E501
+                       decimation=int(dec), band=float(band), trim=float(trim), derivation="; ".join(chosen),
+                       noise_share=share, warnings=tuple(dict.fromkeys(warnings)))
 
     def to_dict(self) -> dict:
+        """The settings as results.json stores them (``warnings`` go to the result's own warnings)."""
         return {f.name: (list(getattr(self, f.name)) if isinstance(getattr(self, f.name), tuple) else getattr(self, f.name))
-                for f in fields(self)}
+                for f in fields(self) if f.name != "warnings"}
+
+
+def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
+    """Settings of a log scored with another log's parameters (a validation log): the identification's filters in Hz
+    (resolved on its data), so both are scored through the same filters; the decimation and the trim derived again
+    for this log (its rate and length may differ; a decimation the config gives is the identification log's); no
+    Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
+    cutoff above this log's Nyquist frequency is lowered, with a warning."""
+    if resolved is None:
+        return replace(given, fourier=None, decimation=None, warnings=())
+    return replace(resolved, fourier=None, decimation=None, trim=given.trim, rest_velocity=given.rest_velocity,
+                   min_speed=given.min_speed, derivation="", warnings=(), noise_share=None)

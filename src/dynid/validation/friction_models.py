@@ -1,0 +1,335 @@
+"""Each joint's friction model chosen by blocked cross-validation on the identification log.
+
+Friction is the part of a real robot's torque that the rigid-body model leaves to an assumption, and the best
+assumption differs from joint to joint and from robot to robot. The candidates here all keep the torque linear
+in the parameters (paper eq. 6); where one has a nonlinear constant (a Stribeck or smoothing velocity, a
+relaxation time), a small grid of it is searched, each point fitted by linear least squares (a separable search):
+
+* the **state at rest** of the Coulomb-like terms (:func:`dynid.friction.held_direction`): the friction of the
+  last motion held while the joint rests (a controller with integral action), relaxing with a time constant of
+  1 or 0.3 s, or none at rest;
+* the **family**: Coulomb + viscous (+ the description's offset, rotor inertia, counterbalance), asymmetric
+  Coulomb (``fca``: while the joint moves, the same as an offset; at rest, 0 where an offset stays), Stribeck with
+  its velocity, smooth Coulomb ``tanh(q̇/v_s)`` with
+  its velocity, and load-dependent Coulomb (``fcl·|τ_load|``, harmonic drives).
+
+Every candidate is applied to all joints at once; its parameters are fitted on all contiguous blocks of the log but
+one (rows of moving joints only, as the estimation) and scored on the block left out, **all** its rows, rests and
+reversals included, joint by joint (Bergmeir & Benítez, Information Sciences 191, 2012). Each joint keeps the
+candidate with its smallest out-of-fold error; a candidate other than the plain model must lower it by
+:data:`MARGIN` to be chosen. One pass over the log accumulates, per block and joint, the Gram matrix of the
+rigid-body base columns, every candidate's columns and the torque (all parallel-filtered and decimated like the
+estimation's rows), so each candidate costs one small solve per block, not a pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..column_store import root_mean_square
+from ..dynamics.base_parameters import base_parameters
+from ..dynamics.regressor import regressor
+from ..friction import TERMS, Velocities, held_direction
+from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with
+from ..model.robot import Robot
+from ..preprocessing.filters import parallel_decimation
+from ..preprocessing.pipeline import PreparedData, _min_speed, rest_decay
+
+__all__ = ["FOLDS", "FrictionChoice", "choose_friction"]
+
+FOLDS = 5
+
+MARGIN = 0.01
+"""A candidate other than the plain model (held at rest, Coulomb + viscous) must lower a joint's out-of-fold RMS
+error by this fraction to be chosen."""
+
+REST_SHARE = 0.05
+"""A joint's state at rest is judged only when at least this share of its samples are at rest in the log;
+otherwise it stays "held" (what a controller with integral action does)."""
+
+LOAD_SHARE = 0.25
+"""The load-dependent term is a candidate for a joint whose nominal rigid-body torque has an RMS of at least this
+share of its measured RMS torque (a transmission that carries little load cannot tell it from Coulomb)."""
+
+REST_GRID: tuple = ("held", 1.0, 0.3, "zero")
+"""Candidate states at rest: held, relaxing with these time constants [s], none."""
+
+STRIBECK_GRID = (0.01, 0.03, 0.1, 0.3)
+"""Candidate Stribeck velocities, as fractions of the joint's RMS speed."""
+
+SMOOTH_GRID = (0.003, 0.01, 0.03, 0.1)
+"""Candidate smoothing velocities of ``tanh(q̇/v_s)``, as fractions of the joint's RMS speed."""
+
+
+
+@dataclass(frozen=True)
+class FrictionChoice:
+    """Friction models chosen per joint, with the out-of-fold errors behind the choice.
+
+    Attributes
+    ----------
+    models : tuple of JointFriction
+    candidates : tuple of str
+        Labels of the candidates tried (each applied to all joints).
+    error : (n_candidates, n_dof) array [N·m]
+        Out-of-fold RMS torque error of each candidate, per joint, on all rows of the held-out blocks.
+    plain : (n_dof,) array [N·m]
+        That of the plain model (held at rest, Coulomb + viscous).
+    chosen : (n_dof,) array [N·m]
+        That of the chosen mixture.
+    folds : int
+    rest_share : (n_dof,) array
+        Share of each joint's samples at rest in the log (its state at rest is judged from :data:`REST_SHARE` on).
+    load_candidate : (n_dof,) bool array
+        Joints for which the load-dependent term was a candidate (:data:`LOAD_SHARE`).
+    """
+
+    models: tuple[JointFriction, ...]
+    candidates: tuple[str, ...]
+    error: np.ndarray
+    plain: np.ndarray
+    chosen: np.ndarray
+    folds: int
+    rest_share: np.ndarray | None = None
+    load_candidate: np.ndarray | None = None
+
+    def robot(self, robot: Robot) -> Robot:
+        """``robot`` with each joint's chosen terms (drive terms and mask) and velocities (Stribeck, smoothing)."""
+        return robot_with(robot, self.models)
+
+    def rest_friction(self) -> tuple:
+        """Each joint's state at rest, as ``Preprocessing.rest_friction``."""
+        return tuple(m.rest for m in self.models)
+
+    def to_dict(self) -> dict:
+        return {"models": [m.to_dict() for m in self.models], "candidates": list(self.candidates),
+                "out_of_fold_rms_error": self.error, "plain_out_of_fold_rms_error": self.plain,
+                "chosen_out_of_fold_rms_error": self.chosen, "folds": self.folds, "margin": MARGIN,
+                "rest_share": self.rest_share, "rest_share_judged_from": REST_SHARE,
+                "load_candidate": None if self.load_candidate is None else self.load_candidate.tolist()}
+
+
+def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> FrictionChoice:
+    """Choose each joint's friction model by blocked cross-validation (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        Its drive terms other than the Coulomb-like ones (rotor inertia, viscous, offset, counterbalance) are in
+        every candidate.
+    data : PreparedData
+        The identification log after :func:`dynid.preprocessing.prepare`.
+    folds : int
+        Contiguous blocks (at least 2).
+
+    Returns
+    -------
+    FrictionChoice
+    """
+    n = robot.n_dof
+    s = data.settings
+    rest_v = np.broadcast_to(np.asarray(0.0 if s.rest_velocity == "auto" else s.rest_velocity, dtype=float), (n,))
+    speed = np.maximum(root_mean_square(data.dq), 1e-9)
+    rigid = replace(robot, drive_terms=(), drive=np.zeros((n, 0)), drive_mask=None)
+    rigid_base = base_parameters(rigid, rng=0)
+    p = rigid_base.n_base
+    nominal = rigid_base.base_from_standard(rigid.standard_parameters())
+    load_ok = bool(np.any(rigid.inertial != 0))
+    others = [t for t in robot.drive_terms if t not in COULOMB_LIKE]
+    # the bank of columns, per joint the same layout: the description's other terms, then per state at rest the
+    # Coulomb, asymmetric, Stribeck (grid) and load columns, then the smooth Coulomb ones
+    names = list(others)
+    for r in REST_GRID:
+        names += [f"fc|{r}", f"fca|{r}"] + [f"fst|{r}|{g}" for g in STRIBECK_GRID] + ([f"fcl|{r}"] if load_ok else [])
+    names += [f"tanh|{g}" for g in SMOOTH_GRID]
+    index = {name: i for i, name in enumerate(names)}
+    k_bank = len(names)
+    has = {t: robot.drive_mask[:, robot.drive_terms.index(t)] for t in others}
+    decays = [rest_decay(r, n) for r in REST_GRID]
+    cutoff = s.velocity_cutoff or s.position_cutoff or data.rate / 4
+    directions = [_directions(data, rest_v, d, cutoff) for d in decays]
+    velocities = robot.friction_velocities
+
+    def block(a, b):
+        q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))
+        y = regressor(rigid, q, dq, ddq, rigid_base.independent)
+        bank = np.zeros((b - a, n, k_bank))
+        v = Velocities(velocities.coulomb, velocities.stribeck, rest_v)
+        for t in others:
+            bank[:, :, index[t]] = TERMS[t].column(q, dq, ddq, v) * has[t]
+        load = np.abs(y @ nominal) if load_ok else None
+        for r, direction in zip(REST_GRID, directions):
+            z = np.asarray(direction[a:b])
+            bank[:, :, index[f"fc|{r}"]] = z
+            bank[:, :, index[f"fca|{r}"]] = np.abs(z)
+            for g in STRIBECK_GRID:
+                bank[:, :, index[f"fst|{r}|{g}"]] = z * np.exp(-(dq / (g * speed)) ** 2)
+            if load_ok:
+                bank[:, :, index[f"fcl|{r}"]] = load * z
+        for g in SMOOTH_GRID:
+            bank[:, :, index[f"tanh|{g}"]] = np.tanh(dq / (g * speed))
+        return y, bank, tau
+
+    size = p + k_bank + 1
+    fit = np.zeros((folds, n, size, size))
+    score = np.zeros((folds, n, size, size))
+    n_rows = np.zeros((folds, n))
+    vmin = _min_speed(s, n)
+    n_s = data.t.shape[0]
+    load_sq, tau_sq, resting = np.zeros(n), np.zeros(n), np.zeros(n)
+    for idx, (y, bank, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk,
+                                                   s.parallel_cutoff or None):
+        z = np.concatenate([y, bank, tau[:, :, None]], axis=2)
+        tau_sq += (tau**2).sum(axis=0)
+        if load_ok:
+            load_sq += ((y @ nominal) ** 2).sum(axis=0)
+        guide = np.asarray((data.motion if data.motion is not None else data.dq)[idx])
+        resting += (np.abs(guide) <= rest_v).sum(axis=0)
+        keep = np.abs(np.asarray(data.dq[idx])) >= vmin
+        fold = idx * folds // n_s
+        for f in np.unique(fold):
+            sel = fold == f
+            zf = z[sel]
+            score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
+            zk = zf * keep[sel][:, :, None]
+            fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
+            n_rows[f] += sel.sum()
+
+    def columns(model: JointFriction, j: int) -> list[int]:
+        own = [index[t] for t in others if has[t][j]]
+        r = model.rest
+        if model.kind == "smooth":
+            return own + [index[f"tanh|{model.velocity}"]]
+        cols = own + [index[f"fc|{r}"]]
+        if model.kind == "asymmetric":
+            cols.append(index[f"fca|{r}"])
+        elif model.kind == "stribeck":
+            cols.append(index[f"fst|{r}|{model.velocity}"])
+        elif model.kind == "load":
+            cols.append(index[f"fcl|{r}"])
+        return cols
+
+    def out_of_fold(assignment, signs=False):
+        """Out-of-fold errors per joint; with ``signs`` also whether a load-dependent coefficient (the last column
+        of that model) comes out >= 0, as friction that grows with the load must."""
+        cols = [columns(m, j) for j, m in enumerate(assignment)]
+        err, coef = _out_of_fold(fit, score, n_rows, p, cols)
+        if not signs:
+            return err
+        ok = np.array([m.kind != "load" or coef[j][-1] >= 0 for j, m in enumerate(assignment)])
+        return err, ok
+
+    # Stage 1: the state at rest, with the plain model; stage 2: the family, with each joint's state at rest.
+    # Each candidate is first tried on all joints at once (a table of how each fares), then each joint's choice is
+    # refined with the other joints at their current choices (coordinate descent): a joint whose own friction is
+    # misfitted spoils the shared rigid-body parameters, and so every joint's error, under the plain model.
+    rows = max(n_rows.sum(axis=0).max(), 1)
+    judged = np.zeros(n, bool)
+    labels, errors = [], []
+    rest_err = []
+    for r in REST_GRID:
+        e = out_of_fold([JointFriction("coulomb", 0.0, r)] * n)
+        rest_err.append(e)
+        labels.append(JointFriction("coulomb", 0.0, r).label)
+        errors.append(e)
+    plain = rest_err[0]
+    judged = resting / rows >= REST_SHARE
+    loaded = load_ok & (np.sqrt(load_sq) >= LOAD_SHARE * np.sqrt(tau_sq))
+    family = [("coulomb", 0.0), ("asymmetric", 0.0)] + [("stribeck", g) for g in STRIBECK_GRID] + \
+        [("smooth", g) for g in SMOOTH_GRID] + ([("load", 0.0)] if load_ok else [])
+    for kind, g in family[1:]:
+        e = out_of_fold([JointFriction(kind, g, "held")] * n)
+        labels.append(JointFriction(kind, g).label.split(",")[0])
+        errors.append(e)
+
+    def allowed(j: int, m: JointFriction) -> bool:
+        # load-dependent friction needs a loaded transmission; smooth Coulomb has no state at rest (tanh(q̇/v_s) is 0
+        # there) and asymmetric Coulomb differs from the offset only where the friction is not held at rest, so they
+        # are candidates only where the log shows how the joint rests
+        return ((m.kind != "load" or bool(loaded[j])) and (m.kind not in ("smooth", "asymmetric") or bool(judged[j]))
+                and (m.rest == "held" or bool(judged[j])) and not (m.kind == "asymmetric" and m.rest == "held"))  # noqa: E501
+
+    # a smooth Coulomb term is 0 at rest (tanh(0) = 0): its state at rest is "zero"
+    options = [JointFriction(kind, g, r) for kind, g in family for r in REST_GRID if kind != "smooth" or r == "zero"]
+    assignment = [JointFriction()] * n
+    for _ in range(3):  # sweeps of coordinate descent
+        changed = False
+        for j in range(n):
+            trial = []
+            for m in options:
+                if not allowed(j, m):
+                    trial.append(np.inf)
+                    continue
+                err, ok = out_of_fold(assignment[:j] + [m] + assignment[j + 1:], signs=True)
+                trial.append(err[j] if ok[j] else np.inf)
+            best = options[_pick(trial)]
+            if best != assignment[j]:
+                assignment[j], changed = best, True
+        if not changed:
+            break
+    chosen_rel = assignment
+    final = out_of_fold(chosen_rel)
+    models = tuple(JointFriction(m.kind, float(m.velocity * speed[j]) if m.kind in ("stribeck", "smooth") else 0.0,
+                                 m.rest) for j, m in enumerate(chosen_rel))
+    return FrictionChoice(models, tuple(labels), np.array(errors), plain, final, folds, resting / rows, loaded)
+
+
+def _directions(data: PreparedData, rest_v, decay, cutoff: float):
+    """The direction of motion of every joint for one state at rest (column by column, as the pipeline)."""
+    from ..column_store import by_column
+
+    travel = rest_v / cutoff
+    guide = data.motion if data.motion is not None else data.dq
+    return by_column(data.dq, lambda column, j: held_direction(column[:, None], rest_v[j], decay[j], 0.0, data.rate,
+                                                               np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
+
+
+def _pick(errors) -> int:
+    """Index of the smallest error; the first (plainest) unless another is at least :data:`MARGIN` better."""
+    errors = np.asarray(errors, dtype=float)
+    best = int(np.argmin(errors))
+    return best if errors[best] < (1.0 - MARGIN) * errors[0] else 0
+
+
+def _solve(g, p: int, cols, offsets) -> np.ndarray:
+    """Least squares from per-joint Gram matrices ``g`` (n, size, size): the shared rigid-body columns, then each
+    joint's own bank columns ``cols[j]``, the torque last (column scaling, minimum-norm where rank-deficient)."""
+    n, size, _ = g.shape
+    t = size - 1
+    m = offsets[-1]
+    a = np.zeros((m, m))
+    b = np.zeros(m)
+    for j in range(n):
+        own = p + np.asarray(cols[j], dtype=int)
+        sl = slice(offsets[j], offsets[j + 1])
+        a[:p, :p] += g[j][:p, :p]
+        a[:p, sl] += g[j][:p][:, own]
+        a[sl, :p] += g[j][own][:, :p]
+        a[sl, sl] += g[j][np.ix_(own, own)]
+        b[:p] += g[j][:p, t]
+        b[sl] += g[j][own, t]
+    scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
+    return np.linalg.lstsq(a / scale[:, None] / scale[None, :], b / scale, rcond=1e-10)[0] / scale
+
+
+def _out_of_fold(fit, score, n_rows, p: int, cols) -> tuple[np.ndarray, list]:
+    """Out-of-fold RMS error per joint when each joint ``j`` has the bank columns ``cols[j]`` (plus the shared
+    rigid-body columns), fitted on the other blocks' moving rows and scored on all rows of the block left out;
+    and each joint's own coefficients fitted on every block."""
+    folds, n, size, _ = fit.shape
+    t = size - 1
+    offsets = np.cumsum([p] + [len(c) for c in cols])
+    sse = np.zeros(n)
+    whole = _solve(fit.sum(axis=0), p, cols, offsets)
+    own_coef = [whole[offsets[j]:offsets[j + 1]] for j in range(n)]
+    for k in range(folds):
+        g = fit[[f for f in range(folds) if f != k]].sum(axis=0)
+        theta = _solve(g, p, cols, offsets)
+        for j in range(n):
+            own = p + np.asarray(cols[j], dtype=int)
+            idx = np.concatenate([np.arange(p), own, [t]])
+            e = np.concatenate([theta[:p], theta[offsets[j]:offsets[j + 1]], [-1.0]])
+            sse[j] += max(float(e @ score[k, j][np.ix_(idx, idx)] @ e), 0.0)
+    return np.sqrt(sse / np.maximum(n_rows.sum(axis=0), 1)), own_coef
