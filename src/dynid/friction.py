@@ -86,9 +86,9 @@ def held_direction(dq: np.ndarray, rest, decay=np.inf, presliding=0.0, rate: flo
         like a short reversal): it says where the joint moves (``|guide| > v_r``), while the sign of ``dq`` (flat in
         the motion's band, so its crossings are the motion's) gives the direction. Default ``dq``.
     min_travel : (n_dof,) array or float [rad]
-        A move against the last direction that travels less than this before the joint rests or turns back is not
-        a reversal (a velocity blip where a joint stops: the controller's velocity estimate rings); a longer one
-        reverses at its start.
+        A move against the last direction (or the first move) that travels less than this before the joint rests or
+        turns back is not a reversal (a velocity blip where a joint stops: the controller's velocity estimate rings);
+        a longer one reverses at its start.
 
     Returns
     -------
@@ -124,13 +124,13 @@ def _held_column(v: np.ndarray, vr: float, tr: float, x0: float, rate: float, gu
     if not sigma.any():
         return np.zeros(n)
     bounds = np.concatenate([[0], np.flatnonzero(np.diff(sigma) != 0) + 1, [n]])
-    if min_travel > 0:  # short moves against the last direction are blips: rest
+    if min_travel > 0:  # short moves against the last direction (or before any) are blips: rest
         last = 0.0
         for a, b in zip(bounds[:-1], bounds[1:]):
             d = sigma[a]
             if d == 0:
                 continue
-            if last != 0 and d != last and np.abs(v[a:b]).sum() / rate < min_travel:
+            if d != last and np.abs(v[a:b]).sum() / rate < min_travel:
                 following = sigma[b:b + 1]
                 if b == n or following[0] != d:  # it rests or turns back after it
                     sigma[a:b] = 0.0

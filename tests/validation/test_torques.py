@@ -56,3 +56,50 @@ def test_the_rows_kept_for_the_figure_do_not_hold_the_chunks():
     kept = sums.kept_t + sums.kept_y + sums.kept_tau
     assert not any(np.shares_memory(k, c) for k in kept for chunk in chunks for c in chunk)
     assert sum(k.nbytes for k in kept) < sum(c.nbytes for chunk in chunks for c in chunk) / 100
+
+
+def test_moving_and_resting_samples_are_scored_apart():
+    """Where a joint rests, the figures are those of its resting samples (RMSE, share inside ±f_s), and where it
+    moves those of its moving samples, each computed directly here; the accumulated sums of the fit agree."""
+    rng = np.random.default_rng(2)
+    m, n, p = 3_000, 2, 4
+    y = rng.standard_normal((m, n, p))
+    beta = rng.standard_normal(p)
+    resting = np.zeros((m, n), dtype=bool)
+    resting[1000:1600, 0] = True
+    tau = y @ beta + 0.2 * rng.standard_normal((m, n))
+    tau[resting] += rng.uniform(-1.5, 1.5, resting.sum())  # the static friction: anything within ±1.5 N·m
+    pred = y @ beta
+    cmp = TorqueComparison("x", np.arange(m) * 0.01, tau, {"b": pred}, resting=resting, static={"b": np.array([1.5, 1.0])})
+    got = cmp.metrics()["b"]
+    err = tau - pred
+    mov = ~resting[:, 0]
+    np.testing.assert_allclose(got["moving_rmse"][0], np.sqrt((err[mov, 0] ** 2).mean()))
+    np.testing.assert_allclose(got["moving_relative_error"][0], 100 * np.linalg.norm(err[mov, 0]) / np.linalg.norm(tau[mov, 0]))
+    np.testing.assert_allclose(got["rest_rmse"][0], np.sqrt((err[~mov, 0] ** 2).mean()))
+    assert got["rest_in_static_band"][0] == np.mean(np.abs(err[~mov, 0]) <= 1.5 * 1.05) > 0.9
+    assert np.isnan(got["rest_rmse"][1]) and cmp.rest_share.tolist() == [0.2, 0.0]
+    sums = TorqueSums(n, p, m)
+    for a in range(0, m, 700):
+        sums.add(cmp.t[a:a + 700], y[a:a + 700], tau[a:a + 700], resting[a:a + 700])
+    acc = sums.comparison("x", {"b": beta}).metrics()["b"]
+    for key in ("moving_rmse", "moving_relative_error", "rest_rmse"):
+        np.testing.assert_allclose(acc[key][0], got[key][0], rtol=1e-8, err_msg=key)
+
+
+def test_a_joint_at_the_noise_level_is_flagged_with_its_absolute_error():
+    from dynid.validation.torques import comparison_table
+
+    rng = np.random.default_rng(3)
+    m = 500
+    tau = np.column_stack([50 + 10 * np.sin(np.arange(m) / 30), 0.05 * rng.standard_normal(m)])
+    pred = tau + 0.3 * rng.standard_normal((m, 2))
+    cmp = TorqueComparison("p1", np.arange(m) * 0.01, tau, {"b": pred}, noise=np.array([0.5, 0.3]),
+                           speed=np.array([0.4, 0.001]))
+    assert cmp.meaningful().tolist() == [True, False]
+    (flag,) = cmp.flags()
+    assert flag.startswith("p1: J2 barely moves") and "relative error not meaningful" in flag and "RMSE 0.3" in flag
+    table = comparison_table(cmp)
+    error_row = next(r for r in table.rows if r[0].strip() == "error %")
+    assert error_row[1] != "n/m" and error_row[2] == "n/m"
+    assert cmp.to_dict()["relative_error_meaningful"] == [True, False]

@@ -10,7 +10,7 @@ reference set.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from ..model.robot import Robot
 from ..estimators.names import LEAST_SQUARES as METHODS
 from ..preprocessing.pipeline import PreparedData, base_chunks
 from ..tables import Line, TextTable, render_text
-from ..validation.torques import TorqueComparison, TorqueSums, comparison_table
+from ..validation.torques import TorqueComparison, TorqueSums, comparison_table, resting_rows
 
 __all__ = ["IdentificationResult", "identify"]
 
@@ -260,7 +260,9 @@ class IdentificationResult:
                             "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations"))
         if self.drive_gains is not None:
             out.extend(self.drive_gains.summary_blocks())
-        out.extend(comparison_table(c) for c in (self.fit, *self.validations))
+        for c in (self.fit, *self.validations):
+            out.append(comparison_table(c))
+            out.extend(Line(f) for f in c.flags())
         out.extend(Line(w, "warning") for w in self.warnings)
         return out
 
@@ -324,7 +326,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
             y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
-        sums.add(data.t[index], y, tau)
+        sums.add(data.t[index], y, tau, resting_rows(data, index))
         if extra:
             k = keep.reshape(-1)
             stacked_w.append(y.reshape(-1, base.n_base) * k[:, None])
@@ -366,7 +368,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
         except DynIdError as exc:  # a failed check never stops the identification
             margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
-    fit = sums.comparison(data.name, sets)
+    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,

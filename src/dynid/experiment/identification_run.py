@@ -41,7 +41,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 
 
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
-              progress=None, resolved: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
+              progress=None, resolved: Preprocessing | None = None, noise=None) -> tuple[tuple, tuple[str, ...]]:
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
 
@@ -52,7 +52,8 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
             progress(f"validation, {spec.name}", 0, 1)
         data = prepare(load_recording(spec, config.robot), settings, strict=False)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
-                                   None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t))))
+                                   None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
+                                   noise=noise))
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
 
@@ -119,7 +120,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,
-                                      data.settings)
+                                      data.settings, result.joint_std)
     return replace(result, validations=validations, warnings=result.warnings + warnings)
 
 
@@ -165,7 +166,12 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    comparisons, warnings = _validate(config, base, sets, datasets, progress, stored_preprocessing(identified))
+    try:
+        noise = np.asarray(identified.get("joint_residual_std"), dtype=float) if "joint_residual_std" in identified else None
+        noise = noise if noise is not None and noise.shape == (config.robot.n_dof,) else None
+    except (TypeError, ValueError):
+        noise = None
+    comparisons, warnings = _validate(config, base, sets, datasets, progress, stored_preprocessing(identified), noise)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 

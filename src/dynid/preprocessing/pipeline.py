@@ -104,7 +104,7 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
     tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
     moving = _direction_velocity(recording, s, dq)
     if s.rest_velocity == "auto":
-        rest = REST_FACTOR * _velocity_noise(recording, s)
+        rest = np.maximum(REST_FACTOR * _velocity_noise(recording, s), np.asarray(s.rest_floor, dtype=float))
         s = replace(s, rest_velocity=tuple(float(v) for v in rest),
                     derivation=s.derivation + f"; a joint rests below {REST_FACTOR:g}σ of its velocity's noise ("
                     + ", ".join(f"{v:.2g}" for v in rest) + " rad/s), " + _rest_words(s.rest_friction))

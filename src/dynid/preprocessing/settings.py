@@ -61,6 +61,9 @@ class Preprocessing:
         (default): :data:`dynid.preprocessing.bands.REST_FACTOR` × the standard deviation of the noise the
         filtered velocity carries (:func:`dynid.preprocessing.filters.velocity_noise_std`), for each log
         anew; 0: plain sign.
+    rest_floor : float or tuple [rad/s]
+        Lower bound of the "auto" rest velocity: a log scored with another log's parameters takes that log's rest
+        velocities as the floor (the same sensors; a log that barely moves shows too little noise to measure it).
     rest_friction : "held", "zero", float [s], or a tuple of them
         Per joint, the friction predicted while it rests: "held" (default), that of its last motion (the static
         friction holds the link while the controller keeps the torque it had when the joint stopped); a time in
@@ -93,6 +96,7 @@ class Preprocessing:
     fourier: tuple[float, int] | None = None
     coulomb_velocity: str | float | tuple = 0.0
     rest_velocity: str | float | tuple = "auto"
+    rest_floor: float | tuple = 0.0
     rest_friction: str | float | tuple = "held"
     presliding: float | tuple = 0.0
     auto: bool = False
@@ -212,5 +216,6 @@ def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "P
     cutoff above this log's Nyquist frequency is lowered, with a warning."""
     if resolved is None:
         return replace(given, fourier=None, decimation=None, warnings=())
+    floor = resolved.rest_velocity if given.rest_velocity == "auto" and resolved.rest_velocity != "auto" else 0.0
     return replace(resolved, fourier=None, decimation=None, trim=given.trim, rest_velocity=given.rest_velocity,
-                   min_speed=given.min_speed, derivation="", warnings=(), noise_share=None)
+                   rest_floor=floor, min_speed=given.min_speed, derivation="", warnings=(), noise_share=None)

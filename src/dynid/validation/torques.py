@@ -1,5 +1,9 @@
 """Measured against predicted torques on the same preprocessed samples: per-joint relative error, RMSE,
-correlation coefficient (eq. 18) and the global relative error, for any number of parameter sets."""
+correlation coefficient (eq. 18) and the global relative error, for any number of parameter sets; and figures that
+say what they measure: the samples where a joint moves and those where it rests apart (at rest, the friction is
+whatever holds the joint, within ``±f_s``: there the RMSE and the share of samples inside that static band are
+given, not a relative error), and a joint whose torque is at the noise level flagged rather than given a
+relative error of 1500 %."""
 
 from __future__ import annotations
 
@@ -35,27 +39,110 @@ class TorqueComparison:
     summary: dict | None = None
     """From :class:`TorqueSums`: the metrics, sample count and RMS torque of all samples, while ``t``,
     ``measured`` and ``predicted`` hold only the samples a figure draws."""
+    resting: np.ndarray | None = None
+    """(M, n_dof) bool: where each joint rests (its velocity below its rest velocity)."""
+    static: dict | None = None
+    """label -> (n_dof,) static friction ``f_s`` [N·m] of each parameter set (the band a resting joint's friction
+    stays in)."""
+    noise: np.ndarray | None = None
+    """(n_dof,) [N·m]: each joint's residual level on the identification log; a joint whose RMS torque is below
+    :data:`MEANINGFUL` times it has no meaningful relative error."""
+    speed: np.ndarray | None = None
+    """(n_dof,) RMS speed of each joint in this dataset [rad/s]."""
 
     def metrics(self) -> dict:
         """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,), and
-        global_relative_error [%] over all joints and samples (a float)."""
+        global_relative_error [%] over all joints and samples (a float); where the joints rest in the dataset, also
+        moving_relative_error [%], moving_rmse [N·m] on the samples where each joint moves, rest_rmse [N·m] and
+        rest_in_static_band (share of the resting samples whose error is within the set's ``±f_s``)."""
         if self.summary is not None:
             return self.summary["metrics"]
-        return {label: {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
-                        "correlation": correlation_coefficient(self.measured, p),
-                        "global_relative_error": global_relative_error(self.measured, p)}
-                for label, p in self.predicted.items()}
+        out = {}
+        for label, p in self.predicted.items():
+            m = {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
+                 "correlation": correlation_coefficient(self.measured, p),
+                 "global_relative_error": global_relative_error(self.measured, p)}
+            if self.resting is not None and self.resting.any():
+                m.update(_moving_and_rest(self.measured, p, self.resting, None if self.static is None else self.static.get(label)))
+            out[label] = m
+        return out
+
+    @property
+    def rest_share(self) -> np.ndarray | None:
+        """(n_dof,) share of the samples where each joint rests."""
+        if self.summary is not None:
+            return self.summary.get("rest_share")
+        return None if self.resting is None else self.resting.mean(axis=0)
+
+    def meaningful(self) -> np.ndarray:
+        """(n_dof,) bool: whether each joint's relative error means something (its RMS torque is at least
+        :data:`MEANINGFUL` times its residual level on the identification log)."""
+        if self.noise is None:
+            return np.ones(self.rms_torque.shape, dtype=bool)
+        return self.rms_torque >= MEANINGFUL * np.asarray(self.noise)
+
+    def flags(self) -> list[str]:
+        """One line per joint whose relative error means nothing here, with its absolute figure."""
+        out = []
+        first = next(iter(self.metrics().values()), None)
+        for j in np.flatnonzero(~self.meaningful()):
+            moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} rad/s) and " if
+                                                   self.speed[j] < 0.05 else "")
+            rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} N·m"
+            out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} N·m, "
+                       f"{self.rms_torque[j] / self.noise[j]:.2g}× the identification residual): relative error not meaningful"
+                       f"{rmse_j}")
+        return out
 
     @property
     def n_samples(self) -> int:
         return int(self.summary["n_samples"]) if self.summary is not None else int(self.t.shape[0])
 
     @property
+    def torque_std(self) -> np.ndarray:
+        """(n_dof,) standard deviation of each joint's measured torque [N·m] (what the correlation coefficient sees)."""
+        if self.summary is not None and "torque_std" in self.summary:
+            return self.summary["torque_std"]
+        return self.measured.std(axis=0)
+
+    def varies(self) -> np.ndarray:
+        """(n_dof,) bool: whether each joint's torque varies beyond its noise, so that its correlation coefficient
+        (eq. 18) means something."""
+        if self.noise is None:
+            return np.ones(self.rms_torque.shape, dtype=bool)
+        return self.torque_std >= MEANINGFUL * np.asarray(self.noise)
+
+    @property
     def rms_torque(self) -> np.ndarray:
         return self.summary["rms_torque"] if self.summary is not None else np.sqrt((self.measured**2).mean(axis=0))
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "n_samples": self.n_samples, "rms_torque": self.rms_torque, "metrics": self.metrics()}
+        out = {"name": self.name, "n_samples": self.n_samples, "rms_torque": self.rms_torque, "metrics": self.metrics()}
+        if self.rest_share is not None:
+            out["rest_share"] = self.rest_share
+        if self.noise is not None:
+            out["relative_error_meaningful"] = self.meaningful().tolist()
+            out["flags"] = self.flags()
+        return out
+
+
+MEANINGFUL = 3.0
+"""A joint's relative error is given only where its RMS torque is at least this many times its residual level."""
+
+
+def _moving_and_rest(measured, predicted, resting, static) -> dict:
+    """The metrics of the samples where each joint moves, and of those where it rests (module docstring)."""
+    err = measured - predicted
+    moving = ~resting
+    with np.errstate(invalid="ignore", divide="ignore"):
+        m_rmse = np.sqrt(np.where(moving, err**2, 0).sum(0) / moving.sum(0))
+        m_rms = np.sqrt(np.where(moving, measured**2, 0).sum(0) / moving.sum(0))
+        r_rmse = np.sqrt(np.where(resting, err**2, 0).sum(0) / resting.sum(0))
+        out = {"moving_relative_error": 100 * m_rmse / m_rms, "moving_rmse": m_rmse, "rest_rmse": r_rmse}
+        if static is not None:
+            inside = (np.abs(err) <= np.asarray(static) * 1.05) & resting
+            out["rest_in_static_band"] = inside.sum(0) / resting.sum(0)
+    return out
 
 
 class TorqueSums:
@@ -82,6 +169,8 @@ class TorqueSums:
         self.mean = np.zeros((n_dof, n_columns + 1))
         self.m2 = np.zeros((n_dof, n_columns + 1, n_columns + 1))
         self.count = 0
+        self.rest_gram = np.zeros((n_dof, n_columns + 1, n_columns + 1))  # raw sums of z zᵀ over resting rows
+        self.rest_count = np.zeros(n_dof)
         self.thin = max(1, -(-n_rows // max_points))
         self.kept_t, self.kept_y, self.kept_tau = [], [], []
 
@@ -90,10 +179,15 @@ class TorqueSums:
         """Statistics for the decimated samples :func:`dynid.preprocessing.pipeline.base_chunks` gives of ``data``."""
         return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation)))
 
-    def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray) -> None:
-        """Rows ``y`` (M, n_dof, n_columns), torques ``tau`` (M, n_dof) at times ``t`` (M,)."""
+    def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray, resting: np.ndarray | None = None) -> None:
+        """Rows ``y`` (M, n_dof, n_columns), torques ``tau`` (M, n_dof) at times ``t`` (M,); ``resting`` (M, n_dof)
+        bool: where each joint rests."""
         m = y.shape[0]
         z = np.concatenate([y, tau[:, :, None]], axis=2)
+        if resting is not None and resting.any():
+            zr = z * resting[:, :, None]
+            self.rest_gram += np.einsum("mjc,mjd->jcd", zr, zr)
+            self.rest_count += resting.sum(axis=0)
         mean = z.mean(axis=0)
         zc = z - mean
         m2 = np.einsum("mjc,mjd->jcd", zc, zc)
@@ -123,40 +217,102 @@ class TorqueSums:
             metrics[label] = {"relative_error": 100.0 * np.sqrt(sse / tau_sq), "rmse": np.sqrt(sse / n),
                               "correlation": s_pt / np.sqrt(s_tt * s_pp),
                               "global_relative_error": float(100.0 * np.sqrt(sse.sum() / tau_sq.sum()))}
+            if self.rest_count.any():  # raw sums of the resting rows: Σ (τ - p)² = eᵀ G e with e = (β, -1)
+                e = np.concatenate([b, [-1.0]])
+                r_sse = np.maximum(np.einsum("c,jcd,d->j", e, self.rest_gram, e), 0.0)
+                r_tau = self.rest_gram[:, -1, -1]
+                moving = n - self.rest_count
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    metrics[label].update({
+                        "moving_relative_error": 100.0 * np.sqrt(np.maximum(sse - r_sse, 0) / np.maximum(tau_sq - r_tau, 1e-300)),
+                        "moving_rmse": np.sqrt(np.maximum(sse - r_sse, 0) / moving), "rest_rmse": np.sqrt(r_sse / self.rest_count)})
         y = np.concatenate(self.kept_y)
-        summary = {"metrics": metrics, "n_samples": n, "rms_torque": np.sqrt(tau_sq / n)}
+        summary = {"metrics": metrics, "n_samples": n, "rms_torque": np.sqrt(tau_sq / n), "torque_std": np.sqrt(s_tt / n),
+                   **({"rest_share": self.rest_count / n} if self.rest_count.any() else {})}
         return TorqueComparison(name, np.concatenate(self.kept_t), np.concatenate(self.kept_tau),
                                 {label: y @ np.asarray(beta, dtype=float) for label, beta in parameter_sets.items()}, summary)
 
 
+def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
+    """(M, n_dof) bool: where each joint rests at the samples ``index`` (its motion velocity at or below its rest
+    velocity, :func:`dynid.friction.held_direction`)."""
+    rest = data.settings.rest_velocity
+    n = data.tau.shape[1]
+    rest = np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float), (n,))
+    v = data.motion if data.motion is not None else data.dq
+    return np.abs(np.asarray(v[index])) <= rest
+
+
+def static_friction(base: BaseParameters, parameter_sets: dict, n_dof: int) -> dict:
+    """label -> (n_dof,) static friction ``f_s = |fc| + max(fst, 0)`` [N·m] of each set (its base parameters
+    named ``fc<j>``, ``fst<j>``)."""
+    out = {}
+    for label, beta in parameter_sets.items():
+        fs = np.zeros(n_dof)
+        for j in range(n_dof):
+            for name, f in ((f"fc{j + 1}", abs), (f"fst{j + 1}", lambda x: max(x, 0.0))):
+                if name in base.names:
+                    fs[j] += f(float(beta[base.names.index(name)]))
+        out[label] = fs
+    return out
+
+
 def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
-                    progress=None) -> TorqueComparison:
+                    progress=None, noise: np.ndarray | None = None) -> TorqueComparison:
     """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
     (n_base,)), on the same parallel-decimated samples as the estimation. The parameter sets are known
     before the pass, so the predictions are stored and the metrics computed from them directly (exact also
     for a log at rest, where a prediction is almost constant); :class:`TorqueSums` serves the fit, whose
-    parameters come out of the same pass."""
-    ts, meas, preds = [], [], {k: [] for k in parameter_sets}
+    parameters come out of the same pass.
+
+    Parameters
+    ----------
+    noise : (n_dof,) array [N·m], optional
+        Each joint's residual level on the identification log, to flag joints whose torque is at that level
+        (:meth:`TorqueComparison.flags`).
+    """
+    ts, meas, rest, preds = [], [], [], {k: [] for k in parameter_sets}
     for index, y, tau, _ in base_chunks(robot, base, data, progress):
         ts.append(data.t[index])
         meas.append(tau)
+        rest.append(resting_rows(data, index))
         for label, beta in parameter_sets.items():
             preds[label].append(y @ beta)
+    from ..column_store import root_mean_square
+
     return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
-                            {k: np.concatenate(v) for k, v in preds.items()})
+                            {k: np.concatenate(v) for k, v in preds.items()}, resting=np.concatenate(rest),
+                            static=static_friction(base, parameter_sets, robot.n_dof), noise=noise,
+                            speed=root_mean_square(data.dq))
+
+
+REST_ROWS = 0.05
+"""Tables show the moving and resting figures apart where some joint rests on at least this share of samples."""
 
 
 def comparison_table(cmp: TorqueComparison) -> TextTable:
     """Relative error, RMSE and correlation coefficient per joint for every parameter set of ``cmp``: one
-    label row per set, then one row per metric (narrow enough for 80 columns with six joints)."""
+    label row per set, then one row per metric (narrow enough for 80 columns with six joints). A joint whose
+    relative error is not meaningful (:meth:`TorqueComparison.meaningful`) shows "n/m" there, and one whose torque
+    does not vary beyond its noise (:meth:`TorqueComparison.varies`) "n/m" as its correlation; where joints rest,
+    the error on the moving samples and the RMSE at rest follow."""
     rms = cmp.rms_torque
     n = cmp.measured.shape[1]
+    ok = cmp.meaningful()
+    share = cmp.rest_share
+    split = share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
     rows, ends = [], set()
     for label, m in cmp.metrics().items():
         rows.append((label,) + ("",) * (n + 1))
-        rows.append(("  error %", *(f"{x:.1f}" for x in m["relative_error"]), f"{m['global_relative_error']:.2f}"))
+        rows.append(("  error %", *(f"{x:.1f}" if k else "n/m" for x, k in zip(m["relative_error"], ok)),
+                     f"{m['global_relative_error']:.2f}"))
         rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), ""))
-        rows.append(("  ρ (eq. 18)", *(f"{x:.4f}" for x in m["correlation"]), ""))
+        rows.append(("  ρ (eq. 18)", *(f"{x:.4f}" if v else "n/m" for x, v in zip(m["correlation"], cmp.varies())), ""))
+        if split and "moving_relative_error" in m:
+            rows.append(("  moving error %", *(f"{x:.1f}" if k and np.isfinite(x) else "n/m"
+                                               for x, k in zip(m["moving_relative_error"], ok)), ""))
+            rows.append(("  at rest RMSE N·m", *(f"{x:.3g}" if s >= REST_ROWS else "" for x, s in zip(m["rest_rmse"], share)), ""))
         ends.add(len(rows) - 1)
-    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + " N·m",
+    rest = "" if not split else "; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the samples"
+    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
                      ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
