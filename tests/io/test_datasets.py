@@ -98,12 +98,23 @@ def _log(tmp_path, t, q, cur, name="ur.csv"):
 
 
 def test_a_gap_in_the_time_stamps_is_refused_unless_interpolation_is_asked(tmp_path):
+    """The message names the line, the time stamp in the file and into the selected rows, and the table and setting
+    to change; gaps = "interpolate" fills gaps up to max_gap (0.1 s by default), with a warning saying how many and
+    how long, and refuses a longer one (it would invent that much data)."""
     t = np.concatenate([np.arange(100) * 0.01, 3.0 + np.arange(100) * 0.01])
     spec = _log(tmp_path, t, np.full((200, 6), 0.1), np.full((200, 6), 0.5))
-    with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps .*gaps = \"interpolate\""):
+    with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps \(median step 0.01 s\) after "
+                                        r"the time stamp 0.99 s \(0.990 s into the selected rows\); set gaps = \"interpolate\" in \[identification\]"):
         load_recording(spec, load_robot("ur10e"))
-    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "interpolate"}, tmp_path, "cfg", "ident", 6)
-    assert load_recording(spec, load_robot("ur10e")).n_samples > 200
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "interpolate"}, tmp_path, "c.toml: identification", "ident", 6)
+    with pytest.raises(DataError, match=r"longer than max_gap = 0.1 s.*raise max_gap in \[identification\]"):
+        load_recording(spec, load_robot("ur10e"))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "interpolate", "max_gap": 3.0}, tmp_path,
+                        "c.toml: validation[1]", "p3", 6)
+    rec = load_recording(spec, load_robot("ur10e"))
+    assert rec.n_samples > 200
+    assert any(w.startswith("p3: 1 gap(s) in the time stamps filled by interpolation, the longest 2.01 s") and
+               "[[validation]] 2" in w for w in rec.warnings)
 
 
 def test_positions_in_degrees_are_refused_with_the_hint(tmp_path):
@@ -181,3 +192,41 @@ def test_a_spooled_recording_equals_the_one_in_memory(tmp_path, rng, log, monkey
         if a is not None:
             np.testing.assert_allclose(np.asarray(b), a, rtol=0, atol=1e-13, err_msg=name)  # LAPACK's solve by chunks
     assert (spooled.rate, spooled.warnings) == (memory.rate, memory.warnings)
+
+
+def test_signals_as_the_robot_gives_them_sign_scale_and_side(tmp_path):
+    """A sign and a scale per signal (one value or one per joint) multiply it; a signal's own side overrides the
+    dataset's, so motor-side torques of a log whose positions are joint side go through the gear ratios."""
+    from dynid.model.description import robot_from_toml_text
+
+    text = ('drive_terms = ["fv"]\n[transmission]\ngear_ratios = [10, -20]\n'
+            + "[[joints]]\nalpha = 0.0\nmass = 1.0\ncom = [0.1, 0, 0]\ninertia = [0.01, 0.01, 0.01, 0, 0, 0]\n" * 2)
+    robot = robot_from_toml_text(text, "r.toml", tmp_path)
+    t = np.arange(50) * 0.01
+    q = np.column_stack([np.sin(t), np.cos(t)])
+    tau_m = np.column_stack([np.sin(3 * t), 0.5 + t])
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, q, tau_m]), delimiter=",")
+    spec = dataset_spec({"file": "log.csv", "time": {"column": 1}, "positions": {"columns": [2, 3]},
+                         "torques": {"columns": [4, 5], "side": "motor", "sign": -1, "scale": [1.0, 2.0]}},
+                        tmp_path, "c.toml: identification", "ident", 2)
+    rec = load_recording(spec, robot)
+    np.testing.assert_allclose(rec.q, q, atol=1e-12)  # joint side, no transmission
+    np.testing.assert_allclose(rec.tau, -tau_m * [1.0, 2.0] * [10.0, -20.0], rtol=1e-12)  # τ = Rᵀ τ_m
+    with pytest.raises(ConfigError, match=r"identification.torques.sign: expected 1 or -1 or a list of 2"):
+        dataset_spec({"file": "log.csv", "time": {"column": 1}, "positions": {"columns": [2, 3]},
+                      "torques": {"columns": [4, 5], "sign": [1, 2]}}, tmp_path, "c.toml: identification", "ident", 2)
+
+
+def test_rows_repeating_the_previous_one_are_stale_and_interpolated(tmp_path):
+    """A logger faster than its source repeats rows: with held = "interpolate" (default) each repeated row is
+    replaced by linear interpolation in time between fresh rows, and the warning says how many there were."""
+    t = np.arange(400) * 0.01
+    q = np.outer(0.3 * t, np.ones(6))
+    cur = np.outer(np.ones(400), np.arange(6)) + np.outer(t, np.ones(6))
+    stale = np.zeros(400, bool)
+    stale[5::4] = True  # 25 % of the rows: the previous row again
+    idx = np.where(stale, np.arange(400) - 1, np.arange(400))
+    spec = _log(tmp_path, t, q[idx], cur[idx])
+    rec = load_recording(spec, load_robot("ur10e"))
+    np.testing.assert_allclose(rec.q, q + np.asarray(load_robot("ur10e").transmission.position_offset), atol=1e-12)
+    assert any("99 rows (25 %) repeat the previous one exactly" in w for w in rec.warnings)

@@ -40,8 +40,9 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple[DatasetSpec, ...],
+def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
               progress=None, resolved: Preprocessing | None = None, noise=None) -> tuple[tuple, tuple[str, ...]]:
+    """Score ``parameter_sets`` on each of ``datasets`` (DatasetSpec, read here, or a Recording already read)."""
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
 
@@ -50,7 +51,8 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
     for spec in datasets:
         if progress is not None:  # one step per log: reading, filtering and predicting it
             progress(f"validation, {spec.name}", 0, 1)
-        data = prepare(load_recording(spec, config.robot), settings, strict=False)
+        recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
+        data = prepare(recording, settings, strict=False)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
                                    None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                    noise=noise))
@@ -81,6 +83,11 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     refs = _references(config, base)  # read here to report a bad reference file before any computation
     step(f"reading {config.identification.name}")
     recording = load_recording(config.identification, config.robot)
+    # every dataset is read (its gaps, rates and ranges checked) before any computation
+    checked = []
+    for spec in config.validation if validate else ():
+        step(f"reading {spec.name}")
+        checked.append(load_recording(spec, config.robot))
     step("preprocessing" + (" (cross-validation of the cutoffs)" if config.preprocessing.auto else ""))
     filters = None
     if config.preprocessing.auto:
@@ -119,7 +126,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if not validate or not config.validation:
         return result
-    validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), config.validation, progress,
+    validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
                                       data.settings, result.joint_std)
     return replace(result, validations=validations, warnings=result.warnings + warnings)
 

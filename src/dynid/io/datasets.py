@@ -18,6 +18,13 @@ A dataset is described by a table of the experiment config (TOML)::
     velocities = { columns = [8, 9, 10, 11, 12, 13], unit = "rad/s" }  # optional
     currents = { columns = [14, 15, 16, 17, 18, 19] }  # A; torque = drive gain · current (eq. 16)
     torques = { file = "tau.csv", columns = ["Joint_1", …] }           # N·m, instead of currents
+    torques = { columns = [...], sign = -1, scale = [1, 1, 2], side = "motor" }   # as the robot gives them:
+                                     # sign and scale (one value or one per joint) multiply the signal;
+                                     # side overrides the dataset's for this signal (motor-side torques
+                                     # of a log whose positions are joint side go through the gear ratios)
+    max_gap = 0.1                    # s: gaps = "interpolate" fills gaps up to this long (default 0.1 s)
+    held = "interpolate"             # rows that repeat the previous one exactly (a logger faster than its
+                                     # source): replaced by interpolation (default) or "keep"
 
 or a ROS 2 bag of ``sensor_msgs/JointState`` (:mod:`dynid.io.bags`)::
 
@@ -74,9 +81,13 @@ _SIGNALS = tuple(_UNITS)
 
 @dataclass(frozen=True)
 class SignalSpec:
+    """Where a signal is and how it converts: ``file``, ``columns``, ``scale`` (the unit's factor times the
+    config's ``sign`` and ``scale``: a number or one per joint), ``side`` ("joint", "motor" or None: the dataset's)."""
+
     file: Path
     columns: tuple
-    scale: float
+    scale: float | tuple = 1.0
+    side: str | None = None
 
 
 @dataclass(frozen=True)
@@ -96,6 +107,10 @@ class DatasetSpec:
     time_range: tuple[float, float] | None = None
     gaps: str = "refuse"
     bag: "BagSpec | None" = None
+    table: str = ""
+    """The config table it comes from, for messages: ``[identification]``, ``[[validation]] "p3"``."""
+    max_gap: float = 0.1
+    held: str = "interpolate"
 
 
 @dataclass(frozen=True)
@@ -184,6 +199,9 @@ def _gaps(value, where: str) -> str:
 GAP_FACTOR = 5.0
 """A time step longer than this many median steps is a gap in the log (a lost connection, a pause)."""
 
+HELD_SHARE = 0.05
+"""A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
+
 SATURATION_SAMPLES = 20
 """Consecutive samples at a joint's extreme value that count as saturation (clipped current or torque)."""
 
@@ -246,7 +264,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             merged[k] = v
     if "bag" in merged:
         return _bag_spec(merged, base, where, name, n_dof)
-    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "gaps", "delimiter", "name", *_SIGNALS}
+    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "gaps", "delimiter",
+             "name", "max_gap", "held", *_SIGNALS}
     unknown = sorted(set(merged) - known)
     if unknown:
         raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(known)}")
@@ -274,7 +293,27 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         unit = sig.get("unit", next(iter(units)))
         if unit not in units:
             raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
-        signals[kind] = SignalSpec(path_of(sig, w), tuple(cols), units[unit])
+        unknown = sorted(set(sig) - {"columns", "unit", "file", "sign", "scale", "side"})
+        if unknown:
+            raise ConfigError(f"{w}: unknown field(s) {unknown}, expected some of columns, file, unit, sign, scale, side")
+        factor = np.full(n_dof, units[unit])
+        for key in ("sign", "scale"):
+            if key in sig:
+                v = sig[key]
+                many = isinstance(v, list)
+                values = v if many else [v]
+                ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x != 0 for x in values)
+                if key == "sign":
+                    ok = ok and all(x in (1, -1) for x in values)
+                if not ok or (many and len(v) != n_dof):
+                    what = "1 or -1" if key == "sign" else "a non-zero number"
+                    raise ConfigError(f"{w}.{key}: expected {what} or a list of {n_dof} of them (one per joint), got {v!r}")
+                factor = factor * np.asarray(values, dtype=float)
+        side = sig.get("side")
+        if side is not None and side not in ("joint", "motor"):
+            raise ConfigError(f"{w}.side: expected 'joint' or 'motor', got {side!r}")
+        scale = float(factor[0]) if np.all(factor == factor[0]) else tuple(float(x) for x in factor)
+        signals[kind] = SignalSpec(path_of(sig, w), tuple(cols), scale, side)
     if "positions" not in signals:
         raise ConfigError(f"{where}: expected 'positions' (columns of the joint or motor angles)")
     if ("currents" in signals) == ("torques" in signals):
@@ -300,7 +339,30 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         rate=None if rate is None else float(rate), resample=None if merged.get("resample") is None else float(merged["resample"]),
         side=side, header=bool(merged.get("header", False)), n_columns=merged.get("n_columns"),
         rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")),
-        time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where))
+        time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where),
+        table=_table_name(where), max_gap=_max_gap(merged.get("max_gap", 0.1), where), held=_held(merged.get("held", "interpolate"), where))
+
+
+def _table_name(where: str) -> str:
+    """The config table of a dataset, from the ``where`` of its messages (``"c.toml: validation[2]"``)."""
+    part = where.split(": ")[-1]
+    if part.startswith("validation["):
+        return f"[[validation]] {int(part[11:-1]) + 1}"
+    if part.startswith("drive_gains."):
+        return f"[{part}]"
+    return f"[{part}]"
+
+
+def _max_gap(value, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise ConfigError(f"{where}.max_gap: expected the longest gap to interpolate, in seconds (> 0), got {value!r}")
+    return float(value)
+
+
+def _held(value, where: str) -> str:
+    if value not in ("interpolate", "keep"):
+        raise ConfigError(f'{where}.held: expected "interpolate" or "keep", got {value!r}')
+    return value
 
 
 def _bag_spec(merged: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
@@ -382,12 +444,13 @@ def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -
 
     def get(s: SignalSpec) -> np.ndarray:
         tb, cols = tables[s.file]
+        scale = np.broadcast_to(np.asarray(s.scale, dtype=float), (len(s.columns),))
         if isinstance(tb.data, StoredColumns):  # a view of the stored columns; scaled into new ones
             x = tb.data.select([cols.index(c) for c in s.columns], n_s)
-            return x if s.scale == 1.0 else x.map_columns(lambda column, j: column * s.scale)
+            return x if np.all(scale == 1.0) else x.map_columns(lambda column, j: column * scale[j])
         x = tb.data[:n_s, [cols.index(c) for c in s.columns]]  # a copy of its own: scaled in place
-        if s.scale != 1.0:
-            x *= s.scale
+        if np.any(scale != 1.0):
+            x *= scale
         return x
 
     if spec.time is not None:
@@ -429,14 +492,26 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
         if where is not None:
             where = (lambda w, f: (lambda k: w(k + f)))(where, first)
+    raw = _held_rows(spec, t, raw, warnings)
     median = float(np.median(np.diff(t)))
-    if timed and spec.gaps == "refuse":
+    table = spec.table or spec.name
+    if timed:
         steps = np.diff(t)
-        if np.any(steps > GAP_FACTOR * median):
-            k = int(np.argmax(steps > GAP_FACTOR * median))
-            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps "
-                            f"(median step {median:.3g} s) after t = {t[k] - t[0]:.3f} s; select rows or a time_range on "
-                            "one side of it, or set gaps = \"interpolate\"")
+        gaps = np.flatnonzero(steps > GAP_FACTOR * median)
+        if gaps.size and spec.gaps == "refuse":
+            k = int(gaps[0])
+            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s) after "
+                            f"the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s into the selected rows); set gaps = "
+                            f"\"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select rows "
+                            "on one side of it")
+        if gaps.size:
+            k = int(gaps[np.argmax(steps[gaps])])
+            if steps[k] > spec.max_gap:
+                raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps after {t[k] - t[0]:.3f} s of "
+                                f"the selected rows is longer than max_gap = {spec.max_gap:g} s, the most gaps = \"interpolate\" "
+                                f"fills with invented samples; select rows on one side of it, or raise max_gap in {table}")
+            warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
+                            f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"interpolate\" in {table})")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = spec.rate if not timed else (spec.resample or float(f"{1.0 / median:.6g}"))
     if timed and (not uniform or spec.resample is not None):
@@ -444,20 +519,51 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         raw = {kind: by_column(x, lambda column, j: np.interp(grid, t, column)) for kind, x in raw.items()}
         t = grid
     tr = robot.transmission
-    if spec.side == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
+    side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
+    if side("positions") == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
         q = _row_wise(tr.joint_positions, raw.pop("positions"))
-        dq = _row_wise(tr.joint_velocities, raw.pop("velocities")) if "velocities" in raw else None
     else:
         q = _per_joint(np.add, raw.pop("positions"), tr.position_offset)
+    if "velocities" in raw and side("velocities") == "motor":
+        dq = _row_wise(tr.joint_velocities, raw.pop("velocities"))
+    else:
         dq = raw.pop("velocities", None)
-    if "currents" in raw:
+    kind = "currents" if "currents" in raw else "torques"
+    if kind == "currents":
         motor_or_joint = _per_joint(np.multiply, raw["currents"], robot.drive_gains)
     else:
         motor_or_joint = raw["torques"]
-    tau = _row_wise(tr.joint_torques, motor_or_joint) if spec.side == "motor" else motor_or_joint
+    tau = _row_wise(tr.joint_torques, motor_or_joint) if side(kind) == "motor" else motor_or_joint
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
+
+
+def _held_rows(spec: DatasetSpec, t, raw: dict, warnings: list[str]) -> dict:
+    """Rows whose every signal repeats the previous row exactly are stale samples (a logger that ran faster than its
+    source): with ``held = "interpolate"``, when they are at least :data:`HELD_SHARE` of the rows, they are replaced
+    by linear interpolation in time between the fresh rows around them; the warning says how many."""
+    signals = [x for x in raw.values()]
+    n = t.shape[0]
+    if n < 3 or any(isinstance(x, StoredColumns) for x in signals):
+        return raw
+    same = np.ones(n - 1, dtype=bool)
+    for x in signals:
+        same &= np.all(x[1:] == x[:-1], axis=1)
+    held = np.concatenate([[False], same])
+    share = held.mean()
+    if share < HELD_SHARE or share > 0.5:  # a log mostly of repeated rows is frozen, not stale now and then
+        return raw
+    table = spec.table or spec.name
+    if spec.held == "keep":
+        warnings.append(f"{spec.name}: {held.sum()} rows ({100 * share:.0f} %) repeat the previous one exactly (stale samples "
+                        f"of a logger faster than its source), kept as they are (held = \"keep\" in {table})")
+        return raw
+    fresh = ~held
+    warnings.append(f"{spec.name}: {held.sum()} rows ({100 * share:.0f} %) repeat the previous one exactly (stale samples of a "
+                    f"logger faster than its source): replaced by interpolation between the fresh rows (held = \"keep\" in "
+                    f"{table} keeps them)")
+    return {kind: np.column_stack([np.interp(t, t[fresh], x[fresh, j]) for j in range(x.shape[1])]) for kind, x in raw.items()}
 
 
 def _row_wise(f, x):

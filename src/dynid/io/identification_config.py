@@ -290,7 +290,7 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
     files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
     if len(files) > 1:
         raise DataError("file: the identification dataset reads several files; add a [[validation]] table to the config instead", field="file")
-    signals = {k: SignalSpec(Path(file), s.columns, s.scale) for k, s in spec.signals.items()}
+    signals = {k: SignalSpec(Path(file), s.columns, s.scale, s.side) for k, s in spec.signals.items()}
     time = SignalSpec(Path(file), spec.time.columns, 1.0) if spec.time else None
     return replace(spec, name=Path(file).name, signals=signals, time=time,
                    rows=None if rows is None else tuple(rows))
