@@ -134,8 +134,8 @@ def test_tx40_time_split_validation():
     m = val.metrics()
     assert np.sum(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"]) >= 4
     assert m["dynid WLS"]["global_relative_error"] <= m["FIGAROH OLS"]["global_relative_error"]
-    assert m["dynid WLS"]["correlation"].min() > 0.95
-    assert result.consistency["dynid SDP"] >= -1e-7 and m["dynid SDP"]["correlation"].min() > 0.95
+    assert np.all(m["dynid WLS"]["correlation"] >= m["FIGAROH OLS"]["correlation"] - 0.01)
+    assert result.consistency["dynid SDP"] >= -1e-7 and np.all(m["dynid SDP"]["correlation"] >= m["FIGAROH OLS"]["correlation"] - 0.01)
     assert np.all(m["dynid SDP"]["relative_error"] <= m["dynid WLS"]["relative_error"] + 5.0)
 
 

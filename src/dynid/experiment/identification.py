@@ -27,6 +27,8 @@ from ..model.robot import Robot
 from ..estimators.names import LEAST_SQUARES as METHODS
 from ..preprocessing.pipeline import PreparedData, base_chunks
 from ..tables import Line, TextTable, render_text
+from ..validation.diagnostics import (BlockGrams, Finding, ResidualSums, bootstrap_finding, excitation_findings,
+                                     sign_findings)
 from ..validation.torques import TorqueComparison, TorqueSums, comparison_table, resting_rows
 
 __all__ = ["IdentificationResult", "identify"]
@@ -147,6 +149,12 @@ class IdentificationResult:
         Drive gains and payload from ``[drive_gains]``.
     model : Robot or None
         The robot as identified: its drive terms are the friction models chosen for its joints.
+    findings : tuple of Finding
+        The verdict on the model: one line each (:mod:`dynid.validation.diagnostics`).
+    diagnostics : dict
+        The statistics behind the findings (residual autocorrelation, bootstrap σ, nominal correlation, …).
+    main : str
+        Label of the estimate to trust (the first unless the physically consistent one validates better).
     """
 
     robot: str
@@ -168,6 +176,9 @@ class IdentificationResult:
     box: np.ndarray | None = None
     drive_gains: object = None
     model: Robot | None = None
+    findings: tuple = ()
+    diagnostics: dict = field(default_factory=dict)
+    main: str = ""
 
     @property
     def label(self) -> str:
@@ -211,7 +222,8 @@ class IdentificationResult:
             "consistency_margin": self.consistency, "physically_consistent_verdict": self.consistency_verdicts,
             "methods": {o.label: {"key": o.key, "values": dict(zip(self.base.names, o.params.tolist())),
                                   "seconds": o.seconds, "n_evaluations": o.n_evaluations} for o in self.others},
-            "objective_eq9": self.objective,
+            "objective_eq9": self.objective, "main_estimate": self.main or self.label,
+            "findings": [f.to_dict() for f in self.findings], "diagnostics": self.diagnostics,
             **({} if self.drive_gains is None else {"drive_gains": self.drive_gains.to_dict()}),
             **({} if self.box is None else {"search_box": {"rule": f"estimate ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|estimate|)",
                                                             "bounds": dict(zip(self.base.names, self.box.tolist()))}}),
@@ -263,6 +275,9 @@ class IdentificationResult:
         for c in (self.fit, *self.validations):
             out.append(comparison_table(c))
             out.extend(Line(f) for f in c.flags())
+        out.append(Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
+                                                   if not self.findings else f"{len(self.findings)} finding(s)"), "title"))
+        out.extend(Line(f.text) for f in self.findings)
         out.extend(Line(w, "warning") for w in self.warnings)
         return out
 
@@ -319,14 +334,20 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     acc_std = LeastSquaresAccumulator(robot.n_params, n) if physically_consistent else None
     extra = tuple(k for k in methods if k not in (method, "sdp"))
     stacked_w, stacked_tau = [], []
-    # the fit's metrics accumulate on the same pass (TorqueSums): no second pass over the log
+    # the fit's metrics and the verdict's sums accumulate on the same pass: no second pass over the log
     sums = TorqueSums.for_data(data, base.n_base)
+    residuals = ResidualSums(n, base.n_base)
+    blocks = BlockGrams(n, base.n_base, data.t.shape[0])
+    near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
     for index, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
             y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
         sums.add(data.t[index], y, tau, resting_rows(data, index))
+        direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
+        residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, near_reversal, keep)
+        blocks.add(index, y, tau, keep)
         if extra:
             k = keep.reshape(-1)
             stacked_w.append(y.reshape(-1, base.n_base) * k[:, None])
@@ -369,10 +390,39 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
         except DynIdError as exc:  # a failed check never stops the identification
             margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
+    findings, stats = _verdict(robot, base, sol, ols, joint_std, row_weights, sums, residuals, blocks, fit, data, rng)
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,
-                                others=others, objective=objective, box=box, model=robot)
+                                others=others, objective=objective, box=box, model=robot, findings=tuple(findings),
+                                diagnostics=stats)
+
+
+def _verdict(robot, base, sol, ols, joint_std, row_weights, sums, residuals, blocks, fit, data, rng):
+    """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics."""
+    n = robot.n_dof
+    rms = fit.rms_torque
+    findings, stats = [], {}
+    if np.any(robot.inertial != 0):  # the description's nominal model: does the data run against it?
+        nominal = base.base_from_standard(robot.standard_parameters())
+        corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
+        stats["nominal_correlation"] = corr
+        findings += sign_findings(corr, fit.varies(), data.name)
+    fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
+    more, res_stats = residuals.residual_checks(ols.params, rms, fc)
+    findings += more
+    stats.update(res_stats)
+    boot = blocks.bootstrap_std(row_weights, rng=rng)
+    more, ratio = bootstrap_finding(sol.params_std, boot)
+    findings += more
+    stats.update({"bootstrap_std": dict(zip(base.names, boot.tolist())), "bootstrap_over_covariance_std": ratio})
+    raw = sums.m2 + sums.count * np.einsum("jc,jd->jcd", sums.mean, sums.mean)  # Σ z zᵀ per joint
+    col_rms = np.sqrt(np.max(np.diagonal(raw, axis1=1, axis2=2)[:, :-1], axis=0) / max(sums.count, 1))
+    findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, float(np.sqrt(np.mean(rms**2))))
+    # the prediction's spread from the parameters' covariance: Σ diag(y C yᵀ) = trace(C Σ y yᵀ)
+    spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
+    stats["prediction_spread"] = spread
+    return findings, stats
 
 
 def _step(progress, label: str):

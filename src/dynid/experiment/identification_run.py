@@ -41,7 +41,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 
 
 def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
-              progress=None, resolved: Preprocessing | None = None, noise=None) -> tuple[tuple, tuple[str, ...]]:
+              progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None) -> tuple[tuple, tuple[str, ...]]:
     """Score ``parameter_sets`` on each of ``datasets`` (DatasetSpec, read here, or a Recording already read)."""
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
@@ -55,7 +55,7 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
         data = prepare(recording, settings, strict=False)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
                                    None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
-                                   noise=noise))
+                                   noise=noise, covariance=covariance))
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
 
@@ -127,8 +127,38 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     if not validate or not config.validation:
         return result
     validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
-                                      data.settings, result.joint_std)
-    return replace(result, validations=validations, warnings=result.warnings + warnings)
+                                      data.settings, result.joint_std, {result.label: result.solution.covariance})
+    result = replace(result, validations=validations, warnings=result.warnings + warnings)
+    return replace(result, **_main_estimate(result))
+
+
+def _main_estimate(result) -> dict:
+    """The estimate to trust, and the verdict's findings on the validation logs: the physically consistent one when the
+    unconstrained one is not consistent and the consistent one validates better (mean global error over the validation
+    logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`)."""
+    from ..validation.diagnostics import Finding, validation_findings
+
+    label = result.label
+    fit_err = result.fit.metrics()[label]["global_relative_error"]
+    fit_spread = result.diagnostics.get("prediction_spread")
+    findings = list(result.findings)
+    for v in result.validations:
+        err = v.metrics()[label]["global_relative_error"]
+        moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: its friction is unknown
+        findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread, label)
+    main = label
+    consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
+    if result.consistent is not None and not consistent and result.validations:
+        from .identification import SDP_LABEL
+
+        own = np.mean([v.metrics()[label]["global_relative_error"] for v in result.validations])
+        sdp = np.mean([v.metrics()[SDP_LABEL]["global_relative_error"] for v in result.validations])
+        if sdp < own:
+            main = SDP_LABEL
+            findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where {label} is not and "
+                                               f"predicts the validation logs worse ({sdp:.3g} % against {own:.3g} % on "
+                                               "average)"))
+    return {"main": main, "findings": tuple(findings)}
 
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,

@@ -33,18 +33,31 @@ def read_config(path: Path, known: set[str]) -> dict:
     return doc
 
 
-def config_robot(doc: dict, path: Path) -> Robot:
-    """The robot of a config's ``robot`` field: a built-in name, or a description TOML relative to the config.
+def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
+    """The robot of a config's ``robot`` field: a built-in name, a description TOML or a URDF (relative to the config,
+    else to the data root), or a ``[robot]`` table: a description inline (``urdf = "arm.urdf"`` and what a URDF
+    cannot say: ``drive_terms``, ``gravity``, ``[robot.transmission]``, ``[robot.payload]``, ``[[robot.joints]]``).
 
     Raises
     ------
     ConfigError
-        A missing or non-string field, or an unknown robot.
+        A missing field, or an unknown robot.
     """
     ref = doc.get("robot")
+    if isinstance(ref, dict):
+        from ..model.description import robot_from_document
+
+        table = dict(ref)
+        if isinstance(table.get("urdf"), str) and not (path.parent / table["urdf"]).is_file() and data_root is not None \
+                and (data_root / table["urdf"]).is_file():
+            table["urdf"] = str((data_root / table["urdf"]).resolve())
+        table.setdefault("name", Path(str(table.get("urdf", "robot"))).stem)
+        return robot_from_document(table, f"{path}: robot", path.parent)
     if not isinstance(ref, str):
-        raise ConfigError(f"{path}: expected a field robot = \"name or description.toml\"")
+        raise ConfigError(f"{path}: expected a field robot = \"name, description.toml or robot.urdf\", or a [robot] table")
     local = path.parent / ref  # a description file, relative to the config (an absolute path stays as is)
+    if ref not in builtin_robots() and not local.is_file() and data_root is not None and (data_root / ref).is_file():
+        local = data_root / ref
     if ref not in builtin_robots() and local.is_file():
         return load_robot(local)
     try:

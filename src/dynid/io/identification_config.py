@@ -185,13 +185,13 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     doc = read_config(path, {"robot", "data_root", "identification", "validation", "preprocessing", "estimation",
                              "references", "name", "notes", "drive_gains"})
     here = path.parent
-    robot = config_robot(doc, path)
     override = data_root or os.environ.get(DATA_ROOT_ENV)
     if override is None and not isinstance(doc.get("data_root", "."), str):
         raise ConfigError(f"{path}: data_root: expected a folder path, got {doc['data_root']!r}")
     root = Path(override) if override else here / doc.get("data_root", ".")  # an absolute path stays as is
     if not root.is_dir():
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
+    robot = config_robot(doc, path, root)
     n = robot.n_dof
     if "identification" not in doc:
         raise ConfigError(f"{path}: expected an [identification] table describing the identification dataset")

@@ -131,3 +131,29 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
     if not joints:
         raise ConfigError(f"{path}: expected at least one revolute joint, found none")
     return tuple(joints), np.array(inertial), tuple(model.names[1:])
+
+
+def urdf_limits(path: str | Path) -> dict:
+    """Each revolute joint's limits in a URDF (Pinocchio's reading): ``q_min, q_max`` [rad], ``dq_max`` [rad/s],
+    ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none); a limit the URDF leaves out (or 0) is ``±inf``."""
+    import pinocchio as pin
+
+    with _silenced_stderr([]):
+        model = pin.buildModelFromUrdf(str(path))
+    out = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")}
+    for j in range(1, model.njoints):
+        i, nv = model.joints[j].idx_q, model.joints[j].nq
+        if nv == 2:  # continuous (cos, sin): no position limit
+            lo, hi = -np.inf, np.inf
+        else:
+            lo, hi = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+            if not lo < hi or not (np.isfinite(lo) and np.isfinite(hi)) or abs(lo) > 1e10:
+                lo, hi = -np.inf, np.inf
+        v = model.joints[j].idx_v
+        vel, eff = float(model.velocityLimit[v]), float(model.effortLimit[v])
+        out["q_min"].append(lo)
+        out["q_max"].append(hi)
+        out["dq_max"].append(vel if 0 < vel < 1e10 else np.inf)
+        out["tau_max"].append(eff if 0 < eff < 1e10 else np.inf)
+        out["ddq_max"].append(np.inf)
+    return {k: np.array(v) for k, v in out.items()}

@@ -61,6 +61,9 @@ class Preprocessing:
         (default): :data:`dynid.preprocessing.bands.REST_FACTOR` × the standard deviation of the noise the
         filtered velocity carries (:func:`dynid.preprocessing.filters.velocity_noise_std`), for each log
         anew; 0: plain sign.
+    band_floor : float [Hz]
+        Lower bound of a band estimated from the data: a log scored with another log's parameters is filtered for
+        the faster of the two motions.
     rest_floor : float or tuple [rad/s]
         Lower bound of the "auto" rest velocity: a log scored with another log's parameters takes that log's rest
         velocities as the floor (the same sensors; a log that barely moves shows too little noise to measure it).
@@ -97,6 +100,7 @@ class Preprocessing:
     coulomb_velocity: str | float | tuple = 0.0
     rest_velocity: str | float | tuple = "auto"
     rest_floor: float | tuple = 0.0
+    band_floor: float = 0.0
     rest_friction: str | float | tuple = "held"
     presliding: float | tuple = 0.0
     auto: bool = False
@@ -147,7 +151,12 @@ class Preprocessing:
             band, share = found.band, found.noise_share
             source = (f"99 % of the motion's velocity energy, above a noise floor holding {100 * share:.2g} % of the "
                       "positions' spectrum" if found.motion_found else "99 % of the velocity energy: no motion above the noise")
-            warnings.extend(found.warnings(name))
+            if self.band_floor > 0 and found.warnings(name):  # a log that barely moves: the identification's band
+                band, source = self.band_floor, "the identification log's: this log's own is implausible"
+            else:
+                warnings.extend(found.warnings(name))
+            if band < self.band_floor:
+                band, source = self.band_floor, "the identification log's, wider than this log's"
         derived = cutoffs_from_band(band, rate)
 
         def given(key: str, value: float | None) -> float | None:  # a cutoff in Hz, capped for this log's rate
@@ -186,6 +195,8 @@ class Preprocessing:
         else:
             on = [c for c in ((pos, vel) if measured_velocity else (pos,)) if c > 0]
         trim = self.trim if self.trim is not None else (3.0 / min(on) if on else 0.0)
+        if self.trim is None and q is not None:  # at most a tenth of the log at each end
+            trim = min(trim, 0.1 * q.shape[0] / rate)
         chosen = [f"excitation band {band:.3g} Hz ({source})"]
         if self.fourier is None:
             chosen.append(f"positions low-passed at {pos:.3g} Hz" + ("" if self.position_cutoff is not None else f" ({POSITION_FACTOR:g}× band)"))
@@ -209,13 +220,15 @@ class Preprocessing:
 
 
 def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
-    """Settings of a log scored with another log's parameters (a validation log): the identification's filters in Hz
-    (resolved on its data), so both are scored through the same filters; the decimation and the trim derived again
-    for this log (its rate and length may differ; a decimation the config gives is the identification log's); no
-    Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
-    cutoff above this log's Nyquist frequency is lowered, with a warning."""
+    """Settings of a log scored with another log's parameters (a validation log): the config's settings as given (cutoffs
+    in Hz stay what the user wrote), the rest derived for this log: its band, at least the identification log's (so a
+    faster validation motion is filtered for its own band, never below the identification's), its decimation and trim
+    (its rate and length may differ; a decimation the config gives is the identification log's), its rest velocity
+    (at least the identification's); the identification's friction state at rest; no Fourier fit (the excitation's
+    harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a cutoff above this log's Nyquist
+    frequency is lowered, with a warning."""
     if resolved is None:
         return replace(given, fourier=None, decimation=None, warnings=())
     floor = resolved.rest_velocity if given.rest_velocity == "auto" and resolved.rest_velocity != "auto" else 0.0
-    return replace(resolved, fourier=None, decimation=None, trim=given.trim, rest_velocity=given.rest_velocity,
-                   rest_floor=floor, min_speed=given.min_speed, derivation="", warnings=(), noise_share=None)
+    return replace(given, fourier=None, decimation=None, band_floor=resolved.band or 0.0, rest_floor=floor,
+                   rest_friction=resolved.rest_friction, presliding=resolved.presliding, warnings=(), derivation="")

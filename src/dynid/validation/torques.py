@@ -49,6 +49,9 @@ class TorqueComparison:
     :data:`MEANINGFUL` times it has no meaningful relative error."""
     speed: np.ndarray | None = None
     """(n_dof,) RMS speed of each joint in this dataset [rad/s]."""
+    spread: dict | None = None
+    """label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
+    (for the sets whose covariance is known)."""
 
     def metrics(self) -> dict:
         """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,), and
@@ -123,6 +126,8 @@ class TorqueComparison:
         if self.noise is not None:
             out["relative_error_meaningful"] = self.meaningful().tolist()
             out["flags"] = self.flags()
+        if self.spread:
+            out["prediction_spread"] = self.spread
         return out
 
 
@@ -258,7 +263,7 @@ def static_friction(base: BaseParameters, parameter_sets: dict, n_dof: int) -> d
 
 
 def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
-                    progress=None, noise: np.ndarray | None = None) -> TorqueComparison:
+                    progress=None, noise: np.ndarray | None = None, covariance: dict | None = None) -> TorqueComparison:
     """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
     (n_base,)), on the same parallel-decimated samples as the estimation. The parameter sets are known
     before the pass, so the predictions are stored and the metrics computed from them directly (exact also
@@ -270,20 +275,28 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
     noise : (n_dof,) array [N·m], optional
         Each joint's residual level on the identification log, to flag joints whose torque is at that level
         (:meth:`TorqueComparison.flags`).
+    covariance : dict, optional
+        label -> (n_base, n_base) covariance of a set: its prediction's spread ``sqrt(diag(Y C Yᵀ))`` is kept
+        (:attr:`TorqueComparison.spread`).
     """
+    covariance = covariance or {}
     ts, meas, rest, preds = [], [], [], {k: [] for k in parameter_sets}
+    var = {k: np.zeros(robot.n_dof) for k in covariance}
     for index, y, tau, _ in base_chunks(robot, base, data, progress):
         ts.append(data.t[index])
         meas.append(tau)
         rest.append(resting_rows(data, index))
         for label, beta in parameter_sets.items():
             preds[label].append(y @ beta)
+        for label, cov in covariance.items():
+            var[label] += np.einsum("mjc,cd,mjd->j", y, cov, y)
     from ..column_store import root_mean_square
 
+    m = sum(x.shape[0] for x in ts)
     return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
                             {k: np.concatenate(v) for k, v in preds.items()}, resting=np.concatenate(rest),
                             static=static_friction(base, parameter_sets, robot.n_dof), noise=noise,
-                            speed=root_mean_square(data.dq))
+                            speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()})
 
 
 REST_ROWS = 0.05

@@ -1,0 +1,270 @@
+"""A verdict on the model itself: does it fit the data, and what do the figures that depend on it mean?
+
+Least squares always returns parameters; whether they describe the robot is a separate question, which the
+residuals answer (Ljung, *System Identification*, 2nd ed., 1999, §16.6, "model validation": residual analysis,
+correlation of the residuals with inputs and with themselves; Swevers, Verdonck & De Schutter, IEEE Control
+Systems 27(5), 2007, on robots). Each check here gives one line when it finds something:
+
+* **a flipped torque sign**: the measured torques run against those of the description's nominal model;
+* **friction misfit near reversals**: at low speed, the residual still correlates with the direction of motion;
+* **an unmodelled position dependence**: the residual correlates with the joint's angle (a counterbalance, a
+  cable, a wrong mass);
+* **correlated residuals**: :math:`σ` of the covariance assumes white residuals; a moving-block bootstrap says how
+  far off it is;
+* **poorly excited parameters**: large relative σ on parameters that matter for the torques;
+* **extrapolation**: a validation log whose predictions the parameters' covariance makes far less certain than on
+  the identification log, and a validation error far above the identification's.
+
+Significance accounts for the correlation of the (filtered, decimated) residuals: a regression's t statistic uses
+the effective number of samples ``N·(1 - ρ₁)/(1 + ρ₁)`` with ``ρ₁`` the residuals' lag-1 autocorrelation
+(Bartlett's approximation for an AR(1) series).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Finding", "ResidualSums", "sign_findings", "validation_findings"]
+
+SIGNIFICANT = 4.0
+"""|t| above which a residual's correlation with a feature is reported."""
+
+FEATURES = ("direction at low speed", "sin q", "cos q", "sin 2q", "cos 2q")
+"""The features the residual is regressed on, per joint (besides a constant)."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One line of the verdict.
+
+    Attributes
+    ----------
+    kind : str
+        "sign", "friction", "position", "correlated", "excitation", "extrapolation", "validation".
+    text : str
+        The line, naming the joint or dataset, the size, and what to do.
+    joint : int or None
+        0-based joint, when the finding is about one.
+    """
+
+    kind: str
+    text: str
+    joint: int | None = None
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "text": self.text, **({} if self.joint is None else {"joint": self.joint + 1})}
+
+
+@dataclass
+class ResidualSums:
+    """Sums from which the residual checks follow once the parameters are known, accumulated in the estimation's
+    pass (memory independent of the log's length).
+
+    Per joint ``j``, for the rows ``z = (y, τ, f, 1)`` with ``f`` the :data:`FEATURES` of joint ``j``: the Gram matrix
+    ``Σ z zᵀ``, and ``Σ z_k z_{k-1}ᵀ`` of consecutive rows (the lag-1 autocorrelation of the residual).
+    """
+
+    n_dof: int
+    n_columns: int
+    gram: np.ndarray = field(init=False)
+    lagged: np.ndarray = field(init=False)
+    count: int = 0
+    _last: np.ndarray | None = None
+
+    def __post_init__(self):
+        size = self.n_columns + 1 + len(FEATURES) + 1
+        self.gram = np.zeros((self.n_dof, size, size))
+        self.lagged = np.zeros((self.n_dof, size, size))
+
+    def add(self, y: np.ndarray, tau: np.ndarray, q: np.ndarray, dq: np.ndarray, direction: np.ndarray,
+            low_speed: np.ndarray, keep: np.ndarray) -> None:
+        """Rows ``y`` (M, n_dof, p), torques ``tau`` (M, n_dof), and per row each joint's position ``q``, velocity
+        ``dq``, direction of motion, the speed under which it is near a reversal ``low_speed`` (n_dof,) [rad/s], and
+        ``keep`` (M, n_dof): the rows of moving joints the estimation uses (at rest, the friction is whatever holds the
+        joint: no check applies)."""
+        m = y.shape[0]
+        low = (np.abs(dq) < low_speed) * direction
+        f = np.stack([low, np.sin(q), np.cos(q), np.sin(2 * q), np.cos(2 * q)], axis=2)
+        z = np.concatenate([y, tau[:, :, None], f, np.ones((m, self.n_dof, 1))], axis=2) * keep[:, :, None]
+        self.gram += np.einsum("mjc,mjd->jcd", z, z)
+        if self._last is not None:
+            self.lagged += np.einsum("jc,jd->jcd", z[0], self._last)
+        if m > 1:
+            self.lagged += np.einsum("mjc,mjd->jcd", z[1:], z[:-1])
+        self._last = z[-1].copy()
+        self.count += m
+
+    def residual_checks(self, beta: np.ndarray, rms_torque: np.ndarray, fc: np.ndarray | None = None) -> tuple[list, dict]:
+        """The findings on the residual ``τ - yβ``, and the statistics behind them (per joint: lag-1
+        autocorrelation, effective samples, the amplitude and t statistic of each feature)."""
+        p = self.n_columns
+        e = np.concatenate([-np.asarray(beta, dtype=float), [1.0]])  # r = e·(y, τ)
+        findings, stats = [], {"lag1_autocorrelation": [], "effective_samples": [], "friction_amplitude": [],
+                               "friction_t": [], "position_amplitude": [], "position_t": []}
+        for j in range(self.n_dof):
+            g = self.gram[j]
+            head = slice(0, p + 1)
+            rr = float(e @ g[head, head] @ e)
+            n = max(float(g[-1, -1]), 1.0)  # the kept rows of this joint
+            # regress r on (features, 1) over the kept rows: normal equations from the Gram's feature block
+            fi = slice(p + 1, g.shape[0])
+            ff = g[fi, fi]
+            fr = g[fi, head] @ e
+            inv = np.linalg.pinv(ff, rcond=1e-12)
+            coef = inv @ fr
+            rss = max(rr - float(coef @ fr), 0.0)
+            # the lag-1 autocorrelation of what the features leave (u = r - X c, mean 0): Σ u_k u_{k-1} / Σ u²
+            full = np.concatenate([e, -coef])
+            rho = float(np.clip(full @ self.lagged[j] @ full / max(rss, 1e-300), -0.99, 0.99))
+            n_eff = max(n * (1 - rho) / (1 + rho), 2.0)
+            # the coefficients' variance of independent rows, inflated by n / n_eff for the correlation
+            s2 = rss / max(n - ff.shape[0], 1.0)
+            se = np.sqrt(np.maximum(np.diag(inv) * s2 * (n / n_eff), 1e-300))
+            t = coef / se
+            stats["lag1_autocorrelation"].append(rho)
+            stats["effective_samples"].append(n_eff)
+            stats["friction_amplitude"].append(float(coef[0]))
+            stats["friction_t"].append(float(t[0]))
+            # the position dependence: the amplitude of the harmonic part over the joint's range, its F-like statistic
+            pos = coef[1:5]
+            amp = float(np.hypot(pos[0], pos[1]) + np.hypot(pos[2], pos[3]))
+            t_pos = float(np.sqrt(np.sum(t[1:5] ** 2) / 4))
+            stats["position_amplitude"].append(amp)
+            stats["position_t"].append(t_pos)
+            scale = rms_torque[j]
+            friction_size = abs(coef[0]) >= 0.05 * scale or (fc is not None and abs(coef[0]) >= 0.2 * abs(fc[j]))
+            if abs(t[0]) >= SIGNIFICANT and friction_size and abs(coef[0]) > 0:
+                findings.append(Finding("friction", f"J{j + 1}: the residual follows the direction of motion at low speed "
+                                        f"({coef[0]:+.3g} N·m, t = {t[0]:.1f}): the friction model misfits near reversals",
+                                        j))
+            if t_pos >= SIGNIFICANT and amp >= 0.05 * scale:
+                findings.append(Finding("position", f"J{j + 1}: the residual depends on the joint's angle (±{amp:.3g} N·m, "
+                                        f"t = {t_pos:.1f}): a counterbalance, a cable, a wrong mass or gravity? "
+                                        "(counterbalance = true in the description models one)", j))
+        return findings, stats
+
+
+def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]"
+                  ) -> list[Finding]:
+    """A flipped torque sign: the measured torques of the joints whose torque varies correlate strongly negatively
+    (ρ < -0.5) with those of the description's nominal model.
+
+    Parameters
+    ----------
+    correlation : (n_dof,) array
+        Correlation coefficient (eq. 18) of the nominal model's torques with the measured ones.
+    varies : (n_dof,) bool array
+        Joints whose measured torque varies beyond its noise.
+    """
+    corr = np.asarray(correlation, dtype=float)
+    bad = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and corr[j] < -0.5]
+    if not bad:
+        return []
+    n = corr.size
+    joints = ", ".join(f"J{j + 1}" for j in bad)
+    values = ", ".join(f"{corr[j]:.3f}" for j in bad)
+    if len(bad) >= max(2, sum(bool(v) for v in varies) - 1):
+        fix = "sign = -1"
+    else:
+        fix = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]"
+    return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
+                            f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
+                            "other datasets (or check the description's gravity)")]
+
+
+def validation_findings(name: str, global_error: float, fit_error: float, prediction_spread: np.ndarray | None,
+                        fit_spread: np.ndarray | None, label: str) -> list[Finding]:
+    """Extrapolation and a validation error far above the identification's, for one validation log.
+
+    Parameters
+    ----------
+    prediction_spread, fit_spread : (n_dof,) arrays [N·m] or None
+        RMS over the samples of the prediction's standard deviation from the parameters' covariance, on the validation
+        log and on the identification log.
+    """
+    out = []
+    if prediction_spread is not None and fit_spread is not None:
+        ratio = np.asarray(prediction_spread) / np.maximum(np.asarray(fit_spread), 1e-12)
+        far = np.flatnonzero(ratio > 5.0)
+        if far.size:
+            j = int(far[np.argmax(ratio[far])])
+            out.append(Finding("extrapolation", f"{name}: {label}'s predictions leave the range the identification log "
+                               f"supports: J{j + 1}'s prediction σ is {ratio[j]:.0f}× that on the identification log "
+                               f"({prediction_spread[j]:.3g} N·m); trust a physically consistent estimate there, or "
+                               "identify on a log that covers this motion", j))
+    if np.isfinite(global_error) and fit_error > 0 and global_error > 3 * fit_error:
+        out.append(Finding("validation", f"{name}: {label} predicts it {global_error / fit_error:.1f}× worse than it fits the "
+                           f"identification log ({global_error:.3g} % against {fit_error:.3g} %): over-fitting, "
+                           "extrapolation or a model that misses something this motion shows"))
+    return out
+
+
+BOOTSTRAP_BLOCKS = 20
+"""Contiguous blocks of the identification log for the moving-block bootstrap of σ."""
+
+BOOTSTRAP_RESAMPLES = 200
+
+
+class BlockGrams:
+    """Per contiguous block of the log, each joint's Gram matrix of ``(y, τ)`` over the rows the estimation uses: a
+    moving-block bootstrap resamples blocks, not rows (the residuals are correlated in time), and refits by the normal
+    equations (Künsch, Ann. Statist. 17(3), 1989).
+
+    Parameters
+    ----------
+    n_dof, n_columns, n_samples : int
+        Joints, regressor columns, samples of the log (blocks by sample index).
+    blocks : int
+    """
+
+    def __init__(self, n_dof: int, n_columns: int, n_samples: int, blocks: int = BOOTSTRAP_BLOCKS):
+        self.blocks = blocks
+        self.n_samples = max(int(n_samples), 1)
+        self.gram = np.zeros((blocks, n_dof, n_columns + 1, n_columns + 1))
+
+    def add(self, index: np.ndarray, y: np.ndarray, tau: np.ndarray, keep: np.ndarray) -> None:
+        z = np.concatenate([y, tau[:, :, None]], axis=2) * keep[:, :, None]
+        block = np.minimum(index * self.blocks // self.n_samples, self.blocks - 1)
+        for b in np.unique(block):
+            zb = z[block == b]
+            self.gram[b] += np.einsum("mjc,mjd->jcd", zb, zb)
+
+    def bootstrap_std(self, weights: np.ndarray | None = None, rng=0, resamples: int = BOOTSTRAP_RESAMPLES) -> np.ndarray:
+        """Bootstrap standard deviation of the (weighted) least-squares parameters, (p,)."""
+        rng = np.random.default_rng(rng)
+        w = np.ones(self.gram.shape[1]) if weights is None else np.asarray(weights, dtype=float)
+        g = np.einsum("j,bjcd->bcd", w**2, self.gram)  # joints weighted, summed: one Gram per block
+        p = g.shape[1] - 1
+        draws = []
+        for _ in range(resamples):
+            total = g[rng.integers(0, self.blocks, self.blocks)].sum(axis=0)
+            a, b = total[:p, :p], total[:p, p]
+            scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
+            draws.append(np.linalg.lstsq(a / scale[:, None] / scale[None, :], b / scale, rcond=1e-12)[0] / scale)
+        return np.std(np.array(draws), axis=0, ddof=1)
+
+
+def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> tuple[list[Finding], float]:
+    """σ from the covariance against the bootstrap's: the median ratio over the parameters, and a finding when the
+    covariance understates the spread by 2× or more."""
+    ratio = float(np.median(np.asarray(bootstrap_std) / np.maximum(np.asarray(covariance_std), 1e-300)))
+    if ratio >= 2.0:
+        return [Finding("correlated", f"σ from the covariance is {ratio:.1f}× below the moving-block bootstrap's (median over "
+                                      "the parameters): the residuals are correlated or the model misfits; read the "
+                                      "bootstrap's σ (results.json: bootstrap_std)")], ratio
+    return [], ratio
+
+
+def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: np.ndarray, rms_torque: float) -> list[Finding]:
+    """Parameters the log hardly excites yet that matter: relative σ above 50 % and a torque of ±σ above 5 % of the
+    RMS torque."""
+    rel = np.abs(std) / np.maximum(np.abs(params), 1e-300)
+    weak = [i for i in range(len(names)) if rel[i] > 0.5 and std[i] * column_rms[i] > 0.05 * rms_torque]
+    if not weak:
+        return []
+    shown = ", ".join(names[i] for i in weak[:8]) + (f" and {len(weak) - 8} more" if len(weak) > 8 else "")
+    return [Finding("excitation", f"the identification log hardly excites {shown} (σ above half their value, yet worth "
+                                  f"over 5 % of the torque): a richer excitation (dynid excite) or a physically "
+                                  "consistent estimate")]
