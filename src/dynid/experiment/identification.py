@@ -305,7 +305,7 @@ def coulomb_choice_table(cv: dict) -> TextTable:
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str = "wls",
              references: tuple[ReferenceSet, ...] = (), progress=None, physically_consistent: bool = False,
-             methods: tuple[str, ...] = (), rng=0) -> IdentificationResult:
+             methods: tuple[str, ...] = (), rng=0, held_out: bool = False) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording by OLS or WLS (chunked), and with
     ``physically_consistent`` also by physically consistent least squares over the standard parameters
     (same row weights; prior: the robot model's nominal parameters). Every parameter set gets its
@@ -313,6 +313,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
 
     ``progress(step, done, total)`` reports each step (the regressor pass chunk by chunk, the SDP, each other
     estimator, the consistency checks).
+
+    ``held_out``: with ``physically_consistent``, when no validation log will say which estimate to trust, compare the
+    unconstrained and the physically consistent estimates by blocked cross-validation (:data:`HELD_OUT_FOLDS`
+    contiguous blocks), and make the consistent one the main estimate when the unconstrained one is not consistent
+    and predicts the held-out blocks worse.
 
     ``methods`` adds estimators of :mod:`dynid.estimators.registry` other than OLS/WLS/SDP (IRLS, LAD, ABC,
     ABC×10, DE, PSO) on the same parallel-filtered rows, stacked in memory (rows below ``min_speed`` set
@@ -339,9 +344,15 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     residuals = ResidualSums(n, base.n_base)
     blocks = BlockGrams(n, base.n_base, data.t.shape[0])
     near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
+    folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out and acc_std is not None else []
+    n_s = data.t.shape[0]
     for index, y, tau, keep in base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=physically_consistent):
         if acc_std is not None:
             acc_std.add(y.reshape(-1, robot.n_params), tau.reshape(-1), keep.reshape(-1))
+            fold = index * HELD_OUT_FOLDS // n_s
+            for k in np.unique(fold) if folds else ():
+                sel = fold == k
+                folds[k].add(y[sel].reshape(-1, robot.n_params), tau[sel].reshape(-1), keep[sel].reshape(-1))
             y = base.base_observation(y)
         acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
         sums.add(data.t[index], y, tau, resting_rows(data, index))
@@ -391,11 +402,23 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
             margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     findings, stats = _verdict(robot, base, sol, ols, joint_std, row_weights, sums, residuals, blocks, fit, data, rng)
+    main = ""
+    if folds and consistent is not None and not str(verdicts.get(estimate_label(method), "yes")).startswith("yes"):
+        if progress is not None:
+            progress("physically consistent SDP, held-out blocks", 0, 1)
+        own, sdp = _held_out_errors(robot, folds, row_weights)
+        stats["held_out_rms_error"] = {estimate_label(method): own, SDP_LABEL: sdp}
+        if sdp < own:
+            main = SDP_LABEL
+            findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where "
+                                               f"{estimate_label(method)} is not and predicts held-out blocks of the log "
+                                               f"worse ({sdp:.3g} against {own:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
+                                               "cross-validation)"))
     return IdentificationResult(robot.name, base, method, sol, joint_std, tuple(references), fit, n_rows=int(acc.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistent=consistent, consistency=margins, consistency_verdicts=verdicts,
                                 others=others, objective=objective, box=box, model=robot, findings=tuple(findings),
-                                diagnostics=stats)
+                                diagnostics=stats, main=main)
 
 
 def _verdict(robot, base, sol, ols, joint_std, row_weights, sums, residuals, blocks, fit, data, rng):
@@ -423,6 +446,29 @@ def _verdict(robot, base, sol, ols, joint_std, row_weights, sums, residuals, blo
     spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
     stats["prediction_spread"] = spread
     return findings, stats
+
+
+HELD_OUT_FOLDS = 5
+"""Contiguous blocks of the identification log that compare the estimates when no validation log does."""
+
+
+def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
+    """RMS torque error on the held-out blocks of the unconstrained (OLS/WLS, minimum-norm over the standard
+    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others."""
+    p = robot.n_params
+    links, nonneg = consistency_layout(robot)
+    sse = np.zeros(2)
+    rows = 0
+    for k, held in enumerate(folds):
+        rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
+        reduced = rest.reduced(row_weights)
+        phi = np.linalg.lstsq(reduced[:p, :p], reduced[:p, p], rcond=1e-10)[0]
+        est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters())
+        est.fit(reduced[:, :p], reduced[:, p])
+        sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
+        rows += int(held.rows.sum())
+    own, sdp = np.sqrt(sse / max(rows, 1))
+    return float(own), float(sdp)
 
 
 def _step(progress, label: str):

@@ -116,7 +116,8 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed)
+        result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed,
+                          held_out=not (validate and config.validation))
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
@@ -146,7 +147,7 @@ def _main_estimate(result) -> dict:
         err = v.metrics()[label]["global_relative_error"]
         moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: its friction is unknown
         findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread, label)
-    main = label
+    main = result.main or label
     consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
     if result.consistent is not None and not consistent and result.validations:
         from .identification import SDP_LABEL
@@ -266,4 +267,4 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     rate = 1.0 / float(np.median(steps))
     data = prepare(Recording(name, t - t[0], q, dq, tau, rate), preprocessing or Preprocessing())
     base = base_parameters(robot, rng=0)
-    return identify(robot, base, data, method, (), None, physically_consistent or "sdp" in methods, tuple(methods))
+    return identify(robot, base, data, method, (), None, physically_consistent or "sdp" in methods, tuple(methods), held_out=True)
