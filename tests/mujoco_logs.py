@@ -121,7 +121,7 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
              rate: float = 1000.0, substeps: int = 2, f0: float = 0.1, harmonics: int = 4, amplitude=0.6,
              encoder_bits: int = 20, noise_share: float = 0.05, torque_std=0.05, jitter: float = 0.02,
              gaps: int = 3, rate_change: float = 0.0, kp=None, kd=None, integral: float = 0.5,
-             dry: str = "frictionloss", loop_noise: bool = False) -> SimulatedLog:
+             dry: str = "frictionloss", loop_noise: bool = False, controller: bool = True) -> SimulatedLog:
     """Simulate a log (module docstring).
 
     Parameters
@@ -147,6 +147,10 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
         Whether the controller sees the positions' broadband noise (it always sees the encoder's quantisation):
         a loop that feeds noise back makes the torques' noise correlate with the positions', which biases least
         squares (the closed-loop identification problem); without it, the noise is the log's alone.
+    controller : bool
+        False: the motion is the reference itself and the torques are MuJoCo's inverse dynamics of it (``mj_inverse``
+        of the model without dry friction) plus ``fc·sign(q̇)`` (``dry = "sign"`` only): at rest the velocity is exactly
+        0 and so is the dry friction.
     """
     import mujoco
 
@@ -174,6 +178,11 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
     kp = m_jj * wn**2 if kp is None else np.asarray(kp, dtype=float)
     kd = 2 * 0.9 * m_jj * wn if kd is None else np.asarray(kd, dtype=float)
     step_q = 2 * np.pi / 2**encoder_bits
+    if not controller:
+        if dry != "sign":
+            raise ValueError("inverse dynamics needs dry = 'sign' (a frictionloss constraint has no inverse of its own)")
+        return _prescribed(model, qr, dqr, ddqr, rate, duration, drives.fc, rng, step_q, noise_share, torque_std, jitter,
+                           gaps, rate_change)
     # fine-grained truth, every integration step, for the log's jittered instants
     n_fine = (n_ctrl - 1) * substeps + 1
     fine = {k: np.empty((n_fine, n)) for k in ("q", "dq", "ddq", "tau")}
@@ -201,26 +210,51 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
             if k < n_ctrl - 1:
                 mujoco.mj_step(model, data)
     t_fine = np.arange(n_fine) * dt
-    # logged instants: nominal rate, then (1 + rate_change) × it half-way; jitter; gaps
-    half = duration / 2
-    n1 = int(half * rate)
-    t_nom = np.concatenate([np.arange(n1) / rate, half + np.arange(int((duration - half) * rate * (1 + rate_change)) - 1)
-                            / (rate * (1 + rate_change))])
-    t_nom = t_nom[t_nom <= t_fine[-1] - 2.0 / rate]
-    period = np.diff(t_nom, append=t_nom[-1] + 1 / rate)
-    t_log = t_nom + jitter * period * np.clip(rng.normal(size=t_nom.size), -3, 3)
-    t_log[0] = 0.0
-    t_log = np.maximum.accumulate(t_log)
-    keep = np.ones(t_log.size, bool)
-    for g in range(gaps):
-        start = int(rng.uniform(0.1, 0.9) * t_log.size)
-        keep[start:start + int(rng.integers(5, 11))] = False
-    t_log = t_log[keep]
+    t_log = _log_instants(duration, rate, rate_change, jitter, gaps, t_fine[-1], rng)
     # the true states at the logged instants (linear interpolation between integration steps of dt ≤ 0.5 ms);
     # the torque is the command held over its control period
     interp = lambda x: np.column_stack([np.interp(t_log, t_fine, x[:, j]) for j in range(n)])  # noqa: E731
     q, dq, ddq = interp(fine["q"]), interp(fine["dq"]), interp(fine["ddq"])
     tau = fine["tau"][np.minimum(np.floor(t_log / dt + 1e-9).astype(int), n_fine - 1)]
+    q_meas = np.round(q / step_q) * step_q + rng.normal(size=q.shape) * noise_std
+    tau_meas = tau + rng.normal(size=tau.shape) * np.asarray(torque_std)
+    return SimulatedLog(t_log, q_meas, tau_meas, q, dq, ddq, tau)
+
+
+def _log_instants(duration, rate, rate_change, jitter, gaps, t_end, rng):
+    """The logged instants: the nominal rate, then (1 + rate_change) × it half-way; jitter; gaps of 5-10 samples."""
+    half = duration / 2
+    n1 = int(half * rate)
+    t_nom = np.concatenate([np.arange(n1) / rate, half + np.arange(int((duration - half) * rate * (1 + rate_change)) - 1)
+                            / (rate * (1 + rate_change))])
+    t_nom = t_nom[t_nom <= t_end - 2.0 / rate]
+    period = np.diff(t_nom, append=t_nom[-1] + 1 / rate)
+    t_log = t_nom + jitter * period * np.clip(rng.normal(size=t_nom.size), -3, 3)
+    t_log[0] = 0.0
+    t_log = np.maximum.accumulate(t_log)
+    keep = np.ones(t_log.size, bool)
+    for _ in range(gaps):
+        start = int(rng.uniform(0.1, 0.9) * t_log.size)
+        keep[start:start + int(rng.integers(5, 11))] = False
+    return t_log[keep]
+
+
+def _prescribed(model, qr, dqr, ddqr, rate, duration, fc, rng, step_q, noise_share, torque_std, jitter, gaps, rate_change):
+    """A log of the reference motion itself, with MuJoCo's inverse dynamics plus fc·sign(q̇) as the torques."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    t_ref = np.arange(qr.shape[0]) / rate
+    t_log = _log_instants(duration, rate, rate_change, jitter, gaps, t_ref[-1], rng)
+    interp = lambda x: np.column_stack([np.interp(t_log, t_ref, x[:, j]) for j in range(x.shape[1])])  # noqa: E731
+    q, dq, ddq = interp(qr), interp(dqr), interp(ddqr)
+    dq[np.abs(dq) < 1e-12] = 0.0
+    tau = np.empty_like(q)
+    for k in range(q.shape[0]):
+        data.qpos[:], data.qvel[:], data.qacc[:] = q[k], dq[k], ddq[k]
+        mujoco.mj_inverse(model, data)
+        tau[k] = data.qfrc_inverse + fc * np.sign(dq[k])
+    noise_std = noise_for_share(qr, rate, noise_share, rng).std(axis=0) if noise_share > 0 else np.zeros(q.shape[1])
     q_meas = np.round(q / step_q) * step_q + rng.normal(size=q.shape) * noise_std
     tau_meas = tau + rng.normal(size=tau.shape) * np.asarray(torque_std)
     return SimulatedLog(t_log, q_meas, tau_meas, q, dq, ddq, tau)

@@ -106,10 +106,25 @@ def held_direction(dq: np.ndarray, rest, decay=np.inf, presliding=0.0, rate: flo
     x0 = np.broadcast_to(np.asarray(presliding, dtype=float), (k,))
     guide = dq if guide is None else np.asarray(guide, dtype=float)
     travel = np.broadcast_to(np.asarray(min_travel, dtype=float), (k,))
-    out = moving_sign(dq, np.where(tr > 0, 0.0, vr))
+    # decay 0: the sign of dq where the joint moves (the guide says where, with moving_sign's ramp), 0 at rest
+    out = np.sign(dq) * np.abs(moving_sign(guide, np.where(tr > 0, 0.0, vr)))
     for j in np.flatnonzero(tr > 0):
         out[:, j] = _held_column(dq[:, j], vr[j], tr[j], x0[j], rate, guide[:, j], travel[j])
     return out
+
+
+def moving_joints(dq: np.ndarray, guide: np.ndarray, rest) -> np.ndarray:
+    """(N, n_dof) bool: where each joint moves (``|guide|`` above the rest velocity); the complement is where it
+    rests."""
+    dq, guide = np.asarray(dq, dtype=float), np.asarray(guide, dtype=float)
+    vr = np.broadcast_to(np.asarray(rest, dtype=float), dq.shape[-1:])
+    return np.column_stack([_moving(dq[:, j], guide[:, j], vr[j]) != 0 if vr[j] > 0 else dq[:, j] != 0
+                            for j in range(dq.shape[1])])
+
+
+def _moving(v: np.ndarray, guide: np.ndarray, vr: float) -> np.ndarray:
+    """``sign(v)`` where the joint moves (``|guide| > v_r``), 0 at rest."""
+    return np.where(np.abs(guide) > vr, np.sign(v), 0.0)
 
 
 def _held_column(v: np.ndarray, vr: float, tr: float, x0: float, rate: float, guide: np.ndarray,
@@ -120,7 +135,7 @@ def _held_column(v: np.ndarray, vr: float, tr: float, x0: float, rate: float, gu
     friction of its last motion until it leaves)."""
     n = v.shape[0]
     sign = np.sign(v)
-    sigma = np.where(np.abs(guide) > vr, sign, 0.0)
+    sigma = _moving(v, guide, vr)
     if not sigma.any():
         return np.zeros(n)
     bounds = np.concatenate([[0], np.flatnonzero(np.diff(sigma) != 0) + 1, [n]])

@@ -117,7 +117,10 @@ def base_parameters(robot: Robot, rng: np.random.Generator | int | None = 0, n_s
     q = rng.uniform(lo, hi, (n_samples, n))
     dq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 2.0
     ddq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 5.0
-    if "fca" in robot.drive_terms:  # asymmetric Coulomb friction differs from an offset only at rest: some states rest
+    if {"fca", "fst"} & set(robot.drive_terms) or np.any(robot.coulomb_velocity > 0):
+        # velocity-shaped friction (Stribeck, smooth Coulomb) lives at low speed, asymmetric Coulomb friction differs
+        # from an offset only at rest: speeds spread over four decades, and some states at rest
+        dq = np.sign(dq) * 10.0 ** rng.uniform(-4.0, 0.3, (n_samples, n))
         dq[rng.uniform(size=(n_samples, n)) < 0.2] = 0.0
     w = observation_matrix(robot, q, dq, ddq)
     r = scipy.linalg.qr(w, mode="r")[0]

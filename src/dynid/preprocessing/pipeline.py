@@ -24,7 +24,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
-from ..friction import Velocities, held_direction
+from ..friction import Velocities, held_direction, moving_joints
 from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
 from .filters import butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
 from .fourier_fit import fourier_fit_derivatives
@@ -51,6 +51,8 @@ class PreparedData:
     """(N, n_dof) direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`)."""
     motion: np.ndarray | None = None
     """(N, n_dof) the velocity [rad/s] that says where a joint moves (no overshoot where it stops)."""
+    resting: np.ndarray | None = None
+    """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
 
     def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
         """The same samples with another rest model and presliding distance (per joint): the direction of motion
@@ -123,8 +125,11 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
             raise DataError(f"{recording.label}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
                             f"the {t[-1] - t[0]:.3f} s recording")
         t, q, dq, ddq, tau, moving = (x[cut:-cut] for x in (t, q, dq, ddq, tau, moving))
+    resting = np.empty(dq.shape, dtype=bool)  # one byte a sample and joint, whatever the log's length
+    for j in range(dq.shape[1]):
+        resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
-                        tuple(recording.warnings) + s.warnings, direction_of_motion(dq, moving, s, rate), moving)
+                        tuple(recording.warnings) + s.warnings, direction_of_motion(dq, moving, s, rate), moving, resting)
 
 
 

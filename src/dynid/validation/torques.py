@@ -239,8 +239,9 @@ class TorqueSums:
 
 
 def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
-    """(M, n_dof) bool: where each joint rests at the samples ``index`` (its motion velocity at or below its rest
-    velocity, :func:`dynid.friction.held_direction`)."""
+    """(M, n_dof) bool: where each joint rests at the samples ``index`` (:func:`dynid.friction.moving_joints`)."""
+    if data.resting is not None:
+        return data.resting[index]
     rest = data.settings.rest_velocity
     n = data.tau.shape[1]
     rest = np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float), (n,))
