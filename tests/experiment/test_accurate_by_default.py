@@ -54,14 +54,19 @@ def test_a_torque_only_filter_is_refused_with_the_reason(tmp_path):
 
 
 def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path):
-    """preprocessing = "auto": every candidate scored on the same held-out samples; the result is as accurate
-    as the defaults' on this log (validation within 1.2x of the true parameters' own error)."""
+    """preprocessing = "auto" (quiet positions: the noise knee far above 10× the band, so the cutoffs are
+    cross-validated): every candidate scored on the same held-out samples, the rule's cutoff kept unless another
+    scores 10 % better; as accurate as the defaults' on this log (validation within 1.2x of the true parameters'
+    own error)."""
     cfg, truth_robot = simulated_case(tmp_path, "er16", 500.0, "ptp", seed=2, duration=40.0, current_std=0.01)
     cfg.write_text('preprocessing = "auto"\n' + cfg.read_text())
     result = run_identification(load_identification_config(cfg))
     cv = result.settings["preprocessing_cross_validation"]
     assert len(cv["candidates"]) == 3 and np.asarray(cv["out_of_fold_rms_error"]).shape == (3, 6)
-    assert cv["chosen"] == int(np.argmin(cv["score"])) and "cross-validation" in result.settings["preprocessing"]["derivation"]
+    score = np.asarray(cv["score"])
+    best = int(np.argmin(score))
+    assert cv["chosen"] == (best if score[best] <= 0.9 * score[0] else 0)
+    assert "cross-validation" in result.settings["preprocessing"]["derivation"]
     assert "coulomb_cross_validation" in result.settings
     m = result.validations[0].metrics()
     assert m["dynid OLS"]["global_relative_error"] <= 1.2 * m["truth"]["global_relative_error"]

@@ -292,7 +292,7 @@ def filter_choice_table(cv: dict) -> TextTable:
     rows = tuple((f"{c['position_cutoff']:.3g}{'*' if i == cv['chosen'] else ''}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
                   *(f"{x:.4g}" for x in e), f"{s:.4g}")
                  for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
-    return TextTable('preprocessing = "auto": out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *',
+    return TextTable("Cutoffs by cross-validation: out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
                      ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
 
 

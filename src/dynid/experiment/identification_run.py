@@ -95,6 +95,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
 
         filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)
         data = filters.data
+        filters = filters if filters.chose else None
     else:
         data = prepare(recording, config.preprocessing)
     del recording  # the raw positions and velocities: only the filtered ones are used from here

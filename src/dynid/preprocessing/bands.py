@@ -88,6 +88,10 @@ class BandEstimate:
     noise_share: float
     rate: float
     motion_found: bool = True
+    knee: float | None = None
+    """Frequency [Hz] above the band where the motion's spectrum meets the noise floor (the median over the joints
+    of the first 1/6-octave band above ``band`` whose mean power is below twice the floor): above it, noise dominates
+    positions, velocities and accelerations alike; below it, the motion does."""
 
     def warnings(self, name: str) -> tuple[str, ...]:
         """One line per implausible finding, naming the dataset ``name`` and the setting that fixes it."""
@@ -169,10 +173,13 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
     motion = np.zeros(f.size)
     noise = 0.0
     kernel = np.ones(9) / 9
+    floors, powers = [], []
     for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
         x = _detrended(np.asarray(q[:, j], dtype=float), ramp) * window
         power = np.abs(np.fft.rfft(x)) ** 2
         floor = _noise_floor(power, f, rate / 2)
+        floors.append(floor)
+        powers.append(_octave_smoothed(power, f))
         total += f2 * power
         if floor > 0:
             smooth = np.convolve(power, kernel, mode="same")
@@ -189,7 +196,19 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
     k = int(np.searchsorted(np.cumsum(energy) / energy.sum(), fraction))
     band = float(min(max(f[min(k, f.size - 1)], lo), hi))
     share = float(min(noise / total.sum(), 1.0)) if total.sum() > 0 else 0.0
-    return BandEstimate(band, share, float(rate), bool(found))
+    knees = []
+    for floor, smooth in zip(floors, powers):
+        below = np.flatnonzero((f > band) & (smooth < 2 * floor))
+        knees.append(f[below[0]] if below.size and floor > 0 else hi)
+    return BandEstimate(band, share, float(rate), bool(found), float(np.median(knees)))
+
+
+def _octave_smoothed(power: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """The mean of ``power`` over a sixth of an octave around each frequency (a running sum: O(N))."""
+    lo = np.searchsorted(f, f / 2 ** (1 / 12))
+    hi = np.searchsorted(f, f * 2 ** (1 / 12), side="right")
+    c = np.concatenate([[0.0], np.cumsum(power)])
+    return (c[hi] - c[lo]) / np.maximum(hi - lo, 1)
 
 
 def white_noise_std(x, rate: float) -> np.ndarray:

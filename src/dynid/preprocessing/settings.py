@@ -75,9 +75,11 @@ class Preprocessing:
         Per joint, Dahl's presliding distance over which the friction reverses with the direction of motion
         (:func:`dynid.friction.held_direction`); 0 (default): at once.
     auto : bool
-        ``preprocessing = "auto"``: the position and parallel cutoffs (hence the decimation) are chosen
-        by blocked cross-validation (:func:`dynid.validation.cross_validation.choose_preprocessing`), and
-        the Coulomb smoothing velocity too unless given.
+        Default true: when neither cutoff is given and the positions' noise knee lies well above
+        :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band (a slow motion on a quiet log: the 10× rule
+        would filter away content the data hold), the position and parallel cutoffs (hence the decimation) are
+        chosen by blocked cross-validation among 10× the band, the knee and their geometric mean
+        (:func:`dynid.validation.cross_validation.choose_preprocessing`); false: the 10× rule.
     derivation : str
         Filled by :meth:`resolved`: what was derived from the data, and why.
     noise_share : float or None
@@ -101,9 +103,10 @@ class Preprocessing:
     rest_velocity: str | float | tuple = "auto"
     rest_floor: float | tuple = 0.0
     band_floor: float = 0.0
+    knee: float | None = None
     rest_friction: str | float | tuple = "held"
     presliding: float | tuple = 0.0
-    auto: bool = False
+    auto: bool = True
     derivation: str = ""
     noise_share: float | None = None
     warnings: tuple[str, ...] = ()
@@ -141,14 +144,14 @@ class Preprocessing:
                 raise ConfigError(f"preprocessing.{key}: expected below the Nyquist frequency {nyq:g} Hz of {name} "
                                   f"({rate:.6g} Hz), got {v:g} Hz")
         warnings = list(self.warnings)
-        band, source, share = self.band, "given by preprocessing.band", self.noise_share
+        band, source, share, knee = self.band, "given by preprocessing.band", self.noise_share, self.knee
         if band is None and self.fourier is not None:
             band, source = self.fourier[0] * self.fourier[1] / (2 * np.pi), "the excitation's highest harmonic"
         if band is None:
             if q is None:
                 raise ConfigError("preprocessing.band: needed when no positions are given to estimate it")
             found = estimate_band(q, rate)
-            band, share = found.band, found.noise_share
+            band, share, knee = found.band, found.noise_share, found.knee
             source = (f"99 % of the motion's velocity energy, above a noise floor holding {100 * share:.2g} % of the "
                       "positions' spectrum" if found.motion_found else "99 % of the velocity energy: no motion above the noise")
             if self.band_floor > 0 and found.warnings(name):  # a log that barely moves: the identification's band
@@ -211,7 +214,7 @@ class Preprocessing:
         chosen.append(f"decimation by {dec}" + ("" if self.decimation is not None else " (down to the parallel band)"))
         return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),  # noqa: E501
                        decimation=int(dec), band=float(band), trim=float(trim), derivation="; ".join(chosen),
-                       noise_share=share, warnings=tuple(dict.fromkeys(warnings)))
+                       noise_share=share, knee=knee, warnings=tuple(dict.fromkeys(warnings)))
 
     def to_dict(self) -> dict:
         """The settings as results.json stores them (``warnings`` go to the result's own warnings)."""

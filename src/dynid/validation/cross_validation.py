@@ -24,7 +24,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
-from ..preprocessing.bands import capped
+from ..preprocessing.bands import POSITION_FACTOR, capped
 from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
 
 COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
@@ -121,8 +121,11 @@ def choose_coulomb_velocity(robot: Robot, base: BaseParameters, data: PreparedDa
     return CoulombChoice(candidates[best, np.arange(n)], candidates, error, folds)
 
 
-FILTER_FACTORS = (5.0, 10.0, 20.0)
-"""Candidate position and parallel cutoffs, as multiples of the excitation band (the default is 10)."""
+KNEE_MARGIN = 2.0
+"""The cutoffs are cross-validated when the noise knee lies at least this many times above the 10×-band rule."""
+
+SCORE_MARGIN = 0.1
+"""A cutoff other than the rule's must lower the cross-validation score by this fraction to be chosen."""
 
 
 @dataclass(frozen=True)
@@ -151,8 +154,14 @@ class PreprocessingChoice:
     note: str = ""
     data: PreparedData | None = None
 
+    @property
+    def chose(self) -> bool:
+        """Whether there was a choice to make (several candidates)."""
+        return len(self.candidates) > 1
+
     def to_dict(self) -> dict:
-        return {"chosen": int(np.argmin(self.score)), "note": self.note,
+        chosen = next(i for i, c in enumerate(self.candidates) if c.position_cutoff == self.settings.position_cutoff)
+        return {"chosen": chosen, "note": self.note,
                 "candidates": [{"position_cutoff": c.position_cutoff, "parallel_cutoff": c.parallel_cutoff,
                                 "decimation": c.decimation} for c in self.candidates],
                 "out_of_fold_rms_error": self.error, "score": self.score}
@@ -174,13 +183,18 @@ def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: 
     return accs, np.sqrt(sumsq / max(count, 1))
 
 
-def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS,
-                         factors=FILTER_FACTORS) -> PreprocessingChoice:
-    """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation.
+def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS
+                         ) -> PreprocessingChoice:
+    """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation, when
+    there is a choice to make.
 
-    Each candidate sets both cutoffs to ``factor × band`` (band from the data, as by default; cutoffs the
-    config gives are kept). Its parameters are fitted on all blocks but one of its own preprocessed rows
-    and scored on the held-out block of the **default** preprocessing's rows, the same for every candidate.
+    The default rule filters at 10× the excitation band (:mod:`dynid.preprocessing.bands`); on a slow motion logged
+    with little noise, the positions' spectrum stays above the noise floor far beyond that (the knee,
+    :attr:`dynid.preprocessing.bands.BandEstimate.knee`), and the content there (what the accelerations of the
+    robot's own dynamics hold) is worth keeping. When the knee lies :data:`KNEE_MARGIN` times above the rule and the
+    config gives no cutoff, the candidates are the rule's cutoff, the knee and their geometric mean. Each candidate's
+    parameters are fitted on all blocks but one of its own preprocessed rows and scored on the held-out block of the
+    **default** preprocessing's rows, the same for every candidate.
 
     Parameters
     ----------
@@ -190,19 +204,25 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     given : Preprocessing
         The config's settings (``None`` fields are chosen).
     folds : int
-    factors : sequence of float
 
     Returns
     -------
     PreprocessingChoice
+        With one candidate (the default rule's) when there was nothing to choose.
     """
     reference = prepare(recording, given)
-    band = reference.settings.band
+    rs = reference.settings
+    band, knee = rs.band, rs.knee
+    default = POSITION_FACTOR * band
+    if (given.position_cutoff is not None or given.parallel_cutoff is not None or rs.fourier is not None or knee is None
+            or knee < KNEE_MARGIN * default):
+        return PreprocessingChoice(rs, (rs,), np.zeros((1, robot.n_dof)), np.zeros(1), "", reference)
+    cutoffs = (default, float(np.sqrt(default * knee)), knee)
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
     candidates, errors, prepared = [], [], []
-    for f in factors:
-        cutoff = capped(f * band, recording.rate)
+    for f in cutoffs:
+        cutoff = capped(f, recording.rate)
         settings = replace(given,
                            position_cutoff=given.position_cutoff if given.position_cutoff is not None else cutoff,
                            parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else cutoff)
@@ -222,8 +242,10 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
     best = int(np.argmin(score))
-    note = (f"cutoffs {factors[best]:g}× band, chosen by {folds}-fold blocked cross-validation among "
-            f"{', '.join(f'{f:g}' for f in factors)}× band")
+    if score[best] > (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
+        best = 0
+    note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among "
+            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz (10× the band, the noise knee and their geometric mean)")
     data = prepared[best]
     data = replace(data, settings=replace(data.settings, derivation=f"{data.settings.derivation}; {note}"))
     return PreprocessingChoice(data.settings, tuple(candidates), error, score, note, data)
