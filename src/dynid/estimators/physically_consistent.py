@@ -195,10 +195,14 @@ def _consistency_constraints(phi, links, nonnegative, margin) -> list:
 
 def _solve(problem, what: str):
     """Solve with Clarabel; a solver failure becomes a one-line :class:`DynIdError` naming ``what``."""
+    import warnings
+
     import cvxpy as cp
 
     try:
-        problem.solve(solver=cp.CLARABEL)
+        with warnings.catch_warnings():  # an inaccurate solution is said by its status, which the callers report
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError as exc:
         raise DynIdError(f"{what}: the SDP solver failed ({exc})") from None
     except BaseException as exc:  # Clarabel's Rust core panics on extreme values (a PanicException, not an Exception)

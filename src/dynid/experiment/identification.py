@@ -107,6 +107,7 @@ class ConsistentEstimate:
     base: np.ndarray
     pseudo_inertia_min_eig: np.ndarray
     prior: str = "the robot model's nominal parameters"
+    note: str = ""
 
 
 @dataclass(frozen=True)
@@ -376,7 +377,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, method: str
     if acc_std is not None and progress is not None:
         progress("physically consistent SDP", 0, 1)
     consistent = None if acc_std is None else _consistent_estimate(robot, base, acc_std, row_weights)
-    warnings = list(robot.nominal_problems) + list(data.warnings)
+    warnings = list(robot.nominal_problems) + list(data.warnings) + ([consistent.note] if consistent is not None and consistent.note else [])
     dropped = 1.0 - acc.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
@@ -497,4 +498,7 @@ def _consistent_estimate(robot: Robot, base: BaseParameters, acc: LeastSquaresAc
     links, nonneg = consistency_layout(robot)
     est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters())
     est.fit(reduced[:, :p], reduced[:, p])
-    return ConsistentEstimate(est.params_, base.base_from_standard(est.params_), est.pseudo_inertia_min_eig_)
+    note = ("" if est.status_ == "optimal" else
+            f"physically consistent least squares: the SDP solver (Clarabel) ended with status {est.status_}: its estimate "
+            "may be slightly off the optimum (a poorly excited log or badly scaled parameters)")
+    return ConsistentEstimate(est.params_, base.base_from_standard(est.params_), est.pseudo_inertia_min_eig_, note=note)
