@@ -118,7 +118,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
         result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed,
-                          held_out=not (validate and config.validation))
+                          held_out=validate and not config.validation)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())

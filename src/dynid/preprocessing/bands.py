@@ -174,12 +174,13 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
     noise = 0.0
     kernel = np.ones(9) / 9
     floors, powers = [], []
+    grid = np.unique(np.searchsorted(f, np.geomspace(max(f[1], 1e-12), f[-1], 400)))  # 400 points, ~ 1/40 octave
     for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
         x = _detrended(np.asarray(q[:, j], dtype=float), ramp) * window
         power = np.abs(np.fft.rfft(x)) ** 2
         floor = _noise_floor(power, f, rate / 2)
         floors.append(floor)
-        powers.append(_octave_smoothed(power, f))
+        powers.append(_octave_smoothed(power, f)[grid])  # on a log-spaced grid: a long log's spectrum is not kept
         total += f2 * power
         if floor > 0:
             smooth = np.convolve(power, kernel, mode="same")
@@ -198,8 +199,8 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
     share = float(min(noise / total.sum(), 1.0)) if total.sum() > 0 else 0.0
     knees = []
     for floor, smooth in zip(floors, powers):
-        below = np.flatnonzero((f > band) & (smooth < 2 * floor))
-        knees.append(f[below[0]] if below.size and floor > 0 else hi)
+        below = np.flatnonzero((f[grid] > band) & (smooth < 2 * floor))
+        knees.append(f[grid][below[0]] if below.size and floor > 0 else hi)
     return BandEstimate(band, share, float(rate), bool(found), float(np.median(knees)))
 
 

@@ -121,7 +121,21 @@ def choose_coulomb_velocity(robot: Robot, base: BaseParameters, data: PreparedDa
     return CoulombChoice(candidates[best, np.arange(n)], candidates, error, folds)
 
 
-KNEE_MARGIN = 2.0
+MAX_SAMPLES = 60_000
+"""A longer log has its cutoffs chosen on its middle ``MAX_SAMPLES`` samples (a minute of a 1 kHz log)."""
+
+
+def _middle(recording, n: int):
+    """The recording's middle ``n`` samples (the recording itself when it is not longer)."""
+    if recording.n_samples <= n:
+        return recording
+    a = (recording.n_samples - n) // 2
+    cut = lambda x: None if x is None else x[a:a + n]  # noqa: E731 - stored columns slice as views
+    return replace(recording, t=recording.t[a:a + n] - recording.t[a], q=cut(recording.q), dq=cut(recording.dq),
+                   tau=cut(recording.tau))
+
+
+KNEE_MARGIN = 3.0
 """The cutoffs are cross-validated when the noise knee lies at least this many times above the 10×-band rule."""
 
 SCORE_MARGIN = 0.1
@@ -217,6 +231,9 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     if (given.position_cutoff is not None or given.parallel_cutoff is not None or rs.fourier is not None or knee is None
             or knee < KNEE_MARGIN * default):
         return PreprocessingChoice(rs, (rs,), np.zeros((1, robot.n_dof)), np.zeros(1), "", reference)
+    full, recording = recording, _middle(recording, MAX_SAMPLES)  # a long log: its middle minute decides
+    if recording is not full:
+        reference = prepare(recording, replace(given, band=band))
     cutoffs = (default, float(np.sqrt(default * knee)), knee)
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
@@ -245,7 +262,12 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     if score[best] > (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
         best = 0
     note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among "
-            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz (10× the band, the noise knee and their geometric mean)")
+            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz (10× the band, the noise knee and their geometric mean)"
+            + ("" if recording is full else f" on the log's middle {recording.n_samples} samples"))
     data = prepared[best]
+    if recording is not full:
+        chosen = candidates[best]
+        data = prepare(full, replace(given, band=band, position_cutoff=chosen.position_cutoff,
+                                     parallel_cutoff=chosen.parallel_cutoff))
     data = replace(data, settings=replace(data.settings, derivation=f"{data.settings.derivation}; {note}"))
     return PreprocessingChoice(data.settings, tuple(candidates), error, score, note, data)

@@ -237,13 +237,15 @@ class BlockGrams:
         w = np.ones(self.gram.shape[1]) if weights is None else np.asarray(weights, dtype=float)
         g = np.einsum("j,bjcd->bcd", w**2, self.gram)  # joints weighted, summed: one Gram per block
         p = g.shape[1] - 1
-        draws = []
-        for _ in range(resamples):
-            total = g[rng.integers(0, self.blocks, self.blocks)].sum(axis=0)
-            a, b = total[:p, :p], total[:p, p]
-            scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
-            draws.append(np.linalg.lstsq(a / scale[:, None] / scale[None, :], b / scale, rcond=1e-12)[0] / scale)
-        return np.std(np.array(draws), axis=0, ddof=1)
+        counts = np.zeros((resamples, self.blocks))  # each resample: how often it drew each block
+        for r in range(resamples):
+            counts[r] = np.bincount(rng.integers(0, self.blocks, self.blocks), minlength=self.blocks)
+        totals = np.einsum("rb,bcd->rcd", counts, g)
+        a, b = totals[:, :p, :p], totals[:, :p, p]
+        scale = np.sqrt(np.maximum(np.diagonal(a, axis1=1, axis2=2), 1e-300))
+        scaled = a / scale[:, :, None] / scale[:, None, :] + 1e-12 * np.eye(p)  # a ridge for unexcited directions
+        draws = np.linalg.solve(scaled, (b / scale)[:, :, None])[:, :, 0] / scale
+        return np.std(draws, axis=0, ddof=1)
 
 
 def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> tuple[list[Finding], float]:

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..column_store import root_mean_square
 from ..dynamics.base_parameters import base_parameters
+from ..exceptions import IdentifiabilityError
 from ..dynamics.regressor import regressor
 from ..friction import TERMS, Velocities, held_direction
 from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with
@@ -44,6 +45,10 @@ FOLDS = 5
 MARGIN = 0.01
 """A candidate other than the plain model (held at rest, Coulomb + viscous) must lower a joint's out-of-fold RMS
 error by this fraction to be chosen."""
+
+MAX_SAMPLES = 60_000
+"""A longer log is cross-validated on one contiguous segment of ``MAX_SAMPLES / folds`` samples in the middle of each
+block (a minute of a 1 kHz log in all): the choice needs the log's kinds of motion, not all its hours."""
 
 REST_SHARE = 0.05
 """A joint's state at rest is judged only when at least this share of its samples are at rest in the log;
@@ -149,8 +154,8 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     has = {t: robot.drive_mask[:, robot.drive_terms.index(t)] for t in others}
     decays = [rest_decay(r, n) for r in REST_GRID]
     cutoff = s.velocity_cutoff or s.position_cutoff or data.rate / 4
-    directions = [_directions(data, rest_v, d, cutoff) for d in decays]
     velocities = robot.friction_velocities
+    directions: list = []
 
     def block(a, b):
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))
@@ -161,7 +166,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
             bank[:, :, index[t]] = TERMS[t].column(q, dq, ddq, v) * has[t]
         load = np.abs(y @ nominal) if load_ok else None
         for r, direction in zip(REST_GRID, directions):
-            z = np.asarray(direction[a:b])
+            z = np.asarray(direction[a - directions_start[0]:b - directions_start[0]])
             bank[:, :, index[f"fc|{r}"]] = z
             bank[:, :, index[f"fca|{r}"]] = np.abs(z)
             for g in STRIBECK_GRID:
@@ -179,16 +184,17 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     vmin = _min_speed(s, n)
     n_s = data.t.shape[0]
     load_sq, tau_sq, resting = np.zeros(n), np.zeros(n), np.zeros(n)
-    for idx, (y, bank, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk,
-                                                   s.parallel_cutoff or None):
+    directions_start = [0]
+
+    def _accumulate(idx, y, bank, tau, fold):
+        nonlocal load_sq, tau_sq, resting
         z = np.concatenate([y, bank, tau[:, :, None]], axis=2)
         tau_sq += (tau**2).sum(axis=0)
         if load_ok:
             load_sq += ((y @ nominal) ** 2).sum(axis=0)
-        guide = np.asarray((data.motion if data.motion is not None else data.dq)[idx])
-        resting += (np.abs(guide) <= rest_v).sum(axis=0)
+        resting += (data.resting[idx] if data.resting is not None else
+                    np.abs(np.asarray(data.dq[idx])) <= rest_v).sum(axis=0)
         keep = np.abs(np.asarray(data.dq[idx])) >= vmin
-        fold = idx * folds // n_s
         for f in np.unique(fold):
             sel = fold == f
             zf = z[sel]
@@ -196,6 +202,26 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
             zk = zf * keep[sel][:, :, None]
             fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
             n_rows[f] += sel.sum()
+
+    for start, stop, fold_of in _segments(n_s, folds):
+        directions[:] = [_directions(data, rest_v, d, cutoff, start, stop) for d in decays]  # the segment's, from its start
+        directions_start[0] = start
+        for idx, (y, bank, tau) in parallel_decimation(lambda a, b: block(start + a, start + b), stop - start, data.rate,
+                                                       s.decimation, s.order, s.chunk, s.parallel_cutoff or None):
+            idx = idx + start
+            _accumulate(idx, y, bank, tau, fold_of(idx))
+    if not n_rows.any():
+        raise IdentifiabilityError(f"{data.name}: no samples left for the friction models' cross-validation")
+
+    total = fit.sum(axis=0)
+    sets = np.concatenate([total[None], total[None] - fit])  # every block, and every block but one
+
+    def columns(model: JointFriction, j: int) -> list[int]:
+        tau_sq += (tau**2).sum(axis=0)
+        if load_ok:
+            load_sq += ((y @ nominal) ** 2).sum(axis=0)
+    total = fit.sum(axis=0)
+    sets = np.concatenate([total[None], total[None] - fit])  # every block, and every block but one
 
     def columns(model: JointFriction, j: int) -> list[int]:
         own = [index[t] for t in others if has[t][j]]
@@ -215,7 +241,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
         """Out-of-fold errors per joint; with ``signs`` also whether a load-dependent coefficient (the last column
         of that model) comes out >= 0, as friction that grows with the load must."""
         cols = [columns(m, j) for j, m in enumerate(assignment)]
-        err, coef = _out_of_fold(fit, score, n_rows, p, cols)
+        err, coef = _out_of_fold(fit, score, n_rows, p, cols, sets)
         if not signs:
             return err
         ok = np.array([m.kind != "load" or coef[j][-1] >= 0 for j, m in enumerate(assignment)])
@@ -276,14 +302,25 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     return FrictionChoice(models, tuple(labels), np.array(errors), plain, final, folds, resting / rows, loaded)
 
 
-def _directions(data: PreparedData, rest_v, decay, cutoff: float):
-    """The direction of motion of every joint for one state at rest (column by column, as the pipeline)."""
-    from ..column_store import by_column
+def _segments(n_s: int, folds: int):
+    """(start, stop, fold of each index) of the segments the cross-validation reads: the whole log in one (its blocks the
+    folds), or for a log longer than :data:`MAX_SAMPLES` one segment in the middle of each block (its fold)."""
+    if n_s <= MAX_SAMPLES:
+        return [(0, n_s, lambda idx: idx * folds // n_s)]
+    length = MAX_SAMPLES // folds
+    out = []
+    for f in range(folds):
+        mid = (2 * f + 1) * n_s // (2 * folds)
+        out.append((mid - length // 2, mid - length // 2 + length, lambda idx, f=f: np.full(idx.shape, f)))
+    return out
 
+
+def _directions(data: PreparedData, rest_v, decay, cutoff: float, start: int, stop: int):
+    """The direction of motion of every joint for one state at rest, on samples ``start:stop`` (column by column)."""
     travel = rest_v / cutoff
     guide = data.motion if data.motion is not None else data.dq
-    return by_column(data.dq, lambda column, j: held_direction(column[:, None], rest_v[j], decay[j], 0.0, data.rate,
-                                                               np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
+    dq, guide = np.asarray(data.dq[start:stop]), np.asarray(guide[start:stop])  # stored columns: these rows read here
+    return held_direction(dq, rest_v, decay, 0.0, data.rate, guide, travel)
 
 
 def _pick(errors) -> int:
@@ -293,43 +330,42 @@ def _pick(errors) -> int:
     return best if errors[best] < (1.0 - MARGIN) * errors[0] else 0
 
 
-def _solve(g, p: int, cols, offsets) -> np.ndarray:
-    """Least squares from per-joint Gram matrices ``g`` (n, size, size): the shared rigid-body columns, then each
-    joint's own bank columns ``cols[j]``, the torque last (column scaling, minimum-norm where rank-deficient)."""
-    n, size, _ = g.shape
-    t = size - 1
-    m = offsets[-1]
-    a = np.zeros((m, m))
-    b = np.zeros(m)
-    for j in range(n):
-        own = p + np.asarray(cols[j], dtype=int)
-        sl = slice(offsets[j], offsets[j + 1])
-        a[:p, :p] += g[j][:p, :p]
-        a[:p, sl] += g[j][:p][:, own]
-        a[sl, :p] += g[j][own][:, :p]
-        a[sl, sl] += g[j][np.ix_(own, own)]
-        b[:p] += g[j][:p, t]
-        b[sl] += g[j][own, t]
-    scale = np.sqrt(np.maximum(np.diag(a), 1e-300))
-    return np.linalg.lstsq(a / scale[:, None] / scale[None, :], b / scale, rcond=1e-10)[0] / scale
-
-
-def _out_of_fold(fit, score, n_rows, p: int, cols) -> tuple[np.ndarray, list]:
+def _out_of_fold(fit, score, n_rows, p: int, cols, sets=None) -> tuple[np.ndarray, list]:
     """Out-of-fold RMS error per joint when each joint ``j`` has the bank columns ``cols[j]`` (plus the shared
     rigid-body columns), fitted on the other blocks' moving rows and scored on all rows of the block left out;
-    and each joint's own coefficients fitted on every block."""
+    and each joint's own coefficients fitted on every block.
+
+    The normal equations of all blocks are assembled and solved together (column scaling, a ridge of 1e-10 on the
+    scaled diagonal for the rank-deficient directions, which change no prediction). ``sets`` (folds + 1, n, size,
+    size): the Gram matrices of every block and of every block but one, when the caller has them.
+    """
     folds, n, size, _ = fit.shape
     t = size - 1
+    if sets is None:
+        total = fit.sum(axis=0)
+        sets = np.concatenate([total[None], total[None] - fit])
     offsets = np.cumsum([p] + [len(c) for c in cols])
+    m = offsets[-1]
+    a = np.zeros((folds + 1, m, m))
+    b = np.zeros((folds + 1, m))
+    a[:, :p, :p] = sets[:, :, :p, :p].sum(axis=1)
+    b[:, :p] = sets[:, :, :p, t].sum(axis=1)
+    owns = [p + np.asarray(c, dtype=int) for c in cols]
+    for j, own in enumerate(owns):
+        sl = slice(offsets[j], offsets[j + 1])
+        gj = sets[:, j]
+        a[:, :p, sl] = gj[:, :p][:, :, own]
+        a[:, sl, :p] = gj[:, own][:, :, :p]
+        a[:, sl, sl] = gj[:, own][:, :, own]
+        b[:, sl] = gj[:, own, t]
+    scale = np.sqrt(np.maximum(np.diagonal(a, axis1=1, axis2=2), 1e-300))
+    scaled = a / scale[:, :, None] / scale[:, None, :] + 1e-10 * np.eye(m)
+    theta = np.linalg.solve(scaled, (b / scale)[:, :, None])[:, :, 0] / scale
+    own_coef = [theta[0, offsets[j]:offsets[j + 1]] for j in range(n)]
     sse = np.zeros(n)
-    whole = _solve(fit.sum(axis=0), p, cols, offsets)
-    own_coef = [whole[offsets[j]:offsets[j + 1]] for j in range(n)]
-    for k in range(folds):
-        g = fit[[f for f in range(folds) if f != k]].sum(axis=0)
-        theta = _solve(g, p, cols, offsets)
-        for j in range(n):
-            own = p + np.asarray(cols[j], dtype=int)
-            idx = np.concatenate([np.arange(p), own, [t]])
-            e = np.concatenate([theta[:p], theta[offsets[j]:offsets[j + 1]], [-1.0]])
-            sse[j] += max(float(e @ score[k, j][np.ix_(idx, idx)] @ e), 0.0)
+    for j, own in enumerate(owns):
+        idx = np.concatenate([np.arange(p), own, [t]])
+        sub = score[:, j][:, idx][:, :, idx]
+        e = np.concatenate([theta[1:, :p], theta[1:, offsets[j]:offsets[j + 1]], -np.ones((folds, 1))], axis=1)
+        sse[j] = np.maximum(np.einsum("kl,klm,km->k", e, sub, e), 0.0).sum()
     return np.sqrt(sse / np.maximum(n_rows.sum(axis=0), 1)), own_coef
