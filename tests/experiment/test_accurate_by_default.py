@@ -58,9 +58,21 @@ def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path)
     cross-validated): every candidate scored on the same held-out samples, the rule's cutoff kept unless another
     scores 10 % better; as accurate as the defaults' on this log (validation within 1.2x of the true parameters'
     own error)."""
-    cfg, truth_robot = simulated_case(tmp_path, "er16", 500.0, "ptp", seed=2, duration=40.0, current_std=0.01)
+    from ..simulated_logs import config_text, point_to_point_motion, robot_toml, truth_robot, write_log, write_truth
+
+    rng = np.random.default_rng(2)
+    robot, friction = truth_robot("er16", rng)
+    t = np.arange(int(60 * 1000.0)) / 1000.0
+    for label in ("ident", "valid"):  # slow moves (4 s each) logged by 20-bit encoders: a low band, a high knee
+        q, dq, ddq = point_to_point_motion(robot, t, rng, segment=4.0, rest=1.0)
+        write_log(tmp_path / f"{label}.csv", robot, t, q, dq, ddq, friction, rng, 0.01)
+    write_truth(tmp_path / "truth.csv", robot, robot.parameter_names)
+    cfg = tmp_path / "config.toml"
+    cfg.write_text(config_text(robot_toml("er16", tmp_path), tmp_path, "ident.csv", "valid.csv", robot.n_dof))
     cfg.write_text('preprocessing = "auto"\n' + cfg.read_text())
     result = run_identification(load_identification_config(cfg))
+    pre = result.settings["preprocessing"]
+    assert pre["knee"] >= 3 * 10 * pre["band"]  # 20-bit positions: their noise floor far below the motion's spectrum
     cv = result.settings["preprocessing_cross_validation"]
     assert len(cv["candidates"]) == 3 and np.asarray(cv["out_of_fold_rms_error"]).shape == (3, 6)
     score = np.asarray(cv["score"])
