@@ -247,6 +247,8 @@ class IdentificationResult:
             out.append(filter_choice_table(self.settings["preprocessing_cross_validation"]))
         if self.settings.get("coulomb_cross_validation") is not None:
             out.append(coulomb_choice_table(self.settings["coulomb_cross_validation"]))
+        if self.settings.get("friction_models") is not None:
+            out.append(friction_choice_table(self.settings["friction_models"]))
         rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
                       *(f"{r.beta[i]:.4g}" for r in self.references)) for i, n in enumerate(base.names))
         out.append(TextTable("Base parameters (σ: standard deviation; reference values beside)",
@@ -295,6 +297,17 @@ def filter_choice_table(cv: dict) -> TextTable:
                  for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
     return TextTable("Cutoffs by cross-validation: out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
                      ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
+
+
+def friction_choice_table(choice: dict) -> TextTable:
+    """Each joint's friction model chosen by cross-validation, its out-of-fold error against the plain model's."""
+    plain, chosen = np.asarray(choice["plain_out_of_fold_rms_error"]), np.asarray(choice["chosen_out_of_fold_rms_error"])
+    share = choice.get("rest_share")
+    rows = tuple((f"J{j + 1}", m["label"], f"{plain[j]:.3g}", f"{chosen[j]:.3g}",
+                  "" if share is None else f"{100 * share[j]:.0f}") for j, m in enumerate(choice["models"]))
+    return TextTable(f"Friction model of each joint, chosen by {choice['folds']}-fold blocked cross-validation "
+                     "(out-of-fold RMS torque error, N·m; the state at rest is judged where 5 % of the samples rest)",
+                     ("joint", "model", "plain", "chosen", "at rest %"), rows, labels=2)
 
 
 def coulomb_choice_table(cv: dict) -> TextTable:
