@@ -1,0 +1,150 @@
+"""Digests of what every config in ``configs/``, ``dynid run`` and a Monte Carlo realisation produce.
+
+A digest is the flattened ``results.json`` (every leaf under its JSON path: numbers, strings, booleans), without
+wall times and file paths. ``tests/test_digests.py`` compares each case against ``tests/data/digests.json``, so a
+restructuring that is meant to change nothing is shown to change nothing.
+
+Regenerate (only when a change of results is intended, and say so in the commit)::
+
+    .venv/bin/python -m tests.digests [case ...]
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+STORE = ROOT / "tests" / "data" / "digests.json"
+
+IDENTIFY = ("ur10e", "tx40", "tx40-full", "kuka_kr300", "kuka_med7")
+EXCITE = ("excite-er16", "excite-ur10e", "excite-er16-6dof", "excite-er16-beta1-envelope")
+CASES = (*(f"identify:{c}" for c in IDENTIFY), *(f"excite:{c}" for c in EXCITE), "run", "montecarlo")
+
+SKIPPED = {"seconds", "timings", "config", "path", "file", "cluster"}
+"""Keys whose values are wall times or file paths: not results."""
+
+RTOL = 1e-9
+ATOL = 1e-12
+"""Numbers agree when ``|a - b| <= RTOL·max(|a|, |b|) + ATOL``: bit-identical arithmetic agrees exactly; a reordered
+sum may move the last digits, a changed result does not stay within a billionth."""
+
+
+def data_root(config: Path) -> Path | None:
+    """The shared data folder of an identification config (None when the workplace's data are absent)."""
+    import tomllib
+
+    doc = tomllib.loads(config.read_text())
+    name = Path(doc.get("data_root", ".")).name
+    import os
+
+    for root in (os.environ.get("DYNID_SHARED_DATA"), ROOT.parent / "shared" / "data", Path("/work/shared/data")):
+        if root and (Path(root) / name).is_dir():
+            return Path(root) / name
+    return None
+
+
+def compute(case: str) -> dict:
+    """``results.json`` of ``case`` as a plain dict (what the CLI writes)."""
+    from dynid.io.files import _clean
+
+    kind, _, name = case.partition(":")
+    if kind == "identify":
+        from dynid import load_identification_config, run_identification
+
+        path = ROOT / "configs" / f"{name}.toml"
+        root = data_root(path)
+        if root is None:
+            raise FileNotFoundError(f"data of {path.name} not found")
+        return _clean(run_identification(load_identification_config(path, data_root=root)).to_dict())
+    if kind == "excite":
+        from dynid.experiment.excitation import run_excitation
+        from dynid.io.excitation_config import load_excitation_config
+
+        return _clean(run_excitation(load_excitation_config(ROOT / "configs" / f"{name}.toml")).to_dict())
+    if kind == "run":
+        from dynid import PaperExperimentConfig, run_paper_experiment
+
+        return _clean(run_paper_experiment(PaperExperimentConfig()).to_dict())
+    if kind == "montecarlo":
+        from dynid.experiment.montecarlo import MonteCarloConfig, _prepare, simulate_realisation
+
+        config = MonteCarloConfig(noise_levels=(0.05, 0.2), realisations=2, methods=("ols", "wls", "irls", "lad", "sdp", "abc"),
+                                  duration=8.0, rate=100.0, maxiter=5)
+        setup = _prepare(config)
+        out = {}
+        for level in range(2):
+            for r in range(2):
+                one = simulate_realisation(setup, level, r)
+                out[f"{level}/{r}"] = {"params": one["params"], "errors": one["errors"]}
+        return _clean(out)
+    raise ValueError(f"unknown case {case!r}")
+
+
+def flatten(obj, prefix: str = "") -> dict:
+    """JSON path -> leaf (number, string, bool or None), without :data:`SKIPPED` keys."""
+    out = {}
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            if k not in SKIPPED:
+                out.update(flatten(v, f"{prefix}/{k}"))
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            out.update(flatten(v, f"{prefix}[{i}]"))
+    else:
+        out[prefix] = obj
+    return out
+
+
+def differences(stored: dict, now: dict, renamed: dict | None = None) -> list[str]:
+    """What differs between a stored digest and today's (every stored path must hold the same value; new paths are
+    allowed). ``renamed``: stored path prefix -> today's prefix."""
+    renamed = renamed or {}
+    out = []
+    for path, old in stored.items():
+        new_path = path
+        for a, b in renamed.items():
+            if path.startswith(a):
+                new_path = b + path[len(a):]
+        if new_path not in now:
+            out.append(f"{path}: missing")
+            continue
+        new = now[new_path]
+        if isinstance(old, float) or isinstance(new, float):
+            if old is None or new is None or isinstance(old, (str, bool)) or isinstance(new, (str, bool)):
+                same = old == new
+            else:
+                same = math.isclose(old, new, rel_tol=RTOL, abs_tol=ATOL)
+        else:
+            same = old == new
+        if not same:
+            out.append(f"{path}: {old!r} -> {new!r}")
+    return out
+
+
+def load() -> dict:
+    return json.loads(STORE.read_text()) if STORE.exists() else {}
+
+
+def main(argv: list[str]) -> int:
+    from threadpoolctl import threadpool_limits
+
+    store = load()
+    cases = argv or list(CASES)
+    with threadpool_limits(1):
+        for case in cases:
+            try:
+                store[case] = flatten(compute(case))
+            except FileNotFoundError as exc:
+                print(f"{case}: skipped ({exc})")
+                continue
+            print(f"{case}: {len(store[case])} leaves")
+    STORE.parent.mkdir(parents=True, exist_ok=True)
+    STORE.write_text(json.dumps(store, indent=None, separators=(',', ':'), sort_keys=True, ensure_ascii=False, allow_nan=False) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,31 @@
+"""Results of every config in configs/, dynid run and Monte Carlo realisations against stored digests
+(tests/digests.py): a restructuring meant to change nothing is checked to change nothing."""
+
+import pytest
+from threadpoolctl import threadpool_limits
+
+from tests import digests
+
+RENAMED: dict = {}
+"""Stored JSON path prefix -> today's, for keys a change renamed (the values must still agree)."""
+
+
+@pytest.mark.parametrize("case", digests.CASES)
+def test_results_agree_with_the_stored_digest(case):
+    stored = digests.load().get(case)
+    if stored is None:
+        pytest.fail(f"no stored digest for {case}: run python -m tests.digests {case}")
+    if case.startswith("identify:") and digests.data_root(digests.ROOT / "configs" / f"{case.split(':')[1]}.toml") is None:
+        pytest.skip(f"data of {case} not found (set DYNID_SHARED_DATA to the shared/data folder)")
+    with threadpool_limits(1):
+        now = digests.flatten(digests.compute(case))
+    diff = digests.differences(stored, now, RENAMED)
+    assert not diff, f"{case}: {len(diff)} of {len(stored)} values differ, e.g.\n" + "\n".join(diff[:15])
+
+
+def test_the_comparison_sees_a_changed_value_and_a_missing_key():
+    stored = {"/a": 1.0, "/b": "x", "/c[0]": 2.0}
+    assert digests.differences(stored, dict(stored)) == []
+    assert digests.differences(stored, {**stored, "/a": 1.0 + 1e-6}) == ["/a: 1.0 -> 1.000001"]
+    assert digests.differences(stored, {"/a": 1.0, "/c[0]": 2.0}) == ["/b: missing"]
+    assert digests.differences(stored, {"/a": 1.0, "/new/b": "x", "/c[0]": 2.0}, {"/b": "/new/b"}) == []
