@@ -58,10 +58,10 @@ def main() -> None:
     t, _ = command([dynid, "identify", str(out / "typo.toml")], repeats=3)
     row("a config typo reported (dynid identify)", t, "s", 0.5)
     t, _ = command([dynid, "run", "--out", str(out / "run1")])
-    row("dynid run (default: all methods, figures)", t, "s", 10.0)
-    t, _ = command([dynid, "run", "--methods", "ols", "--bootstrap", "0", "--out", str(out / "run2")], repeats=2)
-    row("dynid run --methods ols --bootstrap 0", t, "s", 2.0)
-    t, _ = command([dynid, "run", "--methods", "ols", "--bootstrap", "0", "--no-figures", "--out", str(out / "run3")], repeats=2)
+    row("dynid run (default: all estimators, figures)", t, "s", 10.0)
+    t, _ = command([dynid, "run", "--estimators", "ols", "--bootstrap", "0", "--out", str(out / "run2")], repeats=2)
+    row("dynid run --estimators ols --bootstrap 0", t, "s", 2.0)
+    t, _ = command([dynid, "run", "--estimators", "ols", "--bootstrap", "0", "--no-figures", "--out", str(out / "run3")], repeats=2)
     row("  the same, --no-figures", t, "s", 2.0)
 
     ur = DATA / "ur10e_mamedov2020"

@@ -18,9 +18,10 @@ q = (rng.uniform(-0.5, 0.5, (4, 1, 6)) / k * np.sin(2 * np.pi * 0.1 * k * t[None
 dq, ddq = np.gradient(q, t, axis=0), np.gradient(np.gradient(q, t, axis=0), t, axis=0)
 tau = dynid.rnea_torques(robot, q, dq, ddq) + rng.normal(0, 0.2, q.shape)
 
-result = dynid.identify_from_arrays(robot, t, q, tau, method="ols", physically_consistent=True)
+result = dynid.identify_from_arrays(robot, t, q, tau, estimators=("ols", "sdp"))
+sdp = result.estimates["dynid SDP"]
 urdf = Path(tempfile.mkdtemp()) / "er16_identified.urdf"
-urdf.write_text(dynid.urdf_from_robot(robot, result.consistent.standard))
+urdf.write_text(dynid.urdf_from_robot(robot, sdp.standard))
 model = pin.buildModelFromUrdf(str(urdf))
 data = model.createData()
 
@@ -28,7 +29,7 @@ data = model.createData()
 qs, dqs, ddqs = (rng.uniform(-1, 1, (5, 6)) for _ in range(3))
 exported = np.array([pin.rnea(model, data, a, b, c) for a, b, c in zip(qs, dqs, ddqs)])
 exported += model.damping * dqs + model.friction * np.sign(dqs)
-predicted = result.base.base_observation(dynid.regressor(robot, qs, dqs, ddqs)) @ result.consistent.base
+predicted = result.base.base_observation(dynid.regressor(robot, qs, dqs, ddqs)) @ sdp.params
 print("largest difference, exported URDF vs dynid (N·m):", float(np.abs(exported - predicted).max()))
 
 # forward dynamics: the arm released from rest, 0.5 s with viscous joint damping

@@ -14,6 +14,6 @@ q = (a * np.sin(2 * np.pi * 0.1 * k * t[None, :, None] + rng.uniform(0, 6, (4, 1
 dq, ddq = np.gradient(q, t, axis=0), np.gradient(np.gradient(q, t, axis=0), t, axis=0)
 tau = dynid.rnea_torques(robot, q, dq, ddq) + 2.0 * np.sign(dq) + 1.0 * dq + rng.normal(0, 0.05, q.shape)
 
-result = dynid.identify_from_arrays(robot, t, q, tau, method="ols")
-print(result.summary(width=100))  # what dynid identify prints: settings, base parameters with σ, fit per joint
+result = dynid.identify_from_arrays(robot, t, q, tau, estimators=("ols",))
+print(dynid.summary(result, width=100))  # what dynid identify prints: settings, base parameters with σ, fit per joint
 print("relative error per joint on the fit (%):", np.round(result.fit.metrics()["dynid OLS"]["relative_error"], 2))

@@ -72,3 +72,12 @@ def sine_motion(rng, t, n_dof, n_harmonics=4, omega=2 * np.pi * 0.2, amplitude=0
     dq = (a[:, None, :] * k * np.cos(arg)).sum(0)
     ddq = -(a[:, None, :] * k**2 * np.sin(arg)).sum(0)
     return q, dq, ddq
+
+
+def without_wall_times(obj):
+    """A results dictionary without its ``seconds`` entries (wall times), to compare two runs' results."""
+    if isinstance(obj, dict):
+        return {k: without_wall_times(v) for k, v in obj.items() if k != "seconds"}
+    if isinstance(obj, list):
+        return [without_wall_times(v) for v in obj]
+    return obj

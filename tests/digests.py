@@ -71,7 +71,7 @@ def compute(case: str) -> dict:
     if kind == "montecarlo":
         from dynid.experiment.montecarlo import MonteCarloConfig, _prepare, simulate_realisation
 
-        config = MonteCarloConfig(noise_levels=(0.05, 0.2), realisations=2, methods=("ols", "wls", "irls", "lad", "sdp", "abc"),
+        config = MonteCarloConfig(noise_levels=(0.05, 0.2), realisations=2, estimators=("ols", "wls", "irls", "lad", "sdp", "abc"),
                                   duration=8.0, rate=100.0, maxiter=5)
         setup = _prepare(config)
         out = {}
@@ -98,16 +98,19 @@ def flatten(obj, prefix: str = "") -> dict:
     return out
 
 
-def differences(stored: dict, now: dict, renamed: dict | None = None) -> list[str]:
+def differences(stored: dict, now: dict, renamed: dict | None = None, dropped: tuple = ()) -> list[str]:
     """What differs between a stored digest and today's (every stored path must hold the same value; new paths are
-    allowed). ``renamed``: stored path prefix -> today's prefix."""
+    allowed). ``renamed``: stored path prefix -> today's prefix; ``dropped``: stored paths no longer written."""
     renamed = renamed or {}
     out = []
     for path, old in stored.items():
+        if path in dropped:
+            continue
         new_path = path
-        for a, b in renamed.items():
-            if path.startswith(a):
+        for a, b in renamed.items():  # a prefix ending in "/" renames a subtree, any other one path or its children
+            if path == a or path.startswith(a if a.endswith("/") else a + "/") or (not a.endswith("/") and path.startswith(a + "[")):
                 new_path = b + path[len(a):]
+                break
         if new_path not in now:
             out.append(f"{path}: missing")
             continue

@@ -102,7 +102,7 @@ def config_text(robot_toml: str, data_root, ident: str, validation: str, n: int,
     table = lambda f: (f'file = "{f}"\ntime = {{ column = 1 }}\npositions = {{ columns = {cols(2)} }}\n'
                        f'currents = {{ columns = {cols(2 + n)} }}\n')
     return (f'robot = "{robot_toml}"\ndata_root = "{data_root}"\n[identification]\n{table(ident)}{extra}'
-            f'[estimation]\nmethod = "ols"\n[[validation]]\nname = "validation"\n{table(validation)}'
+            f'[estimation]\nestimators = ["ols"]\n[[validation]]\nname = "validation"\n{table(validation)}'
             f'[[references]]\nname = "truth"\nfile = "truth.csv"\nformat = "standard"\nheader = true\nnames = "name"\nvalues = "value"\n')
 
 

@@ -20,13 +20,13 @@ def _check(path, kind):
     data = json.loads(path.read_text())
     errors = [f"{'/'.join(map(str, e.path))}: {e.message}" for e in _validator().iter_errors(data)]
     assert not errors, errors[:5]
-    assert data["kind"] == kind and data["schema_version"] == 1
+    assert data["kind"] == kind and data["schema_version"] == 2
 
 
 def test_run_identify_validate_excite_and_montecarlo_outputs_follow_the_schema(tmp_path):
     from .simulated_logs import simulated_case
 
-    p = dynid("run", "--methods", "ols,abc", "--bootstrap", "0", "--duration", "4", "--no-figures", "--out", str(tmp_path / "run"))
+    p = dynid("run", "--estimators", "ols,abc", "--bootstrap", "0", "--duration", "4", "--no-figures", "--out", str(tmp_path / "run"))
     assert p.returncode == 0, p.stderr
     _check(tmp_path / "run" / "results.json", "run")
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
@@ -36,7 +36,7 @@ def test_run_identify_validate_excite_and_montecarlo_outputs_follow_the_schema(t
     p = dynid("validate", str(cfg), "--results", str(tmp_path / "id" / "results.json"), "--out", str(tmp_path / "val"))
     assert p.returncode == 0, p.stderr
     _check(tmp_path / "val" / "validation.json", "validate")
-    p = dynid("montecarlo", "--realisations", "2", "--noise-levels", "0.05", "--methods", "ols", "--duration", "4",
+    p = dynid("montecarlo", "--realisations", "2", "--noise-levels", "0.05", "--estimators", "ols", "--duration", "4",
               "--rate", "100", "--workers", "1", "--out", str(tmp_path / "mc"))
     assert p.returncode == 0, p.stderr
     _check(tmp_path / "mc" / "montecarlo.json", "montecarlo")

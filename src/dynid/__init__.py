@@ -42,6 +42,7 @@ _EXPORTS = {
     "mjcf_from_robot": "dynid.io.export",
     "PaperExperimentConfig": "dynid.experiment.paper",
     "run_paper_experiment": "dynid.experiment.paper",
+    "summary": "dynid.report.summaries",
 }
 
 __all__ = ["__version__", *_EXPORTS]

@@ -20,10 +20,9 @@ def warm_up() -> None:
 
     er16 = load_robot("er16")
     regressor.compile_kernels([er16, er16.submodel(3), load_robot("ur10e"), load_robot("tx40")])
-    from .estimators.names import parse_methods
     from .experiment import PaperExperimentConfig, run_paper_experiment
 
-    run_paper_experiment(PaperExperimentConfig(duration=2.0, rate=200.0, methods=parse_methods("all"), bootstrap=2, maxiter=2))
+    run_paper_experiment(PaperExperimentConfig(duration=2.0, rate=200.0, bootstrap=2, maxiter=2))
 
 
 if __name__ == "__main__":

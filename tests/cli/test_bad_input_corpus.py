@@ -145,10 +145,10 @@ CONFIGS = {
     "min_speed of the wrong length": ("[preprocessing]\nmin_speed = [0.1, 0.1]\n", "preprocessing.min_speed"),
     "unknown preprocessing field": ("[preprocessing]\ncutof = 3\n", "cutof"),
     "excitation file missing": ("[preprocessing]\nexcitation = \"nosuch.json\"\n", "nosuch.json"),
-    "estimation method abc": ("[estimation]\nmethod = \"abc\"\n", "estimation.method"),
-    "unknown estimator": ("[estimation]\nmethods = [\"ols\", \"magic\"]\n", "estimation.methods"),
+    "estimation method (renamed)": ("[estimation]\nmethod = \"abc\"\n", "estimation.method"),
+    "unknown estimator": ("[estimation]\nestimators = [\"ols\", \"magic\"]\n", "estimation.estimators"),
     "negative seed": ("[estimation]\nseed = -1\n", "estimation.seed"),
-    "physically_consistent not a boolean": ("[estimation]\nphysically_consistent = \"yes\"\n", "estimation.physically_consistent"),
+    "estimators not a list": ("[estimation]\nestimators = \"wls\"\n", "estimation.estimators"),
     "drive gains without the loaded run": ("[drive_gains]\npayload_mass = 2.0\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "loaded"),
     "zero payload mass": ("[drive_gains]\npayload_mass = 0\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n"
                           "[drive_gains.loaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "payload_mass"),
@@ -176,7 +176,7 @@ def test_a_config_in_utf16(ur):
     assert_refused(invoke("identify", cfg, "--out", ur.folder / "o"), "c.toml: not UTF-8 text (it looks like UTF-16", ur.folder / "o")
 
 
-RUN = ["--duration", "4", "--rate", "100", "--abc-iterations", "2", "--methods", "ols,abc", "--bootstrap", "0"]
+RUN = ["--duration", "4", "--rate", "100", "--abc-iterations", "2", "--estimators", "ols,abc", "--bootstrap", "0"]
 RUN_OPTIONS = {
     "no joints": (["--joints", "0"], "--joints"),
     "zero duration": (["--duration", "0"], "--duration must be positive"),
@@ -188,7 +188,7 @@ RUN_OPTIONS = {
     "unknown plant": (["--plant", "real"], "--plant"),
     "paper plant on two joints": (["--plant", "paper", "--joints", "2"], "--plant"),
     "unknown box": (["--abc-bounds", "wide"], "--abc-bounds"),
-    "empty methods": (["--methods", ","], "--methods"),
+    "empty estimators": (["--estimators", ","], "--estimators"),
     "excitation file missing": (["--excitation", "nosuch.json"], "nosuch.json"),
     "negative smoothing passes": (["--smoothing-passes", "-1"], "--smoothing-passes"),
     "one bootstrap resample": (["--bootstrap", "1"], "--bootstrap"),
@@ -213,7 +213,7 @@ MONTECARLO = {
     "zero noise": (["--noise-levels", "0"], "--noise-levels"),
     "one realisation": (["--realisations", "1"], "--realisations"),
     "no workers": (["--workers", "0"], "--workers"),
-    "unknown estimator": (["--methods", "ols,magic"], "--methods"),
+    "unknown estimator": (["--estimators", "ols,magic"], "--estimators"),
 }
 
 

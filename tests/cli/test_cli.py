@@ -14,9 +14,9 @@ def test_run_writes_results_and_figures(tmp_path):
     assert "ρ (eq. 18)" in p.stdout and "0.3182" in p.stdout
     data = json.loads((out / "results.json").read_text())
     assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
-    assert set(data["methods"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
+    assert set(data["estimates"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
     assert "Estimators:" in p.stdout and "ABC×10" in p.stdout and "physically consistent" in p.stdout
-    assert "moving-block" in p.stdout and set(data["methods"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
+    assert "moving-block" in p.stdout and set(data["estimates"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
     assert len(list(out.glob("fig*.png"))) == 6 and len(list(out.glob("methods_*.png"))) == 2
     assert not list(out.glob(".*tmp"))
 
@@ -27,7 +27,7 @@ def test_run_writes_results_and_figures(tmp_path):
     (["--seed", "-1"], "--seed must be a non-negative integer, got -1"),
     (["--rate", "-5"], "rate"),
     (["--weights", "1,x"], "weights"),
-    (["--methods", "ols,bogus"], "--methods"),
+    (["--estimators", "ols,bogus"], "--estimators"),
     (["--bootstrap", "1"], "--bootstrap"),
 ])
 def test_bad_options_get_one_line_errors(tmp_path, args, message):
@@ -37,10 +37,10 @@ def test_bad_options_get_one_line_errors(tmp_path, args, message):
 
 def test_methods_subset_without_abc(tmp_path):
     out = tmp_path / "run"
-    p = dynid("run", "--out", str(out), *FAST, "--methods", "ols,lad", "--bootstrap", "0")
+    p = dynid("run", "--out", str(out), *FAST, "--estimators", "ols,lad", "--bootstrap", "0")
     assert p.returncode == 0, p.stderr
     data = json.loads((out / "results.json").read_text())
-    assert list(data["methods"]) == ["ols", "lad"] and "bootstrap" not in data["methods"]["ols"]
+    assert list(data["estimates"]) == ["ols", "lad"] and "bootstrap" not in data["estimates"]["ols"]
     assert not (out / "fig6_abc_convergence.png").exists() and (out / "methods_comparison.png").exists()
     # piped: one progress line per step on standard error, each once, the tables on standard output
     steps = [line for line in p.stderr.splitlines() if line.startswith("dynid run: ")]
@@ -59,7 +59,7 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path):
     import time
 
     out = tmp_path / "o"
-    proc = subprocess.Popen([sys.executable, "-m", "dynid", "run", "--out", str(out), "--methods", "abc10,de", "--bootstrap", "0"],
+    proc = subprocess.Popen([sys.executable, "-m", "dynid", "run", "--out", str(out), "--estimators", "abc10,de", "--bootstrap", "0"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "MPLBACKEND": "Agg"})
     for line in proc.stderr:  # piped: one line per step; interrupt once the estimators started
         if line.startswith("dynid run: ABC×10") or line.startswith("dynid run: DE"):
@@ -75,7 +75,7 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path):
 
 
 def test_quiet_prints_nothing_but_warnings(tmp_path):
-    p = dynid("run", "--out", str(tmp_path / "q"), *FAST, "--methods", "ols,abc", "--bootstrap", "0", "--no-figures", "--quiet")
+    p = dynid("run", "--out", str(tmp_path / "q"), *FAST, "--estimators", "ols,abc", "--bootstrap", "0", "--no-figures", "--quiet")
     assert p.returncode == 0, p.stderr
     assert p.stdout == "" and all(line.startswith("warning: ") for line in p.stderr.splitlines())
     assert "truth outside the ABC search box" in p.stderr and (tmp_path / "q" / "results.json").is_file()
@@ -108,10 +108,10 @@ def test_same_seed_gives_the_same_results_json_except_timings(tmp_path):
 
         return strip(data)
 
-    args = ("--methods", "ols,wls,abc,pso,sdp", "--bootstrap", "10", "--duration", "6", "--no-figures", "--seed", "7")
+    args = ("--estimators", "ols,wls,abc,pso,sdp", "--bootstrap", "10", "--duration", "6", "--no-figures", "--seed", "7")
     a, b = tmp_path / "a", tmp_path / "b"
     for out in (a, b):  # two processes, as two runs of a user (in one process the SDP's compiled problem is reused,
         p = dynid_process("run", "--out", str(out), *args)  # and its margin may differ in the 13th digit)
         assert p.returncode == 0, p.stderr
     assert load(a) == load(b)
-    assert json.loads((a / "results.json").read_text())["methods"]["abc"]["seconds"] >= 0  # the timings are there
+    assert json.loads((a / "results.json").read_text())["estimates"]["abc"]["seconds"] >= 0  # the timings are there

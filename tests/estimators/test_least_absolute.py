@@ -50,16 +50,15 @@ def test_a_wide_box_on_poorly_conditioned_rows_needs_one_band(monkeypatch):
     spaced pilot rows is far from the optimum there, and its band failed the check twice before the LP on
     every row was solved. The pilot is now whichever of that fit and least squares in the box fits every
     row better: the first band holds the optimum (two LPs in all), and it is the exact minimiser."""
-    from dynid.estimators.names import parse_methods
     from dynid.experiment import PaperExperimentConfig, run_paper_experiment
 
     calls = []
     real = la._dual_lp
     monkeypatch.setattr(la, "_dual_lp", lambda *a: calls.append(a) or real(*a))
-    result = run_paper_experiment(PaperExperimentConfig(methods=parse_methods("lad"), bootstrap=0, rate=200.0,
+    result = run_paper_experiment(PaperExperimentConfig(estimators=("lad",), bootstrap=0, rate=200.0,
                                                         abc_bounds="scaled"))
     w, tau, row_w, lo, hi = calls[0][:5]
     assert len(calls) == 2 and calls[1][5].size < w.shape[0] // 2
     none = np.array([], dtype=int)
     exact, _ = real(w, tau, row_w, lo, hi, np.arange(w.shape[0]), none, none)
-    np.testing.assert_allclose(result.methods["lad"].params, exact, atol=1e-8 * np.abs(exact).max())
+    np.testing.assert_allclose(result.estimates["lad"].params, exact, atol=1e-8 * np.abs(exact).max())

@@ -10,7 +10,7 @@ from dynid.io.identification_config import load_identification_config
 from dynid.experiment.identification_run import run_identification
 from dynid.model.description import load_robot
 
-from ..conftest import shared_data, sine_motion
+from ..conftest import shared_data, sine_motion, without_wall_times
 
 REPO = __import__("pathlib").Path(__file__).resolve().parents[2]
 
@@ -62,8 +62,7 @@ position_cutoff = 40.0
 decimation = 10
 chunk = 3000
 [estimation]
-method = "ols"
-physically_consistent = true
+estimators = ["ols", "sdp"]
 friction = "description"
 ''')
     cfg = load_identification_config(tmp_path / "c.toml")
@@ -77,9 +76,9 @@ friction = "description"
     assert np.all(np.abs(est - truth) <= np.maximum(4 * result.solution.params_std, 0.01 * np.abs(truth).max()))
     assert result.fit.metrics()["dynid OLS"]["relative_error"].max() < 1.0
     # the physically consistent estimate: consistent links, same base parameters, every set checked
-    sdp = result.consistent
+    sdp = result.estimates["dynid SDP"]
     assert sdp.pseudo_inertia_min_eig.min() >= -1e-7
-    np.testing.assert_allclose(sdp.base[big], truth[big], rtol=0.01)
+    np.testing.assert_allclose(sdp.params[big], truth[big], rtol=0.01)
     assert set(result.consistency) == {"dynid OLS", "dynid SDP"} and result.consistency["dynid SDP"] >= -1e-7
     assert result.fit.metrics()["dynid SDP"]["relative_error"].max() < 1.0
 
@@ -105,7 +104,7 @@ def test_ur10e_real_logs_against_the_published_parameters():
     assert result.solution.condition_number < 1e4 and np.all(np.isfinite(result.solution.relative_std))  # fcl columns: N·m scale
     # physically consistent least squares beside OLS: consistent, and as good on the validation run
     assert result.consistency["dynid SDP"] >= -1e-7 and result.consistency["Mamedov & Mikhel 2020"] >= -1e-7
-    assert result.consistent.pseudo_inertia_min_eig.min() >= -1e-7
+    assert result.estimates["dynid SDP"].pseudo_inertia_min_eig.min() >= -1e-7
     assert np.all(m["dynid SDP"]["relative_error"][:5] <= m["dynid OLS"]["relative_error"][:5] + 1.0)
 
 
@@ -148,8 +147,8 @@ def test_config_errors_name_file_and_field(tmp_path):
                    'torques = { file = "b.csv" }\n[preprocessing]\ndecimation = 0\n')
     with pytest.raises(ConfigError, match=r"preprocessing.decimation: expected an integer >= 1"):
         load_identification_config(cfg)
-    cfg.write_text('robot = "ur10e"\n[identification]\npreset = "ur-rtde"\nfile = "x.csv"\n[estimation]\nmethod = "abc"\n')
-    with pytest.raises(ConfigError, match=r"c.toml: estimation.method: expected one of ols, wls, got 'abc'"):
+    cfg.write_text('robot = "ur10e"\n[identification]\npreset = "ur-rtde"\nfile = "x.csv"\n[estimation]\nestimators = ["abc", "magic"]\n')
+    with pytest.raises(ConfigError, match=r"c.toml: estimation.estimators: expected a comma-separated subset of ols, wls, .*got \['abc', 'magic'\]"):
         load_identification_config(cfg)
     cfg.write_text('robot = "ur10e"\n[identification]\npreset = "ur-rtde"\nfile = "x.csv"\npositions = { columns = [2, 3] }\n')
     with pytest.raises(ConfigError, match=r"identification.positions.columns: expected 6 columns"):
@@ -191,7 +190,7 @@ decimation = 1
 trim = 0
 excitation = "excitation.json"
 [estimation]
-method = "ols"
+estimators = ["ols"]
 '''
     (tmp_path / "c.toml").write_text(text)
     result = run_identification(load_identification_config(tmp_path / "c.toml"))
@@ -227,12 +226,12 @@ def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch
 
     root = shared_data("ur10e_mamedov2020")
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
-    memory = run_identification(cfg).to_dict()
+    memory = without_wall_times(run_identification(cfg).to_dict())
     read = []
     monkeypatch.setattr(datasets, "SPOOL_BYTES", 0)
     original = datasets._assemble
     monkeypatch.setattr(datasets, "_assemble", lambda *a: read.append(original(*a)) or read[-1])
-    spooled = run_identification(cfg).to_dict()
+    spooled = without_wall_times(run_identification(cfg).to_dict())
     stored = {r.name for r in read if isinstance(r.q, StoredColumns) and isinstance(r.tau, StoredColumns)}
     assert stored == {"identification", *(v.name for v in cfg.validation)}  # the drive-gain runs stay in memory
     # the SDP margins to the solver's tolerance: a re-solve of cvxpy's cached problem moves them by ~1e-11

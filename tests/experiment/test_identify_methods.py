@@ -17,11 +17,11 @@ ALL = ["wls", "ols", "sdp", "irls", "lad", "abc", "abc10", "de", "pso"]
 
 def test_identify_runs_every_estimator_side_by_side(tmp_path):
     cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
-    cfg.write_text(cfg.read_text().replace('method = "ols"\n', f'methods = {json.dumps(ALL)}\nseed = 3\n'))
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', f'estimators = {json.dumps(ALL)}\nseed = 3\n'))
     config = load_identification_config(cfg)
-    assert config.method == "wls" and config.physically_consistent
+    assert config.estimators == tuple(ALL)
     result = run_identification(config)
-    labels = ["dynid WLS", "dynid SDP", "dynid OLS", "dynid IRLS", "dynid LAD", "dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"]
+    labels = ["dynid WLS", "dynid OLS", "dynid SDP", "dynid IRLS", "dynid LAD", "dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"]
     assert list(result.parameter_sets())[:9] == labels
     for cmp in (result.fit, *result.validations):
         assert set(labels) <= set(cmp.metrics())
@@ -29,17 +29,18 @@ def test_identify_runs_every_estimator_side_by_side(tmp_path):
     f = result.objective
     assert all(f["dynid LAD"] <= f[k] + 1e-9 for k in ("dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"))
     lo, hi = result.box.T
-    for o in result.others:
+    others = [e for e in result.estimates.values() if e.key != "wls"]
+    for o in others:
         if o.key in ("lad", "abc", "abc10", "de", "pso"):
             assert np.all(o.params >= lo - 1e-9) and np.all(o.params <= hi + 1e-9)
     # the least-squares family recovers the truth on this simulated log
     truth = truth_beta(result, truth_robot)
-    for o in result.others:
+    for o in others:
         if o.key in ("ols", "irls", "lad"):
             assert np.linalg.norm(o.params - truth) / np.linalg.norm(truth) < 0.02, o.key
     # the same seed gives the same box searches
     again = run_identification(config, validate=False)
-    for a, b in zip(result.others, again.others):
+    for a, b in zip(result.estimates.values(), again.estimates.values()):
         np.testing.assert_array_equal(a.params, b.params)
     # dynid validate reads every set back from results.json
     save_identification(result, tmp_path / "out")
@@ -50,8 +51,27 @@ def test_identify_runs_every_estimator_side_by_side(tmp_path):
                                result.validations[0].metrics()["dynid ABC"]["relative_error"], rtol=1e-9)
 
 
-def test_unknown_method_in_the_config_names_the_field(tmp_path):
+def test_unknown_estimator_in_the_config_names_the_field(tmp_path):
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
-    cfg.write_text(cfg.read_text().replace('method = "ols"\n', 'methods = ["wls", "magic"]\n'))
-    with pytest.raises(ConfigError, match=r"config.toml: estimation.methods: expected .*got \['wls', 'magic'\]"):
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["wls", "magic"]\n'))
+    with pytest.raises(ConfigError, match=r"config.toml: estimation.estimators: expected .*got \['wls', 'magic'\]"):
         load_identification_config(cfg)
+
+
+@pytest.mark.parametrize("old, new", [
+    ('method = "wls"\nphysically_consistent = true\n', 'estimators = ["wls", "sdp"]'),
+    ('methods = ["ols", "lad", "sdp"]\n', 'estimators = ["ols", "sdp", "lad"]'),
+    ('physically_consistent = true\n', 'estimators = ["wls", "sdp"]'),
+])
+def test_the_old_estimation_keys_say_how_to_write_them_now(tmp_path, old, new):
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', old))
+    with pytest.raises(ConfigError) as err:
+        load_identification_config(cfg)
+    assert "no longer exists" in str(err.value) and str(err.value).endswith(new) and "\n" not in str(err.value)
+
+
+def test_estimator_names_are_case_insensitive(tmp_path):
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["OLS", "Wls"]\n'))
+    assert load_identification_config(cfg).estimators == ("ols", "wls")

@@ -48,7 +48,7 @@ def _case(folder, motion, dry, controller, seed):
     table = lambda rows: (f'file = "log.csv"\ntime = {{ column = 1 }}\npositions = {{ columns = {cols(2)} }}\n'  # noqa: E731
                           f'torques = {{ columns = {cols(8)} }}\nrows = [{rows[0]}, {rows[1]}]\ngaps = "interpolate"\n')
     (folder / "config.toml").write_text(
-        f'robot = "ur10e"\ndata_root = "{folder}"\n[identification]\n{table((1, half))}[estimation]\nmethod = "ols"\n'
+        f'robot = "ur10e"\ndata_root = "{folder}"\n[identification]\n{table((1, half))}[estimation]\nestimators = ["ols"]\n'
         f'[[validation]]\nname = "validation"\n{table((half + 1, len(log.t)))}[[references]]\nname = "truth"\n'
         'file = "truth.csv"\nformat = "standard"\nheader = true\nnames = "name"\nvalues = "value"\n')
     return folder / "config.toml", log, half

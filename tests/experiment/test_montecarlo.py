@@ -6,7 +6,7 @@ import pytest
 from dynid.exceptions import ConfigError
 from dynid.experiment.montecarlo import MonteCarloConfig, _prepare, run_montecarlo, simulate_realisation
 
-SMALL = MonteCarloConfig(noise_levels=(0.05, 0.4), realisations=12, methods=("ols", "wls", "abc"), duration=8.0,
+SMALL = MonteCarloConfig(noise_levels=(0.05, 0.4), realisations=12, estimators=("ols", "wls", "abc"), duration=8.0,
                          rate=100.0, maxiter=3)
 
 
@@ -51,15 +51,15 @@ def test_same_seed_same_study(study):
     again = run_montecarlo(MonteCarloConfig(**{**SMALL.__dict__, "realisations": 3}), workers=1)
     np.testing.assert_array_equal(again.estimates, study.estimates[:, :3])
     d = study.to_dict()
-    assert d["methods"]["ols"]["levels"][1]["noise_level_A"] == 0.4
-    assert set(d["methods"]["abc"]["levels"][0]) >= {"bias", "std", "std_over_crb", "failures"}
+    assert d["estimates"]["ols"]["levels"][1]["noise_level_A"] == 0.4
+    assert set(d["estimates"]["abc"]["levels"][0]) >= {"bias", "std", "std_over_crb", "failures"}
 
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"noise_levels": ()}, "noise_levels"),
     ({"noise_levels": (0.0,)}, "noise_levels"),
     ({"realisations": 1}, "realisations"),
-    ({"methods": ("ols", "magic")}, "methods"),
+    ({"estimators": ("ols", "magic")}, "estimators"),
     ({"joints": 9}, "joints"),
 ])
 def test_bad_settings(kwargs, message):

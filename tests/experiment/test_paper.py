@@ -11,51 +11,51 @@ FAST = dict(duration=10.0, rate=200.0, maxiter=5)
 def test_ols_recovers_truth_exactly_from_noise_free_pipeline():
     cfg = PaperExperimentConfig(current_noise=0.0, encoder_resolution=0.0, smoothing_passes=0, **FAST)
     r = run_paper_experiment(cfg)
-    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-8, atol=1e-8)
-    assert r.methods["ols"].objective < 1e-8
+    np.testing.assert_allclose(r.estimates["ols"].params, r.truth, rtol=1e-8, atol=1e-8)
+    assert r.estimates["ols"].objective < 1e-8
 
 
 def test_noisy_run_is_reproducible_and_sane():
     cfg = PaperExperimentConfig(**FAST)
     a, b = run_paper_experiment(cfg), run_paper_experiment(cfg)
     for k in ("abc", "ols"):
-        np.testing.assert_array_equal(a.methods[k].params, b.methods[k].params)
-    ols = a.methods["ols"]
+        np.testing.assert_array_equal(a.estimates[k].params, b.estimates[k].params)
+    ols = a.estimates["ols"]
     assert np.all(ols.metrics["correlation"]["validation"] > 0.99)
-    lad = a.methods["lad"]
-    assert lad.objective <= a.methods["abc"].objective + 1e-9  # LAD is the exact minimum of eq. 9 in the box
+    lad = a.estimates["lad"]
+    assert lad.objective <= a.estimates["abc"].objective + 1e-9  # LAD is the exact minimum of eq. 9 in the box
     d = a.to_dict()
-    for key in ("robot", "joints", "parameters", "truth", "methods"):
+    for key in ("robot", "joints", "parameters", "truth", "estimates"):
         assert key in d
     for m in ("abc", "lad", "ols"):
-        assert set(d["methods"][m]) >= {"params", "objective", "correlation", "rmse", "seconds"}
-        assert len(d["methods"][m]["correlation"]["validation"]) == 3
-    assert len(d["methods"]["abc"]["history"]) == 5
+        assert set(d["estimates"][m]) >= {"params", "objective", "correlation", "rmse", "seconds"}
+        assert len(d["estimates"][m]["correlation"]["validation"]) == 3
+    assert len(d["estimates"]["abc"]["history"]) == 5
 
 
 def test_all_methods_compared_honestly_and_reproducibly():
     """Every box search is bounded below by LAD's exact minimum of eq. 9; the SDP result is physically
     consistent; the same seed gives identical results, whichever other methods run beside."""
-    from dynid.estimators.registry import METHODS
+    from dynid.estimators.registry import keys
 
     cfg = PaperExperimentConfig(bootstrap=20, **FAST)
     a = run_paper_experiment(cfg)
-    assert tuple(a.methods) == METHODS
-    lad = a.methods["lad"].objective
+    assert tuple(a.estimates) == keys()
+    lad = a.estimates["lad"].objective
     for k in ("abc", "abc10", "de", "pso"):
-        assert lad <= a.methods[k].objective + 1e-9
-        assert a.methods[k].n_evaluations > 0
-    assert a.methods["abc10"].n_evaluations > 5 * a.methods["abc"].n_evaluations
-    assert a.methods["sdp"].pseudo_inertia_min_eig.min() >= -1e-8
-    assert a.truth_consistency_margin > 0 and a.methods["sdp"].consistency_margin >= -1e-7
+        assert lad <= a.estimates[k].objective + 1e-9
+        assert a.estimates[k].n_evaluations > 0
+    assert a.estimates["abc10"].n_evaluations > 5 * a.estimates["abc"].n_evaluations
+    assert a.estimates["sdp"].pseudo_inertia_min_eig.min() >= -1e-8
+    assert a.truth_consistency_margin > 0 and a.estimates["sdp"].consistency_margin >= -1e-7
     truth_norm = np.linalg.norm(a.truth)
-    assert np.linalg.norm(a.methods["sdp"].params - a.truth) / truth_norm < 0.05
-    ols = a.methods["ols"]
+    assert np.linalg.norm(a.estimates["sdp"].params - a.truth) / truth_norm < 0.05
+    ols = a.estimates["ols"]
     assert np.all(ols.bootstrap["lower"] < ols.params) and np.all(ols.params < ols.bootstrap["upper"])
-    b = run_paper_experiment(PaperExperimentConfig(bootstrap=20, methods=("pso", "ols"), **FAST))
+    b = run_paper_experiment(PaperExperimentConfig(bootstrap=20, estimators=("pso", "ols"), **FAST))
     for k in ("pso", "ols"):
-        np.testing.assert_array_equal(a.methods[k].params, b.methods[k].params)
-    np.testing.assert_array_equal(a.methods["ols"].bootstrap["std"], b.methods["ols"].bootstrap["std"])
+        np.testing.assert_array_equal(a.estimates[k].params, b.estimates[k].params)
+    np.testing.assert_array_equal(a.estimates["ols"].bootstrap["std"], b.estimates["ols"].bootstrap["std"])
 
 
 def test_paper_plant_uses_table2():
@@ -63,7 +63,7 @@ def test_paper_plant_uses_table2():
                                                    smoothing_passes=0, **FAST))
     truth = dict(zip(r.base.names, r.truth))
     assert truth["ZZ1R"] == ref.TABLE2["I_zz1"] and truth["fv3"] == ref.TABLE2["f_v3"]
-    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-7, atol=1e-7)
+    np.testing.assert_allclose(r.estimates["ols"].params, r.truth, rtol=1e-7, atol=1e-7)
     assert any("fc2" in w for w in r.warnings)  # Table 2's f_c2 = 11.02 lies outside Table 3's [-10, 10]
 
 
@@ -77,7 +77,7 @@ def test_paper_plant_uses_table2():
     (dict(weights=(1.0, 2.0, 1.0)), "weights"),
     (dict(abc_bounds="wide"), "abc_bounds"),
     (dict(joints=6, abc_bounds="table3"), "table3"),
-    (dict(methods=("ols", "nope")), "methods"),
+    (dict(estimators=("ols", "nope")), "estimators"),
     (dict(bootstrap=1), "bootstrap"),
 ])
 def test_bad_settings(kwargs, message):
@@ -89,7 +89,7 @@ def test_bad_settings(kwargs, message):
 def test_six_joints_run_with_scaled_bounds():
     r = run_paper_experiment(PaperExperimentConfig(joints=6, **FAST))
     assert r.base.n_base == 48
-    assert np.all(r.methods["ols"].metrics["correlation"]["identification"] > 0.9)
+    assert np.all(r.estimates["ols"].metrics["correlation"]["identification"] > 0.9)
 
 
 def test_trajectories_within_er16_limits():
@@ -116,18 +116,18 @@ def test_optimized_excitation_run_has_at_most_half_the_cond_of_beta1_and_is_repr
     assert ex["trajectory"].startswith("optimized")
     assert ex["cond_base_regressor"] <= 0.5 * ex["cond_base_regressor_beta1"]
     assert not [w for w in a.warnings if "limits" in w or "tau_max" in w]  # within the er16's limits
-    np.testing.assert_array_equal(a.methods["ols"].params, b.methods["ols"].params)
+    np.testing.assert_array_equal(a.estimates["ols"].params, b.estimates["ols"].params)
 
 
 def test_a_robot_with_coupled_motors_is_simulated_with_its_coupling():
     """The TX40's wrist motors are coupled (extra standard parameters beyond the joints' own): the
     simulation's truth includes their torques, so the noise-free pipeline's OLS recovers the truth
     (the simulation used to reshape the parameter vector per joint and stop with a ValueError)."""
-    cfg = PaperExperimentConfig(robot="tx40", joints=6, methods=("ols",), bootstrap=0, current_noise=0.0,
+    cfg = PaperExperimentConfig(robot="tx40", joints=6, estimators=("ols",), bootstrap=0, current_noise=0.0,
                                 encoder_resolution=0.0, smoothing_passes=0, **FAST)
     r = run_paper_experiment(cfg)
     assert r.robot.n_params > r.robot.n_dof * r.robot.n_params_per_joint  # coupled-motor parameters present
-    np.testing.assert_allclose(r.methods["ols"].params, r.truth, rtol=1e-6, atol=1e-6 * np.abs(r.truth).max())
+    np.testing.assert_allclose(r.estimates["ols"].params, r.truth, rtol=1e-6, atol=1e-6 * np.abs(r.truth).max())
 
 
 def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_columns():
@@ -145,7 +145,12 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     args = (robot, base, paper_validation_trajectory(0.1 * np.pi, 6), t, NoiseModel(0.05, 1e-5))
     rest = (robot.standard_parameters(), 2, "validation", [])
     alone = simulate_dataset(*args, np.random.default_rng(4), *rest)
-    kept = simulate_dataset(*args, np.random.default_rng(4), *rest, keep_standard=True)
-    assert alone.w_standard is None and kept.w_standard is not None
+    from dynid.estimators.estimation import Estimation
+    from dynid.estimators.registry import FitData
+    from dynid.dynamics.layout import consistency_layout
+
+    with_sdp = Estimation(("ols", "sdp"), FitData(None, None, 6, None, base, layout=consistency_layout(robot)), keep_rows=True)
+    kept = simulate_dataset(*args, np.random.default_rng(4), *rest, with_sdp)
+    assert with_sdp.standard and with_sdp.streamed["sdp"].accumulator_.n_params == robot.n_params
     np.testing.assert_allclose(alone.w_base, kept.w_base, rtol=1e-12, atol=1e-12 * np.abs(kept.w_base).max())
     np.testing.assert_array_equal(alone.tau, kept.tau)

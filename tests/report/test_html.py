@@ -33,7 +33,7 @@ def _parse(path):
 def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
     from ..simulated_logs import simulated_case
 
-    p = dynid("run", "--methods", "ols,abc", "--bootstrap", "0", "--duration", "4", "--out", str(tmp_path / "run"))
+    p = dynid("run", "--estimators", "ols,abc", "--bootstrap", "0", "--duration", "4", "--out", str(tmp_path / "run"))
     assert p.returncode == 0, p.stderr
     report = _parse(tmp_path / "run" / "report.html")
     pngs = sorted((tmp_path / "run").glob("*.png"))
@@ -43,7 +43,7 @@ def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
     assert "0.3182" in text and "ABC" in text and "numpy" in text and "Pinocchio" in text
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
-    cfg.write_text(cfg.read_text().replace('method = "ols"\n', 'method = "ols"\nphysically_consistent = true\n'))
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
     p = dynid("identify", str(cfg), "--out", str(tmp_path / "id"))
     assert p.returncode == 0, p.stderr
     report = _parse(tmp_path / "id" / "report.html")

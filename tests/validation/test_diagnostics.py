@@ -97,7 +97,7 @@ def test_a_well_fitted_simulated_log_has_no_finding_and_a_counterbalance_is_foun
         write_truth(folder / "truth.csv", robot, robot.parameter_names)
         cfg = folder / "config.toml"
         cfg.write_text(config_text(robot_toml("er16", folder), folder, "ident.csv", "valid.csv", robot.n_dof)
-                       .replace('method = "ols"', 'method = "ols"\nfriction = "description"'))
+                       .replace('estimators = ["ols"]', 'estimators = ["ols"]\nfriction = "description"'))
         cases[spring] = run_identification(load_identification_config(cfg), validate=False)
     assert [f.kind for f in cases[0.0].findings if f.kind in ("position", "friction", "sign")] == []
     assert any(f.kind == "position" and f.joint == 1 for f in cases[40.0].findings), cases[40.0].findings

@@ -67,7 +67,7 @@ def test_stribeck_and_load_dependent_friction_are_found_where_they_are(tmp_path)
     plain = np.asarray(result.settings["friction_models"]["plain_out_of_fold_rms_error"])
     assert chosen[1] < 0.8 * plain[1] and chosen[2] < 0.9 * plain[2]
     # the plain model, identified on the same log, predicts the validation log worse on those joints
-    cfg.write_text(cfg.read_text().replace('method = "ols"', 'method = "ols"\nfriction = "description"'))
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ols"]\nfriction = "description"'))
     plain_result = run_identification(load_identification_config(cfg))
     auto_err = result.validations[0].metrics()["dynid OLS"]["relative_error"]
     plain_err = plain_result.validations[0].metrics()["dynid OLS"]["relative_error"]

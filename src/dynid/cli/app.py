@@ -21,7 +21,7 @@ QUIET = typer.Option(False, "--quiet", "-q", help="Print only warnings and error
 
 OPTIONS = {"out": "--out", "seed": "--seed", "joints": "--joints", "plant": "--plant", "abc_bounds": "--abc-bounds",
            "smoothing_passes": "--smoothing-passes", "bootstrap": "--bootstrap", "weights": "--weights",
-           "excitation": "--excitation", "methods": "--methods", "noise_levels": "--noise-levels",
+           "excitation": "--excitation", "estimators": "--estimators", "noise_levels": "--noise-levels",
            "realisations": "--realisations", "scheduler": "--scheduler", "workers": "--workers", "data_root": "--data-root",
            "file": "--file", "robot": "--robot", "duration": "--duration", "rate": "--rate", "current_noise": "--current-noise",
            "colony_size": "--abc-colony", "limit": "--abc-limit", "maxiter": "--abc-iterations", "starts": "--starts"}
@@ -58,6 +58,12 @@ def _check_out(out) -> None:
     from ..report.output import check_output_folder
 
     check_output_folder(out)
+
+
+def _renamed(methods: Optional[str]) -> None:
+    """``--methods`` was renamed ``--estimators``: a one-line message, not a usage error."""
+    if methods is not None:
+        raise DynIdError(f"--methods is now --estimators (the same values): --estimators {methods}")
 
 
 def _parse_weights(text: Optional[str]):
@@ -100,7 +106,8 @@ def run(
     abc_bounds: str = typer.Option("auto", help="ABC search box: auto, table3 (paper Table 3) or scaled (±(2|β_OLS|+1))."),
     weights: Optional[str] = typer.Option(None, help="Eq. 9 weights per joint, comma separated (default all 1)."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized (designed for the run, min cond), or an excitation.json of dynid excite."),
-    methods: str = typer.Option("all", help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default all)."),
+    estimators: str = typer.Option("all", help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, or any registered (default all)."),
+    methods: Optional[str] = typer.Option(None, hidden=True),
     bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
     figures: bool = typer.Option(True, help="Write the figures (--no-figures: results.json only)."),
     quiet: bool = QUIET,
@@ -108,22 +115,23 @@ def run(
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
     from ..experiment import PaperExperimentConfig, run_paper_experiment
-    from ..estimators.names import LABELS, parse_methods
+    from ..estimators.registry import label, parse_estimators
     from ..report.output import figure_process
     from ..report.paper_run import save_paper_run
 
     rep = Reporter(quiet)
     try:
+        _renamed(methods)
         _check_out(out)
         config = PaperExperimentConfig(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
-            excitation=excitation, methods=parse_methods(methods), bootstrap=bootstrap)
+            excitation=excitation, estimators=parse_estimators(estimators), bootstrap=bootstrap)
         with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
             with rep.progress("dynid run") as progress:
                 result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
-                    LABELS.get(k, k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
+                    label(k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
                 progress.update("writing results" + (" and figures" if figures else ""))
             paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
     except DynIdError as exc:
@@ -158,7 +166,9 @@ def identify(
             paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
-    rep.blocks(result.summary_blocks())
+    from ..report.summaries import identification_blocks
+
+    rep.blocks(identification_blocks(result))
     rep.wrote(paths)
 
 
@@ -309,8 +319,9 @@ def montecarlo(
     joints: int = typer.Option(3, help="Number of joints identified."),
     noise_levels: str = typer.Option("0.02,0.05,0.1", help="Motor current noise standard deviations [A], comma separated."),
     realisations: int = typer.Option(100, help="Noise realisations per level."),
-    methods: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
-                                                     "or all (default: ols,wls,irls,lad,sdp,abc)."),
+    estimators: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
+                                                        "any registered, or all (default: ols,wls,irls,lad,sdp,abc)."),
+    methods: Optional[str] = typer.Option(None, hidden=True),
     seed: int = typer.Option(0, help="Seed of every random number of the study."),
     duration: float = typer.Option(25.0, help="Recording length [s]."),
     rate: float = typer.Option(200.0, help="Sampling rate [Hz] (the paper: 1000)."),
@@ -322,15 +333,16 @@ def montecarlo(
     quiet: bool = QUIET,
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
-    from ..estimators.names import parse_methods
-    from ..experiment.montecarlo import DEFAULT_METHODS, MonteCarloConfig, run_montecarlo
+    from ..estimators.registry import parse_estimators
+    from ..experiment.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 
     rep = Reporter(quiet)
     try:
+        _renamed(methods)
         _check_out(out)
         cfg = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
-                               methods=DEFAULT_METHODS if methods is None else parse_methods(methods), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
+                               estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
                                excitation=excitation)
         with rep.progress("dynid montecarlo") as progress:
             progress.update("starting the workers")

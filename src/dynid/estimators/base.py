@@ -160,6 +160,120 @@ class Estimator:
         return 1.0 - float(res @ res) / float(((tau - tau.mean()) ** 2).sum())
 
 
+class AccumulatingEstimator(Estimator):
+    """Base of the estimators that can learn from rows given chunk by chunk (``partial_fit``), so that memory does
+    not grow with the log: the rows of each joint are folded into a triangular factor
+    (:class:`dynid.estimators.accumulate.LeastSquaresAccumulator`), and the solution is computed from the factors
+    when a learned attribute is first read (or :meth:`solve` is called) after the last ``partial_fit``.
+
+    Subclasses implement ``_solve(accumulator)``, which sets the learned attributes. They take ``n_dof=None``
+    (joints per sample: inferred from ``tau`` given as (N, n_dof), else 1).
+    """
+
+    n_dof: int | None = None
+    needs_joints = False
+    """Whether the estimator weighs the joints' rows apart (then ``n_dof`` or ``tau`` as (N, n_dof) is required)."""
+
+    def partial_fit(self, w, tau, mask=None, *, names=None) -> "AccumulatingEstimator":
+        """Fold rows into the estimate.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation rows, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array
+            Torques [N·m].
+        mask : (M,) bool array, optional
+            Rows to use (e.g. those fast enough).
+        names : sequence of str, optional
+            The parameters' names (said when the data do not excite some of them).
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, a number of parameters that changed between calls, or non-finite values.
+        """
+        from .accumulate import LeastSquaresAccumulator
+
+        w = np.asarray(w, dtype=np.float64)
+        if w.ndim != 2:
+            raise ShapeError(f"expected W with shape (N*n_dof, n_params), got {w.shape}")
+        acc = self.__dict__.get("accumulator_")
+        if acc is None:
+            shape = np.shape(tau)
+            if self.n_dof is not None or len(shape) == 2 or not self.needs_joints:
+                n = self.n_dof if self.n_dof is not None else (shape[1] if len(shape) == 2 else 1)
+            else:
+                n = infer_n_dof(None, tau)  # raises: the rows' joints are needed
+            acc = LeastSquaresAccumulator(w.shape[1], n)
+            self.accumulator_ = acc
+            self.n_dof_ = int(n)
+        self._forget()
+        if names is not None:
+            self.names_in_ = tuple(names)
+        acc.add(w, tau, mask)
+        return self
+
+    def fit(self, w, tau):
+        """Fit on all rows at once: ``partial_fit`` on a fresh accumulator, then :meth:`solve`.
+
+        Parameters
+        ----------
+        w : (M, p) array
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+        """
+        w, tau_flat = check_observations(w, tau, self.n_dof)
+        self.__dict__.pop("accumulator_", None)
+        self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat)
+        return self.solve()
+
+    def solve(self) -> "AccumulatingEstimator":
+        """Compute the learned attributes from the rows folded in so far.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        AttributeError
+            No rows were given yet.
+        """
+        acc = self.__dict__.get("accumulator_")
+        if acc is None:
+            raise AttributeError(f"{type(self).__name__} has no rows yet: call fit or partial_fit first")
+        self._solve(acc)
+        self.__dict__["_solved"] = True
+        return self
+
+    def _solve(self, acc) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _forget(self) -> None:
+        """Drop the learned attributes of an earlier solution (new rows came)."""
+        keep = {"accumulator_", "n_dof_", "names_in_"}
+        for name in [k for k in self.__dict__ if k.endswith("_") and not k.startswith("_") and k not in keep]:
+            del self.__dict__[name]
+        self.__dict__["_solved"] = False
+
+    def __getattr__(self, name: str):
+        # a learned attribute read after partial_fit: solve once, then it is an ordinary attribute
+        if name.endswith("_") and not name.startswith("_") and not self.__dict__.get("_solved", True) \
+                and "accumulator_" in self.__dict__:
+            self.solve()
+            if name in self.__dict__:
+                return self.__dict__[name]
+        raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
+
+
 class BoxSearchEstimator(Estimator):
     """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
 

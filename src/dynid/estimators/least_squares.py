@@ -1,47 +1,66 @@
-"""Ordinary least squares with parameter standard deviations (Gautier & Khalil)."""
+"""Ordinary and weighted least squares with parameter standard deviations (Gautier & Khalil), on all rows at once
+(``fit``) or chunk by chunk (``partial_fit``: memory independent of the log's length)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .accumulate import LeastSquaresAccumulator
-from .base import Estimator, check_observations, infer_n_dof
+from .base import AccumulatingEstimator
 
 
-class OrdinaryLeastSquares(Estimator):
+class OrdinaryLeastSquares(AccumulatingEstimator):
     """OLS: ``params_ = argmin ||tau - W p||²``.
 
-    Learned attributes
-    ------------------
+    Parameters
+    ----------
+    n_dof : int or None
+        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau given as
+        (N, n_dof), else 1 (then :attr:`joint_std_` is the residual's standard deviation over all rows).
+    rcond : float or None
+        Singular values below ``rcond`` × the largest count as zero (rank deficiency); default
+        ``max(M, p) · eps``.
+
+    Attributes
+    ----------
     params_ : (p,) array
     covariance_ : (p, p) array
         ``sigma² (WᵀW)⁻¹`` with ``sigma² = ||r||² / (M - p)``.
     residual_std_ : float
-        ``sigma``.
+        ``sigma`` [N·m].
     params_std_ : (p,) array
     relative_std_ : (p,) array
         ``100 · std / |param|`` [%].
     condition_number_ : float
         cond(W).
+    joint_std_ : (n_dof,) array
+        Residual standard deviation of each joint [N·m].
+    solution_ : dynid.estimators.accumulate.LeastSquaresSolution
+        All of the above as one object.
 
     Raises
     ------
     IdentifiabilityError
         If ``W`` is rank-deficient (the data do not excite every parameter).
+
+    Notes
+    -----
+    Ref.: M. Gautier, W. Khalil, "Exciting trajectories for the identification of base inertial parameters of
+    robots", IJRR 11(4), 1992 (σ of the estimates).
     """
 
-    def __init__(self, *, rcond: float | None = None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None):
+        self.n_dof = n_dof
         self.rcond = rcond
 
-    def fit(self, w, tau) -> "OrdinaryLeastSquares":
-        w, tau = check_observations(w, tau)
-        acc = LeastSquaresAccumulator(w.shape[1])
-        acc.add(w, tau)
-        _set_solution(self, acc.solve(rcond=self.rcond))
-        return self
+    def _solve(self, acc) -> None:
+        sol = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"))
+        _set_solution(self, sol)
+        self.ols_params_ = sol.params
+        self.joint_std_ = acc.joint_residual_std(sol.params)
 
 
 def _set_solution(est, sol) -> None:
+    est.solution_ = sol
     est.params_ = sol.params
     est.covariance_ = sol.covariance
     est.params_std_ = sol.params_std
@@ -50,34 +69,48 @@ def _set_solution(est, sol) -> None:
     est.residual_std_ = sol.residual_std
 
 
-class WeightedLeastSquares(Estimator):
+class WeightedLeastSquares(AccumulatingEstimator):
     """WLS with one weight per joint: each joint's rows are divided by that joint's residual standard
-    deviation from a first OLS fit (Gautier & Poignet 2001, the paper's ref. [6]).
+    deviation from a first OLS fit.
 
     Parameters
     ----------
     n_dof : int or None
         Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau
         given as (N, n_dof).
+    rcond : float or None
+        As :class:`OrdinaryLeastSquares`.
 
-    Learned attributes
-    ------------------
-    params_, covariance_, params_std_, relative_std_, condition_number_ (of the weighted W),
-    joint_std_ : (n_dof,) residual standard deviation of each joint [N·m].
+    Attributes
+    ----------
+    params_, covariance_, params_std_, relative_std_, residual_std_, condition_number_, solution_
+        As :class:`OrdinaryLeastSquares`, of the weighted problem.
+    ols_params_ : (p,) array
+        The first (OLS) fit.
+    joint_std_ : (n_dof,) array
+        Residual standard deviation of each joint in the OLS fit [N·m]; the weights are their inverses
+        (1 where a joint's is 0).
+
+    Raises
+    ------
+    IdentifiabilityError
+        If ``W`` is rank-deficient.
+
+    Notes
+    -----
+    Ref.: M. Gautier, P. Poignet, "Extended Kalman filtering and weighted least squares dynamic identification of
+    robot", Control Engineering Practice 9(12), 2001 (the paper's ref. [6]).
     """
+
+    needs_joints = True
 
     def __init__(self, *, n_dof: int | None = None, rcond: float | None = None):
         self.n_dof = n_dof
         self.rcond = rcond
 
-    def fit(self, w, tau) -> "WeightedLeastSquares":
-        self.n_dof_ = infer_n_dof(self.n_dof, tau)
-        w, tau = check_observations(w, tau, self.n_dof_)
-        acc = LeastSquaresAccumulator(w.shape[1], self.n_dof_)
-        acc.add(w, tau)
-        ols = acc.solve(rcond=self.rcond)
+    def _solve(self, acc) -> None:
+        ols = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"))
         std = acc.joint_residual_std(ols.params)
-        std = np.where(std > 0, std, 1.0)
-        _set_solution(self, acc.solve(1.0 / std, rcond=self.rcond))
+        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond))
+        self.ols_params_ = ols.params
         self.joint_std_ = std
-        return self

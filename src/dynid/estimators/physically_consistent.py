@@ -18,14 +18,14 @@ import numpy as np
 
 from ..exceptions import DynIdError, ShapeError
 from ..model.spatial import pseudo_inertia
-from .base import Estimator, check_observations
+from .base import AccumulatingEstimator, check_observations
 
 CONSISTENCY_TOL = 1e-7
 """Base parameters count as physically consistent when their :func:`consistency_margin` is >= -1e-7
 (the solver's accuracy), and an SDP result when its smallest pseudo-inertia eigenvalue is."""
 
 
-class PhysicallyConsistentLeastSquares(Estimator):
+class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
 
     Parameters
@@ -41,9 +41,13 @@ class PhysicallyConsistentLeastSquares(Estimator):
         directions and fixes the unidentifiable ones at the prior's values.
     epsilon : float
         Smallest eigenvalue allowed for each pseudo-inertia [kg·m², kg].
+    n_dof : int or None
+        Joints per sample (rows given chunk by chunk by ``partial_fit`` are folded per joint).
+    joint_weights : (n_dof,) array or None
+        Weight of each joint's rows when solving rows given by ``partial_fit`` (e.g. the WLS weights); default 1.
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_ : (p,) array
         Standard parameters.
     pseudo_inertia_min_eig_ : (n_links,) array
@@ -59,14 +63,41 @@ class PhysicallyConsistentLeastSquares(Estimator):
         If the layout does not fit ``W``.
     """
 
-    def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0):
+    def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
+                 n_dof: int | None = None, joint_weights=None):
         self.links = links
         self.nonnegative = nonnegative
         self.prior = prior
         self.prior_weight = prior_weight
         self.epsilon = epsilon
+        self.n_dof = n_dof
+        self.joint_weights = joint_weights
 
     def fit(self, w, tau) -> "PhysicallyConsistentLeastSquares":
+        """Solve the SDP on all rows at once (their QR factor).
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Standard observation matrix.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+        """
+        self.__dict__.pop("accumulator_", None)
+        self._fit_rows(w, tau)
+        self.__dict__["_solved"] = True
+        return self
+
+    def _solve(self, acc) -> None:
+        """The SDP on the accumulated triangular factor ``[R | z]`` of the (joint-weighted) rows."""
+        p = acc.n_params
+        reduced = acc.reduced(self.joint_weights)
+        self._fit_rows(reduced[:, :p], reduced[:, p])
+
+    def _fit_rows(self, w, tau) -> None:
         import cvxpy as cp
 
         w, tau = check_observations(w, tau)
@@ -91,7 +122,6 @@ class PhysicallyConsistentLeastSquares(Estimator):
         self.params_ = np.asarray(phi.value, dtype=float)
         self.status_ = problem.status
         self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])
-        return self
 
 
 def _reduced_least_squares(w: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

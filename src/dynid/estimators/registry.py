@@ -1,36 +1,57 @@
-"""The one registry of estimators used by ``dynid run``, ``identify``, ``validate`` and ``montecarlo``.
+"""The one registry of estimators, used by ``dynid run``, ``identify``, ``validate``, ``montecarlo`` and the API.
 
-Each method has a short key, a label for tables and one way to be built from a :class:`FitData`:
+Each estimator has a key (case-insensitive), a label for tables, a description, and is built from a
+:class:`FitData` (what it sees of the problem: the observation rows, the joints, the search box, the eq. 9
+weights, the SDP's prior and layout). Built in:
 
 - ``ols``, ``wls``, ``irls``: least squares, per-joint weighted least squares, Huber IRLS;
 - ``lad``: the exact minimiser of eq. 9 over the search box (a linear program);
 - ``sdp``: physically consistent least squares over the standard parameters, reported as base parameters;
-- ``abc``: the artificial bee colony at the paper's budget (Ns = 30, limit = 15, Tmax = 50);
+- ``abc``: the artificial bee colony of §3.1 at the paper's budget (Ns = 30, limit = 15, Tmax = 50);
 - ``abc10``: the same with 10× the iterations;
 - ``de``, ``pso``: differential evolution and particle swarm on eq. 9 over the same box, each given the
   evaluation budget of ``abc10`` (``10 · Ns · Tmax``).
+
+A new estimator is one file that subclasses :class:`dynid.estimators.base.Estimator` and calls :func:`register`;
+every command and :class:`dynid.Identifier` can then use its key. Reading the keys (a config check) imports
+no solver: the built-in classes load when first built.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
+import inspect
 import math
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Any, Callable, Iterable
 
-import numpy as np
-
-from ..dynamics.base_parameters import BaseParameters
-from .base import Estimator
 from ..exceptions import ConfigError
-from .names import BOOTSTRAPPED, BOX_SEARCHES, DESCRIPTIONS, LABELS, METHODS, parse_methods
 
-__all__ = ["BOOTSTRAPPED", "BOX_SEARCHES", "DESCRIPTIONS", "LABELS", "METHODS", "parse_methods", "SearchBudget", "FitData",
-           "Fitted", "make_estimator", "fit_method"]
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..dynamics.base_parameters import BaseParameters
+    from .base import Estimator
+
+__all__ = ["EstimatorSpec", "SearchBudget", "FitData", "Fitted", "register", "unregister", "spec", "keys", "label",
+           "parse_estimators", "make_estimator", "fit_method", "fit_methods"]
+
 
 @dataclass(frozen=True)
 class SearchBudget:
-    """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations."""
+    """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations.
+
+    Attributes
+    ----------
+    colony_size : int
+        ABC's ``Ns`` (employed plus onlooker bees); PSO's swarm size.
+    limit : int
+        ABC's scout limit.
+    maxiter : int
+        ABC's ``Tmax``.
+    """
 
     colony_size: int = 30
     limit: int = 15
@@ -38,137 +59,401 @@ class SearchBudget:
 
     @property
     def evaluations(self) -> int:
+        """Evaluations of eq. 9 given to DE and PSO: ``10 · colony_size · maxiter``."""
         return 10 * self.colony_size * self.maxiter
 
 
 @dataclass
 class FitData:
-    """What the estimators see of one identification recording.
+    """What the estimators see of one identification problem.
 
     Attributes
     ----------
-    w_base : (N·n_dof, n_base) array
-        Base observation matrix, rows sample-major.
-    tau : (N·n_dof,) array
-        Measured torques [N·m].
+    w_base : (M, n_base) array, or None
+        Base observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j`` (None when the rows were streamed
+        into the estimators that accumulate, and none needs them in memory).
+    tau : (M,) array or None
+        Measured torques [N·m], same rows.
     n_dof : int
-    bounds : (n_base, 2) array
+        Joints per sample.
+    bounds : (n_base, 2) array or None
         Search box of the box searches and LAD.
-    base : BaseParameters
-    w_standard : (N·n_dof, p) array, optional
-        Standard observation matrix (needed by ``sdp`` only).
+    base : BaseParameters or None
+        The base-parameter map (``sdp`` maps its standard estimate through it).
+    w_standard : (M, p) array, optional
+        Standard observation matrix (estimators of the standard space, ``sdp``, fitted on arrays).
     layout : tuple, optional
         ``(links, nonnegative)`` of :func:`dynid.dynamics.layout.consistency_layout` (``sdp``).
     prior : (p,) array, optional
         Standard parameters the SDP pulls unidentifiable directions towards.
     weights : (n_dof,) array, optional
         ``delta`` of eq. 9.
+    joint_weights : (n_dof,) array, optional
+        Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
+        estimate on real logs).
     """
 
-    w_base: np.ndarray
-    tau: np.ndarray
+    w_base: Any
+    tau: Any
     n_dof: int
-    bounds: np.ndarray
-    base: BaseParameters
-    w_standard: np.ndarray | None = None
+    bounds: Any
+    base: "BaseParameters | None"
+    w_standard: Any = None
     layout: tuple | None = None
-    prior: np.ndarray | None = None
-    weights: np.ndarray | None = None
+    prior: Any = None
+    weights: Any = None
+    joint_weights: Any = None
 
 
-@dataclass
-class Fitted:
-    """One method's fit: base parameters, the fitted estimator, wall time and evaluations of eq. 9."""
+Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
+
+
+@dataclass(frozen=True)
+class EstimatorSpec:
+    """How the registry knows an estimator.
+
+    Attributes
+    ----------
+    key : str
+        Lower-case name used in configs, on the command line and in :class:`dynid.Identifier`.
+    label : str
+        Shown in tables and figures (``"dynid <label>"`` names its estimate).
+    description : str
+        One line for reports.
+    build : callable or str
+        ``build(data, budget, rng, callback) -> Estimator``, or an :class:`~dynid.estimators.base.Estimator`
+        subclass (its keyword hyper-parameters named ``n_dof``, ``bounds``, ``weights``, ``prior``, ``links``,
+        ``nonnegative``, ``joint_weights``, ``rng`` and ``callback`` are filled from the problem), or
+        ``"module:attribute"`` of either (imported when first built).
+    space : {"base", "standard"}
+        The parameters it estimates: base parameters, or standard ones (mapped to the base by the pipeline).
+    cost : float
+        Relative fitting time: the longest start first, so that two cores finish together.
+    needs_box : bool
+        It searches the box :attr:`FitData.bounds` (the pipeline builds one around the least-squares estimate).
+    bootstrapped : bool
+        Cheap enough to refit on every bootstrap resample.
+    options : dict
+        Fixed hyper-parameters passed to the class.
+    """
 
     key: str
-    params: np.ndarray
-    estimator: Estimator
-    seconds: float
-    n_evaluations: int | None
+    label: str
+    description: str
+    build: Any
+    space: str = "base"
+    cost: float = 1.0
+    needs_box: bool = False
+    bootstrapped: bool = False
+    options: dict = dataclasses.field(default_factory=dict)
+
+    def builder(self) -> Builder:
+        """The callable that builds an unfitted estimator from :class:`FitData`."""
+        target = self.build
+        if isinstance(target, str):
+            module, _, attr = target.partition(":")
+            target = getattr(importlib.import_module(module, __package__), attr)
+        if isinstance(target, type):
+            return _from_class(target, self.options)
+        return target
 
 
-def make_estimator(key: str, data: FitData, budget: SearchBudget, rng: np.random.Generator,
-                   callback: Callable[[int, float], None] | None = None) -> Estimator:
-    """An unfitted estimator of method ``key`` for ``data`` (``rng`` seeds the box searches)."""
-    n, wts, box = data.n_dof, data.weights, data.bounds
-    if key in ("ols", "wls"):  # each estimator's module (and its solver) is imported on first use
-        from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback")
 
-        return OrdinaryLeastSquares() if key == "ols" else WeightedLeastSquares(n_dof=n)
-    if key == "irls":
-        from .robust import IterativelyReweightedLeastSquares
 
-        return IterativelyReweightedLeastSquares(n_dof=n)
-    if key == "lad":
-        from .least_absolute import LeastAbsoluteDeviations
+def _from_class(cls: type, options: dict) -> Builder:
+    """A builder that passes the problem's matching keyword hyper-parameters to ``cls`` (see :class:`EstimatorSpec`)."""
+    accepted = set(inspect.signature(cls).parameters)
 
-        return LeastAbsoluteDeviations(n_dof=n, weights=wts, bounds=box)
-    if key == "sdp":
-        from .physically_consistent import PhysicallyConsistentLeastSquares
+    def build(data: FitData, budget: SearchBudget, rng, callback):
+        values = {"n_dof": data.n_dof, "bounds": data.bounds, "weights": data.weights, "prior": data.prior,
+                  "joint_weights": data.joint_weights, "rng": rng, "callback": callback}
+        if data.layout is not None:
+            values.update(links=data.layout[0], nonnegative=data.layout[1])
+        kwargs = {k: v for k, v in values.items() if k in accepted and (k in _FILLED or v is not None)}
+        return cls(**{**kwargs, **options})
 
-        if data.w_standard is None or data.layout is None:
-            raise ConfigError("method sdp needs the standard observation matrix and the parameter layout")
-        links, nonneg = data.layout
-        return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior)
-    if key in ("abc", "abc10"):
-        from .bee_colony import BeeColonyEstimator
+    return build
 
-        iters = budget.maxiter * (10 if key == "abc10" else 1)
-        return BeeColonyEstimator(bounds=box, n_dof=n, weights=wts, colony_size=budget.colony_size, limit=budget.limit,
-                                  maxiter=iters, rng=rng, callback=callback)
-    from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
 
-    if key == "pso":
-        return ParticleSwarmEstimator(bounds=box, n_dof=n, weights=wts, swarm_size=budget.colony_size,
-                                      maxiter=max(1, budget.evaluations // budget.colony_size - 1), rng=rng, callback=callback)
-    if key == "de":
-        p = box.shape[0]
+def _box_search(kind: str, iterations: int = 1) -> Builder:
+    """Builder of a box search at the budget of :class:`SearchBudget` (ABC: ``iterations`` × Tmax; DE and PSO:
+    :attr:`SearchBudget.evaluations`)."""
+
+    def build(data: FitData, budget: SearchBudget, rng, callback):
+        n, wts, box = data.n_dof, data.weights, data.bounds
+        if kind == "abc":
+            from .bee_colony import BeeColonyEstimator
+
+            return BeeColonyEstimator(bounds=box, n_dof=n, weights=wts, colony_size=budget.colony_size, limit=budget.limit,
+                                      maxiter=budget.maxiter * iterations, rng=rng, callback=callback)
+        from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
+
+        if kind == "pso":
+            return ParticleSwarmEstimator(bounds=box, n_dof=n, weights=wts, swarm_size=budget.colony_size,
+                                          maxiter=max(1, budget.evaluations // budget.colony_size - 1), rng=rng, callback=callback)
+        p = len(box)
         popsize = max(1, math.ceil(budget.colony_size / p))
         return DifferentialEvolutionEstimator(bounds=box, n_dof=n, weights=wts, popsize=popsize,
                                               maxiter=max(1, budget.evaluations // (popsize * p) - 1), rng=rng, callback=callback)
-    raise ConfigError(f"unknown method {key!r}; expected one of {', '.join(METHODS)}")
+
+    return build
 
 
-def fit_method(key: str, data: FitData, budget: SearchBudget, rng: np.random.Generator,
-               callback: Callable[[int, float], None] | None = None) -> Fitted:
-    """Fit method ``key`` and return its base parameters (the SDP's standard set mapped to the base).
+def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> "Estimator":
+    from .physically_consistent import PhysicallyConsistentLeastSquares
+
+    if data.layout is None:
+        raise ConfigError("estimator sdp needs the parameter layout of the robot (links and non-negative columns)")
+    links, nonneg = data.layout
+    return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior, n_dof=data.n_dof,
+                                            joint_weights=data.joint_weights)
+
+
+_REGISTRY: dict[str, EstimatorSpec] = {}
+
+
+def register(key: str, build, *, label: str | None = None, description: str = "", space: str = "base",
+             cost: float = 1.0, needs_box: bool = False, bootstrapped: bool = False, replace: bool = False,
+             **options) -> EstimatorSpec:
+    """Make an estimator known to every command and to :class:`dynid.Identifier` under ``key``.
+
+    Parameters
+    ----------
+    key : str
+        Its name (case-insensitive: stored in lower case); letters, digits and ``_``.
+    build : Estimator subclass, callable or "module:attribute"
+        See :attr:`EstimatorSpec.build`.
+    label, description, space, cost, needs_box, bootstrapped
+        See :class:`EstimatorSpec` (``label`` defaults to ``key`` in upper case).
+    replace : bool
+        Replace an estimator registered under the same key (else a ``ValueError``).
+    **options
+        Fixed hyper-parameters of the class.
+
+    Returns
+    -------
+    EstimatorSpec
+
+    Raises
+    ------
+    ValueError
+        A malformed key, an unknown ``space``, or a key already registered (without ``replace``).
+
+    Examples
+    --------
+    >>> from dynid.estimators import Estimator, register
+    >>> class Ridge(Estimator):
+    ...     def __init__(self, *, alpha=1e-3):
+    ...         self.alpha = alpha
+    ...     def fit(self, w, tau):
+    ...         import numpy as np
+    ...         self.params_ = np.linalg.solve(w.T @ w + self.alpha * np.eye(w.shape[1]), w.T @ tau)
+    ...         return self
+    >>> spec = register("ridge", Ridge, description="ridge regression")
+    """
+    k = str(key).strip().lower()
+    if not k or not k.replace("_", "").isalnum():
+        raise ValueError(f"estimator key: expected letters, digits and _, got {key!r}")
+    if space not in ("base", "standard"):
+        raise ValueError(f"estimator {k}: space must be 'base' or 'standard', got {space!r}")
+    if k in _REGISTRY and not replace:
+        raise ValueError(f"estimator {k!r} is registered already (pass replace=True to replace it)")
+    entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options))
+    _REGISTRY[k] = entry
+    return entry
+
+
+def unregister(key: str) -> None:
+    """Forget the estimator ``key`` (a ``KeyError`` if unknown)."""
+    del _REGISTRY[str(key).strip().lower()]
+
+
+register("ols", ".least_squares:OrdinaryLeastSquares", label="OLS", description="ordinary least squares", cost=0.2,
+         bootstrapped=True)
+register("wls", ".least_squares:WeightedLeastSquares", label="WLS", description="weighted least squares, one weight per joint",
+         cost=0.1, bootstrapped=True)
+register("irls", ".robust:IterativelyReweightedLeastSquares", label="IRLS",
+         description="iteratively reweighted least squares (Huber)", cost=0.4)
+register("lad", ".least_absolute:LeastAbsoluteDeviations", label="LAD",
+         description="least absolute deviations: exact minimum of eq. 9 in the search box (HiGHS)", cost=6, needs_box=True)
+register("sdp", _sdp, label="SDP", space="standard", cost=5,
+         description="physically consistent least squares (SDP, cvxpy + Clarabel), prior: nominal parameters × U(0.7, 1.3)")
+register("abc", _box_search("abc"), label="ABC", description="artificial bee colony, the paper's budget", cost=0.3,
+         needs_box=True)
+register("abc10", _box_search("abc", 10), label="ABC×10", description="artificial bee colony, 10× the paper's iterations",
+         cost=7, needs_box=True)
+register("de", _box_search("de"), label="DE", description="differential evolution (SciPy), the budget of ABC×10", cost=9,
+         needs_box=True)
+register("pso", _box_search("pso"), label="PSO", description="particle swarm (constriction), the budget of ABC×10", cost=8,
+         needs_box=True)
+
+LEAST_SQUARES = ("ols", "wls")
+"""The least-squares estimates that carry σ; one of them is the reference of every identification (the first of
+these in the list of estimators, else WLS): its residuals give each joint's noise, its σ the search box."""
+
+
+def spec(key: str) -> EstimatorSpec:
+    """The registered estimator ``key`` (case-insensitive).
 
     Raises
     ------
     ConfigError
-        ``sdp`` without ``w_standard`` and ``layout``, or an unknown key.
+        An unknown key (the message lists the known ones).
+    """
+    k = str(key).strip().lower()
+    try:
+        return _REGISTRY[k]
+    except KeyError:
+        raise ConfigError(f"unknown estimator {key!r}; expected one of {', '.join(_REGISTRY)}", field="estimators") from None
+
+
+def keys() -> tuple[str, ...]:
+    """Every registered key, the built-in ones first, in registration order."""
+    return tuple(_REGISTRY)
+
+
+def label(key: str) -> str:
+    """The table label of ``key`` (``"WLS"``, ``"ABC×10"``); anything else as it is."""
+    entry = _REGISTRY.get(str(key).strip().lower())
+    return entry.label if entry is not None else str(key)
+
+
+def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...] | None = None) -> tuple[str, ...]:
+    """Keys from ``"ols,abc"`` or a sequence, case-insensitive; ``None`` gives ``default`` (every registered key
+    when ``default`` is None) and ``"all"`` every registered key.
+
+    Raises
+    ------
+    ConfigError
+        Unknown, repeated or no estimator (field ``estimators``).
+    """
+    if text is None:
+        return default if default is not None else keys()
+    if isinstance(text, str) and text.strip().lower() == "all":
+        return keys()
+    items = text.split(",") if isinstance(text, str) else list(text)
+    if not all(isinstance(k, str) for k in items):
+        raise ConfigError(f"estimators: expected names of estimators, got {text!r}", field="estimators")
+    found = [k.strip().lower() for k in items]
+    unknown = [k for k in found if k not in _REGISTRY]
+    if unknown or not found:
+        raise ConfigError(f"estimators: expected a comma-separated subset of {', '.join(_REGISTRY)} (or all), got {text!r}",
+                          field="estimators")
+    if len(set(found)) != len(found):
+        raise ConfigError(f"estimators: each estimator once, got {text!r}", field="estimators")
+    return tuple(found)
+
+
+def seed_index(key: str) -> int:
+    """Position of ``key`` in the registry: with the run's seed it seeds the estimator's own generator, so that
+    adding estimators to a run leaves the others' results as they were."""
+    return keys().index(spec(key).key)
+
+
+@dataclass
+class Fitted:
+    """One estimator's fit.
+
+    Attributes
+    ----------
+    key : str
+    params : (n_base,) array
+        Base parameters (a standard-space estimator's mapped through the base-parameter map).
+    estimator : Estimator
+        The fitted estimator (its learned attributes: ``params_std_``, ``history_``, …).
+    seconds : float
+        Wall time of the fit [s].
+    n_evaluations : int or None
+        Evaluations of eq. 9 (box searches only).
+    """
+
+    key: str
+    params: "np.ndarray"
+    estimator: "Estimator"
+    seconds: float
+    n_evaluations: int | None
+
+
+def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
+                   callback: Callable[[int, float], None] | None = None) -> "Estimator":
+    """An unfitted estimator ``key`` for ``data`` (``rng`` seeds the box searches).
+
+    Raises
+    ------
+    ConfigError
+        Unknown key, or ``sdp`` without the parameter layout.
+    """
+    return spec(key).builder()(data, budget, rng, callback)
+
+
+def finish(key: str, est: "Estimator", data: FitData, seconds: float) -> Fitted:
+    """A fitted estimator as :class:`Fitted`: its parameters in the base (a standard-space estimator's mapped)."""
+    import numpy as np
+
+    params = est.params_
+    if spec(key).space == "standard":
+        if data.base is None:
+            raise ConfigError(f"estimator {key} estimates standard parameters: the base-parameter map is needed")
+        params = data.base.base_from_standard(params)
+    return Fitted(spec(key).key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
+
+
+def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
+               callback: Callable[[int, float], None] | None = None, estimator: "Estimator | None" = None) -> Fitted:
+    """Fit estimator ``key`` on ``data`` and return its base parameters.
+
+    ``estimator``: one built and fed already (rows streamed by ``partial_fit``): only its solution is computed here.
+
+    Raises
+    ------
+    ConfigError
+        Unknown key, or a standard-space estimator without ``w_standard`` (or a base map).
     DynIdError
         From the estimator (rank deficiency, solver failure).
     """
-    est = make_estimator(key, data, budget, rng, callback)
+    entry = spec(key)
     t0 = time.perf_counter()
-    if key == "sdp":
-        est.fit(data.w_standard, data.tau)
-        params = data.base.base_from_standard(est.params_)
+    if estimator is not None:
+        est = estimator.solve() if hasattr(estimator, "solve") else estimator
     else:
-        est.fit(data.w_base, data.tau)
-        params = est.params_
-    seconds = time.perf_counter() - t0
-    return Fitted(key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
+        est = make_estimator(key, data, budget, rng, callback)
+        w = data.w_standard if entry.space == "standard" else data.w_base
+        if w is None:
+            raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
+        est.fit(w, data.tau)
+    return finish(key, est, data, time.perf_counter() - t0)
 
 
-COST_ORDER = ("de", "pso", "abc10", "lad", "sdp", "irls", "abc", "ols", "wls")
-"""Methods from the longest to the shortest fit (measured on dynid run): the pool starts the long ones first,
-so that two cores finish together."""
-
-
-def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress: Callable[[str, int, float], None] | None = None,
-                workers: int | None = None, extra: dict | None = None) -> dict:
-    """Fit every method of ``keys``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
+def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs: dict, progress=None,
+                workers: int | None = None, extra: dict | None = None, fed: dict | None = None) -> dict:
+    """Fit every estimator of ``keys_``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
     and numba, which release the GIL).
 
-    Each method draws from its own generator ``rngs[key]``, so the results depend neither on the order nor
-    on the number of workers; each ``seconds`` is that method's wall time while the others ran.
-    ``progress(key, iteration, best)`` reports the box searches (and ``(key, None, None)`` as a method starts).
-    ``extra`` (name -> callable without arguments) adds independent tasks to the same pool, started after
-    the three longest fits (their results are returned under their names).
-    Returns key -> :class:`Fitted` in the order of ``keys``, then the extra tasks' results.
+    Parameters
+    ----------
+    keys_ : sequence of str
+    data : FitData
+    budget : SearchBudget
+    rngs : dict
+        key -> generator of that estimator: the results depend neither on the order nor on the number of workers.
+    progress : callable, optional
+        ``progress(key, iteration, best)`` reports the box searches (and ``(key, None, None)`` as a fit starts).
+    workers : int, optional
+        Threads (default: the cores).
+    extra : dict, optional
+        name -> callable without arguments: independent tasks run in the same pool, after the three longest fits.
+    fed : dict, optional
+        key -> estimator already fed by ``partial_fit``: only solved.
 
+    Returns
+    -------
+    dict
+        key -> :class:`Fitted` in the order of ``keys_``, then the extra tasks' results under their names.
+        Each ``seconds`` is that fit's wall time while the others ran.
+
+    Notes
+    -----
     When a fit fails, or this thread is interrupted (Ctrl-C), the box searches stop at their next iteration,
     the fits not started are cancelled, and the error is raised once the running ones have ended.
     """
@@ -177,6 +462,8 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
 
     from ..threads import cores
 
+    keys_ = tuple(keys_)
+    fed = fed or {}
     stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration
 
     def fit(key):
@@ -191,11 +478,10 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
             if progress is not None:
                 progress(key, i, f)
 
-        return fit_method(key, data, budget, rngs[key], callback)
+        return fit_method(key, data, budget, rngs.get(key), callback, fed.get(key))
 
     extra = extra or {}
-    rank = {k: i for i, k in enumerate(COST_ORDER)}
-    tasks = [(rank[k], k, lambda k=k: fit(k)) for k in keys] + [(2.5, name, f) for name, f in extra.items()]
+    tasks = [(-spec(k).cost, k, lambda k=k: fit(k)) for k in keys_] + [(-6.5, name, f) for name, f in extra.items()]
     tasks.sort(key=lambda task: task[0])
     pool = ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(tasks))))
     try:
@@ -212,7 +498,7 @@ def fit_methods(keys, data: FitData, budget: SearchBudget, rngs: dict, progress:
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown()
-    return {**{key: done[key] for key in keys}, **{name: done[name] for name in extra}}
+    return {**{key: done[key] for key in keys_}, **{name: done[name] for name in extra}}
 
 
 class _Stopped(Exception):

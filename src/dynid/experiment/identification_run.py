@@ -117,7 +117,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = identify(robot, base, data, config.method, refs, progress, config.physically_consistent, config.methods, config.seed,
+        result = identify(robot, base, data, config.estimators, refs, progress, config.seed,
                           held_out=validate and not config.validation)
         if gains is not None:
             step("drive gains and payload")
@@ -148,11 +148,11 @@ def _main_estimate(result) -> dict:
         err = v.metrics()[label]["global_relative_error"]
         moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: its friction is unknown
         findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread, label)
+    from .identification import SDP_LABEL
+
     main = result.main or label
     consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
-    if result.consistent is not None and not consistent and result.validations:
-        from .identification import SDP_LABEL
-
+    if SDP_LABEL in result.estimates and main == label and not consistent and result.validations:
         own = np.mean([v.metrics()[label]["global_relative_error"] for v in result.validations])
         sdp = np.mean([v.metrics()[SDP_LABEL]["global_relative_error"] for v in result.validations])
         if sdp < own:
@@ -165,43 +165,43 @@ def _main_estimate(result) -> dict:
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
                    progress=None) -> tuple[tuple, tuple[str, ...]]:
-    """Validate identified base parameters (``identified``: results.json of ``dynid identify``) and the
-    config's reference sets on the config's validation datasets (or on ``datasets``).
+    """Validate identified base parameters and the config's reference sets on the config's validation datasets (or on
+    ``datasets``).
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    identified : dict
+        The results.json of ``dynid identify`` (every estimate in it is scored).
+    datasets : tuple of DatasetSpec, optional
+        Logs to validate on instead of the config's ``[[validation]]`` ones.
+    progress : callable, optional
+        ``progress(step, done, total)``.
+
+    Returns
+    -------
+    comparisons : tuple of TorqueComparison
+    warnings : tuple of str
 
     Raises
     ------
     DataError
-        The results do not belong to this robot (different base parameters).
+        Results that do not belong to this robot (different base parameters), or malformed.
+    ConfigError
+        No log to validate on.
     """
     from ..dynamics.base_parameters import base_parameters
+    from ..io.results import stored_estimates
     from ..model.friction_model import robot_from_settings
-    from .identification import parameter_sets
 
     try:
         config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
     except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
         raise DataError(f"results: settings: {exc}") from None
     base = base_parameters(config.robot, rng=0)
-    try:
-        names = [p["name"] for p in identified["base_parameters"]]
-        values = np.array([float(p["value"]) for p in identified["base_parameters"]])
-        method = str(identified.get("method", "ls"))
-    except (KeyError, TypeError, ValueError):
-        raise DataError("results: expected the results.json of dynid identify (a list base_parameters of {name, value})") from None
-    if tuple(names) != base.names:
-        raise DataError(f"results: its base parameters ({len(names)}) are not those of robot {config.robot.name!r} ({base.n_base}); was it identified with this config?")
+    estimates = stored_estimates(identified, base.names, "results", config.robot.name)
     refs = _references(config, base)
-    consistent = identified.get("physically_consistent")
-    try:
-        sdp = None if consistent is None else np.array([float(consistent["values"][n]) for n in base.names])
-    except (KeyError, TypeError, ValueError):
-        raise DataError("results: physically_consistent.values must give every base parameter") from None
-    stored = identified.get("methods", {})
-    try:
-        others = {str(label): np.array([float(m["values"][n]) for n in base.names]) for label, m in stored.items()}
-    except (KeyError, TypeError, ValueError, AttributeError):
-        raise DataError("results: methods.*.values must give every base parameter") from None
-    sets = parameter_sets(method, values, refs, sdp, others)
+    sets = {**estimates, **{r.name: r.beta for r in refs}}
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
@@ -216,17 +216,17 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
 
 @with_single_blas_thread
 def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
-                         method: str = "wls", physically_consistent: bool = False, methods: tuple[str, ...] = (),
-                         name: str = "arrays"):
+                         estimators=("wls",), name: str = "arrays", friction: str = "description"):
     """Identify a robot from arrays, without a config file or a CSV: the same pipeline as ``dynid identify``
-    (data-derived preprocessing, parallel filtering, OLS/WLS with σ, optionally the SDP and other estimators).
+    (data-derived preprocessing, parallel filtering, the estimators, the verdict).
 
     Parameters
     ----------
     robot : Robot
         E.g. :func:`dynid.load_robot`.
     t : (N,) array [s]
-        Uniformly sampled time stamps.
+        Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step,
+        as the log readers do (with a warning).
     q : (N, n_dof) array [rad]
         Joint positions.
     tau : (N, n_dof) array [N·m]
@@ -235,8 +235,12 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         Measured velocities (default: differentiated from the filtered positions).
     preprocessing : Preprocessing, optional
         Default: every setting derived from the data.
-    method, physically_consistent, methods
-        As ``[estimation]`` of a config.
+    estimators : sequence of str
+        As ``[estimation] estimators`` of a config (the first is the main estimate).
+    name : str
+        The dataset's name in tables and messages.
+    friction : {"description", "auto"}
+        The robot's friction terms as described, or each joint's model chosen by cross-validation.
 
     Returns
     -------
@@ -247,12 +251,14 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     ShapeError
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
-        Time stamps that are not uniform and increasing.
+        Time stamps that do not increase, or a gap longer than 5 median steps.
+    ConfigError
+        An unknown estimator.
     """
     from ..checks import check_trajectory_array
     from ..dynamics.base_parameters import base_parameters
     from ..exceptions import ShapeError
-    from ..io.datasets import Recording
+    from ..io.datasets import GAP_FACTOR, Recording, resampled, uniform_rate
     from ..preprocessing.pipeline import prepare
     from .identification import identify
 
@@ -263,9 +269,34 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     if not (q.shape[0] == tau.shape[0] == t.shape[0] and (dq is None or dq.shape[0] == t.shape[0])):
         raise ShapeError(f"expected t, q, tau (and dq) with the same number of samples, got {t.shape[0]}, {q.shape[0]}, {tau.shape[0]}")
     steps = np.diff(t)
-    if t.size < 2 or np.any(steps <= 0) or np.ptp(steps) > 1e-6 * np.median(steps):
-        raise DataError("t: expected uniformly spaced, increasing time stamps (resample the data first)")
-    rate = 1.0 / float(np.median(steps))
-    data = prepare(Recording(name, t - t[0], q, dq, tau, rate), preprocessing or Preprocessing())
+    if t.size < 2 or not np.all(np.isfinite(t)) or np.any(steps <= 0):
+        raise DataError("t: expected finite, increasing time stamps")
+    median = float(np.median(steps))
+    if np.any(steps > GAP_FACTOR * median):
+        k = int(np.argmax(steps))
+        raise DataError(f"t: a gap of {steps[k]:.3g} s after {t[k] - t[0]:.3f} s (median step {median:.3g} s): give the parts "
+                        "on each side of it separately")
+    warnings: tuple[str, ...] = ()
+    rate = uniform_rate(t)
+    if np.ptp(steps) > 1e-6 * median:
+        signals = {"q": q, "tau": tau, **({} if dq is None else {"dq": dq})}
+        t, signals = resampled(t, signals, rate)
+        q, tau, dq = signals["q"], signals["tau"], signals.get("dq")
+        warnings = (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated onto a "
+                    f"uniform grid at {rate:.6g} Hz",)
+    else:
+        rate = 1.0 / median
+    recording = Recording(name, t - t[0], q, dq, tau, rate, warnings)
+    settings = preprocessing or Preprocessing()
+    data = prepare(recording, settings)
     base = base_parameters(robot, rng=0)
-    return identify(robot, base, data, method, (), None, physically_consistent or "sdp" in methods, tuple(methods), held_out=True)
+    if friction == "auto":
+        from ..validation.friction_models import choose_friction
+
+        choice = choose_friction(robot, data)
+        robot = choice.robot(robot)
+        data = data.with_rest_model(choice.rest_friction(), data.settings.presliding)
+        base = base_parameters(robot, rng=0)
+    elif friction != "description":
+        raise ConfigError(f'friction: expected "description" or "auto", got {friction!r}', field="friction")
+    return identify(robot, base, data, estimators, (), None, held_out=True)

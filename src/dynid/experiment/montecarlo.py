@@ -37,13 +37,14 @@ from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..exceptions import ConfigError, DynIdError
 from ..model.description import load_robot
 from ..simulation.measurements import NoiseModel
-from ..estimators.registry import LABELS, METHODS, SearchBudget, fit_method, parse_methods
-from .paper import PaperExperimentConfig, fit_data, identification_trajectory, search_box, simulate_dataset
+from ..estimators.estimation import Estimation
+from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
+from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
 from ..tables import Line, TextTable, render_text
 from ..threads import with_single_blas_thread
 
-DEFAULT_METHODS = ("ols", "wls", "irls", "lad", "sdp", "abc")
-"""The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with methods."""
+DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
+"""The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with estimators."""
 
 
 @dataclass(frozen=True)
@@ -60,8 +61,8 @@ class MonteCarloConfig:
         Motor current noise standard deviations [A], each > 0.
     realisations : int
         Noise realisations per level (>= 2; the issue's study uses >= 100).
-    methods : tuple of str
-        Estimators (keys of :data:`dynid.estimators.registry.METHODS`).
+    estimators : tuple of str
+        Estimators (keys of :mod:`dynid.estimators.registry`).
     seed : int
     duration, rate : float
         Recording length [s] and sampling rate [Hz] (default 25 s at 200 Hz; the paper records at 1 kHz).
@@ -84,7 +85,7 @@ class MonteCarloConfig:
     joints: int = 3
     noise_levels: tuple[float, ...] = (0.02, 0.05, 0.1)
     realisations: int = 100
-    methods: tuple[str, ...] = DEFAULT_METHODS
+    estimators: tuple[str, ...] = DEFAULT_ESTIMATORS
     seed: int = 0
     duration: float = 25.0
     rate: float = 200.0
@@ -103,7 +104,7 @@ class MonteCarloConfig:
             robot=self.robot, joints=self.joints, seed=self.seed, duration=self.duration, rate=self.rate,
             omega_f=self.omega_f, current_noise=level, encoder_resolution=self.encoder_resolution,
             smoothing_passes=self.smoothing_passes, colony_size=self.colony_size, limit=self.limit, maxiter=self.maxiter,
-            abc_bounds=self.abc_bounds, excitation=self.excitation, methods=tuple(self.methods), bootstrap=0)
+            abc_bounds=self.abc_bounds, excitation=self.excitation, estimators=tuple(self.estimators), bootstrap=0)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
@@ -112,7 +113,7 @@ class MonteCarloConfig:
             raise ConfigError(f"noise_levels: expected positive current noise levels in A like 0.02,0.05, got {list(self.noise_levels)}", field="noise_levels")
         if self.realisations < 2:
             raise ConfigError(f"realisations must be at least 2, got {self.realisations}", field="realisations")
-        parse_methods(self.methods)
+        parse_estimators(self.estimators)
 
 
 @dataclass
@@ -161,17 +162,19 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     cfg = setup.config
     level = float(cfg.noise_levels[level_index])
     rng = np.random.default_rng([cfg.seed, 10, level_index, realisation])
+    keys = parse_estimators(cfg.estimators)
+    estimation = Estimation(keys, problem(setup.run, setup.robot, setup.base), setup.base.names, keep_rows=True)
     ds = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t, NoiseModel(level, cfg.encoder_resolution), rng,
-                          setup.phi_true, cfg.smoothing_passes, "identification", [], keep_standard="sdp" in cfg.methods)
+                          setup.phi_true, cfg.smoothing_passes, "identification", [], estimation)
     bounds = search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
-    data = fit_data(setup.run, setup.robot, setup.base, ds, bounds)
     budget = SearchBudget(cfg.colony_size, cfg.limit, cfg.maxiter)
-    params = np.full((len(cfg.methods), setup.base.n_base), np.nan)
-    seconds = np.zeros(len(cfg.methods))
+    params = np.full((len(keys), setup.base.n_base), np.nan)
+    seconds = np.zeros(len(keys))
     errors = {}
-    for i, key in enumerate(cfg.methods):
+    for i, key in enumerate(keys):
+        generator = np.random.default_rng([cfg.seed, 11, level_index, realisation, seed_index(key)])
         try:
-            fit = fit_method(key, data, budget, np.random.default_rng([cfg.seed, 11, level_index, realisation, METHODS.index(key)]))
+            fit = estimation.fit(bounds, {key: generator}, budget, keys=(key,), workers=1)[key]
         except DynIdError as exc:
             errors[key] = str(exc)
             continue
@@ -206,7 +209,7 @@ class MonteCarloResult:
         """Per method key: arrays (n_levels, n_base) ``mean``, ``bias``, ``std``, ``rmse``, ``std_over_crb``,
         ``bias_over_crb`` and ``failures`` (n_levels,), over the realisations that succeeded."""
         out = {}
-        for m, key in enumerate(self.config.methods):
+        for m, key in enumerate(self.config.estimators):
             est = self.estimates[:, :, m, :]
             ok = np.all(np.isfinite(est), axis=2)
             mean = np.array([est[li][ok[li]].mean(axis=0) if ok[li].sum() else np.full(self.truth.size, np.nan) for li in range(est.shape[0])])
@@ -228,7 +231,7 @@ class MonteCarloResult:
             "noise_levels_A": levels,
             "cluster": self.cluster,
             "cramer_rao_std": [dict(zip(names, row.tolist())) for row in self.crb_std],
-            "methods": {key: {"label": LABELS[key], "levels": [
+            "estimates": {key: {"label": label(key), "levels": [
                 {"noise_level_A": lv, "failures": int(s["failures"][li]), "seconds_median": float(s["seconds_median"][li]),
                  **{stat: dict(zip(names, s[stat][li].tolist())) for stat in ("mean", "bias", "std", "rmse", "std_over_crb")},
                  "median_std_over_crb": float(np.nanmedian(s["std_over_crb"][li])),
@@ -244,9 +247,9 @@ class MonteCarloResult:
         nonzero = np.abs(self.truth) > 1e-9 * np.abs(self.truth).max()
         rows, ends = [], set()
         for li, level in enumerate(cfg.noise_levels):
-            for key in cfg.methods:
+            for key in cfg.estimators:
                 s = stats[key]
-                rows.append((f"{level:g}", LABELS[key], *(f"{f(s[k][li]):.3g}" for k, f in (
+                rows.append((f"{level:g}", label(key), *(f"{f(s[k][li]):.3g}" for k, f in (
                     ("std_over_crb", np.nanmedian), ("std_over_crb", np.nanmax), ("bias_over_crb", np.nanmedian), ("bias_over_crb", np.nanmax))),
                     f"{100 * np.nanmedian(s['rmse'][li][nonzero] / np.abs(self.truth[nonzero])):.3g}",
                     str(int(s["failures"][li])), f"{s['seconds_median'][li]:.3g}"))
@@ -323,7 +326,7 @@ def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: 
 
     t0 = time.perf_counter()
     setup = _prepare(config)
-    n_levels, n_real, n_methods = len(config.noise_levels), config.realisations, len(config.methods)
+    n_levels, n_real, n_methods = len(config.noise_levels), config.realisations, len(config.estimators)
     estimates = np.full((n_levels, n_real, n_methods, setup.base.n_base), np.nan)
     seconds = np.zeros((n_levels, n_real, n_methods))
     errors = []

@@ -1,10 +1,12 @@
 """The paper's identification experiment, end to end (§3-4), on a simulated robot.
 
-Model → base parameters → excitation β1 (eq. 14) → simulated currents (eq. 16) → eq. 17 smoothing and
-Fourier-fit derivatives → the estimators of :mod:`dynid.estimators.registry` (ABC of eqs. 7-13 at the paper's
-budget and 10× it, DE and PSO on the same objective and box, LAD = the exact minimiser of eq. 9 in that box,
-OLS, WLS, IRLS, physically consistent least squares) → correlation coefficient (eq. 18), RMSE and relative
-error on β1 and on the validation trajectory β2, parameter error against the truth, bootstrap intervals.
+Model → base parameters → excitation β1 (eq. 14) → simulated currents (eq. 16) → the pipeline every command
+shares: the preprocessing strategy "paper" (eq. 17 smoothing and Fourier-fit derivatives,
+:mod:`dynid.preprocessing.paper_smoothing`) → the estimators of :mod:`dynid.estimators.registry` fed from its rows
+(:class:`dynid.estimators.estimation.Estimation`: ABC of eqs. 7-13 at the paper's budget and 10× it, DE and PSO on
+the same objective and box, LAD = the exact minimiser of eq. 9 in that box, OLS, WLS, IRLS, physically consistent
+least squares) → correlation coefficient (eq. 18), RMSE and relative error on β1 and on the validation trajectory
+β2, parameter error against the truth, bootstrap intervals.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..dynamics.regressor import regressor
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
+from ..estimators.estimation import Estimation, stacked_rows, stream_rows
 from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
@@ -30,11 +33,13 @@ from ..excitation.paper_trajectories import (PAPER_DURATION, PAPER_OMEGA_F, PAPE
                                             paper_validation_trajectory)
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing import five_point_cubic_smoothing, fourier_fit_derivatives
+from ..io.datasets import Recording
+from ..preprocessing.pipeline import base_chunks, prepare
+from ..preprocessing.settings import Preprocessing
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
-from ..estimators.registry import BOOTSTRAPPED, DESCRIPTIONS, LABELS, METHODS, FitData, SearchBudget, fit_methods, make_estimator, parse_methods
+from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
 from ..tables import render_text
 from ..threads import with_single_blas_thread
 
@@ -78,8 +83,8 @@ class PaperExperimentConfig:
         Identification trajectory: "paper" (β1, eq. A.1), "optimized" (designed for this run by
         :func:`dynid.excitation.design.design_excitation`: 5 harmonics at ``omega_f``, β1's offsets, the
         robot's limits, starting from β1) or the path of an ``excitation.json`` written by ``dynid excite``.
-    methods : tuple of str
-        Estimators compared (keys of :data:`dynid.estimators.registry.METHODS`; default all).
+    estimators : tuple of str
+        Estimators compared (keys of :mod:`dynid.estimators.registry`; default every one registered).
     bootstrap : int
         Moving-block bootstrap resamples for the least-squares methods (0: none).
     """
@@ -100,7 +105,7 @@ class PaperExperimentConfig:
     weights: tuple[float, ...] | None = None
     abc_bounds: str = "auto"
     excitation: str = "paper"
-    methods: tuple[str, ...] = METHODS
+    estimators: tuple[str, ...] | None = None
     bootstrap: int = 100
 
     def validate(self, robot: Robot) -> None:
@@ -125,7 +130,7 @@ class PaperExperimentConfig:
             raise ConfigError(f"encoder_resolution must be >= 0 (rad), got {self.encoder_resolution}", field="encoder_resolution")
         if self.smoothing_passes < 0:
             raise ConfigError(field="smoothing_passes", message=f"smoothing_passes must be >= 0, got {self.smoothing_passes}")
-        parse_methods(self.methods)
+        parse_estimators(self.estimators)
         if self.bootstrap != 0 and self.bootstrap < 2:
             raise ConfigError(field="bootstrap", message=f"bootstrap must be 0 (none) or at least 2 resamples, got {self.bootstrap}")
         if self.weights is not None:
@@ -146,11 +151,10 @@ class Dataset:
     tau_true: np.ndarray     # noise-free torques, (N, n)
     w_base: np.ndarray       # (N*n, n_base)
     tool: np.ndarray         # (N, 3)
-    w_standard: np.ndarray | None = None  # (N*n, p), kept for the physically consistent estimator
 
 
 @dataclass
-class MethodResult:
+class PaperEstimate:
     """What one estimator gave (``n_evaluations`` of eq. 9 is None for the solvers)."""
 
     params: np.ndarray
@@ -179,7 +183,7 @@ class PaperRunResult:
     identification: Dataset
     validation: Dataset
     trajectories: dict
-    methods: dict = field(default_factory=dict)
+    estimates: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     truth_consistency_margin: float | None = None
@@ -191,7 +195,8 @@ class PaperRunResult:
             "joints": self.config.joints,
             "plant": self.config.plant,
             "seed": self.config.seed,
-            "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self.config).items()},
+            "settings": {**{k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self.config).items()},
+                         "estimators": list(parse_estimators(self.config.estimators))},
             "parameters": names,
             "units": {n: unit_of(n) for n in names},
             "paper_symbols": {n: ref.paper_symbol(n) for n in names},
@@ -200,7 +205,7 @@ class PaperRunResult:
             "truth_consistency_margin": self.truth_consistency_margin,
             "abc_bounds": {n: b.tolist() for n, b in zip(names, self.bounds)},
             "trajectories": self.trajectories,
-            "methods": {},
+            "estimates": {},
             "paper": {"objective": ref.OBJECTIVE,
                       "correlation": {"identification": list(ref.CORRELATION_IDENTIFICATION),
                                       "validation": list(ref.CORRELATION_VALIDATION)},
@@ -208,8 +213,8 @@ class PaperRunResult:
             "timings": self.timings,
             "warnings": self.warnings,
         }
-        for key, m in self.methods.items():
-            d = {"label": LABELS[key], "description": DESCRIPTIONS[key],
+        for key, m in self.estimates.items():
+            d = {"label": spec(key).label, "description": spec(key).description,
                  "params": dict(zip(names, m.params.tolist())), "objective": m.objective, "seconds": m.seconds,
                  "n_evaluations": m.n_evaluations,
                  "parameter_error_percent": dict(zip(names, _percent_error(m.params, self.truth).tolist())),
@@ -228,7 +233,7 @@ class PaperRunResult:
             if m.consistency_margin is not None:
                 d["consistency_margin"] = m.consistency_margin
                 d["physically_consistent"] = bool(m.consistency_margin >= -CONSISTENCY_TOL)
-            out["methods"][key] = d
+            out["estimates"][key] = d
         return out
 
     def summary_blocks(self) -> list:
@@ -280,25 +285,63 @@ def _limit_warnings(robot: Robot, label: str, q, dq, ddq, tau) -> list[str]:
     return out
 
 
-def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, keep_standard=False) -> Dataset:
-    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16), fit the Fourier series for the
-    derivatives, build the observation matrices, and smooth the torques **and every column of the
-    observation matrices** with eq. 17 ``passes`` times (parallel filtering: smoothing the torques alone
-    makes measured and modelled torque differ at each velocity reversal, where the Coulomb column steps).
+def simulate_recording(robot: Robot, traj, t: np.ndarray, noise: NoiseModel, rng, phi_true: np.ndarray, label: str,
+                       warnings: list) -> tuple[Recording, np.ndarray, np.ndarray]:
+    """Simulate one recording of ``traj``: quantised positions and torques from noisy currents (eq. 16).
 
-    Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
+    Parameters
+    ----------
+    robot : Robot
+    traj : FourierTrajectory
+        The commanded motion.
+    t : (N,) array [s]
+    noise : NoiseModel
+    rng : numpy.random.Generator
+    phi_true : (n_params,) array
+        The simulation truth (standard parameters).
+    label : str
+        The recording's name; limit violations of the commanded motion are appended to ``warnings`` with it.
+    warnings : list of str
+
+    Returns
+    -------
+    recording : Recording
+        Positions (no velocities) and torques ``K·I`` as a robot would log them.
+    tau_true : (N, n_dof) array [N·m]
+        The noise-free torques.
+    tool : (N, 3) array [m]
+        The tool path.
     """
     q, dq, ddq = traj.evaluate(t)
     meas = simulate_measurements(robot.with_parameters(phi_true), t, q, dq, ddq, noise, rng)  # coupled motors' terms too
     warnings.extend(_limit_warnings(robot, label, q, dq, ddq, meas.tau_true))
-    tau = five_point_cubic_smoothing(torques_from_currents(meas.current, robot.drive_gains), passes)
-    q_f, dq_f, ddq_f, _ = fourier_fit_derivatives(t, meas.q, traj.omega_f, traj.n_harmonics)
-    # eq. 17 along time, every column: of the base regressor directly (its columns are some of the standard
-    # regressor's, and each column is smoothed on its own) unless the standard one is kept
-    y = five_point_cubic_smoothing(regressor(robot, q_f, dq_f, ddq_f, None if keep_standard else base.independent), passes)
-    w = y.reshape(-1, y.shape[2])
-    return Dataset(t, q_f, dq_f, ddq_f, tau, meas.tau_true, base.base_observation(w) if keep_standard else w,
-                   tool_positions(robot, q), w if keep_standard else None)
+    tau = torques_from_currents(meas.current, robot.drive_gains)
+    rate = 1.0 / float(t[1] - t[0]) if t.size > 1 else 1.0
+    return Recording(label, t, meas.q, None, tau, rate), meas.tau_true, tool_positions(robot, q)
+
+
+def paper_preprocessing(traj, passes: int) -> Preprocessing:
+    """The paper's preprocessing (§3.3) of a recording of ``traj``: the strategy "paper" with its harmonics and
+    ``passes`` applications of eq. 17."""
+    return Preprocessing(strategy="paper", fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes)
+
+
+def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, estimation: Estimation | None = None) -> Dataset:
+    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16) and prepare it by the strategy "paper":
+    the Fourier fit for the derivatives, eq. 17 ``passes`` times on the torques **and every column of the
+    observation matrix** (parallel filtering: smoothing the torques alone makes measured and modelled torque differ
+    at each velocity reversal, where the Coulomb column steps). With ``estimation``, its estimators are fed the rows.
+
+    Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
+    """
+    recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
+    data = prepare(recording, paper_preprocessing(traj, passes))
+    if estimation is None:
+        w, tau = stacked_rows(base_chunks(robot, base, data), base.n_base)
+    else:
+        stream_rows(base_chunks(robot, base, data, standard=estimation.standard), estimation, base)
+        w, tau = estimation.rows()
+    return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool)
 
 
 def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
@@ -309,7 +352,7 @@ def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
 @with_single_blas_thread
 def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig(),
                          progress: Callable[[str, int, float], None] | None = None) -> PaperRunResult:
-    """Run the paper's experiment (§4) on a simulated robot and compare the estimators of ``config.methods``.
+    """Run the paper's experiment (§4) on a simulated robot and compare the estimators of ``config.estimators``.
 
     Parameters
     ----------
@@ -330,7 +373,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t0 = time.perf_counter()
     full = load_robot(config.robot)
     config.validate(full)
-    methods = parse_methods(config.methods)
+    keys = parse_estimators(config.estimators)
     robot = full.submodel(config.joints) if config.joints < full.n_dof else full
     k = config.joints
     rng = np.random.default_rng(config.seed)
@@ -355,18 +398,19 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t_sim = time.perf_counter()
     if progress is not None:
         progress("simulation and preprocessing", None, None)
+    estimation = Estimation(keys, problem(config, robot, base), base.names, keep_rows=True)
     ident = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
-                     keep_standard="sdp" in methods)
+                             estimation)
     valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
     bounds = search_box(config, robot, base, ident.w_base, y)
     outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
-    if outside and any(m in ("lad", "abc", "abc10", "de", "pso") for m in methods):  # only the box searches and LAD use it
+    if outside and any(spec(m).needs_box for m in keys):  # only the box searches and LAD use it
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
-    data = fit_data(config, robot, base, ident, bounds)
     budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
+    data = FitData(ident.w_base, y, k, bounds, base, None, estimation.problem.layout, estimation.problem.prior, config.weights)
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
                             {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
@@ -374,15 +418,16 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
                             warnings=warnings)
     def bootstrap(key):  # independent of the fit: it refits on resamples, so it runs in the same pool
         if progress is not None:
-            progress(f"bootstrap of {LABELS[key]}", None, None)
+            progress(f"bootstrap of {spec(key).label}", None, None)
         t_b = time.perf_counter()
         bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
-                                 n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, METHODS.index(key)]))
+                                 n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, seed_index(key)]))
         return bs, time.perf_counter() - t_b
 
-    boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in methods if key in BOOTSTRAPPED and config.bootstrap}
-    fits = _fit_methods(methods, data, budget, config.seed, progress, boots)
-    for key in methods:
+    boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in keys if spec(key).bootstrapped and config.bootstrap}
+    fits = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys}, budget,
+                          progress=progress, extra=boots)
+    for key in keys:
         fit = fits[key]
         timings[key] = fit.seconds
         p_id = (ident.w_base @ fit.params).reshape(-1, k)
@@ -397,7 +442,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
             bs, timings[f"{key}_bootstrap"] = fits[f"{key}_bootstrap"]
             boot = {"resamples": config.bootstrap, "block_length": bs.block_length, "level": bs.level,
                     "lower": bs.lower, "upper": bs.upper, "std": bs.std}
-        result.methods[key] = MethodResult(
+        result.estimates[key] = PaperEstimate(
             params=fit.params, objective=float(paper_objective(y - p_id.ravel(), k, config.weights)), seconds=fit.seconds,
             n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
             params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
@@ -409,21 +454,14 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     return result
 
 
-def _fit_methods(methods, data: FitData, budget: SearchBudget, seed: int, progress, extra=None) -> dict:
-    """Every method side by side, each seeded by (seed, 2, method), with the ``extra`` tasks in the same pool
-    (:func:`dynid.estimators.registry.fit_methods`)."""
-    return fit_methods(methods, data, budget, {k: np.random.default_rng([seed, 2, METHODS.index(k)]) for k in methods}, progress,
-                       extra=extra)
-
-
-def fit_data(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, dataset: Dataset, bounds: np.ndarray) -> FitData:
-    """What the estimators of ``config.methods`` see of ``dataset``: the observation matrices, the search box,
-    the parameter layout and, for ``sdp``, a rough CAD guess as prior (nominal parameters × U(0.7, 1.3), seeded)."""
+def problem(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -> FitData:
+    """What the estimators know of the problem before any row: the joints, the base map, the parameter layout and
+    the eq. 9 weights; for ``sdp`` a rough CAD guess as prior (nominal parameters × U(0.7, 1.3), seeded by the run)."""
+    keys = parse_estimators(config.estimators)
     prior = None
-    if "sdp" in config.methods:
+    if "sdp" in keys:
         prior = robot.standard_parameters() * np.random.default_rng([config.seed, 4]).uniform(0.7, 1.3, robot.n_params)
-    return FitData(dataset.w_base, dataset.tau.ravel(), config.joints, bounds, base, dataset.w_standard,
-                   consistency_layout(robot), prior, config.weights)
+    return FitData(None, None, config.joints, None, base, None, consistency_layout(robot), prior, config.weights)
 
 
 def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -4,7 +4,7 @@ OLS/WLS uncertainties and the timings."""
 
 from __future__ import annotations
 
-from ..estimators.names import DESCRIPTIONS, LABELS
+from ..estimators.registry import spec
 from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..tables import Line, TextTable
 from . import paper_reference as ref
@@ -17,7 +17,7 @@ def _joined(values, fmt: str) -> str:
 def run_summary_blocks(result) -> list:
     """Blocks of a :class:`dynid.experiment.paper.PaperRunResult`."""
     d = result.to_dict()
-    methods = {LABELS[k]: v for k, v in d["methods"].items()}
+    methods = {spec(k).label: v for k, v in d["estimates"].items()}
     cfg = result.config
     n_par = len(d["parameters"])
     ex = d["trajectories"]["excitation"]
@@ -25,7 +25,7 @@ def run_summary_blocks(result) -> list:
                 f"{n_par} base parameters ({n_par - 2 * cfg.joints} inertial + {2 * cfg.joints} friction)", "title"),
            Line(f"identification trajectory: {ex['trajectory']}; cond(W_base) {ex['cond_base_regressor']:.2f} "
                 f"(β1: {ex['cond_base_regressor_beta1']:.2f})"),
-           Line("methods: " + "; ".join(f"{LABELS[k]} = {DESCRIPTIONS[k]}" for k in d["methods"]))]
+           Line("estimators: " + "; ".join(f"{spec(k).label} = {spec(k).description}" for k in d["estimates"]))]
     rows = []
     for n in d["parameters"]:
         sym = d["paper_symbols"][n]
@@ -50,8 +50,8 @@ def run_summary_blocks(result) -> list:
             out.append(TextTable(f"{key.capitalize()} trajectory {beta}: {title} per joint", ("method", *(f"J{j + 1}" for j in range(cfg.joints))),
                                  tuple(rows)))
     out.extend(_uncertainty_blocks(d, methods))
-    if "sdp" in d["methods"]:
-        eig = d["methods"]["sdp"]["pseudo_inertia_min_eig"]
+    if "sdp" in d["estimates"]:
+        eig = d["estimates"]["sdp"]["pseudo_inertia_min_eig"]
         verdict = "physically consistent" if min(eig) >= -CONSISTENCY_TOL else "NOT physically consistent"
         out.append(Line(f"SDP: smallest pseudo-inertia eigenvalue per link {_joined(eig, '.3g')} → {verdict}"))
     out.append(Line("consistent: some mass distribution with non-negative friction and rotor inertias has these base parameters "

@@ -513,11 +513,9 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
             warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
                             f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"interpolate\" in {table})")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
-    rate = spec.rate if not timed else (spec.resample or float(f"{1.0 / median:.6g}"))
+    rate = spec.rate if not timed else (spec.resample or uniform_rate(t))
     if timed and (not uniform or spec.resample is not None):
-        grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
-        raw = {kind: by_column(x, lambda column, j: np.interp(grid, t, column)) for kind, x in raw.items()}
-        t = grid
+        t, raw = resampled(t, raw, rate)
     tr = robot.transmission
     side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
     if side("positions") == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
@@ -537,6 +535,32 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
+
+
+def uniform_rate(t: np.ndarray) -> float:
+    """The rate of a uniform grid for time stamps ``t`` [s]: one over their median step, to 6 digits [Hz]."""
+    return float(f"{1.0 / float(np.median(np.diff(t))):.6g}")
+
+
+def resampled(t: np.ndarray, signals: dict, rate: float) -> tuple[np.ndarray, dict]:
+    """Signals at jittered time stamps linearly interpolated onto a uniform grid from ``t[0]`` at ``rate``.
+
+    Parameters
+    ----------
+    t : (N,) array [s]
+        Increasing time stamps.
+    signals : dict
+        name -> (N, n) array (or stored columns).
+    rate : float [Hz]
+
+    Returns
+    -------
+    grid : (M,) array [s]
+    signals : dict
+        name -> (M, n) array.
+    """
+    grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
+    return grid, {kind: by_column(x, lambda column, j: np.interp(grid, t, column)) for kind, x in signals.items()}
 
 
 def _held_rows(spec: DatasetSpec, t, raw: dict, warnings: list[str]) -> dict:

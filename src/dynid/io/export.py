@@ -199,7 +199,8 @@ def _finite(x: float) -> float:
 
 def consistent_estimate(robot: Robot, results: dict, source: str = "results") -> tuple[Robot, np.ndarray]:
     """The robot (with the Coulomb smoothing it was identified with) and the physically consistent standard
-    parameters stored in a ``results.json`` of ``dynid identify`` (``physically_consistent.standard_values``).
+    parameters stored in a ``results.json`` of ``dynid identify`` (the ``standard_values`` of its physically consistent
+    estimate).
 
     Raises
     ------
@@ -207,14 +208,16 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
         No physically consistent estimate in the results, results of another robot, or a set that did not
         pass the consistency check (the verdict says why).
     """
-    sdp = results.get("physically_consistent") if isinstance(results, dict) else None
-    if not isinstance(sdp, dict) or not isinstance(sdp.get("standard_values"), dict):
+    from .results import stored_standard
+
+    found = stored_standard(results)
+    if found is None:
         raise ConfigError(f"{source}: no physically consistent estimate to export; identify with "
-                          "[estimation] physically_consistent = true (or methods including \"sdp\")")
-    verdict = results.get("physically_consistent_verdict", {}).get(sdp.get("label", ""), "yes")
+                          '[estimation] estimators including "sdp"')
+    label, values = found
+    verdict = results.get("physically_consistent_verdict", {}).get(label, "yes")
     if verdict != "yes":
         raise ConfigError(f"{source}: the physically consistent estimate did not pass the consistency check ({verdict})")
-    values = sdp["standard_values"]
     from ..model.friction_model import robot_from_settings
 
     try:

@@ -29,9 +29,8 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
                                          # by a Fourier fit on its harmonics instead of filters
 
     [estimation]
-    method = "wls"                       # "ols" or "wls": the estimate with σ
-    physically_consistent = true         # also physically consistent least squares (SDP), default false
-    methods = ["wls", "sdp", "lad", "abc", "de", "pso", "irls"]   # optional: every estimator side by side
+    estimators = ["wls", "sdp"]          # the first is the main estimate (default ["wls"]); any of ols, wls, irls,
+                                         # lad, sdp (physically consistent), abc, abc10, de, pso, or one registered
     seed = 0                             # seeds the box searches (ABC, ABC×10, DE, PSO)
     friction = "auto"                    # each joint's friction model and its state at rest chosen by
                                          # cross-validation (default); "description": the description's terms
@@ -73,7 +72,7 @@ from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .trajectories import load_trajectory
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
-from ..estimators.names import LEAST_SQUARES as METHODS, parse_methods
+from ..estimators.registry import parse_estimators
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.
@@ -90,11 +89,9 @@ class IdentificationConfig:
     identification: DatasetSpec
     validation: tuple[DatasetSpec, ...]
     preprocessing: Preprocessing
-    method: str
     references: tuple[dict, ...]
     data_root: Path
-    physically_consistent: bool = False
-    methods: tuple[str, ...] = ()
+    estimators: tuple[str, ...] = ("wls",)
     seed: int = 0
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
@@ -103,7 +100,7 @@ class IdentificationConfig:
 _PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
              "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None,
              "coulomb_velocity": None, "rest_velocity": None, "rest_friction": None, "presliding": None,
-             "auto": None}
+             "auto": None, "strategy": None, "smoothing_passes": int}
 
 
 def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
@@ -139,6 +136,14 @@ def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preproc
                 raise ConfigError(f'{where}.rest_friction: expected "held", "zero", a relaxation time in seconds, or a list '
                                   f"of {n} of them, got {v!r}")
             values[key] = tuple(v) if isinstance(v, list) else v
+            continue
+        if key == "strategy":
+            from ..preprocessing.strategies import check_strategy
+
+            try:
+                values[key] = check_strategy(v) if isinstance(v, str) else check_strategy(repr(v))
+            except ConfigError as exc:
+                raise ConfigError(f"{where}.strategy: {str(exc).split(': ', 1)[1]}") from None
             continue
         if key == "auto":
             if not isinstance(v, bool):
@@ -210,28 +215,24 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     est = doc.get("estimation", {})
     if not isinstance(est, dict):
         raise ConfigError(f"{path}: estimation: expected a table")
-    unknown = sorted(set(est) - {"method", "physically_consistent", "methods", "seed", "friction"})
+    old = [k for k in ("method", "physically_consistent", "methods") if k in est]
+    if old:
+        raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
+                          f"estimators = {_estimators_from_old(est)}")
+    unknown = sorted(set(est) - {"estimators", "seed", "friction"})
     if unknown:
-        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected friction, method, methods, "
-                          "physically_consistent, seed")
+        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected estimators, friction, seed")
     friction = est.get("friction", "description" if pre.coulomb_velocity != 0.0 else "auto")
     if friction not in ("auto", "description"):
         raise ConfigError(f'{path}: estimation.friction: expected "auto" (each joint\'s friction model chosen by '
                           f'cross-validation) or "description" (the robot description\'s terms), got {friction!r}')
-    methods = est.get("methods", [])
-    if not isinstance(methods, list) or not all(isinstance(m, str) for m in methods):
-        raise ConfigError(f"{path}: estimation.methods: expected a list of method names, got {methods!r}")
+    listed = est.get("estimators", ["wls"])
+    if not isinstance(listed, list) or not all(isinstance(m, str) for m in listed):
+        raise ConfigError(f"{path}: estimation.estimators: expected a list of estimator names like [\"wls\", \"sdp\"], got {listed!r}")
     try:
-        methods = parse_methods(methods) if methods else ()
+        estimators = parse_estimators(listed)
     except ConfigError as exc:
-        raise ConfigError(f"{path}: estimation.methods: {str(exc).split(': ', 1)[1]}") from None
-    primary = next((m for m in methods if m in METHODS), "wls")
-    method = est.get("method", primary)
-    if method not in METHODS:
-        raise ConfigError(f"{path}: estimation.method: expected one of {', '.join(METHODS)}, got {method!r}")
-    consistent = est.get("physically_consistent", "sdp" in methods)
-    if not isinstance(consistent, bool):
-        raise ConfigError(f"{path}: estimation.physically_consistent: expected true or false, got {consistent!r}")
+        raise ConfigError(f"{path}: estimation.estimators: {str(exc).split(': ', 1)[1]}") from None
     seed = est.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError(f"{path}: estimation.seed: expected a non-negative integer, got {seed!r}")
@@ -239,8 +240,16 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
         raise ConfigError(f"{path}: references: expected [[references]] tables")
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
-    return IdentificationConfig(path, robot, ident, validation, pre, method, tuple(refs), root, consistent or "sdp" in methods,
-                                methods, seed, gains, friction)
+    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators, seed, gains, friction)
+
+
+def _estimators_from_old(est: dict) -> str:
+    """The ``estimators`` list that says what the old keys ``method``, ``physically_consistent`` and ``methods`` said."""
+    methods = [str(m).lower() for m in est.get("methods", [])] if isinstance(est.get("methods"), list) else []
+    first = est.get("method") if isinstance(est.get("method"), str) else next((m for m in methods if m in ("ols", "wls")), "wls")
+    keys = [first.lower()] + (["sdp"] if est.get("physically_consistent") is True or "sdp" in methods else [])
+    keys += [m for m in methods if m not in keys]
+    return "[" + ", ".join(f'"{k}"' for k in keys) + "]"
 
 
 def _drive_gains(table, root: Path, where: str, n: int):

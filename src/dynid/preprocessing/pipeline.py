@@ -30,7 +30,9 @@ from .filters import butterworth_filtfilt, differentiate, gaussian_smooth, paral
 from .fourier_fit import fourier_fit_derivatives
 from .settings import Preprocessing
 
-__all__ = ["PreparedData", "Preprocessing", "base_chunks", "prepare"]
+from .strategies import Strategy, strategy_for
+
+__all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare"]
 
 
 @dataclass(frozen=True)
@@ -62,27 +64,97 @@ class PreparedData:
 
 
 def prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
-    """Filter and differentiate a recording (positions, velocities: measured or from positions;
-    accelerations: derivative of the filtered velocities). The torques are not filtered here: they go
-    through the parallel filter with the regressor (:func:`base_chunks`).
+    """Filtered joint signals of a recording, by the strategy ``settings.strategy`` names
+    (:mod:`dynid.preprocessing.strategies`; default :class:`ParallelFiltering`).
 
     Parameters
     ----------
     recording : dynid.io.datasets.Recording
-        Anything with ``name, t, q, dq (or None), tau, rate, n_samples, warnings``.
+        Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``.
     settings : Preprocessing
         Unset values are derived from this recording (:meth:`Preprocessing.resolved`).
     strict : bool
-        Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning:
-        settings carried over from another dataset).
+        Refuse settings that do not fit this recording rather than adapt them (with a warning).
+
+    Returns
+    -------
+    PreparedData
 
     Raises
     ------
     ConfigError
-        A cutoff at or above the Nyquist frequency.
+        An unknown strategy, or settings the recording cannot take.
     DataError
-        Too few samples to filter, or none left after trimming.
+        Too few samples.
     """
+    return strategy_for(settings).prepare(recording, settings, strict)
+
+
+def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
+                progress: Callable[[int, int], None] | None = None, standard: bool = False):
+    """The rows of ``data`` for the estimators, block by block, by the strategy that prepared it
+    (:meth:`dynid.preprocessing.strategies.Strategy.chunks`).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    data : PreparedData
+    progress : callable, optional
+        ``progress(done, total)`` in samples.
+    standard : bool
+        Yield the standard regressor instead of the base one.
+
+    Yields
+    ------
+    index : (M,) int array
+    y : (M, n_dof, n_base) or (M, n_dof, n_params) array
+    tau : (M, n_dof) array [N·m]
+    keep : (M, n_dof) bool array
+    """
+    return strategy_for(data.settings).chunks(robot, base, data, progress, standard)
+
+
+class ParallelFiltering(Strategy):
+    """The default strategy: every filter chosen from the data and applied to the torques and the regressor alike
+    (module docstring); long logs are streamed chunk by chunk."""
+
+    name = "parallel"
+    chooses_cutoffs = True
+
+    def prepare(self, recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
+        """Filter and differentiate a recording (positions, velocities: measured or from positions; accelerations:
+        derivative of the filtered velocities), find where each joint rests and its direction of motion. The torques
+        are not filtered here: they go through the parallel filter with the regressor (:meth:`chunks`).
+
+        Parameters
+        ----------
+        recording : dynid.io.datasets.Recording
+        settings : Preprocessing
+        strict : bool
+            Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning).
+
+        Returns
+        -------
+        PreparedData
+
+        Raises
+        ------
+        ConfigError
+            A cutoff at or above the Nyquist frequency.
+        DataError
+            Too few samples to filter, or none left after trimming.
+        """
+        return _parallel_prepare(recording, settings, strict)
+
+    def chunks(self, robot, base, data, progress=None, standard=False):
+        """Parallel-filtered, decimated base (or standard) regressor and torques, chunk by chunk; rows of joints slower
+        than ``min_speed`` not kept (see :meth:`Strategy.chunks`)."""
+        return _parallel_chunks(robot, base, data, progress, standard)
+
+
+def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
+    """:meth:`ParallelFiltering.prepare`."""
     rate = recording.rate
     if recording.n_samples < 3 * (2 * settings.order + 1) + 1:
         raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
@@ -218,9 +290,9 @@ def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
     return v
 
 
-def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
-                progress: Callable[[int, int], None] | None = None, standard: bool = False):
-    """Parallel-filtered, decimated base (or standard) regressor and torques, chunk by chunk.
+def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
+                     progress: Callable[[int, int], None] | None = None, standard: bool = False):
+    """:meth:`ParallelFiltering.chunks`: parallel-filtered, decimated base (or standard) regressor and torques.
 
     Yields
     ------

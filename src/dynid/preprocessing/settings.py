@@ -74,6 +74,12 @@ class Preprocessing:
     presliding : float or tuple [rad]
         Per joint, Dahl's presliding distance over which the friction reverses with the direction of motion
         (:func:`dynid.friction.held_direction`); 0 (default): at once.
+    strategy : str
+        The preprocessing strategy (:mod:`dynid.preprocessing.strategies`): "parallel" (default: the filters
+        described here) or "paper" (the paper's §3.3: a Fourier fit on ``fourier``'s harmonics and eq. 17 on the
+        torques and every regressor column, ``smoothing_passes`` times), or one registered by the user.
+    smoothing_passes : int
+        Applications of eq. 17 by the "paper" strategy (default 1).
     auto : bool
         Default true: when neither cutoff is given and the positions' noise knee lies well above
         :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band (a slow motion on a quiet log: the 10× rule
@@ -106,6 +112,8 @@ class Preprocessing:
     knee: float | None = None
     rest_friction: str | float | tuple = "held"
     presliding: float | tuple = 0.0
+    strategy: str = "parallel"
+    smoothing_passes: int = 1
     auto: bool = True
     derivation: str = ""
     noise_share: float | None = None

@@ -69,7 +69,7 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
             sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",
                                              ["parameters", "verdict"], [[k, v] for k, v in verdicts.items()], (1,)))
     if d.get("objective_eq9"):
-        others = d.get("methods", {})
+        others = d.get("estimates", {})
         rows = [[label, _fmt(f), _fmt(others.get(label, {}).get("n_evaluations")), _fmt(others.get(label, {}).get("seconds"), ".2f")]
                 for label, f in d["objective_eq9"].items()]
         sections.append(Section("Estimators", [Table("F (eq. 9) on the identification rows", ["parameters", "F (N·m)", "evaluations", "time (s)"], rows)]))
@@ -101,9 +101,9 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 
 def run_sections(d: dict) -> tuple[dict, list[Section]]:
     """Settings and sections of ``dynid run`` from its results dictionary."""
-    settings = {k: v for k, v in d.get("settings", {}).items() if not isinstance(v, (list, dict)) or k == "methods"}
+    settings = {k: v for k, v in d.get("settings", {}).items() if not isinstance(v, (list, dict)) or k == "estimators"}
     names = d["parameters"]
-    methods = d["methods"]
+    methods = d["estimates"]
     rows = [[n, _fmt(d["truth"][n]), *(_fmt(m["params"][n]) for m in methods.values())] for n in names]
     params = Table("Base parameters: truth and estimates", ["name", "truth", *(m["label"] for m in methods.values())], rows)
     rows = [[m["label"], _fmt(m["objective"]), _fmt(m["n_evaluations"]), _fmt(m["seconds"], ".2f"), _fmt(m["parameter_error_norm_percent"], ".3g"),

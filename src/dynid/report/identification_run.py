@@ -63,8 +63,10 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     write_results(json_path, data, "identify")
     write_html_report(out / "report.html", data, "identify", paths, f"dynid identify — {result.robot}")
     paths.insert(0, out / "report.html")
-    sdp = data.get("physically_consistent")
-    if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp["label"]) == "yes":
+    from ..io.results import stored_standard
+
+    sdp = stored_standard(data)
+    if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp[0]) == "yes":
         from ..io import atomic_write_text
         from ..io.export import mjcf_from_results, urdf_from_results
 

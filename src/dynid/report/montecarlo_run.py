@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..estimators.names import LABELS
+from ..estimators.registry import label
 from ..experiment.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures
@@ -31,17 +31,17 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
     """
     out = output_folder(out)
     stats = result.statistics()
-    labels = [LABELS[k] for k in result.config.methods]
+    labels = [label(k) for k in result.config.estimators]
     levels = np.asarray(result.config.noise_levels, dtype=float)
     paths = [out / "montecarlo.json", out / "montecarlo_estimates.csv", *(out / name for name in FIGURES)]
-    save_figure(figures.plot_std_over_bound(levels, labels, [stats[k]["std_over_crb"] for k in result.config.methods]), paths[2])
-    save_figure(figures.plot_noise_level_study(levels, labels, [stats[k]["std_over_crb"] for k in result.config.methods],
-                                               [stats[k]["bias_over_crb"] for k in result.config.methods]), paths[3])
+    save_figure(figures.plot_std_over_bound(levels, labels, [stats[k]["std_over_crb"] for k in result.config.estimators]), paths[2])
+    save_figure(figures.plot_noise_level_study(levels, labels, [stats[k]["std_over_crb"] for k in result.config.estimators],
+                                               [stats[k]["bias_over_crb"] for k in result.config.estimators]), paths[3])
     buf = io.StringIO()
-    buf.write(",".join(["noise_level_A", "realisation", "method", *result.names]) + "\n")
+    buf.write(",".join(["noise_level_A", "realisation", "estimator", *result.names]) + "\n")
     for li, level in enumerate(levels):
         for r in range(result.estimates.shape[1]):
-            for m, key in enumerate(result.config.methods):
+            for m, key in enumerate(result.config.estimators):
                 buf.write(f"{level:.6g},{r},{key}," + ",".join(f"{v:.10g}" for v in result.estimates[li, r, m]) + "\n")
     atomic_write_text(paths[1], buf.getvalue())
     data = result.to_dict()

@@ -263,7 +263,7 @@ def save_figure(fig_or_axes, path: Path) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 """Version of the layout of the JSON files dynid writes; raised when a field changes meaning or goes."""
 
 

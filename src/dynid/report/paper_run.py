@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..experiment import paper_reference as ref
-from ..estimators.names import BOX_SEARCHES, LABELS
+from ..estimators.registry import label
 from ..experiment.paper import PaperRunResult
 from . import figures
 from .html import write_html_report
@@ -31,10 +31,10 @@ TORQUE_PLOT_METHODS = ("abc", "lad", "ols", "sdp")
 def _figure_drawers(result: PaperRunResult) -> dict:
     """Each figure this run has, by file name: a callable that draws it and returns its Figure."""
     ident, valid, lim = result.identification, result.validation, result.robot.limits
-    methods = result.methods
+    methods = result.estimates
     ident_name = "β1" if result.config.excitation == "paper" else "(optimized)" if result.config.excitation == "optimized" else "(from file)"
-    shown = {LABELS[k]: methods[k] for k in TORQUE_PLOT_METHODS if k in methods} or {LABELS[k]: m for k, m in list(methods.items())[:3]}
-    references = {f"{LABELS[k]} F": methods[k].objective for k in ("lad", "ols") if k in methods}
+    shown = {label(k): methods[k] for k in TORQUE_PLOT_METHODS if k in methods} or {label(k): m for k, m in list(methods.items())[:3]}
+    references = {f"{label(k)} F": methods[k].objective for k in ("lad", "ols") if k in methods}
     references[f"paper F = {ref.OBJECTIVE}"] = ref.OBJECTIVE
     figs = {
         "fig4_identification_trajectory.png": lambda: figures.plot_joint_trajectories(
@@ -49,14 +49,14 @@ def _figure_drawers(result: PaperRunResult) -> dict:
             valid.t, valid.tau, {k: m.tau_validation for k, m in shown.items()},
             title="Fig. 9 — validation trajectory: measured vs predicted"),
         "methods_comparison.png": lambda: figures.plot_method_comparison(
-            [LABELS[k] for k in methods], [m.metrics["relative_error"]["validation"] for m in methods.values()],
+            [label(k) for k in methods], [m.metrics["relative_error"]["validation"] for m in methods.values()],
             [100 * np.linalg.norm(m.params - result.truth) / np.linalg.norm(result.truth) for m in methods.values()],
             title="Estimators on the validation trajectory β2 (top) and against the true base parameters (bottom)"),
     }
     if "abc" in methods:
         figs["fig6_abc_convergence.png"] = lambda: figures.plot_convergence(
             methods["abc"].history, reference=references, title="Fig. 6 — ABC convergence (eq. 9)")
-    searches = {LABELS[k]: methods[k] for k in BOX_SEARCHES if k in methods}
+    searches = {label(k): m for k, m in methods.items() if m.history is not None}
     if searches:
         figs["methods_convergence.png"] = lambda: figures.plot_convergence(
             {label: (np.linspace(m.n_evaluations / len(m.history), m.n_evaluations, len(m.history)), m.history)
@@ -69,7 +69,7 @@ def _for_figures(result: PaperRunResult) -> PaperRunResult:
     """The result without its observation matrices (25 MB and more), which no figure draws: what is handed
     to the figure process."""
     def light(d):
-        return dataclasses.replace(d, w_base=None, w_standard=None)
+        return dataclasses.replace(d, w_base=None)
 
     return dataclasses.replace(result, identification=light(result.identification), validation=light(result.validation))
 

@@ -1,0 +1,178 @@
+"""The registry of preprocessing strategies: how a recording becomes filtered joint signals, and those become the
+rows the estimators see.
+
+A strategy has two steps, used by ``dynid identify``, ``validate``, ``run``, ``montecarlo`` and :class:`dynid.Identifier`
+alike:
+
+- ``prepare(recording, settings, strict)`` → :class:`dynid.preprocessing.pipeline.PreparedData`: positions,
+  velocities and accelerations on a uniform grid (torques as measured);
+- ``chunks(robot, base, data, progress, standard)`` → ``(index, y, tau, keep)`` blocks: the base (or standard)
+  regressor and the torques after the filters that must touch both alike, and the rows kept for estimation.
+
+Built in:
+
+- ``"parallel"`` (default, :class:`dynid.preprocessing.pipeline.ParallelFiltering`): zero-phase low-pass of the
+  positions, central differences, the same low-pass on the torques and every regressor column, decimation; every
+  cutoff from the data's excitation band; streams long logs chunk by chunk;
+- ``"paper"`` (:class:`dynid.preprocessing.paper_smoothing.PaperSmoothing`): the paper's §3.3, derivatives from a
+  Fourier fit on the excitation's harmonics and eq. 17 on the torques and every regressor column.
+
+A new strategy is one file: a subclass of :class:`Strategy` and a call to :func:`register_strategy`; configs then
+name it in ``[preprocessing] strategy``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any, Callable, Iterator
+
+from ..exceptions import ConfigError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..dynamics.base_parameters import BaseParameters
+    from ..model.robot import Robot
+    from .pipeline import PreparedData
+    from .settings import Preprocessing
+
+__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for"]
+
+Chunk = tuple["np.ndarray", "np.ndarray", "np.ndarray", "np.ndarray"]
+
+
+class Strategy:
+    """Base class of the preprocessing strategies (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        The key it is registered under.
+    chooses_cutoffs : bool
+        Whether ``Preprocessing.auto`` cross-validates its cutoffs (:func:`dynid.validation.cross_validation.choose_preprocessing`).
+    """
+
+    name = ""
+    chooses_cutoffs = False
+
+    def prepare(self, recording, settings: "Preprocessing", strict: bool = True) -> "PreparedData":
+        """Filtered joint signals of ``recording``.
+
+        Parameters
+        ----------
+        recording : dynid.io.datasets.Recording
+            Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``.
+        settings : Preprocessing
+            Unset values are derived from the recording; the resolved settings travel with the result.
+        strict : bool
+            Refuse settings that do not fit this recording (else adapt them, with a warning: settings carried over
+            from another dataset).
+
+        Returns
+        -------
+        PreparedData
+        """
+        raise NotImplementedError
+
+    def chunks(self, robot: "Robot", base: "BaseParameters", data: "PreparedData",
+               progress: Callable[[int, int], None] | None = None, standard: bool = False) -> Iterator[Chunk]:
+        """The rows of ``data`` for the estimators, block by block.
+
+        Parameters
+        ----------
+        robot : Robot
+        base : BaseParameters
+        data : PreparedData
+            From :meth:`prepare`.
+        progress : callable, optional
+            ``progress(done, total)`` in samples.
+        standard : bool
+            Yield the standard regressor (the base one is ``base.base_observation(y)``).
+
+        Yields
+        ------
+        index : (M,) int array
+            Samples of ``data`` the block holds.
+        y : (M, n_dof, n_base) or (M, n_dof, n_params) array
+            Regressor, filtered like the torques.
+        tau : (M, n_dof) array [N·m]
+        keep : (M, n_dof) bool array
+            Rows used by the estimation.
+        """
+        raise NotImplementedError
+
+
+_STRATEGIES: dict[str, Any] = {}
+
+
+def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
+    """Make a preprocessing strategy known under ``name`` (case-insensitive).
+
+    Parameters
+    ----------
+    name : str
+    strategy : Strategy subclass, instance, or "module:attribute" of either (imported when first used)
+    replace : bool
+        Replace a strategy of the same name (else a ``ValueError``).
+
+    Raises
+    ------
+    ValueError
+        An empty name, or one registered already.
+    """
+    key = str(name).strip().lower()
+    if not key:
+        raise ValueError("preprocessing strategy: expected a name")
+    if key in _STRATEGIES and not replace:
+        raise ValueError(f"preprocessing strategy {key!r} is registered already (pass replace=True to replace it)")
+    _STRATEGIES[key] = strategy
+
+
+def unregister_strategy(name: str) -> None:
+    """Forget the strategy ``name`` (a ``KeyError`` if unknown)."""
+    del _STRATEGIES[str(name).strip().lower()]
+
+
+register_strategy("parallel", ".pipeline:ParallelFiltering")
+register_strategy("paper", ".paper_smoothing:PaperSmoothing")
+
+
+def strategy_names() -> tuple[str, ...]:
+    """Every registered strategy, the built-in ones first."""
+    return tuple(_STRATEGIES)
+
+
+def check_strategy(name: str) -> str:
+    """``name`` in lower case if registered.
+
+    Raises
+    ------
+    ConfigError
+        An unknown strategy (field ``preprocessing.strategy``, the message lists the known ones).
+    """
+    key = str(name).strip().lower()
+    if key not in _STRATEGIES:
+        raise ConfigError(f"preprocessing.strategy: expected one of {', '.join(_STRATEGIES)}, got {name!r}",
+                          field="preprocessing.strategy")
+    return key
+
+
+def strategy_for(settings: "Preprocessing | str") -> Strategy:
+    """The strategy instance that ``settings.strategy`` (or a name) names.
+
+    Raises
+    ------
+    ConfigError
+        An unknown strategy.
+    """
+    key = check_strategy(settings if isinstance(settings, str) else settings.strategy)
+    target = _STRATEGIES[key]
+    if isinstance(target, str):
+        module, _, attr = target.partition(":")
+        target = getattr(importlib.import_module(module, __package__), attr)
+    if isinstance(target, type):
+        target = target()
+        _STRATEGIES[key] = target
+    if not target.name:
+        target.name = key
+    return target

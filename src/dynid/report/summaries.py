@@ -1,0 +1,171 @@
+"""What the commands print, as blocks of :mod:`dynid.tables` (lines and tables), built from the result objects:
+the results hold numbers, this module their text. :func:`summary` renders any result as plain text.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..conventions import unit_of
+from ..tables import Line, TextTable, render_text
+from ..validation.torques import comparison_table
+
+__all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
+           "coulomb_choice_table"]
+
+
+def summary(result, width: int = 100) -> str:
+    """Plain-text summary of a result of dynid (identification, paper run, Monte Carlo study, excitation design).
+
+    Parameters
+    ----------
+    result : IdentificationResult, PaperRunResult, MonteCarloResult or ExcitationRun
+    width : int
+        Characters per line the tables are fitted to.
+
+    Returns
+    -------
+    str
+    """
+    return render_text(blocks(result), width)
+
+
+def blocks(result) -> list:
+    """The blocks of :func:`summary` (the terminal renders them with colours, :mod:`dynid.report.console`).
+
+    Raises
+    ------
+    TypeError
+        Not a result of dynid.
+    """
+    from ..experiment.identification import IdentificationResult
+
+    if isinstance(result, IdentificationResult):
+        return identification_blocks(result)
+    if hasattr(result, "summary_blocks"):
+        return result.summary_blocks()
+    raise TypeError(f"expected a result of dynid, got {type(result).__name__}")
+
+
+def identification_blocks(result) -> list:
+    """What ``dynid identify`` prints: how the data were prepared, the base parameters with σ beside the references,
+    the estimators, the drive gains, the fit and validation tables and the verdict.
+
+    Parameters
+    ----------
+    result : dynid.experiment.identification.IdentificationResult
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    from ..experiment.identification import BOX_FRACTION, BOX_SIGMAS
+
+    r = result
+    sol, base = r.solution, r.base
+    out = [Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {base.n_base} base "
+                f"parameters from {r.n_rows} equations, cond = {sol.condition_number:.4g}", "title")]
+    pre = r.settings.get("preprocessing", {})
+    if pre.get("derivation"):
+        out.append(Line("preprocessing: " + pre["derivation"]))
+    if r.settings.get("preprocessing_cross_validation") is not None:
+        out.append(filter_choice_table(r.settings["preprocessing_cross_validation"]))
+    if r.settings.get("coulomb_cross_validation") is not None:
+        out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
+    if r.settings.get("friction_models") is not None:
+        out.append(friction_choice_table(r.settings["friction_models"]))
+    rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
+                  *(f"{ref.beta[i]:.4g}" for ref in r.references)) for i, n in enumerate(base.names))
+    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; reference values beside)",
+                         ("name", "unit", "value", "σ", "σ %", *(ref.name for ref in r.references)), rows, labels=2))
+    for ref in r.references:
+        if ref.relative_std is not None:
+            a = r.reference_agreement(ref)
+            out.append(Line(f"{ref.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
+                            f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters"))
+    out.append(Line("residual σ per joint (N·m): " + ", ".join(f"{x:.3g}" for x in r.joint_std)))
+    for label, e in r.estimates.items():
+        if e.pseudo_inertia_min_eig is not None:
+            out.append(Line(f"{label}: physically consistent least squares, prior: the robot model's nominal parameters; smallest "
+                            "pseudo-inertia eigenvalue per link " + ", ".join(f"{x:.3g}" for x in e.pseudo_inertia_min_eig)))
+    if r.consistency_verdicts:
+        out.append(Line("physically consistent (some mass distribution with friction and rotor inertias ≥ 0 has these base "
+                        "parameters)? " + "; ".join(f"{label}: {v}" for label, v in r.consistency_verdicts.items())))
+    if r.objective:
+        rows = tuple((label, f"{f:.4f}",
+                      "" if label not in r.estimates else (str(r.estimates[label].n_evaluations) if r.estimates[label].n_evaluations else "solve"),
+                      "" if label not in r.estimates else f"{r.estimates[label].seconds:.2f}") for label, f in r.objective.items())
+        out.append(TextTable(f"Estimators on {r.fit.name} (the validation tables follow)",
+                             ("parameters", "F eq. 9 (N·m)", "evaluations", "time (s)"), rows))
+        if r.box is not None:
+            out.append(Line(f"LAD, ABC, DE and PSO search the box {r.label} ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|value|); "
+                            "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations"))
+    if r.drive_gains is not None:
+        out.extend(r.drive_gains.summary_blocks())
+    for c in (r.fit, *r.validations):
+        out.append(comparison_table(c))
+        out.extend(Line(f) for f in c.flags())
+    out.append(Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
+                                               if not r.findings else f"{len(r.findings)} finding(s)"), "title"))
+    out.extend(Line(f.text) for f in r.findings)
+    out.extend(Line(w, "warning") for w in r.warnings)
+    return out
+
+
+def filter_choice_table(cv: dict) -> TextTable:
+    """``preprocessing.auto``: each candidate's cutoffs and out-of-fold errors on the common held-out samples.
+
+    Parameters
+    ----------
+    cv : dict
+        ``settings["preprocessing_cross_validation"]`` of an identification.
+
+    Returns
+    -------
+    TextTable
+    """
+    n = len(cv["out_of_fold_rms_error"][0])
+    rows = tuple((f"{c['position_cutoff']:.3g}{'*' if i == cv['chosen'] else ''}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
+                  *(f"{x:.4g}" for x in e), f"{s:.4g}")
+                 for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
+    return TextTable("Cutoffs by cross-validation: out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
+                     ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
+
+
+def friction_choice_table(choice: dict) -> TextTable:
+    """Each joint's friction model chosen by cross-validation, its out-of-fold error against the plain model's.
+
+    Parameters
+    ----------
+    choice : dict
+        ``settings["friction_models"]`` of an identification.
+
+    Returns
+    -------
+    TextTable
+    """
+    plain, chosen = np.asarray(choice["plain_out_of_fold_rms_error"]), np.asarray(choice["chosen_out_of_fold_rms_error"])
+    share = choice.get("rest_share")
+    rows = tuple((f"J{j + 1}", m["label"], f"{plain[j]:.3g}", f"{chosen[j]:.3g}",
+                  "" if share is None else f"{100 * share[j]:.0f}") for j, m in enumerate(choice["models"]))
+    return TextTable(f"Friction model of each joint, chosen by {choice['folds']}-fold blocked cross-validation "
+                     "(out-of-fold RMS torque error, N·m; the state at rest is judged where 5 % of the samples rest)",
+                     ("joint", "model", "plain", "chosen", "at rest %"), rows, labels=2)
+
+
+def coulomb_choice_table(cv: dict) -> TextTable:
+    """The candidates of the Coulomb smoothing velocity and their out-of-fold errors, per joint.
+
+    Parameters
+    ----------
+    cv : dict
+        ``settings["coulomb_cross_validation"]`` of an identification.
+
+    Returns
+    -------
+    TextTable
+    """
+    rows = tuple(("sign" if frac == 0 else f"{frac:g}", *(f"{e:.4g}{'*' if v == c else ''}" for e, v, c in zip(e_row, vs_row, cv["velocity"])))
+                 for frac, vs_row, e_row in zip(cv["grid_fraction_of_rms_speed"], cv["candidates"], cv["out_of_fold_rms_error"]))
+    return TextTable(f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m), {cv['folds']} contiguous folds; chosen: *",
+                     ("v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cv["velocity"])))), rows)
