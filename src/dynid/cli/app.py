@@ -24,7 +24,8 @@ OPTIONS = {"out": "--out", "seed": "--seed", "joints": "--joints", "plant": "--p
            "excitation": "--excitation", "estimators": "--estimators", "noise_levels": "--noise-levels",
            "realisations": "--realisations", "scheduler": "--scheduler", "workers": "--workers", "data_root": "--data-root",
            "file": "--file", "robot": "--robot", "duration": "--duration", "rate": "--rate", "current_noise": "--current-noise",
-           "colony_size": "--abc-colony", "limit": "--abc-limit", "maxiter": "--abc-iterations", "starts": "--starts"}
+           "colony_size": "--abc-colony", "limit": "--abc-limit", "maxiter": "--abc-iterations", "starts": "--starts",
+           "preprocessing.strategy": "--strategy"}
 """Library fields (named by the library's messages) and the options that set them."""
 
 
@@ -106,9 +107,10 @@ def run(
     abc_bounds: str = typer.Option("auto", help="ABC search box: auto, table3 (paper Table 3) or scaled (±(2|β_OLS|+1))."),
     weights: Optional[str] = typer.Option(None, help="Eq. 9 weights per joint, comma separated (default all 1)."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized (designed for the run, min cond), or an excitation.json of dynid excite."),
-    estimators: str = typer.Option("all", help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, or any registered (default all)."),
+    estimators: Optional[str] = typer.Option(None, help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default), or all registered."),
     methods: Optional[str] = typer.Option(None, hidden=True),
     bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
+    strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
     figures: bool = typer.Option(True, help="Write the figures (--no-figures: results.json only)."),
     quiet: bool = QUIET,
 ) -> None:
@@ -127,7 +129,7 @@ def run(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
-            excitation=excitation, estimators=parse_estimators(estimators), bootstrap=bootstrap)
+            excitation=excitation, estimators=parse_estimators(estimators), bootstrap=bootstrap, strategy=strategy)
         with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
             with rep.progress("dynid run") as progress:
                 result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
@@ -327,6 +329,7 @@ def montecarlo(
     rate: float = typer.Option(200.0, help="Sampling rate [Hz] (the paper: 1000)."),
     abc_bounds: str = typer.Option("scaled", help="Search box of ABC/DE/PSO/LAD: scaled (±(2|β_OLS|+1), holds the truth) or table3."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized, or an excitation.json."),
+    strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
     scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); default: a LocalCluster of this machine's cores."),
     workers: Optional[int] = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
     out: Path = typer.Option(Path("dynid-montecarlo"), help="Output folder for montecarlo.json, the estimates CSV and figures."),
@@ -343,7 +346,7 @@ def montecarlo(
         _check_out(out)
         cfg = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
                                estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
-                               excitation=excitation)
+                               excitation=excitation, strategy=strategy)
         with rep.progress("dynid montecarlo") as progress:
             progress.update("starting the workers")
             result = run_montecarlo(cfg, scheduler=scheduler, workers=workers,

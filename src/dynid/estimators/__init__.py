@@ -15,6 +15,9 @@ _EXPORTS = {
     "OrdinaryLeastSquares": "least_squares", "WeightedLeastSquares": "least_squares",
     "PhysicallyConsistentLeastSquares": "physically_consistent", "consistency_margin": "physically_consistent",
     "IterativelyReweightedLeastSquares": "robust",
+    "AccumulatingEstimator": "base",
+    "register": "registry", "unregister": "registry", "EstimatorSpec": "registry", "FitData": "registry",
+    "Estimation": "estimation",
 }
 
 __all__ = list(_EXPORTS)

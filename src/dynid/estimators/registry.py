@@ -288,9 +288,25 @@ register("de", _box_search("de"), label="DE", description="differential evolutio
 register("pso", _box_search("pso"), label="PSO", description="particle swarm (constriction), the budget of ABC×10", cost=8,
          needs_box=True)
 
+BUILT_IN = tuple(_REGISTRY)
+"""The estimators dynid comes with (the others were registered by the user)."""
+
 LEAST_SQUARES = ("ols", "wls")
 """The least-squares estimates that carry σ; one of them is the reference of every identification (the first of
 these in the list of estimators, else WLS): its residuals give each joint's noise, its σ the search box."""
+
+
+def registered_by_user(keys_: Iterable[str]) -> dict:
+    """key -> :class:`EstimatorSpec` of those of ``keys_`` that are not built in: what another process (a Dask
+    worker) must register to fit them (:func:`ensure_registered`)."""
+    return {spec(k).key: spec(k) for k in keys_ if spec(k).key not in BUILT_IN}
+
+
+def ensure_registered(specs: dict) -> None:
+    """Register the estimators of ``specs`` (key -> :class:`EstimatorSpec`) that this process does not know."""
+    for key, entry in specs.items():
+        if key not in _REGISTRY:
+            _REGISTRY[key] = entry
 
 
 def spec(key: str) -> EstimatorSpec:
@@ -320,7 +336,7 @@ def label(key: str) -> str:
 
 
 def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...] | None = None) -> tuple[str, ...]:
-    """Keys from ``"ols,abc"`` or a sequence, case-insensitive; ``None`` gives ``default`` (every registered key
+    """Keys from ``"ols,abc"`` or a sequence, case-insensitive; ``None`` gives ``default`` (the built-in estimators
     when ``default`` is None) and ``"all"`` every registered key.
 
     Raises
@@ -329,7 +345,7 @@ def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...
         Unknown, repeated or no estimator (field ``estimators``).
     """
     if text is None:
-        return default if default is not None else keys()
+        return default if default is not None else BUILT_IN
     if isinstance(text, str) and text.strip().lower() == "all":
         return keys()
     items = text.split(",") if isinstance(text, str) else list(text)

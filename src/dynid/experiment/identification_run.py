@@ -88,9 +88,12 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     for spec in config.validation if validate else ():
         step(f"reading {spec.name}")
         checked.append(load_recording(spec, config.robot))
-    step("preprocessing" + (" (cross-validation of the cutoffs)" if config.preprocessing.auto else ""))
+    from ..preprocessing.strategies import strategy_for
+
+    auto = config.preprocessing.auto and strategy_for(config.preprocessing).chooses_cutoffs
+    step("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
     filters = None
-    if config.preprocessing.auto:
+    if auto:
         from ..validation.cross_validation import choose_preprocessing
 
         filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)

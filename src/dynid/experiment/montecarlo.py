@@ -79,6 +79,8 @@ class MonteCarloConfig:
         box holds the truth; "table3" is the paper's box, which does not.
     excitation : str
         "paper" (β1), "optimized" or an ``excitation.json``, as in ``dynid run``.
+    strategy : str
+        Preprocessing strategy of the simulated recordings (default the paper's), as in ``dynid run``.
     """
 
     robot: str = "er16"
@@ -97,6 +99,7 @@ class MonteCarloConfig:
     maxiter: int = 50
     abc_bounds: str = "scaled"
     excitation: str = "paper"
+    strategy: str = "paper"
 
     def run_config(self, level: float = 0.05) -> PaperExperimentConfig:
         """The settings of one realisation, as a paper-experiment configuration."""
@@ -104,7 +107,8 @@ class MonteCarloConfig:
             robot=self.robot, joints=self.joints, seed=self.seed, duration=self.duration, rate=self.rate,
             omega_f=self.omega_f, current_noise=level, encoder_resolution=self.encoder_resolution,
             smoothing_passes=self.smoothing_passes, colony_size=self.colony_size, limit=self.limit, maxiter=self.maxiter,
-            abc_bounds=self.abc_bounds, excitation=self.excitation, estimators=tuple(self.estimators), bootstrap=0)
+            abc_bounds=self.abc_bounds, excitation=self.excitation, estimators=tuple(self.estimators), bootstrap=0,
+            strategy=self.strategy)
 
     def validate(self) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
@@ -129,6 +133,7 @@ class _Setup:
     trajectory: object
     t: np.ndarray
     unit_crb: np.ndarray  # Cramér–Rao covariance for σ = 1 A, (n_base, n_base)
+    plugins: tuple = ({}, {})  # estimators and strategies registered by the user: the workers register them too
 
 
 def _prepare(config: MonteCarloConfig) -> _Setup:
@@ -146,7 +151,11 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     w = base.base_observation(observation_matrix(robot, q, dq, ddq)).reshape(t.size, robot.n_dof, -1)
     gains = np.asarray(robot.drive_gains, dtype=float)
     info = np.einsum("kjp,kjq,j->pq", w, w, 1.0 / gains**2)
-    return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info))
+    from ..estimators import registry
+    from ..preprocessing import strategies
+
+    plugins = (registry.registered_by_user(config.estimators), strategies.registered_by_user([config.strategy]))
+    return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info), plugins)
 
 
 @with_single_blas_thread
@@ -161,11 +170,16 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     """
     cfg = setup.config
     level = float(cfg.noise_levels[level_index])
+    from ..estimators import registry
+    from ..preprocessing import strategies
+
+    registry.ensure_registered(setup.plugins[0])  # a worker process knows only the built-in ones
+    strategies.ensure_registered(setup.plugins[1])
     rng = np.random.default_rng([cfg.seed, 10, level_index, realisation])
     keys = parse_estimators(cfg.estimators)
     estimation = Estimation(keys, problem(setup.run, setup.robot, setup.base), setup.base.names, keep_rows=True)
     ds = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t, NoiseModel(level, cfg.encoder_resolution), rng,
-                          setup.phi_true, cfg.smoothing_passes, "identification", [], estimation)
+                          setup.phi_true, cfg.smoothing_passes, "identification", [], estimation, cfg.strategy)
     bounds = search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
     budget = SearchBudget(cfg.colony_size, cfg.limit, cfg.maxiter)
     params = np.full((len(keys), setup.base.n_base), np.nan)

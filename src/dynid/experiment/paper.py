@@ -84,9 +84,12 @@ class PaperExperimentConfig:
         :func:`dynid.excitation.design.design_excitation`: 5 harmonics at ``omega_f``, β1's offsets, the
         robot's limits, starting from β1) or the path of an ``excitation.json`` written by ``dynid excite``.
     estimators : tuple of str
-        Estimators compared (keys of :mod:`dynid.estimators.registry`; default every one registered).
+        Estimators compared (keys of :mod:`dynid.estimators.registry`; default the built-in ones).
     bootstrap : int
         Moving-block bootstrap resamples for the least-squares methods (0: none).
+    strategy : str
+        Preprocessing strategy of the simulated recordings (:mod:`dynid.preprocessing.strategies`; default the
+        paper's: eq. 17 and the Fourier fit); it is given the trajectory's harmonics and ``smoothing_passes``.
     """
 
     robot: str = "er16"
@@ -107,6 +110,7 @@ class PaperExperimentConfig:
     excitation: str = "paper"
     estimators: tuple[str, ...] | None = None
     bootstrap: int = 100
+    strategy: str = "paper"
 
     def validate(self, robot: Robot) -> None:
         """Raise :class:`ConfigError` (one line) on any invalid setting."""
@@ -131,6 +135,9 @@ class PaperExperimentConfig:
         if self.smoothing_passes < 0:
             raise ConfigError(field="smoothing_passes", message=f"smoothing_passes must be >= 0, got {self.smoothing_passes}")
         parse_estimators(self.estimators)
+        from ..preprocessing.strategies import check_strategy
+
+        check_strategy(self.strategy)
         if self.bootstrap != 0 and self.bootstrap < 2:
             raise ConfigError(field="bootstrap", message=f"bootstrap must be 0 (none) or at least 2 resamples, got {self.bootstrap}")
         if self.weights is not None:
@@ -320,13 +327,14 @@ def simulate_recording(robot: Robot, traj, t: np.ndarray, noise: NoiseModel, rng
     return Recording(label, t, meas.q, None, tau, rate), meas.tau_true, tool_positions(robot, q)
 
 
-def paper_preprocessing(traj, passes: int) -> Preprocessing:
-    """The paper's preprocessing (§3.3) of a recording of ``traj``: the strategy "paper" with its harmonics and
-    ``passes`` applications of eq. 17."""
-    return Preprocessing(strategy="paper", fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes)
+def paper_preprocessing(traj, passes: int, strategy: str = "paper") -> Preprocessing:
+    """The preprocessing of a recording of ``traj``: by default the paper's (§3.3), the strategy "paper" with the
+    trajectory's harmonics and ``passes`` applications of eq. 17."""
+    return Preprocessing(strategy=strategy, fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes)
 
 
-def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, estimation: Estimation | None = None) -> Dataset:
+def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, estimation: Estimation | None = None,
+                     strategy: str = "paper") -> Dataset:
     """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16) and prepare it by the strategy "paper":
     the Fourier fit for the derivatives, eq. 17 ``passes`` times on the torques **and every column of the
     observation matrix** (parallel filtering: smoothing the torques alone makes measured and modelled torque differ
@@ -335,7 +343,7 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
     """
     recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
-    data = prepare(recording, paper_preprocessing(traj, passes))
+    data = prepare(recording, paper_preprocessing(traj, passes, strategy))
     if estimation is None:
         w, tau = stacked_rows(base_chunks(robot, base, data), base.n_base)
     else:
@@ -400,8 +408,9 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         progress("simulation and preprocessing", None, None)
     estimation = Estimation(keys, problem(config, robot, base), base.names, keep_rows=True)
     ident = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
-                             estimation)
-    valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings)
+                             estimation, config.strategy)
+    valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings,
+                             strategy=config.strategy)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()

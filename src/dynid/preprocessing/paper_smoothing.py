@@ -26,6 +26,7 @@ class PaperSmoothing(Strategy):
     regressor; every row kept, no decimation."""
 
     name = "paper"
+    needs_harmonics = True
 
     def prepare(self, recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
         """Positions, velocities and accelerations of the series fitted on ``settings.fourier``'s harmonics.

@@ -243,6 +243,7 @@ def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
     """Each joint's direction of motion (:func:`dynid.friction.held_direction`, velocities ``dq`` and ``guide``) with
     the log's rest velocities, rest model and presliding distances, column by column (stored columns stay stored)."""
     n = dq.shape[1]
+    guide = dq if guide is None else guide
     rest = _per_joint(0.0 if s.rest_velocity == "auto" else s.rest_velocity, n, "rest_velocity").astype(float)
     decay = rest_decay(s.rest_friction, n)
     x0 = _per_joint(s.presliding, n, "presliding").astype(float)

@@ -238,6 +238,10 @@ def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "P
     (at least the identification's); the identification's friction state at rest; no Fourier fit (the excitation's
     harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a cutoff above this log's Nyquist
     frequency is lowered, with a warning."""
+    from .strategies import strategy_for
+
+    if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log
+        given = replace(given, strategy="parallel")
     if resolved is None:
         return replace(given, fourier=None, decimation=None, warnings=())
     floor = resolved.rest_velocity if given.rest_velocity == "auto" and resolved.rest_velocity != "auto" else 0.0

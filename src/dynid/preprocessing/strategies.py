@@ -50,10 +50,19 @@ class Strategy:
         The key it is registered under.
     chooses_cutoffs : bool
         Whether ``Preprocessing.auto`` cross-validates its cutoffs (:func:`dynid.validation.cross_validation.choose_preprocessing`).
+    needs_harmonics : bool
+        Whether it needs the excitation's harmonics (``Preprocessing.fourier``): a log scored with another log's
+        parameters (a validation log) then goes through the default strategy.
+
+    Notes
+    -----
+    :meth:`prepare` returns settings with nothing left to derive: numbers (not "auto") for ``min_speed`` and
+    ``rest_velocity``, and a ``decimation``.
     """
 
     name = ""
     chooses_cutoffs = False
+    needs_harmonics = False
 
     def prepare(self, recording, settings: "Preprocessing", strict: bool = True) -> "PreparedData":
         """Filtered joint signals of ``recording``.
@@ -135,6 +144,21 @@ def unregister_strategy(name: str) -> None:
 
 register_strategy("parallel", ".pipeline:ParallelFiltering")
 register_strategy("paper", ".paper_smoothing:PaperSmoothing")
+
+
+BUILT_IN = tuple(_STRATEGIES)
+"""The strategies dynid comes with."""
+
+
+def registered_by_user(names) -> dict:
+    """name -> registered target of those of ``names`` that are not built in (for another process to register)."""
+    return {check_strategy(n): _STRATEGIES[check_strategy(n)] for n in names if check_strategy(n) not in BUILT_IN}
+
+
+def ensure_registered(targets: dict) -> None:
+    """Register the strategies of ``targets`` (name -> target) that this process does not know."""
+    for name, target in targets.items():
+        _STRATEGIES.setdefault(name, target)
 
 
 def strategy_names() -> tuple[str, ...]:
