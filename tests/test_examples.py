@@ -10,11 +10,24 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def _run(name: str) -> str:
+def _run(name: str, cwd=None) -> str:
     p = subprocess.run([sys.executable, str(EXAMPLES / name)], capture_output=True, text=True, timeout=600,
-                       env={**os.environ, "MPLBACKEND": "Agg"})
+                       env={**os.environ, "MPLBACKEND": "Agg"}, cwd=cwd)
     assert p.returncode == 0, p.stderr
     return p.stdout
+
+
+def test_quickstart_example_fits_predicts_saves_loads_and_exports(tmp_path):
+    assert len([line for line in (EXAMPLES / "quickstart.py").read_text().splitlines()
+                if line.strip() and not line.startswith(('"""', "import"))]) <= 10
+    out = _run("quickstart.py", cwd=tmp_path)
+    assert "σ" in out and "ZZ1R" in out
+    r2 = float(out.split("another log:")[1].split()[0])
+    assert 0.99 < r2 <= 1.0
+    import json
+
+    assert json.loads((tmp_path / "er16_results.json").read_text())["kind"] == "identify"
+    assert (tmp_path / "er16_identified.urdf").read_text().startswith("<?xml")
 
 
 def test_paper_experiment_example():

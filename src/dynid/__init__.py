@@ -43,6 +43,11 @@ _EXPORTS = {
     "PaperExperimentConfig": "dynid.experiment.paper",
     "run_paper_experiment": "dynid.experiment.paper",
     "summary": "dynid.report.summaries",
+    "Identifier": "dynid.experiment.identifier",
+    "IdentifiedModel": "dynid.experiment.identified",
+    "load_results": "dynid.experiment.identified",
+    "simulated_log": "dynid.experiment.simulated_logs",
+    "load_recording": "dynid.io.datasets",
 }
 
 __all__ = ["__version__", *_EXPORTS]

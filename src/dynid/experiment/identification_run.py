@@ -125,7 +125,8 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
-    result = replace(result, settings={**result.settings, "coulomb_velocity": robot.coulomb_velocity.tolist(),
+    result = replace(result, settings={**result.settings, "robot_source": config.robot_source,
+                                       "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
                                        **({} if friction is None else {"friction_models": friction.to_dict()}),
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
@@ -302,4 +303,9 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         base = base_parameters(robot, rng=0)
     elif friction != "description":
         raise ConfigError(f'friction: expected "description" or "auto", got {friction!r}', field="friction")
-    return identify(robot, base, data, estimators, (), None, held_out=True)
+    result = identify(robot, base, data, estimators, (), None, held_out=True)
+    from ..model.description import builtin_robots
+
+    return replace(result, settings={**result.settings, "robot_source": robot.name if robot.name in builtin_robots() else "",
+                                     "coulomb_velocity": robot.coulomb_velocity.tolist(),
+                                     **({} if friction != "auto" else {"friction_models": choice.to_dict()})})

@@ -33,6 +33,22 @@ def read_config(path: Path, known: set[str]) -> dict:
     return doc
 
 
+def robot_source(doc: dict, path: Path, data_root: Path | None = None) -> str:
+    """Where a config's robot comes from, for results to find it again: a built-in name, the absolute path of its
+    description or URDF, or ``"config:<absolute path of the config>"`` for a ``[robot]`` table."""
+    ref = doc.get("robot")
+    if isinstance(ref, dict):
+        return f"config:{path.resolve()}"
+    if not isinstance(ref, str):
+        return ""
+    if ref in builtin_robots():
+        return ref
+    for folder in (path.parent, data_root):
+        if folder is not None and (folder / ref).is_file():
+            return str((folder / ref).resolve())
+    return ref
+
+
 def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     """The robot of a config's ``robot`` field: a built-in name, a description TOML or a URDF (relative to the config,
     else to the data root), or a ``[robot]`` table: a description inline (``urdf = "arm.urdf"`` and what a URDF

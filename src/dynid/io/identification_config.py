@@ -67,7 +67,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from ..exceptions import ConfigError, DataError
-from .configs import config_robot, read_config
+from .configs import config_robot, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .trajectories import load_trajectory
 from ..model.robot import Robot
@@ -94,6 +94,7 @@ class IdentificationConfig:
     estimators: tuple[str, ...] = ("wls",)
     seed: int = 0
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
+    robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
 
 
@@ -240,7 +241,8 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
         raise ConfigError(f"{path}: references: expected [[references]] tables")
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
-    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators, seed, gains, friction)
+    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators, seed=seed,
+                                drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root))
 
 
 def _estimators_from_old(est: dict) -> str:

@@ -31,7 +31,7 @@ def stored_estimates(identified: dict, names, source: str = "results", robot: st
     Returns
     -------
     dict
-        label -> (n_base,) array, the main estimate first.
+        label -> (n_base,) array, in the order results.json holds them.
 
     Raises
     ------
@@ -53,9 +53,6 @@ def stored_estimates(identified: dict, names, source: str = "results", robot: st
     if isinstance(identified.get("estimates"), dict):
         for label, e in identified["estimates"].items():
             sets[str(label)] = _vector(e, names, f"{source}: estimates.{label}")
-        main = identified.get("main_estimate")
-        if main in sets:
-            sets = {main: sets[main], **{k: v for k, v in sets.items() if k != main}}
         return sets
     # results.json before the estimates table
     method = str(identified.get("method", "ls")).upper()

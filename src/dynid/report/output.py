@@ -263,7 +263,7 @@ def save_figure(fig_or_axes, path: Path) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
-SCHEMA_VERSION = 2
+from ..experiment.identified import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # noqa: E402  one number for both
 """Version of the layout of the JSON files dynid writes; raised when a field changes meaning or goes."""
 
 

@@ -1,0 +1,257 @@
+"""``dynid.Identifier``: the identification as a scikit-learn style estimator — ``fit`` on a robot's arrays or on a
+config, ``predict`` torques, ``score``, the parameters by name with σ, ``get_params``/``set_params``.
+
+Example::
+
+    ident = dynid.Identifier("ur10e", estimators=["wls", "sdp"]).fit(t, q, tau)
+    tau_hat = ident.predict(q, dq, ddq)
+    print(ident.parameters_)                 # name, value, σ, unit
+    ident.save("results.json"); model = dynid.load_results("results.json")
+"""
+
+from __future__ import annotations
+
+import inspect
+from pathlib import Path
+
+import numpy as np
+
+from ..model.robot import Robot
+from ..preprocessing.settings import Preprocessing
+
+__all__ = ["Identifier"]
+
+
+class Identifier:
+    """Identify a robot's dynamic model (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot, str or path, optional
+        The robot's description: a :class:`~dynid.model.robot.Robot`, a built-in name (``"ur10e"``) or a description
+        TOML / URDF path. Required to fit arrays; a config names its own.
+    estimators : sequence of str, optional
+        Keys of :mod:`dynid.estimators.registry`, case-insensitive; the first is the main estimate (default
+        ``["wls"]``, or the config's).
+    preprocessing : Preprocessing or dict, optional
+        Preprocessing settings (default: every setting derived from the data, or the config's).
+    friction : {"auto", "description"}, optional
+        Each joint's friction model chosen by cross-validation, or the description's terms (default: "description"
+        for arrays, the config's for a config).
+    seed : int, optional
+        Seeds the box searches (default 0, or the config's).
+
+    Attributes
+    ----------
+    result_ : dynid.experiment.identification.IdentificationResult
+        Everything the identification found (fit, validations, verdict).
+    model_ : dynid.experiment.identified.IdentifiedModel
+        The identified model (predict, validate, export, save).
+    params_ : (n_base,) array
+        The main estimate's base parameters.
+    params_std_ : (n_base,) array
+        Their standard deviations (NaN when the main estimator gives none).
+    parameters_ : Parameters
+        The same by name: ``ident.parameters_["ZZ1R"].value``, ``.std``, ``.unit``.
+    feature_names_out_ : tuple of str
+        The base parameters' names.
+    estimates_ : dict
+        label -> (n_base,) array of every estimate.
+    """
+
+    def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
+                 friction: str | None = None, seed: int | None = None):
+        self.robot = robot
+        self.estimators = estimators
+        self.preprocessing = preprocessing
+        self.friction = friction
+        self.seed = seed
+
+    def get_params(self, deep: bool = True) -> dict:
+        """The constructor's parameters and their values (scikit-learn's contract).
+
+        Parameters
+        ----------
+        deep : bool
+            Unused (no nested estimators).
+
+        Returns
+        -------
+        dict
+        """
+        return {name: getattr(self, name) for name in inspect.signature(type(self).__init__).parameters if name != "self"}
+
+    def set_params(self, **params) -> "Identifier":
+        """Set constructor parameters by name.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ValueError
+            An unknown name.
+        """
+        known = self.get_params()
+        for name, value in params.items():
+            if name not in known:
+                raise ValueError(f"Identifier has no parameter {name!r}; expected one of {sorted(known)}")
+            setattr(self, name, value)
+        return self
+
+    def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> "Identifier":
+        """Identify the robot from arrays, or from a config file.
+
+        Parameters
+        ----------
+        t : (N,) array [s], or path of an identification config (TOML)
+            Time stamps (jittered ones are interpolated onto a uniform grid, as the log readers do); or a config,
+            whose settings this identifier's given parameters override.
+        q : (N, n_dof) array [rad]
+            Joint positions (arrays only).
+        tau : (N, n_dof) array [N·m]
+            Joint torques (arrays only).
+        dq : (N, n_dof) array [rad/s], optional
+            Measured velocities.
+        data_root : path, optional
+            A config's data folder (overrides the config's).
+        validate : bool
+            Validate on a config's validation logs.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ConfigError
+            A malformed config or setting, or no robot for arrays.
+        DataError, ShapeError, IdentifiabilityError
+            Data that cannot be identified from (the message says why).
+        """
+        from ..exceptions import ConfigError
+        from .identified import IdentifiedModel
+
+        if isinstance(t, (str, Path)):
+            result = self._fit_config(Path(t), data_root, validate)
+        else:
+            from .identification_run import identify_from_arrays
+
+            if q is None or tau is None:
+                raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
+            result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
+                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description")
+        self.result_ = result
+        self.model_ = IdentifiedModel.from_result(result)
+        main = result.main_estimate
+        self.params_ = main.params
+        self.params_std_ = main.std if main.std is not None else np.full(main.params.shape, np.nan)
+        self.feature_names_out_ = result.base.names
+        self.parameters_ = self.model_.parameters()
+        self.estimates_ = dict(self.model_.estimates)
+        return self
+
+    def _fit_config(self, path: Path, data_root, validate: bool):
+        from dataclasses import replace
+
+        from ..estimators.registry import parse_estimators
+        from ..io.identification_config import load_identification_config
+        from .identification_run import run_identification
+
+        config = load_identification_config(path, data_root)
+        changes = {}
+        if self.robot is not None:
+            changes["robot"] = self._robot()
+        if self.estimators is not None:
+            changes["estimators"] = parse_estimators(tuple(self.estimators))
+        if self.preprocessing is not None:
+            changes["preprocessing"] = self._preprocessing()
+        if self.friction is not None:
+            changes["friction"] = self.friction
+        if self.seed is not None:
+            changes["seed"] = int(self.seed)
+        return run_identification(replace(config, **changes), validate=validate)
+
+    def _robot(self) -> Robot:
+        from ..exceptions import ConfigError
+        from ..model.description import load_robot
+
+        if self.robot is None:
+            raise ConfigError("Identifier(robot=...): the robot's description is needed to fit arrays", field="robot")
+        return self.robot if isinstance(self.robot, Robot) else load_robot(self.robot)
+
+    def _preprocessing(self) -> Preprocessing | None:
+        from ..exceptions import ConfigError
+
+        p = self.preprocessing
+        if p is None or isinstance(p, Preprocessing):
+            return p
+        if isinstance(p, dict):
+            try:
+                return Preprocessing(**p)
+            except TypeError as exc:
+                raise ConfigError(f"preprocessing: {exc}", field="preprocessing") from None
+        raise ConfigError(f"preprocessing: expected Preprocessing settings or a dict of them, got {type(p).__name__}",
+                          field="preprocessing")
+
+    def _model(self):
+        if not hasattr(self, "model_"):
+            raise AttributeError("this Identifier is not fitted yet: call fit(t, q, tau) or fit(config) first")
+        return self.model_
+
+    def parameters(self, estimate: str | None = None):
+        """The base parameters of ``estimate`` (a label such as ``"dynid WLS"`` or a key such as ``"wls"``; default the
+        main one) by name, with σ where the estimator gives it.
+
+        Returns
+        -------
+        dynid.experiment.identified.Parameters
+        """
+        return self._model().parameters(estimate)
+
+    def predict(self, q, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
+        """Joint torques of the identified model (:meth:`dynid.experiment.identified.IdentifiedModel.predict`).
+
+        Parameters
+        ----------
+        q : (N, n_dof) array [rad], or a recording
+        dq, ddq : (N, n_dof) arrays [rad/s, rad/s²]
+        estimate : str, optional
+            Label of the estimate (default the main one).
+
+        Returns
+        -------
+        (N, n_dof) array [N·m]
+        """
+        return self._model().predict(q, dq, ddq, estimate)
+
+    def score(self, q, dq=None, ddq=None, tau=None, estimate: str | None = None) -> float:
+        """R² of the predicted torques: on a motion and its measured torques ``score(q, dq, ddq, tau)``, or on a log
+        ``score(recording)`` (prepared as the identification log was).
+
+        Returns
+        -------
+        float
+            1 is a perfect prediction.
+        """
+        if hasattr(q, "tau") and hasattr(q, "rate"):
+            return self._model().score(q, estimate)
+        if tau is None:
+            raise ValueError("score(q, dq, ddq, tau): the measured torques are needed (or give a log)")
+        pred = self.predict(q, dq, ddq, estimate)
+        tau = np.asarray(tau, dtype=float)
+        return 1.0 - float(np.sum((tau - pred) ** 2)) / float(np.sum((tau - tau.mean(axis=0)) ** 2))
+
+    def save(self, path: str | Path) -> Path:
+        """Write the identification's results.json (read back by :func:`dynid.load_results`).
+
+        Returns
+        -------
+        Path
+        """
+        return self._model().save(path)
+
+    def __repr__(self) -> str:
+        given = {k: v for k, v in self.get_params().items() if v is not None}
+        return f"Identifier({', '.join(f'{k}={v!r}' for k, v in given.items())})"

@@ -1,0 +1,121 @@
+"""dynid.Identifier and dynid.load_results: the identification as a scikit-learn style estimator, checked against
+the simulation's truth and Pinocchio's inverse dynamics."""
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import ConfigError, DataError
+
+from ..simulated_logs import simulated_case, truth_beta
+
+
+@pytest.fixture(scope="module")
+def er16():
+    robot = dynid.load_robot("er16")
+    return robot, dynid.simulated_log(robot, seconds=30, seed=1), dynid.simulated_log(robot, seconds=20, seed=2)
+
+
+@pytest.fixture(scope="module")
+def fitted(er16):
+    robot, log, _ = er16
+    return dynid.Identifier(robot, estimators=["WLS", "sdp"]).fit(log.t, log.q, log.tau)
+
+
+def test_fit_on_arrays_finds_the_truth_within_its_sigma(er16, fitted):
+    robot, _, _ = er16
+    truth = fitted.result_.base.base_from_standard(robot.standard_parameters())
+    wls = fitted.parameters("wls")
+    assert wls.names == fitted.feature_names_out_ and len(wls) == truth.size
+    assert np.all(np.abs(wls.values - truth) <= np.maximum(5 * wls.std, 1e-6 * np.abs(truth).max()))
+    assert wls["ZZ1R"].unit == "kg·m²" and wls["ZZ1R"].value == wls.values[0] and np.isfinite(wls["ZZ1R"].std)
+    assert set(fitted.estimates_) == {"dynid WLS", "dynid SDP"} and fitted.params_ is fitted.estimates_[fitted.result_.main]
+
+
+def test_predict_matches_pinocchio_inverse_dynamics(er16, fitted):
+    robot, _, _ = er16
+    assert robot.drive_terms == ("fc", "fv")
+    rng = np.random.default_rng(3)
+    q, dq, ddq = (rng.uniform(-1, 1, (50, robot.n_dof)) for _ in range(3))
+    fc, fv = robot.drive.T
+    rigid = dynid.rnea_torques(robot, q, dq, ddq, drive=np.zeros_like(robot.drive))  # Pinocchio's RNEA, no drive terms
+    truth = rigid + fc * np.sign(dq) + fv * dq
+    for estimate in ("wls", "sdp"):
+        predicted = fitted.predict(q, dq, ddq, estimate=estimate)
+        rms = np.sqrt(np.mean((predicted - truth) ** 2, axis=0))
+        assert np.all(rms < 0.01 * np.sqrt(np.mean(truth**2, axis=0))), (estimate, rms)
+
+
+def test_score_on_another_log_and_on_arrays(er16, fitted):
+    robot, _, other = er16
+    assert 0.99 < fitted.score(other) <= 1.0
+    q, dq, ddq = (np.random.default_rng(4).uniform(-1, 1, (30, robot.n_dof)) for _ in range(3))
+    tau = dynid.regressor(robot, q, dq, ddq) @ robot.standard_parameters()
+    assert fitted.score(q, dq, ddq, tau) > 0.99
+    assert fitted.score(q, dq, ddq, tau + 100.0 * np.random.default_rng(5).normal(size=tau.shape)) < 0.5
+
+
+def test_save_and_load_back_give_the_same_model(tmp_path, er16, fitted):
+    robot, _, other = er16
+    path = fitted.save(tmp_path / "results.json")
+    model = dynid.load_results(path)  # the robot from the results' settings (a built-in name)
+    assert model.main == fitted.result_.main and list(model.estimates) == list(fitted.estimates_)
+    for label, beta in fitted.estimates_.items():
+        np.testing.assert_array_equal(model.params(label), beta)
+    np.testing.assert_array_equal(model.parameters("wls").std, fitted.parameters("wls").std)
+    q, dq, ddq = (np.random.default_rng(6).uniform(-1, 1, (10, robot.n_dof)) for _ in range(3))
+    np.testing.assert_array_equal(model.predict(q, dq, ddq), fitted.predict(q, dq, ddq))
+    assert model.score(other) == pytest.approx(fitted.score(other), rel=1e-12)
+    assert model.urdf() == fitted.model_.urdf() and "<robot name=\"er16\">" in model.urdf()
+    assert json.loads(path.read_text())["kind"] == "identify"
+
+
+def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
+    data = json.loads(fitted.save(tmp_path / "r.json").read_text())
+    data["settings"]["robot_source"] = ""
+    (tmp_path / "r.json").write_text(json.dumps(data))
+    with pytest.raises(DataError, match=r"r.json: the robot's description is not found .*load_results\(path, robot=\.\.\.\)"):
+        dynid.load_results(tmp_path / "r.json")
+    assert dynid.load_results(tmp_path / "r.json", robot="er16").robot.name == "er16"
+    with pytest.raises(DataError, match="not those of robot 'ur10e'"):
+        dynid.load_results(tmp_path / "r.json", robot="ur10e")
+    (tmp_path / "bad.json").write_text("{")
+    with pytest.raises(DataError, match="bad.json: cannot read it as JSON"):
+        dynid.load_results(tmp_path / "bad.json")
+
+
+def test_get_and_set_params_follow_scikit_learns_contract():
+    ident = dynid.Identifier("er16", estimators=["ols"])
+    assert ident.get_params() == {"robot": "er16", "estimators": ["ols"], "preprocessing": None, "friction": None, "seed": None}
+    assert ident.set_params(seed=3, friction="auto") is ident and ident.get_params()["seed"] == 3
+    with pytest.raises(ValueError, match="no parameter 'alpha'"):
+        ident.set_params(alpha=1)
+    with pytest.raises(AttributeError, match="not fitted yet"):
+        ident.predict(np.zeros((1, 6)), np.zeros((1, 6)), np.zeros((1, 6)))
+    with pytest.raises(ConfigError, match="robot's description is needed"):
+        dynid.Identifier().fit(np.arange(10.0), np.zeros((10, 6)), np.zeros((10, 6)))
+    with pytest.raises(ConfigError, match="unknown estimator|expected a comma-separated subset"):
+        dynid.Identifier("er16", estimators=["magic"]).fit(np.arange(1000) / 100, np.zeros((1000, 6)), np.zeros((1000, 6)))
+
+
+def test_fit_on_a_config_with_the_identifiers_settings_on_top(tmp_path):
+    cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
+    ident = dynid.Identifier(estimators=["wls", "ols"], seed=2).fit(cfg)
+    assert ident.result_.estimators == ("wls", "ols") and ident.result_.validations  # the config's validation log
+    truth = truth_beta(ident.result_, truth_robot)
+    assert np.linalg.norm(ident.params_ - truth) / np.linalg.norm(truth) < 0.02
+    saved = ident.save(tmp_path / "results.json")
+    model = dynid.load_results(saved)  # the robot: the config's description file, found from the results
+    np.testing.assert_array_equal(model.params(), ident.params_)
+
+
+def test_jittered_time_stamps_are_resampled_as_the_readers_do(er16):
+    robot, log, _ = er16
+    jitter = np.random.default_rng(7).uniform(-20e-6, 20e-6, log.t.shape)
+    exact = dynid.identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("ols",))
+    jittered = dynid.identify_from_arrays(robot, log.t + jitter, log.q, log.tau, estimators=("ols",))
+    assert any("interpolated onto a uniform grid at 249.99" in w for w in jittered.warnings)  # 1 / median step, as read from a CSV
+    # 20 µs of jitter at 250 Hz moves samples by 0.5 % of a step: the estimate moves far less than its σ
+    assert np.all(np.abs(jittered.solution.params - exact.solution.params) < 0.5 * exact.solution.params_std + 1e-9)
