@@ -76,6 +76,13 @@ def _parse_weights(text: Optional[str]):
         raise DynIdError(f"--weights: expected comma-separated numbers like 1,1,0.5, got {text!r}") from None
 
 
+def summary_blocks(result) -> list:
+    """What a command prints of its result (:func:`dynid.report.summaries.blocks`)."""
+    from ..report.summaries import blocks
+
+    return blocks(result)
+
+
 def _version(value: bool) -> None:
     if value:
         from .. import __version__
@@ -138,7 +145,7 @@ def run(
             paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
     except DynIdError as exc:
         _fail(exc, rep)
-    rep.blocks(result.summary_blocks())
+    rep.blocks(summary_blocks(result))
     rep.wrote(paths)
 
 
@@ -168,9 +175,7 @@ def identify(
             paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
     except DynIdError as exc:
         _fail(exc, rep)
-    from ..report.summaries import identification_blocks
-
-    rep.blocks(identification_blocks(result))
+    rep.blocks(summary_blocks(result))
     rep.wrote(paths)
 
 
@@ -304,7 +309,7 @@ def excite(
         paths = save_excitation(run, out)
     except DynIdError as exc:
         _fail(exc, rep)
-    rep.blocks(run.summary_blocks())
+    rep.blocks(summary_blocks(run))
     rep.wrote(paths)
 
 
@@ -355,7 +360,7 @@ def montecarlo(
         paths = save_montecarlo(result, out)
     except DynIdError as exc:
         _fail(exc, rep)
-    rep.blocks(result.summary_blocks())
+    rep.blocks(summary_blocks(result))
     rep.wrote(paths)
 
 

@@ -21,13 +21,11 @@ last link, about its origin, eq. 5 order).
 
 from __future__ import annotations
 
-import math
 
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..tables import Line, TextTable
 import scipy.linalg
 
 from ..conventions import INERTIAL_TERMS
@@ -190,19 +188,3 @@ class GainsAndPayload:
     def to_dict(self) -> dict:
         return {**self.gains.to_dict(), "description_gains": list(self.description_gains),
                 "payload": self.payload.to_dict(), "payload_frame": "last link's frame, about its origin (eq. 5 order)"}
-
-    def summary_blocks(self) -> list:
-        """The gains beside the description's, and the payload (blocks of :mod:`dynid.tables`)."""
-        g, p = self.gains, self.payload
-        rows = []
-        for j, (k, s, d) in enumerate(zip(g.gains, g.gains_std, self.description_gains)):
-            rows.append((f"J{j + 1}", f"{k:.4g}", f"{s:.2g}", f"{d:.4g}", f"{100 * (k - d) / d:+.1f}") if math.isfinite(k)
-                        else (f"J{j + 1}", "not observable", "", f"{d:.4g}", ""))
-        table = TextTable(f"Drive gains K (eq. 16) from the runs without and with the {g.payload_mass:g} kg payload "
-                          f"(Gautier & Briot; {g.n_rows} equations)",
-                          ("joint", "K (N·m/A)", "σ", "description", "diff. %"), tuple(rows))
-        vals = dict(zip(p.names, zip(p.values, p.std)))
-        line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"
-        if all(k in vals for k in ("MX", "MY", "MZ")):
-            line += ", centre of mass in the last link's frame (" + ", ".join(f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
-        return [table, Line(line)]

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -11,7 +10,6 @@ import numpy as np
 
 from ..excitation.design import ExcitationDesign, design_excitation
 from ..io.excitation_config import ExcitationConfig
-from ..tables import Line, TextTable, render_text
 
 
 @dataclass(frozen=True)
@@ -24,34 +22,6 @@ class ExcitationRun:
     q: np.ndarray
     dq: np.ndarray
     ddq: np.ndarray
-
-    def summary_blocks(self) -> list:
-        """What ``dynid excite`` prints, as blocks of :mod:`dynid.tables`."""
-        d, p, c = self.design, self.config.problem, self.config
-        out = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
-                    f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title"),
-               TextTable(f"Before / after (design grid of {p.grid_points} samples per period)", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
-                         ((f"initial: {c.initial_label}", f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),
-                          ("optimised", f"{d.cond:.2f}", f"{d.log_det:.2f}")))]
-        if d.initial_violations:
-            out.append(Line("the initial trajectory violates: " + "; ".join(
-                f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
-        else:
-            out.append(Line("the initial trajectory satisfies every constraint too (same limits for both)"))
-        out.append(Line(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
-                        f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)")
-                        + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
-                        + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s"))
-        rows = tuple((m.constraint, m.where, f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}",
-                      "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}") for m in d.margins)
-        out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
-                             ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
-        out.append(Line(f"excitation.csv: {self.t.size} set-points at {c.rate:g} Hz"))
-        return out
-
-    def summary(self, width: int = 100) -> str:
-        """Plain-text summary of the design."""
-        return render_text(self.summary_blocks(), width)
 
     def to_dict(self) -> dict:
         c, p = self.config, self.config.problem

@@ -40,7 +40,6 @@ from ..simulation.measurements import NoiseModel
 from ..estimators.estimation import Estimation
 from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
 from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
-from ..tables import Line, TextTable, render_text
 from ..threads import with_single_blas_thread
 
 DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
@@ -254,34 +253,6 @@ class MonteCarloResult:
             "errors": self.errors,
             "timings": self.timings,
         }
-
-    def summary_blocks(self) -> list:
-        """What ``dynid montecarlo`` prints, as blocks of :mod:`dynid.tables`."""
-        cfg, stats = self.config, self.statistics()
-        nonzero = np.abs(self.truth) > 1e-9 * np.abs(self.truth).max()
-        rows, ends = [], set()
-        for li, level in enumerate(cfg.noise_levels):
-            for key in cfg.estimators:
-                s = stats[key]
-                rows.append((f"{level:g}", label(key), *(f"{f(s[k][li]):.3g}" for k, f in (
-                    ("std_over_crb", np.nanmedian), ("std_over_crb", np.nanmax), ("bias_over_crb", np.nanmedian), ("bias_over_crb", np.nanmax))),
-                    f"{100 * np.nanmedian(s['rmse'][li][nonzero] / np.abs(self.truth[nonzero])):.3g}",
-                    str(int(s["failures"][li])), f"{s['seconds_median'][li]:.3g}"))
-            ends.add(len(rows) - 1)
-        out = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(self.names)} base parameters, "
-                    f"{cfg.realisations} realisations × {len(cfg.noise_levels)} noise levels, {cfg.duration:g} s at {cfg.rate:g} Hz; "
-                    f"ran on {self.cluster} in {self.timings.get('total', float('nan')):.1f} s", "title"),
-               TextTable("Spread σ and bias |b| of the base parameters in units of √CRB (Cramér–Rao bound, raw-torque Gaussian "
-                         "noise): median and worst over the parameters; median RMSE/|β| %; failed fits; median s per fit",
-                         ("noise A", "method", "σ med", "σ max", "|b| med", "|b| max", "RMSE %", "fails", "s/fit"),
-                         tuple(rows), labels=2, section_ends=frozenset(ends))]
-        if self.errors:
-            out.append(Line(f"{len(self.errors)} fits failed; the first: {self.errors[0]['error']}", "warning"))
-        return out
-
-    def summary(self, width: int = 100) -> str:
-        """Plain-text summary of the study."""
-        return render_text(self.summary_blocks(), width)
 
 
 @contextlib.contextmanager

@@ -21,7 +21,6 @@ from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
-from ..dynamics.regressor import regressor
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.estimation import Estimation, stacked_rows, stream_rows
 from ..estimators.physically_consistent import CONSISTENCY_TOL
@@ -40,7 +39,6 @@ from ..simulation.measurements import NoiseModel, simulate_measurements, torques
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
 from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
-from ..tables import render_text
 from ..threads import with_single_blas_thread
 
 PLANTS = ("assumed", "paper")
@@ -242,17 +240,6 @@ class PaperRunResult:
                 d["physically_consistent"] = bool(m.consistency_margin >= -CONSISTENCY_TOL)
             out["estimates"][key] = d
         return out
-
-    def summary_blocks(self) -> list:
-        """What ``dynid run`` prints, as blocks of :mod:`dynid.tables`."""
-        from .paper_summary import run_summary_blocks
-
-        return run_summary_blocks(self)
-
-    def summary(self, width: int = 100) -> str:
-        """Plain-text summary: parameters beside the truth and Table 2, the estimators compared, per-joint metrics."""
-        return render_text(self.summary_blocks(), width)
-
 
 def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -4,14 +4,17 @@ the results hold numbers, this module their text. :func:`summary` renders any re
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..conventions import unit_of
+from ..estimators.registry import label
 from ..tables import Line, TextTable, render_text
 from ..validation.torques import comparison_table
 
 __all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
-           "coulomb_choice_table"]
+           "coulomb_choice_table", "drive_gains_blocks", "montecarlo_blocks", "excitation_blocks"]
 
 
 def summary(result, width: int = 100) -> str:
@@ -38,12 +41,16 @@ def blocks(result) -> list:
     TypeError
         Not a result of dynid.
     """
+    from ..experiment.excitation import ExcitationRun
     from ..experiment.identification import IdentificationResult
+    from ..experiment.montecarlo import MonteCarloResult
+    from ..experiment.paper import PaperRunResult
+    from .paper_summary import run_summary_blocks
 
-    if isinstance(result, IdentificationResult):
-        return identification_blocks(result)
-    if hasattr(result, "summary_blocks"):
-        return result.summary_blocks()
+    for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
+                       (MonteCarloResult, montecarlo_blocks), (ExcitationRun, excitation_blocks)):
+        if isinstance(result, kind):
+            return make(result)
     raise TypeError(f"expected a result of dynid, got {type(result).__name__}")
 
 
@@ -84,24 +91,24 @@ def identification_blocks(result) -> list:
             out.append(Line(f"{ref.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
                             f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters"))
     out.append(Line("residual σ per joint (N·m): " + ", ".join(f"{x:.3g}" for x in r.joint_std)))
-    for label, e in r.estimates.items():
+    for name, e in r.estimates.items():
         if e.pseudo_inertia_min_eig is not None:
-            out.append(Line(f"{label}: physically consistent least squares, prior: the robot model's nominal parameters; smallest "
+            out.append(Line(f"{name}: physically consistent least squares, prior: the robot model's nominal parameters; smallest "
                             "pseudo-inertia eigenvalue per link " + ", ".join(f"{x:.3g}" for x in e.pseudo_inertia_min_eig)))
     if r.consistency_verdicts:
         out.append(Line("physically consistent (some mass distribution with friction and rotor inertias ≥ 0 has these base "
-                        "parameters)? " + "; ".join(f"{label}: {v}" for label, v in r.consistency_verdicts.items())))
+                        "parameters)? " + "; ".join(f"{name}: {v}" for name, v in r.consistency_verdicts.items())))
     if r.objective:
-        rows = tuple((label, f"{f:.4f}",
-                      "" if label not in r.estimates else (str(r.estimates[label].n_evaluations) if r.estimates[label].n_evaluations else "solve"),
-                      "" if label not in r.estimates else f"{r.estimates[label].seconds:.2f}") for label, f in r.objective.items())
+        rows = tuple((name, f"{f:.4f}",
+                      "" if name not in r.estimates else (str(r.estimates[name].n_evaluations) if r.estimates[name].n_evaluations else "solve"),
+                      "" if name not in r.estimates else f"{r.estimates[name].seconds:.2f}") for name, f in r.objective.items())
         out.append(TextTable(f"Estimators on {r.fit.name} (the validation tables follow)",
                              ("parameters", "F eq. 9 (N·m)", "evaluations", "time (s)"), rows))
         if r.box is not None:
             out.append(Line(f"LAD, ABC, DE and PSO search the box {r.label} ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|value|); "
                             "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations"))
     if r.drive_gains is not None:
-        out.extend(r.drive_gains.summary_blocks())
+        out.extend(drive_gains_blocks(r.drive_gains))
     for c in (r.fit, *r.validations):
         out.append(comparison_table(c))
         out.extend(Line(f) for f in c.flags())
@@ -169,3 +176,97 @@ def coulomb_choice_table(cv: dict) -> TextTable:
                  for frac, vs_row, e_row in zip(cv["grid_fraction_of_rms_speed"], cv["candidates"], cv["out_of_fold_rms_error"]))
     return TextTable(f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m), {cv['folds']} contiguous folds; chosen: *",
                      ("v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cv["velocity"])))), rows)
+
+
+def drive_gains_blocks(gains) -> list:
+    """The drive gains beside the description's, and the payload (``[drive_gains]`` of an identification).
+
+    Parameters
+    ----------
+    gains : dynid.experiment.drive_gains.GainsAndPayload
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    g, p = gains.gains, gains.payload
+    rows = []
+    for j, (k, s, d) in enumerate(zip(g.gains, g.gains_std, gains.description_gains)):
+        rows.append((f"J{j + 1}", f"{k:.4g}", f"{s:.2g}", f"{d:.4g}", f"{100 * (k - d) / d:+.1f}") if math.isfinite(k)
+                    else (f"J{j + 1}", "not observable", "", f"{d:.4g}", ""))
+    table = TextTable(f"Drive gains K (eq. 16) from the runs without and with the {g.payload_mass:g} kg payload "
+                      f"(Gautier & Briot; {g.n_rows} equations)",
+                      ("joint", "K (N·m/A)", "σ", "description", "diff. %"), tuple(rows))
+    vals = dict(zip(p.names, zip(p.values, p.std)))
+    line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"
+    if all(k in vals for k in ("MX", "MY", "MZ")):
+        line += ", centre of mass in the last link's frame (" + ", ".join(f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
+    return [table, Line(line)]
+
+
+def montecarlo_blocks(result) -> list:
+    """What ``dynid montecarlo`` prints: spread and bias against the Cramér–Rao bound per noise level and estimator.
+
+    Parameters
+    ----------
+    result : dynid.experiment.montecarlo.MonteCarloResult
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    cfg, stats = result.config, result.statistics()
+    nonzero = np.abs(result.truth) > 1e-9 * np.abs(result.truth).max()
+    rows, ends = [], set()
+    for li, level in enumerate(cfg.noise_levels):
+        for key in cfg.estimators:
+            s = stats[key]
+            rows.append((f"{level:g}", label(key), *(f"{f(s[k][li]):.3g}" for k, f in (
+                ("std_over_crb", np.nanmedian), ("std_over_crb", np.nanmax), ("bias_over_crb", np.nanmedian), ("bias_over_crb", np.nanmax))),
+                f"{100 * np.nanmedian(s['rmse'][li][nonzero] / np.abs(result.truth[nonzero])):.3g}",
+                str(int(s["failures"][li])), f"{s['seconds_median'][li]:.3g}"))
+        ends.add(len(rows) - 1)
+    out = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(result.names)} base parameters, "
+                f"{cfg.realisations} realisations × {len(cfg.noise_levels)} noise levels, {cfg.duration:g} s at {cfg.rate:g} Hz; "
+                f"ran on {result.cluster} in {result.timings.get('total', float('nan')):.1f} s", "title"),
+           TextTable("Spread σ and bias |b| of the base parameters in units of √CRB (Cramér–Rao bound, raw-torque Gaussian "
+                     "noise): median and worst over the parameters; median RMSE/|β| %; failed fits; median s per fit",
+                     ("noise A", "estimator", "σ med", "σ max", "|b| med", "|b| max", "RMSE %", "fails", "s/fit"),
+                     tuple(rows), labels=2, section_ends=frozenset(ends))]
+    if result.errors:
+        out.append(Line(f"{len(result.errors)} fits failed; the first: {result.errors[0]['error']}", "warning"))
+    return out
+
+
+def excitation_blocks(run) -> list:
+    """What ``dynid excite`` prints: the design before and after, and the constraint margins.
+
+    Parameters
+    ----------
+    run : dynid.experiment.excitation.ExcitationRun
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    d, p, c = run.design, run.config.problem, run.config
+    out = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
+                f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title"),
+           TextTable(f"Before / after (design grid of {p.grid_points} samples per period)", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
+                     ((f"initial: {c.initial_label}", f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),
+                      ("optimised", f"{d.cond:.2f}", f"{d.log_det:.2f}")))]
+    if d.initial_violations:
+        out.append(Line("the initial trajectory violates: " + "; ".join(
+            f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
+    else:
+        out.append(Line("the initial trajectory satisfies every constraint too (same limits for both)"))
+    out.append(Line(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
+                    f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)")
+                    + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
+                    + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s"))
+    rows = tuple((m.constraint, m.where, f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}",
+                  "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}") for m in d.margins)
+    out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
+                         ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
+    out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    return out

@@ -217,13 +217,6 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     sets = np.concatenate([total[None], total[None] - fit])  # every block, and every block but one
 
     def columns(model: JointFriction, j: int) -> list[int]:
-        tau_sq += (tau**2).sum(axis=0)
-        if load_ok:
-            load_sq += ((y @ nominal) ** 2).sum(axis=0)
-    total = fit.sum(axis=0)
-    sets = np.concatenate([total[None], total[None] - fit])  # every block, and every block but one
-
-    def columns(model: JointFriction, j: int) -> list[int]:
         own = [index[t] for t in others if has[t][j]]
         r = model.rest
         if model.kind == "smooth":
