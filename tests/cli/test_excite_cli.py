@@ -77,9 +77,9 @@ def test_excite_er16_then_run_on_the_designed_trajectory(tmp_path):
     ({'offsets = [-0.3857, 0.0011, 0.0]': 'offsets = [-0.3857, 0.0011, 0.0]\n[limits]\nq_min = [-1, 2, -1]\nq_max = [1, 1, 1]'},
      "limits: joint 2 has q_max = 1 rad not above q_min = 2 rad"),
     ({"floor = -0.5": "floor = 1.5"}, "workspace excludes the start pose"),
-    ({"harmonics = 5": "harmonics = 0"}, "trajectory.harmonics: expected a positive integer, got 0"),
+    ({"harmonics = 5": "harmonics = 0"}, "trajectory.harmonics: expected an integer >= 1, got 0"),
     ({"frequency = 0.05": "omega_f = 0.3\nfrequency = 0.05"}, "give exactly one of frequency"),
-    ({"[design]": "[design]\ncolour = 1"}, "design: unknown field(s) ['colour']"),
+    ({"[design]": "[design]\ncolour = 1"}, "design: unknown field 'colour', expected some of criterion"),
     ({'initial = "paper"': 'initial = "nosuch.json"'}, "nosuch.json: trajectory file not found"),
 ])
 def test_bad_configs_get_one_line_errors_and_no_output(tmp_path, replace, message):

@@ -11,8 +11,9 @@ from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
 
 
-def read_config(path: Path, known: set[str]) -> dict:
-    """The TOML document at ``path``, whose top-level fields must be among ``known``.
+def read_config(path: Path, known: set[str] | None) -> dict:
+    """The TOML document at ``path``, whose top-level fields must be among ``known`` (None: any; the typed
+    structure checks them).
 
     Raises
     ------
@@ -27,7 +28,7 @@ def read_config(path: Path, known: set[str]) -> dict:
         raise ConfigError(f"{path}: not UTF-8 text{text_encoding_hint(path)}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: invalid TOML ({exc})") from None
-    unknown = sorted(set(doc) - known)
+    unknown = sorted(set(doc) - known) if known is not None else []
     if unknown:
         raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known)}")
     return doc

@@ -174,8 +174,7 @@ class Recording:
 def _rows(value, where: str):
     if value is None:
         return None
-    if (not isinstance(value, list) or len(value) != 2 or not all(isinstance(v, int) and not isinstance(v, bool) for v in value)
-            or value[0] < 1 or value[1] < value[0]):
+    if value[1] < value[0]:
         raise ConfigError(f"{where}.rows: expected [first, last] 1-based data rows with first <= last, got {value!r}")
     return (value[0], value[1])
 
@@ -183,17 +182,9 @@ def _rows(value, where: str):
 def _time_range(value, where: str):
     if value is None:
         return None
-    if (not isinstance(value, list) or len(value) != 2
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in value)
-            or value[0] < 0 or value[1] <= value[0]):
+    if not all(np.isfinite(v) for v in value) or value[0] < 0 or value[1] <= value[0]:
         raise ConfigError(f"{where}.time_range: expected [start, stop] in seconds with 0 <= start < stop, got {value!r}")
     return (float(value[0]), float(value[1]))
-
-
-def _gaps(value, where: str) -> str:
-    if value not in ("refuse", "interpolate"):
-        raise ConfigError(f"{where}.gaps: expected \"refuse\" or \"interpolate\", got {value!r}")
-    return value
 
 
 GAP_FACTOR = 5.0
@@ -241,7 +232,25 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
 
 
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
-    """Parse a dataset table of a config (module docstring); paths are relative to ``base``.
+    """Parse a dataset table of a config (module docstring; its structure:
+    :class:`dynid.io.config_types.DatasetTable`); paths are relative to ``base``.
+
+    Parameters
+    ----------
+    table : dict
+        The table as the TOML gave it.
+    base : Path
+        The data root.
+    where : str
+        ``"<config file>: <table>"``, for the messages.
+    name : str
+        The dataset's name when the table gives none.
+    n_dof : int
+        The robot's joints (one column each).
+
+    Returns
+    -------
+    DatasetSpec
 
     Raises
     ------
@@ -249,11 +258,15 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         Unknown preset, unit or side, a missing signal or file, a column list of the wrong length;
         the message names the config field.
     """
+    from ..typed import convert
+    from .config_types import DatasetTable
+
+    source, _, inside = where.rpartition(": ")
     if not isinstance(table, dict):
-        raise ConfigError(f"{where}: expected a table describing the dataset")
-    merged: dict = {}
+        convert(table, DatasetTable, source or where, inside if source else "")  # says what was expected
     preset = table.get("preset")
-    if preset is not None:
+    merged: dict = {}
+    if isinstance(preset, str):  # the preset's fields first, the table's on top (the merged table is checked below)
         if preset not in PRESETS:
             raise ConfigError(f"{where}.preset: unknown preset {preset!r}, expected one of {', '.join(PRESETS)}")
         merged.update({k: (dict(v) if isinstance(v, dict) else v) for k, v in PRESETS[preset].items()})
@@ -262,85 +275,62 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             merged[k] = {**merged[k], **v}
         else:
             merged[k] = v
-    if "bag" in merged:
-        return _bag_spec(merged, base, where, name, n_dof)
-    known = {"preset", "file", "header", "n_columns", "time", "rate", "resample", "side", "rows", "time_range", "gaps", "delimiter",
-             "name", "max_gap", "held", *_SIGNALS}
-    unknown = sorted(set(merged) - known)
-    if unknown:
-        raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(known)}")
-    default_file = merged.get("file")
+    t = convert(merged, DatasetTable, source or where, inside if source else "")
+    if t.bag is not None:
+        return _bag_spec(t, base, where, name, n_dof)
+    for key in ("topic", "joint_names", "effort"):
+        if getattr(t, key) is not None:
+            raise ConfigError(f"{where}.{key}: only for a dataset read from a ROS 2 bag (bag = \"folder\")")
 
-    def path_of(sig: dict, w: str) -> Path:
-        f = sig.get("file", default_file)
-        if not isinstance(f, str) or not f:
+    def path_of(f: str | None, w: str) -> Path:
+        f = f if f is not None else t.file
+        if not f:
             raise ConfigError(f"{w}: expected a 'file' (here or for the whole dataset)")
         p = Path(f)
         return p if p.is_absolute() else base / p
 
     signals = {}
     for kind in _SIGNALS:
-        if kind not in merged:
+        sig = getattr(t, kind)
+        if sig is None:
             continue
-        sig = merged[kind]
         w = f"{where}.{kind}"
-        if not isinstance(sig, dict) or "columns" not in sig:
+        if sig.columns is None:
             raise ConfigError(f"{w}: expected a table with 'columns' (1-based numbers or header names)")
-        cols = sig["columns"]
-        if not isinstance(cols, list) or len(cols) != n_dof:
-            raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {cols!r}")
+        if len(sig.columns) != n_dof:
+            raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {sig.columns!r}")
         units = _UNITS[kind]
-        unit = sig.get("unit", next(iter(units)))
+        unit = sig.unit if sig.unit is not None else next(iter(units))
         if unit not in units:
             raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
-        unknown = sorted(set(sig) - {"columns", "unit", "file", "sign", "scale", "side"})
-        if unknown:
-            raise ConfigError(f"{w}: unknown field(s) {unknown}, expected some of columns, file, unit, sign, scale, side")
         factor = np.full(n_dof, units[unit])
         for key in ("sign", "scale"):
-            if key in sig:
-                v = sig[key]
-                many = isinstance(v, list)
-                values = v if many else [v]
-                ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x != 0 for x in values)
-                if key == "sign":
-                    ok = ok and all(x in (1, -1) for x in values)
-                if not ok or (many and len(v) != n_dof):
-                    what = "1 or -1" if key == "sign" else "a non-zero number"
-                    raise ConfigError(f"{w}.{key}: expected {what} or a list of {n_dof} of them (one per joint), got {v!r}")
-                factor = factor * np.asarray(values, dtype=float)
-        side = sig.get("side")
-        if side is not None and side not in ("joint", "motor"):
-            raise ConfigError(f"{w}.side: expected 'joint' or 'motor', got {side!r}")
+            v = getattr(sig, key)
+            if v is None:
+                continue
+            many = isinstance(v, list)
+            values = v if many else [v]
+            ok = all(np.isfinite(x) and x != 0 for x in values) and (key != "sign" or all(x in (1, -1) for x in values))
+            if not ok or (many and len(v) != n_dof):
+                what = "1 or -1" if key == "sign" else "a non-zero number"
+                raise ConfigError(f"{w}.{key}: expected {what} or a list of {n_dof} of them (one per joint), got {v!r}")
+            factor = factor * np.asarray(values, dtype=float)
         scale = float(factor[0]) if np.all(factor == factor[0]) else tuple(float(x) for x in factor)
-        signals[kind] = SignalSpec(path_of(sig, w), tuple(cols), scale, side)
+        signals[kind] = SignalSpec(path_of(sig.file, w), tuple(sig.columns), scale, sig.side)
     if "positions" not in signals:
         raise ConfigError(f"{where}: expected 'positions' (columns of the joint or motor angles)")
     if ("currents" in signals) == ("torques" in signals):
         raise ConfigError(f"{where}: expected exactly one of 'currents' (with drive gains) or 'torques'")
-    time = None
-    if "time" in merged:
-        tm = merged["time"]
-        if not isinstance(tm, dict) or "column" not in tm:
-            raise ConfigError(f"{where}.time: expected a table {{ column = 1 }}")
-        time = SignalSpec(path_of(tm, f"{where}.time"), (tm["column"],), 1.0)
-    rate = merged.get("rate")
-    if (time is None) == (rate is None):
+    time = None if t.time is None else SignalSpec(path_of(t.time.file, f"{where}.time"), (t.time.column,), 1.0)
+    if (time is None) == (t.rate is None):
         raise ConfigError(f"{where}: expected either a 'time' column or a sampling 'rate' [Hz]")
-    for key in ("rate", "resample"):
-        v = merged.get(key)
-        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0):
-            raise ConfigError(f"{where}.{key}: expected a positive number [Hz], got {v!r}")
-    side = merged.get("side", "joint")
-    if side not in ("joint", "motor"):
-        raise ConfigError(f"{where}.side: expected 'joint' or 'motor', got {side!r}")
     return DatasetSpec(
-        name=str(merged.get("name", name)), signals=signals, time=time,
-        rate=None if rate is None else float(rate), resample=None if merged.get("resample") is None else float(merged["resample"]),
-        side=side, header=bool(merged.get("header", False)), n_columns=merged.get("n_columns"),
-        rows=_rows(merged.get("rows"), where), delimiter=str(merged.get("delimiter", ",")),
-        time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where),
-        table=_table_name(where), max_gap=_max_gap(merged.get("max_gap", 0.1), where), held=_held(merged.get("held", "interpolate"), where))
+        name=str(t.name if t.name is not None else name), signals=signals, time=time,
+        rate=None if t.rate is None else float(t.rate), resample=None if t.resample is None else float(t.resample),
+        side=t.side or "joint", header=bool(t.header), n_columns=t.n_columns,
+        rows=_rows(t.rows, where), delimiter=t.delimiter if t.delimiter is not None else ",",
+        time_range=_time_range(t.time_range, where), gaps=t.gaps or "refuse",
+        table=_table_name(where), max_gap=float(t.max_gap) if t.max_gap is not None else 0.1, held=t.held or "interpolate")
 
 
 def _table_name(where: str) -> str:
@@ -353,47 +343,21 @@ def _table_name(where: str) -> str:
     return f"[{part}]"
 
 
-def _max_gap(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-        raise ConfigError(f"{where}.max_gap: expected the longest gap to interpolate, in seconds (> 0), got {value!r}")
-    return float(value)
-
-
-def _held(value, where: str) -> str:
-    if value not in ("interpolate", "keep"):
-        raise ConfigError(f'{where}.held: expected "interpolate" or "keep", got {value!r}')
-    return value
-
-
-def _bag_spec(merged: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
+def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
     """A dataset read from a ROS 2 bag: ``bag = "folder"``, optional ``topic``, ``joint_names``, ``effort``."""
-    known = {"bag", "topic", "joint_names", "effort", "side", "resample", "time_range", "gaps", "name"}
-    unknown = sorted(set(merged) - known)
-    if unknown:
-        raise ConfigError(f"{where}: unknown field(s) {unknown} for a bag, expected some of {sorted(known)}")
-    bag = merged["bag"]
-    if not isinstance(bag, str) or not bag:
-        raise ConfigError(f"{where}.bag: expected the path of a ROS 2 bag folder, got {bag!r}")
-    path = Path(bag) if Path(bag).is_absolute() else base / bag
-    topic = merged.get("topic", "/joint_states")
-    if not isinstance(topic, str):
-        raise ConfigError(f"{where}.topic: expected a topic name, got {topic!r}")
-    names = merged.get("joint_names")
-    if names is not None and (not isinstance(names, list) or len(names) != n_dof or not all(isinstance(x, str) for x in names)):
-        raise ConfigError(f"{where}.joint_names: expected {n_dof} joint names, got {names!r}")
-    effort = merged.get("effort", "torques")
-    if effort not in ("torques", "currents"):
-        raise ConfigError(f"{where}.effort: expected \"torques\" or \"currents\", got {effort!r}")
-    side = merged.get("side", "joint")
-    if side not in ("joint", "motor"):
-        raise ConfigError(f"{where}.side: expected 'joint' or 'motor', got {side!r}")
-    resample = merged.get("resample")
-    if resample is not None and (isinstance(resample, bool) or not isinstance(resample, (int, float)) or not resample > 0):
-        raise ConfigError(f"{where}.resample: expected a positive number [Hz], got {resample!r}")
-    return DatasetSpec(name=str(merged.get("name", name)), signals={}, side=side,
-                       resample=None if resample is None else float(resample),
-                       time_range=_time_range(merged.get("time_range"), where), gaps=_gaps(merged.get("gaps", "refuse"), where),
-                       bag=BagSpec(path, topic, None if names is None else tuple(names), effort))
+    extra = [k for k in ("file", "header", "n_columns", "delimiter", "rows", "time", "rate", "max_gap", "held", *_SIGNALS)
+             if getattr(t, k) is not None]
+    if extra:
+        raise ConfigError(f"{where}: field(s) {extra} do not apply to a ROS 2 bag; expected some of bag, topic, joint_names, "
+                          "effort, side, resample, time_range, gaps, name")
+    path = Path(t.bag) if Path(t.bag).is_absolute() else base / t.bag
+    if t.joint_names is not None and len(t.joint_names) != n_dof:
+        raise ConfigError(f"{where}.joint_names: expected {n_dof} joint names, got {t.joint_names!r}")
+    return DatasetSpec(name=str(t.name if t.name is not None else name), signals={}, side=t.side or "joint",
+                       resample=None if t.resample is None else float(t.resample),
+                       time_range=_time_range(t.time_range, where), gaps=t.gaps or "refuse",
+                       bag=BagSpec(path, t.topic or "/joint_states", None if t.joint_names is None else tuple(t.joint_names),
+                                   t.effort or "torques"))
 
 
 def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -> Recording:

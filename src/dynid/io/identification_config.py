@@ -66,7 +66,11 @@ import os
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
+import msgspec
+
 from ..exceptions import ConfigError, DataError
+from ..typed import convert
+from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_robot, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .trajectories import load_trajectory
@@ -98,77 +102,56 @@ class IdentificationConfig:
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
 
 
-_PRE_KEYS = {"order": int, "position_cutoff": float, "velocity_cutoff": float, "parallel_cutoff": float, "band": float,
-             "decimation": int, "min_speed": None, "trim": float, "chunk": int, "excitation": None,
-             "coulomb_velocity": None, "rest_velocity": None, "rest_friction": None, "presliding": None,
-             "auto": None, "strategy": None, "smoothing_passes": int}
+REMOVED = {
+    ("preprocessing", "torque_cutoff"): "no longer exists, because a filter on the torques alone biases the estimate near "
+                                        "velocity reversals; use parallel_cutoff (torques and every regressor column), or "
+                                        "leave it out for the data-derived default",
+}
+"""Fields that no longer exist, and what to write instead (said before the typed check, which would only call them
+unknown); ``[estimation] method``, ``methods`` and ``physically_consistent`` are said by :func:`_estimators_from_old`."""
 
 
-def _preprocessing(table, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
-    if not isinstance(table, dict):
-        raise ConfigError(f"{where}: expected a table")
-    if "torque_cutoff" in table:
-        raise ConfigError(f"{where}.torque_cutoff: no longer exists, because a filter on the torques alone biases the "
-                          "estimate near velocity reversals; use parallel_cutoff (torques and every regressor column), "
-                          "or leave it out for the data-derived default")
-    unknown = sorted(set(table) - set(_PRE_KEYS))
-    if unknown:
-        raise ConfigError(f"{where}: unknown field(s) {unknown}, expected some of {sorted(_PRE_KEYS)}")
+def _per_joint(value, n: int, where: str):
+    """A per-joint setting as :class:`Preprocessing` holds it: the value, or a tuple of ``n``."""
+    if isinstance(value, list):
+        if len(value) != n:
+            raise ConfigError(f"{where}: expected one value or a list of {n} (one per joint), got {value!r}")
+        return tuple(float(x) if not isinstance(x, str) else x for x in value)
+    return value if isinstance(value, str) else float(value)
+
+
+def _preprocessing(table: PreprocessingTable, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
+    """:class:`Preprocessing` of a typed ``[preprocessing]`` table: what depends on the robot (one value per joint),
+    the strategy's name and the excitation file checked here."""
     values = {}
-    for key, kind in _PRE_KEYS.items():
-        if key not in table:
+    for f in msgspec.structs.fields(table):
+        v = getattr(table, f.name)
+        if v is None:
             continue
-        v = table[key]
-        if key == "excitation":
-            if not isinstance(v, str):
-                raise ConfigError(f"{where}.excitation: expected the excitation.json of dynid excite, got {v!r}")
+        w = f"{where}.{f.name}"
+        if f.name == "excitation":
             try:
                 traj = load_trajectory(here / v)
             except ConfigError as exc:
-                raise ConfigError(f"{where}.excitation: {exc}") from None
+                raise ConfigError(f"{w}: {exc}") from None
             if traj.n_dof != n:
-                raise ConfigError(f"{where}.excitation: the trajectory has {traj.n_dof} joints, the robot {n}")
+                raise ConfigError(f"{w}: the trajectory has {traj.n_dof} joints, the robot {n}")
             values["fourier"] = (traj.omega_f, traj.n_harmonics)
-            continue
-        if key == "rest_friction":
-            one = lambda x: x in ("held", "zero") or (isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0)  # noqa: E731
-            ok = one(v) or (isinstance(v, list) and len(v) == n and all(one(x) for x in v))
-            if not ok:
-                raise ConfigError(f'{where}.rest_friction: expected "held", "zero", a relaxation time in seconds, or a list '
-                                  f"of {n} of them, got {v!r}")
-            values[key] = tuple(v) if isinstance(v, list) else v
-            continue
-        if key == "strategy":
+        elif f.name == "strategy":
             from ..preprocessing.strategies import check_strategy
 
             try:
-                values[key] = check_strategy(v) if isinstance(v, str) else check_strategy(repr(v))
+                values["strategy"] = check_strategy(v)
             except ConfigError as exc:
-                raise ConfigError(f"{where}.strategy: {str(exc).split(': ', 1)[1]}") from None
-            continue
-        if key == "auto":
-            if not isinstance(v, bool):
-                raise ConfigError(f"{where}.auto: expected true or false, got {v!r}")
-            values[key] = v
-            continue
-        if key in ("min_speed", "coulomb_velocity", "rest_velocity", "presliding"):
-            if v == "auto" and key != "presliding":
-                values[key] = v
-                continue
-            ok = (isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0) or (
-                isinstance(v, list) and len(v) == n and all(isinstance(x, (int, float)) and not isinstance(x, bool) and x >= 0 for x in v))
-            if not ok:
-                auto = '"auto", ' if key != "presliding" else ""
-                raise ConfigError(f"{where}.{key}: expected {auto}a non-negative number or a list of {n} (rad/s), got {v!r}")
-            values[key] = tuple(float(x) for x in v) if isinstance(v, list) else float(v)
-            continue
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or (kind is int and v != int(v)) or v < 0:
-            raise ConfigError(f"{where}.{key}: expected a non-negative {'integer' if kind is int else 'number'}, got {v!r}")
-        if key in ("order", "decimation", "chunk") and v < 1:
-            raise ConfigError(f"{where}.{key}: expected an integer >= 1, got {v!r}")
-        if key == "band" and v <= 0:
-            raise ConfigError(f"{where}.band: expected a positive frequency in Hz, got {v!r}")
-        values[key] = kind(v)
+                raise ConfigError(f"{w}: {str(exc).split(': ', 1)[1]}") from None
+        elif f.name in ("min_speed", "coulomb_velocity", "rest_velocity", "presliding", "rest_friction"):
+            values[f.name] = _per_joint(v, n, w)
+        elif f.name in ("order", "decimation", "chunk", "smoothing_passes"):
+            values[f.name] = int(v)
+        elif f.name == "auto":
+            values[f.name] = bool(v)
+        else:
+            values[f.name] = float(v)
     return Preprocessing(**values)
 
 
@@ -182,67 +165,54 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         Folder the data paths are relative to; default: the environment variable ``DYNID_DATA_ROOT``,
         else the config's ``data_root`` (relative to the config file), else the config's folder.
 
+    Returns
+    -------
+    IdentificationConfig
+
     Raises
     ------
     ConfigError
-        Unreadable file, invalid TOML, unknown or malformed fields (the message names file and field).
+        Unreadable file, invalid TOML, unknown or malformed fields (the message names file and field;
+        the structure: :class:`dynid.io.config_types.IdentificationDocument`).
     """
     path = Path(path)
-    doc = read_config(path, {"robot", "data_root", "identification", "validation", "preprocessing", "estimation",
-                             "references", "name", "notes", "drive_gains"})
+    doc = read_config(path, None)
+    for (table, key), why in REMOVED.items():
+        if isinstance(doc.get(table), dict) and key in doc[table]:
+            raise ConfigError(f"{path}: {table}.{key}: {why}")
+    est = doc.get("estimation")
+    old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
+    if old:
+        raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
+                          f"estimators = {_estimators_from_old(est)}")
+    # the robot table is checked by the description's own parser (its drive terms are those registered now)
+    typed = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, IdentificationDocument, str(path))
     here = path.parent
     override = data_root or os.environ.get(DATA_ROOT_ENV)
-    if override is None and not isinstance(doc.get("data_root", "."), str):
-        raise ConfigError(f"{path}: data_root: expected a folder path, got {doc['data_root']!r}")
-    root = Path(override) if override else here / doc.get("data_root", ".")  # an absolute path stays as is
+    root = Path(override) if override else here / (typed.data_root or ".")  # an absolute path stays as is
     if not root.is_dir():
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
     robot = config_robot(doc, path, root)
     n = robot.n_dof
-    if "identification" not in doc:
-        raise ConfigError(f"{path}: expected an [identification] table describing the identification dataset")
     ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n)
-    vals = doc.get("validation", [])
-    if not isinstance(vals, list):
-        raise ConfigError(f"{path}: validation: expected [[validation]] tables")
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n) for i, v in enumerate(vals))
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n) for i, v in enumerate(doc.get("validation", [])))
     names = [v.name for v in validation]
     if len(set(names)) != len(names):
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
-    table = doc.get("preprocessing", {})
+    table = typed.preprocessing
     if table == "auto":
-        table = {"auto": True, "coulomb_velocity": "auto"}
-    pre = _preprocessing(table, f"{path}: preprocessing", n, here)
-    est = doc.get("estimation", {})
-    if not isinstance(est, dict):
-        raise ConfigError(f"{path}: estimation: expected a table")
-    old = [k for k in ("method", "physically_consistent", "methods") if k in est]
-    if old:
-        raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
-                          f"estimators = {_estimators_from_old(est)}")
-    unknown = sorted(set(est) - {"estimators", "seed", "friction"})
-    if unknown:
-        raise ConfigError(f"{path}: estimation: unknown field(s) {', '.join(unknown)}; expected estimators, friction, seed")
-    friction = est.get("friction", "description" if pre.coulomb_velocity != 0.0 else "auto")
-    if friction not in ("auto", "description"):
-        raise ConfigError(f'{path}: estimation.friction: expected "auto" (each joint\'s friction model chosen by '
-                          f'cross-validation) or "description" (the robot description\'s terms), got {friction!r}')
-    listed = est.get("estimators", ["wls"])
-    if not isinstance(listed, list) or not all(isinstance(m, str) for m in listed):
-        raise ConfigError(f"{path}: estimation.estimators: expected a list of estimator names like [\"wls\", \"sdp\"], got {listed!r}")
+        table = PreprocessingTable(auto=True, coulomb_velocity="auto")
+    pre = _preprocessing(table or PreprocessingTable(), f"{path}: preprocessing", n, here)
+    e = typed.estimation or EstimationTable()
+    friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
     try:
-        estimators = parse_estimators(listed)
+        estimators = parse_estimators(e.estimators) if e.estimators is not None else ("wls",)
     except ConfigError as exc:
         raise ConfigError(f"{path}: estimation.estimators: {str(exc).split(': ', 1)[1]}") from None
-    seed = est.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ConfigError(f"{path}: estimation.seed: expected a non-negative integer, got {seed!r}")
     refs = doc.get("references", [])
-    if not isinstance(refs, list) or not all(isinstance(r, dict) for r in refs):
-        raise ConfigError(f"{path}: references: expected [[references]] tables")
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
-    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators, seed=seed,
-                                drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root))
+    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
+                                seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root))
 
 
 def _estimators_from_old(est: dict) -> str:
@@ -255,25 +225,16 @@ def _estimators_from_old(est: dict) -> str:
 
 
 def _drive_gains(table, root: Path, where: str, n: int):
+    """``(payload_mass, unloaded DatasetSpec, loaded DatasetSpec)`` of a ``[drive_gains]`` table (typed already)."""
     if table is None:
         return None
-    if not isinstance(table, dict):
-        raise ConfigError(f"{where}: expected a table with payload_mass, [unloaded] and [loaded]")
-    unknown = sorted(set(table) - {"payload_mass", "unloaded", "loaded"})
-    missing = sorted({"payload_mass", "unloaded", "loaded"} - set(table))
-    if unknown or missing:
-        raise ConfigError(f"{where}: expected payload_mass, unloaded and loaded; "
-                          + (f"unknown {', '.join(unknown)}" if unknown else f"missing {', '.join(missing)}"))
-    mass = table["payload_mass"]
-    if isinstance(mass, bool) or not isinstance(mass, (int, float)) or not mass > 0:
-        raise ConfigError(f"{where}.payload_mass: expected a positive mass in kg, got {mass!r}")
     specs = []
     for key in ("unloaded", "loaded"):
         spec = dataset_spec(table[key], root, f"{where}.{key}", key, n)
         if "currents" not in spec.signals:
             raise ConfigError(f"{where}.{key}: expected motor currents (a currents column map or a preset with currents)")
         specs.append(spec)
-    return float(mass), specs[0], specs[1]
+    return float(table["payload_mass"]), specs[0], specs[1]
 
 
 def stored_preprocessing(identified: dict) -> Preprocessing | None:

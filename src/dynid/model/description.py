@@ -56,8 +56,10 @@ from pathlib import Path
 import numpy as np
 
 from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS
-from ..friction import COUNTERBALANCE_TERMS, DEFAULT_STRIBECK_VELOCITY, check_terms
+from ..friction import COUNTERBALANCE_TERMS, DEFAULT_STRIBECK_VELOCITY, TERMS, check_terms
 from ..exceptions import ConfigError
+from ..typed import convert
+from .description_types import PayloadTable, TransmissionTable, description_types
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot
 from .transmission import Transmission
@@ -108,35 +110,6 @@ def parse_angle(value, where: str) -> float:
     raise ConfigError(f"{where}: expected a number or an angle like 'pi/2', got {value!r}")
 
 
-def _number(table: dict, key: str, where: str, default=None) -> float:
-    if key not in table:
-        if default is None:
-            raise ConfigError(f"{where}: missing field {key!r}")
-        return float(default)
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigError(f"{where}.{key}: expected a number, got {value!r}")
-    return float(value)
-
-
-def _vector(table: dict, key: str, n: int, where: str, default=None) -> np.ndarray:
-    if key not in table:
-        if default is None:
-            raise ConfigError(f"{where}: missing field {key!r}")
-        return np.asarray(default, dtype=float)
-    value = table[key]
-    if not isinstance(value, list) or len(value) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        raise ConfigError(f"{where}.{key}: expected a list of {n} numbers, got {value!r}")
-    return np.asarray(value, dtype=float)
-
-
-TOP_FIELDS = {"name", "convention", "urdf", "gravity", "drive_terms", "notes", "tool", "transmission", "joints", "payload"}
-"""The fields of a robot description."""
-
-JOINT_FIELDS = {"name", "alpha", "a", "d", "theta_offset", "q_min", "q_max", "dq_max", "ddq_max", "tau_max", "drive_gain",
-                "drive_terms", "position_offset", "mass", "com", "inertia", "stribeck_velocity", "counterbalance"}
-"""The fields of a ``[[joints]]`` table (and one per drive term: its nominal value)."""
-
 URDF_DRIVE_TERMS = ("Ia", "fc", "fv", "offset")
 """Drive terms of a robot given by its URDF alone: what a geared arm with current or torque sensing needs."""
 
@@ -162,6 +135,19 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     """A robot from a parsed description (the module docstring's layout; a table of a config alike). With
     ``convention = "urdf"`` the ``[[joints]]`` tables are optional: the URDF gives the chain, inertias and limits.
 
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML (checked against :class:`dynid.model.description_types.RobotDescription`).
+    source : str
+        Named first in every message (the file).
+    base : Path or None
+        Folder relative paths (the URDF) start from.
+
+    Returns
+    -------
+    Robot
+
     Raises
     ------
     ConfigError
@@ -169,48 +155,41 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     """
     if not isinstance(doc, dict):
         raise ConfigError(f"{source}: expected a robot description table")
-    unknown = sorted(set(doc) - TOP_FIELDS)
-    if unknown:
-        raise ConfigError(f"{source}: unknown field(s) {unknown}, expected some of {sorted(TOP_FIELDS)}")
-    name = doc.get("name", Path(source).stem)
-    convention = doc.get("convention", "urdf" if "urdf" in doc else "modified")
-    if convention not in ("modified", "standard", "urdf"):
-        raise ConfigError(f"{source}: convention: expected 'modified', 'standard' or 'urdf', got {convention!r}")
-    terms = doc.get("drive_terms", DEFAULT_DRIVE_TERMS)
-    if not isinstance(terms, (list, tuple)) or not all(isinstance(t, str) for t in terms):
-        raise ConfigError(f"{source}: drive_terms: expected a list of term names, got {terms!r}")
+    joint_table, robot_table = description_types()
+    d = convert(doc, robot_table, source)
+    name = d.name if d.name is not None else Path(source).stem
+    convention = d.convention or ("urdf" if d.urdf is not None else "modified")
     try:
-        terms = check_terms(terms, f"{source}: drive_terms")
+        terms = check_terms(d.drive_terms if d.drive_terms is not None else DEFAULT_DRIVE_TERMS, f"{source}: drive_terms")
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     urdf_model = None
+    rows = d.joints
     if convention == "urdf":
         from .urdf import joints_from_urdf, urdf_limits
 
-        if "urdf" not in doc or not isinstance(doc["urdf"], str):
+        if d.urdf is None:
             raise ConfigError(f"{source}: convention 'urdf' needs a field 'urdf' with the file path")
-        upath = Path(doc["urdf"])
+        upath = Path(d.urdf)
         if not upath.is_absolute() and base is not None:
             upath = base / upath
         urdf_model = joints_from_urdf(upath)
-        if "joints" not in doc:
-            doc = {**doc, "joints": [{} for _ in urdf_model[0]]}
-    rows = doc.get("joints")
-    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        if rows is None:
+            rows = [joint_table() for _ in urdf_model[0]]
+    if not rows:
         raise ConfigError(f"{source}: expected one or more [[joints]] tables")
     n = len(rows)
     where = [f"{source}: joints[{i}]" for i in range(n)]
     for r, w in zip(rows, where):
-        bad = sorted(set(r) - JOINT_FIELDS - set(terms))
+        bad = sorted(t for t in TERMS if getattr(r, t) is not None and t not in terms)
         if bad:
-            raise ConfigError(f"{w}: unknown field(s) {bad}, expected some of {sorted(JOINT_FIELDS | set(terms))}")
-    names = [str(r.get("name", f"joint{i + 1}")) for i, r in enumerate(rows)]
+            raise ConfigError(f"{w}: field(s) {bad} are drive terms the robot does not have (drive_terms = {list(terms)})")
+    names = [r.name if r.name is not None else f"joint{i + 1}" for i, r in enumerate(rows)]
 
-    tool = doc.get("tool", {})
-    tool_t = _vector(tool, "translation", 3, f"{source}: tool", default=[0.0, 0.0, 0.0])
+    tool_t = np.asarray(d.tool.translation, dtype=float)
     tool_r = np.eye(3)
 
-    alpha = a = d = None
+    alpha = a = dd = None
     urdf_lim = None
     if convention == "urdf":
         joints, inertial, _ = urdf_model
@@ -218,132 +197,107 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
     else:
-        alpha = [parse_angle(r.get("alpha", 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
-        a = [_number(r, "a", w, 0.0) for r, w in zip(rows, where)]
-        d = [_number(r, "d", w, 0.0) for r, w in zip(rows, where)]
-        off = [parse_angle(r.get("theta_offset", 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
+        alpha = [parse_angle(_or(r.alpha, 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
+        a = [float(_or(r.a, 0.0)) for r in rows]
+        dd = [float(_or(r.d, 0.0)) for r in rows]
+        off = [parse_angle(_or(r.theta_offset, 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
         if convention == "modified":
-            joints = joints_from_modified_dh(alpha, a, d, off, names)
+            joints = joints_from_modified_dh(alpha, a, dd, off, names)
         else:
-            joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, d, off, names)
+            joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, dd, off, names)
             tool_t = tool_t0 + tool_r0 @ tool_t
             tool_r = tool_r0
         inertial = np.zeros((n, 10))
         for i, (r, w) in enumerate(zip(rows, where)):
-            mass = _number(r, "mass", w)
-            com = _vector(r, "com", 3, w)
-            ixx, iyy, izz, ixy, ixz, iyz = _vector(r, "inertia", 6, w)
+            for key in ("mass", "com", "inertia"):
+                if getattr(r, key) is None:
+                    raise ConfigError(f"{w}: missing field {key!r}")
+            mass, com = float(r.mass), np.asarray(r.com, dtype=float)
+            ixx, iyy, izz, ixy, ixz, iyz = r.inertia
             inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
             if not np.isfinite(mass) or mass < 0:
                 raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
             phi = inertial_from_physical(mass, com, inertia)
             if convention == "standard":  # given in DH frame i: express in dynid's link frame
-                rr, pp = standard_dh_link_offset(alpha[i], a[i], d[i])
+                rr, pp = standard_dh_link_offset(alpha[i], a[i], dd[i])
                 phi = transform_inertial(phi, rr, pp)
             inertial[i] = phi
 
-    balanced = [j for j, (r, w) in enumerate(zip(rows, where)) if _flag(r, "counterbalance", w)]
+    balanced = [j for j, r in enumerate(rows) if r.counterbalance]
     if balanced:
         terms = check_terms(tuple(terms) + COUNTERBALANCE_TERMS, source)
     mask = np.ones((n, len(terms)), dtype=bool)
     for j in range(n):  # the counterbalance terms belong to the joints that have one
         mask[j] = [t not in COUNTERBALANCE_TERMS or j in balanced for t in terms]
     for i, (r, w) in enumerate(zip(rows, where)):
-        if "drive_terms" in r:
-            own = r["drive_terms"]
-            if not isinstance(own, list) or any(t not in terms for t in own):
-                raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, got {own!r}")
-            mask[i] = [t in own or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
-    drive = np.array([[_number(r, t, w, 0.0) for t in terms] for r, w in zip(rows, where)]).reshape(n, len(terms)) * mask
-    offsets = np.array([parse_angle(r.get("position_offset", 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
-    transmission = _transmission(doc.get("transmission", {}), n, offsets, source)
-    gains = np.array([_number(r, "drive_gain", w, 1.0) for r, w in zip(rows, where)])
+        if r.drive_terms is not None:
+            if any(t not in terms for t in r.drive_terms):
+                raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, "
+                                  f"got {r.drive_terms!r}")
+            mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
+    drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
+    offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
+    transmission = _transmission(d.transmission, n, offsets, source)
+    gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
     if np.any(gains <= 0):
         i = int(np.argmax(gains <= 0))
         raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
     inf = np.inf
-    default = (lambda k, j, d: d) if urdf_lim is None else (lambda k, j, d: urdf_lim[k][j])  # noqa: E731
-    lim = {k: np.array([_number(r, k, w, default(k, j, dflt)) for j, (r, w) in enumerate(zip(rows, where))])
+    default = (lambda k, j, dflt: dflt) if urdf_lim is None else (lambda k, j, dflt: urdf_lim[k][j])  # noqa: E731
+    lim = {k: np.array([float(_or(getattr(r, k), default(k, j, dflt))) for j, r in enumerate(rows)])
            for k, dflt in (("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
     for k, dflt in (("q_min", -inf), ("q_max", inf)):  # angles may be written like "-2*pi"
-        lim[k] = np.array([parse_angle(r.get(k, default(k, j, dflt)), f"{w}.{k}") for j, (r, w) in enumerate(zip(rows, where))])
+        lim[k] = np.array([parse_angle(_or(getattr(r, k), default(k, j, dflt)), f"{w}.{k}") for j, (r, w) in enumerate(zip(rows, where))])
     for i in range(n):
         if not lim["q_min"][i] < lim["q_max"][i]:
             raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")
         for k in ("dq_max", "ddq_max", "tau_max"):
             if not lim[k][i] > 0:
                 raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
-    gravity = _vector(doc, "gravity", 3, source, default=[0.0, 0.0, -9.81])
-    if "payload" in doc:
+    gravity = np.asarray(d.gravity, dtype=float)
+    if d.payload is not None:
         inertial = inertial.copy()
-        inertial[-1] = inertial[-1] + _payload(doc["payload"], f"{source}: payload", convention, alpha, a, d)
-    link_names = [r.get("name", f"joint{i + 1}") for i, r in enumerate(rows)]
-    problems = tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(n)
+        inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, alpha, a, dd)
+    problems = tuple(f"{source}: link {i + 1} ({names[i]}): nominal {p}" for i in range(n)
                      for p in physical_problems(inertial[i]))
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
-        notes=str(doc.get("notes", "")), transmission=transmission, drive_mask=mask, nominal_problems=problems,
-        stribeck_velocity=_positive([_number(r, "stribeck_velocity", w, DEFAULT_STRIBECK_VELOCITY) for r, w in zip(rows, where)],
-                                    [f"{w}.stribeck_velocity" for w in where]),
+        notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
+        stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
     )
 
 
-def _flag(table: dict, key: str, where: str) -> bool:
-    value = table.get(key, False)
-    if not isinstance(value, bool):
-        raise ConfigError(f"{where}.{key}: expected true or false, got {value!r}")
-    return value
+def _or(value, default):
+    """``value`` unless it is None."""
+    return default if value is None else value
 
 
-def _payload(table, where: str, convention: str, alpha, a, d) -> np.ndarray:
+def _payload(p: PayloadTable, where: str, convention: str, alpha, a, d) -> np.ndarray:
     """The payload's inertial parameters in the last link's frame (eq. 5 order)."""
-    if not isinstance(table, dict):
-        raise ConfigError(f"{where}: expected a table with mass, com (and inertia)")
-    unknown = sorted(set(table) - {"mass", "com", "inertia"})
-    if unknown:
-        raise ConfigError(f"{where}: unknown field(s) {unknown}, expected mass, com, inertia")
-    mass = _number(table, "mass", where)
-    if not (np.isfinite(mass) and 0 < mass <= 10_000):
-        raise ConfigError(f"{where}.mass: expected a mass in (0, 10000] kg, got {mass}")
-    com = _vector(table, "com", 3, where)
+    com = np.asarray(p.com, dtype=float)
     if not np.all(np.isfinite(com)) or np.abs(com).max() > 10:
         raise ConfigError(f"{where}.com: expected a centre of mass within 10 m of the last link's origin, got {com.tolist()}")
-    ixx, iyy, izz, ixy, ixz, iyz = _vector(table, "inertia", 6, where, default=[0.0] * 6)
-    phi = inertial_from_physical(mass, com, np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+    ixx, iyy, izz, ixy, ixz, iyz = p.inertia
+    phi = inertial_from_physical(float(p.mass), com, np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
     if convention == "standard":  # given in DH frame n: in dynid's link frame
         rr, pp = standard_dh_link_offset(alpha[-1], a[-1], d[-1])
         phi = transform_inertial(phi, rr, pp)
     return phi
 
 
-def _positive(values, fields) -> np.ndarray:
-    for v, f in zip(values, fields):
-        if not v > 0:
-            raise ConfigError(f"{f}: expected a positive velocity (rad/s), got {v}")
-    return np.array(values)
-
-
-def _transmission(table, n: int, offsets: np.ndarray, source: str) -> Transmission:
+def _transmission(t: TransmissionTable, n: int, offsets: np.ndarray, source: str) -> Transmission:
     where = f"{source}: transmission"
-    if not isinstance(table, dict):
-        raise ConfigError(f"{where}: expected a table")
-    ratios = _vector(table, "gear_ratios", n, where, default=np.ones(n))
+    ratios = np.ones(n) if t.gear_ratios is None else np.asarray(t.gear_ratios, dtype=float)
+    if ratios.shape != (n,):
+        raise ConfigError(f"{where}.gear_ratios: expected a list of {n} numbers, got {t.gear_ratios!r}")
     if np.any(ratios == 0):
         raise ConfigError(f"{where}.gear_ratios: expected non-zero ratios, got {ratios.tolist()}")
     r = np.diag(ratios)
-    coupling = table.get("coupling", [])
-    if not isinstance(coupling, list):
-        raise ConfigError(f"{where}.coupling: expected a list of {{motor, joint, ratio}} tables")
-    for c, entry in enumerate(coupling):
-        w = f"{where}.coupling[{c}]"
-        if not isinstance(entry, dict):
-            raise ConfigError(f"{w}: expected a table {{motor = 6, joint = 5, ratio = 32}}")
-        motor, joint = (int(_number(entry, key, w)) for key in ("motor", "joint"))
-        if not (1 <= motor <= n and 1 <= joint <= n) or motor == joint:
-            raise ConfigError(f"{w}: expected two different joint numbers in 1..{n}, got motor {motor}, joint {joint}")
-        r[motor - 1, joint - 1] = _number(entry, "ratio", w)
-    terms = table.get("coupled_terms", list(COUPLING_TERMS) if coupling else [])
-    if not isinstance(terms, list) or any(t not in COUPLING_TERMS for t in terms):
-        raise ConfigError(f"{where}.coupled_terms: expected a subset of {list(COUPLING_TERMS)}, got {terms!r}")
-    return Transmission(r, offsets, tuple(t for t in COUPLING_TERMS if t in terms))
+    for c, entry in enumerate(t.coupling):
+        if not (entry.motor <= n and entry.joint <= n) or entry.motor == entry.joint:
+            raise ConfigError(f"{where}.coupling[{c}]: expected two different joint numbers in 1..{n}, got motor {entry.motor}, "
+                              f"joint {entry.joint}")
+        r[entry.motor - 1, entry.joint - 1] = entry.ratio
+    terms = t.coupled_terms if t.coupled_terms is not None else (list(COUPLING_TERMS) if t.coupling else [])
+    return Transmission(r, offsets, tuple(x for x in COUPLING_TERMS if x in terms))

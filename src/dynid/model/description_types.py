@@ -1,0 +1,105 @@
+"""The structure of a robot description (TOML), typed: what :func:`dynid.model.description.robot_from_document`
+accepts, checked field by field before any number is used (its JSON Schema: ``dynid/schema/robot.schema.json``).
+
+An angle may be a number [rad] or text like ``"pi/2"``, ``"-2*pi"`` (:func:`dynid.model.description.parse_angle`).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Annotated, Literal, Union
+
+import msgspec
+from msgspec import Meta
+
+from ..friction import TERMS
+from ..typed import Table
+
+__all__ = ["RobotDescription", "JointTable", "ToolTable", "TransmissionTable", "CouplingTable", "PayloadTable"]
+
+Angle = Annotated[Union[float, str], Meta(description='rad, or text like "pi/2", "-2*pi"')]
+Vector3 = Annotated[list[float], Meta(min_length=3, max_length=3)]
+Inertia6 = Annotated[list[float], Meta(min_length=6, max_length=6, description="Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg·m²]")]
+Positive = Annotated[float, Meta(gt=0)]
+
+
+class ToolTable(Table, kw_only=True):
+    """``[tool]``: the flange in the last link's frame."""
+
+    translation: Annotated[Vector3, Meta(description="m")] = msgspec.field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+class CouplingTable(Table, kw_only=True):
+    """One coupled motor: ``{motor = 6, joint = 5, ratio = 32}`` (motor 6 also turns with joint 5)."""
+
+    motor: Annotated[int, Meta(ge=1)]
+    joint: Annotated[int, Meta(ge=1)]
+    ratio: float
+
+
+class TransmissionTable(Table, kw_only=True):
+    """``[transmission]``: gear ratios (motor angle = ratio · joint angle) and coupled motors."""
+
+    gear_ratios: list[float] | None = None
+    coupling: list[CouplingTable] = msgspec.field(default_factory=list)
+    coupled_terms: list[Literal["Iam", "fvm", "fcm"]] | None = None
+
+
+class PayloadTable(Table, kw_only=True):
+    """``[payload]``: a load carried by the last link (nominal values, identified with the last link's)."""
+
+    mass: Annotated[float, Meta(gt=0, le=10_000, description="kg")]
+    com: Annotated[Vector3, Meta(description="m, in the last link's frame")]
+    inertia: Inertia6 = msgspec.field(default_factory=lambda: [0.0] * 6)
+
+
+_JOINT_FIELDS = [
+    ("name", Union[str, None], None),
+    ("alpha", Union[Angle, None], None),
+    ("a", Union[Annotated[float, Meta(description="m")], None], None),
+    ("d", Union[Annotated[float, Meta(description="m")], None], None),
+    ("theta_offset", Union[Angle, None], None),
+    ("q_min", Union[Angle, None], None),
+    ("q_max", Union[Angle, None], None),
+    ("dq_max", Union[Annotated[float, Meta(description="rad/s")], None], None),
+    ("ddq_max", Union[Annotated[float, Meta(description="rad/s²")], None], None),
+    ("tau_max", Union[Annotated[float, Meta(description="N·m")], None], None),
+    ("drive_gain", Union[Annotated[float, Meta(description="N·m/A: joint torque per measured current (eq. 16)")], None], None),
+    ("drive_terms", Union[list[str], None], None),
+    ("counterbalance", bool, False),
+    ("position_offset", Union[Angle, None], None),
+    ("mass", Union[Annotated[float, Meta(description="kg")], None], None),
+    ("com", Union[Annotated[Vector3, Meta(description="m, link frame")], None], None),
+    ("inertia", Union[Inertia6, None], None),
+    ("stribeck_velocity", Union[Annotated[Positive, Meta(description="rad/s")], None], None),
+]
+
+@functools.cache
+def _types(terms: tuple[str, ...]) -> tuple[type, type]:
+    joint = msgspec.defstruct("JointTable", _JOINT_FIELDS + [(t, Union[float, None], None) for t in terms], bases=(Table,),
+                              kw_only=True, module=__name__)
+    joint.__doc__ = ("``[[joints]]``: one per joint, base to tip; DH values (or nothing with a URDF), limits, drive gain and "
+                     "the nominal value of each drive term (a field per term of :data:`dynid.friction.TERMS`).")
+    robot = msgspec.defstruct("RobotDescription", [
+        ("name", Union[str, None], None),
+        ("convention", Union[Literal["modified", "standard", "urdf"], None], None),
+        ("urdf", Union[Annotated[str, Meta(description="with convention = 'urdf': the URDF file, relative to this file")], None], None),
+        ("gravity", Annotated[Vector3, Meta(description="m/s², base frame")], msgspec.field(default_factory=lambda: [0.0, 0.0, -9.81])),
+        ("drive_terms", Union[list[str], None], None),
+        ("notes", str, ""),
+        ("tool", ToolTable, msgspec.field(default_factory=ToolTable)),
+        ("transmission", TransmissionTable, msgspec.field(default_factory=TransmissionTable)),
+        ("joints", Union[list[joint], None], None),  # type: ignore[valid-type]
+        ("payload", Union[PayloadTable, None], None),
+    ], bases=(Table,), kw_only=True, module=__name__)
+    robot.__doc__ = "A robot description (:mod:`dynid.model.description`)."
+    return joint, robot
+
+
+def description_types() -> tuple[type, type]:
+    """``(JointTable, RobotDescription)`` for the drive terms :data:`dynid.friction.TERMS` holds now (a term added there is
+    a field of every ``[[joints]]`` table)."""
+    return _types(tuple(TERMS))
+
+
+JointTable, RobotDescription = description_types()
