@@ -52,7 +52,7 @@ class ColumnFile:
 
     def append(self, values: np.ndarray) -> None:
         """Append ``values`` (1-D, converted to float64)."""
-        data = memoryview(np.ascontiguousarray(values, dtype=np.float64).reshape(-1)).cast("B")
+        data = np.ascontiguousarray(values, dtype=np.float64).reshape(-1).data.cast("B")
         offset, done = 8 * self.n, 0
         try:
             while done < len(data):
@@ -65,7 +65,7 @@ class ColumnFile:
     def read(self, start: int, stop: int) -> np.ndarray:
         """Samples ``start .. stop-1`` as a new (stop - start,) array."""
         out = np.empty(max(stop - start, 0))
-        view, done = memoryview(out).cast("B"), 0
+        view, done = out.data.cast("B"), 0
         while done < len(view):
             got = os.preadv(self._file.fileno(), [view[done:]], 8 * start + done)
             if got <= 0:

@@ -62,7 +62,9 @@ class TextTable:
         if total <= width or len(self.columns) <= self.labels + 1:
             return [self]
         room = width - EDGES - sum(x + PADDING for x in w[:self.labels])
-        groups, current, used = [], [], 0
+        groups: list = []
+        current: list = []
+        used = 0
         for i in range(self.labels, len(self.columns)):
             if current and used + w[i] + PADDING > room:
                 groups.append(current)

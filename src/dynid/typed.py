@@ -195,7 +195,7 @@ def _describe(info) -> str:
     from msgspec import inspect as mi
 
     candidates = _candidates(info)
-    words = []
+    words: list[str] = []
     for c in candidates:
         if isinstance(c, mi.LiteralType):
             words.extend(repr(v) for v in c.values)

@@ -188,9 +188,9 @@ def load_compiled() -> None:
         import numba as nb
 
         options = {"cache": True, "fastmath": False, "boundscheck": False, "nogil": True}
-        _sample = nb.njit(inline="always", **options)(sample_columns)
-        _chunk = nb.njit(**options)(_chunk)
-        _samples = nb.njit(**options)(_samples)
+        _sample = nb.njit(inline="always", **options)(sample_columns)  # type: ignore[call-overload]  # numba's stubs
+        _chunk = nb.njit(**options)(_chunk)  # type: ignore[call-overload]
+        _samples = nb.njit(**options)(_samples)  # type: ignore[call-overload]
         _compiled = True
 
 

@@ -138,7 +138,7 @@ def _trace(rp, pp, axes, gravity, npj: int, n_drive: int):
     drive_map = np.arange(n)[:, None] * npj + 10 + np.arange(n_drive)
     as_objects = [np.array(np.asarray(a, dtype=float).tolist(), dtype=object) for a in (rp, pp, axes, gravity)]
     scratch = [np.empty(s, dtype=object) for s in ((n, 3, 3), (n, 3), (n, 3), (n, 3), (n, 3), (n, 3), (3, 3))]
-    _regressor_kernel.sample_columns(0, *as_objects, q, dq, ddq, out, npj, colmap, drive, drive_map, *scratch)
+    _regressor_kernel.sample_columns(0, *as_objects, q, dq, ddq, out, npj, colmap, drive, drive_map, *scratch)  # type: ignore[call-arg]
     return graph, {key: v for key, v in out.stores.items() if isinstance(v, _Sym) or v != 0.0}
 
 

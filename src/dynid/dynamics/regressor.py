@@ -172,7 +172,7 @@ def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:
     each transmission carries, for the load-dependent Coulomb term (:mod:`dynid.friction`)."""
     from dataclasses import replace
 
-    rigid = replace(robot, drive_terms=(), drive=np.zeros((robot.n_dof, 0)), drive_mask=None)
+    rigid = replace(robot, drive_terms=(), drive=np.zeros((robot.n_dof, 0)), drive_mask=np.ones((robot.n_dof, 0), dtype=bool))
     return regressor(rigid, q, dq, ddq) @ rigid.standard_parameters()
 
 

@@ -144,7 +144,7 @@ class LeastSquaresAccumulator:
 
 
 def _triangular(a: np.ndarray, size: int) -> np.ndarray:
-    r = np.linalg.qr(a, mode="r")
+    r = np.asarray(np.linalg.qr(a, mode="r"))
     out = np.zeros((size, size))
     out[: r.shape[0]] = r[:size]
     return out

@@ -281,7 +281,7 @@ class BoxSearchEstimator(Estimator):
     """
 
     bounds: object
-    n_dof: int
+    n_dof: int | None
     weights: object
 
     def _objectives(self, w, tau):

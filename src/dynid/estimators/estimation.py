@@ -10,7 +10,7 @@ the box searches. It is the first of OLS/WLS in the list, else WLS.
 
 from __future__ import annotations
 
-from typing import Callable, Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -63,7 +63,7 @@ class Estimation:
             if isinstance(est, AccumulatingEstimator):
                 self.streamed[key] = est
         ref = self.streamed.get(self.reference_key)
-        self.reference = ref if ref is not None else make_estimator(self.reference_key, problem)
+        self.reference: Any = ref if ref is not None else make_estimator(self.reference_key, problem)
         self.standard = any(spec(k).space == "standard" for k in self.keys)
         in_memory = [k for k in self.keys if k not in self.streamed]
         self._stack_base = keep_rows or any(spec(k).space == "base" for k in in_memory)

@@ -73,7 +73,7 @@ class IterativelyReweightedLeastSquares(Estimator):
             new = _weighted_solve(w, tau, self._huber_weights(u) / np.tile(scale, m // self.n_dof_) ** 2)
             step = np.linalg.norm(new - params)
             params = new
-            if step <= self.tol * max(np.linalg.norm(params), 1e-300):
+            if step <= self.tol * max(float(np.linalg.norm(params)), 1e-300):
                 self.converged_ = True
                 break
         self.n_iter_ = it

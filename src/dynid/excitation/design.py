@@ -84,15 +84,16 @@ class ExcitationProblem:
     robot: Robot
     omega_f: float
     n_harmonics: int
-    limits: Limits | None = None
+    # given or None; __post_init__ fills in the robot's limits, the nominal parameters and the base parameters
+    limits: Limits = None  # type: ignore[assignment]
     workspace: Workspace = field(default_factory=Workspace)
     offsets: np.ndarray | None = None
     rest: bool = False
     criterion: str = "cond"
     grid_points: int = 100
     safety: float = 0.02
-    phi: np.ndarray | None = None
-    base: BaseParameters | None = None
+    phi: np.ndarray = None  # type: ignore[assignment]
+    base: BaseParameters = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         robot = self.robot
@@ -309,7 +310,8 @@ class _Objective:
 
     def __init__(self, problem: ExcitationProblem, layout: _Layout):
         self.p, self.lay = problem, layout
-        self._x, self._xg = None, None
+        self._x: np.ndarray | None = None
+        self._xg: bool | None = None
         self.nfev = 0
         lim, s = problem.limits, problem.safety
         self.tau_idx = np.flatnonzero(np.isfinite(lim.tau_max))
@@ -494,7 +496,8 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
         if not np.isclose(initial.omega_f, problem.omega_f, rtol=1e-9, atol=0.0):
             raise ConfigError(f"initial trajectory has the fundamental pulsation {initial.omega_f:.6g} rad/s, the design "
                               f"{problem.omega_f:.6g} rad/s: its harmonics would be re-timed; design at its omega_f or start elsewhere")
-        initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets else problem.offsets, initial.a, initial.b)
+        initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets or problem.offsets is None else problem.offsets,
+                                    initial.a, initial.b)
     best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
     nit = 0
     for i in range(n_starts):
@@ -532,6 +535,7 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
             f"{worst.where} reaches {worst.worst:.4g} against {worst.limit:.4g}); raise design.safety, "
             f"design.grid_points or design.starts, or relax the limits")
     ref = initial if initial is not None else first
+    assert ref is not None  # the first start's trajectory exists once a start succeeded
     return ExcitationDesign(
         trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),

@@ -11,6 +11,7 @@ on the model (:mod:`dynid.validation.diagnostics`). Validation on other logs is
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -197,7 +198,7 @@ class IdentificationResult:
     consistency_verdicts: dict = field(default_factory=dict)
     objective: dict = field(default_factory=dict)
     box: np.ndarray | None = None
-    drive_gains: object = None
+    drive_gains: Any = None
     model: Robot | None = None
     findings: tuple = ()
     diagnostics: dict = field(default_factory=dict)

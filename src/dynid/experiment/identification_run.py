@@ -30,6 +30,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     from ..preprocessing.pipeline import prepare
     from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
 
+    assert config.drive_gains is not None  # called only when the config has [drive_gains]
     mass, unloaded, loaded = config.drive_gains
     unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
     pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
@@ -46,7 +47,8 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
 
-    out, warnings = [], []
+    out: list = []
+    warnings: list[str] = []
     settings = carried_over(resolved, config.preprocessing)
     for spec in datasets:
         if progress is not None:  # one step per log: reading, filtering and predicting it
@@ -97,6 +99,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         from ..validation.cross_validation import choose_preprocessing
 
         filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)
+        assert filters.data is not None  # the chosen candidate's prepared data
         data = filters.data
         filters = filters if filters.chose else None
     else:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterator, Mapping
+from typing import Iterator
 
 import numpy as np
 
@@ -47,8 +47,9 @@ class Parameter:
     expression: str = ""
 
 
-class Parameters(Mapping):
-    """An estimate's base parameters by name, each with its σ (a read-only mapping ``name -> Parameter``).
+class Parameters:
+    """An estimate's base parameters by name, each with its σ: ``params["ZZ1R"]`` is a :class:`Parameter`, iterating
+    gives the names, :attr:`values` and :attr:`std` the arrays in the base parameters' order.
 
     Attributes
     ----------
@@ -75,6 +76,17 @@ class Parameters(Mapping):
 
     def __len__(self) -> int:
         return len(self.names)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.names
+
+    def keys(self) -> tuple[str, ...]:
+        """The base parameters' names."""
+        return self.names
+
+    def items(self) -> list[tuple[str, Parameter]]:
+        """``(name, Parameter)`` pairs in order."""
+        return [(n, self[n]) for n in self.names]
 
     def to_dict(self) -> dict:
         """name -> {"value", "std", "unit"} (JSON-ready; a missing σ is None)."""
@@ -301,7 +313,8 @@ class IdentifiedModel:
         for label, e in (results.get("estimates") or {}).items():
             if isinstance(e, dict) and isinstance(e.get("std"), dict):
                 std[str(label)] = np.array([float(e["std"].get(n, np.nan)) for n in base.names])
-        main = results.get("main_estimate") if results.get("main_estimate") in estimates else next(iter(estimates))
+        stated = results.get("main_estimate")
+        main = str(stated) if stated in estimates else next(iter(estimates))
         return cls(robot, base, estimates, std, main, stored_preprocessing(results), results)
 
     @classmethod
@@ -365,7 +378,7 @@ def _robot(robot, results: dict, path: Path) -> Robot:
         return robot
     if robot is not None:
         return load_robot(robot)
-    settings = results.get("settings") if isinstance(results.get("settings"), dict) else {}
+    settings: dict = results["settings"] if isinstance(results.get("settings"), dict) else {}
     source = settings.get("robot_source")
     if isinstance(source, str) and source.startswith("config:"):
         import tomllib

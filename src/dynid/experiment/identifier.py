@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import inspect
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -160,7 +161,7 @@ class Identifier:
         from .identification_run import run_identification
 
         config = load_identification_config(path, data_root)
-        changes = {}
+        changes: dict[str, Any] = {}
         if self.robot is not None:
             changes["robot"] = self._robot()
         if self.estimators is not None:

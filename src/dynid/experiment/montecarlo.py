@@ -30,12 +30,14 @@ from typing import Callable
 
 import numpy as np
 
-from ..dynamics.base_parameters import base_parameters
+from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..exceptions import ConfigError, DynIdError
 from ..model.description import load_robot
+from ..model.robot import Robot
+from ..excitation.fourier import FourierTrajectory
 from ..simulation.measurements import NoiseModel
 from ..estimators.estimation import Estimation
 from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
@@ -125,11 +127,11 @@ class _Setup:
 
     config: MonteCarloConfig
     run: PaperExperimentConfig
-    robot: object
-    base: object
+    robot: Robot
+    base: BaseParameters
     truth: np.ndarray
     phi_true: np.ndarray
-    trajectory: object
+    trajectory: FourierTrajectory
     t: np.ndarray
     unit_crb: np.ndarray  # Cramér–Rao covariance for σ = 1 A, (n_base, n_base)
     plugins: tuple = ({}, {})  # estimators and strategies registered by the user: the workers register them too

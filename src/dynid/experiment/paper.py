@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -195,7 +195,7 @@ class PaperRunResult:
 
     def to_dict(self) -> dict:
         names = list(self.base.names)
-        out = {
+        out: dict[str, Any] = {
             "robot": self.robot.name,
             "joints": self.config.joints,
             "plant": self.config.plant,
@@ -331,11 +331,14 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     """
     recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
     data = prepare(recording, paper_preprocessing(traj, passes, strategy))
+    rows: tuple[np.ndarray | None, np.ndarray | None]
     if estimation is None:
-        w, tau = stacked_rows(base_chunks(robot, base, data), base.n_base)
+        rows = stacked_rows(base_chunks(robot, base, data), base.n_base)
     else:
         stream_rows(base_chunks(robot, base, data, standard=estimation.standard), estimation, base)
-        w, tau = estimation.rows()
+        rows = estimation.rows()
+    w, tau = rows
+    assert w is not None and tau is not None  # kept rows: keep_rows=True
     return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool)
 
 
@@ -346,7 +349,7 @@ def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
 
 @with_single_blas_thread
 def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig(),
-                         progress: Callable[[str, int, float], None] | None = None) -> PaperRunResult:
+                         progress: Callable[[str, int | None, float | None], None] | None = None) -> PaperRunResult:
     """Run the paper's experiment (§4) on a simulated robot and compare the estimators of ``config.estimators``.
 
     Parameters
@@ -406,6 +409,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     if outside and any(spec(m).needs_box for m in keys):  # only the box searches and LAD use it
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
     budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
+    layout = consistency_layout(robot)
     data = FitData(ident.w_base, y, k, bounds, base, None, estimation.problem.layout, estimation.problem.prior, config.weights)
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
@@ -421,14 +425,14 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         return bs, time.perf_counter() - t_b
 
     boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in keys if spec(key).bootstrapped and config.bootstrap}
-    fits = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys}, budget,
+    fits: dict[str, Any] = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys}, budget,
                           progress=progress, extra=boots)
     for key in keys:
         fit = fits[key]
         timings[key] = fit.seconds
         p_id = (ident.w_base @ fit.params).reshape(-1, k)
         p_val = (valid.w_base @ fit.params).reshape(-1, k)
-        metrics = {}
+        metrics: dict[str, dict] = {}
         for name, tau, pred in (("identification", ident.tau, p_id), ("validation", valid.tau, p_val)):
             for mk, mv in _metrics(tau, pred).items():
                 metrics.setdefault(mk, {})[name] = mv
@@ -443,8 +447,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
             n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
             params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
             pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None),
-            consistency_margin=consistency_margin(base.regrouping, fit.params, *data.layout))
-    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *data.layout)
+            consistency_margin=consistency_margin(base.regrouping, fit.params, *layout))
+    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result

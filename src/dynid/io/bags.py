@@ -7,6 +7,8 @@ or motor currents in A with ``effort = "currents"``).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..exceptions import DataError
@@ -38,7 +40,7 @@ def read_joint_states(spec, robot, name: str):
             if any(c.msgtype != "sensor_msgs/msg/JointState" for c in connections):
                 raise DataError(f"{path}: topic {spec.topic!r} holds {connections[0].msgtype}, expected sensor_msgs/msg/JointState")
             for k, (conn, _, raw) in enumerate(reader.messages(connections=connections)):
-                msg = reader.deserialize(raw, conn.msgtype)
+                msg: Any = reader.deserialize(raw, conn.msgtype)
                 names = list(msg.name)
                 missing = [n for n in wanted if n not in names]
                 if missing:
@@ -57,11 +59,11 @@ def read_joint_states(spec, robot, name: str):
         raise DataError(f"{path}: cannot read it as a ROS 2 bag ({exc})") from None
     if len(stamps) < 2:
         raise DataError(f"{path}: {len(stamps)} JointState message(s) on {spec.topic}, expected at least 2")
-    raw = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}
+    signals: dict[str, np.ndarray] = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}
     if all(v is not None for v in vel):
-        raw["velocities"] = np.array(vel)
-    for kind, x in raw.items():
+        signals["velocities"] = np.array(vel)
+    for kind, x in signals.items():
         if not np.all(np.isfinite(x)):
             k = int(np.argwhere(~np.isfinite(x))[0, 0])
             raise DataError(f"{path}: message {k + 1} on {spec.topic}: NaN or infinite {kind}")
-    return np.array(stamps), raw, lambda k: f"{path}: message {k + 1} on {spec.topic}"
+    return np.array(stamps), signals, lambda k: f"{path}: message {k + 1} on {spec.topic}"

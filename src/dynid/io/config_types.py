@@ -13,8 +13,15 @@ from typing import Annotated, Literal, Union
 import msgspec
 from msgspec import Meta
 
-from ..model.description_types import Angle, RobotDescription
+from typing import TYPE_CHECKING, Any
+
+from ..model.description_types import Angle, RobotDescription as _RobotDescription
 from ..typed import Table
+
+if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
+    RobotDescription = Any
+else:
+    RobotDescription = _RobotDescription
 
 __all__ = ["SignalTable", "TimeTable", "DatasetTable", "PreprocessingTable", "EstimationTable", "ReferenceTable",
            "DriveGainsTable", "IdentificationDocument", "ExcitationDocument"]

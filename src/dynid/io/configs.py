@@ -30,7 +30,7 @@ def read_config(path: Path, known: set[str] | None) -> dict:
         raise ConfigError(f"{path}: invalid TOML ({exc})") from None
     unknown = sorted(set(doc) - known) if known is not None else []
     if unknown:
-        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known)}")
+        raise ConfigError(f"{path}: unknown field(s) {unknown}, expected some of {sorted(known or ())}")
     return doc
 
 

@@ -406,16 +406,16 @@ def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -
             raise DataError(f"{spec.name}: files have different numbers of rows: " + ", ".join(f"{p} {n}" for p, n in lengths.items()))
         warnings.append(f"{spec.name}: the files are cut to the shortest one ({n_s} rows)")
 
-    def get(s: SignalSpec) -> np.ndarray:
+    def get(s: SignalSpec) -> "np.ndarray | StoredColumns":
         tb, cols = tables[s.file]
         scale = np.broadcast_to(np.asarray(s.scale, dtype=float), (len(s.columns),))
         if isinstance(tb.data, StoredColumns):  # a view of the stored columns; scaled into new ones
             x = tb.data.select([cols.index(c) for c in s.columns], n_s)
             return x if np.all(scale == 1.0) else x.map_columns(lambda column, j: column * scale[j])
-        x = tb.data[:n_s, [cols.index(c) for c in s.columns]]  # a copy of its own: scaled in place
+        block = tb.data[:n_s, [cols.index(c) for c in s.columns]]  # a copy of its own: scaled in place
         if np.any(scale != 1.0):
-            x *= scale
-        return x
+            block *= scale
+        return block
 
     if spec.time is not None:
         t = get(spec.time)[:, 0]
@@ -477,7 +477,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
             warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
                             f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"interpolate\" in {table})")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
-    rate = spec.rate if not timed else (spec.resample or uniform_rate(t))
+    rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission

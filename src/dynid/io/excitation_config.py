@@ -39,6 +39,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
+
 import numpy as np
 
 import msgspec
@@ -103,7 +105,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     harmonics = tr.harmonics
     if (tr.frequency is None) == (tr.omega_f is None):
         raise ConfigError(f"{path}: trajectory: give exactly one of frequency (Hz) or omega_f (rad/s)")
-    omega_f = 2 * np.pi * tr.frequency if tr.frequency is not None else float(tr.omega_f)
+    omega_f = 2 * np.pi * tr.frequency if tr.frequency is not None else float(tr.omega_f or 0.0)
     form = tr.form or "paper"
     offsets = _per_joint(tr.offsets, k, f"{path}: trajectory.offsets", angle=True) if tr.offsets is not None else None
     rest = bool(tr.rest)
@@ -115,7 +117,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
             limits = replace(limits, **{f.name: _per_joint(val, k, f"{path}: limits.{f.name}", angle=f.name.startswith("q_"))})
 
     ws = c.workspace
-    ws_kw = {key: np.asarray(getattr(ws, key), dtype=float) for key in ("box_min", "box_max") if getattr(ws, key) is not None}
+    ws_kw: dict[str, Any] = {key: np.asarray(getattr(ws, key), dtype=float) for key in ("box_min", "box_max")
+                             if getattr(ws, key) is not None}
     if ws.floor is not None:
         ws_kw["floor"] = float(ws.floor)
     try:

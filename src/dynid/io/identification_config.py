@@ -63,6 +63,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 from __future__ import annotations
 
 import os
+from typing import Any
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -123,7 +124,7 @@ def _per_joint(value, n: int, where: str):
 def _preprocessing(table: PreprocessingTable, where: str, n: int, here: Path = Path(".")) -> Preprocessing:
     """:class:`Preprocessing` of a typed ``[preprocessing]`` table: what depends on the robot (one value per joint),
     the strategy's name and the excitation file checked here."""
-    values = {}
+    values: dict[str, Any] = {}
     for f in msgspec.structs.fields(table):
         v = getattr(table, f.name)
         if v is None:
@@ -177,12 +178,12 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     """
     path = Path(path)
     doc = read_config(path, None)
-    for (table, key), why in REMOVED.items():
-        if isinstance(doc.get(table), dict) and key in doc[table]:
-            raise ConfigError(f"{path}: {table}.{key}: {why}")
+    for (section, key), why in REMOVED.items():
+        if isinstance(doc.get(section), dict) and key in doc[section]:
+            raise ConfigError(f"{path}: {section}.{key}: {why}")
     est = doc.get("estimation")
     old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
-    if old:
+    if old and isinstance(est, dict):
         raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
                           f"estimators = {_estimators_from_old(est)}")
     # the robot table is checked by the description's own parser (its drive terms are those registered now)
@@ -199,10 +200,9 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     names = [v.name for v in validation]
     if len(set(names)) != len(names):
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
-    table = typed.preprocessing
-    if table == "auto":
-        table = PreprocessingTable(auto=True, coulomb_velocity="auto")
-    pre = _preprocessing(table or PreprocessingTable(), f"{path}: preprocessing", n, here)
+    given = typed.preprocessing
+    table = PreprocessingTable(auto=True, coulomb_velocity="auto") if given == "auto" else given or PreprocessingTable()
+    pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     e = typed.estimation or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
     try:
@@ -218,7 +218,8 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
 def _estimators_from_old(est: dict) -> str:
     """The ``estimators`` list that says what the old keys ``method``, ``physically_consistent`` and ``methods`` said."""
     methods = [str(m).lower() for m in est.get("methods", [])] if isinstance(est.get("methods"), list) else []
-    first = est.get("method") if isinstance(est.get("method"), str) else next((m for m in methods if m in ("ols", "wls")), "wls")
+    method = est.get("method")
+    first = method if isinstance(method, str) else next((m for m in methods if m in ("ols", "wls")), "wls")
     keys = [first.lower()] + (["sdp"] if est.get("physically_consistent") is True or "sdp" in methods else [])
     keys += [m for m in methods if m not in keys]
     return "[" + ", ".join(f'"{k}"' for k in keys) + "]"
@@ -244,7 +245,7 @@ def stored_preprocessing(identified: dict) -> Preprocessing | None:
         return None
     known = {f.name for f in fields(Preprocessing)}
     try:
-        values = {k: (tuple(v) if isinstance(v, list) else v) for k, v in stored.items() if k in known}
+        values: dict[str, Any] = {k: (tuple(v) if isinstance(v, list) else v) for k, v in stored.items() if k in known}
         return Preprocessing(**values)
     except TypeError:
         return None

@@ -33,7 +33,7 @@ class Table:
         Problems that were fixed (e.g. a truncated last line skipped).
     """
 
-    data: np.ndarray
+    data: "np.ndarray | StoredColumns"
     first_line: int
     warnings: tuple[str, ...] = ()
 
@@ -98,7 +98,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         raise DataError(f"{path}: not a UTF-8 text table{hint}")
     first, last = rows if rows is not None else (1, None)
     if first < 1 or (last is not None and last < first):
-        raise DataError(f"{path}: rows: expected 1 <= first <= last, got {list(rows)}")
+        raise DataError(f"{path}: rows: expected 1 <= first <= last, got {[first, last]}")
     warnings: list[str] = []
     blocks: list[np.ndarray] = []
     files: list[ColumnFile] | None = None
@@ -166,11 +166,11 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             what = "only a header line" if header else "no data lines"
             raise DataError(f"{path}: {what} (an empty file, or not a text table?)")
         if rows is not None:
-            raise DataError(f"{path}: rows = {list(rows)} selects nothing: the file has {data_row} data rows")
+            raise DataError(f"{path}: rows = {[first, last]} selects nothing: the file has {data_row} data rows")
         raise DataError(f"{path}: no data rows")
     if last is not None and data_row < last and not warnings:
-        raise DataError(f"{path}: rows = {list(rows)} goes beyond the file's end: it has {data_row} data rows")
-    return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line), tuple(warnings))
+        raise DataError(f"{path}: rows = {[first, last]} goes beyond the file's end: it has {data_row} data rows")
+    return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
 
 
 def _stack(blocks: list[np.ndarray]) -> np.ndarray:

@@ -49,6 +49,7 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
 from __future__ import annotations
 
 import re
+from typing import Any
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -156,7 +157,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     if not isinstance(doc, dict):
         raise ConfigError(f"{source}: expected a robot description table")
     joint_table, robot_table = description_types()
-    d = convert(doc, robot_table, source)
+    d: Any = convert(doc, robot_table, source)
     name = d.name if d.name is not None else Path(source).stem
     convention = d.convention or ("urdf" if d.urdf is not None else "modified")
     try:
@@ -192,6 +193,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     alpha = a = dd = None
     urdf_lim = None
     if convention == "urdf":
+        assert urdf_model is not None
         joints, inertial, _ = urdf_model
         urdf_lim = urdf_limits(upath)
         if len(joints) != n:

@@ -107,11 +107,12 @@ class Robot:
     tool_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     tool_translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
     notes: str = ""
-    transmission: Transmission | None = None
-    drive_mask: np.ndarray | None = None
-    coulomb_velocity: np.ndarray | None = None
+    # given or None; __post_init__ fills in the defaults, so after construction they are never None
+    transmission: Transmission = None  # type: ignore[assignment]
+    drive_mask: np.ndarray = None  # type: ignore[assignment]
+    coulomb_velocity: np.ndarray = None  # type: ignore[assignment]
     nominal_problems: tuple[str, ...] = ()
-    stribeck_velocity: np.ndarray | None = None
+    stribeck_velocity: np.ndarray = None  # type: ignore[assignment]
 
     @property
     def friction_velocities(self) -> Velocities:

@@ -140,7 +140,7 @@ def urdf_limits(path: str | Path) -> dict:
 
     with _silenced_stderr([]):
         model = pin.buildModelFromUrdf(str(path))
-    out = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")}
+    out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")}
     for j in range(1, model.njoints):
         i, nv = model.joints[j].idx_q, model.joints[j].nq
         if nv == 2:  # continuous (cos, sin): no position limit

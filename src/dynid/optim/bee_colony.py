@@ -132,12 +132,12 @@ def minimize_bee_colony(fun: Callable[[np.ndarray], float], bounds, *, colony_si
         cur = int(np.argmin(obj))
         if obj[cur] < best_f:  # Step 7: memorise the best
             best_x, best_f = foods[cur].copy(), obj[cur]
-        for i in np.flatnonzero(trials > limit):  # Step 6: scouts (eq. 13)
-            foods[i] = lo + rng.random(dim) * (hi - lo)
-            obj[i], states[i] = evaluate(foods[i])
-            trials[i] = 0
-            if obj[i] < best_f:
-                best_x, best_f = foods[i].copy(), obj[i]
+        for scout in np.flatnonzero(trials > limit):  # Step 6: scouts (eq. 13)
+            foods[scout] = lo + rng.random(dim) * (hi - lo)
+            obj[scout], states[scout] = evaluate(foods[scout])
+            trials[scout] = 0
+            if obj[scout] < best_f:
+                best_x, best_f = foods[scout].copy(), obj[scout]
         history[it] = best_f
         if callback is not None:
             callback(it + 1, best_f)

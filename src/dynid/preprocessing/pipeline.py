@@ -15,7 +15,7 @@ band of the data (:mod:`dynid.preprocessing.bands`), and :attr:`Preprocessing.de
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -34,6 +34,9 @@ from .strategies import Strategy, strategy_for
 
 __all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare"]
 
+Samples = Any
+"""An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
+
 
 @dataclass(frozen=True)
 class PreparedData:
@@ -42,10 +45,10 @@ class PreparedData:
 
     name: str
     t: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    ddq: np.ndarray
-    tau: np.ndarray
+    q: Samples
+    dq: Samples
+    ddq: Samples
+    tau: Samples
     rate: float
     settings: Preprocessing
     warnings: tuple[str, ...] = ()
@@ -214,8 +217,13 @@ def _direction_velocity(recording, s: Preprocessing, dq):
     if s.fourier is not None:
         return dq
     if recording.dq is not None:
-        return gaussian_smooth(recording.dq, recording.rate, s.velocity_cutoff)
-    return differentiate(gaussian_smooth(recording.q, recording.rate, s.position_cutoff), recording.rate)
+        return gaussian_smooth(recording.dq, recording.rate, _hz(s.velocity_cutoff))
+    return differentiate(gaussian_smooth(recording.q, recording.rate, _hz(s.position_cutoff)), recording.rate)
+
+
+def _hz(cutoff: float | None) -> float:
+    """A resolved cutoff [Hz] (never None once :meth:`Preprocessing.resolved` has run; 0: no filter)."""
+    return 0.0 if cutoff is None else float(cutoff)
 
 
 def _velocity_noise(recording, s: Preprocessing) -> np.ndarray:
@@ -223,11 +231,11 @@ def _velocity_noise(recording, s: Preprocessing) -> np.ndarray:
     measured velocities or positions (:func:`dynid.preprocessing.bands.white_noise_std`)."""
     if recording.dq is not None and s.fourier is None:
         sigma = white_noise_std(recording.dq, recording.rate)
-        return velocity_noise_std(sigma, recording.rate, s.velocity_cutoff, s.order, False, gaussian=True)
+        return velocity_noise_std(sigma, recording.rate, _hz(s.velocity_cutoff), s.order, False, gaussian=True)
     sigma = white_noise_std(recording.q, recording.rate)
     if s.fourier is not None:
-        return velocity_noise_std(sigma, recording.rate, s.band, s.order, True)
-    return velocity_noise_std(sigma, recording.rate, s.position_cutoff, s.order, True, gaussian=True)
+        return velocity_noise_std(sigma, recording.rate, _hz(s.band), s.order, True)
+    return velocity_noise_std(sigma, recording.rate, _hz(s.position_cutoff), s.order, True, gaussian=True)
 
 
 def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
@@ -319,7 +327,7 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         return regressor(robot, q, dq, ddq, columns, v), tau
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
-    for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation, s.order, s.chunk, cutoff):
+    for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, s.order, s.chunk, cutoff):
         keep = np.abs(data.dq[index]) >= vmin
         if progress is not None:
             progress(int(index[-1]) + 1, n_s)

@@ -244,6 +244,8 @@ def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "P
         given = replace(given, strategy="parallel")
     if resolved is None:
         return replace(given, fourier=None, decimation=None, warnings=())
-    floor = resolved.rest_velocity if given.rest_velocity == "auto" and resolved.rest_velocity != "auto" else 0.0
+    floor: float | tuple = 0.0
+    if given.rest_velocity == "auto" and not isinstance(resolved.rest_velocity, str):
+        floor = resolved.rest_velocity
     return replace(given, fourier=None, decimation=None, band_floor=resolved.band or 0.0, rest_floor=floor,
                    rest_friction=resolved.rest_friction, presliding=resolved.presliding, warnings=(), derivation="")

@@ -8,6 +8,8 @@ silences progress and summaries; warnings and errors are still printed (on stand
 
 from __future__ import annotations
 
+from typing import Any
+
 import os
 import time
 from pathlib import Path
@@ -101,9 +103,9 @@ class Progress:
     def __init__(self, command: str, console: Console, quiet: bool = False):
         self.command, self.console, self.quiet = command, console, quiet
         self.live = console.is_terminal and not quiet
-        self.seen = set()
+        self.seen: set[str] = set()
         self.t0 = time.perf_counter()
-        self._status = None
+        self._status: Any = None
 
     def __enter__(self) -> Progress:
         if self.live:

@@ -21,7 +21,7 @@ def run_summary_blocks(result) -> list:
     cfg = result.config
     n_par = len(d["parameters"])
     ex = d["trajectories"]["excitation"]
-    out = [Line(f"dynid run — robot {result.robot.name}, joints 1-{cfg.joints}, plant '{cfg.plant}', seed {cfg.seed}: "
+    out: list = [Line(f"dynid run — robot {result.robot.name}, joints 1-{cfg.joints}, plant '{cfg.plant}', seed {cfg.seed}: "
                 f"{n_par} base parameters ({n_par - 2 * cfg.joints} inertial + {2 * cfg.joints} friction)", "title"),
            Line(f"identification trajectory: {ex['trajectory']}; cond(W_base) {ex['cond_base_regressor']:.2f} "
                 f"(β1: {ex['cond_base_regressor_beta1']:.2f})"),
@@ -63,7 +63,8 @@ def run_summary_blocks(result) -> list:
 
 def _uncertainty_blocks(d: dict, methods: dict) -> list:
     """Per bootstrapped method: σ from the covariance beside the bootstrap's, with the bootstrap interval."""
-    out, covered = [], {}
+    out: list = []
+    covered: dict = {}
     for label, m in methods.items():
         if "bootstrap" not in m:
             continue

@@ -70,7 +70,7 @@ def identification_blocks(result) -> list:
 
     r = result
     sol, base = r.solution, r.base
-    out = [Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {base.n_base} base "
+    out: list = [Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {base.n_base} base "
                 f"parameters from {r.n_rows} equations, cond = {sol.condition_number:.4g}", "title")]
     pre = r.settings.get("preprocessing", {})
     if pre.get("derivation"):
@@ -226,7 +226,7 @@ def montecarlo_blocks(result) -> list:
                 f"{100 * np.nanmedian(s['rmse'][li][nonzero] / np.abs(result.truth[nonzero])):.3g}",
                 str(int(s["failures"][li])), f"{s['seconds_median'][li]:.3g}"))
         ends.add(len(rows) - 1)
-    out = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(result.names)} base parameters, "
+    out: list = [Line(f"dynid montecarlo — robot {cfg.robot}, joints 1-{cfg.joints}, {len(result.names)} base parameters, "
                 f"{cfg.realisations} realisations × {len(cfg.noise_levels)} noise levels, {cfg.duration:g} s at {cfg.rate:g} Hz; "
                 f"ran on {result.cluster} in {result.timings.get('total', float('nan')):.1f} s", "title"),
            TextTable("Spread σ and bias |b| of the base parameters in units of √CRB (Cramér–Rao bound, raw-torque Gaussian "
@@ -250,7 +250,7 @@ def excitation_blocks(run) -> list:
     list of Line and TextTable
     """
     d, p, c = run.design, run.config.problem, run.config
-    out = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
+    out: list = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
                 f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title"),
            TextTable(f"Before / after (design grid of {p.grid_points} samples per period)", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
                      ((f"initial: {c.initial_label}", f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),

@@ -227,7 +227,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     reference = prepare(recording, given)
     rs = reference.settings
     band, knee = rs.band, rs.knee
-    default = POSITION_FACTOR * band
+    default = POSITION_FACTOR * (band or 0.0)
     if (given.position_cutoff is not None or given.parallel_cutoff is not None or rs.fourier is not None or knee is None
             or knee < KNEE_MARGIN * default):
         return PreprocessingChoice(rs, (rs,), np.zeros((1, robot.n_dof)), np.zeros(1), "", reference)

@@ -101,7 +101,8 @@ class ResidualSums:
         autocorrelation, effective samples, the amplitude and t statistic of each feature)."""
         p = self.n_columns
         e = np.concatenate([-np.asarray(beta, dtype=float), [1.0]])  # r = e·(y, τ)
-        findings, stats = [], {"lag1_autocorrelation": [], "effective_samples": [], "friction_amplitude": [],
+        findings: list = []
+        stats: dict[str, list] = {"lag1_autocorrelation": [], "effective_samples": [], "friction_amplitude": [],
                                "friction_t": [], "position_amplitude": [], "position_t": []}
         for j in range(self.n_dof):
             g = self.gram[j]

@@ -137,7 +137,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     s = data.settings
     rest_v = np.broadcast_to(np.asarray(0.0 if s.rest_velocity == "auto" else s.rest_velocity, dtype=float), (n,))
     speed = np.maximum(root_mean_square(data.dq), 1e-9)
-    rigid = replace(robot, drive_terms=(), drive=np.zeros((n, 0)), drive_mask=None)
+    rigid = replace(robot, drive_terms=(), drive=np.zeros((n, 0)), drive_mask=np.ones((n, 0), dtype=bool))
     rigid_base = base_parameters(rigid, rng=0)
     p = rigid_base.n_base
     nominal = rigid_base.base_from_standard(rigid.standard_parameters())
@@ -207,7 +207,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
         directions[:] = [_directions(data, rest_v, d, cutoff, start, stop) for d in decays]  # the segment's, from its start
         directions_start[0] = start
         for idx, (y, bank, tau) in parallel_decimation(lambda a, b: block(start + a, start + b), stop - start, data.rate,
-                                                       s.decimation, s.order, s.chunk, s.parallel_cutoff or None):
+                                                       s.decimation or 1, s.order, s.chunk, s.parallel_cutoff or None):
             idx = idx + start
             _accumulate(idx, y, bank, tau, fold_of(idx))
     if not n_rows.any():

@@ -93,7 +93,7 @@ class TorqueComparison:
                                                    self.speed[j] < 0.05 else "")
             rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} N·m"
             out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} N·m, "
-                       f"{self.rms_torque[j] / self.noise[j]:.2g}× the identification residual): relative error not meaningful"
+                       f"{self.rms_torque[j] / np.asarray(self.noise)[j]:.2g}× the identification residual): relative error not meaningful"
                        f"{rmse_j}")
         return out
 
@@ -177,12 +177,14 @@ class TorqueSums:
         self.rest_gram = np.zeros((n_dof, n_columns + 1, n_columns + 1))  # raw sums of z zᵀ over resting rows
         self.rest_count = np.zeros(n_dof)
         self.thin = max(1, -(-n_rows // max_points))
-        self.kept_t, self.kept_y, self.kept_tau = [], [], []
+        self.kept_t: list[np.ndarray] = []
+        self.kept_y: list[np.ndarray] = []
+        self.kept_tau: list[np.ndarray] = []
 
     @classmethod
     def for_data(cls, data: PreparedData, n_columns: int) -> "TorqueSums":
         """Statistics for the decimated samples :func:`dynid.preprocessing.pipeline.base_chunks` gives of ``data``."""
-        return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation)))
+        return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)))
 
     def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray, resting: np.ndarray | None = None) -> None:
         """Rows ``y`` (M, n_dof, n_columns), torques ``tau`` (M, n_dof) at times ``t`` (M,); ``resting`` (M, n_dof)
@@ -242,9 +244,9 @@ def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
     """(M, n_dof) bool: where each joint rests at the samples ``index`` (:func:`dynid.friction.moving_joints`)."""
     if data.resting is not None:
         return data.resting[index]
-    rest = data.settings.rest_velocity
+    given = data.settings.rest_velocity
     n = data.tau.shape[1]
-    rest = np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float), (n,))
+    rest = np.broadcast_to(np.asarray(0.0 if given == "auto" else given, dtype=float), (n,))
     v = data.motion if data.motion is not None else data.dq
     return np.abs(np.asarray(v[index])) <= rest
 
@@ -281,7 +283,10 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
         (:attr:`TorqueComparison.spread`).
     """
     covariance = covariance or {}
-    ts, meas, rest, preds = [], [], [], {k: [] for k in parameter_sets}
+    ts: list = []
+    meas: list = []
+    rest: list = []
+    preds: dict[str, list] = {k: [] for k in parameter_sets}
     var = {k: np.zeros(robot.n_dof) for k in covariance}
     for index, y, tau, _ in base_chunks(robot, base, data, progress):
         ts.append(data.t[index])
@@ -313,8 +318,8 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
     rms = cmp.rms_torque
     n = cmp.measured.shape[1]
     ok = cmp.meaningful()
-    share = cmp.rest_share
-    split = share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
+    share = np.zeros(n) if cmp.rest_share is None else np.asarray(cmp.rest_share)
+    split = cmp.rest_share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
     rows, ends = [], set()
     for label, m in cmp.metrics().items():
         rows.append((label,) + ("",) * (n + 1))
