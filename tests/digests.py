@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -86,8 +87,17 @@ def compute(case: str) -> dict:
     raise ValueError(f"unknown case {case!r}")
 
 
+def _portable(text: str) -> str:
+    """A path in a result with the shared data folder written ``<data>`` and the checkout ``<repo>``, so that a
+    digest stored on one machine compares on another one (CI checks out elsewhere)."""
+    roots = [os.environ.get("DYNID_SHARED_DATA"), str(ROOT.parent / "shared" / "data"), "/work/shared/data"]
+    for root in filter(None, roots):
+        text = text.replace(str(Path(root).resolve()), "<data>").replace(root, "<data>")
+    return text.replace(str(ROOT), "<repo>")
+
+
 def flatten(obj, prefix: str = "") -> dict:
-    """JSON path -> leaf (number, string, bool or None), without :data:`SKIPPED` keys."""
+    """JSON path -> leaf (number, string, bool or None), without :data:`SKIPPED` keys; paths made portable."""
     out = {}
     if isinstance(obj, dict):
         for k, v in obj.items():
@@ -97,7 +107,7 @@ def flatten(obj, prefix: str = "") -> dict:
         for i, v in enumerate(obj):
             out.update(flatten(v, f"{prefix}[{i}]"))
     else:
-        out[prefix] = obj
+        out[prefix] = _portable(obj) if isinstance(obj, str) else obj
     return out
 
 
