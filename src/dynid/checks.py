@@ -8,7 +8,18 @@ from .exceptions import ShapeError
 
 
 def check_trajectory_array(x, n_dof: int, name: str = "q") -> np.ndarray:
-    """Return ``x`` as a C-contiguous float64 array of shape (N, n_dof).
+    """An array as a C-contiguous float64 array of shape (N, n_dof).
+
+    Parameters
+    ----------
+    x : array_like
+    n_dof : int
+    name : str
+        Named in the error.
+
+    Returns
+    -------
+    (N, n_dof) ndarray
 
     Raises
     ------
@@ -30,7 +41,23 @@ def check_trajectory_array(x, n_dof: int, name: str = "q") -> np.ndarray:
 
 
 def check_same_length(**arrays: np.ndarray) -> int:
-    """Check that all arrays have the same number of samples (axis 0); return it."""
+    """Check that arrays have the same number of samples (axis 0).
+
+    Parameters
+    ----------
+    **arrays : ndarray
+        Named arrays; the names appear in the error.
+
+    Returns
+    -------
+    int
+        The common length N.
+
+    Raises
+    ------
+    ShapeError
+        If the lengths differ.
+    """
     lengths = {k: len(v) for k, v in arrays.items()}
     if len(set(lengths.values())) > 1:
         raise ShapeError(f"expected the same number of samples, got {lengths}")
@@ -38,7 +65,24 @@ def check_same_length(**arrays: np.ndarray) -> int:
 
 
 def check_vector(x, n: int, name: str) -> np.ndarray:
-    """Return ``x`` as a float64 vector of length ``n`` (a scalar is broadcast)."""
+    """A float64 vector of a given length (a scalar is broadcast).
+
+    Parameters
+    ----------
+    x : float or array_like
+    n : int
+    name : str
+        Named in the error.
+
+    Returns
+    -------
+    (n,) ndarray
+
+    Raises
+    ------
+    ShapeError
+        A vector of another length.
+    """
     a = np.asarray(x, dtype=np.float64)
     if a.ndim == 0:
         a = np.full(n, float(a))
@@ -48,7 +92,19 @@ def check_vector(x, n: int, name: str) -> np.ndarray:
 
 
 def check_states(q, dq, ddq, n_dof: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Joint positions, velocities and accelerations as (N, n_dof) float64 arrays of one length, and N.
+    """Joint positions, velocities and accelerations as (N, n_dof) float64 arrays of one length.
+
+    Parameters
+    ----------
+    q, dq, ddq : (N, n_dof) array_like
+        [rad], [rad/s], [rad/s²].
+    n_dof : int
+
+    Returns
+    -------
+    q, dq, ddq : (N, n_dof) ndarray
+    n : int
+        N.
 
     Raises
     ------

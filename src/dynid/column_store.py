@@ -51,7 +51,13 @@ class ColumnFile:
         self.n = 0
 
     def append(self, values: np.ndarray) -> None:
-        """Append ``values`` (1-D, converted to float64)."""
+        """Append samples at the end of the column.
+
+        Parameters
+        ----------
+        values : (n,) array_like
+            Samples, converted to float64.
+        """
         data = np.ascontiguousarray(values, dtype=np.float64).reshape(-1).data.cast("B")
         offset, done = 8 * self.n, 0
         try:
@@ -63,7 +69,18 @@ class ColumnFile:
         self.n += len(data) // 8
 
     def read(self, start: int, stop: int) -> np.ndarray:
-        """Samples ``start .. stop-1`` as a new (stop - start,) array."""
+        """Read a range of samples.
+
+        Parameters
+        ----------
+        start, stop : int
+            First sample and one past the last (``0 <= start <= stop <= len``).
+
+        Returns
+        -------
+        (stop - start,) ndarray
+            A new float64 array.
+        """
         out = np.empty(max(stop - start, 0))
         view, done = out.data.cast("B"), 0
         while done < len(view):
@@ -94,7 +111,18 @@ class StoredColumns:
 
     @classmethod
     def from_columns(cls, columns) -> "StoredColumns":
-        """Stored copies of the 1-D arrays ``columns`` (an iterable: a generator holds one at a time)."""
+        """Stored copies of 1-D arrays, one file per column.
+
+        Parameters
+        ----------
+        columns : iterable of (N,) array_like
+            The columns, all of one length; a generator keeps one column in memory at a time.
+
+        Returns
+        -------
+        StoredColumns
+            The stored columns, (N, k) with k the number of columns.
+        """
         files = []
         for c in columns:
             files.append(ColumnFile())
@@ -103,34 +131,93 @@ class StoredColumns:
 
     @property
     def shape(self) -> tuple[int, int]:
+        """``(rows, columns)`` of the view."""
         return (self.stop - self.start, len(self.files))
 
     def __len__(self) -> int:
         return self.stop - self.start
 
     def column(self, j: int) -> np.ndarray:
-        """Column ``j`` as a new (N,) array."""
+        """One column.
+
+        Parameters
+        ----------
+        j : int
+            Column index, ``0 <= j < k``.
+
+        Returns
+        -------
+        (N,) ndarray
+            A new float64 array.
+        """
         return self.files[j].read(self.start, self.stop)
 
     def rows(self, a: int, b: int) -> np.ndarray:
-        """Rows ``a .. b-1`` as a new C-ordered (b - a, k) array."""
+        """A block of rows.
+
+        Parameters
+        ----------
+        a, b : int
+            First row and one past the last.
+
+        Returns
+        -------
+        (b - a, k) ndarray
+            A new C-ordered float64 array.
+        """
         out = np.empty((max(b - a, 0), len(self.files)))
         for j, f in enumerate(self.files):
             out[:, j] = f.read(self.start + a, self.start + b)
         return out
 
     def select(self, columns, n_rows: int | None = None) -> "StoredColumns":
-        """A view of some columns (and the first ``n_rows`` rows); nothing is copied."""
+        """A view of some columns and the first rows; nothing is copied.
+
+        Parameters
+        ----------
+        columns : sequence of int
+            Column indices, in the order wanted.
+        n_rows : int, optional
+            Keep the first ``n_rows`` rows (all by default).
+
+        Returns
+        -------
+        StoredColumns
+            A view over the same files.
+        """
         stop = self.stop if n_rows is None else self.start + n_rows
         return StoredColumns([self.files[int(j)] for j in columns], self.start, stop)
 
     def map_columns(self, along_time: Callable[[np.ndarray, int], np.ndarray]) -> "StoredColumns":
-        """New stored columns ``along_time(column_j, j)``, one column in memory at a time."""
+        """New stored columns computed column by column, one column in memory at a time.
+
+        Parameters
+        ----------
+        along_time : callable
+            ``along_time(column_j, j)`` -> (M,) array, the same M for every column.
+
+        Returns
+        -------
+        StoredColumns
+            (M, k) stored columns.
+        """
         return StoredColumns.from_columns(along_time(self.column(j), j) for j in range(len(self.files)))
 
     def map_rows(self, row_wise: Callable[[np.ndarray], np.ndarray], chunk: int | None = None) -> "StoredColumns":
-        """New stored columns of ``row_wise(rows)`` (an (n, k) → (n, k') map that treats each row alone), chunk by
-        chunk (default :data:`ROW_CHUNK` rows)."""
+        """New stored columns computed chunk of rows by chunk of rows.
+
+        Parameters
+        ----------
+        row_wise : callable
+            An (n, k) -> (n, k') map that treats each row alone.
+        chunk : int, optional
+            Rows per chunk (:data:`ROW_CHUNK` by default).
+
+        Returns
+        -------
+        StoredColumns
+            (N, k') stored columns.
+        """
         chunk = chunk or ROW_CHUNK
         files = None
         for a in range(0, len(self), chunk):
@@ -172,9 +259,20 @@ class StoredColumns:
 
 
 def by_column(x, along_time: Callable[[np.ndarray, int], np.ndarray]):
-    """``along_time(column_j, j)`` for each column of a time-first array, as an array of the same kind:
-    stored columns stay stored; an in-memory (N, ...) array gives an (M, ...) array (the columns of its
-    trailing axes flattened and restored), the same numbers either way."""
+    """Apply a map along time to each column of a time-first array, as an array of the same kind.
+
+    Parameters
+    ----------
+    x : (N, ...) ndarray or StoredColumns
+        Time-first samples; the trailing axes of an array are flattened into columns and restored.
+    along_time : callable
+        ``along_time(column_j, j)`` -> (M,) array.
+
+    Returns
+    -------
+    (M, ...) ndarray or StoredColumns
+        Stored columns stay stored; the same numbers either way.
+    """
     if isinstance(x, StoredColumns):
         return x.map_columns(along_time)
     x = np.asarray(x, dtype=float)
@@ -191,15 +289,41 @@ def by_column(x, along_time: Callable[[np.ndarray, int], np.ndarray]):
 
 
 def select_rows(x, rows):
-    """``x[rows]`` (a boolean mask or integer indices) for an array or stored columns (which stay stored)."""
+    """``x[rows]`` for an array or stored columns (which stay stored).
+
+    Parameters
+    ----------
+    x : (N, ...) ndarray or StoredColumns
+        Time-first samples.
+    rows : (N,) bool array or (M,) int array
+        A boolean mask or row indices.
+
+    Returns
+    -------
+    (M, ...) ndarray or StoredColumns
+        The selected rows.
+    """
     if isinstance(x, StoredColumns):
         return x.map_columns(lambda column, j: column[rows])
     return x[rows]
 
 
 def root_mean_square(x) -> np.ndarray:
-    """RMS of each column of a time-first (N, k) array or stored columns, (k,): column by column, so that
-    both give the same numbers (a sum along axis 0 of an (N, k) array adds in another order)."""
+    """Root mean square of each column, computed column by column.
+
+    Column by column so that an array and stored columns give the same numbers (a sum along axis 0 of an (N, k)
+    array adds in another order).
+
+    Parameters
+    ----------
+    x : (N, k) ndarray or StoredColumns
+        Time-first samples.
+
+    Returns
+    -------
+    (k,) ndarray
+        RMS of each column, in the unit of ``x``.
+    """
     if not isinstance(x, StoredColumns):
         x = np.asarray(x, dtype=float)
     return np.array([np.sqrt(np.mean(x[:, j] ** 2)) for j in range(x.shape[1])])

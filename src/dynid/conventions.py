@@ -49,12 +49,35 @@ def _alias(term: str) -> str:
 
 
 def parameter_name(term: str, joint: int) -> str:
-    """Name of a standard parameter, e.g. ``parameter_name("ZZ", 0) == "ZZ1"`` (joint is 0-based)."""
+    """Name of a standard parameter, e.g. ``parameter_name("ZZ", 0) == "ZZ1"``.
+
+    Parameters
+    ----------
+    term : str
+        Inertial or drive term (``"ZZ"``, ``"fv"``…).
+    joint : int
+        0-based.
+
+    Returns
+    -------
+    str
+    """
     return f"{term}{joint + 1}"
 
 
 def split_name(name: str) -> tuple[str, int]:
-    """Inverse of :func:`parameter_name`: ``"MX3" -> ("MX", 2)``; a trailing ``R`` is ignored."""
+    """Inverse of :func:`parameter_name`: ``"MX3" -> ("MX", 2)``; a trailing ``R`` is ignored.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    term : str
+    joint : int
+        0-based.
+    """
     stem = name[:-1] if name.endswith("R") and not name[-2:-1].isalpha() else name
     i = len(stem)
     while i > 0 and stem[i - 1].isdigit():
@@ -63,8 +86,18 @@ def split_name(name: str) -> tuple[str, int]:
 
 
 def canonical_name(name: str) -> str:
-    """dynid's name of a parameter written in another common spelling: ``"Ixx2" -> "XX2"``,
-    ``"m3" -> "M3"``, ``"fs1" -> "fc1"``, ``"off4"``/``"f04" -> "offset4"``; dynid names pass unchanged.
+    """dynid's name of a parameter written in another common spelling.
+
+    ``"Ixx2" -> "XX2"``, ``"m3" -> "M3"``, ``"fs1" -> "fc1"``, ``"off4"``/``"f04" -> "offset4"``; dynid names pass
+    unchanged.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
 
     Raises
     ------
@@ -88,6 +121,15 @@ def canonical_name(name: str) -> str:
 
 
 def unit_of(name: str) -> str:
-    """Unit of a (standard or base) parameter from its leading term, e.g. ``"ZZ1R" -> "kg·m²"``."""
+    """Unit of a (standard or base) parameter from its leading term, e.g. ``"ZZ1R" -> "kg·m²"``.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+    """
     term, _ = split_name(name)
     return friction.TERMS[term].unit if term in friction.TERMS else UNITS.get(term, "")

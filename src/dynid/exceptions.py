@@ -8,8 +8,15 @@ what was found and, where possible, how to fix it.
 class DynIdError(Exception):
     """Base class of all errors raised by dynid for bad input or data.
 
-    ``field`` names the setting at fault when the message starts with it (``"seed must be …"``): the library
-    speaks of its settings' names, the CLI translates them to its options (``--seed``).
+    ``field`` names the setting at fault when the message starts with it (``"seed must be …"``): the library speaks of
+    its settings' names, the CLI translates them to its options (``--seed``).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
     """
 
     def __init__(self, message: str = "", field: str | None = None):
@@ -18,16 +25,48 @@ class DynIdError(Exception):
 
 
 class ConfigError(DynIdError, ValueError):
-    """A robot description or experiment configuration is invalid (names the file and field)."""
+    """A robot description or experiment configuration is invalid (names the file and field).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """
 
 
 class ShapeError(DynIdError, ValueError):
-    """An array has the wrong shape (says expected vs got)."""
+    """An array has the wrong shape (says expected vs got).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """
 
 
 class DataError(DynIdError, ValueError):
-    """Measured data is unusable (names the file, row or column)."""
+    """Measured data is unusable (names the file, row or column).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """
 
 
 class IdentifiabilityError(DynIdError, ValueError):
-    """The data do not excite the parameters enough (rank-deficient observation matrix)."""
+    """The data do not excite the parameters enough (rank-deficient observation matrix).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """

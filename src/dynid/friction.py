@@ -114,8 +114,21 @@ def held_direction(dq: np.ndarray, rest, decay=np.inf, presliding=0.0, rate: flo
 
 
 def moving_joints(dq: np.ndarray, guide: np.ndarray, rest) -> np.ndarray:
-    """(N, n_dof) bool: where each joint moves (``|guide|`` above the rest velocity); the complement is where it
-    rests."""
+    """Where each joint moves; the complement is where it rests.
+
+    Parameters
+    ----------
+    dq : (N, n_dof) array [rad/s]
+        Velocities.
+    guide : (N, n_dof) array [rad/s]
+        The velocity compared with the rest velocity (e.g. a smoothed one).
+    rest : (n_dof,) array or float [rad/s]
+        Rest velocity of each joint (0: a joint moves wherever ``dq != 0``).
+
+    Returns
+    -------
+    (N, n_dof) bool ndarray
+    """
     dq, guide = np.asarray(dq, dtype=float), np.asarray(guide, dtype=float)
     vr = np.broadcast_to(np.asarray(rest, dtype=float), dq.shape[-1:])
     return np.column_stack([_moving(dq[:, j], guide[:, j], vr[j]) != 0 if vr[j] > 0 else dq[:, j] != 0
@@ -259,20 +272,43 @@ def _asymmetric_dq(q, dq, v):
 
 @dataclass(frozen=True)
 class Velocities:
-    """What the friction columns need beyond the joint state: per-joint Coulomb smoothing, Stribeck and rest
-    velocities [rad/s] (n_dof,), and a log's direction of motion (N, n_dof) when it is held at rest
-    (:func:`held_direction`; the rest velocity and the direction are properties of a log, not of the robot)."""
+    """What the friction columns need beyond the joint state.
+
+    The rest velocity and the direction are properties of a log, not of the robot.
+
+    Attributes
+    ----------
+    coulomb : (n_dof,) array [rad/s]
+        Coulomb smoothing velocity of each joint (0: an exact sign).
+    stribeck : (n_dof,) array [rad/s]
+        Stribeck velocity of each joint.
+    rest : (n_dof,) array or float [rad/s]
+        Below this speed a joint rests (0: never).
+    direction : (N, n_dof) array or None
+        A log's direction of motion held at rest (:func:`held_direction`).
+    load : (N, n_dof) array [N·m] or None
+        Torque each joint's transmission carries, for the load-dependent Coulomb term ``fcl``: the rigid-body torque
+        of the robot's nominal parameters (:func:`dynid.dynamics.regressor.regressor` fills it).
+    """
 
     coulomb: np.ndarray
     stribeck: np.ndarray
     rest: np.ndarray | float = 0.0
     direction: np.ndarray | None = None
     load: np.ndarray | None = None
-    """(N, n_dof) torque each joint's transmission carries [N·m], for the load-dependent Coulomb term ``fcl``: the
-    rigid-body torque of the robot's nominal parameters (:func:`dynid.dynamics.regressor.regressor` fills it)."""
 
     def rows(self, a: int, b: int) -> "Velocities":
-        """The same, with the direction and load of samples ``a:b`` only."""
+        """The same, with the direction and load of some samples only.
+
+        Parameters
+        ----------
+        a, b : int
+            First sample and one past the last.
+
+        Returns
+        -------
+        Velocities
+        """
         cut = lambda x: None if x is None else x[a:b]  # noqa: E731
         return replace(self, direction=cut(self.direction), load=cut(self.load))
 
@@ -361,12 +397,36 @@ DEFAULT_STRIBECK_VELOCITY = 0.01
 
 
 def term_names() -> tuple[str, ...]:
-    """Names of the terms of :data:`TERMS`, in table order."""
+    """Names of the terms of :data:`TERMS`.
+
+    Returns
+    -------
+    tuple of str
+        In table order.
+    """
     return tuple(TERMS)
 
 
 def check_terms(terms, where: str) -> tuple[str, ...]:
-    """Terms in table order; an unknown name is a ``ValueError`` naming ``where`` (never an offset)."""
+    """Friction term names checked against :data:`TERMS`, in table order.
+
+    Parameters
+    ----------
+    terms : iterable of str
+        Term names, e.g. ``("fv", "fc", "off")``.
+    where : str
+        Where the names come from, named in the error.
+
+    Returns
+    -------
+    tuple of str
+        The terms in table order.
+
+    Raises
+    ------
+    ValueError
+        An unknown name, naming ``where``.
+    """
     bad = [t for t in terms if t not in TERMS]
     if bad:
         raise ValueError(f"{where}: unknown drive term(s) {bad}, expected a subset of {list(TERMS)}")
@@ -374,7 +434,21 @@ def check_terms(terms, where: str) -> tuple[str, ...]:
 
 
 def drive_columns(terms, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, velocities: Velocities) -> np.ndarray:
-    """Columns of ``terms`` for every joint: (N, n_dof, len(terms)); ``q, dq, ddq`` (N, n_dof) [rad, rad/s, rad/s²]."""
+    """Columns of the drive terms for every joint (eqs. 3-6 of the paper's friction model).
+
+    Parameters
+    ----------
+    terms : sequence of str
+        Drive term names (:data:`TERMS`).
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+    velocities : Velocities
+
+    Returns
+    -------
+    (N, n_dof, len(terms)) ndarray
+        Column of each term for each joint and sample.
+    """
     q, dq, ddq = (np.asarray(x, dtype=float) for x in (q, dq, ddq))
     if not terms:
         return np.zeros(dq.shape + (0,))
@@ -383,8 +457,21 @@ def drive_columns(terms, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, velocit
 
 def drive_column_derivatives(terms, q: np.ndarray, dq: np.ndarray, velocities: Velocities
                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Derivatives of the columns of ``terms`` with respect to the joint's own position, velocity and
-    acceleration, each (N, n_dof, len(terms))."""
+    """Derivatives of the drive columns with respect to each joint's own position, velocity and acceleration.
+
+    Parameters
+    ----------
+    terms : sequence of str
+        Drive term names (:data:`TERMS`).
+    q, dq : (N, n_dof) arrays
+        [rad], [rad/s].
+    velocities : Velocities
+
+    Returns
+    -------
+    d_q, d_dq, d_ddq : (N, n_dof, len(terms)) ndarray
+        Each column's derivative (the unit of the column per rad, rad/s and rad/s²).
+    """
     q, dq = np.asarray(q, dtype=float), np.asarray(dq, dtype=float)
     d_q = np.stack([(TERMS[t].d_q or _zeros)(q, dq, velocities) for t in terms], axis=-1)
     d_dq = np.stack([TERMS[t].d_dq(q, dq, velocities) for t in terms], axis=-1)
@@ -393,4 +480,10 @@ def drive_column_derivatives(terms, q: np.ndarray, dq: np.ndarray, velocities: V
 
 
 def nonnegative_terms() -> tuple[str, ...]:
+    """Names of the terms that are non-negative on a physical robot (viscous and Coulomb friction…).
+
+    Returns
+    -------
+    tuple of str
+    """
     return tuple(t.name for t in TERMS.values() if t.nonnegative)

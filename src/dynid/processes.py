@@ -21,8 +21,14 @@ _allowed = False
 
 @contextlib.contextmanager
 def allow_forks():
-    """Within this block, work may go to forked children (:func:`can_fork`). The CLI runs its commands in
-    it; the library alone never forks."""
+    """A block within which work may go to forked children (:func:`can_fork`).
+
+    The CLI runs its commands in it; the library alone never forks.
+
+    Yields
+    ------
+    None
+    """
     global _allowed
     before, _allowed = _allowed, True
     try:
@@ -32,16 +38,30 @@ def allow_forks():
 
 
 def can_fork() -> bool:
-    """Whether work may go to a forked child: inside :func:`allow_forks`, on Linux (fork with threads), with
-    two cores or more."""
+    """Whether work may go to a forked child.
+
+    Inside :func:`allow_forks`, on Linux (fork with threads), with two cores or more.
+
+    Returns
+    -------
+    bool
+    """
     from .threads import cores
 
     return _allowed and cores() >= 2 and sys.platform.startswith("linux")
 
 
 def fork() -> int:
-    """``os.fork()``, flushing the standard streams first (not written twice); the child's standard streams
-    are fresh ones on /dev/null: a lock another thread of the parent held at the fork stays held in the child."""
+    """``os.fork()``, flushing the standard streams first (not written twice).
+
+    The child's standard streams are fresh ones on /dev/null: a lock another thread of the parent held at the fork
+    stays held in the child.
+
+    Returns
+    -------
+    int
+        0 in the child, the child's pid in the parent.
+    """
     sys.stdout.flush()
     sys.stderr.flush()
     pid = os.fork()
@@ -51,20 +71,38 @@ def fork() -> int:
 
 
 def read_all(fd: int) -> bytes:
-    """Everything written to the pipe ``fd`` until its writer closes it (then closes ``fd``)."""
+    """Everything written to a pipe until its writer closes it (then closes it).
+
+    Parameters
+    ----------
+    fd : int
+        The pipe's read end.
+
+    Returns
+    -------
+    bytes
+    """
     with os.fdopen(fd, "rb") as pipe:
         return pipe.read()
 
 
 class ForkedCall:
-    """``fn(*args)`` computed in a forked child while this process goes on; :meth:`result` returns its
-    value or raises its exception, as calling ``fn(*args)`` here would. Without a child (:func:`can_fork`
-    false) or when the child leaves no answer, :meth:`result` calls ``fn(*args)`` here.
+    """``fn(*args)`` computed in a forked child while this process goes on.
+
+    :meth:`result` returns its value or raises its exception, as calling ``fn(*args)`` here would. Without a child
+    (:func:`can_fork` false) or when the child leaves no answer, :meth:`result` calls ``fn(*args)`` here.
 
     ``fn`` must not print, warn or report progress (the child's output goes nowhere). Its value and its
-    :class:`~dynid.exceptions.DynIdError` are pickled back; any other exception is raised again by calling
-    ``fn(*args)`` here, with its traceback. Used as a context manager, it stops and waits for a child whose
-    answer was not taken when the block ends (the work it was for failed).
+    :class:`~dynid.exceptions.DynIdError` are pickled back; any other exception is raised again by calling ``fn(*args)``
+    here, with its traceback. Used as a context manager, it stops and waits for a child whose answer was not taken when
+    the block ends (the work it was for failed).
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (its value is pickled).
+    *args
+        Its arguments.
     """
 
     def __init__(self, fn, *args):
@@ -91,7 +129,12 @@ class ForkedCall:
             self._pid = None
 
     def result(self):
-        """The value of ``fn(*args)``; raises what it raised."""
+        """The value of ``fn(*args)``; raises what it raised.
+
+        Returns
+        -------
+        object
+        """
         import pickle
 
         fn, args = self._call

@@ -21,7 +21,14 @@ EDGES = 0
 
 @dataclass(frozen=True)
 class Line:
-    """A line of text in a summary; ``kind`` is ``"text"``, ``"title"`` or ``"warning"``."""
+    """A line of text in a summary.
+
+    Attributes
+    ----------
+    text : str
+    kind : str
+        "text", "title" or "warning".
+    """
 
     text: str
     kind: str = "text"
@@ -51,12 +58,27 @@ class TextTable:
     section_ends: frozenset = field(default_factory=frozenset)
 
     def widths(self) -> list[int]:
-        """Width of each column: its longest cell or header."""
+        """Width of each column: its longest cell or header.
+
+        Returns
+        -------
+        list of int
+        """
         return [max([len(c)] + [len(r[i]) for r in self.rows]) for i, c in enumerate(self.columns)]
 
     def split(self, width: int) -> list[TextTable]:
-        """Parts no wider than ``width`` characters (as far as the label columns allow), each repeating the
-        label columns; one part (``self``) when it fits."""
+        """Parts no wider than a width (as far as the label columns allow), each repeating the label columns.
+
+        Parameters
+        ----------
+        width : int
+            Characters.
+
+        Returns
+        -------
+        list of TextTable
+            ``[self]`` when it fits.
+        """
         w = self.widths()
         total = sum(x + PADDING for x in w) + EDGES
         if total <= width or len(self.columns) <= self.labels + 1:
@@ -79,7 +101,17 @@ class TextTable:
                 for k, g in enumerate(groups)]
 
     def render(self, width: int = 100) -> str:
-        """Plain text, split to ``width`` columns."""
+        """Plain text, split to a width.
+
+        Parameters
+        ----------
+        width : int
+            Characters.
+
+        Returns
+        -------
+        str
+        """
         parts = []
         for part in self.split(width):
             w = part.widths()
@@ -98,7 +130,18 @@ class TextTable:
 
 
 def render_text(blocks, width: int = 100) -> str:
-    """Plain text of a summary's blocks (:class:`Line` or :class:`TextTable`)."""
+    """Plain text of a summary's blocks.
+
+    Parameters
+    ----------
+    blocks : iterable of Line or TextTable
+    width : int
+        Characters.
+
+    Returns
+    -------
+    str
+    """
     out = []
     for b in blocks:
         if isinstance(b, TextTable):

@@ -12,14 +12,28 @@ import os
 
 
 def single_blas_thread():
-    """Context manager: BLAS/LAPACK (OpenBLAS, MKL, …) limited to one thread inside it."""
+    """Context manager: BLAS/LAPACK (OpenBLAS, MKL, …) limited to one thread inside it.
+
+    Returns
+    -------
+    contextlib.AbstractContextManager
+    """
     from threadpoolctl import threadpool_limits
 
     return threadpool_limits(limits=1, user_api="blas")
 
 
 def with_single_blas_thread(func):
-    """Decorator: ``func`` runs under :func:`single_blas_thread` (results independent of the BLAS thread count)."""
+    """Decorator: a function runs under :func:`single_blas_thread` (results independent of the BLAS thread count).
+
+    Parameters
+    ----------
+    func : callable
+
+    Returns
+    -------
+    callable
+    """
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
@@ -30,7 +44,12 @@ def with_single_blas_thread(func):
 
 
 def cores() -> int:
-    """Cores this process may use."""
+    """Cores this process may use.
+
+    Returns
+    -------
+    int
+    """
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux

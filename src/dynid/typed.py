@@ -30,7 +30,16 @@ _KINDS = {"int": "an integer", "float": "a number", "str": "a string", "bool": "
 
 
 def field_path(path: str) -> str:
-    """``$.validation[1].positions`` as dynid's messages write it: ``validation[1].positions``."""
+    """A msgspec field path as dynid's messages write it: ``$.validation[1].positions`` -> ``validation[1].positions``.
+
+    Parameters
+    ----------
+    path : str
+
+    Returns
+    -------
+    str
+    """
     return path[1:] if path.startswith(".") else path
 
 

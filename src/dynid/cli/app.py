@@ -77,7 +77,17 @@ def _parse_weights(text: Optional[str]):
 
 
 def summary_blocks(result) -> list:
-    """What a command prints of its result (:func:`dynid.report.summaries.blocks`)."""
+    """What a command prints of its result (:func:`dynid.report.summaries.blocks`).
+
+    Parameters
+    ----------
+    result : object
+        A command's result object.
+
+    Returns
+    -------
+    list of Block
+    """
     from ..report.summaries import blocks
 
     return blocks(result)

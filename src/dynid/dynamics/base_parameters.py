@@ -48,33 +48,78 @@ class BaseParameters:
 
     @property
     def n_base(self) -> int:
+        """Number of base parameters."""
         return len(self.names)
 
     def base_from_standard(self, phi: np.ndarray) -> np.ndarray:
-        """``beta = regrouping @ phi`` (n_base,)."""
+        """Base parameters of a standard vector: ``beta = regrouping @ phi``.
+
+        Parameters
+        ----------
+        phi : (n_params,) array
+            Standard parameters, SI units.
+
+        Returns
+        -------
+        (n_base,) ndarray
+        """
         return self.regrouping @ np.asarray(phi, dtype=float)
 
     def base_from_named(self, values: dict) -> np.ndarray:
-        """``beta`` of the standard parameters given by name (``{"ZZ1": 0.3, …}``; a standard parameter not given is
-        0, a name this robot does not have is ignored), (n_base,)."""
+        """Base parameters of standard parameters given by name.
+
+        Parameters
+        ----------
+        values : dict
+            ``{"ZZ1": 0.3, …}``; a standard parameter not given is 0, a name this robot does not have is ignored.
+
+        Returns
+        -------
+        (n_base,) ndarray
+        """
         return self.regrouping @ np.array([float(values.get(n, 0.0)) for n in self.standard_names])
 
     def standard_from_base(self, beta: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
         """A standard vector whose base parameters are ``beta``.
 
-        Without ``reference``: ``beta`` on the kept columns, 0 elsewhere. With a reference standard
-        vector (e.g. nominal values): ``reference + E (beta - regrouping @ reference)``, which keeps the
-        reference's masses and other unidentifiable parameters (so a rigid-body simulator can use it).
+        Without ``reference``: ``beta`` on the kept columns, 0 elsewhere. With a reference standard vector (e.g. nominal
+        values): ``reference + E (beta - regrouping @ reference)``, which keeps the reference's masses and other
+        unidentifiable parameters (so a rigid-body simulator can use it).
+
+        Parameters
+        ----------
+        beta : (n_base,) array
+        reference : (n_params,) array, optional
+
+        Returns
+        -------
+        (n_params,) ndarray
         """
         ref = np.zeros(len(self.standard_names)) if reference is None else np.asarray(reference, dtype=float).copy()
         ref[self.independent] += np.asarray(beta, dtype=float) - self.regrouping @ ref
         return ref
 
     def base_observation(self, w: np.ndarray) -> np.ndarray:
-        """Base regressor: the kept columns of ``W`` (..., n_params) -> (..., n_base)."""
+        """Base regressor: the kept columns of the standard one.
+
+        Parameters
+        ----------
+        w : (..., n_params) array
+
+        Returns
+        -------
+        (..., n_base) ndarray
+        """
         return w[..., self.independent]
 
     def to_dict(self) -> dict:
+        """Names and regrouping expressions, JSON-ready.
+
+        Returns
+        -------
+        dict
+            ``names`` and ``expressions``, lists of str.
+        """
         return {"names": list(self.names), "expressions": list(self.expressions)}
 
 

@@ -39,6 +39,16 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 def tool_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Tool (flange) point in the base frame, (N, 3) [m]."""
+    """Tool (flange) point in the base frame.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+
+    Returns
+    -------
+    (N, 3) ndarray [m]
+    """
     rots, orig = forward_kinematics(robot, q)
     return orig[:, -1] + rots[:, -1] @ robot.tool_translation

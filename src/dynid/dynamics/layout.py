@@ -14,12 +14,16 @@ COUPLED_NONNEGATIVE = ("Iam", "fcm", "fvm")
 def consistency_layout(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """Columns of each link's ten inertial parameters, and of the non-negative drive terms.
 
+    Parameters
+    ----------
+    robot : Robot
+
     Returns
     -------
     links : (n_dof, 10) int array
     nonnegative : (k,) int array
-        Columns of the non-negative drive terms (:func:`dynid.friction.nonnegative_terms`) that the joint
-        has, and of the coupled motors' (:data:`COUPLED_NONNEGATIVE`).
+        Columns of the non-negative drive terms (:func:`dynid.friction.nonnegative_terms`) that the joint has, and of
+        the coupled motors' (:data:`COUPLED_NONNEGATIVE`).
     """
     npj = robot.n_params_per_joint
     links = np.array([np.arange(10) + j * npj for j in range(robot.n_dof)], dtype=int)

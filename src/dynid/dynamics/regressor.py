@@ -83,14 +83,32 @@ def regressor(robot: Robot, q, dq, ddq, columns=None, velocities=None) -> np.nda
 
 
 def observation_matrix(robot: Robot, q, dq, ddq) -> np.ndarray:
-    """Stacked regressor ``W`` (N·n_dof, n_params); row ``k·n_dof + j`` is sample ``k``, joint ``j``."""
+    """Stacked regressor (observation matrix) ``W``, eq. 7.
+
+    Parameters
+    ----------
+    robot : Robot
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+
+    Returns
+    -------
+    (N·n_dof, n_params) ndarray
+        Row ``k·n_dof + j`` is sample ``k``, joint ``j``.
+    """
     y = regressor(robot, q, dq, ddq)
     return y.reshape(-1, y.shape[2])
 
 
 def compile_kernels(robots) -> None:
-    """Compile, or load from their caches, the compiled regressors: numba's kernel (where the SIMD code
-    cannot be built) and each robot's SIMD code (the install step's warm-up, :mod:`dynid.warm_up`)."""
+    """Compile, or load from their caches, the compiled regressors (the install step's warm-up).
+
+    numba's kernel (where the SIMD code cannot be built) and each robot's SIMD code (:mod:`dynid.warm_up`).
+
+    Parameters
+    ----------
+    robots : iterable of Robot
+    """
     def run(robot, form):
         z = np.zeros((8, robot.n_dof))
         _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form)
@@ -168,8 +186,20 @@ def _numpy_form(n_samples: int) -> bool:
 
 
 def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:
-    """Rigid-body torques (N, n_dof) [N·m] of the robot's nominal inertial parameters (no drive terms): the torque
-    each transmission carries, for the load-dependent Coulomb term (:mod:`dynid.friction`)."""
+    """Rigid-body torques of the robot's nominal inertial parameters (no drive terms).
+
+    The torque each transmission carries, for the load-dependent Coulomb term (:mod:`dynid.friction`).
+
+    Parameters
+    ----------
+    robot : Robot
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+
+    Returns
+    -------
+    (N, n_dof) ndarray [N·m]
+    """
     from dataclasses import replace
 
     rigid = replace(robot, drive_terms=(), drive=np.zeros((robot.n_dof, 0)), drive_mask=np.ones((robot.n_dof, 0), dtype=bool))
@@ -178,9 +208,24 @@ def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:
 
 def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.ndarray | None = None,
                      coupled: np.ndarray | None = None, q: np.ndarray | None = None) -> np.ndarray:
-    """Torques of the drive terms alone (rotor inertia, eq. 3 friction, offset, coupled motors),
-    (N, n_dof) [N·m]; ``drive`` and ``coupled`` default to the robot's nominal values; ``q`` [rad] for the terms
-    that depend on the position (default zeros)."""
+    """Torques of the drive terms alone (rotor inertia, eq. 3 friction, offset, coupled motors).
+
+    Parameters
+    ----------
+    robot : Robot
+    dq, ddq : (N, n_dof) arrays
+        [rad/s], [rad/s²].
+    drive : (n_dof, n_drive) array, optional
+        Drive parameters per joint (the robot's nominal ones by default).
+    coupled : array, optional
+        Coupled motors' rotor inertias (the robot's by default).
+    q : (N, n_dof) array, optional
+        [rad], for the terms that depend on the position (zeros by default).
+
+    Returns
+    -------
+    (N, n_dof) ndarray [N·m]
+    """
     drive = robot.drive if drive is None else drive
     coupled = robot.transmission.coupled_values if coupled is None else coupled
     q = np.zeros_like(np.asarray(dq, dtype=float)) if q is None else q

@@ -14,9 +14,19 @@ from .regressor import friction_torques
 
 
 def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
-    """A ``pinocchio.Model`` of the chain with the given (n_dof, 10) inertial parameters.
+    """A ``pinocchio.Model`` of the chain with given inertial parameters.
 
     Parameters may be physically inconsistent (e.g. a base-parameter embedding); RNEA stays linear.
+
+    Parameters
+    ----------
+    robot : Robot
+    inertial : (n_dof, 10) array, optional
+        eq. 5 order (the robot's nominal ones by default).
+
+    Returns
+    -------
+    pinocchio.Model
     """
     import pinocchio as pin
 
@@ -41,7 +51,22 @@ def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
 
 
 def rnea_torques(robot: Robot, q, dq, ddq, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
-    """Joint torques (N, n_dof) [N·m]: Pinocchio's RNEA for the rigid bodies plus the drive terms."""
+    """Joint torques: Pinocchio's RNEA for the rigid bodies plus the drive terms.
+
+    Parameters
+    ----------
+    robot : Robot
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+    inertial : (n_dof, 10) array, optional
+        eq. 5 order (the robot's nominal ones by default).
+    drive : (n_dof, n_drive) array, optional
+        Drive parameters (the robot's nominal ones by default).
+
+    Returns
+    -------
+    (N, n_dof) ndarray [N·m]
+    """
     import pinocchio as pin
 
     model = pinocchio_model(robot, inertial)

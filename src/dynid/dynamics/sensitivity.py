@@ -26,7 +26,16 @@ Q_STEP = 1e-6
 
 
 def coulomb_columns(robot: Robot) -> np.ndarray:
-    """Indices of the standard parameters multiplying ``sign`` of a coupled motor's velocity (``fcm#``)."""
+    """Indices of the standard parameters multiplying ``sign`` of a coupled motor's velocity (``fcm#``).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    (k,) int ndarray
+    """
     return np.array([k for k, n in enumerate(robot.parameter_names) if n.startswith("fcm")], dtype=int)
 
 

@@ -61,7 +61,15 @@ class LeastSquaresAccumulator:
         self.rows = np.zeros(self.n_dof, dtype=np.int64)
 
     def add(self, w, tau, mask=None) -> None:
-        """Fold in a chunk: ``w`` (M, p), ``tau`` (M,), optional ``mask`` (M,) of rows to keep.
+        """Fold in a chunk of rows.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix rows, M a whole number of samples (n_dof rows each).
+        tau : (M,) array [N·m]
+        mask : (M,) bool array, optional
+            Rows to keep.
 
         Raises
         ------
@@ -85,7 +93,16 @@ class LeastSquaresAccumulator:
 
     @classmethod
     def merged(cls, accumulators) -> "LeastSquaresAccumulator":
-        """One accumulator holding the rows of all of ``accumulators`` (same sizes)."""
+        """One accumulator holding the rows of several (the same sizes).
+
+        Parameters
+        ----------
+        accumulators : iterable of LeastSquaresAccumulator
+
+        Returns
+        -------
+        LeastSquaresAccumulator
+        """
         first = accumulators[0]
         out = cls(first.n_params, first.n_dof)
         for j in range(out.n_dof):
@@ -94,24 +111,67 @@ class LeastSquaresAccumulator:
         return out
 
     def joint_residual_sumsq(self, params: np.ndarray) -> np.ndarray:
-        """``||tau_j - W_j params||²`` of each joint (n_dof,)."""
+        """Residual sum of squares of each joint, ``||tau_j - W_j params||²``.
+
+        Parameters
+        ----------
+        params : (p,) array
+
+        Returns
+        -------
+        (n_dof,) ndarray [N²·m²]
+        """
         x = np.append(np.asarray(params, dtype=float), -1.0)
         return np.array([float(np.sum((f @ x) ** 2)) for f in self.factors])
 
     def joint_residual_std(self, params: np.ndarray) -> np.ndarray:
-        """Residual standard deviation of each joint, ``sqrt(||r_j||² / (M_j - p/n_dof))`` (n_dof,)."""
+        """Residual standard deviation of each joint, ``sqrt(||r_j||² / (M_j - p/n_dof))``.
+
+        Parameters
+        ----------
+        params : (p,) array
+
+        Returns
+        -------
+        (n_dof,) ndarray [N·m]
+        """
         dof = np.maximum(self.rows - self.n_params / self.n_dof, 1.0)
         return np.sqrt(self.joint_residual_sumsq(params) / dof)
 
     def reduced(self, joint_weights=None) -> np.ndarray:
-        """Triangular ``[R | z]`` (p+1, p+1) of the (weighted) problem: ``||D(τ - Wθ)||² = ||z - Rθ||² + ρ²``
-        with ``R = [:p, :p]``, ``z = [:p, p]`` and ``ρ = [p, p]``; valid for rank-deficient ``W`` too."""
+        """Triangular factor of the (weighted) problem, valid for a rank-deficient ``W`` too.
+
+        ``||D(τ - Wθ)||² = ||z - Rθ||² + ρ²`` with ``R = [:p, :p]``, ``z = [:p, p]`` and ``ρ = [p, p]``.
+
+        Parameters
+        ----------
+        joint_weights : (n_dof,) array, optional
+            ``D``: rows of joint ``j`` multiplied by ``joint_weights[j]`` (ones by default).
+
+        Returns
+        -------
+        (p+1, p+1) ndarray
+            ``[R | z]`` upper triangular.
+        """
         wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
         return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
 
     def solve(self, joint_weights=None, rcond: float | None = None, names=None) -> LeastSquaresSolution:
-        """OLS (default) or WLS with one weight per joint (rows of joint ``j`` multiplied by ``joint_weights[j]``);
-        ``names`` (p,) name the unexcited parameters in the error.
+        """OLS (default) or WLS with one weight per joint.
+
+        Parameters
+        ----------
+        joint_weights : (n_dof,) array, optional
+            Rows of joint ``j`` multiplied by ``joint_weights[j]``.
+        rcond : float, optional
+            Relative singular-value threshold of the rank test.
+        names : sequence of str, optional
+            (p,) names of the parameters, to name the unexcited ones in the error.
+
+        Returns
+        -------
+        LeastSquaresSolution
+            Parameters, their covariance and the residuals.
 
         Raises
         ------

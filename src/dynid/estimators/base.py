@@ -8,9 +8,24 @@ from ..exceptions import ShapeError
 
 
 def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Validate an observation matrix ``W`` (M, p) and torques ``tau`` (M,) or (N, n_dof) with N·n_dof = M.
+    """Validate an observation matrix and torques at the public boundary.
 
-    With ``n_dof``, also check that ``M`` is a whole number of samples.
+    Parameters
+    ----------
+    w : (M, p) array
+    tau : (M,) or (N, n_dof) array with N·n_dof = M [N·m]
+    n_dof : int, optional
+        With it, also check that ``M`` is a whole number of samples.
+
+    Returns
+    -------
+    w : (M, p) float64 array
+    tau : (M,) float64 array
+
+    Raises
+    ------
+    ShapeError
+        Wrong shapes, rows not matching, or NaN/inf values.
     """
     w = np.asarray(w, dtype=np.float64)
     tau = np.asarray(tau, dtype=np.float64).reshape(-1)
@@ -50,6 +65,15 @@ def paper_objective(residual: np.ndarray, n_dof: int, weights: np.ndarray | None
 def infer_n_dof(n_dof: int | None, tau) -> int:
     """Joints per sample: ``n_dof`` when given, else the second axis of ``tau`` given as (N, n_dof).
 
+    Parameters
+    ----------
+    n_dof : int or None
+    tau : array
+
+    Returns
+    -------
+    int
+
     Raises
     ------
     ShapeError
@@ -65,9 +89,20 @@ def infer_n_dof(n_dof: int | None, tau) -> int:
 
 class LinearAbsoluteObjective:
     """Eq. 9 on ``(W, tau)`` as a function of the parameters, ``F(x)`` for ``x`` (p,) or (p, K), with the
-    coordinate-move interface of :func:`dynid.optim.bee_colony.minimize_bee_colony`: the residual of a
-    candidate that differs in coordinate ``j`` by ``delta`` is ``r - delta·W[:, j]``, one fused pass (numba)
-    instead of the product with all of ``W``."""
+    coordinate-move interface of :func:`dynid.optim.bee_colony.minimize_bee_colony`: the residual of a candidate that
+    differs in coordinate ``j`` by ``delta`` is ``r - delta·W[:, j]``, one fused pass (numba) instead of the product
+    with all of ``W``.
+
+    Parameters
+    ----------
+    w : (M, p) array
+        Observation matrix.
+    tau : (M,) array [N·m]
+    n_dof : int
+        Joints per sample.
+    weights : (n_dof,) array, optional
+        ``delta_j`` of eq. 9 (default 1).
+    """
 
     def __init__(self, w: np.ndarray, tau: np.ndarray, n_dof: int, weights=None):
         self.w = w
@@ -102,10 +137,37 @@ class LinearAbsoluteObjective:
         return out
 
     def start(self, x) -> tuple[float, np.ndarray]:
+        """F and the residual of a starting point.
+
+        Parameters
+        ----------
+        x : (p,) array
+
+        Returns
+        -------
+        f : float [N·m]
+        r : (M,) array
+            ``tau - W x``.
+        """
         r = self.tau - self.w @ np.asarray(x, dtype=float)
         return float(self.row_weights @ np.abs(r)), r
 
     def move(self, r: np.ndarray, j: int, delta: float) -> tuple[float, np.ndarray]:
+        """F and the residual of a candidate that differs from the one of residual ``r`` in coordinate ``j`` by
+        ``delta``.
+
+        Parameters
+        ----------
+        r : (M,) array
+            The current candidate's residual.
+        j : int
+        delta : float
+
+        Returns
+        -------
+        f : float [N·m]
+        r_new : (M,) array
+        """
         from ._objective_kernel import shifted_absolute_sum
 
         out = np.empty_like(r)
@@ -124,7 +186,12 @@ class Estimator:
     params_: np.ndarray
 
     def get_params(self) -> dict:
-        """The keyword hyper-parameters of ``__init__`` and their values."""
+        """The keyword hyper-parameters of ``__init__`` and their values (scikit-learn's contract).
+
+        Returns
+        -------
+        dict
+        """
         import inspect
 
         names = [p.name for p in inspect.signature(type(self).__init__).parameters.values()
@@ -132,7 +199,22 @@ class Estimator:
         return {n: getattr(self, n) for n in names}
 
     def set_params(self, **params) -> "Estimator":
-        """Set hyper-parameters by name; an unknown name is a ``ValueError``."""
+        """Set hyper-parameters by name.
+
+        Parameters
+        ----------
+        **params
+            name -> value.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ValueError
+            An unknown name.
+        """
         known = self.get_params()
         for name, value in params.items():
             if name not in known:
@@ -141,20 +223,61 @@ class Estimator:
         return self
 
     def clone(self) -> "Estimator":
-        """An unfitted estimator with the same hyper-parameters."""
+        """An unfitted estimator with the same hyper-parameters.
+
+        Returns
+        -------
+        Estimator
+        """
         return type(self)(**self.get_params())
 
     def fit(self, w, tau):  # pragma: no cover - abstract
+        """Fit the parameters to an observation matrix and torques (each estimator's own method).
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+        """
         raise NotImplementedError
 
     def predict(self, w) -> np.ndarray:
-        """Predicted torques ``W @ params_`` (M,)."""
+        """Predicted torques ``W @ params_``.
+
+        Parameters
+        ----------
+        w : (M, p) array
+
+        Returns
+        -------
+        (M,) array [N·m]
+
+        Raises
+        ------
+        AttributeError
+            Not fitted yet.
+        """
         if not hasattr(self, "params_"):
             raise AttributeError(f"{type(self).__name__} is not fitted yet: call fit(W, tau) first")
         return np.asarray(w, dtype=float) @ self.params_
 
     def score(self, w, tau) -> float:
-        """Coefficient of determination R² of the prediction on (W, tau)."""
+        """Coefficient of determination R² of the prediction (1: perfect).
+
+        Parameters
+        ----------
+        w : (M, p) array
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        float
+        """
         w, tau = check_observations(w, tau)
         res = tau - self.predict(w)
         return 1.0 - float(res @ res) / float(((tau - tau.mean()) ** 2).sum())

@@ -26,8 +26,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
     callback : callable, optional
         ``callback(iteration, best_objective)``.
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_, objective_ (eq. 9), history_ (best objective per iteration), n_evaluations_, result_.
     """
 
@@ -43,6 +43,23 @@ class BeeColonyEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "BeeColonyEstimator":
+        """Search the box for the minimum of eq. 9 with the artificial bee colony (§3.1).
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, or a box that is not (p, 2).
+        """
         bounds, objective = self._objectives(w, tau)
         res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)

@@ -108,13 +108,24 @@ class Estimation:
                 self._ws.append(ws * kk[:, None])
 
     def rows(self) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """The stacked base rows and torques (None when none were kept)."""
+        """The stacked base rows and torques kept for the estimators that need every row.
+
+        Returns
+        -------
+        w : (M, n_base) ndarray or None
+        tau : (M,) ndarray [N·m] or None
+            None when none were kept.
+        """
         if not self._w:
             return None, None
         return np.concatenate(self._w), np.concatenate(self._tau)
 
     def solve_reference(self) -> AccumulatingEstimator:
         """The least-squares reference, solved (its ``solution_``, ``ols_params_``, ``joint_std_``).
+
+        Returns
+        -------
+        AccumulatingEstimator
 
         Raises
         ------

@@ -23,8 +23,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     bounds : (p, 2) array
         Search box (the ABC's).
     n_dof : int or None
-        Joints per sample; None: inferred from tau given as (N, n_dof).
-        Joints per sample in ``W``'s rows.
+        Joints per sample in ``W``'s rows; None: inferred from tau given as (N, n_dof).
     weights : (n_dof,) array, optional
         ``delta`` of eq. 9 (default 1).
     popsize : int
@@ -36,9 +35,11 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     polish : bool
         Finish with L-BFGS-B (off by default: eq. 9 is not differentiable).
     rng : Generator or seed
+    callback : callable, optional
+        ``callback(generation, best_objective)``.
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
     """
 
@@ -55,6 +56,23 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "DifferentialEvolutionEstimator":
+        """Search the box for the minimum of eq. 9 by differential evolution.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, or a box that is not (p, 2).
+        """
         bounds, objective = self._objectives(w, tau)
         history = []
         evaluations = 0
@@ -96,8 +114,8 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     callback : callable, optional
         ``callback(iteration, best_objective)``.
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_, objective_ (eq. 9), history_, n_evaluations_, result_.
     """
 
@@ -112,6 +130,23 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         self.callback = callback
 
     def fit(self, w, tau) -> "ParticleSwarmEstimator":
+        """Search the box for the minimum of eq. 9 by particle swarm optimisation.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, or a box that is not (p, 2).
+        """
         bounds, objective = self._objectives(w, tau)
         res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
                                       rng=self.rng, callback=self.callback)

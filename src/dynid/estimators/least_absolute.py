@@ -35,8 +35,8 @@ class LeastAbsoluteDeviations(Estimator):
         ``delta`` of eq. 9 (default 1).
     bounds : (p, 2) array, optional
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_, objective_ (eq. 9), result_ (SciPy's OptimizeResult).
 
     Raises
@@ -51,6 +51,23 @@ class LeastAbsoluteDeviations(Estimator):
         self.bounds = bounds
 
     def fit(self, w, tau) -> "LeastAbsoluteDeviations":
+        """Minimise the weighted sum of absolute residuals (eq. 9) as a linear programme, within the box if given.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, or bounds that are not (p, 2).
+        """
         self.n_dof_ = infer_n_dof(self.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape

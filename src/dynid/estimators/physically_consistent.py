@@ -175,10 +175,25 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
 def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), nonnegative=()) -> str:
     """A margin of :func:`consistency_margin` in words: "yes", or "no" with the reason.
 
-    Margins within ``CONSISTENCY_TOL`` of 0 are "yes" (the solver's round-off). An infeasible problem
-    (margin -inf) names the base parameters that are a non-negative term alone (friction, rotor inertia)
-    and are negative, e.g. ``no: fv4 = -0.02 < 0``; other negative margins give the margin: how far the
-    closest mass distribution's smallest pseudo-inertia eigenvalue is below 0 [kg·m²].
+    Margins within ``CONSISTENCY_TOL`` of 0 are "yes" (the solver's round-off). An infeasible problem (margin -inf)
+    names the base parameters that are a non-negative term alone (friction, rotor inertia) and are negative, e.g.
+    ``no: fv4 = -0.02 < 0``; other negative margins give the margin: how far the closest mass distribution's smallest
+    pseudo-inertia eigenvalue is below 0 [kg·m²].
+
+    Parameters
+    ----------
+    margin : float [kg·m²]
+    regrouping : (n_base, n_params) array, optional
+    beta : (n_base,) array, optional
+        The estimate, to name its negative terms.
+    names : sequence of str
+        Base parameter names.
+    nonnegative : sequence of int
+        Standard columns of the non-negative terms.
+
+    Returns
+    -------
+    str
     """
     if margin >= -CONSISTENCY_TOL:
         return "yes"

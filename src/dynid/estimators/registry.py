@@ -148,7 +148,14 @@ class EstimatorSpec:
     options: dict = dataclasses.field(default_factory=dict)
 
     def builder(self) -> Builder:
-        """The callable that builds an unfitted estimator from :class:`FitData`."""
+        """The callable that builds an unfitted estimator from :class:`FitData`.
+
+        Returns
+        -------
+        callable
+            ``build(data, budget, rng, callback) -> Estimator`` (a class given as :attr:`build` is wrapped so that the
+            problem's matching keyword hyper-parameters are passed).
+        """
         target = self.build
         if isinstance(target, str):
             module, _, attr = target.partition(":")
@@ -265,7 +272,17 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
 
 
 def unregister(key: str) -> None:
-    """Forget the estimator ``key`` (a ``KeyError`` if unknown)."""
+    """Forget a registered estimator.
+
+    Parameters
+    ----------
+    key : str
+
+    Raises
+    ------
+    KeyError
+        An unknown key.
+    """
     del _REGISTRY[str(key).strip().lower()]
 
 
@@ -297,13 +314,29 @@ these in the list of estimators, else WLS): its residuals give each joint's nois
 
 
 def registered_by_user(keys_: Iterable[str]) -> dict:
-    """key -> :class:`EstimatorSpec` of those of ``keys_`` that are not built in: what another process (a Dask
-    worker) must register to fit them (:func:`ensure_registered`)."""
+    """The estimators among ``keys_`` that are not built in: what another process (a Dask worker) must register to
+    fit them (:func:`ensure_registered`).
+
+    Parameters
+    ----------
+    keys_ : sequence of str
+
+    Returns
+    -------
+    dict
+        key -> :class:`EstimatorSpec`.
+    """
     return {spec(k).key: spec(k) for k in keys_ if spec(k).key not in BUILT_IN}
 
 
 def ensure_registered(specs: dict) -> None:
-    """Register the estimators of ``specs`` (key -> :class:`EstimatorSpec`) that this process does not know."""
+    """Register the estimators of ``specs`` that this process does not know (a Dask worker).
+
+    Parameters
+    ----------
+    specs : dict
+        key -> :class:`EstimatorSpec` (:func:`registered_by_user` in the process that had them).
+    """
     for key, entry in specs.items():
         if key not in _REGISTRY:
             _REGISTRY[key] = entry
@@ -311,6 +344,14 @@ def ensure_registered(specs: dict) -> None:
 
 def spec(key: str) -> EstimatorSpec:
     """The registered estimator ``key`` (case-insensitive).
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    EstimatorSpec
 
     Raises
     ------
@@ -325,19 +366,45 @@ def spec(key: str) -> EstimatorSpec:
 
 
 def keys() -> tuple[str, ...]:
-    """Every registered key, the built-in ones first, in registration order."""
+    """Every registered estimator.
+
+    Returns
+    -------
+    tuple of str
+        The built-in ones first, in registration order.
+    """
     return tuple(_REGISTRY)
 
 
 def label(key: str) -> str:
-    """The table label of ``key`` (``"WLS"``, ``"ABC×10"``); anything else as it is."""
+    """The table label of an estimator.
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    str
+        ``"WLS"``, ``"ABC×10"``; anything not registered as it is.
+    """
     entry = _REGISTRY.get(str(key).strip().lower())
     return entry.label if entry is not None else str(key)
 
 
 def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...] | None = None) -> tuple[str, ...]:
-    """Keys from ``"ols,abc"`` or a sequence, case-insensitive; ``None`` gives ``default`` (the built-in estimators
-    when ``default`` is None) and ``"all"`` every registered key.
+    """Estimator keys from text or a sequence, case-insensitive.
+
+    Parameters
+    ----------
+    text : str, sequence of str, or None
+        ``"ols,abc"``, ``["OLS", "abc"]``; ``"all"``: every registered key.
+    default : tuple of str, optional
+        What None gives (default: the built-in estimators).
+
+    Returns
+    -------
+    tuple of str
 
     Raises
     ------
@@ -362,8 +429,17 @@ def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...
 
 
 def seed_index(key: str) -> int:
-    """Position of ``key`` in the registry: with the run's seed it seeds the estimator's own generator, so that
-    adding estimators to a run leaves the others' results as they were."""
+    """Position of an estimator in the registry: with the run's seed it seeds the estimator's own generator, so
+    that adding estimators to a run leaves the others' results as they were.
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    int
+    """
     return keys().index(spec(key).key)
 
 
@@ -393,7 +469,23 @@ class Fitted:
 
 def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
                    callback: Callable[[int, float], None] | None = None) -> "Estimator":
-    """An unfitted estimator ``key`` for ``data`` (``rng`` seeds the box searches).
+    """An unfitted estimator for a problem.
+
+    Parameters
+    ----------
+    key : str
+        A registered estimator (case-insensitive).
+    data : FitData
+    budget : SearchBudget
+        The box searches' budget.
+    rng : numpy.random.Generator, optional
+        Seeds the box searches.
+    callback : callable, optional
+        ``callback(iteration, best)`` of the box searches.
+
+    Returns
+    -------
+    Estimator
 
     Raises
     ------
@@ -404,7 +496,27 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(
 
 
 def finish(key: str, est: "Estimator", data: FitData, seconds: float) -> Fitted:
-    """A fitted estimator as :class:`Fitted`: its parameters in the base (a standard-space estimator's mapped)."""
+    """A fitted estimator as :class:`Fitted`: its parameters in the base (a standard-space estimator's mapped).
+
+    Parameters
+    ----------
+    key : str
+    est : Estimator
+        Fitted.
+    data : FitData
+        The problem (its base map).
+    seconds : float
+        Wall time of the fit [s].
+
+    Returns
+    -------
+    Fitted
+
+    Raises
+    ------
+    ConfigError
+        A standard-space estimator without a base map.
+    """
     import numpy as np
 
     params = est.params_
@@ -419,7 +531,23 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
                callback: Callable[[int, float], None] | None = None, estimator: "Estimator | None" = None) -> Fitted:
     """Fit estimator ``key`` on ``data`` and return its base parameters.
 
-    ``estimator``: one built and fed already (rows streamed by ``partial_fit``): only its solution is computed here.
+    Parameters
+    ----------
+    key : str
+        A registered estimator.
+    data : FitData
+    budget : SearchBudget
+        The box searches' budget.
+    rng : numpy.random.Generator, optional
+        Seeds the box searches.
+    callback : callable, optional
+        ``callback(iteration, best)`` of the box searches.
+    estimator : Estimator, optional
+        One built and fed already (rows streamed by ``partial_fit``): only its solution is computed here.
+
+    Returns
+    -------
+    Fitted
 
     Raises
     ------

@@ -33,8 +33,8 @@ class IterativelyReweightedLeastSquares(Estimator):
     tol : float
         Stop when ``||Δp|| <= tol · ||p||``.
 
-    Learned attributes
-    ------------------
+    Attributes
+    ----------
     params_ : (p,) array
     covariance_ : (p, p) array
         Huber's sandwich ``(M/(M-p)) A⁻¹ B A⁻¹`` with ``A = Σ ψ'(u) w wᵀ / s²``, ``B = Σ ψ(u)² w wᵀ / s²``.
@@ -59,6 +59,25 @@ class IterativelyReweightedLeastSquares(Estimator):
         self.tol = tol
 
     def fit(self, w, tau) -> "IterativelyReweightedLeastSquares":
+        """Huber M-estimate by iteratively reweighted least squares, with its sandwich covariance.
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ConfigError
+            A tuning constant that is not positive.
+        IdentifiabilityError
+            No more rows than parameters.
+        """
         if not self.tuning > 0:
             raise ConfigError(f"IRLS tuning constant must be positive, got {self.tuning}")
         self.n_dof_ = infer_n_dof(self.n_dof, tau)

@@ -49,7 +49,15 @@ class Workspace:
             raise ConfigError(f"workspace.floor: expected a height in metres, got {self.floor}")
 
     def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """``G p <= h`` for the finite sides: G (m, 3), h (m,), and a label per row."""
+        """``G p <= h`` for the finite sides of the box and the floor.
+
+        Returns
+        -------
+        G : (m, 3) ndarray
+        h : (m,) ndarray [m]
+        labels : list of str
+            One per row.
+        """
         rows, h, labels = [], [], []
         for i in range(3):
             if np.isfinite(self.box_min[i]):
@@ -61,6 +69,12 @@ class Workspace:
         return np.array(rows).reshape(-1, 3), np.array(h, dtype=float), labels
 
     def to_dict(self) -> dict:
+        """JSON-ready workspace (infinite sides as None).
+
+        Returns
+        -------
+        dict
+        """
         fin = lambda v: [float(x) if np.isfinite(x) else None for x in v]  # noqa: E731
         return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
                 "floor": float(self.floor) if np.isfinite(self.floor) else None}
@@ -70,7 +84,20 @@ class Workspace:
 class ConstraintMargin:
     """How close a trajectory comes to one constraint: ``margin = limit - worst`` (≥ 0 when satisfied).
 
-    ``relative`` is the margin divided by the limit (by the range for positions), in [0, 1] when satisfied.
+    Attributes
+    ----------
+    constraint : str
+        Position, velocity, acceleration, torque or workspace.
+    where : str
+        The joint or workspace side.
+    limit : float
+        The limit, in the constraint's unit.
+    worst : float
+        The trajectory's worst value.
+    margin : float
+        ``limit - worst``.
+    relative : float
+        The margin divided by the limit (by the range for positions), in [0, 1] when satisfied.
     """
 
     constraint: str
@@ -82,14 +109,28 @@ class ConstraintMargin:
 
     @property
     def satisfied(self) -> bool:
+        """Whether the margin is not negative."""
         return self.margin >= 0.0
 
     def to_dict(self) -> dict:
+        """JSON-ready margin.
+
+        Returns
+        -------
+        dict
+        """
         return {k: getattr(self, k) for k in ("constraint", "where", "limit", "worst", "margin", "relative")}
 
 
 def check_limits(limits: Limits, n_dof: int, source: str = "limits") -> None:
-    """Raise a one-line :class:`ConfigError` for limits no trajectory can satisfy.
+    """Refuse limits no trajectory can satisfy.
+
+    Parameters
+    ----------
+    limits : Limits
+    n_dof : int
+    source : str
+        Named in the error.
 
     Raises
     ------

@@ -20,9 +20,18 @@ CRITERIA = ("cond", "d-optimal")
 
 
 def log_condition_number(w: np.ndarray) -> tuple[float, np.ndarray]:
-    """``log cond(W)`` and its derivative with respect to ``W`` (same shape as ``W``).
+    """``log cond(W)`` and its derivative with respect to ``W``.
 
     From the extreme eigenpairs ``(λ, v)`` of ``W^T W`` (``σ² = λ``): ``d log σ = (W v)^T dW v / λ``.
+
+    Parameters
+    ----------
+    w : (M, p) array
+
+    Returns
+    -------
+    value : float
+    gradient : (M, p) ndarray
     """
     lam, v = np.linalg.eigh(w.T @ w)
     if lam[0] <= lam[-1] * 1e-24:
@@ -32,7 +41,17 @@ def log_condition_number(w: np.ndarray) -> tuple[float, np.ndarray]:
 
 
 def neg_log_det_information(w: np.ndarray) -> tuple[float, np.ndarray]:
-    """``-log det(W^T W / N)`` (N rows) and its derivative with respect to ``W``."""
+    """``-log det(W^T W / N)`` (N rows) and its derivative with respect to ``W``.
+
+    Parameters
+    ----------
+    w : (M, p) array
+
+    Returns
+    -------
+    value : float
+    gradient : (M, p) ndarray
+    """
     info = w.T @ w
     sign, logdet = np.linalg.slogdet(info / w.shape[0])
     if sign <= 0:
@@ -41,7 +60,17 @@ def neg_log_det_information(w: np.ndarray) -> tuple[float, np.ndarray]:
 
 
 def criterion_function(name: str):
-    """The criterion function for ``"cond"`` or ``"d-optimal"``.
+    """The criterion function of a design criterion.
+
+    Parameters
+    ----------
+    name : str
+        "cond" or "d-optimal".
+
+    Returns
+    -------
+    callable
+        ``f(W) -> (value, dvalue/dW)``.
 
     Raises
     ------

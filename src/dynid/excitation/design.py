@@ -45,7 +45,15 @@ safety doubled when SLSQP converged, else from the start with half its amplitude
 
 
 class InfeasibleDesignError(DynIdError, ValueError):
-    """No trajectory satisfying every constraint was found (the message says which constraint)."""
+    """No trajectory satisfying every constraint was found (the message says which constraint).
+
+    Parameters
+    ----------
+    message : str
+        One line: what was expected, what was found, how to fix it.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """
 
 
 @dataclass(frozen=True)
@@ -123,10 +131,16 @@ class ExcitationProblem:
 
     @property
     def period(self) -> float:
+        """The period ``2π / ω_f`` [s]."""
         return 2.0 * np.pi / self.omega_f
 
     def start_pose(self) -> np.ndarray:
-        """The offsets: the fixed ones, or the middle of the position limits (0 where unlimited)."""
+        """The offsets: the fixed ones, or the middle of the position limits (0 where unlimited).
+
+        Returns
+        -------
+        (n_dof,) array [rad]
+        """
         if self.offsets is not None:
             return self.offsets.copy()
         lim = self.limits
@@ -157,34 +171,89 @@ class ExcitationProblem:
                               f"above its limit {lim.tau_max[j]:g} N·m")
 
     def design_grid(self) -> np.ndarray:
-        """One period sampled with ``grid_points`` samples [s]."""
+        """One period sampled with ``grid_points`` samples.
+
+        Returns
+        -------
+        (grid_points,) array [s]
+        """
         return np.arange(self.grid_points) * (self.period / self.grid_points)
 
     def verification_grid(self) -> np.ndarray:
-        """The design grid refined :data:`VERIFY_REFINEMENT` times [s]."""
+        """The design grid refined :data:`VERIFY_REFINEMENT` times.
+
+        Returns
+        -------
+        array [s]
+        """
         n = self.grid_points * VERIFY_REFINEMENT
         return np.arange(n) * (self.period / n)
 
     def margins(self, trajectory: FourierTrajectory, t: np.ndarray | None = None) -> list[ConstraintMargin]:
-        """Margins of every constraint on ``t`` (default: the verification grid)."""
+        """Margins of every constraint (eq. 15) of a trajectory.
+
+        Parameters
+        ----------
+        trajectory : FourierTrajectory
+        t : array [s], optional
+            Where to check (default: the verification grid).
+
+        Returns
+        -------
+        list of ConstraintMargin
+        """
         t = self.verification_grid() if t is None else t
         return constraint_margins(self.robot, trajectory, t, self.limits, self.workspace, self.phi)
 
     def criterion_value(self, trajectory: FourierTrajectory) -> float:
-        """cond(W_base) or −log det of the information matrix on the design grid."""
+        """The design criterion of a trajectory on the design grid.
+
+        Parameters
+        ----------
+        trajectory : FourierTrajectory
+
+        Returns
+        -------
+        float
+            cond(W_base), or −log det of the information matrix ("d-optimal").
+        """
         w = _stacked_base_observation(self.robot, self.base, trajectory, self.design_grid())
         value, _ = criterion_function(self.criterion)(w)
         return float(np.exp(value)) if self.criterion == "cond" else value
 
 
 def condition_number(problem: ExcitationProblem, trajectory: FourierTrajectory, t: np.ndarray | None = None) -> float:
-    """cond(W_base) of ``trajectory`` on ``t`` (default: the design grid)."""
+    """cond(W_base) of a trajectory.
+
+    Parameters
+    ----------
+    problem : ExcitationProblem
+    trajectory : FourierTrajectory
+    t : array [s], optional
+        Where to sample it (default: the design grid).
+
+    Returns
+    -------
+    float
+    """
     t = problem.design_grid() if t is None else t
     return float(np.linalg.cond(_stacked_base_observation(problem.robot, problem.base, trajectory, t)))
 
 
 def base_condition_number(robot: Robot, base: BaseParameters, trajectory: FourierTrajectory, n_samples: int = 100) -> float:
-    """cond(W_base) of ``trajectory`` sampled ``n_samples`` times over one period (no limits involved).
+    """cond(W_base) of a trajectory sampled over one period (no limits involved).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    trajectory : FourierTrajectory
+    n_samples : int
+        Samples over the period.
+
+    Returns
+    -------
+    float
 
     Raises
     ------
@@ -210,6 +279,8 @@ class ExcitationDesign:
     trajectory : FourierTrajectory
     initial : FourierTrajectory
         The start the design came from (the given initial trajectory when one was given).
+    criterion : str
+        "cond" or "d-optimal".
     cond, initial_cond : float
         cond(W_base) on the design grid after and before the optimisation.
     cond_verification : float
@@ -250,9 +321,21 @@ class ExcitationDesign:
 
     @property
     def feasible(self) -> bool:
+        """Whether the trajectory satisfies every constraint on the verification grid."""
         return all(m.satisfied for m in self.margins)
 
     def to_dict(self, form: str = "paper") -> dict:
+        """The design as excitation.json stores it.
+
+        Parameters
+        ----------
+        form : {"paper", "swevers"}
+            How the trajectory's coefficients are written (eq. 14 or the Swevers form).
+
+        Returns
+        -------
+        dict
+        """
         return {"criterion": self.criterion, "cond": self.cond, "initial_cond": self.initial_cond,
                 "cond_verification_grid": self.cond_verification, "log_det_information": self.log_det,
                 "initial_log_det_information": self.initial_log_det, "success": self.success,

@@ -36,19 +36,34 @@ class FourierTrajectory:
 
     @property
     def n_dof(self) -> int:
+        """Number of joints."""
         return self.q0.shape[0]
 
     @property
     def n_harmonics(self) -> int:
+        """Number of harmonics N of each joint's series."""
         return self.a.shape[1]
 
     @property
     def period(self) -> float:
+        """Period ``2π / ω_f`` of the trajectory [s]."""
         return 2.0 * np.pi / self.omega_f
 
     @classmethod
     def from_rows(cls, rows, omega_f: float) -> "FourierTrajectory":
-        """From the paper's layout: one row per joint, ``[q_o, a_1..a_N, b_1..b_N]`` (Appendix A)."""
+        """A trajectory from the paper's layout (Appendix A).
+
+        Parameters
+        ----------
+        rows : (n_dof, 2N+1) array_like
+            One row per joint, ``[q_o, a_1..a_N, b_1..b_N]`` [rad] (eq. 14).
+        omega_f : float
+            Fundamental pulsation ω_f [rad/s].
+
+        Returns
+        -------
+        FourierTrajectory
+        """
         rows = np.atleast_2d(np.asarray(rows, dtype=float))
         if rows.shape[1] % 2 != 1:
             raise ConfigError(f"expected rows of 2N+1 coefficients [q_o, a_1..a_N, b_1..b_N], got {rows.shape[1]}")
@@ -56,11 +71,28 @@ class FourierTrajectory:
         return cls(float(omega_f), rows[:, 0].copy(), rows[:, 1:1 + nh].copy(), rows[:, 1 + nh:].copy())
 
     def to_rows(self) -> np.ndarray:
-        """Inverse of :meth:`from_rows`: (n_dof, 2N+1)."""
+        """Inverse of :meth:`from_rows`.
+
+        Returns
+        -------
+        (n_dof, 2N+1) ndarray
+            ``[q_o, a_1..a_N, b_1..b_N]`` per joint [rad].
+        """
         return np.concatenate([self.q0[:, None], self.a, self.b], axis=1)
 
     def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Positions, velocities and accelerations at times ``t`` (N,), each of shape (N, n_dof)."""
+        """Positions, velocities and accelerations of eq. 14 and its derivatives.
+
+        Parameters
+        ----------
+        t : (N,) array_like
+            Times [s].
+
+        Returns
+        -------
+        q, dq, ddq : (N, n_dof) ndarray
+            [rad], [rad/s], [rad/s²].
+        """
         t = np.asarray(t, dtype=float)
         k = np.arange(1, self.n_harmonics + 1)
         wk = k * self.omega_f
@@ -72,20 +104,54 @@ class FourierTrajectory:
 
     @classmethod
     def from_swevers(cls, q0, a, b, omega_f: float) -> "FourierTrajectory":
-        """From the Swevers form ``q_i = q_i0 + Σ_l a_il/(l w_f) sin(l w_f t) - b_il/(l w_f) cos(l w_f t)``
-        (Swevers, Ganseman, Tükel, de Schutter, Van Brussel, IEEE TRA 13(5), 1997), where ``a, b``
-        are velocity amplitudes [rad/s]."""
+        """A trajectory from the Swevers form.
+
+        ``q_i = q_i0 + Σ_l a_il/(l ω_f) sin(l ω_f t) - b_il/(l ω_f) cos(l ω_f t)`` (Swevers, Ganseman, Tükel,
+        de Schutter, Van Brussel, IEEE TRA 13(5), 1997).
+
+        Parameters
+        ----------
+        q0 : (n_dof,) array_like
+            Offsets [rad].
+        a, b : (n_dof, N) array_like
+            Velocity amplitudes [rad/s].
+        omega_f : float
+            Fundamental pulsation ω_f [rad/s].
+
+        Returns
+        -------
+        FourierTrajectory
+        """
         a, b = np.atleast_2d(np.asarray(a, dtype=float)), np.atleast_2d(np.asarray(b, dtype=float))
         lw = omega_f * np.arange(1, a.shape[1] + 1)
         return cls(float(omega_f), np.asarray(q0, dtype=float).copy(), a / lw, -b / lw)
 
     def to_swevers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Inverse of :meth:`from_swevers`: ``(q0, a, b)`` with velocity amplitudes [rad/s]."""
+        """Inverse of :meth:`from_swevers`.
+
+        Returns
+        -------
+        q0 : (n_dof,) ndarray
+            Offsets [rad].
+        a, b : (n_dof, N) ndarray
+            Velocity amplitudes [rad/s].
+        """
         lw = self.omega_f * np.arange(1, self.n_harmonics + 1)
         return self.q0.copy(), self.a * lw, -self.b * lw
 
     def to_dict(self, form: str = "paper") -> dict:
-        """JSON-ready coefficients in the paper's form (eq. 14) or the Swevers form; see :func:`trajectory_from_dict`."""
+        """JSON-ready coefficients; read back by :func:`trajectory_from_dict`.
+
+        Parameters
+        ----------
+        form : {"paper", "swevers"}
+            The paper's form (eq. 14) or the Swevers form.
+
+        Returns
+        -------
+        dict
+            ``form``, ``omega_f`` [rad/s] and the coefficients per joint.
+        """
         if form == "swevers":
             q0, a, b = self.to_swevers()
             return {"form": "swevers", "omega_f": self.omega_f, "q0": q0.tolist(), "a": a.tolist(), "b": b.tolist()}
@@ -99,7 +165,18 @@ FORMS = ("paper", "swevers")
 
 
 def trajectory_from_dict(d: dict, source: str = "trajectory") -> FourierTrajectory:
-    """A trajectory from :meth:`FourierTrajectory.to_dict` output (``form`` "paper" — eq. 14 — or "swevers").
+    """A trajectory from :meth:`FourierTrajectory.to_dict` output.
+
+    Parameters
+    ----------
+    d : dict
+        ``form`` ("paper", eq. 14, or "swevers"), ``omega_f`` and the coefficients.
+    source : str
+        Where ``d`` comes from, named in error messages.
+
+    Returns
+    -------
+    FourierTrajectory
 
     Raises
     ------
@@ -133,7 +210,19 @@ def trajectory_from_dict(d: dict, source: str = "trajectory") -> FourierTrajecto
 
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
-    """Uniform sample times ``0, 1/rate, ...`` covering ``duration`` seconds (N = round(duration*rate)).
+    """Uniform sample times ``0, 1/rate, ...`` covering ``duration`` seconds.
+
+    Parameters
+    ----------
+    duration : float
+        [s], > 0.
+    rate : float
+        Sample rate [Hz], > 0.
+
+    Returns
+    -------
+    (N,) ndarray
+        Times [s], N = round(duration·rate).
 
     Raises
     ------

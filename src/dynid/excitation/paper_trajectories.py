@@ -36,10 +36,32 @@ BETA2_ROWS = np.array([
 
 
 def paper_identification_trajectory(omega_f: float = PAPER_OMEGA_F, n_dof: int = 3) -> FourierTrajectory:
-    """β1 (eq. A.1), five harmonics; joints beyond three reuse rows 1-3 (the paper gives no wrist trajectory)."""
+    """β1 (eq. A.1), five harmonics; joints beyond three reuse rows 1-3 (the paper gives no wrist trajectory).
+
+    Parameters
+    ----------
+    omega_f : float [rad/s]
+        Fundamental pulsation.
+    n_dof : int
+
+    Returns
+    -------
+    FourierTrajectory
+    """
     return FourierTrajectory.from_rows(BETA1_ROWS[[j % 3 for j in range(n_dof)]], omega_f)
 
 
 def paper_validation_trajectory(omega_f: float = PAPER_OMEGA_F, n_dof: int = 3) -> FourierTrajectory:
-    """β2 (eq. A.2), three harmonics; joints beyond three reuse rows 1-3."""
+    """β2 (eq. A.2), three harmonics; joints beyond three reuse rows 1-3.
+
+    Parameters
+    ----------
+    omega_f : float [rad/s]
+        Fundamental pulsation.
+    n_dof : int
+
+    Returns
+    -------
+    FourierTrajectory
+    """
     return FourierTrajectory.from_rows(BETA2_ROWS[[j % 3 for j in range(n_dof)]], omega_f)

@@ -79,6 +79,13 @@ class DriveGainEstimate:
     condition_number: float
 
     def to_dict(self) -> dict:
+        """JSON-ready estimate.
+
+        Returns
+        -------
+        dict
+            ``gains``, ``gains_std``, ``payload_mass`` [kg], ``n_rows``, ``condition_number``.
+        """
         return {"gains": self.gains.tolist(), "gains_std": self.gains_std.tolist(), "payload_mass": self.payload_mass,
                 "n_rows": self.n_rows, "condition_number": self.condition_number}
 
@@ -100,9 +107,17 @@ class PayloadEstimate:
 
     @property
     def mass(self) -> float:
+        """The payload's mass [kg] (NaN when not identifiable)."""
         return float(self.values[self.names.index("M")]) if "M" in self.names else float("nan")
 
     def to_dict(self) -> dict:
+        """JSON-ready payload parameters.
+
+        Returns
+        -------
+        dict
+            name -> {"value", "std"} in SI units.
+        """
         return {n: {"value": float(v), "std": float(s)} for n, v, s in zip(self.names, self.values, self.std)}
 
 
@@ -120,11 +135,15 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
     robot : Robot
     base : BaseParameters
     unloaded, loaded : PreparedData
-        The two runs with their ``tau`` holding motor currents [A] (joint side), e.g. loaded through a
-        robot with unit drive gains.
+        The two runs with their ``tau`` holding motor currents [A] (joint side), e.g. loaded through a robot with
+        unit drive gains.
     payload_mass : float [kg]
     rng : int
         Seed of the random states that find the payload's identifiable parameters.
+
+    Returns
+    -------
+    DriveGainEstimate
 
     Raises
     ------
@@ -158,8 +177,22 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
 
 
 def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, rng=0) -> PayloadEstimate:
-    """A payload's identifiable inertial parameters from a loaded run, given the unloaded robot's base
-    parameters ``beta`` and the joint torques of ``loaded`` (its ``tau`` in N·m).
+    """A payload's identifiable inertial parameters from a loaded run.
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    beta : (n_base,) array
+        The unloaded robot's base parameters.
+    loaded : PreparedData
+        The loaded run, its ``tau`` in N·m.
+    rng : int
+        Seed of the random states that find the identifiable parameters.
+
+    Returns
+    -------
+    PayloadEstimate
 
     Raises
     ------
@@ -178,13 +211,26 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
 
 @dataclass(frozen=True)
 class GainsAndPayload:
-    """What ``[drive_gains]`` of an identification config gives: the gains, the payload, and the gains the
-    robot description states (for comparison)."""
+    """What ``[drive_gains]`` of an identification config gives.
+
+    Attributes
+    ----------
+    gains : DriveGainEstimate
+    payload : PayloadEstimate
+    description_gains : tuple of float
+        The gains the robot description states, for comparison.
+    """
 
     gains: DriveGainEstimate
     payload: PayloadEstimate
     description_gains: tuple[float, ...]
 
     def to_dict(self) -> dict:
+        """JSON-ready gains, payload and the description's gains.
+
+        Returns
+        -------
+        dict
+        """
         return {**self.gains.to_dict(), "description_gains": list(self.description_gains),
                 "payload": self.payload.to_dict(), "payload_frame": "last link's frame, about its origin (eq. 5 order)"}

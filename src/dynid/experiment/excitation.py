@@ -14,7 +14,17 @@ from ..io.excitation_config import ExcitationConfig
 
 @dataclass(frozen=True)
 class ExcitationRun:
-    """What ``dynid excite`` produced: the design and the sampled trajectory."""
+    """What ``dynid excite`` produced: the design and the sampled trajectory.
+
+    Attributes
+    ----------
+    config : ExcitationConfig
+    design : ExcitationDesign
+    t : (N,) array [s]
+        Set-point times at the config's rate.
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+    """
 
     config: ExcitationConfig
     design: ExcitationDesign
@@ -24,6 +34,13 @@ class ExcitationRun:
     ddq: np.ndarray
 
     def to_dict(self) -> dict:
+        """The run as ``excitation.json``.
+
+        Returns
+        -------
+        dict
+            Robot, settings, limits, the trajectory's coefficients and the design's figures.
+        """
         c, p = self.config, self.config.problem
         lim = p.limits
         return {
@@ -40,7 +57,18 @@ class ExcitationRun:
 
 
 def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:
-    """Design the trajectory of ``config`` and sample it at the controller's rate."""
+    """Design the trajectory of a config and sample it at the controller's rate.
+
+    Parameters
+    ----------
+    config : ExcitationConfig
+    callback : callable, optional
+        ``callback(start, iteration, best)`` reports the optimisation's progress.
+
+    Returns
+    -------
+    ExcitationRun
+    """
     design = design_excitation(config.problem, n_starts=config.starts, rng=config.seed, initial=config.initial,
                                maxiter=config.maxiter, callback=callback)
     n = int(round(config.periods * config.problem.period * config.rate))

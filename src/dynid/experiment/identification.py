@@ -116,7 +116,16 @@ class Estimate:
         return estimate_label(self.key)
 
     def to_dict(self, base: BaseParameters) -> dict:
-        """The estimate as results.json stores it (values and σ by base parameter name)."""
+        """The estimate as results.json stores it (values and σ by base parameter name).
+
+        Parameters
+        ----------
+        base : BaseParameters
+
+        Returns
+        -------
+        dict
+        """
         out = {"key": self.key, "values": dict(zip(base.names, self.params.tolist())), "seconds": self.seconds,
                "n_evaluations": self.n_evaluations}
         if self.std is not None:
@@ -215,7 +224,13 @@ class IdentificationResult:
         return self.estimates[self.main or estimate_label(self.estimators[0])]
 
     def parameter_sets(self) -> dict:
-        """label -> base parameter vector: dynid's estimates, then each reference set."""
+        """Every parameter set compared: dynid's estimates, then each reference set.
+
+        Returns
+        -------
+        dict
+            label -> (n_base,) base parameter vector.
+        """
         return {**{label: e.params for label, e in self.estimates.items()}, **{r.name: r.beta for r in self.references}}
 
     def reference_agreement(self, ref: ReferenceSet) -> dict:
@@ -239,7 +254,12 @@ class IdentificationResult:
                 "within_3_sigma": int(np.sum(z[ok] <= 3)), "compared": int(ok.sum())}
 
     def to_dict(self) -> dict:
-        """The result as results.json stores it (read back by :func:`dynid.load_results`)."""
+        """The result as results.json stores it (read back by :func:`dynid.load_results`).
+
+        Returns
+        -------
+        dict
+        """
         sol = self.solution
         params = [{"name": n, "value": float(v), "std": float(s), "relative_std_percent": float(r), "unit": unit_of(n),
                    "expression": e.split(" = ", 1)[1]}

@@ -64,12 +64,27 @@ def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets
 
 @with_single_blas_thread
 def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
-    """Identify the base parameters from the config's identification dataset, then validate them on
-    each validation dataset beside the reference sets. ``progress(step, done, total)`` reports each step.
+    """Identify the base parameters from a config's identification dataset, then validate them.
+
+    Validation on each validation dataset beside the reference sets.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    progress : callable, optional
+        ``progress(step, done, total)`` reports each step.
+    validate : bool
+        Validate on the config's ``[[validation]]`` datasets.
 
     Returns
     -------
-    dynid.experiment.identification.IdentificationResult
+    IdentificationResult
+
+    Raises
+    ------
+    DynIdError
+        Bad data (:class:`DataError`), settings (:class:`ConfigError`) or a problem the data do not identify
+        (:class:`IdentifiabilityError`), each one line.
     """
     from ..dynamics.base_parameters import base_parameters
     from ..preprocessing.pipeline import prepare

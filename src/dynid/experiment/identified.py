@@ -48,8 +48,21 @@ class Parameter:
 
 
 class Parameters:
-    """An estimate's base parameters by name, each with its σ: ``params["ZZ1R"]`` is a :class:`Parameter`, iterating
-    gives the names, :attr:`values` and :attr:`std` the arrays in the base parameters' order.
+    """An estimate's base parameters by name, each with its σ.
+
+    ``params["ZZ1R"]`` is a :class:`Parameter`, iterating gives the names, :attr:`values` and :attr:`std` the arrays in
+    the base parameters' order.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Base parameter names.
+    values : (n_base,) array_like
+        Values in SI units.
+    std : (n_base,) array_like, optional
+        Standard deviations, NaN where the estimator gives none.
+    expressions : sequence of str, optional
+        Each base parameter's regrouping of standard parameters.
 
     Attributes
     ----------
@@ -81,15 +94,31 @@ class Parameters:
         return name in self.names
 
     def keys(self) -> tuple[str, ...]:
-        """The base parameters' names."""
+        """The base parameters' names.
+
+        Returns
+        -------
+        tuple of str
+        """
         return self.names
 
     def items(self) -> list[tuple[str, Parameter]]:
-        """``(name, Parameter)`` pairs in order."""
+        """``(name, Parameter)`` pairs in the base parameters' order.
+
+        Returns
+        -------
+        list of (str, Parameter)
+        """
         return [(n, self[n]) for n in self.names]
 
     def to_dict(self) -> dict:
-        """name -> {"value", "std", "unit"} (JSON-ready; a missing σ is None)."""
+        """JSON-ready parameters.
+
+        Returns
+        -------
+        dict
+            name -> {"value", "std", "unit"}; a missing σ is None.
+        """
         return {n: {"value": float(v), "std": None if np.isnan(s) else float(s), "unit": unit_of(n)}
                 for n, v, s in zip(self.names, self.values, self.std)}
 
@@ -130,8 +159,17 @@ class IdentifiedModel:
     results: dict = field(default_factory=dict)
 
     def label(self, estimate: str | None = None) -> str:
-        """The label of ``estimate``: a label (``"dynid SDP"``), an estimator's key (``"sdp"``, any case), or None for
-        the main one.
+        """The label of an estimate.
+
+        Parameters
+        ----------
+        estimate : str, optional
+            A label (``"dynid SDP"``), an estimator's key (``"sdp"``, any case), or None for the main estimate.
+
+        Returns
+        -------
+        str
+            The estimate's label as results.json names it.
 
         Raises
         ------
@@ -150,7 +188,17 @@ class IdentifiedModel:
         raise KeyError(f"no estimate {estimate!r}; expected one of {', '.join(self.estimates)}")
 
     def params(self, estimate: str | None = None) -> np.ndarray:
-        """Base parameters (n_base,) of ``estimate`` (label or key; default the main one).
+        """Base parameters of an estimate.
+
+        Parameters
+        ----------
+        estimate : str, optional
+            A label (``"dynid SDP"``), an estimator's key (``"sdp"``, any case), or None for the main estimate.
+
+        Returns
+        -------
+        (n_base,) ndarray
+            In SI units, in the base parameters' order.
 
         Raises
         ------
@@ -160,7 +208,22 @@ class IdentifiedModel:
         return self.estimates[self.label(estimate)]
 
     def parameters(self, estimate: str | None = None) -> Parameters:
-        """The base parameters of ``estimate`` (label or key; default the main one) by name, with σ where known."""
+        """The base parameters of an estimate by name, with σ where known.
+
+        Parameters
+        ----------
+        estimate : str, optional
+            A label (``"dynid SDP"``), an estimator's key (``"sdp"``, any case), or None for the main estimate.
+
+        Returns
+        -------
+        Parameters
+
+        Raises
+        ------
+        KeyError
+            An unknown estimate.
+        """
         label = self.label(estimate)
         return Parameters(self.base.names, self.params(label), self.std.get(label),
                           [e.split(" = ", 1)[1] for e in self.base.expressions])
@@ -261,6 +324,11 @@ class IdentifiedModel:
     def urdf(self) -> str:
         """The physically consistent estimate as URDF text (:func:`dynid.io.export.urdf_from_results`).
 
+        Returns
+        -------
+        str
+            A URDF document.
+
         Raises
         ------
         ConfigError
@@ -271,17 +339,34 @@ class IdentifiedModel:
         return urdf_from_results(self.robot, self.results)
 
     def mjcf(self) -> str:
-        """The physically consistent estimate as MuJoCo MJCF text (:func:`dynid.io.export.mjcf_from_results`)."""
+        """The physically consistent estimate as MuJoCo MJCF text (:func:`dynid.io.export.mjcf_from_results`).
+
+        Returns
+        -------
+        str
+            An MJCF document.
+
+        Raises
+        ------
+        ConfigError
+            No physically consistent estimate that passed the consistency check.
+        """
         from ..io.export import mjcf_from_results
 
         return mjcf_from_results(self.robot, self.results)
 
     def save(self, path: str | Path) -> Path:
-        """Write results.json (atomically) to ``path``, to be read back by :func:`load_results`.
+        """Write results.json atomically, to be read back by :func:`load_results`.
+
+        Parameters
+        ----------
+        path : str or Path
+            A file, or a folder to hold ``results.json``.
 
         Returns
         -------
         Path
+            The file written.
         """
         from ..io.files import write_json
 
@@ -291,7 +376,18 @@ class IdentifiedModel:
 
     @classmethod
     def from_results(cls, results: dict, robot: Robot) -> "IdentifiedModel":
-        """The model of a results.json dictionary of ``dynid identify`` for ``robot`` (its description).
+        """The model of a results.json dictionary of ``dynid identify``.
+
+        Parameters
+        ----------
+        results : dict
+            The parsed results.json.
+        robot : Robot
+            The robot's description the results were identified for.
+
+        Returns
+        -------
+        IdentifiedModel
 
         Raises
         ------
@@ -319,7 +415,17 @@ class IdentifiedModel:
 
     @classmethod
     def from_result(cls, result) -> "IdentifiedModel":
-        """The model of an :class:`dynid.experiment.identification.IdentificationResult`."""
+        """The model of an identification run's result.
+
+        Parameters
+        ----------
+        result : IdentificationResult
+            What :func:`dynid.run_identification` returned.
+
+        Returns
+        -------
+        IdentifiedModel
+        """
         return cls(result.model, result.base, {label: e.params for label, e in result.estimates.items()},
                    {label: e.std for label, e in result.estimates.items() if e.std is not None},
                    result.main_estimate.label, _stored(result.settings), json.loads(json.dumps(_plain(result.to_dict()))))

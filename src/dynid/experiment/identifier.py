@@ -85,9 +85,15 @@ class Identifier:
     def set_params(self, **params) -> "Identifier":
         """Set constructor parameters by name.
 
+        Parameters
+        ----------
+        **params
+            Constructor parameters.
+
         Returns
         -------
-        self
+        Identifier
+            ``self``.
 
         Raises
         ------
@@ -202,8 +208,12 @@ class Identifier:
         return self.model_
 
     def parameters(self, estimate: str | None = None):
-        """The base parameters of ``estimate`` (a label such as ``"dynid WLS"`` or a key such as ``"wls"``; default the
-        main one) by name, with σ where the estimator gives it.
+        """The base parameters of an estimate by name, with σ where the estimator gives it.
+
+        Parameters
+        ----------
+        estimate : str, optional
+            A label such as ``"dynid WLS"`` or a key such as ``"wls"``; default the main one.
 
         Returns
         -------
@@ -228,8 +238,20 @@ class Identifier:
         return self._model().predict(q, dq, ddq, estimate)
 
     def score(self, q, dq=None, ddq=None, tau=None, estimate: str | None = None) -> float:
-        """R² of the predicted torques: on a motion and its measured torques ``score(q, dq, ddq, tau)``, or on a log
-        ``score(recording)`` (prepared as the identification log was).
+        """R² of the predicted torques.
+
+        On a motion and its measured torques ``score(q, dq, ddq, tau)``, or on a log ``score(recording)`` (prepared as the
+        identification log was).
+
+        Parameters
+        ----------
+        q : (N, n_dof) array [rad] or Recording
+        dq, ddq : (N, n_dof) arrays, optional
+            [rad/s], [rad/s²]; not with a recording.
+        tau : (N, n_dof) array [N·m], optional
+            Measured torques; not with a recording.
+        estimate : str, optional
+            Label or key (default the main estimate).
 
         Returns
         -------
@@ -247,9 +269,15 @@ class Identifier:
     def save(self, path: str | Path) -> Path:
         """Write the identification's results.json (read back by :func:`dynid.load_results`).
 
+        Parameters
+        ----------
+        path : str or Path
+            A file, or a folder to hold ``results.json``.
+
         Returns
         -------
         Path
+            The file written.
         """
         return self._model().save(path)
 

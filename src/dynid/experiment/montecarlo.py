@@ -103,7 +103,17 @@ class MonteCarloConfig:
     strategy: str = "paper"
 
     def run_config(self, level: float = 0.05) -> PaperExperimentConfig:
-        """The settings of one realisation, as a paper-experiment configuration."""
+        """The settings of one realisation, as a paper-experiment configuration.
+
+        Parameters
+        ----------
+        level : float [A]
+            Current noise σ.
+
+        Returns
+        -------
+        PaperExperimentConfig
+        """
         return PaperExperimentConfig(
             robot=self.robot, joints=self.joints, seed=self.seed, duration=self.duration, rate=self.rate,
             omega_f=self.omega_f, current_noise=level, encoder_resolution=self.encoder_resolution,
@@ -161,7 +171,14 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
 
 @with_single_blas_thread
 def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> dict:
-    """Simulate realisation ``realisation`` at noise level ``level_index`` and fit every method.
+    """Simulate one realisation at one noise level and fit every method.
+
+    Parameters
+    ----------
+    setup : _Setup
+        What every realisation shares (robot, trajectory, estimators).
+    level_index : int
+    realisation : int
 
     Returns
     -------
@@ -203,11 +220,21 @@ class MonteCarloResult:
 
     Attributes
     ----------
+    config : MonteCarloConfig
+    names : tuple of str
+        Base parameter names.
+    truth : (n_base,) array
     estimates : (n_levels, n_realisations, n_methods, n_base) array
         NaN where a method failed.
     seconds : (n_levels, n_realisations, n_methods) array
     crb_std : (n_levels, n_base) array
         Square roots of the Cramér–Rao bound's diagonal.
+    errors : list
+        What failed, with the message.
+    timings : dict
+        Step -> wall time [s].
+    cluster : str
+        The Dask cluster the study ran on.
     """
 
     config: MonteCarloConfig
@@ -221,8 +248,14 @@ class MonteCarloResult:
     cluster: str = ""
 
     def statistics(self) -> dict:
-        """Per method key: arrays (n_levels, n_base) ``mean``, ``bias``, ``std``, ``rmse``, ``std_over_crb``,
-        ``bias_over_crb`` and ``failures`` (n_levels,), over the realisations that succeeded."""
+        """Statistics of each method over the realisations that succeeded.
+
+        Returns
+        -------
+        dict
+            Per method key: (n_levels, n_base) arrays ``mean``, ``bias``, ``std``, ``rmse``, ``std_over_crb``,
+            ``bias_over_crb``, and (n_levels,) ``failures`` and ``seconds_median``.
+        """
         out = {}
         for m, key in enumerate(self.config.estimators):
             est = self.estimates[:, :, m, :]
@@ -236,6 +269,12 @@ class MonteCarloResult:
         return out
 
     def to_dict(self) -> dict:
+        """The study as ``montecarlo.json``.
+
+        Returns
+        -------
+        dict
+        """
         stats = self.statistics()
         names = list(self.names)
         levels = [float(x) for x in self.config.noise_levels]
@@ -259,9 +298,20 @@ class MonteCarloResult:
 
 @contextlib.contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0):
-    """A Dask client: to ``scheduler`` (an address like ``tcp://host:8786``, given ``connect_timeout`` seconds
-    to answer) if given, else to a new :class:`distributed.LocalCluster` of ``workers`` single-threaded
-    processes (default: the local cores).
+    """A Dask client to a scheduler, or to a new local cluster.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        An address like ``tcp://host:8786``; default: a new :class:`distributed.LocalCluster`.
+    workers : int, optional
+        Single-threaded worker processes of the local cluster (default: the local cores).
+    connect_timeout : float [s]
+        Time the scheduler is given to answer.
+
+    Yields
+    ------
+    distributed.Client
 
     Raises
     ------

@@ -111,7 +111,18 @@ class PaperExperimentConfig:
     strategy: str = "paper"
 
     def validate(self, robot: Robot) -> None:
-        """Raise :class:`ConfigError` (one line) on any invalid setting."""
+        """Check every setting against the robot.
+
+        Parameters
+        ----------
+        robot : Robot
+            The robot of the run.
+
+        Raises
+        ------
+        ConfigError
+            One line naming the first invalid setting.
+        """
         if self.seed < 0:
             raise ConfigError(field="seed", message=f"seed must be a non-negative integer, got {self.seed}")
         if not 1 <= self.joints <= robot.n_dof:
@@ -146,7 +157,22 @@ class PaperExperimentConfig:
 
 @dataclass
 class Dataset:
-    """One preprocessed recording and its observation matrix."""
+    """One preprocessed recording and its observation matrix.
+
+    Attributes
+    ----------
+    t : (N,) array [s]
+    q, dq, ddq : (N, n) arrays [rad, rad/s, rad/s²]
+        Joint motion after the preprocessing (Fourier-fit derivatives).
+    tau : (N, n) array [N·m]
+        Measured torques after eq. 16 and eq. 17.
+    tau_true : (N, n) array [N·m]
+        Noise-free torques.
+    w_base : (N·n, n_base) array
+        Base observation matrix, filtered like ``tau``.
+    tool : (N, 3) array [m]
+        Tool position, for the workspace figure.
+    """
 
     t: np.ndarray
     q: np.ndarray
@@ -160,7 +186,33 @@ class Dataset:
 
 @dataclass
 class PaperEstimate:
-    """What one estimator gave (``n_evaluations`` of eq. 9 is None for the solvers)."""
+    """What one estimator gave.
+
+    Attributes
+    ----------
+    params : (n_base,) array
+        Base parameters in SI units.
+    objective : float
+        Eq. 9 at ``params``.
+    seconds : float
+        Wall time of the estimator [s].
+    n_evaluations : int or None
+        Evaluations of eq. 9 (None for the solvers).
+    tau_identification, tau_validation : (N, n) arrays [N·m]
+        Predicted torques on both recordings.
+    metrics : dict
+        dataset -> metric -> (n,) values (eq. 18, RMSE, relative error).
+    params_std : (n_base,) array or None
+        σ of ``params`` where the estimator gives one.
+    history : array or None
+        Best objective per iteration of a search.
+    bootstrap : dict or None
+        Block-bootstrap intervals (``lower``, ``upper``, ``std``, ``level``, ``resamples``, ``block_length``).
+    pseudo_inertia_min_eig : (n_links,) array or None
+        Smallest eigenvalue of each link's pseudo-inertia (physical consistency).
+    consistency_margin : float or None
+        Smallest such eigenvalue over the links.
+    """
 
     params: np.ndarray
     objective: float
@@ -178,7 +230,30 @@ class PaperEstimate:
 
 @dataclass
 class PaperRunResult:
-    """Everything :func:`run_paper_experiment` measured; :meth:`to_dict` is ``results.json``."""
+    """Everything :func:`run_paper_experiment` measured; :meth:`to_dict` is ``results.json``.
+
+    Attributes
+    ----------
+    config : PaperExperimentConfig
+    robot : Robot
+    base : BaseParameters
+        The base-parameter map of the identified joints.
+    truth : (n_base,) array
+        The simulated plant's base parameters.
+    bounds : (n_base, 2) array
+        The ABC's search box.
+    identification, validation : Dataset
+        The two recordings.
+    trajectories : dict
+        What is known of the excitation trajectories (labels, condition numbers).
+    estimates : dict
+        estimator key -> :class:`PaperEstimate`.
+    timings : dict
+        Step -> wall time [s].
+    warnings : list of str
+    truth_consistency_margin : float or None
+        Physical-consistency margin of the truth.
+    """
 
     config: PaperExperimentConfig
     robot: Robot
@@ -194,6 +269,13 @@ class PaperRunResult:
     truth_consistency_margin: float | None = None
 
     def to_dict(self) -> dict:
+        """The run as ``results.json``.
+
+        Returns
+        -------
+        dict
+            JSON-ready: settings, truth, every estimate with its metrics and errors against the truth, the paper's figures.
+        """
         names = list(self.base.names)
         out: dict[str, Any] = {
             "robot": self.robot.name,
@@ -247,7 +329,26 @@ def _percent_error(est: np.ndarray, truth: np.ndarray) -> np.ndarray:
 
 
 def identification_trajectory(config: PaperExperimentConfig, robot: Robot, base: BaseParameters):
-    """The identification trajectory of ``config.excitation`` and what is known of it (cond(W_base) …)."""
+    """The identification trajectory of ``config.excitation`` and what is known of it.
+
+    Parameters
+    ----------
+    config : PaperExperimentConfig
+    robot : Robot
+    base : BaseParameters
+
+    Returns
+    -------
+    traj : FourierTrajectory
+    info : dict
+        ``trajectory`` (label), ``cond_base_regressor`` (cond(W_base) on 100 samples of a period) and the same for the
+        paper's β1.
+
+    Raises
+    ------
+    ConfigError
+        A trajectory file whose joint count is not the run's.
+    """
     k = config.joints
     beta1 = paper_identification_trajectory(config.omega_f, k)
     if config.excitation == "paper":
@@ -315,19 +416,58 @@ def simulate_recording(robot: Robot, traj, t: np.ndarray, noise: NoiseModel, rng
 
 
 def paper_preprocessing(traj, passes: int, strategy: str = "paper") -> Preprocessing:
-    """The preprocessing of a recording of ``traj``: by default the paper's (§3.3), the strategy "paper" with the
-    trajectory's harmonics and ``passes`` applications of eq. 17."""
+    """The preprocessing of a recording of a Fourier trajectory: by default the paper's (§3.3).
+
+    Parameters
+    ----------
+    traj : FourierTrajectory
+        Its harmonics drive the Fourier-fit derivatives.
+    passes : int
+        Applications of eq. 17.
+    strategy : str
+        A registered preprocessing strategy.
+
+    Returns
+    -------
+    Preprocessing
+    """
     return Preprocessing(strategy=strategy, fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes)
 
 
 def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, estimation: Estimation | None = None,
                      strategy: str = "paper") -> Dataset:
-    """Simulate one recording of ``traj`` (currents with ``noise``, eq. 16) and prepare it by the strategy "paper":
-    the Fourier fit for the derivatives, eq. 17 ``passes`` times on the torques **and every column of the
-    observation matrix** (parallel filtering: smoothing the torques alone makes measured and modelled torque differ
-    at each velocity reversal, where the Coulomb column steps). With ``estimation``, its estimators are fed the rows.
+    """Simulate one recording of a trajectory (currents with noise, eq. 16) and prepare it by a strategy.
 
-    Limit violations of the commanded motion are appended to ``warnings`` (prefixed by ``label``).
+    By default the strategy "paper": the Fourier fit for the derivatives, eq. 17 ``passes`` times on the torques **and
+    every column of the observation matrix** (parallel filtering: smoothing the torques alone makes measured and
+    modelled torque differ at each velocity reversal, where the Coulomb column steps).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    traj : FourierTrajectory
+    t : (N,) array
+        Sample times [s].
+    noise : float
+        Current noise σ [A].
+    rng : numpy.random.Generator
+    phi_true : (n_std,) array
+        The plant's standard parameters.
+    passes : int
+        Applications of eq. 17.
+    label : str
+        The recording's name, prefixing warnings.
+    warnings : list of str
+        Limit violations of the commanded motion are appended.
+    estimation : Estimation, optional
+        Its estimators are fed the recording's rows.
+    strategy : str
+        A registered preprocessing strategy.
+
+    Returns
+    -------
+    Dataset
     """
     recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
     data = prepare(recording, paper_preprocessing(traj, passes, strategy))
@@ -455,8 +595,21 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
 
 
 def problem(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -> FitData:
-    """What the estimators know of the problem before any row: the joints, the base map, the parameter layout and
-    the eq. 9 weights; for ``sdp`` a rough CAD guess as prior (nominal parameters × U(0.7, 1.3), seeded by the run)."""
+    """What the estimators know of the problem before any row.
+
+    The joints, the base map, the parameter layout and the eq. 9 weights; for ``sdp`` a rough CAD guess as prior
+    (nominal parameters × U(0.7, 1.3), seeded by the run).
+
+    Parameters
+    ----------
+    config : PaperExperimentConfig
+    robot : Robot
+    base : BaseParameters
+
+    Returns
+    -------
+    FitData
+    """
     keys = parse_estimators(config.estimators)
     prior = None
     if "sdp" in keys:
@@ -465,7 +618,23 @@ def problem(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -
 
 
 def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """The ABC's search box (n_base, 2) of ``config.abc_bounds``: the paper's Table 3, or ``±(2|β_OLS| + 1)``.
+    """The ABC's search box: the paper's Table 3, or ``±(2|β_OLS| + 1)``.
+
+    Parameters
+    ----------
+    config : PaperExperimentConfig
+        ``abc_bounds`` chooses.
+    robot : Robot
+    base : BaseParameters
+    w_base : (N·n, n_base) array
+        Identification observation matrix.
+    y : (N·n,) array [N·m]
+        Identification torques.
+
+    Returns
+    -------
+    (n_base, 2) ndarray
+        Lower and upper bound per base parameter.
 
     Raises
     ------

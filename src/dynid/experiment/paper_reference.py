@@ -29,8 +29,19 @@ CORRELATION_VALIDATION = (0.9272, 0.9534, 0.9606)
 
 
 def paper_symbol(name: str) -> str:
-    """The paper's symbol of a dynid parameter name: ``"ZZ1R" -> "I_zz1"``, ``"MX2R" -> "m2rx2"``,
-    ``"fc3" -> "f_c3"``; empty string when the paper has none."""
+    """The paper's symbol of a dynid parameter name.
+
+    ``"ZZ1R" -> "I_zz1"``, ``"MX2R" -> "m2rx2"``, ``"fc3" -> "f_c3"``.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+        Empty when the paper has none.
+    """
     term, j = split_name(name)
     k = j + 1
     if term in ("XX", "XY", "XZ", "YY", "YZ", "ZZ"):

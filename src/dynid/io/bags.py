@@ -15,14 +15,29 @@ from ..exceptions import DataError
 
 
 def read_joint_states(spec, robot, name: str):
-    """Time stamps (N,) and raw signals {positions, velocities?, torques|currents} (N, n_dof) of a bag, and a
-    function naming sample k's place (for errors).
+    """Time stamps and raw signals of a ROS 2 bag's JointState messages.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        Its ``bag`` says the file, topic and joints.
+    robot : Robot
+    name : str
+        The dataset, for errors.
+
+    Returns
+    -------
+    t : (N,) ndarray [s]
+    signals : dict
+        positions, velocities (if present), torques or currents: (N, n_dof) arrays in the bag's units.
+    where : callable
+        ``where(k)`` names sample k's place in the bag (for errors).
 
     Raises
     ------
     DataError
-        A missing or unreadable bag, no such topic, a topic of another type, joints missing from the messages,
-        or messages without positions or efforts.
+        A missing or unreadable bag, no such topic, a topic of another type, joints missing from the messages, or
+        messages without positions or efforts.
     """
     from rosbags.highlevel import AnyReader
 

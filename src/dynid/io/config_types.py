@@ -27,81 +27,87 @@ __all__ = ["SignalTable", "TimeTable", "DatasetTable", "PreprocessingTable", "Es
            "DriveGainsTable", "IdentificationDocument", "ExcitationDocument"]
 
 Column = Union[Annotated[int, Meta(ge=1)], str]
-PositiveHz = Annotated[float, Meta(gt=0, description="Hz")]
+PositiveHz = Annotated[float, Meta(gt=0)]
 NonNegative = Annotated[float, Meta(ge=0)]
 PerJoint = Union[NonNegative, list[NonNegative]]
 Factor = Union[float, list[float]]
 
 
+def _d(text: str) -> Meta:
+    """A field's description, shown by editors from the JSON Schema."""
+    return Meta(description=text)
+
+
 class SignalTable(Table, kw_only=True):
     """Where one signal is: ``{ columns = [2, 3, 4, 5, 6, 7], unit = "rad" }``."""
 
-    columns: Annotated[list[Column], Meta(description="one per joint: 1-based numbers or header names")] | None = None
-    file: Annotated[str, Meta(description="default: the dataset's file")] | None = None
-    unit: Annotated[str, Meta(description="rad or deg; rad/s or deg/s; A or mA; N*m")] | None = None
-    sign: Annotated[Factor, Meta(description="1 or -1, or one per joint: multiplies the signal")] | None = None
-    scale: Annotated[Factor, Meta(description="a non-zero factor, or one per joint")] | None = None
-    side: Literal["joint", "motor"] | None = None
+    columns: Annotated[list[Column], _d("one per joint: 1-based numbers or header names")] | None = None
+    file: Annotated[str, _d("the file, relative to the data root (default: the dataset's file)")] | None = None
+    unit: Annotated[str, _d("rad or deg; rad/s or deg/s; A or mA; N*m")] | None = None
+    sign: Annotated[Factor, _d("1 or -1, or one per joint: multiplies the signal")] | None = None
+    scale: Annotated[Factor, _d("a non-zero factor, or one per joint: multiplies the signal")] | None = None
+    side: Annotated[Literal["joint", "motor"], _d("this signal's side of the transmission (default: the dataset's)")] | None = None
 
 
 class TimeTable(Table, kw_only=True):
     """The time stamps' column [s]: ``time = { column = 1 }``."""
 
-    column: Column
-    file: str | None = None
+    column: Annotated[Column, _d("1-based number or header name of the time stamps [s]")]
+    file: Annotated[str, _d("the file (default: the dataset's file)")] | None = None
 
 
 class DatasetTable(Table, kw_only=True):
     """A dataset: columns of CSV files, or a ROS 2 bag of sensor_msgs/JointState (:mod:`dynid.io.datasets`)."""
 
-    preset: Annotated[str, Meta(description="ur-rtde, ur-rtde-19, motor-side: fills in the other fields")] | None = None
-    name: str | None = None
-    file: Annotated[str, Meta(description="default file of every signal, relative to the data root")] | None = None
-    header: bool | None = None
-    n_columns: Annotated[int, Meta(ge=1)] | None = None
-    delimiter: str | None = None
+    preset: Annotated[str, _d("ur-rtde, ur-rtde-19 or motor-side: fills in the other fields")] | None = None
+    name: Annotated[str, _d("the dataset's name in tables and messages")] | None = None
+    file: Annotated[str, _d("default file of every signal, relative to the data root")] | None = None
+    header: Annotated[bool, _d("the first line holds column names")] | None = None
+    n_columns: Annotated[int, Meta(ge=1, description="columns every line has")] | None = None
+    delimiter: Annotated[str, _d("field separator (default ',')")] | None = None
     rows: Annotated[list[Annotated[int, Meta(ge=1)]], Meta(min_length=2, max_length=2,
-                                                           description="1-based inclusive data rows")] | None = None
-    time_range: Annotated[list[float], Meta(min_length=2, max_length=2, description="s from the first row read")] | None = None
-    gaps: Literal["refuse", "interpolate"] | None = None
-    max_gap: Annotated[float, Meta(gt=0, description="s: the longest gap interpolated")] | None = None
-    held: Literal["interpolate", "keep"] | None = None
-    time: TimeTable | None = None
-    rate: Annotated[PositiveHz, Meta(description="Hz, when there is no time column")] | None = None
-    resample: Annotated[PositiveHz, Meta(description="Hz: uniform grid for jittered time stamps")] | None = None
-    side: Literal["joint", "motor"] | None = None
-    positions: SignalTable | None = None
-    velocities: SignalTable | None = None
-    currents: SignalTable | None = None
-    torques: SignalTable | None = None
-    bag: Annotated[str, Meta(description="a ROS 2 bag's folder, relative to the data root")] | None = None
-    topic: str | None = None
-    joint_names: list[str] | None = None
-    effort: Literal["torques", "currents"] | None = None
+                                                           description="[first, last] 1-based inclusive data rows")] | None = None
+    time_range: Annotated[list[float], Meta(min_length=2, max_length=2,
+                                            description="[start, stop] s from the first row read")] | None = None
+    gaps: Annotated[Literal["refuse", "interpolate"], _d("a time step over 5x the median: refuse (default) or interpolate")] | None = None
+    max_gap: Annotated[float, Meta(gt=0, description="s: the longest gap interpolated (default 0.1)")] | None = None
+    held: Annotated[Literal["interpolate", "keep"], _d("rows repeating the previous one exactly: interpolate (default) or keep")] | None = None
+    time: Annotated[TimeTable, _d("the time stamps' column")] | None = None
+    rate: Annotated[PositiveHz, _d("Hz, when there is no time column")] | None = None
+    resample: Annotated[PositiveHz, _d("Hz: uniform grid for jittered time stamps (default 1 / median step)")] | None = None
+    side: Annotated[Literal["joint", "motor"], _d("joint (default) or motor side of the transmission")] | None = None
+    positions: Annotated[SignalTable, _d("joint or motor angles (rad or deg)")] | None = None
+    velocities: Annotated[SignalTable, _d("measured velocities (optional)")] | None = None
+    currents: Annotated[SignalTable, _d("motor currents: torque = drive gain · current (eq. 16)")] | None = None
+    torques: Annotated[SignalTable, _d("torques [N·m], instead of currents")] | None = None
+    bag: Annotated[str, _d("a ROS 2 bag's folder, relative to the data root")] | None = None
+    topic: Annotated[str, _d("the bag's JointState topic (default /joint_states)")] | None = None
+    joint_names: Annotated[list[str], _d("the bag's joint names, in the robot's order")] | None = None
+    effort: Annotated[Literal["torques", "currents"], _d("what the bag's effort holds")] | None = None
 
 
 class PreprocessingTable(Table, kw_only=True):
     """``[preprocessing]``: every field optional; by default everything derives from the data
     (:class:`dynid.preprocessing.settings.Preprocessing`)."""
 
-    strategy: Annotated[str, Meta(description="parallel (default), paper, or one registered")] | None = None
-    order: Annotated[int, Meta(ge=1)] | None = None
-    band: Annotated[PositiveHz, Meta(description="Hz, the excitation band")] | None = None
-    position_cutoff: Annotated[NonNegative, Meta(description="Hz; 0: no filter")] | None = None
-    velocity_cutoff: Annotated[NonNegative, Meta(description="Hz; 0: no filter")] | None = None
-    parallel_cutoff: Annotated[NonNegative, Meta(description="Hz, torques and every regressor column")] | None = None
-    decimation: Annotated[int, Meta(ge=1)] | None = None
-    min_speed: Annotated[Union[Literal["auto"], PerJoint], Meta(description="rad/s")] | None = None
-    trim: Annotated[NonNegative, Meta(description="s at both ends")] | None = None
-    chunk: Annotated[int, Meta(ge=1)] | None = None
-    excitation: Annotated[str, Meta(description="the excitation.json the robot ran: Fourier-fit derivatives")] | None = None
-    coulomb_velocity: Annotated[Union[Literal["auto"], PerJoint], Meta(description="rad/s; 0: sign")] | None = None
-    rest_velocity: Annotated[Union[Literal["auto"], PerJoint], Meta(description="rad/s")] | None = None
+    strategy: Annotated[str, _d("parallel (default), paper, or one registered")] | None = None
+    order: Annotated[int, Meta(ge=1, description="order of the Butterworth filters (default 4)")] | None = None
+    band: Annotated[PositiveHz, _d("Hz, the excitation band (default: from the positions' spectrum)")] | None = None
+    position_cutoff: Annotated[NonNegative, _d("Hz, positions (default 10x band); 0: no filter")] | None = None
+    velocity_cutoff: Annotated[NonNegative, _d("Hz, measured velocities (default: the position cutoff)")] | None = None
+    parallel_cutoff: Annotated[NonNegative, _d("Hz, torques and every regressor column (default 10x band)")] | None = None
+    decimation: Annotated[int, Meta(ge=1, description="parallel decimation (default: down to the parallel band)")] | None = None
+    min_speed: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: slower rows left out (default auto)")] | None = None
+    trim: Annotated[NonNegative, _d("s removed at both ends (default 3 / cutoff)")] | None = None
+    chunk: Annotated[int, Meta(ge=1, description="samples per chunk of the regressor")] | None = None
+    excitation: Annotated[str, _d("the excitation.json the robot ran: Fourier-fit derivatives")] | None = None
+    coulomb_velocity: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: Coulomb term tanh(dq/v); 0: sign")] | None = None
+    rest_velocity: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: below it a joint rests (default auto)")] | None = None
     rest_friction: Annotated[Union[Literal["held", "zero"], NonNegative, list[Union[Literal["held", "zero"], NonNegative]]],
-                             Meta(description='"held", "zero" or a relaxation time [s], one or one per joint')] | None = None
-    presliding: Annotated[PerJoint, Meta(description="rad")] | None = None
-    smoothing_passes: Annotated[int, Meta(ge=0)] | None = None
-    auto: bool | None = None
+                             _d('friction at rest: "held", "zero" or a relaxation time [s], one or one per joint')] | None = None
+    presliding: Annotated[PerJoint, _d("rad: Dahl's presliding distance (default 0)")] | None = None
+    smoothing_passes: Annotated[int, Meta(ge=0, description="applications of eq. 17 (strategy paper)")] | None = None
+    auto: Annotated[bool, _d("cross-validate the cutoffs when the positions' noise knee allows (default true)")] | None = None
 
 
 class EstimationTable(Table, kw_only=True):
@@ -109,43 +115,45 @@ class EstimationTable(Table, kw_only=True):
 
     estimators: Annotated[list[str], Meta(min_length=1, description="the first is the main estimate: ols, wls, irls, "
                                                                     "lad, sdp, abc, abc10, de, pso or one registered")] | None = None
-    seed: Annotated[int, Meta(ge=0)] | None = None
-    friction: Literal["auto", "description"] | None = None
+    seed: Annotated[int, Meta(ge=0, description="seeds the box searches (default 0)")] | None = None
+    friction: Annotated[Literal["auto", "description"], _d("each joint's friction model by cross-validation, or the "
+                                                           "description's terms")] | None = None
 
 
 class ReferenceTable(Table, kw_only=True):
     """``[[references]]``: a published parameter set (:mod:`dynid.io.references`)."""
 
-    name: str
-    file: str | None = None
-    format: Literal["standard", "base", "nominal"] | None = None
-    header: bool | None = None
-    names: Column | None = None
-    values: Column | None = None
-    rel_std: Column | None = None
+    name: Annotated[str, _d("the set's name in tables")]
+    file: Annotated[str, _d("CSV of the set, relative to the data root")] | None = None
+    format: Annotated[Literal["standard", "base", "nominal"], _d("one standard parameter per row, one base parameter "
+                                                                "(an expression) per row, or the description's values")] | None = None
+    header: Annotated[bool, _d("the first line holds column names")] | None = None
+    names: Annotated[Column, _d("column of the names")] | None = None
+    values: Annotated[Column, _d("column of the values")] | None = None
+    rel_std: Annotated[Column, _d("column of the relative standard deviations [%]")] | None = None
 
 
 class DriveGainsTable(Table, kw_only=True):
     """``[drive_gains]``: drive gains from a run without and one with a payload of known mass."""
 
     payload_mass: Annotated[float, Meta(gt=0, description="kg")]
-    unloaded: DatasetTable
-    loaded: DatasetTable
+    unloaded: Annotated[DatasetTable, _d("the run without the payload (currents)")]
+    loaded: Annotated[DatasetTable, _d("the same motion with the payload (currents)")]
 
 
 class IdentificationDocument(Table, kw_only=True):
     """A config of ``dynid identify`` and ``dynid validate`` (:mod:`dynid.io.identification_config`)."""
 
-    robot: Annotated[Union[str, RobotDescription], Meta(description="built-in name, description TOML or URDF, or a table")]
-    data_root: Annotated[str, Meta(description="folder of the data files, relative to this file")] | None = None
-    name: str | None = None
-    notes: str | None = None
-    identification: DatasetTable
-    validation: list[DatasetTable] = msgspec.field(default_factory=list)
-    preprocessing: Union[PreprocessingTable, Literal["auto"]] | None = None
-    estimation: EstimationTable | None = None
-    references: list[ReferenceTable] = msgspec.field(default_factory=list)
-    drive_gains: DriveGainsTable | None = None
+    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML or URDF, or a table")]
+    data_root: Annotated[str, _d("folder of the data files, relative to this file")] | None = None
+    name: Annotated[str, _d("the config's name")] | None = None
+    notes: Annotated[str, _d("free text")] | None = None
+    identification: Annotated[DatasetTable, _d("the log to identify from")]
+    validation: Annotated[list[DatasetTable], _d("logs to validate on")] = msgspec.field(default_factory=list)
+    preprocessing: Annotated[Union[PreprocessingTable, Literal["auto"]], _d("filters; by default from the data")] | None = None
+    estimation: Annotated[EstimationTable, _d("the estimators")] | None = None
+    references: Annotated[list[ReferenceTable], _d("published parameter sets scored beside")] = msgspec.field(default_factory=list)
+    drive_gains: Annotated[DriveGainsTable, _d("drive gains from a known payload")] | None = None
 
 
 PerJointAngle = Union[Angle, list[Angle]]
@@ -158,60 +166,60 @@ class TrajectoryTable(Table, kw_only=True):
     harmonics: Annotated[int, Meta(ge=1, description="N of eq. 14")]
     frequency: Annotated[float, Meta(gt=0, description="fundamental frequency, Hz")] | None = None
     omega_f: Annotated[float, Meta(gt=0, description="fundamental pulsation, rad/s")] | None = None
-    form: Literal["paper", "swevers"] | None = None
-    offsets: PerJointAngle | None = None
-    rest: bool | None = None
+    form: Annotated[Literal["paper", "swevers"], _d("how the coefficients are written: eq. 14 or the Swevers form")] | None = None
+    offsets: Annotated[PerJointAngle, _d("fixed q_o [rad]; omit to optimise them")] | None = None
+    rest: Annotated[bool, _d("start and end at rest at the offsets")] | None = None
 
 
 class LimitsTable(Table, kw_only=True):
     """``[limits]``: the robot's limits overridden, one value or one per joint."""
 
-    q_min: PerJointAngle | None = None
-    q_max: PerJointAngle | None = None
-    dq_max: PerJointNumber | None = None
-    ddq_max: PerJointNumber | None = None
-    tau_max: PerJointNumber | None = None
+    q_min: Annotated[PerJointAngle, _d("rad")] | None = None
+    q_max: Annotated[PerJointAngle, _d("rad")] | None = None
+    dq_max: Annotated[PerJointNumber, _d("rad/s")] | None = None
+    ddq_max: Annotated[PerJointNumber, _d("rad/s²")] | None = None
+    tau_max: Annotated[PerJointNumber, _d("N·m")] | None = None
 
 
 class WorkspaceTable(Table, kw_only=True):
     """``[workspace]``: where the tool point may go, base frame [m]."""
 
-    box_min: Annotated[list[float], Meta(min_length=3, max_length=3)] | None = None
-    box_max: Annotated[list[float], Meta(min_length=3, max_length=3)] | None = None
-    floor: float | None = None
+    box_min: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
+    box_max: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
+    floor: Annotated[float, _d("lowest height of the tool point, m")] | None = None
 
 
 class DesignTable(Table, kw_only=True):
     """``[design]``: the optimisation."""
 
-    criterion: Literal["cond", "d-optimal"] | None = None
-    starts: Annotated[int, Meta(ge=1)] | None = None
-    seed: int | None = None
-    grid_points: Annotated[int, Meta(ge=1)] | None = None
-    safety: float | None = None
-    maxiter: Annotated[int, Meta(ge=1)] | None = None
-    initial: Annotated[str, Meta(description='"paper" (β1) or an excitation JSON')] | None = None
+    criterion: Annotated[Literal["cond", "d-optimal"], _d("cond(W_base) (default) or -log det")] | None = None
+    starts: Annotated[int, Meta(ge=1, description="optimisation starts (default 6)")] | None = None
+    seed: Annotated[int, _d("seeds the random starts")] | None = None
+    grid_points: Annotated[int, Meta(ge=1, description="samples per period of the design grid")] | None = None
+    safety: Annotated[float, _d("margin kept from each limit, as a fraction (default 0.02)")] | None = None
+    maxiter: Annotated[int, Meta(ge=1, description="SLSQP iterations per start (default 150)")] | None = None
+    initial: Annotated[str, _d('"paper" (β1) or an excitation JSON')] | None = None
 
 
 class OutputTable(Table, kw_only=True):
     """``[output]``: the set-points' CSV."""
 
-    rate: Annotated[float, Meta(gt=0, description="controller rate, Hz")] | None = None
-    periods: Annotated[int, Meta(ge=1)] | None = None
+    rate: Annotated[float, Meta(gt=0, description="controller rate, Hz (default 500)")] | None = None
+    periods: Annotated[int, Meta(ge=1, description="periods written (default 1)")] | None = None
 
 
 class ExcitationDocument(Table, kw_only=True):
     """A config of ``dynid excite`` (:mod:`dynid.io.excitation_config`)."""
 
-    robot: Union[str, RobotDescription]
-    joints: Annotated[int, Meta(ge=1)] | None = None
-    name: str | None = None
-    notes: str | None = None
-    trajectory: TrajectoryTable
-    limits: LimitsTable = msgspec.field(default_factory=LimitsTable)
-    workspace: WorkspaceTable = msgspec.field(default_factory=WorkspaceTable)
-    design: DesignTable = msgspec.field(default_factory=DesignTable)
-    output: OutputTable = msgspec.field(default_factory=OutputTable)
+    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML or URDF, or a table")]
+    joints: Annotated[int, Meta(ge=1, description="identify the first joints (default all)")] | None = None
+    name: Annotated[str, _d("the config's name")] | None = None
+    notes: Annotated[str, _d("free text")] | None = None
+    trajectory: Annotated[TrajectoryTable, _d("the Fourier trajectory (eq. 14)")]
+    limits: Annotated[LimitsTable, _d("limits overriding the robot's")] = msgspec.field(default_factory=LimitsTable)
+    workspace: Annotated[WorkspaceTable, _d("where the tool may go")] = msgspec.field(default_factory=WorkspaceTable)
+    design: Annotated[DesignTable, _d("the optimisation")] = msgspec.field(default_factory=DesignTable)
+    output: Annotated[OutputTable, _d("the set-points' CSV")] = msgspec.field(default_factory=OutputTable)
 
 
 SCHEMAS = {
@@ -226,7 +234,12 @@ SCHEMAS = {
 
 
 def write_schemas(folder=None) -> list:
-    """Write the JSON Schemas of :data:`SCHEMAS` (default: into the package's ``schema`` folder).
+    """Write the JSON Schemas of :data:`SCHEMAS`.
+
+    Parameters
+    ----------
+    folder : path, optional
+        Where (default: the package's ``schema`` folder).
 
     Returns
     -------

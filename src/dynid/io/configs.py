@@ -12,8 +12,17 @@ from ..model.robot import Robot
 
 
 def read_config(path: Path, known: set[str] | None) -> dict:
-    """The TOML document at ``path``, whose top-level fields must be among ``known`` (None: any; the typed
-    structure checks them).
+    """A TOML config, its top-level fields checked.
+
+    Parameters
+    ----------
+    path : Path
+    known : set of str or None
+        The top-level fields allowed (None: any; the typed structure checks them).
+
+    Returns
+    -------
+    dict
 
     Raises
     ------
@@ -35,8 +44,23 @@ def read_config(path: Path, known: set[str] | None) -> dict:
 
 
 def robot_source(doc: dict, path: Path, data_root: Path | None = None) -> str:
-    """Where a config's robot comes from, for results to find it again: a built-in name, the absolute path of its
-    description or URDF, or ``"config:<absolute path of the config>"`` for a ``[robot]`` table."""
+    """Where a config's robot comes from, for results to find it again.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed config.
+    path : Path
+        The config file (relative paths are resolved against its folder).
+    data_root : Path, optional
+        The data folder, searched second.
+
+    Returns
+    -------
+    str
+        A built-in name, the absolute path of its description or URDF, or ``"config:<absolute path of the config>"``
+        for a ``[robot]`` table.
+    """
     ref = doc.get("robot")
     if isinstance(ref, dict):
         return f"config:{path.resolve()}"
@@ -51,9 +75,24 @@ def robot_source(doc: dict, path: Path, data_root: Path | None = None) -> str:
 
 
 def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
-    """The robot of a config's ``robot`` field: a built-in name, a description TOML or a URDF (relative to the config,
-    else to the data root), or a ``[robot]`` table: a description inline (``urdf = "arm.urdf"`` and what a URDF
-    cannot say: ``drive_terms``, ``gravity``, ``[robot.transmission]``, ``[robot.payload]``, ``[[robot.joints]]``).
+    """The robot of a config's ``robot`` field.
+
+    A built-in name, a description TOML or a URDF (relative to the config, else to the data root), or a ``[robot]``
+    table: a description inline (``urdf = "arm.urdf"`` and what a URDF cannot say: ``drive_terms``, ``gravity``,
+    ``[robot.transmission]``, ``[robot.payload]``, ``[[robot.joints]]``).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed config.
+    path : Path
+        The config file (relative paths are resolved against its folder).
+    data_root : Path, optional
+        The data folder, searched second.
+
+    Returns
+    -------
+    Robot
 
     Raises
     ------

@@ -81,8 +81,18 @@ _SIGNALS = tuple(_UNITS)
 
 @dataclass(frozen=True)
 class SignalSpec:
-    """Where a signal is and how it converts: ``file``, ``columns``, ``scale`` (the unit's factor times the
-    config's ``sign`` and ``scale``: a number or one per joint), ``side`` ("joint", "motor" or None: the dataset's)."""
+    """Where a signal is and how it converts.
+
+    Attributes
+    ----------
+    file : Path
+    columns : tuple
+        Column names or 1-based indices, one per joint.
+    scale : float or (n_dof,) array
+        The unit's factor times the config's ``sign`` and ``scale``.
+    side : str or None
+        "joint", "motor", or None: the dataset's.
+    """
 
     file: Path
     columns: tuple
@@ -92,7 +102,41 @@ class SignalSpec:
 
 @dataclass(frozen=True)
 class DatasetSpec:
-    """Where a dataset's signals are and how to read them (see the module docstring)."""
+    """Where a dataset's signals are and how to read them (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+    signals : dict
+        Signal name (positions, velocities, torques, currents…) -> :class:`SignalSpec`.
+    time : SignalSpec or None
+        The time stamps' column.
+    rate : float or None [Hz]
+        When there is no time column.
+    resample : float or None [Hz]
+        Uniform grid for jittered time stamps (default 1 / median step).
+    side : str
+        "joint" or "motor" side of the transmission.
+    header : bool
+        The first line holds column names.
+    n_columns : int or None
+        Columns every line has.
+    rows : (first, last) or None
+        1-based inclusive data rows.
+    delimiter : str
+    time_range : (start, stop) or None [s]
+        From the first row read.
+    gaps : str
+        A time step over 5× the median: "refuse" or "interpolate".
+    bag : BagSpec or None
+        A ROS 2 bag instead of columns.
+    table : str
+        The config table it comes from, for messages: ``[identification]``, ``[[validation]] "p3"``.
+    max_gap : float [s]
+        The longest gap interpolated.
+    held : str
+        Rows repeating the previous one exactly: "interpolate" or "keep".
+    """
 
     name: str
     signals: dict
@@ -163,6 +207,7 @@ class Recording:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples N."""
         return self.t.shape[0]
 
     @property
@@ -363,20 +408,29 @@ def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
 def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
-    Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages,
-    scale units, check the time stamps, resample jittered time stamps linearly onto a uniform grid,
-    convert motor-side signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``),
-    currents to torques with the drive gains (eq. 16).
+    Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
+    units, check the time stamps, resample jittered time stamps linearly onto a uniform grid, convert motor-side
+    signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``), currents to torques with the
+    drive gains (eq. 16).
 
-    ``spool``: hold the signals in temporary files (:mod:`dynid.column_store`) rather than in memory;
-    by default when the files hold more than :data:`dynid.column_store.SPOOL_BYTES` (an hour-long log).
-    The numbers are the same either way.
+    Parameters
+    ----------
+    spec : DatasetSpec
+    robot : Robot
+    spool : bool, optional
+        Hold the signals in temporary files (:mod:`dynid.column_store`) rather than in memory; by default when the
+        files hold more than :data:`dynid.column_store.SPOOL_BYTES` (an hour-long log). The numbers are the same
+        either way.
+
+    Returns
+    -------
+    Recording
 
     Raises
     ------
     DataError
-        Unreadable or damaged files, non-increasing time stamps (names file and line), files of
-        different lengths, implausible values.
+        Unreadable or damaged files, non-increasing time stamps (names file and line), files of different lengths,
+        implausible values.
     """
     warnings: list[str] = []
     if spec.bag is not None:
@@ -502,7 +556,16 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
 
 
 def uniform_rate(t: np.ndarray) -> float:
-    """The rate of a uniform grid for time stamps ``t`` [s]: one over their median step, to 6 digits [Hz]."""
+    """The rate of a uniform grid for time stamps: one over their median step, to 6 digits.
+
+    Parameters
+    ----------
+    t : (N,) array [s]
+
+    Returns
+    -------
+    float [Hz]
+    """
     return float(f"{1.0 / float(np.median(np.diff(t))):.6g}")
 
 

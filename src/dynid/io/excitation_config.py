@@ -59,7 +59,31 @@ from ..model.robot import Robot
 
 @dataclass(frozen=True)
 class ExcitationConfig:
-    """A parsed ``dynid excite`` config (module docstring)."""
+    """A parsed ``dynid excite`` config (module docstring).
+
+    Attributes
+    ----------
+    path : Path
+        The config file.
+    full_robot : Robot
+        The robot before the joints are selected.
+    problem : ExcitationProblem
+        The design problem (joints, limits, workspace, criterion).
+    form : str
+        Coefficient form written: "paper" (eq. 14) or "swevers".
+    starts : int
+        Optimisation starts.
+    seed : int
+    maxiter : int
+        Iterations per start.
+    initial : FourierTrajectory or None
+        A first start given by the user.
+    initial_label : str
+    rate : float [Hz]
+        Rate of the set-point CSV.
+    periods : int
+        Periods written to the set-point CSV.
+    """
 
     path: Path
     full_robot: Robot
@@ -84,12 +108,19 @@ def _per_joint(v, n: int, where: str, angle: bool = False) -> np.ndarray:
 def load_excitation_config(path: str | Path) -> ExcitationConfig:
     """Parse a ``dynid excite`` config.
 
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    ExcitationConfig
+
     Raises
     ------
     ConfigError
-        Unreadable file, invalid TOML, unknown or malformed fields, or constraints no trajectory can
-        satisfy (q_max <= q_min, a workspace that excludes the start pose …); the message names the file
-        and the field.
+        Unreadable file, invalid TOML, unknown or malformed fields, or constraints no trajectory can satisfy
+        (q_max <= q_min, a workspace that excludes the start pose …); the message names the file and the field.
     """
     path = Path(path)
     doc = read_config(path, None)

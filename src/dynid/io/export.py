@@ -67,8 +67,18 @@ def _exportable(robot: Robot, phi: np.ndarray | None) -> Robot:
 
 
 def quoteattr(value: str) -> str:
-    """An XML attribute value in double quotes, with &, <, >, " and ' escaped (``html.escape`` produces valid
-    XML entities; ``xml.sax.saxutils`` would import ``urllib`` on the way, 70 ms)."""
+    """An XML attribute value in double quotes, with &, <, >, " and ' escaped.
+
+    ``html.escape`` produces valid XML entities; ``xml.sax.saxutils`` would import ``urllib`` on the way (70 ms).
+
+    Parameters
+    ----------
+    value : str
+
+    Returns
+    -------
+    str
+    """
     return f'"{escape(str(value), quote=True)}"'
 
 
@@ -133,16 +143,28 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
 
 
 def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
-    """MuJoCo MJCF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
+    """MuJoCo MJCF text of a robot with given standard parameters.
 
-    Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about
-    it (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping``
-    (viscous ``fv``) and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments:
-    the torque offset, the Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's
-    ``frictionloss`` is a dry-friction *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but
-    its force in ``mj_inverse`` comes from the constraint solver, so only the other terms reproduce dynid's
-    torques exactly (see the round-trip test). Massless links and point masses get MuJoCo's smallest mass
-    and inertia (``boundmass``, ``boundinertia`` of 1e-9).
+    Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
+    (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping`` (viscous ``fv``)
+    and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments: the torque offset, the
+    Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's ``frictionloss`` is a dry-friction
+    *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but its force in ``mj_inverse`` comes from the
+    constraint solver, so only the other terms reproduce dynid's torques exactly (see the round-trip test). Massless
+    links and point masses get MuJoCo's smallest mass and inertia (``boundmass``, ``boundinertia`` of 1e-9).
+
+    Parameters
+    ----------
+    robot : Robot
+    phi : (n_params,) array, optional
+        Standard parameters (the robot's nominal ones by default).
+    name : str, optional
+        The model's name (the robot's by default).
+
+    Returns
+    -------
+    str
+        An MJCF document.
 
     Raises
     ------
@@ -198,15 +220,31 @@ def _finite(x: float) -> float:
 
 
 def consistent_estimate(robot: Robot, results: dict, source: str = "results") -> tuple[Robot, np.ndarray]:
-    """The robot (with the Coulomb smoothing it was identified with) and the physically consistent standard
-    parameters stored in a ``results.json`` of ``dynid identify`` (the ``standard_values`` of its physically consistent
-    estimate).
+    """The robot and the physically consistent standard parameters stored in a results file.
+
+    The robot carries the Coulomb smoothing it was identified with; the parameters are the ``standard_values`` of the
+    results' physically consistent estimate.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's description the results were identified for.
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    robot : Robot
+    phi : (n_params,) ndarray
+        Standard parameters, SI units.
 
     Raises
     ------
     ConfigError
-        No physically consistent estimate in the results, results of another robot, or a set that did not
-        pass the consistency check (the verdict says why).
+        No physically consistent estimate in the results, results of another robot, or a set that did not pass the
+        consistency check (the verdict says why).
     """
     from .results import stored_standard
 
@@ -232,10 +270,50 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
 
 
 def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
-    """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`)."""
+    """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's description the results were identified for.
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    str
+        A URDF document.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`consistent_estimate`.
+    """
     return urdf_from_robot(*consistent_estimate(robot, results, source))
 
 
 def mjcf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
-    """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`)."""
+    """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's description the results were identified for.
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    str
+        An MJCF document.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`consistent_estimate`.
+    """
     return mjcf_from_robot(*consistent_estimate(robot, results, source))

@@ -16,8 +16,16 @@ def _umask() -> int:
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (no half-written file on error), with the permissions an
-    ordinary new file gets under the user's umask (a temporary file would otherwise keep mode 0600)."""
+    """Write a file atomically (no half-written file on error).
+
+    With the permissions an ordinary new file gets under the user's umask (a temporary file would otherwise keep mode
+    0600).
+
+    Parameters
+    ----------
+    path : str or Path
+    data : bytes
+    """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -31,6 +39,13 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write UTF-8 text atomically (:func:`atomic_write_bytes`).
+
+    Parameters
+    ----------
+    path : str or Path
+    text : str
+    """
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
@@ -47,13 +62,28 @@ def _clean(obj):
 
 
 def write_json(path: str | Path, data: dict) -> None:
-    """Write ``data`` as indented JSON atomically; NaN and inf become ``null``."""
+    """Write indented JSON atomically; NaN and inf become ``null``.
+
+    Parameters
+    ----------
+    path : str or Path
+    data : dict
+    """
     atomic_write_text(path, json.dumps(_clean(data), indent=2, ensure_ascii=False) + "\n")
 
 
 def text_encoding_hint(path: Path) -> str:
-    """``" (UTF-16: save it as UTF-8)"`` or ``" (a binary file?)"`` from the first bytes of ``path``; ``""`` if
-    neither applies."""
+    """A hint from a file's first bytes when it is not UTF-8 text.
+
+    Parameters
+    ----------
+    path : Path
+
+    Returns
+    -------
+    str
+        ``" (UTF-16: save it as UTF-8)"``, ``" (a binary file?)"``, or ``""`` if neither applies.
+    """
     try:
         with open(path, "rb") as fh:
             head = fh.read(4096)

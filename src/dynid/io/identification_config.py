@@ -87,7 +87,31 @@ DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
 @dataclass(frozen=True)
 class IdentificationConfig:
-    """A parsed identification config (module docstring)."""
+    """A parsed identification config (module docstring).
+
+    Attributes
+    ----------
+    path : Path
+        The config file.
+    robot : Robot
+    identification : DatasetSpec
+    validation : tuple of DatasetSpec
+    preprocessing : Preprocessing
+        As given (``None``: derived from the data).
+    references : tuple of dict
+        Reference parameter sets' tables.
+    data_root : Path
+        Folder the data files are relative to.
+    estimators : tuple of str
+        Estimator keys, the first the main estimate.
+    seed : int
+    drive_gains : tuple or None
+        ``(payload_mass [kg], unloaded DatasetSpec, loaded DatasetSpec)``.
+    robot_source : str
+        A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
+    friction : str
+        "auto": each joint's friction model by cross-validation; "description": as described.
+    """
 
     path: Path
     robot: Robot
@@ -239,7 +263,18 @@ def _drive_gains(table, root: Path, where: str, n: int):
 
 
 def stored_preprocessing(identified: dict) -> Preprocessing | None:
-    """The identification's resolved preprocessing as results.json stores it (None if absent)."""
+    """The identification's resolved preprocessing as results.json stores it.
+
+    Parameters
+    ----------
+    identified : dict
+        The results' ``identification`` section.
+
+    Returns
+    -------
+    Preprocessing or None
+        None if absent.
+    """
     stored = identified.get("settings", {}).get("preprocessing") if isinstance(identified.get("settings"), dict) else None
     if not isinstance(stored, dict):
         return None
@@ -252,7 +287,18 @@ def stored_preprocessing(identified: dict) -> Preprocessing | None:
 
 
 def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> DatasetSpec:
-    """The identification dataset's column map applied to another log ``file`` (optional ``rows``).
+    """The identification dataset's column map applied to another log.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    file : Path
+    rows : (first, last), optional
+        1-based inclusive rows.
+
+    Returns
+    -------
+    DatasetSpec
 
     Raises
     ------

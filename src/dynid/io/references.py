@@ -72,8 +72,21 @@ _TERM = re.compile(r"([+-]?)(?:(\d+\.?\d*(?:[eE][+-]?\d+)?)\*)?([A-Za-z_]\w*)")
 
 
 def parse_expression(text: str, names: tuple[str, ...], where: str) -> np.ndarray:
-    """Coefficients (n_params,) of a linear expression of standard parameters, e.g.
-    ``"Ixx2 - 1.0*Iyy2 - 0.050625*m3"``; names may use the aliases of :func:`canonical_name`.
+    """Coefficients of a linear expression of standard parameters, e.g. ``"Ixx2 - 1.0*Iyy2 - 0.050625*m3"``.
+
+    Names may use the aliases of :func:`dynid.conventions.canonical_name`.
+
+    Parameters
+    ----------
+    text : str
+    names : tuple of str
+        The standard parameters' names.
+    where : str
+        Named in errors.
+
+    Returns
+    -------
+    (n_params,) ndarray
 
     Raises
     ------
@@ -114,15 +127,29 @@ def _column(header: list[str] | None, col, path: Path, key: str) -> int:
 def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, nominal=None) -> ReferenceSet:
     """Read a reference set (module docstring) and express it as base parameters.
 
-    ``nominal`` (n_params,) gives the values of ``format = "nominal"``.
+    Parameters
+    ----------
+    table : dict
+        The ``[[references]]`` table.
+    base : Path
+        Folder its file is relative to.
+    where : str
+        The table, named in errors.
+    basep : BaseParameters
+    nominal : (n_params,) array, optional
+        The values of ``format = "nominal"``.
+
+    Returns
+    -------
+    ReferenceSet
 
     Raises
     ------
     ConfigError
         Bad config fields (names the field).
     DataError
-        Unreadable file, a value that is not a number, a standard set that lacks parameters, a base
-        set whose expressions do not determine dynid's base parameters (names file and line).
+        Unreadable file, a value that is not a number, a standard set that lacks parameters, a base set whose
+        expressions do not determine dynid's base parameters (names file and line).
     """
     if not isinstance(table, dict) or "name" not in table or ("file" not in table and table.get("format") != "nominal"):
         raise ConfigError(f"{where}: expected a table with 'name' and 'file' (or format = \"nominal\")")

@@ -43,7 +43,24 @@ def _split_header(line: str, delimiter: str) -> list[str]:
 
 
 def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
-    """0-based indices of ``columns`` given as 1-based numbers or header names."""
+    """0-based indices of columns given as 1-based numbers or header names.
+
+    Parameters
+    ----------
+    path : Path
+        The file, named in errors.
+    columns : sequence of int or str
+    header : list of str or None
+
+    Returns
+    -------
+    list of int
+
+    Raises
+    ------
+    DataError
+        A column the file does not have.
+    """
     out = []
     for c in columns:
         if isinstance(c, str):

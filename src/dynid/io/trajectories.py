@@ -14,8 +14,18 @@ from .files import atomic_write_text
 
 
 def load_trajectory(path: str | Path) -> FourierTrajectory:
-    """Read Fourier coefficients: the ``excitation.json`` of ``dynid excite`` (its ``trajectory``), or
-    a bare ``{"form", "omega_f", "q0", "a", "b"}`` object.
+    """Read Fourier coefficients.
+
+    The ``excitation.json`` of ``dynid excite`` (its ``trajectory``), or a bare ``{"form", "omega_f", "q0", "a", "b"}``
+    object.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    FourierTrajectory
 
     Raises
     ------
@@ -35,7 +45,17 @@ def load_trajectory(path: str | Path) -> FourierTrajectory:
 
 
 def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> None:
-    """Set-points for a controller: ``t [s], q1..qn [rad], dq1..dqn [rad/s], ddq1..ddqn [rad/s²]``, atomically."""
+    """Write set-points for a controller, atomically.
+
+    Columns ``t [s], q1..qn [rad], dq1..dqn [rad/s], ddq1..ddqn [rad/s²]``.
+
+    Parameters
+    ----------
+    path : str or Path
+    t : (N,) array [s]
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+    """
     n = q.shape[1]
     header = ["t [s]"] + [f"q{j + 1} [rad]" for j in range(n)] + [f"dq{j + 1} [rad/s]" for j in range(n)] + \
              [f"ddq{j + 1} [rad/s^2]" for j in range(n)]

@@ -70,7 +70,12 @@ _ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))
 
 
 def builtin_robots() -> list[str]:
-    """Names of the robots shipped with dynid."""
+    """Names of the robots shipped with dynid.
+
+    Returns
+    -------
+    list of str
+    """
     folder = resources.files("dynid.model") / "robots"
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
@@ -78,11 +83,19 @@ def builtin_robots() -> list[str]:
 def load_robot(name_or_path: str | Path) -> Robot:
     """A built-in robot by name (``"er16"``) or a robot description TOML file.
 
+    Parameters
+    ----------
+    name_or_path : str or Path
+
+    Returns
+    -------
+    Robot
+
     Raises
     ------
     ConfigError
-        Unknown robot, unreadable file, or a field with a wrong type or value (the message names the
-        file and the field).
+        Unknown robot, unreadable file, or a field with a wrong type or value (the message names the file and the
+        field).
     """
     text = str(name_or_path)
     if text in builtin_robots():
@@ -98,7 +111,23 @@ def load_robot(name_or_path: str | Path) -> Robot:
 
 
 def parse_angle(value, where: str) -> float:
-    """A number, or an angle written like ``"pi/2"``, ``"-pi"``, ``"3*pi/4"`` [rad]; ``where`` names the field in errors."""
+    """A number, or an angle written like ``"pi/2"``, ``"-pi"``, ``"3*pi/4"``.
+
+    Parameters
+    ----------
+    value : float or str
+    where : str
+        The field, named in errors.
+
+    Returns
+    -------
+    float [rad]
+
+    Raises
+    ------
+    ConfigError
+        Neither a number nor such an expression.
+    """
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value)
     if isinstance(value, str):
@@ -116,7 +145,26 @@ URDF_DRIVE_TERMS = ("Ia", "fc", "fv", "offset")
 
 
 def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
-    """Parse a robot description (see the module docstring for the layout)."""
+    """Parse a robot description (see the module docstring for the layout).
+
+    Parameters
+    ----------
+    text : str
+        TOML text.
+    source : str
+        The file, named in errors.
+    base : Path or None
+        Folder that relative paths (a URDF) are resolved against.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    ConfigError
+        A field with a wrong type or value.
+    """
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -125,8 +173,26 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
 
 
 def robot_from_urdf(path: str | Path, source: str | None = None) -> Robot:
-    """A robot given by its URDF alone: its chain, inertias and limits; drive terms :data:`URDF_DRIVE_TERMS`,
-    gravity along -z, drive gains 1 (a log of joint torques)."""
+    """A robot given by its URDF alone.
+
+    Its chain, inertias and limits; drive terms :data:`URDF_DRIVE_TERMS`, gravity along -z, drive gains 1 (a log of
+    joint torques).
+
+    Parameters
+    ----------
+    path : str or Path
+    source : str, optional
+        Named in errors (the path by default).
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    ConfigError
+        An unreadable URDF or one dynid cannot model.
+    """
     path = Path(path)
     return robot_from_document({"convention": "urdf", "urdf": str(path), "drive_terms": list(URDF_DRIVE_TERMS),
                                 "name": path.stem}, source or str(path), path.parent)

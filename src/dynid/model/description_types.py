@@ -32,17 +32,18 @@ class ToolTable(Table, kw_only=True):
 class CouplingTable(Table, kw_only=True):
     """One coupled motor: ``{motor = 6, joint = 5, ratio = 32}`` (motor 6 also turns with joint 5)."""
 
-    motor: Annotated[int, Meta(ge=1)]
-    joint: Annotated[int, Meta(ge=1)]
-    ratio: float
+    motor: Annotated[int, Meta(ge=1, description="1-based motor number (above the joints' own)")]
+    joint: Annotated[int, Meta(ge=1, description="1-based joint whose motion the motor also follows")]
+    ratio: Annotated[float, Meta(description="motor angle per joint angle of that joint")]
 
 
 class TransmissionTable(Table, kw_only=True):
     """``[transmission]``: gear ratios (motor angle = ratio · joint angle) and coupled motors."""
 
-    gear_ratios: list[float] | None = None
-    coupling: list[CouplingTable] = msgspec.field(default_factory=list)
-    coupled_terms: list[Literal["Iam", "fvm", "fcm"]] | None = None
+    gear_ratios: Annotated[list[float], Meta(description="motor angle per joint angle, one per joint")] | None = None
+    coupling: Annotated[list[CouplingTable], Meta(description="coupled motors")] = msgspec.field(default_factory=list)
+    coupled_terms: Annotated[list[Literal["Iam", "fvm", "fcm"]],
+                             Meta(description="terms of each coupled motor: rotor inertia, viscous, Coulomb")] | None = None
 
 
 class PayloadTable(Table, kw_only=True):
@@ -54,7 +55,7 @@ class PayloadTable(Table, kw_only=True):
 
 
 _JOINT_FIELDS = [
-    ("name", Union[str, None], None),
+    ("name", Union[Annotated[str, Meta(description="the joint's name in tables")], None], None),
     ("alpha", Union[Angle, None], None),
     ("a", Union[Annotated[float, Meta(description="m")], None], None),
     ("d", Union[Annotated[float, Meta(description="m")], None], None),
@@ -65,8 +66,8 @@ _JOINT_FIELDS = [
     ("ddq_max", Union[Annotated[float, Meta(description="rad/s²")], None], None),
     ("tau_max", Union[Annotated[float, Meta(description="N·m")], None], None),
     ("drive_gain", Union[Annotated[float, Meta(description="N·m/A: joint torque per measured current (eq. 16)")], None], None),
-    ("drive_terms", Union[list[str], None], None),
-    ("counterbalance", bool, False),
+    ("drive_terms", Union[Annotated[list[str], Meta(description="this joint's drive terms (default: the robot's)")], None], None),
+    ("counterbalance", Annotated[bool, Meta(description="a spring counterbalance (its terms cbs, cbc, cbsd, cbcd)")], False),
     ("position_offset", Union[Angle, None], None),
     ("mass", Union[Annotated[float, Meta(description="kg")], None], None),
     ("com", Union[Annotated[Vector3, Meta(description="m, link frame")], None], None),
@@ -76,29 +77,39 @@ _JOINT_FIELDS = [
 
 @functools.cache
 def _types(terms: tuple[str, ...]) -> tuple[type, type]:
-    joint = msgspec.defstruct("JointTable", _JOINT_FIELDS + [(t, Union[float, None], None) for t in terms], bases=(Table,),
+    joint = msgspec.defstruct("JointTable", _JOINT_FIELDS + [(t, Union[Annotated[float, Meta(description=f"{TERMS[t].unit}: nominal {TERMS[t].description}")], None], None)
+                                                for t in terms], bases=(Table,),
                               kw_only=True, module=__name__)
     joint.__doc__ = ("``[[joints]]``: one per joint, base to tip; DH values (or nothing with a URDF), limits, drive gain and "
                      "the nominal value of each drive term (a field per term of :data:`dynid.friction.TERMS`).")
     robot = msgspec.defstruct("RobotDescription", [
-        ("name", Union[str, None], None),
-        ("convention", Union[Literal["modified", "standard", "urdf"], None], None),
+        ("name", Union[Annotated[str, Meta(description="the robot's name")], None], None),
+        ("convention", Union[Annotated[Literal["modified", "standard", "urdf"],
+                                       Meta(description="DH convention of [[joints]] (Khalil's modified by default), or urdf")], None], None),
         ("urdf", Union[Annotated[str, Meta(description="with convention = 'urdf': the URDF file, relative to this file")], None], None),
         ("gravity", Annotated[Vector3, Meta(description="m/s², base frame")], msgspec.field(default_factory=lambda: [0.0, 0.0, -9.81])),
-        ("drive_terms", Union[list[str], None], None),
-        ("notes", str, ""),
-        ("tool", ToolTable, msgspec.field(default_factory=ToolTable)),
-        ("transmission", TransmissionTable, msgspec.field(default_factory=TransmissionTable)),
-        ("joints", Union[list[joint], None], None),  # type: ignore[valid-type]
-        ("payload", Union[PayloadTable, None], None),
+        ("drive_terms", Union[Annotated[list[str], Meta(description="drive/friction terms of every joint, e.g. [\"Ia\", \"fv\", \"fc\", \"off\"]")], None], None),
+        ("notes", Annotated[str, Meta(description="where the values come from")], ""),
+        ("tool", Annotated[ToolTable, Meta(description="the flange in the last link's frame")], msgspec.field(default_factory=ToolTable)),
+        ("transmission", Annotated[TransmissionTable, Meta(description="gear ratios and coupled motors")],
+         msgspec.field(default_factory=TransmissionTable)),
+        ("joints", Union[Annotated[list[joint], Meta(description="one table per joint, base to tip")], None], None),  # type: ignore[valid-type]
+        ("payload", Union[Annotated[PayloadTable, Meta(description="a load carried by the last link")], None], None),
     ], bases=(Table,), kw_only=True, module=__name__)
     robot.__doc__ = "A robot description (:mod:`dynid.model.description`)."
     return joint, robot
 
 
 def description_types() -> tuple[type, type]:
-    """``(JointTable, RobotDescription)`` for the drive terms :data:`dynid.friction.TERMS` holds now (a term added there is
-    a field of every ``[[joints]]`` table)."""
+    """The typed tables of a robot description for the drive terms :data:`dynid.friction.TERMS` holds now.
+
+    A term added there is a field of every ``[[joints]]`` table.
+
+    Returns
+    -------
+    JointTable, RobotDescription : type
+        msgspec structures.
+    """
     return _types(tuple(TERMS))
 
 

@@ -19,7 +19,18 @@ from .spatial import rot_x, rot_z
 
 
 def joints_from_modified_dh(alpha, a, d, theta_offset, names=None) -> tuple[Joint, ...]:
-    """Joints of a modified-DH table (each argument of shape (n_dof,), radians and metres)."""
+    """Joints of a modified-DH table (Khalil).
+
+    Parameters
+    ----------
+    alpha, a, d, theta_offset : (n_dof,) arrays
+        [rad], [m], [m], [rad].
+    names : sequence of str, optional
+
+    Returns
+    -------
+    tuple of Joint
+    """
     n = len(alpha)
     names = names or [f"joint{i + 1}" for i in range(n)]
     joints = []
@@ -31,12 +42,29 @@ def joints_from_modified_dh(alpha, a, d, theta_offset, names=None) -> tuple[Join
 
 
 def standard_dh_link_offset(alpha_i: float, a_i: float, d_i: float) -> tuple[np.ndarray, np.ndarray]:
-    """Pose of standard-DH frame ``i`` in dynid's frame of link ``i`` (``TransZ(d) TransX(a) RotX(alpha)``)."""
+    """Pose of standard-DH frame ``i`` in dynid's frame of link ``i`` (``TransZ(d) TransX(a) RotX(alpha)``).
+
+    Parameters
+    ----------
+    alpha_i : float [rad]
+    a_i, d_i : float [m]
+
+    Returns
+    -------
+    R : (3, 3) ndarray
+    p : (3,) ndarray [m]
+    """
     return rot_x(alpha_i), np.array([a_i, 0.0, d_i])
 
 
 def joints_from_standard_dh(alpha, a, d, theta_offset, names=None):
     """Joints and tool pose of a standard-DH table.
+
+    Parameters
+    ----------
+    alpha, a, d, theta_offset : (n_dof,) arrays
+        [rad], [m], [m], [rad].
+    names : sequence of str, optional
 
     Returns
     -------

@@ -52,11 +52,26 @@ class JointFriction:
         return f"{names[self.kind]}{v}, {rest}"
 
     def to_dict(self) -> dict:
+        """JSON-ready model.
+
+        Returns
+        -------
+        dict
+            ``kind``, ``velocity``, ``rest`` and ``label``.
+        """
         return {"kind": self.kind, "velocity": self.velocity, "rest": self.rest, "label": self.label}
 
     @classmethod
     def from_dict(cls, d: dict) -> "JointFriction":
         """Inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+
+        Returns
+        -------
+        JointFriction
 
         Raises
         ------
@@ -73,8 +88,21 @@ class JointFriction:
 
 
 def robot_with(robot: Robot, models) -> Robot:
-    """``robot`` with each joint's friction model: the description's terms, the Coulomb-like ones per model
-    (:data:`COULOMB_LIKE`), in the table's order; a joint's mask has only its model's terms."""
+    """A robot with each joint's friction model.
+
+    The description's terms, the Coulomb-like ones per model (:data:`COULOMB_LIKE`), in the table's order; a joint's
+    mask has only its model's terms.
+
+    Parameters
+    ----------
+    robot : Robot
+    models : sequence of JointFriction
+        One per joint.
+
+    Returns
+    -------
+    Robot
+    """
     base_terms = [t for t in robot.drive_terms if t not in COULOMB_LIKE]
     wanted = set(base_terms) | {"fc"}
     for m in models:
@@ -101,8 +129,21 @@ def _model_terms(kind: str, robot: Robot) -> tuple[str, ...]:
 
 
 def robot_from_settings(robot: Robot, settings: dict) -> Robot:
-    """``robot`` as a results.json's ``settings`` say it was identified: each joint's friction model
-    (``friction_models``) or, in results of older versions, the Coulomb smoothing velocities.
+    """A robot as a results.json's ``settings`` say it was identified.
+
+    Each joint's friction model (``friction_models``) or, in results of older versions, the Coulomb smoothing
+    velocities.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's description.
+    settings : dict
+        The results' ``settings``.
+
+    Returns
+    -------
+    Robot
 
     Raises
     ------

@@ -42,8 +42,19 @@ class Joint:
 
 @dataclass(frozen=True)
 class Limits:
-    """Joint limits, each of shape (n_dof,): positions [rad], |velocity| [rad/s],
-    |acceleration| [rad/s²] and |torque| [N·m]. Unknown limits are ``inf``."""
+    """Joint limits; unknown limits are ``inf``.
+
+    Attributes
+    ----------
+    q_min, q_max : (n_dof,) arrays [rad]
+        Position limits.
+    dq_max : (n_dof,) array [rad/s]
+        |velocity| limit.
+    ddq_max : (n_dof,) array [rad/s²]
+        |acceleration| limit.
+    tau_max : (n_dof,) array [N·m]
+        |torque| limit.
+    """
 
     q_min: np.ndarray
     q_max: np.ndarray
@@ -52,6 +63,17 @@ class Limits:
     tau_max: np.ndarray
 
     def subset(self, k: int) -> "Limits":
+        """The limits of the first joints.
+
+        Parameters
+        ----------
+        k : int
+            Number of joints kept.
+
+        Returns
+        -------
+        Limits
+        """
         return Limits(*(getattr(self, f)[:k].copy() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")))
 
 
@@ -120,10 +142,21 @@ class Robot:
         return Velocities(self.coulomb_velocity, self.stribeck_velocity)
 
     def require_physical_nominal(self, use: str) -> None:
-        """Raise :class:`ConfigError` naming link and rule when the nominal inertial parameters, needed
-        for ``use`` (e.g. "the simulation truth"), are those of no real mass distribution (a pseudo-inertia
-        that is not positive semidefinite). Degenerate but realisable links (a massless link, a point
-        mass, a thin rod) pass: they only have a warning in :attr:`nominal_problems`."""
+        """Refuse nominal inertial parameters that are those of no real mass distribution.
+
+        Degenerate but realisable links (a massless link, a point mass, a thin rod) pass: they only have a warning in
+        :attr:`nominal_problems`.
+
+        Parameters
+        ----------
+        use : str
+            What the nominal parameters are needed for (e.g. "the simulation truth"), named in the error.
+
+        Raises
+        ------
+        ConfigError
+            Naming the link and the rule, when a pseudo-inertia is not positive semidefinite.
+        """
         from .spatial import is_physically_consistent
 
         bad = [j for j in range(self.n_dof) if not is_physically_consistent(self.inertial[j])]
@@ -167,10 +200,12 @@ class Robot:
 
     @property
     def n_dof(self) -> int:
+        """Number of joints."""
         return len(self.joints)
 
     @property
     def n_params_per_joint(self) -> int:
+        """Standard parameters per joint: the 10 inertial ones and the drive terms."""
         return len(INERTIAL_TERMS) + len(self.drive_terms)
 
     @property
@@ -187,12 +222,28 @@ class Robot:
         return joint + self.transmission.coupled_parameter_names
 
     def standard_parameters(self) -> np.ndarray:
-        """Nominal standard parameter vector (n_params,), in :attr:`parameter_names` order."""
+        """Nominal standard parameters.
+
+        Returns
+        -------
+        (n_params,) ndarray
+            In :attr:`parameter_names` order, SI units.
+        """
         blocks = np.concatenate([self.inertial, self.drive], axis=1).ravel()
         return np.concatenate([blocks, self.transmission.coupled_values.ravel()])
 
     def with_parameters(self, phi: np.ndarray) -> "Robot":
-        """A copy of this robot whose nominal parameters are ``phi`` (n_params,)."""
+        """A copy of this robot with other nominal parameters.
+
+        Parameters
+        ----------
+        phi : (n_params,) array
+            Standard parameters in :attr:`parameter_names` order.
+
+        Returns
+        -------
+        Robot
+        """
         phi = np.asarray(phi, dtype=float)
         n_joint = self.n_dof * self.n_params_per_joint
         blocks = phi[:n_joint].reshape(self.n_dof, self.n_params_per_joint)
@@ -202,18 +253,44 @@ class Robot:
                        transmission=replace(tr, coupled_values=coupled.copy()))
 
     def link_transform(self, j: int, qj: float) -> tuple[np.ndarray, np.ndarray]:
-        """Pose (R, p) of link ``j``'s frame in link ``j-1``'s frame at joint angle ``qj``."""
+        """Pose of link ``j``'s frame in link ``j-1``'s frame (Khalil's modified DH).
+
+        Parameters
+        ----------
+        j : int
+            Link index, 0-based.
+        qj : float
+            Joint position [rad] (or [m] for a prismatic joint).
+
+        Returns
+        -------
+        R : (3, 3) ndarray
+            Rotation.
+        p : (3,) ndarray
+            Origin [m].
+        """
         from .spatial import rot_axis
 
         jt = self.joints[j]
         return jt.rotation @ rot_axis(jt.axis, np.array([qj]))[0], jt.translation.copy()
 
     def submodel(self, k: int, q_rest: np.ndarray | None = None) -> "Robot":
-        """The first ``k`` joints, the others held still at ``q_rest`` (default 0).
+        """The first ``k`` joints, the others held still.
 
-        Links ``k+1 .. n`` become rigidly attached to link ``k``: their inertial parameters are
-        expressed in link ``k``'s frame and added to it, so link ``k`` carries the wrist (the paper's
-        three-joint model, §4.1). The tool frame moves with them.
+        Links ``k+1 .. n`` become rigidly attached to link ``k``: their inertial parameters are expressed in link ``k``'s
+        frame and added to it, so link ``k`` carries the wrist (the paper's three-joint model, §4.1). The tool frame
+        moves with them.
+
+        Parameters
+        ----------
+        k : int
+            Joints kept, ``1..n_dof``.
+        q_rest : (n_dof - k,) array, optional
+            Positions of the held joints [rad] (0 by default).
+
+        Returns
+        -------
+        Robot
 
         Raises
         ------
@@ -256,7 +333,17 @@ class Robot:
 
 
 def default_limits(n: int) -> Limits:
-    """Limits that constrain nothing (``±inf``)."""
+    """Limits that constrain nothing (``±inf``).
+
+    Parameters
+    ----------
+    n : int
+        Number of joints.
+
+    Returns
+    -------
+    Limits
+    """
     inf = np.full(n, np.inf)
     return Limits(-inf, inf.copy(), inf.copy(), inf.copy(), inf.copy())
 

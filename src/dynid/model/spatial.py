@@ -6,23 +6,63 @@ import numpy as np
 
 
 def skew(v: np.ndarray) -> np.ndarray:
-    """Skew-symmetric matrix S(v) with S(v) @ w == cross(v, w); v has shape (3,)."""
+    """The skew-symmetric matrix ``S(v)`` with ``S(v) @ w == cross(v, w)``.
+
+    Parameters
+    ----------
+    v : (3,) array
+
+    Returns
+    -------
+    (3, 3) array
+    """
     x, y, z = v
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
 def rot_x(a: float) -> np.ndarray:
+    """Rotation about x.
+
+    Parameters
+    ----------
+    a : float [rad]
+
+    Returns
+    -------
+    (3, 3) array
+    """
     c, s = np.cos(a), np.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 def rot_z(a: float) -> np.ndarray:
+    """Rotation about z.
+
+    Parameters
+    ----------
+    a : float [rad]
+
+    Returns
+    -------
+    (3, 3) array
+    """
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def rot_axis(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Batched Rodrigues rotation about a fixed unit ``axis`` (3,) by ``angle`` (N,) -> (N, 3, 3)."""
+    """Batched Rodrigues rotations about a fixed unit axis.
+
+    Parameters
+    ----------
+    axis : (3,) array
+        Unit axis.
+    angle : (N,) array [rad]
+
+    Returns
+    -------
+    (N, 3, 3) array
+    """
     angle = np.asarray(angle, dtype=float)
     c, s = np.cos(angle), np.sin(angle)
     k = skew(axis)
@@ -31,13 +71,33 @@ def rot_axis(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
 
 def inertia_matrix(p: np.ndarray) -> np.ndarray:
-    """3x3 inertia matrix from (XX, XY, XZ, YY, YZ, ZZ)."""
+    """The 3×3 inertia matrix of six inertia parameters.
+
+    Parameters
+    ----------
+    p : (6,) array [kg·m²]
+        XX, XY, XZ, YY, YZ, ZZ (eq. 5 order).
+
+    Returns
+    -------
+    (3, 3) array
+    """
     xx, xy, xz, yy, yz, zz = p
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
 
 def inertia_vector(m: np.ndarray) -> np.ndarray:
-    """(XX, XY, XZ, YY, YZ, ZZ) from a 3x3 inertia matrix."""
+    """The six inertia parameters of a 3×3 inertia matrix (inverse of :func:`inertia_matrix`).
+
+    Parameters
+    ----------
+    m : (3, 3) array [kg·m²]
+
+    Returns
+    -------
+    (6,) array
+        XX, XY, XZ, YY, YZ, ZZ.
+    """
     return np.array([m[0, 0], m[0, 1], m[0, 2], m[1, 1], m[1, 2], m[2, 2]])
 
 
@@ -64,11 +124,22 @@ def inertial_from_physical(mass: float, com: np.ndarray, inertia_com: np.ndarray
 
 
 def transform_inertial(phi: np.ndarray, rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    """Express a body's ten inertial parameters in another frame A.
+    """A body's ten inertial parameters expressed in another frame A:
+    ``I_A = R I_B Rᵀ - m S(p)S(p) - S(p)S(c) - S(c)S(p)`` with ``c = R·MS_B``, ``MS_A = c + m p``.
 
-    ``phi`` is given in frame B; ``rotation`` and ``translation`` are ``A_R_B`` and the origin of B
-    in A. Returns the parameters about the origin of A, in A's axes:
-    ``I_A = R I_B R^T - m S(p)S(p) - S(p)S(c) - S(c)S(p)`` with ``c = R·MS_B``, ``MS_A = c + m p``.
+    Parameters
+    ----------
+    phi : (10,) array
+        Given in frame B (eq. 5 order, about B's origin).
+    rotation : (3, 3) array
+        ``A_R_B``.
+    translation : (3,) array [m]
+        The origin of B in A.
+
+    Returns
+    -------
+    (10,) array
+        About the origin of A, in A's axes.
     """
     r = np.asarray(rotation, dtype=float)
     p = np.asarray(translation, dtype=float)
@@ -80,8 +151,18 @@ def transform_inertial(phi: np.ndarray, rotation: np.ndarray, translation: np.nd
 
 
 def pseudo_inertia(phi: np.ndarray) -> np.ndarray:
-    """4×4 pseudo-inertia ``[[½ tr(I)·1 - I, h], [hᵀ, m]]`` of ten inertial parameters (eq. 5 order);
-    positive semidefinite exactly for a real mass distribution (Wensing, Kim & Slotine, IEEE RA-L 3(1), 2018)."""
+    """The 4×4 pseudo-inertia ``[[½ tr(I)·1 - I, h], [hᵀ, m]]`` of ten inertial parameters; positive semidefinite
+    exactly for a real mass distribution (Wensing, Kim & Slotine, IEEE RA-L 3(1), 2018).
+
+    Parameters
+    ----------
+    phi : (10,) array
+        Eq. 5 order, about the link origin.
+
+    Returns
+    -------
+    (4, 4) array
+    """
     inertia = inertia_matrix(phi[:6])
     sigma = 0.5 * np.trace(inertia) * np.eye(3) - inertia
     h = np.asarray(phi[6:9], dtype=float)
@@ -89,14 +170,39 @@ def pseudo_inertia(phi: np.ndarray) -> np.ndarray:
 
 
 def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
-    """True when the pseudo-inertia matrix of ``phi`` is positive semidefinite (Wensing et al. 2017)."""
+    """Whether ten inertial parameters are those of a real mass distribution: their pseudo-inertia is positive
+    semidefinite (Wensing, Kim & Slotine, IEEE RA-L 3(1), 2018).
+
+    Parameters
+    ----------
+    phi : (10,) array
+        XX..ZZ [kg·m²], MX, MY, MZ [kg·m], M [kg] about the link origin (eq. 5).
+    tol : float
+        Tolerance on the smallest eigenvalue.
+
+    Returns
+    -------
+    bool
+    """
     return bool(np.linalg.eigvalsh(pseudo_inertia(phi)).min() >= -tol * max(1.0, abs(phi[9])))
 
 
 def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass [kg], centre of mass [m] and inertia about the centre of mass [kg·m²] (3×3, link frame axes)
-    of ten inertial parameters (eq. 5 order, about the link origin); the inverse of
+    """Mass, centre of mass and inertia about the centre of mass of ten inertial parameters; the inverse of
     :func:`inertial_from_physical`. A massless link gives a zero centre of mass.
+
+    Parameters
+    ----------
+    phi : (10,) array
+        Eq. 5 order, about the link origin.
+
+    Returns
+    -------
+    mass : float [kg]
+    com : (3,) array [m]
+        In the link frame.
+    inertia : (3, 3) array [kg·m²]
+        About the centre of mass, link frame axes.
     """
     phi = np.asarray(phi, dtype=float)
     mass = float(phi[9])
@@ -106,12 +212,22 @@ def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarr
 
 
 def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
-    """The physical-consistency rules that ten inertial parameters (eq. 5 order, about the link origin)
-    break: positive mass, inertia about the centre of mass positive definite, and its principal moments
-    meeting the triangle inequality (each at most the sum of the other two). Empty when none.
+    """The physical-consistency rules that ten inertial parameters break: positive mass, inertia about the centre
+    of mass positive definite, and its principal moments meeting the triangle inequality (each at most the sum of the
+    other two). A zero mass with zero first moments and inertia (a massless link lumped into its neighbour) breaks the
+    first rule but no other.
 
-    A zero mass with zero first moments and inertia (a massless link lumped into its neighbour) breaks
-    the first rule but no other.
+    Parameters
+    ----------
+    phi : (10,) array
+        Eq. 5 order, about the link origin.
+    tol : float
+        Relative tolerance.
+
+    Returns
+    -------
+    list of str
+        One line per rule broken; empty when none.
     """
     phi = np.asarray(phi, dtype=float)
     mass = float(phi[9])

@@ -75,16 +75,39 @@ class Transmission:
 
     @staticmethod
     def coupled_motors_of(r: np.ndarray) -> tuple[int, ...]:
+        """The motors that also turn with other joints (a coupled wrist).
+
+        Parameters
+        ----------
+        r : (n, n) array
+            Motor-from-joint matrix.
+
+        Returns
+        -------
+        tuple of int
+            0-based motor indices.
+        """
         off = np.asarray(r) - np.diag(np.diag(r))
         return tuple(int(k) for k in np.flatnonzero(np.any(off != 0, axis=1)))
 
     @classmethod
     def identity(cls, n: int) -> "Transmission":
-        """Direct drive on the joint side: ``R = I``, no offsets, no coupling."""
+        """Direct drive on the joint side: ``R = I``, no offsets, no coupling.
+
+        Parameters
+        ----------
+        n : int
+            Joints.
+
+        Returns
+        -------
+        Transmission
+        """
         return cls(np.eye(n), np.zeros(n))
 
     @property
     def n_dof(self) -> int:
+        """Joints (and motors)."""
         return self.motor_from_joint.shape[0]
 
     @property
@@ -94,6 +117,7 @@ class Transmission:
 
     @property
     def n_coupled_params(self) -> int:
+        """Parameters of the coupled motors (coupled motors × coupled terms)."""
         return len(self.coupled_motors) * len(self.coupled_terms)
 
     @property
@@ -102,12 +126,31 @@ class Transmission:
         return tuple(f"{t}{k + 1}" for k in self.coupled_motors for t in self.coupled_terms)
 
     def ratios(self, k: int) -> np.ndarray:
-        """``c = R[k] / R[k, k]`` for motor ``k`` (n,)."""
+        """The ratios ``c = R[k] / R[k, k]`` of motor ``k``.
+
+        Parameters
+        ----------
+        k : int
+            0-based motor.
+
+        Returns
+        -------
+        (n,) array
+        """
         r = self.motor_from_joint
         return r[k] / r[k, k]
 
     def coupling_columns(self, dq: np.ndarray, ddq: np.ndarray) -> np.ndarray:
-        """Regressor columns of the coupling parameters, (N, n_dof, n_coupled_params) (module docstring)."""
+        """Regressor columns of the coupling parameters (module docstring).
+
+        Parameters
+        ----------
+        dq, ddq : (N, n_dof) arrays [rad/s, rad/s²]
+
+        Returns
+        -------
+        (N, n_dof, n_coupled_params) array
+        """
         n_s = dq.shape[0]
         out = np.zeros((n_s, self.n_dof, self.n_coupled_params))
         col = 0
@@ -125,19 +168,60 @@ class Transmission:
         return out
 
     def joint_positions(self, theta_m: np.ndarray) -> np.ndarray:
-        """Model joint angles (N, n) from motor angles (N, n) [rad]: ``R⁻¹ theta_m + offset``."""
+        """Model joint angles from motor angles: ``R⁻¹ theta_m + offset``.
+
+        Parameters
+        ----------
+        theta_m : (N, n) array [rad]
+
+        Returns
+        -------
+        (N, n) array [rad]
+        """
         return np.linalg.solve(self.motor_from_joint, np.asarray(theta_m, dtype=float).T).T + self.position_offset
 
     def joint_velocities(self, dtheta_m: np.ndarray) -> np.ndarray:
-        """Joint velocities (or accelerations) from motor ones (N, n): ``R⁻¹ dtheta_m``."""
+        """Joint velocities (or accelerations) from motor ones: ``R⁻¹ dtheta_m``.
+
+        Parameters
+        ----------
+        dtheta_m : (N, n) array [rad/s or rad/s²]
+
+        Returns
+        -------
+        (N, n) array
+        """
         return np.linalg.solve(self.motor_from_joint, np.asarray(dtheta_m, dtype=float).T).T
 
     def joint_torques(self, tau_m: np.ndarray) -> np.ndarray:
-        """Joint torques (N, n) from motor torques (N, n) [N·m]: ``tau = Rᵀ tau_m``."""
+        """Joint torques from motor torques: ``tau = Rᵀ tau_m``.
+
+        Parameters
+        ----------
+        tau_m : (N, n) array [N·m]
+
+        Returns
+        -------
+        (N, n) array [N·m]
+        """
         return np.asarray(tau_m, dtype=float) @ self.motor_from_joint
 
     def subset(self, k: int) -> "Transmission":
-        """The first ``k`` joints; raises ConfigError if a coupling links them to the others."""
+        """The transmission of the first ``k`` joints.
+
+        Parameters
+        ----------
+        k : int
+
+        Returns
+        -------
+        Transmission
+
+        Raises
+        ------
+        ConfigError
+            A coupling links them to the others.
+        """
         r = self.motor_from_joint
         if np.any(r[:k, k:] != 0) or np.any(r[k:, :k] != 0):
             raise ConfigError(f"transmission couples joints 1-{k} with joints beyond {k}: cannot hold the latter still")

@@ -18,8 +18,13 @@ URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", 
 
 
 def check_urdf_text(path: Path) -> None:
-    """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one: malformed
-    XML and joints of unknown type.
+    """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
+
+    Malformed XML and joints of unknown type.
+
+    Parameters
+    ----------
+    path : Path
 
     Raises
     ------
@@ -65,13 +70,31 @@ def inertial_from_pinocchio(inertia) -> np.ndarray:
     """dynid's ten inertial parameters (eq. 5 order) from a ``pinocchio.Inertia``.
 
     Pinocchio orders them ``[m, mc_x, mc_y, mc_z, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``.
+
+    Parameters
+    ----------
+    inertia : pinocchio.Inertia
+
+    Returns
+    -------
+    (10,) ndarray
     """
     p = np.asarray(inertia.toDynamicParameters()).ravel()
     return np.array([p[4], p[5], p[7], p[6], p[8], p[9], p[1], p[2], p[3], p[0]])
 
 
 def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
-    """Pinocchio's dynamic-parameter order from dynid's ten inertial parameters."""
+    """Pinocchio's dynamic-parameter order from dynid's ten inertial parameters.
+
+    Parameters
+    ----------
+    phi : (10,) array
+        eq. 5 order.
+
+    Returns
+    -------
+    (10,) ndarray
+    """
     xx, xy, xz, yy, yz, zz, mx, my, mz, m = phi
     return np.array([m, mx, my, mz, xx, xy, yy, xz, yz, zz])
 
@@ -79,8 +102,12 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
 def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...]]:
     """Joints and link inertial parameters of a URDF serial chain of revolute joints.
 
-    Fixed joints are merged by Pinocchio into the parent link. Continuous joints (unbounded revolute) are
-    revolute joints without position limits: dynid's joint angle is their angle.
+    Fixed joints are merged by Pinocchio into the parent link. Continuous joints (unbounded revolute) are revolute
+    joints without position limits: dynid's joint angle is their angle.
+
+    Parameters
+    ----------
+    path : str or Path
 
     Returns
     -------
@@ -134,8 +161,18 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
 
 
 def urdf_limits(path: str | Path) -> dict:
-    """Each revolute joint's limits in a URDF (Pinocchio's reading): ``q_min, q_max`` [rad], ``dq_max`` [rad/s],
-    ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none); a limit the URDF leaves out (or 0) is ``±inf``."""
+    """Each revolute joint's limits in a URDF (Pinocchio's reading).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    dict
+        ``q_min, q_max`` [rad], ``dq_max`` [rad/s], ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none), each
+        (n_dof,); a limit the URDF leaves out (or 0) is ``±inf``.
+    """
     import pinocchio as pin
 
     with _silenced_stderr([]):

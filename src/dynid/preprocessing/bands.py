@@ -54,7 +54,19 @@ NYQUIST_CAP = 0.8
 
 
 def decimation_cutoff(rate: float, factor: int) -> float:
-    """Cutoff of the anti-aliasing filter of a decimation by ``factor``: 0.8 × the new Nyquist [Hz]."""
+    """Cutoff of the anti-aliasing filter of a decimation: 0.8 × the new Nyquist frequency.
+
+    Parameters
+    ----------
+    rate : float [Hz]
+        Sampling rate before decimating.
+    factor : int
+        Decimation factor.
+
+    Returns
+    -------
+    float [Hz]
+    """
     return 0.8 * rate / (2 * factor)
 
 
@@ -82,6 +94,9 @@ class BandEstimate:
     rate : float [Hz]
     motion_found : bool
         False when no bin rose above the noise floor (the band is then the plain 99 % rule's).
+    knee : float or None [Hz]
+        Median over the joints of the first frequency above the band where the positions' spectrum falls to twice
+        the noise floor (where the noise takes over).
     """
 
     band: float
@@ -94,7 +109,17 @@ class BandEstimate:
     positions, velocities and accelerations alike; below it, the motion does."""
 
     def warnings(self, name: str) -> tuple[str, ...]:
-        """One line per implausible finding, naming the dataset ``name`` and the setting that fixes it."""
+        """One line per implausible finding, naming the dataset and the setting that fixes it.
+
+        Parameters
+        ----------
+        name : str
+            The dataset.
+
+        Returns
+        -------
+        tuple of str
+        """
         nyquist = self.rate / 2
         out = []
         if not self.motion_found:
@@ -238,7 +263,20 @@ def white_noise_std(x, rate: float) -> np.ndarray:
 
 
 def excitation_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION) -> float:
-    """The excitation band [Hz] of :func:`estimate_band`."""
+    """The excitation band of :func:`estimate_band`.
+
+    Parameters
+    ----------
+    q : (N, n_dof) array [rad]
+        Positions on a uniform grid.
+    rate : float [Hz]
+    fraction : float
+        Share of the motion's velocity energy below the band.
+
+    Returns
+    -------
+    float [Hz]
+    """
     return estimate_band(q, rate, fraction).band
 
 
@@ -260,16 +298,49 @@ class DerivedCutoffs:
 
 
 def decimation_for(rate: float, cutoff: float) -> int:
-    """The largest decimation whose anti-aliasing cutoff (:func:`decimation_cutoff`) is at or above ``cutoff``."""
+    """The largest decimation whose anti-aliasing cutoff (:func:`decimation_cutoff`) is at or above a cutoff.
+
+    Parameters
+    ----------
+    rate : float [Hz]
+    cutoff : float [Hz]
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
     return max(1, int(np.floor(0.8 * rate / (2 * cutoff))))
 
 
 def capped(cutoff: float, rate: float) -> float:
-    """``cutoff`` [Hz], at most :data:`NYQUIST_CAP` × the Nyquist frequency of ``rate``."""
+    """A cutoff at most :data:`NYQUIST_CAP` × the Nyquist frequency of a rate.
+
+    Parameters
+    ----------
+    cutoff : float [Hz]
+    rate : float [Hz]
+
+    Returns
+    -------
+    float [Hz]
+    """
     return min(cutoff, NYQUIST_CAP * rate / 2)
 
 
 def cutoffs_from_band(band: float, rate: float) -> DerivedCutoffs:
-    """The rules of the module docstring for a band ``band`` [Hz] at sampling rate ``rate`` [Hz]."""
+    """The cutoffs and decimation the module's rules derive from an excitation band.
+
+    Parameters
+    ----------
+    band : float [Hz]
+        Excitation band.
+    rate : float [Hz]
+        Sampling rate.
+
+    Returns
+    -------
+    DerivedCutoffs
+    """
     f_p = capped(PARALLEL_FACTOR * band, rate)
     return DerivedCutoffs(float(band), float(capped(POSITION_FACTOR * band, rate)), float(f_p), decimation_for(rate, f_p))

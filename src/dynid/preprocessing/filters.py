@@ -35,6 +35,11 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
         -3 dB frequency of the single pass [Hz] (the forward-backward pass squares the gain).
     order : int
 
+    Returns
+    -------
+    (N, ...) array or StoredColumns
+        The filtered samples.
+
     Raises
     ------
     ConfigError
@@ -46,8 +51,19 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
-    """Time derivative by central differences (one-sided at the ends), (N, ...) (or StoredColumns), one
-    column at a time."""
+    """Time derivative by central differences (one-sided at the ends), one column at a time.
+
+    Parameters
+    ----------
+    x : (N, ...) array or StoredColumns
+    rate : float
+        Sampling rate [Hz].
+
+    Returns
+    -------
+    (N, ...) array or StoredColumns
+        In the unit of ``x`` per second.
+    """
     return by_column(x, lambda column, j: np.gradient(column, 1.0 / rate))
 
 
@@ -56,9 +72,23 @@ GAUSS_CUTOFF = np.sqrt(np.log(2) / 2) / np.pi
 
 
 def gaussian_smooth(x, rate: float, cutoff: float):
-    """Gaussian smoothing along time with its half-power frequency at ``cutoff`` [Hz] (0: none), column by column
-    (stored columns stay stored). Unlike a Butterworth filter its step response does not overshoot, so a velocity
-    smoothed by it never changes sign where the joint stops abruptly."""
+    """Gaussian smoothing along time, column by column (stored columns stay stored).
+
+    Unlike a Butterworth filter its step response does not overshoot, so a velocity smoothed by it never changes sign
+    where the joint stops abruptly.
+
+    Parameters
+    ----------
+    x : (N, ...) array or StoredColumns
+    rate : float
+        Sampling rate [Hz].
+    cutoff : float
+        Half-power frequency [Hz]; 0: no smoothing.
+
+    Returns
+    -------
+    (N, ...) array or StoredColumns
+    """
     from scipy.ndimage import gaussian_filter1d
 
     if not 0 < cutoff < rate / 2:

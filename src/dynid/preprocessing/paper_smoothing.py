@@ -70,8 +70,26 @@ class PaperSmoothing(Strategy):
                             tuple(recording.warnings))
 
     def chunks(self, robot, base, data, progress=None, standard=False):
-        """One block: the whole log, its regressor (the plain sign of the velocity in the Coulomb column) and torques
-        smoothed alike by eq. 17; every row kept (see :meth:`Strategy.chunks`)."""
+        """One block: the whole log, its regressor and torques smoothed alike by eq. 17; every row kept.
+
+        The Coulomb column uses the plain sign of the velocity (see :meth:`Strategy.chunks`).
+
+        Parameters
+        ----------
+        robot : Robot
+        base : BaseParameters
+        data : PreparedData
+            From :meth:`prepare`.
+        progress : callable, optional
+            ``progress(done, total)`` in samples.
+        standard : bool
+            Give the standard regressor instead of the base one.
+
+        Yields
+        ------
+        tuple
+            ``(index, y, tau, keep)`` as :meth:`Strategy.chunks`.
+        """
         passes = data.settings.smoothing_passes
         y = five_point_cubic_smoothing(regressor(robot, data.q, data.dq, data.ddq, None if standard else base.independent), passes)
         tau = five_point_cubic_smoothing(data.tau, passes)

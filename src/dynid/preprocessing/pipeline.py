@@ -40,8 +40,30 @@ Samples = Any
 
 @dataclass(frozen=True)
 class PreparedData:
-    """Filtered joint signals on a uniform grid, ready for the regressor (N, n_dof) each: arrays, or for a
-    spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array)."""
+    """Filtered joint signals on a uniform grid, ready for the regressor.
+
+    Signals are arrays, or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
+
+    Attributes
+    ----------
+    name : str
+        The dataset.
+    t : (N,) array [s]
+    q, dq, ddq : (N, n_dof) samples [rad, rad/s, rad/s²]
+    tau : (N, n_dof) samples [N·m]
+        Joint torques (drive gains applied).
+    rate : float [Hz]
+        Rate of the grid (after decimation).
+    settings : Preprocessing
+        Resolved settings.
+    warnings : tuple of str
+    direction : (N, n_dof) array or None
+        Direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`).
+    motion : (N, n_dof) array or None
+        The velocity [rad/s] that says where a joint moves (no overshoot where it stops).
+    resting : (N, n_dof) bool array or None
+        Where each joint rests (:func:`dynid.friction.moving_joints`).
+    """
 
     name: str
     t: np.ndarray
@@ -60,8 +82,21 @@ class PreparedData:
     """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
 
     def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
-        """The same samples with another rest model and presliding distance (per joint): the direction of motion
-        computed anew, the settings saying so."""
+        """The same samples with another rest model and presliding distance.
+
+        The direction of motion is computed anew, the settings say so.
+
+        Parameters
+        ----------
+        rest_friction : str, float or tuple
+            "held", "zero", a relaxation time [s], or one per joint.
+        presliding : float or tuple
+            Presliding distance [rad], or one per joint.
+
+        Returns
+        -------
+        PreparedData
+        """
         s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
         return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
 
@@ -108,12 +143,11 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
     standard : bool
         Yield the standard regressor instead of the base one.
 
-    Yields
-    ------
-    index : (M,) int array
-    y : (M, n_dof, n_base) or (M, n_dof, n_params) array
-    tau : (M, n_dof) array [N·m]
-    keep : (M, n_dof) bool array
+    Returns
+    -------
+    iterator of tuple
+        ``(index, y, tau, keep)`` blocks: sample indices (M,), regressor (M, n_dof, n_base) (n_params with
+        ``standard``), torques (M, n_dof) [N·m], rows used by the estimation (M, n_dof) bool.
     """
     return strategy_for(data.settings).chunks(robot, base, data, progress, standard)
 
@@ -151,8 +185,26 @@ class ParallelFiltering(Strategy):
         return _parallel_prepare(recording, settings, strict)
 
     def chunks(self, robot, base, data, progress=None, standard=False):
-        """Parallel-filtered, decimated base (or standard) regressor and torques, chunk by chunk; rows of joints slower
-        than ``min_speed`` not kept (see :meth:`Strategy.chunks`)."""
+        """Parallel-filtered, decimated regressor and torques, chunk by chunk.
+
+        Rows of joints slower than ``min_speed`` are not kept (see :meth:`Strategy.chunks`).
+
+        Parameters
+        ----------
+        robot : Robot
+        base : BaseParameters
+        data : PreparedData
+            From :meth:`prepare`.
+        progress : callable, optional
+            ``progress(done, total)`` in samples.
+        standard : bool
+            Give the standard regressor instead of the base one.
+
+        Returns
+        -------
+        iterator of tuple
+            ``(index, y, tau, keep)`` as :meth:`Strategy.chunks`.
+        """
         return _parallel_chunks(robot, base, data, progress, standard)
 
 
@@ -248,8 +300,25 @@ def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
 
 
 def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
-    """Each joint's direction of motion (:func:`dynid.friction.held_direction`, velocities ``dq`` and ``guide``) with
-    the log's rest velocities, rest model and presliding distances, column by column (stored columns stay stored)."""
+    """Each joint's direction of motion, column by column (stored columns stay stored).
+
+    :func:`dynid.friction.held_direction` with the log's rest velocities, rest model and presliding distances.
+
+    Parameters
+    ----------
+    dq : (N, n_dof) samples [rad/s]
+        Velocities.
+    guide : (N, n_dof) samples [rad/s]
+        Velocity that says where a joint moves.
+    s : Preprocessing
+        Resolved settings.
+    rate : float [Hz]
+
+    Returns
+    -------
+    (N, n_dof) array or StoredColumns
+        In [-1, 1].
+    """
     n = dq.shape[1]
     guide = dq if guide is None else guide
     rest = _per_joint(0.0 if s.rest_velocity == "auto" else s.rest_velocity, n, "rest_velocity").astype(float)
@@ -273,7 +342,20 @@ def _rest_words(value) -> str:
 
 
 def rest_decay(value, n: int) -> np.ndarray:
-    """``rest_friction`` ("held", "zero", seconds, or one per joint) as relaxation times [s] (inf: held)."""
+    """``rest_friction`` as relaxation times.
+
+    Parameters
+    ----------
+    value : str, float or tuple
+        "held", "zero", seconds, or one per joint.
+    n : int
+        Number of joints.
+
+    Returns
+    -------
+    (n,) ndarray [s]
+        inf: held; 0: zero.
+    """
     v = _per_joint(value, n, "rest_friction")
     try:
         return np.array([np.inf if x == "held" else 0.0 if x == "zero" else float(x) for x in v.tolist()])
@@ -283,7 +365,17 @@ def rest_decay(value, n: int) -> np.ndarray:
 
 
 def rest_velocities(data: PreparedData, robot: Robot) -> Velocities:
-    """The friction columns' velocities for this log: the robot's, with the log's rest velocity and direction."""
+    """The friction columns' velocities for a log: the robot's, with the log's rest velocity and direction.
+
+    Parameters
+    ----------
+    data : PreparedData
+    robot : Robot
+
+    Returns
+    -------
+    Velocities
+    """
     v = robot.friction_velocities
     rest = data.settings.rest_velocity
     return Velocities(v.coulomb, v.stribeck, np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float),

@@ -91,6 +91,8 @@ class Preprocessing:
     noise_share : float or None
         Filled by :meth:`resolved` when the band comes from the positions: the share of their velocity-weighted
         spectral energy that is broadband noise (:class:`dynid.preprocessing.bands.BandEstimate`).
+    knee : float or None [Hz]
+        Filled by :meth:`resolved` like ``noise_share``: where the positions' spectrum meets the noise floor.
     warnings : tuple of str
         Filled by :meth:`resolved`: an implausible band, a capped cutoff (one line each, naming the dataset).
     """
@@ -139,6 +141,11 @@ class Preprocessing:
         strict : bool
             Refuse a given cutoff at or above this log's Nyquist frequency (the config's own log: a mistake) rather
             than lowering it (settings carried over to a log of another rate).
+
+        Returns
+        -------
+        Preprocessing
+            No ``None`` left; :attr:`derivation` says what was derived and why.
 
         Raises
         ------
@@ -225,19 +232,39 @@ class Preprocessing:
                        noise_share=share, knee=knee, warnings=tuple(dict.fromkeys(warnings)))
 
     def to_dict(self) -> dict:
-        """The settings as results.json stores them (``warnings`` go to the result's own warnings)."""
+        """The settings as results.json stores them (``warnings`` go to the result's own warnings).
+
+        Returns
+        -------
+        dict
+            field -> value (tuples as lists).
+        """
         return {f.name: (list(getattr(self, f.name)) if isinstance(getattr(self, f.name), tuple) else getattr(self, f.name))
                 for f in fields(self) if f.name != "warnings"}
 
 
 def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
-    """Settings of a log scored with another log's parameters (a validation log): the config's settings as given (cutoffs
-    in Hz stay what the user wrote), the rest derived for this log: its band, at least the identification log's (so a
-    faster validation motion is filtered for its own band, never below the identification's), its decimation and trim
-    (its rate and length may differ; a decimation the config gives is the identification log's), its rest velocity
-    (at least the identification's); the identification's friction state at rest; no Fourier fit (the excitation's
-    harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a cutoff above this log's Nyquist
-    frequency is lowered, with a warning."""
+    """Settings of a log scored with another log's parameters (a validation log).
+
+    The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,
+    at least the identification log's (so a faster validation motion is filtered for its own band, never below the
+    identification's), its decimation and trim (its rate and length may differ; a decimation the config gives is the
+    identification log's), its rest velocity (at least the identification's); the identification's friction state at
+    rest; no Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
+    cutoff above this log's Nyquist frequency is lowered, with a warning.
+
+    Parameters
+    ----------
+    resolved : Preprocessing or None
+        The identification log's resolved settings (None: nothing to carry over).
+    given : Preprocessing
+        The config's settings as written.
+
+    Returns
+    -------
+    Preprocessing
+        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the other log.
+    """
     from .strategies import strategy_for
 
     if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log

@@ -22,6 +22,11 @@ def five_point_cubic_smoothing(y: np.ndarray, passes: int = 1) -> np.ndarray:
     passes : int >= 0
         The paper notes that more passes smooth more but bias the identification.
 
+    Returns
+    -------
+    ndarray
+        Same shape as ``y``.
+
     Raises
     ------
     ConfigError

@@ -138,7 +138,17 @@ def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
 
 
 def unregister_strategy(name: str) -> None:
-    """Forget the strategy ``name`` (a ``KeyError`` if unknown)."""
+    """Forget a registered strategy.
+
+    Parameters
+    ----------
+    name : str
+
+    Raises
+    ------
+    KeyError
+        An unknown name.
+    """
     del _STRATEGIES[str(name).strip().lower()]
 
 
@@ -151,23 +161,53 @@ BUILT_IN = tuple(_STRATEGIES)
 
 
 def registered_by_user(names) -> dict:
-    """name -> registered target of those of ``names`` that are not built in (for another process to register)."""
+    """The user's strategies among some names, for another process to register.
+
+    Parameters
+    ----------
+    names : iterable of str
+
+    Returns
+    -------
+    dict
+        name -> registered target of those of ``names`` that are not built in.
+    """
     return {check_strategy(n): _STRATEGIES[check_strategy(n)] for n in names if check_strategy(n) not in BUILT_IN}
 
 
 def ensure_registered(targets: dict) -> None:
-    """Register the strategies of ``targets`` (name -> target) that this process does not know."""
+    """Register the strategies that this process does not know (in a worker process).
+
+    Parameters
+    ----------
+    targets : dict
+        name -> registered target, from :func:`registered_by_user`.
+    """
     for name, target in targets.items():
         _STRATEGIES.setdefault(name, target)
 
 
 def strategy_names() -> tuple[str, ...]:
-    """Every registered strategy, the built-in ones first."""
+    """Every registered strategy, the built-in ones first.
+
+    Returns
+    -------
+    tuple of str
+    """
     return tuple(_STRATEGIES)
 
 
 def check_strategy(name: str) -> str:
-    """``name`` in lower case if registered.
+    """A strategy's name, checked.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    str
+        ``name`` in lower case.
 
     Raises
     ------
@@ -182,7 +222,15 @@ def check_strategy(name: str) -> str:
 
 
 def strategy_for(settings: "Preprocessing | str") -> Strategy:
-    """The strategy instance that ``settings.strategy`` (or a name) names.
+    """The strategy instance that settings (or a name) name.
+
+    Parameters
+    ----------
+    settings : Preprocessing or str
+
+    Returns
+    -------
+    Strategy
 
     Raises
     ------

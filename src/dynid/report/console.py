@@ -26,7 +26,17 @@ DEFAULT_WIDTH = 100
 
 
 def make_console(stderr: bool = False) -> Console:
-    """A console of the terminal's width, or, for pipes and logs, of ``COLUMNS`` (else 100 columns)."""
+    """A console of the terminal's width, or, for pipes and logs, of ``COLUMNS`` (else 100 columns).
+
+    Parameters
+    ----------
+    stderr : bool
+        Write to standard error.
+
+    Returns
+    -------
+    rich.console.Console
+    """
     c = Console(stderr=stderr)
     if c.is_terminal:
         return c
@@ -35,7 +45,19 @@ def make_console(stderr: bool = False) -> Console:
 
 
 def rich_tables(table: TextTable, width: int) -> list[Table]:
-    """``table`` as rich tables no wider than ``width`` (split into parts repeating the label columns)."""
+    """A text table as rich tables no wider than a width.
+
+    Parameters
+    ----------
+    table : TextTable
+    width : int
+        Columns available.
+
+    Returns
+    -------
+    list of rich.table.Table
+        Parts repeating the label columns.
+    """
     out = []
     for part in table.split(width):
         t = Table(title=escape(part.title), box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
@@ -48,8 +70,17 @@ def rich_tables(table: TextTable, width: int) -> list[Table]:
 
 
 class Reporter:
-    """What a command prints: summaries and the "wrote" line on standard output, warnings and progress on
-    standard error; ``quiet`` keeps only warnings and errors."""
+    """What a command prints.
+
+    Summaries and the "wrote" line on standard output, warnings and progress on standard error.
+
+    Parameters
+    ----------
+    quiet : bool
+        Keep only warnings and errors.
+    out, err : rich.console.Console, optional
+        Consoles of standard output and error (made by :func:`make_console` by default).
+    """
 
     def __init__(self, quiet: bool = False, out: Console | None = None, err: Console | None = None):
         self.quiet = quiet
@@ -57,17 +88,43 @@ class Reporter:
         self.err = err or make_console(stderr=True)
 
     def warning(self, text: str) -> None:
+        """Print a warning on standard error.
+
+        Parameters
+        ----------
+        text : str
+            One line.
+        """
         self.err.print(f"[yellow]warning:[/] {escape(text)}", highlight=False, soft_wrap=True)
 
     def error(self, text: str) -> None:
+        """Print an error on standard error.
+
+        Parameters
+        ----------
+        text : str
+            One line.
+        """
         self.err.print(f"[bold red]error:[/] {escape(text)}", highlight=False, soft_wrap=True)
 
     def line(self, text: str) -> None:
+        """Print a line on standard output (unless quiet).
+
+        Parameters
+        ----------
+        text : str
+        """
         if not self.quiet:
             self.out.print(text, markup=False, highlight=False)
 
     def blocks(self, blocks) -> None:
-        """Print a summary: tables split to the console's width, titles in bold, warnings on standard error."""
+        """Print a summary: tables split to the console's width, titles in bold, warnings on standard error.
+
+        Parameters
+        ----------
+        blocks : iterable of Block
+            What :mod:`dynid.report.summaries` builds.
+        """
         for b in blocks:
             if isinstance(b, Line) and b.kind == "warning":
                 self.warning(b.text)
@@ -82,23 +139,62 @@ class Reporter:
                 self.out.print(b.text, markup=False, highlight=False)
 
     def wrote(self, paths: list[Path]) -> None:
-        """One line: the first file, the other files by name, and how many figures, in which folder."""
+        """One line: the first file, the other files by name, and how many figures, in which folder.
+
+        Parameters
+        ----------
+        paths : list of Path
+            Files written.
+        """
         pngs = [p for p in paths if p.suffix == ".png"]
         others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
         self.line(f"wrote {paths[0]}{others} and {count(len(pngs), 'figure')} in {paths[0].parent}/")
 
     def progress(self, command: str) -> Progress:
+        """A progress reporter for a command.
+
+        Parameters
+        ----------
+        command : str
+
+        Returns
+        -------
+        Progress
+        """
         return Progress(command, self.err, self.quiet)
 
 
 def count(n: int, noun: str) -> str:
-    """``"no figures"``, ``"1 figure"``, ``"3 figures"``."""
+    """A count with its noun: ``"no figures"``, ``"1 figure"``, ``"3 figures"``.
+
+    Parameters
+    ----------
+    n : int
+    noun : str
+        Singular.
+
+    Returns
+    -------
+    str
+    """
     return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
 
 
 class Progress:
-    """``with reporter.progress("identify") as p: p.update("regressor", "40 %")``: on a terminal a live line
-    on standard error; in a pipe or log one line when a step starts (with the elapsed time)."""
+    """Progress of a command on standard error.
+
+    On a terminal a live line; in a pipe or log one line when a step starts (with the elapsed time). Used as
+    ``with reporter.progress("identify") as p: p.update("regressor", "40 %")``.
+
+    Parameters
+    ----------
+    command : str
+        The command's name, shown first.
+    console : rich.console.Console
+        Standard error's console.
+    quiet : bool
+        Print nothing.
+    """
 
     def __init__(self, command: str, console: Console, quiet: bool = False):
         self.command, self.console, self.quiet = command, console, quiet
@@ -118,7 +214,15 @@ class Progress:
             self._status.__exit__(*exc)
 
     def update(self, step: str, detail: str = "") -> None:
-        """Report that ``step`` is running (``detail``: iteration, best value, percentage…)."""
+        """Report that a step is running.
+
+        Parameters
+        ----------
+        step : str
+            The step's name.
+        detail : str
+            Iteration, best value, percentage…
+        """
         if self.quiet:
             return
         elapsed = time.perf_counter() - self.t0

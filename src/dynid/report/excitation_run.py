@@ -20,7 +20,18 @@ FIGURES = {
 
 @staged
 def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
-    """Write ``excitation.json``, ``excitation.csv`` and the figures into ``out``; return the paths.
+    """Write ``excitation.json``, ``excitation.csv`` and the figures.
+
+    Parameters
+    ----------
+    run : ExcitationRun
+    out : str or Path
+        Output folder.
+
+    Returns
+    -------
+    list of Path
+        Files written.
 
     Raises
     ------

@@ -17,8 +17,17 @@ def _thin(t, *series):
 
 
 def fixed_layout(fig, left=0.85, right=0.25, top=0.45, bottom=0.55, hspace=0.35) -> None:
-    """Margins in inches, whatever the figure's size: matplotlib's automatic (constrained) layout measures
-    every tick label and costs more than drawing the figure (0.2 s each, most of dynid run's figures)."""
+    """Margins in inches, whatever the figure's size: matplotlib's automatic (constrained) layout measures every
+    tick label and costs more than drawing the figure (0.2 s each, most of dynid run's figures).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    left, right, top, bottom : float
+        Margins [inch].
+    hspace : float
+        Height between panels, as a fraction of a panel's height.
+    """
     w, h = fig.get_size_inches()
     fig.subplots_adjust(left=left / w, right=1 - right / w, top=1 - top / h, bottom=bottom / h, hspace=hspace)
 
@@ -42,7 +51,22 @@ def _axes(ax, n=1, projection=None, figsize=(8, 6)):
 
 
 def plot_joint_trajectories(t, q, q_min=None, q_max=None, ax=None, title="Excitation trajectory"):
-    """Joint positions against time with their limits (paper Figs. 4 and 8). ``q`` (N, n) [rad]."""
+    """Joint positions against time with their limits (paper Figs. 4 and 8).
+
+    Parameters
+    ----------
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+    q_min, q_max : (n_dof,) arrays [rad], optional
+        Drawn dashed.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     n = q.shape[1]
     axes = _axes(ax, n, figsize=(8, 2.2 * n))
     t, q = _thin(t, q)
@@ -59,10 +83,25 @@ def plot_joint_trajectories(t, q, q_min=None, q_max=None, ax=None, title="Excita
 
 
 def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory", others=None, box=None, floor=None):
-    """3-D path of the tool point (paper Fig. 5); ``xyz`` (N, 3) [m] in the base frame.
+    """3-D path of the tool point (paper Fig. 5).
 
-    ``others`` maps a label to another (M, 3) path (drawn dashed); ``box = (box_min, box_max)`` draws the
-    workspace box's finite edges and ``floor`` a floor plane under the paths.
+    Parameters
+    ----------
+    xyz : (N, 3) array [m]
+        In the base frame.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+    others : dict, optional
+        label -> another (M, 3) path, drawn dashed.
+    box : (box_min, box_max), optional
+        The workspace box; its finite edges are drawn.
+    floor : float, optional
+        Height of a floor plane drawn under the paths [m].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     ax = _axes(ax, projection="3d", figsize=(7, 6))
     for label, path in (others or {}).items():
@@ -93,8 +132,19 @@ def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory",
 def plot_convergence(histories, ax=None, reference=None, title="ABC convergence", xlabel="iteration"):
     """Best objective F (eq. 9) against iterations or evaluations (paper Fig. 6).
 
-    ``histories`` maps a label to ``(x, best_F)``; a bare array is the ABC's best F per iteration.
-    ``reference`` maps a label to a horizontal line.
+    Parameters
+    ----------
+    histories : dict or array
+        label -> ``(x, best_F)``; a bare (T,) array is the ABC's best F per iteration.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    reference : dict, optional
+        label -> F [N·m] drawn as a horizontal line.
+    title, xlabel : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     axes = _axes(ax, figsize=(7, 4))
     a = np.atleast_1d(axes)[0]
@@ -117,9 +167,22 @@ def plot_convergence(histories, ax=None, reference=None, title="ABC convergence"
 
 def plot_method_comparison(labels, validation_error, parameter_error, ax=None,
                            title="Estimators on the validation trajectory"):
-    """Relative validation error per joint (grouped bars, log scale) and parameter error per method.
+    """Relative validation error per joint (grouped bars, log scale) and parameter error per estimator.
 
-    ``validation_error`` (n_methods, n_dof) [%]; ``parameter_error`` (n_methods,) ``‖β̂−β‖/‖β‖`` [%].
+    Parameters
+    ----------
+    labels : sequence of str
+        One per estimator.
+    validation_error : (n_estimators, n_dof) array [%]
+    parameter_error : (n_estimators,) array [%]
+        ``‖β̂−β‖/‖β‖``.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
 
@@ -150,9 +213,22 @@ def plot_method_comparison(labels, validation_error, parameter_error, ax=None,
 
 def plot_std_over_bound(levels, labels, ratios, ax=None,
                         title="Monte Carlo: std / √CRB of every base parameter"):
-    """One panel per noise level: ``std/√CRB`` of every parameter (dots) for each method; 1 = efficient.
+    """One panel per noise level: ``std/√CRB`` of every parameter (dots) for each estimator; 1 = efficient.
 
-    ``ratios`` is a list over methods of (n_levels, n_params) arrays.
+    Parameters
+    ----------
+    levels : (n_levels,) array [A]
+    labels : sequence of str
+        One per estimator.
+    ratios : list of (n_levels, n_params) arrays
+        One per estimator.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
 
@@ -177,7 +253,24 @@ def plot_std_over_bound(levels, labels, ratios, ax=None,
 
 def plot_noise_level_study(levels, labels, std_ratios, bias_ratios, ax=None,
                            title="Monte Carlo: spread and bias against the current noise level"):
-    """Median over the parameters of ``std/√CRB`` (left) and ``|bias|/√CRB`` (right) against the noise level."""
+    """Median over the parameters of ``std/√CRB`` (left) and ``|bias|/√CRB`` (right) against the current noise
+    level (Monte Carlo study).
+
+    Parameters
+    ----------
+    levels : (n_levels,) array [A]
+    labels : sequence of str
+        One per estimator.
+    std_ratios, bias_ratios : list of (n_levels, n_params) arrays
+        One per estimator.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -206,7 +299,22 @@ def _torque_axes(fig, n: int):
 
 
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):
-    """Measured against predicted joint torques (paper Figs. 7 and 9). ``predicted`` maps a label to (N, n)."""
+    """Measured against predicted joint torques (paper Figs. 7 and 9).
+
+    Parameters
+    ----------
+    t : (N,) array [s]
+    measured : (N, n_dof) array [N·m]
+    predicted : dict
+        label -> (N, n_dof) array [N·m].
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -250,7 +358,20 @@ class TorqueFigure:
         self.axes[-1].set_xlabel("t [s]")
 
     def draw(self, t, measured, predicted: dict, title: str):
-        """The figure with this dataset's curves (``predicted``: label -> (N, n_dof)); returns the Figure."""
+        """The figure with one dataset's curves (the figure is reused from dataset to dataset).
+
+        Parameters
+        ----------
+        t : (N,) array [s]
+        measured : (N, n_dof) array [N·m]
+        predicted : dict
+            label -> (N, n_dof) predicted torques [N·m].
+        title : str
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         t, measured, *preds = _thin(t, measured, *(predicted[k] for k in self.labels))
         for j, (a, row) in enumerate(zip(self.axes, self.lines)):
             for line, y in zip(row, [measured] + preds):
@@ -264,8 +385,21 @@ class TorqueFigure:
 def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation trajectory and its limits"):
     """Positions, velocities, accelerations and torques of each joint with their limits (paper Fig. 4).
 
-    ``states`` maps a label to ``(q, dq, ddq, tau)``, each (N, n); the first is drawn solid, the others
-    dashed. ``limits`` has ``q_min, q_max, dq_max, ddq_max, tau_max`` (n,) each; infinite ones are omitted.
+    Parameters
+    ----------
+    t : (N,) array [s]
+    states : dict
+        label -> ``(q, dq, ddq, tau)``, each (N, n_dof) [rad, rad/s, rad/s², N·m]; the first drawn solid, the others
+        dashed.
+    limits : Limits
+        ``q_min, q_max, dq_max, ddq_max, tau_max`` (n_dof,) each; infinite ones are omitted.
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     import matplotlib.pyplot as plt
 

@@ -14,6 +14,17 @@ from pathlib import Path
 
 @dataclass
 class Table:
+    """A table of the report.
+
+    Attributes
+    ----------
+    caption : str
+    headers : list of str
+    rows : list of list
+        Cells; numbers are formatted by the report.
+    text_columns : tuple of int
+        Columns that hold text (left-aligned).
+    """
     caption: str
     headers: list
     rows: list
@@ -22,6 +33,15 @@ class Table:
 
 @dataclass
 class Section:
+    """A titled part of the report.
+
+    Attributes
+    ----------
+    title : str
+    tables : list of Table
+    texts : list of str
+        Paragraphs after the tables.
+    """
     title: str
     tables: list = field(default_factory=list)
     texts: list = field(default_factory=list)
@@ -52,7 +72,19 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
 
 
 def identify_sections(d: dict) -> tuple[dict, list[Section]]:
-    """Settings and sections of ``dynid identify`` (or ``dynid validate``) from its results dictionary."""
+    """Settings and sections of ``dynid identify`` (or ``dynid validate``).
+
+    Parameters
+    ----------
+    d : dict
+        The command's results dictionary (results.json).
+
+    Returns
+    -------
+    settings : dict
+        Setting -> value shown at the top.
+    sections : list of Section
+    """
     settings = {"robot": d.get("robot", ""), "method": d.get("method", ""),
                 "preprocessing": d.get("settings", {}).get("preprocessing", {}).get("derivation", ""),
                 "Coulomb smoothing velocity (rad/s)": d.get("settings", {}).get("coulomb_velocity", "")}
@@ -100,7 +132,19 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 
 
 def run_sections(d: dict) -> tuple[dict, list[Section]]:
-    """Settings and sections of ``dynid run`` from its results dictionary."""
+    """Settings and sections of ``dynid run``.
+
+    Parameters
+    ----------
+    d : dict
+        The command's results dictionary (results.json).
+
+    Returns
+    -------
+    settings : dict
+        Setting -> value shown at the top.
+    sections : list of Section
+    """
     settings = {k: v for k, v in d.get("settings", {}).items() if not isinstance(v, (list, dict)) or k == "estimators"}
     names = d["parameters"]
     methods = d["estimates"]
@@ -135,7 +179,19 @@ def run_sections(d: dict) -> tuple[dict, list[Section]]:
 
 
 def generic_sections(d: dict) -> tuple[dict, list[Section]]:
-    """Settings and the top-level numbers of ``dynid excite`` and ``dynid montecarlo``."""
+    """Settings and the top-level numbers of ``dynid excite`` and ``dynid montecarlo``.
+
+    Parameters
+    ----------
+    d : dict
+        The command's results dictionary (results.json).
+
+    Returns
+    -------
+    settings : dict
+        Setting -> value shown at the top.
+    sections : list of Section
+    """
     given = d.get("settings", d.get("config"))
     settings = dict(given) if isinstance(given, dict) else {}
     scalars = [[k, _fmt(v)] for k, v in d.items() if isinstance(v, (int, float, str)) and k not in ("schema_version", "dynid_version", "kind")]
@@ -143,7 +199,19 @@ def generic_sections(d: dict) -> tuple[dict, list[Section]]:
 
 
 def excite_sections(d: dict) -> tuple[dict, list[Section]]:
-    """Settings, the before/after table and the constraint margins of ``dynid excite``."""
+    """Settings, the before/after table and the constraint margins of ``dynid excite``.
+
+    Parameters
+    ----------
+    d : dict
+        The command's results dictionary (results.json).
+
+    Returns
+    -------
+    settings : dict
+        Setting -> value shown at the top.
+    sections : list of Section
+    """
     settings, _ = generic_sections(d)
     g = d["design"]
     before = Table("Before / after (design grid)", ["trajectory", "cond(W_base)", "log det(WᵀW/N)"],
@@ -162,7 +230,20 @@ SECTIONS = {"identify": identify_sections, "validate": identify_sections, "run":
 
 
 def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], title: str) -> None:
-    """Write ``report.html``: one file, figures embedded, nothing fetched from elsewhere."""
+    """Write ``report.html``: one file, figures embedded, nothing fetched from elsewhere.
+
+    Parameters
+    ----------
+    path : Path
+        The file to write.
+    data : dict
+        The command's results dictionary.
+    kind : str
+        run, identify, validate, excite or montecarlo.
+    figures : list of Path
+        PNG files to embed.
+    title : str
+    """
     import jinja2
     import numpy
     import pinocchio

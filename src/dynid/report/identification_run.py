@@ -16,8 +16,24 @@ def _slug(name: str) -> str:
 
 
 def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=None) -> list[Path]:
-    """One PNG per dataset (default name ``{prefix}_{dataset}.png``): measured vs predicted torques of every
-    parameter set, drawn on one figure that is redrawn for each dataset."""
+    """One PNG per dataset: measured vs predicted torques of every parameter set.
+
+    Drawn on one figure that is redrawn for each dataset.
+
+    Parameters
+    ----------
+    comparisons : sequence of TorqueComparison
+    out : Path
+        Folder.
+    prefix : str
+        Files are ``{prefix}_{dataset}.png`` unless ``names`` says otherwise.
+    names : sequence of str, optional
+        File name of each comparison.
+
+    Returns
+    -------
+    list of Path
+    """
     paths, titles = [], []
     for i, cmp in enumerate(comparisons):
         kind = prefix if names is None else names[i][0]
@@ -43,9 +59,26 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 
 @staged
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None) -> list[Path]:
-    """Write ``results.json``, the identification fit figure and one figure per validation dataset
-    (figures unless ``figures_too`` is false), and with ``robot`` (the identified robot) ``robot.urdf`` and
-    ``robot.xml`` (MJCF) when the physically consistent estimate passed the consistency check.
+    """Write an identification's results and figures.
+
+    ``results.json``, the identification fit figure and one figure per validation dataset, and with ``robot`` (the
+    identified robot) ``robot.urdf`` and ``robot.xml`` (MJCF) when the physically consistent estimate passed the
+    consistency check.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    out : str or Path
+        Output folder.
+    figures_too : bool
+        Write the figures.
+    robot : Robot, optional
+        The identified robot, for the exports.
+
+    Returns
+    -------
+    list of Path
+        Files written.
 
     Raises
     ------
@@ -78,7 +111,26 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
 
 @staged
 def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
-    """Write ``validation.json`` (per-joint metrics of every parameter set) and one figure per dataset."""
+    """Write ``validation.json`` (per-joint metrics of every parameter set) and one figure per dataset.
+
+    Parameters
+    ----------
+    comparisons : sequence of TorqueComparison
+    out : str or Path
+        Output folder.
+    warnings : sequence of str
+        Stored in the file.
+
+    Returns
+    -------
+    list of Path
+        Files written.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
     out = output_folder(out)
     paths = save_comparisons(comparisons, out)
     json_path = out / "validation.json"

@@ -22,7 +22,18 @@ FIGURES = {
 
 @staged
 def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
-    """Write ``montecarlo.json``, ``montecarlo_estimates.csv`` and the figures into ``out``; return the paths.
+    """Write ``montecarlo.json``, ``montecarlo_estimates.csv`` and the figures.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+    out : str or Path
+        Output folder.
+
+    Returns
+    -------
+    list of Path
+        Files written.
 
     Raises
     ------

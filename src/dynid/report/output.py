@@ -23,6 +23,15 @@ MANIFEST = ".dynid-manifest.json"
 def check_output_folder(out: str | Path) -> Path:
     """Refuse, before any computation, an output folder that is a file or a folder that cannot be written.
 
+    Parameters
+    ----------
+    out : str or Path
+
+    Returns
+    -------
+    Path
+        ``out`` as a path.
+
     Raises
     ------
     ConfigError
@@ -38,13 +47,25 @@ def check_output_folder(out: str | Path) -> Path:
 
 
 def staged(save):
-    """Decorator for ``save(result, out, ...) -> paths``: the files are written into a hidden staging folder
-    inside ``out``, then moved into ``out`` one by one; the files of an earlier run there that this one
-    does not write again are removed, and the manifest (:data:`MANIFEST`) is written last. An error or a
-    Ctrl-C while saving leaves ``out`` as it was (the staging folder is removed). The old manifest is removed
-    before the first file moves, so a folder killed while files move (SIGKILL, power loss) has no manifest:
-    files without a manifest are an incomplete run. Staging folders such a kill leaves behind are removed by
-    the next run into the same folder once they are an hour old."""
+    """Decorator that writes a command's files through a staging folder.
+
+    For ``save(result, out, ...) -> paths``: the files are written into a hidden staging folder inside ``out``, then
+    moved into ``out`` one by one; the files of an earlier run there that this one does not write again are removed,
+    and the manifest (:data:`MANIFEST`) is written last. An error or a Ctrl-C while saving leaves ``out`` as it was
+    (the staging folder is removed). The old manifest is removed before the first file moves, so a folder killed while
+    files move (SIGKILL, power loss) has no manifest: files without a manifest are an incomplete run. Staging folders
+    such a kill leaves behind are removed by the next run into the same folder once they are an hour old.
+
+    Parameters
+    ----------
+    save : callable
+        ``save(result, out, ...)`` returning the paths written.
+
+    Returns
+    -------
+    callable
+        The same signature.
+    """
 
     @functools.wraps(save)
     def wrapper(result, out, *args, **kwargs):
@@ -93,7 +114,16 @@ def _manifest_files(out: Path) -> set[str]:
 
 
 def output_folder(out: str | Path) -> Path:
-    """Create ``out`` if needed and return it.
+    """Create an output folder if needed.
+
+    Parameters
+    ----------
+    out : str or Path
+
+    Returns
+    -------
+    Path
+        The folder.
 
     Raises
     ------
@@ -109,10 +139,18 @@ def output_folder(out: str | Path) -> Path:
 
 
 def draw_figures(build, *args) -> None:
-    """Draw the figure jobs ``build(*args)`` returns (callables without arguments, each writing its own
-    file): in the figure process when one waits (:func:`figure_process`), else here, on two processes
-    (:func:`_draw_jobs`). ``build`` is a module-level function and ``args`` can be pickled; if the figure
-    process fails, this process draws every job, so every file is written or an error is raised.
+    """Draw the figure jobs that ``build(*args)`` returns.
+
+    The jobs are callables without arguments, each writing its own file: drawn in the figure process when one waits
+    (:func:`figure_process`), else here, on two processes. If the figure process fails, this process draws every job,
+    so every file is written or an error is raised.
+
+    Parameters
+    ----------
+    build : callable
+        A module-level function (it is pickled) returning the jobs.
+    *args
+        Its arguments, picklable.
     """
     global _waiting
     worker, _waiting = _waiting, None  # one use: the process leaves once it has drawn
@@ -232,12 +270,22 @@ _waiting: _FigureProcess | None = None
 
 @contextlib.contextmanager
 def figure_process(enabled: bool = True):
-    """Within this block, :func:`draw_figures` hands the figures to a process forked on entry, which imports
-    matplotlib and warms up drawing (:func:`_warm_up_drawing`) while this process computes, so that both
-    are off the command's path. Nothing is forked where ``enabled`` is false or
-    :func:`dynid.processes.can_fork` is (outside the CLI's commands, on one core, not on Linux). Enter it
-    with no other Python thread running (before the CLI's live progress line starts its thread). On exit
-    the process is waited for (it leaves at once when nothing was sent).
+    """A block within which :func:`draw_figures` hands the figures to a forked process.
+
+    The process, forked on entry, imports matplotlib and warms up drawing while this process computes, so that both
+    are off the command's path. Nothing is forked where ``enabled`` is false or :func:`dynid.processes.can_fork` is
+    (outside the CLI's commands, on one core, not on Linux). Enter it with no other Python thread running (before the
+    CLI's live progress line starts its thread). On exit the process is waited for (it leaves at once when nothing was
+    sent).
+
+    Parameters
+    ----------
+    enabled : bool
+        Fork at all.
+
+    Yields
+    ------
+    None
     """
     global _waiting
     if not enabled or not can_fork() or _waiting is not None:
@@ -253,7 +301,13 @@ def figure_process(enabled: bool = True):
 
 
 def save_figure(fig_or_axes, path: Path) -> None:
-    """Write the figure of ``fig_or_axes`` (a Figure, an Axes or an array of Axes) as PNG, atomically."""
+    """Write a figure as PNG, atomically.
+
+    Parameters
+    ----------
+    fig_or_axes : Figure, Axes or array of Axes
+    path : Path
+    """
     import matplotlib.pyplot as plt
 
     fig = fig_or_axes.figure if hasattr(fig_or_axes, "figure") else fig_or_axes.flat[0].figure
@@ -268,8 +322,16 @@ from ..experiment.identified import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # 
 
 
 def write_results(path: Path, data: dict, kind: str) -> None:
-    """Write a results JSON atomically, headed by what wrote it: ``schema_version``, ``dynid_version`` and
-    ``kind`` (run, identify, validate, excite, montecarlo)."""
+    """Write a results JSON atomically, headed by what wrote it.
+
+    Parameters
+    ----------
+    path : Path
+    data : dict
+        JSON-ready results.
+    kind : str
+        run, identify, validate, excite or montecarlo; stored with ``schema_version`` and ``dynid_version``.
+    """
     from .. import __version__
     from ..io import write_json
 

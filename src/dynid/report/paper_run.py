@@ -82,8 +82,20 @@ def _figure_jobs(result: PaperRunResult, paths: list[Path]) -> list:
 
 @staged
 def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = True) -> list[Path]:
-    """Write ``results.json`` and (unless ``figures_too`` is false) the figures into ``out`` (created if
-    needed); return the paths.
+    """Write ``results.json`` and the figures of ``dynid run``.
+
+    Parameters
+    ----------
+    result : PaperRunResult
+    out : str or Path
+        Output folder (created if needed).
+    figures_too : bool
+        Write the figures.
+
+    Returns
+    -------
+    list of Path
+        Files written.
 
     Raises
     ------

@@ -15,7 +15,16 @@ def _joined(values, fmt: str) -> str:
 
 
 def run_summary_blocks(result) -> list:
-    """Blocks of a :class:`dynid.experiment.paper.PaperRunResult`."""
+    """Blocks of a paper run's summary.
+
+    Parameters
+    ----------
+    result : PaperRunResult
+
+    Returns
+    -------
+    list of Line or TextTable
+    """
     d = result.to_dict()
     methods = {spec(k).label: v for k, v in d["estimates"].items()}
     cfg = result.config

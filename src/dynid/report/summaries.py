@@ -36,6 +36,15 @@ def summary(result, width: int = 100) -> str:
 def blocks(result) -> list:
     """The blocks of :func:`summary` (the terminal renders them with colours, :mod:`dynid.report.console`).
 
+    Parameters
+    ----------
+    result : object
+        Any result of dynid (identification, validation, drive gains, Monte Carlo, excitation, paper run).
+
+    Returns
+    -------
+    list of Line or TextTable
+
     Raises
     ------
     TypeError

@@ -64,18 +64,26 @@ class Measurements:
 def simulate_measurements(robot: Robot, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray,
                           noise: NoiseModel, rng: np.random.Generator,
                           inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> Measurements:
-    """Simulate the recording of a motion ``(q, dq, ddq)`` sampled at ``t``.
+    """Simulate the recording of a motion sampled at given times.
 
     Parameters
     ----------
     robot : Robot
         Its drive gains ``K`` convert torques to currents (eq. 16).
-    t : (N,) array; q, dq, ddq : (N, n_dof) arrays
+    t : (N,) array [s]
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
     noise : NoiseModel
-    rng : numpy Generator
-    inertial, drive : arrays, optional
-        Truth parameters (default: the robot's nominal ones), shapes (n_dof, 10) and
-        (n_dof, n_drive_terms).
+    rng : numpy.random.Generator
+    inertial : (n_dof, 10) array, optional
+        Truth inertial parameters (the robot's nominal ones by default).
+    drive : (n_dof, n_drive_terms) array, optional
+        Truth drive parameters (the robot's nominal ones by default).
+
+    Returns
+    -------
+    Measurements
+        Noisy positions and currents with the noise-free torques.
     """
     gains = check_vector(robot.drive_gains, robot.n_dof, "drive gains")
     tau = rnea_torques(robot, q, dq, ddq, inertial, drive)
@@ -88,5 +96,15 @@ def simulate_measurements(robot: Robot, t: np.ndarray, q: np.ndarray, dq: np.nda
 
 
 def torques_from_currents(current: np.ndarray, gains: np.ndarray) -> np.ndarray:
-    """Joint torques ``tau = K·I`` (eq. 16); ``current`` (N, n_dof) [A], ``gains`` (n_dof,) [N·m/A]."""
+    """Joint torques ``tau = K·I`` (eq. 16).
+
+    Parameters
+    ----------
+    current : (N, n_dof) array [A]
+    gains : (n_dof,) array [N·m/A]
+
+    Returns
+    -------
+    (N, n_dof) ndarray [N·m]
+    """
     return np.asarray(current, dtype=float) * np.asarray(gains, dtype=float)

@@ -54,13 +54,28 @@ class CoulombChoice:
     folds: int
 
     def to_dict(self) -> dict:
+        """JSON-ready choice.
+
+        Returns
+        -------
+        dict
+            The velocities chosen, the candidates and their out-of-fold errors.
+        """
         return {"velocity": self.velocity, "candidates": self.candidates, "out_of_fold_rms_error": self.error,
                 "folds": self.folds, "grid_fraction_of_rms_speed": list(COULOMB_GRID)}
 
 
 def out_of_fold_error(accumulators: list[LeastSquaresAccumulator]) -> np.ndarray:
-    """RMS residual of each joint on each block when fitted (OLS) on all the other blocks, pooled over
-    the blocks, (n_dof,) [N·m].
+    """RMS residual of each joint on each block when fitted (OLS) on all the other blocks, pooled over the blocks.
+
+    Parameters
+    ----------
+    accumulators : list of LeastSquaresAccumulator
+        One per block.
+
+    Returns
+    -------
+    (n_dof,) ndarray [N·m]
 
     Raises
     ------
@@ -174,6 +189,13 @@ class PreprocessingChoice:
         return len(self.candidates) > 1
 
     def to_dict(self) -> dict:
+        """JSON-ready choice.
+
+        Returns
+        -------
+        dict
+            The candidate chosen, the candidates and their out-of-fold errors and scores.
+        """
         chosen = next(i for i, c in enumerate(self.candidates) if c.position_cutoff == self.settings.position_cutoff)
         return {"chosen": chosen, "note": self.note,
                 "candidates": [{"position_cutoff": c.position_cutoff, "parallel_cutoff": c.parallel_cutoff,

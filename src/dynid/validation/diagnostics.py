@@ -54,6 +54,13 @@ class Finding:
     joint: int | None = None
 
     def to_dict(self) -> dict:
+        """The finding as results.json stores it.
+
+        Returns
+        -------
+        dict
+            ``kind``, ``text`` and, for a joint's finding, ``joint`` (1-based).
+        """
         return {"kind": self.kind, "text": self.text, **({} if self.joint is None else {"joint": self.joint + 1})}
 
 
@@ -64,6 +71,18 @@ class ResidualSums:
 
     Per joint ``j``, for the rows ``z = (y, τ, f, 1)`` with ``f`` the :data:`FEATURES` of joint ``j``: the Gram matrix
     ``Σ z zᵀ``, and ``Σ z_k z_{k-1}ᵀ`` of consecutive rows (the lag-1 autocorrelation of the residual).
+
+    Attributes
+    ----------
+    n_dof : int
+    n_columns : int
+        Regressor columns.
+    gram : (n_dof, size, size) array
+        ``Σ z zᵀ`` per joint.
+    lagged : (n_dof, size, size) array
+        ``Σ z_k z_{k-1}ᵀ`` per joint.
+    count : int
+        Rows added.
     """
 
     n_dof: int
@@ -80,10 +99,25 @@ class ResidualSums:
 
     def add(self, y: np.ndarray, tau: np.ndarray, q: np.ndarray, dq: np.ndarray, direction: np.ndarray,
             low_speed: np.ndarray, keep: np.ndarray) -> None:
-        """Rows ``y`` (M, n_dof, p), torques ``tau`` (M, n_dof), and per row each joint's position ``q``, velocity
-        ``dq``, direction of motion, the speed under which it is near a reversal ``low_speed`` (n_dof,) [rad/s], and
-        ``keep`` (M, n_dof): the rows of moving joints the estimation uses (at rest, the friction is whatever holds the
-        joint: no check applies)."""
+        """Fold one block of rows into the sums.
+
+        Parameters
+        ----------
+        y : (M, n_dof, p) array
+            Regressor rows.
+        tau : (M, n_dof) array [N·m]
+        q : (M, n_dof) array [rad]
+            Positions.
+        dq : (M, n_dof) array [rad/s]
+            Velocities.
+        direction : (M, n_dof) array
+            Direction of motion (-1, 0, 1 or in between).
+        low_speed : (n_dof,) array [rad/s]
+            Speed under which a joint is near a reversal.
+        keep : (M, n_dof) bool array
+            The rows of moving joints the estimation uses (at rest the friction is whatever holds the joint: no check
+            applies).
+        """
         m = y.shape[0]
         low = (np.abs(dq) < low_speed) * direction
         f = np.stack([low, np.sin(q), np.cos(q), np.sin(2 * q), np.cos(2 * q)], axis=2)
@@ -97,8 +131,23 @@ class ResidualSums:
         self.count += m
 
     def residual_checks(self, beta: np.ndarray, rms_torque: np.ndarray, fc: np.ndarray | None = None) -> tuple[list, dict]:
-        """The findings on the residual ``τ - yβ``, and the statistics behind them (per joint: lag-1
-        autocorrelation, effective samples, the amplitude and t statistic of each feature)."""
+        """The findings on the residual ``τ - yβ``, and the statistics behind them.
+
+        Parameters
+        ----------
+        beta : (p,) array
+            The parameters (OLS: the residual is that of the fit).
+        rms_torque : (n_dof,) array [N·m]
+            RMS torque of each joint (the scale a finding is judged against).
+        fc : (n_dof,) array [N·m], optional
+            Coulomb friction of each joint (the scale of the friction features).
+
+        Returns
+        -------
+        findings : list of Finding
+        stats : dict
+            Per joint: lag-1 autocorrelation, effective samples, the amplitude and t statistic of each feature.
+        """
         p = self.n_columns
         e = np.concatenate([-np.asarray(beta, dtype=float), [1.0]])  # r = e·(y, τ)
         findings: list = []
@@ -149,8 +198,8 @@ class ResidualSums:
 
 def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]"
                   ) -> list[Finding]:
-    """A flipped torque sign: the measured torques of the joints whose torque varies correlate strongly negatively
-    (ρ < -0.5) with those of the description's nominal model.
+    """A flipped torque sign: the measured torques of the joints whose torque varies correlate strongly
+    negatively (ρ < -0.5) with those of the description's nominal model.
 
     Parameters
     ----------
@@ -158,6 +207,14 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
         Correlation coefficient (eq. 18) of the nominal model's torques with the measured ones.
     varies : (n_dof,) bool array
         Joints whose measured torque varies beyond its noise.
+    dataset : str
+        The log, named in the finding.
+    table : str
+        The config table to fix (its ``sign``).
+
+    Returns
+    -------
+    list of Finding
     """
     corr = np.asarray(correlation, dtype=float)
     bad = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and corr[j] < -0.5]
@@ -181,9 +238,21 @@ def validation_findings(name: str, global_error: float, fit_error: float, predic
 
     Parameters
     ----------
+    name : str
+        The validation log.
+    global_error : float [%]
+        Its global relative error (NaN: not judged).
+    fit_error : float [%]
+        The identification's.
     prediction_spread, fit_spread : (n_dof,) arrays [N·m] or None
         RMS over the samples of the prediction's standard deviation from the parameters' covariance, on the validation
         log and on the identification log.
+    label : str
+        The estimate judged.
+
+    Returns
+    -------
+    list of Finding
     """
     out = []
     if prediction_spread is not None and fit_spread is not None:
@@ -226,6 +295,18 @@ class BlockGrams:
         self.gram = np.zeros((blocks, n_dof, n_columns + 1, n_columns + 1))
 
     def add(self, index: np.ndarray, y: np.ndarray, tau: np.ndarray, keep: np.ndarray) -> None:
+        """Fold one block of rows into the Gram matrix of its contiguous block of the log.
+
+        Parameters
+        ----------
+        index : (M,) int array
+            Sample indices of the rows.
+        y : (M, n_dof, p) array
+            Regressor rows.
+        tau : (M, n_dof) array [N·m]
+        keep : (M, n_dof) bool array
+            Rows the estimation uses.
+        """
         z = np.concatenate([y, tau[:, :, None]], axis=2) * keep[:, :, None]
         block = np.minimum(index * self.blocks // self.n_samples, self.blocks - 1)
         for b in np.unique(block):
@@ -233,7 +314,21 @@ class BlockGrams:
             self.gram[b] += np.einsum("mjc,mjd->jcd", zb, zb)
 
     def bootstrap_std(self, weights: np.ndarray | None = None, rng=0, resamples: int = BOOTSTRAP_RESAMPLES) -> np.ndarray:
-        """Bootstrap standard deviation of the (weighted) least-squares parameters, (p,)."""
+        """Moving-block bootstrap standard deviation of the (weighted) least-squares parameters: the blocks' Gram
+        matrices resampled with replacement, each resample solved (Künsch 1989; blocks keep the residuals' correlation).
+
+        Parameters
+        ----------
+        weights : (n_dof,) array, optional
+            Row weight of each joint (the WLS weights).
+        rng : int or numpy.random.Generator
+            Seeds the resampling.
+        resamples : int
+
+        Returns
+        -------
+        (p,) array
+        """
         rng = np.random.default_rng(rng)
         w = np.ones(self.gram.shape[1]) if weights is None else np.asarray(weights, dtype=float)
         g = np.einsum("j,bjcd->bcd", w**2, self.gram)  # joints weighted, summed: one Gram per block
@@ -250,8 +345,20 @@ class BlockGrams:
 
 
 def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> tuple[list[Finding], float]:
-    """σ from the covariance against the bootstrap's: the median ratio over the parameters, and a finding when the
-    covariance understates the spread by 2× or more."""
+    """σ from the covariance against the bootstrap's: a finding when the covariance understates the spread by 2×
+    or more.
+
+    Parameters
+    ----------
+    covariance_std : (p,) array
+    bootstrap_std : (p,) array
+
+    Returns
+    -------
+    findings : list of Finding
+    ratio : float
+        Median over the parameters of bootstrap σ / covariance σ.
+    """
     ratio = float(np.median(np.asarray(bootstrap_std) / np.maximum(np.asarray(covariance_std), 1e-300)))
     if ratio >= 2.0:
         return [Finding("correlated", f"σ from the covariance is {ratio:.1f}× below the moving-block bootstrap's (median over "
@@ -261,8 +368,23 @@ def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> 
 
 
 def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: np.ndarray, rms_torque: float) -> list[Finding]:
-    """Parameters the log hardly excites yet that matter: relative σ above 50 % and a torque of ±σ above 5 % of the
-    RMS torque."""
+    """Parameters the log hardly excites yet that matter: relative σ above 50 % and a torque of ±σ above 5 % of
+    the RMS torque.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Base parameters.
+    params, std : (p,) arrays
+        Estimate and standard deviations.
+    column_rms : (p,) array
+        RMS of each regressor column (largest over the joints).
+    rms_torque : float [N·m]
+
+    Returns
+    -------
+    list of Finding
+    """
     rel = np.abs(std) / np.maximum(np.abs(params), 1e-300)
     weak = [i for i in range(len(names)) if rel[i] > 0.5 and std[i] * column_rms[i] > 0.05 * rms_torque]
     if not weak:

@@ -101,14 +101,35 @@ class FrictionChoice:
     load_candidate: np.ndarray | None = None
 
     def robot(self, robot: Robot) -> Robot:
-        """``robot`` with each joint's chosen terms (drive terms and mask) and velocities (Stribeck, smoothing)."""
+        """A robot with each joint's chosen terms (drive terms and mask) and velocities (Stribeck, smoothing).
+
+        Parameters
+        ----------
+        robot : Robot
+
+        Returns
+        -------
+        Robot
+        """
         return robot_with(robot, self.models)
 
     def rest_friction(self) -> tuple:
-        """Each joint's state at rest, as ``Preprocessing.rest_friction``."""
+        """Each joint's state at rest, as ``Preprocessing.rest_friction``.
+
+        Returns
+        -------
+        tuple
+        """
         return tuple(m.rest for m in self.models)
 
     def to_dict(self) -> dict:
+        """JSON-ready choice.
+
+        Returns
+        -------
+        dict
+            The models chosen, the candidates and their out-of-fold errors.
+        """
         return {"models": [m.to_dict() for m in self.models], "candidates": list(self.candidates),
                 "out_of_fold_rms_error": self.error, "plain_out_of_fold_rms_error": self.plain,
                 "chosen_out_of_fold_rms_error": self.chosen, "folds": self.folds, "margin": MARGIN,

@@ -20,11 +20,15 @@ def _pair(measured, predicted) -> tuple[np.ndarray, np.ndarray]:
 
 
 def correlation_coefficient(measured, predicted) -> np.ndarray:
-    """Correlation coefficient per joint (paper eq. 18), (n_dof,); 1 is a perfect model.
+    """Correlation coefficient per joint (paper eq. 18); 1 is a perfect model.
 
     Parameters
     ----------
     measured, predicted : (N, n_dof) arrays [N·m]
+
+    Returns
+    -------
+    (n_dof,) ndarray
     """
     m, p = _pair(measured, predicted)
     mc, pc = m - m.mean(axis=0), p - p.mean(axis=0)
@@ -32,20 +36,47 @@ def correlation_coefficient(measured, predicted) -> np.ndarray:
 
 
 def rmse(measured, predicted) -> np.ndarray:
-    """Root-mean-square error per joint, (n_dof,) [N·m]."""
+    """Root-mean-square error per joint.
+
+    Parameters
+    ----------
+    measured, predicted : (N, n_dof) arrays [N·m]
+
+    Returns
+    -------
+    (n_dof,) ndarray [N·m]
+    """
     m, p = _pair(measured, predicted)
     return np.sqrt(((m - p) ** 2).mean(axis=0))
 
 
 def relative_error(measured, predicted) -> np.ndarray:
-    """Relative error per joint ``100·||tau - tau_p|| / ||tau||``, (n_dof,) [%]."""
+    """Relative error per joint, ``100·||tau - tau_p|| / ||tau||``.
+
+    Parameters
+    ----------
+    measured, predicted : (N, n_dof) arrays [N·m]
+
+    Returns
+    -------
+    (n_dof,) ndarray [%]
+    """
     m, p = _pair(measured, predicted)
     return 100.0 * np.linalg.norm(m - p, axis=0) / np.linalg.norm(m, axis=0)
 
 
 def global_relative_error(measured, predicted) -> float:
-    """Relative error over all joints and samples, ``100·||tau - tau_p||_F / ||tau||_F`` [%].
+    """Relative error over all joints and samples, ``100·||tau - tau_p||_F / ||tau||_F``.
 
-    Joints with large torques weigh more than in the per-joint :func:`relative_error`."""
+    Joints with large torques weigh more than in the per-joint :func:`relative_error`.
+
+    Parameters
+    ----------
+    measured, predicted : (N, n_dof) arrays [N·m]
+
+    Returns
+    -------
+    float [%]
+    """
     m, p = _pair(measured, predicted)
     return float(100.0 * np.linalg.norm(m - p) / np.linalg.norm(m))

@@ -22,14 +22,34 @@ __all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "comparison_tabl
 
 @dataclass(frozen=True)
 class TorqueComparison:
-    """Measured and predicted torques of one dataset (decimated), with per-joint metrics.
+    """Measured and predicted torques of one dataset (decimated), with per-joint metrics (eq. 18, RMSE, relative error).
 
     Attributes
     ----------
     name : str
+        The dataset.
     t : (M,) array [s]
+        The samples a figure draws.
     measured : (M, n_dof) array [N·m]
-    predicted : dict label -> (M, n_dof) array
+        Measured torques on those samples (filtered like the predictions).
+    predicted : dict
+        label -> (M, n_dof) predicted torques [N·m] of each parameter set.
+    summary : dict or None
+        From :class:`TorqueSums`: the metrics, sample count and RMS torque of all samples, while ``t``, ``measured`` and
+        ``predicted`` hold only the samples a figure draws.
+    resting : (M, n_dof) bool array or None
+        Where each joint rests (its velocity below its rest velocity).
+    static : dict or None
+        label -> (n_dof,) static friction ``f_s`` [N·m] of each parameter set (the band a resting joint's friction stays
+        in).
+    noise : (n_dof,) array [N·m] or None
+        Each joint's residual level on the identification log; a joint whose RMS torque is below :data:`MEANINGFUL`
+        times it has no meaningful relative error.
+    speed : (n_dof,) array [rad/s] or None
+        RMS speed of each joint in this dataset.
+    spread : dict or None
+        label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
+        (for the sets whose covariance is known).
     """
 
     name: str
@@ -54,10 +74,16 @@ class TorqueComparison:
     (for the sets whose covariance is known)."""
 
     def metrics(self) -> dict:
-        """label -> {relative_error [%], rmse [N·m], correlation (eq. 18)}, each (n_dof,), and
-        global_relative_error [%] over all joints and samples (a float); where the joints rest in the dataset, also
-        moving_relative_error [%], moving_rmse [N·m] on the samples where each joint moves, rest_rmse [N·m] and
-        rest_in_static_band (share of the resting samples whose error is within the set's ``±f_s``)."""
+        """The paper's metrics of every parameter set on this dataset.
+
+        Returns
+        -------
+        dict
+            label -> {``relative_error`` [%], ``rmse`` [N·m], ``correlation`` (eq. 18), each (n_dof,);
+            ``global_relative_error`` [%] over all joints and samples}; where the joints rest in the dataset, also
+            ``moving_relative_error`` [%], ``moving_rmse`` [N·m] on the samples where each joint moves, ``rest_rmse`` [N·m]
+            and ``rest_in_static_band`` (share of the resting samples whose error is within the set's ``±f_s``).
+        """
         if self.summary is not None:
             return self.summary["metrics"]
         out = {}
@@ -78,14 +104,26 @@ class TorqueComparison:
         return None if self.resting is None else self.resting.mean(axis=0)
 
     def meaningful(self) -> np.ndarray:
-        """(n_dof,) bool: whether each joint's relative error means something (its RMS torque is at least
-        :data:`MEANINGFUL` times its residual level on the identification log)."""
+        """Whether each joint's relative error means something here.
+
+        Returns
+        -------
+        (n_dof,) bool array
+            True where the joint's RMS torque is at least :data:`MEANINGFUL` times its residual level on the
+            identification log (all True when that level is unknown).
+        """
         if self.noise is None:
             return np.ones(self.rms_torque.shape, dtype=bool)
         return self.rms_torque >= MEANINGFUL * np.asarray(self.noise)
 
     def flags(self) -> list[str]:
-        """One line per joint whose relative error means nothing here, with its absolute figure."""
+        """The joints whose relative error means nothing here, each with its absolute figure.
+
+        Returns
+        -------
+        list of str
+            One line per such joint (its RMS torque against the noise, its RMSE).
+        """
         out = []
         first = next(iter(self.metrics().values()), None)
         for j in np.flatnonzero(~self.meaningful()):
@@ -99,6 +137,7 @@ class TorqueComparison:
 
     @property
     def n_samples(self) -> int:
+        """Samples compared (all of them, not only those drawn)."""
         return int(self.summary["n_samples"]) if self.summary is not None else int(self.t.shape[0])
 
     @property
@@ -109,17 +148,29 @@ class TorqueComparison:
         return self.measured.std(axis=0)
 
     def varies(self) -> np.ndarray:
-        """(n_dof,) bool: whether each joint's torque varies beyond its noise, so that its correlation coefficient
-        (eq. 18) means something."""
+        """Whether each joint's torque varies beyond its noise, so that its correlation coefficient (eq. 18) means
+        something.
+
+        Returns
+        -------
+        (n_dof,) bool array
+        """
         if self.noise is None:
             return np.ones(self.rms_torque.shape, dtype=bool)
         return self.torque_std >= MEANINGFUL * np.asarray(self.noise)
 
     @property
     def rms_torque(self) -> np.ndarray:
+        """(n_dof,) RMS of the measured torque of each joint over all samples [N·m]."""
         return self.summary["rms_torque"] if self.summary is not None else np.sqrt((self.measured**2).mean(axis=0))
 
     def to_dict(self) -> dict:
+        """The comparison as results.json stores it (metrics, sample count, RMS torques, flags).
+
+        Returns
+        -------
+        dict
+        """
         out = {"name": self.name, "n_samples": self.n_samples, "rms_torque": self.rms_torque, "metrics": self.metrics()}
         if self.rest_share is not None:
             out["rest_share"] = self.rest_share
@@ -183,12 +234,35 @@ class TorqueSums:
 
     @classmethod
     def for_data(cls, data: PreparedData, n_columns: int) -> "TorqueSums":
-        """Statistics for the decimated samples :func:`dynid.preprocessing.pipeline.base_chunks` gives of ``data``."""
+        """Empty statistics sized for the decimated samples of ``data``.
+
+        Parameters
+        ----------
+        data : PreparedData
+            The dataset (its length and decimation size the thinning of the kept curves).
+        n_columns : int
+            Columns of the regressor blocks that will be added.
+
+        Returns
+        -------
+        TorqueSums
+        """
         return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)))
 
     def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray, resting: np.ndarray | None = None) -> None:
-        """Rows ``y`` (M, n_dof, n_columns), torques ``tau`` (M, n_dof) at times ``t`` (M,); ``resting`` (M, n_dof)
-        bool: where each joint rests."""
+        """Fold one block of rows into the statistics.
+
+        Parameters
+        ----------
+        t : (M,) array [s]
+            Time of the block's samples.
+        y : (M, n_dof, n_columns) array
+            Regressor rows (filtered like the torques).
+        tau : (M, n_dof) array [N·m]
+            Measured torques.
+        resting : (M, n_dof) bool array, optional
+            Where each joint rests.
+        """
         m = y.shape[0]
         z = np.concatenate([y, tau[:, :, None]], axis=2)
         if resting is not None and resting.any():
@@ -210,7 +284,19 @@ class TorqueSums:
         self.count = n + m
 
     def comparison(self, name: str, parameter_sets: dict) -> TorqueComparison:
-        """The dataset's :class:`TorqueComparison`: metrics from the statistics, curves on the kept rows."""
+        """The dataset's comparison: metrics from the statistics, curves on the kept rows.
+
+        Parameters
+        ----------
+        name : str
+            The dataset.
+        parameter_sets : dict
+            label -> (n_columns,) parameter vector.
+
+        Returns
+        -------
+        TorqueComparison
+        """
         n = self.count
         s_yy, s_yt, s_tt = self.m2[:, :-1, :-1], self.m2[:, :-1, -1], self.m2[:, -1, -1]
         y_mean, t_mean = self.mean[:, :-1], self.mean[:, -1]
@@ -241,7 +327,18 @@ class TorqueSums:
 
 
 def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
-    """(M, n_dof) bool: where each joint rests at the samples ``index`` (:func:`dynid.friction.moving_joints`)."""
+    """Where each joint rests at some samples of a prepared log (:func:`dynid.friction.moving_joints`).
+
+    Parameters
+    ----------
+    data : PreparedData
+    index : (M,) int array
+        Sample indices.
+
+    Returns
+    -------
+    (M, n_dof) bool array
+    """
     if data.resting is not None:
         return data.resting[index]
     given = data.settings.rest_velocity
@@ -252,8 +349,21 @@ def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
 
 
 def static_friction(base: BaseParameters, parameter_sets: dict, n_dof: int) -> dict:
-    """label -> (n_dof,) static friction ``f_s = |fc| + max(fst, 0)`` [N·m] of each set (its base parameters
-    named ``fc<j>``, ``fst<j>``)."""
+    """The static friction of each parameter set: ``f_s = |fc| + max(fst, 0)`` per joint (its base parameters named
+    ``fc<j>``, ``fst<j>``; 0 where absent).
+
+    Parameters
+    ----------
+    base : BaseParameters
+    parameter_sets : dict
+        label -> (n_base,) base parameters.
+    n_dof : int
+
+    Returns
+    -------
+    dict
+        label -> (n_dof,) array [N·m].
+    """
     out = {}
     for label, beta in parameter_sets.items():
         fs = np.zeros(n_dof)
@@ -267,20 +377,35 @@ def static_friction(base: BaseParameters, parameter_sets: dict, n_dof: int) -> d
 
 def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
                     progress=None, noise: np.ndarray | None = None, covariance: dict | None = None) -> TorqueComparison:
-    """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` (label ->
-    (n_base,)), on the same parallel-decimated samples as the estimation. The parameter sets are known
-    before the pass, so the predictions are stored and the metrics computed from them directly (exact also
-    for a log at rest, where a prediction is almost constant); :class:`TorqueSums` serves the fit, whose
-    parameters come out of the same pass.
+    """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` on the same
+    parallel-decimated samples as the estimation, and score them (eq. 18, RMSE, relative error).
+
+    The parameter sets are known before the pass, so the predictions are stored and the metrics computed from them
+    directly (exact also for a log at rest, where a prediction is almost constant); :class:`TorqueSums` serves the fit,
+    whose parameters come out of the same pass.
 
     Parameters
     ----------
+    robot : Robot
+        The model the sets belong to.
+    base : BaseParameters
+        Its base-parameter map.
+    data : PreparedData
+        The prepared log (:func:`dynid.preprocessing.pipeline.prepare`).
+    parameter_sets : dict
+        label -> (n_base,) base parameters.
+    progress : callable, optional
+        ``progress(done, total)`` in samples.
     noise : (n_dof,) array [N·m], optional
         Each joint's residual level on the identification log, to flag joints whose torque is at that level
         (:meth:`TorqueComparison.flags`).
     covariance : dict, optional
         label -> (n_base, n_base) covariance of a set: its prediction's spread ``sqrt(diag(Y C Yᵀ))`` is kept
         (:attr:`TorqueComparison.spread`).
+
+    Returns
+    -------
+    TorqueComparison
     """
     covariance = covariance or {}
     ts: list = []
@@ -310,11 +435,21 @@ REST_ROWS = 0.05
 
 
 def comparison_table(cmp: TorqueComparison) -> TextTable:
-    """Relative error, RMSE and correlation coefficient per joint for every parameter set of ``cmp``: one
-    label row per set, then one row per metric (narrow enough for 80 columns with six joints). A joint whose
-    relative error is not meaningful (:meth:`TorqueComparison.meaningful`) shows "n/m" there, and one whose torque
-    does not vary beyond its noise (:meth:`TorqueComparison.varies`) "n/m" as its correlation; where joints rest,
-    the error on the moving samples and the RMSE at rest follow."""
+    """Relative error, RMSE and correlation coefficient (eq. 18) per joint for every parameter set of ``cmp``.
+
+    One label row per set, then one row per metric (narrow enough for 80 columns with six joints). A joint whose
+    relative error is not meaningful (:meth:`TorqueComparison.meaningful`) shows "n/m" there, and one whose torque does
+    not vary beyond its noise (:meth:`TorqueComparison.varies`) "n/m" as its correlation; where joints rest, the error
+    on the moving samples and the RMSE at rest follow.
+
+    Parameters
+    ----------
+    cmp : TorqueComparison
+
+    Returns
+    -------
+    TextTable
+    """
     rms = cmp.rms_torque
     n = cmp.measured.shape[1]
     ok = cmp.meaningful()
