@@ -18,6 +18,7 @@ demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/dynid run
 
 test: $(STAMP)
+	$(BIN)/python -m mypy  # type check of src/dynid ([tool.mypy] in pyproject.toml)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
 
 bench: $(STAMP)
