@@ -50,8 +50,10 @@ def test_methods_subset_without_abc(tmp_path):
     assert "Estimators:" in p.stdout and "dynid run:" not in p.stdout
 
 
-def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path):
-    """A real process and a real SIGINT, while the estimators run."""
+@pytest.mark.parametrize("signame, code, said", [("SIGINT", 130, "Ctrl-C"), ("SIGTERM", 143, "SIGTERM")])
+def test_ctrl_c_and_sigterm_exit_with_one_line_and_leave_no_output(tmp_path, signame, code, said):
+    """A real process and a real SIGINT (SIGTERM: what a process manager or a batch system sends), while the
+    estimators run."""
     import os
     import signal
     import subprocess
@@ -65,11 +67,11 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path):
         if line.startswith("dynid run: ABC×10") or line.startswith("dynid run: DE"):
             break
     time.sleep(0.3)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(getattr(signal, signame))
     stdout, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 130, (proc.returncode, stderr)
+    assert proc.returncode == code, (proc.returncode, stderr)
     lines = stderr.strip().splitlines()
-    assert lines[-1] == "interrupted (Ctrl-C)" and all(line.startswith("dynid run: ") for line in lines[:-1]), lines
+    assert lines[-1] == f"interrupted ({said})" and all(line.startswith("dynid run: ") for line in lines[:-1]), lines
     assert "Traceback" not in stdout + stderr
     assert not out.exists() or not any(out.iterdir())
 
@@ -79,6 +81,18 @@ def test_quiet_prints_nothing_but_warnings(tmp_path):
     assert p.returncode == 0, p.stderr
     assert p.stdout == "" and all(line.startswith("warning: ") for line in p.stderr.splitlines())
     assert "truth outside the ABC search box" in p.stderr and (tmp_path / "q" / "results.json").is_file()
+
+
+def test_main_takes_argv_and_returns_the_exit_code(tmp_path, capsys):
+    from dynid import __version__
+    from dynid.cli.app import main
+
+    assert main(["--version"]) == 0 and capsys.readouterr().out.strip() == f"dynid {__version__}"
+    assert main(["run", "--no-such-option"]) == 2
+    missing = tmp_path / "missing.toml"
+    assert main(["identify", str(missing), "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert "missing.toml" in err and "Traceback" not in err and not (tmp_path / "o").exists()
 
 
 def test_usage_error_exit_2():

@@ -93,6 +93,61 @@ def summary_blocks(result) -> list:
     return blocks(result)
 
 
+class _Command:
+    """The frame every command shares: what it reads and checks (before any computation), what it computes under a
+    live progress line, what it writes, and what it prints; a :class:`DynIdError` anywhere is one line and exit 1.
+
+    Parameters
+    ----------
+    name : str
+        The command, e.g. "dynid identify".
+    quiet : bool
+        Print only warnings and errors.
+    out : Path, optional
+        Output folder, refused before any computation when unusable.
+    figures : bool
+        Draw figures in a process forked before the live line starts (:func:`dynid.report.output.figure_process`).
+    """
+
+    def __init__(self, name: str, quiet: bool, out: Optional[Path] = None, figures: bool = False):
+        self.name, self.out, self.figures = name, out, figures
+        self.reporter = Reporter(quiet)
+
+    def run(self, prepare, compute, save, show=None) -> None:
+        """Run the command.
+
+        Parameters
+        ----------
+        prepare : callable
+            ``prepare()`` reads and checks the inputs, returns what ``compute`` needs.
+        compute : callable
+            ``compute(prepared, progress)`` returns the result.
+        save : callable
+            ``save(result)`` writes the files, returns their paths.
+        show : callable, optional
+            ``show(reporter, result, paths)`` prints the outcome (default: the result's summary and the files).
+        """
+        rep = self.reporter
+        try:
+            prepared = prepare()  # a mistake is reported before any heavy import
+            if self.out is not None:
+                _check_out(self.out)
+            from ..report.output import figure_process
+
+            with figure_process(self.figures):  # forked before the live line's thread starts: imports pyplot meanwhile
+                with rep.progress(self.name) as progress:
+                    result = compute(prepared, progress)
+                    progress.update("writing results" + (" and figures" if self.figures else ""))
+                paths = save(result)  # after the live progress line ended: the figures fork
+        except DynIdError as exc:
+            _fail(exc, rep)
+        if show is None:
+            rep.blocks(summary_blocks(result))
+            rep.wrote(paths)
+        else:
+            show(rep, result, paths)
+
+
 def _version(value: bool) -> None:
     if value:
         from .. import __version__
@@ -133,30 +188,23 @@ def run(
 ) -> None:
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
-    from ..experiment import PaperExperimentConfig, run_paper_experiment
     from ..estimators.registry import label, parse_estimators
-    from ..report.output import figure_process
+    from ..experiment import PaperExperimentConfig, run_paper_experiment
     from ..report.paper_run import save_paper_run
 
-    rep = Reporter(quiet)
-    try:
+    def prepare():
         _renamed(methods)
-        _check_out(out)
-        config = PaperExperimentConfig(
+        return PaperExperimentConfig(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
             excitation=excitation, estimators=parse_estimators(estimators), bootstrap=bootstrap, strategy=strategy)
-        with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
-            with rep.progress("dynid run") as progress:
-                result = run_paper_experiment(config, progress=lambda k, i, f: progress.update(
-                    label(k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
-                progress.update("writing results" + (" and figures" if figures else ""))
-            paths = save_paper_run(result, out, figures)  # after the live progress line ended: the figures fork
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.blocks(summary_blocks(result))
-    rep.wrote(paths)
+
+    def compute(config, progress):
+        return run_paper_experiment(config, progress=lambda k, i, f: progress.update(
+            label(k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
+
+    _Command("dynid run", quiet, out, figures).run(prepare, compute, lambda result: save_paper_run(result, out, figures))
 
 
 @app.command()
@@ -172,21 +220,19 @@ def identify(
     from ..experiment.identification_run import run_identification
     from ..io.identification_config import load_identification_config
 
-    rep = Reporter(quiet)
-    try:
-        cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
-        _check_out(out)
+    def compute(cfg, progress):
+        return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate)
+
+    def save(identified):
         from ..report.identification_run import save_identification
-        from ..report.output import figure_process
-        with figure_process(figures):  # forked before the live line's thread starts: imports pyplot meanwhile
-            with rep.progress("dynid identify") as progress:
-                result = run_identification(cfg, progress=_steps(progress), validate=validate)
-                progress.update("writing results" + (" and figures" if figures else ""))
-            paths = save_identification(result, out, figures, robot=cfg.robot)  # after the live line ended
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.blocks(summary_blocks(result))
-    rep.wrote(paths)
+
+        return save_identification(identified[1], out, figures, robot=identified[0])
+
+    def show(rep, identified, paths):
+        rep.blocks(summary_blocks(identified[1]))
+        rep.wrote(paths)
+
+    _Command("dynid identify", quiet, out, figures).run(lambda: load_identification_config(config, data_root), compute, save, show)
 
 
 @app.command()
@@ -202,28 +248,37 @@ def export(
     from ..exceptions import DataError
     from ..io.identification_config import load_identification_config
 
-    rep = Reporter(quiet)
-    try:
+    def prepare():
         cfg = load_identification_config(config, data_root)
         identified = _read_results(results)
-        from ..io.export import mjcf_from_results, urdf_from_results
-        from ..io.files import atomic_write_text
-
-        targets = [(flag, path, fn) for flag, path, fn in (("--urdf", urdf, urdf_from_results), ("--mjcf", mjcf, mjcf_from_results))
-                   if path is not None]
+        targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
         if not targets:
             raise DataError("give --urdf FILE and/or --mjcf FILE")
-        texts = []
-        for flag, path, fn in targets:
+        for flag, path in targets:
             if not path.parent.is_dir():
                 raise DataError(f"{flag} {path}: its folder does not exist")
-            texts.append((path, fn(cfg.robot, identified, str(results))))
-        for path, text in texts:
+        return cfg, identified, targets
+
+    def compute(prepared, progress):
+        from ..io.export import mjcf_from_results, urdf_from_results
+
+        cfg, identified, targets = prepared
+        export = {"--urdf": urdf_from_results, "--mjcf": mjcf_from_results}
+        return cfg.robot, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets]
+
+    def save(computed):
+        from ..io.files import atomic_write_text
+
+        for path, text in computed[1]:
             atomic_write_text(path, text)
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.line(f"wrote {', '.join(str(p) for p, _ in texts)} (robot {cfg.robot.name}, {cfg.robot.n_dof} joints; what the "
-             "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
+        return [path for path, _ in computed[1]]
+
+    def show(rep, computed, paths):
+        robot = computed[0]
+        rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints; what the "
+                 "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
+
+    _Command("dynid export", quiet).run(prepare, compute, save, show)
 
 
 def _read_results(results: Path) -> dict:
@@ -266,29 +321,29 @@ def validate(
     from ..io.identification_config import dataset_for_file, load_identification_config
     from ..validation.torques import comparison_table
 
-    rep = Reporter(quiet)
-    try:
+    def prepare():
         cfg = load_identification_config(config, data_root)
-        _check_out(out)
-        from ..report.identification_run import save_validation
-        from ..report.output import figure_process
         identified = _read_results(results)
-        datasets = None
         if file is not None:
-            datasets = (dataset_for_file(cfg, file, _parse_rows(rows)),)
-        elif rows is not None:
+            return cfg, identified, (dataset_for_file(cfg, file, _parse_rows(rows)),)
+        if rows is not None:
             raise DataError("--rows needs --file")
-        with figure_process():  # forked before the live line's thread starts: imports pyplot meanwhile
-            with rep.progress("dynid validate") as progress:
-                comparisons, warnings = run_validation(cfg, identified, datasets, progress=_steps(progress))
-                progress.update("writing results and figures")
-            paths = save_validation(comparisons, out, warnings)  # after the live line ended
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.blocks([comparison_table(c) for c in comparisons])
-    for w in warnings:
-        rep.warning(w)
-    rep.wrote(paths)
+        return cfg, identified, None
+
+    def save(validated):
+        from ..report.identification_run import save_validation
+
+        return save_validation(validated[0], out, validated[1])
+
+    def show(rep, validated, paths):
+        comparisons, warnings = validated
+        rep.blocks([comparison_table(c) for c in comparisons])
+        for w in warnings:
+            rep.warning(w)
+        rep.wrote(paths)
+
+    _Command("dynid validate", quiet, out, figures=True).run(
+        prepare, lambda p, progress: run_validation(p[0], p[1], p[2], progress=_steps(progress)), save, show)
 
 
 @app.command()
@@ -305,22 +360,21 @@ def excite(
     from ..experiment.excitation import run_excitation
     from ..io.excitation_config import load_excitation_config
 
-    rep = Reporter(quiet)
-    try:
+    def prepare():
         cfg = load_excitation_config(config)
-        _check_out(out)
+        return replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
+
+    def compute(cfg, progress):
+        progress.update(f"design, start 1 of {cfg.starts}")
+        return run_excitation(cfg, callback=lambda i, n, c: progress.update(
+            f"design, start {min(i + 1, n)} of {n}", f"best cond = {c:.4g}"))
+
+    def save(run):
         from ..report.excitation_run import save_excitation
-        cfg = replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
-        with rep.progress("dynid excite") as progress:
-            progress.update(f"design, start 1 of {cfg.starts}")
-            run = run_excitation(cfg, callback=lambda i, n, c: progress.update(
-                f"design, start {min(i + 1, n)} of {n}", f"best cond = {c:.4g}"))
-            progress.update("writing results and figures")
-        paths = save_excitation(run, out)
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.blocks(summary_blocks(run))
-    rep.wrote(paths)
+
+        return save_excitation(run, out)
+
+    _Command("dynid excite", quiet, out).run(prepare, compute, save)
 
 
 def _parse_levels(text: str):
@@ -355,36 +409,55 @@ def montecarlo(
     from ..experiment.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 
-    rep = Reporter(quiet)
-    try:
+    def prepare():
         _renamed(methods)
-        _check_out(out)
-        cfg = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
-                               estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration, rate=rate, abc_bounds=abc_bounds,
-                               excitation=excitation, strategy=strategy)
-        with rep.progress("dynid montecarlo") as progress:
-            progress.update("starting the workers")
-            result = run_montecarlo(cfg, scheduler=scheduler, workers=workers,
-                                    progress=lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}"))
-            progress.update("writing results and figures")
-        paths = save_montecarlo(result, out)
-    except DynIdError as exc:
-        _fail(exc, rep)
-    rep.blocks(summary_blocks(result))
-    rep.wrote(paths)
+        return MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
+                                estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
+                                rate=rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
+
+    def compute(cfg, progress):
+        progress.update("starting the workers")
+        return run_montecarlo(cfg, scheduler=scheduler, workers=workers,
+                              progress=lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}"))
+
+    _Command("dynid montecarlo", quiet, out).run(prepare, compute, lambda result: save_montecarlo(result, out))
 
 
 class Interrupted(BaseException):
-    """Ctrl-C, raised by dynid's SIGINT handler: a BaseException that is no KeyboardInterrupt, so no library
-    on the way swallows it and the atomic writes' clean-up still runs."""
+    """Ctrl-C or SIGTERM, raised by dynid's signal handler: a BaseException that is no KeyboardInterrupt, so no
+    library on the way swallows it and the atomic writes' and staging's clean-up still runs.
+
+    Parameters
+    ----------
+    signum : int
+        The signal received.
+    """
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
 
 
 def _interrupt(signum, frame):
-    raise Interrupted()
+    raise Interrupted(signum)
 
 
-def main() -> None:
-    """Console-script entry point. Ctrl-C ends with one line and exit code 130 (128 + SIGINT)."""
+def main(argv: Optional[list[str]] = None) -> int:
+    """Console-script entry point.
+
+    Ctrl-C ends with one line and exit code 130 (128 + SIGINT), SIGTERM likewise with 143 (128 + SIGTERM): the
+    output folder is left as it was before the command (its staged files are removed).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``dynid`` (default: the command line's).
+
+    Returns
+    -------
+    int
+        The exit code: 0 success, 1 user or data error, 2 usage error, 130/143 interrupted.
+    """
     import os
     import signal
 
@@ -392,24 +465,31 @@ def main() -> None:
 
     from ..processes import allow_forks
 
-    signal.signal(signal.SIGINT, _interrupt)
+    handlers = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         with allow_forks():  # this process is dynid's: figures and drive gains may go to forked children
-            app()
+            app(args=argv, prog_name="dynid")
+    except SystemExit as exc:  # typer ends every command this way
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
     except DynIdError as exc:  # pragma: no cover - commands already catch theirs
         Reporter().error(_message(exc))
-        sys.exit(1)
-    except Interrupted:
-        print("interrupted (Ctrl-C)", file=sys.stderr)
-        sys.exit(130)
+        return 1
+    except Interrupted as exc:
+        name = "Ctrl-C" if exc.signum == signal.SIGINT else "SIGTERM"
+        print(f"interrupted ({name})", file=sys.stderr)
+        return 128 + exc.signum
     finally:
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
         # The process ends here. Its objects leave the garbage collector's sight, so that the interpreter's
         # last collection does not walk every object of SciPy, cvxpy and Pinocchio (0.1 s of every command);
         # modules, files and atexit handlers are still finalised as usual, and the system frees the memory.
-        import gc
+        if argv is None:  # the process ends here; a caller's process goes on
+            import gc
 
-        gc.freeze()
+            gc.freeze()
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
