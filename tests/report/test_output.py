@@ -84,6 +84,40 @@ def test_a_kill_while_files_move_leaves_no_manifest_and_its_staging_folder_goes_
     assert not list(out.glob(".dynid-staging-*")) and json.loads((out / MANIFEST).read_text())["files"] == ["results.json"]
 
 
+def test_a_staging_folder_of_a_process_that_is_gone_goes_at_once(tmp_path):
+    """SIGKILL or power loss during staging: the next run removes the folder without waiting an hour; a fresh
+    staging folder of a live process (a run saving now) stays."""
+    import socket
+    import subprocess
+    import sys
+
+    from dynid.report.output import _STAGING
+
+    out = tmp_path / "out"
+    out.mkdir()
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()  # its pid is free now
+    host = socket.gethostname().replace("-", "_")
+    dead = out / f"{_STAGING}{host}-{child.pid}-abc"
+    live = out / f"{_STAGING}{host}-{os.getpid()}-def"
+    for folder in (dead, live):
+        folder.mkdir()
+        (folder / "results.json").write_text("half")
+    _save({"results.json": "1"}, out)
+    assert not dead.exists() and live.exists()
+
+
+def test_a_folder_where_a_file_goes_is_refused_before_anything_moves(tmp_path):
+    out = tmp_path / "out"
+    _save({"results.json": "1", "a.png": "A1"}, out)
+    (out / "a.png").unlink()
+    (out / "a.png").mkdir()
+    with pytest.raises(ConfigError, match="a.png: a folder where this run writes a file"):
+        _save({"results.json": "2", "a.png": "A2"}, out)
+    assert (out / "results.json").read_text() == "1" and json.loads((out / MANIFEST).read_text())["files"] == ["results.json", "a.png"]
+    assert not list(out.glob(".dynid-staging-*"))
+
+
 def _writer_jobs(folder, n, parent=None):
     """Jobs that write ``{i}.png`` holding the writer's pid; with ``parent``, they fail in any other process."""
     def job(i):

@@ -71,10 +71,13 @@ def staged(save):
     def wrapper(result, out, *args, **kwargs):
         out = output_folder(out)
         _remove_stale_staging(out)
-        stage = Path(tempfile.mkdtemp(prefix=".dynid-staging-", dir=out))
+        stage = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{_owner()}-", dir=out))
         try:
             written = save(result, stage, *args, **kwargs)
             final = [out / p.relative_to(stage) for p in written]
+            blocked = [f for f in final if f.is_dir() and not f.is_symlink()]
+            if blocked:  # checked before anything moves: a failed move half-way would leave two runs mixed
+                raise ConfigError(f"{blocked[0]}: a folder where this run writes a file; move or remove it")
             previous = _manifest_files(out)
             (out / MANIFEST).unlink(missing_ok=True)  # from here until the new one: visibly incomplete
             for p in previous - {f.name for f in final}:
@@ -93,16 +96,43 @@ def staged(save):
     return wrapper
 
 
+_STAGING = ".dynid-staging-"
+
+
+def _owner() -> str:
+    """This process as a staging folder names it: host and process id."""
+    import socket
+
+    return f"{socket.gethostname().replace('-', '_')}-{os.getpid()}"
+
+
 def _remove_stale_staging(out: Path, age: float = 3600.0) -> None:
-    """Remove staging folders of runs killed over ``age`` seconds ago (a running save's folder is younger)."""
+    """Remove staging folders of killed runs: at once when the process that made it on this machine is gone, and any
+    (another machine's sharing the folder, a folder of an older version) once it is over ``age`` seconds old."""
+    import socket
     import time
 
-    for folder in out.glob(".dynid-staging-*"):
+    host = socket.gethostname().replace("-", "_")
+    for folder in out.glob(_STAGING + "*"):
         try:
-            if folder.is_dir() and time.time() - folder.stat().st_mtime > age:
+            if not folder.is_dir():
+                continue
+            parts = folder.name[len(_STAGING):].split("-")
+            dead = len(parts) >= 3 and parts[0] == host and parts[1].isdigit() and not _alive(int(parts[1]))
+            if dead or time.time() - folder.stat().st_mtime > age:
                 shutil.rmtree(folder, ignore_errors=True)
         except OSError:
             pass
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
 
 
 def _manifest_files(out: Path) -> set[str]:
