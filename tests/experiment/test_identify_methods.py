@@ -75,3 +75,21 @@ def test_estimator_names_are_case_insensitive(tmp_path):
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["OLS", "Wls"]\n'))
     assert load_identification_config(cfg).estimators == ("ols", "wls")
+
+
+def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
+    """``identify(..., "wls")`` is WLS, not the estimators "w", "l", "s"."""
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.experiment.identification import identify
+    from dynid.io.datasets import load_recording
+    from dynid.preprocessing.pipeline import prepare
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    config = load_identification_config(cfg)
+    base = base_parameters(config.robot)
+    data = prepare(load_recording(config.identification, config.robot), config.preprocessing)
+    as_text = identify(config.robot, base, data, "ols,wls")
+    as_tuple = identify(config.robot, base, data, ("ols", "wls"))
+    assert [e.key for e in as_text.estimates.values()] == ["ols", "wls"]
+    for a, b in zip(as_text.estimates.values(), as_tuple.estimates.values()):
+        np.testing.assert_array_equal(a.params, b.params)

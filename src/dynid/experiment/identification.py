@@ -302,8 +302,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         The base-parameter map of ``robot``.
     data : PreparedData
         From :func:`dynid.preprocessing.pipeline.prepare`.
-    estimators : sequence of str
-        Keys of :mod:`dynid.estimators.registry` (case-insensitive); the first is the main estimate. A least-squares
+    estimators : sequence of str, or str
+        Keys of :mod:`dynid.estimators.registry` (case-insensitive; a text: comma-separated, ``"wls,sdp"``); the first
+        is the main estimate. A least-squares
         estimate is always computed (the first of OLS/WLS listed, else WLS): it gives σ, each joint's noise (and
         the SDP's row weights) and the box of LAD and the box searches (:func:`search_box`).
     references : tuple of ReferenceSet
@@ -329,7 +330,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     IdentifiabilityError
         Too few rows or a rank-deficient base observation matrix (the log does not excite every base parameter).
     """
-    keys = parse_estimators(tuple(estimators))
+    keys = parse_estimators(estimators if isinstance(estimators, str) else tuple(estimators))
     n = robot.n_dof
     sdp = "sdp" in keys
     if sdp:
