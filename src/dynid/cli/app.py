@@ -220,6 +220,12 @@ def identify(
     from ..experiment.identification_run import run_identification
     from ..io.identification_config import load_identification_config
 
+    def prepare():
+        cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
+        from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
+
+        return cfg
+
     def compute(cfg, progress):
         return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate)
 
@@ -232,7 +238,7 @@ def identify(
         rep.blocks(summary_blocks(identified[1]))
         rep.wrote(paths)
 
-    _Command("dynid identify", quiet, out, figures).run(lambda: load_identification_config(config, data_root), compute, save, show)
+    _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
 
 
 @app.command()
@@ -323,6 +329,8 @@ def validate(
 
     def prepare():
         cfg = load_identification_config(config, data_root)
+        from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
+
         identified = _read_results(results)
         if file is not None:
             return cfg, identified, (dataset_for_file(cfg, file, _parse_rows(rows)),)
