@@ -79,6 +79,6 @@ def test_validate_needs_results_of_the_same_robot(tmp_path):
     cfg = _ur_config(tmp_path, "".join(f"{t / 100},{_ROW}\n" for t in range(200)))
     (tmp_path / "r.json").write_text(json.dumps({"base_parameters": [{"name": "ZZ1R", "value": 1.0}]}))
     p = dynid("validate", str(cfg), "--results", str(tmp_path / "r.json"), "--file", str(tmp_path / "log.csv"), "--out", str(tmp_path / "v"))
-    assert p.returncode == 1 and "are not those of robot 'ur10e'" in p.stderr
+    assert p.returncode == 1 and "r.json: robot: missing" in p.stderr
     p = dynid("validate", str(cfg), "--results", str(tmp_path / "missing.json"))
     assert p.returncode == 1 and "run dynid identify first" in p.stderr

@@ -79,7 +79,7 @@ def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
     with pytest.raises(DataError, match=r"r.json: the robot's description is not found .*load_results\(path, robot=\.\.\.\)"):
         dynid.load_results(tmp_path / "r.json")
     assert dynid.load_results(tmp_path / "r.json", robot="er16").robot.name == "er16"
-    with pytest.raises(DataError, match="not those of robot 'ur10e'"):
+    with pytest.raises(DataError, match="r.json: results of robot 'er16', the robot given is 'ur10e'"):
         dynid.load_results(tmp_path / "r.json", robot="ur10e")
     (tmp_path / "bad.json").write_text("{")
     with pytest.raises(DataError, match="bad.json: cannot read it as JSON"):

@@ -193,12 +193,16 @@ def run(
     from ..report.paper_run import save_paper_run
 
     def prepare():
+        from ..model.description import load_robot
+
         _renamed(methods)
-        return PaperExperimentConfig(
+        config = PaperExperimentConfig(
             robot=robot, joints=joints, plant=plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
             limit=abc_limit, maxiter=abc_iterations, weights=_parse_weights(weights), abc_bounds=abc_bounds,
             excitation=excitation, estimators=parse_estimators(estimators), bootstrap=bootstrap, strategy=strategy)
+        config.validate(load_robot(config.robot))  # every option checked before the run starts
+        return config
 
     def compute(config, progress):
         return run_paper_experiment(config, progress=lambda k, i, f: progress.update(
@@ -256,13 +260,21 @@ def export(
 
     def prepare():
         cfg = load_identification_config(config, data_root)
-        identified = _read_results(results)
+        identified = _read_results(results, cfg.robot.name)
         targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
         if not targets:
             raise DataError("give --urdf FILE and/or --mjcf FILE")
-        for flag, path in targets:
+        import os
+
+        for flag, path in targets:  # checked before any work: export writes nothing unless it can write everything
+            if path.is_dir():
+                raise DataError(f"{flag} {path}: a folder; give the name of the file to write")
             if not path.parent.is_dir():
                 raise DataError(f"{flag} {path}: its folder does not exist")
+            if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+                raise DataError(f"{flag} {path}: cannot be written (permissions)")
+        if len(targets) == 2 and targets[0][1].resolve() == targets[1][1].resolve():
+            raise DataError(f"--urdf and --mjcf name the same file ({targets[0][1]}): give each its own")
         return cfg, identified, targets
 
     def compute(prepared, progress):
@@ -287,18 +299,11 @@ def export(
     _Command("dynid export", quiet).run(prepare, compute, save, show)
 
 
-def _read_results(results: Path) -> dict:
-    """The results.json of dynid identify, or a one-line DataError."""
-    import json
+def _read_results(results: Path, robot: str) -> dict:
+    """The results.json of dynid identify for ``robot``, checked (:func:`dynid.io.results.read_results`)."""
+    from ..io.results import read_results
 
-    from ..exceptions import DataError
-
-    try:
-        return json.loads(results.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DataError(f"{results}: not found; run dynid identify first or give --results") from None
-    except (OSError, json.JSONDecodeError) as exc:
-        raise DataError(f"{results}: cannot read it as JSON ({exc})") from None
+    return read_results(results, robot, "; run dynid identify first or give --results")
 
 
 def _parse_rows(text: Optional[str]):
@@ -331,7 +336,7 @@ def validate(
         cfg = load_identification_config(config, data_root)
         from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
 
-        identified = _read_results(results)
+        identified = _read_results(results, cfg.robot.name)
         if file is not None:
             return cfg, identified, (dataset_for_file(cfg, file, _parse_rows(rows)),)
         if rows is not None:
@@ -351,7 +356,7 @@ def validate(
         rep.wrote(paths)
 
     _Command("dynid validate", quiet, out, figures=True).run(
-        prepare, lambda p, progress: run_validation(p[0], p[1], p[2], progress=_steps(progress)), save, show)
+        prepare, lambda p, progress: run_validation(p[0], p[1], p[2], progress=_steps(progress), source=str(results)), save, show)
 
 
 @app.command()

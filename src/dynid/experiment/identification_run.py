@@ -186,7 +186,7 @@ def _main_estimate(result) -> dict:
 
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
-                   progress=None) -> tuple[tuple, tuple[str, ...]]:
+                   progress=None, source: str = "results") -> tuple[tuple, tuple[str, ...]]:
     """Validate identified base parameters and the config's reference sets on the config's validation datasets (or on
     ``datasets``).
 
@@ -199,6 +199,8 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
         Logs to validate on instead of the config's ``[[validation]]`` ones.
     progress : callable, optional
         ``progress(step, done, total)``.
+    source : str
+        Where the results come from (their file), named in errors.
 
     Returns
     -------
@@ -219,9 +221,9 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
     try:
         config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
     except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
-        raise DataError(f"results: settings: {exc}") from None
+        raise DataError(f"{source}: settings: {exc}") from None
     base = base_parameters(config.robot, rng=0)
-    estimates = stored_estimates(identified, base.names, "results", config.robot.name)
+    estimates = stored_estimates(identified, base.names, source, config.robot.name)
     refs = _references(config, base)
     sets = {**estimates, **{r.name: r.beta for r in refs}}
     datasets = config.validation if datasets is None else datasets

@@ -371,11 +371,14 @@ class IdentifiedModel:
         from ..io.files import write_json
 
         path = Path(path)
-        write_json(path, {**self.results, "schema_version": RESULTS_SCHEMA_VERSION, "kind": "identify"})
+        from .. import __version__
+
+        write_json(path, {**self.results, "schema_version": RESULTS_SCHEMA_VERSION, "dynid_version": __version__,
+                          "kind": "identify"})
         return path
 
     @classmethod
-    def from_results(cls, results: dict, robot: Robot) -> "IdentifiedModel":
+    def from_results(cls, results: dict, robot: Robot, source: str = "results") -> "IdentifiedModel":
         """The model of a results.json dictionary of ``dynid identify``.
 
         Parameters
@@ -384,6 +387,8 @@ class IdentifiedModel:
             The parsed results.json.
         robot : Robot
             The robot's description the results were identified for.
+        source : str
+            Where the results come from (their file), named in errors.
 
         Returns
         -------
@@ -402,9 +407,9 @@ class IdentifiedModel:
         try:
             robot = robot_from_settings(robot, results.get("settings", {}))
         except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
-            raise DataError(f"results: settings: {exc}") from None
+            raise DataError(f"{source}: settings: {exc}") from None
         base = base_parameters(robot, rng=0)
-        estimates = stored_estimates(results, base.names, "results", robot.name)
+        estimates = stored_estimates(results, base.names, source, robot.name)
         std = {}
         for label, e in (results.get("estimates") or {}).items():
             if isinstance(e, dict) and isinstance(e.get("std"), dict):
@@ -464,16 +469,14 @@ def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> I
     DataError
         An unreadable file, results of another robot, or no way to find the robot's description.
     """
+    from ..io.results import read_results
+
     path = Path(path)
-    try:
-        results = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DataError(f"{path}: not found") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise DataError(f"{path}: cannot read it as JSON ({exc})") from None
-    if not isinstance(results, dict) or results.get("kind", "identify") != "identify":
-        raise DataError(f"{path}: expected the results.json of dynid identify")
-    return IdentifiedModel.from_results(results, _robot(robot, results, path))
+    results = read_results(path)
+    model_robot = _robot(robot, results, path)
+    if isinstance(results.get("robot"), str) and results["robot"] != model_robot.name:
+        raise DataError(f"{path}: results of robot {results['robot']!r}, the robot given is {model_robot.name!r}")
+    return IdentifiedModel.from_results(results, model_robot, str(path))
 
 
 def _robot(robot, results: dict, path: Path) -> Robot:

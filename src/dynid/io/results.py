@@ -7,11 +7,93 @@ read too.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 
 from ..exceptions import DataError
 
-__all__ = ["stored_estimates", "stored_standard"]
+__all__ = ["read_results", "stored_estimates", "stored_standard"]
+
+OLD_LAYOUT = 1
+"""``schema_version`` of results written before the estimates table: read without the schema's check."""
+
+
+def read_results(path: str | Path, robot: str | None = None, missing_hint: str = "") -> dict:
+    """The results.json of ``dynid identify``, checked against the shipped schema and against the robot.
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : str, optional
+        The name of the robot the results are read for (a config's robot): results of another robot are refused.
+    missing_hint : str
+        Said after "not found" (e.g. what to run first).
+
+    Returns
+    -------
+    dict
+        The parsed results.
+
+    Raises
+    ------
+    DataError
+        One line naming the file and the first field that does not follow ``dynid/schema/results.schema.json``
+        (JSON path, what was expected), a file of another kind, or results of another robot.
+    """
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DataError(f"{path}: not found{missing_hint}") from None
+    except IsADirectoryError:
+        raise DataError(f"{path}: a folder; give the results.json in it") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DataError(f"{path}: cannot read it as JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise DataError(f"{path}: expected the results.json of dynid identify (a JSON object), got a {type(data).__name__}")
+    kind = data.get("kind", "identify")
+    if kind != "identify":
+        raise DataError(f"{path}: expected the results.json of dynid identify, got the results of dynid {kind}")
+    if data.get("schema_version") != OLD_LAYOUT:
+        problem = schema_problem(data)
+        if problem:
+            raise DataError(f"{path}: {problem}")
+    if robot is not None and isinstance(data.get("robot"), str) and data["robot"] != robot:
+        raise DataError(f"{path}: results of robot {data['robot']!r}, the config's robot is {robot!r}; give the config "
+                        "they were identified with")
+    return data
+
+
+def schema_problem(data: dict) -> str:
+    """The first place where results depart from the shipped schema, as ``field.path: what was expected``.
+
+    Parameters
+    ----------
+    data : dict
+        Parsed results of any kind.
+
+    Returns
+    -------
+    str
+        Empty when the results follow the schema.
+    """
+    from importlib import resources
+
+    import jsonschema
+
+    schema = json.loads((resources.files("dynid") / "schema" / "results.schema.json").read_text(encoding="utf-8"))
+    error = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
+    if error is None:
+        return ""
+    where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")
+    if error.validator == "required":
+        missing = error.message.split("'")[1] if "'" in error.message else error.message
+        return f"{where + '.' if where else ''}{missing}: missing"
+    if error.validator == "const" and where == "schema_version":
+        return f"schema_version: expected {error.validator_value}, got {error.instance!r} (written by another version of dynid?)"
+    return f"{where or 'the file'}: {error.message}"
 
 
 def stored_estimates(identified: dict, names, source: str = "results", robot: str = "") -> dict:
