@@ -241,7 +241,7 @@ def test_validate_and_export_refusals(identified, tmp_path):
     cases = [
         (["validate", cfg, "--results", folder / "nosuch.json", "--out", folder / "v"], "run dynid identify first"),
         (["validate", cfg, "--results", folder / "bad.json", "--out", folder / "v"], "bad.json: cannot read it as JSON"),
-        (["validate", cfg, "--results", folder / "other.json", "--out", folder / "v"], "are not those of robot 'ur10e'"),
+        (["validate", cfg, "--results", folder / "other.json", "--out", folder / "v"], "other.json: robot: missing"),
         (["validate", cfg, "--results", results, "--rows", "1,10", "--out", folder / "v"], "--rows needs --file"),
         (["validate", cfg, "--results", results, "--file", folder / "log.csv", "--rows", "a,b", "--out", folder / "v"], "--rows"),
         (["validate", cfg, "--results", results, "--file", folder / "nosuch.csv", "--out", folder / "v"], "nosuch.csv"),
@@ -287,3 +287,179 @@ def test_bad_urdfs_in_a_real_process(tmp_path, case):
     out = tmp_path / "o"
     p = dynid_process("run", "--robot", str(tmp_path / "r.toml"), "--joints", "2", "--out", str(out), *RUN)
     assert_refused_process(p, message, out)
+
+
+# --- round three (issue "Bad input, round three"): results files, export targets, references, ranges, options ----
+
+
+def _edited(results: Path, folder: Path, edit) -> Path:
+    data = json.loads(results.read_text())
+    edit(data)
+    path = folder / "edited.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+def _first_estimate(d):
+    return next(iter(d["estimates"].values()))
+
+
+RESULTS_EDITS = {
+    "a value null": (lambda d: d["base_parameters"][0].__setitem__("value", None), "edited.json: base_parameters[0].value"),
+    "a value as text": (lambda d: d["base_parameters"][1].__setitem__("value", "0.5"), "edited.json: base_parameters[1].value"),
+    "an estimate's value null": (lambda d: _first_estimate(d)["values"].__setitem__(next(iter(_first_estimate(d)["values"])), None),
+                                 "edited.json: "),
+    "a setting of the wrong type": (lambda d: d["settings"]["preprocessing"].__setitem__("order", "four"),
+                                    "edited.json: settings.preprocessing.order"),
+    "settings not a table": (lambda d: d.__setitem__("settings", [1, 2]), "edited.json: settings"),
+    "no schema version": (lambda d: d.pop("schema_version"), "edited.json: schema_version"),
+    "another kind of results": (lambda d: d.__setitem__("kind", "excite"), "edited.json: expected the results.json of dynid identify"),
+    "another robot's results": (lambda d: d.__setitem__("robot", "tx40"), "edited.json: results of robot 'tx40'"),
+    "estimators empty": (lambda d: d.__setitem__("estimators", []), "edited.json: estimators"),
+}
+
+
+@pytest.mark.parametrize("command", ["validate", "export"])
+@pytest.mark.parametrize("case", sorted(RESULTS_EDITS))
+def test_results_edited_by_hand(identified, case, command):
+    cfg, results = identified
+    folder = cfg.parent
+    edit, message = RESULTS_EDITS[case]
+    path = _edited(results, folder, edit)
+    args = ["--urdf", folder / "r.urdf"] if command == "export" else ["--out", folder / "v"]
+    assert_refused(invoke(command, cfg, "--results", path, *args), message, folder / "v")
+    assert not (folder / "r.urdf").exists()
+
+
+def test_export_targets_are_checked_before_any_work(identified):
+    cfg, results = identified
+    folder = cfg.parent
+    (folder / "adir").mkdir()
+    cases = [
+        (["--urdf", folder / "adir"], "--urdf"),
+        (["--urdf", folder / "same.xml", "--mjcf", folder / "same.xml"], "--urdf and --mjcf name the same file"),
+        (["--mjcf", folder / "adir"], "--mjcf"),
+    ]
+    for args, message in cases:
+        assert_refused(invoke("export", cfg, "--results", results, *args), message)
+    assert sorted(p.name for p in folder.iterdir() if p.suffix in (".urdf", ".xml")) == []
+
+
+def test_an_earlier_runs_folder_holding_a_folder_where_a_file_goes(ur):
+    from .refusals import snapshot
+
+    cfg = ur()
+    out = ur.folder / "out"
+    assert invoke("identify", cfg, "--out", out, "--no-figures").exit_code == 0
+    (out / "results.json").unlink()
+    (out / "results.json").mkdir()
+    (out / "results.json" / "keep").write_text("x")
+    before = snapshot(out)
+    result = invoke("identify", cfg, "--out", out, "--no-figures")
+    assert isinstance(result.exception, SystemExit)
+    check_refusal(result.exit_code, result.stdout, result.stderr, "results.json: a folder where this run writes a file", out, before)
+
+
+RANGES = {
+    "payload of 1000 tonnes": ("[drive_gains]\npayload_mass = 1e6\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n"
+                               "[drive_gains.loaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "drive_gains.payload_mass"),
+    "payload of infinite mass": ("[drive_gains]\npayload_mass = inf\n[drive_gains.unloaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n"
+                                 "[drive_gains.loaded]\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n", "drive_gains.payload_mass"),
+    "Coulomb smoothing of 1e9 rad/s": ("[preprocessing]\ncoulomb_velocity = 1e9\n", "preprocessing.coulomb_velocity"),
+    "a minimum speed above every speed": ("[preprocessing]\nmin_speed = 50.0\n", "preprocessing.min_speed"),
+    "a decimation of 1000": ("[preprocessing]\ndecimation = 1000\n", "preprocessing.decimation"),
+    "a 50 ms time range": ({"file = \"log.csv\"": "file = \"log.csv\"\ntime_range = [1.0, 1.05]"}, "time_range"),
+}
+
+
+def test_interpolation_invents_no_more_than_max_gap(ur):
+    rows = _with(GOOD, lambda r: r.__setitem__((slice(1000, None), 0), r[1000:, 0] + 60.0))
+    cfg = ur(replace={"file = \"log.csv\"": "file = \"log.csv\"\ngaps = \"interpolate\""}, log_text=_text(rows))
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), "is longer than max_gap = 0.1 s", out)
+
+
+@pytest.mark.parametrize("case", sorted(RANGES))
+def test_settings_out_of_range_are_named(ur, case):
+    change, message = RANGES[case]
+    cfg = ur(replace=change) if isinstance(change, dict) else ur(config_extra=change)
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), message, out)
+
+
+def test_a_current_of_1e300_is_refused(ur):
+    rows = _with(GOOD, lambda r: r.__setitem__((slice(100, 200), 13), 1e300))
+    cfg = ur(log_text=_text(rows))
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), "log.csv", out)
+
+
+def test_a_frozen_log_names_the_file(ur):
+    rows = _with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 13)), 0.3))
+    cfg = ur(log_text=_text(rows))
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), "log.csv", out)
+
+
+REFERENCE = '[[references]]\nname = "{name}"\nfile = "ref.csv"\nformat = "standard"\nheader = true\nnames = "name"\nvalues = "value"\n'
+NOMINAL = '[[references]]\nname = "{name}"\nformat = "nominal"\n'
+REFERENCES = {
+    "a parameter given twice": ("name,value\nZZ1,1.0\nM2,3.0\nZZ1,2.0\n", REFERENCE.format(name="pub"), "ref.csv: line 4: ZZ1 given twice (line 2)"),
+    "two sets with one name": ("", NOMINAL.format(name="pub") * 2, "references[1].name: 'pub' names two reference sets"),
+    "a set named like dynid's estimate": ("", NOMINAL.format(name="dynid WLS"), "references[0].name: 'dynid WLS' is the name of dynid's"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(REFERENCES))
+def test_reference_sets(ur, case):
+    ref, extra, message = REFERENCES[case]
+    (ur.folder / "ref.csv").write_text(ref)
+    cfg = ur(config_extra=extra)
+    out = ur.folder / "out"
+    assert_refused(invoke("identify", cfg, "--out", out), message, out)
+
+
+def test_an_unknown_field_in_a_robot_description(tmp_path):
+    from dynid.model.description import builtin_robots  # noqa: F401  the built-in descriptions parse
+
+    (tmp_path / "r.toml").write_text('name = "r"\nconvention = "urdf"\nurdf = "r.urdf"\ndrives = ["fv", "fc"]\n'
+                                     '[[joints]]\nname = "j1"\n[[joints]]\nname = "j2"\n')
+    (tmp_path / "r.urdf").write_text(URDF)
+    out = tmp_path / "o"
+    assert_refused(invoke("run", "--robot", tmp_path / "r.toml", "--joints", "2", "--out", out, *RUN), "drives", out)
+
+
+RUN_OPTIONS_ROUND3 = {
+    "a rate of 2 Hz": (["--rate", "2"], "--rate"),
+    "no ABC iterations": (["--abc-iterations", "0"], "--abc-iterations"),
+    "a colony of one bee": (["--abc-colony", "1"], "--abc-colony"),
+    "a scout limit of 0": (["--abc-limit", "0"], "--abc-limit"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(RUN_OPTIONS_ROUND3))
+def test_run_options_are_checked_before_the_run_starts(tmp_path, case):
+    args, message = RUN_OPTIONS_ROUND3[case]
+    out = tmp_path / "o"
+    result = invoke("run", "--out", out, *RUN, *args)
+    assert_refused(result, message, out)
+    assert "dynid run: " not in result.stderr  # refused before the first step
+
+
+URDFS_ROUND3 = {
+    "a link without inertial": ({'<link name="l2"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>':
+                                 '<link name="l2"/>'}, "r.urdf: link 2 (j2) has a nominal mass of 0 kg (a URDF link without <inertial>?)"),
+    "a mimic joint": ({'<axis xyz="0 1 0"/>': '<axis xyz="0 1 0"/><mimic joint="j1" multiplier="1"/>'}, "r.urdf: line 7: joint 'j2' mimics joint 'j1' (<mimic>)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(URDFS_ROUND3))
+def test_urdfs_dynid_cannot_model(tmp_path, case):
+    change, message = URDFS_ROUND3[case]
+    text = URDF
+    for a, b in change.items():
+        assert a in text, a
+        text = text.replace(a, b)
+    (tmp_path / "r.urdf").write_text(text)
+    out = tmp_path / "o"
+    assert_refused(invoke("run", "--robot", tmp_path / "r.urdf", "--joints", "2", "--out", out, *RUN), message, out)

@@ -46,7 +46,8 @@ def test_bag_of_joint_states_reads_like_a_log(tmp_path, rng):
 def test_bag_errors_name_the_bag_topic_and_joint(tmp_path):
     robot = load_robot("ur10e")
     t = np.arange(5) * 0.01
-    _write_bag(tmp_path / "bag", t, ["a", "b", "c", "d", "e", "f"], np.zeros((5, 6)), np.zeros((5, 6)), np.zeros((5, 6)))
+    moving = 0.01 * np.outer(np.arange(5), np.ones(6))
+    _write_bag(tmp_path / "bag", t, ["a", "b", "c", "d", "e", "f"], moving, np.zeros((5, 6)), np.zeros((5, 6)))
     with pytest.raises(DataError, match=r"bag: message 1 on /joint_states lacks joint\(s\) shoulder_pan_joint"):
         load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg", "ident", 6), robot)
     with pytest.raises(DataError, match=r"no topic '/other' in the bag \(it has /joint_states\)"):

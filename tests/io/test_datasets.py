@@ -102,7 +102,7 @@ def test_a_gap_in_the_time_stamps_is_refused_unless_interpolation_is_asked(tmp_p
     to change; gaps = "interpolate" fills gaps up to max_gap (0.1 s by default), with a warning saying how many and
     how long, and refuses a longer one (it would invent that much data)."""
     t = np.concatenate([np.arange(100) * 0.01, 3.0 + np.arange(100) * 0.01])
-    spec = _log(tmp_path, t, np.full((200, 6), 0.1), np.full((200, 6), 0.5))
+    spec = _log(tmp_path, t, 0.1 + 1e-3 * np.outer(np.arange(200), np.ones(6)), np.full((200, 6), 0.5))
     with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps \(median step 0.01 s\) after "
                                         r"the time stamp 0.99 s \(0.990 s into the selected rows\); set gaps = \"interpolate\" in \[identification\]"):
         load_recording(spec, load_robot("ur10e"))
@@ -128,7 +128,7 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
     t = np.arange(300) * 0.01
     cur = rng.normal(0, 1, (300, 6))
     cur[100:160, 2] = 7.5  # clipped
-    q = np.full((300, 6), 0.1)
+    q = 0.1 + 1e-3 * np.outer(np.arange(300), np.ones(6))
     q[:, 1] = 7.0  # beyond the UR10e's ±2π
     rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
     assert any("joint 3's currents stay at their extreme 7.5 for 60 samples (t = 1.000-1.590 s)" in w for w in rec.warnings)

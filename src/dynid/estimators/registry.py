@@ -392,6 +392,21 @@ def label(key: str) -> str:
     return entry.label if entry is not None else str(key)
 
 
+def estimate_label(key: str) -> str:
+    """How dynid's estimate by ``key`` is labelled in tables, figures and JSON: ``"dynid WLS"``, ``"dynid ABC×10"``.
+
+    Parameters
+    ----------
+    key : str
+        A registered estimator.
+
+    Returns
+    -------
+    str
+    """
+    return f"dynid {label(key)}"
+
+
 def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...] | None = None) -> tuple[str, ...]:
     """Estimator keys from text or a sequence, case-insensitive.
 

@@ -23,7 +23,7 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
-from ..estimators.registry import LEAST_SQUARES, FitData, label as estimator_label, parse_estimators, seed_index, spec
+from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, label as estimator_label, parse_estimators, seed_index, spec
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
@@ -33,21 +33,6 @@ from ..validation.diagnostics import (BlockGrams, Finding, ResidualSums, bootstr
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 
 __all__ = ["Estimate", "IdentificationResult", "identify"]
-
-
-def estimate_label(key: str) -> str:
-    """How dynid's estimate by ``key`` is labelled in tables, figures and JSON: ``"dynid WLS"``, ``"dynid ABC×10"``.
-
-    Parameters
-    ----------
-    key : str
-        An estimator of :mod:`dynid.estimators.registry`.
-
-    Returns
-    -------
-    str
-    """
-    return f"dynid {estimator_label(key)}"
 
 
 SDP_LABEL = estimate_label("sdp")

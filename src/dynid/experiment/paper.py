@@ -137,6 +137,24 @@ class PaperExperimentConfig:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ConfigError(f"{name} must be positive, got {v}", field=name)
+        if 1 <= self.joints <= robot.n_dof:  # the truth of the simulation: the description's nominal values
+            simulated = robot.submodel(self.joints) if self.joints < robot.n_dof else robot
+            phi, names = simulated.standard_parameters(), list(simulated.parameter_names)
+            masses = np.array([phi[names.index(f"M{j + 1}")] for j in range(simulated.n_dof)])
+            for j in np.flatnonzero(~(masses > 0)):
+                raise ConfigError(f"robot: {self.robot}: link {j + 1} ({robot.joints[j].name}) has a nominal mass of "
+                                  f"{masses[j]:g} kg (a URDF link without <inertial>?); dynid run simulates the robot with "
+                                  "its nominal values: give the link its mass and inertia", field="robot")
+        n = int(round(self.duration * self.rate))
+        if n < MIN_SAMPLES:
+            raise ConfigError(f"rate: duration × rate gives {n} samples, expected at least {MIN_SAMPLES}: raise the rate "
+                              "or the duration", field="rate")
+        if self.colony_size < 4 or self.colony_size % 2:
+            raise ConfigError(f"colony_size must be an even number >= 4 (half employed, half onlooker bees), got "
+                              f"{self.colony_size}", field="colony_size")
+        for name in ("limit", "maxiter"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"{name} must be >= 1, got {getattr(self, name)}", field=name)
         if not self.current_noise >= 0:
             raise ConfigError(f"current_noise must be >= 0 (A), got {self.current_noise}", field="current_noise")
         if not self.encoder_resolution >= 0:
@@ -153,6 +171,10 @@ class PaperExperimentConfig:
             w = np.asarray(self.weights, dtype=float)
             if w.shape != (self.joints,) or np.any(w < 0) or np.any(w > 1):
                 raise ConfigError(field="weights", message=f"weights needs {self.joints} values in [0, 1], got {list(self.weights)}")
+
+
+MIN_SAMPLES = 10
+"""Samples a simulated recording needs at least (:func:`dynid.excitation.fourier.sample_times`)."""
 
 
 @dataclass

@@ -30,6 +30,7 @@ Column = Union[Annotated[int, Meta(ge=1)], str]
 PositiveHz = Annotated[float, Meta(gt=0)]
 NonNegative = Annotated[float, Meta(ge=0)]
 PerJoint = Union[NonNegative, list[NonNegative]]
+SmoothingVelocity = Annotated[float, Meta(ge=0, le=10)]
 Factor = Union[float, list[float]]
 
 
@@ -101,7 +102,8 @@ class PreprocessingTable(Table, kw_only=True):
     trim: Annotated[NonNegative, _d("s removed at both ends (default 3 / cutoff)")] | None = None
     chunk: Annotated[int, Meta(ge=1, description="samples per chunk of the regressor")] | None = None
     excitation: Annotated[str, _d("the excitation.json the robot ran: Fourier-fit derivatives")] | None = None
-    coulomb_velocity: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: Coulomb term tanh(dq/v); 0: sign")] | None = None
+    coulomb_velocity: Annotated[Union[Literal["auto"], SmoothingVelocity, list[SmoothingVelocity]],
+                                _d("rad/s: Coulomb term tanh(dq/v); 0: sign; at most 10 (above, the term is a viscous one)")] | None = None
     rest_velocity: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: below it a joint rests (default auto)")] | None = None
     rest_friction: Annotated[Union[Literal["held", "zero"], NonNegative, list[Union[Literal["held", "zero"], NonNegative]]],
                              _d('friction at rest: "held", "zero" or a relaxation time [s], one or one per joint')] | None = None
@@ -136,7 +138,7 @@ class ReferenceTable(Table, kw_only=True):
 class DriveGainsTable(Table, kw_only=True):
     """``[drive_gains]``: drive gains from a run without and one with a payload of known mass."""
 
-    payload_mass: Annotated[float, Meta(gt=0, description="kg")]
+    payload_mass: Annotated[float, Meta(gt=0, le=10_000, description="kg: the known payload (at most 10 t)")]
     unloaded: Annotated[DatasetTable, _d("the run without the payload (currents)")]
     loaded: Annotated[DatasetTable, _d("the same motion with the payload (currents)")]
 

@@ -242,20 +242,32 @@ SATURATION_SAMPLES = 20
 """Consecutive samples at a joint's extreme value that count as saturation (clipped current or torque)."""
 
 
+MIN_SELECTED = 50
+"""Samples a ``time_range`` or ``rows`` must select: fewer cannot be filtered and identify nothing."""
+
+IMPLAUSIBLE_EFFORT = 1e6
+"""|torque| [N·m] or |current| [A] above which a log's value is refused: no robot joint comes near it (the largest
+industrial arms' joints carry about 1e5 N·m)."""
+
+
 def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
     """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
     currents or torques flat at their extreme (saturation), naming joint and time range."""
     lim = robot.limits
-    worst, outside = np.zeros(q.shape[1]), []
+    worst, outside, still = np.zeros(q.shape[1]), [], []
     for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
         column = q[:, j]
         worst[j] = np.abs(column).max()
+        still.append(bool(column.max() == column.min()))
         k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
         outside.append((k.size, k[0] if k.size else 0))
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
                         f"positions in degrees (positions = {{ ..., unit = \"deg\" }})?")
+    if all(still):
+        raise DataError(f"{source}: no joint's position ever changes ({spec.table or spec.name}): a frozen log, or the "
+                        "wrong columns or rows?")
     for j, (count, first) in enumerate(outside):
         if count:
             warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
@@ -264,6 +276,10 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
     for j in range(tau.shape[1]):
         x = tau[:, j]
         peak = np.abs(x).max()
+        if peak > IMPLAUSIBLE_EFFORT:
+            top = int(np.argmax(np.abs(x)))
+            raise DataError(f"{tau_source}: joint {j + 1}'s {kind} reach {x[top]:.4g} at t = {t[top]:.3f} s, implausible for "
+                            f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
         if peak == 0:
             continue
         at = np.abs(np.abs(x) - peak) <= 1e-9 * peak
@@ -511,6 +527,10 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         if where is not None:
             where = (lambda w, f: (lambda k: w(k + f)))(where, first)
     raw = _held_rows(spec, t, raw, warnings)
+    if (spec.time_range is not None or spec.rows is not None) and t.size < MIN_SELECTED:
+        which, value = ("time_range", list(spec.time_range)) if spec.time_range is not None else ("rows", list(spec.rows or ()))
+        raise DataError(f"{spec.table or spec.name}: {which} = {value} selects {t.size} samples; at least {MIN_SELECTED} "
+                        f"are needed: widen it")
     median = float(np.median(np.diff(t)))
     table = spec.table or spec.name
     if timed:

@@ -234,9 +234,27 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     except ConfigError as exc:
         raise ConfigError(f"{path}: estimation.estimators: {str(exc).split(': ', 1)[1]}") from None
     refs = doc.get("references", [])
+    _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root))
+
+
+def _check_reference_names(refs: list, path: Path) -> None:
+    """Reference sets are told apart by name in every table: one name per set, none of dynid's estimates' labels."""
+    from ..estimators.registry import estimate_label, keys
+
+    labels = {estimate_label(k) for k in keys()}
+    seen: dict[str, int] = {}
+    for i, r in enumerate(refs):
+        name = str(r.get("name", "")) if isinstance(r, dict) else ""
+        if name in labels:
+            raise ConfigError(f"{path}: references[{i}].name: {name!r} is the name of dynid's own estimate; name the set "
+                              "after its source")
+        if name in seen:
+            raise ConfigError(f"{path}: references[{i}].name: {name!r} names two reference sets (references[{seen[name]}] "
+                              "too); give each its own name")
+        seen[name] = i
 
 
 def _estimators_from_old(est: dict) -> str:

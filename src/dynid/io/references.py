@@ -175,6 +175,7 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
     warnings = []
     funcs, values, stds = [], [], []
     ignored = []
+    first_seen: dict[str, int] = {}
     for k, r in enumerate(rows):
         line = first_line + k
         try:
@@ -195,6 +196,10 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
             f[std_names.index(cname)] = 1.0
         else:
             f = parse_expression(name, std_names, f"{path}: line {line}")
+            cname = " ".join(name.split())
+        if cname in first_seen:
+            raise DataError(f"{path}: line {line}: {cname} given twice (line {first_seen[cname]}); keep one")
+        first_seen[cname] = line
         funcs.append(f)
         values.append(value)
         stds.append(std)

@@ -20,7 +20,8 @@ URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", 
 def check_urdf_text(path: Path) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
-    Malformed XML and joints of unknown type.
+    Malformed XML, joints of unknown type, and ``<mimic>`` joints (coupled to another: dynid would identify them as
+    independent joints).
 
     Parameters
     ----------
@@ -34,13 +35,25 @@ def check_urdf_text(path: Path) -> None:
 
     parser = expat.ParserCreate()
     problems = []
+    joint: list = []  # the joint element being read (name, type)
 
     def start(name, attrs):
-        if name == "joint" and "type" in attrs and attrs["type"] not in URDF_JOINT_TYPES:
-            problems.append(f"line {parser.CurrentLineNumber}: joint {attrs.get('name', '?')!r} has type {attrs['type']!r}, "
-                            f"expected one of {', '.join(URDF_JOINT_TYPES)}")
+        if name == "joint" and "type" in attrs:
+            joint[:] = [attrs.get("name", "?"), attrs["type"]]
+            if attrs["type"] not in URDF_JOINT_TYPES:
+                problems.append(f"line {parser.CurrentLineNumber}: joint {attrs.get('name', '?')!r} has type {attrs['type']!r}, "
+                                f"expected one of {', '.join(URDF_JOINT_TYPES)}")
+        elif name == "mimic" and joint and joint[1] != "fixed":
+            problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} mimics joint {attrs.get('joint', '?')!r} "
+                            "(<mimic>): dynid identifies independent joints; make it a fixed joint at its usual angle, or "
+                            "describe the coupling as a [transmission] of a robot description")
+
+    def end(name):
+        if name == "joint":
+            joint.clear()
 
     parser.StartElementHandler = start
+    parser.EndElementHandler = end
     try:
         parser.Parse(path.read_bytes(), True)
     except expat.ExpatError as exc:

@@ -243,6 +243,16 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
         s = replace(s, min_speed=tuple(float(v) for v in vmin),
                     derivation=s.derivation + f"; rows slower than {100 * MIN_SPEED_FRACTION:g} % of the joint's RMS speed "
                     "(or than twice its rest velocity) left out of the estimation")
+    elif strict:  # a given minimum speed above every speed of a joint leaves it no row
+        vmin = _min_speed(s, recording.q.shape[1])
+        peak = np.abs(dq).max(axis=0) if isinstance(dq, np.ndarray) else np.array(
+            [np.abs(dq.column(j)).max() for j in range(dq.shape[1])])
+        slow = np.flatnonzero(vmin > peak)
+        if slow.size:
+            j = int(slow[0])
+            raise ConfigError(f"preprocessing.min_speed: {vmin[j]:.4g} rad/s is above every speed of joint {j + 1} in "
+                              f"{recording.label} (at most {peak[j]:.4g} rad/s), which leaves it no row; lower it, or "
+                              "leave it out (5 % of each joint's RMS speed)")
     if ddq is None:
         ddq = differentiate(dq, rate)
     t = recording.t

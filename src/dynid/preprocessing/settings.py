@@ -194,6 +194,11 @@ class Preprocessing:
         lowered = False
         if par is None:
             par = derived.parallel_cutoff
+        if strict and self.decimation is not None and self.decimation > 1 and decimation_cutoff(rate, self.decimation) < band:
+            raise ConfigError(f"preprocessing.decimation: {self.decimation} keeps {rate / self.decimation:.4g} Hz of {name} "
+                              f"({rate:.6g} Hz), whose anti-aliasing filter ({decimation_cutoff(rate, self.decimation):.3g} Hz) "
+                              f"would remove the motion ({source}: {band:.3g} Hz); at most "
+                              f"{decimation_for(rate, band)}, or leave it out")
         if self.decimation is not None and self.decimation > 1 and par > decimation_cutoff(rate, self.decimation):
             limit = decimation_cutoff(rate, self.decimation)
             if self.parallel_cutoff:  # both given and they contradict: say so
