@@ -463,3 +463,56 @@ def test_urdfs_dynid_cannot_model(tmp_path, case):
     (tmp_path / "r.urdf").write_text(text)
     out = tmp_path / "o"
     assert_refused(invoke("run", "--robot", tmp_path / "r.urdf", "--joints", "2", "--out", out, *RUN), message, out)
+
+
+def test_a_damaged_bag_metadata_file_is_one_line(tmp_path):
+    from ..io.test_bags import _write_bag
+
+    t = np.arange(200) * 0.01
+    q = 0.01 * np.outer(np.arange(200), np.ones(6))
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    _write_bag(tmp_path / "bag", t, names, q, q, q)
+    (tmp_path / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  version: [5\n  bad: : :\n")
+    (tmp_path / "c.toml").write_text('robot = "ur10e"\ndata_root = "."\n[identification]\nbag = "bag"\n')
+    out = tmp_path / "o"
+    assert_refused(invoke("identify", tmp_path / "c.toml", "--out", out),
+                   "metadata.yaml: while parsing a flow sequence at line 2, column 12; expected ',' or ']', but got ':' at line 3", out)
+
+
+def test_results_files_of_the_wrong_shape(identified):
+    cfg, results = identified
+    folder = cfg.parent
+    (folder / "empty.json").write_text("")
+    (folder / "list.json").write_text("[1, 2]")
+    (folder / "run.json").write_text(json.dumps({"schema_version": 2, "dynid_version": "0", "kind": "run"}))
+    (folder / "future.json").write_text(json.dumps({**json.loads(results.read_text()), "schema_version": 9}))
+    cases = [
+        (folder, "a folder; give the results.json in it"),
+        (folder / "empty.json", "empty.json: cannot read it as JSON"),
+        (folder / "list.json", "list.json: expected the results.json of dynid identify (a JSON object), got a list"),
+        (folder / "run.json", "run.json: expected the results.json of dynid identify, got the results of dynid run"),
+        (folder / "future.json", "future.json: schema_version: expected 2, got 9 (written by another version of dynid?)"),
+    ]
+    for path, message in cases:
+        for command, args in (("validate", ["--out", folder / "v"]), ("export", ["--urdf", folder / "r.urdf"])):
+            assert_refused(invoke(command, cfg, "--results", path, *args), message, folder / "v")
+    assert not (folder / "r.urdf").exists()
+
+
+MONTECARLO_ROUND3 = {
+    "zero duration": (["--duration", "0"], "--duration"),
+    "too few samples": (["--duration", "1", "--rate", "2"], "--rate"),
+    "unknown robot": (["--robot", "ur99"], "ur99"),
+    "joints beyond the robot": (["--joints", "9"], "--joints"),
+    "unknown strategy": (["--strategy", "magic"], "--strategy"),
+    "unknown box": (["--abc-bounds", "wide"], "--abc-bounds"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MONTECARLO_ROUND3))
+def test_montecarlo_options_are_checked_before_the_workers_start(tmp_path, case):
+    args, message = MONTECARLO_ROUND3[case]
+    out = tmp_path / "o"
+    result = invoke("montecarlo", "--out", out, "--realisations", "2", *args)
+    assert_refused(result, message, out)
+    assert "starting the workers" not in result.stderr

@@ -424,9 +424,11 @@ def montecarlo(
 
     def prepare():
         _renamed(methods)
-        return MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
-                                estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
-                                rate=rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
+        config = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
+                                  estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
+                                  rate=rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
+        config.validate()  # every option checked before the workers start
+        return config
 
     def compute(cfg, progress):
         progress.update("starting the workers")

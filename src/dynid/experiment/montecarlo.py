@@ -121,14 +121,27 @@ class MonteCarloConfig:
             abc_bounds=self.abc_bounds, excitation=self.excitation, estimators=tuple(self.estimators), bootstrap=0,
             strategy=self.strategy)
 
-    def validate(self) -> None:
-        """Raise :class:`ConfigError` (one line) on any invalid setting."""
+    def validate(self, robot: Robot | None = None) -> None:
+        """Check every setting.
+
+        Parameters
+        ----------
+        robot : Robot, optional
+            The robot of the study (loaded from ``robot`` when not given): the settings of one realisation are
+            checked against it too (:meth:`PaperExperimentConfig.validate`).
+
+        Raises
+        ------
+        ConfigError
+            One line naming the first invalid setting.
+        """
         levels = np.asarray(self.noise_levels, dtype=float)
         if levels.ndim != 1 or levels.size == 0 or not np.all(np.isfinite(levels)) or np.any(levels <= 0):
             raise ConfigError(f"noise_levels: expected positive current noise levels in A like 0.02,0.05, got {list(self.noise_levels)}", field="noise_levels")
         if self.realisations < 2:
             raise ConfigError(f"realisations must be at least 2, got {self.realisations}", field="realisations")
         parse_estimators(self.estimators)
+        self.run_config().validate(robot if robot is not None else load_robot(self.robot))
 
 
 @dataclass
@@ -148,10 +161,9 @@ class _Setup:
 
 
 def _prepare(config: MonteCarloConfig) -> _Setup:
-    config.validate()
     full = load_robot(config.robot)
+    config.validate(full)
     run = config.run_config()
-    run.validate(full)
     robot = full.submodel(config.joints) if config.joints < full.n_dof else full
     base = base_parameters(robot, rng=np.random.default_rng([config.seed, 1]))
     robot.require_physical_nominal("the simulation truth of dynid montecarlo")

@@ -71,7 +71,7 @@ def read_joint_states(spec, robot, name: str):
     except DataError:
         raise
     except Exception as exc:  # rosbags' own errors: a damaged or foreign file
-        raise DataError(f"{path}: cannot read it as a ROS 2 bag ({exc})") from None
+        raise DataError(f"{path}: cannot read it as a ROS 2 bag ({_one_line(str(exc))})") from None
     if len(stamps) < 2:
         raise DataError(f"{path}: {len(stamps)} JointState message(s) on {spec.topic}, expected at least 2")
     signals: dict[str, np.ndarray] = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}
@@ -82,3 +82,21 @@ def read_joint_states(spec, robot, name: str):
             k = int(np.argwhere(~np.isfinite(x))[0, 0])
             raise DataError(f"{path}: message {k + 1} on {spec.topic}: NaN or infinite {kind}")
     return np.array(stamps), signals, lambda k: f"{path}: message {k + 1} on {spec.topic}"
+
+
+def _one_line(message: str) -> str:
+    """A library's multi-line message (a YAML parser's, with the text it quotes and a caret under it) as one line:
+    what it says and where (line and column)."""
+    import re
+
+    parts, quoted = [], False
+    for line in (x.strip() for x in message.splitlines()):
+        where = re.fullmatch(r'in "<[^>]*>", (line \d+, column \d+):?', line)
+        if where:
+            parts.append(f"at {where.group(1)};")
+            quoted = True  # the parser quotes the text next, then a caret under it
+        elif quoted or not line or line.startswith("^"):
+            quoted = False
+        else:
+            parts.append(line)
+    return " ".join(parts).rstrip(";")
