@@ -10,7 +10,7 @@ STAMP  := $(VENV)/.installed
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet --only-binary=:all: -e ".[test]"
+	$(BIN)/pip install --quiet --only-binary=:all: -e ".[test,docs]"
 	$(BIN)/python -m dynid.warm_up  # compiles the numba kernels into their cache, so the first run does not
 	touch $(STAMP)
 
@@ -20,6 +20,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m mypy  # type check of src/dynid ([tool.mypy] in pyproject.toml)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict --quiet  # the docs site (mkdocs.yml) into .site/
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_table.py
@@ -28,4 +29,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_excitation_design.py
 
 clean:
-	rm -rf $(VENV) dynid-run
+	rm -rf $(VENV) dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo .site

@@ -54,3 +54,15 @@ def test_package_exports_the_entry_points():
         assert getattr(dynid, name) is not None, name
     with pytest.raises(AttributeError):
         dynid.nonexistent
+
+
+def test_own_robot_example_identifies_from_a_urdf_and_a_csv(tmp_path):
+    """The docs' quickstart: a config of a few lines naming a URDF and a CSV's columns by header."""
+    import json
+
+    out = _run("own_robot.py", cwd=tmp_path)
+    assert "wrote arm-identified/results.json" in out
+    assert "robot = " in (tmp_path / "arm.toml").read_text() and len((tmp_path / "arm.toml").read_text().splitlines()) <= 9
+    results = json.loads((tmp_path / "arm-identified" / "results.json").read_text())
+    fit = results["identification"]["metrics"][results["main_estimate"]]
+    assert fit["global_relative_error"] < 1.0  # a simulated log: the model is right, the noise is small

@@ -21,7 +21,7 @@ The main entry points, importable from the package (each loads its modules on fi
 
 from ._lazy import lazy_exports
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 _EXPORTS = {
     "load_robot": "dynid.model.description",

@@ -1,0 +1,58 @@
+"""The docs' code runs as written: every ```python block of a tutorial, in order, in one namespace."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+
+
+def _blocks(page: Path) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S)
+
+
+@pytest.mark.parametrize("page", ["tutorials/using-the-model.md"])
+def test_the_tutorials_python_runs(page, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    blocks = _blocks(DOCS / page)
+    assert blocks, f"no python blocks in {page}"
+    namespace: dict = {}
+    for code in blocks:
+        exec(compile(code, str(DOCS / page), "exec"), namespace)
+    out = capsys.readouterr().out
+    contact, alarm = re.search(r"contact at ([\d.]+) s; first alarm at ([\d.]+) s on joint 2", out).groups()
+    assert contact == alarm, out
+    ratios = re.search(r"largest \|residual\| / σ per joint: \[(.*?)\]", out).group(1).split()
+    assert all(float(r) < 8 for r in ratios), out  # no false alarm on the log before the contact
+
+
+def test_every_page_of_the_site_is_in_its_navigation():
+    import yaml  # mkdocs' own dependency
+
+    nav = yaml.safe_load((DOCS.parent / "mkdocs.yml").read_text())["nav"]
+
+    def pages(entries):
+        for e in entries:
+            for v in e.values():
+                yield from (pages(v) if isinstance(v, list) else [v])
+
+    listed = set(pages(nav))
+    present = {p.relative_to(DOCS).as_posix() for p in DOCS.rglob("*.md")}
+    assert present == listed, (present - listed, listed - present)
+
+
+def test_the_readmes_python_runs(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (code,) = _blocks(DOCS.parent / "README.md")
+    exec(compile(code, "README.md", "exec"), {})
+    assert float(capsys.readouterr().out.strip().splitlines()[-1]) > 0.99
+    assert (tmp_path / "results.json").is_file()
+
+
+def test_the_readme_is_a_users_guide_under_250_lines():
+    readme = (DOCS.parent / "README.md").read_text(encoding="utf-8")
+    assert len(readme.splitlines()) < 250
+    blocks = re.findall(r"```sh\n(.*?)```", readme, flags=re.S)
+    setup = [line.split("#")[0].strip() for line in blocks[0].splitlines() if line.strip()]
+    assert setup == ["make demo", "make test"]  # the two set-up commands, and only them
