@@ -64,6 +64,12 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     np.testing.assert_allclose(gp.description_gains, authors)
     assert np.all(np.abs(gp.gains.gains[1:] - authors[1:]) <= 0.2 * authors[1:])
     assert gp.payload.mass == pytest.approx(2.805, rel=0.1)
+    # K1 (a vertical axis: the payload adds only its inertia's torque) is not determined, as the authors found: said
+    # with why, not printed as a number ± σ; the wrist's gains, set by the joints below them, are
+    assert np.isnan(gp.gains.gains[0]) and np.all(np.isfinite(gp.gains.gains[1:]))
+    why = gp.gains.why_not_observable(0)
+    assert "residual σ (at least 3× needed)" in why and "moves to" in why
+    assert gp.gains.to_dict()["not_observable"] == {"K1": why}
 
 
 def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed_after_it(monkeypatch, tmp_path):
@@ -94,6 +100,9 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     assert len(forks) == n_beside
     for path, result in (("beside.json", beside), ("after.json", after)):
         write_json(tmp_path / path, without_wall_times(result.to_dict()))
-    assert (tmp_path / "beside.json").read_text() == (tmp_path / "after.json").read_text()
+    from .. import digests  # the same numbers, but SDP optima (consistency margins) to the solver's tolerance: cvxpy
+    #                         re-solving a problem it cached earlier in the process moves them in the 11th digit
+    read = lambda name: digests.flatten(json.loads((tmp_path / name).read_text()))  # noqa: E731
+    assert digests.differences(read("beside.json"), read("after.json")) == []
     assert "drive_gains" in json.loads((tmp_path / "after.json").read_text())
-    assert beside.drive_gains.gains.gains.tolist() == after.drive_gains.gains.gains.tolist()
+    np.testing.assert_array_equal(beside.drive_gains.gains.gains, after.drive_gains.gains.gains)  # NaN where not determined

@@ -54,6 +54,12 @@ def _independent(columns: np.ndarray, rng: np.random.Generator, robot: Robot, to
     return np.sort(columns[piv[:rank]])
 
 
+MIN_SIGNAL_TO_NOISE = 3.0
+"""The known mass's torque on a joint (RMS) must be this many times the joint's residual σ for its gain to count as
+determined: below, model error, not the payload, sets the value (Gautier & Briot's method needs the payload to
+change each joint's torque well above the noise)."""
+
+
 @dataclass(frozen=True)
 class DriveGainEstimate:
     """Drive gains from a run without and one with a payload of known mass.
@@ -69,6 +75,16 @@ class DriveGainEstimate:
     payload_mass : float [kg]
     n_rows : int
     condition_number : float
+    payload_torque : (n_dof,) array [N·m] or None
+        RMS over the loaded run of the torque the known mass adds to each joint.
+    residual_std : (n_dof,) array [N·m] or None
+        Each joint's residual σ in the stacked fit. A gain is not observable where ``payload_torque`` is below
+        :data:`MIN_SIGNAL_TO_NOISE` times it and the other joints' equations do not set it.
+    undetermined : (n_dof,) array [N·m/A] or None
+        What the fit gave for the gains it does not determine (NaN elsewhere), for the record.
+    without_own : (n_dof,) array [N·m/A] or None
+        The estimate without the joint's own payload torque, for the joints whose payload torque is weak (NaN
+        elsewhere): a move beyond 3σ says the weak torque set the value.
     """
 
     gains: np.ndarray
@@ -77,6 +93,34 @@ class DriveGainEstimate:
     payload_mass: float
     n_rows: int
     condition_number: float
+    payload_torque: np.ndarray | None = None
+    residual_std: np.ndarray | None = None
+    undetermined: np.ndarray | None = None
+    without_own: np.ndarray | None = None
+
+    def why_not_observable(self, j: int) -> str:
+        """Why joint ``j``'s gain is not observable ("" when it is).
+
+        Parameters
+        ----------
+        j : int
+            0-based joint.
+
+        Returns
+        -------
+        str
+        """
+        if np.isfinite(self.gains[j]):
+            return ""
+        if self.payload_torque is None or self.residual_std is None:
+            return "the payload does not reach this joint"
+        ratio = self.payload_torque[j] / max(float(self.residual_std[j]), 1e-300)
+        text = (f"the payload adds RMS {self.payload_torque[j]:.3g} N·m to this joint, {ratio:.2g}× its residual σ "
+                f"(at least {MIN_SIGNAL_TO_NOISE:g}× needed)")
+        if self.undetermined is not None and self.without_own is not None and np.isfinite(self.without_own[j]):
+            text += (f"; the fit's {self.undetermined[j]:.4g} N·m/A moves to {self.without_own[j]:.4g} without that "
+                     "torque")
+        return text
 
     def to_dict(self) -> dict:
         """JSON-ready estimate.
@@ -84,10 +128,17 @@ class DriveGainEstimate:
         Returns
         -------
         dict
-            ``gains``, ``gains_std``, ``payload_mass`` [kg], ``n_rows``, ``condition_number``.
+            ``gains`` (None where not observable), ``gains_std``, ``payload_mass`` [kg], ``n_rows``,
+            ``condition_number``, ``not_observable`` (gain -> why), ``payload_torque_rms`` and ``residual_std`` [N·m].
         """
-        return {"gains": self.gains.tolist(), "gains_std": self.gains_std.tolist(), "payload_mass": self.payload_mass,
-                "n_rows": self.n_rows, "condition_number": self.condition_number}
+        out = {"gains": self.gains.tolist(), "gains_std": self.gains_std.tolist(), "payload_mass": self.payload_mass,
+               "n_rows": self.n_rows, "condition_number": self.condition_number,
+               "not_observable": {f"K{j + 1}": self.why_not_observable(j) for j in range(self.gains.size)
+                                  if not np.isfinite(self.gains[j])}}
+        if self.payload_torque is not None and self.residual_std is not None:
+            out["payload_torque_rms"] = self.payload_torque.tolist()
+            out["residual_std"] = self.residual_std.tolist()
+        return out
 
 
 @dataclass(frozen=True)
@@ -156,6 +207,8 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
     nb, nl = base.n_base, last.size
     p = n + nb + nl
     acc = LeastSquaresAccumulator(p, n)
+    known_sumsq, known_rows = np.zeros(n), np.zeros(n)  # the known mass's torque on each joint, on the rows kept
+    normal, by_joint = np.zeros((p, p)), np.zeros((p, n))  # AᵀA, and Aᵀb from each joint's rows (for the test below)
     for data, is_loaded in ((unloaded, False), (loaded, True)):
         for _, y, current, keep in base_chunks(robot, base, data, standard=True):
             m = y.shape[0]
@@ -166,14 +219,34 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
             if is_loaded:
                 a[:, :, n + nb:] = -y[:, :, last]
                 rhs = y[:, :, mass_col] * payload_mass
+                known_sumsq += np.sum(np.where(keep, rhs, 0.0) ** 2, axis=0)
+                known_rows += keep.sum(axis=0)
+            kept = a * keep[:, :, None]
+            normal += np.einsum("mjp,mjq->pq", kept, a)
+            by_joint += np.einsum("mjp,mj->pj", kept, rhs)
             acc.add(a.reshape(-1, p), rhs.reshape(-1), keep.reshape(-1))
     sol = acc.solve(rcond=1e-12)
     gains, std = sol.params[:n].copy(), sol.params_std[:n].copy()
-    weak = ~(std < 0.5 * np.abs(gains))  # σ beyond half the value: the payload does not reach that joint
-    gains[weak], std[weak] = np.nan, np.inf
+    known = np.sqrt(known_sumsq / np.maximum(known_rows, 1))
+    residual = acc.joint_residual_std(sol.params)
+    signal_to_noise = known / np.maximum(residual, 1e-300)
+    # A gain is determined where the known mass changes the joint's torque well above the residual; elsewhere the
+    # covariance's σ, computed as if the model were exact, says nothing of the error (UR10e J1: σ 2 %, the value
+    # 26 % off the description's, the payload's torque 1.8× the residual).
+    weak = ~(std < 0.5 * np.abs(gains))
+    without_own = np.full(n, np.nan)
+    for j in np.flatnonzero(~(signal_to_noise >= MIN_SIGNAL_TO_NOISE) & ~weak):
+        # A gain whose own payload torque is weak may still be set by the other joints' equations (a wrist joint
+        # shares its link's parameters with the joints below it): it is determined if it stays where it is without
+        # that torque; if it moves by more than 3σ, the weak torque set it and the σ understates its error.
+        without_own[j] = np.linalg.lstsq(normal, by_joint.sum(axis=1) - by_joint[:, j], rcond=None)[0][j]
+        weak[j] = not abs(without_own[j] - gains[j]) <= 3 * std[j]
     if np.all(weak):
         raise IdentifiabilityError("drive_gains: the payload's mass makes no joint's gain observable")
-    return DriveGainEstimate(gains, std, sol.params[n:n + nb], float(payload_mass), sol.n_rows, sol.condition_number)
+    estimate = DriveGainEstimate(gains, std, sol.params[n:n + nb], float(payload_mass), sol.n_rows,
+                                 sol.condition_number, known, residual, np.where(weak, gains, np.nan), without_own)
+    estimate.gains[weak], estimate.gains_std[weak] = np.nan, np.inf
+    return estimate
 
 
 def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, rng=0) -> PayloadEstimate:

@@ -202,15 +202,17 @@ def drive_gains_blocks(gains) -> list:
     rows = []
     for j, (k, s, d) in enumerate(zip(g.gains, g.gains_std, gains.description_gains)):
         rows.append((f"J{j + 1}", f"{k:.4g}", f"{s:.2g}", f"{d:.4g}", f"{100 * (k - d) / d:+.1f}") if math.isfinite(k)
-                    else (f"J{j + 1}", "not observable", "", f"{d:.4g}", ""))
+                    else (f"J{j + 1}", "not determined", "", f"{d:.4g}", ""))
     table = TextTable(f"Drive gains K (eq. 16) from the runs without and with the {g.payload_mass:g} kg payload "
                       f"(Gautier & Briot; {g.n_rows} equations)",
                       ("joint", "K (N·m/A)", "σ", "description", "diff. %"), tuple(rows))
+    why = [Line(f"K{j + 1} not determined: {g.why_not_observable(j)}; the description's {d:.4g} N·m/A is used",
+                "warning") for j, d in enumerate(gains.description_gains) if not math.isfinite(g.gains[j])]
     vals = dict(zip(p.names, zip(p.values, p.std)))
     line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"
     if all(k in vals for k in ("MX", "MY", "MZ")):
         line += ", centre of mass in the last link's frame (" + ", ".join(f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
-    return [table, Line(line)]
+    return [table, *why, Line(line)]
 
 
 def montecarlo_blocks(result) -> list:
