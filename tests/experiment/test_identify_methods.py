@@ -93,3 +93,21 @@ def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
     assert [e.key for e in as_text.estimates.values()] == ["ols", "wls"]
     for a, b in zip(as_text.estimates.values(), as_tuple.estimates.values()):
         np.testing.assert_array_equal(a.params, b.params)
+
+
+def test_the_output_ends_with_how_it_went_and_what_to_do_next(tmp_path):
+    """The last lines of dynid identify: the estimate to use, each log's error and worst joint, the next step."""
+    from dynid.report.summaries import identification_blocks
+    from dynid.tables import render_text
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
+    result = run_identification(load_identification_config(cfg))
+    text = render_text(identification_blocks(result), 200)
+    tail = text[text.index("In short"):].splitlines()
+    label = result.main_estimate.label
+    assert tail[1].startswith(f"use {label}, ") and "physically consistent" in tail[1]
+    main = result.fit.metrics()[label]
+    assert tail[2].startswith(f"{result.fit.name}: torque error {main['global_relative_error']:.3g} % over all joints, worst J")
+    assert len([t for t in tail if "torque error" in t]) == 1 + len(result.validations)
+    assert tail[-1].startswith("next: ")

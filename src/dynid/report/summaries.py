@@ -125,6 +125,58 @@ def identification_blocks(result) -> list:
                                                if not r.findings else f"{len(r.findings)} finding(s)"), "title"))
     out.extend(Line(f.text) for f in r.findings)
     out.extend(Line(w, "warning") for w in r.warnings)
+    out.extend(in_short(r))
+    return out
+
+
+def in_short(result) -> list:
+    """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
+    log's global error and worst joint, and what to do next.
+
+    Parameters
+    ----------
+    result : dynid.experiment.identification.IdentificationResult
+
+    Returns
+    -------
+    list of Line
+    """
+    r = result
+    label = r.main_estimate.label
+    verdict = r.consistency_verdicts.get(label, "")
+    consistent = verdict.startswith("yes")
+    out = [Line("In short", "title"),
+           Line(f"use {label}" + ("" if not verdict else
+                                  ", physically consistent" if consistent else ", not physically consistent"))]
+    errors = {}
+    for c in (r.fit, *r.validations):
+        m = c.metrics().get(label)
+        if m is None:
+            continue
+        rel, ok = np.asarray(m["relative_error"], dtype=float), c.meaningful()
+        worst = int(np.nanargmax(np.where(ok, rel, -np.inf))) if np.any(ok) else None
+        errors[c.name] = float(m["global_relative_error"])
+        out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
+                        + ("" if worst is None else f", worst J{worst + 1} {rel[worst]:.3g} %")
+                        + (" (the fit)" if c is r.fit else "")))
+    fit = errors.get(r.fit.name)
+    far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)]
+    if far:
+        out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
+                        "rests; the report shows where)"))
+    exportable = [name for name, v in r.consistency_verdicts.items() if name in r.estimates and v.startswith("yes")]
+    if r.findings:
+        step = "read the verdict's findings above: they say where the model misses the data"
+    elif not r.validations:
+        step = "add [[validation]] logs (other motions) to check the model where it was not fitted"
+    elif exportable:
+        step = (f"{exportable[0]} is physically consistent: export it for a simulator or a controller with "
+                "dynid export CONFIG --urdf FILE --mjcf FILE")
+    elif "sdp" not in r.estimators:
+        step = 'for a model to simulate, add "sdp" to [estimation] estimators (a physically consistent estimate)'
+    else:
+        step = "use the model to predict torques; no estimate is physically consistent, so none is exported"
+    out.append(Line("next: " + step))
     return out
 
 
