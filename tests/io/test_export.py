@@ -1,6 +1,7 @@
 """URDF export: the exported model, loaded by Pinocchio, reproduces dynid's torques (round trip)."""
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -60,3 +61,72 @@ def test_inconsistent_parameters_are_refused_naming_link_and_rule(rng):
                "physically_consistent_verdict": {"dynid SDP": "no: fv4 = -0.02 < 0"}}
     with pytest.raises(ConfigError, match=r"did not pass the consistency check \(no: fv4 = -0.02 < 0\)"):
         urdf_from_results(robot, results, "r.json")
+
+
+def _without_identified(root):
+    """The URDF's elements as (path, tag, attributes, text), leaving out what the write-back replaces: the moving links'
+    and their fixed children's <inertial>, the joints' <dynamics>, and comments."""
+    out = []
+
+    def walk(e, where):
+        for child in e:
+            if not isinstance(child.tag, str) or child.tag in ("inertial", "dynamics"):
+                continue
+            here = f"{where}/{child.tag}[{child.get('name', '')}]"
+            out.append((here, tuple(sorted(child.attrib.items())), (child.text or "").strip()))
+            walk(child, here)
+
+    walk(root, "")
+    return out
+
+
+def test_the_users_urdf_gets_the_identified_values_and_keeps_everything_else(tmp_path):
+    """Write-back export: names, frames, visuals, collisions, meshes, transmissions, gazebo tags stay; read back by
+    Pinocchio (dynid's URDF reader), the links hold exactly the standard parameters written (the fixed tool frames'
+    inertials merged into the last link, as dynid identified them)."""
+    import xml.etree.ElementTree as ET
+    from importlib import resources
+
+    import dynid
+    from dynid.io.export import urdf_written_back
+
+    urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+    robot = dynid.load_robot(urdf)
+    rng = np.random.default_rng(0)
+    phi = robot.standard_parameters().copy()
+    names = list(robot.parameter_names)
+    for j in range(robot.n_dof):  # another physically consistent set: each link's mass and friction scaled
+        scale = rng.uniform(0.7, 1.3)
+        for term in ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"):
+            phi[names.index(f"{term}{j + 1}")] *= scale
+        phi[names.index(f"fv{j + 1}")] = 0.5 + j
+        phi[names.index(f"fc{j + 1}")] = 2.0 + j
+    text, moved = urdf_written_back(urdf, robot, phi)
+    (tmp_path / "back.urdf").write_text(text)
+    original = ET.parse(urdf).getroot()
+    written = ET.fromstring(text.split("\n", 1)[1])
+    assert _without_identified(written) == _without_identified(original)
+    back = dynid.load_robot(tmp_path / "back.urdf")
+    assert [j.name for j in back.joints] == [j.name for j in robot.joints]
+    np.testing.assert_allclose(back.inertial, robot.with_parameters(phi).inertial, rtol=1e-12, atol=1e-15)
+    dynamics = {j.get("name"): j.find("dynamics") for j in written.findall("joint") if j.get("type") == "revolute"}
+    assert [float(dynamics[j.name].get("damping")) for j in robot.joints] == [0.5 + j for j in range(6)]
+    assert [float(dynamics[j.name].get("friction")) for j in robot.joints] == [2.0 + j for j in range(6)]
+    assert "one physically consistent choice among the many" in text and moved == []
+
+
+def test_a_link_far_from_the_urdfs_values_is_said(tmp_path):
+    from importlib import resources
+
+    import dynid
+    from dynid.io.export import urdf_written_back
+
+    urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+    robot = dynid.load_robot(urdf)
+    phi = robot.standard_parameters().copy()
+    names = list(robot.parameter_names)
+    for term in ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"):
+        phi[names.index(f"{term}4")] *= 3.0
+    text, moved = urdf_written_back(urdf, robot, phi)
+    assert len(moved) == 1 and moved[0].startswith("wrist_1_link: mass ") and "(the URDF's " in moved[0]
+    assert "Far from the URDF's own values" in text

@@ -278,11 +278,21 @@ def export(
         return cfg, identified, targets
 
     def compute(prepared, progress):
-        from ..io.export import mjcf_from_results, urdf_from_results
+        from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results, urdf_written_back
 
         cfg, identified, targets = prepared
-        export = {"--urdf": urdf_from_results, "--mjcf": mjcf_from_results}
-        return cfg.robot, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets]
+        moved: list[str] = []
+
+        def urdf_text(robot, identified, source):
+            if cfg.urdf is None:  # a DH description: a URDF of its own
+                return urdf_from_results(robot, identified, source)
+            fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
+            text, far = urdf_written_back(cfg.urdf, fitted, phi)
+            moved.extend(far)
+            return text
+
+        export = {"--urdf": urdf_text, "--mjcf": mjcf_from_results}
+        return cfg, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets], moved
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -292,8 +302,12 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        robot = computed[0]
-        rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints; what the "
+        cfg, _, moved = computed
+        robot = cfg.robot
+        into = f"; the URDF is {cfg.urdf.name} with only its inertials and joint dynamics replaced" if cfg.urdf else ""
+        for line in moved:
+            rep.warning(f"far from the URDF's own values: {line}")
+        rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)

@@ -120,3 +120,46 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
         return load_robot(ref)
     except ConfigError as exc:  # an unknown name: said as the config wrote it, with the config and the field
         raise ConfigError(f"{path}: robot: {exc}") from None
+
+
+def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | None:
+    """The URDF a config's robot comes from, if it comes from one (for the export to write the values back into it).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed config.
+    path : Path
+        The config file.
+    data_root : Path, optional
+        The data folder, searched second.
+
+    Returns
+    -------
+    Path or None
+        ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
+        ``convention = "urdf"``; None for a built-in robot or a DH description.
+    """
+    ref = doc.get("robot")
+
+    def found(name: str, folder: Path) -> Path | None:
+        for base in (folder, data_root):
+            if base is not None and (base / name).is_file():
+                return (base / name).resolve()
+        return None
+
+    if isinstance(ref, dict):
+        return found(str(ref["urdf"]), path.parent) if isinstance(ref.get("urdf"), str) else None
+    if not isinstance(ref, str) or ref in builtin_robots():
+        return None
+    file = found(ref, path.parent)
+    if file is None:
+        return None
+    if file.suffix.lower() == ".urdf":
+        return file
+    try:
+        described = tomllib.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    urdf = described.get("urdf")
+    return found(urdf, file.parent) if described.get("convention") == "urdf" and isinstance(urdf, str) else None

@@ -72,7 +72,7 @@ import msgspec
 from ..exceptions import ConfigError, DataError
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
-from .configs import config_robot, read_config, robot_source
+from .configs import config_robot, config_urdf, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .trajectories import load_trajectory
 from ..model.robot import Robot
@@ -111,6 +111,9 @@ class IdentificationConfig:
         A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
     friction : str
         "auto": each joint's friction model by cross-validation; "description": as described.
+    urdf : Path or None
+        The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
+        identified values back into it.
     """
 
     path: Path
@@ -125,6 +128,7 @@ class IdentificationConfig:
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
+    urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
 
 
 REMOVED = {
@@ -237,7 +241,8 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
-                                seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root))
+                                seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
+                                urdf=config_urdf(doc, path, root))
 
 
 def _check_reference_names(refs: list, path: Path) -> None:
