@@ -50,6 +50,12 @@ def run_summary_blocks(result) -> list:
     out.append(TextTable("Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; "
                          "mean over joints of ρ (eq. 18), RMSE (N·m) and error % on β2; physically consistent",
                          ("method", "F", "evals", "s", "Δβ %", "ρ β2", "RMSE", "err %", "cons."), tuple(rows)))
+    if d.get("search_box") == "table3":
+        out.append(Line("LAD, ABC, DE and PSO search the paper's Table 3 box"))
+    elif d.get("search_box") == "scaled":
+        out.append(Line("LAD, ABC, DE and PSO search the box ±(2|β_OLS| + 1), which holds the truth"
+                        + (" (the paper's Table 3 box holds the paper's plant, not this one: --plant paper, or "
+                           "--abc-bounds table3)" if cfg.robot == "er16" and cfg.joints == 3 else "")))
     for key, beta, paper_vals in (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
                                   ("validation", "β2", ref.CORRELATION_VALIDATION)):
         for metric, title, fmt in (("correlation", "correlation coefficient ρ (eq. 18)", ".4f"), ("relative_error", "relative error %", ".3g")):
