@@ -95,8 +95,8 @@ def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
         np.testing.assert_array_equal(a.params, b.params)
 
 
-def test_the_output_ends_with_how_it_went_and_what_to_do_next(tmp_path):
-    """The last lines of dynid identify: the estimate to use, each log's error and worst joint, the next step."""
+def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
+    """The first lines of dynid identify: the estimate to use, each log's error and worst joint, the next step."""
     from dynid.report.summaries import identification_blocks
     from dynid.tables import render_text
 
@@ -104,7 +104,9 @@ def test_the_output_ends_with_how_it_went_and_what_to_do_next(tmp_path):
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
     result = run_identification(load_identification_config(cfg))
     text = render_text(identification_blocks(result), 200)
-    tail = text[text.index("In short"):].splitlines()
+    lines = text.splitlines()
+    assert lines[1].startswith("In short")  # right after the title
+    tail = lines[1:next(i for i, t in enumerate(lines) if t.startswith("next: ")) + 1]
     label = result.main_estimate.label
     assert tail[1].startswith(f"use {label}, ") and "physically consistent" in tail[1]
     main = result.fit.metrics()[label]

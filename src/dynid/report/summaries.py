@@ -81,6 +81,7 @@ def identification_blocks(result) -> list:
     sol, base = r.solution, r.base
     out: list = [Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {base.n_base} base "
                 f"parameters from {r.n_rows} equations, cond = {sol.condition_number:.4g}", "title")]
+    out.extend(in_short(r))  # how it went and what to do next, first; the details follow
     pre = r.settings.get("preprocessing", {})
     if pre.get("derivation"):
         out.append(Line("preprocessing: " + pre["derivation"]))
@@ -125,7 +126,6 @@ def identification_blocks(result) -> list:
                                                if not r.findings else f"{len(r.findings)} finding(s)"), "title"))
     out.extend(Line(f.text) for f in r.findings)
     out.extend(Line(w, "warning") for w in r.warnings)
-    out.extend(in_short(r))
     return out
 
 
@@ -145,7 +145,7 @@ def in_short(result) -> list:
     label = r.main_estimate.label
     verdict = r.consistency_verdicts.get(label, "")
     consistent = verdict.startswith("yes")
-    out = [Line("In short", "title"),
+    out = [Line("In short (the details follow)", "title"),
            Line(f"use {label}" + ("" if not verdict else
                                   ", physically consistent" if consistent else ", not physically consistent"))]
     errors = {}
@@ -166,7 +166,7 @@ def in_short(result) -> list:
                         "rests; the report shows where)"))
     exportable = [name for name, v in r.consistency_verdicts.items() if name in r.estimates and v.startswith("yes")]
     if r.findings:
-        step = "read the verdict's findings above: they say where the model misses the data"
+        step = "read the verdict's findings at the end: they say where the model misses the data"
     elif not r.validations:
         step = "add [[validation]] logs (other motions) to check the model where it was not fitted"
     elif exportable:
