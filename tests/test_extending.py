@@ -87,3 +87,18 @@ def test_an_unknown_strategy_names_the_field(tmp_path):
 
     with pytest.raises(ConfigError, match="preprocessing.strategy: expected one of parallel, paper"):
         run_paper_experiment(PaperExperimentConfig(strategy="nope", **NOISE_FREE))
+
+
+def test_a_missing_optional_dependency_names_the_extra(monkeypatch, tmp_path):
+    """Dask and rosbags are extras: without them, the command that needs one says which extra installs it, in one
+    line, before any work."""
+    import sys
+
+    from typer.testing import CliRunner
+
+    from dynid.cli.app import app
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed: importing it raises ImportError
+    result = CliRunner().invoke(app, ["montecarlo", "--realisations", "2", "--out", str(tmp_path / "o")])
+    assert result.exit_code == 1 and not (tmp_path / "o").exists()
+    assert result.stderr.strip() == 'error: dynid montecarlo needs distributed, which is not installed: pip install "dynid[montecarlo]"'

@@ -14,7 +14,7 @@ import typer
 from ..exceptions import DynIdError
 from ..report.console import Reporter
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
+app = typer.Typer(add_completion=True, no_args_is_help=True, rich_markup_mode=None,
                   help="dynid: dynamic model identification of industrial robot arms.")
 
 QUIET = typer.Option(False, "--quiet", "-q", help="Print only warnings and errors (no progress, no tables).")
@@ -442,6 +442,9 @@ def montecarlo(
                                   estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
                                   rate=rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
         config.validate()  # every option checked before the workers start
+        from ..extras import require
+
+        require("distributed", "montecarlo", "dynid montecarlo")
         return config
 
     def compute(cfg, progress):

@@ -35,6 +35,7 @@ from ..dynamics.regressor import observation_matrix
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..exceptions import ConfigError, DynIdError
+from ..extras import require
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..excitation.fourier import FourierTrajectory
@@ -330,6 +331,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     ConfigError
         The scheduler cannot be reached, or ``workers`` < 1.
     """
+    require("distributed", "montecarlo", "dynid montecarlo")
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -371,6 +373,7 @@ def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: 
     ConfigError
         Invalid settings or an unreachable scheduler.
     """
+    require("distributed", "montecarlo", "dynid montecarlo")
     from distributed import as_completed
 
     t0 = time.perf_counter()

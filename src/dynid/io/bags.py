@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError
+from ..extras import require
 
 
 def read_joint_states(spec, robot, name: str):
@@ -39,9 +40,10 @@ def read_joint_states(spec, robot, name: str):
         A missing or unreadable bag, no such topic, a topic of another type, joints missing from the messages, or
         messages without positions or efforts.
     """
+    path = spec.path
+    require("rosbags.highlevel", "ros", f"{path}: reading a ROS 2 bag")
     from rosbags.highlevel import AnyReader
 
-    path = spec.path
     if not path.exists():
         raise DataError(f"{path}: ROS 2 bag not found")
     wanted = list(spec.joint_names or [j.name for j in robot.joints])
