@@ -52,3 +52,36 @@ def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
     assert len(report.images) == len(list((tmp_path / "id").glob("*.png"))) == n_logs
     text = " ".join(report.text)
     assert "truth" in text and "dynid SDP" in text and "excitation band" in text
+    # a report for people: what it found first, a table of contents, values outside their range marked, real captions,
+    # settings as people write them, and small (the figures scaled to the page, in few colours)
+    html = (tmp_path / "id" / "report.html").read_text(encoding="utf-8")
+    assert html.index('class="summary"') < html.index('id="settings"') < html.index('id="figures"')
+    assert "Use dynid " in html and "torque error" in html[:html.index('id="settings"')]
+    import re
+
+    targets = set(re.findall(r'href="#([^"]+)"', html))
+    assert targets and all(f'id="{t}"' in html for t in targets)
+    assert "Measured and predicted torques on the identification log" in html
+    assert "True" not in " ".join(report.text).split("Settings", 1)[1].split("Base parameters", 1)[0]
+    embedded = sum(len(src) for src in report.images) * 3 / 4
+    assert embedded < sum(p.stat().st_size for p in (tmp_path / "id").glob("*.png"))
+
+
+def test_values_outside_their_range_are_highlighted():
+    from dynid.report.html import BAD_RELATIVE_STD, identify_sections
+
+    d = {"robot": "r", "condition_number": 10.0, "n_rows": 100,
+         "base_parameters": [{"name": "ZZ1R", "unit": "kg·m²", "value": 1.0, "std": 0.01, "relative_std_percent": 1.0, "expression": "ZZ1"},
+                             {"name": "MX2", "unit": "kg·m", "value": 0.01, "std": 0.02, "relative_std_percent": 2 * BAD_RELATIVE_STD,
+                              "expression": "MX2"}],
+         "identification": {"name": "identification", "n_samples": 10, "relative_error_meaningful": [True, False],
+                             "metrics": {"dynid WLS": {"relative_error": [80.0, 900.0], "rmse": [1.0, 1.0],
+                                                       "correlation": [0.9, 0.1], "global_relative_error": 5.0}}},
+         "main_estimate": "dynid WLS"}
+    _, sections = identify_sections(d)
+    params = next(s for s in sections if s.title == "Base parameters").tables[0]
+    assert params.flagged == {(1, 4)}
+    fit = next(s for s in sections if s.title.startswith("Measured")).tables[0]
+    assert fit.flagged == {(0, 2)} and fit.rows[0][3] == "n/m"  # J2's torque is at the noise level: not flagged, n/m
+    summary = next(s for s in sections if s.title == "In short").texts
+    assert summary[1] == "identification: torque error 5 % over all joints, worst J1 80 %."

@@ -24,11 +24,14 @@ class Table:
         Cells; numbers are formatted by the report.
     text_columns : tuple of int
         Columns that hold text (left-aligned).
+    flagged : set of (int, int)
+        Cells (row, column) whose values are outside their good range: highlighted.
     """
     caption: str
     headers: list
     rows: list
     text_columns: tuple = ()
+    flagged: set = field(default_factory=set)
 
 
 @dataclass
@@ -47,6 +50,25 @@ class Section:
     texts: list = field(default_factory=list)
 
 
+BAD_RELATIVE_STD = 100.0
+"""[%] A base parameter whose σ reaches its value is not determined by the data: highlighted."""
+BAD_ERROR = 50.0
+"""[%] A joint's relative torque error from here on is highlighted."""
+
+
+def _human(value) -> str:
+    """A setting as people write it: yes/no, —, numbers to 4 digits, lists joined."""
+    if value is None or value == "":
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return format(value, ".4g")
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_human(v) for v in value)
+    return str(value)
+
+
 def _fmt(x, spec: str = ".4g") -> str:
     if x is None:
         return "—"
@@ -62,12 +84,18 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
     for c in comparisons:
         sets = c["metrics"]
         n = len(next(iter(sets.values()))["relative_error"])
-        rows = []
+        rows: list[list] = []
+        flagged: set = set()
+        ok = c.get("relative_error_meaningful") or [True] * n
         for label, m in sets.items():
-            rows.append([label, "error %", *(_fmt(x, ".3g") for x in m["relative_error"]), _fmt(m.get("global_relative_error"), ".3g")])
+            flagged |= {(len(rows), 2 + j) for j, x in enumerate(m["relative_error"]) if x is not None and ok[j] and x >= BAD_ERROR}
+            rows.append([label, "error %", *(_fmt(x, ".3g") if ok[j] else "n/m" for j, x in enumerate(m["relative_error"])),
+                         _fmt(m.get("global_relative_error"), ".3g")])
             rows.append(["", "RMSE N·m", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
-            rows.append(["", "ρ (eq. 18)", *(_fmt(x, ".4f") for x in m["correlation"]), ""])
-        tables.append(Table(f"{c['name']}: {c['n_samples']} samples", ["parameters", "metric", *(f"J{j + 1}" for j in range(n)), "all"], rows))
+            rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") for x in m["correlation"]), ""])
+        tables.append(Table(f"{c['name']}: {c['n_samples']} samples (error of {BAD_ERROR:g} % and more highlighted; n/m: the "
+                            "joint's torque is at the noise level, its relative error means nothing)",
+                            ["parameters", "metric", *(f"J{j + 1}" for j in range(n)), "all"], rows, flagged=flagged))
     return tables
 
 
@@ -85,17 +113,21 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         Setting -> value shown at the top.
     sections : list of Section
     """
-    settings = {"robot": d.get("robot", ""), "method": d.get("method", ""),
+    settings = {"robot": d.get("robot", ""), "estimators": _human(d.get("estimators", d.get("method", ""))),
+                "main estimate": d.get("main_estimate", ""),
                 "preprocessing": d.get("settings", {}).get("preprocessing", {}).get("derivation", ""),
-                "Coulomb smoothing velocity (rad/s)": d.get("settings", {}).get("coulomb_velocity", "")}
-    sections = []
+                "Coulomb smoothing velocity (rad/s)": _human(d.get("settings", {}).get("coulomb_velocity", ""))}
+    sections = [Section("In short", [], _identify_summary(d))] if "identification" in d or "validation" in d else []
     if "base_parameters" in d:
         refs = d.get("references", [])
         rows = [[p["name"], p["unit"], _fmt(p["value"]), _fmt(p["std"], ".2g"), _fmt(p["relative_std_percent"], ".3g"),
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
-        sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations",
+        flagged = {(i, 4) for i, p in enumerate(d["base_parameters"])
+                   if p.get("relative_std_percent") is not None and p["relative_std_percent"] >= BAD_RELATIVE_STD}
+        sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
+                                                          f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted",
                                                           ["name", "unit", "value", "σ", "σ %", *(r["name"] for r in refs), "expression"], rows,
-                                                          (5 + len(refs),))]))
+                                                          (5 + len(refs),), flagged)]))
         verdicts = d.get("physically_consistent_verdict", {})
         if verdicts:
             sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",
@@ -107,10 +139,12 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         sections.append(Section("Estimators", [Table("F (eq. 9) on the identification rows", ["parameters", "F (N·m)", "evaluations", "time (s)"], rows)]))
     if d.get("drive_gains"):
         g = d["drive_gains"]
-        rows = [[f"J{j + 1}", _fmt(k), _fmt(s, ".2g"), _fmt(ref)] for j, (k, s, ref) in enumerate(zip(g["gains"], g["gains_std"], g["description_gains"]))]
+        rows = [[f"J{j + 1}", "not determined" if k is None else _fmt(k), "" if k is None else _fmt(s, ".2g"), _fmt(ref)]
+                for j, (k, s, ref) in enumerate(zip(g["gains"], g["gains_std"], g["description_gains"]))]
         sections.append(Section("Drive gains", [Table(f"K from the runs without and with the {g['payload_mass']} kg payload",
                                                       ["joint", "K (N·m/A)", "σ", "description"], rows)],
-                                [f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else []))
+                                [f"{k} not determined: {why}" for k, why in g.get("not_observable", {}).items()]
+                                + ([f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else [])))
     cv = d.get("settings", {}).get("preprocessing_cross_validation")
     if cv:
         rows = [[_fmt(c["position_cutoff"], ".3g") + ("*" if i == cv["chosen"] else ""), _fmt(c["parallel_cutoff"], ".3g"),
@@ -129,6 +163,29 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     if comparisons:
         sections.append(Section("Measured against predicted torques", _comparison_tables(comparisons)))
     return settings, sections
+
+
+def _identify_summary(d: dict) -> list[str]:
+    """How an identification went, from its results: the estimate to use, whether it is physically consistent, each
+    log's error and worst joint, what was not determined (the terminal's "In short")."""
+    label = d.get("main_estimate", "")
+    verdict = d.get("physically_consistent_verdict", {}).get(label, "")
+    out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
+                              else ", not physically consistent.")] if label else []
+    for c in ([d["identification"]] if "identification" in d else []) + list(d.get("validation", [])):
+        m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)
+        if not m:
+            continue
+        ok = c.get("relative_error_meaningful") or [True] * len(m["relative_error"])
+        errors = [(x, j) for j, x in enumerate(m["relative_error"]) if x is not None and ok[j]]
+        worst = max(errors) if errors else None
+        out.append(f"{c['name']}: torque error {_fmt(m.get('global_relative_error'), '.3g')} % over all joints"
+                   + ("" if worst is None else f", worst J{worst[1] + 1} {worst[0]:.3g} %") + ".")
+    for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
+        out.append(f"{k} not determined: {why}.")
+    findings = d.get("findings") or []
+    out.append(f"{len(findings)} finding(s) on the model: see the warnings." if findings else "No finding on the model.")
+    return out
 
 
 def run_sections(d: dict) -> tuple[dict, list[Section]]:
@@ -253,9 +310,52 @@ def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], ti
 
     env = jinja2.Environment(loader=jinja2.PackageLoader("dynid.report", "templates"), autoescape=True)
     settings, sections = SECTIONS[kind](data)
-    figs = [{"name": p.name, "data": base64.b64encode(p.read_bytes()).decode("ascii")} for p in figures if p.suffix == ".png"]
+    figs = [{"name": _caption(p.name), "data": base64.b64encode(_compact_png(p)).decode("ascii")}
+            for p in figures if p.suffix == ".png"]
     html = env.get_template("report.html.j2").render(
         title=title, versions={"dynid": __version__, "numpy": numpy.__version__, "pinocchio": pinocchio.__version__},
-        written=datetime.datetime.now().isoformat(timespec="seconds"), settings=settings, sections=sections,
+        written=datetime.datetime.now().isoformat(timespec="seconds"), settings={k: _human(v) for k, v in settings.items()},
+        sections=sections,
         figures=figs, warnings=data.get("warnings", []))
     atomic_write_text(path, html)
+
+
+CAPTIONS = {"identification_fit": "Measured and predicted torques on the identification log",
+            "fig4_identification_trajectory": "Identification trajectory β1 (the paper's Figure 4)",
+            "fig5_tool_path": "Tool path of β1 (Figure 5)", "fig6_abc_convergence": "Convergence of the ABC (Figure 6)",
+            "fig7_torques_identification": "Measured and predicted torques on β1 (Figure 7)",
+            "fig8_validation_trajectory": "Validation trajectory β2 (Figure 8)",
+            "fig9_torques_validation": "Measured and predicted torques on β2 (Figure 9)",
+            "methods_comparison": "The estimators compared", "methods_convergence": "Convergence of the box searches",
+            "excitation_joints": "The excitation against the joints' limits", "excitation_tool_path": "Tool path of the excitation",
+            "montecarlo_std_vs_crb": "Spread of each estimator against the Cramér–Rao bound",
+            "montecarlo_noise_levels": "Spread against the noise level"}
+
+
+def _caption(name: str) -> str:
+    """A figure's caption from its file name (``validation_p3.png``: the validation log p3)."""
+    stem = name.rsplit(".", 1)[0]
+    if stem in CAPTIONS:
+        return CAPTIONS[stem]
+    if stem.startswith("validation_"):
+        return f"Measured and predicted torques on the validation log {stem[len('validation_'):]}"
+    return stem.replace("_", " ")
+
+
+MAX_FIGURE_WIDTH = 900
+"""[px] Figures are embedded at most this wide (the page's width), in 32 colours (line plots on white lose nothing visible): a report stays under 1 MB."""
+
+
+def _compact_png(path: Path) -> bytes:
+    """A figure's PNG, scaled to the page and reduced to 32 colours."""
+    import io
+
+    from PIL import Image  # matplotlib's own dependency
+
+    with Image.open(path) as opened:
+        image = opened.convert("RGB")
+    if image.width > MAX_FIGURE_WIDTH:
+        image = image.resize((MAX_FIGURE_WIDTH, round(image.height * MAX_FIGURE_WIDTH / image.width)), Image.Resampling.LANCZOS)
+    out = io.BytesIO()
+    image.quantize(colors=32, method=Image.Quantize.MEDIANCUT).save(out, format="PNG", optimize=True)
+    return out.getvalue()
