@@ -404,6 +404,41 @@ def excite(
     _Command("dynid excite", quiet, out).run(prepare, compute, save)
 
 
+@app.command()
+def init(
+    urdf: Path = typer.Argument(..., help="The robot's URDF."),
+    log: Path = typer.Argument(..., help="A CSV log of the robot moving: time, joint angles, joint torques or currents."),
+    out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
+    force: bool = typer.Option(False, help="Overwrite --out if it exists."),
+    quiet: bool = QUIET,
+) -> None:
+    """Write a starter identification config for a URDF and a log, with the columns it detected."""
+    from ..io.starter import check_target, starter_config
+    from ..model.description import load_robot
+
+    def prepare():
+        check_target(out, force)
+        if not out.parent.is_dir():
+            raise DynIdError(f"--out {out}: its folder does not exist")
+        return load_robot(urdf)
+
+    def compute(robot, progress):
+        return starter_config(urdf, log, robot.n_dof, out)
+
+    def save(written):
+        from ..io.files import atomic_write_text
+
+        atomic_write_text(out, written[0])
+        return [out]
+
+    def show(rep, written, paths):
+        for note in written[1]:
+            rep.line(note)
+        rep.line(f"wrote {out}: check the columns and units, then: dynid identify {out}")
+
+    _Command("dynid init", quiet).run(prepare, compute, save, show)
+
+
 def _parse_levels(text: str):
     try:
         return tuple(float(x) for x in text.split(","))

@@ -194,8 +194,8 @@ def robot_from_urdf(path: str | Path, source: str | None = None) -> Robot:
         An unreadable URDF or one dynid cannot model.
     """
     path = Path(path)
-    return robot_from_document({"convention": "urdf", "urdf": str(path), "drive_terms": list(URDF_DRIVE_TERMS),
-                                "name": path.stem}, source or str(path), path.parent)
+    return robot_from_document({"convention": "urdf", "urdf": path.name, "drive_terms": list(URDF_DRIVE_TERMS),
+                                "name": path.stem}, source or str(path), path.parent)  # the URDF relative to its folder
 
 
 def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:

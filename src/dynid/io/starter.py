@@ -1,0 +1,167 @@
+"""``dynid init``: a starter identification config for a robot's URDF and a log, with the columns it detected.
+
+The log's columns are matched by their header names (time: ``t``, ``time``, ``timestamp``; positions: ``q``, ``pos``,
+``position``, ``angle``; velocities: ``dq``, ``qd``, ``vel``; torques: ``tau``, ``torque``, ``effort``; currents:
+``i``, ``current``), in the order they appear; without a header, by their count (a time column first, then one
+block of ``n_dof`` columns per signal: positions and torques, or positions, velocities and torques) or a known
+logger's layout (Universal Robots' RTDE: ``preset = "ur-rtde"``). What was detected is written as comments in the
+config, to check before identifying.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from ..exceptions import ConfigError, DataError
+from .files import text_encoding_hint
+
+PATTERNS = {
+    "time": r"(t|time|times?tamp|stamp|sec|seconds)",
+    "positions": r"(q|pos|position|positions|angle|joint_?pos|actual_q)",
+    "velocities": r"(dq|qd|qdot|vel|velocity|velocities|actual_qd)",
+    "torques": r"(tau|torque|torques|effort|moment|target_moment)",
+    "currents": r"(i|cur|current|currents|actual_current)",
+}
+"""Header-name stems of each signal (case-insensitive, followed by an optional separator and joint number)."""
+
+
+def _kind(name: str) -> str | None:
+    stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", name.strip().lower())
+    for kind, pattern in PATTERNS.items():
+        if re.fullmatch(pattern, stem):
+            return kind
+    return None
+
+
+def starter_config(urdf: Path, log: Path, n_dof: int, out: Path) -> tuple[str, list[str]]:
+    """A starter config for a URDF and a log.
+
+    Parameters
+    ----------
+    urdf : Path
+        The robot's URDF.
+    log : Path
+        A CSV log (comma, semicolon, tab or space separated).
+    n_dof : int
+        The robot's joints.
+    out : Path
+        Where the config will be: the URDF and the log's folder are written relative to its folder.
+
+    Returns
+    -------
+    text : str
+        The config (TOML), with what was detected in comments.
+    notes : list of str
+        What was detected, one line each.
+
+    Raises
+    ------
+    DataError
+        An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
+    """
+    try:
+        lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
+    except UnicodeDecodeError:
+        raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None
+    except OSError as exc:
+        raise DataError(f"{log}: cannot read it ({exc.strerror or exc})") from None
+    if len(lines) < 2:
+        raise DataError(f"{log}: fewer than two lines: not a log")
+    delimiter = max((",", ";", "\t", " "), key=lambda d: lines[1].count(d))
+    split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
+    first = split(lines[0])
+    header = not all(_number(c) for c in first)
+    n_columns = len(first)
+    notes: list[str] = [f"{log.name}: {n_columns} columns separated by {_named(delimiter)}, "
+                        + ("a header line" if header else "no header line")]
+    table = [f'file = "{log.name}"']
+    if delimiter != ",":
+        table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
+    if header:
+        found: dict[str, list[str]] = {}
+        for name in first:
+            kind = _kind(name)
+            if kind:
+                found.setdefault(kind, []).append(name)
+        if "time" not in found:
+            raise DataError(f"{log}: no time column among {first} (named t, time or timestamp); add one, or write the "
+                            "config by hand with rate = ... (docs: Configuration files)")
+        effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
+        missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
+        if missing:
+            raise DataError(f"{log}: found {len(found.get(missing[0], []))} {missing[0]} column(s) of the {n_dof} the robot "
+                            f"needs among {first}")
+        table += ["header = true", f'time = {{ column = "{found["time"][0]}" }}']
+        for kind in ("positions", "velocities", effort):
+            if len(found.get(kind, [])) >= n_dof:
+                table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
+                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
+    elif n_columns == 31 and n_dof == 6:
+        table = ['preset = "ur-rtde"', f'file = "{log.name}"']
+        notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\"")
+    elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
+        blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
+        table += ["time = { column = 1 }"]
+        for b, kind in enumerate(blocks):
+            table.append(f"{kind} = {{ columns = [" + ", ".join(str(2 + b * n_dof + j) for j in range(n_dof)) + "] }")
+        notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
+    else:
+        raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
+                        "signal (or name the columns in a header line: t, q1…, tau1…)")
+    notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
+                 "positions for degrees")
+    text = "\n".join([
+        "# dynid identification config, written by dynid init: check the columns and units below, then",
+        "#   dynid identify THIS_FILE",
+        *(f"# {n}" for n in notes),
+        f'robot = "{_relative(urdf, out.parent)}"',
+        f'data_root = "{_relative(log.parent, out.parent)}"',
+        "",
+        "[identification]",
+        *table,
+        "",
+        "# [[validation]]                  # other logs, same layout, to check the model where it was not fitted",
+        '# name = "second_run"',
+        '# file = "second_run.csv"',
+        "",
+        "# [estimation]",
+        '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
+        "",
+    ])
+    return text, notes
+
+
+def _relative(path: Path, folder: Path) -> str:
+    import os
+
+    return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _named(delimiter: str) -> str:
+    return {",": "commas", ";": "semicolons", "\t": "tabs", " ": "spaces"}[delimiter]
+
+
+def check_target(path: Path, force: bool) -> None:
+    """Refuse to overwrite a config unless asked.
+
+    Parameters
+    ----------
+    path : Path
+    force : bool
+
+    Raises
+    ------
+    ConfigError
+        ``path`` exists and ``force`` is false.
+    """
+    if path.exists() and not force:
+        raise ConfigError(f"--out {path}: exists; give another name, or --force to overwrite it")
