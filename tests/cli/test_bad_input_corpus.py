@@ -105,7 +105,8 @@ LOGS = {
     "degrees written as radians": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), np.degrees(r[:, 1:7])))), 'unit = "deg"'),
     "huge values": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), 1e300))), "positions"),
     "three rows": (_text(GOOD[:3]), "identification (" ),
-    "a joint that never moves": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(3, 4)), 0.2) or r.__setitem__((slice(None), slice(9, 10)), 0.0))), "J3"),
+    "a joint that never moves": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(3, 4)), 0.2) or r.__setitem__((slice(None), slice(9, 10)), 0.0))),
+                                 "log.csv: joint 3's position never changes in [identification]"),
     "UTF-16": (None, "log.csv: not a UTF-8 text table (it looks like UTF-16: save it as UTF-8)"),
     "a binary file": (None, "log.csv: not a UTF-8 text table (a binary file?)"),
 }

@@ -129,7 +129,7 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
     cur = rng.normal(0, 1, (300, 6))
     cur[100:160, 2] = 7.5  # clipped
     q = 0.1 + 1e-3 * np.outer(np.arange(300), np.ones(6))
-    q[:, 1] = 7.0  # beyond the UR10e's ±2π
+    q[:, 1] = 7.0 + 1e-3 * np.arange(300)  # beyond the UR10e's ±2π
     rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
     assert any("joint 3's currents stay at their extreme 7.5 for 60 samples (t = 1.000-1.590 s)" in w for w in rec.warnings)
     assert any("joint 2 leaves its limits" in w for w in rec.warnings)
