@@ -113,3 +113,39 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     assert tail[2].startswith(f"{result.fit.name}: torque error {main['global_relative_error']:.3g} % over all joints, worst J")
     assert len([t for t in tail if "torque error" in t]) == 1 + len(result.validations)
     assert tail[-1].startswith("next: ")
+
+
+def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accuracy(tmp_path):
+    """[estimation] sdp_prior = "geometric": the SDP keeps what the data do not determine near the nominal links by
+    the pseudo-inertias' log-det divergence (Lee, Wensing & Park 2020): the fit is the Euclidean prior's, and every
+    link of the estimate is a non-degenerate mass distribution (principal inertias of the nominal's order)."""
+    from dynid.io.export import consistent_estimate
+    from dynid.model.spatial import physical_from_inertial
+
+    cfg, _ = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
+    runs = {}
+    for kind in ("euclidean", "geometric"):
+        cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n')
+                       .replace('estimators = ["ols", "sdp"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n', 1)
+                       if kind == "euclidean" else cfg.read_text().replace('sdp_prior = "euclidean"', 'sdp_prior = "geometric"'))
+        config = load_identification_config(cfg)
+        assert config.sdp_prior == kind
+        runs[kind] = (config, run_identification(config, validate=True))
+    fit = {k: r.validations[0].metrics()["dynid SDP"]["global_relative_error"] for k, (_, r) in runs.items()}
+    assert fit["geometric"] <= 1.01 * fit["euclidean"], fit
+    config, result = runs["geometric"]
+    from dynid.io.files import _clean  # results.json's own conversion (NaN and arrays)
+
+    robot, phi = consistent_estimate(config.robot, json.loads(json.dumps(_clean(result.to_dict()))))
+    fitted = robot.with_parameters(phi)
+    for j in range(robot.n_dof):
+        smallest = np.linalg.eigvalsh(physical_from_inertial(fitted.inertial[j])[2]).min()
+        nominal = np.linalg.eigvalsh(physical_from_inertial(config.robot.inertial[j])[2]).min()
+        assert smallest > 1e-3 * nominal, (j, smallest, nominal)
+
+
+def test_an_unknown_sdp_prior_is_refused(tmp_path):
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols"]\nsdp_prior = "round"\n'))
+    with pytest.raises(ConfigError, match=r"estimation.sdp_prior"):
+        load_identification_config(cfg)

@@ -25,6 +25,10 @@ CONSISTENCY_TOL = 1e-7
 (the solver's accuracy), and an SDP result when its smallest pseudo-inertia eigenvalue is."""
 
 
+PRIOR_KIND = "euclidean"
+"""The SDP's prior by default (:class:`PhysicallyConsistentLeastSquares`)."""
+
+
 class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
 
@@ -45,6 +49,11 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         Joints per sample (rows given chunk by chunk by ``partial_fit`` are folded per joint).
     joint_weights : (n_dof,) array or None
         Weight of each joint's rows when solving rows given by ``partial_fit`` (e.g. the WLS weights); default 1.
+    prior_kind : {"euclidean", "geometric"}
+        How the prior pulls: the squared distance ``||φ - φ_prior||²``, or, for each link whose prior pseudo-inertia
+        ``J₀`` is positive definite, the log-det divergence ``tr(J₀⁻¹ J) - log det J`` (up to constants; Lee, Wensing
+        & Park, "Geometric robot dynamic identification", IEEE T-RO 2020), which keeps the unidentifiable directions
+        at a plausible mass distribution (no vanishing principal inertia); the drive terms keep the squared distance.
 
     Attributes
     ----------
@@ -64,7 +73,8 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """
 
     def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
-                 n_dof: int | None = None, joint_weights=None):
+                 n_dof: int | None = None, joint_weights=None, prior_kind: str = PRIOR_KIND):
+        self.prior_kind = prior_kind
         self.links = links
         self.nonnegative = nonnegative
         self.prior = prior
@@ -114,7 +124,13 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
             prior = np.asarray(self.prior, dtype=float)
             if prior.shape != (p,):
                 raise ShapeError(f"expected a prior of shape ({p},), got {prior.shape}")
-            cost = cost + self.prior_weight * float(np.mean(r**2) * r.shape[0]) * cp.sum_squares(phi - prior)
+            weight = self.prior_weight * float(np.mean(r**2) * r.shape[0])
+            if self.prior_kind == "geometric":
+                cost = cost + weight * _geometric_prior(cp, phi, prior, links)
+            elif self.prior_kind == "euclidean":
+                cost = cost + weight * cp.sum_squares(phi - prior)
+            else:
+                raise ShapeError(f"prior_kind: expected 'euclidean' or 'geometric', got {self.prior_kind!r}")
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
@@ -255,6 +271,22 @@ def _solve(problem, what: str):
             raise
         raise DynIdError(f"{what}: the SDP solver failed on these values ({exc})") from None
     return problem
+
+
+def _geometric_prior(cp, phi, prior, links):
+    """The log-det divergence of each link's pseudo-inertia from the prior's where that is positive definite, the
+    squared distance for everything else (drive terms, links whose prior is degenerate)."""
+    terms, euclidean = [], np.ones(phi.shape[0], dtype=bool)
+    for idx in links:
+        j0 = pseudo_inertia(prior[idx])
+        eig = np.linalg.eigvalsh(j0)
+        if eig.min() <= 1e-9 * max(eig.max(), 1e-300):
+            continue
+        j = _pseudo_inertia_expression(phi, idx)
+        terms.append(cp.trace(np.linalg.inv(j0) @ j) - cp.log_det((j + j.T) / 2))
+        euclidean[np.asarray(idx, dtype=int)] = False
+    out = cp.sum_squares(phi[np.flatnonzero(euclidean)] - prior[euclidean]) if euclidean.any() else 0
+    return out + (cp.sum(cp.hstack(terms)) if terms else 0)
 
 
 def _pseudo_inertia_expression(phi, idx):

@@ -91,6 +91,8 @@ class FitData:
     joint_weights : (n_dof,) array, optional
         Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
         estimate on real logs).
+    prior_kind : {"euclidean", "geometric"}
+        How ``sdp`` pulls towards the prior (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
     """
 
     w_base: Any
@@ -103,6 +105,7 @@ class FitData:
     prior: Any = None
     weights: Any = None
     joint_weights: Any = None
+    prior_kind: str = "euclidean"
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -214,7 +217,7 @@ def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> "Estimator":
         raise ConfigError("estimator sdp needs the parameter layout of the robot (links and non-negative columns)")
     links, nonneg = data.layout
     return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior, n_dof=data.n_dof,
-                                            joint_weights=data.joint_weights)
+                                            joint_weights=data.joint_weights, prior_kind=data.prior_kind)
 
 
 _REGISTRY: dict[str, EstimatorSpec] = {}

@@ -275,7 +275,8 @@ class IdentificationResult:
 
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",),
-             references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False) -> IdentificationResult:
+             references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
+             sdp_prior: str = "euclidean") -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
     over its rows; check every estimate's physical consistency and give the verdict on the model.
 
@@ -304,6 +305,10 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         and make the consistent one the main estimate when the least-squares one is not consistent and predicts the
         held-out blocks worse.
 
+    sdp_prior : {"euclidean", "geometric"}
+        How ``sdp`` pulls its unidentifiable directions towards the nominal parameters: squared distance, or the
+        log-det divergence of each link's pseudo-inertia (plausible links for export; Lee, Wensing & Park 2020).
+
     Returns
     -------
     IdentificationResult
@@ -321,7 +326,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     if sdp:
         robot.require_physical_nominal("the sdp estimator (its prior is the description's nominal values)")
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=robot.standard_parameters() if sdp else None)
+                      prior=robot.standard_parameters() if sdp else None, prior_kind=sdp_prior)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)

@@ -139,7 +139,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
         result = identify(robot, base, data, config.estimators, refs, progress, config.seed,
-                          held_out=validate and not config.validation)
+                          held_out=validate and not config.validation, sdp_prior=config.sdp_prior)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())

@@ -120,6 +120,9 @@ class EstimationTable(Table, kw_only=True):
     seed: Annotated[int, Meta(ge=0, description="seeds the box searches (default 0)")] | None = None
     friction: Annotated[Literal["auto", "description"], _d("each joint's friction model by cross-validation, or the "
                                                            "description's terms")] | None = None
+    sdp_prior: Annotated[Literal["euclidean", "geometric"], _d("how sdp keeps what the data do not determine near the "
+                                                               "nominal values: squared distance (default) or the "
+                                                               "pseudo-inertias' log-det divergence (plausible links)")] | None = None
 
 
 class ReferenceTable(Table, kw_only=True):

@@ -111,6 +111,8 @@ class IdentificationConfig:
         A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
     friction : str
         "auto": each joint's friction model by cross-validation; "description": as described.
+    sdp_prior : str
+        ``[estimation] sdp_prior``: how the SDP keeps unidentifiable directions near the nominal values.
     urdf : Path or None
         The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
@@ -128,6 +130,7 @@ class IdentificationConfig:
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
+    sdp_prior: str = "euclidean"  # [estimation] sdp_prior: "euclidean" or "geometric"
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
 
 
@@ -242,7 +245,7 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
-                                urdf=config_urdf(doc, path, root))
+                                urdf=config_urdf(doc, path, root), sdp_prior=e.sdp_prior or "euclidean")
 
 
 def _check_reference_names(refs: list, path: Path) -> None:
