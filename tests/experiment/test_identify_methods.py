@@ -113,6 +113,9 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     assert tail[2].startswith(f"{result.fit.name}: torque error {main['global_relative_error']:.3g} % over all joints, worst J")
     assert len([t for t in tail if "torque error" in t]) == 1 + len(result.validations)
     assert tail[-1].startswith("next: ")
+    loose = [n for n, rel in zip(result.base.names, result.solution.relative_std) if rel >= 100]
+    said = [t for t in tail if t.startswith("not determined by this log")]
+    assert (said[0].split("): ")[1].split(": their")[0].split(", ") if said else []) == loose
 
 
 def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accuracy(tmp_path):

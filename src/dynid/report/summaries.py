@@ -129,6 +129,10 @@ def identification_blocks(result) -> list:
     return out
 
 
+NOT_DETERMINED = 100.0
+"""[%] A base parameter whose σ reaches this share of its value is said to be not determined by the log."""
+
+
 def in_short(result) -> list:
     """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
     log's global error and worst joint, and what to do next.
@@ -159,6 +163,10 @@ def in_short(result) -> list:
         out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
                         + ("" if worst is None else f", worst J{worst + 1} {rel[worst]:.3g} %")
                         + (" (the fit)" if c is r.fit else "")))
+    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std) if not rel < NOT_DETERMINED]
+    if loose:
+        out.append(Line(f"not determined by this log (σ ≥ {NOT_DETERMINED:g} % of the value): {', '.join(loose)}: their "
+                        "values are set by the noise; a richer excitation (dynid excite) determines them"))
     fit = errors.get(r.fit.name)
     far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)]
     if far:
