@@ -152,3 +152,21 @@ def test_an_unknown_sdp_prior_is_refused(tmp_path):
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols"]\nsdp_prior = "round"\n'))
     with pytest.raises(ConfigError, match=r"estimation.sdp_prior"):
         load_identification_config(cfg)
+
+
+def test_validate_opens_with_each_logs_errors_and_the_best_set(tmp_path):
+    from dynid.report.summaries import validation_in_short
+    from dynid.tables import render_text
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
+    config = load_identification_config(cfg)
+    save_identification(run_identification(config, validate=False), tmp_path / "out", False)
+    comparisons, _ = run_validation(config, json.loads((tmp_path / "out" / "results.json").read_text()))
+    lines = render_text(validation_in_short(comparisons), 400).splitlines()
+    assert lines[0].startswith("In short") and len(lines) == 1 + len(comparisons)
+    for c, line in zip(comparisons, lines[1:]):
+        m = c.metrics()
+        assert line.startswith(f"{c.name}: torque error over all joints: ")
+        assert all(f"{label} {v['global_relative_error']:.3g} %" in line for label, v in m.items())
+        assert line.endswith(f"best: {min(m, key=lambda k: m[k]['global_relative_error'])}")

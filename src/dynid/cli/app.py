@@ -363,8 +363,10 @@ def validate(
         return save_validation(validated[0], out, validated[1])
 
     def show(rep, validated, paths):
+        from ..report.summaries import validation_in_short
+
         comparisons, warnings = validated
-        rep.blocks([comparison_table(c) for c in comparisons])
+        rep.blocks([*validation_in_short(comparisons), *(comparison_table(c) for c in comparisons)])
         for w in warnings:
             rep.warning(w)
         rep.wrote(paths)

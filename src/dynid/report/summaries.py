@@ -129,6 +129,32 @@ def identification_blocks(result) -> list:
     return out
 
 
+def validation_in_short(comparisons) -> list:
+    """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
+    meaningful joint, the best set named.
+
+    Parameters
+    ----------
+    comparisons : sequence of dynid.validation.torques.TorqueComparison
+
+    Returns
+    -------
+    list of Line
+    """
+    out = [Line("In short (the tables follow)", "title")]
+    for c in comparisons:
+        metrics, ok = c.metrics(), c.meaningful()
+        parts = []
+        for label, m in metrics.items():
+            rel = np.asarray(m["relative_error"], dtype=float)
+            worst = int(np.nanargmax(np.where(ok, rel, -np.inf))) if np.any(ok) else None
+            parts.append(f"{label} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst + 1} {rel[worst]:.3g} %)"))
+        best = min(metrics, key=lambda k: metrics[k]["global_relative_error"]) if metrics else None
+        out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
+                        + ("" if best is None or len(metrics) < 2 else f"; best: {best}")))
+    return out
+
+
 NOT_DETERMINED = 100.0
 """[%] A base parameter whose σ reaches this share of its value is said to be not determined by the log."""
 
