@@ -126,11 +126,10 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     from dynid.model.spatial import physical_from_inertial
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
+    text = cfg.read_text()
     runs = {}
     for kind in ("euclidean", "geometric"):
-        cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n')
-                       .replace('estimators = ["ols", "sdp"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n', 1)
-                       if kind == "euclidean" else cfg.read_text().replace('sdp_prior = "euclidean"', 'sdp_prior = "geometric"'))
+        cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n'))
         config = load_identification_config(cfg)
         assert config.sdp_prior == kind
         runs[kind] = (config, run_identification(config, validate=True))

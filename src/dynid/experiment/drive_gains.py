@@ -208,7 +208,7 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
     p = n + nb + nl
     acc = LeastSquaresAccumulator(p, n)
     known_sumsq, known_rows = np.zeros(n), np.zeros(n)  # the known mass's torque on each joint, on the rows kept
-    normal, by_joint = np.zeros((p, p)), np.zeros((p, n))  # AᵀA, and Aᵀb from each joint's rows (for the test below)
+    by_joint = np.zeros((p, n))  # Aᵀb from each joint's rows alone (for the test below)
     for data, is_loaded in ((unloaded, False), (loaded, True)):
         for _, y, current, keep in base_chunks(robot, base, data, standard=True):
             m = y.shape[0]
@@ -221,9 +221,7 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
                 rhs = y[:, :, mass_col] * payload_mass
                 known_sumsq += np.sum(np.where(keep, rhs, 0.0) ** 2, axis=0)
                 known_rows += keep.sum(axis=0)
-            kept = a * keep[:, :, None]
-            normal += np.einsum("mjp,mjq->pq", kept, a)
-            by_joint += np.einsum("mjp,mj->pj", kept, rhs)
+            by_joint += np.einsum("mjp,mj->pj", a * keep[:, :, None], rhs)
             acc.add(a.reshape(-1, p), rhs.reshape(-1), keep.reshape(-1))
     sol = acc.solve(rcond=1e-12)
     gains, std = sol.params[:n].copy(), sol.params_std[:n].copy()
@@ -235,11 +233,14 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
     # 26 % off the description's, the payload's torque 1.8× the residual).
     weak = ~(std < 0.5 * np.abs(gains))
     without_own = np.full(n, np.nan)
+    r = acc.reduced()[:p, :p]
     for j in np.flatnonzero(~(signal_to_noise >= MIN_SIGNAL_TO_NOISE) & ~weak):
         # A gain whose own payload torque is weak may still be set by the other joints' equations (a wrist joint
         # shares its link's parameters with the joints below it): it is determined if it stays where it is without
         # that torque; if it moves by more than 3σ, the weak torque set it and the σ understates its error.
-        without_own[j] = np.linalg.lstsq(normal, by_joint.sum(axis=1) - by_joint[:, j], rcond=None)[0][j]
+        # the solution moves by (AᵀA)⁻¹ Aᵀb_j = R⁻¹ R⁻ᵀ Aᵀb_j, R the accumulator's triangular factor
+        shift = scipy.linalg.solve_triangular(r, scipy.linalg.solve_triangular(r, by_joint[:, j], trans="T"))
+        without_own[j] = sol.params[j] - shift[j]
         weak[j] = not abs(without_own[j] - gains[j]) <= 3 * std[j]
     if np.all(weak):
         raise IdentifiabilityError("drive_gains: the payload's mass makes no joint's gain observable")

@@ -104,17 +104,14 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
         from ..model.description import robot_from_document
 
         table = dict(ref)
-        if isinstance(table.get("urdf"), str) and not (path.parent / table["urdf"]).is_file() and data_root is not None \
-                and (data_root / table["urdf"]).is_file():
-            table["urdf"] = str((data_root / table["urdf"]).resolve())
+        if isinstance(table.get("urdf"), str) and not (path.parent / table["urdf"]).is_file():
+            table["urdf"] = str(_located(table["urdf"], path.parent, data_root) or table["urdf"])
         table.setdefault("name", Path(str(table.get("urdf", "robot"))).stem)
         return robot_from_document(table, f"{path}: robot", path.parent)
     if not isinstance(ref, str):
         raise ConfigError(f"{path}: expected a field robot = \"name, description.toml or robot.urdf\", or a [robot] table")
-    local = path.parent / ref  # a description file, relative to the config (an absolute path stays as is)
-    if ref not in builtin_robots() and not local.is_file() and data_root is not None and (data_root / ref).is_file():
-        local = data_root / ref
-    if ref not in builtin_robots() and local.is_file():
+    local = None if ref in builtin_robots() else _located(ref, path.parent, data_root)  # relative to the config, else
+    if local is not None:                                                               # to the data root
         return load_robot(local)
     try:
         return load_robot(ref)
@@ -141,18 +138,11 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         ``convention = "urdf"``; None for a built-in robot or a DH description.
     """
     ref = doc.get("robot")
-
-    def found(name: str, folder: Path) -> Path | None:
-        for base in (folder, data_root):
-            if base is not None and (base / name).is_file():
-                return (base / name).resolve()
-        return None
-
     if isinstance(ref, dict):
-        return found(str(ref["urdf"]), path.parent) if isinstance(ref.get("urdf"), str) else None
+        return _located(str(ref["urdf"]), path.parent, data_root) if isinstance(ref.get("urdf"), str) else None
     if not isinstance(ref, str) or ref in builtin_robots():
         return None
-    file = found(ref, path.parent)
+    file = _located(ref, path.parent, data_root)
     if file is None:
         return None
     if file.suffix.lower() == ".urdf":
@@ -162,4 +152,12 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     except (OSError, ValueError):
         return None
     urdf = described.get("urdf")
-    return found(urdf, file.parent) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+    return _located(urdf, file.parent, None) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+
+
+def _located(name: str, folder: Path, data_root: Path | None) -> Path | None:
+    """A file a config names: relative to the config's folder (an absolute path stays as is), else to the data root."""
+    for base in (folder, data_root):
+        if base is not None and (base / name).is_file():
+            return (base / name).resolve()
+    return None

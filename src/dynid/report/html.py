@@ -168,6 +168,8 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 def _identify_summary(d: dict) -> list[str]:
     """How an identification went, from its results: the estimate to use, whether it is physically consistent, each
     log's error and worst joint, what was not determined (the terminal's "In short")."""
+    from .summaries import worst_joint
+
     label = d.get("main_estimate", "")
     verdict = d.get("physically_consistent_verdict", {}).get(label, "")
     out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
@@ -176,11 +178,9 @@ def _identify_summary(d: dict) -> list[str]:
         m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)
         if not m:
             continue
-        ok = c.get("relative_error_meaningful") or [True] * len(m["relative_error"])
-        errors = [(x, j) for j, x in enumerate(m["relative_error"]) if x is not None and ok[j]]
-        worst = max(errors) if errors else None
+        worst = worst_joint(m["relative_error"], c.get("relative_error_meaningful") or [True] * len(m["relative_error"]))
         out.append(f"{c['name']}: torque error {_fmt(m.get('global_relative_error'), '.3g')} % over all joints"
-                   + ("" if worst is None else f", worst J{worst[1] + 1} {worst[0]:.3g} %") + ".")
+                   + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %") + ".")
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")
     findings = d.get("findings") or []
@@ -310,8 +310,8 @@ def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], ti
 
     env = jinja2.Environment(loader=jinja2.PackageLoader("dynid.report", "templates"), autoescape=True)
     settings, sections = SECTIONS[kind](data)
-    figs = [{"name": _caption(p.name), "data": base64.b64encode(_compact_png(p)).decode("ascii")}
-            for p in figures if p.suffix == ".png"]
+    figs = [{"name": _caption(p.name), "data": base64.b64encode(p.read_bytes()).decode("ascii")}  # already compact:
+            for p in figures if p.suffix == ".png"]                                                 # save_figure
     html = env.get_template("report.html.j2").render(
         title=title, versions={"dynid": __version__, "numpy": numpy.__version__, "pinocchio": pinocchio.__version__},
         written=datetime.datetime.now().isoformat(timespec="seconds"), settings={k: _human(v) for k, v in settings.items()},
@@ -340,22 +340,3 @@ def _caption(name: str) -> str:
     if stem.startswith("validation_"):
         return f"Measured and predicted torques on the validation log {stem[len('validation_'):]}"
     return stem.replace("_", " ")
-
-
-MAX_FIGURE_WIDTH = 900
-"""[px] Figures are embedded at most this wide (the page's width), in 32 colours (line plots on white lose nothing visible): a report stays under 1 MB."""
-
-
-def _compact_png(path: Path) -> bytes:
-    """A figure's PNG, scaled to the page and reduced to 32 colours."""
-    import io
-
-    from PIL import Image  # matplotlib's own dependency
-
-    with Image.open(path) as opened:
-        image = opened.convert("RGB")
-    if image.width > MAX_FIGURE_WIDTH:
-        image = image.resize((MAX_FIGURE_WIDTH, round(image.height * MAX_FIGURE_WIDTH / image.width)), Image.Resampling.LANCZOS)
-    out = io.BytesIO()
-    image.quantize(colors=32, method=Image.Quantize.MEDIANCUT).save(out, format="PNG", optimize=True)
-    return out.getvalue()

@@ -331,7 +331,11 @@ def figure_process(enabled: bool = True):
 
 
 def save_figure(fig_or_axes, path: Path) -> None:
-    """Write a figure as PNG, atomically.
+    """Write a figure as PNG, atomically, in :data:`FIGURE_COLOURS` colours.
+
+    The canvas is rendered at 100 dpi and its pixels quantised: line plots on white lose nothing visible, the file is
+    a quarter of a full-colour one (the HTML report embeds the files as they are: about 1 MB for a dozen figures),
+    and it takes no longer than ``savefig``'s own PNG (about 0.09 s for a 900 × 1440 px figure either way).
 
     Parameters
     ----------
@@ -339,12 +343,23 @@ def save_figure(fig_or_axes, path: Path) -> None:
     path : Path
     """
     import matplotlib.pyplot as plt
+    from PIL import Image  # matplotlib's own dependency
 
     fig = fig_or_axes.figure if hasattr(fig_or_axes, "figure") else fig_or_axes.flat[0].figure
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, pil_kwargs={"compress_level": 1})  # fast zlib: 3x quicker, 1.3x larger
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig.set_dpi(100)
+    canvas = FigureCanvasAgg(fig)  # what savefig would render with (a Figure made without pyplot has no canvas of its own)
+    canvas.draw()
+    image = Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba()).convert("RGB")
     plt.close(fig)
+    buf = io.BytesIO()
+    image.quantize(colors=FIGURE_COLOURS, method=Image.Quantize.FASTOCTREE).save(buf, format="PNG", compress_level=6)
     atomic_write_bytes(path, buf.getvalue())
+
+
+FIGURE_COLOURS = 32
+"""Colours of a figure's PNG (:func:`save_figure`)."""
 
 
 from ..experiment.identified import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # noqa: E402  one number for both

@@ -129,6 +129,29 @@ def identification_blocks(result) -> list:
     return out
 
 
+def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
+    """The joint with the largest relative error among those whose relative error means something.
+
+    Parameters
+    ----------
+    relative_error : (n_dof,) sequence [%]
+        None or NaN where unknown.
+    meaningful : (n_dof,) sequence of bool
+        :meth:`dynid.validation.torques.TorqueComparison.meaningful`.
+
+    Returns
+    -------
+    (int, float) or None
+        0-based joint and its error [%]; None when no joint's error means something.
+    """
+    rel = np.asarray(relative_error, dtype=float)
+    ranked = np.where(np.asarray(meaningful, dtype=bool) & np.isfinite(rel), rel, -np.inf)
+    if not np.isfinite(ranked).any():
+        return None
+    j = int(np.argmax(ranked))
+    return j, float(rel[j])
+
+
 def validation_in_short(comparisons) -> list:
     """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
     meaningful joint, the best set named.
@@ -146,9 +169,8 @@ def validation_in_short(comparisons) -> list:
         metrics, ok = c.metrics(), c.meaningful()
         parts = []
         for label, m in metrics.items():
-            rel = np.asarray(m["relative_error"], dtype=float)
-            worst = int(np.nanargmax(np.where(ok, rel, -np.inf))) if np.any(ok) else None
-            parts.append(f"{label} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst + 1} {rel[worst]:.3g} %)"))
+            worst = worst_joint(m["relative_error"], ok)
+            parts.append(f"{label} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
         best = min(metrics, key=lambda k: metrics[k]["global_relative_error"]) if metrics else None
         out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
                         + ("" if best is None or len(metrics) < 2 else f"; best: {best}")))
@@ -183,11 +205,10 @@ def in_short(result) -> list:
         m = c.metrics().get(label)
         if m is None:
             continue
-        rel, ok = np.asarray(m["relative_error"], dtype=float), c.meaningful()
-        worst = int(np.nanargmax(np.where(ok, rel, -np.inf))) if np.any(ok) else None
+        worst = worst_joint(m["relative_error"], c.meaningful())
         errors[c.name] = float(m["global_relative_error"])
         out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
-                        + ("" if worst is None else f", worst J{worst + 1} {rel[worst]:.3g} %")
+                        + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
                         + (" (the fit)" if c is r.fit else "")))
     loose = [n for n, rel in zip(r.base.names, r.solution.relative_std) if not rel < NOT_DETERMINED]
     if loose:
