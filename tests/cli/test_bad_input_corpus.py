@@ -340,10 +340,16 @@ def test_export_targets_are_checked_before_any_work(identified):
         (["--urdf", folder / "adir"], "--urdf"),
         (["--urdf", folder / "same.xml", "--mjcf", folder / "same.xml"], "--urdf and --mjcf name the same file"),
         (["--mjcf", folder / "adir"], "--mjcf"),
+        (["--mjcf-model", folder / "m.xml"], "give --mjcf FILE too"),
+        (["--mjcf", folder / "o.xml", "--mjcf-model", folder / "nosuch.xml"], "--mjcf-model"),
+        (["--mjcf", folder / "o.xml", "--mjcf-model", folder / "other.xml"], "other.xml: has no joint"),
+        (["--mjcf", folder / "o.xml", "--mjcf-model", folder / "bad.xml"], "bad.xml: cannot read it as MJCF"),
     ]
+    (folder / "other.xml").write_text("<mujoco><worldbody><body name='b'><joint name='x'/><geom size='.1'/></body></worldbody></mujoco>")
+    (folder / "bad.xml").write_text("<mujoco><worldbody>")
     for args, message in cases:
         assert_refused(invoke("export", cfg, "--results", results, *args), message)
-    assert sorted(p.name for p in folder.iterdir() if p.suffix in (".urdf", ".xml")) == []
+    assert sorted(p.name for p in folder.iterdir() if p.suffix in (".urdf", ".xml")) == ["bad.xml", "other.xml"]
 
 
 def test_an_earlier_runs_folder_holding_a_folder_where_a_file_goes(ur):

@@ -7,6 +7,7 @@ import pytest
 
 from ..conftest import shared_data
 from .refusals import assert_refused, dynid
+from .refusals import dynid as dynid_cli
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -37,6 +38,24 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
               str(tmp_path / "u.urdf"), "--mjcf", str(tmp_path / "u.xml"), "--data-root", str(root))
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "u.urdf").read_text() == (out / "robot.urdf").read_text()
+    # into the user's own MuJoCo model: same joints' values as dynid's own MJCF, the user's bodies and meshes kept
+    import numpy as np
+
+    from dynid import load_robot
+
+    from ..io.test_mjcf_write_back import TETRAHEDRON, _users_mjcf
+
+    (tmp_path / "mine" / "meshes").mkdir(parents=True)
+    (tmp_path / "mine" / "meshes" / "piece.obj").write_text(TETRAHEDRON)
+    (tmp_path / "mine" / "arm.xml").write_text(_users_mjcf(load_robot("ur10e"), np.random.default_rng(1)))
+    p = dynid_cli("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--mjcf",
+                  str(tmp_path / "mine_identified.xml"), "--mjcf-model", str(tmp_path / "mine" / "arm.xml"), "--data-root", str(root))
+    assert p.returncode == 0, p.stderr
+    assert "the MJCF is arm.xml with only its inertials and joint dynamics replaced" in " ".join(p.stdout.split())
+    ours, theirs = (mujoco.MjModel.from_xml_path(str(f)) for f in (out / "robot.xml", tmp_path / "mine_identified.xml"))
+    np.testing.assert_allclose(theirs.dof_damping, ours.dof_damping)
+    np.testing.assert_allclose(theirs.body_subtreemass[theirs.jnt_bodyid[0]], ours.body_subtreemass[ours.jnt_bodyid[0]])
+    assert theirs.nmesh == 1 and theirs.nu == 1
     # validate the result on another log given on the command line: the truncated-line log
     log = root / "identification_data" / "ur-20_02_19_15harm50secLoad.csv"
     p = dynid("validate", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--file", str(log),

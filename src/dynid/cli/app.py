@@ -251,6 +251,7 @@ def export(
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
     urdf: Optional[Path] = typer.Option(None, help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
     mjcf: Optional[Path] = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
+    mjcf_model: Optional[Path] = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept)."),
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     quiet: bool = QUIET,
 ) -> None:
@@ -262,8 +263,16 @@ def export(
         cfg = load_identification_config(config, data_root)
         identified = _read_results(results, cfg.robot.name)
         targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
+        if mjcf_model is not None and mjcf is None:
+            raise DataError("--mjcf-model is the model --mjcf writes into: give --mjcf FILE too")
         if not targets:
             raise DataError("give --urdf FILE and/or --mjcf FILE")
+        if mjcf_model is not None and not mjcf_model.is_file():
+            raise DataError(f"--mjcf-model {mjcf_model}: no such file")
+        if mjcf_model is not None:
+            from ..io.mjcf_write_back import read_users_mjcf
+
+            read_users_mjcf(mjcf_model, cfg.robot)  # its joints are the robot's, before any work
         import os
 
         for flag, path in targets:  # checked before any work: export writes nothing unless it can write everything
@@ -279,6 +288,7 @@ def export(
 
     def compute(prepared, progress):
         from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results, urdf_written_back
+        from ..io.mjcf_write_back import mjcf_written_back
 
         cfg, identified, targets = prepared
         moved: list[str] = []
@@ -291,7 +301,15 @@ def export(
             moved.extend(far)
             return text
 
-        export = {"--urdf": urdf_text, "--mjcf": mjcf_from_results}
+        def mjcf_text(robot, identified, source):
+            if mjcf_model is None:
+                return mjcf_from_results(robot, identified, source)
+            fitted, phi = consistent_estimate(robot, identified, source)
+            text, far = mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf.parent if mjcf else None)
+            moved.extend(far)
+            return text
+
+        export = {"--urdf": urdf_text, "--mjcf": mjcf_text}
         return cfg, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets], moved
 
     def save(computed):
@@ -304,9 +322,11 @@ def export(
     def show(rep, computed, paths):
         cfg, _, moved = computed
         robot = cfg.robot
-        into = f"; the URDF is {cfg.urdf.name} with only its inertials and joint dynamics replaced" if cfg.urdf else ""
+        into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
+            ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
+            ("MJCF", mjcf_model.name if mjcf_model else "", mjcf_model is not None)) if given)
         for line in moved:
-            rep.warning(f"far from the URDF's own values: {line}")
+            rep.warning(f"far from the description's own values: {line}")
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
 

@@ -416,26 +416,76 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         if robot.coulomb_velocity[k] > 0:
             element.append(ET.Comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
         m0, c0, _ = physical_from_inertial(nominal[k]) if nominal[k][9] > 0 else (0.0, np.zeros(3), None)
-        if abs(mass - m0) > MOVED_MASS * max(m0, 1e-12) or np.linalg.norm(com - c0) > MOVED_COM:
-            moved.append(f"{link_name}: mass {mass:.4g} kg (the URDF's {m0:.4g}), centre of mass at ({_vec(com)}) m "
-                         f"(the URDF's ({_vec(c0)}))")
+        far = moved_far(link_name, mass, com, m0, c0, "URDF")
+        moved.extend([far] if far else [])
     if robot.transmission.n_coupled_params:
         names = robot.transmission.coupled_parameter_names
         root.append(ET.Comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " "))
-    header = [f" written by dynid into {path.name}: the <inertial> of every moving link and the <dynamics> of every "
-              f"moving joint hold {estimate}; every other element is the original's.",
+    root.insert(0, ET.Comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of "
+                                                "every moving joint", estimate, moved, "URDF")))
+    if root[0].tail is None or not root[0].tail.strip():
+        root[0].tail = "\n  "
+    text = ET.tostring(root, encoding="unicode")
+    return '<?xml version="1.0"?>\n' + text + "\n", moved
+
+
+def moved_far(link: str, mass: float, com: np.ndarray, nominal_mass: float, nominal_com: np.ndarray,
+              form: str) -> str | None:
+    """A line saying that a link's written values are far from its description's own, or None when they are not
+    (mass by over :data:`MOVED_MASS`, centre of mass by over :data:`MOVED_COM` m).
+
+    Parameters
+    ----------
+    link : str
+    mass, nominal_mass : float [kg]
+    com, nominal_com : (3,) arrays [m]
+        Centres of mass, in one frame.
+    form : str
+        "URDF" or "MJCF", for the line.
+
+    Returns
+    -------
+    str or None
+    """
+    if abs(mass - nominal_mass) <= MOVED_MASS * max(nominal_mass, 1e-12) and np.linalg.norm(com - nominal_com) <= MOVED_COM:
+        return None
+    def point(v):
+        return " ".join(f"{x:.3g}" for x in v)
+
+    return (f"{link}: mass {mass:.4g} kg (the {form}'s {nominal_mass:.4g}), centre of mass at ({point(com)}) m "
+            f"(the {form}'s ({point(nominal_com)}))")
+
+
+def identified_header(file: str, replaced: str, estimate: str, moved: list[str], form: str) -> str:
+    """The header comment of a written-back description: what holds identified values, and what they are.
+
+    Parameters
+    ----------
+    file : str
+        The description's file name.
+    replaced : str
+        Which elements hold identified values.
+    estimate : str
+        What the values are.
+    moved : list of str
+        :func:`moved_far` lines.
+    form : str
+        "URDF" or "MJCF".
+
+    Returns
+    -------
+    str
+        The comment's text.
+    """
+    header = [f" written by dynid into {file}: {replaced} hold {estimate}; every other element is the original's.",
               "dynid identifies base parameters: the values written are one physically consistent choice among the many",
               "that predict the same torques (the split between a link and its motor's rotor inertia, and what the",
               "experiment does not excite, are that choice's). Use them to simulate or control the robot, not as each",
               "link's measured mass."]
     if moved:
-        header += ["Far from the URDF's own values (a choice, as said above, or a description to check):"] + moved
-    root.insert(0, ET.Comment("\n     ".join(header) + " "))
-    if root[0].tail is None or not root[0].tail.strip():
-        root[0].tail = "\n  "
-    text = ET.tostring(root, encoding="unicode")
-    return '<?xml version="1.0"?>\n' + text + "\n", moved
+        header += [f"Far from the {form}'s own values (a choice, as said above, or a description to check):"] + moved
+    return "\n     ".join(header) + " "
 
 
 def _inertial_element(mass: float, com: np.ndarray, inertia: np.ndarray):

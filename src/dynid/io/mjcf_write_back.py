@@ -1,0 +1,246 @@
+"""The user's own MuJoCo model (MJCF) with the identified values written into it, and nothing else changed.
+
+A MuJoCo model of an arm rarely puts its bodies at the frames of the URDF dynid identified with (MuJoCo Menagerie's
+UR10e turns its base by π and places each body where its meshes were drawn). The two models are matched where they
+must agree, the joint axes at the zero configuration: a rigid transform of the whole arm maps the robot's joint
+axes onto the MJCF's (rotation by Kabsch's method on their directions, translation by least squares on the lines),
+and each identified link is then expressed in its MJCF body's own frame. MuJoCo (the ``mujoco`` extra) computes the
+MJCF's kinematics, so every way MJCF can state a frame (``quat``, ``euler``, ``axisangle``, defaults, ``angle``
+units) is read as MuJoCo reads it.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import ConfigError
+from ..model.robot import Robot
+from ..model.spatial import physical_from_inertial, transform_inertial
+from .export import _exportable, _replace, _vec, identified_header, moved_far
+
+AXIS_TOLERANCE = 1e-4
+"""[rad, m] How far a joint axis of the MJCF may lie from the robot's, once the arms are aligned."""
+
+
+def _joint_frames(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations (n, 3, 3) and origins (n, 3) of the robot's joint frames at q = 0, in its base frame."""
+    from ..dynamics.kinematics import forward_kinematics
+
+    rotations, origins = forward_kinematics(robot, np.zeros((1, robot.n_dof)))
+    return rotations[0], origins[0]
+
+
+def _alignment(axes_robot, points_robot, axes_model, points_model) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(R, t, misfit)`` mapping the robot's base frame into the MJCF's world: ``R a_robot = a_model`` and each robot
+    joint line onto the model's (Kabsch on the directions, then the translation nearest every line)."""
+    h = axes_robot.T @ axes_model
+    u, s, vt = np.linalg.svd(h)
+    if s[1] < 1e-6:  # every axis parallel: the rotation about them is not determined by the axes alone
+        raise ValueError("parallel")
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    projectors = np.eye(3)[None] - axes_model[:, :, None] * axes_model[:, None, :]
+    lhs = projectors.sum(axis=0)
+    rhs = np.einsum("kij,kj->i", projectors, points_model - points_robot @ r.T)
+    t = np.linalg.lstsq(lhs, rhs, rcond=None)[0]
+    off_line = np.einsum("kij,kj->ki", projectors, points_robot @ r.T + t - points_model)
+    misfit = max(float(np.abs(axes_robot @ r.T - axes_model).max()), float(np.linalg.norm(off_line, axis=1).max()))
+    return r, t, misfit
+
+
+def _rebased(source_dir: Path, out_dir: Path, value: str | None) -> str:
+    """A path the original resolves from ``source_dir``, as the written file must say it from ``out_dir``."""
+    target = Path(value) if value else Path(".")
+    if target.is_absolute():
+        return str(target)
+    return os.path.relpath(source_dir / target, out_dir)
+
+
+def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: str | Path | None = None,
+                      estimate: str = "the physically consistent estimate") -> tuple[str, list[str]]:
+    """The user's MJCF with each moving body's ``<inertial>`` and each joint's ``armature``, ``damping`` and
+    ``frictionloss`` replaced by the identified values; every other element kept (names, frames, geoms, meshes,
+    sites, actuators, sensors, defaults, comments).
+
+    Each joint of ``robot`` is found by name among the MJCF's hinges. The link identified in the robot's joint frame
+    is expressed in the MJCF body that carries the joint (``transform_inertial``); bodies welded to it (no joint of
+    their own, e.g. a flange or a tool) are identified with it, so their inertials become massless (a comment says
+    so). A compiler told to take inertias from geoms (``inertiafromgeom="true"``) would ignore the written values: it
+    is set to ``"auto"``. Relative file paths (``meshdir``, ``texturedir``, ``assetdir``, ``<include file>``) are
+    rewritten for the folder the result is written to. The header comment says what was identified, as in
+    :func:`dynid.io.export.urdf_written_back`.
+
+    Parameters
+    ----------
+    mjcf : str or Path
+        The user's MJCF, one file holding the arm's bodies (included files are kept as they are).
+    robot : Robot
+        The identified robot (its joint names are the MJCF's).
+    phi : (n_params,) array
+        Standard parameters to write (physically consistent).
+    out_dir : str or Path, optional
+        Folder the result will be written to (default: the MJCF's own).
+    estimate : str
+        What the values are, for the header comment.
+
+    Returns
+    -------
+    text : str
+        The MJCF.
+    moved : list of str
+        Links whose values moved far from the MJCF's own (:data:`dynid.io.export.MOVED_MASS`, ``MOVED_COM``).
+
+    Raises
+    ------
+    ConfigError
+        The MJCF cannot be read or compiled by MuJoCo, lacks a joint of the robot (or has it as another type or in
+        an included file), its joint axes at q = 0 are not the robot's (another robot, or another zero), or the
+        values are not exportable.
+    """
+    import mujoco
+
+    path = Path(mjcf)
+    fitted = _exportable(robot, phi)
+    model, root, ids = read_users_mjcf(path, robot)
+    elements = {e.get("name"): e for e in root.iter("joint") if e.get("name")}
+    bodies = {e.get("name"): e for e in root.iter("body") if e.get("name")}
+    data = mujoco.MjData(model)
+    data.qpos[:] = model.qpos0
+    data.qpos[model.jnt_qposadr[ids]] = 0.0
+    mujoco.mj_kinematics(model, data)
+    rotations, origins = _joint_frames(robot)
+    axes_robot = np.einsum("kij,kj->ki", rotations, np.array([j.axis for j in robot.joints], dtype=float))
+    axes_robot /= np.linalg.norm(axes_robot, axis=1, keepdims=True)
+    try:
+        r, t, misfit = _alignment(axes_robot, origins, data.xaxis[ids], data.xanchor[ids])
+    except ValueError:
+        raise ConfigError(f"{path}: every joint axis is parallel, so the axes cannot place the arm: write back needs "
+                          "two joints that are not parallel") from None
+    if misfit > AXIS_TOLERANCE:
+        raise ConfigError(f"{path}: its joint axes at q = 0 are not the robot's (off by {misfit:.3g}, in m or rad): "
+                          "another robot, another zero position or joints turning the other way")
+    moving = set(model.jnt_bodyid[ids])
+    moved: list[str] = []
+    for k, (joint, jid) in enumerate(zip(robot.joints, ids)):
+        body_id = int(model.jnt_bodyid[jid])
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body_id)
+        body = bodies.get(name)
+        if body is None:
+            raise ConfigError(f"{path}: the body of joint {joint.name!r} has no name: name it to write into it")
+        body_r = data.xmat[body_id].reshape(3, 3)
+        frame_r, frame_p = r @ rotations[k], r @ origins[k] + t  # the robot's joint frame in MuJoCo's world
+        in_body = transform_inertial(fitted.inertial[k], body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
+        mass, com, inertia = physical_from_inertial(in_body)
+        nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
+        _replace(body, "inertial", ET.Element("inertial", pos=_vec(com), mass=f"{mass:.17g}", fullinertia=" ".join(
+            f"{v:.17g}" for v in (inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]))))
+        welded = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}" for b in range(model.nbody)
+                  if b not in moving and _carried_by(model, b, body_id, moving)]
+        for other in welded:
+            if other in bodies:
+                _replace(bodies[other], "inertial", ET.Element("inertial", pos="0 0 0", mass="0", diaginertia="0 0 0"))
+        if welded:
+            body.insert(0, ET.Comment(f" dynid: {', '.join(welded)} (welded to this body) identified with it: their "
+                                      "mass is written here "))
+        terms = dict(zip(robot.drive_terms, fitted.drive[k]))
+        element = elements[joint.name]
+        element.set("armature", f"{terms.get('Ia', 0.0):.17g}")
+        element.set("damping", f"{terms.get('fv', 0.0):.17g}")
+        element.set("frictionloss", f"{terms.get('fc', 0.0):.17g}")
+        extra = {n: v for n, v in terms.items() if n not in ("Ia", "fc", "fv") and v != 0}
+        if extra:
+            body.append(ET.Comment(" dynid: drive terms MJCF cannot hold, add them to the torques: "
+                                   + ", ".join(f"{n}{k + 1} = {v:.17g}" for n, v in extra.items()) + " "))
+        if robot.coulomb_velocity[k] > 0:
+            body.append(ET.Comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
+        far = moved_far(name, mass, com, nominal_mass, nominal_com, "MJCF")
+        moved.extend([far] if far else [])
+    if robot.transmission.n_coupled_params:
+        root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
+            f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
+                                              fitted.transmission.coupled_values.ravel())) + " "))
+    _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
+    header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
+                               "frictionloss of every joint", estimate, moved, "MJCF")
+    root.insert(0, ET.Comment(header))
+    if root[0].tail is None or not root[0].tail.strip():
+        root[0].tail = "\n  "
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", moved
+
+
+def read_users_mjcf(path: Path, robot: Robot):
+    """The user's MJCF compiled by MuJoCo and parsed as XML (comments kept), with the ids of the robot's joints.
+
+    Parameters
+    ----------
+    path : Path
+    robot : Robot
+
+    Returns
+    -------
+    model : mujoco.MjModel
+    root : xml.etree.ElementTree.Element
+    ids : list of int
+        MuJoCo's joint id of each of the robot's joints.
+
+    Raises
+    ------
+    ConfigError
+        MuJoCo is not installed (names the extra), the file cannot be read or compiled, a joint of the robot is
+        missing, is not a hinge, or is in an included file.
+    """
+    from ..extras import require
+
+    mujoco = require("mujoco", "mujoco", "writing into an MJCF")
+    try:
+        model = mujoco.MjModel.from_xml_path(str(path))
+        root = ET.parse(path, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))).getroot()
+    except (OSError, ValueError, ET.ParseError) as exc:
+        raise ConfigError(f"{path}: cannot read it as MJCF ({' '.join(str(exc).split())})") from None
+    named = {e.get("name") for e in root.iter("joint")}
+    ids = []
+    for joint in robot.joints:
+        k = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name)
+        if k < 0:
+            raise ConfigError(f"{path}: has no joint {joint.name!r}: the results are of another robot than this MJCF's")
+        if model.jnt_type[k] != mujoco.mjtJoint.mjJNT_HINGE:
+            raise ConfigError(f"{path}: joint {joint.name!r} is not a hinge, the robot's joint is revolute")
+        if joint.name not in named:
+            raise ConfigError(f"{path}: joint {joint.name!r} is in an included file: write back into one file holding the arm")
+        ids.append(k)
+    return model, root, ids
+
+
+def _carried_by(model, body: int, owner: int, moving: set) -> bool:
+    """``body`` rides on ``owner`` with no joint between them."""
+    while body not in (0, owner):
+        if model.body_jntnum[body] or body in moving:
+            return False
+        body = int(model.body_parentid[body])
+    return body == owner
+
+
+def _compiler_for(root, source_dir: Path, out_dir: Path) -> None:
+    """Make the written file compile as the original did: inertias written here not overridden by geoms, and file
+    references resolved from the folder it is written to."""
+    compiler = root.find("compiler")
+    if compiler is None:
+        compiler = ET.Element("compiler")
+        compiler.tail = "\n  "
+        root.insert(0, compiler)
+    if compiler.get("inertiafromgeom") == "true":
+        compiler.set("inertiafromgeom", "auto")
+        root.insert(0, ET.Comment(" dynid: inertiafromgeom was \"true\", which would ignore the identified inertials "))
+    if out_dir == source_dir:
+        return
+    for attribute in ("meshdir", "texturedir"):
+        if compiler.get(attribute) is not None:
+            compiler.set(attribute, _rebased(source_dir, out_dir, compiler.get(attribute)))
+    compiler.set("assetdir", _rebased(source_dir, out_dir, compiler.get("assetdir")))
+    for include in root.iter("include"):
+        if include.get("file"):
+            include.set("file", _rebased(source_dir, out_dir, include.get("file")))
