@@ -210,6 +210,7 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
         if floor > 0:
             smooth = np.convolve(power, kernel, mode="same")
             above = (power > NOISE_BIN_FACTOR * floor) | (smooth > NOISE_SMOOTH_FACTOR * floor)
+            above &= f < _first_gap(_octave_smoothed(power, f), f, floor)
             motion += np.where(above, f2 * np.maximum(power - floor, 0.0), 0.0)
             noise += float(f2.sum() * floor)
         else:
@@ -227,6 +228,23 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
         below = np.flatnonzero((f[grid] > band) & (smooth < 2 * floor))
         knees.append(f[grid][below[0]] if below.size and floor > 0 else hi)
     return BandEstimate(band, share, float(rate), bool(found), float(np.median(knees)))
+
+
+GAP_OCTAVES = 1.0
+"""The excitation's motion is the spectrum up to its first stretch of this many octaves at the noise floor (below
+twice it, sixth-octave means): what rises above the floor beyond such a gap is not the excitation. In closed loop the
+controller shapes the encoder's noise (the sensitivity function: suppressed within the loop's bandwidth, raised
+around its crossover), so the floor measured where the loop suppresses it is below the white noise at the top of
+the spectrum, which would otherwise count as motion and, weighted by f², put the band near the Nyquist frequency."""
+
+
+def _first_gap(smoothed: np.ndarray, f: np.ndarray, floor: float) -> float:
+    """The frequency [Hz] where the first :data:`GAP_OCTAVES` stretch at the floor starts (inf when there is none)."""
+    quiet = np.concatenate([[0], (smoothed[1:] < 2 * floor).astype(np.int8), [0]])
+    edges = np.diff(quiet)
+    starts, last = np.flatnonzero(edges == 1) + 1, np.flatnonzero(edges == -1)  # runs [start, last] of quiet bins
+    wide = f[last] >= f[starts] * 2**GAP_OCTAVES
+    return float(f[starts[wide][0]]) if wide.any() else np.inf
 
 
 def _octave_smoothed(power: np.ndarray, f: np.ndarray) -> np.ndarray:
