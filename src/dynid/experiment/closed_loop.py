@@ -1,0 +1,229 @@
+"""Identification of a robot run in closed loop: IDIM-IV and DIDIM beside least squares.
+
+Both estimators simulate the robot's closed loop (:mod:`dynid.simulation.closed_loop`: the same controller, reference
+and feed-forward as the experiment) with the current estimate, and prepare the simulated positions exactly as the
+measured ones (the same resolved preprocessing settings, the same parallel filter and decimation), so the rows of
+the simulated observation matrix ``W_s`` match the measured ``W`` and ``τ``:
+
+- **IDIM-IV** (Janot, Vandanjon & Gautier, IEEE TCST 22(1), 2014): ``W_s`` as instruments,
+  ``β_{k+1} = (W_sᵀ W)⁻¹ W_sᵀ τ``; ``W_s`` is noise-free and so uncorrelated with the loop's noise in ``W``.
+- **DIDIM** (Gautier, Janot & Vandanjon, IEEE TCST 21(2), 2013): closed-loop output error on the torques, by
+  Gauss–Newton with the Jacobian ``∂τ_s/∂β`` taken as ``W_s`` re-linearised at each step: ``β_{k+1} = W_s⁺ τ``.
+
+Both start from the weighted least-squares estimate on the measured rows (IDIM-WLS) — or from the description's
+values when that estimate is too biased to be simulated (unstable) — weight every joint's rows by
+the inverse of its residual σ, and stop when the simulated torques change by less than ``tol`` (relative) between
+iterations. A base-parameter estimate is simulated through the standard vector nearest the description's nominal
+values with the same base parameters (:meth:`dynid.dynamics.base_parameters.BaseParameters.standard_from_base`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..dynamics.base_parameters import BaseParameters
+from ..estimators.instrumental import instrumental_variables
+from ..exceptions import ConfigError, DataError, ShapeError
+from ..io.datasets import Recording
+from ..model.robot import Robot
+from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
+from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
+
+__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]
+
+CLOSED_LOOP_METHODS = ("idim-iv", "didim")
+"""Keys of the closed-loop estimators (case-insensitive)."""
+
+LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM"}
+
+
+@dataclass(frozen=True)
+class ClosedLoopExperiment:
+    """What the closed-loop estimators must know of an experiment to simulate it.
+
+    Attributes
+    ----------
+    controller : Controller
+    q_ref, dq_ref : (N, n_dof) arrays
+        The reference at the log's instants [rad, rad/s].
+    feedforward : (N, n_dof) array or None
+        Feed-forward torques the controller added [N·m].
+    """
+
+    controller: Controller
+    q_ref: np.ndarray
+    dq_ref: np.ndarray
+    feedforward: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class ClosedLoopEstimate:
+    """One estimate of the base parameters.
+
+    Attributes
+    ----------
+    method : str
+        "IDIM-WLS", "IDIM-IV" or "DIDIM".
+    params, params_std : (n_base,) arrays
+    iterations : int
+        Closed-loop simulations run.
+    converged : bool
+    changes : tuple of float
+        Relative change of the simulated torques at each iteration.
+    message : str
+        Why it stopped.
+    """
+
+    method: str
+    params: np.ndarray
+    params_std: np.ndarray
+    iterations: int = 0
+    converged: bool = True
+    changes: tuple[float, ...] = field(default=())
+    message: str = ""
+
+    def to_dict(self, names=None) -> dict:
+        """JSON-ready, parameters by name when ``names`` are given.
+
+        Parameters
+        ----------
+        names : sequence of str, optional
+
+        Returns
+        -------
+        dict
+        """
+        names = list(names) if names is not None else [f"beta{k + 1}" for k in range(self.params.size)]
+        return {"method": self.method, "iterations": self.iterations, "converged": self.converged, "message": self.message,
+                "changes": list(self.changes),
+                "parameters": [{"name": n, "value": float(v), "std": float(s)} for n, v, s in zip(names, self.params, self.params_std)]}
+
+
+def _rows(robot: Robot, base: BaseParameters, data: PreparedData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Base rows, torques and the rows kept (M,), of a prepared recording."""
+    ws, taus, keeps = [], [], []
+    for _, y, tau, keep in base_chunks(robot, base, data):
+        ws.append(y.reshape(-1, y.shape[-1]))
+        taus.append(np.asarray(tau).reshape(-1))
+        keeps.append(np.asarray(keep).reshape(-1))
+    return np.concatenate(ws), np.concatenate(taus), np.concatenate(keeps)
+
+
+def _weighted_least_squares(w, tau, row_sigma):
+    a, b = w / row_sigma[:, None], tau / row_sigma
+    params, *_ = np.linalg.lstsq(a, b, rcond=None)
+    r = b - a @ params
+    sigma2 = float(r @ r) / max(a.shape[0] - a.shape[1], 1)
+    cov = sigma2 * np.linalg.pinv(a.T @ a)
+    return params, np.sqrt(np.maximum(np.diag(cov), 0.0))
+
+
+def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
+                         methods=CLOSED_LOOP_METHODS, preprocessing: Preprocessing | None = None, max_iter: int = 10,
+                         tol: float = 1e-4) -> dict[str, ClosedLoopEstimate]:
+    """IDIM-WLS, then each closed-loop estimator of ``methods`` (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        The model identified (its friction terms), and the nominal values a base estimate is simulated through.
+    base : BaseParameters
+    recording : Recording
+        The closed-loop log: measured positions and torques at the controller's instants.
+    experiment : ClosedLoopExperiment
+    methods : sequence of str
+        Among :data:`CLOSED_LOOP_METHODS`.
+    preprocessing : Preprocessing, optional
+        Default: every setting derived from the log (the settings resolved on it prepare the simulations too).
+    max_iter : int
+        Closed-loop simulations per estimator at most.
+    tol : float
+        Relative change of the simulated torques that ends the iterations.
+
+    Returns
+    -------
+    dict
+        ``{"wls": ..., "idim-iv": ..., "didim": ...}`` (those asked for), :class:`ClosedLoopEstimate` each.
+
+    Raises
+    ------
+    ConfigError
+        An unknown method.
+    ShapeError
+        A reference or feed-forward whose length is not the log's, or a log not at the controller's rate.
+    """
+    keys = [str(m).lower() for m in methods]
+    unknown = [m for m in keys if m not in CLOSED_LOOP_METHODS]
+    if unknown:
+        raise ConfigError(f"closed-loop estimator {unknown[0]!r}: expected one of {', '.join(CLOSED_LOOP_METHODS)}")
+    n_s = recording.t.size
+    for name, x in (("reference q", experiment.q_ref), ("reference dq", experiment.dq_ref), ("feed-forward", experiment.feedforward)):
+        if x is not None and np.shape(x) != (n_s, robot.n_dof):
+            raise ShapeError(f"{name}: expected ({n_s}, {robot.n_dof}) samples, one per sample of {recording.name}, got {np.shape(x)}")
+    if abs(recording.rate - experiment.controller.rate) > 1e-6 * experiment.controller.rate:
+        raise ShapeError(f"{recording.name}: logged at {recording.rate:.6g} Hz, the controller runs at {experiment.controller.rate:.6g} Hz: "
+                         "the closed-loop estimators need the log at the control rate")
+    data = prepare(recording, preprocessing or Preprocessing())
+    w, tau, keep = _rows(robot, base, data)
+    n = robot.n_dof
+    w, tau = w[keep], tau[keep]
+    joint = np.tile(np.arange(n), keep.size // n)[keep]
+    params, _ = _weighted_least_squares(w, tau, np.ones(tau.size))
+    residual = tau - w @ params
+    sigma = np.array([np.sqrt(np.mean(residual[joint == j] ** 2)) if np.any(joint == j) else 1.0 for j in range(n)])
+    row_sigma = np.maximum(sigma, 1e-12)[joint]
+    start, start_std = _weighted_least_squares(w, tau, row_sigma)
+    out = {"wls": ClosedLoopEstimate(LABELS["wls"], start, start_std, message="least squares on the measured rows")}
+    nominal = robot.standard_parameters()
+
+    def simulated_rows(beta):
+        phi = base.standard_from_base(beta, reference=nominal)
+        run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
+                                   ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
+        sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate)
+        ws, _, _ = _rows(robot, base, prepare(sim, data.settings, strict=False))
+        if ws.shape[0] != keep.size:
+            raise DataError(f"{recording.name}: the simulated log prepares to {ws.shape[0] // n} samples, the measured one to "
+                            f"{keep.size // n}")
+        return ws[keep]
+
+    for key in keys:
+        beta, message, converged, note = start.copy(), "", False, ""
+        changes: list[float] = []
+        previous = w @ beta
+        std = start_std
+        for _ in range(max_iter):
+            try:
+                ws = simulated_rows(beta)
+            except ConfigError as exc:  # the estimate cannot be simulated (unstable, a massless link)
+                if changes or note:
+                    message = f"stopped: {exc}"
+                    break
+                # least squares biased far enough to be unstable in simulation: start from the description instead
+                # (instruments need only be uncorrelated with the noise; the iterations take them to the estimate)
+                note = f"the least-squares estimate cannot be simulated ({exc}); started from the description's values; "
+                beta = base.base_from_standard(nominal)
+                try:
+                    ws = simulated_rows(beta)
+                except ConfigError as again:
+                    message = f"stopped: neither the least-squares estimate nor the description can be simulated ({again})"
+                    break
+            if key == "idim-iv":
+                sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None])
+                beta, std = sol.params, sol.params_std
+                torque = w @ beta
+            else:
+                beta, std = _weighted_least_squares(ws, tau, row_sigma)
+                torque = ws @ beta
+            change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
+            changes.append(change)
+            previous = torque
+            if change < tol:
+                converged, message = True, f"converged: the simulated torques changed by {change:.2g} (relative)"
+                break
+        else:
+            message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
+        out[key] = ClosedLoopEstimate(LABELS[key], beta, std, len(changes), converged, tuple(changes), note + message)
+    return out

@@ -1,0 +1,394 @@
+"""A robot identified while its own controller drives it: closed-loop simulation.
+
+A joint-space PD or PID controller (optional feed-forward torques) runs at its control rate on the *measured*
+positions (encoder quantisation plus noise), as a real one does, so the loop's noise reaches the motion; the
+torque it commands is held over the control period and drives the direct dynamics
+
+    M(q) q̈ = τ − h(q, q̇),  M = M_rigid + M_drive,  h = h_rigid + τ_drive(q̇),
+
+with ``M_rigid`` and ``h_rigid`` from Pinocchio (CRBA and the non-linear effects of RNEA), and the drive terms of
+dynid's friction table (rotor inertia, Coulomb, viscous, offset, coupled motors) added, integrated by a fixed-step
+fourth-order Runge–Kutta at the control rate. The logged torques are the commanded ones plus measurement noise.
+
+The same simulator, given a model's standard parameters instead of the truth, is what the closed-loop estimators
+(IDIM-IV, DIDIM) simulate at each iteration.
+
+References: Gautier, Janot & Vandanjon, "A new closed-loop output error method for parameter identification of
+robot dynamics", IEEE TCST 21(2), 2013; Janot, Vandanjon & Gautier, "A generic instrumental variable approach for
+industrial robot identification", IEEE TCST 22(1), 2014; Leboutet et al., "Inertial parameter identification in
+robotics: a survey", Applied Sciences 11(9), 2021 (the noise grid).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..dynamics.regressor import friction_torques
+from ..dynamics.rnea import pinocchio_model
+from ..exceptions import ConfigError, ShapeError
+from ..model.robot import Robot
+
+__all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "JointDynamics", "simulate_closed_loop"]
+
+_FAST_TERMS = frozenset({"Ia", "fc", "fv", "offset"})
+
+
+def _gains(value, n: int, name: str, positive: bool) -> np.ndarray:
+    arr = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy() if np.ndim(value) == 0 else np.asarray(value, dtype=float)
+    if arr.shape != (n,):
+        raise ConfigError(f"controller.{name}: expected one value per joint ({n}), got {np.shape(value)}", field=name)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or (positive and np.any(arr <= 0)):
+        raise ConfigError(f"controller.{name}: expected {'positive' if positive else 'non-negative'} finite gains, got "
+                          f"{arr.tolist()}", field=name)
+    return arr
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A joint-space PD/PID controller on the measured positions.
+
+    ``τ_k = τ_ff,k + Kp (q_ref,k − q_meas,k) + Kd (q̇_ref,k − q̇_est,k) + Ki Σ (q_ref − q_meas)/f``, with ``q̇_est`` the
+    backward difference of the measured positions (what a drive computes from its encoder), through a first-order
+    low-pass filter at ``velocity_cutoff``.
+
+    Attributes
+    ----------
+    kp : (n_dof,) array [N·m/rad]
+    kd : (n_dof,) array [N·m·s/rad]
+    ki : (n_dof,) array [N·m/(rad·s)]
+        Zero for a PD controller.
+    rate : float [Hz]
+        Control rate, also the integrator's and the log's.
+    velocity_cutoff : float [Hz]
+        Cutoff of the velocity estimate's first-order filter (0: the raw difference).
+    """
+
+    kp: np.ndarray
+    kd: np.ndarray
+    ki: np.ndarray
+    rate: float
+    velocity_cutoff: float = 0.0
+
+    @classmethod
+    def for_robot(cls, robot: Robot, bandwidth: float = 5.0, rate: float = 1000.0, integral: bool = True,
+                  velocity_cutoff: float = 50.0, phi: np.ndarray | None = None) -> "Controller":
+        """A PID (or PD) tuned per joint on the diagonal of the mass matrix at q = 0: ``Kp = I ω²``, ``Kd = 2 I ω``
+        (critical damping), ``Ki = Kp ω / 10``, with ``ω = 2π · bandwidth``.
+
+        Parameters
+        ----------
+        robot : Robot
+        bandwidth : float [Hz]
+        rate : float [Hz]
+        integral : bool
+            PID (True) or PD.
+        velocity_cutoff : float [Hz]
+        phi : (n_params,) array, optional
+            Standard parameters of the robot (its nominal ones by default).
+
+        Returns
+        -------
+        Controller
+
+        Raises
+        ------
+        ConfigError
+            A joint with no inertia at q = 0 (no gain can be derived), or the checks of :meth:`of`.
+        """
+        n = robot.n_dof
+        m, _ = JointDynamics(robot, phi).mass_and_bias(np.zeros(n), np.zeros(n))
+        inertia = np.diag(m)
+        if np.any(inertia <= 0):
+            k = int(np.argmin(inertia))
+            raise ConfigError(f"controller: joint {k + 1} has no inertia at q = 0 (no rotor inertia Ia, no link inertia "
+                              "about its axis), so no gain can be derived from it: give kp and kd")
+        w = 2 * np.pi * bandwidth
+        kp = inertia * w**2
+        return cls.of(n, kp, 2 * inertia * w, kp * w / 10 if integral else 0.0, rate, velocity_cutoff)
+
+    @classmethod
+    def of(cls, n_dof: int, kp, kd, ki=0.0, rate: float = 1000.0, velocity_cutoff: float = 0.0) -> "Controller":
+        """A controller with gains checked (a scalar is every joint's).
+
+        Parameters
+        ----------
+        n_dof : int
+        kp, kd, ki : float or (n_dof,) array
+            [N·m/rad], [N·m·s/rad], [N·m/(rad·s)].
+        rate : float [Hz]
+        velocity_cutoff : float [Hz]
+            0 for the raw backward difference; below half the rate.
+
+        Returns
+        -------
+        Controller
+
+        Raises
+        ------
+        ConfigError
+            A gain of the wrong length, negative or not finite (``kp``, ``kd`` must be positive), a rate that is
+            not positive, or a velocity cutoff outside [0, rate/2).
+        """
+        if not (np.isfinite(rate) and rate > 0):
+            raise ConfigError(f"controller.rate: expected a positive rate in Hz, got {rate!r}", field="rate")
+        if not (np.isfinite(velocity_cutoff) and 0 <= velocity_cutoff < rate / 2):
+            raise ConfigError(f"controller.velocity_cutoff: expected 0 (none) or a cutoff below half the rate ({rate / 2:g} Hz), "
+                              f"got {velocity_cutoff!r}", field="velocity_cutoff")
+        return cls(_gains(kp, n_dof, "kp", True), _gains(kd, n_dof, "kd", True), _gains(ki, n_dof, "ki", False), float(rate),
+                   float(velocity_cutoff))
+
+
+@dataclass(frozen=True)
+class ClosedLoopNoise:
+    """What the loop and the log see of the truth.
+
+    Attributes
+    ----------
+    position_std : float [rad]
+        Gaussian noise on the measured positions (before quantisation).
+    encoder_resolution : float [rad]
+        Quantisation step of the measured positions (0: none).
+    torque_std : float [N·m]
+        Gaussian noise on the logged torques (currents through the drive gains).
+    """
+
+    position_std: float = 0.0
+    encoder_resolution: float = 0.0
+    torque_std: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("position_std", "encoder_resolution", "torque_std"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ConfigError(f"noise.{name}: expected a non-negative number, got {value!r}", field=name)
+
+    def measured_positions(self, q: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Positions as the encoder gives them.
+
+        Parameters
+        ----------
+        q : array [rad]
+        rng : numpy.random.Generator
+
+        Returns
+        -------
+        array [rad], same shape
+        """
+        y = q + rng.normal(0.0, self.position_std, np.shape(q)) if self.position_std > 0 else np.array(q, dtype=float)
+        return np.round(y / self.encoder_resolution) * self.encoder_resolution if self.encoder_resolution > 0 else y
+
+
+@dataclass(frozen=True)
+class ClosedLoopRun:
+    """One closed-loop run, time-first arrays of shape (N, n_dof) unless noted.
+
+    Attributes
+    ----------
+    t : (N,) array [s]
+    q : measured positions [rad] (what the loop saw and the log holds)
+    tau : logged torques [N·m] (commanded, plus measurement noise)
+    q_true, dq_true, ddq_true : the motion [rad, rad/s, rad/s²] (``ddq_true`` at the start of each step)
+    tau_applied : the commanded torques [N·m], held over each control period
+    q_ref, dq_ref : the reference [rad, rad/s]
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    tau: np.ndarray
+    q_true: np.ndarray
+    dq_true: np.ndarray
+    ddq_true: np.ndarray
+    tau_applied: np.ndarray
+    q_ref: np.ndarray = field(repr=False)
+    dq_ref: np.ndarray = field(repr=False)
+
+
+class JointDynamics:
+    """Direct dynamics of a robot with given standard parameters: ``q̈ = M(q)⁻¹ (τ − h(q, q̇))``.
+
+    The rigid bodies are Pinocchio's (CRBA and non-linear effects); the drive terms are dynid's friction table:
+    their inertia (rotor inertia, coupled motors) is constant and joins ``M``; their velocity terms join ``h``.
+
+    Parameters
+    ----------
+    robot : Robot
+    phi : (n_params,) array, optional
+        Standard parameters (the robot's nominal ones by default). They need not be physically consistent (a model
+        of base parameters embedded in the standard space): CRBA and RNEA are linear in them, but each link's mass
+        must not be zero.
+
+    Raises
+    ------
+    ConfigError
+        A link of zero mass in ``phi`` (Pinocchio cannot place its centre of mass).
+    """
+
+    def __init__(self, robot: Robot, phi: np.ndarray | None = None):
+        robot = robot if phi is None else robot.with_parameters(np.asarray(phi, dtype=float))
+        masses = robot.inertial[:, 9]
+        if np.any(np.abs(masses) < 1e-12):
+            k = int(np.argmin(np.abs(masses)))
+            raise ConfigError(f"closed-loop simulation: link {k + 1} has zero mass in the parameters simulated")
+        import pinocchio as pin
+
+        self._pin = pin
+        self.robot = robot
+        self.model = pinocchio_model(robot, robot.inertial)
+        self.data = self.model.createData()
+        n = robot.n_dof
+        zeros = np.zeros((n, n))
+        self.drive_inertia = (friction_torques(robot, zeros, np.eye(n)) - friction_torques(robot, zeros[:1], zeros[:1])[0]).T
+        self._fast = set(robot.drive_terms) <= _FAST_TERMS
+        values = dict(zip(robot.drive_terms, (robot.drive * robot.drive_mask).T))
+        self._fc, self._fv, self._offset = (values.get(k, np.zeros(n)) for k in ("fc", "fv", "offset"))
+        self._vs = np.asarray(robot.coulomb_velocity, dtype=float)
+        self._smooth = bool(np.any(self._vs > 0))
+        self._coupled = robot.transmission.n_coupled_params > 0
+        # a diagonal drive inertia (rotor inertias, no coupled motor) is Pinocchio's armature: ABA then gives q̈ in one
+        # call; a coupled motor's inertia is off the diagonal: M from CRBA, solved
+        off_diagonal = self.drive_inertia - np.diag(np.diag(self.drive_inertia))
+        self._aba = not np.any(off_diagonal)
+        if self._aba:
+            self.model.armature = np.diag(self.drive_inertia).copy()
+
+    def drive_torques(self, dq: np.ndarray) -> np.ndarray:
+        """Torques of the drive terms at zero acceleration (friction, offset, coupled motors' friction).
+
+        Parameters
+        ----------
+        dq : (n_dof,) array [rad/s]
+
+        Returns
+        -------
+        (n_dof,) array [N·m]
+        """
+        if not self._fast:
+            return friction_torques(self.robot, dq[None], np.zeros((1, dq.size)))[0]
+        if self._smooth:
+            s = np.where(self._vs > 0, np.tanh(dq / np.where(self._vs > 0, self._vs, 1.0)), np.sign(dq))
+        else:
+            s = np.sign(dq)
+        tau = self._fc * s + self._fv * dq + self._offset
+        if self._coupled:
+            tr = self.robot.transmission
+            tau = tau + tr.coupling_columns(dq[None], np.zeros((1, dq.size)))[0] @ np.ravel(tr.coupled_values)
+        return tau
+
+    def mass_and_bias(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``M(q)`` and ``h(q, q̇)``, so that the joint torque is ``M q̈ + h``.
+
+        Parameters
+        ----------
+        q, dq : (n_dof,) arrays [rad, rad/s]
+
+        Returns
+        -------
+        m : (n_dof, n_dof) array [kg·m²]
+        h : (n_dof,) array [N·m]
+        """
+        pin = self._pin
+        m = pin.crba(self.model, self.data, q)
+        m = np.triu(m) + np.triu(m, 1).T + (0.0 if self._aba else self.drive_inertia)  # armature: in CRBA's M already
+        return m, pin.nonLinearEffects(self.model, self.data, q, dq) + self.drive_torques(dq)
+
+    def accelerations(self, q: np.ndarray, dq: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Direct dynamics.
+
+        Parameters
+        ----------
+        q, dq, tau : (n_dof,) arrays [rad, rad/s, N·m]
+
+        Returns
+        -------
+        (n_dof,) array [rad/s²]
+        """
+        if self._aba:
+            return self._pin.aba(self.model, self.data, q, dq, tau - self.drive_torques(dq))
+        m, h = self.mass_and_bias(q, dq)
+        return np.linalg.solve(m, tau - h)
+
+
+def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller, noise: ClosedLoopNoise = ClosedLoopNoise(),
+                         rng: np.random.Generator | None = None, phi: np.ndarray | None = None,
+                         feedforward=None) -> ClosedLoopRun:
+    """Run the controller on the robot along a reference, at the control rate.
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+        Control instants, ``1/controller.rate`` apart.
+    q_ref, dq_ref : (N, n_dof) arrays
+        The reference [rad, rad/s]; the run starts on it, at rest or moving as it does.
+    controller : Controller
+    noise : ClosedLoopNoise
+    rng : numpy.random.Generator, optional
+        Draws the noise (required when there is noise).
+    phi : (n_params,) array, optional
+        Standard parameters simulated (the robot's nominal ones by default; an estimate's, for IDIM-IV and DIDIM).
+    feedforward : (N, n_dof) array [N·m], optional
+        Torques added to the feedback at each instant (e.g. a nominal model's inverse dynamics of the reference).
+
+    Returns
+    -------
+    ClosedLoopRun
+
+    Raises
+    ------
+    ShapeError
+        Arrays of other shapes than (N, n_dof), or instants not ``1/rate`` apart.
+    ConfigError
+        Noise without ``rng``, or parameters with a massless link.
+    """
+    n = robot.n_dof
+    t = np.asarray(t, dtype=float).reshape(-1)
+    q_ref, dq_ref = (np.asarray(x, dtype=float) for x in (q_ref, dq_ref))
+    ff = np.zeros((t.size, n)) if feedforward is None else np.asarray(feedforward, dtype=float)
+    for name, x in (("q_ref", q_ref), ("dq_ref", dq_ref), ("feedforward", ff)):
+        if x.shape != (t.size, n):
+            raise ShapeError(f"{name}: expected shape ({t.size}, {n}), got {x.shape}")
+    h = 1.0 / controller.rate
+    if t.size < 2 or not np.allclose(np.diff(t), h, rtol=1e-6, atol=1e-12):
+        raise ShapeError(f"t: expected instants 1/rate = {h:.6g} s apart")
+    noisy = noise.position_std > 0 or noise.encoder_resolution > 0 or noise.torque_std > 0
+    if noisy and rng is None:
+        raise ConfigError("closed-loop simulation with noise needs an rng (np.random.default_rng(seed))")
+    rng = rng if rng is not None else np.random.default_rng(0)
+    dynamics = JointDynamics(robot, phi)
+    accelerations = dynamics.accelerations
+    q_true, dq_true, ddq_true, tau_applied, q_meas = (np.empty((t.size, n)) for _ in range(5))
+    q, dq = q_ref[0].copy(), dq_ref[0].copy()
+    kp, kd, ki = controller.kp, controller.kd, controller.ki
+    integral = np.zeros(n)
+    previous = None
+    # first-order low-pass of the differenced positions (backward Euler): v ← v + α (raw − v)
+    alpha = 1.0 if controller.velocity_cutoff == 0 else 1.0 - np.exp(-2 * np.pi * controller.velocity_cutoff * h)
+    velocity = dq_ref[0].copy()
+    position_noise = noise.position_std > 0 or noise.encoder_resolution > 0
+    for k in range(t.size):
+        y = noise.measured_positions(q, rng) if position_noise else q
+        if previous is not None:  # the first instant: no difference yet, the reference's velocity
+            velocity = velocity + alpha * ((y - previous) / h - velocity)
+        error = q_ref[k] - y
+        integral += error * h
+        tau = ff[k] + kp * error + kd * (dq_ref[k] - velocity) + ki * integral
+        a1 = accelerations(q, dq, tau)
+        q_true[k], dq_true[k], ddq_true[k], tau_applied[k], q_meas[k] = q, dq, a1, tau, y
+        previous = y
+        # classic Runge-Kutta on (q, q̇) with the torque held
+        v2 = dq + 0.5 * h * a1
+        a2 = accelerations(q + 0.5 * h * dq, v2, tau)
+        v3 = dq + 0.5 * h * a2
+        a3 = accelerations(q + 0.5 * h * v2, v3, tau)
+        v4 = dq + h * a3
+        a4 = accelerations(q + h * v3, v4, tau)
+        q = q + h / 6.0 * (dq + 2 * v2 + 2 * v3 + v4)
+        dq = dq + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(dq))):
+            raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
+                              "or a model that cannot be simulated")
+    tau_log = tau_applied + rng.normal(0.0, noise.torque_std, tau_applied.shape) if noise.torque_std > 0 else tau_applied.copy()
+    return ClosedLoopRun(t, q_meas, tau_log, q_true, dq_true, ddq_true, tau_applied, q_ref, dq_ref)
+
