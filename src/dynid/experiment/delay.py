@@ -1,0 +1,143 @@
+"""A transport delay between a log's torque (current) channel and its position channel, estimated from the data.
+
+Drives often log currents a few samples after the positions they were computed from (a bus cycle, a filter's
+group delay). A delay ``d`` makes the measured torque at ``t`` the model's torque at ``t − d``, which the regressor
+cannot absorb. The delay minimises the least-squares residual of the identification: with the observation matrix
+``W`` of the positions fixed (computed once), the parallel-filtered torques are read at ``t_k + d`` (interpolated
+on the full-rate grid, so ``d`` is found to a fraction of a sample) and ``RSS(d) = ‖(I − P_W) τ(t + d)‖²`` is
+minimised over ``|d| ≤ max_samples``. Its σ is the Gauss–Newton one, ``σ_d² = 2 σ² / RSS''(d)`` with ``σ²`` the
+residual variance (MuJoCo's system identification fits the same measurement parameter, as a sensor delay).
+Current offsets need no step of their own: they are the ``offset`` drive term, identified with σ like the others.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..dynamics.base_parameters import BaseParameters
+from ..exceptions import ConfigError, IdentifiabilityError
+from ..io.datasets import Recording
+from ..model.robot import Robot
+from ..preprocessing.filters import butterworth_filtfilt
+from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+
+__all__ = ["DelayEstimate", "estimate_delay", "delayed"]
+
+
+@dataclass(frozen=True)
+class DelayEstimate:
+    """The torque channel's delay behind the positions.
+
+    Attributes
+    ----------
+    samples : float
+        Delay in samples of the log (positive: the torques come late).
+    std : float
+        Its σ, in samples.
+    seconds : float [s]
+    at_bound : bool
+        The minimum lies at ``±max_samples``: the delay may be larger (give a larger bound).
+    """
+
+    samples: float
+    std: float
+    seconds: float
+    at_bound: bool = False
+
+
+def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | None = None,
+                   preprocessing: Preprocessing | None = None, max_samples: float = 20.0) -> DelayEstimate:
+    """The delay of the torque channel behind the positions (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    recording : Recording
+        ``t`` (N,) [s], ``q`` and ``tau`` (N, n_dof) on a uniform grid.
+    base : BaseParameters, optional
+        Default: computed from ``robot``.
+    preprocessing : Preprocessing, optional
+        Default: every setting derived from the log.
+    max_samples : float
+        Largest delay searched, either way [samples].
+
+    Returns
+    -------
+    DelayEstimate
+
+    Raises
+    ------
+    ConfigError
+        ``max_samples`` not positive.
+    IdentifiabilityError
+        Fewer rows than parameters, or a residual that does not change with the delay (no motion).
+    """
+    from scipy.optimize import minimize_scalar
+
+    from ..dynamics.base_parameters import base_parameters
+
+    if not (np.isfinite(max_samples) and max_samples > 0):
+        raise ConfigError(f"max_samples: expected a positive number of samples, got {max_samples!r}")
+    base = base if base is not None else base_parameters(robot, rng=0)
+    data = prepare(recording, preprocessing or Preprocessing())
+    s = data.settings
+    rows, times, keeps = [], [], []
+    for index, y, _, keep in base_chunks(robot, base, data):
+        rows.append(y.reshape(-1, y.shape[-1]))
+        times.append(np.asarray(data.t)[index])
+        keeps.append(np.asarray(keep).reshape(-1))
+    w, t_rows, keep = np.concatenate(rows), np.concatenate(times), np.concatenate(keeps)
+    n = robot.n_dof
+    if keep.sum() <= w.shape[1]:
+        raise IdentifiabilityError(f"{recording.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
+    q_factor, _ = np.linalg.qr(w[keep])
+    tau = np.asarray(butterworth_filtfilt(np.asarray(data.tau, dtype=float), data.rate, s.parallel_cutoff, s.order))
+    t_full = np.asarray(data.t, dtype=float)
+
+    def rss(d: float) -> float:
+        shifted = np.column_stack([np.interp(t_rows + d / data.rate, t_full, tau[:, j]) for j in range(n)]).reshape(-1)[keep]
+        r = shifted - q_factor @ (q_factor.T @ shifted)
+        return float(r @ r)
+
+    bound = float(max_samples)
+    grid = np.linspace(-bound, bound, int(4 * bound) + 1)  # a coarse scan first: RSS need not be convex far away
+    values = [rss(d) for d in grid]
+    k = int(np.argmin(values))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    best = minimize_scalar(rss, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+    d = float(best.x)
+    h = 0.25
+    curvature = (rss(d + h) - 2 * best.fun + rss(d - h)) / h**2
+    dof = int(keep.sum()) - w.shape[1]
+    if not curvature > 0:
+        raise IdentifiabilityError(f"{recording.name}: the residual does not change with the delay (does the robot move?)")
+    std = float(np.sqrt(2 * (best.fun / dof) / curvature))
+    return DelayEstimate(d, std, d / data.rate, bool(abs(d) > bound - 0.5))
+
+
+def delayed(recording: Recording, samples: float) -> Recording:
+    """The recording with its torques read ``samples`` later (the delay undone), on the same grid.
+
+    Parameters
+    ----------
+    recording : Recording
+    samples : float
+        A :class:`DelayEstimate`'s ``samples``.
+
+    Returns
+    -------
+    Recording
+        The last ``ceil(samples)`` samples (or first, for a negative delay) are dropped: their torques were not logged.
+    """
+    from dataclasses import replace
+
+    t = np.asarray(recording.t, dtype=float)
+    tau = np.asarray(recording.tau, dtype=float)
+    shifted = np.column_stack([np.interp(t + samples / recording.rate, t, tau[:, j]) for j in range(tau.shape[1])])
+    cut = int(np.ceil(abs(samples)))
+    keep = slice(0, t.size - cut) if samples >= 0 else slice(cut, t.size)
+    q = np.asarray(recording.q)[keep]
+    dq = None if recording.dq is None else np.asarray(recording.dq)[keep]
+    return replace(recording, t=t[keep] - t[keep][0], q=q, dq=dq, tau=shifted[keep])
