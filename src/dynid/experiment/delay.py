@@ -93,7 +93,9 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     if keep.sum() <= w.shape[1]:
         raise IdentifiabilityError(f"{recording.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
     q_factor, _ = np.linalg.qr(w[keep])
-    tau = np.asarray(butterworth_filtfilt(np.asarray(data.tau, dtype=float), data.rate, s.parallel_cutoff, s.order))
+    tau = np.asarray(data.tau, dtype=float)
+    if s.parallel_cutoff is not None:  # the torques as the regressor's columns are filtered
+        tau = np.asarray(butterworth_filtfilt(tau, data.rate, s.parallel_cutoff, s.order))
     t_full = np.asarray(data.t, dtype=float)
 
     def rss(d: float) -> float:
