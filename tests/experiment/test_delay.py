@@ -24,7 +24,7 @@ def test_a_delay_of_a_fraction_of_a_sample_is_recovered(delay):
 
     found = estimate_delay(robot, replace(log, tau=late))
     assert abs(found.samples - delay) < 0.25 and abs(found.samples - delay) < 3 * found.std + 0.05
-    assert found.seconds == pytest.approx(found.samples / log.rate) and not found.at_bound
+    assert found.seconds == pytest.approx(found.samples / log.rate) and found.determined
     again = estimate_delay(robot, delayed(replace(log, tau=late), found.samples))
     assert abs(again.samples) < 0.25
 

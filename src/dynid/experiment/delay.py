@@ -25,6 +25,9 @@ from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 
 __all__ = ["DelayEstimate", "estimate_delay", "delayed"]
 
+DETERMINED_STD = 0.5
+"""[samples] A delay estimate with a larger σ is not determined by the log."""
+
 
 @dataclass(frozen=True)
 class DelayEstimate:
@@ -45,6 +48,12 @@ class DelayEstimate:
     std: float
     seconds: float
     at_bound: bool = False
+
+    @property
+    def determined(self) -> bool:
+        """The log determines the delay: the minimum lies inside the bound and σ is below :data:`DETERMINED_STD`
+        samples (a slow excitation on a fast log changes the residual too little for a delay of a few samples)."""
+        return not self.at_bound and self.std < DETERMINED_STD
 
 
 def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | None = None,
