@@ -8,7 +8,7 @@ from types import ModuleType
 
 from .exceptions import ConfigError
 
-EXTRAS = {"montecarlo": ("distributed",), "ros": ("rosbags",), "mujoco": ("mujoco",)}
+EXTRAS = {"montecarlo": ("distributed",), "fleet": ("distributed", "pyarrow"), "ros": ("rosbags",), "mujoco": ("mujoco",)}
 """Extra (``pip install "dynid[extra]"``) -> the modules it brings."""
 
 

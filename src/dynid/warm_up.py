@@ -14,7 +14,8 @@ from __future__ import annotations
 
 def warm_up() -> None:
     """Compile the regressors of the built-in robots (their SIMD code, and numba's kernel), then run a 2 s,
-    200 Hz paper experiment with every estimator (2 ABC iterations, 2 bootstrap resamples)."""
+    200 Hz paper experiment with every estimator (2 ABC iterations, 2 bootstrap resamples), and compile the recursive
+    least squares of ``dynid monitor``."""
     from .dynamics import regressor
     from .model.description import load_robot
 
@@ -23,6 +24,11 @@ def warm_up() -> None:
     from .experiment import PaperExperimentConfig, run_paper_experiment
 
     run_paper_experiment(PaperExperimentConfig(duration=2.0, rate=200.0, bootstrap=2, maxiter=2))
+    import numpy as np
+
+    from .estimators.recursive import RecursiveLeastSquares
+
+    RecursiveLeastSquares(np.zeros((6, 3))).update(np.ones((2, 6, 3)), np.ones((2, 6)))  # dynid monitor's kernel
 
 
 if __name__ == "__main__":

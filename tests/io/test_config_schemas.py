@@ -81,3 +81,14 @@ def test_the_schema_refuses_what_dynid_refuses(tmp_path, text, where):
     assert errors  # the editor's check
     with pytest.raises(ConfigError, match=f"c.toml: .*{where.split('.')[-1]}"):  # dynid's own, one line naming the field
         load_identification_config(tmp_path / "c.toml")
+
+
+def test_a_fleet_manifest_and_its_template_are_valid_against_their_schemas(tmp_path):
+    from dynid.experiment.simulated_fleet import simulate_fleet
+
+    simulate_fleet(tmp_path, units=2, seconds=2.0, rate=50.0, validation_seconds=2.0, odd_unit=None)
+    assert not list(_validator("fleet").iter_errors(tomllib.loads((tmp_path / "fleet.toml").read_text())))
+    assert not list(_validator("identification").iter_errors(tomllib.loads((tmp_path / "unit.toml").read_text())))
+    wrong = tomllib.loads((tmp_path / "fleet.toml").read_text())
+    wrong["units"][0]["payload"] = -1.0  # dynid refuses it: so does the schema
+    assert list(_validator("fleet").iter_errors(wrong))

@@ -25,7 +25,8 @@ OPTIONS = {"out": "--out", "seed": "--seed", "joints": "--joints", "plant": "--p
            "realisations": "--realisations", "scheduler": "--scheduler", "workers": "--workers", "data_root": "--data-root",
            "file": "--file", "robot": "--robot", "duration": "--duration", "rate": "--rate", "current_noise": "--current-noise",
            "colony_size": "--abc-colony", "limit": "--abc-limit", "maxiter": "--abc-iterations", "starts": "--starts",
-           "preprocessing.strategy": "--strategy"}
+           "preprocessing.strategy": "--strategy", "window": "--window", "reference_windows": "--reference-windows",
+           "false_alarm_days": "--false-alarm-days", "logs": "--logs"}
 """Library fields (named by the library's messages) and the options that set them."""
 
 
@@ -510,6 +511,80 @@ def montecarlo(
                               progress=lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}"))
 
     _Command("dynid montecarlo", quiet, out).run(prepare, compute, lambda result: save_montecarlo(result, out))
+
+
+@app.command()
+def fleet(
+    manifest: Path = typer.Argument(..., help="Fleet manifest (TOML): the units, their logs, a template config."),
+    out: Path = typer.Option(Path("dynid-fleet"), help="Output folder: fleet.json, fleet.parquet, fleet.html, units/<id>/."),
+    data_root: Optional[Path] = typer.Option(None, help="Data root of units given by their own config."),
+    scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); its workers read the "
+                                                       "logs at the manifest's paths. Default: a LocalCluster of this machine's cores."),
+    workers: Optional[int] = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
+    quiet: bool = QUIET,
+) -> None:
+    """Identify every unit of a fleet on a Dask cluster, flag the units that stand out, pool their estimates."""
+    from ..experiment.fleet import check_fleet_options, run_fleet
+    from ..io.fleet_manifest import load_fleet_manifest
+
+    def prepare():
+        check_fleet_options(workers)
+        parsed = load_fleet_manifest(manifest, data_root)  # every unit's config checked before the workers start
+        from ..extras import require
+
+        require("distributed", "fleet", "dynid fleet")
+        require("pyarrow", "fleet", "dynid fleet")
+        return parsed
+
+    def compute(parsed, progress):
+        from ..report.fleet_run import save_unit
+
+        progress.update("starting the workers")
+        return run_fleet(parsed, out=out, save=save_unit, scheduler=scheduler, workers=workers, progress=_steps(progress))
+
+    def save(result):
+        from ..report.fleet_run import save_fleet
+
+        return save_fleet(result, out)
+
+    _Command("dynid fleet", quiet, out).run(prepare, compute, save)
+
+
+@app.command()
+def monitor(
+    config: Path = typer.Argument(..., help="The robot's identify config (its identification log's columns read the logs)."),
+    logs: Path = typer.Option(..., help="Folder of the robot's logs; time order from the dates in their names "
+                                        "(2026-01-15T08-30.csv), else their names."),
+    results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json of the last full identification."),
+    out: Path = typer.Option(Path("dynid-monitor"), help="Output folder: monitor.json, monitor.parquet, monitor.png."),
+    data_root: Optional[Path] = typer.Option(None, help="Folder of the config's data files."),
+    window: float = typer.Option(10.0, help="Seconds of log per window of re-identified friction terms."),
+    reference_windows: int = typer.Option(60, help="Windows that set each term's reference (the first ones)."),
+    false_alarm_days: float = typer.Option(30.0, help="One false alarm per this many days of logs, on average."),
+    quiet: bool = QUIET,
+) -> None:
+    """Follow a robot's friction and drive terms through its logs and raise an alarm when one changes (wear)."""
+    from ..experiment.monitor import MonitorSettings, dated_logs, monitor_logs
+    from ..io.identification_config import load_identification_config
+
+    def prepare():
+        settings = MonitorSettings(window, reference_windows, false_alarm_days)
+        cfg = load_identification_config(config, data_root)
+        files = dated_logs(logs)
+        from ..experiment.identified import load_results
+
+        return cfg, load_results(results, cfg.robot), files, settings
+
+    def compute(prepared, progress):
+        cfg, model, files, settings = prepared
+        return monitor_logs(cfg, model, files, settings, progress=_steps(progress))
+
+    def save(result):
+        from ..report.monitor_run import save_monitor
+
+        return save_monitor(result, out)
+
+    _Command("dynid monitor", quiet, out).run(prepare, compute, save)
 
 
 class Interrupted(BaseException):

@@ -41,9 +41,38 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-def _validate(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
-              progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None) -> tuple[tuple, tuple[str, ...]]:
-    """Score ``parameter_sets`` on each of ``datasets`` (DatasetSpec, read here, or a Recording already read)."""
+def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
+                  progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None) -> tuple[tuple, tuple[str, ...]]:
+    """Score parameter sets on logs: their predicted torques against the measured ones.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+        Its robot (as identified: friction terms, Coulomb smoothing) and preprocessing.
+    base : BaseParameters
+    parameter_sets : dict
+        label -> (n_base,) base parameters.
+    datasets : tuple
+        DatasetSpec (read here) or Recording (read already).
+    progress : callable, optional
+        ``progress(step, done, total)``.
+    resolved : Preprocessing, optional
+        The identification's resolved preprocessing, carried over to these logs.
+    noise : (n_dof,) array [N·m], optional
+        Each joint's residual σ (for the prediction bands).
+    covariance : dict, optional
+        label -> covariance of that set.
+
+    Returns
+    -------
+    comparisons : tuple of TorqueComparison
+    warnings : tuple of str
+
+    Raises
+    ------
+    DataError
+        A log that cannot be read or prepared.
+    """
     from ..preprocessing.pipeline import prepare
     from ..validation.torques import compare_torques
 
@@ -150,7 +179,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
                                        **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if not validate or not config.validation:
         return result
-    validations, warnings = _validate(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
+    validations, warnings = validate_sets(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
                                       data.settings, result.joint_std, {result.label: result.solution.covariance})
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     return replace(result, **_main_estimate(result))
@@ -234,7 +263,7 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
         noise = noise if noise is not None and noise.shape == (config.robot.n_dof,) else None
     except (TypeError, ValueError):
         noise = None
-    comparisons, warnings = _validate(config, base, sets, datasets, progress, stored_preprocessing(identified), noise)
+    comparisons, warnings = validate_sets(config, base, sets, datasets, progress, stored_preprocessing(identified), noise)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 

@@ -310,7 +310,8 @@ class MonteCarloResult:
 
 
 @contextlib.contextmanager
-def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0):
+def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0,
+                extra: str = "montecarlo", what: str = "dynid montecarlo"):
     """A Dask client to a scheduler, or to a new local cluster.
 
     Parameters
@@ -321,6 +322,8 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         Single-threaded worker processes of the local cluster (default: the local cores).
     connect_timeout : float [s]
         Time the scheduler is given to answer.
+    extra, what : str
+        The extra that installs Dask and what needs it, for the message when it is missing.
 
     Yields
     ------
@@ -329,9 +332,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     Raises
     ------
     ConfigError
-        The scheduler cannot be reached, or ``workers`` < 1.
+        The scheduler cannot be reached, ``workers`` < 1, or Dask is not installed.
     """
-    require("distributed", "montecarlo", "dynid montecarlo")
+    require("distributed", extra, what)
     from distributed import Client, LocalCluster
 
     if scheduler:

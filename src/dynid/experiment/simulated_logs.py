@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..excitation.fourier import FourierTrajectory
 from ..io.datasets import Recording
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
+from .simulated_fleet import random_excitation
 
 __all__ = ["simulated_log"]
 
@@ -46,14 +46,7 @@ def simulated_log(robot: Robot, seconds: float = 30.0, rate: float = 250.0, seed
     """
     robot.require_physical_nominal("a simulated log (its truth is the description's parameters)")
     rng = np.random.default_rng(seed)
-    n, harmonics, omega = robot.n_dof, 5, 2 * np.pi * 0.1
-    lo, hi = np.maximum(robot.limits.q_min, -np.pi), np.minimum(robot.limits.q_max, np.pi)
-    k = np.arange(1, harmonics + 1)
-    a, b = rng.normal(size=(n, harmonics)) / k, rng.normal(size=(n, harmonics)) / k
-    amplitude = np.abs(a).sum(axis=1) + np.abs(b).sum(axis=1)
-    speed = omega * (np.abs(a) * k + np.abs(b) * k).sum(axis=1)
-    scale = np.minimum(0.6 * (hi - lo) / 2 / amplitude, 0.8 * np.minimum(robot.limits.dq_max, 3.0) / speed)
-    trajectory = FourierTrajectory(omega, (lo + hi) / 2, a * scale[:, None], b * scale[:, None])
+    trajectory = random_excitation(robot, rng)
     t = np.arange(int(round(seconds * rate))) / rate
     q, dq, ddq = trajectory.evaluate(t)
     meas = simulate_measurements(robot, t, q, dq, ddq, noise, rng)

@@ -8,6 +8,7 @@ field), then check what depends on the robot (one value per joint) and the files
 
 from __future__ import annotations
 
+import datetime
 from typing import Annotated, Literal, Union
 
 import msgspec
@@ -24,7 +25,8 @@ else:
     RobotDescription = _RobotDescription
 
 __all__ = ["SignalTable", "TimeTable", "DatasetTable", "PreprocessingTable", "EstimationTable", "ReferenceTable",
-           "DriveGainsTable", "IdentificationDocument", "ExcitationDocument"]
+           "DriveGainsTable", "IdentificationDocument", "ExcitationDocument", "UnitTable",
+           "FleetDocument"]
 
 Column = Union[Annotated[int, Meta(ge=1)], str]
 PositiveHz = Annotated[float, Meta(gt=0)]
@@ -161,6 +163,36 @@ class IdentificationDocument(Table, kw_only=True):
     drive_gains: Annotated[DriveGainsTable, _d("drive gains from a known payload")] | None = None
 
 
+class UnitGainsTable(Table, kw_only=True):
+    """A fleet unit's drive-gain runs: the files for the template's ``[drive_gains]`` tables."""
+
+    unloaded: Annotated[str, _d("the run without the payload, relative to the manifest")]
+    loaded: Annotated[str, _d("the same motion with the payload, relative to the manifest")]
+
+
+class UnitTable(Table, kw_only=True):
+    """``[[units]]`` of a fleet manifest: one arm, its logs read with the template's column maps (or its own config)."""
+
+    id: Annotated[str, Meta(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$",
+                            description="the unit's name: letters, digits, '_', '-', '.' (its output folder)")]
+    config: Annotated[str, _d("the unit's own identify config, instead of the template and the files below")] | None = None
+    identification: Annotated[str, _d("the log to identify from, relative to the manifest")] | None = None
+    validation: Annotated[list[str], _d("logs to validate on, relative to the manifest")] = msgspec.field(default_factory=list)
+    drive_gains: Annotated[UnitGainsTable, _d("the drive-gain runs (the template has [drive_gains])")] | None = None
+    payload: Annotated[float, Meta(ge=0, le=10_000, description="kg: the tool mounted on this unit (reported)")] | None = None
+    date: Annotated[datetime.date, _d("when the logs were recorded")] | None = None
+
+
+class FleetDocument(Table, kw_only=True):
+    """A fleet manifest of ``dynid fleet`` (:mod:`dynid.io.fleet_manifest`)."""
+
+    name: Annotated[str, _d("the fleet's name")] | None = None
+    notes: Annotated[str, _d("free text")] | None = None
+    template: Annotated[str, _d("identify config every unit shares (robot, columns, estimators), relative to this "
+                                "file")] | None = None
+    units: Annotated[list[UnitTable], Meta(min_length=1, description="the arms of the fleet")]
+
+
 PerJointAngle = Union[Angle, list[Angle]]
 PerJointNumber = Union[float, list[float]]
 
@@ -231,6 +263,8 @@ SCHEMAS = {
     "identification": (IdentificationDocument, "dynid identify / validate config",
                        "An identification config of dynid: the robot, its logs, preprocessing, "
                        "estimators, references."),
+    "fleet": (FleetDocument, "dynid fleet manifest", "A fleet manifest of dynid: the units of one robot model and "
+                                                        "their logs."),
     "excitation": (ExcitationDocument, "dynid excite config", "An excitation design config of dynid."),
     "robot": (RobotDescription, "dynid robot description", "A robot description of dynid: DH table or URDF, limits, drive "
                                                              "gains, drive terms and their nominal values."),

@@ -208,7 +208,30 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
         the structure: :class:`dynid.io.config_types.IdentificationDocument`).
     """
     path = Path(path)
-    doc = read_config(path, None)
+    return config_from_document(read_config(path, None), path, data_root)
+
+
+def config_from_document(doc: dict, path: Path, data_root: str | Path | None = None) -> IdentificationConfig:
+    """Parse an identification config already read (e.g. a fleet's unit: its template with the unit's files).
+
+    Parameters
+    ----------
+    doc : dict
+        The TOML document.
+    path : Path
+        The file it stands for: messages name it, relative paths start from its folder.
+    data_root : path, optional
+        As :func:`load_identification_config`.
+
+    Returns
+    -------
+    IdentificationConfig
+
+    Raises
+    ------
+    ConfigError
+        As :func:`load_identification_config`.
+    """
     for (section, key), why in REMOVED.items():
         if isinstance(doc.get(section), dict) and key in doc[section]:
             raise ConfigError(f"{path}: {section}.{key}: {why}")

@@ -14,7 +14,8 @@ from ..tables import Line, TextTable, render_text
 from ..validation.torques import comparison_table
 
 __all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
-           "coulomb_choice_table", "drive_gains_blocks", "montecarlo_blocks", "excitation_blocks"]
+           "coulomb_choice_table", "drive_gains_blocks", "montecarlo_blocks", "excitation_blocks", "fleet_blocks",
+           "monitor_blocks"]
 
 
 def summary(result, width: int = 100) -> str:
@@ -51,13 +52,16 @@ def blocks(result) -> list:
         Not a result of dynid.
     """
     from ..experiment.excitation import ExcitationRun
+    from ..experiment.fleet import FleetResult
+    from ..experiment.monitor import MonitorResult
     from ..experiment.identification import IdentificationResult
     from ..experiment.montecarlo import MonteCarloResult
     from ..experiment.paper import PaperRunResult
     from .paper_summary import run_summary_blocks
 
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
-                       (MonteCarloResult, montecarlo_blocks), (ExcitationRun, excitation_blocks)):
+                       (MonteCarloResult, montecarlo_blocks), (ExcitationRun, excitation_blocks),
+                       (FleetResult, fleet_blocks), (MonitorResult, monitor_blocks)):
         if isinstance(result, kind):
             return make(result)
     raise TypeError(f"expected a result of dynid, got {type(result).__name__}")
@@ -387,4 +391,85 @@ def excitation_blocks(run) -> list:
     out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
                          ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    return out
+
+
+def _cell(value, fmt: str = ".3g") -> str:
+    return "—" if value is None or (isinstance(value, float) and not math.isfinite(value)) else format(value, fmt)
+
+
+def fleet_blocks(result) -> list:
+    """What ``dynid fleet`` prints: a verdict, then one row per unit (validation error alone and pooled, worst joint,
+    consistency, flags) and the flagged parameters.
+
+    Parameters
+    ----------
+    result : dynid.experiment.fleet.FleetResult
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    table = result.table()
+    ok, units = result.identified, result.units
+    flagged = sorted({o.unit for o in result.outliers})
+    helped = [u for u, e in result.pooled_errors.items()
+              if e < next(s.validation_error for s in ok if s.id == u)]
+    verdict = (f"{len(ok)} of {len(units)} units identified; "
+               + (f"{len(flagged)} stand out from the fleet: {', '.join(flagged)}" if flagged else "none stands out from the fleet")
+               + (f"; pooling improved {len(helped)} of {len(result.pooled_errors)} units' validation error"
+                  if result.pooled_errors else (f"; not pooled: {result.pooled_note}" if result.pooled_note else "")))
+    out: list = [Line(f"dynid fleet — {result.manifest.name}: {verdict}", "title")]
+    rows = []
+    for i, uid in enumerate(table["unit"]):
+        rows.append((uid, table["date"][i] or "—", _cell(table["payload_kg"][i]), _cell(table["validation_error_pct"][i]),
+                     _cell(table["pooled_validation_error_pct"][i]), table["worst_joint"][i] or "—",
+                     {True: "yes", False: "no", None: "—"}[table["consistent"][i]],
+                     ", ".join(o.parameter for o in result.flagged(uid)) or ("not identified" if table["error"][i] else "")))
+    out.append(TextTable("Units: global validation error [%] of each unit's own estimate and of its pooled estimate; worst "
+                         "joint; physically consistent; parameters that stand out (robust z-score against the other units)",
+                         ("unit", "date", "payload kg", "error %", "pooled %", "worst", "consistent", "flags"), tuple(rows)))
+    for o in result.outliers[:10]:
+        out.append(Line(f"flag: {o}", "warning"))
+    if len(result.outliers) > 10:
+        out.append(Line(f"… and {len(result.outliers) - 10} more flags (fleet.json)", "warning"))
+    for s in units:
+        if s.error:
+            out.append(Line(f"{s.id}: not identified: {s.error}", "warning"))
+    out.append(Line(f"ran on {result.cluster} in {result.seconds:.1f} s; flag threshold |z| > {result.threshold:.2f} (1 % "
+                    "chance of any false flag in a fleet whose units differ only at random)"))
+    return out
+
+
+def monitor_blocks(result) -> list:
+    """What ``dynid monitor`` prints: a verdict (alarms or none), each term's reference, the alarms in words.
+
+    Parameters
+    ----------
+    result : dynid.experiment.monitor.MonitorResult
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    hours = sum(w.end - w.start for w in result.windows) / 3600
+    first: dict = {}
+    for a in result.alarms:
+        first.setdefault(a.term, a)
+    verdict = (f"{len(first)} term(s) changed: " + ", ".join(f"joint {a.joint} {a.term} {a.change:+.3g} %" for a in first.values())
+               if first else "no change")
+    out: list = [Line(f"dynid monitor — {len(result.logs)} logs, {len(result.windows)} windows of {result.settings.window:g} s "
+                      f"({hours:.3g} h of logs): {verdict}", "title")]
+    latest = result.windows[-1].tracked if result.windows else np.full(len(result.terms), np.nan)
+    rows = tuple((t, f"joint {j}", _cell(float(m), ".4g"), _cell(float(s), ".2g"), _cell(float(x), ".4g"),
+                  str(sum(a.term == t for a in result.alarms)))
+                 for t, j, m, s, x in zip(result.terms, result.joints, result.reference_mean, result.reference_std, latest))
+    out.append(TextTable(f"Terms: reference over the first {result.settings.reference_windows} windows (mean, spread), the "
+                         "recursive estimate at the end, alarms", ("term", "joint", "reference", "spread", "latest", "alarms"),
+                         rows))
+    for a in result.alarms:
+        out.append(Line(f"alarm: {a}", "warning"))
+    out.append(Line(f"CUSUM per term (tuned to shifts of {result.settings.shift:g} reference spreads: k = "
+                    f"{result.settings.shift / 2:g}, h = {result.threshold:.3g}): one false alarm per "
+                    f"{result.settings.false_alarm_days:g} days of logs on average over all {len(result.terms)} terms"))
     return out

@@ -1,0 +1,456 @@
+"""``dynid monitor``: a robot's friction and drive terms followed through its service life, and an alarm when one of
+them changes (the field's indicator of gearbox wear).
+
+The rigid-body part stays that of the last full identification (its results.json); each new log is prepared as the
+identification prepared its own (the resolved filters carried over), its torques less the rigid-body prediction
+leave, for each joint, what its friction and offset explain. On every window of ``window`` seconds, each joint's
+friction terms are re-identified by least squares (their σ from the window's residual); recursive least squares
+with forgetting (:mod:`dynid.estimators.recursive`) follows them sample by sample meanwhile. The first
+``reference_windows`` windows set each term's reference (mean and spread: what the term does when nothing
+changes, temperature and noise included); from then on each window's estimate, standardised by the reference, feeds
+a two-sided CUSUM chart per term (:mod:`dynid.validation.change_detection`) whose threshold gives the whole family
+one false alarm per ``false_alarm_days`` days of logs on average. An alarm names the joint and the term, dates the
+change (log and time), and says how large it is; the term's new level is then learned over the next
+``reference_windows`` windows and its chart restarts from it, so a wear that goes on raises a new alarm each time it
+has moved as much again.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+from ..estimators.recursive import RecursiveLeastSquares
+from ..exceptions import ConfigError, DataError
+from ..validation.change_detection import Cusum
+
+__all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
+           "monitor_logs"]
+
+TERM_NAMES = {"fc": "Coulomb friction", "fv": "viscous friction", "fs": "Stribeck friction", "offset": "current offset",
+              "fa": "asymmetric friction", "fl": "load-dependent friction"}
+"""Plain names of the per-joint terms a monitor follows."""
+
+_DATE = re.compile(r"(\d{4})-(\d{2})-(\d{2})(?:[T_ ](\d{2})[-:](\d{2})(?:[-:](\d{2}))?)?")
+
+
+@dataclass(frozen=True)
+class MonitorSettings:
+    """How a monitor windows, references and alarms.
+
+    Attributes
+    ----------
+    window : float [s]
+        Log time per window.
+    reference_windows : int
+        Windows that set each term's reference (the first of the monitored logs).
+    false_alarm_days : float [days]
+        The family of charts raises a false alarm once per this many days of logs, on average.
+    forgetting_seconds : float [s]
+        Memory of the recursive estimate (its forgetting factor is ``1 - 1 / (rows in this time)``).
+    shift : float
+        The smallest change, in reference spreads, the charts are tuned to (their reference value k is half of it).
+        Two spreads: a reference mean estimated from a few dozen windows is itself off by a few tenths of a spread,
+        which charts tuned to smaller shifts would accumulate into false alarms.
+    """
+
+    window: float = 10.0
+    reference_windows: int = 60
+    false_alarm_days: float = 30.0
+    forgetting_seconds: float = 60.0
+    shift: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.window) and self.window > 0):
+            raise ConfigError(f"window must be a positive number of seconds, got {self.window}", field="window")
+        if self.reference_windows < 3:
+            raise ConfigError(f"reference_windows must be at least 3, got {self.reference_windows}", field="reference_windows")
+        if not (np.isfinite(self.false_alarm_days) and self.false_alarm_days > 0):
+            raise ConfigError(f"false_alarm_days must be positive, got {self.false_alarm_days}", field="false_alarm_days")
+
+
+@dataclass(frozen=True)
+class MonitorWindow:
+    """One window's re-identified terms.
+
+    Attributes
+    ----------
+    log : str
+    start, end : float [s]
+        In the log.
+    theta, std : (n_terms,) arrays
+        The terms (NaN where the joint did not move enough) and their σ.
+    tracked : (n_terms,) array
+        The recursive estimate at the window's end.
+    """
+
+    log: str
+    start: float
+    end: float
+    theta: np.ndarray
+    std: np.ndarray
+    tracked: np.ndarray
+
+
+@dataclass(frozen=True)
+class DriftAlarm:
+    """A term that changed.
+
+    Attributes
+    ----------
+    joint : int
+        1-based.
+    term : str
+        Its base parameter name (``fv3``).
+    since_log, since : str, float [s]
+        Where the change starts: the log and the time in it.
+    detected_log, detected : str, float [s]
+        Where the alarm was raised.
+    reference : float
+        The term's reference value.
+    value : float
+        Its mean since the change.
+    delay : float [s]
+        Log time from the change to the alarm.
+    """
+
+    joint: int
+    term: str
+    since_log: str
+    since: float
+    detected_log: str
+    detected: float
+    reference: float
+    value: float
+    delay: float
+
+    @property
+    def change(self) -> float:
+        """Relative change [%]."""
+        return 100 * (self.value - self.reference) / abs(self.reference) if self.reference else float("inf")
+
+    def __str__(self) -> str:
+        kind = TERM_NAMES.get(re.sub(r"\d+$", "", self.term), self.term)
+        verb = "rose" if self.value > self.reference else "fell"
+        return (f"joint {self.joint}: {kind} ({self.term}) {verb} {abs(self.change):.3g} % ({self.reference:.4g} -> "
+                f"{self.value:.4g}) since {self.since_log} at {self.since:.0f} s; alarm in {self.detected_log} at "
+                f"{self.detected:.0f} s, {self.delay:.0f} s of logs later")
+
+    def to_dict(self) -> dict:
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+        """
+        return {"joint": self.joint, "term": self.term, "since_log": self.since_log, "since_s": self.since,
+                "detected_log": self.detected_log, "detected_s": self.detected, "reference": self.reference,
+                "value": self.value, "change_percent": self.change, "delay_s": self.delay, "message": str(self)}
+
+
+@dataclass(frozen=True)
+class MonitorResult:
+    """A monitored service life.
+
+    Attributes
+    ----------
+    terms : tuple of str
+        The monitored terms (base parameter names).
+    joints : tuple of int
+        Each term's joint (1-based).
+    windows : tuple of MonitorWindow
+    reference_mean, reference_std : (n_terms,) arrays
+    threshold : float
+        The CUSUM decision interval h.
+    alarms : tuple of DriftAlarm
+    settings : MonitorSettings
+    logs : tuple of str
+    """
+
+    terms: tuple[str, ...]
+    joints: tuple[int, ...]
+    windows: tuple[MonitorWindow, ...]
+    reference_mean: np.ndarray
+    reference_std: np.ndarray
+    threshold: float
+    alarms: tuple[DriftAlarm, ...]
+    settings: MonitorSettings
+    logs: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the alarms, the reference, every window's terms.
+
+        Returns
+        -------
+        dict
+        """
+        return {"kind": "monitor", "terms": list(self.terms), "alarms": [a.to_dict() for a in self.alarms],
+                "reference": {t: {"mean": float(m), "std": float(s)} for t, m, s in
+                              zip(self.terms, self.reference_mean, self.reference_std)},
+                "cusum_threshold": self.threshold,
+                "settings": {"window_s": self.settings.window, "reference_windows": self.settings.reference_windows,
+                             "shift": self.settings.shift,
+                             "false_alarm_days": self.settings.false_alarm_days,
+                             "forgetting_seconds": self.settings.forgetting_seconds},
+                "logs": list(self.logs),
+                "windows": [{"log": w.log, "start_s": w.start, "end_s": w.end,
+                             "terms": dict(zip(self.terms, np.where(np.isfinite(w.theta), w.theta, np.nan).tolist())),
+                             "std": dict(zip(self.terms, w.std.tolist())),
+                             "tracked": dict(zip(self.terms, w.tracked.tolist()))} for w in self.windows]}
+
+
+def dated_logs(folder: str | Path, pattern: str = "*.csv") -> list[Path]:
+    """The logs of a folder in time order: by the date and time in their names (``2026-01-15T08-30.csv``), else by name.
+
+    Parameters
+    ----------
+    folder : path
+    pattern : str
+
+    Returns
+    -------
+    list of Path
+
+    Raises
+    ------
+    ConfigError
+        Not a folder, or no log in it.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ConfigError(f"{folder}: not a folder of logs", field="logs")
+    files = [p for p in folder.glob(pattern) if p.is_file()]
+    if not files:
+        raise ConfigError(f"{folder}: no log matching {pattern}", field="logs")
+
+    def key(p: Path):
+        m = _DATE.search(p.name)
+        return (0, tuple(int(g or 0) for g in m.groups()), p.name) if m else (1, (), p.name)
+
+    return sorted(files, key=key)
+
+
+class FrictionMonitor:
+    """The monitor's state through a stream of prepared logs (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        As identified (its friction terms and Coulomb smoothing).
+    base : BaseParameters
+    params : (n_base,) array
+        The last full identification's base parameters.
+    settings : MonitorSettings
+
+    Raises
+    ------
+    DataError
+        Base parameters without per-joint friction or offset terms.
+    """
+
+    def __init__(self, robot, base, params, settings: MonitorSettings = MonitorSettings()):
+        from ..estimators.pooled import OWN_TERMS
+
+        self.robot, self.base, self.settings = robot, base, settings
+        self.params = np.asarray(params, dtype=float)
+        names = list(base.names)
+        self.columns: list[list[int]] = []
+        terms, joints = [], []
+        for j in range(robot.n_dof):
+            cols = [i for i, nm in enumerate(names) if nm.startswith(OWN_TERMS) and re.fullmatch(rf"[a-z]+{j + 1}", nm)]
+            self.columns.append(cols)
+            terms += [names[i] for i in cols]
+            joints += [j + 1] * len(cols)
+        if not terms:
+            raise DataError("the identification has no per-joint friction or offset terms to monitor")
+        self.terms, self.joints = tuple(terms), tuple(joints)
+        self.q = max(len(c) for c in self.columns)
+        rigid = np.ones(len(names), dtype=bool)
+        rigid[[i for c in self.columns for i in c]] = False
+        self.rigid = rigid
+        theta0 = np.zeros((robot.n_dof, self.q))
+        for j, cols in enumerate(self.columns):
+            theta0[j, :len(cols)] = self.params[cols]
+        self.rls: RecursiveLeastSquares | None = None
+        self.theta0 = theta0
+        self.windows: list[MonitorWindow] = []
+        self.alarms: list[DriftAlarm] = []
+        self.cusum: Cusum | None = None
+        self.mean = self.std = np.full(len(terms), np.nan)
+        self.threshold = float("nan")
+        self.elapsed = 0.0  # log time seen [s]
+        self.relearn: dict[int, list] = {}
+        self.window_times: list[tuple[str, float, float]] = []  # (log, start, end) of each window, for dating alarms
+        self.logs: list[str] = []
+
+    def _flat(self, theta: np.ndarray) -> np.ndarray:
+        return np.concatenate([theta[j, :len(c)] for j, c in enumerate(self.columns)])
+
+    def feed(self, data, name: str) -> list[DriftAlarm]:
+        """Take in one prepared log.
+
+        Parameters
+        ----------
+        data : PreparedData
+            Prepared with the identification's resolved settings.
+        name : str
+            The log's name (alarms name it).
+
+        Returns
+        -------
+        list of DriftAlarm
+            The alarms this log raised.
+        """
+        from ..preprocessing.pipeline import base_chunks
+
+        n, q = self.robot.n_dof, self.q
+        self.logs.append(name)
+        t_parts, phi_parts, r_parts, keep_parts = [], [], [], []
+        for index, y, tau, keep in base_chunks(self.robot, self.base, data):
+            residual = tau - y[:, :, self.rigid] @ self.params[self.rigid]
+            phi = np.zeros((y.shape[0], n, q))
+            for j, cols in enumerate(self.columns):
+                phi[:, j, :len(cols)] = y[:, j, cols]
+            t_parts.append(np.asarray(data.t)[index])
+            phi_parts.append(phi)
+            r_parts.append(residual)
+            keep_parts.append(keep)
+        if not t_parts:
+            return []
+        t, phi, r, keep = (np.concatenate(x) for x in (t_parts, phi_parts, r_parts, keep_parts))
+        if self.rls is None:
+            rows_per_second = len(t) / max(float(t[-1] - t[0]), 1e-9)
+            lam = 1.0 - 1.0 / max(self.settings.forgetting_seconds * rows_per_second, 2.0)
+            self.rls = RecursiveLeastSquares(self.theta0, 1e2, lam)
+        new: list[DriftAlarm] = []
+        edges = np.arange(t[0], t[-1] + 1e-9, self.settings.window)
+        for a, b in zip(edges[:-1], edges[1:]):
+            rows = (t >= a) & (t < b)
+            if rows.sum() < 4 * q:
+                continue
+            tracked = self.rls.update(phi[rows], r[rows], keep[rows])
+            theta, std = self._window_fit(phi[rows], r[rows], keep[rows])
+            self.windows.append(MonitorWindow(name, float(a), float(b), theta, std, self._flat(tracked)))
+            self.window_times.append((name, float(a), float(b)))
+            new += self._chart()
+        self.alarms += new
+        return new
+
+    def _window_fit(self, phi, r, keep) -> tuple[np.ndarray, np.ndarray]:
+        """Each joint's terms by least squares on the window, with σ; NaN where the joint did not move enough."""
+        theta, std = [], []
+        for j, cols in enumerate(self.columns):
+            k = len(cols)
+            a, y = phi[keep[:, j], j, :k], r[keep[:, j], j]
+            if a.shape[0] < 4 * k or np.linalg.cond(a) > 1e6:
+                theta.append(np.full(k, np.nan))
+                std.append(np.full(k, np.inf))
+                continue
+            sol, *_ = np.linalg.lstsq(a, y, rcond=None)
+            dof = max(a.shape[0] - k, 1)
+            s2 = float(np.sum((y - a @ sol) ** 2)) / dof
+            theta.append(sol)
+            std.append(np.sqrt(np.maximum(np.diag(np.linalg.inv(a.T @ a)) * s2, 0.0)))
+        return np.concatenate(theta), np.concatenate(std)
+
+    def _chart(self) -> list[DriftAlarm]:
+        from ..validation.change_detection import cusum_threshold
+
+        count = len(self.windows)
+        ref = self.settings.reference_windows
+        if count < ref:
+            return []
+        if count == ref:
+            values = np.array([w.theta for w in self.windows])
+            sigmas = np.array([w.std for w in self.windows])
+            with np.errstate(all="ignore"):
+                import warnings
+
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    self.mean = np.nanmean(values, axis=0)
+                    self.std = np.fmax(np.nanstd(values, axis=0, ddof=1),
+                                       np.nanmedian(np.where(np.isfinite(sigmas), sigmas, np.nan), axis=0))
+            per_day = 86400.0 / self.settings.window
+            k = self.settings.shift / 2
+            self.threshold = cusum_threshold(self.settings.false_alarm_days * per_day, 2 * len(self.terms), k)
+            self.cusum = Cusum(len(self.terms), self.threshold, k)
+            return []
+        assert self.cusum is not None
+        w = self.windows[-1]
+        z = (w.theta - self.mean) / self.std
+        for c, seen in list(self.relearn.items()):  # a term that alarmed: its new level learned before its chart restarts
+            seen.append(w.theta[c])
+            z[c] = np.nan
+            if len(seen) >= self.settings.reference_windows:
+                self.mean[c] = float(np.nanmean(seen))
+                del self.relearn[c]
+        out = []
+        for alarm in self.cusum.update(z):
+            start = ref + alarm.start  # windows before the chart started are the reference
+            since_log, since, _ = self.window_times[start]
+            c = alarm.channel
+            values = np.array([x.theta[c] for x in self.windows[start:]])
+            elapsed = sum(e - s for _, s, e in self.window_times[start:])
+            out.append(DriftAlarm(self.joints[c], self.terms[c], since_log, since, w.log, w.end, float(self.mean[c]),
+                                  float(np.nanmean(values)), float(elapsed)))
+            self.relearn[c] = []  # the change is said: the chart follows the term's new level once it is learned
+        return out
+
+    def result(self) -> MonitorResult:
+        """The monitored life so far.
+
+        Returns
+        -------
+        MonitorResult
+        """
+        return MonitorResult(self.terms, self.joints, tuple(self.windows), self.mean, self.std, self.threshold,
+                             tuple(self.alarms), self.settings, tuple(self.logs))
+
+
+def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings = MonitorSettings(),
+                 progress=None) -> MonitorResult:
+    """Monitor a robot through its logs, oldest first.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+        The robot's identify config: its identification dataset's column map reads the logs.
+    model : IdentifiedModel
+        The last full identification (:func:`dynid.load_results`).
+    logs : iterable of Path
+        In time order (:func:`dated_logs`).
+    settings : MonitorSettings
+    progress : callable, optional
+        ``progress(step, done, total)``.
+
+    Returns
+    -------
+    MonitorResult
+
+    Raises
+    ------
+    DataError
+        A log that cannot be read, or too few windows for the reference.
+    """
+    from ..io.datasets import load_recording
+    from ..io.identification_config import dataset_for_file
+    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.settings import carried_over
+
+    logs = list(logs)
+    monitor = FrictionMonitor(model.robot, model.base, model.params(), settings)
+    prep = carried_over(model.preprocessing, config.preprocessing)
+    for i, path in enumerate(logs):
+        if progress is not None:
+            progress(f"log {path.name}", i, len(logs))
+        recording = load_recording(dataset_for_file(config, path), model.robot)
+        monitor.feed(prepare(recording, prep, strict=False), path.name)
+    if len(monitor.windows) <= settings.reference_windows:
+        raise DataError(f"{len(monitor.windows)} windows of {settings.window:g} s in the logs: the reference needs "
+                        f"{settings.reference_windows} and monitoring more (give more logs, or --reference-windows)")
+    return monitor.result()

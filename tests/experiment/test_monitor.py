@@ -1,0 +1,105 @@
+"""``dynid monitor``: recursive least squares against its closed form, the CUSUM against its design, and a simulated
+worn joint found in its logs (and nothing found where nothing changed)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.estimators.recursive import RecursiveLeastSquares
+from dynid.exceptions import ShapeError
+from dynid.experiment.simulated_fleet import simulate_service_life
+from dynid.validation.change_detection import Cusum, cusum_threshold
+
+from ..cli.refusals import assert_refused, dynid
+
+
+def test_recursive_least_squares_is_the_regularised_batch_solution():
+    rng = np.random.default_rng(0)
+    m, n, q = 400, 3, 3
+    phi, theta_true = rng.normal(size=(m, n, q)), rng.normal(size=(n, q))
+    y = np.einsum("mnq,nq->mn", phi, theta_true) + 0.1 * rng.normal(size=(m, n))
+    theta0, p0 = rng.normal(size=(n, q)), 5.0
+    rls = RecursiveLeastSquares(theta0, p0, forgetting=1.0)
+    rls.update(phi[:150], y[:150])
+    got = rls.update(phi[150:], y[150:])
+    for j in range(n):  # argmin |y - Aθ|² + |θ - θ0|²/p0
+        a = phi[:, j, :]
+        expected = np.linalg.solve(a.T @ a + np.eye(q) / p0, a.T @ y[:, j] + theta0[j] / p0)
+        np.testing.assert_allclose(got[j], expected, rtol=1e-8)
+    # with forgetting, the estimate follows a change: the old samples fade
+    rls = RecursiveLeastSquares(np.zeros((n, q)), 1e3, forgetting=0.98)
+    rls.update(phi[:200], y[:200])
+    shifted = rls.update(phi[200:], y[200:] + 2.0 * phi[200:, :, 0])
+    np.testing.assert_allclose(shifted[:, 0], theta_true[:, 0] + 2.0, atol=0.1)
+    with pytest.raises(ShapeError):
+        rls.update(phi[:, :, :2], y)
+
+
+def test_the_cusum_keeps_its_false_alarm_rate_and_dates_a_change():
+    rng = np.random.default_rng(1)
+    h = cusum_threshold(200.0, charts=2)  # one two-sided chart: a false alarm every 200 values on average
+    runs = []
+    for _ in range(300):
+        chart, i = Cusum(1, h), 0
+        while not chart.update(rng.normal(size=1)):
+            i += 1
+        runs.append(i + 1)
+    assert 120 < np.mean(runs) < 330  # Siegmund's approximation (design 200)
+    chart = Cusum(1, cusum_threshold(1e6, 2))
+    z = np.r_[rng.normal(size=100), rng.normal(size=40) + 3.0]
+    alarms = [a for v in z for a in chart.update(np.array([v]))]
+    assert alarms and alarms[0].direction == 1 and abs(alarms[0].start - 100) <= 2 and 100 < alarms[0].index < 110
+    assert 2.0 < alarms[0].shift < 4.0
+
+
+def _identified(root):
+    out = root / "id"
+    p = dynid("identify", root / "unit.toml", "--out", out, "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    return out / "results.json"
+
+
+def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(tmp_path):
+    """A 10 % rise of joint 3's viscous friction on day 14 (of 1-minute logs, one a day; the first 12 are the
+    reference): the alarm names joint 3 and its viscous friction, within 60 s of logs of the change, with its size; no
+    other term alarms."""
+    simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
+                          step=0.10, coulomb=False, seed=3)
+    results = _identified(tmp_path)
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
+    assert p.returncode == 0, p.stderr
+    report = json.loads((tmp_path / "m" / "monitor.json").read_text())
+    alarms = report["alarms"]
+    assert [(a["joint"], a["term"]) for a in alarms] == [(3, "fv3")]
+    a = alarms[0]
+    assert a["detected_log"] == "2026-01-15T00-00.csv" and a["since_log"] == "2026-01-15T00-00.csv"
+    assert a["detected_s"] <= 60.0 and a["delay_s"] <= 60.0
+    assert a["change_percent"] == pytest.approx(10.0, abs=2.0)
+    assert "joint 3: viscous friction (fv3) rose" in " ".join((p.stdout + p.stderr).split())
+    assert (tmp_path / "m" / "monitor.png").is_file() and (tmp_path / "m" / "monitor.parquet").is_file()
+
+
+def test_dynid_monitor_raises_no_alarm_where_nothing_changed(tmp_path):
+    """Two hours of logs (120 one-minute logs at 100 Hz) of an unchanged robot: no alarm. The 24-hour figure is
+    measured by benchmarks/bench_monitor.py."""
+    simulate_service_life(tmp_path, days=120, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=4)
+    results = _identified(tmp_path)
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
+    assert p.returncode == 0, p.stderr
+    report = json.loads((tmp_path / "m" / "monitor.json").read_text())
+    assert report["alarms"] == [] and len(report["windows"]) >= 600
+    assert "no change" in p.stdout
+
+
+def test_monitor_refusals(tmp_path):
+    simulate_service_life(tmp_path, days=2, seconds=20.0, rate=100.0, seed=5)
+    (tmp_path / "empty").mkdir()
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "empty", "--results", tmp_path / "none.json",
+              "--out", tmp_path / "m")
+    assert_refused(p, "no log matching")
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--window", "0", "--out", tmp_path / "m")
+    assert_refused(p, "--window must be a positive number of seconds")
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", tmp_path / "none.json",
+              "--out", tmp_path / "m")
+    assert_refused(p, "none.json")
