@@ -29,4 +29,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_excitation_design.py
 
 clean:
-	rm -rf $(VENV) dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo .site
+	rm -rf $(VENV) dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo dynid-fleet dynid-monitor .site

@@ -67,3 +67,17 @@ def test_the_closed_loop_pages_python_runs(tmp_path, monkeypatch):
     assert set(namespace["estimates"]) == {"wls", "idim-iv", "didim"}
     d = namespace["d"]  # 1 kHz, an excitation below 0.3 Hz: a delay of a few samples is not determined, and said
     assert not d.determined and (d.at_bound or d.std > 0.5)
+
+
+def test_the_fleet_tutorials_python_runs(tmp_path, monkeypatch, capsys):
+    """docs/tutorials/fleets.md as written: a simulated fleet identified on Dask, the odd unit flagged; a service life
+    monitored, the worn joint named."""
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    for code in _blocks(DOCS / "tutorials" / "fleets.md"):
+        exec(compile(code, "fleets.md", "exec"), namespace)
+    out = capsys.readouterr().out
+    assert re.search(r"^r03: K2 = [\d.]+, the other units [\d.]+ \(z \+\d+", out, flags=re.M), out
+    alarms = [line for line in out.splitlines() if line.startswith("joint ")]
+    assert len(alarms) == 1 and alarms[0].startswith("joint 3: viscous friction (fv3) rose"), out
+    assert "since 2026-01-15T00-00.csv at 1 s; alarm in 2026-01-15T00-00.csv at 11 s, 10 s of logs later" in alarms[0]

@@ -22,7 +22,7 @@ def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     out = tmp_path / "out"
     p = dynid("fleet", tmp_path / "fleet" / "fleet.toml", "--out", out, "--workers", "2")
     assert p.returncode == 0, p.stderr
-    assert "6 of 6 units identified; 1 stand out from the fleet: r03" in " ".join(p.stdout.split())
+    assert "6 of 6 units identified; 1 stands out from the fleet: r03" in " ".join(p.stdout.split())
     table = pa.read_table(out / "fleet.parquet").to_pydict()
     assert table["unit"] == [f"r0{k}" for k in range(1, 7)]
     flags = dict(zip(table["unit"], table["flags"]))

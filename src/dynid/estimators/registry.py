@@ -379,6 +379,10 @@ def keys() -> tuple[str, ...]:
     return tuple(_REGISTRY)
 
 
+OTHER_LABELS = {"idim-iv": "IDIM-IV", "didim": "DIDIM"}
+"""Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.experiment.closed_loop`)."""
+
+
 def label(key: str) -> str:
     """The table label of an estimator.
 
@@ -392,7 +396,7 @@ def label(key: str) -> str:
         ``"WLS"``, ``"ABC×10"``; anything not registered as it is.
     """
     entry = _REGISTRY.get(str(key).strip().lower())
-    return entry.label if entry is not None else str(key)
+    return entry.label if entry is not None else OTHER_LABELS.get(str(key).strip().lower(), str(key))
 
 
 def estimate_label(key: str) -> str:

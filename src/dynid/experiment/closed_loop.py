@@ -33,8 +33,7 @@ from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_close
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]
 
-CLOSED_LOOP_METHODS = ("idim-iv", "didim")
-"""Keys of the closed-loop estimators (case-insensitive)."""
+from ..estimators.instrumental import CLOSED_LOOP_METHODS  # noqa: E402  the keys, where a config's parser sees them
 
 LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM"}
 
@@ -194,11 +193,27 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         changes: list[float] = []
         previous = w @ beta
         std = start_std
+        good = None  # the last estimate that simulated
         for _ in range(max_iter):
             try:
                 ws = simulated_rows(beta)
             except ConfigError as exc:  # the estimate cannot be simulated (unstable, a massless link)
-                if changes or note:
+                if good is not None:
+                    # a step too long for the closed loop (Gauss-Newton far from the optimum): halve it towards the
+                    # last estimate that simulated, up to 6 times
+                    for halving in range(1, 7):
+                        trial = good + 0.5 ** halving * (beta - good)
+                        try:
+                            ws = simulated_rows(trial)
+                        except ConfigError:
+                            continue
+                        beta = trial
+                        note += f"a step halved {halving} time(s) to keep the closed loop stable; "
+                        break
+                    else:
+                        message = f"stopped: {exc}"
+                        break
+                elif changes or note:
                     message = f"stopped: {exc}"
                     break
                 # least squares biased far enough to be unstable in simulation: start from the description instead
@@ -210,6 +225,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
                 except ConfigError as again:
                     message = f"stopped: neither the least-squares estimate nor the description can be simulated ({again})"
                     break
+            good = beta.copy()
             if key == "idim-iv":
                 sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None])
                 beta, std = sol.params, sol.params_std

@@ -57,6 +57,8 @@ class UnitSummary:
         Drive gains when the unit's config has ``[drive_gains]`` (NaN / inf where not observable).
     seconds : float
         Wall time of the unit's task.
+    memory_mb : float
+        Peak resident memory of the process that ran it, when it ended [MB] (NaN where unknown).
     error : str
         The one-line message of a unit that failed ("" when it did not); its arrays are then empty.
     files : tuple of str
@@ -81,10 +83,23 @@ class UnitSummary:
     gains: np.ndarray | None = None
     gains_std: np.ndarray | None = None
     seconds: float = 0.0
+    memory_mb: float = float("nan")
     error: str = ""
     files: tuple[str, ...] = ()
     model: object = None  # the robot as identified (for the second round's validation); not in the table
     preprocessing: object = None  # the identification's resolved preprocessing, carried over to the validation logs
+
+
+def _peak_memory() -> float:
+    """This process's peak resident memory [MB] (NaN where the platform does not say)."""
+    try:
+        import resource
+        import sys
+
+        kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        return kb / (1024 * 1024) if sys.platform == "darwin" else kb / 1024
+    except (ImportError, OSError):
+        return float("nan")
 
 
 def _mean_errors(validations, label: str) -> tuple[float, np.ndarray]:
@@ -139,7 +154,7 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
     return UnitSummary(unit.id, date, unit.payload, tuple(result.base.names), sol.params, scale * sol.params_std,
                        scale ** 2 * sol.covariance, label,
                        err, joints, str(result.consistency_verdicts.get(label, "")), gains, gains_std,
-                       time.perf_counter() - t0, "", files, result.model or unit.config.robot,
+                       time.perf_counter() - t0, _peak_memory(), "", files, result.model or unit.config.robot,
                        stored_preprocessing({"settings": result.settings}))
 
 
@@ -284,7 +299,8 @@ class FleetResult:
         return {"kind": "fleet", "name": self.manifest.name, "manifest": str(self.manifest.path), "table": self.table(),
                 "outliers": [o.to_dict() for o in self.outliers], "flag_threshold": self.threshold,
                 "pooled": pooled, "pooled_note": self.pooled_note, "cluster": self.cluster,
-                "seconds": {"total": self.seconds, **{u.id: u.seconds for u in self.units}}}
+                "seconds": {"total": self.seconds, **{u.id: u.seconds for u in self.units}},
+                "peak_memory_mb": {u.id: u.memory_mb for u in self.units}}
 
 
 def _flag(units: tuple[UnitSummary, ...]):

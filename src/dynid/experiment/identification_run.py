@@ -172,6 +172,9 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
+    if config.closed_loop:
+        step("closed-loop estimators (" + ", ".join(config.closed_loop) + ")")
+        result = _closed_loop(config, robot, base, result)
     result = replace(result, settings={**result.settings, "robot_source": config.robot_source,
                                        "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
@@ -183,6 +186,38 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
                                       data.settings, result.joint_std, {result.label: result.solution.covariance})
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     return replace(result, **_main_estimate(result))
+
+
+def _closed_loop(config: IdentificationConfig, robot, base, result):
+    """IDIM-IV / DIDIM beside the other estimates, on the identification log at the control rate (``[controller]``)."""
+    from ..dynamics.rnea import rnea_torques
+    from .closed_loop import ClosedLoopExperiment, closed_loop_identify
+    from .identification import Estimate
+
+    assert config.controller is not None  # the config's parser refuses closed-loop estimators without it
+    controller, reference, feedforward = config.controller
+    recording = load_recording(config.identification, config.robot, spool=False)
+    q_ref = reference.read()
+    if q_ref.shape[0] != recording.t.size:
+        raise DataError(f"{reference.file}: {q_ref.shape[0]} rows of set-points, the identification log has "
+                        f"{recording.t.size} samples: give one set-point per row of the log (and the same rows)")
+    dt = 1.0 / controller.rate
+    dq_ref = np.gradient(q_ref, dt, axis=0)
+    ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if feedforward else None
+    import time
+
+    estimates = dict(result.estimates)
+    notes = []
+    for key in config.closed_loop:
+        t0 = time.perf_counter()
+        out = closed_loop_identify(robot, base, recording, ClosedLoopExperiment(controller, q_ref, dq_ref, ff), methods=(key,),
+                                   preprocessing=config.preprocessing)[key]
+        estimate = Estimate(key, out.params, out.params_std, time.perf_counter() - t0,
+                            note="" if out.converged else out.message)
+        estimates[estimate.label] = estimate
+        if not out.converged:
+            notes.append(f"{estimate.label}: {out.message}")
+    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes))
 
 
 def _main_estimate(result) -> dict:

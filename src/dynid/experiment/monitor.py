@@ -7,7 +7,8 @@ leave, for each joint, what its friction and offset explain. On every window of 
 friction terms are re-identified by least squares (their σ from the window's residual); recursive least squares
 with forgetting (:mod:`dynid.estimators.recursive`) follows them sample by sample meanwhile. The first
 ``reference_windows`` windows set each term's reference (mean and spread: what the term does when nothing
-changes, temperature and noise included); from then on each window's estimate, standardised by the reference, feeds
+changes, temperature and noise included; the spread taken at its upper 95 % confidence bound, since an
+underestimated spread multiplies false alarms); from then on each window's estimate, standardised by the reference, feeds
 a two-sided CUSUM chart per term (:mod:`dynid.validation.change_detection`) whose threshold gives the whole family
 one false alarm per ``false_alarm_days`` days of logs on average. An alarm names the joint and the term, dates the
 change (log and time), and says how large it is; the term's new level is then learned over the next
@@ -358,6 +359,8 @@ class FrictionMonitor:
         return np.concatenate(theta), np.concatenate(std)
 
     def _chart(self) -> list[DriftAlarm]:
+        from scipy.stats import chi2
+
         from ..validation.change_detection import cusum_threshold
 
         count = len(self.windows)
@@ -373,8 +376,12 @@ class FrictionMonitor:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     self.mean = np.nanmean(values, axis=0)
-                    self.std = np.fmax(np.nanstd(values, axis=0, ddof=1),
-                                       np.nanmedian(np.where(np.isfinite(sigmas), sigmas, np.nan), axis=0))
+                    # the spread is itself estimated from `ref` windows: its upper 95 % confidence bound, and the
+                    # mean's own uncertainty, so that the charts' false-alarm rate holds (a spread 15 % low would
+                    # make false alarms some 40 times as frequent)
+                    upper = np.sqrt((ref - 1) / chi2.ppf(0.05, ref - 1))
+                    self.std = np.fmax(np.nanstd(values, axis=0, ddof=1) * upper,
+                                       np.nanmedian(np.where(np.isfinite(sigmas), sigmas, np.nan), axis=0)) * np.sqrt(1 + 1 / ref)
             per_day = 86400.0 / self.settings.window
             k = self.settings.shift / 2
             self.threshold = cusum_threshold(self.settings.false_alarm_days * per_day, 2 * len(self.terms), k)

@@ -159,7 +159,7 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
                    rate: float = 250.0, validation_seconds: float = 20.0, friction_spread: float = 0.2,
                    payload_max: float = 2.0, odd_unit: int | None = 2, odd_joint: int = 2, gain_error: float = 0.05,
                    calibration_payload: float = 5.0, noise: NoiseModel = NoiseModel(),
-                   validation_noise: NoiseModel | None = None, seed: int = 0) -> list[UnitTruth]:
+                   validation_noise: NoiseModel | None = None, calibration: bool = True, seed: int = 0) -> list[UnitTruth]:
     """Write a simulated fleet: its manifest ``fleet.toml``, the unit config template ``unit.toml``, each unit's logs
     and ``truth.json``.
 
@@ -189,6 +189,8 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     noise : NoiseModel
     validation_noise : NoiseModel, optional
         Of the validation logs (default ``noise``); without current noise, a validation error is the model's alone.
+    calibration : bool
+        Write the drive-gain runs (and ``[drive_gains]`` in the template).
     seed : int
 
     Returns
@@ -225,21 +227,22 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
                    rate, noise, unit_rng)
         _write_log(folder / uid / "validation.csv", nominal, real, gains, random_excitation(nominal, unit_rng),
                    validation_seconds, rate, noise if validation_noise is None else validation_noise, unit_rng)
-        runs = random_excitation(nominal, unit_rng)
-        loaded = unit_robot(nominal, replace(truth, payload=truth.payload + calibration_payload))
-        _write_log(folder / uid / "unloaded.csv", nominal, real, gains, runs, seconds, rate, noise, unit_rng)
-        _write_log(folder / uid / "loaded.csv", nominal, loaded, gains, runs, seconds, rate, noise, unit_rng)
         lines += ["[[units]]", f'id = "{uid}"', f'identification = "{uid}/identification.csv"',
-                  f'validation = ["{uid}/validation.csv"]',
-                  f'drive_gains = {{ unloaded = "{uid}/unloaded.csv", loaded = "{uid}/loaded.csv" }}',
-                  f"payload = {truth.payload:.3f}", ""]
+                  f'validation = ["{uid}/validation.csv"]']
+        if calibration:
+            runs = random_excitation(nominal, unit_rng)
+            loaded = unit_robot(nominal, replace(truth, payload=truth.payload + calibration_payload))
+            _write_log(folder / uid / "unloaded.csv", nominal, real, gains, runs, seconds, rate, noise, unit_rng)
+            _write_log(folder / uid / "loaded.csv", nominal, loaded, gains, runs, seconds, rate, noise, unit_rng)
+            lines.append(f'drive_gains = {{ unloaded = "{uid}/unloaded.csv", loaded = "{uid}/loaded.csv" }}')
+        lines += [f"payload = {truth.payload:.3f}", ""]
     (folder / "fleet.toml").write_text("\n".join(lines))
     (folder / "unit.toml").write_text(
         f'# What every unit of the fleet shares: the robot, the logs\' columns, the estimators.\nrobot = "{robot}"\n\n'
         f"[identification]\n{_columns(n)}\n[[validation]]\nname = \"validation\"\n{_columns(n)}\n"
         '[estimation]\nestimators = ["wls"]\nfriction = "description"\n\n'
-        f"[drive_gains]\npayload_mass = {calibration_payload}\n[drive_gains.unloaded]\n{_columns(n)}"
-        f"[drive_gains.loaded]\n{_columns(n)}")
+        + (f"[drive_gains]\npayload_mass = {calibration_payload}\n[drive_gains.unloaded]\n{_columns(n)}"
+           f"[drive_gains.loaded]\n{_columns(n)}" if calibration else ""))
     (folder / "truth.json").write_text(json.dumps({"robot": robot, "seed": seed, "units": [t.to_dict() for t in truths]},
                                                   indent=1))
     return truths

@@ -25,7 +25,7 @@ else:
     RobotDescription = _RobotDescription
 
 __all__ = ["SignalTable", "TimeTable", "DatasetTable", "PreprocessingTable", "EstimationTable", "ReferenceTable",
-           "DriveGainsTable", "IdentificationDocument", "ExcitationDocument", "UnitTable",
+           "DriveGainsTable", "ControllerTable", "IdentificationDocument", "ExcitationDocument", "UnitTable",
            "FleetDocument"]
 
 Column = Union[Annotated[int, Meta(ge=1)], str]
@@ -148,6 +148,34 @@ class DriveGainsTable(Table, kw_only=True):
     loaded: Annotated[DatasetTable, _d("the same motion with the payload (currents)")]
 
 
+class ReferenceTrajectoryTable(Table, kw_only=True):
+    """``[controller.reference]``: the set-points the controller followed, one row per row of the identification log."""
+
+    file: Annotated[str, _d("CSV of the set-points, relative to the data root")]
+    header: Annotated[bool, _d("the first line names the columns")] | None = None
+    positions: Annotated[list[Column], _d("one per joint: 1-based numbers or header names")]
+    unit: Annotated[Literal["rad", "deg"], _d("of the positions (default rad)")] | None = None
+    rows: Annotated[list[Annotated[int, Meta(ge=1)]], Meta(min_length=2, max_length=2,
+                                                          description="1-based inclusive data rows")] | None = None
+
+
+GainValues = Union[Annotated[float, Meta(ge=0)], list[Annotated[float, Meta(ge=0)]]]
+
+
+class ControllerTable(Table, kw_only=True):
+    """``[controller]``: the joint controller that drove the identification run, for the closed-loop estimators
+    (IDIM-IV, DIDIM: :mod:`dynid.experiment.closed_loop`)."""
+
+    kp: Annotated[GainValues, _d("N·m/rad: proportional gain, one value or one per joint")]
+    kd: Annotated[GainValues, _d("N·m·s/rad: derivative gain, one value or one per joint")]
+    ki: Annotated[GainValues, _d("N·m/(rad·s): integral gain (default 0: PD)")] | None = None
+    rate: Annotated[PositiveHz, _d("Hz: the control rate; the identification log is logged at it")]
+    velocity_cutoff: Annotated[NonNegative, _d("Hz: first-order filter of the drive's velocity estimate (0: none)")] | None = None
+    feedforward: Annotated[Literal["model", "none"], _d("the description's torque of the reference added to the "
+                                                        "loop's (model), or none (default)")] | None = None
+    reference: Annotated[ReferenceTrajectoryTable, _d("the reference trajectory: one row per row of the log")]
+
+
 class IdentificationDocument(Table, kw_only=True):
     """A config of ``dynid identify`` and ``dynid validate`` (:mod:`dynid.io.identification_config`)."""
 
@@ -161,6 +189,7 @@ class IdentificationDocument(Table, kw_only=True):
     estimation: Annotated[EstimationTable, _d("the estimators")] | None = None
     references: Annotated[list[ReferenceTable], _d("published parameter sets scored beside")] = msgspec.field(default_factory=list)
     drive_gains: Annotated[DriveGainsTable, _d("drive gains from a known payload")] | None = None
+    controller: Annotated[ControllerTable, _d("the controller of the identification run (IDIM-IV, DIDIM)")] | None = None
 
 
 class UnitGainsTable(Table, kw_only=True):

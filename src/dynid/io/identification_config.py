@@ -68,6 +68,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import msgspec
+import numpy as np
 
 from ..exceptions import ConfigError, DataError
 from ..typed import convert
@@ -116,6 +117,10 @@ class IdentificationConfig:
     urdf : Path or None
         The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
+    closed_loop : tuple of str
+        Closed-loop estimators asked for in ``[estimation] estimators`` (IDIM-IV, DIDIM), run beside the others.
+    controller : tuple or None
+        ``(Controller, reference DatasetSpec, feed-forward: bool)`` from ``[controller]``.
     """
 
     path: Path
@@ -132,6 +137,8 @@ class IdentificationConfig:
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
     sdp_prior: str = "euclidean"  # [estimation] sdp_prior: "euclidean" or "geometric"
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
+    closed_loop: tuple[str, ...] = ()  # IDIM-IV / DIDIM asked for, run beside the estimators
+    controller: tuple | None = None  # (Controller, reference DatasetSpec, feed-forward) of [controller]
 
 
 REMOVED = {
@@ -259,16 +266,88 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     e = typed.estimation or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
+
+    asked = [str(k).strip().lower() for k in e.estimators] if e.estimators is not None else ["wls"]
+    closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
+    if asked and asked[0] in CLOSED_LOOP_METHODS:
+        raise ConfigError(f"{path}: estimation.estimators: the first is the main estimate and starts the closed-loop "
+                          f"ones: list ols or wls before {asked[0]!r}")
     try:
-        estimators = parse_estimators(e.estimators) if e.estimators is not None else ("wls",)
+        estimators = parse_estimators([k for k in asked if k not in CLOSED_LOOP_METHODS])
     except ConfigError as exc:
         raise ConfigError(f"{path}: estimation.estimators: {str(exc).split(': ', 1)[1]}") from None
+    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof)
+    if closed_loop and controller is None:
+        raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
+                          "controller: add a [controller] table (kp, kd, rate, the reference trajectory), or leave it out "
+                          "(without the controller only the open-loop estimators can run)")
     refs = doc.get("references", [])
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
-                                urdf=config_urdf(doc, path, root), sdp_prior=e.sdp_prior or "euclidean")
+                                urdf=config_urdf(doc, path, root), sdp_prior=e.sdp_prior or "euclidean",
+                                closed_loop=closed_loop, controller=controller)
+
+
+def _controller(table, root: Path, where: str, n: int):
+    """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None."""
+    if table is None:
+        return None
+    from ..simulation.closed_loop import Controller
+
+    try:
+        controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),
+                                   float(table.get("velocity_cutoff", 0.0)))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {str(exc).removeprefix('controller.')}") from None
+    ref = table["reference"]
+    if len(ref["positions"]) != n:
+        raise ConfigError(f"{where}.reference.positions: expected {n} columns (one per joint), got {ref['positions']!r}")
+    reference = ReferenceTrajectory(root / ref["file"], tuple(ref["positions"]), bool(ref.get("header", False)),
+                                    np.pi / 180 if ref.get("unit") == "deg" else 1.0,
+                                    None if ref.get("rows") is None else (int(ref["rows"][0]), int(ref["rows"][1])))
+    return controller, reference, table.get("feedforward", "none") == "model"
+
+
+@dataclass(frozen=True)
+class ReferenceTrajectory:
+    """Where the reference of ``[controller]`` is.
+
+    Attributes
+    ----------
+    file : Path
+    positions : tuple of int or str
+        Columns, 1-based or header names.
+    header : bool
+    scale : float
+        To radians.
+    rows : (first, last) or None
+    """
+
+    file: Path
+    positions: tuple
+    header: bool = False
+    scale: float = 1.0
+    rows: tuple[int, int] | None = None
+
+    def read(self) -> np.ndarray:
+        """The set-points.
+
+        Returns
+        -------
+        (N, n_dof) ndarray [rad]
+
+        Raises
+        ------
+        DataError
+            A missing or malformed file (named, with the line).
+        """
+        from .tables import read_table
+
+        table = read_table(self.file, list(self.positions), header=self.header, rows=self.rows)
+        return np.asarray(table.data, dtype=float) * self.scale
 
 
 def _check_reference_names(refs: list, path: Path) -> None:

@@ -31,6 +31,11 @@ def save_unit(result, folder: Path, robot) -> list[Path]:
     return save_identification(result, folder, False, robot=robot)
 
 
+HEADERS = {"payload_kg": "payload kg", "validation_error_pct": "error %", "pooled_validation_error_pct": "pooled error %",
+           "worst_joint": "worst joint"}
+"""Column headers of the HTML table (the Parquet file keeps the column names)."""
+
+
 def _cell(value) -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "—"
@@ -60,7 +65,7 @@ def fleet_html(result: FleetResult) -> str:
     verdict = next(b.text for b in fleet_blocks(result) if isinstance(b, Line))
     flagged = {(o.unit, o.parameter) for o in result.outliers}
     columns = list(table)
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+    head = "".join(f"<th>{html.escape(HEADERS.get(c, c.replace('_std', ' σ')))}</th>" for c in columns)
     rows = []
     for i, uid in enumerate(table["unit"]):
         cells = []
@@ -86,13 +91,15 @@ td.bad {{ background: #f9c9c9; font-weight: 600; }}
 <h1>Fleet: {html.escape(result.manifest.name)}</h1>
 <p class="verdict">{html.escape(verdict.split(": ", 1)[1] if ": " in verdict else verdict)}</p>
 <h2>Units that stand out</h2>
-<p>Robust z-score of each parameter against the other units (their median and spread, with the unit's own σ); flagged
-beyond |z| = {result.threshold:.2f}, where a fleet whose units differ only at random has a 1 % chance of any flag.</p>
+<p>z-score of each parameter against the other units, with the unit's own σ: against their median and spread where
+they agree within their σ (drive gains, rigid-body parameters), against a prediction interval where they differ by
+nature (friction, offsets, a tool). Flagged beyond |z| = {result.threshold:.2f} where the units agree (more where they
+differ): a fleet whose units differ only at random has a 1 % chance of any flag.</p>
 <ul>{flags}</ul>
 <h2>The fleet table</h2>
 <p>One row per unit: global validation error [%] of its own estimate and of its pooled estimate (the fleet's shared
 rigid-body parameters), friction per joint (Coulomb fc [N·m], viscous fv [N·m·s/rad]) with σ, drive gains K [N·m/A]
-when identified. The same table is in <code>fleet.parquet</code>.</p>
+when identified. Flagged units and parameters are marked in red. The same table is in <code>fleet.parquet</code>.</p>
 <div class="wrap"><table><thead><tr>{head}</tr></thead><tbody>{"".join(rows)}</tbody></table></div>
 <p>Ran on {html.escape(result.cluster)} in {result.seconds:.1f} s. Each unit's own results: <code>units/&lt;id&gt;/</code>.</p>
 </body></html>

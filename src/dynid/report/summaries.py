@@ -95,10 +95,16 @@ def identification_blocks(result) -> list:
         out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
     if r.settings.get("friction_models") is not None:
         out.append(friction_choice_table(r.settings["friction_models"]))
+    from ..estimators.registry import OTHER_LABELS
+
+    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS]  # IDIM-IV, DIDIM: beside least squares
     rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
-                  *(f"{ref.beta[i]:.4g}" for ref in r.references)) for i, n in enumerate(base.names))
-    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; reference values beside)",
-                         ("name", "unit", "value", "σ", "σ %", *(ref.name for ref in r.references)), rows, labels=2))
+                  *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
+                 for i, n in enumerate(base.names))
+    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; "
+                         + ("closed-loop estimates and " if closed else "") + "reference values beside)",
+                         ("name", "unit", "value", "σ", "σ %", *(label(e.key) for e in closed), *(ref.name for ref in r.references)),
+                         rows, labels=2))
     for ref in r.references:
         if ref.relative_std is not None:
             a = r.reference_agreement(ref)
@@ -416,7 +422,8 @@ def fleet_blocks(result) -> list:
     helped = [u for u, e in result.pooled_errors.items()
               if e < next(s.validation_error for s in ok if s.id == u)]
     verdict = (f"{len(ok)} of {len(units)} units identified; "
-               + (f"{len(flagged)} stand out from the fleet: {', '.join(flagged)}" if flagged else "none stands out from the fleet")
+               + (f"{len(flagged)} {'stands' if len(flagged) == 1 else 'stand'} out from the fleet: {', '.join(flagged)}"
+                  if flagged else "none stands out from the fleet")
                + (f"; pooling improved {len(helped)} of {len(result.pooled_errors)} units' validation error"
                   if result.pooled_errors else (f"; not pooled: {result.pooled_note}" if result.pooled_note else "")))
     out: list = [Line(f"dynid fleet — {result.manifest.name}: {verdict}", "title")]

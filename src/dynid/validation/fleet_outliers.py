@@ -128,7 +128,7 @@ class Outlier:
 
     def __str__(self) -> str:
         return (f"{self.unit}: {self.parameter} = {self.value:.4g}, the other units {self.fleet:.4g} "
-                f"(robust z {self.z:+.1f})")
+                f"(z {self.z:+.1f})")
 
 
 def fleet_outliers(units, names, values, std=None, alpha: float = FALSE_FLAG_RATE,

@@ -1,0 +1,89 @@
+"""``[controller]`` in a config: IDIM-IV and DIDIM run by ``dynid identify`` on a closed-loop log beside least
+squares, and refused in one line when the controller is not given."""
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.rnea import rnea_torques
+from dynid.excitation.paper_trajectories import paper_identification_trajectory
+from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
+
+from ..cli.refusals import assert_refused, dynid as dynid_cli
+
+N = 6
+COLUMNS = ", ".join(f'"q{j}"' for j in range(1, N + 1))
+
+
+def _write(tmp_path, controller_table: str, estimators='["wls", "idim-iv", "didim"]') -> None:
+    (tmp_path / "cl.toml").write_text(f'''robot = "er16"
+[identification]
+file = "log.csv"
+header = true
+time = {{ column = "t" }}
+positions = {{ columns = [{COLUMNS}] }}
+torques = {{ columns = [{", ".join(f'"tau{j}"' for j in range(1, N + 1))}] }}
+[estimation]
+estimators = {estimators}
+friction = "description"
+{controller_table}''')
+
+
+@pytest.fixture(scope="module")
+def closed_loop_log(tmp_path_factory):
+    """10 s of the ER-16's paper excitation at 1 kHz under a PID with model feed-forward, encoder noise 1e-3 deg."""
+    root = tmp_path_factory.mktemp("closed-loop")
+    robot = dynid.load_robot("er16")
+    t = np.arange(10000) / 1000.0
+    q, dq, ddq = paper_identification_trajectory(n_dof=N).evaluate(t)
+    c = Controller.for_robot(robot)
+    run = simulate_closed_loop(robot, t, q, dq, c, ClosedLoopNoise(position_std=np.deg2rad(1e-3), torque_std=0.1),
+                               np.random.default_rng(0), feedforward=rnea_torques(robot, q, dq, ddq))
+    header = "t," + ",".join(f"q{j}" for j in range(1, N + 1)) + "," + ",".join(f"tau{j}" for j in range(1, N + 1))
+    np.savetxt(root / "log.csv", np.column_stack([t, run.q, run.tau]), delimiter=",", header=header, comments="", fmt="%.10g")
+    np.savetxt(root / "ref.csv", q, delimiter=",", header=",".join(f"r{j}" for j in range(1, N + 1)), comments="",
+               fmt="%.12g")
+    table = (f"[controller]\nkp = {c.kp.tolist()}\nkd = {c.kd.tolist()}\nki = {c.ki.tolist()}\nrate = 1000.0\n"
+             f"velocity_cutoff = {c.velocity_cutoff}\nfeedforward = \"model\"\n"
+             f"reference = {{ file = \"ref.csv\", header = true, positions = [{COLUMNS.replace('q', 'r')}] }}\n")
+    base = base_parameters(robot, rng=0)
+    return root, table, dict(zip(base.names, base.base_from_standard(robot.standard_parameters())))
+
+
+def test_dynid_identify_runs_idim_iv_and_didim_beside_least_squares(closed_loop_log):
+    root, table, truth = closed_loop_log
+    _write(root, table)
+    p = dynid_cli("identify", root / "cl.toml", "--out", root / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    assert "IDIM-IV" in p.stdout and "DIDIM" in p.stdout  # beside least squares in the parameters table
+    estimates = json.loads((root / "out" / "results.json").read_text())["estimates"]
+    assert list(estimates) == ["dynid WLS", "dynid IDIM-IV", "dynid DIDIM"]
+    for label, e in estimates.items():
+        assert "note" not in e, (label, e.get("note"))  # converged
+        # the well-determined parameters (σ below 5 % of the value) against the simulation's truth: within 5 σ
+        good = [n for n in e["values"] if e["std"][n] < 0.05 * abs(truth[n])]
+        assert len(good) >= 10
+        z = [abs(e["values"][n] - truth[n]) / e["std"][n] for n in good]
+        assert np.median(z) < 5, (label, np.median(z))
+
+
+def test_closed_loop_estimators_without_the_controller_are_refused_in_one_line(closed_loop_log, tmp_path):
+    root, table, _ = closed_loop_log
+    (tmp_path / "log.csv").write_bytes((root / "log.csv").read_bytes())
+    _write(tmp_path, "")
+    assert_refused(dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "o"),
+                   "estimation.estimators: idim-iv simulates the run in closed loop and needs its controller: add a "
+                   "[controller] table")
+    _write(tmp_path, table, '["didim", "wls"]')
+    assert_refused(dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "o"), "list ols or wls before 'didim'")
+    _write(tmp_path, table.replace("kp = [", "kp = [-1.0, "))
+    assert_refused(dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "o"), "controller.kp")
+    # a reference with fewer set-points than the log has samples
+    lines = (root / "ref.csv").read_text().splitlines()
+    (tmp_path / "ref.csv").write_text("\n".join(lines[:-10]) + "\n")
+    _write(tmp_path, table, '["wls", "idim-iv"]')
+    assert_refused(dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "o"),
+                   "ref.csv: 9990 rows of set-points, the identification log has 10000 samples")
