@@ -8,7 +8,8 @@ from types import ModuleType
 
 from .exceptions import ConfigError
 
-EXTRAS = {"montecarlo": ("distributed",), "fleet": ("distributed", "pyarrow"), "ros": ("rosbags",), "mujoco": ("mujoco",)}
+EXTRAS = {"montecarlo": ("distributed",), "fleet": ("distributed", "pyarrow"), "ros": ("rosbags",), "mujoco": ("mujoco",),
+          "xacro": ("xacro",)}
 """Extra (``pip install "dynid[extra]"``) -> the modules it brings."""
 
 

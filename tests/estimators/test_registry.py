@@ -5,8 +5,11 @@ import sys
 import textwrap
 
 SCENARIO = textwrap.dedent('''
-    import _thread, threading
+    import _thread, signal, threading
     import numpy as np
+    # Ctrl-C raises KeyboardInterrupt here even when this process was started with SIGINT ignored (a background job
+    # of a non-interactive shell, as a CI runner may start it): interrupt_main does nothing where SIGINT is ignored
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     from dynid.estimators.registry import FitData, SearchBudget, fit_methods
 
     rng = np.random.default_rng(0)

@@ -137,22 +137,27 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
         ``convention = "urdf"``; None for a built-in robot or a DH description.
     """
+    from ..model.urdf import expand_xacro, is_xacro
+
+    def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to
+        return expand_xacro(file) if file is not None and is_xacro(file) else file
+
     ref = doc.get("robot")
     if isinstance(ref, dict):
-        return _located(str(ref["urdf"]), path.parent, data_root) if isinstance(ref.get("urdf"), str) else None
+        return urdf_of(_located(str(ref["urdf"]), path.parent, data_root)) if isinstance(ref.get("urdf"), str) else None
     if not isinstance(ref, str) or ref in builtin_robots():
         return None
     file = _located(ref, path.parent, data_root)
     if file is None:
         return None
-    if file.suffix.lower() == ".urdf":
-        return file
+    if file.suffix.lower() == ".urdf" or is_xacro(file):
+        return urdf_of(file)
     try:
         described = tomllib.loads(file.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     urdf = described.get("urdf")
-    return _located(urdf, file.parent, None) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+    return urdf_of(_located(urdf, file.parent, None)) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
 
 
 def _located(name: str, folder: Path, data_root: Path | None) -> Path | None:

@@ -104,9 +104,13 @@ def load_robot(name_or_path: str | Path) -> Robot:
     path = Path(text)
     if path.suffix == ".urdf" and path.is_file():
         return robot_from_urdf(path)
+    from .urdf import expand_xacro, is_xacro
+
+    if is_xacro(path) and path.is_file():
+        return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0])
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
-                          "description file or a .urdf file")
+                          "description file, a .urdf or a .xacro file")
     return robot_from_toml_text(path.read_text(encoding="utf-8"), source=str(path), base=path.parent)
 
 
@@ -172,7 +176,7 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     return robot_from_document(doc, source, base)
 
 
-def robot_from_urdf(path: str | Path, source: str | None = None) -> Robot:
+def robot_from_urdf(path: str | Path, source: str | None = None, name: str | None = None) -> Robot:
     """A robot given by its URDF alone.
 
     Its chain, inertias and limits; drive terms :data:`URDF_DRIVE_TERMS`, gravity along -z, drive gains 1 (a log of
@@ -183,6 +187,8 @@ def robot_from_urdf(path: str | Path, source: str | None = None) -> Robot:
     path : str or Path
     source : str, optional
         Named in errors (the path by default).
+    name : str, optional
+        The robot's name (default: the file's stem).
 
     Returns
     -------
@@ -195,7 +201,7 @@ def robot_from_urdf(path: str | Path, source: str | None = None) -> Robot:
     """
     path = Path(path)
     return robot_from_document({"convention": "urdf", "urdf": path.name, "drive_terms": list(URDF_DRIVE_TERMS),
-                                "name": path.stem}, source or str(path), path.parent)  # the URDF relative to its folder
+                                "name": name or path.stem}, source or str(path), path.parent)  # the URDF relative to its folder
 
 
 def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
@@ -240,6 +246,10 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         upath = Path(d.urdf)
         if not upath.is_absolute() and base is not None:
             upath = base / upath
+        from .urdf import expand_xacro, is_xacro
+
+        if is_xacro(upath):
+            upath = expand_xacro(upath)
         urdf_model = joints_from_urdf(upath)
         if rows is None:
             rows = [joint_table() for _ in urdf_model[0]]

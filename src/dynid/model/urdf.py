@@ -207,3 +207,71 @@ def urdf_limits(path: str | Path) -> dict:
         out["tau_max"].append(eff if 0 < eff < 1e10 else np.inf)
         out["ddq_max"].append(np.inf)
     return {k: np.array(v) for k, v in out.items()}
+
+
+def is_xacro(path: str | Path) -> bool:
+    """Whether a robot file is a xacro file (``arm.xacro``, ``arm.urdf.xacro``).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    bool
+    """
+    return str(path).lower().endswith(".xacro")
+
+
+def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
+    """The URDF a xacro file expands to, written once into dynid's cache (``$XDG_CACHE_HOME/dynid/xacro``, by default
+    ``~/.cache/dynid/xacro``) under a name that changes with the file's contents, and reused after.
+
+    The ``xacro`` package (PyPI, no ROS needed) expands macros, properties, arguments, math and includes by relative
+    path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths stay as the file wrote them.
+
+    Parameters
+    ----------
+    path : str or Path
+    mappings : dict, optional
+        xacro arguments (``name:=value``).
+
+    Returns
+    -------
+    Path
+        The expanded URDF.
+
+    Raises
+    ------
+    ConfigError
+        The ``xacro`` extra is missing, the file is unreadable, or xacro cannot expand it (the message names the file).
+    """
+    import hashlib
+    import os
+
+    from ..extras import require
+
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: xacro file not found")
+    xacro = require("xacro", "xacro", f"{path.name} (a xacro robot description)")
+    text = path.read_bytes()
+    key = hashlib.sha256(text + repr(sorted((mappings or {}).items())).encode() + str(path.resolve()).encode()).hexdigest()[:16]
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid" / "xacro"
+    out = cache / f"{path.name[:-len('.xacro')].removesuffix('.urdf')}-{key}.urdf"
+    if out.is_file():
+        return out
+    try:
+        with _silenced_stderr([]):
+            doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
+        urdf = doc.toprettyxml(indent="  ")
+    except Exception as exc:  # xacro raises its own exceptions, and ROS lookups fail in many ways without ROS
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        ros = "find" in message or "substitution args" in message or "ament_index" in message or "rospkg" in message
+        hint = " (a $(find ...) needs a ROS workspace: write the path relative to the file instead)" if ros else ""
+        raise ConfigError(f"{path}: xacro cannot expand it: {message}{hint}") from None
+    cache.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text(urdf, encoding="utf-8")
+    os.replace(tmp, out)
+    return out

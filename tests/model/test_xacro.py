@@ -1,0 +1,67 @@
+"""A xacro robot description, expanded by the xacro package without ROS: the same robot as the URDF it stands for."""
+
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.model.description import load_robot
+
+pytest.importorskip("xacro")
+
+URDF = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+
+
+def _xacro_of_ur10e(folder: Path, tool_mass: str = "${tool_mass}") -> Path:
+    """The shipped UR10e URDF as a xacro file: a property for the last link's mass, a macro for the base's inertia
+    block, the rest included unchanged."""
+    text = URDF.read_text(encoding="utf-8")
+    text = text.replace('<robot name="ur10e" xmlns:xacro="http://ros.org/wiki/xacro">',
+                        '<robot name="ur10e" xmlns:xacro="http://ros.org/wiki/xacro">\n'
+                        '  <xacro:property name="tool_mass" value="${0.2 + 0.002}"/>\n'
+                        '  <xacro:macro name="mass_of" params="value"><mass value="${value}"/></xacro:macro>')
+    assert text.count('<mass value="0.202"/>') == 1
+    text = text.replace('<mass value="0.202"/>', f'<xacro:mass_of value="{tool_mass}"/>')
+    path = folder / "ur10e.urdf.xacro"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_a_xacro_description_is_the_robot_of_its_urdf(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    from_xacro, from_urdf = load_robot(_xacro_of_ur10e(tmp_path)), load_robot(URDF)
+    assert from_xacro.name == "ur10e" and from_xacro.n_dof == from_urdf.n_dof == 6
+    np.testing.assert_allclose(from_xacro.inertial, from_urdf.inertial, rtol=1e-12, atol=1e-15)
+    for a, b in zip(from_xacro.joints, from_urdf.joints):
+        np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-12)
+        np.testing.assert_allclose(a.translation, b.translation, atol=1e-12)
+    np.testing.assert_allclose(from_xacro.limits.dq_max, from_urdf.limits.dq_max)
+    assert len(list((tmp_path / "cache" / "dynid" / "xacro").glob("*.urdf"))) == 1  # expanded once, into the cache
+    load_robot(tmp_path / "ur10e.urdf.xacro")
+    assert len(list((tmp_path / "cache" / "dynid" / "xacro").glob("*.urdf"))) == 1  # and reused
+
+
+def test_a_config_names_a_xacro_robot_and_export_writes_into_its_expansion(tmp_path, monkeypatch):
+    from dynid.io.configs import config_robot, config_urdf
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    _xacro_of_ur10e(tmp_path)
+    doc = {"robot": "ur10e.urdf.xacro"}
+    robot = config_robot(doc, tmp_path / "c.toml")
+    assert robot.n_dof == 6
+    urdf = config_urdf(doc, tmp_path / "c.toml")
+    assert urdf is not None and urdf.suffix == ".urdf" and "<mass value=\"0.202\"/>" in urdf.read_text().replace("  ", "")
+
+
+def test_a_xacro_that_cannot_be_expanded_is_refused_in_one_line(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    bad = _xacro_of_ur10e(tmp_path, "${undefined_property}")
+    with pytest.raises(ConfigError, match=r"ur10e.urdf.xacro: xacro cannot expand it: .*undefined_property") as info:
+        load_robot(bad)
+    assert "\n" not in str(info.value)
+    (tmp_path / "ros.urdf.xacro").write_text('<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro">'
+                                             '<xacro:include filename="$(find ur_description)/urdf/ur.xacro"/></robot>')
+    with pytest.raises(ConfigError, match=r"needs a ROS workspace"):
+        load_robot(tmp_path / "ros.urdf.xacro")
