@@ -327,9 +327,15 @@ def drive_gains_blocks(gains) -> list:
                 "warning") for j, d in enumerate(gains.description_gains) if not math.isfinite(g.gains[j])]
     vals = dict(zip(p.names, zip(p.values, p.std)))
     line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"
+    lost = p.not_determined
     if all(k in vals for k in ("MX", "MY", "MZ")):
-        line += ", centre of mass in the last link's frame (" + ", ".join(f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
-    return [table, *why, Line(line)]
+        line += ", centre of mass in the last link's frame (" + ", ".join(
+            "not determined" if k in lost else f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
+    out = [table, *why, Line(line)]
+    if lost:
+        out.append(Line(f"payload parameters not determined by the loaded run (σ ≥ 100 % of the value): {', '.join(lost)}: "
+                        "the noise sets them; a loaded run that turns the payload about more axes determines them", "warning"))
+    return out
 
 
 def montecarlo_blocks(result) -> list:
