@@ -102,6 +102,17 @@ def main() -> None:
     t, _ = command([str(BIN / "python"), str(REPO / "benchmarks" / "bench_excitation_design.py")])
     row("bench_excitation_design.py (6 joints, 5 harmonics, 4 starts)", t, "s", 15.0)
 
+    # closed loop: IDIM-IV and DIDIM on the paper's ER-16 experiment (benchmarks/bench_closed_loop.py)
+    from bench_closed_loop import measure as closed_loop
+
+    for key, (seconds, iterations, _) in closed_loop().items():
+        row(f"{key.upper()}, ER-16 paper experiment in closed loop (25 s at 1 kHz, {iterations} simulations)", seconds, "s", 10.0)
+
+    # dynid monitor's recursive least squares (benchmarks/bench_fleet.py)
+    from bench_fleet import recursive_update
+
+    row("recursive least squares of dynid monitor, 6 joints x 3 terms, per sample", recursive_update(), "µs", 50.0)
+
     widths = [max(len(r[i]) for r in ROWS + [("what", "dynid", "reference", "target", "")]) for i in range(5)]
     print(f"machine: {os.cpu_count()} cores, load average {load:.2f} at the start of the table")
     for r in [("what", "dynid", "reference", "target", "")] + ROWS:
