@@ -30,10 +30,11 @@ __all__ = ["NOMINAL_FRICTION", "UnitTruth", "simulate_fleet", "simulate_service_
 
 NOMINAL_FRICTION = {
     "ur10e": ((9.0, 9.0, 7.0, 2.5, 2.5, 2.5), (6.0, 6.0, 4.0, 1.2, 1.2, 1.2)),
-    "tx40": ((6.0, 6.0, 4.0, 1.5, 1.5, 1.0), (8.0, 6.0, 3.0, 1.0, 1.0, 0.8)),
 }
-"""Coulomb [N·m] and viscous [N·m·s/rad] friction per joint of the simulated units (typical of arms of their size;
-the built-in descriptions carry none)."""
+"""Coulomb [N·m] and viscous [N·m·s/rad] friction per joint of the simulated units (typical of an arm of its size;
+the built-in description carries none). Only the UR10e: the logs are written joint side with the description's
+drive gains, and the TX40's description reads motor-side torques through its gear ratios and coupled wrist, which
+these logs do not model (tried: its gains came out meaningless)."""
 
 
 @dataclass(frozen=True)
@@ -170,7 +171,7 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     ----------
     folder : path
         Created if missing.
-    robot : {"ur10e", "tx40"}
+    robot : {"ur10e"}
         Built-in robot the units are.
     units : int
     seconds, validation_seconds : float [s]
@@ -261,7 +262,7 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
     Parameters
     ----------
     folder : path
-    robot : {"ur10e", "tx40"}
+    robot : {"ur10e"}
     days, logs_per_day : int
     seconds : float [s]
         Length of each log.

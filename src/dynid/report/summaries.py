@@ -440,7 +440,7 @@ def fleet_blocks(result) -> list:
                      {True: "yes", False: "no", None: "—"}[table["consistent"][i]],
                      ", ".join(o.parameter for o in result.flagged(uid)) or ("not identified" if table["error"][i] else "")))
     out.append(TextTable("Units: global validation error [%] of each unit's own estimate and of its pooled estimate; worst "
-                         "joint; physically consistent; parameters that stand out (robust z-score against the other units)",
+                         "joint; physically consistent; parameters that stand out (z-score against the other units)",
                          ("unit", "date", "payload kg", "error %", "pooled %", "worst", "consistent", "flags"), tuple(rows)))
     for o in result.outliers[:10]:
         out.append(Line(f"flag: {o}", "warning"))
