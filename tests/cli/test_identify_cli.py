@@ -15,7 +15,8 @@ REPO = Path(__file__).resolve().parents[2]
 def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     root = shared_data("ur10e_mamedov2020")
     out = tmp_path / "ur"
-    p = dynid("identify", str(REPO / "configs" / "ur10e.toml"), "--out", str(out), "--data-root", str(root), env={"COLUMNS": "80"})
+    p = dynid("identify", str(REPO / "configs" / "ur10e.toml"), "--out", str(out), "--data-root", str(root), "--verbose",
+              env={"COLUMNS": "80"})
     assert p.returncode == 0, p.stderr
     assert "Mamedov & Mikhel 2020" in p.stdout and "ptp_10_points" in p.stdout and "error %" in p.stdout
     # an 80-column terminal: every line fits and no number is cut; in a pipe, one progress line per step
@@ -68,7 +69,8 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
 
 def test_identify_tx40(tmp_path):
     root = shared_data("staubli_tx40_figaroh")
-    p = dynid("identify", str(REPO / "configs" / "tx40.toml"), "--out", str(tmp_path / "tx"), "--data-root", str(root))
+    p = dynid("identify", str(REPO / "configs" / "tx40.toml"), "--out", str(tmp_path / "tx"), "--data-root", str(root),
+              "--verbose")
     assert p.returncode == 0, p.stderr
     assert "FIGAROH OLS: dynid's values lie within 1σ / 2σ / 3σ" in p.stdout and "time split" in p.stdout
 
@@ -101,3 +103,20 @@ def test_validate_needs_results_of_the_same_robot(tmp_path):
     assert p.returncode == 1 and "r.json: robot: missing" in p.stderr
     p = dynid("validate", str(cfg), "--results", str(tmp_path / "missing.json"))
     assert p.returncode == 1 and "run dynid identify first" in p.stderr
+
+
+def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
+    """Without --verbose, dynid identify on the UR10e prints its verdict in a screenful: each log's error and worst
+    joint, what the log does not determine, the next step, the verdict; the tables (419 lines at 100 columns before)
+    are behind --verbose and in the report."""
+    root = shared_data("ur10e_mamedov2020")
+    p = dynid("identify", str(REPO / "configs" / "ur10e.toml"), "--out", str(tmp_path / "u"), "--data-root", str(root),
+              "--no-figures", env={"COLUMNS": "100"})
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.strip().splitlines()
+    assert len(lines) < 60, len(lines)
+    text = " ".join(p.stdout.split())
+    assert "In short (every table: --verbose, and report.html)" in text and "Verdict on the model" in text
+    assert "p10: torque error" in text and "next:" in text and "payload, from the loaded run" in text
+    assert "Base parameters" not in text and "RMSE" not in text
+    assert (tmp_path / "u" / "report.html").is_file()

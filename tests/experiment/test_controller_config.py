@@ -56,7 +56,7 @@ def closed_loop_log(tmp_path_factory):
 def test_dynid_identify_runs_idim_iv_and_didim_beside_least_squares(closed_loop_log):
     root, table, truth = closed_loop_log
     _write(root, table)
-    p = dynid_cli("identify", root / "cl.toml", "--out", root / "out", "--no-figures")
+    p = dynid_cli("identify", root / "cl.toml", "--out", root / "out", "--no-figures", "--verbose")
     assert p.returncode == 0, p.stderr
     assert "IDIM-IV" in p.stdout and "DIDIM" in p.stdout  # beside least squares in the parameters table
     estimates = json.loads((root / "out" / "results.json").read_text())["estimates"]

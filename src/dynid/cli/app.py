@@ -219,6 +219,8 @@ def identify(
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     validate: bool = typer.Option(True, help="Also validate on the config's [[validation]] datasets."),
     figures: bool = typer.Option(True, help="Write the torque figures (--no-figures: results.json only)."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every table (parameters, preprocessing, "
+                                                                 "fit and validation per joint); report.html has them too."),
     quiet: bool = QUIET,
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
@@ -240,7 +242,9 @@ def identify(
         return save_identification(identified[1], out, figures, robot=identified[0])
 
     def show(rep, identified, paths):
-        rep.blocks(summary_blocks(identified[1]))
+        from ..report.summaries import identification_brief
+
+        rep.blocks(summary_blocks(identified[1]) if verbose else identification_brief(identified[1]))
         rep.wrote(paths)
 
     _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)

@@ -14,7 +14,7 @@ from ..tables import Line, TextTable, render_text
 from ..validation.torques import comparison_table
 
 __all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
-           "coulomb_choice_table", "drive_gains_blocks", "montecarlo_blocks", "excitation_blocks", "fleet_blocks",
+           "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "excitation_blocks", "fleet_blocks",
            "monitor_blocks"]
 
 
@@ -137,6 +137,31 @@ def identification_blocks(result) -> list:
     out.extend(Line(f.text) for f in r.findings)
     out.extend(Line(w, "warning") for w in r.warnings)
     return out
+
+
+def identification_brief(result) -> list:
+    """What ``dynid identify`` prints without ``--verbose``: the title, how it went and what to do next
+    (:func:`in_short`), the verdict's findings and the warnings; every table is in ``--verbose`` and the report.
+
+    Parameters
+    ----------
+    result : dynid.experiment.identification.IdentificationResult
+
+    Returns
+    -------
+    list of Line
+    """
+    full = identification_blocks(result)
+    short = in_short(result)
+    short[0] = Line("In short (every table: --verbose, and report.html)", "title")
+    r = result
+    verdict = [Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
+                                               if not r.findings else f"{len(r.findings)} finding(s)"), "title"),
+               *(Line(f.text) for f in r.findings)]
+    drive = []
+    if r.drive_gains is not None:
+        drive = [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
+    return [full[0], *short, *drive, *verdict, *(Line(w, "warning") for w in r.warnings)]
 
 
 def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
