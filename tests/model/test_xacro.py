@@ -65,3 +65,9 @@ def test_a_xacro_that_cannot_be_expanded_is_refused_in_one_line(tmp_path, monkey
                                              '<xacro:include filename="$(find ur_description)/urdf/ur.xacro"/></robot>')
     with pytest.raises(ConfigError, match=r"needs a ROS workspace"):
         load_robot(tmp_path / "ros.urdf.xacro")
+
+
+def test_an_unwritable_cache_falls_back_to_the_temporary_folder(tmp_path, monkeypatch):
+    (tmp_path / "not-a-folder").write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "not-a-folder"))
+    assert load_robot(_xacro_of_ur10e(tmp_path)).n_dof == 6

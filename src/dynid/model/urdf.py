@@ -270,7 +270,14 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
         ros = "find" in message or "substitution args" in message or "ament_index" in message or "rospkg" in message
         hint = " (a $(find ...) needs a ROS workspace: write the path relative to the file instead)" if ros else ""
         raise ConfigError(f"{path}: xacro cannot expand it: {message}{hint}") from None
-    cache.mkdir(parents=True, exist_ok=True)
+    try:
+        cache.mkdir(parents=True, exist_ok=True)
+    except OSError:  # an unwritable cache: the system's temporary folder instead
+        import tempfile
+
+        cache = Path(tempfile.gettempdir()) / f"dynid-xacro-{os.getuid() if hasattr(os, 'getuid') else 0}"
+        cache.mkdir(parents=True, exist_ok=True)
+        out = cache / out.name
     tmp = out.with_suffix(f".{os.getpid()}.tmp")
     tmp.write_text(urdf, encoding="utf-8")
     os.replace(tmp, out)
