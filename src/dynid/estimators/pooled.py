@@ -17,16 +17,32 @@ large ``τ²`` and is hardly pooled.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..exceptions import ShapeError
 
-__all__ = ["PooledEstimate", "pooled_estimate", "shared_parameters"]
+__all__ = ["PooledEstimate", "pooled_estimate", "shared_parameters", "own_term"]
 
-OWN_TERMS = ("fc", "fv", "fs", "offset", "vs")
-"""Base parameter names starting with these are each unit's own (friction, current offsets), never pooled."""
+OWN_TERMS = frozenset({"fc", "fv", "fst", "fca", "fcl", "offset"})
+"""Drive terms (:data:`dynid.friction.TERMS`) that are each unit's own (friction, current offsets), never pooled."""
+
+
+def own_term(name: str) -> bool:
+    """Whether a base parameter is a unit's own friction or offset term (``fc3``, ``offset1``; not ``ZZ1R``, ``Ia2``).
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    bool
+    """
+    m = re.fullmatch(r"([a-z]+)\d+", str(name))
+    return m is not None and m.group(1) in OWN_TERMS
 
 
 def shared_parameters(names) -> np.ndarray:
@@ -41,7 +57,7 @@ def shared_parameters(names) -> np.ndarray:
     -------
     (n,) bool ndarray
     """
-    return np.array([not str(n).startswith(OWN_TERMS) for n in names])
+    return np.array([not own_term(n) for n in names])
 
 
 @dataclass(frozen=True)

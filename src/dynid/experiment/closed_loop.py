@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters
-from ..estimators.instrumental import instrumental_variables
+from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
@@ -33,7 +33,6 @@ from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_close
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]
 
-from ..estimators.instrumental import CLOSED_LOOP_METHODS  # noqa: E402  the keys, where a config's parser sees them
 
 LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM"}
 

@@ -47,8 +47,7 @@ class UnitSummary:
     label : str
         That estimate's label.
     validation_error : float [%]
-        Global relative error on the unit's validation logs (their mean), or the held-out error of the fit when it
-        has none (NaN: neither).
+        Global relative error on the unit's validation logs (their mean); NaN for a unit without validation logs.
     joint_errors : (n_dof,) array [%]
         Each joint's relative error on the validation logs (mean over them).
     consistency : str
@@ -138,8 +137,7 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
     if result.validations:
         err, joints = _mean_errors(result.validations, label)
     else:
-        err = float(result.diagnostics.get("held_out_error", np.nan))
-        joints = np.full(unit.config.robot.n_dof, np.nan)
+        err, joints = float("nan"), np.full(unit.config.robot.n_dof, np.nan)
     gains = gains_std = None
     if result.drive_gains is not None:
         gains, gains_std = result.drive_gains.gains.gains, result.drive_gains.gains.gains_std

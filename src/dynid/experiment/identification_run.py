@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import contextlib
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -148,6 +149,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         filters = filters if filters.chose else None
     else:
         data = prepare(recording, config.preprocessing)
+    raw = recording if config.closed_loop else None  # the closed-loop estimators prepare the log themselves
     del recording  # the raw positions and velocities: only the filtered ones are used from here
     vs = config.preprocessing.coulomb_velocity
     if vs == "auto":
@@ -174,7 +176,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
             result = replace(result, drive_gains=gains.result())
     if config.closed_loop:
         step("closed-loop estimators (" + ", ".join(config.closed_loop) + ")")
-        result = _closed_loop(config, robot, base, result)
+        result = _closed_loop(config, robot, base, result, raw)
     result = replace(result, settings={**result.settings, "robot_source": config.robot_source,
                                        "coulomb_velocity": robot.coulomb_velocity.tolist(),
                                        **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
@@ -188,15 +190,15 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     return replace(result, **_main_estimate(result))
 
 
-def _closed_loop(config: IdentificationConfig, robot, base, result):
-    """IDIM-IV / DIDIM beside the other estimates, on the identification log at the control rate (``[controller]``)."""
+def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
+    """IDIM-IV / DIDIM beside the other estimates, on the identification log (``recording``, as read) at the control
+    rate (``[controller]``)."""
     from ..dynamics.rnea import rnea_torques
     from .closed_loop import ClosedLoopExperiment, closed_loop_identify
     from .identification import Estimate
 
     assert config.controller is not None  # the config's parser refuses closed-loop estimators without it
     controller, reference, feedforward = config.controller
-    recording = load_recording(config.identification, config.robot, spool=False)
     q_ref = reference.read()
     if q_ref.shape[0] != recording.t.size:
         raise DataError(f"{reference.file}: {q_ref.shape[0]} rows of set-points, the identification log has "
@@ -204,8 +206,6 @@ def _closed_loop(config: IdentificationConfig, robot, base, result):
     dt = 1.0 / controller.rate
     dq_ref = np.gradient(q_ref, dt, axis=0)
     ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if feedforward else None
-    import time
-
     estimates = dict(result.estimates)
     notes = []
     for key in config.closed_loop:

@@ -32,10 +32,6 @@ from ..validation.change_detection import Cusum
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
            "monitor_logs"]
 
-TERM_NAMES = {"fc": "Coulomb friction", "fv": "viscous friction", "fs": "Stribeck friction", "offset": "current offset",
-              "fa": "asymmetric friction", "fl": "load-dependent friction"}
-"""Plain names of the per-joint terms a monitor follows."""
-
 _DATE = re.compile(r"(\d{4})-(\d{2})-(\d{2})(?:[T_ ](\d{2})[-:](\d{2})(?:[-:](\d{2}))?)?")
 
 
@@ -135,7 +131,10 @@ class DriftAlarm:
         return 100 * (self.value - self.reference) / abs(self.reference) if self.reference else float("inf")
 
     def __str__(self) -> str:
-        kind = TERM_NAMES.get(re.sub(r"\d+$", "", self.term), self.term)
+        from ..friction import TERMS
+
+        term = TERMS.get(re.sub(r"\d+$", "", self.term))
+        kind = term.description.split(",")[0] if term is not None else self.term
         verb = "rose" if self.value > self.reference else "fell"
         return (f"joint {self.joint}: {kind} ({self.term}) {verb} {abs(self.change):.3g} % ({self.reference:.4g} -> "
                 f"{self.value:.4g}) since {self.since_log} at {self.since:.0f} s; alarm in {self.detected_log} at "
@@ -254,7 +253,7 @@ class FrictionMonitor:
     """
 
     def __init__(self, robot, base, params, settings: MonitorSettings = MonitorSettings()):
-        from ..estimators.pooled import OWN_TERMS
+        from ..estimators.pooled import own_term
 
         self.robot, self.base, self.settings = robot, base, settings
         self.params = np.asarray(params, dtype=float)
@@ -262,7 +261,7 @@ class FrictionMonitor:
         self.columns: list[list[int]] = []
         terms, joints = [], []
         for j in range(robot.n_dof):
-            cols = [i for i, nm in enumerate(names) if nm.startswith(OWN_TERMS) and re.fullmatch(rf"[a-z]+{j + 1}", nm)]
+            cols = [i for i, nm in enumerate(names) if own_term(nm) and re.fullmatch(rf"[a-z]+{j + 1}", nm)]
             self.columns.append(cols)
             terms += [names[i] for i in cols]
             joints += [j + 1] * len(cols)
@@ -281,7 +280,7 @@ class FrictionMonitor:
         self.windows: list[MonitorWindow] = []
         self.alarms: list[DriftAlarm] = []
         self.cusum: Cusum | None = None
-        self.mean = self.std = np.full(len(terms), np.nan)
+        self.mean, self.std = np.full(len(terms), np.nan), np.full(len(terms), np.nan)
         self.threshold = float("nan")
         self.elapsed = 0.0  # log time seen [s]
         self.relearn: dict[int, list] = {}

@@ -77,7 +77,8 @@ def _unit_document(template: dict, unit: UnitTable, here: Path, where: str) -> d
     if unit.identification is None:
         raise ConfigError(f"{where}: expected identification (a log, read with the template's columns) or config")
     doc["identification"] = {**doc["identification"], "file": str((here / unit.identification).resolve())}
-    doc["identification"].pop("rows", None), doc["identification"].pop("time_range", None)
+    for key in ("rows", "time_range"):  # the template's rows belong to its own log
+        doc["identification"].pop(key, None)
     if unit.validation:
         maps = template.get("validation") or [template["identification"]]
         doc["validation"] = [{**{k: v for k, v in maps[0].items() if k not in ("rows", "time_range")}, "name": Path(f).stem,

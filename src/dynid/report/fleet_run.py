@@ -58,11 +58,10 @@ def fleet_html(result: FleetResult) -> str:
     -------
     str
     """
-    from ..tables import Line
-    from .summaries import fleet_blocks
+    from .summaries import fleet_verdict
 
     table = result.table()
-    verdict = next(b.text for b in fleet_blocks(result) if isinstance(b, Line))
+    verdict = fleet_verdict(result)
     flagged = {(o.unit, o.parameter) for o in result.outliers}
     columns = list(table)
     head = "".join(f"<th>{html.escape(HEADERS.get(c, c.replace('_std', ' σ')))}</th>" for c in columns)
@@ -89,7 +88,7 @@ tr.flagged td:first-child {{ background: #fde7e7; font-weight: 600; }}
 td.bad {{ background: #f9c9c9; font-weight: 600; }}
 </style></head><body>
 <h1>Fleet: {html.escape(result.manifest.name)}</h1>
-<p class="verdict">{html.escape(verdict.split(": ", 1)[1] if ": " in verdict else verdict)}</p>
+<p class="verdict">{html.escape(verdict)}</p>
 <h2>Units that stand out</h2>
 <p>z-score of each parameter against the other units, with the unit's own σ: against their median and spread where
 they agree within their σ (drive gains, rigid-body parameters), against a prediction interval where they differ by

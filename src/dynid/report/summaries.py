@@ -14,7 +14,7 @@ from ..tables import Line, TextTable, render_text
 from ..validation.torques import comparison_table
 
 __all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
-           "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "excitation_blocks", "fleet_blocks",
+           "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
            "monitor_blocks"]
 
 
@@ -83,8 +83,7 @@ def identification_blocks(result) -> list:
 
     r = result
     sol, base = r.solution, r.base
-    out: list = [Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {base.n_base} base "
-                f"parameters from {r.n_rows} equations, cond = {sol.condition_number:.4g}", "title")]
+    out: list = [_identification_title(r)]
     out.extend(in_short(r))  # how it went and what to do next, first; the details follow
     pre = r.settings.get("preprocessing", {})
     if pre.get("derivation"):
@@ -132,11 +131,20 @@ def identification_blocks(result) -> list:
     for c in (r.fit, *r.validations):
         out.append(comparison_table(c))
         out.extend(Line(f) for f in c.flags())
-    out.append(Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
-                                               if not r.findings else f"{len(r.findings)} finding(s)"), "title"))
-    out.extend(Line(f.text) for f in r.findings)
+    out.extend(_verdict(r))
     out.extend(Line(w, "warning") for w in r.warnings)
     return out
+
+
+def _identification_title(r) -> Line:
+    return Line(f"dynid identify — robot {r.robot}, {r.least_squares.upper()} on {r.fit.name}: {r.base.n_base} base "
+                f"parameters from {r.n_rows} equations, cond = {r.solution.condition_number:.4g}", "title")
+
+
+def _verdict(r) -> list:
+    return [Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
+                                            if not r.findings else f"{len(r.findings)} finding(s)"), "title"),
+            *(Line(f.text) for f in r.findings)]
 
 
 def identification_brief(result) -> list:
@@ -151,17 +159,11 @@ def identification_brief(result) -> list:
     -------
     list of Line
     """
-    full = identification_blocks(result)
-    short = in_short(result)
-    short[0] = Line("In short (every table: --verbose, and report.html)", "title")
     r = result
-    verdict = [Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
-                                               if not r.findings else f"{len(r.findings)} finding(s)"), "title"),
-               *(Line(f.text) for f in r.findings)]
-    drive = []
-    if r.drive_gains is not None:
-        drive = [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
-    return [full[0], *short, *drive, *verdict, *(Line(w, "warning") for w in r.warnings)]
+    short = in_short(r)
+    short[0] = Line("In short (every table: --verbose, and report.html)", "title")
+    drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
+    return [_identification_title(r), *short, *drive, *_verdict(r), *(Line(w, "warning") for w in r.warnings)]
 
 
 def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
@@ -435,6 +437,27 @@ def _cell(value, fmt: str = ".3g") -> str:
     return "—" if value is None or (isinstance(value, float) and not math.isfinite(value)) else format(value, fmt)
 
 
+def fleet_verdict(result) -> str:
+    """How a fleet's identification went, in one sentence: units identified, those that stand out, what pooling did.
+
+    Parameters
+    ----------
+    result : dynid.experiment.fleet.FleetResult
+
+    Returns
+    -------
+    str
+    """
+    ok = {s.id: s for s in result.identified}
+    flagged = sorted({o.unit for o in result.outliers})
+    helped = [u for u, e in result.pooled_errors.items() if e < ok[u].validation_error]
+    return (f"{len(ok)} of {len(result.units)} units identified; "
+            + (f"{len(flagged)} {'stands' if len(flagged) == 1 else 'stand'} out from the fleet: {', '.join(flagged)}"
+               if flagged else "none stands out from the fleet")
+            + (f"; pooling improved {len(helped)} of {len(result.pooled_errors)} units' validation error"
+               if result.pooled_errors else (f"; not pooled: {result.pooled_note}" if result.pooled_note else "")))
+
+
 def fleet_blocks(result) -> list:
     """What ``dynid fleet`` prints: a verdict, then one row per unit (validation error alone and pooled, worst joint,
     consistency, flags) and the flagged parameters.
@@ -448,16 +471,8 @@ def fleet_blocks(result) -> list:
     list of Line and TextTable
     """
     table = result.table()
-    ok, units = result.identified, result.units
-    flagged = sorted({o.unit for o in result.outliers})
-    helped = [u for u, e in result.pooled_errors.items()
-              if e < next(s.validation_error for s in ok if s.id == u)]
-    verdict = (f"{len(ok)} of {len(units)} units identified; "
-               + (f"{len(flagged)} {'stands' if len(flagged) == 1 else 'stand'} out from the fleet: {', '.join(flagged)}"
-                  if flagged else "none stands out from the fleet")
-               + (f"; pooling improved {len(helped)} of {len(result.pooled_errors)} units' validation error"
-                  if result.pooled_errors else (f"; not pooled: {result.pooled_note}" if result.pooled_note else "")))
-    out: list = [Line(f"dynid fleet — {result.manifest.name}: {verdict}", "title")]
+    units = result.units
+    out: list = [Line(f"dynid fleet — {result.manifest.name}: {fleet_verdict(result)}", "title")]
     rows = []
     for i, uid in enumerate(table["unit"]):
         rows.append((uid, table["date"][i] or "—", _cell(table["payload_kg"][i]), _cell(table["validation_error_pct"][i]),

@@ -110,7 +110,6 @@ class Cusum:
         self.up, self.down = np.zeros(channels), np.zeros(channels)
         self.start_up = np.zeros(channels, dtype=int)
         self.start_down = np.zeros(channels, dtype=int)
-        self.sums_up, self.sums_down = np.zeros(channels), np.zeros(channels)
         self.count = 0
         self.history: list[np.ndarray] = []
         self.alarms: list[CusumAlarm] = []
@@ -140,19 +139,14 @@ class Cusum:
         ok = np.isfinite(z)
         zz = np.where(ok, z, 0.0)
         self.history.append(np.where(ok, z, np.nan))
-        for side, sign, starts, sums in ((self.up, 1.0, self.start_up, self.sums_up),
-                                         (self.down, -1.0, self.start_down, self.sums_down)):
-            rest = ok & (side == 0)
-            starts[rest] = i
-            sums[rest] = 0.0
-            value = np.where(ok, np.maximum(0.0, side + sign * zz - self.k), side)
-            sums[ok] += zz[ok]
-            side[:] = value
+        for side, sign, starts in ((self.up, 1.0, self.start_up), (self.down, -1.0, self.start_down)):
+            starts[ok & (side == 0)] = i
+            side[:] = np.where(ok, np.maximum(0.0, side + sign * zz - self.k), side)
             for c in np.nonzero(side > self.h)[0]:
                 since = self._change_point(int(c), int(starts[c]), i)
                 seen = np.array([h[c] for h in self.history[since:i + 1]])
                 new.append(CusumAlarm(int(c), i, since, int(sign), float(np.nanmean(seen))))
-                side[c], sums[c] = 0.0, 0.0
+                side[c] = 0.0
                 starts[c] = i + 1
         self.count += 1
         self.alarms.extend(new)
