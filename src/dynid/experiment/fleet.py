@@ -289,7 +289,7 @@ class FleetResult:
         pooled = None
         if self.pooled is not None:
             names = self.identified[0].names
-            pooled = {"fleet": dict(zip(names, np.nan_to_num(self.pooled.fleet, nan=0.0).tolist())),
+            pooled = {"fleet": {n: float(v) for n, v in zip(names, self.pooled.fleet) if np.isfinite(v)},  # shared ones
                       "unit_to_unit_std": {n: float(s) for n, s in zip(names, self.pooled.spread) if np.isfinite(s)},
                       "shared": [n for n, s in zip(names, self.pooled.shared) if s],
                       "units": {u.id: dict(zip(names, self.pooled.params[i].tolist())) for i, u in enumerate(self.identified)},

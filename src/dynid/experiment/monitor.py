@@ -8,9 +8,10 @@ friction terms are re-identified by least squares (their σ from the window's re
 with forgetting (:mod:`dynid.estimators.recursive`) follows them sample by sample meanwhile. The first
 ``reference_windows`` windows set each term's reference (mean and spread: what the term does when nothing
 changes, temperature and noise included; the spread taken at its upper 95 % confidence bound, since an
-underestimated spread multiplies false alarms); from then on each window's estimate, standardised by the reference, feeds
-a two-sided CUSUM chart per term (:mod:`dynid.validation.change_detection`) whose threshold gives the whole family
-one false alarm per ``false_alarm_days`` days of logs on average. An alarm names the joint and the term, dates the
+underestimated spread multiplies false alarms; windows that did not determine a term, such as a joint that kept one
+direction, left out of its reference). From then on each window's estimate, standardised by the reference spread
+and its own σ, feeds a two-sided CUSUM chart per term (:mod:`dynid.validation.change_detection`) whose threshold
+gives the whole family one false alarm per ``false_alarm_days`` days of logs on average. An alarm names the joint and the term, dates the
 change (log and time), and says how large it is; the term's new level is then learned over the next
 ``reference_windows`` windows and its chart restarts from it, so a wear that goes on raises a new alarm each time it
 has moved as much again.
@@ -30,7 +31,7 @@ from ..exceptions import ConfigError, DataError
 from ..validation.change_detection import Cusum
 
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
-           "monitor_logs"]
+           "monitor_logs", "determined"]
 
 _DATE = re.compile(r"(\d{4})-(\d{2})-(\d{2})(?:[T_ ](\d{2})[-:](\d{2})(?:[-:](\d{2}))?)?")
 
@@ -203,6 +204,32 @@ class MonitorResult:
                              "tracked": dict(zip(self.terms, w.tracked.tolist()))} for w in self.windows]}
 
 
+UNDETERMINED = 3.0
+"""A window's estimate of a term whose σ exceeds this many times the term's median σ over the reference windows did
+not determine it."""
+
+
+def determined(sigmas: np.ndarray) -> np.ndarray:
+    """Which windows determine each term: σ at most :data:`UNDETERMINED` times the term's median σ over the windows.
+
+    Parameters
+    ----------
+    sigmas : (n_windows, n_terms) array
+        Each window's σ of each term (inf where not estimated).
+
+    Returns
+    -------
+    (n_windows, n_terms) bool ndarray
+    """
+    finite = np.where(np.isfinite(sigmas), sigmas, np.nan)
+    with np.errstate(all="ignore"):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.asarray(sigmas <= UNDETERMINED * np.nanmedian(finite, axis=0), dtype=bool)
+
+
 def dated_logs(folder: str | Path, pattern: str = "*.csv") -> list[Path]:
     """The logs of a folder in time order: by the date and time in their names (``2026-01-15T08-30.csv``), else by name.
 
@@ -369,6 +396,9 @@ class FrictionMonitor:
         if count == ref:
             values = np.array([w.theta for w in self.windows])
             sigmas = np.array([w.std for w in self.windows])
+            # a window that did not determine a term (a joint that kept one direction: its Coulomb friction and its
+            # offset are then one column) is left out of that term's reference
+            values = np.where(determined(sigmas), values, np.nan)
             with np.errstate(all="ignore"):
                 import warnings
 
@@ -388,7 +418,8 @@ class FrictionMonitor:
             return []
         assert self.cusum is not None
         w = self.windows[-1]
-        z = (w.theta - self.mean) / self.std
+        # the window's own σ enters, so that a term it determines poorly cannot make a large step of its chart
+        z = (w.theta - self.mean) / np.sqrt(self.std**2 + np.where(np.isfinite(w.std), w.std, np.inf) ** 2)
         for c, seen in list(self.relearn.items()):  # a term that alarmed: its new level learned before its chart restarts
             seen.append(w.theta[c])
             z[c] = np.nan
