@@ -61,7 +61,8 @@ def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
     pooled_half = np.array([half.pooled_errors[u.id] for u in half.units])
     alone_full = np.array([u.validation_error for u in full.units])
     assert np.all(pooled_half < alone_half)
-    # the fleet closes most of the way from half a log to a whole one (measured: 0.70 of the gap, seed 1)
+    # the fleet closes most of the way from half a log to a whole one (measured: 1.53 of the gap here, seed 1: the
+    # pooled half log below the whole log alone for 4 of the 5 units)
     assert np.mean(alone_half - pooled_half) > 0.5 * np.mean(alone_half - alone_full)
     assert not half.outliers and not full.outliers  # no odd unit in this fleet: none flagged
 
