@@ -137,6 +137,29 @@ COLUMN_BLOCK = 16
 took 33 MB off the TX40 identification's peak, with the same numbers, since each column is filtered on its own)."""
 
 
+def edge_padding(rate: float, cutoff: float, order: int) -> int:
+    """Samples the parallel filter pads each end of a log with, by even (mirror) extension: about the filter's
+    settling time, ``order / (2 · cutoff)`` seconds.
+
+    A mirror extension of that length makes the filter's start average the samples near the edge. SciPy's default
+    odd extension of a few samples pivots on the edge sample itself and starts the filter from twice its value: a
+    noisy torque log (a robot in closed loop carries the loop's torque noise) then left one sample's whole noise in
+    the first and last decimated rows (measured: edge spread 102 against 6.9 inside, for white noise through a
+    2.8 Hz filter at 1 kHz). Torques and observation matrix are padded alike, so ``τ = Wβ`` holds on the padded
+    rows as on the others.
+
+    Parameters
+    ----------
+    rate, cutoff : float [Hz]
+    order : int
+
+    Returns
+    -------
+    int
+    """
+    return int(np.ceil(order * rate / (2.0 * cutoff)))
+
+
 def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,
                         order: int = 4, chunk: int = 20_000,
                         cutoff: float | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
@@ -146,7 +169,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     go through the same zero-phase low-pass filter, then every ``factor``-th sample is kept. Chunks
     overlap by a margin so that memory stays bounded by ``chunk`` samples whatever the log's length,
     while the result matches filtering the whole signal at once (to the decay of the filter's
-    transient over the margin).
+    transient over the margin). The log's ends are padded by mirror extension (:func:`edge_padding`).
 
     Parameters
     ----------
@@ -193,7 +216,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
         values = block(lo, hi)
         index = np.arange(start, stop)
         index = index[index % factor == 0]
-        padlen = min(3 * (2 * len(sos) + 1), hi - lo - 1)
+        padlen = min(edge_padding(rate, cutoff, order), hi - lo - 1)
 
         def filtered(v):
             flat = v.reshape(v.shape[0], -1)
@@ -203,7 +226,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
             live = np.flatnonzero(np.any(flat != 0.0, axis=0))
             for c in range(0, live.size, COLUMN_BLOCK):  # column blocks: the filter's copies stay small
                 cols = live[c:c + COLUMN_BLOCK]
-                out[:, cols] = signal.sosfiltfilt(sos, flat[:, cols], axis=0, padlen=padlen)[index - lo]
+                out[:, cols] = signal.sosfiltfilt(sos, flat[:, cols], axis=0, padtype="even", padlen=padlen)[index - lo]
             return out.reshape((index.size,) + v.shape[1:])
 
         yield index, (tuple(filtered(v) for v in values) if isinstance(values, tuple) else filtered(values))
