@@ -9,9 +9,9 @@ FAST = ["--duration", "8", "--rate", "100", "--abc-iterations", "3"]
 
 def test_run_writes_results_and_figures(tmp_path):
     out = tmp_path / "run"
-    p = dynid("run", "--out", str(out), *FAST)
+    p = dynid("run", "--out", str(out), *FAST, "--verbose")
     assert p.returncode == 0, p.stderr
-    assert "ρ (eq. 18)" in p.stdout and "0.3182" in p.stdout
+    assert "ρ (eq. 18)" in p.stdout and "0.3182" in p.stdout and "Base parameters: truth and estimates" in p.stdout
     data = json.loads((out / "results.json").read_text())
     assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
     assert set(data["estimates"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
@@ -48,6 +48,11 @@ def test_methods_subset_without_abc(tmp_path):
     assert names[0] == "simulation and preprocessing" and names[-1] == "writing results and figures"
     assert sorted(names[1:-1]) == ["LAD", "OLS"]  # side by side: in either order
     assert "Estimators:" in p.stdout and "dynid run:" not in p.stdout
+    # without --verbose: the estimators' table and the verdict, not the parameters' and per-joint tables
+    data = json.loads((out / "results.json").read_text())
+    best = min(data["estimates"], key=lambda k: data["estimates"][k]["parameter_error_norm_percent"])
+    assert f"nearest the truth: {best.upper()} (Δβ" in p.stdout and "--verbose" in p.stdout
+    assert "ρ (eq. 18) per joint" not in p.stdout and "truth and estimates" not in p.stdout
 
 
 @pytest.mark.parametrize("signame, code, said", [("SIGINT", 130, "Ctrl-C"), ("SIGTERM", 143, "SIGTERM")])

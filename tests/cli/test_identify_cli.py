@@ -3,6 +3,7 @@
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ..conftest import shared_data
@@ -120,3 +121,13 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     assert "p10: torque error" in text and "next:" in text and "payload, from the loaded run" in text
     assert "Base parameters" not in text and "RMSE" not in text
     assert (tmp_path / "u" / "report.html").is_file()
+    # dynid validate the same way: each log's line, the mean over the logs with the best set, the next step
+    p = dynid("validate", str(REPO / "configs" / "ur10e.toml"), "--results", str(tmp_path / "u" / "results.json"),
+              "--out", str(tmp_path / "v"), "--data-root", str(root), env={"COLUMNS": "100"})
+    assert p.returncode == 0, p.stderr
+    text = " ".join(p.stdout.split())
+    val = json.loads((tmp_path / "v" / "validation.json").read_text())["validation"]
+    means = {name: np.mean([v["metrics"][name]["global_relative_error"] for v in val]) for name in val[0]["metrics"]}
+    assert len(p.stdout.strip().splitlines()) < 40 and "RMSE" not in text and "next:" in text
+    assert f"mean torque error over the {len(val)} logs: " in text and f"best: {min(means, key=means.get)}" in text
+    assert all(f"{name} {m:.3g} %" in text for name, m in means.items())

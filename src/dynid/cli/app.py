@@ -185,6 +185,8 @@ def run(
     bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
     strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
     figures: bool = typer.Option(True, help="Write the figures (--no-figures: results.json only)."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every table (parameters, per joint, bootstrap); "
+                                                                 "report.html has them too."),
     quiet: bool = QUIET,
 ) -> None:
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
@@ -209,7 +211,13 @@ def run(
         return run_paper_experiment(config, progress=lambda k, i, f: progress.update(
             label(k), "" if i is None else f"iteration {i}, best F = {f:.4g}"))
 
-    _Command("dynid run", quiet, out, figures).run(prepare, compute, lambda result: save_paper_run(result, out, figures))
+    def show(rep, result, paths):
+        from ..report.paper_summary import run_summary_blocks
+
+        rep.blocks(run_summary_blocks(result, verbose))
+        rep.wrote(paths)
+
+    _Command("dynid run", quiet, out, figures).run(prepare, compute, lambda result: save_paper_run(result, out, figures), show)
 
 
 @app.command()
@@ -363,6 +371,8 @@ def validate(
     rows: Optional[str] = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
     out: Path = typer.Option(Path("dynid-validate"), help="Output folder for validation.json and figures."),
     data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every log's table (error, RMSE and ρ per joint "
+                                                                 "and parameter set); report.html has them too."),
     quiet: bool = QUIET,
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
@@ -388,10 +398,11 @@ def validate(
         return save_validation(validated[0], out, validated[1])
 
     def show(rep, validated, paths):
-        from ..report.summaries import validation_in_short
+        from ..report.summaries import validation_in_short, validation_verdict
 
         comparisons, warnings = validated
-        rep.blocks([*validation_in_short(comparisons), *(comparison_table(c) for c in comparisons)])
+        tables = [comparison_table(c) for c in comparisons] if verbose else []
+        rep.blocks([*validation_in_short(comparisons, tables_follow=verbose), *tables, *validation_verdict(comparisons)])
         for w in warnings:
             rep.warning(w)
         rep.wrote(paths)
@@ -466,11 +477,24 @@ def init(
     _Command("dynid init", quiet).run(prepare, compute, save, show)
 
 
-def _parse_levels(text: str):
+def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", example: str = "0.02,0.05,0.1"):
     try:
         return tuple(float(x) for x in text.split(","))
     except ValueError:
-        raise DynIdError(f"--noise-levels: expected comma-separated current noise levels in A like 0.02,0.05,0.1, got {text!r}") from None
+        raise DynIdError(f"{option}: expected comma-separated noise levels in {unit} like {example}, got {text!r}") from None
+
+
+def _closed_loop_estimators(text: Optional[str]) -> tuple[str, ...]:
+    """The estimators of a closed-loop study: the open-loop ones checked by the registry, IDIM-IV and DIDIM beside."""
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
+    from ..estimators.registry import parse_estimators
+    from ..experiment.closed_loop_study import CLOSED_LOOP_ESTIMATORS
+
+    if text is None:
+        return CLOSED_LOOP_ESTIMATORS
+    keys = [k.strip().lower() for k in text.split(",")]
+    parse_estimators([k for k in keys if k not in CLOSED_LOOP_METHODS] or ["wls"])
+    return tuple(keys)
 
 
 @app.command()
@@ -480,14 +504,20 @@ def montecarlo(
     noise_levels: str = typer.Option("0.02,0.05,0.1", help="Motor current noise standard deviations [A], comma separated."),
     realisations: int = typer.Option(100, help="Noise realisations per level."),
     estimators: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
-                                                        "any registered, or all (default: ols,wls,irls,lad,sdp,abc)."),
+                                                        "any registered, or all (default: ols,wls,irls,lad,sdp,abc); with --closed-loop also idim-iv, didim (default: all eight)."),
     methods: Optional[str] = typer.Option(None, hidden=True),
     seed: int = typer.Option(0, help="Seed of every random number of the study."),
     duration: float = typer.Option(25.0, help="Recording length [s]."),
-    rate: float = typer.Option(200.0, help="Sampling rate [Hz] (the paper: 1000)."),
+    rate: Optional[float] = typer.Option(None, help="Sampling rate [Hz] (default 200; 1000 in closed loop, the control rate; the paper: 1000)."),
     abc_bounds: str = typer.Option("scaled", help="Search box of ABC/DE/PSO/LAD: scaled (±(2|β_OLS|+1), holds the truth) or table3."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized, or an excitation.json."),
     strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
+    closed_loop: bool = typer.Option(False, "--closed-loop", help="Simulate the robot under its own PID (the loop sees the noisy positions) on the "
+                                                                  "noise grid of Leboutet et al. 2021, and fit IDIM-IV and DIDIM beside the others."),
+    encoder_noise: str = typer.Option("1e-4,1e-3,1e-2", help="Closed loop: encoder noise standard deviations [°], comma separated."),
+    torque_noise: str = typer.Option("0.05,0.1", help="Closed loop: torque noise standard deviations [N·m], comma separated."),
+    band: Optional[float] = typer.Option(None, help="Closed loop: the excitation band [Hz] given to the preprocessing (default: derived from each log)."),
+    bandwidth: float = typer.Option(5.0, help="Closed loop: the PID's bandwidth [Hz]."),
     scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); default: a LocalCluster of this machine's cores."),
     workers: Optional[int] = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
     out: Path = typer.Option(Path("dynid-montecarlo"), help="Output folder for montecarlo.json, the estimates CSV and figures."),
@@ -500,10 +530,21 @@ def montecarlo(
 
     def prepare():
         _renamed(methods)
-        config = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
-                                  estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
-                                  rate=rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
-        config.validate()  # every option checked before the workers start
+        if closed_loop:
+            from ..experiment.closed_loop_study import ClosedLoopStudyConfig
+
+            study = ClosedLoopStudyConfig(robot=robot, joints=joints, encoder_noise=_parse_levels(encoder_noise, "--encoder-noise", "°", "1e-4,1e-3,1e-2"),
+                                          torque_noise=_parse_levels(torque_noise, "--torque-noise", "N·m", "0.05,0.1"),
+                                          realisations=realisations, estimators=_closed_loop_estimators(estimators), seed=seed,
+                                          duration=duration, rate=1000.0 if rate is None else rate, bandwidth=bandwidth, band=band,
+                                          excitation=excitation)
+            study.validate()
+            config = study
+        else:
+            config = MonteCarloConfig(robot=robot, joints=joints, noise_levels=_parse_levels(noise_levels), realisations=realisations,
+                                      estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
+                                      rate=200.0 if rate is None else rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
+            config.validate()  # every option checked before the workers start
         from ..extras import require
 
         require("distributed", "montecarlo", "dynid montecarlo")
@@ -511,10 +552,21 @@ def montecarlo(
 
     def compute(cfg, progress):
         progress.update("starting the workers")
-        return run_montecarlo(cfg, scheduler=scheduler, workers=workers,
-                              progress=lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}"))
+        report = lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}")  # noqa: E731
+        if closed_loop:
+            from ..experiment.closed_loop_study import run_closed_loop_study
 
-    _Command("dynid montecarlo", quiet, out).run(prepare, compute, lambda result: save_montecarlo(result, out))
+            return run_closed_loop_study(cfg, scheduler=scheduler, workers=workers, progress=report)
+        return run_montecarlo(cfg, scheduler=scheduler, workers=workers, progress=report)
+
+    def save(result):
+        if closed_loop:
+            from ..report.montecarlo_run import save_closed_loop_study
+
+            return save_closed_loop_study(result, out)
+        return save_montecarlo(result, out)
+
+    _Command("dynid montecarlo", quiet, out).run(prepare, compute, save)
 
 
 @app.command()

@@ -282,8 +282,33 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
                                                    f"10× grid: {g['feasible']}"]), Section("Constraints", [margins])]
 
 
+def closed_loop_sections(d: dict) -> tuple[dict, list[Section]]:
+    """Settings, the verdict and the table of ``dynid montecarlo --closed-loop``.
+
+    Parameters
+    ----------
+    d : dict
+        The study's montecarlo.json.
+
+    Returns
+    -------
+    settings : dict
+        Setting -> value shown at the top.
+    sections : list of Section
+    """
+    from .summaries import closed_loop_study_rows, closed_loop_verdict
+
+    settings, _ = generic_sections(d)
+    headers, rows, _ = closed_loop_study_rows(d)
+    flagged = {(i, 6) for i, r in enumerate(rows) if r[6] != "—" and not 90 <= float(r[6].split()[0]) <= 99}
+    return settings, [Section("Estimators on the noise grid", [Table(
+        "Per cell and estimator: medians over the base parameters of |bias|/|β| and spread/|β| (%), and in units of "
+        "√CRB; the share of 95 % intervals that hold the truth (flagged outside 90-99 %)", list(headers),
+        [list(r) for r in rows], (0, 1), flagged)], closed_loop_verdict(d))]
+
+
 SECTIONS = {"identify": identify_sections, "validate": identify_sections, "run": run_sections,
-            "excite": excite_sections, "montecarlo": generic_sections}
+            "excite": excite_sections, "montecarlo": generic_sections, "montecarlo_closed_loop": closed_loop_sections}
 
 
 def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], title: str) -> None:

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..estimators.registry import label
+from ..experiment.closed_loop_study import ClosedLoopStudyResult
 from ..experiment.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures
@@ -59,4 +60,43 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
     write_results(paths[0], data, "montecarlo")
     write_html_report(out / "report.html", data, "montecarlo", paths[2:], "dynid montecarlo")
     paths.insert(2, out / "report.html")
+    return paths
+
+
+@staged
+def save_closed_loop_study(result: ClosedLoopStudyResult, out: str | Path) -> list[Path]:
+    """Write ``montecarlo.json``, ``montecarlo_estimates.csv`` (every estimate with its σ) and ``report.html`` of a
+    closed-loop study.
+
+    Parameters
+    ----------
+    result : ClosedLoopStudyResult
+    out : str or Path
+        Output folder.
+
+    Returns
+    -------
+    list of Path
+        Files written.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    out = output_folder(out)
+    paths = [out / "montecarlo.json", out / "montecarlo_estimates.csv", out / "report.html"]
+    buf = io.StringIO()
+    buf.write(",".join(["encoder_noise_deg", "torque_noise_Nm", "realisation", "estimator", "converged", *result.names,
+                        *(f"std_{n}" for n in result.names)]) + "\n")
+    for c, (encoder, torque) in enumerate(result.config.cells):
+        for r in range(result.estimates.shape[1]):
+            for m, key in enumerate(result.config.estimators):
+                values = (*result.estimates[c, r, m], *result.std[c, r, m])
+                buf.write(f"{encoder:g},{torque:g},{r},{key},{int(result.converged[c, r, m])}," +
+                          ",".join(f"{v:.10g}" for v in values) + "\n")
+    atomic_write_text(paths[1], buf.getvalue())
+    data = result.to_dict()
+    write_results(paths[0], data, "montecarlo")
+    write_html_report(paths[2], data, "montecarlo_closed_loop", [], "dynid montecarlo --closed-loop")
     return paths

@@ -14,12 +14,15 @@ def _joined(values, fmt: str) -> str:
     return " / ".join(format(v, fmt) for v in values)
 
 
-def run_summary_blocks(result) -> list:
+def run_summary_blocks(result, verbose: bool = True) -> list:
     """Blocks of a paper run's summary.
 
     Parameters
     ----------
     result : PaperRunResult
+    verbose : bool
+        Every table (the parameters, per joint, the bootstrap's); else the estimators' table and the verdict, which
+        ``dynid run`` prints without ``--verbose``.
 
     Returns
     -------
@@ -40,8 +43,9 @@ def run_summary_blocks(result) -> list:
         sym = d["paper_symbols"][n]
         rows.append((f"{n} ({sym})" if sym else n, f"{d['truth'][n]:.4g}", *(f"{m['params'][n]:.4g}" for m in methods.values()),
                      f"{ref.TABLE2[sym]:.4g}" if sym in ref.TABLE2 else ""))
-    out.append(TextTable("Base parameters: truth and estimates (units in results.json)",
-                         ("name (paper)", "truth", *methods, "Table 2"), tuple(rows), labels=2))
+    if verbose:
+        out.append(TextTable("Base parameters: truth and estimates (units in results.json)",
+                             ("name (paper)", "truth", *methods, "Table 2"), tuple(rows), labels=2))
     rows = [(label, f"{m['objective']:.4g}", str(m["n_evaluations"]) if m["n_evaluations"] else "—", f"{m['seconds']:.1f}",
              f"{m['parameter_error_norm_percent']:.3g}",
              *(f"{sum(m[k]['validation']) / cfg.joints:{f}}" for k, f in (("correlation", ".4f"), ("rmse", ".3g"), ("relative_error", ".3g"))),
@@ -56,15 +60,16 @@ def run_summary_blocks(result) -> list:
         out.append(Line("LAD, ABC, DE and PSO search the box ±(2|β_OLS| + 1), which holds the truth"
                         + (" (the paper's Table 3 box holds the paper's plant, not this one: --plant paper, or "
                            "--abc-bounds table3)" if cfg.robot == "er16" and cfg.joints == 3 else "")))
-    for key, beta, paper_vals in (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
-                                  ("validation", "β2", ref.CORRELATION_VALIDATION)):
+    per_joint = (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
+                 ("validation", "β2", ref.CORRELATION_VALIDATION)) if verbose else ()
+    for key, beta, paper_vals in per_joint:
         for metric, title, fmt in (("correlation", "correlation coefficient ρ (eq. 18)", ".4f"), ("relative_error", "relative error %", ".3g")):
             rows = [(label, *(format(x, fmt) for x in m[metric][key])) for label, m in methods.items()]
             if metric == "correlation":
                 rows.append(("paper (ABC)", *(f"{paper_vals[j]:.4f}" if j < len(paper_vals) else "—" for j in range(cfg.joints))))
             out.append(TextTable(f"{key.capitalize()} trajectory {beta}: {title} per joint", ("method", *(f"J{j + 1}" for j in range(cfg.joints))),
                                  tuple(rows)))
-    out.extend(_uncertainty_blocks(d, methods))
+    out.extend(b for b in _uncertainty_blocks(d, methods) if verbose or isinstance(b, Line))
     if "sdp" in d["estimates"]:
         eig = d["estimates"]["sdp"]["pseudo_inertia_min_eig"]
         verdict = "physically consistent" if min(eig) >= -CONSISTENCY_TOL else "NOT physically consistent"
@@ -73,7 +78,28 @@ def run_summary_blocks(result) -> list:
                     f"(feasibility SDP; the truth's margin is {d['truth_consistency_margin']:.3g})"))
     out.append(Line("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in d["timings"].items())))
     out.extend(Line(w, "warning") for w in d["warnings"])
+    out.extend(_verdict(d, methods, verbose))
     return out
+
+
+def _verdict(d: dict, methods: dict, verbose: bool) -> list:
+    """The run's last lines: the estimator nearest the truth, where the paper's ABC budget stands, where the rest is."""
+    best = min(methods, key=lambda k: methods[k]["parameter_error_norm_percent"])
+    b = methods[best]
+    text = (f"nearest the truth: {best} (Δβ {b['parameter_error_norm_percent']:.3g} %, error {_mean(b['relative_error']['validation']):.3g} % "
+            f"on the validation trajectory β2)")
+    abc = next((m for k, m in d["estimates"].items() if k == "abc"), None)
+    if abc is not None:
+        text += (f"; the paper's ABC budget: Δβ {abc['parameter_error_norm_percent']:.3g} %, ρ on β2 "
+                 f"{_mean(abc['correlation']['validation']):.4f} (the paper's: {sum(ref.CORRELATION_VALIDATION) / 3:.4f})")
+    out = [Line(text, "title")]
+    if not verbose:
+        out.append(Line("the parameters and per-joint tables: --verbose, and report.html"))
+    return out
+
+
+def _mean(values) -> float:
+    return sum(values) / len(values)
 
 
 def _uncertainty_blocks(d: dict, methods: dict) -> list:

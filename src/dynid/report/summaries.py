@@ -14,7 +14,7 @@ from ..tables import Line, TextTable, render_text
 from ..validation.torques import comparison_table
 
 __all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
-           "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
+           "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "closed_loop_study_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
            "monitor_blocks"]
 
 
@@ -55,12 +55,14 @@ def blocks(result) -> list:
     from ..experiment.fleet import FleetResult
     from ..experiment.monitor import MonitorResult
     from ..experiment.identification import IdentificationResult
+    from ..experiment.closed_loop_study import ClosedLoopStudyResult
     from ..experiment.montecarlo import MonteCarloResult
     from ..experiment.paper import PaperRunResult
     from .paper_summary import run_summary_blocks
 
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
-                       (MonteCarloResult, montecarlo_blocks), (ExcitationRun, excitation_blocks),
+                       (MonteCarloResult, montecarlo_blocks), (ClosedLoopStudyResult, closed_loop_study_blocks),
+                       (ExcitationRun, excitation_blocks),
                        (FleetResult, fleet_blocks), (MonitorResult, monitor_blocks)):
         if isinstance(result, kind):
             return make(result)
@@ -189,19 +191,21 @@ def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
     return j, float(rel[j])
 
 
-def validation_in_short(comparisons) -> list:
+def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
     meaningful joint, the best set named.
 
     Parameters
     ----------
     comparisons : sequence of dynid.validation.torques.TorqueComparison
+    tables_follow : bool
+        The title says the tables follow (``--verbose``), or where they are.
 
     Returns
     -------
     list of Line
     """
-    out = [Line("In short (the tables follow)", "title")]
+    out = [Line("In short (the tables follow)" if tables_follow else "In short (every table: --verbose, and report.html)", "title")]
     for c in comparisons:
         metrics, ok = c.metrics(), c.meaningful()
         parts = []
@@ -211,6 +215,38 @@ def validation_in_short(comparisons) -> list:
         best = min(metrics, key=lambda k: metrics[k]["global_relative_error"]) if metrics else None
         out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
                         + ("" if best is None or len(metrics) < 2 else f"; best: {best}")))
+    return out
+
+
+def validation_verdict(comparisons) -> list:
+    """The last lines of ``dynid validate``: each parameter set's mean torque error over the logs, the set to use and
+    the next step.
+
+    Parameters
+    ----------
+    comparisons : sequence of dynid.validation.torques.TorqueComparison
+
+    Returns
+    -------
+    list of Line
+    """
+    errors: dict[str, list[float]] = {}
+    for c in comparisons:
+        for name, m in c.metrics().items():
+            errors.setdefault(name, []).append(m["global_relative_error"])
+    if not errors:
+        return []
+    means = {name: float(np.mean(v)) for name, v in errors.items()}
+    best = min(means, key=lambda k: means[k])
+    n = len(comparisons)
+    out = [Line(f"mean torque error over the {n} log{'s' if n > 1 else ''}: "
+                + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
+                + (f" — best: {best}" if len(means) > 1 else ""), "title")]
+    if not best.startswith("dynid"):
+        out.append(Line(f"next: {best} predicts these logs better than dynid's estimates; identify on a log that moves "
+                        "as these do, or add them to [[validation]] to choose among the estimates"))
+    else:
+        out.append(Line("next: dynid export writes the estimate as URDF/MJCF for your controller or simulator"))
     return out
 
 
@@ -396,6 +432,101 @@ def montecarlo_blocks(result) -> list:
                      tuple(rows), labels=2, section_ends=frozenset(ends))]
     if result.errors:
         out.append(Line(f"{len(result.errors)} fits failed; the first: {result.errors[0]['error']}", "warning"))
+    return out
+
+
+def _percent(x) -> str:
+    return "—" if x is None else f"{100 * x:.3g}"
+
+
+def _ratio(x) -> str:
+    return "—" if x is None else f"{x:.3g}"
+
+
+def closed_loop_study_rows(data: dict) -> tuple[tuple[str, ...], list[tuple[str, ...]], set[int]]:
+    """The table of a closed-loop study, one row per cell and estimator, from its ``montecarlo.json`` data.
+
+    Parameters
+    ----------
+    data : dict
+        :meth:`dynid.experiment.closed_loop_study.ClosedLoopStudyResult.to_dict`.
+
+    Returns
+    -------
+    headers : tuple of str
+    rows : list of tuple of str
+    ends : set of int
+        The last row of each cell.
+    """
+    n = data["settings"]["realisations"]
+    headers: tuple[str, ...] = ("noise", "estimator", "|bias| %", "spread %", "|b|/√CRB", "σ/√CRB", "cover", "fitted", "s/fit")
+    rows: list[tuple[str, ...]] = []
+    ends: set[int] = set()
+    for cell in data["cells"]:
+        for est in cell["estimators"].values():
+            rows.append((f"{cell['encoder_noise_deg']:g}° {cell['torque_noise_Nm']:g} N·m", str(est["label"]),
+                         _percent(est["median_relative_bias"]), _percent(est["median_relative_spread"]),
+                         _ratio(est["median_bias_over_crb"]), _ratio(est["median_spread_over_crb"]),
+                         "—" if est["coverage_95"] is None else f"{100 * est['coverage_95']:.0f} %",
+                         f"{est['converged']}/{n}", _ratio(est["seconds_median"])))
+        ends.add(len(rows) - 1)
+    return headers, rows, ends
+
+
+def closed_loop_verdict(data: dict) -> list[str]:
+    """The study's verdict in a few lines: per cell, the estimator nearest the Cramér–Rao bound, and how least squares
+    fares against IDIM-IV and DIDIM at the highest encoder noise.
+
+    Parameters
+    ----------
+    data : dict
+        :meth:`dynid.experiment.closed_loop_study.ClosedLoopStudyResult.to_dict`.
+
+    Returns
+    -------
+    list of str
+    """
+    out = []
+    best = [f"{c['encoder_noise_deg']:g}°/{c['torque_noise_Nm']:g} N·m: {label(c['best'])}" for c in data["cells"] if c["best"]]
+    if best:
+        out.append("smallest RMSE against the Cramér–Rao bound per cell — " + "; ".join(best))
+    worst = max(c["encoder_noise_deg"] for c in data["cells"])
+    for cell in (c for c in data["cells"] if c["encoder_noise_deg"] == worst):
+        ests = cell["estimators"]
+        ls = next((k for k in ("ols", "wls") if k in ests and ests[k]["median_relative_bias"] is not None), None)
+        closed = [k for k in ("idim-iv", "didim") if k in ests and ests[k]["median_relative_bias"] is not None]
+        if ls and closed:
+            out.append(f"at {worst:g}° and {cell['torque_noise_Nm']:g} N·m: median |bias| {label(ls)} "
+                       f"{_percent(ests[ls]['median_relative_bias'])} %, " + ", ".join(
+                           f"{label(k)} {_percent(ests[k]['median_relative_bias'])} %" for k in closed))
+    return out
+
+
+def closed_loop_study_blocks(result) -> list:
+    """What ``dynid montecarlo --closed-loop`` prints: bias, spread and coverage per cell of the grid and estimator.
+
+    Parameters
+    ----------
+    result : dynid.experiment.closed_loop_study.ClosedLoopStudyResult
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    cfg, data = result.config, result.to_dict()
+    headers, rows, ends = closed_loop_study_rows(data)
+    band = "derived from each log" if cfg.band is None else f"{cfg.band:g} Hz given"
+    out: list = [Line(f"dynid montecarlo, closed loop — robot {cfg.robot}, joints 1-{cfg.joints}, {len(result.names)} base "
+                      f"parameters, {cfg.realisations} realisations × {len(cfg.cells)} cells, {cfg.duration:g} s at "
+                      f"{cfg.rate:g} Hz under a PID of {cfg.bandwidth:g} Hz, excitation band {band}; ran on {result.cluster} "
+                      f"in {result.timings.get('total', float('nan')):.1f} s", "title"),
+                 TextTable("Per cell (encoder σ, torque σ) and estimator: medians over the base parameters of |bias|/|β| and "
+                           "spread/|β| (%) and in units of √CRB (torque noise, exact motion); share of 95 % intervals "
+                           "holding the truth (— : no σ); fits converged; median s per fit",
+                           headers, tuple(rows), labels=2, section_ends=frozenset(ends))]
+    out += [Line(text) for text in closed_loop_verdict(data)]
+    if result.errors:
+        out.append(Line(f"{len(result.errors)} fits failed or did not converge; the first: {result.errors[0]['error']}", "warning"))
     return out
 
 
