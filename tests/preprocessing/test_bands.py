@@ -6,7 +6,7 @@ from scipy import signal
 
 from dynid.exceptions import ConfigError
 from dynid.preprocessing.bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, estimate_band, excitation_band
-from dynid.preprocessing.filters import decimation_cutoff, parallel_decimation
+from dynid.preprocessing.filters import decimation_cutoff, edge_padding, parallel_decimation
 from dynid.preprocessing.pipeline import Preprocessing
 
 
@@ -94,7 +94,7 @@ def test_parallel_filter_without_decimation_equals_scipy(rng):
     parts = list(parallel_decimation(lambda a, b: x[a:b], x.shape[0], rate, 1, chunk=3000, cutoff=cutoff))
     values = np.concatenate([v for _, v in parts])
     sos = signal.butter(4, cutoff, fs=rate, output="sos")
-    whole = signal.sosfiltfilt(sos, x, axis=0, padlen=3 * (2 * len(sos) + 1))
+    whole = signal.sosfiltfilt(sos, x, axis=0, padtype="even", padlen=edge_padding(rate, cutoff, 4))
     np.testing.assert_allclose(values, whole, rtol=0, atol=1e-8 * np.abs(whole).max())
     with pytest.raises(ConfigError, match="aliases when decimating by 10"):
         list(parallel_decimation(lambda a, b: x[a:b], x.shape[0], rate, 10, cutoff=100.0))
