@@ -426,9 +426,7 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
         Invalid settings, an unreachable scheduler, or Dask not installed.
     """
     require("distributed", "montecarlo", "dynid montecarlo --closed-loop")
-    from distributed import as_completed
-
-    from .montecarlo import dask_client
+    from .montecarlo import map_realisations
 
     t0 = time.perf_counter()
     setup = _prepare(config)
@@ -438,19 +436,14 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
     converged = np.zeros((len(cells), n_real, n_methods), dtype=bool)
     seconds = np.zeros((len(cells), n_real, n_methods))
     errors = []
-    with dask_client(scheduler, workers, what="dynid montecarlo --closed-loop") as client:
-        cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
-        shared = client.scatter(setup, broadcast=True)
-        futures = {client.submit(simulate_realisation, shared, c, r, pure=False): (c, r)
-                   for c in range(len(cells)) for r in range(n_real)}
-        for done, fut in enumerate(as_completed(futures), start=1):
-            c, r = futures[fut]
-            out = fut.result()
-            estimates[c, r], std[c, r], converged[c, r], seconds[c, r] = out["params"], out["std"], out["converged"], out["seconds"]
-            errors += [{"encoder_noise_deg": cells[c][0], "torque_noise_Nm": cells[c][1], "realisation": r, "estimator": k,
-                        "error": msg} for k, msg in out["errors"].items()]
-            if progress is not None:
-                progress(done, len(futures))
+    def store(key, out):
+        c, r = key
+        estimates[c, r], std[c, r], converged[c, r], seconds[c, r] = out["params"], out["std"], out["converged"], out["seconds"]
+        errors.extend({"encoder_noise_deg": cells[c][0], "torque_noise_Nm": cells[c][1], "realisation": r, "estimator": k,
+                       "error": msg} for k, msg in out["errors"].items())
+
+    cluster = map_realisations(simulate_realisation, setup, [(c, r) for c in range(len(cells)) for r in range(n_real)],
+                               store, scheduler, workers, "dynid montecarlo --closed-loop", progress)
     crb_std = np.sqrt(np.outer(np.array([s for _, s in cells]) ** 2, np.diag(setup.unit_crb)))
     errors.sort(key=lambda e: (e["encoder_noise_deg"], e["torque_noise_Nm"], e["realisation"], e["estimator"]))
     return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, estimates, std, converged, seconds, crb_std,

@@ -353,6 +353,51 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         yield client
 
 
+def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], store: Callable, scheduler: str | None = None,
+                     workers: int | None = None, what: str = "dynid montecarlo",
+                     progress: Callable[[int, int], None] | None = None) -> str:
+    """Run ``function(setup, *key)`` for every key on a Dask cluster, ``setup`` sent once to every worker, and hand each
+    result to ``store(key, result)`` as it arrives.
+
+    Parameters
+    ----------
+    function : callable
+        ``function(setup, i, j) -> result``, seeding its own generators from its arguments.
+    setup : object
+        What every task shares.
+    keys : list of (int, int)
+    store : callable
+        ``store(key, result)``, called in the order the tasks finish.
+    scheduler, workers :
+        As :func:`dask_client`.
+    what : str
+        The command, for the message when Dask is missing.
+    progress : callable, optional
+        ``progress(done, total)``.
+
+    Returns
+    -------
+    str
+        The cluster the tasks ran on.
+
+    Raises
+    ------
+    ConfigError
+        From :func:`dask_client`.
+    """
+    from distributed import as_completed
+
+    with dask_client(scheduler, workers, what=what) as client:
+        cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
+        shared = client.scatter(setup, broadcast=True)
+        futures = {client.submit(function, shared, *key, pure=False): key for key in keys}
+        for done, fut in enumerate(as_completed(futures), start=1):
+            store(futures[fut], fut.result())
+            if progress is not None:
+                progress(done, len(futures))
+    return cluster
+
+
 def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: str | None = None,
                    workers: int | None = None, progress: Callable[[int, int], None] | None = None) -> MonteCarloResult:
     """Run the Monte Carlo study on a Dask cluster (a LocalCluster of the local cores by default).
@@ -377,29 +422,20 @@ def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: 
         Invalid settings or an unreachable scheduler.
     """
     require("distributed", "montecarlo", "dynid montecarlo")
-    from distributed import as_completed
-
     t0 = time.perf_counter()
     setup = _prepare(config)
     n_levels, n_real, n_methods = len(config.noise_levels), config.realisations, len(config.estimators)
     estimates = np.full((n_levels, n_real, n_methods, setup.base.n_base), np.nan)
     seconds = np.zeros((n_levels, n_real, n_methods))
     errors = []
-    with dask_client(scheduler, workers) as client:
-        cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
-        shared = client.scatter(setup, broadcast=True)
-        futures = {client.submit(simulate_realisation, shared, li, r, pure=False): (li, r)
-                   for li in range(n_levels) for r in range(n_real)}
-        done = 0
-        for fut in as_completed(futures):
-            li, r = futures[fut]
-            out = fut.result()
-            estimates[li, r], seconds[li, r] = out["params"], out["seconds"]
-            errors += [{"noise_level_A": float(config.noise_levels[li]), "realisation": r, "method": k, "error": msg}
-                       for k, msg in out["errors"].items()]
-            done += 1
-            if progress is not None:
-                progress(done, len(futures))
+    def store(key, out):
+        li, r = key
+        estimates[li, r], seconds[li, r] = out["params"], out["seconds"]
+        errors.extend({"noise_level_A": float(config.noise_levels[li]), "realisation": r, "method": k, "error": msg}
+                      for k, msg in out["errors"].items())
+
+    cluster = map_realisations(simulate_realisation, setup, [(li, r) for li in range(n_levels) for r in range(n_real)],
+                               store, scheduler, workers, progress=progress)
     crb_std = np.sqrt(np.outer(np.asarray(config.noise_levels, dtype=float) ** 2, np.diag(setup.unit_crb)))
     errors.sort(key=lambda e: (e["noise_level_A"], e["realisation"], e["method"]))
     return MonteCarloResult(config, tuple(setup.base.names), setup.truth, estimates, seconds, crb_std, errors,
