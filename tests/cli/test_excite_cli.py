@@ -38,6 +38,10 @@ def test_excite_ur10e_satisfies_every_constraint_on_a_10x_finer_grid(tmp_path):
     doc = json.loads((out / "excitation.json").read_text())
     assert doc["trajectory"]["form"] == "swevers" and doc["design"]["feasible"]
     assert doc["design"]["cond"] < doc["design"]["initial_cond"]
+    # the verdict closes the output: the conditioning before and after, the constraints, the next step
+    text = " ".join(p.stdout.split())
+    assert f"cond(W_base) {doc['design']['initial_cond']:.2f} → {doc['design']['cond']:.2f}" in text
+    assert "every constraint holds" in text and "next: play excitation.csv on the robot" in text
     traj = load_trajectory(out / "excitation.json")
     config = load_excitation_config(cfg)
     lim, ws = config.problem.limits, config.problem.workspace

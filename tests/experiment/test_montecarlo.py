@@ -83,3 +83,14 @@ def test_scheduler_address_path_gives_the_same_study(study):
         remote = run_montecarlo(MonteCarloConfig(**{**SMALL.__dict__, "realisations": 2}), scheduler=cluster.scheduler_address)
     assert cluster.scheduler_address in remote.cluster
     np.testing.assert_array_equal(remote.estimates, study.estimates[:, :2])
+
+
+def test_the_summary_names_the_estimator_nearest_the_bound_at_each_level(study):
+    from dynid.report.summaries import summary
+
+    text = " ".join(summary(study, 200).split())
+    stats = study.statistics()
+    for li, level in enumerate(SMALL.noise_levels):
+        scores = {k: np.nanmedian(stats[k]["rmse"][li] / study.crb_std[li]) for k in SMALL.estimators}
+        best = min(scores, key=scores.get)
+        assert f"{level:g} A: {best.upper()} ({scores[best]:.3g}× √CRB)" in text

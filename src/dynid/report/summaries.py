@@ -430,6 +430,12 @@ def montecarlo_blocks(result) -> list:
                      "noise): median and worst over the parameters; median RMSE/|β| %; failed fits; median s per fit",
                      ("noise A", "estimator", "σ med", "σ max", "|b| med", "|b| max", "RMSE %", "fails", "s/fit"),
                      tuple(rows), labels=2, section_ends=frozenset(ends))]
+    nearest = []
+    for li, level in enumerate(cfg.noise_levels):
+        scores = {k: float(np.nanmedian(stats[k]["rmse"][li] / result.crb_std[li])) for k in cfg.estimators}
+        best = min(scores, key=lambda k: scores[k])
+        nearest.append(f"{level:g} A: {label(best)} ({scores[best]:.3g}× √CRB)")
+    out.append(Line("nearest the Cramér–Rao bound (median RMSE over the parameters) — " + "; ".join(nearest), "title"))
     if result.errors:
         out.append(Line(f"{len(result.errors)} fits failed; the first: {result.errors[0]['error']}", "warning"))
     return out
@@ -561,6 +567,14 @@ def excitation_blocks(run) -> list:
     out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
                          ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    tight = min(d.margins, key=lambda m: m.margin if math.isnan(m.relative) else m.relative) if d.margins else None
+    held = d.feasible
+    out.append(Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
+                    + ("every constraint holds" if held else "a constraint is violated (table above)")
+                    + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where}"), "title"))
+    if held:
+        out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
+                        "and currents, and dynid identify the log"))
     return out
 
 
