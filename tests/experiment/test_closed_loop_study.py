@@ -59,7 +59,7 @@ def test_the_bound_is_taken_at_the_true_states_of_the_closed_loop():
 
 def test_statistics_on_constructed_estimates():
     """Bias, spread and coverage against numbers built to have them: estimates truth + b + σ·z with z chosen so that
-    exactly 3 of 40 (realisation, parameter) pairs fall outside 1.96 σ."""
+    exactly 4 of 40 (realisation, parameter) pairs fall outside 1.96 σ."""
     truth = np.array([1.0, -2.0, 4.0, 0.0])
     z = np.array([[0.5, -0.5, 1.0, 0.0], [-0.5, 0.5, -1.0, 2.5], [1.5, -1.5, 0.2, -0.2], [-1.5, 1.5, -0.2, 0.2],
                   [2.0, 0.0, 0.0, 0.0], [-0.3, 0.3, 0.0, 0.0], [0.0, 0.0, 3.0, 0.0], [0.0, 0.0, -3.0, 0.0],

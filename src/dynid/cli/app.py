@@ -485,16 +485,10 @@ def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", ex
 
 
 def _closed_loop_estimators(text: Optional[str]) -> tuple[str, ...]:
-    """The estimators of a closed-loop study: the open-loop ones checked by the registry, IDIM-IV and DIDIM beside."""
-    from ..estimators.instrumental import CLOSED_LOOP_METHODS
-    from ..estimators.registry import parse_estimators
+    """The estimators of a closed-loop study (checked by :meth:`ClosedLoopStudyConfig.validate`)."""
     from ..experiment.closed_loop_study import CLOSED_LOOP_ESTIMATORS
 
-    if text is None:
-        return CLOSED_LOOP_ESTIMATORS
-    keys = [k.strip().lower() for k in text.split(",")]
-    parse_estimators([k for k in keys if k not in CLOSED_LOOP_METHODS] or ["wls"])
-    return tuple(keys)
+    return CLOSED_LOOP_ESTIMATORS if text is None else tuple(k.strip().lower() for k in text.split(","))
 
 
 @app.command()

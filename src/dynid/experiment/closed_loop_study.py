@@ -44,7 +44,7 @@ from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare
-from ..simulation.closed_loop import ClosedLoopNoise, ClosedLoopRun, Controller, simulate_closed_loop
+from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from ..threads import with_single_blas_thread
 from .closed_loop import ClosedLoopExperiment, closed_loop_identify
 from .paper import PaperExperimentConfig, identification_trajectory
@@ -145,7 +145,10 @@ class ClosedLoopStudyConfig:
         if self.realisations < 2:
             raise ConfigError(f"realisations must be at least 2, got {self.realisations}", field="realisations")
         keys = [str(k).strip().lower() for k in self.estimators]
-        parse_estimators([k for k in keys if k not in CLOSED_LOOP_METHODS] or ["wls"])
+        try:
+            parse_estimators([k for k in keys if k not in CLOSED_LOOP_METHODS] or ["wls"])
+        except ConfigError as exc:
+            raise ConfigError(f"{exc}; in closed loop also {', '.join(CLOSED_LOOP_METHODS)}", field="estimators") from None
         if len(set(keys)) != len(keys) or keys != list(self.estimators):
             raise ConfigError(f"estimators: each estimator once, in lower case, got {list(self.estimators)}", field="estimators")
         for name, value in (("duration", self.duration), ("rate", self.rate), ("bandwidth", self.bandwidth)):
@@ -185,7 +188,6 @@ class _Setup:
     truth: np.ndarray
     t: np.ndarray
     experiment: ClosedLoopExperiment
-    clean: ClosedLoopRun  # the noise-free run: its true states give the bound
     unit_crb: np.ndarray  # Cramér–Rao covariance for σ_τ = 1 N·m, (n_base, n_base)
 
 
@@ -199,7 +201,7 @@ def _prepare(config: ClosedLoopStudyConfig) -> _Setup:
     experiment = ClosedLoopExperiment(controller, q, dq, rnea_torques(robot, q, dq, ddq))
     clean = simulate_closed_loop(robot, t, q, dq, controller, feedforward=experiment.feedforward)
     w = base.base_observation(observation_matrix(robot, clean.q_true, clean.dq_true, clean.ddq_true)).reshape(-1, base.n_base)
-    return _Setup(config, robot, base, base.base_from_standard(robot.standard_parameters()), t, experiment, clean,
+    return _Setup(config, robot, base, base.base_from_standard(robot.standard_parameters()), t, experiment,
                   np.linalg.inv(w.T @ w))
 
 

@@ -88,7 +88,7 @@ def _verdict(d: dict, methods: dict, verbose: bool) -> list:
     b = methods[best]
     text = (f"nearest the truth: {best} (Δβ {b['parameter_error_norm_percent']:.3g} %, error {_mean(b['relative_error']['validation']):.3g} % "
             f"on the validation trajectory β2)")
-    abc = next((m for k, m in d["estimates"].items() if k == "abc"), None)
+    abc = d["estimates"].get("abc")
     if abc is not None:
         text += (f"; the paper's ABC budget: Δβ {abc['parameter_error_norm_percent']:.3g} %, ρ on β2 "
                  f"{_mean(abc['correlation']['validation']):.4f} (the paper's: {sum(ref.CORRELATION_VALIDATION) / 3:.4f})")

@@ -567,7 +567,8 @@ def excitation_blocks(run) -> list:
     out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
                          ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
-    tight = min(d.margins, key=lambda m: m.margin if math.isnan(m.relative) else m.relative) if d.margins else None
+    relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
+    tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
     out.append(Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
                     + ("every constraint holds" if held else "a constraint is violated (table above)")
