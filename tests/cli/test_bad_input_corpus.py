@@ -375,6 +375,8 @@ RANGES = {
     "Coulomb smoothing of 1e9 rad/s": ("[preprocessing]\ncoulomb_velocity = 1e9\n", "preprocessing.coulomb_velocity"),
     "a minimum speed above every speed": ("[preprocessing]\nmin_speed = 50.0\n", "preprocessing.min_speed"),
     "a decimation of 1000": ("[preprocessing]\ndecimation = 1000\n", "preprocessing.decimation"),
+    "a torque delay of an hour": ("[preprocessing]\ntorque_delay = 3600.0\n", "preprocessing.torque_delay"),
+    "a torque delay of nan": ("[preprocessing]\ntorque_delay = nan\n", "preprocessing.torque_delay"),
     "a 50 ms time range": ({"file = \"log.csv\"": "file = \"log.csv\"\ntime_range = [1.0, 1.05]"}, "time_range"),
 }
 

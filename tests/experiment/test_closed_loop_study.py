@@ -57,6 +57,19 @@ def test_the_bound_is_taken_at_the_true_states_of_the_closed_loop():
     np.testing.assert_allclose(setup.unit_crb @ gram, np.eye(setup.base.n_base), atol=1e-6)
 
 
+def test_closed_loop_intervals_hold_the_truth_at_the_highest_encoder_noise():
+    """The issue's check, at BIRDy's highest encoder noise (1e-2°, 0.1 N·m), 24 realisations of the 25 s experiment:
+    IDIM-IV's and DIDIM's 95 % intervals hold the truth in 93-99 % of the (realisation, parameter) pairs (measured
+    0.946 and 0.958). Before the log's zero-order hold was given as a torque delay and σ took the residuals'
+    correlation in time into account, they held it in 78-80 % (a 0.13 % bias from the half period, σ from the
+    white-noise formula)."""
+    cfg = ClosedLoopStudyConfig(encoder_noise=(1e-2,), torque_noise=(0.1,), realisations=24, estimators=("idim-iv", "didim"))
+    stats = run_closed_loop_study(cfg, workers=2).statistics()
+    for key in cfg.estimators:
+        assert stats[key]["converged"][0] == 24, key
+        assert 0.93 <= stats[key]["coverage"][0] <= 0.99, (key, stats[key]["coverage"][0])
+
+
 def test_statistics_on_constructed_estimates():
     """Bias, spread and coverage against numbers built to have them: estimates truth + b + σ·z with z chosen so that
     exactly 4 of 40 (realisation, parameter) pairs fall outside 1.96 σ."""

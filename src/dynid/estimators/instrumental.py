@@ -47,8 +47,70 @@ class InstrumentalSolution:
     condition_number: float
 
 
-def instrumental_variables(w, tau, z) -> InstrumentalSolution:
+def newey_west_lags(n_instants: int) -> int:
+    """Lags of :func:`long_run_covariance` for a log of ``n_instants`` rows in time: ``⌊4 (T/100)^(2/9)⌋``
+    (Newey & West, "Automatic lag selection in covariance matrix estimation", Rev. Econ. Stud. 61(4), 1994, the
+    Bartlett kernel's rule of thumb).
+
+    Parameters
+    ----------
+    n_instants : int
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
+    return max(1, int(4 * (max(n_instants, 1) / 100) ** (2 / 9)))
+
+
+def long_run_covariance(scores, instants, lags: int | None = None) -> np.ndarray:
+    """The covariance of a sum of scores correlated in time: Newey–West's estimate with the Bartlett kernel.
+
+    The rows of one instant (one per joint) are summed first (the loop's noise couples the joints), then
+    ``S = Γ₀ + Σ_{l=1}^{L} (1 − l/(L+1)) (Γ_l + Γ_lᵀ)``, ``Γ_l = Σ_k g_k g_{k−l}ᵀ`` over the instants, a missing instant
+    counting zero (Newey & West, Econometrica 55(3), 1987). Filtered and decimated residuals are neither white nor
+    independent between joints, which the textbook ``σ² (WᵀW)⁻¹`` assumes.
+
+    Parameters
+    ----------
+    scores : (M, p) array
+        One row's contribution to the estimating equation, e.g. ``z_i e_i`` (instrument row times residual).
+    instants : (M,) int array
+        The instant (row in time, 0-based) of each row.
+    lags : int, optional
+        ``L``; default :func:`newey_west_lags` of the number of instants.
+
+    Returns
+    -------
+    (p, p) array
+        Symmetric, positive semi-definite.
+
+    Raises
+    ------
+    ShapeError
+        ``instants`` not one non-negative integer per row.
+    """
+    scores = np.asarray(scores, dtype=float)
+    instants = np.asarray(instants)
+    if scores.ndim != 2 or instants.shape != (scores.shape[0],) or (instants.size and instants.min() < 0):
+        raise ShapeError(f"expected one non-negative instant per score row ({scores.shape[0]}), got shape {instants.shape}")
+    n_instants = int(instants.max()) + 1 if instants.size else 0
+    g = np.zeros((n_instants, scores.shape[1]))
+    np.add.at(g, instants.astype(int), scores)
+    lags = newey_west_lags(n_instants) if lags is None else int(lags)
+    total = g.T @ g
+    for lag in range(1, min(lags, n_instants - 1) + 1):
+        gamma = g[lag:].T @ g[:-lag]
+        total += (1.0 - lag / (lags + 1.0)) * (gamma + gamma.T)
+    return total
+
+
+def instrumental_variables(w, tau, z, instants=None) -> InstrumentalSolution:
     """The simple instrumental-variable estimate with its covariance (module docstring).
+
+    With ``instants`` the covariance is the sandwich ``(ZᵀW)⁻¹ S (WᵀZ)⁻¹`` with ``S`` the long-run covariance of the
+    scores ``z_i e_i`` (:func:`long_run_covariance`), for residuals correlated in time and between joints.
 
     Parameters
     ----------
@@ -58,6 +120,8 @@ def instrumental_variables(w, tau, z) -> InstrumentalSolution:
         Measured torques, same rows.
     z : (M, p) array
         Instruments, same rows: the observation matrix of a noise-free simulation.
+    instants : (M,) int array, optional
+        The instant of each row (rows of one instant: one per joint); default: rows independent, ``σ²`` formula.
 
     Returns
     -------
@@ -87,5 +151,6 @@ def instrumental_variables(w, tau, z) -> InstrumentalSolution:
     residual = tau - w @ params
     sigma2 = float(residual @ residual) / (m - p)
     inverse = np.linalg.inv(zw)
-    covariance = sigma2 * inverse @ (z.T @ z) @ inverse.T
+    middle = sigma2 * (z.T @ z) if instants is None else long_run_covariance(z * residual[:, None], instants)
+    covariance = inverse @ middle @ inverse.T
     return InstrumentalSolution(params, np.sqrt(np.maximum(np.diag(covariance), 0.0)), covariance, float(np.sqrt(sigma2)), cond)

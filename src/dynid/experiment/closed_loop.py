@@ -10,6 +10,11 @@ the simulated observation matrix ``W_s`` match the measured ``W`` and ``τ``:
 - **DIDIM** (Gautier, Janot & Vandanjon, IEEE TCST 21(2), 2013): closed-loop output error on the torques, by
   Gauss–Newton with the Jacobian ``∂τ_s/∂β`` taken as ``W_s`` re-linearised at each step: ``β_{k+1} = W_s⁺ τ``.
 
+Their σ is the sandwich ``A⁻¹ S A⁻ᵀ`` (``A = W_sᵀ W`` for IDIM-IV, ``W_sᵀ W_s`` for DIDIM) with ``S`` the long-run
+covariance of the scores over the log's instants (:func:`dynid.estimators.instrumental.long_run_covariance`): the
+residuals of a filtered, decimated closed-loop log are correlated in time and between joints, and the white-noise
+formula ``σ² A⁻¹`` put the 95 % intervals around the truth in 78-80 % of the ER-16 study's realisations at 1e-2°.
+
 Both start from the weighted least-squares estimate on the measured rows (IDIM-WLS) — or from the description's
 values when that estimate is too biased to be simulated (unstable) — weight every joint's rows by
 the inverse of its residual σ, and stop when the simulated torques change by less than ``tol`` (relative) between
@@ -24,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters
-from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables
+from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, long_run_covariance
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
@@ -114,12 +119,17 @@ def _rows(robot: Robot, base: BaseParameters, data: PreparedData) -> tuple[np.nd
     return np.concatenate(ws), np.concatenate(taus), np.concatenate(keeps)
 
 
-def _weighted_least_squares(w, tau, row_sigma):
+def _weighted_least_squares(w, tau, row_sigma, instants=None):
+    """Weighted least squares with σ: the textbook ``σ² (AᵀA)⁻¹``, or with ``instants`` the sandwich whose middle is
+    the long-run covariance of the scores (:func:`dynid.estimators.instrumental.long_run_covariance`)."""
     a, b = w / row_sigma[:, None], tau / row_sigma
     params, *_ = np.linalg.lstsq(a, b, rcond=None)
     r = b - a @ params
-    sigma2 = float(r @ r) / max(a.shape[0] - a.shape[1], 1)
-    cov = sigma2 * np.linalg.pinv(a.T @ a)
+    inverse = np.linalg.pinv(a.T @ a)
+    if instants is None:
+        cov = float(r @ r) / max(a.shape[0] - a.shape[1], 1) * inverse
+    else:
+        cov = inverse @ long_run_covariance(a * r[:, None], instants) @ inverse
     return params, np.sqrt(np.maximum(np.diag(cov), 0.0))
 
 
@@ -173,6 +183,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     n = robot.n_dof
     w, tau = w[keep], tau[keep]
     joint = np.tile(np.arange(n), keep.size // n)[keep]
+    instants = np.repeat(np.arange(keep.size // n), n)[keep]
     params, _ = _weighted_least_squares(w, tau, np.ones(tau.size))
     residual = tau - w @ params
     sigma = np.array([np.sqrt(np.mean(residual[joint == j] ** 2)) if np.any(joint == j) else 1.0 for j in range(n)])
@@ -231,11 +242,11 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
                     break
             good = beta.copy()
             if key == "idim-iv":
-                sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None])
+                sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None], instants)
                 beta, std = sol.params, sol.params_std
                 torque = w @ beta
             else:
-                beta, std = _weighted_least_squares(ws, tau, row_sigma)
+                beta, std = _weighted_least_squares(ws, tau, row_sigma, instants)
                 torque = ws @ beta
             change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
             changes.append(change)

@@ -110,6 +110,8 @@ class PreprocessingTable(Table, kw_only=True):
     rest_friction: Annotated[Union[Literal["held", "zero"], NonNegative, list[Union[Literal["held", "zero"], NonNegative]]],
                              _d('friction at rest: "held", "zero" or a relaxation time [s], one or one per joint')] | None = None
     presliding: Annotated[PerJoint, _d("rad: Dahl's presliding distance (default 0)")] | None = None
+    torque_delay: Annotated[float, _d("s: how long the torque (current) channel lags the positions (default 0); "
+                                      "a logged command held over the control period leads by half of it: -0.5/rate")] | None = None
     smoothing_passes: Annotated[int, Meta(ge=0, description="applications of eq. 17 (strategy paper)")] | None = None
     auto: Annotated[bool, _d("cross-validate the cutoffs when the positions' noise knee allows (default true)")] | None = None
 

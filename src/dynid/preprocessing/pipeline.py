@@ -32,7 +32,7 @@ from .settings import Preprocessing
 
 from .strategies import Strategy, strategy_for
 
-__all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare"]
+__all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare", "torque_delayed"]
 
 Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
@@ -125,7 +125,38 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
     DataError
         Too few samples.
     """
+    if settings.torque_delay:
+        recording = torque_delayed(recording, settings.torque_delay)
     return strategy_for(settings).prepare(recording, settings, strict)
+
+
+def torque_delayed(recording, delay: float):
+    """The recording with its torques read ``delay`` seconds later, on the same grid (:attr:`Preprocessing.torque_delay`).
+
+    Parameters
+    ----------
+    recording : dynid.io.datasets.Recording
+    delay : float [s]
+        The torque channel's lag behind the positions (negative: it leads).
+
+    Returns
+    -------
+    dynid.io.datasets.Recording
+        ``tau(t + delay)`` by linear interpolation between samples; at the ends, where the log holds no torque that
+        late (or early), the first or last torque held. Stored columns stay stored.
+
+    Raises
+    ------
+    ConfigError
+        A delay that is not finite, or not shorter than a tenth of the recording.
+    """
+    t = np.asarray(recording.t, dtype=float)
+    span = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    if not np.isfinite(delay) or abs(delay) >= 0.1 * span:
+        raise ConfigError(f"preprocessing.torque_delay: expected a delay in seconds shorter than a tenth of "
+                          f"{recording.label} ({0.1 * span:.3g} s), got {delay!r}")
+    later = t + float(delay)
+    return replace(recording, tau=by_column(recording.tau, lambda x, _: np.interp(later, t, x)))
 
 
 def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,

@@ -74,6 +74,12 @@ class Preprocessing:
     presliding : float or tuple [rad]
         Per joint, Dahl's presliding distance over which the friction reverses with the direction of motion
         (:func:`dynid.friction.held_direction`); 0 (default): at once.
+    torque_delay : float [s]
+        How long the torque (current) channel lags the positions: the torque logged at ``t`` is the model's torque at
+        ``t − torque_delay``, so the torques are read ``torque_delay`` later (linear interpolation on the log's grid,
+        the ends held) before any filter. Default 0. A drive that holds each commanded torque over its control period
+        and logs the command leads the motion by half a period: ``−0.5 / rate`` (the closed-loop study's logs).
+        :func:`dynid.experiment.delay.estimate_delay` estimates it from a log.
     strategy : str
         The preprocessing strategy (:mod:`dynid.preprocessing.strategies`): "parallel" (default: the filters
         described here) or "paper" (the paper's §3.3: a Fourier fit on ``fourier``'s harmonics and eq. 17 on the
@@ -114,6 +120,7 @@ class Preprocessing:
     knee: float | None = None
     rest_friction: str | float | tuple = "held"
     presliding: float | tuple = 0.0
+    torque_delay: float = 0.0
     strategy: str = "parallel"
     smoothing_passes: int = 1
     auto: bool = True
