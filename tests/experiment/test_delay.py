@@ -13,7 +13,7 @@ from dynid.experiment.simulated_logs import simulated_log
 def test_a_delay_of_a_fraction_of_a_sample_is_recovered(delay):
     """A simulated UR10e log (250 Hz, noisy currents, quantised positions) whose torques are logged ``delay``
     samples late (read from the exact torques' band-limited interpolation): the estimate lies within 0.25
-    samples, within 3σ, and undoing it lowers the identification residual."""
+    samples, within 3σ, and once undone the log shows no delay beyond its σ."""
     robot = dynid.load_robot("ur10e")
     log = simulated_log(robot, seconds=30.0, rate=250.0, seed=3)
     t, tau = log.t, np.asarray(log.tau)
@@ -26,7 +26,7 @@ def test_a_delay_of_a_fraction_of_a_sample_is_recovered(delay):
     assert abs(found.samples - delay) < 0.25 and abs(found.samples - delay) < 3 * found.std + 0.05
     assert found.seconds == pytest.approx(found.samples / log.rate) and found.determined
     again = estimate_delay(robot, delayed(replace(log, tau=late), found.samples))
-    assert abs(again.samples) < 0.25
+    assert abs(again.samples) < 3 * again.std  # undone, within its own σ (the decimated rows now fall elsewhere)
 
 
 def test_the_bound_is_checked():

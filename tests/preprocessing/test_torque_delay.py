@@ -20,14 +20,23 @@ def _log(n=500, rate=100.0, seed=0):
     return Recording("log", t, rng.normal(size=(n, 2)), None, rng.normal(size=(n, 2)), rate, source="log.csv")
 
 
-def test_a_whole_number_of_samples_is_a_shift_and_half_a_sample_the_mean_of_neighbours():
+def test_a_whole_number_of_samples_is_a_shift_and_a_fraction_reads_the_signal_between_samples():
+    """Independent truth: a whole number of samples moves the samples (the end: their mirror image); half a sample
+    of a slow sinusoid is the sinusoid half a sample earlier; and the shift keeps white noise's power, where
+    averaging neighbours would halve it."""
     log = _log()
     three = torque_delayed(log, 3 / log.rate)
-    np.testing.assert_allclose(three.tau[:-3], log.tau[3:], rtol=0, atol=1e-12)
-    np.testing.assert_array_equal(three.tau[-3:], np.repeat(log.tau[-1:], 3, axis=0))  # the end held
-    half = torque_delayed(log, -0.5 / log.rate)
-    np.testing.assert_allclose(half.tau[1:], 0.5 * (log.tau[1:] + log.tau[:-1]), rtol=0, atol=1e-12)
-    np.testing.assert_array_equal(half.q, log.q)  # the positions untouched
+    np.testing.assert_allclose(three.tau[:-3], log.tau[3:], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(three.tau[-3:], log.tau[::-1][:3], rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(three.q, log.q)  # the positions untouched
+    f = 1.3  # Hz, at 100 Hz
+    slow = replace(log, tau=np.column_stack([np.sin(2 * np.pi * f * log.t), np.cos(2 * np.pi * f * log.t)]))
+    half = torque_delayed(slow, -0.5 / log.rate)
+    earlier = log.t - 0.5 / log.rate
+    inner = slice(50, -50)
+    np.testing.assert_allclose(half.tau[inner, 0], np.sin(2 * np.pi * f * earlier)[inner], atol=1e-3)
+    noise = torque_delayed(log, -0.5 / log.rate).tau[inner]
+    assert np.var(noise) == pytest.approx(np.var(log.tau[inner]), rel=0.1)
     stored = torque_delayed(replace(log, tau=StoredColumns.from_columns(log.tau.T)), 3 / log.rate)
     np.testing.assert_array_equal(np.asarray(stored.tau), three.tau)
 

@@ -26,7 +26,7 @@ from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
 from ..friction import Velocities, held_direction, moving_joints
 from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
-from .filters import butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
+from .filters import FractionalShift, butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
 from .fourier_fit import fourier_fit_derivatives
 from .settings import Preprocessing
 
@@ -142,8 +142,8 @@ def torque_delayed(recording, delay: float):
     Returns
     -------
     dynid.io.datasets.Recording
-        ``tau(t + delay)`` by linear interpolation between samples; at the ends, where the log holds no torque that
-        late (or early), the first or last torque held. Stored columns stay stored.
+        ``tau(t + delay)`` by a band-limited shift (:class:`dynid.preprocessing.filters.FractionalShift`); at the ends,
+        where the log holds no torque that late (or early), its mirror image. Stored columns stay stored.
 
     Raises
     ------
@@ -155,8 +155,8 @@ def torque_delayed(recording, delay: float):
     if not np.isfinite(delay) or abs(delay) >= 0.1 * span:
         raise ConfigError(f"preprocessing.torque_delay: expected a delay in seconds shorter than a tenth of "
                           f"{recording.label} ({0.1 * span:.3g} s), got {delay!r}")
-    later = t + float(delay)
-    return replace(recording, tau=by_column(recording.tau, lambda x, _: np.interp(later, t, x)))
+    samples = float(delay) * recording.rate
+    return replace(recording, tau=by_column(recording.tau, lambda x, _: FractionalShift(x).read(samples)))
 
 
 def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,

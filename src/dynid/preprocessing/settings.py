@@ -76,8 +76,8 @@ class Preprocessing:
         (:func:`dynid.friction.held_direction`); 0 (default): at once.
     torque_delay : float [s]
         How long the torque (current) channel lags the positions: the torque logged at ``t`` is the model's torque at
-        ``t − torque_delay``, so the torques are read ``torque_delay`` later (linear interpolation on the log's grid,
-        the ends held) before any filter. Default 0. A drive that holds each commanded torque over its control period
+        ``t − torque_delay``, so the torques are read ``torque_delay`` later (a band-limited shift on the log's grid,
+        :class:`dynid.preprocessing.filters.FractionalShift`) before any filter. Default 0. A drive that holds each commanded torque over its control period
         and logs the command leads the motion by half a period: ``−0.5 / rate`` (the closed-loop study's logs).
         :func:`dynid.experiment.delay.estimate_delay` estimates it from a log.
     strategy : str
