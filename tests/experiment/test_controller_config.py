@@ -70,6 +70,25 @@ def test_dynid_identify_runs_idim_iv_and_didim_beside_least_squares(closed_loop_
         assert np.median(z) < 5, (label, np.median(z))
 
 
+def test_dynid_identify_runs_didim_sdp_from_a_config(closed_loop_log, tmp_path):
+    """``didim-sdp`` in ``[estimation] estimators``: a physically consistent estimate (its margin >= 0 in results.json,
+    against the feasibility SDP) with no σ, beside least squares."""
+    root, table, truth = closed_loop_log
+    for name in ("log.csv", "ref.csv"):
+        (tmp_path / name).write_bytes((root / name).read_bytes())
+    _write(tmp_path, table, '["wls", "didim-sdp"]')
+    p = dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "out", "--no-figures", "--verbose")
+    assert p.returncode == 0, p.stderr
+    result = json.loads((tmp_path / "out" / "results.json").read_text())
+    e = result["estimates"]["dynid DIDIM-SDP"]
+    assert "note" not in e, e.get("note")
+    assert e.get("std") is None
+    assert result["consistency_margin"]["dynid DIDIM-SDP"] >= -1e-6
+    assert result["physically_consistent_verdict"]["dynid DIDIM-SDP"].startswith("yes")
+    good = [n for n in e["values"] if abs(truth[n]) > 1.0]
+    assert np.median([abs(e["values"][n] - truth[n]) / abs(truth[n]) for n in good]) < 0.01
+
+
 def test_closed_loop_estimators_without_the_controller_are_refused_in_one_line(closed_loop_log, tmp_path):
     root, table, _ = closed_loop_log
     (tmp_path / "log.csv").write_bytes((root / "log.csv").read_bytes())

@@ -498,7 +498,7 @@ def montecarlo(
     noise_levels: str = typer.Option("0.02,0.05,0.1", help="Motor current noise standard deviations [A], comma separated."),
     realisations: int = typer.Option(100, help="Noise realisations per level."),
     estimators: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
-                                                        "any registered, or all (default: ols,wls,irls,lad,sdp,abc); with --closed-loop also idim-iv, didim (default: all eight)."),
+                                                        "any registered, or all (default: ols,wls,irls,lad,sdp,abc); with --closed-loop also idim-iv, didim, didim-sdp (default: the first six and idim-iv, didim)."),
     methods: Optional[str] = typer.Option(None, hidden=True),
     seed: int = typer.Option(0, help="Seed of every random number of the study."),
     duration: float = typer.Option(25.0, help="Recording length [s]."),

@@ -20,7 +20,7 @@ import numpy as np
 from ..exceptions import IdentifiabilityError, ShapeError
 from .base import check_observations
 
-CLOSED_LOOP_METHODS = ("idim-iv", "didim")
+CLOSED_LOOP_METHODS = ("idim-iv", "didim", "didim-sdp")
 """Keys of the closed-loop estimators (:mod:`dynid.experiment.closed_loop`; case-insensitive): they need the
 controller that drove the run (``[controller]`` of a config)."""
 

@@ -379,7 +379,7 @@ def keys() -> tuple[str, ...]:
     return tuple(_REGISTRY)
 
 
-OTHER_LABELS = {"idim-iv": "IDIM-IV", "didim": "DIDIM"}
+OTHER_LABELS = {"idim-iv": "IDIM-IV", "didim": "DIDIM", "didim-sdp": "DIDIM-SDP"}
 """Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.experiment.closed_loop`)."""
 
 

@@ -9,6 +9,11 @@ the simulated observation matrix ``W_s`` match the measured ``W`` and ``τ``:
   ``β_{k+1} = (W_sᵀ W)⁻¹ W_sᵀ τ``; ``W_s`` is noise-free and so uncorrelated with the loop's noise in ``W``.
 - **DIDIM** (Gautier, Janot & Vandanjon, IEEE TCST 21(2), 2013): closed-loop output error on the torques, by
   Gauss–Newton with the Jacobian ``∂τ_s/∂β`` taken as ``W_s`` re-linearised at each step: ``β_{k+1} = W_s⁺ τ``.
+- **DIDIM-SDP**: DIDIM whose every step is the physically consistent least squares
+  (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`: each link's pseudo-inertia
+  positive semidefinite, friction and rotor inertias non-negative, the description's values as the prior) on the
+  *standard* simulated observation matrix; the iterate is a standard parameter vector, simulated as it is, so every
+  simulation runs a physically consistent model. The SDP gives no σ.
 
 Their σ is the sandwich ``A⁻¹ S A⁻ᵀ`` (``A = W_sᵀ W`` for IDIM-IV, ``W_sᵀ W_s`` for DIDIM) with ``S`` the long-run
 covariance of the scores over the log's instants (:func:`dynid.estimators.instrumental.long_run_covariance`): the
@@ -39,7 +44,7 @@ from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_close
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]
 
 
-LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM"}
+LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM", "didim-sdp": "DIDIM-SDP"}
 
 STALLED = 1e-3
 """A relative change of the simulated torques below which iterations whose changes no longer fall (three in a row, none
@@ -75,6 +80,7 @@ class ClosedLoopEstimate:
     method : str
         "IDIM-WLS", "IDIM-IV" or "DIDIM".
     params, params_std : (n_base,) arrays
+        ``params_std`` NaN where the estimator gives no σ (DIDIM-SDP).
     iterations : int
         Closed-loop simulations run.
     converged : bool
@@ -106,13 +112,15 @@ class ClosedLoopEstimate:
         names = list(names) if names is not None else [f"beta{k + 1}" for k in range(self.params.size)]
         return {"method": self.method, "iterations": self.iterations, "converged": self.converged, "message": self.message,
                 "changes": list(self.changes),
-                "parameters": [{"name": n, "value": float(v), "std": float(s)} for n, v, s in zip(names, self.params, self.params_std)]}
+                "parameters": [{"name": n, "value": float(v), "std": float(s) if np.isfinite(s) else None}
+                               for n, v, s in zip(names, self.params, self.params_std)]}
 
 
-def _rows(robot: Robot, base: BaseParameters, data: PreparedData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Base rows, torques and the rows kept (M,), of a prepared recording."""
+def _rows(robot: Robot, base: BaseParameters, data: PreparedData,
+          standard: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Base (or standard) rows, torques and the rows kept (M,), of a prepared recording."""
     ws, taus, keeps = [], [], []
-    for _, y, tau, keep in base_chunks(robot, base, data):
+    for _, y, tau, keep in base_chunks(robot, base, data, standard=standard):
         ws.append(y.reshape(-1, y.shape[-1]))
         taus.append(np.asarray(tau).reshape(-1))
         keeps.append(np.asarray(keep).reshape(-1))
@@ -134,7 +142,7 @@ def _weighted_least_squares(w, tau, row_sigma, instants=None):
 
 
 def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
-                         methods=CLOSED_LOOP_METHODS, preprocessing: Preprocessing | None = None, max_iter: int = 10,
+                         methods=("idim-iv", "didim"), preprocessing: Preprocessing | None = None, max_iter: int = 10,
                          tol: float = 1e-4) -> dict[str, ClosedLoopEstimate]:
     """IDIM-WLS, then each closed-loop estimator of ``methods`` (module docstring).
 
@@ -147,7 +155,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         The closed-loop log: measured positions and torques at the controller's instants.
     experiment : ClosedLoopExperiment
     methods : sequence of str
-        Among :data:`CLOSED_LOOP_METHODS`.
+        Among :data:`CLOSED_LOOP_METHODS` (IDIM-IV and DIDIM by default; DIDIM-SDP on request).
     preprocessing : Preprocessing, optional
         Default: every setting derived from the log (the settings resolved on it prepare the simulations too).
     max_iter : int
@@ -158,7 +166,8 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     Returns
     -------
     dict
-        ``{"wls": ..., "idim-iv": ..., "didim": ...}`` (those asked for), :class:`ClosedLoopEstimate` each.
+        ``{"wls": ..., "idim-iv": ..., "didim": ..., "didim-sdp": ...}`` (those asked for), :class:`ClosedLoopEstimate`
+        each.
 
     Raises
     ------
@@ -192,18 +201,22 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     out = {"wls": ClosedLoopEstimate(LABELS["wls"], start, start_std, message="least squares on the measured rows")}
     nominal = robot.standard_parameters()
 
-    def simulated_rows(beta):
-        phi = base.standard_from_base(beta, reference=nominal)
+    def simulated_rows(x, standard=False):
+        phi = x if standard else base.standard_from_base(x, reference=nominal)
         run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
                                    ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
         sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate)
-        ws, _, _ = _rows(robot, base, prepare(sim, data.settings, strict=False))
+        ws, _, _ = _rows(robot, base, prepare(sim, data.settings, strict=False), standard)
         if ws.shape[0] != keep.size:
             raise DataError(f"{recording.name}: the simulated log prepares to {ws.shape[0] // n} samples, the measured one to "
                             f"{keep.size // n}")
         return ws[keep]
 
     for key in keys:
+        if key == "didim-sdp":
+            w_standard = _rows(robot, base, data, standard=True)[0][keep]
+            out[key] = _didim_sdp(robot, base, simulated_rows, w_standard, tau, row_sigma, max_iter, tol)
+            continue
         beta, message, converged, note = start.copy(), "", False, ""
         changes: list[float] = []
         previous = w @ beta
@@ -262,3 +275,59 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
             message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
         out[key] = ClosedLoopEstimate(LABELS[key], beta, std, len(changes), converged, tuple(changes), note + message)
     return out
+
+
+def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, tau, row_sigma, max_iter: int,
+               tol: float) -> ClosedLoopEstimate:
+    """DIDIM with the physically consistent least squares at each step (module docstring).
+
+    It starts from the physically consistent least squares on the measured rows ``w_standard`` (IDIM-SDP), or from
+    the description's values when that cannot be simulated; a step whose closed loop cannot be simulated (a link left
+    with almost no inertia about its axis: the controller's gains then destabilise it) is halved towards the last
+    iterate that could be, up to 6 times — a mean of consistent models is consistent."""
+    from ..dynamics.layout import consistency_layout
+    from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
+
+    nominal = robot.standard_parameters()
+    links, nonneg = consistency_layout(robot)
+
+    def fit(w):
+        sdp = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=nominal)
+        return sdp.fit(w / row_sigma[:, None], tau / row_sigma).params_
+
+    phi = fit(w_standard)
+    previous = w_standard @ phi
+    changes: list[float] = []
+    converged, message, note = False, "", ""
+    good = None  # the last iterate that simulated
+    for _ in range(max_iter):
+        try:
+            ws = simulated_rows(phi, standard=True)
+        except ConfigError as exc:
+            trials = [(nominal, "started from the description's values")] if good is None else [
+                (good + 0.5**h * (phi - good), f"a step halved {h} time(s) to keep the closed loop stable") for h in range(1, 7)]
+            for trial, words in trials:
+                try:
+                    ws = simulated_rows(trial, standard=True)
+                except ConfigError:
+                    continue
+                phi, note = trial, note + words + "; "
+                break
+            else:
+                message = f"stopped: {exc}"
+                phi = good if good is not None else phi
+                break
+        good = phi.copy()
+        phi = fit(ws)
+        torque = ws @ phi
+        change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
+        changes.append(change)
+        previous = torque
+        if change < tol or (len(changes) >= 3 and change < STALLED and change >= 0.9 * min(changes[-3:-1])):
+            converged, message = True, f"converged: the simulated torques changed by {change:.2g} (relative)"
+            break
+    else:
+        message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
+    beta = base.base_from_standard(phi)
+    return ClosedLoopEstimate(LABELS["didim-sdp"], beta, np.full(beta.size, np.nan), len(changes), converged,
+                              tuple(changes), note + message)

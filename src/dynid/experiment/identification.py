@@ -378,14 +378,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
     if progress is not None:
         progress("consistency checks", 0, 1)
-    links, nonneg = consistency_layout(robot)
-    margins, verdicts = {}, {}
-    for label, beta in sets.items():
-        try:
-            margins[label] = consistency_margin(base.regrouping, beta, links, nonneg)
-            verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
-        except DynIdError as exc:  # a failed check never stops the identification
-            margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
+    margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks, fit, data, rng)
     main = ""
@@ -452,6 +445,32 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
     spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
     stats["prediction_spread"] = spread
     return findings, stats
+
+
+def consistency_checks(robot: Robot, base: BaseParameters, sets: dict) -> tuple[dict, dict]:
+    """Each parameter set's consistency margin and verdict (:func:`dynid.estimators.consistency_margin`).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    sets : dict
+        label -> base parameters (n_base,).
+
+    Returns
+    -------
+    tuple of dict
+        label -> margin (NaN when the check failed), label -> verdict (one line).
+    """
+    links, nonneg = consistency_layout(robot)
+    margins, verdicts = {}, {}
+    for label, beta in sets.items():
+        try:
+            margins[label] = consistency_margin(base.regrouping, beta, links, nonneg)
+            verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
+        except DynIdError as exc:  # a failed check never stops the identification
+            margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
+    return margins, verdicts
 
 
 HELD_OUT_FOLDS = 5

@@ -195,7 +195,7 @@ def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
     rate (``[controller]``)."""
     from ..dynamics.rnea import rnea_torques
     from .closed_loop import ClosedLoopExperiment, closed_loop_identify
-    from .identification import Estimate
+    from .identification import Estimate, consistency_checks
 
     assert config.controller is not None  # the config's parser refuses closed-loop estimators without it
     controller, reference, feedforward = config.controller
@@ -212,12 +212,16 @@ def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
         t0 = time.perf_counter()
         out = closed_loop_identify(robot, base, recording, ClosedLoopExperiment(controller, q_ref, dq_ref, ff), methods=(key,),
                                    preprocessing=config.preprocessing)[key]
-        estimate = Estimate(key, out.params, out.params_std, time.perf_counter() - t0,
+        std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
+        estimate = Estimate(key, out.params, std, time.perf_counter() - t0,
                             note="" if out.converged else out.message)
         estimates[estimate.label] = estimate
         if not out.converged:
             notes.append(f"{estimate.label}: {out.message}")
-    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes))
+    added = {label: e.params for label, e in estimates.items() if label not in result.estimates}
+    margins, verdicts = consistency_checks(robot, base, added)
+    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes),
+                   consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})
 
 
 def _main_estimate(result) -> dict:
