@@ -8,6 +8,7 @@ estimator (OLS, WLS, IRLS, LAD, SDP, ABC, IDIM-IV, DIDIM). ``--band 3`` gives th
 each log as ``dynid identify`` does.
 
     .venv/bin/python benchmarks/closed_loop_grid.py [realisations] [--band HZ] [--encoder DEG,..] [--torque NM,..]
+        [--robot NAME_OR_DESCRIPTION --joints N]   (e.g. configs/robots/tx40_simulation.toml, 6: the coupled wrist)
 """
 
 from __future__ import annotations
@@ -29,15 +30,17 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--band", type=float, default=None)
     parser.add_argument("--encoder", default=",".join(map(str, ENCODER_NOISE_DEG)))
     parser.add_argument("--torque", default=",".join(map(str, TORQUE_NOISE)))
+    parser.add_argument("--robot", default="er16")
+    parser.add_argument("--joints", type=int, default=3)
     args = parser.parse_args(argv)
-    config = ClosedLoopStudyConfig(encoder_noise=tuple(float(x) for x in args.encoder.split(",")),
+    config = ClosedLoopStudyConfig(robot=args.robot, joints=args.joints, encoder_noise=tuple(float(x) for x in args.encoder.split(",")),
                                    torque_noise=tuple(float(x) for x in args.torque.split(",")),
                                    realisations=args.realisations, band=args.band)
     load = os.getloadavg()[0]
     result = run_closed_loop_study(config, workers=2)
     data = result.to_dict()
     band = "derived from each log" if args.band is None else f"{args.band:g} Hz"
-    print(f"ER-16 (3 joints), {args.realisations} realisations per cell, band {band}, Dask local cluster of 2 workers: "
+    print(f"{args.robot} ({args.joints} joints), {args.realisations} realisations per cell, band {band}, Dask local cluster of 2 workers: "
           f"{result.timings['total']:.0f} s; load {load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end")
     headers, rows, _ = closed_loop_study_rows(data)
     print("| " + " | ".join(headers) + " |")

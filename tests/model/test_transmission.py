@@ -104,3 +104,44 @@ def test_submodel_refuses_to_cut_a_coupling():
     with pytest.raises(ConfigError, match="couples joints"):
         robot.submodel(2)
     assert load_robot("er16").submodel(3).transmission.n_dof == 3
+
+
+def test_coupled_values_are_nominal_values_in_dynids_order_and_enter_the_mass_matrix():
+    """``coupled_values``: the coupled motor's nominal terms, given in the order of ``coupled_terms`` and kept in
+    dynid's (Iam, fvm, fcm). Independent truth: motor 3 turns by ``12.5 q2 + 25 q3``; its rotor inertia ``J`` adds
+    ``J R[k]ᵀ R[k]`` to the mass matrix, whose off-diagonal part in joint units (``Iam = J R[k, k]²``) is
+    ``Iam · c2 · c3 = Iam · 0.5`` at (2, 3), and nothing else (Pinocchio's CRBA plus the drive terms)."""
+    from dynid.simulation.closed_loop import JointDynamics
+
+    given = _WRIST.replace("coupling = [", 'coupled_terms = ["fcm", "Iam"]\ncoupled_values = [[1.5, 0.02]]\ncoupling = [')
+    robot = robot_from_toml_text(given, "w.toml", None)
+    assert robot.transmission.coupled_terms == ("Iam", "fcm")
+    np.testing.assert_array_equal(robot.transmission.coupled_values, [[0.02, 1.5]])
+    plain = robot_from_toml_text(_WRIST.replace("coupling = [", 'coupled_terms = ["fcm", "Iam"]\ncoupling = ['), "w.toml", None)
+    q = np.array([0.3, -0.4, 0.5])
+    difference = JointDynamics(robot).mass_and_bias(q, np.zeros(3))[0] - JointDynamics(plain).mass_and_bias(q, np.zeros(3))[0]
+    expected = np.zeros((3, 3))
+    expected[1, 2] = expected[2, 1] = 0.02 * (12.5 / 25) * 1.0
+    np.testing.assert_allclose(difference, expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("values", ["[[0.02]]", "[[0.02, 1.5], [0.0, 0.0]]", "[[nan, 1.5]]"])
+def test_coupled_values_of_the_wrong_shape_are_named(values):
+    bad = _WRIST.replace("coupling = [", f'coupled_terms = ["fcm", "Iam"]\ncoupled_values = {values}\ncoupling = [')
+    with pytest.raises(ConfigError, match=r"w.toml: transmission.coupled_values: expected 1 list\(s\) .* of 2 finite numbers"):
+        robot_from_toml_text(bad, "w.toml", None)
+
+
+def test_the_tx40_simulation_truth_can_be_controlled_where_the_built_in_cannot():
+    """The built-in TX40 has no inertia about joint 6's axis, so no gain follows from its mass matrix; the simulation
+    truth of ``configs/robots/tx40_simulation.toml`` (FIGAROH's drive values) has, and a positive definite one."""
+    from pathlib import Path
+
+    from dynid.simulation.closed_loop import Controller, JointDynamics
+
+    with pytest.raises(ConfigError, match="joint 6 has no inertia"):
+        Controller.for_robot(load_robot("tx40"))
+    truth = load_robot(str(Path(__file__).parents[2] / "configs" / "robots" / "tx40_simulation.toml"))
+    np.testing.assert_array_equal(truth.transmission.coupled_values, [[0.00964, 0.616, 1.95]])
+    assert np.linalg.eigvalsh(JointDynamics(truth).mass_and_bias(np.zeros(6), np.zeros(6))[0]).min() > 0
+    assert np.all(Controller.for_robot(truth).kp > 0)

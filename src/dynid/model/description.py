@@ -16,6 +16,7 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     gear_ratios = [32, 32, 45, -48, 45, 32]          # motor angle = ratio · joint angle
     coupling = [{motor = 6, joint = 5, ratio = 32}]  # motor 6 also turns with joint 5 (coupled wrist)
     coupled_terms = ["Iam", "fvm", "fcm"]            # identified per coupled motor
+    coupled_values = [[0.0096, 0.62, 1.95]]          # optional: their nominal values, one list per coupled motor
 
     [[joints]]                     # one table per joint, base to tip
     name = "joint1"
@@ -378,4 +379,11 @@ def _transmission(t: TransmissionTable, n: int, offsets: np.ndarray, source: str
                               f"joint {entry.joint}")
         r[entry.motor - 1, entry.joint - 1] = entry.ratio
     terms = t.coupled_terms if t.coupled_terms is not None else (list(COUPLING_TERMS) if t.coupling else [])
-    return Transmission(r, offsets, tuple(x for x in COUPLING_TERMS if x in terms))
+    if t.coupled_values is None:
+        return Transmission(r, offsets, tuple(x for x in COUPLING_TERMS if x in terms))
+    motors, given = Transmission.coupled_motors_of(r), [list(row) for row in t.coupled_values]
+    if len(given) != len(motors) or any(len(row) != len(terms) for row in given) or not np.all(np.isfinite(given)):
+        raise ConfigError(f"{where}.coupled_values: expected {len(motors)} list(s) (one per coupled motor) of {len(terms)} "
+                          f"finite numbers ({', '.join(terms)}), got {t.coupled_values!r}")
+    order = [terms.index(x) for x in COUPLING_TERMS if x in terms]  # the values in the order dynid keeps the terms
+    return Transmission(r, offsets, tuple(x for x in COUPLING_TERMS if x in terms), np.asarray(given, dtype=float)[:, order])

@@ -44,6 +44,9 @@ class TransmissionTable(Table, kw_only=True):
     coupling: Annotated[list[CouplingTable], Meta(description="coupled motors")] = msgspec.field(default_factory=list)
     coupled_terms: Annotated[list[Literal["Iam", "fvm", "fcm"]],
                              Meta(description="terms of each coupled motor: rotor inertia, viscous, Coulomb")] | None = None
+    coupled_values: Annotated[list[list[float]],
+                              Meta(description="nominal values of the coupled terms: one list per coupled motor (in motor "
+                                               "order), one value per term of coupled_terms (default 0)")] | None = None
 
 
 class PayloadTable(Table, kw_only=True):
