@@ -9,6 +9,7 @@ each log as ``dynid identify`` does.
 
     .venv/bin/python benchmarks/closed_loop_grid.py [realisations] [--band HZ] [--encoder DEG,..] [--torque NM,..]
         [--robot NAME_OR_DESCRIPTION --joints N]   (e.g. configs/robots/tx40_simulation.toml, 6: the coupled wrist)
+        [--estimators ols,idim-iv,didim-sdp]
 """
 
 from __future__ import annotations
@@ -32,8 +33,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--torque", default=",".join(map(str, TORQUE_NOISE)))
     parser.add_argument("--robot", default="er16")
     parser.add_argument("--joints", type=int, default=3)
+    parser.add_argument("--estimators", default=None, help="comma-separated (default: the study's eight)")
     args = parser.parse_args(argv)
-    config = ClosedLoopStudyConfig(robot=args.robot, joints=args.joints, encoder_noise=tuple(float(x) for x in args.encoder.split(",")),
+    chosen = {} if args.estimators is None else {"estimators": tuple(args.estimators.split(","))}
+    config = ClosedLoopStudyConfig(**chosen, robot=args.robot, joints=args.joints, encoder_noise=tuple(float(x) for x in args.encoder.split(",")),
                                    torque_noise=tuple(float(x) for x in args.torque.split(",")),
                                    realisations=args.realisations, band=args.band)
     load = os.getloadavg()[0]

@@ -78,7 +78,7 @@ class ClosedLoopEstimate:
     Attributes
     ----------
     method : str
-        "IDIM-WLS", "IDIM-IV" or "DIDIM".
+        "IDIM-WLS", "IDIM-IV", "DIDIM" or "DIDIM-SDP".
     params, params_std : (n_base,) arrays
         ``params_std`` NaN where the estimator gives no σ (DIDIM-SDP).
     iterations : int
