@@ -385,5 +385,6 @@ def _transmission(t: TransmissionTable, n: int, offsets: np.ndarray, source: str
     if len(given) != len(motors) or any(len(row) != len(terms) for row in given) or not np.all(np.isfinite(given)):
         raise ConfigError(f"{where}.coupled_values: expected {len(motors)} list(s) (one per coupled motor) of {len(terms)} "
                           f"finite numbers ({', '.join(terms)}), got {t.coupled_values!r}")
-    order = [terms.index(x) for x in COUPLING_TERMS if x in terms]  # the values in the order dynid keeps the terms
+    named = [str(x) for x in terms]
+    order = [named.index(x) for x in COUPLING_TERMS if x in named]  # the values in the order dynid keeps the terms
     return Transmission(r, offsets, tuple(x for x in COUPLING_TERMS if x in terms), np.asarray(given, dtype=float)[:, order])
