@@ -66,3 +66,9 @@ def test_the_zero_order_hold_of_a_closed_loop_log_is_half_a_period():
     held = zero_order_hold_delay(exp.controller.rate)
     assert held == pytest.approx(-0.5e-3)
     assert error(held) < 2e-4 < 1e-3 < error(0.0) < error(-held)
+
+
+def test_the_delay_is_said_where_the_settings_are():
+    said = Preprocessing(band=1.0, torque_delay=-5e-4).resolved(1000.0).derivation
+    assert "torques read 0.5 ms earlier than logged (torque_delay)" in said
+    assert "torque_delay" not in Preprocessing(band=1.0).resolved(1000.0).derivation

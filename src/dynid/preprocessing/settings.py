@@ -228,6 +228,9 @@ class Preprocessing:
         if self.trim is None and q is not None:  # at most a tenth of the log at each end
             trim = min(trim, 0.1 * q.shape[0] / rate)
         chosen = [f"excitation band {band:.3g} Hz ({source})"]
+        if self.torque_delay:
+            chosen.append(f"torques read {1e3 * abs(self.torque_delay):.3g} ms {'later' if self.torque_delay > 0 else 'earlier'} "
+                          "than logged (torque_delay)")
         if self.fourier is None:
             chosen.append(f"positions low-passed at {pos:.3g} Hz" + ("" if self.position_cutoff is not None else f" ({POSITION_FACTOR:g}× band)"))
         else:
