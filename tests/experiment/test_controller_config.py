@@ -61,8 +61,14 @@ def test_dynid_identify_runs_idim_iv_and_didim_beside_least_squares(closed_loop_
     assert "IDIM-IV" in p.stdout and "DIDIM" in p.stdout  # beside least squares in the parameters table
     estimates = json.loads((root / "out" / "results.json").read_text())["estimates"]
     assert list(estimates) == ["dynid WLS", "dynid IDIM-IV", "dynid DIDIM"]
+    # IDIM-IV converges. DIDIM's Gauss–Newton steps on this short six-joint log lead to a model whose closed loop
+    # cannot be simulated even when halved six times: it stops and says so, with the last estimate that could be
+    # (until the review of this stop it "converged" only because a bug restarted it from the description — here the
+    # simulation's truth — after every halved step)
+    assert "note" not in estimates["dynid IDIM-IV"], estimates["dynid IDIM-IV"].get("note")
+    didim = estimates["dynid DIDIM"].get("note", "")
+    assert didim == "" or "stopped: closed-loop simulation diverged" in didim, didim
     for label, e in estimates.items():
-        assert "note" not in e, (label, e.get("note"))  # converged
         # the well-determined parameters (σ below 5 % of the value) against the simulation's truth: within 5 σ
         good = [n for n in e["values"] if e["std"][n] < 0.05 * abs(truth[n])]
         assert len(good) >= 10

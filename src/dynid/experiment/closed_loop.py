@@ -214,77 +214,115 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
 
     for key in keys:
         if key == "didim-sdp":
-            w_standard = _rows(robot, base, data, standard=True)[0][keep]
-            out[key] = _didim_sdp(robot, base, simulated_rows, w_standard, tau, row_sigma, max_iter, tol)
+            out[key] = _didim_sdp(robot, base, simulated_rows, _rows(robot, base, data, standard=True)[0][keep], tau,
+                                  row_sigma, max_iter, tol)
             continue
-        beta, message, converged, note = start.copy(), "", False, ""
-        changes: list[float] = []
-        previous = w @ beta
-        std = start_std
-        good = None  # the last estimate that simulated
-        for _ in range(max_iter):
-            try:
-                ws = simulated_rows(beta)
-            except ConfigError as exc:  # the estimate cannot be simulated (unstable, a massless link)
-                if good is not None:
-                    # a step too long for the closed loop (Gauss-Newton far from the optimum): halve it towards the
-                    # last estimate that simulated, up to 6 times
-                    for halving in range(1, 7):
-                        trial = good + 0.5 ** halving * (beta - good)
-                        try:
-                            ws = simulated_rows(trial)
-                        except ConfigError:
-                            continue
-                        beta = trial
-                        note += f"a step halved {halving} time(s) to keep the closed loop stable; "
-                        break
-                    else:
-                        message = f"stopped: {exc}"
-                        break
-                elif changes or note:
-                    message = f"stopped: {exc}"
-                    break
-                # least squares biased far enough to be unstable in simulation: start from the description instead
-                # (instruments need only be uncorrelated with the noise; the iterations take them to the estimate)
-                note = f"the least-squares estimate cannot be simulated ({exc}); started from the description's values; "
-                beta = base.base_from_standard(nominal)
-                try:
-                    ws = simulated_rows(beta)
-                except ConfigError as again:
-                    message = f"stopped: neither the least-squares estimate nor the description can be simulated ({again})"
-                    break
-            good = beta.copy()
+
+        def step(ws, key=key):
             if key == "idim-iv":
                 sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None], instants)
-                beta, std = sol.params, sol.params_std
-                torque = w @ beta
-            else:
-                beta, std = _weighted_least_squares(ws, tau, row_sigma, instants)
-                torque = ws @ beta
-            change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
-            changes.append(change)
-            previous = torque
-            if change < tol:
-                converged, message = True, f"converged: the simulated torques changed by {change:.2g} (relative)"
-                break
-            if len(changes) >= 3 and change < STALLED and change >= 0.9 * min(changes[-3:-1]):
-                converged, message = True, (f"converged: the simulated torques change by {change:.2g} (relative) at each "
-                                            "iteration and no longer fall (the closed-loop simulation's own resolution)")
-                break
-        else:
-            message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
-        out[key] = ClosedLoopEstimate(LABELS[key], beta, std, len(changes), converged, tuple(changes), note + message)
+                return sol.params, sol.params_std, w @ sol.params
+            beta, std = _weighted_least_squares(ws, tau, row_sigma, instants)
+            return beta, std, ws @ beta
+
+        run = _iterate(simulated_rows, step, start, base.base_from_standard(nominal), w @ start, max_iter, tol,
+                       "the least-squares estimate")
+        out[key] = ClosedLoopEstimate(LABELS[key], run.x, start_std if run.std is None else run.std, len(run.changes),
+                                      run.converged, run.changes, run.message)
     return out
+
+
+@dataclass(frozen=True)
+class _Iterations:
+    """How the closed-loop iterations ended: the estimate ``x`` and its ``std`` (None: the start's), the relative
+    changes, whether they converged, and why they stopped."""
+
+    x: np.ndarray
+    std: np.ndarray | None
+    changes: tuple[float, ...]
+    converged: bool
+    message: str
+
+
+def _iterate(simulate, step, start, fallback, previous, max_iter: int, tol: float, start_words: str) -> _Iterations:
+    """The iterations IDIM-IV, DIDIM and DIDIM-SDP share: simulate the closed loop with the current estimate, take a
+    step on the simulated rows, until the modelled torques change by less than ``tol`` (or stall below
+    :data:`STALLED`).
+
+    An estimate whose closed loop cannot be simulated (unstable, a massless link) is replaced: the start by
+    ``fallback`` (the description's values: instruments need only be uncorrelated with the noise, and the iterations
+    take them to the estimate), a later step by halving it towards the last estimate that simulated, up to 6 times
+    (a Gauss–Newton step too long for the closed loop). When no halving can be simulated either, the iterations stop
+    and give the last estimate whose own closed loop could be simulated.
+
+    Parameters
+    ----------
+    simulate : callable
+        ``simulate(x)`` -> simulated rows; raises ConfigError when ``x`` cannot be simulated.
+    step : callable
+        ``step(rows)`` -> ``(x, std, torque)``, the next estimate, its σ and its modelled torques.
+    start, fallback : (p,) arrays
+    previous : (M,) array
+        The start's modelled torques [N·m].
+    max_iter : int
+    tol : float
+    start_words : str
+        What the start is, for the message.
+
+    Returns
+    -------
+    _Iterations
+    """
+    x, std, message, converged, note = start.copy(), None, "", False, ""
+    changes: list[float] = []
+    good = None  # the last estimate that simulated, halved steps included
+    kept = (x, std)  # the last estimate (and σ) of the iterations whose own closed loop simulated
+    for _ in range(max_iter):
+        try:
+            rows = simulate(x)
+            kept = (x, std)
+        except ConfigError as exc:
+            trials = ([(fallback, f"{start_words} cannot be simulated ({exc}); started from the description's values; ")]
+                      if good is None else
+                      [(good + 0.5**h * (x - good), f"a step halved {h} time(s) to keep the closed loop stable; ")
+                       for h in range(1, 7)])
+            last = exc
+            for trial, words in trials:
+                try:
+                    rows = simulate(trial)
+                except ConfigError as again:
+                    last = again
+                    continue
+                x, note = trial, note + words
+                break
+            else:
+                message = (f"stopped: {exc}; the estimate is the last one whose closed loop could be simulated"
+                           if good is not None else
+                           f"stopped: neither {start_words} nor the description can be simulated ({last})")
+                x, std = kept
+                break
+        good = x.copy()
+        x, std, torque = step(rows)
+        change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
+        changes.append(change)
+        previous = torque
+        if change < tol:
+            converged, message = True, f"converged: the simulated torques changed by {change:.2g} (relative)"
+            break
+        if len(changes) >= 3 and change < STALLED and change >= 0.9 * min(changes[-3:-1]):
+            converged, message = True, (f"converged: the simulated torques change by {change:.2g} (relative) at each "
+                                        "iteration and no longer fall (the closed-loop simulation's own resolution)")
+            break
+    else:
+        message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
+    return _Iterations(x, std, tuple(changes), converged, note + message)
 
 
 def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, tau, row_sigma, max_iter: int,
                tol: float) -> ClosedLoopEstimate:
-    """DIDIM with the physically consistent least squares at each step (module docstring).
-
-    It starts from the physically consistent least squares on the measured rows ``w_standard`` (IDIM-SDP), or from
-    the description's values when that cannot be simulated; a step whose closed loop cannot be simulated (a link left
-    with almost no inertia about its axis: the controller's gains then destabilise it) is halved towards the last
-    iterate that could be, up to 6 times — a mean of consistent models is consistent."""
+    """DIDIM with the physically consistent least squares at each step (module docstring), by :func:`_iterate` on
+    standard parameter vectors, from the physically consistent least squares on the measured rows ``w_standard``
+    (IDIM-SDP); a mean of consistent models is consistent, so the halved steps stay physical."""
     from ..dynamics.layout import consistency_layout
     from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 
@@ -295,39 +333,13 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
         sdp = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=nominal)
         return sdp.fit(w / row_sigma[:, None], tau / row_sigma).params_
 
-    phi = fit(w_standard)
-    previous = w_standard @ phi
-    changes: list[float] = []
-    converged, message, note = False, "", ""
-    good = None  # the last iterate that simulated
-    for _ in range(max_iter):
-        try:
-            ws = simulated_rows(phi, standard=True)
-        except ConfigError as exc:
-            trials = [(nominal, "started from the description's values")] if good is None else [
-                (good + 0.5**h * (phi - good), f"a step halved {h} time(s) to keep the closed loop stable") for h in range(1, 7)]
-            for trial, words in trials:
-                try:
-                    ws = simulated_rows(trial, standard=True)
-                except ConfigError:
-                    continue
-                phi, note = trial, note + words + "; "
-                break
-            else:
-                message = f"stopped: {exc}"
-                phi = good if good is not None else phi
-                break
-        good = phi.copy()
+    def step(ws):
         phi = fit(ws)
-        torque = ws @ phi
-        change = float(np.linalg.norm(torque - previous)) / max(float(np.linalg.norm(previous)), 1e-300)
-        changes.append(change)
-        previous = torque
-        if change < tol or (len(changes) >= 3 and change < STALLED and change >= 0.9 * min(changes[-3:-1])):
-            converged, message = True, f"converged: the simulated torques changed by {change:.2g} (relative)"
-            break
-    else:
-        message = f"not converged after {max_iter} simulations (last change {changes[-1]:.2g})"
-    beta = base.base_from_standard(phi)
-    return ClosedLoopEstimate(LABELS["didim-sdp"], beta, np.full(beta.size, np.nan), len(changes), converged,
-                              tuple(changes), note + message)
+        return phi, None, ws @ phi
+
+    phi = fit(w_standard)
+    run = _iterate(lambda x: simulated_rows(x, standard=True), step, phi, nominal, w_standard @ phi, max_iter, tol,
+                   "the IDIM-SDP estimate")
+    beta = base.base_from_standard(run.x)
+    return ClosedLoopEstimate(LABELS["didim-sdp"], beta, np.full(beta.size, np.nan), len(run.changes), run.converged,
+                              run.changes, run.message)

@@ -5,9 +5,9 @@ group delay). A delay ``d`` makes the measured torque at ``t`` the model's torqu
 cannot absorb. The delay minimises the least-squares residual of the identification: with the observation matrix
 ``W`` of the positions fixed (computed once), the parallel-filtered torques are read at ``t_k + d`` (interpolated
 on the full-rate grid, so ``d`` is found to a fraction of a sample) and ``RSS(d) = ‖(I − P_W) τ(t + d)‖²`` is
-minimised over ``|d| ≤ max_samples``, the torques shifted by a phase ramp on the mirror-extended log (band-limited:
-linear interpolation would average neighbouring samples, lower the noise at half-sample delays and pull the minimum
-there). Its σ is the Gauss–Newton one, ``σ_d² = S / (JᵀJ)²`` with ``J = ∂r/∂d`` and ``S`` the long-run variance of
+minimised over ``|d| ≤ max_samples``, the torques shifted by a band-limited fractional delay
+(:class:`dynid.preprocessing.filters.FractionalShift`: linear interpolation would average neighbouring samples, lower
+the noise at half-sample delays and pull the minimum there). Its σ is the Gauss–Newton one, ``σ_d² = S / (JᵀJ)²`` with ``J = ∂r/∂d`` and ``S`` the long-run variance of
 the scores ``J_i r_i`` over the log's instants (:func:`dynid.estimators.instrumental.long_run_covariance`), since the
 residual of a real log is correlated in time (MuJoCo's system identification fits the same measurement parameter, as a sensor delay).
 Current offsets need no step of their own: they are the ``offset`` drive term, identified with σ like the others.
@@ -56,7 +56,13 @@ class DelayEstimate:
     @property
     def determined(self) -> bool:
         """The log determines the delay: the minimum lies inside the bound and σ is below :data:`DETERMINED_STD`
-        samples (a slow excitation on a fast log changes the residual too little for a delay of a few samples)."""
+        samples (a slow excitation on a fast log changes the residual too little for a delay of a few samples).
+
+        A local criterion: on a short log whose motion barely excites the parameters, the delay trades off against
+        them, the residual has several near-equal minima and one of them can pass. Measured on the UR10e's
+        point-to-point logs: over ±20 samples the residual changes by 1-5 % (p1-p5; 21 times on its excitation log),
+        and in seven of p1-p10 delays of -18 to +18 samples pass with σ of 0.008-0.5. Estimate the delay on an
+        excitation log."""
         return not self.at_bound and self.std < DETERMINED_STD
 
 
