@@ -61,9 +61,12 @@ def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
     pooled_half = np.array([half.pooled_errors[u.id] for u in half.units])
     alone_full = np.array([u.validation_error for u in full.units])
     assert np.all(pooled_half < alone_half)
-    # the fleet closes most of the way from half a log to a whole one (measured: 1.53 of the gap here, seed 1: the
-    # pooled half log below the whole log alone for 4 of the 5 units)
+    # the fleet closes most of the way from half a log to a whole one
     assert np.mean(alone_half - pooled_half) > 0.5 * np.mean(alone_half - alone_full)
+    # the issue's bar: pooled on half its log, a unit predicts as well as alone on all of it — over the fleet (mean of
+    # the units' errors); unit by unit it holds for 16 of 20 units over seeds 1-4 (5, 5, 2, 4 of 5; measured at
+    # fc894ea), the mean in all four (seed 1: 0.077 against 0.106 %)
+    assert np.mean(pooled_half) <= np.mean(alone_full)
     assert not half.outliers and not full.outliers  # no odd unit in this fleet: none flagged
 
 

@@ -80,6 +80,51 @@ def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(tmp_path):
     assert (tmp_path / "m" / "monitor.png").is_file() and (tmp_path / "m" / "monitor.parquet").is_file()
 
 
+def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
+    """A folder that grows (14 daily logs, then 4 more, the change on the 15th): run once a day, the monitor goes on
+    from its state in --out, reads only the new logs, and writes the very monitor.json one run over every log writes;
+    its state refuses other settings and a new log dated before the last one it saw; --restart starts over."""
+    import shutil
+
+    simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
+                          step=0.10, coulomb=False, seed=3)
+    results = _identified(tmp_path)
+    files = sorted((tmp_path / "logs").glob("*.csv"))
+    growing = tmp_path / "growing"
+    growing.mkdir()
+
+    def run(folder, out, *extra):
+        return dynid("monitor", tmp_path / "unit.toml", "--logs", folder, "--results", results, "--out", out, *extra)
+
+    p = run(tmp_path / "logs", tmp_path / "once")
+    assert p.returncode == 0, p.stderr
+    for f in files[:14]:
+        shutil.copy(f, growing / f.name)
+    p = run(growing, tmp_path / "daily")
+    assert p.returncode == 0, p.stderr
+    assert json.loads((tmp_path / "daily" / "monitor.json").read_text())["alarms"] == []  # the change is in log 15
+    assert (tmp_path / "daily" / "monitor-state.pkl").is_file()
+    for f in files[14:]:
+        shutil.copy(f, growing / f.name)
+    p = run(growing, tmp_path / "daily")
+    assert p.returncode == 0, p.stderr
+    assert "went on from an earlier run's state (14 logs seen then, 4 new)" in " ".join(p.stdout.split())
+    once = json.loads((tmp_path / "once" / "monitor.json").read_text())
+    daily = json.loads((tmp_path / "daily" / "monitor.json").read_text())
+    assert daily == once and [a["term"] for a in daily["alarms"]] == ["fv3"]
+
+    assert_refused(run(growing, tmp_path / "daily", "--window", "5"), "monitor-state.pkl: made from another "
+                   "identification or with other monitor settings")
+    shutil.copy(files[0], growing / "2025-12-31T00-00.csv")
+    assert_refused(run(growing, tmp_path / "daily"), "2025-12-31T00-00.csv: a new log that sorts before")
+    (growing / "2025-12-31T00-00.csv").unlink()
+    (tmp_path / "daily" / "monitor-state.pkl").write_bytes(b"not a pickle")
+    assert_refused(run(growing, tmp_path / "daily"), "monitor-state.pkl: not a monitor state dynid can read")
+    p = run(growing, tmp_path / "daily", "--restart")
+    assert p.returncode == 0, p.stderr
+    assert json.loads((tmp_path / "daily" / "monitor.json").read_text()) == once and "went on" not in p.stdout
+
+
 def test_dynid_monitor_raises_no_alarm_where_nothing_changed(tmp_path):
     """Two hours of logs (120 one-minute logs at 100 Hz) of an unchanged robot: no alarm. The 24-hour figure is
     measured by benchmarks/bench_monitor.py."""

@@ -606,15 +606,21 @@ def monitor(
     logs: Path = typer.Option(..., help="Folder of the robot's logs; time order from the dates in their names "
                                         "(2026-01-15T08-30.csv), else their names."),
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json of the last full identification."),
-    out: Path = typer.Option(Path("dynid-monitor"), help="Output folder: monitor.json, monitor.parquet, monitor.png."),
+    out: Path = typer.Option(Path("dynid-monitor"), help="Output folder: monitor.json, monitor.parquet, monitor.png, "
+                                                         "and the state the next run goes on from."),
     data_root: Optional[Path] = typer.Option(None, help="Folder of the config's data files."),
     window: float = typer.Option(10.0, help="Seconds of log per window of re-identified friction terms."),
     reference_windows: int = typer.Option(60, help="Windows that set each term's reference (the first ones)."),
     false_alarm_days: float = typer.Option(30.0, help="One false alarm per this many days of logs, on average."),
+    restart: bool = typer.Option(False, "--restart", help="Monitor every log anew, not going on from the state an "
+                                                          "earlier run left in --out (monitor-state.pkl)."),
     quiet: bool = QUIET,
 ) -> None:
-    """Follow a robot's friction and drive terms through its logs and raise an alarm when one changes (wear)."""
-    from ..experiment.monitor import MonitorSettings, dated_logs, monitor_logs
+    """Follow a robot's friction and drive terms through its logs and raise an alarm when one changes (wear).
+
+    Run again on a growing folder, it goes on from the state the last run left in --out and reads only the new logs.
+    """
+    from ..experiment.monitor import STATE_FILE, MonitorSettings, dated_logs, monitor_fingerprint, monitor_logs, resumed_monitor
     from ..io.identification_config import load_identification_config
 
     def prepare():
@@ -623,11 +629,15 @@ def monitor(
         files = dated_logs(logs)
         from ..experiment.identified import load_results
 
-        return cfg, load_results(results, cfg.robot), files, settings
+        model = load_results(results, cfg.robot)
+        fingerprint = monitor_fingerprint(results, settings)
+        state = out / STATE_FILE
+        resume = resumed_monitor(state, fingerprint) if state.is_file() and not restart else None
+        return cfg, model, files, settings, resume, fingerprint
 
     def compute(prepared, progress):
-        cfg, model, files, settings = prepared
-        return monitor_logs(cfg, model, files, settings, progress=_steps(progress))
+        cfg, model, files, settings, resume, fingerprint = prepared
+        return monitor_logs(cfg, model, files, settings, progress=_steps(progress), resume=resume, fingerprint=fingerprint)
 
     def save(result):
         from ..report.monitor_run import save_monitor

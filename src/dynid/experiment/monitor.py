@@ -15,12 +15,19 @@ gives the whole family one false alarm per ``false_alarm_days`` days of logs on 
 change (log and time), and says how large it is; the term's new level is then learned over the next
 ``reference_windows`` windows and its chart restarts from it, so a wear that goes on raises a new alarm each time it
 has moved as much again.
+
+The monitor follows a stream: :meth:`FrictionMonitor.feed` takes one prepared log (or chunk of one) at a time, and its
+whole state pickles (:meth:`FrictionMonitor.state`, :func:`resumed_monitor`), so that ``dynid monitor`` run every day
+on a growing folder reads only the logs it has not seen (``monitor-state.pkl`` in its output folder) and gives what
+one run over every log would.
 """
 
 from __future__ import annotations
 
+import hashlib
+import pickle
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Iterable
 
@@ -31,7 +38,11 @@ from ..exceptions import ConfigError, DataError
 from ..validation.change_detection import Cusum
 
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
-           "monitor_logs", "determined"]
+           "monitor_logs", "determined", "STATE_FILE", "monitor_fingerprint", "resumed_monitor"]
+
+STATE_FILE = "monitor-state.pkl"
+"""The monitor's state in ``dynid monitor``'s output folder: the next run goes on from it."""
+_STATE_VERSION = 1
 
 _DATE = re.compile(r"(\d{4})-(\d{2})-(\d{2})(?:[T_ ](\d{2})[-:](\d{2})(?:[-:](\d{2}))?)?")
 
@@ -170,6 +181,11 @@ class MonitorResult:
     alarms : tuple of DriftAlarm
     settings : MonitorSettings
     logs : tuple of str
+        Every log monitored so far, oldest first.
+    state : bytes or None
+        The monitor's state to go on from (:meth:`FrictionMonitor.state`), when the run was asked to keep it.
+    resumed : int
+        Logs of an earlier run this one went on from (0: a new monitor).
     """
 
     terms: tuple[str, ...]
@@ -181,6 +197,8 @@ class MonitorResult:
     alarms: tuple[DriftAlarm, ...]
     settings: MonitorSettings
     logs: tuple[str, ...] = ()
+    state: bytes | None = field(default=None, repr=False, compare=False)
+    resumed: int = 0
 
     def to_dict(self) -> dict:
         """JSON-ready: the alarms, the reference, every window's terms.
@@ -438,6 +456,22 @@ class FrictionMonitor:
             self.relearn[c] = []  # the change is said: the chart follows the term's new level once it is learned
         return out
 
+    def state(self, fingerprint: str) -> bytes:
+        """The whole state, to go on from later (:func:`resumed_monitor`).
+
+        Parameters
+        ----------
+        fingerprint : str
+            What the state is valid for (:func:`monitor_fingerprint`).
+
+        Returns
+        -------
+        bytes
+            A pickle: read it back only from a folder you trust.
+        """
+        return pickle.dumps({"version": _STATE_VERSION, "fingerprint": fingerprint, "monitor": self},
+                            protocol=pickle.HIGHEST_PROTOCOL)
+
     def result(self) -> MonitorResult:
         """The monitored life so far.
 
@@ -449,8 +483,63 @@ class FrictionMonitor:
                              tuple(self.alarms), self.settings, tuple(self.logs))
 
 
+def monitor_fingerprint(results: str | Path, settings: MonitorSettings) -> str:
+    """What a monitor's state is valid for: the identification it started from (its results.json's bytes) and its
+    settings.
+
+    Parameters
+    ----------
+    results : str or Path
+        The results.json of the last full identification.
+    settings : MonitorSettings
+
+    Returns
+    -------
+    str
+        A SHA-256 hex digest.
+    """
+    digest = hashlib.sha256(Path(results).read_bytes())
+    digest.update(repr(settings).encode())
+    return digest.hexdigest()
+
+
+def resumed_monitor(path: str | Path, fingerprint: str) -> "FrictionMonitor":
+    """A monitor's saved state (:meth:`FrictionMonitor.state`), to feed it the logs it has not seen.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``monitor-state.pkl``.
+    fingerprint : str
+        :func:`monitor_fingerprint` of this run: the state must have been made from the same identification and
+        settings.
+
+    Returns
+    -------
+    FrictionMonitor
+
+    Raises
+    ------
+    DataError
+        A file that is no monitor state of this dynid, or one made from another identification or other settings.
+    """
+    path = Path(path)
+    try:
+        saved = pickle.loads(path.read_bytes())
+        version, made_for, monitor = saved["version"], saved["fingerprint"], saved["monitor"]
+    except Exception as exc:  # any unpickling failure: a foreign or damaged file
+        raise DataError(f"{path}: not a monitor state dynid can read ({type(exc).__name__}); remove it or give "
+                        "--restart") from None
+    if version != _STATE_VERSION or not isinstance(monitor, FrictionMonitor):
+        raise DataError(f"{path}: a monitor state of another dynid version; give --restart to start over")
+    if made_for != fingerprint:
+        raise DataError(f"{path}: made from another identification or with other monitor settings (--window, "
+                        "--reference-windows, --false-alarm-days); give --restart to start over, or another --out")
+    return monitor
+
+
 def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings = MonitorSettings(),
-                 progress=None) -> MonitorResult:
+                 progress=None, resume: "FrictionMonitor | None" = None, fingerprint: str | None = None) -> MonitorResult:
     """Monitor a robot through its logs, oldest first.
 
     Parameters
@@ -464,6 +553,10 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
     settings : MonitorSettings
     progress : callable, optional
         ``progress(step, done, total)``.
+    resume : FrictionMonitor, optional
+        An earlier run's monitor (:func:`resumed_monitor`): the logs it has seen are skipped, the others fed to it.
+    fingerprint : str, optional
+        Keep the state (:attr:`MonitorResult.state`) for the next run, valid for this (:func:`monitor_fingerprint`).
 
     Returns
     -------
@@ -472,7 +565,8 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
     Raises
     ------
     DataError
-        A log that cannot be read, or too few windows for the reference.
+        A log that cannot be read, too few windows for the reference, or (resuming) a new log that sorts before the
+        last one the monitor saw.
     """
     from ..io.datasets import load_recording
     from ..io.identification_config import dataset_for_file
@@ -480,7 +574,16 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
     from ..preprocessing.settings import carried_over
 
     logs = list(logs)
-    monitor = FrictionMonitor(model.robot, model.base, model.params(), settings)
+    monitor = resume if resume is not None else FrictionMonitor(model.robot, model.base, model.params(), settings)
+    resumed = len(monitor.logs)
+    if resume is not None:
+        seen = set(monitor.logs)
+        last = max((i for i, p in enumerate(logs) if p.name in seen), default=-1)
+        early = [p.name for p in logs[:last] if p.name not in seen]
+        if early:
+            raise DataError(f"{early[0]}: a new log that sorts before {logs[last].name}, the last one the monitor saw "
+                            "(it follows time); give --restart to monitor every log again")
+        logs = [p for p in logs if p.name not in seen]
     prep = carried_over(model.preprocessing, config.preprocessing)
     for i, path in enumerate(logs):
         if progress is not None:
@@ -490,4 +593,4 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
     if len(monitor.windows) <= settings.reference_windows:
         raise DataError(f"{len(monitor.windows)} windows of {settings.window:g} s in the logs: the reference needs "
                         f"{settings.reference_windows} and monitoring more (give more logs, or --reference-windows)")
-    return monitor.result()
+    return replace(monitor.result(), state=None if fingerprint is None else monitor.state(fingerprint), resumed=resumed)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..experiment.monitor import MonitorResult
+from ..experiment.monitor import STATE_FILE, MonitorResult
 from .output import save_figure, staged, write_results
 
 __all__ = ["save_monitor", "monitor_table"]
@@ -76,7 +76,8 @@ def _figure(result: MonitorResult, path: Path) -> None:
 
 @staged
 def save_monitor(result: MonitorResult, out: str | Path) -> list[Path]:
-    """Write ``monitor.json``, ``monitor.parquet`` (when pyarrow is installed) and ``monitor.png``.
+    """Write ``monitor.json``, ``monitor.parquet`` (when pyarrow is installed), ``monitor.png`` and the state the next
+    run goes on from (``monitor-state.pkl``, when the result keeps it).
 
     Parameters
     ----------
@@ -90,6 +91,9 @@ def save_monitor(result: MonitorResult, out: str | Path) -> list[Path]:
     out = Path(out)
     write_results(out / "monitor.json", result.to_dict(), "monitor")
     paths = [out / "monitor.json"]
+    if result.state is not None:
+        (out / STATE_FILE).write_bytes(result.state)
+        paths.append(out / STATE_FILE)
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq

@@ -668,6 +668,9 @@ def monitor_blocks(result) -> list:
                          rows))
     for a in result.alarms:
         out.append(Line(f"alarm: {a}", "warning"))
+    if result.resumed:
+        out.append(Line(f"went on from an earlier run's state ({result.resumed} logs seen then, "
+                        f"{len(result.logs) - result.resumed} new)"))
     out.append(Line(f"CUSUM per term (tuned to shifts of {result.settings.shift:g} reference spreads: k = "
                     f"{result.settings.shift / 2:g}, h = {result.threshold:.3g}): one false alarm per "
                     f"{result.settings.false_alarm_days:g} days of logs on average over all {len(result.terms)} terms"))
