@@ -37,6 +37,15 @@ def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     fleet = json.loads((out / "fleet.json").read_text())
     assert fleet["kind"] == "fleet" and fleet["outliers"][0]["unit"] == "r03" and fleet["outliers"][0]["parameter"] == "K2"
     assert (out / "units" / "r01" / "results.json").is_file() and (out / "fleet.html").is_file()
+    # each unit's pooled estimate is in its own results.json, beside its own estimate (which stays the main one)
+    from dynid import load_results
+
+    model = load_results(out / "units" / "r01" / "results.json")
+    pooled = fleet["pooled"]["units"]["r01"]
+    assert np.array_equal(model.params("pooled"), [pooled[n] for n in model.base.names])
+    assert model.main != "pooled" and not np.allclose(model.params("pooled"), model.params())
+    q = np.zeros((3, model.robot.n_dof)) + 0.3  # and predicts with it
+    assert not np.allclose(model.predict(q, q, q, estimate="pooled"), model.predict(q, q, q))
     assert "r03" in (out / "fleet.html").read_text()
 
 

@@ -23,7 +23,7 @@ from ..estimators.pooled import PooledEstimate
 from ..exceptions import ConfigError, DynIdError
 from ..io.fleet_manifest import FleetManifest, FleetUnit
 
-__all__ = ["UnitSummary", "FleetResult", "identify_unit", "run_fleet"]
+__all__ = ["UnitSummary", "FleetResult", "identify_unit", "run_fleet", "add_pooled_estimates"]
 
 POOLED = "pooled"
 """Label of the pooled estimate in the units' validations."""
@@ -154,6 +154,41 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
                        err, joints, str(result.consistency_verdicts.get(label, "")), gains, gains_std,
                        time.perf_counter() - t0, _peak_memory(), "", files, result.model or unit.config.robot,
                        stored_preprocessing({"settings": result.settings}))
+
+
+def add_pooled_estimates(out: str | Path, units: tuple[UnitSummary, ...], pooled) -> list[Path]:
+    """Write each unit's pooled estimate into its results.json (``out/units/<id>``) as one more estimate, ``"pooled"``,
+    beside the unit's own: ``dynid.load_results(...).predict(q, dq, ddq, estimate="pooled")`` uses it.
+
+    Parameters
+    ----------
+    out : path
+        The fleet's output folder.
+    units : tuple of UnitSummary
+        The units pooled, in the order of ``pooled``'s rows.
+    pooled : PooledEstimate
+
+    Returns
+    -------
+    list of Path
+        The results files rewritten (atomically; a unit without one is left out).
+    """
+    from ..io.files import write_json
+    from ..io.results import read_results
+
+    written = []
+    for i, unit in enumerate(units):
+        path = Path(out) / "units" / unit.id / "results.json"
+        if not path.is_file():
+            continue
+        results = read_results(path)
+        names = list(unit.names)
+        results.setdefault("estimates", {})[POOLED] = {
+            "key": POOLED, "values": dict(zip(names, pooled.params[i].tolist())),
+            "std": dict(zip(names, pooled.std[i].tolist())), "seconds": 0.0, "n_evaluations": None}
+        write_json(path, results)
+        written.append(path)
+    return written
 
 
 def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dict:
@@ -388,6 +423,8 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
                     pooled_errors[checks[fut]] = errors[POOLED]
                 if progress is not None:
                     progress(f"validated the pooled estimate of {checks[fut]}", done, len(checks))
+            if out is not None and save is not None:
+                add_pooled_estimates(out, ok, pooled)
     outliers, threshold = _flag(ok) if len(names) == 1 else ((), float("inf"))
     return FleetResult(manifest, ordered, outliers, threshold, pooled, pooled_errors, note, cluster,
                        time.perf_counter() - t0)
