@@ -49,6 +49,28 @@ def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     assert "r03" in (out / "fleet.html").read_text()
 
 
+def test_a_tx40_fleet_finds_its_unit_whose_drive_gain_is_off(tmp_path):
+    """Six simulated TX40s (coupled wrist; joints 2-3 with position offsets, which the written logs take off the angles
+    as an encoder reads them): the gains identified against the truth (1, one unit's K2 5 % off), friction within 5 %,
+    joint 6's gain undetermined (the calibration payload sits on its axis), and the odd unit flagged on K2 first."""
+    from dynid.experiment.fleet import run_fleet
+    from dynid.io.fleet_manifest import load_fleet_manifest
+
+    truths = simulate_fleet(tmp_path, robot="tx40", units=6, seconds=20.0, rate=200.0, validation_seconds=10.0,
+                            odd_unit=2, odd_joint=2, seed=0)
+    result = run_fleet(load_fleet_manifest(tmp_path / "fleet.toml"), workers=2)
+    assert [u.error for u in result.units] == [""] * 6
+    for unit, truth in zip(result.units, truths):
+        expected = truth.gain_factor[:5]
+        assert np.all(np.abs(unit.gains[:5] - expected) < 3 * unit.gains_std[:5] + 2e-3), unit.id
+        assert np.isnan(unit.gains[5])
+        names = list(unit.names)
+        if unit.id != "r03":  # the odd unit's own parameters carry its off gain
+            fv = np.array([unit.params[names.index(f"fv{j}")] for j in range(1, 7)])
+            assert fv == pytest.approx(truth.viscous, rel=0.05)
+    assert (result.outliers[0].unit, result.outliers[0].parameter) == ("r03", "K2")
+
+
 def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
     """Five units, each identified from half of its log: pooled with the others, each predicts its validation motion
     (noise-free, so the error is the model's alone) better than from its half log alone."""

@@ -30,11 +30,12 @@ __all__ = ["NOMINAL_FRICTION", "UnitTruth", "simulate_fleet", "simulate_service_
 
 NOMINAL_FRICTION = {
     "ur10e": ((9.0, 9.0, 7.0, 2.5, 2.5, 2.5), (6.0, 6.0, 4.0, 1.2, 1.2, 1.2)),
+    "tx40": ((7.14, 8.26, 6.34, 2.48, 3.03, 0.282), (8.05, 5.53, 1.97, 1.11, 1.86, 0.65)),
 }
-"""Coulomb [N·m] and viscous [N·m·s/rad] friction per joint of the simulated units (typical of an arm of its size;
-the built-in description carries none). Only the UR10e: the logs are written joint side with the description's
-drive gains, and the TX40's description reads motor-side torques through its gear ratios and coupled wrist, which
-these logs do not model (tried: its gains came out meaningless)."""
+"""Coulomb [N·m] and viscous [N·m·s/rad] friction per joint of the simulated units (the built-in descriptions carry
+none): for the UR10e, typical of an arm of its size; for the TX40, FIGAROH's values identified on the real robot
+(configs/robots/tx40_simulation.toml). The logs are written joint side, with the description's drive gains and its
+position offsets taken off the angles (the TX40's joints 2-3), as an encoder reads them."""
 
 
 @dataclass(frozen=True)
@@ -140,7 +141,9 @@ def _write_log(path: Path, robot: Robot, truth_robot: Robot, gains: np.ndarray, 
     n = robot.n_dof
     header = ",".join(["t"] + [f"q{j + 1}" for j in range(n)] + [f"i{j + 1}" for j in range(n)])
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, np.column_stack([t, meas.q, meas.current]), delimiter=",", header=header, comments="", fmt="%.9g")
+    # the log holds the encoders' angles: a reader adds the description's position offsets back (io.datasets)
+    logged = meas.q - robot.transmission.position_offset
+    np.savetxt(path, np.column_stack([t, logged, meas.current]), delimiter=",", header=header, comments="", fmt="%.9g")
 
 
 def _columns(n: int) -> str:
@@ -171,8 +174,8 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     ----------
     folder : path
         Created if missing.
-    robot : {"ur10e"}
-        Built-in robot the units are.
+    robot : {"ur10e", "tx40"}
+        Built-in robot the units are (the TX40 with its coupled wrist).
     units : int
     seconds, validation_seconds : float [s]
     rate : float [Hz]
@@ -262,7 +265,7 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
     Parameters
     ----------
     folder : path
-    robot : {"ur10e"}
+    robot : {"ur10e", "tx40"}
     days, logs_per_day : int
     seconds : float [s]
         Length of each log.
