@@ -50,3 +50,15 @@ def test_a_design_is_compared_on_its_criterion_and_the_rest_exactly():
     assert digests.differences(stored, {**moved, "/design/cond": 25.0}) == ["/design/cond: 20.0 -> 25.0"]
     assert digests.differences(stored, {**moved, "/design/initial_cond": 70.0}) == ["/design/initial_cond: 63.86 -> 70.0"]
     assert digests.differences(stored, {**moved, "/limits/q_max[0]": 2.9}) == ["/limits/q_max[0]: 2.96 -> 2.9"]
+
+
+def test_a_meaningless_correlation_and_a_pseudo_inertias_zero_are_compared_as_such():
+    stored = {"/validation[0]/metrics/dynid OLS/correlation[0]": -0.007, "/validation[0]/metrics/dynid OLS/correlation[1]": 0.9,
+              "/validation[0]/correlation_meaningful[0]": False, "/validation[0]/correlation_meaningful[1]": True,
+              "/estimates/dynid SDP/pseudo_inertia_min_eig[0]": 5.6793e-07}
+    moved = {**stored, "/validation[0]/metrics/dynid OLS/correlation[0]": -0.011, "/estimates/dynid SDP/pseudo_inertia_min_eig[0]": 5.6803e-07}
+    assert digests.differences(stored, moved) == []
+    assert digests.differences(stored, {**moved, "/validation[0]/metrics/dynid OLS/correlation[1]": 0.8}) == [
+        "/validation[0]/metrics/dynid OLS/correlation[1]: 0.9 -> 0.8"]
+    assert digests.differences(stored, {**moved, "/estimates/dynid SDP/pseudo_inertia_min_eig[0]": -1e-4}) == [
+        "/estimates/dynid SDP/pseudo_inertia_min_eig[0]: 5.6793e-07 -> -0.0001"]

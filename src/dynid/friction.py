@@ -30,8 +30,8 @@ def moving_sign(dq: np.ndarray, rest=0.0) -> np.ndarray:
     """``sign(dq)`` where the joint moves, 0 where it rests: with a rest velocity ``v_r > 0``,
     ``sign(dq)·clip(|dq|/v_r - 1, 0, 1)`` (0 below ``v_r``, a ramp to ±1 at ``2·v_r``).
 
-    Below ``v_r`` the measured velocity is noise (``v_r`` is 3 × its standard deviation,
-    :data:`dynid.preprocessing.bands.REST_FACTOR`), so its sign says nothing about the direction of motion;
+    Below ``v_r`` the measured velocity is noise (``v_r`` is :data:`dynid.preprocessing.bands.REST_FACTOR` × its
+    standard deviation), so its sign says nothing about the direction of motion;
     the friction of a joint at rest is whatever holds it, within ``±f_s`` (static friction). This is the
     memoryless form ("zero at rest"); :func:`held_direction` keeps the last direction instead.
 

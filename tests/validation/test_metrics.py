@@ -29,3 +29,11 @@ def test_global_relative_error_weighs_every_sample_and_joint():
     m = np.array([[3.0, 0.1], [4.0, 0.0]])
     p = np.array([[3.0, 0.0], [4.0, 0.1]])
     assert global_relative_error(m, p) == pytest.approx(100 * np.sqrt(0.02) / np.sqrt(25.01))
+
+
+def test_a_prediction_that_does_not_vary_has_no_correlation(rng):
+    m = rng.normal(size=(200, 2))
+    p = np.column_stack([m[:, 0], np.full(200, 75.0) + 1e-14 * rng.normal(size=200)])  # a held pose's rounding
+    rho = correlation_coefficient(m, p)
+    assert rho[0] == pytest.approx(1.0) and np.isnan(rho[1])
+    assert np.isfinite(correlation_coefficient(m, m + 1e-6 * rng.normal(size=m.shape))).all()

@@ -103,3 +103,24 @@ def test_a_joint_at_the_noise_level_is_flagged_with_its_absolute_error():
     error_row = next(r for r in table.rows if r[0].strip() == "error %")
     assert error_row[1] != "n/m" and error_row[2] == "n/m"
     assert cmp.to_dict()["relative_error_meaningful"] == [True, False]
+
+
+def test_a_prediction_that_is_rounding_of_zero_has_no_correlation():
+    """The TX40's nominal torque of joint 6 is 0 in exact arithmetic and 4e-17 N·m in floating point: its correlation
+    with the measured torque was ±0.254, its sign set by the last digits. Here the prediction of joint 2 is
+    ``0.1·3·x - 0.3·x``: rounding that follows the signal, so Pearson's formula gives 0.74."""
+    rng = np.random.default_rng(2)
+    m = 3_000
+    x = rng.standard_normal(m)
+    y = np.zeros((m, 2, 2))
+    y[:, 0] = rng.standard_normal((m, 2))
+    y[:, 1, 0], y[:, 1, 1] = 0.1 * x, 0.3 * x
+    beta = np.array([3.0, -1.0])
+    p = y @ beta
+    assert 0 < np.abs(p[:, 1]).max() < 1e-15 and abs(np.corrcoef(p[:, 1], x)[0, 1]) > 0.5  # what made it look defined
+    tau = p + np.column_stack([0.1 * rng.standard_normal(m), x])
+    sums = TorqueSums(2, 2, m)
+    sums.add(np.arange(m) * 0.01, y, tau)
+    for rho in (sums.comparison("x", {"b": beta}).metrics()["b"]["correlation"],
+                TorqueComparison("x", np.arange(m) * 0.01, tau, {"b": p}).metrics()["b"]["correlation"]):
+        assert rho[0] > 0.99 and np.isnan(rho[1])

@@ -17,6 +17,7 @@ from msgspec import Meta
 from typing import TYPE_CHECKING, Any
 
 from ..model.description_types import Angle, RobotDescription as _RobotDescription
+from ..preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
 from ..typed import Table
 
 if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
@@ -96,17 +97,17 @@ class PreprocessingTable(Table, kw_only=True):
     strategy: Annotated[str, _d("parallel (default), paper, or one registered")] | None = None
     order: Annotated[int, Meta(ge=1, description="order of the Butterworth filters (default 4)")] | None = None
     band: Annotated[PositiveHz, _d("Hz, the excitation band (default: from the positions' spectrum)")] | None = None
-    position_cutoff: Annotated[NonNegative, _d("Hz, positions (default 10x band); 0: no filter")] | None = None
+    position_cutoff: Annotated[NonNegative, _d(f"Hz, positions (default {POSITION_FACTOR:g}x band); 0: no filter")] | None = None
     velocity_cutoff: Annotated[NonNegative, _d("Hz, measured velocities (default: the position cutoff)")] | None = None
-    parallel_cutoff: Annotated[NonNegative, _d("Hz, torques and every regressor column (default 10x band)")] | None = None
+    parallel_cutoff: Annotated[NonNegative, _d(f"Hz, torques and every regressor column (default {PARALLEL_FACTOR:g}x band)")] | None = None
     decimation: Annotated[int, Meta(ge=1, description="parallel decimation (default: down to the parallel band)")] | None = None
-    min_speed: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: slower rows left out (default auto)")] | None = None
+    min_speed: Annotated[Union[Literal["auto"], PerJoint], _d(f"rad/s: slower rows left out (default auto: {MIN_SPEED_FRACTION:g} x the RMS speed)")] | None = None
     trim: Annotated[NonNegative, _d("s removed at both ends (default 3 / cutoff)")] | None = None
     chunk: Annotated[int, Meta(ge=1, description="samples per chunk of the regressor")] | None = None
     excitation: Annotated[str, _d("the excitation.json the robot ran: Fourier-fit derivatives")] | None = None
     coulomb_velocity: Annotated[Union[Literal["auto"], SmoothingVelocity, list[SmoothingVelocity]],
                                 _d("rad/s: Coulomb term tanh(dq/v); 0: sign; at most 10 (above, the term is a viscous one)")] | None = None
-    rest_velocity: Annotated[Union[Literal["auto"], PerJoint], _d("rad/s: below it a joint rests (default auto)")] | None = None
+    rest_velocity: Annotated[Union[Literal["auto"], PerJoint], _d(f"rad/s: below it a joint rests (default auto: {REST_FACTOR:g} x its velocity's noise)")] | None = None
     rest_friction: Annotated[Union[Literal["held", "zero"], NonNegative, list[Union[Literal["held", "zero"], NonNegative]]],
                              _d('friction at rest: "held", "zero" or a relaxation time [s], one or one per joint')] | None = None
     presliding: Annotated[PerJoint, _d("rad: Dahl's presliding distance (default 0)")] | None = None

@@ -12,17 +12,18 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 
     [preprocessing]                      # dynid.preprocessing.Preprocessing; all optional: by default every
                                          # cutoff derives from the excitation band found in the data
+                                         # (the factors: dynid.preprocessing.bands)
     order = 4
     band = 0.5                           # Hz, the excitation band (default: from the positions' spectrum)
-    position_cutoff = 5.0                # Hz, positions and measured velocities (default 10× band)
-    parallel_cutoff = 2.5                # Hz, torques AND every regressor column (default 5× band)
+    position_cutoff = 5.0                # Hz, positions and measured velocities (default: POSITION_FACTOR × band)
+    parallel_cutoff = 2.5                # Hz, torques AND every regressor column (default: PARALLEL_FACTOR × band)
     decimation = 16                      # default: down to the parallel band
-    min_speed = 0.0                      # rad/s, one value or one per joint; "auto" (default): 5 % of
-                                         # each joint's RMS speed
+    min_speed = 0.0                      # rad/s, one value or one per joint; "auto" (default):
+                                         # MIN_SPEED_FRACTION × each joint's RMS speed
     coulomb_velocity = 0.0               # rad/s, Coulomb term tanh(dq/v) per joint; 0 (default): sign(dq);
                                          # "auto": chosen per joint by blocked cross-validation
     rest_velocity = "auto"               # rad/s: below it a joint rests (no Coulomb friction predicted);
-                                         # "auto" (default): 3x its velocity's noise, for each log
+                                         # "auto" (default): REST_FACTOR × its velocity's noise, each log
     rest_friction = "held"               # at rest: the friction of the last motion ("held", default) or
                                          # none ("zero"); one value or one per joint
     excitation = "excitation.json"       # the robot ran this trajectory of dynid excite: derivatives

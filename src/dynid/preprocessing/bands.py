@@ -8,21 +8,21 @@ A user should never have to choose a cutoff. The rules below follow Gautier's id
   energy of the joint velocities lies, estimated from the spectrum of the measured positions above
   its noise floor (every joint together, each weighted by its own energy; :func:`estimate_band`), or
   ``n_harmonics·ω_f/2π`` of a known Fourier excitation (eq. 14);
-* positions (and measured velocities) are low-passed at ``f_q = 10·f_exc`` (Gautier: ω_fq ≥ 10·ω_dyn),
+* positions (and measured velocities) are low-passed at ``f_q =`` :data:`POSITION_FACTOR` ``· f_exc`` (Gautier: ω_fq ≥ 10·ω_dyn),
   so the filter leaves the motion untouched (a 4th-order zero-phase Butterworth changes a component at
   ``f_q/5`` by less than 0.01 %) while removing the noise that differentiation amplifies;
 * the **parallel filter** (the same zero-phase low-pass on the torques and on every column of the
   observation matrix, so measured and modelled torque stay comparable, sign(q̇) included) has its
-  cutoff at ``f_p = 5·f_exc``: every column keeps its in-band content while the torque noise above
+  cutoff at ``f_p =`` :data:`PARALLEL_FACTOR` ``· f_exc``: every column keeps its in-band content while the torque noise above
   it, which carries no information on the parameters, is removed;
 * the **decimation** keeps the largest factor whose anti-aliasing cutoff ``0.8·f_s/(2·d)`` stays at or
   above ``f_p`` (Khalil & Dombre: decimate after the parallel filter down to about twice its band).
 
-* rows of joint ``j`` slower than ``min_speed_j = 0.05 × its RMS speed`` are left out of the estimation
+* rows of joint ``j`` slower than ``min_speed_j =`` :data:`MIN_SPEED_FRACTION` ``× its RMS speed`` are left out of the estimation
   (not of the validation): near rest the measured velocity's sign, and so the Coulomb column, is
   unreliable (filter ringing, encoder noise, static friction), and those few rows bias every parameter.
 
-All cutoffs are capped at 0.8 × the Nyquist frequency.
+All cutoffs are capped at :data:`NYQUIST_CAP` × the Nyquist frequency.
 """
 
 from __future__ import annotations

@@ -283,7 +283,7 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
             j = int(slow[0])
             raise ConfigError(f"preprocessing.min_speed: {vmin[j]:.4g} rad/s is above every speed of joint {j + 1} in "
                               f"{recording.label} (at most {peak[j]:.4g} rad/s), which leaves it no row; lower it, or "
-                              "leave it out (5 % of each joint's RMS speed)")
+                              f"leave it out ({100 * MIN_SPEED_FRACTION:g} % of each joint's RMS speed)")
     if ddq is None:
         ddq = differentiate(dq, rate)
     t = recording.t

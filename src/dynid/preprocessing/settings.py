@@ -25,11 +25,11 @@ class Preprocessing:
         Order of the Butterworth filters.
     position_cutoff, velocity_cutoff : float or None [Hz]
         Zero-phase low-pass cutoffs of the positions and of measured velocities; 0 switches a filter
-        off. Default: ``10·band`` (velocities: the position cutoff).
+        off. Default: :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × ``band`` (velocities: the position cutoff).
     parallel_cutoff : float or None [Hz]
         Cutoff of the zero-phase low-pass applied to the torques **and** to every regressor column
-        (parallel filtering); 0: only the decimation's anti-aliasing filter. Default: ``10·band``
-        (:data:`dynid.preprocessing.bands.PARALLEL_FACTOR`), lowered to the decimation's own cutoff when a
+        (parallel filtering); 0: only the decimation's anti-aliasing filter. Default:
+        :data:`~dynid.preprocessing.bands.PARALLEL_FACTOR` × ``band``, lowered to the decimation's own cutoff when a
         given ``decimation`` needs it (said in :attr:`derivation`).
     decimation : int or None
         Parallel decimation factor. Default: the largest whose anti-aliasing cutoff is at or above
@@ -39,7 +39,7 @@ class Preprocessing:
         or the harmonics of ``fourier``.
     min_speed : "auto", float or tuple [rad/s]
         Rows of joint ``j`` where ``|dq_j| < min_speed_j`` are left out of the estimation (0: keep all).
-        "auto": 5 % of each joint's RMS speed (:data:`dynid.preprocessing.bands.MIN_SPEED_FRACTION`).
+        "auto": :data:`~dynid.preprocessing.bands.MIN_SPEED_FRACTION` × each joint's RMS speed.
     trim : float or None [s]
         Removed at both ends after filtering, where the filters' edge effects corrupt the derivatives.
         Default: ``3 / cutoff`` of the slowest filter the derivatives go through, 0 when those are off.
@@ -88,10 +88,10 @@ class Preprocessing:
         Applications of eq. 17 by the "paper" strategy (default 1).
     auto : bool
         Default true: when neither cutoff is given and the positions' noise knee lies well above
-        :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band (a slow motion on a quiet log: the 10× rule
+        :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band (a slow motion on a quiet log: the rule
         would filter away content the data hold), the position and parallel cutoffs (hence the decimation) are
-        chosen by blocked cross-validation among 10× the band, the knee and their geometric mean
-        (:func:`dynid.validation.cross_validation.choose_preprocessing`); false: the 10× rule.
+        chosen by blocked cross-validation among the rule's cutoff, the knee and their geometric mean
+        (:func:`dynid.validation.cross_validation.choose_preprocessing`); false: the rule.
     derivation : str
         Filled by :meth:`resolved`: what was derived from the data, and why.
     noise_share : float or None

@@ -87,14 +87,16 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
         rows: list[list] = []
         flagged: set = set()
         ok = c.get("relative_error_meaningful") or [True] * n
+        varies = c.get("correlation_meaningful") or [True] * n
         for label, m in sets.items():
             flagged |= {(len(rows), 2 + j) for j, x in enumerate(m["relative_error"]) if x is not None and ok[j] and x >= BAD_ERROR}
             rows.append([label, "error %", *(_fmt(x, ".3g") if ok[j] else "n/m" for j, x in enumerate(m["relative_error"])),
                          _fmt(m.get("global_relative_error"), ".3g")])
             rows.append(["", "RMSE N·m", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
-            rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") for x in m["correlation"]), ""])
+            rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") if varies[j] else "n/m" for j, x in enumerate(m["correlation"])), ""])
         tables.append(Table(f"{c['name']}: {c['n_samples']} samples (error of {BAD_ERROR:g} % and more highlighted; n/m: the "
-                            "joint's torque is at the noise level, its relative error means nothing)",
+                            "joint's torque is at the noise level, or does not vary beyond it: its relative error or correlation "
+                            "means nothing)",
                             ["parameters", "metric", *(f"J{j + 1}" for j in range(n)), "all"], rows, flagged=flagged))
     return tables
 

@@ -224,7 +224,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation, when
     there is a choice to make.
 
-    The default rule filters at 10× the excitation band (:mod:`dynid.preprocessing.bands`); on a slow motion logged
+    The default rule filters at :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the excitation band; on a slow motion logged
     with little noise, the positions' spectrum stays above the noise floor far beyond that (the knee,
     :attr:`dynid.preprocessing.bands.BandEstimate.knee`), and the content there (what the accelerations of the
     robot's own dynamics hold) is worth keeping. When the knee lies :data:`KNEE_MARGIN` times above the rule and the
@@ -284,7 +284,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     if score[best] > (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
         best = 0
     note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among "
-            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz (10× the band, the noise knee and their geometric mean)"
+            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz ({POSITION_FACTOR:g}× the band, the noise knee and their geometric mean)"
             + ("" if recording is full else f" on the log's middle {recording.n_samples} samples"))
     data = prepared[best]
     if recording is not full:

@@ -19,6 +19,38 @@ def _pair(measured, predicted) -> tuple[np.ndarray, np.ndarray]:
     return m, p
 
 
+ROUND_OFF = 1e-7
+"""A prediction whose standard deviation over the samples is below this fraction of its size does not vary: what is
+left is rounding (e.g. a joint whose nominal torque is 0 in exact arithmetic, 4e-17 N·m in floating point), and its
+correlation with anything is undefined. The size is the larger of the measured torque's spread and that of the
+terms the prediction sums where they are known (:func:`correlation_from_sums`: their rounding floor is ``√ε ≈ 1.5e-8``
+of it), else the prediction's RMS: a prediction that varies 1e-7 as much as what it predicts explains nothing of it."""
+
+
+def correlation_from_sums(s_mp: np.ndarray, s_mm: np.ndarray, s_pp: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Correlation coefficient (paper eq. 18) from centred sums; NaN where the prediction does not vary.
+
+    Parameters
+    ----------
+    s_mp, s_mm, s_pp : (n_dof,) arrays
+        ``Σ (m - m̄)(p - p̄)``, ``Σ (m - m̄)²``, ``Σ (p - p̄)²`` over the samples of each joint.
+    size : (n_dof,) array
+        The prediction's size in the units of ``s_pp``: where ``s_pp <= ROUND_OFF² · size`` its spread is rounding
+        (:data:`ROUND_OFF`; ``s_mm`` when it is larger). For ``p = Y·β`` from centred column sums ``S``:
+        ``(Σ_c |β_c| √S_cc)²``.
+
+    Returns
+    -------
+    (n_dof,) ndarray
+        ρ per joint, NaN where it is undefined (a prediction or a measurement that does not vary).
+    """
+    s_pp, s_mm = np.asarray(s_pp, dtype=float), np.asarray(s_mm, dtype=float)
+    varies = s_pp > ROUND_OFF**2 * np.maximum(np.asarray(size, dtype=float), s_mm)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rho = np.asarray(s_mp, dtype=float) / np.sqrt(s_mm * s_pp)
+    return np.where(varies, rho, np.nan)
+
+
 def correlation_coefficient(measured, predicted) -> np.ndarray:
     """Correlation coefficient per joint (paper eq. 18); 1 is a perfect model.
 
@@ -29,10 +61,12 @@ def correlation_coefficient(measured, predicted) -> np.ndarray:
     Returns
     -------
     (n_dof,) ndarray
+        NaN for a joint whose prediction (or measurement) does not vary: a standard deviation below :data:`ROUND_OFF`
+        times the prediction's RMS, or the measured torque's spread, is rounding, and no correlation is defined.
     """
     m, p = _pair(measured, predicted)
     mc, pc = m - m.mean(axis=0), p - p.mean(axis=0)
-    return (mc * pc).sum(axis=0) / np.sqrt((mc**2).sum(axis=0) * (pc**2).sum(axis=0))
+    return correlation_from_sums((mc * pc).sum(axis=0), (mc**2).sum(axis=0), (pc**2).sum(axis=0), (p**2).sum(axis=0))
 
 
 def rmse(measured, predicted) -> np.ndarray:

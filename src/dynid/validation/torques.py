@@ -15,7 +15,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..model.robot import Robot
 from ..preprocessing.pipeline import PreparedData, base_chunks
 from ..tables import TextTable
-from .metrics import correlation_coefficient, global_relative_error, relative_error, rmse
+from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
 
 __all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "comparison_table"]
 
@@ -176,6 +176,7 @@ class TorqueComparison:
             out["rest_share"] = self.rest_share
         if self.noise is not None:
             out["relative_error_meaningful"] = self.meaningful().tolist()
+            out["correlation_meaningful"] = self.varies().tolist()
             out["flags"] = self.flags()
         if self.spread:
             out["prediction_spread"] = self.spread
@@ -306,9 +307,11 @@ class TorqueSums:
             b = np.asarray(beta, dtype=float)
             s_pp = np.einsum("c,jcd,d->j", b, s_yy, b)
             s_pt = s_yt @ b
+            # the size of the centred terms the prediction sums: the rounding of s_pp = bᵀ S b is ε of it
+            terms = (np.sqrt(np.diagonal(s_yy, axis1=1, axis2=2)) @ np.abs(b)) ** 2
             sse = np.maximum(s_tt - 2 * s_pt + s_pp, 0.0) + n * (t_mean - y_mean @ b) ** 2
             metrics[label] = {"relative_error": 100.0 * np.sqrt(sse / tau_sq), "rmse": np.sqrt(sse / n),
-                              "correlation": s_pt / np.sqrt(s_tt * s_pp),
+                              "correlation": correlation_from_sums(s_pt, s_tt, s_pp, terms),
                               "global_relative_error": float(100.0 * np.sqrt(sse.sum() / tau_sq.sum()))}
             if self.rest_count.any():  # raw sums of the resting rows: Σ (τ - p)² = eᵀ G e with e = (β, -1)
                 e = np.concatenate([b, [-1.0]])
