@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 
 from dynid.dynamics.regressor import regressor
-from dynid.preprocessing.pipeline import PreparedData
+from dynid.preprocessing.prepared import PreparedData
 from dynid.preprocessing.strategies import Strategy, register_strategy
 
 

@@ -38,7 +38,8 @@ from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variable
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, Preprocessing, base_chunks, prepare
+from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]

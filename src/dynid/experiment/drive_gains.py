@@ -34,7 +34,8 @@ from ..dynamics.regressor import regressor
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.prepared import PreparedData
 
 
 def _last_link_columns(robot: Robot) -> np.ndarray:

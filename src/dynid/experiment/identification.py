@@ -27,7 +27,8 @@ from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, label 
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (BlockGrams, Finding, ResidualSums, bootstrap_finding, excitation_findings,
                                      sign_findings)
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows

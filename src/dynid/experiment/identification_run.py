@@ -13,7 +13,9 @@ from ..exceptions import ConfigError, DataError
 from ..io.datasets import DatasetSpec, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..model.robot import Robot
-from ..preprocessing.settings import Preprocessing, carried_over
+from ..preprocessing.settings import Preprocessing
+from ..preprocessing.strategies import carried_over
+from .identification_pipeline import IdentificationPipeline
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 
@@ -117,9 +119,6 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         (:class:`IdentifiabilityError`), each one line.
     """
     from ..dynamics.base_parameters import base_parameters
-    from ..preprocessing.pipeline import prepare
-    from ..validation.cross_validation import choose_coulomb_velocity
-    from .identification import identify
 
     def step(label):
         if progress is not None:
@@ -135,59 +134,44 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     for spec in config.validation if validate else ():
         step(f"reading {spec.name}")
         checked.append(load_recording(spec, config.robot))
-    from ..preprocessing.strategies import strategy_for
-
-    auto = config.preprocessing.auto and strategy_for(config.preprocessing).chooses_cutoffs
-    step("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
-    filters = None
-    if auto:
-        from ..validation.cross_validation import choose_preprocessing
-
-        filters = choose_preprocessing(config.robot, base, recording, config.preprocessing)
-        assert filters.data is not None  # the chosen candidate's prepared data
-        data = filters.data
-        filters = filters if filters.chose else None
-    else:
-        data = prepare(recording, config.preprocessing)
+    pipeline = pipeline_of(config)
+    prepared = pipeline.prepare(recording, base, step)
     raw = recording if config.closed_loop else None  # the closed-loop estimators prepare the log themselves
     del recording  # the raw positions and velocities: only the filtered ones are used from here
-    vs = config.preprocessing.coulomb_velocity
-    if vs == "auto":
-        step("Coulomb smoothing velocity (cross-validation)")
-    choice = choose_coulomb_velocity(config.robot, base, data) if vs == "auto" else None
-    robot = replace(config.robot, coulomb_velocity=choice.velocity if choice is not None else np.broadcast_to(vs, (config.robot.n_dof,)))
-    friction = None
-    if config.friction == "auto":
-        from ..validation.friction_models import choose_friction
-
-        step("friction model of each joint (cross-validation)")
-        friction = choose_friction(robot, data)
-        robot = friction.robot(robot)
-        data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
-        base = base_parameters(robot, rng=0)
-        refs = _references(replace(config, robot=robot), base)
+    if prepared.base is not base:  # the friction models chosen changed the map: the references follow it
+        refs = _references(replace(config, robot=prepared.robot), prepared.base)
+    robot, base = prepared.robot, prepared.base
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = identify(robot, base, data, config.estimators, refs, progress, config.seed,
-                          held_out=validate and not config.validation, sdp_prior=config.sdp_prior)
+        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
     if config.closed_loop:
         step("closed-loop estimators (" + ", ".join(config.closed_loop) + ")")
         result = _closed_loop(config, robot, base, result, raw)
-    result = replace(result, settings={**result.settings, "robot_source": config.robot_source,
-                                       "coulomb_velocity": robot.coulomb_velocity.tolist(),
-                                       **({} if choice is None else {"coulomb_cross_validation": choice.to_dict()}),
-                                       **({} if friction is None else {"friction_models": friction.to_dict()}),
-                                       **({} if filters is None else {"preprocessing_cross_validation": filters.to_dict()})})
     if not validate or not config.validation:
         return result
     validations, warnings = validate_sets(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
-                                      data.settings, result.joint_std, {result.label: result.solution.covariance})
+                                          prepared.data.settings, result.joint_std, {result.label: result.solution.covariance})
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     return replace(result, **_main_estimate(result))
+
+
+def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
+    """The identification pipeline a config describes: its robot, preprocessing, estimators, friction choice, seed.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+
+    Returns
+    -------
+    IdentificationPipeline
+    """
+    return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
+                                  config.sdp_prior, config.robot_source)
 
 
 def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
@@ -308,9 +292,11 @@ def run_validation(config: IdentificationConfig, identified: dict, datasets: tup
 
 @with_single_blas_thread
 def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
-                         estimators=("wls",), name: str = "arrays", friction: str = "description"):
-    """Identify a robot from arrays, without a config file or a CSV: the same pipeline as ``dynid identify``
-    (data-derived preprocessing, parallel filtering, the estimators, the verdict).
+                         estimators=("wls",), name: str = "arrays", friction: str = "description", seed: int = 0,
+                         sdp_prior: str = "euclidean"):
+    """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
+    (:class:`~dynid.experiment.identification_pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
+    cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
 
     Parameters
     ----------
@@ -333,6 +319,10 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         The dataset's name in tables and messages.
     friction : {"description", "auto"}
         The robot's friction terms as described, or each joint's model chosen by cross-validation.
+    seed : int
+        Seeds the box searches and the bootstrap (``[estimation] seed``).
+    sdp_prior : {"euclidean", "geometric"}
+        As ``[estimation] sdp_prior``.
 
     Returns
     -------
@@ -345,14 +335,45 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     DataError
         Time stamps that do not increase, or a gap longer than 5 median steps.
     ConfigError
-        An unknown estimator.
+        An unknown estimator or ``friction``.
+    """
+    from ..model.description import builtin_robots
+
+    pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), tuple(estimators), friction, int(seed), sdp_prior,
+                                      robot.name if robot.name in builtin_robots() else "")
+    return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))
+
+
+def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"):
+    """A recording of arrays, checked and on a uniform grid as the log readers give one.
+
+    Parameters
+    ----------
+    robot : Robot
+        Its number of joints is the arrays' width.
+    t : (N,) array [s]
+        Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step.
+    q : (N, n_dof) array [rad]
+    tau : (N, n_dof) array [N·m]
+    dq : (N, n_dof) array [rad/s], optional
+    name : str
+        The dataset's name in messages.
+
+    Returns
+    -------
+    dynid.io.datasets.Recording
+        Starting at t = 0; a warning when the time stamps were interpolated.
+
+    Raises
+    ------
+    ShapeError
+        Arrays of inconsistent shapes, not time-first, or not finite.
+    DataError
+        Time stamps that do not increase, or a gap longer than 5 median steps.
     """
     from ..checks import check_trajectory_array
-    from ..dynamics.base_parameters import base_parameters
     from ..exceptions import ShapeError
     from ..io.datasets import GAP_FACTOR, Recording, resampled, uniform_rate
-    from ..preprocessing.pipeline import prepare
-    from .identification import identify
 
     t = np.asarray(t, dtype=float).reshape(-1)
     q = check_trajectory_array(q, robot.n_dof, "q")
@@ -378,22 +399,4 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
                     f"uniform grid at {rate:.6g} Hz",)
     else:
         rate = 1.0 / median
-    recording = Recording(name, t - t[0], q, dq, tau, rate, warnings)
-    settings = preprocessing or Preprocessing()
-    data = prepare(recording, settings)
-    base = base_parameters(robot, rng=0)
-    if friction == "auto":
-        from ..validation.friction_models import choose_friction
-
-        choice = choose_friction(robot, data)
-        robot = choice.robot(robot)
-        data = data.with_rest_model(choice.rest_friction(), data.settings.presliding)
-        base = base_parameters(robot, rng=0)
-    elif friction != "description":
-        raise ConfigError(f'friction: expected "description" or "auto", got {friction!r}', field="friction")
-    result = identify(robot, base, data, estimators, (), None, held_out=True)
-    from ..model.description import builtin_robots
-
-    return replace(result, settings={**result.settings, "robot_source": robot.name if robot.name in builtin_robots() else "",
-                                     "coulomb_velocity": robot.coulomb_velocity.tolist(),
-                                     **({} if friction != "auto" else {"friction_models": choice.to_dict()})})
+    return Recording(name, t - t[0], q, dq, tau, rate, warnings)

@@ -265,7 +265,7 @@ class IdentifiedModel:
 
     def predict_log(self, recording, estimate: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Measured and predicted torques of a log, prepared as the identification log was (its filters, carried
-        over: :func:`dynid.preprocessing.settings.carried_over`), on the samples the comparison keeps.
+        over: :func:`dynid.preprocessing.strategies.carried_over`), on the samples the comparison keeps.
 
         Parameters
         ----------
@@ -296,7 +296,7 @@ class IdentifiedModel:
         dynid.validation.torques.TorqueComparison
         """
         from ..preprocessing.pipeline import prepare
-        from ..preprocessing.settings import carried_over
+        from ..preprocessing.strategies import carried_over
         from ..validation.torques import compare_torques
 
         settings = carried_over(self.preprocessing, self.preprocessing or Preprocessing())

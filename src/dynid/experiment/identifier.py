@@ -148,7 +148,8 @@ class Identifier:
             if q is None or tau is None:
                 raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
-                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description")
+                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
+                                          seed=0 if self.seed is None else int(self.seed))
         self.result_ = result
         self.model_ = IdentifiedModel.from_result(result)
         main = result.main_estimate

@@ -571,7 +571,7 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
     from ..io.datasets import load_recording
     from ..io.identification_config import dataset_for_file
     from ..preprocessing.pipeline import prepare
-    from ..preprocessing.settings import carried_over
+    from ..preprocessing.strategies import carried_over
 
     logs = list(logs)
     monitor = resume if resume is not None else FrictionMonitor(model.robot, model.base, model.params(), settings)

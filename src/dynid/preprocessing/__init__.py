@@ -7,7 +7,7 @@ _EXPORTS = {
     "cutoffs_from_band": "bands",
     "excitation_band": "bands",
     "fourier_fit_derivatives": "fourier_fit",
-    "PreparedData": "pipeline",
+    "PreparedData": "prepared",
     "Preprocessing": "settings",
     "base_chunks": "pipeline",
     "prepare": "pipeline",

@@ -15,7 +15,7 @@ import numpy as np
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
 from .fourier_fit import fourier_fit_derivatives
-from .pipeline import PreparedData
+from .prepared import PreparedData
 from .settings import Preprocessing
 from .smoothing import five_point_cubic_smoothing
 from .strategies import Strategy

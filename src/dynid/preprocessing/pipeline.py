@@ -1,4 +1,6 @@
-"""The preprocessing pipeline of logs: one place where every filter is chosen and applied.
+"""The preprocessing of logs: :func:`prepare` and :func:`base_chunks` by the strategy the settings name
+(:mod:`dynid.preprocessing.strategies`), and the default strategy, :class:`ParallelFiltering`, where every filter is
+chosen and applied:
 
 Recording → zero-phase low-pass of positions (and measured velocities) → derivatives by central
 differences (or a Fourier fit on a known excitation's harmonics) → base regressor and torques computed
@@ -14,8 +16,8 @@ band of the data (:mod:`dynid.preprocessing.bands`), and :attr:`Preprocessing.de
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-from typing import Any, Callable
+from dataclasses import replace
+from typing import Callable
 
 import numpy as np
 
@@ -24,82 +26,15 @@ from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
-from ..friction import Velocities, held_direction, moving_joints
+from ..friction import moving_joints
 from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
 from .filters import FractionalShift, butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
 from .fourier_fit import fourier_fit_derivatives
+from .prepared import PreparedData, direction_of_motion, min_speeds, rest_velocities
 from .settings import Preprocessing
-
 from .strategies import Strategy, strategy_for
 
 __all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare", "torque_delayed"]
-
-Samples = Any
-"""An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
-
-
-@dataclass(frozen=True)
-class PreparedData:
-    """Filtered joint signals on a uniform grid, ready for the regressor.
-
-    Signals are arrays, or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
-
-    Attributes
-    ----------
-    name : str
-        The dataset.
-    t : (N,) array [s]
-    q, dq, ddq : (N, n_dof) samples [rad, rad/s, rad/s²]
-    tau : (N, n_dof) samples [N·m]
-        Joint torques (drive gains applied).
-    rate : float [Hz]
-        Rate of the grid (after decimation).
-    settings : Preprocessing
-        Resolved settings.
-    warnings : tuple of str
-    direction : (N, n_dof) array or None
-        Direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`).
-    motion : (N, n_dof) array or None
-        The velocity [rad/s] that says where a joint moves (no overshoot where it stops).
-    resting : (N, n_dof) bool array or None
-        Where each joint rests (:func:`dynid.friction.moving_joints`).
-    """
-
-    name: str
-    t: np.ndarray
-    q: Samples
-    dq: Samples
-    ddq: Samples
-    tau: Samples
-    rate: float
-    settings: Preprocessing
-    warnings: tuple[str, ...] = ()
-    direction: np.ndarray | None = None
-    """(N, n_dof) direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`)."""
-    motion: np.ndarray | None = None
-    """(N, n_dof) the velocity [rad/s] that says where a joint moves (no overshoot where it stops)."""
-    resting: np.ndarray | None = None
-    """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
-
-    def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
-        """The same samples with another rest model and presliding distance.
-
-        The direction of motion is computed anew, the settings say so.
-
-        Parameters
-        ----------
-        rest_friction : str, float or tuple
-            "held", "zero", a relaxation time [s], or one per joint.
-        presliding : float or tuple
-            Presliding distance [rad], or one per joint.
-
-        Returns
-        -------
-        PreparedData
-        """
-        s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
-        return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
-
 
 def prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
     """Filtered joint signals of a recording, by the strategy ``settings.strategy`` names
@@ -275,7 +210,7 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
                     derivation=s.derivation + f"; rows slower than {100 * MIN_SPEED_FRACTION:g} % of the joint's RMS speed "
                     "(or than twice its rest velocity) left out of the estimation")
     elif strict:  # a given minimum speed above every speed of a joint leaves it no row
-        vmin = _min_speed(s, recording.q.shape[1])
+        vmin = min_speeds(s, recording.q.shape[1])
         peak = np.abs(dq).max(axis=0) if isinstance(dq, np.ndarray) else np.array(
             [np.abs(dq.column(j)).max() for j in range(dq.shape[1])])
         slow = np.flatnonzero(vmin > peak)
@@ -331,46 +266,6 @@ def _velocity_noise(recording, s: Preprocessing) -> np.ndarray:
     return velocity_noise_std(sigma, recording.rate, _hz(s.position_cutoff), s.order, True, gaussian=True)
 
 
-def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
-    v = np.asarray(value)
-    v = np.full(n, v.item()) if v.ndim == 0 else v
-    if v.shape != (n,) or (allowed is not None and not set(v.tolist()) <= allowed):
-        raise ConfigError(f"preprocessing.{where}: expected one value or {n} of them"
-                          + (f" among {sorted(allowed)}" if allowed else "") + f", got {value!r}")
-    return v
-
-
-def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
-    """Each joint's direction of motion, column by column (stored columns stay stored).
-
-    :func:`dynid.friction.held_direction` with the log's rest velocities, rest model and presliding distances.
-
-    Parameters
-    ----------
-    dq : (N, n_dof) samples [rad/s]
-        Velocities.
-    guide : (N, n_dof) samples [rad/s]
-        Velocity that says where a joint moves.
-    s : Preprocessing
-        Resolved settings.
-    rate : float [Hz]
-
-    Returns
-    -------
-    (N, n_dof) array or StoredColumns
-        In [-1, 1].
-    """
-    n = dq.shape[1]
-    guide = dq if guide is None else guide
-    rest = _per_joint(0.0 if s.rest_velocity == "auto" else s.rest_velocity, n, "rest_velocity").astype(float)
-    decay = rest_decay(s.rest_friction, n)
-    x0 = _per_joint(s.presliding, n, "presliding").astype(float)
-    cutoff = s.band if s.fourier is not None else (s.velocity_cutoff or s.position_cutoff or rate / 4)
-    travel = rest / cutoff  # a blip of the rest velocity's size lasts about 1/cutoff
-    return by_column(dq, lambda column, j: held_direction(column[:, None], rest[j], decay[j], x0[j], rate,
-                                                          np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
-
-
 def _rest_words(value) -> str:
     if value == "held":
         return "where it keeps the friction of its last motion"
@@ -380,56 +275,6 @@ def _rest_words(value) -> str:
         return f"where the friction of its last motion relaxes with a time constant of {value:g} s"
     return "where the friction of its last motion relaxes with time constants " + ", ".join(
         "∞" if x == "held" else "0" if x == "zero" else f"{x:g}" for x in value) + " s"
-
-
-def rest_decay(value, n: int) -> np.ndarray:
-    """``rest_friction`` as relaxation times.
-
-    Parameters
-    ----------
-    value : str, float or tuple
-        "held", "zero", seconds, or one per joint.
-    n : int
-        Number of joints.
-
-    Returns
-    -------
-    (n,) ndarray [s]
-        inf: held; 0: zero.
-    """
-    v = _per_joint(value, n, "rest_friction")
-    try:
-        return np.array([np.inf if x == "held" else 0.0 if x == "zero" else float(x) for x in v.tolist()])
-    except (TypeError, ValueError):
-        raise ConfigError(f'preprocessing.rest_friction: expected "held", "zero" or a relaxation time in seconds, '
-                          f"got {value!r}") from None
-
-
-def rest_velocities(data: PreparedData, robot: Robot) -> Velocities:
-    """The friction columns' velocities for a log: the robot's, with the log's rest velocity and direction.
-
-    Parameters
-    ----------
-    data : PreparedData
-    robot : Robot
-
-    Returns
-    -------
-    Velocities
-    """
-    v = robot.friction_velocities
-    rest = data.settings.rest_velocity
-    return Velocities(v.coulomb, v.stribeck, np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float),
-                                                               (robot.n_dof,)), None)
-
-
-def _min_speed(settings: Preprocessing, n: int) -> np.ndarray:
-    v = np.asarray(settings.min_speed, dtype=float)
-    if v.ndim == 0:
-        v = np.full(n, float(v))
-    if v.shape != (n,) or np.any(v < 0):
-        raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
-    return v
 
 
 def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
@@ -449,7 +294,7 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
     """
     n = robot.n_dof
     s = data.settings
-    vmin = _min_speed(s, n)
+    vmin = min_speeds(s, n)
     n_s = data.t.shape[0]
     velocities = rest_velocities(data, robot)
 

@@ -256,38 +256,3 @@ class Preprocessing:
         """
         return {f.name: (list(getattr(self, f.name)) if isinstance(getattr(self, f.name), tuple) else getattr(self, f.name))
                 for f in fields(self) if f.name != "warnings"}
-
-
-def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
-    """Settings of a log scored with another log's parameters (a validation log).
-
-    The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,
-    at least the identification log's (so a faster validation motion is filtered for its own band, never below the
-    identification's), its decimation and trim (its rate and length may differ; a decimation the config gives is the
-    identification log's), its rest velocity (at least the identification's); the identification's friction state at
-    rest; no Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
-    cutoff above this log's Nyquist frequency is lowered, with a warning.
-
-    Parameters
-    ----------
-    resolved : Preprocessing or None
-        The identification log's resolved settings (None: nothing to carry over).
-    given : Preprocessing
-        The config's settings as written.
-
-    Returns
-    -------
-    Preprocessing
-        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the other log.
-    """
-    from .strategies import strategy_for
-
-    if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log
-        given = replace(given, strategy="parallel")
-    if resolved is None:
-        return replace(given, fourier=None, decimation=None, warnings=())
-    floor: float | tuple = 0.0
-    if given.rest_velocity == "auto" and not isinstance(resolved.rest_velocity, str):
-        floor = resolved.rest_velocity
-    return replace(given, fourier=None, decimation=None, band_floor=resolved.band or 0.0, rest_floor=floor,
-                   rest_friction=resolved.rest_friction, presliding=resolved.presliding, warnings=(), derivation="")

@@ -4,7 +4,7 @@ rows the estimators see.
 A strategy has two steps, used by ``dynid identify``, ``validate``, ``run``, ``montecarlo`` and :class:`dynid.Identifier`
 alike:
 
-- ``prepare(recording, settings, strict)`` → :class:`dynid.preprocessing.pipeline.PreparedData`: positions,
+- ``prepare(recording, settings, strict)`` → :class:`dynid.preprocessing.prepared.PreparedData`: positions,
   velocities and accelerations on a uniform grid (torques as measured);
 - ``chunks(robot, base, data, progress, standard)`` → ``(index, y, tau, keep)`` blocks: the base (or standard)
   regressor and the torques after the filters that must touch both alike, and the rows kept for estimation.
@@ -24,19 +24,20 @@ name it in ``[preprocessing] strategy``.
 from __future__ import annotations
 
 import importlib
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from ..exceptions import ConfigError
+from .settings import Preprocessing
 
 if TYPE_CHECKING:
     import numpy as np
 
     from ..dynamics.base_parameters import BaseParameters
     from ..model.robot import Robot
-    from .pipeline import PreparedData
-    from .settings import Preprocessing
+    from .prepared import PreparedData
 
-__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for"]
+__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for", "carried_over"]
 
 Chunk = tuple["np.ndarray", "np.ndarray", "np.ndarray", "np.ndarray"]
 
@@ -248,3 +249,36 @@ def strategy_for(settings: "Preprocessing | str") -> Strategy:
     if not target.name:
         target.name = key
     return target
+
+
+def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
+    """Settings of a log scored with another log's parameters (a validation log).
+
+    The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,
+    at least the identification log's (so a faster validation motion is filtered for its own band, never below the
+    identification's), its decimation and trim (its rate and length may differ; a decimation the config gives is the
+    identification log's), its rest velocity (at least the identification's); the identification's friction state at
+    rest; no Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
+    cutoff above this log's Nyquist frequency is lowered, with a warning.
+
+    Parameters
+    ----------
+    resolved : Preprocessing or None
+        The identification log's resolved settings (None: nothing to carry over).
+    given : Preprocessing
+        The config's settings as written.
+
+    Returns
+    -------
+    Preprocessing
+        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the other log.
+    """
+    if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log
+        given = replace(given, strategy="parallel")
+    if resolved is None:
+        return replace(given, fourier=None, decimation=None, warnings=())
+    floor: float | tuple = 0.0
+    if given.rest_velocity == "auto" and not isinstance(resolved.rest_velocity, str):
+        floor = resolved.rest_velocity
+    return replace(given, fourier=None, decimation=None, band_floor=resolved.band or 0.0, rest_floor=floor,
+                   rest_friction=resolved.rest_friction, presliding=resolved.presliding, warnings=(), derivation="")

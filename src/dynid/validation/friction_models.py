@@ -36,7 +36,7 @@ from ..friction import TERMS, Velocities, held_direction
 from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with
 from ..model.robot import Robot
 from ..preprocessing.filters import parallel_decimation
-from ..preprocessing.pipeline import PreparedData, _min_speed, rest_decay
+from ..preprocessing.prepared import PreparedData, min_speeds, rest_decay
 
 __all__ = ["FOLDS", "FrictionChoice", "choose_friction"]
 
@@ -202,7 +202,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     fit = np.zeros((folds, n, size, size))
     score = np.zeros((folds, n, size, size))
     n_rows = np.zeros((folds, n))
-    vmin = _min_speed(s, n)
+    vmin = min_speeds(s, n)
     n_s = data.t.shape[0]
     load_sq, tau_sq, resting = np.zeros(n), np.zeros(n), np.zeros(n)
     directions_start = [0]

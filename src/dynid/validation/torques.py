@@ -13,7 +13,8 @@ import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters
 from ..model.robot import Robot
-from ..preprocessing.pipeline import PreparedData, base_chunks
+from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.prepared import PreparedData
 from ..tables import TextTable
 from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
 

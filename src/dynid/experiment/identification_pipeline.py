@@ -1,0 +1,241 @@
+"""The identification pipeline, assembled from its parts: a robot model, a preprocessing strategy with the choices it
+derives from the data, the base-parameter map, and the estimators.
+
+One recording goes through it the same way whoever calls it (``dynid identify`` from a config,
+:func:`dynid.identify_from_arrays` and :class:`dynid.Identifier` from arrays)::
+
+    pipeline = IdentificationPipeline(robot, preprocessing, estimators=("wls", "sdp"), friction="auto")
+    prepared = pipeline.prepare(recording)          # filters, Coulomb smoothing, friction models: chosen on the data
+    result = pipeline.estimate(prepared)            # every estimator, the consistency checks, the verdict
+
+:meth:`~IdentificationPipeline.prepare` (Gautier's parallel filtering and decimation, or the paper's eq. 17 with
+Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
+
+1. the filters: the strategy's rule on the excitation band, or, when the positions' noise knee lies far above it,
+   cutoffs chosen by blocked cross-validation (:func:`dynid.validation.cross_validation.choose_preprocessing`);
+2. the Coulomb smoothing velocity (``preprocessing.coulomb_velocity``: given, or "auto" by cross-validation);
+3. each joint's friction model and its state at rest (``friction = "auto"``,
+   :func:`dynid.validation.friction_models.choose_friction`), which may change the base-parameter map.
+
+:meth:`~IdentificationPipeline.estimate` is :func:`dynid.experiment.identification.identify` on the prepared data; the
+result's ``settings`` say every choice and why. Reading logs and configs, drive gains, closed-loop estimators and
+validation on other logs are the callers' (:mod:`dynid.experiment.identification_run`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+
+from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..exceptions import ConfigError
+from ..model.robot import Robot
+from ..preprocessing.pipeline import prepare
+from ..preprocessing.prepared import PreparedData
+from ..preprocessing.settings import Preprocessing
+from ..preprocessing.strategies import strategy_for
+
+__all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
+
+FRICTION_CHOICES = ("auto", "description")
+"""``friction``: each joint's model chosen by cross-validation, or the description's terms."""
+
+
+@dataclass(frozen=True)
+class PreparedIdentification:
+    """A recording prepared for the estimators, with the model the data chose.
+
+    Attributes
+    ----------
+    robot : Robot
+        The model as it will be identified: the description with the chosen Coulomb smoothing velocities and friction
+        models (the description itself is never modified).
+    base : BaseParameters
+        The base-parameter map of :attr:`robot`.
+    data : PreparedData
+        The filtered signals (their resolved settings in ``data.settings``).
+    choices : dict
+        What the data chose, as results.json stores it: ``coulomb_velocity`` [rad/s] per joint, and when made,
+        ``preprocessing_cross_validation``, ``coulomb_cross_validation``, ``friction_models``.
+    """
+
+    robot: Robot
+    base: BaseParameters
+    data: PreparedData
+    choices: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class IdentificationPipeline:
+    """Identification of one robot from one recording (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot's description.
+    preprocessing : Preprocessing
+        The settings as given (``None`` fields: derived from the data).
+    estimators : tuple of str
+        Keys of :mod:`dynid.estimators.registry`; the first is the main estimate.
+    friction : {"description", "auto"}
+        The description's friction terms, or each joint's model chosen by cross-validation.
+    seed : int
+        Seeds the box searches and the bootstrap.
+    sdp_prior : {"euclidean", "geometric"}
+        The SDP's pull towards the nominal parameters.
+    source : str
+        Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
+        :func:`dynid.load_results` finds it.
+
+    Raises
+    ------
+    ConfigError
+        An unknown ``friction`` (when built) or preprocessing strategy (when preparing).
+    """
+
+    robot: Robot
+    preprocessing: Preprocessing = field(default_factory=Preprocessing)
+    estimators: tuple[str, ...] = ("wls",)
+    friction: str = "description"
+    seed: int = 0
+    sdp_prior: str = "euclidean"
+    source: str = ""
+
+    def __post_init__(self):
+        if self.friction not in FRICTION_CHOICES:
+            raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
+
+    def prepare(self, recording, base: BaseParameters | None = None,
+                step: Callable[[str], Any] | None = None) -> PreparedIdentification:
+        """Filter a recording and make the choices that depend on it (module docstring, steps 1-3).
+
+        Parameters
+        ----------
+        recording : dynid.io.datasets.Recording
+            Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``; ``tau`` [N·m] with the
+            drive gains applied (eq. 16).
+        base : BaseParameters, optional
+            The description's base-parameter map, when the caller has it already.
+        step : callable, optional
+            ``step(label)`` before each step that takes time.
+
+        Returns
+        -------
+        PreparedIdentification
+
+        Raises
+        ------
+        ConfigError
+            Settings that do not fit the recording (a cutoff above its Nyquist frequency, an unknown strategy).
+        DataError
+            A recording the strategy cannot prepare.
+        IdentifiabilityError
+            Too little motion to cross-validate a choice on.
+        """
+        from ..validation.cross_validation import choose_coulomb_velocity
+
+        def say(label: str) -> None:
+            if step is not None:
+                step(label)
+
+        settings = self.preprocessing
+        base = base if base is not None else base_parameters(self.robot, rng=0)
+        made: dict = {}
+        auto = settings.auto and strategy_for(settings).chooses_cutoffs
+        say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
+        if auto:
+            from ..validation.cross_validation import choose_preprocessing
+
+            filters = choose_preprocessing(self.robot, base, recording, settings)
+            assert filters.data is not None  # the chosen candidate's prepared data
+            data = filters.data
+            if filters.chose:
+                made["preprocessing_cross_validation"] = filters.to_dict()
+        else:
+            data = prepare(recording, settings)
+        vs = settings.coulomb_velocity
+        if vs == "auto":
+            say("Coulomb smoothing velocity (cross-validation)")
+            coulomb = choose_coulomb_velocity(self.robot, base, data)
+            velocity = coulomb.velocity
+            made["coulomb_cross_validation"] = coulomb.to_dict()
+        else:
+            velocity = np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,))
+        robot = replace(self.robot, coulomb_velocity=velocity)
+        if self.friction == "auto":
+            from ..validation.friction_models import choose_friction
+
+            say("friction model of each joint (cross-validation)")
+            friction = choose_friction(robot, data)
+            robot = friction.robot(robot)
+            data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
+            base = base_parameters(robot, rng=0)
+            made["friction_models"] = friction.to_dict()
+        order = ("coulomb_cross_validation", "friction_models", "preprocessing_cross_validation")
+        choices = {"coulomb_velocity": robot.coulomb_velocity.tolist(), **{k: made[k] for k in order if k in made}}
+        return PreparedIdentification(robot, base, data, choices)
+
+    def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
+                 held_out: bool = False):
+        """Every estimator on the prepared data, the consistency checks and the verdict
+        (:func:`dynid.experiment.identification.identify`).
+
+        Parameters
+        ----------
+        prepared : PreparedIdentification
+            From :meth:`prepare`.
+        references : tuple of ReferenceSet
+            Published parameter sets scored beside, in :attr:`PreparedIdentification.base`'s layout.
+        progress : callable, optional
+            ``progress(step, done, total)``.
+        held_out : bool
+            With ``sdp`` listed and no validation log to come: choose the estimate to trust on held-out blocks.
+
+        Returns
+        -------
+        dynid.experiment.identification.IdentificationResult
+            Its ``settings`` hold the resolved preprocessing, :attr:`PreparedIdentification.choices` and
+            ``robot_source``.
+
+        Raises
+        ------
+        ConfigError
+            An unknown estimator, or ``sdp`` with a description without physical nominal parameters.
+        IdentifiabilityError
+            A log that does not excite every base parameter.
+        """
+        from .identification import identify
+
+        result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
+                          held_out=held_out, sdp_prior=self.sdp_prior)
+        return replace(result, settings={**result.settings, "robot_source": self.source, **prepared.choices})
+
+    def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
+            held_out: bool = True):
+        """:meth:`prepare` then :meth:`estimate`.
+
+        Parameters
+        ----------
+        recording : dynid.io.datasets.Recording
+        references : callable, optional
+            ``references(robot, base)`` -> the reference sets in the prepared model's layout.
+        progress : callable, optional
+            ``progress(step, done, total)``.
+        held_out : bool
+            As :meth:`estimate`'s (default true: no validation log).
+
+        Returns
+        -------
+        dynid.experiment.identification.IdentificationResult
+
+        Raises
+        ------
+        DynIdError
+            As :meth:`prepare` and :meth:`estimate`.
+        """
+        step = None if progress is None else (lambda label: progress(label, 0, 1))
+        prepared = self.prepare(recording, step=step)
+        refs = () if references is None else references(prepared.robot, prepared.base)
+        return self.estimate(prepared, refs, progress, held_out)

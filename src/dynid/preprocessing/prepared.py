@@ -1,0 +1,192 @@
+"""A log prepared for the estimators, whichever strategy prepared it (:mod:`dynid.preprocessing.strategies`): its
+filtered signals on a uniform grid, its resolved settings, and where and in which direction each joint moves — the
+friction state at rest that every Coulomb-like regressor column uses (:func:`dynid.friction.held_direction`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..column_store import by_column
+from ..exceptions import ConfigError
+from ..friction import Velocities, held_direction
+from ..model.robot import Robot
+from .settings import Preprocessing
+
+__all__ = ["PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
+
+Samples = Any
+"""An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
+
+
+@dataclass(frozen=True)
+class PreparedData:
+    """Filtered joint signals on a uniform grid, ready for the regressor.
+
+    Signals are arrays, or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
+
+    Attributes
+    ----------
+    name : str
+        The dataset.
+    t : (N,) array [s]
+    q, dq, ddq : (N, n_dof) samples [rad, rad/s, rad/s²]
+    tau : (N, n_dof) samples [N·m]
+        Joint torques (drive gains applied).
+    rate : float [Hz]
+        Rate of the grid (after decimation).
+    settings : Preprocessing
+        Resolved settings.
+    warnings : tuple of str
+    direction : (N, n_dof) array or None
+        Direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`).
+    motion : (N, n_dof) array or None
+        The velocity [rad/s] that says where a joint moves (no overshoot where it stops).
+    resting : (N, n_dof) bool array or None
+        Where each joint rests (:func:`dynid.friction.moving_joints`).
+    """
+
+    name: str
+    t: np.ndarray
+    q: Samples
+    dq: Samples
+    ddq: Samples
+    tau: Samples
+    rate: float
+    settings: Preprocessing
+    warnings: tuple[str, ...] = ()
+    direction: np.ndarray | None = None
+    """(N, n_dof) direction of motion the Coulomb-like columns use (:func:`dynid.friction.held_direction`)."""
+    motion: np.ndarray | None = None
+    """(N, n_dof) the velocity [rad/s] that says where a joint moves (no overshoot where it stops)."""
+    resting: np.ndarray | None = None
+    """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
+
+    def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
+        """The same samples with another rest model and presliding distance.
+
+        The direction of motion is computed anew, the settings say so.
+
+        Parameters
+        ----------
+        rest_friction : str, float or tuple
+            "held", "zero", a relaxation time [s], or one per joint.
+        presliding : float or tuple
+            Presliding distance [rad], or one per joint.
+
+        Returns
+        -------
+        PreparedData
+        """
+        s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
+        return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
+
+
+def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
+    v = np.asarray(value)
+    v = np.full(n, v.item()) if v.ndim == 0 else v
+    if v.shape != (n,) or (allowed is not None and not set(v.tolist()) <= allowed):
+        raise ConfigError(f"preprocessing.{where}: expected one value or {n} of them"
+                          + (f" among {sorted(allowed)}" if allowed else "") + f", got {value!r}")
+    return v
+
+
+def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
+    """Each joint's direction of motion, column by column (stored columns stay stored).
+
+    :func:`dynid.friction.held_direction` with the log's rest velocities, rest model and presliding distances.
+
+    Parameters
+    ----------
+    dq : (N, n_dof) samples [rad/s]
+        Velocities.
+    guide : (N, n_dof) samples [rad/s]
+        Velocity that says where a joint moves.
+    s : Preprocessing
+        Resolved settings.
+    rate : float [Hz]
+
+    Returns
+    -------
+    (N, n_dof) array or StoredColumns
+        In [-1, 1].
+    """
+    n = dq.shape[1]
+    guide = dq if guide is None else guide
+    rest = _per_joint(0.0 if s.rest_velocity == "auto" else s.rest_velocity, n, "rest_velocity").astype(float)
+    decay = rest_decay(s.rest_friction, n)
+    x0 = _per_joint(s.presliding, n, "presliding").astype(float)
+    cutoff = s.band if s.fourier is not None else (s.velocity_cutoff or s.position_cutoff or rate / 4)
+    travel = rest / cutoff  # a blip of the rest velocity's size lasts about 1/cutoff
+    return by_column(dq, lambda column, j: held_direction(column[:, None], rest[j], decay[j], x0[j], rate,
+                                                          np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
+
+
+def rest_decay(value, n: int) -> np.ndarray:
+    """``rest_friction`` as relaxation times.
+
+    Parameters
+    ----------
+    value : str, float or tuple
+        "held", "zero", seconds, or one per joint.
+    n : int
+        Number of joints.
+
+    Returns
+    -------
+    (n,) ndarray [s]
+        inf: held; 0: zero.
+    """
+    v = _per_joint(value, n, "rest_friction")
+    try:
+        return np.array([np.inf if x == "held" else 0.0 if x == "zero" else float(x) for x in v.tolist()])
+    except (TypeError, ValueError):
+        raise ConfigError(f'preprocessing.rest_friction: expected "held", "zero" or a relaxation time in seconds, '
+                          f"got {value!r}") from None
+
+
+def rest_velocities(data: PreparedData, robot: Robot) -> Velocities:
+    """The friction columns' velocities for a log: the robot's, with the log's rest velocity and direction.
+
+    Parameters
+    ----------
+    data : PreparedData
+    robot : Robot
+
+    Returns
+    -------
+    Velocities
+    """
+    v = robot.friction_velocities
+    rest = data.settings.rest_velocity
+    return Velocities(v.coulomb, v.stribeck, np.broadcast_to(np.asarray(0.0 if rest == "auto" else rest, dtype=float),
+                                                               (robot.n_dof,)), None)
+
+
+def min_speeds(settings: Preprocessing, n: int) -> np.ndarray:
+    """``min_speed`` per joint, checked.
+
+    Parameters
+    ----------
+    settings : Preprocessing
+        Resolved (a number or one per joint, not "auto").
+    n : int
+        Number of joints.
+
+    Returns
+    -------
+    (n,) ndarray [rad/s]
+
+    Raises
+    ------
+    ConfigError
+        A negative speed, or not one per joint.
+    """
+    v = np.asarray(settings.min_speed, dtype=float)
+    if v.ndim == 0:
+        v = np.full(n, float(v))
+    if v.shape != (n,) or np.any(v < 0):
+        raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
+    return v

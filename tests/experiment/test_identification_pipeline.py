@@ -1,0 +1,91 @@
+"""One identification pipeline: a log identified from a config (``dynid identify``) and the same log given as arrays
+(``dynid.Identifier``, ``dynid.identify_from_arrays``) go through the same parts and make the same choices."""
+
+import json
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.experiment.identification_pipeline import IdentificationPipeline
+from dynid.exceptions import ConfigError
+from dynid.io.datasets import load_recording
+from dynid.io.identification_config import load_identification_config
+
+from ..simulated_logs import config_text, point_to_point_motion, robot_toml, truth_robot, write_log, write_truth
+
+
+def _plain(x):
+    """A settings entry as results.json holds it (arrays as lists)."""
+    return json.loads(json.dumps(x, default=lambda a: np.asarray(a).tolist()))
+
+
+def _same(a, b, where=""):
+    """The same structure, strings and choices equal, numbers to 1e-9 (the arrays' grid rate is 1 / median step, the
+    reader's its fit: their last digits differ)."""
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), where
+        for k in a:
+            _same(a[k], b[k], f"{where}/{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            _same(x, y, f"{where}[{i}]")
+    elif isinstance(a, float) or isinstance(b, float):
+        assert a == pytest.approx(b, rel=1e-9, abs=1e-12), where
+    else:
+        assert a == b, where
+
+
+@pytest.fixture(scope="module")
+def slow_quiet_log(tmp_path_factory):
+    """Slow moves logged by 20-bit encoders at 1 kHz: the positions' noise knee lies far above 10x the band, so the
+    default cross-validates the cutoffs (what the arrays' path skipped before issue 23's pipeline)."""
+    folder = tmp_path_factory.mktemp("pipeline")
+    rng = np.random.default_rng(2)
+    robot, friction = truth_robot("er16", rng)
+    t = np.arange(int(40 * 1000.0)) / 1000.0
+    q, dq, ddq = point_to_point_motion(robot, t, rng, segment=4.0, rest=1.0)
+    write_log(folder / "ident.csv", robot, t, q, dq, ddq, friction, rng, 0.01)
+    write_log(folder / "valid.csv", robot, t, *point_to_point_motion(robot, t, rng, segment=4.0, rest=1.0), friction, rng, 0.01)
+    write_truth(folder / "truth.csv", robot, robot.parameter_names)
+    cfg = folder / "config.toml"
+    cfg.write_text(config_text(robot_toml("er16", folder), folder, "ident.csv", "valid.csv", robot.n_dof))
+    return load_identification_config(cfg)
+
+
+def test_arrays_and_a_config_of_the_same_log_give_the_same_identification(slow_quiet_log):
+    config = slow_quiet_log
+    from_config = dynid.run_identification(config, validate=False)
+    recording = load_recording(config.identification, config.robot)
+    ident = dynid.Identifier(config.robot, estimators=list(config.estimators), friction=config.friction, seed=config.seed)
+    from_arrays = ident.fit(recording.t, recording.q, recording.tau).result_
+    cv = from_config.settings["preprocessing_cross_validation"]  # the case this test is about: the cutoffs were chosen
+    assert len(cv["candidates"]) == 3
+    for key in ("preprocessing_cross_validation", "coulomb_velocity", "friction_models"):
+        _same(_plain(from_arrays.settings[key]), _plain(from_config.settings[key]), key)
+    pre_a, pre_c = from_arrays.settings["preprocessing"], from_config.settings["preprocessing"]
+    _same(_plain({k: v for k, v in pre_a.items() if k != "derivation"}), _plain({k: v for k, v in pre_c.items() if k != "derivation"}))
+    assert from_arrays.base.names == from_config.base.names
+    np.testing.assert_allclose(from_arrays.solution.params, from_config.solution.params, rtol=1e-9, atol=1e-12)
+
+
+def test_settings_given_to_the_arrays_path_are_applied(slow_quiet_log):
+    """A Coulomb smoothing velocity and a seed given with arrays: the arrays' path used to ignore both."""
+    config = slow_quiet_log
+    rec = load_recording(config.identification, config.robot)
+    fit = lambda **kw: dynid.identify_from_arrays(config.robot, rec.t, rec.q, rec.tau, estimators=("ols",), **kw)
+    smooth = fit(preprocessing=dynid.Preprocessing(coulomb_velocity=0.05, auto=False))
+    sign = fit(preprocessing=dynid.Preprocessing(auto=False))
+    assert smooth.settings["coulomb_velocity"] == [0.05] * 6 and sign.settings["coulomb_velocity"] == [0.0] * 6
+    assert smooth.model.coulomb_velocity.tolist() == [0.05] * 6
+    assert not np.allclose(smooth.solution.params, sign.solution.params, rtol=1e-6)
+    boot = lambda r: np.array(list(r.diagnostics["bootstrap_std"].values()))
+    one, again = fit(preprocessing=dynid.Preprocessing(auto=False), seed=1), fit(preprocessing=dynid.Preprocessing(auto=False), seed=1)
+    np.testing.assert_array_equal(boot(one), boot(again))
+    assert not np.array_equal(boot(one), boot(sign))  # seed 0 against seed 1: another bootstrap
+
+
+def test_the_pipeline_refuses_an_unknown_friction_choice():
+    with pytest.raises(ConfigError, match='friction: expected "description" or "auto", got \'magic\''):
+        IdentificationPipeline(dynid.load_robot("er16"), friction="magic")
