@@ -9,7 +9,7 @@ each log as ``dynid identify`` does.
 
     .venv/bin/python benchmarks/closed_loop_grid.py [realisations] [--band HZ] [--encoder DEG,..] [--torque NM,..]
         [--robot NAME_OR_DESCRIPTION --joints N]   (e.g. configs/robots/tx40_simulation.toml, 6: the coupled wrist)
-        [--estimators ols,idim-iv,didim-sdp]
+        [--estimators ols,idim-iv,didim-sdp] [--excitation EXCITATION_JSON --duration S]
 """
 
 from __future__ import annotations
@@ -34,16 +34,20 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--robot", default="er16")
     parser.add_argument("--joints", type=int, default=3)
     parser.add_argument("--estimators", default=None, help="comma-separated (default: the study's eight)")
+    parser.add_argument("--excitation", default="paper", help="paper (β1), optimized, or an excitation.json of dynid excite")
+    parser.add_argument("--duration", type=float, default=25.0, help="seconds of each log")
     args = parser.parse_args(argv)
     chosen = {} if args.estimators is None else {"estimators": tuple(args.estimators.split(","))}
     config = ClosedLoopStudyConfig(**chosen, robot=args.robot, joints=args.joints, encoder_noise=tuple(float(x) for x in args.encoder.split(",")),
                                    torque_noise=tuple(float(x) for x in args.torque.split(",")),
-                                   realisations=args.realisations, band=args.band)
+                                   realisations=args.realisations, band=args.band, excitation=args.excitation,
+                                   duration=args.duration)
     load = os.getloadavg()[0]
     result = run_closed_loop_study(config, workers=2)
     data = result.to_dict()
     band = "derived from each log" if args.band is None else f"{args.band:g} Hz"
-    print(f"{args.robot} ({args.joints} joints), {args.realisations} realisations per cell, band {band}, Dask local cluster of 2 workers: "
+    print(f"{args.robot} ({args.joints} joints), excitation {args.excitation}, {args.duration:g} s, {args.realisations} realisations per "
+          f"cell, band {band}, Dask local cluster of 2 workers: "
           f"{result.timings['total']:.0f} s; load {load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end")
     headers, rows, _ = closed_loop_study_rows(data)
     print("| " + " | ".join(headers) + " |")

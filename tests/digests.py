@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 STORE = ROOT / "tests" / "data" / "digests.json"
 
 IDENTIFY = ("ur10e", "tx40", "tx40-full", "kuka_kr300", "kuka_med7")
-EXCITE = ("excite-er16", "excite-ur10e", "excite-er16-6dof", "excite-er16-beta1-envelope")
+EXCITE = ("excite-er16", "excite-ur10e", "excite-er16-6dof", "excite-er16-beta1-envelope", "excite-tx40")
 CASES = (*(f"identify:{c}" for c in IDENTIFY), *(f"excite:{c}" for c in EXCITE), "run", "montecarlo")
 
 SKIPPED = {"seconds", "timings", "config", "path", "file", "cluster"}

@@ -21,6 +21,8 @@ robotics: a survey", Applied Sciences 11(9), 2021 (the noise grid).
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -246,6 +248,13 @@ class JointDynamics:
         self._vs = np.asarray(robot.coulomb_velocity, dtype=float)
         self._smooth = bool(np.any(self._vs > 0))
         self._coupled = robot.transmission.n_coupled_params > 0
+        if self._coupled:  # the coupled motors' velocity terms (Transmission.coupling_columns at zero acceleration)
+            tr = robot.transmission
+            self._coupling = [(tr.ratios(k), np.outer(tr.ratios(k), tr.ratios(k)) - np.diag(tr.ratios(k) ** 2))
+                              for k in tr.coupled_motors]
+            self._coupled_values = np.ravel(tr.coupled_values)
+            self._coupled_terms = tr.coupled_terms
+        self._lower = np.tril_indices(n, -1)
         # a diagonal drive inertia (rotor inertias, no coupled motor) is Pinocchio's armature: ABA then gives q̈ in one
         # call; a coupled motor's inertia is off the diagonal: M from CRBA, solved
         off_diagonal = self.drive_inertia - np.diag(np.diag(self.drive_inertia))
@@ -272,9 +281,23 @@ class JointDynamics:
             s = np.sign(dq)
         tau = self._fc * s + self._fv * dq + self._offset
         if self._coupled:
-            tr = self.robot.transmission
-            tau = tau + tr.coupling_columns(dq[None], np.zeros((1, dq.size)))[0] @ np.ravel(tr.coupled_values)
+            tau = tau + self._coupling_columns(dq) @ self._coupled_values
         return tau
+
+    def _coupling_columns(self, dq: np.ndarray) -> np.ndarray:
+        """(n_dof, n_coupled_params): :meth:`dynid.model.transmission.Transmission.coupling_columns` at ``dq`` and zero
+        acceleration, from the ratios computed once."""
+        out = np.zeros((dq.size, self._coupled_values.size))
+        row = dq[None]
+        col = 0
+        for c, off in self._coupling:
+            for term in self._coupled_terms:
+                if term == "fvm":
+                    out[:, col] = (row @ off.T)[0]
+                elif term == "fcm":
+                    out[:, col] = np.sign(row @ c)[0] * c
+                col += 1  # Iam: its column is the acceleration's, 0 here
+        return out
 
     def mass_and_bias(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``M(q)`` and ``h(q, q̇)``, so that the joint torque is ``M q̈ + h``.
@@ -289,8 +312,9 @@ class JointDynamics:
         h : (n_dof,) array [N·m]
         """
         pin = self._pin
-        m = pin.crba(self.model, self.data, q)
-        m = np.triu(m) + np.triu(m, 1).T + (0.0 if self._aba else self.drive_inertia)  # armature: in CRBA's M already
+        m = pin.crba(self.model, self.data, q).copy()  # CRBA fills the upper triangle
+        m[self._lower] = m.T[self._lower]
+        m = m + (0.0 if self._aba else self.drive_inertia)  # armature: in CRBA's M already
         return m, pin.nonLinearEffects(self.model, self.data, q, dq) + self.drive_torques(dq)
 
     def accelerations(self, q: np.ndarray, dq: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -357,18 +381,34 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
         raise ConfigError("closed-loop simulation with noise needs an rng (np.random.default_rng(seed))")
     rng = rng if rng is not None else np.random.default_rng(0)
     dynamics = JointDynamics(robot, phi)
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is refused in one line, not warned about
+        return _run_loop(t, q_ref, dq_ref, ff, controller, dynamics, noise, rng)
+
+
+def _run_loop(t, q_ref, dq_ref, ff, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
+    """:func:`simulate_closed_loop`'s loop over the control instants."""
+    n = q_ref.shape[1]
+    h = 1.0 / controller.rate
     accelerations = dynamics.accelerations
-    q_true, dq_true, ddq_true, tau_applied, q_meas = (np.empty((t.size, n)) for _ in range(5))
-    q, dq = q_ref[0].copy(), dq_ref[0].copy()
     kp, kd, ki = controller.kp, controller.kd, controller.ki
-    integral = np.zeros(n)
-    previous = None
     # first-order low-pass of the differenced positions (backward Euler): v ← v + α (raw − v)
     alpha = 1.0 if controller.velocity_cutoff == 0 else 1.0 - np.exp(-2 * np.pi * controller.velocity_cutoff * h)
-    velocity = dq_ref[0].copy()
     position_noise = noise.position_std > 0 or noise.encoder_resolution > 0
+    q_true, dq_true, ddq_true, tau_applied, q_meas = (np.empty((t.size, n)) for _ in range(5))
+    q, dq = q_ref[0].copy(), dq_ref[0].copy()
+    integral = np.zeros(n)
+    previous = None
+    velocity = dq_ref[0].copy()
+    # the encoder's noise drawn at once: the same numbers as one draw per instant (a Generator's stream)
+    draws = rng.normal(0.0, noise.position_std, (t.size, n)) if noise.position_std > 0 else None
+    resolution = noise.encoder_resolution
     for k in range(t.size):
-        y = noise.measured_positions(q, rng) if position_noise else q
+        if position_noise:
+            y = q + draws[k] if draws is not None else np.array(q, dtype=float)
+            if resolution > 0:
+                y = np.round(y / resolution) * resolution
+        else:
+            y = q
         if previous is not None:  # the first instant: no difference yet, the reference's velocity
             velocity = velocity + alpha * ((y - previous) / h - velocity)
         error = q_ref[k] - y
@@ -386,7 +426,7 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
         a4 = accelerations(q + h * v3, v4, tau)
         q = q + h / 6.0 * (dq + 2 * v2 + 2 * v3 + v4)
         dq = dq + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(dq))):
+        if not math.isfinite(q.dot(q) + dq.dot(dq)):  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
             raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
                               "or a model that cannot be simulated")
     tau_log = tau_applied + rng.normal(0.0, noise.torque_std, tau_applied.shape) if noise.torque_std > 0 else tau_applied.copy()
