@@ -88,7 +88,7 @@ def test_moving_and_resting_samples_are_scored_apart():
 
 
 def test_a_joint_at_the_noise_level_is_flagged_with_its_absolute_error():
-    from dynid.validation.torques import comparison_table
+    from dynid.report.summaries import comparison_table
 
     rng = np.random.default_rng(3)
     m = 500

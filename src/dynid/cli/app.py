@@ -379,7 +379,7 @@ def validate(
     from ..exceptions import DataError
     from ..experiment.identification_run import run_validation
     from ..io.identification_config import dataset_for_file, load_identification_config
-    from ..validation.torques import comparison_table
+    from ..report.summaries import comparison_table
 
     def prepare():
         cfg = load_identification_config(config, data_root)

@@ -11,11 +11,54 @@ import numpy as np
 from ..conventions import unit_of
 from ..estimators.registry import label
 from ..tables import Line, TextTable, render_text
-from ..validation.torques import comparison_table
+from ..validation.torques import TorqueComparison
 
-__all__ = ["blocks", "summary", "identification_blocks", "filter_choice_table", "friction_choice_table",
+__all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
            "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "closed_loop_study_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
            "monitor_blocks"]
+
+
+REST_ROWS = 0.05
+"""Tables show the moving and resting figures apart where some joint rests on at least this share of samples."""
+
+
+def comparison_table(cmp: TorqueComparison) -> TextTable:
+    """Relative error, RMSE and correlation coefficient (eq. 18) per joint for every parameter set of ``cmp``.
+
+    One label row per set, then one row per metric (narrow enough for 80 columns with six joints). A joint whose
+    relative error is not meaningful (:meth:`TorqueComparison.meaningful`) shows "n/m" there, and one whose torque does
+    not vary beyond its noise (:meth:`TorqueComparison.varies`), or whose prediction does not vary, "n/m" as its
+    correlation; where joints rest, the error
+    on the moving samples and the RMSE at rest follow.
+
+    Parameters
+    ----------
+    cmp : dynid.validation.torques.TorqueComparison
+
+    Returns
+    -------
+    TextTable
+    """
+    rms = cmp.rms_torque
+    n = cmp.measured.shape[1]
+    ok = cmp.meaningful()
+    share = np.zeros(n) if cmp.rest_share is None else np.asarray(cmp.rest_share)
+    split = cmp.rest_share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
+    rows, ends = [], set()
+    for label, m in cmp.metrics().items():
+        rows.append((label,) + ("",) * (n + 1))
+        rows.append(("  error %", *(f"{x:.1f}" if k else "n/m" for x, k in zip(m["relative_error"], ok)),
+                     f"{m['global_relative_error']:.2f}"))
+        rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), ""))
+        rows.append(("  ρ (eq. 18)", *(f"{x:.4f}" if v and np.isfinite(x) else "n/m" for x, v in zip(m["correlation"], cmp.varies())), ""))
+        if split and "moving_relative_error" in m:
+            rows.append(("  moving error %", *(f"{x:.1f}" if k and np.isfinite(x) else "n/m"
+                                               for x, k in zip(m["moving_relative_error"], ok)), ""))
+            rows.append(("  at rest RMSE N·m", *(f"{x:.3g}" if s >= REST_ROWS else "" for x, s in zip(m["rest_rmse"], share)), ""))
+        ends.add(len(rows) - 1)
+    rest = "" if not split else "; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the samples"
+    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
+                     ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
 
 
 def summary(result, width: int = 100) -> str:

@@ -15,10 +15,9 @@ from ..dynamics.base_parameters import BaseParameters
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
-from ..tables import TextTable
 from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
 
-__all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "comparison_table"]
+__all__ = ["TorqueComparison", "TorqueSums", "compare_torques"]
 
 
 @dataclass(frozen=True)
@@ -432,45 +431,3 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
                             {k: np.concatenate(v) for k, v in preds.items()}, resting=np.concatenate(rest),
                             static=static_friction(base, parameter_sets, robot.n_dof), noise=noise,
                             speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()})
-
-
-REST_ROWS = 0.05
-"""Tables show the moving and resting figures apart where some joint rests on at least this share of samples."""
-
-
-def comparison_table(cmp: TorqueComparison) -> TextTable:
-    """Relative error, RMSE and correlation coefficient (eq. 18) per joint for every parameter set of ``cmp``.
-
-    One label row per set, then one row per metric (narrow enough for 80 columns with six joints). A joint whose
-    relative error is not meaningful (:meth:`TorqueComparison.meaningful`) shows "n/m" there, and one whose torque does
-    not vary beyond its noise (:meth:`TorqueComparison.varies`) "n/m" as its correlation; where joints rest, the error
-    on the moving samples and the RMSE at rest follow.
-
-    Parameters
-    ----------
-    cmp : TorqueComparison
-
-    Returns
-    -------
-    TextTable
-    """
-    rms = cmp.rms_torque
-    n = cmp.measured.shape[1]
-    ok = cmp.meaningful()
-    share = np.zeros(n) if cmp.rest_share is None else np.asarray(cmp.rest_share)
-    split = cmp.rest_share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
-    rows, ends = [], set()
-    for label, m in cmp.metrics().items():
-        rows.append((label,) + ("",) * (n + 1))
-        rows.append(("  error %", *(f"{x:.1f}" if k else "n/m" for x, k in zip(m["relative_error"], ok)),
-                     f"{m['global_relative_error']:.2f}"))
-        rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), ""))
-        rows.append(("  ρ (eq. 18)", *(f"{x:.4f}" if v else "n/m" for x, v in zip(m["correlation"], cmp.varies())), ""))
-        if split and "moving_relative_error" in m:
-            rows.append(("  moving error %", *(f"{x:.1f}" if k and np.isfinite(x) else "n/m"
-                                               for x, k in zip(m["moving_relative_error"], ok)), ""))
-            rows.append(("  at rest RMSE N·m", *(f"{x:.3g}" if s >= REST_ROWS else "" for x, s in zip(m["rest_rmse"], share)), ""))
-        ends.add(len(rows) - 1)
-    rest = "" if not split else "; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the samples"
-    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
-                     ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
