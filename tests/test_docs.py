@@ -27,6 +27,27 @@ def test_the_tutorials_python_runs(page, tmp_path, monkeypatch, capsys):
     assert all(float(r) < 8 for r in ratios), out  # no false alarm on the log before the contact
 
 
+def test_the_extending_pages_python_runs(tmp_path, monkeypatch, capsys):
+    """The pipeline's parts, a new estimator and a new strategy, as the page writes them."""
+    from dynid.estimators import registry
+    from dynid.preprocessing import strategies
+
+    monkeypatch.chdir(tmp_path)
+    estimators, known = dict(registry._REGISTRY), dict(strategies._STRATEGIES)
+    namespace: dict = {}
+    try:
+        for code in _blocks(DOCS / "extending.md"):
+            exec(compile(code, str(DOCS / "extending.md"), "exec"), namespace)
+    finally:  # the page's registrations are the page's
+        registry._REGISTRY.clear(), registry._REGISTRY.update(estimators)
+        strategies._STRATEGIES.clear(), strategies._STRATEGIES.update(known)
+    out = capsys.readouterr().out.splitlines()
+    assert "excitation band" in out[0] and out[1].startswith("dynid WLS ")
+    ridge, ols = (float(x) for x in out[2].split()[:2])
+    assert abs(ridge - ols) < 1e-6 * abs(ols)
+    assert out[3] == "central differences, no filter"
+
+
 def test_every_page_of_the_site_is_in_its_navigation():
     import yaml  # mkdocs' own dependency
 

@@ -159,8 +159,15 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
-                                       help="Print dynid's version and exit.")) -> None:
+                                       help="Print dynid's version and exit."),
+          plugin: Optional[list[str]] = typer.Option(None, "--plugin", metavar="FILE_OR_MODULE",
+                                                     help="A Python file or module that registers estimators or preprocessing "
+                                                          "strategies of your own (repeatable; also DYNID_PLUGINS).")) -> None:
     """dynid: dynamic model identification of industrial robot arms."""
+    if plugin:
+        from ..plugins import add_plugins
+
+        add_plugins(plugin)
 
 
 @app.command()

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
 from ..exceptions import ConfigError
+from ..plugins import load_plugins
 
 if TYPE_CHECKING:
     import numpy as np
@@ -237,7 +238,8 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
     label, description, space, cost, needs_box, bootstrapped
         See :class:`EstimatorSpec` (``label`` defaults to ``key`` in upper case).
     replace : bool
-        Replace an estimator registered under the same key (else a ``ValueError``).
+        Replace an estimator registered under the same key (else a ``ValueError``, unless it is the same class of the
+        same module: a plugin imported again).
     **options
         Fixed hyper-parameters of the class.
 
@@ -267,11 +269,18 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
         raise ValueError(f"estimator key: expected letters, digits and _, got {key!r}")
     if space not in ("base", "standard"):
         raise ValueError(f"estimator {k}: space must be 'base' or 'standard', got {space!r}")
-    if k in _REGISTRY and not replace:
+    if k in _REGISTRY and not replace and _origin(_REGISTRY[k].build) != _origin(build):
         raise ValueError(f"estimator {k!r} is registered already (pass replace=True to replace it)")
     entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options))
     _REGISTRY[k] = entry
     return entry
+
+
+def _origin(build) -> str:
+    """Where an estimator's (or strategy's) builder is defined: ``module.qualname``, or the text naming it."""
+    if isinstance(build, str):
+        return build
+    return f"{getattr(build, '__module__', '')}.{getattr(build, '__qualname__', repr(build))}"
 
 
 def unregister(key: str) -> None:
@@ -362,6 +371,8 @@ def spec(key: str) -> EstimatorSpec:
         An unknown key (the message lists the known ones).
     """
     k = str(key).strip().lower()
+    if k not in _REGISTRY:
+        load_plugins()  # the user's own estimators (dynid.plugins)
     try:
         return _REGISTRY[k]
     except KeyError:
@@ -441,6 +452,8 @@ def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...
     if not all(isinstance(k, str) for k in items):
         raise ConfigError(f"estimators: expected names of estimators, got {text!r}", field="estimators")
     found = [k.strip().lower() for k in items]
+    if any(k not in _REGISTRY for k in found):
+        load_plugins()  # the user's own estimators (dynid.plugins)
     unknown = [k for k in found if k not in _REGISTRY]
     if unknown or not found:
         raise ConfigError(f"estimators: expected a comma-separated subset of {', '.join(_REGISTRY)} (or all), got {text!r}",

@@ -337,12 +337,15 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     require("distributed", extra, what)
     from distributed import Client, LocalCluster
 
+    from ..plugins import share_with
+
     if scheduler:
         try:
             client = Client(scheduler, timeout=f"{connect_timeout}s")
         except (OSError, TimeoutError) as exc:
             raise ConfigError(f"scheduler {scheduler}: cannot reach the Dask scheduler ({exc})", field="scheduler") from None
         with client:
+            share_with(client)
             yield client
         return
     n = workers if workers is not None else (os.cpu_count() or 1)
@@ -350,6 +353,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         raise ConfigError(f"workers must be at least 1, got {workers}", field="workers")
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        share_with(client)
         yield client
 
 

@@ -28,6 +28,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from ..exceptions import ConfigError
+from ..plugins import load_plugins
 from .settings import Preprocessing
 
 if TYPE_CHECKING:
@@ -123,7 +124,8 @@ def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
     name : str
     strategy : Strategy subclass, instance, or "module:attribute" of either (imported when first used)
     replace : bool
-        Replace a strategy of the same name (else a ``ValueError``).
+        Replace a strategy of the same name (else a ``ValueError``, unless it is the same class of the same module: a
+        plugin imported again).
 
     Raises
     ------
@@ -133,9 +135,17 @@ def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
     key = str(name).strip().lower()
     if not key:
         raise ValueError("preprocessing strategy: expected a name")
-    if key in _STRATEGIES and not replace:
+    if key in _STRATEGIES and not replace and _origin(_STRATEGIES[key]) != _origin(strategy):
         raise ValueError(f"preprocessing strategy {key!r} is registered already (pass replace=True to replace it)")
     _STRATEGIES[key] = strategy
+
+
+def _origin(strategy) -> str:
+    """Where a strategy is defined: ``module.qualname`` of its class, or the text naming it."""
+    if isinstance(strategy, str):
+        return strategy
+    cls = strategy if isinstance(strategy, type) else type(strategy)
+    return f"{cls.__module__}.{cls.__qualname__}"
 
 
 def unregister_strategy(name: str) -> None:
@@ -216,6 +226,8 @@ def check_strategy(name: str) -> str:
         An unknown strategy (field ``preprocessing.strategy``, the message lists the known ones).
     """
     key = str(name).strip().lower()
+    if key not in _STRATEGIES:
+        load_plugins()  # the user's own strategies (dynid.plugins)
     if key not in _STRATEGIES:
         raise ConfigError(f"preprocessing.strategy: expected one of {', '.join(_STRATEGIES)}, got {name!r}",
                           field="preprocessing.strategy")

@@ -1,0 +1,143 @@
+"""The user's own estimators and preprocessing strategies, loaded where a config or a command names them.
+
+A new estimator or strategy is one Python file that registers it (:func:`dynid.estimators.register`,
+:func:`dynid.preprocessing.strategies.register_strategy`). dynid imports such files or modules
+
+- named by ``--plugin FILE_OR_MODULE`` on the command line (``dynid --plugin my_ridge.py identify arm.toml``);
+- listed in the environment variable ``DYNID_PLUGINS`` (separated by ``os.pathsep``), which worker processes of a
+  local Dask cluster inherit;
+- declared by an installed package as an entry point of the group ``dynid.plugins`` (``[project.entry-points.
+  "dynid.plugins"] ridge = "my_package.ridge"`` in its ``pyproject.toml``).
+
+They are imported when a name is not a built-in one, once per process (a file as the module named after it), and on
+every worker of the Dask clusters dynid starts or joins (:func:`share_with`: a file is uploaded).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import sys
+from pathlib import Path
+
+from .exceptions import ConfigError
+
+__all__ = ["ENTRY_POINT_GROUP", "ENVIRONMENT", "load_plugins", "add_plugins", "share_with"]
+
+ENTRY_POINT_GROUP = "dynid.plugins"
+"""Entry-point group of installed plugin packages."""
+
+ENVIRONMENT = "DYNID_PLUGINS"
+"""Environment variable listing plugin files or modules (``os.pathsep``-separated)."""
+
+_LOADED: dict[str, str] = {}
+"""plugin (as named) -> module name, for the plugins this process imported."""
+
+
+def add_plugins(plugins) -> None:
+    """Name plugins for this process and the processes it starts (``DYNID_PLUGINS``), and import them.
+
+    Parameters
+    ----------
+    plugins : iterable of str
+        Python files (``.py``) or importable module names.
+
+    Raises
+    ------
+    ConfigError
+        A plugin that cannot be found or imported (one line naming it).
+    """
+    plugins = [str(p) for p in plugins]
+    if not plugins:
+        return
+    resolved = [str(Path(p).resolve()) if p.endswith(".py") else p for p in plugins]
+    for given, plugin in zip(plugins, resolved):
+        if plugin not in _LOADED:
+            _LOADED[plugin] = _import(plugin, f"--plugin {given}")
+    listed = [p for p in os.environ.get(ENVIRONMENT, "").split(os.pathsep) if p]
+    os.environ[ENVIRONMENT] = os.pathsep.join(dict.fromkeys(listed + resolved))
+
+
+def load_plugins() -> tuple[str, ...]:
+    """Import every plugin named by ``DYNID_PLUGINS`` and the ``dynid.plugins`` entry points, those not imported yet.
+
+    Returns
+    -------
+    tuple of str
+        The plugins imported by this call.
+
+    Raises
+    ------
+    ConfigError
+        A plugin that cannot be found or imported (one line naming it and where it was named).
+    """
+    named = [(p, f"from {ENVIRONMENT}") for p in os.environ.get(ENVIRONMENT, "").split(os.pathsep) if p]
+    try:
+        from importlib.metadata import entry_points
+
+        named += [(ep.value, f"entry point {ep.name!r} of {ENTRY_POINT_GROUP}") for ep in entry_points(group=ENTRY_POINT_GROUP)]
+    except Exception:  # a broken distribution's metadata: the plugins named otherwise still load
+        pass
+    done = []
+    for plugin, where in named:
+        if plugin in _LOADED:
+            continue
+        _LOADED[plugin] = _import(plugin, where)
+        done.append(plugin)
+    return tuple(done)
+
+
+def _import(plugin: str, where: str) -> str:
+    """Import one plugin; its module's name."""
+    try:
+        if plugin.endswith(".py"):
+            path = Path(plugin)
+            if not path.is_file():
+                raise ConfigError(f"plugin {plugin} ({where}): no such file")
+            name = path.stem  # as Dask's upload_file names it on the workers (share_with)
+            known = sys.modules.get(name)
+            if known is not None:
+                if Path(getattr(known, "__file__", "") or "").resolve() != path.resolve():
+                    raise ConfigError(f"plugin {plugin} ({where}): its name {name!r} is the module {known.__name__} "
+                                      f"already imported from {getattr(known, '__file__', 'elsewhere')}: rename the file")
+                return name
+            spec = importlib.util.spec_from_file_location(name, path)
+            assert spec is not None and spec.loader is not None
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[name] = module
+            try:
+                spec.loader.exec_module(module)
+            except BaseException:
+                del sys.modules[name]
+                raise
+            return name
+        importlib.import_module(plugin.split(":")[0])
+        return plugin.split(":")[0]
+    except ConfigError:
+        raise
+    except Exception as exc:  # the plugin's own error, said in one line
+        raise ConfigError(f"plugin {plugin} ({where}): cannot import it: {type(exc).__name__}: {exc}") from None
+
+
+def share_with(client) -> None:
+    """Import this process's plugins on every worker of a Dask cluster: a file is uploaded (the workers of a remote
+    cluster need not have it), a module imported.
+
+    Parameters
+    ----------
+    client : distributed.Client
+
+    Raises
+    ------
+    ConfigError
+        A plugin the workers cannot import (one line naming it).
+    """
+    for plugin, module in list(_LOADED.items()):
+        try:
+            if plugin.endswith(".py"):
+                client.upload_file(plugin, load=True)
+            else:
+                client.run(importlib.import_module, module)
+        except Exception as exc:
+            raise ConfigError(f"plugin {plugin}: the Dask workers cannot import it: {type(exc).__name__}: {exc}") from None
