@@ -201,8 +201,20 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     start, start_std = _weighted_least_squares(w, tau, row_sigma)
     out = {"wls": ClosedLoopEstimate(LABELS["wls"], start, start_std, message="least squares on the measured rows")}
     nominal = robot.standard_parameters()
+    simulated: dict = {}  # the estimators all start from the same estimate: its closed loop is simulated once
 
     def simulated_rows(x, standard=False):
+        key = (np.asarray(x, dtype=float).tobytes(), standard)
+        if key not in simulated:
+            try:
+                simulated[key] = _simulated_rows(x, standard)
+            except ConfigError as exc:  # a closed loop that cannot be simulated: said again without simulating it again
+                simulated[key] = exc
+        if isinstance(simulated[key], ConfigError):
+            raise simulated[key]
+        return simulated[key]
+
+    def _simulated_rows(x, standard):
         phi = x if standard else base.standard_from_base(x, reference=nominal)
         run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
                                    ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
