@@ -26,8 +26,9 @@ from ..io.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.prepared import PreparedData
 
-__all__ = ["DelayEstimate", "estimate_delay", "delayed"]
+__all__ = ["DelayEstimate", "estimate_delay", "delay_of_prepared", "delayed"]
 
 DETERMINED_STD = 0.5
 """[samples] A delay estimate with a larger σ is not determined by the log."""
@@ -93,14 +94,37 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     IdentifiabilityError
         Fewer rows than parameters, or a residual that does not change with the delay (no motion).
     """
-    from scipy.optimize import minimize_scalar
-
     from ..dynamics.base_parameters import base_parameters
 
     if not (np.isfinite(max_samples) and max_samples > 0):
         raise ConfigError(f"max_samples: expected a positive number of samples, got {max_samples!r}")
     base = base if base is not None else base_parameters(robot, rng=0)
-    data = prepare(recording, preprocessing or Preprocessing())
+    return delay_of_prepared(robot, base, prepare(recording, preprocessing or Preprocessing()), max_samples)
+
+
+def delay_of_prepared(robot: Robot, base: BaseParameters, data: PreparedData, max_samples: float = 20.0) -> DelayEstimate:
+    """:func:`estimate_delay` on a log prepared already (by the default strategy, ``"parallel"``).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    data : PreparedData
+        From :func:`dynid.preprocessing.pipeline.prepare` (its torques at the log's rate, not yet filtered).
+    max_samples : float
+        Largest delay searched, either way [samples].
+
+    Returns
+    -------
+    DelayEstimate
+
+    Raises
+    ------
+    IdentifiabilityError
+        Fewer rows than parameters, or a residual that does not change with the delay (no motion).
+    """
+    from scipy.optimize import minimize_scalar
+
     s = data.settings
     rows, times, keeps = [], [], []
     for index, y, _, keep in base_chunks(robot, base, data):
@@ -110,7 +134,7 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     w, t_rows, keep = np.concatenate(rows), np.concatenate(times), np.concatenate(keeps)
     n = robot.n_dof
     if keep.sum() <= w.shape[1]:
-        raise IdentifiabilityError(f"{recording.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
+        raise IdentifiabilityError(f"{data.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
     q_factor, _ = np.linalg.qr(w[keep])
     tau = np.asarray(data.tau, dtype=float)
     if s.parallel_cutoff is not None:  # the torques as the regressor's columns are filtered
@@ -140,7 +164,7 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     slope = (residual(d + h) - residual(d - h)) / (2 * h)  # ∂r/∂d, samples⁻¹
     information = float(slope @ slope)
     if not information > 0:
-        raise IdentifiabilityError(f"{recording.name}: the residual does not change with the delay (does the robot move?)")
+        raise IdentifiabilityError(f"{data.name}: the residual does not change with the delay (does the robot move?)")
     # Gauss–Newton σ with the scores' long-run covariance: a residual correlated in time (model error on a short
     # point-to-point log) determines the delay far less than white noise of the same size would
     instants = np.repeat(np.arange(keep.size // n), n)[keep]

@@ -210,7 +210,9 @@ class IdentificationPipeline:
 
         result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
                           held_out=held_out, sdp_prior=self.sdp_prior)
-        return replace(result, settings={**result.settings, "robot_source": self.source, **prepared.choices})
+        findings, delay = _delay_check(prepared)
+        return replace(result, settings={**result.settings, "robot_source": self.source, **prepared.choices},
+                       findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
             held_out: bool = True):
@@ -239,3 +241,36 @@ class IdentificationPipeline:
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
         return self.estimate(prepared, refs, progress, held_out)
+
+
+DELAY_MAX_SAMPLES = 60_000
+"""The delay check of :func:`_delay_check` holds the log's rows in memory: a longer log is not checked (said so)."""
+
+
+def _delay_check(prepared: PreparedIdentification) -> tuple[list, dict]:
+    """The delay between the torque and position channels the identification log shows on top of the one given
+    (:func:`dynid.experiment.delay.delay_of_prepared`), and the finding when it matters
+    (:func:`dynid.validation.diagnostics.delay_findings`)."""
+    from ..exceptions import DynIdError
+    from ..preprocessing.filters import FractionalShift
+    from ..validation.diagnostics import DELAY_MIN_SAMPLES, delay_findings
+    from .delay import delay_of_prepared
+
+    data = prepared.data
+    if data.settings.strategy != "parallel":
+        return [], {"note": f"not estimated: the {data.settings.strategy!r} strategy"}
+    if data.t.shape[0] > DELAY_MAX_SAMPLES:
+        return [], {"note": f"not estimated: {data.t.shape[0]} samples (at most {DELAY_MAX_SAMPLES}); estimate_delay on a part"}
+    try:
+        d = delay_of_prepared(prepared.robot, prepared.base, data)
+        undone = None
+        if d.determined and abs(d.samples) >= DELAY_MIN_SAMPLES:  # does the log agree once the delay is undone?
+            shifted = replace(data, tau=FractionalShift(np.asarray(data.tau, dtype=float)).read(d.samples))
+            undone = delay_of_prepared(prepared.robot, prepared.base, shifted)
+    except DynIdError as exc:
+        return [], {"note": f"not estimated: {exc}"}
+    left = None if undone is None else undone.samples
+    found = delay_findings(d.samples, d.std, d.determined, data.rate, data.settings.torque_delay, data.name, left,
+                           0.0 if undone is None else undone.std)
+    return found, {"samples": d.samples, "std": d.std, "seconds": d.seconds, "determined": d.determined,
+                   "at_bound": d.at_bound, **({} if left is None else {"samples_left_when_undone": left})}

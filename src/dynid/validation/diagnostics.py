@@ -42,7 +42,7 @@ class Finding:
     Attributes
     ----------
     kind : str
-        "sign", "friction", "position", "correlated", "excitation", "extrapolation", "validation".
+        "sign", "friction", "position", "correlated", "excitation", "extrapolation", "validation", "delay".
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
@@ -230,6 +230,57 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
                             "other datasets (or check the description's gravity)")]
+
+
+DELAY_SIGNIFICANT = 3.0
+"""A torque channel's delay is reported when it lies this many of its σ from 0 …"""
+
+DELAY_MIN_SAMPLES = 0.25
+"""… and is at least this many samples (half a control period, a zero-order hold's, biased the ER-16's least squares by
+0.13 %)."""
+
+
+def delay_findings(samples: float, std: float, determined: bool, rate: float, given: float, dataset: str,
+                   left: float | None = None, left_std: float = 0.0) -> list[Finding]:
+    """A delay between the torque (current) and position channels that the log determines and that matters.
+
+    Parameters
+    ----------
+    samples, std : float
+        The delay the log shows on top of the one given, and its σ [samples] (:func:`dynid.experiment.delay.estimate_delay`).
+    determined : bool
+        Whether the log determines it (:attr:`dynid.experiment.delay.DelayEstimate.determined`).
+    rate : float [Hz]
+        The log's rate.
+    given : float [s]
+        ``preprocessing.torque_delay`` already applied.
+    dataset : str
+        The log, named in the finding.
+    left, left_std : float, optional
+        The delay the same log shows once ``samples`` is undone, and its σ [samples]: a real delay leaves none (within
+        :data:`DELAY_SIGNIFICANT` σ and 0.05 samples); a delay traded against a misfit of the model (a real log's friction
+        near reversals) leaves some (measured on the LBR Med7's identification log: -1.88 ± 0.04 samples, -0.19 ± 0.04
+        left, and identified again with it, its validation errors moved both ways).
+
+    Returns
+    -------
+    list of Finding
+        One finding with the ``torque_delay`` to give, or to try when undoing it leaves a delay; none when the log
+        determines no delay that matters.
+    """
+    if not determined or abs(samples) < max(DELAY_SIGNIFICANT * std, DELAY_MIN_SAMPLES):
+        return []
+    way = "lag" if samples > 0 else "lead"
+    total = given + samples / rate
+    size = f"{abs(samples):.2g} ± {std:.1g} samples ({1e3 * abs(samples) / rate:.3g} ms"
+    size += " more than the torque_delay given)" if given else ")"
+    setting = f"[preprocessing] torque_delay = {total:.4g} (seconds; Preprocessing(torque_delay=...) for arrays)"
+    if left is not None and abs(left) > DELAY_SIGNIFICANT * left_std + 0.05:
+        return [Finding("delay", f"{dataset}: the residual is smallest with the torques read as if they {way} the positions "
+                                 f"by {size}, but undoing that leaves {left:.2g} samples: the delay trades off against a "
+                                 f"misfit of the model, not only the drive's timing; try {setting} and keep it if the "
+                                 "validation logs agree")]
+    return [Finding("delay", f"{dataset}: the torques {way} the positions by {size}: give {setting} and identify again")]
 
 
 def validation_findings(name: str, global_error: float, fit_error: float, prediction_spread: np.ndarray | None,
