@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import time
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,9 +16,11 @@ from ..io.identification_config import IdentificationConfig, stored_preprocessin
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over
-from .identification_pipeline import IdentificationPipeline
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
+
+if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
+    from .identification_pipeline import IdentificationPipeline
 
 
 def _references(config: IdentificationConfig, base):
@@ -159,7 +162,7 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
     return replace(result, **_main_estimate(result))
 
 
-def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
+def pipeline_of(config: IdentificationConfig) -> "IdentificationPipeline":
     """The identification pipeline a config describes: its robot, preprocessing, estimators, friction choice, seed.
 
     Parameters
@@ -170,6 +173,8 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     -------
     IdentificationPipeline
     """
+    from .identification_pipeline import IdentificationPipeline
+
     return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
                                   config.sdp_prior, config.robot_source)
 
@@ -338,6 +343,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         An unknown estimator or ``friction``.
     """
     from ..model.description import builtin_robots
+    from .identification_pipeline import IdentificationPipeline
 
     pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), tuple(estimators), friction, int(seed), sdp_prior,
                                       robot.name if robot.name in builtin_robots() else "")
