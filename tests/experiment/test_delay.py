@@ -49,7 +49,7 @@ def test_identify_says_which_torque_delay_to_give():
     delays = lambda result: [f.text for f in result.findings if f.kind == "delay"]
 
     found = delays(dynid.identify_from_arrays(robot, log.t, log.q, late, estimators=("ols",)))
-    assert len(found) == 1 and "the torques lag the positions by" in found[0], found
+    assert len(found) == 1 and "as if they lag the positions by" in found[0], found
     assert float(found[0].split("positions by ")[1].split()[0]) == pytest.approx(2.5, abs=0.25)
     given = float(found[0].split("torque_delay = ")[1].split()[0])
     assert given == pytest.approx(2.5 / log.rate, abs=0.25 / log.rate)

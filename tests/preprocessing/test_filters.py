@@ -69,3 +69,19 @@ def test_parallel_filter_edges_average_the_noise_rather_than_amplify_one_sample(
     interior = np.std(middles)
     assert interior < 15.0  # the filter keeps a few % of the noise's band
     assert np.std(firsts) < 2.0 * interior and np.std(lasts) < 2.0 * interior, (np.std(firsts), np.std(lasts), interior)
+
+
+def test_a_fractional_shift_read_at_some_samples_equals_the_whole_shift_there():
+    """The delay check reads the shifted torques only at the decimated rows: the same numbers as shifting the whole log
+    (a sinusoid within the band shifted by 2.3 samples, independent truth: its own value 2.3 samples later)."""
+    from dynid.preprocessing.filters import FractionalShift
+
+    k = np.arange(2000)
+    x = np.column_stack([np.sin(2 * np.pi * 0.01 * k), np.cos(2 * np.pi * 0.02 * k)])
+    at = np.arange(5, 2000, 37)
+    shift = FractionalShift(x)
+    np.testing.assert_array_equal(shift.read(2.3, at=at), shift.read(2.3)[at])
+    np.testing.assert_array_equal(shift.read(-3.0, at=at), shift.read(-3.0)[at])
+    inside = at[(at > 40) & (at < 1950)]
+    truth = np.column_stack([np.sin(2 * np.pi * 0.01 * (inside + 2.3)), np.cos(2 * np.pi * 0.02 * (inside + 2.3))])
+    np.testing.assert_allclose(shift.read(2.3, at=inside), truth, atol=1e-3)

@@ -28,7 +28,7 @@ from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
-__all__ = ["DelayEstimate", "estimate_delay", "delay_of_prepared", "delayed"]
+__all__ = ["DelayEstimate", "estimate_delay", "delay_of_prepared", "delay_from_rows", "delayed"]
 
 DETERMINED_STD = 0.5
 """[samples] A delay estimate with a larger σ is not determined by the log."""
@@ -123,18 +123,42 @@ def delay_of_prepared(robot: Robot, base: BaseParameters, data: PreparedData, ma
     IdentifiabilityError
         Fewer rows than parameters, or a residual that does not change with the delay (no motion).
     """
+    return delay_from_rows(data, base_chunks(robot, base, data), max_samples)
+
+
+def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> DelayEstimate:
+    """:func:`delay_of_prepared` from the blocks of rows the identification's own pass made (no second pass).
+
+    Parameters
+    ----------
+    data : PreparedData
+    blocks : iterable of tuple
+        ``(index, y, tau, keep)`` as :func:`dynid.preprocessing.pipeline.base_chunks` yields them (``tau`` unused).
+    max_samples : float
+        Largest delay searched, either way [samples].
+
+    Returns
+    -------
+    DelayEstimate
+
+    Raises
+    ------
+    IdentifiabilityError
+        Fewer rows than parameters, or a residual that does not change with the delay (no motion).
+    """
     from scipy.optimize import minimize_scalar
 
     s = data.settings
     rows, times, keeps = [], [], []
-    for index, y, _, keep in base_chunks(robot, base, data):
+    for index, y, _, keep in blocks:
         rows.append(y.reshape(-1, y.shape[-1]))
         times.append(np.asarray(data.t)[index])
         keeps.append(np.asarray(keep).reshape(-1))
     w, t_rows, keep = np.concatenate(rows), np.concatenate(times), np.concatenate(keeps)
-    n = robot.n_dof
+    n = w.shape[0] // t_rows.size  # rows per instant: the joints
     if keep.sum() <= w.shape[1]:
         raise IdentifiabilityError(f"{data.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
+    del rows
     q_factor, _ = np.linalg.qr(w[keep])
     tau = np.asarray(data.tau, dtype=float)
     if s.parallel_cutoff is not None:  # the torques as the regressor's columns are filtered
@@ -146,7 +170,7 @@ def delay_of_prepared(robot: Robot, base: BaseParameters, data: PreparedData, ma
     rows_index = np.rint((t_rows - t_full[0]) * data.rate).astype(int)
 
     def residual(d: float) -> np.ndarray:
-        shifted = shift.read(d)[rows_index].reshape(-1)[keep]
+        shifted = shift.read(d, at=rows_index).reshape(-1)[keep]
         return shifted - q_factor @ (q_factor.T @ shifted)
 
     def rss(d: float) -> float:

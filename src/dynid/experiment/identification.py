@@ -277,7 +277,7 @@ class IdentificationResult:
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",),
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
-             sdp_prior: str = "euclidean") -> IdentificationResult:
+             sdp_prior: str = "euclidean", observers: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
     over its rows; check every estimate's physical consistency and give the verdict on the model.
 
@@ -309,6 +309,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     sdp_prior : {"euclidean", "geometric"}
         How ``sdp`` pulls its unidentifiable directions towards the nominal parameters: squared distance, or the
         log-det divergence of each link's pseudo-inertia (plausible links for export; Lee, Wensing & Park 2020).
+    observers : tuple of callable
+        ``observer(index, y, tau, keep)`` called with every block of base rows of the one pass (what else needs them,
+        e.g. the delay check of :mod:`dynid.experiment.identification_pipeline`).
 
     Returns
     -------
@@ -347,6 +350,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
         residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, near_reversal, keep)
         blocks.add(index, y, tau, keep)
+        for observer in observers:
+            observer(index, y, tau, keep)
 
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=estimation.standard or bool(folds))
     stream_rows(chunks, estimation, base, observe, standard=estimation.standard or bool(folds))

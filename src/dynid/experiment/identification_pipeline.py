@@ -208,9 +208,12 @@ class IdentificationPipeline:
         """
         from .identification import identify
 
+        blocks: list = []  # the delay check's rows, from the identification's own pass
+        check = _delay_checked(prepared.data)
         result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
-                          held_out=held_out, sdp_prior=self.sdp_prior)
-        findings, delay = _delay_check(prepared)
+                          held_out=held_out, sdp_prior=self.sdp_prior,
+                          observers=(lambda *block: blocks.append(block),) if check is None else ())
+        findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
         return replace(result, settings={**result.settings, "robot_source": self.source, **prepared.choices},
                        findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
 
@@ -247,30 +250,29 @@ DELAY_MAX_SAMPLES = 60_000
 """The delay check of :func:`_delay_check` holds the log's rows in memory: a longer log is not checked (said so)."""
 
 
-def _delay_check(prepared: PreparedIdentification) -> tuple[list, dict]:
-    """The delay between the torque and position channels the identification log shows on top of the one given
-    (:func:`dynid.experiment.delay.delay_of_prepared`), and the finding when it matters
-    (:func:`dynid.validation.diagnostics.delay_findings`)."""
-    from ..exceptions import DynIdError
-    from ..preprocessing.filters import FractionalShift
-    from ..validation.diagnostics import DELAY_MIN_SAMPLES, delay_findings
-    from .delay import delay_of_prepared
-
-    data = prepared.data
+def _delay_checked(data: PreparedData) -> str | None:
+    """Why the delay check does not run on ``data`` (None: it runs)."""
     if data.settings.strategy != "parallel":
-        return [], {"note": f"not estimated: the {data.settings.strategy!r} strategy"}
+        return f"not estimated: the {data.settings.strategy!r} strategy"
     if data.t.shape[0] > DELAY_MAX_SAMPLES:
-        return [], {"note": f"not estimated: {data.t.shape[0]} samples (at most {DELAY_MAX_SAMPLES}); estimate_delay on a part"}
+        return f"not estimated: {data.t.shape[0]} samples (at most {DELAY_MAX_SAMPLES}); estimate_delay on a part"
+    return None
+
+
+def _delay_check(data: PreparedData, blocks: list) -> tuple[list, dict]:
+    """The delay between the torque and position channels the identification log shows on top of the one given
+    (:func:`dynid.experiment.delay.delay_from_rows`, on the identification's own rows), and the finding when it
+    matters (:func:`dynid.validation.diagnostics.delay_findings`)."""
+    from ..exceptions import DynIdError
+    from ..validation.diagnostics import delay_findings
+    from .delay import delay_from_rows
+
     try:
-        d = delay_of_prepared(prepared.robot, prepared.base, data)
-        undone = None
-        if d.determined and abs(d.samples) >= DELAY_MIN_SAMPLES:  # does the log agree once the delay is undone?
-            shifted = replace(data, tau=FractionalShift(np.asarray(data.tau, dtype=float)).read(d.samples))
-            undone = delay_of_prepared(prepared.robot, prepared.base, shifted)
+        d = delay_from_rows(data, [(index, y, None, keep) for index, y, _, keep in blocks])
     except DynIdError as exc:
         return [], {"note": f"not estimated: {exc}"}
-    left = None if undone is None else undone.samples
-    found = delay_findings(d.samples, d.std, d.determined, data.rate, data.settings.torque_delay, data.name, left,
-                           0.0 if undone is None else undone.std)
+    finally:
+        blocks.clear()
+    found = delay_findings(d.samples, d.std, d.determined, data.rate, data.settings.torque_delay, data.name)
     return found, {"samples": d.samples, "std": d.std, "seconds": d.seconds, "determined": d.determined,
-                   "at_bound": d.at_bound, **({} if left is None else {"samples_left_when_undone": left})}
+                   "at_bound": d.at_bound}

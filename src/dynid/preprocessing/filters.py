@@ -161,17 +161,19 @@ class FractionalShift:
         self.n = self.x.shape[0]
         self.taps = int(taps)
 
-    def read(self, samples: float) -> np.ndarray:
+    def read(self, samples: float, at: np.ndarray | None = None) -> np.ndarray:
         """The signal ``samples`` later: ``y[k] = x(k + samples)``.
 
         Parameters
         ----------
         samples : float
             Negative: earlier.
+        at : (M,) int array, optional
+            Only these samples ``k`` (the same values as ``read(samples)[at]``, computed at them alone).
 
         Returns
         -------
-        array, the shape of ``x``
+        array, the shape of ``x`` (of ``x[at]``)
             At the ends the mirror image stands for the samples the log does not hold.
         """
         whole = int(np.floor(samples))
@@ -184,10 +186,10 @@ class FractionalShift:
             weights /= weights.sum()
         pad = abs(whole) + self.taps + 1
         mirrored = np.pad(self.x, [(pad, pad)] + [(0, 0)] * (self.x.ndim - 1), mode="symmetric")
-        out = np.zeros_like(self.x)
+        out = np.zeros_like(self.x if at is None else self.x[at])
         for offset, weight in zip(offsets, weights):
             start = pad + whole + int(offset)
-            out += weight * mirrored[start:start + self.n]
+            out += weight * (mirrored[start:start + self.n] if at is None else mirrored[start + np.asarray(at)])
         return out
 
 

@@ -240,9 +240,12 @@ DELAY_MIN_SAMPLES = 0.25
 0.13 %)."""
 
 
-def delay_findings(samples: float, std: float, determined: bool, rate: float, given: float, dataset: str,
-                   left: float | None = None, left_std: float = 0.0) -> list[Finding]:
+def delay_findings(samples: float, std: float, determined: bool, rate: float, given: float, dataset: str) -> list[Finding]:
     """A delay between the torque (current) and position channels that the log determines and that matters.
+
+    Worded as what to try: a real log's residual is also smallest at a delay that trades off against a misfit of the
+    model (measured on the LBR Med7's identification log: -1.88 ± 0.04 samples; identified again with it, its
+    validation errors moved both ways), so the validation logs decide.
 
     Parameters
     ----------
@@ -256,31 +259,22 @@ def delay_findings(samples: float, std: float, determined: bool, rate: float, gi
         ``preprocessing.torque_delay`` already applied.
     dataset : str
         The log, named in the finding.
-    left, left_std : float, optional
-        The delay the same log shows once ``samples`` is undone, and its σ [samples]: a real delay leaves none (within
-        :data:`DELAY_SIGNIFICANT` σ and 0.05 samples); a delay traded against a misfit of the model (a real log's friction
-        near reversals) leaves some (measured on the LBR Med7's identification log: -1.88 ± 0.04 samples, -0.19 ± 0.04
-        left, and identified again with it, its validation errors moved both ways).
 
     Returns
     -------
     list of Finding
-        One finding with the ``torque_delay`` to give, or to try when undoing it leaves a delay; none when the log
-        determines no delay that matters.
+        One finding with the ``torque_delay`` to try, or none when the log determines no delay that matters.
     """
     if not determined or abs(samples) < max(DELAY_SIGNIFICANT * std, DELAY_MIN_SAMPLES):
         return []
     way = "lag" if samples > 0 else "lead"
     total = given + samples / rate
-    size = f"{abs(samples):.2g} ± {std:.1g} samples ({1e3 * abs(samples) / rate:.3g} ms"
-    size += " more than the torque_delay given)" if given else ")"
-    setting = f"[preprocessing] torque_delay = {total:.4g} (seconds; Preprocessing(torque_delay=...) for arrays)"
-    if left is not None and abs(left) > DELAY_SIGNIFICANT * left_std + 0.05:
-        return [Finding("delay", f"{dataset}: the residual is smallest with the torques read as if they {way} the positions "
-                                 f"by {size}, but undoing that leaves {left:.2g} samples: the delay trades off against a "
-                                 f"misfit of the model, not only the drive's timing; try {setting} and keep it if the "
-                                 "validation logs agree")]
-    return [Finding("delay", f"{dataset}: the torques {way} the positions by {size}: give {setting} and identify again")]
+    more = " more than the torque_delay given" if given else ""
+    return [Finding("delay", f"{dataset}: the residual is smallest with the torques read as if they {way} the positions by "
+                             f"{abs(samples):.2g} ± {std:.1g} samples ({1e3 * abs(samples) / rate:.3g} ms{more}): if the "
+                             f"drive logs them so, give [preprocessing] torque_delay = {total:.4g} (seconds; "
+                             "Preprocessing(torque_delay=...) for arrays), identify again and keep it if the validation "
+                             "logs agree")]
 
 
 def validation_findings(name: str, global_error: float, fit_error: float, prediction_spread: np.ndarray | None,
