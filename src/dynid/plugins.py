@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .exceptions import ConfigError
 
-__all__ = ["ENTRY_POINT_GROUP", "ENVIRONMENT", "load_plugins", "add_plugins", "share_with"]
+__all__ = ["ENTRY_POINT_GROUP", "ENVIRONMENT", "load_plugins", "add_plugins", "share_with", "origin"]
 
 ENTRY_POINT_GROUP = "dynid.plugins"
 """Entry-point group of installed plugin packages."""
@@ -141,3 +141,22 @@ def share_with(client) -> None:
                 client.run(importlib.import_module, module)
         except Exception as exc:
             raise ConfigError(f"plugin {plugin}: the Dask workers cannot import it: {type(exc).__name__}: {exc}") from None
+
+
+def origin(builder) -> str:
+    """Where an estimator's or a strategy's builder is defined, ``module.qualname`` of its class (or of the builder),
+    or the ``"module:attribute"`` text naming it: a plugin imported again registers the same origin, which is no
+    conflict.
+
+    Parameters
+    ----------
+    builder : class, instance, callable or str
+
+    Returns
+    -------
+    str
+    """
+    if isinstance(builder, str):
+        return builder
+    target = builder if hasattr(builder, "__qualname__") else type(builder)  # a class or a function, else an instance
+    return f"{target.__module__}.{target.__qualname__}"

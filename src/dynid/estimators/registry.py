@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
 from ..exceptions import ConfigError
-from ..plugins import load_plugins
+from ..plugins import load_plugins, origin
 
 if TYPE_CHECKING:
     import numpy as np
@@ -269,18 +269,11 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
         raise ValueError(f"estimator key: expected letters, digits and _, got {key!r}")
     if space not in ("base", "standard"):
         raise ValueError(f"estimator {k}: space must be 'base' or 'standard', got {space!r}")
-    if k in _REGISTRY and not replace and _origin(_REGISTRY[k].build) != _origin(build):
+    if k in _REGISTRY and not replace and origin(_REGISTRY[k].build) != origin(build):
         raise ValueError(f"estimator {k!r} is registered already (pass replace=True to replace it)")
     entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options))
     _REGISTRY[k] = entry
     return entry
-
-
-def _origin(build) -> str:
-    """Where an estimator's (or strategy's) builder is defined: ``module.qualname``, or the text naming it."""
-    if isinstance(build, str):
-        return build
-    return f"{getattr(build, '__module__', '')}.{getattr(build, '__qualname__', repr(build))}"
 
 
 def unregister(key: str) -> None:

@@ -28,7 +28,7 @@ from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
-__all__ = ["DelayEstimate", "estimate_delay", "delay_of_prepared", "delay_from_rows", "delayed"]
+__all__ = ["DelayEstimate", "estimate_delay", "delay_from_rows", "delayed"]
 
 DETERMINED_STD = 0.5
 """[samples] A delay estimate with a larger σ is not determined by the log."""
@@ -99,39 +99,18 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     if not (np.isfinite(max_samples) and max_samples > 0):
         raise ConfigError(f"max_samples: expected a positive number of samples, got {max_samples!r}")
     base = base if base is not None else base_parameters(robot, rng=0)
-    return delay_of_prepared(robot, base, prepare(recording, preprocessing or Preprocessing()), max_samples)
-
-
-def delay_of_prepared(robot: Robot, base: BaseParameters, data: PreparedData, max_samples: float = 20.0) -> DelayEstimate:
-    """:func:`estimate_delay` on a log prepared already (by the default strategy, ``"parallel"``).
-
-    Parameters
-    ----------
-    robot : Robot
-    base : BaseParameters
-    data : PreparedData
-        From :func:`dynid.preprocessing.pipeline.prepare` (its torques at the log's rate, not yet filtered).
-    max_samples : float
-        Largest delay searched, either way [samples].
-
-    Returns
-    -------
-    DelayEstimate
-
-    Raises
-    ------
-    IdentifiabilityError
-        Fewer rows than parameters, or a residual that does not change with the delay (no motion).
-    """
+    data = prepare(recording, preprocessing or Preprocessing())
     return delay_from_rows(data, base_chunks(robot, base, data), max_samples)
 
 
 def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> DelayEstimate:
-    """:func:`delay_of_prepared` from the blocks of rows the identification's own pass made (no second pass).
+    """:func:`estimate_delay` on a log prepared already (by the default strategy, ``"parallel"``), from its blocks of
+    base rows: the identification's own pass gives them, so the check needs no second pass.
 
     Parameters
     ----------
     data : PreparedData
+        From :func:`dynid.preprocessing.pipeline.prepare` (its torques at the log's rate, not yet filtered).
     blocks : iterable of tuple
         ``(index, y, tau, keep)`` as :func:`dynid.preprocessing.pipeline.base_chunks` yields them (``tau`` unused).
     max_samples : float

@@ -173,9 +173,7 @@ class IdentificationPipeline:
             data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
             base = base_parameters(robot, rng=0)
             made["friction_models"] = friction.to_dict()
-        order = ("coulomb_cross_validation", "friction_models", "preprocessing_cross_validation")
-        choices = {"coulomb_velocity": robot.coulomb_velocity.tolist(), **{k: made[k] for k in order if k in made}}
-        return PreparedIdentification(robot, base, data, choices)
+        return PreparedIdentification(robot, base, data, {"coulomb_velocity": robot.coulomb_velocity.tolist(), **made})
 
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
                  held_out: bool = False):
@@ -268,11 +266,9 @@ def _delay_check(data: PreparedData, blocks: list) -> tuple[list, dict]:
     from .delay import delay_from_rows
 
     try:
-        d = delay_from_rows(data, [(index, y, None, keep) for index, y, _, keep in blocks])
+        d = delay_from_rows(data, blocks)
     except DynIdError as exc:
         return [], {"note": f"not estimated: {exc}"}
-    finally:
-        blocks.clear()
     found = delay_findings(d.samples, d.std, d.determined, data.rate, data.settings.torque_delay, data.name)
     return found, {"samples": d.samples, "std": d.std, "seconds": d.seconds, "determined": d.determined,
                    "at_bound": d.at_bound}

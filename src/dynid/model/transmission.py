@@ -19,6 +19,7 @@ are absorbed by them. For the TX40 this is FIGAROH's parameterisation (joint-5 r
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -110,10 +111,17 @@ class Transmission:
         """Joints (and motors)."""
         return self.motor_from_joint.shape[0]
 
-    @property
+    @cached_property
     def coupled_motors(self) -> tuple[int, ...]:
         """0-based indices of the motors that turn with more than one joint."""
         return self.coupled_motors_of(self.motor_from_joint)
+
+    @cached_property
+    def _coupling(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Per coupled motor, ``c`` and ``c cᵀ - diag(c²)`` (module docstring), computed once: a closed-loop
+        simulation asks for the coupling columns four times a control period."""
+        return tuple((self.ratios(k), np.outer(self.ratios(k), self.ratios(k)) - np.diag(self.ratios(k) ** 2))
+                     for k in self.coupled_motors)
 
     @property
     def n_coupled_params(self) -> int:
@@ -154,9 +162,7 @@ class Transmission:
         n_s = dq.shape[0]
         out = np.zeros((n_s, self.n_dof, self.n_coupled_params))
         col = 0
-        for k in self.coupled_motors:
-            c = self.ratios(k)
-            off = np.outer(c, c) - np.diag(c**2)
+        for c, off in self._coupling:
             for term in self.coupled_terms:
                 if term == "Iam":
                     out[:, :, col] = ddq @ off.T

@@ -28,7 +28,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from ..exceptions import ConfigError
-from ..plugins import load_plugins
+from ..plugins import load_plugins, origin
 from .settings import Preprocessing
 
 if TYPE_CHECKING:
@@ -135,17 +135,9 @@ def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
     key = str(name).strip().lower()
     if not key:
         raise ValueError("preprocessing strategy: expected a name")
-    if key in _STRATEGIES and not replace and _origin(_STRATEGIES[key]) != _origin(strategy):
+    if key in _STRATEGIES and not replace and origin(_STRATEGIES[key]) != origin(strategy):
         raise ValueError(f"preprocessing strategy {key!r} is registered already (pass replace=True to replace it)")
     _STRATEGIES[key] = strategy
-
-
-def _origin(strategy) -> str:
-    """Where a strategy is defined: ``module.qualname`` of its class, or the text naming it."""
-    if isinstance(strategy, str):
-        return strategy
-    cls = strategy if isinstance(strategy, type) else type(strategy)
-    return f"{cls.__module__}.{cls.__qualname__}"
 
 
 def unregister_strategy(name: str) -> None:

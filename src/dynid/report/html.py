@@ -93,7 +93,7 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
             rows.append([label, "error %", *(_fmt(x, ".3g") if ok[j] else "n/m" for j, x in enumerate(m["relative_error"])),
                          _fmt(m.get("global_relative_error"), ".3g")])
             rows.append(["", "RMSE N·m", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
-            rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") if varies[j] else "n/m" for j, x in enumerate(m["correlation"])), ""])
+            rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") if varies[j] and x is not None else "n/m" for j, x in enumerate(m["correlation"])), ""])
         tables.append(Table(f"{c['name']}: {c['n_samples']} samples (error of {BAD_ERROR:g} % and more highlighted; n/m: the "
                             "joint's torque is at the noise level, or does not vary beyond it: its relative error or correlation "
                             "means nothing)",

@@ -166,19 +166,24 @@ class ClosedLoopNoise:
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"noise.{name}: expected a non-negative number, got {value!r}", field=name)
 
-    def measured_positions(self, q: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    def measured_positions(self, q: np.ndarray, rng: np.random.Generator, draw: np.ndarray | None = None) -> np.ndarray:
         """Positions as the encoder gives them.
 
         Parameters
         ----------
         q : array [rad]
         rng : numpy.random.Generator
+        draw : array [rad], optional
+            The noise, drawn already (``rng`` is then not used).
 
         Returns
         -------
         array [rad], same shape
         """
-        y = q + rng.normal(0.0, self.position_std, np.shape(q)) if self.position_std > 0 else np.array(q, dtype=float)
+        if self.position_std > 0:
+            y = q + (rng.normal(0.0, self.position_std, np.shape(q)) if draw is None else draw)
+        else:
+            y = np.array(q, dtype=float)
         return np.round(y / self.encoder_resolution) * self.encoder_resolution if self.encoder_resolution > 0 else y
 
 
@@ -248,12 +253,9 @@ class JointDynamics:
         self._vs = np.asarray(robot.coulomb_velocity, dtype=float)
         self._smooth = bool(np.any(self._vs > 0))
         self._coupled = robot.transmission.n_coupled_params > 0
-        if self._coupled:  # the coupled motors' velocity terms (Transmission.coupling_columns at zero acceleration)
-            tr = robot.transmission
-            self._coupling = [(tr.ratios(k), np.outer(tr.ratios(k), tr.ratios(k)) - np.diag(tr.ratios(k) ** 2))
-                              for k in tr.coupled_motors]
-            self._coupled_values = np.ravel(tr.coupled_values)
-            self._coupled_terms = tr.coupled_terms
+        if self._coupled:  # the coupled motors' velocity terms: their columns at zero acceleration
+            self._coupled_values = np.ravel(robot.transmission.coupled_values)
+            self._no_acceleration = np.zeros((1, n))
         self._lower = np.tril_indices(n, -1)
         # a diagonal drive inertia (rotor inertias, no coupled motor) is Pinocchio's armature: ABA then gives q̈ in one
         # call; a coupled motor's inertia is off the diagonal: M from CRBA, solved
@@ -281,23 +283,8 @@ class JointDynamics:
             s = np.sign(dq)
         tau = self._fc * s + self._fv * dq + self._offset
         if self._coupled:
-            tau = tau + self._coupling_columns(dq) @ self._coupled_values
+            tau = tau + self.robot.transmission.coupling_columns(dq[None], self._no_acceleration)[0] @ self._coupled_values
         return tau
-
-    def _coupling_columns(self, dq: np.ndarray) -> np.ndarray:
-        """(n_dof, n_coupled_params): :meth:`dynid.model.transmission.Transmission.coupling_columns` at ``dq`` and zero
-        acceleration, from the ratios computed once."""
-        out = np.zeros((dq.size, self._coupled_values.size))
-        row = dq[None]
-        col = 0
-        for c, off in self._coupling:
-            for term in self._coupled_terms:
-                if term == "fvm":
-                    out[:, col] = (row @ off.T)[0]
-                elif term == "fcm":
-                    out[:, col] = np.sign(row @ c)[0] * c
-                col += 1  # Iam: its column is the acceleration's, 0 here
-        return out
 
     def mass_and_bias(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``M(q)`` and ``h(q, q̇)``, so that the joint torque is ``M q̈ + h``.
@@ -401,14 +388,8 @@ def _run_loop(t, q_ref, dq_ref, ff, controller: Controller, dynamics: JointDynam
     velocity = dq_ref[0].copy()
     # the encoder's noise drawn at once: the same numbers as one draw per instant (a Generator's stream)
     draws = rng.normal(0.0, noise.position_std, (t.size, n)) if noise.position_std > 0 else None
-    resolution = noise.encoder_resolution
     for k in range(t.size):
-        if position_noise:
-            y = q + draws[k] if draws is not None else np.array(q, dtype=float)
-            if resolution > 0:
-                y = np.round(y / resolution) * resolution
-        else:
-            y = q
+        y = noise.measured_positions(q, rng, None if draws is None else draws[k]) if position_noise else q
         if previous is not None:  # the first instant: no difference yet, the reference's velocity
             velocity = velocity + alpha * ((y - previous) / h - velocity)
         error = q_ref[k] - y
