@@ -20,7 +20,7 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m mypy  # type check of src/dynid ([tool.mypy] in pyproject.toml)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
-	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict --quiet  # the docs site (mkdocs.yml) into .site/
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict  # the docs site (mkdocs.yml) into .site/; a warning (a broken link) fails it
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_table.py

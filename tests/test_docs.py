@@ -102,3 +102,28 @@ def test_the_fleet_tutorials_python_runs(tmp_path, monkeypatch, capsys):
     alarms = [line for line in out.splitlines() if line.startswith("joint ")]
     assert len(alarms) == 1 and alarms[0].startswith("joint 3: viscous friction (fv3) rose"), out
     assert "since 2026-01-15T00-00.csv at 1 s; alarm in 2026-01-15T00-00.csv at 11 s, 10 s of logs later" in alarms[0]
+
+
+def test_the_docs_build_counts_its_warnings():
+    """make test builds the docs with --strict and nothing that hides warnings from it (--quiet did: a broken link
+    passed)."""
+    lines = [ln for ln in (DOCS.parent / "Makefile").read_text().splitlines() if "mkdocs build" in ln]
+    assert lines, "make test builds no docs"
+    for line in lines:
+        command = line.split("#", 1)[0].split()
+        assert "--strict" in command and "--quiet" not in command and "-q" not in command, line
+
+
+def test_the_readme_and_docs_link_to_files_that_exist():
+    """Every relative link of the README and of the docs' pages names a file of the repository (mkdocs checks the
+    pages' links among themselves; this checks the README's and the docs' links out of docs/)."""
+    root = DOCS.parent
+    broken = []
+    for page in [root / "README.md", *sorted(DOCS.rglob("*.md"))]:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text(encoding="utf-8")):
+            path = target.split("#", 1)[0]
+            if not path or re.match(r"^[a-z]+:", path):
+                continue
+            if not (page.parent / path).exists():
+                broken.append(f"{page.relative_to(root)} -> {target}")
+    assert broken == []

@@ -103,7 +103,7 @@ def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
     p = run(growing, tmp_path / "daily")
     assert p.returncode == 0, p.stderr
     assert json.loads((tmp_path / "daily" / "monitor.json").read_text())["alarms"] == []  # the change is in log 15
-    assert (tmp_path / "daily" / "monitor-state.pkl").is_file()
+    assert (tmp_path / "daily" / "monitor-state.json").is_file()
     for f in files[14:]:
         shutil.copy(f, growing / f.name)
     p = run(growing, tmp_path / "daily")
@@ -113,13 +113,13 @@ def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
     daily = json.loads((tmp_path / "daily" / "monitor.json").read_text())
     assert daily == once and [a["term"] for a in daily["alarms"]] == ["fv3"]
 
-    assert_refused(run(growing, tmp_path / "daily", "--window", "5"), "monitor-state.pkl: made from another "
+    assert_refused(run(growing, tmp_path / "daily", "--window", "5"), "monitor-state.json: made from another "
                    "identification or with other monitor settings")
     shutil.copy(files[0], growing / "2025-12-31T00-00.csv")
     assert_refused(run(growing, tmp_path / "daily"), "2025-12-31T00-00.csv: a new log that sorts before")
     (growing / "2025-12-31T00-00.csv").unlink()
-    (tmp_path / "daily" / "monitor-state.pkl").write_bytes(b"not a pickle")
-    assert_refused(run(growing, tmp_path / "daily"), "monitor-state.pkl: not a monitor state dynid can read")
+    (tmp_path / "daily" / "monitor-state.json").write_bytes(b"not a state")
+    assert_refused(run(growing, tmp_path / "daily"), "monitor-state.json: not a monitor state dynid can read")
     p = run(growing, tmp_path / "daily", "--restart")
     assert p.returncode == 0, p.stderr
     assert json.loads((tmp_path / "daily" / "monitor.json").read_text()) == once and "went on" not in p.stdout

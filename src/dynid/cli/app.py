@@ -620,14 +620,16 @@ def monitor(
     reference_windows: int = typer.Option(60, help="Windows that set each term's reference (the first ones)."),
     false_alarm_days: float = typer.Option(30.0, help="One false alarm per this many days of logs, on average."),
     restart: bool = typer.Option(False, "--restart", help="Monitor every log anew, not going on from the state an "
-                                                          "earlier run left in --out (monitor-state.pkl)."),
+                                                          "earlier run left in --out (monitor-state.json)."),
     quiet: bool = QUIET,
 ) -> None:
     """Follow a robot's friction and drive terms through its logs and raise an alarm when one changes (wear).
 
     Run again on a growing folder, it goes on from the state the last run left in --out and reads only the new logs.
     """
-    from ..experiment.monitor import STATE_FILE, MonitorSettings, dated_logs, monitor_fingerprint, monitor_logs, resumed_monitor
+    from ..exceptions import DataError
+    from ..experiment.monitor import (STATE_FILE, MonitorSettings, dated_logs, legacy_state_refusal, monitor_fingerprint,
+                                      monitor_logs, resumed_monitor)
     from ..io.identification_config import load_identification_config
 
     def prepare():
@@ -639,7 +641,10 @@ def monitor(
         model = load_results(results, cfg.robot)
         fingerprint = monitor_fingerprint(results, settings)
         state = out / STATE_FILE
-        resume = resumed_monitor(state, fingerprint) if state.is_file() and not restart else None
+        refusal = None if restart else legacy_state_refusal(out)
+        if refusal is not None:
+            raise DataError(refusal)
+        resume = resumed_monitor(state, fingerprint, model, settings) if state.is_file() and not restart else None
         return cfg, model, files, settings, resume, fingerprint
 
     def compute(prepared, progress):

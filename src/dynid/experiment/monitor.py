@@ -17,32 +17,38 @@ change (log and time), and says how large it is; the term's new level is then le
 has moved as much again.
 
 The monitor follows a stream: :meth:`FrictionMonitor.feed` takes one prepared log (or chunk of one) at a time, and its
-whole state pickles (:meth:`FrictionMonitor.state`, :func:`resumed_monitor`), so that ``dynid monitor`` run every day
-on a growing folder reads only the logs it has not seen (``monitor-state.pkl`` in its output folder) and gives what
-one run over every log would.
+whole state is saved as data (:meth:`FrictionMonitor.state`, :func:`resumed_monitor`), so that ``dynid monitor`` run
+every day on a growing folder reads only the logs it has not seen (``monitor-state.json`` in its output folder) and
+gives what one run over every log would. The state is a JSON document of a fixed schema (numbers only, arrays as
+little-endian float64 in base64, so that they come back bit for bit); it is checked, field by field, before any of it
+is used, and nothing in it is ever executed: a results folder is something users pass around.
 """
 
 from __future__ import annotations
 
 import hashlib
-import pickle
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Iterable
 
+import msgspec
 import numpy as np
 
 from ..estimators.recursive import RecursiveLeastSquares
 from ..exceptions import ConfigError, DataError
-from ..validation.change_detection import Cusum
+from ..validation.change_detection import Cusum, CusumAlarm
 
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
-           "monitor_logs", "determined", "STATE_FILE", "monitor_fingerprint", "resumed_monitor"]
+           "monitor_logs", "determined", "STATE_FILE", "LEGACY_STATE_FILE", "monitor_fingerprint", "resumed_monitor",
+           "legacy_state_refusal"]
 
-STATE_FILE = "monitor-state.pkl"
+STATE_FILE = "monitor-state.json"
 """The monitor's state in ``dynid monitor``'s output folder: the next run goes on from it."""
-_STATE_VERSION = 1
+LEGACY_STATE_FILE = "monitor-state.pkl"
+"""The state's name in development versions of 0.2.0 (a pickle): never read, since unpickling a file can run code."""
+_STATE_FORMAT = "dynid-monitor-state"
+_STATE_VERSION = 2
 
 _DATE = re.compile(r"(\d{4})-(\d{2})-(\d{2})(?:[T_ ](\d{2})[-:](\d{2})(?:[-:](\d{2}))?)?")
 
@@ -467,10 +473,77 @@ class FrictionMonitor:
         Returns
         -------
         bytes
-            A pickle: read it back only from a folder you trust.
+            A JSON document of the schema :class:`_State` (data only: reading it back runs no code).
         """
-        return pickle.dumps({"version": _STATE_VERSION, "fingerprint": fingerprint, "monitor": self},
-                            protocol=pickle.HIGHEST_PROTOCOL)
+        cusum = None
+        if self.cusum is not None:
+            c = self.cusum
+            cusum = _CusumState(_num(c.h), _num(c.k), _Array.of(c.up), _Array.of(c.down), c.start_up.tolist(), c.start_down.tolist(),
+                                c.count, _Array.of(np.array(c.history).reshape(len(c.history), len(self.terms))),
+                                [_CusumAlarmState(a.channel, a.index, a.start, a.direction, _num(a.shift)) for a in c.alarms])
+        rls = None if self.rls is None else _RlsState(_Array.of(self.rls.theta), _Array.of(self.rls.p),
+                                                      _num(self.rls.forgetting))
+        state = _State(
+            _STATE_FORMAT, _STATE_VERSION, fingerprint, list(self.terms), rls,
+            [_WindowState(w.log, _num(w.start), _num(w.end), _Array.of(w.theta), _Array.of(w.std), _Array.of(w.tracked))
+             for w in self.windows],
+            [_AlarmState(a.joint, a.term, a.since_log, _num(a.since), a.detected_log, _num(a.detected),
+                         _num(a.reference), _num(a.value), _num(a.delay)) for a in self.alarms],
+            cusum, _Array.of(self.mean), _Array.of(self.std), _num(self.threshold), _num(self.elapsed),
+            {str(c): _Array.of(np.array(v, dtype=float)) for c, v in self.relearn.items()},
+            [[log, _num(a), _num(b)] for log, a, b in self.window_times], list(self.logs))
+        return msgspec.json.encode(state)
+
+    def _restore(self, state: "_State", where: str) -> None:
+        """Take the saved state's values, each checked against this monitor's terms (:func:`resumed_monitor`)."""
+        n_terms, (n, q) = len(self.terms), self.theta0.shape
+
+        def bad(what: str) -> DataError:
+            return DataError(f"{where}: not a monitor state dynid can read ({what}); remove it or give --restart")
+
+        def terms_array(a: _Array, what: str) -> np.ndarray:
+            return a.array((n_terms,), bad(f"{what}: expected {n_terms} values"))
+
+        if tuple(state.terms) != self.terms:
+            raise bad(f"terms {state.terms} are not the identification's {list(self.terms)}")
+        if state.rls is not None:
+            self.rls = RecursiveLeastSquares(state.rls.theta.array((n, q), bad("rls.theta: wrong shape")),
+                                             state.rls.p.array((n, q, q), bad("rls.p: wrong shape")),
+                                             _forgetting(_value(state.rls.forgetting, bad), bad))
+        self.windows = [MonitorWindow(w.log, _value(w.start, bad), _value(w.end, bad), terms_array(w.theta, "window theta"),
+                                      terms_array(w.std, "window std"), terms_array(w.tracked, "window tracked"))
+                        for w in state.windows]
+        self.alarms = [DriftAlarm(a.joint, a.term, a.since_log, _value(a.since, bad), a.detected_log,
+                                  _value(a.detected, bad), _value(a.reference, bad), _value(a.value, bad),
+                                  _value(a.delay, bad)) for a in state.alarms]
+        self.mean, self.std = terms_array(state.mean, "mean"), terms_array(state.std, "std")
+        self.threshold, self.elapsed = _value(state.threshold, bad), _value(state.elapsed, bad)
+        self.relearn = {}
+        for key, values in state.relearn.items():
+            if not (key.isdigit() and int(key) < n_terms):
+                raise bad(f"relearn: {key!r} is no term's index")
+            self.relearn[int(key)] = list(values.array((len(values.data) // 8,), bad("relearn: wrong size")))
+        if any(len(w) != 3 or not isinstance(w[0], str) for w in state.window_times) \
+                or len(state.window_times) != len(self.windows):
+            raise bad("window_times: expected one [log, start, end] per window")
+        self.window_times = [(str(w[0]), _value(w[1], bad), _value(w[2], bad)) for w in state.window_times]
+        self.logs = list(state.logs)
+        self.cusum = None
+        if state.cusum is not None:
+            c = state.cusum
+            count = c.count
+            if count < 0 or len(c.start_up) != n_terms or len(c.start_down) != n_terms:
+                raise bad("cusum: wrong sizes")
+            if any(not 0 <= a.channel < n_terms for a in c.alarms):
+                raise bad("cusum alarms: a channel outside the terms")
+            self.cusum = Cusum(n_terms, _value(c.h, bad), _value(c.k, bad))
+            self.cusum.up, self.cusum.down = terms_array(c.up, "cusum up"), terms_array(c.down, "cusum down")
+            self.cusum.start_up = np.array(c.start_up, dtype=int)
+            self.cusum.start_down = np.array(c.start_down, dtype=int)
+            self.cusum.count = count
+            self.cusum.history = list(c.history.array((count, n_terms), bad("cusum history: wrong shape")))
+            self.cusum.alarms = [CusumAlarm(a.channel, a.index, a.start, a.direction, _value(a.shift, bad))
+                                 for a in c.alarms]
 
     def result(self) -> MonitorResult:
         """The monitored life so far.
@@ -503,16 +576,23 @@ def monitor_fingerprint(results: str | Path, settings: MonitorSettings) -> str:
     return digest.hexdigest()
 
 
-def resumed_monitor(path: str | Path, fingerprint: str) -> "FrictionMonitor":
+def resumed_monitor(path: str | Path, fingerprint: str, model,
+                    settings: MonitorSettings = MonitorSettings()) -> "FrictionMonitor":
     """A monitor's saved state (:meth:`FrictionMonitor.state`), to feed it the logs it has not seen.
+
+    The file is read as data of a fixed schema and checked field by field (types, shapes, the identification's terms)
+    before any of it is used; nothing in it is executed.
 
     Parameters
     ----------
     path : str or Path
-        ``monitor-state.pkl``.
+        ``monitor-state.json``.
     fingerprint : str
         :func:`monitor_fingerprint` of this run: the state must have been made from the same identification and
         settings.
+    model : IdentifiedModel
+        The identification the state was made from (:func:`dynid.load_results`).
+    settings : MonitorSettings
 
     Returns
     -------
@@ -525,17 +605,164 @@ def resumed_monitor(path: str | Path, fingerprint: str) -> "FrictionMonitor":
     """
     path = Path(path)
     try:
-        saved = pickle.loads(path.read_bytes())
-        version, made_for, monitor = saved["version"], saved["fingerprint"], saved["monitor"]
-    except Exception as exc:  # any unpickling failure: a foreign or damaged file
-        raise DataError(f"{path}: not a monitor state dynid can read ({type(exc).__name__}); remove it or give "
+        raw = path.read_bytes()
+        header = msgspec.json.decode(raw, type=_Header)
+        if header.format != _STATE_FORMAT:
+            raise ValueError(f"format {header.format!r}")
+    except (OSError, msgspec.DecodeError, ValueError) as exc:
+        raise DataError(f"{path}: not a monitor state dynid can read ({_first_line(exc)}); remove it or give "
                         "--restart") from None
-    if version != _STATE_VERSION or not isinstance(monitor, FrictionMonitor):
-        raise DataError(f"{path}: a monitor state of another dynid version; give --restart to start over")
-    if made_for != fingerprint:
+    if header.version != _STATE_VERSION:
+        raise DataError(f"{path}: a monitor state of another dynid version (schema {header.version}, this dynid "
+                        f"reads {_STATE_VERSION}); give --restart to start over")
+    if header.fingerprint != fingerprint:
         raise DataError(f"{path}: made from another identification or with other monitor settings (--window, "
                         "--reference-windows, --false-alarm-days); give --restart to start over, or another --out")
+    try:
+        state = msgspec.json.decode(raw, type=_State)
+    except msgspec.DecodeError as exc:
+        raise DataError(f"{path}: not a monitor state dynid can read ({_first_line(exc)}); remove it or give "
+                        "--restart") from None
+    monitor = FrictionMonitor(model.robot, model.base, model.params(), settings)
+    monitor._restore(state, str(path))
     return monitor
+
+
+def legacy_state_refusal(folder: str | Path) -> str | None:
+    """The one line that refuses an output folder holding only a pickled state of a development version, or None.
+
+    Parameters
+    ----------
+    folder : str or Path
+        ``dynid monitor``'s ``--out``.
+
+    Returns
+    -------
+    str or None
+    """
+    folder = Path(folder)
+    if (folder / LEGACY_STATE_FILE).exists() and not (folder / STATE_FILE).exists():
+        return (f"{folder / LEGACY_STATE_FILE}: a monitor state of an earlier dynid, a pickle, which dynid no longer "
+                "reads (reading one can run code); give --restart to monitor every log anew (it writes "
+                f"{STATE_FILE}), then delete the .pkl")
+    return None
+
+
+_NON_FINITE = {"nan": float("nan"), "inf": float("inf"), "-inf": float("-inf")}
+
+
+def _num(x: float) -> "float | str":
+    """A number for the state: finite as it is, non-finite as ``"nan"``, ``"inf"`` or ``"-inf"`` (JSON has none)."""
+    x = float(x)
+    return x if np.isfinite(x) else repr(x)
+
+
+def _value(x: "float | str", bad) -> float:
+    if isinstance(x, str):
+        if x not in _NON_FINITE:
+            raise bad(f"{x!r} is no number")
+        return _NON_FINITE[x]
+    return float(x)
+
+
+def _first_line(exc: BaseException) -> str:
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
+def _forgetting(value: float, bad) -> float:
+    if not 0 < value <= 1:
+        raise bad("rls.forgetting: expected a factor in (0, 1]")
+    return value
+
+
+class _Array(msgspec.Struct, forbid_unknown_fields=True):
+    """An array of float64 in the state: its shape and its little-endian bytes (base64 in JSON), exact."""
+
+    shape: list[int]
+    data: bytes
+
+    @classmethod
+    def of(cls, a) -> "_Array":
+        a = np.ascontiguousarray(a, dtype="<f8")
+        return cls(list(a.shape), a.tobytes())
+
+    def array(self, shape: tuple[int, ...], error: Exception) -> np.ndarray:
+        if tuple(self.shape) != tuple(shape) or len(self.data) != 8 * int(np.prod(shape, dtype=np.int64)):
+            raise error
+        return np.frombuffer(self.data, dtype="<f8").reshape(shape).astype(float)
+
+
+class _Header(msgspec.Struct):
+    format: str
+    version: int
+    fingerprint: str
+
+
+class _RlsState(msgspec.Struct, forbid_unknown_fields=True):
+    theta: _Array
+    p: _Array
+    forgetting: float | str
+
+
+class _WindowState(msgspec.Struct, forbid_unknown_fields=True):
+    log: str
+    start: float | str
+    end: float | str
+    theta: _Array
+    std: _Array
+    tracked: _Array
+
+
+class _AlarmState(msgspec.Struct, forbid_unknown_fields=True):
+    joint: int
+    term: str
+    since_log: str
+    since: float | str
+    detected_log: str
+    detected: float | str
+    reference: float | str
+    value: float | str
+    delay: float | str
+
+
+class _CusumAlarmState(msgspec.Struct, forbid_unknown_fields=True):
+    channel: int
+    index: int
+    start: int
+    direction: int
+    shift: float | str
+
+
+class _CusumState(msgspec.Struct, forbid_unknown_fields=True):
+    h: float | str
+    k: float | str
+    up: _Array
+    down: _Array
+    start_up: list[int]
+    start_down: list[int]
+    count: int
+    history: _Array
+    alarms: list[_CusumAlarmState]
+
+
+class _State(msgspec.Struct, forbid_unknown_fields=True):
+    """The schema of ``monitor-state.json`` (version 2)."""
+
+    format: str
+    version: int
+    fingerprint: str
+    terms: list[str]
+    rls: _RlsState | None
+    windows: list[_WindowState]
+    alarms: list[_AlarmState]
+    cusum: _CusumState | None
+    mean: _Array
+    std: _Array
+    threshold: float | str
+    elapsed: float | str
+    relearn: dict[str, _Array]
+    window_times: list[list[str | float]]
+    logs: list[str]
 
 
 def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings = MonitorSettings(),

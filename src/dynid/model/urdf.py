@@ -229,6 +229,8 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
 
     The ``xacro`` package (PyPI, no ROS needed) expands macros, properties, arguments, math and includes by relative
     path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths stay as the file wrote them.
+    Every expression is checked before xacro evaluates it (:mod:`dynid.model.xacro_expressions`): a description that
+    would run code (files, introspection) is refused in one line.
 
     Parameters
     ----------
@@ -250,6 +252,7 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     import os
 
     from ..extras import require
+    from .xacro_expressions import guarded_xacro
 
     path = Path(path)
     if not path.is_file():
@@ -262,9 +265,16 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     if out.is_file():
         return out
     try:
-        with _silenced_stderr([]):
-            doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
+        with _silenced_stderr([]), guarded_xacro(xacro, str(path)) as refused:
+            try:
+                doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
+            except Exception:
+                if refused:  # an expression the guard refused, wrapped by xacro: said as the guard said it
+                    raise refused[0] from None
+                raise
         urdf = doc.toprettyxml(indent="  ")
+    except ConfigError:
+        raise
     except Exception as exc:  # xacro raises its own exceptions, and ROS lookups fail in many ways without ROS
         message = " ".join(str(exc).split()) or type(exc).__name__
         ros = "find" in message or "substitution args" in message or "ament_index" in message or "rospkg" in message

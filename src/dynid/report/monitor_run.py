@@ -77,7 +77,7 @@ def _figure(result: MonitorResult, path: Path) -> None:
 @staged
 def save_monitor(result: MonitorResult, out: str | Path) -> list[Path]:
     """Write ``monitor.json``, ``monitor.parquet`` (when pyarrow is installed), ``monitor.png`` and the state the next
-    run goes on from (``monitor-state.pkl``, when the result keeps it).
+    run goes on from (``monitor-state.json``, when the result keeps it).
 
     Parameters
     ----------
