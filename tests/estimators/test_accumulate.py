@@ -49,3 +49,30 @@ def test_accumulator_errors(rng):
     acc.add(np.column_stack([np.ones(20), np.ones(20), rng.normal(size=(20, 2))]), rng.normal(size=20))
     with pytest.raises(IdentifiabilityError, match=r"the data do not excite a, b \(cond = "):
         acc.solve(names=["a", "b", "c", "d"])  # columns a and b are equal: only their sum is identifiable
+
+
+def test_a_rank_deficient_problem_keeps_the_prior_where_the_rows_say_nothing():
+    """Columns 2 and 3 equal (a joint that moves one way: Coulomb friction and offset are one column): without a prior
+    the problem is refused; with one, the other columns and the sum θ2 + θ3 are the truth's (noise-free rows), the
+    difference θ2 - θ3 is the prior's, and exactly those two parameters are said to be the prior's (σ NaN)."""
+    from dynid.estimators.accumulate import LeastSquaresAccumulator
+    from dynid.exceptions import IdentifiabilityError
+
+    rng = np.random.default_rng(7)
+    w = rng.standard_normal((400, 4)) * np.array([1.0, 100.0, 0.01, 0.01])
+    w[:, 3] = w[:, 2]
+    truth = np.array([1.0, -0.02, 30.0, 10.0])
+    acc = LeastSquaresAccumulator(4, 1)
+    acc.add(w, w @ truth)
+    with pytest.raises(IdentifiabilityError, match="do not excite"):
+        acc.solve()
+    prior = np.array([5.0, 5.0, 1.0, 3.0])
+    sol = acc.solve(prior=prior)
+    assert sol.params[:2] == pytest.approx(truth[:2], rel=1e-9)
+    assert sol.params[2] + sol.params[3] == pytest.approx(truth[2] + truth[3], rel=1e-9)
+    assert sol.params[2] - sol.params[3] == pytest.approx(prior[2] - prior[3], rel=1e-9)
+    assert sol.from_prior == (2, 3)
+    assert np.isnan(sol.params_std[2:]).all() and np.isfinite(sol.params_std[:2]).all()
+    full = LeastSquaresAccumulator(3, 1)  # a full-rank problem is solved as without a prior
+    full.add(w[:, :3], w[:, :3] @ truth[:3] + 0.01 * rng.standard_normal(400))
+    assert full.solve(prior=np.zeros(3)).params == pytest.approx(full.solve().params, rel=1e-12)

@@ -330,7 +330,7 @@ def export(
             return text
 
         export = {"--urdf": urdf_text, "--mjcf": mjcf_text}
-        return cfg, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets], moved
+        return cfg, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets], moved, identified
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -340,13 +340,18 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        cfg, _, moved = computed
+        cfg, _, moved, _ = computed
         robot = cfg.robot
         into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
             ("MJCF", mjcf_model.name if mjcf_model else "", mjcf_model is not None)) if given)
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
+        from ..io.export import nominal_warning
+
+        gate = nominal_warning(computed[3])
+        if gate is not None:
+            rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
 

@@ -33,6 +33,8 @@ class LeastSquaresSolution:
     residual_std : float
         ``sigma`` of the (weighted) residual.
     n_rows : int
+    from_prior : tuple of int
+        Parameters the rows do not determine, whose values are the prior's (σ NaN).
     """
 
     params: np.ndarray
@@ -42,6 +44,13 @@ class LeastSquaresSolution:
     condition_number: float
     residual_std: float
     n_rows: int
+    from_prior: tuple[int, ...] = ()
+    """Parameters the rows do not determine, whose values are the prior's (their σ is NaN: not known)."""
+
+
+UNDETERMINED_RCOND = 1e-10
+"""With a prior, directions of the column-scaled observation matrix whose singular value is below this fraction of
+the largest are left at the prior (:meth:`LeastSquaresAccumulator.solve`)."""
 
 
 class LeastSquaresAccumulator:
@@ -156,8 +165,14 @@ class LeastSquaresAccumulator:
         wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
         return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
 
-    def solve(self, joint_weights=None, rcond: float | None = None, names=None) -> LeastSquaresSolution:
+    def solve(self, joint_weights=None, rcond: float | None = None, names=None, prior=None) -> LeastSquaresSolution:
         """OLS (default) or WLS with one weight per joint.
+
+        Where the rows do not determine every parameter (a rank-deficient observation matrix) and a ``prior`` is given,
+        the directions they determine are estimated and the others keep the prior's values: the least-squares
+        correction of the prior within the determined subspace of the column-scaled problem (truncated SVD about
+        the prior; Gautier's base parameters with a prior, e.g. Hansen, *Rank-Deficient and Discrete Ill-Posed
+        Problems*, SIAM 1998, §3.2). A full-rank problem is solved as without a prior.
 
         Parameters
         ----------
@@ -167,16 +182,19 @@ class LeastSquaresAccumulator:
             Relative singular-value threshold of the rank test.
         names : sequence of str, optional
             (p,) names of the parameters, to name the unexcited ones in the error.
+        prior : (p,) array, optional
+            Values kept where the rows say nothing (the description's nominal parameters).
 
         Returns
         -------
         LeastSquaresSolution
-            Parameters, their covariance and the residuals.
+            Parameters, their covariance and the residuals; :attr:`LeastSquaresSolution.from_prior` lists the
+            parameters left at the prior (σ NaN).
 
         Raises
         ------
         IdentifiabilityError
-            Fewer rows than parameters, or a rank-deficient observation matrix.
+            Fewer rows than parameters, or a rank-deficient observation matrix without a prior.
         """
         p = self.n_params
         m = int(self.rows.sum())
@@ -187,8 +205,9 @@ class LeastSquaresAccumulator:
         _, sv, vt = np.linalg.svd(r)
         tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps
         if sv[-1] <= tol * sv[0]:
-            null = np.abs(vt[sv <= tol * sv[0]])  # directions the data cannot tell apart
-            weak = np.any(null > 0.3 * null.max(axis=1, keepdims=True), axis=0)
+            if prior is not None:
+                return _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float))
+            weak = _weak(vt[sv <= tol * sv[0]])
             what = (", ".join(str(names[i]) for i in np.flatnonzero(weak)) if names is not None
                     else f"{int(weak.sum())} parameter(s)")
             raise IdentifiabilityError(f"the data do not excite {what} (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): "
@@ -201,6 +220,38 @@ class LeastSquaresAccumulator:
         with np.errstate(divide="ignore", invalid="ignore"):
             rel = 100.0 * std / np.abs(params)
         return LeastSquaresSolution(params, cov, std, rel, float(sv[0] / sv[-1]), float(np.sqrt(sigma2)), m)
+
+
+def _weak(null_rows: np.ndarray) -> np.ndarray:
+    """The parameters that take part in the given null-space directions (rows of Vᵀ): (p,) bool."""
+    null = np.abs(null_rows)
+    return np.any(null > 0.3 * null.max(axis=1, keepdims=True), axis=0)
+
+
+def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.ndarray) -> LeastSquaresSolution:
+    """Least squares in the determined subspace of the column-scaled ``r``, the prior elsewhere (:meth:`solve`)."""
+    p = r.shape[1]
+    if prior.shape != (p,) or not np.all(np.isfinite(prior)):
+        raise IdentifiabilityError(f"the prior must be {p} finite values, got shape {prior.shape}")
+    scale = np.linalg.norm(r, axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    rs = r / scale
+    u, sv, vt = np.linalg.svd(rs)
+    k = int(np.sum(sv > UNDETERMINED_RCOND * sv[0])) if sv[0] > 0 else 0
+    x0 = prior * scale
+    x = x0 + vt[:k].T @ ((u[:, :k].T @ (rhs - rs @ x0)) / sv[:k])
+    params = x / scale
+    rss = rho**2 + float(np.sum((rhs - r @ params) ** 2))
+    sigma2 = rss / max(m - k, 1)
+    vk = vt[:k].T / scale[:, None]
+    cov = sigma2 * (vk / sv[:k] ** 2) @ vk.T
+    undetermined = _weak(vt[k:]) if k < p else np.zeros(p, dtype=bool)
+    std = np.where(undetermined, np.nan, np.sqrt(np.maximum(np.diag(cov), 0.0)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = 100.0 * std / np.abs(params)
+    cond = float(sv[0] / sv[k - 1]) if k else float("inf")
+    return LeastSquaresSolution(params, cov, std, rel, cond, float(np.sqrt(sigma2)), m,
+                                tuple(int(i) for i in np.flatnonzero(undetermined)))
 
 
 def _triangular(a: np.ndarray, size: int) -> np.ndarray:

@@ -10,6 +10,8 @@ the box searches. It is the first of OLS/WLS in the list, else WLS.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from typing import Any, Callable, Iterable
 
 import numpy as np
@@ -171,8 +173,7 @@ class Estimation:
         """
         w, tau = self.rows()
         ws = np.concatenate(self._ws) if self._ws else None
-        data = FitData(w, tau, self.problem.n_dof, box, self.problem.base, ws, self.problem.layout, self.problem.prior,
-                       self.problem.weights, joint_weights)
+        data = replace(self.problem, w_base=w, tau=tau, bounds=box, w_standard=ws, joint_weights=joint_weights)
         chosen = self.keys if keys is None else tuple(keys)
         for key in chosen:
             if spec(key).needs_box and box is None:

@@ -19,6 +19,9 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
     rcond : float or None
         Singular values below ``rcond`` × the largest count as zero (rank deficiency); default
         ``max(M, p) · eps``.
+    base_prior : (p,) array or None
+        Values kept along the directions the rows do not determine (the description's nominal base parameters);
+        without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it.
 
     Attributes
     ----------
@@ -35,12 +38,12 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
     joint_std_ : (n_dof,) array
         Residual standard deviation of each joint [N·m].
     solution_ : dynid.estimators.accumulate.LeastSquaresSolution
-        All of the above as one object.
+        All of the above as one object (its ``from_prior``: the parameters left at ``base_prior``).
 
     Raises
     ------
     IdentifiabilityError
-        If ``W`` is rank-deficient (the data do not excite every parameter).
+        If ``W`` is rank-deficient (the data do not excite every parameter) and no ``base_prior`` is given.
 
     Notes
     -----
@@ -48,12 +51,13 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
     robots", IJRR 11(4), 1992 (σ of the estimates).
     """
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None):
         self.n_dof = n_dof
         self.rcond = rcond
+        self.base_prior = base_prior
 
     def _solve(self, acc) -> None:
-        sol = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"))
+        sol = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"), prior=self.base_prior)
         _set_solution(self, sol)
         self.ols_params_ = sol.params
         self.joint_std_ = acc.joint_residual_std(sol.params)
@@ -80,6 +84,8 @@ class WeightedLeastSquares(AccumulatingEstimator):
         given as (N, n_dof).
     rcond : float or None
         As :class:`OrdinaryLeastSquares`.
+    base_prior : (p,) array or None
+        As :class:`OrdinaryLeastSquares`.
 
     Attributes
     ----------
@@ -94,7 +100,7 @@ class WeightedLeastSquares(AccumulatingEstimator):
     Raises
     ------
     IdentifiabilityError
-        If ``W`` is rank-deficient.
+        If ``W`` is rank-deficient and no ``base_prior`` is given.
 
     Notes
     -----
@@ -104,13 +110,14 @@ class WeightedLeastSquares(AccumulatingEstimator):
 
     needs_joints = True
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None):
         self.n_dof = n_dof
         self.rcond = rcond
+        self.base_prior = base_prior
 
     def _solve(self, acc) -> None:
-        ols = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"))
+        ols = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"), prior=self.base_prior)
         std = acc.joint_residual_std(ols.params)
-        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond))
+        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=self.base_prior))
         self.ols_params_ = ols.params
         self.joint_std_ = std

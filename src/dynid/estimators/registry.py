@@ -94,6 +94,8 @@ class FitData:
         estimate on real logs).
     prior_kind : {"euclidean", "geometric"}
         How ``sdp`` pulls towards the prior (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
+    base_prior : (n_base,) array, optional
+        Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
     """
 
     w_base: Any
@@ -107,6 +109,7 @@ class FitData:
     weights: Any = None
     joint_weights: Any = None
     prior_kind: str = "euclidean"
+    base_prior: Any = None
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -169,7 +172,7 @@ class EstimatorSpec:
         return target
 
 
-_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback")
+_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback", "base_prior")
 
 
 def _from_class(cls: type, options: dict) -> Builder:
@@ -178,7 +181,7 @@ def _from_class(cls: type, options: dict) -> Builder:
 
     def build(data: FitData, budget: SearchBudget, rng, callback):
         values = {"n_dof": data.n_dof, "bounds": data.bounds, "weights": data.weights, "prior": data.prior,
-                  "joint_weights": data.joint_weights, "rng": rng, "callback": callback}
+                  "joint_weights": data.joint_weights, "rng": rng, "callback": callback, "base_prior": data.base_prior}
         if data.layout is not None:
             values.update(links=data.layout[0], nonnegative=data.layout[1])
         kwargs = {k: v for k, v in values.items() if k in accepted and (k in _FILLED or v is not None)}

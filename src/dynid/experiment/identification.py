@@ -30,7 +30,7 @@ from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (BlockGrams, Finding, ResidualSums, bootstrap_finding, excitation_findings,
-                                     sign_findings)
+                                     prior_findings, sign_findings)
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 
 __all__ = ["Estimate", "IdentificationResult", "identify"]
@@ -330,7 +330,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     if sdp:
         robot.require_physical_nominal("the sdp estimator (its prior is the description's nominal values)")
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=robot.standard_parameters() if sdp else None, prior_kind=sdp_prior)
+                      prior=robot.standard_parameters() if sdp else None, prior_kind=sdp_prior,
+                      base_prior=base.base_from_standard(robot.standard_parameters()))
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
@@ -447,10 +448,25 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
     raw = sums.m2 + sums.count * np.einsum("jc,jd->jcd", sums.mean, sums.mean)  # Σ z zᵀ per joint
     col_rms = np.sqrt(np.max(np.diagonal(raw, axis1=1, axis2=2)[:, :-1], axis=0) / max(sums.count, 1))
     findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, float(np.sqrt(np.mean(rms**2))))
+    if sol.from_prior:
+        stats["from_prior"] = [base.names[i] for i in sol.from_prior]
+        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead)
     # the prediction's spread from the parameters' covariance: Σ diag(y C yᵀ) = trace(C Σ y yᵀ)
     spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
     stats["prediction_spread"] = spread
     return findings, stats
+
+
+def _one_way(data: PreparedData) -> list[int]:
+    """The joints that moved in one direction only (at least 99 % of their moving samples one way)."""
+    dq = np.asarray(data.dq)
+    moving = np.abs(dq) > np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (dq.shape[1],))
+    out = []
+    for j in range(dq.shape[1]):
+        signs = np.sign(dq[moving[:, j], j])
+        if signs.size and min(np.mean(signs > 0), np.mean(signs < 0)) < 0.01:
+            out.append(j)
+    return out
 
 
 def consistency_checks(robot: Robot, base: BaseParameters, sets: dict) -> tuple[dict, dict]:

@@ -156,10 +156,30 @@ def run_identification(config: IdentificationConfig, progress=None, validate: bo
         result = _closed_loop(config, robot, base, result, raw)
     if not validate or not config.validation:
         return result
-    validations, warnings = validate_sets(replace(config, robot=robot), base, result.parameter_sets(), tuple(checked), progress,
+    sets = result.parameter_sets()
+    nominal = _nominal_set(robot, base, result.references)
+    if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
+        sets[nominal[0]] = nominal[1]
+    validations, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
                                           prepared.data.settings, result.joint_std, {result.label: result.solution.covariance})
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    return replace(result, **_main_estimate(result))
+    return replace(result, **_main_estimate(result, None if nominal is None else nominal[0]))
+
+
+NOMINAL_LABEL = "description (nominal)"
+"""The set of the description's own nominal values, scored on the validation logs beside the estimates when no
+reference set of the config is that."""
+
+
+def _nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
+    """The description's nominal model as a base-parameter set (None: a description without inertias): a reference
+    set of the config that is it, else :data:`NOMINAL_LABEL`."""
+    if not np.any(robot.inertial != 0):
+        return None
+    beta = base.base_from_standard(robot.standard_parameters())
+    same = next((r.name for r in references if r.beta.shape == beta.shape and
+                 np.allclose(r.beta, beta, rtol=1e-9, atol=1e-12)), None)
+    return (same or NOMINAL_LABEL), beta
 
 
 def pipeline_of(config: IdentificationConfig) -> "IdentificationPipeline":
@@ -213,11 +233,13 @@ def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
                    consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})
 
 
-def _main_estimate(result) -> dict:
+def _main_estimate(result, nominal: str | None = None) -> dict:
     """The estimate to trust, and the verdict's findings on the validation logs: the physically consistent one when the
     unconstrained one is not consistent and the consistent one validates better (mean global error over the validation
-    logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`)."""
-    from ..validation.diagnostics import Finding, validation_findings
+    logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`);
+    and the main estimate against the description's nominal model (the set ``nominal``), joint by joint
+    (:func:`dynid.validation.diagnostics.nominal_gate`)."""
+    from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 
     label = result.label
     fit_err = result.fit.metrics()[label]["global_relative_error"]
@@ -239,7 +261,12 @@ def _main_estimate(result) -> dict:
             findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where {label} is not and "
                                                f"predicts the validation logs worse ({sdp:.3g} % against {own:.3g} % on "
                                                "average)"))
-    return {"main": main, "findings": tuple(findings)}
+    diagnostics = dict(result.diagnostics)
+    if nominal is not None:
+        gate, stats = nominal_gate(result.validations, main, nominal)
+        findings += gate
+        diagnostics.update({"nominal_set": nominal, "versus_nominal": stats})
+    return {"main": main, "findings": tuple(findings), "diagnostics": diagnostics}
 
 
 def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,

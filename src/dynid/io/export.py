@@ -270,6 +270,42 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     return robot, phi
 
 
+def nominal_warning(results: dict) -> str | None:
+    """One line when the exported (physically consistent) estimate predicted some joints of the validation logs worse
+    than the description's nominal model (the gate of ``dynid identify``), naming them; None otherwise.
+
+    Parameters
+    ----------
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+
+    Returns
+    -------
+    str or None
+    """
+    from .results import stored_standard
+
+    found = stored_standard(results)
+    nominal = (results.get("diagnostics") or {}).get("nominal_set")
+    if found is None or not isinstance(nominal, str):
+        return None
+    label, worse = found[0], []
+    for v in results.get("validation") or []:
+        metrics = v.get("metrics") or {}
+        if label not in metrics or nominal not in metrics:
+            continue
+        own, nom = metrics[label].get("relative_error") or [], metrics[nominal].get("relative_error") or []
+        meaningful = v.get("relative_error_meaningful") or [True] * len(own)
+        for j, (a, b, ok) in enumerate(zip(own, nom, meaningful)):
+            if ok and a is not None and b is not None and a > b:
+                worse.append(f"J{j + 1} of {v.get('name')} ({a:.3g} % against {b:.3g} %)")
+    if not worse:
+        return None
+    return (f"{label} predicts {', '.join(worse[:4])}{f' and {len(worse) - 4} more' if len(worse) > 4 else ''} worse "
+            f"than the description's nominal model ({nominal}): keep the nominal values for those joints, or identify "
+            "on a log that excites them")
+
+
 def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
     """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
 

@@ -30,7 +30,7 @@ from ..friction import moving_joints
 from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
 from .filters import FractionalShift, butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
 from .fourier_fit import fourier_fit_derivatives
-from .prepared import PreparedData, direction_of_motion, min_speeds, rest_velocities
+from .prepared import PreparedData, dead_channels, direction_of_motion, min_speeds, rest_velocities
 from .settings import Preprocessing
 from .strategies import Strategy, strategy_for
 
@@ -231,8 +231,10 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     resting = np.empty(dq.shape, dtype=bool)  # one byte a sample and joint, whatever the log's length
     for j in range(dq.shape[1]):
         resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
+    dead, dead_words = dead_channels(tau, recording.label)
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
-                        tuple(recording.warnings) + s.warnings, direction_of_motion(dq, moving, s, rate), moving, resting)
+                        tuple(recording.warnings) + s.warnings + dead_words, direction_of_motion(dq, moving, s, rate),
+                        moving, resting, dead)
 
 
 
@@ -306,7 +308,7 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, s.order, s.chunk, cutoff):
-        keep = np.abs(data.dq[index]) >= vmin
+        keep = data.kept(index, vmin)
         if progress is not None:
             progress(int(index[-1]) + 1, n_s)
         yield index, y, tau, keep

@@ -15,7 +15,7 @@ from ..friction import Velocities, held_direction
 from ..model.robot import Robot
 from .settings import Preprocessing
 
-__all__ = ["PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
+__all__ = ["dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
 
 Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
@@ -46,6 +46,8 @@ class PreparedData:
         The velocity [rad/s] that says where a joint moves (no overshoot where it stops).
     resting : (N, n_dof) bool array or None
         Where each joint rests (:func:`dynid.friction.moving_joints`).
+    dead : tuple of int
+        Joints whose measured torque is constant over the log (:func:`dead_channels`).
     """
 
     name: str
@@ -63,6 +65,28 @@ class PreparedData:
     """(N, n_dof) the velocity [rad/s] that says where a joint moves (no overshoot where it stops)."""
     resting: np.ndarray | None = None
     """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
+    dead: tuple[int, ...] = ()
+    """Joints (0-based) whose measured torque is constant over the whole log (:func:`dead_channels`): their rows are
+    used by no estimate and no metric."""
+
+    def kept(self, index: np.ndarray, vmin: np.ndarray) -> np.ndarray:
+        """The rows an estimate uses: joints moving at least ``vmin``, and none of a dead channel.
+
+        Parameters
+        ----------
+        index : (M,) int array
+            Sample indices.
+        vmin : (n_dof,) array [rad/s]
+            Minimum speed of each joint.
+
+        Returns
+        -------
+        (M, n_dof) bool array
+        """
+        keep = np.abs(np.asarray(self.dq[index])) >= vmin
+        if self.dead:
+            keep[:, list(self.dead)] = False
+        return keep
 
     def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
         """The same samples with another rest model and presliding distance.
@@ -190,3 +214,31 @@ def min_speeds(settings: Preprocessing, n: int) -> np.ndarray:
     if v.shape != (n,) or np.any(v < 0):
         raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
     return v
+
+
+def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
+    """The joints whose measured torque never changes in a log (a dead sensor, a disconnected drive, a column that is
+    not this joint's torque), and the warning that says so.
+
+    Parameters
+    ----------
+    tau : (N, n_dof) array or StoredColumns [N·m]
+        The measured torques.
+    label : str
+        The dataset, for the warning.
+
+    Returns
+    -------
+    dead : tuple of int
+        0-based joints.
+    warnings : tuple of str
+        One line per dead joint, naming the dataset and the joint.
+    """
+    dead, words = [], []
+    for j in range(tau.shape[1]):
+        column = np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j], dtype=float)
+        if column.size and float(np.ptp(column)) <= 1e-12 * max(1.0, float(np.abs(column).max())):
+            dead.append(j)
+            words.append(f"{label}: J{j + 1}'s torque reads {column[0]:.4g} N·m throughout (a dead sensor, or a column that "
+                         "is not this joint's torque?): its rows are left out of the estimation and of the metrics")
+    return tuple(dead), tuple(words)

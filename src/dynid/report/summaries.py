@@ -326,7 +326,11 @@ def in_short(result) -> list:
         out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
                         + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
                         + (" (the fit)" if c is r.fit else "")))
-    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std) if not rel < NOT_DETERMINED]
+    kept = {r.base.names[i] for i in r.solution.from_prior}
+    if kept:
+        out.append(Line(f"kept at the description's nominal values (this log does not determine them): "
+                        f"{', '.join(n for n in r.base.names if n in kept)}"))
+    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std) if not rel < NOT_DETERMINED and n not in kept]
     if loose:
         out.append(Line(f"not determined by this log (σ ≥ {NOT_DETERMINED:g} % of the value): {', '.join(loose)}: their "
                         "values are set by the noise; a richer excitation (dynid excite) determines them"))

@@ -26,10 +26,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Finding", "ResidualSums", "sign_findings", "validation_findings"]
+__all__ = ["Finding", "ResidualSums", "sign_findings", "validation_findings", "prior_findings",
+           "nominal_gate"]
 
 SIGNIFICANT = 4.0
 """|t| above which a residual's correlation with a feature is reported."""
+
+POSITION_SHARE = 0.01
+"""A position dependence is reported when its spread over the joint's angles is at least this share of the joint's RMS
+torque (and significant): what the model leaves of a counterbalance or a cable is small, since least squares takes
+most of it into the gravity parameters."""
 
 FEATURES = ("direction at low speed", "sin q", "cos q", "sin 2q", "cos 2q")
 """The features the residual is regressed on, per joint (besides a constant)."""
@@ -177,9 +183,14 @@ class ResidualSums:
             stats["effective_samples"].append(n_eff)
             stats["friction_amplitude"].append(float(coef[0]))
             stats["friction_t"].append(float(t[0]))
-            # the position dependence: the amplitude of the harmonic part over the joint's range, its F-like statistic
+            # the position dependence: its size is the spread of the fitted harmonic part over the angles the joint
+            # went through (√2 times its RMS about its mean, the amplitude of a sine), from the features' Gram; the
+            # coefficients' own amplitude is no size: over a narrow range of angles sin q, cos q, sin 2q, cos 2q and
+            # the constant are nearly collinear, and large coefficients cancel (±100 N·m said of a 1 N·m joint)
             pos = coef[1:5]
-            amp = float(np.hypot(pos[0], pos[1]) + np.hypot(pos[2], pos[3]))
+            harmonic = slice(1, 5)
+            mean = float(ff[harmonic, -1] @ pos) / n
+            amp = float(np.sqrt(2 * max(float(pos @ ff[harmonic, harmonic] @ pos) / n - mean**2, 0.0)))
             t_pos = float(np.sqrt(np.sum(t[1:5] ** 2) / 4))
             stats["position_amplitude"].append(amp)
             stats["position_t"].append(t_pos)
@@ -189,8 +200,9 @@ class ResidualSums:
                 findings.append(Finding("friction", f"J{j + 1}: the residual follows the direction of motion at low speed "
                                         f"({coef[0]:+.3g} N·m, t = {t[0]:.1f}): the friction model misfits near reversals",
                                         j))
-            if t_pos >= SIGNIFICANT and amp >= 0.05 * scale:
-                findings.append(Finding("position", f"J{j + 1}: the residual depends on the joint's angle (±{amp:.3g} N·m, "
+            if t_pos >= SIGNIFICANT and amp >= POSITION_SHARE * scale:
+                findings.append(Finding("position", f"J{j + 1}: the residual depends on the joint's angle (±{amp:.3g} N·m "
+                                        f"over its angles, {100 * amp / scale:.2g} % of its RMS torque, "
                                         f"t = {t_pos:.1f}): a counterbalance, a cable, a wrong mass or gravity? "
                                         "(counterbalance = true in the description models one)", j))
         return findings, stats
@@ -316,6 +328,56 @@ def validation_findings(name: str, global_error: float, fit_error: float, predic
     return out
 
 
+def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], dict]:
+    """Whether an estimate predicts the validation logs better than the description's nominal model, joint by joint:
+    the gate before a model is published (exported to a controller or simulator).
+
+    Parameters
+    ----------
+    validations : sequence of TorqueComparison
+        The validation logs, each scored with ``label`` and ``nominal``.
+    label : str
+        The estimate judged.
+    nominal : str
+        The nominal model's set.
+
+    Returns
+    -------
+    findings : list of Finding
+        One: the joints where the nominal model predicts better, with both figures; or that the estimate is better
+        on every joint.
+    stats : dict
+        Per validation log: both per-joint errors [%] and the joints (1-based) where the nominal predicts better.
+    """
+    stats, worse_lines, better = {}, [], []
+    for v in validations:
+        metrics = v.metrics()
+        if label not in metrics or nominal not in metrics:
+            continue
+        own = np.asarray(metrics[label]["relative_error"], dtype=float)
+        nom = np.asarray(metrics[nominal]["relative_error"], dtype=float)
+        judged = v.meaningful() & np.isfinite(own) & np.isfinite(nom)
+        worse = [int(j) for j in np.flatnonzero(judged & (own > nom))]
+        stats[v.name] = {"estimate": label, "nominal": nominal, "estimate_error_percent": own.tolist(),
+                         "nominal_error_percent": nom.tolist(), "worse_joints": [j + 1 for j in worse]}
+        if worse:
+            shown = ", ".join(f"J{j + 1} {own[j]:.3g} % against {nom[j]:.3g} %" for j in worse[:4])
+            worse_lines.append(f"{v.name}: {shown}" + (f" and {len(worse) - 4} more" if len(worse) > 4 else ""))
+        else:
+            better.append(f"{v.name}: {float(metrics[label]['global_relative_error']):.3g} % against "
+                          f"{float(metrics[nominal]['global_relative_error']):.3g} %")
+    if worse_lines:
+        more = f"; and {len(worse_lines) - 3} more logs" if len(worse_lines) > 3 else ""
+        return [Finding("nominal", f"the description's nominal model predicts some joints of the validation logs better "
+                                   f"than {label} ({'; '.join(worse_lines[:3])}{more}; results.json: "
+                                   "diagnostics.versus_nominal): keep the nominal values for those joints, or identify "
+                                   "on a log that excites them (dynid excite)")], stats
+    if better:
+        return [Finding("nominal", f"{label} predicts every joint of the validation logs better than the description's "
+                                   f"nominal model ({'; '.join(better)} over all joints)")], stats
+    return [], stats
+
+
 BOOTSTRAP_BLOCKS = 20
 """Contiguous blocks of the identification log for the moving-block bootstrap of σ."""
 
@@ -404,12 +466,48 @@ def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> 
     ratio : float
         Median over the parameters of bootstrap σ / covariance σ.
     """
-    ratio = float(np.median(np.asarray(bootstrap_std) / np.maximum(np.asarray(covariance_std), 1e-300)))
+    cov = np.asarray(covariance_std, dtype=float)
+    known = np.isfinite(cov)  # parameters kept at the prior have no σ from the data
+    ratio = float(np.median(np.asarray(bootstrap_std)[known] / np.maximum(cov[known], 1e-300))) if known.any() else float("nan")
     if ratio >= 2.0:
         return [Finding("correlated", f"σ from the covariance is {ratio:.1f}× below the moving-block bootstrap's (median over "
                                       "the parameters): the residuals are correlated or the model misfits; read the "
                                       "bootstrap's σ (results.json: bootstrap_std)")], ratio
     return [], ratio
+
+
+def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tuple[int, ...] = ()) -> list[Finding]:
+    """The parameters a log does not determine, whose values are the description's nominal ones (least squares with a
+    prior, :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`).
+
+    Parameters
+    ----------
+    names : sequence of str
+        Base parameters.
+    from_prior : sequence of int
+        The indices of those left at the prior.
+    one_way : list of int
+        Joints (0-based) that moved in one direction only in the log: their Coulomb friction and offset are one term.
+    dataset : str
+    dead : tuple of int
+        Joints whose torque channel is dead in the log (their rows were left out).
+
+    Returns
+    -------
+    list of Finding
+    """
+    if not len(from_prior):
+        return []
+    shown = [names[i] for i in from_prior]
+    both = [j for j in one_way if f"fc{j + 1}" in shown and f"offset{j + 1}" in shown]
+    why = (f" ({', '.join(f'J{j + 1}' for j in both)} moved one way only: Coulomb friction and offset act as one term, "
+           "their sum is estimated)" if both else "")
+    if dead:
+        why += f" ({', '.join(f'J{j + 1}' for j in dead)}: a dead torque channel, its rows left out)"
+    listed = ", ".join(shown[:10]) + (f" and {len(shown) - 10} more" if len(shown) > 10 else "")
+    return [Finding("prior", f"{dataset}: the log does not determine {listed}{why}: along those directions the estimate "
+                             "keeps the description's nominal values (no σ); a log that moves every joint both ways "
+                             "with every torque channel live (dynid excite) determines them")]
 
 
 def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: np.ndarray, rms_torque: float) -> list[Finding]:

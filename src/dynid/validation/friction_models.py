@@ -58,6 +58,16 @@ LOAD_SHARE = 0.25
 """The load-dependent term is a candidate for a joint whose nominal rigid-body torque has an RMS of at least this
 share of its measured RMS torque (a transmission that carries little load cannot tell it from Coulomb)."""
 
+REVERSAL_SHARE = 0.01
+"""A joint whose moving samples go each way at least this share of the time reverses in the log; only then are the
+shapes of friction near a reversal (asymmetric, Stribeck, smooth Coulomb) candidates: on a joint that moves one way
+they are not determined, and a Stribeck term fitted where the speed never comes near its velocity predicts any
+slower motion with a coefficient of 1e31."""
+
+EXCITED_SHARE = 0.01
+"""A Stribeck or load-dependent column is a candidate only where its RMS over the fitted rows is at least this share
+of the Coulomb column's."""
+
 REST_GRID: tuple = ("held", 1.0, 0.3, "zero")
 """Candidate states at rest: held, relaxing with these time constants [s], none."""
 
@@ -215,7 +225,7 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
             load_sq += ((y @ nominal) ** 2).sum(axis=0)
         resting += (data.resting[idx] if data.resting is not None else
                     np.abs(np.asarray(data.dq[idx])) <= rest_v).sum(axis=0)
-        keep = np.abs(np.asarray(data.dq[idx])) >= vmin
+        keep = data.kept(idx, vmin)
         for f in np.unique(fold):
             sel = fold == f
             zf = z[sel]
@@ -284,12 +294,27 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
         labels.append(JointFriction(kind, g).label.split(",")[0])
         errors.append(e)
 
+    dq_all = np.asarray(data.dq)
+    moving = np.abs(dq_all) >= vmin
+    moving[:, list(data.dead)] = False
+    forwards = np.array([np.mean(dq_all[moving[:, j], j] > 0) if moving[:, j].any() else 0.0 for j in range(n)])
+    reverses = np.minimum(forwards, 1 - forwards) >= REVERSAL_SHARE
+
+    def excited(j: int, m: JointFriction) -> bool:
+        """Whether the model's own column carries enough of the rows to be determined (:data:`EXCITED_SHARE`)."""
+        if m.kind not in ("stribeck", "load"):
+            return True
+        own, coulomb = columns(m, j)[-1], index[f"fc|{m.rest}"]
+        energy = total[j, p + own, p + own]
+        return bool(energy >= EXCITED_SHARE**2 * total[j, p + coulomb, p + coulomb])
+
     def allowed(j: int, m: JointFriction) -> bool:
         # load-dependent friction needs a loaded transmission; smooth Coulomb has no state at rest (tanh(q̇/v_s) is 0
         # there) and asymmetric Coulomb differs from the offset only where the friction is not held at rest, so they
-        # are candidates only where the log shows how the joint rests
+        # are candidates only where the log shows how the joint rests; the shapes near a reversal need reversals
         return ((m.kind != "load" or bool(loaded[j])) and (m.kind not in ("smooth", "asymmetric") or bool(judged[j]))
-                and (m.rest == "held" or bool(judged[j])) and not (m.kind == "asymmetric" and m.rest == "held"))  # noqa: E501
+                and (m.rest == "held" or bool(judged[j])) and not (m.kind == "asymmetric" and m.rest == "held")
+                and (m.kind not in ("asymmetric", "stribeck", "smooth") or bool(reverses[j])) and excited(j, m))
 
     # a smooth Coulomb term is 0 at rest (tanh(0) = 0): its state at rest is "zero"
     options = [JointFriction(kind, g, r) for kind, g in family for r in REST_GRID if kind != "smooth" or r == "zero"]

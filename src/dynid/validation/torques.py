@@ -50,6 +50,8 @@ class TorqueComparison:
     spread : dict or None
         label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
         (for the sets whose covariance is known).
+    dead : tuple of int
+        Joints whose measured torque is constant over the log: left out of every metric.
     """
 
     name: str
@@ -72,6 +74,9 @@ class TorqueComparison:
     spread: dict | None = None
     """label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
     (for the sets whose covariance is known)."""
+    dead: tuple[int, ...] = ()
+    """Joints whose measured torque is constant over the log (:func:`dynid.preprocessing.prepared.dead_channels`):
+    left out of every metric (their per-joint figures NaN, the global ones over the other joints)."""
 
     def metrics(self) -> dict:
         """The paper's metrics of every parameter set on this dataset.
@@ -87,10 +92,19 @@ class TorqueComparison:
         if self.summary is not None:
             return self.summary["metrics"]
         out = {}
+        live = np.ones(self.measured.shape[1], dtype=bool)
+        live[list(self.dead)] = False
+
+        def joints(values):
+            full = np.full(live.shape, np.nan)
+            full[live] = values
+            return full
+
         for label, p in self.predicted.items():
-            m = {"relative_error": relative_error(self.measured, p), "rmse": rmse(self.measured, p),
-                 "correlation": correlation_coefficient(self.measured, p),
-                 "global_relative_error": global_relative_error(self.measured, p)}
+            mm, pp = self.measured[:, live], p[:, live]
+            m = {"relative_error": joints(relative_error(mm, pp)), "rmse": joints(rmse(mm, pp)),
+                 "correlation": joints(correlation_coefficient(mm, pp)),
+                 "global_relative_error": global_relative_error(mm, pp)}
             if self.resting is not None and self.resting.any():
                 m.update(_moving_and_rest(self.measured, p, self.resting, None if self.static is None else self.static.get(label)))
             out[label] = m
@@ -112,9 +126,10 @@ class TorqueComparison:
             True where the joint's RMS torque is at least :data:`MEANINGFUL` times its residual level on the
             identification log (all True when that level is unknown).
         """
-        if self.noise is None:
-            return np.ones(self.rms_torque.shape, dtype=bool)
-        return self.rms_torque >= MEANINGFUL * np.asarray(self.noise)
+        ok = np.ones(self.rms_torque.shape, dtype=bool) if self.noise is None else \
+            self.rms_torque >= MEANINGFUL * np.asarray(self.noise)
+        ok[list(self.dead)] = False
+        return ok
 
     def flags(self) -> list[str]:
         """The joints whose relative error means nothing here, each with its absolute figure.
@@ -127,6 +142,10 @@ class TorqueComparison:
         out = []
         first = next(iter(self.metrics().values()), None)
         for j in np.flatnonzero(~self.meaningful()):
+            if j in self.dead:
+                out.append(f"{self.name}: J{j + 1}'s torque is constant over the log (a dead channel): left out of "
+                           "the metrics")
+                continue
             moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} rad/s) and " if
                                                    self.speed[j] < 0.05 else "")
             rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} N·m"
@@ -220,9 +239,12 @@ class TorqueSums:
         Decimated samples the dataset will give (for the figure's thinning, as :func:`dynid.report.figures`).
     max_points : int
         Samples a figure draws at most.
+    dead : tuple of int
+        Joints whose measured torque is constant over the log: left out of every metric.
     """
 
-    def __init__(self, n_dof: int, n_columns: int, n_rows: int, max_points: int = 2500):
+    def __init__(self, n_dof: int, n_columns: int, n_rows: int, max_points: int = 2500, dead: tuple[int, ...] = ()):
+        self.dead = tuple(dead)
         self.mean = np.zeros((n_dof, n_columns + 1))
         self.m2 = np.zeros((n_dof, n_columns + 1, n_columns + 1))
         self.count = 0
@@ -248,7 +270,8 @@ class TorqueSums:
         -------
         TorqueSums
         """
-        return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)))
+        return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)),
+                   dead=data.dead)
 
     def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray, resting: np.ndarray | None = None) -> None:
         """Fold one block of rows into the statistics.
@@ -310,9 +333,13 @@ class TorqueSums:
             # the size of the centred terms the prediction sums: the rounding of s_pp = bᵀ S b is ε of it
             terms = (np.sqrt(np.diagonal(s_yy, axis1=1, axis2=2)) @ np.abs(b)) ** 2
             sse = np.maximum(s_tt - 2 * s_pt + s_pp, 0.0) + n * (t_mean - y_mean @ b) ** 2
-            metrics[label] = {"relative_error": 100.0 * np.sqrt(sse / tau_sq), "rmse": np.sqrt(sse / n),
-                              "correlation": correlation_from_sums(s_pt, s_tt, s_pp, terms),
-                              "global_relative_error": float(100.0 * np.sqrt(sse.sum() / tau_sq.sum()))}
+            live = np.ones(sse.shape, dtype=bool)
+            live[list(self.dead)] = False  # a dead channel's rows count in no metric
+            with np.errstate(invalid="ignore", divide="ignore"):
+                relative = np.where(live, 100.0 * np.sqrt(sse / np.where(live, tau_sq, 1.0)), np.nan)
+            metrics[label] = {"relative_error": relative, "rmse": np.where(live, np.sqrt(sse / n), np.nan),
+                              "correlation": np.where(live, correlation_from_sums(s_pt, s_tt, s_pp, terms), np.nan),
+                              "global_relative_error": float(100.0 * np.sqrt(sse[live].sum() / max(tau_sq[live].sum(), 1e-300)))}
             if self.rest_count.any():  # raw sums of the resting rows: Σ (τ - p)² = eᵀ G e with e = (β, -1)
                 e = np.concatenate([b, [-1.0]])
                 r_sse = np.maximum(np.einsum("c,jcd,d->j", e, self.rest_gram, e), 0.0)
@@ -326,7 +353,8 @@ class TorqueSums:
         summary = {"metrics": metrics, "n_samples": n, "rms_torque": np.sqrt(tau_sq / n), "torque_std": np.sqrt(s_tt / n),
                    **({"rest_share": self.rest_count / n} if self.rest_count.any() else {})}
         return TorqueComparison(name, np.concatenate(self.kept_t), np.concatenate(self.kept_tau),
-                                {label: y @ np.asarray(beta, dtype=float) for label, beta in parameter_sets.items()}, summary)
+                                {label: y @ np.asarray(beta, dtype=float) for label, beta in parameter_sets.items()}, summary,
+                                dead=self.dead)
 
 
 def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
@@ -430,4 +458,5 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
     return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
                             {k: np.concatenate(v) for k, v in preds.items()}, resting=np.concatenate(rest),
                             static=static_friction(base, parameter_sets, robot.n_dof), noise=noise,
-                            speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()})
+                            speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()},
+                            dead=data.dead)
