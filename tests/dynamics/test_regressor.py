@@ -49,7 +49,7 @@ def test_urdf_robot_against_pinocchio_parsed_directly(urdf_path, rng):
     tau_pin = np.array([pin.rnea(model, data, q[k], dq[k], ddq[k]) for k in range(40)])
     tau_pin += 0.5 * np.sign(dq) + 0.2 * dq
     np.testing.assert_allclose(y @ robot.standard_parameters(), tau_pin, atol=1e-9, rtol=0)
-    joints, inertial, names = joints_from_urdf(urdf_path)
+    joints, inertial, names, _ = joints_from_urdf(urdf_path)
     assert names == ("j1", "j2", "j3", "j4") and inertial.shape == (4, 10)
 
 

@@ -327,10 +327,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     keys = parse_estimators(estimators if isinstance(estimators, str) else tuple(estimators))
     n = robot.n_dof
     sdp = "sdp" in keys
-    if sdp:
-        robot.require_physical_nominal("the sdp estimator (its prior is the description's nominal values)")
+    prior, prior_notes = robot.physical_prior() if sdp else (None, ())
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=robot.standard_parameters() if sdp else None, prior_kind=sdp_prior,
+                      prior=prior, prior_kind=sdp_prior,
                       base_prior=base.base_from_standard(robot.standard_parameters()))
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
@@ -372,7 +371,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     estimates = {}
     for key in (*keys, *(() if ls_key in keys else (ls_key,))):
         estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
-    warnings = list(robot.nominal_problems) + list(data.warnings) + [e.note for e in estimates.values() if e.note]
+    warnings = list(robot.nominal_problems) + list(prior_notes) + list(data.warnings) + \
+        [e.note for e in estimates.values() if e.note]
     dropped = 1.0 - reference.accumulator_.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation or 1)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")

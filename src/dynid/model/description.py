@@ -34,8 +34,8 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     counterbalance = true          # optional: a weight counterbalance (spring, hydraulic cylinder) acts on this
                                    # joint: its torque, a smooth function of the angle, is identified too
     position_offset = "-pi/2"      # optional: added to measured angles to get the model's angles
-    mass = 60.0                    # kg (DH conventions; a URDF brings its own)
-    com = [0.0, 0.0, -0.1]         # m, link frame (standard DH: DH frame i)
+    mass = 60.0                    # kg (with a URDF: mass, com and inertia together replace that link's)
+    com = [0.0, 0.0, -0.1]         # m, link frame (standard DH: DH frame i; a URDF: its link's frame)
     inertia = [2.0, 2.0, 1.5, 0.0, 0.0, 0.0]   # about the COM: Ixx, Iyy, Izz, Ixy, Ixz, Iyz
     fc = 8.0                       # one value per drive term
     fv = 5.0
@@ -269,12 +269,14 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
 
     alpha = a = dd = None
     urdf_lim = None
+    links: tuple[str, ...] = ()
     if convention == "urdf":
         assert urdf_model is not None
-        joints, inertial, _ = urdf_model
+        joints, inertial, _, links = urdf_model
         urdf_lim = urdf_limits(upath)
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
+        inertial = _merged_inertials(rows, where, inertial, upath)
     else:
         alpha = [parse_angle(_or(r.alpha, 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
         a = [float(_or(r.a, 0.0)) for r in rows]
@@ -337,7 +339,8 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     if d.payload is not None:
         inertial = inertial.copy()
         inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, alpha, a, dd)
-    problems = tuple(f"{source}: link {i + 1} ({names[i]}): nominal {p}" for i in range(n)
+    link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
+    problems = tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(n)
                      for p in physical_problems(inertial[i]))
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
@@ -345,6 +348,32 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
     )
+
+
+def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarray:
+    """A URDF's link inertials with those the ``[[joints]]`` tables give: a table's ``mass``, ``com`` and ``inertia``
+    (all three, in the URDF link's frame, the inertia about the centre of mass, as a URDF writes them) replace that
+    link's; the DH geometry fields are refused (the URDF gives the chain)."""
+    out = inertial.copy()
+    for i, (r, w) in enumerate(zip(rows, where)):
+        geometry = [k for k in ("alpha", "a", "d", "theta_offset") if getattr(r, k) is not None]
+        if geometry:
+            raise ConfigError(f"{w}: {', '.join(geometry)} describe a DH chain, but the chain is {urdf.name}'s: leave "
+                              "them out (the URDF's joints give the geometry)")
+        given = [k for k in ("mass", "com", "inertia") if getattr(r, k) is not None]
+        if not given:
+            continue
+        if len(given) < 3:
+            missing = [k for k in ("mass", "com", "inertia") if k not in given]
+            raise ConfigError(f"{w}: {', '.join(given)} without {', '.join(missing)}: give mass, com and inertia "
+                              f"together to replace {urdf.name}'s inertial of this link")
+        mass = float(r.mass)
+        if not np.isfinite(mass) or mass < 0:
+            raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
+        ixx, iyy, izz, ixy, ixz, iyz = r.inertia
+        out[i] = inertial_from_physical(mass, np.asarray(r.com, dtype=float),
+                                        np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
+    return out
 
 
 def _or(value, default):

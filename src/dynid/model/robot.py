@@ -141,6 +141,31 @@ class Robot:
         """The per-joint velocities the friction columns use (:mod:`dynid.friction`)."""
         return Velocities(self.coulomb_velocity, self.stribeck_velocity)
 
+    def physical_prior(self) -> tuple[np.ndarray, tuple[str, ...]]:
+        """The nominal standard parameters with each physically impossible link replaced by its nearest consistent
+        one (:func:`dynid.model.spatial.nearest_consistent`), as the prior of a physically consistent estimate.
+
+        Returns
+        -------
+        phi : (n_params,) ndarray
+            :attr:`parameter_names` order.
+        notes : tuple of str
+            One line per link replaced, naming it and the rule its nominal values break.
+        """
+        from .spatial import is_physically_consistent, nearest_consistent
+
+        bad = [j for j in range(self.n_dof) if not is_physically_consistent(self.inertial[j])]
+        if not bad:
+            return self.standard_parameters(), ()
+        fixed = self.inertial.copy()
+        notes = []
+        for j in bad:
+            fixed[j] = nearest_consistent(self.inertial[j])
+            said = [p for p in self.nominal_problems if f"link {j + 1} " in p] or [f"link {j + 1}: nominal inertial parameters"]
+            notes.append(f"{said[0]}: the physically consistent estimate's prior is the nearest consistent link "
+                         "(its pseudo-inertia's negative eigenvalues raised to zero)")
+        return replace(self, inertial=fixed).standard_parameters(), tuple(notes)
+
     def require_physical_nominal(self, use: str) -> None:
         """Refuse nominal inertial parameters that are those of no real mass distribution.
 

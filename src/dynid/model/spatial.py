@@ -187,6 +187,32 @@ def is_physically_consistent(phi: np.ndarray, tol: float = 1e-9) -> bool:
     return bool(np.linalg.eigvalsh(pseudo_inertia(phi)).min() >= -tol * max(1.0, abs(phi[9])))
 
 
+def nearest_consistent(phi: np.ndarray, floor: float = 1e-6) -> np.ndarray:
+    """The physically consistent inertial parameters nearest to ``phi``: its pseudo-inertia's negative eigenvalues
+    raised to a small positive floor (the Frobenius-nearest positive definite pseudo-inertia; Wensing, Kim & Slotine,
+    IEEE RA-L 3(1), 2018), mapped back. Consistent parameters come back unchanged.
+
+    Parameters
+    ----------
+    phi : (10,) array
+        Eq. 5 order, about the link origin.
+    floor : float
+        Smallest eigenvalue kept, relative to the largest (a positive definite result, as a log-det prior needs).
+
+    Returns
+    -------
+    (10,) ndarray
+    """
+    phi = np.asarray(phi, dtype=float)
+    if is_physically_consistent(phi, tol=0.0):
+        return phi.copy()
+    ev, vec = np.linalg.eigh(pseudo_inertia(phi))
+    j = (vec * np.maximum(ev, floor * max(float(ev.max()), 1e-12))) @ vec.T
+    sigma = j[:3, :3]
+    inertia = np.trace(sigma) * np.eye(3) - sigma  # Σ = ½ tr(I)·1 - I  ⇔  I = tr(Σ)·1 - Σ
+    return np.concatenate([inertia_vector(inertia), j[:3, 3], [j[3, 3]]])
+
+
 def physical_from_inertial(phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     """Mass, centre of mass and inertia about the centre of mass of ten inertial parameters; the inverse of
     :func:`inertial_from_physical`. A massless link gives a zero centre of mass.

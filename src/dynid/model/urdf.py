@@ -20,7 +20,7 @@ URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", 
 def check_urdf_text(path: Path) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
-    Malformed XML, joints of unknown type, and ``<mimic>`` joints (coupled to another: dynid would identify them as
+    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), and ``<mimic>`` joints (coupled to another: dynid would identify them as
     independent joints).
 
     Parameters
@@ -43,6 +43,14 @@ def check_urdf_text(path: Path) -> None:
             if attrs["type"] not in URDF_JOINT_TYPES:
                 problems.append(f"line {parser.CurrentLineNumber}: joint {attrs.get('name', '?')!r} has type {attrs['type']!r}, "
                                 f"expected one of {', '.join(URDF_JOINT_TYPES)}")
+        elif name == "axis" and joint and joint[1] in ("revolute", "continuous", "prismatic"):
+            try:
+                xyz = [float(v) for v in attrs.get("xyz", "1 0 0").split()]
+            except ValueError:
+                xyz = []
+            if len(xyz) != 3 or not all(np.isfinite(xyz)) or float(np.linalg.norm(xyz)) < 1e-9:
+                problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} has axis xyz=\"{attrs.get('xyz')}\", "
+                                "expected three numbers not all zero (the direction it turns about)")
         elif name == "mimic" and joint and joint[1] != "fixed":
             problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} mimics joint {attrs.get('joint', '?')!r} "
                             "(<mimic>): dynid identifies independent joints; make it a fixed joint at its usual angle, or "
@@ -112,7 +120,7 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
     return np.array([m, mx, my, mz, xx, xy, yy, xz, yz, zz])
 
 
-def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...]]:
+def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
     """Joints and link inertial parameters of a URDF serial chain of revolute joints.
 
     Fixed joints are merged by Pinocchio into the parent link. Continuous joints (unbounded revolute) are revolute
@@ -128,6 +136,9 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
     inertial : (n_dof, 10) array
         Inertial parameters of each link in its joint frame (eq. 5 order).
     names : tuple of str
+        The joints' names.
+    links : tuple of str
+        The name of each joint's child link in the URDF (the link its inertial belongs to).
 
     Raises
     ------
@@ -170,7 +181,9 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
         inertial.append(inertial_from_pinocchio(model.inertias[j]))
     if not joints:
         raise ConfigError(f"{path}: expected at least one revolute joint, found none")
-    return tuple(joints), np.array(inertial), tuple(model.names[1:])
+    links = tuple(next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == j),
+                       model.names[j]) for j in range(1, model.njoints))
+    return tuple(joints), np.array(inertial), tuple(model.names[1:]), links
 
 
 def urdf_limits(path: str | Path) -> dict:
