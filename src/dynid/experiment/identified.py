@@ -5,7 +5,7 @@ be validated on other logs and be exported — built from an identification or r
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Iterator
 
@@ -299,7 +299,9 @@ class IdentifiedModel:
         from ..preprocessing.strategies import carried_over
         from ..validation.torques import compare_torques
 
-        settings = carried_over(self.preprocessing, self.preprocessing or Preprocessing())
+        # the resolved settings stand for the config's here: the decimation (derived, not known to be given) follows
+        # this log's own band
+        settings = carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
         data = prepare(recording, settings, strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
         return compare_torques(self.robot, self.base, data, sets)

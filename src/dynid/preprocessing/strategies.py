@@ -260,10 +260,11 @@ def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "P
 
     The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,
     at least the identification log's (so a faster validation motion is filtered for its own band, never below the
-    identification's), its decimation and trim (its rate and length may differ; a decimation the config gives is the
-    identification log's), its rest velocity (at least the identification's); the identification's friction state at
-    rest; no Fourier fit (the excitation's harmonics fit only its own log). Use with ``prepare(..., strict=False)``: a
-    cutoff above this log's Nyquist frequency is lowered, with a warning.
+    identification's), its decimation and trim (its rate and length may differ), its rest velocity (at least the identification's); the identification's friction state at
+    rest; no Fourier fit (the excitation's harmonics fit only its own log). A ``decimation`` the config gives is every
+    log's, as it always was (with ``parallel_cutoff = 0`` its anti-aliasing filter is the only filter of the torques:
+    dropping it scored validation logs on raw samples). Use with ``prepare(..., strict=False)``: a cutoff above this
+    log's Nyquist frequency is lowered, with a warning.
 
     Parameters
     ----------
@@ -280,9 +281,9 @@ def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "P
     if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log
         given = replace(given, strategy="parallel")
     if resolved is None:
-        return replace(given, fourier=None, decimation=None, warnings=())
+        return replace(given, fourier=None, warnings=())
     floor: float | tuple = 0.0
     if given.rest_velocity == "auto" and not isinstance(resolved.rest_velocity, str):
         floor = resolved.rest_velocity
-    return replace(given, fourier=None, decimation=None, band_floor=resolved.band or 0.0, rest_floor=floor,
+    return replace(given, fourier=None, band_floor=resolved.band or 0.0, rest_floor=floor,
                    rest_friction=resolved.rest_friction, presliding=resolved.presliding, warnings=(), derivation="")
