@@ -248,7 +248,9 @@ def _main_estimate(result, nominal: str | None = None) -> dict:
     for v in result.validations:
         err = v.metrics()[label]["global_relative_error"]
         moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: its friction is unknown
-        findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread, label)
+        floor = (v.floor_metrics() or {}).get("global_relative_error", np.nan)
+        findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread,
+                                        label, floor)
     from .identification import SDP_LABEL
 
     main = result.main or label

@@ -8,9 +8,12 @@ import math
 
 import numpy as np
 
+from ..validation.noise_floor import AT_FLOOR
+
 from ..conventions import unit_of
 from ..estimators.registry import label
 from ..tables import Line, TextTable, render_text
+from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison
 
 __all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
@@ -55,6 +58,13 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
             rows.append(("  moving error %", *(f"{x:.1f}" if k and np.isfinite(x) else "n/m"
                                                for x, k in zip(m["moving_relative_error"], ok)), ""))
             rows.append(("  at rest RMSE N·m", *(f"{x:.3g}" if s >= REST_ROWS else "" for x, s in zip(m["rest_rmse"], share)), ""))
+        ends.add(len(rows) - 1)
+    floor = cmp.floor_metrics()
+    if floor is not None:  # what a perfect model scores on the same samples
+        rows.append(("noise floor (a perfect model)",) + ("",) * (n + 1))
+        rows.append(("  error %", *(f"{x:.2g}" if k and np.isfinite(x) else "n/m" for x, k in zip(floor["relative_error"], ok)),
+                     f"{floor['global_relative_error']:.2g}"))
+        rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in floor["rmse"]), ""))
         ends.add(len(rows) - 1)
     rest = "" if not split else "; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the samples"
     return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
@@ -323,8 +333,10 @@ def in_short(result) -> list:
             continue
         worst = worst_joint(m["relative_error"], c.meaningful())
         errors[c.name] = float(m["global_relative_error"])
+        floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
         out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
                         + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
+                        + (f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
                         + (" (the fit)" if c is r.fit else "")))
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
@@ -335,7 +347,9 @@ def in_short(result) -> list:
         out.append(Line(f"not determined by this log (σ ≥ {NOT_DETERMINED:g} % of the value): {', '.join(loose)}: their "
                         "values are set by the noise; a richer excitation (dynid excite) determines them"))
     fit = errors.get(r.fit.name)
-    far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)]
+    at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
+                >= errors.get(c.name, np.inf)}
+    far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9) and k not in at_floor]
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))

@@ -290,7 +290,7 @@ def delay_findings(samples: float, std: float, determined: bool, rate: float, gi
 
 
 def validation_findings(name: str, global_error: float, fit_error: float, prediction_spread: np.ndarray | None,
-                        fit_spread: np.ndarray | None, label: str) -> list[Finding]:
+                        fit_spread: np.ndarray | None, label: str, floor: float = float("nan")) -> list[Finding]:
     """Extrapolation and a validation error far above the identification's, for one validation log.
 
     Parameters
@@ -306,12 +306,20 @@ def validation_findings(name: str, global_error: float, fit_error: float, predic
         log and on the identification log.
     label : str
         The estimate judged.
+    floor : float [%]
+        The log's noise floor over all joints (:mod:`dynid.validation.noise_floor`; NaN: unknown).
 
     Returns
     -------
     list of Finding
     """
+    from .noise_floor import AT_FLOOR
+
     out = []
+    if np.isfinite(global_error) and np.isfinite(floor) and global_error <= AT_FLOOR * floor:
+        return [Finding("floor", f"{name}: {label} scores {global_error:.3g} %, at the noise floor of this log's samples "
+                                 f"({floor:.3g} %: what a perfect model scores there, from the torques' own noise); "
+                                 "nothing is left for a better model to explain")]
     if prediction_spread is not None and fit_spread is not None:
         ratio = np.asarray(prediction_spread) / np.maximum(np.asarray(fit_spread), 1e-12)
         far = np.flatnonzero(ratio > 5.0)

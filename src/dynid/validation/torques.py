@@ -52,6 +52,9 @@ class TorqueComparison:
         (for the sets whose covariance is known).
     dead : tuple of int
         Joints whose measured torque is constant over the log: left out of every metric.
+    floor : (n_dof,) array [N·m] or None
+        The noise floor of these samples (:func:`dynid.validation.noise_floor.noise_floor`): the RMSE a perfect model
+        would have.
     """
 
     name: str
@@ -77,6 +80,29 @@ class TorqueComparison:
     dead: tuple[int, ...] = ()
     """Joints whose measured torque is constant over the log (:func:`dynid.preprocessing.prepared.dead_channels`):
     left out of every metric (their per-joint figures NaN, the global ones over the other joints)."""
+    floor: np.ndarray | None = None
+    """(n_dof,) [N·m]: the noise floor of these samples (:mod:`dynid.validation.noise_floor`)."""
+
+    def floor_metrics(self) -> dict | None:
+        """What a perfect model would score on these samples (:mod:`dynid.validation.noise_floor`).
+
+        Returns
+        -------
+        dict or None
+            ``rmse`` [N·m] and ``relative_error`` [%] per joint, ``global_relative_error`` [%] over the joints that
+            count (dead channels left out); None when the floor is unknown.
+        """
+        if self.floor is None:
+            return None
+        floor = np.asarray(self.floor, dtype=float)
+        rms = np.asarray(self.rms_torque, dtype=float)
+        live = np.ones(floor.shape, dtype=bool)
+        live[list(self.dead)] = False
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.where(live & (rms > 0), 100.0 * floor / np.where(rms > 0, rms, 1.0), np.nan)
+        total = float(np.sqrt(np.sum(rms[live] ** 2)))
+        return {"rmse": floor, "relative_error": rel,
+                "global_relative_error": 100.0 * float(np.sqrt(np.sum(floor[live] ** 2))) / total if total > 0 else float("nan")}
 
     def metrics(self) -> dict:
         """The paper's metrics of every parameter set on this dataset.
@@ -199,6 +225,9 @@ class TorqueComparison:
             out["flags"] = self.flags()
         if self.spread:
             out["prediction_spread"] = self.spread
+        floor = self.floor_metrics()
+        if floor is not None:
+            out["noise_floor"] = floor
         return out
 
 
@@ -241,10 +270,14 @@ class TorqueSums:
         Samples a figure draws at most.
     dead : tuple of int
         Joints whose measured torque is constant over the log: left out of every metric.
+    floor : (n_dof,) array [N·m], optional
+        The noise floor of the samples (:mod:`dynid.validation.noise_floor`).
     """
 
-    def __init__(self, n_dof: int, n_columns: int, n_rows: int, max_points: int = 2500, dead: tuple[int, ...] = ()):
+    def __init__(self, n_dof: int, n_columns: int, n_rows: int, max_points: int = 2500, dead: tuple[int, ...] = (),
+                 floor: np.ndarray | None = None):
         self.dead = tuple(dead)
+        self.floor = floor
         self.mean = np.zeros((n_dof, n_columns + 1))
         self.m2 = np.zeros((n_dof, n_columns + 1, n_columns + 1))
         self.count = 0
@@ -270,8 +303,10 @@ class TorqueSums:
         -------
         TorqueSums
         """
+        from .noise_floor import noise_floor
+
         return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)),
-                   dead=data.dead)
+                   dead=data.dead, floor=noise_floor(data))
 
     def add(self, t: np.ndarray, y: np.ndarray, tau: np.ndarray, resting: np.ndarray | None = None) -> None:
         """Fold one block of rows into the statistics.
@@ -354,7 +389,7 @@ class TorqueSums:
                    **({"rest_share": self.rest_count / n} if self.rest_count.any() else {})}
         return TorqueComparison(name, np.concatenate(self.kept_t), np.concatenate(self.kept_tau),
                                 {label: y @ np.asarray(beta, dtype=float) for label, beta in parameter_sets.items()}, summary,
-                                dead=self.dead)
+                                dead=self.dead, floor=self.floor)
 
 
 def resting_rows(data: PreparedData, index: np.ndarray) -> np.ndarray:
@@ -453,10 +488,11 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
         for label, cov in covariance.items():
             var[label] += np.einsum("mjc,cd,mjd->j", y, cov, y)
     from ..column_store import root_mean_square
+    from .noise_floor import noise_floor
 
     m = sum(x.shape[0] for x in ts)
     return TorqueComparison(data.name, np.concatenate(ts), np.concatenate(meas),
                             {k: np.concatenate(v) for k, v in preds.items()}, resting=np.concatenate(rest),
                             static=static_friction(base, parameter_sets, robot.n_dof), noise=noise,
                             speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()},
-                            dead=data.dead)
+                            dead=data.dead, floor=noise_floor(data))
