@@ -66,7 +66,8 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
                      f"{floor['global_relative_error']:.2g}"))
         rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in floor["rmse"]), ""))
         ends.add(len(rows) - 1)
-    rest = "" if not split else "; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the samples"
+    rest = "" if not np.any(share > 0) else ("; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the "
+                                             "samples, scored as the distance to the static-friction band ±f_s")
     return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
                      ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
 

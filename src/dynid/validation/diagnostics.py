@@ -381,8 +381,9 @@ def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], 
                                    "diagnostics.versus_nominal): keep the nominal values for those joints, or identify "
                                    "on a log that excites them (dynid excite)")], stats
     if better:
+        more = f"; and {len(better) - 3} more logs" if len(better) > 3 else ""
         return [Finding("nominal", f"{label} predicts every joint of the validation logs better than the description's "
-                                   f"nominal model ({'; '.join(better)} over all joints)")], stats
+                                   f"nominal model ({'; '.join(better[:3])}{more}, over all joints)")], stats
     return [], stats
 
 
