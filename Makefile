@@ -5,7 +5,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench zoo clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -28,5 +28,9 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_identify_memory.py
 	$(BIN)/python benchmarks/bench_excitation_design.py
 
+zoo: $(STAMP)  # dynid's defaults on nine public arm descriptions simulated in MuJoCo (benchmarks/zoo, ~15 min)
+	$(BIN)/pip install --quiet --only-binary=:all: -c constraints.txt -e ".[zoo]"
+	$(BIN)/python benchmarks/zoo/zoo.py
+
 clean:
-	rm -rf $(VENV) dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo dynid-fleet dynid-monitor .site
+	rm -rf $(VENV) dynid-zoo dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo dynid-fleet dynid-monitor .site

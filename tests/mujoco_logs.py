@@ -121,7 +121,8 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
              rate: float = 1000.0, substeps: int = 2, f0: float = 0.1, harmonics: int = 4, amplitude=0.6,
              encoder_bits: int = 20, noise_share: float = 0.05, torque_std=0.05, jitter: float = 0.02,
              gaps: int = 3, rate_change: float = 0.0, kp=None, kd=None, integral: float = 0.5,
-             dry: str = "frictionloss", loop_noise: bool = False, controller: bool = True) -> SimulatedLog:
+             dry: str = "frictionloss", loop_noise: bool = False, controller: bool = True, centre=None,
+             reference=None) -> SimulatedLog:
     """Simulate a log (module docstring).
 
     Parameters
@@ -147,6 +148,10 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
         Whether the controller sees the positions' broadband noise (it always sees the encoder's quantisation):
         a loop that feeds noise back makes the torques' noise correlate with the positions', which biases least
         squares (the closed-loop identification problem); without it, the noise is the log's alone.
+    centre : (n,) array, optional
+        The pose the motion is about [rad] (default 0: every joint's zero, which some arms' ranges exclude).
+    reference : callable, optional
+        ``reference(t, n, rng, amplitude, centre) -> (q, dq, ddq)``: a motion of one's own instead of ``motion``'s.
     controller : bool
         False: the motion is the reference itself and the torques are MuJoCo's inverse dynamics of it (``mj_inverse``
         of the model without dry friction) plus ``fc·sign(q̇)`` (``dry = "sign"`` only): at rest the velocity is exactly
@@ -160,11 +165,13 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
     rigid = mujoco_model(urdf_text, None, dt)  # the controller's feed-forward model: no friction, no rotor
     data, rdata = mujoco.MjData(model), mujoco.MjData(rigid)
     n = model.nv
-    centre = np.zeros(n)
+    centre = np.zeros(n) if centre is None else np.asarray(centre, dtype=float)
     amp = np.broadcast_to(np.asarray(amplitude, dtype=float), (n,))
     n_ctrl = int(round(duration * rate)) + 1
     t_ctrl = np.arange(n_ctrl) / rate
-    if motion == "fourier":
+    if reference is not None:
+        qr, dqr, ddqr = reference(t_ctrl, n, rng, amp, centre)
+    elif motion == "fourier":
         qr, dqr, ddqr = fourier_reference(t_ctrl, n, rng, f0, harmonics, amp, centre)
     else:
         qr, dqr, ddqr = ptp_reference(t_ctrl, n, rng, amp, centre)

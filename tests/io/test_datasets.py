@@ -103,8 +103,9 @@ def test_a_gap_in_the_time_stamps_is_refused_unless_interpolation_is_asked(tmp_p
     how long, and refuses a longer one (it would invent that much data)."""
     t = np.concatenate([np.arange(100) * 0.01, 3.0 + np.arange(100) * 0.01])
     spec = _log(tmp_path, t, 0.1 + 1e-3 * np.outer(np.arange(200), np.ones(6)), np.full((200, 6), 0.5))
-    with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps \(median step 0.01 s\) after "
-                                        r"the time stamp 0.99 s \(0.990 s into the selected rows\); set gaps = \"interpolate\" in \[identification\]"):
+    with pytest.raises(DataError, match=r"ur.csv: line 101: a gap of 2.01 s in the time stamps \(median step 0.01 s, 201 "
+                                        r"samples\) after the time stamp 0.99 s \(0.990 s into the selected rows\), longer "
+                                        r"than the 20 samples dynid fills by itself; set gaps = \"interpolate\" in \[identification\]"):
         load_recording(spec, load_robot("ur10e"))
     spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "interpolate"}, tmp_path, "c.toml: identification", "ident", 6)
     with pytest.raises(DataError, match=r"longer than max_gap = 0.1 s.*raise max_gap in \[identification\]"):
@@ -115,6 +116,21 @@ def test_a_gap_in_the_time_stamps_is_refused_unless_interpolation_is_asked(tmp_p
     assert rec.n_samples > 200
     assert any(w.startswith("p3: 1 gap(s) in the time stamps filled by interpolation, the longest 2.01 s") and
                "[[validation]] 2" in w for w in rec.warnings)
+
+
+def test_a_few_dropped_samples_are_filled_by_default_and_said(tmp_path):
+    """gaps = "auto" (the default): a logger that dropped 7 samples is filled by interpolation, with a warning that names
+    the setting; gaps = "refuse" refuses it as the default used to."""
+    t = np.concatenate([np.arange(100) * 0.01, 1.07 + np.arange(100) * 0.01])
+    spec = _log(tmp_path, t, 0.1 + 1e-3 * np.outer(np.arange(200), np.ones(6)), np.full((200, 6), 0.5))
+    rec = load_recording(spec, load_robot("ur10e"))
+    assert rec.n_samples == 207
+    assert any("1 gap(s) in the time stamps filled by interpolation, the longest 0.08 s" in w and 'gaps = "auto"' in w
+               for w in rec.warnings)
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "gaps": "refuse"}, tmp_path, "c.toml: identification",
+                        "ident", 6)
+    with pytest.raises(DataError, match=r"a gap of 0.08 s in the time stamps"):
+        load_recording(spec, load_robot("ur10e"))
 
 
 def test_positions_in_degrees_are_refused_with_the_hint(tmp_path):

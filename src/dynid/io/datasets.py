@@ -9,7 +9,8 @@ A dataset is described by a table of the experiment config (TOML)::
     header = false                   # first line holds column names
     rows = [635, 3510]               # 1-based inclusive data rows (header excluded)
     time_range = [6.3, 35.1]         # seconds from the first row read (after rows), inclusive
-    gaps = "refuse"                  # a time step over 5x the median: "refuse" (default) or "interpolate"
+    gaps = "auto"                    # a time step over 5x the median: "auto" (default: fill up to 20 samples),
+                                     # "refuse" or "interpolate" (up to max_gap)
     time = { column = 1 }            # time stamps [s] …
     rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
     resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
@@ -127,7 +128,8 @@ class DatasetSpec:
     time_range : (start, stop) or None [s]
         From the first row read.
     gaps : str
-        A time step over 5× the median: "refuse" or "interpolate".
+        A time step over 5× the median: "auto" (filled when at most :data:`AUTO_GAP_SAMPLES` samples and
+        ``max_gap`` long, refused otherwise), "refuse" or "interpolate" (up to ``max_gap``).
     bag : BagSpec or None
         A ROS 2 bag instead of columns.
     table : str
@@ -149,7 +151,7 @@ class DatasetSpec:
     rows: tuple[int, int] | None = None
     delimiter: str = ","
     time_range: tuple[float, float] | None = None
-    gaps: str = "refuse"
+    gaps: str = "auto"
     bag: "BagSpec | None" = None
     table: str = ""
     """The config table it comes from, for messages: ``[identification]``, ``[[validation]] "p3"``."""
@@ -234,6 +236,10 @@ def _time_range(value, where: str):
 
 GAP_FACTOR = 5.0
 """A time step longer than this many median steps is a gap in the log (a lost connection, a pause)."""
+
+AUTO_GAP_SAMPLES = 20
+"""With ``gaps = "auto"`` (the default), gaps of at most this many samples are filled by interpolation (a logger
+that dropped a few packets), with a warning; a longer one is refused, naming the setting that fills it."""
 
 HELD_SHARE = 0.05
 """A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
@@ -395,7 +401,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         rate=None if t.rate is None else float(t.rate), resample=None if t.resample is None else float(t.resample),
         side=t.side or "joint", header=bool(t.header), n_columns=t.n_columns,
         rows=_rows(t.rows, where), delimiter=t.delimiter if t.delimiter is not None else ",",
-        time_range=_time_range(t.time_range, where), gaps=t.gaps or "refuse",
+        time_range=_time_range(t.time_range, where), gaps=t.gaps or "auto",
         table=_table_name(where), max_gap=float(t.max_gap) if t.max_gap is not None else 0.1, held=t.held or "interpolate")
 
 
@@ -421,7 +427,7 @@ def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
         raise ConfigError(f"{where}.joint_names: expected {n_dof} joint names, got {t.joint_names!r}")
     return DatasetSpec(name=str(t.name if t.name is not None else name), signals={}, side=t.side or "joint",
                        resample=None if t.resample is None else float(t.resample),
-                       time_range=_time_range(t.time_range, where), gaps=t.gaps or "refuse",
+                       time_range=_time_range(t.time_range, where), gaps=t.gaps or "auto",
                        bag=BagSpec(path, t.topic or "/joint_states", None if t.joint_names is None else tuple(t.joint_names),
                                    t.effort or "torques"))
 
@@ -541,6 +547,13 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     if timed:
         steps = np.diff(t)
         gaps = np.flatnonzero(steps > GAP_FACTOR * median)
+        if gaps.size and spec.gaps == "auto" and float(steps[gaps].max()) > AUTO_GAP_SAMPLES * median:
+            k = int(gaps[np.argmax(steps[gaps])])
+            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s, "
+                            f"{steps[k] / median:.0f} samples) after the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s "
+                            f"into the selected rows), longer than the {AUTO_GAP_SAMPLES} samples dynid fills by itself; set "
+                            f"gaps = \"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select "
+                            "rows on one side of it")
         if gaps.size and spec.gaps == "refuse":
             k = int(gaps[0])
             raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s) after "
@@ -554,7 +567,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
                                 f"the selected rows is longer than max_gap = {spec.max_gap:g} s, the most gaps = \"interpolate\" "
                                 f"fills with invented samples; select rows on one side of it, or raise max_gap in {table}")
             warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
-                            f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"interpolate\" in {table})")
+                            f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"{spec.gaps}\" in {table}; \"refuse\" "
+                            "refuses them)")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
     if timed and (not uniform or spec.resample is not None):
