@@ -22,8 +22,12 @@ def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     out = tmp_path / "out"
     p = dynid("fleet", tmp_path / "fleet" / "fleet.toml", "--out", out, "--workers", "2")
     assert p.returncode == 0, p.stderr
-    assert "6 of 6 units identified; 1 stands out from the fleet: r03" in " ".join(p.stdout.split())
+    said = " ".join(p.stdout.split())
+    assert "6 of 6 units identified; 1 stands out from the fleet: r03" in said
     table = pa.read_table(out / "fleet.parquet").to_pydict()
+    # "consistent: no" is said to be the unconstrained estimate's, with a reason and what gives a consistent one
+    no = table["consistent"].count(False)
+    assert (f"consistent: no for {no} of 6 units: their dynid " in said and 'list "sdp" in the template' in said) == (no > 0)
     assert table["unit"] == [f"r0{k}" for k in range(1, 7)]
     flags = dict(zip(table["unit"], table["flags"]))
     assert flags["r03"].startswith("K2 (z +") and all(flags[u] == "" for u in flags if u != "r03")
@@ -124,3 +128,30 @@ def test_bad_manifests_are_refused_in_one_line(tmp_path):
     assert p.returncode == 0, p.stderr
     text = " ".join((p.stdout + p.stderr).split())
     assert "3 of 4 units identified" in text and "r02: not identified:" in text and "missing.csv" in text
+
+
+def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_path):
+    """Four bare units and a fifth with a 5.3 kg tool stated in the manifest, nothing else odd: no unit stands out (the
+    tool was compared as if it were the arm's: r05 flagged on MZ3R at z = 330, MZ4R, YY3R, ...); the tooled unit's
+    pooled estimate carries its tool again and predicts its own motion as well as its own estimate does."""
+    import shutil
+
+    from dynid.experiment.fleet import run_fleet
+    from dynid.io.fleet_manifest import load_fleet_manifest
+
+    simulate_fleet(tmp_path / "bare", units=4, seconds=20.0, rate=200.0, validation_seconds=6.0, odd_unit=None,
+                   payload_max=0.0, seed=3)
+    (tooled,) = simulate_fleet(tmp_path / "tool", units=1, seconds=20.0, rate=200.0, validation_seconds=6.0,
+                               odd_unit=None, payload_max=8.0, seed=11)
+    assert tooled.payload > 5.0
+    shutil.copytree(tmp_path / "tool" / "r01", tmp_path / "bare" / "r05")
+    unit = (tmp_path / "tool" / "fleet.toml").read_text().split("[[units]]")[1].replace("r01", "r05")
+    manifest = tmp_path / "bare" / "mixed.toml"
+    manifest.write_text(((tmp_path / "bare" / "fleet.toml").read_text() + "[[units]]" + unit)
+                        .replace("drive_gains = ", "# drive_gains = "))
+    result = run_fleet(load_fleet_manifest(manifest), workers=2)
+    assert [u.error for u in result.units] == [""] * 5
+    assert result.outliers == ()
+    r05 = result.units[4]
+    assert r05.tool is not None and np.any(r05.tool != 0) and all(u.tool is None for u in result.units[:4])
+    assert result.pooled_errors["r05"] < 1.5 * r05.validation_error

@@ -66,6 +66,8 @@ class UnitSummary:
         The robot as identified (for the pooled estimate's validation; not in the table).
     preprocessing : Preprocessing or None
         The identification's resolved preprocessing, carried over to the validation logs.
+    tool : (n_base,) array or None
+        The unit's stated tool as base parameters: ``params - tool`` is its arm alone, what the fleet compares and pools.
     """
 
     id: str
@@ -87,6 +89,12 @@ class UnitSummary:
     files: tuple[str, ...] = ()
     model: object = None  # the robot as identified (for the second round's validation); not in the table
     preprocessing: object = None  # the identification's resolved preprocessing, carried over to the validation logs
+    tool: np.ndarray | None = None
+
+    @property
+    def arm(self) -> np.ndarray:
+        """The estimate without the unit's stated tool (:attr:`tool`): what is compared across the fleet."""
+        return self.params if self.tool is None else self.params - self.tool
 
 
 def _peak_memory() -> float:
@@ -149,11 +157,13 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
     # over the covariance's (median over the parameters) scales the covariance the fleet weighs the unit by
     ratio = float(result.diagnostics.get("bootstrap_over_covariance_std", 1.0) or 1.0)
     scale = max(1.0, ratio if np.isfinite(ratio) else 1.0)
+    robot = result.model or unit.config.robot
+    tool = result.base.base_from_standard(unit.tool_standard(robot)) if unit.payload else None
     return UnitSummary(unit.id, date, unit.payload, tuple(result.base.names), sol.params, scale * sol.params_std,
                        scale ** 2 * sol.covariance, label,
                        err, joints, str(result.consistency_verdicts.get(label, "")), gains, gains_std,
-                       time.perf_counter() - t0, _peak_memory(), "", files, result.model or unit.config.robot,
-                       stored_preprocessing({"settings": result.settings}))
+                       time.perf_counter() - t0, _peak_memory(), "", files, robot,
+                       stored_preprocessing({"settings": result.settings}), tool)
 
 
 def add_pooled_estimates(out: str | Path, units: tuple[UnitSummary, ...], pooled) -> list[Path]:
@@ -342,7 +352,7 @@ def _flag(units: tuple[UnitSummary, ...]):
 
     names = list(units[0].names)
     differ = list(~shared_parameters(names))
-    values = np.array([u.params for u in units])
+    values = np.array([u.arm for u in units])  # each unit's stated tool taken out
     std = np.array([u.std for u in units])
     if all(u.gains is not None for u in units):
         n = units[0].gains.size  # type: ignore[union-attr]
@@ -412,8 +422,11 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
         elif len(names) > 1:
             note = "the units' base parameters differ (friction models or robot descriptions): nothing to pool"
         else:
-            pooled = pooled_estimate(np.array([s.params for s in ok]), np.array([s.covariance for s in ok]),
+            pooled = pooled_estimate(np.array([s.arm for s in ok]), np.array([s.covariance for s in ok]),
                                      shared_parameters(ok[0].names))
+            # each unit's pooled estimate carries its own tool again
+            pooled = replace(pooled, params=pooled.params + np.array([np.zeros(len(s.names)) if s.tool is None else s.tool
+                                                                      for s in ok]))
             by_id = {u.id: u for u in units}
             checks = {client.submit(validate_unit, by_id[s.id], s.model, {s.label: s.params, POOLED: pooled.params[i]}, s.preprocessing,
                                     pure=False, key=f"validate-{s.id}"): s.id for i, s in enumerate(ok)}

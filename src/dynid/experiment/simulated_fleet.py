@@ -28,6 +28,9 @@ from ..simulation.measurements import NoiseModel, simulate_measurements
 __all__ = ["NOMINAL_FRICTION", "UnitTruth", "simulate_fleet", "simulate_service_life", "random_excitation",
            "unit_robot"]
 
+TOOL_COM = (0.0, 0.0, 0.05)
+"""Where each simulated unit's tool sits: its centre of mass in the last link's frame [m] (the manifest states it)."""
+
 NOMINAL_FRICTION = {
     "ur10e": ((9.0, 9.0, 7.0, 2.5, 2.5, 2.5), (6.0, 6.0, 4.0, 1.2, 1.2, 1.2)),
     "tx40": ((7.14, 8.26, 6.34, 2.48, 3.03, 0.282), (8.05, 5.53, 1.97, 1.11, 1.86, 0.65)),
@@ -96,7 +99,7 @@ def unit_robot(robot: Robot, truth: UnitTruth) -> Robot:
     drive[:, terms.index("fv")] = truth.viscous
     inertial = robot.inertial.copy()
     if truth.payload > 0:  # a point mass m at c in the last link's frame: first and second moments about its origin
-        c, m = np.array([0.0, 0.0, 0.05]), truth.payload
+        c, m = np.array(TOOL_COM), truth.payload
         second = m * (c @ c * np.eye(3) - np.outer(c, c))
         inertial[-1, :6] += second[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
         inertial[-1, 6:9] += m * c
@@ -239,7 +242,7 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
             _write_log(folder / uid / "unloaded.csv", nominal, real, gains, runs, seconds, rate, noise, unit_rng)
             _write_log(folder / uid / "loaded.csv", nominal, loaded, gains, runs, seconds, rate, noise, unit_rng)
             lines.append(f'drive_gains = {{ unloaded = "{uid}/unloaded.csv", loaded = "{uid}/loaded.csv" }}')
-        lines += [f"payload = {truth.payload:.3f}", ""]
+        lines += [f"payload = {truth.payload:.3f}", f"payload_com = {list(TOOL_COM)}", ""]
     (folder / "fleet.toml").write_text("\n".join(lines))
     (folder / "unit.toml").write_text(
         f'# What every unit of the fleet shares: the robot, the logs\' columns, the estimators.\nrobot = "{robot}"\n\n'

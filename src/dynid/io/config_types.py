@@ -213,7 +213,11 @@ class UnitTable(Table, kw_only=True):
     identification: Annotated[str, _d("the log to identify from, relative to the manifest")] | None = None
     validation: Annotated[list[str], _d("logs to validate on, relative to the manifest")] = msgspec.field(default_factory=list)
     drive_gains: Annotated[UnitGainsTable, _d("the drive-gain runs (the template has [drive_gains])")] | None = None
-    payload: Annotated[float, Meta(ge=0, le=10_000, description="kg: the tool mounted on this unit (reported)")] | None = None
+    payload: Annotated[float, Meta(ge=0, le=10_000, description="kg: the tool mounted on this unit (taken out of its "
+                                                                "estimate before the fleet compares and pools)")] | None = None
+    payload_com: Annotated[list[float], Meta(min_length=3, max_length=3, description="m: the tool's centre of mass in the "
+                                                                                      "last link's frame (default: the "
+                                                                                      "description's tool frame)")] | None = None
     date: Annotated[datetime.date, _d("when the logs were recorded")] | None = None
 
 

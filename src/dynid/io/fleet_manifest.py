@@ -12,7 +12,9 @@ Layout (logs relative to the manifest; the template relative to it too)::
     identification = "r01/identification.csv"      # read with the template's [identification] column map
     validation = ["r01/validation.csv"]            # read with the template's first [[validation]] map
     drive_gains = { unloaded = "r01/unloaded.csv", loaded = "r01/loaded.csv" }   # the template has [drive_gains]
-    payload = 1.2                                  # kg, the unit's tool (reported in the fleet table)
+    payload = 1.2                                  # kg, the unit's tool: taken out of its estimate before the fleet
+    payload_com = [0.0, 0.0, 0.05]                 # compares and pools (a point mass; m, in the last link's frame,
+                                                   # default the description's tool frame)
     date = 2026-11-01                              # when the logs were recorded
 
     [[units]]
@@ -26,6 +28,8 @@ import copy
 import datetime
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from ..exceptions import ConfigError
 from ..typed import convert
@@ -47,12 +51,36 @@ class FleetUnit:
         Its identification, as ``dynid identify`` would run it.
     payload : float or None [kg]
     date : datetime.date or None
+    payload_com : (3,) array or None [m]
+        The tool's centre of mass in the last link's frame (None: the description's tool frame).
     """
 
     id: str
     config: IdentificationConfig
     payload: float | None = None
     date: datetime.date | None = None
+    payload_com: tuple[float, float, float] | None = None
+
+    def tool_standard(self, robot) -> np.ndarray:
+        """The stated tool as standard parameters of ``robot`` (a point mass on the last link; zeros without one).
+
+        Parameters
+        ----------
+        robot : Robot
+            The robot as identified (its parameter layout).
+
+        Returns
+        -------
+        (n_params,) ndarray
+        """
+        from ..model.spatial import inertial_from_physical
+
+        phi = np.zeros(robot.n_params)
+        if self.payload:
+            com = np.asarray(self.payload_com if self.payload_com is not None else robot.tool_translation, dtype=float)
+            last = (robot.n_dof - 1) * robot.n_params_per_joint
+            phi[last:last + 10] = inertial_from_physical(float(self.payload), com, np.zeros((3, 3)))
+        return phi
 
 
 @dataclass(frozen=True)
@@ -141,7 +169,11 @@ def load_fleet_manifest(path: str | Path, data_root: str | Path | None = None) -
         except ConfigError as exc:
             text = str(exc)
             raise ConfigError(text if text.startswith(where) else f"{where}: {text}") from None
-        units.append(FleetUnit(u.id, config, u.payload, u.date))
+        com = None if u.payload_com is None else tuple(float(x) for x in u.payload_com)
+        if com is not None and (not np.all(np.isfinite(com)) or max(abs(x) for x in com) > 10):
+            raise ConfigError(f"{where}.payload_com: expected a centre of mass within 10 m of the last link's origin, got "
+                              f"{list(com)}")
+        units.append(FleetUnit(u.id, config, u.payload, u.date, com))
     models = {(c.config.robot.name, c.config.robot.n_dof) for c in units}
     if len(models) > 1:
         raise ConfigError(f"{path}: units: a fleet is of one robot model, got {sorted(m[0] for m in models)}")

@@ -687,9 +687,18 @@ def fleet_blocks(result) -> list:
                      _cell(table["pooled_validation_error_pct"][i]), table["worst_joint"][i] or "—",
                      {True: "yes", False: "no", None: "—"}[table["consistent"][i]],
                      ", ".join(o.parameter for o in result.flagged(uid)) or ("not identified" if table["error"][i] else "")))
+    labels = sorted({s.label for s in result.identified})
     out.append(TextTable("Units: global validation error [%] of each unit's own estimate and of its pooled estimate; worst "
-                         "joint; physically consistent; parameters that stand out (z-score against the other units)",
+                         f"joint; whether {', '.join(labels) or 'the estimate'} is physically consistent; parameters that "
+                         "stand out (z-score against the other units, each unit's stated tool taken out)",
                          ("unit", "date", "payload kg", "error %", "pooled %", "worst", "consistent", "flags"), tuple(rows)))
+    inconsistent = [s for s in result.identified if not s.consistency.startswith("yes")]
+    if inconsistent:
+        why = inconsistent[0].consistency.removeprefix("no").strip(" :")
+        out.append(Line(f"consistent: no for {len(inconsistent)} of {len(result.identified)} units: their "
+                        f"{inconsistent[0].label} is unconstrained least squares, which no mass distribution need match "
+                        f"({inconsistent[0].id}: {why}); list \"sdp\" in the template's [estimation] estimators for a "
+                        "physically consistent estimate of each unit"))
     for o in result.outliers[:10]:
         out.append(Line(f"flag: {o}", "warning"))
     if len(result.outliers) > 10:
