@@ -121,3 +121,75 @@ def test_an_estimator_registered_again_by_the_same_class_is_no_conflict(clean):
     registry.register("twice_test", Twice)  # the same class: a plugin imported again
     with pytest.raises(ValueError, match="registered already"):
         registry.register("twice_test", dict)
+
+
+MISBEHAVING = {
+    "wrong_length": ("self.params_ = np.zeros(w.shape[1] - 1)",
+                     r"estimator misbehaving_wrong_length \(plugin misbehaving_wrong_length\.Odd\): returned parameters of "
+                     r"shape \(\d+,\), expected \(\d+,\)"),
+    "raises": ("raise RuntimeError('my solver diverged')",
+               r"estimator misbehaving_raises \(plugin misbehaving_raises\.Odd\): its fit raised RuntimeError: my solver "
+               "diverged"),
+    "nan": ("self.params_ = np.full(w.shape[1], np.nan)",
+            r"estimator misbehaving_nan \(plugin misbehaving_nan\.Odd\): returned \d+ NaN or infinite parameter"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MISBEHAVING))
+def test_a_plugin_estimator_that_misbehaves_is_one_line_naming_it(tmp_path, clean, capsys, case):
+    """A plugin whose fit raises (a 160-line traceback), returns the wrong number of parameters (a matmul error) or
+    NaN (which became the main estimate): one line naming the estimator, its plugin and what it did; exit 1."""
+    body, message = MISBEHAVING[case]
+    key = f"misbehaving_{case}"
+    path = tmp_path / f"{key}.py"
+    path.write_text(textwrap.dedent(f'''
+        import numpy as np
+        from dynid.estimators import Estimator, register
+
+        class Odd(Estimator):
+            def fit(self, w, tau):
+                {body}
+                return self
+
+        register("{key}", Odd)
+    '''))
+    code = main(["--plugin", str(path), "run", "--estimators", f"ols,{key}", "--out", str(tmp_path / "run"), *RUN])
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert re_search(message, err), err
+
+
+def test_a_plain_estimator_cannot_replace_the_least_squares_reference(tmp_path, clean, capsys):
+    path = tmp_path / "plain_wls.py"
+    path.write_text(textwrap.dedent('''
+        import numpy as np
+        from dynid.estimators import Estimator, register
+
+        class Plain(Estimator):
+            def fit(self, w, tau):
+                self.params_ = np.linalg.lstsq(w, np.ravel(tau), rcond=None)[0]
+                return self
+
+        register("wls", Plain, replace=True)
+    '''))
+    code = main(["--plugin", str(path), "run", "--estimators", "wls", "--out", str(tmp_path / "run"), *RUN])
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert "estimator wls (plugin plain_wls.Plain): replaces the least-squares reference" in err
+
+
+def test_a_missing_plugin_in_the_environment_names_the_variable_and_the_file(tmp_path, clean, monkeypatch, capsys):
+    from .simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=8.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ols", "someones_ridge"]'))
+    monkeypatch.setenv(plugins.ENVIRONMENT, str(tmp_path / "missing.py"))
+    assert main(["identify", str(cfg), "--out", str(tmp_path / "out"), "--no-figures", "-q"]) == 1
+    err = capsys.readouterr().err
+    assert f"plugin {tmp_path / 'missing.py'} (from DYNID_PLUGINS): no such file" in err
+
+
+def re_search(pattern, text):
+    import re
+
+    return re.search(pattern, text) is not None

@@ -171,3 +171,35 @@ def test_a_pickle_given_as_results_is_refused_and_never_run(tmp_path):
     with pytest.raises(DynIdError, match="results.json") as caught:
         api.load_results(results, api.load_robot("er16"))
     assert "\n" not in str(caught.value) and not marker.exists()
+
+
+def test_a_non_finite_number_in_a_results_file_is_refused_where_it_is_read(tmp_path):
+    """dynid export on a results.json whose physically consistent value is null or NaN: one line naming the field
+    (a TypeError and a LinAlgError traceback before), nothing written; load_results likewise for an estimate's values."""
+    import json
+
+    import dynid as api
+    from dynid.exceptions import DynIdError
+
+    from .simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    good = json.loads((tmp_path / "out" / "results.json").read_text())
+    name = next(iter(good["estimates"]["dynid SDP"]["standard_values"]))
+    for bad, said in ((None, "null"), (float("nan"), "nan")):
+        r = json.loads(json.dumps(good))
+        r["estimates"]["dynid SDP"]["standard_values"][name] = bad
+        path = tmp_path / f"bad-{said}.json"
+        path.write_text(json.dumps(r))
+        assert_refused(dynid("export", cfg, "--results", path, "--urdf", tmp_path / "x.urdf"),
+                       f"estimates.dynid SDP.standard_values.{name}: expected a finite number, got {said}")
+        assert not (tmp_path / "x.urdf").exists()
+    r = json.loads(json.dumps(good))
+    first = next(iter(r["estimates"]["dynid WLS"]["values"]))
+    r["estimates"]["dynid WLS"]["values"][first] = float("nan")
+    (tmp_path / "nan-values.json").write_text(json.dumps(r))
+    with pytest.raises(DynIdError, match=rf"values.{first}: expected a finite number"):
+        api.load_results(tmp_path / "nan-values.json", api.load_robot(str(cfg.parent / "er16_truth.toml")))

@@ -57,3 +57,24 @@ def test_init_refusals(tmp_path):
     assert_refused(run("init", str(URDF), str(odd), "--out", str(tmp_path / "x.toml")), "odd.csv: no time column among ['a', 'b', 'c']")
     assert_refused(run("init", str(tmp_path / "none.urdf"), str(log), "--out", str(tmp_path / "y.toml")), "none.urdf")
     assert not (tmp_path / "x.toml").exists() and not (tmp_path / "y.toml").exists()
+
+
+def test_init_says_which_columns_it_took_and_which_it_left(tmp_path):
+    """A log of six joints for a robot of three (a URDF that is not the whole arm): init took q1-q3 and tau1-tau3 and
+    left q4-q6 and tau4-tau6 without a word; now it names what it left and asks whether the URDF is the whole arm."""
+    import re
+
+    text = URDF.read_text()
+    for name in ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint"):  # the wrist made fixed: a 3-joint robot
+        text = re.sub(rf'(<joint name="{name}" type=")revolute(")', r"\1fixed\2", text)
+    (tmp_path / "arm3.urdf").write_text(text)
+    t = np.arange(200) * 0.01
+    names = ["t"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)] + ["temperature"]
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t] + [np.sin(t + j) for j in range(13)]), delimiter=",",
+               header=",".join(names), comments="")
+    p = run("init", str(tmp_path / "arm3.urdf"), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    said = " ".join(p.stdout.split())
+    assert "positions: q1, q2, q3" in said
+    assert ("left: q4, q5, q6, tau4, tau5, tau6, temperature — the log has more joint columns than the robot's 3 "
+            "joints (q4, q5, q6, tau4, tau5, tau6): is arm3.urdf the whole arm") in said

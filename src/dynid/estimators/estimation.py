@@ -66,6 +66,13 @@ class Estimation:
                 self.streamed[key] = est
         ref = self.streamed.get(self.reference_key)
         self.reference: Any = ref if ref is not None else make_estimator(self.reference_key, problem)
+        if not isinstance(self.reference, AccumulatingEstimator):
+            from ..exceptions import ConfigError
+            from .registry import _named
+
+            raise ConfigError(f"{_named(self.reference_key)}: replaces the least-squares reference of every "
+                              "identification, which takes the rows block by block (partial_fit) and gives σ; register "
+                              "it under a key of its own, or subclass dynid.estimators.AccumulatingEstimator")
         self.standard = any(spec(k).space == "standard" for k in self.keys)
         in_memory = [k for k in self.keys if k not in self.streamed]
         self._stack_base = keep_rows or any(spec(k).space == "base" for k in in_memory)

@@ -27,7 +27,7 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
-from ..exceptions import ConfigError
+from ..exceptions import ConfigError, DynIdError
 from ..plugins import load_plugins, origin
 
 if TYPE_CHECKING:
@@ -316,6 +316,29 @@ register("pso", _box_search("pso"), label="PSO", description="particle swarm (co
 BUILT_IN = tuple(_REGISTRY)
 """The estimators dynid comes with (the others were registered by the user)."""
 
+_BUILT_IN_ORIGINS = {k: origin(_REGISTRY[k].build) for k in BUILT_IN}
+
+
+def is_plugin(key: str) -> bool:
+    """Whether estimator ``key`` is the user's (registered by a plugin, or a built-in key replaced by one).
+
+    Parameters
+    ----------
+    key : str
+
+    Returns
+    -------
+    bool
+    """
+    k = str(key).strip().lower()
+    return k not in _BUILT_IN_ORIGINS or origin(_REGISTRY[k].build) != _BUILT_IN_ORIGINS[k]
+
+
+def _named(key: str) -> str:
+    """``estimator KEY`` and, for a plugin's, where it comes from."""
+    k = str(key).strip().lower()
+    return f"estimator {k} (plugin {origin(_REGISTRY[k].build)})" if is_plugin(k) else f"estimator {k}"
+
 LEAST_SQUARES = ("ols", "wls")
 """The least-squares estimates that carry σ; one of them is the reference of every identification (the first of
 these in the list of estimators, else WLS): its residuals give each joint's noise, its σ the search box."""
@@ -550,7 +573,20 @@ def finish(key: str, est: "Estimator", data: FitData, seconds: float) -> Fitted:
     """
     import numpy as np
 
-    params = est.params_
+    try:
+        params = np.asarray(est.params_, dtype=float)
+    except (AttributeError, TypeError, ValueError) as exc:
+        raise ConfigError(f"{_named(key)}: after fit, expected params_ as an array of numbers "
+                          f"({type(exc).__name__}: {exc})") from None
+    w = data.w_standard if spec(key).space == "standard" else data.w_base
+    expected = w.shape[1] if w is not None else (len(data.base.names) if data.base is not None and spec(key).space == "base"
+                                                 else params.size)
+    if params.shape != (expected,):
+        raise ConfigError(f"{_named(key)}: returned parameters of shape {params.shape}, expected ({expected},): one per "
+                          "column of the observation matrix it was given")
+    if not np.all(np.isfinite(params)):
+        bad = int(np.sum(~np.isfinite(params)))
+        raise ConfigError(f"{_named(key)}: returned {bad} NaN or infinite parameter(s) of {params.size}: no estimate")
     if spec(key).space == "standard":
         if data.base is None:
             raise ConfigError(f"estimator {key} estimates standard parameters: the base-parameter map is needed")
@@ -589,14 +625,22 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
     """
     entry = spec(key)
     t0 = time.perf_counter()
-    if estimator is not None:
-        est = estimator.solve() if hasattr(estimator, "solve") else estimator
-    else:
-        est = make_estimator(key, data, budget, rng, callback)
-        w = data.w_standard if entry.space == "standard" else data.w_base
-        if w is None:
-            raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
-        est.fit(w, data.tau)
+    try:
+        if estimator is not None:
+            est = estimator.solve() if hasattr(estimator, "solve") else estimator
+        else:
+            est = make_estimator(key, data, budget, rng, callback)
+            w = data.w_standard if entry.space == "standard" else data.w_base
+            if w is None:
+                raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
+            est.fit(w, data.tau)
+    except (DynIdError, _Stopped):
+        raise
+    except Exception as exc:  # a plugin's own error, said in one line naming it (a built-in's is a bug: raised as is)
+        if not is_plugin(key):
+            raise
+        text = " ".join(str(exc).split()) or "no message"
+        raise ConfigError(f"{_named(key)}: its fit raised {type(exc).__name__}: {text[:200]}") from None
     return finish(key, est, data, time.perf_counter() - t0)
 
 

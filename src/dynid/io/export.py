@@ -266,6 +266,11 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     missing = [n for n in robot.parameter_names if n not in values]
     if missing:
         raise ConfigError(f"{source}: its standard parameters are not those of robot {robot.name!r} (missing {', '.join(missing[:4])})")
+    for n in robot.parameter_names:
+        v = values[n]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+            raise ConfigError(f"{source}: estimates.{label}.standard_values.{n}: expected a finite number, got "
+                              f"{'null' if v is None else repr(v)}")
     phi = np.array([float(values[n]) for n in robot.parameter_names])
     return robot, phi
 

@@ -277,7 +277,10 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     try:
         estimators = parse_estimators([k for k in asked if k not in CLOSED_LOOP_METHODS])
     except ConfigError as exc:
-        raise ConfigError(f"{path}: estimation.estimators: {str(exc).split(': ', 1)[1]}") from None
+        text = str(exc)
+        if text.startswith("plugin "):  # a plugin that cannot be imported names itself and where it was named
+            raise ConfigError(f"{path}: estimation.estimators: {text}") from None
+        raise ConfigError(f"{path}: estimation.estimators: {text.split(': ', 1)[1]}") from None
     controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof)
     if closed_loop and controller is None:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "

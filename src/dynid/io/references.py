@@ -183,6 +183,8 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
             std = float(r[i_std]) if i_std is not None else np.nan
         except (IndexError, ValueError):
             raise DataError(f"{path}: line {line}: expected a name and numeric value(s) in the configured columns, got {r}") from None
+        if not np.isfinite(value):
+            raise DataError(f"{path}: line {line}: {name}'s value is {r[i_value].strip()}: expected a finite number")
         if fmt == "standard":
             try:
                 cname = canonical_name(name)

@@ -181,6 +181,10 @@ def stored_standard(identified: dict) -> tuple[str, dict] | None:
 
 def _vector(entry, names: tuple, where: str) -> np.ndarray:
     try:
-        return np.array([float(entry["values"][n]) for n in names])
+        out = np.array([float(entry["values"][n]) for n in names])
     except (KeyError, TypeError, ValueError):
         raise DataError(f"{where}.values: expected a value for every base parameter") from None
+    if not np.all(np.isfinite(out)):
+        bad = names[int(np.flatnonzero(~np.isfinite(out))[0])]
+        raise DataError(f"{where}.values.{bad}: expected a finite number, got {entry['values'][bad]!r}")
+    return out

@@ -93,10 +93,19 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path) -> tuple[str, l
             raise DataError(f"{log}: found {len(found.get(missing[0], []))} {missing[0]} column(s) of the {n_dof} the robot "
                             f"needs among {first}")
         table += ["header = true", f'time = {{ column = "{found["time"][0]}" }}']
+        taken = [found["time"][0]]
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
                 table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
                 notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
+                taken += found[kind][:n_dof]
+        left = [c for c in first if c not in taken]
+        extra = [c for c in left if _kind(c) in ("positions", effort)]
+        if extra:
+            notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
+                         f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
+        elif left:
+            notes.append(f"left: {', '.join(left)}")
     elif n_columns == 31 and n_dof == 6:
         table = ['preset = "ur-rtde"', f'file = "{log.name}"']
         notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\"")
