@@ -64,7 +64,11 @@ def test_point_to_point_with_rests_at_the_floor_and_honest_at_rest(prescribed_pt
     result, log, half = prescribed_ptp
     m = result.validations[0].metrics()
     est, floor = m["dynid OLS"]["relative_error"], m["truth"]["relative_error"]
-    assert np.all(est <= 1.2 * floor), (est, floor)
+    assert m["dynid OLS"]["global_relative_error"] <= 1.2 * m["truth"]["global_relative_error"]
+    # per joint within 1.6x: with rests scored against the static-friction band the truth's error fell to its moving
+    # samples' (J5 0.46 %, was dominated by the held friction both sets were charged at rest), which shows the
+    # estimate's own error while J5 moves, 0.016 N·m RMS (0.5 % of its torque; measured at this commit)
+    assert np.all(est <= 1.6 * floor), (est, floor)
     # at rest: the truth's RMS error in dynid's table against its error on the raw samples (the true states,
     # dynid's model with sign(q̇) exact, the log's torques): the noise alone there
     robot = result.model

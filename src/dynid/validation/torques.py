@@ -52,6 +52,10 @@ class TorqueComparison:
         (for the sets whose covariance is known).
     dead : tuple of int
         Joints whose measured torque is constant over the log: left out of every metric.
+    centre : dict or None
+        label -> (M, n_dof) the prediction without its Coulomb-like terms [N·m] (the static-friction band's centre).
+    band : (n_dof,) array [N·m] or None
+        The band's half-width ``f_s``, the same for every set.
     floor : (n_dof,) array [N·m] or None
         The noise floor of these samples (:func:`dynid.validation.noise_floor.noise_floor`): the RMSE a perfect model
         would have.
@@ -141,7 +145,9 @@ class TorqueComparison:
         -------
         dict
             label -> {``relative_error`` [%], ``rmse`` [N·m], ``correlation`` (eq. 18), each (n_dof,);
-            ``global_relative_error`` [%] over all joints and samples}; where the joints rest in the dataset, also
+            ``global_relative_error`` [%] over all joints and samples; at rest the distance to the static-friction band
+            (:meth:`scored`)}; where the joints rest in the dataset, also ``plain_relative_error`` and
+            ``plain_global_relative_error`` [%] (the set's own prediction at rest, as published figures are), and
             ``moving_relative_error`` [%], ``moving_rmse`` [N·m] on the samples where each joint moves, ``rest_rmse`` [N·m]
             and ``rest_in_static_band`` (share of the resting samples whose error is within the set's ``±f_s``).
         """
@@ -162,6 +168,11 @@ class TorqueComparison:
             m = {"relative_error": joints(relative_error(mm, pp)), "rmse": joints(rmse(mm, pp)),
                  "correlation": joints(correlation_coefficient(mm, pp)),
                  "global_relative_error": global_relative_error(mm, pp)}
+            if self.centre is not None and self.resting is not None and self.resting.any():
+                # the literature's figure: the set's own prediction at rest too (to compare with published errors)
+                raw = self.predicted[label][:, live]
+                m.update(plain_relative_error=joints(relative_error(mm, raw)),
+                         plain_global_relative_error=global_relative_error(mm, raw))
             if self.resting is not None and self.resting.any():
                 m.update(_moving_and_rest(self.measured, self.predicted[label], self.resting,
                                           None if self.static is None else self.static.get(label)))
