@@ -1,5 +1,6 @@
 """Drive gains (eq. 16) and a payload from runs without and with a payload of known mass."""
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -160,3 +161,25 @@ def test_the_currents_noise_is_taken_out_of_the_gains():
     assert plain[4] < -2.0  # the bias, measured: -4.2 % (compensated: -0.18 %)
     assert abs(compensated[4]) < abs(plain[4]) / 3
     assert np.all(np.abs(compensated[:4]) < 0.2)
+
+
+def test_a_drive_gains_error_names_the_runs_it_comes_from(tmp_path):
+    """[drive_gains] whose loaded run selects too few rows: the one-line error named the table but no file; now it
+    names both runs' files."""
+    from pathlib import Path
+
+    from dynid.exceptions import DynIdError
+    from dynid.experiment.identification_run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    from ..conftest import shared_data
+
+    root = shared_data("ur10e_mamedov2020")
+    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
+    text = re.sub(r"rows = \[308, 5071\]", "rows = [308, 340]", text)
+    cfg_path = tmp_path / "light.toml"
+    cfg_path.write_text(text.replace('data_root = "../../shared/data/ur10e_mamedov2020"', f'data_root = "{root}"'))
+    with pytest.raises(DynIdError, match=r"^\[drive_gains\] \(.*14harm50sec.csv and .*14harm50secLoad.csv\): "
+                                         r"\[drive_gains.loaded\]: rows = \[308, 340\] selects 33 samples") as caught:
+        run_identification(load_identification_config(cfg_path), validate=False)
+    assert "\n" not in str(caught.value)

@@ -155,3 +155,19 @@ def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_p
     r05 = result.units[4]
     assert r05.tool is not None and np.any(r05.tool != 0) and all(u.tool is None for u in result.units[:4])
     assert result.pooled_errors["r05"] < 1.5 * r05.validation_error
+
+
+def test_a_units_warnings_reach_the_console_and_fleet_json(tmp_path):
+    """One unit's identification log cut off mid-line (a copy that stopped): its warning was dropped from dynid fleet's
+    console; now it is there, named by the unit, and in fleet.json."""
+    simulate_fleet(tmp_path / "fleet", units=3, seconds=12.0, rate=100.0, validation_seconds=4.0, odd_unit=None, seed=2)
+    log = tmp_path / "fleet" / "r02" / "identification.csv"
+    data = log.read_bytes()
+    log.write_bytes(data[: data.rindex(b"\n", 0, len(data) - 1) + 15])  # the last line cut short
+    out = tmp_path / "out"
+    p = dynid("fleet", tmp_path / "fleet" / "fleet.toml", "--out", out, "--workers", "2")
+    assert p.returncode == 0, p.stderr
+    fleet = json.loads((out / "fleet.json").read_text())
+    assert list(fleet["warnings"]) == ["r02"], fleet["warnings"]
+    said = " ".join((p.stdout + p.stderr).split())
+    assert all(f"r02: {' '.join(w.split())}" in said for w in fleet["warnings"]["r02"])

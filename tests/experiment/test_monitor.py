@@ -148,3 +148,40 @@ def test_monitor_refusals(tmp_path):
     p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", tmp_path / "none.json",
               "--out", tmp_path / "m")
     assert_refused(p, "none.json")
+
+
+def test_a_log_still_being_written_is_left_for_the_next_run(tmp_path):
+    """The newest log of a growing folder is half written (its last line unfinished): the run says so and leaves it;
+    once complete, the next run reads it, and monitor.json is the one run over every log's (it was read half and
+    never again). A log that changed after the monitor read it is refused in one line."""
+    import shutil
+
+    simulate_service_life(tmp_path, days=8, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=4)
+    results = _identified(tmp_path)
+    files = sorted((tmp_path / "logs").glob("*.csv"))
+    growing = tmp_path / "growing"
+    growing.mkdir()
+
+    def run(folder, out):
+        return dynid("monitor", tmp_path / "unit.toml", "--logs", folder, "--results", results, "--out", out,
+                     "--reference-windows", "10")
+
+    p = run(tmp_path / "logs", tmp_path / "once")
+    assert p.returncode == 0, p.stderr
+    for f in files[:-1]:
+        shutil.copy(f, growing / f.name)
+    whole = files[-1].read_bytes()
+    (growing / files[-1].name).write_bytes(whole[: len(whole) // 2 - 7])  # a logger half-way through a line
+    p = run(growing, tmp_path / "daily")
+    assert p.returncode == 0, p.stderr
+    assert f"{files[-1].name}: still being written (its last line is unfinished): left for the next run" in \
+        " ".join((p.stdout + p.stderr).split())
+    assert files[-1].name not in json.loads((tmp_path / "daily" / "monitor.json").read_text())["logs"]
+    (growing / files[-1].name).write_bytes(whole)
+    p = run(growing, tmp_path / "daily")
+    assert p.returncode == 0, p.stderr
+    assert json.loads((tmp_path / "daily" / "monitor.json").read_text()) == \
+        json.loads((tmp_path / "once" / "monitor.json").read_text())
+    with open(growing / files[0].name, "ab") as fh:  # an old log written to again
+        fh.write(whole.splitlines(keepends=True)[-1])
+    assert_refused(run(growing, tmp_path / "daily"), f"{files[0].name}: changed since the monitor read it")

@@ -68,6 +68,8 @@ class UnitSummary:
         The identification's resolved preprocessing, carried over to the validation logs.
     tool : (n_base,) array or None
         The unit's stated tool as base parameters: ``params - tool`` is its arm alone, what the fleet compares and pools.
+    warnings : tuple of str
+        What the unit's identification warned of (a truncated log, gaps filled, a dead channel...).
     """
 
     id: str
@@ -90,6 +92,7 @@ class UnitSummary:
     model: object = None  # the robot as identified (for the second round's validation); not in the table
     preprocessing: object = None  # the identification's resolved preprocessing, carried over to the validation logs
     tool: np.ndarray | None = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def arm(self) -> np.ndarray:
@@ -163,7 +166,7 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
                        scale ** 2 * sol.covariance, label,
                        err, joints, str(result.consistency_verdicts.get(label, "")), gains, gains_std,
                        time.perf_counter() - t0, _peak_memory(), "", files, robot,
-                       stored_preprocessing({"settings": result.settings}), tool)
+                       stored_preprocessing({"settings": result.settings}), tool, tuple(result.warnings))
 
 
 def add_pooled_estimates(out: str | Path, units: tuple[UnitSummary, ...], pooled) -> list[Path]:
@@ -343,7 +346,8 @@ class FleetResult:
                 "outliers": [o.to_dict() for o in self.outliers], "flag_threshold": self.threshold,
                 "pooled": pooled, "pooled_note": self.pooled_note, "cluster": self.cluster,
                 "seconds": {"total": self.seconds, **{u.id: u.seconds for u in self.units}},
-                "peak_memory_mb": {u.id: u.memory_mb for u in self.units}}
+                "peak_memory_mb": {u.id: u.memory_mb for u in self.units},
+                "warnings": {u.id: list(u.warnings) for u in self.units if u.warnings}}
 
 
 def _flag(units: tuple[UnitSummary, ...]):

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..exceptions import ConfigError, DataError
+from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.datasets import DatasetSpec, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..model.robot import Robot
@@ -39,11 +39,18 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     assert config.drive_gains is not None  # called only when the config has [drive_gains]
     mass, unloaded, loaded = config.drive_gains
     unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
-    pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
-    pre_l = prepare(load_recording(loaded, unit, spool=False), config.preprocessing)
-    gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
-    k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
-    payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
+    files = [str(s.file) for spec in (unloaded, loaded) for s in list(spec.signals.values())[:1]]
+    try:
+        pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
+        pre_l = prepare(load_recording(loaded, unit, spool=False), config.preprocessing)
+        gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
+        k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
+        payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
+    except DynIdError as exc:  # said with the runs it comes from, when the message names neither
+        text = str(exc)
+        if any(f in text for f in files) or not files:
+            raise
+        raise type(exc)(f"[drive_gains] ({' and '.join(files)}): {text}") from None
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 

@@ -192,6 +192,8 @@ class MonitorResult:
         The monitor's state to go on from (:meth:`FrictionMonitor.state`), when the run was asked to keep it.
     resumed : int
         Logs of an earlier run this one went on from (0: a new monitor).
+    deferred : tuple of str
+        Logs still being written, left for the next run (one line each, naming them).
     """
 
     terms: tuple[str, ...]
@@ -205,6 +207,7 @@ class MonitorResult:
     logs: tuple[str, ...] = ()
     state: bytes | None = field(default=None, repr=False, compare=False)
     resumed: int = 0
+    deferred: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready: the alarms, the reference, every window's terms.
@@ -337,6 +340,7 @@ class FrictionMonitor:
         self.relearn: dict[int, list] = {}
         self.window_times: list[tuple[str, float, float]] = []  # (log, start, end) of each window, for dating alarms
         self.logs: list[str] = []
+        self.sizes: dict[str, int] = {}  # each log's size in bytes when it was read
 
     def _flat(self, theta: np.ndarray) -> np.ndarray:
         return np.concatenate([theta[j, :len(c)] for j, c in enumerate(self.columns)])
@@ -491,7 +495,7 @@ class FrictionMonitor:
                          _num(a.reference), _num(a.value), _num(a.delay)) for a in self.alarms],
             cusum, _Array.of(self.mean), _Array.of(self.std), _num(self.threshold), _num(self.elapsed),
             {str(c): _Array.of(np.array(v, dtype=float)) for c, v in self.relearn.items()},
-            [[log, _num(a), _num(b)] for log, a, b in self.window_times], list(self.logs))
+            [[log, _num(a), _num(b)] for log, a, b in self.window_times], list(self.logs), dict(self.sizes))
         return msgspec.json.encode(state)
 
     def _restore(self, state: "_State", where: str) -> None:
@@ -528,6 +532,9 @@ class FrictionMonitor:
             raise bad("window_times: expected one [log, start, end] per window")
         self.window_times = [(str(w[0]), _value(w[1], bad), _value(w[2], bad)) for w in state.window_times]
         self.logs = list(state.logs)
+        if any(v < 0 for v in state.sizes.values()):
+            raise bad("sizes: expected sizes in bytes")
+        self.sizes = dict(state.sizes)
         self.cusum = None
         if state.cusum is not None:
             c = state.cusum
@@ -763,6 +770,7 @@ class _State(msgspec.Struct, forbid_unknown_fields=True):
     relearn: dict[str, _Array]
     window_times: list[list[str | float]]
     logs: list[str]
+    sizes: dict[str, int] = {}
 
 
 def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings = MonitorSettings(),
@@ -810,14 +818,40 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
         if early:
             raise DataError(f"{early[0]}: a new log that sorts before {logs[last].name}, the last one the monitor saw "
                             "(it follows time); give --restart to monitor every log again")
+        grown = [p for p in logs if p.name in monitor.sizes and p.stat().st_size != monitor.sizes[p.name]]
+        if grown:
+            p = grown[0]
+            raise DataError(f"{p.name}: changed since the monitor read it ({monitor.sizes[p.name]} -> {p.stat().st_size} "
+                            "bytes: was it still being written?); give --restart to monitor every log again")
         logs = [p for p in logs if p.name not in seen]
+    logs, deferred = _complete(logs)
     prep = carried_over(model.preprocessing, config.preprocessing)
     for i, path in enumerate(logs):
         if progress is not None:
             progress(f"log {path.name}", i, len(logs))
+        size = path.stat().st_size
         recording = load_recording(dataset_for_file(config, path), model.robot)
         monitor.feed(prepare(recording, prep, strict=False), path.name)
+        monitor.sizes[path.name] = size
     if len(monitor.windows) <= settings.reference_windows:
         raise DataError(f"{len(monitor.windows)} windows of {settings.window:g} s in the logs: the reference needs "
                         f"{settings.reference_windows} and monitoring more (give more logs, or --reference-windows)")
-    return replace(monitor.result(), state=None if fingerprint is None else monitor.state(fingerprint), resumed=resumed)
+    return replace(monitor.result(), state=None if fingerprint is None else monitor.state(fingerprint), resumed=resumed,
+                   deferred=deferred)
+
+
+def _complete(logs: list[Path]) -> tuple[list[Path], tuple[str, ...]]:
+    """The logs a run may read, in order, and the line that names those left for the next run: from the first log whose
+    last line is unfinished (no newline at its end: a logger still writing it), that log and every later one (a monitor
+    follows time: none may be read before it)."""
+    for i, path in enumerate(logs):
+        size = path.stat().st_size
+        with open(path, "rb") as fh:
+            if size:
+                fh.seek(-1, 2)
+            unfinished = size == 0 or fh.read(1) != b"\n"
+        if unfinished:
+            later = f" (and the {len(logs) - i - 1} after it)" if len(logs) > i + 1 else ""
+            return logs[:i], (f"{path.name}: still being written (its last line is unfinished): left for the next "
+                              f"run{later}",)
+    return logs, ()

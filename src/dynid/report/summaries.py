@@ -706,6 +706,8 @@ def fleet_blocks(result) -> list:
     for s in units:
         if s.error:
             out.append(Line(f"{s.id}: not identified: {s.error}", "warning"))
+        for w in s.warnings:  # each unit's own warnings (a truncated log, gaps filled), named by the unit
+            out.append(Line(f"{s.id}: {w}", "warning"))
     out.append(Line(f"ran on {result.cluster} in {result.seconds:.1f} s; flag threshold |z| > {result.threshold:.2f} (1 % "
                     "chance of any false flag in a fleet whose units differ only at random)"))
     return out
@@ -739,6 +741,8 @@ def monitor_blocks(result) -> list:
                          rows))
     for a in result.alarms:
         out.append(Line(f"alarm: {a}", "warning"))
+    for line in result.deferred:
+        out.append(Line(line, "warning"))
     if result.resumed:
         out.append(Line(f"went on from an earlier run's state ({result.resumed} logs seen then, "
                         f"{len(result.logs) - result.resumed} new)"))
