@@ -489,6 +489,44 @@ def init(
     _Command("dynid init", quiet).run(prepare, compute, save, show)
 
 
+@app.command()
+def migrate(
+    config: Path = typer.Argument(..., help="An identify config (TOML) of an earlier release."),
+    out: Optional[Path] = typer.Option(None, help="Write the migrated config here (default: rewrite CONFIG in place)."),
+    quiet: bool = QUIET,
+) -> None:
+    """Rewrite an identify config of an earlier release for this one (renamed keys), keeping its comments and layout,
+    and name the settings it uses whose meaning changed."""
+    from ..io.migrate import migrate_text
+
+    target = out or config
+
+    def prepare():
+        if not config.is_file():
+            raise DynIdError(f"{config}: no such config")
+        if out is not None and not out.parent.is_dir():
+            raise DynIdError(f"--out {out}: its folder does not exist")
+        return config.read_text(encoding="utf-8")
+
+    def compute(text, progress):
+        return migrate_text(text, str(config))
+
+    def save(migrated):
+        from ..io.files import atomic_write_text
+
+        if migrated[0] == config.read_text(encoding="utf-8") and out is None:
+            return []
+        atomic_write_text(target, migrated[0])
+        return [target]
+
+    def show(rep, migrated, paths):
+        for change in migrated[1]:
+            rep.line(f"{config}: {change}")
+        rep.line(f"wrote {target}" if paths else f"{config}: nothing to rewrite")
+
+    _Command("dynid migrate", quiet).run(prepare, compute, save, show)
+
+
 def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", example: str = "0.02,0.05,0.1"):
     try:
         return tuple(float(x) for x in text.split(","))

@@ -242,12 +242,12 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     """
     for (section, key), why in REMOVED.items():
         if isinstance(doc.get(section), dict) and key in doc[section]:
-            raise ConfigError(f"{path}: {section}.{key}: {why}")
+            raise ConfigError(f"{path}: {section}.{key}: {why} (dynid migrate {path} rewrites it)")
     est = doc.get("estimation")
     old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
     if old and isinstance(est, dict):
         raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
-                          f"estimators = {_estimators_from_old(est)}")
+                          f"estimators = {_estimators_from_old(est)} (dynid migrate {path} rewrites it)")
     # the robot table is checked by the description's own parser (its drive terms are those registered now)
     typed = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, IdentificationDocument, str(path))
     here = path.parent
