@@ -127,3 +127,11 @@ def test_the_readme_and_docs_link_to_files_that_exist():
             if not (page.parent / path).exists():
                 broken.append(f"{page.relative_to(root)} -> {target}")
     assert broken == []
+
+
+def test_the_docs_site_opened_from_disk_navigates():
+    """The README says to open .site/index.html: with directory URLs every nav link showed a folder listing."""
+    import re as _re
+
+    text = (DOCS.parent / "mkdocs.yml").read_text()
+    assert _re.search(r"^use_directory_urls:\s*false\b", text, flags=_re.M)

@@ -4,6 +4,7 @@ import json
 import os
 import sys
 
+import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
@@ -198,3 +199,28 @@ def test_an_unused_figure_process_leaves_with_the_block(tmp_path, forks):
             raise ValueError("the computation failed")  # no figures sent
     with pytest.raises(ChildProcessError):
         os.waitpid(pid, os.WNOHANG)
+
+
+def test_the_report_holds_every_finding_and_warning_the_terminal_printed(tmp_path):
+    """The verdict said "see the warnings" and the report had no findings: now a section the table of contents links
+    to holds each finding, each warning (a dead torque channel here) and each log's flags."""
+    import html as html_lib
+
+    from ..cli.refusals import dynid
+    from ..simulated_logs import simulated_case
+
+    cfg, robot = simulated_case(tmp_path, "er16", 250.0, "fourier", seed=2, duration=20.0)
+    data = np.loadtxt(tmp_path / "valid.csv", delimiter=",")
+    data[:, 1 + robot.n_dof + 3] = 0.0  # J4's channel dead in the validation log
+    np.savetxt(tmp_path / "valid.csv", data, delimiter=",", fmt="%.10g")
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    page = html_lib.unescape((tmp_path / "out" / "report.html").read_text())
+    section = page[page.index('id="warnings"'):]
+    assert results["findings"] and results["warnings"]
+    for f in results["findings"]:
+        assert f"finding: {f['text']}" in section
+    for w in results["warnings"] + [x for v in results["validation"] for x in v.get("flags", [])]:
+        assert w in section
+    assert 'href="#warnings">Findings and warnings' in page and "see Findings and warnings below" in page

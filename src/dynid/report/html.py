@@ -186,7 +186,8 @@ def _identify_summary(d: dict) -> list[str]:
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")
     findings = d.get("findings") or []
-    out.append(f"{len(findings)} finding(s) on the model: see the warnings." if findings else "No finding on the model.")
+    out.append(f"{len(findings)} finding(s) on the model: see Findings and warnings below." if findings else
+               "No finding on the model.")
     return out
 
 
@@ -343,8 +344,29 @@ def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], ti
         title=title, versions={"dynid": __version__, "numpy": numpy.__version__, "pinocchio": pinocchio.__version__},
         written=datetime.datetime.now().isoformat(timespec="seconds"), settings={k: _human(v) for k, v in settings.items()},
         sections=sections,
-        figures=figs, warnings=data.get("warnings", []))
+        figures=figs, warnings=said(data))
     atomic_write_text(path, html)
+
+
+def said(data: dict) -> list[str]:
+    """Everything the terminal said of a run beside its tables: the verdict's findings, the warnings, the flags of each
+    log (a joint whose figure means nothing there), in that order.
+
+    Parameters
+    ----------
+    data : dict
+        A command's results dictionary (results.json).
+
+    Returns
+    -------
+    list of str
+    """
+    out = [f"finding: {f['text']}" for f in data.get("findings") or [] if isinstance(f, dict) and f.get("text")]
+    out += [str(w) for w in data.get("warnings") or []]
+    for c in ([data["identification"]] if isinstance(data.get("identification"), dict) else []) + \
+            [v for v in data.get("validation") or [] if isinstance(v, dict)]:
+        out += [str(f) for f in c.get("flags") or []]
+    return list(dict.fromkeys(out))
 
 
 CAPTIONS = {"identification_fit": "Measured and predicted torques on the identification log",
