@@ -49,7 +49,7 @@ def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     assert np.array_equal(model.params("pooled"), [pooled[n] for n in model.base.names])
     assert model.main != "pooled" and not np.allclose(model.params("pooled"), model.params())
     q = np.zeros((3, model.robot.n_dof)) + 0.3  # and predicts with it
-    assert not np.allclose(model.predict(q, q, q, estimate="pooled"), model.predict(q, q, q))
+    assert not np.allclose(model.predict_states(q, q, q, estimate="pooled"), model.predict_states(q, q, q))
     assert "r03" in (out / "fleet.html").read_text()
 
 

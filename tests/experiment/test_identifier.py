@@ -43,18 +43,22 @@ def test_predict_matches_pinocchio_inverse_dynamics(er16, fitted):
     rigid = dynid.rnea_torques(robot, q, dq, ddq, drive=np.zeros_like(robot.drive))  # Pinocchio's RNEA, no drive terms
     truth = rigid + fc * np.sign(dq) + fv * dq
     for estimate in ("wls", "sdp"):
-        predicted = fitted.predict(q, dq, ddq, estimate=estimate)
+        with pytest.warns(UserWarning, match="mostly noise"):  # random states: their accelerations are white noise
+            predicted = fitted.predict_states(q, dq, ddq, estimate=estimate)
         rms = np.sqrt(np.mean((predicted - truth) ** 2, axis=0))
         assert np.all(rms < 0.01 * np.sqrt(np.mean(truth**2, axis=0))), (estimate, rms)
 
 
+@pytest.mark.filterwarnings("ignore:predict_states. the accelerations:UserWarning")  # random states: white noise
 def test_score_on_another_log_and_on_arrays(er16, fitted):
     robot, _, other = er16
     assert 0.99 < fitted.score(other) <= 1.0
     q, dq, ddq = (np.random.default_rng(4).uniform(-1, 1, (30, robot.n_dof)) for _ in range(3))
     tau = dynid.regressor(robot, q, dq, ddq) @ robot.standard_parameters()
-    assert fitted.score(q, dq, ddq, tau) > 0.99
-    assert fitted.score(q, dq, ddq, tau + 100.0 * np.random.default_rng(5).normal(size=tau.shape)) < 0.5
+    with pytest.warns(FutureWarning, match="score\\(q, dq, ddq, tau\\) scores states of one's own"):
+        assert fitted.score(q, dq, ddq, tau) > 0.99
+    with pytest.warns(FutureWarning):
+        assert fitted.score(q, dq, ddq, tau + 100.0 * np.random.default_rng(5).normal(size=tau.shape)) < 0.5
 
 
 def test_save_and_load_back_give_the_same_model(tmp_path, er16, fitted):
@@ -66,7 +70,8 @@ def test_save_and_load_back_give_the_same_model(tmp_path, er16, fitted):
         np.testing.assert_array_equal(model.params(label), beta)
     np.testing.assert_array_equal(model.parameters("wls").std, fitted.parameters("wls").std)
     q, dq, ddq = (np.random.default_rng(6).uniform(-1, 1, (10, robot.n_dof)) for _ in range(3))
-    np.testing.assert_array_equal(model.predict(q, dq, ddq), fitted.predict(q, dq, ddq))
+    with pytest.warns(UserWarning, match="mostly noise"):
+        np.testing.assert_array_equal(model.predict_states(q, dq, ddq), fitted.predict_states(q, dq, ddq))
     assert model.score(other) == pytest.approx(fitted.score(other), rel=1e-12)
     assert model.urdf() == fitted.model_.urdf() and "<robot name=\"er16\">" in model.urdf()
     assert json.loads(path.read_text())["kind"] == "identify"
@@ -93,7 +98,7 @@ def test_get_and_set_params_follow_scikit_learns_contract():
     with pytest.raises(ValueError, match="no parameter 'alpha'"):
         ident.set_params(alpha=1)
     with pytest.raises(AttributeError, match="not fitted yet"):
-        ident.predict(np.zeros((1, 6)), np.zeros((1, 6)), np.zeros((1, 6)))
+        ident.predict_states(np.zeros((1, 6)), np.zeros((1, 6)), np.zeros((1, 6)))
     with pytest.raises(ConfigError, match="robot's description is needed"):
         dynid.Identifier().fit(np.arange(10.0), np.zeros((10, 6)), np.zeros((10, 6)))
     with pytest.raises(ConfigError, match="unknown estimator|expected a comma-separated subset"):
@@ -119,3 +124,36 @@ def test_jittered_time_stamps_are_resampled_as_the_readers_do(er16):
     assert any("interpolated onto a uniform grid at 249.99" in w for w in jittered.warnings)  # 1 / median step, as read from a CSV
     # 20 µs of jitter at 250 Hz moves samples by 0.5 % of a step: the estimate moves far less than its σ
     assert np.all(np.abs(jittered.solution.params - exact.solution.params) < 0.5 * exact.solution.params_std + 1e-9)
+
+
+def test_predict_and_score_take_a_raw_log_as_fit_does(er16, fitted):
+    """predict(t, q) and score(t, q, tau) prepare a raw log as fit(t, q, tau) prepared its own (issue "A user's first
+    hour", item 1): on another simulated log, the prediction is within the torques' own noise of what was measured,
+    where states differentiated by hand (np.gradient twice) gave R² = -37 and a warning now says why; score(t, q, tau)
+    is score(recording) on the very samples dynid validate scores; the earlier predict(q, dq, ddq) is predict_states,
+    with a FutureWarning."""
+    from dynid.simulation.measurements import NoiseModel
+    from dynid.validation.noise_floor import torque_noise
+
+    robot, _, _ = er16  # another log at 1 kHz with 16-bit encoders: differences of its positions are mostly noise
+    other = dynid.simulated_log(robot, seconds=10, rate=1000.0, seed=2,
+                                noise=NoiseModel(encoder_resolution=2 * np.pi / 2**16))
+    t, q, tau = other.t, np.asarray(other.q), np.asarray(other.tau)
+    predicted = fitted.predict(t, q)
+    assert predicted.shape == q.shape
+    inside = np.all(np.isfinite(predicted), axis=1)
+    assert inside.mean() >= 0.8  # NaN only where the filters' settling leaves the ends out (a tenth at most at each end)
+    rmse = np.sqrt(np.mean((predicted[inside] - tau[inside]) ** 2, axis=0))
+    noise = torque_noise(tau)
+    rms = np.sqrt(np.mean(tau**2, axis=0))
+    assert np.all(rmse < 3 * noise + 0.01 * rms), (rmse, noise)
+    dq = np.gradient(q, t, axis=0)
+    with pytest.warns(UserWarning, match="mostly noise"):
+        by_hand = fitted.predict_states(q, dq, np.gradient(dq, t, axis=0))
+    assert np.sqrt(np.mean((by_hand - tau) ** 2)) > 10 * np.sqrt(np.mean((predicted[inside] - tau[inside]) ** 2))
+    # (the same samples; the rate from the time stamps is 1000.0000000001 Hz where the recording holds 1000 exactly)
+    assert fitted.score(t, q, tau) == pytest.approx(fitted.score(other), rel=1e-7)
+    assert fitted.model_.score(t, q, tau) == pytest.approx(fitted.score(other), rel=1e-7)
+    with pytest.warns(FutureWarning, match="predict\\(q, dq, ddq\\) is predict_states"):
+        old = fitted.predict(q[:20], q[:20] * 0, q[:20] * 0)
+    np.testing.assert_array_equal(old, fitted.predict_states(q[:20], q[:20] * 0, q[:20] * 0))

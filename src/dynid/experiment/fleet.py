@@ -171,7 +171,7 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
 
 def add_pooled_estimates(out: str | Path, units: tuple[UnitSummary, ...], pooled) -> list[Path]:
     """Write each unit's pooled estimate into its results.json (``out/units/<id>``) as one more estimate, ``"pooled"``,
-    beside the unit's own: ``dynid.load_results(...).predict(q, dq, ddq, estimate="pooled")`` uses it.
+    beside the unit's own: ``dynid.load_results(...).predict_states(q, dq, ddq, estimate="pooled")`` uses it.
 
     Parameters
     ----------

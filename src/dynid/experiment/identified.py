@@ -228,40 +228,113 @@ class IdentifiedModel:
         return Parameters(self.base.names, self.params(label), self.std.get(label),
                           [e.split(" = ", 1)[1] for e in self.base.expressions])
 
-    def predict(self, q, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
-        """Joint torques of the model along a motion (inverse dynamics with friction: ``Y(q, q̇, q̈)·β``).
+    def predict(self, t, q=None, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
+        """Joint torques of the model along a logged motion, its positions prepared as the identification log's were
+        (the fitted filters and derivatives): symmetric with ``Identifier.fit(t, q, tau)``.
+
+        ``predict(t, q)`` takes a raw log's time stamps and positions (and measured velocities ``dq`` if the fit had
+        them); ``predict(recording)`` a log read with :func:`dynid.load_recording`. For states one has computed oneself,
+        :meth:`predict_states` (``predict(q, dq, ddq)``, the earlier form, still does that, with a FutureWarning).
 
         Parameters
         ----------
-        q : (N, n_dof) array [rad], or a recording
-            Joint positions; or a log (:class:`dynid.io.datasets.Recording`, e.g. from
-            :func:`dynid.io.datasets.load_recording`), prepared as the identification log was
-            (:meth:`predict_log`).
-        dq, ddq : (N, n_dof) arrays [rad/s, rad/s²]
-            Velocities and accelerations (required with positions).
+        t : (N,) array [s], or a recording
+            Time stamps of the log.
+        q : (N, n_dof) array [rad]
+            Its joint positions, as measured.
+        dq : (N, n_dof) array [rad/s], optional
+            Its measured velocities.
+        ddq : None
+            Only in the earlier state form.
         estimate : str, optional
             Label of the estimate (default the main one).
 
         Returns
         -------
         (N, n_dof) array [N·m]
-            The Coulomb-like terms take the sign of ``dq`` (a log's state at rest: :meth:`predict_log`).
+            At the given time stamps; NaN at the few samples at each end that the filters' settling leaves out.
 
         Raises
         ------
         ShapeError
             Arrays not (N, n_dof), or holding NaN.
-        ValueError
-            Positions without velocities and accelerations.
+        DataError
+            Time stamps that do not increase, or a gap in them.
         """
-        if hasattr(q, "tau") and hasattr(q, "rate"):
-            return self.predict_log(q, estimate)[1]
-        if dq is None or ddq is None:
-            raise ValueError("predict(q, dq, ddq): velocities and accelerations are needed with positions (or give a log)")
-        from ..dynamics.regressor import regressor
+        if hasattr(t, "tau") and hasattr(t, "rate"):
+            return self.predict_log(t, estimate)[1]
+        if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
+            import warnings
 
+            warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
+                          "fit did", FutureWarning, stacklevel=2)
+            return self.predict_states(t, q, dq, estimate)
+        if q is None:
+            raise ValueError("predict(t, q): the positions are needed with the time stamps (or give a log)")
+        from ..dynamics.regressor import regressor
+        from ..preprocessing.pipeline import prepare
+        from ..preprocessing.prepared import rest_velocities
+        from .identification_run import recording_from_arrays
+
+        q = np.asarray(q, dtype=float)
+        times = np.asarray(t, dtype=float).reshape(-1)
+        recording = recording_from_arrays(self.robot, times, q, np.zeros_like(q), dq, name="predict")
+        data = prepare(recording, self._settings(), strict=False)
+        v = rest_velocities(data, self.robot)
+        if data.direction is not None:
+            v = replace(v, direction=np.asarray(data.direction))
+        y = regressor(self.robot, np.asarray(data.q), np.asarray(data.dq), np.asarray(data.ddq), self.base.independent, v)
+        pred = y @ self.params(estimate)
+        at = times - times[0]
+        return np.column_stack([np.interp(at, data.t, pred[:, j], left=np.nan, right=np.nan)
+                                for j in range(pred.shape[1])])
+
+    def predict_states(self, q, dq, ddq, estimate: str | None = None) -> np.ndarray:
+        """Joint torques of the model at given states (inverse dynamics with friction: ``Y(q, q̇, q̈)·β``), as they are.
+
+        The accelerations are the caller's: a second difference of measured positions is mostly noise, and a warning
+        says so when the given ones look like that (their high-frequency part against their spread; the MAD estimate of
+        :mod:`dynid.validation.noise_floor`); :meth:`predict` prepares a raw log as the fit did.
+
+        Parameters
+        ----------
+        q, dq, ddq : (N, n_dof) arrays [rad, rad/s, rad/s²]
+        estimate : str, optional
+
+        Returns
+        -------
+        (N, n_dof) array [N·m]
+            The Coulomb-like terms take the sign of ``dq``.
+
+        Raises
+        ------
+        ShapeError
+            Arrays not (N, n_dof), or holding NaN.
+        """
+        from ..dynamics.regressor import regressor
+        from ..validation.noise_floor import torque_noise
+
+        acc = np.asarray(ddq, dtype=float)
+        if acc.ndim == 2 and acc.shape[0] >= 10:
+            noise, spread = torque_noise(acc), acc.std(axis=0)
+            noisy = [j for j in range(acc.shape[1]) if spread[j] > 0 and noise[j] > 0.3 * spread[j]]
+            if noisy:
+                import warnings
+
+                warnings.warn(f"predict_states: the accelerations of {', '.join(f'J{j + 1}' for j in noisy)} are mostly "
+                              f"noise (its level {max(noise[j] / spread[j] for j in noisy):.0%} of their spread): "
+                              "differentiate filtered positions, or give the raw log to predict(t, q)", UserWarning,
+                              stacklevel=2)
         y = regressor(self.robot, q, dq, ddq, self.base.independent)
         return y @ self.params(estimate)
+
+    def _settings(self):
+        """The preprocessing a log other than the identification one gets (:meth:`validate`)."""
+        from ..preprocessing.strategies import carried_over
+
+        # the resolved settings stand for the config's here: the decimation (derived, not known to be given) follows
+        # this log's own band
+        return carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
 
     def predict_log(self, recording, estimate: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Measured and predicted torques of a log, prepared as the identification log was (its filters, carried
@@ -296,29 +369,41 @@ class IdentifiedModel:
         dynid.validation.torques.TorqueComparison
         """
         from ..preprocessing.pipeline import prepare
-        from ..preprocessing.strategies import carried_over
         from ..validation.torques import compare_torques
 
-        # the resolved settings stand for the config's here: the decimation (derived, not known to be given) follows
-        # this log's own band
-        settings = carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
-        data = prepare(recording, settings, strict=False)
+        data = prepare(recording, self._settings(), strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
         return compare_torques(self.robot, self.base, data, sets)
 
-    def score(self, recording, estimate: str | None = None) -> float:
+    def score(self, t, q=None, tau=None, estimate: str | None = None) -> float:
         """Coefficient of determination R² of the predicted torques of a log, over its joints and samples (1 is a
-        perfect prediction; scikit-learn's ``score``).
+        perfect prediction; scikit-learn's ``score``), on the samples ``dynid validate`` scores: the log prepared as the
+        identification log was.
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        t : (N,) array [s], or a recording
+            A raw log's time stamps, or a log read with :func:`dynid.load_recording`.
+        q, tau : (N, n_dof) arrays [rad, N·m]
+            Its positions and measured torques (with time stamps).
         estimate : str, optional
 
         Returns
         -------
         float
+
+        Raises
+        ------
+        ValueError
+            Time stamps without positions and torques.
         """
+        recording = t
+        if not (hasattr(t, "tau") and hasattr(t, "rate")):
+            if q is None or tau is None:
+                raise ValueError("score(t, q, tau): positions and measured torques are needed with the time stamps")
+            from .identification_run import recording_from_arrays
+
+            recording = recording_from_arrays(self.robot, t, q, tau, name="score")
         _, pred, meas = self.predict_log(recording, estimate)
         res = meas - pred
         return 1.0 - float(np.sum(res**2)) / float(np.sum((meas - meas.mean(axis=0)) ** 2))

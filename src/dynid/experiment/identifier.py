@@ -4,7 +4,7 @@ config, ``predict`` torques, ``score``, the parameters by name with σ, ``get_pa
 Example::
 
     ident = dynid.Identifier("ur10e", estimators=["wls", "sdp"]).fit(t, q, tau)
-    tau_hat = ident.predict(q, dq, ddq)
+    tau_hat = ident.predict(t2, q2)          # another raw log, prepared as the fit prepared its own
     print(ident.parameters_)                 # name, value, σ, unit
     ident.save("results.json"); model = dynid.load_results("results.json")
 """
@@ -222,13 +222,19 @@ class Identifier:
         """
         return self._model().parameters(estimate)
 
-    def predict(self, q, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
-        """Joint torques of the identified model (:meth:`dynid.experiment.identified.IdentifiedModel.predict`).
+    def predict(self, t, q=None, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
+        """Joint torques of the identified model along a raw log, prepared as the fit prepared its own
+        (:meth:`dynid.experiment.identified.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
+        ``fit(t, q, tau)``; ``predict(recording)``; states of one's own: :meth:`predict_states`.
 
         Parameters
         ----------
-        q : (N, n_dof) array [rad], or a recording
-        dq, ddq : (N, n_dof) arrays [rad/s, rad/s²]
+        t : (N,) array [s], or a recording
+        q : (N, n_dof) array [rad]
+        dq : (N, n_dof) array [rad/s], optional
+            Measured velocities.
+        ddq : None
+            Only in the earlier state form ``predict(q, dq, ddq)`` (a FutureWarning).
         estimate : str, optional
             Label of the estimate (default the main one).
 
@@ -236,21 +242,42 @@ class Identifier:
         -------
         (N, n_dof) array [N·m]
         """
-        return self._model().predict(q, dq, ddq, estimate)
+        if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
+            import warnings
 
-    def score(self, q, dq=None, ddq=None, tau=None, estimate: str | None = None) -> float:
-        """R² of the predicted torques.
+            warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
+                          "fit did", FutureWarning, stacklevel=2)
+            return self._model().predict_states(t, q, dq, estimate)
+        return self._model().predict(t, q, dq, ddq, estimate)
 
-        On a motion and its measured torques ``score(q, dq, ddq, tau)``, or on a log ``score(recording)`` (prepared as the
-        identification log was).
+    def predict_states(self, q, dq, ddq, estimate: str | None = None) -> np.ndarray:
+        """Joint torques at states one computed oneself (:meth:`dynid.experiment.identified.IdentifiedModel.predict_states`).
 
         Parameters
         ----------
-        q : (N, n_dof) array [rad] or Recording
-        dq, ddq : (N, n_dof) arrays, optional
-            [rad/s], [rad/s²]; not with a recording.
-        tau : (N, n_dof) array [N·m], optional
-            Measured torques; not with a recording.
+        q, dq, ddq : (N, n_dof) arrays [rad, rad/s, rad/s²]
+        estimate : str, optional
+
+        Returns
+        -------
+        (N, n_dof) array [N·m]
+        """
+        return self._model().predict_states(q, dq, ddq, estimate)
+
+    def score(self, t, q=None, tau=None, *args, estimate: str | None = None) -> float:
+        """R² of the predicted torques of a raw log (``score(t, q, tau)``, symmetric with ``fit``) or of a recording
+        (``score(recording)``), on the samples ``dynid validate`` scores
+        (:meth:`dynid.experiment.identified.IdentifiedModel.score`).
+
+        The earlier form ``score(q, dq, ddq, tau)`` on states of one's own still works, with a FutureWarning.
+
+        Parameters
+        ----------
+        t : (N,) array [s], or a recording
+        q : (N, n_dof) array [rad]
+        tau : (N, n_dof) array [N·m]
+        *args
+            The earlier form's torques.
         estimate : str, optional
             Label or key (default the main estimate).
 
@@ -259,13 +286,15 @@ class Identifier:
         float
             1 is a perfect prediction.
         """
-        if hasattr(q, "tau") and hasattr(q, "rate"):
-            return self._model().score(q, estimate)
-        if tau is None:
-            raise ValueError("score(q, dq, ddq, tau): the measured torques are needed (or give a log)")
-        pred = self.predict(q, dq, ddq, estimate)
-        tau = np.asarray(tau, dtype=float)
-        return 1.0 - float(np.sum((tau - pred) ** 2)) / float(np.sum((tau - tau.mean(axis=0)) ** 2))
+        if np.ndim(t) == 2 and args:  # the earlier score(q, dq, ddq, tau)
+            import warnings
+
+            warnings.warn("score(q, dq, ddq, tau) scores states of one's own: score(t, q, tau) prepares a raw log as the "
+                          "fit did", FutureWarning, stacklevel=2)
+            measured = np.asarray(args[0], dtype=float)
+            pred = self._model().predict_states(t, q, tau, estimate)
+            return 1.0 - float(np.sum((measured - pred) ** 2)) / float(np.sum((measured - measured.mean(axis=0)) ** 2))
+        return self._model().score(t, q, tau, estimate)
 
     def save(self, path: str | Path) -> Path:
         """Write the identification's results.json (read back by :func:`dynid.load_results`).
