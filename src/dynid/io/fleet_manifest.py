@@ -169,7 +169,7 @@ def load_fleet_manifest(path: str | Path, data_root: str | Path | None = None) -
         except ConfigError as exc:
             text = str(exc)
             raise ConfigError(text if text.startswith(where) else f"{where}: {text}") from None
-        com = None if u.payload_com is None else tuple(float(x) for x in u.payload_com)
+        com = None if u.payload_com is None else (float(u.payload_com[0]), float(u.payload_com[1]), float(u.payload_com[2]))
         if com is not None and (not np.all(np.isfinite(com)) or max(abs(x) for x in com) > 10):
             raise ConfigError(f"{where}.payload_com: expected a centre of mass within 10 m of the last link's origin, got "
                               f"{list(com)}")

@@ -210,12 +210,12 @@ class TorqueComparison:
         """
         out = []
         first = next(iter(self.metrics().values()), None)
-        share = self.rest_share
-        still = [] if share is None or self.band is None else [int(j) for j in np.flatnonzero(np.asarray(share) >= 0.95)]
-        if still:
+        share, band = self.rest_share, self.band
+        still = [] if share is None or band is None else [int(j) for j in np.flatnonzero(np.asarray(share) >= 0.95)]
+        if still and share is not None and band is not None:
             which = "every joint" if len(still) == len(share) else ", ".join(f"J{j + 1}" for j in still)
             out.append(f"{self.name}: {which} at rest in 95 % of the log or more: the error there is the distance to the "
-                       "static-friction band (±f_s, " + ", ".join(f"{float(self.band[j]):.3g}" for j in still) + " N·m), "
+                       "static-friction band (±f_s, " + ", ".join(f"{float(band[j]):.3g}" for j in still) + " N·m), "
                        "which says whether a model is consistent with the torque that holds the arm, not how it "
                        "predicts motion")
         for j in np.flatnonzero(~self.meaningful()):
