@@ -122,7 +122,10 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     sections = [Section("In short", [], _identify_summary(d))] if "identification" in d or "validation" in d else []
     if "base_parameters" in d:
         refs = d.get("references", [])
-        rows = [[p["name"], p["unit"], _fmt(p["value"]), _fmt(p["std"], ".2g"), _fmt(p["relative_std_percent"], ".3g"),
+        kept = set((d.get("diagnostics") or {}).get("from_prior") or [])  # directions the log did not determine: the prior's
+        rows = [[p["name"], p["unit"], _fmt(p["value"]),
+                 "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
+                 "—" if p["name"] in kept else _fmt(p["relative_std_percent"], ".3g"),
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
         flagged = {(i, 4) for i, p in enumerate(d["base_parameters"])
                    if p.get("relative_std_percent") is not None and p["relative_std_percent"] >= BAD_RELATIVE_STD}

@@ -153,7 +153,9 @@ def identification_blocks(result) -> list:
     from ..estimators.registry import OTHER_LABELS
 
     closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS]  # IDIM-IV, DIDIM: beside least squares
-    rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", f"{sol.params_std[i]:.2g}", f"{sol.relative_std[i]:.1f}",
+    kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
+    rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
+                  "—" if i in kept else f"{sol.relative_std[i]:.1f}",
                   *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
                  for i, n in enumerate(base.names))
     out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; "
