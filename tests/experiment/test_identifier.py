@@ -157,3 +157,23 @@ def test_predict_and_score_take_a_raw_log_as_fit_does(er16, fitted):
     with pytest.warns(FutureWarning, match="predict\\(q, dq, ddq\\) is predict_states"):
         old = fitted.predict(q[:20], q[:20] * 0, q[:20] * 0)
     np.testing.assert_array_equal(old, fitted.predict_states(q[:20], q[:20] * 0, q[:20] * 0))
+
+
+def test_load_recording_takes_a_logs_path_and_load_results_a_folder(tmp_path, fitted):
+    """dynid.load_recording("log.csv", robot) raised a raw AttributeError: a path is read with the columns dynid init
+    finds, anything else refused in one line; load_results takes the folder dynid identify wrote."""
+    robot = dynid.load_robot("er16")
+    t = np.arange(500) / 100.0
+    q, tau = np.sin(np.outer(t, np.arange(1, 7))), np.cos(np.outer(t, np.arange(1, 7)))
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, q, tau]), delimiter=",", header=",".join(names), comments="")
+    rec = dynid.load_recording(tmp_path / "log.csv", robot)
+    np.testing.assert_allclose(np.asarray(rec.q), q, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(rec.tau), tau, atol=1e-12)
+    with pytest.raises(TypeError, match="load_recording: expected a log's path or a DatasetSpec .*, got int"):
+        dynid.load_recording(42, robot)
+    with pytest.raises(DataError, match="nothere.csv: no such log"):
+        dynid.load_recording(tmp_path / "nothere.csv", robot)
+    (tmp_path / "out").mkdir()
+    fitted.save(tmp_path / "out" / "results.json")
+    assert dynid.load_results(tmp_path / "out").main == fitted.result_.main

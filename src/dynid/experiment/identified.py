@@ -542,7 +542,7 @@ def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> I
     Parameters
     ----------
     path : path
-        results.json.
+        results.json, or the folder dynid identify wrote it into.
     robot : Robot, built-in name or description path, optional
         The robot's description; default: the one the results name (``settings.robot_source``: a built-in name, a
         description or URDF file, or the config that held it).
@@ -559,6 +559,8 @@ def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> I
     from ..io.results import read_results
 
     path = Path(path)
+    if path.is_dir() and (path / "results.json").is_file():  # the output folder of dynid identify
+        path = path / "results.json"
     results = read_results(path)
     model_robot = _robot(robot, results, path)
     if isinstance(results.get("robot"), str) and results["robot"] != model_robot.name:

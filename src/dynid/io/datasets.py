@@ -303,6 +303,18 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
                             f"{b - a} samples (t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? select rows or a time_range without them")
 
 
+def _detected(log: Path, robot: Robot) -> DatasetSpec:
+    """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.starter.starter_config`)."""
+    import tomllib
+
+    from .starter import starter_config
+
+    if not log.is_file():
+        raise DataError(f"{log}: no such log")
+    text, _ = starter_config(Path("robot.urdf"), log, robot.n_dof, log.parent / "detected.toml")
+    return dataset_spec(tomllib.loads(text)["identification"], log.parent, str(log), log.stem, robot.n_dof)
+
+
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring; its structure:
     :class:`dynid.io.config_types.DatasetTable`); paths are relative to ``base``.
@@ -432,7 +444,7 @@ def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
                                    t.effort or "torques"))
 
 
-def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -> Recording:
+def load_recording(spec: "DatasetSpec | str | Path", robot: Robot, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
@@ -442,7 +454,9 @@ def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -
 
     Parameters
     ----------
-    spec : DatasetSpec
+    spec : DatasetSpec, or a log's path
+        A dataset of a config; or a CSV log whose columns are found as ``dynid init`` finds them (a header naming
+        time, positions and torques or currents).
     robot : Robot
     spool : bool, optional
         Hold the signals in temporary files (:mod:`dynid.column_store`) rather than in memory; by default when the
@@ -457,8 +471,15 @@ def load_recording(spec: DatasetSpec, robot: Robot, spool: bool | None = None) -
     ------
     DataError
         Unreadable or damaged files, non-increasing time stamps (names file and line), files of different lengths,
-        implausible values.
+        implausible values, a log whose columns cannot be told.
+    TypeError
+        Neither a dataset nor a path (one line saying what was given).
     """
+    if isinstance(spec, (str, Path)):
+        spec = _detected(Path(spec), robot)
+    elif not isinstance(spec, DatasetSpec):
+        raise TypeError(f"load_recording: expected a log's path or a DatasetSpec (a config's dataset), got "
+                        f"{type(spec).__name__}")
     warnings: list[str] = []
     if spec.bag is not None:
         from .bags import read_joint_states
