@@ -458,6 +458,7 @@ def excite(
 def init(
     urdf: Path = typer.Argument(..., help="The robot's URDF."),
     log: Path = typer.Argument(..., help="A CSV log of the robot moving: time, joint angles, joint torques or currents."),
+    validation: Optional[list[Path]] = typer.Argument(None, help="Other logs of the same layout, to validate on."),
     out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
     force: bool = typer.Option(False, help="Overwrite --out if it exists."),
     quiet: bool = QUIET,
@@ -473,7 +474,10 @@ def init(
         return load_robot(urdf)
 
     def compute(robot, progress):
-        return starter_config(urdf, log, robot.n_dof, out)
+        for v in validation or ():
+            if not v.is_file():
+                raise DynIdError(f"{v}: no such validation log")
+        return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()))
 
     def save(written):
         from ..io.files import atomic_write_text

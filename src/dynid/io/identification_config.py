@@ -240,6 +240,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     ConfigError
         As :func:`load_identification_config`.
     """
+    doc = with_inherited_layout(doc)
     for (section, key), why in REMOVED.items():
         if isinstance(doc.get(section), dict) and key in doc[section]:
             raise ConfigError(f"{path}: {section}.{key}: {why} (dynid migrate {path} rewrites it)")
@@ -369,6 +370,41 @@ def _check_reference_names(refs: list, path: Path) -> None:
             raise ConfigError(f"{path}: references[{i}].name: {name!r} names two reference sets (references[{seen[name]}] "
                               "too); give each its own name")
         seen[name] = i
+
+
+LAYOUT_KEYS = ("preset", "header", "n_columns", "delimiter", "gaps", "max_gap", "held", "time", "rate", "resample", "side",
+               "positions", "velocities", "currents", "torques")
+"""The keys of a dataset table that say how its file is laid out (the rest say which file and which part of it)."""
+
+
+def with_inherited_layout(doc: dict) -> dict:
+    """The config with each ``[[validation]]`` table that states no signals of its own (no ``positions``, ``torques``,
+    ``currents``, ``preset`` or ``bag``) given the identification's column layout (:data:`LAYOUT_KEYS`); its own keys
+    (``file``, ``rows``, ``time_range``, ``name``...) stay. The identification's signals must then read its default
+    ``file`` (none of them naming a file of its own).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed config.
+
+    Returns
+    -------
+    dict
+        A new document (``doc`` is not modified).
+    """
+    ident = doc.get("identification")
+    validation = doc.get("validation")
+    if not isinstance(ident, dict) or not isinstance(validation, list):
+        return doc
+    own_files = any(isinstance(ident.get(k), dict) and "file" in ident[k] for k in ("time", "positions", "velocities",
+                                                                                     "currents", "torques"))
+    layout = {k: ident[k] for k in LAYOUT_KEYS if k in ident}
+    merged = []
+    for v in validation:
+        states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "torques", "currents", "preset", "bag"))
+        merged.append(v if states_its_own or own_files or "bag" in ident else {**layout, **v})
+    return {**doc, "validation": merged}
 
 
 def _estimators_from_old(est: dict) -> str:

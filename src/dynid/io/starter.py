@@ -34,7 +34,7 @@ def _kind(name: str) -> str | None:
     return None
 
 
-def starter_config(urdf: Path, log: Path, n_dof: int, out: Path) -> tuple[str, list[str]]:
+def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = ()) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -47,6 +47,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path) -> tuple[str, l
         The robot's joints.
     out : Path
         Where the config will be: the URDF and the log's folder are written relative to its folder.
+    validation : tuple of Path
+        Other logs of the same layout: each a ``[[validation]]`` entry (it takes the identification's columns).
 
     Returns
     -------
@@ -130,10 +132,10 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path) -> tuple[str, l
         "[identification]",
         *table,
         "",
-        "# [[validation]]                  # other logs, same layout, to check the model where it was not fitted",
-        '# name = "second_run"',
-        '# file = "second_run.csv"',
-        "",
+        *([line for v in validation for line in ("[[validation]]                    # the identification's columns",
+                                                   f'name = "{v.stem}"', f'file = "{_relative(v, log.parent)}"', "")]
+          or ["# [[validation]]                  # other logs, same layout, to check the model where it was not fitted",
+              '# name = "second_run"', '# file = "second_run.csv"', ""]),
         "# [estimation]",
         '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
         "",
