@@ -68,7 +68,8 @@ def test_the_old_estimation_keys_say_how_to_write_them_now(tmp_path, old, new):
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', old))
     with pytest.raises(ConfigError) as err:
         load_identification_config(cfg)
-    assert "no longer exists" in str(err.value) and str(err.value).endswith(new) and "\n" not in str(err.value)
+    text = str(err.value)
+    assert "no longer exists" in text and f"{new} (dynid migrate {cfg} rewrites it)" in text and "\n" not in text
 
 
 def test_estimator_names_are_case_insensitive(tmp_path):
@@ -96,7 +97,8 @@ def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
 
 
 def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
-    """The first lines of dynid identify: the estimate to use, each log's error and worst joint, the next step."""
+    """The first lines of dynid identify: whether the model is ready and what to do (the first line), then the estimate
+    to use, each log's error and worst joint, the next step."""
     from dynid.report.summaries import identification_blocks
     from dynid.tables import render_text
 
@@ -105,10 +107,11 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     result = run_identification(load_identification_config(cfg))
     text = render_text(identification_blocks(result), 200)
     lines = text.splitlines()
-    assert lines[1].startswith("In short")  # right after the title
-    tail = lines[1:next(i for i, t in enumerate(lines) if t.startswith("next: ")) + 1]
+    assert lines[0].startswith(("model ready", "warning: not ready"))
+    assert lines[2].startswith("In short")  # right after the title
+    tail = lines[2:next(i for i, t in enumerate(lines) if t.startswith("next: ")) + 1]
     label = result.main_estimate.label
-    assert tail[1].startswith(f"use {label}, ") and "physically consistent" in tail[1]
+    assert tail[1].startswith(f"main estimate: {label}, ") and "physically consistent" in tail[1]
     main = result.fit.metrics()[label]
     assert tail[2].startswith(f"{result.fit.name}: torque error {main['global_relative_error']:.3g} % over all joints, worst J")
     assert len([t for t in tail if "torque error" in t]) == 1 + len(result.validations)
@@ -169,3 +172,27 @@ def test_validate_opens_with_each_logs_errors_and_the_best_set(tmp_path):
         assert line.startswith(f"{c.name}: torque error over all joints: ")
         assert all(f"{label} {v['global_relative_error']:.3g} %" in line for label, v in m.items())
         assert line.endswith(f"best: {min(m, key=lambda k: m[k]['global_relative_error'])}")
+
+
+def test_the_first_line_says_whether_the_model_is_ready(tmp_path):
+    """issue "A user's first hour", item 6: the first line is the verdict and the next step: ready with a physically
+    consistent estimate that beats the nominal model on the validation log; not ready, saying how to get there, with
+    least squares alone; the main-estimate line says which estimate export writes."""
+    from dynid.report.summaries import identification_brief
+    from dynid.tables import render_text
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    text = cfg.read_text()
+    cfg.write_text(text.replace('estimators = ["ols"]\n', 'estimators = ["wls"]\n'))
+    first = render_text(identification_brief(run_identification(load_identification_config(cfg))), 400).splitlines()[0]
+    assert first == 'warning: not ready to export: add "sdp" to [estimation] estimators for a physically consistent estimate'
+    cfg.write_text(text.replace('estimators = ["ols"]\n', 'estimators = ["wls", "sdp"]\n'))
+    result = run_identification(load_identification_config(cfg))
+    lines = render_text(identification_brief(result), 400).splitlines()
+    worse = [s["worse_joints"] for s in result.diagnostics["versus_nominal"].values()]
+    if any(worse):
+        assert lines[0].startswith("warning: not ready: the description's nominal model predicts")
+    else:
+        exported = next(n for n, e in result.estimates.items()  # what dynid export writes: standard values, consistent
+                        if e.standard is not None and result.consistency_verdicts[n].startswith("yes"))
+        assert lines[0] == f"model ready: export {exported} with dynid export CONFIG --urdf FILE --mjcf FILE"

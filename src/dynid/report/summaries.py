@@ -139,7 +139,7 @@ def identification_blocks(result) -> list:
 
     r = result
     sol, base = r.solution, r.base
-    out: list = [_identification_title(r)]
+    out: list = [readiness(r), _identification_title(r)]
     out.extend(in_short(r))  # how it went and what to do next, first; the details follow
     pre = r.settings.get("preprocessing", {})
     if pre.get("derivation"):
@@ -205,6 +205,50 @@ def _verdict(r) -> list:
             *(Line(f.text) for f in r.findings)]
 
 
+def _exportable(r) -> list[str]:
+    """The estimates ``dynid export`` can write: standard parameters that passed the consistency check (the SDP's)."""
+    return [n for n, e in r.estimates.items() if getattr(e, "standard", None) is not None
+            and str(r.consistency_verdicts.get(n, "")).startswith("yes")]
+
+
+def readiness(result) -> Line:
+    """The first line of ``dynid identify``: whether the model is ready to use, and the one thing to do next.
+
+    Ready: a physically consistent estimate (what ``dynid export`` writes), no torque running against the model, and
+    on the validation logs no joint the description's nominal model predicts better (the publish gate). Otherwise the
+    first reason, with what would help.
+
+    Parameters
+    ----------
+    result : dynid.experiment.identification.IdentificationResult
+
+    Returns
+    -------
+    Line
+    """
+    r = result
+    kinds = {f.kind for f in r.findings}
+    exportable = _exportable(r)
+    worse = {log: s.get("worse_joints", []) for log, s in (r.diagnostics.get("versus_nominal") or {}).items()}
+    worse = {log: j for log, j in worse.items() if j}
+    if "sign" in kinds:
+        return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
+                    "verdict at the end names it and the setting that fixes it", "warning")
+    if not exportable:
+        why = ('add "sdp" to [estimation] estimators for a physically consistent estimate' if "sdp" not in r.estimators
+               else "no estimate passed the consistency check (the verdict says why)")
+        return Line(f"not ready to export: {why}", "warning")
+    if worse:
+        log, joints = next(iter(worse.items()))
+        return Line(f"not ready: the description's nominal model predicts {', '.join(f'J{j}' for j in joints)} of {log} "
+                    f"better than dynid's estimate; identify on a log that excites them (dynid excite), or keep the "
+                    "nominal values there", "warning")
+    if not r.validations:
+        return Line(f"model ready to check: {exportable[0]} is physically consistent; add [[validation]] logs (other "
+                    "motions) before you export it with dynid export CONFIG --urdf FILE", "title")
+    return Line(f"model ready: export {exportable[0]} with dynid export CONFIG --urdf FILE --mjcf FILE", "title")
+
+
 def identification_brief(result) -> list:
     """What ``dynid identify`` prints without ``--verbose``: the title, how it went and what to do next
     (:func:`in_short`), the verdict's findings and the warnings; every table is in ``--verbose`` and the report.
@@ -221,7 +265,7 @@ def identification_brief(result) -> list:
     short = in_short(r)
     short[0] = Line("In short (every table: --verbose, and report.html)", "title")
     drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
-    return [_identification_title(r), *short, *drive, *_verdict(r), *(Line(w, "warning") for w in r.warnings)]
+    return [readiness(r), _identification_title(r), *short, *drive, *_verdict(r), *(Line(w, "warning") for w in r.warnings)]
 
 
 def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
@@ -326,9 +370,12 @@ def in_short(result) -> list:
     label = r.main_estimate.label
     verdict = r.consistency_verdicts.get(label, "")
     consistent = verdict.startswith("yes")
+    exportable = _exportable(r)
+    export = "" if not exportable or consistent else f"; dynid export writes {exportable[0]}, which is"
     out = [Line("In short (the details follow)", "title"),
-           Line(f"use {label}" + ("" if not verdict else
-                                  ", physically consistent" if consistent else ", not physically consistent"))]
+           Line(f"main estimate: {label}" + ("" if not verdict else
+                                             ", physically consistent" if consistent else
+                                             f", not physically consistent{export}"))]
     errors = {}
     for c in (r.fit, *r.validations):
         m = c.metrics().get(label)
@@ -356,7 +403,6 @@ def in_short(result) -> list:
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))
-    exportable = [name for name, v in r.consistency_verdicts.items() if name in r.estimates and v.startswith("yes")]
     if r.findings:
         step = "read the verdict's findings at the end: they say where the model misses the data"
     elif not r.validations:
