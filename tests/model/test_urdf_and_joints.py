@@ -95,3 +95,8 @@ def test_a_joint_axis_that_is_no_direction_is_refused_with_its_line(tmp_path, ax
     with pytest.raises(ConfigError, match=r"arm.urdf: line \d+: joint 'elbow_joint' has axis .*expected three numbers "
                                           "not all zero"):
         load_robot(_description(tmp_path, text))
+
+
+def test_a_non_finite_override_is_refused(tmp_path):
+    with pytest.raises(ConfigError, match=r"joints\[1\]\.com: expected finite numbers"):
+        load_robot(_description(tmp_path, _broken_urdf(), "mass = 28.0\ncom = [0.0, nan, 0.3]\ninertia = [1, 1, 1, 0, 0, 0]\n"))

@@ -370,6 +370,9 @@ def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarr
         mass = float(r.mass)
         if not np.isfinite(mass) or mass < 0:
             raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
+        for key in ("com", "inertia"):
+            if not np.all(np.isfinite(np.asarray(getattr(r, key), dtype=float))):
+                raise ConfigError(f"{w}.{key}: expected finite numbers, got {list(getattr(r, key))}")
         ixx, iyy, izz, ixy, ixz, iyz = r.inertia
         out[i] = inertial_from_physical(mass, np.asarray(r.com, dtype=float),
                                         np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]))
