@@ -1,7 +1,7 @@
 """Benchmark of ``dynid fleet`` and ``dynid monitor``'s recursive update.
 
-1. A simulated UR10e fleet (:func:`dynid.experiment.simulated_fleet.simulate_fleet`: units of 6-minute identification
-   logs at 500 Hz and 1-minute validation logs, no drive-gain runs) identified by :func:`dynid.experiment.fleet.run_fleet`
+1. A simulated UR10e fleet (:func:`dynid.studies.simulated_fleet.simulate_fleet`: units of 6-minute identification
+   logs at 500 Hz and 1-minute validation logs, no drive-gain runs) identified by :func:`dynid.fleet.identification.run_fleet`
    on a LocalCluster of 1 worker, then of 2 workers (the same fleet, read from disk each time): wall time, speed-up, the
    units' median task time, and each worker's peak resident memory after its first units and after its last ones (flat:
    a worker's memory does not grow with the units it has identified).
@@ -26,8 +26,8 @@ import numpy as np  # noqa: E402
 
 
 def fleet(units: int) -> None:
-    from dynid.experiment.fleet import run_fleet
-    from dynid.experiment.simulated_fleet import simulate_fleet
+    from dynid.fleet.identification import run_fleet
+    from dynid.studies.simulated_fleet import simulate_fleet
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     folder = Path(tempfile.mkdtemp(prefix="dynid-fleet-bench-"))

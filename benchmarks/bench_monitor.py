@@ -1,6 +1,6 @@
 """Benchmark of ``dynid monitor`` on a day of logs of an unchanged robot: false alarms and time.
 
-A simulated UR10e (:func:`dynid.experiment.simulated_fleet.simulate_service_life`) logs one minute at 250 Hz every
+A simulated UR10e (:func:`dynid.studies.simulated_fleet.simulate_service_life`) logs one minute at 250 Hz every
 minute for 24 hours (1440 logs, the same task with fresh noise, nothing wears); its reference log is identified by
 ``dynid identify``'s pipeline, then every log is monitored with the default settings (10 s windows, the first 60 the
 reference, one false alarm per 30 days of logs by design). Prints the alarms (expected: none), the windows and the time
@@ -23,10 +23,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def main(hours: float) -> None:
-    from dynid.experiment.identification_run import run_identification
-    from dynid.experiment.identified import IdentifiedModel
-    from dynid.experiment.monitor import dated_logs, monitor_logs
-    from dynid.experiment.simulated_fleet import simulate_service_life
+    from dynid.identification.run import run_identification
+    from dynid.identification.identified import IdentifiedModel
+    from dynid.fleet.monitor import dated_logs, monitor_logs
+    from dynid.studies.simulated_fleet import simulate_service_life
     from dynid.io.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp(prefix="dynid-monitor-bench-"))

@@ -1,4 +1,4 @@
-"""The independent check of ``tests/experiment/test_independent_check.py``, with its figures printed, over several
+"""The independent check of ``tests/identification/test_independent_check.py``, with its figures printed, over several
 seeds: UR10e logs simulated in MuJoCo outside dynid's model (tests/mujoco_logs.py), no [preprocessing] table.
 
 For each case and seed: the validation error per joint of dynid's main estimate over that of the true parameters on
@@ -26,7 +26,7 @@ NAMES = {("ptp", "sign", False): "point-to-point, inverse dynamics + fcÂ·sign(qÌ
 
 
 def main(seeds=(1, 2, 3)) -> None:
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
     for case in CASES:

@@ -86,7 +86,7 @@ def compute(case: str) -> dict:
             raise FileNotFoundError(f"data of {path.name} not found")
         return _clean(run_identification(load_identification_config(path, data_root=root)).to_dict())
     if kind == "excite":
-        from dynid.experiment.excitation import run_excitation
+        from dynid.identification.excitation_run import run_excitation
         from dynid.io.excitation_config import load_excitation_config
 
         return _clean(run_excitation(load_excitation_config(ROOT / "configs" / f"{name}.toml")).to_dict())
@@ -95,7 +95,7 @@ def compute(case: str) -> dict:
 
         return _clean(run_paper_experiment(PaperExperimentConfig()).to_dict())
     if kind == "montecarlo":
-        from dynid.experiment.montecarlo import MonteCarloConfig, _prepare, simulate_realisation
+        from dynid.studies.montecarlo import MonteCarloConfig, _prepare, simulate_realisation
 
         config = MonteCarloConfig(noise_levels=(0.05, 0.2), realisations=2, estimators=("ols", "wls", "irls", "lad", "sdp", "abc"),
                                   duration=8.0, rate=100.0, maxiter=5)

@@ -7,9 +7,10 @@ import dynid
 
 ORDER = ["conventions", "exceptions", "checks", "friction", "threads", "tables", "model", "dynamics",
          "excitation", "simulation", "preprocessing", "optim", "estimators", "validation", "io",
-         "experiment", "report", "cli"]
-LEVEL = {"conventions": 0, "exceptions": 0, "checks": 0, "typed": 0, "friction": 0, "threads": 0, "tables": 0, "_lazy": 0, "column_store": 0, "processes": 0, "extras": 0, "plugins": 0, "model": 1, "dynamics": 2, "excitation": 3, "simulation": 3,
-         "preprocessing": 3, "optim": 3, "estimators": 4, "validation": 5, "io": 5, "experiment": 6, "report": 7, "cli": 8, "warm_up": 8}
+         "identification", "studies", "fleet", "report", "cli"]
+LEVEL = {"conventions": 0, "exceptions": 0, "checks": 0, "typed": 0, "friction": 0, "threads": 0, "tables": 0, "_lazy": 0, "column_store": 0, "processes": 0, "extras": 0, "plugins": 0, "cluster": 0, "model": 1, "dynamics": 2, "excitation": 3, "simulation": 3,
+         "preprocessing": 3, "optim": 3, "estimators": 4, "validation": 5, "io": 5, "identification": 6, "studies": 7, "fleet": 7, "report": 8, "cli": 9,
+         "warm_up": 9, "experiment": 9}
 FACADE = {"__init__", "__main__"}
 """The package's front door (``import dynid``, ``python -m dynid``): it may import any layer, none imports it."""
 
@@ -72,3 +73,41 @@ def test_the_layering_check_sees_every_kind_of_import():
     for code, expected in cases.items():
         node = ast.parse(code).body[0]
         assert _targets(node, ("model", "robot.py"), "model") == expected, code
+
+
+def _imports_of(package: str):
+    """(file, imported dynid module) for every import in a subpackage, relative ones resolved."""
+    root = Path(dynid.__file__).parent
+    for path in (root / package).rglob("*.py"):
+        rel = path.relative_to(root).with_suffix("").parts
+        pkg = ["dynid", *rel[:-1]] if rel[-1] != "__init__" else ["dynid", *rel[:-1]]
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg[:len(pkg) - (node.level - 1)]
+                    mod = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    mod = node.module or ""
+                yield "/".join(rel), mod
+            elif isinstance(node, ast.Import):
+                for a in node.names:
+                    yield "/".join(rel), a.name
+
+
+def test_estimators_never_import_the_robot_model():
+    """Estimators see (W, tau, a parameter layout): of model/ only the spatial algebra (pseudo-inertia) is theirs."""
+    bad = [f"{f} imports {m}" for f, m in _imports_of("estimators")
+           if m.startswith("dynid.model") and m != "dynid.model.spatial"]
+    assert not bad, bad
+
+
+def test_studies_and_fleet_stand_apart():
+    """The simulated studies and the fleet tools both build on identification/, never on each other."""
+    bad = [f"{f} imports {m}" for pkg, other in (("studies", "fleet"), ("fleet", "studies"))
+           for f, m in _imports_of(pkg) if m.startswith(f"dynid.{other}")]
+    assert not bad, bad
+
+
+def test_the_import_resolver_sees_relative_imports():
+    found = dict(_imports_of("studies"))
+    assert "dynid.identification.identify" in set(m for _, m in _imports_of("studies")), found

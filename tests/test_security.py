@@ -55,7 +55,7 @@ def test_no_loader_that_runs_code_in_the_package():
 @pytest.fixture(scope="module")
 def monitored(tmp_path_factory):
     """A robot's logs, its identification, and one monitor run that left its state."""
-    from dynid.experiment.simulated_fleet import simulate_service_life
+    from dynid.studies.simulated_fleet import simulate_service_life
 
     root = tmp_path_factory.mktemp("life")
     simulate_service_life(root, days=6, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=5)

@@ -21,7 +21,7 @@ def warm_up() -> None:
 
     er16 = load_robot("er16")
     regressor.compile_kernels([er16, er16.submodel(3), load_robot("ur10e"), load_robot("tx40")])
-    from .experiment import PaperExperimentConfig, run_paper_experiment
+    from .studies.paper import PaperExperimentConfig, run_paper_experiment
 
     run_paper_experiment(PaperExperimentConfig(duration=2.0, rate=200.0, bootstrap=2, maxiter=2))
     import numpy as np

@@ -2,7 +2,7 @@ import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import observation_matrix
-from dynid.experiment.paper_reference import TABLE2, paper_symbol
+from dynid.studies.paper_reference import TABLE2, paper_symbol
 from dynid.model.description import load_robot
 
 from ..conftest import random_states

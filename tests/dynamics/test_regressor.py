@@ -119,7 +119,7 @@ SHORT_RUN = """
 import sys
 import numpy as np
 from dynid.dynamics import regressor as module
-from dynid.experiment.identification_run import run_identification
+from dynid.identification.run import run_identification
 from dynid.io.identification_config import load_identification_config
 from dynid.model.description import load_robot
 run_identification(load_identification_config(sys.argv[1], data_root=sys.argv[2]))

@@ -50,7 +50,7 @@ def test_a_wide_box_on_poorly_conditioned_rows_needs_one_band(monkeypatch):
     spaced pilot rows is far from the optimum there, and its band failed the check twice before the LP on
     every row was solved. The pilot is now whichever of that fit and least squares in the box fits every
     row better: the first band holds the optimum (two LPs in all), and it is the exact minimiser."""
-    from dynid.experiment import PaperExperimentConfig, run_paper_experiment
+    from dynid.studies.paper import PaperExperimentConfig, run_paper_experiment
 
     calls = []
     real = la._dual_lp

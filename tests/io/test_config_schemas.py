@@ -84,7 +84,7 @@ def test_the_schema_refuses_what_dynid_refuses(tmp_path, text, where):
 
 
 def test_a_fleet_manifest_and_its_template_are_valid_against_their_schemas(tmp_path):
-    from dynid.experiment.simulated_fleet import simulate_fleet
+    from dynid.studies.simulated_fleet import simulate_fleet
 
     simulate_fleet(tmp_path, units=2, seconds=2.0, rate=50.0, validation_seconds=2.0, odd_unit=None)
     assert not list(_validator("fleet").iter_errors(tomllib.loads((tmp_path / "fleet.toml").read_text())))

@@ -74,7 +74,7 @@ def test_the_sdp_runs_on_a_vendor_urdf_whose_inertia_no_body_has(tmp_path):
     inequality: the physically consistent estimate was refused ('needs physically consistent nominal values'); now it
     runs from the nearest consistent prior, says so naming the link and the rule, and is consistent."""
     import dynid
-    from dynid.experiment.identifier import Identifier
+    from dynid.identification.identifier import Identifier
 
     truth = load_robot(str(ROBOTS / "ur10e.toml"))
     log = dynid.simulated_log(truth, seconds=20, seed=3)

@@ -7,8 +7,8 @@ import pytest
 
 from dynid.column_store import StoredColumns
 from dynid.exceptions import ConfigError
-from dynid.experiment.closed_loop import _rows
-from dynid.experiment.closed_loop_study import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
+from dynid.identification.closed_loop import _rows
+from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 from dynid.io.datasets import Recording
 from dynid.preprocessing.pipeline import Preprocessing, prepare, torque_delayed
 from dynid.simulation.closed_loop import simulate_closed_loop

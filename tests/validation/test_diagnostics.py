@@ -75,7 +75,7 @@ def test_a_well_fitted_simulated_log_has_no_finding_and_a_counterbalance_is_foun
     joint 2 (a second harmonic of its angle, ±100 N·m, about a third of the joint's RMS torque) the description does
     not declare: the position finding names J2, with a size below the spring's (least squares takes most of it into
     the gravity parameters)."""
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
     from ..simulated_logs import write_log

@@ -199,7 +199,7 @@ def run(
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
     from ..estimators.registry import label, parse_estimators
-    from ..experiment import PaperExperimentConfig, run_paper_experiment
+    from ..studies.paper import PaperExperimentConfig, run_paper_experiment
     from ..report.paper_run import save_paper_run
 
     def prepare():
@@ -239,7 +239,7 @@ def identify(
     quiet: bool = QUIET,
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
-    from ..experiment.identification_run import run_identification
+    from ..identification.run import run_identification
     from ..io.identification_config import load_identification_config
 
     def prepare():
@@ -389,7 +389,7 @@ def validate(
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
     from ..exceptions import DataError
-    from ..experiment.identification_run import run_validation
+    from ..identification.run import run_validation
     from ..io.identification_config import dataset_for_file, load_identification_config
     from ..report.summaries import comparison_table
 
@@ -434,7 +434,7 @@ def excite(
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
     from dataclasses import replace
 
-    from ..experiment.excitation import run_excitation
+    from ..identification.excitation_run import run_excitation
     from ..io.excitation_config import load_excitation_config
 
     def prepare():
@@ -540,7 +540,7 @@ def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", ex
 
 def _closed_loop_estimators(text: Optional[str]) -> tuple[str, ...]:
     """The estimators of a closed-loop study (checked by :meth:`ClosedLoopStudyConfig.validate`)."""
-    from ..experiment.closed_loop_study import CLOSED_LOOP_ESTIMATORS
+    from ..studies.closed_loop import CLOSED_LOOP_ESTIMATORS
 
     return CLOSED_LOOP_ESTIMATORS if text is None else tuple(k.strip().lower() for k in text.split(","))
 
@@ -573,13 +573,13 @@ def montecarlo(
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
     from ..estimators.registry import parse_estimators
-    from ..experiment.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
+    from ..studies.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
 
     def prepare():
         _renamed(methods)
         if closed_loop:
-            from ..experiment.closed_loop_study import ClosedLoopStudyConfig
+            from ..studies.closed_loop import ClosedLoopStudyConfig
 
             study = ClosedLoopStudyConfig(robot=robot, joints=joints, encoder_noise=_parse_levels(encoder_noise, "--encoder-noise", "°", "1e-4,1e-3,1e-2"),
                                           torque_noise=_parse_levels(torque_noise, "--torque-noise", "N·m", "0.05,0.1"),
@@ -602,7 +602,7 @@ def montecarlo(
         progress.update("starting the workers")
         report = lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}")  # noqa: E731
         if closed_loop:
-            from ..experiment.closed_loop_study import run_closed_loop_study
+            from ..studies.closed_loop import run_closed_loop_study
 
             return run_closed_loop_study(cfg, scheduler=scheduler, workers=workers, progress=report)
         return run_montecarlo(cfg, scheduler=scheduler, workers=workers, progress=report)
@@ -628,7 +628,7 @@ def fleet(
     quiet: bool = QUIET,
 ) -> None:
     """Identify every unit of a fleet on a Dask cluster, flag the units that stand out, pool their estimates."""
-    from ..experiment.fleet import check_fleet_options, run_fleet
+    from ..fleet.identification import check_fleet_options, run_fleet
     from ..io.fleet_manifest import load_fleet_manifest
 
     def prepare():
@@ -675,7 +675,7 @@ def monitor(
     Run again on a growing folder, it goes on from the state the last run left in --out and reads only the new logs.
     """
     from ..exceptions import DataError
-    from ..experiment.monitor import (STATE_FILE, MonitorSettings, dated_logs, legacy_state_refusal, monitor_fingerprint,
+    from ..fleet.monitor import (STATE_FILE, MonitorSettings, dated_logs, legacy_state_refusal, monitor_fingerprint,
                                       monitor_logs, resumed_monitor)
     from ..io.identification_config import load_identification_config
 
@@ -683,7 +683,7 @@ def monitor(
         settings = MonitorSettings(window, reference_windows, false_alarm_days)
         cfg = load_identification_config(config, data_root)
         files = dated_logs(logs)
-        from ..experiment.identified import load_results
+        from ..identification.identified import load_results
 
         model = load_results(results, cfg.robot)
         fingerprint = monitor_fingerprint(results, settings)

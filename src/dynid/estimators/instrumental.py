@@ -21,7 +21,7 @@ from ..exceptions import IdentifiabilityError, ShapeError
 from .base import check_observations
 
 CLOSED_LOOP_METHODS = ("idim-iv", "didim", "didim-sdp")
-"""Keys of the closed-loop estimators (:mod:`dynid.experiment.closed_loop`; case-insensitive): they need the
+"""Keys of the closed-loop estimators (:mod:`dynid.identification.closed_loop`; case-insensitive): they need the
 controller that drove the run (``[controller]`` of a config)."""
 
 

@@ -410,7 +410,7 @@ def keys() -> tuple[str, ...]:
 
 
 OTHER_LABELS = {"idim-iv": "IDIM-IV", "didim": "DIDIM", "didim-sdp": "DIDIM-SDP"}
-"""Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.experiment.closed_loop`)."""
+"""Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.identification.closed_loop`)."""
 
 
 def label(key: str) -> str:

@@ -1,13 +1,74 @@
-"""End-to-end experiments assembled from the library's parts."""
+"""Former home of the identification route, the simulated studies and the fleet tools (dynid ≤ 0.8), kept so that old
+imports still work for one release: ``dynid.experiment.X`` now lives in :mod:`dynid.identification`,
+:mod:`dynid.studies` or :mod:`dynid.fleet` (docs/changelog.md). Each old name imports the new module and says where it
+went with a ``FutureWarning``."""
 
-from .._lazy import lazy_exports
+from __future__ import annotations
 
-_EXPORTS = {
-    "PaperExperimentConfig": "paper",
-    "PaperRunResult": "paper",
-    "run_paper_experiment": "paper",
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+
+MOVED = {
+    "closed_loop": "dynid.identification.closed_loop",
+    "closed_loop_study": "dynid.studies.closed_loop",
+    "delay": "dynid.identification.delay",
+    "drive_gains": "dynid.identification.drive_gains",
+    "excitation": "dynid.identification.excitation_run",
+    "fleet": "dynid.fleet.identification",
+    "identification": "dynid.identification.identify",
+    "identification_pipeline": "dynid.identification.pipeline",
+    "identification_run": "dynid.identification.run",
+    "identified": "dynid.identification.identified",
+    "identifier": "dynid.identification.identifier",
+    "monitor": "dynid.fleet.monitor",
+    "montecarlo": "dynid.studies.montecarlo",
+    "paper": "dynid.studies.paper",
+    "paper_reference": "dynid.studies.paper_reference",
+    "simulated_fleet": "dynid.studies.simulated_fleet",
+    "simulated_logs": "dynid.studies.simulated_logs",
 }
+"""Old submodule of ``dynid.experiment`` → the module it became."""
 
-__all__ = ["PaperExperimentConfig", "PaperRunResult", "run_paper_experiment"]
+_NAMES = {"PaperExperimentConfig": "dynid.studies.paper", "PaperRunResult": "dynid.studies.paper",
+          "run_paper_experiment": "dynid.studies.paper"}
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+
+def _moved(old: str, new: str) -> None:
+    warnings.warn(f"{old} moved to {new}; the old name goes in a later release", FutureWarning, stacklevel=3)
+
+
+class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Imports ``dynid.experiment.<old>`` as the module it became (the same module object, so state is shared)."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        prefix = __name__ + "."
+        if fullname.startswith(prefix) and fullname[len(prefix):] in MOVED:
+            return importlib.util.spec_from_loader(fullname, self)
+        return None
+
+    def create_module(self, spec):
+        new = MOVED[spec.name.rsplit(".", 1)[1]]
+        _moved(spec.name, new)
+        module = importlib.import_module(new)
+        self._kept = (module.__spec__, module.__loader__)  # the import system writes the alias's over them
+        return module
+
+    def exec_module(self, module):
+        module.__spec__, module.__loader__ = self._kept
+
+
+if not any(isinstance(f, _Alias) for f in sys.meta_path):
+    sys.meta_path.append(_Alias())
+
+
+def __getattr__(name):
+    if name in _NAMES:
+        _moved(f"{__name__}.{name}", _NAMES[name])
+        value = globals()[name] = getattr(importlib.import_module(_NAMES[name]), name)
+        return value
+    if name in MOVED:
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

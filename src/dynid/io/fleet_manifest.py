@@ -1,5 +1,5 @@
 """Fleet manifests of ``dynid fleet`` (TOML): the units of one robot model and their logs; parsing only
-(:mod:`dynid.experiment.fleet` runs them).
+(:mod:`dynid.fleet.identification` runs them).
 
 Layout (logs relative to the manifest; the template relative to it too)::
 

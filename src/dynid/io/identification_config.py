@@ -1,4 +1,4 @@
-"""Configs of ``dynid identify`` / ``dynid validate`` (TOML): parsing only; :mod:`dynid.experiment.identification_run` runs them.
+"""Configs of ``dynid identify`` / ``dynid validate`` (TOML): parsing only; :mod:`dynid.identification.run` runs them.
 
 Layout (paths relative to the config file; data paths relative to ``data_root``)::
 

@@ -1,6 +1,6 @@
 """A joint's friction model: which Coulomb-like terms it has, their velocities and their state at rest.
 
-:class:`JointFriction` names a model of the family :mod:`dynid.validation.friction_models` chooses from;
+:class:`JointFriction` names a model of the family :mod:`dynid.identification.friction_models` chooses from;
 :func:`robot_with` gives the robot whose regressor has those terms. The state at rest is a property of the
 logs' preprocessing (``Preprocessing.rest_friction``), the rest of the robot.
 """

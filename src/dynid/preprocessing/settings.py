@@ -52,7 +52,7 @@ class Preprocessing:
     coulomb_velocity : "auto", float or tuple [rad/s]
         Smoothing velocity of the Coulomb term per joint (:mod:`dynid.friction`); 0 (default):
         sign. "auto": chosen per joint by blocked cross-validation on the identification log
-        (:func:`dynid.validation.cross_validation.choose_coulomb_velocity`). Not the default: on the
+        (:func:`dynid.identification.cross_validation.choose_coulomb_velocity`). Not the default: on the
         UR10e logs the choice made on the excitation log raised the point-to-point validation errors.
     rest_velocity : "auto", float or tuple [rad/s]
         Per joint, the velocity below which the joint counts as resting: its Coulomb (and Stribeck, asymmetric
@@ -79,7 +79,7 @@ class Preprocessing:
         ``t − torque_delay``, so the torques are read ``torque_delay`` later (a band-limited shift on the log's grid,
         :class:`dynid.preprocessing.filters.FractionalShift`) before any filter. Default 0. A drive that holds each commanded torque over its control period
         and logs the command leads the motion by half a period: ``−0.5 / rate`` (the closed-loop study's logs).
-        :func:`dynid.experiment.delay.estimate_delay` estimates it from a log.
+        :func:`dynid.identification.delay.estimate_delay` estimates it from a log.
     strategy : str
         The preprocessing strategy (:mod:`dynid.preprocessing.strategies`): "parallel" (default: the filters
         described here) or "paper" (the paper's §3.3: a Fourier fit on ``fourier``'s harmonics and eq. 17 on the
@@ -91,7 +91,7 @@ class Preprocessing:
         :data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band (a slow motion on a quiet log: the rule
         would filter away content the data hold), the position and parallel cutoffs (hence the decimation) are
         chosen by blocked cross-validation among the rule's cutoff, the knee and their geometric mean
-        (:func:`dynid.validation.cross_validation.choose_preprocessing`); false: the rule.
+        (:func:`dynid.identification.cross_validation.choose_preprocessing`); false: the rule.
     derivation : str
         Filled by :meth:`resolved`: what was derived from the data, and why.
     noise_share : float or None

@@ -51,7 +51,7 @@ class Strategy:
     name : str
         The key it is registered under.
     chooses_cutoffs : bool
-        Whether ``Preprocessing.auto`` cross-validates its cutoffs (:func:`dynid.validation.cross_validation.choose_preprocessing`).
+        Whether ``Preprocessing.auto`` cross-validates its cutoffs (:func:`dynid.identification.cross_validation.choose_preprocessing`).
     needs_harmonics : bool
         Whether it needs the excitation's harmonics (``Preprocessing.fourier``): a log scored with another log's
         parameters (a validation log) then goes through the default strategy.

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import regressor
-from ..experiment.excitation import ExcitationRun
+from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report

@@ -7,7 +7,7 @@ import html
 import math
 from pathlib import Path
 
-from ..experiment.fleet import FleetResult
+from ..fleet.identification import FleetResult
 from .identification_run import save_identification
 from .output import staged, write_results
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from ..experiment.identification import IdentificationResult
+from ..identification.identify import IdentificationResult
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, output_folder, save_figure, write_results, staged

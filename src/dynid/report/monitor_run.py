@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..experiment.monitor import STATE_FILE, MonitorResult
+from ..fleet.monitor import STATE_FILE, MonitorResult
 from .output import save_figure, staged, write_results
 
 __all__ = ["save_monitor", "monitor_table"]

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..estimators.registry import label
-from ..experiment.closed_loop_study import ClosedLoopStudyResult
-from ..experiment.montecarlo import MonteCarloResult
+from ..studies.closed_loop import ClosedLoopStudyResult
+from ..studies.montecarlo import MonteCarloResult
 from ..io import atomic_write_text
 from . import figures
 from .html import write_html_report

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..experiment import paper_reference as ref
+from ..studies import paper_reference as ref
 from ..estimators.registry import label
-from ..experiment.paper import PaperRunResult
+from ..studies.paper import PaperRunResult
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, output_folder, save_figure, write_results, staged

@@ -7,7 +7,7 @@ from __future__ import annotations
 from ..estimators.registry import spec
 from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..tables import Line, TextTable
-from ..experiment import paper_reference as ref
+from ..studies import paper_reference as ref
 
 
 def _joined(values, fmt: str) -> str:

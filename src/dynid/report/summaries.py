@@ -105,13 +105,13 @@ def blocks(result) -> list:
     TypeError
         Not a result of dynid.
     """
-    from ..experiment.excitation import ExcitationRun
-    from ..experiment.fleet import FleetResult
-    from ..experiment.monitor import MonitorResult
-    from ..experiment.identification import IdentificationResult
-    from ..experiment.closed_loop_study import ClosedLoopStudyResult
-    from ..experiment.montecarlo import MonteCarloResult
-    from ..experiment.paper import PaperRunResult
+    from ..identification.excitation_run import ExcitationRun
+    from ..fleet.identification import FleetResult
+    from ..fleet.monitor import MonitorResult
+    from ..identification.identify import IdentificationResult
+    from ..studies.closed_loop import ClosedLoopStudyResult
+    from ..studies.montecarlo import MonteCarloResult
+    from ..studies.paper import PaperRunResult
     from .paper_summary import run_summary_blocks
 
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
@@ -129,13 +129,13 @@ def identification_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.identification.IdentificationResult
+    result : dynid.identification.identify.IdentificationResult
 
     Returns
     -------
     list of Line and TextTable
     """
-    from ..experiment.identification import BOX_FRACTION, BOX_SIGMAS
+    from ..identification.identify import BOX_FRACTION, BOX_SIGMAS
 
     r = result
     sol, base = r.solution, r.base
@@ -220,7 +220,7 @@ def readiness(result) -> Line:
 
     Parameters
     ----------
-    result : dynid.experiment.identification.IdentificationResult
+    result : dynid.identification.identify.IdentificationResult
 
     Returns
     -------
@@ -255,7 +255,7 @@ def identification_brief(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.identification.IdentificationResult
+    result : dynid.identification.identify.IdentificationResult
 
     Returns
     -------
@@ -360,7 +360,7 @@ def in_short(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.identification.IdentificationResult
+    result : dynid.identification.identify.IdentificationResult
 
     Returns
     -------
@@ -482,7 +482,7 @@ def drive_gains_blocks(gains) -> list:
 
     Parameters
     ----------
-    gains : dynid.experiment.drive_gains.GainsAndPayload
+    gains : dynid.identification.drive_gains.GainsAndPayload
 
     Returns
     -------
@@ -516,7 +516,7 @@ def montecarlo_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.montecarlo.MonteCarloResult
+    result : dynid.studies.montecarlo.MonteCarloResult
 
     Returns
     -------
@@ -565,7 +565,7 @@ def closed_loop_study_rows(data: dict) -> tuple[tuple[str, ...], list[tuple[str,
     Parameters
     ----------
     data : dict
-        :meth:`dynid.experiment.closed_loop_study.ClosedLoopStudyResult.to_dict`.
+        :meth:`dynid.studies.closed_loop.ClosedLoopStudyResult.to_dict`.
 
     Returns
     -------
@@ -596,7 +596,7 @@ def closed_loop_verdict(data: dict) -> list[str]:
     Parameters
     ----------
     data : dict
-        :meth:`dynid.experiment.closed_loop_study.ClosedLoopStudyResult.to_dict`.
+        :meth:`dynid.studies.closed_loop.ClosedLoopStudyResult.to_dict`.
 
     Returns
     -------
@@ -623,7 +623,7 @@ def closed_loop_study_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.closed_loop_study.ClosedLoopStudyResult
+    result : dynid.studies.closed_loop.ClosedLoopStudyResult
 
     Returns
     -------
@@ -651,7 +651,7 @@ def excitation_blocks(run) -> list:
 
     Parameters
     ----------
-    run : dynid.experiment.excitation.ExcitationRun
+    run : dynid.identification.excitation_run.ExcitationRun
 
     Returns
     -------
@@ -698,7 +698,7 @@ def fleet_verdict(result) -> str:
 
     Parameters
     ----------
-    result : dynid.experiment.fleet.FleetResult
+    result : dynid.fleet.identification.FleetResult
 
     Returns
     -------
@@ -720,7 +720,7 @@ def fleet_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.fleet.FleetResult
+    result : dynid.fleet.identification.FleetResult
 
     Returns
     -------
@@ -766,7 +766,7 @@ def monitor_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.experiment.monitor.MonitorResult
+    result : dynid.fleet.monitor.MonitorResult
 
     Returns
     -------

@@ -262,9 +262,9 @@ def delay_findings(samples: float, std: float, determined: bool, rate: float, gi
     Parameters
     ----------
     samples, std : float
-        The delay the log shows on top of the one given, and its σ [samples] (:func:`dynid.experiment.delay.estimate_delay`).
+        The delay the log shows on top of the one given, and its σ [samples] (:func:`dynid.identification.delay.estimate_delay`).
     determined : bool
-        Whether the log determines it (:attr:`dynid.experiment.delay.DelayEstimate.determined`).
+        Whether the log determines it (:attr:`dynid.identification.delay.DelayEstimate.determined`).
     rate : float [Hz]
         The log's rate.
     given : float [s]

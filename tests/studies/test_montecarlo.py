@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.experiment.montecarlo import MonteCarloConfig, _prepare, run_montecarlo, simulate_realisation
+from dynid.studies.montecarlo import MonteCarloConfig, _prepare, run_montecarlo, simulate_realisation
 
 SMALL = MonteCarloConfig(noise_levels=(0.05, 0.4), realisations=12, estimators=("ols", "wls", "abc"), duration=8.0,
                          rate=100.0, maxiter=3)
@@ -68,7 +68,7 @@ def test_bad_settings(kwargs, message):
 
 
 def test_unreachable_scheduler_is_a_one_line_error():
-    from dynid.experiment.montecarlo import dask_client
+    from dynid.cluster import dask_client
 
     with pytest.raises(ConfigError, match="cannot reach the Dask scheduler"):
         with dask_client(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0):

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from dynid.experiment.simulated_fleet import simulate_fleet
+from dynid.studies.simulated_fleet import simulate_fleet
 from dynid.simulation.measurements import NoiseModel
 
 from ..cli.refusals import assert_refused, dynid
@@ -57,7 +57,7 @@ def test_a_tx40_fleet_finds_its_unit_whose_drive_gain_is_off(tmp_path):
     """Six simulated TX40s (coupled wrist; joints 2-3 with position offsets, which the written logs take off the angles
     as an encoder reads them): the gains identified against the truth (1, one unit's K2 5 % off), friction within 5 %,
     joint 6's gain undetermined (the calibration payload sits on its axis), and the odd unit flagged on K2 first."""
-    from dynid.experiment.fleet import run_fleet
+    from dynid.fleet.identification import run_fleet
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     truths = simulate_fleet(tmp_path, robot="tx40", units=6, seconds=20.0, rate=200.0, validation_seconds=10.0,
@@ -78,7 +78,7 @@ def test_a_tx40_fleet_finds_its_unit_whose_drive_gain_is_off(tmp_path):
 def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
     """Five units, each identified from half of its log: pooled with the others, each predicts its validation motion
     (noise-free, so the error is the model's alone) better than from its half log alone."""
-    from dynid.experiment.fleet import run_fleet
+    from dynid.fleet.identification import run_fleet
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     root = tmp_path / "fleet"
@@ -136,7 +136,7 @@ def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_p
     pooled estimate carries its tool again and predicts its own motion as well as its own estimate does."""
     import shutil
 
-    from dynid.experiment.fleet import run_fleet
+    from dynid.fleet.identification import run_fleet
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     simulate_fleet(tmp_path / "bare", units=4, seconds=20.0, rate=200.0, validation_seconds=6.0, odd_unit=None,

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from dynid.dynamics.regressor import regressor
-from dynid.experiment.identification_run import run_identification
+from dynid.identification.run import run_identification
 from dynid.io.identification_config import load_identification_config
 from dynid.model.description import load_robot
 

@@ -10,7 +10,7 @@ import pytest
 from dynid.cli.app import main
 from dynid.dynamics.regressor import observation_matrix
 from dynid.exceptions import ConfigError
-from dynid.experiment.closed_loop_study import (ClosedLoopStudyConfig, ClosedLoopStudyResult, _prepare,
+from dynid.studies.closed_loop import (ClosedLoopStudyConfig, ClosedLoopStudyResult, _prepare,
                                                 run_closed_loop_study, simulate_realisation)
 from dynid.simulation.closed_loop import simulate_closed_loop
 

@@ -1,12 +1,12 @@
 """``dynid fleet``: every unit of a fleet identified on a Dask cluster, one table of the fleet, the units that stand out
 flagged, and every unit's estimate helped by the others' (pooled identification).
 
-Each unit is identified by the standard pipeline (:func:`dynid.experiment.identification_run.run_identification`)
+Each unit is identified by the standard pipeline (:func:`dynid.identification.run.run_identification`)
 in a Dask task that reads its logs where the worker runs: on a :class:`distributed.LocalCluster` of the local cores
 by default, or on the cluster of a scheduler's address. A task returns what the fleet needs (the main estimate with
 its covariance, the validation errors, the drive gains) and, when given a writer, writes the unit's results as
 ``dynid identify`` does. The fleet's statistics run on the client: robust z-scores
-(:mod:`dynid.validation.fleet_outliers`) and the hierarchical pooled estimate (:mod:`dynid.estimators.pooled`),
+(:mod:`dynid.fleet.outliers`) and the hierarchical pooled estimate (:mod:`dynid.estimators.pooled`),
 which a second round of tasks validates on each unit's validation logs.
 """
 
@@ -135,7 +135,7 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
     UnitSummary
         With ``error`` set (one line) when the unit's data or config fail; nothing is raised for them.
     """
-    from ..experiment.identification_run import run_identification
+    from ..identification.run import run_identification
     from ..io.identification_config import stored_preprocessing
 
     t0 = time.perf_counter()
@@ -223,7 +223,7 @@ def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dic
         label -> error [%]; empty when the unit has no validation log.
     """
     from ..dynamics.base_parameters import base_parameters
-    from .identification_run import validate_sets
+    from ..identification.run import validate_sets
 
     if not unit.config.validation:
         return {}
@@ -243,7 +243,7 @@ class FleetResult:
     outliers : tuple of Outlier
         Parameters (and drive gains) of units that stand out, largest first.
     threshold : float
-        The lowest ``|z|`` flagged (:func:`dynid.validation.fleet_outliers.fleet_outliers`).
+        The lowest ``|z|`` flagged (:func:`dynid.fleet.outliers.fleet_outliers`).
     pooled : PooledEstimate or None
         None when fewer than 2 units were identified, or their base parameters differ.
     pooled_errors : dict
@@ -352,7 +352,7 @@ class FleetResult:
 
 def _flag(units: tuple[UnitSummary, ...]):
     from ..estimators.pooled import shared_parameters
-    from ..validation.fleet_outliers import fleet_outliers
+    from .outliers import fleet_outliers
 
     names = list(units[0].names)
     differ = list(~shared_parameters(names))
@@ -403,7 +403,7 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
 
     from ..estimators.pooled import pooled_estimate, shared_parameters
     from ..exceptions import DataError
-    from .montecarlo import dask_client
+    from ..cluster import dask_client
 
     t0 = time.perf_counter()
     units = manifest.units

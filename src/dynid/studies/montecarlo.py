@@ -21,9 +21,6 @@ order tasks run.
 
 from __future__ import annotations
 
-import contextlib
-import logging
-import os
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Callable
@@ -43,6 +40,7 @@ from ..simulation.measurements import NoiseModel
 from ..estimators.estimation import Estimation
 from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
 from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
+from ..cluster import map_realisations
 from ..threads import with_single_blas_thread
 
 DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
@@ -307,99 +305,6 @@ class MonteCarloResult:
             "errors": self.errors,
             "timings": self.timings,
         }
-
-
-@contextlib.contextmanager
-def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0,
-                extra: str = "montecarlo", what: str = "dynid montecarlo"):
-    """A Dask client to a scheduler, or to a new local cluster.
-
-    Parameters
-    ----------
-    scheduler : str, optional
-        An address like ``tcp://host:8786``; default: a new :class:`distributed.LocalCluster`.
-    workers : int, optional
-        Single-threaded worker processes of the local cluster (default: the local cores).
-    connect_timeout : float [s]
-        Time the scheduler is given to answer.
-    extra, what : str
-        The extra that installs Dask and what needs it, for the message when it is missing.
-
-    Yields
-    ------
-    distributed.Client
-
-    Raises
-    ------
-    ConfigError
-        The scheduler cannot be reached, ``workers`` < 1, or Dask is not installed.
-    """
-    require("distributed", extra, what)
-    from distributed import Client, LocalCluster
-
-    from ..plugins import share_with
-
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout=f"{connect_timeout}s")
-        except (OSError, TimeoutError) as exc:
-            raise ConfigError(f"scheduler {scheduler}: cannot reach the Dask scheduler ({exc})", field="scheduler") from None
-        with client:
-            share_with(client)
-            yield client
-        return
-    n = workers if workers is not None else (os.cpu_count() or 1)
-    if n < 1:
-        raise ConfigError(f"workers must be at least 1, got {workers}", field="workers")
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
-        share_with(client)
-        yield client
-
-
-def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], store: Callable, scheduler: str | None = None,
-                     workers: int | None = None, what: str = "dynid montecarlo",
-                     progress: Callable[[int, int], None] | None = None) -> str:
-    """Run ``function(setup, *key)`` for every key on a Dask cluster, ``setup`` sent once to every worker, and hand each
-    result to ``store(key, result)`` as it arrives.
-
-    Parameters
-    ----------
-    function : callable
-        ``function(setup, i, j) -> result``, seeding its own generators from its arguments.
-    setup : object
-        What every task shares.
-    keys : list of (int, int)
-    store : callable
-        ``store(key, result)``, called in the order the tasks finish.
-    scheduler, workers :
-        As :func:`dask_client`.
-    what : str
-        The command, for the message when Dask is missing.
-    progress : callable, optional
-        ``progress(done, total)``.
-
-    Returns
-    -------
-    str
-        The cluster the tasks ran on.
-
-    Raises
-    ------
-    ConfigError
-        From :func:`dask_client`.
-    """
-    from distributed import as_completed
-
-    with dask_client(scheduler, workers, what=what) as client:
-        cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
-        shared = client.scatter(setup, broadcast=True)
-        futures = {client.submit(function, shared, *key, pure=False): key for key in keys}
-        for done, fut in enumerate(as_completed(futures), start=1):
-            store(futures[fut], fut.result())
-            if progress is not None:
-                progress(done, len(futures))
-    return cluster
 
 
 def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: str | None = None,

@@ -7,8 +7,8 @@ positions; the log (measured positions, commanded torques plus noise) is prepare
 real one, given the one thing known of its drives: each command is held over the control period, so the logged
 torques lead the motion by half a period (:func:`zero_order_hold_delay`, the ``torque_delay`` setting); and every
 estimator is fitted on it: the open-loop ones through
-:func:`dynid.experiment.identification.identify` (OLS, WLS, IRLS, LAD, SDP, ABC, …) and IDIM-IV and DIDIM through
-:func:`dynid.experiment.closed_loop.closed_loop_identify`. Per cell and estimator the study reports the bias and
+:func:`dynid.identification.identify.identify` (OLS, WLS, IRLS, LAD, SDP, ABC, …) and IDIM-IV and DIDIM through
+:func:`dynid.identification.closed_loop.closed_loop_identify`. Per cell and estimator the study reports the bias and
 spread of each base parameter, against |β| and against the Cramér–Rao bound, and the coverage of the estimator's
 95 % intervals (``|β̂ − β| ≤ 1.96 σ̂``) where it gives σ.
 
@@ -48,7 +48,7 @@ from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from ..threads import with_single_blas_thread
-from .closed_loop import ClosedLoopExperiment, closed_loop_identify
+from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
 from .paper import PaperExperimentConfig, identification_trajectory
 
 __all__ = ["ENCODER_NOISE_DEG", "TORQUE_NOISE", "CLOSED_LOOP_ESTIMATORS", "ClosedLoopStudyConfig", "ClosedLoopStudyResult",
@@ -238,7 +238,7 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     params, std = np.full((len(keys), n_base), np.nan), np.full((len(keys), n_base), np.nan)
     converged, seconds = np.zeros(len(keys), dtype=bool), np.zeros(len(keys))
     errors: dict[str, str] = {}
-    from .identification import identify
+    from ..identification.identify import identify
 
     open_keys = [k for k in keys if k not in CLOSED_LOOP_METHODS]
     if open_keys:
@@ -451,7 +451,7 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
         Invalid settings, an unreachable scheduler, or Dask not installed.
     """
     require("distributed", "montecarlo", "dynid montecarlo --closed-loop")
-    from .montecarlo import map_realisations
+    from ..cluster import map_realisations
 
     t0 = time.perf_counter()
     setup = _prepare(config)

@@ -5,7 +5,7 @@ Prepared recording (:mod:`dynid.preprocessing`) → the strategy's blocks of bas
 torques → the estimators of ``estimators`` (the first is the main estimate; OLS/WLS and the SDP accumulate block by
 block, so memory does not depend on the log's length) → fit metrics, the consistency of every estimate, the verdict
 on the model (:mod:`dynid.validation.diagnostics`). Validation on other logs is
-:mod:`dynid.experiment.identification_run`'s.
+:mod:`dynid.identification.run`'s.
 """
 
 from __future__ import annotations
@@ -164,7 +164,7 @@ class IdentificationResult:
         label -> F of eq. 9 on the identification rows [N·m] (when estimators other than least squares ran).
     box : (n_base, 2) array or None
         The box searches' box (:func:`search_box`).
-    drive_gains : dynid.experiment.drive_gains.GainsAndPayload or None
+    drive_gains : dynid.identification.drive_gains.GainsAndPayload or None
         Drive gains and payload from ``[drive_gains]``.
     model : Robot or None
         The robot as identified: its drive terms are the friction models chosen for its joints.
@@ -311,7 +311,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         log-det divergence of each link's pseudo-inertia (plausible links for export; Lee, Wensing & Park 2020).
     observers : tuple of callable
         ``observer(index, y, tau, keep)`` called with every block of base rows of the one pass (what else needs them,
-        e.g. the delay check of :mod:`dynid.experiment.identification_pipeline`).
+        e.g. the delay check of :mod:`dynid.identification.pipeline`).
 
     Returns
     -------

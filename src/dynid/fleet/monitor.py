@@ -10,7 +10,7 @@ with forgetting (:mod:`dynid.estimators.recursive`) follows them sample by sampl
 changes, temperature and noise included; the spread taken at its upper 95 % confidence bound, since an
 underestimated spread multiplies false alarms; windows that did not determine a term, such as a joint that kept one
 direction, left out of its reference). From then on each window's estimate, standardised by the reference spread
-and its own σ, feeds a two-sided CUSUM chart per term (:mod:`dynid.validation.change_detection`) whose threshold
+and its own σ, feeds a two-sided CUSUM chart per term (:mod:`dynid.fleet.change_detection`) whose threshold
 gives the whole family one false alarm per ``false_alarm_days`` days of logs on average. An alarm names the joint and the term, dates the
 change (log and time), and says how large it is; the term's new level is then learned over the next
 ``reference_windows`` windows and its chart restarts from it, so a wear that goes on raises a new alarm each time it
@@ -37,7 +37,7 @@ import numpy as np
 
 from ..estimators.recursive import RecursiveLeastSquares
 from ..exceptions import ConfigError, DataError
-from ..validation.change_detection import Cusum, CusumAlarm
+from .change_detection import Cusum, CusumAlarm
 
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
            "monitor_logs", "determined", "STATE_FILE", "LEGACY_STATE_FILE", "monitor_fingerprint", "resumed_monitor",
@@ -415,7 +415,7 @@ class FrictionMonitor:
     def _chart(self) -> list[DriftAlarm]:
         from scipy.stats import chi2
 
-        from ..validation.change_detection import cusum_threshold
+        from .change_detection import cusum_threshold
 
         count = len(self.windows)
         ref = self.settings.reference_windows

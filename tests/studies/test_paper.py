@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.experiment import PaperExperimentConfig, run_paper_experiment
-from dynid.experiment import paper_reference as ref
+from dynid.studies.paper import PaperExperimentConfig, run_paper_experiment
+from dynid.studies import paper_reference as ref
 
 FAST = dict(duration=10.0, rate=200.0, maxiter=5)
 
@@ -135,7 +135,7 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     to round-off in the end samples' polynomial fits, as smoothing every standard column and then keeping them."""
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.excitation.paper_trajectories import paper_validation_trajectory
-    from dynid.experiment.paper import simulate_dataset
+    from dynid.studies.paper import simulate_dataset
     from dynid.model.description import load_robot
     from dynid.simulation import NoiseModel
 

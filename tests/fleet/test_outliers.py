@@ -6,7 +6,7 @@ import pytest
 from scipy.stats import norm, t
 
 from dynid.exceptions import ShapeError
-from dynid.validation.fleet_outliers import FALSE_FLAG_RATE, fleet_outliers, fleet_z
+from dynid.fleet.outliers import FALSE_FLAG_RATE, fleet_outliers, fleet_z
 
 
 def test_a_unit_off_a_fleet_that_agrees_within_its_sigma_gets_the_z_computed_by_hand():

@@ -3,7 +3,7 @@
 import numpy as np
 
 from dynid.estimators.accumulate import LeastSquaresAccumulator
-from dynid.validation.cross_validation import out_of_fold_error
+from dynid.identification.cross_validation import out_of_fold_error
 
 
 def test_out_of_fold_error_equals_refitting_without_each_block(rng):
@@ -38,7 +38,7 @@ def test_coulomb_cross_validation_prefers_smoothing_when_the_truth_is_smooth(tmp
     from dynid.model.description import load_robot
     from dynid.preprocessing.pipeline import Preprocessing
     from dynid.preprocessing.prepared import PreparedData
-    from dynid.validation.cross_validation import choose_coulomb_velocity
+    from dynid.identification.cross_validation import choose_coulomb_velocity
 
     from ..conftest import sine_motion
 

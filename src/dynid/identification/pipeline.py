@@ -12,14 +12,14 @@ One recording goes through it the same way whoever calls it (``dynid identify`` 
 Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
 
 1. the filters: the strategy's rule on the excitation band, or, when the positions' noise knee lies far above it,
-   cutoffs chosen by blocked cross-validation (:func:`dynid.validation.cross_validation.choose_preprocessing`);
+   cutoffs chosen by blocked cross-validation (:func:`dynid.identification.cross_validation.choose_preprocessing`);
 2. the Coulomb smoothing velocity (``preprocessing.coulomb_velocity``: given, or "auto" by cross-validation);
 3. each joint's friction model and its state at rest (``friction = "auto"``,
-   :func:`dynid.validation.friction_models.choose_friction`), which may change the base-parameter map.
+   :func:`dynid.identification.friction_models.choose_friction`), which may change the base-parameter map.
 
-:meth:`~IdentificationPipeline.estimate` is :func:`dynid.experiment.identification.identify` on the prepared data; the
+:meth:`~IdentificationPipeline.estimate` is :func:`dynid.identification.identify.identify` on the prepared data; the
 result's ``settings`` say every choice and why. Reading logs and configs, drive gains, closed-loop estimators and
-validation on other logs are the callers' (:mod:`dynid.experiment.identification_run`).
+validation on other logs are the callers' (:mod:`dynid.identification.run`).
 """
 
 from __future__ import annotations
@@ -134,7 +134,7 @@ class IdentificationPipeline:
         IdentifiabilityError
             Too little motion to cross-validate a choice on.
         """
-        from ..validation.cross_validation import choose_coulomb_velocity
+        from .cross_validation import choose_coulomb_velocity
 
         def say(label: str) -> None:
             if step is not None:
@@ -146,7 +146,7 @@ class IdentificationPipeline:
         auto = settings.auto and strategy_for(settings).chooses_cutoffs
         say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
         if auto:
-            from ..validation.cross_validation import choose_preprocessing
+            from .cross_validation import choose_preprocessing
 
             filters = choose_preprocessing(self.robot, base, recording, settings)
             assert filters.data is not None  # the chosen candidate's prepared data
@@ -165,7 +165,7 @@ class IdentificationPipeline:
             velocity = np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,))
         robot = replace(self.robot, coulomb_velocity=velocity)
         if self.friction == "auto":
-            from ..validation.friction_models import choose_friction
+            from .friction_models import choose_friction
 
             say("friction model of each joint (cross-validation)")
             friction = choose_friction(robot, data)
@@ -178,7 +178,7 @@ class IdentificationPipeline:
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
                  held_out: bool = False):
         """Every estimator on the prepared data, the consistency checks and the verdict
-        (:func:`dynid.experiment.identification.identify`).
+        (:func:`dynid.identification.identify.identify`).
 
         Parameters
         ----------
@@ -193,7 +193,7 @@ class IdentificationPipeline:
 
         Returns
         -------
-        dynid.experiment.identification.IdentificationResult
+        dynid.identification.identify.IdentificationResult
             Its ``settings`` hold the resolved preprocessing, :attr:`PreparedIdentification.choices` and
             ``robot_source``.
 
@@ -204,7 +204,7 @@ class IdentificationPipeline:
         IdentifiabilityError
             A log that does not excite every base parameter.
         """
-        from .identification import identify
+        from .identify import identify
 
         blocks: list = []  # the delay check's rows, from the identification's own pass
         check = _delay_checked(prepared.data)
@@ -231,7 +231,7 @@ class IdentificationPipeline:
 
         Returns
         -------
-        dynid.experiment.identification.IdentificationResult
+        dynid.identification.identify.IdentificationResult
 
         Raises
         ------
@@ -259,7 +259,7 @@ def _delay_checked(data: PreparedData) -> str | None:
 
 def _delay_check(data: PreparedData, blocks: list) -> tuple[list, dict]:
     """The delay between the torque and position channels the identification log shows on top of the one given
-    (:func:`dynid.experiment.delay.delay_from_rows`, on the identification's own rows), and the finding when it
+    (:func:`dynid.identification.delay.delay_from_rows`, on the identification's own rows), and the finding when it
     matters (:func:`dynid.validation.diagnostics.delay_findings`)."""
     from ..exceptions import DynIdError
     from ..validation.diagnostics import delay_findings

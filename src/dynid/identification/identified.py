@@ -274,7 +274,7 @@ class IdentifiedModel:
         from ..dynamics.regressor import regressor
         from ..preprocessing.pipeline import prepare
         from ..preprocessing.prepared import rest_velocities
-        from .identification_run import recording_from_arrays
+        from .run import recording_from_arrays
 
         q = np.asarray(q, dtype=float)
         times = np.asarray(t, dtype=float).reshape(-1)
@@ -401,7 +401,7 @@ class IdentifiedModel:
         if not (hasattr(t, "tau") and hasattr(t, "rate")):
             if q is None or tau is None:
                 raise ValueError("score(t, q, tau): positions and measured torques are needed with the time stamps")
-            from .identification_run import recording_from_arrays
+            from .run import recording_from_arrays
 
             recording = recording_from_arrays(self.robot, t, q, tau, name="score")
         _, pred, meas = self.predict_log(recording, estimate)

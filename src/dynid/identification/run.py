@@ -20,7 +20,7 @@ from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
-    from .identification_pipeline import IdentificationPipeline
+    from .pipeline import IdentificationPipeline
 
 
 def _references(config: IdentificationConfig, base):
@@ -200,7 +200,7 @@ def pipeline_of(config: IdentificationConfig) -> "IdentificationPipeline":
     -------
     IdentificationPipeline
     """
-    from .identification_pipeline import IdentificationPipeline
+    from .pipeline import IdentificationPipeline
 
     return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
                                   config.sdp_prior, config.robot_source)
@@ -211,7 +211,7 @@ def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
     rate (``[controller]``)."""
     from ..dynamics.rnea import rnea_torques
     from .closed_loop import ClosedLoopExperiment, closed_loop_identify
-    from .identification import Estimate, consistency_checks
+    from .identify import Estimate, consistency_checks
 
     assert config.controller is not None  # the config's parser refuses closed-loop estimators without it
     controller, reference, feedforward = config.controller
@@ -258,7 +258,7 @@ def _main_estimate(result, nominal: str | None = None) -> dict:
         floor = (v.floor_metrics() or {}).get("global_relative_error", np.nan)
         findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread,
                                         label, floor)
-    from .identification import SDP_LABEL
+    from .identify import SDP_LABEL
 
     main = result.main or label
     consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
@@ -336,7 +336,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
                          estimators=("wls",), name: str = "arrays", friction: str = "description", seed: int = 0,
                          sdp_prior: str = "euclidean"):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
-    (:class:`~dynid.experiment.identification_pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
+    (:class:`~dynid.identification.pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
     cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
 
     Parameters
@@ -367,7 +367,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
 
     Returns
     -------
-    dynid.experiment.identification.IdentificationResult
+    dynid.identification.identify.IdentificationResult
 
     Raises
     ------
@@ -379,7 +379,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         An unknown estimator or ``friction``.
     """
     from ..model.description import builtin_robots
-    from .identification_pipeline import IdentificationPipeline
+    from .pipeline import IdentificationPipeline
 
     pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), tuple(estimators), friction, int(seed), sdp_prior,
                                       robot.name if robot.name in builtin_robots() else "")

@@ -31,7 +31,7 @@ def test_stribeck_and_load_dependent_friction_are_found_where_they_are(tmp_path)
     there, the plain model elsewhere, and the chosen model predicts the validation log better than the plain one."""
     from dataclasses import replace
 
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
     rng = np.random.default_rng(7)
@@ -78,7 +78,7 @@ def test_the_state_at_rest_is_judged_only_on_a_log_with_rests(tmp_path):
     """Point-to-point moves with rests, simulated with no friction at rest (the joint's friction is that of its
     motion only while it moves): the cross-validation chooses "zero" (or a quick relaxation) at rest on the joints
     with a large Coulomb torque; on a Fourier log without rests, every joint stays "held"."""
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
     rng = np.random.default_rng(11)

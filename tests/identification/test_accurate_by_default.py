@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from dynid.io.identification_config import load_identification_config
-from dynid.experiment.identification_run import run_identification
+from dynid.identification.run import run_identification
 
 from ..simulated_logs import simulated_case, truth_beta
 

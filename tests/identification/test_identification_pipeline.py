@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.experiment.identification_pipeline import IdentificationPipeline
+from dynid.identification.pipeline import IdentificationPipeline
 from dynid.exceptions import ConfigError
 from dynid.io.datasets import load_recording
 from dynid.io.identification_config import load_identification_config

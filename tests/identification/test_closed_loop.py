@@ -7,7 +7,7 @@ import dynid
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.rnea import rnea_torques
 from dynid.excitation.paper_trajectories import paper_identification_trajectory
-from dynid.experiment.closed_loop import ClosedLoopExperiment, closed_loop_identify
+from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
 from dynid.exceptions import ConfigError, ShapeError
 from dynid.io.datasets import Recording
 from dynid.preprocessing.bands import estimate_band
@@ -92,7 +92,7 @@ def test_didim_sdp_keeps_every_simulated_model_physically_consistent():
     tolerance) and it converged. Independent truth: the feasibility SDP of Sousa & Cortesão (2014)."""
     from dynid.dynamics.layout import consistency_layout
     from dynid.estimators.physically_consistent import consistency_margin
-    from dynid.experiment.closed_loop_study import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
+    from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 
     setup = _prepare(ClosedLoopStudyConfig(joints=6, realisations=2))
     exp = setup.experiment

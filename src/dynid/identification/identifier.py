@@ -44,9 +44,9 @@ class Identifier:
 
     Attributes
     ----------
-    result_ : dynid.experiment.identification.IdentificationResult
+    result_ : dynid.identification.identify.IdentificationResult
         Everything the identification found (fit, validations, verdict).
-    model_ : dynid.experiment.identified.IdentifiedModel
+    model_ : dynid.identification.identified.IdentifiedModel
         The identified model (predict, validate, export, save).
     params_ : (n_base,) array
         The main estimate's base parameters.
@@ -143,7 +143,7 @@ class Identifier:
         if isinstance(t, (str, Path)):
             result = self._fit_config(Path(t), data_root, validate)
         else:
-            from .identification_run import identify_from_arrays
+            from .run import identify_from_arrays
 
             if q is None or tau is None:
                 raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
@@ -165,7 +165,7 @@ class Identifier:
 
         from ..estimators.registry import parse_estimators
         from ..io.identification_config import load_identification_config
-        from .identification_run import run_identification
+        from .run import run_identification
 
         config = load_identification_config(path, data_root)
         changes: dict[str, Any] = {}
@@ -218,13 +218,13 @@ class Identifier:
 
         Returns
         -------
-        dynid.experiment.identified.Parameters
+        dynid.identification.identified.Parameters
         """
         return self._model().parameters(estimate)
 
     def predict(self, t, q=None, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the identified model along a raw log, prepared as the fit prepared its own
-        (:meth:`dynid.experiment.identified.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
+        (:meth:`dynid.identification.identified.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
         ``fit(t, q, tau)``; ``predict(recording)``; states of one's own: :meth:`predict_states`.
 
         Parameters
@@ -251,7 +251,7 @@ class Identifier:
         return self._model().predict(t, q, dq, ddq, estimate)
 
     def predict_states(self, q, dq, ddq, estimate: str | None = None) -> np.ndarray:
-        """Joint torques at states one computed oneself (:meth:`dynid.experiment.identified.IdentifiedModel.predict_states`).
+        """Joint torques at states one computed oneself (:meth:`dynid.identification.identified.IdentifiedModel.predict_states`).
 
         Parameters
         ----------
@@ -267,7 +267,7 @@ class Identifier:
     def score(self, t, q=None, tau=None, *args, estimate: str | None = None) -> float:
         """R² of the predicted torques of a raw log (``score(t, q, tau)``, symmetric with ``fit``) or of a recording
         (``score(recording)``), on the samples ``dynid validate`` scores
-        (:meth:`dynid.experiment.identified.IdentifiedModel.score`).
+        (:meth:`dynid.identification.identified.IdentifiedModel.score`).
 
         The earlier form ``score(q, dq, ddq, tau)`` on states of one's own still works, with a FutureWarning.
 

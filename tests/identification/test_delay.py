@@ -5,8 +5,8 @@ import pytest
 
 import dynid
 from dynid.exceptions import ConfigError
-from dynid.experiment.delay import delayed, estimate_delay
-from dynid.experiment.simulated_logs import simulated_log
+from dynid.identification.delay import delayed, estimate_delay
+from dynid.studies.simulated_logs import simulated_log
 
 
 @pytest.mark.parametrize("delay", [2.5, -1.25])

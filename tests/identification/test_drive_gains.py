@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
-from dynid.experiment.drive_gains import identify_drive_gains, identify_payload
+from dynid.identification.drive_gains import identify_drive_gains, identify_payload
 from dynid.io.datasets import Recording
 from dynid.model.spatial import inertial_from_physical
 from dynid.preprocessing.pipeline import Preprocessing, prepare
@@ -53,7 +53,7 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     from pathlib import Path
 
     from dynid.io.identification_config import load_identification_config
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
 
     from ..conftest import shared_data, without_wall_times
 
@@ -85,7 +85,7 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     from dynid.processes import allow_forks
     from dynid.threads import cores
     from dynid.io.identification_config import load_identification_config
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
 
     from ..conftest import shared_data, without_wall_times
 
@@ -110,7 +110,7 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
 
 
 def test_payload_parameters_the_loaded_run_does_not_determine_are_said_so():
-    from dynid.experiment.drive_gains import DriveGainEstimate, GainsAndPayload, PayloadEstimate
+    from dynid.identification.drive_gains import DriveGainEstimate, GainsAndPayload, PayloadEstimate
     from dynid.report.summaries import drive_gains_blocks
 
     payload = PayloadEstimate(("XX", "MX", "MY", "MZ", "M"), np.array([0.004, 0.03, -0.001, 0.17, 2.8]),
@@ -130,7 +130,7 @@ def test_the_currents_noise_is_taken_out_of_the_gains():
     its variance (errors in variables). UR10e simulated as above at 0.02 A, three seeds, the same filter for every run:
     least squares gives the wrist's K5 about 4 % low; bias-compensated least squares takes the noise's variance out of
     the normal equations and leaves a third of that at most, the other gains within 0.2 %."""
-    import dynid.experiment.drive_gains as dg
+    import dynid.identification.drive_gains as dg
 
     plain, compensated = [], []
     for seed in range(3):
@@ -169,7 +169,7 @@ def test_a_drive_gains_error_names_the_runs_it_comes_from(tmp_path):
     from pathlib import Path
 
     from dynid.exceptions import DynIdError
-    from dynid.experiment.identification_run import run_identification
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
     from ..conftest import shared_data

@@ -7,7 +7,7 @@ import pytest
 
 from dynid.exceptions import ConfigError
 from dynid.io.identification_config import load_identification_config
-from dynid.experiment.identification_run import run_identification, run_validation
+from dynid.identification.run import run_identification, run_validation
 from dynid.report.identification_run import save_identification
 
 from ..simulated_logs import simulated_case, truth_beta
@@ -81,7 +81,7 @@ def test_estimator_names_are_case_insensitive(tmp_path):
 def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
     """``identify(..., "wls")`` is WLS, not the estimators "w", "l", "s"."""
     from dynid.dynamics.base_parameters import base_parameters
-    from dynid.experiment.identification import identify
+    from dynid.identification.identify import identify
     from dynid.io.datasets import load_recording
     from dynid.preprocessing.pipeline import prepare
 

@@ -1,0 +1,46 @@
+"""Old import paths of ``dynid.experiment`` keep working for a release, say where the module went, and give the very
+same objects (docs/changelog.md)."""
+
+import importlib
+import subprocess
+import sys
+import warnings
+
+import pytest
+
+from dynid.experiment import MOVED
+
+
+@pytest.mark.parametrize("old", sorted(MOVED))
+def test_an_old_module_path_warns_and_is_the_new_module(old):
+    new = importlib.import_module(MOVED[old])
+    sys.modules.pop(f"dynid.experiment.{old}", None)
+    with pytest.warns(FutureWarning, match=f"dynid.experiment.{old} moved to {MOVED[old]}"):
+        aliased = importlib.import_module(f"dynid.experiment.{old}")
+    assert aliased is new
+    assert new.__spec__.name == MOVED[old] and new.__name__ == MOVED[old]  # the alias leaves the module's identity
+
+
+def test_the_old_paper_names_warn_and_are_the_new_objects():
+    from dynid.studies.paper import run_paper_experiment
+
+    code = ("import warnings; warnings.simplefilter('error')\n"
+            "from dynid.experiment import run_paper_experiment")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode != 0 and "moved to dynid.studies.paper" in out.stderr
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        import dynid.experiment as old
+
+        assert old.run_paper_experiment is run_paper_experiment
+
+
+def test_every_moved_module_exists_and_no_old_file_is_left():
+    from pathlib import Path
+
+    import dynid
+
+    root = Path(dynid.__file__).parent
+    assert [p.name for p in (root / "experiment").glob("*.py")] == ["__init__.py"]
+    for new in MOVED.values():
+        assert (root.parent / (new.replace(".", "/") + ".py")).exists(), new
