@@ -20,8 +20,8 @@ import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.identification.identify import identify
-from dynid.preprocessing.pipeline import PreparedData, Preprocessing
 from dynid.model.description import load_robot
+from dynid.preprocessing.pipeline import PreparedData, Preprocessing
 
 RATE = 1000.0
 DECIMATION = 10

@@ -23,11 +23,11 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def main(hours: float) -> None:
-    from dynid.identification.run import run_identification
-    from dynid.identification.identified import IdentifiedModel
     from dynid.fleet.monitor import dated_logs, monitor_logs
-    from dynid.studies.simulated_fleet import simulate_service_life
+    from dynid.identification.identified import IdentifiedModel
+    from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
+    from dynid.studies.simulated_fleet import simulate_service_life
 
     folder = Path(tempfile.mkdtemp(prefix="dynid-monitor-bench-"))
     try:

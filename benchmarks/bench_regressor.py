@@ -10,13 +10,12 @@ cannot be built).
 
 from __future__ import annotations
 
-
 import numpy as np
 import pinocchio as pin
-
 from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
 
-from dynid.dynamics import _regressor_kernel, regressor as regressor_module
+from dynid.dynamics import _regressor_kernel
+from dynid.dynamics import regressor as regressor_module
 from dynid.dynamics.regressor import friction_torques, regressor
 from dynid.dynamics.rnea import pinocchio_model
 from dynid.model.description import load_robot

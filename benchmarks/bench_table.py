@@ -18,8 +18,6 @@ from pathlib import Path
 
 import numpy as np
 
-from timing import best_of  # benchmarks/timing.py
-
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 DATA = Path(os.environ.get("DYNID_SHARED_DATA", REPO.parent / "shared" / "data"))
@@ -92,7 +90,8 @@ def main() -> None:
 
     # regressor: dynid's batched kernel against a loop over Pinocchio's computeJointTorqueRegressor, both
     # writing the full array (benchmarks/bench_regressor.py)
-    from bench_regressor import N as n, measure
+    from bench_regressor import N as n
+    from bench_regressor import measure
 
     t_pin, t_dyn = measure(repeats=10)  # best of ten: a moment when both cores are free
     row("regressor, er16, 25 000 samples: dynid vs Pinocchio loop (ratio)", t_pin / t_dyn, "x", 6.0,

@@ -31,11 +31,11 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 from scipy import signal  # noqa: E402
 
-from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay  # noqa: E402
 from dynid.io.datasets import Recording  # noqa: E402
 from dynid.preprocessing.pipeline import Preprocessing, prepare  # noqa: E402
 from dynid.preprocessing.strategies import strategy_for  # noqa: E402
 from dynid.simulation.closed_loop import ClosedLoopNoise, simulate_closed_loop  # noqa: E402
+from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay  # noqa: E402
 
 SHARE = 0.95
 

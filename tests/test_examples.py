@@ -53,7 +53,7 @@ def test_package_exports_the_entry_points():
     for name in dynid.__all__:
         assert getattr(dynid, name) is not None, name
     with pytest.raises(AttributeError):
-        dynid.nonexistent
+        _ = dynid.nonexistent
 
 
 def test_own_robot_example_identifies_from_a_urdf_and_a_csv(tmp_path):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-from typing import Callable
+from collections.abc import Callable
 
 from .exceptions import ConfigError
 from .extras import require

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import os
 import tempfile
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -110,7 +110,7 @@ class StoredColumns:
         self.stop = int(min(f.n for f in self.files) if stop is None else stop)
 
     @classmethod
-    def from_columns(cls, columns) -> "StoredColumns":
+    def from_columns(cls, columns) -> StoredColumns:
         """Stored copies of 1-D arrays, one file per column.
 
         Parameters
@@ -170,7 +170,7 @@ class StoredColumns:
             out[:, j] = f.read(self.start + a, self.start + b)
         return out
 
-    def select(self, columns, n_rows: int | None = None) -> "StoredColumns":
+    def select(self, columns, n_rows: int | None = None) -> StoredColumns:
         """A view of some columns and the first rows; nothing is copied.
 
         Parameters
@@ -188,7 +188,7 @@ class StoredColumns:
         stop = self.stop if n_rows is None else self.start + n_rows
         return StoredColumns([self.files[int(j)] for j in columns], self.start, stop)
 
-    def map_columns(self, along_time: Callable[[np.ndarray, int], np.ndarray]) -> "StoredColumns":
+    def map_columns(self, along_time: Callable[[np.ndarray, int], np.ndarray]) -> StoredColumns:
         """New stored columns computed column by column, one column in memory at a time.
 
         Parameters
@@ -203,7 +203,7 @@ class StoredColumns:
         """
         return StoredColumns.from_columns(along_time(self.column(j), j) for j in range(len(self.files)))
 
-    def map_rows(self, row_wise: Callable[[np.ndarray], np.ndarray], chunk: int | None = None) -> "StoredColumns":
+    def map_rows(self, row_wise: Callable[[np.ndarray], np.ndarray], chunk: int | None = None) -> StoredColumns:
         """New stored columns computed chunk of rows by chunk of rows.
 
         Parameters

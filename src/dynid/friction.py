@@ -20,8 +20,8 @@ viscous, Stribeck); Olsson, Åström et al., Eur. J. Control 4(3), 1998 (smooth 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Callable
 
 import numpy as np
 
@@ -297,7 +297,7 @@ class Velocities:
     direction: np.ndarray | None = None
     load: np.ndarray | None = None
 
-    def rows(self, a: int, b: int) -> "Velocities":
+    def rows(self, a: int, b: int) -> Velocities:
         """The same, with the direction and load of some samples only.
 
         Parameters

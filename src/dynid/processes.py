@@ -118,7 +118,7 @@ class ForkedCall:
         os.close(write)
         self._read = read
 
-    def __enter__(self) -> "ForkedCall":
+    def __enter__(self) -> ForkedCall:
         return self
 
     def __exit__(self, *exc) -> None:

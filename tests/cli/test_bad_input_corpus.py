@@ -276,7 +276,8 @@ URDFS = {
 @pytest.mark.parametrize("case", sorted(URDFS))
 def test_bad_urdfs_in_a_real_process(tmp_path, case):
     """A separate process: urdfdom prints on the process's own standard error, which must stay clean."""
-    from .refusals import assert_refused as assert_refused_process, dynid_process
+    from .refusals import assert_refused as assert_refused_process
+    from .refusals import dynid_process
 
     change, message = URDFS[case]
     text = URDF

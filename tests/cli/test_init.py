@@ -7,7 +7,8 @@ import numpy as np
 
 import dynid
 
-from .refusals import assert_refused, dynid as run
+from .refusals import assert_refused
+from .refusals import dynid as run
 
 URDF = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
 

@@ -2,8 +2,8 @@ import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import observation_matrix
-from dynid.studies.paper_reference import TABLE2, paper_symbol
 from dynid.model.description import load_robot
+from dynid.studies.paper_reference import TABLE2, paper_symbol
 
 from ..conftest import random_states
 

@@ -4,9 +4,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from dynid.friction import coulomb_column
 from dynid.dynamics.regressor import regressor
 from dynid.dynamics.rnea import pinocchio_model
+from dynid.friction import coulomb_column
 from dynid.model.description import load_robot
 
 

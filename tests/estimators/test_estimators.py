@@ -3,8 +3,14 @@ import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import observation_matrix
-from dynid.estimators import (BeeColonyEstimator, DifferentialEvolutionEstimator, IterativelyReweightedLeastSquares,
-                              OrdinaryLeastSquares, ParticleSwarmEstimator, paper_objective)
+from dynid.estimators import (
+    BeeColonyEstimator,
+    DifferentialEvolutionEstimator,
+    IterativelyReweightedLeastSquares,
+    OrdinaryLeastSquares,
+    ParticleSwarmEstimator,
+    paper_objective,
+)
 from dynid.exceptions import IdentifiabilityError, ShapeError
 from dynid.model.description import load_robot
 

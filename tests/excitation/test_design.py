@@ -9,7 +9,7 @@ from dynid.dynamics.kinematics import tool_positions
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
-from dynid.excitation.design import (ExcitationProblem, _Layout, _Objective, condition_number, design_excitation)
+from dynid.excitation.design import ExcitationProblem, _Layout, _Objective, condition_number, design_excitation
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
 from dynid.model.description import load_robot
 

@@ -6,8 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from dynid.studies.simulated_fleet import simulate_fleet
 from dynid.simulation.measurements import NoiseModel
+from dynid.studies.simulated_fleet import simulate_fleet
 
 from ..cli.refusals import assert_refused, dynid
 

@@ -8,8 +8,8 @@ import pytest
 
 from dynid.estimators.recursive import RecursiveLeastSquares
 from dynid.exceptions import ShapeError
-from dynid.studies.simulated_fleet import simulate_service_life
 from dynid.fleet.change_detection import Cusum, cusum_threshold
+from dynid.studies.simulated_fleet import simulate_service_life
 
 from ..cli.refusals import assert_refused, dynid
 

@@ -10,8 +10,8 @@ excitation and point-to-point moves with rests, so with many velocity reversals)
 import numpy as np
 import pytest
 
-from dynid.io.identification_config import load_identification_config
 from dynid.identification.run import run_identification
+from dynid.io.identification_config import load_identification_config
 
 from ..simulated_logs import simulated_case, truth_beta
 

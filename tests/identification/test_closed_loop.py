@@ -6,9 +6,9 @@ import pytest
 import dynid
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.rnea import rnea_torques
+from dynid.exceptions import ConfigError, ShapeError
 from dynid.excitation.paper_trajectories import paper_identification_trajectory
 from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
-from dynid.exceptions import ConfigError, ShapeError
 from dynid.io.datasets import Recording
 from dynid.preprocessing.bands import estimate_band
 from dynid.preprocessing.pipeline import Preprocessing

@@ -12,7 +12,8 @@ from dynid.dynamics.rnea import rnea_torques
 from dynid.excitation.paper_trajectories import paper_identification_trajectory
 from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 
-from ..cli.refusals import assert_refused, dynid as dynid_cli
+from ..cli.refusals import assert_refused
+from ..cli.refusals import dynid as dynid_cli
 
 N = 6
 COLUMNS = ", ".join(f'"q{j}"' for j in range(1, N + 1))

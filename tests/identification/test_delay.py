@@ -38,7 +38,6 @@ def test_the_bound_is_checked():
 def test_identify_says_which_torque_delay_to_give():
     """dynid identify's verdict on a log whose torques come 2.5 samples late: the finding names the delay and the
     setting that undoes it; identified again with that setting, or on the log without delay, no delay finding."""
-    from dataclasses import replace
 
     robot = dynid.load_robot("ur10e")
     log = simulated_log(robot, seconds=30.0, rate=250.0, seed=3)

@@ -52,10 +52,10 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     authors' (which fix K1 = 10 and are uncertain by 10-20 %, SOURCE.md), the payload's mass within 10 %."""
     from pathlib import Path
 
-    from dynid.io.identification_config import load_identification_config
     from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
 
-    from ..conftest import shared_data, without_wall_times
+    from ..conftest import shared_data
 
     root = shared_data("ur10e_mamedov2020")
     cfg = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml", data_root=root)
@@ -81,11 +81,11 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     from pathlib import Path
 
     from dynid import processes
+    from dynid.identification.run import run_identification
     from dynid.io import write_json
+    from dynid.io.identification_config import load_identification_config
     from dynid.processes import allow_forks
     from dynid.threads import cores
-    from dynid.io.identification_config import load_identification_config
-    from dynid.identification.run import run_identification
 
     from ..conftest import shared_data, without_wall_times
 

@@ -6,8 +6,8 @@ import pytest
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
-from dynid.io.identification_config import load_identification_config
 from dynid.identification.run import run_identification
+from dynid.io.identification_config import load_identification_config
 from dynid.model.description import load_robot
 
 from ..conftest import shared_data, sine_motion, without_wall_times

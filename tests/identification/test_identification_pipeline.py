@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.identification.pipeline import IdentificationPipeline
 from dynid.exceptions import ConfigError
+from dynid.identification.pipeline import IdentificationPipeline
 from dynid.io.datasets import load_recording
 from dynid.io.identification_config import load_identification_config
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.io.identification_config import load_identification_config
 from dynid.identification.run import run_identification, run_validation
+from dynid.io.identification_config import load_identification_config
 from dynid.report.identification_run import save_identification
 
 from ..simulated_logs import simulated_case, truth_beta

@@ -3,7 +3,6 @@ decimation the config gives is every log's, as it was before the validation logs
 
 import json
 
-
 from ..cli.refusals import dynid
 from ..simulated_logs import simulated_case
 

@@ -51,8 +51,8 @@ def test_every_shipped_config_is_valid_against_its_schema(path):
 
 
 def test_the_tests_configs_are_valid_against_the_schema(tmp_path):
-    from tests.simulated_logs import config_text, robot_toml
     from tests.cli.test_bad_input_corpus import CONFIG
+    from tests.simulated_logs import config_text, robot_toml
 
     docs = [tomllib.loads(config_text(robot_toml("ur10e", tmp_path), tmp_path, "a.csv", "b.csv", 6, "[preprocessing]\nband = 1.0\n")),
             tomllib.loads(CONFIG), tomllib.loads(Path(robot_toml("er16", tmp_path)).read_text())]

@@ -58,7 +58,7 @@ def _users_mjcf(robot, rng, inertiafromgeom="true"):
     lines += [f"{tip}<body name='tool' pos='0 0 0.1'><inertial pos='0 0 0.02' mass='0.7' diaginertia='1e-3 1e-3 1e-3'/>"
               "<site name='tcp'/></body>"]
     lines += ["  " * (j + 3) + "</body>" for j in range(robot.n_dof, -1, -1)]
-    lines += ["  </worldbody>", "  <actuator><motor name='m1' joint='%s'/></actuator>" % robot.joints[0].name, "</mujoco>", ""]
+    lines += ["  </worldbody>", f"  <actuator><motor name='m1' joint='{robot.joints[0].name}'/></actuator>", "</mujoco>", ""]
     return "\n".join(lines)
 
 

@@ -5,7 +5,13 @@ import pytest
 from scipy import signal
 
 from dynid.exceptions import ConfigError
-from dynid.preprocessing.bands import PARALLEL_FACTOR, POSITION_FACTOR, cutoffs_from_band, estimate_band, excitation_band
+from dynid.preprocessing.bands import (
+    PARALLEL_FACTOR,
+    POSITION_FACTOR,
+    cutoffs_from_band,
+    estimate_band,
+    excitation_band,
+)
 from dynid.preprocessing.filters import decimation_cutoff, edge_padding, parallel_decimation
 from dynid.preprocessing.pipeline import Preprocessing
 

@@ -3,8 +3,13 @@ import pytest
 from scipy import signal
 
 from dynid.exceptions import ConfigError
-from dynid.preprocessing.filters import (butterworth_filtfilt, decimation_cutoff, differentiate, edge_padding,
-                                        parallel_decimation)
+from dynid.preprocessing.filters import (
+    butterworth_filtfilt,
+    decimation_cutoff,
+    differentiate,
+    edge_padding,
+    parallel_decimation,
+)
 
 
 def test_filtfilt_keeps_slow_sine_without_phase_lag_and_removes_fast_one():

@@ -8,10 +8,10 @@ import pytest
 from dynid.column_store import StoredColumns
 from dynid.exceptions import ConfigError
 from dynid.identification.closed_loop import _rows
-from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 from dynid.io.datasets import Recording
 from dynid.preprocessing.pipeline import Preprocessing, prepare, torque_delayed
 from dynid.simulation.closed_loop import simulate_closed_loop
+from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 
 
 def _log(n=500, rate=100.0, seed=0):

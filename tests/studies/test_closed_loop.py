@@ -10,9 +10,14 @@ import pytest
 from dynid.cli.app import main
 from dynid.dynamics.regressor import observation_matrix
 from dynid.exceptions import ConfigError
-from dynid.studies.closed_loop import (ClosedLoopStudyConfig, ClosedLoopStudyResult, _prepare,
-                                                run_closed_loop_study, simulate_realisation)
 from dynid.simulation.closed_loop import simulate_closed_loop
+from dynid.studies.closed_loop import (
+    ClosedLoopStudyConfig,
+    ClosedLoopStudyResult,
+    _prepare,
+    run_closed_loop_study,
+    simulate_realisation,
+)
 
 SMALL = ClosedLoopStudyConfig(encoder_noise=(0.0, 1e-2), torque_noise=(0.1,), realisations=3,
                               estimators=("ols", "wls", "irls", "idim-iv"), duration=10.0)

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.studies.paper import PaperExperimentConfig, run_paper_experiment
 from dynid.studies import paper_reference as ref
+from dynid.studies.paper import PaperExperimentConfig, run_paper_experiment
 
 FAST = dict(duration=10.0, rate=200.0, maxiter=5)
 
@@ -135,9 +135,9 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     to round-off in the end samples' polynomial fits, as smoothing every standard column and then keeping them."""
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.excitation.paper_trajectories import paper_validation_trajectory
-    from dynid.studies.paper import simulate_dataset
     from dynid.model.description import load_robot
     from dynid.simulation import NoiseModel
+    from dynid.studies.paper import simulate_dataset
 
     robot = load_robot("er16")
     base = base_parameters(robot, rng=0)
@@ -145,9 +145,9 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     args = (robot, base, paper_validation_trajectory(0.1 * np.pi, 6), t, NoiseModel(0.05, 1e-5))
     rest = (robot.standard_parameters(), 2, "validation", [])
     alone = simulate_dataset(*args, np.random.default_rng(4), *rest)
+    from dynid.dynamics.layout import consistency_layout
     from dynid.estimators.estimation import Estimation
     from dynid.estimators.registry import FitData
-    from dynid.dynamics.layout import consistency_layout
 
     with_sdp = Estimation(("ols", "sdp"), FitData(None, None, 6, None, base, layout=consistency_layout(robot)), keep_rows=True)
     kept = simulate_dataset(*args, np.random.default_rng(4), *rest, with_sdp)

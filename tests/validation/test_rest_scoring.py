@@ -7,8 +7,15 @@ import numpy as np
 import pytest
 
 from ..cli.refusals import dynid
-from ..simulated_logs import config_text, fourier_motion, point_to_point_motion, robot_toml, truth_robot, write_log, \
-    write_truth
+from ..simulated_logs import (
+    config_text,
+    fourier_motion,
+    point_to_point_motion,
+    robot_toml,
+    truth_robot,
+    write_log,
+    write_truth,
+)
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Optional
 
 import typer
 
@@ -62,13 +61,13 @@ def _check_out(out) -> None:
     check_output_folder(out)
 
 
-def _renamed(methods: Optional[str]) -> None:
+def _renamed(methods: str | None) -> None:
     """``--methods`` was renamed ``--estimators``: a one-line message, not a usage error."""
     if methods is not None:
         raise DynIdError(f"--methods is now --estimators (the same values): --estimators {methods}")
 
 
-def _parse_weights(text: Optional[str]):
+def _parse_weights(text: str | None):
     if text is None:
         return None
     try:
@@ -110,7 +109,7 @@ class _Command:
         Draw figures in a process forked before the live line starts (:func:`dynid.report.output.figure_process`).
     """
 
-    def __init__(self, name: str, quiet: bool, out: Optional[Path] = None, figures: bool = False):
+    def __init__(self, name: str, quiet: bool, out: Path | None = None, figures: bool = False):
         self.name, self.out, self.figures = name, out, figures
         self.reporter = Reporter(quiet)
 
@@ -160,7 +159,7 @@ def _version(value: bool) -> None:
 @app.callback()
 def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
                                        help="Print dynid's version and exit."),
-          plugin: Optional[list[str]] = typer.Option(None, "--plugin", metavar="FILE_OR_MODULE",
+          plugin: list[str] | None = typer.Option(None, "--plugin", metavar="FILE_OR_MODULE",
                                                      help="A Python file or module that registers estimators or preprocessing "
                                                           "strategies of your own (repeatable; also DYNID_PLUGINS).")) -> None:
     """dynid: dynamic model identification of industrial robot arms."""
@@ -185,10 +184,10 @@ def run(
     abc_limit: int = typer.Option(15, help="ABC scout limit."),
     abc_iterations: int = typer.Option(50, help="ABC iterations Tmax."),
     abc_bounds: str = typer.Option("auto", help="ABC search box: auto, table3 (paper Table 3) or scaled (±(2|β_OLS|+1))."),
-    weights: Optional[str] = typer.Option(None, help="Eq. 9 weights per joint, comma separated (default all 1)."),
+    weights: str | None = typer.Option(None, help="Eq. 9 weights per joint, comma separated (default all 1)."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized (designed for the run, min cond), or an excitation.json of dynid excite."),
-    estimators: Optional[str] = typer.Option(None, help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default), or all registered."),
-    methods: Optional[str] = typer.Option(None, hidden=True),
+    estimators: str | None = typer.Option(None, help="Estimators compared, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso (default), or all registered."),
+    methods: str | None = typer.Option(None, hidden=True),
     bootstrap: int = typer.Option(100, help="Moving-block bootstrap resamples for OLS and WLS confidence intervals (0: none)."),
     strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
     figures: bool = typer.Option(True, help="Write the figures (--no-figures: results.json only)."),
@@ -199,8 +198,8 @@ def run(
     """Reproduce the paper's identification experiment on a simulated robot (default: ER-16, joints 1-3)
     and compare the estimators on it."""
     from ..estimators.registry import label, parse_estimators
-    from ..studies.paper import PaperExperimentConfig, run_paper_experiment
     from ..report.paper_run import save_paper_run
+    from ..studies.paper import PaperExperimentConfig, run_paper_experiment
 
     def prepare():
         from ..model.description import load_robot
@@ -231,7 +230,7 @@ def run(
 def identify(
     config: Path = typer.Argument(..., help="Identification config (TOML), e.g. configs/ur10e.toml."),
     out: Path = typer.Option(Path("dynid-identify"), help="Output folder for results.json and figures."),
-    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     validate: bool = typer.Option(True, help="Also validate on the config's [[validation]] datasets."),
     figures: bool = typer.Option(True, help="Write the torque figures (--no-figures: results.json only)."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every table (parameters, preprocessing, "
@@ -269,10 +268,10 @@ def identify(
 def export(
     config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
-    urdf: Optional[Path] = typer.Option(None, help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
-    mjcf: Optional[Path] = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
-    mjcf_model: Optional[Path] = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept)."),
-    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    urdf: Path | None = typer.Option(None, help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
+    mjcf: Path | None = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
+    mjcf_model: Path | None = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept)."),
+    data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     quiet: bool = QUIET,
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
@@ -365,7 +364,7 @@ def _read_results(results: Path, robot: str) -> dict:
     return read_results(results, robot, "; run dynid identify first or give --results")
 
 
-def _parse_rows(text: Optional[str]):
+def _parse_rows(text: str | None):
     if text is None:
         return None
     try:
@@ -379,10 +378,10 @@ def _parse_rows(text: Optional[str]):
 def validate(
     config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
-    file: Optional[Path] = typer.Option(None, help="Validate on this log instead (same column map as the identification data)."),
-    rows: Optional[str] = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
+    file: Path | None = typer.Option(None, help="Validate on this log instead (same column map as the identification data)."),
+    rows: str | None = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
     out: Path = typer.Option(Path("dynid-validate"), help="Output folder for validation.json and figures."),
-    data_root: Optional[Path] = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every log's table (error, RMSE and ρ per joint "
                                                                  "and parameter set); report.html has them too."),
     quiet: bool = QUIET,
@@ -427,8 +426,8 @@ def validate(
 def excite(
     config: Path = typer.Argument(..., help="Excitation config (TOML), e.g. configs/excite-er16.toml."),
     out: Path = typer.Option(Path("dynid-excite"), help="Output folder for excitation.json, excitation.csv and figures."),
-    starts: Optional[int] = typer.Option(None, help="Number of optimisation starts (overrides design.starts)."),
-    seed: Optional[int] = typer.Option(None, help="Seed of the random starts (overrides design.seed)."),
+    starts: int | None = typer.Option(None, help="Number of optimisation starts (overrides design.starts)."),
+    seed: int | None = typer.Option(None, help="Seed of the random starts (overrides design.seed)."),
     quiet: bool = QUIET,
 ) -> None:
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
@@ -458,7 +457,7 @@ def excite(
 def init(
     urdf: Path = typer.Argument(..., help="The robot's URDF."),
     log: Path = typer.Argument(..., help="A CSV log of the robot moving: time, joint angles, joint torques or currents."),
-    validation: Optional[list[Path]] = typer.Argument(None, help="Other logs of the same layout, to validate on."),
+    validation: list[Path] | None = typer.Argument(None, help="Other logs of the same layout, to validate on."),
     out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
     force: bool = typer.Option(False, help="Overwrite --out if it exists."),
     quiet: bool = QUIET,
@@ -496,7 +495,7 @@ def init(
 @app.command()
 def migrate(
     config: Path = typer.Argument(..., help="An identify config (TOML) of an earlier release."),
-    out: Optional[Path] = typer.Option(None, help="Write the migrated config here (default: rewrite CONFIG in place)."),
+    out: Path | None = typer.Option(None, help="Write the migrated config here (default: rewrite CONFIG in place)."),
     quiet: bool = QUIET,
 ) -> None:
     """Rewrite an identify config of an earlier release for this one (renamed keys), keeping its comments and layout,
@@ -538,7 +537,7 @@ def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", ex
         raise DynIdError(f"{option}: expected comma-separated noise levels in {unit} like {example}, got {text!r}") from None
 
 
-def _closed_loop_estimators(text: Optional[str]) -> tuple[str, ...]:
+def _closed_loop_estimators(text: str | None) -> tuple[str, ...]:
     """The estimators of a closed-loop study (checked by :meth:`ClosedLoopStudyConfig.validate`)."""
     from ..studies.closed_loop import CLOSED_LOOP_ESTIMATORS
 
@@ -551,12 +550,12 @@ def montecarlo(
     joints: int = typer.Option(3, help="Number of joints identified."),
     noise_levels: str = typer.Option("0.02,0.05,0.1", help="Motor current noise standard deviations [A], comma separated."),
     realisations: int = typer.Option(100, help="Noise realisations per level."),
-    estimators: Optional[str] = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
+    estimators: str | None = typer.Option(None, help="Estimators, comma separated: ols, wls, irls, lad, sdp, abc, abc10, de, pso, "
                                                         "any registered, or all (default: ols,wls,irls,lad,sdp,abc); with --closed-loop also idim-iv, didim, didim-sdp (default: the first six and idim-iv, didim)."),
-    methods: Optional[str] = typer.Option(None, hidden=True),
+    methods: str | None = typer.Option(None, hidden=True),
     seed: int = typer.Option(0, help="Seed of every random number of the study."),
     duration: float = typer.Option(25.0, help="Recording length [s]."),
-    rate: Optional[float] = typer.Option(None, help="Sampling rate [Hz] (default 200; 1000 in closed loop, the control rate; the paper: 1000)."),
+    rate: float | None = typer.Option(None, help="Sampling rate [Hz] (default 200; 1000 in closed loop, the control rate; the paper: 1000)."),
     abc_bounds: str = typer.Option("scaled", help="Search box of ABC/DE/PSO/LAD: scaled (±(2|β_OLS|+1), holds the truth) or table3."),
     excitation: str = typer.Option("paper", help="Identification trajectory: paper (β1), optimized, or an excitation.json."),
     strategy: str = typer.Option("paper", help="Preprocessing strategy of the simulated logs: paper (eq. 17 and the Fourier fit), parallel, or one registered."),
@@ -564,17 +563,17 @@ def montecarlo(
                                                                   "noise grid of Leboutet et al. 2021, and fit IDIM-IV and DIDIM beside the others."),
     encoder_noise: str = typer.Option("1e-4,1e-3,1e-2", help="Closed loop: encoder noise standard deviations [°], comma separated."),
     torque_noise: str = typer.Option("0.05,0.1", help="Closed loop: torque noise standard deviations [N·m], comma separated."),
-    band: Optional[float] = typer.Option(None, help="Closed loop: the excitation band [Hz] given to the preprocessing (default: derived from each log)."),
+    band: float | None = typer.Option(None, help="Closed loop: the excitation band [Hz] given to the preprocessing (default: derived from each log)."),
     bandwidth: float = typer.Option(5.0, help="Closed loop: the PID's bandwidth [Hz]."),
-    scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); default: a LocalCluster of this machine's cores."),
-    workers: Optional[int] = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
+    scheduler: str | None = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); default: a LocalCluster of this machine's cores."),
+    workers: int | None = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
     out: Path = typer.Option(Path("dynid-montecarlo"), help="Output folder for montecarlo.json, the estimates CSV and figures."),
     quiet: bool = QUIET,
 ) -> None:
     """Monte Carlo study: bias and spread of each estimator over noise realisations against the Cramér–Rao bound."""
     from ..estimators.registry import parse_estimators
-    from ..studies.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
     from ..report.montecarlo_run import save_montecarlo
+    from ..studies.montecarlo import DEFAULT_ESTIMATORS, MonteCarloConfig, run_montecarlo
 
     def prepare():
         _renamed(methods)
@@ -621,10 +620,10 @@ def montecarlo(
 def fleet(
     manifest: Path = typer.Argument(..., help="Fleet manifest (TOML): the units, their logs, a template config."),
     out: Path = typer.Option(Path("dynid-fleet"), help="Output folder: fleet.json, fleet.parquet, fleet.html, units/<id>/."),
-    data_root: Optional[Path] = typer.Option(None, help="Data root of units given by their own config."),
-    scheduler: Optional[str] = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); its workers read the "
+    data_root: Path | None = typer.Option(None, help="Data root of units given by their own config."),
+    scheduler: str | None = typer.Option(None, help="Dask scheduler address (e.g. tcp://host:8786); its workers read the "
                                                        "logs at the manifest's paths. Default: a LocalCluster of this machine's cores."),
-    workers: Optional[int] = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
+    workers: int | None = typer.Option(None, help="Worker processes of the LocalCluster (default: number of cores)."),
     quiet: bool = QUIET,
 ) -> None:
     """Identify every unit of a fleet on a Dask cluster, flag the units that stand out, pool their estimates."""
@@ -662,7 +661,7 @@ def monitor(
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json of the last full identification."),
     out: Path = typer.Option(Path("dynid-monitor"), help="Output folder: monitor.json, monitor.parquet, monitor.png, "
                                                          "and the state the next run goes on from."),
-    data_root: Optional[Path] = typer.Option(None, help="Folder of the config's data files."),
+    data_root: Path | None = typer.Option(None, help="Folder of the config's data files."),
     window: float = typer.Option(10.0, help="Seconds of log per window of re-identified friction terms."),
     reference_windows: int = typer.Option(60, help="Windows that set each term's reference (the first ones)."),
     false_alarm_days: float = typer.Option(30.0, help="One false alarm per this many days of logs, on average."),
@@ -675,8 +674,15 @@ def monitor(
     Run again on a growing folder, it goes on from the state the last run left in --out and reads only the new logs.
     """
     from ..exceptions import DataError
-    from ..fleet.monitor import (STATE_FILE, MonitorSettings, dated_logs, legacy_state_refusal, monitor_fingerprint,
-                                      monitor_logs, resumed_monitor)
+    from ..fleet.monitor import (
+        STATE_FILE,
+        MonitorSettings,
+        dated_logs,
+        legacy_state_refusal,
+        monitor_fingerprint,
+        monitor_logs,
+        resumed_monitor,
+    )
     from ..io.identification_config import load_identification_config
 
     def prepare():
@@ -725,7 +731,7 @@ def _interrupt(signum, frame):
     raise Interrupted(signum)
 
 
-def main(argv: Optional[list[str]] = None) -> int:
+def main(argv: list[str] | None = None) -> int:
     """Console-script entry point.
 
     Ctrl-C ends with one line and exit code 130 (128 + SIGINT), SIGTERM likewise with 143 (128 + SIGTERM): the

@@ -145,7 +145,7 @@ def _trace(rp, pp, axes, gravity, npj: int, n_drive: int):
 # ---- LLVM IR -------------------------------------------------------------------------------------------
 
 def _hex(x: float) -> str:
-    return "0x%016X" % struct.unpack("<Q", struct.pack("<d", x))[0]
+    return f"0x{struct.unpack('<Q', struct.pack('<d', x))[0]:016X}"
 
 
 def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:

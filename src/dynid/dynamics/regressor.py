@@ -25,8 +25,8 @@ import threading
 import numpy as np
 
 from ..checks import check_states
-from ..model.robot import Robot
 from ..friction import drive_columns
+from ..model.robot import Robot
 from . import _regressor_kernel as kernel
 
 NUMPY_SAMPLES = 60_000

@@ -101,7 +101,7 @@ class LeastSquaresAccumulator:
             self.rows[j] += int(sel.sum())
 
     @classmethod
-    def merged(cls, accumulators) -> "LeastSquaresAccumulator":
+    def merged(cls, accumulators) -> LeastSquaresAccumulator:
         """One accumulator holding the rows of several (the same sizes).
 
         Parameters

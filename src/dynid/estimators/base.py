@@ -198,7 +198,7 @@ class Estimator:
                  if p.kind == p.KEYWORD_ONLY]
         return {n: getattr(self, n) for n in names}
 
-    def set_params(self, **params) -> "Estimator":
+    def set_params(self, **params) -> Estimator:
         """Set hyper-parameters by name.
 
         Parameters
@@ -222,7 +222,7 @@ class Estimator:
             setattr(self, name, value)
         return self
 
-    def clone(self) -> "Estimator":
+    def clone(self) -> Estimator:
         """An unfitted estimator with the same hyper-parameters.
 
         Returns
@@ -297,7 +297,7 @@ class AccumulatingEstimator(Estimator):
     needs_joints = False
     """Whether the estimator weighs the joints' rows apart (then ``n_dof`` or ``tau`` as (N, n_dof) is required)."""
 
-    def partial_fit(self, w, tau, mask=None, *, names=None) -> "AccumulatingEstimator":
+    def partial_fit(self, w, tau, mask=None, *, names=None) -> AccumulatingEstimator:
         """Fold rows into the estimate.
 
         Parameters
@@ -358,7 +358,7 @@ class AccumulatingEstimator(Estimator):
         self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat)
         return self.solve()
 
-    def solve(self) -> "AccumulatingEstimator":
+    def solve(self) -> AccumulatingEstimator:
         """Compute the learned attributes from the rows folded in so far.
 
         Returns

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 from ..optim.bee_colony import minimize_bee_colony
 from .base import BoxSearchEstimator
@@ -42,7 +42,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> "BeeColonyEstimator":
+    def fit(self, w, tau) -> BeeColonyEstimator:
         """Search the box for the minimum of eq. 9 with the artificial bee colony (§3.1).
 
         Parameters

@@ -10,8 +10,8 @@ Ref.: H. R. Künsch, "The jackknife and the bootstrap for general stationary obs
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -10,9 +10,9 @@ the box searches. It is the first of OLS/WLS in the list, else WLS.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import replace
-
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import numpy as np
 

@@ -6,7 +6,7 @@ report the same learned attributes (``params_``, ``objective_``, ``history_``, `
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import differential_evolution
@@ -55,7 +55,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> "DifferentialEvolutionEstimator":
+    def fit(self, w, tau) -> DifferentialEvolutionEstimator:
         """Search the box for the minimum of eq. 9 by differential evolution.
 
         Parameters
@@ -129,7 +129,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> "ParticleSwarmEstimator":
+    def fit(self, w, tau) -> ParticleSwarmEstimator:
         """Search the box for the minimum of eq. 9 by particle swarm optimisation.
 
         Parameters

@@ -50,7 +50,7 @@ class LeastAbsoluteDeviations(Estimator):
         self.weights = weights
         self.bounds = bounds
 
-    def fit(self, w, tau) -> "LeastAbsoluteDeviations":
+    def fit(self, w, tau) -> LeastAbsoluteDeviations:
         """Minimise the weighted sum of absolute residuals (eq. 9) as a linear programme, within the box if given.
 
         Parameters

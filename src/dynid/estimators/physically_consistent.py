@@ -83,7 +83,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         self.n_dof = n_dof
         self.joint_weights = joint_weights
 
-    def fit(self, w, tau) -> "PhysicallyConsistentLeastSquares":
+    def fit(self, w, tau) -> PhysicallyConsistentLeastSquares:
         """Solve the SDP on all rows at once (their QR factor).
 
         Parameters

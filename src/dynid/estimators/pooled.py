@@ -133,7 +133,7 @@ def pooled_estimate(params, covariance, shared=None, max_iterations: int = 500, 
     mu = np.median(b, axis=0)
     tau2 = np.maximum(np.var(b, axis=0) - own_var.mean(axis=0), 1e-6 * own_var.mean(axis=0)) + 1e-300
     it = 0
-    for it in range(1, max_iterations + 1):
+    for it in range(1, max_iterations + 1):  # noqa: B007 - the count is returned
         d = np.where(s, 1.0 / tau2, 0.0)
         post_info = info + d[None, :] * np.eye(p)[None]
         post_cov = np.linalg.inv(post_info)

@@ -24,8 +24,9 @@ import importlib
 import inspect
 import math
 import time
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Iterable
+from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError, DynIdError
 from ..plugins import load_plugins, origin
@@ -102,7 +103,7 @@ class FitData:
     tau: Any
     n_dof: int
     bounds: Any
-    base: "BaseParameters | None"
+    base: BaseParameters | None
     w_standard: Any = None
     layout: tuple | None = None
     prior: Any = None
@@ -214,7 +215,7 @@ def _box_search(kind: str, iterations: int = 1) -> Builder:
     return build
 
 
-def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> "Estimator":
+def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> Estimator:
     from .physically_consistent import PhysicallyConsistentLeastSquares
 
     if data.layout is None:
@@ -444,7 +445,7 @@ def estimate_label(key: str) -> str:
     return f"dynid {label(key)}"
 
 
-def parse_estimators(text: "str | Iterable[str] | None", default: tuple[str, ...] | None = None) -> tuple[str, ...]:
+def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] | None = None) -> tuple[str, ...]:
     """Estimator keys from text or a sequence, case-insensitive.
 
     Parameters
@@ -515,14 +516,14 @@ class Fitted:
     """
 
     key: str
-    params: "np.ndarray"
-    estimator: "Estimator"
+    params: np.ndarray
+    estimator: Estimator
     seconds: float
     n_evaluations: int | None
 
 
 def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-                   callback: Callable[[int, float], None] | None = None) -> "Estimator":
+                   callback: Callable[[int, float], None] | None = None) -> Estimator:
     """An unfitted estimator for a problem.
 
     Parameters
@@ -549,7 +550,7 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(
     return spec(key).builder()(data, budget, rng, callback)
 
 
-def finish(key: str, est: "Estimator", data: FitData, seconds: float) -> Fitted:
+def finish(key: str, est: Estimator, data: FitData, seconds: float) -> Fitted:
     """A fitted estimator as :class:`Fitted`: its parameters in the base (a standard-space estimator's mapped).
 
     Parameters
@@ -595,7 +596,7 @@ def finish(key: str, est: "Estimator", data: FitData, seconds: float) -> Fitted:
 
 
 def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-               callback: Callable[[int, float], None] | None = None, estimator: "Estimator | None" = None) -> Fitted:
+               callback: Callable[[int, float], None] | None = None, estimator: Estimator | None = None) -> Fitted:
     """Fit estimator ``key`` on ``data`` and return its base parameters.
 
     Parameters

@@ -58,7 +58,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         self.max_iter = max_iter
         self.tol = tol
 
-    def fit(self, w, tau) -> "IterativelyReweightedLeastSquares":
+    def fit(self, w, tau) -> IterativelyReweightedLeastSquares:
         """Huber M-estimate by iteratively reweighted least squares, with its sandwich covariance.
 
         Parameters
@@ -87,7 +87,7 @@ class IterativelyReweightedLeastSquares(Estimator):
             raise IdentifiabilityError(f"IRLS needs more equations than parameters, got {m} rows for {p} parameters")
         params = _weighted_solve(w, tau, np.ones(m))
         self.converged_ = False
-        for it in range(1, self.max_iter + 1):
+        for it in range(1, self.max_iter + 1):  # noqa: B007 - the count is n_iter_
             u, scale = self._standardised(tau - w @ params)
             new = _weighted_solve(w, tau, self._huber_weights(u) / np.tile(scale, m // self.n_dof_) ** 2)
             step = np.linalg.norm(new - params)

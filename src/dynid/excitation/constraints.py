@@ -61,11 +61,17 @@ class Workspace:
         rows, h, labels = [], [], []
         for i in range(3):
             if np.isfinite(self.box_min[i]):
-                rows.append(-np.eye(3)[i]); h.append(-self.box_min[i]); labels.append(f"{AXES[i]} >= {self.box_min[i]:g} m")
+                rows.append(-np.eye(3)[i])
+                h.append(-self.box_min[i])
+                labels.append(f"{AXES[i]} >= {self.box_min[i]:g} m")
             if np.isfinite(self.box_max[i]):
-                rows.append(np.eye(3)[i]); h.append(self.box_max[i]); labels.append(f"{AXES[i]} <= {self.box_max[i]:g} m")
+                rows.append(np.eye(3)[i])
+                h.append(self.box_max[i])
+                labels.append(f"{AXES[i]} <= {self.box_max[i]:g} m")
         if np.isfinite(self.floor):
-            rows.append(-np.eye(3)[2]); h.append(-self.floor); labels.append(f"z >= floor {self.floor:g} m")
+            rows.append(-np.eye(3)[2])
+            h.append(-self.floor)
+            labels.append(f"z >= floor {self.floor:g} m")
         return np.array(rows).reshape(-1, 3), np.array(h, dtype=float), labels
 
     def to_dict(self) -> dict:

@@ -20,8 +20,8 @@ base inertial parameters of robots", IJRR 11(4), 1992.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
@@ -31,10 +31,10 @@ from ..dynamics.regressor import regressor
 from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..model.robot import Limits, Robot
+from ..threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
-from ..threads import with_single_blas_thread
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -472,11 +472,13 @@ def _linear_constraints(problem: ExcitationProblem, lay: _Layout) -> tuple[np.nd
         if np.isfinite(lim.q_max[j]):
             hi = lim.q_max[j] - s * span[j] if np.isfinite(span[j]) else lim.q_max[j]
             scale = span[j] if np.isfinite(span[j]) else 1.0
-            rows.append(-lq / scale); consts.append((hi - cq) / scale)
+            rows.append(-lq / scale)
+            consts.append((hi - cq) / scale)
         if np.isfinite(lim.q_min[j]):
             lo = lim.q_min[j] + s * span[j] if np.isfinite(span[j]) else lim.q_min[j]
             scale = span[j] if np.isfinite(span[j]) else 1.0
-            rows.append(lq / scale); consts.append((cq - lo) / scale)
+            rows.append(lq / scale)
+            consts.append((cq - lo) / scale)
         for kind, vmax in ((1, lim.dq_max[j]), (2, lim.ddq_max[j])):
             if np.isfinite(vmax):
                 l_ = lay.lin[kind][:, j] / vmax
@@ -589,7 +591,7 @@ def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.ran
         if first is None:
             first = lay.to_trajectory(x0, problem.offsets)
         safety = problem.safety
-        for attempt in range(RETRIES + 1):
+        for _ in range(RETRIES + 1):
             objective, _, _, cons = solver(safety)
             res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=cons,
                            options={"maxiter": maxiter, "ftol": 1e-7})

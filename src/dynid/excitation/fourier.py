@@ -50,7 +50,7 @@ class FourierTrajectory:
         return 2.0 * np.pi / self.omega_f
 
     @classmethod
-    def from_rows(cls, rows, omega_f: float) -> "FourierTrajectory":
+    def from_rows(cls, rows, omega_f: float) -> FourierTrajectory:
         """A trajectory from the paper's layout (Appendix A).
 
         Parameters
@@ -103,7 +103,7 @@ class FourierTrajectory:
         return q, dq, ddq
 
     @classmethod
-    def from_swevers(cls, q0, a, b, omega_f: float) -> "FourierTrajectory":
+    def from_swevers(cls, q0, a, b, omega_f: float) -> FourierTrajectory:
         """A trajectory from the Swevers form.
 
         ``q_i = q_i0 + Σ_l a_il/(l ω_f) sin(l ω_f t) - b_il/(l ω_f) cos(l ω_f t)`` (Swevers, Ganseman, Tükel,

@@ -13,9 +13,9 @@ which a second round of tasks validates on each unit's validation logs.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -401,9 +401,9 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
     require("distributed", "fleet", "dynid fleet")
     from distributed import as_completed
 
+    from ..cluster import dask_client
     from ..estimators.pooled import pooled_estimate, shared_parameters
     from ..exceptions import DataError
-    from ..cluster import dask_client
 
     t0 = time.perf_counter()
     units = manifest.units

@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import hashlib
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Iterable
 
 import msgspec
 import numpy as np
@@ -498,7 +498,7 @@ class FrictionMonitor:
             [[log, _num(a), _num(b)] for log, a, b in self.window_times], list(self.logs), dict(self.sizes))
         return msgspec.json.encode(state)
 
-    def _restore(self, state: "_State", where: str) -> None:
+    def _restore(self, state: _State, where: str) -> None:
         """Take the saved state's values, each checked against this monitor's terms (:func:`resumed_monitor`)."""
         n_terms, (n, q) = len(self.terms), self.theta0.shape
 
@@ -584,7 +584,7 @@ def monitor_fingerprint(results: str | Path, settings: MonitorSettings) -> str:
 
 
 def resumed_monitor(path: str | Path, fingerprint: str, model,
-                    settings: MonitorSettings = MonitorSettings()) -> "FrictionMonitor":
+                    settings: MonitorSettings = MonitorSettings()) -> FrictionMonitor:
     """A monitor's saved state (:meth:`FrictionMonitor.state`), to feed it the logs it has not seen.
 
     The file is read as data of a fixed schema and checked field by field (types, shapes, the identification's terms)
@@ -658,13 +658,13 @@ def legacy_state_refusal(folder: str | Path) -> str | None:
 _NON_FINITE = {"nan": float("nan"), "inf": float("inf"), "-inf": float("-inf")}
 
 
-def _num(x: float) -> "float | str":
+def _num(x: float) -> float | str:
     """A number for the state: finite as it is, non-finite as ``"nan"``, ``"inf"`` or ``"-inf"`` (JSON has none)."""
     x = float(x)
     return x if np.isfinite(x) else repr(x)
 
 
-def _value(x: "float | str", bad) -> float:
+def _value(x: float | str, bad) -> float:
     if isinstance(x, str):
         if x not in _NON_FINITE:
             raise bad(f"{x!r} is no number")
@@ -689,7 +689,7 @@ class _Array(msgspec.Struct, forbid_unknown_fields=True):
     data: bytes
 
     @classmethod
-    def of(cls, a) -> "_Array":
+    def of(cls, a) -> _Array:
         a = np.ascontiguousarray(a, dtype="<f8")
         return cls(list(a.shape), a.tobytes())
 
@@ -774,7 +774,7 @@ class _State(msgspec.Struct, forbid_unknown_fields=True):
 
 
 def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings = MonitorSettings(),
-                 progress=None, resume: "FrictionMonitor | None" = None, fingerprint: str | None = None) -> MonitorResult:
+                 progress=None, resume: FrictionMonitor | None = None, fingerprint: str | None = None) -> MonitorResult:
     """Monitor a robot through its logs, oldest first.
 
     Parameters

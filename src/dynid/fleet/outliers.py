@@ -21,6 +21,7 @@ unit's own σ enters every z, so a parameter its log determines poorly is not fl
 from __future__ import annotations
 
 from dataclasses import dataclass
+
 import numpy as np
 
 from ..exceptions import ShapeError

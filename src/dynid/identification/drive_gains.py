@@ -21,11 +21,9 @@ last link, about its origin, eq. 5 order).
 
 from __future__ import annotations
 
-
 from dataclasses import dataclass, replace
 
 import numpy as np
-
 import scipy.linalg
 
 from ..conventions import INERTIAL_TERMS

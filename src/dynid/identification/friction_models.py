@@ -30,8 +30,8 @@ import numpy as np
 
 from ..column_store import root_mean_square
 from ..dynamics.base_parameters import base_parameters
-from ..exceptions import IdentifiabilityError
 from ..dynamics.regressor import regressor
+from ..exceptions import IdentifiabilityError
 from ..friction import TERMS, Velocities, held_direction
 from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with
 from ..model.robot import Robot

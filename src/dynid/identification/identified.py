@@ -5,9 +5,9 @@ be validated on other logs and be exported — built from an identification or r
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
@@ -465,7 +465,7 @@ class IdentifiedModel:
         return path
 
     @classmethod
-    def from_results(cls, results: dict, robot: Robot, source: str = "results") -> "IdentifiedModel":
+    def from_results(cls, results: dict, robot: Robot, source: str = "results") -> IdentifiedModel:
         """The model of a results.json dictionary of ``dynid identify``.
 
         Parameters
@@ -506,7 +506,7 @@ class IdentifiedModel:
         return cls(robot, base, estimates, std, main, stored_preprocessing(results), results)
 
     @classmethod
-    def from_result(cls, result) -> "IdentifiedModel":
+    def from_result(cls, result) -> IdentifiedModel:
         """The model of an identification run's result.
 
         Parameters

@@ -82,7 +82,7 @@ class Identifier:
         """
         return {name: getattr(self, name) for name in inspect.signature(type(self).__init__).parameters if name != "self"}
 
-    def set_params(self, **params) -> "Identifier":
+    def set_params(self, **params) -> Identifier:
         """Set constructor parameters by name.
 
         Parameters
@@ -107,7 +107,7 @@ class Identifier:
             setattr(self, name, value)
         return self
 
-    def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> "Identifier":
+    def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> Identifier:
         """Identify the robot from arrays, or from a config file.
 
         Parameters

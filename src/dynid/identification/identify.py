@@ -23,14 +23,22 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
-from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, label as estimator_label, parse_estimators, seed_index, spec
+from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, parse_estimators, seed_index, spec
+from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
-from ..validation.diagnostics import (BlockGrams, Finding, ResidualSums, bootstrap_finding, excitation_findings,
-                                     prior_findings, sign_findings)
+from ..validation.diagnostics import (
+    BlockGrams,
+    Finding,
+    ResidualSums,
+    bootstrap_finding,
+    excitation_findings,
+    prior_findings,
+    sign_findings,
+)
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 
 __all__ = ["Estimate", "IdentificationResult", "identify"]

@@ -24,8 +24,9 @@ validation on other logs are the callers' (:mod:`dynid.identification.run`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 

@@ -189,7 +189,7 @@ def _nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
     return (same or NOMINAL_LABEL), beta
 
 
-def pipeline_of(config: IdentificationConfig) -> "IdentificationPipeline":
+def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     """The identification pipeline a config describes: its robot, preprocessing, estimators, friction choice, seed.
 
     Parameters

@@ -9,14 +9,13 @@ field), then check what depends on the robot (one value per joint) and the files
 from __future__ import annotations
 
 import datetime
-from typing import Annotated, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Union
 
 import msgspec
 from msgspec import Meta
 
-from typing import TYPE_CHECKING, Any
-
-from ..model.description_types import Angle, RobotDescription as _RobotDescription
+from ..model.description_types import Angle
+from ..model.description_types import RobotDescription as _RobotDescription
 from ..preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
 from ..typed import Table
 

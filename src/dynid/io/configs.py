@@ -6,9 +6,9 @@ import tomllib
 from pathlib import Path
 
 from ..exceptions import ConfigError
-from .files import text_encoding_hint
 from ..model.description import builtin_robots, load_robot
 from ..model.robot import Robot
+from .files import text_encoding_hint
 
 
 def read_config(path: Path, known: set[str] | None) -> dict:

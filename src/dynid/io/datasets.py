@@ -152,7 +152,7 @@ class DatasetSpec:
     delimiter: str = ","
     time_range: tuple[float, float] | None = None
     gaps: str = "auto"
-    bag: "BagSpec | None" = None
+    bag: BagSpec | None = None
     table: str = ""
     """The config table it comes from, for messages: ``[identification]``, ``[[validation]] "p3"``."""
     max_gap: float = 0.1
@@ -444,7 +444,7 @@ def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
                                    t.effort or "torques"))
 
 
-def load_recording(spec: "DatasetSpec | str | Path", robot: Robot, spool: bool | None = None) -> Recording:
+def load_recording(spec: DatasetSpec | str | Path, robot: Robot, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
@@ -508,7 +508,7 @@ def load_recording(spec: "DatasetSpec | str | Path", robot: Robot, spool: bool |
             raise DataError(f"{spec.name}: files have different numbers of rows: " + ", ".join(f"{p} {n}" for p, n in lengths.items()))
         warnings.append(f"{spec.name}: the files are cut to the shortest one ({n_s} rows)")
 
-    def get(s: SignalSpec) -> "np.ndarray | StoredColumns":
+    def get(s: SignalSpec) -> np.ndarray | StoredColumns:
         tb, cols = tables[s.file]
         scale = np.broadcast_to(np.asarray(s.scale, dtype=float), (len(s.columns),))
         if isinstance(tb.data, StoredColumns):  # a view of the stored columns; scaled into new ones
@@ -527,7 +527,7 @@ def load_recording(spec: "DatasetSpec | str | Path", robot: Robot, spool: bool |
         t = np.arange(n_s) / spec.rate
         where = None
     raw = {kind: get(s) for kind, s in spec.signals.items()}
-    del tables  # the files' columns are in t and raw now: a long log is not held twice
+    tables.clear()  # the files' columns are in t and raw now: a long log is not held twice
     tau_kind = "currents" if "currents" in spec.signals else "torques"
     return _assemble(spec, robot, t, raw, where, spec.time is not None, str(spec.signals["positions"].file),
                      str(spec.signals[tau_kind].file), warnings)

@@ -41,21 +41,21 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 
-import msgspec
-
 from ..exceptions import ConfigError
-from ..typed import convert
-from .config_types import ExcitationDocument
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationProblem
 from ..excitation.fourier import FourierTrajectory
 from ..excitation.paper_trajectories import paper_identification_trajectory
-from .configs import config_robot, read_config
-from .trajectories import load_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
+from ..typed import convert
+from .config_types import ExcitationDocument
+from .configs import config_robot, read_config
+from .trajectories import load_trajectory
+
 
 @dataclass(frozen=True)
 class ExcitationConfig:

@@ -113,8 +113,7 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
         link = f"link{j + 1}"
         lines += [f'  <link name="{link}">', "    <inertial>", f'      <origin xyz="{_vec(com)}" rpy="0 0 0"/>',
                   f'      <mass value="{mass:.17g}"/>',
-                  '      <inertia ixx="{:.17g}" ixy="{:.17g}" ixz="{:.17g}" iyy="{:.17g}" iyz="{:.17g}" izz="{:.17g}"/>'.format(
-                      inertia[0, 0], inertia[0, 1], inertia[0, 2], inertia[1, 1], inertia[1, 2], inertia[2, 2]),
+                  f'      <inertia ixx="{inertia[0, 0]:.17g}" ixy="{inertia[0, 1]:.17g}" ixz="{inertia[0, 2]:.17g}" iyy="{inertia[1, 1]:.17g}" iyz="{inertia[1, 2]:.17g}" izz="{inertia[2, 2]:.17g}"/>',
                   "    </inertial>", "  </link>"]
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
         fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)

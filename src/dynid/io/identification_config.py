@@ -64,22 +64,22 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 from __future__ import annotations
 
 import os
-from typing import Any
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import Any
 
 import msgspec
 import numpy as np
 
+from ..estimators.registry import parse_estimators
 from ..exceptions import ConfigError, DataError
+from ..model.robot import Robot
+from ..preprocessing.settings import Preprocessing
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_robot, config_urdf, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .trajectories import load_trajectory
-from ..model.robot import Robot
-from ..preprocessing.settings import Preprocessing
-from ..estimators.registry import parse_estimators
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.

@@ -33,7 +33,7 @@ class Table:
         Problems that were fixed (e.g. a truncated last line skipped).
     """
 
-    data: "np.ndarray | StoredColumns"
+    data: np.ndarray | StoredColumns
     first_line: int
     warnings: tuple[str, ...] = ()
 
@@ -124,7 +124,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     cols: list[int] | None = None
     expected = n_columns
     first_line = None
-    with open(path, "r", encoding="utf-8", errors="replace", newline="") as fh:
+    with open(path, encoding="utf-8", errors="replace", newline="") as fh:
         if header:
             line = fh.readline()
             line_no = 1

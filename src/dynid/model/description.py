@@ -50,22 +50,22 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
 from __future__ import annotations
 
 import re
-from typing import Any
 import tomllib
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS
-from ..friction import COUNTERBALANCE_TERMS, DEFAULT_STRIBECK_VELOCITY, TERMS, check_terms
 from ..exceptions import ConfigError
+from ..friction import COUNTERBALANCE_TERMS, DEFAULT_STRIBECK_VELOCITY, TERMS, check_terms
 from ..typed import convert
 from .description_types import PayloadTable, TransmissionTable, description_types
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot
-from .transmission import Transmission
 from .spatial import inertial_from_physical, physical_problems, transform_inertial
+from .transmission import Transmission
 
 _ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
 

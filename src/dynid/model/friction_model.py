@@ -62,7 +62,7 @@ class JointFriction:
         return {"kind": self.kind, "velocity": self.velocity, "rest": self.rest, "label": self.label}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "JointFriction":
+    def from_dict(cls, d: dict) -> JointFriction:
         """Inverse of :meth:`to_dict`.
 
         Parameters

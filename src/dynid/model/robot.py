@@ -13,8 +13,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..conventions import DEFAULT_DRIVE_TERMS, INERTIAL_TERMS, parameter_name
-from ..friction import DEFAULT_STRIBECK_VELOCITY, Velocities, check_terms
 from ..exceptions import ConfigError
+from ..friction import DEFAULT_STRIBECK_VELOCITY, Velocities, check_terms
 from .spatial import transform_inertial
 from .transmission import Transmission
 
@@ -62,7 +62,7 @@ class Limits:
     ddq_max: np.ndarray
     tau_max: np.ndarray
 
-    def subset(self, k: int) -> "Limits":
+    def subset(self, k: int) -> Limits:
         """The limits of the first joints.
 
         Parameters
@@ -257,7 +257,7 @@ class Robot:
         blocks = np.concatenate([self.inertial, self.drive], axis=1).ravel()
         return np.concatenate([blocks, self.transmission.coupled_values.ravel()])
 
-    def with_parameters(self, phi: np.ndarray) -> "Robot":
+    def with_parameters(self, phi: np.ndarray) -> Robot:
         """A copy of this robot with other nominal parameters.
 
         Parameters
@@ -299,7 +299,7 @@ class Robot:
         jt = self.joints[j]
         return jt.rotation @ rot_axis(jt.axis, np.array([qj]))[0], jt.translation.copy()
 
-    def submodel(self, k: int, q_rest: np.ndarray | None = None) -> "Robot":
+    def submodel(self, k: int, q_rest: np.ndarray | None = None) -> Robot:
         """The first ``k`` joints, the others held still.
 
         Links ``k+1 .. n`` become rigidly attached to link ``k``: their inertial parameters are expressed in link ``k``'s

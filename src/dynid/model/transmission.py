@@ -92,7 +92,7 @@ class Transmission:
         return tuple(int(k) for k in np.flatnonzero(np.any(off != 0, axis=1)))
 
     @classmethod
-    def identity(cls, n: int) -> "Transmission":
+    def identity(cls, n: int) -> Transmission:
         """Direct drive on the joint side: ``R = I``, no offsets, no coupling.
 
         Parameters
@@ -212,7 +212,7 @@ class Transmission:
         """
         return np.asarray(tau_m, dtype=float) @ self.motor_from_joint
 
-    def subset(self, k: int) -> "Transmission":
+    def subset(self, k: int) -> Transmission:
         """The transmission of the first ``k`` joints.
 
         Parameters

@@ -25,7 +25,7 @@ instead of the whole product; the candidates and the random draws are the same.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import OptimizeResult

@@ -12,7 +12,7 @@ width and positions clipped to the box (the velocity component that hit a wall i
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import OptimizeResult

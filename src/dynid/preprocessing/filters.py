@@ -7,7 +7,7 @@ decimation of the observation matrix and the torques); Khalil & Dombre 2002, §1
 
 from __future__ import annotations
 
-from typing import Callable, Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 from scipy import signal

@@ -16,8 +16,8 @@ band of the data (:mod:`dynid.preprocessing.bands`), and :attr:`Preprocessing.de
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Callable
 
 import numpy as np
 
@@ -25,10 +25,17 @@ from ..column_store import StoredColumns, by_column, root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
-from ..model.robot import Robot
 from ..friction import moving_joints
+from ..model.robot import Robot
 from .bands import MIN_SPEED_FRACTION, REST_FACTOR, white_noise_std
-from .filters import FractionalShift, butterworth_filtfilt, differentiate, gaussian_smooth, parallel_decimation, velocity_noise_std
+from .filters import (
+    FractionalShift,
+    butterworth_filtfilt,
+    differentiate,
+    gaussian_smooth,
+    parallel_decimation,
+    velocity_noise_std,
+)
 from .fourier_fit import fourier_fit_derivatives
 from .prepared import PreparedData, dead_channels, direction_of_motion, min_speeds, rest_velocities
 from .settings import Preprocessing

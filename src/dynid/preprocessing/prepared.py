@@ -88,7 +88,7 @@ class PreparedData:
             keep[:, list(self.dead)] = False
         return keep
 
-    def with_rest_model(self, rest_friction, presliding) -> "PreparedData":
+    def with_rest_model(self, rest_friction, presliding) -> PreparedData:
         """The same samples with another rest model and presliding distance.
 
         The direction of motion is computed anew, the settings say so.

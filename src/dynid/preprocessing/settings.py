@@ -8,8 +8,15 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..exceptions import ConfigError
-from .bands import PARALLEL_FACTOR, POSITION_FACTOR, capped, cutoffs_from_band, decimation_cutoff, decimation_for, estimate_band
-
+from .bands import (
+    PARALLEL_FACTOR,
+    POSITION_FACTOR,
+    capped,
+    cutoffs_from_band,
+    decimation_cutoff,
+    decimation_for,
+    estimate_band,
+)
 
 MIN_SAMPLES_KEPT = 200
 """A log whose settings come from another dataset is decimated by at most ``N // MIN_SAMPLES_KEPT``."""
@@ -129,7 +136,7 @@ class Preprocessing:
     warnings: tuple[str, ...] = ()
 
     def resolved(self, rate: float, q: np.ndarray | None = None, measured_velocity: bool = True,
-                 name: str = "data", strict: bool = True) -> "Preprocessing":
+                 name: str = "data", strict: bool = True) -> Preprocessing:
         """Every ``None`` replaced by its data-derived value (module :mod:`dynid.preprocessing.bands`).
 
         Cutoffs given in Hz stay what the user wrote; a cutoff at or above :data:`~dynid.preprocessing.bands.NYQUIST_CAP`

@@ -24,8 +24,9 @@ name it in ``[preprocessing] strategy``.
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable, Iterator
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Callable, Iterator
+from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError
 from ..plugins import load_plugins, origin
@@ -66,7 +67,7 @@ class Strategy:
     chooses_cutoffs = False
     needs_harmonics = False
 
-    def prepare(self, recording, settings: "Preprocessing", strict: bool = True) -> "PreparedData":
+    def prepare(self, recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
         """Filtered joint signals of ``recording``.
 
         Parameters
@@ -85,7 +86,7 @@ class Strategy:
         """
         raise NotImplementedError
 
-    def chunks(self, robot: "Robot", base: "BaseParameters", data: "PreparedData",
+    def chunks(self, robot: Robot, base: BaseParameters, data: PreparedData,
                progress: Callable[[int, int], None] | None = None, standard: bool = False) -> Iterator[Chunk]:
         """The rows of ``data`` for the estimators, block by block.
 
@@ -226,7 +227,7 @@ def check_strategy(name: str) -> str:
     return key
 
 
-def strategy_for(settings: "Preprocessing | str") -> Strategy:
+def strategy_for(settings: Preprocessing | str) -> Strategy:
     """The strategy instance that settings (or a name) name.
 
     Parameters
@@ -255,7 +256,7 @@ def strategy_for(settings: "Preprocessing | str") -> Strategy:
     return target
 
 
-def carried_over(resolved: "Preprocessing | None", given: "Preprocessing") -> "Preprocessing":
+def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Preprocessing:
     """Settings of a log scored with another log's parameters (a validation log).
 
     The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,

@@ -8,11 +8,10 @@ silences progress and summaries; warnings and errors are still printed (on stand
 
 from __future__ import annotations
 
-from typing import Any
-
 import os
 import time
 from pathlib import Path
+from typing import Any
 
 from rich import box
 from rich.console import Console

@@ -10,7 +10,7 @@ from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, write_results, staged
+from .output import output_folder, save_figure, staged, write_results
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 MAX_POINTS = 2500
 """Points drawn per line at most: more cannot be told apart at a figure's resolution, and each one costs
 drawing and layout time (a 1 kHz log has 25 000 per line)."""

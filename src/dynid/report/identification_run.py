@@ -8,7 +8,7 @@ from pathlib import Path
 from ..identification.identify import IdentificationResult
 from . import figures
 from .html import write_html_report
-from .output import draw_figures, output_folder, save_figure, write_results, staged
+from .output import draw_figures, output_folder, save_figure, staged, write_results
 
 
 def _slug(name: str) -> str:

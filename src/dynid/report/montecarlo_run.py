@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 
 from ..estimators.registry import label
+from ..io import atomic_write_text
 from ..studies.closed_loop import ClosedLoopStudyResult
 from ..studies.montecarlo import MonteCarloResult
-from ..io import atomic_write_text
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, write_results, staged
+from .output import output_folder, save_figure, staged, write_results
 
 FIGURES = {
     "montecarlo_std_vs_crb.png": "per noise level: standard deviation / Cramér–Rao bound of every base parameter, per method",

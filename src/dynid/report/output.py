@@ -15,7 +15,6 @@ from ..exceptions import ConfigError
 from ..io import atomic_write_bytes
 from ..processes import can_fork, fork, read_all
 
-
 MANIFEST = ".dynid-manifest.json"
 """Written last into an output folder: the files of the run that is there, whole."""
 
@@ -363,6 +362,7 @@ FIGURE_COLOURS = 32
 
 
 from ..identification.identified import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # noqa: E402  one number for both
+
 """Version of the layout of the JSON files dynid writes; raised when a field changes meaning or goes."""
 
 

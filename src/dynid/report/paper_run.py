@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..studies import paper_reference as ref
 from ..estimators.registry import label
+from ..studies import paper_reference as ref
 from ..studies.paper import PaperRunResult
 from . import figures
 from .html import write_html_report
-from .output import draw_figures, output_folder, save_figure, write_results, staged
+from .output import draw_figures, output_folder, save_figure, staged, write_results
 
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",

@@ -4,10 +4,10 @@ OLS/WLS uncertainties and the timings."""
 
 from __future__ import annotations
 
-from ..estimators.registry import spec
 from ..estimators.physically_consistent import CONSISTENCY_TOL
-from ..tables import Line, TextTable
+from ..estimators.registry import spec
 from ..studies import paper_reference as ref
+from ..tables import Line, TextTable
 
 
 def _joined(values, fmt: str) -> str:

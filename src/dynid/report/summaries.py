@@ -8,8 +8,6 @@ import math
 
 import numpy as np
 
-from ..validation.noise_floor import AT_FLOOR
-
 from ..conventions import unit_of
 from ..estimators.registry import label
 from ..tables import Line, TextTable, render_text
@@ -48,8 +46,8 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
     share = np.zeros(n) if cmp.rest_share is None else np.asarray(cmp.rest_share)
     split = cmp.rest_share is not None and np.any(share >= REST_ROWS) and np.any(share <= 1 - REST_ROWS)
     rows, ends = [], set()
-    for label, m in cmp.metrics().items():
-        rows.append((label,) + ("",) * (n + 1))
+    for name, m in cmp.metrics().items():
+        rows.append((name,) + ("",) * (n + 1))
         rows.append(("  error %", *(f"{x:.1f}" if k else "n/m" for x, k in zip(m["relative_error"], ok)),
                      f"{m['global_relative_error']:.2f}"))
         rows.append(("  RMSE N·m", *(f"{x:.3g}" for x in m["rmse"]), ""))
@@ -105,9 +103,9 @@ def blocks(result) -> list:
     TypeError
         Not a result of dynid.
     """
-    from ..identification.excitation_run import ExcitationRun
     from ..fleet.identification import FleetResult
     from ..fleet.monitor import MonitorResult
+    from ..identification.excitation_run import ExcitationRun
     from ..identification.identify import IdentificationResult
     from ..studies.closed_loop import ClosedLoopStudyResult
     from ..studies.montecarlo import MonteCarloResult
@@ -309,9 +307,9 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     for c in comparisons:
         metrics, ok = c.metrics(), c.meaningful()
         parts = []
-        for label, m in metrics.items():
+        for name, m in metrics.items():
             worst = worst_joint(m["relative_error"], ok)
-            parts.append(f"{label} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
+            parts.append(f"{name} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
         best = min(metrics, key=lambda k: metrics[k]["global_relative_error"]) if metrics else None
         out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
                         + ("" if best is None or len(metrics) < 2 else f"; best: {best}")))

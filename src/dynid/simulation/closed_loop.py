@@ -22,7 +22,6 @@ robotics: a survey", Applied Sciences 11(9), 2021 (the noise grid).
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -75,7 +74,7 @@ class Controller:
 
     @classmethod
     def for_robot(cls, robot: Robot, bandwidth: float = 5.0, rate: float = 1000.0, integral: bool = True,
-                  velocity_cutoff: float = 50.0, phi: np.ndarray | None = None) -> "Controller":
+                  velocity_cutoff: float = 50.0, phi: np.ndarray | None = None) -> Controller:
         """A PID (or PD) tuned per joint on the diagonal of the mass matrix at q = 0: ``Kp = I ω²``, ``Kd = 2 I ω``
         (critical damping), ``Ki = Kp ω / 10``, with ``ω = 2π · bandwidth``.
 
@@ -111,7 +110,7 @@ class Controller:
         return cls.of(n, kp, 2 * inertia * w, kp * w / 10 if integral else 0.0, rate, velocity_cutoff)
 
     @classmethod
-    def of(cls, n_dof: int, kp, kd, ki=0.0, rate: float = 1000.0, velocity_cutoff: float = 0.0) -> "Controller":
+    def of(cls, n_dof: int, kp, kd, ki=0.0, rate: float = 1000.0, velocity_cutoff: float = 0.0) -> Controller:
         """A controller with gains checked (a scalar is every joint's).
 
         Parameters

@@ -28,8 +28,8 @@ the tasks run.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -42,13 +42,13 @@ from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..extras import require
+from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
 from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from ..threads import with_single_blas_thread
-from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
 from .paper import PaperExperimentConfig, identification_trajectory
 
 __all__ = ["ENCODER_NOISE_DEG", "TORQUE_NOISE", "CLOSED_LOOP_ESTIMATORS", "ClosedLoopStudyConfig", "ClosedLoopStudyResult",

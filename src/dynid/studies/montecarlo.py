@@ -22,26 +22,25 @@ order tasks run.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Callable
 
 import numpy as np
 
+from ..cluster import map_realisations
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
-from ..excitation.fourier import sample_times
-from ..excitation.paper_trajectories import PAPER_OMEGA_F
+from ..estimators.estimation import Estimation
+from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
 from ..exceptions import ConfigError, DynIdError
+from ..excitation.fourier import FourierTrajectory, sample_times
+from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..extras import require
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..excitation.fourier import FourierTrajectory
 from ..simulation.measurements import NoiseModel
-from ..estimators.estimation import Estimation
-from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
-from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
-from ..cluster import map_realisations
 from ..threads import with_single_blas_thread
+from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
 
 DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
 """The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with estimators."""

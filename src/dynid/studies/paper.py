@@ -12,8 +12,9 @@ least squares) → correlation coefficient (eq. 18), RMSE and relative error on 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -24,22 +25,27 @@ from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.estimation import Estimation, stacked_rows, stream_rows
 from ..estimators.physically_consistent import CONSISTENCY_TOL
+from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import sample_times
+from ..excitation.paper_trajectories import (
+    PAPER_DURATION,
+    PAPER_OMEGA_F,
+    PAPER_RATE,
+    paper_identification_trajectory,
+    paper_validation_trajectory,
+)
+from ..io.datasets import Recording
 from ..io.trajectories import load_trajectory
-from ..excitation.paper_trajectories import (PAPER_DURATION, PAPER_OMEGA_F, PAPER_RATE, paper_identification_trajectory,
-                                            paper_validation_trajectory)
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..io.datasets import Recording
 from ..preprocessing.pipeline import base_chunks, prepare
 from ..preprocessing.settings import Preprocessing
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
+from ..threads import with_single_blas_thread
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
-from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
-from ..threads import with_single_blas_thread
 
 PLANTS = ("assumed", "paper")
 BOUNDS = ("auto", "table3", "scaled")

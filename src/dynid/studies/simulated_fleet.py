@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..excitation.fourier import FourierTrajectory
 from ..exceptions import ConfigError
+from ..excitation.fourier import FourierTrajectory
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements

@@ -340,7 +340,7 @@ class TorqueSums:
         self.kept_tau: list[np.ndarray] = []
 
     @classmethod
-    def for_data(cls, data: PreparedData, n_columns: int) -> "TorqueSums":
+    def for_data(cls, data: PreparedData, n_columns: int) -> TorqueSums:
         """Empty statistics sized for the decimated samples of ``data``.
 
         Parameters
