@@ -7,13 +7,33 @@ from .refusals import assert_refused, dynid, dynid_process
 FAST = ["--duration", "8", "--rate", "100", "--abc-iterations", "3"]
 
 
-def test_run_writes_results_and_figures(tmp_path):
+def test_run_is_the_papers_experiment_and_says_its_defaults_changed(tmp_path):
+    """The main job as the paper set it: its Table 2 plant, its Table 3 box (amended where it misses Table 2, and
+    said), OLS and the ABC at the paper's budget; the former default is --compare, and the change is said."""
+    from dynid.studies import paper_reference as ref
+
     out = tmp_path / "run"
-    p = dynid("run", "--out", str(out), *FAST, "--verbose")
+    p = dynid("run", "--out", str(out), *FAST, "--bootstrap", "0", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    data = json.loads((out / "results.json").read_text())
+    assert data["plant"] == "paper" and data["search_box"] == "table3" and list(data["estimates"]) == ["ols", "abc"]
+    assert data["settings"]["colony_size"] == 30 and data["settings"]["limit"] == 15  # the paper's colony
+    assert "now reproduces the paper's experiment" in p.stderr and "--compare" in p.stderr
+    assert "±12" in p.stdout and "truth outside" not in p.stdout + p.stderr
+    assert data["abc_bounds"]["fc2"] == [-12.0, 12.0] and -10 <= ref.TABLE3["f_c2"][0]  # the paper's printed scope kept
+    assert ref.TABLE3["f_c2"][1] < ref.TABLE2["f_c2"] <= data["abc_bounds"]["fc2"][1]
+    given = dynid("run", "--out", str(tmp_path / "given"), *FAST, "--plant", "paper", "--bootstrap", "0", "--no-figures")
+    assert given.returncode == 0 and "now reproduces" not in given.stderr  # a user who chose says nothing
+
+
+def test_run_compare_writes_results_and_figures(tmp_path):
+    out = tmp_path / "run"
+    p = dynid("run", "--out", str(out), *FAST, "--compare", "--verbose")
     assert p.returncode == 0, p.stderr
     assert "ρ (eq. 18)" in p.stdout and "0.3182" in p.stdout and "Base parameters: truth and estimates" in p.stdout
     data = json.loads((out / "results.json").read_text())
-    assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21
+    assert data["robot"] == "er16" and data["joints"] == 3 and len(data["parameters"]) == 21 and data["plant"] == "assumed"
+    assert "now reproduces" not in p.stderr
     assert set(data["estimates"]) == {"ols", "wls", "irls", "lad", "sdp", "abc", "abc10", "de", "pso"}
     assert "Estimators:" in p.stdout and "ABC×10" in p.stdout and "physically consistent" in p.stdout
     assert "moving-block" in p.stdout and set(data["estimates"]["ols"]["bootstrap"]) >= {"lower", "upper", "std"}
@@ -83,7 +103,7 @@ def test_ctrl_c_and_sigterm_exit_with_one_line_and_leave_no_output(tmp_path, sig
 
 def test_quiet_prints_nothing_but_warnings(tmp_path):
     p = dynid("run", "--out", str(tmp_path / "q"), *FAST, "--estimators", "ols,abc", "--bootstrap", "0", "--no-figures", "--quiet",
-              "--abc-bounds", "table3")  # the paper's box, which does not hold the assumed plant: a warning
+              "--abc-bounds", "table3", "--plant", "assumed")  # the paper's box misses the assumed plant: a warning
     assert p.returncode == 0, p.stderr
     assert p.stdout == "" and all(line.startswith("warning: ") for line in p.stderr.splitlines())
     assert "truth outside the ABC search box" in p.stderr and (tmp_path / "q" / "results.json").is_file()

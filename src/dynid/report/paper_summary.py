@@ -55,7 +55,7 @@ def run_summary_blocks(result, verbose: bool = True) -> list:
                          "mean over joints of ρ (eq. 18), RMSE (N·m) and error % on β2; physically consistent",
                          ("method", "F", "evals", "s", "Δβ %", "ρ β2", "RMSE", "err %", "cons."), tuple(rows)))
     if d.get("search_box") == "table3":
-        out.append(Line("LAD, ABC, DE and PSO search the paper's Table 3 box"))
+        out.append(Line("LAD, ABC, DE and PSO search the paper's Table 3 box; " + ref.TABLE3_NOTE))
     elif d.get("search_box") == "scaled":
         out.append(Line("LAD, ABC, DE and PSO search the box ±(2|β_OLS| + 1), which holds the truth"
                         + (" (the paper's Table 3 box holds the paper's plant, not this one: --plant paper, or "

@@ -681,7 +681,8 @@ def box_kind(config, robot: Robot, base: BaseParameters) -> str:
 
 
 def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """The ABC's search box: the paper's Table 3, or ``±(2|β_OLS| + 1)``.
+    """The ABC's search box: the paper's Table 3 (amended where it misses the paper's own Table 2,
+    :data:`dynid.studies.paper_reference.TABLE3_AMENDED`), or ``±(2|β_OLS| + 1)``.
 
     Parameters
     ----------
@@ -705,6 +706,6 @@ def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y
         "table3" asked for a model whose base parameters are not the paper's.
     """
     if box_kind(config, robot, base) == "table3":
-        return np.array([ref.TABLE3[ref.paper_symbol(n)] for n in base.names], dtype=float)
+        return np.array([ref.search_scope(ref.paper_symbol(n)) for n in base.names], dtype=float)
     half = 2.0 * np.abs(OrdinaryLeastSquares().fit(w_base, y).params_) + 1.0
     return np.stack([-half, half], axis=1)
