@@ -173,7 +173,7 @@ PAPER_ESTIMATORS = "ols,abc"
 """What ``dynid run`` compares by default: the paper's ABC at its budget, beside ordinary least squares."""
 
 RUN_DEFAULTS_CHANGED = ("dynid run now reproduces the paper's experiment as the paper set it (plant 'paper', its Table 3 "
-                        "box, OLS and ABC at the paper's budget); until 0.2 it compared every estimator on the assumed "
+                        "box, OLS and ABC at the paper's budget); before 0.2 it compared every estimator on the assumed "
                         "plant: --compare (docs/changelog.md)")
 """Said by a ``dynid run`` given none of --plant, --estimators, --compare, for the release that changed its defaults."""
 

@@ -53,11 +53,11 @@ class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         new = MOVED[spec.name.rsplit(".", 1)[1]]
         _moved(spec.name, new)
         module = importlib.import_module(new)
-        self._kept = (module.__spec__, module.__loader__)  # the import system writes the alias's over them
+        spec.loader_state = (module.__spec__, module.__loader__)  # the import system writes the alias's over them
         return module
 
     def exec_module(self, module):
-        module.__spec__, module.__loader__ = self._kept
+        module.__spec__, module.__loader__ = module.__spec__.loader_state
 
 
 if not any(isinstance(f, _Alias) for f in sys.meta_path):
