@@ -99,3 +99,47 @@ def test_init_with_a_validation_log_writes_a_config_that_validates(tmp_path):
 
     results = json.loads((tmp_path / "id" / "results.json").read_text())
     assert [v["name"] for v in results["validation"]] == ["other"]
+
+
+def test_init_reads_a_plotjuggler_export_of_joint_states_in_the_urdfs_joint_order(tmp_path):
+    """PlotJuggler's CSV of ``/joint_states``: ``__time`` (epoch seconds) and ``/joint_states/<joint>/position|velocity|
+    effort``, the joints in the driver's (alphabetical) order. init refused it ("no time column among ['__time', …]",
+    then "found 0 positions column(s)"); now it takes the columns in the URDF's joint order and says so, and identify
+    on the config recovers the simulated arm (a wrong order would swap joints' torques)."""
+    import json
+
+    robot = dynid.load_robot(URDF)
+    log = dynid.simulated_log(robot, seconds=30, seed=4)
+    joints = [j.name for j in robot.joints]
+    order = sorted(range(6), key=lambda j: joints[j])  # elbow_joint, shoulder_lift_joint, shoulder_pan_joint, wrist_…
+    assert order != list(range(6))
+    names = ["__time", "/joint_states/header/stamp"] + [f"/joint_states/{joints[j]}/{signal}"
+                                                          for signal in ("position", "velocity", "effort") for j in order]
+    dq = np.gradient(log.q, log.t, axis=0)
+    columns = [log.t + 1.7e9, log.t + 1.7e9] + [x[:, j] for x in (log.q, dq, log.tau) for j in order]
+    (tmp_path / "logs").mkdir()
+    np.savetxt(tmp_path / "logs" / "joint_states.csv", np.column_stack(columns), delimiter=",", comments="",
+               header=",".join(names), fmt="%.10f")
+    p = run("init", str(URDF), str(tmp_path / "logs" / "joint_states.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "arm.toml").read_text()
+    assert 'time = { column = "__time" }' in text
+    assert ('positions = { columns = ["/joint_states/shoulder_pan_joint/position", '
+            '"/joint_states/shoulder_lift_joint/position", "/joint_states/elbow_joint/position"') in text
+    assert "taken in the URDF's joint order" in " ".join(p.stdout.split())
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "id" / "results.json").read_text())
+    # the log is the URDF's own model simulated: its prediction matches every joint carrying torque (J6 carries 0.01 N·m)
+    assert min(results["diagnostics"]["nominal_correlation"][:5]) > 0.99
+    assert max(results["identification"]["metrics"]["dynid WLS"]["relative_error"][:3]) < 0.1
+
+
+def test_init_names_the_patterns_it_accepts(tmp_path):
+    """A header init cannot read: the refusal lists what it accepts, the ROS-style names among them."""
+    odd = tmp_path / "odd.csv"
+    odd.write_text("__time,a,b\n1,2,3\n4,5,6\n")
+    assert_refused(run("init", str(URDF), str(odd), "--out", str(tmp_path / "x.toml")),
+                   "odd.csv: found 0 positions column(s) of the 6 the robot needs among ['__time', 'a', 'b']; accepted: t, "
+                   "time, timestamp or __time")
+    assert not (tmp_path / "x.toml").exists()

@@ -501,7 +501,7 @@ def init(
         for v in validation or ():
             if not v.is_file():
                 raise DynIdError(f"{v}: no such validation log")
-        return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()))
+        return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints))
 
     def save(written):
         from ..io.files import atomic_write_text

@@ -311,7 +311,8 @@ def _detected(log: Path, robot: Robot) -> DatasetSpec:
 
     if not log.is_file():
         raise DataError(f"{log}: no such log")
-    text, _ = starter_config(Path("robot.urdf"), log, robot.n_dof, log.parent / "detected.toml")
+    text, _ = starter_config(Path("robot.urdf"), log, robot.n_dof, log.parent / "detected.toml",
+                             joints=tuple(j.name for j in robot.joints))
     return dataset_spec(tomllib.loads(text)["identification"], log.parent, str(log), log.stem, robot.n_dof)
 
 

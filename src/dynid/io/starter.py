@@ -1,8 +1,11 @@
 """``dynid init``: a starter identification config for a robot's URDF and a log, with the columns it detected.
 
-The log's columns are matched by their header names (time: ``t``, ``time``, ``timestamp``; positions: ``q``, ``pos``,
-``position``, ``angle``; velocities: ``dq``, ``qd``, ``vel``; torques: ``tau``, ``torque``, ``effort``; currents:
-``i``, ``current``), in the order they appear; without a header, by their count (a time column first, then one
+The log's columns are matched by their header names (time: ``t``, ``time``, ``timestamp``, PlotJuggler's ``__time``;
+positions: ``q``, ``pos``, ``position``, ``angle``; velocities: ``dq``, ``qd``, ``vel``; torques: ``tau``, ``torque``,
+``effort``; currents: ``i``, ``current``). A header naming the URDF's joints — ROS-style
+``/joint_states/<joint>/position|velocity|effort`` (PlotJuggler's CSV export), ``<joint>_pos``, ``<joint>.effort`` —
+is taken in the URDF's joint order, whatever the log's (ROS drivers often publish joints alphabetically); other names
+in the order they appear (``q1``…, ``/joint_states/position[0]``…). Without a header, by their count (a time column first, then one
 block of ``n_dof`` columns per signal: positions and torques, or positions, velocities and torques) or a known
 logger's layout (Universal Robots' RTDE: ``preset = "ur-rtde"``). What was detected is written as comments in the
 config, to check before identifying.
@@ -17,7 +20,7 @@ from ..exceptions import ConfigError, DataError
 from .files import text_encoding_hint
 
 PATTERNS = {
-    "time": r"(t|time|times?tamp|stamp|sec|seconds)",
+    "time": r"_*(t|time|times?tamp|stamp|sec|seconds)",
     "positions": r"(q|pos|position|positions|angle|joint_?pos|actual_q)",
     "velocities": r"(dq|qd|qdot|vel|velocity|velocities|actual_qd)",
     "torques": r"(tau|torque|torques|effort|moment|target_moment)",
@@ -26,15 +29,59 @@ PATTERNS = {
 """Header-name stems of each signal (case-insensitive, followed by an optional separator and joint number)."""
 
 
+ACCEPTED = ("t, time, timestamp or __time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… or i1…; "
+            "or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
+"""The header patterns init accepts, named in its refusals."""
+
+_SEPARATORS = r"[\s/._\-\[\]()]"
+
+
 def _kind(name: str) -> str | None:
-    stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", name.strip().lower())
+    """The signal a column's name says, by its last path component (``/joint_states/position[0]`` → positions)."""
+    last = [part for part in re.split(r"[/.]", name.strip().lower()) if part] or [""]
+    stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", last[-1])
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
             return kind
     return None
 
 
-def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = ()) -> tuple[str, list[str]]:
+def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
+    """``(signal, joint index)`` of a column that names one of the URDF's joints and a signal beside it
+    (``/joint_states/elbow_joint/position``, ``elbow_joint_pos``, ``elbow_joint.effort``); the longest joint name wins
+    (``joint_1`` against ``joint_10``)."""
+    low = name.strip().lower()
+    for j in sorted(range(len(joints)), key=lambda j: -len(joints[j])):
+        joint = joints[j].lower()
+        match = re.search(rf"(^|{_SEPARATORS}){re.escape(joint)}($|{_SEPARATORS})", low)
+        if not joint or match is None:
+            continue
+        rest = [part for part in re.split(rf"{_SEPARATORS}+", low[:match.start()] + " " + low[match.end():]) if part]
+        kinds = [k for k in (_kind(part) for part in reversed(rest)) if k not in (None, "time")]
+        if kinds:
+            return kinds[0], j
+    return None
+
+
+def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str, list[str]], list[str]]:
+    """Columns naming every joint of the URDF, per signal in the URDF's joint order, and a note per signal whose log
+    order differs."""
+    named: dict[str, dict[int, str]] = {}
+    for column in first:
+        hit = _named_joint(column, joints)
+        if hit is not None:
+            named.setdefault(hit[0], {}).setdefault(hit[1], column)
+    found, notes = {}, []
+    for kind, columns in named.items():
+        if len(columns) == len(joints):
+            found[kind] = [columns[j] for j in range(len(joints))]
+            if found[kind] != [c for c in first if c in found[kind]]:
+                notes.append(f"{kind}: taken in the URDF's joint order ({', '.join(joints)}), not the log's")
+    return found, notes
+
+
+def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
+                   joints: tuple[str, ...] = ()) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -49,6 +96,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         Where the config will be: the URDF and the log's folder are written relative to its folder.
     validation : tuple of Path
         Other logs of the same layout: each a ``[[validation]]`` entry (it takes the identification's columns).
+    joints : tuple of str
+        The URDF's joint names, in the chain's order (columns naming them are taken in this order).
 
     Returns
     -------
@@ -81,19 +130,23 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if delimiter != ",":
         table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
     if header:
+        by_name, order_notes = _by_joint_names(first, joints) if len(joints) == n_dof else ({}, [])
+        named = {c for columns in by_name.values() for c in columns}
         found: dict[str, list[str]] = {}
         for name in first:
             kind = _kind(name)
-            if kind:
+            if kind and name not in named:
                 found.setdefault(kind, []).append(name)
+        found.update(by_name)
         if "time" not in found:
-            raise DataError(f"{log}: no time column among {first} (named t, time or timestamp); add one, or write the "
-                            "config by hand with rate = ... (docs: Configuration files)")
+            raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; or write the config by "
+                            "hand with rate = ... (docs: Configuration files)")
         effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
         missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
         if missing:
             raise DataError(f"{log}: found {len(found.get(missing[0], []))} {missing[0]} column(s) of the {n_dof} the robot "
-                            f"needs among {first}")
+                            f"needs among {_shown(first)}; accepted: {ACCEPTED}")
+        notes += order_notes
         table += ["header = true", f'time = {{ column = "{found["time"][0]}" }}']
         taken = [found["time"][0]]
         for kind in ("positions", "velocities", effort):
@@ -141,6 +194,11 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         "",
     ])
     return text, notes
+
+
+def _shown(columns: list[str], most: int = 12) -> str:
+    """The header's first columns, for a message."""
+    return str(columns[:most])[:-1] + (f", … {len(columns) - most} more]" if len(columns) > most else "]")
 
 
 def _relative(path: Path, folder: Path) -> str:
