@@ -143,3 +143,30 @@ def test_init_names_the_patterns_it_accepts(tmp_path):
                    "odd.csv: found 0 positions column(s) of the 6 the robot needs among ['__time', 'a', 'b']; accepted: t, "
                    "time, timestamp or __time")
     assert not (tmp_path / "x.toml").exists()
+
+
+def test_init_on_a_ros2_mcap_bag_writes_a_config_identify_runs(tmp_path):
+    """A rosbag2 in MCAP (ROS 2's default storage since Iron) of a simulated UR10e's /joint_states, joints in the
+    driver's order: init writes a bag table (it read the bag as text before: "not a UTF-8 text table") and identify
+    on it matches the URDF's own model."""
+    import json
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "io"))
+    from test_bags import _write_bag
+
+    robot = dynid.load_robot(URDF)
+    log = dynid.simulated_log(robot, seconds=30, seed=4)
+    names = [j.name for j in robot.joints]
+    order = sorted(range(6), key=lambda j: names[j])
+    (tmp_path / "logs").mkdir()
+    dq = np.gradient(log.q, log.t, axis=0)
+    _write_bag(tmp_path / "logs" / "run_01", log.t + 100.0, [names[j] for j in order], log.q[:, order], dq[:, order],
+               log.tau[:, order], storage="mcap")
+    p = run("init", str(URDF), str(tmp_path / "logs" / "run_01"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    assert 'bag = "run_01"' in (tmp_path / "arm.toml").read_text()
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "id" / "results.json").read_text())
+    assert min(results["diagnostics"]["nominal_correlation"][:5]) > 0.99

@@ -7,16 +7,15 @@ from dynid.exceptions import ConfigError, DataError
 from dynid.io.datasets import dataset_spec, load_recording
 from dynid.model.description import load_robot
 
-rosbags = pytest.importorskip("rosbags")
 
-
-def _write_bag(path, t, names, q, dq, effort, topic="/joint_states"):
-    from rosbags.rosbag2 import Writer
+def _write_bag(path, t, names, q, dq, effort, topic="/joint_states", storage="sqlite3"):
+    from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
     ts = get_typestore(Stores.ROS2_HUMBLE)
     JointState, Header, Time = ts.types["sensor_msgs/msg/JointState"], ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
-    with Writer(path, version=8) as writer:
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(path, version=8, storage_plugin=plugin) as writer:
         conn = writer.add_connection(topic, JointState.__msgtype__, typestore=ts)
         for k, tk in enumerate(t):
             stamp = Time(sec=int(tk), nanosec=int(round((tk - int(tk)) * 1e9)))
@@ -25,7 +24,9 @@ def _write_bag(path, t, names, q, dq, effort, topic="/joint_states"):
             writer.write(conn, int(tk * 1e9), ts.serialize_cdr(msg, JointState.__msgtype__))
 
 
-def test_bag_of_joint_states_reads_like_a_log(tmp_path, rng):
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_bag_of_joint_states_reads_like_a_log(tmp_path, rng, storage):
+    """Both rosbag2 storages (MCAP: the default since ROS 2 Iron)."""
     robot = load_robot("ur10e")
     names = [j.name for j in robot.joints]
     t = 100.0 + np.arange(200) * 0.008  # 125 Hz
@@ -33,7 +34,8 @@ def test_bag_of_joint_states_reads_like_a_log(tmp_path, rng):
     dq = np.outer(np.cos(t), np.arange(1, 7) * 0.1)
     tau = rng.normal(0, 1, (200, 6))
     order = [3, 0, 5, 1, 4, 2]  # the bag lists the joints in another order
-    _write_bag(tmp_path / "bag", t, [names[i] for i in order], q[:, order], dq[:, order], tau[:, order])
+    _write_bag(tmp_path / "bag", t, [names[i] for i in order], q[:, order], dq[:, order], tau[:, order], storage=storage)
+    assert any(p.suffix == (".mcap" if storage == "mcap" else ".db3") for p in (tmp_path / "bag").iterdir())
     rec = load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg: identification", "ident", 6), robot)
     assert rec.n_samples == 200 and rec.rate == pytest.approx(125.0)
     np.testing.assert_allclose(rec.q, q + robot.transmission.position_offset, atol=1e-12)

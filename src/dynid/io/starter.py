@@ -89,7 +89,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     urdf : Path
         The robot's URDF.
     log : Path
-        A CSV log (comma, semicolon, tab or space separated).
+        A CSV log (comma, semicolon, tab or space separated), or a ROS 2 bag (its folder, or its ``.mcap``/``.db3``
+        file).
     n_dof : int
         The robot's joints.
     out : Path
@@ -111,6 +112,11 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     DataError
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
+    if log.is_dir() or log.suffix.lower() in (".mcap", ".db3"):
+        table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
+                 '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
+        notes = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
+        return _config(urdf, log, out, validation, table, notes), notes
     try:
         lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
     except UnicodeDecodeError:
@@ -175,7 +181,12 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                         "signal (or name the columns in a header line: t, q1…, tau1…)")
     notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
                  "positions for degrees")
-    text = "\n".join([
+    return _config(urdf, log, out, validation, table, notes), notes
+
+
+def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: list[str], notes: list[str]) -> str:
+    """The config's text: what was detected in comments, the dataset table, the validation logs."""
+    return "\n".join([
         "# dynid identification config, written by dynid init: check the columns and units below, then",
         "#   dynid identify THIS_FILE",
         *(f"# {n}" for n in notes),
@@ -193,7 +204,6 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
         "",
     ])
-    return text, notes
 
 
 def _shown(columns: list[str], most: int = 12) -> str:
