@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from dynid.estimators.instrumental import instrumental_variables, long_run_covariance, newey_west_lags
+from dynid.estimators import instrumental
+from dynid.estimators.instrumental import instrumental_variables, long_run_covariance, newey_west_lags, parzen_lags
 from dynid.exceptions import ShapeError
 
 
@@ -55,3 +56,48 @@ def test_shapes_are_checked_and_the_lags_follow_the_rule():
     with pytest.raises(ShapeError, match="instant"):
         long_run_covariance(np.ones((4, 2)), np.arange(3))
     assert newey_west_lags(100) == 4 and newey_west_lags(1) == 1 and newey_west_lags(176) == 4
+
+
+def test_parzen_lags_see_the_cancellation_of_blue_noise():
+    """Independent truth: a residual that is differenced, smoothed white noise plus a little white noise (blue, as a
+    log filtered above its excitation band leaves it) has the autocovariance ``γ_l`` of its taps, so the variance of
+    ``Σ z_k r_k`` for fixed, slow instruments is ``Σ_l γ_l Σ_k z_{k+l} z_kᵀ`` exactly. Averaged over draws the Parzen
+    estimate with :func:`parzen_lags` is within 25 % of it; Newey–West's Bartlett rule counts the noise the lags cancel
+    (measured 3.2-3.3 times; the closed-loop study's σ was 2.7-3.3 times the spread with 30 Hz cutoffs)."""
+    rng = np.random.default_rng(7)
+    t = 2000
+    k = np.arange(t)
+    z = np.column_stack([np.sin(2 * np.pi * k / 400), np.cos(2 * np.pi * k / 170) + 0.5])
+    taps = np.convolve([1.0, -1.0], [0.25, 0.5, 0.25])
+    white = 0.2
+    gamma = np.correlate(taps, taps, "full")[taps.size - 1:]
+    gamma[0] += white**2
+    exact = sum((1 if lag == 0 else 2) * gamma[lag] * 0.5 * (z[lag:].T @ z[: t - lag] + z[: t - lag].T @ z[lag:])
+                for lag in range(gamma.size))
+    parzen, bartlett = [], []
+    for _ in range(100):
+        r = np.convolve(rng.normal(size=t + taps.size - 1), taps, "valid") + white * rng.normal(size=t)
+        parzen.append(np.diag(long_run_covariance(z * r[:, None], k, kernel="parzen")))
+        bartlett.append(np.diag(long_run_covariance(z * r[:, None], k)))
+    ratio = np.mean(parzen, axis=0) / np.diag(exact)
+    assert np.all((ratio > 0.9) & (ratio < 1.25)), ratio
+    assert np.all(np.mean(bartlett, axis=0) / np.diag(exact) > 2.5)
+    assert parzen_lags(t) == 40 and parzen_lags(161) == 2 * newey_west_lags(161) == 8
+
+
+def test_long_lag_windows_are_summed_by_fft_to_the_same_sum(monkeypatch):
+    """The FFT path against the direct sum over lags (both kernels, missing instants, lags beyond the log)."""
+    rng = np.random.default_rng(8)
+    g = rng.normal(size=(3000, 4))
+    instants = np.sort(rng.integers(0, 2500, 3000))
+    fast = [long_run_covariance(g, instants, lags=lags, kernel=kernel)
+            for kernel in ("parzen", "bartlett") for lags in (200, 5000)]
+    monkeypatch.setattr(instrumental, "_FFT_ABOVE", 10**9)
+    direct = [long_run_covariance(g, instants, lags=lags, kernel=kernel)
+              for kernel in ("parzen", "bartlett") for lags in (200, 5000)]
+    for a, b in zip(fast, direct):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
+    np.testing.assert_allclose(fast[0], fast[0].T)
+    assert np.linalg.eigvalsh(fast[0]).min() > -1e-9 * np.abs(fast[0]).max()
+    with pytest.raises(ValueError, match="kernel"):
+        long_run_covariance(g, instants, kernel="tukey")
