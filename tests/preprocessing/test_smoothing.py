@@ -42,3 +42,35 @@ def test_errors():
         five_point_cubic_smoothing(np.zeros(10), -1)
     with pytest.raises(ConfigError, match="at least 5"):
         five_point_cubic_smoothing(np.zeros(4), 1)
+
+
+def test_eq17_is_scipys_savitzky_golay_to_rounding():
+    """Independent truth: eq. 17 is the 5-point cubic Savitzky–Golay filter with polynomial ends (SciPy's
+    ``savgol_filter(y, 5, 3, mode="interp")``), which dynid called before it applied the paper's formulas itself."""
+    from scipy.signal import savgol_filter
+
+    rng = np.random.default_rng(3)
+    for shape in [(5,), (6, 3), (1000, 4)]:
+        y = rng.normal(size=shape)
+        np.testing.assert_allclose(five_point_cubic_smoothing(y, 1), savgol_filter(y, 5, 3, mode="interp", axis=0),
+                                   rtol=0, atol=1e-13)
+
+
+def test_the_paper_strategy_needs_no_scipy_signal():
+    """dynid run's strategy (eq. 17 and the Fourier fit) prepares a log without importing scipy.signal, whose import
+    cost a whole run about 0.5-1.5 s (SciPy 1.17 parses every docstring of the module); a Butterworth filter imports it."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, dynid\n"
+            "from dynid.preprocessing.pipeline import Preprocessing, prepare\n"
+            "robot = dynid.load_robot('er16').submodel(3)\n"
+            "log = dynid.simulated_log(robot, seconds=10, seed=1)\n"
+            "prepare(log, Preprocessing(strategy='paper', fourier=(0.1 * np.pi, 5)))\n"
+            "print('scipy.signal' in sys.modules)\n"
+            "from dynid.preprocessing.filters import butterworth_filtfilt\n"
+            "butterworth_filtfilt(np.ones((100, 1)), 100.0, 10.0)\n"
+            "print('scipy.signal' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["False", "True"]

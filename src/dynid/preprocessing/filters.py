@@ -10,11 +10,18 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 
 import numpy as np
-from scipy import signal
 
 from ..column_store import by_column
 from ..exceptions import ConfigError
 from .bands import decimation_cutoff
+
+
+def _signal():
+    """``scipy.signal``, imported when a filter is designed: its import costs about 1.5 s (SciPy 1.17), which a run
+    that filters nothing (the paper's eq. 17 and Fourier-fit strategy) does not pay."""
+    from scipy import signal
+
+    return signal
 
 
 def _check_cutoff(rate: float, cutoff: float, what: str) -> None:
@@ -46,6 +53,7 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
         If ``cutoff`` is not in (0, rate/2).
     """
     _check_cutoff(rate, cutoff, "Butterworth filter")
+    signal = _signal()
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
     return by_column(x, lambda column, j: signal.sosfiltfilt(sos, column))
 
@@ -124,6 +132,7 @@ def velocity_noise_std(sigma: np.ndarray, rate: float, cutoff: float, order: int
     if 0 < cutoff < rate / 2 and gaussian:
         gain = np.exp(-((2 * np.pi * f * GAUSS_CUTOFF / cutoff) ** 2))
     elif 0 < cutoff < rate / 2:
+        signal = _signal()
         sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
         gain = np.abs(signal.sosfreqz(sos, worN=f, fs=rate)[1]) ** 4
     if differentiated:
@@ -264,6 +273,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
         raise ConfigError(f"parallel filter: a cutoff of {cutoff:g} Hz aliases when decimating by {factor} "
                           f"(at most {decimation_cutoff(rate, factor):g} Hz)")
     _check_cutoff(rate, cutoff, "parallel filter")
+    signal = _signal()
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
     margin = int(np.ceil(10 * order * 0.4 * rate / cutoff))  # the filter's transient, as 10·factor·order at the decimation's cutoff
     for start in range(0, n_samples, chunk):
