@@ -170,3 +170,31 @@ def test_init_on_a_ros2_mcap_bag_writes_a_config_identify_runs(tmp_path):
     assert p.returncode == 0, p.stderr
     results = json.loads((tmp_path / "id" / "results.json").read_text())
     assert min(results["diagnostics"]["nominal_correlation"][:5]) > 0.99
+
+
+def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(tmp_path, monkeypatch):
+    """``dynid excite`` on the config init wrote refused it ("unknown field 'data_root'": another format, which init
+    writes none of); an identification config is now an excitation config (its robot, an optional [excitation]
+    table). And identify's advice is a command that runs as printed: the export line names this config, the results
+    just written and files to write, where it said CONFIG and FILE."""
+    import shlex
+
+    log = _log(tmp_path, header=True)
+    monkeypatch.chdir(tmp_path)
+    assert run("init", str(URDF), str(log), "--out", "arm.toml").returncode == 0
+    text = (tmp_path / "arm.toml").read_text().replace('# [estimation]\n# estimators = ["wls", "sdp"]',
+                                                       '[estimation]\nestimators = ["wls", "sdp"]')
+    (tmp_path / "arm.toml").write_text(text + "\n[excitation.design]\nstarts = 1\nmaxiter = 3\n")
+    p = run("excite", "arm.toml", "--out", "excitation", "-q")
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "excitation" / "excitation.csv").is_file()
+    p = run("identify", "arm.toml", "--out", "id", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    said = " ".join(p.stdout.split())  # the console wraps long lines
+    assert "CONFIG" not in said and "FILE" not in said
+    start = said.index("dynid export")
+    command = shlex.split(said[start: said.index("-identified.urdf", start) + len("-identified.urdf")])
+    assert command[:2] == ["dynid", "export"]
+    p = run(*command[1:])
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "arm-identified.urdf").is_file()

@@ -283,10 +283,33 @@ def identify(
     def show(rep, identified, paths):
         from ..report.summaries import identification_brief
 
-        rep.blocks(summary_blocks(identified[1]) if verbose else identification_brief(identified[1]))
+        blocks = summary_blocks(identified[1]) if verbose else identification_brief(identified[1])
+        rep.blocks(runnable_advice(blocks, config, out))
         rep.wrote(paths)
 
     _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
+
+
+def runnable_advice(blocks, config: Path, out: Path) -> list:
+    """The summary's advice as commands that run as printed: ``dynid export CONFIG --urdf FILE [--mjcf FILE]`` with
+    this config, the results just written and files named after the config; ``(dynid excite)`` as ``dynid excite
+    CONFIG`` (an identification config is an excitation config: its robot and ``[excitation]`` table)."""
+    import dataclasses
+    import shlex
+
+    from ..tables import Line
+
+    cfg, stem = shlex.quote(str(config)), shlex.quote(config.stem)
+    export = f"dynid export {cfg} --results {shlex.quote(str(out / 'results.json'))} --urdf {stem}-identified.urdf"
+    words = {"dynid export CONFIG --urdf FILE --mjcf FILE": f"{export} --mjcf {stem}-identified.xml",
+             "dynid export CONFIG --urdf FILE": export, "(dynid excite)": f"(dynid excite {cfg})"}
+
+    def concrete(text: str) -> str:
+        for placeholder, command in words.items():
+            text = text.replace(placeholder, command)
+        return text
+
+    return [dataclasses.replace(b, text=concrete(b.text)) if isinstance(b, Line) else b for b in blocks]
 
 
 @app.command()

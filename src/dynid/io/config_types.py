@@ -194,6 +194,7 @@ class IdentificationDocument(Table, kw_only=True):
     references: Annotated[list[ReferenceTable], _d("published parameter sets scored beside")] = msgspec.field(default_factory=list)
     drive_gains: Annotated[DriveGainsTable, _d("drive gains from a known payload")] | None = None
     controller: Annotated[ControllerTable, _d("the controller of the identification run (IDIM-IV, DIDIM)")] | None = None
+    excitation: Annotated[ExcitationTable, _d("what dynid excite designs for this robot (dynid excite CONFIG)")] | None = None
 
 
 class UnitGainsTable(Table, kw_only=True):
@@ -280,6 +281,18 @@ class OutputTable(Table, kw_only=True):
 
     rate: Annotated[float, Meta(gt=0, description="controller rate, Hz (default 500)")] | None = None
     periods: Annotated[int, Meta(ge=1, description="periods written (default 1)")] | None = None
+
+
+class ExcitationTable(Table, kw_only=True):
+    """``[excitation]`` of an identification config: what ``dynid excite CONFIG`` designs for the config's robot (every
+    table optional; the trajectory defaults to 5 harmonics of 0.1 Hz, starting and ending at rest)."""
+
+    joints: Annotated[int, Meta(ge=1, description="identify the first joints (default all)")] | None = None
+    trajectory: Annotated[TrajectoryTable, _d("the Fourier trajectory (eq. 14)")] | None = None
+    limits: Annotated[LimitsTable, _d("limits overriding the robot's")] = msgspec.field(default_factory=LimitsTable)
+    workspace: Annotated[WorkspaceTable, _d("where the tool may go")] = msgspec.field(default_factory=WorkspaceTable)
+    design: Annotated[DesignTable, _d("the optimisation")] = msgspec.field(default_factory=DesignTable)
+    output: Annotated[OutputTable, _d("the set-points' CSV")] = msgspec.field(default_factory=OutputTable)
 
 
 class ExcitationDocument(Table, kw_only=True):

@@ -33,6 +33,10 @@ Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to t
     [output]
     rate = 500                   # controller rate of the CSV [Hz]
     periods = 1
+
+An identification config (``dynid identify``'s) is an excitation config too: its robot, and its optional
+``[excitation]`` table holding the tables above (``joints``, ``[excitation.trajectory]``, ``[excitation.limits]`` …);
+without ``[excitation.trajectory]`` the design has :data:`DEFAULT_TRAJECTORY`.
 """
 
 from __future__ import annotations
@@ -55,6 +59,20 @@ from ..typed import convert
 from .config_types import ExcitationDocument
 from .configs import config_robot, read_config
 from .trajectories import load_trajectory
+
+DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
+"""The trajectory designed for an identification config without ``[excitation.trajectory]``: 5 harmonics of 0.1 Hz
+(a 10 s period, as the UR10e's example) starting and ending at rest at offsets chosen by the design."""
+
+
+def _from_identification(doc: dict, path: Path) -> dict:
+    """An identification config as an excitation document: its robot and its ``[excitation]`` table."""
+    table = doc.get("excitation", {})
+    if not isinstance(table, dict):
+        raise ConfigError(f"{path}: excitation: expected a table ([excitation]), got {type(table).__name__}")
+    excitation = dict(table)
+    excitation.setdefault("trajectory", dict(DEFAULT_TRAJECTORY))
+    return {"robot": doc.get("robot"), **excitation}
 
 
 @dataclass(frozen=True)
@@ -111,6 +129,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     Parameters
     ----------
     path : str or Path
+        An excitation config, or an identification config (its robot and ``[excitation]`` table).
 
     Returns
     -------
@@ -124,6 +143,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     """
     path = Path(path)
     doc = read_config(path, None)
+    if "identification" in doc:  # dynid identify's config: its robot, and its [excitation] table
+        doc = _from_identification(doc, path)
     c = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, ExcitationDocument, str(path))
     here = path.parent
     full = config_robot(doc, path)

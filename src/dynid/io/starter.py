@@ -115,8 +115,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if log.is_dir() or log.suffix.lower() in (".mcap", ".db3"):
         table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
-        notes = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
-        return _config(urdf, log, out, validation, table, notes), notes
+        said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
+        return _config(urdf, log, out, validation, table, said), said
     try:
         lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
     except UnicodeDecodeError:
