@@ -113,3 +113,25 @@ def test_closed_loop_estimators_without_the_controller_are_refused_in_one_line(c
     _write(tmp_path, table, '["wls", "idim-iv"]')
     assert_refused(dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "o"),
                    "ref.csv: 9990 rows of set-points, the identification log has 10000 samples")
+
+
+def test_the_identifier_takes_every_estimator_a_config_takes(closed_loop_log):
+    """Identifier(estimators=["wls", "idim-iv"]) was refused ("expected a comma-separated subset of ols, wls, …") where
+    the config took the same list: on a config with a [controller] it runs IDIM-IV beside WLS, the same estimates as
+    the config's own list; on arrays, and on a config without a controller, it says what is missing in one line."""
+    from dynid.exceptions import ConfigError
+
+    root, table, _ = closed_loop_log
+    _write(root, table, estimators='["wls", "idim-iv"]')
+    ident = dynid.Identifier(estimators=["wls", "idim-iv"]).fit(root / "cl.toml", validate=False)
+    assert list(ident.estimates_) == ["dynid WLS", "dynid IDIM-IV"]
+    by_config = dynid.Identifier().fit(root / "cl.toml", validate=False)
+    np.testing.assert_allclose(ident.estimates_["dynid IDIM-IV"], by_config.estimates_["dynid IDIM-IV"], rtol=1e-12)
+    _write(root, "", estimators='["wls"]')
+    with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: .*cl.toml has no \[controller\]"):
+        dynid.Identifier(estimators=["wls", "idim-iv"]).fit(root / "cl.toml", validate=False)
+    log = dynid.simulated_log(dynid.load_robot("er16"), seconds=5, seed=1)
+    with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: fit a config"):
+        dynid.Identifier("er16", estimators=["wls", "idim-iv"]).fit(log.t, log.q, log.tau)
+    with pytest.raises(ConfigError, match="list ols or wls before 'idim-iv'"):
+        dynid.Identifier(estimators=["idim-iv", "wls"]).fit(root / "cl.toml")

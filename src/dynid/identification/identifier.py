@@ -33,7 +33,8 @@ class Identifier:
         TOML / URDF path. Required to fit arrays; a config names its own.
     estimators : sequence of str, optional
         Keys of :mod:`dynid.estimators.registry`, case-insensitive; the first is the main estimate (default
-        ``["wls"]``, or the config's).
+        ``["wls"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
+        (``idim-iv``, ``didim``, ``didim-sdp``) too, when fitting a config with a ``[controller]`` table.
     preprocessing : Preprocessing or dict, optional
         Preprocessing settings (default: every setting derived from the data, or the config's).
     friction : {"auto", "description"}, optional
@@ -143,10 +144,15 @@ class Identifier:
         if isinstance(t, (str, Path)):
             result = self._fit_config(Path(t), data_root, validate)
         else:
+            from ..io.identification_config import split_estimators
             from .run import identify_from_arrays
 
             if q is None or tau is None:
                 raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
+            if self.estimators is not None and split_estimators(self.estimators, "Identifier(estimators=...)")[1]:
+                raise ConfigError(f"Identifier(estimators=...): {split_estimators(self.estimators, '')[1][0]} simulates the "
+                                  "run in closed loop and needs its controller: fit a config with a [controller] table "
+                                  "(Identifier(...).fit('arm.toml')), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
                                           seed=0 if self.seed is None else int(self.seed))
@@ -163,8 +169,8 @@ class Identifier:
     def _fit_config(self, path: Path, data_root, validate: bool):
         from dataclasses import replace
 
-        from ..estimators.registry import parse_estimators
-        from ..io.identification_config import load_identification_config
+        from ..exceptions import ConfigError
+        from ..io.identification_config import load_identification_config, split_estimators
         from .run import run_identification
 
         config = load_identification_config(path, data_root)
@@ -172,7 +178,11 @@ class Identifier:
         if self.robot is not None:
             changes["robot"] = self._robot()
         if self.estimators is not None:
-            changes["estimators"] = parse_estimators(tuple(self.estimators))
+            changes["estimators"], changes["closed_loop"] = split_estimators(self.estimators, "Identifier(estimators=...)")
+            if changes["closed_loop"] and config.controller is None:
+                raise ConfigError(f"Identifier(estimators=...): {changes['closed_loop'][0]} simulates the run in closed loop "
+                                  f"and needs its controller: {path} has no [controller] table (kp, kd, rate, the "
+                                  "reference trajectory)", field="estimators")
         if self.preprocessing is not None:
             changes["preprocessing"] = self._preprocessing()
         if self.friction is not None:

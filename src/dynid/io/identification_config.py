@@ -219,6 +219,47 @@ def load_identification_config(path: str | Path, data_root: str | Path | None = 
     return config_from_document(read_config(path, None), path, data_root)
 
 
+def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
+    """The open-loop estimators (:func:`dynid.estimators.registry.parse_estimators`) and the closed-loop ones
+    (IDIM-IV, DIDIM, DIDIM-SDP: :data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS`) of an estimator list, as a
+    config's ``[estimation] estimators`` and :class:`dynid.identification.identifier.Identifier` take it.
+
+    Parameters
+    ----------
+    asked : sequence of str
+        Estimator keys; the first is the main estimate.
+    where : str
+        Where the list was given, for the messages.
+
+    Returns
+    -------
+    estimators : tuple
+        The parsed open-loop estimators.
+    closed_loop : tuple of str
+        The closed-loop keys, lower case.
+
+    Raises
+    ------
+    ConfigError
+        An unknown key, or a closed-loop estimator first (it starts from the first's estimate).
+    """
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
+
+    asked = [str(k).strip().lower() for k in asked]
+    closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
+    if asked and asked[0] in CLOSED_LOOP_METHODS:
+        raise ConfigError(f"{where}: the first is the main estimate and starts the closed-loop ones: list ols or wls "
+                          f"before {asked[0]!r}")
+    try:
+        estimators = parse_estimators([k for k in asked if k not in CLOSED_LOOP_METHODS])
+    except ConfigError as exc:
+        text = str(exc)
+        if text.startswith("plugin "):  # a plugin that cannot be imported names itself and where it was named
+            raise ConfigError(f"{where}: {text}") from None
+        raise ConfigError(f"{where}: {text.split(': ', 1)[1]}") from None
+    return estimators, closed_loop
+
+
 def config_from_document(doc: dict, path: Path, data_root: str | Path | None = None) -> IdentificationConfig:
     """Parse an identification config already read (e.g. a fleet's unit: its template with the unit's files).
 
@@ -268,20 +309,8 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     e = typed.estimation or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
-    from ..estimators.instrumental import CLOSED_LOOP_METHODS
-
     asked = [str(k).strip().lower() for k in e.estimators] if e.estimators is not None else ["wls"]
-    closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
-    if asked and asked[0] in CLOSED_LOOP_METHODS:
-        raise ConfigError(f"{path}: estimation.estimators: the first is the main estimate and starts the closed-loop "
-                          f"ones: list ols or wls before {asked[0]!r}")
-    try:
-        estimators = parse_estimators([k for k in asked if k not in CLOSED_LOOP_METHODS])
-    except ConfigError as exc:
-        text = str(exc)
-        if text.startswith("plugin "):  # a plugin that cannot be imported names itself and where it was named
-            raise ConfigError(f"{path}: estimation.estimators: {text}") from None
-        raise ConfigError(f"{path}: estimation.estimators: {text.split(': ', 1)[1]}") from None
+    estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof)
     if closed_loop and controller is None:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
