@@ -284,16 +284,31 @@ def identify(
         from ..report.summaries import identification_brief
 
         blocks = summary_blocks(identified[1]) if verbose else identification_brief(identified[1])
-        rep.blocks(runnable_advice(blocks, config, out))
+        rep.blocks(_runnable_advice(blocks, config, out))
         rep.wrote(paths)
 
     _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
 
 
-def runnable_advice(blocks, config: Path, out: Path) -> list:
+def _runnable_advice(blocks, config: Path, out: Path) -> list:
     """The summary's advice as commands that run as printed: ``dynid export CONFIG --urdf FILE [--mjcf FILE]`` with
     this config, the results just written and files named after the config; ``(dynid excite)`` as ``dynid excite
-    CONFIG`` (an identification config is an excitation config: its robot and ``[excitation]`` table)."""
+    CONFIG`` (an identification config is an excitation config: its robot and ``[excitation]`` table).
+
+    Parameters
+    ----------
+    blocks : list of Block
+        What :mod:`dynid.report.summaries` builds for the identification.
+    config : Path
+        The config ``dynid identify`` was given.
+    out : Path
+        Its output folder.
+
+    Returns
+    -------
+    list of Block
+        The same blocks, the lines' placeholders replaced.
+    """
     import dataclasses
     import shlex
 
