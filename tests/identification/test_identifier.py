@@ -105,6 +105,26 @@ def test_get_and_set_params_follow_scikit_learns_contract():
         dynid.Identifier("er16", estimators=["magic"]).fit(np.arange(1000) / 100, np.zeros((1000, 6)), np.zeros((1000, 6)))
 
 
+def test_scikit_learns_check_is_fitted_and_clone(fitted):
+    """scikit-learn's own functions on an Identifier: check_is_fitted raised AttributeError (no ``__sklearn_tags__``);
+    now NotFittedError before fit and nothing after; clone copies the settings, not the fitted state."""
+    from sklearn.base import clone
+    from sklearn.exceptions import NotFittedError
+    from sklearn.utils.validation import check_is_fitted
+
+    fresh = dynid.Identifier("er16", estimators=["wls"], seed=3)
+    with pytest.raises(NotFittedError):
+        check_is_fitted(fresh)
+    check_is_fitted(fitted)
+    copy = clone(fitted)
+    given, copied = fitted.get_params(), copy.get_params()
+    assert copied.keys() == given.keys() and copied["estimators"] == given["estimators"] and copy is not fitted
+    assert copied["robot"].name == given["robot"].name
+    with pytest.raises(NotFittedError):
+        check_is_fitted(copy)
+    assert len(repr(fitted).splitlines()) == 1
+
+
 def test_fit_on_a_config_with_the_identifiers_settings_on_top(tmp_path):
     cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
     ident = dynid.Identifier(estimators=["wls", "ols"], seed=2).fit(cfg)

@@ -69,6 +69,28 @@ class Identifier:
         self.friction = friction
         self.seed = seed
 
+    def __sklearn_is_fitted__(self) -> bool:
+        """Whether :meth:`fit` ran (scikit-learn's ``check_is_fitted`` asks this).
+
+        Returns
+        -------
+        bool
+        """
+        return hasattr(self, "result_")
+
+    def __sklearn_tags__(self):
+        """scikit-learn's tags (asked by its ``check_is_fitted``, ``clone`` and meta-estimators; scikit-learn is then
+        imported already): no estimator type of its own (it fits a robot's log, not ``X, y``), fitting required, its
+        input not validated by scikit-learn, its box searches seeded (``seed``), so deterministic.
+
+        Returns
+        -------
+        sklearn.utils.Tags
+        """
+        from sklearn.utils import Tags, TargetTags
+
+        return Tags(estimator_type=None, target_tags=TargetTags(required=True), no_validation=True, requires_fit=True)
+
     def get_params(self, deep: bool = True) -> dict:
         """The constructor's parameters and their values (scikit-learn's contract).
 
@@ -323,4 +345,8 @@ class Identifier:
 
     def __repr__(self) -> str:
         given = {k: v for k, v in self.get_params().items() if v is not None}
-        return f"Identifier({', '.join(f'{k}={v!r}' for k, v in given.items())})"
+
+        def short(v) -> str:  # a Robot object by its name and joints (its arrays made a repr of 40 lines)
+            return f"<Robot {v.name!r}, {v.n_dof} joints>" if isinstance(v, Robot) else repr(v)
+
+        return f"Identifier({', '.join(f'{k}={short(v)}' for k, v in given.items())})"
