@@ -382,9 +382,12 @@ def in_short(result) -> list:
         worst = worst_joint(m["relative_error"], c.meaningful())
         errors[c.name] = float(m["global_relative_error"])
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
+        still = c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
         out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
                         + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
-                        + (f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
+                        + (" (at rest throughout: the distance to the static-friction band, a check of the gravity "
+                           "model to within friction, not of motion)" if still else
+                           f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
                         + (" (the fit)" if c is r.fit else "")))
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
