@@ -166,6 +166,9 @@ def test_init_on_a_ros2_mcap_bag_writes_a_config_identify_runs(tmp_path):
     p = run("init", str(URDF), str(tmp_path / "logs" / "run_01"), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 0, p.stderr
     assert 'bag = "run_01"' in (tmp_path / "arm.toml").read_text()
+    assert_refused(run("init", str(URDF), str(tmp_path / "logs"), "--out", str(tmp_path / "x.toml")),
+                   "logs: a folder without metadata.yaml, not a ROS 2 bag")
+    assert not (tmp_path / "x.toml").exists()
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     results = json.loads((tmp_path / "id" / "results.json").read_text())

@@ -112,6 +112,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     DataError
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
+    if log.is_dir() and not (log / "metadata.yaml").is_file():
+        raise DataError(f"{log}: a folder without metadata.yaml, not a ROS 2 bag: give a CSV log, or a bag's folder or "
+                        "its .mcap/.db3 file")
     if log.is_dir() or log.suffix.lower() in (".mcap", ".db3"):
         table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
