@@ -171,8 +171,9 @@ class Identifier:
 
             if q is None or tau is None:
                 raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
-            if self.estimators is not None and split_estimators(self.estimators, "Identifier(estimators=...)")[1]:
-                raise ConfigError(f"Identifier(estimators=...): {split_estimators(self.estimators, '')[1][0]} simulates the "
+            closed_loop = () if self.estimators is None else split_estimators(self.estimators, "Identifier(estimators=...)")[1]
+            if closed_loop:
+                raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the "
                                   "run in closed loop and needs its controller: fit a config with a [controller] table "
                                   "(Identifier(...).fit('arm.toml')), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
