@@ -35,11 +35,11 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     import mujoco
     import pinocchio as pin
 
-    assert pin.buildModelFromUrdf(str(out / "robot.urdf")).nq == 6 and mujoco.MjModel.from_xml_path(str(out / "robot.xml")).nv == 6
+    assert pin.buildModelFromUrdf(str(out / "dynid-model.urdf")).nq == 6 and mujoco.MjModel.from_xml_path(str(out / "dynid-model.xml")).nv == 6
     p = dynid("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--urdf",
               str(tmp_path / "u.urdf"), "--mjcf", str(tmp_path / "u.xml"), "--data-root", str(root))
     assert p.returncode == 0, p.stderr
-    assert (tmp_path / "u.urdf").read_text() == (out / "robot.urdf").read_text()
+    assert (tmp_path / "u.urdf").read_text() == (out / "dynid-model.urdf").read_text()
     # into the user's own MuJoCo model: same joints' values as dynid's own MJCF, the user's bodies and meshes kept
     import numpy as np
 
@@ -54,7 +54,7 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
                   str(tmp_path / "mine_identified.xml"), "--mjcf-model", str(tmp_path / "mine" / "arm.xml"), "--data-root", str(root))
     assert p.returncode == 0, p.stderr
     assert "the MJCF is arm.xml with only its inertials and joint dynamics replaced" in " ".join(p.stdout.split())
-    ours, theirs = (mujoco.MjModel.from_xml_path(str(f)) for f in (out / "robot.xml", tmp_path / "mine_identified.xml"))
+    ours, theirs = (mujoco.MjModel.from_xml_path(str(f)) for f in (out / "dynid-model.xml", tmp_path / "mine_identified.xml"))
     np.testing.assert_allclose(theirs.dof_damping, ours.dof_damping)
     np.testing.assert_allclose(theirs.body_subtreemass[theirs.jnt_bodyid[0]], ours.body_subtreemass[ours.jnt_bodyid[0]])
     assert theirs.nmesh == 1 and theirs.nu == 1

@@ -35,6 +35,25 @@ def test_init_detects_the_columns_by_header_and_identify_runs_on_the_config(tmp_
     p = run("identify", "arm.toml", "--out", "id", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "cfg" / "id" / "results.json").is_file()
+    assert '# [estimation]\n# estimators = ["wls", "sdp"]' in text  # the physically consistent estimate, as init says
+    (tmp_path / "cfg" / "arm.toml").write_text(text.replace('# [estimation]\n# estimators', '[estimation]\nestimators'))
+    p = run("identify", "arm.toml", "--out", "id", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    # one output folder, one model: the user's URDF with the identified values written in, under its own name, the
+    # same file `dynid export --urdf` writes; every line but <inertial>/<dynamics> values and dynid's comments the user's
+    written = tmp_path / "cfg" / "id" / URDF.name
+    assert written.is_file() and not (tmp_path / "cfg" / "id" / "dynid-model.urdf").exists()
+    assert (tmp_path / "cfg" / "id" / "dynid-model.xml").is_file()
+    p = run("export", "arm.toml", "--results", "id/results.json", "--urdf", "exported.urdf")
+    assert p.returncode == 0, p.stderr
+    assert written.read_text() == (tmp_path / "cfg" / "exported.urdf").read_text()
+    import difflib
+    import re
+
+    changed = [ln for ln in difflib.unified_diff(URDF.read_text().splitlines(), written.read_text().splitlines(),
+                                                 lineterm="", n=0) if ln[:1] in "+-" and ln[:3] not in ("+++", "---")]
+    assert changed and all(re.match(r"[-+]\s*(<origin|<mass|<inertia|<dynamics|<!-- |dynid|that predict|experiment|link's)",
+                                    ln) for ln in changed), changed
 
 
 def test_init_without_a_header_takes_blocks_of_columns(tmp_path):
@@ -183,8 +202,10 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     import shlex
 
     log = _log(tmp_path, header=True)
+    other = log.with_name("other.csv")
+    other.write_text(log.read_text())
     monkeypatch.chdir(tmp_path)
-    assert run("init", str(URDF), str(log), "--out", "arm.toml").returncode == 0
+    assert run("init", str(URDF), str(log), str(other), "--out", "arm.toml").returncode == 0
     text = (tmp_path / "arm.toml").read_text().replace('# [estimation]\n# estimators = ["wls", "sdp"]',
                                                        '[estimation]\nestimators = ["wls", "sdp"]')
     (tmp_path / "arm.toml").write_text(text + "\n[excitation.design]\nstarts = 1\nmaxiter = 3\n")
@@ -195,6 +216,7 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     assert p.returncode == 0, p.stderr
     said = " ".join(p.stdout.split())  # the console wraps long lines
     assert "CONFIG" not in said and "FILE" not in said
+    assert said.startswith("model ready: dynid SDP, as the URDF and MJCF in the output folder"), said[:200]
     start = said.index("dynid export")
     command = shlex.split(said[start: said.index("-identified.urdf", start) + len("-identified.urdf")])
     assert command[:2] == ["dynid", "export"]

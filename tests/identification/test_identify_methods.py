@@ -195,7 +195,8 @@ def test_the_first_line_says_whether_the_model_is_ready(tmp_path):
     else:
         exported = next(n for n, e in result.estimates.items()  # what dynid export writes: standard values, consistent
                         if e.standard is not None and result.consistency_verdicts[n].startswith("yes"))
-        assert lines[0] == f"model ready: export {exported} with dynid export CONFIG --urdf FILE --mjcf FILE"
+        assert lines[0] == (f"model ready: {exported}, as the URDF and MJCF in the output folder (other names: dynid "
+                            "export CONFIG --urdf FILE --mjcf FILE)")
 
 
 def test_a_log_at_rest_throughout_says_what_its_figure_checks(tmp_path):

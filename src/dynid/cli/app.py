@@ -273,12 +273,12 @@ def identify(
         return cfg
 
     def compute(cfg, progress):
-        return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate)
+        return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate), cfg.urdf
 
     def save(identified):
         from ..report.identification_run import save_identification
 
-        return save_identification(identified[1], out, figures, robot=identified[0])
+        return save_identification(identified[1], out, figures, robot=identified[0], urdf=identified[2])
 
     def show(rep, identified, paths):
         from ..report.summaries import identification_brief
@@ -369,8 +369,9 @@ def export(
         return cfg, identified, targets
 
     def compute(prepared, progress):
-        from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results, urdf_written_back
+        from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results
         from ..io.mjcf_write_back import mjcf_written_back
+        from ..io.urdf_write_back import urdf_written_back
 
         cfg, identified, targets = prepared
         moved: list[str] = []

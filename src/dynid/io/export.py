@@ -9,8 +9,8 @@ frame (:func:`dynid.model.spatial.physical_from_inertial`); each joint's ``<dyna
 viscous (``damping``) and Coulomb (``friction``) coefficients. URDF has no field for the rotor inertia,
 a torque offset, the Stribeck term or a coupled motor: they are written as XML comments on the joint,
 and the model's torques then need them added (``τ = RNEA + Ia·q̈ + fc·sign(q̇) + fv·q̇ + offset``).
-Visual and collision geometry is not copied: merge the inertials into the original URDF by link name
-if needed (dynid's link j is the link moved by joint j).
+Visual and collision geometry is not copied: for a robot described by a URDF, the identified values are
+written into the user's own file instead (:func:`dynid.io.urdf_write_back.urdf_written_back`).
 
 Only physically consistent parameters are exported: a URDF with a negative mass or an impossible
 inertia makes simulators fail or behave wrongly.
@@ -19,7 +19,6 @@ inertia makes simulators fail or behave wrongly.
 from __future__ import annotations
 
 from html import escape
-from pathlib import Path
 
 import numpy as np
 
@@ -366,110 +365,6 @@ MOVED_COM = 0.1
 """[m] A link whose identified centre of mass lies this far from its nominal one is said in the export."""
 
 
-def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate: str = "the physically consistent "
-                      "estimate") -> tuple[str, list[str]]:
-    """The user's own URDF with the identified values written into it, and nothing else changed.
-
-    Every element of the URDF stays as it is — link and joint names, frames, visuals, collisions, meshes, limits,
-    comments — but each moving link's ``<inertial>`` and each moving joint's ``<dynamics>``. A link attached by fixed
-    joints to a moving one (a flange, a tool frame) is identified together with it: its ``<inertial>`` moves into the
-    moving link's (a comment says so). What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term,
-    coupled motors) is written in comments. A header comment says what was identified: only the base parameters
-    are; the values written are one physically consistent choice among the many with the same base parameters (the
-    split between a link and the rotor inertia, and unidentifiable directions, are that choice's).
-
-    Parameters
-    ----------
-    urdf : str or Path
-        The URDF the robot was described by.
-    robot : Robot
-        The robot read from it (its joints carry the URDF's joint names).
-    phi : (n_params,) array
-        Standard parameters to write (physically consistent).
-    estimate : str
-        What the values are, for the header comment.
-
-    Returns
-    -------
-    text : str
-        The URDF.
-    moved : list of str
-        One line per link whose values moved far from the URDF's own (mass by over :data:`MOVED_MASS`, centre of
-        mass by over :data:`MOVED_COM` m), also in the header comment.
-
-    Raises
-    ------
-    ConfigError
-        The URDF cannot be read, its joints are not the robot's, or the values are not exportable
-        (:func:`urdf_from_robot`'s checks).
-    """
-    import xml.etree.ElementTree as ET
-
-    path = Path(urdf)
-    fitted = _exportable(robot, phi)
-    try:
-        tree = ET.parse(path, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
-    except (OSError, ET.ParseError) as exc:
-        raise ConfigError(f"{path}: cannot read it as URDF ({exc})") from None
-    root = tree.getroot()
-    joints = {j.get("name"): j for j in root.findall("joint")}  # not a <transmission>'s <joint>
-    links = {link.get("name"): link for link in root.findall("link")}
-    missing = [j.name for j in robot.joints if j.name not in joints]
-    if missing:
-        raise ConfigError(f"{path}: has no joint {missing[0]!r}: the results are of another robot than this URDF's")
-    def end(joint, which: str) -> str:  # the link a joint's <parent> or <child> names
-        e = joint.find(which)
-        if e is None or not e.get("link"):
-            raise ConfigError(f"{path}: joint {joint.get('name')!r} has no <{which} link=...>")
-        return str(e.get("link"))
-
-    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints
-    for j in root.findall("joint"):
-        if j.get("type") == "fixed":
-            children.setdefault(end(j, "parent"), []).append(end(j, "child"))
-    nominal = robot.inertial
-    moved: list[str] = []
-    for k, joint in enumerate(robot.joints):
-        element = joints[joint.name]
-        link_name = end(element, "child")
-        link = links[link_name]
-        mass, com, inertia = physical_from_inertial(fitted.inertial[k])
-        _replace(link, "inertial", _inertial_element(mass, com, inertia))
-        stack, merged = list(children.get(link_name, ())), []
-        while stack:  # links rigidly attached: identified with this one
-            name = stack.pop()
-            stack.extend(children.get(name, ()))
-            old = links[name].find("inertial") if name in links else None
-            if old is not None:
-                links[name].remove(old)
-                merged.append(name)
-        if merged:
-            link.insert(0, ET.Comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are "
-                                      "identified with it and written here "))
-        terms = dict(zip(robot.drive_terms, fitted.drive[k]))
-        _replace(element, "dynamics", ET.Element("dynamics", damping=f"{terms.get('fv', 0.0):.17g}",
-                                                 friction=f"{terms.get('fc', 0.0):.17g}"))
-        extra = {t: v for t, v in terms.items() if t not in ("fc", "fv") and v != 0}
-        if extra:
-            element.append(ET.Comment(" dynid: drive terms URDF cannot hold, add them to the torques: "
-                                      + ", ".join(f"{t}{k + 1} = {v:.17g}" for t, v in extra.items()) + " "))
-        if robot.coulomb_velocity[k] > 0:
-            element.append(ET.Comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
-        m0, c0, _ = physical_from_inertial(nominal[k]) if nominal[k][9] > 0 else (0.0, np.zeros(3), None)
-        far = moved_far(link_name, mass, com, m0, c0, "URDF")
-        moved.extend([far] if far else [])
-    if robot.transmission.n_coupled_params:
-        names = robot.transmission.coupled_parameter_names
-        root.append(ET.Comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
-            f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " "))
-    root.insert(0, ET.Comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of "
-                                                "every moving joint", estimate, moved, "URDF")))
-    if root[0].tail is None or not root[0].tail.strip():
-        root[0].tail = "\n  "
-    text = ET.tostring(root, encoding="unicode")
-    return '<?xml version="1.0"?>\n' + text + "\n", moved
-
-
 def moved_far(link: str, mass: float, com: np.ndarray, nominal_mass: float, nominal_com: np.ndarray,
               form: str) -> str | None:
     """A line saying that a link's written values are far from its description's own, or None when they are not
@@ -526,17 +421,6 @@ def identified_header(file: str, replaced: str, estimate: str, moved: list[str],
     if moved:
         header += [f"Far from the {form}'s own values (a choice, as said above, or a description to check):"] + moved
     return "\n     ".join(header) + " "
-
-
-def _inertial_element(mass: float, com: np.ndarray, inertia: np.ndarray):
-    import xml.etree.ElementTree as ET
-
-    e = ET.Element("inertial")
-    ET.SubElement(e, "origin", xyz=_vec(com), rpy="0 0 0")
-    ET.SubElement(e, "mass", value=f"{mass:.17g}")
-    ET.SubElement(e, "inertia", ixx=f"{inertia[0, 0]:.17g}", ixy=f"{inertia[0, 1]:.17g}", ixz=f"{inertia[0, 2]:.17g}",
-                  iyy=f"{inertia[1, 1]:.17g}", iyz=f"{inertia[1, 2]:.17g}", izz=f"{inertia[2, 2]:.17g}")
-    return e
 
 
 def _replace(parent, tag: str, new) -> None:

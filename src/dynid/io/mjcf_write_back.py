@@ -72,7 +72,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     so). A compiler told to take inertias from geoms (``inertiafromgeom="true"``) would ignore the written values: it
     is set to ``"auto"``. Relative file paths (``meshdir``, ``texturedir``, ``assetdir``, ``<include file>``) are
     rewritten for the folder the result is written to. The header comment says what was identified, as in
-    :func:`dynid.io.export.urdf_written_back`.
+    :func:`dynid.io.urdf_write_back.urdf_written_back`.
 
     Parameters
     ----------

@@ -58,12 +58,15 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 
 
 @staged
-def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None) -> list[Path]:
+def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None,
+                        urdf: str | Path | None = None) -> list[Path]:
     """Write an identification's results and figures.
 
-    ``results.json``, the identification fit figure and one figure per validation dataset, and with ``robot`` (the
-    identified robot) ``robot.urdf`` and ``robot.xml`` (MJCF) when the physically consistent estimate passed the
-    consistency check.
+    ``results.json``, ``report.html``, the identification fit figure and one figure per validation dataset; with
+    ``robot`` (the identified robot), when the physically consistent estimate passed the consistency check, the model
+    to use: the user's own URDF with the identified values written into it (``urdf``: the same file name, only its
+    ``<inertial>`` and ``<dynamics>`` values changed, :func:`dynid.io.urdf_write_back.urdf_written_back`) or, for a
+    robot described otherwise, ``dynid-model.urdf`` of dynid's own naming; and ``dynid-model.xml`` (MJCF).
 
     Parameters
     ----------
@@ -74,6 +77,8 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         Write the figures.
     robot : Robot, optional
         The identified robot, for the exports.
+    urdf : str or Path, optional
+        The URDF the robot was read from (:attr:`dynid.io.identification_config.IdentificationConfig.urdf`).
 
     Returns
     -------
@@ -101,11 +106,17 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     sdp = stored_standard(data)
     if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp[0]) == "yes":
         from ..io import atomic_write_text
-        from ..io.export import mjcf_from_results, urdf_from_results
+        from ..io.export import consistent_estimate, mjcf_from_robot, urdf_from_robot
+        from ..io.urdf_write_back import urdf_written_back
 
-        paths[:0] = [out / "robot.urdf", out / "robot.xml"]
-        atomic_write_text(paths[0], urdf_from_results(robot, data))
-        atomic_write_text(paths[1], mjcf_from_results(robot, data))
+        fitted, phi = consistent_estimate(robot, data)
+        if urdf is None:
+            model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
+        else:
+            model = (out / Path(urdf).name, urdf_written_back(urdf, fitted, phi)[0])
+        paths[:0] = [model[0], out / "dynid-model.xml"]
+        atomic_write_text(model[0], model[1])
+        atomic_write_text(paths[1], mjcf_from_robot(fitted, phi))
     return [json_path] + paths
 
 

@@ -242,9 +242,10 @@ def readiness(result) -> Line:
                     f"better than dynid's estimate; identify on a log that excites them (dynid excite), or keep the "
                     "nominal values there", "warning")
     if not r.validations:
-        return Line(f"model ready to check: {exportable[0]} is physically consistent; add [[validation]] logs (other "
-                    "motions) before you export it with dynid export CONFIG --urdf FILE", "title")
-    return Line(f"model ready: export {exportable[0]} with dynid export CONFIG --urdf FILE --mjcf FILE", "title")
+        return Line(f"model ready to check: {exportable[0]} is physically consistent (its URDF and MJCF are in the output "
+                    "folder); add [[validation]] logs (other motions) before you use it", "title")
+    return Line(f"model ready: {exportable[0]}, as the URDF and MJCF in the output folder (other names: dynid export "
+                "CONFIG --urdf FILE --mjcf FILE)", "title")
 
 
 def identification_brief(result) -> list:

@@ -1,0 +1,311 @@
+"""The user's own URDF with the identified values written into it, as a text edit: only the ``<inertial>`` of each
+moving link and the ``<dynamics>`` of each moving joint change, every other byte of the file stays as it was (its
+declaration, the comments before ``<robot>``, the layout of each line, ``/>`` or ``" />"``), so that ``diff`` against
+the user's file shows only the identified values (issue "A user's first hour", item 5).
+
+The file is read by expat (the standard library's XML parser), which gives each element's byte offset in the file;
+the edits are spans of the original bytes replaced by new text at the indentation the file already uses.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import ConfigError
+from ..model.robot import Robot
+from ..model.spatial import physical_from_inertial
+from .export import _exportable, identified_header, moved_far
+
+__all__ = ["urdf_written_back"]
+
+
+@dataclass
+class _Element:
+    """An element of the file: its tag, attributes, and byte spans (``start``: ``<``; ``open_end``: after the start
+    tag's ``>``; ``close``: the end tag's ``<``, or ``open_end`` when the element is empty, ``<x/>``; ``end``: after
+    its last ``>``)."""
+
+    tag: str
+    attrs: dict
+    start: int
+    open_end: int = 0
+    close: int = 0
+    end: int = 0
+    children: list = field(default_factory=list)
+
+    def child(self, tag: str):
+        return next((c for c in self.children if c.tag == tag), None)
+
+
+def _tag_end(data: bytes, start: int) -> int:
+    """The offset after the ``>`` that closes the tag starting at ``start`` (quotes respected: ``>`` may appear in an
+    attribute's value)."""
+    quote = None
+    for i in range(start + 1, len(data)):
+        c = data[i:i + 1]
+        if quote is not None:
+            if c == quote:
+                quote = None
+        elif c in (b'"', b"'"):
+            quote = c
+        elif c == b">":
+            return i + 1
+    raise ValueError("unterminated tag")
+
+
+def _parse(data: bytes) -> _Element:
+    """The element tree of ``data`` with byte spans (expat's ``CurrentByteIndex`` at each start and end tag)."""
+    from xml.parsers import expat
+
+    parser = expat.ParserCreate()
+    stack: list[_Element] = []
+    top: list[_Element] = []
+
+    def start(tag, attrs):
+        i = parser.CurrentByteIndex
+        e = _Element(tag, attrs, i, _tag_end(data, i))
+        (stack[-1].children if stack else top).append(e)
+        stack.append(e)
+
+    def end(tag):
+        e = stack.pop()
+        i = parser.CurrentByteIndex
+        empty = data[e.open_end - 2:e.open_end] == b"/>" and i == e.start
+        e.close, e.end = (e.open_end, e.open_end) if empty else (i, _tag_end(data, i))
+
+    parser.StartElementHandler, parser.EndElementHandler = start, end
+    parser.Parse(data, True)
+    return top[0]
+
+
+def _column(data: bytes, at: int) -> bytes:
+    """The whitespace that begins the line of offset ``at`` (up to it, when only whitespace precedes it)."""
+    line = data.rfind(b"\n", 0, at) + 1
+    lead = data[line:at]
+    return lead if not lead.strip() else b""
+
+
+def _unit(data: bytes, root: _Element) -> bytes:
+    """The file's indentation step: the first child of the root's indentation (two spaces if the file has none)."""
+    for e in root.children:
+        lead = _column(data, e.start)
+        if lead:
+            return lead
+    return b"  "
+
+
+def _empty_close(data: bytes) -> str:
+    """How the file closes an empty element: ``" />"`` where it does so more often than ``"/>"``."""
+    spaced = data.count(b" />")
+    return " />" if spaced > data.count(b"/>") - spaced else "/>"
+
+
+def _number(x: float) -> str:
+    """The shortest text that reads back as the same double (``repr``): 7.778, not 7.7779999999999996."""
+    return repr(float(x))
+
+
+def _inertial_values(mass: float, com: np.ndarray, inertia: np.ndarray) -> dict[str, dict[str, str]]:
+    """The attributes of an ``<inertial>``'s children: the centre of mass and the inertia about it, in the link's
+    frame (``rpy = 0 0 0``); entries below 1e-12 of the inertia's trace are written as 0."""
+    i = np.where(np.abs(inertia) < 1e-12 * np.trace(inertia), 0.0, inertia)  # a rotation's rounding, not a value
+    return {"origin": {"xyz": " ".join(_number(x) for x in com), "rpy": "0 0 0"}, "mass": {"value": _number(mass)},
+            "inertia": {a: _number(i[r, c]) for a, (r, c) in zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"),
+                                                                  ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)))}}
+
+
+def _inertial_text(values: dict[str, dict[str, str]], indent: str, unit: str, close: str) -> str:
+    """An ``<inertial>`` block whose first line starts at the caller's position and whose other lines at ``indent``."""
+    inner = indent + unit
+    lines = [f"{inner}<{tag}" + "".join(f' {k}="{v}"' for k, v in attrs.items()) + close for tag, attrs in values.items()]
+    return "<inertial>\n" + "\n".join(lines) + f"\n{indent}</inertial>"
+
+
+def _set_attributes(tag: str, values: dict[str, str]) -> str:
+    """The start tag ``tag`` with each attribute of ``values`` given that value (replaced where present, added before
+    the tag's end otherwise); every other byte kept."""
+    for name, value in values.items():
+        pattern = re.compile(rf"(\s{name}\s*=\s*)([\"'])(.*?)\2", re.S)
+        found = pattern.search(tag)
+        if found and _same_numbers(found.group(3), value):  # the file's own text where the value is the same
+            continue
+        if found:
+            tag = f"{tag[:found.start(3)]}{value}{tag[found.end(3):]}"
+        else:
+            cut = len(tag) - (2 if tag.endswith("/>") else 1)
+            cut -= len(tag[:cut]) - len(tag[:cut].rstrip())
+            tag = f"{tag[:cut]} {name}=\"{value}\"{tag[cut:]}"
+    return tag
+
+
+def _same_numbers(old: str, new: str) -> bool:
+    """Whether two attribute values hold the same numbers to 1e-12 (a value read and written back, rounding aside)."""
+    try:
+        a, b = np.array(old.split(), dtype=float), np.array(new.split(), dtype=float)
+    except ValueError:
+        return False
+    return a.shape == b.shape and bool(np.allclose(a, b, rtol=1e-12, atol=1e-300))
+
+
+def _comment(text: str) -> str:
+    return "<!--" + text.replace("--", "- -") + "-->"
+
+
+def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate: str = "the physically consistent "
+                      "estimate") -> tuple[str, list[str]]:
+    """The user's own URDF with the identified values written into it, and nothing else changed.
+
+    Every byte of the URDF stays as it is — link and joint names, frames, visuals, collisions, meshes, limits,
+    transmissions, comments, the layout of each line — but each moving link's ``<inertial>`` and each moving joint's
+    ``<dynamics>`` ``damping`` and ``friction`` (its other attributes kept). A link attached by fixed joints to a
+    moving one (a flange, a tool frame) is identified together with it: its ``<inertial>`` moves into the moving
+    link's (a comment says so). What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term, coupled
+    motors) is written in comments, and a header comment inside ``<robot>`` says what was identified: only the base
+    parameters are; the values written are one physically consistent choice among the many with the same base
+    parameters (the split between a link and the rotor inertia, and unidentifiable directions, are that choice's).
+
+    Parameters
+    ----------
+    urdf : str or Path
+        The URDF the robot was described by (UTF-8).
+    robot : Robot
+        The robot read from it (its joints carry the URDF's joint names).
+    phi : (n_params,) array
+        Standard parameters to write (physically consistent).
+    estimate : str
+        What the values are, for the header comment.
+
+    Returns
+    -------
+    text : str
+        The URDF.
+    moved : list of str
+        One line per link whose values moved far from the URDF's own (:func:`dynid.io.export.moved_far`), also in the
+        header comment.
+
+    Raises
+    ------
+    ConfigError
+        The URDF cannot be read, its joints are not the robot's, or the values are not exportable
+        (:func:`dynid.io.export.urdf_from_robot`'s checks).
+    """
+    path = Path(urdf)
+    fitted = _exportable(robot, phi)
+    from xml.parsers.expat import ExpatError
+
+    try:
+        data = path.read_bytes()
+        data.decode("utf-8")
+        root = _parse(data)
+    except (OSError, ValueError, ExpatError) as exc:  # UnicodeDecodeError is a ValueError
+        raise ConfigError(f"{path}: cannot read it as URDF ({exc})") from None
+    joints = {e.attrs.get("name"): e for e in root.children if e.tag == "joint"}  # not a <transmission>'s <joint>
+    links = {e.attrs.get("name"): e for e in root.children if e.tag == "link"}
+    missing = [j.name for j in robot.joints if j.name not in joints]
+    if missing:
+        raise ConfigError(f"{path}: has no joint {missing[0]!r}: the results are of another robot than this URDF's")
+
+    def end(joint: _Element, which: str) -> str:  # the link a joint's <parent> or <child> names
+        e = joint.child(which)
+        if e is None or not e.attrs.get("link"):
+            raise ConfigError(f"{path}: joint {joint.attrs.get('name')!r} has no <{which} link=...>")
+        if e.attrs["link"] not in links:
+            raise ConfigError(f"{path}: joint {joint.attrs.get('name')!r} names link {e.attrs['link']!r}, which the file does not have")
+        return str(e.attrs["link"])
+
+    unit, close = _unit(data, root).decode(), _empty_close(data)
+    edits: list[tuple[int, int, str]] = []  # (start, end, new text) of the original bytes
+
+    def indent_in(parent: _Element) -> str:
+        first = next((c for c in parent.children), None)
+        lead = _column(data, first.start) if first is not None else b""
+        return lead.decode() if lead else _column(data, parent.start).decode() + unit
+
+    def append_inside(parent: _Element, text: str) -> None:
+        """``text`` (lines at the parent's child indentation) as the parent's last content."""
+        inner = indent_in(parent)
+        if parent.close == parent.open_end:  # <link name="x"/>: opened
+            tag = data[parent.start:parent.open_end].decode()
+            head = tag[:-2].rstrip() + ">"
+            edits.append((parent.start, parent.open_end,
+                          f"{head}\n{inner}{text}\n{_column(data, parent.start).decode()}</{parent.tag}>"))
+        else:
+            at = parent.close
+            lead = _column(data, at)
+            edits.append((at - len(lead), at - len(lead), f"{inner}{text}\n" if lead else f"\n{inner}{text}\n"))
+
+    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints
+    for j in joints.values():
+        if j.attrs.get("type") == "fixed":
+            children.setdefault(end(j, "parent"), []).append(end(j, "child"))
+    nominal = robot.inertial
+    moved: list[str] = []
+    for k, joint in enumerate(robot.joints):
+        element = joints[joint.name]
+        link_name = end(element, "child")
+        link = links[link_name]
+        mass, com, inertia = physical_from_inertial(fitted.inertial[k])
+        stack, merged = list(children.get(link_name, ())), []
+        while stack:  # links rigidly attached: identified with this one
+            name = stack.pop()
+            stack.extend(children.get(name, ()))
+            old = links[name].child("inertial")
+            if old is not None:  # removed with its line(s)
+                lead = _column(data, old.start)
+                after = old.end + 1 if data[old.end:old.end + 1] == b"\n" and lead else old.end
+                edits.append((old.start - len(lead), after, ""))
+                merged.append(name)
+        note = (_comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are identified with it and "
+                         "written here ") if merged else "")
+        inertial = _inertial_values(mass, com, inertia)
+        current = link.child("inertial")
+        parts = {c.tag: c for c in current.children} if current is not None else {}
+        if current is not None and set(parts) == set(inertial) and len(current.children) == 3:  # values edited in place
+            for tag, attrs in inertial.items():
+                e = parts[tag]
+                edits.append((e.start, e.open_end, _set_attributes(data[e.start:e.open_end].decode(), attrs)))
+            if note:
+                edits.append((current.start, current.start, f"{note}\n{_column(data, current.start).decode()}"))
+        elif current is not None:
+            indent = _column(data, current.start).decode()
+            edits.append((current.start, current.end,
+                          (f"{note}\n{indent}" if note else "") + _inertial_text(inertial, indent, unit, close)))
+        else:
+            inner = indent_in(link)
+            append_inside(link, (f"{note}\n{inner}" if note else "") + _inertial_text(inertial, inner, unit, close))
+        terms = dict(zip(robot.drive_terms, fitted.drive[k]))
+        values = {"damping": _number(terms.get("fv", 0.0)), "friction": _number(terms.get("fc", 0.0))}
+        notes = []
+        extra = {t: v for t, v in terms.items() if t not in ("fc", "fv") and v != 0}
+        if extra:
+            notes.append(_comment(" dynid: drive terms URDF cannot hold, add them to the torques: "
+                                  + ", ".join(f"{t}{k + 1} = {v:.17g}" for t, v in extra.items()) + " "))
+        if robot.coulomb_velocity[k] > 0:
+            notes.append(_comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
+        dynamics = element.child("dynamics")
+        inner = indent_in(element)
+        if dynamics is not None:
+            tag = _set_attributes(data[dynamics.start:dynamics.open_end].decode(), values)
+            edits.append((dynamics.start, dynamics.open_end, tag + "".join(f"\n{inner}{n}" for n in notes)))
+        else:
+            append_inside(element, f"<dynamics damping=\"{values['damping']}\" friction=\"{values['friction']}\"{close}"
+                          + "".join(f"\n{inner}{n}" for n in notes))
+        m0, c0, _ = physical_from_inertial(nominal[k]) if nominal[k][9] > 0 else (0.0, np.zeros(3), None)
+        far = moved_far(link_name, mass, com, m0, c0, "URDF")
+        moved.extend([far] if far else [])
+    head = [_comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of every "
+                                       "moving joint", estimate, moved, "URDF"))]
+    if robot.transmission.n_coupled_params:
+        names = robot.transmission.coupled_parameter_names
+        head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
+            f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " "))
+    inner = indent_in(root)
+    edits.append((root.open_end, root.open_end, "".join(f"\n{inner}{h}" for h in head)))
+    out = data
+    for start, stop, text in sorted(edits, key=lambda e: (e[0], e[1]), reverse=True):
+        out = out[:start] + text.encode() + out[stop:]
+    return out.decode("utf-8"), moved
