@@ -5,7 +5,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench zoo clean
+.PHONY: demo test wheel-check bench zoo clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -23,6 +23,18 @@ test: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
 	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict  # the docs site (mkdocs.yml) into .site/; a warning (a broken link) fails it
 
+wheel-check: $(STAMP)  # the wheel as a user installs it, in a fresh virtualenv: example, identify, export (CI)
+	rm -rf .wheel-check && mkdir -p .wheel-check/dist
+	$(BIN)/pip wheel --quiet --no-deps -w .wheel-check/dist .
+	$(PYTHON) -m venv .wheel-check/venv
+	.wheel-check/venv/bin/pip install --quiet --only-binary=:all: -c constraints.txt .wheel-check/dist/dynid-*.whl
+	cd .wheel-check && venv/bin/dynid example ur10e try -q
+	cd .wheel-check/try && ../venv/bin/dynid identify ur10e.toml -q && test -s dynid-identify/ur10e.urdf \
+	  && ../venv/bin/dynid export ur10e.toml --results dynid-identify/results.json --urdf ur10e-identified.urdf \
+	     --mjcf ur10e-identified.xml -q && test -s ur10e-identified.urdf && test -s ur10e-identified.xml
+	@echo "wheel-check: $$(.wheel-check/venv/bin/pip list --format=freeze | wc -l) packages," \
+	  "$$(du -sm .wheel-check/venv/lib/python3*/site-packages | cut -f1) MB installed; example, identify, export ran"
+
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_table.py
 	$(BIN)/python benchmarks/bench_regressor.py
@@ -34,4 +46,4 @@ zoo: $(STAMP)  # dynid's defaults on nine public arm descriptions simulated in M
 	$(BIN)/python benchmarks/zoo/zoo.py
 
 clean:
-	rm -rf $(VENV) dynid-zoo dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo dynid-fleet dynid-monitor .site
+	rm -rf $(VENV) .wheel-check dynid-zoo dynid-run dynid-identify dynid-validate dynid-excite dynid-montecarlo dynid-fleet dynid-monitor .site

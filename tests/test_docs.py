@@ -135,3 +135,17 @@ def test_the_docs_site_opened_from_disk_navigates():
 
     text = (DOCS.parent / "mkdocs.yml").read_text()
     assert _re.search(r"^use_directory_urls:\s*false\b", text, flags=_re.M)
+
+
+def test_the_extras_are_listed_once_and_as_pyproject_has_them():
+    """docs/getting-started.md's table names exactly pyproject.toml's extras; the README points to it, lists none."""
+    import tomllib
+
+    root = DOCS.parent
+    extras = set(tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["project"]["optional-dependencies"])
+    page = (DOCS / "getting-started.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| (`[^|]*`) \|", page, flags=re.M)
+    listed = {name for row in rows for name in re.findall(r"`([\w-]+)`", row)}
+    assert listed == extras
+    readme = (root / "README.md").read_text(encoding="utf-8")
+    assert "docs/getting-started.md#install" in readme and not any(f"`{e}`" in readme for e in extras - {"test"})

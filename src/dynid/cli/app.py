@@ -557,6 +557,42 @@ def init(
 
 
 @app.command()
+def example(
+    robot: str = typer.Argument(..., help="A robot built into dynid: ur10e, tx40 or er16."),
+    out: Path = typer.Argument(..., help="The folder to write (new, or empty)."),
+    quiet: bool = QUIET,
+) -> None:
+    """Write a folder to try dynid on: the robot's URDF, two simulated logs and the config identify runs on."""
+
+    def prepare():
+        if out.exists() and (not out.is_dir() or any(p for p in out.iterdir() if not p.name.startswith("."))):
+            raise DynIdError(f"{out}: exists and is not an empty folder; give a new folder")
+        from ..studies.example import EXAMPLES
+
+        if robot not in EXAMPLES:
+            raise DynIdError(f"no example for robot {robot!r}: choose one of {', '.join(EXAMPLES)}")
+        return robot
+
+    def compute(name, progress):
+        from ..studies.example import example_files
+
+        progress.update("simulating the logs")
+        return example_files(name)
+
+    def save(files):
+        from ..report.output import save_texts
+
+        return save_texts(files, out)
+
+    def show(rep, files, paths):
+        config = next(name for name in files if name.endswith(".toml"))
+        rep.line(f"wrote {', '.join(files)} in {out}/ (simulated logs of the {robot}): now cd {out} and run "
+                 f"dynid identify {config}, then open dynid-identify/report.html")
+
+    _Command("dynid example", quiet, out).run(prepare, compute, save, show)
+
+
+@app.command()
 def migrate(
     config: Path = typer.Argument(..., help="An identify config (TOML) of an earlier release."),
     out: Path | None = typer.Option(None, help="Write the migrated config here (default: rewrite CONFIG in place)."),

@@ -381,3 +381,32 @@ def write_results(path: Path, data: dict, kind: str) -> None:
     from ..io import write_json
 
     write_json(path, {"schema_version": SCHEMA_VERSION, "dynid_version": __version__, "kind": kind, **data})
+
+
+@staged
+def save_texts(files: dict[str, str], out: str | Path) -> list[Path]:
+    """Write text files into an output folder through a staging folder (:func:`staged`): all of them or none.
+
+    Parameters
+    ----------
+    files : dict
+        File name (in ``out``) -> text (UTF-8).
+    out : str or Path
+        Output folder.
+
+    Returns
+    -------
+    list of Path
+        Files written.
+
+    Raises
+    ------
+    ConfigError
+        If ``out`` exists and is not a folder, or cannot be created.
+    """
+    from ..io import atomic_write_text
+
+    out = Path(out)
+    for name, text in files.items():
+        atomic_write_text(out / name, text)
+    return [out / name for name in files]
