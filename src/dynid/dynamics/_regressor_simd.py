@@ -148,11 +148,8 @@ def _hex(x: float) -> str:
     return f"0x{struct.unpack('<Q', struct.pack('<d', x))[0]:016X}"
 
 
-def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
-    """``kernel(q, dq, ddq, drive, out, colmap, m, start, stop)``: samples ``start:stop`` (a multiple
-    of LANES apart) of ``out`` (N, n, m), C order; ``colmap`` (n·npj,) int64 (-1: not written)."""
-    w = LANES
-    vec = f"<{w} x double>"
+def _live(graph: _Graph, stores: dict) -> set:
+    """The nodes a stored value depends on (the others are not emitted)."""
     live, stack = set(), [v.id for v in stores.values() if isinstance(v, _Sym)]
     while stack:
         i = stack.pop()
@@ -161,6 +158,37 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
             op, args = graph.nodes[i]
             if op != "load":
                 stack.extend(a.id for a in args if isinstance(a, _Sym))
+    return live
+
+
+def _store_lines(stores: dict, head: list, body: list, counter, vec: str) -> None:
+    """The stores of each (joint, column) value, lane by lane: where the column goes is read once per call (``head``),
+    the selected column's offset in a row or the scratch slot; the stores go in the loop (``body``)."""
+    for (joint, column), value in sorted(stores.items()):
+        d = f"%d{joint}_{column}"
+        head.append(f"  %c{joint}_{column} = getelementptr i64, ptr %colmap, i64 {column}")
+        head.append(f"  {d} = load i64, ptr %c{joint}_{column}, align 8")
+        head.append(f"  %k{joint}_{column} = icmp sge i64 {d}, 0")
+        head.append(f"  %j{joint}_{column} = mul i64 %m, {joint}")
+        head.append(f"  %o{joint}_{column} = add i64 %j{joint}_{column}, {d}")
+        for lane in range(LANES):
+            base = "%b_out" if lane == 0 else f"%b_out{lane}"
+            p, s, x = (f"%{c}{next(counter)}" for c in "psx")
+            body.append(f"  {p} = getelementptr double, ptr {base}, i64 %o{joint}_{column}")
+            body.append(f"  {s} = select i1 %k{joint}_{column}, ptr {p}, ptr %scratch")
+            if isinstance(value, _Sym):
+                body.append(f"  {x} = extractelement {vec} %t{value.id}, i32 {lane}")
+                body.append(f"  store double {x}, ptr {s}, align 8")
+            else:
+                body.append(f"  store double {_hex(value)}, ptr {s}, align 8")
+
+
+def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
+    """``kernel(q, dq, ddq, drive, out, colmap, m, start, stop)``: samples ``start:stop`` (a multiple
+    of LANES apart) of ``out`` (N, n, m), C order; ``colmap`` (n·npj,) int64 (-1: not written)."""
+    w = LANES
+    vec = f"<{w} x double>"
+    live = _live(graph, stores)
 
     def const(x):
         return "<" + ", ".join([f"double {_hex(x)}"] * w) + ">"
@@ -218,24 +246,7 @@ def _ir(graph: _Graph, stores: dict, n: int, npj: int, n_drive: int) -> str:
             body.append(f"  %t{i} = fneg {vec} {ref(args[0])}")
         else:
             body.append(f"  %t{i} = {op} {vec} {ref(args[0])}, {ref(args[1])}")
-    for (joint, column), value in sorted(stores.items()):
-        # where this column goes, read once per call: the selected column's offset in a row, or the scratch slot
-        d = f"%d{joint}_{column}"
-        head.append(f"  %c{joint}_{column} = getelementptr i64, ptr %colmap, i64 {column}")
-        head.append(f"  {d} = load i64, ptr %c{joint}_{column}, align 8")
-        head.append(f"  %k{joint}_{column} = icmp sge i64 {d}, 0")
-        head.append(f"  %j{joint}_{column} = mul i64 %m, {joint}")
-        head.append(f"  %o{joint}_{column} = add i64 %j{joint}_{column}, {d}")
-        for lane in range(w):
-            base = "%b_out" if lane == 0 else f"%b_out{lane}"
-            p, s, x = (f"%{c}{next(counter)}" for c in "psx")
-            body.append(f"  {p} = getelementptr double, ptr {base}, i64 %o{joint}_{column}")
-            body.append(f"  {s} = select i1 %k{joint}_{column}, ptr {p}, ptr %scratch")
-            if isinstance(value, _Sym):
-                body.append(f"  {x} = extractelement {vec} %t{value.id}, i32 {lane}")
-                body.append(f"  store double {x}, ptr {s}, align 8")
-            else:
-                body.append(f"  store double {_hex(value)}, ptr {s}, align 8")
+    _store_lines(stores, head, body, counter, vec)
     head.append("  %empty = icmp sge i64 %start, %stop")
     head.append("  br i1 %empty, label %exit, label %loop")
     body += [f"  %next = add i64 %k, {w}", "  %done = icmp sge i64 %next, %stop", "  br i1 %done, label %exit, label %loop",

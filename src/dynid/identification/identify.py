@@ -41,7 +41,7 @@ from ..validation.diagnostics import (
 )
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 
-__all__ = ["Estimate", "IdentificationResult", "identify"]
+__all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
 
 SDP_LABEL = estimate_label("sdp")
@@ -342,27 +342,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
-    # the fit's metrics and the verdict's sums accumulate on the same pass: no second pass over the log
-    sums = TorqueSums.for_data(data, base.n_base)
-    residuals = ResidualSums(n, base.n_base)
-    blocks = BlockGrams(n, base.n_base, data.t.shape[0])
-    near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
-    folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out and sdp else []
-    n_s = data.t.shape[0]
-
-    def observe(index, y, tau, keep, y_standard):
-        for k in np.unique(index * HELD_OUT_FOLDS // n_s) if folds else ():
-            sel = index * HELD_OUT_FOLDS // n_s == k
-            folds[k].add(y_standard[sel].reshape(-1, robot.n_params), tau[sel].reshape(-1), keep[sel].reshape(-1))
-        sums.add(data.t[index], y, tau, resting_rows(data, index))
-        direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
-        residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, near_reversal, keep)
-        blocks.add(index, y, tau, keep)
-        for observer in observers:
-            observer(index, y, tau, keep)
-
-    chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=estimation.standard or bool(folds))
-    stream_rows(chunks, estimation, base, observe, standard=estimation.standard or bool(folds))
+    scoring = BlockScoring(robot, base, data, held_out=held_out and sdp, observers=observers)
+    standard = estimation.standard or bool(scoring.folds)
+    chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
+    stream_rows(chunks, estimation, base, scoring.add, standard=standard)
+    sums, folds = scoring.sums, scoring.folds
     try:
         reference = estimation.solve_reference()
     except IdentifiabilityError as exc:
@@ -395,25 +379,76 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks, fit, data, rng)
+    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, sums, scoring.residuals, scoring.blocks, fit,
+                               data, rng)
     main = ""
     ls_label = estimate_label(ls_key)
     if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):
-        if progress is not None:
-            progress("physically consistent SDP, held-out blocks", 0, 1)
-        own, held = _held_out_errors(robot, folds, row_weights)
-        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
-        if held < own:
-            main = SDP_LABEL
-            findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where "
-                                               f"{ls_label} is not and predicts held-out blocks of the log "
-                                               f"worse ({held:.3g} against {own:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
-                                               "cross-validation)"))
+        main = _held_out_choice(robot, folds, row_weights, ls_label, findings, stats, progress)
     return IdentificationResult(robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
                                 n_rows=int(reference.accumulator_.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box, model=robot,
                                 findings=tuple(findings), diagnostics=stats, main=main or estimate_label(keys[0]))
+
+
+class BlockScoring:
+    """What the one pass over the identification log feeds besides the estimators, fed once per block of base rows
+    (:func:`dynid.estimators.estimation.stream_rows`' observer): the fit's metrics (:class:`TorqueSums`), the verdict's
+    residual statistics (:class:`ResidualSums`) and block Gram matrices for the bootstrap (:class:`BlockGrams`), the
+    held-out folds of the least-squares/SDP comparison, and any further ``observers``.
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    data : PreparedData
+        The log the blocks come from.
+    held_out : bool
+        Keep :data:`HELD_OUT_FOLDS` contiguous folds of the standard rows (the SDP's held-out comparison).
+    observers : tuple of callable
+        ``observer(index, y, tau, keep)``, each called with every block.
+    """
+
+    def __init__(self, robot: Robot, base: BaseParameters, data: PreparedData, held_out: bool = False,
+                 observers: tuple = ()):
+        n = robot.n_dof
+        self.robot, self.data, self.observers = robot, data, tuple(observers)
+        self.sums = TorqueSums.for_data(data, base.n_base)
+        self.residuals = ResidualSums(n, base.n_base)
+        self.blocks = BlockGrams(n, base.n_base, data.t.shape[0])
+        self.near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
+        self.folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out else []
+
+    def add(self, index, y, tau, keep, y_standard) -> None:
+        """One block: sample indices (M,), base rows (M, n, p), torques (M, n), kept rows (M, n) and, with folds,
+        the standard rows (M, n, n_params)."""
+        data, n_s = self.data, self.data.t.shape[0]
+        for k in np.unique(index * HELD_OUT_FOLDS // n_s) if self.folds else ():
+            sel = index * HELD_OUT_FOLDS // n_s == k
+            self.folds[k].add(y_standard[sel].reshape(-1, self.robot.n_params), tau[sel].reshape(-1), keep[sel].reshape(-1))
+        self.sums.add(data.t[index], y, tau, resting_rows(data, index))
+        direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
+        self.residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, self.near_reversal, keep)
+        self.blocks.add(index, y, tau, keep)
+        for observer in self.observers:
+            observer(index, y, tau, keep)
+
+
+def _held_out_choice(robot: Robot, folds, row_weights, ls_label: str, findings: list, stats: dict, progress) -> str:
+    """The SDP as the main estimate ("" otherwise) when it predicts the held-out blocks better than the least-squares
+    estimate, which is not physically consistent; the figures into ``stats`` and the finding into ``findings``."""
+    if progress is not None:
+        progress("physically consistent SDP, held-out blocks", 0, 1)
+    own, held = _held_out_errors(robot, folds, row_weights)
+    stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
+    if held >= own:
+        return ""
+    findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where "
+                                       f"{ls_label} is not and predicts held-out blocks of the log "
+                                       f"worse ({held:.3g} against {own:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
+                                       "cross-validation)"))
+    return SDP_LABEL
 
 
 def _estimate(key: str, fitted, reference) -> Estimate:

@@ -200,9 +200,10 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     try:
         data = path.read_bytes()
         data.decode("utf-8")
-        root = _parse(data)
+        text = _TextEdits(data, _parse(data))
     except (OSError, ValueError, ExpatError) as exc:  # UnicodeDecodeError is a ValueError
         raise ConfigError(f"{path}: cannot read it as URDF ({exc})") from None
+    root = text.root
     joints = {e.attrs.get("name"): e for e in root.children if e.tag == "joint"}  # not a <transmission>'s <joint>
     links = {e.attrs.get("name"): e for e in root.children if e.tag == "link"}
     missing = [j.name for j in robot.joints if j.name not in joints]
@@ -217,84 +218,18 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
             raise ConfigError(f"{path}: joint {joint.attrs.get('name')!r} names link {e.attrs['link']!r}, which the file does not have")
         return str(e.attrs["link"])
 
-    unit, close = _unit(data, root).decode(), _empty_close(data)
-    edits: list[tuple[int, int, str]] = []  # (start, end, new text) of the original bytes
-
-    def indent_in(parent: _Element) -> str:
-        first = next((c for c in parent.children), None)
-        lead = _column(data, first.start) if first is not None else b""
-        return lead.decode() if lead else _column(data, parent.start).decode() + unit
-
-    def append_inside(parent: _Element, text: str) -> None:
-        """``text`` (lines at the parent's child indentation) as the parent's last content."""
-        inner = indent_in(parent)
-        if parent.close == parent.open_end:  # <link name="x"/>: opened
-            tag = data[parent.start:parent.open_end].decode()
-            head = tag[:-2].rstrip() + ">"
-            edits.append((parent.start, parent.open_end,
-                          f"{head}\n{inner}{text}\n{_column(data, parent.start).decode()}</{parent.tag}>"))
-        else:
-            at = parent.close
-            lead = _column(data, at)
-            edits.append((at - len(lead), at - len(lead), f"{inner}{text}\n" if lead else f"\n{inner}{text}\n"))
-
     children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints
     for j in joints.values():
         if j.attrs.get("type") == "fixed":
             children.setdefault(end(j, "parent"), []).append(end(j, "child"))
-    nominal = robot.inertial
     moved: list[str] = []
     for k, joint in enumerate(robot.joints):
-        element = joints[joint.name]
-        link_name = end(element, "child")
-        link = links[link_name]
+        link_name = end(joints[joint.name], "child")
         mass, com, inertia = physical_from_inertial(fitted.inertial[k])
-        stack, merged = list(children.get(link_name, ())), []
-        while stack:  # links rigidly attached: identified with this one
-            name = stack.pop()
-            stack.extend(children.get(name, ()))
-            old = links[name].child("inertial")
-            if old is not None:  # removed with its line(s)
-                lead = _column(data, old.start)
-                after = old.end + 1 if data[old.end:old.end + 1] == b"\n" and lead else old.end
-                edits.append((old.start - len(lead), after, ""))
-                merged.append(name)
-        note = (_comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are identified with it and "
-                         "written here ") if merged else "")
-        inertial = _inertial_values(mass, com, inertia)
-        current = link.child("inertial")
-        parts = {c.tag: c for c in current.children} if current is not None else {}
-        if current is not None and set(parts) == set(inertial) and len(current.children) == 3:  # values edited in place
-            for tag, attrs in inertial.items():
-                e = parts[tag]
-                edits.append((e.start, e.open_end, _set_attributes(data[e.start:e.open_end].decode(), attrs)))
-            if note:
-                edits.append((current.start, current.start, f"{note}\n{_column(data, current.start).decode()}"))
-        elif current is not None:
-            indent = _column(data, current.start).decode()
-            edits.append((current.start, current.end,
-                          (f"{note}\n{indent}" if note else "") + _inertial_text(inertial, indent, unit, close)))
-        else:
-            inner = indent_in(link)
-            append_inside(link, (f"{note}\n{inner}" if note else "") + _inertial_text(inertial, inner, unit, close))
-        terms = dict(zip(robot.drive_terms, fitted.drive[k]))
-        values = {"damping": _number(terms.get("fv", 0.0)), "friction": _number(terms.get("fc", 0.0))}
-        notes = []
-        extra = {t: v for t, v in terms.items() if t not in ("fc", "fv") and v != 0}
-        if extra:
-            notes.append(_comment(" dynid: drive terms URDF cannot hold, add them to the torques: "
-                                  + ", ".join(f"{t}{k + 1} = {v:.17g}" for t, v in extra.items()) + " "))
-        if robot.coulomb_velocity[k] > 0:
-            notes.append(_comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
-        dynamics = element.child("dynamics")
-        inner = indent_in(element)
-        if dynamics is not None:
-            tag = _set_attributes(data[dynamics.start:dynamics.open_end].decode(), values)
-            edits.append((dynamics.start, dynamics.open_end, tag + "".join(f"\n{inner}{n}" for n in notes)))
-        else:
-            append_inside(element, f"<dynamics damping=\"{values['damping']}\" friction=\"{values['friction']}\"{close}"
-                          + "".join(f"\n{inner}{n}" for n in notes))
-        m0, c0, _ = physical_from_inertial(nominal[k]) if nominal[k][9] > 0 else (0.0, np.zeros(3), None)
+        merged = _remove_fixed_inertials(text, links, children, link_name)
+        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged)
+        _write_dynamics(text, joints[joint.name], robot, fitted, k)
+        m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
         far = moved_far(link_name, mass, com, m0, c0, "URDF")
         moved.extend([far] if far else [])
     head = [_comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of every "
@@ -303,9 +238,114 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         names = robot.transmission.coupled_parameter_names
         head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " "))
-    inner = indent_in(root)
-    edits.append((root.open_end, root.open_end, "".join(f"\n{inner}{h}" for h in head)))
-    out = data
-    for start, stop, text in sorted(edits, key=lambda e: (e[0], e[1]), reverse=True):
-        out = out[:start] + text.encode() + out[stop:]
-    return out.decode("utf-8"), moved
+    inner = text.indent_in(root)
+    text.insert(root.open_end, "".join(f"\n{inner}{h}" for h in head))
+    return text.result(), moved
+
+
+class _TextEdits:
+    """Spans of a file's bytes to replace, applied at the end from the last to the first (offsets stay valid)."""
+
+    def __init__(self, data: bytes, root: _Element):
+        self.data, self.root = data, root
+        self.unit, self.close = _unit(data, root).decode(), _empty_close(data)
+        self.edits: list[tuple[int, int, str]] = []  # (start, end, new text) of the original bytes
+
+    def replace(self, start: int, stop: int, text: str) -> None:
+        self.edits.append((start, stop, text))
+
+    def insert(self, at: int, text: str) -> None:
+        self.edits.append((at, at, text))
+
+    def source(self, e: _Element) -> str:
+        """An element's start tag as the file has it."""
+        return self.data[e.start:e.open_end].decode()
+
+    def column(self, at: int) -> str:
+        return _column(self.data, at).decode()
+
+    def indent_in(self, parent: _Element) -> str:
+        """The indentation of the parent's children (its first child's, or the parent's plus the file's step)."""
+        first = next((c for c in parent.children), None)
+        lead = _column(self.data, first.start) if first is not None else b""
+        return lead.decode() if lead else self.column(parent.start) + self.unit
+
+    def append_inside(self, parent: _Element, text: str) -> None:
+        """``text`` (lines at the parent's child indentation) as the parent's last content."""
+        inner = self.indent_in(parent)
+        if parent.close == parent.open_end:  # <link name="x"/>: opened
+            head = self.source(parent)[:-2].rstrip() + ">"
+            self.replace(parent.start, parent.open_end, f"{head}\n{inner}{text}\n{self.column(parent.start)}</{parent.tag}>")
+        else:
+            at = parent.close
+            lead = _column(self.data, at)
+            self.insert(at - len(lead), f"{inner}{text}\n" if lead else f"\n{inner}{text}\n")
+
+    def remove(self, e: _Element) -> None:
+        """An element, with its line where it stood alone on it."""
+        lead = _column(self.data, e.start)
+        after = e.end + 1 if self.data[e.end:e.end + 1] == b"\n" and lead else e.end
+        self.replace(e.start - len(lead), after, "")
+
+    def result(self) -> str:
+        out = self.data
+        for start, stop, text in sorted(self.edits, key=lambda e: (e[0], e[1]), reverse=True):
+            out = out[:start] + text.encode() + out[stop:]
+        return out.decode("utf-8")
+
+
+def _remove_fixed_inertials(text: _TextEdits, links: dict, children: dict, link_name: str) -> list[str]:
+    """Remove the ``<inertial>`` of the links fixed (directly or not) to ``link_name``: identified with it. Returns
+    their names."""
+    stack, merged = list(children.get(link_name, ())), []
+    while stack:
+        name = stack.pop()
+        stack.extend(children.get(name, ()))
+        old = links[name].child("inertial")
+        if old is not None:
+            text.remove(old)
+            merged.append(name)
+    return merged
+
+
+def _write_inertial(text: _TextEdits, link: _Element, inertial: dict, merged: list[str]) -> None:
+    """A link's identified ``<inertial>``: its three children's values edited in place where the file has exactly
+    them, the element rewritten at its place otherwise, or added as the link's last child."""
+    note = (_comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are identified with it and "
+                     "written here ") if merged else "")
+    current = link.child("inertial")
+    parts = {c.tag: c for c in current.children} if current is not None else {}
+    if current is not None and set(parts) == set(inertial) and len(current.children) == 3:  # values edited in place
+        for tag, attrs in inertial.items():
+            e = parts[tag]
+            text.replace(e.start, e.open_end, _set_attributes(text.source(e), attrs))
+        if note:
+            text.insert(current.start, f"{note}\n{text.column(current.start)}")
+    elif current is not None:
+        indent = text.column(current.start)
+        text.replace(current.start, current.end,
+                     (f"{note}\n{indent}" if note else "") + _inertial_text(inertial, indent, text.unit, text.close))
+    else:
+        inner = text.indent_in(link)
+        text.append_inside(link, (f"{note}\n{inner}" if note else "") + _inertial_text(inertial, inner, text.unit, text.close))
+
+
+def _write_dynamics(text: _TextEdits, element: _Element, robot: Robot, fitted: Robot, k: int) -> None:
+    """Joint ``k``'s ``<dynamics>`` damping (viscous) and friction (Coulomb), and comments for what URDF cannot hold."""
+    terms = dict(zip(robot.drive_terms, fitted.drive[k]))
+    values = {"damping": _number(terms.get("fv", 0.0)), "friction": _number(terms.get("fc", 0.0))}
+    notes = []
+    extra = {t: v for t, v in terms.items() if t not in ("fc", "fv") and v != 0}
+    if extra:
+        notes.append(_comment(" dynid: drive terms URDF cannot hold, add them to the torques: "
+                              + ", ".join(f"{t}{k + 1} = {v:.17g}" for t, v in extra.items()) + " "))
+    if robot.coulomb_velocity[k] > 0:
+        notes.append(_comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
+    dynamics = element.child("dynamics")
+    inner = text.indent_in(element)
+    if dynamics is not None:
+        tag = _set_attributes(text.source(dynamics), values)
+        text.replace(dynamics.start, dynamics.open_end, tag + "".join(f"\n{inner}{n}" for n in notes))
+    else:
+        text.append_inside(element, f"<dynamics damping=\"{values['damping']}\" friction=\"{values['friction']}\"{text.close}"
+                           + "".join(f"\n{inner}{n}" for n in notes))

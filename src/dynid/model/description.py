@@ -240,18 +240,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     urdf_model = None
     rows = d.joints
     if convention == "urdf":
-        from .urdf import joints_from_urdf, urdf_limits
-
-        if d.urdf is None:
-            raise ConfigError(f"{source}: convention 'urdf' needs a field 'urdf' with the file path")
-        upath = Path(d.urdf)
-        if not upath.is_absolute() and base is not None:
-            upath = base / upath
-        from .urdf import expand_xacro, is_xacro
-
-        if is_xacro(upath):
-            upath = expand_xacro(upath)
-        urdf_model = joints_from_urdf(upath)
+        upath, urdf_model = _read_urdf(d.urdf, base, source)
         if rows is None:
             rows = [joint_table() for _ in urdf_model[0]]
     if not rows:
@@ -273,6 +262,8 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     if convention == "urdf":
         assert urdf_model is not None
         joints, inertial, _, links = urdf_model
+        from .urdf import urdf_limits
+
         urdf_lim = urdf_limits(upath)
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
@@ -288,53 +279,16 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
             joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, dd, off, names)
             tool_t = tool_t0 + tool_r0 @ tool_t
             tool_r = tool_r0
-        inertial = np.zeros((n, 10))
-        for i, (r, w) in enumerate(zip(rows, where)):
-            for key in ("mass", "com", "inertia"):
-                if getattr(r, key) is None:
-                    raise ConfigError(f"{w}: missing field {key!r}")
-            mass, com = float(r.mass), np.asarray(r.com, dtype=float)
-            ixx, iyy, izz, ixy, ixz, iyz = r.inertia
-            inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-            if not np.isfinite(mass) or mass < 0:
-                raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
-            phi = inertial_from_physical(mass, com, inertia)
-            if convention == "standard":  # given in DH frame i: express in dynid's link frame
-                rr, pp = standard_dh_link_offset(alpha[i], a[i], dd[i])
-                phi = transform_inertial(phi, rr, pp)
-            inertial[i] = phi
+        inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
 
-    balanced = [j for j, r in enumerate(rows) if r.counterbalance]
-    if balanced:
-        terms = check_terms(tuple(terms) + COUNTERBALANCE_TERMS, source)
-    mask = np.ones((n, len(terms)), dtype=bool)
-    for j in range(n):  # the counterbalance terms belong to the joints that have one
-        mask[j] = [t not in COUNTERBALANCE_TERMS or j in balanced for t in terms]
-    for i, (r, w) in enumerate(zip(rows, where)):
-        if r.drive_terms is not None:
-            if any(t not in terms for t in r.drive_terms):
-                raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, "
-                                  f"got {r.drive_terms!r}")
-            mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
-    drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
+    terms, mask, drive = _drive_terms(rows, where, terms, source)
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(d.transmission, n, offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
     if np.any(gains <= 0):
         i = int(np.argmax(gains <= 0))
         raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
-    inf = np.inf
-    default = (lambda k, j, dflt: dflt) if urdf_lim is None else (lambda k, j, dflt: urdf_lim[k][j])  # noqa: E731
-    lim = {k: np.array([float(_or(getattr(r, k), default(k, j, dflt))) for j, r in enumerate(rows)])
-           for k, dflt in (("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
-    for k, dflt in (("q_min", -inf), ("q_max", inf)):  # angles may be written like "-2*pi"
-        lim[k] = np.array([parse_angle(_or(getattr(r, k), default(k, j, dflt)), f"{w}.{k}") for j, (r, w) in enumerate(zip(rows, where))])
-    for i in range(n):
-        if not lim["q_min"][i] < lim["q_max"][i]:
-            raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")
-        for k in ("dq_max", "ddq_max", "tau_max"):
-            if not lim[k][i] > 0:
-                raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
+    lim = _limits(rows, where, urdf_lim)
     gravity = np.asarray(d.gravity, dtype=float)
     if d.payload is not None:
         inertial = inertial.copy()
@@ -348,6 +302,79 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
     )
+
+
+def _read_urdf(urdf: str | None, base: Path | None, source: str):
+    """The URDF a description names (relative to ``base``; a xacro file expanded) and its chain
+    (:func:`dynid.model.urdf.joints_from_urdf`)."""
+    from .urdf import expand_xacro, is_xacro, joints_from_urdf
+
+    if urdf is None:
+        raise ConfigError(f"{source}: convention 'urdf' needs a field 'urdf' with the file path")
+    upath = Path(urdf)
+    if not upath.is_absolute() and base is not None:
+        upath = base / upath
+    if is_xacro(upath):
+        upath = expand_xacro(upath)
+    return upath, joints_from_urdf(upath)
+
+
+def _dh_inertials(rows, where, convention: str, alpha, a, dd) -> np.ndarray:
+    """(n, 10) inertial parameters of a DH table's ``[[joints]]`` (mass, com, inertia each required), in dynid's link
+    frames (a standard-DH table gives them in DH frame i)."""
+    inertial = np.zeros((len(rows), 10))
+    for i, (r, w) in enumerate(zip(rows, where)):
+        for key in ("mass", "com", "inertia"):
+            if getattr(r, key) is None:
+                raise ConfigError(f"{w}: missing field {key!r}")
+        mass, com = float(r.mass), np.asarray(r.com, dtype=float)
+        ixx, iyy, izz, ixy, ixz, iyz = r.inertia
+        inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        if not np.isfinite(mass) or mass < 0:
+            raise ConfigError(f"{w}.mass: expected a mass >= 0 (kg), got {mass}")
+        phi = inertial_from_physical(mass, com, inertia)
+        if convention == "standard":  # given in DH frame i: express in dynid's link frame
+            rr, pp = standard_dh_link_offset(alpha[i], a[i], dd[i])
+            phi = transform_inertial(phi, rr, pp)
+        inertial[i] = phi
+    return inertial
+
+
+def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndarray, np.ndarray]:
+    """The robot's drive terms (with the counterbalance's where a joint has one), which joint has which (a joint's
+    own ``drive_terms``), and their nominal values."""
+    n = len(rows)
+    balanced = [j for j, r in enumerate(rows) if r.counterbalance]
+    if balanced:
+        terms = check_terms(tuple(terms) + COUNTERBALANCE_TERMS, source)
+    mask = np.ones((n, len(terms)), dtype=bool)
+    for j in range(n):  # the counterbalance terms belong to the joints that have one
+        mask[j] = [t not in COUNTERBALANCE_TERMS or j in balanced for t in terms]
+    for i, (r, w) in enumerate(zip(rows, where)):
+        if r.drive_terms is not None:
+            if any(t not in terms for t in r.drive_terms):
+                raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, "
+                                  f"got {r.drive_terms!r}")
+            mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
+    drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
+    return terms, mask, drive
+
+
+def _limits(rows, where, urdf_lim) -> dict:
+    """Each joint's limits: its table's, else the URDF's (``urdf_lim``), else none (±inf); checked."""
+    inf = np.inf
+    default = (lambda k, j, dflt: dflt) if urdf_lim is None else (lambda k, j, dflt: urdf_lim[k][j])  # noqa: E731
+    lim = {k: np.array([float(_or(getattr(r, k), default(k, j, dflt))) for j, r in enumerate(rows)])
+           for k, dflt in (("dq_max", inf), ("ddq_max", inf), ("tau_max", inf))}
+    for k, dflt in (("q_min", -inf), ("q_max", inf)):  # angles may be written like "-2*pi"
+        lim[k] = np.array([parse_angle(_or(getattr(r, k), default(k, j, dflt)), f"{w}.{k}") for j, (r, w) in enumerate(zip(rows, where))])
+    for i in range(len(rows)):
+        if not lim["q_min"][i] < lim["q_max"][i]:
+            raise ConfigError(f"{where[i]}: expected q_min < q_max, got {lim['q_min'][i]} >= {lim['q_max'][i]}")
+        for k in ("dq_max", "ddq_max", "tau_max"):
+            if not lim[k][i] > 0:
+                raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
+    return lim
 
 
 def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarray:

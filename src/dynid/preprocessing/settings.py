@@ -173,22 +173,7 @@ class Preprocessing:
                 raise ConfigError(f"preprocessing.{key}: expected below the Nyquist frequency {nyq:g} Hz of {name} "
                                   f"({rate:.6g} Hz), got {v:g} Hz")
         warnings = list(self.warnings)
-        band, source, share, knee = self.band, "given by preprocessing.band", self.noise_share, self.knee
-        if band is None and self.fourier is not None:
-            band, source = self.fourier[0] * self.fourier[1] / (2 * np.pi), "the excitation's highest harmonic"
-        if band is None:
-            if q is None:
-                raise ConfigError("preprocessing.band: needed when no positions are given to estimate it")
-            found = estimate_band(q, rate)
-            band, share, knee = found.band, found.noise_share, found.knee
-            source = (f"99 % of the motion's velocity energy, above a noise floor holding {100 * share:.2g} % of the "
-                      "positions' spectrum" if found.motion_found else "99 % of the velocity energy: no motion above the noise")
-            if self.band_floor > 0 and found.warnings(name):  # a log that barely moves: the identification's band
-                band, source = self.band_floor, "the identification log's: this log's own is implausible"
-            else:
-                warnings.extend(found.warnings(name))
-            if band < self.band_floor:
-                band, source = self.band_floor, "the identification log's, wider than this log's"
+        band, source, share, knee = self._band(rate, q, name, warnings)
         derived = cutoffs_from_band(band, rate)
 
         def given(key: str, value: float | None) -> float | None:  # a cutoff in Hz, capped for this log's rate
@@ -234,6 +219,35 @@ class Preprocessing:
         trim = self.trim if self.trim is not None else (3.0 / min(on) if on else 0.0)
         if self.trim is None and q is not None:  # at most a tenth of the log at each end
             trim = min(trim, 0.1 * q.shape[0] / rate)
+        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),  # noqa: E501
+                       decimation=int(dec), band=float(band), trim=float(trim),
+                       derivation=self._derivation(band, source, pos, par, dec, lowered),
+                       noise_share=share, knee=knee, warnings=tuple(dict.fromkeys(warnings)))
+
+    def _band(self, rate: float, q, name: str, warnings: list) -> tuple[float, str, float | None, float | None]:
+        """:meth:`resolved`'s excitation band: given, the Fourier fit's highest harmonic, or estimated from ``q``
+        (no lower than ``band_floor``); with where it comes from, the noise share and the knee. Appends the
+        estimate's warnings."""
+        band, source, share, knee = self.band, "given by preprocessing.band", self.noise_share, self.knee
+        if band is None and self.fourier is not None:
+            band, source = self.fourier[0] * self.fourier[1] / (2 * np.pi), "the excitation's highest harmonic"
+        if band is None:
+            if q is None:
+                raise ConfigError("preprocessing.band: needed when no positions are given to estimate it")
+            found = estimate_band(q, rate)
+            band, share, knee = found.band, found.noise_share, found.knee
+            source = (f"99 % of the motion's velocity energy, above a noise floor holding {100 * share:.2g} % of the "
+                      "positions' spectrum" if found.motion_found else "99 % of the velocity energy: no motion above the noise")
+            if self.band_floor > 0 and found.warnings(name):  # a log that barely moves: the identification's band
+                band, source = self.band_floor, "the identification log's: this log's own is implausible"
+            else:
+                warnings.extend(found.warnings(name))
+            if band < self.band_floor:
+                band, source = self.band_floor, "the identification log's, wider than this log's"
+        return band, source, share, knee
+
+    def _derivation(self, band: float, source: str, pos: float, par: float, dec: int, lowered: bool) -> str:
+        """:meth:`resolved`'s account of what it chose and why (:attr:`derivation`)."""
         chosen = [f"excitation band {band:.3g} Hz ({source})"]
         if self.torque_delay:
             chosen.append(f"torques read {1e3 * abs(self.torque_delay):.3g} ms {'later' if self.torque_delay > 0 else 'earlier'} "
@@ -249,9 +263,7 @@ class Preprocessing:
         else:
             chosen.append("no parallel filter")
         chosen.append(f"decimation by {dec}" + ("" if self.decimation is not None else " (down to the parallel band)"))
-        return replace(self, position_cutoff=float(pos), velocity_cutoff=float(vel), parallel_cutoff=float(par),  # noqa: E501
-                       decimation=int(dec), band=float(band), trim=float(trim), derivation="; ".join(chosen),
-                       noise_share=share, knee=knee, warnings=tuple(dict.fromkeys(warnings)))
+        return "; ".join(chosen)
 
     def to_dict(self) -> dict:
         """The settings as results.json stores them (``warnings`` go to the result's own warnings).
