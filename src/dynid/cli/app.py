@@ -327,6 +327,24 @@ def _runnable_advice(blocks, config: Path, out: Path) -> list:
     return [dataclasses.replace(b, text=concrete(b.text)) if isinstance(b, Line) else b for b in blocks]
 
 
+def _check_targets(targets: list) -> None:
+    """The files ``dynid export`` is to write, checked before any work (it writes nothing unless it can write
+    everything): each a writable file in an existing folder, not the same file twice."""
+    import os
+
+    from ..exceptions import DataError
+
+    for flag, path in targets:
+        if path.is_dir():
+            raise DataError(f"{flag} {path}: a folder; give the name of the file to write")
+        if not path.parent.is_dir():
+            raise DataError(f"{flag} {path}: its folder does not exist")
+        if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+            raise DataError(f"{flag} {path}: cannot be written (permissions)")
+    if len(targets) == 2 and targets[0][1].resolve() == targets[1][1].resolve():
+        raise DataError(f"--urdf and --mjcf name the same file ({targets[0][1]}): give each its own")
+
+
 @app.command()
 def export(
     config: Path = typer.Argument(..., help="Identification config (TOML) the results were identified with."),
@@ -355,17 +373,7 @@ def export(
             from ..io.mjcf_write_back import read_users_mjcf
 
             read_users_mjcf(mjcf_model, cfg.robot)  # its joints are the robot's, before any work
-        import os
-
-        for flag, path in targets:  # checked before any work: export writes nothing unless it can write everything
-            if path.is_dir():
-                raise DataError(f"{flag} {path}: a folder; give the name of the file to write")
-            if not path.parent.is_dir():
-                raise DataError(f"{flag} {path}: its folder does not exist")
-            if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
-                raise DataError(f"{flag} {path}: cannot be written (permissions)")
-        if len(targets) == 2 and targets[0][1].resolve() == targets[1][1].resolve():
-            raise DataError(f"--urdf and --mjcf name the same file ({targets[0][1]}): give each its own")
+        _check_targets(targets)
         return cfg, identified, targets
 
     def compute(prepared, progress):

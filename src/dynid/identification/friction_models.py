@@ -164,91 +164,139 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
     -------
     FrictionChoice
     """
+    cv = _CrossValidation(robot, data, folds)
+    cv.accumulate()
     n = robot.n_dof
-    s = data.settings
-    rest_v = np.broadcast_to(np.asarray(0.0 if s.rest_velocity == "auto" else s.rest_velocity, dtype=float), (n,))
-    speed = np.maximum(root_mean_square(data.dq), 1e-9)
-    rigid = replace(robot, drive_terms=(), drive=np.zeros((n, 0)), drive_mask=np.ones((n, 0), dtype=bool))
-    rigid_base = base_parameters(rigid, rng=0)
-    p = rigid_base.n_base
-    nominal = rigid_base.base_from_standard(rigid.standard_parameters())
-    load_ok = bool(np.any(rigid.inertial != 0))
-    others = [t for t in robot.drive_terms if t not in COULOMB_LIKE]
-    # the bank of columns, per joint the same layout: the description's other terms, then per state at rest the
-    # Coulomb, asymmetric, Stribeck (grid) and load columns, then the smooth Coulomb ones
-    names = list(others)
+    # Stage 1: the state at rest, with the plain model; stage 2: the family, with each joint's state at rest.
+    # Each candidate is first tried on all joints at once (a table of how each fares), then each joint's choice is
+    # refined with the other joints at their current choices (coordinate descent): a joint whose own friction is
+    # misfitted spoils the shared rigid-body parameters, and so every joint's error, under the plain model.
+    labels, errors = [], []
     for r in REST_GRID:
-        names += [f"fc|{r}", f"fca|{r}"] + [f"fst|{r}|{g}" for g in STRIBECK_GRID] + ([f"fcl|{r}"] if load_ok else [])
-    names += [f"tanh|{g}" for g in SMOOTH_GRID]
-    index = {name: i for i, name in enumerate(names)}
-    k_bank = len(names)
-    has = {t: robot.drive_mask[:, robot.drive_terms.index(t)] for t in others}
-    decays = [rest_decay(r, n) for r in REST_GRID]
-    cutoff = s.velocity_cutoff or s.position_cutoff or data.rate / 4
-    velocities = robot.friction_velocities
-    directions: list = []
+        errors.append(cv.out_of_fold([JointFriction("coulomb", 0.0, r)] * n))
+        labels.append(JointFriction("coulomb", 0.0, r).label)
+    plain = errors[0]
+    family = [("coulomb", 0.0), ("asymmetric", 0.0)] + [("stribeck", g) for g in STRIBECK_GRID] + \
+        [("smooth", g) for g in SMOOTH_GRID] + ([("load", 0.0)] if cv.load_ok else [])
+    for kind, g in family[1:]:
+        errors.append(cv.out_of_fold([JointFriction(kind, g, "held")] * n))
+        labels.append(JointFriction(kind, g).label.split(",")[0])
+    # a smooth Coulomb term is 0 at rest (tanh(0) = 0): its state at rest is "zero"
+    options = [JointFriction(kind, g, r) for kind, g in family for r in REST_GRID if kind != "smooth" or r == "zero"]
+    chosen_rel = cv.descend(options)
+    final = cv.out_of_fold(chosen_rel)
+    models = tuple(JointFriction(m.kind, float(m.velocity * cv.speed[j]) if m.kind in ("stribeck", "smooth") else 0.0,
+                                 m.rest) for j, m in enumerate(chosen_rel))
+    return FrictionChoice(models, tuple(labels), np.array(errors), plain, final, folds, cv.resting / cv.rows, cv.loaded)
 
-    def block(a, b):
+
+class _CrossValidation:
+    """:func:`choose_friction`'s blocked cross-validation: a bank of candidate friction columns per joint (the
+    description's other drive terms, then per state at rest the Coulomb, asymmetric, Stribeck (grid) and load
+    columns, then the smooth Coulomb ones), the Gram matrices of each block from one pass over the log, and the
+    out-of-fold error of any assignment of models to joints."""
+
+    def __init__(self, robot: Robot, data: PreparedData, folds: int):
+        n = robot.n_dof
+        s = data.settings
+        self.robot, self.data, self.n_folds = robot, data, folds
+        self.rest_v = np.broadcast_to(np.asarray(0.0 if s.rest_velocity == "auto" else s.rest_velocity, dtype=float), (n,))
+        self.speed = np.maximum(root_mean_square(data.dq), 1e-9)
+        self.rigid = replace(robot, drive_terms=(), drive=np.zeros((n, 0)), drive_mask=np.ones((n, 0), dtype=bool))
+        self.rigid_base = base_parameters(self.rigid, rng=0)
+        self.p = self.rigid_base.n_base
+        self.nominal = self.rigid_base.base_from_standard(self.rigid.standard_parameters())
+        self.load_ok = bool(np.any(self.rigid.inertial != 0))
+        self.others = [t for t in robot.drive_terms if t not in COULOMB_LIKE]
+        names = list(self.others)
+        for r in REST_GRID:
+            names += [f"fc|{r}", f"fca|{r}"] + [f"fst|{r}|{g}" for g in STRIBECK_GRID] + ([f"fcl|{r}"] if self.load_ok else [])
+        names += [f"tanh|{g}" for g in SMOOTH_GRID]
+        self.index = {name: i for i, name in enumerate(names)}
+        self.k_bank = len(names)
+        self.has = {t: robot.drive_mask[:, robot.drive_terms.index(t)] for t in self.others}
+        size = self.p + self.k_bank + 1
+        self.fit = np.zeros((folds, n, size, size))
+        self.score = np.zeros((folds, n, size, size))
+        self.n_rows = np.zeros((folds, n))
+        self.load_sq, self.tau_sq, self.resting = np.zeros(n), np.zeros(n), np.zeros(n)
+
+    def block(self, a: int, b: int, directions, start: int):
+        """Rigid-body base rows, the bank's columns and the torques of samples ``a:b`` (``directions``: each state
+        at rest's direction of motion on the segment from ``start``)."""
+        data, n = self.data, self.robot.n_dof
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))
-        y = regressor(rigid, q, dq, ddq, rigid_base.independent)
-        bank = np.zeros((b - a, n, k_bank))
-        v = Velocities(velocities.coulomb, velocities.stribeck, rest_v)
-        for t in others:
-            bank[:, :, index[t]] = TERMS[t].column(q, dq, ddq, v) * has[t]
-        load = np.abs(y @ nominal) if load_ok else None
+        y = regressor(self.rigid, q, dq, ddq, self.rigid_base.independent)
+        bank = np.zeros((b - a, n, self.k_bank))
+        velocities = self.robot.friction_velocities
+        v = Velocities(velocities.coulomb, velocities.stribeck, self.rest_v)
+        for t in self.others:
+            bank[:, :, self.index[t]] = TERMS[t].column(q, dq, ddq, v) * self.has[t]
+        load = np.abs(y @ self.nominal) if self.load_ok else None
         for r, direction in zip(REST_GRID, directions):
-            z = np.asarray(direction[a - directions_start[0]:b - directions_start[0]])
-            bank[:, :, index[f"fc|{r}"]] = z
-            bank[:, :, index[f"fca|{r}"]] = np.abs(z)
+            z = np.asarray(direction[a - start:b - start])
+            bank[:, :, self.index[f"fc|{r}"]] = z
+            bank[:, :, self.index[f"fca|{r}"]] = np.abs(z)
             for g in STRIBECK_GRID:
-                bank[:, :, index[f"fst|{r}|{g}"]] = z * np.exp(-(dq / (g * speed)) ** 2)
-            if load_ok:
-                bank[:, :, index[f"fcl|{r}"]] = load * z
+                bank[:, :, self.index[f"fst|{r}|{g}"]] = z * np.exp(-(dq / (g * self.speed)) ** 2)
+            if self.load_ok:
+                bank[:, :, self.index[f"fcl|{r}"]] = load * z
         for g in SMOOTH_GRID:
-            bank[:, :, index[f"tanh|{g}"]] = np.tanh(dq / (g * speed))
+            bank[:, :, self.index[f"tanh|{g}"]] = np.tanh(dq / (g * self.speed))
         return y, bank, tau
 
-    size = p + k_bank + 1
-    fit = np.zeros((folds, n, size, size))
-    score = np.zeros((folds, n, size, size))
-    n_rows = np.zeros((folds, n))
-    vmin = min_speeds(s, n)
-    n_s = data.t.shape[0]
-    load_sq, tau_sq, resting = np.zeros(n), np.zeros(n), np.zeros(n)
-    directions_start = [0]
-
-    def _accumulate(idx, y, bank, tau, fold):
-        nonlocal load_sq, tau_sq, resting
+    def _add(self, idx, y, bank, tau, fold, vmin) -> None:
+        """One block's Gram matrices into its folds: all rows to score, the moving rows to fit."""
+        data = self.data
         z = np.concatenate([y, bank, tau[:, :, None]], axis=2)
-        tau_sq += (tau**2).sum(axis=0)
-        if load_ok:
-            load_sq += ((y @ nominal) ** 2).sum(axis=0)
-        resting += (data.resting[idx] if data.resting is not None else
-                    np.abs(np.asarray(data.dq[idx])) <= rest_v).sum(axis=0)
+        self.tau_sq += (tau**2).sum(axis=0)
+        if self.load_ok:
+            self.load_sq += ((y @ self.nominal) ** 2).sum(axis=0)
+        self.resting += (data.resting[idx] if data.resting is not None else
+                         np.abs(np.asarray(data.dq[idx])) <= self.rest_v).sum(axis=0)
         keep = data.kept(idx, vmin)
         for f in np.unique(fold):
             sel = fold == f
             zf = z[sel]
-            score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
+            self.score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
             zk = zf * keep[sel][:, :, None]
-            fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
-            n_rows[f] += sel.sum()
+            self.fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
+            self.n_rows[f] += sel.sum()
 
-    for start, stop, fold_of in _segments(n_s, folds):
-        directions[:] = [_directions(data, rest_v, d, cutoff, start, stop) for d in decays]  # the segment's, from its start
-        directions_start[0] = start
-        for idx, (y, bank, tau) in parallel_decimation(lambda a, b: block(start + a, start + b), stop - start, data.rate,
-                                                       s.decimation or 1, s.order, s.chunk, s.parallel_cutoff or None):
-            idx = idx + start
-            _accumulate(idx, y, bank, tau, fold_of(idx))
-    if not n_rows.any():
-        raise IdentifiabilityError(f"{data.name}: no samples left for the friction models' cross-validation")
+    def accumulate(self) -> None:
+        """The one pass over the log (or a segment of each block of a long one), parallel-filtered and decimated as
+        the estimation's; then what the choice needs to know of the log (rests, load, reversals)."""
+        data, s, n = self.data, self.data.settings, self.robot.n_dof
+        decays = [rest_decay(r, n) for r in REST_GRID]
+        cutoff = s.velocity_cutoff or s.position_cutoff or data.rate / 4
+        vmin = min_speeds(s, n)
+        for start, stop, fold_of in _segments(data.t.shape[0], self.n_folds):
+            directions = [_directions(data, self.rest_v, d, cutoff, start, stop) for d in decays]  # from its start
 
-    total = fit.sum(axis=0)
-    sets = np.concatenate([total[None], total[None] - fit])  # every block, and every block but one
+            def segment_block(a: int, b: int, start: int = start, directions: list = directions):
+                return self.block(start + a, start + b, directions, start)
 
-    def columns(model: JointFriction, j: int) -> list[int]:
-        own = [index[t] for t in others if has[t][j]]
+            for idx, (y, bank, tau) in parallel_decimation(segment_block, stop - start, data.rate, s.decimation or 1,
+                                                           s.order, s.chunk, s.parallel_cutoff or None):
+                idx = idx + start
+                self._add(idx, y, bank, tau, fold_of(idx), vmin)
+        if not self.n_rows.any():
+            raise IdentifiabilityError(f"{data.name}: no samples left for the friction models' cross-validation")
+        self.total = self.fit.sum(axis=0)
+        self.sets = np.concatenate([self.total[None], self.total[None] - self.fit])  # every block, and every block but one
+        self.rows = max(self.n_rows.sum(axis=0).max(), 1)
+        self.judged = self.resting / self.rows >= REST_SHARE
+        self.loaded = self.load_ok & (np.sqrt(self.load_sq) >= LOAD_SHARE * np.sqrt(self.tau_sq))
+        dq_all = np.asarray(data.dq)
+        moving = np.abs(dq_all) >= vmin
+        moving[:, list(data.dead)] = False
+        forwards = np.array([np.mean(dq_all[moving[:, j], j] > 0) if moving[:, j].any() else 0.0 for j in range(n)])
+        self.reverses = np.minimum(forwards, 1 - forwards) >= REVERSAL_SHARE
+
+    def columns(self, model: JointFriction, j: int) -> list[int]:
+        """Joint ``j``'s bank columns under ``model``."""
+        index = self.index
+        own = [index[t] for t in self.others if self.has[t][j]]
         r = model.rest
         if model.kind == "smooth":
             return own + [index[f"tanh|{model.velocity}"]]
@@ -261,84 +309,54 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
             cols.append(index[f"fcl|{r}"])
         return cols
 
-    def out_of_fold(assignment, signs=False):
+    def out_of_fold(self, assignment, signs=False):
         """Out-of-fold errors per joint; with ``signs`` also whether a load-dependent coefficient (the last column
         of that model) comes out >= 0, as friction that grows with the load must."""
-        cols = [columns(m, j) for j, m in enumerate(assignment)]
-        err, coef = _out_of_fold(fit, score, n_rows, p, cols, sets)
+        cols = [self.columns(m, j) for j, m in enumerate(assignment)]
+        err, coef = _out_of_fold(self.fit, self.score, self.n_rows, self.p, cols, self.sets)
         if not signs:
             return err
         ok = np.array([m.kind != "load" or coef[j][-1] >= 0 for j, m in enumerate(assignment)])
         return err, ok
 
-    # Stage 1: the state at rest, with the plain model; stage 2: the family, with each joint's state at rest.
-    # Each candidate is first tried on all joints at once (a table of how each fares), then each joint's choice is
-    # refined with the other joints at their current choices (coordinate descent): a joint whose own friction is
-    # misfitted spoils the shared rigid-body parameters, and so every joint's error, under the plain model.
-    rows = max(n_rows.sum(axis=0).max(), 1)
-    judged = np.zeros(n, bool)
-    labels, errors = [], []
-    rest_err = []
-    for r in REST_GRID:
-        e = out_of_fold([JointFriction("coulomb", 0.0, r)] * n)
-        rest_err.append(e)
-        labels.append(JointFriction("coulomb", 0.0, r).label)
-        errors.append(e)
-    plain = rest_err[0]
-    judged = resting / rows >= REST_SHARE
-    loaded = load_ok & (np.sqrt(load_sq) >= LOAD_SHARE * np.sqrt(tau_sq))
-    family = [("coulomb", 0.0), ("asymmetric", 0.0)] + [("stribeck", g) for g in STRIBECK_GRID] + \
-        [("smooth", g) for g in SMOOTH_GRID] + ([("load", 0.0)] if load_ok else [])
-    for kind, g in family[1:]:
-        e = out_of_fold([JointFriction(kind, g, "held")] * n)
-        labels.append(JointFriction(kind, g).label.split(",")[0])
-        errors.append(e)
-
-    dq_all = np.asarray(data.dq)
-    moving = np.abs(dq_all) >= vmin
-    moving[:, list(data.dead)] = False
-    forwards = np.array([np.mean(dq_all[moving[:, j], j] > 0) if moving[:, j].any() else 0.0 for j in range(n)])
-    reverses = np.minimum(forwards, 1 - forwards) >= REVERSAL_SHARE
-
-    def excited(j: int, m: JointFriction) -> bool:
+    def excited(self, j: int, m: JointFriction) -> bool:
         """Whether the model's own column carries enough of the rows to be determined (:data:`EXCITED_SHARE`)."""
         if m.kind not in ("stribeck", "load"):
             return True
-        own, coulomb = columns(m, j)[-1], index[f"fc|{m.rest}"]
-        energy = total[j, p + own, p + own]
-        return bool(energy >= EXCITED_SHARE**2 * total[j, p + coulomb, p + coulomb])
+        own, coulomb = self.columns(m, j)[-1], self.index[f"fc|{m.rest}"]
+        energy = self.total[j, self.p + own, self.p + own]
+        return bool(energy >= EXCITED_SHARE**2 * self.total[j, self.p + coulomb, self.p + coulomb])
 
-    def allowed(j: int, m: JointFriction) -> bool:
-        # load-dependent friction needs a loaded transmission; smooth Coulomb has no state at rest (tanh(q̇/v_s) is 0
-        # there) and asymmetric Coulomb differs from the offset only where the friction is not held at rest, so they
-        # are candidates only where the log shows how the joint rests; the shapes near a reversal need reversals
-        return ((m.kind != "load" or bool(loaded[j])) and (m.kind not in ("smooth", "asymmetric") or bool(judged[j]))
-                and (m.rest == "held" or bool(judged[j])) and not (m.kind == "asymmetric" and m.rest == "held")
-                and (m.kind not in ("asymmetric", "stribeck", "smooth") or bool(reverses[j])) and excited(j, m))
+    def allowed(self, j: int, m: JointFriction) -> bool:
+        """Whether joint ``j`` may have model ``m``: load-dependent friction needs a loaded transmission; smooth
+        Coulomb has no state at rest (tanh(q̇/v_s) is 0 there) and asymmetric Coulomb differs from the offset only
+        where the friction is not held at rest, so they are candidates only where the log shows how the joint rests;
+        the shapes near a reversal need reversals."""
+        judged = bool(self.judged[j])
+        return ((m.kind != "load" or bool(self.loaded[j])) and (m.kind not in ("smooth", "asymmetric") or judged)
+                and (m.rest == "held" or judged) and not (m.kind == "asymmetric" and m.rest == "held")
+                and (m.kind not in ("asymmetric", "stribeck", "smooth") or bool(self.reverses[j])) and self.excited(j, m))
 
-    # a smooth Coulomb term is 0 at rest (tanh(0) = 0): its state at rest is "zero"
-    options = [JointFriction(kind, g, r) for kind, g in family for r in REST_GRID if kind != "smooth" or r == "zero"]
-    assignment = [JointFriction()] * n
-    for _ in range(3):  # sweeps of coordinate descent
-        changed = False
-        for j in range(n):
-            trial = []
-            for m in options:
-                if not allowed(j, m):
-                    trial.append(np.inf)
-                    continue
-                err, ok = out_of_fold(assignment[:j] + [m] + assignment[j + 1:], signs=True)
-                trial.append(err[j] if ok[j] else np.inf)
-            best = options[_pick(trial)]
-            if best != assignment[j]:
-                assignment[j], changed = best, True
-        if not changed:
-            break
-    chosen_rel = assignment
-    final = out_of_fold(chosen_rel)
-    models = tuple(JointFriction(m.kind, float(m.velocity * speed[j]) if m.kind in ("stribeck", "smooth") else 0.0,
-                                 m.rest) for j, m in enumerate(chosen_rel))
-    return FrictionChoice(models, tuple(labels), np.array(errors), plain, final, folds, resting / rows, loaded)
+    def descend(self, options: list[JointFriction]) -> list[JointFriction]:
+        """Each joint's model by coordinate descent (up to three sweeps) over ``options``, from the plain model."""
+        n = self.robot.n_dof
+        assignment = [JointFriction()] * n
+        for _ in range(3):
+            changed = False
+            for j in range(n):
+                trial = []
+                for m in options:
+                    if not self.allowed(j, m):
+                        trial.append(np.inf)
+                        continue
+                    err, ok = self.out_of_fold(assignment[:j] + [m] + assignment[j + 1:], signs=True)
+                    trial.append(err[j] if ok[j] else np.inf)
+                best = options[_pick(trial)]
+                if best != assignment[j]:
+                    assignment[j], changed = best, True
+            if not changed:
+                break
+        return assignment
 
 
 def _segments(n_s: int, folds: int):

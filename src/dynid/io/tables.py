@@ -163,13 +163,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                 expected = n_fields if expected is None else expected
                 if max(cols) >= expected:
                     raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have {expected} columns")
-            if n_fields != expected:
-                if not line.endswith("\n"):  # only the last line can lack a newline
-                    warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
-                    break
-                other = next((d for d in (";", "\t", "|") if d != delimiter and d in line), None)
-                hint = f" (fields separated by {other!r}? dynid reads {delimiter!r})" if n_fields == 1 and other else ""
-                raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}{hint}")
+            if n_fields != expected:  # the truncated last line (a warning), or a mistake (refused)
+                _odd_line(path, line, line_no, n_fields, expected, delimiter, warnings)
+                break
             if first_line is None:
                 first_line = line_no
             if not pending:
@@ -178,16 +174,34 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if len(pending) >= BLOCK:
                 flush()
         flush()
-    if not blocks and files is None:
+    _check_selection(path, not blocks and files is None, data_row, header, rows, bool(warnings))
+    return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
+
+
+def _odd_line(path: Path, line: str, line_no: int, n_fields: int, expected: int | None, delimiter: str,
+              warnings: list) -> None:
+    """A line with another number of fields than the first: the file's truncated last line (no newline: a warning;
+    reading stops there) or a mistake (DataError, with a hint where another delimiter is in the line)."""
+    if not line.endswith("\n"):  # only the last line can lack a newline
+        warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
+        return
+    other = next((d for d in (";", "\t", "|") if d != delimiter and d in line), None)
+    hint = f" (fields separated by {other!r}? dynid reads {delimiter!r})" if n_fields == 1 and other else ""
+    raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}{hint}")
+
+
+def _check_selection(path: Path, empty: bool, data_row: int, header: bool, rows, truncated: bool) -> None:
+    """Refuse a table that holds no data row, or a ``rows`` selection that selects nothing or reaches past the end."""
+    first, last = rows if rows is not None else (1, None)
+    if empty:
         if data_row == 0:
             what = "only a header line" if header else "no data lines"
             raise DataError(f"{path}: {what} (an empty file, or not a text table?)")
         if rows is not None:
             raise DataError(f"{path}: rows = {[first, last]} selects nothing: the file has {data_row} data rows")
         raise DataError(f"{path}: no data rows")
-    if last is not None and data_row < last and not warnings:
+    if last is not None and data_row < last and not truncated:
         raise DataError(f"{path}: rows = {[first, last]} goes beyond the file's end: it has {data_row} data rows")
-    return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
 
 
 def _stack(blocks: list[np.ndarray]) -> np.ndarray:

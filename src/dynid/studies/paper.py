@@ -550,17 +550,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     base = base_parameters(robot, rng=np.random.default_rng([config.seed, 1]))
     warnings: list[str] = []
 
-    if config.plant == "paper":
-        missing = [n for n in base.names if ref.paper_symbol(n) not in ref.TABLE2]
-        if missing:
-            raise ConfigError(field="plant", message=f"plant 'paper': no Table 2 value for {', '.join(missing)}")
-        truth = np.array([ref.TABLE2[ref.paper_symbol(n)] for n in base.names])
-        phi_true = base.standard_from_base(truth, reference=robot.standard_parameters())
-    else:
-        robot.require_physical_nominal("the simulation truth of dynid run")
-        phi_true = robot.standard_parameters()
-        truth = base.base_from_standard(phi_true)
-
+    truth, phi_true = _plant(config, robot, base)
     t = sample_times(config.duration, config.rate)
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
     traj_id, excitation_info = identification_trajectory(config, robot, base)
@@ -600,30 +590,50 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     fits: dict[str, Any] = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys}, budget,
                           progress=progress, extra=boots)
     for key in keys:
-        fit = fits[key]
-        timings[key] = fit.seconds
-        p_id = (ident.w_base @ fit.params).reshape(-1, k)
-        p_val = (valid.w_base @ fit.params).reshape(-1, k)
-        metrics: dict[str, dict] = {}
-        for name, tau, pred in (("identification", ident.tau, p_id), ("validation", valid.tau, p_val)):
-            for mk, mv in _metrics(tau, pred).items():
-                metrics.setdefault(mk, {})[name] = mv
-        est = fit.estimator
+        timings[key] = fits[key].seconds
         boot = None
         if f"{key}_bootstrap" in fits:
             bs, timings[f"{key}_bootstrap"] = fits[f"{key}_bootstrap"]
             boot = {"resamples": config.bootstrap, "block_length": bs.block_length, "level": bs.level,
                     "lower": bs.lower, "upper": bs.upper, "std": bs.std}
-        result.estimates[key] = PaperEstimate(
-            params=fit.params, objective=float(paper_objective(y - p_id.ravel(), k, config.weights)), seconds=fit.seconds,
-            n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val, metrics=metrics,
-            params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None), bootstrap=boot,
-            pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None),
-            consistency_margin=consistency_margin(base.regrouping, fit.params, *layout))
+        result.estimates[key] = _paper_estimate(fits[key], ident, valid, config, base, layout, boot)
     result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
+
+
+def _plant(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -> tuple[np.ndarray, np.ndarray]:
+    """The simulated plant's base and standard parameters: the paper's Table 2 (``plant = "paper"``) or the robot's
+    description."""
+    if config.plant == "paper":
+        missing = [n for n in base.names if ref.paper_symbol(n) not in ref.TABLE2]
+        if missing:
+            raise ConfigError(field="plant", message=f"plant 'paper': no Table 2 value for {', '.join(missing)}")
+        truth = np.array([ref.TABLE2[ref.paper_symbol(n)] for n in base.names])
+        return truth, base.standard_from_base(truth, reference=robot.standard_parameters())
+    robot.require_physical_nominal("the simulation truth of dynid run")
+    phi_true = robot.standard_parameters()
+    return base.base_from_standard(phi_true), phi_true
+
+
+def _paper_estimate(fit, ident, valid, config: PaperExperimentConfig, base: BaseParameters, layout, boot) -> PaperEstimate:
+    """One estimator's :class:`PaperEstimate`: its predictions and metrics on β1 and β2, eq. 9's objective, σ and
+    history where it has them, its consistency margin, the bootstrap's intervals (``boot``)."""
+    k = config.joints
+    p_id = (ident.w_base @ fit.params).reshape(-1, k)
+    p_val = (valid.w_base @ fit.params).reshape(-1, k)
+    metrics: dict[str, dict] = {}
+    for name, tau, pred in (("identification", ident.tau, p_id), ("validation", valid.tau, p_val)):
+        for mk, mv in _metrics(tau, pred).items():
+            metrics.setdefault(mk, {})[name] = mv
+    est = fit.estimator
+    return PaperEstimate(
+        params=fit.params, objective=float(paper_objective(ident.tau.ravel() - p_id.ravel(), k, config.weights)),
+        seconds=fit.seconds, n_evaluations=fit.n_evaluations, tau_identification=p_id, tau_validation=p_val,
+        metrics=metrics, params_std=getattr(est, "params_std_", None), history=getattr(est, "history_", None),
+        bootstrap=boot, pseudo_inertia_min_eig=getattr(est, "pseudo_inertia_min_eig_", None),
+        consistency_margin=consistency_margin(base.regrouping, fit.params, *layout))
 
 
 def problem(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -> FitData:
