@@ -51,3 +51,37 @@ def test_example_refusals(tmp_path):
     assert (tmp_path / "full" / "mine.txt").read_text() == "a user's file" and len(list((tmp_path / "full").iterdir())) == 1
     assert_refused(run("example", "ur5", str(tmp_path / "new")), "no example for robot 'ur5': choose one of ur10e, tx40, er16")
     assert not (tmp_path / "new").exists()
+
+
+def test_results_refuse_a_description_whose_kinematics_changed(tmp_path, monkeypatch):
+    """results.json holds the description's kinematic fingerprint: load_results and export refuse a description whose
+    joint frames changed since (the base parameters then mean something else); the same description loads."""
+    import dataclasses
+
+    import pytest
+
+    import dynid
+    from dynid.exceptions import DataError
+
+    monkeypatch.chdir(tmp_path)
+    assert run("example", "ur10e", "try", "-q").returncode == 0
+    monkeypatch.chdir(tmp_path / "try")
+    assert run("identify", "ur10e.toml", "--no-figures", "-q").returncode == 0
+    assert dynid.load_results("dynid-identify").robot.name == "ur10e"
+    urdf = tmp_path / "try" / "ur10e.urdf"
+    text = urdf.read_text()
+    assert text.count('xyz="0.0 0.0 0.181"') == 1
+    urdf.write_text(text.replace('xyz="0.0 0.0 0.181"', 'xyz="0.0 0.0 0.19"'))
+    with pytest.raises(DataError, match=r"results\.json: identified with a description of 'ur10e' whose joint frames"):
+        dynid.load_results("dynid-identify")
+    assert_refused(run("export", "ur10e.toml", "--urdf", "x.urdf"), "fingerprint")
+    assert not (tmp_path / "try" / "x.urdf").exists()
+    # the fingerprint: the frames, not the nominal inertia; the built-in UR10e and its URDF read directly agree
+    from importlib import resources
+
+    robot = dynid.load_robot("ur10e")
+    same = dataclasses.replace(robot, inertial=2 * robot.inertial)
+    from_urdf = dynid.load_robot(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+    assert same.kinematic_fingerprint() == robot.kinematic_fingerprint() == from_urdf.kinematic_fingerprint()
+    assert dynid.load_robot(urdf).kinematic_fingerprint() != robot.kinematic_fingerprint()
+    assert dynid.load_robot("tx40").kinematic_fingerprint() != robot.kinematic_fingerprint()

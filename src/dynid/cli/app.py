@@ -361,7 +361,7 @@ def export(
 
     def prepare():
         cfg = load_identification_config(config, data_root)
-        identified = _read_results(results, cfg.robot.name)
+        identified = _read_results(results, cfg.robot)
         targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
         if mjcf_model is not None and mjcf is None:
             raise DataError("--mjcf-model is the model --mjcf writes into: give --mjcf FILE too")
@@ -429,11 +429,14 @@ def export(
     _Command("dynid export", quiet).run(prepare, compute, save, show)
 
 
-def _read_results(results: Path, robot: str) -> dict:
-    """The results.json of dynid identify for ``robot``, checked (:func:`dynid.io.results.read_results`)."""
-    from ..io.results import read_results
+def _read_results(results: Path, robot) -> dict:
+    """The results.json of dynid identify for ``robot`` (a Robot), checked (:func:`dynid.io.results.read_results`,
+    :func:`dynid.io.results.check_fingerprint`)."""
+    from ..io.results import check_fingerprint, read_results
 
-    return read_results(results, robot, "; run dynid identify first or give --results")
+    found = read_results(results, robot.name, "; run dynid identify first or give --results")
+    check_fingerprint(found, robot, str(results))
+    return found
 
 
 def _parse_rows(text: str | None):
@@ -468,7 +471,7 @@ def validate(
         cfg = load_identification_config(config, data_root)
         from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
 
-        identified = _read_results(results, cfg.robot.name)
+        identified = _read_results(results, cfg.robot)
         if file is not None:
             return cfg, identified, (dataset_for_file(cfg, file, _parse_rows(rows)),)
         if rows is not None:

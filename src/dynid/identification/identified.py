@@ -554,9 +554,11 @@ def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> I
     Raises
     ------
     DataError
-        An unreadable file, results of another robot, or no way to find the robot's description.
+        An unreadable file, results of another robot, or no way to find the robot's description; a description whose
+        kinematics differ from those the results were identified with (``settings.robot_fingerprint``, from this
+        release on: :meth:`dynid.model.robot.Robot.kinematic_fingerprint`).
     """
-    from ..io.results import read_results
+    from ..io.results import check_fingerprint, read_results
 
     path = Path(path)
     if path.is_dir() and (path / "results.json").is_file():  # the output folder of dynid identify
@@ -565,6 +567,7 @@ def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> I
     model_robot = _robot(robot, results, path)
     if isinstance(results.get("robot"), str) and results["robot"] != model_robot.name:
         raise DataError(f"{path}: results of robot {results['robot']!r}, the robot given is {model_robot.name!r}")
+    check_fingerprint(results, model_robot, str(path))
     return IdentifiedModel.from_results(results, model_robot, str(path))
 
 

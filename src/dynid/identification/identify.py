@@ -421,8 +421,21 @@ class BlockScoring:
         self.folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out else []
 
     def add(self, index, y, tau, keep, y_standard) -> None:
-        """One block: sample indices (M,), base rows (M, n, p), torques (M, n), kept rows (M, n) and, with folds,
-        the standard rows (M, n, n_params)."""
+        """Feed one block of base rows to every accumulator.
+
+        Parameters
+        ----------
+        index : (M,) int array
+            Sample indices of the block.
+        y : (M, n_dof, n_base) array
+            Base rows.
+        tau : (M, n_dof) array [N·m]
+            Torques.
+        keep : (M, n_dof) bool array
+            Rows kept for the estimation.
+        y_standard : (M, n_dof, n_params) array or None
+            Standard rows (used with held-out folds).
+        """
         data, n_s = self.data, self.data.t.shape[0]
         for k in np.unique(index * HELD_OUT_FOLDS // n_s) if self.folds else ():
             sel = index * HELD_OUT_FOLDS // n_s == k

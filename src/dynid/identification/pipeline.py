@@ -195,8 +195,8 @@ class IdentificationPipeline:
         Returns
         -------
         dynid.identification.identify.IdentificationResult
-            Its ``settings`` hold the resolved preprocessing, :attr:`PreparedIdentification.choices` and
-            ``robot_source``.
+            Its ``settings`` hold the resolved preprocessing, :attr:`PreparedIdentification.choices`,
+            ``robot_source`` and ``robot_fingerprint`` (:meth:`dynid.model.robot.Robot.kinematic_fingerprint`).
 
         Raises
         ------
@@ -213,7 +213,8 @@ class IdentificationPipeline:
                           held_out=held_out, sdp_prior=self.sdp_prior,
                           observers=(lambda *block: blocks.append(block),) if check is None else ())
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
-        return replace(result, settings={**result.settings, "robot_source": self.source, **prepared.choices},
+        return replace(result, settings={**result.settings, "robot_source": self.source,
+                                         "robot_fingerprint": prepared.robot.kinematic_fingerprint(), **prepared.choices},
                        findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,

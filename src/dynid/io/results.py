@@ -20,6 +20,34 @@ OLD_LAYOUT = 1
 """``schema_version`` of results written before the estimates table: read without the schema's check."""
 
 
+def check_fingerprint(results: dict, robot, source: str) -> None:
+    """Refuse results identified with a description whose kinematics differ from ``robot``'s (its
+    ``settings.robot_fingerprint``, :meth:`dynid.model.robot.Robot.kinematic_fingerprint`; results of earlier releases
+    have none and are not checked).
+
+    Parameters
+    ----------
+    results : dict
+        A parsed results.json.
+    robot : Robot
+        The description the results are used with.
+    source : str
+        The results' file, named in the error.
+
+    Raises
+    ------
+    DataError
+        The fingerprints differ.
+    """
+    settings = results.get("settings")
+    stored = settings.get("robot_fingerprint") if isinstance(settings, dict) else None
+    now = robot.kinematic_fingerprint()
+    if isinstance(stored, str) and stored != now:
+        raise DataError(f"{source}: identified with a description of {robot.name!r} whose joint frames, tool, gravity "
+                        f"or gear ratios differ from the one given now (fingerprint {stored} against {now}): use the "
+                        "description it was identified with")
+
+
 def read_results(path: str | Path, robot: str | None = None, missing_hint: str = "") -> dict:
     """The results.json of ``dynid identify``, checked against the shipped schema and against the robot.
 

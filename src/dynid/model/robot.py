@@ -246,6 +246,26 @@ class Robot:
         joint = tuple(parameter_name(t, j) for j in range(self.n_dof) for t in terms)
         return joint + self.transmission.coupled_parameter_names
 
+    def kinematic_fingerprint(self) -> str:
+        """A short hash of what gives the base parameters their meaning: the joint frames and axes, the tool frame,
+        gravity and the transmission's gear ratios and coupling (not the nominal inertia, the friction model or the
+        limits, which an identification does not depend on in that way).
+
+        Returns
+        -------
+        str
+            16 hexadecimal digits (SHA-256 of the values rounded to 12 significant digits: the same for a description
+            read again, or from a URDF and a TOML that state the same frames).
+        """
+        import hashlib
+
+        values = [np.asarray(x, dtype=float).ravel() for j in self.joints for x in (j.rotation, j.translation, j.axis)]
+        values += [np.asarray(x, dtype=float).ravel() for x in (self.tool_rotation, self.tool_translation, self.gravity,
+                                                                 self.transmission.motor_from_joint)]
+        flat = np.concatenate(values)
+        text = ",".join(f"{0.0 if abs(v) < 1e-12 else v:.12g}" for v in flat)
+        return hashlib.sha256(f"{self.n_dof};{text}".encode()).hexdigest()[:16]
+
     def standard_parameters(self) -> np.ndarray:
         """Nominal standard parameters.
 
