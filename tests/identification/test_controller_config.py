@@ -123,15 +123,15 @@ def test_the_identifier_takes_every_estimator_a_config_takes(closed_loop_log):
 
     root, table, _ = closed_loop_log
     _write(root, table, estimators='["wls", "idim-iv"]')
-    ident = dynid.Identifier(estimators=["wls", "idim-iv"]).fit(root / "cl.toml", validate=False)
+    ident = dynid.Identifier.from_config(root / "cl.toml", estimators=["wls", "idim-iv"], validate=False)
     assert list(ident.estimates_) == ["dynid WLS", "dynid IDIM-IV"]
-    by_config = dynid.Identifier().fit(root / "cl.toml", validate=False)
+    by_config = dynid.Identifier.from_config(root / "cl.toml", validate=False)
     np.testing.assert_allclose(ident.estimates_["dynid IDIM-IV"], by_config.estimates_["dynid IDIM-IV"], rtol=1e-12)
     _write(root, "", estimators='["wls"]')
     with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: .*cl.toml has no \[controller\]"):
-        dynid.Identifier(estimators=["wls", "idim-iv"]).fit(root / "cl.toml", validate=False)
+        dynid.Identifier.from_config(root / "cl.toml", estimators=["wls", "idim-iv"], validate=False)
     log = dynid.simulated_log(dynid.load_robot("er16"), seconds=5, seed=1)
     with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: fit a config"):
         dynid.Identifier("er16", estimators=["wls", "idim-iv"]).fit(log.t, log.q, log.tau)
     with pytest.raises(ConfigError, match="list ols or wls before 'idim-iv'"):
-        dynid.Identifier(estimators=["idim-iv", "wls"]).fit(root / "cl.toml")
+        dynid.Identifier.from_config(root / "cl.toml", estimators=["idim-iv", "wls"])

@@ -130,14 +130,45 @@ class Identifier:
             setattr(self, name, value)
         return self
 
-    def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> Identifier:
-        """Identify the robot from arrays, or from a config file.
+    @classmethod
+    def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:
+        """Identify the robot of an identification config (TOML) as ``dynid identify`` does, the ``params`` given
+        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``) over the config's.
 
         Parameters
         ----------
-        t : (N,) array [s], or path of an identification config (TOML)
-            Time stamps (jittered ones are interpolated onto a uniform grid, as the log readers do); or a config,
-            whose settings this identifier's given parameters override.
+        path : str or Path
+            The config.
+        data_root : path, optional
+            Its data folder (overrides the config's ``data_root``).
+        validate : bool
+            Validate on the config's validation logs.
+        **params
+            Keyword arguments of :class:`Identifier`.
+
+        Returns
+        -------
+        Identifier
+            Fitted.
+
+        Raises
+        ------
+        ConfigError
+            A malformed config or setting.
+        DataError, IdentifiabilityError
+            Logs that cannot be read or identified from (the message says why).
+        """
+        ident = cls(**params)
+        return ident._fitted(ident._config_result(Path(path), data_root, validate))
+
+    def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> Identifier:
+        """Identify the robot from arrays (a config: :meth:`from_config`).
+
+        Parameters
+        ----------
+        t : (N,) array [s]
+            Time stamps (jittered ones are interpolated onto a uniform grid, as the log readers do). A config's path
+            here still works, with a FutureWarning: it is :meth:`from_config`.
         q : (N, n_dof) array [rad]
             Joint positions (arrays only).
         tau : (N, n_dof) array [N·m]
@@ -161,10 +192,13 @@ class Identifier:
             Data that cannot be identified from (the message says why).
         """
         from ..exceptions import ConfigError
-        from .identified import IdentifiedModel
 
         if isinstance(t, (str, Path)):
-            result = self._fit_config(Path(t), data_root, validate)
+            import warnings
+
+            warnings.warn("Identifier(...).fit(config_path) is Identifier.from_config(config_path, ...): fit takes the "
+                          "arrays t, q, tau", FutureWarning, stacklevel=2)
+            result = self._config_result(Path(t), data_root, validate)
         else:
             from ..io.identification_config import split_estimators
             from .run import identify_from_arrays
@@ -175,10 +209,16 @@ class Identifier:
             if closed_loop:
                 raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the "
                                   "run in closed loop and needs its controller: fit a config with a [controller] table "
-                                  "(Identifier(...).fit('arm.toml')), or leave it out", field="estimators")
+                                  "(Identifier.from_config('arm.toml', estimators=...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
                                           seed=0 if self.seed is None else int(self.seed))
+        return self._fitted(result)
+
+    def _fitted(self, result) -> Identifier:
+        """Set the fitted attributes from an identification's result."""
+        from .identified import IdentifiedModel
+
         self.result_ = result
         self.model_ = IdentifiedModel.from_result(result)
         main = result.main_estimate
@@ -189,7 +229,7 @@ class Identifier:
         self.estimates_ = dict(self.model_.estimates)
         return self
 
-    def _fit_config(self, path: Path, data_root, validate: bool):
+    def _config_result(self, path: Path, data_root, validate: bool):
         from dataclasses import replace
 
         from ..exceptions import ConfigError
