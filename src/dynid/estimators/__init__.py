@@ -18,6 +18,7 @@ _EXPORTS = {
     "AccumulatingEstimator": "base",
     "register": "registry", "unregister": "registry", "EstimatorSpec": "registry", "FitData": "registry",
     "Estimation": "estimation",
+    "check_estimator": "checks", "EstimatorCheckError": "checks",
 }
 
 __all__ = list(_EXPORTS)

@@ -1,0 +1,87 @@
+"""check_estimator: every registered base-space estimator passes it, and each of its checks catches the estimator
+that breaks it (a plugin's author runs it on theirs)."""
+
+import numpy as np
+import pytest
+
+from dynid.estimators import Estimator, check_estimator, register, unregister
+from dynid.estimators import registry as reg
+from dynid.estimators.checks import EstimatorCheckError
+
+BASE_SPACE = [k for k in reg.keys() if reg.spec(k).space == "base"]
+
+
+@pytest.mark.parametrize("key", BASE_SPACE)
+def test_every_registered_base_space_estimator_passes(key):
+    check_estimator(key)
+
+
+def test_a_standard_space_estimator_is_refused_in_one_line():
+    with pytest.raises(EstimatorCheckError, match="sdp: estimates standard parameters, which need a robot's layout"):
+        check_estimator("sdp")
+
+
+class _LeastSquares(Estimator):
+    def __init__(self, *, n_dof=None):
+        self.n_dof = n_dof
+
+    def solution(self, w, tau):
+        return np.linalg.lstsq(w, np.asarray(tau, dtype=float).reshape(-1), rcond=None)[0]
+
+    def fit(self, w, tau):
+        self.params_ = self.solution(w, tau)
+        return self
+
+
+class _Biased(_LeastSquares):
+    def fit(self, w, tau):
+        self.params_ = 1.01 * self.solution(w, tau)
+        return self
+
+
+class _Unseeded(_LeastSquares):
+    def fit(self, w, tau):
+        self.params_ = self.solution(w, tau) + 1e-9 * np.random.default_rng().standard_normal(w.shape[1])
+        return self
+
+
+class _InPlace(_LeastSquares):
+    def fit(self, w, tau):
+        tau -= 0.0 * tau + 1e-12  # the caller's array, changed
+        self.params_ = self.solution(w, tau)
+        return self
+
+
+class _WrongLength(_LeastSquares):
+    def fit(self, w, tau):
+        self.params_ = self.solution(w, tau)[:-1]
+        return self
+
+
+class _BoxCentre(Estimator):
+    def __init__(self, *, bounds=None, n_dof=None):
+        self.bounds, self.n_dof = bounds, n_dof
+
+    def fit(self, w, tau):
+        self.params_ = np.asarray(self.bounds, dtype=float).mean(axis=1)
+        return self
+
+
+@pytest.mark.parametrize("cls, box, said", [
+    (_LeastSquares, False, None),
+    (_Biased, False, "more than 5 σ from the truth"),
+    (_Unseeded, False, "the same rng gave other parameters"),
+    (_InPlace, False, "fit changed the W or tau it was given"),
+    (_WrongLength, False, r"fit failed on a well-posed problem: .*returned parameters of shape \(5,\), expected \(6,\)"),
+    (_BoxCentre, True, "did not improve eq. 9 on the box's centre"),
+])
+def test_each_check_catches_the_estimator_that_breaks_it(cls, box, said):
+    register("checked", cls, needs_box=box, replace=True)
+    try:
+        if said is None:
+            check_estimator("checked")
+        else:
+            with pytest.raises(EstimatorCheckError, match=said):
+                check_estimator("checked")
+    finally:
+        unregister("checked")
