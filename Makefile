@@ -38,6 +38,7 @@ wheel-check: $(STAMP)  # the wheel as a user installs it, in a fresh virtualenv:
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_table.py
 	$(BIN)/python benchmarks/bench_regressor.py
+	$(BIN)/python benchmarks/bench_objective.py
 	$(BIN)/python benchmarks/bench_identify_memory.py
 	$(BIN)/python benchmarks/bench_excitation_design.py
 

@@ -34,3 +34,22 @@ def test_de_and_pso_do_not_depend_on_the_blocking(monkeypatch):
         results.append((de.params_, pso.params_))
     for a, b in zip(*results):
         np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_a_coordinate_move_is_eq_9_of_the_moved_candidate_and_its_residual_is_written_when_used():
+    """The ABC's move: F of x + δ·e_j equals eq. 9 of that candidate; the residual, written only when a later move
+    starts from it, is the candidate's (chains of moves stay exact)."""
+    from dynid.estimators.base import ShiftedResidual
+
+    w, tau, _, n = _problem(m=3_000)
+    f = LinearAbsoluteObjective(w, tau, n)
+    x = np.random.default_rng(5).standard_normal(w.shape[1])
+    _, r = f.start(x)
+    state = r
+    for j, delta in ((2, 0.3), (0, -1.1), (2, 0.05)):
+        fv, state = f.move(state, j, delta)
+        x = x.copy()
+        x[j] += delta
+        assert isinstance(state, ShiftedResidual)
+        np.testing.assert_allclose(fv, paper_objective(tau - w @ x, n), rtol=1e-12)
+    np.testing.assert_allclose(state.array(), tau - w @ x, rtol=1e-10, atol=1e-10)

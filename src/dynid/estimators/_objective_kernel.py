@@ -6,14 +6,21 @@ import numba as nb
 
 
 @nb.njit(cache=True, fastmath=False, nogil=True)
-def shifted_absolute_sum(r, column, delta, row_weights, out):
-    """``out = r - delta·column`` and ``Σ row_weights·|out|`` in one pass."""
+def shifted_absolute_total(r, column, delta, row_weights):
+    """``Σ row_weights·|r - delta·column|`` in one pass, without writing the shifted residual (:func:`shifted` writes
+    it, with the same operations, when it is needed)."""
     s = 0.0
     for i in range(r.shape[0]):
         v = r[i] - column[i] * delta
-        out[i] = v
         s += row_weights[i] * abs(v)
     return s
+
+
+@nb.njit(cache=True, fastmath=False, nogil=True)
+def shifted(r, column, delta, out):
+    """``out = r - delta·column``."""
+    for i in range(r.shape[0]):
+        out[i] = r[i] - column[i] * delta
 
 
 @nb.njit(cache=True, fastmath=False, nogil=True)

@@ -152,13 +152,15 @@ class LinearAbsoluteObjective:
         r = self.tau - self.w @ np.asarray(x, dtype=float)
         return float(self.row_weights @ np.abs(r)), r
 
-    def move(self, r: np.ndarray, j: int, delta: float) -> tuple[float, np.ndarray]:
+    def move(self, r, j: int, delta: float) -> tuple[float, ShiftedResidual]:
         """F and the residual of a candidate that differs from the one of residual ``r`` in coordinate ``j`` by
-        ``delta``.
+        ``delta``. F is summed without writing the new residual: a search keeps most candidates' residuals never
+        (a greedy selection rejects them), so it is written only when a move starts from it
+        (:class:`ShiftedResidual`); the numbers are those of writing it first.
 
         Parameters
         ----------
-        r : (M,) array
+        r : (M,) array or ShiftedResidual
             The current candidate's residual.
         j : int
         delta : float
@@ -166,12 +168,48 @@ class LinearAbsoluteObjective:
         Returns
         -------
         f : float [N·m]
-        r_new : (M,) array
+        r_new : ShiftedResidual
         """
-        from ._objective_kernel import shifted_absolute_sum
+        from ._objective_kernel import shifted_absolute_total
 
-        out = np.empty_like(r)
-        return float(shifted_absolute_sum(r, self.columns[:, j], float(delta), self.row_weights, out)), out
+        base = r.array() if isinstance(r, ShiftedResidual) else r
+        column = self.columns[:, j]
+        return float(shifted_absolute_total(base, column, float(delta), self.row_weights)), ShiftedResidual(base, column, float(delta))
+
+
+class ShiftedResidual:
+    """``r - delta·column``, written on first use (:meth:`LinearAbsoluteObjective.move`).
+
+    Parameters
+    ----------
+    r : (M,) array
+    column : (M,) array
+    delta : float
+    """
+
+    __slots__ = ("_r", "_column", "_delta", "_array")
+
+    def __init__(self, r: np.ndarray, column: np.ndarray, delta: float):
+        self._r: np.ndarray | None = r
+        self._column: np.ndarray | None = column
+        self._delta = delta
+        self._array: np.ndarray | None = None
+
+    def array(self) -> np.ndarray:
+        """The residual (written once, then kept).
+
+        Returns
+        -------
+        (M,) array
+        """
+        if self._array is None:
+            from ._objective_kernel import shifted
+
+            assert self._r is not None and self._column is not None
+            out = np.empty_like(self._r)
+            shifted(self._r, self._column, self._delta, out)
+            self._array, self._r, self._column = out, None, None  # the candidate's own residual: the inputs let go
+        return self._array
 
 
 class Estimator:
