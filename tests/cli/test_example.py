@@ -85,3 +85,20 @@ def test_results_refuse_a_description_whose_kinematics_changed(tmp_path, monkeyp
     assert same.kinematic_fingerprint() == robot.kinematic_fingerprint() == from_urdf.kinematic_fingerprint()
     assert dynid.load_robot(urdf).kinematic_fingerprint() != robot.kinematic_fingerprint()
     assert dynid.load_robot("tx40").kinematic_fingerprint() != robot.kinematic_fingerprint()
+
+
+def test_identify_into_the_folder_of_the_users_urdf_leaves_the_urdf_as_it_was(tmp_path, monkeypatch):
+    """--out . where the config's URDF lives: the written-back model is ur10e-identified.urdf, the user's file is not
+    replaced."""
+    monkeypatch.chdir(tmp_path)
+    assert run("example", "ur10e", "try", "-q").returncode == 0
+    users = (tmp_path / "try" / "ur10e.urdf").read_text()
+    assert not (tmp_path / "try" / ".dynid-manifest.json").exists()  # the user's files, not a run's outputs
+    monkeypatch.chdir(tmp_path / "try")
+    for _ in range(2):  # the second run replaces the first's outputs, never the user's files
+        p = run("identify", "ur10e.toml", "--out", ".", "--no-figures", "-q")
+        assert p.returncode == 0, p.stderr
+    assert (tmp_path / "try" / "ur10e.urdf").read_text() == users
+    assert (tmp_path / "try" / "identification.csv").is_file() and (tmp_path / "try" / "ur10e.toml").is_file()
+    written = (tmp_path / "try" / "ur10e-identified.urdf").read_text()
+    assert written != users and "written by dynid into ur10e.urdf" in written

@@ -276,9 +276,11 @@ def identify(
         return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate), cfg.urdf
 
     def save(identified):
-        from ..report.identification_run import save_identification
+        from ..report.identification_run import model_file_name, save_identification
 
-        return save_identification(identified[1], out, figures, robot=identified[0], urdf=identified[2])
+        urdf = identified[2]
+        return save_identification(identified[1], out, figures, robot=identified[0], urdf=urdf,
+                                   urdf_name=None if urdf is None else model_file_name(urdf, out))
 
     def show(rep, identified, paths):
         from ..report.summaries import identification_brief

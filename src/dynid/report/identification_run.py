@@ -59,7 +59,7 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 
 @staged
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None,
-                        urdf: str | Path | None = None) -> list[Path]:
+                        urdf: str | Path | None = None, urdf_name: str | None = None) -> list[Path]:
     """Write an identification's results and figures.
 
     ``results.json``, ``report.html``, the identification fit figure and one figure per validation dataset; with
@@ -79,6 +79,9 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         The identified robot, for the exports.
     urdf : str or Path, optional
         The URDF the robot was read from (:attr:`dynid.io.identification_config.IdentificationConfig.urdf`).
+    urdf_name : str, optional
+        The written-back URDF's file name (default the user's; :func:`model_file_name` keeps a user's URDF in the
+        output folder from being replaced).
 
     Returns
     -------
@@ -113,11 +116,31 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         if urdf is None:
             model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
         else:
-            model = (out / Path(urdf).name, urdf_written_back(urdf, fitted, phi)[0])
+            model = (out / (urdf_name or Path(urdf).name), urdf_written_back(urdf, fitted, phi)[0])
         paths[:0] = [model[0], out / "dynid-model.xml"]
         atomic_write_text(model[0], model[1])
         atomic_write_text(paths[1], mjcf_from_robot(fitted, phi))
     return [json_path] + paths
+
+
+def model_file_name(urdf: str | Path, out: str | Path) -> str:
+    """The written-back URDF's name in the output folder ``out``: the user's file name, or ``<stem>-identified.urdf``
+    when the user's URDF is itself in ``out`` (it is never replaced).
+
+    Parameters
+    ----------
+    urdf : str or Path
+        The user's URDF.
+    out : str or Path
+        The output folder.
+
+    Returns
+    -------
+    str
+    """
+    urdf = Path(urdf)
+    same = (Path(out) / urdf.name).resolve() == urdf.resolve()
+    return f"{urdf.stem}-identified.urdf" if same else urdf.name
 
 
 @staged

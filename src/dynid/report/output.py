@@ -383,16 +383,17 @@ def write_results(path: Path, data: dict, kind: str) -> None:
     write_json(path, {"schema_version": SCHEMA_VERSION, "dynid_version": __version__, "kind": kind, **data})
 
 
-@staged
 def save_texts(files: dict[str, str], out: str | Path) -> list[Path]:
-    """Write text files into an output folder through a staging folder (:func:`staged`): all of them or none.
+    """Write text files into a folder, all of them or none (through a staging folder inside it), with no manifest:
+    they are a user's files (``dynid example``), which a later run writing into the same folder never removes
+    (:func:`staged` removes an earlier run's files listed in its manifest).
 
     Parameters
     ----------
     files : dict
         File name (in ``out``) -> text (UTF-8).
     out : str or Path
-        Output folder.
+        The folder (created if needed).
 
     Returns
     -------
@@ -406,7 +407,13 @@ def save_texts(files: dict[str, str], out: str | Path) -> list[Path]:
     """
     from ..io import atomic_write_text
 
-    out = Path(out)
-    for name, text in files.items():
-        atomic_write_text(out / name, text)
+    out = output_folder(out)
+    stage = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{_owner()}-", dir=out))
+    try:
+        for name, text in files.items():
+            atomic_write_text(stage / name, text)
+        for name in files:
+            os.replace(stage / name, out / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
     return [out / name for name in files]
