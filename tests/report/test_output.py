@@ -224,3 +224,22 @@ def test_the_report_holds_every_finding_and_warning_the_terminal_printed(tmp_pat
     for w in results["warnings"] + [x for v in results["validation"] for x in v.get("flags", [])]:
         assert w in section
     assert 'href="#warnings">Findings and warnings' in page and "see Findings and warnings below" in page
+
+
+def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
+    """The "main estimate" line of ``dynid identify`` read "…; dynid export writes dynid SDP, which is" and stopped
+    (found on a zoo log where WLS is the main estimate): the sentence now ends by saying why export writes it."""
+    from types import SimpleNamespace
+
+    from dynid.report.summaries import in_short
+
+    empty_log = SimpleNamespace(name="identification", metrics=lambda: {})
+    result = SimpleNamespace(
+        main_estimate=SimpleNamespace(label="dynid WLS"),
+        consistency_verdicts={"dynid WLS": "no: link 2's inertia", "dynid SDP": "yes"},
+        estimates={"dynid WLS": SimpleNamespace(standard=None), "dynid SDP": SimpleNamespace(standard=np.zeros(3))},
+        fit=empty_log, validations=[], findings=[], estimators=["wls", "sdp"],
+        solution=SimpleNamespace(from_prior=[], relative_std=[]), base=SimpleNamespace(names=[]))
+    lines = [line.text for line in in_short(result)]
+    assert lines[1] == ("main estimate: dynid WLS, not physically consistent; dynid export writes dynid SDP, which is "
+                        "physically consistent")

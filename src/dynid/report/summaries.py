@@ -370,7 +370,7 @@ def in_short(result) -> list:
     verdict = r.consistency_verdicts.get(label, "")
     consistent = verdict.startswith("yes")
     exportable = _exportable(r)
-    export = "" if not exportable or consistent else f"; dynid export writes {exportable[0]}, which is"
+    export = "" if not exportable or consistent else f"; dynid export writes {exportable[0]}, which is physically consistent"
     out = [Line("In short (the details follow)", "title"),
            Line(f"main estimate: {label}" + ("" if not verdict else
                                              ", physically consistent" if consistent else
