@@ -47,6 +47,11 @@ def test_a_short_log_with_joints_that_move_one_way_identifies(tmp_path):
     assert abs(values["fc3"]["value"] + values["offset3"]["value"] - f_plus[2]) < 0.1 * f_plus[2]
     metrics = results["validation"][0]["metrics"]
     assert metrics["dynid WLS"]["global_relative_error"] < metrics["nominal"]["global_relative_error"]
+    # the cutoffs' cross-validation fits its folds as the estimate is fitted (undetermined directions at the nominal
+    # values): it refused every fold of such a log, scored every candidate inf and still said "chosen by cross-validation"
+    cv = results["settings"]["preprocessing_cross_validation"]
+    assert len(cv["candidates"]) == 3 and all(s is not None and s > 0 for s in cv["score"]), cv
+    assert cv["chosen"] in (0, int(np.argmin(cv["score"])))  # the rule's cutoff unless another scores clearly better
 
 
 def _worse(results, label):

@@ -243,3 +243,18 @@ def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
     lines = [line.text for line in in_short(result)]
     assert lines[1] == ("main estimate: dynid WLS, not physically consistent; dynid export writes dynid SDP, which is "
                         "physically consistent")
+
+
+def test_a_cutoff_candidate_not_scored_shows_a_dash_not_inf():
+    """A candidate whose folds could not be fitted is stored as null in results.json: the table shows "—" (it
+    showed "inf" in every cell, under a title that said the cutoffs were chosen by cross-validation)."""
+    from dynid.report.summaries import filter_choice_table
+    from dynid.tables import render_text
+
+    cv = {"chosen": 0, "candidates": [{"position_cutoff": 10.0, "parallel_cutoff": 10.0, "decimation": 39},
+                                      {"position_cutoff": 18.1, "parallel_cutoff": 18.1, "decimation": 22}],
+          "out_of_fold_rms_error": [[None, None], [0.25, float("inf")]], "score": [None, 0.5]}
+    text = render_text([filter_choice_table(cv)], 200)
+    assert "inf" not in text and "None" not in text
+    rows = [line.split() for line in text.splitlines() if line.strip().startswith(("10*", "18.1"))]
+    assert rows == [["10*", "10", "39", "—", "—", "—"], ["18.1", "18.1", "22", "0.25", "—", "0.5"]]

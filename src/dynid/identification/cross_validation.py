@@ -260,6 +260,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     cutoffs = (default, float(np.sqrt(default * knee)), knee)
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
+    prior = base.base_from_standard(robot.standard_parameters())  # as the estimate: undetermined directions kept there
     candidates, errors, prepared = [], [], []
     for f in cutoffs:
         cutoff = capped(f, recording.rate)
@@ -271,7 +272,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
         sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
         try:
             for k in range(folds):
-                params = LeastSquaresAccumulator.merged([a for i, a in enumerate(fitted) if i != k]).solve().params
+                params = LeastSquaresAccumulator.merged([a for i, a in enumerate(fitted) if i != k]).solve(prior=prior).params
                 sumsq += evaluation[k].joint_residual_sumsq(params)
                 rows += evaluation[k].rows
             errors.append(np.sqrt(sumsq / np.maximum(rows, 1)))
@@ -282,11 +283,14 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
     best = int(np.argmin(score))
-    if score[best] > (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
+    if not score[best] <= (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
         best = 0
-    note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among "
-            f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz ({POSITION_FACTOR:g}× the band, the noise knee and their geometric mean)"
-            + ("" if recording is full else f" on the log's middle {recording.n_samples} samples"))
+    among = f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz ({POSITION_FACTOR:g}× the band, the noise knee and their geometric mean)"
+    note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among {among}"
+            if np.all(np.isfinite(score)) else
+            f"cutoffs {cutoffs[0]:.3g} Hz ({POSITION_FACTOR:g}× the band): not cross-validated among {among}, as a fold "
+            f"of {duration / folds:.3g} s holds too few rows to fit the {base.n_base} base parameters on the others")
+    note += "" if recording is full else f" on the log's middle {recording.n_samples} samples"
     data = prepared[best]
     if recording is not full:
         chosen = candidates[best]

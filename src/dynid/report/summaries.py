@@ -420,6 +420,11 @@ def in_short(result) -> list:
     return out
 
 
+def _number(x) -> str:
+    """A figure of a table, "—" for one that was not computed (None or not finite in results.json)."""
+    return f"{x:.4g}" if x is not None and np.isfinite(x) else "—"
+
+
 def filter_choice_table(cv: dict) -> TextTable:
     """``preprocessing.auto``: each candidate's cutoffs and out-of-fold errors on the common held-out samples.
 
@@ -434,7 +439,7 @@ def filter_choice_table(cv: dict) -> TextTable:
     """
     n = len(cv["out_of_fold_rms_error"][0])
     rows = tuple((f"{c['position_cutoff']:.3g}{'*' if i == cv['chosen'] else ''}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
-                  *(f"{x:.4g}" for x in e), f"{s:.4g}")
+                  *(_number(x) for x in e), _number(s))
                  for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
     return TextTable("Cutoffs by cross-validation: out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
                      ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
