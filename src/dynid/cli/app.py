@@ -273,14 +273,15 @@ def identify(
         return cfg
 
     def compute(cfg, progress):
-        return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate), cfg.urdf
+        return cfg.robot, run_identification(cfg, progress=_steps(progress), validate=validate), cfg
 
     def save(identified):
         from ..report.identification_run import model_file_name, save_identification
 
-        urdf = identified[2]
+        urdf, mjcf = identified[2].urdf, identified[2].mjcf_model
         return save_identification(identified[1], out, figures, robot=identified[0], urdf=urdf,
-                                   urdf_name=None if urdf is None else model_file_name(urdf, out))
+                                   urdf_name=None if urdf is None else model_file_name(urdf, out), mjcf_model=mjcf,
+                                   mjcf_name=None if mjcf is None else model_file_name(mjcf, out), mjcf_folder=out)
 
     def show(rep, identified, paths):
         from ..report.summaries import identification_brief
@@ -353,13 +354,16 @@ def export(
     results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json written by dynid identify."),
     urdf: Path | None = typer.Option(None, help="URDF file to write (inertials and joint friction of the physically consistent estimate)."),
     mjcf: Path | None = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
-    mjcf_model: Path | None = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept)."),
+    mjcf_model: Path | None = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept). Default: the config's mjcf_model."),
     data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     quiet: bool = QUIET,
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
     from ..exceptions import DataError
     from ..io.identification_config import load_identification_config
+
+    def _users_mjcf(cfg):  # the model --mjcf writes into: --mjcf-model, else the config's mjcf_model
+        return mjcf_model if mjcf_model is not None else cfg.mjcf_model
 
     def prepare():
         cfg = load_identification_config(config, data_root)
@@ -395,10 +399,11 @@ def export(
             return text
 
         def mjcf_text(robot, identified, source):
-            if mjcf_model is None:
+            users = _users_mjcf(cfg)
+            if users is None:
                 return mjcf_from_results(robot, identified, source)
             fitted, phi = consistent_estimate(robot, identified, source)
-            text, far = mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf.parent if mjcf else None)
+            text, far = mjcf_written_back(users, fitted, phi, out_dir=mjcf.parent if mjcf else None)
             moved.extend(far)
             return text
 
@@ -417,7 +422,7 @@ def export(
         robot = cfg.robot
         into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
-            ("MJCF", mjcf_model.name if mjcf_model else "", mjcf_model is not None)) if given)
+            ("MJCF", getattr(_users_mjcf(cfg), "name", ""), _users_mjcf(cfg) is not None and mjcf is not None)) if given)
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
         from ..io.export import nominal_warning

@@ -118,6 +118,10 @@ class IdentificationConfig:
     urdf : Path or None
         The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
+    mjcf_model : Path or None
+        ``mjcf_model``: the user's own MuJoCo model of the arm, checked against the robot's joints
+        (:func:`dynid.io.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
+        values into a copy of it.
     closed_loop : tuple of str
         Closed-loop estimators asked for in ``[estimation] estimators`` (IDIM-IV, DIDIM), run beside the others.
     controller : tuple or None
@@ -138,6 +142,7 @@ class IdentificationConfig:
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
     sdp_prior: str = "euclidean"  # [estimation] sdp_prior: "euclidean" or "geometric"
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
+    mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
     closed_loop: tuple[str, ...] = ()  # IDIM-IV / DIDIM asked for, run beside the estimators
     controller: tuple | None = None  # (Controller, reference DatasetSpec, feed-forward) of [controller]
 
@@ -319,10 +324,31 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     refs = doc.get("references", [])
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
+    urdf = config_urdf(doc, path, root)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
-                                urdf=config_urdf(doc, path, root), sdp_prior=e.sdp_prior or "euclidean",
-                                closed_loop=closed_loop, controller=controller)
+                                urdf=urdf, sdp_prior=e.sdp_prior or "euclidean", closed_loop=closed_loop,
+                                controller=controller, mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path))
+
+
+def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: Path) -> Path | None:
+    """``mjcf_model``, relative to the config's folder, checked now against the robot's joints (one line: no such
+    file, not MJCF, a joint missing or not a hinge, MuJoCo not installed)."""
+    if given is None:
+        return None
+    file = here / given  # an absolute path stays as is
+    if not file.is_file():
+        raise ConfigError(f"{path}: mjcf_model: no such file {file}", field="mjcf_model")
+    if urdf is not None and urdf.name == file.name:
+        raise ConfigError(f"{path}: mjcf_model: {file.name} is also the URDF's file name, and identify writes both into "
+                          "one folder: give the MJCF another name", field="mjcf_model")
+    from .mjcf_write_back import read_users_mjcf
+
+    try:
+        read_users_mjcf(file, robot)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: mjcf_model: {exc}", field="mjcf_model") from None
+    return file
 
 
 def _controller(table, root: Path, where: str, n: int):

@@ -206,7 +206,8 @@ def read_users_mjcf(path: Path, robot: Robot):
     for joint in robot.joints:
         k = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name)
         if k < 0:
-            raise ConfigError(f"{path}: has no joint {joint.name!r}: the results are of another robot than this MJCF's")
+            raise ConfigError(f"{path}: has no joint {joint.name!r}: the robot identified (joints "
+                              f"{', '.join(j.name for j in robot.joints)}) is another than this MJCF's")
         if model.jnt_type[k] != mujoco.mjtJoint.mjJNT_HINGE:
             raise ConfigError(f"{path}: joint {joint.name!r} is not a hinge, the robot's joint is revolute")
         if joint.name not in named:

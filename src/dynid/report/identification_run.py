@@ -59,14 +59,18 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 
 @staged
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None,
-                        urdf: str | Path | None = None, urdf_name: str | None = None) -> list[Path]:
+                        urdf: str | Path | None = None, urdf_name: str | None = None,
+                        mjcf_model: str | Path | None = None, mjcf_name: str | None = None,
+                        mjcf_folder: str | Path | None = None) -> list[Path]:
     """Write an identification's results and figures.
 
     ``results.json``, ``report.html``, the identification fit figure and one figure per validation dataset; with
     ``robot`` (the identified robot), when the physically consistent estimate passed the consistency check, the model
     to use: the user's own URDF with the identified values written into it (``urdf``: the same file name, only its
     ``<inertial>`` and ``<dynamics>`` values changed, :func:`dynid.io.urdf_write_back.urdf_written_back`) or, for a
-    robot described otherwise, ``dynid-model.urdf`` of dynid's own naming; and ``dynid-model.xml`` (MJCF).
+    robot described otherwise, ``dynid-model.urdf`` of dynid's own naming; and the MJCF: the user's own MuJoCo model
+    with the identified values written into it (``mjcf_model``, :func:`dynid.io.mjcf_write_back.mjcf_written_back`)
+    or ``dynid-model.xml``.
 
     Parameters
     ----------
@@ -82,6 +86,13 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     urdf_name : str, optional
         The written-back URDF's file name (default the user's; :func:`model_file_name` keeps a user's URDF in the
         output folder from being replaced).
+    mjcf_model : str or Path, optional
+        The user's own MJCF of the arm (:attr:`dynid.io.identification_config.IdentificationConfig.mjcf_model`).
+    mjcf_name : str, optional
+        The written-back MJCF's file name (default the user's; :func:`model_file_name`).
+    mjcf_folder : str or Path, optional
+        The folder the MJCF ends up in, from which its relative paths (meshes, includes) are rewritten (default
+        ``out``; the command's output folder when ``out`` is a staging folder inside it).
 
     Returns
     -------
@@ -110,6 +121,7 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp[0]) == "yes":
         from ..io import atomic_write_text
         from ..io.export import consistent_estimate, mjcf_from_robot, urdf_from_robot
+        from ..io.mjcf_write_back import mjcf_written_back
         from ..io.urdf_write_back import urdf_written_back
 
         fitted, phi = consistent_estimate(robot, data)
@@ -117,20 +129,25 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
             model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
         else:
             model = (out / (urdf_name or Path(urdf).name), urdf_written_back(urdf, fitted, phi)[0])
-        paths[:0] = [model[0], out / "dynid-model.xml"]
-        atomic_write_text(model[0], model[1])
-        atomic_write_text(paths[1], mjcf_from_robot(fitted, phi))
+        if mjcf_model is None:
+            mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi))
+        else:
+            mjcf = (out / (mjcf_name or Path(mjcf_model).name),
+                    mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out)[0])
+        paths[:0] = [model[0], mjcf[0]]
+        for path, text in (model, mjcf):
+            atomic_write_text(path, text)
     return [json_path] + paths
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:
-    """The written-back URDF's name in the output folder ``out``: the user's file name, or ``<stem>-identified.urdf``
-    when the user's URDF is itself in ``out`` (it is never replaced).
+    """A written-back model's name in the output folder ``out``: the user's file name, or ``<stem>-identified<ext>``
+    (``arm-identified.urdf``, ``arm-identified.xml``) when the user's file is itself in ``out`` (it is never replaced).
 
     Parameters
     ----------
     urdf : str or Path
-        The user's URDF.
+        The user's URDF or MJCF.
     out : str or Path
         The output folder.
 
@@ -140,7 +157,7 @@ def model_file_name(urdf: str | Path, out: str | Path) -> str:
     """
     urdf = Path(urdf)
     same = (Path(out) / urdf.name).resolve() == urdf.resolve()
-    return f"{urdf.stem}-identified.urdf" if same else urdf.name
+    return f"{urdf.stem}-identified{urdf.suffix}" if same else urdf.name
 
 
 @staged
