@@ -6,6 +6,7 @@ import pytest
 
 from dynid.estimators import Estimator, check_estimator, register, unregister
 from dynid.estimators import registry as reg
+from dynid.estimators.base import weighted_rows
 from dynid.estimators.checks import EstimatorCheckError
 
 BASE_SPACE = [k for k in reg.keys() if reg.spec(k).space == "base"]
@@ -28,8 +29,21 @@ class _LeastSquares(Estimator):
     def solution(self, w, tau):
         return np.linalg.lstsq(w, np.asarray(tau, dtype=float).reshape(-1), rcond=None)[0]
 
+    def fit(self, w, tau, sample_weight=None):
+        self.params_ = self.solution(*weighted_rows(w, tau, sample_weight, 0.5))
+        return self
+
+
+class _NoSampleWeight(_LeastSquares):
     def fit(self, w, tau):
         self.params_ = self.solution(w, tau)
+        return self
+
+
+class _WeightsMisread(_LeastSquares):
+    def fit(self, w, tau, sample_weight=None):  # the weights taken as the row scale of an absolute loss
+        self.params_ = self.solution(*weighted_rows(w, tau, None if sample_weight is None else 2 * sample_weight, 1.0))
+        self.params_ = self.params_ * (1.0 if sample_weight is None else 1.001)
         return self
 
 
@@ -74,6 +88,8 @@ class _BoxCentre(Estimator):
     (_InPlace, False, "fit changed the W or tau it was given"),
     (_WrongLength, False, r"fit failed on a well-posed problem: .*returned parameters of shape \(5,\), expected \(6,\)"),
     (_BoxCentre, True, "did not improve eq. 9 on the box's centre"),
+    (_NoSampleWeight, False, r"fit takes no sample_weight: the contract is fit\(W, tau, sample_weight=None\)"),
+    (_WeightsMisread, False, "sample_weight of ones gave other parameters than no sample_weight"),
 ])
 def test_each_check_catches_the_estimator_that_breaks_it(cls, box, said):
     register("checked", cls, needs_box=box, replace=True)

@@ -3,16 +3,17 @@ for dynid identify, run, montecarlo and Identifier to use it."""
 
 import numpy as np
 
-from dynid.estimators import Estimator, register
+from dynid.estimators import Estimator, register, weighted_rows
 
 
 class Ridge(Estimator):
-    """``argmin ||τ - W p||² + α·(mean squared column norm)·||p||²`` (Tikhonov)."""
+    """``argmin Σ s_i (τ_i - W_i p)² + α·(mean squared column norm)·||p||²`` (Tikhonov)."""
 
     def __init__(self, *, alpha: float = 1e-9):
         self.alpha = alpha
 
-    def fit(self, w, tau):
+    def fit(self, w, tau, sample_weight=None):
+        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
         w = np.asarray(w, dtype=float)
         tau = np.asarray(tau, dtype=float).reshape(-1)
         gram = w.T @ w

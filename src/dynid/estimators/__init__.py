@@ -7,7 +7,7 @@ the classes load on first use, so that reading method names (a config check) imp
 from .._lazy import lazy_exports
 
 _EXPORTS = {
-    "Estimator": "base", "BoxSearchEstimator": "base", "paper_objective": "base",
+    "Estimator": "base", "BoxSearchEstimator": "base", "paper_objective": "base", "weighted_rows": "base",
     "BeeColonyEstimator": "bee_colony",
     "BootstrapIntervals": "bootstrap", "bootstrap_intervals": "bootstrap",
     "DifferentialEvolutionEstimator": "global_search", "ParticleSwarmEstimator": "global_search",

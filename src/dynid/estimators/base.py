@@ -40,6 +40,47 @@ def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np
     return w, tau
 
 
+def weighted_rows(w, tau, sample_weight, power: float):
+    """The rows of ``(W, tau)`` scaled for a fit with sample weights (scikit-learn's ``sample_weight``).
+
+    A least-squares fit of the scaled rows minimises ``Σ s_i r_i²`` when each row is scaled by ``√s_i`` (``power``
+    0.5); a fit of the sum of absolute residuals (eq. 9) minimises ``Σ s_i |r_i|`` when it is scaled by ``s_i``
+    (``power`` 1). A weight of 2 is then the row given twice, 0 the row left out (its zero row stays).
+
+    Parameters
+    ----------
+    w : (M, p) array
+    tau : (M,) or (N, n_dof) array [N·m]
+    sample_weight : (M,) or (N, n_dof) array, or None
+        One weight ≥ 0 per row of ``W`` (or per torque, shaped as ``tau``); None: ``w, tau`` returned as given.
+    power : float
+        0.5 for a squared loss, 1 for an absolute one.
+
+    Returns
+    -------
+    w : (M, p) array
+    tau : array shaped as given
+
+    Raises
+    ------
+    ShapeError
+        Weights of another shape than one per row, or weights that are negative, NaN or infinite.
+    """
+    if sample_weight is None:
+        return w, tau
+    w = np.asarray(w, dtype=np.float64)
+    tau = np.asarray(tau, dtype=np.float64)
+    s = np.asarray(sample_weight, dtype=np.float64)
+    if w.ndim != 2 or s.size != w.shape[0] or s.shape not in ((w.shape[0],), tau.shape):
+        raise ShapeError(f"sample_weight: expected one weight per row of W, shape ({w.shape[0] if w.ndim == 2 else '?'},) "
+                         f"or {tau.shape} as tau, got {s.shape}")
+    s = s.reshape(-1)
+    if not np.all(np.isfinite(s)) or np.any(s < 0):
+        raise ShapeError("sample_weight: expected finite weights >= 0, got negative, NaN or infinite ones")
+    factor = np.sqrt(s) if power == 0.5 else s**power
+    return w * factor[:, None], (tau.reshape(-1) * factor).reshape(tau.shape)
+
+
 def paper_objective(residual: np.ndarray, n_dof: int, weights: np.ndarray | None = None) -> np.ndarray:
     """Objective ``F`` of eq. 9: ``(1/N) sum_i sum_j delta_j |tau_ji - tau_pji|``.
 
@@ -269,7 +310,10 @@ class Estimator:
         """
         return type(self)(**self.get_params())
 
-    def fit(self, w, tau):  # pragma: no cover - abstract
+    loss_power = 0.5
+    """How ``sample_weight`` scales the rows (:func:`weighted_rows`): 0.5 for a squared loss, 1 for eq. 9's absolute one."""
+
+    def fit(self, w, tau, sample_weight=None):  # pragma: no cover - abstract
         """Fit the parameters to an observation matrix and torques (each estimator's own method).
 
         Parameters
@@ -277,6 +321,8 @@ class Estimator:
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row (:func:`weighted_rows`): 2 counts a row twice, 0 leaves it out.
 
         Returns
         -------
@@ -335,7 +381,7 @@ class AccumulatingEstimator(Estimator):
     needs_joints = False
     """Whether the estimator weighs the joints' rows apart (then ``n_dof`` or ``tau`` as (N, n_dof) is required)."""
 
-    def partial_fit(self, w, tau, mask=None, *, names=None) -> AccumulatingEstimator:
+    def partial_fit(self, w, tau, mask=None, *, names=None, sample_weight=None) -> AccumulatingEstimator:
         """Fold rows into the estimate.
 
         Parameters
@@ -348,6 +394,8 @@ class AccumulatingEstimator(Estimator):
             Rows to use (e.g. those fast enough).
         names : sequence of str, optional
             The parameters' names (said when the data do not excite some of them).
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the squared loss (:func:`weighted_rows`).
 
         Returns
         -------
@@ -360,6 +408,7 @@ class AccumulatingEstimator(Estimator):
         """
         from .accumulate import LeastSquaresAccumulator
 
+        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
         w = np.asarray(w, dtype=np.float64)
         if w.ndim != 2:
             raise ShapeError(f"expected W with shape (N*n_dof, n_params), got {w.shape}")
@@ -379,18 +428,21 @@ class AccumulatingEstimator(Estimator):
         acc.add(w, tau, mask)
         return self
 
-    def fit(self, w, tau):
+    def fit(self, w, tau, sample_weight=None):
         """Fit on all rows at once: ``partial_fit`` on a fresh accumulator, then :meth:`solve`.
 
         Parameters
         ----------
         w : (M, p) array
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the squared loss (:func:`weighted_rows`).
 
         Returns
         -------
         self
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
         w, tau_flat = check_observations(w, tau, self.n_dof)
         self.__dict__.pop("accumulator_", None)
         self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat)
@@ -444,6 +496,7 @@ class BoxSearchEstimator(Estimator):
     bounds: object
     n_dof: int | None
     weights: object
+    loss_power = 1.0  # eq. 9: sample_weight multiplies each absolute residual
 
     def _objectives(self, w, tau):
         """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""

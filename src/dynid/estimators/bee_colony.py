@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..optim.bee_colony import minimize_bee_colony
-from .base import BoxSearchEstimator
+from .base import BoxSearchEstimator, weighted_rows
 
 
 class BeeColonyEstimator(BoxSearchEstimator):
@@ -42,7 +42,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> BeeColonyEstimator:
+    def fit(self, w, tau, sample_weight=None) -> BeeColonyEstimator:
         """Search the box for the minimum of eq. 9 with the artificial bee colony (§3.1).
 
         Parameters
@@ -50,6 +50,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
@@ -60,6 +62,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
         bounds, objective = self._objectives(w, tau)
         res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)

@@ -11,7 +11,8 @@ holds the truth off its centre. What is checked:
   searches (``needs_box``) end inside the box, with eq. 9 below its value at the box's centre;
 * the same ``rng`` gives the same parameters (dynid's results are reproducible);
 * it leaves ``W`` and ``τ`` as they were;
-* ``get_params`` returns the constructor's parameters (:meth:`dynid.estimators.base.Estimator.get_params`).
+* ``get_params`` returns the constructor's parameters (:meth:`dynid.estimators.base.Estimator.get_params`);
+* ``fit(W, tau, sample_weight=None)`` (scikit-learn's contract): weights of one give the estimate without weights.
 
 Estimators of the standard parameters (``space = "standard"``, e.g. ``sdp``) need a robot's parameter layout, which
 the estimators do not see: they are checked by dynid's tests on a robot, not here.
@@ -117,5 +118,27 @@ def check_estimator(key: str, seed: int = 0) -> None:
     else:
         if not isinstance(params_given, dict):
             failures.append("get_params did not return a dict")
+    failures += _sample_weight_failures(first.estimator, w, tau, seed)
     if failures:
         raise EstimatorCheckError(f"{entry.key}: " + "; ".join(failures))
+
+
+def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int) -> list[str]:
+    """Refit a clone of ``fitted`` without weights and with weights of one (the same ``rng`` seed, if it has one):
+    the same parameters, or the failure in words."""
+    import inspect
+
+    if "sample_weight" not in inspect.signature(fitted.fit).parameters:
+        return ["fit takes no sample_weight: the contract is fit(W, tau, sample_weight=None) (one weight >= 0 per row)"]
+    fits = []
+    for weights in (None, np.ones(tau.shape[0])):
+        est = fitted.clone()
+        if "rng" in est.get_params():
+            est.set_params(rng=np.random.default_rng([seed, 13]))
+        try:
+            fits.append(np.asarray(est.fit(w, tau, sample_weight=weights).params_, dtype=float))
+        except Exception as exc:  # noqa: BLE001  any failure is the check's finding
+            return [f"fit(W, tau, sample_weight=...) failed: {type(exc).__name__}: {exc}"]
+    if not np.allclose(fits[0], fits[1], rtol=1e-9, atol=1e-12 * (1.0 + np.abs(fits[0]).max())):
+        return ["sample_weight of ones gave other parameters than no sample_weight"]
+    return []

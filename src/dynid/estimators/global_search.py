@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ..optim.particle_swarm import minimize_particle_swarm
-from .base import BoxSearchEstimator
+from .base import BoxSearchEstimator, weighted_rows
 
 
 class DifferentialEvolutionEstimator(BoxSearchEstimator):
@@ -55,7 +55,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> DifferentialEvolutionEstimator:
+    def fit(self, w, tau, sample_weight=None) -> DifferentialEvolutionEstimator:
         """Search the box for the minimum of eq. 9 by differential evolution.
 
         Parameters
@@ -63,6 +63,8 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
@@ -73,6 +75,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
         bounds, objective = self._objectives(w, tau)
         history = []
         evaluations = 0
@@ -129,7 +132,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau) -> ParticleSwarmEstimator:
+    def fit(self, w, tau, sample_weight=None) -> ParticleSwarmEstimator:
         """Search the box for the minimum of eq. 9 by particle swarm optimisation.
 
         Parameters
@@ -137,6 +140,8 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
@@ -147,6 +152,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
         bounds, objective = self._objectives(w, tau)
         res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
                                       rng=self.rng, callback=self.callback)

@@ -6,7 +6,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..exceptions import DynIdError, ShapeError
-from .base import Estimator, check_observations, infer_n_dof, paper_objective
+from .base import Estimator, check_observations, infer_n_dof, paper_objective, weighted_rows
 
 
 class LeastAbsoluteDeviations(Estimator):
@@ -45,12 +45,14 @@ class LeastAbsoluteDeviations(Estimator):
         If HiGHS reports the problem infeasible or fails.
     """
 
+    loss_power = 1.0  # eq. 9: sample_weight multiplies each absolute residual
+
     def __init__(self, *, n_dof: int | None = None, weights=None, bounds=None):
         self.n_dof = n_dof
         self.weights = weights
         self.bounds = bounds
 
-    def fit(self, w, tau) -> LeastAbsoluteDeviations:
+    def fit(self, w, tau, sample_weight=None) -> LeastAbsoluteDeviations:
         """Minimise the weighted sum of absolute residuals (eq. 9) as a linear programme, within the box if given.
 
         Parameters
@@ -58,6 +60,8 @@ class LeastAbsoluteDeviations(Estimator):
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
@@ -68,6 +72,7 @@ class LeastAbsoluteDeviations(Estimator):
         ShapeError
             Wrong shapes, or bounds that are not (p, 2).
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
         self.n_dof_ = infer_n_dof(self.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..exceptions import DynIdError, ShapeError
 from ..model.spatial import pseudo_inertia
-from .base import AccumulatingEstimator, check_observations
+from .base import AccumulatingEstimator, check_observations, weighted_rows
 
 CONSISTENCY_TOL = 1e-7
 """Base parameters count as physically consistent when their :func:`consistency_margin` is >= -1e-7
@@ -83,7 +83,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         self.n_dof = n_dof
         self.joint_weights = joint_weights
 
-    def fit(self, w, tau) -> PhysicallyConsistentLeastSquares:
+    def fit(self, w, tau, sample_weight=None) -> PhysicallyConsistentLeastSquares:
         """Solve the SDP on all rows at once (their QR factor).
 
         Parameters
@@ -91,11 +91,14 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         w : (M, p) array
             Standard observation matrix.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the squared loss (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
         self
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
         self.__dict__.pop("accumulator_", None)
         self._fit_rows(w, tau)
         self.__dict__["_solved"] = True

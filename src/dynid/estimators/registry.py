@@ -262,8 +262,10 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
     >>> class Ridge(Estimator):
     ...     def __init__(self, *, alpha=1e-3):
     ...         self.alpha = alpha
-    ...     def fit(self, w, tau):
+    ...     def fit(self, w, tau, sample_weight=None):
     ...         import numpy as np
+    ...         from dynid.estimators import weighted_rows
+    ...         w, tau = weighted_rows(w, tau, sample_weight, 0.5)
     ...         self.params_ = np.linalg.solve(w.T @ w + self.alpha * np.eye(w.shape[1]), w.T @ tau)
     ...         return self
     >>> spec = register("ridge", Ridge, description="ridge regression")

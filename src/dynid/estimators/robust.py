@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..exceptions import ConfigError, IdentifiabilityError
-from .base import Estimator, check_observations, infer_n_dof
+from .base import Estimator, check_observations, infer_n_dof, weighted_rows
 
 HUBER_C = 1.345
 MAD_TO_STD = 1.4826
@@ -58,7 +58,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         self.max_iter = max_iter
         self.tol = tol
 
-    def fit(self, w, tau) -> IterativelyReweightedLeastSquares:
+    def fit(self, w, tau, sample_weight=None) -> IterativelyReweightedLeastSquares:
         """Huber M-estimate by iteratively reweighted least squares, with its sandwich covariance.
 
         Parameters
@@ -66,6 +66,8 @@ class IterativelyReweightedLeastSquares(Estimator):
         w : (M, p) array
             Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
         tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the squared loss (:func:`dynid.estimators.base.weighted_rows`).
 
         Returns
         -------
@@ -78,6 +80,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         IdentifiabilityError
             No more rows than parameters.
         """
+        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
         if not self.tuning > 0:
             raise ConfigError(f"IRLS tuning constant must be positive, got {self.tuning}")
         self.n_dof_ = infer_n_dof(self.n_dof, tau)

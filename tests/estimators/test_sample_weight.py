@@ -1,0 +1,56 @@
+"""``fit(W, tau, sample_weight=None)``, scikit-learn's contract (issue "Re-zone the top floors", item 6): a weight of 2
+is the row given twice and 0 the row left out, for the squared loss (OLS) and eq. 9's absolute one (LAD); chunked
+``partial_fit`` with weights equals ``fit``; bad weights are refused in one line."""
+
+import numpy as np
+import pytest
+
+from dynid.estimators.least_absolute import LeastAbsoluteDeviations
+from dynid.estimators.least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+from dynid.exceptions import ShapeError
+
+N_DOF, P = 2, 5
+
+
+def _problem(rng, samples=120):
+    w = rng.standard_normal((samples * N_DOF, P)) * np.geomspace(1.0, 10.0, P)
+    tau = w @ rng.uniform(-2, 2, P) + 0.05 * rng.standard_normal(samples * N_DOF)
+    return w, tau
+
+
+@pytest.mark.parametrize("make", [lambda: OrdinaryLeastSquares(n_dof=N_DOF), lambda: LeastAbsoluteDeviations(n_dof=N_DOF)])
+def test_integer_weights_are_repeated_samples_and_zero_leaves_a_sample_out(make, rng):
+    w, tau = _problem(rng)
+    per_sample = rng.integers(0, 4, w.shape[0] // N_DOF)  # 0 to 3 copies of each sample (both joints' rows)
+    weights = np.repeat(per_sample, N_DOF)
+    rows = np.repeat(np.arange(w.shape[0]).reshape(-1, N_DOF), per_sample, axis=0).reshape(-1)
+    weighted = make().fit(w, tau, sample_weight=weights).params_
+    repeated = make().fit(w[rows], tau[rows]).params_
+    np.testing.assert_allclose(weighted, repeated, rtol=1e-7, atol=1e-9)
+    plain = make().fit(w, tau).params_
+    assert np.abs(weighted - plain).max() > 1e-6  # the weights changed the estimate
+
+
+def test_weights_shaped_as_the_torques_and_chunked_partial_fit_agree(rng):
+    w, tau = _problem(rng)
+    weights = rng.uniform(0.2, 3.0, w.shape[0])
+    whole = WeightedLeastSquares(n_dof=N_DOF).fit(w, tau.reshape(-1, N_DOF), sample_weight=weights.reshape(-1, N_DOF))
+    chunked = WeightedLeastSquares(n_dof=N_DOF)
+    for part in np.array_split(np.arange(w.shape[0] // N_DOF), 3):
+        rows = (part[:, None] * N_DOF + np.arange(N_DOF)).reshape(-1)
+        chunked.partial_fit(w[rows], tau[rows], sample_weight=weights[rows])
+    np.testing.assert_allclose(chunked.solve().params_, whole.params_, rtol=1e-10, atol=1e-12)
+    ones = WeightedLeastSquares(n_dof=N_DOF).fit(w, tau, sample_weight=np.ones(w.shape[0]))
+    np.testing.assert_allclose(ones.params_, WeightedLeastSquares(n_dof=N_DOF).fit(w, tau).params_, rtol=1e-12)
+
+
+@pytest.mark.parametrize("weights, said", [
+    (lambda m: -np.ones(m), "sample_weight: expected finite weights >= 0"),
+    (lambda m: np.full(m, np.nan), "sample_weight: expected finite weights >= 0"),
+    (lambda m: np.ones(m - 1), r"sample_weight: expected one weight per row of W, shape \(240,\)"),
+])
+def test_bad_weights_are_refused_in_one_line(weights, said, rng):
+    w, tau = _problem(rng)
+    for est in (OrdinaryLeastSquares(n_dof=N_DOF), LeastAbsoluteDeviations(n_dof=N_DOF)):
+        with pytest.raises(ShapeError, match=said):
+            est.fit(w, tau, sample_weight=weights(w.shape[0]))
