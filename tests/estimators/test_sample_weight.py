@@ -54,3 +54,16 @@ def test_bad_weights_are_refused_in_one_line(weights, said, rng):
     for est in (OrdinaryLeastSquares(n_dof=N_DOF), LeastAbsoluteDeviations(n_dof=N_DOF)):
         with pytest.raises(ShapeError, match=said):
             est.fit(w, tau, sample_weight=weights(w.shape[0]))
+
+
+def test_wls_is_ols_with_weights_of_one_over_each_joints_residual_variance(rng):
+    """Gautier & Poignet's WLS: OLS with sample_weight 1/σ_j² on joint j's rows, σ_j of the OLS residuals."""
+    w, tau = _problem(rng)
+    tau = tau + np.tile([0.0, 1.0], w.shape[0] // N_DOF) * 0.5 * rng.standard_normal(w.shape[0])  # joint 2 noisier
+    wls = WeightedLeastSquares(n_dof=N_DOF).fit(w, tau)
+    residual = (tau - w @ OrdinaryLeastSquares(n_dof=N_DOF).fit(w, tau).params_).reshape(-1, N_DOF)
+    sigma = np.sqrt((residual**2).sum(axis=0) / (residual.shape[0] - P / N_DOF))
+    np.testing.assert_allclose(sigma, wls.joint_std_, rtol=1e-8)  # dynid's σ_j: RSS_j / (N - p / n_dof)
+    ols = OrdinaryLeastSquares(n_dof=N_DOF).fit(w, tau, sample_weight=np.tile(1.0 / sigma**2, w.shape[0] // N_DOF))
+    np.testing.assert_allclose(ols.params_, wls.params_, rtol=1e-9, atol=1e-12)
+    assert np.abs(wls.params_ - OrdinaryLeastSquares(n_dof=N_DOF).fit(w, tau).params_).max() > 1e-4
