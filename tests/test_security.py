@@ -169,7 +169,7 @@ def test_a_pickle_given_as_results_is_refused_and_never_run(tmp_path):
     results = tmp_path / "results.json"
     results.write_bytes(_hostile_pickle(marker))
     with pytest.raises(DynIdError, match="results.json") as caught:
-        api.load_results(results, api.load_robot("er16"))
+        api.load_results(results, robot=api.load_robot("er16"))
     assert "\n" not in str(caught.value) and not marker.exists()
 
 
@@ -202,4 +202,4 @@ def test_a_non_finite_number_in_a_results_file_is_refused_where_it_is_read(tmp_p
     r["estimates"]["dynid WLS"]["values"][first] = float("nan")
     (tmp_path / "nan-values.json").write_text(json.dumps(r))
     with pytest.raises(DynIdError, match=rf"values.{first}: expected a finite number"):
-        api.load_results(tmp_path / "nan-values.json", api.load_robot(str(cfg.parent / "er16_truth.toml")))
+        api.load_results(tmp_path / "nan-values.json", robot=api.load_robot(str(cfg.parent / "er16_truth.toml")))

@@ -91,9 +91,9 @@ def test_selected_columns_are_the_same_numbers_as_the_full_regressor(name):
     q, dq, ddq = (rng.uniform(-2, 2, (300, robot.n_dof)) for _ in range(3))
     full = regressor(robot, q, dq, ddq)
     cols = base_parameters(robot, rng=0).independent
-    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, cols), full[..., cols])
+    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, columns=cols), full[..., cols])
     some = np.array([robot.n_params - 1, 3, 0])  # any order, drive and coupled columns included
-    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, some), full[..., some])
+    np.testing.assert_array_equal(regressor(robot, q, dq, ddq, columns=some), full[..., some])
 
 
 @pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])
@@ -108,7 +108,7 @@ def test_the_numpy_form_gives_the_compiled_kernels_numbers(name, monkeypatch):
     forms = {}
     for numpy in (True, False):
         monkeypatch.setattr(module, "_numpy_form", lambda n, numpy=numpy: numpy)
-        forms[numpy] = regressor(robot, q, dq, ddq), regressor(robot, q, dq, ddq, some)
+        forms[numpy] = regressor(robot, q, dq, ddq), regressor(robot, q, dq, ddq, columns=some)
     np.testing.assert_array_equal(forms[True][0], forms[False][0])
     np.testing.assert_array_equal(forms[True][1], forms[False][1])
     np.testing.assert_allclose(forms[True][0][:500] @ robot.standard_parameters(), rnea_torques(robot, q[:500], dq[:500], ddq[:500]),

@@ -54,7 +54,7 @@ def test_swevers_form_is_the_same_trajectory_and_dicts_round_trip():
     expected = q0 + np.sin(np.outer(t, k * w)) @ (a / (k * w)).T - np.cos(np.outer(t, k * w)) @ (b / (k * w)).T
     np.testing.assert_allclose(sw.evaluate(t)[0], expected, atol=1e-12)
     for form in ("paper", "swevers"):
-        back = trajectory_from_dict(sw.to_dict(form))
+        back = trajectory_from_dict(sw.to_dict(form=form))
         np.testing.assert_allclose(back.evaluate(t)[1], sw.evaluate(t)[1], atol=1e-12)
     with pytest.raises(ConfigError, match="x.json: expected a and b of shape"):
         trajectory_from_dict({"omega_f": 1.0, "q0": [0, 0], "a": [[1.0]], "b": [[1.0]]}, "x.json")

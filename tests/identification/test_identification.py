@@ -170,7 +170,7 @@ def test_identify_with_the_excitation_json_uses_fourier_fit_derivatives(tmp_path
     home = np.array([0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
     prob = ExcitationProblem(robot, 2 * np.pi * 0.1, 4, offsets=home, workspace=Workspace(floor=0.1), grid_points=80)
     design = design_excitation(prob, n_starts=1, rng=0)
-    write_json(tmp_path / "excitation.json", {"trajectory": design.trajectory.to_dict("swevers")})
+    write_json(tmp_path / "excitation.json", {"trajectory": design.trajectory.to_dict(form="swevers")})
     rng = np.random.default_rng(5)
     rate = 250.0
     t = np.arange(int(3 * design.trajectory.period * rate)) / rate  # three periods

@@ -46,7 +46,7 @@ def test_every_shipped_config_loads_as_it_is_or_after_migrate(path, tmp_path):
     old = re.findall(r"^\s*(method|methods|physically_consistent|torque_cutoff)\s*=", text, flags=re.M)
     if old:
         with pytest.raises(ConfigError, match=r"(estimation\.\w+|preprocessing\.torque_cutoff): no longer exists"):
-            load_identification_config(config, root)
+            load_identification_config(config, data_root=root)
         if "torque_cutoff" in old:
             assert any("torque_cutoff" in c and "its meaning changed" in c for c in changes)
         if set(old) - {"torque_cutoff"}:
@@ -60,5 +60,5 @@ def test_every_shipped_config_loads_as_it_is_or_after_migrate(path, tmp_path):
         assert [ln for ln in migrated.splitlines() if not re.match(r"(estimators|parallel_cutoff) = ", ln)] == kept
     else:
         assert migrated == text
-    cfg = load_identification_config(config, root)
+    cfg = load_identification_config(config, data_root=root)
     assert cfg.estimators and cfg.robot.n_dof in (6, 7)

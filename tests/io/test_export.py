@@ -56,11 +56,11 @@ def test_inconsistent_parameters_are_refused_naming_link_and_rule(rng):
     with pytest.raises(ConfigError, match=r"export: link 2 \(joint2\): .*only physically consistent parameters"):
         urdf_from_robot(robot, phi)
     with pytest.raises(ConfigError, match=r"r.json: no physically consistent estimate to export"):
-        urdf_from_results(robot, {"base_parameters": []}, "r.json")
+        urdf_from_results(robot, {"base_parameters": []}, source="r.json")
     results = {"physically_consistent": {"label": "dynid SDP", "standard_values": dict(zip(robot.parameter_names, phi))},
                "physically_consistent_verdict": {"dynid SDP": "no: fv4 = -0.02 < 0"}}
     with pytest.raises(ConfigError, match=r"did not pass the consistency check \(no: fv4 = -0.02 < 0\)"):
-        urdf_from_results(robot, results, "r.json")
+        urdf_from_results(robot, results, source="r.json")
 
 
 def _without_identified(root):

@@ -24,7 +24,7 @@ class CentralDifferences(Strategy):
                             tuple(recording.warnings))
 
     def chunks(self, robot, base, data, progress=None, standard=False):
-        y = regressor(robot, data.q, data.dq, data.ddq, None if standard else base.independent)
+        y = regressor(robot, data.q, data.dq, data.ddq, columns=None if standard else base.independent)
         yield np.arange(data.t.shape[0]), y, data.tau, np.ones(data.tau.shape, dtype=bool)
 
 

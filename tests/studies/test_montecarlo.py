@@ -88,7 +88,7 @@ def test_scheduler_address_path_gives_the_same_study(study):
 def test_the_summary_names_the_estimator_nearest_the_bound_at_each_level(study):
     from dynid.report.summaries import summary
 
-    text = " ".join(summary(study, 200).split())
+    text = " ".join(summary(study, width=200).split())
     stats = study.statistics()
     for li, level in enumerate(SMALL.noise_levels):
         scores = {k: np.nanmedian(stats[k]["rmse"][li] / study.crb_std[li]) for k in SMALL.estimators}

@@ -267,7 +267,7 @@ def identify(
     from ..io.identification_config import load_identification_config
 
     def prepare():
-        cfg = load_identification_config(config, data_root)  # a mistake is reported before any heavy import
+        cfg = load_identification_config(config, data_root=data_root)  # a mistake is reported before any heavy import
         from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
 
         return cfg
@@ -366,7 +366,7 @@ def export(
         return mjcf_model if mjcf_model is not None else cfg.mjcf_model
 
     def prepare():
-        cfg = load_identification_config(config, data_root)
+        cfg = load_identification_config(config, data_root=data_root)
         identified = _read_results(results, cfg.robot)
         targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
         if mjcf_model is not None and mjcf is None:
@@ -392,7 +392,7 @@ def export(
 
         def urdf_text(robot, identified, source):
             if cfg.urdf is None:  # a DH description: a URDF of its own
-                return urdf_from_results(robot, identified, source)
+                return urdf_from_results(robot, identified, source=source)
             fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
             text, far = urdf_written_back(cfg.urdf, fitted, phi)
             moved.extend(far)
@@ -401,7 +401,7 @@ def export(
         def mjcf_text(robot, identified, source):
             users = _users_mjcf(cfg)
             if users is None:
-                return mjcf_from_results(robot, identified, source)
+                return mjcf_from_results(robot, identified, source=source)
             fitted, phi = consistent_estimate(robot, identified, source)
             text, far = mjcf_written_back(users, fitted, phi, out_dir=mjcf.parent if mjcf else None)
             moved.extend(far)
@@ -475,7 +475,7 @@ def validate(
     from ..report.summaries import comparison_table
 
     def prepare():
-        cfg = load_identification_config(config, data_root)
+        cfg = load_identification_config(config, data_root=data_root)
         from ..report import identification_run  # noqa: F401  imported before the figure process forks: once for both
 
         identified = _read_results(results, cfg.robot)
@@ -501,7 +501,7 @@ def validate(
         rep.wrote(paths)
 
     _Command("dynid validate", quiet, out, figures=True).run(
-        prepare, lambda p, progress: run_validation(p[0], p[1], p[2], progress=_steps(progress), source=str(results)), save, show)
+        prepare, lambda p, progress: run_validation(p[0], p[1], datasets=p[2], progress=_steps(progress), source=str(results)), save, show)
 
 
 @app.command()
@@ -805,11 +805,11 @@ def monitor(
 
     def prepare():
         settings = MonitorSettings(window, reference_windows, false_alarm_days)
-        cfg = load_identification_config(config, data_root)
+        cfg = load_identification_config(config, data_root=data_root)
         files = dated_logs(logs)
         from ..identification.identified import load_results
 
-        model = load_results(results, cfg.robot)
+        model = load_results(results, robot=cfg.robot)
         fingerprint = monitor_fingerprint(results, settings)
         state = out / STATE_FILE
         refusal = None if restart else legacy_state_refusal(out)

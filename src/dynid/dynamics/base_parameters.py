@@ -16,6 +16,7 @@ import numpy as np
 import scipy.linalg
 
 from ..exceptions import IdentifiabilityError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from .regressor import observation_matrix
 
@@ -132,7 +133,8 @@ def _format_term(coef: float, name: str, first: bool) -> str:
     return f" {sign} {body}"
 
 
-def base_parameters(robot: Robot, rng: np.random.Generator | int | None = 0, n_samples: int = 400,
+@keyword_only_after_data
+def base_parameters(robot: Robot, *, rng: np.random.Generator | int | None = 0, n_samples: int = 400,
                     tol: float = 1e-8) -> BaseParameters:
     """Compute the base parameters of ``robot`` numerically.
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..checks import check_states
 from ..friction import drive_columns
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from . import _regressor_kernel as kernel
 
@@ -45,7 +46,8 @@ _numpy_used = 0
 _numpy_lock = threading.Lock()
 
 
-def regressor(robot: Robot, q, dq, ddq, columns=None, velocities=None) -> np.ndarray:
+@keyword_only_after_data
+def regressor(robot: Robot, q, dq, ddq, *, columns=None, velocities=None) -> np.ndarray:
     """Per-sample joint-torque regressor.
 
     Parameters

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..model.urdf import pinocchio_from_inertial
 from .regressor import friction_torques
@@ -50,7 +51,8 @@ def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
     return model
 
 
-def rnea_torques(robot: Robot, q, dq, ddq, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
+@keyword_only_after_data
+def rnea_torques(robot: Robot, q, dq, ddq, *, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
     """Joint torques: Pinocchio's RNEA for the rigid bodies plus the drive terms.
 
     Parameters

@@ -30,6 +30,7 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import regressor
 from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Limits, Robot
 from ..threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
@@ -324,7 +325,8 @@ class ExcitationDesign:
         """Whether the trajectory satisfies every constraint on the verification grid."""
         return all(m.satisfied for m in self.margins)
 
-    def to_dict(self, form: str = "paper") -> dict:
+    @keyword_only_after_data
+    def to_dict(self, *, form: str = "paper") -> dict:
         """The design as excitation.json stores it.
 
         Parameters
@@ -342,7 +344,7 @@ class ExcitationDesign:
                 "message": self.message, "nit": self.nit, "nfev": self.nfev, "start_values": self.start_values,
                 "seconds": self.seconds, "feasible": self.feasible, "margins": [m.to_dict() for m in self.margins],
                 "initial_violations": [m.to_dict() for m in self.initial_violations],
-                "trajectory": self.trajectory.to_dict(form), "initial_trajectory": self.initial.to_dict(form)}
+                "trajectory": self.trajectory.to_dict(form=form), "initial_trajectory": self.initial.to_dict(form=form)}
 
 
 class _Layout:
@@ -521,7 +523,8 @@ def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
 
 
 @with_single_blas_thread
-def design_excitation(problem: ExcitationProblem, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
+@keyword_only_after_data
+def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
                       initial: FourierTrajectory | None = None, maxiter: int = 150,
                       callback: Callable[[int, int, float], None] | None = None) -> ExcitationDesign:
     """Optimise an excitation trajectory for ``problem`` (paper eq. 15).

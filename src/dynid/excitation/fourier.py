@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..keywords import keyword_only_after_data
 
 
 @dataclass(frozen=True)
@@ -139,7 +140,8 @@ class FourierTrajectory:
         lw = self.omega_f * np.arange(1, self.n_harmonics + 1)
         return self.q0.copy(), self.a * lw, -self.b * lw
 
-    def to_dict(self, form: str = "paper") -> dict:
+    @keyword_only_after_data
+    def to_dict(self, *, form: str = "paper") -> dict:
         """JSON-ready coefficients; read back by :func:`trajectory_from_dict`.
 
         Parameters

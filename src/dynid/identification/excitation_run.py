@@ -51,8 +51,8 @@ class ExcitationRun:
             "workspace": p.workspace.to_dict(),
             "settings": {"starts": c.starts, "seed": c.seed, "maxiter": c.maxiter, "grid_points": p.grid_points,
                          "safety": p.safety, "initial": c.initial_label, "csv_rate": c.rate, "csv_periods": c.periods},
-            "trajectory": self.design.trajectory.to_dict(c.form),
-            "design": {k: v for k, v in self.design.to_dict(c.form).items() if k != "trajectory"},
+            "trajectory": self.design.trajectory.to_dict(form=c.form),
+            "design": {k: v for k, v in self.design.to_dict(form=c.form).items() if k != "trajectory"},
         }
 
 

@@ -226,7 +226,7 @@ class _CrossValidation:
         at rest's direction of motion on the segment from ``start``)."""
         data, n = self.data, self.robot.n_dof
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))
-        y = regressor(self.rigid, q, dq, ddq, self.rigid_base.independent)
+        y = regressor(self.rigid, q, dq, ddq, columns=self.rigid_base.independent)
         bank = np.zeros((b - a, n, self.k_bank))
         velocities = self.robot.friction_velocities
         v = Velocities(velocities.coulomb, velocities.stribeck, self.rest_v)

@@ -14,6 +14,7 @@ import numpy as np
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..exceptions import ConfigError, DataError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 
@@ -228,7 +229,8 @@ class IdentifiedModel:
         return Parameters(self.base.names, self.params(label), self.std.get(label),
                           [e.split(" = ", 1)[1] for e in self.base.expressions])
 
-    def predict(self, t, q=None, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
+    @keyword_only_after_data
+    def predict(self, t, q=None, dq=None, ddq=None, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the model along a logged motion, its positions prepared as the identification log's were
         (the fitted filters and derivatives): symmetric with ``Identifier.fit(t, q, tau)``.
 
@@ -262,13 +264,13 @@ class IdentifiedModel:
             Time stamps that do not increase, or a gap in them.
         """
         if hasattr(t, "tau") and hasattr(t, "rate"):
-            return self.predict_log(t, estimate)[1]
+            return self.predict_log(t, estimate=estimate)[1]
         if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
             import warnings
 
             warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)
-            return self.predict_states(t, q, dq, estimate)
+            return self.predict_states(t, q, dq, estimate=estimate)
         if q is None:
             raise ValueError("predict(t, q): the positions are needed with the time stamps (or give a log)")
         from ..dynamics.regressor import regressor
@@ -283,13 +285,15 @@ class IdentifiedModel:
         v = rest_velocities(data, self.robot)
         if data.direction is not None:
             v = replace(v, direction=np.asarray(data.direction))
-        y = regressor(self.robot, np.asarray(data.q), np.asarray(data.dq), np.asarray(data.ddq), self.base.independent, v)
+        y = regressor(self.robot, np.asarray(data.q), np.asarray(data.dq), np.asarray(data.ddq), columns=self.base.independent,
+                      velocities=v)
         pred = y @ self.params(estimate)
         at = times - times[0]
         return np.column_stack([np.interp(at, data.t, pred[:, j], left=np.nan, right=np.nan)
                                 for j in range(pred.shape[1])])
 
-    def predict_states(self, q, dq, ddq, estimate: str | None = None) -> np.ndarray:
+    @keyword_only_after_data
+    def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the model at given states (inverse dynamics with friction: ``Y(q, q̇, q̈)·β``), as they are.
 
         The accelerations are the caller's: a second difference of measured positions is mostly noise, and a warning
@@ -325,7 +329,7 @@ class IdentifiedModel:
                               f"noise (its level {max(noise[j] / spread[j] for j in noisy):.0%} of their spread): "
                               "differentiate filtered positions, or give the raw log to predict(t, q)", UserWarning,
                               stacklevel=2)
-        y = regressor(self.robot, q, dq, ddq, self.base.independent)
+        y = regressor(self.robot, q, dq, ddq, columns=self.base.independent)
         return y @ self.params(estimate)
 
     def _settings(self):
@@ -336,7 +340,8 @@ class IdentifiedModel:
         # this log's own band
         return carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
 
-    def predict_log(self, recording, estimate: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    @keyword_only_after_data
+    def predict_log(self, recording, *, estimate: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Measured and predicted torques of a log, prepared as the identification log was (its filters, carried
         over: :func:`dynid.preprocessing.strategies.carried_over`), on the samples the comparison keeps.
 
@@ -352,10 +357,11 @@ class IdentifiedModel:
         measured : (M, n_dof) array [N·m]
             Filtered like the prediction (parallel filtering).
         """
-        comparison = self.validate(recording, estimate)
+        comparison = self.validate(recording, estimate=estimate)
         return comparison.t, comparison.predicted[self.label(estimate)], comparison.measured
 
-    def validate(self, recording, estimate: str | None = None):
+    @keyword_only_after_data
+    def validate(self, recording, *, estimate: str | None = None):
         """The paper's metrics (eq. 18, RMSE, relative error) of the estimates on a log.
 
         Parameters
@@ -375,7 +381,8 @@ class IdentifiedModel:
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
         return compare_torques(self.robot, self.base, data, sets)
 
-    def score(self, t, q=None, tau=None, estimate: str | None = None) -> float:
+    @keyword_only_after_data
+    def score(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:
         """Coefficient of determination R² of the predicted torques of a log, over its joints and samples (1 is a
         perfect prediction; scikit-learn's ``score``), on the samples ``dynid validate`` scores: the log prepared as the
         identification log was.
@@ -404,7 +411,7 @@ class IdentifiedModel:
             from .run import recording_from_arrays
 
             recording = recording_from_arrays(self.robot, t, q, tau, name="score")
-        _, pred, meas = self.predict_log(recording, estimate)
+        _, pred, meas = self.predict_log(recording, estimate=estimate)
         res = meas - pred
         return 1.0 - float(np.sum(res**2)) / float(np.sum((meas - meas.mean(axis=0)) ** 2))
 
@@ -536,7 +543,8 @@ def _plain(obj):
     return _clean(obj)
 
 
-def load_results(path: str | Path, robot: Robot | str | Path | None = None) -> IdentifiedModel:
+@keyword_only_after_data
+def load_results(path: str | Path, *, robot: Robot | str | Path | None = None) -> IdentifiedModel:
     """Read the results.json of ``dynid identify`` (or :meth:`IdentifiedModel.save`) back as the identified model.
 
     Parameters

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 
@@ -236,7 +237,7 @@ class Identifier:
         from ..io.identification_config import load_identification_config, split_estimators
         from .run import run_identification
 
-        config = load_identification_config(path, data_root)
+        config = load_identification_config(path, data_root=data_root)
         changes: dict[str, Any] = {}
         if self.robot is not None:
             changes["robot"] = self._robot()
@@ -295,7 +296,8 @@ class Identifier:
         """
         return self._model().parameters(estimate)
 
-    def predict(self, t, q=None, dq=None, ddq=None, estimate: str | None = None) -> np.ndarray:
+    @keyword_only_after_data
+    def predict(self, t, q=None, dq=None, ddq=None, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the identified model along a raw log, prepared as the fit prepared its own
         (:meth:`dynid.identification.identified.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
         ``fit(t, q, tau)``; ``predict(recording)``; states of one's own: :meth:`predict_states`.
@@ -320,10 +322,11 @@ class Identifier:
 
             warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)
-            return self._model().predict_states(t, q, dq, estimate)
-        return self._model().predict(t, q, dq, ddq, estimate)
+            return self._model().predict_states(t, q, dq, estimate=estimate)
+        return self._model().predict(t, q, dq, ddq, estimate=estimate)
 
-    def predict_states(self, q, dq, ddq, estimate: str | None = None) -> np.ndarray:
+    @keyword_only_after_data
+    def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques at states one computed oneself (:meth:`dynid.identification.identified.IdentifiedModel.predict_states`).
 
         Parameters
@@ -335,7 +338,7 @@ class Identifier:
         -------
         (N, n_dof) array [N·m]
         """
-        return self._model().predict_states(q, dq, ddq, estimate)
+        return self._model().predict_states(q, dq, ddq, estimate=estimate)
 
     def score(self, t, q=None, tau=None, *args, estimate: str | None = None) -> float:
         """R² of the predicted torques of a raw log (``score(t, q, tau)``, symmetric with ``fit``) or of a recording
@@ -365,9 +368,9 @@ class Identifier:
             warnings.warn("score(q, dq, ddq, tau) scores states of one's own: score(t, q, tau) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)
             measured = np.asarray(args[0], dtype=float)
-            pred = self._model().predict_states(t, q, tau, estimate)
+            pred = self._model().predict_states(t, q, tau, estimate=estimate)
             return 1.0 - float(np.sum((measured - pred) ** 2)) / float(np.sum((measured - measured.mean(axis=0)) ** 2))
-        return self._model().score(t, q, tau, estimate)
+        return self._model().score(t, q, tau, estimate=estimate)
 
     def save(self, path: str | Path) -> Path:
         """Write the identification's results.json (read back by :func:`dynid.load_results`).

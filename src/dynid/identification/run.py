@@ -13,6 +13,7 @@ import numpy as np
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.datasets import DatasetSpec, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over
@@ -105,7 +106,8 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
 
 
 @with_single_blas_thread
-def run_identification(config: IdentificationConfig, progress=None, validate: bool = True):
+@keyword_only_after_data
+def run_identification(config: IdentificationConfig, *, progress=None, validate: bool = True):
     """Identify the base parameters from a config's identification dataset, then validate them.
 
     Validation on each validation dataset beside the reference sets.
@@ -278,7 +280,8 @@ def _main_estimate(result, nominal: str | None = None) -> dict:
     return {"main": main, "findings": tuple(findings), "diagnostics": diagnostics}
 
 
-def run_validation(config: IdentificationConfig, identified: dict, datasets: tuple[DatasetSpec, ...] | None = None,
+@keyword_only_after_data
+def run_validation(config: IdentificationConfig, identified: dict, *, datasets: tuple[DatasetSpec, ...] | None = None,
                    progress=None, source: str = "results") -> tuple[tuple, tuple[str, ...]]:
     """Validate identified base parameters and the config's reference sets on the config's validation datasets (or on
     ``datasets``).

@@ -47,6 +47,7 @@ import numpy as np
 
 from ..column_store import SPOOL_BYTES, StoredColumns, by_column, select_rows
 from ..exceptions import ConfigError, DataError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from .tables import read_table
 
@@ -445,7 +446,8 @@ def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
                                    t.effort or "torques"))
 
 
-def load_recording(spec: DatasetSpec | str | Path, robot: Robot, spool: bool | None = None) -> Recording:
+@keyword_only_after_data
+def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale

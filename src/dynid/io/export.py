@@ -23,6 +23,7 @@ from html import escape
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
 
@@ -82,7 +83,8 @@ def quoteattr(value: str) -> str:
     return f'"{escape(str(value), quote=True)}"'
 
 
-def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
+@keyword_only_after_data
+def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
     """URDF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
 
     Parameters
@@ -141,7 +143,8 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | Non
     return "\n".join(lines)
 
 
-def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, name: str | None = None) -> str:
+@keyword_only_after_data
+def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
     """MuJoCo MJCF text of a robot with given standard parameters.
 
     Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
@@ -309,7 +312,8 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
+@keyword_only_after_data
+def urdf_from_results(robot: Robot, results: dict, *, source: str = "results") -> str:
     """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
 
     Parameters
@@ -334,7 +338,8 @@ def urdf_from_results(robot: Robot, results: dict, source: str = "results") -> s
     return urdf_from_robot(*consistent_estimate(robot, results, source))
 
 
-def mjcf_from_results(robot: Robot, results: dict, source: str = "results") -> str:
+@keyword_only_after_data
+def mjcf_from_results(robot: Robot, results: dict, *, source: str = "results") -> str:
     """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
 
     Parameters

@@ -161,7 +161,7 @@ def load_fleet_manifest(path: str | Path, data_root: str | Path | None = None) -
         seen[u.id] = i
         try:
             if u.config is not None:
-                config = load_identification_config(here / u.config, data_root)
+                config = load_identification_config(here / u.config, data_root=data_root)
             elif template is None or template_path is None:
                 raise ConfigError(f"{where}: expected config (the unit's own identify config), or a template in the manifest")
             else:

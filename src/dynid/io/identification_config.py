@@ -73,6 +73,7 @@ import numpy as np
 
 from ..estimators.registry import parse_estimators
 from ..exceptions import ConfigError, DataError
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..typed import convert
@@ -200,7 +201,8 @@ def _preprocessing(table: PreprocessingTable, where: str, n: int, here: Path = P
     return Preprocessing(**values)
 
 
-def load_identification_config(path: str | Path, data_root: str | Path | None = None) -> IdentificationConfig:
+@keyword_only_after_data
+def load_identification_config(path: str | Path, *, data_root: str | Path | None = None) -> IdentificationConfig:
     """Parse an identification config.
 
     Parameters

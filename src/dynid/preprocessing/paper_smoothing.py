@@ -91,7 +91,7 @@ class PaperSmoothing(Strategy):
             ``(index, y, tau, keep)`` as :meth:`Strategy.chunks`.
         """
         passes = data.settings.smoothing_passes
-        y = five_point_cubic_smoothing(regressor(robot, data.q, data.dq, data.ddq, None if standard else base.independent), passes)
+        y = five_point_cubic_smoothing(regressor(robot, data.q, data.dq, data.ddq, columns=None if standard else base.independent), passes)
         tau = five_point_cubic_smoothing(data.tau, passes)
         n = data.t.shape[0]
         if progress is not None:

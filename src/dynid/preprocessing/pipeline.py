@@ -187,7 +187,7 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     if recording.n_samples < 3 * (2 * settings.order + 1) + 1:
         raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
                         f"(at least {3 * (2 * settings.order + 1) + 1} for preprocessing.order = {settings.order})")
-    s = settings.resolved(rate, recording.q, recording.dq is not None, recording.label, strict)
+    s = settings.resolved(rate, recording.q, measured_velocity=recording.dq is not None, name=recording.label, strict=strict)
 
     def lowpass(x, cutoff, what):
         if cutoff <= 0:
@@ -311,7 +311,7 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))  # stored columns: read here
         v = velocities if data.direction is None else replace(velocities, direction=np.asarray(data.direction[a:b]))
-        return regressor(robot, q, dq, ddq, columns, v), tau
+        return regressor(robot, q, dq, ddq, columns=columns, velocities=v), tau
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, s.order, s.chunk, cutoff):

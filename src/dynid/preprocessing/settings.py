@@ -8,6 +8,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..keywords import keyword_only_after_data
 from .bands import (
     PARALLEL_FACTOR,
     POSITION_FACTOR,
@@ -135,7 +136,8 @@ class Preprocessing:
     noise_share: float | None = None
     warnings: tuple[str, ...] = ()
 
-    def resolved(self, rate: float, q: np.ndarray | None = None, measured_velocity: bool = True,
+    @keyword_only_after_data
+    def resolved(self, rate: float, q: np.ndarray | None = None, *, measured_velocity: bool = True,
                  name: str = "data", strict: bool = True) -> Preprocessing:
         """Every ``None`` replaced by its data-derived value (module :mod:`dynid.preprocessing.bands`).
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..conventions import unit_of
 from ..estimators.registry import label
+from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison
@@ -70,7 +71,8 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
                      ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
 
 
-def summary(result, width: int = 100) -> str:
+@keyword_only_after_data
+def summary(result, *, width: int = 100) -> str:
     """Plain-text summary of a result of dynid (identification, paper run, Monte Carlo study, excitation design).
 
     Parameters

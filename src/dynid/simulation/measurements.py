@@ -86,7 +86,7 @@ def simulate_measurements(robot: Robot, t: np.ndarray, q: np.ndarray, dq: np.nda
         Noisy positions and currents with the noise-free torques.
     """
     gains = check_vector(robot.drive_gains, robot.n_dof, "drive gains")
-    tau = rnea_torques(robot, q, dq, ddq, inertial, drive)
+    tau = rnea_torques(robot, q, dq, ddq, inertial=inertial, drive=drive)
     current = tau / gains + rng.normal(0.0, noise.current_std, tau.shape) if noise.current_std > 0 else tau / gains
     if noise.encoder_resolution > 0:
         q_meas = np.round(q / noise.encoder_resolution) * noise.encoder_resolution

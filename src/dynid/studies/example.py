@@ -84,8 +84,8 @@ def example_files(name: str, seed: int = 0) -> dict[str, str]:
     if name in FROM_URDF:
         files[f"{name}.urdf"] = (resources.files("dynid.model") / "robots" / f"{name}.urdf").read_text(encoding="utf-8")
     names = [j.name for j in robot.joints]
-    files["identification.csv"] = _csv(simulated_log(robot, IDENTIFICATION_SECONDS, RATE, seed), names)
-    files["validation.csv"] = _csv(simulated_log(robot, VALIDATION_SECONDS, RATE, seed + 1), names)
+    files["identification.csv"] = _csv(simulated_log(robot, seconds=IDENTIFICATION_SECONDS, rate=RATE, seed=seed), names)
+    files["validation.csv"] = _csv(simulated_log(robot, seconds=VALIDATION_SECONDS, rate=RATE, seed=seed + 1), names)
     columns = lambda what: "[" + ", ".join(f'"{n}_{what}"' for n in names) + "]"  # noqa: E731
     layout = (f'header = true\ntime = {{ column = "time" }}\npositions = {{ columns = {columns("position")} }}\n'
               f'torques = {{ columns = {columns("effort")} }}\n')

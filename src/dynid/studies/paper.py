@@ -38,6 +38,7 @@ from ..excitation.paper_trajectories import (
 )
 from ..io.datasets import Recording
 from ..io.trajectories import load_trajectory
+from ..keywords import keyword_only_after_data
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks, prepare
@@ -520,7 +521,8 @@ def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
 
 
 @with_single_blas_thread
-def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig(),
+@keyword_only_after_data
+def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig(), *,
                          progress: Callable[[str, int | None, float | None], None] | None = None) -> PaperRunResult:
     """Run the paper's experiment (§4) on a simulated robot and compare the estimators of ``config.estimators``.
 

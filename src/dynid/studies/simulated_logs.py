@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..io.datasets import Recording
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from .simulated_fleet import random_excitation
@@ -17,7 +18,8 @@ from .simulated_fleet import random_excitation
 __all__ = ["simulated_log"]
 
 
-def simulated_log(robot: Robot, seconds: float = 30.0, rate: float = 250.0, seed: int = 0,
+@keyword_only_after_data
+def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, seed: int = 0,
                   noise: NoiseModel = NoiseModel()) -> Recording:
     """A log of ``robot`` running a random Fourier excitation.
 
