@@ -9,14 +9,13 @@ regression. Run from the repository root (about 5 minutes on two cores; the data
 config runs where it was in its release (``configs/``, beside that release's robot descriptions): a user upgrading
 keeps both:
 
-    .venv/bin/python benchmarks/compat_figures.py [--only ur10e@7b90d67,...] [--jobs 2]
+    .venv/bin/python benchmarks/compat_figures.py [--only ur10e@7b90d67,...] [--jobs 2] [--record FILE]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import re
 import subprocess
@@ -24,6 +23,8 @@ import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+from dynid.io.results import global_errors
 
 REPO = Path(__file__).resolve().parents[1]
 CORPUS = REPO / "tests" / "data" / "compat"
@@ -48,22 +49,8 @@ def _identify(src: Path, config: Path, data_root: Path, out: Path) -> tuple[dict
     return json.loads((out / "results.json").read_text()), ""
 
 
-def _figures(results: dict) -> dict:
-    """(log, estimate) -> global relative error [%] of the identification log and every validation log:
-    ``100·‖τ − τ̂‖_F / ‖τ‖_F`` (:func:`dynid.validation.metrics.global_relative_error`), from the per-joint RMSE and RMS
-    torque where an earlier results.json has no global figure."""
-    out = {}
-    for part in [results.get("identification")] + list(results.get("validation", [])):
-        if not part:
-            continue
-        rms = part.get("rms_torque")
-        for label, m in part.get("metrics", {}).items():
-            value = m.get("global_relative_error")
-            if value is None and m.get("rmse") is not None and rms is not None:  # an earlier results.json: from its
-                value = 100.0 * math.sqrt(sum(e * e for e in m["rmse"]) / sum(r * r for r in rms))  # per-joint figures
-            if value is not None:
-                out[(part["name"], label)] = float(value)
-    return out
+RECORDED: dict = {}
+"""name -> {"migrated", "then", "now"}: the figures of each version, for ``--record``."""
 
 
 def _case(name: str, work: Path) -> tuple[list[str], str]:
@@ -87,7 +74,9 @@ def _case(name: str, work: Path) -> tuple[list[str], str]:
     if then is None or now is None:
         row = f"| {name} | — | — | {why_then or 'ran'} | {why_now or 'ran'} | — |"
         return [row], row
-    a, b = _figures(then), _figures(now)
+    a, b = global_errors(then), global_errors(now)
+    RECORDED[name] = {"migrated": now_config != config, "then": {f"{k[0]}\t{k[1]}": v for k, v in sorted(a.items())},
+                      "now": {f"{k[0]}\t{k[1]}": v for k, v in sorted(b.items())}}
     rows = []
     moved = {k: (b[k] - a[k]) / max(abs(a[k]), 1e-12) for k in set(a) & set(b)}
     big = {k: v for k, v in moved.items() if abs(v) > 0.01}
@@ -106,6 +95,9 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="comma-separated corpus names (config@commit)")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--record", type=Path, default=None,
+                        help="also write every figure then and now as JSON (tests/data/compat/figures.json is this "
+                             "file: the suite checks today's figures against the releases' own)")
     args = parser.parse_args(argv)
     names = sorted(p.stem for p in CORPUS.glob("*@*.toml"))
     if args.only:
@@ -130,6 +122,10 @@ def main(argv: list[str]) -> int:
             print("|---|---|---|---|---|---|")
             for rows, _ in tables:
                 print("\n".join(rows))
+            if args.record is not None:
+                args.record.write_text(json.dumps({"measured_at": subprocess.run(
+                    ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip(),
+                    "versions": dict(sorted(RECORDED.items()))}, indent=1) + "\n")
         finally:
             for commit in sorted({n.split("@")[1] for n in names}):
                 subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(work / f"tree-{commit}")],
