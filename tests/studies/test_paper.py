@@ -157,3 +157,27 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     assert with_sdp.standard and with_sdp.streamed["sdp"].accumulator_.n_params == robot.n_params
     np.testing.assert_allclose(alone.w_base, kept.w_base, rtol=1e-12, atol=1e-12 * np.abs(kept.w_base).max())
     np.testing.assert_array_equal(alone.tau, kept.tau)
+
+
+def test_the_papers_table2_is_said_to_be_inconsistent_and_why():
+    """The paper's Table 2 has f_c1 = -0.0448 and I_zz3 = -0.4069: no mass distribution with non-negative friction
+    gives those base parameters. `dynid run` printed "the truth's margin is -inf"; it now says so in words."""
+    from dynid import load_robot
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.dynamics.layout import consistency_layout
+    from dynid.estimators.physically_consistent import consistency_margin, consistency_verdict
+    from dynid.report.paper_summary import _truth_consistency
+    from dynid.studies.paper import _plant
+
+    robot = load_robot("er16").submodel(3)
+    base = base_parameters(robot)
+    truth, _ = _plant(PaperExperimentConfig(plant="paper"), robot, base)
+    assert ref.TABLE2["f_c1"] < 0  # the paper's own value
+    layout = consistency_layout(robot)
+    margin = consistency_margin(base.regrouping, truth, *layout)
+    verdict = consistency_verdict(margin, base.regrouping, truth, base.names, layout[1])
+    assert margin < 0 and verdict.startswith("no") and "fc1" in verdict
+    said = _truth_consistency({"plant": "paper", "truth_consistency": verdict, "truth_consistency_margin": None})
+    assert said == f"the paper's Table 2 values are not consistent ({verdict.removeprefix('no: ')})" and "inf" not in said
+    assert _truth_consistency({"plant": "assumed", "truth_consistency": "yes", "truth_consistency_margin": 0.15}) == \
+        "the simulated truth is consistent"

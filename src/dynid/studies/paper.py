@@ -24,7 +24,7 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.estimation import Estimation, stacked_rows, stream_rows
-from ..estimators.physically_consistent import CONSISTENCY_TOL
+from ..estimators.physically_consistent import CONSISTENCY_TOL, consistency_verdict
 from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
@@ -282,6 +282,9 @@ class PaperRunResult:
     warnings : list of str
     truth_consistency_margin : float or None
         Physical-consistency margin of the truth.
+    truth_consistency : str
+        The margin in words (:func:`dynid.estimators.physically_consistent.consistency_verdict`): "yes", or "no" and
+        why (the paper's Table 2 has ``fc1 = -0.0448 < 0``).
     """
 
     config: PaperExperimentConfig
@@ -296,6 +299,7 @@ class PaperRunResult:
     timings: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     truth_consistency_margin: float | None = None
+    truth_consistency: str = ""
 
     def to_dict(self) -> dict:
         """The run as ``results.json``.
@@ -319,6 +323,7 @@ class PaperRunResult:
             "regrouping": list(self.base.expressions),
             "truth": dict(zip(names, self.truth.tolist())),
             "truth_consistency_margin": self.truth_consistency_margin,
+            "truth_consistency": self.truth_consistency,
             "abc_bounds": {n: b.tolist() for n, b in zip(names, self.bounds)},
             "search_box": box_kind(self.config, self.robot, self.base),
             "trajectories": self.trajectories,
@@ -600,6 +605,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
                     "lower": bs.lower, "upper": bs.upper, "std": bs.std}
         result.estimates[key] = _paper_estimate(fits[key], ident, valid, config, base, layout, boot)
     result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
+    result.truth_consistency = consistency_verdict(result.truth_consistency_margin, base.regrouping, truth, base.names,
+                                                   layout[1])
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
