@@ -239,7 +239,7 @@ def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
         consistency_verdicts={"dynid WLS": "no: link 2's inertia", "dynid SDP": "yes"},
         estimates={"dynid WLS": SimpleNamespace(standard=None), "dynid SDP": SimpleNamespace(standard=np.zeros(3))},
         fit=empty_log, validations=[], findings=[], estimators=["wls", "sdp"],
-        solution=SimpleNamespace(from_prior=[], relative_std=[]), base=SimpleNamespace(names=[]))
+        solution=SimpleNamespace(from_prior=[], relative_std=[]), base=SimpleNamespace(names=[]), diagnostics={})
     lines = [line.text for line in in_short(result)]
     assert lines[1] == ("main estimate: dynid WLS, not physically consistent; dynid export writes dynid SDP, which is "
                         "physically consistent")
@@ -258,3 +258,22 @@ def test_a_cutoff_candidate_not_scored_shows_a_dash_not_inf():
     assert "inf" not in text and "None" not in text
     rows = [line.split() for line in text.splitlines() if line.strip().startswith(("10*", "18.1"))]
     assert rows == [["10*", "10", "39", "—", "—", "—"], ["18.1", "18.1", "22", "0.25", "—", "0.5"]]
+
+
+def test_a_torque_offset_determined_to_be_about_zero_is_not_said_undetermined():
+    """σ ≥ 100 % of a value near 0 is not "not determined" when ±σ is a negligible torque: the UR10e example listed its
+    six offsets (truth 0, σ a few hundredths of a N·m) beside the inertial directions the log really leaves open. An
+    offset whose ±σ is 1 % of its joint's torque or more, and any other term, is still listed."""
+    from types import SimpleNamespace
+
+    from dynid.report.summaries import in_short
+
+    names = ["offset1", "offset2", "MX2", "fc1"]
+    empty_log = SimpleNamespace(name="identification", metrics=lambda: {})
+    result = SimpleNamespace(
+        main_estimate=SimpleNamespace(label="dynid WLS"), consistency_verdicts={}, estimates={}, fit=empty_log,
+        validations=[], findings=[], estimators=["wls"], base=SimpleNamespace(names=names),
+        solution=SimpleNamespace(from_prior=[], relative_std=[300.0, 300.0, 300.0, 2.0]),
+        diagnostics={"sigma_torque_percent": {"offset1": 0.2, "offset2": 4.0, "MX2": 0.1, "fc1": 0.01}})
+    (line,) = [ln.text for ln in in_short(result) if ln.text.startswith("not determined by this log")]
+    assert ": offset2, MX2: " in line

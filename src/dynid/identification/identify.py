@@ -503,7 +503,13 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
     stats.update({"bootstrap_std": dict(zip(base.names, boot.tolist())), "bootstrap_over_covariance_std": ratio})
     raw = sums.m2 + sums.count * np.einsum("jc,jd->jcd", sums.mean, sums.mean)  # Σ z zᵀ per joint
     col_rms = np.sqrt(np.max(np.diagonal(raw, axis1=1, axis2=2)[:, :-1], axis=0) / max(sums.count, 1))
-    findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, float(np.sqrt(np.mean(rms**2))))
+    rms_all = float(np.sqrt(np.mean(rms**2)))
+    findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, rms_all)
+    joint_col_rms = np.sqrt(np.diagonal(raw, axis1=1, axis2=2)[:, :-1] / max(sums.count, 1))  # (n_dof, p)
+    with np.errstate(invalid="ignore"):  # σ NaN where the prior keeps a direction
+        share = 100.0 * np.max(np.asarray(sol.params_std, dtype=float) * joint_col_rms
+                               / np.maximum(rms, 1e-300)[:, None], axis=0)  # on the joint it matters most to
+    stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
         findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead)

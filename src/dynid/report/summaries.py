@@ -354,6 +354,11 @@ def validation_verdict(comparisons) -> list:
 NOT_DETERMINED = 100.0
 """[%] A base parameter whose σ reaches this share of its value is said to be not determined by the log."""
 
+NEGLIGIBLE_TORQUE = 1.0
+"""[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
+N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
+torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
+
 
 def in_short(result) -> list:
     """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
@@ -396,7 +401,11 @@ def in_short(result) -> list:
     if kept:
         out.append(Line(f"kept at the description's nominal values (this log does not determine them): "
                         f"{', '.join(n for n in r.base.names if n in kept)}"))
-    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std) if not rel < NOT_DETERMINED and n not in kept]
+    share = (r.diagnostics or {}).get("sigma_torque_percent", {})
+    near_zero = {n for n in r.base.names if n.startswith("offset") and share.get(n) is not None
+                 and share[n] < NEGLIGIBLE_TORQUE}
+    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std)
+             if not rel < NOT_DETERMINED and n not in kept and n not in near_zero]
     if loose:
         out.append(Line(f"not determined by this log (σ ≥ {NOT_DETERMINED:g} % of the value): {', '.join(loose)}: their "
                         "values are set by the noise; a richer excitation (dynid excite) determines them"))
