@@ -408,7 +408,7 @@ class AccumulatingEstimator(Estimator):
         """
         from .accumulate import LeastSquaresAccumulator
 
-        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         w = np.asarray(w, dtype=np.float64)
         if w.ndim != 2:
             raise ShapeError(f"expected W with shape (N*n_dof, n_params), got {w.shape}")
@@ -442,7 +442,7 @@ class AccumulatingEstimator(Estimator):
         -------
         self
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         w, tau_flat = check_observations(w, tau, self.n_dof)
         self.__dict__.pop("accumulator_", None)
         self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat)

@@ -62,7 +62,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         bounds, objective = self._objectives(w, tau)
         res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)

@@ -75,7 +75,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         bounds, objective = self._objectives(w, tau)
         history = []
         evaluations = 0
@@ -152,7 +152,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         ShapeError
             Wrong shapes, or a box that is not (p, 2).
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         bounds, objective = self._objectives(w, tau)
         res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
                                       rng=self.rng, callback=self.callback)

@@ -72,7 +72,7 @@ class LeastAbsoluteDeviations(Estimator):
         ShapeError
             Wrong shapes, or bounds that are not (p, 2).
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 1.0)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         self.n_dof_ = infer_n_dof(self.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape

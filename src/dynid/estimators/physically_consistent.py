@@ -98,7 +98,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         -------
         self
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         self.__dict__.pop("accumulator_", None)
         self._fit_rows(w, tau)
         self.__dict__["_solved"] = True

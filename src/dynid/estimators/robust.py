@@ -80,7 +80,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         IdentifiabilityError
             No more rows than parameters.
         """
-        w, tau = weighted_rows(w, tau, sample_weight, 0.5)
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         if not self.tuning > 0:
             raise ConfigError(f"IRLS tuning constant must be positive, got {self.tuning}")
         self.n_dof_ = infer_n_dof(self.n_dof, tau)
