@@ -282,12 +282,13 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
         prepared.append(data)
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
-    best = int(np.argmin(score))
-    if not score[best] <= (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
+    scored = bool(np.all(np.isfinite(score)))
+    best = int(np.argmin(score)) if scored else 0  # a candidate not scored: the rule's cutoff, said so
+    if scored and score[best] > (1 - SCORE_MARGIN) * score[0]:  # the rule's cutoff unless another is clearly better
         best = 0
     among = f"{', '.join(f'{f:.3g}' for f in cutoffs)} Hz ({POSITION_FACTOR:g}× the band, the noise knee and their geometric mean)"
     note = (f"cutoffs {cutoffs[best]:.3g} Hz, chosen by {folds}-fold blocked cross-validation among {among}"
-            if np.all(np.isfinite(score)) else
+            if scored else
             f"cutoffs {cutoffs[0]:.3g} Hz ({POSITION_FACTOR:g}× the band): not cross-validated among {among}, as a fold "
             f"of {duration / folds:.3g} s holds too few rows to fit the {base.n_base} base parameters on the others")
     note += "" if recording is full else f" on the log's middle {recording.n_samples} samples"
