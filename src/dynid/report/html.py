@@ -52,6 +52,33 @@ class Section:
 
 BAD_RELATIVE_STD = 100.0
 """[%] A base parameter whose σ reaches its value is not determined by the data: highlighted."""
+
+NEGLIGIBLE_TORQUE = 1.0
+"""[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
+N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
+torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
+
+
+def not_determined(name: str, relative_std: float | None, sigma_torque_percent: dict) -> bool:
+    """Whether a base parameter is not determined by the log: σ of :data:`BAD_RELATIVE_STD` of its value or more,
+    except a torque offset whose ±σ is under :data:`NEGLIGIBLE_TORQUE` of its joint's torque (determined: about 0).
+
+    Parameters
+    ----------
+    name : str
+    relative_std : float or None
+        σ over |value| [%] (None: kept at the prior, no σ).
+    sigma_torque_percent : dict
+        results.json ``diagnostics.sigma_torque_percent``: each parameter's ±σ torque over its joint's RMS torque [%].
+
+    Returns
+    -------
+    bool
+    """
+    if relative_std is None or relative_std < BAD_RELATIVE_STD:  # NaN (no value to compare with) falls through
+        return False
+    share = sigma_torque_percent.get(name)
+    return not (name.startswith("offset") and share is not None and share < NEGLIGIBLE_TORQUE)
 BAD_ERROR = 50.0
 """[%] A joint's relative torque error from here on is highlighted."""
 
@@ -127,10 +154,12 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
                  "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
                  "—" if p["name"] in kept else _fmt(p["relative_std_percent"], ".3g"),
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
+        share = (d.get("diagnostics") or {}).get("sigma_torque_percent") or {}
         flagged = {(i, 4) for i, p in enumerate(d["base_parameters"])
-                   if p.get("relative_std_percent") is not None and p["relative_std_percent"] >= BAD_RELATIVE_STD}
+                   if p["name"] not in kept and not_determined(p["name"], p.get("relative_std_percent"), share)}
         sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
-                                                          f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted",
+                                                          f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted, but a "
+                                                          f"torque offset within ±{NEGLIGIBLE_TORQUE:g} % of its joint's torque",
                                                           ["name", "unit", "value", "σ", "σ %", *(r["name"] for r in refs), "expression"], rows,
                                                           (5 + len(refs),), flagged)]))
         verdicts = d.get("physically_consistent_verdict", {})

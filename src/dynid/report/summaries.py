@@ -14,6 +14,7 @@ from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison
+from .html import BAD_RELATIVE_STD, not_determined
 
 __all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
            "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "closed_loop_study_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
@@ -351,15 +352,6 @@ def validation_verdict(comparisons) -> list:
     return out
 
 
-NOT_DETERMINED = 100.0
-"""[%] A base parameter whose σ reaches this share of its value is said to be not determined by the log."""
-
-NEGLIGIBLE_TORQUE = 1.0
-"""[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
-N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
-torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
-
-
 def in_short(result) -> list:
     """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
     log's global error and worst joint, and what to do next.
@@ -401,13 +393,11 @@ def in_short(result) -> list:
     if kept:
         out.append(Line(f"kept at the description's nominal values (this log does not determine them): "
                         f"{', '.join(n for n in r.base.names if n in kept)}"))
-    share = (r.diagnostics or {}).get("sigma_torque_percent", {})
-    near_zero = {n for n in r.base.names if n.startswith("offset") and share.get(n) is not None
-                 and share[n] < NEGLIGIBLE_TORQUE}
+    share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     loose = [n for n, rel in zip(r.base.names, r.solution.relative_std)
-             if not rel < NOT_DETERMINED and n not in kept and n not in near_zero]
+             if n not in kept and not_determined(n, float(rel), share)]
     if loose:
-        out.append(Line(f"not determined by this log (σ ≥ {NOT_DETERMINED:g} % of the value): {', '.join(loose)}: their "
+        out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value): {', '.join(loose)}: their "
                         "values are set by the noise; a richer excitation (dynid excite) determines them"))
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
