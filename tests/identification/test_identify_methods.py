@@ -1,6 +1,7 @@
 """Every estimator on a log (the paper's ABC included): one registry for run and identify."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -216,8 +217,14 @@ def test_a_log_at_rest_throughout_says_what_its_figure_checks(tmp_path):
     pose = pose + np.random.default_rng(4).normal(0.0, 2e-5, pose.shape)  # the encoders' noise: a held arm
     write_log(tmp_path / "valid.csv", robot, t, pose, np.zeros_like(pose), np.zeros_like(pose), friction,
               np.random.default_rng(3))
-    text = render_text(in_short(run_identification(load_identification_config(cfg))), 400)
+    result = run_identification(load_identification_config(cfg))
+    text = render_text(in_short(result), 400)
     rest = next(line for line in text.splitlines() if line.startswith("validation:"))
     assert "at rest throughout: the distance to the static-friction band" in rest and "noise floor" not in rest
     fit = next(line for line in text.splitlines() if line.startswith("identification:"))
     assert "noise floor" in fit and "at rest" not in fit
+    # several resting logs share one line (the UR10e's p1-p10 took twenty lines to say "0 %" ten times)
+    held = result.validations[0]
+    twice = replace(result, validations=(held, replace(held, name="held again")))
+    lines = [line for line in render_text(in_short(twice), 400).splitlines() if "at rest throughout" in line]
+    assert len(lines) == 1 and lines[0].startswith("validation, held again (2 logs at rest throughout): torque error")

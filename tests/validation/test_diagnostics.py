@@ -132,3 +132,24 @@ def test_a_position_finding_is_sized_by_what_it_explains(rng):
     (f,) = [f for f in findings if f.kind == "position"]
     size = float(f.text.split("±")[1].split(" N·m")[0])
     assert size < rms[0]
+
+
+def test_the_nominal_gate_calls_an_equal_log_equal_not_better(rng):
+    """A log where the estimate and the nominal model predict alike (the UR10e's resting logs: both 0 % within the
+    static-friction band) was counted as one the estimate predicts "better"; it is now named as the same, and the
+    logs that show a difference come first."""
+    from dynid.validation.diagnostics import nominal_gate
+    from dynid.validation.torques import TorqueComparison
+
+    t = np.arange(400) * 0.01
+    measured = np.column_stack([np.sin(t), 2 * np.cos(0.7 * t)])
+    close = measured + 0.01 * rng.standard_normal(measured.shape)
+    far = 1.3 * measured
+    moving = TorqueComparison("moving", t, measured, {"est": close, "nominal": far})
+    alike = TorqueComparison("alike", t, measured, {"est": far, "nominal": far})
+    (gate,), stats = nominal_gate([alike, moving], "est", "nominal")
+    assert stats["alike"]["worse_joints"] == [] and stats["moving"]["worse_joints"] == []
+    assert "better on 1 of the 2 logs (moving:" in gate.text and gate.text.endswith("the same on alike")
+    assert "every joint of the validation logs better" not in gate.text
+    (only,), _ = nominal_gate([moving], "est", "nominal")
+    assert only.text.startswith("est predicts every joint of the validation logs better") and "alike" not in only.text

@@ -293,6 +293,45 @@ def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
     return j, float(rel[j])
 
 
+_AT_REST = ("the distance to the static-friction band, a check of the gravity model to within friction, not of "
+            "motion")
+
+
+def _log_lines(r, label: str) -> tuple[list, dict]:
+    """:func:`in_short`'s line per scored log (global error, worst joint, noise floor) and the global errors [%] by
+    log. Logs at rest throughout share one line when there are several (the UR10e's p1-p10 took twenty lines to say
+    "0 %" ten times)."""
+    out, errors, still = [], {}, []
+    for c in (r.fit, *r.validations):
+        m = c.metrics().get(label)
+        if m is None:
+            continue
+        worst = worst_joint(m["relative_error"], c.meaningful())
+        errors[c.name] = float(m["global_relative_error"])
+        if c is not r.fit and c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95)):
+            still.append((c.name, errors[c.name], worst))
+            continue
+        floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
+        out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
+                        + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
+                        + (f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
+                        + (" (the fit)" if c is r.fit else "")))
+    if len(still) == 1:
+        name, e, worst = still[0]
+        out.append(Line(f"{name}: torque error {e:.3g} % over all joints"
+                        + ("" if worst is None or worst[1] == 0 else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
+                        + f" (at rest throughout: {_AT_REST})"))
+    elif still:
+        low, high = min(e for _, e, _ in still), max(e for _, e, _ in still)
+        spread = f"{low:.3g} %" if high == low else f"{low:.3g}-{high:.3g} %"
+        name, _, worst = max(still, key=lambda x: -np.inf if x[2] is None else x[2][1])
+        out.append(Line(f"{', '.join(x[0] for x in still)} ({len(still)} logs at rest throughout): torque error "
+                        f"{spread} over all joints" + ("" if worst is None or worst[1] == 0 else
+                                                      f", worst {name} J{worst[0] + 1} {worst[1]:.3g} %")
+                        + f" ({_AT_REST})"))
+    return out, errors
+
+
 def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
     meaningful joint, the best set named.
@@ -374,21 +413,8 @@ def in_short(result) -> list:
            Line(f"main estimate: {label}" + ("" if not verdict else
                                              ", physically consistent" if consistent else
                                              f", not physically consistent{export}"))]
-    errors = {}
-    for c in (r.fit, *r.validations):
-        m = c.metrics().get(label)
-        if m is None:
-            continue
-        worst = worst_joint(m["relative_error"], c.meaningful())
-        errors[c.name] = float(m["global_relative_error"])
-        floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
-        still = c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
-        out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
-                        + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
-                        + (" (at rest throughout: the distance to the static-friction band, a check of the gravity "
-                           "model to within friction, not of motion)" if still else
-                           f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
-                        + (" (the fit)" if c is r.fit else "")))
+    lines, errors = _log_lines(r, label)
+    out += lines
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
         out.append(Line(f"kept at the description's nominal values (this log does not determine them): "

@@ -372,8 +372,8 @@ def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], 
             shown = ", ".join(f"J{j + 1} {own[j]:.3g} % against {nom[j]:.3g} %" for j in worse[:4])
             worse_lines.append(f"{v.name}: {shown}" + (f" and {len(worse) - 4} more" if len(worse) > 4 else ""))
         else:
-            better.append(f"{v.name}: {float(metrics[label]['global_relative_error']):.3g} % against "
-                          f"{float(metrics[nominal]['global_relative_error']):.3g} %")
+            own_g, nom_g = float(metrics[label]["global_relative_error"]), float(metrics[nominal]["global_relative_error"])
+            better.append((own_g < nom_g, v.name, f"{v.name}: {own_g:.3g} % against {nom_g:.3g} %"))
     if worse_lines:
         more = f"; and {len(worse_lines) - 3} more logs" if len(worse_lines) > 3 else ""
         return [Finding("nominal", f"the description's nominal model predicts some joints of the validation logs better "
@@ -381,10 +381,25 @@ def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], 
                                    "diagnostics.versus_nominal): keep the nominal values for those joints, or identify "
                                    "on a log that excites them (dynid excite)")], stats
     if better:
-        more = f"; and {len(better) - 3} more logs" if len(better) > 3 else ""
-        return [Finding("nominal", f"{label} predicts every joint of the validation logs better than the description's "
-                                   f"nominal model ({'; '.join(better[:3])}{more}, over all joints)")], stats
+        return [Finding("nominal", _no_worse_than_nominal(label, better))], stats
     return [], stats
+
+
+def _no_worse_than_nominal(label: str, logs: list) -> str:
+    """:func:`nominal_gate`'s sentence when no joint is worse; ``logs``: (strictly better overall, name, figures) per
+    log. A log where both score the same (at rest within the static-friction band both read 0 %) is said to be equal,
+    not better, and the logs that show a difference come first."""
+    strict = [text for better, _, text in logs if better]
+    same = [name for better, name, _ in logs if not better]
+    shown = strict[:3]
+    more = f"; and {len(strict) - 3} more logs" if len(strict) > 3 else ""
+    if not same:
+        return (f"{label} predicts every joint of the validation logs better than the description's nominal model "
+                f"({'; '.join(shown)}{more}, over all joints)")
+    equal = ", ".join(same[:4]) + (f" and {len(same) - 4} more" if len(same) > 4 else "")
+    head = (f"{label} predicts no joint of the validation logs worse than the description's nominal model: better on "
+            f"{len(strict)} of the {len(logs)} logs")
+    return head + (f" ({'; '.join(shown)}{more}, over all joints)" if strict else "") + f", the same on {equal}"
 
 
 BOOTSTRAP_BLOCKS = 20
