@@ -118,7 +118,10 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     assert len(lines) < 60, len(lines)
     text = " ".join(p.stdout.split())
     assert "In short (every table: --verbose, and report.html)" in text and "Verdict on the model" in text
-    assert "p10: torque error" in text and "next:" in text and "payload, from the loaded run" in text
+    assert "ptp_10_points: torque error" in text and "next:" in text and "payload, from the loaded run" in text
+    # the ten logs that hold the arm still share one line (they took twenty to say "0 %" ten times)
+    assert "p1, p2, p3, p4, p5, p6, p7, p8, p9, p10 (10 logs at rest throughout): torque error 0 % over all joints" in text
+    assert "p10: torque error" not in text
     assert "Base parameters" not in text and "RMSE" not in text
     assert (tmp_path / "u" / "report.html").is_file()
     # dynid validate the same way: each log's line, the mean over the logs with the best set, the next step

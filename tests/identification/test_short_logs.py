@@ -35,8 +35,9 @@ def test_a_short_log_with_joints_that_move_one_way_identifies(tmp_path):
     p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
     assert p.returncode == 0, p.stderr
     text = " ".join((p.stdout + p.stderr).split())
-    assert "kept at the description's nominal values (this log does not determine them): fc3, offset3, fc5, offset5" \
-        in text, text
+    assert ("taken from the description's nominal values along what this log does not determine (no σ): fc3, offset3, "
+            "fc5, offset5; J3, J5 moved one way only: Coulomb friction + offset is estimated as one term, the split "
+            "between them is the description's") in text, text
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     (finding,) = [f for f in results["findings"] if f["kind"] == "prior"]
     assert "J3, J5 moved one way only" in finding["text"]

@@ -332,6 +332,22 @@ def _log_lines(r, label: str) -> tuple[list, dict]:
     return out, errors
 
 
+def _kept_line(kept: list, dead) -> Line:
+    """:func:`in_short`'s line on the parameters the log does not determine (:attr:`LeastSquaresSolution.from_prior`).
+    A joint that moved one way only has its Coulomb friction and offset undetermined apart, not each: their sum is
+    estimated and only the split is the description's (it read "kept at the description's nominal values" beside
+    fc = offset = 4.7 N·m, nominal 0)."""
+    pairs = sorted(int(n[2:]) for n in kept
+                   if n.startswith("fc") and n[2:].isdigit() and f"offset{n[2:]}" in kept and int(n[2:]) - 1 not in dead)
+    text = (f"taken from the description's nominal values along what this log does not determine (no σ): "
+            f"{', '.join(kept)}")
+    if pairs:
+        joints = ", ".join(f"J{j}" for j in pairs)
+        text += (f"; {joints} moved one way only: Coulomb friction + offset is estimated as one term, the split between "
+                 "them is the description's")
+    return Line(text)
+
+
 def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
     meaningful joint, the best set named.
@@ -417,8 +433,7 @@ def in_short(result) -> list:
     out += lines
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
-        out.append(Line(f"kept at the description's nominal values (this log does not determine them): "
-                        f"{', '.join(n for n in r.base.names if n in kept)}"))
+        out.append(_kept_line([n for n in r.base.names if n in kept], r.fit.dead))
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     loose = [n for n, rel in zip(r.base.names, r.solution.relative_std)
              if n not in kept and not_determined(n, float(rel), share)]
