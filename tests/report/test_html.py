@@ -92,4 +92,14 @@ def test_values_outside_their_range_are_highlighted():
     fit = next(s for s in sections if s.title.startswith("Measured")).tables[0]
     assert fit.flagged == {(0, 2)} and fit.rows[0][3] == "n/m"  # J2's torque is at the noise level: not flagged, n/m
     summary = next(s for s in sections if s.title == "In short").texts
-    assert summary[1] == "identification: torque error 5 % over all joints, worst J1 80 %."
+    assert summary[1] == "identification: torque error 5 % over all joints, worst J1 80 % (the fit)."
+    # the report's summary says what the terminal's does (one function): resting logs share one line
+    resting = {"n_samples": 10, "relative_error_meaningful": [True, True], "rest_share": [1.0, 0.97],
+               "metrics": {"dynid WLS": {"relative_error": [0.0, 0.0], "rmse": [0.0, 0.0],
+                                         "correlation": [None, None], "global_relative_error": 0.0}}}
+    d["validation"] = [{**resting, "name": "p1"}, {**resting, "name": "p2"}]
+    _, sections = identify_sections(d)
+    summary = next(s for s in sections if s.title == "In short").texts
+    assert [t for t in summary if "rest" in t] == [
+        "p1, p2 (2 logs at rest throughout): torque error 0 % over all joints (the distance to the static-friction "
+        "band, a check of the gravity model to within friction, not of motion)."]

@@ -202,19 +202,26 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 def _identify_summary(d: dict) -> list[str]:
     """How an identification went, from its results: the estimate to use, whether it is physically consistent, each
     log's error and worst joint, what was not determined (the terminal's "In short")."""
-    from .summaries import worst_joint
+    from .summaries import ScoredLog, log_summaries, worst_joint
 
     label = d.get("main_estimate", "")
     verdict = d.get("physically_consistent_verdict", {}).get(label, "")
     out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
                               else ", not physically consistent.")] if label else []
+    logs = []
     for c in ([d["identification"]] if "identification" in d else []) + list(d.get("validation", [])):
         m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)
         if not m:
             continue
         worst = worst_joint(m["relative_error"], c.get("relative_error_meaningful") or [True] * len(m["relative_error"]))
-        out.append(f"{c['name']}: torque error {_fmt(m.get('global_relative_error'), '.3g')} % over all joints"
-                   + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %") + ".")
+        error = m.get("global_relative_error")
+        floor = (c.get("noise_floor") or {}).get("global_relative_error")
+        fit = c is d.get("identification")
+        rest = [] if c.get("rest_share") is None else [float(x) for x in c["rest_share"]]
+        logs.append(ScoredLog(c["name"], float("nan") if error is None else float(error), worst,
+                              not fit and bool(rest) and min(rest) >= 0.95, float("nan") if floor is None else float(floor),
+                              fit))
+    out += [f"{line}." for line in log_summaries(logs)]
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")
     findings = d.get("findings") or []

@@ -5,6 +5,7 @@ the results hold numbers, this module their text. :func:`summary` renders any re
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -298,38 +299,78 @@ _AT_REST = ("the distance to the static-friction band, a check of the gravity mo
 
 
 def _log_lines(r, label: str) -> tuple[list, dict]:
-    """:func:`in_short`'s line per scored log (global error, worst joint, noise floor) and the global errors [%] by
-    log. Logs at rest throughout share one line when there are several (the UR10e's p1-p10 took twenty lines to say
-    "0 %" ten times)."""
-    out, errors, still = [], {}, []
+    """:func:`in_short`'s line per scored log (:func:`log_summaries`) and the global errors [%] by log."""
+    logs, errors = [], {}
     for c in (r.fit, *r.validations):
         m = c.metrics().get(label)
         if m is None:
             continue
-        worst = worst_joint(m["relative_error"], c.meaningful())
         errors[c.name] = float(m["global_relative_error"])
-        if c is not r.fit and c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95)):
-            still.append((c.name, errors[c.name], worst))
-            continue
+        still = c is not r.fit and c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
-        out.append(Line(f"{c.name}: torque error {m['global_relative_error']:.3g} % over all joints"
-                        + ("" if worst is None else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
-                        + (f" (noise floor {floor:.2g} %)" if np.isfinite(floor) else "")
-                        + (" (the fit)" if c is r.fit else "")))
+        logs.append(ScoredLog(c.name, errors[c.name], worst_joint(m["relative_error"], c.meaningful()), still,
+                              float(floor), c is r.fit))
+    return [Line(text) for text in log_summaries(logs)], errors
+
+
+@dataclass(frozen=True)
+class ScoredLog:
+    """What the summaries say of one scored log (:func:`log_summaries`).
+
+    Attributes
+    ----------
+    name : str
+        The dataset.
+    error : float
+        Global relative torque error [%] of the estimate judged.
+    worst : (int, float) or None
+        Worst meaningful joint (0-based) and its error [%] (:func:`worst_joint`).
+    still : bool
+        Whether every joint rests in 95 % of the log or more (scored against the static-friction band).
+    floor : float
+        Noise floor [%] of these samples (NaN: unknown).
+    fit : bool
+        Whether it is the identification log.
+    """
+
+    name: str
+    error: float
+    worst: tuple[int, float] | None
+    still: bool
+    floor: float = float("nan")
+    fit: bool = False
+
+
+def log_summaries(logs) -> list[str]:
+    """One line per scored log, as the terminal's and the report's "In short" give them: global error, worst joint,
+    noise floor. Logs at rest throughout share one line when there are several (the UR10e's p1-p10 took twenty lines
+    to say "0 %" ten times), and a worst joint at 0 % is not named.
+
+    Parameters
+    ----------
+    logs : sequence of ScoredLog
+
+    Returns
+    -------
+    list of str
+    """
+    def worst_text(worst, name=""):
+        return "" if worst is None or worst[1] == 0 else f", worst {name}J{worst[0] + 1} {worst[1]:.3g} %"
+
+    out = [f"{g.name}: torque error {g.error:.3g} % over all joints" + worst_text(g.worst)
+           + (f" (noise floor {g.floor:.2g} %)" if np.isfinite(g.floor) else "") + (" (the fit)" if g.fit else "")
+           for g in logs if not g.still]
+    still = [g for g in logs if g.still]
     if len(still) == 1:
-        name, e, worst = still[0]
-        out.append(Line(f"{name}: torque error {e:.3g} % over all joints"
-                        + ("" if worst is None or worst[1] == 0 else f", worst J{worst[0] + 1} {worst[1]:.3g} %")
-                        + f" (at rest throughout: {_AT_REST})"))
+        out.append(f"{still[0].name}: torque error {still[0].error:.3g} % over all joints{worst_text(still[0].worst)} "
+                   f"(at rest throughout: {_AT_REST})")
     elif still:
-        low, high = min(e for _, e, _ in still), max(e for _, e, _ in still)
-        spread = f"{low:.3g} %" if high == low else f"{low:.3g}-{high:.3g} %"
-        name, _, worst = max(still, key=lambda x: -np.inf if x[2] is None else x[2][1])
-        out.append(Line(f"{', '.join(x[0] for x in still)} ({len(still)} logs at rest throughout): torque error "
-                        f"{spread} over all joints" + ("" if worst is None or worst[1] == 0 else
-                                                      f", worst {name} J{worst[0] + 1} {worst[1]:.3g} %")
-                        + f" ({_AT_REST})"))
-    return out, errors
+        low, high = min(g.error for g in still), max(g.error for g in still)
+        spread = f"{low:.3g} %" if f"{high:.3g}" == f"{low:.3g}" else f"{low:.3g}-{high:.3g} %"
+        top = max(still, key=lambda g: -np.inf if g.worst is None else g.worst[1])
+        out.append(f"{', '.join(g.name for g in still)} ({len(still)} logs at rest throughout): torque error {spread} "
+                   f"over all joints{worst_text(top.worst, top.name + ' ')} ({_AT_REST})")
+    return out
 
 
 def _kept_line(kept: list, dead) -> Line:
