@@ -62,20 +62,3 @@ def test_a_meaningless_correlation_and_a_pseudo_inertias_zero_are_compared_as_su
         "/validation[0]/metrics/dynid OLS/correlation[1]: 0.9 -> 0.8"]
     assert digests.differences(stored, {**moved, "/estimates/dynid SDP/pseudo_inertia_min_eig[0]": -1e-4}) == [
         "/estimates/dynid SDP/pseudo_inertia_min_eig[0]: 5.6793e-07 -> -0.0001"]
-
-
-def test_every_openblas_runs_the_kernels_the_digests_were_made_with():
-    """The pin of tests/__init__.py took effect in this process (it must run before NumPy loads OpenBLAS): NumPy's
-    and SciPy's OpenBLAS both report the pinned kernels."""
-    import os
-
-    import scipy.linalg  # noqa: F401 - loads SciPy's own OpenBLAS
-    from threadpoolctl import threadpool_info
-
-    from tests import SAME_BLAS_KERNELS
-
-    pinned = os.environ.get("OPENBLAS_CORETYPE", SAME_BLAS_KERNELS)
-    if pinned is None:
-        pytest.fail("this CPU has no AVX2/FMA: the stored digests were made with AVX2 kernels; set OPENBLAS_CORETYPE")
-    blas = [i for i in threadpool_info() if i.get("internal_api") == "openblas"]
-    assert len(blas) >= 2 and all(i["architecture"].lower() == pinned.lower() for i in blas), blas
