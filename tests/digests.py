@@ -57,6 +57,28 @@ every other value."""
 DESIGN_CHECKED = ("/design/cond", "/design/initial_cond", "/design/feasible")
 DESIGN_RTOL = 0.05
 
+SCALED = "/estimates/"
+"""An SDP estimate's values (:data:`SOLVER_PATHS` under this prefix) are compared to :data:`SOLVER_RTOL` of the
+largest magnitude among the estimate's values besides their own: an optimum holds its values to the solver's
+tolerance on the problem's scale, not each to itself. A friction at its bound of 0 (the LBR Med7's SDP: fv1 = 2.0e-9 on
+one CPU, 3.7e-10 on another) or a weakly determined inertia (its XX1, 0.07189 against 0.07186) moves by more than its
+own 1e-4 (measured between a Zen 3, AVX2 kernels, where the digests were made, and a Zen 4, AVX-512 kernels)."""
+
+STATISTICS = "/diagnostics/"
+STATISTICS_RTOL = 1e-4
+"""The diagnostics are statistics of the fit's residuals (autocorrelations, t-values, the moving-block bootstrap's
+refits): on the KR 300 (cond 2.9e8) those two CPUs' kernels move them by up to 6e-5 relative."""
+
+MARGINS = ("consistency_margin",)
+"""A consistency margin is the smallest eigenvalue of the links' pseudo-inertias: compared as one
+(:data:`EIGENVALUE_ATOL`; the Med7's SDP: -1.55e-8 against -2.81e-8 on those two CPUs)."""
+
+CROSS_VALIDATION = ("/settings/friction_models/out_of_fold_rms_error",)
+CROSS_VALIDATION_RTOL = 0.1
+"""The friction models' out-of-fold errors of the candidates: fits on four fifths of the log, whose rank decisions on
+an ill-conditioned log follow the CPU's last digits (the KR 300: a candidate the choice rejects moved by 9 % between
+those CPUs). The choice itself (every joint's model) and every estimate made with it are compared as any value."""
+
 
 def data_root(config: Path) -> Path | None:
     """The shared data folder of an identification config (None when the workplace's data are absent)."""
@@ -139,6 +161,7 @@ def differences(stored: dict, now: dict, renamed: dict | None = None, dropped: t
     ``solver``: every number a solver's optimum (:data:`SOLVER_RTOL`)."""
     renamed = renamed or {}
     out = []
+    scales = _sibling_scales(stored)
     for path, old in stored.items():
         if path in dropped or _undefined(path, stored) or _undefined(path, now):
             continue
@@ -158,12 +181,47 @@ def differences(stored: dict, now: dict, renamed: dict | None = None, dropped: t
             if old is None or new is None or isinstance(old, (str, bool)) or isinstance(new, (str, bool)):
                 same = old == new
             else:
-                rtol = DESIGN_RTOL if optimised else SOLVER_RTOL if solver or any(p in path for p in SOLVER_PATHS) else RTOL
-                same = math.isclose(old, new, rel_tol=rtol, abs_tol=EIGENVALUE_ATOL if "pseudo_inertia_min_eig" in path else ATOL)
+                same = math.isclose(old, new, rel_tol=_rtol(path, optimised, solver), abs_tol=_atol(path, scales))
         else:
             same = old == new
         if not same:
             out.append(f"{path}: {old!r} -> {new!r}")
+    return out
+
+
+def _rtol(path: str, optimised: bool, solver: bool) -> float:
+    """The relative tolerance of one stored leaf (module constants)."""
+    if optimised:
+        return DESIGN_RTOL
+    if path.startswith(CROSS_VALIDATION):
+        return CROSS_VALIDATION_RTOL
+    if path.startswith(STATISTICS):
+        return STATISTICS_RTOL
+    return SOLVER_RTOL if solver or any(p in path for p in SOLVER_PATHS) else RTOL
+
+
+def _atol(path: str, scales: dict) -> float:
+    """The absolute tolerance of one stored leaf: :data:`EIGENVALUE_ATOL` for eigenvalues and margins, a share of its
+    siblings' magnitude for an SDP estimate's values (:data:`SCALED`), else :data:`ATOL`."""
+    if "pseudo_inertia_min_eig" in path or any(m in path for m in MARGINS):
+        return EIGENVALUE_ATOL
+    if path.startswith(SCALED) and any(p in path for p in SOLVER_PATHS):
+        return max(ATOL, SOLVER_RTOL * scales.get(_parent(path), 0.0))
+    return ATOL
+
+
+def _parent(path: str) -> str:
+    """A leaf's parent: the path without its last key or index."""
+    return path[: path.rindex("[")] if path.endswith("]") else path.rsplit("/", 1)[0]
+
+
+def _sibling_scales(digest: dict) -> dict:
+    """Parent path -> largest magnitude of the numbers under it."""
+    out: dict = {}
+    for path, value in digest.items():
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+            key = _parent(path)
+            out[key] = max(out.get(key, 0.0), abs(float(value)))
     return out
 
 

@@ -62,3 +62,22 @@ def test_a_meaningless_correlation_and_a_pseudo_inertias_zero_are_compared_as_su
         "/validation[0]/metrics/dynid OLS/correlation[1]: 0.9 -> 0.8"]
     assert digests.differences(stored, {**moved, "/estimates/dynid SDP/pseudo_inertia_min_eig[0]": -1e-4}) == [
         "/estimates/dynid SDP/pseudo_inertia_min_eig[0]: 5.6793e-07 -> -0.0001"]
+
+
+def test_the_comparison_allows_another_cpus_digits_and_nothing_more():
+    """Each tolerance of tests/digests.py lets through what two CPUs' kernels were measured to move (a Zen 3 against a
+    Zen 4) and flags a change ten times smaller than a real one."""
+    sdp = "/estimates/dynid SDP/standard_values/"
+    stored = {f"{sdp}M1": 3.0, f"{sdp}XX1": 0.07189410577888398, f"{sdp}fv1": 2.0386580735360316e-09,
+              "/estimates/dynid WLS/values/fv1": 0.0123, "/consistency_margin/dynid SDP": -1.554626574708685e-08,
+              "/diagnostics/bootstrap_std/MY2": 164413.39852469388, "/diagnostics/position_t[1]": 0.04665770085660343,
+              "/settings/friction_models/out_of_fold_rms_error[13][5]": 49.68590919069535}
+    measured = {f"{sdp}XX1": 0.07186426369692626, f"{sdp}fv1": 3.7e-10, "/consistency_margin/dynid SDP": -2.81e-08,
+                "/diagnostics/bootstrap_std/MY2": 164417.40466010655, "/diagnostics/position_t[1]": 0.046654826174520506,
+                "/settings/friction_models/out_of_fold_rms_error[13][5]": 54.45643018108679}
+    assert digests.differences(stored, {**stored, **measured}) == []
+    moved = {f"{sdp}M1": 3.003, f"{sdp}fv1": 0.003, "/estimates/dynid WLS/values/fv1": 0.0123 * (1 + 1e-5),
+             "/consistency_margin/dynid SDP": -1e-5, "/diagnostics/bootstrap_std/MY2": 164413.39852469388 * 1.001,
+             "/diagnostics/position_t[1]": 0.0467 * 1.001, "/settings/friction_models/out_of_fold_rms_error[13][5]": 60.0}
+    for path, value in moved.items():
+        assert [d.split(":")[0] for d in digests.differences(stored, {**stored, path: value})] == [path], path
