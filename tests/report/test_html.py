@@ -103,3 +103,21 @@ def test_values_outside_their_range_are_highlighted():
     assert [t for t in summary if "rest" in t] == [
         "p1, p2 (2 logs at rest throughout): torque error 0 % over all joints (the distance to the static-friction "
         "band, a check of the gravity model to within friction, not of motion)."]
+
+
+def test_the_report_says_a_flag_several_logs_share_once_and_what_export_writes():
+    """The UR10e's ten resting logs each flagged "every joint at rest in 95 % of the log or more: …" (ten entries of
+    the same words); and its summary said "Use dynid OLS, not physically consistent." where the terminal adds what
+    dynid export writes instead."""
+    from dynid.report.html import _identify_summary, said
+
+    rest = "every joint at rest in 95 % of the log or more: the error there is the distance to the band"
+    d = {"validation": [{"name": "p1", "flags": [f"p1: {rest}", "p1: J1 barely moves (RMS 1.3 N·m)"]},
+                        {"name": "p2", "flags": [f"p2: {rest}", "p2: J1 barely moves (RMS 0.6 N·m)"]}],
+         "warnings": ["a warning"], "main_estimate": "dynid OLS",
+         "physically_consistent_verdict": {"dynid OLS": "no: an eigenvalue < 0", "dynid SDP": "yes"},
+         "estimates": {"dynid OLS": {"values": {}}, "dynid SDP": {"values": {}, "standard_values": {"M1": 1.0}}}}
+    assert said(d) == ["a warning", f"p1, p2: {rest}", "p1: J1 barely moves (RMS 1.3 N·m)",
+                       "p2: J1 barely moves (RMS 0.6 N·m)"]
+    assert _identify_summary({**d, "validation": []})[0] == ("Use dynid OLS, not physically consistent; dynid export writes dynid SDP, "
+                                       "which is consistent.")

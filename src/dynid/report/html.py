@@ -205,9 +205,14 @@ def _identify_summary(d: dict) -> list[str]:
     from .summaries import ScoredLog, log_summaries, worst_joint
 
     label = d.get("main_estimate", "")
-    verdict = d.get("physically_consistent_verdict", {}).get(label, "")
+    verdicts = d.get("physically_consistent_verdict", {})
+    verdict = verdicts.get(label, "")
+    # what dynid export writes when the main estimate is not consistent (the terminal's "In short" says it too)
+    export = next((n for n, e in (d.get("estimates") or {}).items() if isinstance(e, dict) and e.get("standard_values")
+                   and str(verdicts.get(n, "")).startswith("yes")), None)
     out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
-                              else ", not physically consistent.")] if label else []
+                              else ", not physically consistent" + (f"; dynid export writes {export}, which is consistent."
+                                                                    if export else "."))] if label else []
     logs = []
     for c in ([d["identification"]] if "identification" in d else []) + list(d.get("validation", [])):
         m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)
@@ -402,9 +407,15 @@ def said(data: dict) -> list[str]:
     """
     out = [f"finding: {f['text']}" for f in data.get("findings") or [] if isinstance(f, dict) and f.get("text")]
     out += [str(w) for w in data.get("warnings") or []]
+    flags: dict[str, list[str]] = {}  # a flag several logs share (ten resting logs: "every joint at rest …") once
     for c in ([data["identification"]] if isinstance(data.get("identification"), dict) else []) + \
             [v for v in data.get("validation") or [] if isinstance(v, dict)]:
-        out += [str(f) for f in c.get("flags") or []]
+        name = str(c.get("name", ""))
+        for f in c.get("flags") or []:
+            text = str(f)
+            own = bool(name) and text.startswith(f"{name}: ")
+            flags.setdefault(text[len(name) + 2:] if own else text, []).extend([name] if own else [])
+    out += [f"{', '.join(names)}: {text}" if names else text for text, names in flags.items()]
     return list(dict.fromkeys(out))
 
 
