@@ -181,3 +181,13 @@ def test_the_papers_table2_is_said_to_be_inconsistent_and_why():
     assert said == f"the paper's Table 2 values are not consistent ({verdict.removeprefix('no: ')})" and "inf" not in said
     assert _truth_consistency({"plant": "assumed", "truth_consistency": "yes", "truth_consistency_margin": 0.15}) == \
         "the simulated truth is consistent"
+
+
+def test_the_line_on_the_search_box_names_the_searches_that_ran():
+    """`dynid run` (OLS and the ABC) said "LAD, ABC, DE and PSO search the paper's Table 3 box" though only the ABC
+    searched it; the line names the box searches among the run's estimators, and is left out when none ran."""
+    from dynid.report.paper_summary import _box_searches
+
+    assert _box_searches({"estimates": {"ols": {}, "abc": {}}}) == "ABC searches"
+    assert _box_searches({"estimates": {"ols": {}, "lad": {}, "abc": {}, "pso": {}}}) == "LAD, ABC and PSO search"
+    assert _box_searches({"estimates": {"ols": {}, "wls": {}}}) == ""

@@ -54,10 +54,11 @@ def run_summary_blocks(result, verbose: bool = True) -> list:
     out.append(TextTable("Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; "
                          "mean over joints of ρ (eq. 18), RMSE (N·m) and error % on β2; physically consistent",
                          ("method", "F", "evals", "s", "Δβ %", "ρ β2", "RMSE", "err %", "cons."), tuple(rows)))
-    if d.get("search_box") == "table3":
-        out.append(Line("LAD, ABC, DE and PSO search the paper's Table 3 box; " + ref.TABLE3_NOTE))
-    elif d.get("search_box") == "scaled":
-        out.append(Line("LAD, ABC, DE and PSO search the box ±(2|β_OLS| + 1), which holds the truth"
+    searches = _box_searches(d)
+    if searches and d.get("search_box") == "table3":
+        out.append(Line(f"{searches} the paper's Table 3 box; " + ref.TABLE3_NOTE))
+    elif searches and d.get("search_box") == "scaled":
+        out.append(Line(f"{searches} the box ±(2|β_OLS| + 1), which holds the truth"
                         + (" (the paper's Table 3 box holds the paper's plant, not this one: --plant paper, or "
                            "--abc-bounds table3)" if cfg.robot == "er16" and cfg.joints == 3 else "")))
     per_joint = (("identification", "β1" if cfg.excitation == "paper" else "(see above)", ref.CORRELATION_IDENTIFICATION),
@@ -74,12 +75,26 @@ def run_summary_blocks(result, verbose: bool = True) -> list:
         eig = d["estimates"]["sdp"]["pseudo_inertia_min_eig"]
         verdict = "physically consistent" if min(eig) >= -CONSISTENCY_TOL else "NOT physically consistent"
         out.append(Line(f"SDP: smallest pseudo-inertia eigenvalue per link {_joined(eig, '.3g')} → {verdict}"))
-    out.append(Line("consistent: some mass distribution with non-negative friction and rotor inertias has these base "
-                    "parameters (feasibility SDP); " + _truth_consistency(d)))
+    out.append(Line("cons.: whether some mass distribution with non-negative friction and rotor inertias has the "
+                    "estimate's base parameters (feasibility SDP); " + _truth_consistency(d)))
     out.append(Line("timings (s): " + ", ".join(f"{k.replace('_', ' ')} {v:.2f}" for k, v in d["timings"].items())))
     out.extend(Line(w, "warning") for w in d["warnings"])
     out.extend(_verdict(d, methods, verbose))
     return out
+
+
+BOX_SEARCHES = ("lad", "abc", "abc10", "de", "pso")
+"""The estimators of ``dynid run`` that search a box (LAD's bounds, the ABC's, DE's and PSO's)."""
+
+
+def _box_searches(d: dict) -> str:
+    """"ABC searches" or "LAD, ABC and DE search": the box searches that ran, for the line on their box ("" if none;
+    it named all four when only the ABC ran)."""
+    labels = [spec(k).label for k in d["estimates"] if k in BOX_SEARCHES]
+    if not labels:
+        return ""
+    names = labels[0] if len(labels) == 1 else ", ".join(labels[:-1]) + " and " + labels[-1]
+    return names + (" searches" if len(labels) == 1 else " search")
 
 
 def _truth_consistency(d: dict) -> str:
