@@ -232,6 +232,13 @@ def readiness(result) -> Line:
     kinds = {f.kind for f in r.findings}
     exportable = _exportable(r)
     worse = {log: s.get("worse_joints", []) for log, s in (r.diagnostics.get("versus_nominal") or {}).items()}
+    nominal = r.diagnostics.get("nominal_set")
+    if exportable and nominal is not None and any(s.get("estimate") != exportable[0]
+                                                  for s in (r.diagnostics.get("versus_nominal") or {}).values()):
+        # the gate judged the main estimate; what is ready is what export writes (it warns on these joints)
+        from ..validation.diagnostics import nominal_gate
+
+        worse = {log: s["worse_joints"] for log, s in nominal_gate(r.validations, exportable[0], nominal)[1].items()}
     worse = {log: j for log, j in worse.items() if j}
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
@@ -243,8 +250,8 @@ def readiness(result) -> Line:
     if worse:
         log, joints = next(iter(worse.items()))
         return Line(f"not ready: the description's nominal model predicts {', '.join(f'J{j}' for j in joints)} of {log} "
-                    f"better than dynid's estimate; identify on a log that excites them (dynid excite), or keep the "
-                    "nominal values there", "warning")
+                    f"better than {exportable[0]} (what dynid export writes); identify on a log that excites them "
+                    "(dynid excite), or keep the nominal values there", "warning")
     if not r.validations:
         return Line(f"model ready to check: {exportable[0]} is physically consistent (its URDF and MJCF are in the output "
                     "folder); add [[validation]] logs (other motions) before you use it", "title")
