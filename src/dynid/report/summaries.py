@@ -313,7 +313,7 @@ def _log_lines(r, label: str) -> tuple[list, dict]:
         if m is None:
             continue
         errors[c.name] = float(m["global_relative_error"])
-        still = c is not r.fit and c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
+        still = c is not r.fit and _rests_throughout(c)
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
         logs.append(ScoredLog(c.name, errors[c.name], worst_joint(m["relative_error"], c.meaningful()), still,
                               float(floor), c is r.fit))
@@ -396,9 +396,25 @@ def _kept_line(kept: list, dead) -> Line:
     return Line(text)
 
 
+def _rests_throughout(c) -> bool:
+    """Whether every joint rests in 95 % of a log or more: its error is then the distance to the static-friction band
+    (a check of the gravity model within friction), not a prediction of motion."""
+    return c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
+
+
+def _best(errors: dict) -> str:
+    """"; best: X", or "; equal best: X, Y" where sets tie at the three digits shown ("" for one set)."""
+    if len(errors) < 2:
+        return ""
+    low = min(errors.values())
+    tied = [k for k, v in errors.items() if f"{v:.3g}" == f"{low:.3g}"]
+    return f"; best: {tied[0]}" if len(tied) == 1 else f"; equal best: {', '.join(tied)}"
+
+
 def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     """How a validation went, first: for each log, each parameter set's torque error over all joints and its worst
-    meaningful joint, the best set named.
+    meaningful joint, the best set named (sets that tie at the digits shown named together); logs at rest throughout
+    in one line (their figure is a check of the gravity model within friction).
 
     Parameters
     ----------
@@ -411,21 +427,35 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     list of Line
     """
     out = [Line("In short (the tables follow)" if tables_follow else "In short (every table: --verbose, and report.html)", "title")]
+    still = [c for c in comparisons if _rests_throughout(c)]
     for c in comparisons:
+        if c in still and len(still) > 1:
+            continue
         metrics, ok = c.metrics(), c.meaningful()
         parts = []
         for name, m in metrics.items():
             worst = worst_joint(m["relative_error"], ok)
-            parts.append(f"{name} {m['global_relative_error']:.3g} %" + ("" if worst is None else f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
-        best = min(metrics, key=lambda k: metrics[k]["global_relative_error"]) if metrics else None
+            parts.append(f"{name} {m['global_relative_error']:.3g} %" + ("" if worst is None or worst[1] == 0 else
+                                                                       f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
         out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
-                        + ("" if best is None or len(metrics) < 2 else f"; best: {best}")))
+                        + _best({k: m["global_relative_error"] for k, m in metrics.items()})
+                        + (f" (at rest throughout: {_AT_REST})" if c in still else "")))
+    if len(still) > 1:
+        spans = {}
+        for c in still:
+            for name, m in c.metrics().items():
+                spans.setdefault(name, []).append(float(m["global_relative_error"]))
+        parts = [f"{name} {min(v):.3g} %" if f"{min(v):.3g}" == f"{max(v):.3g}" else f"{name} {min(v):.3g}-{max(v):.3g} %"
+                 for name, v in spans.items()]
+        out.append(Line(f"{', '.join(c.name for c in still)} ({len(still)} logs at rest throughout): torque error over "
+                        f"all joints: {'; '.join(parts)} ({_AT_REST})"))
     return out
 
 
 def validation_verdict(comparisons) -> list:
-    """The last lines of ``dynid validate``: each parameter set's mean torque error over the logs, the set to use and
-    the next step.
+    """The last lines of ``dynid validate``: each parameter set's mean torque error over the logs that move (logs at
+    rest throughout check the gravity model within friction and would dilute the mean), the set to use and the next
+    step.
 
     Parameters
     ----------
@@ -435,18 +465,21 @@ def validation_verdict(comparisons) -> list:
     -------
     list of Line
     """
+    moving = [c for c in comparisons if not _rests_throughout(c)] or list(comparisons)
     errors: dict[str, list[float]] = {}
-    for c in comparisons:
+    for c in moving:
         for name, m in c.metrics().items():
             errors.setdefault(name, []).append(m["global_relative_error"])
     if not errors:
         return []
     means = {name: float(np.mean(v)) for name, v in errors.items()}
     best = min(means, key=lambda k: means[k])
-    n = len(comparisons)
-    out = [Line(f"mean torque error over the {n} log{'s' if n > 1 else ''}: "
-                + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
-                + (f" — best: {best}" if len(means) > 1 else ""), "title")]
+    n, left = len(moving), len(comparisons) - len(moving)
+    what = f"the {n} log{'s' if n > 1 else ''}" if not left else \
+        (f"the {n} log{'s that move' if n > 1 else ' that moves'} ({left} at rest throughout left out: they check the "
+         "gravity model)")
+    out = [Line(f"mean torque error over {what}: " + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
+                + (_best(means).replace("; ", " — ", 1) if len(means) > 1 else ""), "title")]
     if not best.startswith("dynid"):
         out.append(Line(f"next: {best} predicts these logs better than dynid's estimates; identify on a log that moves "
                         "as these do, or add them to [[validation]] to choose among the estimates"))
