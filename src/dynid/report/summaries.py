@@ -441,7 +441,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
                         + _best({k: m["global_relative_error"] for k, m in metrics.items()})
                         + (f" (at rest throughout: {_AT_REST})" if c in still else "")))
     if len(still) > 1:
-        spans = {}
+        spans: dict[str, list[float]] = {}
         for c in still:
             for name, m in c.metrics().items():
                 spans.setdefault(name, []).append(float(m["global_relative_error"]))
