@@ -202,6 +202,7 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 def _identify_summary(d: dict) -> list[str]:
     """How an identification went, from its results: the estimate to use, whether it is physically consistent, each
     log's error and worst joint, what was not determined (the terminal's "In short")."""
+    from ..validation.torques import rests_throughout
     from .summaries import ScoredLog, log_summaries, worst_joint
 
     label = d.get("main_estimate", "")
@@ -222,10 +223,9 @@ def _identify_summary(d: dict) -> list[str]:
         error = m.get("global_relative_error")
         floor = (c.get("noise_floor") or {}).get("global_relative_error")
         fit = c is d.get("identification")
-        rest = [] if c.get("rest_share") is None else [float(x) for x in c["rest_share"]]
         logs.append(ScoredLog(c["name"], float("nan") if error is None else float(error), worst,
-                              not fit and bool(rest) and min(rest) >= 0.95, float("nan") if floor is None else float(floor),
-                              fit))
+                              not fit and rests_throughout(c.get("rest_share")),
+                              float("nan") if floor is None else float(floor), fit))
     out += [f"{line}." for line in log_summaries(logs)]
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")

@@ -14,7 +14,7 @@ from ..estimators.registry import label
 from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.noise_floor import AT_FLOOR
-from ..validation.torques import TorqueComparison
+from ..validation.torques import TorqueComparison, rests_throughout
 from .html import BAD_RELATIVE_STD, not_determined
 
 __all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
@@ -313,7 +313,7 @@ def _log_lines(r, label: str) -> tuple[list, dict]:
         if m is None:
             continue
         errors[c.name] = float(m["global_relative_error"])
-        still = c is not r.fit and _rests_throughout(c)
+        still = c is not r.fit and rests_throughout(c.rest_share)
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
         logs.append(ScoredLog(c.name, errors[c.name], worst_joint(m["relative_error"], c.meaningful()), still,
                               float(floor), c is r.fit))
@@ -375,7 +375,7 @@ def log_summaries(logs) -> list[str]:
         low, high = min(g.error for g in still), max(g.error for g in still)
         spread = f"{low:.3g} %" if f"{high:.3g}" == f"{low:.3g}" else f"{low:.3g}-{high:.3g} %"
         top = max(still, key=lambda g: -np.inf if g.worst is None else g.worst[1])
-        out.append(f"{', '.join(g.name for g in still)} ({len(still)} logs at rest throughout): torque error {spread} "
+        out.append(f"{_resting([g.name for g in still])}: torque error {spread} "
                    f"over all joints{worst_text(top.worst, top.name + ' ')} ({_AT_REST})")
     return out
 
@@ -396,19 +396,18 @@ def _kept_line(kept: list, dead) -> Line:
     return Line(text)
 
 
-def _rests_throughout(c) -> bool:
-    """Whether every joint rests in 95 % of a log or more: its error is then the distance to the static-friction band
-    (a check of the gravity model within friction), not a prediction of motion."""
-    return c.rest_share is not None and bool(np.all(np.asarray(c.rest_share) >= 0.95))
-
-
-def _best(errors: dict) -> str:
+def _best(errors: dict, sep: str = "; ") -> str:
     """"; best: X", or "; equal best: X, Y" where sets tie at the three digits shown ("" for one set)."""
     if len(errors) < 2:
         return ""
     low = min(errors.values())
     tied = [k for k, v in errors.items() if f"{v:.3g}" == f"{low:.3g}"]
-    return f"; best: {tied[0]}" if len(tied) == 1 else f"; equal best: {', '.join(tied)}"
+    return f"{sep}best: {tied[0]}" if len(tied) == 1 else f"{sep}equal best: {', '.join(tied)}"
+
+
+def _resting(names: list) -> str:
+    """The head of the one line several logs at rest throughout share: "p1, p2 (2 logs at rest throughout)"."""
+    return f"{', '.join(names)} ({len(names)} logs at rest throughout)"
 
 
 def validation_in_short(comparisons, tables_follow: bool = True) -> list:
@@ -427,7 +426,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     list of Line
     """
     out = [Line("In short (the tables follow)" if tables_follow else "In short (every table: --verbose, and report.html)", "title")]
-    still = [c for c in comparisons if _rests_throughout(c)]
+    still = [c for c in comparisons if rests_throughout(c.rest_share)]
     for c in comparisons:
         if c in still and len(still) > 1:
             continue
@@ -447,7 +446,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
                 spans.setdefault(name, []).append(float(m["global_relative_error"]))
         parts = [f"{name} {min(v):.3g} %" if f"{min(v):.3g}" == f"{max(v):.3g}" else f"{name} {min(v):.3g}-{max(v):.3g} %"
                  for name, v in spans.items()]
-        out.append(Line(f"{', '.join(c.name for c in still)} ({len(still)} logs at rest throughout): torque error over "
+        out.append(Line(f"{_resting([c.name for c in still])}: torque error over "
                         f"all joints: {'; '.join(parts)} ({_AT_REST})"))
     return out
 
@@ -465,7 +464,7 @@ def validation_verdict(comparisons) -> list:
     -------
     list of Line
     """
-    moving = [c for c in comparisons if not _rests_throughout(c)] or list(comparisons)
+    moving = [c for c in comparisons if not rests_throughout(c.rest_share)] or list(comparisons)
     errors: dict[str, list[float]] = {}
     for c in moving:
         for name, m in c.metrics().items():
@@ -479,7 +478,7 @@ def validation_verdict(comparisons) -> list:
         (f"the {n} log{'s that move' if n > 1 else ' that moves'} ({left} at rest throughout left out: they check the "
          "gravity model)")
     out = [Line(f"mean torque error over {what}: " + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
-                + (_best(means).replace("; ", " — ", 1) if len(means) > 1 else ""), "title")]
+                + _best(means, " — "), "title")]
     if not best.startswith("dynid"):
         out.append(Line(f"next: {best} predicts these logs better than dynid's estimates; identify on a log that moves "
                         "as these do, or add them to [[validation]] to choose among the estimates"))

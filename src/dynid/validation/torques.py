@@ -17,7 +17,7 @@ from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
 
-__all__ = ["TorqueComparison", "TorqueSums", "compare_torques"]
+__all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "rests_throughout"]
 
 
 @dataclass(frozen=True)
@@ -211,7 +211,7 @@ class TorqueComparison:
         out = []
         first = next(iter(self.metrics().values()), None)
         share, band = self.rest_share, self.band
-        still = [] if share is None or band is None else [int(j) for j in np.flatnonzero(np.asarray(share) >= 0.95)]
+        still = [] if share is None or band is None else [int(j) for j in np.flatnonzero(np.asarray(share) >= AT_REST_SHARE)]
         if still and share is not None and band is not None:
             which = "every joint" if len(still) == len(share) else ", ".join(f"J{j + 1}" for j in still)
             out.append(f"{self.name}: {which} at rest in 95 % of the log or more: the error there is the distance to the "
@@ -280,6 +280,28 @@ class TorqueComparison:
         if floor is not None:
             out["noise_floor"] = floor
         return out
+
+
+AT_REST_SHARE = 0.95
+"""A joint at rest in this share of a log's samples or more is flagged so: its error is then the distance to the
+static-friction band."""
+
+
+def rests_throughout(rest_share) -> bool:
+    """Whether every joint of a log rests in :data:`AT_REST_SHARE` of its samples or more: its figure is then a check
+    of the gravity model within friction, not a prediction of motion.
+
+    Parameters
+    ----------
+    rest_share : (n_dof,) sequence or None
+        :attr:`TorqueComparison.rest_share` (results.json ``rest_share``).
+
+    Returns
+    -------
+    bool
+        False when the share is unknown or empty.
+    """
+    return rest_share is not None and len(rest_share) > 0 and bool(np.all(np.asarray(rest_share, dtype=float) >= AT_REST_SHARE))
 
 
 MEANINGFUL = 3.0
