@@ -10,7 +10,7 @@ STAMP  := $(VENV)/.installed
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet --only-binary=:all: -c constraints.txt -e ".[test,docs,montecarlo,fleet,ros,xacro]"
+	$(BIN)/pip install --quiet --only-binary=:all: -c constraints.txt -e ".[test,docs,montecarlo,fleet,long-logs,ros,xacro]"
 	$(BIN)/python -m dynid.warm_up  # compiles the numba kernels into their cache, so the first run does not
 	touch $(STAMP)
 

@@ -57,3 +57,83 @@ def test_blocks_are_stacked_into_the_same_array_as_one_parse(tmp_path, monkeypat
     p = tmp_path / "log.csv"
     np.savetxt(p, values, delimiter=",", fmt="%.6f")
     np.testing.assert_array_equal(read_table(p, [3, 1, 4]).data, np.loadtxt(p, delimiter=",")[:, [2, 0, 3]])
+
+
+@pytest.fixture(params=["line reader", "pyarrow"])
+def reader(request, monkeypatch):
+    """Both readers of read_table: the line reader, and pyarrow's for every file (its size threshold at 0)."""
+    import dynid.io.tables as tables
+
+    if request.param == "pyarrow":
+        pytest.importorskip("pyarrow", exc_type=ImportError)
+        monkeypatch.setattr(tables, "ARROW_BYTES", -1)
+    return request.param
+
+
+def test_pyarrow_reads_the_same_values_as_the_line_reader(tmp_path, monkeypatch):
+    """Numbers written every way a log writes them (17 digits, exponents, signs, integers, '.5'): pyarrow's reader
+    and NumPy's line reader give the same float64, bit for bit, with row ranges and columns in any order."""
+    pytest.importorskip("pyarrow", exc_type=ImportError)
+    import dynid.io.tables as tables
+
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(3000, 5)) * 10.0 ** rng.integers(-12, 12, size=(3000, 5))
+    forms = ["{:.17g}", "{:.6f}", "{:e}", "{:+.3E}", "{:.0f}"]
+    lines = ["t,a,b,c,d"] + [",".join(forms[(i + j) % 5].format(v) for j, v in enumerate(r)) for i, r in enumerate(x)]
+    p = tmp_path / "log.csv"
+    p.write_text("\n".join(lines).replace(",0.5", ",.5") + "\n")
+    for kwargs in ({"rows": None}, {"rows": (17, 2500)}, {"rows": (2999, 3000)}):
+        slow = read_table(p, ["d", "t", "b"], header=True, **kwargs)
+        monkeypatch.setattr(tables, "ARROW_BYTES", -1)
+        monkeypatch.setattr(tables, "ARROW_BLOCK", 4096)  # many blocks
+        fast = read_table(p, ["d", "t", "b"], header=True, **kwargs)
+        for spool in (False, True):
+            s = read_table(p, ["d", "t", "b"], header=True, spool=spool, **kwargs)
+            assert s.first_line == slow.first_line
+            np.testing.assert_array_equal(np.asarray(s.data[:] if spool else s.data), slow.data)
+        rows = kwargs["rows"] or (1, None)
+        assert tables._arrow_table(p, ["d", "t", "b"], True, ",", None, rows, False) is not None  # pyarrow read it
+        monkeypatch.setattr(tables, "ARROW_BYTES", 32 * 2**20)
+        assert fast.first_line == slow.first_line and fast.warnings == slow.warnings
+        assert np.array_equal(fast.data, slow.data) and fast.data.dtype == np.float64
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("1,2,3\n\n4,5,6\n", [[1, 3], [4, 6]]),            # a blank line: skipped, and the lines numbered as before
+    ("1,2,3\r\n4,5,6\r\n", [[1, 3], [4, 6]]),          # carriage returns
+    ("1, 2,3\n4,5 ,6\n", [[1, 3], [4, 6]]),            # spaces around a number
+    ("1,x,3\n4,y,6\n", [[1, 3], [4, 6]]),              # text in a column that is not read
+])
+def test_what_pyarrow_might_read_otherwise_is_read_by_the_line_reader(tmp_path, reader, text, expected):
+    p = _write(tmp_path, text)
+    np.testing.assert_array_equal(read_table(p, [1, 3]).data, expected)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("1,2,3\n4,5\n7,8,9\n", r"log.csv: line 2: expected 3 columns, got 2"),
+    ("1,2,3\n4,nan,6\n", r"log.csv: line 2, column 2: NaN or infinite value"),
+    ("1,2,3\n4,inf,6\n", r"log.csv: line 2, column 2: NaN or infinite value"),
+    ("1,2,3\n4,x,6\n", r"log.csv: line 2, column 2: expected a number, got 'x'"),
+    ("1,2,3\n4,,6\n", r"log.csv: line 2, column 2: expected a number, got ''"),
+    ('1,2,3\n4,"5",6\n', r"log.csv: line 2, column 2: expected a number, got '\"5\"'"),
+    ("1,2\n3,4\n", r"log.csv: line 1: column 3 requested but the lines have 2 columns"),
+])
+def test_both_readers_refuse_damaged_files_alike(tmp_path, reader, text, message):
+    p = _write(tmp_path, text)
+    with pytest.raises(DataError, match=message):
+        read_table(p, [1, 2, 3])
+
+
+def test_both_readers_refuse_a_row_range_past_the_end(tmp_path, reader):
+    p = _write(tmp_path, "1,2\n3,4\n5,6\n")
+    with pytest.raises(DataError, match=r"rows = \[2, 9\] goes beyond the file's end: it has 3 data rows"):
+        read_table(p, [1], rows=(2, 9))
+    with pytest.raises(DataError, match=r"rows = \[5, 9\] selects nothing: the file has 3 data rows"):
+        read_table(p, [1], rows=(5, 9))
+    np.testing.assert_array_equal(read_table(p, [2, 1], rows=(2, 3)).data, [[4, 3], [6, 5]])
+    assert read_table(p, [2], rows=(2, 3)).first_line == 2
+    if reader == "pyarrow":
+        import dynid.io.tables as tables
+
+        assert tables._arrow_table(p, [2, 1], False, ",", None, (2, 3), False) is not None
+        assert tables._arrow_table(p, [1], False, ",", None, (2, 9), False) is None  # past the end: the line reader
