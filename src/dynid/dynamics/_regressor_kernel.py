@@ -194,21 +194,22 @@ def load_compiled() -> None:
         _compiled = True
 
 
-NUMPY_BLOCK = 2048
+NUMPY_BLOCK = 1024
 """Samples per block of :func:`numpy_regressor` (its vectors stay in the cache)."""
 
 
 def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map):
     """What :func:`joint_torque_regressor` computes, by :func:`sample_columns` on blocks of samples at once
     (NumPy vectors; 4.4-5.3 µs an er16 sample against the kernel's 0.8 µs in ``bench_regressor.py``, but no
-    start-up)."""
+    start-up). ``drive(a, b)`` gives the drive columns of samples ``a:b`` (block by block: no array of the whole
+    call's)."""
     n_s, n = q.shape
     for a in range(0, n_s, NUMPY_BLOCK):
         b = min(a + NUMPY_BLOCK, n_s)
         m = b - a
         block = np.empty((n, out.shape[2], m))  # a column's samples side by side: written at full speed
         sample_columns(slice(None), rp, pp, axes, gravity, q[a:b], dq[a:b], ddq[a:b], block.transpose(2, 0, 1), npj,
-                       colmap, drive[a:b], drive_map, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
+                       colmap, drive(a, b), drive_map, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
                        np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((3, 3, m)))
         out[a:b] = block.transpose(2, 0, 1)
 

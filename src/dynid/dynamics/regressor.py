@@ -144,8 +144,10 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None, veloci
     if form == "compiled":
         _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
     else:
-        fill = kernel.numpy_regressor if form == "numpy" else kernel.joint_torque_regressor
-        fill(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
+        if form == "numpy":
+            kernel.numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
+        else:
+            kernel.joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
     n_joint = robot.n_dof * npj
     if robot.n_params > n_joint:  # coupled motors (see dynid.model.transmission)
         src = np.arange(n_joint, robot.n_params)

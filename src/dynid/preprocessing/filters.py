@@ -141,7 +141,7 @@ def velocity_noise_std(sigma: np.ndarray, rate: float, cutoff: float, order: int
     return np.asarray(sigma, dtype=float) * np.sqrt(2.0 / rate * integral)
 
 
-COLUMN_BLOCK = 16
+COLUMN_BLOCK = 8
 """Columns filtered at once by :func:`parallel_decimation` (bounds the filter's temporary copies: 16 rather than 64
 took 33 MB off the TX40 identification's peak, with the same numbers, since each column is filtered on its own)."""
 
@@ -289,7 +289,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
             out = np.zeros((index.size, flat.shape[1]))
             # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a
             # regressor has many (joint i does not see the links before it), so only the others are filtered.
-            live = np.flatnonzero(np.any(flat != 0.0, axis=0))
+            live = np.flatnonzero(np.any(flat, axis=0))  # no (samples, columns) temporary: any() casts by buffers
             for c in range(0, live.size, COLUMN_BLOCK):  # column blocks: the filter's copies stay small
                 cols = live[c:c + COLUMN_BLOCK]
                 out[:, cols] = signal.sosfiltfilt(sos, flat[:, cols], axis=0, padtype="even", padlen=padlen)[index - lo]
