@@ -10,6 +10,8 @@ cannot be built).
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pinocchio as pin
 from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
@@ -86,17 +88,37 @@ def numba_kernel(n: int = N, repeats: int = 3) -> float:
                                                   np.arange(robot.n_params), "numba"), repeats)
 
 
+def fill_floor(n: int = N, repeats: int = REPEATS, threads: int = 1) -> float:
+    """Best wall time [s] of allocating the er16's (n, n_dof, n_params) array and writing each entry once, on
+    ``threads`` threads: the floor of any regressor that returns that array (issue 40), measured beside it."""
+    robot = load_robot("er16")
+
+    def fill():
+        out = np.empty((n, robot.n_dof, robot.n_params))
+        bounds = np.linspace(0, n, threads + 1).astype(int)
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(lambda k: out[bounds[k]:bounds[k + 1]].fill(1.0), range(threads)))
+        return out
+
+    return best_of(fill, repeats)
+
+
 def main() -> None:
     t_np = numpy_form()
     t_ref, t_dyn = measure()
     t_numba = numba_kernel()
+    t_fill, t_fill2 = fill_floor(), fill_floor(threads=2)
     print(f"samples: {N}, robot: er16 (6 DOF), best of {REPEATS}")
     print(f"pinocchio computeJointTorqueRegressor loop: {1e6 * t_ref / N:8.3f} µs/sample ({t_ref:.3f} s)")
     print(f"dynid batched regressor (with friction):    {1e6 * t_dyn / N:8.3f} µs/sample ({t_dyn:.3f} s)")
     print(f"its NumPy form (a process's first {regressor_module.NUMPY_SAMPLES} samples):                        "
           f"{1e6 * t_np / N:.3f} µs/sample")
     print(f"numba's kernel (where the SIMD code cannot be built):          {1e6 * t_numba / N:.3f} µs/sample")
+    print(f"the fill floor (allocate the array, write each entry once): {1e6 * t_fill / N:.3f} µs/sample on one thread, "
+          f"{1e6 * t_fill2 / N:.3f} on two")
     print(f"ratio (reference / dynid): {t_ref / t_dyn:.1f}x   target >= 6x: {'met' if t_ref / t_dyn >= 6 else 'NOT met'}")
+    print(f"ratio (dynid / one thread's fill floor): {t_dyn / t_fill:.2f}x   target <= 1.2x: "
+          f"{'met' if t_dyn / t_fill <= 1.2 else 'NOT met'}")
 
 
 if __name__ == "__main__":

@@ -99,6 +99,11 @@ def main() -> None:
     row("regressor, er16, 25 000 samples: dynid vs Pinocchio loop (ratio)", t_pin / t_dyn, "x", 6.0,
         f"Pinocchio {1e6 * t_pin / n:.2f} µs/sample", smaller_is_better=False)
     row("  dynid per sample", 1e6 * t_dyn / n, "µs", 0.5)
+    from bench_regressor import fill_floor
+
+    t_fill = fill_floor(repeats=10)
+    row("  dynid against the fill floor (the array allocated and written once, one thread)", t_dyn / t_fill, "x", 1.2,
+        f"floor {1e6 * t_fill / n:.3f} µs/sample")
 
     t, _ = command([str(BIN / "python"), str(REPO / "benchmarks" / "bench_excitation_design.py")])
     row("bench_excitation_design.py (6 joints, 5 harmonics, 4 starts)", t, "s", 15.0)
