@@ -90,3 +90,26 @@ def test_a_fractional_shift_read_at_some_samples_equals_the_whole_shift_there():
     inside = at[(at > 40) & (at < 1950)]
     truth = np.column_stack([np.sin(2 * np.pi * 0.01 * (inside + 2.3)), np.cos(2 * np.pi * 0.02 * (inside + 2.3))])
     np.testing.assert_allclose(shift.read(2.3, at=inside), truth, atol=1e-3)
+
+
+def test_parallel_decimation_gives_the_same_numbers_on_any_number_of_cores(rng, monkeypatch):
+    """Column blocks are filtered on the process's cores from PARALLEL_VALUES on: the numbers are those of one
+    thread's column-by-column loop, bit for bit, with zero columns left zero and every column in its place."""
+    import dynid.preprocessing.filters as filters
+
+    x = rng.normal(size=(9000, 3, 7)).cumsum(0)
+    x[:, 1, 2] = 0.0  # a zero column: skipped, and zero in the result
+    x[:, 0, 5] = 1e6 * np.sin(np.arange(9000) / 50.0)  # one column far from the others: a swap would show
+
+    def run(parallel_values, cores):
+        monkeypatch.setattr(filters, "PARALLEL_VALUES", parallel_values)
+        monkeypatch.setattr(filters, "cores", lambda: cores)
+        return np.concatenate([v for _, v in parallel_decimation(lambda a, b: x[a:b], x.shape[0], 1000.0, 5, chunk=4000)])
+
+    one = run(10**12, 1)
+    np.testing.assert_array_equal(run(0, 2), one)
+    np.testing.assert_array_equal(run(0, 3), one)
+    assert not one[:, 1, 2].any() and np.abs(one[:, 0, 5]).max() > 1e5
+    sos = signal.butter(4, decimation_cutoff(1000.0, 5), fs=1000.0, output="sos")
+    whole = signal.sosfiltfilt(sos, x, axis=0, padtype="even", padlen=edge_padding(1000.0, decimation_cutoff(1000.0, 5), 4))[::5]
+    np.testing.assert_allclose(one, whole, rtol=0, atol=1e-9 * np.abs(whole).max())
