@@ -121,3 +121,41 @@ def test_the_report_says_a_flag_several_logs_share_once_and_what_export_writes()
                        "p2: J1 barely moves (RMS 0.6 N·m)"]
     assert _identify_summary({**d, "validation": []})[0] == ("Use dynid OLS, not physically consistent; dynid export writes dynid SDP, "
                                        "which is consistent.")
+
+
+def test_a_dead_torque_channel_is_said_where_the_errors_say_over_all_joints():
+    """A log with a joint whose torque reads a constant (the zoo's xArm7 dead-channel log, J4 at 0 N·m) had that
+    joint left out of its errors while the terminal's and the report's summaries said "over all joints"; both now
+    name it, and a resting log with a dead channel is not summed up with the others."""
+    from dynid.report.html import identify_sections
+    from dynid.report.summaries import ScoredLog, log_summaries
+
+    lines = log_summaries([ScoredLog("dead", 0.482, (6, 6.55), False, 0.12, dead=(3,)),
+                           ScoredLog("p1", 0.0, None, True), ScoredLog("p2", 0.0, None, True),
+                           ScoredLog("p3", 0.0, None, True, dead=(0, 5))])
+    assert lines[0] == ("dead: torque error 0.482 % over the joints but J4 (its torque reads a constant: left out), "
+                        "worst J7 6.55 % (noise floor 0.12 %)")
+    assert lines[1].startswith("p3: torque error 0 % over the joints but J1, J6 (their torques read a constant: left out) "
+                               "(at rest throughout")
+    assert lines[2].startswith("p1, p2 (2 logs at rest throughout): torque error 0 % over all joints")
+    log = {"name": "dead", "n_samples": 10, "relative_error_meaningful": [True, True], "dead_channels": [1],
+           "metrics": {"dynid WLS": {"relative_error": [2.0, 0.0], "rmse": [1.0, 0.0], "correlation": [0.9, None],
+                                     "global_relative_error": 2.0}}}
+    d = {"robot": "r", "condition_number": 10.0, "n_rows": 100, "base_parameters": [], "main_estimate": "dynid WLS",
+         "identification": {**log, "name": "identification", "dead_channels": []}, "validation": [log]}
+    summary = next(s for s in identify_sections(d)[1] if s.title == "In short").texts
+    assert "dead: torque error 2 % over the joints but J2 (its torque reads a constant: left out), worst J1 2 %." in summary
+
+
+def test_results_json_names_the_dead_channels_of_a_log():
+    import numpy as np
+
+    from dynid.validation.torques import TorqueComparison
+
+    measured = np.random.default_rng(0).normal(size=(50, 3))
+    measured[:, 1] = 0.0
+    t = np.arange(50) / 100.0
+    c = TorqueComparison("dead", t, measured, {"A": measured + 0.01}, dead=(1,))
+    assert c.to_dict()["dead_channels"] == [1]
+    live = measured + 1.0
+    assert "dead_channels" not in TorqueComparison("ok", t, live, {"A": live}).to_dict()

@@ -225,7 +225,7 @@ def _identify_summary(d: dict) -> list[str]:
         fit = c is d.get("identification")
         logs.append(ScoredLog(c["name"], float("nan") if error is None else float(error), worst,
                               not fit and rests_throughout(c.get("rest_share")),
-                              float("nan") if floor is None else float(floor), fit))
+                              float("nan") if floor is None else float(floor), fit, tuple(c.get("dead_channels") or ())))
     out += [f"{line}." for line in log_summaries(logs)]
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")

@@ -316,7 +316,7 @@ def _log_lines(r, label: str) -> tuple[list, dict]:
         still = c is not r.fit and rests_throughout(c.rest_share)
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
         logs.append(ScoredLog(c.name, errors[c.name], worst_joint(m["relative_error"], c.meaningful()), still,
-                              float(floor), c is r.fit))
+                              float(floor), c is r.fit, tuple(c.dead)))
     return [Line(text) for text in log_summaries(logs)], errors
 
 
@@ -338,6 +338,8 @@ class ScoredLog:
         Noise floor [%] of these samples (NaN: unknown).
     fit : bool
         Whether it is the identification log.
+    dead : tuple of int
+        Joints (0-based) whose torque channel is constant over the log: left out of its errors.
     """
 
     name: str
@@ -346,6 +348,7 @@ class ScoredLog:
     still: bool
     floor: float = float("nan")
     fit: bool = False
+    dead: tuple[int, ...] = ()
 
 
 def log_summaries(logs) -> list[str]:
@@ -364,20 +367,30 @@ def log_summaries(logs) -> list[str]:
     def worst_text(worst, name=""):
         return "" if worst is None or worst[1] == 0 else f", worst {name}J{worst[0] + 1} {worst[1]:.3g} %"
 
-    out = [f"{g.name}: torque error {g.error:.3g} % over all joints" + worst_text(g.worst)
+    out = [f"{g.name}: torque error {g.error:.3g} % {_over_joints(g.dead)}" + worst_text(g.worst)
            + (f" (noise floor {g.floor:.2g} %)" if np.isfinite(g.floor) else "") + (" (the fit)" if g.fit else "")
            for g in logs if not g.still]
-    still = [g for g in logs if g.still]
-    if len(still) == 1:
-        out.append(f"{still[0].name}: torque error {still[0].error:.3g} % over all joints{worst_text(still[0].worst)} "
+    still = [g for g in logs if g.still and not g.dead]  # one line for several; a log with a dead channel says so alone
+    for g in [g for g in logs if g.still and g.dead] + (still if len(still) == 1 else []):
+        out.append(f"{g.name}: torque error {g.error:.3g} % {_over_joints(g.dead)}{worst_text(g.worst)} "
                    f"(at rest throughout: {_AT_REST})")
-    elif still:
+    if len(still) > 1:
         low, high = min(g.error for g in still), max(g.error for g in still)
         spread = f"{low:.3g} %" if f"{high:.3g}" == f"{low:.3g}" else f"{low:.3g}-{high:.3g} %"
         top = max(still, key=lambda g: -np.inf if g.worst is None else g.worst[1])
         out.append(f"{_resting([g.name for g in still])}: torque error {spread} "
                    f"over all joints{worst_text(top.worst, top.name + ' ')} ({_AT_REST})")
     return out
+
+
+def _over_joints(dead) -> str:
+    """"over all joints", or which joints a log's errors leave out: a dead torque channel's joint is in none of them
+    (:attr:`dynid.validation.torques.TorqueComparison.dead`)."""
+    if not len(dead):
+        return "over all joints"
+    joints = ", ".join(f"J{j + 1}" for j in dead)
+    return (f"over the joints but {joints} ({'its torque reads' if len(dead) == 1 else 'their torques read'} a constant: "
+            "left out)")
 
 
 def _kept_line(kept: list, dead) -> Line:
@@ -426,7 +439,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     list of Line
     """
     out = [Line("In short (the tables follow)" if tables_follow else "In short (every table: --verbose, and report.html)", "title")]
-    still = [c for c in comparisons if rests_throughout(c.rest_share)]
+    still = [c for c in comparisons if rests_throughout(c.rest_share) and not c.dead]
     for c in comparisons:
         if c in still and len(still) > 1:
             continue
@@ -436,9 +449,9 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
             worst = worst_joint(m["relative_error"], ok)
             parts.append(f"{name} {m['global_relative_error']:.3g} %" + ("" if worst is None or worst[1] == 0 else
                                                                        f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
-        out.append(Line(f"{c.name}: torque error over all joints: " + "; ".join(parts)
+        out.append(Line(f"{c.name}: torque error {_over_joints(c.dead)}: " + "; ".join(parts)
                         + _best({k: m["global_relative_error"] for k, m in metrics.items()})
-                        + (f" (at rest throughout: {_AT_REST})" if c in still else "")))
+                        + (f" (at rest throughout: {_AT_REST})" if rests_throughout(c.rest_share) else "")))
     if len(still) > 1:
         spans: dict[str, list[float]] = {}
         for c in still:

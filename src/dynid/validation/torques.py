@@ -270,6 +270,8 @@ class TorqueComparison:
         out = {"name": self.name, "n_samples": self.n_samples, "rms_torque": self.rms_torque, "metrics": self.metrics()}
         if self.rest_share is not None:
             out["rest_share"] = self.rest_share
+        if self.dead:
+            out["dead_channels"] = list(self.dead)  # 0-based joints left out of every metric
         if self.noise is not None:
             out["relative_error_meaningful"] = self.meaningful().tolist()
             out["correlation_meaningful"] = self.varies().tolist()
