@@ -135,3 +135,40 @@ def test_the_identifier_takes_every_estimator_a_config_takes(closed_loop_log):
         dynid.Identifier("er16", estimators=["wls", "idim-iv"]).fit(log.t, log.q, log.tau)
     with pytest.raises(ConfigError, match="list ols or wls before 'idim-iv'"):
         dynid.Identifier.from_config(root / "cl.toml", estimators=["idim-iv", "wls"])
+
+
+def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop_log):
+    """IDIM-IV and DIDIM are pipeline estimators: identify_from_arrays and Identifier(controller=...) run them on
+    arrays with the same numbers as ``dynid identify`` on the config that describes the same log and controller; the
+    pipeline refuses them without a controller, in one line."""
+    from dynid.exceptions import ConfigError
+    from dynid.identification.closed_loop import ClosedLoopSetup
+    from dynid.identification.pipeline import IdentificationPipeline
+    from dynid.simulation.closed_loop import Controller
+
+    root, table, _ = closed_loop_log
+    _write(root, table, estimators='["wls", "idim-iv"]')
+    by_config = dynid.Identifier.from_config(root / "cl.toml", validate=False)
+    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
+    robot = dynid.load_robot("er16")
+    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
+                            feedforward=True)
+    t, q, tau = log[:, 0], log[:, 1:N + 1], log[:, N + 1:]
+    ident = dynid.Identifier(robot, estimators=["wls", "idim-iv"], controller=setup).fit(t, q, tau)
+    assert list(ident.estimates_) == ["dynid WLS", "dynid IDIM-IV"]
+    for label in ident.estimates_:  # the same to rounding (the arrays' route resamples as the config's reader does)
+        expected = by_config.estimates_[label]
+        np.testing.assert_allclose(ident.estimates_[label], expected, rtol=1e-7, atol=1e-10 * np.abs(expected).max())
+    result = dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=setup)
+    np.testing.assert_allclose(result.estimates["dynid IDIM-IV"].params, ident.estimates_["dynid IDIM-IV"], rtol=0)
+    _write(root, "", estimators='["wls"]')  # a config without [controller]: the one given is used
+    given = dynid.Identifier.from_config(root / "cl.toml", estimators=["wls", "idim-iv"], controller=setup, validate=False)
+    np.testing.assert_allclose(given.estimates_["dynid IDIM-IV"], by_config.estimates_["dynid IDIM-IV"], rtol=1e-12)
+    _write(root, table, estimators='["wls", "idim-iv"]')
+    with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller \(a ClosedLoopSetup"):
+        IdentificationPipeline(robot, closed_loop=("idim-iv",))
+    short = ClosedLoopSetup(setup.controller, setup.reference[:-10], feedforward=True)
+    from dynid.exceptions import DataError
+
+    with pytest.raises(DataError, match="the reference: 9990 rows of set-points, the identification log has 10000"):
+        dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=short)

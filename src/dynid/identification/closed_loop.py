@@ -46,7 +46,8 @@ from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 
-__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "closed_loop_identify", "CLOSED_LOOP_METHODS"]
+__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopSetup", "closed_loop_identify", "closed_loop_estimates",
+           "CLOSED_LOOP_METHODS"]
 
 
 LABELS = {"wls": "IDIM-WLS", "idim-iv": "IDIM-IV", "didim": "DIDIM", "didim-sdp": "DIDIM-SDP"}
@@ -74,6 +75,38 @@ class ClosedLoopExperiment:
     q_ref: np.ndarray
     dq_ref: np.ndarray
     feedforward: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedLoopSetup:
+    """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
+    config's ``[controller]`` table gives it (:func:`closed_loop_estimates`).
+
+    Attributes
+    ----------
+    controller : Controller
+        The joint controller and its rate.
+    reference : (N, n_dof) array [rad], or an object with ``read() -> (N, n_dof) array``
+        The position set-points, one per sample of the log as read (a config's reference file is read when the
+        estimators run).
+    feedforward : bool
+        Whether the controller added the model's torques along the reference (computed with the identified model's
+        description, :func:`dynid.dynamics.rnea.rnea_torques`).
+    """
+
+    controller: Controller
+    reference: object
+    feedforward: bool = False
+
+    def reference_positions(self) -> np.ndarray:
+        """The set-points as an array.
+
+        Returns
+        -------
+        (N, n_dof) array [rad]
+        """
+        read = getattr(self.reference, "read", None)
+        return np.asarray(read() if callable(read) else self.reference, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -361,3 +394,64 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
     beta = base.base_from_standard(run.x)
     return ClosedLoopEstimate(LABELS["didim-sdp"], beta, np.full(beta.size, np.nan), len(run.changes), run.converged,
                               run.changes, run.message)
+
+
+def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording: Recording, setup: ClosedLoopSetup,
+                          keys: tuple[str, ...], preprocessing: Preprocessing):
+    """The closed-loop estimators beside an identification's other estimates, on its log as read, at the control rate.
+
+    Parameters
+    ----------
+    robot, base : Robot, BaseParameters
+        The model as identified (with the choices the data made) and its base-parameter map.
+    result : dynid.identification.identify.IdentificationResult
+        The open-loop estimates; the first of them starts the iterations.
+    recording : Recording
+        The identification log as read (the estimators prepare their simulations as it was prepared).
+    setup : ClosedLoopSetup
+    keys : tuple of str
+        Among :data:`CLOSED_LOOP_METHODS`, in order.
+    preprocessing : Preprocessing
+        The settings as given (the simulated logs derive theirs as the measured one did).
+
+    Returns
+    -------
+    IdentificationResult
+        ``result`` with the estimates added (a stop before convergence: the estimate's note and a warning) and their
+        consistency checked.
+
+    Raises
+    ------
+    DataError
+        A reference without one set-point per sample of the log.
+    """
+    import time
+    from dataclasses import replace
+
+    from ..dynamics.rnea import rnea_torques
+    from .identify import Estimate, consistency_checks
+
+    controller = setup.controller
+    q_ref = setup.reference_positions()
+    if q_ref.shape[0] != recording.t.size:
+        where = getattr(setup.reference, "file", "the reference")
+        raise DataError(f"{where}: {q_ref.shape[0]} rows of set-points, the identification log has "
+                        f"{recording.t.size} samples: give one set-point per row of the log (and the same rows)")
+    dt = 1.0 / controller.rate
+    dq_ref = np.gradient(q_ref, dt, axis=0)
+    ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if setup.feedforward else None
+    estimates = dict(result.estimates)
+    notes = []
+    for key in keys:
+        t0 = time.perf_counter()
+        out = closed_loop_identify(robot, base, recording, ClosedLoopExperiment(controller, q_ref, dq_ref, ff), methods=(key,),
+                                   preprocessing=preprocessing)[key]
+        std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
+        estimate = Estimate(key, out.params, std, time.perf_counter() - t0, note="" if out.converged else out.message)
+        estimates[estimate.label] = estimate
+        if not out.converged:
+            notes.append(f"{estimate.label}: {out.message}")
+    added = {label: e.params for label, e in estimates.items() if label not in result.estimates}
+    margins, verdicts = consistency_checks(robot, base, added)
+    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes),
+                   consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})

@@ -35,7 +35,8 @@ class Identifier:
     estimators : sequence of str, optional
         Keys of :mod:`dynid.estimators.registry`, case-insensitive; the first is the main estimate (default
         ``["wls"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
-        (``idim-iv``, ``didim``, ``didim-sdp``) too, when fitting a config with a ``[controller]`` table.
+        (``idim-iv``, ``didim``, ``didim-sdp``) too, with ``controller`` for arrays, or fitting a config with a
+        ``[controller]`` table.
     preprocessing : Preprocessing or dict, optional
         Preprocessing settings (default: every setting derived from the data, or the config's).
     friction : {"auto", "description"}, optional
@@ -43,6 +44,10 @@ class Identifier:
         for arrays, the config's for a config).
     seed : int, optional
         Seeds the box searches (default 0, or the config's).
+    controller : ClosedLoopSetup, optional
+        How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`: the
+        controller, one set-point per sample, the feed-forward), for the closed-loop estimators; a config gives its
+        ``[controller]`` table instead.
 
     Attributes
     ----------
@@ -63,12 +68,13 @@ class Identifier:
     """
 
     def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
-                 friction: str | None = None, seed: int | None = None):
+                 friction: str | None = None, seed: int | None = None, controller=None):
         self.robot = robot
         self.estimators = estimators
         self.preprocessing = preprocessing
         self.friction = friction
         self.seed = seed
+        self.controller = controller
 
     def __sklearn_is_fitted__(self) -> bool:
         """Whether :meth:`fit` ran (scikit-learn's ``check_is_fitted`` asks this).
@@ -134,7 +140,8 @@ class Identifier:
     @classmethod
     def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:
         """Identify the robot of an identification config (TOML) as ``dynid identify`` does, the ``params`` given
-        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``) over the config's.
+        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``) over
+        the config's.
 
         Parameters
         ----------
@@ -207,13 +214,14 @@ class Identifier:
             if q is None or tau is None:
                 raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
             closed_loop = () if self.estimators is None else split_estimators(self.estimators, "Identifier(estimators=...)")[1]
-            if closed_loop:
+            if closed_loop and self.controller is None:
                 raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the "
                                   "run in closed loop and needs its controller: fit a config with a [controller] table "
-                                  "(Identifier.from_config('arm.toml', estimators=...)), or leave it out", field="estimators")
+                                  "(Identifier.from_config('arm.toml', estimators=...)), give "
+                                  "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
-                                          seed=0 if self.seed is None else int(self.seed))
+                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller)
         return self._fitted(result)
 
     def _fitted(self, result) -> Identifier:
@@ -241,9 +249,11 @@ class Identifier:
         changes: dict[str, Any] = {}
         if self.robot is not None:
             changes["robot"] = self._robot()
+        if self.controller is not None:  # the config's [controller] as a ClosedLoopSetup gives it
+            changes["controller"] = (self.controller.controller, self.controller.reference, self.controller.feedforward)
         if self.estimators is not None:
             changes["estimators"], changes["closed_loop"] = split_estimators(self.estimators, "Identifier(estimators=...)")
-            if changes["closed_loop"] and config.controller is None:
+            if changes["closed_loop"] and config.controller is None and self.controller is None:
                 raise ConfigError(f"Identifier(estimators=...): {changes['closed_loop'][0]} simulates the run in closed loop "
                                   f"and needs its controller: {path} has no [controller] table (kp, kd, rate, the "
                                   "reference trajectory)", field="estimators")

@@ -17,9 +17,10 @@ Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
 3. each joint's friction model and its state at rest (``friction = "auto"``,
    :func:`dynid.identification.friction_models.choose_friction`), which may change the base-parameter map.
 
-:meth:`~IdentificationPipeline.estimate` is :func:`dynid.identification.identify.identify` on the prepared data; the
-result's ``settings`` say every choice and why. Reading logs and configs, drive gains, closed-loop estimators and
-validation on other logs are the callers' (:mod:`dynid.identification.run`).
+:meth:`~IdentificationPipeline.estimate` is :func:`dynid.identification.identify.identify` on the prepared data, then
+the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP: :func:`dynid.identification.closed_loop.closed_loop_estimates`)
+when the pipeline has them and the log's controller; the result's ``settings`` say every choice and why. Reading logs
+and configs, drive gains and validation on other logs are the callers' (:mod:`dynid.identification.run`).
 """
 
 from __future__ import annotations
@@ -89,11 +90,18 @@ class IdentificationPipeline:
     source : str
         Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
         :func:`dynid.load_results` finds it.
+    closed_loop : tuple of str
+        Closed-loop estimators run after the others, on the log as read
+        (:data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS`, in order).
+    controller : ClosedLoopSetup or None
+        How the log was recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`); needed
+        with ``closed_loop``.
 
     Raises
     ------
     ConfigError
-        An unknown ``friction`` (when built) or preprocessing strategy (when preparing).
+        An unknown ``friction`` or closed-loop estimator, closed-loop estimators without ``controller`` (when built), or
+        an unknown preprocessing strategy (when preparing).
     """
 
     robot: Robot
@@ -103,10 +111,22 @@ class IdentificationPipeline:
     seed: int = 0
     sdp_prior: str = "euclidean"
     source: str = ""
+    closed_loop: tuple[str, ...] = ()
+    controller: Any = None
 
     def __post_init__(self):
+        from ..estimators.instrumental import CLOSED_LOOP_METHODS
+
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
+        unknown = [k for k in self.closed_loop if k not in CLOSED_LOOP_METHODS]
+        if unknown:
+            raise ConfigError(f"closed_loop: {unknown[0]!r} is not a closed-loop estimator (expected "
+                              f"{', '.join(CLOSED_LOOP_METHODS)})", field="closed_loop")
+        if self.closed_loop and self.controller is None:
+            raise ConfigError(f"estimators: {self.closed_loop[0]} simulates the run in closed loop and needs its "
+                              "controller (a ClosedLoopSetup: the controller, the set-points, the feed-forward)",
+                              field="controller")
 
     def prepare(self, recording, base: BaseParameters | None = None,
                 step: Callable[[str], Any] | None = None) -> PreparedIdentification:
@@ -177,9 +197,9 @@ class IdentificationPipeline:
         return PreparedIdentification(robot, base, data, {"coulomb_velocity": robot.coulomb_velocity.tolist(), **made})
 
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
-                 held_out: bool = False):
+                 held_out: bool = False, recording=None):
         """Every estimator on the prepared data, the consistency checks and the verdict
-        (:func:`dynid.identification.identify.identify`).
+        (:func:`dynid.identification.identify.identify`), then the closed-loop estimators.
 
         Parameters
         ----------
@@ -191,6 +211,8 @@ class IdentificationPipeline:
             ``progress(step, done, total)``.
         held_out : bool
             With ``sdp`` listed and no validation log to come: choose the estimate to trust on held-out blocks.
+        recording : dynid.io.datasets.Recording, optional
+            The log as read, which the closed-loop estimators simulate (needed with :attr:`closed_loop`).
 
         Returns
         -------
@@ -201,7 +223,10 @@ class IdentificationPipeline:
         Raises
         ------
         ConfigError
-            An unknown estimator, or ``sdp`` with a description without physical nominal parameters.
+            An unknown estimator, ``sdp`` with a description without physical nominal parameters, or closed-loop
+            estimators without ``recording``.
+        DataError
+            Set-points that are not one per sample of ``recording``.
         IdentifiabilityError
             A log that does not excite every base parameter.
         """
@@ -213,9 +238,20 @@ class IdentificationPipeline:
                           held_out=held_out, sdp_prior=self.sdp_prior,
                           observers=(lambda *block: blocks.append(block),) if check is None else ())
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
-        return replace(result, settings={**result.settings, "robot_source": self.source,
-                                         "robot_fingerprint": prepared.robot.kinematic_fingerprint(), **prepared.choices},
-                       findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
+        result = replace(result, settings={**result.settings, "robot_source": self.source,
+                                           "robot_fingerprint": prepared.robot.kinematic_fingerprint(), **prepared.choices},
+                         findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
+        if not self.closed_loop:
+            return result
+        if recording is None:
+            raise ConfigError(f"{self.closed_loop[0]} simulates the log as read: IdentificationPipeline.estimate(..., "
+                              "recording=...), or fit(recording)", field="closed_loop")
+        from .closed_loop import closed_loop_estimates
+
+        if progress is not None:
+            progress("closed-loop estimators (" + ", ".join(self.closed_loop) + ")", 0, 1)
+        return closed_loop_estimates(prepared.robot, prepared.base, result, recording, self.controller, self.closed_loop,
+                                     self.preprocessing)
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
             held_out: bool = True):
@@ -243,7 +279,7 @@ class IdentificationPipeline:
         step = None if progress is None else (lambda label: progress(label, 0, 1))
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
-        return self.estimate(prepared, refs, progress, held_out)
+        return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
 
 
 DELAY_MAX_SAMPLES = 60_000

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import contextlib
-import time
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -156,13 +155,10 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation)
+        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
-    if config.closed_loop:
-        step("closed-loop estimators (" + ", ".join(config.closed_loop) + ")")
-        result = _closed_loop(config, robot, base, result, raw)
     if not validate or not config.validation:
         return result
     sets = result.parameter_sets()
@@ -192,7 +188,8 @@ def _nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
 
 
 def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
-    """The identification pipeline a config describes: its robot, preprocessing, estimators, friction choice, seed.
+    """The identification pipeline a config describes: its robot, preprocessing, estimators (the closed-loop ones with
+    the ``[controller]``), friction choice, seed.
 
     Parameters
     ----------
@@ -202,44 +199,12 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     -------
     IdentificationPipeline
     """
+    from .closed_loop import ClosedLoopSetup
     from .pipeline import IdentificationPipeline
 
+    setup = None if config.controller is None or not config.closed_loop else ClosedLoopSetup(*config.controller)
     return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
-                                  config.sdp_prior, config.robot_source)
-
-
-def _closed_loop(config: IdentificationConfig, robot, base, result, recording):
-    """IDIM-IV / DIDIM beside the other estimates, on the identification log (``recording``, as read) at the control
-    rate (``[controller]``)."""
-    from ..dynamics.rnea import rnea_torques
-    from .closed_loop import ClosedLoopExperiment, closed_loop_identify
-    from .identify import Estimate, consistency_checks
-
-    assert config.controller is not None  # the config's parser refuses closed-loop estimators without it
-    controller, reference, feedforward = config.controller
-    q_ref = reference.read()
-    if q_ref.shape[0] != recording.t.size:
-        raise DataError(f"{reference.file}: {q_ref.shape[0]} rows of set-points, the identification log has "
-                        f"{recording.t.size} samples: give one set-point per row of the log (and the same rows)")
-    dt = 1.0 / controller.rate
-    dq_ref = np.gradient(q_ref, dt, axis=0)
-    ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if feedforward else None
-    estimates = dict(result.estimates)
-    notes = []
-    for key in config.closed_loop:
-        t0 = time.perf_counter()
-        out = closed_loop_identify(robot, base, recording, ClosedLoopExperiment(controller, q_ref, dq_ref, ff), methods=(key,),
-                                   preprocessing=config.preprocessing)[key]
-        std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
-        estimate = Estimate(key, out.params, std, time.perf_counter() - t0,
-                            note="" if out.converged else out.message)
-        estimates[estimate.label] = estimate
-        if not out.converged:
-            notes.append(f"{estimate.label}: {out.message}")
-    added = {label: e.params for label, e in estimates.items() if label not in result.estimates}
-    margins, verdicts = consistency_checks(robot, base, added)
-    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes),
-                   consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})
+                                  config.sdp_prior, config.robot_source, tuple(config.closed_loop), setup)
 
 
 def _main_estimate(result, nominal: str | None = None) -> dict:
@@ -344,7 +309,7 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
 @with_single_blas_thread
 def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
                          estimators=("wls",), name: str = "arrays", friction: str = "description", seed: int = 0,
-                         sdp_prior: str = "euclidean"):
+                         sdp_prior: str = "euclidean", controller=None):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
     (:class:`~dynid.identification.pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
     cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
@@ -365,7 +330,8 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     preprocessing : Preprocessing, optional
         Default: every setting derived from the data.
     estimators : sequence of str
-        As ``[estimation] estimators`` of a config (the first is the main estimate).
+        As ``[estimation] estimators`` of a config (the first is the main estimate; the closed-loop ones with
+        ``controller``).
     name : str
         The dataset's name in tables and messages.
     friction : {"description", "auto"}
@@ -374,6 +340,9 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         Seeds the box searches and the bootstrap (``[estimation] seed``).
     sdp_prior : {"euclidean", "geometric"}
         As ``[estimation] sdp_prior``.
+    controller : ClosedLoopSetup, optional
+        How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`), for
+        the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP) as a config's ``[controller]`` gives it.
 
     Returns
     -------
@@ -384,15 +353,23 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     ShapeError
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
-        Time stamps that do not increase, or a gap longer than 5 median steps.
+        Time stamps that do not increase, a gap longer than 5 median steps, or set-points that are not one per sample.
     ConfigError
-        An unknown estimator or ``friction``.
+        An unknown estimator or ``friction``, or closed-loop estimators without ``controller``.
     """
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
     from ..model.description import builtin_robots
     from .pipeline import IdentificationPipeline
 
-    pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), tuple(estimators), friction, int(seed), sdp_prior,
-                                      robot.name if robot.name in builtin_robots() else "")
+    estimators = tuple(estimators)
+    closed_loop: tuple[str, ...] = ()
+    if any(str(k).strip().lower() in CLOSED_LOOP_METHODS for k in estimators):  # as a config splits its list
+        from ..io.identification_config import split_estimators
+
+        parsed, closed_loop = split_estimators(estimators, "estimators")
+        estimators = tuple(parsed)
+    pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), estimators, friction, int(seed), sdp_prior,
+                                      robot.name if robot.name in builtin_robots() else "", closed_loop, controller)
     return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))
 
 
