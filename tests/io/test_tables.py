@@ -103,6 +103,8 @@ def test_pyarrow_reads_the_same_values_as_the_line_reader(tmp_path, monkeypatch)
     ("1,2,3\r\n4,5,6\r\n", [[1, 3], [4, 6]]),          # carriage returns
     ("1, 2,3\n4,5 ,6\n", [[1, 3], [4, 6]]),            # spaces around a number
     ("1,x,3\n4,y,6\n", [[1, 3], [4, 6]]),              # text in a column that is not read
+    ("1,2,3\n4,5,6\r\n7,8,9\r7,8,9\n", [[1, 3], [4, 6], [7, 9], [7, 9]]),  # carriage returns after the first line
+    ("1,2,3\n   \n4,5,6\n", [[1, 3], [4, 6]]),         # a whitespace-only line
 ])
 def test_what_pyarrow_might_read_otherwise_is_read_by_the_line_reader(tmp_path, reader, text, expected):
     p = _write(tmp_path, text)
