@@ -160,3 +160,149 @@ def origin(builder) -> str:
         return builder
     target = builder if hasattr(builder, "__qualname__") else type(builder)  # a class or a function, else an instance
     return f"{target.__module__}.{target.__qualname__}"
+
+
+class Registry:
+    """Names of one kind of the user's extensible parts (estimators, preprocessing strategies) -> their entries.
+
+    One register/unregister/look-up for both kinds: a key is case-insensitive; registering a key again is an error
+    unless ``replace`` or the same origin (:func:`origin`: a plugin imported again); a name not known is looked up
+    again after :func:`load_plugins`.
+
+    Parameters
+    ----------
+    what : str
+        The kind, in messages: ``"estimator"``, ``"preprocessing strategy"``.
+    builder : callable
+        entry -> what :func:`origin` reads (the entry itself, or its ``build``).
+
+    Attributes
+    ----------
+    entries : dict
+        key -> entry, in registration order.
+    built_in : tuple of str
+        The keys registered when :meth:`seal` was called (dynid's own).
+    """
+
+    def __init__(self, what: str, builder=lambda entry: entry):
+        self.what = what
+        self.builder = builder
+        self.entries: dict = {}
+        self.built_in: tuple[str, ...] = ()
+        self._built_in_origins: dict[str, str] = {}
+
+    @staticmethod
+    def key(name) -> str:
+        """``name`` as stored: stripped, in lower case.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        str
+        """
+        return str(name).strip().lower()
+
+    def add(self, key: str, entry, *, replace: bool = False) -> None:
+        """Register ``entry`` under ``key`` (already checked by the caller).
+
+        Parameters
+        ----------
+        key : str
+            In lower case.
+        entry : object
+        replace : bool
+            Replace an entry of another origin.
+
+        Raises
+        ------
+        ValueError
+            ``key`` registered already, from another origin, without ``replace``.
+        """
+        if key in self.entries and not replace and origin(self.builder(self.entries[key])) != origin(self.builder(entry)):
+            raise ValueError(f"{self.what} {key!r} is registered already (pass replace=True to replace it)")
+        self.entries[key] = entry
+
+    def remove(self, name: str) -> None:
+        """Forget a registered entry.
+
+        Parameters
+        ----------
+        name : str
+
+        Raises
+        ------
+        KeyError
+            An unknown name.
+        """
+        del self.entries[self.key(name)]
+
+    def seal(self) -> tuple[str, ...]:
+        """Record the entries registered so far as the built-in ones.
+
+        Returns
+        -------
+        tuple of str
+            Their keys.
+        """
+        self.built_in = tuple(self.entries)
+        self._built_in_origins = {k: origin(self.builder(self.entries[k])) for k in self.built_in}
+        return self.built_in
+
+    def is_plugin(self, name: str) -> bool:
+        """Whether ``name``'s entry is the user's (a plugin's, or a built-in key replaced by one).
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        bool
+        """
+        k = self.key(name)
+        return k not in self._built_in_origins or origin(self.builder(self.entries[k])) != self._built_in_origins[k]
+
+    def find(self, name: str):
+        """The entry of ``name``, the plugins loaded first if it is not known.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        object or None
+            None: not registered, even by a plugin.
+        """
+        k = self.key(name)
+        if k not in self.entries:
+            load_plugins()
+        return self.entries.get(k)
+
+    def by_user(self, keys) -> dict:
+        """The entries among ``keys`` (already checked) that are not built in, for another process to register.
+
+        Parameters
+        ----------
+        keys : iterable of str
+
+        Returns
+        -------
+        dict
+            key -> entry.
+        """
+        return {k: self.entries[k] for k in keys if k not in self.built_in}
+
+    def ensure(self, entries: dict) -> None:
+        """Register the entries that this process does not know (a worker process).
+
+        Parameters
+        ----------
+        entries : dict
+            key -> entry, from :meth:`by_user` in the process that had them.
+        """
+        for key, entry in entries.items():
+            self.entries.setdefault(key, entry)

@@ -490,13 +490,42 @@ class AccumulatingEstimator(Estimator):
 class BoxSearchEstimator(Estimator):
     """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
 
-    Subclasses set ``bounds`` (p, 2), ``n_dof`` (or None: inferred) and ``weights`` and call :meth:`_objectives`.
+    Subclasses set ``bounds`` (p, 2), ``n_dof`` (or None: inferred) and ``weights``, and implement ``_search(objective,
+    bounds)``: the minimum of eq. 9's ``F`` over the box as an ``OptimizeResult`` (``x``, ``fun``, ``nfev``, ``history``).
     """
 
     bounds: object
     n_dof: int | None
     weights: object
     loss_power = 1.0  # eq. 9: sample_weight multiplies each absolute residual
+
+    def fit(self, w, tau, sample_weight=None):
+        """Search the box for the minimum of eq. 9 (each subclass's search).
+
+        Parameters
+        ----------
+        w : (M, p) array
+            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
+        tau : (M,) or (N, n_dof) array [N·m]
+        sample_weight : (M,) or (N, n_dof) array, optional
+            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`weighted_rows`).
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ShapeError
+            Wrong shapes, or a box that is not (p, 2).
+        """
+        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
+        bounds, objective = self._objectives(w, tau)
+        self._set_search_result(self._search(objective, bounds))
+        return self
+
+    def _search(self, objective, bounds):  # pragma: no cover - abstract
+        raise NotImplementedError
 
     def _objectives(self, w, tau):
         """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""

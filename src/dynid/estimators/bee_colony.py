@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..optim.bee_colony import minimize_bee_colony
-from .base import BoxSearchEstimator, weighted_rows
+from .base import BoxSearchEstimator
 
 
 class BeeColonyEstimator(BoxSearchEstimator):
@@ -42,29 +42,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau, sample_weight=None) -> BeeColonyEstimator:
-        """Search the box for the minimum of eq. 9 with the artificial bee colony (§3.1).
-
-        Parameters
-        ----------
-        w : (M, p) array
-            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
-        tau : (M,) or (N, n_dof) array [N·m]
-        sample_weight : (M,) or (N, n_dof) array, optional
-            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
-
-        Returns
-        -------
-        self
-
-        Raises
-        ------
-        ShapeError
-            Wrong shapes, or a box that is not (p, 2).
-        """
-        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
-        bounds, objective = self._objectives(w, tau)
-        res = minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
-                                  maxiter=self.maxiter, rng=self.rng, callback=self.callback)
-        self._set_search_result(res)
-        return self
+    def _search(self, objective, bounds):
+        """The artificial bee colony's search of the box (§3.1)."""
+        return minimize_bee_colony(objective, bounds, colony_size=self.colony_size, limit=self.limit,
+                                   maxiter=self.maxiter, rng=self.rng, callback=self.callback)

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ..optim.particle_swarm import minimize_particle_swarm
-from .base import BoxSearchEstimator, weighted_rows
+from .base import BoxSearchEstimator
 
 
 class DifferentialEvolutionEstimator(BoxSearchEstimator):
@@ -55,28 +55,8 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau, sample_weight=None) -> DifferentialEvolutionEstimator:
-        """Search the box for the minimum of eq. 9 by differential evolution.
-
-        Parameters
-        ----------
-        w : (M, p) array
-            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
-        tau : (M,) or (N, n_dof) array [N·m]
-        sample_weight : (M,) or (N, n_dof) array, optional
-            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
-
-        Returns
-        -------
-        self
-
-        Raises
-        ------
-        ShapeError
-            Wrong shapes, or a box that is not (p, 2).
-        """
-        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
-        bounds, objective = self._objectives(w, tau)
+    def _search(self, objective, bounds):
+        """SciPy's differential evolution over the box, its evaluations counted point by point."""
         history = []
         evaluations = 0
 
@@ -95,8 +75,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
                                      rng=np.random.default_rng(self.rng), callback=record)
         res.history = np.array(history)
         res.nfev = evaluations
-        self._set_search_result(res)
-        return self
+        return res
 
 
 class ParticleSwarmEstimator(BoxSearchEstimator):
@@ -132,29 +111,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
         self.rng = rng
         self.callback = callback
 
-    def fit(self, w, tau, sample_weight=None) -> ParticleSwarmEstimator:
-        """Search the box for the minimum of eq. 9 by particle swarm optimisation.
-
-        Parameters
-        ----------
-        w : (M, p) array
-            Observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j``.
-        tau : (M,) or (N, n_dof) array [N·m]
-        sample_weight : (M,) or (N, n_dof) array, optional
-            One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
-
-        Returns
-        -------
-        self
-
-        Raises
-        ------
-        ShapeError
-            Wrong shapes, or a box that is not (p, 2).
-        """
-        w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
-        bounds, objective = self._objectives(w, tau)
-        res = minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
-                                      rng=self.rng, callback=self.callback)
-        self._set_search_result(res)
-        return self
+    def _search(self, objective, bounds):
+        """The particle swarm's search of the box."""
+        return minimize_particle_swarm(objective, bounds, swarm_size=self.swarm_size, maxiter=self.maxiter,
+                                       rng=self.rng, callback=self.callback)

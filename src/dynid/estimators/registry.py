@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError, DynIdError
-from ..plugins import load_plugins, origin
+from ..plugins import Registry, load_plugins, origin
 
 if TYPE_CHECKING:
     import numpy as np
@@ -225,7 +225,8 @@ def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> Estimator:
                                             joint_weights=data.joint_weights, prior_kind=data.prior_kind)
 
 
-_REGISTRY: dict[str, EstimatorSpec] = {}
+_ESTIMATORS = Registry("estimator", builder=lambda entry: entry.build)
+_REGISTRY: dict[str, EstimatorSpec] = _ESTIMATORS.entries
 
 
 def register(key: str, build, *, label: str | None = None, description: str = "", space: str = "base",
@@ -275,10 +276,8 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
         raise ValueError(f"estimator key: expected letters, digits and _, got {key!r}")
     if space not in ("base", "standard"):
         raise ValueError(f"estimator {k}: space must be 'base' or 'standard', got {space!r}")
-    if k in _REGISTRY and not replace and origin(_REGISTRY[k].build) != origin(build):
-        raise ValueError(f"estimator {k!r} is registered already (pass replace=True to replace it)")
     entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options))
-    _REGISTRY[k] = entry
+    _ESTIMATORS.add(k, entry, replace=replace)
     return entry
 
 
@@ -294,7 +293,7 @@ def unregister(key: str) -> None:
     KeyError
         An unknown key.
     """
-    del _REGISTRY[str(key).strip().lower()]
+    _ESTIMATORS.remove(key)
 
 
 register("ols", ".least_squares:OrdinaryLeastSquares", label="OLS", description="ordinary least squares", cost=0.2,
@@ -316,10 +315,8 @@ register("de", _box_search("de"), label="DE", description="differential evolutio
 register("pso", _box_search("pso"), label="PSO", description="particle swarm (constriction), the budget of ABC×10", cost=8,
          needs_box=True)
 
-BUILT_IN = tuple(_REGISTRY)
+BUILT_IN = _ESTIMATORS.seal()
 """The estimators dynid comes with (the others were registered by the user)."""
-
-_BUILT_IN_ORIGINS = {k: origin(_REGISTRY[k].build) for k in BUILT_IN}
 
 
 def is_plugin(key: str) -> bool:
@@ -333,8 +330,7 @@ def is_plugin(key: str) -> bool:
     -------
     bool
     """
-    k = str(key).strip().lower()
-    return k not in _BUILT_IN_ORIGINS or origin(_REGISTRY[k].build) != _BUILT_IN_ORIGINS[k]
+    return _ESTIMATORS.is_plugin(key)
 
 
 def _named(key: str) -> str:
@@ -360,7 +356,7 @@ def registered_by_user(keys_: Iterable[str]) -> dict:
     dict
         key -> :class:`EstimatorSpec`.
     """
-    return {spec(k).key: spec(k) for k in keys_ if spec(k).key not in BUILT_IN}
+    return _ESTIMATORS.by_user([spec(k).key for k in keys_])
 
 
 def ensure_registered(specs: dict) -> None:
@@ -371,9 +367,7 @@ def ensure_registered(specs: dict) -> None:
     specs : dict
         key -> :class:`EstimatorSpec` (:func:`registered_by_user` in the process that had them).
     """
-    for key, entry in specs.items():
-        if key not in _REGISTRY:
-            _REGISTRY[key] = entry
+    _ESTIMATORS.ensure(specs)
 
 
 def spec(key: str) -> EstimatorSpec:
@@ -392,13 +386,10 @@ def spec(key: str) -> EstimatorSpec:
     ConfigError
         An unknown key (the message lists the known ones).
     """
-    k = str(key).strip().lower()
-    if k not in _REGISTRY:
-        load_plugins()  # the user's own estimators (dynid.plugins)
-    try:
-        return _REGISTRY[k]
-    except KeyError:
-        raise ConfigError(f"unknown estimator {key!r}; expected one of {', '.join(_REGISTRY)}", field="estimators") from None
+    entry = _ESTIMATORS.find(key)  # the user's own estimators too (dynid.plugins)
+    if entry is None:
+        raise ConfigError(f"unknown estimator {key!r}; expected one of {', '.join(_REGISTRY)}", field="estimators")
+    return entry
 
 
 def keys() -> tuple[str, ...]:

@@ -29,7 +29,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError
-from ..plugins import load_plugins, origin
+from ..plugins import Registry
 from .settings import Preprocessing
 
 if TYPE_CHECKING:
@@ -114,7 +114,8 @@ class Strategy:
         raise NotImplementedError
 
 
-_STRATEGIES: dict[str, Any] = {}
+_REGISTRY = Registry("preprocessing strategy")
+_STRATEGIES: dict[str, Any] = _REGISTRY.entries
 
 
 def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
@@ -136,9 +137,7 @@ def register_strategy(name: str, strategy, *, replace: bool = False) -> None:
     key = str(name).strip().lower()
     if not key:
         raise ValueError("preprocessing strategy: expected a name")
-    if key in _STRATEGIES and not replace and origin(_STRATEGIES[key]) != origin(strategy):
-        raise ValueError(f"preprocessing strategy {key!r} is registered already (pass replace=True to replace it)")
-    _STRATEGIES[key] = strategy
+    _REGISTRY.add(key, strategy, replace=replace)
 
 
 def unregister_strategy(name: str) -> None:
@@ -153,14 +152,14 @@ def unregister_strategy(name: str) -> None:
     KeyError
         An unknown name.
     """
-    del _STRATEGIES[str(name).strip().lower()]
+    _REGISTRY.remove(name)
 
 
 register_strategy("parallel", ".pipeline:ParallelFiltering")
 register_strategy("paper", ".paper_smoothing:PaperSmoothing")
 
 
-BUILT_IN = tuple(_STRATEGIES)
+BUILT_IN = _REGISTRY.seal()
 """The strategies dynid comes with."""
 
 
@@ -176,7 +175,7 @@ def registered_by_user(names) -> dict:
     dict
         name -> registered target of those of ``names`` that are not built in.
     """
-    return {check_strategy(n): _STRATEGIES[check_strategy(n)] for n in names if check_strategy(n) not in BUILT_IN}
+    return _REGISTRY.by_user([check_strategy(n) for n in names])
 
 
 def ensure_registered(targets: dict) -> None:
@@ -187,8 +186,7 @@ def ensure_registered(targets: dict) -> None:
     targets : dict
         name -> registered target, from :func:`registered_by_user`.
     """
-    for name, target in targets.items():
-        _STRATEGIES.setdefault(name, target)
+    _REGISTRY.ensure(targets)
 
 
 def strategy_names() -> tuple[str, ...]:
@@ -218,10 +216,8 @@ def check_strategy(name: str) -> str:
     ConfigError
         An unknown strategy (field ``preprocessing.strategy``, the message lists the known ones).
     """
-    key = str(name).strip().lower()
-    if key not in _STRATEGIES:
-        load_plugins()  # the user's own strategies (dynid.plugins)
-    if key not in _STRATEGIES:
+    key = _REGISTRY.key(name)
+    if _REGISTRY.find(key) is None:  # the user's own strategies too (dynid.plugins)
         raise ConfigError(f"preprocessing.strategy: expected one of {', '.join(_STRATEGIES)}, got {name!r}",
                           field="preprocessing.strategy")
     return key

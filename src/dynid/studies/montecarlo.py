@@ -40,7 +40,7 @@ from ..model.description import load_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel
 from ..threads import with_single_blas_thread
-from .paper import PaperExperimentConfig, identification_trajectory, problem, search_box, simulate_dataset
+from .paper import PaperExperimentConfig, identification_trajectory, paper_search_box, problem, simulate_dataset
 
 DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
 """The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with estimators."""
@@ -208,7 +208,7 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     estimation = Estimation(keys, problem(setup.run, setup.robot, setup.base), setup.base.names, keep_rows=True)
     ds = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t, NoiseModel(level, cfg.encoder_resolution), rng,
                           setup.phi_true, cfg.smoothing_passes, "identification", [], estimation, cfg.strategy)
-    bounds = search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
+    bounds = paper_search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
     budget = SearchBudget(cfg.colony_size, cfg.limit, cfg.maxiter)
     params = np.full((len(keys), setup.base.n_base), np.nan)
     seconds = np.zeros(len(keys))

@@ -573,7 +573,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
-    bounds = search_box(config, robot, base, ident.w_base, y)
+    bounds = paper_search_box(config, robot, base, ident.w_base, y)
     outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
     if outside and any(spec(m).needs_box for m in keys):  # only the box searches and LAD use it
         warnings.append("truth outside the ABC search box for " + ", ".join(outside))
@@ -699,7 +699,7 @@ def box_kind(config, robot: Robot, base: BaseParameters) -> str:
     return "scaled"
 
 
-def search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
+def paper_search_box(config, robot: Robot, base: BaseParameters, w_base: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The ABC's search box: the paper's Table 3 (amended where it misses the paper's own Table 2,
     :data:`dynid.studies.paper_reference.TABLE3_AMENDED`), or ``±(2|β_OLS| + 1)``.
 
