@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 from .exceptions import ConfigError
 from .extras import require
+from .plugins import share_with
 
 
 @contextlib.contextmanager
@@ -40,7 +41,6 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     require("distributed", extra, what)
     from distributed import Client, LocalCluster
 
-    from .plugins import share_with
 
     if scheduler:
         try:

@@ -13,8 +13,12 @@ from __future__ import annotations
 
 import contextlib
 import os
+import pickle
 import signal
 import sys
+
+from .exceptions import DynIdError
+from .threads import cores
 
 _allowed = False
 
@@ -46,8 +50,6 @@ def can_fork() -> bool:
     -------
     bool
     """
-    from .threads import cores
-
     return _allowed and cores() >= 2 and sys.platform.startswith("linux")
 
 
@@ -135,8 +137,6 @@ class ForkedCall:
         -------
         object
         """
-        import pickle
-
         fn, args = self._call
         if self._pid is None:
             return fn(*args)
@@ -162,10 +162,6 @@ def _child(write: int, fn, args):
     """The child of :class:`ForkedCall`: compute, write the pickled ``(ok, value)`` and leave; never returns."""
     code = 1
     try:
-        import pickle
-
-        from .exceptions import DynIdError
-
         try:
             answer = (True, fn(*args))
         except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)

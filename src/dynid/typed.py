@@ -12,6 +12,7 @@ import re
 from typing import Any, TypeVar
 
 import msgspec
+from msgspec import inspect as mi
 
 from .exceptions import ConfigError
 
@@ -105,8 +106,6 @@ def _message(text: str, doc: Any, type_: type, source: str, where: str) -> str:
 
 def _fixed_length(info) -> str:
     """``"a list of 3 numbers"`` for a list type of one allowed length, else ""."""
-    from msgspec import inspect as mi
-
     for c in _candidates(info):
         if isinstance(c, mi.ListType) and c.min_length is not None and c.min_length == c.max_length:
             inner = re.sub(r"^an? ", "", _describe(c.item_type)) or "value"
@@ -137,8 +136,6 @@ def _value_at(doc, parts) -> tuple[Any, bool]:
 
 def _bare(info):
     """A type's information without its metadata wrappers (descriptions)."""
-    from msgspec import inspect as mi
-
     while isinstance(info, mi.Metadata):
         info = info.type
     return info
@@ -146,8 +143,6 @@ def _bare(info):
 
 def _candidates(info) -> list:
     """The alternatives of a union (or the type itself), without metadata and without None."""
-    from msgspec import inspect as mi
-
     info = _bare(info)
     if info is None or isinstance(info, mi.NoneType):
         return []
@@ -166,8 +161,6 @@ def _info_at(info, parts):
 
 
 def _unwrapped(info, step):
-    from msgspec import inspect as mi
-
     for c in _candidates(info):
         if isinstance(step, int) and isinstance(c, (mi.ListType, mi.TupleType, mi.VarTupleType)):
             return c.item_type if hasattr(c, "item_type") else c.item_types[min(step, len(c.item_types) - 1)]
@@ -181,16 +174,12 @@ def _unwrapped(info, step):
 
 
 def _fields(info) -> list[str]:
-    from msgspec import inspect as mi
-
     return [f.encode_name for c in _candidates(info) if isinstance(c, mi.StructType) for f in c.fields]
 
 
 def _expected(info) -> str:
     """What a field accepts, in words, when that says more than msgspec's message: a choice among fixed values, or
     among several kinds (a number or a list); else ""."""
-    from msgspec import inspect as mi
-
     candidates = _candidates(info)
     if not candidates:
         return ""
@@ -201,8 +190,6 @@ def _expected(info) -> str:
 
 def _describe(info) -> str:
     """Any type in words: ``'auto', a number >= 0 or a list of numbers >= 0``."""
-    from msgspec import inspect as mi
-
     candidates = _candidates(info)
     words: list[str] = []
     for c in candidates:

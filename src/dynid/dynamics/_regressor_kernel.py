@@ -18,8 +18,11 @@ frames, then for every link ``j`` and joint ``i <= j`` the ten closed-form colum
 from __future__ import annotations
 
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+
+from ..threads import cores
 
 
 def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl):
@@ -224,15 +227,12 @@ def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, 
     inertial columns of each link; skipped where ``colmap[c] < 0``) and the drive columns of ``drive`` as
     ``drive_map`` places them (:func:`sample_columns`). Every sample is computed on its own, so the result does not
     depend on how the samples are split over threads."""
-    from ..threads import cores
-
     load_compiled()
     n_s = q.shape[0]
     workers = min(cores(), max(1, n_s // PARALLEL_SAMPLES))
     if workers == 1:
         _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, 0, n_s)
         return
-    from concurrent.futures import ThreadPoolExecutor
 
     bounds = np.linspace(0, n_s, workers + 1).astype(np.int64)
     with ThreadPoolExecutor(max_workers=workers) as pool:

@@ -23,14 +23,17 @@ CPU and llvmlite's version. Compiling takes 0.4-0.5 s for a 6-joint arm; loading
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
 import os
 import struct
 import threading
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+from ..threads import cores
 from . import _regressor_kernel
 
 LANES = 4
@@ -299,8 +302,6 @@ def _write_cache(path: Path | None, data: bytes) -> None:
 def _compile(ir: str):
     """The compiled ``kernel`` of ``ir`` as a ctypes function (the engine is kept alive with it): the cached
     machine code when there is a valid one, else compiled and cached."""
-    import ctypes
-
     import llvmlite
     import llvmlite.binding as llvm
 
@@ -348,8 +349,6 @@ def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, d
     (N, n, m), C-ordered, is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
     samples after the last whole group of lanes go through it padded. ``colmap`` must place the drive
     columns where ``drive_map`` does (as :func:`dynid.dynamics.regressor.regressor` builds them)."""
-    from ..threads import cores
-
     n_s, n = q.shape
     m, n_drive = out.shape[2], drive_map.shape[1]
     function = kernel(rp, pp, axes, gravity, npj, n_drive)
@@ -370,8 +369,6 @@ def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, d
     if workers == 1:
         part(0, whole)
     else:
-        from concurrent.futures import ThreadPoolExecutor
-
         with ThreadPoolExecutor(max_workers=workers) as pool:
             list(pool.map(lambda i: part(bounds[i], bounds[i + 1]), range(workers)))
     if whole < n_s:  # the last samples, padded with copies of the last one to a whole group of lanes

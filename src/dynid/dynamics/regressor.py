@@ -21,6 +21,7 @@ run three ways with the same numbers:
 from __future__ import annotations
 
 import threading
+from dataclasses import replace
 
 import numpy as np
 
@@ -29,6 +30,7 @@ from ..friction import drive_columns
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from . import _regressor_kernel as kernel
+from . import _regressor_simd
 
 NUMPY_SAMPLES = 60_000
 """Samples a process computes with the NumPy form before the compiled regressor takes over: NumPy takes
@@ -130,8 +132,6 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None, veloci
     npj = robot.n_params_per_joint
     v = robot.friction_velocities if velocities is None else velocities
     if "fcl" in robot.drive_terms and v.load is None:
-        from dataclasses import replace
-
         v = replace(v, load=nominal_rigid_torque(robot, q, dq, ddq))
 
     def drive(a, b):
@@ -165,8 +165,6 @@ def _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, dri
     ``drive(a, b)`` gives the drive columns of samples ``a:b``."""
     if not _simd["failed"]:
         try:
-            from . import _regressor_simd
-
             _regressor_simd.simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
             _simd["used"] = True
             return
@@ -204,8 +202,6 @@ def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:
     -------
     (N, n_dof) ndarray [N·m]
     """
-    from dataclasses import replace
-
     rigid = replace(robot, drive_terms=(), drive=np.zeros((robot.n_dof, 0)), drive_mask=np.ones((robot.n_dof, 0), dtype=bool))
     return regressor(rigid, q, dq, ddq) @ rigid.standard_parameters()
 
@@ -235,8 +231,6 @@ def friction_torques(robot: Robot, dq: np.ndarray, ddq: np.ndarray, drive: np.nd
     q = np.zeros_like(np.asarray(dq, dtype=float)) if q is None else q
     v = robot.friction_velocities
     if "fcl" in robot.drive_terms:
-        from dataclasses import replace
-
         v = replace(v, load=nominal_rigid_torque(robot, q, dq, ddq))
     cols = drive_columns(robot.drive_terms, q, dq, ddq, v)
     tau = np.einsum("njt,jt->nj", cols, drive * robot.drive_mask) if robot.drive_terms else np.zeros_like(np.asarray(dq, dtype=float))

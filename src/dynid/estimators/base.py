@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from ..exceptions import ShapeError
+from .accumulate import LeastSquaresAccumulator
 
 
 def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -271,8 +274,6 @@ class Estimator:
         -------
         dict
         """
-        import inspect
-
         names = [p.name for p in inspect.signature(type(self).__init__).parameters.values()
                  if p.kind == p.KEYWORD_ONLY]
         return {n: getattr(self, n) for n in names}
@@ -406,8 +407,6 @@ class AccumulatingEstimator(Estimator):
         ShapeError
             Wrong shapes, a number of parameters that changed between calls, or non-finite values.
         """
-        from .accumulate import LeastSquaresAccumulator
-
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         w = np.asarray(w, dtype=np.float64)
         if w.ndim != 2:

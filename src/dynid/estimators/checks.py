@@ -20,6 +20,8 @@ the estimators do not see: they are checked by dynid's tests on a robot, not her
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from ..exceptions import DynIdError
@@ -126,8 +128,6 @@ def check_estimator(key: str, seed: int = 0) -> None:
 def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int) -> list[str]:
     """Refit a clone of ``fitted`` without weights and with weights of one (the same ``rng`` seed, if it has one):
     the same parameters, or the failure in words."""
-    import inspect
-
     if "sample_weight" not in inspect.signature(fitted.fit).parameters:
         return ["fit takes no sample_weight: the contract is fit(W, tau, sample_weight=None) (one weight >= 0 per row)"]
     fits = []

@@ -16,8 +16,19 @@ from typing import Any
 
 import numpy as np
 
+from ..exceptions import ConfigError
 from .base import AccumulatingEstimator
-from .registry import LEAST_SQUARES, FitData, Fitted, SearchBudget, fit_methods, make_estimator, parse_estimators, spec
+from .registry import (
+    LEAST_SQUARES,
+    FitData,
+    Fitted,
+    SearchBudget,
+    _named,
+    fit_methods,
+    make_estimator,
+    parse_estimators,
+    spec,
+)
 
 __all__ = ["Estimation", "stream_rows", "stacked_rows"]
 
@@ -67,9 +78,6 @@ class Estimation:
         ref = self.streamed.get(self.reference_key)
         self.reference: Any = ref if ref is not None else make_estimator(self.reference_key, problem)
         if not isinstance(self.reference, AccumulatingEstimator):
-            from ..exceptions import ConfigError
-            from .registry import _named
-
             raise ConfigError(f"{_named(self.reference_key)}: replaces the least-squares reference of every "
                               "identification, which takes the rows block by block (partial_fit) and gives σ; register "
                               "it under a key of its own, or subclass dynid.estimators.AccumulatingEstimator")
@@ -184,8 +192,6 @@ class Estimation:
         chosen = self.keys if keys is None else tuple(keys)
         for key in chosen:
             if spec(key).needs_box and box is None:
-                from ..exceptions import ConfigError
-
                 raise ConfigError(f"estimator {key} searches a box: none was given")
         fed = {}
         for key in chosen:

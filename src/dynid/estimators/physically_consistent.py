@@ -14,6 +14,8 @@ parameters, which must be non-negative); :func:`dynid.dynamics.layout.consistenc
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..exceptions import DynIdError, ShapeError
@@ -259,8 +261,6 @@ def _consistency_constraints(phi, links, nonnegative, margin) -> list:
 
 def _solve(problem, what: str):
     """Solve with Clarabel; a solver failure becomes a one-line :class:`DynIdError` naming ``what``."""
-    import warnings
-
     import cvxpy as cp
 
     try:

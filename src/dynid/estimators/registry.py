@@ -23,13 +23,16 @@ import dataclasses
 import importlib
 import inspect
 import math
+import threading
 import time
 from collections.abc import Callable, Iterable
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError, DynIdError
 from ..plugins import Registry, load_plugins, origin
+from ..threads import cores
 
 if TYPE_CHECKING:
     import numpy as np
@@ -670,11 +673,6 @@ def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs:
     When a fit fails, or this thread is interrupted (Ctrl-C), the box searches stop at their next iteration,
     the fits not started are cancelled, and the error is raised once the running ones have ended.
     """
-    import threading
-    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
-
-    from ..threads import cores
-
     keys_ = tuple(keys_)
     fed = fed or {}
     stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration

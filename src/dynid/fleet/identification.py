@@ -12,6 +12,7 @@ which a second round of tasks validates on each unit's validation logs.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -19,9 +20,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..estimators.pooled import PooledEstimate
-from ..exceptions import ConfigError, DynIdError
+from ..cluster import dask_client
+from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_parameters
+from ..exceptions import ConfigError, DataError, DynIdError
+from ..extras import require
+from ..identification.run import run_identification, validate_sets
+from ..io.files import write_json
 from ..io.fleet_manifest import FleetManifest, FleetUnit
+from ..io.identification_config import stored_preprocessing
+from ..io.results import read_results
+from .outliers import fleet_outliers
 
 __all__ = ["UnitSummary", "FleetResult", "identify_unit", "run_fleet", "add_pooled_estimates"]
 
@@ -104,7 +112,6 @@ def _peak_memory() -> float:
     """This process's peak resident memory [MB] (NaN where the platform does not say)."""
     try:
         import resource
-        import sys
 
         kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         return kb / (1024 * 1024) if sys.platform == "darwin" else kb / 1024
@@ -135,9 +142,6 @@ def identify_unit(unit: FleetUnit, out: str | Path | None = None, save: Callable
     UnitSummary
         With ``error`` set (one line) when the unit's data or config fail; nothing is raised for them.
     """
-    from ..identification.run import run_identification
-    from ..io.identification_config import stored_preprocessing
-
     t0 = time.perf_counter()
     date = None if unit.date is None else unit.date.isoformat()
     try:
@@ -186,9 +190,6 @@ def add_pooled_estimates(out: str | Path, units: tuple[UnitSummary, ...], pooled
     list of Path
         The results files rewritten (atomically; a unit without one is left out).
     """
-    from ..io.files import write_json
-    from ..io.results import read_results
-
     written = []
     for i, unit in enumerate(units):
         path = Path(out) / "units" / unit.id / "results.json"
@@ -223,7 +224,6 @@ def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dic
         label -> error [%]; empty when the unit has no validation log.
     """
     from ..dynamics.base_parameters import base_parameters
-    from ..identification.run import validate_sets
 
     if not unit.config.validation:
         return {}
@@ -351,9 +351,6 @@ class FleetResult:
 
 
 def _flag(units: tuple[UnitSummary, ...]):
-    from ..estimators.pooled import shared_parameters
-    from .outliers import fleet_outliers
-
     names = list(units[0].names)
     differ = list(~shared_parameters(names))
     values = np.array([u.arm for u in units])  # each unit's stated tool taken out
@@ -396,14 +393,9 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
     ConfigError
         An unreachable scheduler; ``DataError`` when no unit could be identified (the first unit's message).
     """
-    from ..extras import require
-
     require("distributed", "fleet", "dynid fleet")
     from distributed import as_completed
 
-    from ..cluster import dask_client
-    from ..estimators.pooled import pooled_estimate, shared_parameters
-    from ..exceptions import DataError
 
     t0 = time.perf_counter()
     units = manifest.units

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -35,9 +36,14 @@ from pathlib import Path
 import msgspec
 import numpy as np
 
+from ..estimators.pooled import own_term
 from ..estimators.recursive import RecursiveLeastSquares
 from ..exceptions import ConfigError, DataError
-from .change_detection import Cusum, CusumAlarm
+from ..friction import TERMS
+from ..io.datasets import load_recording
+from ..io.identification_config import dataset_for_file
+from ..preprocessing.strategies import carried_over
+from .change_detection import Cusum, CusumAlarm, cusum_threshold
 
 __all__ = ["MonitorSettings", "MonitorWindow", "DriftAlarm", "MonitorResult", "FrictionMonitor", "dated_logs",
            "monitor_logs", "determined", "STATE_FILE", "LEGACY_STATE_FILE", "monitor_fingerprint", "resumed_monitor",
@@ -149,8 +155,6 @@ class DriftAlarm:
         return 100 * (self.value - self.reference) / abs(self.reference) if self.reference else float("inf")
 
     def __str__(self) -> str:
-        from ..friction import TERMS
-
         term = TERMS.get(re.sub(r"\d+$", "", self.term))
         kind = term.description.split(",")[0] if term is not None else self.term
         verb = "rose" if self.value > self.reference else "fell"
@@ -250,8 +254,6 @@ def determined(sigmas: np.ndarray) -> np.ndarray:
     """
     finite = np.where(np.isfinite(sigmas), sigmas, np.nan)
     with np.errstate(all="ignore"):
-        import warnings
-
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             return np.asarray(sigmas <= UNDETERMINED * np.nanmedian(finite, axis=0), dtype=bool)
@@ -307,8 +309,6 @@ class FrictionMonitor:
     """
 
     def __init__(self, robot, base, params, settings: MonitorSettings = MonitorSettings()):
-        from ..estimators.pooled import own_term
-
         self.robot, self.base, self.settings = robot, base, settings
         self.params = np.asarray(params, dtype=float)
         names = list(base.names)
@@ -415,7 +415,6 @@ class FrictionMonitor:
     def _chart(self) -> list[DriftAlarm]:
         from scipy.stats import chi2
 
-        from .change_detection import cusum_threshold
 
         count = len(self.windows)
         ref = self.settings.reference_windows
@@ -428,8 +427,6 @@ class FrictionMonitor:
             # offset are then one column) is left out of that term's reference
             values = np.where(determined(sigmas), values, np.nan)
             with np.errstate(all="ignore"):
-                import warnings
-
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     self.mean = np.nanmean(values, axis=0)
@@ -803,10 +800,7 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
         A log that cannot be read, too few windows for the reference, or (resuming) a new log that sorts before the
         last one the monitor saw.
     """
-    from ..io.datasets import load_recording
-    from ..io.identification_config import dataset_for_file
     from ..preprocessing.pipeline import prepare
-    from ..preprocessing.strategies import carried_over
 
     logs = list(logs)
     monitor = resume if resume is not None else FrictionMonitor(model.robot, model.base, model.params(), settings)

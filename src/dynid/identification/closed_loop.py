@@ -33,18 +33,23 @@ values with the same base parameters (:meth:`dynid.dynamics.base_parameters.Base
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import time
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters
+from ..dynamics.layout import consistency_layout
+from ..dynamics.rnea import rnea_torques
 from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, long_run_covariance
+from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
+from .identify import Estimate, consistency_checks
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopSetup", "closed_loop_identify", "closed_loop_estimates",
            "CLOSED_LOOP_METHODS"]
@@ -374,9 +379,6 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
     """DIDIM with the physically consistent least squares at each step (module docstring), by :func:`_iterate` on
     standard parameter vectors, from the physically consistent least squares on the measured rows ``w_standard``
     (IDIM-SDP); a mean of consistent models is consistent, so the halved steps stay physical."""
-    from ..dynamics.layout import consistency_layout
-    from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
-
     nominal = robot.standard_parameters()
     links, nonneg = consistency_layout(robot)
 
@@ -425,11 +427,6 @@ def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording:
     DataError
         A reference without one set-point per sample of the log.
     """
-    import time
-    from dataclasses import replace
-
-    from ..dynamics.rnea import rnea_torques
-    from .identify import Estimate, consistency_checks
 
     controller = setup.controller
     q_ref = setup.reference_positions()

@@ -15,11 +15,11 @@ Current offsets need no step of their own: they are the ``offset`` drive term, i
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics.base_parameters import BaseParameters
+from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.instrumental import long_run_covariance
 from ..exceptions import ConfigError, IdentifiabilityError
 from ..io.datasets import Recording
@@ -94,8 +94,6 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     IdentifiabilityError
         Fewer rows than parameters, or a residual that does not change with the delay (no motion).
     """
-    from ..dynamics.base_parameters import base_parameters
-
     if not (np.isfinite(max_samples) and max_samples > 0):
         raise ConfigError(f"max_samples: expected a positive number of samples, got {max_samples!r}")
     base = base if base is not None else base_parameters(robot, rng=0)
@@ -190,8 +188,6 @@ def delayed(recording: Recording, samples: float) -> Recording:
     Recording
         The last ``ceil(samples)`` samples (or first, for a negative delay) are dropped: their torques were not logged.
     """
-    from dataclasses import replace
-
     t = np.asarray(recording.t, dtype=float)
     tau = np.asarray(recording.tau, dtype=float)
     shifted = FractionalShift(tau).read(samples)

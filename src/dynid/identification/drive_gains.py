@@ -29,9 +29,11 @@ import scipy.linalg
 from ..conventions import INERTIAL_TERMS
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
-from ..estimators.accumulate import LeastSquaresAccumulator
+from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
+from ..preprocessing.bands import difference_noise_std
+from ..preprocessing.filters import decimation_cutoff, velocity_noise_std
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 
@@ -277,9 +279,6 @@ def filtered_current_noise(data: PreparedData) -> np.ndarray:
     -------
     (n_dof,) ndarray [A²]
     """
-    from ..preprocessing.bands import difference_noise_std
-    from ..preprocessing.filters import decimation_cutoff, velocity_noise_std
-
     s = data.settings
     n = data.q.shape[1]
     if s.strategy != "parallel":
@@ -295,8 +294,6 @@ def _compensated(sol, acc: LeastSquaresAccumulator, noise_sumsq: np.ndarray):
     current column carries noise of known variance, which adds ``Σ σ²`` to its diagonal of ``AᵀA`` and pulls every
     gain towards zero (on a simulated UR10e at 0.01 A, its wrist gain K5 by 0.9 % on average); subtracting it removes that bias. Falls back
     to plain least squares where the compensated matrix is not positive definite."""
-    from ..estimators.accumulate import LeastSquaresSolution
-
     n, p = noise_sumsq.size, sol.params.size
     r_all = acc.reduced()
     r, z = r_all[:p, :p], r_all[:p, p]

@@ -5,18 +5,32 @@ be validated on other logs and be exported — built from an identification or r
 from __future__ import annotations
 
 import json
+import tomllib
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from .. import __version__
 from ..conventions import unit_of
-from ..dynamics.base_parameters import BaseParameters
+from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..dynamics.regressor import regressor
+from ..estimators.registry import label
 from ..exceptions import ConfigError, DataError
+from ..io.export import mjcf_from_results, urdf_from_results
+from ..io.files import _clean, write_json
+from ..io.results import check_fingerprint, read_results, stored_estimates
 from ..keywords import keyword_only_after_data
+from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
+from ..preprocessing.pipeline import prepare
+from ..preprocessing.prepared import rest_velocities
 from ..preprocessing.settings import Preprocessing
+from ..preprocessing.strategies import carried_over
+from ..validation.noise_floor import torque_noise
+from ..validation.torques import compare_torques
 
 __all__ = ["Parameter", "Parameters", "IdentifiedModel", "load_results"]
 
@@ -181,7 +195,6 @@ class IdentifiedModel:
             return self.main
         if estimate in self.estimates:
             return estimate
-        from ..estimators.registry import label
 
         named = f"dynid {label(estimate)}"
         if named in self.estimates:
@@ -266,16 +279,12 @@ class IdentifiedModel:
         if hasattr(t, "tau") and hasattr(t, "rate"):
             return self.predict_log(t, estimate=estimate)[1]
         if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
-            import warnings
 
             warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)
             return self.predict_states(t, q, dq, estimate=estimate)
         if q is None:
             raise ValueError("predict(t, q): the positions are needed with the time stamps (or give a log)")
-        from ..dynamics.regressor import regressor
-        from ..preprocessing.pipeline import prepare
-        from ..preprocessing.prepared import rest_velocities
         from .run import recording_from_arrays
 
         q = np.asarray(q, dtype=float)
@@ -315,16 +324,11 @@ class IdentifiedModel:
         ShapeError
             Arrays not (N, n_dof), or holding NaN.
         """
-        from ..dynamics.regressor import regressor
-        from ..validation.noise_floor import torque_noise
-
         acc = np.asarray(ddq, dtype=float)
         if acc.ndim == 2 and acc.shape[0] >= 10:
             noise, spread = torque_noise(acc), acc.std(axis=0)
             noisy = [j for j in range(acc.shape[1]) if spread[j] > 0 and noise[j] > 0.3 * spread[j]]
             if noisy:
-                import warnings
-
                 warnings.warn(f"predict_states: the accelerations of {', '.join(f'J{j + 1}' for j in noisy)} are mostly "
                               f"noise (its level {max(noise[j] / spread[j] for j in noisy):.0%} of their spread): "
                               "differentiate filtered positions, or give the raw log to predict(t, q)", UserWarning,
@@ -334,8 +338,6 @@ class IdentifiedModel:
 
     def _settings(self):
         """The preprocessing a log other than the identification one gets (:meth:`validate`)."""
-        from ..preprocessing.strategies import carried_over
-
         # the resolved settings stand for the config's here: the decimation (derived, not known to be given) follows
         # this log's own band
         return carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
@@ -374,9 +376,6 @@ class IdentifiedModel:
         -------
         dynid.validation.torques.TorqueComparison
         """
-        from ..preprocessing.pipeline import prepare
-        from ..validation.torques import compare_torques
-
         data = prepare(recording, self._settings(), strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
         return compare_torques(self.robot, self.base, data, sets)
@@ -428,8 +427,6 @@ class IdentifiedModel:
         ConfigError
             No physically consistent estimate that passed the consistency check.
         """
-        from ..io.export import urdf_from_results
-
         return urdf_from_results(self.robot, self.results)
 
     def mjcf(self) -> str:
@@ -445,8 +442,6 @@ class IdentifiedModel:
         ConfigError
             No physically consistent estimate that passed the consistency check.
         """
-        from ..io.export import mjcf_from_results
-
         return mjcf_from_results(self.robot, self.results)
 
     def save(self, path: str | Path) -> Path:
@@ -462,10 +457,7 @@ class IdentifiedModel:
         Path
             The file written.
         """
-        from ..io.files import write_json
-
         path = Path(path)
-        from .. import __version__
 
         write_json(path, {**self.results, "schema_version": RESULTS_SCHEMA_VERSION, "dynid_version": __version__,
                           "kind": "identify"})
@@ -493,10 +485,7 @@ class IdentifiedModel:
         DataError
             Results of another robot, or malformed.
         """
-        from ..dynamics.base_parameters import base_parameters
         from ..io.identification_config import stored_preprocessing
-        from ..io.results import stored_estimates
-        from ..model.friction_model import robot_from_settings
 
         try:
             robot = robot_from_settings(robot, results.get("settings", {}))
@@ -505,9 +494,9 @@ class IdentifiedModel:
         base = base_parameters(robot, rng=0)
         estimates = stored_estimates(results, base.names, source, robot.name)
         std = {}
-        for label, e in (results.get("estimates") or {}).items():
+        for key, e in (results.get("estimates") or {}).items():
             if isinstance(e, dict) and isinstance(e.get("std"), dict):
-                std[str(label)] = np.array([float(e["std"].get(n, np.nan)) for n in base.names])
+                std[str(key)] = np.array([float(e["std"].get(n, np.nan)) for n in base.names])
         stated = results.get("main_estimate")
         main = str(stated) if stated in estimates else next(iter(estimates))
         return cls(robot, base, estimates, std, main, stored_preprocessing(results), results)
@@ -538,8 +527,6 @@ def _stored(settings: dict) -> Preprocessing | None:
 
 def _plain(obj):
     """numpy values as JSON-ready Python values (NaN and inf as None)."""
-    from ..io.files import _clean
-
     return _clean(obj)
 
 
@@ -566,8 +553,6 @@ def load_results(path: str | Path, *, robot: Robot | str | Path | None = None) -
         kinematics differ from those the results were identified with (``settings.robot_fingerprint``, from this
         release on: :meth:`dynid.model.robot.Robot.kinematic_fingerprint`).
     """
-    from ..io.results import check_fingerprint, read_results
-
     path = Path(path)
     if path.is_dir() and (path / "results.json").is_file():  # the output folder of dynid identify
         path = path / "results.json"
@@ -590,8 +575,6 @@ def _robot(robot, results: dict, path: Path) -> Robot:
     settings: dict = results["settings"] if isinstance(results.get("settings"), dict) else {}
     source = settings.get("robot_source")
     if isinstance(source, str) and source.startswith("config:"):
-        import tomllib
-
         from ..io.configs import config_robot
 
         config = Path(source[len("config:"):])

@@ -12,11 +12,14 @@ Example::
 from __future__ import annotations
 
 import inspect
+import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..exceptions import ConfigError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -199,11 +202,7 @@ class Identifier:
         DataError, ShapeError, IdentifiabilityError
             Data that cannot be identified from (the message says why).
         """
-        from ..exceptions import ConfigError
-
         if isinstance(t, (str, Path)):
-            import warnings
-
             warnings.warn("Identifier(...).fit(config_path) is Identifier.from_config(config_path, ...): fit takes the "
                           "arrays t, q, tau", FutureWarning, stacklevel=2)
             result = self._config_result(Path(t), data_root, validate)
@@ -239,9 +238,6 @@ class Identifier:
         return self
 
     def _config_result(self, path: Path, data_root, validate: bool):
-        from dataclasses import replace
-
-        from ..exceptions import ConfigError
         from ..io.identification_config import load_identification_config, split_estimators
         from .run import run_identification
 
@@ -266,7 +262,6 @@ class Identifier:
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:
-        from ..exceptions import ConfigError
         from ..model.description import load_robot
 
         if self.robot is None:
@@ -274,8 +269,6 @@ class Identifier:
         return self.robot if isinstance(self.robot, Robot) else load_robot(self.robot)
 
     def _preprocessing(self) -> Preprocessing | None:
-        from ..exceptions import ConfigError
-
         p = self.preprocessing
         if p is None or isinstance(p, Preprocessing):
             return p
@@ -328,7 +321,6 @@ class Identifier:
         (N, n_dof) array [N·m]
         """
         if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
-            import warnings
 
             warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)
@@ -373,7 +365,6 @@ class Identifier:
             1 is a perfect prediction.
         """
         if np.ndim(t) == 2 and args:  # the earlier score(q, dq, ddq, tau)
-            import warnings
 
             warnings.warn("score(q, dq, ddq, tau) scores states of one's own: score(t, q, tau) prepares a raw log as the "
                           "fit did", FutureWarning, stacklevel=2)

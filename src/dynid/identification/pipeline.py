@@ -32,12 +32,19 @@ from typing import Any
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
-from ..exceptions import ConfigError
+from ..estimators.instrumental import CLOSED_LOOP_METHODS
+from ..exceptions import ConfigError, DynIdError
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
 from ..preprocessing.prepared import PreparedData
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
+from ..validation.diagnostics import delay_findings
+from .closed_loop import closed_loop_estimates
+from .cross_validation import choose_coulomb_velocity, choose_preprocessing
+from .delay import delay_from_rows
+from .friction_models import choose_friction
+from .identify import identify
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
 
@@ -115,8 +122,6 @@ class IdentificationPipeline:
     controller: Any = None
 
     def __post_init__(self):
-        from ..estimators.instrumental import CLOSED_LOOP_METHODS
-
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
         unknown = [k for k in self.closed_loop if k not in CLOSED_LOOP_METHODS]
@@ -155,8 +160,6 @@ class IdentificationPipeline:
         IdentifiabilityError
             Too little motion to cross-validate a choice on.
         """
-        from .cross_validation import choose_coulomb_velocity
-
         def say(label: str) -> None:
             if step is not None:
                 step(label)
@@ -167,8 +170,6 @@ class IdentificationPipeline:
         auto = settings.auto and strategy_for(settings).chooses_cutoffs
         say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
         if auto:
-            from .cross_validation import choose_preprocessing
-
             filters = choose_preprocessing(self.robot, base, recording, settings)
             assert filters.data is not None  # the chosen candidate's prepared data
             data = filters.data
@@ -186,8 +187,6 @@ class IdentificationPipeline:
             velocity = np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,))
         robot = replace(self.robot, coulomb_velocity=velocity)
         if self.friction == "auto":
-            from .friction_models import choose_friction
-
             say("friction model of each joint (cross-validation)")
             friction = choose_friction(robot, data)
             robot = friction.robot(robot)
@@ -230,8 +229,6 @@ class IdentificationPipeline:
         IdentifiabilityError
             A log that does not excite every base parameter.
         """
-        from .identify import identify
-
         blocks: list = []  # the delay check's rows, from the identification's own pass
         check = _delay_checked(prepared.data)
         result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
@@ -246,7 +243,6 @@ class IdentificationPipeline:
         if recording is None:
             raise ConfigError(f"{self.closed_loop[0]} simulates the log as read: IdentificationPipeline.estimate(..., "
                               "recording=...), or fit(recording)", field="closed_loop")
-        from .closed_loop import closed_loop_estimates
 
         if progress is not None:
             progress("closed-loop estimators (" + ", ".join(self.closed_loop) + ")", 0, 1)
@@ -299,10 +295,6 @@ def _delay_check(data: PreparedData, blocks: list) -> tuple[list, dict]:
     """The delay between the torque and position channels the identification log shows on top of the one given
     (:func:`dynid.identification.delay.delay_from_rows`, on the identification's own rows), and the finding when it
     matters (:func:`dynid.validation.diagnostics.delay_findings`)."""
-    from ..exceptions import DynIdError
-    from ..validation.diagnostics import delay_findings
-    from .delay import delay_from_rows
-
     try:
         d = delay_from_rows(data, blocks)
     except DynIdError as exc:

@@ -7,6 +7,7 @@ or motor currents in A with ``effort = "currents"``).
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -89,8 +90,6 @@ def read_joint_states(spec, robot, name: str):
 def _one_line(message: str) -> str:
     """A library's multi-line message (a YAML parser's, with the text it quotes and a caret under it) as one line:
     what it says and where (line and column)."""
-    import re
-
     parts, quoted = [], False
     for line in (x.strip() for x in message.splitlines()):
         where = re.fullmatch(r'in "<[^>]*>", (line \d+, column \d+):?', line)

@@ -9,6 +9,8 @@ field), then check what depends on the robot (one value per joint) and the files
 from __future__ import annotations
 
 import datetime
+import json
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Union
 
 import msgspec
@@ -17,7 +19,7 @@ from msgspec import Meta
 from ..model.description_types import Angle
 from ..model.description_types import RobotDescription as _RobotDescription
 from ..preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
-from ..typed import Table
+from ..typed import Table, json_schema
 
 if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
     RobotDescription = Any
@@ -336,10 +338,6 @@ def write_schemas(folder=None) -> list:
     -------
     list of Path
     """
-    import json
-    from pathlib import Path
-
-    from ..typed import json_schema
 
     folder = Path(folder) if folder is not None else Path(__file__).resolve().parents[1] / "schema"
     paths = []

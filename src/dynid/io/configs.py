@@ -6,8 +6,9 @@ import tomllib
 from pathlib import Path
 
 from ..exceptions import ConfigError
-from ..model.description import builtin_robots, load_robot
+from ..model.description import builtin_robots, load_robot, robot_from_document
 from ..model.robot import Robot
+from ..model.urdf import expand_xacro, is_xacro
 from .files import text_encoding_hint
 
 
@@ -101,8 +102,6 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     """
     ref = doc.get("robot")
     if isinstance(ref, dict):
-        from ..model.description import robot_from_document
-
         table = dict(ref)
         if isinstance(table.get("urdf"), str) and not (path.parent / table["urdf"]).is_file():
             table["urdf"] = str(_located(table["urdf"], path.parent, data_root) or table["urdf"])
@@ -137,8 +136,6 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
         ``convention = "urdf"``; None for a built-in robot or a DH description.
     """
-    from ..model.urdf import expand_xacro, is_xacro
-
     def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to
         return expand_xacro(file) if file is not None and is_xacro(file) else file
 

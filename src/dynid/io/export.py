@@ -24,8 +24,10 @@ import numpy as np
 
 from ..exceptions import ConfigError
 from ..keywords import keyword_only_after_data
+from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
+from .results import stored_standard
 
 CONSISTENCY_TOL = 1e-7
 """Smallest pseudo-inertia eigenvalue tolerated (the SDP solver's accuracy) [kg·m², kg]."""
@@ -248,8 +250,6 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
         No physically consistent estimate in the results, results of another robot, or a set that did not pass the
         consistency check (the verdict says why).
     """
-    from .results import stored_standard
-
     found = stored_standard(results)
     if found is None:
         raise ConfigError(f"{source}: no physically consistent estimate to export; identify with "
@@ -258,7 +258,6 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     verdict = results.get("physically_consistent_verdict", {}).get(label, "yes")
     if verdict != "yes":
         raise ConfigError(f"{source}: the physically consistent estimate did not pass the consistency check ({verdict})")
-    from ..model.friction_model import robot_from_settings
 
     try:
         robot = robot_from_settings(robot, results.get("settings", {}))
@@ -289,8 +288,6 @@ def nominal_warning(results: dict) -> str | None:
     -------
     str or None
     """
-    from .results import stored_standard
-
     found = stored_standard(results)
     nominal = (results.get("diagnostics") or {}).get("nominal_set")
     if found is None or not isinstance(nominal, str):

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..model.spatial import inertial_from_physical
 from ..typed import convert
 from .config_types import FleetDocument, UnitTable
 from .configs import read_config
@@ -73,8 +74,6 @@ class FleetUnit:
         -------
         (n_params,) ndarray
         """
-        from ..model.spatial import inertial_from_physical
-
         phi = np.zeros(robot.n_params)
         if self.payload:
             com = np.asarray(self.payload_com if self.payload_com is not None else robot.tool_translation, dtype=float)

@@ -71,15 +71,20 @@ from typing import Any
 import msgspec
 import numpy as np
 
-from ..estimators.registry import parse_estimators
+from ..estimators.instrumental import CLOSED_LOOP_METHODS
+from ..estimators.registry import estimate_label, keys, parse_estimators
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
+from ..preprocessing.strategies import check_strategy
+from ..simulation.closed_loop import Controller
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_robot, config_urdf, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
+from .mjcf_write_back import read_users_mjcf
+from .tables import read_table
 from .trajectories import load_trajectory
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
@@ -184,8 +189,6 @@ def _preprocessing(table: PreprocessingTable, where: str, n: int, here: Path = P
                 raise ConfigError(f"{w}: the trajectory has {traj.n_dof} joints, the robot {n}")
             values["fourier"] = (traj.omega_f, traj.n_harmonics)
         elif f.name == "strategy":
-            from ..preprocessing.strategies import check_strategy
-
             try:
                 values["strategy"] = check_strategy(v)
             except ConfigError as exc:
@@ -250,8 +253,6 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
     ConfigError
         An unknown key, or a closed-loop estimator first (it starts from the first's estimate).
     """
-    from ..estimators.instrumental import CLOSED_LOOP_METHODS
-
     asked = [str(k).strip().lower() for k in asked]
     closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
     if asked and asked[0] in CLOSED_LOOP_METHODS:
@@ -344,7 +345,6 @@ def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: P
     if urdf is not None and urdf.name == file.name:
         raise ConfigError(f"{path}: mjcf_model: {file.name} is also the URDF's file name, and identify writes both into "
                           "one folder: give the MJCF another name", field="mjcf_model")
-    from .mjcf_write_back import read_users_mjcf
 
     try:
         read_users_mjcf(file, robot)
@@ -357,7 +357,6 @@ def _controller(table, root: Path, where: str, n: int):
     """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None."""
     if table is None:
         return None
-    from ..simulation.closed_loop import Controller
 
     try:
         controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),
@@ -406,16 +405,12 @@ class ReferenceTrajectory:
         DataError
             A missing or malformed file (named, with the line).
         """
-        from .tables import read_table
-
         table = read_table(self.file, list(self.positions), header=self.header, rows=self.rows)
         return np.asarray(table.data, dtype=float) * self.scale
 
 
 def _check_reference_names(refs: list, path: Path) -> None:
     """Reference sets are told apart by name in every table: one name per set, none of dynid's estimates' labels."""
-    from ..estimators.registry import estimate_label, keys
-
     labels = {estimate_label(k) for k in keys()}
     seen: dict[str, int] = {}
     for i, r in enumerate(refs):

@@ -17,7 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..dynamics.kinematics import forward_kinematics
 from ..exceptions import ConfigError
+from ..extras import require
 from ..model.robot import Robot
 from ..model.spatial import physical_from_inertial, transform_inertial
 from .export import _exportable, _replace, _vec, identified_header, moved_far
@@ -28,8 +30,6 @@ AXIS_TOLERANCE = 1e-4
 
 def _joint_frames(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     """Rotations (n, 3, 3) and origins (n, 3) of the robot's joint frames at q = 0, in its base frame."""
-    from ..dynamics.kinematics import forward_kinematics
-
     rotations, origins = forward_kinematics(robot, np.zeros((1, robot.n_dof)))
     return rotations[0], origins[0]
 
@@ -193,8 +193,6 @@ def read_users_mjcf(path: Path, robot: Robot):
         MuJoCo is not installed (names the extra), the file cannot be read or compiled, a joint of the robot is
         missing, is not a hinge, or is in an included file.
     """
-    from ..extras import require
-
     mujoco = require("mujoco", "mujoco", "writing into an MJCF")
     try:
         model = mujoco.MjModel.from_xml_path(str(path))

@@ -42,9 +42,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import canonical_name
+from ..conventions import canonical_name, split_name
 from ..dynamics.base_parameters import BaseParameters
 from ..exceptions import ConfigError, DataError
+from ..model.friction_model import COULOMB_LIKE
 
 
 @dataclass(frozen=True)
@@ -228,9 +229,6 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
 def _friction_like(name: str) -> bool:
     """Whether a standard parameter is a friction term a published model may lack (then it has the value 0 there):
     the Coulomb-like terms of :mod:`dynid.model.friction_model`."""
-    from ..conventions import split_name
-    from ..model.friction_model import COULOMB_LIKE
-
     return split_name(name)[0] in COULOMB_LIKE[1:]
 
 

@@ -8,6 +8,7 @@ read too.
 from __future__ import annotations
 
 import json
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -107,8 +108,6 @@ def schema_problem(data: dict) -> str:
     str
         Empty when the results follow the schema.
     """
-    from importlib import resources
-
     import jsonschema
 
     schema = json.loads((resources.files("dynid") / "schema" / "results.schema.json").read_text(encoding="utf-8"))

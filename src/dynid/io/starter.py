@@ -13,6 +13,7 @@ config, to check before identifying.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -215,8 +216,6 @@ def _shown(columns: list[str], most: int = 12) -> str:
 
 
 def _relative(path: Path, folder: Path) -> str:
-    import os
-
     return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
 
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from xml.parsers import expat
+from xml.parsers.expat import ExpatError
 
 import numpy as np
 
@@ -59,8 +61,6 @@ def _tag_end(data: bytes, start: int) -> int:
 
 def _parse(data: bytes) -> _Element:
     """The element tree of ``data`` with byte spans (expat's ``CurrentByteIndex`` at each start and end tag)."""
-    from xml.parsers import expat
-
     parser = expat.ParserCreate()
     stack: list[_Element] = []
     top: list[_Element] = []
@@ -195,7 +195,6 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     """
     path = Path(urdf)
     fitted = _exportable(robot, phi)
-    from xml.parsers.expat import ExpatError
 
     try:
         data = path.read_bytes()

@@ -8,6 +8,7 @@ and URDF chains all reduce to this form (see :mod:`dynid.model.dh` and :mod:`dyn
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -15,7 +16,7 @@ import numpy as np
 from ..conventions import DEFAULT_DRIVE_TERMS, INERTIAL_TERMS, parameter_name
 from ..exceptions import ConfigError
 from ..friction import DEFAULT_STRIBECK_VELOCITY, Velocities, check_terms
-from .spatial import transform_inertial
+from .spatial import is_physically_consistent, nearest_consistent, rot_axis, transform_inertial
 from .transmission import Transmission
 
 
@@ -152,8 +153,6 @@ class Robot:
         notes : tuple of str
             One line per link replaced, naming it and the rule its nominal values break.
         """
-        from .spatial import is_physically_consistent, nearest_consistent
-
         bad = [j for j in range(self.n_dof) if not is_physically_consistent(self.inertial[j])]
         if not bad:
             return self.standard_parameters(), ()
@@ -182,8 +181,6 @@ class Robot:
         ConfigError
             Naming the link and the rule, when a pseudo-inertia is not positive semidefinite.
         """
-        from .spatial import is_physically_consistent
-
         bad = [j for j in range(self.n_dof) if not is_physically_consistent(self.inertial[j])]
         if bad:
             lines = [p for p in self.nominal_problems if f"link {bad[0] + 1} " in p] or [f"link {bad[0] + 1}: nominal inertial parameters"]
@@ -257,8 +254,6 @@ class Robot:
             16 hexadecimal digits (SHA-256 of the values rounded to 12 significant digits: the same for a description
             read again, or from a URDF and a TOML that state the same frames).
         """
-        import hashlib
-
         values = [np.asarray(x, dtype=float).ravel() for j in self.joints for x in (j.rotation, j.translation, j.axis)]
         values += [np.asarray(x, dtype=float).ravel() for x in (self.tool_rotation, self.tool_translation, self.gravity,
                                                                  self.transmission.motor_from_joint)]
@@ -314,8 +309,6 @@ class Robot:
         p : (3,) ndarray
             Origin [m].
         """
-        from .spatial import rot_axis
-
         jt = self.joints[j]
         return jt.rotation @ rot_axis(jt.axis, np.array([qj]))[0], jt.translation.copy()
 

@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import sys
 import tempfile
 from pathlib import Path
+from xml.parsers import expat
 
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..extras import require
 from .robot import Joint
+from .xacro_expressions import guarded_xacro
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -31,8 +35,6 @@ def check_urdf_text(path: Path) -> None:
     ------
     ConfigError
     """
-    from xml.parsers import expat
-
     parser = expat.ParserCreate()
     problems = []
     joint: list = []  # the joint element being read (name, type)
@@ -261,11 +263,6 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     ConfigError
         The ``xacro`` extra is missing, the file is unreadable, or xacro cannot expand it (the message names the file).
     """
-    import hashlib
-    import os
-
-    from ..extras import require
-    from .xacro_expressions import guarded_xacro
 
     path = Path(path)
     if not path.is_file():
@@ -296,7 +293,6 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     try:
         cache.mkdir(parents=True, exist_ok=True)
     except OSError:  # an unwritable cache: the system's temporary folder instead
-        import tempfile
 
         cache = Path(tempfile.gettempdir()) / f"dynid-xacro-{os.getuid() if hasattr(os, 'getuid') else 0}"
         cache.mkdir(parents=True, exist_ok=True)

@@ -8,6 +8,7 @@ decimation of the observation matrix and the torques); Khalil & Dombre 2002, §1
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -240,7 +241,6 @@ def _on_cores(task: Callable, items: list, parallel: bool) -> None:
         for item in items:
             task(item)
         return
-    from concurrent.futures import ThreadPoolExecutor  # only a long block pays for the pool
 
     with ThreadPoolExecutor(max_workers=workers) as pool:
         list(pool.map(task, items))

@@ -10,6 +10,7 @@ from pathlib import Path
 from ..fleet.identification import FleetResult
 from .identification_run import save_identification
 from .output import staged, write_results
+from .summaries import fleet_verdict
 
 __all__ = ["save_unit", "save_fleet"]
 
@@ -58,8 +59,6 @@ def fleet_html(result: FleetResult) -> str:
     -------
     str
     """
-    from .summaries import fleet_verdict
-
     table = result.table()
     verdict = fleet_verdict(result)
     flagged = {(o.unit, o.parameter) for o in result.outliers}

@@ -11,6 +11,9 @@ import datetime
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import __version__
+from ..io import atomic_write_text
+
 
 @dataclass
 class Table:
@@ -376,9 +379,6 @@ def write_html_report(path: Path, data: dict, kind: str, figures: list[Path], ti
     import jinja2
     import numpy
     import pinocchio
-
-    from .. import __version__
-    from ..io import atomic_write_text
 
     env = jinja2.Environment(loader=jinja2.PackageLoader("dynid.report", "templates"), autoescape=True)
     settings, sections = SECTIONS[kind](data)

@@ -6,6 +6,11 @@ import re
 from pathlib import Path
 
 from ..identification.identify import IdentificationResult
+from ..io import atomic_write_text
+from ..io.export import consistent_estimate, mjcf_from_robot, urdf_from_robot
+from ..io.mjcf_write_back import mjcf_written_back
+from ..io.results import stored_standard
+from ..io.urdf_write_back import urdf_written_back
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, output_folder, save_figure, staged, write_results
@@ -115,15 +120,9 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     write_results(json_path, data, "identify")
     write_html_report(out / "report.html", data, "identify", paths, f"dynid identify — {result.robot}")
     paths.insert(0, out / "report.html")
-    from ..io.results import stored_standard
 
     sdp = stored_standard(data)
     if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp[0]) == "yes":
-        from ..io import atomic_write_text
-        from ..io.export import consistent_estimate, mjcf_from_robot, urdf_from_robot
-        from ..io.mjcf_write_back import mjcf_written_back
-        from ..io.urdf_write_back import urdf_written_back
-
         fitted, phi = consistent_estimate(robot, data)
         if urdf is None:
             model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))

@@ -7,12 +7,16 @@ import functools
 import io
 import json
 import os
+import pickle
 import shutil
+import socket
 import tempfile
+import time
 from pathlib import Path
 
+from .. import __version__
 from ..exceptions import ConfigError
-from ..io import atomic_write_bytes
+from ..io import atomic_write_bytes, atomic_write_text, write_json
 from ..processes import can_fork, fork, read_all
 
 MANIFEST = ".dynid-manifest.json"
@@ -83,8 +87,6 @@ def staged(save):
                 (out / p).unlink(missing_ok=True)
             for src, dst in zip(written, final):
                 os.replace(src, dst)
-            from .. import __version__
-            from ..io import atomic_write_text
 
             atomic_write_text(out / MANIFEST, json.dumps({"dynid_version": __version__, "files": [f.name for f in final]},
                                                           indent=2) + "\n")
@@ -100,17 +102,12 @@ _STAGING = ".dynid-staging-"
 
 def _owner() -> str:
     """This process as a staging folder names it: host and process id."""
-    import socket
-
     return f"{socket.gethostname().replace('-', '_')}-{os.getpid()}"
 
 
 def _remove_stale_staging(out: Path, age: float = 3600.0) -> None:
     """Remove staging folders of killed runs: at once when the process that made it on this machine is gone, and any
     (another machine's sharing the folder, a folder of an older version) once it is over ``age`` seconds old."""
-    import socket
-    import time
-
     host = socket.gethostname().replace("-", "_")
     for folder in out.glob(_STAGING + "*"):
         try:
@@ -232,8 +229,6 @@ class _FigureProcess:
 
     def draw(self, build, args) -> bool:
         """Send the jobs; return whether the child drew them all (false: this process draws them)."""
-        import pickle
-
         try:
             message = pickle.dumps((build, args), protocol=pickle.HIGHEST_PROTOCOL)
         except Exception:  # noqa: BLE001 - data that do not pickle: the child leaves, this process draws
@@ -264,8 +259,6 @@ def _figure_process_main(read: int):
     """The figure process: import pyplot, wait for ``(build, args)`` and draw; never returns."""
     code = 1
     try:
-        import pickle
-
         _warm_up_drawing()
         data = read_all(read)
         if data:  # empty: the parent closed the pipe without figures to draw
@@ -377,9 +370,6 @@ def write_results(path: Path, data: dict, kind: str) -> None:
     kind : str
         run, identify, validate, excite or montecarlo; stored with ``schema_version`` and ``dynid_version``.
     """
-    from .. import __version__
-    from ..io import write_json
-
     write_json(path, {"schema_version": SCHEMA_VERSION, "dynid_version": __version__, "kind": kind, **data})
 
 
@@ -405,8 +395,6 @@ def save_texts(files: dict[str, str], out: str | Path) -> list[Path]:
     ConfigError
         If ``out`` exists and is not a folder, or cannot be created.
     """
-    from ..io import atomic_write_text
-
     out = output_folder(out)
     stage = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{_owner()}-", dir=out))
     try:

@@ -10,12 +10,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..conventions import unit_of
-from ..estimators.registry import label
+from ..estimators.registry import OTHER_LABELS, label
+from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, IdentificationResult
 from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
+from ..validation.diagnostics import nominal_gate
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison, rests_throughout
 from .html import BAD_RELATIVE_STD, not_determined
+from .paper_summary import run_summary_blocks
 
 __all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
            "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "closed_loop_study_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
@@ -110,11 +113,9 @@ def blocks(result) -> list:
     from ..fleet.identification import FleetResult
     from ..fleet.monitor import MonitorResult
     from ..identification.excitation_run import ExcitationRun
-    from ..identification.identify import IdentificationResult
     from ..studies.closed_loop import ClosedLoopStudyResult
     from ..studies.montecarlo import MonteCarloResult
     from ..studies.paper import PaperRunResult
-    from .paper_summary import run_summary_blocks
 
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
                        (MonteCarloResult, montecarlo_blocks), (ClosedLoopStudyResult, closed_loop_study_blocks),
@@ -137,8 +138,6 @@ def identification_blocks(result) -> list:
     -------
     list of Line and TextTable
     """
-    from ..identification.identify import BOX_FRACTION, BOX_SIGMAS
-
     r = result
     sol, base = r.solution, r.base
     out: list = [readiness(r), _identification_title(r)]
@@ -152,7 +151,6 @@ def identification_blocks(result) -> list:
         out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
     if r.settings.get("friction_models") is not None:
         out.append(friction_choice_table(r.settings["friction_models"]))
-    from ..estimators.registry import OTHER_LABELS
 
     closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS]  # IDIM-IV, DIDIM: beside least squares
     kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
@@ -236,7 +234,6 @@ def readiness(result) -> Line:
     if exportable and nominal is not None and any(s.get("estimate") != exportable[0]
                                                   for s in (r.diagnostics.get("versus_nominal") or {}).values()):
         # the gate judged the main estimate; what is ready is what export writes (it warns on these joints)
-        from ..validation.diagnostics import nominal_gate
 
         worse = {log: s["worse_joints"] for log, s in nominal_gate(r.validations, exportable[0], nominal)[1].items()}
     worse = {log: j for log, j in worse.items() if j}

@@ -33,6 +33,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..cluster import map_realisations
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..dynamics.rnea import rnea_torques
@@ -43,6 +44,7 @@ from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..extras import require
 from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
+from ..identification.identify import identify
 from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
@@ -238,7 +240,6 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     params, std = np.full((len(keys), n_base), np.nan), np.full((len(keys), n_base), np.nan)
     converged, seconds = np.zeros(len(keys), dtype=bool), np.zeros(len(keys))
     errors: dict[str, str] = {}
-    from ..identification.identify import identify
 
     open_keys = [k for k in keys if k not in CLOSED_LOOP_METHODS]
     if open_keys:
@@ -451,7 +452,6 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
         Invalid settings, an unreachable scheduler, or Dask not installed.
     """
     require("distributed", "montecarlo", "dynid montecarlo --closed-loop")
-    from ..cluster import map_realisations
 
     t0 = time.perf_counter()
     setup = _prepare(config)

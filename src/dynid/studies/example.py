@@ -11,6 +11,7 @@ redistributed, and a simulated one is small and the same on every machine.
 from __future__ import annotations
 
 import io
+from dataclasses import replace
 from importlib import resources
 
 import numpy as np
@@ -42,7 +43,6 @@ def _with_drives(robot, rng):
     for k, term in enumerate(robot.drive_terms):
         if term in size:
             drive[:, k] = size[term] * tau * rng.uniform(0.7, 1.3, robot.n_dof)
-    from dataclasses import replace
 
     return replace(robot, drive=drive * robot.drive_mask)
 

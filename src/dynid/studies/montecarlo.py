@@ -30,6 +30,7 @@ import numpy as np
 from ..cluster import map_realisations
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
+from ..estimators import registry
 from ..estimators.estimation import Estimation
 from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
 from ..exceptions import ConfigError, DynIdError
@@ -38,6 +39,7 @@ from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..extras import require
 from ..model.description import load_robot
 from ..model.robot import Robot
+from ..preprocessing import strategies
 from ..simulation.measurements import NoiseModel
 from ..threads import with_single_blas_thread
 from .paper import PaperExperimentConfig, identification_trajectory, paper_search_box, problem, simulate_dataset
@@ -172,8 +174,6 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     w = base.base_observation(observation_matrix(robot, q, dq, ddq)).reshape(t.size, robot.n_dof, -1)
     gains = np.asarray(robot.drive_gains, dtype=float)
     info = np.einsum("kjp,kjq,j->pq", w, w, 1.0 / gains**2)
-    from ..estimators import registry
-    from ..preprocessing import strategies
 
     plugins = (registry.registered_by_user(config.estimators), strategies.registered_by_user([config.strategy]))
     return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info), plugins)
@@ -198,8 +198,6 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     """
     cfg = setup.config
     level = float(cfg.noise_levels[level_index])
-    from ..estimators import registry
-    from ..preprocessing import strategies
 
     registry.ensure_registered(setup.plugins[0])  # a worker process knows only the built-in ones
     strategies.ensure_registered(setup.plugins[1])

@@ -43,6 +43,7 @@ from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks, prepare
 from ..preprocessing.settings import Preprocessing
+from ..preprocessing.strategies import check_strategy
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from ..threads import with_single_blas_thread
 from ..validation import correlation_coefficient, relative_error, rmse
@@ -169,7 +170,6 @@ class PaperExperimentConfig:
         if self.smoothing_passes < 0:
             raise ConfigError(field="smoothing_passes", message=f"smoothing_passes must be >= 0, got {self.smoothing_passes}")
         parse_estimators(self.estimators)
-        from ..preprocessing.strategies import check_strategy
 
         check_strategy(self.strategy)
         if self.bootstrap != 0 and self.bootstrap < 2:

@@ -13,6 +13,7 @@ A service life is one unit's dated logs over weeks while one joint's viscous and
 
 from __future__ import annotations
 
+import datetime
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -288,8 +289,6 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
     UnitTruth
         The unworn unit.
     """
-    import datetime
-
     folder = Path(folder)
     nominal = load_robot(robot)
     fc, fv = _nominal_friction(nominal, robot)

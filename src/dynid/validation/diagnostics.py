@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .noise_floor import AT_FLOOR
+
 __all__ = ["Finding", "ResidualSums", "sign_findings", "validation_findings", "prior_findings",
            "nominal_gate"]
 
@@ -313,8 +315,6 @@ def validation_findings(name: str, global_error: float, fit_error: float, predic
     -------
     list of Finding
     """
-    from .noise_floor import AT_FLOOR
-
     out = []
     if np.isfinite(global_error) and np.isfinite(floor) and global_error <= AT_FLOOR * floor:
         return [Finding("floor", f"{name}: {label} scores {global_error:.3g} %, at the noise floor of this log's samples "

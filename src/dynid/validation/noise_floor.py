@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..preprocessing.bands import decimation_cutoff
+
 __all__ = ["AT_FLOOR", "torque_noise", "scored_bandwidth", "noise_floor"]
 
 AT_FLOOR = 1.5
@@ -67,8 +69,6 @@ def scored_bandwidth(settings, rate: float) -> float:
     float
         In (0, 1]: 1 when nothing filters the torques.
     """
-    from ..preprocessing.bands import decimation_cutoff
-
     cutoff = float(settings.parallel_cutoff or 0.0)
     dec = int(settings.decimation or 1)
     if cutoff <= 0 and dec > 1:

@@ -11,11 +11,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..column_store import root_mean_square
 from ..dynamics.base_parameters import BaseParameters
+from ..model.friction_model import COULOMB_LIKE
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
+from .noise_floor import noise_floor
 
 __all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "rests_throughout"]
 
@@ -378,8 +381,6 @@ class TorqueSums:
         -------
         TorqueSums
         """
-        from .noise_floor import noise_floor
-
         return cls(data.tau.shape[1], n_columns, len(range(0, data.t.shape[0], data.settings.decimation or 1)),
                    dead=data.dead, floor=noise_floor(data))
 
@@ -528,8 +529,6 @@ def coulomb_like_columns(base: BaseParameters, n_dof: int) -> np.ndarray:
     (n_dof, n_base) float array
         1 where column ``c`` is joint ``j``'s Coulomb-like term.
     """
-    from ..model.friction_model import COULOMB_LIKE
-
     out = np.zeros((n_dof, len(base.names)))
     for j in range(n_dof):
         for term in COULOMB_LIKE:
@@ -615,8 +614,6 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
             centres[label].append(preds[label][-1] - (y * holding) @ beta)
         for label, cov in covariance.items():
             var[label] += np.einsum("mjc,cd,mjd->j", y, cov, y)
-    from ..column_store import root_mean_square
-    from .noise_floor import noise_floor
 
     m = sum(x.shape[0] for x in ts)
     static = static_friction(base, parameter_sets, robot.n_dof)
