@@ -41,7 +41,6 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     require("distributed", extra, what)
     from distributed import Client, LocalCluster
 
-
     if scheduler:
         try:
             client = Client(scheduler, timeout=f"{connect_timeout}s")

@@ -16,7 +16,6 @@ every worker of the Dask clusters dynid starts or joins (:func:`share_with`: a f
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import importlib.util
 import os
 import sys
@@ -75,7 +74,9 @@ def load_plugins() -> tuple[str, ...]:
     """
     named = [(p, f"from {ENVIRONMENT}") for p in os.environ.get(ENVIRONMENT, "").split(os.pathsep) if p]
     try:
-        named += [(ep.value, f"entry point {ep.name!r} of {ENTRY_POINT_GROUP}") for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)]
+        from importlib.metadata import entry_points
+
+        named += [(ep.value, f"entry point {ep.name!r} of {ENTRY_POINT_GROUP}") for ep in entry_points(group=ENTRY_POINT_GROUP)]
     except Exception:  # a broken distribution's metadata: the plugins named otherwise still load
         pass
     done = []

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import pickle
 import signal
 import sys
 
@@ -137,6 +136,8 @@ class ForkedCall:
         -------
         object
         """
+        import pickle
+
         fn, args = self._call
         if self._pid is None:
             return fn(*args)
@@ -162,6 +163,8 @@ def _child(write: int, fn, args):
     """The child of :class:`ForkedCall`: compute, write the pickled ``(ok, value)`` and leave; never returns."""
     code = 1
     try:
+        import pickle
+
         try:
             answer = (True, fn(*args))
         except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)

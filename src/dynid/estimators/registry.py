@@ -23,10 +23,8 @@ import dataclasses
 import importlib
 import inspect
 import math
-import threading
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -673,6 +671,9 @@ def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs:
     When a fit fails, or this thread is interrupted (Ctrl-C), the box searches stop at their next iteration,
     the fits not started are cancelled, and the error is raised once the running ones have ended.
     """
+    import threading
+    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
+
     keys_ = tuple(keys_)
     fed = fed or {}
     stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration

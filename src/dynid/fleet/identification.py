@@ -396,7 +396,6 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
     require("distributed", "fleet", "dynid fleet")
     from distributed import as_completed
 
-
     t0 = time.perf_counter()
     units = manifest.units
     summaries: dict[str, UnitSummary] = {}

@@ -415,7 +415,6 @@ class FrictionMonitor:
     def _chart(self) -> list[DriftAlarm]:
         from scipy.stats import chi2
 
-
         count = len(self.windows)
         ref = self.settings.reference_windows
         if count < ref:

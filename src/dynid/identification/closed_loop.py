@@ -427,7 +427,6 @@ def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording:
     DataError
         A reference without one set-point per sample of the log.
     """
-
     controller = setup.controller
     q_ref = setup.reference_positions()
     if q_ref.shape[0] != recording.t.size:

@@ -9,21 +9,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..checks import check_trajectory_array
-from ..estimators.instrumental import CLOSED_LOOP_METHODS
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
 from ..io.datasets import GAP_FACTOR, DatasetSpec, Recording, load_recording, resampled, uniform_rate
 from ..io.identification_config import IdentificationConfig, split_estimators, stored_preprocessing
-from ..io.results import stored_estimates
 from ..keywords import keyword_only_after_data
 from ..model.description import builtin_robots
-from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
-from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -219,6 +214,8 @@ def _main_estimate(result, nominal: str | None = None) -> dict:
     logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`);
     and the main estimate against the description's nominal model (the set ``nominal``), joint by joint
     (:func:`dynid.validation.diagnostics.nominal_gate`)."""
+    from ..validation.diagnostics import Finding, nominal_gate, validation_findings
+
     label = result.label
     fit_err = result.fit.metrics()[label]["global_relative_error"]
     fit_spread = result.diagnostics.get("prediction_spread")
@@ -287,6 +284,8 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
         No log to validate on.
     """
     from ..dynamics.base_parameters import base_parameters
+    from ..io.results import stored_estimates
+    from ..model.friction_model import robot_from_settings
 
     try:
         config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
@@ -359,6 +358,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     ConfigError
         An unknown estimator or ``friction``, or closed-loop estimators without ``controller``.
     """
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
     from .pipeline import IdentificationPipeline
 
     estimators = tuple(estimators)
@@ -399,6 +399,8 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     DataError
         Time stamps that do not increase, or a gap longer than 5 median steps.
     """
+    from ..checks import check_trajectory_array
+
     t = np.asarray(t, dtype=float).reshape(-1)
     q = check_trajectory_array(q, robot.n_dof, "q")
     tau = check_trajectory_array(tau, robot.n_dof, "tau")

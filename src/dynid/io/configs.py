@@ -8,7 +8,6 @@ from pathlib import Path
 from ..exceptions import ConfigError
 from ..model.description import builtin_robots, load_robot, robot_from_document
 from ..model.robot import Robot
-from ..model.urdf import expand_xacro, is_xacro
 from .files import text_encoding_hint
 
 
@@ -136,6 +135,8 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
         ``convention = "urdf"``; None for a built-in robot or a DH description.
     """
+    from ..model.urdf import expand_xacro, is_xacro
+
     def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to
         return expand_xacro(file) if file is not None and is_xacro(file) else file
 

@@ -50,8 +50,6 @@ from ..column_store import SPOOL_BYTES, StoredColumns, by_column, select_rows
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
-from .bags import read_joint_states
-from .starter import starter_config
 from .tables import read_table
 
 PRESETS: dict[str, dict] = {
@@ -309,6 +307,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:
     """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.starter.starter_config`)."""
+    from .starter import starter_config
 
     if not log.is_file():
         raise DataError(f"{log}: no such log")
@@ -485,6 +484,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
                         f"{type(spec).__name__}")
     warnings: list[str] = []
     if spec.bag is not None:
+        from .bags import read_joint_states
+
         t, raw, where = read_joint_states(spec.bag, robot, spec.name)
         return _assemble(spec, robot, t, raw, where, True, str(spec.bag.path), str(spec.bag.path), warnings)
     requests: dict[Path, list] = {}

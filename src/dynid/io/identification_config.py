@@ -71,19 +71,16 @@ from typing import Any
 import msgspec
 import numpy as np
 
-from ..estimators.instrumental import CLOSED_LOOP_METHODS
 from ..estimators.registry import estimate_label, keys, parse_estimators
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
-from ..simulation.closed_loop import Controller
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_robot, config_urdf, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
-from .mjcf_write_back import read_users_mjcf
 from .tables import read_table
 from .trajectories import load_trajectory
 
@@ -253,6 +250,8 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
     ConfigError
         An unknown key, or a closed-loop estimator first (it starts from the first's estimate).
     """
+    from ..estimators.instrumental import CLOSED_LOOP_METHODS
+
     asked = [str(k).strip().lower() for k in asked]
     closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
     if asked and asked[0] in CLOSED_LOOP_METHODS:
@@ -345,6 +344,7 @@ def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: P
     if urdf is not None and urdf.name == file.name:
         raise ConfigError(f"{path}: mjcf_model: {file.name} is also the URDF's file name, and identify writes both into "
                           "one folder: give the MJCF another name", field="mjcf_model")
+    from .mjcf_write_back import read_users_mjcf
 
     try:
         read_users_mjcf(file, robot)
@@ -357,6 +357,7 @@ def _controller(table, root: Path, where: str, n: int):
     """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None."""
     if table is None:
         return None
+    from ..simulation.closed_loop import Controller
 
     try:
         controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),

@@ -66,7 +66,6 @@ from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_li
 from .robot import Limits, Robot
 from .spatial import inertial_from_physical, physical_problems, transform_inertial
 from .transmission import Transmission
-from .urdf import expand_xacro, is_xacro, joints_from_urdf, urdf_limits
 
 _ANGLE = re.compile(r"^\s*([+-]?)\s*(\d*\.?\d*)\s*\*?\s*pi\s*(?:/\s*(\d+\.?\d*))?\s*$")
 
@@ -106,6 +105,7 @@ def load_robot(name_or_path: str | Path) -> Robot:
     path = Path(text)
     if path.suffix == ".urdf" and path.is_file():
         return robot_from_urdf(path)
+    from .urdf import expand_xacro, is_xacro
 
     if is_xacro(path) and path.is_file():
         return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0])
@@ -262,6 +262,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     if convention == "urdf":
         assert urdf_model is not None
         joints, inertial, _, links = urdf_model
+        from .urdf import urdf_limits
 
         urdf_lim = urdf_limits(upath)
         if len(joints) != n:
@@ -306,6 +307,8 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
 def _read_urdf(urdf: str | None, base: Path | None, source: str):
     """The URDF a description names (relative to ``base``; a xacro file expanded) and its chain
     (:func:`dynid.model.urdf.joints_from_urdf`)."""
+    from .urdf import expand_xacro, is_xacro, joints_from_urdf
+
     if urdf is None:
         raise ConfigError(f"{source}: convention 'urdf' needs a field 'urdf' with the file path")
     upath = Path(urdf)

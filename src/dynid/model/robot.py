@@ -8,7 +8,6 @@ and URDF chains all reduce to this form (see :mod:`dynid.model.dh` and :mod:`dyn
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -254,6 +253,8 @@ class Robot:
             16 hexadecimal digits (SHA-256 of the values rounded to 12 significant digits: the same for a description
             read again, or from a URDF and a TOML that state the same frames).
         """
+        import hashlib
+
         values = [np.asarray(x, dtype=float).ravel() for j in self.joints for x in (j.rotation, j.translation, j.axis)]
         values += [np.asarray(x, dtype=float).ravel() for x in (self.tool_rotation, self.tool_translation, self.gravity,
                                                                  self.transmission.motor_from_joint)]

@@ -263,7 +263,6 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     ConfigError
         The ``xacro`` extra is missing, the file is unreadable, or xacro cannot expand it (the message names the file).
     """
-
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: xacro file not found")
