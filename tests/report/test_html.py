@@ -76,7 +76,8 @@ def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
 
 
 def test_values_outside_their_range_are_highlighted():
-    from dynid.report.html import BAD_RELATIVE_STD, identify_sections
+    from dynid.report.html import identify_sections
+    from dynid.report.summaries import BAD_RELATIVE_STD
 
     d = {"robot": "r", "condition_number": 10.0, "n_rows": 100,
          "base_parameters": [{"name": "ZZ1R", "unit": "kg·m²", "value": 1.0, "std": 0.01, "relative_std_percent": 1.0, "expression": "ZZ1"},

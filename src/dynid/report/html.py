@@ -53,35 +53,6 @@ class Section:
     texts: list = field(default_factory=list)
 
 
-BAD_RELATIVE_STD = 100.0
-"""[%] A base parameter whose σ reaches its value is not determined by the data: highlighted."""
-
-NEGLIGIBLE_TORQUE = 1.0
-"""[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
-N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
-torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
-
-
-def not_determined(name: str, relative_std: float | None, sigma_torque_percent: dict) -> bool:
-    """Whether a base parameter is not determined by the log: σ of :data:`BAD_RELATIVE_STD` of its value or more,
-    except a torque offset whose ±σ is under :data:`NEGLIGIBLE_TORQUE` of its joint's torque (determined: about 0).
-
-    Parameters
-    ----------
-    name : str
-    relative_std : float or None
-        σ over |value| [%] (None: kept at the prior, no σ).
-    sigma_torque_percent : dict
-        results.json ``diagnostics.sigma_torque_percent``: each parameter's ±σ torque over its joint's RMS torque [%].
-
-    Returns
-    -------
-    bool
-    """
-    if relative_std is None or relative_std < BAD_RELATIVE_STD:  # NaN (no value to compare with) falls through
-        return False
-    share = sigma_torque_percent.get(name)
-    return not (name.startswith("offset") and share is not None and share < NEGLIGIBLE_TORQUE)
 BAD_ERROR = 50.0
 """[%] A joint's relative torque error from here on is highlighted."""
 
@@ -145,6 +116,8 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         Setting -> value shown at the top.
     sections : list of Section
     """
+    from .summaries import BAD_RELATIVE_STD, NEGLIGIBLE_TORQUE, not_determined  # summaries loads NumPy
+
     settings = {"robot": d.get("robot", ""), "estimators": _human(d.get("estimators", d.get("method", ""))),
                 "main estimate": d.get("main_estimate", ""),
                 "preprocessing": d.get("settings", {}).get("preprocessing", {}).get("derivation", ""),

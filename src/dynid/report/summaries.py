@@ -17,8 +17,38 @@ from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison, rests_throughout
-from .html import BAD_RELATIVE_STD, not_determined
 from .paper_summary import run_summary_blocks
+
+BAD_RELATIVE_STD = 100.0
+"""[%] A base parameter whose σ reaches its value is not determined by the data: highlighted."""
+
+NEGLIGIBLE_TORQUE = 1.0
+"""[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
+N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
+torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
+
+
+def not_determined(name: str, relative_std: float | None, sigma_torque_percent: dict) -> bool:
+    """Whether a base parameter is not determined by the log: σ of :data:`BAD_RELATIVE_STD` of its value or more,
+    except a torque offset whose ±σ is under :data:`NEGLIGIBLE_TORQUE` of its joint's torque (determined: about 0).
+
+    Parameters
+    ----------
+    name : str
+    relative_std : float or None
+        σ over |value| [%] (None: kept at the prior, no σ).
+    sigma_torque_percent : dict
+        results.json ``diagnostics.sigma_torque_percent``: each parameter's ±σ torque over its joint's RMS torque [%].
+
+    Returns
+    -------
+    bool
+    """
+    if relative_std is None or relative_std < BAD_RELATIVE_STD:  # NaN (no value to compare with) falls through
+        return False
+    share = sigma_torque_percent.get(name)
+    return not (name.startswith("offset") and share is not None and share < NEGLIGIBLE_TORQUE)
+
 
 __all__ = ["blocks", "summary", "comparison_table", "identification_blocks", "filter_choice_table", "friction_choice_table",
            "coulomb_choice_table", "drive_gains_blocks", "identification_brief", "montecarlo_blocks", "closed_loop_study_blocks", "excitation_blocks", "fleet_blocks", "fleet_verdict",
