@@ -42,6 +42,7 @@ from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
 from ..dynamics.rnea import rnea_torques
 from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, long_run_covariance
+from ..estimators.least_squares import OrdinaryLeastSquares
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
@@ -171,17 +172,18 @@ def _rows(robot: Robot, base: BaseParameters, data: PreparedData,
 
 
 def _weighted_least_squares(w, tau, row_sigma, instants=None):
-    """Weighted least squares with σ: the textbook ``σ² (AᵀA)⁻¹``, or with ``instants`` the sandwich whose middle is
-    the long-run covariance of the scores (:func:`dynid.estimators.instrumental.long_run_covariance`)."""
-    a, b = w / row_sigma[:, None], tau / row_sigma
-    params, *_ = np.linalg.lstsq(a, b, rcond=None)
-    r = b - a @ params
-    inverse = np.linalg.pinv(a.T @ a)
+    """Weighted least squares, the package's (:class:`~dynid.estimators.least_squares.OrdinaryLeastSquares` with the
+    weights ``1/σ²``), with its σ: the textbook ``σ² (AᵀA)⁻¹`` of the scaled rows ``A``, or with ``instants`` the
+    sandwich whose middle is the long-run covariance of the scores
+    (:func:`dynid.estimators.instrumental.long_run_covariance`)."""
+    fit = OrdinaryLeastSquares(n_dof=1).fit(w, tau, sample_weight=row_sigma**-2.0)
     if instants is None:
-        cov = float(r @ r) / max(a.shape[0] - a.shape[1], 1) * inverse
-    else:
-        cov = inverse @ long_run_covariance(a * r[:, None], instants, kernel="parzen") @ inverse
-    return params, np.sqrt(np.maximum(np.diag(cov), 0.0))
+        return fit.params_, fit.params_std_
+    a = w / row_sigma[:, None]
+    r = tau / row_sigma - a @ fit.params_
+    inverse = np.linalg.pinv(a.T @ a)
+    cov = inverse @ long_run_covariance(a * r[:, None], instants, kernel="parzen") @ inverse
+    return fit.params_, np.sqrt(np.maximum(np.diag(cov), 0.0))
 
 
 def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
