@@ -101,3 +101,30 @@ def test_each_check_catches_the_estimator_that_breaks_it(cls, box, said):
                 check_estimator("checked")
     finally:
         unregister("checked")
+
+
+def test_a_class_is_checked_before_it_is_registered_and_the_registry_stays_as_it_was():
+    from dynid.estimators.bee_colony import BeeColonyEstimator
+
+    before = dict(reg._REGISTRY)
+    check_estimator(_LeastSquares)
+    check_estimator(BeeColonyEstimator)  # a box search: checked inside its box, against the box's centre
+    with pytest.raises(EstimatorCheckError, match=r"^_Biased: estimates \d parameter\(s\) more than 5 σ from the truth"):
+        check_estimator(_Biased)
+    with pytest.raises(EstimatorCheckError, match="^_NoSampleWeight: fit takes no sample_weight"):
+        check_estimator(_NoSampleWeight)
+    assert reg._REGISTRY == before
+
+
+def test_a_class_named_like_a_registered_key_leaves_that_key_as_it_was():
+    register("check__leastsquares", _Biased, replace=True)
+    try:
+        check_estimator(_LeastSquares)  # registered for the check under the same key, then the earlier entry back
+        assert reg.spec("check__leastsquares").build is _Biased
+    finally:
+        unregister("check__leastsquares")
+
+
+def test_neither_a_key_nor_an_estimator_class_is_a_type_error():
+    with pytest.raises(TypeError, match="expected a registry key or an Estimator subclass, got 3"):
+        check_estimator(3)

@@ -1,5 +1,5 @@
-"""``check_estimator(key)``: the checks a registered estimator passes before dynid trusts it, for a plugin's author and
-for dynid's own tests (issue "Re-zone the top floors", item 6; scikit-learn's ``check_estimator`` is the model).
+"""``check_estimator(key_or_class)``: the checks an estimator passes before dynid trusts it, for a plugin's author
+(before registering it, or after) and for dynid's own tests (issue "Re-zone the top floors", item 6; scikit-learn's ``check_estimator`` is the model).
 
 The estimator is built and fitted the way the pipeline does (:func:`dynid.estimators.registry.fit_method`, the
 plugin guard included) on a small synthetic problem whose parameters are known: an observation matrix of two joints
@@ -25,8 +25,8 @@ import inspect
 import numpy as np
 
 from ..exceptions import DynIdError
-from .base import paper_objective
-from .registry import FitData, SearchBudget, fit_method, spec
+from .base import BoxSearchEstimator, Estimator, paper_objective
+from .registry import _REGISTRY, FitData, SearchBudget, fit_method, register, spec
 
 __all__ = ["EstimatorCheckError", "check_estimator"]
 
@@ -64,26 +64,50 @@ def _problem(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     return w, tau, truth, bounds, sigma
 
 
-def check_estimator(key: str, seed: int = 0) -> None:
-    """Check a registered estimator (module docstring).
+def check_estimator(estimator, seed: int = 0) -> None:
+    """Check an estimator (module docstring), registered or not.
 
     Parameters
     ----------
-    key : str
-        Its registry key (a plugin registers it with :func:`dynid.estimators.register`).
+    estimator : str or Estimator subclass
+        A registry key (a plugin registers its estimator with :func:`dynid.estimators.register`), or the class itself,
+        checked before it is registered, as registered with its defaults (a :class:`BoxSearchEstimator` as a box
+        search); the registry is as it was afterwards.
     seed : int
         Seeds the synthetic problem and the estimator's ``rng``.
 
     Raises
     ------
     ConfigError
-        ``key`` is not registered.
+        A key that is not registered.
+    TypeError
+        Neither a key nor an :class:`~dynid.estimators.base.Estimator` subclass.
     EstimatorCheckError
         Every failed check, in one line.
     """
-    entry = spec(key)
+    if isinstance(estimator, str):
+        _check(spec(estimator), seed)
+        return
+    if not (isinstance(estimator, type) and issubclass(estimator, Estimator)):
+        raise TypeError(f"check_estimator: expected a registry key or an Estimator subclass, got {estimator!r}")
+    key = "check_" + "".join(c if c.isalnum() else "_" for c in estimator.__name__.lower())
+    before = _REGISTRY.get(key)
+    entry = register(key, estimator, label=estimator.__name__, needs_box=issubclass(estimator, BoxSearchEstimator),
+                     replace=True)
+    try:
+        _check(entry, seed, estimator.__name__)
+    finally:
+        if before is None:
+            _REGISTRY.pop(key, None)
+        else:
+            _REGISTRY[key] = before
+
+
+def _check(entry, seed: int, name: str | None = None) -> None:
+    """The checks of :func:`check_estimator` on a registry entry; ``name`` in messages (default its key)."""
+    said = name or entry.key
     if entry.space != "base":
-        raise EstimatorCheckError(f"{entry.key}: estimates {entry.space} parameters, which need a robot's layout: "
+        raise EstimatorCheckError(f"{said}: estimates {entry.space} parameters, which need a robot's layout: "
                                   "check_estimator checks base-space estimators")
     w, tau, truth, bounds, sigma = _problem(seed)
     w0, tau0 = w.copy(), tau.copy()
@@ -94,7 +118,7 @@ def check_estimator(key: str, seed: int = 0) -> None:
         first = fit_method(entry.key, data, budget, np.random.default_rng([seed, 11]))
         again = fit_method(entry.key, data, budget, np.random.default_rng([seed, 11]))
     except DynIdError as exc:
-        raise EstimatorCheckError(f"{entry.key}: fit failed on a well-posed problem: {exc}") from None
+        raise EstimatorCheckError(f"{said}: fit failed on a well-posed problem: {exc}") from None
     params = first.params
     if not (np.array_equal(w, w0) and np.array_equal(tau, tau0)):
         failures.append("fit changed the W or tau it was given")
@@ -122,7 +146,7 @@ def check_estimator(key: str, seed: int = 0) -> None:
             failures.append("get_params did not return a dict")
     failures += _sample_weight_failures(first.estimator, w, tau, seed)
     if failures:
-        raise EstimatorCheckError(f"{entry.key}: " + "; ".join(failures))
+        raise EstimatorCheckError(f"{said}: " + "; ".join(failures))
 
 
 def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int) -> list[str]:
