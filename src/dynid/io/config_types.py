@@ -338,7 +338,6 @@ def write_schemas(folder=None) -> list:
     -------
     list of Path
     """
-
     folder = Path(folder) if folder is not None else Path(__file__).resolve().parents[1] / "schema"
     paths = []
     for name, (kind, title, description) in SCHEMAS.items():
