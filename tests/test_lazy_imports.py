@@ -3,8 +3,8 @@
 Every other import stands at the top of its module. A function-level import outside ``dynid.cli`` is kept only when
 it is one of these:
 
-- a third-party package that costs start-up time (:data:`HEAVY`, NumPy among them; SciPy per subpackage: ``scipy.signal`` alone is
-  0.4-0.6 s with SciPy 1.17) that the module's own top-level imports do not load already;
+- a third-party package that costs start-up time (:data:`HEAVY`, NumPy among them; SciPy per subpackage:
+  ``scipy.signal`` alone is 0.4-0.6 s with SciPy 1.17) that the module's own top-level imports do not load already;
 - a dynid module whose top-level imports load such a package that the importing module does not, or that imports the
   importing module back (a cycle);
 - a standard module inside ``try: ... except ImportError`` (one a platform may lack);
@@ -29,8 +29,7 @@ HEAVY = {"numpy", "scipy", "pinocchio", "numba", "llvmlite", "cvxpy", "matplotli
          "dask", "pyarrow", "rosbags", "jinja2", "msgspec", "jsonschema", "sklearn", "xacro", "threadpoolctl", "typer",
          "rich", "numpydoc"}
 """Third-party packages whose import is a start-up cost worth keeping away from the commands that do not need them
-(NumPy too: 0.1 s of the 0.2 s in which a config's typo is reported; the estimators' registry, read there, loads
-none)."""
+(NumPy too: 0.1 s, and ``dynid --help`` loads none of these)."""
 
 CONFIG_CHECK = ("dynid.cli.app", "dynid.identification.run", "dynid.io.identification_config")
 """What ``dynid identify`` imports before it reads and checks a config (tests/cli/test_cli.py)."""
