@@ -5,7 +5,8 @@ For each case and seed: the validation error per joint of dynid's main estimate 
 the same samples (the floor: 1.00 is at it); and, on the point-to-point logs, the true parameters' error as dynid
 reports it over their error on the raw samples (the simulation's true states, unfiltered, every sample of the
 validation half, dynid's model of the truth with sign(q̇) exact at rest): over every sample (``relative_error``) and
-at rest (``rest_rmse`` against the raw RMS error where the true velocity is exactly 0: the prescribed motions'). Run from the repository root:
+at rest (``rest_rmse`` against the raw RMS error where the true velocity is exactly 0: the prescribed motions').
+Run from the repository root:
 ``.venv/bin/python benchmarks/independent_check.py`` (two to three minutes).
 """
 

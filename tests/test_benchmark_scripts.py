@@ -14,7 +14,8 @@ BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 def _imports(path: Path):
     """``(line, module, names)`` of every import from dynid or the tests in a script, wherever it stands."""
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] in ("dynid", "tests"):
+        ours = (getattr(node, "module", None) or "").split(".")[0] in ("dynid", "tests")
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and ours:
             yield node.lineno, node.module, [a.name for a in node.names]
         elif isinstance(node, ast.Import):
             for a in node.names:

@@ -25,8 +25,8 @@ import dynid
 
 ROOT = Path(dynid.__file__).parent
 
-HEAVY = {"numpy", "scipy", "pinocchio", "numba", "llvmlite", "cvxpy", "matplotlib", "mpl_toolkits", "PIL", "mujoco", "distributed",
-         "dask", "pyarrow", "rosbags", "jinja2", "msgspec", "jsonschema", "sklearn", "xacro", "threadpoolctl", "typer",
+HEAVY = {"numpy", "scipy", "pinocchio", "numba", "llvmlite", "cvxpy", "matplotlib", "mpl_toolkits", "PIL", "mujoco",
+         "distributed", "dask", "pyarrow", "rosbags", "jinja2", "msgspec", "jsonschema", "sklearn", "xacro", "threadpoolctl", "typer",
          "rich", "numpydoc"}
 """Third-party packages whose import is a start-up cost worth keeping away from the commands that do not need them
 (NumPy too: 0.1 s, and ``dynid --help`` loads none of these)."""
@@ -112,11 +112,13 @@ class ImportGraph:
     def __init__(self, sources: dict[str, tuple[str, bool]]):
         self.trees = {m: ast.parse(text) for m, (text, _) in sources.items()}
         self.package = {m: package for m, (_, package) in sources.items()}
-        self.edges = {m: [t for node in _top_level_imports(tree) for t in _resolved(node, m, self.package[m], self.trees)]
+        self.edges = {m: [t for node in _top_level_imports(tree)
+                          for t in _resolved(node, m, self.package[m], self.trees)]
                       for m, tree in self.trees.items()}
         self._closures: dict[str, tuple[frozenset, frozenset]] = {}
         self.config_path = frozenset().union(*(self.closure(m)[0] for m in CONFIG_CHECK if m in self.trees))
-        self.config_path_external = frozenset(t for m in self.config_path for t in self.edges[m] if not t.startswith("dynid"))
+        self.config_path_external = frozenset(t for m in self.config_path for t in self.edges[m]
+                                              if not t.startswith("dynid"))
 
     def closure(self, module: str) -> tuple[frozenset, frozenset]:
         """The dynid modules and the start-up costs (:func:`_key`) that importing ``module`` loads."""
@@ -138,7 +140,8 @@ class ImportGraph:
         return self._closures[module]
 
     def needless(self, module: str) -> list[str]:
-        """The function-level imports of ``module`` that keep no start-up cost away, as ``"module.function: import"``."""
+        """The function-level imports of ``module`` that keep no start-up cost away, as
+        ``"module.function: import"``."""
         if module.startswith(EXEMPT):
             return []
         own = self.closure(module)[1]
@@ -169,7 +172,8 @@ def _dynid_graph() -> ImportGraph:
 def test_every_function_level_import_keeps_a_start_up_cost_away():
     graph = _dynid_graph()
     bad = [line for module in sorted(graph.trees) for line in graph.needless(module)]
-    assert not bad, f"{len(bad)} imports inside functions keep no start-up cost away (move them to the top):\n" + "\n".join(bad)
+    assert not bad, (f"{len(bad)} imports inside functions keep no start-up cost away (move them to the top):\n"
+                     + "\n".join(bad))
 
 
 def test_the_check_sees_a_needless_import_and_keeps_a_justified_one():

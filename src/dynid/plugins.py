@@ -221,7 +221,8 @@ class Registry:
         ValueError
             ``key`` registered already, from another origin, without ``replace``.
         """
-        if key in self.entries and not replace and origin(self.builder(self.entries[key])) != origin(self.builder(entry)):
+        known = self.entries.get(key)
+        if known is not None and not replace and origin(self.builder(known)) != origin(self.builder(entry)):
             raise ValueError(f"{self.what} {key!r} is registered already (pass replace=True to replace it)")
         self.entries[key] = entry
 

@@ -490,7 +490,8 @@ class BoxSearchEstimator(Estimator):
     """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
 
     Subclasses set ``bounds`` (p, 2), ``n_dof`` (or None: inferred) and ``weights``, and implement ``_search(objective,
-    bounds)``: the minimum of eq. 9's ``F`` over the box as an ``OptimizeResult`` (``x``, ``fun``, ``nfev``, ``history``).
+    bounds)``: the minimum of eq. 9's ``F`` over the box as an ``OptimizeResult`` (``x``, ``fun``, ``nfev``,
+    ``history``).
     """
 
     bounds: object

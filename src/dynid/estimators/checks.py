@@ -1,5 +1,6 @@
 """``check_estimator(key_or_class)``: the checks an estimator passes before dynid trusts it, for a plugin's author
-(before registering it, or after) and for dynid's own tests (issue "Re-zone the top floors", item 6; scikit-learn's ``check_estimator`` is the model).
+(before registering it, or after) and for dynid's own tests (issue "Re-zone the top floors", item 6; scikit-learn's
+``check_estimator`` is the model).
 
 The estimator is built and fitted the way the pipeline does (:func:`dynid.estimators.registry.fit_method`, the
 plugin guard included) on a small synthetic problem whose parameters are known: an observation matrix of two joints
