@@ -241,7 +241,8 @@ def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
     """The physical-consistency rules that ten inertial parameters break: positive mass, inertia about the centre
     of mass positive definite, and its principal moments meeting the triangle inequality (each at most the sum of the
     other two). A zero mass with zero first moments and inertia (a massless link lumped into its neighbour) breaks the
-    first rule but no other.
+    first rule but no other; a singular inertia (a point mass, a thin rod: principal moments within ``tol`` of zero) is
+    said as such, the limit of a real link rather than an impossible one.
 
     Parameters
     ----------
@@ -261,10 +262,15 @@ def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
         return [f"mass {mass:.6g} kg is not positive"]
     ev = np.linalg.eigvalsh(physical_from_inertial(phi)[2])
     scale = max(abs(ev).max(), 1e-12)
+    if ev.min() < -tol * scale:
+        return [f"inertia about the COM is not positive definite (principal moments {_fmt(ev)} kg·m²)"]
     out = []
     if ev.min() <= tol * scale:
-        out.append(f"inertia about the COM is not positive definite (principal moments {_fmt(ev)} kg·m²)")
-    elif 2 * ev.max() > ev.sum() * (1 + 1e-9):
+        shape = "a point mass" if ev.max() <= 1e-12 else "a thin rod"
+        shown = np.where(abs(ev) <= tol * scale, 0.0, ev)
+        out.append(f"inertia about the COM is singular (principal moments {_fmt(shown)} kg·m²: {shape}, the limit of a "
+                   "real link)")
+    if 2 * ev.max() > ev.sum() * (1 + 1e-9) + tol * scale:
         out.append(f"principal moments {_fmt(ev)} kg·m² break the triangle inequality")
     return out
 
