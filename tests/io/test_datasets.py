@@ -151,6 +151,20 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
     assert any("joint 2 leaves its limits" in w for w in rec.warnings)
 
 
+def test_a_current_clipped_on_one_side_only_is_named(tmp_path, rng):
+    """A drive that limits one direction (here -4 A) while the other reaches further (+9 A): the clipped side is
+    the channel's minimum, not its largest magnitude, and is named all the same."""
+    t = np.arange(300) * 0.01
+    cur = rng.normal(0, 1, (300, 6))
+    cur[20, 1] = 9.0
+    cur[100:160, 1] = -4.0  # clipped at the negative side
+    q = 0.1 + 1e-3 * np.outer(np.arange(300), np.ones(6))
+    rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
+    assert [w for w in rec.warnings if "stay at their extreme" in w] == [
+        f"{tmp_path / 'ur.csv'}: joint 2's currents stay at their extreme -4 for 60 samples (t = 1.000-1.590 s): "
+        "saturated? select rows or a time_range without them"]
+
+
 @pytest.mark.parametrize("content, rows, message", [
     ("", None, r"no data lines \(an empty file"),
     ("\x00\x01\x02garbage\n", None, r"not a UTF-8 text table \(a binary file\?\)"),

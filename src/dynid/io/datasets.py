@@ -295,10 +295,12 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
         if peak == 0:
             continue
-        at = np.abs(np.abs(x) - peak) <= 1e-9 * peak
-        runs = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
-        starts, stops = np.flatnonzero(runs == 1), np.flatnonzero(runs == -1)
-        long = [(a, b) for a, b in zip(starts, stops) if b - a >= SATURATION_SAMPLES]
+        long = []
+        for extreme in {float(x.max()), float(x.min())}:  # each side: a limit may clip one direction only
+            at = np.abs(x - extreme) <= 1e-9 * peak
+            runs = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
+            starts, stops = np.flatnonzero(runs == 1), np.flatnonzero(runs == -1)
+            long += [(a, b) for a, b in zip(starts, stops) if b - a >= SATURATION_SAMPLES]
         if long:
             a, b = max(long, key=lambda r: r[1] - r[0])
             warnings.append(f"{tau_source}: joint {j + 1}'s {kind} stay at their extreme {x[a]:.4g} for "
