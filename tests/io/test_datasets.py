@@ -4,6 +4,8 @@ import pytest
 from dynid.exceptions import ConfigError, DataError
 from dynid.io.datasets import dataset_spec, load_recording
 from dynid.model.description import load_robot
+from dynid.preprocessing.pipeline import prepare
+from dynid.preprocessing.settings import Preprocessing
 
 
 def _ur_row(t, q, dq, i):
@@ -146,23 +148,13 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
     cur[100:160, 2] = 7.5  # clipped
     q = 0.1 + 1e-3 * np.outer(np.arange(300), np.ones(6))
     q[:, 1] = 7.0 + 1e-3 * np.arange(300)  # beyond the UR10e's ±2π
-    rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
-    assert any("joint 3's currents stay at their extreme 7.5 for 60 samples (t = 1.000-1.590 s)" in w for w in rec.warnings)
+    robot = load_robot("ur10e")
+    rec = load_recording(_log(tmp_path, t, q, cur), robot)
     assert any("joint 2 leaves its limits" in w for w in rec.warnings)
-
-
-def test_a_current_clipped_on_one_side_only_is_named(tmp_path, rng):
-    """A drive that limits one direction (here -4 A) while the other reaches further (+9 A): the clipped side is
-    the channel's minimum, not its largest magnitude, and is named all the same."""
-    t = np.arange(300) * 0.01
-    cur = rng.normal(0, 1, (300, 6))
-    cur[20, 1] = 9.0
-    cur[100:160, 1] = -4.0  # clipped at the negative side
-    q = 0.1 + 1e-3 * np.outer(np.arange(300), np.ones(6))
-    rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
-    assert [w for w in rec.warnings if "stay at their extreme" in w] == [
-        f"{tmp_path / 'ur.csv'}: joint 2's currents stay at their extreme -4 for 60 samples (t = 1.000-1.590 s): "
-        "saturated? select rows or a time_range without them"]
+    prepared = prepare(rec, Preprocessing())  # where a clipped torque is found (tests/preprocessing/test_clipped.py)
+    k3 = robot.drive_gains[2]
+    assert any(f"J3's torque stays at its extreme {7.5 * k3:.4g} N·m for 60 samples (t = 1.000-1.590 s)" in w
+               for w in prepared.warnings)
 
 
 @pytest.mark.parametrize("content, rows, message", [

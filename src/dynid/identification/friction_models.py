@@ -290,6 +290,8 @@ class _CrossValidation:
         dq_all = np.asarray(data.dq)
         moving = np.abs(dq_all) >= vmin
         moving[:, list(data.dead)] = False
+        if data.clipped is not None:
+            moving &= ~data.clipped
         forwards = np.array([np.mean(dq_all[moving[:, j], j] > 0) if moving[:, j].any() else 0.0 for j in range(n)])
         self.reverses = np.minimum(forwards, 1 - forwards) >= REVERSAL_SHARE
 

@@ -440,7 +440,11 @@ class BlockScoring:
         for k in np.unique(index * HELD_OUT_FOLDS // n_s) if self.folds else ():
             sel = index * HELD_OUT_FOLDS // n_s == k
             self.folds[k].add(y_standard[sel].reshape(-1, self.robot.n_params), tau[sel].reshape(-1), keep[sel].reshape(-1))
-        self.sums.add(data.t[index], y, tau, resting_rows(data, index))
+        scored = data.scored(index)
+        if scored.all():
+            self.sums.add(data.t[index], y, tau, resting_rows(data, index))
+        elif scored.any():  # a clipped torque's samples count in no metric
+            self.sums.add(data.t[index[scored]], y[scored], tau[scored], resting_rows(data, index[scored]))
         direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
         self.residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, self.near_reversal, keep)
         self.blocks.add(index, y, tau, keep)

@@ -246,10 +246,6 @@ that dropped a few packets), with a warning; a longer one is refused, naming the
 HELD_SHARE = 0.05
 """A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
 
-SATURATION_SAMPLES = 20
-"""Consecutive samples at a joint's extreme value that count as saturation (clipped current or torque)."""
-
-
 MIN_SELECTED = 50
 """Samples a ``time_range`` or ``rows`` must select: fewer cannot be filtered and identify nothing."""
 
@@ -259,8 +255,9 @@ industrial arms' joints carry about 1e5 N·m)."""
 
 
 def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
-    """Refuse positions that cannot be radians, warn about positions outside the joint limits and about
-    currents or torques flat at their extreme (saturation), naming joint and time range."""
+    """Refuse positions that cannot be radians and implausible efforts, warn about positions outside the joint limits,
+    naming joint and time range (a current or torque held at its extreme is found where the log is prepared:
+    :func:`dynid.preprocessing.prepared.clipped_samples`)."""
     lim = robot.limits
     worst, outside, still = np.zeros(q.shape[1]), [], []
     for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
@@ -293,18 +290,6 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
             top = int(np.argmax(np.abs(x)))
             raise DataError(f"{tau_source}: joint {j + 1}'s {kind} reach {x[top]:.4g} at t = {t[top]:.3f} s, implausible for "
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
-        if peak == 0:
-            continue
-        long = []
-        for extreme in {float(x.max()), float(x.min())}:  # each side: a limit may clip one direction only
-            at = np.abs(x - extreme) <= 1e-9 * peak
-            runs = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
-            starts, stops = np.flatnonzero(runs == 1), np.flatnonzero(runs == -1)
-            long += [(a, b) for a, b in zip(starts, stops) if b - a >= SATURATION_SAMPLES]
-        if long:
-            a, b = max(long, key=lambda r: r[1] - r[0])
-            warnings.append(f"{tau_source}: joint {j + 1}'s {kind} stay at their extreme {x[a]:.4g} for "
-                            f"{b - a} samples (t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? select rows or a time_range without them")
 
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:

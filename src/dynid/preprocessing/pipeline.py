@@ -37,7 +37,7 @@ from .filters import (
     velocity_noise_std,
 )
 from .fourier_fit import fourier_fit_derivatives
-from .prepared import PreparedData, dead_channels, direction_of_motion, min_speeds, rest_velocities
+from .prepared import PreparedData, clipped_samples, dead_channels, direction_of_motion, min_speeds, rest_velocities
 from .settings import Preprocessing
 from .strategies import Strategy, strategy_for
 
@@ -239,9 +239,11 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     for j in range(dq.shape[1]):
         resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
     dead, dead_words = dead_channels(tau, recording.label)
+    reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
+    clipped, clipped_words = clipped_samples(tau, t, recording.label, reach)
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
-                        tuple(recording.warnings) + s.warnings + dead_words, direction_of_motion(dq, moving, s, rate),
-                        moving, resting, dead)
+                        tuple(recording.warnings) + s.warnings + dead_words + clipped_words,
+                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, clipped)
 
 
 

@@ -10,12 +10,12 @@ from typing import Any
 import numpy as np
 
 from ..column_store import by_column
-from ..exceptions import ConfigError
+from ..exceptions import ConfigError, DataError
 from ..friction import Velocities, held_direction
 from ..model.robot import Robot
 from .settings import Preprocessing
 
-__all__ = ["dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
+__all__ = ["clipped_samples", "dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
 
 Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
@@ -48,6 +48,8 @@ class PreparedData:
         Where each joint rests (:func:`dynid.friction.moving_joints`).
     dead : tuple of int
         Joints whose measured torque is constant over the log (:func:`dead_channels`).
+    clipped : (N, n_dof) bool array or None
+        Samples where a joint's measured torque is held at its extreme (:func:`clipped_samples`).
     """
 
     name: str
@@ -68,6 +70,9 @@ class PreparedData:
     dead: tuple[int, ...] = ()
     """Joints (0-based) whose measured torque is constant over the whole log (:func:`dead_channels`): their rows are
     used by no estimate and no metric."""
+    clipped: np.ndarray | None = None
+    """(N, n_dof) bool, or None where nothing is: samples where a joint's measured torque is held at its extreme
+    (:func:`clipped_samples`): that joint's rows there are used by no estimate, and those samples by no metric."""
 
     def kept(self, index: np.ndarray, vmin: np.ndarray) -> np.ndarray:
         """The rows an estimate uses: joints moving at least ``vmin``, and none of a dead channel.
@@ -86,7 +91,25 @@ class PreparedData:
         keep = np.abs(np.asarray(self.dq[index])) >= vmin
         if self.dead:
             keep[:, list(self.dead)] = False
+        if self.clipped is not None:
+            keep &= ~self.clipped[index]
         return keep
+
+    def scored(self, index: np.ndarray) -> np.ndarray:
+        """The samples the metrics score: all but those where some joint's torque is clipped.
+
+        Parameters
+        ----------
+        index : (M,) int array
+            Sample indices.
+
+        Returns
+        -------
+        (M,) bool array
+        """
+        if self.clipped is None:
+            return np.ones(len(index), dtype=bool)
+        return ~self.clipped[index].any(axis=1)
 
     def with_rest_model(self, rest_friction, presliding) -> PreparedData:
         """The same samples with another rest model and presliding distance.
@@ -214,6 +237,67 @@ def min_speeds(settings: Preprocessing, n: int) -> np.ndarray:
     if v.shape != (n,) or np.any(v < 0):
         raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
     return v
+
+
+SATURATION_SAMPLES = 20
+"""Consecutive samples at a joint's extreme value that count as saturation (a clipped current or torque)."""
+
+
+def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.ndarray | None, tuple[str, ...]]:
+    """The samples where a joint's measured torque is held at its largest or smallest value for at least
+    :data:`SATURATION_SAMPLES` samples in a row (a drive's current or torque limit, on either side: a limit may clip
+    one direction only), and the warning that says so. Such a sample says only that the torque was at least that
+    much; it is left out of the estimation (that joint's rows) and of the metrics (the whole sample).
+
+    Parameters
+    ----------
+    tau : (N, n_dof) array or StoredColumns [N·m]
+        The measured torques (a constant channel is a dead one, :func:`dead_channels`, not a clipped one).
+    t : (N,) array [s]
+        Time stamps, for the warning.
+    label : str
+        The dataset, for the warning.
+    reach : int
+        Samples marked on each side of a clipped run as well: the reach of the filter the torques go through.
+
+    Returns
+    -------
+    clipped : (N, n_dof) bool array or None
+        None where no joint is clipped.
+    warnings : tuple of str
+        One line per clipped joint: the dataset, the joint, its longest run and how many samples are left out.
+
+    Raises
+    ------
+    DataError
+        If no sample is left to score.
+    """
+    n = tau.shape[0]
+    mask, words = None, []
+    for j in range(tau.shape[1]):
+        x = np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j], dtype=float)
+        peak = float(np.abs(x).max()) if x.size else 0.0
+        if peak == 0 or float(np.ptp(x)) <= 1e-12 * max(1.0, peak):
+            continue
+        runs = []
+        for extreme in {float(x.max()), float(x.min())}:
+            edges = np.diff(np.concatenate([[0], (np.abs(x - extreme) <= 1e-9 * peak).astype(np.int8), [0]]))
+            runs += [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
+                     if b - a >= SATURATION_SAMPLES]
+        if not runs:
+            continue
+        mask = np.zeros((n, tau.shape[1]), dtype=bool) if mask is None else mask
+        for a, b in runs:
+            mask[max(a - reach, 0):min(b + reach, n), j] = True
+        if mask.any(axis=1).all():
+            raise DataError(f"{label}: J{j + 1}'s torque is at its extreme {x[runs[0][0]]:.4g} N·m so much that, with "
+                            "the filter's reach, no sample is left to score: a log, or rows, where the drive is not at its "
+                            "limit is needed")
+        a, b = max(runs, key=lambda r: r[1] - r[0])
+        words.append(f"{label}: J{j + 1}'s torque stays at its extreme {x[a]:.4g} N·m for {b - a} samples "
+                     f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "
+                     "within the filter's reach are left out of the estimation and of the metrics")
+    return mask, tuple(words)
 
 
 def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:

@@ -606,6 +606,9 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
     holding = coulomb_like_columns(base, robot.n_dof)  # (n_dof, n_base): the terms that hold a resting joint
     at_rest = scored_rest(data)
     for index, y, tau, _ in base_chunks(robot, base, data, progress):
+        scored = data.scored(index)  # a clipped torque says only that it was at least that much
+        if not scored.all():
+            index, y, tau = index[scored], y[scored], tau[scored]
         ts.append(data.t[index])
         meas.append(tau)
         rest.append(resting_rows(data, index) if at_rest is None else at_rest[index])

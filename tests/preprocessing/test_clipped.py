@@ -1,0 +1,55 @@
+"""A torque held at its extreme (a drive's current or torque limit) found on either side of the channel, with the
+filter's reach around it; a dead channel and a noisy one are not clipped (issue "Honest on any log", item 3)."""
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import DataError
+from dynid.preprocessing.prepared import SATURATION_SAMPLES, clipped_samples
+
+
+def _channels(rng, n=400):
+    t = np.arange(n) * 0.01
+    tau = rng.normal(0.0, 1.0, (n, 3))
+    return t, tau
+
+
+def test_a_limit_on_one_side_is_found_though_the_other_side_reaches_further(rng):
+    """J2 clipped at -4 N·m (samples 100-159) while it reaches +9 N·m once: the clipped side is its minimum, not its
+    largest magnitude; the warning names the dataset, the joint, the value and the time range."""
+    t, tau = _channels(rng)
+    tau[20, 1] = 9.0
+    tau[100:160, 1] = -4.0
+    mask, words = clipped_samples(tau, t, "identification (log.csv)")
+    assert mask is not None and mask.shape == tau.shape
+    assert np.flatnonzero(mask[:, 1]).tolist() == list(range(100, 160)) and not mask[:, [0, 2]].any()
+    assert words == ("identification (log.csv): J2's torque stays at its extreme -4 N·m for 60 samples (t = 1.000-1.590 s): "
+                     "saturated? its 60 samples there and within the filter's reach are left out of the estimation and "
+                     "of the metrics",)
+
+
+def test_both_sides_and_the_filters_reach_are_marked(rng):
+    t, tau = _channels(rng)
+    tau[50:80, 0] = 5.0
+    tau[200:230, 0] = -5.0
+    mask, words = clipped_samples(tau, t, "log", reach=7)
+    expected = set(range(43, 87)) | set(range(193, 237))
+    assert set(np.flatnonzero(mask[:, 0]).tolist()) == expected
+    assert len(words) == 1 and "its 88 samples there" in words[0]
+
+
+def test_short_runs_dead_and_noisy_channels_are_not_clipped(rng):
+    """A run one sample shorter than SATURATION_SAMPLES, a channel reading one value throughout (a dead one, said by
+    dead_channels) and plain noise: nothing is marked, nothing said."""
+    t, tau = _channels(rng)
+    tau[100:100 + SATURATION_SAMPLES - 1, 0] = 6.0
+    tau[:, 1] = 2.5
+    mask, words = clipped_samples(tau, t, "log")
+    assert mask is None and words == ()
+
+
+def test_a_channel_clipped_everywhere_is_refused_in_one_line(rng):
+    t, tau = _channels(rng, 100)
+    tau[:, 2] = np.where(np.arange(100) % 50 < 45, 3.0, -3.0)
+    with pytest.raises(DataError, match=r"^log: J3's torque is at its extreme .* no sample is left to score"):
+        clipped_samples(tau, t, "log", reach=5)
