@@ -204,19 +204,38 @@ estimators = ["ols"]
         load_identification_config(tmp_path / "c.toml")
 
 
-def test_a_joint_that_never_moves_is_named(tmp_path):
-    """A log in which joint 3 stays still: refused as it is read, naming the file, the joint and the table."""
-    from ..simulated_logs import simulated_case
+def test_a_joint_that_never_moves_is_named_and_keeps_the_descriptions_drive_terms(tmp_path):
+    """A log in which joint 3 is held still, its torques simulated so (issue "Honest on any log", item 1: refuse only
+    where nothing can be estimated; it was refused): identified, with a warning naming the file, the joint and the
+    table; J3's friction and rotor inertia appear in no row, so those the model has keep the description's values
+    and the finding says why, not that J3 moved one way; the other joints' validation errors stay near the truth's."""
+    from .. import simulated_logs as sim
 
-    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
-    data = np.loadtxt(tmp_path / "ident.csv", delimiter=",")
-    data[:, 3] = data[0, 3]  # column 1 is time, 2-7 positions: joint 3 frozen
-    np.savetxt(tmp_path / "ident.csv", data, delimiter=",", fmt="%.10g")
-    from dynid.exceptions import DataError
-
-    with pytest.raises(DataError, match=r"ident.csv: joint 3's position never changes in \[identification\]: its parameters "
-                                        r"cannot be identified from this log"):
-        run_identification(load_identification_config(cfg), validate=False)
+    rng = np.random.default_rng(3)
+    truth, friction = sim.truth_robot("er16", rng)
+    t = np.arange(int(20 * 125.0)) / 125.0
+    for label in ("ident", "valid"):
+        q, dq, ddq = sim.fourier_motion(truth, t, rng)
+        if label == "ident":
+            q[:, 2], dq[:, 2], ddq[:, 2] = q[0, 2], 0.0, 0.0
+        sim.write_log(tmp_path / f"{label}.csv", truth, t, q, dq, ddq, friction, rng)
+    sim.write_truth(tmp_path / "truth.csv", truth, truth.parameter_names)
+    cfg = tmp_path / "config.toml"
+    cfg.write_text(sim.config_text(sim.robot_toml("er16", tmp_path), tmp_path, "ident.csv", "valid.csv", truth.n_dof))
+    result = run_identification(load_identification_config(cfg))
+    assert any("ident.csv: joint 3's position never changes in [identification]" in w for w in result.warnings)
+    own = [n for n in result.base.names if n[:-1] in ("Ia", "fc", "fv", "offset", "fst") and n.endswith("3")]
+    kept = {result.base.names[i] for i in result.solution.from_prior}
+    assert own and set(own) <= kept
+    config = load_identification_config(cfg)
+    nominal = result.base.base_from_standard(config.robot.standard_parameters())
+    for n in own:  # each of these columns is zero: the estimate is the description's value itself
+        k = result.base.names.index(n)
+        assert result.solution.params[k] == pytest.approx(nominal[k], abs=1e-9), n
+    (prior,) = [f for f in result.findings if f.kind == "prior"]
+    assert "J3 never moved in the log" in prior.text and "J3 moved one way" not in prior.text
+    ours, true = (result.validations[0].metrics()[k]["relative_error"] for k in ("dynid OLS", "truth"))
+    assert all(ours[j] < 2 * true[j] + 0.5 for j in (0, 1, 3, 4, 5)), (ours, true)
 
 
 def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch):

@@ -289,7 +289,7 @@ class _CrossValidation:
         self.loaded = self.load_ok & (np.sqrt(self.load_sq) >= LOAD_SHARE * np.sqrt(self.tau_sq))
         dq_all = np.asarray(data.dq)
         moving = np.abs(dq_all) >= vmin
-        moving[:, list(data.dead)] = False
+        moving[:, list(data.dead) + list(data.still)] = False
         if data.clipped is not None:
             moving &= ~data.clipped
         forwards = np.array([np.mean(dq_all[moving[:, j], j] > 0) if moving[:, j].any() else 0.0 for j in range(n)])

@@ -516,7 +516,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
     stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
-        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead)
+        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead, still=data.still)
     # the prediction's spread from the parameters' covariance: Σ diag(y C yᵀ) = trace(C Σ y yᵀ)
     spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
     stats["prediction_spread"] = spread
@@ -524,11 +524,12 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
 
 
 def _one_way(data: PreparedData) -> list[int]:
-    """The joints that moved in one direction only (at least 99 % of their moving samples one way)."""
+    """The joints that moved in one direction only (at least 99 % of their moving samples one way; a joint that never
+    moved is not one of them, :attr:`PreparedData.still`)."""
     dq = np.asarray(data.dq)
     moving = np.abs(dq) > np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (dq.shape[1],))
     out = []
-    for j in range(dq.shape[1]):
+    for j in (j for j in range(dq.shape[1]) if j not in data.still):
         signs = np.sign(dq[moving[:, j], j])
         if signs.size and min(np.mean(signs > 0), np.mean(signs < 0)) < 0.01:
             out.append(j)

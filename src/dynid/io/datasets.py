@@ -273,11 +273,9 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
     if all(still):
         raise DataError(f"{source}: no joint's position ever changes ({spec.table or spec.name}): a frozen log, or the "
                         "wrong columns or rows?")
-    if any(still) and spec.table == "[identification]":
-        j = still.index(True)
-        raise DataError(f"{source}: joint {j + 1}'s position never changes in [identification]: its parameters cannot be "
-                        "identified from this log (the wrong column, or a joint held still: use a log where every joint "
-                        "moves)")
+    for j in (j for j, s in enumerate(still) if s and spec.table == "[identification]"):
+        warnings.append(f"{source}: joint {j + 1}'s position never changes in [identification] (a joint held still, or "
+                        "the wrong column?): what only its motion shows keeps the description's values")
     for j, (count, first) in enumerate(outside):
         if count:
             warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "

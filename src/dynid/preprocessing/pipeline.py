@@ -241,9 +241,12 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     dead, dead_words = dead_channels(tau, recording.label)
     reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
     clipped, clipped_words = clipped_samples(tau, t, recording.label, reach)
+    positions = recording.q[cut:-cut] if cut else recording.q
+    still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
+                  if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
                         tuple(recording.warnings) + s.warnings + dead_words + clipped_words,
-                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, clipped)
+                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped)
 
 
 

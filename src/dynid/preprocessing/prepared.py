@@ -48,6 +48,8 @@ class PreparedData:
         Where each joint rests (:func:`dynid.friction.moving_joints`).
     dead : tuple of int
         Joints whose measured torque is constant over the log (:func:`dead_channels`).
+    still : tuple of int
+        Joints whose position never changes in the log.
     clipped : (N, n_dof) bool array or None
         Samples where a joint's measured torque is held at its extreme (:func:`clipped_samples`).
     """
@@ -70,12 +72,16 @@ class PreparedData:
     dead: tuple[int, ...] = ()
     """Joints (0-based) whose measured torque is constant over the whole log (:func:`dead_channels`): their rows are
     used by no estimate and no metric."""
+    still: tuple[int, ...] = ()
+    """Joints (0-based) whose position never changes in the log (a joint held still): their rows are used by no
+    estimate (their friction at rest is anywhere in its static band, and their drive terms appear in no other row)."""
     clipped: np.ndarray | None = None
     """(N, n_dof) bool, or None where nothing is: samples where a joint's measured torque is held at its extreme
     (:func:`clipped_samples`): that joint's rows there are used by no estimate, and those samples by no metric."""
 
     def kept(self, index: np.ndarray, vmin: np.ndarray) -> np.ndarray:
-        """The rows an estimate uses: joints moving at least ``vmin``, and none of a dead channel.
+        """The rows an estimate uses: joints moving at least ``vmin``, none of a dead channel or of a joint held still,
+        none where a joint's torque is clipped.
 
         Parameters
         ----------
@@ -89,8 +95,8 @@ class PreparedData:
         (M, n_dof) bool array
         """
         keep = np.abs(np.asarray(self.dq[index])) >= vmin
-        if self.dead:
-            keep[:, list(self.dead)] = False
+        if self.dead or self.still:
+            keep[:, list(self.dead) + list(self.still)] = False
         if self.clipped is not None:
             keep &= ~self.clipped[index]
         return keep

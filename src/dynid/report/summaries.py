@@ -427,12 +427,15 @@ def _kept_line(kept: list, dead) -> Line:
     fc = offset = 4.7 N·m, nominal 0)."""
     pairs = sorted(int(n[2:]) for n in kept
                    if n.startswith("fc") and n[2:].isdigit() and f"offset{n[2:]}" in kept and int(n[2:]) - 1 not in dead)
+    none = [j for j in pairs if f"fv{j}" in kept]  # no friction term determined: a joint that did not move
     text = (f"taken from the description's nominal values along what this log does not determine (no σ): "
             f"{', '.join(kept)}")
-    if pairs:
-        joints = ", ".join(f"J{j}" for j in pairs)
+    if [j for j in pairs if j not in none]:
+        joints = ", ".join(f"J{j}" for j in pairs if j not in none)
         text += (f"; {joints} moved one way only: Coulomb friction + offset is estimated as one term, the split between "
                  "them is the description's")
+    if none:
+        text += f"; {', '.join(f'J{j}' for j in none)}: no friction term determined (a joint held still?)"
     return Line(text)
 
 

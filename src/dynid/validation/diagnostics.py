@@ -501,7 +501,8 @@ def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> 
     return [], ratio
 
 
-def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tuple[int, ...] = ()) -> list[Finding]:
+def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tuple[int, ...] = (),
+                   still: list[int] | tuple[int, ...] = ()) -> list[Finding]:
     """The parameters a log does not determine, whose values are the description's nominal ones (least squares with a
     prior, :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`).
 
@@ -516,6 +517,8 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tu
     dataset : str
     dead : tuple of int
         Joints whose torque channel is dead in the log (their rows were left out).
+    still : sequence of int
+        Joints that never moved in the log (their friction and rotor inertia appear in no row).
 
     Returns
     -------
@@ -529,6 +532,8 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tu
            "their sum is estimated)" if both else "")
     if dead:
         why += f" ({', '.join(f'J{j + 1}' for j in dead)}: a dead torque channel, its rows left out)"
+    if still:
+        why += f" ({', '.join(f'J{j + 1}' for j in still)} never moved in the log)"
     listed = ", ".join(shown[:10]) + (f" and {len(shown) - 10} more" if len(shown) > 10 else "")
     return [Finding("prior", f"{dataset}: the log does not determine {listed}{why}: along those directions the estimate "
                              "keeps the description's nominal values (no σ); a log that moves every joint both ways "

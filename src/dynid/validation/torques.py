@@ -196,10 +196,12 @@ class TorqueComparison:
         -------
         (n_dof,) bool array
             True where the joint's RMS torque is at least :data:`MEANINGFUL` times its residual level on the
-            identification log (all True when that level is unknown).
+            identification log and times the noise floor of these samples (:attr:`floor`; each where known).
         """
         ok = np.ones(self.rms_torque.shape, dtype=bool) if self.noise is None else \
             self.rms_torque >= MEANINGFUL * np.asarray(self.noise)
+        if self.floor is not None:  # a joint whose torque is at the noise floor (held still, or a light wrist)
+            ok &= self.rms_torque >= MEANINGFUL * np.asarray(self.floor, dtype=float)
         ok[list(self.dead)] = False
         return ok
 
@@ -229,9 +231,11 @@ class TorqueComparison:
             moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} rad/s) and " if
                                                    self.speed[j] < 0.05 else "")
             rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} N·m"
+            residual = self.noise is not None and self.rms_torque[j] < MEANINGFUL * np.asarray(self.noise)[j]
+            level, what = ((np.asarray(self.noise)[j], "the identification residual") if residual
+                           else (np.asarray(self.floor, dtype=float)[j], "the noise floor of these samples"))
             out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} N·m, "
-                       f"{self.rms_torque[j] / np.asarray(self.noise)[j]:.2g}× the identification residual): relative error not meaningful"
-                       f"{rmse_j}")
+                       f"{self.rms_torque[j] / level:.2g}× {what}): relative error not meaningful{rmse_j}")
         return out
 
     @property
