@@ -422,6 +422,39 @@ class TorqueSums:
         self.kept_tau.append(tau[first::self.thin].copy())
         self.count = n + m
 
+    def partial_correlation(self, beta: np.ndarray, nuisance: dict) -> np.ndarray:
+        """Each joint's correlation of the measured torque with the prediction ``y·β`` once the columns
+        ``nuisance[j]`` are regressed out of both (a partial correlation: the part of the torque the prediction
+        should explain whatever those terms' values are).
+
+        Parameters
+        ----------
+        beta : (n_columns,) array
+            The parameter set.
+        nuisance : dict
+            Joint (0-based) -> indices of the regressor columns to regress out on that joint's rows.
+
+        Returns
+        -------
+        (n_dof,) array
+            NaN where either part has no variance left.
+        """
+        b = np.asarray(beta, dtype=float)
+        n_dof, size = self.m2.shape[0], self.m2.shape[1]
+        out = np.full(n_dof, np.nan)
+        for j in range(n_dof):
+            cols = list(nuisance.get(j, ()))
+            t = np.zeros((2 + len(cols), size))
+            t[0, :-1], t[1, -1] = b, 1.0
+            for k, c in enumerate(cols):
+                t[2 + k, c] = 1.0
+            cov = t @ self.m2[j] @ t.T  # centred sums of (prediction, torque, nuisance columns)
+            if cols:
+                cov = cov[:2, :2] - cov[:2, 2:] @ np.linalg.pinv(cov[2:, 2:]) @ cov[2:, :2]
+            if cov[0, 0] > 1e-12 * max(abs(float(self.m2[j, -1, -1])), 1e-300) and cov[1, 1] > 0:
+                out[j] = cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1])
+        return out
+
     def comparison(self, name: str, parameter_sets: dict) -> TorqueComparison:
         """The dataset's comparison: metrics from the statistics, curves on the kept rows.
 
