@@ -105,6 +105,8 @@ LOGS = {
     "degrees written as radians": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), np.degrees(r[:, 1:7])))), 'unit = "deg"'),
     "huge values": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(1, 7)), 1e300))), "positions"),
     "three rows": (_text(GOOD[:3]), "identification (" ),
+    "every current zero": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(13, 19)), 0.0))),
+                           "log.csv): every joint's torque reads one value throughout"),
     "UTF-16": (None, "log.csv: not a UTF-8 text table (it looks like UTF-16: save it as UTF-8)"),
     "a binary file": (None, "log.csv: not a UTF-8 text table (a binary file?)"),
 }

@@ -33,10 +33,10 @@ import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.instrumental import CLOSED_LOOP_METHODS
-from ..exceptions import ConfigError, DynIdError
+from ..exceptions import ConfigError, DataError, DynIdError
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
-from ..preprocessing.prepared import PreparedData
+from ..preprocessing.prepared import PreparedData, dead_channels
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
 from ..validation.diagnostics import delay_findings
@@ -156,7 +156,7 @@ class IdentificationPipeline:
         ConfigError
             Settings that do not fit the recording (a cutoff above its Nyquist frequency, an unknown strategy).
         DataError
-            A recording the strategy cannot prepare.
+            A recording the strategy cannot prepare, or whose every torque channel is dead.
         IdentifiabilityError
             Too little motion to cross-validate a choice on.
         """
@@ -164,6 +164,10 @@ class IdentificationPipeline:
             if step is not None:
                 step(label)
 
+        dead, _ = dead_channels(recording.tau, recording.label)
+        if len(dead) == recording.tau.shape[1]:
+            raise DataError(f"{recording.label}: every joint's torque reads one value throughout (dead channels, or not "
+                            "the torque or current columns?): nothing can be identified from this log")
         settings = self.preprocessing
         base = base if base is not None else base_parameters(self.robot, rng=0)
         made: dict = {}
