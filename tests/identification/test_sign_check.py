@@ -16,7 +16,8 @@ from ..simulated_logs import simulated_case
 
 def test_the_partial_correlation_is_that_of_the_residuals_of_a_direct_regression(rng):
     """Against NumPy: both the prediction and the torque regressed on the nuisance columns (with an intercept),
-    then np.corrcoef of the two residuals; on joint 0 with two nuisance columns, on joint 1 with none."""
+    then np.corrcoef of the two residuals and the slope of one on the other; on joint 0 with two nuisance columns, on
+    joint 1 with none."""
     m, n, p = 3000, 2, 5
     y = rng.standard_normal((m, n, p))
     beta = rng.standard_normal(p)
@@ -24,13 +25,14 @@ def test_the_partial_correlation_is_that_of_the_residuals_of_a_direct_regression
     sums = TorqueSums(n, p, m)
     for a in range(0, m, 700):
         sums.add(np.arange(a, min(a + 700, m)) * 0.01, y[a:a + 700], tau[a:a + 700])
-    got = sums.partial_correlation(beta, {0: [1, 3]})
+    got, slope = sums.beyond(beta, {0: [1, 3]})
     for j, cols in ((0, [1, 3]), (1, [])):
         x = np.column_stack([np.ones(m), *(y[:, j, c] for c in cols)])
         pred, meas = y[:, j] @ beta, tau[:, j]
         rp = pred - x @ np.linalg.lstsq(x, pred, rcond=None)[0]
         rt = meas - x @ np.linalg.lstsq(x, meas, rcond=None)[0]
         assert got[j] == pytest.approx(np.corrcoef(rp, rt)[0, 1], abs=1e-10)
+        assert slope[j] == pytest.approx((rp @ rt) / (rp @ rp), rel=1e-10)
 
 
 def test_a_flipped_torque_sign_is_still_named(tmp_path):
@@ -63,3 +65,37 @@ def test_two_seconds_of_the_ur10e_log_are_not_called_flipped(tmp_path):
     assert results["diagnostics"]["nominal_correlation"][3] < -0.5  # what the plain check saw
     assert [f for f in results["findings"] if f["kind"] == "sign"] == []
     assert "flipped" not in p.stdout + p.stderr
+
+
+def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
+    """The median slope over the joints whose torque has the nominal model's shape (ρ ≥ 0.9), not over the others;
+    a power of ten is given as one; within 3× nothing is said."""
+    from dynid.validation.diagnostics import scale_findings
+
+    rho = np.array([0.99, 0.95, 0.97, 0.5, 0.93])
+    varies = np.ones(5, bool)
+    (f,) = scale_findings(rho, np.array([980.0, 1010.0, 1100.0, 2.0, 990.0]), varies, "identification")
+    assert f.kind == "scale" and "about 1e+03× " in f.text and "on J1, J2, J3, J5," in f.text and "scale = 0.001" in f.text
+    (g,) = scale_findings(rho, np.array([0.2, 0.21, 0.19, 1.0, 0.2]), varies, "log")
+    assert "scale = 5" in g.text
+    assert scale_findings(rho, np.array([1.5, 0.9, 2.8, 40.0, 1.1]), varies, "log") == []
+    assert scale_findings(np.full(5, 0.5), np.full(5, 1000.0), varies, "log") == []
+
+
+def test_currents_in_milliamperes_are_named_and_the_model_not_called_ready(tmp_path):
+    """Every current of the logs written in mA (1000× the amperes the description's drive gains take): a fit absorbs
+    the scale (it fits as well, with masses 1000× the arm's, and dynid called it ready); the verdict names the scale
+    and the fix. The same logs in amperes get no such finding."""
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    p = dynid("identify", cfg, "--out", tmp_path / "a", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    assert [f for f in json.loads((tmp_path / "a" / "results.json").read_text())["findings"] if f["kind"] == "scale"] == []
+    for name in ("ident.csv", "valid.csv"):
+        data = np.loadtxt(tmp_path / name, delimiter=",")
+        data[:, 7:13] *= 1000.0
+        np.savetxt(tmp_path / name, data, delimiter=",", fmt="%.10g")
+    p = dynid("identify", cfg, "--out", tmp_path / "ma", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    (scale,) = [f for f in json.loads((tmp_path / "ma" / "results.json").read_text())["findings"] if f["kind"] == "scale"]
+    assert "scale = 0.001" in scale["text"]
+    assert "not ready: the measured torques are far from the description's size" in " ".join((p.stdout + p.stderr).split())

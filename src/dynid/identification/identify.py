@@ -37,6 +37,7 @@ from ..validation.diagnostics import (
     bootstrap_finding,
     excitation_findings,
     prior_findings,
+    scale_findings,
     sign_findings,
 )
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
@@ -503,9 +504,11 @@ def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks,
         # the friction the nominal model may lack can run against it over a short log: judge the rest of the torque
         friction = {j: [k for k, name in enumerate(base.names) for term in FRICTION_TERMS if name == f"{term}{j + 1}"]
                     for j in range(n)}
-        beyond = sums.partial_correlation(nominal, friction)
+        beyond, slope = sums.beyond(nominal, friction)
         stats["nominal_correlation_beyond_friction"] = beyond
+        stats["nominal_slope_beyond_friction"] = slope
         findings += sign_findings(np.where(np.isfinite(beyond), np.maximum(corr, beyond), corr), fit.varies(), data.name)
+        findings += scale_findings(beyond, slope, fit.varies(), data.name)
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
     more, res_stats = residuals.residual_checks(ols_params, rms, fc)
     findings += more

@@ -28,7 +28,7 @@ import numpy as np
 
 from .noise_floor import AT_FLOOR
 
-__all__ = ["Finding", "ResidualSums", "sign_findings", "validation_findings", "prior_findings",
+__all__ = ["Finding", "ResidualSums", "sign_findings", "scale_findings", "validation_findings", "prior_findings",
            "nominal_gate"]
 
 SIGNIFICANT = 4.0
@@ -50,7 +50,7 @@ class Finding:
     Attributes
     ----------
     kind : str
-        "sign", "friction", "position", "correlated", "excitation", "extrapolation", "validation", "delay".
+        "sign", "scale", "friction", "position", "correlated", "excitation", "extrapolation", "validation", "delay".
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
@@ -244,6 +244,57 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
                             "other datasets (or check the description's gravity)")]
+
+
+SCALE_LIMIT = 3.0
+"""The measured torques this many times the nominal model's, or less than its inverse, on the joints where their
+shapes agree, are a unit or gain error (:func:`scale_findings`): a description's masses are rarely that far off."""
+
+SCALE_SHAPE = 0.9
+"""Correlation beyond friction from which a joint's torque and the nominal model's have the same shape, so that the
+slope between them is a scale."""
+
+
+def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
+                   table: str = "[identification]") -> list[Finding]:
+    """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
+    of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
+    that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``. A fit absorbs such a scale (a model with masses 1000× the
+    robot's, from currents in mA, fits as well as the right one), so only the description can see it.
+
+    Parameters
+    ----------
+    correlation : (n_dof,) array
+        Each joint's partial correlation of the measured torque with the nominal model's beyond its friction terms
+        (:meth:`dynid.validation.torques.TorqueSums.beyond`).
+    slope : (n_dof,) array
+        The slope of the measured torque on the nominal model's, beyond friction.
+    varies : (n_dof,) bool array
+        Joints whose measured torque varies beyond its noise.
+    dataset : str
+        The log, named in the finding.
+    table : str
+        The config table to fix (its ``scale``).
+
+    Returns
+    -------
+    list of Finding
+    """
+    rho, k = np.asarray(correlation, dtype=float), np.asarray(slope, dtype=float)
+    judged = [j for j in range(rho.size) if varies[j] and np.isfinite(rho[j]) and rho[j] >= SCALE_SHAPE
+              and np.isfinite(k[j]) and k[j] > 0]
+    if not judged:
+        return []
+    median = float(np.median(k[judged]))
+    if 1 / SCALE_LIMIT <= median <= SCALE_LIMIT:
+        return []
+    power = round(float(np.log10(median)))
+    fix = f"{10.0 ** -power:g}" if abs(np.log10(median) - power) < 0.1 else f"{1 / median:.3g}"
+    joints = ", ".join(f"J{j + 1}" for j in judged)
+    return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal model's "
+                             f"on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): a unit (currents "
+                             f"in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the torques (or currents) "
+                             f"of {table} and the other datasets, or check drive_gain in the description")]
 
 
 DELAY_SIGNIFICANT = 3.0

@@ -422,10 +422,10 @@ class TorqueSums:
         self.kept_tau.append(tau[first::self.thin].copy())
         self.count = n + m
 
-    def partial_correlation(self, beta: np.ndarray, nuisance: dict) -> np.ndarray:
-        """Each joint's correlation of the measured torque with the prediction ``y·β`` once the columns
-        ``nuisance[j]`` are regressed out of both (a partial correlation: the part of the torque the prediction
-        should explain whatever those terms' values are).
+    def beyond(self, beta: np.ndarray, nuisance: dict) -> tuple[np.ndarray, np.ndarray]:
+        """Each joint's measured torque against the prediction ``y·β`` once the columns ``nuisance[j]`` are regressed
+        out of both: their partial correlation, and the slope of the torque on the prediction (1 where the torque
+        has the prediction's size; a unit or gain error scales it).
 
         Parameters
         ----------
@@ -436,12 +436,12 @@ class TorqueSums:
 
         Returns
         -------
-        (n_dof,) array
+        correlation, slope : (n_dof,) arrays
             NaN where either part has no variance left.
         """
         b = np.asarray(beta, dtype=float)
         n_dof, size = self.m2.shape[0], self.m2.shape[1]
-        out = np.full(n_dof, np.nan)
+        rho, slope = np.full(n_dof, np.nan), np.full(n_dof, np.nan)
         for j in range(n_dof):
             cols = list(nuisance.get(j, ()))
             t = np.zeros((2 + len(cols), size))
@@ -452,8 +452,9 @@ class TorqueSums:
             if cols:
                 cov = cov[:2, :2] - cov[:2, 2:] @ np.linalg.pinv(cov[2:, 2:]) @ cov[2:, :2]
             if cov[0, 0] > 1e-12 * max(abs(float(self.m2[j, -1, -1])), 1e-300) and cov[1, 1] > 0:
-                out[j] = cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1])
-        return out
+                rho[j] = cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1])
+                slope[j] = cov[0, 1] / cov[0, 0]
+        return rho, slope
 
     def comparison(self, name: str, parameter_sets: dict) -> TorqueComparison:
         """The dataset's comparison: metrics from the statistics, curves on the kept rows.
