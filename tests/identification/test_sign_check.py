@@ -85,8 +85,9 @@ def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
 def test_currents_in_milliamperes_are_named_and_the_model_not_called_ready(tmp_path):
     """Every current of the logs written in mA (1000× the amperes the description's drive gains take): a fit absorbs
     the scale (it fits as well, with masses 1000× the arm's, and dynid called it ready); the verdict names the scale
-    and the fix. The same logs in amperes get no such finding."""
+    and the fix, and dynid export repeats it. The same logs in amperes get no such finding."""
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ols", "sdp"]'))
     p = dynid("identify", cfg, "--out", tmp_path / "a", "--no-figures")
     assert p.returncode == 0, p.stderr
     assert [f for f in json.loads((tmp_path / "a" / "results.json").read_text())["findings"] if f["kind"] == "scale"] == []
@@ -99,3 +100,6 @@ def test_currents_in_milliamperes_are_named_and_the_model_not_called_ready(tmp_p
     (scale,) = [f for f in json.loads((tmp_path / "ma" / "results.json").read_text())["findings"] if f["kind"] == "scale"]
     assert "scale = 0.001" in scale["text"]
     assert "not ready: the measured torques are far from the description's size" in " ".join((p.stdout + p.stderr).split())
+    e = dynid("export", cfg, "--results", tmp_path / "ma" / "results.json", "--urdf", tmp_path / "ma.urdf")
+    assert e.returncode == 0, e.stderr
+    assert "the model was fitted to torques dynid identify doubts" in " ".join(e.stderr.split()) and "scale = 0.001" in e.stderr

@@ -309,6 +309,28 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
+READINESS_KINDS = ("sign", "scale")
+"""Findings of ``dynid identify``'s verdict that say the torques themselves are wrong (a flipped sign, a unit or gain):
+a model fitted to them is exported with a warning."""
+
+
+def verdict_warnings(results: dict) -> list[str]:
+    """One line per finding of ``dynid identify``'s verdict that says the torques the model was fitted to are wrong
+    (:data:`READINESS_KINDS`), for ``dynid export`` to repeat.
+
+    Parameters
+    ----------
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+
+    Returns
+    -------
+    list of str
+    """
+    return [f"the model was fitted to torques dynid identify doubts: {f.get('text')}"
+            for f in results.get("findings") or [] if isinstance(f, dict) and f.get("kind") in READINESS_KINDS]
+
+
 @keyword_only_after_data
 def urdf_from_results(robot: Robot, results: dict, *, source: str = "results") -> str:
     """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
