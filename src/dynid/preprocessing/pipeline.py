@@ -37,7 +37,15 @@ from .filters import (
     velocity_noise_std,
 )
 from .fourier_fit import fourier_fit_derivatives
-from .prepared import PreparedData, clipped_samples, dead_channels, direction_of_motion, min_speeds, rest_velocities
+from .prepared import (
+    PreparedData,
+    check_velocities,
+    clipped_samples,
+    dead_channels,
+    direction_of_motion,
+    min_speeds,
+    rest_velocities,
+)
 from .settings import Preprocessing
 from .strategies import Strategy, strategy_for
 
@@ -203,6 +211,8 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     else:
         q = lowpass(recording.q, s.position_cutoff, "position")
         dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
+        if recording.dq is not None:
+            check_velocities(dq, differentiate(q, rate), recording.label)
     tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
     moving = _direction_velocity(recording, s, dq)
     if s.rest_velocity == "auto":

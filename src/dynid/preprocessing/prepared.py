@@ -15,7 +15,7 @@ from ..friction import Velocities, held_direction
 from ..model.robot import Robot
 from .settings import Preprocessing
 
-__all__ = ["clipped_samples", "dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
+__all__ = ["check_velocities", "clipped_samples", "dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
 
 Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
@@ -243,6 +243,51 @@ def min_speeds(settings: Preprocessing, n: int) -> np.ndarray:
     if v.shape != (n,) or np.any(v < 0):
         raise ConfigError(f"preprocessing.min_speed: expected a non-negative number or {n} of them, got {settings.min_speed!r}")
     return v
+
+
+VELOCITY_SHAPE = 0.9
+"""Correlation from which measured velocities and the positions' derivative have the same shape (:func:`check_velocities`)."""
+
+VELOCITY_RATIO = 2.0
+"""Measured velocities more than this many times the positions' derivative, or less than its inverse, or of the
+opposite sign, are in another unit, sign or side than the positions (:func:`check_velocities`)."""
+
+
+def check_velocities(dq, from_positions, label: str) -> None:
+    """Refuse measured velocities that are not the derivative of the positions: where a joint's two have the same
+    shape (correlation at least :data:`VELOCITY_SHAPE` in magnitude), their ratio must lie within a factor
+    :data:`VELOCITY_RATIO` of 1 (deg/s read as rad/s gives 57.3, a motor-side velocity the gear ratio, a flipped
+    sign -1): a model fitted with them has every velocity-dependent term wrong.
+
+    Parameters
+    ----------
+    dq : (N, n_dof) array or StoredColumns [rad/s]
+        The measured velocities, filtered.
+    from_positions : (N, n_dof) array or StoredColumns [rad/s]
+        The derivative of the filtered positions.
+    label : str
+        The dataset, for the message.
+
+    Raises
+    ------
+    DataError
+        Naming the dataset, the joint, the ratio and the settings to check.
+    """
+    for j in range(dq.shape[1]):
+        v = np.asarray(dq.column(j) if hasattr(dq, "column") else dq[:, j], dtype=float)
+        d = np.asarray(from_positions.column(j) if hasattr(from_positions, "column") else from_positions[:, j], dtype=float)
+        vv, dd, vd = float(v @ v), float(d @ d), float(v @ d)
+        if vv <= 0 or dd <= 0 or abs(vd) < VELOCITY_SHAPE * np.sqrt(vv * dd):
+            continue
+        ratio = vd / dd
+        if 1 / VELOCITY_RATIO <= ratio <= VELOCITY_RATIO:
+            continue
+        hint = (" (deg/s read as rad/s?)" if abs(ratio / (180 / np.pi) - 1) < 0.1 else
+                " (positions in degrees?)" if abs(ratio / (np.pi / 180) - 1) < 0.1 else
+                " (a flipped sign?)" if abs(ratio + 1) < 0.1 else "")
+        raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its positions"
+                        f"{hint}: check their unit, sign and side (velocities = {{ ..., unit = \"deg/s\" }}, sign = -1 or "
+                        "side = \"motor\"), or leave the velocities out to derive them from the positions")
 
 
 SATURATION_SAMPLES = 20

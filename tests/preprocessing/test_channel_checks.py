@@ -1,5 +1,8 @@
-"""A torque held at its extreme (a drive's current or torque limit) found on either side of the channel, with the
-filter's reach around it; a dead channel and a noisy one are not clipped (issue "Honest on any log", item 3)."""
+"""Every channel checked where a log is prepared (issue "Honest on any log", item 3): a torque held at its extreme (a
+drive's current or torque limit) found on either side of the channel, with the filter's reach around it, a dead
+channel and a noisy one not clipped; measured velocities that are not the positions' derivative refused."""
+
+import re
 
 import numpy as np
 import pytest
@@ -53,3 +56,26 @@ def test_a_channel_clipped_everywhere_is_refused_in_one_line(rng):
     tau[:, 2] = np.where(np.arange(100) % 50 < 45, 3.0, -3.0)
     with pytest.raises(DataError, match=r"^log: J3's torque is at its extreme .* no sample is left to score"):
         clipped_samples(tau, t, "log", reach=5)
+
+
+@pytest.mark.parametrize("factor, hint", [(180 / np.pi, "(deg/s read as rad/s?)"), (-1.0, "(a flipped sign?)"),
+                                          (100.0, "× the derivative of its positions: check")])
+def test_measured_velocities_in_another_unit_sign_or_side_are_refused(rng, factor, hint):
+    """Measured velocities that are not the positions' derivative (deg/s read as rad/s, a flipped sign, a motor-side
+    velocity through a gear of 100): refused in one line naming the dataset, the joint and the ratio; the same
+    velocities in rad/s pass (they were taken as they were, and every velocity-dependent term fitted to them)."""
+    from dynid.io.datasets import Recording
+    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.settings import Preprocessing
+
+    rate = 200.0
+    t = np.arange(4000) / rate
+    w = 2 * np.pi * np.array([0.1, 0.17, 0.23])
+    q = np.sin(w * t[:, None])
+    dq = w * np.cos(w * t[:, None])
+    tau = rng.normal(0.0, 1.0, q.shape)
+    prepare(Recording("identification", t, q, dq, tau, rate), Preprocessing())
+    wrong = dq.copy()
+    wrong[:, 1] *= factor
+    with pytest.raises(DataError, match=r"^identification: joint 2's measured velocities are .*" + re.escape(hint)):
+        prepare(Recording("identification", t, q, wrong, tau, rate), Preprocessing())
