@@ -246,6 +246,9 @@ that dropped a few packets), with a warning; a longer one is refused, naming the
 HELD_SHARE = 0.05
 """A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
 
+MIN_RATE = 5.0
+"""Hz: a log whose time stamps step slower than this holds them in another unit (milliseconds read as seconds)."""
+
 MIN_SELECTED = 50
 """Samples a ``time_range`` or ``rows`` must select: fewer cannot be filtered and identify nothing."""
 
@@ -579,6 +582,10 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
                             "refuses them)")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
+    if timed and spec.resample is None and rate < MIN_RATE:
+        raise DataError(f"{q_source}: the time stamps step by {1 / rate:.4g} s ({rate:.4g} Hz), slower than any robot "
+                        f"controller logs (at least {MIN_RATE:g} Hz): are they in milliseconds? dynid reads seconds; give "
+                        f"rate (Hz) in {table} instead of the time column, or write the time stamps in seconds")
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission

@@ -283,6 +283,7 @@ def check_velocities(dq, from_positions, label: str) -> None:
         if 1 / VELOCITY_RATIO <= ratio <= VELOCITY_RATIO:
             continue
         hint = (" (deg/s read as rad/s?)" if abs(ratio / (180 / np.pi) - 1) < 0.1 else
+                " (time stamps in milliseconds?)" if abs(ratio / 1000 - 1) < 0.1 else
                 " (positions in degrees?)" if abs(ratio / (np.pi / 180) - 1) < 0.1 else
                 " (a flipped sign?)" if abs(ratio + 1) < 0.1 else "")
         raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its positions"
