@@ -492,23 +492,30 @@ FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 """Drive terms that are friction (not the rotor inertia, not a counterbalance): the sign check looks beyond them."""
 
 
+def _nominal_checks(robot, base, sums, fit, data, stats: dict) -> list:
+    """The torques against the description's nominal model: a flipped sign and a scale (unit or gain)
+    (:mod:`dynid.validation.diagnostics`); their statistics go into ``stats``."""
+    nominal = base.base_from_standard(robot.standard_parameters())
+    corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
+    stats["nominal_correlation"] = corr
+    # the friction the nominal model may lack can run against it over a short log: judge the rest of the torque
+    friction = {j: [k for k, name in enumerate(base.names) for term in FRICTION_TERMS if name == f"{term}{j + 1}"]
+                for j in range(robot.n_dof)}
+    beyond, slope = sums.beyond(nominal, friction)
+    stats["nominal_correlation_beyond_friction"] = beyond
+    stats["nominal_slope_beyond_friction"] = slope
+    varies = fit.varies()
+    return (sign_findings(np.where(np.isfinite(beyond), np.maximum(corr, beyond), corr), varies, data.name)
+            + scale_findings(beyond, slope, varies, data.name))
+
+
 def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks, fit, data, rng):
     """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics."""
     n = robot.n_dof
     rms = fit.rms_torque
     findings, stats = [], {}
     if np.any(robot.inertial != 0):  # the description's nominal model: does the data run against it?
-        nominal = base.base_from_standard(robot.standard_parameters())
-        corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
-        stats["nominal_correlation"] = corr
-        # the friction the nominal model may lack can run against it over a short log: judge the rest of the torque
-        friction = {j: [k for k, name in enumerate(base.names) for term in FRICTION_TERMS if name == f"{term}{j + 1}"]
-                    for j in range(n)}
-        beyond, slope = sums.beyond(nominal, friction)
-        stats["nominal_correlation_beyond_friction"] = beyond
-        stats["nominal_slope_beyond_friction"] = slope
-        findings += sign_findings(np.where(np.isfinite(beyond), np.maximum(corr, beyond), corr), fit.varies(), data.name)
-        findings += scale_findings(beyond, slope, fit.varies(), data.name)
+        findings += _nominal_checks(robot, base, sums, fit, data, stats)
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
     more, res_stats = residuals.residual_checks(ols_params, rms, fc)
     findings += more
