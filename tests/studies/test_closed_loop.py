@@ -76,6 +76,20 @@ def test_closed_loop_intervals_hold_the_truth_at_the_highest_encoder_noise():
         assert 0.93 <= stats[key]["coverage"][0] <= 0.99, (key, stats[key]["coverage"][0])
 
 
+def test_didim_holds_the_truth_with_30_hz_cutoffs_at_the_highest_encoder_noise():
+    """Cutoffs at 30 Hz (band 3 Hz) let the loop's noise in, where least squares is biased: DIDIM's 95 % intervals
+    hold the truth in 92-99 % of the (realisation, parameter) pairs over 12 realisations, and its median |bias| is below
+    0.1 %. The rows where the simulated joint is slower than min_speed fit nothing, as the measured ones do not;
+    before, the loop's velocity jitter near reversals, which the noise-free simulation lacks, pulled fc 1 % low and
+    fv 1 % high: 88.9 % and 0.126 % here (87 % over 40 realisations, benchmarks/README.md)."""
+    cfg = ClosedLoopStudyConfig(encoder_noise=(1e-2,), torque_noise=(0.1,), realisations=12, estimators=("didim",),
+                                band=3.0)
+    stats = run_closed_loop_study(cfg, workers=2).statistics()["didim"]
+    assert stats["converged"][0] == 12
+    assert 0.92 <= stats["coverage"][0] <= 0.99, stats["coverage"][0]
+    assert stats["median_relative_bias"][0] < 1e-3, stats["median_relative_bias"][0]
+
+
 def test_statistics_on_constructed_estimates():
     """Bias, spread and coverage against numbers built to have them: estimates truth + b + σ·z with z chosen so that
     exactly 4 of 40 (realisation, parameter) pairs fall outside 1.96 σ."""

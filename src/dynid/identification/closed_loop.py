@@ -248,6 +248,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     simulated: dict = {}  # the estimators all start from the same estimate: its closed loop is simulated once
 
     def simulated_rows(x, standard=False):
+        """The simulated rows at the measured rows kept, and whether the simulated joint moves there."""
         key = (np.asarray(x, dtype=float).tobytes(), standard)
         if key not in simulated:
             try:
@@ -263,11 +264,11 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
                                    ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
         sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate)
-        ws, _, _ = _rows(robot, base, prepare(sim, data.settings, strict=False), standard)
+        ws, _, moving = _rows(robot, base, prepare(sim, data.settings, strict=False), standard)
         if ws.shape[0] != keep.size:
             raise DataError(f"{recording.name}: the simulated log prepares to {ws.shape[0] // n} samples, the measured one to "
                             f"{keep.size // n}")
-        return ws[keep]
+        return ws[keep], moving[keep]
 
     for key in keys:
         if key == "didim-sdp":
@@ -275,12 +276,14 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
                                   row_sigma, max_iter, tol)
             continue
 
-        def step(ws, key=key):
+        def step(rows, key=key):
+            ws, moving = rows
             if key == "idim-iv":
                 sol = instrumental_variables(w / row_sigma[:, None], tau / row_sigma, ws / row_sigma[:, None], instants,
                                              kernel="parzen")
                 return sol.params, sol.params_std, w @ sol.params
-            beta, std = _weighted_least_squares(ws, tau, row_sigma, instants)
+            # a row where the simulated joint is slower than min_speed fits nothing, as a measured one does not
+            beta, std = _weighted_least_squares(ws, tau, np.where(moving, row_sigma, np.inf), instants)
             return beta, std, ws @ beta
 
         run = _iterate(simulated_rows, step, start, base.base_from_standard(nominal), w @ start, max_iter, tol,
@@ -384,12 +387,13 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
     nominal = robot.standard_parameters()
     links, nonneg = consistency_layout(robot)
 
-    def fit(w):
+    def fit(w, weight=None):
         sdp = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=nominal)
-        return sdp.fit(w / row_sigma[:, None], tau / row_sigma).params_
+        return sdp.fit(w / row_sigma[:, None], tau / row_sigma, sample_weight=weight).params_
 
-    def step(ws):
-        phi = fit(ws)
+    def step(rows):
+        ws, moving = rows
+        phi = fit(ws, moving.astype(float))  # a row where the simulated joint is slower than min_speed fits nothing
         return phi, None, ws @ phi
 
     phi = fit(w_standard)
