@@ -51,5 +51,6 @@ def test_a_clipped_identification_channel_fits_nothing_and_is_said(case, tmp_pat
     truth = results["validation"][0]["metrics"]["truth"]["relative_error"]
     assert ours[1] < truth[1] + 1.0, (ours, truth)
     # the fit is scored on the unclipped samples only: the truth's J2 misses them by the noise, as on the validation log
-    fit_truth, valid_truth = (r["metrics"]["truth"]["rmse"][1] for r in (results["identification"], results["validation"][0]))
+    fit_truth, valid_truth = (r["metrics"]["truth"]["rmse"][1]
+                              for r in (results["identification"], results["validation"][0]))
     assert fit_truth < 1.5 * valid_truth, (fit_truth, valid_truth)

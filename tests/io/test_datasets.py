@@ -151,7 +151,7 @@ def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path,
     robot = load_robot("ur10e")
     rec = load_recording(_log(tmp_path, t, q, cur), robot)
     assert any("joint 2 leaves its limits" in w for w in rec.warnings)
-    prepared = prepare(rec, Preprocessing())  # where a clipped torque is found (tests/preprocessing/test_channel_checks.py)
+    prepared = prepare(rec, Preprocessing())  # where a clipped torque is found (preprocessing/test_channel_checks.py)
     k3 = robot.drive_gains[2]
     assert any(f"J3's torque stays at its extreme {7.5 * k3:.4g} N·m for 60 samples (t = 1.000-1.590 s)" in w
                for w in prepared.warnings)

@@ -26,9 +26,9 @@ def test_a_limit_on_one_side_is_found_though_the_other_side_reaches_further(rng)
     mask, words = clipped_samples(tau, t, "identification (log.csv)")
     assert mask is not None and mask.shape == tau.shape
     assert np.flatnonzero(mask[:, 1]).tolist() == list(range(100, 160)) and not mask[:, [0, 2]].any()
-    assert words == ("identification (log.csv): J2's torque stays at its extreme -4 N·m for 60 samples (t = 1.000-1.590 s): "
-                     "saturated? its 60 samples there and within the filter's reach are left out of the estimation and "
-                     "of the metrics",)
+    assert words == ("identification (log.csv): J2's torque stays at its extreme -4 N·m for 60 samples "
+                     "(t = 1.000-1.590 s): saturated? its 60 samples there and within the filter's reach are left "
+                     "out of the estimation and of the metrics",)
 
 
 def test_both_sides_and_the_filters_reach_are_marked(rng):

@@ -166,8 +166,8 @@ class IdentificationPipeline:
 
         dead, _ = dead_channels(recording.tau, recording.label)
         if len(dead) == recording.tau.shape[1]:
-            raise DataError(f"{recording.label}: every joint's torque reads one value throughout (dead channels, or not "
-                            "the torque or current columns?): nothing can be identified from this log")
+            raise DataError(f"{recording.label}: every joint's torque reads one value throughout (dead channels, or "
+                            "not the torque or current columns?): nothing can be identified from this log")
         settings = self.preprocessing
         base = base if base is not None else base_parameters(self.robot, rng=0)
         made: dict = {}

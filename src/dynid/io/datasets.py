@@ -584,8 +584,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
     if timed and spec.resample is None and rate < MIN_RATE:
         raise DataError(f"{q_source}: the time stamps step by {1 / rate:.4g} s ({rate:.4g} Hz), slower than any robot "
-                        f"controller logs (at least {MIN_RATE:g} Hz): are they in milliseconds? dynid reads seconds; give "
-                        f"rate (Hz) in {table} instead of the time column, or write the time stamps in seconds")
+                        f"controller logs (at least {MIN_RATE:g} Hz): are they in milliseconds? dynid reads seconds; "
+                        f"give rate (Hz) in {table} instead of the time column, or write the time stamps in seconds")
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission

@@ -268,8 +268,8 @@ def physical_problems(phi: np.ndarray, tol: float = 1e-9) -> list[str]:
     if ev.min() <= tol * scale:
         shape = "a point mass" if ev.max() <= 1e-12 else "a thin rod"
         shown = np.where(abs(ev) <= tol * scale, 0.0, ev)
-        out.append(f"inertia about the COM is singular (principal moments {_fmt(shown)} kg·m²: {shape}, the limit of a "
-                   "real link)")
+        out.append(f"inertia about the COM is singular (principal moments {_fmt(shown)} kg·m²: {shape}, the limit "
+                   "of a real link)")
     if 2 * ev.max() > ev.sum() * (1 + 1e-9) + tol * scale:
         out.append(f"principal moments {_fmt(ev)} kg·m² break the triangle inequality")
     return out

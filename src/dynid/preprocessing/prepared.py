@@ -15,7 +15,8 @@ from ..friction import Velocities, held_direction
 from ..model.robot import Robot
 from .settings import Preprocessing
 
-__all__ = ["check_velocities", "clipped_samples", "dead_channels", "PreparedData", "Samples", "direction_of_motion", "min_speeds", "rest_decay", "rest_velocities"]
+__all__ = ["check_velocities", "clipped_samples", "dead_channels", "PreparedData", "Samples", "direction_of_motion",
+           "min_speeds", "rest_decay", "rest_velocities"]
 
 Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
@@ -246,7 +247,8 @@ def min_speeds(settings: Preprocessing, n: int) -> np.ndarray:
 
 
 VELOCITY_SHAPE = 0.9
-"""Correlation from which measured velocities and the positions' derivative have the same shape (:func:`check_velocities`)."""
+"""Correlation from which measured velocities and the positions' derivative have the same shape
+(:func:`check_velocities`)."""
 
 VELOCITY_RATIO = 2.0
 """Measured velocities more than this many times the positions' derivative, or less than its inverse, or of the
@@ -275,7 +277,8 @@ def check_velocities(dq, from_positions, label: str) -> None:
     """
     for j in range(dq.shape[1]):
         v = np.asarray(dq.column(j) if hasattr(dq, "column") else dq[:, j], dtype=float)
-        d = np.asarray(from_positions.column(j) if hasattr(from_positions, "column") else from_positions[:, j], dtype=float)
+        d = np.asarray(from_positions.column(j) if hasattr(from_positions, "column") else from_positions[:, j],
+                       dtype=float)
         vv, dd, vd = float(v @ v), float(d @ d), float(v @ d)
         if vv <= 0 or dd <= 0 or abs(vd) < VELOCITY_SHAPE * np.sqrt(vv * dd):
             continue
@@ -286,9 +289,9 @@ def check_velocities(dq, from_positions, label: str) -> None:
                 " (time stamps in milliseconds?)" if abs(ratio / 1000 - 1) < 0.1 else
                 " (positions in degrees?)" if abs(ratio / (np.pi / 180) - 1) < 0.1 else
                 " (a flipped sign?)" if abs(ratio + 1) < 0.1 else "")
-        raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its positions"
-                        f"{hint}: check their unit, sign and side (velocities = {{ ..., unit = \"deg/s\" }}, sign = -1 or "
-                        "side = \"motor\"), or leave the velocities out to derive them from the positions")
+        raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its "
+                        f"positions{hint}: check their unit, sign and side (velocities = {{ ..., unit = \"deg/s\" }}, "
+                        "sign = -1 or side = \"motor\"), or leave the velocities out to derive them from the positions")
 
 
 SATURATION_SAMPLES = 20
@@ -342,9 +345,9 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
         for a, b in runs:
             mask[max(a - reach, 0):min(b + reach, n), j] = True
         if mask.any(axis=1).all():
-            raise DataError(f"{label}: J{j + 1}'s torque is at its extreme {x[runs[0][0]]:.4g} N·m so much that, with "
-                            "the filter's reach, no sample is left to score: a log, or rows, where the drive is not at its "
-                            "limit is needed")
+            raise DataError(f"{label}: J{j + 1}'s torque is at its extreme {x[runs[0][0]]:.4g} N·m so much that, "
+                            "with the filter's reach, no sample is left to score: a log, or rows, where the drive is "
+                            "not at its limit is needed")
         a, b = max(runs, key=lambda r: r[1] - r[0])
         words.append(f"{label}: J{j + 1}'s torque stays at its extreme {x[a]:.4g} N·m for {b - a} samples "
                      f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "

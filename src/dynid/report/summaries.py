@@ -271,8 +271,8 @@ def readiness(result) -> Line:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
                     "verdict at the end names it and the setting that fixes it", "warning")
     if "scale" in kinds:
-        return Line("not ready: the measured torques are far from the description's size (a unit, or the drive gains?): "
-                    "the verdict at the end says how far and the setting that fixes it", "warning")
+        return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
+                    "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
     if not exportable:
         why = ('add "sdp" to [estimation] estimators for a physically consistent estimate' if "sdp" not in r.estimators
                else "no estimate passed the consistency check (the verdict says why)")

@@ -291,10 +291,11 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     power = round(float(np.log10(median)))
     fix = f"{10.0 ** -power:g}" if abs(np.log10(median) - power) < 0.1 else f"{1 / median:.3g}"
     joints = ", ".join(f"J{j + 1}" for j in judged)
-    return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal model's "
-                             f"on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): a unit (currents "
-                             f"in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the torques (or currents) "
-                             f"of {table} and the other datasets, or check drive_gain in the description")]
+    return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal "
+                             f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): a "
+                             f"unit (currents in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the "
+                             f"torques (or currents) of {table} and the other datasets, or check drive_gain in the "
+                             "description")]
 
 
 DELAY_SIGNIFICANT = 3.0
