@@ -110,3 +110,43 @@ def test_currents_in_milliamperes_are_named_and_the_model_not_called_ready(tmp_p
     assert e.returncode == 0, e.stderr
     assert "the model was fitted to torques dynid identify doubts" in " ".join(e.stderr.split())
     assert "scale = 0.001" in e.stderr
+
+
+def test_swapped_torque_channels_are_told_by_their_fit_with_friction(rng):
+    """Three joints whose nominal torques have overlapping shapes (J2's is J1's plus a little, as parallel axes give):
+    measured torques built as nominal + friction + noise, J1's and J2's columns swapped: the pair is named; in order,
+    nothing. The correlation of the shapes alone (above 0.9 both ways) could not tell them."""
+    from dynid.validation.diagnostics import OrderSums
+
+    m = 4000
+    t = np.arange(m) * 0.01
+    base = np.sin(0.7 * t)
+    nominal = np.column_stack([40 * base, 15 * base + 3 * np.sin(1.9 * t), 5 * np.cos(1.3 * t)])
+    dq = np.column_stack([np.cos(0.5 * t), np.cos(0.8 * t + 1), np.cos(1.1 * t + 2)])
+    tau = nominal + 2.0 * np.sign(dq) + 0.5 * dq + 0.2 * rng.standard_normal((m, 3))
+    assert np.corrcoef(nominal[:, 0], nominal[:, 1])[0, 1] > 0.9
+    for order, expected in (((0, 1, 2), []), ((1, 0, 2), ["order"])):
+        sums = OrderSums(3)
+        for a in range(0, m, 1000):
+            sums.add(nominal[a:a + 1000], np.sign(dq[a:a + 1000]), dq[a:a + 1000], tau[a:a + 1000][:, list(order)])
+        found = sums.findings(np.ones(3, bool), "log")
+        assert [f.kind for f in found] == expected
+        if found:
+            assert "the torques of J1 and J2 (" in found[0].text and "look swapped" in found[0].text
+
+
+def test_swapped_current_columns_are_named_and_the_model_not_called_ready(tmp_path):
+    """J2's and J3's currents written in each other's column in both logs of a simulated ER-16: named, not ready.
+    Before, the log was fitted and called ready with no word."""
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
+    p = dynid("identify", cfg, "--out", tmp_path / "in-order", "--no-figures")
+    assert p.returncode == 0 and [f for f in _findings(tmp_path / "in-order") if f["kind"] == "order"] == []
+    for name in ("ident.csv", "valid.csv"):
+        data = np.loadtxt(tmp_path / name, delimiter=",")
+        data[:, [8, 9]] = data[:, [9, 8]]  # time, 6 positions, J1's current, then J2's and J3's
+        np.savetxt(tmp_path / name, data, delimiter=",", fmt="%.10g")
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    (order,) = [f for f in _findings(tmp_path / "out") if f["kind"] == "order"]
+    assert "J2 and J3" in order["text"]
+    assert "not ready: the torques of some joints look swapped" in " ".join((p.stdout + p.stderr).split())

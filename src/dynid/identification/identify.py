@@ -33,6 +33,7 @@ from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (
     BlockGrams,
     Finding,
+    OrderSums,
     ResidualSums,
     bootstrap_finding,
     excitation_findings,
@@ -40,7 +41,7 @@ from ..validation.diagnostics import (
     scale_findings,
     sign_findings,
 )
-from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
+from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
@@ -382,6 +383,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, sums, scoring.residuals, scoring.blocks, fit,
                                data, rng)
+    if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
+        floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
+        findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
     main = ""
     ls_label = estimate_label(ls_key)
     if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):
@@ -420,6 +424,8 @@ class BlockScoring:
         self.blocks = BlockGrams(n, base.n_base, data.t.shape[0])
         self.near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
         self.folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out else []
+        self.nominal = base.base_from_standard(robot.standard_parameters()) if np.any(robot.inertial != 0) else None
+        self.order = OrderSums(n)
 
     def add(self, index, y, tau, keep, y_standard) -> None:
         """Feed one block of base rows to every accumulator.
@@ -448,6 +454,8 @@ class BlockScoring:
             self.sums.add(data.t[index[scored]], y[scored], tau[scored], resting_rows(data, index[scored]))
         direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
         self.residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, self.near_reversal, keep)
+        if self.nominal is not None:
+            self.order.add(y @ self.nominal, direction, np.asarray(data.dq[index]), tau)
         self.blocks.add(index, y, tau, keep)
         for observer in self.observers:
             observer(index, y, tau, keep)

@@ -309,9 +309,9 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("sign", "scale")
-"""Findings of ``dynid identify``'s verdict that say the torques themselves are wrong (a flipped sign, a unit or gain):
-a model fitted to them is exported with a warning."""
+READINESS_KINDS = ("sign", "scale", "order")
+"""Findings of ``dynid identify``'s verdict that say the torques themselves are wrong (a flipped sign, a unit or gain,
+channels swapped): a model fitted to them is exported with a warning."""
 
 
 def verdict_warnings(results: dict) -> list[str]:

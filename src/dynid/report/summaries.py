@@ -270,6 +270,8 @@ def readiness(result) -> Line:
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
                     "verdict at the end names it and the setting that fixes it", "warning")
+    if "order" in kinds:
+        return Line("not ready: the torques of some joints look swapped: the verdict at the end names them", "warning")
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")

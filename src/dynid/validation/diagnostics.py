@@ -28,7 +28,8 @@ import numpy as np
 
 from .noise_floor import AT_FLOOR
 
-__all__ = ["Finding", "ResidualSums", "sign_findings", "scale_findings", "validation_findings", "prior_findings",
+__all__ = ["Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "validation_findings",
+           "prior_findings",
            "nominal_gate"]
 
 SIGNIFICANT = 4.0
@@ -50,7 +51,8 @@ class Finding:
     Attributes
     ----------
     kind : str
-        "sign", "scale", "friction", "position", "correlated", "excitation", "extrapolation", "validation", "delay".
+        "sign", "scale", "order", "friction", "position", "correlated", "excitation", "extrapolation", "validation",
+        "delay".
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
@@ -296,6 +298,82 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
                              f"unit (currents in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the "
                              f"torques (or currents) of {table} and the other datasets, or check drive_gain in the "
                              "description")]
+
+
+ORDER_GAIN = 0.25
+"""A joint's measured torque fits another joint's nominal torque (with that joint's friction) with at most this share
+of the residual power of its own: the two channels are swapped (:class:`OrderSums`)."""
+
+
+class OrderSums:
+    """Sums over a log's samples to tell torque channels in another order than the joints: each joint's measured
+    torque regressed on each joint's nominal torque (the description's model) with that joint's friction terms —
+    its direction of motion, its velocity, a constant. Channels j and k are swapped when each fits the other's
+    nominal torque with at most :data:`ORDER_GAIN` of the residual power it has on its own, at a slope within
+    [1/3, 3] (the nominal model's size). Shapes alone cannot tell them: on the UR10e the nominal J2 and J3 torques
+    correlate at 0.9 and more; the residuals with friction differ 40-400×.
+
+    Parameters
+    ----------
+    n_dof : int
+    """
+
+    def __init__(self, n_dof: int):
+        self.n = n_dof
+        self.gram = np.zeros((4 * n_dof + 1, 4 * n_dof + 1))
+
+    def add(self, nominal: np.ndarray, direction: np.ndarray, dq: np.ndarray, tau: np.ndarray) -> None:
+        """Fold one block of samples into the sums.
+
+        Parameters
+        ----------
+        nominal, direction, dq, tau : (M, n_dof) arrays
+            The nominal model's torques [N·m], each joint's direction of motion (-1, 0, 1), velocities [rad/s] and the
+            measured torques [N·m].
+        """
+        z = np.column_stack([nominal, direction, dq, np.ones(nominal.shape[0]), tau])
+        self.gram += z.T @ z
+
+    def _fit(self, j: int, k: int) -> tuple[float, float]:
+        """Residual power of measured torque ``j`` on joint ``k``'s nominal torque and friction terms, and the slope."""
+        n = self.n
+        cols = [k, n + k, 2 * n + k, 3 * n]
+        a, b = self.gram[np.ix_(cols, cols)], self.gram[cols, 3 * n + 1 + j]
+        coef = np.linalg.lstsq(a, b, rcond=None)[0]
+        return float(self.gram[3 * n + 1 + j, 3 * n + 1 + j] - coef @ b), float(coef[0])
+
+    def findings(self, varies: np.ndarray, dataset: str, table: str = "[identification]") -> list[Finding]:
+        """The swapped pairs, one finding naming them.
+
+        Parameters
+        ----------
+        varies : (n_dof,) bool array
+            Joints whose measured torque varies beyond its noise.
+        dataset : str
+            The log, named in the finding.
+        table : str
+            The config table to fix (its torque or current columns).
+
+        Returns
+        -------
+        list of Finding
+        """
+        n = self.n
+        fits = [[self._fit(j, k) for k in range(n)] for j in range(n)]
+        swapped = []
+        for j in range(n):
+            for k in range(j + 1, n):
+                (r_jk, s_jk), (r_kj, s_kj) = fits[j][k], fits[k][j]
+                own_j, own_k = fits[j][j][0], fits[k][k][0]
+                if (varies[j] and varies[k] and own_j > 0 and own_k > 0 and r_jk <= ORDER_GAIN * own_j
+                        and r_kj <= ORDER_GAIN * own_k and 1 / 3 <= s_jk <= 3 and 1 / 3 <= s_kj <= 3):
+                    swapped.append(f"J{j + 1} and J{k + 1} (each fits the other's nominal torque with "
+                                   f"{100 * r_jk / own_j:.2g} % and {100 * r_kj / own_k:.2g} % of the residual of its "
+                                   "own)")
+        if not swapped:
+            return []
+        return [Finding("order", f"{dataset}: the torques of {'; '.join(swapped)} look swapped: check the order of the "
+                                 f"torque or current columns of {table} and the other datasets")]
 
 
 DELAY_SIGNIFICANT = 3.0
