@@ -29,8 +29,7 @@ import numpy as np
 from .noise_floor import AT_FLOOR
 
 __all__ = ["Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "validation_findings",
-           "prior_findings",
-           "nominal_gate"]
+           "prior_findings", "nominal_gate"]
 
 SIGNIFICANT = 4.0
 """|t| above which a residual's correlation with a feature is reported."""
