@@ -381,8 +381,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, sums, scoring.residuals, scoring.blocks, fit,
-                               data, rng)
+    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
@@ -424,6 +423,7 @@ class BlockScoring:
         self.blocks = BlockGrams(n, base.n_base, data.t.shape[0])
         self.near_reversal = 5 * np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
         self.folds = [LeastSquaresAccumulator(robot.n_params, n) for _ in range(HELD_OUT_FOLDS)] if held_out else []
+        # the description's nominal model (base parameters), where it has one: the verdict checks the torques against it
         self.nominal = base.base_from_standard(robot.standard_parameters()) if np.any(robot.inertial != 0) else None
         self.order = OrderSums(n)
 
@@ -500,15 +500,16 @@ FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 """Drive terms that are friction (not the rotor inertia, not a counterbalance): the sign check looks beyond them."""
 
 
-def _nominal_checks(robot, base, sums, fit, data, stats: dict) -> list:
-    """The torques against the description's nominal model: a flipped sign and a scale (unit or gain)
-    (:mod:`dynid.validation.diagnostics`); their statistics go into ``stats``."""
-    nominal = base.base_from_standard(robot.standard_parameters())
+def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
+    """The torques against the description's nominal model (``scoring.nominal``): a flipped sign and a scale (unit or
+    gain) (:mod:`dynid.validation.diagnostics`); their statistics go into ``stats``."""
+    nominal, sums, data = scoring.nominal, scoring.sums, scoring.data
+    assert nominal is not None  # called only where the description has a nominal model
     corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
     stats["nominal_correlation"] = corr
     # the friction the nominal model may lack can run against it over a short log: judge the rest of the torque
     friction = {j: [k for k, name in enumerate(base.names) for term in FRICTION_TERMS if name == f"{term}{j + 1}"]
-                for j in range(robot.n_dof)}
+                for j in range(scoring.robot.n_dof)}
     beyond, slope = sums.beyond(nominal, friction)
     stats["nominal_correlation_beyond_friction"] = beyond
     stats["nominal_slope_beyond_friction"] = slope
@@ -517,13 +518,15 @@ def _nominal_checks(robot, base, sums, fit, data, stats: dict) -> list:
             + scale_findings(beyond, slope, varies, data.name))
 
 
-def _verdict(robot, base, sol, ols_params, row_weights, sums, residuals, blocks, fit, data, rng):
+def _verdict(robot, base, sol, ols_params, row_weights, scoring: BlockScoring, fit, rng):
     """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics."""
     n = robot.n_dof
     rms = fit.rms_torque
-    findings, stats = [], {}
-    if np.any(robot.inertial != 0):  # the description's nominal model: does the data run against it?
-        findings += _nominal_checks(robot, base, sums, fit, data, stats)
+    sums, residuals, blocks, data = scoring.sums, scoring.residuals, scoring.blocks, scoring.data
+    findings: list = []
+    stats: dict = {}
+    if scoring.nominal is not None:  # the description's nominal model: does the data run against it?
+        findings += _nominal_checks(base, scoring, fit, stats)
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
     more, res_stats = residuals.residual_checks(ols_params, rms, fc)
     findings += more
