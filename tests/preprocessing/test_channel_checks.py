@@ -79,3 +79,28 @@ def test_measured_velocities_in_another_unit_sign_or_side_are_refused(rng, facto
     wrong[:, 1] *= factor
     with pytest.raises(DataError, match=r"^identification: joint 2's measured velocities are .*" + re.escape(hint)):
         prepare(Recording("identification", t, q, wrong, tau, rate), Preprocessing())
+
+
+def _logged_in_steps(x, step):
+    return np.round(x / step) * step
+
+
+def test_a_quantised_channel_is_not_clipped_at_its_smooth_peaks(rng):
+    """Torques logged in steps of 0.1 N·m at 1 kHz (a wrist of ±1.6 N·m): a smooth peak reads its top step for tens of
+    samples, as a clipped torque would, but the torque on both sides of it does not head beyond: nothing is marked.
+    The same channel clipped at ±1.2 N·m and then logged in steps: the clipped runs are marked, on both sides."""
+    t = np.arange(40000) * 1e-3
+    smooth = 1.6 * np.sin(2 * np.pi * 0.15 * t) * np.cos(2 * np.pi * 0.05 * t) + rng.normal(0.0, 0.01, t.size)
+    tau = np.column_stack([_logged_in_steps(smooth, 0.1), rng.normal(0.0, 1.0, t.size)])
+    top = np.abs(tau[:, 0] - tau[:, 0].max()) < 1e-9
+    longest = max(len(r) for r in np.split(top, np.flatnonzero(np.diff(top)) + 1) if r[0])
+    assert longest >= SATURATION_SAMPLES  # a run the plain rule takes for saturation
+    mask, words = clipped_samples(tau, t, "log")
+    assert mask is None and words == ()
+    tau[:, 0] = _logged_in_steps(np.clip(smooth, -1.2, 1.2), 0.1)
+    mask, words = clipped_samples(tau, t, "log")
+    assert mask is not None and not mask[:, 1].any()
+    held = np.abs(np.abs(tau[:, 0]) - 1.2) < 1e-9
+    assert mask[:, 0].sum() >= 0.9 * held.sum()
+    assert (tau[mask[:, 0], 0] > 0).any() and (tau[mask[:, 0], 0] < 0).any()
+    assert len(words) == 1 and words[0].startswith("log: J1's torque stays at its extreme")

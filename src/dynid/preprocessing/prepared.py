@@ -296,13 +296,23 @@ def check_velocities(dq, from_positions, label: str) -> None:
 
 SATURATION_SAMPLES = 20
 """Consecutive samples at a joint's extreme value that count as saturation (a clipped current or torque)."""
+QUANTISED_SHARE = 0.05
+"""A channel with at least this share of consecutive samples reading the same value (away from its extremes) is
+quantised (logged in steps, e.g. 0.1 N·m): a smooth peak then also reads one value for many samples, and a run at the
+extreme counts as saturation only where the torque on both sides of it heads beyond it (:func:`_heads_beyond`)."""
+FLANK_STEPS = 3
+"""The flanks of a run in a quantised channel: the samples next to it within this many steps (:func:`_quantum`) of
+its value."""
+BEYOND_STEPS = 1.0
+"""A run in a quantised channel is saturation where its flanks' parabola exceeds it by more than this many steps."""
 
 
 def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.ndarray | None, tuple[str, ...]]:
     """The samples where a joint's measured torque is held at its largest or smallest value for at least
     :data:`SATURATION_SAMPLES` samples in a row (a drive's current or torque limit, on either side: a limit may clip
     one direction only), and the warning that says so. Such a sample says only that the torque was at least that
-    much; it is left out of the estimation (that joint's rows) and of the metrics (the whole sample).
+    much; it is left out of the estimation (that joint's rows) and of the metrics (the whole sample). In a quantised
+    channel (:data:`QUANTISED_SHARE`) a run counts only where the torque on both sides heads beyond it.
 
     Parameters
     ----------
@@ -334,11 +344,12 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
         peak = float(np.abs(x).max()) if x.size else 0.0
         if peak == 0 or float(np.ptp(x)) <= 1e-12 * max(1.0, peak):
             continue
-        runs = []
-        for extreme in {float(x.max()), float(x.min())}:
-            edges = np.diff(np.concatenate([[0], (np.abs(x - extreme) <= 1e-9 * peak).astype(np.int8), [0]]))
+        runs, step = [], _quantum(x, peak)
+        for extreme, side in ((float(x.max()), 1.0), (float(x.min()), -1.0)):
+            at = np.abs(x - extreme) <= 1e-9 * peak
+            edges = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
             runs += [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
-                     if b - a >= SATURATION_SAMPLES]
+                     if b - a >= SATURATION_SAMPLES and (step == 0 or _heads_beyond(x, a, b, side, step))]
         if not runs:
             continue
         mask = np.zeros((n, tau.shape[1]), dtype=bool) if mask is None else mask
@@ -353,6 +364,42 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
                      f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "
                      "within the filter's reach are left out of the estimation and of the metrics")
     return mask, tuple(words)
+
+
+def _quantum(x: np.ndarray, peak: float) -> float:
+    """The step of a quantised channel (:data:`QUANTISED_SHARE`): the median change between consecutive samples that
+    differ, away from the channel's extremes (a clip's own runs do not make a channel quantised); 0 if not quantised."""
+    tol = 1e-9 * peak
+    inner = x[(np.abs(x - x.max()) > tol) & (np.abs(x - x.min()) > tol)]
+    moves = np.abs(np.diff(inner))
+    changed = moves[moves > tol]
+    if changed.size == 0 or changed.size > (1 - QUANTISED_SHARE) * moves.size:
+        return 0.0
+    return float(np.median(changed))
+
+
+def _heads_beyond(x: np.ndarray, a: int, b: int, side: float, step: float) -> bool:
+    """Whether the torque on both sides of the run ``x[a:b]`` (at the channel's maximum, ``side`` 1, or minimum, -1)
+    heads beyond it.
+
+    The flanks are the samples next to the run, outwards, while they stay within :data:`FLANK_STEPS` steps ``step`` of
+    the run's value (at most ten times the run's length on each side). A parabola in the sample index fitted to both
+    (a line to one, where the run touches an end of the log) goes beyond the run's value inside the run by more than
+    :data:`BEYOND_STEPS` steps: a clipped torque was heading further; a smooth peak read in steps stays within about a
+    step of its top value."""
+    level, m = x[a], 10 * (b - a)
+    near = np.abs(x - level) <= FLANK_STEPS * step * (1 + 1e-9)
+
+    def flank(index: np.ndarray) -> np.ndarray:
+        off = np.flatnonzero(~near[index])
+        return index[:off[0]] if off.size else index
+
+    before, after = flank(np.arange(a - 1, max(a - m, 0) - 1, -1)), flank(np.arange(b, min(b + m, x.shape[0])))
+    if before.size < 3 and after.size < 3:
+        return True  # nothing to judge by: the run is kept as saturation, as in a channel that is not quantised
+    index = np.concatenate([before[::-1], after])
+    fit = np.polynomial.Polynomial.fit(index, x[index], 2 if before.size >= 3 and after.size >= 3 else 1)
+    return float(np.max(side * (fit(np.arange(a, b, dtype=float)) - level))) > BEYOND_STEPS * step
 
 
 def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
