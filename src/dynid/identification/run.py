@@ -10,7 +10,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
-from ..io.datasets import GAP_FACTOR, DatasetSpec, Recording, load_recording, resampled, uniform_rate
+from ..io.datasets import (
+    GAP_FACTOR,
+    DatasetSpec,
+    Recording,
+    load_recording,
+    resampled,
+    uniform_rate,
+    unwrapped_positions,
+)
 from ..io.identification_config import IdentificationConfig, split_estimators, stored_preprocessing
 from ..keywords import keyword_only_after_data
 from ..model.description import builtin_robots
@@ -415,13 +423,15 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
         k = int(np.argmax(steps))
         raise DataError(f"t: a gap of {steps[k]:.3g} s after {t[k] - t[0]:.3f} s (median step {median:.3g} s): give the parts "
                         "on each side of it separately")
-    warnings: tuple[str, ...] = ()
+    said: list[str] = []
+    q = unwrapped_positions(q, name, said)
+    warnings: tuple[str, ...] = tuple(said)
     rate = uniform_rate(t)
     if np.ptp(steps) > 1e-6 * median:
         signals = {"q": q, "tau": tau, **({} if dq is None else {"dq": dq})}
         t, signals = resampled(t, signals, rate)
         q, tau, dq = signals["q"], signals["tau"], signals.get("dq")
-        warnings = (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated onto a "
+        warnings += (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated onto a "
                     f"uniform grid at {rate:.6g} Hz",)
     else:
         rate = 1.0 / median

@@ -548,6 +548,9 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
         if where is not None:
             where = (lambda w, f: (lambda k: w(k + f)))(where, first)
+    side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
+    if "positions" in raw and side("positions") != "motor":  # a motor may turn near a whole turn between samples
+        raw["positions"] = unwrapped_positions(raw["positions"], spec.name, warnings)
     raw = _held_rows(spec, t, raw, warnings)
     if (spec.time_range is not None or spec.rows is not None) and t.size < MIN_SELECTED:
         which, value = ("time_range", list(spec.time_range)) if spec.time_range is not None else ("rows", list(spec.rows or ()))
@@ -589,7 +592,6 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission
-    side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
     if side("positions") == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
         q = _row_wise(tr.joint_positions, raw.pop("positions"))
     else:
@@ -642,6 +644,59 @@ def resampled(t: np.ndarray, signals: dict, rate: float) -> tuple[np.ndarray, di
     """
     grid = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * rate + 1e-9)) + 1) / rate
     return grid, {kind: by_column(x, lambda column, j: np.interp(grid, t, column)) for kind, x in signals.items()}
+
+
+WRAP_TOLERANCE = 0.5
+"""[rad] A step between two samples of a joint's position within this of a whole turn (2π) is the angle wrapped to one
+turn (a continuous joint logged in [-π, π)), not a motion: no joint turns that far in one sample."""
+
+
+def unwrapped_positions(x, name: str, warnings: list[str]):
+    """Positions with every step of a whole turn (:data:`WRAP_TOLERANCE`) taken back: an angle logged within one turn
+    (a continuous joint in [-π, π)) runs on. The dynamics of a revolute joint repeat every turn; filtering,
+    resampling and differentiation do not.
+
+    Parameters
+    ----------
+    x : (N, n_dof) array or StoredColumns [rad]
+    name : str
+        The dataset, for the warning.
+    warnings : list of str
+        Gets one line naming each joint taken back and how often, if any.
+
+    Returns
+    -------
+    (N, n_dof) array or StoredColumns [rad]
+        ``x`` itself where no step is a whole turn.
+    """
+    said = []
+
+    def unwrap(column: np.ndarray, j: int) -> np.ndarray:
+        turns = _turns(column)
+        if not turns.any():
+            return column
+        jumps = np.count_nonzero(turns)
+        said.append(f"joint {j + 1}: {jumps} jump{'s' if jumps > 1 else ''}")
+        return column - 2 * np.pi * np.concatenate([[0.0], np.cumsum(turns)])
+
+    if isinstance(x, StoredColumns):
+        if not any(_turns(x.column(j)).any() for j in range(x.shape[1])):
+            return x
+        out = x.map_columns(unwrap)
+    else:
+        out = np.column_stack([unwrap(np.asarray(x[:, j], dtype=float), j) for j in range(x.shape[1])])
+    if not said:
+        return x
+    warnings.append(f"{name}: positions jump by a whole turn (2π) between two samples, an angle logged within one turn: "
+                    f"taken back so that they run on ({'; '.join(said)})")
+    return out
+
+
+def _turns(column: np.ndarray) -> np.ndarray:
+    """The whole turns each step of a position column wraps by (0 for a step that is not a whole turn)."""
+    steps = np.diff(column)
+    turns = np.round(steps / (2 * np.pi))
+    return np.where(np.abs(steps - 2 * np.pi * turns) <= WRAP_TOLERANCE, turns, 0.0)
 
 
 def _held_rows(spec: DatasetSpec, t, raw: dict, warnings: list[str]) -> dict:
