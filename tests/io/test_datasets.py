@@ -27,11 +27,34 @@ def test_ur_rtde_preset_resamples_jittered_time_onto_a_uniform_grid(tmp_path, rn
 
 
 def test_non_increasing_time_names_file_and_line(tmp_path):
-    rows = [_ur_row(t, np.zeros(6), np.zeros(6), np.zeros(6)) for t in (0.0, 0.01, 0.02, 0.02, 0.03)]
+    rows = [_ur_row(t, np.full(6, k), np.zeros(6), np.zeros(6)) for k, t in enumerate((0.0, 0.01, 0.02, 0.02, 0.03))]
     (tmp_path / "ur.csv").write_text("".join(rows))
     spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv"}, tmp_path, "cfg", "ident", 6)
-    with pytest.raises(DataError, match=r"ur.csv: line 4: time stamps must increase"):
+    with pytest.raises(DataError, match=r"ur.csv: line 4: time stamps must increase, got a repeated time stamp"):
         load_recording(spec, load_robot("ur10e"))
+
+
+@pytest.mark.parametrize("spool", [False, True])
+def test_a_row_written_twice_is_dropped_and_said(tmp_path, spool):
+    """A row that repeats the previous one, time stamp and every value (a logger that wrote a sample twice): dropped,
+    the recording the same as without it, one warning; time going back after it is refused naming its line in the
+    file (line 6: the dropped row counted)."""
+    t = np.arange(200) * 0.01
+    q = 0.1 * np.sin(np.outer(t, np.arange(1, 7)))
+    rows = [_ur_row(tk, qk, np.zeros(6), np.full(6, 0.5)) for tk, qk in zip(t, q)]
+    (tmp_path / "once.csv").write_text("".join(rows))
+    (tmp_path / "twice.csv").write_text("".join(rows[:50] + rows[49:]))
+    robot = load_robot("ur10e")
+    once, twice = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident", 6),
+                                  robot, spool=spool) for name in ("once", "twice"))
+    np.testing.assert_array_equal(np.asarray(twice.q), np.asarray(once.q))
+    np.testing.assert_array_equal(twice.t, once.t)
+    assert [w for w in twice.warnings if w not in once.warnings] == [
+        "ident: 1 row(s) repeat the previous one, time stamp and every value (a sample written twice): dropped"]
+    (tmp_path / "back.csv").write_text("".join(rows[:3] + rows[2:4] + rows[2:3] + rows[5:]))
+    with pytest.raises(DataError, match=r"back.csv: line 6: time stamps must increase, got time going back"):
+        load_recording(dataset_spec({"preset": "ur-rtde", "file": "back.csv"}, tmp_path, "cfg", "ident", 6), robot,
+                       spool=spool)
 
 
 def test_wrong_column_count_for_the_preset(tmp_path):

@@ -523,6 +523,48 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
                      str(spec.signals[tau_kind].file), warnings)
 
 
+def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
+    """Time stamps that increase: a row that repeats the previous one, time stamp and every value, is a sample written
+    twice and dropped (said); any other time stamp that does not increase is refused, naming its place."""
+    steps = np.diff(t)
+    if not np.any(steps <= 0):
+        return t, raw, where
+    k = np.flatnonzero(steps == 0)
+    twice = k[np.all([np.all(np.asarray(select_rows(x, k + 1)) == np.asarray(select_rows(x, k)), axis=1)
+                      for x in raw.values()], axis=0)] + 1
+    if twice.size:
+        keep = np.ones(t.shape[0], dtype=bool)
+        keep[twice] = False
+        t, raw = t[keep], {kind: select_rows(x, keep) for kind, x in raw.items()}
+        where = (lambda w, rows: (lambda i: w(int(rows[i]))))(where, np.flatnonzero(keep))
+        warnings.append(f"{spec.name}: {twice.size} row(s) repeat the previous one, time stamp and every value (a sample "
+                        "written twice): dropped")
+        steps = np.diff(t)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0))
+        what = "a repeated time stamp" if t[i + 1] == t[i] else "time going back"
+        raise DataError(f"{where(i + 1)}: time stamps must increase, got {what}: {float(t[i + 1]):.9g} s after "
+                        f"{float(t[i]):.9g} s")
+    return t, raw, where
+
+
+def _in_time_range(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
+    """The samples in ``spec.time_range`` (seconds from the first sample), checked."""
+    assert spec.time_range is not None
+    start, stop = spec.time_range
+    inside = (t - t[0] >= start - 1e-9) & (t - t[0] <= stop + 1e-9)
+    if inside.sum() < 2:
+        raise DataError(f"{spec.name}: time_range [{start:g}, {stop:g}] s holds fewer than 2 samples of the "
+                        f"{t[-1] - t[0]:.3f} s recording")
+    if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
+        warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
+    first = int(np.argmax(inside))
+    t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
+    if where is not None:
+        where = (lambda w, f: (lambda k: w(k + f)))(where, first)
+    return t, raw, where
+
+
 def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool, q_source: str, tau_source: str,
               warnings: list[str]) -> Recording:
     """Time checks, selection, gaps, resampling, transmission, drive gains and plausibility, shared by every
@@ -531,23 +573,9 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     if n_s < 2:
         raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
     if timed:
-        steps = np.diff(t)
-        if np.any(steps <= 0):
-            k = int(np.argmax(steps <= 0))
-            what = "a repeated time stamp" if t[k + 1] == t[k] else "time going back"
-            raise DataError(f"{where(k + 1)}: time stamps must increase, got {what}: {float(t[k + 1]):.9g} s after {float(t[k]):.9g} s")
+        t, raw, where = _increasing(spec, t, raw, where, warnings)
     if spec.time_range is not None:
-        start, stop = spec.time_range
-        inside = (t - t[0] >= start - 1e-9) & (t - t[0] <= stop + 1e-9)
-        if inside.sum() < 2:
-            raise DataError(f"{spec.name}: time_range [{start:g}, {stop:g}] s holds fewer than 2 samples of the "
-                            f"{t[-1] - t[0]:.3f} s recording")
-        if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
-            warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
-        first = int(np.argmax(inside))
-        t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
-        if where is not None:
-            where = (lambda w, f: (lambda k: w(k + f)))(where, first)
+        t, raw, where = _in_time_range(spec, t, raw, where, warnings)
     side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
     if "positions" in raw and side("positions") != "motor":  # a motor may turn near a whole turn between samples
         raw["positions"] = unwrapped_positions(raw["positions"], spec.name, warnings)
@@ -679,6 +707,7 @@ def unwrapped_positions(x, name: str, warnings: list[str]):
         said.append(f"joint {j + 1}: {jumps} jump{'s' if jumps > 1 else ''}")
         return column - 2 * np.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
+    out: StoredColumns | np.ndarray
     if isinstance(x, StoredColumns):
         if not any(_turns(x.column(j)).any() for j in range(x.shape[1])):
             return x

@@ -348,8 +348,8 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
         for extreme, side in ((float(x.max()), 1.0), (float(x.min()), -1.0)):
             at = np.abs(x - extreme) <= 1e-9 * peak
             edges = np.diff(np.concatenate([[0], at.astype(np.int8), [0]]))
-            runs += [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
-                     if b - a >= SATURATION_SAMPLES and (step == 0 or _heads_beyond(x, a, b, side, step))]
+            runs += [(int(a), int(b)) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
+                     if b - a >= SATURATION_SAMPLES and (step == 0 or _heads_beyond(x, int(a), int(b), side, step))]
         if not runs:
             continue
         mask = np.zeros((n, tau.shape[1]), dtype=bool) if mask is None else mask
