@@ -97,8 +97,11 @@ LOGS = {
     "only blank lines": ("\n\n\n", "log.csv: "),
     "semicolons": (_text(GOOD[:50]).replace(",", ";"), "log.csv: line 1: expected 31 columns, got 1 (fields separated by ';'?"),
     "a text cell": (_text(GOOD[:40]) + "0.5,abc" + ",1" * 29 + "\n" + _text(GOOD[41:60]), "log.csv: line 41"),
-    "NaN": (_text(_with(GOOD[:300], lambda r: r.__setitem__((5, 3), np.nan))), "log.csv: line 6, column 4: NaN or infinite value"),
-    "infinity": (_text(_with(GOOD[:300], lambda r: r.__setitem__((7, 15), np.inf))), "log.csv: line 8, column 16: NaN or infinite value"),
+    "NaN for 36 rows": (_text(_with(GOOD[:300], lambda r: r.__setitem__((slice(5, 41), 3), np.nan))),
+                        "log.csv: line 6: joint 3's positions are missing for 36 rows in a row"),
+    "a missing time stamp": (_text(_with(GOOD[:300], lambda r: r.__setitem__((5, 0), np.nan))),
+                             "log.csv: line 6: the time stamp is missing"),
+    "infinity": (_text(_with(GOOD[:300], lambda r: r.__setitem__((7, 15), np.inf))), "log.csv: line 8, column 16: infinite value"),
     "duplicate time stamps": (_text(_with(GOOD[:300], lambda r: r.__setitem__((10, 0), r[9, 0]))), "log.csv: line 11: time stamps must increase, got a repeated time stamp"),
     "time going back": (_text(_with(GOOD[:300], lambda r: r.__setitem__((10, 0), r[5, 0]))), "log.csv: line 11: time stamps must increase"),
     "a time gap": (_text(_with(GOOD, lambda r: r.__setitem__((slice(1000, None), 0), r[1000:, 0] + 3.0))), "gap"),
@@ -139,6 +142,20 @@ def test_a_joint_that_never_moves_is_identified_with_a_warning(ur):
     result = invoke("identify", ur(), "--out", out, "--no-figures")
     assert result.exit_code == 0, result.stderr
     assert "log.csv: joint 3's position never changes in [identification]" in " ".join(result.stderr.split())
+    assert (out / "results.json").is_file()
+
+
+def test_a_few_missing_values_are_filled_with_a_warning(ur):
+    """An empty field and a NaN (a log merging signals of other rates): filled by interpolation in time, said; they
+    were refused ("NaN or infinite value")."""
+    text = _text(_with(GOOD, lambda r: r.__setitem__((5, 3), np.nan))).splitlines(keepends=True)
+    text[9] = ",".join(f if i != 14 else "" for i, f in enumerate(text[9].split(",")))
+    (ur.folder / "log.csv").write_text("".join(text))
+    out = ur.folder / "out"
+    result = invoke("identify", ur(), "--out", out, "--no-figures")
+    assert result.exit_code == 0, result.stderr
+    assert ("2 missing value(s) (empty or NaN fields) in positions of joint 3; currents of joint 2: filled by "
+            "interpolation in time") in " ".join(result.stderr.split())
     assert (out / "results.json").is_file()
 
 

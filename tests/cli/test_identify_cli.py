@@ -88,7 +88,7 @@ _ROW = ",".join(["0.5"] * 30)
 @pytest.mark.parametrize("csv_text, message", [
     ("".join(f"{t},{_ROW}\n" for t in (0.0, 0.01)) + "0.02,1,2\n", "log.csv: line 3: expected 31 columns, got 3"),
     ("".join(f"{t},{_ROW}\n" for t in (0.0, 0.01, 0.005, 0.02)), "log.csv: line 3: time stamps must increase"),
-    (f"0.0,{_ROW}\n0.01,nan{_ROW[3:]}\n", "log.csv: line 2, column 2: NaN or infinite value"),
+    (f"0.0,{_ROW}\n0.01,inf{_ROW[3:]}\n", "log.csv: line 2, column 2: infinite value"),
 ])
 def test_damaged_logs_get_one_line_errors_and_leave_nothing_behind(tmp_path, csv_text, message):
     cfg = _ur_config(tmp_path, csv_text)

@@ -297,3 +297,40 @@ def test_positions_logged_within_one_turn_are_taken_back(tmp_path, spool):
     said = [w for w in rec.warnings if "whole turn" in w]
     assert said == ["ident: positions jump by a whole turn (2π) between two samples, an angle logged within one turn: "
                     "taken back so that they run on (joint 6: 2 jumps)"]
+
+
+@pytest.mark.parametrize("spool", [False, True])
+def test_signals_of_other_rates_are_filled_in_time_and_long_holes_refused(tmp_path, spool):
+    """A log that merges signals of other rates (PlotJuggler, a topics' merge): currents only every third row, empty
+    before the drive's first message. The rows before are dropped, the empty fields filled by interpolation in time
+    between each column's own values (linear currents: exactly), one warning; a hole longer than dynid fills is
+    refused naming the line, gaps = "interpolate" fills it up to max_gap, gaps = "refuse" refuses any."""
+    t = np.arange(300) * 0.01
+    q = 0.1 * np.sin(np.outer(t, np.arange(1, 7)))
+    cur = np.outer(1.0 + t, np.arange(1, 7))
+    lines = [_ur_row(tk, qk, np.zeros(6), ik).split(",") for tk, qk, ik in zip(t, q, cur)]
+    for k, fields in enumerate(lines):
+        if k % 3 or k < 4:
+            fields[13:19] = [""] * 6
+    (tmp_path / "merged.csv").write_text("".join(",".join(f) for f in lines))
+    robot = load_robot("ur10e")
+    rec = load_recording(dataset_spec({"preset": "ur-rtde", "file": "merged.csv"}, tmp_path, "cfg", "ident", 6), robot,
+                         spool=spool)
+    np.testing.assert_allclose(rec.t, t[6:298] - t[6], atol=1e-12)  # rows 0-5 and 298-299 lack a current
+    np.testing.assert_allclose(np.asarray(rec.tau), cur[6:298] * robot.drive_gains, rtol=1e-9)
+    filled = 6 * sum(1 for k in range(6, 298) if k % 3)
+    assert [w for w in rec.warnings if "missing" in w] == [
+        f"ident: {filled} missing value(s) (empty or NaN fields) in currents of joints 1, 2, 3, 4, 5, 6: filled by "
+        "interpolation in time between each column's own values (gaps = \"auto\" in [cfg]; \"refuse\" refuses them); "
+        "6 row(s) before every signal started and 2 after one stopped dropped"]
+    for k in range(100, 130):
+        lines[k][15] = "nan"
+    (tmp_path / "hole.csv").write_text("".join(",".join(f) for f in lines))
+    with pytest.raises(DataError, match=r"hole.csv: line 101: joint 3's currents are missing for 32 rows in a row"):
+        load_recording(dataset_spec({"preset": "ur-rtde", "file": "hole.csv"}, tmp_path, "cfg", "ident", 6), robot)
+    spec = dataset_spec({"preset": "ur-rtde", "file": "hole.csv", "gaps": "interpolate", "max_gap": 0.5}, tmp_path,
+                        "cfg", "ident", 6)
+    assert load_recording(spec, robot, spool=spool).n_samples == 292
+    with pytest.raises(DataError, match=r"merged.csv: line 8: joint 1's currents are missing .*gaps = \"refuse\""):
+        load_recording(dataset_spec({"preset": "ur-rtde", "file": "merged.csv", "gaps": "refuse"}, tmp_path, "cfg",
+                                    "ident", 6), robot)

@@ -139,3 +139,16 @@ def test_both_readers_refuse_a_row_range_past_the_end(tmp_path, reader):
 
         assert tables._arrow_table(p, [2, 1], False, ",", None, (2, 3), False) is not None
         assert tables._arrow_table(p, [1], False, ",", None, (2, 9), False) is None  # past the end: the line reader
+
+
+def test_missing_values_are_read_as_nan_where_asked(tmp_path, reader):
+    """With ``missing``, an empty field and NaN are NaN (the dataset fills or refuses them); infinity and text are
+    still refused with their line and column; without it, both are refused as before."""
+    p = _write(tmp_path, "1,2,3\n4,,6\n7,nan,9\n")
+    np.testing.assert_array_equal(read_table(p, [1, 2, 3], missing=True).data, [[1, 2, 3], [4, np.nan, 6], [7, np.nan, 9]])
+    with pytest.raises(DataError, match=r"log.csv: line 2, column 2: expected a number, got ''"):
+        read_table(p, [1, 2, 3])
+    for text, message in (("1,2,3\n4,inf,6\n", r"line 2, column 2: infinite value"),
+                          ("1,2,3\n4,x,6\n", r"line 2, column 2: expected a number, got 'x'")):
+        with pytest.raises(DataError, match=message):
+            read_table(_write(tmp_path, text), [1, 2, 3], missing=True)

@@ -10,7 +10,8 @@ A dataset is described by a table of the experiment config (TOML)::
     rows = [635, 3510]               # 1-based inclusive data rows (header excluded)
     time_range = [6.3, 35.1]         # seconds from the first row read (after rows), inclusive
     gaps = "auto"                    # a time step over 5x the median: "auto" (default: fill up to 20 samples),
-                                     # "refuse" or "interpolate" (up to max_gap)
+                                     # "refuse" or "interpolate" (up to max_gap); empty or NaN
+                                     # fields of a signal are filled or refused alike
     time = { column = 1 }            # time stamps [s] …
     rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
     resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
@@ -131,7 +132,8 @@ class DatasetSpec:
         From the first row read.
     gaps : str
         A time step over 5× the median: "auto" (filled when at most :data:`AUTO_GAP_SAMPLES` samples and
-        ``max_gap`` long, refused otherwise), "refuse" or "interpolate" (up to ``max_gap``).
+        ``max_gap`` long, refused otherwise), "refuse" or "interpolate" (up to ``max_gap``); missing values (empty
+        or NaN fields) are filled or refused alike (:func:`_filled`).
     bag : BagSpec or None
         A ROS 2 bag instead of columns.
     table : str
@@ -487,7 +489,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
     tables = {}
     for path, cols in requests.items():
         table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows,
-                           spool=spool)
+                           spool=spool, missing=True)
         tables[path] = (table, cols)
         warnings.extend(table.warnings)
     del table
@@ -513,6 +515,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
         t = get(spec.time)[:, 0]
         first_line = tables[spec.time.file][0].first_line
         where = lambda k: f"{spec.time.file}: line {first_line + k}"  # noqa: E731 - sample k's place in the file
+        if np.isnan(t).any():
+            raise DataError(f"{where(int(np.argmax(np.isnan(t))))}: the time stamp is missing (an empty or NaN field)")
     else:
         t = np.arange(n_s) / spec.rate
         where = None
@@ -548,6 +552,76 @@ def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     return t, raw, where
 
 
+def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
+    """Missing values (empty or NaN fields: signals logged at other times than the rows, as a log merging topics has
+    them) filled by interpolation in time between the column's own values, as ``spec.gaps`` fills gaps in time: "auto"
+    up to :data:`AUTO_GAP_SAMPLES` missing in a row, "interpolate" up to ``max_gap`` seconds, "refuse" none. Rows before
+    every signal has started or after one has stopped are dropped; the warning says how many of each."""
+    holes = {kind: [j for j in range(x.shape[1]) if np.isnan(x[:, j]).any()] for kind, x in raw.items()}
+    if not any(holes.values()):
+        return t, raw, where
+    table = spec.table or spec.name
+    whole = np.ones(t.shape[0], dtype=bool)  # rows that hold every signal
+    for kind, columns in holes.items():
+        for j in columns:
+            whole &= ~np.isnan(raw[kind][:, j])
+    kept = np.flatnonzero(whole)
+    if kept.size < 2:
+        raise DataError(f"{spec.name}: no two rows hold every signal (empty or NaN fields): are the columns right?")
+    a, b = int(kept[0]), int(kept[-1]) + 1
+    if a or b < t.shape[0]:
+        t, raw = t[a:b], {kind: x[a:b] for kind, x in raw.items()}
+        where = where if where is None or not a else (lambda w, f: (lambda k: w(k + f)))(where, a)
+    count = 0
+    for kind, columns in holes.items():
+        for j in columns:
+            gone = np.isnan(raw[kind][:, j])
+            count += int(gone.sum())
+            _check_missing(spec, t, gone, f"joint {j + 1}'s {kind}", where, table)
+
+    def fill(column: np.ndarray, j: int, kind: str) -> np.ndarray:
+        if j not in holes[kind]:
+            return column
+        gone = np.isnan(column)
+        return np.where(gone, np.interp(t, t[~gone], column[~gone]), column)
+
+    def filled(kind: str, x):
+        if not holes[kind]:
+            return x
+        if isinstance(x, StoredColumns):
+            return x.map_columns(lambda column, j: fill(column, j, kind))
+        return np.column_stack([fill(np.asarray(x[:, j]), j, kind) for j in range(x.shape[1])])
+
+    raw = {kind: filled(kind, x) for kind, x in raw.items()}
+    named = "; ".join(f"{kind} of joint{'s' if len(c) > 1 else ''} {', '.join(str(j + 1) for j in c)}"
+                      for kind, c in holes.items() if c)
+    dropped = f"; {a} row(s) before every signal started and {len(whole) - b} after one stopped dropped" if a or b < len(whole) else ""
+    warnings.append(f"{spec.name}: {count} missing value(s) (empty or NaN fields) in {named}: filled by interpolation in "
+                    f"time between each column's own values (gaps = \"{spec.gaps}\" in {table}; \"refuse\" refuses "
+                    f"them){dropped}")
+    return t, raw, where
+
+
+def _check_missing(spec: DatasetSpec, t, gone: np.ndarray, what: str, where, table: str) -> None:
+    """Refuse a column's missing values where ``spec.gaps`` does not fill them (:func:`_filled`), naming the longest run."""
+    edges = np.diff(np.concatenate([[0], gone.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    i = int(np.argmax(stops - starts))
+    k, n = int(starts[i]), int(stops[i] - starts[i])
+    span = float(t[min(k + n, t.shape[0] - 1)] - t[max(k - 1, 0)])
+    place = where(k) if where is not None else f"{spec.name}: sample {k + 1}"
+    if spec.gaps == "refuse":
+        raise DataError(f"{place}: {what} are missing (an empty or NaN field); gaps = \"refuse\" in {table} refuses "
+                        f"filling it; \"auto\" fills up to {AUTO_GAP_SAMPLES} in a row by interpolation")
+    if spec.gaps == "auto" and n > AUTO_GAP_SAMPLES:
+        raise DataError(f"{place}: {what} are missing for {n} rows in a row ({span:.3g} s), more than the "
+                        f"{AUTO_GAP_SAMPLES} dynid fills by itself; set gaps = \"interpolate\" in {table} to fill up to "
+                        f"max_gap = {spec.max_gap:g} s, or select rows without it")
+    if spec.gaps == "interpolate" and span > spec.max_gap:
+        raise DataError(f"{place}: {what} are missing for {span:.3g} s ({n} rows), longer than max_gap = "
+                        f"{spec.max_gap:g} s in {table}; select rows without it, or raise max_gap")
+
+
 def _in_time_range(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     """The samples in ``spec.time_range`` (seconds from the first sample), checked."""
     assert spec.time_range is not None
@@ -576,6 +650,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         t, raw, where = _increasing(spec, t, raw, where, warnings)
     if spec.time_range is not None:
         t, raw, where = _in_time_range(spec, t, raw, where, warnings)
+    t, raw, where = _filled(spec, t, raw, where, warnings)
     side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
     if "positions" in raw and side("positions") != "motor":  # a motor may turn near a whole turn between samples
         raw["positions"] = unwrapped_positions(raw["positions"], spec.name, warnings)

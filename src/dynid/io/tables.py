@@ -93,7 +93,8 @@ def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
 
 
 def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
-               n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False) -> Table:
+               n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False,
+               missing: bool = False) -> Table:
     """Read numeric columns from a delimited text file.
 
     Parameters
@@ -111,6 +112,8 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     spool : bool
         Write each block's columns to temporary files (:mod:`dynid.column_store`) instead of holding
         them: a long log's memory is then one block, whatever its length.
+    missing : bool
+        Read an empty field or NaN as NaN (a missing value, for the caller to fill or refuse) instead of refusing it.
 
     Returns
     -------
@@ -120,8 +123,8 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     ------
     DataError
         Missing file; a line with the wrong number of fields (except a truncated last line without a
-        newline, which is skipped with a warning); a field that is not a number; NaN or infinity;
-        an empty selection. The message names the file, the line and, where it applies, the column.
+        newline, which is skipped with a warning); a field that is not a number; NaN (unless ``missing``) or
+        infinity; an empty selection. The message names the file, the line and, where it applies, the column.
     """
     path = Path(path)
     if not path.is_file():
@@ -158,7 +161,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         def flush():
             nonlocal files
             if pending:
-                block = _parse_block(path, pending, pending_start, cols, delimiter)
+                block = _parse_block(path, pending, pending_start, cols, delimiter, missing)
                 pending.clear()
                 if not spool:
                     blocks.append(block)
@@ -305,20 +308,23 @@ def _stack(blocks: list[np.ndarray]) -> np.ndarray:
     return data
 
 
-def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str) -> np.ndarray:
+def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str,
+                 missing: bool = False) -> np.ndarray:
     try:
         block = np.loadtxt(lines, delimiter=delimiter, usecols=cols, ndmin=2, dtype=np.float64, comments=None)
     except ValueError:
-        for k, line in enumerate(lines):  # find the culprit for a precise message
+        block = np.empty((len(lines), len(cols)))
+        for k, line in enumerate(lines):  # field by field: an empty one missing (``missing``), else a precise message
             fields = line.rstrip("\r\n").split(delimiter)
-            for c in cols:
+            for i, c in enumerate(cols):
+                text = fields[c].strip()
                 try:
-                    float(fields[c])
+                    block[k, i] = np.nan if missing and not text else float(text)
                 except ValueError:
-                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {fields[c].strip()!r}") from None
-        raise DataError(f"{path}: lines {start}-{start + len(lines) - 1}: cannot parse as numbers") from None
-    bad = ~np.isfinite(block)
+                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {text!r}") from None
+    bad = np.isinf(block) if missing else ~np.isfinite(block)
     if bad.any():
         k, c = np.argwhere(bad)[0]
-        raise DataError(f"{path}: line {start + int(k)}, column {cols[int(c)] + 1}: NaN or infinite value")
+        raise DataError(f"{path}: line {start + int(k)}, column {cols[int(c)] + 1}: "
+                        f"{'infinite' if missing else 'NaN or infinite'} value")
     return block
