@@ -45,8 +45,8 @@ def test_a_row_written_twice_is_dropped_and_said(tmp_path, spool):
     (tmp_path / "once.csv").write_text("".join(rows))
     (tmp_path / "twice.csv").write_text("".join(rows[:50] + rows[49:]))
     robot = load_robot("ur10e")
-    once, twice = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident", 6),
-                                  robot, spool=spool) for name in ("once", "twice"))
+    once, twice = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident",
+                                               6), robot, spool=spool) for name in ("once", "twice"))
     np.testing.assert_array_equal(np.asarray(twice.q), np.asarray(once.q))
     np.testing.assert_array_equal(twice.t, once.t)
     assert [w for w in twice.warnings if w not in once.warnings] == [

@@ -145,7 +145,8 @@ def test_missing_values_are_read_as_nan_where_asked(tmp_path, reader):
     """With ``missing``, an empty field and NaN are NaN (the dataset fills or refuses them); infinity and text are
     still refused with their line and column; without it, both are refused as before."""
     p = _write(tmp_path, "1,2,3\n4,,6\n7,nan,9\n")
-    np.testing.assert_array_equal(read_table(p, [1, 2, 3], missing=True).data, [[1, 2, 3], [4, np.nan, 6], [7, np.nan, 9]])
+    np.testing.assert_array_equal(read_table(p, [1, 2, 3], missing=True).data,
+                                  [[1, 2, 3], [4, np.nan, 6], [7, np.nan, 9]])
     with pytest.raises(DataError, match=r"log.csv: line 2, column 2: expected a number, got ''"):
         read_table(p, [1, 2, 3])
     for text, message in (("1,2,3\n4,inf,6\n", r"line 2, column 2: infinite value"),

@@ -431,8 +431,8 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
         signals = {"q": q, "tau": tau, **({} if dq is None else {"dq": dq})}
         t, signals = resampled(t, signals, rate)
         q, tau, dq = signals["q"], signals["tau"], signals.get("dq")
-        warnings += (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated onto a "
-                    f"uniform grid at {rate:.6g} Hz",)
+        warnings += (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated "
+                     f"onto a uniform grid at {rate:.6g} Hz",)
     else:
         rate = 1.0 / median
     return Recording(name, t - t[0], q, dq, tau, rate, warnings)

@@ -541,8 +541,8 @@ def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
         keep[twice] = False
         t, raw = t[keep], {kind: select_rows(x, keep) for kind, x in raw.items()}
         where = (lambda w, rows: (lambda i: w(int(rows[i]))))(where, np.flatnonzero(keep))
-        warnings.append(f"{spec.name}: {twice.size} row(s) repeat the previous one, time stamp and every value (a sample "
-                        "written twice): dropped")
+        warnings.append(f"{spec.name}: {twice.size} row(s) repeat the previous one, time stamp and every value (a "
+                        "sample written twice): dropped")
         steps = np.diff(t)
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
@@ -595,15 +595,17 @@ def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     raw = {kind: filled(kind, x) for kind, x in raw.items()}
     named = "; ".join(f"{kind} of joint{'s' if len(c) > 1 else ''} {', '.join(str(j + 1) for j in c)}"
                       for kind, c in holes.items() if c)
-    dropped = f"; {a} row(s) before every signal started and {len(whole) - b} after one stopped dropped" if a or b < len(whole) else ""
-    warnings.append(f"{spec.name}: {count} missing value(s) (empty or NaN fields) in {named}: filled by interpolation in "
-                    f"time between each column's own values (gaps = \"{spec.gaps}\" in {table}; \"refuse\" refuses "
+    after = len(whole) - b
+    dropped = f"; {a} row(s) before every signal started and {after} after one stopped dropped" if a or after else ""
+    warnings.append(f"{spec.name}: {count} missing value(s) (empty or NaN fields) in {named}: filled by interpolation "
+                    f"in time between each column's own values (gaps = \"{spec.gaps}\" in {table}; \"refuse\" refuses "
                     f"them){dropped}")
     return t, raw, where
 
 
 def _check_missing(spec: DatasetSpec, t, gone: np.ndarray, what: str, where, table: str) -> None:
-    """Refuse a column's missing values where ``spec.gaps`` does not fill them (:func:`_filled`), naming the longest run."""
+    """Refuse a column's missing values where ``spec.gaps`` does not fill them (:func:`_filled`), naming the longest
+    run."""
     edges = np.diff(np.concatenate([[0], gone.astype(np.int8), [0]]))
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     i = int(np.argmax(stops - starts))
@@ -615,8 +617,8 @@ def _check_missing(spec: DatasetSpec, t, gone: np.ndarray, what: str, where, tab
                         f"filling it; \"auto\" fills up to {AUTO_GAP_SAMPLES} in a row by interpolation")
     if spec.gaps == "auto" and n > AUTO_GAP_SAMPLES:
         raise DataError(f"{place}: {what} are missing for {n} rows in a row ({span:.3g} s), more than the "
-                        f"{AUTO_GAP_SAMPLES} dynid fills by itself; set gaps = \"interpolate\" in {table} to fill up to "
-                        f"max_gap = {spec.max_gap:g} s, or select rows without it")
+                        f"{AUTO_GAP_SAMPLES} dynid fills by itself; set gaps = \"interpolate\" in {table} to fill up "
+                        f"to max_gap = {spec.max_gap:g} s, or select rows without it")
     if spec.gaps == "interpolate" and span > spec.max_gap:
         raise DataError(f"{place}: {what} are missing for {span:.3g} s ({n} rows), longer than max_gap = "
                         f"{spec.max_gap:g} s in {table}; select rows without it, or raise max_gap")
@@ -631,7 +633,8 @@ def _in_time_range(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
         raise DataError(f"{spec.name}: time_range [{start:g}, {stop:g}] s holds fewer than 2 samples of the "
                         f"{t[-1] - t[0]:.3f} s recording")
     if stop > t[-1] - t[0] + 1.0 / (spec.rate or 1.0 / float(np.median(np.diff(t)))):
-        warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at {t[-1] - t[0]:.3f} s")
+        warnings.append(f"{spec.name}: time_range ends at {stop:g} s, after the recording's end at "
+                        f"{t[-1] - t[0]:.3f} s")
     first = int(np.argmax(inside))
     t, raw = t[inside], {kind: select_rows(x, inside) for kind, x in raw.items()}
     if where is not None:
@@ -791,8 +794,8 @@ def unwrapped_positions(x, name: str, warnings: list[str]):
         out = np.column_stack([unwrap(np.asarray(x[:, j], dtype=float), j) for j in range(x.shape[1])])
     if not said:
         return x
-    warnings.append(f"{name}: positions jump by a whole turn (2π) between two samples, an angle logged within one turn: "
-                    f"taken back so that they run on ({'; '.join(said)})")
+    warnings.append(f"{name}: positions jump by a whole turn (2π) between two samples, an angle logged within one "
+                    f"turn: taken back so that they run on ({'; '.join(said)})")
     return out
 
 

@@ -321,7 +321,8 @@ def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], deli
                 try:
                     block[k, i] = np.nan if missing and not text else float(text)
                 except ValueError:
-                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {text!r}") from None
+                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, "
+                                    f"got {text!r}") from None
     bad = np.isinf(block) if missing else ~np.isfinite(block)
     if bad.any():
         k, c = np.argwhere(bad)[0]
