@@ -133,3 +133,31 @@ def unit_of(name: str) -> str:
     """
     term, _ = split_name(name)
     return friction.TERMS[term].unit if term in friction.TERMS else UNITS.get(term, "")
+
+
+TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+"""Units of a log's time column (``time = { column = ..., unit = "ns" }``), in seconds."""
+
+CONTROLLER_STEPS: tuple[float, float] = (1e-4, 0.2)
+"""[s] The time steps robot controllers log at (10 kHz to 5 Hz)."""
+
+
+def time_unit_of(step: float) -> str | None:
+    """The unit of time stamps whose median step, read as seconds, is ``step``: the one that makes it a controller's
+    step (:data:`CONTROLLER_STEPS`), or None where seconds do or no unit does.
+
+    Parameters
+    ----------
+    step : float
+        Median step of the time stamps as read.
+
+    Returns
+    -------
+    str or None
+        A key of :data:`TIME_UNITS` other than "s".
+    """
+    low, high = CONTROLLER_STEPS
+    if low <= step <= high:
+        return None
+    return next((u for u, f in TIME_UNITS.items() if f < 1.0 and low <= step * f <= high), None)
+

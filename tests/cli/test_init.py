@@ -160,7 +160,7 @@ def test_init_names_the_patterns_it_accepts(tmp_path):
     odd.write_text("__time,a,b\n1,2,3\n4,5,6\n")
     assert_refused(run("init", str(URDF), str(odd), "--out", str(tmp_path / "x.toml")),
                    "odd.csv: found 0 positions column(s) of the 6 the robot needs among ['__time', 'a', 'b']; accepted: t, "
-                   "time, timestamp or __time")
+                   "time, timestamp, __time or %time")
     assert not (tmp_path / "x.toml").exists()
 
 
@@ -223,3 +223,25 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     p = run(*command[1:])
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "arm-identified.urdf").is_file()
+
+
+def test_init_reads_a_rostopic_export_with_nanosecond_time_stamps(tmp_path):
+    """`rostopic echo -p /joint_states` writes %time in nanoseconds since the epoch, the joint names as text and
+    field.position0…: init takes %time with unit = "ns" (it took field.header.stamp as seconds, and identify refused
+    the config it wrote: "are they in milliseconds?"), and identify runs on the config as written."""
+    import json
+
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=5)
+    stamps = np.round((1.6e9 + sim.t) * 1e9).astype(np.int64)
+    header = (["%time", "field.header.seq", "field.header.stamp"] + [f"field.name{j}" for j in range(6)]
+              + [f"field.position{j}" for j in range(6)] + [f"field.effort{j}" for j in range(6)])
+    rows = [",".join([str(s), str(k), str(s)] + [f"joint_{j}" for j in range(6)] + [f"{x:.9g}" for x in (*q, *tau)])
+            for k, (s, q, tau) in enumerate(zip(stamps, sim.q, sim.tau))]
+    (tmp_path / "js.csv").write_text("\n".join([",".join(header), *rows]) + "\n")
+    p = run("init", str(URDF), str(tmp_path / "js.csv"), "--out", str(tmp_path / "ros.toml"))
+    assert p.returncode == 0, p.stderr
+    assert 'time = { column = "%time", unit = "ns" }' in (tmp_path / "ros.toml").read_text()
+    p = run("identify", str(tmp_path / "ros.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "id" / "results.json").read_text())
+    assert abs(results["settings"]["rate"] - 1.0 / float(np.median(np.diff(sim.t)))) < 1e-2 * results["settings"]["rate"]

@@ -334,3 +334,29 @@ def test_signals_of_other_rates_are_filled_in_time_and_long_holes_refused(tmp_pa
     with pytest.raises(DataError, match=r"merged.csv: line 8: joint 1's currents are missing .*gaps = \"refuse\""):
         load_recording(dataset_spec({"preset": "ur-rtde", "file": "merged.csv", "gaps": "refuse"}, tmp_path, "cfg",
                                     "ident", 6), robot)
+
+
+@pytest.mark.parametrize("unit, factor", [("ms", 1e3), ("us", 1e6), ("ns", 1e9)])
+def test_time_stamps_in_another_unit_are_named_and_read_with_it(tmp_path, unit, factor):
+    """Time stamps in ms, µs or ns (ROS's are ns since the epoch): refused as seconds with the unit they look like and
+    the setting; read with time = { ..., unit = ... } they give the recording in seconds."""
+    t = np.arange(300) * 0.008
+    q = 0.1 * np.sin(np.outer(t, np.arange(1, 7)))
+    stamps = (1.7e9 + t) * factor if unit == "ns" else t * factor
+    header = "t," + ",".join(f"q{j}" for j in range(1, 7)) + "," + ",".join(f"i{j}" for j in range(1, 7))
+    np.savetxt(tmp_path / "log.csv", np.column_stack([stamps, q, np.ones_like(q)]), delimiter=",", header=header,
+               comments="", fmt="%.17g")
+    table = {"file": "log.csv", "header": True, "time": {"column": "t"},
+             "positions": {"columns": [f"q{j}" for j in range(1, 7)]},
+             "currents": {"columns": [f"i{j}" for j in range(1, 7)]}}
+    robot = load_robot("ur10e")
+    with pytest.raises(DataError, match=rf"log.csv: the time stamps step by .* they look like {unit} \(time = \{{ \.\.\., "
+                                        rf"unit = \"{unit}\" \}}\)"):
+        load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), robot)
+    table["time"] = {"column": "t", "unit": unit}
+    rec = load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), robot)
+    assert rec.n_samples == 300 and abs(rec.rate - 125.0) < 0.01  # ns since the epoch: float64 keeps 0.25 µs
+    if unit == "ns":  # resampled onto a grid of its 0.25 µs steps: the motion at the grid's times
+        np.testing.assert_allclose(np.asarray(rec.q), 0.1 * np.sin(np.outer(rec.t, np.arange(1, 7))), atol=5e-5)
+    else:
+        np.testing.assert_allclose(np.asarray(rec.q), q, atol=1e-12)

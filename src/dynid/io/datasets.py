@@ -12,7 +12,7 @@ A dataset is described by a table of the experiment config (TOML)::
     gaps = "auto"                    # a time step over 5x the median: "auto" (default: fill up to 20 samples),
                                      # "refuse" or "interpolate" (up to max_gap); empty or NaN
                                      # fields of a signal are filled or refused alike
-    time = { column = 1 }            # time stamps [s] …
+    time = { column = 1 }            # time stamps [s] (unit = "ms", "us" or "ns" otherwise) …
     rate = 5000.0                    # … or a sampling rate [Hz] when there is no time column
     resample = 100.0                 # Hz: uniform grid for jittered time stamps (default: 1/median step)
     side = "joint"                   # "joint" or "motor" (motor-side values go through the transmission)
@@ -48,6 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from ..column_store import SPOOL_BYTES, StoredColumns, by_column, select_rows
+from ..conventions import TIME_UNITS, time_unit_of
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
@@ -396,7 +397,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         raise ConfigError(f"{where}: expected 'positions' (columns of the joint or motor angles)")
     if ("currents" in signals) == ("torques" in signals):
         raise ConfigError(f"{where}: expected exactly one of 'currents' (with drive gains) or 'torques'")
-    time = None if t.time is None else SignalSpec(path_of(t.time.file, f"{where}.time"), (t.time.column,), 1.0)
+    time = None if t.time is None else SignalSpec(path_of(t.time.file, f"{where}.time"), (t.time.column,),
+                                                  TIME_UNITS[t.time.unit or "s"])
     if (time is None) == (t.rate is None):
         raise ConfigError(f"{where}: expected either a 'time' column or a sampling 'rate' [Hz]")
     return DatasetSpec(
@@ -692,9 +694,12 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
     if timed and spec.resample is None and rate < MIN_RATE:
-        raise DataError(f"{q_source}: the time stamps step by {1 / rate:.4g} s ({rate:.4g} Hz), slower than any robot "
-                        f"controller logs (at least {MIN_RATE:g} Hz): are they in milliseconds? dynid reads seconds; "
-                        f"give rate (Hz) in {table} instead of the time column, or write the time stamps in seconds")
+        step = 1.0 / rate
+        unit = time_unit_of(step)
+        guess = f"they look like {unit} (time = {{ ..., unit = \"{unit}\" }})" if unit else "another unit?"
+        raise DataError(f"{q_source}: the time stamps step by {step:.4g} s ({rate:.4g} Hz), slower than any robot "
+                        f"controller logs (at least {MIN_RATE:g} Hz): {guess}; dynid reads seconds unless the time "
+                        f"column's unit says otherwise, or give rate (Hz) in {table} instead of the time column")
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission

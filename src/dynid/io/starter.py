@@ -17,11 +17,12 @@ import os
 import re
 from pathlib import Path
 
+from ..conventions import time_unit_of
 from ..exceptions import ConfigError, DataError
 from .files import text_encoding_hint
 
 PATTERNS = {
-    "time": r"_*(t|time|times?tamp|stamp|sec|seconds)",
+    "time": r"[_%]*(t|time|times?tamp|stamp|sec|seconds)",
     "positions": r"(q|pos|position|positions|angle|joint_?pos|actual_q)",
     "velocities": r"(dq|qd|qdot|vel|velocity|velocities|actual_qd)",
     "torques": r"(tau|torque|torques|effort|moment|target_moment)",
@@ -30,8 +31,8 @@ PATTERNS = {
 """Header-name stems of each signal (case-insensitive, followed by an optional separator and joint number)."""
 
 
-ACCEPTED = ("t, time, timestamp or __time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… or i1…; "
-            "or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
+ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
+            "or i1…; or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
 """The header patterns init accepts, named in its refusals."""
 
 _SEPARATORS = r"[\s/._\-\[\]()]"
@@ -157,7 +158,11 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             raise DataError(f"{log}: found {len(found.get(missing[0], []))} {missing[0]} column(s) of the {n_dof} the robot "
                             f"needs among {_shown(first)}; accepted: {ACCEPTED}")
         notes += order_notes
-        table += ["header = true", f'time = {{ column = "{found["time"][0]}" }}']
+        unit = _time_unit([split(line) for line in lines[1:]], first.index(found["time"][0]))
+        table += ["header = true", f'time = {{ column = "{found["time"][0]}"'
+                  + (f', unit = "{unit}" }}' if unit else " }")]
+        if unit:
+            notes.append(f"time stamps: {found['time'][0]} steps as a controller's in {unit}: unit = \"{unit}\"")
         taken = [found["time"][0]]
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
@@ -208,6 +213,18 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
         '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
         "",
     ])
+
+
+def _time_unit(rows: list[list[str]], column: int) -> str | None:
+    """The unit of a log's time column from its first rows (:func:`dynid.conventions.time_unit_of`)."""
+    values = []
+    for fields in rows:
+        try:
+            values.append(float(fields[column]))
+        except (ValueError, IndexError):
+            continue
+    steps = sorted(b - a for a, b in zip(values, values[1:]) if b > a)
+    return time_unit_of(steps[len(steps) // 2]) if steps else None
 
 
 def _shown(columns: list[str], most: int = 12) -> str:
