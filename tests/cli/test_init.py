@@ -244,4 +244,20 @@ def test_init_reads_a_rostopic_export_with_nanosecond_time_stamps(tmp_path):
     p = run("identify", str(tmp_path / "ros.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     results = json.loads((tmp_path / "id" / "results.json").read_text())
-    assert abs(results["settings"]["rate"] - 1.0 / float(np.median(np.diff(sim.t)))) < 1e-2 * results["settings"]["rate"]
+    rate = results["settings"]["rate"]
+    assert abs(rate - 1.0 / float(np.median(np.diff(sim.t)))) < 1e-2 * rate
+
+
+def test_init_reads_a_log_saved_by_numpy_with_its_header_as_a_comment(tmp_path):
+    """np.savetxt(..., header="time,q1,…") writes "# time,q1,…": init found "no time column among ['# time', …]" and
+    identify "no column named 'time'"; both now take the comment as the header, and identify runs on the config."""
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=6)
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    np.savetxt(tmp_path / "run.csv", np.column_stack([sim.t, sim.q, sim.tau]), delimiter=",", header=",".join(names))
+    assert (tmp_path / "run.csv").read_text().startswith("# time,q1")
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), "--out", str(tmp_path / "np.toml"))
+    assert p.returncode == 0, p.stderr
+    assert 'time = { column = "time" }' in (tmp_path / "np.toml").read_text()
+    p = run("identify", str(tmp_path / "np.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "id" / "results.json").is_file()

@@ -350,8 +350,8 @@ def test_time_stamps_in_another_unit_are_named_and_read_with_it(tmp_path, unit, 
              "positions": {"columns": [f"q{j}" for j in range(1, 7)]},
              "currents": {"columns": [f"i{j}" for j in range(1, 7)]}}
     robot = load_robot("ur10e")
-    with pytest.raises(DataError, match=rf"log.csv: the time stamps step by .* they look like {unit} \(time = \{{ \.\.\., "
-                                        rf"unit = \"{unit}\" \}}\)"):
+    with pytest.raises(DataError, match=rf"log.csv: the time stamps step by .* they look like {unit} "
+                                        rf"\(time = \{{ \.\.\., unit = \"{unit}\" \}}\)"):
         load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), robot)
     table["time"] = {"column": "t", "unit": unit}
     rec = load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), robot)

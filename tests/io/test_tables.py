@@ -153,3 +153,20 @@ def test_missing_values_are_read_as_nan_where_asked(tmp_path, reader):
                           ("1,2,3\n4,x,6\n", r"line 2, column 2: expected a number, got 'x'")):
         with pytest.raises(DataError, match=message):
             read_table(_write(tmp_path, text), [1, 2, 3], missing=True)
+
+
+def test_comment_lines_and_a_header_written_as_one(tmp_path, reader):
+    """NumPy's savetxt(header=...) writes the header as a comment ("# t,a,b"): its names are the columns'; comment
+    lines before a header or before headerless data are skipped; a message names the line in the file as counted
+    with them. ("no column named 't' in the header (found # t, a, b)" before.)"""
+    rows = "".join(f"{i},{2 * i},{3 * i}\n" for i in range(5))
+    p = _write(tmp_path, "# t,a,b\n" + rows)
+    np.testing.assert_array_equal(read_table(p, ["b", "t"], header=True).data, [[3 * i, i] for i in range(5)])
+    p = _write(tmp_path, "# logged by a tool\n#   on a day\nt,a,b\n" + rows)
+    tb = read_table(p, ["a"], header=True)
+    np.testing.assert_array_equal(tb.data[:, 0], 2 * np.arange(5))
+    assert tb.first_line == 4
+    p = _write(tmp_path, "# logged by a tool\n" + rows)
+    np.testing.assert_array_equal(read_table(p, [1, 3]).data, [[i, 3 * i] for i in range(5)])
+    with pytest.raises(DataError, match=r"log.csv: line 5, column 2: expected a number, got 'x'"):
+        read_table(_write(tmp_path, "# t,a,b\n1,2,3\n4,5,6\n7,8,9\n1,x,3\n"), ["a"], header=True)

@@ -55,11 +55,12 @@ class SignalTable(Table, kw_only=True):
 
 
 class TimeTable(Table, kw_only=True):
-    """The time stamps' column: ``time = { column = 1 }`` (seconds), ``time = { column = "%time", unit = "ns" }``."""
+    """The time stamps' column: ``time = { column = 1 }`` (seconds), ``{ column = "%time", unit = "ns" }``."""
 
     column: Annotated[Column, _d("1-based number or header name of the time stamps")]
     file: Annotated[str, _d("the file (default: the dataset's file)")] | None = None
-    unit: Annotated[Literal["s", "ms", "us", "ns"], _d("the time stamps' unit: s (default), ms, us or ns")] | None = None
+    unit: Annotated[Literal["s", "ms", "us", "ns"],
+                    _d("the time stamps' unit: s (default), ms, us or ns")] | None = None
 
 
 class DatasetTable(Table, kw_only=True):

@@ -20,6 +20,7 @@ from pathlib import Path
 from ..conventions import time_unit_of
 from ..exceptions import ConfigError, DataError
 from .files import text_encoding_hint
+from .tables import is_data_line
 
 PATTERNS = {
     "time": r"[_%]*(t|time|times?tamp|stamp|sec|seconds)",
@@ -32,7 +33,8 @@ PATTERNS = {
 
 
 ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
-            "or i1…; or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
+            "or i1…; or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, "
+            "<joint>.effort")
 """The header patterns init accepts, named in its refusals."""
 
 _SEPARATORS = r"[\s/._\-\[\]()]"
@@ -122,15 +124,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
         return _config(urdf, log, out, validation, table, said), said
-    try:
-        lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
-    except UnicodeDecodeError:
-        raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None
-    except OSError as exc:
-        raise DataError(f"{log}: cannot read it ({exc.strerror or exc})") from None
-    if len(lines) < 2:
-        raise DataError(f"{log}: fewer than two lines: not a log")
-    delimiter = max((",", ";", "\t", " "), key=lambda d: lines[1].count(d))
+    lines, delimiter = _first_lines(log)
     split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
     first = split(lines[0])
     header = not all(_number(c) for c in first)
@@ -213,6 +207,25 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
         '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
         "",
     ])
+
+
+def _first_lines(log: Path) -> tuple[list[str], str]:
+    """A text log's first non-blank lines from its header (or first data line) on, and its delimiter: comment lines
+    (``#`` first) left out, a header written as one (NumPy's ``# t,q1,…``) taken as the header."""
+    try:
+        lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
+    except UnicodeDecodeError:
+        raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None
+    except OSError as exc:
+        raise DataError(f"{log}: cannot read it ({exc.strerror or exc})") from None
+    comments = next((k for k, line in enumerate(lines) if not line.lstrip().startswith("#")), len(lines))
+    if len(lines) - comments < 2:
+        raise DataError(f"{log}: fewer than two lines: not a log")
+    delimiter = max((",", ";", "\t", " "), key=lambda d: lines[comments + 1].count(d))
+    if comments and is_data_line(lines[comments], delimiter):
+        comments -= 1
+        lines[comments] = lines[comments].lstrip()[1:].strip()
+    return lines[comments:], delimiter
 
 
 def _time_unit(rows: list[list[str]], column: int) -> str | None:

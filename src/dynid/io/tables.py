@@ -54,6 +54,64 @@ class Table:
     warnings: tuple[str, ...] = ()
 
 
+def table_head(fh, delimiter: str, header: bool) -> tuple[str | None, int]:
+    """Read a table's head: its comment lines (``#`` first) and its header line, leaving ``fh`` at the first data line.
+
+    A header written as a comment (NumPy's ``savetxt(header=...)`` writes ``# t,q1,…``) is the last comment line
+    right before the data.
+
+    Parameters
+    ----------
+    fh : text file
+        At its start; seekable.
+    delimiter : str
+    header : bool
+        Whether the table has a header line.
+
+    Returns
+    -------
+    header : str or None
+        The header's text (without ``#``), None without a header or in an empty file.
+    lines : int
+        The lines read before the first data line.
+    """
+    comments, lines = [], 0
+    while True:
+        at = fh.tell()
+        line = fh.readline()
+        if not line.lstrip().startswith("#"):
+            break
+        comments.append(line.lstrip()[1:])
+        lines += 1
+    if not header:
+        fh.seek(at)
+        return None, lines
+    if comments and is_data_line(line, delimiter):
+        fh.seek(at)
+        return comments[-1], lines
+    return (line or None), lines + 1
+
+
+def is_data_line(line: str, delimiter: str) -> bool:
+    """Whether a table's line is data (its first field a number) rather than a header.
+
+    Parameters
+    ----------
+    line : str
+    delimiter : str
+
+    Returns
+    -------
+    bool
+    """
+    fields = line.split() if delimiter == " " else line.split(delimiter)
+    try:
+        float(fields[0])
+    except (ValueError, IndexError):
+        return False
+    return True
+
+
 def _split_header(line: str, delimiter: str) -> list[str]:
     return [f.strip().strip('"') for f in line.rstrip("\r\n").split(delimiter)]
 
@@ -147,12 +205,11 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     expected = n_columns
     first_line = None
     with open(path, encoding="utf-8", errors="replace", newline="") as fh:
+        head, line_no = table_head(fh, delimiter, header)
         if header:
-            line = fh.readline()
-            line_no = 1
-            if not line:
+            if head is None:
                 raise DataError(f"{path}: empty file, expected a header line")
-            names = _split_header(line, delimiter)
+            names = _split_header(head, delimiter)
         cols = resolve_columns(path, columns, names)
         pending: list[str] = []
         pending_start = None
@@ -213,6 +270,9 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
         return None
     first, last = rows
     with open(path, "rb") as fh:  # lines up to the first data line, by "\n" as pyarrow and the line reader count them
+        if fh.read(1) == b"#":  # comment lines, or a header written as one: the line reader
+            return None
+        fh.seek(0)
         head = [fh.readline() for _ in range(int(header) + first - 1)]
         offset = fh.tell()
         line = fh.readline()  # the first data line: its fields are the file's
