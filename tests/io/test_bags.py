@@ -60,3 +60,25 @@ def test_bag_errors_name_the_bag_topic_and_joint(tmp_path):
         dataset_spec({"bag": "bag", "joint_names": ["a"]}, tmp_path, "cfg", "ident", 6)
     names = dataset_spec({"bag": "bag", "joint_names": list("abcdef")}, tmp_path, "cfg", "ident", 6)
     assert load_recording(names, robot).n_samples == 5
+
+
+def test_a_bag_with_missing_efforts_is_filled_as_a_log_is(tmp_path):
+    """A driver that publishes NaN for an effort it has not read yet, and NaN velocities: the efforts are filled by
+    interpolation in time as a log's empty fields are (were refused: "NaN or infinite torques"), the velocities derived
+    from the positions; a long hole is refused naming the message."""
+    robot = load_robot("ur10e")
+    names = [j.name for j in robot.joints]
+    t = 100.0 + np.arange(200) * 0.008
+    q = np.outer(np.sin(t), np.arange(1, 7) * 0.1)
+    tau = np.outer(1.0 + t - t[0], np.arange(1, 7))  # linear: interpolation gives it back exactly
+    effort = tau.copy()
+    effort[[0, 1, 50, 51, 52], 2] = np.nan
+    _write_bag(tmp_path / "bag", t, names, q, np.full_like(q, np.nan), effort)
+    rec = load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg", "ident", 6), robot)
+    assert rec.dq is None and rec.n_samples == 198  # the first two messages, before J3's effort, dropped
+    np.testing.assert_allclose(rec.tau, tau[2:], atol=1e-9)
+    assert any("3 missing value(s) (empty or NaN fields) in torques of joint 3" in w for w in rec.warnings)
+    effort[60:100, 4] = np.nan
+    _write_bag(tmp_path / "hole", t, names, q, np.zeros_like(q), effort)
+    with pytest.raises(DataError, match=r"hole: message 61 on /joint_states: joint 5's torques are missing for 40 rows"):
+        load_recording(dataset_spec({"bag": "hole"}, tmp_path, "cfg", "ident", 6), robot)

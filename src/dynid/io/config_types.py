@@ -76,9 +76,10 @@ class DatasetTable(Table, kw_only=True):
                                                            description="[first, last] 1-based inclusive data rows")] | None = None
     time_range: Annotated[list[float], Meta(min_length=2, max_length=2,
                                             description="[start, stop] s from the first row read")] | None = None
-    gaps: Annotated[Literal["auto", "refuse", "interpolate"], _d("a time step over 5x the median: auto (default: filled "
-                                                                 "when at most 20 samples, refused when longer), refuse, "
-                                                                 "or interpolate (up to max_gap)")] | None = None
+    gaps: Annotated[Literal["auto", "refuse", "interpolate"], _d("a time step over 5x the median, or missing values "
+                                                                 "(empty or NaN fields): auto (default: filled when at "
+                                                                 "most 20 samples, refused when longer), refuse, or "
+                                                                 "interpolate (up to max_gap)")] | None = None
     max_gap: Annotated[float, Meta(gt=0, description="s: the longest gap interpolated (default 0.1)")] | None = None
     held: Annotated[Literal["interpolate", "keep"], _d("rows repeating the previous one exactly: interpolate (default) or keep")] | None = None
     time: Annotated[TimeTable, _d("the time stamps' column")] | None = None
