@@ -360,3 +360,24 @@ def test_time_stamps_in_another_unit_are_named_and_read_with_it(tmp_path, unit, 
         np.testing.assert_allclose(np.asarray(rec.q), 0.1 * np.sin(np.outer(rec.t, np.arange(1, 7))), atol=5e-5)
     else:
         np.testing.assert_allclose(np.asarray(rec.q), q, atol=1e-12)
+
+
+def test_signals_of_two_topics_in_alternate_rows_are_filled_in_time(tmp_path):
+    """PlotJuggler's CSV of two topics published in turn: each row holds one topic's fields, the other's empty. No
+    row holds every signal (that was refused as "no two rows hold every signal"); from the row where both have
+    started to the one where the first stops, each column is filled between its own values (linear: exactly)."""
+    t = np.arange(201) * 0.004
+    q = np.outer(0.1 + t, np.arange(1, 7) * 0.1)
+    cur = np.outer(1.0 + t, np.arange(1, 7))
+    header = ["__time"] + [f"/joint_states/position[{j}]" for j in range(6)] + [f"/currents/data[{j}]" for j in range(6)]
+    rows = [",".join([f"{tk:.6f}"] + ([f"{x:.9g}" for x in q[k]] + [""] * 6 if k % 2 == 0 else
+                                      [""] * 6 + [f"{x:.9g}" for x in cur[k]])) for k, tk in enumerate(t)]
+    (tmp_path / "pj.csv").write_text("\n".join([",".join(header), *rows]) + "\n")
+    table = {"file": "pj.csv", "header": True, "time": {"column": "__time"},
+             "positions": {"columns": header[1:7]}, "currents": {"columns": header[7:]}}
+    robot = load_robot("ur10e")
+    rec = load_recording(dataset_spec(table, tmp_path, "cfg", "ident", 6), robot)
+    assert rec.n_samples == 199  # rows 1-199: the currents start at row 1, the positions stop at row 200
+    np.testing.assert_allclose(np.asarray(rec.q), q[1:200] + robot.transmission.position_offset, atol=1e-8)
+    np.testing.assert_allclose(np.asarray(rec.tau), cur[1:200] * robot.drive_gains, rtol=1e-8)
+    assert any("1 row(s) before every signal started and 1 after one stopped dropped" in w for w in rec.warnings)

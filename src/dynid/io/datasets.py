@@ -563,21 +563,22 @@ def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     if not any(holes.values()):
         return t, raw, where
     table = spec.table or spec.name
-    whole = np.ones(t.shape[0], dtype=bool)  # rows that hold every signal
+    n, a, b = t.shape[0], 0, t.shape[0]  # from the row where every signal has started to the one after the first stops
     for kind, columns in holes.items():
         for j in columns:
-            whole &= ~np.isnan(raw[kind][:, j])
-    kept = np.flatnonzero(whole)
-    if kept.size < 2:
-        raise DataError(f"{spec.name}: no two rows hold every signal (empty or NaN fields): are the columns right?")
-    a, b = int(kept[0]), int(kept[-1]) + 1
-    if a or b < t.shape[0]:
-        t, raw = t[a:b], {kind: x[a:b] for kind, x in raw.items()}
-        where = where if where is None or not a else (lambda w, f: (lambda k: w(k + f)))(where, a)
+            held = np.flatnonzero(~np.isnan(raw[kind][:, j]))
+            if held.size < 2:
+                raise DataError(f"{spec.name}: joint {j + 1}'s {kind} hold {held.size} value(s), the rest empty or NaN: "
+                                "are the columns right?")
+            a, b = max(a, int(held[0])), min(b, int(held[-1]) + 1)
+    if b - a < 2:
+        raise DataError(f"{spec.name}: the signals' values do not overlap in time (empty or NaN fields elsewhere): are "
+                        "the columns right?")
     count = 0
     for kind, columns in holes.items():
         for j in columns:
             gone = np.isnan(raw[kind][:, j])
+            gone[:a], gone[b:] = False, False  # rows dropped: not filled
             count += int(gone.sum())
             _check_missing(spec, t, gone, f"joint {j + 1}'s {kind}", where, table)
 
@@ -594,10 +595,13 @@ def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
             return x.map_columns(lambda column, j: fill(column, j, kind))
         return np.column_stack([fill(np.asarray(x[:, j]), j, kind) for j in range(x.shape[1])])
 
-    raw = {kind: filled(kind, x) for kind, x in raw.items()}
+    raw = {kind: filled(kind, x) for kind, x in raw.items()}  # between the values either side, then the rows kept
+    if a or b < n:
+        t, raw = t[a:b], {kind: x[a:b] for kind, x in raw.items()}
+        where = where if where is None or not a else (lambda w, f: (lambda k: w(k + f)))(where, a)
     named = "; ".join(f"{kind} of joint{'s' if len(c) > 1 else ''} {', '.join(str(j + 1) for j in c)}"
                       for kind, c in holes.items() if c)
-    after = len(whole) - b
+    after = n - b
     dropped = f"; {a} row(s) before every signal started and {after} after one stopped dropped" if a or after else ""
     warnings.append(f"{spec.name}: {count} missing value(s) (empty or NaN fields) in {named}: filled by interpolation "
                     f"in time between each column's own values (gaps = \"{spec.gaps}\" in {table}; \"refuse\" refuses "
@@ -608,6 +612,8 @@ def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
 def _check_missing(spec: DatasetSpec, t, gone: np.ndarray, what: str, where, table: str) -> None:
     """Refuse a column's missing values where ``spec.gaps`` does not fill them (:func:`_filled`), naming the longest
     run."""
+    if not gone.any():
+        return
     edges = np.diff(np.concatenate([[0], gone.astype(np.int8), [0]]))
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     i = int(np.argmax(stops - starts))
