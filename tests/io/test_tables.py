@@ -170,3 +170,13 @@ def test_comment_lines_and_a_header_written_as_one(tmp_path, reader):
     np.testing.assert_array_equal(read_table(p, [1, 3]).data, [[i, 3 * i] for i in range(5)])
     with pytest.raises(DataError, match=r"log.csv: line 5, column 2: expected a number, got 'x'"):
         read_table(_write(tmp_path, "# t,a,b\n1,2,3\n4,5,6\n7,8,9\n1,x,3\n"), ["a"], header=True)
+
+
+def test_a_decimal_comma_is_named(tmp_path, reader):
+    """A spreadsheet's export in a European locale (semicolons, decimal commas): the refusal says what to change."""
+    p = _write(tmp_path, "1;2,5;3\n4;5,5;6\n")
+    with pytest.raises(DataError, match=r"line 1, column 2: expected a number, got '2,5' \(a decimal comma\? dynid "
+                                        r"reads a decimal point"):
+        read_table(p, [1, 2, 3], delimiter=";")
+    with pytest.raises(DataError, match=r"expected a number, got 'x'$"):
+        read_table(_write(tmp_path, "1;2;3\n4;x;6\n"), [1, 2, 3], delimiter=";")

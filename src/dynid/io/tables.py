@@ -14,6 +14,7 @@ sends the file to the line reader, which reads it, or refuses it with its messag
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -368,6 +369,10 @@ def _stack(blocks: list[np.ndarray]) -> np.ndarray:
     return data
 
 
+_DECIMAL_COMMA = re.compile(r"[+-]?\d*,\d+([eE][+-]?\d+)?")
+"""A number written with a decimal comma (a spreadsheet's export in a European locale): ``-0,0131``."""
+
+
 def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str,
                  missing: bool = False) -> np.ndarray:
     try:
@@ -381,8 +386,10 @@ def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], deli
                 try:
                     block[k, i] = np.nan if missing and not text else float(text)
                 except ValueError:
-                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, "
-                                    f"got {text!r}") from None
+                    comma = _DECIMAL_COMMA.fullmatch(text) is not None
+                    raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {text!r}"
+                                    + (" (a decimal comma? dynid reads a decimal point: save the log with '.' as the "
+                                       "decimal separator)" if comma else "")) from None
     bad = np.isinf(block) if missing else ~np.isfinite(block)
     if bad.any():
         k, c = np.argwhere(bad)[0]
