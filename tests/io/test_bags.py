@@ -78,6 +78,8 @@ def test_a_bag_with_missing_efforts_is_filled_as_a_log_is(tmp_path):
     assert rec.dq is None and rec.n_samples == 198  # the first two messages, before J3's effort, dropped
     np.testing.assert_allclose(rec.tau, tau[2:], atol=1e-9)
     assert any("3 missing value(s) (empty or NaN fields) in torques of joint 3" in w for w in rec.warnings)
+    assert any("message 1 on /joint_states has NaN or infinite velocities: the bag's velocities are left out" in w
+               for w in rec.warnings)
     effort[60:100, 4] = np.nan
     _write_bag(tmp_path / "hole", t, names, q, np.zeros_like(q), effort)
     with pytest.raises(DataError, match=r"hole: message 61 on /joint_states: joint 5's torques are missing for 40 rows"):

@@ -16,7 +16,7 @@ from ..exceptions import DataError
 from ..extras import require
 
 
-def read_joint_states(spec, robot, name: str):
+def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None):
     """Time stamps and raw signals of a ROS 2 bag's JointState messages.
 
     Parameters
@@ -26,6 +26,8 @@ def read_joint_states(spec, robot, name: str):
     robot : Robot
     name : str
         The dataset, for errors.
+    warnings : list of str, optional
+        Gets a line where the velocities are left out for NaN values.
 
     Returns
     -------
@@ -78,8 +80,15 @@ def read_joint_states(spec, robot, name: str):
     if len(stamps) < 2:
         raise DataError(f"{path}: {len(stamps)} JointState message(s) on {spec.topic}, expected at least 2")
     signals: dict[str, np.ndarray] = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}
-    if all(v is not None and np.all(np.isfinite(v)) for v in vel):  # optional: else derived from the positions
-        signals["velocities"] = np.array(vel)
+    given = [v for v in vel if v is not None]
+    if len(given) == len(vel):  # optional: else derived from the positions
+        finite = [bool(np.all(np.isfinite(v))) for v in given]
+        if all(finite):
+            signals["velocities"] = np.array(given)
+        elif warnings is not None:
+            k = finite.index(False)
+            warnings.append(f"{name}: message {k + 1} on {spec.topic} has NaN or infinite velocities: the bag's "
+                            "velocities are left out and derived from the positions")
     for kind, x in signals.items():  # NaN: a missing value, filled or refused as the dataset's gaps say
         if np.isinf(x).any():
             k = int(np.argwhere(np.isinf(x))[0, 0])

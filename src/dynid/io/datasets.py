@@ -478,7 +478,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
     if spec.bag is not None:
         from .bags import read_joint_states
 
-        t, raw, where = read_joint_states(spec.bag, robot, spec.name)
+        t, raw, where = read_joint_states(spec.bag, robot, spec.name, warnings)
         return _assemble(spec, robot, t, raw, where, True, str(spec.bag.path), str(spec.bag.path), warnings)
     requests: dict[Path, list] = {}
     for s in list(spec.signals.values()) + ([spec.time] if spec.time else []):

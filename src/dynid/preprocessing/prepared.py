@@ -388,10 +388,9 @@ def _heads_beyond(x: np.ndarray, a: int, b: int, side: float, step: float) -> bo
     :data:`BEYOND_STEPS` steps: a clipped torque was heading further; a smooth peak read in steps stays within about a
     step of its top value."""
     level, m = x[a], 10 * (b - a)
-    near = np.abs(x - level) <= FLANK_STEPS * step * (1 + 1e-9)
 
-    def flank(index: np.ndarray) -> np.ndarray:
-        off = np.flatnonzero(~near[index])
+    def flank(index: np.ndarray) -> np.ndarray:  # judged on the samples within the flank's reach only
+        off = np.flatnonzero(np.abs(x[index] - level) > FLANK_STEPS * step * (1 + 1e-9))
         return index[:off[0]] if off.size else index
 
     before, after = flank(np.arange(a - 1, max(a - m, 0) - 1, -1)), flank(np.arange(b, min(b + m, x.shape[0])))
