@@ -52,8 +52,15 @@ def test_a_row_written_twice_is_dropped_and_said(tmp_path, spool):
     assert [w for w in twice.warnings if w not in once.warnings] == [
         "ident: 1 row(s) repeat the previous one, time stamp and every value (a sample written twice): dropped"]
     (tmp_path / "back.csv").write_text("".join(rows[:3] + rows[2:4] + rows[2:3] + rows[5:]))
-    with pytest.raises(DataError, match=r"back.csv: line 6: time stamps must increase, got time going back"):
+    with pytest.raises(DataError, match=r"back.csv: line 6: time stamps must increase, got time going back: "
+                                        r"0.02 s after 0.03 s$"):  # a glitch of the clock: no hint of two recordings
         load_recording(dataset_spec({"preset": "ur-rtde", "file": "back.csv"}, tmp_path, "cfg", "ident", 6), robot,
+                       spool=spool)
+    (tmp_path / "again.csv").write_text("".join(rows + rows))  # a second recording appended, its clock started again
+    with pytest.raises(DataError, match=r"again.csv: line 201: time stamps must increase, got time going back: 0 s after "
+                                        r"1.99 s; two recordings one after the other\? give each its own file, or select "
+                                        r"one with rows$"):
+        load_recording(dataset_spec({"preset": "ur-rtde", "file": "again.csv"}, tmp_path, "cfg", "ident", 6), robot,
                        spool=spool)
 
 

@@ -1,3 +1,6 @@
+import re
+import tomllib
+
 import numpy as np
 import pytest
 
@@ -180,3 +183,22 @@ def test_a_decimal_comma_is_named(tmp_path, reader):
         read_table(p, [1, 2, 3], delimiter=";")
     with pytest.raises(DataError, match=r"expected a number, got 'x'$"):
         read_table(_write(tmp_path, "1;2;3\n4;x;6\n"), [1, 2, 3], delimiter=";")
+
+
+@pytest.mark.parametrize(("separator", "setting"), [(";", 'delimiter = ";"'), ("\t", 'delimiter = "\\t"')])
+def test_another_separator_is_named_with_the_setting_that_reads_it(tmp_path, reader, separator, setting):
+    """A log whose fields are separated by semicolons or tabs: the refusal names the separator and the setting, written
+    as TOML reads it (a tab as "\\t"), and with that setting the same log is read."""
+    rows = [[float(i), 2.0 * i, 3.0 * i] for i in range(5)]
+    p = _write(tmp_path, "".join(separator.join(str(x) for x in r) + "\n" for r in rows))
+    with pytest.raises(DataError, match=re.escape(f"(fields separated by {separator!r}? dynid reads ',': give {setting} "
+                                                  "in the dataset's table)")):
+        read_table(p, [1, 2, 3], n_columns=3)
+    with pytest.raises(DataError, match=re.escape(f"column 3 requested but the lines have 1 columns (fields separated by "
+                                                  f"{separator!r}? dynid reads ','")):
+        read_table(p, [1, 2, 3])
+    named = _write(tmp_path, separator.join(("t", "a", "b")) + "\n" + p.read_text(), "named.csv")
+    with pytest.raises(DataError, match=re.escape(f"no column named 't' in the header (found t{separator}a{separator}b) "
+                                                  f"(fields separated by {separator!r}? dynid reads ','")):
+        read_table(named, ["t", "a"], header=True)
+    np.testing.assert_array_equal(read_table(p, [1, 2, 3], delimiter=tomllib.loads(setting)["delimiter"]).data, rows)

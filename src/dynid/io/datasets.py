@@ -246,6 +246,10 @@ AUTO_GAP_SAMPLES = 20
 """With ``gaps = "auto"`` (the default), gaps of at most this many samples are filled by interpolation (a logger
 that dropped a few packets), with a warning; a longer one is refused, naming the setting that fills it."""
 
+RESTART_STEPS = 100
+"""A time stamp this many typical steps before the one above it starts a second recording, not a glitch of the clock:
+the refusal says how to read each (:func:`_increasing`)."""
+
 HELD_SHARE = 0.05
 """A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
 
@@ -549,8 +553,11 @@ def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
         what = "a repeated time stamp" if t[i + 1] == t[i] else "time going back"
+        typical = float(np.median(steps[steps > 0])) if np.any(steps > 0) else 0.0
+        again = (t[i] - t[i + 1] > RESTART_STEPS * typical
+                 and "; two recordings one after the other? give each its own file, or select one with rows")
         raise DataError(f"{where(i + 1)}: time stamps must increase, got {what}: {float(t[i + 1]):.9g} s after "
-                        f"{float(t[i]):.9g} s")
+                        f"{float(t[i]):.9g} s{again or ''}")
     return t, raw, where
 
 

@@ -14,6 +14,7 @@ sends the file to the line reader, which reads it, or refuses it with its messag
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -117,7 +118,7 @@ def _split_header(line: str, delimiter: str) -> list[str]:
     return [f.strip().strip('"') for f in line.rstrip("\r\n").split(delimiter)]
 
 
-def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
+def resolve_columns(path: Path, columns, header: list[str] | None, delimiter: str = ",") -> list[int]:
     """0-based indices of columns given as 1-based numbers or header names.
 
     Parameters
@@ -126,6 +127,8 @@ def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
         The file, named in errors.
     columns : sequence of int or str
     header : list of str or None
+    delimiter : str
+        The field separator the header was split on, named in an error where the header is one field.
 
     Returns
     -------
@@ -142,7 +145,8 @@ def resolve_columns(path: Path, columns, header: list[str] | None) -> list[int]:
             if header is None:
                 raise DataError(f"{path}: column {c!r} is a name but the file has no header; give 1-based column numbers")
             if c not in header:
-                raise DataError(f"{path}: no column named {c!r} in the header (found {', '.join(header)})")
+                raise DataError(f"{path}: no column named {c!r} in the header (found {', '.join(header)})"
+                                + (_separator_hint(header[0], delimiter) if len(header) == 1 else ""))
             out.append(header.index(c))
         else:
             if int(c) < 1:
@@ -211,7 +215,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if head is None:
                 raise DataError(f"{path}: empty file, expected a header line")
             names = _split_header(head, delimiter)
-        cols = resolve_columns(path, columns, names)
+        cols = resolve_columns(path, columns, names, delimiter)
         pending: list[str] = []
         pending_start = None
         data_row = 0
@@ -242,7 +246,8 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if first_line is None:  # the first data line: the column map must fit it
                 expected = n_fields if expected is None else expected
                 if max(cols) >= expected:
-                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have {expected} columns")
+                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have {expected} columns"
+                                + (_separator_hint(line, delimiter) if n_fields == 1 else ""))
             if n_fields != expected:  # the truncated last line (a warning), or a mistake (refused)
                 _odd_line(path, line, line_no, n_fields, expected, delimiter, warnings)
                 break
@@ -280,7 +285,7 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
     if b"\r" in line or any(b"\r" in h or not h.strip() for h in head):  # other line ends, blank lines: the line reader
         return None
     names = _split_header(head[0].decode("utf-8", errors="replace"), delimiter) if header else None
-    cols = resolve_columns(path, columns, names)
+    cols = resolve_columns(path, columns, names, delimiter)
     fields = line.count(delimiter.encode()) + 1
     if not line.strip() or fields != (n_columns or fields) or max(cols) >= fields:
         return None
@@ -338,9 +343,15 @@ def _odd_line(path: Path, line: str, line_no: int, n_fields: int, expected: int 
     if not line.endswith("\n"):  # only the last line can lack a newline
         warnings.append(f"{path}: line {line_no} is truncated ({n_fields} of {expected} fields, no newline): skipped")
         return
-    other = next((d for d in (";", "\t", "|") if d != delimiter and d in line), None)
-    hint = f" (fields separated by {other!r}? dynid reads {delimiter!r})" if n_fields == 1 and other else ""
+    hint = _separator_hint(line, delimiter) if n_fields == 1 else ""
     raise DataError(f"{path}: line {line_no}: expected {expected} columns, got {n_fields}{hint}")
+
+
+def _separator_hint(line: str, delimiter: str) -> str:
+    """For a line read as one field: the separator it holds instead, and the setting that reads it ("" if none)."""
+    other = next((d for d in (";", "\t", "|") if d != delimiter and d in line), None)
+    return (f" (fields separated by {other!r}? dynid reads {delimiter!r}: give delimiter = {json.dumps(other)} in the "
+            "dataset's table)" if other else "")
 
 
 def _check_selection(path: Path, empty: bool, data_row: int, header: bool, rows, truncated: bool) -> None:
