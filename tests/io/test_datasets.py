@@ -388,3 +388,33 @@ def test_signals_of_two_topics_in_alternate_rows_are_filled_in_time(tmp_path):
     np.testing.assert_allclose(np.asarray(rec.q), q[1:200] + robot.transmission.position_offset, atol=1e-8)
     np.testing.assert_allclose(np.asarray(rec.tau), cur[1:200] * robot.drive_gains, rtol=1e-8)
     assert any("1 row(s) before every signal started and 1 after one stopped dropped" in w for w in rec.warnings)
+
+
+@pytest.mark.parametrize("spool", [False, True])
+def test_a_velocity_channel_not_logged_is_left_out_and_said(tmp_path, spool):
+    """A logger that writes 0 for the velocities it does not fill: joint 3's velocities read 0 throughout while its
+    positions span 0.6 rad. The measured velocities are left out (one warning naming the joint), so the recording is
+    the one of the same log without velocity columns; a joint held still with velocity 0 is not taken for that."""
+    t = np.arange(400) * 0.008
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, 7)))
+    q[:, 5] = 0.2  # J6 held still: its velocity 0 is right
+    dq = 0.3 * np.cos(np.outer(t, np.arange(1, 7))) * np.arange(1, 7)
+    dq[:, 5] = 0.0
+    cur = np.sin(np.outer(t, np.ones(6)))
+    (tmp_path / "live.csv").write_text("".join(_ur_row(*r) for r in zip(t, q, dq, cur)))
+    dq[:, 2] = 0.0
+    (tmp_path / "dead.csv").write_text("".join(_ur_row(*r) for r in zip(t, q, dq, cur)))
+    robot = load_robot("ur10e")
+    live, dead = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident", 6),
+                                 robot, spool=spool) for name in ("live", "dead"))
+    assert live.dq is not None and not [w for w in live.warnings if "velocit" in w]
+    without = load_recording(dataset_spec({"file": "dead.csv", "header": False, "time": {"column": 1},
+                                           "positions": {"columns": [2, 3, 4, 5, 6, 7]},
+                                           "currents": {"columns": [14, 15, 16, 17, 18, 19]}}, tmp_path, "cfg", "ident", 6),
+                             robot, spool=spool)
+    assert dead.dq is None and without.dq is None
+    np.testing.assert_array_equal(np.asarray(dead.q), np.asarray(without.q))
+    np.testing.assert_array_equal(np.asarray(dead.tau), np.asarray(without.tau))
+    assert [w for w in dead.warnings if w not in without.warnings] == [
+        "ident: joint 3's measured velocities read 0 rad/s throughout while the positions span up to 0.6 rad (a velocity "
+        "channel not logged?): every joint's velocities are left out and derived from the positions"]

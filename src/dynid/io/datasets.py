@@ -246,6 +246,10 @@ AUTO_GAP_SAMPLES = 20
 """With ``gaps = "auto"`` (the default), gaps of at most this many samples are filled by interpolation (a logger
 that dropped a few packets), with a warning; a longer one is refused, naming the setting that fills it."""
 
+DEAD_VELOCITY_SPAN = 0.05
+"""A joint whose positions span more than this [rad] in a log moves: a velocity channel that holds one value all the
+while is not logged (:func:`_logged_velocities`)."""
+
 RESTART_STEPS = 100
 """A time stamp this many typical steps before the one above it starts a second recording, not a glitch of the clock:
 the refusal says how to read each (:func:`_increasing`)."""
@@ -724,6 +728,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         dq = _row_wise(tr.joint_velocities, raw.pop("velocities"))
     else:
         dq = raw.pop("velocities", None)
+    dq = _logged_velocities(spec, q, dq, warnings)
     kind = "currents" if "currents" in raw else "torques"
     if kind == "currents":
         motor_or_joint = _per_joint(np.multiply, raw["currents"], robot.drive_gains)
@@ -733,6 +738,31 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
+
+
+def _logged_velocities(spec: DatasetSpec, q, dq, warnings: list[str]):
+    """The measured velocities, or None where a joint's holds one value throughout while its positions span more than
+    :data:`DEAD_VELOCITY_SPAN` (a logger writing 0 for a field it does not fill): a model fitted with them would have
+    that joint's velocity-dependent terms wrong, so every joint's are left out and derived from the positions, said."""
+    if dq is None:
+        return None
+    dead, values, spans = [], set(), []
+    for j in range(q.shape[1]):  # one joint at a time: the columns may be stored
+        v = dq[:, j]
+        if v.max() == v.min():
+            x = q[:, j]
+            span = float(x.max() - x.min())
+            if span > DEAD_VELOCITY_SPAN:
+                dead.append(j + 1)
+                values.add(f"{float(v[0]):.4g}")
+                spans.append(span)
+    if not dead:
+        return dq
+    who = f"joint {dead[0]}'s" if len(dead) == 1 else f"joints {', '.join(map(str, dead))}'"
+    warnings.append(f"{spec.name}: {who} measured velocities read {' or '.join(sorted(values))} rad/s throughout while "
+                    f"the positions span up to {max(spans):.3g} rad (a velocity channel not logged?): every joint's "
+                    "velocities are left out and derived from the positions")
+    return None
 
 
 def uniform_rate(t: np.ndarray) -> float:
