@@ -1,3 +1,5 @@
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -418,3 +420,30 @@ def test_a_velocity_channel_not_logged_is_left_out_and_said(tmp_path, spool):
     assert [w for w in dead.warnings if w not in without.warnings] == [
         "ident: joint 3's measured velocities read 0 rad/s throughout while the positions span up to 0.6 rad (a velocity "
         "channel not logged?): every joint's velocities are left out and derived from the positions"]
+
+
+def test_a_position_step_the_joint_stays_at_is_refused_a_spike_is_read(tmp_path):
+    """An encoder homed again mid-log: joint 2's positions step by 0.5 rad between two samples and stay there (the
+    filtered derivative would be a torque-sized spike, one side of the log off by 0.5 rad): refused naming the joint,
+    the step and its time. A one-sample spike of the same size, which the filters pass over, and a log whose
+    description understates the joint's velocity limit are read."""
+    t = np.arange(600) * 0.008
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, 7)))
+    cur = np.cos(np.outer(t, np.ones(6)))
+    step, spike = q.copy(), q.copy()
+    step[300:, 1] += 0.5
+    spike[300, 1] += 0.5
+    for name, x in (("step", step), ("spike", spike)):
+        (tmp_path / f"{name}.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), ik) for tk, qk, ik in zip(t, x, cur)))
+    robot = load_robot("ur10e")
+    spec = dataset_spec({"preset": "ur-rtde", "file": "step.csv"}, tmp_path, "cfg", "ident", 6)
+    jump = step[300, 1] - step[299, 1]
+    with pytest.raises(DataError, match=rf"step.csv: joint 2's position steps by {jump:.4g} rad at t = 2.400 s and stays "
+                                        r"there, faster than the joint moves \(limit 2.09 rad/s\): an encoder homed again"):
+        load_recording(spec, robot)
+    read = load_recording(dataset_spec({"preset": "ur-rtde", "file": "spike.csv"}, tmp_path, "cfg", "ident", 6), robot)
+    np.testing.assert_allclose(np.asarray(read.q)[300, 1], spike[300, 1], atol=1e-6)
+    slow = replace(robot, limits=replace(robot.limits, dq_max=np.full(6, 0.01)))  # 1/100 of what the log moves at
+    (tmp_path / "plain.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), ik) for tk, qk, ik in zip(t, q, cur)))
+    plain = load_recording(dataset_spec({"preset": "ur-rtde", "file": "plain.csv"}, tmp_path, "cfg", "ident", 6), slow)
+    np.testing.assert_allclose(np.asarray(plain.q), q, atol=1e-6)

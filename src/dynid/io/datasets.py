@@ -263,6 +263,17 @@ MIN_RATE = 5.0
 MIN_SELECTED = 50
 """Samples a ``time_range`` or ``rows`` must select: fewer cannot be filtered and identify nothing."""
 
+STEP_SPEED = 2.0
+"""A position step between two samples faster than this many times the joint's velocity limit is a jump of the
+encoder, not motion (:func:`_position_step`)."""
+
+STEP_SHARE = 20.0
+"""... and than this many times the 99th percentile of the joint's own steps in the log."""
+
+SPIKE_SAMPLES = 5
+"""A jump the positions come back from within this many samples is a spike, which the filters pass over; one they stay
+at (this many samples before and after it differ by more than the joint can move) is a step (:func:`_position_step`)."""
+
 IMPLAUSIBLE_EFFORT = 1e6
 """|torque| [N·m] or |current| [A] above which a log's value is refused: no robot joint comes near it (the largest
 industrial arms' joints carry about 1e5 N·m)."""
@@ -276,6 +287,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
     worst, outside, still = np.zeros(q.shape[1]), [], []
     for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
         column = q[:, j]
+        _position_step(column, t, lim.dq_max[j], j, source)
         worst[j] = np.abs(column).max()
         still.append(bool(column.max() == column.min()))
         k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
@@ -302,6 +314,27 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
             top = int(np.argmax(np.abs(x)))
             raise DataError(f"{tau_source}: joint {j + 1}'s {kind} reach {x[top]:.4g} at t = {t[top]:.3f} s, implausible for "
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
+
+
+def _position_step(column: np.ndarray, t: np.ndarray, limit: float, j: int, source: str) -> None:
+    """Refuse a step of a joint's positions that no motion makes and that the positions stay at (an encoder homed
+    again, two recordings joined): faster than :data:`STEP_SPEED` times the velocity limit and :data:`STEP_SHARE` times
+    the joint's 99th-percentile step, and not undone within :data:`SPIKE_SAMPLES` samples. Its filtered derivative
+    would be a torque-sized spike, and the positions on one side of it are off by the step."""
+    if not np.isfinite(limit) or limit <= 0 or column.shape[0] < 2 * SPIKE_SAMPLES + 2:
+        return
+    steps = np.abs(np.diff(column))
+    quick = steps > STEP_SPEED * limit * np.diff(t)
+    for k in np.flatnonzero(quick & (steps > STEP_SHARE * np.percentile(steps, 99))):
+        before, after = max(int(k) - SPIKE_SAMPLES, 0), min(int(k) + 1 + SPIKE_SAMPLES, column.shape[0] - 1)
+        if abs(column[after] - column[before]) > STEP_SPEED * limit * (t[after] - t[before]):
+            end = int(k) + 1  # the step's samples: a resampled log spreads it over two
+            while end < quick.shape[0] and quick[end]:
+                end += 1
+            raise DataError(f"{source}: joint {j + 1}'s position steps by {column[end] - column[k]:.4g} rad at t = "
+                            f"{t[k + 1]:.3f} s and stays there, faster than the joint moves (limit {limit:.3g} rad/s): "
+                            "an encoder homed again, or two recordings joined? select rows or time_range on one side "
+                            "of it")
 
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:
