@@ -14,7 +14,9 @@ from ..io.datasets import (
     GAP_FACTOR,
     DatasetSpec,
     Recording,
+    check_position_steps,
     load_recording,
+    logged_velocities,
     resampled,
     uniform_rate,
     unwrapped_positions,
@@ -405,7 +407,8 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     ShapeError
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
-        Time stamps that do not increase, or a gap longer than 5 median steps.
+        Time stamps that do not increase, a gap longer than 5 median steps, or a position step no motion makes
+        (:func:`dynid.io.datasets.check_position_steps`).
     """
     from ..checks import check_trajectory_array
 
@@ -425,6 +428,8 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
                         "on each side of it separately")
     said: list[str] = []
     q = unwrapped_positions(q, name, said)
+    check_position_steps(q, t - t[0], robot, name)
+    dq = logged_velocities(q, dq, name, said)
     warnings: tuple[str, ...] = tuple(said)
     rate = uniform_rate(t)
     if np.ptp(steps) > 1e-6 * median:

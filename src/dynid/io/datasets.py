@@ -248,7 +248,7 @@ that dropped a few packets), with a warning; a longer one is refused, naming the
 
 DEAD_VELOCITY_SPAN = 0.05
 """A joint whose positions span more than this [rad] in a log moves: a velocity channel that holds one value all the
-while is not logged (:func:`_logged_velocities`)."""
+while is not logged (:func:`logged_velocities`)."""
 
 RESTART_STEPS = 100
 """A time stamp this many typical steps before the one above it starts a second recording, not a glitch of the clock:
@@ -287,7 +287,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
     worst, outside, still = np.zeros(q.shape[1]), [], []
     for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
         column = q[:, j]
-        _position_step(column, t, lim.dq_max[j], j, source)
+        _position_step(column, t, float(lim.dq_max[j]), j, source)
         worst[j] = np.abs(column).max()
         still.append(bool(column.max() == column.min()))
         k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
@@ -314,6 +314,29 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_s
             top = int(np.argmax(np.abs(x)))
             raise DataError(f"{tau_source}: joint {j + 1}'s {kind} reach {x[top]:.4g} at t = {t[top]:.3f} s, implausible for "
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
+
+
+def check_position_steps(q, t, robot: Robot, source: str) -> None:
+    """Refuse a step of a joint's positions that no motion makes and that the positions stay at (an encoder homed
+    again, two recordings joined): faster than :data:`STEP_SPEED` times the joint's velocity limit and
+    :data:`STEP_SHARE` times its 99th-percentile step in the log, and not undone within :data:`SPIKE_SAMPLES` samples.
+
+    Parameters
+    ----------
+    q : (N, n_dof) array or StoredColumns [rad]
+    t : (N,) array [s]
+    robot : Robot
+        Its velocity limits (a joint without one is not checked).
+    source : str
+        The file or dataset, for the message.
+
+    Raises
+    ------
+    DataError
+        Naming the joint, the step and its time, and what to select.
+    """
+    for j in range(q.shape[1]):
+        _position_step(np.asarray(q[:, j], dtype=float), t, float(robot.limits.dq_max[j]), j, source)
 
 
 def _position_step(column: np.ndarray, t: np.ndarray, limit: float, j: int, source: str) -> None:
@@ -761,7 +784,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
         dq = _row_wise(tr.joint_velocities, raw.pop("velocities"))
     else:
         dq = raw.pop("velocities", None)
-    dq = _logged_velocities(spec, q, dq, warnings)
+    dq = logged_velocities(q, dq, spec.name, warnings)
     kind = "currents" if "currents" in raw else "torques"
     if kind == "currents":
         motor_or_joint = _per_joint(np.multiply, raw["currents"], robot.drive_gains)
@@ -773,10 +796,25 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
 
 
-def _logged_velocities(spec: DatasetSpec, q, dq, warnings: list[str]):
-    """The measured velocities, or None where a joint's holds one value throughout while its positions span more than
+def logged_velocities(q, dq, name: str, warnings: list[str]):
+    """The measured velocities, or None where a joint's hold one value throughout while its positions span more than
     :data:`DEAD_VELOCITY_SPAN` (a logger writing 0 for a field it does not fill): a model fitted with them would have
-    that joint's velocity-dependent terms wrong, so every joint's are left out and derived from the positions, said."""
+    that joint's velocity-dependent terms wrong, so every joint's are left out and derived from the positions, said.
+
+    Parameters
+    ----------
+    q : (N, n_dof) array or StoredColumns [rad]
+    dq : (N, n_dof) array or StoredColumns [rad/s], or None
+    name : str
+        The dataset, for the warning.
+    warnings : list of str
+        Gets one line naming the joints, if any.
+
+    Returns
+    -------
+    (N, n_dof) array or StoredColumns [rad/s], or None
+        ``dq`` itself, or None where it is left out.
+    """
     if dq is None:
         return None
     dead, values, spans = [], set(), []
@@ -792,7 +830,7 @@ def _logged_velocities(spec: DatasetSpec, q, dq, warnings: list[str]):
     if not dead:
         return dq
     who = f"joint {dead[0]}'s" if len(dead) == 1 else f"joints {', '.join(map(str, dead))}'"
-    warnings.append(f"{spec.name}: {who} measured velocities read {' or '.join(sorted(values))} rad/s throughout while "
+    warnings.append(f"{name}: {who} measured velocities read {' or '.join(sorted(values))} rad/s throughout while "
                     f"the positions span up to {max(spans):.3g} rad (a velocity channel not logged?): every joint's "
                     "velocities are left out and derived from the positions")
     return None
