@@ -548,19 +548,22 @@ def init(
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
     from ..io.starter import check_target, starter_config
-    from ..model.description import load_robot
+    from ..model.description import load_robot, robot_from_urdf
+    from ..model.urdf import joints_to_hold
 
     def prepare():
         check_target(out, force)
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
-        return load_robot(urdf)
+        held = joints_to_hold(urdf) if urdf.suffix.lower() == ".urdf" and urdf.is_file() else ()
+        return robot_from_urdf(urdf, held=held) if held else load_robot(urdf)
 
     def compute(robot, progress):
         for v in validation or ():
             if not v.is_file():
                 raise DynIdError(f"{v}: no such validation log")
-        return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints))
+        return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints),
+                              robot.held)
 
     def save(written):
         from ..io.files import atomic_write_text

@@ -13,12 +13,14 @@ config, to check before identifying.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 from pathlib import Path
 
 from ..conventions import time_unit_of
 from ..exceptions import ConfigError, DataError
+from ..model.description import URDF_DRIVE_TERMS
 from .files import text_encoding_hint
 from .tables import is_data_line
 
@@ -85,7 +87,7 @@ def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
-                   joints: tuple[str, ...] = ()) -> tuple[str, list[str]]:
+                   joints: tuple[str, ...] = (), held: tuple[str, ...] = ()) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -103,6 +105,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         Other logs of the same layout: each a ``[[validation]]`` entry (it takes the identification's columns).
     joints : tuple of str
         The URDF's joint names, in the chain's order (columns naming them are taken in this order).
+    held : tuple of str
+        The URDF's joints held fixed (:func:`dynid.model.urdf.joints_to_hold`): written as the ``[robot]`` table's
+        ``held``, and said.
 
     Returns
     -------
@@ -123,7 +128,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
-        return _config(urdf, log, out, validation, table, said), said
+        said += _held_notes(urdf, held)
+        return _config(urdf, log, out, validation, table, said, held), said
     lines, delimiter = _first_lines(log)
     split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
     first = split(lines[0])
@@ -184,17 +190,29 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                         "signal (or name the columns in a header line: t, q1…, tau1…)")
     notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
                  "positions for degrees")
-    return _config(urdf, log, out, validation, table, notes), notes
+    notes += _held_notes(urdf, held)
+    return _config(urdf, log, out, validation, table, notes, held), notes
 
 
-def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: list[str], notes: list[str]) -> str:
-    """The config's text: what was detected in comments, the dataset table, the validation logs."""
+def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
+    return [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain of revolute joints (a gripper?): held fixed "
+            "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
+
+
+def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: list[str], notes: list[str],
+            held: tuple[str, ...] = ()) -> str:
+    """The config's text: what was detected in comments, the robot (a table where joints are held), the dataset
+    table, the validation logs."""
+    root = f'data_root = "{_relative(log.parent, out.parent)}"'
+    robot = [f'robot = "{_relative(urdf, out.parent)}"', root] if not held else [  # a key before the first table
+        root, "", "[robot]", f'urdf = "{_relative(urdf, out.parent)}"',
+        f"held = [{', '.join(json.dumps(h) for h in held)}]   # not the arm's joints: held fixed at 0",
+        f"drive_terms = [{', '.join(json.dumps(t) for t in URDF_DRIVE_TERMS)}]"]
     return "\n".join([
         "# dynid identification config, written by dynid init: check the columns and units below, then",
         "#   dynid identify THIS_FILE",
         *(f"# {n}" for n in notes),
-        f'robot = "{_relative(urdf, out.parent)}"',
-        f'data_root = "{_relative(log.parent, out.parent)}"',
+        *robot,
         "",
         "[identification]",
         *table,

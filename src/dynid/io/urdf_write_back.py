@@ -162,8 +162,9 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     Every byte of the URDF stays as it is — link and joint names, frames, visuals, collisions, meshes, limits,
     transmissions, comments, the layout of each line — but each moving link's ``<inertial>`` and each moving joint's
     ``<dynamics>`` ``damping`` and ``friction`` (its other attributes kept). A link attached by fixed joints to a
-    moving one (a flange, a tool frame) is identified together with it: its ``<inertial>`` moves into the moving
-    link's (a comment says so). What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term, coupled
+    moving one (a flange, a tool frame), or by joints the robot holds fixed (:attr:`dynid.model.robot.Robot.held`: a
+    gripper's fingers), is identified together with it: its ``<inertial>`` moves into the moving link's (a comment
+    says so). What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term, coupled
     motors) is written in comments, and a header comment inside ``<robot>`` says what was identified: only the base
     parameters are; the values written are one physically consistent choice among the many with the same base
     parameters (the split between a link and the rotor inertia, and unidentifiable directions, are that choice's).
@@ -217,16 +218,16 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
             raise ConfigError(f"{path}: joint {joint.attrs.get('name')!r} names link {e.attrs['link']!r}, which the file does not have")
         return str(e.attrs["link"])
 
-    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints
+    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints, or joints held fixed
     for j in joints.values():
-        if j.attrs.get("type") == "fixed":
+        if j.attrs.get("type") == "fixed" or j.attrs.get("name") in robot.held:
             children.setdefault(end(j, "parent"), []).append(end(j, "child"))
     moved: list[str] = []
     for k, joint in enumerate(robot.joints):
         link_name = end(joints[joint.name], "child")
         mass, com, inertia = physical_from_inertial(fitted.inertial[k])
         merged = _remove_fixed_inertials(text, links, children, link_name)
-        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged)
+        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged, bool(robot.held))
         _write_dynamics(text, joints[joint.name], robot, fitted, k)
         m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
         far = moved_far(link_name, mass, com, m0, c0, "URDF")
@@ -307,10 +308,11 @@ def _remove_fixed_inertials(text: _TextEdits, links: dict, children: dict, link_
     return merged
 
 
-def _write_inertial(text: _TextEdits, link: _Element, inertial: dict, merged: list[str]) -> None:
+def _write_inertial(text: _TextEdits, link: _Element, inertial: dict, merged: list[str], held: bool = False) -> None:
     """A link's identified ``<inertial>``: its three children's values edited in place where the file has exactly
     them, the element rewritten at its place otherwise, or added as the link's last child."""
-    note = (_comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are identified with it and "
+    how = "fixed or held" if held else "fixed"
+    note = (_comment(f" dynid: the inertials of {', '.join(merged)} ({how} to this link) are identified with it and "
                      "written here ") if merged else "")
     current = link.child("inertial")
     parts = {c.tag: c for c in current.children} if current is not None else {}

@@ -177,7 +177,7 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     return robot_from_document(doc, source, base)
 
 
-def robot_from_urdf(path: str | Path, source: str | None = None, name: str | None = None) -> Robot:
+def robot_from_urdf(path: str | Path, source: str | None = None, name: str | None = None, held=()) -> Robot:
     """A robot given by its URDF alone.
 
     Its chain, inertias and limits; drive terms :data:`URDF_DRIVE_TERMS`, gravity along -z, drive gains 1 (a log of
@@ -190,6 +190,8 @@ def robot_from_urdf(path: str | Path, source: str | None = None, name: str | Non
         Named in errors (the path by default).
     name : str, optional
         The robot's name (default: the file's stem).
+    held : sequence of str
+        Joints held fixed at 0 (:func:`dynid.model.urdf.joints_from_urdf`).
 
     Returns
     -------
@@ -202,7 +204,8 @@ def robot_from_urdf(path: str | Path, source: str | None = None, name: str | Non
     """
     path = Path(path)
     return robot_from_document({"convention": "urdf", "urdf": path.name, "drive_terms": list(URDF_DRIVE_TERMS),
-                                "name": name or path.stem}, source or str(path), path.parent)  # the URDF relative to its folder
+                                "name": name or path.stem, **({"held": list(held)} if held else {})},
+                               source or str(path), path.parent)  # the URDF relative to its folder
 
 
 def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
@@ -239,8 +242,9 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         raise ConfigError(str(exc)) from None
     urdf_model = None
     rows = d.joints
+    held = _held(d.held, convention, source)
     if convention == "urdf":
-        upath, urdf_model = _read_urdf(d.urdf, base, source)
+        upath, urdf_model = _read_urdf(d.urdf, base, source, held)
         if rows is None:
             rows = [joint_table() for _ in urdf_model[0]]
     if not rows:
@@ -264,7 +268,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         joints, inertial, _, links = urdf_model
         from .urdf import urdf_limits
 
-        urdf_lim = urdf_limits(upath)
+        urdf_lim = urdf_limits(upath, held)
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
         inertial = _merged_inertials(rows, where, inertial, upath)
@@ -301,10 +305,21 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
+        held=tuple(held),
     )
 
 
-def _read_urdf(urdf: str | None, base: Path | None, source: str):
+def _held(held, convention: str, source: str) -> dict:
+    """``held`` as joint name -> position (a list holds each at 0); only a URDF has joints to hold."""
+    if held is None:
+        return {}
+    if convention != "urdf":
+        raise ConfigError(f"{source}: held names joints of a URDF to hold fixed, but this description has no URDF "
+                          "(leave those joints out of [[joints]])")
+    return dict.fromkeys(held, 0.0) if isinstance(held, list) else {str(k): float(v) for k, v in held.items()}
+
+
+def _read_urdf(urdf: str | None, base: Path | None, source: str, held=None):
     """The URDF a description names (relative to ``base``; a xacro file expanded) and its chain
     (:func:`dynid.model.urdf.joints_from_urdf`)."""
     from .urdf import expand_xacro, is_xacro, joints_from_urdf
@@ -316,7 +331,7 @@ def _read_urdf(urdf: str | None, base: Path | None, source: str):
         upath = base / upath
     if is_xacro(upath):
         upath = expand_xacro(upath)
-    return upath, joints_from_urdf(upath)
+    return upath, joints_from_urdf(upath, held)
 
 
 def _dh_inertials(rows, where, convention: str, alpha, a, dd) -> np.ndarray:

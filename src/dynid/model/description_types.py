@@ -90,6 +90,10 @@ def _types(terms: tuple[str, ...]) -> tuple[type, type]:
         ("convention", Union[Annotated[Literal["modified", "standard", "urdf"],
                                        Meta(description="DH convention of [[joints]] (Khalil's modified by default), or urdf")], None], None),
         ("urdf", Union[Annotated[str, Meta(description="with convention = 'urdf': the URDF file, relative to this file")], None], None),
+        ("held", Union[Annotated[Union[list[str], dict[str, float]], Meta(
+            description="joints of the URDF held fixed, not identified (a gripper's fingers, mimic joints): a list of "
+                        "names (held at 0) or a table name = position (rad or m); their links count with the link "
+                        "they are held to")], None], None),
         ("gravity", Annotated[Vector3, Meta(description="m/s², base frame")], msgspec.field(default_factory=lambda: [0.0, 0.0, -9.81])),
         ("drive_terms", Union[Annotated[list[str], Meta(description="drive/friction terms of every joint, e.g. [\"Ia\", \"fv\", \"fc\", \"off\"]")], None], None),
         ("notes", Annotated[str, Meta(description="where the values come from")], ""),

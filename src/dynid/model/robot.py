@@ -116,6 +116,9 @@ class Robot:
         linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.friction`.
     stribeck_velocity : (n_dof,) array [rad/s]
         Stribeck velocity of the ``fst`` term (default :data:`dynid.friction.DEFAULT_STRIBECK_VELOCITY`).
+    held : tuple of str
+        Joints of the robot's URDF held fixed, not identified (a gripper's fingers): their links count with the link
+        they are held to, as a fixed joint's do (:func:`dynid.model.urdf.joints_from_urdf`).
     """
 
     name: str
@@ -134,6 +137,7 @@ class Robot:
     drive_mask: np.ndarray = None  # type: ignore[assignment]
     coulomb_velocity: np.ndarray = None  # type: ignore[assignment]
     nominal_problems: tuple[str, ...] = ()
+    held: tuple[str, ...] = ()
     stribeck_velocity: np.ndarray = None  # type: ignore[assignment]
 
     @property

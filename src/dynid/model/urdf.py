@@ -21,15 +21,21 @@ _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
-def check_urdf_text(path: Path) -> None:
+HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (a gripper's fingers)"
+"""What a refusal of a joint dynid cannot identify says to do (:func:`check_urdf_text`, :func:`joints_from_urdf`)."""
+
+
+def check_urdf_text(path: Path, held=()) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
-    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), and ``<mimic>`` joints (coupled to another: dynid would identify them as
-    independent joints).
+    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), and ``<mimic>`` joints
+    (coupled to another: dynid would identify them as independent joints) that are not held fixed.
 
     Parameters
     ----------
     path : Path
+    held : collection of str
+        Joints held fixed (:func:`joints_from_urdf`): their ``<mimic>`` is no problem.
 
     Raises
     ------
@@ -53,10 +59,11 @@ def check_urdf_text(path: Path) -> None:
             if len(xyz) != 3 or not all(np.isfinite(xyz)) or float(np.linalg.norm(xyz)) < 1e-9:
                 problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} has axis xyz=\"{attrs.get('xyz')}\", "
                                 "expected three numbers not all zero (the direction it turns about)")
-        elif name == "mimic" and joint and joint[1] != "fixed":
+        elif name == "mimic" and joint and joint[1] != "fixed" and joint[0] not in held:
+            both = ", ".join(f'"{n}"' for n in dict.fromkeys([attrs.get("joint", "?"), joint[0]]))
             problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} mimics joint {attrs.get('joint', '?')!r} "
-                            "(<mimic>): dynid identifies independent joints; make it a fixed joint at its usual angle, or "
-                            "describe the coupling as a [transmission] of a robot description")
+                            "(<mimic>): dynid identifies independent joints; " + HELD_HINT.format(names=both)
+                            + ", or describe the coupling as a [transmission] of a robot description")
 
     def end(name):
         if name == "joint":
@@ -122,15 +129,18 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
     return np.array([m, mx, my, mz, xx, xy, yy, xz, yz, zz])
 
 
-def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
+def joints_from_urdf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
     """Joints and link inertial parameters of a URDF serial chain of revolute joints.
 
-    Fixed joints are merged by Pinocchio into the parent link. Continuous joints (unbounded revolute) are revolute
-    joints without position limits: dynid's joint angle is their angle.
+    Fixed joints are merged by Pinocchio into the parent link, and so are ``held`` joints (a gripper's fingers, mimic
+    joints: locked at their position by Pinocchio's ``buildReducedModel``). Continuous joints (unbounded revolute)
+    are revolute joints without position limits: dynid's joint angle is their angle.
 
     Parameters
     ----------
     path : str or Path
+    held : dict, optional
+        Joint name -> position [rad or m] at which it is held fixed.
 
     Returns
     -------
@@ -145,27 +155,23 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
     Raises
     ------
     ConfigError
-        If the file cannot be parsed, or the chain is not serial or has non-revolute joints.
+        If the file cannot be parsed, a held joint is not in it, or the chain is not serial or has non-revolute joints.
     """
     import pinocchio as pin
 
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: URDF file not found")
-    check_urdf_text(path)
-    printed: list[str] = []
-    try:
-        with _silenced_stderr(printed):
-            model = pin.buildModelFromUrdf(str(path))
-    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError; urdfdom prints its reason
-        reason = printed[0] if printed else (str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
-        raise ConfigError(f"{path}: cannot parse URDF ({' '.join(reason.split())})") from None
+    held = dict(held or {})
+    check_urdf_text(path, held)
+    model = _pinocchio_model(path, held)
     joints, inertial = [], []
     for j in range(1, model.njoints):
         jm = model.joints[j]
         short = jm.shortname()
         if model.parents[j] != j - 1:
-            raise ConfigError(f"{path}: joint {model.names[j]!r} does not continue a serial chain")
+            raise ConfigError(f"{path}: joint {model.names[j]!r} does not continue a serial chain: "
+                              + HELD_HINT.format(names=f'"{model.names[j]}"'))
         if short.startswith("JointModelR") and short[-2:] in _AXES and "Unbounded" not in short:
             axis = np.array(_AXES[short[-2:]])  # revolute, or continuous (RUB: unbounded, same dynamics)
         elif short.startswith("JointModelRUB") and "R" + short[-1] in _AXES:  # continuous joint about x, y or z
@@ -177,7 +183,8 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
             pin.forwardKinematics(model, data, pin.neutral(model))
             axis = np.asarray(data.joints[j].S, dtype=float).ravel()[3:]
         else:
-            raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute joint")
+            raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute joint; "
+                              + HELD_HINT.format(names=f'"{model.names[j]}"'))
         placement = model.jointPlacements[j]
         joints.append(Joint(model.names[j], np.array(placement.rotation), np.array(placement.translation), axis))
         inertial.append(inertial_from_pinocchio(model.inertias[j]))
@@ -188,8 +195,36 @@ def joints_from_urdf(path: str | Path) -> tuple[tuple[Joint, ...], np.ndarray, t
     return tuple(joints), np.array(inertial), tuple(model.names[1:]), links
 
 
-def urdf_limits(path: str | Path) -> dict:
-    """Each revolute joint's limits in a URDF (Pinocchio's reading).
+def _pinocchio_model(path: Path, held: dict):
+    """Pinocchio's model of a URDF, its ``held`` joints locked at their positions (their links merged into the parent's)."""
+    import pinocchio as pin
+
+    printed: list[str] = []
+    try:
+        with _silenced_stderr(printed):
+            model = pin.buildModelFromUrdf(str(path))
+    except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError; urdfdom prints its reason
+        reason = printed[0] if printed else (str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        raise ConfigError(f"{path}: cannot parse URDF ({' '.join(reason.split())})") from None
+    if not held:
+        return model
+    q = pin.neutral(model)
+    ids = []
+    for name, value in held.items():
+        if not model.existJointName(name):
+            raise ConfigError(f"{path}: held names joint {name!r}, which the URDF's moving joints do not include "
+                              f"({', '.join(model.names[1:])})")
+        j = model.getJointId(name)
+        i, nq = model.joints[j].idx_q, model.joints[j].nq
+        q[i:i + nq] = [np.cos(value), np.sin(value)] if nq == 2 else [value] * nq  # a continuous joint: cos, sin
+        ids.append(j)
+    return pin.buildReducedModel(model, ids, q)
+
+
+def joints_to_hold(path: str | Path) -> tuple[str, ...]:
+    """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: from the first joint that does
+    not continue a serial chain of revolute joints from the base (a gripper's fingers, prismatic or on a branch) or
+    that mimics another, every joint after it in Pinocchio's depth-first order.
 
     Parameters
     ----------
@@ -197,14 +232,62 @@ def urdf_limits(path: str | Path) -> dict:
 
     Returns
     -------
+    tuple of str
+        Joint names (empty for a URDF that is one serial revolute chain).
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be parsed.
+    """
+    path = Path(path)
+    check_urdf_text(path, held=_mimic_joints(path))
+    model = _pinocchio_model(path, {})
+    mimic = _mimic_joints(path)
+    for j in range(1, model.njoints):
+        if (model.parents[j] != j - 1 or not model.joints[j].shortname().startswith("JointModelR")
+                or model.names[j] in mimic):
+            return tuple(model.names[j:])
+    return ()
+
+
+def _mimic_joints(path: Path) -> set[str]:
+    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first)."""
+    parser = expat.ParserCreate()
+    joint: list[str] = []
+    out: set[str] = set()
+
+    def start(name, attrs):
+        if name == "joint" and "type" in attrs:
+            joint[:] = [attrs.get("name", "?")]
+        elif name == "mimic" and joint:
+            out.add(joint[0])
+
+    parser.StartElementHandler = start
+    try:
+        parser.Parse(path.read_bytes(), True)
+    except expat.ExpatError:  # check_urdf_text says where
+        check_urdf_text(path)
+    return out
+
+
+def urdf_limits(path: str | Path, held=None) -> dict:
+    """Each revolute joint's limits in a URDF (Pinocchio's reading).
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joints held fixed (:func:`joints_from_urdf`): not among the joints.
+
+    Returns
+    -------
     dict
         ``q_min, q_max`` [rad], ``dq_max`` [rad/s], ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none), each
         (n_dof,); a limit the URDF leaves out (or 0) is ``±inf``.
     """
-    import pinocchio as pin
-
     with _silenced_stderr([]):
-        model = pin.buildModelFromUrdf(str(path))
+        model = _pinocchio_model(Path(path), dict(held or {}))
     out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")}
     for j in range(1, model.njoints):
         i, nv = model.joints[j].idx_q, model.joints[j].nq

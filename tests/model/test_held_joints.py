@@ -1,0 +1,112 @@
+"""Joints of a URDF held fixed (a gripper's fingers): the arm identified, the fingers counted with their link."""
+
+import re
+import tomllib
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.io.starter import starter_config
+from dynid.io.urdf_write_back import urdf_written_back
+from dynid.model.description import robot_from_document
+from dynid.model.urdf import joints_from_urdf, joints_to_hold
+
+
+def _link(name, mass, xyz):
+    return (f'<link name="{name}"><inertial><origin xyz="{xyz}"/><mass value="{mass}"/>'
+            f'<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.015"/></inertial></link>')
+
+
+def _revolute(name, parent, child, xyz, axis):
+    return (f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}"/><axis xyz="{axis}"/><limit lower="-3" upper="3" effort="50" velocity="2"/></joint>')
+
+
+def _finger(name, xyz, mimic=""):
+    return (f'<joint name="{name}" type="prismatic"><parent link="hand"/><child link="{name}_link"/>'
+            f'<origin xyz="{xyz}"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/>'
+            f'{mimic}</joint>')
+
+
+ARM = "".join([_link("base", 4.0, "0 0 0.05"), _link("l1", 3.0, "0 0 0.2"), _link("l2", 2.0, "0.2 0 0"),
+               _link("hand", 0.7, "0 0 0.05"), _revolute("j1", "base", "l1", "0 0 0.1", "0 0 1"),
+               _revolute("j2", "l1", "l2", "0 0 0.4", "0 1 0"),
+               '<joint name="hand_joint" type="fixed"><parent link="l2"/><child link="hand"/><origin xyz="0.4 0 0"/>'
+               '</joint>'])
+FINGERS = (_link("f1_link", 0.1, "0 0.01 0.05") + _link("f2_link", 0.1, "0 -0.01 0.05")
+           + _finger("f1", "0 0.02 0.06") + _finger("f2", "0 -0.02 0.06", '<mimic joint="f1" multiplier="-1"/>'))
+
+
+def _urdf(tmp_path, body, name="arm.urdf"):
+    path = tmp_path / name
+    path.write_text(f'<?xml version="1.0"?>\n<robot name="arm">{body}</robot>\n')
+    return path
+
+
+def test_held_fingers_are_merged_as_fixed_ones_are(tmp_path):
+    """The arm with its two prismatic fingers (one mimicking the other) held at 0 has the joints and inertial parameters
+    of the same file with the fingers written as fixed joints (Pinocchio merging them either way); without held it is
+    refused naming the setting."""
+    gripper = _urdf(tmp_path, ARM + FINGERS)
+    fixed = _urdf(tmp_path, ARM + FINGERS.replace('type="prismatic"', 'type="fixed"'), "fixed.urdf")
+    with pytest.raises(ConfigError, match=r"joint 'f2' mimics joint 'f1' \(<mimic>\): dynid identifies independent "
+                                          r"joints; hold it fixed with held = \[\"f1\", \"f2\"\]"):
+        joints_from_urdf(gripper)
+    held = joints_from_urdf(gripper, {"f1": 0.0, "f2": 0.0})
+    plain = joints_from_urdf(fixed)
+    assert held[2] == plain[2] == ("j1", "j2")
+    np.testing.assert_allclose(held[1], plain[1], rtol=1e-12, atol=1e-15)
+    assert held[1][1, 9] == pytest.approx(2.0 + 0.7 + 0.1 + 0.1)  # l2, the hand and both fingers
+    assert joints_to_hold(gripper) == ("f1", "f2") and joints_to_hold(fixed) == ()
+    robot = robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2"]}, "arm.toml", tmp_path)
+    assert robot.n_dof == 2 and robot.held == ("f1", "f2")
+    opened = robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": {"f1": 0.03, "f2": 0.03}},
+                                 "arm.toml", tmp_path)
+    assert not np.allclose(opened.inertial[1], robot.inertial[1])  # the fingers' mass elsewhere: another first moment
+    assert opened.inertial[1][9] == pytest.approx(robot.inertial[1][9])
+
+
+def test_held_is_refused_where_it_cannot_mean_anything(tmp_path):
+    _urdf(tmp_path, ARM + FINGERS)
+    with pytest.raises(ConfigError, match=r"arm.urdf: held names joint 'f3', which the URDF's moving joints do not "
+                                          r"include \(j1, j2, f1, f2\)"):
+        robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2", "f3"]}, "arm.toml", tmp_path)
+    with pytest.raises(ConfigError, match=r"arm.toml: held names joints of a URDF to hold fixed, but this description "
+                                          r"has no URDF"):
+        robot_from_document({"convention": "modified", "held": ["f1"], "joints": [{"mass": 1.0, "com": [0, 0, 0],
+                             "inertia": [1, 1, 1, 0, 0, 0]}]}, "arm.toml", tmp_path)
+
+
+def test_write_back_moves_the_held_fingers_inertials_into_their_link(tmp_path):
+    """The identified URDF: the fingers' <inertial> removed (their mass is in the hand's link, with a comment), the
+    finger joints untouched; read back with the same held joints it gives the values written."""
+    path = _urdf(tmp_path, ARM + FINGERS)
+    robot = robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2"]}, "arm.toml", tmp_path)
+    phi = robot.standard_parameters().copy()
+    phi[robot.parameter_names.index("M2")] *= 1.1  # link 2's mass 10 % more: a value to find again
+    text, _ = urdf_written_back(path, robot, phi)
+    assert len(re.findall(r"<mass value=", text)) == 3  # base, l1, l2: hand and fingers merged into l2
+    assert "the inertials of hand, f1_link, f2_link (fixed or held to this link)" in text or \
+        "the inertials of hand, f2_link, f1_link (fixed or held to this link)" in text
+    assert text.count('type="prismatic"') == 2 and '<mimic joint="f1"' in text
+    again = tmp_path / "again.urdf"
+    again.write_text(text)
+    read = robot_from_document({"convention": "urdf", "urdf": again.name, "held": ["f1", "f2"]}, "again.toml", tmp_path)
+    np.testing.assert_allclose(read.inertial, robot.with_parameters(phi).inertial, rtol=1e-9, atol=1e-12)
+    assert read.inertial[1, 9] == pytest.approx(1.1 * robot.inertial[1, 9])
+
+
+def test_init_holds_the_joints_off_the_arm(tmp_path):
+    """dynid init on a URDF with a gripper: the config's [robot] table holds the fingers, and it reads as a robot of
+    the arm's joints."""
+    urdf = _urdf(tmp_path, ARM + FINGERS)
+    t = np.arange(200) * 0.01
+    (tmp_path / "log.csv").write_text("".join(f"{x},{np.sin(x)},{np.cos(x)},{0.5 * x},{-x}\n" for x in t))
+    text, notes = starter_config(urdf, tmp_path / "log.csv", 2, tmp_path / "arm.toml", joints=("j1", "j2"),
+                                 held=("f1", "f2"))
+    doc = tomllib.loads(text)
+    assert doc["robot"] == {"urdf": "arm.urdf", "held": ["f1", "f2"], "drive_terms": ["Ia", "fc", "fv", "offset"]}
+    assert any("f1, f2 not on the arm's serial chain" in n for n in notes)
+    robot = robot_from_document(doc["robot"], "arm.toml", tmp_path)
+    assert robot.n_dof == 2
