@@ -6,7 +6,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from dynid.exceptions import ConfigError
+from dynid.exceptions import ConfigError, DataError
 from dynid.io.starter import starter_config
 from dynid.io.urdf_write_back import urdf_written_back
 from dynid.model.description import robot_from_document
@@ -110,3 +110,17 @@ def test_init_holds_the_joints_off_the_arm(tmp_path):
     assert any("f1, f2 not on the arm's serial chain" in n for n in notes)
     robot = robot_from_document(doc["robot"], "arm.toml", tmp_path)
     assert robot.n_dof == 2
+
+
+@pytest.mark.parametrize("header", [True, False])
+def test_init_names_the_joints_to_hold_where_the_log_has_fewer(tmp_path, header):
+    """A URDF whose chain ends in a revolute gripper joint (the Z1's, the SO-100's) and a log of the arm's two joints:
+    init cannot tell the gripper from the arm, and its refusal names the setting that holds it."""
+    urdf = _urdf(tmp_path, ARM + _link("jaw", 0.2, "0 0 0.02")
+                 + _revolute("gripper", "hand", "jaw", "0 0 0.1", "1 0 0"))
+    t = np.arange(100) * 0.01
+    rows = "".join(f"{x},{np.sin(x)},{np.cos(x)},{x},{-x}\n" for x in t)
+    (tmp_path / "log.csv").write_text(("t,q1,q2,tau1,tau2\n" if header else "") + rows)
+    with pytest.raises(DataError, match=r"if the log holds the first 2 of arm.urdf's joints and the rest are a gripper's, "
+                                        r"hold them: \[robot\] urdf = \"arm.urdf\", held = \[\"gripper\"\]"):
+        starter_config(urdf, tmp_path / "log.csv", 3, tmp_path / "arm.toml", joints=("j1", "j2", "gripper"))

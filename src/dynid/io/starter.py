@@ -155,8 +155,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
         missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
         if missing:
-            raise DataError(f"{log}: found {len(found.get(missing[0], []))} {missing[0]} column(s) of the {n_dof} the robot "
-                            f"needs among {_shown(first)}; accepted: {ACCEPTED}")
+            count = len(found.get(missing[0], []))
+            raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
+                            f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
         unit = _time_unit([split(line) for line in lines[1:]], first.index(found["time"][0]))
         table += ["header = true", f'time = {{ column = "{found["time"][0]}"'
@@ -186,12 +187,22 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             table.append(f"{kind} = {{ columns = [" + ", ".join(str(2 + b * n_dof + j) for j in range(n_dof)) + "] }")
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
     else:
+        fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
         raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
-                        "signal (or name the columns in a header line: t, q1…, tau1…)")
+                        "signal (or name the columns in a header line: t, q1…, tau1…)" + _hold_hint(urdf, joints, fewer))
     notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
                  "positions for degrees")
     notes += _held_notes(urdf, held)
     return _config(urdf, log, out, validation, table, notes, held), notes
+
+
+def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
+    """Where the log has the signals of fewer joints than the URDF: the URDF's last joints held (a gripper's), said."""
+    if not 0 < count < len(joints):
+        return ""
+    rest = ", ".join(json.dumps(j) for j in joints[count:])
+    return (f"; if the log holds the first {count} of {urdf.name}'s joints and the rest are a gripper's, hold them: "
+            f"[robot] urdf = \"{urdf.name}\", held = [{rest}] (docs: Your robot from a URDF)")
 
 
 def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
