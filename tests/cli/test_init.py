@@ -261,3 +261,32 @@ def test_init_reads_a_log_saved_by_numpy_with_its_header_as_a_comment(tmp_path):
     p = run("identify", str(tmp_path / "np.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "id" / "results.json").is_file()
+
+
+def test_init_takes_a_rostopic_export_in_the_urdfs_joint_order_by_its_name_columns(tmp_path):
+    """ROS drivers publish /joint_states with the joints in their own order (the UR driver's is alphabetical: elbow
+    first), which `rostopic echo -p` writes as field.name0… text columns beside field.position0…: init took
+    field.position0 for the URDF's first joint (the UR10e log so fitted at 29.7 % instead of 1.77 %). Now each signal's
+    columns are taken in the URDF's order by the names, said, and the log reads as the one written in that order."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    robot = dynid.load_robot(URDF)
+    joints = [j.name for j in robot.joints]
+    sim = dynid.simulated_log(robot, seconds=5, seed=6)
+    for name, order in (("urdf", list(range(6))), ("alphabetical", sorted(range(6), key=lambda j: joints[j]))):
+        header = (["%time"] + [f"field.name{k}" for k in range(6)] + [f"field.position{k}" for k in range(6)]
+                  + [f"field.effort{k}" for k in range(6)])
+        rows = [",".join([f"{t:.6f}"] + [joints[j] for j in order] + [f"{q[j]:.9g}" for j in order]
+                         + [f"{tau[j]:.9g}" for j in order]) for t, q, tau in zip(sim.t, sim.q, sim.tau)]
+        (tmp_path / f"{name}.csv").write_text("\n".join([",".join(header), *rows]) + "\n")
+        p = run("init", str(URDF), str(tmp_path / f"{name}.csv"), "--out", str(tmp_path / f"{name}.toml"))
+        assert p.returncode == 0, p.stderr
+    text = (tmp_path / "alphabetical.toml").read_text()
+    assert "the log names its joints in field.name0" in p.stdout.replace("\n", " ")
+    shuffled = sorted(range(6), key=lambda j: joints[j])
+    assert 'positions = { columns = [' + ", ".join(f'"field.position{shuffled.index(j)}"' for j in range(6)) in text
+    plain, alpha = (load_identification_config(tmp_path / f"{n}.toml") for n in ("urdf", "alphabetical"))
+    a, b = (load_recording(c.identification, c.robot) for c in (plain, alpha))
+    np.testing.assert_array_equal(np.asarray(a.q), np.asarray(b.q))
+    np.testing.assert_array_equal(np.asarray(a.tau), np.asarray(b.tau))

@@ -69,6 +69,23 @@ def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
     return None
 
 
+def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str], joints: tuple[str, ...]) -> list[str]:
+    """Where the log names its joints in columns of their own (``rostopic echo -p``'s ``field.name0``…, a JointState's
+    names in every row, often alphabetical), each signal's numbered columns reordered into the URDF's joint order, said;
+    ``found`` is changed in place."""
+    names = {int(m.group(1)): row[i] for i, c in enumerate(first) if i < len(row)
+             and (m := re.fullmatch(r".*name[\[_]?(\d+)\]?", c.strip().lower())) is not None}
+    order = [names[k] for k in sorted(names)]
+    if not set(joints) <= set(order) or order[:len(joints)] == list(joints):
+        return []
+    taken = [order.index(j) for j in joints]  # the log may name more joints (a gripper's): the URDF's are taken
+    moved = [kind for kind, columns in found.items() if kind != "time" and len(columns) == len(order)]
+    for kind in moved:
+        found[kind] = [found[kind][k] for k in taken]
+    return [f"{', '.join(moved)}: the log names its joints in {', '.join(f for f in first if 'name' in f.lower())} "
+            f"({', '.join(order)}): taken in the URDF's joint order ({', '.join(joints)})"] if moved else []
+
+
 def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str, list[str]], list[str]]:
     """Columns naming every joint of the URDF, per signal in the URDF's joint order, and a note per signal whose log
     order differs."""
@@ -149,6 +166,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             if kind and name not in named:
                 found.setdefault(kind, []).append(name)
         found.update(by_name)
+        order_notes += _in_named_order(found, first, split(lines[1]) if len(lines) > 1 else [], joints)
         if "time" not in found:
             raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; or write the config by "
                             "hand with rate = ... (docs: Configuration files)")
