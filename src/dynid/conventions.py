@@ -135,6 +135,9 @@ def unit_of(name: str) -> str:
     return friction.TERMS[term].unit if term in friction.TERMS else UNITS.get(term, "")
 
 
+MOVING_SPAN = 0.05
+"""[rad] A joint whose positions span more than this in a log moves: its measured velocities must follow them."""
+
 TIME_UNITS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 """Units of a log's time column (``time = { column = ..., unit = "ns" }``), in seconds."""
 

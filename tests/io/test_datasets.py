@@ -447,3 +447,20 @@ def test_a_position_step_the_joint_stays_at_is_refused_a_spike_is_read(tmp_path)
     (tmp_path / "plain.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), ik) for tk, qk, ik in zip(t, q, cur)))
     plain = load_recording(dataset_spec({"preset": "ur-rtde", "file": "plain.csv"}, tmp_path, "cfg", "ident", 6), slow)
     np.testing.assert_allclose(np.asarray(plain.q), q, atol=1e-6)
+
+
+def test_velocities_false_leaves_a_presets_velocities_out(tmp_path):
+    """velocities = false: a preset's velocity columns are not read (derived from the positions), as the refusals of
+    measured velocities unlike the positions advise; velocities = true says what it takes."""
+    t = np.arange(100) * 0.008
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, 7)))
+    dq = 0.3 * np.cos(np.outer(t, np.arange(1, 7))) * np.arange(1, 7)
+    (tmp_path / "ur.csv").write_text("".join(_ur_row(tk, qk, vk, np.ones(6)) for tk, qk, vk in zip(t, q, dq)))
+    robot = load_robot("ur10e")
+    given = load_recording(dataset_spec({"preset": "ur-rtde", "file": "ur.csv"}, tmp_path, "cfg", "ident", 6), robot)
+    left = load_recording(dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "velocities": False}, tmp_path, "cfg",
+                                       "ident", 6), robot)
+    assert given.dq is not None and left.dq is None
+    np.testing.assert_array_equal(np.asarray(left.q), np.asarray(given.q))
+    with pytest.raises(ConfigError, match=r"cfg.velocities: expected a table with 'columns', or false for none"):
+        dataset_spec({"preset": "ur-rtde", "file": "ur.csv", "velocities": True}, tmp_path, "cfg", "ident", 6)

@@ -81,6 +81,32 @@ def test_measured_velocities_in_another_unit_sign_or_side_are_refused(rng, facto
         prepare(Recording("identification", t, q, wrong, tau, rate), Preprocessing())
 
 
+@pytest.mark.parametrize("wrong", ["another joint's", "currents"])
+def test_measured_velocities_unlike_the_positions_are_refused_where_the_joint_moves(rng, wrong):
+    """Joint 2's velocity column holding joint 3's velocities, or its motor current (which a viscous term then fits as
+    the torque, below the noise floor): refused naming the joint and the correlation, with the setting that leaves
+    them out. A joint that hardly moves (positions spanning 0.02 rad) is not required to follow."""
+    from dynid.io.datasets import Recording
+    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.settings import Preprocessing
+
+    rate = 200.0
+    t = np.arange(4000) / rate
+    w = 2 * np.pi * np.array([0.1, 0.17, 0.23])
+    q = np.sin(w * t[:, None])
+    dq = w * np.cos(w * t[:, None])
+    tau = np.column_stack([np.sin(3 * w[j] * t) + rng.normal(0.0, 0.1, t.size) for j in range(3)])
+    bad = dq.copy()
+    bad[:, 1] = dq[:, 2] if wrong == "another joint's" else tau[:, 1]
+    with pytest.raises(DataError, match=r"^identification: joint 2's measured velocities do not follow the derivative "
+                                        r"of its positions \(correlation -?0\.\d+ over a motion of 2 rad\): .* leave "
+                                        r"them out \(velocities = false\)"):
+        prepare(Recording("identification", t, q, bad, tau, rate), Preprocessing())
+    still = q.copy()
+    still[:, 1] *= 0.01  # a span of 0.02 rad: its derivative's shape is not required of the velocities
+    prepare(Recording("identification", t, still, bad, tau, rate), Preprocessing())
+
+
 def _logged_in_steps(x, step):
     return np.round(x / step) * step
 

@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from ..column_store import SPOOL_BYTES, StoredColumns, by_column, select_rows
-from ..conventions import TIME_UNITS, time_unit_of
+from ..conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
@@ -246,10 +246,6 @@ AUTO_GAP_SAMPLES = 20
 """With ``gaps = "auto"`` (the default), gaps of at most this many samples are filled by interpolation (a logger
 that dropped a few packets), with a warning; a longer one is refused, naming the setting that fills it."""
 
-DEAD_VELOCITY_SPAN = 0.05
-"""A joint whose positions span more than this [rad] in a log moves: a velocity channel that holds one value all the
-while is not logged (:func:`logged_velocities`)."""
-
 RESTART_STEPS = 100
 """A time stamp this many typical steps before the one above it starts a second recording, not a glitch of the clock:
 the refusal says how to read each (:func:`_increasing`)."""
@@ -432,9 +428,11 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
     signals = {}
     for kind in _SIGNALS:
         sig = getattr(t, kind)
-        if sig is None:
+        if sig is None or sig is False:  # velocities = false: none (a preset's left out)
             continue
         w = f"{where}.{kind}"
+        if sig is True:
+            raise ConfigError(f"{w}: expected a table with 'columns', or false for none (derived from the positions)")
         if sig.columns is None:
             raise ConfigError(f"{w}: expected a table with 'columns' (1-based numbers or header names)")
         if len(sig.columns) != n_dof:
@@ -798,7 +796,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
 
 def logged_velocities(q, dq, name: str, warnings: list[str]):
     """The measured velocities, or None where a joint's hold one value throughout while its positions span more than
-    :data:`DEAD_VELOCITY_SPAN` (a logger writing 0 for a field it does not fill): a model fitted with them would have
+    :data:`MOVING_SPAN` (a logger writing 0 for a field it does not fill): a model fitted with them would have
     that joint's velocity-dependent terms wrong, so every joint's are left out and derived from the positions, said.
 
     Parameters
@@ -823,7 +821,7 @@ def logged_velocities(q, dq, name: str, warnings: list[str]):
         if v.max() == v.min():
             x = q[:, j]
             span = float(x.max() - x.min())
-            if span > DEAD_VELOCITY_SPAN:
+            if span > MOVING_SPAN:
                 dead.append(j + 1)
                 values.add(f"{float(v[0]):.4g}")
                 spans.append(span)

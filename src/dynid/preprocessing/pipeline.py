@@ -212,7 +212,7 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
         q = lowpass(recording.q, s.position_cutoff, "position")
         dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
         if recording.dq is not None:
-            check_velocities(dq, differentiate(q, rate), recording.label)
+            check_velocities(dq, differentiate(q, rate), recording.label, positions=q)
     tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
     moving = _direction_velocity(recording, s, dq)
     if s.rest_velocity == "auto":

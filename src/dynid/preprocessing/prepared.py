@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..column_store import by_column
+from ..conventions import MOVING_SPAN
 from ..exceptions import ConfigError, DataError
 from ..friction import Velocities, held_direction
 from ..model.robot import Robot
@@ -250,16 +251,23 @@ VELOCITY_SHAPE = 0.9
 """Correlation from which measured velocities and the positions' derivative have the same shape
 (:func:`check_velocities`)."""
 
+VELOCITY_UNLIKE = 0.5
+"""Correlation below which measured velocities do not follow the positions' derivative at all, on a joint whose
+positions span more than :data:`dynid.conventions.MOVING_SPAN` (:func:`check_velocities`)."""
+
 VELOCITY_RATIO = 2.0
 """Measured velocities more than this many times the positions' derivative, or less than its inverse, or of the
 opposite sign, are in another unit, sign or side than the positions (:func:`check_velocities`)."""
 
 
-def check_velocities(dq, from_positions, label: str) -> None:
+def check_velocities(dq, from_positions, label: str, *, positions=None) -> None:
     """Refuse measured velocities that are not the derivative of the positions: where a joint's two have the same
     shape (correlation at least :data:`VELOCITY_SHAPE` in magnitude), their ratio must lie within a factor
     :data:`VELOCITY_RATIO` of 1 (deg/s read as rad/s gives 57.3, a motor-side velocity the gear ratio, a flipped
-    sign -1): a model fitted with them has every velocity-dependent term wrong.
+    sign -1): a model fitted with them has every velocity-dependent term wrong. Where the joint moves (its
+    ``positions`` span more than :data:`dynid.conventions.MOVING_SPAN`), they must have its shape at all
+    (correlation at least :data:`VELOCITY_UNLIKE`): another joint's column, or currents read as velocities (which a
+    viscous term then fits as the torque, below the noise floor), are refused.
 
     Parameters
     ----------
@@ -269,17 +277,27 @@ def check_velocities(dq, from_positions, label: str) -> None:
         The derivative of the filtered positions.
     label : str
         The dataset, for the message.
+    positions : (N, n_dof) array or StoredColumns [rad], optional
+        The filtered positions, whose span says which joints move (without them, no joint is required to).
 
     Raises
     ------
     DataError
-        Naming the dataset, the joint, the ratio and the settings to check.
+        Naming the dataset, the joint, the ratio or correlation and the settings to check.
     """
     for j in range(dq.shape[1]):
         v = np.asarray(dq.column(j) if hasattr(dq, "column") else dq[:, j], dtype=float)
         d = np.asarray(from_positions.column(j) if hasattr(from_positions, "column") else from_positions[:, j],
                        dtype=float)
         vv, dd, vd = float(v @ v), float(d @ d), float(v @ d)
+        if positions is not None and vv > 0 and dd > 0 and abs(vd) < VELOCITY_UNLIKE * np.sqrt(vv * dd):
+            x = np.asarray(positions.column(j) if hasattr(positions, "column") else positions[:, j], dtype=float)
+            span = float(np.ptp(x))
+            if span > MOVING_SPAN:
+                raise DataError(f"{label}: joint {j + 1}'s measured velocities do not follow the derivative of its "
+                                f"positions (correlation {vd / np.sqrt(vv * dd):.2f} over a motion of {span:.3g} rad): "
+                                "another joint's column, or not velocities? check the velocities' columns, or leave "
+                                "them out (velocities = false) to derive them from the positions")
         if vv <= 0 or dd <= 0 or abs(vd) < VELOCITY_SHAPE * np.sqrt(vv * dd):
             continue
         ratio = vd / dd
@@ -291,7 +309,8 @@ def check_velocities(dq, from_positions, label: str) -> None:
                 " (a flipped sign?)" if abs(ratio + 1) < 0.1 else "")
         raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its "
                         f"positions{hint}: check their unit, sign and side (velocities = {{ ..., unit = \"deg/s\" }}, "
-                        "sign = -1 or side = \"motor\"), or leave the velocities out to derive them from the positions")
+                        "sign = -1 or side = \"motor\"), or leave them out (velocities = false) to derive them from the "
+                        "positions")
 
 
 SATURATION_SAMPLES = 20
