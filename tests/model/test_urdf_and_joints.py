@@ -100,3 +100,24 @@ def test_a_joint_axis_that_is_no_direction_is_refused_with_its_line(tmp_path, ax
 def test_a_non_finite_override_is_refused(tmp_path):
     with pytest.raises(ConfigError, match=r"joints\[1\]\.com: expected finite numbers"):
         load_robot(_description(tmp_path, _broken_urdf(), "mass = 28.0\ncom = [0.0, nan, 0.3]\ninertia = [1, 1, 1, 0, 0, 0]\n"))
+
+
+def test_a_urdf_without_inertias_is_said_once(tmp_path):
+    """A kinematic URDF (no <inertial> at all): one line saying there is no nominal model, not one per link; a URDF
+    with one massless link still names that link."""
+    text = (ROBOTS / "ur10e.urdf").read_text()
+    bare = re.sub(r"<inertial>.*?</inertial>", "", text, flags=re.S)
+    (tmp_path / "bare.urdf").write_text(bare)
+    robot = load_robot(tmp_path / "bare.urdf")
+    assert not np.any(robot.inertial)
+    assert len(robot.nominal_problems) == 1
+    assert robot.nominal_problems[0].endswith("no link has a nominal mass or inertia (a URDF without <inertial>, a "
+                                              "kinematic description): there is no nominal model to compare the "
+                                              "estimate with, nor a prior for what the log does not determine (zero)")
+    first = re.search(r"<inertial>.*?</inertial>", text, flags=re.S)
+    wrist = text.rfind("<inertial>")  # the last link's inertial left out, the others kept
+    (tmp_path / "one.urdf").write_text(text[:wrist] + re.sub(r"<inertial>.*?</inertial>", "", text[wrist:], count=1,
+                                                             flags=re.S))
+    one = load_robot(tmp_path / "one.urdf")
+    assert first is not None and len(one.nominal_problems) == 1 and "link 6 (wrist_3_link): nominal mass 0 kg" in \
+        one.nominal_problems[0]

@@ -300,6 +300,10 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
     problems = tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(n)
                      for p in physical_problems(inertial[i]))
+    if n > 1 and not np.any(inertial):  # one line for a description without inertias, not one a link
+        problems = (f"{source}: no link has a nominal mass or inertia (a URDF without <inertial>, a kinematic "
+                    "description): there is no nominal model to compare the estimate with, nor a prior for what the "
+                    "log does not determine (zero)",)
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
