@@ -25,9 +25,9 @@ def test_velocities_of_zeros_are_left_out_and_said():
     without = recording_from_arrays(robot, t, q, tau, name="run")
     assert given.dq is None
     np.testing.assert_array_equal(given.q, without.q)
-    assert given.warnings == ("run: joint 4's measured velocities read 0 rad/s throughout while the positions span up to "
-                              "0.6 rad (a velocity channel not logged?): every joint's velocities are left out and "
-                              "derived from the positions",)
+    assert given.warnings == ("run: joint 4's measured velocities read 0 rad/s throughout while the positions span "
+                              "up to 0.6 rad (a velocity channel not logged?): every joint's velocities are left out "
+                              "and derived from the positions",)
     assert recording_from_arrays(robot, *_arrays()[:2], _arrays()[3], _arrays()[2]).dq is not None
 
 

@@ -59,9 +59,9 @@ def test_a_row_written_twice_is_dropped_and_said(tmp_path, spool):
         load_recording(dataset_spec({"preset": "ur-rtde", "file": "back.csv"}, tmp_path, "cfg", "ident", 6), robot,
                        spool=spool)
     (tmp_path / "again.csv").write_text("".join(rows + rows))  # a second recording appended, its clock started again
-    with pytest.raises(DataError, match=r"again.csv: line 201: time stamps must increase, got time going back: 0 s after "
-                                        r"1.99 s; two recordings one after the other\? give each its own file, or select "
-                                        r"one with rows$"):
+    with pytest.raises(DataError, match=r"again.csv: line 201: time stamps must increase, got time going back: 0 s "
+                                        r"after 1.99 s; two recordings one after the other\? give each its own file, "
+                                        r"or select one with rows$"):
         load_recording(dataset_spec({"preset": "ur-rtde", "file": "again.csv"}, tmp_path, "cfg", "ident", 6), robot,
                        spool=spool)
 
@@ -407,19 +407,20 @@ def test_a_velocity_channel_not_logged_is_left_out_and_said(tmp_path, spool):
     dq[:, 2] = 0.0
     (tmp_path / "dead.csv").write_text("".join(_ur_row(*r) for r in zip(t, q, dq, cur)))
     robot = load_robot("ur10e")
-    live, dead = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident", 6),
-                                 robot, spool=spool) for name in ("live", "dead"))
+    live, dead = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg", "ident",
+                                              6), robot, spool=spool) for name in ("live", "dead"))
     assert live.dq is not None and not [w for w in live.warnings if "velocit" in w]
     without = load_recording(dataset_spec({"file": "dead.csv", "header": False, "time": {"column": 1},
                                            "positions": {"columns": [2, 3, 4, 5, 6, 7]},
-                                           "currents": {"columns": [14, 15, 16, 17, 18, 19]}}, tmp_path, "cfg", "ident", 6),
+                                           "currents": {"columns": [14, 15, 16, 17, 18, 19]}}, tmp_path, "cfg",
+                                          "ident", 6),
                              robot, spool=spool)
     assert dead.dq is None and without.dq is None
     np.testing.assert_array_equal(np.asarray(dead.q), np.asarray(without.q))
     np.testing.assert_array_equal(np.asarray(dead.tau), np.asarray(without.tau))
     assert [w for w in dead.warnings if w not in without.warnings] == [
-        "ident: joint 3's measured velocities read 0 rad/s throughout while the positions span up to 0.6 rad (a velocity "
-        "channel not logged?): every joint's velocities are left out and derived from the positions"]
+        "ident: joint 3's measured velocities read 0 rad/s throughout while the positions span up to 0.6 rad (a "
+        "velocity channel not logged?): every joint's velocities are left out and derived from the positions"]
 
 
 def test_a_position_step_the_joint_stays_at_is_refused_a_spike_is_read(tmp_path):
@@ -434,12 +435,14 @@ def test_a_position_step_the_joint_stays_at_is_refused_a_spike_is_read(tmp_path)
     step[300:, 1] += 0.5
     spike[300, 1] += 0.5
     for name, x in (("step", step), ("spike", spike)):
-        (tmp_path / f"{name}.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), ik) for tk, qk, ik in zip(t, x, cur)))
+        rows = (_ur_row(tk, qk, np.zeros(6), ik) for tk, qk, ik in zip(t, x, cur))
+        (tmp_path / f"{name}.csv").write_text("".join(rows))
     robot = load_robot("ur10e")
     spec = dataset_spec({"preset": "ur-rtde", "file": "step.csv"}, tmp_path, "cfg", "ident", 6)
     jump = step[300, 1] - step[299, 1]
-    with pytest.raises(DataError, match=rf"step.csv: joint 2's position steps by {jump:.4g} rad at t = 2.400 s and stays "
-                                        r"there, faster than the joint moves \(limit 2.09 rad/s\): an encoder homed again"):
+    with pytest.raises(DataError, match=rf"step.csv: joint 2's position steps by {jump:.4g} rad at t = 2.400 s and "
+                                        r"stays there, faster than the joint moves \(limit 2.09 rad/s\): an encoder "
+                                        r"homed again"):
         load_recording(spec, robot)
     read = load_recording(dataset_spec({"preset": "ur-rtde", "file": "spike.csv"}, tmp_path, "cfg", "ident", 6), robot)
     np.testing.assert_allclose(np.asarray(read.q)[300, 1], spike[300, 1], atol=1e-6)

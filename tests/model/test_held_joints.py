@@ -71,7 +71,8 @@ def test_held_is_refused_where_it_cannot_mean_anything(tmp_path):
     _urdf(tmp_path, ARM + FINGERS)
     with pytest.raises(ConfigError, match=r"arm.urdf: held names joint 'f3', which the URDF's moving joints do not "
                                           r"include \(j1, j2, f1, f2\)"):
-        robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2", "f3"]}, "arm.toml", tmp_path)
+        robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2", "f3"]}, "arm.toml",
+                            tmp_path)
     with pytest.raises(ConfigError, match=r"arm.toml: held names joints of a URDF to hold fixed, but this description "
                                           r"has no URDF"):
         robot_from_document({"convention": "modified", "held": ["f1"], "joints": [{"mass": 1.0, "com": [0, 0, 0],
@@ -121,6 +122,6 @@ def test_init_names_the_joints_to_hold_where_the_log_has_fewer(tmp_path, header)
     t = np.arange(100) * 0.01
     rows = "".join(f"{x},{np.sin(x)},{np.cos(x)},{x},{-x}\n" for x in t)
     (tmp_path / "log.csv").write_text(("t,q1,q2,tau1,tau2\n" if header else "") + rows)
-    with pytest.raises(DataError, match=r"if the log holds the first 2 of arm.urdf's joints and the rest are a gripper's, "
-                                        r"hold them: \[robot\] urdf = \"arm.urdf\", held = \[\"gripper\"\]"):
+    with pytest.raises(DataError, match=r"if the log holds the first 2 of arm.urdf's joints and the rest are a "
+                                        r"gripper's, hold them: \[robot\] urdf = \"arm.urdf\", held = \[\"gripper\"\]"):
         starter_config(urdf, tmp_path / "log.csv", 3, tmp_path / "arm.toml", joints=("j1", "j2", "gripper"))

@@ -87,8 +87,9 @@ class DatasetTable(Table, kw_only=True):
     resample: Annotated[PositiveHz, _d("Hz: uniform grid for jittered time stamps (default 1 / median step)")] | None = None
     side: Annotated[Literal["joint", "motor"], _d("joint (default) or motor side of the transmission")] | None = None
     positions: Annotated[SignalTable, _d("joint or motor angles (rad or deg)")] | None = None
-    velocities: Annotated[Union[SignalTable, bool], _d("measured velocities (optional; false: none, a preset's left out "
-                                                       "and derived from the positions)")] | None = None
+    velocities: Annotated[Union[SignalTable, bool], _d(
+        "measured velocities (optional; false: none, a preset's left out and derived from the positions)"
+    )] | None = None
     currents: Annotated[SignalTable, _d("motor currents: torque = drive gain · current (eq. 16)")] | None = None
     torques: Annotated[SignalTable, _d("torques [N·m], instead of currents")] | None = None
     bag: Annotated[str, _d("a ROS 2 bag's folder, relative to the data root")] | None = None

@@ -194,9 +194,9 @@ def read_users_mjcf(path: Path, robot: Robot):
         missing, is not a hinge, or is in an included file; the robot holds joints fixed (:attr:`Robot.held`).
     """
     if robot.held:
-        raise ConfigError(f"{path}: the robot holds {', '.join(robot.held)} fixed (held), whose bodies this MJCF moves: "
-                          "writing into it would count them twice; export dynid's own MJCF (dynid export --mjcf FILE "
-                          "without --mjcf-model and no mjcf_model in the config)")
+        raise ConfigError(f"{path}: the robot holds {', '.join(robot.held)} fixed (held), whose bodies this MJCF "
+                          "moves: writing into it would count them twice; export dynid's own MJCF (dynid export "
+                          "--mjcf FILE without --mjcf-model and no mjcf_model in the config)")
     mujoco = require("mujoco", "mujoco", "writing into an MJCF")
     try:
         model = mujoco.MjModel.from_xml_path(str(path))

@@ -69,7 +69,8 @@ def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
     return None
 
 
-def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str], joints: tuple[str, ...]) -> list[str]:
+def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str],
+                    joints: tuple[str, ...]) -> list[str]:
     """Where the log names its joints in columns of their own (``rostopic echo -p``'s ``field.name0``…, a JointState's
     names in every row, often alphabetical), each signal's numbered columns reordered into the URDF's joint order, said;
     ``found`` is changed in place."""
@@ -207,7 +208,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     else:
         fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
         raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
-                        "signal (or name the columns in a header line: t, q1…, tau1…)" + _hold_hint(urdf, joints, fewer))
+                        "signal (or name the columns in a header line: t, q1…, tau1…)"
+                        + _hold_hint(urdf, joints, fewer))
     notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
                  "positions for degrees")
     notes += _held_notes(urdf, held)

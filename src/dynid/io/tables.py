@@ -246,8 +246,8 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
             if first_line is None:  # the first data line: the column map must fit it
                 expected = n_fields if expected is None else expected
                 if max(cols) >= expected:
-                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have {expected} columns"
-                                + (_separator_hint(line, delimiter) if n_fields == 1 else ""))
+                    raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have "
+                                f"{expected} columns" + (_separator_hint(line, delimiter) if n_fields == 1 else ""))
             if n_fields != expected:  # the truncated last line (a warning), or a mistake (refused)
                 _odd_line(path, line, line_no, n_fields, expected, delimiter, warnings)
                 break

@@ -129,7 +129,8 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
     return np.array([m, mx, my, mz, xx, xy, yy, xz, yz, zz])
 
 
-def joints_from_urdf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
+def joints_from_urdf(path: str | Path,
+                     held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
     """Joints and link inertial parameters of a URDF serial chain of revolute joints.
 
     Fixed joints are merged by Pinocchio into the parent link, and so are ``held`` joints (a gripper's fingers, mimic
@@ -196,7 +197,8 @@ def joints_from_urdf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
 
 
 def _pinocchio_model(path: Path, held: dict):
-    """Pinocchio's model of a URDF, its ``held`` joints locked at their positions (their links merged into the parent's)."""
+    """Pinocchio's model of a URDF, its ``held`` joints locked at their positions (their links merged into the
+    parent's)."""
     import pinocchio as pin
 
     printed: list[str] = []

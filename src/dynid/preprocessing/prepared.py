@@ -309,8 +309,8 @@ def check_velocities(dq, from_positions, label: str, *, positions=None) -> None:
                 " (a flipped sign?)" if abs(ratio + 1) < 0.1 else "")
         raise DataError(f"{label}: joint {j + 1}'s measured velocities are {ratio:.4g}× the derivative of its "
                         f"positions{hint}: check their unit, sign and side (velocities = {{ ..., unit = \"deg/s\" }}, "
-                        "sign = -1 or side = \"motor\"), or leave them out (velocities = false) to derive them from the "
-                        "positions")
+                        "sign = -1 or side = \"motor\"), or leave them out (velocities = false) to derive them "
+                        "from the positions")
 
 
 SATURATION_SAMPLES = 20
