@@ -298,12 +298,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         inertial = inertial.copy()
         inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, alpha, a, dd)
     link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
-    problems = tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(n)
-                     for p in physical_problems(inertial[i]))
-    if n > 1 and not np.any(inertial):  # one line for a description without inertias, not one a link
-        problems = (f"{source}: no link has a nominal mass or inertia (a URDF without <inertial>, a kinematic "
-                    "description): there is no nominal model to compare the estimate with, nor a prior for what the "
-                    "log does not determine (zero)",)
+    problems = _nominal_problems(inertial, link_names, source)
     return Robot(
         name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
@@ -311,6 +306,17 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
         held=tuple(held),
     )
+
+
+def _nominal_problems(inertial: np.ndarray, link_names, source: str) -> tuple[str, ...]:
+    """A line per physical-consistency rule each link's nominal values break; one line for a description without
+    inertias (a kinematic URDF), not one a link."""
+    if inertial.shape[0] > 1 and not np.any(inertial):
+        return (f"{source}: no link has a nominal mass or inertia (a URDF without <inertial>, a kinematic "
+                "description): there is no nominal model to compare the estimate with, nor a prior for what the "
+                "log does not determine (zero)",)
+    return tuple(f"{source}: link {i + 1} ({link_names[i]}): nominal {p}" for i in range(inertial.shape[0])
+                 for p in physical_problems(inertial[i]))
 
 
 def _held(held, convention: str, source: str) -> dict:
