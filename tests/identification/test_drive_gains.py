@@ -183,3 +183,22 @@ def test_a_drive_gains_error_names_the_runs_it_comes_from(tmp_path):
                                          r"\[drive_gains.loaded\]: rows = \[308, 340\] selects 33 samples") as caught:
         run_identification(load_identification_config(cfg_path), validate=False)
     assert "\n" not in str(caught.value)
+
+
+def test_gains_the_description_does_not_give_are_offered_to_it():
+    """A URDF alone gives drive gains 1 (currents taken as N·m): where the runs determine gains far from 1, the report
+    says so with the values to give; where the description gives gains, or the runs find 1, it says nothing more."""
+    from dynid.identification.drive_gains import DriveGainEstimate, GainsAndPayload, PayloadEstimate
+    from dynid.report.summaries import drive_gains_blocks
+
+    payload = PayloadEstimate(("MX", "MY", "MZ", "M"), np.array([0.03, -0.001, 0.17, 2.8]), np.full(4, 0.001))
+    k = np.array([np.nan, 11.83, 9.77, 10.27, 1.02, 10.30])
+    gains = DriveGainEstimate(k, np.full(6, 0.05), np.zeros(3), 2.805, 1000, 10.0)
+
+    def said(description):
+        return " ".join(line.text for line in drive_gains_blocks(GainsAndPayload(gains, payload, description))
+                        if hasattr(line, "text"))
+
+    assert ("the description gives no drive gains (1 N·m/A: the identification above took the currents as N·m); "
+            "these runs give J2 11.83, J3 9.77, J4 10.27, J6 10.3 N·m/A: give them as drive_gain") in said((1.0,) * 6)
+    assert "gives no drive gains" not in said((10.0, 10.7, 8.46, 9.0, 9.48, 10.1))

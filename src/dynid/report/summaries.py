@@ -681,11 +681,25 @@ def drive_gains_blocks(gains) -> list:
     if all(k in vals for k in ("MX", "MY", "MZ")):
         line += ", centre of mass in the last link's frame (" + ", ".join(
             "not determined" if k in lost else f"{vals[k][0] / p.mass:.3g}" for k in ("MX", "MY", "MZ")) + ") m"
-    out = [table, *why, Line(line)]
+    out = [table, *why, *_gains_not_given(gains), Line(line)]
     if lost:
         out.append(Line(f"payload parameters not determined by the loaded run (σ ≥ 100 % of the value): {', '.join(lost)}: "
                         "the noise sets them; a loaded run that turns the payload about more axes determines them", "warning"))
     return out
+
+
+def _gains_not_given(gains) -> list:
+    """Where the description gives no drive gains (every one 1: currents taken as N·m in the identification) and the
+    runs determine gains far from 1: the line that says so, with the values to give."""
+    g = gains.gains
+    far = [j for j, (k, s) in enumerate(zip(g.gains, g.gains_std))
+           if math.isfinite(k) and abs(k - 1.0) > max(0.1, 3 * s)]
+    if not far or any(d != 1.0 for d in gains.description_gains):
+        return []
+    values = ", ".join(f"J{j + 1} {g.gains[j]:.4g}" for j in far)
+    return [Line("the description gives no drive gains (1 N·m/A: the identification above took the currents as "
+                 f"N·m); these runs give {values} N·m/A: give them as drive_gain in the description's [[joints]] "
+                 "tables and identify again", "warning")]
 
 
 def montecarlo_blocks(result) -> list:
