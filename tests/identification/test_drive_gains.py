@@ -200,5 +200,7 @@ def test_gains_the_description_does_not_give_are_offered_to_it():
                         if hasattr(line, "text"))
 
     assert ("the description gives no drive gains (1 N·m/A: the identification above took the currents as N·m); "
-            "these runs give J2 11.83, J3 9.77, J4 10.27, J6 10.3 N·m/A: give them as drive_gain") in said((1.0,) * 6)
+            "these runs give J2 11.83, J3 9.77, J4 10.27, J6 10.3 N·m/A: give them as drive_gain in the description's "
+            "[[joints]] tables (J1: not determined by these runs, a datasheet's value) and identify again") in \
+        said((1.0,) * 6)
     assert "gives no drive gains" not in said((10.0, 10.7, 8.46, 9.0, 9.48, 10.1))

@@ -71,3 +71,28 @@ def test_an_unwritable_cache_falls_back_to_the_temporary_folder(tmp_path, monkey
     (tmp_path / "not-a-folder").write_text("")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "not-a-folder"))
     assert load_robot(_xacro_of_ur10e(tmp_path)).n_dof == 6
+
+
+def test_init_holds_a_xacro_grippers_fingers(tmp_path, monkeypatch):
+    """dynid init on a xacro file whose arm carries two prismatic fingers (one a mimic): the fingers are held, as for
+    a URDF, and the config it writes names the xacro file."""
+    import tomllib
+
+    from tests.cli.refusals import dynid as run
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    fingers = "".join(
+        f'<link name="{n}_link"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" '
+        f'izz="1e-4"/></inertial></link><joint name="{n}" type="prismatic"><parent link="wrist_3_link"/>'
+        f'<child link="{n}_link"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/>{m}'
+        '</joint>' for n, m in (("f1", ""), ("f2", '<mimic joint="f1"/>')))
+    path = _xacro_of_ur10e(tmp_path)
+    path.write_text(path.read_text(encoding="utf-8").replace("</robot>", fingers + "</robot>"), encoding="utf-8")
+    sim = np.column_stack([np.arange(200) * 0.01, np.zeros((200, 12))])
+    np.savetxt(tmp_path / "log.csv", sim, delimiter=",", comments="",
+               header=",".join(["t", *(f"q{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))]))
+    p = run("init", str(path), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"),
+            env={"XDG_CACHE_HOME": str(tmp_path / "cache")})
+    assert p.returncode == 0, p.stderr
+    robot = tomllib.loads((tmp_path / "arm.toml").read_text())["robot"]
+    assert robot["urdf"] == "ur10e.urdf.xacro" and robot["held"] == ["f1", "f2"]

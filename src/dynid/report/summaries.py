@@ -697,9 +697,11 @@ def _gains_not_given(gains) -> list:
     if not far or any(d != 1.0 for d in gains.description_gains):
         return []
     values = ", ".join(f"J{j + 1} {g.gains[j]:.4g}" for j in far)
+    unknown = [f"J{j + 1}" for j, k in enumerate(g.gains) if not math.isfinite(k)]
+    rest = f" ({', '.join(unknown)}: not determined by these runs, a datasheet's value)" if unknown else ""
     return [Line("the description gives no drive gains (1 N·m/A: the identification above took the currents as "
                  f"N·m); these runs give {values} N·m/A: give them as drive_gain in the description's [[joints]] "
-                 "tables and identify again", "warning")]
+                 f"tables{rest} and identify again", "warning")]
 
 
 def montecarlo_blocks(result) -> list:
