@@ -76,3 +76,48 @@ def test_a_rank_deficient_problem_keeps_the_prior_where_the_rows_say_nothing():
     full = LeastSquaresAccumulator(3, 1)  # a full-rank problem is solved as without a prior
     full.add(w[:, :3], w[:, :3] @ truth[:3] + 0.01 * rng.standard_normal(400))
     assert full.solve(prior=np.zeros(3)).params == pytest.approx(full.solve().params, rel=1e-12)
+
+
+def _one_way_rows(rng, direction: float, noise: float):
+    """A joint moving one way only: its Coulomb column sign(q̇) = ``direction`` everywhere, its offset column 1."""
+    x = rng.standard_normal((600, 2))
+    w = np.column_stack([x, np.full(600, direction), np.ones(600)])
+    truth = np.array([2.0, -1.0, 3.0, 0.5])  # the rows see only direction·fc + offset
+    acc = LeastSquaresAccumulator(4, 1)
+    acc.add(w, w @ truth + noise * rng.standard_normal(600))
+    return acc, truth
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_a_determined_pair_term_goes_to_its_free_member(direction):
+    """(fc, offset) as an anchored pair: where the log determines their one term to 10 %, the offset keeps the prior
+    and Coulomb friction takes the term (its σ that of the term); the residual is the one of the prior's split."""
+    rng = np.random.default_rng(3)
+    acc, truth = _one_way_rows(rng, direction, noise=0.05)
+    prior = np.array([0.0, 0.0, 0.4, 0.2])
+    term = direction * truth[2] + truth[3]
+    split = acc.solve(prior=prior)
+    sol = acc.solve(prior=prior, pairs=[(2, 3)])
+    assert split.anchored == () and sol.anchored == (2,)
+    assert sol.params[3] == prior[3]
+    assert direction * sol.params[2] + sol.params[3] == pytest.approx(term, abs=0.01)
+    assert sol.params[:2] == pytest.approx(split.params[:2], rel=1e-9)
+    assert sol.from_prior == (3,) and np.isfinite(sol.params_std[2]) and np.isnan(sol.params_std[3])
+    # the free member's σ is the determined term's: the spread of 'direction·fc + offset' over repeated noise draws
+    draws = []
+    for k in range(200):
+        a, _ = _one_way_rows(np.random.default_rng(100 + k), direction, noise=0.05)
+        draws.append(a.solve(prior=prior, pairs=[(2, 3)]).params[2])
+    assert sol.params_std[2] == pytest.approx(np.std(draws), rel=0.25)
+    assert np.sum(acc.joint_residual_sumsq(sol.params)) == pytest.approx(np.sum(acc.joint_residual_sumsq(split.params)),
+                                                                         rel=1e-9)
+
+
+def test_a_loose_or_negative_pair_term_keeps_the_prior_split():
+    """Not anchored where the term's σ is over 10 % of it, nor where the free member would turn negative."""
+    rng = np.random.default_rng(4)
+    acc, _ = _one_way_rows(rng, 1.0, noise=200.0)
+    prior = np.zeros(4)
+    assert acc.solve(prior=prior, pairs=[(2, 3)]).anchored == ()
+    acc, _ = _one_way_rows(rng, 1.0, noise=0.05)
+    assert acc.solve(prior=np.array([0.0, 0.0, 0.0, 10.0]), pairs=[(2, 3)]).anchored == ()  # fc would be 3.5 - 10 < 0

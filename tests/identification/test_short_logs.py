@@ -35,17 +35,28 @@ def test_a_short_log_with_joints_that_move_one_way_identifies(tmp_path):
     p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
     assert p.returncode == 0, p.stderr
     text = " ".join((p.stdout + p.stderr).split())
-    assert ("taken from the description's nominal values along what this log does not determine (no σ): fc3, offset3, "
-            "fc5, offset5; J3, J5 moved one way only: Coulomb friction + offset is estimated as one term, the split "
-            "between them is the description's") in text, text
+    assert ("taken from the description's nominal values along what this log does not determine (no σ): offset3, "
+            "offset5; J3, J5 moved one way only: Coulomb friction + offset is estimated as one term and taken as "
+            "Coulomb friction (the same in the direction not moved), the offset is the description's") in text, text
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     (finding,) = [f for f in results["findings"] if f["kind"] == "prior"]
-    assert "J3, J5 moved one way only" in finding["text"]
+    assert "J3, J5 moved one way only" in finding["text"] and "taken as Coulomb friction" in finding["text"]
+    assert results["diagnostics"]["coulomb_from_one_term"] == ["fc3", "fc5"]
     values = {b["name"]: b for b in results["base_parameters"]}
-    assert all(values[k]["std"] is None for k in ("fc3", "offset3", "fc5", "offset5"))
-    # the sum the log does determine (joint 3 moves forwards: fc3 + offset3 is its Coulomb friction f+)
-    f_plus = friction[0]
+    assert all(values[k]["std"] is None for k in ("offset3", "offset5"))
+    assert all(values[k]["std"] is not None and values[k]["std"] < 0.1 * values[k]["value"] for k in ("fc3", "fc5"))
+    nominal = {r["name"]: r for r in results["references"]}["nominal"]["values"]
+    assert values["offset3"]["value"] == nominal["offset3"] and values["offset5"]["value"] == nominal["offset5"]
+    # the term the log does determine (joint 3 moves forwards: fc3 + offset3 is its Coulomb friction f+, joint 5
+    # backwards: fc5 - offset5 is f-) ...
+    f_plus, f_minus = friction[0], friction[1]
     assert abs(values["fc3"]["value"] + values["offset3"]["value"] - f_plus[2]) < 0.1 * f_plus[2]
+    assert abs(values["fc5"]["value"] - values["offset5"]["value"] - f_minus[4]) < 0.1 * f_minus[4]
+    # ... and the direction it never moved gets that friction too: nearer the truth than the half split's 0
+    assert abs(values["fc3"]["value"] - values["offset3"]["value"] - f_minus[2]) < 0.5 * f_minus[2]
+    assert abs(values["fc5"]["value"] + values["offset5"]["value"] - f_plus[4]) < 0.5 * f_plus[4]
+    sdp = results["estimates"]["dynid SDP"]["values"]  # the physically consistent estimate splits the term the same way
+    assert abs(sdp["offset3"] - nominal["offset3"]) < 0.1 * sdp["fc3"]
     metrics = results["validation"][0]["metrics"]
     assert metrics["dynid WLS"]["global_relative_error"] < metrics["nominal"]["global_relative_error"]
     # the cutoffs' cross-validation fits its folds as the estimate is fitted (undetermined directions at the nominal

@@ -46,11 +46,18 @@ class LeastSquaresSolution:
     n_rows: int
     from_prior: tuple[int, ...] = ()
     """Parameters the rows do not determine, whose values are the prior's (their σ is NaN: not known)."""
+    anchored: tuple[int, ...] = ()
+    """The free member of each anchored pair (:meth:`LeastSquaresAccumulator.solve`'s ``pairs``) that took the pair's
+    determined combination, its partner keeping the prior."""
 
 
 UNDETERMINED_RCOND = 1e-10
 """With a prior, directions of the column-scaled observation matrix whose singular value is below this fraction of
 the largest are left at the prior (:meth:`LeastSquaresAccumulator.solve`)."""
+
+ANCHOR_RELATIVE_STD = 0.1
+"""An anchored pair (:meth:`LeastSquaresAccumulator.solve`'s ``pairs``) whose one determined combination has a σ at most
+this fraction of its value gives that combination to its free member."""
 
 
 class LeastSquaresAccumulator:
@@ -165,7 +172,8 @@ class LeastSquaresAccumulator:
         wts = np.ones(self.n_dof) if joint_weights is None else np.asarray(joint_weights, dtype=float)
         return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
 
-    def solve(self, joint_weights=None, rcond: float | None = None, names=None, prior=None) -> LeastSquaresSolution:
+    def solve(self, joint_weights=None, rcond: float | None = None, names=None, prior=None,
+              pairs=()) -> LeastSquaresSolution:
         """OLS (default) or WLS with one weight per joint.
 
         Where the rows do not determine every parameter (a rank-deficient observation matrix) and a ``prior`` is given,
@@ -184,6 +192,8 @@ class LeastSquaresAccumulator:
             (p,) names of the parameters, to name the unexcited ones in the error.
         prior : (p,) array, optional
             Values kept where the rows say nothing (the description's nominal parameters).
+        pairs : sequence of (int, int)
+            ``(free, anchored)`` parameter indices (with a prior only), as above.
 
         Returns
         -------
@@ -206,7 +216,7 @@ class LeastSquaresAccumulator:
         tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps
         if sv[-1] <= tol * sv[0]:
             if prior is not None:
-                return _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float))
+                return _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs)
             weak = _weak(vt[sv <= tol * sv[0]])
             what = (", ".join(str(names[i]) for i in np.flatnonzero(weak)) if names is not None
                     else f"{int(weak.sum())} parameter(s)")
@@ -228,7 +238,7 @@ def _weak(null_rows: np.ndarray) -> np.ndarray:
     return np.any(null > 0.3 * null.max(axis=1, keepdims=True), axis=0)
 
 
-def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.ndarray) -> LeastSquaresSolution:
+def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.ndarray, pairs=()) -> LeastSquaresSolution:
     """Least squares in the determined subspace of the column-scaled ``r``, the prior elsewhere (:meth:`solve`)."""
     p = r.shape[1]
     if prior.shape != (p,) or not np.all(np.isfinite(prior)):
@@ -246,12 +256,49 @@ def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.n
     vk = vt[:k].T / scale[:, None]
     cov = sigma2 * (vk / sv[:k] ** 2) @ vk.T
     undetermined = _weak(vt[k:]) if k < p else np.zeros(p, dtype=bool)
+    anchored = []
+    for free, fixed in pairs:
+        moved = _anchor(rs, scale, vt[k:], sv[0], params, cov, prior, free, fixed)
+        if moved is not None:
+            params, cov = moved
+            undetermined[free] = False
+            anchored.append(int(free))
     std = np.where(undetermined, np.nan, np.sqrt(np.maximum(np.diag(cov), 0.0)))
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = 100.0 * std / np.abs(params)
     cond = float(sv[0] / sv[k - 1]) if k else float("inf")
     return LeastSquaresSolution(params, cov, std, rel, cond, float(np.sqrt(sigma2)), m,
-                                tuple(int(i) for i in np.flatnonzero(undetermined)))
+                                tuple(int(i) for i in np.flatnonzero(undetermined)), tuple(anchored))
+
+
+def _anchor(rs, scale, null_rows, sv_max, params, cov, prior, free: int, fixed: int):
+    """``params`` and ``cov`` with ``fixed`` at the prior and ``free`` taking the pair's determined combination, or None
+    where the two columns are not collinear by themselves, the combination is not determined to
+    :data:`ANCHOR_RELATIVE_STD`, or ``free`` would be negative (:meth:`LeastSquaresAccumulator.solve`)."""
+    _, sv2, vt2 = np.linalg.svd(rs[:, [free, fixed]])
+    if sv2[-1] > UNDETERMINED_RCOND * sv_max:
+        return None
+    n_free, n_fixed = vt2[-1] / scale[[free, fixed]]  # the pair's null direction, unscaled
+    if abs(n_free) < 1e-12 * abs(n_fixed) or abs(n_fixed) < 1e-12 * abs(n_free):
+        return None
+    g = np.zeros(params.size)  # the combination the rows determine: value of `fixed` with `free` moved to 0
+    g[free], g[fixed] = -n_fixed / n_free, 1.0
+    h = g / scale  # in the scaled coordinates, orthogonal to every undetermined direction if determined
+    if np.linalg.norm(null_rows @ h) > 1e-6 * np.linalg.norm(h):
+        return None
+    c = float(g @ params)
+    sd = float(np.sqrt(max(g @ cov @ g, 0.0)))
+    d = -n_fixed / n_free  # c = d·free + fixed along the null direction
+    value = (c - prior[fixed]) / d
+    if not sd <= ANCHOR_RELATIVE_STD * abs(c) or value < 0:
+        return None
+    t = np.eye(params.size)  # the new parameters as a linear map of the old (plus the prior's offset)
+    t[free] = g / d
+    t[fixed] = 0.0
+    out = t @ params
+    out[fixed] = prior[fixed]
+    out[free] = value
+    return out, t @ cov @ t.T
 
 
 def _triangular(a: np.ndarray, size: int) -> np.ndarray:

@@ -5,7 +5,30 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import split_name
 from .base import AccumulatingEstimator
+
+
+def coulomb_offset_pairs(names) -> tuple[tuple[int, int], ...]:
+    """``(fc_j, offset_j)`` index pairs of the parameters ``names`` (none without names).
+
+    A joint that moves one way only has its Coulomb friction and torque offset in one term; where the log determines
+    that term, the offset keeps the description's value and the term is taken as Coulomb friction (symmetric: the same
+    friction in the direction the log never moved), :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`.
+
+    Parameters
+    ----------
+    names : sequence of str or None
+        (p,) base parameters' names.
+
+    Returns
+    -------
+    tuple of (int, int)
+    """
+    if names is None:
+        return ()
+    where = {split_name(n): i for i, n in enumerate(names) if n[-1:].isdigit()}
+    return tuple((i, where[("offset", j)]) for (term, j), i in where.items() if term == "fc" and ("offset", j) in where)
 
 
 class OrdinaryLeastSquares(AccumulatingEstimator):
@@ -21,7 +44,9 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
         ``max(M, p) · eps``.
     base_prior : (p,) array or None
         Values kept along the directions the rows do not determine (the description's nominal base parameters);
-        without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it.
+        without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it. With the parameters'
+        names given (``partial_fit(..., names=)``), a joint's Coulomb friction takes the one term it shares with its
+        offset where only that term is determined (:func:`coulomb_offset_pairs`).
 
     Attributes
     ----------
@@ -57,7 +82,8 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
         self.base_prior = base_prior
 
     def _solve(self, acc) -> None:
-        sol = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"), prior=self.base_prior)
+        names = self.__dict__.get("names_in_")
+        sol = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=coulomb_offset_pairs(names))
         _set_solution(self, sol)
         self.ols_params_ = sol.params
         self.joint_std_ = acc.joint_residual_std(sol.params)
@@ -116,8 +142,11 @@ class WeightedLeastSquares(AccumulatingEstimator):
         self.base_prior = base_prior
 
     def _solve(self, acc) -> None:
-        ols = acc.solve(rcond=self.rcond, names=self.__dict__.get("names_in_"), prior=self.base_prior)
+        names = self.__dict__.get("names_in_")
+        pairs = coulomb_offset_pairs(names)
+        ols = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=pairs)
         std = acc.joint_residual_std(ols.params)
-        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=self.base_prior))
+        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=self.base_prior,
+                                      pairs=pairs))
         self.ols_params_ = ols.params
         self.joint_std_ = std

@@ -357,6 +357,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         hint = f"; joint(s) {', '.join(still)} barely move" if still else ""
         raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None
     sol, ols_params, joint_std = reference.solution_, reference.ols_params_, reference.joint_std_
+    if sol.anchored and "sdp" in estimation.streamed:  # the SDP splits Coulomb + offset as least squares did
+        _anchor_prior(estimation.streamed["sdp"], robot, base, sol)
     row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     box = search_box(sol.params, sol.params_std) if any(spec(k).needs_box for k in keys) else None
     rngs = {k: np.random.default_rng([int(rng), seed_index(k)]) for k in keys}  # (seed, estimator): whatever else is asked for
@@ -546,11 +548,25 @@ def _verdict(robot, base, sol, ols_params, row_weights, scoring: BlockScoring, f
     stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
-        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead, still=data.still)
+        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead, still=data.still,
+                                   anchored=sol.anchored)
+    if sol.anchored:
+        stats["coulomb_from_one_term"] = [base.names[i] for i in sol.anchored]
     # the prediction's spread from the parameters' covariance: Σ diag(y C yᵀ) = trace(C Σ y yᵀ)
     spread = np.sqrt(np.maximum(np.einsum("cd,jdc->j", sol.covariance, raw[:, :-1, :-1]) / max(sums.count, 1), 0.0))
     stats["prediction_spread"] = spread
     return findings, stats
+
+
+def _anchor_prior(sdp, robot: Robot, base: BaseParameters, sol) -> None:
+    """Set the physically consistent estimate's prior Coulomb friction of the joints whose Coulomb + offset term least
+    squares gave to Coulomb friction (:attr:`LeastSquaresSolution.anchored`) to that value, so that its pull toward the
+    prior splits the term as least squares did (offset at the description's value) rather than half and half."""
+    prior = np.array(sdp.get_params()["prior"], dtype=float)
+    names = robot.parameter_names
+    for i in sol.anchored:
+        prior[names.index(base.names[i])] = sol.params[i]
+    sdp.set_params(prior=prior)
 
 
 def _one_way(data: PreparedData) -> list[int]:

@@ -425,7 +425,7 @@ def _over_joints(dead) -> str:
             "left out)")
 
 
-def _kept_line(kept: list, dead) -> Line:
+def _kept_line(kept: list, dead, anchored=()) -> Line:
     """:func:`in_short`'s line on the parameters the log does not determine (:attr:`LeastSquaresSolution.from_prior`).
     A joint that moved one way only has its Coulomb friction and offset undetermined apart, not each: their sum is
     estimated and only the split is the description's (it read "kept at the description's nominal values" beside
@@ -441,6 +441,11 @@ def _kept_line(kept: list, dead) -> Line:
                  "them is the description's")
     if none:
         text += f"; {', '.join(f'J{j}' for j in none)}: no friction term determined (a joint held still?)"
+    taken = [n[2:] for n in anchored if n.startswith("fc")]
+    if taken:
+        text += (f"; {', '.join(f'J{j}' for j in taken)} moved one way only: Coulomb friction + offset is estimated as "
+                 "one term and taken as Coulomb friction (the same in the direction not moved), the offset is the "
+                 "description's")
     return Line(text)
 
 
@@ -561,7 +566,8 @@ def in_short(result) -> list:
     out += lines
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
-        out.append(_kept_line([n for n in r.base.names if n in kept], r.fit.dead))
+        out.append(_kept_line([n for n in r.base.names if n in kept], r.fit.dead,
+                              [r.base.names[i] for i in r.solution.anchored]))
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     loose = [n for n, rel in zip(r.base.names, r.solution.relative_std)
              if n not in kept and not_determined(n, float(rel), share)]

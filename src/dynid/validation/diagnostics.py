@@ -631,7 +631,7 @@ def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> 
 
 
 def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tuple[int, ...] = (),
-                   still: list[int] | tuple[int, ...] = ()) -> list[Finding]:
+                   still: list[int] | tuple[int, ...] = (), anchored=()) -> list[Finding]:
     """The parameters a log does not determine, whose values are the description's nominal ones (least squares with a
     prior, :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`).
 
@@ -648,6 +648,9 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tu
         Joints whose torque channel is dead in the log (their rows were left out).
     still : sequence of int
         Joints that never moved in the log (their friction and rotor inertia appear in no row).
+    anchored : sequence of int
+        The Coulomb friction parameters that took their joint's one Coulomb + offset term, its offset kept at the
+        prior (:attr:`dynid.estimators.accumulate.LeastSquaresSolution.anchored`).
 
     Returns
     -------
@@ -659,6 +662,10 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tu
     both = [j for j in one_way if f"fc{j + 1}" in shown and f"offset{j + 1}" in shown]
     why = (f" ({', '.join(f'J{j + 1}' for j in both)} moved one way only: Coulomb friction and offset act as one term, "
            "their sum is estimated)" if both else "")
+    taken = [names[i][2:] for i in anchored if names[i].startswith("fc")]
+    if taken:
+        why += (f" ({', '.join(f'J{j}' for j in taken)} moved one way only: the one term of Coulomb friction and offset is "
+                "estimated and taken as Coulomb friction, the same in the direction not moved)")
     if dead:
         why += f" ({', '.join(f'J{j + 1}' for j in dead)}: a dead torque channel, its rows left out)"
     if still:
