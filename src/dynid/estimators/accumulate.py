@@ -35,6 +35,9 @@ class LeastSquaresSolution:
     n_rows : int
     from_prior : tuple of int
         Parameters the rows do not determine, whose values are the prior's (σ NaN).
+    anchored : tuple of int
+        The free member of each anchored pair that took the pair's determined combination
+        (:meth:`LeastSquaresAccumulator.solve`'s ``pairs``).
     """
 
     params: np.ndarray
