@@ -1,0 +1,68 @@
+"""dynid's defaults on short windows of a real identification log in which some joints move one way only (issue
+"Honest on any log", item 1).
+
+The UR10e's identification log (``configs/ur10e.toml``, Mamedov & Mikhel 2020) cut to windows of 3-6 s in which at
+least one joint never reverses; each window is identified with the defaults and scored on the config's 11 validation
+logs. Prints, per window: the joints that moved one way, the main estimate's mean global validation error, the
+least-squares and SDP estimates' beside it, the joints whose Coulomb + offset term was taken as Coulomb friction
+(``diagnostics.coulomb_from_one_term``) and the parameters kept at the description's values. Run at two commits
+to compare them. From the repository root: ``.venv/bin/python benchmarks/short_windows.py`` (about a minute).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+DATA = Path(os.environ.get("DYNID_SHARED_DATA", REPO.parent / "shared" / "data")) / "ur10e_mamedov2020"
+WINDOWS = ((635, 935), (710, 1010), (635, 1135), (785, 1285), (1060, 1560), (635, 1235))
+"""Row ranges of the identification log (the config's rows are 635-3510): each has a joint that moves one way."""
+
+
+def one_way(dq: np.ndarray, min_speed: float = 0.02) -> list[int]:
+    """Joints (1-based) whose moving samples (|q̇| above ``min_speed``) all go one way."""
+    out = []
+    for j in range(dq.shape[1]):
+        v = dq[np.abs(dq[:, j]) > min_speed, j]
+        if v.size > 10 and min(np.mean(v > 0), np.mean(v < 0)) < 0.01:
+            out.append(j + 1)
+    return out
+
+
+def main() -> int:
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    if not DATA.is_dir():
+        print(f"{DATA} not found (set DYNID_SHARED_DATA to the shared/data folder)")
+        return 1
+    raw = np.loadtxt(DATA / "identification_data" / "ur-20_02_10-30sec_12harm.csv", delimiter=",")
+    text = (REPO / "configs" / "ur10e.toml").read_text()
+    folder = Path(tempfile.mkdtemp())
+    print("rows | one way | main estimate: mean validation error % | least squares | SDP | taken as Coulomb | kept at nominal")
+    for a, b in WINDOWS:
+        path = folder / f"ur10e-{a}-{b}.toml"
+        path.write_text(re.sub(r"^rows = \[635, 3510\]", f"rows = [{a}, {b}]", text, count=1, flags=re.M))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = run_identification(load_identification_config(path, data_root=DATA))
+        mean = {k: float(np.mean([v.metrics()[k]["global_relative_error"] for v in result.validations]))
+                for k in result.estimates}
+        ls = next(k for k in result.estimates if "SDP" not in k)
+        stats = result.diagnostics or {}
+        print(f"{a}-{b} | {one_way(raw[a:b, 7:13])} | {result.main}: {mean[result.main]:.2f} | {mean[ls]:.2f} | "
+              f"{mean.get('dynid SDP', float('nan')):.2f} | {stats.get('coulomb_from_one_term', [])} | "
+              f"{stats.get('from_prior', [])}")
+        sys.stdout.flush()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
