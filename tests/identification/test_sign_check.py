@@ -67,6 +67,59 @@ def test_two_seconds_of_the_ur10e_log_are_not_called_flipped(tmp_path):
     assert "flipped" not in p.stdout + p.stderr
 
 
+def test_three_seconds_of_the_ur10e_log_are_not_called_scaled(tmp_path):
+    """Rows 635-935 of the UR10e's identification log (3 s, slow): beyond friction, J5's and J6's torques are mostly
+    their rotor inertia's, which the description lacks (slopes 6.7 and about 2000 on the nominal model's, ρ ≥ 0.9), and
+    the verdict read "the measured torques are about 6.7× the description's nominal model's ...: set scale = 0.149".
+    The scale is judged beyond the rotor inertia too: no such finding (the full log gives none either)."""
+    root = shared_data("ur10e_mamedov2020")
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
+    text = text.replace('data_root = "../../shared/data/ur10e_mamedov2020"', f'data_root = "{root}"')
+    text = text.replace("rows = [635, 3510]", "rows = [635, 935]")
+    (tmp_path / "c.toml").write_text(text)
+    p = dynid("identify", tmp_path / "c.toml", "--out", tmp_path / "out", "--no-figures", "--no-validate")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["diagnostics"]["nominal_slope_beyond_friction"][4] > 3  # what the check beyond friction saw
+    assert [f for f in results["findings"] if f["kind"] == "scale"] == []
+    slope = np.array(results["diagnostics"]["nominal_slope_beyond_drive"][:3], dtype=float)
+    assert np.all(np.abs(slope - 1) < 0.5), slope  # the arm's torques have the description's size (J1-J3)
+
+
+def test_a_large_rotor_inertia_the_description_lacks_is_not_a_scale(tmp_path):
+    """A simulated UR10e whose rotor inertias (in the torques, not in the description) dominate a short, slow log
+    in which the currents are in amperes, as the description's gains take them: no scale finding; the same torques
+    in mA still get one."""
+    from ..simulated_logs import config_text, fourier_motion, robot_toml, truth_robot, write_log, write_truth
+
+    rng = np.random.default_rng(5)
+    robot, (f_plus, f_minus, fv, ia) = truth_robot("ur10e", rng)
+    friction = (f_plus, f_minus, fv, 300.0 * ia)  # 2-23 kg·m² at the joints, the description's Ia is 0
+    rate = 500.0
+    t = np.arange(int(3 * rate)) / rate
+    write_log(tmp_path / "ident.csv", robot, t, *fourier_motion(robot, t, rng, f0=0.5, n_harmonics=3, fill=0.15),
+              friction, rng, current_std=0.01)
+    write_log(tmp_path / "valid.csv", robot, t, *fourier_motion(robot, t, rng), friction, rng, current_std=0.01)
+    write_truth(tmp_path / "truth.csv", robot, robot.parameter_names)  # a reference the config names (not judged here)
+    cfg = tmp_path / "config.toml"
+    cfg.write_text(config_text(robot_toml("ur10e", tmp_path), tmp_path, "ident.csv", "valid.csv", robot.n_dof))
+    p = dynid("identify", cfg, "--out", tmp_path / "a", "--no-figures", "--no-validate")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "a" / "results.json").read_text())
+    judged = np.array(results["diagnostics"]["nominal_correlation_beyond_friction"], dtype=float) >= 0.9
+    assert np.median(np.array(results["diagnostics"]["nominal_slope_beyond_friction"])[judged]) > 3  # what it saw
+    assert [f for f in results["findings"] if f["kind"] == "scale"] == []
+    data = np.loadtxt(tmp_path / "ident.csv", delimiter=",")
+    data[:, 7:13] *= 1000.0
+    np.savetxt(tmp_path / "ident.csv", data, delimiter=",", fmt="%.10g")
+    p = dynid("identify", cfg, "--out", tmp_path / "ma", "--no-figures", "--no-validate")
+    assert p.returncode == 0, p.stderr
+    (scale,) = [f for f in _findings(tmp_path / "ma") if f["kind"] == "scale"]
+    assert "scale = 0.001" in scale["text"]
+
+
 def _findings(out):
     return json.loads((out / "results.json").read_text())["findings"]
 

@@ -515,9 +515,28 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     beyond, slope = sums.beyond(nominal, friction)
     stats["nominal_correlation_beyond_friction"] = beyond
     stats["nominal_slope_beyond_friction"] = slope
+    # the scale is judged beyond the rotor inertia too: descriptions rarely give it (a URDF has no armature), and on a
+    # short slow log the torque it takes can be most of what varies beyond friction (the UR10e: 6.7× "the nominal")
+    rotor = _rotor_columns(scoring.robot, base)
+    drive = {j: cols + rotor.get(j, []) for j, cols in friction.items()}
+    beyond_drive, slope_drive = sums.beyond(nominal, drive)
+    stats["nominal_correlation_beyond_drive"] = beyond_drive
+    stats["nominal_slope_beyond_drive"] = slope_drive
     varies = fit.varies()
     return (sign_findings(np.where(np.isfinite(beyond), np.maximum(corr, beyond), corr), varies, data.name)
-            + scale_findings(beyond, slope, varies, data.name))
+            + scale_findings(beyond_drive, slope_drive, varies, data.name))
+
+
+def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:
+    """Joint (0-based) -> the base columns that hold its rotor inertia ``Ia`` (its own, or the inertial one it is
+    regrouped into), from the base map's regrouping."""
+    names = list(robot.parameter_names)
+    out: dict = {}
+    for j in range(robot.n_dof):
+        if f"Ia{j + 1}" in names:
+            column = np.asarray(base.regrouping)[:, names.index(f"Ia{j + 1}")]
+            out[j] = [int(k) for k in np.flatnonzero(np.abs(column) > 0)]
+    return out
 
 
 def _verdict(robot, base, sol, ols_params, row_weights, scoring: BlockScoring, fit, rng):
