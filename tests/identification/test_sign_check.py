@@ -52,16 +52,7 @@ def test_two_seconds_of_the_ur10e_log_are_not_called_flipped(tmp_path):
     """Rows 635-800 of the UR10e's identification log (2 s): J4's torque runs against the nominal model
     (ρ = -0.865: friction the nominal model lacks) but not beyond its friction terms (-0.086); the log's sign is right
     (its full length gives no such finding). It read "J4: ... is their sign flipped?" and "not ready"."""
-    root = shared_data("ur10e_mamedov2020")
-    from pathlib import Path
-
-    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
-    text = text.replace('data_root = "../../shared/data/ur10e_mamedov2020"', f'data_root = "{root}"')
-    text = text.replace("rows = [635, 3510]", "rows = [635, 800]")
-    (tmp_path / "c.toml").write_text(text)
-    p = dynid("identify", tmp_path / "c.toml", "--out", tmp_path / "out", "--no-figures", "--no-validate")
-    assert p.returncode == 0, p.stderr
-    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    p, results = _ur10e_rows(tmp_path, 635, 800)
     assert results["diagnostics"]["nominal_correlation"][3] < -0.5  # what the plain check saw
     assert [f for f in results["findings"] if f["kind"] == "sign"] == []
     assert "flipped" not in p.stdout + p.stderr
@@ -72,16 +63,7 @@ def test_three_seconds_of_the_ur10e_log_are_not_called_scaled(tmp_path):
     their rotor inertia's, which the description lacks (slopes 6.7 and about 2000 on the nominal model's, ρ ≥ 0.9), and
     the verdict read "the measured torques are about 6.7× the description's nominal model's ...: set scale = 0.149".
     The scale is judged beyond the rotor inertia too: no such finding (the full log gives none either)."""
-    root = shared_data("ur10e_mamedov2020")
-    from pathlib import Path
-
-    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
-    text = text.replace('data_root = "../../shared/data/ur10e_mamedov2020"', f'data_root = "{root}"')
-    text = text.replace("rows = [635, 3510]", "rows = [635, 935]")
-    (tmp_path / "c.toml").write_text(text)
-    p = dynid("identify", tmp_path / "c.toml", "--out", tmp_path / "out", "--no-figures", "--no-validate")
-    assert p.returncode == 0, p.stderr
-    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    _, results = _ur10e_rows(tmp_path, 635, 935)
     assert results["diagnostics"]["nominal_slope_beyond_friction"][4] > 3  # what the check beyond friction saw
     assert [f for f in results["findings"] if f["kind"] == "scale"] == []
     slope = np.array(results["diagnostics"]["nominal_slope_beyond_drive"][:3], dtype=float)
@@ -118,6 +100,21 @@ def test_a_large_rotor_inertia_the_description_lacks_is_not_a_scale(tmp_path):
     assert p.returncode == 0, p.stderr
     (scale,) = [f for f in _findings(tmp_path / "ma") if f["kind"] == "scale"]
     assert "scale = 0.001" in scale["text"]
+
+
+def _ur10e_rows(tmp_path, first: int, last: int):
+    """``dynid identify --no-validate`` on rows ``first``-``last`` of the UR10e's identification log (configs/ur10e.toml):
+    the process and its results.json."""
+    root = shared_data("ur10e_mamedov2020")
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
+    text = text.replace('data_root = "../../shared/data/ur10e_mamedov2020"', f'data_root = "{root}"')
+    text = text.replace("rows = [635, 3510]", f"rows = [{first}, {last}]")
+    (tmp_path / "c.toml").write_text(text)
+    p = dynid("identify", tmp_path / "c.toml", "--out", tmp_path / "out", "--no-figures", "--no-validate")
+    assert p.returncode == 0, p.stderr
+    return p, json.loads((tmp_path / "out" / "results.json").read_text())
 
 
 def _findings(out):
