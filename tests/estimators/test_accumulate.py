@@ -121,3 +121,28 @@ def test_a_loose_or_negative_pair_term_keeps_the_prior_split():
     assert acc.solve(prior=prior, pairs=[(2, 3)]).anchored == ()
     acc, _ = _one_way_rows(rng, 1.0, noise=0.05)
     assert acc.solve(prior=np.array([0.0, 0.0, 0.0, 10.0]), pairs=[(2, 3)]).anchored == ()  # fc would be 3.5 - 10 < 0
+
+
+def test_an_affine_subset_is_the_weighted_least_squares_of_its_coordinates(rng):
+    """``params = offset + basis x``: x against np.linalg.lstsq of the weighted ``(W basis) x = τ - W offset``, the
+    covariance ``basis (σ² (AᵀA)⁻¹) basisᵀ`` with σ² from that fit's residual, the fixed directions exactly at
+    ``offset``."""
+    w, tau, theta = _problem(rng)
+    basis = np.zeros((7, 3))
+    basis[[1, 4, 6], [0, 1, 2]] = 1.0
+    basis[2, 0] = 0.5  # a column that moves two parameters together
+    offset = theta + 0.3 * rng.normal(size=7)
+    acc = LeastSquaresAccumulator(7, 3)
+    acc.add(w, tau)
+    wts = np.array([10.0, 1.0, 0.3])
+    params, cov, sol = acc.solve_affine(basis, offset, wts)
+    scale = np.tile(wts, w.shape[0] // 3)
+    a = (w @ basis) * scale[:, None]
+    b = (tau - w @ offset) * scale
+    x, res, *_ = np.linalg.lstsq(a, b, rcond=None)
+    np.testing.assert_allclose(sol.params, x, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(params, offset + basis @ x, rtol=1e-9, atol=1e-12)
+    fixed = [0, 3, 5]
+    np.testing.assert_array_equal(params[fixed], offset[fixed])
+    sigma2 = res[0] / (a.shape[0] - 3)
+    np.testing.assert_allclose(cov, basis @ (sigma2 * np.linalg.inv(a.T @ a)) @ basis.T, rtol=1e-7, atol=1e-14)

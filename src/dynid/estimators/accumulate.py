@@ -225,14 +225,63 @@ class LeastSquaresAccumulator:
                     else f"{int(weak.sum())} parameter(s)")
             raise IdentifiabilityError(f"the data do not excite {what} (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): "
                                        "a richer excitation, or a longer log, is needed")
-        params = np.linalg.solve(r, rhs)
-        sigma2 = rho**2 / (m - p)
-        rinv = np.linalg.inv(r)
-        cov = sigma2 * (rinv @ rinv.T)
-        std = np.sqrt(np.diag(cov))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            rel = 100.0 * std / np.abs(params)
-        return LeastSquaresSolution(params, cov, std, rel, float(sv[0] / sv[-1]), float(np.sqrt(sigma2)), m)
+        return _full_rank(r, rhs, rho, m, sv)
+
+    def solve_affine(self, basis, offset, joint_weights=None, prior=None, pairs=()) -> tuple[np.ndarray, np.ndarray, LeastSquaresSolution]:
+        """Least squares over an affine subset of the parameters, ``params = offset + basis @ x``.
+
+        The parameters of a model whose other terms are fixed (e.g. the description's rigid body with only the drive
+        terms fitted): ``x`` solves ``min ||D(τ - W (offset + basis x))||²`` as :meth:`solve` does, with the
+        undetermined directions of ``x`` at ``prior`` and the same ``pairs`` rule.
+
+        Parameters
+        ----------
+        basis : (p, d) array
+        offset : (p,) array
+        joint_weights : (n_dof,) array, optional
+            As :meth:`solve`.
+        prior : (d,) array, optional
+            Values of ``x`` kept where the rows say nothing (zeros by default).
+        pairs : sequence of (int, int)
+            ``(free, anchored)`` indices of ``x``, as :meth:`solve`.
+
+        Returns
+        -------
+        params : (p,) ndarray
+        covariance : (p, p) ndarray
+            ``basis · cov(x) · basisᵀ``.
+        solution : LeastSquaresSolution
+            Of ``x``.
+
+        Raises
+        ------
+        IdentifiabilityError
+            No more rows than columns of ``basis``.
+        """
+        basis = np.asarray(basis, dtype=float)
+        offset = np.asarray(offset, dtype=float)
+        p, d = basis.shape
+        m = int(self.rows.sum())
+        if m <= d:
+            raise IdentifiabilityError(f"least squares needs more equations than parameters, got {m} rows for {d} parameters")
+        r_all = self.reduced(joint_weights)
+        r, z, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
+        prior = np.zeros(d) if prior is None else np.asarray(prior, dtype=float)
+        sol = _about_prior(r @ basis, z - r @ offset, rho, m, prior, pairs)
+        return offset + basis @ sol.params, basis @ sol.covariance @ basis.T, sol
+
+
+def _full_rank(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, sv: np.ndarray) -> LeastSquaresSolution:
+    """The least-squares solution and its covariance of a full-rank triangular problem (:meth:`LeastSquaresAccumulator.solve`)."""
+    p = r.shape[1]
+    params = np.linalg.solve(r, rhs)
+    sigma2 = rho**2 / (m - p)
+    rinv = np.linalg.inv(r)
+    cov = sigma2 * (rinv @ rinv.T)
+    std = np.sqrt(np.diag(cov))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = 100.0 * std / np.abs(params)
+    return LeastSquaresSolution(params, cov, std, rel, float(sv[0] / sv[-1]), float(np.sqrt(sigma2)), m)
 
 
 def _weak(null_rows: np.ndarray) -> np.ndarray:

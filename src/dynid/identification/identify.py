@@ -42,12 +42,16 @@ from ..validation.diagnostics import (
     sign_findings,
 )
 from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
+from .drive_only import DRIVE_ONLY_KEY, DriveOnly, drive_only
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
 
 SDP_LABEL = estimate_label("sdp")
 """Label of the physically consistent estimate."""
+
+DRIVE_ONLY_LABEL = estimate_label(DRIVE_ONLY_KEY)
+"""Label of the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`)."""
 
 BOX_SIGMAS = 5.0
 BOX_FRACTION = 0.5
@@ -184,6 +188,10 @@ class IdentificationResult:
         The statistics behind the findings (residual autocorrelation, bootstrap σ, nominal correlation, …).
     main : str
         Label of the estimate to trust.
+    drive_only : DriveOnly or None
+        The description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`): made the
+        main estimate by :func:`dynid.identification.run.run_identification` where the validation logs prefer it; not
+        in :attr:`estimates` otherwise (None: a description without inertial parameters).
     """
 
     robot: str
@@ -208,6 +216,7 @@ class IdentificationResult:
     findings: tuple = ()
     diagnostics: dict = field(default_factory=dict)
     main: str = ""
+    drive_only: DriveOnly | None = None
 
     @property
     def label(self) -> str:
@@ -383,6 +392,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
+    found = drive_only(robot, base, reference.accumulator_, row_weights) if scoring.nominal is not None else None
+    alternative = None if found is None else DriveOnly(*found, replace(
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found[0]}), noise=joint_std, speed=fit.speed))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
@@ -395,7 +407,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                 n_rows=int(reference.accumulator_.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box, model=robot,
-                                findings=tuple(findings), diagnostics=stats, main=main or estimate_label(keys[0]))
+                                findings=tuple(findings), diagnostics=stats, main=main or estimate_label(keys[0]),
+                                drive_only=alternative)
 
 
 class BlockScoring:

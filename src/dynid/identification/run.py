@@ -176,10 +176,53 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     nominal = _nominal_set(robot, base, result.references)
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
         sets[nominal[0]] = nominal[1]
-    validations, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
-                                          prepared.data.settings, result.joint_std, {result.label: result.solution.covariance})
+    def scored(sets):
+        return validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress, prepared.data.settings,
+                             result.joint_std, {result.label: result.solution.covariance})
+
+    validations, warnings = scored(sets)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    return replace(result, **_main_estimate(result, None if nominal is None else nominal[0]))
+    chosen = _main_estimate(result, None if nominal is None else nominal[0])
+    preferred = _drive_only_preferred(result, chosen["main"], None if nominal is None else nominal[0], sets, scored)
+    if preferred is not None:
+        result, finding = preferred
+        chosen = _main_estimate(result, nominal[0], (finding[0], finding[1]))
+    return replace(result, **chosen)
+
+
+def _mean_error(validations, label: str) -> float:
+    """The mean over ``validations`` of ``label``'s global relative error [%]."""
+    return float(np.mean([v.metrics()[label]["global_relative_error"] for v in validations]))
+
+
+def _drive_only_preferred(result, main: str, nominal: str | None, sets: dict, scored):
+    """``result`` with :attr:`IdentificationResult.drive_only` among its estimates and its validations rescored, and
+    the main-estimate finding, where the validation logs say the identified rigid body predicts them worse than the
+    description's nominal model (mean global error) and the description's rigid body with the drive terms fitted
+    better than the main estimate; None otherwise (:mod:`dynid.identification.drive_only`). ``sets``: those scored
+    already; ``scored(sets)``: the validation of sets."""
+    from .identify import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, Estimate, consistency_checks
+
+    alt = result.drive_only
+    if alt is None or nominal is None or not result.validations:
+        return None
+    own, described = _mean_error(result.validations, main), _mean_error(result.validations, nominal)
+    if not described < own:
+        return None
+    validations, _ = scored({**sets, DRIVE_ONLY_LABEL: alt.params})  # the same logs: their warnings are said already
+    better = _mean_error(validations, DRIVE_ONLY_LABEL)
+    if not better < _mean_error(validations, main):
+        return None
+    estimate = Estimate(DRIVE_ONLY_KEY, alt.params, alt.std, standard=alt.standard)
+    margins, verdicts = consistency_checks(result.model, result.base, {DRIVE_ONLY_LABEL: alt.params})
+    result = replace(result, estimates={**result.estimates, DRIVE_ONLY_LABEL: estimate}, fit=alt.fit,
+                     validations=validations, consistency={**result.consistency, **margins},
+                     consistency_verdicts={**result.consistency_verdicts, **verdicts})
+    finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
+               f"rotor inertia) fitted to this log, because the description's nominal model predicts the validation logs "
+               f"better than {main} ({_apart(described, own)} on average) and {DRIVE_ONLY_LABEL} better still "
+               f"({better:.3g} %); chosen on the validation logs, so their figures for it are not an independent test")
+    return result, (DRIVE_ONLY_LABEL, finding)
 
 
 NOMINAL_LABEL = "description (nominal)"
@@ -218,12 +261,13 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
                                   config.sdp_prior, config.robot_source, tuple(config.closed_loop), setup)
 
 
-def _main_estimate(result, nominal: str | None = None) -> dict:
+def _main_estimate(result, nominal: str | None = None, preferred: tuple[str, str] | None = None) -> dict:
     """The estimate to trust, and the verdict's findings on the validation logs: the physically consistent one when the
     unconstrained one is not consistent and the consistent one validates better (mean global error over the validation
     logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`);
     and the main estimate against the description's nominal model (the set ``nominal``), joint by joint
-    (:func:`dynid.validation.diagnostics.nominal_gate`)."""
+    (:func:`dynid.validation.diagnostics.nominal_gate`). ``preferred``: (label, finding), the main estimate chosen
+    already, and why."""
     from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 
     label = result.label
@@ -240,7 +284,10 @@ def _main_estimate(result, nominal: str | None = None) -> dict:
 
     main = result.main or label
     consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
-    if SDP_LABEL in result.estimates and main == label and not consistent and result.validations:
+    if preferred is not None:
+        main = preferred[0]
+        findings.insert(0, Finding("main", preferred[1]))
+    elif SDP_LABEL in result.estimates and main == label and not consistent and result.validations:
         own = np.mean([v.metrics()[label]["global_relative_error"] for v in result.validations])
         sdp = np.mean([v.metrics()[SDP_LABEL]["global_relative_error"] for v in result.validations])
         if sdp < own:

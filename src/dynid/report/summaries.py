@@ -11,6 +11,7 @@ import numpy as np
 
 from ..conventions import unit_of
 from ..estimators.registry import OTHER_LABELS, label
+from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, IdentificationResult
 from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
@@ -182,14 +183,16 @@ def identification_blocks(result) -> list:
     if r.settings.get("friction_models") is not None:
         out.append(friction_choice_table(r.settings["friction_models"]))
 
-    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS]  # IDIM-IV, DIDIM: beside least squares
+    # IDIM-IV, DIDIM and the drive-only main estimate (the description's rigid body): beside least squares
+    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY]
     kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
     rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
                   "—" if i in kept else f"{sol.relative_std[i]:.1f}",
                   *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
                  for i, n in enumerate(base.names))
     out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; "
-                         + ("closed-loop estimates and " if closed else "") + "reference values beside)",
+                         + ("closed-loop estimates and " if any(e.key in OTHER_LABELS for e in closed) else
+                            "the main estimate and " if closed else "") + "reference values beside)",
                          ("name", "unit", "value", "σ", "σ %", *(label(e.key) for e in closed), *(ref.name for ref in r.references)),
                          rows, labels=2))
     for ref in r.references:
@@ -236,8 +239,10 @@ def _verdict(r) -> list:
 
 
 def _exportable(r) -> list[str]:
-    """The estimates ``dynid export`` can write: standard parameters that passed the consistency check (the SDP's)."""
-    return [n for n, e in r.estimates.items() if getattr(e, "standard", None) is not None
+    """The estimates ``dynid export`` can write: standard parameters that passed the consistency check (the SDP's, the
+    drive-only one's), the main estimate first as export takes it (:func:`dynid.io.results.stored_standard`)."""
+    ordered = sorted(r.estimates.items(), key=lambda item: item[0] != r.main)
+    return [n for n, e in ordered if getattr(e, "standard", None) is not None
             and str(r.consistency_verdicts.get(n, "")).startswith("yes")]
 
 
