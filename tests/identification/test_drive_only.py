@@ -68,4 +68,3 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
     assert e.returncode == 0, e.stderr
     masses = [float(m) for m in re.findall(r'<mass value="([^"]+)"', (tmp_path / "model.urdf").read_text())]
     assert sorted(np.round(masses, 6))[-robot.n_dof:] == sorted(np.round(robot.inertial[:, 9], 6))
-    print(e.stderr)

@@ -176,17 +176,21 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     nominal = _nominal_set(robot, base, result.references)
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
         sets[nominal[0]] = nominal[1]
-    def scored(sets):
+
+    def scored(sets, why: str = ""):
+        if why:
+            step(why)
         return validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress, prepared.data.settings,
                              result.joint_std, {result.label: result.solution.covariance})
 
     validations, warnings = scored(sets)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    chosen = _main_estimate(result, None if nominal is None else nominal[0])
-    preferred = _drive_only_preferred(result, chosen["main"], None if nominal is None else nominal[0], sets, scored)
+    described = None if nominal is None else nominal[0]
+    chosen = _main_estimate(result, described)
+    preferred = _drive_only_preferred(result, chosen["main"], described, sets, scored)
     if preferred is not None:
-        result, finding = preferred
-        chosen = _main_estimate(result, nominal[0], (finding[0], finding[1]))
+        result = preferred[0]
+        chosen = _main_estimate(result, described, preferred[1])
     return replace(result, **chosen)
 
 
@@ -209,7 +213,8 @@ def _drive_only_preferred(result, main: str, nominal: str | None, sets: dict, sc
     own, described = _mean_error(result.validations, main), _mean_error(result.validations, nominal)
     if not described < own:
         return None
-    validations, _ = scored({**sets, DRIVE_ONLY_LABEL: alt.params})  # the same logs: their warnings are said already
+    validations, _ = scored({**sets, DRIVE_ONLY_LABEL: alt.params},  # the same logs: their warnings are said already
+                            f"the description's nominal model validates better than {main}: {DRIVE_ONLY_LABEL} scored")
     better = _mean_error(validations, DRIVE_ONLY_LABEL)
     if not better < _mean_error(validations, main):
         return None
