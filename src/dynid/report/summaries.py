@@ -241,7 +241,7 @@ def _verdict(r) -> list:
 def _exportable(r) -> list[str]:
     """The estimates ``dynid export`` can write: standard parameters that passed the consistency check (the SDP's, the
     drive-only one's), the main estimate first as export takes it (:func:`dynid.io.results.stored_standard`)."""
-    ordered = sorted(r.estimates.items(), key=lambda item: item[0] != r.main)
+    ordered = sorted(r.estimates.items(), key=lambda item: item[0] != getattr(r, "main", ""))
     return [n for n, e in ordered if getattr(e, "standard", None) is not None
             and str(r.consistency_verdicts.get(n, "")).startswith("yes")]
 
