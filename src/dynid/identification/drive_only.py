@@ -1,15 +1,15 @@
 """The description's rigid body with only the drive terms identified: the model a short or poor log can still improve
 on the description with (issue "Honest on any log", item 1).
 
-A log of a few seconds determines the drive terms (Coulomb and viscous friction, offsets, rotor inertia) of the joints
-it moves far better than the links' inertial parameters, which a short log's fit bends to whatever the log shows: on
-windows of 3-6 s of the UR10e's identification log the full estimate predicted the validation logs worse than the
-description (5.5-22 % against 3.4-4.5 %), the description's rigid body with the drive terms fitted better than both
-(2.2-3.5 %). Nothing in the identification log alone says which of the two predicts other motions better (a blocked
-cross-validation, a stronger prior and an F test of the restriction were measured and rejected:
-benchmarks/README.md), so :func:`dynid.identification.run.run_identification` offers this estimate as the main one
-only where validation logs show that the identified rigid body predicts them worse than the description does, and
-this one better than the identified one.
+A log of a few seconds determines the drive terms (Coulomb and viscous friction, offsets, rotor inertia) of the
+joints it moves far better than the links' inertial parameters, which a short log's fit bends to whatever the log
+shows: on windows of 3-6 s of the UR10e's identification log the full estimate predicted the validation logs worse
+than the description on five of six (5.5-22.2 % against 3.4-4.5 %), the description's rigid body with the drive terms
+fitted better than both (2.1-3.5 %). Nothing in the identification log alone says which of the two predicts other
+motions better (a blocked cross-validation, a stronger prior and an F test of the restriction were measured and
+rejected: benchmarks/README.md), so :func:`dynid.identification.run.run_identification` offers this estimate as the
+main one only where validation logs show that the identified rigid body predicts them worse than the description
+does, and this one better than the identified one.
 """
 
 from __future__ import annotations
