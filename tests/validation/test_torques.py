@@ -124,3 +124,30 @@ def test_a_prediction_that_is_rounding_of_zero_has_no_correlation():
     for rho in (sums.comparison("x", {"b": beta}).metrics()["b"]["correlation"],
                 TorqueComparison("x", np.arange(m) * 0.01, tau, {"b": p}).metrics()["b"]["correlation"]):
         assert rho[0] > 0.99 and np.isnan(rho[1])
+
+
+def test_a_set_left_out_leaves_the_others_as_if_it_had_never_been_scored():
+    """A candidate scored beside the others and then left out (``without``): every other set's metrics, curves and
+    static friction are those of a comparison that never had it, from the sums and from the samples."""
+    rng = np.random.default_rng(3)
+    m, n, p = 2_000, 2, 4
+    y = rng.standard_normal((m, n, p))
+    tau = y @ rng.standard_normal(p) + 0.2 * rng.standard_normal((m, n))
+    t = np.arange(m) * 0.01
+    sets = {"a": rng.standard_normal(p), "b": rng.standard_normal(p)}
+    resting = np.zeros((m, n), dtype=bool)
+    resting[500:700] = True
+    static = {"a": np.array([0.5, 0.2]), "b": np.array([0.1, 0.3])}
+    full = TorqueComparison("x", t, tau, {k: y @ v for k, v in sets.items()}, resting=resting, static=static,
+                            centre={k: y @ v - 0.1 for k, v in sets.items()}, band=static["a"]).without("b")
+    alone = TorqueComparison("x", t, tau, {"a": y @ sets["a"]}, resting=resting, static={"a": static["a"]},
+                             centre={"a": y @ sets["a"] - 0.1}, band=static["a"])
+    assert list(full.metrics()) == ["a"] == list(full.predicted) == list(full.static) == list(full.centre)
+    for key, value in alone.metrics()["a"].items():
+        np.testing.assert_array_equal(full.metrics()["a"][key], value, err_msg=key)
+    sums = TorqueSums(n, p, m)
+    sums.add(t, y, tau, resting)
+    kept = sums.comparison("x", sets).without("b")
+    assert list(kept.metrics()) == list(kept.predicted) == ["a"]
+    for key, value in sums.comparison("x", {"a": sets["a"]}).metrics()["a"].items():
+        np.testing.assert_array_equal(kept.metrics()["a"][key], value, err_msg=key)

@@ -5,11 +5,13 @@ A log of a few seconds determines the drive terms (Coulomb and viscous friction,
 joints it moves far better than the links' inertial parameters, which a short log's fit bends to whatever the log
 shows: on windows of 3-6 s of the UR10e's identification log the full estimate predicted the validation logs worse
 than the description on five of six (5.5-22.2 % against 3.4-4.5 %), the description's rigid body with the drive terms
-fitted better than both (2.1-3.5 %). Nothing in the identification log alone says which of the two predicts other
-motions better (a blocked cross-validation, a stronger prior and an F test of the restriction were measured and
-rejected: benchmarks/README.md), so :func:`dynid.identification.run.run_identification` offers this estimate as the
-main one only where validation logs show that the identified rigid body predicts them worse than the description
-does, and this one better than the identified one.
+fitted better than both (2.1-3.5 %), and on the sixth better than the full estimate (1.68 % against 1.78 %).
+Nothing in the identification log alone says which of the two predicts other motions better (a blocked
+cross-validation, a stronger prior and an F test of the restriction were measured and rejected:
+benchmarks/README.md), so :func:`dynid.identification.run.run_identification` scores this estimate beside the others
+on the validation logs and makes it the main one where the identified rigid body is doubtful there (the nominal model
+predicts them better, or the least-squares estimate extrapolates) and this one predicts them better than the main
+estimate does.
 """
 
 from __future__ import annotations

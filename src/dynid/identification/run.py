@@ -177,17 +177,20 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
         sets[nominal[0]] = nominal[1]
 
-    def scored(sets, why: str = ""):
-        if why:
-            step(why)
-        return validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress, prepared.data.settings,
-                             result.joint_std, {result.label: result.solution.covariance})
-
-    validations, warnings = scored(sets)
-    result = replace(result, validations=validations, warnings=result.warnings + warnings)
     described = None if nominal is None else nominal[0]
+    alt = result.drive_only if described is not None else None
+    if alt is not None:  # a candidate scored in the same pass, kept only where it predicts the logs better
+        from .identify import DRIVE_ONLY_LABEL
+
+        sets[DRIVE_ONLY_LABEL] = alt.params
+    scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
+                                         prepared.data.settings, result.joint_std,
+                                         {result.label: result.solution.covariance})
+    validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
+    result = replace(result, validations=validations, warnings=result.warnings + warnings)
     chosen = _main_estimate(result, described)
-    preferred = _drive_only_preferred(result, chosen["main"], described, sets, scored)
+    preferred = None if alt is None or described is None else _drive_only_preferred(result, chosen, described,
+                                                                                      scored_all)
     if preferred is not None:
         result = preferred[0]
         chosen = _main_estimate(result, described, preferred[1])
@@ -199,34 +202,38 @@ def _mean_error(validations, label: str) -> float:
     return float(np.mean([v.metrics()[label]["global_relative_error"] for v in validations]))
 
 
-def _drive_only_preferred(result, main: str, nominal: str | None, sets: dict, scored):
-    """``result`` with :attr:`IdentificationResult.drive_only` among its estimates and its validations rescored, and
-    the main-estimate finding, where the validation logs say the identified rigid body predicts them worse than the
-    description's nominal model (mean global error) and the description's rigid body with the drive terms fitted
-    better than the main estimate; None otherwise (:mod:`dynid.identification.drive_only`). ``sets``: those scored
-    already; ``scored(sets)``: the validation of sets."""
+def _drive_only_preferred(result, chosen: dict, nominal: str, scored: tuple):
+    """``result`` with :attr:`IdentificationResult.drive_only` among its estimates and ``scored`` as its validations,
+    and the main-estimate finding, where the identified rigid body is doubtful on the validation logs and the
+    description's rigid body with the drive terms fitted predicts them better than the main estimate (mean global
+    error); None otherwise (:mod:`dynid.identification.drive_only`).
+
+    Doubtful: the description's nominal model predicts the validation logs better than the main estimate, or the
+    least-squares estimate's predictions there leave the range the identification log supports (the finding
+    ``extrapolation``: its prediction σ from the parameters' covariance over 5× that on the identification log), so
+    the log does not determine the directions those motions need. ``chosen``: :func:`_main_estimate`'s;
+    ``scored``: the validations of every set and of the drive-only one."""
     from .identify import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, Estimate, consistency_checks
 
-    alt = result.drive_only
-    if alt is None or nominal is None or not result.validations:
-        return None
-    own, described = _mean_error(result.validations, main), _mean_error(result.validations, nominal)
-    if not described < own:
-        return None
-    validations, _ = scored({**sets, DRIVE_ONLY_LABEL: alt.params},  # the same logs: their warnings are said already
-                            f"the description's nominal model validates better than {main}: {DRIVE_ONLY_LABEL} scored")
-    better = _mean_error(validations, DRIVE_ONLY_LABEL)
-    if not better < _mean_error(validations, main):
+    alt, main = result.drive_only, chosen["main"]
+    own, described = _mean_error(scored, main), _mean_error(scored, nominal)
+    far = [f for f in chosen["findings"] if f.kind == "extrapolation"]
+    better = _mean_error(scored, DRIVE_ONLY_LABEL)
+    if not (described < own or far) or not better < own:
         return None
     estimate = Estimate(DRIVE_ONLY_KEY, alt.params, alt.std, standard=alt.standard)
     margins, verdicts = consistency_checks(result.model, result.base, {DRIVE_ONLY_LABEL: alt.params})
     result = replace(result, estimates={**result.estimates, DRIVE_ONLY_LABEL: estimate}, fit=alt.fit,
-                     validations=validations, consistency={**result.consistency, **margins},
+                     validations=scored, consistency={**result.consistency, **margins},
                      consistency_verdicts={**result.consistency_verdicts, **verdicts})
+    why = (f"the description's nominal model predicts the validation logs better than {main} "
+           f"({_apart(described, own)} on average)" if described < own else
+           f"{result.label}'s predictions leave the range the identification log supports on "
+           f"{len(far)} of {len(scored)} validation logs")
     finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
-               f"rotor inertia) fitted to this log, because the description's nominal model predicts the validation logs "
-               f"better than {main} ({_apart(described, own)} on average) and {DRIVE_ONLY_LABEL} better still "
-               f"({better:.3g} %); chosen on the validation logs, so their figures for it are not an independent test")
+               f"rotor inertia) fitted to this log, because {why} and {DRIVE_ONLY_LABEL} predicts them better than "
+               f"{main} ({_apart(better, own)} on average; the description's nominal model {described:.3g} %); chosen on "
+               f"the validation logs, so their figures for it are not an independent test")
     return result, (DRIVE_ONLY_LABEL, finding)
 
 

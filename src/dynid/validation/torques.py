@@ -7,7 +7,7 @@ relative error of 1500 %."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -181,6 +181,26 @@ class TorqueComparison:
                                           None if self.static is None else self.static.get(label)))
             out[label] = m
         return out
+
+    def without(self, label: str) -> TorqueComparison:
+        """The same comparison with the set ``label`` left out (a candidate scored beside the others and not kept).
+
+        Parameters
+        ----------
+        label : str
+
+        Returns
+        -------
+        TorqueComparison
+            Every other set's curves and metrics unchanged (each set is scored on its own; the static-friction band is
+            the first set's).
+        """
+        def drop(d):
+            return d if d is None else {k: v for k, v in d.items() if k != label}
+
+        summary = self.summary if self.summary is None else {**self.summary, "metrics": drop(self.summary["metrics"])}
+        return replace(self, predicted=drop(self.predicted), summary=summary, static=drop(self.static),
+                       spread=drop(self.spread), centre=drop(self.centre))
 
     @property
     def rest_share(self) -> np.ndarray | None:
