@@ -23,6 +23,21 @@ def _window(tmp_path, first: int, last: int) -> Path:
     return tmp_path / "c.toml"
 
 
+def _identified(tmp_path, first: int, last: int) -> tuple[Path, dict, list[str]]:
+    """The window's config, its results.json with drive-only as the main estimate, and the other estimates' labels."""
+    config = _window(tmp_path, first, last)
+    p = dynid("identify", config, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    r = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert r["main_estimate"] == LABEL
+    others = [k for k in r["estimates"] if k != LABEL]
+    assert others and all(_mean(r, LABEL) < _mean(r, k) for k in others)
+    return config, r, others
+
+
+LABEL = "dynid drive-only"
+
+
 def _mean(results: dict, label: str) -> float:
     return float(np.mean([v["metrics"][label]["global_relative_error"] for v in results["validation"]]))
 
@@ -32,15 +47,9 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
     than the description; the main estimate is then "dynid drive-only": the description's links to the digit, drive
     terms that differ from the description's, base parameters = regrouping · its standard ones, better on the
     validation logs than every other estimate and than the description, said in the findings; export writes it."""
-    config = _window(tmp_path, 635, 935)
-    p = dynid("identify", config, "--out", tmp_path / "out", "--no-figures")
-    assert p.returncode == 0, p.stderr
-    r = json.loads((tmp_path / "out" / "results.json").read_text())
-    label = "dynid drive-only"
-    assert r["main_estimate"] == label
+    config, r, others = _identified(tmp_path, 635, 935)
+    label = LABEL
     nominal = r["diagnostics"]["nominal_set"]
-    others = [k for k in r["estimates"] if k != label]
-    assert others and all(_mean(r, label) < _mean(r, k) for k in others)
     assert _mean(r, label) < _mean(r, nominal) < min(_mean(r, k) for k in others)
 
     cfg = load_identification_config(config)
@@ -74,17 +83,12 @@ def test_drive_only_is_chosen_where_it_predicts_better_even_when_the_description
     """Rows 1060-1560 (J2 one way): least squares and the SDP predict the validation logs better than the description's
     nominal model (no friction, no rotor inertia), and the description's rigid body with the drive terms fitted better
     still: it is the main estimate, the candidate the same validation pass scored; the finding gives the three
-    figures. (Until the commit after e88fa23 it was scored only where the nominal model beat the main estimate.)"""
-    config = _window(tmp_path, 1060, 1560)
-    p = dynid("identify", config, "--out", tmp_path / "out", "--no-figures")
-    assert p.returncode == 0, p.stderr
-    r = json.loads((tmp_path / "out" / "results.json").read_text())
-    label = "dynid drive-only"
-    assert r["main_estimate"] == label
+    figures and the reason: least squares extrapolates there (the finding ``extrapolation``). (Until the commit after
+    e88fa23 it was scored only where the nominal model beat the main estimate.)"""
+    _, r, others = _identified(tmp_path, 1060, 1560)
     nominal = r["diagnostics"]["nominal_set"]
-    others = [k for k in r["estimates"] if k != label]
-    assert others and max(_mean(r, k) for k in others) < _mean(r, nominal)
-    assert all(_mean(r, label) < _mean(r, k) for k in others)
-    said = next(f["text"] if isinstance(f, dict) else str(f) for f in r["findings"]
-                if "main estimate: dynid drive-only" in (f["text"] if isinstance(f, dict) else str(f)))
+    assert max(_mean(r, k) for k in others) < _mean(r, nominal)
+    assert any(f["kind"] == "extrapolation" for f in r["findings"])
+    said = next(f["text"] for f in r["findings"] if f["kind"] == "main")
+    assert said.startswith(f"main estimate: {LABEL}") and "leave the range the identification log supports" in said
     assert f"{_mean(r, nominal):.3g} %" in said and "not an independent test" in said
