@@ -179,7 +179,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
 
     described = None if nominal is None else nominal[0]
     alt = result.drive_only if described is not None else None
-    if alt is not None:  # a candidate scored in the same pass, kept only where it predicts the logs better
+    if alt is not None:  # a candidate scored in the same pass, kept only where chosen (_drive_only_preferred)
         from .identify import DRIVE_ONLY_LABEL
 
         sets[DRIVE_ONLY_LABEL] = alt.params
