@@ -63,7 +63,31 @@ def test_a_dead_identification_channel_is_left_out_of_the_estimation(case, tmp_p
     _kill(c / "ident.csv", 5)
     p, results = _run(c, c / "config.toml", "out")
     (finding,) = [f for f in results["findings"] if f["kind"] == "prior"]
-    assert "Ia6, fc6, fv6, offset6" in finding["text"] and "J6: a dead torque channel" in finding["text"]
+    assert "Ia6, fc6, fv6, offset6" in finding["text"] and "J6: a dead or saturated torque channel" in finding["text"]
     ours = results["validation"][0]["metrics"]["dynid OLS"]["relative_error"]
     truth = results["validation"][0]["metrics"]["truth"]["relative_error"]
     assert all(ours[j] < truth[j] + 1.0 for j in range(5))
+
+
+def test_a_channel_at_its_limit_most_of_the_log_is_left_out_not_refused(case, tmp_path):
+    """J2's torque clipped at its 30th and 70th percentiles in the identification log (60 % of the samples at a limit):
+    it was refused ("no sample is left to score") though five joints are live. Now J2 is left out as a dead channel
+    is, said in a warning naming the log, the joint and the share; every other joint's identification figure is
+    finite and J2's is null; no NumPy warning."""
+    import shutil
+
+    folder, cfg, robot = case
+    shutil.copytree(folder, tmp_path / "c", dirs_exist_ok=True)
+    c = tmp_path / "c"
+    (c / "config.toml").write_text((folder / "config.toml").read_text().replace(str(folder), str(c)))
+    shutil.copy(c / "ident.csv", c / "valid.csv")
+    data = np.loadtxt(c / "ident.csv", delimiter=",")
+    column = 1 + 6 + 1
+    low, high = np.percentile(data[:, column], [30, 70])
+    data[:, column] = np.clip(data[:, column], low, high)
+    np.savetxt(c / "ident.csv", data, delimiter=",", fmt="%.10g")
+    p, results = _run(c, c / "config.toml", "out")
+    text = " ".join((p.stdout + p.stderr).split())
+    assert "J2's torque is at its extreme" in text and "saturated throughout?" in text
+    errors = results["identification"]["metrics"]["dynid OLS"]["relative_error"]
+    assert errors[1] is None and all(np.isfinite(errors[j]) for j in (0, 2, 3, 4, 5))

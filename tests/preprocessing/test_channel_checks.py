@@ -23,7 +23,7 @@ def test_a_limit_on_one_side_is_found_though_the_other_side_reaches_further(rng)
     t, tau = _channels(rng)
     tau[20, 1] = 9.0
     tau[100:160, 1] = -4.0
-    mask, words = clipped_samples(tau, t, "identification (log.csv)")
+    mask, words, _ = clipped_samples(tau, t, "identification (log.csv)")
     assert mask is not None and mask.shape == tau.shape
     assert np.flatnonzero(mask[:, 1]).tolist() == list(range(100, 160)) and not mask[:, [0, 2]].any()
     assert words == ("identification (log.csv): J2's torque stays at its extreme -4 N·m for 60 samples "
@@ -35,7 +35,7 @@ def test_both_sides_and_the_filters_reach_are_marked(rng):
     t, tau = _channels(rng)
     tau[50:80, 0] = 5.0
     tau[200:230, 0] = -5.0
-    mask, words = clipped_samples(tau, t, "log", reach=7)
+    mask, words, _ = clipped_samples(tau, t, "log", reach=7)
     expected = set(range(43, 87)) | set(range(193, 237))
     assert set(np.flatnonzero(mask[:, 0]).tolist()) == expected
     assert len(words) == 1 and "its 88 samples there" in words[0]
@@ -47,15 +47,53 @@ def test_short_runs_dead_and_noisy_channels_are_not_clipped(rng):
     t, tau = _channels(rng)
     tau[100:100 + SATURATION_SAMPLES - 1, 0] = 6.0
     tau[:, 1] = 2.5
-    mask, words = clipped_samples(tau, t, "log")
+    mask, words, _ = clipped_samples(tau, t, "log")
     assert mask is None and words == ()
 
 
-def test_a_channel_clipped_everywhere_is_refused_in_one_line(rng):
+def test_a_channel_clipped_almost_everywhere_is_left_out_and_the_others_keep_their_samples(rng):
+    """J3 at ±3 N·m in 90 % of the samples: it was refused ("no sample is left to score") though J1 and J2 are live.
+    Now J3 is saturated throughout (its rows left out as a dead channel's, said naming the log, the joint, the value
+    and the share) and no sample is taken from the metrics for it."""
     t, tau = _channels(rng, 100)
     tau[:, 2] = np.where(np.arange(100) % 50 < 45, 3.0, -3.0)
-    with pytest.raises(DataError, match=r"^log: J3's torque is at its extreme .* no sample is left to score"):
-        clipped_samples(tau, t, "log", reach=5)
+    mask, words, saturated = clipped_samples(tau, t, "log", reach=5)
+    assert saturated == (2,) and mask is None
+    assert words == ("log: J3's torque is at its extreme 3 N·m in 100 % of the samples (with the filter's reach): "
+                     "saturated throughout? its rows are left out of the estimation and of the metrics, as a dead "
+                     "channel's, so that the other joints keep their samples",)
+
+
+def test_the_metrics_keep_half_the_samples_the_longest_clipped_joint_left_out_first(rng):
+    """J1 clipped over samples 0-219 and J2 over 200-379 of 400: together 95 % of the samples would leave the metrics.
+    J1, the longer, is taken as saturated throughout; J2 keeps its own clipped samples masked; half or more remain."""
+    t, tau = _channels(rng, 400)
+    tau[:220, 0] = 5.0
+    tau[200:380, 1] = -5.0
+    mask, words, saturated = clipped_samples(tau, t, "log")
+    assert saturated == (0,)
+    assert mask is not None and not mask[:, [0, 2]].any()
+    assert np.flatnonzero(mask[:, 1]).tolist() == list(range(200, 380))
+    assert (~mask.any(axis=1)).mean() >= 0.5
+    assert "J1's torque is at its extreme 5 N·m in 55 % of the samples" in words[0]
+    assert words[1].startswith("log: J2's torque stays at its extreme -5 N·m for 180 samples")
+
+
+def test_a_log_whose_every_joint_is_dead_or_saturated_is_refused_in_one_line(rng):
+    """Nothing can be estimated: one line naming the log, no traceback."""
+    from dynid.io.datasets import Recording
+    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.settings import Preprocessing
+
+    rate = 200.0
+    t = np.arange(2000) / rate
+    w = 2 * np.pi * np.array([0.1, 0.17, 0.23])
+    q = np.sin(w * t[:, None])
+    tau = np.column_stack([np.clip(np.sin(3 * w[0] * t), -0.2, 0.2), np.full(t.size, 1.5),
+                           np.where(np.sin(w[2] * t) > 0, 2.0, -2.0)])
+    with pytest.raises(DataError, match=r"^identification: every joint's torque reads one value or its limit "
+                                        r"throughout \(dead or saturated channels\): nothing can be identified"):
+        prepare(Recording("identification", t, q, None, tau, rate), Preprocessing())
 
 
 @pytest.mark.parametrize("factor, hint", [(180 / np.pi, "(deg/s read as rad/s?)"), (-1.0, "(a flipped sign?)"),
@@ -121,10 +159,10 @@ def test_a_quantised_channel_is_not_clipped_at_its_smooth_peaks(rng):
     top = np.abs(tau[:, 0] - tau[:, 0].max()) < 1e-9
     longest = max(len(r) for r in np.split(top, np.flatnonzero(np.diff(top)) + 1) if r[0])
     assert longest >= SATURATION_SAMPLES  # a run the plain rule takes for saturation
-    mask, words = clipped_samples(tau, t, "log")
+    mask, words, _ = clipped_samples(tau, t, "log")
     assert mask is None and words == ()
     tau[:, 0] = _logged_in_steps(np.clip(smooth, -1.2, 1.2), 0.1)
-    mask, words = clipped_samples(tau, t, "log")
+    mask, words, _ = clipped_samples(tau, t, "log")
     assert mask is not None and not mask[:, 1].any()
     held = np.abs(np.abs(tau[:, 0]) - 1.2) < 1e-9
     assert mask[:, 0].sum() >= 0.9 * held.sum()

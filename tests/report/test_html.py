@@ -134,9 +134,10 @@ def test_a_dead_torque_channel_is_said_where_the_errors_say_over_all_joints():
     lines = log_summaries([ScoredLog("dead", 0.482, (6, 6.55), False, 0.12, dead=(3,)),
                            ScoredLog("p1", 0.0, None, True), ScoredLog("p2", 0.0, None, True),
                            ScoredLog("p3", 0.0, None, True, dead=(0, 5))])
-    assert lines[0] == ("dead: torque error 0.482 % over the joints but J4 (its torque reads a constant: left out), "
-                        "worst J7 6.55 % (noise floor 0.12 %)")
-    assert lines[1].startswith("p3: torque error 0 % over the joints but J1, J6 (their torques read a constant: left out) "
+    assert lines[0] == ("dead: torque error 0.482 % over the joints but J4 (its torque reads a constant or the "
+                        "drive's limit throughout: left out), worst J7 6.55 % (noise floor 0.12 %)")
+    assert lines[1].startswith("p3: torque error 0 % over the joints but J1, J6 (their torques read a constant or the "
+                               "drive's limit throughout: left out) "
                                "(at rest throughout")
     assert lines[2].startswith("p1, p2 (2 logs at rest throughout): torque error 0 % over all joints")
     log = {"name": "dead", "n_samples": 10, "relative_error_meaningful": [True, True], "dead_channels": [1],
@@ -145,7 +146,8 @@ def test_a_dead_torque_channel_is_said_where_the_errors_say_over_all_joints():
     d = {"robot": "r", "condition_number": 10.0, "n_rows": 100, "base_parameters": [], "main_estimate": "dynid WLS",
          "identification": {**log, "name": "identification", "dead_channels": []}, "validation": [log]}
     summary = next(s for s in identify_sections(d)[1] if s.title == "In short").texts
-    assert "dead: torque error 2 % over the joints but J2 (its torque reads a constant: left out), worst J1 2 %." in summary
+    assert ("dead: torque error 2 % over the joints but J2 (its torque reads a constant or the drive's limit throughout: "
+            "left out), worst J1 2 %.") in summary
 
 
 def test_results_json_names_the_dead_channels_of_a_log():
@@ -176,4 +178,4 @@ def test_the_publish_gate_says_which_joints_a_log_with_a_dead_channel_leaves_out
     t = np.arange(80) / 100.0
     c = TorqueComparison("dead", t, measured, {"A": measured + 0.01, "nominal": measured + 0.5}, dead=(1,))
     findings, _ = nominal_gate([c], "A", "nominal")
-    assert "dead: " in findings[0].text and "% without J2 (a dead torque channel)" in findings[0].text
+    assert "dead: " in findings[0].text and "% without J2 (a dead or saturated torque channel)" in findings[0].text

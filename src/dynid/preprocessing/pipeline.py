@@ -250,7 +250,12 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
         resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
     dead, dead_words = dead_channels(tau, recording.label)
     reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
-    clipped, clipped_words = clipped_samples(tau, t, recording.label, reach)
+    clipped, clipped_words, saturated = clipped_samples(tau, t, recording.label, reach)
+    dead = tuple(sorted(set(dead) | set(saturated)))  # a joint at its limit throughout is left out as a dead one
+    if len(dead) == tau.shape[1]:
+        raise DataError(f"{recording.label}: every joint's torque reads one value or its limit throughout (dead or "
+                        "saturated channels): nothing can be identified from this log; a log where the drives are "
+                        "within their limits is needed")
     positions = recording.q[cut:-cut] if cut else recording.q
     still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
                   if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)

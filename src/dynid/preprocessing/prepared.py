@@ -49,7 +49,8 @@ class PreparedData:
     resting : (N, n_dof) bool array or None
         Where each joint rests (:func:`dynid.friction.moving_joints`).
     dead : tuple of int
-        Joints whose measured torque is constant over the log (:func:`dead_channels`).
+        Joints whose measured torque is constant over the log (:func:`dead_channels`) or saturated throughout
+        (:func:`clipped_samples`).
     still : tuple of int
         Joints whose position never changes in the log.
     clipped : (N, n_dof) bool array or None
@@ -72,8 +73,9 @@ class PreparedData:
     resting: np.ndarray | None = None
     """(N, n_dof) bool: where each joint rests (:func:`dynid.friction.moving_joints`)."""
     dead: tuple[int, ...] = ()
-    """Joints (0-based) whose measured torque is constant over the whole log (:func:`dead_channels`): their rows are
-    used by no estimate and no metric."""
+    """Joints (0-based) whose measured torque is constant over the whole log (:func:`dead_channels`), or at its limit
+    so long that it is taken as saturated throughout (:func:`clipped_samples`): their rows are used by no estimate and
+    no metric."""
     still: tuple[int, ...] = ()
     """Joints (0-based) whose position never changes in the log (a joint held still): their rows are used by no
     estimate (their friction at rest is anywhere in its static band, and their drive terms appear in no other row)."""
@@ -324,14 +326,22 @@ FLANK_STEPS = 3
 its value."""
 BEYOND_STEPS = 1.0
 """A run in a quantised channel is saturation where its flanks' parabola exceeds it by more than this many steps."""
+SCORED_SHARE = 0.5
+"""The share of a log's samples the metrics keep at least where torques are clipped (:func:`clipped_samples`)."""
 
 
-def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.ndarray | None, tuple[str, ...]]:
+def clipped_samples(tau, t: np.ndarray, label: str,
+                    reach: int = 0) -> tuple[np.ndarray | None, tuple[str, ...], tuple[int, ...]]:
     """The samples where a joint's measured torque is held at its largest or smallest value for at least
     :data:`SATURATION_SAMPLES` samples in a row (a drive's current or torque limit, on either side: a limit may clip
     one direction only), and the warning that says so. Such a sample says only that the torque was at least that
     much; it is left out of the estimation (that joint's rows) and of the metrics (the whole sample). In a quantised
     channel (:data:`QUANTISED_SHARE`) a run counts only where the torque on both sides heads beyond it.
+
+    Where that would leave the metrics less than :data:`SCORED_SHARE` of the samples, the joints clipped the longest
+    are taken as saturated throughout instead, one at a time until it does not: their rows are left out of the
+    estimation and of the metrics, as a dead channel's, and the other joints keep their samples (issue "Honest on any
+    log": refuse only where nothing can be estimated).
 
     Parameters
     ----------
@@ -347,17 +357,14 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
     Returns
     -------
     clipped : (N, n_dof) bool array or None
-        None where no joint is clipped.
+        None where no joint is clipped but those saturated throughout.
     warnings : tuple of str
         One line per clipped joint: the dataset, the joint, its longest run and how many samples are left out.
-
-    Raises
-    ------
-    DataError
-        If no sample is left to score.
+    saturated : tuple of int
+        The joints (0-based) saturated throughout, whose rows are all left out.
     """
     n = tau.shape[0]
-    mask, words = None, []
+    mask, words, extremes = None, [], {}
     for j in range(tau.shape[1]):
         x = np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j], dtype=float)
         peak = float(np.abs(x).max()) if x.size else 0.0
@@ -374,15 +381,24 @@ def clipped_samples(tau, t: np.ndarray, label: str, reach: int = 0) -> tuple[np.
         mask = np.zeros((n, tau.shape[1]), dtype=bool) if mask is None else mask
         for a, b in runs:
             mask[max(a - reach, 0):min(b + reach, n), j] = True
-        if mask.any(axis=1).all():
-            raise DataError(f"{label}: J{j + 1}'s torque is at its extreme {x[runs[0][0]]:.4g} N·m so much that, "
-                            "with the filter's reach, no sample is left to score: a log, or rows, where the drive is "
-                            "not at its limit is needed")
         a, b = max(runs, key=lambda r: r[1] - r[0])
+        extremes[j] = x[a]
         words.append(f"{label}: J{j + 1}'s torque stays at its extreme {x[a]:.4g} N·m for {b - a} samples "
                      f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "
                      "within the filter's reach are left out of the estimation and of the metrics")
-    return mask, tuple(words)
+    if mask is None:
+        return None, (), ()
+    saturated: list[int] = []
+    while mask.any(axis=1).mean() > 1.0 - SCORED_SHARE:
+        j = int(np.argmax(mask.sum(axis=0)))
+        share = float(mask[:, j].mean())
+        words[sorted(extremes).index(j)] = (
+            f"{label}: J{j + 1}'s torque is at its extreme {extremes[j]:.4g} N·m in {100 * share:.3g} % of the samples "
+            "(with the filter's reach): saturated throughout? its rows are left out of the estimation and of the "
+            "metrics, as a dead channel's, so that the other joints keep their samples")
+        saturated.append(j)
+        mask[:, j] = False
+    return (mask if mask.any() else None), tuple(words), tuple(sorted(saturated))
 
 
 def _quantum(x: np.ndarray, peak: float) -> float:

@@ -426,8 +426,8 @@ def _over_joints(dead) -> str:
     if not len(dead):
         return "over all joints"
     joints = ", ".join(f"J{j + 1}" for j in dead)
-    return (f"over the joints but {joints} ({'its torque reads' if len(dead) == 1 else 'their torques read'} a constant: "
-            "left out)")
+    return (f"over the joints but {joints} ({'its torque reads' if len(dead) == 1 else 'their torques read'} a constant "
+            "or the drive's limit throughout: left out)")
 
 
 def _kept_line(kept: list, dead, anchored=()) -> Line:

@@ -502,7 +502,8 @@ def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], 
             worse_lines.append(f"{v.name}: {shown}" + (f" and {len(worse) - 4} more" if len(worse) > 4 else ""))
         else:
             own_g, nom_g = float(metrics[label]["global_relative_error"]), float(metrics[nominal]["global_relative_error"])
-            without = f" without {', '.join(f'J{j + 1}' for j in v.dead)} (a dead torque channel)" if v.dead else ""
+            without = (f" without {', '.join(f'J{j + 1}' for j in v.dead)} (a dead or saturated torque channel)"
+                       if v.dead else "")
             better.append((own_g < nom_g, v.name, f"{v.name}: {own_g:.3g} % against {nom_g:.3g} %{without}"))
     if worse_lines:
         more = f"; and {len(worse_lines) - 3} more logs" if len(worse_lines) > 3 else ""
@@ -667,7 +668,7 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tu
         why += (f" ({', '.join(f'J{j}' for j in taken)} moved one way only: the one term of Coulomb friction and offset is "
                 "estimated and taken as Coulomb friction, the same in the direction not moved)")
     if dead:
-        why += f" ({', '.join(f'J{j + 1}' for j in dead)}: a dead torque channel, its rows left out)"
+        why += f" ({', '.join(f'J{j + 1}' for j in dead)}: a dead or saturated torque channel, its rows left out)"
     if still:
         why += f" ({', '.join(f'J{j + 1}' for j in still)} never moved in the log)"
     listed = ", ".join(shown[:10]) + (f" and {len(shown) - 10} more" if len(shown) > 10 else "")

@@ -54,7 +54,7 @@ class TorqueComparison:
         label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
         (for the sets whose covariance is known).
     dead : tuple of int
-        Joints whose measured torque is constant over the log: left out of every metric.
+        Joints whose measured torque is constant over the log, or saturated throughout: left out of every metric.
     centre : dict or None
         label -> (M, n_dof) the prediction without its Coulomb-like terms [N·m] (the static-friction band's centre).
     band : (n_dof,) array [N·m] or None
@@ -85,8 +85,9 @@ class TorqueComparison:
     """label -> (n_dof,) RMS over the samples of the prediction's standard deviation from that set's covariance [N·m]
     (for the sets whose covariance is known)."""
     dead: tuple[int, ...] = ()
-    """Joints whose measured torque is constant over the log (:func:`dynid.preprocessing.prepared.dead_channels`):
-    left out of every metric (their per-joint figures NaN, the global ones over the other joints)."""
+    """Joints whose measured torque is constant over the log (:func:`dynid.preprocessing.prepared.dead_channels`) or
+    saturated throughout (:func:`dynid.preprocessing.prepared.clipped_samples`): left out of every metric (their
+    per-joint figures NaN, the global ones over the other joints)."""
     floor: np.ndarray | None = None
     """(n_dof,) [N·m]: the noise floor of these samples (:mod:`dynid.validation.noise_floor`)."""
     centre: dict | None = None
@@ -245,8 +246,8 @@ class TorqueComparison:
                        "predicts motion")
         for j in np.flatnonzero(~self.meaningful()):
             if j in self.dead:
-                out.append(f"{self.name}: J{j + 1}'s torque is constant over the log (a dead channel): left out of "
-                           "the metrics")
+                out.append(f"{self.name}: J{j + 1}'s torque is constant, or at its limit, over the log (a dead or "
+                           "saturated channel): left out of the metrics")
                 continue
             moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} rad/s) and " if
                                                    self.speed[j] < 0.05 else "")
@@ -371,7 +372,7 @@ class TorqueSums:
     max_points : int
         Samples a figure draws at most.
     dead : tuple of int
-        Joints whose measured torque is constant over the log: left out of every metric.
+        Joints whose measured torque is constant over the log, or saturated throughout: left out of every metric.
     floor : (n_dof,) array [N·m], optional
         The noise floor of the samples (:mod:`dynid.validation.noise_floor`).
     """
