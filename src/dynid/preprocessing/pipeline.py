@@ -252,7 +252,7 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
     clipped, clipped_words, saturated = clipped_samples(tau, t, recording.label, reach)
     dead = tuple(sorted(set(dead) | set(saturated)))  # a joint at its limit throughout is left out as a dead one
-    if len(dead) == tau.shape[1]:
+    if saturated and len(dead) == tau.shape[1]:  # (torques all dead, e.g. none given to predict: refused upstream)
         raise DataError(f"{recording.label}: every joint's torque reads one value or its limit throughout (dead or "
                         "saturated channels): nothing can be identified from this log; a log where the drives are "
                         "within their limits is needed")
