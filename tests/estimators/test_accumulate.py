@@ -78,6 +78,23 @@ def test_a_rank_deficient_problem_keeps_the_prior_where_the_rows_say_nothing():
     assert full.solve(prior=np.zeros(3)).params == pytest.approx(full.solve().params, rel=1e-12)
 
 
+def test_a_column_that_only_rounding_fills_keeps_the_prior():
+    """A parameter that acts on no row the log keeps (a link inertia only a dead torque channel's joint feels) has a
+    column of rounding, ~1e-16 of the others: scaled to unit norm with them it was "determined", at -3.7e14 ± 2.9e15
+    on a simulated UR5 with J2's channel dead, and that estimate missed the validation log by 1e15 %. Now it keeps
+    the prior, is said to (σ NaN), and the other parameters are the truth's (noise-free rows)."""
+    rng = np.random.default_rng(3)
+    w = rng.standard_normal((500, 4))
+    w[:, 2] = 1e-17 * rng.standard_normal(500)  # what rounding leaves of an absent term
+    truth = np.array([1.5, -2.0, 0.7, 4.0])
+    acc = LeastSquaresAccumulator(4, 1)
+    acc.add(w, w[:, [0, 1, 3]] @ truth[[0, 1, 3]])
+    prior = np.array([0.0, 0.0, 0.25, 0.0])
+    sol = acc.solve(prior=prior)
+    assert sol.params[2] == prior[2] and sol.from_prior == (2,) and np.isnan(sol.params_std[2])
+    assert sol.params[[0, 1, 3]] == pytest.approx(truth[[0, 1, 3]], rel=1e-9)
+
+
 def _one_way_rows(rng, direction: float, noise: float):
     """A joint moving one way only: its Coulomb column sign(q̇) = ``direction`` everywhere, its offset column 1."""
     x = rng.standard_normal((600, 2))

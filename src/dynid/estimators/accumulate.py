@@ -58,6 +58,12 @@ UNDETERMINED_RCOND = 1e-10
 """With a prior, directions of the column-scaled observation matrix whose singular value is below this fraction of
 the largest are left at the prior (:meth:`LeastSquaresAccumulator.solve`)."""
 
+ZERO_COLUMN = 1e-10
+"""With a prior, a column of the observation matrix whose norm is below this fraction of the largest column's is
+numerically zero: the parameter acts on no row the log keeps (e.g. a link's inertia that only a dead torque channel's
+joint feels), and rounding alone gives its column; it is left at the prior, not scaled up to unit norm with the
+others and "determined" with a σ of 1e15 (:meth:`LeastSquaresAccumulator.solve`)."""
+
 ANCHOR_RELATIVE_STD = 0.1
 """An anchored pair (:meth:`LeastSquaresAccumulator.solve`'s ``pairs``) whose one determined combination has a σ at most
 this fraction of its value gives that combination to its free member."""
@@ -295,9 +301,10 @@ def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.n
     p = r.shape[1]
     if prior.shape != (p,) or not np.all(np.isfinite(prior)):
         raise IdentifiabilityError(f"the prior must be {p} finite values, got shape {prior.shape}")
-    scale = np.linalg.norm(r, axis=0)
-    scale = np.where(scale > 0, scale, 1.0)
-    rs = r / scale
+    norms = np.linalg.norm(r, axis=0)
+    zero = norms <= ZERO_COLUMN * norms.max()
+    scale = np.where(zero, 1.0, norms)
+    rs = np.where(zero, 0.0, r / scale)
     u, sv, vt = np.linalg.svd(rs)
     k = int(np.sum(sv > UNDETERMINED_RCOND * sv[0])) if sv[0] > 0 else 0
     x0 = prior * scale
