@@ -153,3 +153,14 @@ def test_the_nominal_gate_calls_an_equal_log_equal_not_better(rng):
     assert "every joint of the validation logs better" not in gate.text
     (only,), _ = nominal_gate([moving], "est", "nominal")
     assert only.text.startswith("est predicts every joint of the validation logs better") and "alike" not in only.text
+
+
+def test_a_validation_error_far_above_the_fits_is_said_in_a_readable_figure():
+    """An estimate gone astray (a WLS estimate at 1.1e15 % on a validation log it fits at 0.54 %) was said to predict
+    it "2056681467058500.0× worse"; such a ratio is now given to three digits, and an ordinary one as before."""
+    from dynid.validation.diagnostics import validation_findings
+
+    (astray,) = validation_findings("validation", 1.11e15, 0.54, None, None, "dynid WLS")
+    assert "predicts it 2.06e+15× worse than it fits the identification log (1.11e+15 % against 0.54 %)" in astray.text
+    (ordinary,) = validation_findings("validation", 12.3, 2.74, None, None, "dynid WLS")
+    assert "predicts it 4.5× worse than it fits" in ordinary.text

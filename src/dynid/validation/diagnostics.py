@@ -459,7 +459,9 @@ def validation_findings(name: str, global_error: float, fit_error: float, predic
                                f"({prediction_spread[j]:.3g} N·m); trust a physically consistent estimate there, or "
                                "identify on a log that covers this motion", j))
     if np.isfinite(global_error) and fit_error > 0 and global_error > 3 * fit_error:
-        out.append(Finding("validation", f"{name}: {label} predicts it {global_error / fit_error:.1f}× worse than it fits the "
+        times = global_error / fit_error
+        shown = f"{times:.1f}" if times < 1e4 else f"{times:.3g}"  # not 13696171289551554.0 (an estimate gone astray)
+        out.append(Finding("validation", f"{name}: {label} predicts it {shown}× worse than it fits the "
                            f"identification log ({global_error:.3g} % against {fit_error:.3g} %): over-fitting, "
                            "extrapolation or a model that misses something this motion shows"))
     return out
