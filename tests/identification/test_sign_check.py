@@ -48,6 +48,40 @@ def test_a_flipped_torque_sign_is_still_named(tmp_path):
     assert "J2" in sign["text"] and "sign = [1, -1, 1, 1, 1, 1]" in sign["text"]
 
 
+def test_a_flipped_sign_that_friction_hides_from_the_plain_correlation_is_named(tmp_path):
+    """J1's current negated in the UR10e's identification log: J1's torque is mostly friction, which the nominal model
+    lacks, so its plain correlation with that model is only -0.36, while beyond its friction it is -0.98. The check
+    took the larger of the two and said nothing (the fit then bent the other joints' parameters to the flipped
+    torque). The correlation beyond friction now judges wherever it is known: J1 is named, with the fix."""
+    from pathlib import Path
+
+    root = shared_data("ur10e_mamedov2020")
+    data = tmp_path / "data"
+    (data / "identification_data").mkdir(parents=True)
+    for item in root.iterdir():
+        if item.name != "identification_data":
+            (data / item.name).symlink_to(item)
+    name = "ur-20_02_10-30sec_12harm.csv"
+    for item in (root / "identification_data").iterdir():  # the drive gains' runs as they are
+        if item.name != name:
+            (data / "identification_data" / item.name).symlink_to(item)
+    rows = [line.split(",") for line in (root / "identification_data" / name).read_text().splitlines()]
+    for row in rows:
+        row[13] = f"{-float(row[13]):.6f}"  # J1's current (column 14 of the ur-rtde preset)
+    (data / "identification_data" / name).write_text("\n".join(",".join(row) for row in rows) + "\n")
+    text = (Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml").read_text()
+    (tmp_path / "c.toml").write_text(text.replace('data_root = "../../shared/data/ur10e_mamedov2020"',
+                                                  f'data_root = "{data}"'))
+    p = dynid("identify", tmp_path / "c.toml", "--out", tmp_path / "out", "--no-figures", "--no-validate")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["diagnostics"]["nominal_correlation"][0] > -0.5  # what the larger of the two gave
+    assert results["diagnostics"]["nominal_correlation_beyond_friction"][0] < -0.9
+    (sign,) = [f for f in results["findings"] if f["kind"] == "sign"]
+    assert sign["text"].startswith("identification: J1: the measured torques run against")
+    assert "sign = [-1, 1, 1, 1, 1, 1]" in sign["text"]
+
+
 def test_two_seconds_of_the_ur10e_log_are_not_called_flipped(tmp_path):
     """Rows 635-800 of the UR10e's identification log (2 s): J4's torque runs against the nominal model
     (ρ = -0.865: friction the nominal model lacks) but not beyond its friction terms (-0.086); the log's sign is right
