@@ -959,10 +959,8 @@ def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
         return x
 
     x = raw[kind]
-    if isinstance(x, StoredColumns):
-        out = x.map_columns(mended)
-    else:
-        out = np.column_stack([mended(np.asarray(x[:, j]), j) for j in range(x.shape[1])])
+    out: StoredColumns | np.ndarray = (x.map_columns(mended) if isinstance(x, StoredColumns) else
+                                       np.column_stack([mended(np.asarray(x[:, j]), j) for j in range(x.shape[1])]))
     if not found:
         return raw
     unit = "A" if kind == "currents" else "N·m"
