@@ -940,8 +940,9 @@ def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
 
     def mended(column: np.ndarray, j: int) -> np.ndarray:
         x = np.asarray(column, dtype=float)
-        limit = SPIKE_SPREADS * float(np.std(x)) if x.size >= 5 else 0.0
-        if limit <= 0:
+        with np.errstate(over="ignore", invalid="ignore"):  # a value of 1e300 is refused later, by the plausibility check
+            limit = SPIKE_SPREADS * float(np.std(x)) if x.size >= 5 else 0.0
+        if not 0 < limit < np.inf:
             return x
         # a sample that far from the median of its five has a neighbour that far from it: check those only
         step = np.abs(np.diff(x)) > limit
