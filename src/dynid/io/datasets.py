@@ -940,8 +940,10 @@ def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
 
     def mended(column: np.ndarray, j: int) -> np.ndarray:
         x = np.asarray(column, dtype=float)
+        if x.size < 5 or np.mean(x == np.median(x)) >= 0.5:
+            return x  # mostly one value (dead, at a limit, a quantised rest): its deviation says nothing of a spike
         with np.errstate(over="ignore", invalid="ignore"):  # a value of 1e300 is refused later, by the plausibility check
-            limit = SPIKE_SPREADS * float(np.std(x)) if x.size >= 5 else 0.0
+            limit = SPIKE_SPREADS * float(np.std(x))
         if not 0 < limit < np.inf:
             return x
         # a sample that far from the median of its five has a neighbour that far from it: check those only
