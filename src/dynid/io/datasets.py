@@ -932,46 +932,55 @@ def _turns(column: np.ndarray) -> np.ndarray:
 
 def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
     """The torques or currents with their isolated spikes (:data:`SPIKE_SPREADS`) replaced by the median of the five
-    samples around each, and a warning per channel that had any: the dataset, the joint, how many and the largest."""
+    samples around each, and a warning per channel that had any: the dataset, the joint, how many and the largest.
+    Only a log with spikes is copied (a long log's stored columns are read once, not written again)."""
     kind = "currents" if "currents" in raw else "torques"
     if kind not in raw:
         return raw
-    found: dict[int, tuple[int, float]] = {}
-
-    def mended(column: np.ndarray, j: int) -> np.ndarray:
-        x = np.asarray(column, dtype=float)
-        if x.size < 5 or np.mean(x == np.median(x)) >= 0.5:
-            return x  # mostly one value (dead, at a limit, a quantised rest): its deviation says nothing of a spike
-        with np.errstate(over="ignore", invalid="ignore"):  # a value of 1e300 is refused later, by the plausibility check
-            limit = SPIKE_SPREADS * float(np.std(x))
-        if not 0 < limit < np.inf:
-            return x
-        # a sample that far from the median of its five has a neighbour that far from it: check those only
-        step = np.abs(np.diff(x)) > limit
-        near = np.flatnonzero(np.concatenate([[False], step]) | np.concatenate([step, [False]]))
-        near = near[(near >= 2) & (near < x.size - 2)]
-        if near.size == 0:
-            return x
-        median = np.median(np.stack([x[near + k] for k in range(-2, 3)]), axis=0)
-        spikes = np.abs(x[near] - median) > limit
-        if not spikes.any():
-            return x
-        found[j] = (int(spikes.sum()), float(np.max(np.abs(x[near] - median)[spikes])))
-        x = x.copy()
-        x[near[spikes]] = median[spikes]
-        return x
-
     x = raw[kind]
-    out: StoredColumns | np.ndarray = (x.map_columns(mended) if isinstance(x, StoredColumns) else
-                                       np.column_stack([mended(np.asarray(x[:, j]), j) for j in range(x.shape[1])]))
+    column = (lambda j: x.column(j)) if isinstance(x, StoredColumns) else (lambda j: x[:, j])  # noqa: E731
+    found = {j: hit for j in range(x.shape[1]) if (hit := _spikes(np.asarray(column(j), dtype=float))) is not None}
     if not found:
         return raw
+
+    def mended(values: np.ndarray, j: int) -> np.ndarray:
+        if j not in found:
+            return values
+        out = np.array(values, dtype=float)
+        out[found[j][0]] = found[j][1]
+        return out
+
+    fixed = (x.map_columns(mended) if isinstance(x, StoredColumns) else
+             np.column_stack([mended(np.asarray(x[:, j]), j) for j in range(x.shape[1])]))
     unit = "A" if kind == "currents" else "N·m"
-    for j, (count, largest) in sorted(found.items()):
-        warnings.append(f"{spec.name}: J{j + 1}'s {kind[:-1]} has {count} isolated spike(s), up to {largest:.4g} {unit} "
-                        f"from the samples around them (over {SPIKE_SPREADS:g}× the channel's standard deviation): each "
-                        "replaced by the median of the five samples around it")
-    return {**raw, kind: out}
+    for j, (where, _, largest) in sorted(found.items()):
+        warnings.append(f"{spec.name}: J{j + 1}'s {kind[:-1]} has {where.size} isolated spike(s), up to {largest:.4g} "
+                        f"{unit} from the samples around them (over {SPIKE_SPREADS:g}× the channel's standard deviation): "
+                        "each replaced by the median of the five samples around it")
+    return {**raw, kind: fixed}
+
+
+def _spikes(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """A channel's isolated spikes (:data:`SPIKE_SPREADS`): their indices, the medians that replace them and the largest
+    departure; None where there are none."""
+    if x.size < 5 or np.mean(x == np.median(x)) >= 0.5:
+        return None  # mostly one value (dead, at a limit, a quantised rest): its deviation says nothing of a spike
+    with np.errstate(over="ignore", invalid="ignore"):  # a value of 1e300 is refused later, by the plausibility check
+        limit = SPIKE_SPREADS * float(np.std(x))
+    if not 0 < limit < np.inf:
+        return None
+    # a sample that far from the median of its five has a neighbour that far from it: check those only
+    step = np.abs(np.diff(x)) > limit
+    near = np.flatnonzero(np.concatenate([[False], step]) | np.concatenate([step, [False]]))
+    near = near[(near >= 2) & (near < x.size - 2)]
+    if near.size == 0:
+        return None
+    median = np.median(np.stack([x[near + k] for k in range(-2, 3)]), axis=0)
+    departure = np.abs(x[near] - median)
+    spikes = departure > limit
+    if not spikes.any():
+        return None
+    return near[spikes], median[spikes], float(departure[spikes].max())
 
 
 def _held_rows(spec: DatasetSpec, t, raw: dict, warnings: list[str]) -> dict:
