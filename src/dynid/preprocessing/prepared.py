@@ -364,7 +364,7 @@ def clipped_samples(tau, t: np.ndarray, label: str,
         The joints (0-based) saturated throughout, whose rows are all left out.
     """
     n = tau.shape[0]
-    mask, words, extremes = None, [], {}
+    mask, words, extremes = None, {}, {}  # words and extremes by joint
     for j in range(tau.shape[1]):
         x = np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j], dtype=float)
         peak = float(np.abs(x).max()) if x.size else 0.0
@@ -383,22 +383,22 @@ def clipped_samples(tau, t: np.ndarray, label: str,
             mask[max(a - reach, 0):min(b + reach, n), j] = True
         a, b = max(runs, key=lambda r: r[1] - r[0])
         extremes[j] = x[a]
-        words.append(f"{label}: J{j + 1}'s torque stays at its extreme {x[a]:.4g} N·m for {b - a} samples "
-                     f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "
-                     "within the filter's reach are left out of the estimation and of the metrics")
+        words[j] = (f"{label}: J{j + 1}'s torque stays at its extreme {x[a]:.4g} N·m for {b - a} samples "
+                    f"(t = {t[a]:.3f}-{t[b - 1]:.3f} s): saturated? its {int(mask[:, j].sum())} samples there and "
+                    "within the filter's reach are left out of the estimation and of the metrics")
     if mask is None:
         return None, (), ()
     saturated: list[int] = []
     while mask.any(axis=1).mean() > 1.0 - SCORED_SHARE:
         j = int(np.argmax(mask.sum(axis=0)))
         share = float(mask[:, j].mean())
-        words[sorted(extremes).index(j)] = (
+        words[j] = (
             f"{label}: J{j + 1}'s torque is at its extreme {extremes[j]:.4g} N·m in {100 * share:.3g} % of the samples "
             "(with the filter's reach): saturated throughout? its rows are left out of the estimation and of the "
             "metrics, as a dead channel's, so that the other joints keep their samples")
         saturated.append(j)
         mask[:, j] = False
-    return (mask if mask.any() else None), tuple(words), tuple(sorted(saturated))
+    return (mask if mask.any() else None), tuple(words[j] for j in sorted(words)), tuple(sorted(saturated))
 
 
 def _quantum(x: np.ndarray, peak: float) -> float:
