@@ -38,6 +38,36 @@ def test_non_increasing_time_names_file_and_line(tmp_path):
 
 
 @pytest.mark.parametrize("spool", [False, True])
+def test_a_stalled_clock_is_spread_to_the_next_stamp(tmp_path, spool):
+    """Ten rows whose time stamp stalled while their values go on (a clock that stuck for 10 ms of a 100 Hz log):
+    their stamps are spread evenly to the next one, the recording equal to the one with the true stamps, one warning.
+    Ten rows at one stamp with the next stamp one step later cannot be spread at the log's rate: refused, naming the
+    first repeat's line."""
+    t = np.arange(200) * 0.01
+    q = 0.1 * np.sin(np.outer(t, np.arange(1, 7)))
+    stamps = t.copy()
+    stamps[50:60] = t[50]
+    for name, when in (("true", t), ("stalled", stamps)):
+        (tmp_path / f"{name}.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), np.full(6, 0.5))
+                                                      for tk, qk in zip(when, q)))
+    robot = load_robot("ur10e")
+    true, stalled = (load_recording(dataset_spec({"preset": "ur-rtde", "file": f"{name}.csv"}, tmp_path, "cfg",
+                                                 "ident", 6), robot, spool=spool) for name in ("true", "stalled"))
+    np.testing.assert_allclose(stalled.t, true.t, atol=1e-12)
+    np.testing.assert_array_equal(np.asarray(stalled.q), np.asarray(true.q))
+    assert [w for w in stalled.warnings if w not in true.warnings] == [
+        "ident: 9 time stamp(s) in 1 run(s) repeat the one before while the values change (a stalled or coarse clock): "
+        "spread evenly to the next time stamp"]
+    burst = np.r_[t[:60], np.full(10, t[60]), t[61:]]  # ten rows more at one stamp: 0.001 s apart at most
+    q = 0.1 * np.sin(np.outer(np.arange(burst.size) * 0.01, np.arange(1, 7)))
+    (tmp_path / "burst.csv").write_text("".join(_ur_row(tk, qk, np.zeros(6), np.full(6, 0.5))
+                                                for tk, qk in zip(burst, q)))
+    with pytest.raises(DataError, match=r"burst.csv: line 62: time stamps must increase, got a repeated time stamp"):
+        load_recording(dataset_spec({"preset": "ur-rtde", "file": "burst.csv"}, tmp_path, "cfg", "ident", 6), robot,
+                       spool=spool)
+
+
+@pytest.mark.parametrize("spool", [False, True])
 def test_a_row_written_twice_is_dropped_and_said(tmp_path, spool):
     """A row that repeats the previous one, time stamp and every value (a logger that wrote a sample twice): dropped,
     the recording the same as without it, one warning; time going back after it is refused naming its line in the

@@ -250,6 +250,10 @@ RESTART_STEPS = 100
 """A time stamp this many typical steps before the one above it starts a second recording, not a glitch of the clock:
 the refusal says how to read each (:func:`_increasing`)."""
 
+STALL_STEPS = (0.75, 1.5)
+"""Rows that share a time stamp while their values change are taken as evenly spaced up to the next stamp when that
+makes their steps this share of the log's mean step (a stalled clock); otherwise the repeat is refused."""
+
 HELD_SHARE = 0.05
 """A log whose rows repeat the previous one exactly this often holds stale samples (a logger faster than its source)."""
 
@@ -614,6 +618,9 @@ def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
         warnings.append(f"{spec.name}: {twice.size} row(s) repeat the previous one, time stamp and every value (a "
                         "sample written twice): dropped")
         steps = np.diff(t)
+    if np.any(steps == 0) and not np.any(steps < 0):
+        t = _stalled_clock(spec, t, steps, warnings)
+        steps = np.diff(t)
     if np.any(steps <= 0):
         i = int(np.argmax(steps <= 0))
         what = "a repeated time stamp" if t[i + 1] == t[i] else "time going back"
@@ -623,6 +630,30 @@ def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
         raise DataError(f"{where(i + 1)}: time stamps must increase, got {what}: {float(t[i + 1]):.9g} s after "
                         f"{float(t[i]):.9g} s{again or ''}")
     return t, raw, where
+
+
+def _stalled_clock(spec: DatasetSpec, t, steps, warnings: list[str]):
+    """Runs of rows whose time stamp repeats while their values change (a clock that stalled, or stamps written
+    coarser than the samples) spread evenly from their stamp to the next one, when that puts their steps within
+    :data:`STALL_STEPS` of the log's mean step; otherwise ``t`` is returned unchanged and the caller refuses the first
+    repeat, naming its line."""
+    n = t.shape[0]
+    same = steps == 0
+    a = np.flatnonzero(same & ~np.r_[False, same[:-1]])  # each run's first row
+    b = np.flatnonzero(same & ~np.r_[same[1:], False]) + 1  # ... and its last
+    k = b - a + 1
+    typical = float(t[-1] - t[0]) / (n - 1)
+    after = np.where(b + 1 < n, t[np.minimum(b + 1, n - 1)], t[a] + k * typical)  # the last run: the mean step
+    step = (after - t[a]) / k
+    low, high = STALL_STEPS
+    if typical <= 0 or np.any((step < low * typical) | (step > high * typical)):
+        return t
+    place = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+    t = np.array(t, dtype=float)
+    t[np.repeat(a, k) + place] = np.repeat(t[a], k) + place * np.repeat(step, k)
+    warnings.append(f"{spec.name}: {int((k - 1).sum())} time stamp(s) in {a.size} run(s) repeat the one before while "
+                    "the values change (a stalled or coarse clock): spread evenly to the next time stamp")
+    return t
 
 
 def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
