@@ -239,7 +239,7 @@ def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
         consistency_verdicts={"dynid WLS": "no: link 2's inertia", "dynid SDP": "yes"},
         estimates={"dynid WLS": SimpleNamespace(standard=None), "dynid SDP": SimpleNamespace(standard=np.zeros(3))},
         fit=empty_log, validations=[], findings=[], estimators=["wls", "sdp"],
-        solution=SimpleNamespace(from_prior=[], relative_std=[]), base=SimpleNamespace(names=[]), diagnostics={})
+        solution=SimpleNamespace(from_prior=[], params=[], relative_std=[]), base=SimpleNamespace(names=[]), diagnostics={})
     lines = [line.text for line in in_short(result)]
     assert lines[1] == ("main estimate: dynid WLS, not physically consistent; dynid export writes dynid SDP, which is "
                         "physically consistent")
@@ -273,7 +273,41 @@ def test_a_torque_offset_determined_to_be_about_zero_is_not_said_undetermined():
     result = SimpleNamespace(
         main_estimate=SimpleNamespace(label="dynid WLS"), consistency_verdicts={}, estimates={}, fit=empty_log,
         validations=[], findings=[], estimators=["wls"], base=SimpleNamespace(names=names),
-        solution=SimpleNamespace(from_prior=[], relative_std=[300.0, 300.0, 300.0, 2.0]),
+        solution=SimpleNamespace(from_prior=[], params=[0.01, 0.5, 0.2, 1.0], relative_std=[300.0, 300.0, 300.0, 2.0]),
         diagnostics={"sigma_torque_percent": {"offset1": 0.2, "offset2": 4.0, "MX2": 0.1, "fc1": 0.01}})
     (line,) = [ln.text for ln in in_short(result) if ln.text.startswith("not determined by this log")]
     assert ": offset2, MX2: " in line
+
+
+def test_a_sigma_the_bootstrap_finds_larger_decides_what_is_determined(tmp_path):
+    """The covariance's σ assumes white residuals (the LBR Med7's is 9× below the moving-block bootstrap's): a
+    parameter at 20 % by the covariance and 150 % by the bootstrap is not determined, in the summary and in the
+    report's table, which shows both σ and the relative σ from the larger; one the bootstrap puts lower keeps the
+    covariance's."""
+    from types import SimpleNamespace
+
+    from dynid.report.html import identify_sections
+    from dynid.report.summaries import in_short, larger_relative_std
+
+    assert larger_relative_std("MX2", -0.2, 20.0, {"MX2": 0.3}) == pytest.approx(150.0)
+    assert larger_relative_std("MX2", 0.2, 20.0, {"MX2": 0.01}) == 20.0
+    assert larger_relative_std("MX2", 0.2, 20.0, {}) == 20.0
+    assert larger_relative_std("MX2", 0.2, None, {"MX2": 0.3}) is None
+    names = ["MX2", "fc1"]
+    boot = {"MX2": 0.3, "fc1": 0.001}
+    empty_log = SimpleNamespace(name="identification", metrics=lambda: {})
+    result = SimpleNamespace(
+        main_estimate=SimpleNamespace(label="dynid WLS"), consistency_verdicts={}, estimates={}, fit=empty_log,
+        validations=[], findings=[], estimators=["wls"], base=SimpleNamespace(names=names),
+        solution=SimpleNamespace(from_prior=[], params=[-0.2, 1.0], relative_std=[20.0, 2.0]),
+        diagnostics={"sigma_torque_percent": {}, "bootstrap_std": boot})
+    (line,) = [ln.text for ln in in_short(result) if ln.text.startswith("not determined by this log")]
+    assert ": MX2: " in line
+    d = {"base_parameters": [{"name": n, "unit": "", "value": v, "std": s, "relative_std_percent": r, "expression": n}
+                             for n, v, s, r in (("MX2", -0.2, 0.04, 20.0), ("fc1", 1.0, 0.02, 2.0))],
+         "condition_number": 10.0, "n_rows": 100, "diagnostics": {"bootstrap_std": boot}}
+    _, sections = identify_sections(d)
+    (table,) = [t for sec in sections if sec.title == "Base parameters" for t in sec.tables][:1]
+    assert table.headers[:6] == ["name", "unit", "value", "σ", "σ boot.", "σ %"]
+    assert [row[3:6] for row in table.rows] == [["0.04", "0.3", "150"], ["0.02", "0.001", "2"]]
+    assert table.flagged == {(0, 5)}

@@ -116,7 +116,13 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         Setting -> value shown at the top.
     sections : list of Section
     """
-    from .summaries import BAD_RELATIVE_STD, NEGLIGIBLE_TORQUE, not_determined  # summaries loads NumPy
+    from .summaries import (  # summaries loads NumPy
+        BAD_RELATIVE_STD,
+        NEGLIGIBLE_TORQUE,
+        SIGMA_WORDS,
+        larger_relative_std,
+        not_determined,
+    )
 
     settings = {"robot": d.get("robot", ""), "estimators": _human(d.get("estimators", d.get("method", ""))),
                 "main estimate": d.get("main_estimate", ""),
@@ -125,19 +131,27 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     sections = [Section("In short", [], _identify_summary(d))] if "identification" in d or "validation" in d else []
     if "base_parameters" in d:
         refs = d.get("references", [])
-        kept = set((d.get("diagnostics") or {}).get("from_prior") or [])  # directions the log did not determine: the prior's
+        diagnostics = d.get("diagnostics") or {}
+        kept = set(diagnostics.get("from_prior") or [])  # directions the log did not determine: the prior's
+        boot = diagnostics.get("bootstrap_std") or {}
+        rel = {p["name"]: larger_relative_std(p["name"], p["value"], p.get("relative_std_percent"), boot)
+               for p in d["base_parameters"]}
         rows = [[p["name"], p["unit"], _fmt(p["value"]),
                  "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
-                 "—" if p["name"] in kept else _fmt(p["relative_std_percent"], ".3g"),
+                 *(("prior" if p["name"] in kept else _fmt(boot.get(p["name"]), ".2g"),) if boot else ()),
+                 "—" if p["name"] in kept else _fmt(rel[p["name"]], ".3g"),
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
-        share = (d.get("diagnostics") or {}).get("sigma_torque_percent") or {}
-        flagged = {(i, 4) for i, p in enumerate(d["base_parameters"])
-                   if p["name"] not in kept and not_determined(p["name"], p.get("relative_std_percent"), share)}
+        share = diagnostics.get("sigma_torque_percent") or {}
+        column = 5 if boot else 4
+        flagged = {(i, column) for i, p in enumerate(d["base_parameters"])
+                   if p["name"] not in kept and not_determined(p["name"], rel[p["name"]], share)}
         sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
+                                                          f"σ{SIGMA_WORDS if boot else ''}; "
                                                           f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted, but a "
                                                           f"torque offset within ±{NEGLIGIBLE_TORQUE:g} % of its joint's torque",
-                                                          ["name", "unit", "value", "σ", "σ %", *(r["name"] for r in refs), "expression"], rows,
-                                                          (5 + len(refs),), flagged)]))
+                                                          ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
+                                                           *(r["name"] for r in refs), "expression"], rows,
+                                                          (column + 1 + len(refs),), flagged)]))
         verdicts = d.get("physically_consistent_verdict", {})
         if verdicts:
             sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",

@@ -20,6 +20,10 @@ from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison, rests_throughout
 from .paper_summary import run_summary_blocks
 
+SIGMA_WORDS = (" from the covariance and from a moving-block bootstrap over the log; σ % from the larger. Both are "
+               "the spread from the noise, not a model's bias")
+"""How the base-parameter tables' σ columns read (a :func:`larger_relative_std` table)."""
+
 BAD_RELATIVE_STD = 100.0
 """[%] A base parameter whose σ reaches its value is not determined by the data: highlighted."""
 
@@ -27,6 +31,31 @@ NEGLIGIBLE_TORQUE = 1.0
 """[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
 N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
 torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
+
+
+def larger_relative_std(name: str, value: float, relative_std: float | None, bootstrap_std: dict) -> float | None:
+    """A base parameter's σ over |value| [%], from the larger of the covariance's σ and the moving-block bootstrap's
+    (results.json ``diagnostics.bootstrap_std``): the covariance assumes white residuals and understates the spread
+    of a log whose residuals are correlated (9× on the LBR Med7's), so neither alone is shown as the σ to trust.
+
+    Parameters
+    ----------
+    name : str
+    value : float
+        The estimate.
+    relative_std : float or None
+        The covariance's σ over |value| [%] (None: kept at the prior).
+    bootstrap_std : dict
+        name -> the bootstrap's σ, in the parameter's unit; a missing name: the covariance's alone.
+
+    Returns
+    -------
+    float or None
+    """
+    boot = bootstrap_std.get(name)
+    if relative_std is None or boot is None or not math.isfinite(boot) or value == 0:
+        return relative_std
+    return max(float(relative_std), 100.0 * float(boot) / abs(float(value)))
 
 
 def not_determined(name: str, relative_std: float | None, sigma_torque_percent: dict) -> bool:
@@ -186,14 +215,17 @@ def identification_blocks(result) -> list:
     # IDIM-IV, DIDIM and the drive-only main estimate (the description's rigid body): beside least squares
     closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY]
     kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
+    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
     rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
-                  "—" if i in kept else f"{sol.relative_std[i]:.1f}",
+                  *(("prior" if i in kept else f"{boot.get(n, math.nan):.2g}",) if boot else ()),
+                  "—" if i in kept else f"{larger_relative_std(n, sol.params[i], sol.relative_std[i], boot):.1f}",
                   *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
                  for i, n in enumerate(base.names))
-    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation; "
+    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation{SIGMA_WORDS if boot else ''}; "
                          + ("closed-loop estimates and " if any(e.key in OTHER_LABELS for e in closed) else
                             "the main estimate and " if closed else "") + "reference values beside)",
-                         ("name", "unit", "value", "σ", "σ %", *(label(e.key) for e in closed), *(ref.name for ref in r.references)),
+                         ("name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
+                          *(label(e.key) for e in closed), *(ref.name for ref in r.references)),
                          rows, labels=2))
     for ref in r.references:
         if ref.relative_std is not None:
@@ -574,8 +606,9 @@ def in_short(result) -> list:
         out.append(_kept_line([n for n in r.base.names if n in kept], r.fit.dead,
                               [r.base.names[i] for i in r.solution.anchored]))
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
-    loose = [n for n, rel in zip(r.base.names, r.solution.relative_std)
-             if n not in kept and not_determined(n, float(rel), share)]
+    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
+    loose = [n for n, v, rel in zip(r.base.names, r.solution.params, r.solution.relative_std)
+             if n not in kept and not_determined(n, larger_relative_std(n, v, float(rel), boot), share)]
     if loose:
         out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value): {', '.join(loose)}: their "
                         "values are set by the noise; a richer excitation (dynid excite) determines them"))
