@@ -359,7 +359,6 @@ def export(
     quiet: bool = QUIET,
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
-    from ..exceptions import DataError
     from ..io.identification_config import load_identification_config
 
     def _users_mjcf(cfg):  # the model --mjcf writes into: --mjcf-model, else the config's mjcf_model
@@ -368,47 +367,14 @@ def export(
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)
         identified = _read_results(results, cfg.robot)
-        targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
-        if mjcf_model is not None and mjcf is None:
-            raise DataError("--mjcf-model is the model --mjcf writes into: give --mjcf FILE too")
-        if not targets:
-            raise DataError("give --urdf FILE and/or --mjcf FILE")
-        if mjcf_model is not None and not mjcf_model.is_file():
-            raise DataError(f"--mjcf-model {mjcf_model}: no such file")
-        if mjcf_model is not None:
-            from ..io.mjcf_write_back import read_users_mjcf
-
-            read_users_mjcf(mjcf_model, cfg.robot)  # its joints are the robot's, before any work
-        _check_targets(targets)
-        return cfg, identified, targets
+        return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
 
     def compute(prepared, progress):
-        from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results
-        from ..io.mjcf_write_back import mjcf_written_back
-        from ..io.urdf_write_back import urdf_written_back
-
         cfg, identified, targets = prepared
         moved: list[str] = []
-
-        def urdf_text(robot, identified, source):
-            if cfg.urdf is None:  # a DH description: a URDF of its own
-                return urdf_from_results(robot, identified, source=source)
-            fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
-            text, far = urdf_written_back(cfg.urdf, fitted, phi)
-            moved.extend(far)
-            return text
-
-        def mjcf_text(robot, identified, source):
-            users = _users_mjcf(cfg)
-            if users is None:
-                return mjcf_from_results(robot, identified, source=source)
-            fitted, phi = consistent_estimate(robot, identified, source)
-            text, far = mjcf_written_back(users, fitted, phi, out_dir=mjcf.parent if mjcf else None)
-            moved.extend(far)
-            return text
-
-        export = {"--urdf": urdf_text, "--mjcf": mjcf_text}
-        return cfg, [(path, export[flag](cfg.robot, identified, str(results))) for flag, path in targets], moved, identified
+        texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
+                 for flag, path in targets]
+        return cfg, texts, moved, identified
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -436,6 +402,52 @@ def export(
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)
+
+
+def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | None, robot) -> list[tuple[str, Path]]:
+    """The files ``dynid export`` is to write, as (flag, path), checked before any work: at least one, a
+    ``--mjcf-model`` only with ``--mjcf`` and with the robot's joints, writable places (:func:`_check_targets`)."""
+    from ..exceptions import DataError
+
+    targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
+    if mjcf_model is not None and mjcf is None:
+        raise DataError("--mjcf-model is the model --mjcf writes into: give --mjcf FILE too")
+    if not targets:
+        raise DataError("give --urdf FILE and/or --mjcf FILE")
+    if mjcf_model is not None and not mjcf_model.is_file():
+        raise DataError(f"--mjcf-model {mjcf_model}: no such file")
+    if mjcf_model is not None:
+        from ..io.mjcf_write_back import read_users_mjcf
+
+        read_users_mjcf(mjcf_model, robot)  # its joints are the robot's, before any work
+    _check_targets(targets)
+    return targets
+
+
+def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path | None, mjcf: Path | None,
+                 moved: list[str]) -> str:
+    """The text of one ``dynid export`` file (``flag``: "--urdf" or "--mjcf"): the user's URDF or MJCF with the
+    identified values written in, or a file of dynid's own where the description has none; values far from the
+    description's own are appended to ``moved``."""
+    from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results
+
+    robot = cfg.robot
+    if flag == "--urdf":
+        if cfg.urdf is None:  # a DH description: a URDF of its own
+            return urdf_from_results(robot, identified, source=source)
+        from ..io.urdf_write_back import urdf_written_back
+
+        fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
+        text, far = urdf_written_back(cfg.urdf, fitted, phi)
+    else:
+        if users_mjcf is None:
+            return mjcf_from_results(robot, identified, source=source)
+        from ..io.mjcf_write_back import mjcf_written_back
+
+        fitted, phi = consistent_estimate(robot, identified, source)
+        text, far = mjcf_written_back(users_mjcf, fitted, phi, out_dir=mjcf.parent if mjcf else None)
+    moved.extend(far)
+    return text
 
 
 def _read_results(results: Path, robot) -> dict:
