@@ -117,7 +117,11 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     assert tail[2].startswith(f"{result.fit.name}: torque error {main['global_relative_error']:.3g} % over all joints, worst J")
     assert len([t for t in tail if "torque error" in t]) == 1 + len(result.validations)
     assert tail[-1].startswith("next: ")
-    loose = [n for n, rel in zip(result.base.names, result.solution.relative_std) if rel >= 100]
+    boot = result.diagnostics["bootstrap_std"]  # σ % from the larger of the covariance's and the bootstrap's
+    assert set(boot) == set(result.base.names)
+    loose = [n for n, v, rel in zip(result.base.names, result.solution.params, result.solution.relative_std)
+             if max(rel, 100 * boot[n] / abs(v)) >= 100]
+    assert loose != [n for n, rel in zip(result.base.names, result.solution.relative_std) if rel >= 100]  # the bootstrap's say
     said = [t for t in tail if t.startswith("not determined by this log")]
     assert (said[0].split("): ")[1].split(": their")[0].split(", ") if said else []) == loose
 

@@ -311,3 +311,25 @@ def test_a_sigma_the_bootstrap_finds_larger_decides_what_is_determined(tmp_path)
     assert table.headers[:6] == ["name", "unit", "value", "σ", "σ boot.", "σ %"]
     assert [row[3:6] for row in table.rows] == [["0.04", "0.3", "150"], ["0.02", "0.001", "2"]]
     assert table.flagged == {(0, 5)}
+
+
+def test_the_base_parameter_table_shows_the_main_estimate_beside_least_squares():
+    """The table's value and σ are least squares' (σ is theirs); where the main estimate is another (the SDP on
+    the KR300's log: ZZ1R 1446 kg·m² against least squares' 1.5e5), its values stand beside them, marked, and the
+    title names least squares. Where least squares is the main estimate, no column is added."""
+    from dynid.report.html import identify_sections
+
+    d = {"base_parameters": [{"name": n, "unit": "", "value": v, "std": 0.1, "relative_std_percent": 10.0,
+                              "expression": n} for n, v in (("ZZ1R", 1.5e5), ("fc1", 344.0))],
+         "condition_number": 10.0, "n_rows": 100, "least_squares": "wls", "main_estimate": "dynid SDP",
+         "estimates": {"dynid WLS": {"key": "wls", "values": {"ZZ1R": 1.5e5, "fc1": 344.0}},
+                       "dynid SDP": {"key": "sdp", "values": {"ZZ1R": 1446.0, "fc1": 436.0}}}}
+    _, sections = identify_sections(d)
+    table = next(t for sec in sections if sec.title == "Base parameters" for t in sec.tables)
+    assert table.caption.startswith("dynid WLS with condition number")
+    assert table.headers[:7] == ["name", "unit", "value", "σ", "σ %", "dynid SDP (main)", "expression"]
+    assert [row[5] for row in table.rows] == ["1446", "436"]
+    d["main_estimate"] = "dynid WLS"
+    _, sections = identify_sections(d)
+    table = next(t for sec in sections if sec.title == "Base parameters" for t in sec.tables)
+    assert "dynid SDP (main)" not in table.headers and "dynid WLS (main)" not in table.headers

@@ -102,6 +102,18 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
     return tables
 
 
+def _beside_least_squares(d: dict) -> list[tuple[str, dict]]:
+    """The estimates a results.json's base-parameter table shows beside least squares', as (header, name -> value):
+    IDIM-IV, DIDIM, the drive-only estimate and the main estimate where it is not least squares' (the SDP)."""
+    from ..estimators.registry import OTHER_LABELS
+    from ..identification.drive_only import DRIVE_ONLY_KEY
+
+    main = d.get("main_estimate")
+    return [(label + (" (main)" if label == main else ""), e["values"]) for label, e in (d.get("estimates") or {}).items()
+            if isinstance(e.get("values"), dict) and (e.get("key") in OTHER_LABELS or e.get("key") == DRIVE_ONLY_KEY
+                                                       or (label == main and e.get("key") != d.get("least_squares")))]
+
+
 def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     """Settings and sections of ``dynid identify`` (or ``dynid validate``).
 
@@ -136,22 +148,27 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         boot = diagnostics.get("bootstrap_std") or {}
         rel = {p["name"]: larger_relative_std(p["name"], p["value"], p.get("relative_std_percent"), boot)
                for p in d["base_parameters"]}
+        beside = _beside_least_squares(d)
         rows = [[p["name"], p["unit"], _fmt(p["value"]),
                  "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
                  *(("prior" if p["name"] in kept else _fmt(boot.get(p["name"]), ".2g"),) if boot else ()),
                  "—" if p["name"] in kept else _fmt(rel[p["name"]], ".3g"),
+                 *(_fmt(values.get(p["name"])) for _, values in beside),
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
         share = diagnostics.get("sigma_torque_percent") or {}
         column = 5 if boot else 4
         flagged = {(i, column) for i, p in enumerate(d["base_parameters"])
                    if p["name"] not in kept and not_determined(p["name"], rel[p["name"]], share)}
-        sections.append(Section("Base parameters", [Table(f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
+        ls_label = next((k for k, e in (d.get("estimates") or {}).items() if e.get("key") == d.get("least_squares")), "")
+        sections.append(Section("Base parameters", [Table(f"{ls_label + ' with ' if ls_label else ''}"
+                                                          f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
                                                           f"σ{SIGMA_WORDS if boot else ''}; "
                                                           f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted, but a "
                                                           f"torque offset within ±{NEGLIGIBLE_TORQUE:g} % of its joint's torque",
                                                           ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
-                                                           *(r["name"] for r in refs), "expression"], rows,
-                                                          (column + 1 + len(refs),), flagged)]))
+                                                           *(name for name, _ in beside), *(r["name"] for r in refs),
+                                                           "expression"], rows,
+                                                          (column + 1 + len(beside) + len(refs),), flagged)]))
         verdicts = d.get("physically_consistent_verdict", {})
         if verdicts:
             sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",

@@ -212,8 +212,10 @@ def identification_blocks(result) -> list:
     if r.settings.get("friction_models") is not None:
         out.append(friction_choice_table(r.settings["friction_models"]))
 
-    # IDIM-IV, DIDIM and the drive-only main estimate (the description's rigid body): beside least squares
-    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY]
+    # IDIM-IV, DIDIM, the drive-only estimate and any other main estimate (the SDP): beside least squares
+    main = r.main_estimate
+    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY
+              or (e is main and e.key != r.least_squares)]
     kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}
     rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
@@ -225,7 +227,8 @@ def identification_blocks(result) -> list:
                          + ("closed-loop estimates and " if any(e.key in OTHER_LABELS for e in closed) else
                             "the main estimate and " if closed else "") + "reference values beside)",
                          ("name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
-                          *(label(e.key) for e in closed), *(ref.name for ref in r.references)),
+                          *(label(e.key) + (" (main)" if e is main else "") for e in closed),
+                          *(ref.name for ref in r.references)),
                          rows, labels=2))
     for ref in r.references:
         if ref.relative_std is not None:
@@ -610,8 +613,10 @@ def in_short(result) -> list:
     loose = [n for n, v, rel in zip(r.base.names, r.solution.params, r.solution.relative_std)
              if n not in kept and not_determined(n, larger_relative_std(n, v, float(rel), boot), share)]
     if loose:
-        out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value): {', '.join(loose)}: their "
-                        "values are set by the noise; a richer excitation (dynid excite) determines them"))
+        which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
+        out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(loose)}: "
+                        "their values are set by the noise and the misfit; a richer excitation (dynid excite) determines "
+                        "them"))
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
                 >= errors.get(c.name, np.inf)}
