@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
+from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
 
 
@@ -105,7 +106,6 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
 def _beside_least_squares(d: dict) -> list[tuple[str, dict]]:
     """The estimates a results.json's base-parameter table shows beside least squares', as (header, name -> value):
     IDIM-IV, DIDIM, the drive-only estimate and the main estimate where it is not least squares' (the SDP)."""
-    from ..estimators.registry import OTHER_LABELS
     from ..identification.drive_only import DRIVE_ONLY_KEY
 
     main = d.get("main_estimate")
