@@ -201,3 +201,20 @@ def test_load_recording_takes_a_logs_path_and_load_results_a_folder(tmp_path, fi
     (tmp_path / "out").mkdir()
     fitted.save(tmp_path / "out" / "results.json")
     assert dynid.load_results(tmp_path / "out").main == fitted.result_.main
+
+
+def test_the_sdp_prior_is_a_setting_of_the_identifier(er16):
+    """Identifier(sdp_prior=...) is the config's [estimation] sdp_prior: the geometric prior's SDP estimate is
+    identify_from_arrays's with that prior, not the Euclidean one's; an unknown prior is a one-line ConfigError."""
+    from dynid.identification.run import identify_from_arrays
+
+    robot, log, _ = er16
+    ident = dynid.Identifier(robot, estimators=["wls", "sdp"], sdp_prior="geometric")
+    assert ident.get_params()["sdp_prior"] == "geometric"
+    geometric = ident.fit(log.t, log.q, log.tau).estimates_["dynid SDP"]
+    direct = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", "sdp"), sdp_prior="geometric")
+    euclidean = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", "sdp"))
+    np.testing.assert_array_equal(geometric, direct.estimates["dynid SDP"].params)
+    assert not np.array_equal(geometric, euclidean.estimates["dynid SDP"].params)
+    with pytest.raises(ConfigError, match="sdp_prior=...\\): expected one of euclidean, geometric, got 'logdet'"):
+        dynid.Identifier(robot, estimators=["sdp"], sdp_prior="logdet").fit(log.t, log.q, log.tau)

@@ -30,6 +30,9 @@ CONSISTENCY_TOL = 1e-7
 PRIOR_KIND = "euclidean"
 """The SDP's prior by default (:class:`PhysicallyConsistentLeastSquares`)."""
 
+PRIOR_KINDS = ("euclidean", "geometric")
+"""The SDP's priors: squared distance to the nominal parameters, or the pseudo-inertias' log-det divergence."""
+
 
 class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
@@ -135,7 +138,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
             elif self.prior_kind == "euclidean":
                 cost = cost + weight * cp.sum_squares(phi - prior)
             else:
-                raise ShapeError(f"prior_kind: expected 'euclidean' or 'geometric', got {self.prior_kind!r}")
+                raise ShapeError(f"prior_kind: expected one of {', '.join(PRIOR_KINDS)}, got {self.prior_kind!r}")
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ..estimators.physically_consistent import PRIOR_KINDS as SDP_PRIORS
 from ..exceptions import ConfigError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
@@ -51,6 +52,10 @@ class Identifier:
         How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`: the
         controller, one set-point per sample, the feed-forward), for the closed-loop estimators; a config gives its
         ``[controller]`` table instead.
+    sdp_prior : {"euclidean", "geometric"}, optional
+        How ``sdp`` keeps what the data do not determine near the description's nominal parameters: squared distance,
+        or the log-det divergence of each link's pseudo-inertia (Lee, Wensing & Park 2020); default "euclidean", or
+        the config's ``[estimation] sdp_prior``.
 
     Attributes
     ----------
@@ -71,13 +76,14 @@ class Identifier:
     """
 
     def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
-                 friction: str | None = None, seed: int | None = None, controller=None):
+                 friction: str | None = None, seed: int | None = None, controller=None, sdp_prior: str | None = None):
         self.robot = robot
         self.estimators = estimators
         self.preprocessing = preprocessing
         self.friction = friction
         self.seed = seed
         self.controller = controller
+        self.sdp_prior = sdp_prior
 
     def __sklearn_is_fitted__(self) -> bool:
         """Whether :meth:`fit` ran (scikit-learn's ``check_is_fitted`` asks this).
@@ -143,7 +149,8 @@ class Identifier:
     @classmethod
     def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:
         """Identify the robot of an identification config (TOML) as ``dynid identify`` does, the ``params`` given
-        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``) over
+        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``,
+        ``sdp_prior``) over
         the config's.
 
         Parameters
@@ -220,7 +227,8 @@ class Identifier:
                                   "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
-                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller)
+                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller,
+                                          sdp_prior=self._sdp_prior() or "euclidean")
         return self._fitted(result)
 
     def _fitted(self, result) -> Identifier:
@@ -259,6 +267,8 @@ class Identifier:
             changes["friction"] = self.friction
         if self.seed is not None:
             changes["seed"] = int(self.seed)
+        if self._sdp_prior() is not None:
+            changes["sdp_prior"] = self._sdp_prior()
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:
@@ -267,6 +277,12 @@ class Identifier:
         if self.robot is None:
             raise ConfigError("Identifier(robot=...): the robot's description is needed to fit arrays", field="robot")
         return self.robot if isinstance(self.robot, Robot) else load_robot(self.robot)
+
+    def _sdp_prior(self) -> str | None:
+        if self.sdp_prior is None or self.sdp_prior in SDP_PRIORS:
+            return self.sdp_prior
+        raise ConfigError(f"Identifier(sdp_prior=...): expected one of {', '.join(SDP_PRIORS)}, got {self.sdp_prior!r}",
+                          field="sdp_prior")
 
     def _preprocessing(self) -> Preprocessing | None:
         p = self.preprocessing
