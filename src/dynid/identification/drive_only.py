@@ -102,32 +102,41 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     x = np.zeros(drive.size)
     for _ in range(drive.size + 1):
         free = np.flatnonzero(~active)
+        pairs = coulomb_offset_pairs([names[i] for i in drive[free]])
         params, cov, sol = accumulator.solve_affine(basis[:, free], offset, joint_weights, prior=phi0[drive[free]],
-                                                    pairs=coulomb_offset_pairs([names[i] for i in drive[free]]))
+                                                    pairs=pairs)
         x = np.zeros(drive.size)
         x[free] = sol.params
         below = ~active & (x < lower)
         if not below.any():
             break
         # the bounded least squares' active set first (the step that frees a bound is SciPy's), then any term the
-        # prior's directions push below its bound
-        active |= below if active.any() else _at_bound(accumulator, basis, offset, lower, joint_weights) | below
+        # prior's directions push below its bound; a one-way joint's offset that the fit kept at the description's
+        # value stays there, so that the bounded fit does not split that joint's one term otherwise
+        kept = free[[fixed for coulomb, fixed in pairs if coulomb in sol.anchored]]
+        active |= below if active.any() else _at_bound(accumulator, basis, offset, lower, joint_weights,
+                                                        kept, phi0[drive[kept]]) | below
     standard = phi0.copy()
     standard[drive] = x
     return params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard
 
 
 def _at_bound(accumulator: LeastSquaresAccumulator, basis: np.ndarray, offset: np.ndarray, lower: np.ndarray,
-              joint_weights) -> np.ndarray:
+              joint_weights, fixed=(), values=()) -> np.ndarray:
     """The terms at their lower bound in the bounded least squares ``min ||D(τ - W(offset + basis x))||², x ≥ lower``
-    (SciPy's BVLS on the column-scaled triangular factor; Stark & Parker 1995): (d,) bool."""
+    (SciPy's BVLS on the column-scaled triangular factor; Stark & Parker 1995), the terms ``fixed`` held at
+    ``values`` (never at bound): (d,) bool."""
     from scipy.optimize import lsq_linear
 
-    p = basis.shape[0]
+    p, d = basis.shape
+    held = np.zeros(d, dtype=bool)
+    held[np.asarray(fixed, dtype=int)] = True
+    offset = offset + basis[:, held] @ np.asarray(values, dtype=float)
     red = accumulator.reduced(joint_weights)
-    a = red[:p, :p] @ basis
+    a = red[:p, :p] @ basis[:, ~held]
     scale = np.linalg.norm(a, axis=0)
     scale = np.where(scale > 0, scale, 1.0)
-    fit = lsq_linear(a / scale, red[:p, p] - red[:p, :p] @ offset, bounds=(lower * scale, np.inf), method="bvls")
-    x = fit.x / scale
-    return np.isfinite(lower) & (x <= lower + 1e-9 * np.maximum(1.0, np.abs(x)))
+    fit = lsq_linear(a / scale, red[:p, p] - red[:p, :p] @ offset, bounds=(lower[~held] * scale, np.inf), method="bvls")
+    x = np.zeros(d)
+    x[~held] = fit.x / scale
+    return ~held & np.isfinite(lower) & (x <= lower + 1e-9 * np.maximum(1.0, np.abs(x)))
