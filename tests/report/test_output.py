@@ -263,7 +263,8 @@ def test_a_cutoff_candidate_not_scored_shows_a_dash_not_inf():
 def test_a_torque_offset_determined_to_be_about_zero_is_not_said_undetermined():
     """σ ≥ 100 % of a value near 0 is not "not determined" when ±σ is a negligible torque: the UR10e example listed its
     six offsets (truth 0, σ a few hundredths of a N·m) beside the inertial directions the log really leaves open. An
-    offset whose ±σ is 1 % of its joint's torque or more, and any other term, is still listed."""
+    offset whose ±σ is 1 % of its joint's torque or more is still listed; another term under 1 % is said "about 0 on
+    this log's motion" (test below), since its ±σ torque on another motion may differ."""
     from types import SimpleNamespace
 
     from dynid.report.summaries import in_short
@@ -275,8 +276,11 @@ def test_a_torque_offset_determined_to_be_about_zero_is_not_said_undetermined():
         validations=[], findings=[], estimators=["wls"], base=SimpleNamespace(names=names),
         solution=SimpleNamespace(from_prior=[], params=[0.01, 0.5, 0.2, 1.0], relative_std=[300.0, 300.0, 300.0, 2.0]),
         diagnostics={"sigma_torque_percent": {"offset1": 0.2, "offset2": 4.0, "MX2": 0.1, "fc1": 0.01}})
-    (line,) = [ln.text for ln in in_short(result) if ln.text.startswith("not determined by this log")]
-    assert ": offset2, MX2: " in line
+    lines = [ln.text for ln in in_short(result)]
+    (line,) = [t for t in lines if t.startswith("not determined by this log")]
+    assert ": offset2: " in line
+    (line,) = [t for t in lines if t.startswith("about 0 on this log's motion")]
+    assert ": MX2: " in line and "offset1" not in line
 
 
 def test_a_sigma_the_bootstrap_finds_larger_decides_what_is_determined(tmp_path):
@@ -333,3 +337,26 @@ def test_the_base_parameter_table_shows_the_main_estimate_beside_least_squares()
     _, sections = identify_sections(d)
     table = next(t for sec in sections if sec.title == "Base parameters" for t in sec.tables)
     assert "dynid SDP (main)" not in table.headers and "dynid WLS (main)" not in table.headers
+
+
+def test_a_parameter_near_zero_within_the_noise_is_said_apart_from_the_undetermined():
+    """σ ≥ 100 % of a value near 0 (a link's MX2 where the link is symmetric) is not a poor excitation: where its ±σ
+    torque on the identification log, scaled to the larger σ, is under 1 % of its joint's torque, the summary says
+    "about 0 on this log's motion" instead of "not determined … a richer excitation determines them"."""
+    from types import SimpleNamespace
+
+    from dynid.report.summaries import in_short
+
+    names = ["MX2", "XZ3", "MY4", "fc1"]
+    share = {"MX2": 0.2, "XZ3": 0.6, "MY4": 3.0, "fc1": 0.1}  # ±σ torque, % of the joint's, from the covariance's σ
+    boot = {"MX2": 0.001, "XZ3": 0.02, "MY4": 0.001, "fc1": 0.001}  # XZ3's bootstrap σ twice its covariance's: 1.2 %
+    empty_log = SimpleNamespace(name="identification", metrics=lambda: {})
+    result = SimpleNamespace(
+        main_estimate=SimpleNamespace(label="dynid WLS"), consistency_verdicts={}, estimates={}, fit=empty_log,
+        validations=[], findings=[], estimators=["wls"], base=SimpleNamespace(names=names),
+        solution=SimpleNamespace(from_prior=[], params=[0.001, 0.01, 0.001, 1.0], relative_std=[150.0, 100.0, 150.0, 2.0]),
+        diagnostics={"sigma_torque_percent": share, "bootstrap_std": boot})
+    lines = [ln.text for ln in in_short(result)]
+    (loose,) = [t for t in lines if t.startswith("not determined by this log")]
+    (small,) = [t for t in lines if t.startswith("about 0 on this log's motion")]
+    assert "): XZ3, MY4: " in loose and "): MX2: " in small and "fc1" not in loose + small

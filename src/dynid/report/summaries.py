@@ -580,6 +580,23 @@ def validation_verdict(comparisons) -> list:
     return out
 
 
+def _undetermined(names, params, relative_std, kept, share: dict, boot: dict) -> tuple[list[str], list[str]]:
+    """The base parameters the summary calls not determined (:func:`not_determined` on the larger σ), split into
+    those whose ±σ torque on the identification log (``share``, from the covariance's σ, scaled to the larger) is
+    :data:`NEGLIGIBLE_TORQUE` of their joint's torque or more, and those under it (about 0 on this motion)."""
+    loose: list[str] = []
+    small: list[str] = []
+    for n, v, rel in zip(names, params, relative_std):
+        larger = larger_relative_std(n, v, float(rel), boot)
+        if n in kept or not not_determined(n, larger, share):
+            continue
+        torque = share.get(n)
+        if torque is not None and larger is not None and float(rel) > 0:
+            torque *= larger / float(rel)
+        (small if torque is not None and torque < NEGLIGIBLE_TORQUE else loose).append(n)
+    return loose, small
+
+
 def in_short(result) -> list:
     """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
     log's global error and worst joint, and what to do next.
@@ -610,13 +627,16 @@ def in_short(result) -> list:
                               [r.base.names[i] for i in r.solution.anchored]))
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}
-    loose = [n for n, v, rel in zip(r.base.names, r.solution.params, r.solution.relative_std)
-             if n not in kept and not_determined(n, larger_relative_std(n, v, float(rel), boot), share)]
+    loose, small = _undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
+    which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
     if loose:
-        which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
         out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(loose)}: "
                         "their values are set by the noise and the misfit; a richer excitation (dynid excite) determines "
                         "them"))
+    if small:
+        out.append(Line(f"about 0 on this log's motion (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}, but ±σ under "
+                        f"{NEGLIGIBLE_TORQUE:g} % of the joint's torque): {', '.join(small)}: a faster or wider motion "
+                        "may need them; the validation logs say whether it does"))
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
                 >= errors.get(c.name, np.inf)}
