@@ -360,3 +360,11 @@ def test_a_parameter_near_zero_within_the_noise_is_said_apart_from_the_undetermi
     (loose,) = [t for t in lines if t.startswith("not determined by this log")]
     (small,) = [t for t in lines if t.startswith("about 0 on this log's motion")]
     assert "): XZ3, MY4: " in loose and "): MX2: " in small and "fc1" not in loose + small
+    from dynid.report.html import identify_sections  # the report highlights the undetermined ones only
+
+    d = {"base_parameters": [{"name": n, "unit": "", "value": v, "std": v * r / 100, "relative_std_percent": r,
+                              "expression": n} for n, v, r in zip(names, result.solution.params, result.solution.relative_std)],
+         "condition_number": 10.0, "n_rows": 100, "diagnostics": result.diagnostics}
+    _, sections = identify_sections(d)
+    table = next(t for sec in sections if sec.title == "Base parameters" for t in sec.tables)
+    assert table.flagged == {(1, 5), (2, 5)} and "about 0 on this motion" in table.caption

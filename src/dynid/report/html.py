@@ -133,7 +133,7 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         NEGLIGIBLE_TORQUE,
         SIGMA_WORDS,
         larger_relative_std,
-        not_determined,
+        undetermined,
     )
 
     settings = {"robot": d.get("robot", ""), "estimators": _human(d.get("estimators", d.get("method", ""))),
@@ -157,14 +157,16 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
                  *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
         share = diagnostics.get("sigma_torque_percent") or {}
         column = 5 if boot else 4
-        flagged = {(i, column) for i, p in enumerate(d["base_parameters"])
-                   if p["name"] not in kept and not_determined(p["name"], rel[p["name"]], share)}
+        loose, _ = undetermined([p["name"] for p in d["base_parameters"]], [p["value"] for p in d["base_parameters"]],
+                                [p.get("relative_std_percent") for p in d["base_parameters"]], kept, share, boot)
+        flagged = {(i, column) for i, p in enumerate(d["base_parameters"]) if p["name"] in loose}
         ls_label = next((k for k, e in (d.get("estimates") or {}).items() if e.get("key") == d.get("least_squares")), "")
         sections.append(Section("Base parameters", [Table(f"{ls_label + ' with ' if ls_label else ''}"
                                                           f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
                                                           f"σ{SIGMA_WORDS if boot else ''}; "
                                                           f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted, but a "
-                                                          f"torque offset within ±{NEGLIGIBLE_TORQUE:g} % of its joint's torque",
+                                                          f"parameter whose ±σ is under {NEGLIGIBLE_TORQUE:g} % of its joint's torque on this "
+                                                          "log (about 0 on this motion)",
                                                           ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
                                                            *(name for name, _ in beside), *(r["name"] for r in refs),
                                                            "expression"], rows,

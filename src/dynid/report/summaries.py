@@ -29,8 +29,9 @@ BAD_RELATIVE_STD = 100.0
 
 NEGLIGIBLE_TORQUE = 1.0
 """[%] A torque offset whose σ is below this share of its joint's RMS torque is determined to be about 0 (0.01 ± 0.02
-N·m), which "not determined" would misstate. Offsets only: their column is 1 on every log, so their ±σ is the same
-torque on any motion; the other terms' ±σ torque on the identification log says nothing of a faster motion."""
+N·m), which "not determined" would misstate: its column is 1 on every log, so its ±σ is the same torque on any
+motion. Another term under it is said "about 0 on this log's motion" (:func:`undetermined`), apart from the
+undetermined ones: its ±σ torque on the identification log says nothing of a faster motion."""
 
 
 def larger_relative_std(name: str, value: float, relative_std: float | None, bootstrap_std: dict) -> float | None:
@@ -580,15 +581,34 @@ def validation_verdict(comparisons) -> list:
     return out
 
 
-def _undetermined(names, params, relative_std, kept, share: dict, boot: dict) -> tuple[list[str], list[str]]:
+def undetermined(names, params, relative_std, kept, share: dict, boot: dict) -> tuple[list[str], list[str]]:
     """The base parameters the summary calls not determined (:func:`not_determined` on the larger σ), split into
     those whose ±σ torque on the identification log (``share``, from the covariance's σ, scaled to the larger) is
-    :data:`NEGLIGIBLE_TORQUE` of their joint's torque or more, and those under it (about 0 on this motion)."""
+    :data:`NEGLIGIBLE_TORQUE` of their joint's torque or more, and those under it (about 0 on this motion).
+
+    Parameters
+    ----------
+    names : sequence of str
+    params, relative_std : sequences of float
+        Least squares' values and covariance σ over |value| [%] (NaN or None where kept at the prior).
+    kept : set of str
+        Names kept at the prior (left out).
+    share : dict
+        results.json ``diagnostics.sigma_torque_percent``.
+    boot : dict
+        results.json ``diagnostics.bootstrap_std``.
+
+    Returns
+    -------
+    (not determined, about 0) : two lists of str
+    """
     loose: list[str] = []
     small: list[str] = []
     for n, v, rel in zip(names, params, relative_std):
+        if n in kept or rel is None:
+            continue
         larger = larger_relative_std(n, v, float(rel), boot)
-        if n in kept or not not_determined(n, larger, share):
+        if not not_determined(n, larger, share):
             continue
         torque = share.get(n)
         if torque is not None and larger is not None and float(rel) > 0:
@@ -627,7 +647,7 @@ def in_short(result) -> list:
                               [r.base.names[i] for i in r.solution.anchored]))
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}
-    loose, small = _undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
+    loose, small = undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
     which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
     if loose:
         out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(loose)}: "
