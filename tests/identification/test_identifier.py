@@ -94,7 +94,7 @@ def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
 def test_get_and_set_params_follow_scikit_learns_contract():
     ident = dynid.Identifier("er16", estimators=["ols"])
     assert ident.get_params() == {"robot": "er16", "estimators": ["ols"], "preprocessing": None, "friction": None, "seed": None,
-                                  "controller": None}
+                                  "controller": None, "sdp_prior": None}
     assert ident.set_params(seed=3, friction="auto") is ident and ident.get_params()["seed"] == 3
     with pytest.raises(ValueError, match="no parameter 'alpha'"):
         ident.set_params(alpha=1)
