@@ -36,7 +36,7 @@ def test_a_one_way_joints_term_stays_coulomb_friction_when_another_term_is_held_
     acc = LeastSquaresAccumulator(base.n_base, truth.n_dof)
     acc.add(w.reshape(-1, base.n_base), tau.reshape(-1))
     description = replace(truth, drive=np.zeros_like(drive))  # the links right, no friction given (a vendor URDF)
-    _, _, standard = drive_only(description, base, acc)
+    standard = drive_only(description, base, acc).standard
     value = dict(zip(names, standard))
     assert value["fv1"] == 0.0  # held at its bound
     assert value["offset3"] == 0.0  # the description's

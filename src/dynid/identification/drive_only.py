@@ -16,17 +16,21 @@ estimate does.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..conventions import split_name
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..estimators.least_squares import coulomb_offset_pairs
 from ..model.robot import Robot
+from ..preprocessing.bands import capped
+from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.prepared import PreparedData
 
-__all__ = ["DRIVE_ONLY_KEY", "DriveOnly", "drive_only"]
+__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveFit", "DriveOnly", "drive_only", "preprocessing_variants"]
 
 DRIVE_ONLY_KEY = "drive-only"
 """The estimate's key (label ``"dynid drive-only"``)."""
@@ -46,16 +50,71 @@ class DriveOnly:
         Standard parameters: the description's (physically consistent) links, the fitted drive terms.
     fit : TorqueComparison
         The identification log's comparison with every set of the result and this one (label ``"dynid drive-only"``).
+    held : dict
+        :attr:`DriveFit.held`: the drive terms the log does not determine, held at the description's values.
+    undetermined : dict
+        :attr:`DriveFit.undetermined`: those that keep this log's value, as the description gives none.
     """
 
     params: np.ndarray
     std: np.ndarray
     standard: np.ndarray
     fit: object
+    held: dict = field(default_factory=dict)
+    undetermined: dict = field(default_factory=dict)
+
+
+CUTOFF_FACTORS = (0.5, 2.0)
+"""The other preparations of a log that :func:`drive_only` compares: every cutoff at these multiples of the log's own."""
+
+
+def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: PreparedData, given: Preprocessing,
+                           one_way=()) -> tuple:
+    """The base rows of the log prepared again at :data:`CUTOFF_FACTORS` × its position, velocity and parallel cutoffs,
+    for :func:`drive_only`'s judgement of the one-way joints' drive terms; none where no joint moved one way, the
+    description has no inertias or the robot no drive terms, or the log was not prepared by parallel filtering (the
+    paper's eq. 17, Fourier-fit derivatives).
+
+    Parameters
+    ----------
+    robot, base
+        The model as identified (the chosen friction models) and its base-parameter map.
+    recording : dynid.io.datasets.Recording
+        The log as read.
+    data : PreparedData
+        The log as prepared for the estimation (its resolved settings and rest model).
+    given : Preprocessing
+        The settings as given (a given decimation or trim stays).
+    one_way : sequence of int
+        The joints that moved one way only.
+
+    Returns
+    -------
+    tuple of (float, LeastSquaresAccumulator)
+        Each factor with the rows its preparation gives, in ``base``'s layout.
+    """
+    s = data.settings
+    if (not len(one_way) or not robot.drive_terms or not np.any(robot.inertial != 0) or s.strategy != "parallel"
+            or s.fourier is not None):
+        return ()
+    out = []
+    for f in CUTOFF_FACTORS:
+        def scaled(cutoff: float | None) -> float | None:
+            return None if cutoff is None else capped(f * cutoff, data.rate)  # noqa: B023 (called at once)
+
+        settings = replace(given, band=s.band, position_cutoff=scaled(s.position_cutoff),
+                           velocity_cutoff=scaled(s.velocity_cutoff), parallel_cutoff=scaled(s.parallel_cutoff),
+                           min_speed=s.min_speed, rest_velocity=s.rest_velocity, coulomb_velocity=s.coulomb_velocity)
+        variant = prepare(recording, settings).with_rest_model(s.rest_friction, s.presliding)
+        acc = LeastSquaresAccumulator(base.n_base, robot.n_dof)
+        for _, y, tau, keep in base_chunks(robot, base, variant):
+            acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
+        out.append((f, acc))
+    return tuple(out)
 
 
 def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccumulator, joint_weights=None,
-               prior: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+               prior: np.ndarray | None = None, variants: tuple = (), one_way=()) -> DriveFit | None:
     """Least squares of the drive terms with the links' inertial parameters at the description's values.
 
     ``φ = φ_nominal + B x``: ``B`` selects the standard drive terms (every term of :attr:`Robot.drive_terms` and the
@@ -65,6 +124,18 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     inertia, Coulomb, viscous and Stribeck friction: :func:`dynid.dynamics.layout.consistency_layout`) are bounded by
     0: a term the unbounded fit makes negative is held at 0 with the bounded fit's other terms at bound (SciPy's BVLS),
     the rest refitted, so that the estimate is physically consistent wherever the description is.
+
+    With ``variants``, the same fit on the same log prepared with other cutoffs (:func:`preprocessing_variants`): a
+    drive term of a joint of ``one_way`` whose estimate moves across the variants by as much as its own value (max -
+    min ≥ |x|, the spread read as a σ of 100 % or more, the threshold at which dynid calls a parameter not
+    determined) is not determined by the log, whatever its covariance says. A joint that crawls one way barely
+    accelerates, so its rotor inertia (and the split of its Coulomb friction and offset) is set by the filters' shaping
+    of a tiny acceleration, not by the robot: on the zoo's 5 s logs (benchmarks/README.md) a shoulder's rotor inertia
+    fitted outside dynid with the TRUE links came out at 0.48, 0.18 and -0.23 kg·m² at 5, 10 and 20 Hz (truth 0.025,
+    covariance σ 0.04). Such a term is held at the description's value where the description gives one; a one-way
+    joint's unstable Coulomb friction or offset holds the offset at the description's value, so that their sum stays
+    Coulomb friction; any other keeps the log's value and is said (:attr:`DriveFit.undetermined`): a description
+    without the term (a URDF has no rotor inertia) is no knowledge of it, and 0 predicts other motions no better.
 
     Parameters
     ----------
@@ -79,12 +150,15 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     prior : (n_params,) array, optional
         The description's standard parameters (default :meth:`Robot.physical_prior`: impossible links replaced by
         their nearest consistent ones).
+    variants : tuple of (float, LeastSquaresAccumulator)
+        The cutoff factor and the base rows of each other preparation of the log (:func:`preprocessing_variants`).
+    one_way : sequence of int
+        The joints (0-based) that moved one way only, whose drive terms the variants judge.
 
     Returns
     -------
-    (params, std, standard) or None
-        ``(n_base,)`` base parameters and σ, ``(n_params,)`` standard parameters; None for a description without
-        inertial parameters or a robot without drive terms.
+    DriveFit or None
+        None for a description without inertial parameters or a robot without drive terms.
     """
     if not np.any(robot.inertial != 0):
         return None
@@ -94,31 +168,112 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     drive = np.setdiff1d(np.arange(len(names)), links.ravel())
     if drive.size == 0:
         return None
-    lower = np.where(np.isin(drive, nonnegative), 0.0, -np.inf)
-    rigid = phi0.copy()
-    rigid[drive] = 0.0
-    basis, offset = base.regrouping[:, drive], base.regrouping @ rigid
-    active = np.zeros(drive.size, dtype=bool)  # non-negative drive terms held at 0
-    x = np.zeros(drive.size)
-    for _ in range(drive.size + 1):
-        free = np.flatnonzero(~active)
-        pairs = coulomb_offset_pairs([names[i] for i in drive[free]])
-        params, cov, sol = accumulator.solve_affine(basis[:, free], offset, joint_weights, prior=phi0[drive[free]],
-                                                    pairs=pairs)
-        x = np.zeros(drive.size)
-        x[free] = sol.params
-        below = ~active & (x < lower)
-        if not below.any():
-            break
-        # the bounded least squares' active set first (the step that frees a bound is SciPy's), then any term the
-        # prior's directions push below its bound; a one-way joint's offset that the fit kept at the description's
-        # value stays there, so that the bounded fit does not split that joint's one term otherwise
-        kept = free[[fixed for coulomb, fixed in pairs if coulomb in sol.anchored]]
-        active |= below if active.any() else _at_bound(accumulator, basis, offset, lower, joint_weights,
-                                                        kept, phi0[drive[kept]]) | below
+    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base, joint_weights)
+    x, params, cov = problem.fit(accumulator)
+    judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in set(one_way)]
+    held: dict[str, tuple[float, ...]] = {}
+    loose: dict[str, tuple[float, ...]] = {}
+    if variants and judged:
+        fitted = {1.0: x, **{f: problem.fit(acc)[0] for f, acc in variants}}
+        factors = sorted(fitted)
+        runs = np.array([fitted[f] for f in factors])
+        spread = runs.max(axis=0) - runs.min(axis=0)
+        unstable = [i for i in judged if spread[i] > 0 and spread[i] >= abs(x[i])]
+        pinned = _pinned(unstable, [names[k] for k in drive], phi0[drive])
+        said = lambda i: tuple(float(v) for v in runs[:, i])  # noqa: E731
+        held = {names[drive[i]]: said(i) for i in pinned}
+        loose = {names[drive[i]]: said(i) for i in unstable
+                 if i not in pinned and split_name(names[drive[i]])[0] not in ("fc", "offset")}
+        if pinned:
+            x, params, cov = problem.fit(accumulator, np.asarray(pinned, dtype=int))
+        held = {"cutoff_factors": tuple(factors), **held} if held else {}
+        loose = {"cutoff_factors": tuple(factors), **loose} if loose else {}
     standard = phi0.copy()
     standard[drive] = x
-    return params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard
+    return DriveFit(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held, loose)
+
+
+def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:
+    """The drive terms (indices into ``names``) that :func:`drive_only` holds at the description's values, of the
+    ``unstable`` ones: a one-way joint's offset where its Coulomb friction or offset is unstable (the two act as one
+    term there: the sum stays Coulomb friction, as :meth:`LeastSquaresAccumulator.solve` takes it), and any other
+    term the description gives a value for (non-zero: a URDF has no rotor inertia, and 0 is no knowledge of one)."""
+    out: set[int] = set()
+    for i in unstable:
+        term, j = split_name(names[i])
+        if term in ("fc", "offset"):
+            out.update(k for k, n in enumerate(names) if n == f"offset{j + 1}")
+        elif prior[i] != 0:
+            out.add(i)
+    return sorted(out)
+
+
+@dataclass(frozen=True)
+class DriveFit:
+    """What :func:`drive_only` fitted.
+
+    Attributes
+    ----------
+    params : (n_base,) array
+        Base parameters.
+    std : (n_base,) array
+        Their standard deviations (0 for what the description fixes).
+    standard : (n_params,) array
+        Standard parameters: the description's links, the fitted drive terms.
+    held : dict
+        The drive terms held at the description's value because the preprocessing variants moved them (or, for an
+        offset, its joint's Coulomb friction) by their own value or more: name -> the estimates at
+        ``held["cutoff_factors"]`` × the log's cutoffs; empty when none.
+    undetermined : dict
+        The same for the terms the variants moved as much that keep this log's value, as the description gives none
+        (a rotor inertia a URDF cannot hold): the log does not determine them.
+    """
+
+    params: np.ndarray
+    std: np.ndarray
+    standard: np.ndarray
+    held: dict
+    undetermined: dict
+
+
+class _DriveProblem:
+    """The bounded fit of :func:`drive_only` on any accumulator of the same base rows' layout, some terms held at the
+    description's values."""
+
+    def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, base: BaseParameters,
+                 joint_weights) -> None:
+        self.names, self.drive, self.lower, self.phi0, self.joint_weights = names, drive, lower, phi0, joint_weights
+        rigid = phi0.copy()
+        rigid[drive] = 0.0
+        self.basis, self.offset = base.regrouping[:, drive], base.regrouping @ rigid
+
+    def fit(self, accumulator: LeastSquaresAccumulator, fixed=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(x, params, covariance)``: the drive terms (``fixed`` ones at the description's values), the base
+        parameters and their covariance."""
+        d, phi0, drive = self.drive.size, self.phi0, self.drive
+        fixed = np.asarray(fixed, dtype=int)
+        pinned = np.zeros(d, dtype=bool)
+        pinned[fixed] = True
+        offset = self.offset + self.basis[:, pinned] @ phi0[drive[pinned]]
+        active = np.zeros(d, dtype=bool)  # non-negative drive terms held at 0
+        x = np.where(pinned, phi0[drive], 0.0)
+        for _ in range(d + 1):
+            free = np.flatnonzero(~active & ~pinned)
+            pairs = coulomb_offset_pairs([self.names[i] for i in drive[free]])
+            params, cov, sol = accumulator.solve_affine(self.basis[:, free], offset, self.joint_weights,
+                                                        prior=phi0[drive[free]], pairs=pairs)
+            x = np.where(pinned, phi0[drive], 0.0)
+            x[free] = sol.params
+            below = ~active & ~pinned & (x < self.lower)
+            if not below.any():
+                break
+            # the bounded least squares' active set first (the step that frees a bound is SciPy's), then any term the
+            # prior's directions push below its bound; a one-way joint's offset that the fit kept at the description's
+            # value stays there, so that the bounded fit does not split that joint's one term otherwise
+            kept = np.concatenate([free[[fixed_ for coulomb, fixed_ in pairs if coulomb in sol.anchored]], fixed])
+            active |= below if active.any() else _at_bound(accumulator, self.basis, self.offset, self.lower,
+                                                            self.joint_weights, kept, phi0[drive[kept]]) | below
+        return x, params, cov
 
 
 def _at_bound(accumulator: LeastSquaresAccumulator, basis: np.ndarray, offset: np.ndarray, lower: np.ndarray,

@@ -296,7 +296,7 @@ class IdentificationResult:
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",),
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
-             sdp_prior: str = "euclidean", observers: tuple = ()) -> IdentificationResult:
+             sdp_prior: str = "euclidean", observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
     over its rows; check every estimate's physical consistency and give the verdict on the model.
 
@@ -331,6 +331,9 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     observers : tuple of callable
         ``observer(index, y, tau, keep)`` called with every block of base rows of the one pass (what else needs them,
         e.g. the delay check of :mod:`dynid.identification.pipeline`).
+    variants : tuple of (float, LeastSquaresAccumulator)
+        The log's base rows at other cutoffs (:func:`dynid.identification.drive_only.preprocessing_variants`), by
+        which the drive-only estimate judges the drive terms of the joints that moved one way.
 
     Returns
     -------
@@ -392,9 +395,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
-    found = drive_only(robot, base, reference.accumulator_, row_weights) if scoring.nominal is not None else None
-    alternative = None if found is None else DriveOnly(*found, replace(
-        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found[0]}), noise=joint_std, speed=fit.speed))
+    found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, row_weights,
+                                                            variants=variants, one_way=one_way_joints(data))
+    alternative = None if found is None else DriveOnly(found.params, found.std, found.standard, replace(
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed),
+        found.held, found.undetermined)
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
@@ -582,7 +587,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, scoring: BlockScoring, f
     stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
-        findings += prior_findings(base.names, sol.from_prior, _one_way(data), data.name, data.dead, still=data.still,
+        findings += prior_findings(base.names, sol.from_prior, one_way_joints(data), data.name, data.dead, still=data.still,
                                    anchored=sol.anchored)
     if sol.anchored:
         stats["coulomb_from_one_term"] = [base.names[i] for i in sol.anchored]
@@ -603,9 +608,20 @@ def _anchor_prior(sdp, robot: Robot, base: BaseParameters, sol) -> None:
     sdp.set_params(prior=prior)
 
 
-def _one_way(data: PreparedData) -> list[int]:
+def one_way_joints(data: PreparedData) -> list[int]:
     """The joints that moved in one direction only (at least 99 % of their moving samples one way; a joint that never
-    moved is not one of them, :attr:`PreparedData.still`)."""
+    moved is not one of them, :attr:`PreparedData.still`).
+
+    Parameters
+    ----------
+    data : PreparedData
+        Its velocities and ``settings.min_speed`` (a joint's moving samples).
+
+    Returns
+    -------
+    list of int
+        The joints, 0-based.
+    """
     dq = np.asarray(data.dq)
     moving = np.abs(dq) > np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (dq.shape[1],))
     out = []

@@ -43,8 +43,9 @@ from ..validation.diagnostics import delay_findings
 from .closed_loop import closed_loop_estimates
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
+from .drive_only import preprocessing_variants
 from .friction_models import choose_friction
-from .identify import identify
+from .identify import identify, one_way_joints
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
 
@@ -68,12 +69,16 @@ class PreparedIdentification:
     choices : dict
         What the data chose, as results.json stores it: ``coulomb_velocity`` [rad/s] per joint, and when made,
         ``preprocessing_cross_validation``, ``coulomb_cross_validation``, ``friction_models``.
+    variants : tuple of (float, LeastSquaresAccumulator)
+        Where a joint moved one way only: the base rows of the log prepared at other cutoffs
+        (:func:`dynid.identification.drive_only.preprocessing_variants`).
     """
 
     robot: Robot
     base: BaseParameters
     data: PreparedData
     choices: dict = field(default_factory=dict)
+    variants: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -197,7 +202,9 @@ class IdentificationPipeline:
             data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
             base = base_parameters(robot, rng=0)
             made["friction_models"] = friction.to_dict()
-        return PreparedIdentification(robot, base, data, {"coulomb_velocity": robot.coulomb_velocity.tolist(), **made})
+        variants = preprocessing_variants(robot, base, recording, data, settings, one_way_joints(data))
+        return PreparedIdentification(robot, base, data, {"coulomb_velocity": robot.coulomb_velocity.tolist(), **made},
+                                      variants)
 
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
                  held_out: bool = False, recording=None):
@@ -237,7 +244,8 @@ class IdentificationPipeline:
         check = _delay_checked(prepared.data)
         result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
                           held_out=held_out, sdp_prior=self.sdp_prior,
-                          observers=(lambda *block: blocks.append(block),) if check is None else ())
+                          observers=(lambda *block: blocks.append(block),) if check is None else (),
+                          variants=prepared.variants)
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
         result = replace(result, settings={**result.settings, "robot_source": self.source,
                                            "robot_fingerprint": prepared.robot.kinematic_fingerprint(), **prepared.choices},

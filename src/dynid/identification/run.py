@@ -233,8 +233,31 @@ def _drive_only_preferred(result, chosen: dict, nominal: str, scored: tuple):
     finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
                f"rotor inertia) fitted to this log, because {why} and {DRIVE_ONLY_LABEL} predicts them better than "
                f"{main} ({_apart(better, own)} on average; the description's nominal model {described:.3g} %); chosen on "
-               f"the validation logs, so their figures for it are not an independent test")
+               f"the validation logs, so their figures for it are not an independent test{_held_note(alt.held, alt.undetermined)}")
+    if alt.held or alt.undetermined:
+        result = replace(result, diagnostics={**result.diagnostics, "drive_only_held": alt.held,
+                                              "drive_only_undetermined": alt.undetermined})
     return result, (DRIVE_ONLY_LABEL, finding)
+
+
+def _held_note(held: dict, undetermined: dict) -> str:
+    """The main-estimate finding's words on the drive terms the log does not determine
+    (:attr:`dynid.identification.drive_only.DriveFit.held` and ``undetermined``)."""
+    def listed(runs: dict) -> str:
+        return ", ".join(f"{name} ({', '.join(f'{v:.3g}' for v in r)})" for name, r in runs.items() if name != "cutoff_factors")
+
+    if not held and not undetermined:
+        return ""
+    factors = (held or undetermined)["cutoff_factors"]
+    out = (f"; the log does not determine some drive terms of the joints that moved one way (their estimates with the "
+           f"cutoffs at {', '.join(f'{f:g}' for f in factors)}× the log's move by their own size or more, as such a "
+           "joint barely accelerates)")
+    if held:
+        out += f": kept at the description's values: {listed(held)}"
+    if undetermined:
+        out += (f"{';' if held else ':'} kept at this log's values, as the description gives none: {listed(undetermined)}"
+                " (a rotor inertia from the drive's data sheet, Ia = ... in [[robot.joints]], would be kept instead)")
+    return out
 
 
 NOMINAL_LABEL = "description (nominal)"

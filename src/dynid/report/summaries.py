@@ -12,7 +12,7 @@ import numpy as np
 from ..conventions import unit_of
 from ..estimators.registry import OTHER_LABELS, label
 from ..identification.drive_only import DRIVE_ONLY_KEY
-from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, IdentificationResult
+from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
 from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
@@ -641,22 +641,7 @@ def in_short(result) -> list:
                                              f", not physically consistent{export}"))]
     lines, errors = _log_lines(r, label)
     out += lines
-    kept = {r.base.names[i] for i in r.solution.from_prior}
-    if kept:
-        out.append(_kept_line([n for n in r.base.names if n in kept], r.fit.dead,
-                              [r.base.names[i] for i in r.solution.anchored]))
-    share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
-    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
-    loose, small = undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
-    which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
-    if loose:
-        out.append(Line(f"not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(loose)}: "
-                        "their values are set by the noise and the misfit; a richer excitation (dynid excite) determines "
-                        "them"))
-    if small:
-        out.append(Line(f"about 0 on this log's motion (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}, but ±σ under "
-                        f"{NEGLIGIBLE_TORQUE:g} % of the joint's torque): {', '.join(small)}: a faster or wider motion "
-                        "may need them; the validation logs say whether it does"))
+    out += _determined_lines(r, label)
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
                 >= errors.get(c.name, np.inf)}
@@ -676,6 +661,41 @@ def in_short(result) -> list:
     else:
         step = "use the model to predict torques; no estimate is physically consistent, so none is exported"
     out.append(Line("next: " + step))
+    return out
+
+
+def _determined_lines(r, label: str) -> list:
+    """:func:`in_short`'s lines on what the log determines. They read least squares' σ; where the main estimate is the
+    drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
+    drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveFit.held`)."""
+    out = []
+    whose = ""
+    if label == DRIVE_ONLY_LABEL:
+        terms, loose = ([k for k in (r.diagnostics or {}).get(key) or {} if k != "cutoff_factors"]
+                        for key in ("drive_only_held", "drive_only_undetermined"))
+        out.append(Line(f"{label}: the links' inertial parameters are the description's, the drive terms fitted to this log"
+                        + (f"; {', '.join(terms)} kept at the description's values, as the log does not determine them "
+                           "(their estimates move with the cutoffs by their own size or more)" if terms else "")
+                        + (f"; not determined by this log either, kept at its values as the description gives none: "
+                           f"{', '.join(loose)} (a rotor inertia from the drive's data sheet: Ia = ... in [[robot.joints]])"
+                           if loose else "")))
+        whose = f"{r.label}, beside it: "
+    kept = {r.base.names[i] for i in r.solution.from_prior}
+    if kept:
+        line = _kept_line([n for n in r.base.names if n in kept], r.fit.dead, [r.base.names[i] for i in r.solution.anchored])
+        out.append(Line(whose + line.text, line.kind) if whose else line)
+    share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
+    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
+    loose, small = undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
+    which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
+    if loose:
+        out.append(Line(f"{whose}not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): "
+                        f"{', '.join(loose)}: their values are set by the noise and the misfit; a richer excitation "
+                        "(dynid excite) determines them"))
+    if small:
+        out.append(Line(f"{whose}about 0 on this log's motion (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}, but ±σ "
+                        f"under {NEGLIGIBLE_TORQUE:g} % of the joint's torque): {', '.join(small)}: a faster or wider "
+                        "motion may need them; the validation logs say whether it does"))
     return out
 
 
