@@ -141,7 +141,53 @@ def write_log(path: Path, log, rng) -> None:
     np.savetxt(path, np.column_stack([log.t, log.q_meas, tau]), delimiter=",", fmt="%.10g")
 
 
-def config(folder: Path, n: int, ident: str) -> Path:
+LOG_FITTED = "truth, one-way drive terms from the log"
+"""The short class's second reference: the true parameters with each one-way joint's rotor inertia, Coulomb and viscous
+friction refitted on the short log (:func:`log_fitted_drive_terms`)."""
+
+
+def log_fitted_drive_terms(folder: Path, log: str, cutoff: float = 10.0, trim: float = 0.3) -> dict[str, float]:
+    """The drive terms (Ia, fc, fv) of each joint that moves one way only in ``log``, fitted joint by joint on that log
+    with the TRUE links: ``τ_j - RNEA_j(q, q̇, q̈) = Ia·q̈_j + fc·sign(q̇_j) + fv·q̇_j`` by least squares, outside dynid
+    (Pinocchio's RNEA on truth.urdf, a 4th-order zero-phase Butterworth at ``cutoff`` Hz on the positions and torques,
+    central differences, ``trim`` s left out at each end). Where this set fits the log as well as the truth and predicts
+    the validation log worse, the log does not tell the two apart: no estimator that reads only that log can be
+    expected to reach the truth's validation error."""
+    import pinocchio as pin
+    from scipy.signal import butter, sosfiltfilt
+
+    model = pin.buildModelFromUrdf(str(folder / "truth.urdf"))
+    data = model.createData()
+    x = np.loadtxt(folder / log, delimiter=",")
+    n = model.nv
+    t = np.arange(x[0, 0], x[-1, 0], 1.0 / RATE)
+    q = np.column_stack([np.interp(t, x[:, 0], x[:, 1 + k]) for k in range(n)])
+    tau = np.column_stack([np.interp(t, x[:, 0], x[:, 1 + n + k]) for k in range(n)])
+    sos = butter(4, cutoff, fs=RATE, output="sos")
+    q, tau = sosfiltfilt(sos, q, axis=0), sosfiltfilt(sos, tau, axis=0)
+    dq = np.gradient(q, t, axis=0)
+    ddq = np.gradient(dq, t, axis=0)
+    keep = slice(int(trim * RATE), t.size - int(trim * RATE))
+
+    def configuration(angles):  # a continuous joint's configuration is (cos, sin) in Pinocchio
+        x = np.empty(model.nq)
+        for k, joint in enumerate(model.joints[1:]):
+            x[joint.idx_q:joint.idx_q + joint.nq] = (np.cos(angles[k]), np.sin(angles[k]))[:joint.nq] if joint.nq == 2 \
+                else angles[k]
+        return x
+
+    rigid = np.array([pin.rnea(model, data, configuration(q[i]), dq[i], ddq[i]) for i in range(keep.start, keep.stop)])
+    out = {}
+    for j in range(n):
+        v, a = dq[keep, j], ddq[keep, j]
+        if min(np.mean(v > 0.01), np.mean(v < -0.01)) >= 0.01:  # it reverses: not one of the one-way joints
+            continue
+        coef = np.linalg.lstsq(np.column_stack([a, np.sign(v), v]), tau[keep, j] - rigid[:, j], rcond=None)[0]
+        out.update({f"Ia{j + 1}": float(coef[0]), f"fc{j + 1}": float(coef[1]), f"fv{j + 1}": float(coef[2])})
+    return out
+
+
+def config(folder: Path, n: int, ident: str, extra: str = "") -> Path:
     cols = lambda a: "[" + ", ".join(str(a + j) for j in range(n)) + "]"  # noqa: E731
     table = (lambda f: f'file = "{f}"\ntime = {{ column = 1 }}\npositions = {{ columns = {cols(2)} }}\n'
              f'torques = {{ columns = {cols(2 + n)} }}\n')
@@ -149,13 +195,13 @@ def config(folder: Path, n: int, ident: str) -> Path:
             f'[identification]\n{table(ident)}[estimation]\nestimators = ["wls", "sdp"]\n'
             f'[[validation]]\nname = "validation"\n{table("valid.csv")}'
             '[[references]]\nname = "truth"\nfile = "truth.csv"\nformat = "standard"\nheader = true\nnames = "name"\n'
-            'values = "value"\n[[references]]\nname = "nominal"\nformat = "nominal"\n')
+            'values = "value"\n[[references]]\nname = "nominal"\nformat = "nominal"\n' + extra)
     path = folder / f"{ident.removesuffix('.csv')}.toml"
     path.write_text(text)
     return path
 
 
-def run_arm(name: str, out: Path, seed: int) -> list[dict]:
+def run_arm(name: str, out: Path, seed: int, classes=CLASSES) -> list[dict]:
     """Every friction truth and log class of one arm (module docstring)."""
     from dynid.model.description import load_robot
 
@@ -193,8 +239,15 @@ def run_arm(name: str, out: Path, seed: int) -> list[dict]:
         dead = np.loadtxt(folder / "excitation.csv", delimiter=",")
         dead[:, 1 + n + n // 2] = 0.0
         np.savetxt(folder / "dead.csv", dead, delimiter=",", fmt="%.10g")
-        for kind in CLASSES:
-            cfg = config(folder, n, f"{kind}.csv")
+        for kind in classes:
+            extra = ""
+            if kind == "short":
+                fitted = log_fitted_drive_terms(folder, "short.csv")
+                (folder / "short_fitted.csv").write_text("name,value\n" + "".join(
+                    f"{k},{fitted.get(k, v):.12g}\n" for k, v in zip(names, values)))
+                extra = (f'[[references]]\nname = "{LOG_FITTED}"\nfile = "short_fitted.csv"\nformat = "standard"\n'
+                         'header = true\nnames = "name"\nvalues = "value"\n')
+            cfg = config(folder, n, f"{kind}.csv", extra)
             t1 = time.perf_counter()
             p = subprocess.run([sys.executable, "-m", "dynid", "identify", str(cfg), "--out", str(folder / f"out-{kind}"),
                                 "--no-figures", "-q"], capture_output=True, text=True, timeout=1800)
@@ -216,6 +269,11 @@ def run_arm(name: str, out: Path, seed: int) -> list[dict]:
                         return float(np.sqrt(np.sum((e * rms) ** 2) / np.sum(rms**2)))
 
                     row["live_ratio"] = over_live(main) / over_live("truth")
+                if LOG_FITTED in v["metrics"]:  # what the log cannot tell from the truth (log_fitted_drive_terms)
+                    fit = r["identification"]["metrics"]
+                    row.update(fitted_fit=fit[LOG_FITTED]["global_relative_error"],
+                               truth_fit=fit["truth"]["global_relative_error"],
+                               fitted_validation=v["metrics"][LOG_FITTED]["global_relative_error"])
                 row.update(refused=False, main=main, estimate=err[main], truth_error=err["truth"], nominal=err["nominal"],
                            ratio=err[main] / err["truth"] if err["truth"] > 0 else float("nan"),
                            floor=(v.get("noise_floor") or {}).get("global_relative_error"),
@@ -248,18 +306,35 @@ def table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def short_table(rows: list[dict]) -> str:
+    """The short logs beside what they cannot tell from the truth: the log-fitted set's error on the identification
+    log and on the validation log, each over the truth's (:func:`log_fitted_drive_terms`)."""
+    lines = ["| arm | dry friction | dynid / truth (validation) | log-fitted / truth, identification log | "
+             "log-fitted / truth, validation |", "|---|---|---|---|---|"]
+    for r in rows:
+        if r["class"] == "short" and not r["refused"] and "fitted_fit" in r:
+            lines.append(f"| {r['arm']} | {r['truth']} | {r['ratio']:.2f}× | {r['fitted_fit'] / r['truth_fit']:.3f}× "
+                         f"({r['fitted_fit']:.3g} / {r['truth_fit']:.3g} %) | {r['fitted_validation'] / r['truth_error']:.2f}× "
+                         f"({r['fitted_validation']:.3g} / {r['truth_error']:.3g} %) |")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--arms", default=",".join(ARMS), help="comma-separated names of ARMS")
     parser.add_argument("--out", default=str(REPO / "dynid-zoo"), help="working folder (logs, configs, results)")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--classes", default=",".join(CLASSES), help="comma-separated log classes to identify (every "
+                        "class is simulated all the same, so a cell's log does not depend on this)")
     args = parser.parse_args(argv)
     out = Path(args.out)
     rows = []
     for name in [a.strip() for a in args.arms.split(",") if a.strip()]:
-        rows += run_arm(name, out, args.seed)
+        rows += run_arm(name, out, args.seed, tuple(c.strip() for c in args.classes.split(",") if c.strip()))
     (out / "zoo.json").write_text(json.dumps(rows, indent=1))
     print(table(rows))
+    print()
+    print(short_table(rows))
     return 0
 
 
