@@ -255,8 +255,10 @@ def _held_note(held: dict, undetermined: dict) -> str:
     if held:
         out += f": kept at the description's values: {listed(held)}"
     if undetermined:
+        sheet = any(k.startswith("Ia") for k in undetermined)
         out += (f"{';' if held else ':'} kept at this log's values, as the description gives none: {listed(undetermined)}"
-                " (a rotor inertia from the drive's data sheet, Ia = ... in [[robot.joints]], would be kept instead)")
+                + (" (a rotor inertia from the drive's data sheet, Ia = ... in [[robot.joints]], would be kept instead)"
+                   if sheet else ""))
     return out
 
 

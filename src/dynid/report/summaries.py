@@ -677,8 +677,9 @@ def _determined_lines(r, label: str) -> list:
                         + (f"; {', '.join(terms)} kept at the description's values, as the log does not determine them "
                            "(their estimates move with the cutoffs by their own size or more)" if terms else "")
                         + (f"; not determined by this log either, kept at its values as the description gives none: "
-                           f"{', '.join(loose)} (a rotor inertia from the drive's data sheet: Ia = ... in [[robot.joints]])"
-                           if loose else "")))
+                           f"{', '.join(loose)}" if loose else "")
+                        + (" (a rotor inertia from the drive's data sheet: Ia = ... in [[robot.joints]])"
+                           if any(k.startswith("Ia") for k in loose) else "")))
         whose = f"{r.label}, beside it: "
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
