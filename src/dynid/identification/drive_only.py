@@ -30,7 +30,7 @@ from ..preprocessing.bands import capped
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
-__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveFit", "DriveOnly", "drive_only", "preprocessing_variants"]
+__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "preprocessing_variants"]
 
 DRIVE_ONLY_KEY = "drive-only"
 """The estimate's key (label ``"dynid drive-only"``)."""
@@ -48,18 +48,22 @@ class DriveOnly:
         Their standard deviations (0 for what the description fixes).
     standard : (n_params,) array
         Standard parameters: the description's (physically consistent) links, the fitted drive terms.
-    fit : TorqueComparison
-        The identification log's comparison with every set of the result and this one (label ``"dynid drive-only"``).
+    fit : TorqueComparison or None
+        The identification log's comparison with every set of the result and this one (label ``"dynid drive-only"``);
+        None as :func:`drive_only` returns it.
     held : dict
-        :attr:`DriveFit.held`: the drive terms the log does not determine, held at the description's values.
+        The drive terms held at the description's value because the preprocessing variants moved them (or, for an
+        offset, its joint's Coulomb friction) by their own value or more (:func:`drive_only`): name -> the estimates
+        at ``held["cutoff_factors"]`` × the log's cutoffs; empty when none.
     undetermined : dict
-        :attr:`DriveFit.undetermined`: those that keep this log's value, as the description gives none.
+        The same for the terms the variants moved as much that keep this log's value, as the description gives none
+        (a rotor inertia a URDF cannot hold): the log does not determine them.
     """
 
     params: np.ndarray
     std: np.ndarray
     standard: np.ndarray
-    fit: object
+    fit: object = None
     held: dict = field(default_factory=dict)
     undetermined: dict = field(default_factory=dict)
 
@@ -114,7 +118,7 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
 
 
 def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccumulator, joint_weights=None,
-               prior: np.ndarray | None = None, variants: tuple = (), one_way=()) -> DriveFit | None:
+               prior: np.ndarray | None = None, variants: tuple = (), one_way=()) -> DriveOnly | None:
     """Least squares of the drive terms with the links' inertial parameters at the description's values.
 
     ``φ = φ_nominal + B x``: ``B`` selects the standard drive terms (every term of :attr:`Robot.drive_terms` and the
@@ -134,7 +138,7 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     fitted outside dynid with the TRUE links came out at 0.48, 0.18 and -0.23 kg·m² at 5, 10 and 20 Hz (truth 0.025,
     covariance σ 0.04). Such a term is held at the description's value where the description gives one; a one-way
     joint's unstable Coulomb friction or offset holds the offset at the description's value, so that their sum stays
-    Coulomb friction; any other keeps the log's value and is said (:attr:`DriveFit.undetermined`): a description
+    Coulomb friction; any other keeps the log's value and is said (:attr:`DriveOnly.undetermined`): a description
     without the term (a URDF has no rotor inertia) is no knowledge of it, and 0 predicts other motions no better.
 
     Parameters
@@ -157,8 +161,8 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
 
     Returns
     -------
-    DriveFit or None
-        None for a description without inertial parameters or a robot without drive terms.
+    DriveOnly or None
+        Without its ``fit``; None for a description without inertial parameters or a robot without drive terms.
     """
     if not np.any(robot.inertial != 0):
         return None
@@ -190,7 +194,7 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
         loose = {"cutoff_factors": tuple(factors), **loose} if loose else {}
     standard = phi0.copy()
     standard[drive] = x
-    return DriveFit(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held, loose)
+    return DriveOnly(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held=held, undetermined=loose)
 
 
 def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:
@@ -206,34 +210,6 @@ def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:
         elif prior[i] != 0:
             out.add(i)
     return sorted(out)
-
-
-@dataclass(frozen=True)
-class DriveFit:
-    """What :func:`drive_only` fitted.
-
-    Attributes
-    ----------
-    params : (n_base,) array
-        Base parameters.
-    std : (n_base,) array
-        Their standard deviations (0 for what the description fixes).
-    standard : (n_params,) array
-        Standard parameters: the description's links, the fitted drive terms.
-    held : dict
-        The drive terms held at the description's value because the preprocessing variants moved them (or, for an
-        offset, its joint's Coulomb friction) by their own value or more: name -> the estimates at
-        ``held["cutoff_factors"]`` × the log's cutoffs; empty when none.
-    undetermined : dict
-        The same for the terms the variants moved as much that keep this log's value, as the description gives none
-        (a rotor inertia a URDF cannot hold): the log does not determine them.
-    """
-
-    params: np.ndarray
-    std: np.ndarray
-    standard: np.ndarray
-    held: dict
-    undetermined: dict
 
 
 class _DriveProblem:

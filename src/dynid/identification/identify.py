@@ -397,9 +397,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
-    alternative = None if found is None else DriveOnly(found.params, found.std, found.standard, replace(
-        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed),
-        found.held, found.undetermined)
+    alternative = None if found is None else replace(found, fit=replace(
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)

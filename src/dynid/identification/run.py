@@ -242,7 +242,7 @@ def _drive_only_preferred(result, chosen: dict, nominal: str, scored: tuple):
 
 def _held_note(held: dict, undetermined: dict) -> str:
     """The main-estimate finding's words on the drive terms the log does not determine
-    (:attr:`dynid.identification.drive_only.DriveFit.held` and ``undetermined``)."""
+    (:attr:`dynid.identification.drive_only.DriveOnly.held` and ``undetermined``)."""
     def listed(runs: dict) -> str:
         return ", ".join(f"{name} ({', '.join(f'{v:.3g}' for v in r)})" for name, r in runs.items() if name != "cutoff_factors")
 

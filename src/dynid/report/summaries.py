@@ -667,7 +667,7 @@ def in_short(result) -> list:
 def _determined_lines(r, label: str) -> list:
     """:func:`in_short`'s lines on what the log determines. They read least squares' σ; where the main estimate is the
     drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
-    drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveFit.held`)."""
+    drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveOnly.held`)."""
     out = []
     whose = ""
     if label == DRIVE_ONLY_LABEL:
