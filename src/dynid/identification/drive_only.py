@@ -139,7 +139,8 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     covariance σ 0.04). Such a term is held at the description's value where the description gives one; a one-way
     joint's unstable Coulomb friction or offset holds the offset at the description's value, so that their sum stays
     Coulomb friction; any other keeps the log's value and is said (:attr:`DriveOnly.undetermined`): a description
-    without the term (a URDF has no rotor inertia) is no knowledge of it, and 0 predicts other motions no better.
+    without the term (a URDF has no rotor inertia) is no knowledge of it, and holding such terms at 0 made the zoo's
+    short logs better in 14 cells and worse in 9 (benchmarks/README.md).
 
     Parameters
     ----------

@@ -250,8 +250,8 @@ def _held_note(held: dict, undetermined: dict) -> str:
         return ""
     factors = (held or undetermined)["cutoff_factors"]
     out = (f"; the log does not determine some drive terms of the joints that moved one way (their estimates with the "
-           f"cutoffs at {', '.join(f'{f:g}' for f in factors)}× the log's move by their own size or more, as such a "
-           "joint barely accelerates)")
+           f"cutoffs at {', '.join(f'{f:g}' for f in factors)}× the log's move by their own size or more: such a "
+           "joint barely accelerates, and its Coulomb friction and offset act as one term)")
     if held:
         out += f": kept at the description's values: {listed(held)}"
     if undetermined:
