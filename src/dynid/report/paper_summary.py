@@ -117,7 +117,8 @@ def _verdict(d: dict, methods: dict, verbose: bool) -> list:
     abc = d["estimates"].get("abc")
     if abc is not None:
         text += (f"; the paper's ABC budget: Δβ {abc['parameter_error_norm_percent']:.3g} %, ρ on β2 "
-                 f"{_mean(abc['correlation']['validation']):.4f} (the paper's: {sum(ref.CORRELATION_VALIDATION) / 3:.4f})")
+                 f"{_mean(abc['correlation']['validation']):.4f} (the paper's: {sum(ref.CORRELATION_VALIDATION) / 3:.4f}; "
+                 f"one draw of a stochastic search, seed {d.get('seed', 0)}: --seed gives others)")
     out = [Line(text, "title")]
     if not verbose:
         out.append(Line("the parameters and per-joint tables: --verbose, and report.html"))
