@@ -103,12 +103,11 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
         return ()
     out = []
     for f in CUTOFF_FACTORS:
-        def scaled(cutoff: float | None) -> float | None:
-            return None if cutoff is None else capped(f * cutoff, data.rate)  # noqa: B023 (called at once)
-
-        settings = replace(given, band=s.band, position_cutoff=scaled(s.position_cutoff),
-                           velocity_cutoff=scaled(s.velocity_cutoff), parallel_cutoff=scaled(s.parallel_cutoff),
-                           min_speed=s.min_speed, rest_velocity=s.rest_velocity, coulomb_velocity=s.coulomb_velocity)
+        position, velocity, parallel = (None if c is None else capped(f * c, data.rate)
+                                        for c in (s.position_cutoff, s.velocity_cutoff, s.parallel_cutoff))
+        settings = replace(given, band=s.band, position_cutoff=position, velocity_cutoff=velocity,
+                           parallel_cutoff=parallel, min_speed=s.min_speed, rest_velocity=s.rest_velocity,
+                           coulomb_velocity=s.coulomb_velocity)
         variant = prepare(recording, settings).with_rest_model(s.rest_friction, s.presliding)
         acc = LeastSquaresAccumulator(base.n_base, robot.n_dof)
         for _, y, tau, keep in base_chunks(robot, base, variant):
@@ -175,7 +174,8 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
         return None
     problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base, joint_weights)
     x, params, cov = problem.fit(accumulator)
-    judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in set(one_way)]
+    moved_one_way = set(one_way)
+    judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in moved_one_way]
     held: dict[str, tuple[float, ...]] = {}
     loose: dict[str, tuple[float, ...]] = {}
     if variants and judged:
