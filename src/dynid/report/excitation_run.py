@@ -10,7 +10,7 @@ from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, staged, write_results
+from .output import save_figure, staged, write_results
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
@@ -27,18 +27,7 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     run : ExcitationRun
     out : str or Path
         Output folder.
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     problem, design = run.config.problem, run.design
     robot = problem.robot
     t = problem.verification_grid()

@@ -114,9 +114,6 @@ def save_fleet(result: FleetResult, out: str | Path) -> list[Path]:
     out : str or Path
         Output folder (the units' folders are beside, in ``units/``).
 
-    Returns
-    -------
-    list of Path
     """
     import pyarrow as pa
     import pyarrow.parquet as pq

@@ -13,7 +13,7 @@ from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
 from . import figures
 from .html import write_html_report
-from .output import draw_figures, output_folder, save_figure, staged, write_results
+from .output import draw_figures, save_figure, staged, write_results
 
 
 def _slug(name: str) -> str:
@@ -98,18 +98,7 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     mjcf_folder : str or Path, optional
         The folder the MJCF ends up in, from which its relative paths (meshes, includes) are rewritten (default
         ``out``; the command's output folder when ``out`` is a staging folder inside it).
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     paths = []
     if figures_too:
         names = [("identification", "identification_fit.png")] + [
@@ -170,18 +159,7 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
         Output folder.
     warnings : sequence of str
         Stored in the file.
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     paths = save_comparisons(comparisons, out)
     json_path = out / "validation.json"
     data = {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)}

@@ -84,9 +84,6 @@ def save_monitor(result: MonitorResult, out: str | Path) -> list[Path]:
     result : MonitorResult
     out : str or Path
 
-    Returns
-    -------
-    list of Path
     """
     out = Path(out)
     write_results(out / "monitor.json", result.to_dict(), "monitor")

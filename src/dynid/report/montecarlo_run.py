@@ -13,7 +13,7 @@ from ..studies.closed_loop import ClosedLoopStudyResult
 from ..studies.montecarlo import MonteCarloResult
 from . import figures
 from .html import write_html_report
-from .output import output_folder, save_figure, staged, write_results
+from .output import save_figure, staged, write_results
 
 FIGURES = {
     "montecarlo_std_vs_crb.png": "per noise level: standard deviation / Cramér–Rao bound of every base parameter, per method",
@@ -30,18 +30,7 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
     result : MonteCarloResult
     out : str or Path
         Output folder.
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     stats = result.statistics()
     labels = [label(k) for k in result.config.estimators]
     levels = np.asarray(result.config.noise_levels, dtype=float)
@@ -73,18 +62,7 @@ def save_closed_loop_study(result: ClosedLoopStudyResult, out: str | Path) -> li
     result : ClosedLoopStudyResult
     out : str or Path
         Output folder.
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     paths = [out / "montecarlo.json", out / "montecarlo_estimates.csv", out / "report.html"]
     buf = io.StringIO()
     buf.write(",".join(["encoder_noise_deg", "torque_noise_Nm", "realisation", "estimator", "converged", *result.names,

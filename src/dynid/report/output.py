@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 import io
 import json
 import os
@@ -67,7 +68,8 @@ def staged(save):
     Returns
     -------
     callable
-        The same signature.
+        The same signature, ``out`` a folder that is created if needed; its docstring gains the sections every
+        staged writer shares (:data:`_STAGED_SECTIONS`: what it returns and raises).
     """
 
     @functools.wraps(save)
@@ -94,7 +96,20 @@ def staged(save):
             shutil.rmtree(stage, ignore_errors=True)
         return final
 
+    wrapper.__doc__ = inspect.cleandoc(save.__doc__ or "") + "\n\n" + _STAGED_SECTIONS
     return wrapper
+
+
+_STAGED_SECTIONS = """Returns
+-------
+list of Path
+    The files written, in ``out``.
+
+Raises
+------
+ConfigError
+    If ``out`` exists and is not a folder, cannot be created, or holds a folder where the run writes a file."""
+"""The numpydoc sections of every :func:`staged` writer, appended to its docstring."""
 
 
 _STAGING = ".dynid-staging-"

@@ -12,7 +12,7 @@ from ..studies import paper_reference as ref
 from ..studies.paper import PaperRunResult
 from . import figures
 from .html import write_html_report
-from .output import draw_figures, output_folder, save_figure, staged, write_results
+from .output import draw_figures, save_figure, staged, write_results
 
 FIGURES = {
     "fig4_identification_trajectory.png": "joint trajectories of β1",
@@ -91,18 +91,7 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
         Output folder (created if needed).
     figures_too : bool
         Write the figures.
-
-    Returns
-    -------
-    list of Path
-        Files written.
-
-    Raises
-    ------
-    ConfigError
-        If ``out`` exists and is not a folder, or cannot be created.
     """
-    out = output_folder(out)
     drawn = _figure_drawers(result) if figures_too else {}
     paths = [out / name for name in FIGURES if name in drawn]
     if paths:
