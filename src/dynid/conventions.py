@@ -94,6 +94,7 @@ def canonical_name(name: str) -> str:
     Parameters
     ----------
     name : str
+        A parameter name in any common spelling, e.g. ``"Ixx2"``.
 
     Returns
     -------
@@ -126,6 +127,7 @@ def unit_of(name: str) -> str:
     Parameters
     ----------
     name : str
+        A standard or base parameter's name.
 
     Returns
     -------

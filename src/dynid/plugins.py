@@ -198,6 +198,7 @@ class Registry:
         Parameters
         ----------
         name : str
+            A name as a user or a plugin wrote it.
 
         Returns
         -------

@@ -93,6 +93,7 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     Returns
     -------
     Robot
+        The config's robot, with what the config adds to a named description.
 
     Raises
     ------

@@ -91,6 +91,7 @@ def load_robot(name_or_path: str | Path) -> Robot:
     Returns
     -------
     Robot
+        The robot the name or file describes.
 
     Raises
     ------
@@ -164,6 +165,7 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     Returns
     -------
     Robot
+        The robot the text describes.
 
     Raises
     ------

@@ -334,6 +334,7 @@ class Robot:
         Returns
         -------
         Robot
+            ``k`` joints, the held links merged into link ``k``.
 
         Raises
         ------

@@ -205,6 +205,7 @@ def check_strategy(name: str) -> str:
     Parameters
     ----------
     name : str
+        A preprocessing strategy's name as a config gives it.
 
     Returns
     -------

@@ -58,6 +58,7 @@ def paper_symbol(name: str) -> str:
     Parameters
     ----------
     name : str
+        A dynid standard or base parameter name.
 
     Returns
     -------

@@ -86,6 +86,7 @@ def unit_robot(robot: Robot, truth: UnitTruth) -> Robot:
     Returns
     -------
     Robot
+        The unit: the description's links, the unit's friction and tool.
 
     Raises
     ------
