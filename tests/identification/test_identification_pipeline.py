@@ -89,3 +89,33 @@ def test_settings_given_to_the_arrays_path_are_applied(slow_quiet_log):
 def test_the_pipeline_refuses_an_unknown_friction_choice():
     with pytest.raises(ConfigError, match='friction: expected "description" or "auto", got \'magic\''):
         IdentificationPipeline(dynid.load_robot("er16"), friction="magic")
+
+
+def test_what_the_data_chose_is_a_value_of_the_result_and_the_description_stays_as_read(slow_quiet_log):
+    """Issue "Re-zone the top floors", item 5: the choices (filters, smoothing, friction models) are a typed value of
+    the prepared identification and of the result; the model identified is that value applied to the description,
+    and the description is not modified."""
+    config = slow_quiet_log
+    description = config.robot
+    before = (description.drive_terms, description.drive_mask.copy(), description.coulomb_velocity.copy(),
+              description.stribeck_velocity.copy())
+    pipeline = IdentificationPipeline(description, config.preprocessing, estimators=("wls",), friction="auto")
+    recording = load_recording(config.identification, description)
+    prepared = pipeline.prepare(recording)
+    choices = prepared.choices
+    assert choices.friction is not None and choices.preprocessing is not None  # both choices were made on this log
+    model = choices.model(description)
+    assert model.drive_terms == prepared.robot.drive_terms
+    np.testing.assert_array_equal(model.drive_mask, prepared.robot.drive_mask)
+    np.testing.assert_array_equal(model.coulomb_velocity, prepared.robot.coulomb_velocity)
+    np.testing.assert_array_equal(model.stribeck_velocity, prepared.robot.stribeck_velocity)
+    # the model's smoothing is each chosen friction model's: a smooth Coulomb's velocity, 0 (sign) for the others
+    expected = [m.velocity if m.kind == "smooth" else 0.0 for m in choices.friction.models]
+    np.testing.assert_array_equal(choices.smoothing_velocity(), expected)
+    after = (description.drive_terms, description.drive_mask, description.coulomb_velocity, description.stribeck_velocity)
+    assert before[0] == after[0] and all(np.array_equal(a, b) for a, b in zip(before[1:], after[1:]))
+    result = pipeline.estimate(prepared)
+    assert result.choices is choices
+    for key, value in choices.to_dict().items():
+        _same(_plain(result.settings[key]), _plain(value), key)
+    assert result.settings["coulomb_velocity"] == list(expected)

@@ -192,6 +192,9 @@ class IdentificationResult:
         The description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`): made the
         main estimate by :func:`dynid.identification.run.run_identification` where the validation logs prefer it; not
         in :attr:`estimates` otherwise (None: a description without inertial parameters).
+    choices : ModelChoices or None
+        What the data chose for :attr:`model` (:class:`dynid.identification.choices.ModelChoices`): set by
+        :class:`dynid.identification.pipeline.IdentificationPipeline`, None where :func:`identify` is called alone.
     """
 
     robot: str
@@ -217,6 +220,7 @@ class IdentificationResult:
     diagnostics: dict = field(default_factory=dict)
     main: str = ""
     drive_only: DriveOnly | None = None
+    choices: Any = None
 
     @property
     def label(self) -> str:

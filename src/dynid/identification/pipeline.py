@@ -40,6 +40,7 @@ from ..preprocessing.prepared import PreparedData, dead_channels
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
 from ..validation.diagnostics import delay_findings
+from .choices import ModelChoices
 from .closed_loop import closed_loop_estimates
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
@@ -60,15 +61,15 @@ class PreparedIdentification:
     Attributes
     ----------
     robot : Robot
-        The model as it will be identified: the description with the chosen Coulomb smoothing velocities and friction
-        models (the description itself is never modified).
+        The model as it will be identified: ``choices.model(description)`` (the description itself is never
+        modified).
     base : BaseParameters
         The base-parameter map of :attr:`robot`.
     data : PreparedData
         The filtered signals (their resolved settings in ``data.settings``).
-    choices : dict
-        What the data chose, as results.json stores it: ``coulomb_velocity`` [rad/s] per joint, and when made,
-        ``preprocessing_cross_validation``, ``coulomb_cross_validation``, ``friction_models``.
+    choices : ModelChoices
+        What the data chose (:class:`dynid.identification.choices.ModelChoices`; results.json's ``settings`` hold its
+        :meth:`~dynid.identification.choices.ModelChoices.to_dict`).
     variants : tuple of (float, LeastSquaresAccumulator)
         Where a joint moved one way only: the base rows of the log prepared at other cutoffs
         (:func:`dynid.identification.drive_only.preprocessing_variants`).
@@ -77,7 +78,7 @@ class PreparedIdentification:
     robot: Robot
     base: BaseParameters
     data: PreparedData
-    choices: dict = field(default_factory=dict)
+    choices: ModelChoices
     variants: tuple = ()
 
 
@@ -175,36 +176,32 @@ class IdentificationPipeline:
                             "not the torque or current columns?): nothing can be identified from this log")
         settings = self.preprocessing
         base = base if base is not None else base_parameters(self.robot, rng=0)
-        made: dict = {}
         auto = settings.auto and strategy_for(settings).chooses_cutoffs
         say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
-        if auto:
-            filters = choose_preprocessing(self.robot, base, recording, settings)
+        filters = choose_preprocessing(self.robot, base, recording, settings) if auto else None
+        if filters is not None:
             assert filters.data is not None  # the chosen candidate's prepared data
             data = filters.data
-            if filters.chose:
-                made["preprocessing_cross_validation"] = filters.to_dict()
         else:
             data = prepare(recording, settings)
         vs = settings.coulomb_velocity
+        coulomb = None
         if vs == "auto":
             say("Coulomb smoothing velocity (cross-validation)")
             coulomb = choose_coulomb_velocity(self.robot, base, data)
-            velocity = coulomb.velocity
-            made["coulomb_cross_validation"] = coulomb.to_dict()
-        else:
-            velocity = np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,))
-        robot = replace(self.robot, coulomb_velocity=velocity)
+        choices = ModelChoices(coulomb.velocity if coulomb is not None
+                               else np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,)),
+                               filters if filters is not None and filters.chose else None, coulomb)
         if self.friction == "auto":
             say("friction model of each joint (cross-validation)")
-            friction = choose_friction(robot, data)
-            robot = friction.robot(robot)
+            friction = choose_friction(choices.model(self.robot), data)
             data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
+            choices = replace(choices, friction=friction)
+        robot = choices.model(self.robot)
+        if choices.friction is not None:
             base = base_parameters(robot, rng=0)
-            made["friction_models"] = friction.to_dict()
         variants = preprocessing_variants(robot, base, recording, data, settings, one_way_joints(data))
-        return PreparedIdentification(robot, base, data, {"coulomb_velocity": robot.coulomb_velocity.tolist(), **made},
-                                      variants)
+        return PreparedIdentification(robot, base, data, choices, variants)
 
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
                  held_out: bool = False, recording=None):
@@ -248,8 +245,10 @@ class IdentificationPipeline:
                           variants=prepared.variants)
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
         result = replace(result, settings={**result.settings, "robot_source": self.source,
-                                           "robot_fingerprint": prepared.robot.kinematic_fingerprint(), **prepared.choices},
-                         findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay})
+                                           "robot_fingerprint": prepared.robot.kinematic_fingerprint(),
+                                           **prepared.choices.to_dict()},
+                         findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay},
+                         choices=prepared.choices)
         if not self.closed_loop:
             return result
         if recording is None:

@@ -118,9 +118,25 @@ def robot_with(robot: Robot, models) -> Robot:
             mask[j, c] = t in own
             if mask[j, c] and t in old:
                 drive[j, c] = robot.drive[j, old[t]]
-    smooth = np.array([m.velocity if m.kind == "smooth" else 0.0 for m in models])
+    smooth = smoothing_velocities(models)
     stribeck = np.array([m.velocity if m.kind == "stribeck" else robot.stribeck_velocity[j] for j, m in enumerate(models)])
     return replace(robot, drive_terms=terms, drive=drive, drive_mask=mask, coulomb_velocity=smooth, stribeck_velocity=stribeck)
+
+
+def smoothing_velocities(models) -> np.ndarray:
+    """Each joint's Coulomb smoothing velocity under its friction model: a smooth Coulomb's, 0 (``sign(q̇)``) for the
+    other models.
+
+    Parameters
+    ----------
+    models : sequence of JointFriction
+        One per joint.
+
+    Returns
+    -------
+    (n_dof,) array [rad/s]
+    """
+    return np.array([m.velocity if m.kind == "smooth" else 0.0 for m in models])
 
 
 def _model_terms(kind: str, robot: Robot) -> tuple[str, ...]:
