@@ -10,8 +10,16 @@ relaxation time), a small grid of it is searched, each point fitted by linear le
   1 or 0.3 s, or none at rest;
 * the **family**: Coulomb + viscous (+ the description's offset, rotor inertia, counterbalance), asymmetric
   Coulomb (``fca``: while the joint moves, the same as an offset; at rest, 0 where an offset stays), Stribeck with
-  its velocity, smooth Coulomb ``tanh(q̇/v_s)`` with
-  its velocity, and load-dependent Coulomb (``fcl·|τ_load|``, harmonic drives).
+  its velocity, smooth Coulomb ``tanh(q̇/v_s)`` with its velocity — fitted only on the joint's rows at least
+  :data:`SMOOTH_FIT_FACTOR` × ``v_s`` fast, where it is Coulomb-like — and load-dependent Coulomb (``fcl·|τ_load|``,
+  harmonic drives).
+
+A smooth Coulomb term describes how the friction fades below ``v_s``; fitted on rows slower than that, its coefficient
+trades with the viscous one. On the zoo's simulated Panda (point-to-point moves, ``fc·sign(q̇)`` under a PID loop, which
+chatters at rest) ``v_s`` at twice J3's ``min_speed`` gave fc3 = 2.42 and fv3 = 0.70 against the truth's 2.23 and 1.01
+(2.24 and 0.99 on the rows at least 2·v_s fast), and the model predicted a faster log 3.2× worse on J3 than the
+truth's parameters. A joint given a smooth Coulomb term keeps those rows out of the estimation too
+(:meth:`FrictionChoice.fit_speeds`).
 
 Every candidate is applied to all joints at once; its parameters are fitted on all contiguous blocks of the log but
 one (rows of moving joints only, as the estimation) and scored on the block left out, **all** its rows, rests and
@@ -77,6 +85,10 @@ STRIBECK_GRID = (0.01, 0.03, 0.1, 0.3)
 SMOOTH_GRID = (0.003, 0.01, 0.03, 0.1)
 """Candidate smoothing velocities of ``tanh(q̇/v_s)``, as fractions of the joint's RMS speed."""
 
+SMOOTH_FIT_FACTOR = 2.0
+"""A joint's smooth Coulomb term ``tanh(q̇/v_s)`` is fitted on its rows at least this many times ``v_s`` fast (where
+``tanh`` is above 0.96), and the estimation leaves its slower rows out (module docstring)."""
+
 
 
 @dataclass(frozen=True)
@@ -122,6 +134,22 @@ class FrictionChoice:
         Robot
         """
         return robot_with(robot, self.models)
+
+    def fit_speeds(self, min_speed) -> np.ndarray:
+        """Each joint's slowest speed the estimation fits under these models.
+
+        Parameters
+        ----------
+        min_speed : (n_dof,) array [rad/s]
+            The prepared log's ``min_speed``.
+
+        Returns
+        -------
+        (n_dof,) array [rad/s]
+            ``min_speed``, raised to :data:`SMOOTH_FIT_FACTOR` × ``v_s`` for a joint with a smooth Coulomb term.
+        """
+        smooth = np.array([SMOOTH_FIT_FACTOR * m.velocity if m.kind == "smooth" else 0.0 for m in self.models])
+        return np.maximum(np.asarray(min_speed, dtype=float), smooth)
 
     def rest_friction(self) -> tuple:
         """Each joint's state at rest, as ``Preprocessing.rest_friction``.
@@ -217,6 +245,8 @@ class _CrossValidation:
         self.has = {t: robot.drive_mask[:, robot.drive_terms.index(t)] for t in self.others}
         size = self.p + self.k_bank + 1
         self.fit = np.zeros((folds, n, size, size))
+        # each smooth term's kept rows too slow for it, by band of speed: [0, 2·g_0·s), [2·g_0·s, 2·g_1·s), ...
+        self.slow = np.zeros((len(SMOOTH_GRID), folds, n, size, size))
         self.score = np.zeros((folds, n, size, size))
         self.n_rows = np.zeros((folds, n))
         self.load_sq, self.tau_sq, self.resting = np.zeros(n), np.zeros(n), np.zeros(n)
@@ -255,12 +285,19 @@ class _CrossValidation:
         self.resting += (data.resting[idx] if data.resting is not None else
                          np.abs(np.asarray(data.dq[idx])) <= self.rest_v).sum(axis=0)
         keep = data.kept(idx, vmin)
+        band = np.searchsorted(SMOOTH_FIT_FACTOR * np.asarray(SMOOTH_GRID), np.abs(np.asarray(data.dq[idx])) / self.speed,
+                               side="right")  # (M, n): the first smooth term each row is fast enough for
         for f in np.unique(fold):
             sel = fold == f
             zf = z[sel]
             self.score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
             zk = zf * keep[sel][:, :, None]
             self.fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
+            slow = keep[sel] & (band[sel] < len(SMOOTH_GRID))
+            for j in np.flatnonzero(slow.any(axis=0)):
+                for i in np.unique(band[sel][slow[:, j], j]):
+                    rows = zf[slow[:, j] & (band[sel][:, j] == i), j]
+                    self.slow[i, f, j] += rows.T @ rows
             self.n_rows[f] += sel.sum()
 
     def accumulate(self) -> None:
@@ -283,6 +320,7 @@ class _CrossValidation:
         if not self.n_rows.any():
             raise IdentifiabilityError(f"{data.name}: no samples left for the friction models' cross-validation")
         self.total = self.fit.sum(axis=0)
+        self.fit_smooth = self.fit[None] - np.cumsum(self.slow, axis=0)  # each smooth term's rows fast enough for it
         self.sets = np.concatenate([self.total[None], self.total[None] - self.fit])  # every block, and every block but one
         self.rows = max(self.n_rows.sum(axis=0).max(), 1)
         self.judged = self.resting / self.rows >= REST_SHARE
@@ -315,7 +353,15 @@ class _CrossValidation:
         """Out-of-fold errors per joint; with ``signs`` also whether a load-dependent coefficient (the last column
         of that model) comes out >= 0, as friction that grows with the load must."""
         cols = [self.columns(m, j) for j, m in enumerate(assignment)]
-        err, coef = _out_of_fold(self.fit, self.score, self.n_rows, self.p, cols, self.sets)
+        fit, sets = self.fit, self.sets
+        smooth = [(j, SMOOTH_GRID.index(m.velocity)) for j, m in enumerate(assignment) if m.kind == "smooth"]
+        if smooth:  # a smooth Coulomb joint is fitted on its rows fast enough for its term
+            fit = fit.copy()
+            for j, i in smooth:
+                fit[:, j] = self.fit_smooth[i, :, j]
+            total = fit.sum(axis=0)
+            sets = np.concatenate([total[None], total[None] - fit])
+        err, coef = _out_of_fold(fit, self.score, self.n_rows, self.p, cols, sets)
         if not signs:
             return err
         ok = np.array([m.kind != "load" or coef[j][-1] >= 0 for j, m in enumerate(assignment)])

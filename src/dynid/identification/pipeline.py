@@ -36,7 +36,7 @@ from ..estimators.instrumental import CLOSED_LOOP_METHODS
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
-from ..preprocessing.prepared import PreparedData, dead_channels
+from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
 from ..validation.diagnostics import delay_findings
@@ -45,7 +45,7 @@ from .closed_loop import closed_loop_estimates
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
-from .friction_models import choose_friction
+from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
 from .identify import identify, one_way_joints
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
@@ -196,6 +196,7 @@ class IdentificationPipeline:
             say("friction model of each joint (cross-validation)")
             friction = choose_friction(choices.model(self.robot), data)
             data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
+            data = _fitted_speeds(data, friction, given=self.preprocessing.min_speed != "auto")
             choices = replace(choices, friction=friction)
         robot = choices.model(self.robot)
         if choices.friction is not None:
@@ -287,6 +288,25 @@ class IdentificationPipeline:
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
         return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
+
+
+def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:
+    """``data`` with each joint's slowest fitted speed raised where its chosen smooth Coulomb term needs it
+    (:meth:`dynid.identification.friction_models.FrictionChoice.fit_speeds`), said in the settings' derivation, and in
+    a warning where the user gave ``min_speed``."""
+    vmin = min_speeds(data.settings, len(friction.models))
+    fit = friction.fit_speeds(vmin)
+    raised = [j for j in range(fit.size) if fit[j] > vmin[j]]
+    if not raised:
+        return data
+    said = ", ".join(f"J{j + 1} {fit[j]:.3g} rad/s" for j in raised)
+    data = data.with_min_speed(fit, f"; rows of a joint with a smooth Coulomb term slower than {SMOOTH_FIT_FACTOR:g}× "
+                                    f"its velocity left out ({said})")
+    if given:
+        data = replace(data, warnings=(*data.warnings, f"preprocessing.min_speed raised where friction = \"auto\" chose "
+                                       f"smooth Coulomb friction, which is fitted only {SMOOTH_FIT_FACTOR:g}× its "
+                                       f"velocity fast or faster: {said}"))
+    return data
 
 
 DELAY_MAX_SAMPLES = 60_000

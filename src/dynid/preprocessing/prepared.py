@@ -140,6 +140,24 @@ class PreparedData:
         s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
         return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
 
+    def with_min_speed(self, min_speed, note: str = "") -> PreparedData:
+        """The same samples with other slowest speeds that the estimation fits.
+
+        Parameters
+        ----------
+        min_speed : (n_dof,) array [rad/s]
+            Each joint's slowest speed fitted (:meth:`kept`).
+        note : str
+            Why, appended to the settings' ``derivation``.
+
+        Returns
+        -------
+        PreparedData
+        """
+        s = replace(self.settings, min_speed=tuple(float(v) for v in min_speed),
+                    derivation=self.settings.derivation + note)
+        return replace(self, settings=s)
+
 
 def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
     v = np.asarray(value)
