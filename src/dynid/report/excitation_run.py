@@ -28,6 +28,7 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     out : str or Path
         Output folder.
     """
+    out = Path(out)  # staged passes its staging folder
     problem, design = run.config.problem, run.design
     robot = problem.robot
     t = problem.verification_grid()

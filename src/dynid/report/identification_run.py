@@ -99,6 +99,7 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         The folder the MJCF ends up in, from which its relative paths (meshes, includes) are rewritten (default
         ``out``; the command's output folder when ``out`` is a staging folder inside it).
     """
+    out = Path(out)  # staged passes its staging folder
     paths = []
     if figures_too:
         names = [("identification", "identification_fit.png")] + [
@@ -160,6 +161,7 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
     warnings : sequence of str
         Stored in the file.
     """
+    out = Path(out)  # staged passes its staging folder
     paths = save_comparisons(comparisons, out)
     json_path = out / "validation.json"
     data = {"validation": [c.to_dict() for c in comparisons], "warnings": list(warnings)}

@@ -31,6 +31,7 @@ def save_montecarlo(result: MonteCarloResult, out: str | Path) -> list[Path]:
     out : str or Path
         Output folder.
     """
+    out = Path(out)  # staged passes its staging folder
     stats = result.statistics()
     labels = [label(k) for k in result.config.estimators]
     levels = np.asarray(result.config.noise_levels, dtype=float)
@@ -63,6 +64,7 @@ def save_closed_loop_study(result: ClosedLoopStudyResult, out: str | Path) -> li
     out : str or Path
         Output folder.
     """
+    out = Path(out)  # staged passes its staging folder
     paths = [out / "montecarlo.json", out / "montecarlo_estimates.csv", out / "report.html"]
     buf = io.StringIO()
     buf.write(",".join(["encoder_noise_deg", "torque_noise_Nm", "realisation", "estimator", "converged", *result.names,

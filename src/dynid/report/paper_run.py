@@ -92,6 +92,7 @@ def save_paper_run(result: PaperRunResult, out: str | Path, figures_too: bool = 
     figures_too : bool
         Write the figures.
     """
+    out = Path(out)  # staged passes its staging folder
     drawn = _figure_drawers(result) if figures_too else {}
     paths = [out / name for name in FIGURES if name in drawn]
     if paths:
