@@ -42,10 +42,11 @@ def test_the_extending_pages_python_runs(tmp_path, monkeypatch, capsys):
         registry._REGISTRY.clear(), registry._REGISTRY.update(estimators)
         strategies._STRATEGIES.clear(), strategies._STRATEGIES.update(known)
     out = capsys.readouterr().out.splitlines()
-    assert "excitation band" in out[0] and out[1].startswith("dynid WLS ")
-    ridge, ols = (float(x) for x in out[2].split()[:2])
+    assert "excitation band" in out[0] and out[2].startswith("dynid WLS ")
+    assert out[1] == str(namespace["prepared"].choices.to_dict()) and "coulomb_velocity" in out[1]
+    ridge, ols = (float(x) for x in out[3].split()[:2])
     assert abs(ridge - ols) < 1e-6 * abs(ols)
-    assert out[3] == "central differences, no filter"
+    assert out[4] == "central differences, no filter"
 
 
 def test_every_page_of_the_site_is_in_its_navigation():
