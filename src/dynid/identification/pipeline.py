@@ -304,8 +304,8 @@ def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:
                                     f"its velocity left out ({said})")
     if given:
         data = replace(data, warnings=(*data.warnings, f"preprocessing.min_speed raised where friction = \"auto\" chose "
-                                       f"smooth Coulomb friction, which is fitted only {SMOOTH_FIT_FACTOR:g}× its "
-                                       f"velocity fast or faster: {said}"))
+                                       f"smooth Coulomb friction, which is fitted only on rows at least "
+                                       f"{SMOOTH_FIT_FACTOR:g}× its velocity fast: {said}"))
     return data
 
 
