@@ -41,7 +41,7 @@ from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import regressor
 from ..exceptions import IdentifiabilityError
 from ..friction import TERMS, Velocities, held_direction
-from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with
+from ..model.friction_model import COULOMB_LIKE, JointFriction, robot_with, smoothing_velocities
 from ..model.robot import Robot
 from ..preprocessing.filters import parallel_decimation
 from ..preprocessing.prepared import PreparedData, min_speeds, rest_decay
@@ -148,8 +148,7 @@ class FrictionChoice:
         (n_dof,) array [rad/s]
             ``min_speed``, raised to :data:`SMOOTH_FIT_FACTOR` × ``v_s`` for a joint with a smooth Coulomb term.
         """
-        smooth = np.array([SMOOTH_FIT_FACTOR * m.velocity if m.kind == "smooth" else 0.0 for m in self.models])
-        return np.maximum(np.asarray(min_speed, dtype=float), smooth)
+        return np.maximum(np.asarray(min_speed, dtype=float), SMOOTH_FIT_FACTOR * smoothing_velocities(self.models))
 
     def rest_friction(self) -> tuple:
         """Each joint's state at rest, as ``Preprocessing.rest_friction``.
@@ -293,10 +292,11 @@ class _CrossValidation:
             self.score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
             zk = zf * keep[sel][:, :, None]
             self.fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
-            slow = keep[sel] & (band[sel] < len(SMOOTH_GRID))
+            bf = band[sel]
+            slow = keep[sel] & (bf < len(SMOOTH_GRID))
             for j in np.flatnonzero(slow.any(axis=0)):
-                for i in np.unique(band[sel][slow[:, j], j]):
-                    rows = zf[slow[:, j] & (band[sel][:, j] == i), j]
+                for i in np.unique(bf[slow[:, j], j]):
+                    rows = zf[slow[:, j] & (bf[:, j] == i), j]
                     self.slow[i, f, j] += rows.T @ rows
             self.n_rows[f] += sel.sum()
 
