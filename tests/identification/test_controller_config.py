@@ -172,3 +172,33 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
 
     with pytest.raises(DataError, match="the reference: 9990 rows of set-points, the identification log has 10000"):
         dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=short)
+
+
+def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_loop_log):
+    """IdentificationPipeline(closed_loop=..., controller=...) is made of ClosedLoopEstimator parts, each carrying the
+    controller: one such part added to the pipeline's open-loop result gives the pipeline's own IDIM-IV estimate, and
+    an unknown method is refused in one line."""
+    from dynid.exceptions import ConfigError
+    from dynid.identification.closed_loop import ClosedLoopEstimator, ClosedLoopSetup
+    from dynid.identification.pipeline import IdentificationPipeline
+    from dynid.io.datasets import Recording
+    from dynid.simulation.closed_loop import Controller
+
+    root, _, _ = closed_loop_log
+    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
+    robot = dynid.load_robot("er16")
+    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
+                            feedforward=True)
+    recording = Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
+    pipeline = IdentificationPipeline(robot, closed_loop=("idim-iv",), controller=setup)
+    assert [(p.method, p.setup) for p in pipeline.closed_loop_estimators] == [("idim-iv", setup)]
+    prepared = pipeline.prepare(recording)
+    whole = pipeline.estimate(prepared, recording=recording)
+    open_loop = IdentificationPipeline(robot).estimate(prepared)
+    alone = ClosedLoopEstimator("idim-iv", setup).added_to(open_loop, prepared.robot, prepared.base, recording,
+                                                           pipeline.preprocessing)
+    assert list(alone.estimates) == ["dynid WLS", "dynid IDIM-IV"]
+    np.testing.assert_array_equal(alone.estimates["dynid IDIM-IV"].params, whole.estimates["dynid IDIM-IV"].params)
+    assert alone.consistency_verdicts["dynid IDIM-IV"] == whole.consistency_verdicts["dynid IDIM-IV"]
+    with pytest.raises(ConfigError, match="closed_loop: 'idim' is not a closed-loop estimator"):
+        ClosedLoopEstimator("idim", setup)

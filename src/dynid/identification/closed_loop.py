@@ -52,7 +52,7 @@ from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from .identify import Estimate, consistency_checks
 
-__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopSetup", "closed_loop_identify", "closed_loop_estimates",
+__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopEstimator", "ClosedLoopSetup", "closed_loop_identify", "closed_loop_estimates",
            "CLOSED_LOOP_METHODS"]
 
 
@@ -404,56 +404,132 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
                               run.changes, run.message)
 
 
+@dataclass(frozen=True)
+class ClosedLoopEstimator:
+    """One closed-loop estimator as a part of the identification pipeline
+    (:class:`dynid.identification.pipeline.IdentificationPipeline`): its method and how the log was recorded, which it
+    carries as an open-loop estimator carries its prior.
+
+    Attributes
+    ----------
+    method : str
+        Among :data:`CLOSED_LOOP_METHODS`.
+    setup : ClosedLoopSetup
+        The controller, the set-points and whether the controller added the model's torques.
+    max_iter : int
+        Closed-loop simulations at most (:func:`closed_loop_identify`).
+    tol : float
+        Relative change of the simulated torques that ends the iterations.
+
+    Raises
+    ------
+    ConfigError
+        An unknown method.
+    """
+
+    method: str
+    setup: ClosedLoopSetup
+    max_iter: int = 10
+    tol: float = 1e-4
+
+    def __post_init__(self):
+        if self.method not in CLOSED_LOOP_METHODS:
+            raise ConfigError(f"closed_loop: {self.method!r} is not a closed-loop estimator (expected "
+                              f"{', '.join(CLOSED_LOOP_METHODS)})", field="closed_loop")
+
+    def experiment(self, robot: Robot, recording: Recording) -> ClosedLoopExperiment:
+        """The experiment to simulate: the set-points, their derivatives and the feed-forward along them.
+
+        Parameters
+        ----------
+        robot : Robot
+            The model whose torques the controller added along the reference (with ``setup.feedforward``).
+        recording : Recording
+            The log as read (one set-point per sample).
+
+        Returns
+        -------
+        ClosedLoopExperiment
+
+        Raises
+        ------
+        DataError
+            A reference without one set-point per sample of the log.
+        """
+        controller = self.setup.controller
+        q_ref = self.setup.reference_positions()
+        if q_ref.shape[0] != recording.t.size:
+            where = getattr(self.setup.reference, "file", "the reference")
+            raise DataError(f"{where}: {q_ref.shape[0]} rows of set-points, the identification log has "
+                            f"{recording.t.size} samples: give one set-point per row of the log (and the same rows)")
+        dt = 1.0 / controller.rate
+        dq_ref = np.gradient(q_ref, dt, axis=0)
+        ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if self.setup.feedforward else None
+        return ClosedLoopExperiment(controller, q_ref, dq_ref, ff)
+
+    def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing):
+        """An identification's result with this estimate beside its others, on its log as read, at the control rate.
+
+        Parameters
+        ----------
+        result : dynid.identification.identify.IdentificationResult
+            The estimates so far.
+        robot, base : Robot, BaseParameters
+            The model as identified (with the choices the data made) and its base-parameter map.
+        recording : Recording
+            The identification log as read (the estimator prepares its simulations as it was prepared).
+        preprocessing : Preprocessing
+            The settings as given (the simulated logs derive theirs as the measured one did).
+
+        Returns
+        -------
+        IdentificationResult
+            ``result`` with the estimate added (a stop before convergence: the estimate's note and a warning) and its
+            consistency checked.
+
+        Raises
+        ------
+        DataError
+            A reference without one set-point per sample of the log.
+        """
+        t0 = time.perf_counter()
+        out = closed_loop_identify(robot, base, recording, self.experiment(robot, recording), methods=(self.method,),
+                                   preprocessing=preprocessing, max_iter=self.max_iter, tol=self.tol)[self.method]
+        std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
+        estimate = Estimate(self.method, out.params, std, time.perf_counter() - t0, note="" if out.converged else out.message)
+        margins, verdicts = consistency_checks(robot, base, {estimate.label: estimate.params})
+        return replace(result, estimates={**result.estimates, estimate.label: estimate},
+                       warnings=result.warnings + (() if out.converged else (f"{estimate.label}: {out.message}",)),
+                       consistency={**result.consistency, **margins},
+                       consistency_verdicts={**result.consistency_verdicts, **verdicts})
+
+
 def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording: Recording, setup: ClosedLoopSetup,
                           keys: tuple[str, ...], preprocessing: Preprocessing):
-    """The closed-loop estimators beside an identification's other estimates, on its log as read, at the control rate.
+    """The closed-loop estimators of ``keys`` beside an identification's other estimates:
+    :meth:`ClosedLoopEstimator.added_to` of each in turn.
 
     Parameters
     ----------
-    robot, base : Robot, BaseParameters
-        The model as identified (with the choices the data made) and its base-parameter map.
-    result : dynid.identification.identify.IdentificationResult
-        The open-loop estimates; the first of them starts the iterations.
-    recording : Recording
-        The identification log as read (the estimators prepare their simulations as it was prepared).
+    robot, base, result, recording, preprocessing
+        As :meth:`ClosedLoopEstimator.added_to`'s.
     setup : ClosedLoopSetup
+        How the log was recorded, shared by the estimators.
     keys : tuple of str
         Among :data:`CLOSED_LOOP_METHODS`, in order.
-    preprocessing : Preprocessing
-        The settings as given (the simulated logs derive theirs as the measured one did).
 
     Returns
     -------
     IdentificationResult
-        ``result`` with the estimates added (a stop before convergence: the estimate's note and a warning) and their
-        consistency checked.
+        ``result`` with each estimate added.
 
     Raises
     ------
+    ConfigError
+        An unknown key.
     DataError
         A reference without one set-point per sample of the log.
     """
-    controller = setup.controller
-    q_ref = setup.reference_positions()
-    if q_ref.shape[0] != recording.t.size:
-        where = getattr(setup.reference, "file", "the reference")
-        raise DataError(f"{where}: {q_ref.shape[0]} rows of set-points, the identification log has "
-                        f"{recording.t.size} samples: give one set-point per row of the log (and the same rows)")
-    dt = 1.0 / controller.rate
-    dq_ref = np.gradient(q_ref, dt, axis=0)
-    ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if setup.feedforward else None
-    estimates = dict(result.estimates)
-    notes = []
     for key in keys:
-        t0 = time.perf_counter()
-        out = closed_loop_identify(robot, base, recording, ClosedLoopExperiment(controller, q_ref, dq_ref, ff), methods=(key,),
-                                   preprocessing=preprocessing)[key]
-        std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
-        estimate = Estimate(key, out.params, std, time.perf_counter() - t0, note="" if out.converged else out.message)
-        estimates[estimate.label] = estimate
-        if not out.converged:
-            notes.append(f"{estimate.label}: {out.message}")
-    added = {label: e.params for label, e in estimates.items() if label not in result.estimates}
-    margins, verdicts = consistency_checks(robot, base, added)
-    return replace(result, estimates=estimates, warnings=result.warnings + tuple(notes),
-                   consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})
+        result = ClosedLoopEstimator(key, setup).added_to(result, robot, base, recording, preprocessing)
+    return result

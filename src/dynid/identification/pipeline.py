@@ -18,8 +18,8 @@ Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
    :func:`dynid.identification.friction_models.choose_friction`), which may change the base-parameter map.
 
 :meth:`~IdentificationPipeline.estimate` is :func:`dynid.identification.identify.identify` on the prepared data, then
-the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP: :func:`dynid.identification.closed_loop.closed_loop_estimates`)
-when the pipeline has them and the log's controller; the result's ``settings`` say every choice and why. Reading logs
+the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop.ClosedLoopEstimator`,
+each carrying the log's controller) when the pipeline has them; the result's ``settings`` say every choice and why. Reading logs
 and configs, drive gains and validation on other logs are the callers' (:mod:`dynid.identification.run`).
 """
 
@@ -41,7 +41,7 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
 from ..validation.diagnostics import delay_findings
 from .choices import ModelChoices
-from .closed_loop import closed_loop_estimates
+from .closed_loop import ClosedLoopEstimator
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
@@ -110,6 +110,12 @@ class IdentificationPipeline:
         How the log was recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`); needed
         with ``closed_loop``.
 
+    Attributes
+    ----------
+    closed_loop_estimators : tuple of ClosedLoopEstimator
+        The parts ``closed_loop`` and ``controller`` make (:class:`dynid.identification.closed_loop.ClosedLoopEstimator`,
+        each carrying the controller), run by :meth:`estimate` in order.
+
     Raises
     ------
     ConfigError
@@ -126,6 +132,7 @@ class IdentificationPipeline:
     source: str = ""
     closed_loop: tuple[str, ...] = ()
     controller: Any = None
+    closed_loop_estimators: tuple[ClosedLoopEstimator, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if self.friction not in FRICTION_CHOICES:
@@ -138,6 +145,8 @@ class IdentificationPipeline:
             raise ConfigError(f"estimators: {self.closed_loop[0]} simulates the run in closed loop and needs its "
                               "controller (a ClosedLoopSetup: the controller, the set-points, the feed-forward)",
                               field="controller")
+        object.__setattr__(self, "closed_loop_estimators",
+                           tuple(ClosedLoopEstimator(key, self.controller) for key in self.closed_loop))
 
     def prepare(self, recording, base: BaseParameters | None = None,
                 step: Callable[[str], Any] | None = None) -> PreparedIdentification:
@@ -258,8 +267,9 @@ class IdentificationPipeline:
 
         if progress is not None:
             progress("closed-loop estimators (" + ", ".join(self.closed_loop) + ")", 0, 1)
-        return closed_loop_estimates(prepared.robot, prepared.base, result, recording, self.controller, self.closed_loop,
-                                     self.preprocessing)
+        for part in self.closed_loop_estimators:
+            result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing)
+        return result
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
             held_out: bool = True):
