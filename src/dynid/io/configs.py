@@ -104,7 +104,10 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     if isinstance(ref, dict):
         table = dict(ref)
         if isinstance(table.get("urdf"), str) and not (path.parent / table["urdf"]).is_file():
-            table["urdf"] = str(_located(table["urdf"], path.parent, data_root) or table["urdf"])
+            found = _located(table["urdf"], path.parent, data_root)
+            if found is None and not Path(table["urdf"]).is_file():
+                raise ConfigError(_not_found(path, "robot.urdf", table["urdf"], data_root), field="robot.urdf")
+            table["urdf"] = str(found or table["urdf"])
         table.setdefault("name", Path(str(table.get("urdf", "robot"))).stem)
         return robot_from_document(table, f"{path}: robot", path.parent)
     if not isinstance(ref, str):
@@ -112,6 +115,8 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     local = None if ref in builtin_robots() else _located(ref, path.parent, data_root)  # relative to the config, else
     if local is not None:                                                               # to the data root
         return load_robot(local)
+    if Path(ref).suffix.lower() in (".urdf", ".xacro", ".toml") and not Path(ref).is_file():
+        raise ConfigError(_not_found(path, "robot", ref, data_root), field="robot")
     try:
         return load_robot(ref)
     except ConfigError as exc:  # an unknown name: said as the config wrote it, with the config and the field
@@ -157,6 +162,14 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         return None
     urdf = described.get("urdf")
     return urdf_of(_located(urdf, file.parent, None)) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+
+
+def _not_found(path: Path, field: str, name: str, data_root: Path | None) -> str:
+    """The one line saying that a file a config names is nowhere it is looked for (:func:`_located`)."""
+    folder = path.parent.resolve()
+    root = None if data_root is None else Path(data_root).resolve()
+    where = f"in {folder}" + ("" if root is None or root == folder else f" (the config's folder) or {root} (the data root)")
+    return f"{path}: {field}: file {name!r} not found {where}"
 
 
 def _located(name: str, folder: Path, data_root: Path | None) -> Path | None:
