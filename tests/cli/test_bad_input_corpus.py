@@ -113,6 +113,11 @@ LOGS = {
     "three rows": (_text(GOOD[:3]), "identification (" ),
     "time stamps in milliseconds": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), 0), r[:, 0] * 1000.0))),
                                     "log.csv: the time stamps step by"),
+    # with a gap of a few samples, which dynid fills in seconds but which, read as seconds, exceeded max_gap first
+    "time stamps in milliseconds, with a gap": (
+        _text(_with(GOOD, lambda r: r.__setitem__((slice(None), 0), 1000.0 * (r[:, 0] + (np.arange(len(r)) >= 1000)
+                                                                              * 8 * (r[1, 0] - r[0, 0]))))),
+        "log.csv: the time stamps step by"),
     "velocities in deg/s": (_text(_with(GOOD, lambda r: r.__setitem__((slice(None), slice(7, 13)),
                                                                       np.degrees(r[:, 7:13])))),
                             "(deg/s read as rad/s?)"),

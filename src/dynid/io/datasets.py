@@ -752,6 +752,18 @@ def _in_time_range(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     return t, raw, where
 
 
+def _check_clock_unit(step: float, source: str, table: str) -> None:
+    """Refuse time stamps ``step`` seconds apart when that is slower than any robot controller logs
+    (:data:`MIN_RATE`): they hold another unit, which the message guesses."""
+    if 1.0 / step >= MIN_RATE:
+        return
+    unit = time_unit_of(step)
+    guess = f"they look like {unit} (time = {{ ..., unit = \"{unit}\" }})" if unit else "another unit?"
+    raise DataError(f"{source}: the time stamps step by {step:.4g} s ({1.0 / step:.4g} Hz), slower than any robot "
+                    f"controller logs (at least {MIN_RATE:g} Hz): {guess}; dynid reads seconds unless the time "
+                    f"column's unit says otherwise, or give rate (Hz) in {table} instead of the time column")
+
+
 def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool, q_source: str, tau_source: str,
               warnings: list[str]) -> Recording:
     """Time checks, selection, gaps, resampling, transmission, drive gains and plausibility, shared by every
@@ -775,6 +787,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
                         f"are needed: widen it")
     median = float(np.median(np.diff(t)))
     table = spec.table or spec.name
+    if timed and spec.resample is None:  # before the gaps: a log in milliseconds has its gaps in seconds
+        _check_clock_unit(median, q_source, table)
     if timed:
         steps = np.diff(t)
         gaps = np.flatnonzero(steps > GAP_FACTOR * median)
@@ -802,13 +816,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
                             "refuses them)")
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
-    if timed and spec.resample is None and rate < MIN_RATE:
-        step = 1.0 / rate
-        unit = time_unit_of(step)
-        guess = f"they look like {unit} (time = {{ ..., unit = \"{unit}\" }})" if unit else "another unit?"
-        raise DataError(f"{q_source}: the time stamps step by {step:.4g} s ({rate:.4g} Hz), slower than any robot "
-                        f"controller logs (at least {MIN_RATE:g} Hz): {guess}; dynid reads seconds unless the time "
-                        f"column's unit says otherwise, or give rate (Hz) in {table} instead of the time column")
+    if timed and spec.resample is None:
+        _check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission
