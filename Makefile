@@ -21,7 +21,7 @@ test: $(STAMP)
 	$(BIN)/ruff check  # lint ([tool.ruff] in pyproject.toml: pyflakes, pycodestyle, imports, bugbear, pyupgrade)
 	$(BIN)/python -m mypy  # type check of src/dynid ([tool.mypy] in pyproject.toml)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
-	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict  # the docs site (mkdocs.yml) into .site/; a warning (a broken link) fails it
+	$(BIN)/python -m mkdocs build --strict  # the docs site (mkdocs.yml) into .site/; a warning (a broken link) fails it
 
 wheel-check: $(STAMP)  # the wheel as a user installs it, in a fresh virtualenv: example, identify, export (CI)
 	rm -rf .wheel-check && mkdir -p .wheel-check/dist
