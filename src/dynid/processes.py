@@ -148,7 +148,7 @@ class ForkedCall:
             _, status = os.waitpid(pid, 0)
         if os.waitstatus_to_exitcode(status) == 0 and data:
             try:
-                answer = pickle.loads(data)
+                answer = pickle.loads(data)  # our forked child's pipe (os.pipe), never a file
             except Exception:  # noqa: BLE001 - an answer that does not unpickle: computed here instead
                 answer = None
         if answer is None:

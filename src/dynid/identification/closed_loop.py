@@ -467,7 +467,8 @@ class ClosedLoopEstimator:
         ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if self.setup.feedforward else None
         return ClosedLoopExperiment(controller, q_ref, dq_ref, ff)
 
-    def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing):
+    def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing,
+                 experiment: ClosedLoopExperiment | None = None):
         """An identification's result with this estimate beside its others, on its log as read, at the control rate.
 
         Parameters
@@ -480,6 +481,8 @@ class ClosedLoopEstimator:
             The identification log as read (the estimator prepares its simulations as it was prepared).
         preprocessing : Preprocessing
             The settings as given (the simulated logs derive theirs as the measured one did).
+        experiment : ClosedLoopExperiment, optional
+            :meth:`experiment` when the caller has it already (estimators sharing a setup read its set-points once).
 
         Returns
         -------
@@ -493,7 +496,8 @@ class ClosedLoopEstimator:
             A reference without one set-point per sample of the log.
         """
         t0 = time.perf_counter()
-        out = closed_loop_identify(robot, base, recording, self.experiment(robot, recording), methods=(self.method,),
+        experiment = experiment if experiment is not None else self.experiment(robot, recording)
+        out = closed_loop_identify(robot, base, recording, experiment, methods=(self.method,),
                                    preprocessing=preprocessing, max_iter=self.max_iter, tol=self.tol)[self.method]
         std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
         estimate = Estimate(self.method, out.params, std, time.perf_counter() - t0, note="" if out.converged else out.message)
@@ -530,6 +534,8 @@ def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording:
     DataError
         A reference without one set-point per sample of the log.
     """
-    for key in keys:
-        result = ClosedLoopEstimator(key, setup).added_to(result, robot, base, recording, preprocessing)
+    parts = [ClosedLoopEstimator(key, setup) for key in keys]
+    experiment = parts[0].experiment(robot, recording) if parts else None  # the set-points read once for all
+    for part in parts:
+        result = part.added_to(result, robot, base, recording, preprocessing, experiment)
     return result

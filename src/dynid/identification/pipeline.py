@@ -32,7 +32,6 @@ from typing import Any
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
-from ..estimators.instrumental import CLOSED_LOOP_METHODS
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
@@ -137,16 +136,12 @@ class IdentificationPipeline:
     def __post_init__(self):
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
-        unknown = [k for k in self.closed_loop if k not in CLOSED_LOOP_METHODS]
-        if unknown:
-            raise ConfigError(f"closed_loop: {unknown[0]!r} is not a closed-loop estimator (expected "
-                              f"{', '.join(CLOSED_LOOP_METHODS)})", field="closed_loop")
-        if self.closed_loop and self.controller is None:
+        parts = tuple(ClosedLoopEstimator(key, self.controller) for key in self.closed_loop)  # an unknown key: refused
+        if parts and self.controller is None:
             raise ConfigError(f"estimators: {self.closed_loop[0]} simulates the run in closed loop and needs its "
                               "controller (a ClosedLoopSetup: the controller, the set-points, the feed-forward)",
                               field="controller")
-        object.__setattr__(self, "closed_loop_estimators",
-                           tuple(ClosedLoopEstimator(key, self.controller) for key in self.closed_loop))
+        object.__setattr__(self, "closed_loop_estimators", parts)
 
     def prepare(self, recording, base: BaseParameters | None = None,
                 step: Callable[[str], Any] | None = None) -> PreparedIdentification:
@@ -267,8 +262,9 @@ class IdentificationPipeline:
 
         if progress is not None:
             progress("closed-loop estimators (" + ", ".join(self.closed_loop) + ")", 0, 1)
+        experiment = self.closed_loop_estimators[0].experiment(prepared.robot, recording)  # one reading for all
         for part in self.closed_loop_estimators:
-            result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing)
+            result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing, experiment)
         return result
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,

@@ -277,7 +277,7 @@ def _figure_process_main(read: int):
         _warm_up_drawing()
         data = read_all(read)
         if data:  # empty: the parent closed the pipe without figures to draw
-            build, args = pickle.loads(data)
+            build, args = pickle.loads(data)  # the parent's own pipe (os.pipe before the fork), never a file
             _draw_jobs(build(*args))
         code = 0
     except BaseException:  # noqa: BLE001 - reported through the exit code; the parent draws instead
