@@ -7,6 +7,7 @@ import inspect
 import numpy as np
 
 from ..exceptions import ShapeError
+from ..hyperparameters import HyperParameters
 from .accumulate import LeastSquaresAccumulator
 
 
@@ -256,7 +257,7 @@ class ShiftedResidual:
         return self._array
 
 
-class Estimator:
+class Estimator(HyperParameters):
     """Base class (scikit-learn contract): ``fit(W, tau)`` sets ``params_`` and returns self; ``predict(W)``;
     ``score``; ``get_params``, ``set_params`` and ``clone``.
 
@@ -266,41 +267,8 @@ class Estimator:
     """
 
     params_: np.ndarray
-
-    def get_params(self) -> dict:
-        """The keyword hyper-parameters of ``__init__`` and their values (scikit-learn's contract).
-
-        Returns
-        -------
-        dict
-        """
-        names = [p.name for p in inspect.signature(type(self).__init__).parameters.values()
-                 if p.kind == p.KEYWORD_ONLY]
-        return {n: getattr(self, n) for n in names}
-
-    def set_params(self, **params) -> Estimator:
-        """Set hyper-parameters by name.
-
-        Parameters
-        ----------
-        **params
-            name -> value.
-
-        Returns
-        -------
-        self
-
-        Raises
-        ------
-        ValueError
-            An unknown name.
-        """
-        known = self.get_params()
-        for name, value in params.items():
-            if name not in known:
-                raise ValueError(f"{type(self).__name__} has no parameter {name!r}; expected one of {sorted(known)}")
-            setattr(self, name, value)
-        return self
+    PARAMETER_KINDS = frozenset({inspect.Parameter.KEYWORD_ONLY})
+    """Only the keyword hyper-parameters are parameters (a plugin's positional arguments are not)."""
 
     def clone(self) -> Estimator:
         """An unfitted estimator with the same hyper-parameters.

@@ -11,7 +11,6 @@ Example::
 
 from __future__ import annotations
 
-import inspect
 import warnings
 from dataclasses import replace
 from pathlib import Path
@@ -21,6 +20,7 @@ import numpy as np
 
 from ..estimators.physically_consistent import PRIOR_KINDS as SDP_PRIORS
 from ..exceptions import ConfigError
+from ..hyperparameters import HyperParameters
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -28,7 +28,7 @@ from ..preprocessing.settings import Preprocessing
 __all__ = ["Identifier"]
 
 
-class Identifier:
+class Identifier(HyperParameters):
     """Identify a robot's dynamic model (module docstring).
 
     Parameters
@@ -106,45 +106,6 @@ class Identifier:
         from sklearn.utils import Tags, TargetTags
 
         return Tags(estimator_type=None, target_tags=TargetTags(required=True), no_validation=True, requires_fit=True)
-
-    def get_params(self, deep: bool = True) -> dict:
-        """The constructor's parameters and their values (scikit-learn's contract).
-
-        Parameters
-        ----------
-        deep : bool
-            Unused (no nested estimators).
-
-        Returns
-        -------
-        dict
-        """
-        return {name: getattr(self, name) for name in inspect.signature(type(self).__init__).parameters if name != "self"}
-
-    def set_params(self, **params) -> Identifier:
-        """Set constructor parameters by name.
-
-        Parameters
-        ----------
-        **params
-            Constructor parameters.
-
-        Returns
-        -------
-        Identifier
-            ``self``.
-
-        Raises
-        ------
-        ValueError
-            An unknown name.
-        """
-        known = self.get_params()
-        for name, value in params.items():
-            if name not in known:
-                raise ValueError(f"Identifier has no parameter {name!r}; expected one of {sorted(known)}")
-            setattr(self, name, value)
-        return self
 
     @classmethod
     def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:

@@ -1,0 +1,56 @@
+"""Parameters by name, as scikit-learn's ``BaseEstimator`` has them: ``get_params`` reads the constructor's
+parameters back from the attributes of the same names, ``set_params`` sets them and refuses an unknown name."""
+
+from __future__ import annotations
+
+import inspect
+
+
+class HyperParameters:
+    """Mixin: ``get_params`` / ``set_params`` over the constructor's parameters (scikit-learn's contract).
+
+    A class stores each constructor parameter under its own name. ``PARAMETER_KINDS`` says which of its
+    constructor's parameters count (:class:`inspect.Parameter` kinds); by default every named one.
+    """
+
+    PARAMETER_KINDS = frozenset({inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY})
+
+    def get_params(self, deep: bool = True) -> dict:
+        """The constructor's parameters and their values.
+
+        Parameters
+        ----------
+        deep : bool
+            Unused (no nested estimators); scikit-learn's signature.
+
+        Returns
+        -------
+        dict
+            Name -> value, in the constructor's order.
+        """
+        parameters = list(inspect.signature(type(self).__init__).parameters.values())[1:]  # not ``self``
+        return {p.name: getattr(self, p.name) for p in parameters if p.kind in self.PARAMETER_KINDS}
+
+    def set_params(self, **params):
+        """Set constructor parameters by name.
+
+        Parameters
+        ----------
+        **params
+            Name -> value.
+
+        Returns
+        -------
+        self
+
+        Raises
+        ------
+        ValueError
+            An unknown name (the message names the class and the known names).
+        """
+        known = self.get_params()
+        for name, value in params.items():
+            if name not in known:
+                raise ValueError(f"{type(self).__name__} has no parameter {name!r}; expected one of {sorted(known)}")
+            setattr(self, name, value)
+        return self
