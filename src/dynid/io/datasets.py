@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import tomllib
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -690,14 +691,8 @@ def _filled(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
         gone = np.isnan(column)
         return np.where(gone, np.interp(t, t[~gone], column[~gone]), column)
 
-    def filled(kind: str, x):
-        if not holes[kind]:
-            return x
-        if isinstance(x, StoredColumns):
-            return x.map_columns(lambda column, j: fill(column, j, kind))
-        return np.column_stack([fill(np.asarray(x[:, j]), j, kind) for j in range(x.shape[1])])
-
-    raw = {kind: filled(kind, x) for kind, x in raw.items()}  # between the values either side, then the rows kept
+    raw = {kind: by_column(x, partial(fill, kind=kind)) if holes[kind] else x
+           for kind, x in raw.items()}  # between the values either side, then the rows kept
     if a or b < n:
         t, raw = t[a:b], {kind: x[a:b] for kind, x in raw.items()}
         where = where if where is None or not a else (lambda w, f: (lambda k: w(k + f)))(where, a)
@@ -939,6 +934,8 @@ def unwrapped_positions(x, name: str, warnings: list[str]):
     (N, n_dof) array or StoredColumns [rad]
         ``x`` itself where no step is a whole turn.
     """
+    if not any(_turns(np.asarray(x[:, j], dtype=float)).any() for j in range(x.shape[1])):
+        return x  # stored columns are read, not written again
     said = []
 
     def unwrap(column: np.ndarray, j: int) -> np.ndarray:
@@ -949,15 +946,7 @@ def unwrapped_positions(x, name: str, warnings: list[str]):
         said.append(f"joint {j + 1}: {jumps} jump{'s' if jumps > 1 else ''}")
         return column - 2 * np.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
-    out: StoredColumns | np.ndarray
-    if isinstance(x, StoredColumns):
-        if not any(_turns(x.column(j)).any() for j in range(x.shape[1])):
-            return x
-        out = x.map_columns(unwrap)
-    else:
-        out = np.column_stack([unwrap(np.asarray(x[:, j], dtype=float), j) for j in range(x.shape[1])])
-    if not said:
-        return x
+    out = by_column(x, unwrap)
     warnings.append(f"{name}: positions jump by a whole turn (2π) between two samples, an angle logged within one "
                     f"turn: taken back so that they run on ({'; '.join(said)})")
     return out
@@ -978,8 +967,7 @@ def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
     if kind not in raw:
         return raw
     x = raw[kind]
-    column = (lambda j: x.column(j)) if isinstance(x, StoredColumns) else (lambda j: x[:, j])  # noqa: E731
-    found = {j: hit for j in range(x.shape[1]) if (hit := _spikes(np.asarray(column(j), dtype=float))) is not None}
+    found = {j: hit for j in range(x.shape[1]) if (hit := _spikes(np.asarray(x[:, j], dtype=float))) is not None}
     if not found:
         return raw
 
@@ -990,8 +978,7 @@ def _despiked(spec: DatasetSpec, raw: dict, warnings: list[str]) -> dict:
         out[found[j][0]] = found[j][1]
         return out
 
-    fixed = (x.map_columns(mended) if isinstance(x, StoredColumns) else
-             np.column_stack([mended(np.asarray(x[:, j]), j) for j in range(x.shape[1])]))
+    fixed = by_column(x, mended)
     unit = "A" if kind == "currents" else "N·m"
     for j, (where, _, largest) in sorted(found.items()):
         warnings.append(f"{spec.name}: J{j + 1}'s {kind[:-1]} has {where.size} isolated spike(s), up to {largest:.4g} "
