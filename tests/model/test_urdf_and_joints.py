@@ -121,3 +121,41 @@ def test_a_urdf_without_inertias_is_said_once(tmp_path):
     one = load_robot(tmp_path / "one.urdf")
     assert first is not None and len(one.nominal_problems) == 1 and "link 6 (wrist_3_link): nominal mass 0 kg" in \
         one.nominal_problems[0]
+
+
+def _with_dynamics(joint: str, damping: str, friction: str) -> str:
+    """The UR10e's URDF with ``joint``'s <dynamics> stating its damping and friction."""
+    text = (ROBOTS / "ur10e.urdf").read_text()
+    return re.sub(rf'(<joint name="{joint}" type="revolute">.*?)<dynamics [^>]*/>',
+                  rf'\1<dynamics damping="{damping}" friction="{friction}"/>', text, count=1, flags=re.S)
+
+
+def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_path):
+    """A URDF joint's <dynamics> damping and friction are named in one line (joint, value) and left out of the nominal
+    friction, which stays 0 (vendor files hold simulator settings there: benchmarks/README.md), with the way to take
+    them; a [[joints]] table's fv or fc is the nominal value and silences the line for that term; a URDF stating only
+    zeros (most vendor files) says nothing."""
+    from dynid.model.description import URDF_DYNAMICS_NOTE
+
+    text = _with_dynamics("shoulder_lift_joint", "0.5", "1.25")
+    robot = load_robot(_description(tmp_path, text))
+    fc, fv = robot.drive_terms.index("fc"), robot.drive_terms.index("fv")
+    assert not np.any(robot.drive[:, [fc, fv]])
+    assert robot.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state damping 0.5 on J2; friction "
+                                   f"1.25 on J2: {URDF_DYNAMICS_NOTE}",)
+    assert not robot.nominal_problems
+
+    given = load_robot(_description(tmp_path, text, "fv = 0.7\n"))
+    assert (given.drive[1, fv], given.drive[1, fc]) == (0.7, 0.0)
+    assert given.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state friction 1.25 on J2: "
+                                   f"{URDF_DYNAMICS_NOTE}",)
+
+    plain = load_robot(_description(tmp_path, (ROBOTS / "ur10e.urdf").read_text()))
+    assert not np.any(plain.drive[:, [fc, fv]]) and plain.nominal_notes == ()
+
+    import dynid
+    from dynid.identification.identifier import Identifier
+
+    log = dynid.simulated_log(load_robot(str(ROBOTS / "ur10e.toml")), seconds=10, seed=3)
+    said = Identifier(robot, estimators=["ols"]).fit(log.t, log.q, log.tau).result_.warnings
+    assert robot.nominal_notes[0] in said  # the identification says it among its warnings

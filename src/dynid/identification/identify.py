@@ -383,7 +383,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     estimates = {}
     for key in (*keys, *(() if ls_key in keys else (ls_key,))):
         estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
-    warnings = list(robot.nominal_problems) + list(prior_notes) + list(data.warnings) + \
+    warnings = list(robot.nominal_problems) + list(robot.nominal_notes) + list(prior_notes) + list(data.warnings) + \
         [e.note for e in estimates.values() if e.note]
     dropped = 1.0 - reference.accumulator_.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation or 1)))
     if dropped > 0.5:

@@ -146,6 +146,11 @@ def parse_angle(value, where: str) -> float:
     raise ConfigError(f"{where}: expected a number or an angle like 'pi/2', got {value!r}")
 
 
+URDF_DYNAMICS_NOTE = ("not taken as the nominal viscous and Coulomb friction, which stay 0 (a URDF's <dynamics> "
+                      "often holds a simulator's setting, not the robot's friction); to take "
+                      "them, give fv = and fc = in the joints' [[joints]] tables of a robot description")
+"""What dynid says of the friction a URDF's ``<dynamics>`` states (:func:`robot_from_document`)."""
+
 URDF_DRIVE_TERMS = ("Ia", "fc", "fv", "offset")
 """Drive terms of a robot given by its URDF alone: what a geared arm with current or torque sensing needs."""
 
@@ -288,6 +293,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
 
     terms, mask, drive = _drive_terms(rows, where, terms, source)
+    stated = _urdf_friction(rows, terms, upath, held, source) if convention == "urdf" else ()
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(d.transmission, n, offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
@@ -306,7 +312,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
-        held=tuple(held),
+        held=tuple(held), nominal_notes=stated,
     )
 
 
@@ -385,6 +391,27 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
             mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
     drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
     return terms, mask, drive
+
+
+def _urdf_friction(rows, terms: tuple, urdf: Path, held: dict, source: str) -> tuple[str, ...]:
+    """A line naming the joints whose URDF ``<dynamics>`` states a damping or friction that no ``[[joints]]`` table's
+    ``fv``/``fc`` gives: they are not taken as nominal friction (see :data:`URDF_DYNAMICS_NOTE`); none where the URDF
+    states only zeros (most vendor files) or the robot has neither term."""
+    from .urdf import urdf_friction
+
+    stated = urdf_friction(urdf, held)
+    parts = []
+    for term, attribute in (("fv", "damping"), ("fc", "friction")):
+        joints = [j for j, r in enumerate(rows) if stated[term][j] != 0 and getattr(r, term) is None]
+        if term in terms and joints:
+            by_value: dict[float, list[int]] = {}
+            for j in joints:
+                by_value.setdefault(float(stated[term][j]), []).append(j + 1)
+            values = ", ".join(f"{v:g} on J{', J'.join(map(str, js))}" for v, js in by_value.items())
+            parts.append(f"{attribute} {values}")
+    if not parts:
+        return ()
+    return (f"{source}: {urdf.name}'s <dynamics> state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE}",)
 
 
 def _limits(rows, where, urdf_lim) -> dict:

@@ -116,6 +116,9 @@ class Robot:
         linear in ``fc``), or ``sign(dq)`` where ``v_s = 0`` (default). See :mod:`dynid.friction`.
     stribeck_velocity : (n_dof,) array [rad/s]
         Stribeck velocity of the ``fst`` term (default :data:`dynid.friction.DEFAULT_STRIBECK_VELOCITY`).
+    nominal_notes : tuple of str
+        What the description states that dynid does not take as nominal values (one line each): a URDF's
+        ``<dynamics>`` damping and friction.
     held : tuple of str
         Joints of the robot's URDF held fixed, not identified (a gripper's fingers): their links count with the link
         they are held to, as a fixed joint's do (:func:`dynid.model.urdf.joints_from_urdf`).
@@ -138,6 +141,7 @@ class Robot:
     coulomb_velocity: np.ndarray = None  # type: ignore[assignment]
     nominal_problems: tuple[str, ...] = ()
     held: tuple[str, ...] = ()
+    nominal_notes: tuple[str, ...] = ()
     stribeck_velocity: np.ndarray = None  # type: ignore[assignment]
 
     @property
@@ -373,6 +377,7 @@ class Robot:
             transmission=self.transmission.subset(k),
             drive_mask=self.drive_mask[:k].copy(),
             nominal_problems=self.nominal_problems,
+            nominal_notes=self.nominal_notes,
         )
 
 

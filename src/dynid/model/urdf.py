@@ -309,6 +309,27 @@ def urdf_limits(path: str | Path, held=None) -> dict:
     return {k: np.array(v) for k, v in out.items()}
 
 
+def urdf_friction(path: str | Path, held=None) -> dict:
+    """Each revolute joint's friction as its URDF's ``<dynamics>`` states it (Pinocchio's reading).
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joints held fixed (:func:`joints_from_urdf`): not among the joints.
+
+    Returns
+    -------
+    dict
+        ``fv``: the ``damping`` (viscous friction) [N·m·s/rad]; ``fc``: the ``friction`` (Coulomb friction) [N·m];
+        each (n_dof,), 0 where the URDF gives none.
+    """
+    with _silenced_stderr([]):
+        model = _pinocchio_model(Path(path), dict(held or {}))
+    v = [model.joints[j].idx_v for j in range(1, model.njoints)]
+    return {"fv": np.array([float(model.damping[i]) for i in v]), "fc": np.array([float(model.friction[i]) for i in v])}
+
+
 def is_xacro(path: str | Path) -> bool:
     """Whether a robot file is a xacro file (``arm.xacro``, ``arm.urdf.xacro``).
 
