@@ -273,9 +273,9 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     if convention == "urdf":
         assert urdf_model is not None
         joints, inertial, _, links = urdf_model
-        from .urdf import urdf_limits
+        from .urdf import urdf_joint_values
 
-        urdf_lim = urdf_limits(upath, held)
+        urdf_lim = urdf_joint_values(upath, held)
         if len(joints) != n:
             raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
         inertial = _merged_inertials(rows, where, inertial, upath)
@@ -293,7 +293,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
 
     terms, mask, drive = _drive_terms(rows, where, terms, source)
-    stated = _urdf_friction(rows, terms, upath, held, source) if convention == "urdf" else ()
+    stated = () if urdf_lim is None else _urdf_friction(rows, terms, urdf_lim, upath.name, source)
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(d.transmission, n, offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
@@ -393,25 +393,23 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
     return terms, mask, drive
 
 
-def _urdf_friction(rows, terms: tuple, urdf: Path, held: dict, source: str) -> tuple[str, ...]:
-    """A line naming the joints whose URDF ``<dynamics>`` states a damping or friction that no ``[[joints]]`` table's
-    ``fv``/``fc`` gives: they are not taken as nominal friction (see :data:`URDF_DYNAMICS_NOTE`); none where the URDF
-    states only zeros (most vendor files) or the robot has neither term."""
-    from .urdf import urdf_friction
-
-    stated = urdf_friction(urdf, held)
+def _urdf_friction(rows, terms: tuple, stated: dict, urdf: str, source: str) -> tuple[str, ...]:
+    """A line naming the joints whose URDF ``<dynamics>`` (``stated``: :func:`dynid.model.urdf.urdf_joint_values`)
+    states a damping or friction that no ``[[joints]]`` table's ``fv``/``fc`` gives: they are not taken as nominal
+    friction (:data:`URDF_DYNAMICS_NOTE`); none where the URDF states only zeros (most vendor files) or the robot has
+    neither term."""
     parts = []
     for term, attribute in (("fv", "damping"), ("fc", "friction")):
-        joints = [j for j, r in enumerate(rows) if stated[term][j] != 0 and getattr(r, term) is None]
+        joints = [j for j, r in enumerate(rows) if stated[attribute][j] != 0 and getattr(r, term) is None]
         if term in terms and joints:
             by_value: dict[float, list[int]] = {}
             for j in joints:
-                by_value.setdefault(float(stated[term][j]), []).append(j + 1)
+                by_value.setdefault(float(stated[attribute][j]), []).append(j + 1)
             values = ", ".join(f"{v:g} on J{', J'.join(map(str, js))}" for v, js in by_value.items())
             parts.append(f"{attribute} {values}")
     if not parts:
         return ()
-    return (f"{source}: {urdf.name}'s <dynamics> state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE}",)
+    return (f"{source}: {urdf}'s <dynamics> state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE}",)
 
 
 def _limits(rows, where, urdf_lim) -> dict:

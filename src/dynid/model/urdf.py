@@ -273,8 +273,9 @@ def _mimic_joints(path: Path) -> set[str]:
     return out
 
 
-def urdf_limits(path: str | Path, held=None) -> dict:
-    """Each revolute joint's limits in a URDF (Pinocchio's reading).
+def urdf_joint_values(path: str | Path, held=None) -> dict:
+    """What a URDF states of each revolute joint beside the chain: its limits and its ``<dynamics>`` (Pinocchio's
+    reading).
 
     Parameters
     ----------
@@ -285,12 +286,14 @@ def urdf_limits(path: str | Path, held=None) -> dict:
     Returns
     -------
     dict
-        ``q_min, q_max`` [rad], ``dq_max`` [rad/s], ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none), each
-        (n_dof,); a limit the URDF leaves out (or 0) is ``±inf``.
+        ``q_min, q_max`` [rad], ``dq_max`` [rad/s], ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none): a limit
+        the URDF leaves out (or 0) is ``±inf``; ``damping`` (viscous friction) [N·m·s/rad] and ``friction``
+        (Coulomb friction) [N·m]: 0 where the URDF gives none. Each (n_dof,).
     """
     with _silenced_stderr([]):
         model = _pinocchio_model(Path(path), dict(held or {}))
-    out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")}
+    out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max", "damping",
+                                                   "friction")}
     for j in range(1, model.njoints):
         i, nv = model.joints[j].idx_q, model.joints[j].nq
         if nv == 2:  # continuous (cos, sin): no position limit
@@ -306,28 +309,9 @@ def urdf_limits(path: str | Path, held=None) -> dict:
         out["dq_max"].append(vel if 0 < vel < 1e10 else np.inf)
         out["tau_max"].append(eff if 0 < eff < 1e10 else np.inf)
         out["ddq_max"].append(np.inf)
+        out["damping"].append(float(model.damping[v]))
+        out["friction"].append(float(model.friction[v]))
     return {k: np.array(v) for k, v in out.items()}
-
-
-def urdf_friction(path: str | Path, held=None) -> dict:
-    """Each revolute joint's friction as its URDF's ``<dynamics>`` states it (Pinocchio's reading).
-
-    Parameters
-    ----------
-    path : str or Path
-    held : dict, optional
-        Joints held fixed (:func:`joints_from_urdf`): not among the joints.
-
-    Returns
-    -------
-    dict
-        ``fv``: the ``damping`` (viscous friction) [N·m·s/rad]; ``fc``: the ``friction`` (Coulomb friction) [N·m];
-        each (n_dof,), 0 where the URDF gives none.
-    """
-    with _silenced_stderr([]):
-        model = _pinocchio_model(Path(path), dict(held or {}))
-    v = [model.joints[j].idx_v for j in range(1, model.njoints)]
-    return {"fv": np.array([float(model.damping[i]) for i in v]), "fc": np.array([float(model.friction[i]) for i in v])}
 
 
 def is_xacro(path: str | Path) -> bool:
