@@ -4,6 +4,7 @@ parameters back from the attributes of the same names, ``set_params`` sets them 
 from __future__ import annotations
 
 import inspect
+from typing import Self
 
 
 class HyperParameters:
@@ -31,7 +32,7 @@ class HyperParameters:
         parameters = list(inspect.signature(type(self).__init__).parameters.values())[1:]  # not ``self``
         return {p.name: getattr(self, p.name) for p in parameters if p.kind in self.PARAMETER_KINDS}
 
-    def set_params(self, **params):
+    def set_params(self, **params) -> Self:
         """Set constructor parameters by name.
 
         Parameters
