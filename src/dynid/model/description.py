@@ -147,8 +147,8 @@ def parse_angle(value, where: str) -> float:
 
 
 URDF_DYNAMICS_NOTE = ("not taken as the nominal viscous and Coulomb friction, which stay 0 (a URDF's <dynamics> "
-                      "often holds a simulator's setting, not the robot's friction); to take "
-                      "them, give fv = and fc = in the joints' [[joints]] tables of a robot description")
+                      "often holds a simulator's setting, not the robot's friction); to take them, give fv = and "
+                      "fc = in the joints' [[robot.joints]] tables (a robot description's [[joints]])")
 """What dynid says of the friction a URDF's ``<dynamics>`` states (:func:`robot_from_document`)."""
 
 URDF_DRIVE_TERMS = ("Ia", "fc", "fv", "offset")
