@@ -141,14 +141,14 @@ def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_p
     robot = load_robot(_description(tmp_path, text))
     fc, fv = robot.drive_terms.index("fc"), robot.drive_terms.index("fv")
     assert not np.any(robot.drive[:, [fc, fv]])
-    assert robot.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state damping 0.5 on J2; friction "
-                                   f"1.25 on J2: {URDF_DYNAMICS_NOTE}",)
+    assert robot.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state damping 0.5 (J2); friction "
+                                   f"1.25 (J2): {URDF_DYNAMICS_NOTE.format(keys='fv = and fc =')}",)
     assert not robot.nominal_problems
 
     given = load_robot(_description(tmp_path, text, "fv = 0.7\n"))
     assert (given.drive[1, fv], given.drive[1, fc]) == (0.7, 0.0)
-    assert given.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state friction 1.25 on J2: "
-                                   f"{URDF_DYNAMICS_NOTE}",)
+    assert given.nominal_notes == (f"{tmp_path / 'arm.toml'}: arm.urdf's <dynamics> state friction 1.25 (J2): "
+                                   f"{URDF_DYNAMICS_NOTE.format(keys='fc =')}",)
 
     plain = load_robot(_description(tmp_path, (ROBOTS / "ur10e.urdf").read_text()))
     assert not np.any(plain.drive[:, [fc, fv]]) and plain.nominal_notes == ()

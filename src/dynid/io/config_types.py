@@ -190,7 +190,7 @@ class ControllerTable(Table, kw_only=True):
 class IdentificationDocument(Table, kw_only=True):
     """A config of ``dynid identify`` and ``dynid validate`` (:mod:`dynid.io.identification_config`)."""
 
-    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML or URDF, or a table")]
+    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML, URDF or MuJoCo MJCF, or a table")]
     mjcf_model: Annotated[str, _d("your own MuJoCo model of the arm (MJCF), relative to this file: identify and export "
                                   "write the identified values into a copy of it")] | None = None
     data_root: Annotated[str, _d("folder of the data files, relative to this file")] | None = None
@@ -307,7 +307,7 @@ class ExcitationTable(Table, kw_only=True):
 class ExcitationDocument(Table, kw_only=True):
     """A config of ``dynid excite`` (:mod:`dynid.io.excitation_config`)."""
 
-    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML or URDF, or a table")]
+    robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML, URDF or MuJoCo MJCF, or a table")]
     joints: Annotated[int, Meta(ge=1, description="identify the first joints (default all)")] | None = None
     name: Annotated[str, _d("the config's name")] | None = None
     notes: Annotated[str, _d("free text")] | None = None

@@ -115,7 +115,7 @@ def config_robot(doc: dict, path: Path, data_root: Path | None = None) -> Robot:
     local = None if ref in builtin_robots() else _located(ref, path.parent, data_root)  # relative to the config, else
     if local is not None:                                                               # to the data root
         return load_robot(local)
-    if Path(ref).suffix.lower() in (".urdf", ".xacro", ".toml") and not Path(ref).is_file():
+    if Path(ref).suffix.lower() in (".urdf", ".xacro", ".toml", ".xml", ".mjcf") and not Path(ref).is_file():
         raise ConfigError(_not_found(path, "robot", ref, data_root), field="robot")
     try:
         return load_robot(ref)
@@ -139,12 +139,14 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     -------
     Path or None
         ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
-        ``convention = "urdf"``; None for a built-in robot or a DH description.
+        ``convention = "urdf"``; None for a built-in robot, a DH description or a MuJoCo model (MJCF).
     """
-    from ..model.urdf import expand_xacro, is_xacro
+    from ..model.urdf import expand_xacro, is_mjcf, is_xacro
 
-    def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to
-        return expand_xacro(file) if file is not None and is_xacro(file) else file
+    def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to; an MJCF is no URDF
+        if file is None or is_mjcf(file):
+            return None
+        return expand_xacro(file) if is_xacro(file) else file
 
     ref = doc.get("robot")
     if isinstance(ref, dict):

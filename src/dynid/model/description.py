@@ -104,15 +104,15 @@ def load_robot(name_or_path: str | Path) -> Robot:
         res = resources.files("dynid.model") / "robots" / f"{text}.toml"
         return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=Path(str(res)).parent)
     path = Path(text)
-    if path.suffix == ".urdf" and path.is_file():
-        return robot_from_urdf(path)
-    from .urdf import expand_xacro, is_xacro
+    from .urdf import expand_xacro, is_mjcf, is_xacro
 
+    if (path.suffix == ".urdf" or is_mjcf(path)) and path.is_file():
+        return robot_from_urdf(path)
     if is_xacro(path) and path.is_file():
         return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0])
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
-                          "description file, a .urdf or a .xacro file")
+                          "description file, a .urdf, a .xacro or a MuJoCo .xml file")
     return robot_from_toml_text(path.read_text(encoding="utf-8"), source=str(path), base=path.parent)
 
 
@@ -146,10 +146,11 @@ def parse_angle(value, where: str) -> float:
     raise ConfigError(f"{where}: expected a number or an angle like 'pi/2', got {value!r}")
 
 
-URDF_DYNAMICS_NOTE = ("not taken as the nominal viscous and Coulomb friction, which stay 0 (a URDF's <dynamics> "
-                      "often holds a simulator's setting, not the robot's friction); to take them, give fv = and "
-                      "fc = in the joints' [[robot.joints]] tables (a robot description's [[joints]])")
-"""What dynid says of the friction a URDF's ``<dynamics>`` states (:func:`robot_from_document`)."""
+URDF_DYNAMICS_NOTE = ("not taken as nominal values, which stay 0 (a robot file's joint friction and armature often "
+                      "hold a simulator's setting, not the robot's); to take them, give {keys} in the joints' "
+                      "[[robot.joints]] tables (a robot description's [[joints]])")
+"""What dynid says of the drive terms a URDF's ``<dynamics>`` or an MJCF's joints state (:func:`robot_from_document`);
+``{keys}`` is filled with the terms' fields."""
 
 URDF_DRIVE_TERMS = ("Ia", "fc", "fv", "offset")
 """Drive terms of a robot given by its URDF alone: what a geared arm with current or torque sensing needs."""
@@ -394,22 +395,25 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
 
 
 def _urdf_friction(rows, terms: tuple, stated: dict, urdf: str, source: str) -> tuple[str, ...]:
-    """A line naming the joints whose URDF ``<dynamics>`` (``stated``: :func:`dynid.model.urdf.urdf_joint_values`)
-    states a damping or friction that no ``[[joints]]`` table's ``fv``/``fc`` gives: they are not taken as nominal
-    friction (:data:`URDF_DYNAMICS_NOTE`); none where the URDF states only zeros (most vendor files) or the robot has
-    neither term."""
-    parts = []
-    for term, attribute in (("fv", "damping"), ("fc", "friction")):
-        joints = [j for j, r in enumerate(rows) if stated[attribute][j] != 0 and getattr(r, term) is None]
+    """A line naming the joints whose URDF ``<dynamics>`` or MJCF joint (``stated``:
+    :func:`dynid.model.urdf.urdf_joint_values`) states a rotor inertia, damping or friction that no ``[[joints]]``
+    table's ``Ia``/``fv``/``fc`` gives: they are not taken as nominal values (:data:`URDF_DYNAMICS_NOTE`); none where
+    the file states only zeros (most vendor files) or the robot has none of those terms."""
+    mjcf = not urdf.lower().endswith(".urdf")
+    parts, keys = [], []
+    for term, value, attribute in (("Ia", "armature", "armature"), ("fv", "damping", "damping"),
+                                   ("fc", "friction", "frictionloss" if mjcf else "friction")):
+        joints = [j for j, r in enumerate(rows) if stated[value][j] != 0 and getattr(r, term) is None]
         if term in terms and joints:
             by_value: dict[float, list[int]] = {}
             for j in joints:
-                by_value.setdefault(float(stated[attribute][j]), []).append(j + 1)
-            values = ", ".join(f"{v:g} on J{', J'.join(map(str, js))}" for v, js in by_value.items())
-            parts.append(f"{attribute} {values}")
+                by_value.setdefault(float(stated[value][j]), []).append(j + 1)
+            parts.append(f"{attribute} " + ", ".join(f"{v:g} (J{', J'.join(map(str, js))})" for v, js in by_value.items()))
+            keys.append(f"{term} =")
     if not parts:
         return ()
-    return (f"{source}: {urdf}'s <dynamics> state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE}",)
+    where = f"{urdf}'s joints" if mjcf else f"{urdf}'s <dynamics>"
+    return (f"{source}: {where} state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE.format(keys=' and '.join(keys))}",)
 
 
 def _limits(rows, where, urdf_lim) -> dict:

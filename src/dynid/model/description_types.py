@@ -89,7 +89,7 @@ def _types(terms: tuple[str, ...]) -> tuple[type, type]:
         ("name", Union[Annotated[str, Meta(description="the robot's name")], None], None),
         ("convention", Union[Annotated[Literal["modified", "standard", "urdf"],
                                        Meta(description="DH convention of [[joints]] (Khalil's modified by default), or urdf")], None], None),
-        ("urdf", Union[Annotated[str, Meta(description="with convention = 'urdf': the URDF file, relative to this file")], None], None),
+        ("urdf", Union[Annotated[str, Meta(description="with convention = 'urdf': the URDF file (or a MuJoCo MJCF), relative to this file")], None], None),
         ("held", Union[Annotated[Union[list[str], dict[str, float]], Meta(
             description="joints of the URDF held fixed, not identified (a gripper's fingers, mimic joints): a list of "
                         "names (held at 0) or a table name = position (rad or m); their links count with the link "

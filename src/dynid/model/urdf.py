@@ -1,10 +1,11 @@
-"""Serial revolute chains from URDF files, parsed by Pinocchio."""
+"""Serial revolute chains from URDF files, and from MuJoCo's MJCF files, parsed by Pinocchio."""
 
 from __future__ import annotations
 
 import contextlib
 import hashlib
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -41,6 +42,9 @@ def check_urdf_text(path: Path, held=()) -> None:
     ------
     ConfigError
     """
+    if is_mjcf(path):  # MuJoCo's own format: only that it is XML is checked here (Pinocchio reads the rest)
+        _check_xml(path)
+        return
     parser = expat.ParserCreate()
     problems = []
     joint: list = []  # the joint element being read (name, type)
@@ -71,13 +75,38 @@ def check_urdf_text(path: Path, held=()) -> None:
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
+    _check_xml(path, parser)
+    if problems:
+        raise ConfigError(f"{path}: {problems[0]}")
+
+
+def _check_xml(path: Path, parser=None) -> None:
+    """Refuse a file that is not well-formed XML, naming the line and column."""
+    parser = parser or expat.ParserCreate()
     try:
         parser.Parse(path.read_bytes(), True)
     except expat.ExpatError as exc:
         raise ConfigError(f"{path}: line {exc.lineno}, column {exc.offset + 1}: malformed XML "
                           f"({expat.ErrorString(exc.code)})") from None
-    if problems:
-        raise ConfigError(f"{path}: {problems[0]}")
+
+
+def is_mjcf(path: str | Path) -> bool:
+    """Whether a robot file is a MuJoCo model (MJCF): a ``.xml`` or ``.mjcf`` file whose root element is ``<mujoco>``.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    bool
+    """
+    path = Path(path)
+    if path.suffix.lower() not in (".xml", ".mjcf") or not path.is_file():
+        return False
+    with open(path, "rb") as f:
+        head = f.read(4096)
+    return re.search(rb"<mujoco[\s>]", re.sub(rb"<!--.*?-->", b"", head, flags=re.S)) is not None
 
 
 @contextlib.contextmanager
@@ -202,12 +231,13 @@ def _pinocchio_model(path: Path, held: dict):
     import pinocchio as pin
 
     printed: list[str] = []
+    mjcf = is_mjcf(path)
     try:
         with _silenced_stderr(printed):
-            model = pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromMJCF(str(path)) if mjcf else pin.buildModelFromUrdf(str(path))
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError; urdfdom prints its reason
         reason = printed[0] if printed else (str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
-        raise ConfigError(f"{path}: cannot parse URDF ({' '.join(reason.split())})") from None
+        raise ConfigError(f"{path}: cannot parse {'MJCF' if mjcf else 'URDF'} ({' '.join(reason.split())})") from None
     if not held:
         return model
     q = pin.neutral(model)
@@ -254,7 +284,9 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
 
 
 def _mimic_joints(path: Path) -> set[str]:
-    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first)."""
+    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first); none in an MJCF."""
+    if is_mjcf(path):
+        return set()
     parser = expat.ParserCreate()
     joint: list[str] = []
     out: set[str] = set()
@@ -287,13 +319,14 @@ def urdf_joint_values(path: str | Path, held=None) -> dict:
     -------
     dict
         ``q_min, q_max`` [rad], ``dq_max`` [rad/s], ``tau_max`` [N·m], ``ddq_max`` (inf: a URDF has none): a limit
-        the URDF leaves out (or 0) is ``±inf``; ``damping`` (viscous friction) [N·m·s/rad] and ``friction``
-        (Coulomb friction) [N·m]: 0 where the URDF gives none. Each (n_dof,).
+        the URDF leaves out (or 0) is ``±inf``; ``armature`` (rotor inertia, an MJCF's) [kg·m²], ``damping``
+        (viscous friction) [N·m·s/rad] and ``friction`` (Coulomb friction: a URDF's ``friction``, an MJCF's
+        ``frictionloss``) [N·m]: 0 where the file gives none. Each (n_dof,).
     """
     with _silenced_stderr([]):
         model = _pinocchio_model(Path(path), dict(held or {}))
-    out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max", "damping",
-                                                   "friction")}
+    out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max", "armature",
+                                                   "damping", "friction")}
     for j in range(1, model.njoints):
         i, nv = model.joints[j].idx_q, model.joints[j].nq
         if nv == 2:  # continuous (cos, sin): no position limit
@@ -309,6 +342,7 @@ def urdf_joint_values(path: str | Path, held=None) -> dict:
         out["dq_max"].append(vel if 0 < vel < 1e10 else np.inf)
         out["tau_max"].append(eff if 0 < eff < 1e10 else np.inf)
         out["ddq_max"].append(np.inf)
+        out["armature"].append(float(model.armature[v]))
         out["damping"].append(float(model.damping[v]))
         out["friction"].append(float(model.friction[v]))
     return {k: np.array(v) for k, v in out.items()}

@@ -1,0 +1,102 @@
+"""A MuJoCo model (MJCF) as the robot's description: the chain, inertias and limits as MuJoCo computes them (read by
+Pinocchio's MJCF parser), checked against MuJoCo's own inverse dynamics; what its joints state of the drives
+(armature, damping, frictionloss) is said, not taken, as a URDF's <dynamics> is."""
+
+import re
+from dataclasses import replace
+from importlib import resources
+
+import mujoco
+import numpy as np
+import pytest
+
+from dynid.dynamics.regressor import regressor
+from dynid.exceptions import ConfigError
+from dynid.io.configs import config_robot, config_urdf
+from dynid.io.export import mjcf_from_robot
+from dynid.model.description import URDF_DYNAMICS_NOTE, load_robot
+
+ROBOTS = resources.files("dynid.model") / "robots"
+
+
+def _mujoco_written(tmp_path, name: str) -> str:
+    """A robot's model as MuJoCo reads it, saved by MuJoCo as MJCF (its frames, quaternions and inertias as MuJoCo
+    writes them): the built-in UR10e's URDF (meshes left out), or dynid's MJCF export of a DH robot."""
+    if (ROBOTS / f"{name}.urdf").is_file():
+        text = re.sub(r"<(visual|collision)>.*?</\1>", "", (ROBOTS / f"{name}.urdf").read_text(), flags=re.S)
+        source = tmp_path / "arm.urdf"
+    else:
+        robot = load_robot(name)
+        text, source = mjcf_from_robot(robot, robot.standard_parameters()), tmp_path / "dynid.xml"
+    source.write_text(text)
+    model = mujoco.MjModel.from_xml_path(str(source))
+    path = tmp_path / "arm.xml"
+    mujoco.mj_saveLastXML(str(path), model)
+    return str(path)
+
+
+@pytest.mark.parametrize("name", ["ur10e", "er16"])
+def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
+    """dynid's regressor times the MJCF robot's nominal parameters equals MuJoCo's recursive Newton-Euler (mj_rne,
+    gravity included) on the same file, at random states."""
+    path = _mujoco_written(tmp_path, name)
+    robot = load_robot(path)
+    model = mujoco.MjModel.from_xml_path(path)
+    data = mujoco.MjData(model)
+    assert robot.n_dof == model.nv
+    q, dq, ddq = (rng.uniform(-1.5, 1.5, (20, robot.n_dof)) for _ in range(3))
+    predicted = np.einsum("njp,p->nj", regressor(robot, q, dq, ddq), robot.standard_parameters())
+    expected = np.empty_like(predicted)
+    for k in range(q.shape[0]):
+        data.qpos[:], data.qvel[:] = q[k], dq[k]
+        mujoco.mj_forward(model, data)
+        data.qacc[:] = ddq[k]
+        mujoco.mj_rne(model, data, 1, expected[k])
+    np.testing.assert_allclose(predicted, expected, atol=1e-9 * np.abs(expected).max())
+    assert np.all(np.isfinite(robot.limits.q_min))  # the joints' ranges
+    assert (robot.nominal_notes == ()) == (name == "ur10e")  # the UR10e's URDF states no friction; the ER-16's export does
+
+
+def test_what_an_mjcfs_joints_state_of_the_drives_is_said_not_taken(tmp_path):
+    """dynid's own MJCF export writes each joint's rotor inertia, viscous and Coulomb friction as armature, damping
+    and frictionloss: read back, those are named joint by joint, the nominal values staying 0 as for a URDF."""
+    robot = load_robot("ur10e")
+    drive = np.zeros_like(robot.drive)
+    drive[:, [robot.drive_terms.index(t) for t in ("Ia", "fv", "fc")]] = [[0.5, 2.0, 3.0]] * 3 + [[0.25, 1.0, 1.5]] * 3
+    robot = replace(robot, drive=drive)
+    path = tmp_path / "ur10e.xml"
+    path.write_text(mjcf_from_robot(robot, robot.standard_parameters()))
+    back = load_robot(path)
+    assert not np.any(back.drive)
+    assert back.nominal_notes == (f"{path}: ur10e.xml's joints state armature 0.5 (J1, J2, J3), 0.25 (J4, J5, J6); "
+                                  "damping 2 (J1, J2, J3), 1 (J4, J5, J6); frictionloss 3 (J1, J2, J3), 1.5 (J4, J5, J6): "
+                                  + URDF_DYNAMICS_NOTE.format(keys="Ia = and fv = and fc ="),)
+    np.testing.assert_allclose(back.standard_parameters(), replace(robot, drive=np.zeros_like(drive)).standard_parameters(),
+                               atol=1e-12)
+
+
+def test_a_config_names_an_mjcf_as_its_robot(tmp_path):
+    """robot = "arm.xml" in a config, relative to it, as a URDF is, or a [robot] table's file; the identified URDF is
+    then written anew, not into the MJCF (identify failed at its end before: "has no joint ..."); a missing file names
+    the field and the folders."""
+    _mujoco_written(tmp_path, "ur10e")
+    for doc in ({"robot": "arm.xml"}, {"robot": {"urdf": "arm.xml", "drive_terms": ["fc", "fv"]}}):
+        assert config_robot(doc, tmp_path / "c.toml").n_dof == 6
+        assert config_urdf(doc, tmp_path / "c.toml") is None
+    assert config_urdf({"robot": {"urdf": "arm.urdf"}}, tmp_path / "c.toml") == tmp_path / "arm.urdf"
+    with pytest.raises(ConfigError, match=r"c.toml: robot: file 'nope.xml' not found in"):
+        config_robot({"robot": "nope.xml"}, tmp_path / "c.toml")
+
+
+@pytest.mark.parametrize("body, message", [
+    ('<mujoco><worldbody><body name="a"><joint name="j1" type="hinge"/></worldbody></mujoco>',
+     r"arm.xml: line 1, column \d+: malformed XML \(mismatched tag\)"),
+    ('<mujoco><worldbody><body name="a"><joint name="j1" type="slide" axis="0 0 1"/>'
+     '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></worldbody></mujoco>',
+     r"arm.xml: joint 'j1' is JointModelPZ, expected a revolute joint"),
+])
+def test_an_mjcf_dynid_cannot_model_is_one_line(tmp_path, body, message):
+    (tmp_path / "arm.xml").write_text(body)
+    with pytest.raises(ConfigError, match=message) as caught:
+        load_robot(tmp_path / "arm.xml")
+    assert "\n" not in str(caught.value)
