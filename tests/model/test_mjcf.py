@@ -1,6 +1,6 @@
-"""A MuJoCo model (MJCF) as the robot's description: the chain, inertias and limits as MuJoCo computes them (read by
-Pinocchio's MJCF parser), checked against MuJoCo's own inverse dynamics; what its joints state of the drives
-(armature, damping, frictionloss) is said, not taken, as a URDF's <dynamics> is."""
+"""A MuJoCo model (MJCF) as the robot's description: the chain, inertias and limits as MuJoCo compiles them, checked
+against MuJoCo's own inverse dynamics (an independent Newton-Euler pass over the same compiled model); what its joints
+state of the drives (armature, damping, frictionloss) is said, not taken, as a URDF's <dynamics> is."""
 
 import re
 from dataclasses import replace
@@ -19,9 +19,35 @@ from dynid.model.description import URDF_DYNAMICS_NOTE, load_robot
 ROBOTS = resources.files("dynid.model") / "robots"
 
 
+HAND_WRITTEN = """<mujoco model="hand">
+  <default><joint damping="0.5"/></default>
+  <worldbody>
+    <body name="l1" pos="0 0 0.1" euler="0 0 30">
+      <joint name="j1" axis="0 0 1" range="-90 90"/>
+      <inertial pos="0.05 0 0" mass="2" diaginertia="0.01 0.02 0.03" euler="10 20 0"/>
+      <body name="l2" pos="0.3 0 0" axisangle="1 0.5 0 60">
+        <joint name="j2" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03" mass="1.5"/>
+        <body name="l3" pos="0.3 0 0" quat="0.9238795 0 0.3826834 0">
+          <joint name="j3" axis="1 0 0" pos="0.02 0 0"/>
+          <inertial pos="0.1 0.01 0" mass="1" fullinertia="0.01 0.012 0.013 0.001 0 0"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+"""An MJCF as people write them: a default class, angles in degrees (MuJoCo's default unit), euler, axis-angle and
+quaternion frames, an inertia from a geom, a joint away from its body's origin."""
+
+
 def _mujoco_written(tmp_path, name: str) -> str:
     """A robot's model as MuJoCo reads it, saved by MuJoCo as MJCF (its frames, quaternions and inertias as MuJoCo
-    writes them): the built-in UR10e's URDF (meshes left out), or dynid's MJCF export of a DH robot."""
+    writes them): the built-in UR10e's URDF (meshes left out), or dynid's MJCF export of a DH robot; ``"hand"`` is
+    :data:`HAND_WRITTEN` as it is."""
+    if name == "hand":
+        (tmp_path / "arm.xml").write_text(HAND_WRITTEN)
+        return str(tmp_path / "arm.xml")
     if (ROBOTS / f"{name}.urdf").is_file():
         text = re.sub(r"<(visual|collision)>.*?</\1>", "", (ROBOTS / f"{name}.urdf").read_text(), flags=re.S)
         source = tmp_path / "arm.urdf"
@@ -35,7 +61,7 @@ def _mujoco_written(tmp_path, name: str) -> str:
     return str(path)
 
 
-@pytest.mark.parametrize("name", ["ur10e", "er16"])
+@pytest.mark.parametrize("name", ["ur10e", "er16", "hand"])
 def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
     """dynid's regressor times the MJCF robot's nominal parameters equals MuJoCo's recursive Newton-Euler (mj_rne,
     gravity included) on the same file, at random states."""
@@ -53,8 +79,8 @@ def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
         data.qacc[:] = ddq[k]
         mujoco.mj_rne(model, data, 1, expected[k])
     np.testing.assert_allclose(predicted, expected, atol=1e-9 * np.abs(expected).max())
-    assert np.all(np.isfinite(robot.limits.q_min))  # the joints' ranges
-    assert (robot.nominal_notes == ()) == (name == "ur10e")  # the UR10e's URDF states no friction; the ER-16's export does
+    assert np.isfinite(robot.limits.q_min[0]) and (name == "hand") != np.all(np.isfinite(robot.limits.q_min))  # ranges
+    assert (robot.nominal_notes == ()) == (name == "ur10e")  # the UR10e's URDF states no friction, the others do
 
 
 def test_what_an_mjcfs_joints_state_of_the_drives_is_said_not_taken(tmp_path):
@@ -93,10 +119,45 @@ def test_a_config_names_an_mjcf_as_its_robot(tmp_path):
      r"arm.xml: line 1, column \d+: malformed XML \(mismatched tag\)"),
     ('<mujoco><worldbody><body name="a"><joint name="j1" type="slide" axis="0 0 1"/>'
      '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></worldbody></mujoco>',
-     r"arm.xml: joint 'j1' is JointModelPZ, expected a revolute joint"),
+     r"arm.xml: joint 'j1' is a slide joint, expected a hinge \(revolute joint\); hold it fixed with held = \[\"j1\"\]"),
 ])
 def test_an_mjcf_dynid_cannot_model_is_one_line(tmp_path, body, message):
     (tmp_path / "arm.xml").write_text(body)
     with pytest.raises(ConfigError, match=message) as caught:
         load_robot(tmp_path / "arm.xml")
     assert "\n" not in str(caught.value)
+
+
+def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tmp_path):
+    """Two finger bodies on slide joints after the arm: refused naming the first, found by dynid init's helper, and
+    held fixed through a [robot] table; their masses then belong to the last link (as a URDF's held joints do)."""
+    from dynid.model.urdf import joints_to_hold
+
+    fingers = ('<body name="f1" pos="0.2 0 0"><joint name="finger1" type="slide" axis="0 1 0"/>'
+               '<inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>'
+               '<body name="f2" pos="0.2 0 0"><joint name="finger2" type="slide" axis="0 -1 0"/>'
+               '<inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>')
+    text = HAND_WRITTEN.replace('fullinertia="0.01 0.012 0.013 0.001 0 0"/>',
+                                'fullinertia="0.01 0.012 0.013 0.001 0 0"/>' + fingers)
+    (tmp_path / "arm.xml").write_text(text)
+    with pytest.raises(ConfigError, match=r"joint 'finger1' is a slide joint"):
+        load_robot(tmp_path / "arm.xml")
+    assert joints_to_hold(tmp_path / "arm.xml") == ("finger1", "finger2")
+    robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["finger1", "finger2"]}}, tmp_path / "c.toml")
+    (tmp_path / "bare.xml").write_text(HAND_WRITTEN)
+    bare = load_robot(tmp_path / "bare.xml")
+    assert robot.n_dof == 3 and robot.inertial[2, 9] == pytest.approx(bare.inertial[2, 9] + 0.2, abs=1e-12)
+    assert robot.held == ("finger1", "finger2")
+
+
+@pytest.mark.parametrize("change, message", [
+    (('<joint name="j3" axis="1 0 0" pos="0.02 0 0"/>', '<joint name="j3" axis="1 0 0" pos="0.02 0 0" ref="10"/>'),
+     r"joint 'j3' has ref = 0.1745"),
+    (('<body name="l3"', '<body name="side" pos="0 0.1 0"><joint name="jb" axis="0 0 1"/>'
+      '<inertial pos="0 0 0" mass="0.5" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l3"'),
+     r"joint 'j3' does not continue a serial chain"),
+])
+def test_an_mjcf_chain_dynid_cannot_identify_is_refused_naming_the_joint(tmp_path, change, message):
+    (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace(*change))
+    with pytest.raises(ConfigError, match=message):
+        load_robot(tmp_path / "arm.xml")

@@ -1,4 +1,4 @@
-"""Serial revolute chains from URDF files, and from MuJoCo's MJCF files, parsed by Pinocchio."""
+"""Serial revolute chains from URDF files, parsed by Pinocchio (a MuJoCo model, MJCF: :mod:`dynid.model.mjcf`)."""
 
 from __future__ import annotations
 
@@ -42,9 +42,6 @@ def check_urdf_text(path: Path, held=()) -> None:
     ------
     ConfigError
     """
-    if is_mjcf(path):  # MuJoCo's own format: only that it is XML is checked here (Pinocchio reads the rest)
-        _check_xml(path)
-        return
     parser = expat.ParserCreate()
     problems = []
     joint: list = []  # the joint element being read (name, type)
@@ -75,13 +72,25 @@ def check_urdf_text(path: Path, held=()) -> None:
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
-    _check_xml(path, parser)
+    check_xml(path, parser)
     if problems:
         raise ConfigError(f"{path}: {problems[0]}")
 
 
-def _check_xml(path: Path, parser=None) -> None:
-    """Refuse a file that is not well-formed XML, naming the line and column."""
+def check_xml(path: Path, parser=None) -> None:
+    """Refuse a file that is not well-formed XML, naming the line and column.
+
+    Parameters
+    ----------
+    path : Path
+    parser : xml.parsers.expat.XMLParserType, optional
+        A parser with handlers set (a new one by default).
+
+    Raises
+    ------
+    ConfigError
+        ``FILE: line L, column C: malformed XML (reason)``.
+    """
     parser = parser or expat.ParserCreate()
     try:
         parser.Parse(path.read_bytes(), True)
@@ -192,6 +201,10 @@ def joints_from_urdf(path: str | Path,
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: URDF file not found")
+    if is_mjcf(path):  # a MuJoCo model: as MuJoCo compiles it
+        from .mjcf import joints_from_mjcf
+
+        return joints_from_mjcf(path, held)
     held = dict(held or {})
     check_urdf_text(path, held)
     model = _pinocchio_model(path, held)
@@ -231,13 +244,12 @@ def _pinocchio_model(path: Path, held: dict):
     import pinocchio as pin
 
     printed: list[str] = []
-    mjcf = is_mjcf(path)
     try:
         with _silenced_stderr(printed):
-            model = pin.buildModelFromMJCF(str(path)) if mjcf else pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromUrdf(str(path))
     except Exception as exc:  # pinocchio raises plain RuntimeError/ValueError; urdfdom prints its reason
         reason = printed[0] if printed else (str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
-        raise ConfigError(f"{path}: cannot parse {'MJCF' if mjcf else 'URDF'} ({' '.join(reason.split())})") from None
+        raise ConfigError(f"{path}: cannot parse URDF ({' '.join(reason.split())})") from None
     if not held:
         return model
     q = pin.neutral(model)
@@ -273,6 +285,10 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
         If the file cannot be parsed.
     """
     path = Path(path)
+    if is_mjcf(path):
+        from .mjcf import mjcf_joints_to_hold
+
+        return mjcf_joints_to_hold(path)
     check_urdf_text(path, held=_mimic_joints(path))
     model = _pinocchio_model(path, {})
     mimic = _mimic_joints(path)
@@ -284,9 +300,7 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
 
 
 def _mimic_joints(path: Path) -> set[str]:
-    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first); none in an MJCF."""
-    if is_mjcf(path):
-        return set()
+    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first)."""
     parser = expat.ParserCreate()
     joint: list[str] = []
     out: set[str] = set()
@@ -323,6 +337,10 @@ def urdf_joint_values(path: str | Path, held=None) -> dict:
         (viscous friction) [N·m·s/rad] and ``friction`` (Coulomb friction: a URDF's ``friction``, an MJCF's
         ``frictionloss``) [N·m]: 0 where the file gives none. Each (n_dof,).
     """
+    if is_mjcf(path):
+        from .mjcf import mjcf_joint_values
+
+        return mjcf_joint_values(path, held)
     with _silenced_stderr([]):
         model = _pinocchio_model(Path(path), dict(held or {}))
     out: dict[str, list[float]] = {k: [] for k in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max", "armature",

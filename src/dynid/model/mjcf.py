@@ -1,0 +1,243 @@
+"""Serial revolute chains from MuJoCo models (MJCF), as MuJoCo compiles them.
+
+MuJoCo (the ``mujoco`` extra) reads the file, so every way MJCF states a frame (``quat``, ``euler`` in any sequence,
+``axisangle`` with an axis of any length, ``xyaxes``, ``zaxis``), angles in degrees or radians, default classes,
+includes and inertias computed from geoms mean what they mean to MuJoCo. From the compiled model: each hinge joint
+is a revolute joint whose frame is its body's frame moved to the joint's ``pos``; bodies without a joint, and joints
+held fixed, count with the link they hang on (as a URDF's fixed joints do); a link's inertial parameters are those
+of all its bodies about its joint frame. Pinocchio's own MJCF parser was not used: it takes an ``axisangle`` axis as
+given where MuJoCo normalises it (a 60° turn about (1, 0.5, 0) put the torques off by 2.3 times their size).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..exceptions import ConfigError
+from ..extras import require
+from .robot import Joint
+from .spatial import inertial_from_physical, rot_axis, transform_inertial
+from .urdf import check_xml
+
+HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (a gripper's fingers)"
+"""What a refusal of a joint dynid cannot identify says to do."""
+
+
+def _compiled(path: Path):
+    """MuJoCo's model of the file (one line naming the file where MuJoCo refuses it)."""
+    mujoco = require("mujoco", "mujoco", f"reading the MuJoCo model {path.name}")
+    check_xml(path)  # with its line and column
+    try:
+        return mujoco, mujoco.MjModel.from_xml_path(str(path))
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{path}: cannot read it as MJCF ({' '.join(str(exc).split())})") from None
+
+
+def _quat_matrix(mujoco, quat) -> np.ndarray:
+    out = np.zeros(9)
+    mujoco.mju_quat2Mat(out, np.asarray(quat, dtype=float))
+    return out.reshape(3, 3)
+
+
+def _chain(path: Path, held: dict):
+    """The compiled model, its moving joints (MuJoCo ids, base to tip) and for each body the moving joint it rides
+    on (-1: the base)."""
+    mujoco, model = _compiled(path)
+    names = [model.joint(k).name for k in range(model.njnt)]
+    unknown = sorted(set(held) - set(names))
+    if unknown:
+        raise ConfigError(f"{path}: held names joint {unknown[0]!r}, which the MJCF's joints do not include "
+                          f"({', '.join(names)})")
+    owner = np.full(model.nbody, -1)  # the moving joint each body rides on
+    moving: list[int] = []
+    for b in range(1, model.nbody):
+        owner[b] = owner[model.body_parentid[b]]
+        for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+            name = names[k] or f"joint {k + 1}"
+            if name in held:
+                continue
+            kind = int(model.jnt_type[k])
+            if kind != mujoco.mjtJoint.mjJNT_HINGE:
+                what = {0: "a free joint (a floating base)", 1: "a ball joint", 2: "a slide joint"}.get(kind, "not a hinge")
+                raise ConfigError(f"{path}: joint {name!r} is {what}, expected a hinge (revolute joint); "
+                                  + HELD_HINT.format(names=f'"{name}"'))
+            if owner[b] >= 0 and body_joint(model, owner[b]) == b:
+                raise ConfigError(f"{path}: body {model.body(b).name!r} has more than one moving joint ({name!r}): "
+                                  "dynid identifies one revolute joint per link; " + HELD_HINT.format(names=f'"{name}"'))
+            previous = moving[-1] if moving else -1
+            if owner[b] != previous:
+                raise ConfigError(f"{path}: joint {name!r} does not continue a serial chain: "
+                                  + HELD_HINT.format(names=f'"{name}"'))
+            if abs(model.qpos0[model.jnt_qposadr[k]]) > 0:
+                raise ConfigError(f"{path}: joint {name!r} has ref = {model.qpos0[model.jnt_qposadr[k]]:g}: dynid's "
+                                  "joint angle is 0 where the body's frame is as written; remove ref (and offset the "
+                                  "log's angles by it) or describe the arm in a URDF")
+            moving.append(k)
+            owner[b] = k
+    if not moving:
+        raise ConfigError(f"{path}: expected at least one hinge joint, found none")
+    return mujoco, model, moving, owner, names
+
+
+def body_joint(model, k: int) -> int:
+    """The body a joint moves.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+    k : int
+        The joint's id.
+
+    Returns
+    -------
+    int
+    """
+    return int(model.jnt_bodyid[k])
+
+
+def _body_in_parent(mujoco, model, b: int, held: dict, names) -> tuple[np.ndarray, np.ndarray]:
+    """Body ``b``'s frame in its parent's, with its held joints turned to their positions."""
+    rotation, translation = _quat_matrix(mujoco, model.body_quat[b]), np.array(model.body_pos[b], dtype=float)
+    for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+        if names[k] in held:  # rotate (hinge) or move (slide) the body about the joint at its held position
+            axis, anchor, value = np.array(model.jnt_axis[k]), np.array(model.jnt_pos[k]), held[names[k]]
+            if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE:
+                translation = translation + rotation @ (axis * value)
+            elif model.jnt_type[k] == mujoco.mjtJoint.mjJNT_HINGE:
+                turn = rot_axis(axis, value)
+                translation = translation + rotation @ (anchor - turn @ anchor)
+                rotation = rotation @ turn
+    return rotation, translation
+
+
+def _frames(mujoco, model, moving, owner, held, names):
+    """Each body's frame in the frame of the moving joint it rides on (its link's), the base's bodies in the world's."""
+    rotations, translations = [np.eye(3)], [np.zeros(3)]
+    joint_of_body = {body_joint(model, k): k for k in moving}
+    for b in range(1, model.nbody):
+        r, t = _body_in_parent(mujoco, model, b, held, names)
+        if b in joint_of_body:  # the link's own frame: the body's, moved to the joint's anchor
+            rotations.append(np.eye(3))
+            translations.append(-np.array(model.jnt_pos[joint_of_body[b]], dtype=float))
+            continue
+        p = model.body_parentid[b]
+        rotations.append(rotations[p] @ r)
+        translations.append(rotations[p] @ t + translations[p])
+    return rotations, translations
+
+
+def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
+    """Joints and link inertial parameters of an MJCF serial chain of hinge joints, as MuJoCo compiles the file.
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joint name -> position [rad or m] at which it is held fixed (its body then counts with its parent's link).
+
+    Returns
+    -------
+    joints : tuple of Joint
+        Placement of each joint frame in the previous link's frame (the base's for the first), its axis in it.
+    inertial : (n_dof, 10) array
+        Inertial parameters of each link in its joint frame (eq. 5 order).
+    names : tuple of str
+        The joints' names.
+    links : tuple of str
+        The name of each joint's body.
+
+    Raises
+    ------
+    ConfigError
+        MuJoCo is not installed (names the extra), the file cannot be compiled, a held joint is not in it, or the
+        chain is not serial, has joints other than hinges, or a hinge with a reference angle (``ref``).
+    """
+    path, held = Path(path), dict(held or {})
+    mujoco, model, moving, owner, names = _chain(path, held)
+    rotations, translations = _frames(mujoco, model, moving, owner, held, names)
+    link_of = {k: i for i, k in enumerate(moving)}
+    inertial = np.zeros((len(moving), 10))
+    for b in range(1, model.nbody):
+        if owner[b] < 0 or model.body_mass[b] == 0:
+            continue
+        principal = _quat_matrix(mujoco, model.body_iquat[b])
+        phi = inertial_from_physical(float(model.body_mass[b]), np.array(model.body_ipos[b]),
+                                     principal @ np.diag(model.body_inertia[b]) @ principal.T)
+        inertial[link_of[owner[b]]] += transform_inertial(phi, rotations[b], translations[b])
+    joints = []
+    for i, k in enumerate(moving):
+        b = body_joint(model, k)
+        parent = model.body_parentid[b]
+        r, t = _body_in_parent(mujoco, model, b, held, names)
+        r_parent, t_parent = rotations[parent], translations[parent]  # parent body in the previous link's frame
+        rotation, translation = r_parent @ r, r_parent @ (t + r @ np.array(model.jnt_pos[k])) + t_parent
+        axis = np.array(model.jnt_axis[k], dtype=float)
+        joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis)))
+    return (tuple(joints), inertial, tuple(j.name for j in joints),
+            tuple(model.body(body_joint(model, k)).name for k in moving))
+
+
+def mjcf_joint_values(path: str | Path, held=None) -> dict:
+    """What an MJCF states of each moving hinge beside the chain: its range and its drive (as MuJoCo compiles them).
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joints held fixed (:func:`joints_from_mjcf`): not among the joints.
+
+    Returns
+    -------
+    dict
+        ``q_min, q_max`` [rad] (``±inf`` for a joint without limits), ``dq_max``, ``ddq_max``, ``tau_max`` (inf:
+        MJCF states none for a joint), ``armature`` [kg·m²], ``damping`` [N·m·s/rad], ``friction`` (its
+        ``frictionloss``) [N·m]; each (n_dof,).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`joints_from_mjcf`.
+    """
+    path, held = Path(path), dict(held or {})
+    _, model, moving, _, _ = _chain(path, held)
+    limited = np.array([bool(model.jnt_limited[k]) for k in moving])
+    ranges = np.array([model.jnt_range[k] for k in moving], dtype=float).reshape(-1, 2)
+    dofs = [model.jnt_dofadr[k] for k in moving]
+    inf = np.full(len(moving), np.inf)
+    return {"q_min": np.where(limited, ranges[:, 0], -np.inf), "q_max": np.where(limited, ranges[:, 1], np.inf),
+            "dq_max": inf.copy(), "ddq_max": inf.copy(), "tau_max": inf.copy(),
+            "armature": np.array([model.dof_armature[d] for d in dofs], dtype=float),
+            "damping": np.array([model.dof_damping[d] for d in dofs], dtype=float),
+            "friction": np.array([model.dof_frictionloss[d] for d in dofs], dtype=float)}
+
+
+def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
+    """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: from the first joint that is not a
+    hinge or does not continue a serial chain of hinges from the base (a gripper's fingers), every joint after it.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    tuple of str
+        Joint names (empty for an MJCF that is one serial chain of hinges).
+
+    Raises
+    ------
+    ConfigError
+        MuJoCo is not installed, or the file cannot be compiled.
+    """
+    mujoco, model = _compiled(Path(path))
+    owner = np.full(model.nbody, -1)
+    last = -1
+    for b in range(1, model.nbody):
+        owner[b] = owner[model.body_parentid[b]]
+        for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+            if model.jnt_type[k] != mujoco.mjtJoint.mjJNT_HINGE or owner[b] != last:
+                return tuple(model.joint(j).name for j in range(k, model.njnt))
+            owner[b] = last = k
+    return ()
