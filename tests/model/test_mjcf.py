@@ -161,3 +161,19 @@ def test_an_mjcf_chain_dynid_cannot_identify_is_refused_naming_the_joint(tmp_pat
     (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace(*change))
     with pytest.raises(ConfigError, match=message):
         load_robot(tmp_path / "arm.xml")
+
+
+def test_an_mjcfs_gravity_other_than_the_robots_is_said(tmp_path):
+    """<option gravity> is a simulation's setting: one other than the robot's (a description's gravity, else -9.81 m/s²
+    along z) is said with how to set it, not taken; the same gravity, or a description that gives one, says nothing."""
+    (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace("<mujoco model=\"hand\">",
+                                                           "<mujoco model=\"hand\"><option gravity=\"0 0 0\"/>"))
+    robot = load_robot(tmp_path / "arm.xml")
+    assert np.array_equal(robot.gravity, [0.0, 0.0, -9.81])
+    assert robot.nominal_notes[-1] == (f"{tmp_path / 'arm.xml'}: arm.xml's <option gravity> is (0, 0, 0) m/s², not taken: "
+                                       "the robot's gravity is (0, 0, -9.81) (gravity = [x, y, z] in the [robot] table, "
+                                       "or the description, sets it)")
+    given = config_robot({"robot": {"urdf": "arm.xml", "gravity": [0.0, 0.0, 0.0]}}, tmp_path / "c.toml")
+    assert np.array_equal(given.gravity, [0.0, 0.0, 0.0]) and not any("<option gravity>" in n for n in given.nominal_notes)
+    (tmp_path / "same.xml").write_text(HAND_WRITTEN)
+    assert not any("<option gravity>" in n for n in load_robot(tmp_path / "same.xml").nominal_notes)

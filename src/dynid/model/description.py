@@ -303,6 +303,9 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
     lim = _limits(rows, where, urdf_lim)
     gravity = np.asarray(d.gravity, dtype=float)
+    if urdf_lim is not None and "gravity" in urdf_lim and "gravity" not in doc and not np.allclose(urdf_lim["gravity"], gravity):
+        stated += (f"{source}: {upath.name}'s <option gravity> is {_vector(urdf_lim['gravity'])} m/s², not taken: the robot's "
+                   f"gravity is {_vector(gravity)} (gravity = [x, y, z] in the [robot] table, or the description, sets it)",)
     if d.payload is not None:
         inertial = inertial.copy()
         inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, alpha, a, dd)
@@ -392,6 +395,10 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
             mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
     drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
     return terms, mask, drive
+
+
+def _vector(v) -> str:
+    return "(" + ", ".join(f"{float(x):g}" for x in v) + ")"
 
 
 def _urdf_friction(rows, terms: tuple, stated: dict, urdf: str, source: str) -> tuple[str, ...]:

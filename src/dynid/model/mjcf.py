@@ -193,7 +193,7 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
     dict
         ``q_min, q_max`` [rad] (``±inf`` for a joint without limits), ``dq_max``, ``ddq_max``, ``tau_max`` (inf:
         MJCF states none for a joint), ``armature`` [kg·m²], ``damping`` [N·m·s/rad], ``friction`` (its
-        ``frictionloss``) [N·m]; each (n_dof,).
+        ``frictionloss``) [N·m]; each (n_dof,); and ``gravity`` (3,) [m/s²], its ``<option gravity>``.
 
     Raises
     ------
@@ -210,7 +210,8 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
             "dq_max": inf.copy(), "ddq_max": inf.copy(), "tau_max": inf.copy(),
             "armature": np.array([model.dof_armature[d] for d in dofs], dtype=float),
             "damping": np.array([model.dof_damping[d] for d in dofs], dtype=float),
-            "friction": np.array([model.dof_frictionloss[d] for d in dofs], dtype=float)}
+            "friction": np.array([model.dof_frictionloss[d] for d in dofs], dtype=float),
+            "gravity": np.array(model.opt.gravity, dtype=float)}
 
 
 def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
