@@ -19,10 +19,7 @@ from ..exceptions import ConfigError
 from ..extras import require
 from .robot import Joint
 from .spatial import inertial_from_physical, rot_axis, transform_inertial
-from .urdf import check_xml
-
-HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (a gripper's fingers)"
-"""What a refusal of a joint dynid cannot identify says to do."""
+from .urdf import HELD_HINT, check_xml
 
 
 def _compiled(path: Path):
