@@ -12,7 +12,7 @@ import pytest
 
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.configs import config_robot, config_urdf
+from dynid.io.configs import config_mjcf, config_robot, config_urdf
 from dynid.io.export import mjcf_from_robot
 from dynid.model.description import URDF_DYNAMICS_NOTE, load_robot
 
@@ -177,3 +177,42 @@ def test_an_mjcfs_gravity_other_than_the_robots_is_said(tmp_path):
     assert np.array_equal(given.gravity, [0.0, 0.0, 0.0]) and not any("<option gravity>" in n for n in given.nominal_notes)
     (tmp_path / "same.xml").write_text(HAND_WRITTEN)
     assert not any("<option gravity>" in n for n in load_robot(tmp_path / "same.xml").nominal_notes)
+
+
+def test_identify_writes_into_a_copy_of_the_mjcf_the_robot_was_read_from(tmp_path):
+    """As a URDF the robot comes from gets the identified values written into a copy of it, so does an MJCF: the
+    config's mjcf_model defaults to it (given, the given one); a robot holding joints fixed gets a new MJCF instead
+    (writing into the file would count the held bodies twice)."""
+    from dynid.io.identification_config import load_identification_config
+
+    path = _mujoco_written(tmp_path, "ur10e")
+    (tmp_path / "log.csv").write_text("".join(f"{k * 0.01}" + ",0" * 12 + "\n" for k in range(50)))
+    table = ('[identification]\nfile = "log.csv"\ntime = { column = 1 }\npositions = { columns = [2, 3, 4, 5, 6, 7] }\n'
+             'torques = { columns = [8, 9, 10, 11, 12, 13] }\n')
+    (tmp_path / "c.toml").write_text('robot = "arm.xml"\n' + table)
+    assert config_mjcf({"robot": "arm.xml"}, tmp_path / "c.toml") == tmp_path / "arm.xml"
+    assert load_identification_config(tmp_path / "c.toml").mjcf_model == tmp_path / "arm.xml"
+    (tmp_path / "other.xml").write_text(open(path).read())
+    (tmp_path / "given.toml").write_text('robot = "arm.xml"\nmjcf_model = "other.xml"\n' + table)
+    assert load_identification_config(tmp_path / "given.toml").mjcf_model == tmp_path / "other.xml"
+    (tmp_path / "held.toml").write_text('[robot]\nurdf = "arm.xml"\nheld = ["wrist_3_joint"]\n'
+                                        + table.replace("2, 3, 4, 5, 6, 7", "2, 3, 4, 5, 6").replace("8, 9, 10, 11, 12, 13", "7, 8, 9, 10, 11"))
+    held = load_identification_config(tmp_path / "held.toml")
+    assert held.mjcf_model is None and held.robot.n_dof == 5
+    six = load_robot(path)  # the held wrist's link counts with the fifth: its mass there, its first moments about it
+    assert held.robot.inertial[4, 9] == pytest.approx(six.inertial[4, 9] + six.inertial[5, 9], rel=1e-12)
+    assert config_mjcf({"robot": "ur10e"}, tmp_path / "c.toml") is None
+
+
+def test_a_hinge_held_at_an_angle_is_the_arm_with_that_joint_at_that_angle(tmp_path, rng):
+    """held = {wrist_2_joint = 0.7}: the five-joint robot's torques are the six-joint robot's with q5 = 0.7 (the wrist
+    turned, at rest), on the first four joints and the sixth: the held body is turned about its joint, not left."""
+    path = _mujoco_written(tmp_path, "ur10e")
+    full = load_robot(path)
+    held = config_robot({"robot": {"urdf": "arm.xml", "held": {"wrist_2_joint": 0.7}}}, tmp_path / "c.toml")
+    q, dq, ddq = (rng.uniform(-1, 1, (10, 5)) for _ in range(3))
+    widen = lambda x, v: np.insert(x, 4, v, axis=1)  # noqa: E731 - the held joint's column
+    expected = np.einsum("njp,p->nj", regressor(full, widen(q, 0.7), widen(dq, 0.0), widen(ddq, 0.0)),
+                         full.standard_parameters())
+    got = np.einsum("njp,p->nj", regressor(held, q, dq, ddq), held.standard_parameters())
+    np.testing.assert_allclose(got, np.delete(expected, 4, axis=1), atol=1e-10 * np.abs(expected).max())

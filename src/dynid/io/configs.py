@@ -139,31 +139,62 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     -------
     Path or None
         ``robot = "arm.urdf"``, ``[robot] urdf = ...``, or the ``urdf`` of a description file with
-        ``convention = "urdf"``; None for a built-in robot, a DH description or a MuJoCo model (MJCF).
+        ``convention = "urdf"`` (a xacro file: the URDF it expands to); None for a built-in robot, a DH description or
+        a MuJoCo model (:func:`config_mjcf`).
     """
     from ..model.urdf import expand_xacro, is_mjcf, is_xacro
 
-    def urdf_of(file: Path | None) -> Path | None:  # a xacro file: the URDF it expands to; an MJCF is no URDF
-        if file is None or is_mjcf(file):
-            return None
-        return expand_xacro(file) if is_xacro(file) else file
+    file = _robot_file(doc, path, data_root)
+    if file is None or is_mjcf(file):
+        return None
+    return expand_xacro(file) if is_xacro(file) else file
+
+
+def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | None:
+    """The MuJoCo model (MJCF) a config's robot comes from, if it comes from one (identify and export write the
+    identified values into a copy of it, as into a URDF the robot comes from).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed config.
+    path : Path
+        The config file.
+    data_root : Path, optional
+        The data folder, searched second.
+
+    Returns
+    -------
+    Path or None
+        The file of ``robot = "arm.xml"``, ``[robot] urdf = "arm.xml"`` or a description's ``urdf``, where it is an
+        MJCF (:func:`dynid.model.urdf.is_mjcf`); None otherwise.
+    """
+    from ..model.urdf import is_mjcf
+
+    file = _robot_file(doc, path, data_root)
+    return file if file is not None and is_mjcf(file) else None
+
+
+def _robot_file(doc: dict, path: Path, data_root: Path | None) -> Path | None:
+    """The URDF, xacro or MJCF file a config's robot is read from (None: a built-in robot or a DH description)."""
+    from ..model.urdf import is_mjcf, is_xacro
 
     ref = doc.get("robot")
     if isinstance(ref, dict):
-        return urdf_of(_located(str(ref["urdf"]), path.parent, data_root)) if isinstance(ref.get("urdf"), str) else None
+        return _located(str(ref["urdf"]), path.parent, data_root) if isinstance(ref.get("urdf"), str) else None
     if not isinstance(ref, str) or ref in builtin_robots():
         return None
     file = _located(ref, path.parent, data_root)
     if file is None:
         return None
-    if file.suffix.lower() == ".urdf" or is_xacro(file):
-        return urdf_of(file)
+    if file.suffix.lower() == ".urdf" or is_xacro(file) or is_mjcf(file):
+        return file
     try:
         described = tomllib.loads(file.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     urdf = described.get("urdf")
-    return urdf_of(_located(urdf, file.parent, None)) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+    return _located(urdf, file.parent, None) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
 
 
 def _not_found(path: Path, field: str, name: str, data_root: Path | None) -> str:

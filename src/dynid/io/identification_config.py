@@ -79,7 +79,7 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
-from .configs import config_robot, config_urdf, read_config, robot_source
+from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
 from .datasets import DatasetSpec, SignalSpec, dataset_spec
 from .tables import read_table
 from .trajectories import load_trajectory
@@ -124,7 +124,7 @@ class IdentificationConfig:
     mjcf_model : Path or None
         ``mjcf_model``: the user's own MuJoCo model of the arm, checked against the robot's joints
         (:func:`dynid.io.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
-        values into a copy of it.
+        values into a copy of it. Not given, the MJCF the robot was read from, if it was and holds no joint fixed.
     closed_loop : tuple of str
         Closed-loop estimators asked for in ``[estimation] estimators`` (IDIM-IV, DIDIM), run beside the others.
     controller : tuple or None
@@ -330,7 +330,8 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
                                 urdf=urdf, sdp_prior=e.sdp_prior or "euclidean", closed_loop=closed_loop,
-                                controller=controller, mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path))
+                                controller=controller,
+                                mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
 
 
 def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: Path) -> Path | None:
@@ -351,6 +352,14 @@ def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: P
     except ConfigError as exc:
         raise ConfigError(f"{path}: mjcf_model: {exc}", field="mjcf_model") from None
     return file
+
+
+def _robots_mjcf(doc: dict, path: Path, root: Path, robot) -> Path | None:
+    """The MJCF the robot was read from, where no ``mjcf_model`` is given: identify and export write the values into a
+    copy of it, as into a URDF the robot was read from; none for a robot with held joints (:func:`_mjcf_model`'s
+    check refuses those: their bodies would count twice), whose MJCF is written anew."""
+    mjcf = config_mjcf(doc, path, root)
+    return None if mjcf is None or robot.held else _mjcf_model(str(mjcf), path.parent, robot, None, path)
 
 
 def _controller(table, root: Path, where: str, n: int):

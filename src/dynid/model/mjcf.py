@@ -103,7 +103,7 @@ def _body_in_parent(mujoco, model, b: int, held: dict, names) -> tuple[np.ndarra
             if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE:
                 translation = translation + rotation @ (axis * value)
             elif model.jnt_type[k] == mujoco.mjtJoint.mjJNT_HINGE:
-                turn = rot_axis(axis, value)
+                turn = rot_axis(axis / np.linalg.norm(axis), np.array([value]))[0]
                 translation = translation + rotation @ (anchor - turn @ anchor)
                 rotation = rotation @ turn
     return rotation, translation
