@@ -216,3 +216,26 @@ def test_a_hinge_held_at_an_angle_is_the_arm_with_that_joint_at_that_angle(tmp_p
                          full.standard_parameters())
     got = np.einsum("njp,p->nj", regressor(held, q, dq, ddq), held.standard_parameters())
     np.testing.assert_allclose(got, np.delete(expected, 4, axis=1), atol=1e-10 * np.abs(expected).max())
+
+
+def test_init_holds_an_mjcfs_gripper_and_writes_a_config_that_loads(tmp_path):
+    """dynid init on an MJCF with two fingers after the arm writes held = [...] (it refused before: "joint 'finger1'
+    is a slide joint"), and the config it writes reads the three-joint arm."""
+    from dynid.io.identification_config import load_identification_config
+
+    from ..cli.refusals import dynid as run
+
+    fingers = ('<body name="f1" pos="0.2 0 0"><joint name="finger1" type="slide" axis="0 1 0"/>'
+               '<inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>'
+               '<body name="f2" pos="0.2 0 0"><joint name="finger2" type="slide" axis="0 -1 0"/>'
+               '<inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/></body>')
+    (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace('fullinertia="0.01 0.012 0.013 0.001 0 0"/>',
+                                                           'fullinertia="0.01 0.012 0.013 0.001 0 0"/>' + fingers))
+    t = np.arange(500) * 0.002
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, np.sin(np.outer(t, [1, 2, 3])), np.cos(np.outer(t, [1, 2, 3]))]),
+               delimiter=",")
+    p = run("init", str(tmp_path / "arm.xml"), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    assert 'held = ["finger1", "finger2"]' in (tmp_path / "arm.toml").read_text()
+    config = load_identification_config(tmp_path / "arm.toml")
+    assert config.robot.n_dof == 3 and config.robot.held == ("finger1", "finger2") and config.mjcf_model is None

@@ -561,14 +561,14 @@ def init(
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
     from ..io.starter import check_target, starter_config
     from ..model.description import load_robot, robot_from_urdf
-    from ..model.urdf import expand_xacro, is_xacro, joints_to_hold
+    from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
 
     def prepare():
         check_target(out, force)
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
         read = (expand_xacro(urdf) if is_xacro(urdf) else urdf) if urdf.is_file() else None
-        held = joints_to_hold(read) if read is not None and read.suffix.lower() == ".urdf" else ()
+        held = joints_to_hold(read) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read)) else ()
         return robot_from_urdf(urdf, held=held) if held else load_robot(urdf)
 
     def compute(robot, progress):
