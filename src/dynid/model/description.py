@@ -294,7 +294,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
 
     terms, mask, drive = _drive_terms(rows, where, terms, source)
-    stated = () if urdf_lim is None else _urdf_friction(rows, terms, urdf_lim, upath.name, source)
+    stated = () if urdf_lim is None else _urdf_friction(rows, terms, urdf_lim, upath, source)
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(d.transmission, n, offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
@@ -401,12 +401,14 @@ def _vector(v) -> str:
     return "(" + ", ".join(f"{float(x):g}" for x in v) + ")"
 
 
-def _urdf_friction(rows, terms: tuple, stated: dict, urdf: str, source: str) -> tuple[str, ...]:
+def _urdf_friction(rows, terms: tuple, stated: dict, urdf: Path, source: str) -> tuple[str, ...]:
     """A line naming the joints whose URDF ``<dynamics>`` or MJCF joint (``stated``:
     :func:`dynid.model.urdf.urdf_joint_values`) states a rotor inertia, damping or friction that no ``[[joints]]``
     table's ``Ia``/``fv``/``fc`` gives: they are not taken as nominal values (:data:`URDF_DYNAMICS_NOTE`); none where
     the file states only zeros (most vendor files) or the robot has none of those terms."""
-    mjcf = not urdf.lower().endswith(".urdf")
+    from .urdf import is_mjcf
+
+    mjcf = is_mjcf(urdf)  # the file's root element, not its name: a URDF may be called arm.xml
     parts, keys = [], []
     for term, value, attribute in (("Ia", "armature", "armature"), ("fv", "damping", "damping"),
                                    ("fc", "friction", "frictionloss" if mjcf else "friction")):
@@ -419,7 +421,7 @@ def _urdf_friction(rows, terms: tuple, stated: dict, urdf: str, source: str) -> 
             keys.append(f"{term} =")
     if not parts:
         return ()
-    where = f"{urdf}'s joints" if mjcf else f"{urdf}'s <dynamics>"
+    where = f"{urdf.name}'s joints" if mjcf else f"{urdf.name}'s <dynamics>"
     return (f"{source}: {where} state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE.format(keys=' and '.join(keys))}",)
 
 

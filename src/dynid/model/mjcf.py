@@ -60,7 +60,7 @@ def _chain(path: Path, held: dict):
                 what = {0: "a free joint (a floating base)", 1: "a ball joint", 2: "a slide joint"}.get(kind, "not a hinge")
                 raise ConfigError(f"{path}: joint {name!r} is {what}, expected a hinge (revolute joint); "
                                   + HELD_HINT.format(names=f'"{name}"'))
-            if owner[b] >= 0 and body_joint(model, owner[b]) == b:
+            if owner[b] >= 0 and _body(model, owner[b]) == b:
                 raise ConfigError(f"{path}: body {model.body(b).name!r} has more than one moving joint ({name!r}): "
                                   "dynid identifies one revolute joint per link; " + HELD_HINT.format(names=f'"{name}"'))
             previous = moving[-1] if moving else -1
@@ -78,19 +78,8 @@ def _chain(path: Path, held: dict):
     return mujoco, model, moving, owner, names
 
 
-def body_joint(model, k: int) -> int:
-    """The body a joint moves.
-
-    Parameters
-    ----------
-    model : mujoco.MjModel
-    k : int
-        The joint's id.
-
-    Returns
-    -------
-    int
-    """
+def _body(model, k: int) -> int:
+    """The body joint ``k`` moves."""
     return int(model.jnt_bodyid[k])
 
 
@@ -109,10 +98,10 @@ def _body_in_parent(mujoco, model, b: int, held: dict, names) -> tuple[np.ndarra
     return rotation, translation
 
 
-def _frames(mujoco, model, moving, owner, held, names):
+def _frames(mujoco, model, moving, held, names):
     """Each body's frame in the frame of the moving joint it rides on (its link's), the base's bodies in the world's."""
     rotations, translations = [np.eye(3)], [np.zeros(3)]
-    joint_of_body = {body_joint(model, k): k for k in moving}
+    joint_of_body = {_body(model, k): k for k in moving}
     for b in range(1, model.nbody):
         r, t = _body_in_parent(mujoco, model, b, held, names)
         if b in joint_of_body:  # the link's own frame: the body's, moved to the joint's anchor
@@ -153,7 +142,7 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
     """
     path, held = Path(path), dict(held or {})
     mujoco, model, moving, owner, names = _chain(path, held)
-    rotations, translations = _frames(mujoco, model, moving, owner, held, names)
+    rotations, translations = _frames(mujoco, model, moving, held, names)
     link_of = {k: i for i, k in enumerate(moving)}
     inertial = np.zeros((len(moving), 10))
     for b in range(1, model.nbody):
@@ -165,7 +154,7 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
         inertial[link_of[owner[b]]] += transform_inertial(phi, rotations[b], translations[b])
     joints = []
     for i, k in enumerate(moving):
-        b = body_joint(model, k)
+        b = _body(model, k)
         parent = model.body_parentid[b]
         r, t = _body_in_parent(mujoco, model, b, held, names)
         r_parent, t_parent = rotations[parent], translations[parent]  # parent body in the previous link's frame
@@ -173,7 +162,7 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
         axis = np.array(model.jnt_axis[k], dtype=float)
         joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis)))
     return (tuple(joints), inertial, tuple(j.name for j in joints),
-            tuple(model.body(body_joint(model, k)).name for k in moving))
+            tuple(model.body(_body(model, k)).name for k in moving))
 
 
 def mjcf_joint_values(path: str | Path, held=None) -> dict:
