@@ -127,16 +127,32 @@ XACRO = """<?xml version="1.0"?>
 </robot>
 """
 
-ESCAPES = [
-    # through xacro's own guard on the code before this test: object's subclasses by a string key, a builtin module
-    "${{[c for c in python.vars(python.type)['__subclasses__'](python.type(1.0).mro()[1]) if python.str(c) == "
-    "&quot;&lt;class '_frozen_importlib.BuiltinImporter'&gt;&quot;][0].load_module('posix').system('touch {marker}') + 1}}",
-    "${{[g for g in [(x for x in [1])]][0].gi_frame.f_globals}}",
-    "${{python.type(1.0)}}",
-]
+_SUBCLASSES = ("python{v}(python{t})['__subclasses__'](python{t}(1.0).mro()[1])")
+_IMPORTER = "&quot;&lt;class '_frozen_importlib.BuiltinImporter'&gt;&quot;"
+ESCAPES = {
+    # what xacro's own evaluator (or the guard in front of it before) let through; the first two ran `touch`
+    "attribute": "${{[c for c in " + _SUBCLASSES.format(v=".vars", t=".type") + " if python.str(c) == " + _IMPORTER
+                 + "][0].load_module('posix').system('touch {marker}') + 1}}",
+    # the issue's escape: every name a string key, so the guard on names and attributes before this passed it
+    "subscript": "${{[python['vars'](python['vars'](python['type'])['__getattribute__'](c, 'load_module')('posix'))"
+                 "['system']('touch {marker}') for c in python['vars'](python['type'])['__subclasses__']"
+                 "(python['vars'](python['type'])['mro'](python['type'](1.0))[1]) if python['str'](c) == "
+                 + _IMPORTER + "][0] + 1}}",
+    "string-built": "${{[c for c in python['va' + 'rs'](python['ty' + 'pe'])['__sub' + 'classes__']"
+                    "(python['ty' + 'pe'](1.0).mro()[1])][0]}}",
+    "passed-to-map": "${{list(map(python['vars'], [1]))}}",
+    "generator frame": "${{[g for g in [(x for x in [1])]][0].gi_frame.f_globals}}",
+    "type": "${{python.type(1.0)}}",
+    "format string": "${{'{{0.__class__}}'.format(1)}}",
+    "lambda": "${{(lambda: 1)()}}",
+    # $(eval ...) ends at its first ')': the call is built in a ${...} first (this one writes the marker with xacro)
+    "eval open": "$(eval ${{'open\\x28\\x27{marker}\\x27, \\x27w\\x27\\x29.write\\x28\\x27x\\x27\\x29'}})",
+    "eval dunder": "$(eval ${{'\\x28\\x29.\\x5f\\x5fclass\\x5f\\x5f'}})",
+    "huge power": "${{9**9**9}}",
+}
 
 
-@pytest.mark.parametrize("escape", ESCAPES)
+@pytest.mark.parametrize("escape", ESCAPES.values(), ids=ESCAPES.keys())
 def test_a_xacro_description_never_runs_code(tmp_path, monkeypatch, escape):
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     from dynid.model.urdf import expand_xacro
@@ -144,20 +160,76 @@ def test_a_xacro_description_never_runs_code(tmp_path, monkeypatch, escape):
     marker = tmp_path / "ran"
     path = tmp_path / "arm.urdf.xacro"
     path.write_text(XACRO.format(value=escape.format(marker=marker)))
-    with pytest.raises(ConfigError, match=r"arm.urdf.xacro: the xacro expression .* uses '\w+', which a robot "
-                                          "description may not run in dynid") as caught:
+    with pytest.raises(ConfigError, match=r"arm.urdf.xacro: (the xacro expression .* uses .*, which a robot "
+                                          "description may not run in dynid|xacro cannot expand it)") as caught:
         expand_xacro(path)
     assert "\n" not in str(caught.value) and not marker.exists()
+    assert not list(tmp_path.glob("cache/dynid/xacro/*.urdf"))  # nothing cached either
 
 
-def test_plain_xacro_arithmetic_still_expands(tmp_path, monkeypatch):
+def test_hostile_includes_and_yaml_are_refused(tmp_path, monkeypatch):
+    """An escape in an included file, a YAML file with a Python tag, and a YAML unit value that is an expression."""
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     from dynid.model.urdf import expand_xacro
 
+    marker = tmp_path / "ran"
+    (tmp_path / "inc.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="evil" '
+        'value="${python[\'vars\'](1)}" lazy_eval="false"/></robot>')
+    (tmp_path / "tag.yaml").write_text(f"m: !!python/object/apply:os.system ['touch {marker}']\n")
+    (tmp_path / "unit.yaml").write_text("m: !degrees python['vars'](1)\n")
+    cases = {
+        "include": '<xacro:include filename="inc.xacro"/>',
+        "yaml tag": '<xacro:property name="y" value="${xacro.load_yaml(\'tag.yaml\')}" lazy_eval="false"/>',
+        "yaml unit": '<xacro:property name="y" value="${xacro.load_yaml(\'unit.yaml\')}" lazy_eval="false"/>',
+    }
+    for name, element in cases.items():
+        path = tmp_path / f"{name.replace(' ', '_')}.urdf.xacro"
+        path.write_text(XACRO.format(value="1.0").replace("<link", element + "\n  <link", 1))
+        with pytest.raises(ConfigError, match=r"(may not run in dynid|xacro cannot expand it)") as caught:
+            expand_xacro(path)
+        assert "\n" not in str(caught.value) and not marker.exists(), name
+
+
+def test_no_xacro_expression_reaches_eval(tmp_path, monkeypatch):
+    """Properties, math, comprehensions, a YAML file with a unit, $(eval ...) and $(arg ...) all expand while
+    Python's eval is taken away from both of xacro's evaluators: dynid's interpreter computes them."""
+    import xacro
+    from xacro import substitution_args
+
+    def no_eval(*args, **kwargs):
+        raise AssertionError("xacro's eval was reached")
+
+    monkeypatch.setattr(xacro, "eval", no_eval, raising=False)
+    monkeypatch.setattr(substitution_args, "eval", no_eval, raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    from dynid.model.urdf import expand_xacro
+
+    (tmp_path / "p.yaml").write_text("link1: {mass: 2.5, angle: !degrees 90}\n")
     path = tmp_path / "arm.urdf.xacro"
-    path.write_text(XACRO.format(value="${pi/2 + radians(90) + math.sqrt(4) + len([i for i in python.range(3)])}"))
+    value = ("${pi/2 + radians(90) + math.sqrt(4) + len([i for i in python.range(3)]) + props['link1']['mass']"
+             " + props.link1.angle - 2.5 - pi/2 + (1 if 'a_b'.upper().startswith('A') else 0) - 1}")
+    path.write_text(XACRO.format(value=value).replace(
+        "<link", '<xacro:property name="props" value="${xacro.load_yaml(\'p.yaml\')}"/>\n  '
+        '<link name="$(eval prefix + \'tool\' + \'8\' * 1)"/>\n  <link', 1))
     text = expand_xacro(path).read_text()
-    assert '<mass value="8.141592653589793"/>' in text and 'name="a_base"' in text
+    assert '<mass value="8.141592653589793"/>' in text and 'name="a_base"' in text and 'name="a_tool8"' in text
+
+
+def test_an_edited_include_expands_again(tmp_path, monkeypatch):
+    """The expansion cache is keyed on every file the expansion read, not the top file only."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    from dynid.model.urdf import expand_xacro
+
+    inc = tmp_path / "inc.xacro"
+    inc.write_text('<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="m" value="2.0"/></robot>')
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text(XACRO.format(value="1.0").replace('<xacro:property name="m" value="1.0"/>',
+                                                      '<xacro:include filename="inc.xacro"/>'))
+    assert '<mass value="2.0"/>' in expand_xacro(path).read_text()
+    assert '<mass value="2.0"/>' in expand_xacro(path).read_text()
+    inc.write_text(inc.read_text().replace("2.0", "3.0"))
+    assert '<mass value="3.0"/>' in expand_xacro(path).read_text()
 
 
 def test_a_pickle_given_as_results_is_refused_and_never_run(tmp_path):

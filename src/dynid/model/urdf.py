@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import re
 import sys
@@ -413,17 +414,20 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     key = hashlib.sha256(text + repr(sorted((mappings or {}).items())).encode() + str(path.resolve()).encode()).hexdigest()[:16]
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid" / "xacro"
     out = cache / f"{path.name[:-len('.xacro')].removesuffix('.urdf')}-{key}.urdf"
-    if out.is_file():
-        return out
+    for folder in (cache, _fallback_cache()):
+        if _cached_and_current(folder / out.name):
+            return folder / out.name
     try:
+        xacro.all_includes = []  # type: ignore[attr-defined]  # the files an expansion reads besides the top one (includes, YAML), for the cache
         with _silenced_stderr([]), guarded_xacro(xacro, str(path)) as refused:
             try:
                 doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
             except Exception:
-                if refused:  # an expression the guard refused, wrapped by xacro: said as the guard said it
+                if refused:  # an expression the evaluator refused, wrapped by xacro: said as the evaluator said it
                     raise refused[0] from None
                 raise
         urdf = doc.toprettyxml(indent="  ")
+        read = sorted({str(Path(f).resolve()) for f in [path, *xacro.all_includes]})  # type: ignore[attr-defined]
     except ConfigError:
         raise
     except Exception as exc:  # xacro raises its own exceptions, and ROS lookups fail in many ways without ROS
@@ -434,11 +438,32 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     try:
         cache.mkdir(parents=True, exist_ok=True)
     except OSError:  # an unwritable cache: the system's temporary folder instead
-
-        cache = Path(tempfile.gettempdir()) / f"dynid-xacro-{os.getuid() if hasattr(os, 'getuid') else 0}"
+        cache = _fallback_cache()
         cache.mkdir(parents=True, exist_ok=True)
         out = cache / out.name
-    tmp = out.with_suffix(f".{os.getpid()}.tmp")
-    tmp.write_text(urdf, encoding="utf-8")
-    os.replace(tmp, out)
+    manifest = {f: hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in read if Path(f).is_file()}
+    _write_atomically(out.with_suffix(".files.json"), json.dumps(manifest, indent=1))
+    _write_atomically(out, urdf)
     return out
+
+
+def _fallback_cache() -> Path:
+    """The xacro cache in the system's temporary folder, where the user's cache folder cannot be written."""
+    return Path(tempfile.gettempdir()) / f"dynid-xacro-{os.getuid() if hasattr(os, 'getuid') else 0}"
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    tmp = path.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def _cached_and_current(out: Path) -> bool:
+    """Whether a cached expansion exists and every file it read (the top file, includes, YAML; its ``.files.json``)
+    still has the contents it had: an edited included file expands again."""
+    try:
+        manifest = json.loads(out.with_suffix(".files.json").read_text(encoding="utf-8"))
+        return out.is_file() and isinstance(manifest, dict) and all(
+            hashlib.sha256(Path(f).read_bytes()).hexdigest() == h for f, h in manifest.items())
+    except (OSError, ValueError):
+        return False

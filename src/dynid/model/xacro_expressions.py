@@ -1,78 +1,365 @@
-"""The expressions of a xacro file checked before xacro evaluates them: a robot description computes, it never runs code.
+"""xacro's expressions evaluated by dynid's own interpreter: a robot description computes, it never runs code.
 
-xacro evaluates ``${...}`` and ``$(eval ...)`` with Python's ``eval``. Its own guard refuses names that start with two
-underscores, but ``${...}`` still reaches ``type``, ``vars`` and generator frames, and ``$(eval ...)`` all of Python's
-builtins (``open``, ``exec``), so a hostile description could write files or run programs when dynid reads it. Every
-expression is therefore parsed first (:mod:`ast`) and evaluated only if it is plain arithmetic: literals, names,
-operators, comparisons, conditionals, calls, subscripts, comprehensions and attributes, with no name or attribute that
-starts with an underscore, no introspection or file name (:data:`REFUSED_NAMES`) and no frame, code or traceback
-attribute (``gi_frame``, ``f_globals``, ``tb_frame``...). That is what xacro files of robot arms use (``${pi/2}``,
-``${radians(90)}``, ``${d1 + 0.1}``, ``${props['link1']['mass']}``, ``$(eval arg('prefix') + 'base')``).
+xacro evaluates ``${...}`` and ``$(eval ...)`` with Python's ``eval``, behind a guard that only refuses names starting
+with two underscores; its ``python`` namespace is a dict holding ``type`` and ``vars``, so a hostile description can
+reach any object by subscripts with strings (``python['vars'](...)['__subclasses__']``) and run programs. dynid never
+lets an expression reach ``eval``: while a xacro file expands, both of xacro's evaluators are replaced by
+:func:`evaluate`, an interpreter of a small part of Python's syntax tree (:mod:`ast`) that admits
+
+- literals (numbers, strings, booleans, ``None``), lists, tuples, dicts and sets of them;
+- the file's properties and arguments by name, and a namespace's or a YAML mapping's members (``math.pi``,
+  ``props.link1.mass``, ``props['link1']['mass']``);
+- arithmetic, comparisons, ``and``/``or``/``not``, conditional expressions, subscripts and slices, comprehensions;
+- calls of an allow-list of functions (:data:`ALLOWED_BUILTINS`, the ``math`` module, xacro's own ``xacro.*``
+  helpers, ``arg``/``dirname``/``env``/``optenv`` inside ``$(eval ...)``) and of a few string and dict methods
+  (:data:`ALLOWED_METHODS`).
+
+Everything else (a lambda, an assignment expression, a name or member starting with an underscore, an attribute of any
+other object, a call of anything outside the allow-list, an integer power or a repetition that would fill the memory)
+refuses the file in one line naming the expression. That is what xacro files of robot arms use (``${pi/2}``,
+``${radians(90)}``, ``${d1 + 0.1}``, ``${props['link1']['mass']}``, ``$(eval arg('prefix') + 'base')``). A YAML file
+loaded with ``xacro.load_yaml`` is read by ``yaml.safe_load`` (data only), and its ``!degrees`` values go through
+:func:`evaluate` too. Reference: the Python language reference's expression grammar; xacro 2.x's ``safe_eval``.
 """
 
 from __future__ import annotations
 
 import ast
+import builtins
+import collections
 import contextlib
-import re
+import math
+import operator
+import types
+from collections.abc import Callable, Mapping
+from typing import Any
 
 from ..exceptions import ConfigError
 
-__all__ = ["REFUSED_NAMES", "check_expression", "guarded_xacro"]
+__all__ = ["ALLOWED_BUILTINS", "ALLOWED_METHODS", "evaluate", "guarded_xacro"]
 
-REFUSED_NAMES = frozenset({
-    "type", "vars", "mro", "dir", "getattr", "setattr", "delattr", "hasattr", "globals", "locals", "eval", "exec",
-    "compile", "open", "input", "breakpoint", "help", "memoryview", "object", "super", "classmethod", "staticmethod",
-    "property", "exit", "quit", "format", "format_map", "load_yaml", "abs_filename", "subclasses", "builtins", "os",
-    "sys", "subprocess", "importlib", "system", "popen",
-})
-"""Names and attributes an expression of a robot description may not use: introspection, evaluation, files."""
+ALLOWED_BUILTINS = ("abs", "all", "any", "bool", "complex", "dict", "divmod", "enumerate", "filter", "float",
+                    "frozenset", "int", "isinstance", "len", "list", "map", "max", "min", "ord", "range", "repr",
+                    "reversed", "round", "set", "sorted", "str", "sum", "tuple", "zip")
+"""Python's built-in functions an expression may call (xacro's ``python`` namespace less ``type``, ``vars``,
+``hash``, ``issubclass`` and ``slice``)."""
 
-_FRAME_ATTRIBUTE = re.compile(r"^(gi|cr|ag|f|tb|co)_")
-_ALLOWED = (ast.Expression, ast.Constant, ast.Name, ast.Load, ast.Store, ast.Attribute, ast.Subscript, ast.Slice,
-            ast.Tuple, ast.List, ast.Dict, ast.Set, ast.BinOp, ast.UnaryOp, ast.BoolOp, ast.Compare, ast.IfExp,
-            ast.Call, ast.keyword, ast.Starred, ast.JoinedStr, ast.FormattedValue, ast.ListComp, ast.SetComp,
-            ast.DictComp, ast.GeneratorExp, ast.comprehension, ast.operator, ast.unaryop, ast.boolop, ast.cmpop)
+ALLOWED_METHODS = {
+    str: frozenset({"lower", "upper", "strip", "lstrip", "rstrip", "split", "rsplit", "replace", "startswith",
+                    "endswith", "join", "find", "count", "capitalize", "title", "zfill", "isdigit"}),
+    dict: frozenset({"get", "keys", "values", "items"}),
+    list: frozenset({"index", "count"}),
+    tuple: frozenset({"index", "count"}),
+}
+"""Methods an expression may call on a value of each type (never ``format``, which reaches attributes itself)."""
+
+_LARGEST = 10_000_000  # elements or characters one operation may make, and the largest integer exponent's bits
+_BINARY: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+    ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: operator.pow, ast.BitAnd: operator.and_,
+    ast.BitOr: operator.or_, ast.BitXor: operator.xor, ast.LShift: operator.lshift, ast.RShift: operator.rshift,
+}
+_UNARY: dict[type, Callable[[Any], Any]] = {ast.UAdd: operator.pos, ast.USub: operator.neg, ast.Not: operator.not_,
+                                           ast.Invert: operator.invert}
+_COMPARE: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt,
+    ast.GtE: operator.ge, ast.In: lambda a, b: a in b, ast.NotIn: lambda a, b: a not in b,
+    ast.Is: operator.is_, ast.IsNot: operator.is_not,
+}
 
 
-def check_expression(text: str, where: str = "") -> None:
-    """Refuse an expression a robot description may not evaluate (module docstring).
+class _Refused(Exception):
+    """What an expression may not do, said by the caller with the expression and the file."""
+
+
+class _Interpreter:
+    """One expression's evaluation: names from ``symbols`` (a xacro table or ``$(eval)``'s argument wrapper),
+    calls only of ``allowed`` (by identity) and of :data:`ALLOWED_METHODS`."""
+
+    def __init__(self, symbols, allowed: Mapping[int, str]):
+        self.symbols, self.allowed = symbols, allowed
+        self.scopes: list[dict[str, Any]] = []
+
+    def value(self, v: Any) -> Any:
+        """Every value an expression makes passes here: a callable outside the allow-list is refused at once, so it
+        can be neither called nor handed to an allowed function (``map(python.vars, ...)``)."""
+        if callable(v) and id(v) not in self.allowed and not self._allowed_method(v):
+            raise _Refused(f"{getattr(v, '__name__', type(v).__name__)!r}, a function outside the allow-list")
+        return v
+
+    @staticmethod
+    def _allowed_method(v: Any) -> bool:
+        owner = getattr(v, "__self__", None)
+        names = next((m for t, m in ALLOWED_METHODS.items() if isinstance(owner, t)), frozenset())
+        return type(v).__name__ == "builtin_function_or_method" and getattr(v, "__name__", "") in names
+
+    def run(self, node: ast.AST) -> Any:
+        method = getattr(self, f"_{type(node).__name__}", None)
+        if method is None:
+            raise _Refused(f"a {type(node).__name__.lower()}")
+        return self.value(method(node))
+
+    def _Expression(self, node: ast.Expression) -> Any:
+        return self.run(node.body)
+
+    def _Constant(self, node: ast.Constant) -> Any:
+        if not isinstance(node.value, (int, float, complex, str, bool, type(None))):
+            raise _Refused(f"the constant {node.value!r}")
+        return node.value
+
+    def _Name(self, node: ast.Name) -> Any:
+        if node.id.startswith("_"):
+            raise _Refused(f"{node.id!r}")
+        for scope in reversed(self.scopes):
+            if node.id in scope:
+                return scope[node.id]
+        try:
+            return self.symbols[node.id]
+        except KeyError:
+            raise NameError(f"name '{node.id}' is not defined") from None
+
+    def _Attribute(self, node: ast.Attribute) -> Any:
+        if node.attr.startswith("_"):
+            raise _Refused(f"{node.attr!r}")
+        owner = self.run(node.value)
+        if isinstance(owner, dict) and type(owner) is not dict:  # xacro's namespaces, tables and YAML mappings
+            try:
+                return owner[node.attr]
+            except KeyError:
+                raise AttributeError(f"no member {node.attr!r}") from None
+        method = getattr(owner, node.attr, None)
+        if method is None or not self._allowed_method(method):
+            raise _Refused(f"the attribute {node.attr!r} of a {type(owner).__name__}")
+        return method
+
+    def _Subscript(self, node: ast.Subscript) -> Any:
+        owner, key = self.run(node.value), self.run(node.slice)
+        if not isinstance(owner, (dict, list, tuple, str)):
+            raise _Refused(f"a subscript of a {type(owner).__name__}")
+        if isinstance(key, str) and key.startswith("_"):
+            raise _Refused(f"the key {key!r}")
+        return owner[key]
+
+    def _Slice(self, node: ast.Slice) -> slice:
+        return slice(*(None if part is None else self.run(part) for part in (node.lower, node.upper, node.step)))
+
+    def _Tuple(self, node: ast.Tuple) -> tuple:
+        return tuple(self._elements(node.elts))
+
+    def _List(self, node: ast.List) -> list:
+        return self._elements(node.elts)
+
+    def _Set(self, node: ast.Set) -> set:
+        return set(self._elements(node.elts))
+
+    def _Dict(self, node: ast.Dict) -> dict:
+        if any(k is None for k in node.keys):
+            raise _Refused("a ** in a dict")
+        return {self.run(k): self.run(v) for k, v in zip(node.keys, node.values)}  # type: ignore[arg-type]
+
+    def _elements(self, nodes: list[ast.expr]) -> list:
+        out: list = []
+        for e in nodes:
+            if isinstance(e, ast.Starred):
+                out.extend(self._bounded(list(self.run(e.value))))
+            else:
+                out.append(self.run(e))
+        return out
+
+    @staticmethod
+    def _bounded(v: Any) -> Any:
+        if isinstance(v, (str, list, tuple, set, dict, range)) and len(v) > _LARGEST:
+            raise _Refused(f"a value of {len(v)} elements")
+        return v
+
+    def _BinOp(self, node: ast.BinOp) -> Any:
+        left, right = self.run(node.left), self.run(node.right)
+        op = type(node.op)
+        if op not in _BINARY:
+            raise _Refused(f"the operator {op.__name__}")
+        if op is ast.Pow and isinstance(left, int) and isinstance(right, int) and abs(right) > 64 and \
+                abs(right) * max(abs(left), 2).bit_length() > _LARGEST:
+            raise _Refused(f"the power {left}**{right}")
+        if op is ast.LShift and isinstance(right, int) and right > _LARGEST:
+            raise _Refused(f"the shift by {right}")
+        if op is ast.Mult:
+            for seq, n in ((left, right), (right, left)):
+                if isinstance(seq, (str, list, tuple)) and isinstance(n, int) and len(seq) * n > _LARGEST:
+                    raise _Refused(f"a repetition of {len(seq) * n} elements")
+        return _BINARY[op](left, right)
+
+    def _UnaryOp(self, node: ast.UnaryOp) -> Any:
+        return _UNARY[type(node.op)](self.run(node.operand))
+
+    def _BoolOp(self, node: ast.BoolOp) -> Any:
+        result: Any = None
+        for v in node.values:
+            result = self.run(v)
+            if bool(result) is isinstance(node.op, ast.Or):
+                return result
+        return result
+
+    def _Compare(self, node: ast.Compare) -> bool:
+        left = self.run(node.left)
+        for op, right_node in zip(node.ops, node.comparators):
+            right = self.run(right_node)
+            if not _COMPARE[type(op)](left, right):
+                return False
+            left = right
+        return True
+
+    def _IfExp(self, node: ast.IfExp) -> Any:
+        return self.run(node.body) if self.run(node.test) else self.run(node.orelse)
+
+    def _Call(self, node: ast.Call) -> Any:
+        function = self.run(node.func)
+        args = self._elements(node.args)
+        kwargs: dict[str, Any] = {}
+        for k in node.keywords:
+            if k.arg is None:
+                raise _Refused("a ** in a call")
+            kwargs[k.arg] = self.run(k.value)
+        if function is range:
+            span = range(*args)
+            self._bounded(span)
+            return span
+        result = function(*args, **kwargs)
+        if function in (map, filter, zip, enumerate, reversed):  # lazy: made here, so a size limit holds
+            result = self._bounded(list(result))
+        return self._bounded(result)
+
+    def _JoinedStr(self, node: ast.JoinedStr) -> str:
+        parts = []
+        for v in node.values:
+            if isinstance(v, ast.FormattedValue):
+                if v.format_spec is not None or v.conversion not in (-1, 115):  # plain {x} or {x!s} only
+                    raise _Refused("a formatted value with a format specification")
+                parts.append(str(self.run(v.value)))
+            else:
+                parts.append(str(self.run(v)))
+        return self._bounded("".join(parts))
+
+    def _comprehension(self, generators: list[ast.comprehension], emit: Callable[[], None]) -> None:
+        first, rest = generators[0], generators[1:]
+        if first.is_async:
+            raise _Refused("an async comprehension")
+        for item in self._bounded(list(self.run(first.iter))):
+            self._bind(first.target, item)
+            if not all(self.run(cond) for cond in first.ifs):
+                continue
+            if rest:
+                self._comprehension(rest, emit)
+            else:
+                emit()
+
+    def _bind(self, target: ast.expr, item: Any) -> None:
+        if isinstance(target, ast.Name) and not target.id.startswith("_"):
+            self.scopes[-1][target.id] = item
+        elif isinstance(target, ast.Tuple):
+            items = list(item)
+            if len(items) != len(target.elts):
+                raise ValueError(f"cannot unpack {len(items)} values into {len(target.elts)}")
+            for t, v in zip(target.elts, items):
+                self._bind(t, v)
+        else:
+            raise _Refused(f"a comprehension target {type(target).__name__}")
+
+    def _collect(self, node: ast.ListComp | ast.SetComp | ast.GeneratorExp | ast.DictComp) -> list:
+        out: list = []
+        self.scopes.append({})
+        try:
+            if isinstance(node, ast.DictComp):
+                self._comprehension(node.generators, lambda: out.append((self.run(node.key), self.run(node.value))))
+            else:
+                self._comprehension(node.generators, lambda: out.append(self.run(node.elt)))
+        finally:
+            self.scopes.pop()
+        return self._bounded(out)
+
+    def _ListComp(self, node: ast.ListComp) -> list:
+        return self._collect(node)
+
+    def _GeneratorExp(self, node: ast.GeneratorExp) -> list:
+        return self._collect(node)
+
+    def _SetComp(self, node: ast.SetComp) -> set:
+        return set(self._collect(node))
+
+    def _DictComp(self, node: ast.DictComp) -> dict:
+        return dict(self._collect(node))
+
+
+def _short(text: str) -> str:
+    short = " ".join(str(text).split())
+    return short if len(short) <= 60 else short[:57] + "..."
+
+
+def evaluate(text: str, symbols, allowed: Mapping[int, str], where: str = "") -> Any:
+    """The value of one xacro expression, computed without ``eval`` (module docstring).
 
     Parameters
     ----------
     text : str
-        The expression, as xacro is about to evaluate it.
+        The expression (the inside of ``${...}`` or ``$(eval ...)``).
+    symbols : mapping
+        Names to values: a xacro property table (lazy properties are evaluated by xacro through this function), or
+        ``$(eval ...)``'s arguments and functions.
+    allowed : mapping of int to str
+        The ``id`` of each function an expression may call, to its name (:func:`allowed_functions`).
     where : str
-        Where it comes from (the file), for the message.
+        The file being expanded, for the message.
+
+    Returns
+    -------
+    object
+        The expression's value.
 
     Raises
     ------
     ConfigError
-        A name, attribute or construct outside plain arithmetic; one line naming it and the expression.
+        The expression does what a robot description may not (one line naming it and the file).
+    SyntaxError, NameError, KeyError, ValueError, TypeError, ArithmeticError
+        As Python would for the same expression; xacro wraps them in its own message.
     """
+    tree = ast.parse(str(text).strip(), mode="eval")
     try:
-        tree = ast.parse(text.strip(), mode="eval")
-    except SyntaxError:
-        return  # xacro's own compile says what is wrong with it
-    for node in ast.walk(tree):
-        name = node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute) else None
-        if not isinstance(node, _ALLOWED):
-            reason = f"a {type(node).__name__.lower()}"
-        elif name is not None and (name.startswith("_") or name in REFUSED_NAMES or _FRAME_ATTRIBUTE.match(name)):
-            reason = f"{name!r}"
-        else:
-            continue
-        short = " ".join(text.split())
-        short = short if len(short) <= 60 else short[:57] + "..."
-        raise ConfigError(f"{where + ': ' if where else ''}the xacro expression {short!r} uses {reason}, which a robot "
-                          "description may not run in dynid (it reads descriptions as data: arithmetic, math functions "
-                          "and the file's own properties only)")
+        return _Interpreter(symbols, allowed).run(tree)
+    except _Refused as exc:
+        raise ConfigError(f"{where + ': ' if where else ''}the xacro expression {_short(text)!r} uses {exc}, which a "
+                          "robot description may not run in dynid (it reads descriptions as data: arithmetic, math "
+                          "functions and the file's own properties only; docs/security.md)") from None
+
+
+def allowed_functions(xacro) -> dict[int, str]:
+    """The functions an expression may call, by ``id``: :data:`ALLOWED_BUILTINS`, the ``math`` module's, and
+    xacro's own helpers (its ``xacro`` namespace and the deprecated global names that wrap them).
+
+    Parameters
+    ----------
+    xacro : module
+        The imported ``xacro`` package.
+
+    Returns
+    -------
+    dict of int to str
+    """
+    functions: dict[str, Any] = {name: getattr(builtins, name) for name in ALLOWED_BUILTINS}
+    functions |= {f"math.{k}": v for k, v in vars(math).items() if callable(v) and not k.startswith("_")}
+    symbols = xacro._global_symbols
+    functions |= {f"xacro.{k}": v for k, v in symbols["xacro"].items() if callable(v)}
+    allowed = {id(v): k for k, v in functions.items()}
+    for name, v in symbols.items():  # xacro's global names: a builtin, a math function, or a wrapper of one
+        closure = v.__closure__ if isinstance(v, types.FunctionType) else None
+        wrapped = [c.cell_contents for c in closure or () if callable(c.cell_contents)]
+        if callable(v) and (id(v) in allowed or any(id(w) in allowed for w in wrapped)):
+            allowed[id(v)] = name
+    return allowed
 
 
 @contextlib.contextmanager
 def guarded_xacro(xacro, where: str = ""):
-    """xacro's two evaluators, ``${...}`` and ``$(eval ...)``, with :func:`check_expression` in front, while the
-    context lasts.
+    """xacro's two evaluators, ``${...}`` and ``$(eval ...)``, replaced by :func:`evaluate` while the context lasts:
+    no expression of the file reaches Python's ``eval``.
 
     Parameters
     ----------
@@ -86,28 +373,34 @@ def guarded_xacro(xacro, where: str = ""):
     list of ConfigError
         The refusals raised inside xacro (which wraps them in its own exceptions): the caller raises the first.
     """
-    from xacro import substitution_args
+    from xacro import substitution_args as sa
 
-    safe_eval, eval_arg = xacro.safe_eval, substitution_args._eval
+    allowed = allowed_functions(xacro)
     refused: list[ConfigError] = []
 
-    def checked(text: str) -> None:
+    def checked(text: str, symbols, allowed: Mapping[int, str]) -> Any:
         try:
-            check_expression(text, where)
+            return evaluate(text, symbols, allowed, where)
         except ConfigError as exc:
             refused.append(exc)
             raise
 
-    def checked_safe_eval(expr, *args, **kwargs):
-        checked(expr)
-        return safe_eval(expr, *args, **kwargs)
+    def safe_eval(expr, globals, locals=None):
+        return checked(expr, globals if locals is None else collections.ChainMap(locals, globals), allowed)
 
-    def checked_eval(s, context):
-        checked(s)
-        return eval_arg(s, context)
+    def eval_arg(s, context):  # xacro's substitution_args._eval, with the same names
+        context.setdefault("arg", {})
+        functions = {"arg": lambda name: sa.convert_value(sa._eval_arg(name, args=context["arg"]), "auto"),
+                     "dirname": lambda: sa._eval_dirname(context["filename"]),
+                     "true": True, "false": False, "True": True, "False": False,
+                     "env": sa._eval_env, "optenv": sa._eval_optenv, "find": sa._eval_find}
+        functions |= {k: v for k, v in vars(math).items() if not k.startswith("_")}
+        here = dict(allowed) | {id(v): k for k, v in functions.items() if callable(v)}
+        return str(checked(s, sa._DictWrapper(context["arg"], functions), here))
 
-    xacro.safe_eval, substitution_args._eval = checked_safe_eval, checked_eval
+    saved = xacro.safe_eval, sa._eval
+    xacro.safe_eval, sa._eval = safe_eval, eval_arg
     try:
         yield refused
     finally:
-        xacro.safe_eval, substitution_args._eval = safe_eval, eval_arg
+        xacro.safe_eval, sa._eval = saved
