@@ -52,6 +52,9 @@ class SignalTable(Table, kw_only=True):
     sign: Annotated[Factor, _d("1 or -1, or one per joint: multiplies the signal")] | None = None
     scale: Annotated[Factor, _d("a non-zero factor, or one per joint: multiplies the signal")] | None = None
     side: Annotated[Literal["joint", "motor"], _d("this signal's side of the transmission (default: the dataset's)")] | None = None
+    sensor: Annotated[Literal["joint", "drive"], _d(
+        "torques only: joint (a joint torque sensor on the link side of the gear: the torque holds no rotor inertia, "
+        "so the default drive terms leave Ia out) or drive (motor currents or a motor-side torque: the default)")] | None = None
 
 
 class TimeTable(Table, kw_only=True):

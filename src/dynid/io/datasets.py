@@ -446,6 +446,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
             raise ConfigError(f"{w}: expected a table with 'columns', or false for none (derived from the positions)")
         if sig.columns is None:
             raise ConfigError(f"{w}: expected a table with 'columns' (1-based numbers or header names)")
+        if sig.sensor is not None and kind != "torques":
+            raise ConfigError(f"{w}.sensor: only the torques have a sensor (joint or drive), got it on the {kind}")
         if len(sig.columns) != n_dof:
             raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {sig.columns!r}")
         units = _UNITS[kind]

@@ -304,7 +304,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     root = Path(override) if override else here / (typed.data_root or ".")  # an absolute path stays as is
     if not root.is_dir():
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
-    robot = config_robot(doc, path, root)
+    robot = _sensed_terms(config_robot(doc, path, root), doc, path)
     n = robot.n_dof
     ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n)
     validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n) for i, v in enumerate(doc.get("validation", [])))
@@ -332,6 +332,27 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
                                 urdf=urdf, sdp_prior=e.sdp_prior or "euclidean", closed_loop=closed_loop,
                                 controller=controller,
                                 mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
+
+
+JOINT_SENSOR_NOTE = ("a joint torque sensor on the link side of the gear (torques.sensor = \"joint\") measures no "
+                     "rotor inertia")
+
+
+def _sensed_terms(robot: Robot, doc: dict, path: Path) -> Robot:
+    """The robot's drive terms as the identification log's torque sensor measures them: with ``torques.sensor =
+    "joint"`` (a joint torque sensor on the link side, e.g. a KUKA LBR's or a Franka's) no rotor inertia ``Ia``
+    unless the config lists it in ``drive_terms`` itself, where it is said: the log's torque holds none, and a rotor
+    inertia fitted to it takes up whatever else the log shows (issue "Never worse than the description", item 3)."""
+    table = doc.get("identification")
+    torques = table.get("torques") if isinstance(table, dict) else None
+    if not isinstance(torques, dict) or torques.get("sensor") != "joint" or "Ia" not in robot.drive_terms:
+        return robot
+    own = doc.get("robot")
+    given = isinstance(own, dict) and own.get("drive_terms") is not None
+    if given:
+        return robot.without_drive_terms((), f"{path}: robot.drive_terms lists Ia, but {JOINT_SENSOR_NOTE}: the "
+                                              "rotor inertia fitted to this log is not the drive's (leave Ia out)")
+    return robot.without_drive_terms(("Ia",))
 
 
 def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: Path) -> Path | None:

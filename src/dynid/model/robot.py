@@ -381,6 +381,29 @@ class Robot:
         )
 
 
+    def without_drive_terms(self, terms, note: str = "") -> Robot:
+        """The same robot without some drive terms (e.g. no rotor inertia ``Ia`` where a joint torque sensor on the
+        link side measures the torque); ``note`` joins :attr:`nominal_notes`.
+
+        Parameters
+        ----------
+        terms : sequence of str
+            Names of :attr:`drive_terms` to drop; those the robot does not have are ignored.
+        note : str
+            A line said among the identification's warnings ("" for none).
+
+        Returns
+        -------
+        Robot
+        """
+        keep = [i for i, t in enumerate(self.drive_terms) if t not in set(terms)]
+        notes = self.nominal_notes + ((note,) if note else ())
+        if len(keep) == len(self.drive_terms):
+            return replace(self, nominal_notes=notes)
+        return replace(self, drive_terms=tuple(self.drive_terms[i] for i in keep), drive=self.drive[:, keep].copy(),
+                       drive_mask=np.asarray(self.drive_mask, dtype=bool)[:, keep].copy(), nominal_notes=notes)
+
+
 def default_limits(n: int) -> Limits:
     """Limits that constrain nothing (``±inf``).
 
