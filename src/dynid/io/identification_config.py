@@ -350,7 +350,7 @@ def _sensed_terms(robot: Robot, doc: dict, path: Path) -> Robot:
     own = doc.get("robot")
     given = isinstance(own, dict) and own.get("drive_terms") is not None
     if given:
-        return robot.without_drive_terms((), f"{path}: robot.drive_terms lists Ia, but {JOINT_SENSOR_NOTE}: the "
+        return robot.without_drive_terms((), note=f"{path}: robot.drive_terms lists Ia, but {JOINT_SENSOR_NOTE}: the "
                                               "rotor inertia fitted to this log is not the drive's (leave Ia out)")
     return robot.without_drive_terms(("Ia",))
 

@@ -381,7 +381,7 @@ class Robot:
         )
 
 
-    def without_drive_terms(self, terms, note: str = "") -> Robot:
+    def without_drive_terms(self, terms, *, note: str = "") -> Robot:
         """The same robot without some drive terms (e.g. no rotor inertia ``Ia`` where a joint torque sensor on the
         link side measures the torque); ``note`` joins :attr:`nominal_notes`.
 
