@@ -32,7 +32,6 @@ from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (
     BlockGrams,
-    Finding,
     OrderSums,
     ResidualSums,
     bootstrap_finding,
@@ -43,6 +42,7 @@ from ..validation.diagnostics import (
 )
 from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DRIVE_ONLY_KEY, DriveOnly, drive_only
+from .verdict import nominal_set
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
@@ -190,11 +190,14 @@ class IdentificationResult:
         Label of the estimate to trust.
     drive_only : DriveOnly or None
         The description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`): made the
-        main estimate by :func:`dynid.identification.run.run_identification` where the validation logs prefer it; not
+        main estimate by :func:`dynid.identification.verdict.choose_main_estimate` where the evidence prefers it; not
         in :attr:`estimates` otherwise (None: a description without inertial parameters).
     choices : ModelChoices or None
         What the data chose for :attr:`model` (:class:`dynid.identification.choices.ModelChoices`): set by
         :class:`dynid.identification.pipeline.IdentificationPipeline`, None where :func:`identify` is called alone.
+    covariances : dict
+        label -> (n_base, n_base) covariance of an estimate whose solver gives none (the SDP's jackknife over the
+        held-out refits), for its prediction spread on other motions.
     """
 
     robot: str
@@ -221,6 +224,7 @@ class IdentificationResult:
     main: str = ""
     drive_only: DriveOnly | None = None
     choices: Any = None
+    covariances: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -360,7 +364,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
-    scoring = BlockScoring(robot, base, data, held_out=held_out and sdp, observers=observers)
+    scoring = BlockScoring(robot, base, data, held_out=sdp, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
     stream_rows(chunks, estimation, base, scoring.add, standard=standard)
@@ -401,22 +405,25 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
-    alternative = None if found is None else replace(found, fit=replace(
-        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
+    described = nominal_set(robot, base, references)  # the verdict weighs it against the others on this log too
+    alternative = None if found is None else replace(found, fit=replace(sums.comparison(data.name, {
+        **sets, **({} if described is None else {described[0]: described[1]}), DRIVE_ONLY_LABEL: found.params}),
+        noise=joint_std, speed=fit.speed))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
-    main = ""
     ls_label = estimate_label(ls_key)
-    if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):
-        main = _held_out_choice(robot, folds, row_weights, ls_label, findings, stats, progress)
+    jackknife = {}
+    if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):  # the SDP's spread for the verdict
+        own, held, jackknife[SDP_LABEL] = _held_out_errors(robot, base, folds, row_weights)
+        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
     return IdentificationResult(robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
                                 n_rows=int(reference.accumulator_.rows.sum()),
                                 settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
                                 consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box, model=robot,
-                                findings=tuple(findings), diagnostics=stats, main=main or estimate_label(keys[0]),
-                                drive_only=alternative)
+                                findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]),
+                                drive_only=alternative, covariances=jackknife)
 
 
 class BlockScoring:
@@ -482,22 +489,6 @@ class BlockScoring:
         self.blocks.add(index, y, tau, keep)
         for observer in self.observers:
             observer(index, y, tau, keep)
-
-
-def _held_out_choice(robot: Robot, folds, row_weights, ls_label: str, findings: list, stats: dict, progress) -> str:
-    """The SDP as the main estimate ("" otherwise) when it predicts the held-out blocks better than the least-squares
-    estimate, which is not physically consistent; the figures into ``stats`` and the finding into ``findings``."""
-    if progress is not None:
-        progress("physically consistent SDP, held-out blocks", 0, 1)
-    own, held = _held_out_errors(robot, folds, row_weights)
-    stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
-    if held >= own:
-        return ""
-    findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where "
-                                       f"{ls_label} is not and predicts held-out blocks of the log "
-                                       f"worse ({held:.3g} against {own:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
-                                       "cross-validation)"))
-    return SDP_LABEL
 
 
 def _estimate(key: str, fitted, reference) -> Estimate:
@@ -665,13 +656,16 @@ HELD_OUT_FOLDS = 5
 """Contiguous blocks of the identification log that compare the estimates when no validation log does."""
 
 
-def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
+def _held_out_errors(robot: Robot, base: BaseParameters, folds, row_weights) -> tuple[float, float, np.ndarray]:
     """RMS torque error on the held-out blocks of the unconstrained (OLS/WLS, minimum-norm over the standard
-    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others."""
+    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others;
+    and the physically consistent estimate's jackknife covariance over those refits (base parameters: its spread on
+    other motions, which its solver does not give; Efron & Stein, Ann. Statist. 9(3), 1981)."""
     p = robot.n_params
     links, nonneg = consistency_layout(robot)
     sse = np.zeros(2)
     rows = 0
+    refits = []
     for k, held in enumerate(folds):
         rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
         reduced = rest.reduced(row_weights)
@@ -680,8 +674,10 @@ def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
         est.fit(reduced[:, :p], reduced[:, p])
         sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
         rows += int(held.rows.sum())
+        refits.append(base.base_from_standard(est.params_))
     own, sdp = np.sqrt(sse / max(rows, 1))
-    return float(own), float(sdp)
+    spread = np.asarray(refits) - np.mean(refits, axis=0)
+    return float(own), float(sdp), (len(refits) - 1) / len(refits) * spread.T @ spread
 
 
 def _step(progress, label: str):

@@ -29,6 +29,7 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
+from .verdict import choose_main_estimate, nominal_set
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -166,116 +167,29 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw)
+        result = pipeline.estimate(prepared, refs, progress, recording=raw)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
+    nominal = nominal_set(robot, base, result.references)
     if not validate or not config.validation:
-        return result
+        return choose_main_estimate(result, nominal)
     sets = result.parameter_sets()
-    nominal = _nominal_set(robot, base, result.references)
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
         sets[nominal[0]] = nominal[1]
 
-    described = None if nominal is None else nominal[0]
-    alt = result.drive_only if described is not None else None
-    if alt is not None:  # a candidate scored in the same pass, kept only where chosen (_drive_only_preferred)
+    alt = result.drive_only if nominal is not None else None
+    covariance = {result.label: result.solution.covariance, **result.covariances}
+    if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
         from .identify import DRIVE_ONLY_LABEL
 
         sets[DRIVE_ONLY_LABEL] = alt.params
+        covariance[DRIVE_ONLY_LABEL] = alt.covariance
     scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
-                                         prepared.data.settings, result.joint_std,
-                                         {result.label: result.solution.covariance})
+                                         prepared.data.settings, result.joint_std, covariance)
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    chosen = _main_estimate(result, described)
-    preferred = None if alt is None or described is None else _drive_only_preferred(result, chosen, described,
-                                                                                      scored_all)
-    if preferred is not None:
-        result = preferred[0]
-        chosen = _main_estimate(result, described, preferred[1])
-    return replace(result, **chosen)
-
-
-def _mean_error(validations, label: str) -> float:
-    """The mean over ``validations`` of ``label``'s global relative error [%]."""
-    return float(np.mean([v.metrics()[label]["global_relative_error"] for v in validations]))
-
-
-def _drive_only_preferred(result, chosen: dict, nominal: str, scored: tuple):
-    """``result`` with :attr:`IdentificationResult.drive_only` among its estimates and ``scored`` as its validations,
-    and the main-estimate finding, where the identified rigid body is doubtful on the validation logs and the
-    description's rigid body with the drive terms fitted predicts them better than the main estimate (mean global
-    error); None otherwise (:mod:`dynid.identification.drive_only`).
-
-    Doubtful: the description's nominal model predicts the validation logs better than the main estimate, or the
-    least-squares estimate's predictions there leave the range the identification log supports (the finding
-    ``extrapolation``: its prediction σ from the parameters' covariance over 5× that on the identification log), so
-    the log does not determine the directions those motions need. ``chosen``: :func:`_main_estimate`'s;
-    ``scored``: the validations of every set and of the drive-only one."""
-    from .identify import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, Estimate, consistency_checks
-
-    alt, main = result.drive_only, chosen["main"]
-    own, described = _mean_error(scored, main), _mean_error(scored, nominal)
-    far = [f for f in chosen["findings"] if f.kind == "extrapolation"]
-    better = _mean_error(scored, DRIVE_ONLY_LABEL)
-    if not (described < own or far) or not better < own:
-        return None
-    estimate = Estimate(DRIVE_ONLY_KEY, alt.params, alt.std, standard=alt.standard)
-    margins, verdicts = consistency_checks(result.model, result.base, {DRIVE_ONLY_LABEL: alt.params})
-    result = replace(result, estimates={**result.estimates, DRIVE_ONLY_LABEL: estimate}, fit=alt.fit,
-                     validations=scored, consistency={**result.consistency, **margins},
-                     consistency_verdicts={**result.consistency_verdicts, **verdicts})
-    why = (f"the description's nominal model predicts the validation logs better than {main} "
-           f"({_apart(described, own)} on average)" if described < own else
-           f"{result.label}'s predictions leave the range the identification log supports on "
-           f"{len(far)} of {len(scored)} validation logs")
-    finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
-               f"rotor inertia) fitted to this log, because {why} and {DRIVE_ONLY_LABEL} predicts them better than "
-               f"{main} ({_apart(better, own)} on average; the description's nominal model {described:.3g} %); chosen on "
-               f"the validation logs, so their figures for it are not an independent test{_held_note(alt.held, alt.undetermined)}")
-    if alt.held or alt.undetermined:
-        result = replace(result, diagnostics={**result.diagnostics, "drive_only_held": alt.held,
-                                              "drive_only_undetermined": alt.undetermined})
-    return result, (DRIVE_ONLY_LABEL, finding)
-
-
-def _held_note(held: dict, undetermined: dict) -> str:
-    """The main-estimate finding's words on the drive terms the log does not determine
-    (:attr:`dynid.identification.drive_only.DriveOnly.held` and ``undetermined``)."""
-    def listed(runs: dict) -> str:
-        return ", ".join(f"{name} ({', '.join(f'{v:.3g}' for v in r)})" for name, r in runs.items() if name != "cutoff_factors")
-
-    if not held and not undetermined:
-        return ""
-    factors = (held or undetermined)["cutoff_factors"]
-    out = (f"; the log does not determine some drive terms of the joints that moved one way (their estimates with the "
-           f"cutoffs at {', '.join(f'{f:g}' for f in factors)}× the log's move by their own size or more: such a "
-           "joint barely accelerates, and its Coulomb friction and offset act as one term)")
-    if held:
-        out += f": kept at the description's values: {listed(held)}"
-    if undetermined:
-        sheet = any(k.startswith("Ia") for k in undetermined)
-        out += (f"{';' if held else ':'} kept at this log's values, as the description gives none: {listed(undetermined)}"
-                + (" (a rotor inertia from the drive's data sheet, Ia = ... in [[robot.joints]], would be kept instead)"
-                   if sheet else ""))
-    return out
-
-
-NOMINAL_LABEL = "description (nominal)"
-"""The set of the description's own nominal values, scored on the validation logs beside the estimates when no
-reference set of the config is that."""
-
-
-def _nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
-    """The description's nominal model as a base-parameter set (None: a description without inertias): a reference
-    set of the config that is it, else :data:`NOMINAL_LABEL`."""
-    if not np.any(robot.inertial != 0):
-        return None
-    beta = base.base_from_standard(robot.standard_parameters())
-    same = next((r.name for r in references if r.beta.shape == beta.shape and
-                 np.allclose(r.beta, beta, rtol=1e-9, atol=1e-12)), None)
-    return (same or NOMINAL_LABEL), beta
+    return choose_main_estimate(result, nominal, scored_all)
 
 
 def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
@@ -296,55 +210,6 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     setup = None if config.controller is None or not config.closed_loop else ClosedLoopSetup(*config.controller)
     return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
                                   config.sdp_prior, config.robot_source, tuple(config.closed_loop), setup)
-
-
-def _main_estimate(result, nominal: str | None = None, preferred: tuple[str, str] | None = None) -> dict:
-    """The estimate to trust, and the verdict's findings on the validation logs: the physically consistent one when the
-    unconstrained one is not consistent and the consistent one validates better (mean global error over the validation
-    logs); extrapolation and validation errors far above the fit's (:func:`dynid.validation.diagnostics.validation_findings`);
-    and the main estimate against the description's nominal model (the set ``nominal``), joint by joint
-    (:func:`dynid.validation.diagnostics.nominal_gate`). ``preferred``: (label, finding), the main estimate chosen
-    already, and why."""
-    from ..validation.diagnostics import Finding, nominal_gate, validation_findings
-
-    label = result.label
-    fit_err = result.fit.metrics()[label]["global_relative_error"]
-    fit_spread = result.diagnostics.get("prediction_spread")
-    findings = list(result.findings)
-    for v in result.validations:
-        err = v.metrics()[label]["global_relative_error"]
-        moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: its friction is unknown
-        floor = (v.floor_metrics() or {}).get("global_relative_error", np.nan)
-        findings += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label), fit_spread,
-                                        label, floor)
-    from .identify import SDP_LABEL
-
-    main = result.main or label
-    consistent = str(result.consistency_verdicts.get(label, "yes")).startswith("yes")
-    if preferred is not None:
-        main = preferred[0]
-        findings.insert(0, Finding("main", preferred[1]))
-    elif SDP_LABEL in result.estimates and main == label and not consistent and result.validations:
-        own = np.mean([v.metrics()[label]["global_relative_error"] for v in result.validations])
-        sdp = np.mean([v.metrics()[SDP_LABEL]["global_relative_error"] for v in result.validations])
-        if sdp < own:
-            main = SDP_LABEL
-            findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where {label} is not and "
-                                               f"predicts the validation logs worse ({_apart(sdp, own)} on average)"))
-    diagnostics = dict(result.diagnostics)
-    if nominal is not None:
-        gate, stats = nominal_gate(result.validations, main, nominal)
-        findings += gate
-        diagnostics.update({"nominal_set": nominal, "versus_nominal": stats})
-    return {"main": main, "findings": tuple(findings), "diagnostics": diagnostics}
-
-
-def _apart(better: float, worse: float) -> str:
-    """"a % against b %" with as many significant digits (3 to 6) as it takes for the two to read differently: the
-    main-estimate finding said "worse (1.11 % against 1.11 % on average)" on a zoo log."""
-    digits = next((d for d in range(3, 7) if f"{better:.{d}g}" != f"{worse:.{d}g}"), 6)
-    form = f".{digits}g" if digits == 3 else f"#.{digits}g"  # past three digits, trailing zeros too: 1.110 against 1.114
-    return f"{better:{form}} % against {worse:{form}} %"
 
 
 @keyword_only_after_data
