@@ -3,7 +3,7 @@ validation logs worse (1.11 % against 1.11 % on average)" on a zoo log with a de
 
 import numpy as np
 
-from dynid.identification.run import _apart
+from dynid.identification.verdict import _apart
 
 
 def test_two_different_errors_never_read_the_same(rng):
