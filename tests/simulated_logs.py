@@ -106,13 +106,18 @@ def config_text(robot_toml: str, data_root, ident: str, validation: str, n: int,
             f'[[references]]\nname = "truth"\nfile = "truth.csv"\nformat = "standard"\nheader = true\nnames = "name"\nvalues = "value"\n')
 
 
-def robot_toml(name: str, folder) -> str:
-    """A copy of a built-in robot's description with drive terms Ia, fc, fv, offset, in ``folder``."""
+def robot_toml(name: str, folder, mass_scale: float = 1.0) -> str:
+    """A copy of a built-in robot's description with drive terms Ia, fc, fv, offset, in ``folder``; ``mass_scale``
+    multiplies every link's mass of a description that states them (a CAD-like description, not the truth)."""
     import re
     from importlib import resources
 
     res = resources.files("dynid.model") / "robots"
     text = (res / f"{name}.toml").read_text(encoding="utf-8")
+    if mass_scale != 1.0:
+        assert re.search(r"^mass = ", text, flags=re.M), f"{name}'s description states no masses to scale"
+        text = re.sub(r"^mass = ([0-9.eE+-]+)", lambda m: f"mass = {float(m.group(1)) * mass_scale!r}", text,
+                      flags=re.M)
     text = re.sub(r"^drive_terms = .*$", 'drive_terms = ["Ia", "fc", "fv", "offset"]', text, count=1, flags=re.M)
     if "drive_terms" not in text:
         text = 'drive_terms = ["Ia", "fc", "fv", "offset"]\n' + text
@@ -128,9 +133,11 @@ def write_truth(path, robot, names) -> None:
 
 
 def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, duration: float = 30.0,
-                   current_std: float = 0.02):
+                   current_std: float = 0.02, mass_scale: float = 1.0):
     """Identification and validation logs of robot ``name`` at ``rate`` Hz with ``motion`` ("fourier" or
-    "ptp"), their config (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot)."""
+    "ptp"), their config (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot).
+    ``mass_scale``: the config's description has the truth's link masses times this (a description unlike the truth,
+    as a real robot's CAD is; 1: the truth itself, whose rigid body with the drive terms fitted is the best model)."""
     rng = np.random.default_rng(seed)
     robot, friction = truth_robot(name, rng)
     t = np.arange(int(duration * rate)) / rate
@@ -139,7 +146,7 @@ def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, d
         q, dq, ddq = make(robot, t, rng)
         write_log(folder / f"{label}.csv", robot, t, q, dq, ddq, friction, rng, current_std)
     write_truth(folder / "truth.csv", robot, robot.parameter_names)
-    toml = robot_toml(name, folder)
+    toml = robot_toml(name, folder, mass_scale)
     cfg = folder / "config.toml"
     cfg.write_text(config_text(toml, folder, "ident.csv", "valid.csv", robot.n_dof))
     return cfg, robot

@@ -139,6 +139,7 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         best = min(expected, key=lambda k: (expected[k], k != main))
         result = replace(result, diagnostics={**result.diagnostics, "expected_validation_rms_error": expected})
         if best != main:
+            findings = [f for f in findings if f.kind != "main"]  # the rigid body's own choice is not the verdict
             why = (f"its expected RMS torque error on the validation logs' motions is lower than {main}'s "
                    f"({_apart(expected[best], expected[main]).replace('%', 'N·m')}: the identification log's residual "
                    "plus the prediction variance on those motions' states; no validation torque is used)")
