@@ -11,6 +11,7 @@ with drive terms Ia, fc, fv, offset.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -114,10 +115,16 @@ def robot_toml(name: str, folder, mass_scale: float = 1.0) -> str:
 
     res = resources.files("dynid.model") / "robots"
     text = (res / f"{name}.toml").read_text(encoding="utf-8")
-    if mass_scale != 1.0:
+    scaled = lambda m: f"{m.group(1)}{float(m.group(2)) * mass_scale!r}{m.group(3)}"  # noqa: E731
+    if mass_scale != 1.0 and re.search(r'^urdf = "(.*)"$', text, flags=re.M):  # the URDF's masses, in a copy
+        urdf = re.search(r'^urdf = "(.*)"$', text, flags=re.M).group(1)
+        copy = Path(folder) / f"{name}_scaled.urdf"
+        copy.write_text(re.sub(r'(<mass value=")([0-9.eE+-]+)(")', scaled, (res / urdf).read_text(encoding="utf-8")),
+                        encoding="utf-8")
+        text = text.replace(f'urdf = "{urdf}"', f'urdf = "{copy}"')
+    elif mass_scale != 1.0:
         assert re.search(r"^mass = ", text, flags=re.M), f"{name}'s description states no masses to scale"
-        text = re.sub(r"^mass = ([0-9.eE+-]+)", lambda m: f"mass = {float(m.group(1)) * mass_scale!r}", text,
-                      flags=re.M)
+        text = re.sub(r"^(mass = )([0-9.eE+-]+)()", scaled, text, flags=re.M)
     text = re.sub(r"^drive_terms = .*$", 'drive_terms = ["Ia", "fc", "fv", "offset"]', text, count=1, flags=re.M)
     if "drive_terms" not in text:
         text = 'drive_terms = ["Ia", "fc", "fv", "offset"]\n' + text

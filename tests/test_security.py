@@ -255,7 +255,7 @@ def test_a_non_finite_number_in_a_results_file_is_refused_where_it_is_read(tmp_p
 
     from .simulated_logs import simulated_case
 
-    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0)
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0, mass_scale=1.3)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
     p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr

@@ -294,7 +294,7 @@ class IdentificationResult:
             "references": refs, "warnings": list(self.warnings),
             "consistency_margin": self.consistency, "physically_consistent_verdict": self.consistency_verdicts,
             "estimates": {label: e.to_dict(self.base) for label, e in self.estimates.items()},
-            "objective_eq9": self.objective, "main_estimate": self.main_estimate.label,
+            "objective_eq9": self.objective, "main_estimate": self.main or estimate_label(self.estimators[0]),
             "findings": [f.to_dict() for f in self.findings], "diagnostics": self.diagnostics,
             **({} if self.drive_gains is None else {"drive_gains": self.drive_gains.to_dict()}),
             **({} if self.box is None else {"search_box": {"rule": f"estimate ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|estimate|)",

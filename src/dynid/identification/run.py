@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..checks import check_trajectory_array
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
 from ..io.datasets import (
     GAP_FACTOR,
@@ -359,7 +360,6 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
         Time stamps that do not increase, a gap longer than 5 median steps, or a position step no motion makes
         (:func:`dynid.io.datasets.check_position_steps`).
     """
-    from ..checks import check_trajectory_array
 
     t = np.asarray(t, dtype=float).reshape(-1)
     q = check_trajectory_array(q, robot.n_dof, "q")

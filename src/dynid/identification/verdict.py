@@ -27,6 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..estimators.registry import estimate_label
 from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 
 __all__ = ["NOMINAL_KEY", "NOMINAL_LABEL", "choose_main_estimate", "expected_errors", "nominal_set"]
@@ -117,7 +118,6 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         With ``main``, ``findings`` and ``diagnostics`` set, and the drive-only or nominal estimate among its
         estimates where it is the main one.
     """
-    from ..estimators.registry import estimate_label
     from .drive_only import DRIVE_ONLY_KEY
     from .identify import SDP_LABEL, Estimate, consistency_checks
 
@@ -155,9 +155,13 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
                 if alt.held or alt.undetermined:
                     result = replace(result, diagnostics={**result.diagnostics, "drive_only_held": alt.held,
                                                           "drive_only_undetermined": alt.undetermined})
-            else:  # the description itself, under the label its set is scored with
-                estimate = Estimate(NOMINAL_KEY, np.asarray(nominal[1], dtype=float), np.zeros_like(nominal[1]))
-                result = replace(result, estimates={**result.estimates, best: estimate})
+            else:  # the description itself, under the label its set is scored with; export writes its own values
+                estimate = Estimate(NOMINAL_KEY, np.asarray(nominal[1], dtype=float), np.zeros_like(nominal[1]),
+                                    standard=result.model.standard_parameters())
+                margins, verdicts = consistency_checks(result.model, result.base, {best: estimate.params})
+                result = replace(result, estimates={**result.estimates, best: estimate},
+                                 consistency={**result.consistency, **margins},
+                                 consistency_verdicts={**result.consistency_verdicts, **verdicts})
                 findings.insert(0, Finding("main", f"main estimate: {best}: keep your robot file's values, this log "
                                                    f"cannot improve them: {why}; what would: a longer, richer "
                                                    "excitation (dynid excite) over the motions the robot will make"))

@@ -13,6 +13,7 @@ from ..conventions import unit_of
 from ..estimators.registry import OTHER_LABELS, label
 from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
+from ..identification.verdict import NOMINAL_KEY
 from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
@@ -316,6 +317,9 @@ def readiness(result) -> Line:
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
+    if getattr(r.estimates.get(r.main), "key", "") == NOMINAL_KEY:
+        return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "
+                    "says why and what would", "title")
     if not exportable:
         why = ('add "sdp" to [estimation] estimators for a physically consistent estimate' if "sdp" not in r.estimators
                else "no estimate passed the consistency check (the verdict says why)")
