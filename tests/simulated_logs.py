@@ -11,7 +11,6 @@ with drive terms Ia, fc, fv, offset.
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -107,24 +106,13 @@ def config_text(robot_toml: str, data_root, ident: str, validation: str, n: int,
             f'[[references]]\nname = "truth"\nfile = "truth.csv"\nformat = "standard"\nheader = true\nnames = "name"\nvalues = "value"\n')
 
 
-def robot_toml(name: str, folder, mass_scale: float = 1.0) -> str:
-    """A copy of a built-in robot's description with drive terms Ia, fc, fv, offset, in ``folder``; ``mass_scale``
-    multiplies every link's mass of a description that states them (a CAD-like description, not the truth)."""
+def robot_toml(name: str, folder) -> str:
+    """A copy of a built-in robot's description with drive terms Ia, fc, fv, offset, in ``folder``."""
     import re
     from importlib import resources
 
     res = resources.files("dynid.model") / "robots"
     text = (res / f"{name}.toml").read_text(encoding="utf-8")
-    scaled = lambda m: f"{m.group(1)}{float(m.group(2)) * mass_scale!r}{m.group(3)}"  # noqa: E731
-    if mass_scale != 1.0 and re.search(r'^urdf = "(.*)"$', text, flags=re.M):  # the URDF's masses, in a copy
-        urdf = re.search(r'^urdf = "(.*)"$', text, flags=re.M).group(1)
-        copy = Path(folder) / f"{name}_scaled.urdf"
-        copy.write_text(re.sub(r'(<mass value=")([0-9.eE+-]+)(")', scaled, (res / urdf).read_text(encoding="utf-8")),
-                        encoding="utf-8")
-        text = text.replace(f'urdf = "{urdf}"', f'urdf = "{copy}"')
-    elif mass_scale != 1.0:
-        assert re.search(r"^mass = ", text, flags=re.M), f"{name}'s description states no masses to scale"
-        text = re.sub(r"^(mass = )([0-9.eE+-]+)()", scaled, text, flags=re.M)
     text = re.sub(r"^drive_terms = .*$", 'drive_terms = ["Ia", "fc", "fv", "offset"]', text, count=1, flags=re.M)
     if "drive_terms" not in text:
         text = 'drive_terms = ["Ia", "fc", "fv", "offset"]\n' + text
@@ -140,11 +128,9 @@ def write_truth(path, robot, names) -> None:
 
 
 def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, duration: float = 30.0,
-                   current_std: float = 0.02, mass_scale: float = 1.0):
+                   current_std: float = 0.02):
     """Identification and validation logs of robot ``name`` at ``rate`` Hz with ``motion`` ("fourier" or
-    "ptp"), their config (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot).
-    ``mass_scale``: the config's description has the truth's link masses times this (a description unlike the truth,
-    as a real robot's CAD is; 1: the truth itself, whose rigid body with the drive terms fitted is the best model)."""
+    "ptp"), their config (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot)."""
     rng = np.random.default_rng(seed)
     robot, friction = truth_robot(name, rng)
     t = np.arange(int(duration * rate)) / rate
@@ -153,7 +139,7 @@ def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, d
         q, dq, ddq = make(robot, t, rng)
         write_log(folder / f"{label}.csv", robot, t, q, dq, ddq, friction, rng, current_std)
     write_truth(folder / "truth.csv", robot, robot.parameter_names)
-    toml = robot_toml(name, folder, mass_scale)
+    toml = robot_toml(name, folder)
     cfg = folder / "config.toml"
     cfg.write_text(config_text(toml, folder, "ident.csv", "valid.csv", robot.n_dof))
     return cfg, robot

@@ -29,7 +29,7 @@ def test_a_new_estimator_runs_in_dynid_run():
 
 
 def test_a_new_estimator_runs_in_dynid_identify_and_validate(tmp_path):
-    cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0, mass_scale=1.3)
+    cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ridge_test", "ols"]'))
     config = load_identification_config(cfg)
     result = run_identification(config)

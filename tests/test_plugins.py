@@ -69,7 +69,7 @@ def test_a_plugin_file_adds_an_estimator_to_dynid_run(tmp_path, clean):
 def test_the_environment_names_plugins_for_a_config(tmp_path, clean, monkeypatch):
     from .simulated_logs import simulated_case
 
-    cfg, _ = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=20.0, mass_scale=1.3)
+    cfg, _ = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=20.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ridge_plugin", "ols"]'))
     monkeypatch.setenv(plugins.ENVIRONMENT, str(_ridge_file(tmp_path)))
     assert main(["identify", str(cfg), "--out", str(tmp_path / "out"), "-q"]) == 0

@@ -255,7 +255,7 @@ def test_a_non_finite_number_in_a_results_file_is_refused_where_it_is_read(tmp_p
 
     from .simulated_logs import simulated_case
 
-    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0, mass_scale=1.3)
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
     p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
@@ -275,3 +275,33 @@ def test_a_non_finite_number_in_a_results_file_is_refused_where_it_is_read(tmp_p
     (tmp_path / "nan-values.json").write_text(json.dumps(r))
     with pytest.raises(DynIdError, match=rf"values.{first}: expected a finite number"):
         api.load_results(tmp_path / "nan-values.json", robot=api.load_robot(str(cfg.parent / "er16_truth.toml")))
+
+
+def test_an_absurd_number_in_a_results_file_is_refused_where_it_is_read(tmp_path):
+    """A results.json holding 1e308 overflowed dynid validate (then a matplotlib crash, an empty output folder left)
+    and dynid export wrote a URDF with a 1e308 kg link; a negative mass was written as it was."""
+    import json
+
+    from .simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=10.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    good = json.loads((tmp_path / "out" / "results.json").read_text())
+    label = "dynid SDP"  # what export writes (least squares has no standard values)
+    for value, said in ((1e308, "expected a link mass in [0, 100000] kg, got 1e+308"),
+                        (-2.0, "expected a link mass in [0, 100000] kg, got -2.0")):
+        r = json.loads(json.dumps(good))
+        r["estimates"][label]["standard_values"]["M1"] = value
+        (tmp_path / "bad.json").write_text(json.dumps(r))
+        assert_refused(dynid("export", cfg, "--results", tmp_path / "bad.json", "--urdf", tmp_path / "x.urdf"),
+                       f"estimates.{label}.standard_values.M1: {said}")
+        assert not (tmp_path / "x.urdf").exists()
+    r = json.loads(json.dumps(good))
+    first = next(iter(r["estimates"]["dynid WLS"]["values"]))
+    r["estimates"]["dynid WLS"]["values"][first] = 1e308
+    (tmp_path / "huge.json").write_text(json.dumps(r))
+    assert_refused(dynid("validate", cfg, "--results", tmp_path / "huge.json", "--out", tmp_path / "v", "-q"),
+                   f"values.{first}: expected a value within ±1e+12 (SI units), got 1e+308", tmp_path / "v", None)
+

@@ -70,3 +70,16 @@ class IdentifiabilityError(DynIdError, ValueError):
     field : str, optional
         The setting at fault when the message starts with it (the CLI names its option instead).
     """
+
+
+class NotFittedError(DynIdError, ValueError, AttributeError):
+    """An estimator or an Identifier used before ``fit``: the same bases as scikit-learn's ``NotFittedError``
+    (``ValueError`` and ``AttributeError``), so code written for either catches it.
+
+    Parameters
+    ----------
+    message : str
+        One line: what was called, and which fit to call first.
+    field : str, optional
+        The setting at fault when the message starts with it (the CLI names its option instead).
+    """

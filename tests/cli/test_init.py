@@ -216,7 +216,7 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     assert p.returncode == 0, p.stderr
     said = " ".join(p.stdout.split())  # the console wraps long lines
     assert "CONFIG" not in said and "FILE" not in said
-    assert said.startswith("model ready: dynid "), said[:200]  # the verdict's choice: the log is the URDF's own
+    assert said.startswith("model ready: dynid SDP, as the URDF and MJCF in the output folder"), said[:200]
     start = said.index("dynid export")
     command = shlex.split(said[start: said.index("-identified.urdf", start) + len("-identified.urdf")])
     assert command[:2] == ["dynid", "export"]

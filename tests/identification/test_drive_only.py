@@ -46,8 +46,7 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
     """Rows 635-935 of the UR10e's log (3 s, J3 and J5 one way): the SDP and OLS predict the 11 validation logs worse
     than the description; the main estimate is then "dynid drive-only": the description's links to the digit, drive
     terms that differ from the description's, base parameters = regrouping · its standard ones, better on the
-    validation logs than every other estimate and than the description, chosen without their torques and said in the
-    findings; export writes it."""
+    validation logs than every other estimate and than the description, said in the findings; export writes it."""
     config, r, others = _identified(tmp_path, 635, 935)
     label = LABEL
     nominal = r["diagnostics"]["nominal_set"]
@@ -72,7 +71,7 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
     np.testing.assert_allclose([values[n] for n in base.names], base.base_from_standard(
         np.array([std[n] for n in chosen.parameter_names])), rtol=1e-9, atol=1e-9)
     said = " ".join(f["text"] if isinstance(f, dict) else str(f) for f in r["findings"])
-    assert "main estimate: dynid drive-only" in said and "no validation torque is used" in said
+    assert "main estimate: dynid drive-only" in said and "not an independent test" in said
 
     e = dynid("export", config, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "model.urdf")
     assert e.returncode == 0, e.stderr
@@ -83,14 +82,13 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
 def test_drive_only_is_chosen_where_it_predicts_better_even_when_the_description_alone_does_not(tmp_path):
     """Rows 1060-1560 (J2 one way): least squares and the SDP predict the validation logs better than the description's
     nominal model (no friction, no rotor inertia), and the description's rigid body with the drive terms fitted better
-    still: it is the main estimate, chosen on the expected errors (the identification log's residual plus the
-    prediction variance on the validation logs' states: :mod:`dynid.identification.verdict`); least squares
-    extrapolates there (the finding ``extrapolation``)."""
+    still: it is the main estimate, the candidate the same validation pass scored; the finding gives the three
+    figures and the reason: least squares extrapolates there (the finding ``extrapolation``). (Until the commit after
+    e88fa23 it was scored only where the nominal model beat the main estimate.)"""
     _, r, others = _identified(tmp_path, 1060, 1560)
     nominal = r["diagnostics"]["nominal_set"]
     assert max(_mean(r, k) for k in others) < _mean(r, nominal)
     assert any(f["kind"] == "extrapolation" for f in r["findings"])
     said = next(f["text"] for f in r["findings"] if f["kind"] == "main")
-    assert said.startswith(f"main estimate: {LABEL}") and "prediction variance on those motions' states" in said
-    expected = r["diagnostics"]["expected_validation_rms_error"]  # the evidence: no validation torque in it
-    assert min(expected, key=expected.get) == LABEL and "no validation torque is used" in said
+    assert said.startswith(f"main estimate: {LABEL}") and "leave the range the identification log supports" in said
+    assert f"{_mean(r, nominal):.3g} %" in said and "not an independent test" in said

@@ -103,7 +103,7 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     from dynid.report.summaries import identification_blocks
     from dynid.tables import render_text
 
-    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0, mass_scale=1.3)
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
     result = run_identification(load_identification_config(cfg))
     text = render_text(identification_blocks(result), 200)
@@ -220,7 +220,7 @@ def test_the_first_line_says_whether_the_model_is_ready(tmp_path):
     from dynid.report.summaries import identification_brief
     from dynid.tables import render_text
 
-    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0, mass_scale=1.3)
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
     text = cfg.read_text()
     cfg.write_text(text.replace('estimators = ["ols"]\n', 'estimators = ["wls"]\n'))
     first = render_text(identification_brief(run_identification(load_identification_config(cfg))), 400).splitlines()[0]

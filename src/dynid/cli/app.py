@@ -225,7 +225,7 @@ def run(
         _renamed(methods)
         paper_first = not compare and plant is None and estimators is None
         chosen_plant = plant or ("assumed" if compare or robot != "er16" or joints != 3 else "paper")
-        chosen = estimators or (None if compare or chosen_plant != "paper" else PAPER_ESTIMATORS)
+        chosen = estimators if estimators is not None else (None if compare or chosen_plant != "paper" else PAPER_ESTIMATORS)
         config = PaperExperimentConfig(
             robot=robot, joints=joints, plant=chosen_plant, seed=seed, duration=duration, rate=rate,
             current_noise=current_noise, smoothing_passes=smoothing_passes, colony_size=abc_colony,
@@ -645,7 +645,10 @@ def migrate(
             raise DynIdError(f"{config}: no such config")
         if out is not None and not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
-        return config.read_text(encoding="utf-8")
+        try:
+            return config.read_text(encoding="utf-8")
+        except UnicodeDecodeError as exc:
+            raise DynIdError(f"{config}: not a text file (byte {exc.start} is no UTF-8): expected a TOML config") from None
 
     def compute(text, progress):
         return migrate_text(text, str(config))

@@ -6,7 +6,7 @@ import inspect
 
 import numpy as np
 
-from ..exceptions import ShapeError
+from ..exceptions import NotFittedError, ShapeError
 from ..hyperparameters import HyperParameters
 from .accumulate import LeastSquaresAccumulator
 
@@ -312,11 +312,11 @@ class Estimator(HyperParameters):
 
         Raises
         ------
-        AttributeError
-            Not fitted yet.
+        NotFittedError
+            Not fitted yet (an ``AttributeError`` and a ``ValueError``, as scikit-learn's).
         """
         if not hasattr(self, "params_"):
-            raise AttributeError(f"{type(self).__name__} is not fitted yet: call fit(W, tau) first")
+            raise NotFittedError(f"{type(self).__name__} is not fitted yet: call fit(W, tau) first")
         return np.asarray(w, dtype=float) @ self.params_
 
     def score(self, w, tau) -> float:

@@ -58,8 +58,6 @@ class DriveOnly:
     undetermined : dict
         The same for the terms the variants moved as much that keep this log's value, as the description gives none
         (a rotor inertia a URDF cannot hold): the log does not determine them.
-    covariance : (n_base, n_base) array or None
-        The base parameters' covariance (its prediction spread on other motions: :mod:`dynid.identification.verdict`).
     """
 
     params: np.ndarray
@@ -68,7 +66,6 @@ class DriveOnly:
     fit: object = None
     held: dict = field(default_factory=dict)
     undetermined: dict = field(default_factory=dict)
-    covariance: np.ndarray | None = None
 
 
 CUTOFF_FACTORS = (0.5, 2.0)
@@ -198,8 +195,7 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
         loose = {"cutoff_factors": tuple(factors), **loose} if loose else {}
     standard = phi0.copy()
     standard[drive] = x
-    return DriveOnly(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held=held, undetermined=loose,
-                     covariance=cov)
+    return DriveOnly(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held=held, undetermined=loose)
 
 
 def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..estimators.physically_consistent import PRIOR_KINDS as SDP_PRIORS
-from ..exceptions import ConfigError
+from ..exceptions import ConfigError, NotFittedError
 from ..hyperparameters import HyperParameters
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
@@ -259,7 +259,8 @@ class Identifier(HyperParameters):
 
     def _model(self):
         if not hasattr(self, "model_"):
-            raise AttributeError("this Identifier is not fitted yet: call fit(t, q, tau) or fit(config) first")
+            raise NotFittedError("this Identifier is not fitted yet: call fit(t, q, tau), or Identifier.from_config(config), "
+                                 "first")
         return self.model_
 
     def parameters(self, estimate: str | None = None):

@@ -42,7 +42,7 @@ from ..validation.diagnostics import (
 )
 from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DRIVE_ONLY_KEY, DriveOnly, drive_only
-from .verdict import nominal_set
+from .verdict import choose_main_estimate
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
@@ -190,14 +190,11 @@ class IdentificationResult:
         Label of the estimate to trust.
     drive_only : DriveOnly or None
         The description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`): made the
-        main estimate by :func:`dynid.identification.verdict.choose_main_estimate` where the evidence prefers it; not
+        main estimate by :func:`dynid.identification.verdict.choose_main_estimate` where the validation logs prefer it; not
         in :attr:`estimates` otherwise (None: a description without inertial parameters).
     choices : ModelChoices or None
         What the data chose for :attr:`model` (:class:`dynid.identification.choices.ModelChoices`): set by
         :class:`dynid.identification.pipeline.IdentificationPipeline`, None where :func:`identify` is called alone.
-    covariances : dict
-        label -> (n_base, n_base) covariance of an estimate whose solver gives none (the SDP's jackknife over the
-        held-out refits), for its prediction spread on other motions.
     """
 
     robot: str
@@ -224,7 +221,6 @@ class IdentificationResult:
     main: str = ""
     drive_only: DriveOnly | None = None
     choices: Any = None
-    covariances: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -364,7 +360,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
-    scoring = BlockScoring(robot, base, data, held_out=sdp, observers=observers)
+    scoring = BlockScoring(robot, base, data, held_out=held_out and sdp, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
     stream_rows(chunks, estimation, base, scoring.add, standard=standard)
@@ -405,25 +401,23 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
-    described = nominal_set(robot, base, references)  # the verdict weighs it against the others on this log too
-    alternative = None if found is None else replace(found, fit=replace(sums.comparison(data.name, {
-        **sets, **({} if described is None else {described[0]: described[1]}), DRIVE_ONLY_LABEL: found.params}),
-        noise=joint_std, speed=fit.speed))
+    alternative = None if found is None else replace(found, fit=replace(
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
     ls_label = estimate_label(ls_key)
-    jackknife = {}
-    if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):  # the SDP's spread for the verdict
-        own, held, jackknife[SDP_LABEL] = _held_out_errors(robot, base, folds, row_weights)
+    if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):  # the verdict's evidence on held-out blocks
+        if progress is not None:
+            progress("physically consistent SDP, held-out blocks", 0, 1)
+        own, held = _held_out_errors(robot, folds, row_weights)
         stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
-    return IdentificationResult(robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
-                                n_rows=int(reference.accumulator_.rows.sum()),
-                                settings={"preprocessing": data.settings.to_dict(), "rate": data.rate}, warnings=tuple(warnings),
-                                consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box, model=robot,
-                                findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]),
-                                drive_only=alternative, covariances=jackknife)
+    return choose_main_estimate(IdentificationResult(
+        robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
+        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate},
+        warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
+        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative))
 
 
 class BlockScoring:
@@ -656,16 +650,13 @@ HELD_OUT_FOLDS = 5
 """Contiguous blocks of the identification log that compare the estimates when no validation log does."""
 
 
-def _held_out_errors(robot: Robot, base: BaseParameters, folds, row_weights) -> tuple[float, float, np.ndarray]:
+def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
     """RMS torque error on the held-out blocks of the unconstrained (OLS/WLS, minimum-norm over the standard
-    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others;
-    and the physically consistent estimate's jackknife covariance over those refits (base parameters: its spread on
-    other motions, which its solver does not give; Efron & Stein, Ann. Statist. 9(3), 1981)."""
+    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others."""
     p = robot.n_params
     links, nonneg = consistency_layout(robot)
     sse = np.zeros(2)
     rows = 0
-    refits = []
     for k, held in enumerate(folds):
         rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
         reduced = rest.reduced(row_weights)
@@ -674,10 +665,8 @@ def _held_out_errors(robot: Robot, base: BaseParameters, folds, row_weights) -> 
         est.fit(reduced[:, :p], reduced[:, p])
         sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
         rows += int(held.rows.sum())
-        refits.append(base.base_from_standard(est.params_))
     own, sdp = np.sqrt(sse / max(rows, 1))
-    spread = np.asarray(refits) - np.mean(refits, axis=0)
-    return float(own), float(sdp), (len(refits) - 1) / len(refits) * spread.T @ spread
+    return float(own), float(sdp)
 
 
 def _step(progress, label: str):

@@ -168,26 +168,25 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = pipeline.estimate(prepared, refs, progress, recording=raw)
+        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw)
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
-    nominal = nominal_set(robot, base, result.references)
     if not validate or not config.validation:
-        return choose_main_estimate(result, nominal)
+        return result
     sets = result.parameter_sets()
+    nominal = nominal_set(robot, base, result.references)
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
         sets[nominal[0]] = nominal[1]
 
     alt = result.drive_only if nominal is not None else None
-    covariance = {result.label: result.solution.covariance, **result.covariances}
     if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
         from .identify import DRIVE_ONLY_LABEL
 
         sets[DRIVE_ONLY_LABEL] = alt.params
-        covariance[DRIVE_ONLY_LABEL] = alt.covariance
     scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
-                                         prepared.data.settings, result.joint_std, covariance)
+                                         prepared.data.settings, result.joint_std,
+                                         {result.label: result.solution.covariance})
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     return choose_main_estimate(result, nominal, scored_all)

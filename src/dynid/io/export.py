@@ -18,6 +18,7 @@ inertia makes simulators fail or behave wrongly.
 
 from __future__ import annotations
 
+import re
 from html import escape
 
 import numpy as np
@@ -27,7 +28,7 @@ from ..keywords import keyword_only_after_data
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
-from .results import stored_standard
+from .results import LARGEST_VALUE, stored_standard
 
 CONSISTENCY_TOL = 1e-7
 """Smallest pseudo-inertia eigenvalue tolerated (the SDP solver's accuracy) [kg·m², kg]."""
@@ -272,8 +273,18 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
             raise ConfigError(f"{source}: estimates.{label}.standard_values.{n}: expected a finite number, got "
                               f"{'null' if v is None else repr(v)}")
     phi = np.array([float(values[n]) for n in robot.parameter_names])
+    for n, v in zip(robot.parameter_names, phi):
+        heavy = re.fullmatch(r"M\d+", n) is not None and not 0.0 <= v <= LARGEST_LINK_MASS
+        if heavy or abs(v) > LARGEST_VALUE:
+            what = (f"a link mass in [0, {LARGEST_LINK_MASS:g}] kg" if heavy else
+                    f"a value within ±{LARGEST_VALUE:g} (SI units)")
+            raise ConfigError(f"{source}: estimates.{label}.standard_values.{n}: expected {what}, got {float(v)!r}")
     return robot, phi
 
+
+LARGEST_LINK_MASS = 1e5
+"""kg: a robot link's mass above this in a results file is no identification (the largest industrial arms' links
+weigh a few tonnes); export refuses it rather than write it."""
 
 def nominal_warning(results: dict) -> str | None:
     """One line when the exported (physically consistent) estimate predicted some joints of the validation logs worse

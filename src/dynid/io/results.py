@@ -245,4 +245,13 @@ def _vector(entry, names: tuple, where: str) -> np.ndarray:
     if not np.all(np.isfinite(out)):
         bad = names[int(np.flatnonzero(~np.isfinite(out))[0])]
         raise DataError(f"{where}.values.{bad}: expected a finite number, got {entry['values'][bad]!r}")
+    if np.any(np.abs(out) > LARGEST_VALUE):  # its squares overflow the scores (a 1e308 crashed dynid validate)
+        bad = names[int(np.flatnonzero(np.abs(out) > LARGEST_VALUE)[0])]
+        raise DataError(f"{where}.values.{bad}: expected a value within ±{LARGEST_VALUE:g} (SI units), got "
+                        f"{entry['values'][bad]!r}")
     return out
+
+
+LARGEST_VALUE = 1e12
+"""The largest magnitude of a base or standard parameter (SI units) a results file may hold: beyond, its squares
+overflow the scores dynid and a simulator form (a 1e308 crashed dynid validate, and export wrote a 1e308 kg link)."""

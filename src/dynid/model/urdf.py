@@ -27,11 +27,17 @@ HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (
 """What a refusal of a joint dynid cannot identify says to do (:func:`check_urdf_text`, :func:`joints_from_urdf`)."""
 
 
+_INERTIAL_VALUES = {"mass": ("value",), "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "origin": ("xyz", "rpy")}
+"""The attributes of a link's elements that :func:`check_urdf_text` requires finite (Pinocchio reads a NaN mass as
+a massless link)."""
+
+
 def check_urdf_text(path: Path, held=()) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
-    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), and ``<mimic>`` joints
-    (coupled to another: dynid would identify them as independent joints) that are not held fixed.
+    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), ``<mimic>`` joints
+    (coupled to another: dynid would identify them as independent joints) that are not held fixed, and a link's mass,
+    inertia or origin that is not finite (NaN was read as a massless link).
 
     Parameters
     ----------
@@ -46,8 +52,21 @@ def check_urdf_text(path: Path, held=()) -> None:
     parser = expat.ParserCreate()
     problems = []
     joint: list = []  # the joint element being read (name, type)
+    link: list = []  # the link element being read (name)
 
     def start(name, attrs):
+        if name == "link":
+            link[:] = [attrs.get("name", "?")]
+        elif link and name in _INERTIAL_VALUES:
+            for key in _INERTIAL_VALUES[name]:
+                text = attrs.get(key)
+                try:
+                    finite = text is None or all(np.isfinite([float(v) for v in text.split()]))
+                except ValueError:
+                    finite = False
+                if not finite:
+                    problems.append(f"line {parser.CurrentLineNumber}: link {link[0]!r}: <{name} {key}=\"{text}\">, "
+                                    "expected finite numbers (a link's inertial values are read, never guessed)")
         if name == "joint" and "type" in attrs:
             joint[:] = [attrs.get("name", "?"), attrs["type"]]
             if attrs["type"] not in URDF_JOINT_TYPES:
@@ -70,6 +89,8 @@ def check_urdf_text(path: Path, held=()) -> None:
     def end(name):
         if name == "joint":
             joint.clear()
+        elif name == "link":
+            link.clear()
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end

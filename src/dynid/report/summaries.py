@@ -317,7 +317,7 @@ def readiness(result) -> Line:
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
-    if getattr(r.estimates.get(r.main), "key", "") == NOMINAL_KEY:
+    if getattr(r.estimates.get(getattr(r, "main", "")), "key", "") == NOMINAL_KEY:
         return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "
                     "says why and what would", "title")
     if not exportable:
