@@ -98,3 +98,24 @@ def test_run_excitation_file_with_wrong_joint_count(tmp_path):
     f.write_text(json.dumps({"form": "paper", "omega_f": 0.5, "q0": [0, 0], "a": [[0.1], [0.1]], "b": [[0.0], [0.0]]}))
     p = dynid("run", "--out", str(tmp_path / "o"), *FAST, "--excitation", str(f))
     assert p.returncode == 1 and "the trajectory has 2 joints, the run identifies 3" in p.stderr
+
+
+def test_a_continuous_joint_is_said_in_one_line_not_a_numpy_warning(tmp_path):
+    """issue "An excitation safe to run", item 4: a URDF joint without position limits leaked NumPy's RuntimeWarning
+    (``mid = 0.5*(q_min+q_max)`` of ±inf); it is said in one line with the range the trajectory takes."""
+    from importlib import resources
+
+    urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8")
+    old = '<joint name="wrist_3_joint" type="revolute">'
+    assert urdf.count(old) == 1
+    (tmp_path / "arm.urdf").write_text(urdf.replace(old, '<joint name="wrist_3_joint" type="continuous">'))
+    (tmp_path / "excite.toml").write_text('robot = "arm.urdf"\n[trajectory]\nharmonics = 2\nfrequency = 0.2\n'
+                                          "[limits]\nddq_max = 4.0\n[design]\nstarts = 1\nmaxiter = 5\n"
+                                          "[output]\nrate = 100\n")
+    p = dynid("excite", str(tmp_path / "excite.toml"), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0, p.stderr
+    assert "RuntimeWarning" not in p.stderr + p.stdout
+    said = " ".join((p.stdout + p.stderr).split())  # a warning line goes to standard error
+    assert "no position limits on J6 (continuous joints)" in said
+    q = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)[:, 6]
+    assert f"J6 {q.min():.3g} to {q.max():.3g} rad" in said

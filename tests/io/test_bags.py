@@ -84,3 +84,21 @@ def test_a_bag_with_missing_efforts_is_filled_as_a_log_is(tmp_path):
     _write_bag(tmp_path / "hole", t, names, q, np.zeros_like(q), effort)
     with pytest.raises(DataError, match=r"hole: message 61 on /joint_states: joint 5's torques are missing for 40 rows"):
         load_recording(dataset_spec({"bag": "hole"}, tmp_path, "cfg", "ident", 6), robot)
+
+
+def test_a_validation_table_of_a_bag_config_inherits_the_bags_reader_settings(tmp_path):
+    """issue "Nothing runs, nothing silent": a [[validation]] bag table inherited neither ``bag`` nor ``joint_names``
+    (a table with only ``time_range`` was refused, one naming another bag read it with the default joint order)."""
+    from dynid.io.identification_config import with_inherited_layout
+
+    names = list("abcdef")
+    doc = {"identification": {"bag": "ident", "topic": "/arm/joint_states", "joint_names": names, "effort": "currents",
+                              "time_range": [0.0, 10.0]},
+           "validation": [{"time_range": [10.0, 20.0]}, {"bag": "other"}, {"bag": "third", "joint_names": names[::-1]},
+                          {"file": "log.csv", "positions": {"columns": [1, 2, 3, 4, 5, 6]}}]}
+    same, other, own, csv = with_inherited_layout(doc)["validation"]
+    assert same == {"bag": "ident", "topic": "/arm/joint_states", "joint_names": names, "effort": "currents",
+                    "time_range": [10.0, 20.0]}
+    assert other == {"bag": "other", "topic": "/arm/joint_states", "joint_names": names, "effort": "currents"}
+    assert own["joint_names"] == names[::-1] and own["bag"] == "third"
+    assert csv == {"file": "log.csv", "positions": {"columns": [1, 2, 3, 4, 5, 6]}}

@@ -145,8 +145,21 @@ class ExcitationProblem:
         if self.offsets is not None:
             return self.offsets.copy()
         lim = self.limits
-        mid = 0.5 * (lim.q_min + lim.q_max)
-        return np.where(np.isfinite(mid), mid, 0.0)
+        bounded = np.isfinite(lim.q_min) & np.isfinite(lim.q_max)  # a continuous joint has neither
+        mid = np.zeros(bounded.shape)
+        mid[bounded] = 0.5 * (lim.q_min[bounded] + lim.q_max[bounded])
+        return mid
+
+    def unlimited_joints(self) -> list[int]:
+        """The joints (0-based) without position limits (continuous joints, or ``±inf`` in ``[limits]``): the
+        design swings them about their offset, bounded by their velocity and acceleration limits only.
+
+        Returns
+        -------
+        list of int
+        """
+        lim = self.limits
+        return [int(j) for j in np.flatnonzero(~(np.isfinite(lim.q_min) & np.isfinite(lim.q_max)))]
 
     def _check_start_pose(self) -> None:
         """The offset (start) pose must satisfy every constraint at rest, or no trajectory can."""

@@ -464,7 +464,8 @@ def with_inherited_layout(doc: dict) -> dict:
     """The config with each ``[[validation]]`` table that states no signals of its own (no ``positions``, ``torques``,
     ``currents``, ``preset`` or ``bag``) given the identification's column layout (:data:`LAYOUT_KEYS`); its own keys
     (``file``, ``rows``, ``time_range``, ``name``...) stay. The identification's signals must then read its default
-    ``file`` (none of them naming a file of its own).
+    ``file`` (none of them naming a file of its own). Where the identification log is a ROS 2 bag, a validation table
+    that names no CSV file takes the bag's reader settings it does not state (:data:`BAG_READER_KEYS`).
 
     Parameters
     ----------
@@ -483,11 +484,21 @@ def with_inherited_layout(doc: dict) -> dict:
     own_files = any(isinstance(ident.get(k), dict) and "file" in ident[k] for k in ("time", "positions", "velocities",
                                                                                      "currents", "torques"))
     layout = {k: ident[k] for k in LAYOUT_KEYS if k in ident}
+    reader = {k: ident[k] for k in BAG_READER_KEYS if k in ident} if "bag" in ident else {}
     merged = []
     for v in validation:
+        if reader and isinstance(v, dict) and not any(k in v for k in ("file", "positions", "preset")):
+            merged.append({**reader, **v})  # a bag's table: the identification's bag, topic, joint names, effort
+            continue
         states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "torques", "currents", "preset", "bag"))
         merged.append(v if states_its_own or own_files or "bag" in ident else {**layout, **v})
     return {**doc, "validation": merged}
+
+
+BAG_READER_KEYS = ("bag", "topic", "joint_names", "effort")
+"""What a ``[[validation]]`` table of a config whose identification log is a ROS 2 bag inherits from it where it does
+not state them (a table naming only ``time_range`` scores another stretch of the same bag; one naming another ``bag``
+reads it with the identification's topic, joint names and effort)."""
 
 
 def _estimators_from_old(est: dict) -> str:

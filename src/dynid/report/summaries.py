@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..conventions import unit_of
+from ..conventions import split_name, unit_of
 from ..estimators.registry import OTHER_LABELS, label
+from ..friction import TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY
@@ -668,6 +669,11 @@ def in_short(result) -> list:
     return out
 
 
+CHOSEN_TERMS = ("fst", "fca", "fcl")
+"""Friction terms beyond Coulomb and viscous friction: in the model because the friction models' cross-validation
+(or the description) chose them, so a loose σ does not make them "not determined"."""
+
+
 def _determined_lines(r, label: str) -> list:
     """:func:`in_short`'s lines on what the log determines. They read least squares' σ; where the main estimate is the
     drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
@@ -693,10 +699,21 @@ def _determined_lines(r, label: str) -> list:
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}
     loose, small = undetermined(r.base.names, r.solution.params, r.solution.relative_std, kept, share, boot)
     which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
+    chosen = [n for n in loose if split_name(n)[0] in CHOSEN_TERMS]  # the friction models' cross-validation kept them
+    loose = [n for n in loose if n not in chosen]
     if loose:
         out.append(Line(f"{whose}not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): "
                         f"{', '.join(loose)}: their values are set by the noise and the misfit; a richer excitation "
                         "(dynid excite) determines them"))
+    if chosen:
+        by = ("the friction models' cross-validation (they lower the held-out error)"
+              if getattr(getattr(r, "choices", None), "friction", None) is not None else "the description")
+        out.append(Line(f"{whose}kept by {by}, their values loose (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(chosen)}: the log "
+                        "shows the effect, not its size; a richer excitation (dynid excite) sizes them"))
+    named = [n for n in [*loose, *chosen, *small] if split_name(n)[0] in TERMS]
+    if named:
+        out.append(Line("the drive terms named: " + "; ".join(
+            f"{n}, {TERMS[split_name(n)[0]].description.split(',')[0]} of J{split_name(n)[1] + 1}" for n in named)))
     if small:
         out.append(Line(f"{whose}about 0 on this log's motion (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}, but ±σ "
                         f"under {NEGLIGIBLE_TORQUE:g} % of the joint's torque): {', '.join(small)}: a faster or wider "
@@ -984,6 +1001,12 @@ def excitation_blocks(run) -> list:
     out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
                          ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    free = p.unlimited_joints()
+    if free:
+        swing = ", ".join(f"J{j + 1} {run.q[:, j].min():.3g} to {run.q[:, j].max():.3g} rad" for j in free)
+        out.append(Line(f"no position limits on {', '.join(f'J{j + 1}' for j in free)} (continuous joints): the design "
+                        f"swings them about their offset within their velocity and acceleration limits only ({swing}); "
+                        "give q_min and q_max in [limits] to bound them", "warning"))
     relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
     tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
