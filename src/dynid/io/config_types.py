@@ -64,6 +64,8 @@ class TimeTable(Table, kw_only=True):
     file: Annotated[str, _d("the file (default: the dataset's file)")] | None = None
     unit: Annotated[Literal["s", "ms", "us", "ns"],
                     _d("the time stamps' unit: s (default), ms, us or ns")] | None = None
+    nanoseconds: Annotated[Column, _d("a column of the nanoseconds beside a column of whole seconds (ROS's "
+                                      "header.stamp.sec and header.stamp.nanosec): the time is their sum")] | None = None
 
 
 class DatasetTable(Table, kw_only=True):

@@ -472,8 +472,9 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         raise ConfigError(f"{where}: expected 'positions' (columns of the joint or motor angles)")
     if ("currents" in signals) == ("torques" in signals):
         raise ConfigError(f"{where}: expected exactly one of 'currents' (with drive gains) or 'torques'")
-    time = None if t.time is None else SignalSpec(path_of(t.time.file, f"{where}.time"), (t.time.column,),
-                                                  TIME_UNITS[t.time.unit or "s"])
+    time = None if t.time is None else SignalSpec(
+        path_of(t.time.file, f"{where}.time"), (t.time.column,) + (() if t.time.nanoseconds is None else (t.time.nanoseconds,)),
+        TIME_UNITS[t.time.unit or "s"] if t.time.nanoseconds is None else (TIME_UNITS[t.time.unit or "s"], 1e-9))
     if (time is None) == (t.rate is None):
         raise ConfigError(f"{where}: expected either a 'time' column or a sampling 'rate' [Hz]")
     return DatasetSpec(
@@ -589,7 +590,9 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
         return block
 
     if spec.time is not None:
-        t = get(spec.time)[:, 0]
+        stamps = np.asarray(get(spec.time), dtype=float)
+        # seconds and nanoseconds in two columns: summed from the first second on (float64 keeps the nanoseconds)
+        t = stamps[:, 0] if stamps.shape[1] == 1 else (stamps[:, 0] - stamps[0, 0]) + stamps[:, 1]
         first_line = tables[spec.time.file][0].first_line
         where = lambda k: f"{spec.time.file}: line {first_line + k}"  # noqa: E731 - sample k's place in the file
         if np.isnan(t).any():

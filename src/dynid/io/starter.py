@@ -42,9 +42,23 @@ ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/pos
 _SEPARATORS = r"[\s/._\-\[\]()]"
 
 
+def _seconds_and_nanoseconds(header: list[str]) -> tuple[str, str] | None:
+    """The columns of a time stamp split into whole seconds and nanoseconds (ROS 2 ``header.stamp.sec`` and
+    ``header.stamp.nanosec``, ROS 1 ``secs`` and ``nsecs``), or None."""
+    low = {c.strip().lower(): c for c in header}
+    for c, name in low.items():
+        for sec, nsec in ((".sec", ".nanosec"), ("/sec", "/nanosec"), (".secs", ".nsecs"), ("/secs", "/nsecs"),
+                          ("_sec", "_nanosec")):
+            if c.endswith(sec) and c[:-len(sec)] + nsec in low:
+                return name, low[c[:-len(sec)] + nsec]
+    return None
+
+
 def _kind(name: str) -> str | None:
     """The signal a column's name says, by its last path component (``/joint_states/position[0]`` → positions)."""
     last = [part for part in re.split(r"[/.]", name.strip().lower()) if part] or [""]
+    if len(last) > 1 and last[-1].isdigit():  # ROS-style position/0 and position.0: the index is a part of its own
+        last = last[:-1]
     stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", last[-1])
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
@@ -178,12 +192,19 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
                             f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
-        unit = _time_unit([split(line) for line in lines[1:]], first.index(found["time"][0]))
-        table += ["header = true", f'time = {{ column = "{found["time"][0]}"'
-                  + (f', unit = "{unit}" }}' if unit else " }")]
-        if unit:
-            notes.append(f"time stamps: {found['time'][0]} steps as a controller's in {unit}: unit = \"{unit}\"")
-        taken = [found["time"][0]]
+        split_stamp = _seconds_and_nanoseconds(first)
+        if split_stamp is not None:  # ROS's header.stamp.sec beside header.stamp.nanosec: one time, two columns
+            seconds, nanoseconds = split_stamp
+            table += ["header = true", f'time = {{ column = "{seconds}", nanoseconds = "{nanoseconds}" }}']
+            notes.append(f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)")
+            taken = [seconds, nanoseconds]
+        else:
+            unit = _time_unit([split(line) for line in lines[1:]], first.index(found["time"][0]))
+            table += ["header = true", f'time = {{ column = "{found["time"][0]}"'
+                      + (f', unit = "{unit}" }}' if unit else " }")]
+            if unit:
+                notes.append(f"time stamps: {found['time'][0]} steps as a controller's in {unit}: unit = \"{unit}\"")
+            taken = [found["time"][0]]
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
                 table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
