@@ -329,3 +329,28 @@ def test_ros_style_indexed_headers_name_their_signal():
 
     assert [_kind(h) for h in ("/joint_states/position/0", "position.0", "/joint_states/effort/5", "velocity.2",
                                "header.stamp.sec")] == ["positions", "positions", "torques", "velocities", "time"]
+
+
+def test_init_opens_a_bag_and_writes_bag_for_a_validation_bag(tmp_path):
+    """``dynid init URDF BAG OTHER_BAG`` wrote ``file =`` for the validation bag (which identify refused) and never
+    opened the bags; it now reads them as identify does (joint names, rate, length, effort range), writes ``bag =``,
+    and identify runs on the config as written. A bag without one of the robot's joints is refused in one line."""
+    from tests.io.test_bags import _write_bag
+
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, seed=8)
+    names = [j.name for j in dynid.load_robot(URDF).joints]
+    half = sim.t.size // 2
+    dq = np.gradient(sim.q, sim.t, axis=0)  # the simulated log has none: the bag's velocity field
+    for bag, part in (("ident", slice(0, half)), ("other", slice(half, None))):
+        _write_bag(tmp_path / bag, sim.t[part], names, sim.q[part], dq[part], sim.tau[part])
+    p = run("init", str(URDF), str(tmp_path / "ident"), str(tmp_path / "other"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "arm.toml").read_text()
+    assert 'bag = "other"' in text and 'file = "other"' not in text
+    assert f"# ident: read as identify reads it: {half} samples over" in text
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    _write_bag(tmp_path / "short", sim.t[:50], names[:5], sim.q[:50, :5], dq[:50, :5], sim.tau[:50, :5])
+    p = run("init", str(URDF), str(tmp_path / "short"), "--out", str(tmp_path / "short.toml"))
+    assert p.returncode == 1 and "lacks joint(s) wrist_3_joint" in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "short.toml").exists()

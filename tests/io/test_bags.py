@@ -102,3 +102,33 @@ def test_a_validation_table_of_a_bag_config_inherits_the_bags_reader_settings(tm
     assert other == {"bag": "other", "topic": "/arm/joint_states", "joint_names": names, "effort": "currents"}
     assert own["joint_names"] == names[::-1] and own["bag"] == "third"
     assert csv == {"file": "log.csv", "positions": {"columns": [1, 2, 3, 4, 5, 6]}}
+
+
+def test_validate_file_reads_the_file_it_is_given_with_the_configs_reader(tmp_path):
+    """``dynid validate CONFIG --file LOG`` on a bag config scored the identification bag and labelled it LOG, even
+    for a LOG that did not exist; a CSV config's --file lost its time unit (milliseconds read as seconds)."""
+    from dynid.exceptions import DataError
+    from dynid.io.identification_config import dataset_for_file, load_identification_config
+
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    t = np.arange(50) * 0.01
+    for bag in ("ident", "other"):
+        _write_bag(tmp_path / bag, t, names, np.zeros((50, 6)), np.zeros((50, 6)), np.zeros((50, 6)))
+    (tmp_path / "bag.toml").write_text('robot = "ur10e"\n[identification]\nbag = "ident"\ntopic = "/joint_states"\n')
+    cfg = load_identification_config(tmp_path / "bag.toml")
+    spec = dataset_for_file(cfg, tmp_path / "other")
+    assert spec.bag.path == tmp_path / "other" and spec.name == "other" and spec.bag.topic == cfg.identification.bag.topic
+    for given, message in ((tmp_path / "nope", "no such file or bag"), (tmp_path / "bag.toml", "expected a bag's folder")):
+        with pytest.raises(DataError, match=message):
+            dataset_for_file(cfg, given)
+    np.savetxt(tmp_path / "log.csv", np.zeros((5, 13)), delimiter=",", comments="",
+               header=",".join(["ms", *(f"q{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))]))
+    (tmp_path / "csv.toml").write_text('robot = "ur10e"\n[identification]\nfile = "log.csv"\nheader = true\n'
+                                       'time = { column = "ms", unit = "ms" }\n'
+                                       f'positions = {{ columns = {[f"q{j}" for j in range(1, 7)]} }}\n'.replace("'", '"')
+                                       + f'torques = {{ columns = {[f"tau{j}" for j in range(1, 7)]} }}\n'.replace("'", '"'))
+    cfg = load_identification_config(tmp_path / "csv.toml")
+    spec = dataset_for_file(cfg, tmp_path / "log.csv")
+    assert spec.time.scale == cfg.identification.time.scale == 1e-3
+    with pytest.raises(DataError, match="a ROS 2 bag, but the config's logs are CSV files"):
+        dataset_for_file(cfg, tmp_path / "other")

@@ -573,10 +573,10 @@ def init(
 
     def compute(robot, progress):
         for v in validation or ():
-            if not v.is_file():
+            if not v.exists():
                 raise DynIdError(f"{v}: no such validation log")
         return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints),
-                              robot.held)
+                              robot.held, robot=robot)
 
     def save(written):
         from ..io.files import atomic_write_text

@@ -565,13 +565,28 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
     Raises
     ------
     DataError
-        If the identification dataset reads several files (add a [[validation]] table instead).
+        A file that does not exist; a CSV log given for a bag's config or a bag for a CSV's (the reader of the
+        identification log reads it: one line, never the identification log under its name); or an identification
+        dataset that reads several files (add a [[validation]] table instead).
     """
     spec = config.identification
+    file = Path(file)
+    if not file.exists():
+        raise DataError(f"--file {file}: no such file or bag", field="file")
+    is_bag = file.is_dir() or file.suffix.lower() in (".mcap", ".db3")
+    if spec.bag is not None:  # read with the identification's bag reader: its topic, joint names, effort
+        if not is_bag:
+            raise DataError(f"--file {file}: the config's logs are ROS 2 bags (bag = ...); expected a bag's folder or its "
+                            ".mcap/.db3 file, or add a [[validation]] table for a CSV log", field="file")
+        return replace(spec, name=file.name, bag=replace(spec.bag, path=file),
+                       rows=None if rows is None else tuple(rows))
+    if is_bag:
+        raise DataError(f"--file {file}: a ROS 2 bag, but the config's logs are CSV files; add a [[validation]] table "
+                        "with bag = ... for it", field="file")
     files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
     if len(files) > 1:
         raise DataError("file: the identification dataset reads several files; add a [[validation]] table to the config instead", field="file")
-    signals = {k: SignalSpec(Path(file), s.columns, s.scale, s.side) for k, s in spec.signals.items()}
-    time = SignalSpec(Path(file), spec.time.columns, 1.0) if spec.time else None
-    return replace(spec, name=Path(file).name, signals=signals, time=time,
+    signals = {k: SignalSpec(file, s.columns, s.scale, s.side) for k, s in spec.signals.items()}
+    time = SignalSpec(file, spec.time.columns, spec.time.scale) if spec.time else None  # its unit too
+    return replace(spec, name=file.name, signals=signals, time=time,
                    rows=None if rows is None else tuple(rows))

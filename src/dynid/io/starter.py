@@ -18,6 +18,8 @@ import os
 import re
 from pathlib import Path
 
+import numpy as np
+
 from ..conventions import time_unit_of
 from ..exceptions import ConfigError, DataError
 from ..model.description import URDF_DRIVE_TERMS
@@ -119,7 +121,7 @@ def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
-                   joints: tuple[str, ...] = (), held: tuple[str, ...] = ()) -> tuple[str, list[str]]:
+                   joints: tuple[str, ...] = (), held: tuple[str, ...] = (), robot=None) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -140,6 +142,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     held : tuple of str
         The URDF's joints held fixed (:func:`dynid.model.urdf.joints_to_hold`): written as the ``[robot]`` table's
         ``held``, and said.
+    robot : Robot, optional
+        The robot read from ``urdf``: a bag is then opened and read as identify reads it (its joint names against the
+        robot's, its rate, length and effort range said).
 
     Returns
     -------
@@ -156,10 +161,15 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if log.is_dir() and not (log / "metadata.yaml").is_file():
         raise DataError(f"{log}: a folder without metadata.yaml, not a ROS 2 bag: give a CSV log, or a bag's folder or "
                         "its .mcap/.db3 file")
-    if log.is_dir() or log.suffix.lower() in (".mcap", ".db3"):
+    bags = [v for v in validation if _is_bag(v)]
+    if _is_bag(log) and len(bags) != len(validation) or not _is_bag(log) and bags:
+        raise DataError(f"{(set(validation) - set(bags) or set(bags)).pop()}: the validation logs and {log.name} must be "
+                        "of one kind (all ROS 2 bags or all CSV logs): they share the identification's reader")
+    if _is_bag(log):
         table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
+        said += [] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]
         said += _held_notes(urdf, held)
         return _config(urdf, log, out, validation, table, said, held), said
     lines, delimiter = _first_lines(log)
@@ -251,6 +261,26 @@ def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
             "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
 
 
+def _is_bag(path: Path) -> bool:
+    """Whether a log is a ROS 2 bag: its folder, or its ``.mcap``/``.db3`` storage file."""
+    return path.is_dir() or path.suffix.lower() in (".mcap", ".db3")
+
+
+def _bag_read(bag: Path, robot) -> str:
+    """A bag read as ``dynid identify`` reads it (its JointState messages' joints by the robot's joint names): one
+    line with its samples, duration, rate and effort range; a bag that cannot be read is refused in one line."""
+    from .datasets import dataset_spec, load_recording
+
+    spec = dataset_spec({"bag": bag.name}, bag.parent, f"{bag}", bag.name, robot.n_dof)
+    rec = load_recording(spec, robot, spool=False)
+    t, tau = np.asarray(rec.t), np.asarray(rec.tau)
+    line = (f"{bag.name}: read as identify reads it: {t.size} samples over {t[-1] - t[0]:.3g} s ({rec.rate:.4g} Hz), "
+            f"every joint of the robot by name; effort from {tau.min():.3g} to {tau.max():.3g}")
+    if not np.any(np.abs(tau) > 0):
+        line += " (all 0: the bag logs no effort; identify needs torques or currents)"
+    return line
+
+
 def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: list[str], notes: list[str],
             held: tuple[str, ...] = ()) -> str:
     """The config's text: what was detected in comments, the robot (a table where joints are held), the dataset
@@ -269,8 +299,9 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
         "[identification]",
         *table,
         "",
-        *([line for v in validation for line in ("[[validation]]                    # the identification's columns",
-                                                   f'name = "{v.stem}"', f'file = "{_relative(v, log.parent)}"', "")]
+        *([line for v in validation for line in ("[[validation]]                    # the identification's reader",
+                                                   f'name = "{v.stem}"',
+                                                   f'{"bag" if _is_bag(v) else "file"} = "{_relative(v, log.parent)}"', "")]
           or ["# [[validation]]                  # other logs, same layout, to check the model where it was not fitted",
               '# name = "second_run"', '# file = "second_run.csv"', ""]),
         "# [estimation]",
