@@ -43,3 +43,24 @@ def test_migrate_refuses_a_file_that_is_not_text(tmp_path):
     before = path.read_bytes()
     assert_refused(dynid("migrate", path), "config.toml: not a text file")
     assert path.read_bytes() == before
+
+
+def test_migrate_rewrites_an_inline_table(tmp_path):
+    """``dynid migrate`` on ``estimation = { method = ... }`` reported a rewrite it did not make, and identify then sent
+    the user back to migrate; the inline table is now rewritten (tomlkit), its comments kept."""
+    import tomllib
+
+    from dynid.io.migrate import migrate_text
+
+    text = ('# my arm\nrobot = "ur10e"\nestimation = { method = "wls", physically_consistent = true }  # as in 0.1\n'
+            'preprocessing = { torque_cutoff = 5.0 }\n[identification]\nfile = "log.csv"  # the run of May\n')
+    migrated, changes = migrate_text(text, "arm.toml")
+    doc = tomllib.loads(migrated)
+    assert doc["estimation"] == {"estimators": ["wls", "sdp"]} and doc["preprocessing"] == {"parallel_cutoff": 5.0}
+    assert "# my arm" in migrated and "# the run of May" in migrated
+    assert any("-> estimators = [" in c for c in changes) and any("torque_cutoff" in c for c in changes)
+    path = tmp_path / "arm.toml"
+    path.write_text(text)
+    p = dynid("migrate", path)
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads(path.read_text()) == doc and "wrote" in p.stdout

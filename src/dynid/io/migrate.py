@@ -1,5 +1,5 @@
-"""``dynid migrate``: an identify config of an earlier release rewritten for this one, line by line, so that its comments
-and layout stay as the user wrote them.
+"""``dynid migrate``: an identify config of an earlier release rewritten for this one with tomlkit (a TOML document that
+keeps the comments and layout the user wrote; an inline table is rewritten as one).
 
 What an earlier release accepted and this one does not:
 
@@ -16,8 +16,10 @@ migration names them in its report when a config uses them (:data:`CHANGED_MEANI
 
 from __future__ import annotations
 
-import re
 import tomllib
+
+import tomlkit
+from tomlkit.exceptions import TOMLKitError
 
 from ..exceptions import ConfigError
 
@@ -64,7 +66,8 @@ def migrate_text(text: str, where: str = "config") -> tuple[str, list[str]]:
     """
     try:
         doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+        edited = tomlkit.parse(text)  # the same text as a document that keeps its comments and layout
+    except (tomllib.TOMLDecodeError, TOMLKitError) as exc:
         raise ConfigError(f"{where}: invalid TOML ({exc})") from None
     changes: list[str] = []
     est = doc.get("estimation")
@@ -75,23 +78,40 @@ def migrate_text(text: str, where: str = "config") -> tuple[str, list[str]]:
         new = _estimators_from_old(est)
         if "estimators" in est:
             raise ConfigError(f"{where}: [estimation] has both estimators and {', '.join(old)}: keep estimators only")
-        text = _replace_keys(text, "estimation", old, f"estimators = {new}")
+        _replace(edited["estimation"], old, "estimators", tomllib.loads(f"x = {new}")["x"])
         said = ", ".join(f"{k} = {_toml(est[k])}" for k in old)
         changes.append(f"[estimation] {said} -> estimators = {new}")
     for (table, key), (new_key, why) in RENAMED.items():
         section = doc.get(table)
         if isinstance(section, dict) and key in section:
             if new_key in section:
-                text = _replace_keys(text, table, [key], "")
+                _replace(edited[table], [key], None, None)
                 changes.append(f"[{table}] {key} = {_toml(section[key])} removed ({new_key} is given): {why}")
             else:
-                text = _replace_keys(text, table, [key], f"{new_key} = {_toml(section[key])}")
+                _replace(edited[table], [key], new_key, section[key])
                 changes.append(f"[{table}] {key} = {_toml(section[key])} -> {new_key} = {_toml(section[key])}: its "
                                f"meaning changed: {why}")
     for (table, key), why in CHANGED_MEANINGS.items():
         if isinstance(doc.get(table), dict) and key in doc[table]:
             changes.append(f"[{table}] {key} = {_toml(doc[table][key])}: its meaning changed: {why} (kept as written)")
-    return text, changes
+    renamed = [(t, k) for t, k in RENAMED if isinstance(doc.get(t), dict) and k in doc[t]]
+    if not old and not renamed:
+        return text, changes
+    out = tomlkit.dumps(edited)
+    after = tomllib.loads(out)
+    left = [f"[{t}] {k}" for t, k in [*(("estimation", k) for k in old), *renamed] if k in (after.get(t) or {})]
+    if left:  # never report a rewrite that was not made
+        raise ConfigError(f"{where}: cannot rewrite {', '.join(left)}: edit it by hand as the changelog says")
+    return out, changes
+
+
+def _replace(table, keys: list[str], new_key: str | None, value) -> None:
+    """``table`` (a table or an inline table of a tomlkit document) without ``keys``, and ``new_key = value`` in it
+    (at its end; nothing where ``new_key`` is None)."""
+    for k in keys:
+        del table[k]
+    if new_key is not None:
+        table[new_key] = value
 
 
 def _toml(value) -> str:
@@ -102,28 +122,3 @@ def _toml(value) -> str:
     if isinstance(value, list):
         return "[" + ", ".join(_toml(v) for v in value) + "]"
     return str(value)
-
-
-def _replace_keys(text: str, table: str, keys: list[str], replacement: str) -> str:
-    """``text`` with the lines of ``keys`` in ``[table]`` removed (a multi-line array with them) and ``replacement``
-    where the first of them stood."""
-    lines = text.splitlines(keepends=True)
-    out, inside, placed, skipping = [], False, False, False
-    key_line = re.compile(rf"^\s*({'|'.join(map(re.escape, keys))})\s*=")
-    for line in lines:
-        header = re.match(r"^\s*\[+\s*([^\]]+?)\s*\]+", line)
-        if header and not skipping:
-            inside = header.group(1) == table
-        if skipping:
-            skipping = "]" not in line.split("#", 1)[0]
-            continue
-        if inside and key_line.match(line):
-            value = line.split("=", 1)[1].split("#", 1)[0]
-            skipping = value.count("[") > value.count("]")
-            if not placed and replacement:
-                comment = line.split("#", 1)[1].rstrip("\n") if "#" in line and len(keys) == 1 else ""
-                out.append(replacement + (f"  # {comment.strip()}" if comment else "") + "\n")
-                placed = True
-            continue
-        out.append(line)
-    return "".join(out)

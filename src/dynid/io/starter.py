@@ -23,6 +23,7 @@ import numpy as np
 from ..conventions import time_unit_of
 from ..exceptions import ConfigError, DataError
 from ..model.description import URDF_DRIVE_TERMS
+from .datasets import dataset_spec, load_recording
 from .files import text_encoding_hint
 from .tables import is_data_line
 
@@ -269,8 +270,6 @@ def _is_bag(path: Path) -> bool:
 def _bag_read(bag: Path, robot) -> str:
     """A bag read as ``dynid identify`` reads it (its JointState messages' joints by the robot's joint names): one
     line with its samples, duration, rate and effort range; a bag that cannot be read is refused in one line."""
-    from .datasets import dataset_spec, load_recording
-
     spec = dataset_spec({"bag": bag.name}, bag.parent, f"{bag}", bag.name, robot.n_dof)
     rec = load_recording(spec, robot, spool=False)
     t, tau = np.asarray(rec.t), np.asarray(rec.tau)
