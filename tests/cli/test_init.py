@@ -4,6 +4,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import dynid
 
@@ -354,3 +355,26 @@ def test_init_opens_a_bag_and_writes_bag_for_a_validation_bag(tmp_path):
     p = run("init", str(URDF), str(tmp_path / "short"), "--out", str(tmp_path / "short.toml"))
     assert p.returncode == 1 and "lacks joint(s) wrist_3_joint" in p.stderr and "Traceback" not in p.stderr
     assert not (tmp_path / "short.toml").exists()
+
+
+@pytest.mark.parametrize("style", ["plain", "ros"])
+def test_init_never_takes_a_commanded_column_for_a_measured_signal(tmp_path, style):
+    """A log holding commanded positions beside the measured ones (before them): init took the commanded column,
+    and the fit missed by 1.4-1.7 % instead of 0.14 %, dynid suggesting a torque delay. It takes the measured one,
+    and says which it left."""
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, seed=9)
+    names = [j.name for j in dynid.load_robot(URDF).joints]
+    lagged = np.roll(sim.q, 5, axis=0)  # a set-point runs ahead of the measured position
+    if style == "plain":
+        cmd, measured, effort = ([f"{k}{j}" for j in range(1, 7)] for k in ("desired.q", "actual.q", "actual.tau"))
+    else:
+        cmd = [f"/arm_controller/state/desired/{n}/position" for n in names]
+        measured = [f"/joint_states/{n}/position" for n in names]
+        effort = [f"/joint_states/{n}/effort" for n in names]
+    np.savetxt(tmp_path / "log.csv", np.column_stack([sim.t, lagged, sim.q, sim.tau]), delimiter=",", comments="",
+               header=",".join(["t", *cmd, *measured, *effort]))
+    p = run("init", str(URDF), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "arm.toml").read_text()
+    assert "positions = { columns = [" + ", ".join(f'"{c}"' for c in measured) + "] }" in text
+    assert f"# commanded, never taken for a measured signal: {cmd[0]}" in text

@@ -541,3 +541,20 @@ def test_a_channel_mostly_at_one_value_has_no_spikes(tmp_path):
     rec = load_recording(_log(tmp_path, t, q, cur), load_robot("ur10e"))
     assert not any("spike" in w for w in rec.warnings)
     np.testing.assert_allclose(np.asarray(rec.tau)[:, 1], load_robot("ur10e").drive_gains[1] * cur[:, 1], rtol=1e-12)
+
+
+def test_positions_and_velocities_in_degrees_are_read_in_radians(tmp_path):
+    """unit = "deg" (and "deg/s") converts at input: a log in degrees read as radians went through every estimate
+    without a failing test (the conversion was only checked through stored figures)."""
+    t = np.arange(200) * 0.01
+    deg = np.outer(np.sin(2 * np.pi * 0.5 * t), [10.0, -20.0, 30.0, 5.0, 45.0, 60.0])
+    header = ["t", *(f"q{j}" for j in range(1, 7)), *(f"v{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))]
+    np.savetxt(tmp_path / "d.csv", np.column_stack([t, deg, 2 * deg, np.ones((200, 6))]), delimiter=",",
+               header=",".join(header), comments="")
+    spec = dataset_spec({"file": "d.csv", "header": True, "time": {"column": "t"},
+                         "positions": {"columns": header[1:7], "unit": "deg"},
+                         "velocities": {"columns": header[7:13], "unit": "deg/s"},
+                         "torques": {"columns": header[13:]}}, tmp_path, "c.toml: identification", "ident", 6)
+    rec = load_recording(spec, load_robot("ur10e"))
+    np.testing.assert_allclose(rec.q, np.deg2rad(deg), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(rec.dq, np.deg2rad(2 * deg), rtol=1e-12, atol=1e-12)

@@ -353,7 +353,15 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     keys = parse_estimators(estimators if isinstance(estimators, str) else tuple(estimators))
     n = robot.n_dof
     sdp = "sdp" in keys
-    prior, prior_notes = robot.physical_prior() if sdp else (None, ())
+    prior = None
+    prior_notes: tuple[str, ...] = ()
+    if sdp or np.any(robot.inertial != 0):  # the documented prior of every estimator that asks for one, SDP or not
+        try:
+            prior, prior_notes = robot.physical_prior()
+        except DynIdError:
+            if sdp:
+                raise
+        prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
                       prior=prior, prior_kind=sdp_prior,
                       base_prior=base.base_from_standard(robot.standard_parameters()))

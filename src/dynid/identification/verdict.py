@@ -7,9 +7,9 @@ logs are scored. The candidates, in the order they are weighed:
 
 1. the first estimator listed;
 2. the physically consistent SDP (where listed), where the first is least squares and is not physically consistent,
-   and the SDP predicts better: the validation logs (mean global error) or, without validation logs, held-out
-   contiguous blocks of the identification log (:data:`dynid.identification.identify.HELD_OUT_FOLDS`-fold blocked
-   cross-validation);
+   and the SDP predicts as well (to :data:`SAME_FIGURE`) or better: the validation logs (mean global error) or,
+   without validation logs, held-out contiguous blocks of the identification log
+   (:data:`dynid.identification.identify.HELD_OUT_FOLDS`-fold blocked cross-validation, strictly better);
 3. the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`), where the
    estimate so far is doubtful on the validation logs (the description's nominal model predicts them better, or least
    squares' predictions leave the range the identification log supports) and it predicts them better;
@@ -42,6 +42,12 @@ NOMINAL_KEY = "description"
 NOMINAL_LABEL = "description (nominal)"
 """The set of the description's own nominal values, scored on the validation logs beside the estimates when no
 reference set of the config is that."""
+
+
+SAME_FIGURE = 1.02
+"""Two mean validation errors within this ratio are the same figure for the choice: the physically consistent
+estimate (what ``dynid export`` writes) stays the main one where an inconsistent least-squares estimate predicts no
+better than this, so that the first line, the main estimate and the file exported name one estimate."""
 
 
 def nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
@@ -108,10 +114,13 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
                                                "cross-validation)"))
         return replace(result, main=main, findings=tuple(findings))
     chosen: tuple[str, str] | None = None
-    if rigid and _mean_error(result.validations, SDP_LABEL) < _mean_error(result.validations, ls):
-        sdp, own = _mean_error(result.validations, SDP_LABEL), _mean_error(result.validations, ls)
+    sdp, own = (_mean_error(result.validations, SDP_LABEL), _mean_error(result.validations, ls)) if rigid else (0, 0)
+    if rigid and sdp <= SAME_FIGURE * own:  # what export writes, unless the log says it predicts worse
         main, chosen = SDP_LABEL, (SDP_LABEL, f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not "
-                                              f"and predicts the validation logs worse ({_apart(sdp, own)} on average)")
+                                              + (f"and predicts the validation logs worse ({_apart(sdp, own)} on average)"
+                                                 if sdp < own else f"and predicts the validation logs as well, to "
+                                                 f"{100 * (SAME_FIGURE - 1):g} % ({_apart(sdp, own)} on average); it is "
+                                                 "what dynid export writes"))
     if nominal is not None and scored is not None and result.drive_only is not None:
         preferred = _drive_only_preferred(result, main, nominal[0], scored)
         if preferred is not None:

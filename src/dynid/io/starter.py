@@ -104,15 +104,43 @@ def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str
             f"({', '.join(order)}): taken in the URDF's joint order ({', '.join(joints)})"] if moved else []
 
 
+COMMANDED = frozenset({"cmd", "command", "commanded", "commands", "desired", "des", "target", "targets", "setpoint",
+                       "setpoints", "sp", "ref", "reference", "goal", "demand", "demanded"})
+"""Words of a column name that make it a commanded signal (a controller's set-point), never a measured one."""
+
+
+def commanded(name: str, joints: tuple[str, ...] = ()) -> bool:
+    """Whether a column holds a commanded signal (:data:`COMMANDED` among its words, the joint names left out):
+    ``q_cmd1``, ``/joint_trajectory_controller/state/desired/positions/0``, ``elbow_joint/position_setpoint``.
+
+    Parameters
+    ----------
+    name : str
+    joints : tuple of str
+        The URDF's joint names (a word of one of them is no marker).
+
+    Returns
+    -------
+    bool
+    """
+    low = name.strip().lower()
+    for joint in sorted(joints, key=len, reverse=True):
+        low = low.replace(joint.lower(), " ") if joint else low
+    return bool(COMMANDED & set(re.split(r"[^a-z]+", low)))
+
+
 def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str, list[str]], list[str]]:
     """Columns naming every joint of the URDF, per signal in the URDF's joint order, and a note per signal whose log
-    order differs."""
+    order differs; a commanded column (:func:`commanded`) is never taken."""
     named: dict[str, dict[int, str]] = {}
+    twice: list[str] = []
     for column in first:
-        hit = _named_joint(column, joints)
+        hit = None if commanded(column, joints) else _named_joint(column, joints)
         if hit is not None:
+            if hit[1] in named.get(hit[0], {}):
+                twice.append(f"{column} (J{hit[1] + 1} {hit[0]} again: {named[hit[0]][hit[1]]} taken)")
             named.setdefault(hit[0], {}).setdefault(hit[1], column)
-    found, notes = {}, []
+    found, notes = {}, [f"a joint named twice: {', '.join(twice)}"] if twice else []
     for kind, columns in named.items():
         if len(columns) == len(joints):
             found[kind] = [columns[j] for j in range(len(joints))]
@@ -169,9 +197,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if _is_bag(log):
         table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
                  '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
-        said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names"]
-        said += [] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]
-        said += _held_notes(urdf, held)
+        said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
+                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
         return _config(urdf, log, out, validation, table, said, held), said
     lines, delimiter = _first_lines(log)
     split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
@@ -184,15 +211,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if delimiter != ",":
         table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
     if header:
-        by_name, order_notes = _by_joint_names(first, joints) if len(joints) == n_dof else ({}, [])
-        named = {c for columns in by_name.values() for c in columns}
-        found: dict[str, list[str]] = {}
-        for name in first:
-            kind = _kind(name)
-            if kind and name not in named:
-                found.setdefault(kind, []).append(name)
-        found.update(by_name)
-        order_notes += _in_named_order(found, first, split(lines[1]) if len(lines) > 1 else [], joints)
+        found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
         if "time" not in found:
             raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; or write the config by "
                             "hand with rate = ... (docs: Configuration files)")
@@ -203,19 +222,10 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
                             f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
-        split_stamp = _seconds_and_nanoseconds(first)
-        if split_stamp is not None:  # ROS's header.stamp.sec beside header.stamp.nanosec: one time, two columns
-            seconds, nanoseconds = split_stamp
-            table += ["header = true", f'time = {{ column = "{seconds}", nanoseconds = "{nanoseconds}" }}']
-            notes.append(f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)")
-            taken = [seconds, nanoseconds]
-        else:
-            unit = _time_unit([split(line) for line in lines[1:]], first.index(found["time"][0]))
-            table += ["header = true", f'time = {{ column = "{found["time"][0]}"'
-                      + (f', unit = "{unit}" }}' if unit else " }")]
-            if unit:
-                notes.append(f"time stamps: {found['time'][0]} steps as a controller's in {unit}: unit = \"{unit}\"")
-            taken = [found["time"][0]]
+        time_table, time_notes, taken = _time_lines(first, found["time"][0],
+                                                    [split(line) for line in lines[1:]])
+        table += ["header = true", *time_table]
+        notes += time_notes
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
                 table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
@@ -260,6 +270,38 @@ def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
 def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
     return [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain of revolute joints (a gripper?): held fixed "
             "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
+
+
+def _found_columns(first: list[str], row: list[str], joints: tuple[str, ...], n_dof: int) -> tuple[dict, list[str]]:
+    """Each signal's columns in a header (by the URDF's joint names first, else by their names' stems), a commanded
+    column never taken (:func:`commanded`), and what was noticed."""
+    by_name, notes = _by_joint_names(first, joints) if len(joints) == n_dof else ({}, [])
+    named = {c for columns in by_name.values() for c in columns}
+    skipped = [name for name in first if commanded(name, joints)]
+    found: dict[str, list[str]] = {}
+    for name in first:
+        kind = _kind(name)
+        if kind and name not in named and name not in skipped:
+            found.setdefault(kind, []).append(name)
+    if skipped:
+        notes.append(f"commanded, never taken for a measured signal: {', '.join(skipped[:6])}"
+                     + (f" and {len(skipped) - 6} more" if len(skipped) > 6 else ""))
+    found.update(by_name)
+    return found, notes + _in_named_order(found, first, row, joints)
+
+
+def _time_lines(first: list[str], column: str, rows: list[list[str]]) -> tuple[list[str], list[str], list[str]]:
+    """The dataset table's ``time`` line, what was detected, and the columns taken: a time stamp split into whole
+    seconds and nanoseconds (ROS's ``header.stamp.sec`` and ``.nanosec``) is one time of two columns; a single column's
+    unit is told from its steps."""
+    split_stamp = _seconds_and_nanoseconds(first)
+    if split_stamp is not None:
+        seconds, nanoseconds = split_stamp
+        return ([f'time = {{ column = "{seconds}", nanoseconds = "{nanoseconds}" }}'],
+                [f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)"], [seconds, nanoseconds])
+    unit = _time_unit(rows, first.index(column))
+    return ([f'time = {{ column = "{column}"' + (f', unit = "{unit}" }}' if unit else " }")],
+            [f"time stamps: {column} steps as a controller's in {unit}: unit = \"{unit}\""] if unit else [], [column])
 
 
 def _is_bag(path: Path) -> bool:
