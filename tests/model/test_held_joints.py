@@ -79,23 +79,34 @@ def test_held_is_refused_where_it_cannot_mean_anything(tmp_path):
                              "inertia": [1, 1, 1, 0, 0, 0]}]}, "arm.toml", tmp_path)
 
 
-def test_write_back_moves_the_held_fingers_inertials_into_their_link(tmp_path):
-    """The identified URDF: the fingers' <inertial> removed (their mass is in the hand's link, with a comment), the
-    finger joints untouched; read back with the same held joints it gives the values written."""
+def test_write_back_keeps_the_held_fingers_inertials_and_the_model_loads(tmp_path):
+    """issue "Nothing runs, nothing silent": the identified URDF removed the fingers' <inertial> (their mass moved into
+    the hand's link) while keeping their prismatic joints, so the full model's mass matrix was singular and forward
+    dynamics gave NaN. The fingers now keep their own <inertial>, the link they hang on gets the identified values less
+    theirs: read back with the same held joints it gives the values written, and with the fingers free its mass matrix
+    is positive definite."""
+    import pinocchio as pin
+
     path = _urdf(tmp_path, ARM + FINGERS)
     robot = robot_from_document({"convention": "urdf", "urdf": "arm.urdf", "held": ["f1", "f2"]}, "arm.toml", tmp_path)
     phi = robot.standard_parameters().copy()
     phi[robot.parameter_names.index("M2")] *= 1.1  # link 2's mass 10 % more: a value to find again
     text, _ = urdf_written_back(path, robot, phi)
-    assert len(re.findall(r"<mass value=", text)) == 3  # base, l1, l2: hand and fingers merged into l2
-    assert "the inertials of hand, f1_link, f2_link (fixed or held to this link)" in text or \
-        "the inertials of hand, f2_link, f1_link (fixed or held to this link)" in text
+    assert len(re.findall(r"<mass value=", text)) == 5  # base, l1, l2 (the hand merged: fixed), both fingers
+    assert "the inertials of hand (fixed to this link)" in text
+    assert re.search(r'<link name="f1_link"><inertial><origin xyz="0 0.01 0.05"/><mass value="0.1"/>', text)
     assert text.count('type="prismatic"') == 2 and '<mimic joint="f1"' in text
     again = tmp_path / "again.urdf"
     again.write_text(text)
     read = robot_from_document({"convention": "urdf", "urdf": again.name, "held": ["f1", "f2"]}, "again.toml", tmp_path)
     np.testing.assert_allclose(read.inertial, robot.with_parameters(phi).inertial, rtol=1e-9, atol=1e-12)
     assert read.inertial[1, 9] == pytest.approx(1.1 * robot.inertial[1, 9])
+    model = pin.buildModelFromUrdf(str(again))  # every joint free, the fingers' too
+    data = model.createData()
+    for q in (pin.neutral(model), pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))):
+        mass = pin.crba(model, data, q)
+        assert np.linalg.eigvalsh(0.5 * (mass + mass.T)).min() > 0 and np.isfinite(np.linalg.cond(mass))
+        assert np.all(np.isfinite(pin.aba(model, data, q, np.zeros(model.nv), np.zeros(model.nv))))
 
 
 def test_init_holds_the_joints_off_the_arm(tmp_path):

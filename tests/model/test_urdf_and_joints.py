@@ -4,6 +4,7 @@ can use, said in one line."""
 
 import re
 from importlib import resources
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -159,3 +160,35 @@ def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_p
     log = dynid.simulated_log(load_robot(str(ROBOTS / "ur10e.toml")), seconds=10, seed=3)
     said = Identifier(robot, estimators=["ols"]).fit(log.t, log.q, log.tau).result_.warnings
     assert robot.nominal_notes[0] in said  # the identification says it among its warnings
+
+
+def test_load_robot_holds_a_grippers_joints_and_reads_inits_config(tmp_path):
+    """issue "Nothing runs, nothing silent": ``load_robot("arm.urdf")`` refused a gripper and had no ``held=``, and
+    refused the config ``dynid init`` wrote; both now give the arm with the fingers held, as identify reads it."""
+    from dynid.io.identification_config import load_identification_config
+    from tests.cli.refusals import dynid as run
+
+    urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8")
+    fingers = "".join(
+        f'<link name="{n}_link"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" '
+        f'izz="1e-4"/></inertial></link><joint name="{n}" type="prismatic"><parent link="wrist_3_link"/>'
+        f'<child link="{n}_link"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/>'
+        '</joint>' for n in ("f1", "f2"))
+    path = tmp_path / "arm.urdf"
+    path.write_text(urdf.replace("</robot>", fingers + "</robot>"), encoding="utf-8")
+    with pytest.raises(ConfigError):
+        load_robot(path)  # a prismatic finger is no joint of the arm: said, with what to hold
+    arm = load_robot(path, held=["f1", "f2"])
+    assert arm.n_dof == 6 and arm.held == ("f1", "f2")
+    sim = np.column_stack([np.arange(200) * 0.01, np.zeros((200, 12))])
+    np.savetxt(tmp_path / "log.csv", sim, delimiter=",", comments="",
+               header=",".join(["t", *(f"q{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))]))
+    p = run("init", str(path), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    from_config = load_robot(tmp_path / "arm.toml")
+    as_identify = load_identification_config(tmp_path / "arm.toml").robot
+    assert from_config.held == as_identify.held == ("f1", "f2")
+    np.testing.assert_array_equal(from_config.standard_parameters(), as_identify.standard_parameters())
+    np.testing.assert_array_equal(from_config.inertial, arm.inertial)
+    with pytest.raises(ConfigError, match="needs a URDF, xacro or MJCF file"):
+        load_robot("ur10e", held=["f1"])

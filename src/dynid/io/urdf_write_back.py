@@ -19,7 +19,7 @@ import numpy as np
 
 from ..exceptions import ConfigError
 from ..model.robot import Robot
-from ..model.spatial import physical_from_inertial
+from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
 from .export import _exportable, identified_header, moved_far
 
 __all__ = ["urdf_written_back"]
@@ -162,9 +162,10 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     Every byte of the URDF stays as it is — link and joint names, frames, visuals, collisions, meshes, limits,
     transmissions, comments, the layout of each line — but each moving link's ``<inertial>`` and each moving joint's
     ``<dynamics>`` ``damping`` and ``friction`` (its other attributes kept). A link attached by fixed joints to a
-    moving one (a flange, a tool frame), or by joints the robot holds fixed (:attr:`dynid.model.robot.Robot.held`: a
-    gripper's fingers), is identified together with it: its ``<inertial>`` moves into the moving link's (a comment
-    says so). What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term, coupled
+    moving one (a flange, a tool frame) is identified together with it: its ``<inertial>`` moves into the moving link's
+    (a comment says so). The links of joints the robot holds fixed (:attr:`dynid.model.robot.Robot.held`: a gripper's
+    fingers) keep their own ``<inertial>``, and the moving link they hang on gets the identified values less theirs,
+    so that the model with those joints free loads and moves. What a URDF cannot hold (rotor inertia, offsets, a smooth Coulomb term, coupled
     motors) is written in comments, and a header comment inside ``<robot>`` says what was identified: only the base
     parameters are; the values written are one physically consistent choice among the many with the same base
     parameters (the split between a link and the rotor inertia, and unidentifiable directions, are that choice's).
@@ -218,16 +219,23 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
             raise ConfigError(f"{path}: joint {joint.attrs.get('name')!r} names link {e.attrs['link']!r}, which the file does not have")
         return str(e.attrs["link"])
 
-    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints, or joints held fixed
+    children: dict[str, list[str]] = {}  # link -> links attached to it by fixed joints
     for j in joints.values():
-        if j.attrs.get("type") == "fixed" or j.attrs.get("name") in robot.held:
+        if j.attrs.get("type") == "fixed" and j.attrs.get("name") not in robot.held:
             children.setdefault(end(j, "parent"), []).append(end(j, "child"))
+    held_links = _held_subtrees(joints, robot.held, end)
+    own = _held_contributions(path, data, text, links, held_links, robot) if held_links else None
     moved: list[str] = []
     for k, joint in enumerate(robot.joints):
         link_name = end(joints[joint.name], "child")
-        mass, com, inertia = physical_from_inertial(fitted.inertial[k])
+        alone = fitted.inertial[k] - (0.0 if own is None else own[k])
+        if own is not None and np.any(own[k] != 0) and not is_physically_consistent(alone):
+            alone = nearest_consistent(alone)  # the identified link lighter than its held links' nominal values
+            moved.append(f"{link_name}: its identified values less the held links' own are not physically consistent; "
+                         "the nearest consistent ones are written (the held links keep the file's)")
+        mass, com, inertia = physical_from_inertial(alone)
         merged = _remove_fixed_inertials(text, links, children, link_name)
-        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged, bool(robot.held))
+        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged)
         _write_dynamics(text, joints[joint.name], robot, fitted, k)
         m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
         far = moved_far(link_name, mass, com, m0, c0, "URDF")
@@ -294,6 +302,44 @@ class _TextEdits:
         return out.decode("utf-8")
 
 
+def _held_subtrees(joints: dict, held, end) -> set[str]:
+    """The links a held joint carries (a gripper's fingers), with every link attached below them."""
+    below: dict[str, list[str]] = {}
+    for j in joints.values():
+        below.setdefault(end(j, "parent"), []).append(end(j, "child"))
+    stack = [end(j, "child") for name, j in joints.items() if name in held]
+    out: set[str] = set()
+    while stack:
+        name = stack.pop()
+        if name not in out:
+            out.add(name)
+            stack.extend(below.get(name, ()))
+    return out
+
+
+def _held_contributions(path: Path, data: bytes, text: _TextEdits, links: dict, held_links: set[str],
+                        robot: Robot) -> np.ndarray:
+    """Each moving link's share of the held links' own (nominal) inertials, in its frame at the held pose: the robot
+    read from the URDF lumps them into the link they hang on; the same URDF without their ``<inertial>`` gives the
+    links alone, and the difference is theirs (the lumping is a sum). The written URDF keeps their ``<inertial>`` as
+    the file has them and gives the moving link the identified values less this share, so that the full model's
+    mass matrix stays positive definite (with the lumped values written into the last link and the fingers massless,
+    a 9-joint Panda's was singular)."""
+    import tempfile
+
+    from ..model.description import robot_from_urdf
+
+    bare = _TextEdits(data, text.root)
+    for name in held_links:
+        if links[name].child("inertial") is not None:
+            bare.remove(links[name].child("inertial"))
+    with tempfile.TemporaryDirectory() as folder:
+        copy = Path(folder) / path.name
+        copy.write_text(bare.result(), encoding="utf-8")
+        alone = robot_from_urdf(copy, held=robot.held)
+    return np.asarray(robot.inertial, dtype=float) - np.asarray(alone.inertial, dtype=float)
+
+
 def _remove_fixed_inertials(text: _TextEdits, links: dict, children: dict, link_name: str) -> list[str]:
     """Remove the ``<inertial>`` of the links fixed (directly or not) to ``link_name``: identified with it. Returns
     their names."""
@@ -308,11 +354,10 @@ def _remove_fixed_inertials(text: _TextEdits, links: dict, children: dict, link_
     return merged
 
 
-def _write_inertial(text: _TextEdits, link: _Element, inertial: dict, merged: list[str], held: bool = False) -> None:
+def _write_inertial(text: _TextEdits, link: _Element, inertial: dict, merged: list[str]) -> None:
     """A link's identified ``<inertial>``: its three children's values edited in place where the file has exactly
     them, the element rewritten at its place otherwise, or added as the link's last child."""
-    how = "fixed or held" if held else "fixed"
-    note = (_comment(f" dynid: the inertials of {', '.join(merged)} ({how} to this link) are identified with it and "
+    note = (_comment(f" dynid: the inertials of {', '.join(merged)} (fixed to this link) are identified with it and "
                      "written here ") if merged else "")
     current = link.child("inertial")
     parts = {c.tag: c for c in current.children} if current is not None else {}

@@ -81,12 +81,15 @@ def builtin_robots() -> list[str]:
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
-def load_robot(name_or_path: str | Path) -> Robot:
-    """A built-in robot by name (``"er16"``) or a robot description TOML file.
+def load_robot(name_or_path: str | Path, *, held=()) -> Robot:
+    """A built-in robot by name (``"er16"``), a robot description TOML file, a URDF, xacro or MuJoCo (MJCF) file, or
+    the robot of an identification config (``dynid init``'s: its ``robot = ...`` or ``[robot]`` table).
 
     Parameters
     ----------
     name_or_path : str or Path
+    held : sequence of str
+        Joints of a URDF, xacro or MJCF held fixed at 0 (a gripper's fingers: :func:`dynid.model.urdf.joints_from_urdf`).
 
     Returns
     -------
@@ -97,23 +100,47 @@ def load_robot(name_or_path: str | Path) -> Robot:
     ------
     ConfigError
         Unknown robot, unreadable file, or a field with a wrong type or value (the message names the file and the
-        field).
+        field); ``held`` for a robot that is not read from a URDF, xacro or MJCF file.
     """
     text = str(name_or_path)
-    if text in builtin_robots():
-        res = resources.files("dynid.model") / "robots" / f"{text}.toml"
-        return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=Path(str(res)).parent)
     path = Path(text)
     from .urdf import expand_xacro, is_mjcf, is_xacro
 
+    if held and not ((path.suffix == ".urdf" or is_mjcf(path) or is_xacro(path)) and path.is_file()):
+        raise ConfigError(f"{text}: held = {list(held)!r} needs a URDF, xacro or MJCF file (a description TOML or an "
+                          "identification config says held in its [robot] table)")
+    if text in builtin_robots():
+        res = resources.files("dynid.model") / "robots" / f"{text}.toml"
+        return robot_from_toml_text(res.read_text(encoding="utf-8"), source=f"built-in robot {text}", base=Path(str(res)).parent)
     if (path.suffix == ".urdf" or is_mjcf(path)) and path.is_file():
-        return robot_from_urdf(path)
+        return robot_from_urdf(path, held=held)
     if is_xacro(path) and path.is_file():
-        return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0])
+        return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0], held=held)
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
                           "description file, a .urdf, a .xacro or a MuJoCo .xml file")
-    return robot_from_toml_text(path.read_text(encoding="utf-8"), source=str(path), base=path.parent)
+    body = path.read_text(encoding="utf-8")
+    config = _config_robot(body, path)
+    return config if config is not None else robot_from_toml_text(body, source=str(path), base=path.parent)
+
+
+def _config_robot(text: str, path: Path) -> Robot | None:
+    """The robot of an identification config (a TOML with an ``[identification]`` table), as ``dynid identify``
+    reads it: ``robot = "..."`` relative to the config's folder, or a ``[robot]`` table; None for any other TOML."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return None  # the description parser says what is wrong
+    if "identification" not in doc or "robot" not in doc:
+        return None
+    ref = doc["robot"]
+    if isinstance(ref, dict):
+        table = {**ref, "name": ref.get("name", Path(str(ref.get("urdf", path.stem))).stem)}
+        return robot_from_document(table, f"{path}: robot", path.parent)
+    if isinstance(ref, str):
+        local = path.parent / ref
+        return load_robot(ref if ref in builtin_robots() or not local.exists() else local)
+    raise ConfigError(f"{path}: robot: expected a name, a file or a [robot] table, got {ref!r}")
 
 
 def parse_angle(value, where: str) -> float:
