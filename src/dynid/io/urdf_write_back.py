@@ -10,6 +10,7 @@ the edits are spans of the original bytes replaced by new text at the indentatio
 from __future__ import annotations
 
 import re
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
@@ -325,8 +326,6 @@ def _held_contributions(path: Path, data: bytes, text: _TextEdits, links: dict, 
     the file has them and gives the moving link the identified values less this share, so that the full model's
     mass matrix stays positive definite (with the lumped values written into the last link and the fingers massless,
     a 9-joint Panda's was singular)."""
-    import tempfile
-
     from ..model.description import robot_from_urdf
 
     bare = _TextEdits(data, text.root)
