@@ -132,3 +132,24 @@ def test_validate_file_reads_the_file_it_is_given_with_the_configs_reader(tmp_pa
     assert spec.time.scale == cfg.identification.time.scale == 1e-3
     with pytest.raises(DataError, match="a ROS 2 bag, but the config's logs are CSV files"):
         dataset_for_file(cfg, tmp_path / "other")
+
+
+def test_a_bag_without_message_definitions_is_read_with_humbles_types(tmp_path, rng):
+    """A rosbag2 of ROS 2 Humble or earlier holds no message definitions: it was refused with the reading library's
+    own advice ("Instantiate AnyReader with a default_typestore argument"); it is read with ROS 2 Humble's standard
+    types, and said."""
+    import sqlite3
+
+    robot = load_robot("ur10e")
+    names = [j.name for j in robot.joints]
+    t = np.arange(60) * 0.01
+    q = 0.1 * rng.normal(size=(60, 6))
+    tau = rng.normal(size=(60, 6))
+    _write_bag(tmp_path / "humble", t, names, q, np.zeros((60, 6)), tau)
+    db = next((tmp_path / "humble").glob("*.db3"))
+    with sqlite3.connect(db) as con:  # what a Humble recording lacks
+        con.execute("delete from message_definitions")
+    spec = dataset_spec({"bag": "humble"}, tmp_path, "cfg", "ident", 6)
+    rec = load_recording(spec, robot)
+    np.testing.assert_allclose(rec.q, q, atol=1e-12)
+    assert any("holds no message definitions" in w and "ROS 2 Humble's standard types" in w for w in rec.warnings)

@@ -8,6 +8,7 @@ or motor currents in A with ``effort = "currents"``).
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -52,7 +53,11 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
     wanted = list(spec.joint_names or [j.name for j in robot.joints])
     stamps, pos, vel, eff = [], [], [], []
     try:
-        with AnyReader([path]) as reader:
+        typestore = _typestore_for(path, AnyReader)
+        if typestore is not None and warnings is not None:
+            warnings.append(f"{name}: {path.name} holds no message definitions (recorded by ROS 2 Humble or earlier): "
+                            "its messages are read with ROS 2 Humble's standard types")
+        with AnyReader([path], default_typestore=typestore) as reader:
             connections = [c for c in reader.connections if c.topic == spec.topic]
             if not connections:
                 topics = sorted({c.topic for c in reader.connections})
@@ -94,6 +99,21 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
             k = int(np.argwhere(np.isinf(x))[0, 0])
             raise DataError(f"{path}: message {k + 1} on {spec.topic}: infinite {kind}")
     return np.array(stamps), signals, lambda k: f"{path}: message {k + 1} on {spec.topic}"
+
+
+def _typestore_for(path: Path, reader_class):
+    """None for a bag that carries its message definitions (every bag since ROS 2 Iron), ROS 2 Humble's standard
+    typestore for one that does not (rosbags would refuse it: "Bag contains no type definitions")."""
+    from rosbags.highlevel import AnyReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    try:
+        with reader_class([path]):
+            return None
+    except AnyReaderError as exc:
+        if "no type definitions" not in str(exc):
+            raise
+    return get_typestore(Stores.ROS2_HUMBLE)
 
 
 def _one_line(message: str) -> str:
