@@ -253,13 +253,21 @@ def strategy_for(settings: Preprocessing | str) -> Strategy:
     return target
 
 
+HARMONICS_RESOLVED = ("position_cutoff", "velocity_cutoff", "parallel_cutoff", "decimation", "band", "min_speed", "trim",
+                      "rest_velocity")
+"""The settings a strategy that differentiates with the excitation's harmonics (the paper's) resolves to fixed values
+(every cutoff 0): another log, prepared with parallel filtering, derives them from its own data instead."""
+
+
 def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Preprocessing:
     """Settings of a log scored with another log's parameters (a validation log).
 
     The config's settings as given (cutoffs in Hz stay what the user wrote), the rest derived for this log: its band,
     at least the identification log's (so a faster validation motion is filtered for its own band, never below the
     identification's), its decimation and trim (its rate and length may differ), its rest velocity (at least the identification's); the identification's friction state at
-    rest; no Fourier fit (the excitation's harmonics fit only its own log). A ``decimation`` the config gives is every
+    rest; no Fourier fit (the excitation's harmonics fit only its own log: a model prepared with them scores other
+    logs with parallel filtering, its cutoffs derived from each log, :data:`HARMONICS_RESOLVED`). A ``decimation`` the
+    config gives is every
     log's, as it always was (with ``parallel_cutoff = 0`` its anti-aliasing filter is the only filter of the torques:
     dropping it scored validation logs on raw samples). Use with ``prepare(..., strict=False)``: a cutoff above this
     log's Nyquist frequency is lowered, with a warning.
@@ -276,8 +284,11 @@ def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Prepro
     Preprocessing
         Settings for :func:`dynid.preprocessing.pipeline.prepare` on the other log.
     """
-    if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log
-        given = replace(given, strategy="parallel")
+    if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log: parallel filtering,
+        # its filters derived from this log; the harmonics strategy's own resolved zeros (no filter at all: raw
+        # differences of the positions) are no setting of a user's (eq. 18's correlation fell from 0.999 to 0.72)
+        default = Preprocessing()
+        given = replace(given, strategy="parallel", **{f: getattr(default, f) for f in HARMONICS_RESOLVED})
     if resolved is None:
         return replace(given, fourier=None, warnings=())
     floor: float | tuple = 0.0
