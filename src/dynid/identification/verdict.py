@@ -133,7 +133,8 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
             main, chosen = nominal[0], (nominal[0], (
                 f"main estimate: {nominal[0]}: keep your robot file's values, this log cannot improve them: the "
                 f"description's nominal model predicts the validation logs better than every estimate "
-                f"({_apart(described, own)} against {main}, on average); chosen on the validation logs, so their "
+                f"({_apart(described, own).replace(' against ', f' against {main} ')} on average); chosen on the "
+                "validation logs, so their "
                 "figures for it are not an independent test; what would improve it: a longer, richer excitation "
                 "(dynid excite) over the motions the robot will make"))
     if chosen is not None:
