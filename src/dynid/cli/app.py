@@ -370,11 +370,16 @@ def export(
         return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
 
     def compute(prepared, progress):
+        from ..io.export import consistent_estimate
+        from ..io.replay import urdf_replay
+
         cfg, identified, targets = prepared
         moved: list[str] = []
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
-        return cfg, texts, moved, identified
+        checks = {path: urdf_replay(text, *consistent_estimate(cfg.robot, identified, str(results)))
+                  for (flag, path), (_, text) in zip(targets, texts) if flag == "--urdf"}
+        return cfg, texts, moved, identified, checks
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -384,7 +389,7 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        cfg, _, moved, _ = computed
+        cfg, _, moved, _, _ = computed
         robot = cfg.robot
         into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
@@ -400,6 +405,14 @@ def export(
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
+        for path, check in computed[4].items():
+            said = (f"{path.name} read back by Pinocchio: its torques equal dynid's model to {check.relative_error:.1e} "
+                    f"of their RMS ({check.n_states} random states within the joint limits)")
+            if check.missing:
+                j = max(range(len(check.missing_share)), key=lambda k: check.missing_share[k])
+                said += (f"; what URDF cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
+                         f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
+            (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)
 
