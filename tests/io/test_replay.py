@@ -57,3 +57,19 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     error = float(re.search(r"m\.urdf read back by Pinocchio: its torques equal dynid's model to (\S+) of their RMS",
                             said).group(1))
     assert error < 1e-9 and re.search(r"what URDF cannot hold \(Ia, (\w+, )*offset\) is up to \S+ % of J\d", said)
+
+
+def test_a_model_whose_gravity_is_not_minus_z_is_written_with_its_base_turned():
+    """The KR 300's model has gravity along +z of its base frame (the authors' base is turned half a turn about x); a
+    URDF has no gravity field and its users take -z, so the URDF dynid wrote gave torques 71 % off its model. The
+    base is now turned under a world link, and the file reproduces the model."""
+    from dynid.io.export import urdf_from_robot
+
+    robot = load_robot(Path(__file__).resolve().parents[2] / "configs" / "robots" / "kuka_kr300.toml")
+    assert np.allclose(robot.gravity, [0.0, 0.0, 9.81])
+    phi = robot.standard_parameters()
+    text = urdf_from_robot(robot, phi)
+    assert '<link name="world"/>' in text
+    assert urdf_replay(text, robot, phi).relative_error < 1e-9
+    plain = urdf_from_robot(load_robot("er16"))  # gravity along -z already: no world link
+    assert '<link name="world"/>' not in plain

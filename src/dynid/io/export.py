@@ -112,6 +112,12 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
     fitted = _exportable(robot, phi)
     lines = ['<?xml version="1.0"?>', f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
              f"<robot name={quoteattr(name or robot.name)}>", '  <link name="base_link"/>']
+    turn = _world_from_base(robot.gravity)
+    if turn is not None:  # a URDF has no gravity: its users take -z of the root; the base turned so that it is
+        lines += ['  <link name="world"/>', '  <joint name="world_to_base" type="fixed">', '    <parent link="world"/>',
+                  '    <child link="base_link"/>', f'    <origin xyz="0 0 0" rpy="{_vec(_rpy(turn))}"/>',
+                  f"    <!-- dynid: gravity is {_vec(robot.gravity)} m/s² in the model's base frame: the base is turned so "
+                  "that it points along -z of world, as a URDF's users take it -->", "  </joint>"]
     for j, joint in enumerate(robot.joints):
         mass, com, inertia = physical_from_inertial(fitted.inertial[j])
         link = f"link{j + 1}"
@@ -144,6 +150,24 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
               '    <child link="flange"/>',
               f'    <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(robot.tool_rotation))}"/>', "  </joint>", "</robot>", ""]
     return "\n".join(lines)
+
+
+def _world_from_base(gravity: np.ndarray) -> np.ndarray | None:
+    """The rotation world ← base that turns the model's gravity to -z of world (Rodrigues' formula), None where it
+    points there already."""
+    g = np.asarray(gravity, dtype=float)
+    norm = float(np.linalg.norm(g))
+    if norm == 0.0:
+        return None
+    a, b = g / norm, np.array([0.0, 0.0, -1.0])
+    if np.allclose(a, b, atol=1e-12):
+        return None
+    if np.allclose(a, -b, atol=1e-12):  # straight up: half a turn about x
+        return np.diag([1.0, -1.0, -1.0])
+    axis = np.cross(a, b)
+    s, c = float(np.linalg.norm(axis)), float(a @ b)
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]]) / s
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
 @keyword_only_after_data
