@@ -378,3 +378,19 @@ def test_init_never_takes_a_commanded_column_for_a_measured_signal(tmp_path, sty
     text = (tmp_path / "arm.toml").read_text()
     assert "positions = { columns = [" + ", ".join(f'"{c}"' for c in measured) + "] }" in text
     assert f"# commanded, never taken for a measured signal: {cmd[0]}" in text
+
+
+def test_init_asks_which_side_of_the_gear_measured_the_torques(tmp_path):
+    """issue "Never worse than the description", item 3: a log cannot say whether its torques hold the rotor inertia;
+    the config init writes asks, beside the torques, with the setting that says it (read by identify)."""
+    import tomllib
+
+    from dynid.io.starter import SENSOR_HINT
+
+    log = _log(tmp_path, header=True)
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "arm.toml").read_text()
+    assert SENSOR_HINT in text and text.index(SENSOR_HINT) > text.index("torques = {")
+    joint = text.replace("] }\n" + SENSOR_HINT, '], sensor = "joint" }\n' + SENSOR_HINT)
+    assert tomllib.loads(joint)["identification"]["torques"]["sensor"] == "joint"

@@ -231,6 +231,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                 table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
                 notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
                 taken += found[kind][:n_dof]
+                if kind == "torques":  # a log cannot tell which side of the gear measured them: the user says
+                    table.append(SENSOR_HINT)
         left = [c for c in first if c not in taken]
         extra = [c for c in left if _kind(c) in ("positions", effort)]
         if extra:
@@ -270,6 +272,11 @@ def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
 def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
     return [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain of revolute joints (a gripper?): held fixed "
             "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
+
+
+SENSOR_HINT = ('# torques from joint torque sensors on the link side (a KUKA LBR, a Franka)? add sensor = "joint" to '
+               "the torques table: no rotor inertia is then fitted")
+"""The line under a config's torques that asks what a log cannot say: which side of the gear measured them."""
 
 
 def _found_columns(first: list[str], row: list[str], joints: tuple[str, ...], n_dof: int) -> tuple[dict, list[str]]:
