@@ -442,6 +442,7 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
         xacro.all_includes = []  # type: ignore[attr-defined]  # the files an expansion reads besides the top one (includes, YAML), for the cache
         with _silenced_stderr([]), guarded_xacro(xacro, str(path)) as refused:
             try:
+                # xacro's macros and includes; its two evaluators are dynid's own interpreter here (guarded_xacro)
                 doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
             except Exception:
                 if refused:  # an expression the evaluator refused, wrapped by xacro: said as the evaluator said it
