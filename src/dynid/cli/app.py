@@ -493,6 +493,9 @@ def validate(
     data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Print every log's table (error, RMSE and ρ per joint "
                                                                  "and parameter set); report.html has them too."),
+    yardstick: bool = typer.Option(False, "--yardstick", help="Filter every log by dynid's default rules, whatever "
+                                   "settings the results were identified with: results of other settings, or "
+                                   "another tool's model, scored on the same samples."),
     quiet: bool = QUIET,
 ) -> None:
     """Validate identified parameters (and the config's reference sets) on other logs."""
@@ -518,17 +521,21 @@ def validate(
         return save_validation(validated[0], out, validated[1])
 
     def show(rep, validated, paths):
+        from ..identification.run import YARDSTICK
         from ..report.summaries import validation_in_short, validation_verdict
+        from ..tables import Line
 
         comparisons, warnings = validated
         tables = [comparison_table(c) for c in comparisons] if verbose else []
-        rep.blocks([*validation_in_short(comparisons, tables_follow=verbose), *tables, *validation_verdict(comparisons)])
+        said = [Line(f"on one yardstick: {YARDSTICK}")] if yardstick else []
+        rep.blocks([*said, *validation_in_short(comparisons, tables_follow=verbose), *tables, *validation_verdict(comparisons)])
         for w in warnings:
             rep.warning(w)
         rep.wrote(paths)
 
     _Command("dynid validate", quiet, out, figures=True).run(
-        prepare, lambda p, progress: run_validation(p[0], p[1], datasets=p[2], progress=_steps(progress), source=str(results)), save, show)
+        prepare, lambda p, progress: run_validation(p[0], p[1], datasets=p[2], progress=_steps(progress), source=str(results),
+                                                 yardstick=yardstick), save, show)
 
 
 @app.command()

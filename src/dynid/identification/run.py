@@ -27,7 +27,7 @@ from ..keywords import keyword_only_after_data
 from ..model.description import builtin_robots
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
-from ..preprocessing.strategies import carried_over
+from ..preprocessing.strategies import carried_over, yardstick_settings
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 from .verdict import choose_main_estimate, nominal_set
@@ -68,7 +68,8 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 
 
 def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
-                  progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None) -> tuple[tuple, tuple[str, ...]]:
+                  progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
+                  yardstick: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
     Parameters
@@ -88,6 +89,10 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         Each joint's residual σ (for the prediction bands).
     covariance : dict, optional
         label -> covariance of that set.
+    yardstick : Preprocessing, optional
+        Prepare each log by the one yardstick instead of the identification's settings carried over: the
+        identification log's settings resolved by dynid's default rules
+        (:func:`dynid.preprocessing.strategies.yardstick_settings`).
 
     Returns
     -------
@@ -104,7 +109,8 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
 
     out: list = []
     warnings: list[str] = []
-    settings = carried_over(resolved, config.preprocessing)
+    settings = (carried_over(resolved, config.preprocessing) if yardstick is None else
+                yardstick_settings(resolved, config.preprocessing, yardstick))
     for spec in datasets:
         if progress is not None:  # one step per log: reading, filtering and predicting it
             progress(f"validation, {spec.name}", 0, 1)
@@ -161,6 +167,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     pipeline = pipeline_of(config)
     prepared = pipeline.prepare(recording, base, step)
     raw = recording if config.closed_loop else None  # the closed-loop estimators prepare the log themselves
+    reference = yardstick_reference(recording) if validate and config.validation else None
     del recording  # the raw positions and velocities: only the filtered ones are used from here
     if prepared.base is not base:  # the friction models chosen changed the map: the references follow it
         refs = _references(replace(config, robot=prepared.robot), prepared.base)
@@ -189,7 +196,87 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
                                          {result.label: result.solution.covariance})
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    return choose_main_estimate(result, nominal, scored_all)
+    yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), prepared.data.settings,
+                                 reference, progress)
+    return with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick), yardstick)
+
+
+YARDSTICK = ("each validation log prepared by dynid's default rules (filters, samples kept, rest threshold), carried "
+             "over from the identification log prepared by the same rules, whatever the identification's settings")
+"""What the one yardstick is, as results.json and the terminal say it (:func:`with_yardstick`)."""
+
+
+def yardstick_reference(recording) -> Preprocessing | None:
+    """The identification log's settings resolved by dynid's default rules: what the one yardstick carries over to the
+    validation logs (:func:`dynid.preprocessing.strategies.yardstick_settings`).
+
+    Parameters
+    ----------
+    recording : dynid.io.datasets.Recording
+        The identification log, as read.
+
+    Returns
+    -------
+    Preprocessing or None
+        None where the default rules cannot prepare the log (the validation logs then take them alone).
+    """
+    from ..preprocessing.pipeline import prepare
+
+    try:
+        return prepare(recording, Preprocessing(), strict=False).settings
+    except DynIdError:
+        return None
+
+
+def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: tuple, resolved=None, reference=None,
+                     progress=None) -> tuple:
+    """Every set scored on the validation logs by the one yardstick (issue "Never worse than the description", item 5):
+    each log prepared by dynid's default rules, whatever the identification's settings
+    (:func:`dynid.preprocessing.strategies.yardstick_settings`).
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+        As identified (its robot's friction model).
+    base : BaseParameters
+    sets : dict
+        label -> (n_base,) base parameters.
+    datasets : tuple
+        The validation logs (Recording or DatasetSpec).
+    resolved : Preprocessing, optional
+        The identification's resolved settings (only what describes the model is kept from them).
+    reference : Preprocessing, optional
+        The identification log's settings resolved by the default rules (:func:`yardstick_reference`).
+    progress : callable, optional
+
+    Returns
+    -------
+    tuple of TorqueComparison
+    """
+    step = None if progress is None else (lambda label, done, total: progress(f"one yardstick: {label}", done, total))
+    return validate_sets(config, base, sets, datasets, step, resolved, yardstick=reference or Preprocessing())[0]
+
+
+def with_yardstick(result, scored: tuple):
+    """``result`` with the sets' errors on the one yardstick in its diagnostics (``"yardstick"``: the global relative
+    error [%] of each set on each log and their mean over the logs), beside the figures on the identification's own
+    settings.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    scored : tuple of TorqueComparison
+        From :func:`yardstick_scores`.
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    logs = {c.name: {label: float(m["global_relative_error"]) for label, m in c.metrics().items()} for c in scored}
+    labels = [label for label in (scored[0].metrics() if scored else {})]
+    mean = {label: float(np.mean([errors[label] for errors in logs.values()])) for label in labels}
+    figures = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean}
+    return replace(result, diagnostics={**result.diagnostics, "yardstick": figures})
 
 
 def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
@@ -214,7 +301,7 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
 
 @keyword_only_after_data
 def run_validation(config: IdentificationConfig, identified: dict, *, datasets: tuple[DatasetSpec, ...] | None = None,
-                   progress=None, source: str = "results") -> tuple[tuple, tuple[str, ...]]:
+                   progress=None, source: str = "results", yardstick: bool = False) -> tuple[tuple, tuple[str, ...]]:
     """Validate identified base parameters and the config's reference sets on the config's validation datasets (or on
     ``datasets``).
 
@@ -229,6 +316,11 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
         ``progress(step, done, total)``.
     source : str
         Where the results come from (their file), named in errors.
+    yardstick : bool
+        Prepare every log by the one yardstick (dynid's default rules, carried over from the config's identification
+        log prepared by them: :func:`dynid.preprocessing.strategies.yardstick_settings`) instead of the results'
+        settings, so that results identified with other settings, or another tool's model, are scored on the same
+        samples treated the same way.
 
     Returns
     -------
@@ -262,7 +354,9 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
         noise = noise if noise is not None and noise.shape == (config.robot.n_dof,) else None
     except (TypeError, ValueError):
         noise = None
-    comparisons, warnings = validate_sets(config, base, sets, datasets, progress, stored_preprocessing(identified), noise)
+    reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
+    comparisons, warnings = validate_sets(config, base, sets, datasets, progress, stored_preprocessing(identified), noise,
+                                          yardstick=reference)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 

@@ -16,7 +16,10 @@ logs are scored. The candidates, in the order they are weighed:
 4. the description's nominal model itself, where it predicts the validation logs better than every estimate: the
    main estimate is then the robot file's values, and the first finding says to keep them.
 
-The choice reads the validation logs' torques, and says so: where a candidate was chosen on them, their figures for it
+The validation figures it weighs are the one yardstick's (:func:`dynid.identification.run.yardstick_scores`: every
+validation log prepared by dynid's default rules, whatever the identification's settings), so a setting that filters
+the validation logs differently does not move the choice (issue "Never worse than the description", item 5). The
+choice reads the validation logs' torques, and says so: where a candidate was chosen on them, their figures for it
 are not an independent test. Torque-free evidence was measured and rejected (benchmarks/README.md): the
 identification log's residual plus the prediction variance on the validation logs' states chose the drive-only
 estimate on five of six windows of the LBR Med7's log, where it predicts 1.2-2.6× worse than the description; the same
@@ -78,7 +81,8 @@ def _mean_error(validations, label: str) -> float:
     return float(np.mean([v.metrics()[label]["global_relative_error"] for v in validations]))
 
 
-def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, scored: tuple | None = None):
+def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, scored: tuple | None = None,
+                         judged: tuple | None = None):
     """The main estimate of an identification and, with validation logs, the verdict's findings on them (module
     docstring).
 
@@ -91,6 +95,10 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
     scored : tuple of TorqueComparison, optional
         The validation logs with every set scored, the drive-only one (:attr:`IdentificationResult.drive_only`)
         included.
+    judged : tuple of TorqueComparison, optional
+        The same sets scored on the one yardstick (:func:`dynid.identification.run.yardstick_scores`): where given,
+        the choice weighs these figures, so that it does not depend on how the identification's settings filter the
+        validation logs; default ``scored`` (and ``result.validations``).
 
     Returns
     -------
@@ -100,7 +108,7 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
     """
     from .identify import HELD_OUT_FOLDS, SDP_LABEL
 
-    findings = [f for f in result.findings if f.kind != "main"]  # an earlier call's choice is made again here
+    findings = [f for f in result.findings if f.kind not in ("main", "drive")]  # an earlier call's made again here
     ls, main = result.label, estimate_label(result.estimators[0])
     inconsistent = not str(result.consistency_verdicts.get(ls, "yes")).startswith("yes")
     rigid = main == ls and SDP_LABEL in result.estimates and inconsistent
@@ -112,28 +120,31 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
                                                f"and predicts held-out blocks of the log worse ({held[SDP_LABEL]:.3g} "
                                                f"against {held[ls]:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
                                                "cross-validation)"))
-        return replace(result, main=main, findings=tuple(findings))
+        return replace(result, main=main, findings=tuple(findings + _drive_findings(result, main)))
     chosen: tuple[str, str] | None = None
-    sdp, own = (_mean_error(result.validations, SDP_LABEL), _mean_error(result.validations, ls)) if rigid else (0, 0)
+    weighed = judged or result.validations
+    avg = " on average, on one yardstick" if judged else " on average"  # the figures the choice weighed
+    sdp, own = (_mean_error(weighed, SDP_LABEL), _mean_error(weighed, ls)) if rigid else (0, 0)
     if rigid and sdp <= SAME_FIGURE * own:  # what export writes, unless the log says it predicts worse
         main, chosen = SDP_LABEL, (SDP_LABEL, f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not "
-                                              + (f"and predicts the validation logs worse ({_apart(sdp, own)} on average)"
+                                              + (f"and predicts the validation logs worse ({_apart(sdp, own)}{avg})"
                                                  if sdp < own else f"and predicts the validation logs as well, to "
-                                                 f"{100 * (SAME_FIGURE - 1):g} % ({_apart(sdp, own)} on average); it is "
+                                                 f"{100 * (SAME_FIGURE - 1):g} % ({_apart(sdp, own)}{avg}); it is "
                                                  "what dynid export writes"))
     if nominal is not None and scored is not None and result.drive_only is not None:
-        preferred = _drive_only_preferred(result, main, nominal[0], scored)
+        preferred = _drive_only_preferred(result, main, nominal[0], scored, judged or scored, avg)
         if preferred is not None:
             result, chosen = preferred
             main = chosen[0]
     if nominal is not None and scored is not None:
-        described, own = _mean_error(scored, nominal[0]), _mean_error(scored, main)
-        if described < own and all(described < _mean_error(scored, k) for k in result.estimates):
+        weighed = judged or scored
+        described, own = _mean_error(weighed, nominal[0]), _mean_error(weighed, main)
+        if described < own and all(described < _mean_error(weighed, k) for k in result.estimates):
             result = _with_nominal(result, nominal)
             main, chosen = nominal[0], (nominal[0], (
                 f"main estimate: {nominal[0]}: keep your robot file's values, this log cannot improve them: the "
                 f"description's nominal model predicts the validation logs better than every estimate "
-                f"({_apart(described, own).replace(' against ', f' against {main} ')} on average); chosen on the "
+                f"({_apart(described, own).replace(' against ', f' against {main} ')}{avg}); chosen on the "
                 "validation logs, so their "
                 "figures for it are not an independent test; what would improve it: a longer, richer excitation "
                 "(dynid excite) over the motions the robot will make"))
@@ -159,14 +170,27 @@ def _with_validation_findings(result, chosen: list, nominal: tuple[str, np.ndarr
     """The findings: the choice's first, the identification's, then least squares' on each validation log
     (extrapolation, an error far above the fit's) and the main estimate against the description's nominal model, joint
     by joint (:func:`dynid.validation.diagnostics.nominal_gate`)."""
-    findings = [f for f in chosen if f.kind == "main"] + [f for f in result.findings if f.kind != "main"]
-    findings += _validation_findings(result)
+    findings = [f for f in chosen if f.kind == "main"] + [f for f in result.findings if f.kind not in ("main", "drive")]
+    findings += _drive_findings(result, result.main) + _validation_findings(result)
     diagnostics = dict(result.diagnostics)
     if nominal is not None:
         gate, stats = nominal_gate(result.validations, result.main, nominal[0])
         findings += gate
         diagnostics.update({"nominal_set": nominal[0], "versus_nominal": stats})
     return replace(result, findings=tuple(findings), diagnostics=diagnostics)
+
+
+def _drive_findings(result, main: str) -> list:
+    """The main estimate's implausible drive terms (:func:`dynid.identification.plausibility.drive_term_findings`):
+    its standard parameters where it has them, else its base parameters."""
+    from .plausibility import drive_term_findings
+
+    estimate = result.estimates.get(main)
+    if estimate is None or getattr(estimate, "key", "") == NOMINAL_KEY:  # the robot file's own values: not fitted
+        return []
+    if estimate.standard is not None:
+        return drive_term_findings(main, result.model.parameter_names, estimate.standard)
+    return drive_term_findings(main, result.base.names, estimate.params)
 
 
 def _validation_findings(result) -> list:
@@ -185,7 +209,7 @@ def _validation_findings(result) -> list:
     return out
 
 
-def _drive_only_preferred(result, main: str, nominal: str, scored: tuple):
+def _drive_only_preferred(result, main: str, nominal: str, scored: tuple, weighed: tuple, avg: str = " on average"):
     """``result`` with :attr:`IdentificationResult.drive_only` among its estimates and ``scored`` as its validations,
     and (label, finding), where the identified rigid body is doubtful on the validation logs and the description's
     rigid body with the drive terms fitted predicts them better than the main estimate ``main`` (mean global error);
@@ -194,13 +218,13 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple):
     Doubtful: the description's nominal model predicts the validation logs better than ``main``, or the least-squares
     estimate's predictions there leave the range the identification log supports (its prediction σ from the
     parameters' covariance over 5× that on the identification log), so the log does not determine the directions those
-    motions need."""
+    motions need. ``weighed``: the figures the choice weighs (the one yardstick's, else ``scored``)."""
     from .identify import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, Estimate, consistency_checks
 
     alt = result.drive_only
-    own, described = _mean_error(scored, main), _mean_error(scored, nominal)
+    own, described = _mean_error(weighed, main), _mean_error(weighed, nominal)
     far = [f for f in _validation_findings(result) if f.kind == "extrapolation"]
-    better = _mean_error(scored, DRIVE_ONLY_LABEL)
+    better = _mean_error(weighed, DRIVE_ONLY_LABEL)
     if not (described < own or far) or not better < own:
         return None
     estimate = Estimate(DRIVE_ONLY_KEY, alt.params, alt.std, standard=alt.standard)
@@ -209,12 +233,12 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple):
                      validations=scored, consistency={**result.consistency, **margins},
                      consistency_verdicts={**result.consistency_verdicts, **verdicts})
     why = (f"the description's nominal model predicts the validation logs better than {main} "
-           f"({_apart(described, own)} on average)" if described < own else
+           f"({_apart(described, own)}{avg})" if described < own else
            f"{result.label}'s predictions leave the range the identification log supports on "
            f"{len(far)} of {len(scored)} validation logs")
     finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
                f"rotor inertia) fitted to this log, because {why} and {DRIVE_ONLY_LABEL} predicts them better than "
-               f"{main} ({_apart(better, own)} on average; the description's nominal model {described:.3g} %); chosen on "
+               f"{main} ({_apart(better, own)}{avg}; the description's nominal model {described:.3g} %); chosen on "
                f"the validation logs, so their figures for it are not an independent test{_held_note(alt.held, alt.undetermined)}")
     if alt.held or alt.undetermined:
         result = replace(result, diagnostics={**result.diagnostics, "drive_only_held": alt.held,

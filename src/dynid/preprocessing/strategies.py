@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from ..model.robot import Robot
     from .prepared import PreparedData
 
-__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for", "carried_over"]
+__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for", "carried_over", "yardstick_settings"]
 
 Chunk = tuple["np.ndarray", "np.ndarray", "np.ndarray", "np.ndarray"]
 
@@ -257,6 +257,43 @@ HARMONICS_RESOLVED = ("position_cutoff", "velocity_cutoff", "parallel_cutoff", "
                       "rest_velocity")
 """The settings a strategy that differentiates with the excitation's harmonics (the paper's) resolves to fixed values
 (every cutoff 0): another log, prepared with parallel filtering, derives them from its own data instead."""
+
+
+YARDSTICK_DEFAULTS = (*HARMONICS_RESOLVED, "order", "strategy", "smoothing_passes", "auto", "fourier", "band_floor",
+                      "rest_floor")
+"""The settings the one yardstick takes from dynid's default rules (:func:`yardstick_settings`): every filter, the
+samples kept (trim, decimation) and the rest threshold."""
+
+
+def yardstick_settings(resolved: Preprocessing | None, given: Preprocessing,
+                       reference: Preprocessing | None) -> Preprocessing:
+    """Settings of the one yardstick: a validation log prepared the same way whatever the identification's settings
+    (issue "Never worse than the description", item 5).
+
+    Every filter, the trim, the decimation and the rest threshold (:data:`YARDSTICK_DEFAULTS`) are those dynid's
+    default rules give the validation log, carried over from the identification log prepared by the same default
+    rules (``reference``: the faster band of the two, the identification's rest velocity as the floor, as
+    :func:`carried_over` does), so two settings, two estimates, a reference set and another tool's model are scored on
+    the same samples with the measured torque treated the same way. What describes the model rather than the
+    treatment of the log stays as the identification gives it: the torque channel's delay, the Coulomb smoothing, the
+    friction at rest and the presliding distance.
+
+    Parameters
+    ----------
+    resolved : Preprocessing or None
+        The identification log's resolved settings.
+    given : Preprocessing
+        The config's settings as written.
+    reference : Preprocessing or None
+        The identification log's settings resolved by the default rules (``Preprocessing()``).
+
+    Returns
+    -------
+    Preprocessing
+        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the validation log (``strict=False``).
+    """
+    treatment = carried_over(reference, Preprocessing())
+    return replace(carried_over(resolved, given), **{f: getattr(treatment, f) for f in YARDSTICK_DEFAULTS})
 
 
 def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Preprocessing:

@@ -645,7 +645,7 @@ def in_short(result) -> list:
                                              ", physically consistent" if consistent else
                                              f", not physically consistent{export}"))]
     lines, errors = _log_lines(r, label)
-    out += lines
+    out += lines + _yardstick_lines(r, label)
     out += _determined_lines(r, label)
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
@@ -667,6 +667,19 @@ def in_short(result) -> list:
         step = "use the model to predict torques; no estimate is physically consistent, so none is exported"
     out.append(Line("next: " + step))
     return out
+
+
+def _yardstick_lines(r, label: str) -> list:
+    """:func:`in_short`'s line on the one yardstick (:func:`dynid.identification.run.with_yardstick`): the main
+    estimate's and the description's mean validation errors with every log prepared by dynid's default rules alone."""
+    mean = (r.diagnostics.get("yardstick") or {}).get("mean_global_relative_error") or {}
+    if label not in mean:
+        return []
+    nominal = r.diagnostics.get("nominal_set")
+    beside = f", the description's nominal model {mean[nominal]:.3g} %" if nominal in mean and nominal != label else ""
+    return [Line(f"on one yardstick (every validation log filtered by dynid's default rules, the same samples whatever the "
+                 f"settings): {label} {mean[label]:.3g} %{beside} (mean over "
+                 f"{len(r.validations)} logs)")]
 
 
 CHOSEN_TERMS = ("fst", "fca", "fcl")
