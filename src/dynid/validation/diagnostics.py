@@ -51,7 +51,8 @@ class Finding:
     ----------
     kind : str
         "sign", "scale", "order", "friction", "position", "correlated", "excitation", "extrapolation", "validation",
-        "delay".
+        "delay", "main" (the verdict's choice), "drive" (a drive term no drive has:
+        :mod:`dynid.identification.plausibility`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
