@@ -1,5 +1,5 @@
-"""A written URDF read back by Pinocchio reproduces dynid's model where URDF can hold it (issue "The model proven
-where it goes", item 1); a file that lost a value does not, and the check says so."""
+"""A written URDF read back by Pinocchio, and a written MJCF by MuJoCo, reproduce dynid's model where the format can
+hold it (issue "The model proven where it goes", item 1); a file that lost a value does not, and the check says so."""
 
 import re
 from importlib import resources
@@ -51,12 +51,16 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
     p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
-    p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "m.urdf")
+    p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "m.urdf",
+              "--mjcf", tmp_path / "m.xml")
     assert p.returncode == 0, p.stderr
     said = " ".join(p.stdout.split())
     error = float(re.search(r"m\.urdf read back by Pinocchio: its torques equal dynid's model to (\S+) of their RMS",
                             said).group(1))
     assert error < 1e-9 and re.search(r"what URDF cannot hold \(Ia, (\w+, )*offset\) is up to \S+ % of J\d", said)
+    error = float(re.search(r"m\.xml read back by MuJoCo \(mj_inverse\): its torques equal dynid's model to (\S+) of "
+                            r"their RMS", said).group(1))
+    assert error < 1e-6 and "MuJoCo's frictionloss is a constraint" in said
 
 
 def test_a_model_whose_gravity_is_not_minus_z_is_written_with_its_base_turned():
@@ -73,3 +77,46 @@ def test_a_model_whose_gravity_is_not_minus_z_is_written_with_its_base_turned():
     assert urdf_replay(text, robot, phi).relative_error < 1e-9
     plain = urdf_from_robot(load_robot("er16"))  # gravity along -z already: no world link
     assert '<link name="world"/>' not in plain
+
+
+def test_the_written_mjcf_read_back_by_mujoco_reproduces_the_model_and_a_lost_value_is_caught():
+    """MuJoCo's mj_inverse of the MJCF dynid writes (armature = Ia, damping = fv, frictionloss = fc) equals dynid's
+    model of those terms; a file that dropped the off-diagonal inertia, or the armature, is caught; what MJCF cannot
+    hold is the offset alone; MuJoCo's frictionloss constraint is measured apart, and is not fc·sign(q̇)."""
+    from dynid.io.export import mjcf_from_robot
+    from dynid.io.replay import mjcf_replay
+
+    robot, phi = _estimate()
+    text = mjcf_from_robot(robot, phi)
+    check = mjcf_replay(text, robot, phi)
+    assert check.relative_error < 1e-8
+    assert check.missing == ("offset",)
+    assert check.frictionloss_gap > 1e-3  # a soft constraint solved for, not a function of the velocity
+    full = re.compile(r'fullinertia="(\S+) (\S+) (\S+) \S+ \S+ \S+"')
+    diagonal = full.sub(r'fullinertia="\1 \2 \3 0 0 0"', text)
+    assert diagonal != text and mjcf_replay(diagonal, robot, phi).relative_error > 1e-5
+    no_rotor = re.sub(r'armature="[^"]*"', 'armature="0"', text)
+    assert mjcf_replay(no_rotor, robot, phi).relative_error > 1e-5
+
+
+def test_a_link_at_the_limit_of_a_real_one_is_written_so_that_mujoco_loads_it():
+    """A physically consistent estimate may hold a link at the limit (the TX40's link 6 from the SDP: a point mass, a
+    singular inertia); MuJoCo refuses a fullinertia that is not positive definite, so the MJCF dynid wrote did not
+    load; a simulated UR10e's SDP wrist broke MuJoCo's triangle inequality by round-off. The inertia is now written
+    as MuJoCo loads it (dynid.io.export.mujoco_inertia), the torques unchanged to 1e-6."""
+    import mujoco
+
+    from dynid.io.export import mjcf_from_robot
+    from dynid.io.replay import mjcf_replay
+    from dynid.model.spatial import inertial_from_physical
+
+    robot, phi = _estimate()
+    names = robot.parameter_names
+    last = [names.index(f"{p}6") for p in ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M")]
+    phi[last] = inertial_from_physical(0.5, np.array([0.0, 0.0, 0.03]), np.zeros((3, 3)))  # a point mass
+    text = mjcf_from_robot(robot, phi)
+    mujoco.MjModel.from_xml_string(text)  # raised "inertia must have positive eigenvalues" before
+    assert mjcf_replay(text, robot, phi).relative_error < 1e-6
+    rod = inertial_from_physical(0.5, np.array([0.0, 0.0, 0.03]), np.diag([0.0, 0.01, 0.01]) * (1 + np.array([0, 0, 1e-13])))
+    phi[last] = rod  # a thin rod whose largest moment exceeds the sum of the others by round-off
+    mujoco.MjModel.from_xml_string(mjcf_from_robot(robot, phi))

@@ -371,14 +371,13 @@ def export(
 
     def compute(prepared, progress):
         from ..io.export import consistent_estimate
-        from ..io.replay import urdf_replay
 
         cfg, identified, targets = prepared
         moved: list[str] = []
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
-        checks = {path: urdf_replay(text, *consistent_estimate(cfg.robot, identified, str(results)))
-                  for (flag, path), (_, text) in zip(targets, texts) if flag == "--urdf"}
+        estimate = consistent_estimate(cfg.robot, identified, str(results))
+        checks = {path: _replayed(flag, text, estimate) for (flag, path), (_, text) in zip(targets, texts)}
         return cfg, texts, moved, identified, checks
 
     def save(computed):
@@ -405,16 +404,42 @@ def export(
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
-        for path, check in computed[4].items():
-            said = (f"{path.name} read back by Pinocchio: its torques equal dynid's model to {check.relative_error:.1e} "
+        for path, (form, check) in computed[4].items():
+            if isinstance(check, str):
+                rep.line(f"{path.name} not read back: {check}")
+                continue
+            tool = "Pinocchio" if form == "URDF" else "MuJoCo (mj_inverse)"
+            said = (f"{path.name} read back by {tool}: its torques equal dynid's model to {check.relative_error:.1e} "
                     f"of their RMS ({check.n_states} random states within the joint limits)")
+            if form == "MJCF" and check.frictionloss_gap:
+                said += (f"; MuJoCo's frictionloss is a constraint: its force there is {100 * check.frictionloss_gap:.3g} % "
+                         "off frictionloss·sign(q̇)")
             if check.missing:
                 j = max(range(len(check.missing_share)), key=lambda k: check.missing_share[k])
-                said += (f"; what URDF cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
+                said += (f"; what {form} cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
                          f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
             (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)
+
+
+def _replayed(flag: str, text: str, estimate) -> tuple[str, object]:
+    """The written file read back by its tool (:mod:`dynid.io.replay`): ``(format, ReplayCheck)``, or the format and
+    why it was not read back."""
+    if flag == "--urdf":
+        from ..io.replay import urdf_replay
+
+        return "URDF", urdf_replay(text, *estimate)
+    try:
+        import mujoco  # noqa: F401  the MJCF's own reader
+    except ImportError:
+        return "MJCF", "MuJoCo is not installed (pip install 'dynid[mujoco]')"
+    from ..io.replay import mjcf_replay
+
+    try:
+        return "MJCF", mjcf_replay(text, *estimate)
+    except (ValueError, KeyError) as exc:  # a user's model whose meshes MuJoCo finds only beside the original
+        return "MJCF", f"MuJoCo could not load it from its text ({str(exc).splitlines()[0]})"
 
 
 def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | None, robot) -> list[tuple[str, Path]]:

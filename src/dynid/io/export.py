@@ -180,7 +180,9 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
     Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's ``frictionloss`` is a dry-friction
     *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but its force in ``mj_inverse`` comes from the
     constraint solver, so only the other terms reproduce dynid's torques exactly (see the round-trip test). Massless
-    links and point masses get MuJoCo's smallest mass and inertia (``boundmass``, ``boundinertia`` of 1e-9).
+    links and point masses get MuJoCo's smallest mass and inertia (``boundmass``, ``boundinertia`` of 1e-9); a full
+    inertia at the limit of a real link (a point mass, a thin rod) is written as MuJoCo loads it
+    (:func:`mujoco_inertia`).
 
     Parameters
     ----------
@@ -213,6 +215,7 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
         indent = "    " + "  " * j
         q = pin.Quaternion(np.asarray(joint.rotation, dtype=float))
         mass, com, inertia = physical_from_inertial(fitted.inertial[j])
+        inertia = mujoco_inertia(inertia)
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
         lo, hi = robot.limits.q_min[j], robot.limits.q_max[j]
         limit = f' range="{lo:.17g} {hi:.17g}"' if np.isfinite(lo) and np.isfinite(hi) else ""
@@ -242,6 +245,37 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
                      + " -->")
     lines += ["</mujoco>", ""]
     return "\n".join(lines)
+
+
+BOUND_INERTIA = 1e-9
+"""The smallest principal moment written to an MJCF ``fullinertia`` [kg·m²], the value of its ``boundinertia``."""
+
+
+def mujoco_inertia(inertia: np.ndarray) -> np.ndarray:
+    """An inertia about the centre of mass as MuJoCo loads it from ``fullinertia``: its principal moments at least
+    :data:`BOUND_INERTIA` and each at most the sum of the other two, to 1e-10 relative.
+
+    MuJoCo refuses a ``fullinertia`` that is not positive definite or breaks the triangle inequality (its
+    ``boundinertia`` raises only a diagonal one, and ``balanceinertia`` only ``diaginertia``); a physically consistent
+    estimate may hold a link at the limit of a real one (a point mass, a thin rod, a flat plate: the TX40's link 6 from
+    the SDP, a simulated UR10e's wrist), whose MJCF then did not load. The change is within round-off for any other
+    link.
+
+    Parameters
+    ----------
+    inertia : (3, 3) array [kg·m²]
+
+    Returns
+    -------
+    (3, 3) ndarray [kg·m²]
+    """
+    values, vectors = np.linalg.eigh(0.5 * (inertia + inertia.T))
+    fixed = np.maximum(values, BOUND_INERTIA)
+    fixed[2] = min(fixed[2], (fixed[0] + fixed[1]) * (1.0 - 1e-10))  # eigh sorts them: the largest is the last
+    fixed[1] = max(fixed[1], fixed[0])
+    if np.array_equal(fixed, values):
+        return inertia
+    return (vectors * fixed) @ vectors.T
 
 
 def _finite(x: float) -> float:

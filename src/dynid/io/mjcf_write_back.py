@@ -22,7 +22,7 @@ from ..exceptions import ConfigError
 from ..extras import require
 from ..model.robot import Robot
 from ..model.spatial import physical_from_inertial, transform_inertial
-from .export import _exportable, _replace, _vec, identified_header, moved_far
+from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia
 
 AXIS_TOLERANCE = 1e-4
 """[rad, m] How far a joint axis of the MJCF may lie from the robot's, once the arms are aligned."""
@@ -135,6 +135,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         frame_r, frame_p = r @ rotations[k], r @ origins[k] + t  # the robot's joint frame in MuJoCo's world
         in_body = transform_inertial(fitted.inertial[k], body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
         mass, com, inertia = physical_from_inertial(in_body)
+        inertia = mujoco_inertia(inertia)
         nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
         _replace(body, "inertial", ET.Element("inertial", pos=_vec(com), mass=f"{mass:.17g}", fullinertia=" ".join(
             f"{v:.17g}" for v in (inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]))))

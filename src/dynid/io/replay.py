@@ -1,5 +1,5 @@
-"""A URDF that ``dynid export`` writes, read back by Pinocchio and checked against dynid's own model (issue "The model
-proven where it goes", item 1).
+"""A URDF or MJCF that ``dynid export`` writes, read back by the tool it is meant for (Pinocchio, MuJoCo) and checked
+against dynid's own model (issue "The model proven where it goes", item 1).
 
 A converter or a writer that drops a value (a URDF→MJCF converter dropping off-diagonal inertia is a known case) gives
 a file whose torques are not the model's. :func:`urdf_replay` parses the written text with Pinocchio's URDF parser (the
@@ -21,10 +21,13 @@ import numpy as np
 from ..dynamics.regressor import regressor
 from ..model.robot import Robot
 
-__all__ = ["URDF_TERMS", "ReplayCheck", "urdf_replay"]
+__all__ = ["MJCF_TERMS", "URDF_TERMS", "ReplayCheck", "mjcf_replay", "urdf_replay"]
 
 URDF_TERMS = ("fc", "fv")
 """The drive terms a URDF's ``<dynamics>`` holds (``friction``, ``damping``)."""
+
+MJCF_TERMS = ("Ia", "fc", "fv")
+"""The drive terms an MJCF hinge holds (``armature``, ``frictionloss``, ``damping``)."""
 
 
 @dataclass(frozen=True)
@@ -40,12 +43,16 @@ class ReplayCheck:
     missing_share : (n_dof,) array [%]
         Each joint's RMS torque of those terms over its RMS torque, on the same states.
     n_states : int
+    frictionloss_gap : float
+        MJCF only: how far MuJoCo's ``frictionloss`` constraint force in ``mj_inverse`` is from
+        ``frictionloss·sign(q̇)`` on the same states, over the norm of the latter (0 without dry friction).
     """
 
     relative_error: float
     missing: tuple[str, ...]
     missing_share: np.ndarray
     n_states: int
+    frictionloss_gap: float = 0.0
 
 
 def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -102,16 +109,79 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         tau = pin.rnea(model, data, qk, vk, ak)
         idx = [model.joints[jid].idx_v for jid in ids]
         tau_file[k] = tau[idx] + model.damping[idx] * dq[k] + model.friction[idx] * np.sign(dq[k])
+    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS)
+
+
+def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...]) -> ReplayCheck:
+    """The file's torques against dynid's of ``phi`` restricted to the links and the drive terms ``held_terms`` a format
+    holds (Coulomb friction with ``sign(q̇)``), and each joint's share of what the format cannot hold."""
+    q, dq, ddq = states
     full = regressor(robot, q, dq, ddq) @ phi
     coupled = set(robot.transmission.coupled_parameter_names) if robot.transmission.n_coupled_params else set()
-    kept = np.array([not (n[:2] == "Ia" or n in coupled or any(n.startswith(t) for t in ("offset", "fst", "fca", "fcl", "cb")))
+    drive = set(robot.drive_terms)
+    kept = np.array([n not in coupled and (n.rstrip("0123456789") not in drive or n.rstrip("0123456789") in held_terms)
                      for n in robot.parameter_names])
     held_phi = np.where(kept, phi, 0.0)
-    plain = replace(robot, coulomb_velocity=np.zeros(robot.n_dof))  # URDF's friction is fc·sign(q̇)
+    plain = replace(robot, coulomb_velocity=np.zeros(robot.n_dof))  # the formats' friction is fc·sign(q̇)
     model_tau = regressor(plain, q, dq, ddq) @ held_phi
     missing = tuple(sorted({n.rstrip("0123456789") for n, v, k in zip(robot.parameter_names, phi, kept)
                             if not k and v != 0} | ({"smooth Coulomb"} if np.any(robot.coulomb_velocity > 0) else set())))
     rms = np.sqrt(np.mean(full**2, axis=0))
     share = 100.0 * np.sqrt(np.mean((full - model_tau) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     error = float(np.linalg.norm(tau_file - model_tau) / np.maximum(np.linalg.norm(model_tau), 1e-300))
-    return ReplayCheck(error, missing, share, n_states)
+    return ReplayCheck(error, missing, share, q.shape[0])
+
+
+def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0) -> ReplayCheck:
+    """MuJoCo's torques of a written MJCF against dynid's torques of ``phi``: the links, ``armature`` (rotor inertia),
+    ``damping`` (viscous friction) and ``frictionloss`` (Coulomb friction) (module docstring).
+
+    MuJoCo's inverse dynamics (``mj_inverse``) is evaluated with the dry-friction constraint off, and the file's
+    ``frictionloss`` added as ``frictionloss·sign(q̇)``: that checks the value the file holds. How MuJoCo's own
+    ``frictionloss`` constraint differs from ``fc·sign(q̇)`` is measured apart (:attr:`ReplayCheck.frictionloss_gap`):
+    it is a soft constraint whose force the solver finds, not a function of the velocity alone. Joints of the file
+    that are not the robot's (a gripper's, held) stay at 0. Reference: Todorov, Erez & Tassa, "MuJoCo", IROS 2012.
+
+    Parameters
+    ----------
+    text : str
+        The MJCF as written (no assets beside it: a file whose meshes are elsewhere is loaded with them by path).
+    robot : Robot
+        The model ``phi`` is of (its joints carry the MJCF's joint names).
+    phi : (n_params,) array
+        The standard parameters written.
+    n_states : int
+    rng : int or Generator
+
+    Returns
+    -------
+    ReplayCheck
+
+    Raises
+    ------
+    ValueError
+        MuJoCo cannot load the text.
+    """
+    import mujoco
+
+    rng = np.random.default_rng(rng)
+    model = mujoco.MjModel.from_xml_string(text)
+    data = mujoco.MjData(model)
+    joints = [model.joint(j.name) for j in robot.joints]
+    qadr = np.array([int(j.qposadr[0]) for j in joints])
+    vadr = np.array([int(j.dofadr[0]) for j in joints])
+    q, dq, ddq = _states(robot, n_states, rng)
+    dry = model.dof_frictionloss[vadr].copy()
+    tau_file, with_constraint = np.empty((n_states, robot.n_dof)), np.empty((n_states, robot.n_dof))
+    for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
+        model.opt.disableflags = int(flags)
+        for k in range(n_states):
+            data.qpos[:], data.qvel[:], data.qacc[:] = model.qpos0, 0.0, 0.0
+            data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
+            mujoco.mj_inverse(model, data)
+            out[k] = data.qfrc_inverse[vadr]
+    tau_file = tau_file + dry * np.sign(dq)
+    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS)
+    sliding = dry * np.sign(dq)
+    gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
+    return replace(check, frictionloss_gap=gap)
