@@ -564,6 +564,97 @@ def validate(
 
 
 @app.command()
+def payload(
+    config: Path = typer.Argument(..., help="Identification config (TOML) of the arm the results were identified with."),
+    file: Path = typer.Option(..., help="Log with the new tool on the flange (same column map as the identification data)."),
+    results: Path = typer.Option(Path("dynid-identify/results.json"), help="results.json of dynid identify: the arm without the tool."),
+    rows: str | None = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
+    out: Path = typer.Option(Path("dynid-payload"), help="Output folder for payload.json, payload.urdf and payload.xml."),
+    data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    quiet: bool = QUIET,
+) -> None:
+    """Identify a tool's payload (mass, centre of mass, inertia) from a log with it, the arm's model known."""
+    from ..identification.run import run_payload
+    from ..io.identification_config import dataset_for_file, load_identification_config
+
+    def prepare():
+        cfg = load_identification_config(config, data_root=data_root)
+        return cfg, _read_results(results, cfg.robot), dataset_for_file(cfg, file, _parse_rows(rows))
+
+    def compute(p, progress):
+        return p[0], run_payload(p[0], p[1], p[2], source=str(results))
+
+    def save(computed):
+        from ..report.identification_run import save_payload
+
+        cfg, (found, label, _) = computed
+        return save_payload(found, out, robot=cfg.robot, parent=_last_link(cfg), estimate=label)
+
+    def show(rep, computed, paths):
+        _, (found, label, ratio) = computed
+        for line in payload_lines(found, label, ratio):
+            rep.line(line)
+        rep.wrote(paths)
+
+    _Command("dynid payload", quiet, out).run(prepare, compute, save, show)
+
+
+def payload_lines(found, label: str, ratio=None) -> list[str]:
+    """What ``dynid payload`` prints: the payload in the flange's frame with σ, what the log did not determine, and
+    the log's error without and with it.
+
+    Parameters
+    ----------
+    found : dynid.identification.payload.Payload
+    label : str
+        The arm's estimate.
+    ratio : (n_dof,) array, optional
+        The identified drive gains over those the torques were read with (said where not all 1).
+
+    Returns
+    -------
+    list of str
+    """
+    import numpy as np
+
+    inertia = found.inertia
+    lines = [f"payload: {found.mass:.4g} kg (σ {found.mass_std:.2g}), centre of mass "
+             f"({', '.join(f'{1000 * c:.1f}' for c in found.com)}) mm in the flange's frame "
+             f"(σ {', '.join(f'{1000 * c:.1g}' for c in found.com_std)} mm), inertia about it: Ixx {inertia[0, 0]:.3g}, "
+             f"Iyy {inertia[1, 1]:.3g}, Izz {inertia[2, 2]:.3g}, Ixy {inertia[0, 1]:.3g}, Ixz {inertia[0, 2]:.3g}, "
+             f"Iyz {inertia[1, 2]:.3g} kg·m² (physically consistent)",
+             f"the log's torque error: {found.error_without:.3g} % with the arm's model alone ({label}), "
+             f"{found.error_with:.3g} % with the payload"]
+    if ratio is not None and not np.allclose(ratio, 1.0):
+        lines.append("with the drive gains the results identified ([drive_gains]): the torques the payload adds scaled "
+                     f"by {', '.join(f'{r:.3g}' for r in ratio)} (J1-J{len(ratio)}) from the gains the log was read with")
+    if not found.mass > 3 * found.mass_std:
+        lines.append(f"the log shows no payload: its mass is within 3σ of 0 ({found.mass:.3g} ± {found.mass_std:.2g} kg), "
+                     "so its centre of mass and inertia mean nothing")
+    if found.not_determined:
+        lines.append(f"not determined by this log (σ ≥ 100 % of the value, or no action on the joints): "
+                     f"{', '.join(found.not_determined)} (about the last link's frame): kept at a point mass's values; a "
+                     "motion that turns the tool about more axes determines them")
+    return lines
+
+
+def _last_link(cfg) -> str:
+    """The URDF link of the arm's last joint (its child) where the config has a URDF, else dynid's own name for it."""
+    import xml.etree.ElementTree as ET
+
+    last = cfg.robot.joints[-1].name
+    if cfg.urdf is not None:
+        try:
+            for joint in ET.parse(cfg.urdf).getroot().iter("joint"):
+                child = joint.find("child")
+                if joint.get("name") == last and child is not None:
+                    return child.get("link", "")
+        except (OSError, ET.ParseError):
+            pass
+    return f"link{cfg.robot.n_dof}"
+
+
+@app.command()
 def excite(
     config: Path = typer.Argument(..., help="Excitation config (TOML), e.g. configs/excite-er16.toml."),
     out: Path = typer.Option(Path("dynid-excite"), help="Output folder for excitation.json, excitation.csv and figures."),

@@ -313,7 +313,8 @@ def _compensated(sol, acc: LeastSquaresAccumulator, noise_sumsq: np.ndarray):
     return LeastSquaresSolution(params, cov, std, rel, sol.condition_number, float(np.sqrt(sigma2)), m)
 
 
-def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, rng=0) -> PayloadEstimate:
+def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, rng=0,
+                     gain_ratio=None) -> PayloadEstimate:
     """A payload's identifiable inertial parameters from a loaded run.
 
     Parameters
@@ -326,6 +327,9 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
         The loaded run, its ``tau`` in N·m.
     rng : int
         Seed of the random states that find the identifiable parameters.
+    gain_ratio : (n_dof,) array, optional
+        Each joint's torque beyond ``beta`` multiplied by it (identified drive gains over those the torques were read
+        with; default 1).
 
     Returns
     -------
@@ -340,6 +344,8 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     acc = LeastSquaresAccumulator(cols.size, robot.n_dof)
     for _, y, tau, keep in base_chunks(robot, base, loaded, standard=True):
         extra = tau - base.base_observation(y) @ beta
+        if gain_ratio is not None:
+            extra = extra * np.asarray(gain_ratio, dtype=float)
         acc.add(y[:, :, cols].reshape(-1, cols.size), extra.reshape(-1), keep.reshape(-1))
     sol = acc.solve()
     names = tuple(INERTIAL_TERMS[i - _last_link_columns(robot)[0]] for i in cols)

@@ -334,16 +334,7 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     ConfigError
         No log to validate on.
     """
-    from ..dynamics.base_parameters import base_parameters
-    from ..io.results import stored_estimates
-    from ..model.friction_model import robot_from_settings
-
-    try:
-        config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
-    except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
-        raise DataError(f"{source}: settings: {exc}") from None
-    base = base_parameters(config.robot, rng=0)
-    estimates = stored_estimates(identified, base.names, source, config.robot.name)
+    config, base, estimates = _identified_model(config, identified, source)
     refs = _references(config, base)
     sets = {**estimates, **{r.name: r.beta for r in refs}}
     datasets = config.validation if datasets is None else datasets
@@ -358,6 +349,96 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     comparisons, warnings = validate_sets(config, base, sets, datasets, progress, stored_preprocessing(identified), noise,
                                           yardstick=reference)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
+
+
+def _identified_model(config: IdentificationConfig, identified: dict, source: str):
+    """``(config, base, estimates)``: the config with its robot as the results identified it (their friction model),
+    the base-parameter map, and every estimate of results.json (label -> base parameters)."""
+    from ..dynamics.base_parameters import base_parameters
+    from ..io.results import stored_estimates
+    from ..model.friction_model import robot_from_settings
+
+    try:
+        config = replace(config, robot=robot_from_settings(config.robot, identified.get("settings", {})))
+    except (TypeError, ValueError, KeyError, AttributeError, ConfigError) as exc:
+        raise DataError(f"{source}: settings: {exc}") from None
+    base = base_parameters(config.robot, rng=0)
+    return config, base, stored_estimates(identified, base.names, source, config.robot.name)
+
+
+@with_single_blas_thread
+@keyword_only_after_data
+def run_payload(config: IdentificationConfig, identified: dict, dataset: DatasetSpec, *, source: str = "results"):
+    """A tool's payload from a log with it, the arm's model taken from an identification's results (issue "The model
+    proven where it goes", item 4; :func:`dynid.identification.payload.payload_from_log`).
+
+    The log is prepared as the validation logs are (the identification's settings carried over); its torques less
+    the main estimate's are the payload's.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    identified : dict
+        The results.json of ``dynid identify``: its main estimate is the arm without the payload (the description's
+        nominal model where that is the main one).
+    dataset : DatasetSpec
+        The log with the payload (:func:`dynid.io.identification_config.dataset_for_file`).
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    (Payload, str, ndarray or None)
+        The payload, the label of the estimate taken for the arm, and the identified drive gains' ratio to those the
+        torques were read with, where the results identified them (:func:`identified_gain_ratio`), which the
+        payload's torques are scaled by.
+
+    Raises
+    ------
+    DataError
+        Results of another robot, or a log that cannot be read.
+    IdentifiabilityError
+        A log whose motion determines none of the payload's parameters.
+    """
+    from ..preprocessing.pipeline import prepare
+    from .payload import payload_from_log
+
+    config, base, estimates = _identified_model(config, identified, source)
+    label = identified.get("main_estimate")
+    if label not in estimates:  # older results, or the description's values: the first estimate
+        label = next(iter(estimates))
+    recording = load_recording(dataset, config.robot)
+    data = prepare(recording, carried_over(stored_preprocessing(identified), config.preprocessing), strict=False)
+    ratio = identified_gain_ratio(identified, config.robot.n_dof)
+    found = payload_from_log(config.robot, base, estimates[label], data, rng=config.seed, gain_ratio=ratio)
+    return found, label, ratio
+
+
+def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
+    """Each joint's drive gain identified by the results' ``[drive_gains]`` run over the gain its torques were read
+    with (1 where a gain was not determined); None without identified gains.
+
+    Parameters
+    ----------
+    identified : dict
+        results.json.
+    n_dof : int
+
+    Returns
+    -------
+    (n_dof,) ndarray or None
+    """
+    found = identified.get("drive_gains")
+    if not isinstance(found, dict):
+        return None
+    try:
+        gains = np.array([np.nan if g is None else float(g) for g in found.get("gains", [])], dtype=float)
+        read = np.asarray(found.get("description_gains", []), dtype=float)
+    except (TypeError, ValueError):
+        return None
+    if gains.shape != (n_dof,) or read.shape != (n_dof,):
+        return None
+    return np.where(np.isfinite(gains) & (read > 0), gains / np.where(read > 0, read, 1.0), 1.0)
 
 
 @with_single_blas_thread

@@ -527,3 +527,52 @@ def _replace(parent, tag: str, new) -> None:
     else:
         new.tail = parent.text if parent.text and not parent.text.strip() else "\n    "
         parent.insert(0, new)
+
+
+def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
+    """A payload (:class:`dynid.identification.payload.Payload`) as a URDF link on a fixed joint and as an MJCF body,
+    each to paste into the arm's file: the body sits at the flange (the robot's tool frame in its last link), its
+    inertial in the flange's frame.
+
+    Parameters
+    ----------
+    payload : Payload
+    robot : Robot
+        Its tool frame is the flange.
+    parent : str
+        The URDF link the payload is fixed to (the arm's last link).
+
+    Returns
+    -------
+    (str, str)
+        The URDF snippet and the MJCF snippet.
+    """
+    import pinocchio as pin
+
+    inertia = mujoco_inertia(np.asarray(payload.inertia, dtype=float))
+    rotation = np.asarray(robot.tool_rotation, dtype=float)
+    q = pin.Quaternion(rotation)
+    head = (f"identified by dynid payload: {payload.mass:.6g} kg (σ {payload.mass_std:.2g}); "
+            f"not determined by the log, kept at a point mass's values: {', '.join(payload.not_determined) or 'none'}")
+    urdf = "\n".join([
+        f"<!-- {head} -->",
+        '<joint name="payload_joint" type="fixed">',
+        f"  <parent link={quoteattr(parent)}/>",
+        '  <child link="payload"/>',
+        f'  <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(rotation))}"/>',
+        "</joint>",
+        '<link name="payload">',
+        "  <inertial>",
+        f'    <origin xyz="{_vec(payload.com)}" rpy="0 0 0"/>',
+        f'    <mass value="{payload.mass:.17g}"/>',
+        f'    <inertia ixx="{inertia[0, 0]:.17g}" ixy="{inertia[0, 1]:.17g}" ixz="{inertia[0, 2]:.17g}" '
+        f'iyy="{inertia[1, 1]:.17g}" iyz="{inertia[1, 2]:.17g}" izz="{inertia[2, 2]:.17g}"/>',
+        "  </inertial>",
+        "</link>", ""])
+    mjcf = "\n".join([
+        f"<!-- {head}; put this body inside the arm's last body -->",
+        f'<body name="payload" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
+        f'  <inertial pos="{_vec(payload.com)}" mass="{payload.mass:.17g}" fullinertia="{inertia[0, 0]:.17g} '
+        f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>',
+        "</body>", ""])
+    return urdf, mjcf

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
-from ..io.export import consistent_estimate, mjcf_from_robot, urdf_from_robot
+from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot
 from ..io.mjcf_write_back import mjcf_written_back
 from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
@@ -169,3 +169,29 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
     write_html_report(out / "report.html", data, "validate", paths, "dynid validate")
     paths.insert(0, out / "report.html")
     return [json_path] + paths
+
+
+@staged
+def save_payload(payload, out: str | Path, robot=None, parent: str = "", estimate: str = "") -> list[Path]:
+    """Write ``payload.json``, ``payload.urdf`` (a link on a fixed joint to paste into the arm's URDF) and
+    ``payload.xml`` (an MJCF body to put inside the arm's last body) (:func:`dynid.io.export.payload_files`).
+
+    Parameters
+    ----------
+    payload : Payload
+    out : str or Path
+        Output folder.
+    robot : Robot
+        The arm (its tool frame is the flange).
+    parent : str
+        The URDF link the payload is fixed to.
+    estimate : str
+        The arm's estimate the payload was taken beyond, stored in the file.
+    """
+    out = Path(out)  # staged passes its staging folder
+    urdf, mjcf = payload_files(payload, robot, parent)
+    write_results(out / "payload.json", {"payload": payload.to_dict(), "arm_estimate": estimate, "urdf_parent": parent},
+                  "payload")
+    atomic_write_text(out / "payload.urdf", urdf)
+    atomic_write_text(out / "payload.xml", mjcf)
+    return [out / "payload.json", out / "payload.urdf", out / "payload.xml"]

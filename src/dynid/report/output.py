@@ -383,7 +383,7 @@ def write_results(path: Path, data: dict, kind: str) -> None:
     data : dict
         JSON-ready results.
     kind : str
-        run, identify, validate, excite or montecarlo; stored with ``schema_version`` and ``dynid_version``.
+        run, identify, validate, excite, montecarlo or payload; stored with ``schema_version`` and ``dynid_version``.
     """
     write_json(path, {"schema_version": SCHEMA_VERSION, "dynid_version": __version__, "kind": kind, **data})
 

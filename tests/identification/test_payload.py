@@ -1,0 +1,91 @@
+"""dynid payload: a tool's mass, centre of mass and inertia from a log with it, the arm's model known (issue "The model
+proven where it goes", item 4), against a payload simulated with Pinocchio's RNEA (not dynid's regressor)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+MASS, COM = 2.0, np.array([0.02, -0.04, 0.09])  # kg; m, in the flange's frame
+INERTIA = np.diag([0.012, 0.018, 0.009])  # kg·m² about the centre of mass
+
+
+def _loaded_log(folder, truth, rng_seed: int = 5):
+    """A 20 s Fourier log of the truth with the payload on the flange, as simulated_case writes its logs."""
+    from dynid.model.spatial import inertial_from_physical, transform_inertial
+    from tests.simulated_logs import fourier_motion, write_log
+
+    rng = np.random.default_rng(rng_seed)
+    flange = inertial_from_physical(MASS, COM, INERTIA)
+    in_link = transform_inertial(flange, np.asarray(truth.tool_rotation), np.asarray(truth.tool_translation))
+    inertial = truth.inertial.copy()
+    inertial[-1] += in_link
+    loaded = replace(truth, inertial=inertial)
+    t = np.arange(int(20.0 * 100.0)) / 100.0
+    q, dq, ddq = fourier_motion(loaded, t, rng)
+    friction = (truth.drive[:, 1] + truth.drive[:, 3], truth.drive[:, 1] - truth.drive[:, 3], truth.drive[:, 2],
+                truth.drive[:, 0])  # (f+, f-, fv, Ia) of the truth's drive terms
+    write_log(folder / "loaded.csv", loaded, t, q, dq, ddq, friction, rng)
+    return folder / "loaded.csv"
+
+
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory):
+    import json
+
+    from tests.cli.refusals import dynid
+    from tests.simulated_logs import simulated_case
+
+    folder = tmp_path_factory.mktemp("payload")
+    cfg, truth = simulated_case(folder, "ur10e", 100.0, "fourier", duration=20.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
+    p = dynid("identify", cfg, "--out", folder / "out", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    return cfg, truth, folder, json.loads((folder / "out" / "results.json").read_text())
+
+
+def test_the_payload_is_found_in_the_flanges_frame(identified):
+    from dynid.identification.run import run_payload
+    from dynid.io.identification_config import dataset_for_file, load_identification_config
+
+    cfg, truth, folder, results = identified
+    config = load_identification_config(cfg)
+    found, label, ratio = run_payload(config, results, dataset_for_file(config, _loaded_log(folder, truth)))
+    assert label == results["main_estimate"] and ratio is None
+    assert abs(found.mass - MASS) < 0.02 * MASS and found.mass_std < 0.01 * MASS
+    np.testing.assert_allclose(found.com, COM, atol=0.005)
+    assert np.all(np.linalg.eigvalsh(found.inertia) >= -1e-9)  # physically consistent
+    assert found.error_with < 0.5 * found.error_without
+    # the unloaded identification log itself shows no payload: its mass within 3σ of 0, or tiny
+    empty, _, _ = run_payload(config, results, config.identification)
+    assert abs(empty.mass) < max(3 * empty.mass_std, 0.01 * MASS)
+
+
+def test_dynid_payload_writes_a_link_and_a_body_that_load(identified, tmp_path):
+    """The command prints the payload, and its URDF snippet read into the arm's URDF by Pinocchio and its MJCF body
+    by MuJoCo carry the mass found."""
+    import json
+
+    import mujoco
+    import pinocchio as pin
+
+    from tests.cli.refusals import dynid
+
+    cfg, truth, folder, _ = identified
+    p = dynid("payload", cfg, "--results", folder / "out" / "results.json", "--file", _loaded_log(folder, truth),
+              "--out", tmp_path / "pay")
+    assert p.returncode == 0, p.stderr
+    said = " ".join(p.stdout.split())
+    mass = float(json.loads((tmp_path / "pay" / "payload.json").read_text())["payload"]["mass"])
+    assert f"payload: {mass:.4g} kg" in said and abs(mass - MASS) < 0.02 * MASS
+    parent = json.loads((tmp_path / "pay" / "payload.json").read_text())["urdf_parent"]
+    urdf = (tmp_path / "pay" / "payload.urdf").read_text()
+    body = (tmp_path / "pay" / "payload.xml").read_text()
+    model = mujoco.MjModel.from_xml_string(f"<mujoco><worldbody><body name='arm'>{body}</body></worldbody></mujoco>")
+    assert abs(model.body("payload").mass[0] - mass) < 1e-9
+    arm = (f'<robot name="arm"><link name="base"/><joint name="j" type="revolute"><parent link="base"/>'
+           f'<child link="{parent}"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+           f'<link name="{parent}"/>{urdf}</robot>')
+    assert parent and abs(pin.buildModelFromXML(arm).inertias[1].mass - mass) < 1e-9  # the fixed link merged in
