@@ -21,7 +21,9 @@ from ..dynamics.kinematics import forward_kinematics
 from ..exceptions import ConfigError
 from ..extras import require
 from ..model.robot import Robot
-from ..model.spatial import physical_from_inertial, transform_inertial
+from ..model.mjcf import held_inertials
+from ..model.spatial import (is_physically_consistent, nearest_consistent, physical_from_inertial,
+                              transform_inertial)
 from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia
 
 AXIS_TOLERANCE = 1e-4
@@ -69,7 +71,9 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     Each joint of ``robot`` is found by name among the MJCF's hinges. The link identified in the robot's joint frame
     is expressed in the MJCF body that carries the joint (``transform_inertial``); bodies welded to it (no joint of
     their own, e.g. a flange or a tool) are identified with it, so their inertials become massless (a comment says
-    so). A compiler told to take inertias from geoms (``inertiafromgeom="true"``) would ignore the written values: it
+    so). Bodies the robot holds fixed (:attr:`Robot.held`: a gripper's fingers, and what rides on them) keep their
+    own inertials, and the link they hang on gets the identified values less theirs
+    (:func:`dynid.model.mjcf.held_inertials`), so that the full model's mass matrix stays positive definite. A compiler told to take inertias from geoms (``inertiafromgeom="true"``) would ignore the written values: it
     is set to ``"auto"``. Relative file paths (``meshdir``, ``texturedir``, ``assetdir``, ``<include file>``) are
     rewritten for the folder the result is written to. The header comment says what was identified, as in
     :func:`dynid.io.urdf_write_back.urdf_written_back`.
@@ -125,6 +129,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
                           "another robot, another zero position or joints turning the other way")
     moving = set(model.jnt_bodyid[ids])
     moved: list[str] = []
+    own = held_inertials(path, dict.fromkeys(robot.held, 0.0)) if robot.held else np.zeros((robot.n_dof, 10))
     for k, (joint, jid) in enumerate(zip(robot.joints, ids)):
         body_id = int(model.jnt_bodyid[jid])
         name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body_id)
@@ -133,7 +138,12 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
             raise ConfigError(f"{path}: the body of joint {joint.name!r} has no name: name it to write into it")
         body_r = data.xmat[body_id].reshape(3, 3)
         frame_r, frame_p = r @ rotations[k], r @ origins[k] + t  # the robot's joint frame in MuJoCo's world
-        in_body = transform_inertial(fitted.inertial[k], body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
+        alone = fitted.inertial[k] - own[k]  # the held bodies keep their own inertials (a gripper's fingers)
+        if np.any(own[k] != 0) and not is_physically_consistent(alone):
+            alone = nearest_consistent(alone)
+            moved.append(f"{name}: its identified values less the held bodies' own are not physically consistent; the "
+                         "nearest consistent ones are written (the held bodies keep the file's)")
+        in_body = transform_inertial(alone, body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
         mass, com, inertia = physical_from_inertial(in_body)
         inertia = mujoco_inertia(inertia)
         nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
@@ -192,12 +202,8 @@ def read_users_mjcf(path: Path, robot: Robot):
     ------
     ConfigError
         MuJoCo is not installed (names the extra), the file cannot be read or compiled, a joint of the robot is
-        missing, is not a hinge, or is in an included file; the robot holds joints fixed (:attr:`Robot.held`).
+        missing, is not a hinge, or is in an included file.
     """
-    if robot.held:
-        raise ConfigError(f"{path}: the robot holds {', '.join(robot.held)} fixed (held), whose bodies this MJCF "
-                          "moves: writing into it would count them twice; export dynid's own MJCF (dynid export "
-                          "--mjcf FILE without --mjcf-model and no mjcf_model in the config)")
     mujoco = require("mujoco", "mujoco", "writing into an MJCF")
     try:
         model = mujoco.MjModel.from_xml_path(str(path))

@@ -165,6 +165,41 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
             tuple(model.body(_body(model, k)).name for k in moving))
 
 
+def held_inertials(path: str | Path, held=None) -> np.ndarray:
+    """Each link's share of the bodies its held joints carry (a gripper's fingers and what rides on them), as
+    :func:`joints_from_mjcf` lumps them into the link: their own inertials in the link's joint frame, at the held
+    positions. The link alone is :func:`joints_from_mjcf`'s less this.
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joint name -> position [rad or m] at which it is held fixed.
+
+    Returns
+    -------
+    (n_dof, 10) ndarray
+        Eq. 5 order; zero rows for links that carry no held joint.
+    """
+    path, held = Path(path), dict(held or {})
+    mujoco, model, moving, owner, names = _chain(path, held)
+    rotations, translations = _frames(mujoco, model, moving, held, names)
+    link_of = {k: i for i, k in enumerate(moving)}
+    bodies = {_body(model, k) for k in moving}
+    carried = np.zeros(model.nbody, dtype=bool)  # rides on a held joint below its link's body
+    out = np.zeros((len(moving), 10))
+    for b in range(1, model.nbody):
+        own = any(names[k] in held for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]))
+        carried[b] = b not in bodies and (own or carried[model.body_parentid[b]])
+        if not carried[b] or owner[b] < 0 or model.body_mass[b] == 0:
+            continue
+        principal = _quat_matrix(mujoco, model.body_iquat[b])
+        phi = inertial_from_physical(float(model.body_mass[b]), np.array(model.body_ipos[b]),
+                                     principal @ np.diag(model.body_inertia[b]) @ principal.T)
+        out[link_of[owner[b]]] += transform_inertial(phi, rotations[b], translations[b])
+    return out
+
+
 def mjcf_joint_values(path: str | Path, held=None) -> dict:
     """What an MJCF states of each moving hinge beside the chain: its range and its drive (as MuJoCo compiles them).
 
