@@ -22,11 +22,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 def main() -> int:
     import mujoco
     import pinocchio as pin
+    from tests.mujoco_logs import stripped_urdf
     from zoo import robots_folder
 
     from dynid.io.mjcf_write_back import mjcf_written_back
     from dynid.model.description import load_robot
-    from tests.mujoco_logs import stripped_urdf
 
     text = stripped_urdf((robots_folder() / "panda_description/urdf/panda.urdf").read_text(encoding="utf-8"))
     xml = re.sub(r"(<robot\b[^>]*>)", r'\1<mujoco><compiler discardvisual="true" fusestatic="false" '
