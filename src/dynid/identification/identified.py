@@ -337,10 +337,15 @@ class IdentifiedModel:
         return y @ self.params(estimate)
 
     def _settings(self):
-        """The preprocessing a log other than the identification one gets (:meth:`validate`)."""
-        # the resolved settings stand for the config's here: the decimation (derived, not known to be given) follows
-        # this log's own band
-        return carried_over(self.preprocessing, replace(self.preprocessing or Preprocessing(), decimation=None))
+        """The preprocessing a log other than the identification one gets (:meth:`validate`): the settings as given,
+        carried over as ``dynid validate`` does, so that the API and the CLI keep the same samples of a log."""
+        from ..io.identification_config import stored_preprocessing
+
+        given = stored_preprocessing(self.results, "given_preprocessing") if self.results else None
+        if given is None:  # results written before they held it: the resolved settings stand for the config's, the
+            # decimation (derived, not known to be given) following this log's own band
+            given = replace(self.preprocessing or Preprocessing(), decimation=None)
+        return carried_over(self.preprocessing, given)
 
     @keyword_only_after_data
     def predict_log(self, recording, *, estimate: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -413,6 +418,38 @@ class IdentifiedModel:
         _, pred, meas = self.predict_log(recording, estimate=estimate)
         res = meas - pred
         return 1.0 - float(np.sum(res**2)) / float(np.sum((meas - meas.mean(axis=0)) ** 2))
+
+    @keyword_only_after_data
+    def relative_error(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:
+        """The global relative torque error [%] ``dynid validate`` prints for a log, on the same samples (the log
+        prepared as the identification's settings carry over to it): ``100·||τ - τ̂|| / ||τ||`` over its joints.
+
+        Parameters
+        ----------
+        t : (N,) array [s], or a recording
+            A raw log's time stamps, or a log read with :func:`dynid.load_recording`.
+        q, tau : (N, n_dof) arrays [rad, N·m]
+            Its positions and measured torques (with time stamps).
+        estimate : str, optional
+
+        Returns
+        -------
+        float [%]
+
+        Raises
+        ------
+        ValueError
+            Time stamps without positions and torques.
+        """
+        recording = t
+        if not (hasattr(t, "tau") and hasattr(t, "rate")):
+            if q is None or tau is None:
+                raise ValueError("relative_error(t, q, tau): positions and measured torques are needed with the time stamps")
+            from .run import recording_from_arrays
+
+            recording = recording_from_arrays(self.robot, t, q, tau, name="relative_error")
+        label = self.label(estimate)
+        return float(self.validate(recording, estimate=estimate).metrics()[label]["global_relative_error"])
 
     def urdf(self) -> str:
         """The physically consistent estimate as URDF text (:func:`dynid.io.export.urdf_from_results`).

@@ -351,6 +351,25 @@ class Identifier(HyperParameters):
             return 1.0 - float(np.sum((measured - pred) ** 2)) / float(np.sum((measured - measured.mean(axis=0)) ** 2))
         return self._model().score(t, q, tau, estimate=estimate)
 
+    def relative_error(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:
+        """The global relative torque error [%] ``dynid validate`` prints for a raw log (``relative_error(t, q, tau)``)
+        or a recording, on the same samples
+        (:meth:`dynid.identification.identified.IdentifiedModel.relative_error`).
+
+        Parameters
+        ----------
+        t : (N,) array [s], or a recording
+        q : (N, n_dof) array [rad]
+        tau : (N, n_dof) array [N·m]
+        estimate : str, optional
+            Label or key (default the main estimate).
+
+        Returns
+        -------
+        float [%]
+        """
+        return self._model().relative_error(t, q, tau, estimate=estimate)
+
     def save(self, path: str | Path) -> Path:
         """Write the identification's results.json (read back by :func:`dynid.load_results`).
 

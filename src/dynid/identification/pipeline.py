@@ -229,7 +229,9 @@ class IdentificationPipeline:
         Returns
         -------
         dynid.identification.identify.IdentificationResult
-            Its ``settings`` hold the resolved preprocessing, :attr:`PreparedIdentification.choices`,
+            Its ``settings`` hold the resolved preprocessing, the preprocessing as given (``given_preprocessing``: what
+            another log's preparation starts from, :func:`dynid.preprocessing.strategies.carried_over`),
+            :attr:`PreparedIdentification.choices`,
             ``robot_source`` and ``robot_fingerprint`` (:meth:`dynid.model.robot.Robot.kinematic_fingerprint`).
 
         Raises
@@ -249,7 +251,8 @@ class IdentificationPipeline:
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
-        result = replace(result, settings={**result.settings, "robot_source": self.source,
+        result = replace(result, settings={**result.settings, "given_preprocessing": self.preprocessing.to_dict(),
+                                           "robot_source": self.source,
                                            "robot_fingerprint": prepared.robot.kinematic_fingerprint(),
                                            **prepared.choices.to_dict()},
                          findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay},

@@ -524,20 +524,23 @@ def _drive_gains(table, root: Path, where: str, n: int):
     return float(table["payload_mass"]), specs[0], specs[1]
 
 
-def stored_preprocessing(identified: dict) -> Preprocessing | None:
+def stored_preprocessing(identified: dict, key: str = "preprocessing") -> Preprocessing | None:
     """The identification's resolved preprocessing as results.json stores it.
 
     Parameters
     ----------
     identified : dict
         The results' ``identification`` section.
+    key : str
+        ``"preprocessing"`` (the resolved settings) or ``"given_preprocessing"`` (the settings as the config or the
+        call gave them, before anything was derived from the log).
 
     Returns
     -------
     Preprocessing or None
         None if absent.
     """
-    stored = identified.get("settings", {}).get("preprocessing") if isinstance(identified.get("settings"), dict) else None
+    stored = identified.get("settings", {}).get(key) if isinstance(identified.get("settings"), dict) else None
     if not isinstance(stored, dict):
         return None
     known = {f.name for f in fields(Preprocessing)}
