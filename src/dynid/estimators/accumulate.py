@@ -233,7 +233,8 @@ class LeastSquaresAccumulator:
                                        "a richer excitation, or a longer log, is needed")
         return _full_rank(r, rhs, rho, m, sv)
 
-    def solve_affine(self, basis, offset, joint_weights=None, prior=None, pairs=()) -> tuple[np.ndarray, np.ndarray, LeastSquaresSolution]:
+    def solve_affine(self, basis, offset, joint_weights=None, prior=None, pairs=(),
+                     gaussian=None) -> tuple[np.ndarray, np.ndarray, LeastSquaresSolution]:
         """Least squares over an affine subset of the parameters, ``params = offset + basis @ x``.
 
         The parameters of a model whose other terms are fixed (e.g. the description's rigid body with only the drive
@@ -250,6 +251,10 @@ class LeastSquaresAccumulator:
             Values of ``x`` kept where the rows say nothing (zeros by default).
         pairs : sequence of (int, int)
             ``(free, anchored)`` indices of ``x``, as :meth:`solve`.
+        gaussian : ((d,) array, (d,) array), optional
+            ``(values, sigmas)``: a Gaussian prior on the entries of ``x`` whose σ is finite (a drive's data sheet), as
+            rows ``(s/σ_i)·(x_i - value_i)`` beside the data's, ``s`` the residual σ of the fit without them (so the
+            rows weigh as ``1/σ_i²`` against the data's ``1/s²``: the maximum a posteriori estimate).
 
         Returns
         -------
@@ -273,7 +278,15 @@ class LeastSquaresAccumulator:
         r_all = self.reduced(joint_weights)
         r, z, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
         prior = np.zeros(d) if prior is None else np.asarray(prior, dtype=float)
-        sol = _about_prior(r @ basis, z - r @ offset, rho, m, prior, pairs)
+        a, b = r @ basis, z - r @ offset
+        sol = _about_prior(a, b, rho, m, prior, pairs)
+        if gaussian is not None and np.any(np.isfinite(gaussian[1])):
+            values, sigmas = (np.asarray(g, dtype=float) for g in gaussian)
+            held = np.flatnonzero(np.isfinite(sigmas))
+            rows = np.zeros((held.size, d))
+            rows[np.arange(held.size), held] = sol.residual_std / sigmas[held]
+            sol = _about_prior(np.vstack([a, rows]), np.concatenate([b, rows[np.arange(held.size), held] * values[held]]),
+                               rho, m, prior, pairs)
         return offset + basis @ sol.params, basis @ sol.covariance @ basis.T, sol
 
 

@@ -59,6 +59,11 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         ``J₀`` is positive definite, the log-det divergence ``tr(J₀⁻¹ J) - log det J`` (up to constants; Lee, Wensing
         & Park, "Geometric robot dynamic identification", IEEE T-RO 2020), which keeps the unidentifiable directions
         at a plausible mass distribution (no vanishing principal inertia); the drive terms keep the squared distance.
+    prior_std : (p,) array, optional
+        Each parameter's prior standard deviation, NaN where none (a drive's data sheet: :meth:`Robot.prior_sigmas`):
+        such a parameter is pulled toward ``prior`` as a Gaussian prior, ``(s/σ_i)²·(φ_i - prior_i)²`` beside the
+        data's squared residuals, ``s`` the unconstrained least squares' residual σ (the maximum a posteriori
+        estimate under the constraints).
 
     Attributes
     ----------
@@ -78,7 +83,8 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """
 
     def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
-                 n_dof: int | None = None, joint_weights=None, prior_kind: str = PRIOR_KIND):
+                 n_dof: int | None = None, joint_weights=None, prior_kind: str = PRIOR_KIND, prior_std=None):
+        self.prior_std = prior_std
         self.prior_kind = prior_kind
         self.links = links
         self.nonnegative = nonnegative
@@ -113,9 +119,9 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         """The SDP on the accumulated triangular factor ``[R | z]`` of the (joint-weighted) rows."""
         p = acc.n_params
         reduced = acc.reduced(self.joint_weights)
-        self._fit_rows(reduced[:, :p], reduced[:, p])
+        self._fit_rows(reduced[:, :p], reduced[:, p], int(acc.rows.sum()))
 
-    def _fit_rows(self, w, tau) -> None:
+    def _fit_rows(self, w, tau, n_rows: int | None = None) -> None:
         import cvxpy as cp
 
         w, tau = check_observations(w, tau)
@@ -139,6 +145,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
                 cost = cost + weight * cp.sum_squares(phi - prior)
             else:
                 raise ShapeError(f"prior_kind: expected one of {', '.join(PRIOR_KINDS)}, got {self.prior_kind!r}")
+            cost = cost + _gaussian_prior(cp, phi, prior, self.prior_std, r, z, tau / scale, n_rows or m)
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
@@ -146,6 +153,22 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         self.params_ = np.asarray(phi.value, dtype=float)
         self.status_ = problem.status
         self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])
+
+
+def _gaussian_prior(cp, phi, prior: np.ndarray, prior_std, r: np.ndarray, z: np.ndarray, tau: np.ndarray, n_rows: int):
+    """The cost of the parameters with a prior σ (:class:`PhysicallyConsistentLeastSquares`'s ``prior_std``) in the
+    scaled problem ``||rφ - z||²`` of ``(w, τ)`` divided by ``√m``: ``Σ (s²/m)/σ_i² (φ_i - prior_i)²`` with ``s²`` the
+    unconstrained least squares' residual variance on the ``n_rows`` rows the problem stands for."""
+    sigma = None if prior_std is None else np.asarray(prior_std, dtype=float)
+    if sigma is None or not np.any(np.isfinite(sigma)):
+        return 0
+    if sigma.shape != prior.shape:
+        raise ShapeError(f"expected a prior_std of shape {prior.shape}, got {sigma.shape}")
+    fitted, _, rank, _ = np.linalg.lstsq(r, z, rcond=None)
+    rss = max(float(tau @ tau - z @ z + np.sum((r @ fitted - z) ** 2)), 0.0)  # the rows' part beyond R's range too
+    held = np.flatnonzero(np.isfinite(sigma))
+    weight = rss / max(n_rows - int(rank), 1) / sigma[held] ** 2
+    return cp.sum(cp.multiply(weight, cp.square(phi[held] - prior[held])))
 
 
 def _reduced_least_squares(w: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

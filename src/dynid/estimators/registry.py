@@ -98,6 +98,9 @@ class FitData:
         How ``sdp`` pulls towards the prior (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
     base_prior : (n_base,) array, optional
         Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
+    prior_std : (p,) array, optional
+        Standard deviation of ``prior``'s values where the description states one (NaN elsewhere): ``sdp`` pulls
+        those as a Gaussian prior (:meth:`dynid.model.robot.Robot.prior_sigmas`).
     """
 
     w_base: Any
@@ -112,6 +115,7 @@ class FitData:
     joint_weights: Any = None
     prior_kind: str = "euclidean"
     base_prior: Any = None
+    prior_std: Any = None
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -223,7 +227,8 @@ def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> Estimator:
         raise ConfigError("estimator sdp needs the parameter layout of the robot (links and non-negative columns)")
     links, nonneg = data.layout
     return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior, n_dof=data.n_dof,
-                                            joint_weights=data.joint_weights, prior_kind=data.prior_kind)
+                                            joint_weights=data.joint_weights, prior_kind=data.prior_kind,
+                                            prior_std=data.prior_std)
 
 
 _ESTIMATORS = Registry("estimator", builder=lambda entry: entry.build)

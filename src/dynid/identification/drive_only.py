@@ -139,7 +139,9 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     joint's unstable Coulomb friction or offset holds the offset at the description's value, so that their sum stays
     Coulomb friction; any other keeps the log's value and is said (:attr:`DriveOnly.undetermined`): a description
     without the term (a URDF has no rotor inertia) is no knowledge of it, and holding such terms at 0 made the zoo's
-    short logs better in 14 cells and worse in 9 (benchmarks/README.md).
+    short logs better in 14 cells and worse in 9 (benchmarks/README.md). A term the description states with a σ
+    (``Ia = { value = 0.3, sigma = 0.05 }``, :attr:`Robot.prior_sigma`) is pulled toward its value with that Gaussian
+    prior (:meth:`LeastSquaresAccumulator.solve_affine`'s ``gaussian``).
 
     Parameters
     ----------
@@ -172,7 +174,8 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     drive = np.setdiff1d(np.arange(len(names)), links.ravel())
     if drive.size == 0:
         return None
-    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base, joint_weights)
+    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base, joint_weights,
+                            robot.prior_sigmas()[drive])
     x, params, cov = problem.fit(accumulator)
     moved_one_way = set(one_way)
     judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in moved_one_way]
@@ -218,8 +221,9 @@ class _DriveProblem:
     description's values."""
 
     def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, base: BaseParameters,
-                 joint_weights) -> None:
+                 joint_weights, sigmas: np.ndarray | None = None) -> None:
         self.names, self.drive, self.lower, self.phi0, self.joint_weights = names, drive, lower, phi0, joint_weights
+        self.sigmas = np.full(drive.size, np.nan) if sigmas is None else np.asarray(sigmas, dtype=float)
         rigid = phi0.copy()
         rigid[drive] = 0.0
         self.basis, self.offset = base.regrouping[:, drive], base.regrouping @ rigid
@@ -238,7 +242,8 @@ class _DriveProblem:
             free = np.flatnonzero(~active & ~pinned)
             pairs = coulomb_offset_pairs([self.names[i] for i in drive[free]])
             params, cov, sol = accumulator.solve_affine(self.basis[:, free], offset, self.joint_weights,
-                                                        prior=phi0[drive[free]], pairs=pairs)
+                                                        prior=phi0[drive[free]], pairs=pairs,
+                                                        gaussian=(phi0[drive[free]], self.sigmas[free]))
             x = np.where(pinned, phi0[drive], 0.0)
             x[free] = sol.params
             below = ~active & ~pinned & (x < self.lower)

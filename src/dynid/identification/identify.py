@@ -364,7 +364,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
                       prior=prior, prior_kind=sdp_prior,
-                      base_prior=base.base_from_standard(robot.standard_parameters()))
+                      base_prior=base.base_from_standard(robot.standard_parameters()),
+                      prior_std=robot.prior_sigmas() if robot.prior_sigma else None)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)

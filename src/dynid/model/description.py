@@ -343,8 +343,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
-        held=tuple(held), nominal_notes=stated,
-    )
+        prior_sigma=_prior_sigma(rows, terms), held=tuple(held), nominal_notes=stated)
 
 
 def _nominal_problems(inertial: np.ndarray, link_names, source: str) -> tuple[str, ...]:
@@ -420,8 +419,19 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
                 raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, "
                                   f"got {r.drive_terms!r}")
             mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
-    drive = np.array([[float(_or(getattr(r, t), 0.0)) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
+    drive = np.array([[float(_value(getattr(r, t))) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
     return terms, mask, drive
+
+
+def _value(given) -> float:
+    """A drive term's nominal value as a ``[[joints]]`` table gives it: a number, ``{ value, sigma }``, or nothing (0)."""
+    return 0.0 if given is None else float(getattr(given, "value", given))
+
+
+def _prior_sigma(rows, terms: tuple) -> tuple[tuple[str, float], ...]:
+    """``(parameter name, σ)`` of every drive term a ``[[joints]]`` table gives as ``{ value, sigma }``."""
+    return tuple((f"{t}{j + 1}", float(getattr(r, t).sigma)) for j, r in enumerate(rows) for t in terms
+                 if hasattr(getattr(r, t, None), "sigma"))
 
 
 def _vector(v) -> str:

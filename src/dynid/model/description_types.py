@@ -78,9 +78,19 @@ _JOINT_FIELDS = [
     ("stribeck_velocity", Union[Annotated[Positive, Meta(description="rad/s")], None], None),
 ]
 
+class DriveValue(Table, kw_only=True):
+    """A drive term's nominal value with its uncertainty: ``Ia = { value = 0.3, sigma = 0.05 }`` (a drive's data sheet):
+    the estimates that use the description's values are pulled toward ``value`` with a Gaussian prior of standard
+    deviation ``sigma`` (:mod:`dynid.identification.drive_only`, the physically consistent SDP)."""
+
+    value: Annotated[float, Meta(description="the nominal value, in the term's unit")]
+    sigma: Annotated[Positive, Meta(description="its standard deviation, in the term's unit")]
+
+
 @functools.cache
 def _types(terms: tuple[str, ...]) -> tuple[type, type]:
-    joint = msgspec.defstruct("JointTable", _JOINT_FIELDS + [(t, Union[Annotated[float, Meta(description=f"{TERMS[t].unit}: nominal {TERMS[t].description}")], None], None)
+    joint = msgspec.defstruct("JointTable", _JOINT_FIELDS + [(t, Union[Annotated[float, Meta(description=f"{TERMS[t].unit}: nominal {TERMS[t].description}")],
+                                                                    DriveValue, None], None)
                                                 for t in terms], bases=(Table,),
                               kw_only=True, module=__name__)
     joint.__doc__ = ("``[[joints]]``: one per joint, base to tip; DH values (or nothing with a URDF), limits, drive gain and "

@@ -122,6 +122,10 @@ class Robot:
     held : tuple of str
         Joints of the robot's URDF held fixed, not identified (a gripper's fingers): their links count with the link
         they are held to, as a fixed joint's do (:func:`dynid.model.urdf.joints_from_urdf`).
+    prior_sigma : tuple of (str, float)
+        ``(parameter name, σ)`` of the drive terms whose nominal value the description states with an uncertainty
+        (``Ia = { value = 0.3, sigma = 0.05 }``): the estimates that pull toward the nominal values pull these with a
+        Gaussian prior of that σ (:meth:`prior_weights`).
     """
 
     name: str
@@ -143,11 +147,28 @@ class Robot:
     held: tuple[str, ...] = ()
     nominal_notes: tuple[str, ...] = ()
     stribeck_velocity: np.ndarray = None  # type: ignore[assignment]
+    prior_sigma: tuple[tuple[str, float], ...] = ()
 
     @property
     def friction_velocities(self) -> Velocities:
         """The per-joint velocities the friction columns use (:mod:`dynid.friction`)."""
         return Velocities(self.coulomb_velocity, self.stribeck_velocity)
+
+    def prior_sigmas(self) -> np.ndarray:
+        """Each standard parameter's prior standard deviation where the description states one
+        (:attr:`prior_sigma`), NaN elsewhere.
+
+        Returns
+        -------
+        (n_params,) ndarray
+            :attr:`parameter_names` order.
+        """
+        names = list(self.parameter_names)
+        out = np.full(len(names), np.nan)
+        for name, sigma in self.prior_sigma:
+            if name in names:  # a term the robot no longer has (a joint torque sensor's Ia) is dropped with it
+                out[names.index(name)] = sigma
+        return out
 
     def physical_prior(self) -> tuple[np.ndarray, tuple[str, ...]]:
         """The nominal standard parameters with each physically impossible link replaced by its nearest consistent
