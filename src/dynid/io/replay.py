@@ -293,7 +293,7 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
             data.qfrc_applied[vadr] = u
             mujoco.mj_step(model, data)
     modelled = regressor(robot, q, dq, ddq) @ phi
-    rel = lambda a, b: float(100.0 * np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300))  # noqa: E731
+    rel = lambda a, b: 100.0 * float(np.linalg.norm(a - b)) / max(float(np.linalg.norm(b)), 1e-300)  # noqa: E731
     return ForwardCheck(rel(applied, tau), rel(modelled, tau), rel(applied, modelled), worst, int(t.size))
 
 
