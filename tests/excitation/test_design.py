@@ -5,7 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dynid.dynamics.kinematics import tool_positions
+from dynid.dynamics.kinematics import forward_kinematics, tool_positions
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
@@ -51,6 +51,9 @@ def _check_every_constraint_independently(robot, prob, traj):
     p = tool_positions(robot, q)
     ws = prob.workspace
     assert np.all(p >= ws.box_min) and np.all(p <= ws.box_max) and np.all(p[:, 2] >= ws.floor)
+    z = forward_kinematics(robot, q)[1][:, :, 2]  # every link's joint origins above the floor by the clearance
+    moving = np.ptp(z, axis=0) > 1e-6
+    assert np.all(z[:, moving] >= ws.floor + ws.clearance - 1e-9)
 
 
 def test_er16_design_halves_cond_of_beta1_and_satisfies_every_constraint(er16_3):
@@ -105,3 +108,29 @@ def test_initial_trajectory_at_another_fundamental_pulsation_is_refused(er16_3):
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0)
     with pytest.raises(ConfigError, match="fundamental pulsation"):
         design_excitation(prob, n_starts=1, rng=0, initial=beta1)
+
+
+def test_the_origins_jacobian_equals_finite_differences(er16_3, rng):
+    from dynid.dynamics.sensitivity import origins_jacobian
+
+    q = rng.uniform(-1.0, 1.0, (4, 3))
+    _, jac = origins_jacobian(er16_3, q)
+    for k in range(4):
+        fd = _finite_difference(lambda x: forward_kinematics(er16_3, x[None])[1][0], q[k])
+        np.testing.assert_allclose(jac[k], fd, rtol=1e-6, atol=1e-8)
+
+
+def test_a_floor_keeps_every_link_above_it_not_only_the_tool(er16_3):
+    """The paper's β1 trajectory, its offsets kept, designed over a floor 0.45 m below the base: before, only the tool
+    point was held above it, and the er16's elbow (joint 3's origin) went 9 cm through the floor of
+    configs/excite-er16.toml (-0.589 m against -0.5). Now every link's joint origins stay the clearance above it,
+    checked on a 10× finer grid by forward kinematics; a clearance the start pose breaks is refused."""
+    beta1 = paper_identification_trajectory()
+    ws = Workspace(floor=-0.45, clearance=0.05)
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0, workspace=ws)
+    assert [m.where for m in prob.margins(beta1) if m.constraint.startswith("floor clearance")] == ["joint 3's origin"]
+    design = design_excitation(prob, n_starts=2, rng=0, initial=beta1)
+    assert design.feasible
+    _check_every_constraint_independently(er16_3, prob, design.trajectory)
+    with pytest.raises(ConfigError, match="joint 3's origin is less than workspace.clearance"):
+        ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0, workspace=Workspace(floor=-0.45, clearance=2.0))

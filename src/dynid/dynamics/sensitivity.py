@@ -88,6 +88,30 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
     return y, d
 
 
+def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
+    """Every joint frame's origin and its positional Jacobian ``∂o_k/∂q_j = z_j × (o_k - o_j)`` for ``j < k``
+    (revolute joints; a joint does not move its own frame's origin).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+
+    Returns
+    -------
+    o : (N, n_dof, 3) array [m]
+        Origins in the base frame.
+    J : (N, n_dof, 3, n_dof) array [m/rad]
+    """
+    q = check_trajectory_array(q, robot.n_dof, "q")
+    rots, orig = forward_kinematics(robot, q)
+    axes = np.stack([rots[:, j] @ robot.joints[j].axis for j in range(robot.n_dof)], axis=2)  # (N, 3, n)
+    lever = orig[:, :, :, None] - orig.transpose(0, 2, 1)[:, None]  # (N, k, 3, j): o_k - o_j
+    jac = np.cross(axes[:, None], lever, axis=2)
+    jac *= np.tril(np.ones((robot.n_dof, robot.n_dof)), -1)[None, :, None, :]  # only the joints before frame k
+    return orig, jac
+
+
 def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     """Tool point and its positional Jacobian ``∂p/∂q_j = z_j × (p - o_j)`` (revolute joints).
 

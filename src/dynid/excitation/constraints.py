@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..dynamics.kinematics import tool_positions
+from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
@@ -28,12 +28,19 @@ class Workspace:
     box_min, box_max : (3,) arrays
         Axis-aligned box; ``±inf`` leaves a side open.
     floor : float
-        Height of a horizontal floor plane; the tool point stays at ``z >= floor`` (``-inf``: none).
+        Height of a horizontal floor plane (a table, the floor); the tool point stays at ``z >= floor``, and every
+        link at least ``clearance`` above it (``-inf``: none).
+    clearance : float [m]
+        How far every link stays above the floor: each link is taken as a capsule of this radius about the segment
+        between its joint's origin and the next (the flange for the last), so its joints' origins staying
+        ``clearance`` above the plane keeps the whole capsule above it (a plane and a segment: the lowest point is
+        an end). Default 0.05 m.
     """
 
     box_min: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
     box_max: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
     floor: float = -np.inf
+    clearance: float = 0.05
 
     def __post_init__(self) -> None:
         for name in ("box_min", "box_max"):
@@ -47,6 +54,30 @@ class Workspace:
                               f"(box_min {self.box_min.tolist()}, box_max {self.box_max.tolist()})")
         if np.isnan(self.floor) or self.floor == np.inf:
             raise ConfigError(f"workspace.floor: expected a height in metres, got {self.floor}")
+        if not (np.isfinite(self.clearance) and self.clearance >= 0):
+            raise ConfigError(f"workspace.clearance: expected a distance of at least 0 m, got {self.clearance}")
+
+    def moving_origins(self, robot) -> np.ndarray:
+        """The joint frames whose origins the floor constraint holds: those whose height changes with the joints
+        (a point on the first joint's axis, or the base's, never moves and is not constrained); none without a
+        floor.
+
+        Parameters
+        ----------
+        robot : Robot
+
+        Returns
+        -------
+        (m,) int array
+            Joint frame indices (0-based).
+        """
+        if not np.isfinite(self.floor):
+            return np.zeros(0, dtype=int)
+        lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
+        hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
+        q = lo + np.random.default_rng(0).random((24, robot.n_dof)) * (hi - lo)
+        z = forward_kinematics(robot, q)[1][:, :, 2]
+        return np.flatnonzero(z.max(axis=0) - z.min(axis=0) > 1e-6)
 
     def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """``G p <= h`` for the finite sides of the box and the floor.
@@ -83,7 +114,7 @@ class Workspace:
         """
         fin = lambda v: [float(x) if np.isfinite(x) else None for x in v]  # noqa: E731
         return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
-                "floor": float(self.floor) if np.isfinite(self.floor) else None}
+                "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance)}
 
 
 @dataclass(frozen=True)
@@ -199,6 +230,14 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
             if np.isfinite(lim[j]):
                 worst = float(np.abs(values[:, j]).max())
                 out.append(ConstraintMargin(name, f"joint {j + 1}", float(lim[j]), worst, float(lim[j] - worst), float((lim[j] - worst) / lim[j])))
+    moving = workspace.moving_origins(robot)
+    if moving.size:  # every link above the floor by the clearance: its joints' origins (the tool point's row below)
+        z = forward_kinematics(robot, q)[1][:, :, 2]
+        limit = float(workspace.floor + workspace.clearance)
+        for k in moving:
+            worst = float(z[:, k].min())
+            out.append(ConstraintMargin("floor clearance [m]", f"joint {k + 1}'s origin", limit, worst,
+                                        worst - limit, np.nan))
     g, h, labels = workspace.inequalities()
     if len(h):
         p = tool_positions(robot, q)

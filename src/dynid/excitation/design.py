@@ -26,9 +26,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
-from ..dynamics.kinematics import tool_positions
+from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
-from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
+from ..dynamics.sensitivity import origins_jacobian, regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Limits, Robot
@@ -176,6 +176,12 @@ class ExcitationProblem:
         if out:
             raise ConfigError(f"workspace excludes the start pose: at the offsets q_o = {np.round(q0, 4).tolist()} rad the tool "
                               f"point is at {np.round(p, 3).tolist()} m, which violates {', '.join(out)}")
+        low = [int(k) for k in self.workspace.moving_origins(self.robot)
+               if forward_kinematics(self.robot, q0[None])[1][0, k, 2] < self.workspace.floor + self.workspace.clearance]
+        if low:
+            raise ConfigError(f"workspace: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) joint {low[0] + 1}'s "
+                              f"origin is less than workspace.clearance = {self.workspace.clearance:g} m above the floor "
+                              f"({self.workspace.floor:g} m): start higher, or lower the clearance")
         zero = np.zeros((1, self.robot.n_dof))
         tau = (regressor(self.robot, q0[None], zero, zero) @ self.phi)[0]
         bad = np.flatnonzero(np.abs(tau) > lim.tau_max)
@@ -417,6 +423,9 @@ class _Objective:
         g, h, _ = problem.workspace.inequalities()
         reach = sum(float(np.linalg.norm(jt.translation)) for jt in problem.robot.joints) + float(np.linalg.norm(problem.robot.tool_translation))
         self.ws_g, self.ws_h = g, h - s * reach
+        ws = problem.workspace  # every link above the floor: its joints' origins (Workspace.clearance)
+        self.origins = ws.moving_origins(problem.robot)
+        self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
         self.crit = criterion_function(problem.criterion)
 
     def _eval(self, x: np.ndarray) -> None:
@@ -431,6 +440,8 @@ class _Objective:
         self.tau = y[:, self.tau_idx, :] @ p.phi
         if self.ws_h.size:
             self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
+        if self.origins.size:
+            self.lift = forward_kinematics(p.robot, self.q)[1][:, self.origins, 2] - self.floor  # (N, m)
         self.nfev += 1
         self._x, self._xg = x.copy(), None
 
@@ -450,6 +461,9 @@ class _Objective:
         if self.ws_h.size:
             _, jac = tool_jacobian(p.robot, self.q)
             self.ws_jac = -np.einsum("md,kdi,kix->kmx", self.ws_g, jac, lay.lin[0])
+        if self.origins.size:
+            _, jac = origins_jacobian(p.robot, self.q)
+            self.lift_jac = np.einsum("kmi,kix->kmx", jac[:, self.origins, 2, :], lay.lin[0])
         self._xg = True
 
     def fun(self, x):
@@ -466,6 +480,8 @@ class _Objective:
         parts = [((lim - self.tau) / lim).ravel(), ((lim + self.tau) / lim).ravel()]
         if self.ws_h.size:
             parts.append(self.ws.ravel())
+        if self.origins.size:
+            parts.append(self.lift.ravel())
         return np.concatenate(parts)
 
     def cons_jac(self, x):
@@ -474,6 +490,8 @@ class _Objective:
         parts = [(-self.tau_jac / lim).reshape(-1, x.size), (self.tau_jac / lim).reshape(-1, x.size)]
         if self.ws_h.size:
             parts.append(self.ws_jac.reshape(-1, x.size))
+        if self.origins.size:
+            parts.append(self.lift_jac.reshape(-1, x.size))
         return np.concatenate(parts)
 
 

@@ -275,7 +275,11 @@ class WorkspaceTable(Table, kw_only=True):
 
     box_min: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
     box_max: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
-    floor: Annotated[float, _d("lowest height of the tool point, m")] | None = None
+    floor: Annotated[float, _d("height of the floor or table the arm stands over, m: the tool point stays above it and "
+                                "every link `clearance` above it")] | None = None
+    clearance: Annotated[float, Meta(ge=0.0, description="how far every link stays above the floor, m (its capsule's "
+                                                         "radius about the segment between its joint origins); "
+                                                         "default 0.05")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

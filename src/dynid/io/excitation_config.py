@@ -173,6 +173,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
                              if getattr(ws, key) is not None}
     if ws.floor is not None:
         ws_kw["floor"] = float(ws.floor)
+    if ws.clearance is not None:
+        ws_kw["clearance"] = float(ws.clearance)
     try:
         workspace = Workspace(**ws_kw)
     except ConfigError as exc:

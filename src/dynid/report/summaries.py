@@ -1020,6 +1020,12 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"no position limits on {', '.join(f'J{j + 1}' for j in free)} (continuous joints): the design "
                         f"swings them about their offset within their velocity and acceleration limits only ({swing}); "
                         "give q_min and q_max in [limits] to bound them", "warning"))
+    lifted = [m for m in d.margins if m.constraint.startswith("floor clearance")]
+    if lifted:
+        low = min(lifted, key=lambda m: m.worst)
+        out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
+                        f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
+                        f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
     relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
     tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
