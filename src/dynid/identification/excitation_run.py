@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..excitation.collision import SelfClearance, self_clearance
 from ..excitation.design import ExcitationDesign, design_excitation
 from ..io.excitation_config import ExcitationConfig
 
@@ -24,6 +25,9 @@ class ExcitationRun:
         Set-point times at the config's rate.
     q, dq, ddq : (N, n_dof) arrays
         [rad], [rad/s], [rad/s²].
+    self_clearance : SelfClearance or None
+        The smallest distance between links that can touch, over the set-points
+        (:func:`dynid.excitation.collision.self_clearance`; None for a chain too short to fold onto itself).
     """
 
     config: ExcitationConfig
@@ -32,6 +36,7 @@ class ExcitationRun:
     q: np.ndarray
     dq: np.ndarray
     ddq: np.ndarray
+    self_clearance: SelfClearance | None = None
 
     def to_dict(self) -> dict:
         """The run as ``excitation.json``.
@@ -53,6 +58,7 @@ class ExcitationRun:
                          "safety": p.safety, "initial": c.initial_label, "csv_rate": c.rate, "csv_periods": c.periods},
             "trajectory": self.design.trajectory.to_dict(form=c.form),
             "design": {k: v for k, v in self.design.to_dict(form=c.form).items() if k != "trajectory"},
+            **({} if self.self_clearance is None else {"self_clearance": self.self_clearance.to_dict()}),
         }
 
 
@@ -74,4 +80,11 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     n = int(round(config.periods * config.problem.period * config.rate))
     t = np.arange(n + 1) / config.rate  # both ends: the controller's last set-point is the start again
     q, dq, ddq = design.trajectory.evaluate(t)
-    return ExcitationRun(config, design, t, q, dq, ddq)
+    every = max(1, int(np.ceil(t.size / CLEARANCE_SAMPLES)))  # the set-points, at most this many of them
+    clearance = self_clearance(config.problem.robot, t[::every], q[::every], config.problem.workspace.clearance)
+    return ExcitationRun(config, design, t, q, dq, ddq, clearance)
+
+
+CLEARANCE_SAMPLES = 2000
+"""Set-points the links' distances are checked on, evenly spaced (every one of a shorter trajectory): 5-10 ms apart
+on a trajectory of 10-20 s, where a link moves a few millimetres at most."""

@@ -1026,6 +1026,7 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
                         f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
+    out += _self_clearance_lines(run)
     relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
     tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
@@ -1036,6 +1037,23 @@ def excitation_blocks(run) -> list:
         out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
                         "and currents, and dynid identify the log"))
     return out
+
+
+def _self_clearance_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links come to each other
+    (:func:`dynid.excitation.collision.self_clearance`): a warning where their capsules overlap."""
+    c = getattr(run, "self_clearance", None)
+    if c is None:
+        return []
+    radius = run.config.problem.workspace.clearance
+    where = f"links {c.pair[0]} and {c.pair[1]} at t = {c.time:.3g} s"
+    if c.distance < 0:
+        return [Line(f"links that can touch come within each other's {radius:g} m: their capsules overlap by "
+                     f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): the design does not "
+                     "avoid self-collision yet; check this pose on the robot (or in a simulator) before running it, or "
+                     "lower the amplitudes", "warning")]
+    return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:g} m capsules "
+                 f"(closest: {where}; {c.pairs} pairs checked on the set-points)")]
 
 
 def _cell(value, fmt: str = ".3g") -> str:
