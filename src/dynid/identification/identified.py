@@ -408,14 +408,7 @@ class IdentifiedModel:
         ValueError
             Time stamps without positions and torques.
         """
-        recording = t
-        if not (hasattr(t, "tau") and hasattr(t, "rate")):
-            if q is None or tau is None:
-                raise ValueError("score(t, q, tau): positions and measured torques are needed with the time stamps")
-            from .run import recording_from_arrays
-
-            recording = recording_from_arrays(self.robot, t, q, tau, name="score")
-        _, pred, meas = self.predict_log(recording, estimate=estimate)
+        _, pred, meas = self.predict_log(self._scored_log(t, q, tau, "score"), estimate=estimate)
         res = meas - pred
         return 1.0 - float(np.sum(res**2)) / float(np.sum((meas - meas.mean(axis=0)) ** 2))
 
@@ -441,15 +434,18 @@ class IdentifiedModel:
         ValueError
             Time stamps without positions and torques.
         """
-        recording = t
-        if not (hasattr(t, "tau") and hasattr(t, "rate")):
-            if q is None or tau is None:
-                raise ValueError("relative_error(t, q, tau): positions and measured torques are needed with the time stamps")
-            from .run import recording_from_arrays
+        recording = self._scored_log(t, q, tau, "relative_error")
+        return float(self.validate(recording, estimate=estimate).metrics()[self.label(estimate)]["global_relative_error"])
 
-            recording = recording_from_arrays(self.robot, t, q, tau, name="relative_error")
-        label = self.label(estimate)
-        return float(self.validate(recording, estimate=estimate).metrics()[label]["global_relative_error"])
+    def _scored_log(self, t, q, tau, what: str):
+        """A recording given as one, or made of a raw log's arrays as the log readers make it."""
+        if hasattr(t, "tau") and hasattr(t, "rate"):
+            return t
+        if q is None or tau is None:
+            raise ValueError(f"{what}(t, q, tau): positions and measured torques are needed with the time stamps")
+        from .run import recording_from_arrays
+
+        return recording_from_arrays(self.robot, t, q, tau, name=what)
 
     def urdf(self) -> str:
         """The physically consistent estimate as URDF text (:func:`dynid.io.export.urdf_from_results`).
