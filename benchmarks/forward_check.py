@@ -2,7 +2,7 @@
 
 For each real config of ``configs/`` (its defaults' main estimate, or the physically consistent one export writes):
 the MJCF ``dynid export`` writes, simulated in MuJoCo from the first moving validation log's first state and driven
-along its positions by the file's own computed torque plus a 10 Hz PD loop (:func:`dynid.io.replay.mjcf_forward`);
+along its positions by the file's own computed torque plus a 30 Hz PD loop (:func:`dynid.io.replay.mjcf_forward`);
 the log prepared as ``dynid validate`` prepares it, without decimation. Prints the torque the simulation needed
 against the measured one, dynid's own inverse dynamics against the measured one on the same samples, and the two
 against each other (what the simulator adds). From the repository root: ``.venv/bin/python

@@ -212,16 +212,16 @@ class ForwardCheck:
     n_samples: int
 
 
-def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *, substeps: int = 10,
-                 bandwidth: float = 10.0) -> ForwardCheck:
+def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *, substeps: int = 40,
+                 bandwidth: float = 30.0) -> ForwardCheck:
     """Simulate a written MJCF along a log's motion and compare the torques it needs with the measured ones (issue
     "The model proven where it goes", item 3).
 
     MuJoCo's forward dynamics of the file (its frictionloss a constraint, its armature and damping as written), from
     the log's first state, driven by a computed-torque controller: the file's own inverse dynamics at the log's
     state (``mj_inverse`` with frictionloss off, plus ``frictionloss·sign(q̇)``) and a PD loop of ``bandwidth`` Hz on
-    the inertia each joint's torque meets (``1/(M⁻¹)_jj`` at the first state), at the log's rate with ``substeps`` integration steps per sample (the reference
-    between samples a cubic Hermite of the positions and velocities: linear positions would leave the curve by
+    the inertia each joint's torque meets (``1/(M⁻¹)_jj`` at the first state), at the log's rate with ``substeps``
+    integration steps per sample (the reference between samples a cubic Hermite of the positions and velocities: linear positions would leave the curve by
     ``Δt²·q̈/8``, which the PD loop then fights). What a simulator user sees: the torque the simulated arm needs to make
     the log's motion, against the torque the real arm needed.
 
@@ -239,6 +239,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     tau : (N, n_dof) array [N·m]
         The measured torques on the same samples.
     substeps : int
+        Integration steps per log sample. With 10 (and a 10 Hz loop) the LBR Med7's simulation lost stability
+        slowly (its SDP estimate holds two links at the limit of a real one); 40 and 30 Hz track every real log.
     bandwidth : float [Hz]
 
     Returns
