@@ -2,8 +2,9 @@
 
 For each real config of ``configs/`` (its defaults' main estimate, or the physically consistent one export writes):
 the MJCF ``dynid export`` writes, simulated in MuJoCo from the first moving validation log's first state and driven
-along its positions by the file's own computed torque plus a 30 Hz PD loop (:func:`dynid.io.replay.mjcf_forward`);
-the log prepared as ``dynid validate`` prepares it, without decimation. Prints the torque the simulation needed
+along its positions by the file's own computed torque plus a 30 Hz PD loop, as ``dynid export --mjcf F --forward``
+does (:func:`dynid.identification.run.forward_check`); the log prepared as ``dynid validate`` prepares it, without
+decimation. Prints the torque the simulation needed
 against the measured one, dynid's own inverse dynamics against the measured one on the same samples, and the two
 against each other (what the simulator adds). From the repository root: ``.venv/bin/python
 benchmarks/forward_check.py`` (about a minute).
@@ -15,23 +16,16 @@ import json
 import sys
 import tempfile
 import warnings
-from dataclasses import replace
 from pathlib import Path
-
-import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIGS = ("ur10e", "tx40", "kuka_kr300", "kuka_med7")
 
 
 def main() -> int:
-    from dynid.identification.run import run_identification
-    from dynid.io.datasets import load_recording
+    from dynid.identification.run import forward_check, run_identification
     from dynid.io.export import consistent_estimate, mjcf_from_robot
     from dynid.io.identification_config import load_identification_config
-    from dynid.io.replay import mjcf_forward
-    from dynid.preprocessing.pipeline import prepare
-    from dynid.preprocessing.strategies import carried_over
     from dynid.report.output import write_results
 
     folder = Path(tempfile.mkdtemp())
@@ -44,17 +38,11 @@ def main() -> int:
             result = run_identification(config)
         write_results(folder / f"{name}.json", result.to_dict(), "identify")
         identified = json.loads((folder / f"{name}.json").read_text())
-        robot, phi = consistent_estimate(result.model, identified, name)
-        text = mjcf_from_robot(robot, phi)
-        moving = next(v for v in result.validations if v.rest_share is None or float(np.mean(v.rest_share)) < 0.5)
-        spec = next(s for s in config.validation if s.name == moving.name)
-        settings = replace(carried_over(None, config.preprocessing), decimation=1, parallel_cutoff=0.0)
+        text = mjcf_from_robot(*consistent_estimate(config.robot, identified, name))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            data = prepare(load_recording(spec, robot), settings, strict=False)
-        q, dq, ddq, tau = (np.asarray(x, dtype=float) for x in (data.q, data.dq, data.ddq, data.tau))
-        check = mjcf_forward(text, robot, phi, np.asarray(data.t), q, dq, ddq, tau)
-        print(f"{name} | {moving.name} | {check.n_samples} | {check.simulated_vs_measured:.2f} | "
+            log, check = forward_check(config, identified, text, source=name)
+        print(f"{name} | {log} | {check.n_samples} | {check.simulated_vs_measured:.2f} | "
               f"{check.model_vs_measured:.2f} | {check.simulated_vs_model:.2f} | {check.tracking_error.max():.2e}")
         sys.stdout.flush()
     return 0

@@ -61,6 +61,14 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     error = float(re.search(r"m\.xml read back by MuJoCo \(mj_inverse\): its torques equal dynid's model to (\S+) of "
                             r"their RMS", said).group(1))
     assert error < 1e-6 and "MuJoCo's frictionloss is a constraint" in said
+    p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--mjcf", tmp_path / "f.xml", "--forward")
+    assert p.returncode == 0, p.stderr
+    simulated = re.search(r"f\.xml simulated in MuJoCo along validation \((\d+) samples.*? the torques it needs are (\S+) % "
+                          r"off the measured ones, against (\S+) % for dynid's model", " ".join(p.stdout.split()))
+    assert simulated is not None and int(simulated.group(1)) > 100
+    assert 0 < float(simulated.group(3)) and 0 < float(simulated.group(2)) < 3 * float(simulated.group(3)) + 1
+    p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "g.urdf", "--forward")
+    assert p.returncode == 1 and "--forward simulates the MJCF: give --mjcf FILE too" in p.stderr
 
 
 def test_a_model_whose_gravity_is_not_minus_z_is_written_with_its_base_turned():

@@ -356,6 +356,8 @@ def export(
     mjcf: Path | None = typer.Option(None, help="MuJoCo MJCF file to write (inertials, armature, damping, frictionloss)."),
     mjcf_model: Path | None = typer.Option(None, help="Your own MuJoCo model of the arm: --mjcf writes the values into a copy of it (names, frames, geoms, meshes kept). Default: the config's mjcf_model."),
     data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    forward: bool = typer.Option(False, "--forward", help="Simulate the MJCF in MuJoCo along the config's first moving "
+                                 "validation log and compare the torques it needs with the measured ones."),
     quiet: bool = QUIET,
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
@@ -365,6 +367,10 @@ def export(
         return mjcf_model if mjcf_model is not None else cfg.mjcf_model
 
     def prepare():
+        from ..exceptions import DataError
+
+        if forward and mjcf is None:
+            raise DataError("--forward simulates the MJCF: give --mjcf FILE too")
         cfg = load_identification_config(config, data_root=data_root)
         identified = _read_results(results, cfg.robot)
         return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
@@ -378,7 +384,8 @@ def export(
                  for flag, path in targets]
         estimate = consistent_estimate(cfg.robot, identified, str(results))
         checks = {path: _replayed(flag, text, estimate) for (flag, path), (_, text) in zip(targets, texts)}
-        return cfg, texts, moved, identified, checks
+        simulated = _simulated(cfg, identified, texts, targets, str(results)) if forward else None
+        return cfg, texts, moved, identified, checks, simulated
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -388,7 +395,7 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        cfg, _, moved, _, _ = computed
+        cfg, _, moved, _, _, simulated = computed
         robot = cfg.robot
         into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
@@ -419,8 +426,26 @@ def export(
                 said += (f"; what {form} cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
                          f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
             (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
+        if simulated is not None:
+            rep.line(simulated)
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)
+
+
+def _simulated(cfg, identified: dict, texts, targets, source: str) -> str:
+    """``dynid export --forward``'s line: the MJCF written simulated along the first moving validation log
+    (:func:`dynid.identification.run.forward_check`)."""
+    from ..identification.run import forward_check
+
+    mjcf = next((path, text) for (flag, _), (path, text) in zip(targets, texts) if flag == "--mjcf")
+    found = forward_check(cfg, identified, mjcf[1], source=source)
+    if found is None:
+        return f"{mjcf[0].name} not simulated: the config has no validation log that moves (--forward follows one)"
+    log, check = found
+    return (f"{mjcf[0].name} simulated in MuJoCo along {log} ({check.n_samples} samples; computed torque and a PD loop, "
+            f"tracking within {check.tracking_error.max():.2g} rad): the torques it needs are {check.simulated_vs_measured:.3g} % "
+            f"off the measured ones, against {check.model_vs_measured:.3g} % for dynid's model on the same samples "
+            f"({check.simulated_vs_model:.3g} % between the two: MuJoCo's frictionloss, what MJCF cannot hold)")
 
 
 def _replayed(flag: str, text: str, estimate) -> tuple[str, object]:

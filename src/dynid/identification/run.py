@@ -414,6 +414,49 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     return found, label, ratio
 
 
+def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str, *, source: str = "results"):
+    """An exported MJCF simulated along the config's first moving validation log (issue "The model proven where it
+    goes", item 3; :func:`dynid.io.replay.mjcf_forward`): the log prepared as ``dynid validate`` prepares it, without
+    decimation, so the simulation follows every sample.
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    identified : dict
+        results.json of ``dynid identify``: the physically consistent estimate the MJCF holds.
+    mjcf_text : str
+        The MJCF as written.
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    (str, ForwardCheck) or None
+        The log's name and the check; None without a validation log that moves.
+
+    Raises
+    ------
+    DataError
+        A log that cannot be read, or results of another robot.
+    ValueError
+        MuJoCo cannot load the text.
+    """
+    from ..io.export import consistent_estimate
+    from ..io.replay import mjcf_forward
+    from ..preprocessing.pipeline import prepare
+
+    robot, phi = consistent_estimate(config.robot, identified, source)
+    settings = replace(carried_over(stored_preprocessing(identified), config.preprocessing), decimation=1,
+                       parallel_cutoff=0.0)  # every sample, as the simulation runs them
+    for spec in config.validation:
+        data = prepare(load_recording(spec, robot), settings, strict=False)
+        if data.resting is not None and float(np.mean(data.resting)) >= 0.5:  # a log at rest shows no motion to follow
+            continue
+        q, dq, ddq, tau = (np.asarray(x, dtype=float) for x in (data.q, data.dq, data.ddq, data.tau))
+        return spec.name, mjcf_forward(mjcf_text, robot, phi, np.asarray(data.t), q, dq, ddq, tau)
+    return None
+
+
 def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
     """Each joint's drive gain identified by the results' ``[drive_gains]`` run over the gain its torques were read
     with (1 where a gain was not determined); None without identified gains.
