@@ -143,15 +143,7 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
     path, held = Path(path), dict(held or {})
     mujoco, model, moving, owner, names = _chain(path, held)
     rotations, translations = _frames(mujoco, model, moving, held, names)
-    link_of = {k: i for i, k in enumerate(moving)}
-    inertial = np.zeros((len(moving), 10))
-    for b in range(1, model.nbody):
-        if owner[b] < 0 or model.body_mass[b] == 0:
-            continue
-        principal = _quat_matrix(mujoco, model.body_iquat[b])
-        phi = inertial_from_physical(float(model.body_mass[b]), np.array(model.body_ipos[b]),
-                                     principal @ np.diag(model.body_inertia[b]) @ principal.T)
-        inertial[link_of[owner[b]]] += transform_inertial(phi, rotations[b], translations[b])
+    inertial = _lumped(mujoco, model, range(1, model.nbody), moving, owner, (rotations, translations))
     joints = []
     for i, k in enumerate(moving):
         b = _body(model, k)
@@ -184,14 +176,22 @@ def held_inertials(path: str | Path, held=None) -> np.ndarray:
     path, held = Path(path), dict(held or {})
     mujoco, model, moving, owner, names = _chain(path, held)
     rotations, translations = _frames(mujoco, model, moving, held, names)
-    link_of = {k: i for i, k in enumerate(moving)}
     bodies = {_body(model, k) for k in moving}
     carried = np.zeros(model.nbody, dtype=bool)  # rides on a held joint below its link's body
-    out = np.zeros((len(moving), 10))
     for b in range(1, model.nbody):
         own = any(names[k] in held for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]))
         carried[b] = b not in bodies and (own or carried[model.body_parentid[b]])
-        if not carried[b] or owner[b] < 0 or model.body_mass[b] == 0:
+    return _lumped(mujoco, model, np.flatnonzero(carried), moving, owner, (rotations, translations))
+
+
+def _lumped(mujoco, model, bodies, moving, owner, frames) -> np.ndarray:
+    """(n_dof, 10): the inertials of ``bodies`` summed into the link each rides on, in its joint frame (``frames``:
+    every body's frame in its link's, :func:`_frames`); bodies on the base or without mass count nowhere."""
+    rotations, translations = frames
+    link_of = {k: i for i, k in enumerate(moving)}
+    out = np.zeros((len(moving), 10))
+    for b in bodies:
+        if owner[b] < 0 or model.body_mass[b] == 0:
             continue
         principal = _quat_matrix(mujoco, model.body_iquat[b])
         phi = inertial_from_physical(float(model.body_mass[b]), np.array(model.body_ipos[b]),
