@@ -10,6 +10,7 @@ from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, _Layout, _Objective, condition_number, design_excitation
+from dynid.excitation.obstacles import Obstacle
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
 from dynid.model.description import load_robot
 
@@ -30,11 +31,13 @@ def _finite_difference(f, x, h=1e-5):
 
 @pytest.mark.parametrize("criterion", ["cond", "d-optimal"])
 def test_gradients_equal_finite_differences_of_the_whole_problem(er16_3, rng, criterion):
-    """The chain-rule gradients (criterion, torque and workspace constraints) against central differences."""
-    ws = Workspace(box_min=np.array([-3.0, -3.0, -3.0]), box_max=np.array([3.0, 3.0, 3.0]), floor=-1.5)
+    """The chain-rule gradients (criterion, torque, workspace and obstacle constraints) against central differences."""
+    ball = Obstacle("sphere", np.array([0.2]), np.array([0.6, 0.4, 1.0]))
+    ws = Workspace(box_min=np.array([-3.0, -3.0, -3.0]), box_max=np.array([3.0, 3.0, 3.0]), floor=-1.5, obstacles=(ball,))
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 2, workspace=ws, criterion=criterion, grid_points=24)
     lay = _Layout(prob, prob.design_grid())
     obj = _Objective(prob, lay)
+    assert obj.pairs
     x = np.concatenate([prob.start_pose(), 0.3 * rng.standard_normal(lay.nx - 3)])
     np.testing.assert_allclose(obj.jac(x), _finite_difference(obj.fun, x), rtol=1e-5, atol=1e-6)
     np.testing.assert_allclose(obj.cons_jac(x), _finite_difference(obj.cons, x).reshape(-1, x.size), rtol=1e-5, atol=1e-6)

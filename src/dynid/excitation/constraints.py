@@ -15,6 +15,7 @@ from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
 from .fourier import FourierTrajectory
+from .obstacles import Obstacle, obstacle_distances
 
 AXES = "xyz"
 
@@ -34,15 +35,20 @@ class Workspace:
         How far every link stays above the floor: each link is taken as a capsule of this radius about the segment
         between its joint's origin and the next (the flange for the last), so its joints' origins staying
         ``clearance`` above the plane keeps the whole capsule above it (a plane and a segment: the lowest point is
-        an end). Default 0.05 m.
+        an end). Default 0.05 m. The same capsules keep clear of :attr:`obstacles`.
+    obstacles : tuple of Obstacle
+        The cell's bodies (a table top, a fixture, a wall): every link's capsule stays off each
+        (:mod:`dynid.excitation.obstacles`).
     """
 
     box_min: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
     box_max: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
     floor: float = -np.inf
     clearance: float = 0.05
+    obstacles: tuple[Obstacle, ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
         for name in ("box_min", "box_max"):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (3,) or np.any(np.isnan(v)):
@@ -114,7 +120,8 @@ class Workspace:
         """
         fin = lambda v: [float(x) if np.isfinite(x) else None for x in v]  # noqa: E731
         return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
-                "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance)}
+                "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance),
+                **({"obstacles": [ob.to_dict() for ob in self.obstacles]} if self.obstacles else {})}
 
 
 @dataclass(frozen=True)
@@ -207,7 +214,8 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
     Returns
     -------
     list of ConstraintMargin
-        Positions (lower and upper), velocities, accelerations, torques, then workspace sides.
+        Positions (lower and upper), velocities, accelerations, torques, the floor, the workspace's sides, then the
+        cell's bodies (the closest link to each; a body no link can reach is left out).
     """
     q, dq, ddq = trajectory.evaluate(t)
     phi = robot.standard_parameters() if phi is None else phi
@@ -245,4 +253,36 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
             m = float(hi - (p @ gi).max())
             sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
             out.append(ConstraintMargin("workspace [m]", f"tool {lbl}", sign * float(hi), sign * float(hi) - sign * m, m, np.nan))
+    return out + obstacle_margins(robot, t, q, workspace)
+
+
+def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
+    """How close the links' capsules come to each of the cell's bodies along ``q``: one margin per body that a link
+    can reach, ``worst`` the smallest surface distance (limit 0: the skeleton ``clearance`` off the body).
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+    workspace : Workspace
+
+    Returns
+    -------
+    list of ConstraintMargin
+        ``where`` names the body, the closest link and when.
+    """
+    if not workspace.obstacles:
+        return []
+    found = obstacle_distances(robot, q, workspace.obstacles, workspace.clearance)
+    out = []
+    for i, ob in enumerate(workspace.obstacles):
+        cols = [c for c, (_, o) in enumerate(found.pairs) if o == i]
+        if not cols:
+            continue
+        d = found.distance[:, cols]
+        n, c = np.unravel_index(int(np.argmin(d)), d.shape)
+        worst = float(d[n, c])
+        out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {found.pairs[cols[c]][0] + 1} at "
+                                    f"t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan))
     return out

@@ -36,6 +36,7 @@ from ..threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
+from .obstacles import obstacle_distances, reachable_pairs
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -182,6 +183,7 @@ class ExcitationProblem:
             raise ConfigError(f"workspace: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) joint {low[0] + 1}'s "
                               f"origin is less than workspace.clearance = {self.workspace.clearance:g} m above the floor "
                               f"({self.workspace.floor:g} m): start higher, or lower the clearance")
+        self._check_start_clear(q0)
         zero = np.zeros((1, self.robot.n_dof))
         tau = (regressor(self.robot, q0[None], zero, zero) @ self.phi)[0]
         bad = np.flatnonzero(np.abs(tau) > lim.tau_max)
@@ -189,6 +191,19 @@ class ExcitationProblem:
             j = bad[0]
             raise ConfigError(f"limits.tau_max: holding the start pose needs {abs(tau[j]):.1f} N·m on joint {j + 1}, "
                               f"above its limit {lim.tau_max[j]:g} N·m")
+
+    def _check_start_clear(self, q0: np.ndarray) -> None:
+        """Every link off the cell's bodies at the start pose: the optimiser cannot pull a link out of a body."""
+        ws = self.workspace
+        if not ws.obstacles:
+            return
+        found = obstacle_distances(self.robot, q0[None], ws.obstacles, ws.clearance)
+        if found.pairs and found.distance.min() < 0:
+            k, i = found.pairs[int(np.argmin(found.distance[0]))]
+            raise ConfigError(f"workspace.obstacles: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) link "
+                              f"{k + 1} comes within workspace.clearance = {ws.clearance:g} m of obstacle "
+                              f"{ws.obstacles[i].name!r} (by {-found.distance.min():.3g} m): move the body, start "
+                              "elsewhere, or lower the clearance")
 
     def design_grid(self) -> np.ndarray:
         """One period sampled with ``grid_points`` samples.
@@ -426,6 +441,8 @@ class _Objective:
         ws = problem.workspace  # every link above the floor: its joints' origins (Workspace.clearance)
         self.origins = ws.moving_origins(problem.robot)
         self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
+        self.pairs = reachable_pairs(problem.robot, ws.obstacles, ws.clearance)  # every link off the cell's bodies
+        self.gap = s * reach
         self.crit = criterion_function(problem.criterion)
 
     def _eval(self, x: np.ndarray) -> None:
@@ -442,6 +459,8 @@ class _Objective:
             self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
         if self.origins.size:
             self.lift = forward_kinematics(p.robot, self.q)[1][:, self.origins, 2] - self.floor  # (N, m)
+        if self.pairs:
+            self.clear = self._distances(gradient=False).distance - self.gap  # (N, pairs)
         self.nfev += 1
         self._x, self._xg = x.copy(), None
 
@@ -464,7 +483,13 @@ class _Objective:
         if self.origins.size:
             _, jac = origins_jacobian(p.robot, self.q)
             self.lift_jac = np.einsum("kmi,kix->kmx", jac[:, self.origins, 2, :], lay.lin[0])
+        if self.pairs:
+            self.clear_jac = np.einsum("kmi,kix->kmx", self._distances(gradient=True).gradient, lay.lin[0])
         self._xg = True
+
+    def _distances(self, *, gradient: bool):
+        ws = self.p.workspace
+        return obstacle_distances(self.p.robot, self.q, ws.obstacles, ws.clearance, pairs=self.pairs, gradient=gradient)
 
     def fun(self, x):
         self._eval(x)
@@ -482,6 +507,8 @@ class _Objective:
             parts.append(self.ws.ravel())
         if self.origins.size:
             parts.append(self.lift.ravel())
+        if self.pairs:
+            parts.append(self.clear.ravel())
         return np.concatenate(parts)
 
     def cons_jac(self, x):
@@ -492,6 +519,8 @@ class _Objective:
             parts.append(self.ws_jac.reshape(-1, x.size))
         if self.origins.size:
             parts.append(self.lift_jac.reshape(-1, x.size))
+        if self.pairs:
+            parts.append(self.clear_jac.reshape(-1, x.size))
         return np.concatenate(parts)
 
 

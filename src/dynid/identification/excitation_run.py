@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..excitation.collision import SelfClearance, self_clearance
+from ..excitation.constraints import ConstraintMargin, obstacle_margins
 from ..excitation.design import ExcitationDesign, design_excitation
 from ..io.excitation_config import ExcitationConfig
 
@@ -28,6 +29,9 @@ class ExcitationRun:
     self_clearance : SelfClearance or None
         The smallest distance between links that can touch, over the set-points
         (:func:`dynid.excitation.collision.self_clearance`; None for a chain too short to fold onto itself).
+    cell_clearance : list of ConstraintMargin
+        The links' smallest distance to each of the cell's bodies over the set-points
+        (:func:`dynid.excitation.constraints.obstacle_margins`; empty without ``[[workspace.obstacles]]``).
     """
 
     config: ExcitationConfig
@@ -37,6 +41,7 @@ class ExcitationRun:
     dq: np.ndarray
     ddq: np.ndarray
     self_clearance: SelfClearance | None = None
+    cell_clearance: tuple[ConstraintMargin, ...] = ()
 
     def to_dict(self) -> dict:
         """The run as ``excitation.json``.
@@ -59,6 +64,7 @@ class ExcitationRun:
             "trajectory": self.design.trajectory.to_dict(form=c.form),
             "design": {k: v for k, v in self.design.to_dict(form=c.form).items() if k != "trajectory"},
             **({} if self.self_clearance is None else {"self_clearance": self.self_clearance.to_dict()}),
+            **({"cell_clearance": [m.to_dict() for m in self.cell_clearance]} if self.cell_clearance else {}),
         }
 
 
@@ -81,8 +87,10 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     t = np.arange(n + 1) / config.rate  # both ends: the controller's last set-point is the start again
     q, dq, ddq = design.trajectory.evaluate(t)
     every = max(1, int(np.ceil(t.size / CLEARANCE_SAMPLES)))  # the set-points, at most this many of them
-    clearance = self_clearance(config.problem.robot, t[::every], q[::every], config.problem.workspace.clearance)
-    return ExcitationRun(config, design, t, q, dq, ddq, clearance)
+    p = config.problem
+    clearance = self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance)
+    cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
+    return ExcitationRun(config, design, t, q, dq, ddq, clearance, cell)
 
 
 CLEARANCE_SAMPLES = 2000

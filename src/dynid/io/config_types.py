@@ -270,6 +270,18 @@ class LimitsTable(Table, kw_only=True):
     tau_max: Annotated[PerJointNumber, _d("N·m")] | None = None
 
 
+class ObstacleTable(Table, kw_only=True):
+    """``[[workspace.obstacles]]``: one body of the robot's cell, in the base frame [m]."""
+
+    shape: Annotated[Literal["box", "cylinder", "sphere"], _d("the body's shape")]
+    size: Annotated[list[float], Meta(min_length=1, max_length=3, description="box: full lengths [x, y, z]; cylinder: "
+                                                                         "[radius, length] along its z; sphere: [radius], m")]
+    position: Annotated[list[float], Meta(min_length=3, max_length=3, description="its centre [x, y, z], m")]
+    rpy: Annotated[list[float], Meta(min_length=3, max_length=3, description="roll, pitch, yaw about the base's fixed "
+                                                                        "axes, rad (default 0)")] | None = None
+    name: Annotated[str, _d("named in messages (default obstacle 1, 2 …)")] | None = None
+
+
 class WorkspaceTable(Table, kw_only=True):
     """``[workspace]``: where the tool point may go, base frame [m]."""
 
@@ -280,6 +292,7 @@ class WorkspaceTable(Table, kw_only=True):
     clearance: Annotated[float, Meta(ge=0.0, description="how far every link stays above the floor, m (its capsule's "
                                                          "radius about the segment between its joint origins); "
                                                          "default 0.05")] | None = None
+    obstacles: Annotated[list[ObstacleTable], _d("the cell's bodies every link keeps `clearance` off")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

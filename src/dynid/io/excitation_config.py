@@ -52,6 +52,7 @@ from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationProblem
 from ..excitation.fourier import FourierTrajectory
+from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
@@ -176,6 +177,9 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     if ws.clearance is not None:
         ws_kw["clearance"] = float(ws.clearance)
     try:
+        ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
+                                   np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
+                                   ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
         workspace = Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None

@@ -1026,7 +1026,7 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
                         f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
-    out += _self_clearance_lines(run)
+    out += _self_clearance_lines(run) + _cell_clearance_lines(run)
     relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
     tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
@@ -1054,6 +1054,22 @@ def _self_clearance_lines(run) -> list:
                      "lower the amplitudes", "warning")]
     return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:g} m capsules "
                  f"(closest: {where}; {c.pairs} pairs checked on the set-points)")]
+
+
+def _cell_clearance_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links come to the cell's bodies at the set-points
+    (:func:`dynid.excitation.constraints.obstacle_margins`): a warning where a capsule reaches one."""
+    found = list(getattr(run, "cell_clearance", ()))
+    if not found:
+        return []
+    radius = run.config.problem.workspace.clearance
+    low = min(found, key=lambda m: m.worst)
+    if low.worst < 0:
+        return [Line(f"a link comes within {radius:g} m of the cell at a set-point: {low.where} (by {-low.worst:.3g} m, "
+                     "between the verification grid's samples): do not run it; raise design.grid_points", "warning")]
+    n = len(run.config.problem.workspace.obstacles)
+    return [Line(f"every link's {radius:g} m capsule stays {low.worst:.3g} m or more off the cell at the set-points "
+                 f"({n} {'body' if n == 1 else 'bodies'}; closest: {low.where})")]
 
 
 def _cell(value, fmt: str = ".3g") -> str:

@@ -1,0 +1,158 @@
+"""The cell's bodies in the excitation design: distances against a brute-force truth, their gradients, the reach
+bound, a design that keeps clear of a body its collision-free counterpart crosses, and the errors a user sees."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.kinematics import forward_kinematics
+from dynid.exceptions import ConfigError
+from dynid.excitation.constraints import Workspace
+from dynid.excitation.design import ExcitationProblem, design_excitation
+from dynid.excitation.obstacles import Obstacle, obstacle_distances, reachable_pairs
+from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
+from dynid.identification.excitation_run import run_excitation
+from dynid.io.excitation_config import load_excitation_config
+from dynid.model.description import load_robot
+from dynid.report.summaries import excitation_blocks
+
+RADIUS = 0.05
+
+
+@pytest.fixture(scope="module")
+def er16():
+    return load_robot("er16")
+
+
+def _segment_points(robot, q, samples=4001):
+    """(N, n_dof, samples, 3): points along each link's segment, from forward kinematics alone."""
+    rots, orig = forward_kinematics(robot, q)
+    flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
+    ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
+    s = np.linspace(0.0, 1.0, samples)[None, None, :, None]
+    return orig[:, :, None] + s * (ends - orig)[:, :, None]
+
+
+def _brute_force(robot, q, ob):
+    """(N, n_dof) surface distance of each link's capsule to an axis-aligned box (outside it) or a sphere."""
+    pts = _segment_points(robot, q)
+    if ob.shape == "sphere":
+        return np.linalg.norm(pts - ob.position, axis=-1).min(axis=-1) - ob.size[0] - RADIUS
+    half = 0.5 * ob.size
+    gap = np.maximum(np.abs(pts - ob.position) - half, 0.0)
+    return np.linalg.norm(gap, axis=-1).min(axis=-1) - RADIUS
+
+
+BOX = Obstacle("box", np.array([0.4, 0.5, 0.3]), np.array([0.9, 0.3, 0.2]), name="table")
+BALL = Obstacle("sphere", np.array([0.2]), np.array([0.6, 0.4, 1.0]), name="ball")
+POST = Obstacle("cylinder", np.array([0.1, 1.0]), np.array([0.5, -0.6, 0.5]), np.array([0.3, 0.0, 0.2]), name="post")
+
+
+def test_distances_equal_a_brute_force_segment_distance(er16, rng):
+    q = rng.uniform(-1.5, 1.5, (40, er16.n_dof))
+    found = obstacle_distances(er16, q, [BOX, BALL], RADIUS)
+    truth = {i: _brute_force(er16, q, ob) for i, ob in enumerate([BOX, BALL])}
+    checked = 0
+    for c, (k, i) in enumerate(found.pairs):
+        d = found.distance[:, c]
+        keep = d > 1e-3 if i == 0 else np.ones(d.size, bool)  # the brute force reads 0 inside the box
+        np.testing.assert_allclose(d[keep], truth[i][keep, k], atol=1e-5)
+        checked += keep.sum()
+    assert checked > 200
+    assert (found.distance < 0).any() and (found.distance > 0).any()  # both sides of contact were met
+
+
+def test_gradients_equal_finite_differences(er16, rng):
+    q = rng.uniform(-1.5, 1.5, (25, er16.n_dof))
+    bodies = [BOX, BALL, POST]
+    found = obstacle_distances(er16, q, bodies, RADIUS, gradient=True)
+    h = 1e-6
+    fd = np.zeros_like(found.gradient)
+    for j in range(er16.n_dof):
+        e = np.zeros(er16.n_dof)
+        e[j] = h
+        up = obstacle_distances(er16, q + e, bodies, RADIUS, pairs=found.pairs).distance
+        down = obstacle_distances(er16, q - e, bodies, RADIUS, pairs=found.pairs).distance
+        fd[:, :, j] = (up - down) / (2 * h)
+    outside = found.distance > 1e-3  # away from contact: overlap depth is not smooth where the medial axis turns
+    exact = np.array([i != 2 for _, i in found.pairs])[None, :] & outside
+    np.testing.assert_allclose(found.gradient[exact], fd[exact], atol=1e-7)
+    cyl = np.array([i == 2 for _, i in found.pairs])[None, :] & outside  # coal measures a cylinder by GJK, to 1e-9
+    np.testing.assert_allclose(found.gradient[cyl], fd[cyl], atol=1e-3)
+
+
+def test_the_reach_bound_leaves_out_only_pairs_that_cannot_touch(er16, rng):
+    far = Obstacle("sphere", np.array([0.3]), np.array([1.9, 0.0, 0.5]), name="far")
+    pairs = reachable_pairs(er16, [BOX, far], RADIUS)
+    left_out = [(k, i) for k in range(er16.n_dof) for i in range(2) if (k, i) not in pairs]
+    assert any(i == 1 for _, i in left_out) and any(i == 1 for _, i in pairs)  # the far body: only the outer links
+    lo = np.where(np.isfinite(er16.limits.q_min), er16.limits.q_min, -np.pi)
+    hi = np.where(np.isfinite(er16.limits.q_max), er16.limits.q_max, np.pi)
+    q = lo + rng.random((500, er16.n_dof)) * (hi - lo)
+    every = obstacle_distances(er16, q, [BOX, far], RADIUS, pairs=left_out)
+    assert every.distance.min() > 0
+
+
+def test_the_design_keeps_clear_of_a_body_beta1_passes_through():
+    """A ball on β1's wrist path: β1 goes through it, the design from β1 keeps every link clear on a 10× finer
+    grid by the brute-force distance."""
+    robot = load_robot("er16").submodel(3)
+    beta1 = paper_identification_trajectory()
+    ball = Obstacle("sphere", np.array([0.15]), np.array([0.609, 0.161, 1.274]), name="lamp")
+    prob = ExcitationProblem(robot, PAPER_OMEGA_F, 5, offsets=beta1.q0, workspace=Workspace(obstacles=(ball,)))
+    t = np.linspace(0, beta1.period, 10 * prob.grid_points, endpoint=False)
+    assert _brute_force(robot, beta1.evaluate(t)[0], ball).min() < -0.05
+    [before] = [m for m in prob.margins(beta1) if m.constraint.startswith("obstacle")]
+    assert not before.satisfied and before.where.startswith("lamp: link 3")
+    design = design_excitation(prob, n_starts=1, rng=0, initial=beta1)
+    assert design.feasible
+    assert _brute_force(robot, design.trajectory.evaluate(t)[0], ball).min() >= -1e-6
+    assert design.cond < design.initial_cond
+
+
+def test_a_start_pose_inside_a_body_is_refused_in_one_line(er16):
+    q0 = np.zeros(er16.n_dof)
+    wrist = forward_kinematics(er16, q0[None])[1][0, 4]
+    inside = Obstacle("box", np.array([0.2, 0.2, 0.2]), wrist, name="fixture")
+    with pytest.raises(ConfigError, match=r"start pose .* obstacle 'fixture'") as err:
+        ExcitationProblem(er16, PAPER_OMEGA_F, 2, offsets=q0, workspace=Workspace(obstacles=(inside,)))
+    assert "\n" not in str(err.value)
+
+
+def test_config_reads_obstacles_and_names_a_bad_one(tmp_path: Path):
+    body = """robot = "er16"
+joints = 3
+[design]
+starts = 1
+maxiter = 20
+[trajectory]
+harmonics = 2
+frequency = 0.1
+[[workspace.obstacles]]
+name = "table"
+shape = "box"
+size = [1.0, 1.0, 0.1]
+position = [0.0, 1.2, -0.3]
+[[workspace.obstacles]]
+shape = "cylinder"
+size = [0.1, 1.5]
+position = [1.0, 0.0, 0.0]
+rpy = [0.0, 1.5707963, 0.0]
+"""
+    good = tmp_path / "good.toml"
+    good.write_text(body)
+    ws = load_excitation_config(good).problem.workspace
+    assert [ob.name for ob in ws.obstacles] == ["table", "obstacle 2"]
+    assert ws.to_dict()["obstacles"][1]["rpy"] == [0.0, 1.5707963, 0.0]
+    run = run_excitation(load_excitation_config(good))  # the set-points checked again, and said
+    table = [m for m in run.cell_clearance if m.where.startswith("table")]
+    assert table and table[0].worst == pytest.approx(
+        obstacle_distances(run.config.problem.robot, run.q, ws.obstacles, ws.clearance).distance[
+            :, [c for c, (_, i) in enumerate(reachable_pairs(run.config.problem.robot, ws.obstacles, ws.clearance)) if i == 0]].min())
+    assert run.to_dict()["cell_clearance"][0]["where"].startswith("table")
+    assert any("off the cell at the set-points" in getattr(line, "text", "") for line in excitation_blocks(run))
+    bad = tmp_path / "bad.toml"
+    bad.write_text(body.replace("size = [0.1, 1.5]", "size = [0.1]"))
+    with pytest.raises(ConfigError, match=r"bad\.toml: obstacle 'obstacle 2': size: a cylinder takes 2 positive"):
+        load_excitation_config(bad)
