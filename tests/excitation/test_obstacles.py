@@ -15,6 +15,7 @@ from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identificat
 from dynid.identification.excitation_run import run_excitation
 from dynid.io.excitation_config import load_excitation_config
 from dynid.model.description import load_robot
+from dynid.report.excitation_run import save_excitation
 from dynid.report.summaries import excitation_blocks
 
 RADIUS = 0.05
@@ -152,6 +153,9 @@ rpy = [0.0, 1.5707963, 0.0]
             :, [c for c, (_, i) in enumerate(reachable_pairs(run.config.problem.robot, ws.obstacles, ws.clearance)) if i == 0]].min())
     assert run.to_dict()["cell_clearance"][0]["where"].startswith("table")
     assert any("off the cell at the set-points" in getattr(line, "text", "") for line in excitation_blocks(run))
+    written = {p.name for p in save_excitation(run, tmp_path / "out")}  # seen before it runs: the cell and the distances
+    assert {"excitation_tool_path.png", "excitation_clearance.png"} <= written
+    assert "How close the links come to the floor and the cell" in (tmp_path / "out" / "report.html").read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text(body.replace("size = [0.1, 1.5]", "size = [0.1]"))
     with pytest.raises(ConfigError, match=r"bad\.toml: obstacle 'obstacle 2': size: a cylinder takes 2 positive"):

@@ -88,7 +88,12 @@ class Obstacle:
         return shape, coal.Transform3s(Rotation.from_euler("xyz", self.rpy).as_matrix(), self.position)
 
     def bounding_radius(self) -> float:
-        """Radius of a sphere about :attr:`position` that holds the body [m]."""
+        """Radius of a sphere about :attr:`position` that holds the body.
+
+        Returns
+        -------
+        float [m]
+        """
         s = self.size
         return float({"box": lambda: 0.5 * np.linalg.norm(s), "cylinder": lambda: np.hypot(s[0], 0.5 * s[1]),
                       "sphere": lambda: s[0]}[self.shape]())

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..dynamics.kinematics import tool_positions
+import numpy as np
+
+from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
+from ..excitation.obstacles import obstacle_distances
 from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
@@ -14,7 +17,9 @@ from .output import save_figure, staged, write_results
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
-    "excitation_tool_path.png": "3-D tool path in the workspace (cf. paper Fig. 5)",
+    "excitation_tool_path.png": "3-D tool path in the workspace and the cell's bodies (cf. paper Fig. 5)",
+    "excitation_clearance.png": "the links' smallest distance to the floor and to each of the cell's bodies over time "
+                                "(with a floor or [[workspace.obstacles]])",
 }
 
 
@@ -36,15 +41,20 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     for label, traj in (("optimised", design.trajectory), (f"initial ({run.config.initial_label})", design.initial)):
         q, dq, ddq = traj.evaluate(t)
         states[label] = (q, dq, ddq, regressor(robot, q, dq, ddq) @ problem.phi)
-    paths = [out / name for name in FIGURES]
+    ws = problem.workspace
+    clearance = _clearance_series(robot, t, states["optimised"][0], ws)
+    paths = [out / name for name in FIGURES if clearance or name != "excitation_clearance.png"]
     save_figure(figures.plot_excitation_states(
         t, states, problem.limits, title=f"{robot.name}: optimised excitation, cond(W_base) {design.initial_cond:.1f} → "
                                           f"{design.cond:.1f} (dotted: limits)"), paths[0])
     box = (problem.workspace.box_min, problem.workspace.box_max)
     paths_xyz = {label: tool_positions(robot, s[0]) for label, s in states.items()}
     optimised = paths_xyz.pop("optimised")
-    save_figure(figures.plot_tool_path(optimised, others=paths_xyz, box=box, floor=problem.workspace.floor,
+    save_figure(figures.plot_tool_path(optimised, others=paths_xyz, box=box, floor=ws.floor, obstacles=ws.obstacles,
                                        title=f"{robot.name}: tool path of the optimised excitation"), paths[1])
+    if clearance:
+        save_figure(figures.plot_clearance(t, clearance, title=f"{robot.name}: how close the links come to the cell "
+                                                               f"(beyond their {ws.clearance:g} m capsules)"), paths[2])
     csv_path = out / "excitation.csv"
     write_trajectory_csv(csv_path, run.t, run.q, run.dq, run.ddq)
     json_path = out / "excitation.json"
@@ -52,3 +62,18 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     write_results(json_path, data, "excite")
     write_html_report(out / "report.html", data, "excite", paths, f"dynid excite — {robot.name}")
     return [json_path, csv_path, out / "report.html"] + paths
+
+
+def _clearance_series(robot, t: np.ndarray, q: np.ndarray, ws) -> dict:
+    """label -> (N,) the links' smallest distance beyond their capsules to the floor and to each body, on ``t``."""
+    out = {}
+    moving = ws.moving_origins(robot)
+    if moving.size:
+        out["floor (lowest joint origin)"] = forward_kinematics(robot, q)[1][:, moving, 2].min(axis=1) - ws.floor - ws.clearance
+    if ws.obstacles:
+        found = obstacle_distances(robot, q, ws.obstacles, ws.clearance)
+        for i, ob in enumerate(ws.obstacles):
+            cols = [c for c, (_, o) in enumerate(found.pairs) if o == i]
+            if cols:
+                out[ob.name] = found.distance[:, cols].min(axis=1)
+    return out

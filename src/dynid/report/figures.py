@@ -81,7 +81,8 @@ def plot_joint_trajectories(t, q, q_min=None, q_max=None, ax=None, title="Excita
     return axes
 
 
-def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory", others=None, box=None, floor=None):
+def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory", others=None, box=None, floor=None,
+                   obstacles=()):
     """3-D path of the tool point (paper Fig. 5).
 
     Parameters
@@ -97,12 +98,16 @@ def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory",
         The workspace box; its finite edges are drawn.
     floor : float, optional
         Height of a floor plane drawn under the paths [m].
+    obstacles : sequence of dynid.excitation.obstacles.Obstacle
+        The cell's bodies, drawn as wireframes.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     ax = _axes(ax, projection="3d", figsize=(7, 6))
+    for k, ob in enumerate(obstacles):
+        _draw_obstacle(ax, ob, label="the cell's bodies" if k == 0 else None)
     for label, path in (others or {}).items():
         ax.plot(path[:, 0], path[:, 1], path[:, 2], lw=0.8, ls="--", color="gray", label=label)
     ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], lw=1.0, label="tool path" if others else None)
@@ -126,6 +131,56 @@ def plot_tool_path(xyz, ax=None, title="Tool path of the excitation trajectory",
     ax.set_title(title)
     ax.legend()
     return ax
+
+
+def _draw_obstacle(ax, ob, label=None) -> None:
+    """A box's edges, or a cylinder's or sphere's wireframe, in its pose (:meth:`Obstacle.geometry`)."""
+    rot = np.asarray(ob.geometry()[1].getRotation())
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 16), np.linspace(0, 1, 7))
+    if ob.shape == "box":
+        half = 0.5 * ob.size
+        corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+        pts = corners @ rot.T + ob.position
+        edges = [(i, k) for i in range(8) for k in range(i + 1, 8) if np.sum(corners[i] != corners[k]) == 1]
+        for n, (i, k) in enumerate(edges):
+            ax.plot(*pts[[i, k]].T, color="tab:purple", lw=1.0, label=label if n == 0 else None)
+        return
+    if ob.shape == "cylinder":
+        local = np.stack([ob.size[0] * np.cos(u), ob.size[0] * np.sin(u), (v - 0.5) * ob.size[1]], axis=-1)
+    else:
+        polar = np.pi * v
+        local = ob.size[0] * np.stack([np.sin(polar) * np.cos(u), np.sin(polar) * np.sin(u), np.cos(polar)], axis=-1)
+    pts = local @ rot.T + ob.position
+    ax.plot_wireframe(pts[..., 0], pts[..., 1], pts[..., 2], color="tab:purple", lw=0.6, label=label)
+
+
+def plot_clearance(t, series: dict, ax=None, title="How close the links come to the cell"):
+    """Smallest distance over time to each of the cell's bodies and to the floor (issue "An excitation safe to run
+    on the real robot", item 3).
+
+    Parameters
+    ----------
+    t : (N,) array [s]
+    series : dict
+        label -> (N,) distances [m] beyond the links' capsules (below 0: inside the clearance).
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    a = np.atleast_1d(_axes(ax, figsize=(8, 4)))[0]
+    for label, d in series.items():
+        a.plot(t, d, lw=1.0, label=label)
+    a.axhline(0.0, color="tab:red", lw=0.8, ls=":", label="the clearance")
+    a.set_xlabel("t [s]")
+    a.set_ylabel("distance beyond the capsules [m]")
+    a.set_title(title)
+    a.grid(alpha=0.3)
+    a.legend()
+    return a
 
 
 def plot_convergence(histories, ax=None, reference=None, title="ABC convergence", xlabel="iteration"):

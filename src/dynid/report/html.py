@@ -433,6 +433,7 @@ CAPTIONS = {"identification_fit": "Measured and predicted torques on the identif
             "fig9_torques_validation": "Measured and predicted torques on β2 (Figure 9)",
             "methods_comparison": "The estimators compared", "methods_convergence": "Convergence of the box searches",
             "excitation_joints": "The excitation against the joints' limits", "excitation_tool_path": "Tool path of the excitation",
+            "excitation_clearance": "How close the links come to the floor and the cell",
             "montecarlo_std_vs_crb": "Spread of each estimator against the Cramér–Rao bound",
             "montecarlo_noise_levels": "Spread against the noise level"}
 

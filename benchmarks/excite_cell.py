@@ -1,0 +1,165 @@
+"""Benchmark: excitation designs in a cell (issue "An excitation safe to run on the real robot", targets).
+
+Four public arm descriptions of example-robot-data (UR5, Panda, Kinova Jaco 2, Unitree Z1; installed by the ``zoo``
+extra) stand on a table (``[workspace] floor`` at the base's height) with one box within reach. For each arm and
+seed, dynid designs the excitation twice: with the box and without it. Reported per arm:
+
+- how many designs with the box have a link capsule inside the box or a joint origin under the floor's clearance,
+  on a 1 kHz check of one period by an independent brute force (points every 0.5 mm along each link's segment, the
+  distance to the axis-aligned box by clipping) — target 0;
+- how many collision-free designs cross the box (the box binds for those seeds);
+- cond(W_base) with the box against without, on the seeds where the box does not bind (target ≤ 1.5×) and where it
+  does;
+- the design time with the box against without, measured in this run (target ≤ 3×).
+
+Not checked here: the descriptions' own collision meshes and a MuJoCo contact check (the links are the capsules of
+:mod:`dynid.excitation.obstacles`).
+
+    python benchmarks/excite_cell.py --seeds 20
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parent
+sys.path.insert(0, str(REPO / "zoo"))
+
+from zoo import ARMS, arm_urdf, robots_folder  # noqa: E402
+
+from dynid.dynamics.kinematics import forward_kinematics  # noqa: E402
+from dynid.exceptions import ConfigError  # noqa: E402
+from dynid.excitation.constraints import Workspace  # noqa: E402
+from dynid.excitation.design import ExcitationProblem, InfeasibleDesignError, design_excitation  # noqa: E402
+from dynid.excitation.obstacles import Obstacle  # noqa: E402
+from dynid.model.description import load_robot  # noqa: E402
+from dynid.threads import with_single_blas_thread  # noqa: E402
+
+CELL_ARMS = ("UR5", "Panda", "Kinova Jaco 2", "Unitree Z1")
+CLEARANCE = 0.05
+HARMONICS, FREQUENCY, GRID, STARTS, MAXITER = 3, 0.1, 60, 2, 100
+
+
+def _arm(name: str, folder: Path):
+    file, keep = ARMS[name]
+    path = folder / f"{name.replace(' ', '_')}.urdf"
+    path.write_text(arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep))
+    robot = load_robot(str(path))
+    lim = robot.limits
+    from dataclasses import replace
+    lo, hi = np.maximum(lim.q_min, -np.pi), np.minimum(lim.q_max, np.pi)
+    # a first, cautious run: half the rated speed, 3 rad/s², the description's torques
+    return replace(robot, limits=replace(lim, q_min=lo, q_max=hi, dq_max=np.minimum(0.5 * lim.dq_max, 1.5),
+                                         ddq_max=np.full(robot.n_dof, 3.0)))
+
+
+def _start(robot) -> np.ndarray:
+    """A start pose held up off the table: of 4000 random poses in the middle half of the joints' ranges (seed 0), the
+    one whose lowest moving joint origin and tool point are highest."""
+    lo, hi = robot.limits.q_min, robot.limits.q_max
+    q = 0.5 * (lo + hi) + (np.random.default_rng(0).random((4000, robot.n_dof)) - 0.5) * 0.5 * (hi - lo)
+    rots, orig = forward_kinematics(robot, q)
+    tool = orig[:, -1] + rots[:, -1] @ robot.tool_translation
+    z = np.concatenate([orig[:, :, 2], tool[:, None, 2]], axis=1)
+    z = z[:, np.ptp(z, axis=0) > 1e-6]
+    return q[int(np.argmax(z.min(axis=1)))]
+
+
+def _cell(robot) -> Workspace:
+    """A table at the base's height and a box of a fifth of the reach, half the reach from the base, off the start."""
+    reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
+    q0 = _start(robot)
+    base_z = float(forward_kinematics(robot, np.zeros((1, robot.n_dof)))[1][0, 0, 2])
+    for angle in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        centre = np.array([0.5 * reach * np.cos(angle), 0.5 * reach * np.sin(angle), base_z + 0.25 * reach])
+        box = Obstacle("box", np.full(3, 0.2 * reach), centre, name="box")
+        ws = Workspace(floor=base_z - 1e-3, clearance=CLEARANCE, obstacles=(box,))
+        try:
+            ExcitationProblem(robot, 2 * np.pi * FREQUENCY, HARMONICS, offsets=q0, workspace=ws, rest=True, grid_points=GRID)
+            return ws
+        except ConfigError as exc:  # the start pose touches it: turn it about the base
+            print(f"  {robot.name}: {exc}")
+            continue
+    raise SystemExit(f"{robot.name}: no place for the box off the start pose")
+
+
+def _brute_force(robot, q, ws: Workspace) -> tuple[float, float]:
+    """Smallest capsule-to-box distance and smallest joint-origin height above floor + clearance, independently."""
+    rots, orig = forward_kinematics(robot, q)
+    flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
+    ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
+    length = np.linalg.norm(ends - orig, axis=-1).max()
+    s = np.linspace(0.0, 1.0, max(2, int(length / 5e-4)))
+    box = ws.obstacles[0]
+    best = np.inf
+    for k in range(robot.n_dof):
+        pts = orig[:, k, None] + s[None, :, None] * (ends[:, k] - orig[:, k])[:, None]
+        gap = np.maximum(np.abs(pts - box.position) - 0.5 * box.size, 0.0)
+        best = min(best, float(np.linalg.norm(gap, axis=-1).min()) - CLEARANCE)
+    z = orig[:, :, 2]
+    moving = np.ptp(z, axis=0) > 1e-6
+    return best, float((z[:, moving] - ws.floor - CLEARANCE).min())
+
+
+def _design(robot, ws: Workspace, seed: int):
+    q0 = _start(robot)
+    prob = ExcitationProblem(robot, 2 * np.pi * FREQUENCY, HARMONICS, offsets=q0, workspace=ws, rest=True, grid_points=GRID)
+    t0 = time.perf_counter()
+    design = design_excitation(prob, n_starts=STARTS, rng=seed, maxiter=MAXITER)
+    return design, time.perf_counter() - t0
+
+
+@with_single_blas_thread
+def run_arm(name: str, seeds: int, folder: Path) -> dict:
+    robot = _arm(name, folder)
+    ws = _cell(robot)
+    free_ws = Workspace(floor=ws.floor, clearance=CLEARANCE)
+    rows = []
+    for seed in range(seeds):
+        try:
+            with_box, t_box = _design(robot, ws, seed)
+            without, t_free = _design(robot, free_ws, seed)
+        except InfeasibleDesignError as exc:  # refused, not written as if safe: counted apart
+            rows.append(dict(seed=seed, refused=str(exc)))
+            print(f"  {name} seed {seed}: refused: {exc}", flush=True)
+            continue
+        t = np.arange(int(round(1000 / FREQUENCY))) / 1000.0  # one period at 1 kHz
+        box_d, floor_d = _brute_force(robot, with_box.trajectory.evaluate(t)[0], ws)
+        free_d, _ = _brute_force(robot, without.trajectory.evaluate(t)[0], ws)
+        rows.append(dict(seed=seed, refused=None, box=box_d, floor=floor_d, crossed=free_d < 0, cond=with_box.cond,
+                         cond_free=without.cond, time=t_box, time_free=t_free))
+        print(f"  {name} seed {seed}: box {box_d:+.4f} m, floor {floor_d:+.4f} m, collision-free design "
+              f"{free_d:+.4f} m; cond {with_box.cond:.1f} / {without.cond:.1f}; {t_box:.1f} / {t_free:.1f} s", flush=True)
+    return dict(name=name, n=robot.n_dof, rows=rows)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--arms", default=",".join(CELL_ARMS))
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        results = [run_arm(name, args.seeds, Path(tmp)) for name in args.arms.split(",")]
+    print("\n| arm | joints | seeds | in the box or under the floor (1 kHz) | free design crosses the box | "
+          "cond ratio, box does not bind | cond ratio, box binds | time ratio (median) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in results:
+        refused = sum(x["refused"] is not None for x in r["rows"])
+        rows = [x for x in r["rows"] if x["refused"] is None]
+        bad = sum(x["box"] < -1e-6 or x["floor"] < -1e-6 for x in rows)
+        free = [x["cond"] / x["cond_free"] for x in rows if not x["crossed"]]
+        bind = [x["cond"] / x["cond_free"] for x in rows if x["crossed"]]
+        span = lambda v: f"{min(v):.2f}-{max(v):.2f}" if v else "—"  # noqa: E731
+        ratio = np.median([x["time"] / x["time_free"] for x in rows])
+        print(f"| {r['name']} | {r['n']} | {len(rows)} (+{refused} refused) | {bad} | {sum(x['crossed'] for x in rows)} | {span(free)} | "
+              f"{span(bind)} | {ratio:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
