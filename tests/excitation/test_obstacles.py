@@ -13,6 +13,7 @@ from dynid.excitation.design import ExcitationProblem, design_excitation
 from dynid.excitation.obstacles import Obstacle, obstacle_distances, reachable_pairs
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
 from dynid.identification.excitation_run import run_excitation
+from dynid.io.cell_replay import cell_contacts, cell_mjcf
 from dynid.io.excitation_config import load_excitation_config
 from dynid.model.description import load_robot
 from dynid.report.excitation_run import save_excitation
@@ -110,6 +111,26 @@ def test_the_design_keeps_clear_of_a_body_beta1_passes_through():
     assert design.feasible
     assert _brute_force(robot, design.trajectory.evaluate(t)[0], ball).min() >= -1e-6
     assert design.cond < design.initial_cond
+    # checked twice: MuJoCo's collision detection finds β1 in the ball and the design clear of it
+    before, after = (cell_contacts(robot, t, traj.evaluate(t)[0], prob.workspace) for traj in (beta1, design.trajectory))
+    assert before.touching > 0 and before.first["body"] == "lamp" and before.deepest > 0.05
+    assert after.touching == 0 and after.deepest == 0.0
+
+
+def test_mujoco_places_the_capsules_on_dynids_skeleton(er16, rng):
+    """The MJCF of the cell check: MuJoCo's capsule centres equal the midpoints of dynid's link segments."""
+    import mujoco
+
+    q = rng.uniform(-1.5, 1.5, (5, er16.n_dof))
+    model = mujoco.MjModel.from_xml_string(cell_mjcf(er16, Workspace(obstacles=(BALL,))))
+    data = mujoco.MjData(model)
+    pts = _segment_points(er16, q, samples=3)
+    for n in range(q.shape[0]):
+        data.qpos[:] = q[n]
+        mujoco.mj_forward(model, data)
+        for k in range(er16.n_dof):
+            g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"link{k + 1}")
+            np.testing.assert_allclose(data.geom_xpos[g], pts[n, k, 1], atol=1e-9)
 
 
 def test_a_start_pose_inside_a_body_is_refused_in_one_line(er16):
@@ -160,3 +181,17 @@ rpy = [0.0, 1.5707963, 0.0]
     bad.write_text(body.replace("size = [0.1, 1.5]", "size = [0.1]"))
     with pytest.raises(ConfigError, match=r"bad\.toml: obstacle 'obstacle 2': size: a cylinder takes 2 positive"):
         load_excitation_config(bad)
+
+
+def test_mujoco_and_coal_agree_on_a_turned_cylinder_and_box(er16, rng):
+    """The second check sees the bodies where the first does: a pose touches in MuJoCo exactly when coal's distance is
+    below zero (poses within a millimetre of contact left out), for bodies turned by their rpy."""
+    turned_box = Obstacle("box", np.array([0.5, 0.2, 0.3]), np.array([0.7, 0.2, 0.4]), np.array([0.0, 0.4, 0.8]), name="crate")
+    bodies = (POST, turned_box)
+    q = rng.uniform(-1.5, 1.5, (120, er16.n_dof))
+    coal_d = obstacle_distances(er16, q, bodies, RADIUS).distance.min(axis=1)
+    clear = np.abs(coal_d) > 1e-3
+    ws = Workspace(obstacles=bodies)
+    touching = np.array([cell_contacts(er16, np.zeros(1), q[n:n + 1], ws).touching > 0 for n in range(q.shape[0])])
+    assert (coal_d[clear] < 0).sum() >= 10 and (coal_d[clear] > 0).sum() >= 10
+    np.testing.assert_array_equal(touching[clear], coal_d[clear] < 0)

@@ -11,6 +11,7 @@ import numpy as np
 from ..excitation.collision import SelfClearance, self_clearance
 from ..excitation.constraints import ConstraintMargin, obstacle_margins
 from ..excitation.design import ExcitationDesign, design_excitation
+from ..io.cell_replay import CellContacts, cell_contacts
 from ..io.excitation_config import ExcitationConfig
 
 
@@ -32,6 +33,9 @@ class ExcitationRun:
     cell_clearance : list of ConstraintMargin
         The links' smallest distance to each of the cell's bodies over the set-points
         (:func:`dynid.excitation.constraints.obstacle_margins`; empty without ``[[workspace.obstacles]]``).
+    mujoco_contacts : CellContacts or None
+        The set-points checked a second time by MuJoCo (:func:`dynid.io.cell_replay.cell_contacts`; None without a
+        floor or bodies, or without MuJoCo).
     """
 
     config: ExcitationConfig
@@ -42,6 +46,7 @@ class ExcitationRun:
     ddq: np.ndarray
     self_clearance: SelfClearance | None = None
     cell_clearance: tuple[ConstraintMargin, ...] = ()
+    mujoco_contacts: CellContacts | None = None
 
     def to_dict(self) -> dict:
         """The run as ``excitation.json``.
@@ -65,6 +70,7 @@ class ExcitationRun:
             "design": {k: v for k, v in self.design.to_dict(form=c.form).items() if k != "trajectory"},
             **({} if self.self_clearance is None else {"self_clearance": self.self_clearance.to_dict()}),
             **({"cell_clearance": [m.to_dict() for m in self.cell_clearance]} if self.cell_clearance else {}),
+            **({} if self.mujoco_contacts is None else {"mujoco_contacts": self.mujoco_contacts.to_dict()}),
         }
 
 
@@ -90,7 +96,7 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     p = config.problem
     clearance = self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance)
     cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
-    return ExcitationRun(config, design, t, q, dq, ddq, clearance, cell)
+    return ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace))
 
 
 CLEARANCE_SAMPLES = 2000

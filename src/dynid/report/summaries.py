@@ -1026,7 +1026,7 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
                         f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
-    out += _self_clearance_lines(run) + _cell_clearance_lines(run)
+    out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run)
     relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
     tight = min(relative, key=lambda m: m.relative) if relative else None
     held = d.feasible
@@ -1070,6 +1070,24 @@ def _cell_clearance_lines(run) -> list:
     n = len(run.config.problem.workspace.obstacles)
     return [Line(f"every link's {radius:g} m capsule stays {low.worst:.3g} m or more off the cell at the set-points "
                  f"({n} {'body' if n == 1 else 'bodies'}; closest: {low.where})")]
+
+
+def _mujoco_lines(run) -> list:
+    """:func:`excitation_blocks`' line on the second check, MuJoCo's contacts at the set-points
+    (:func:`dynid.io.cell_replay.cell_contacts`)."""
+    ws = run.config.problem.workspace
+    if not ws.obstacles and not math.isfinite(ws.floor):
+        return []
+    found = getattr(run, "mujoco_contacts", None)
+    if found is None:
+        return [Line("the set-points were checked against the cell once: MuJoCo is not installed for the second check "
+                     "(pip install 'dynid[mujoco]')")]
+    if found.touching:
+        f = found.first
+        return [Line(f"MuJoCo finds link {f['link']} touching {f['body']} at t = {f['time']:.3g} s ({found.touching} of "
+                     f"{found.set_points} set-points, up to {found.deepest:.3g} m deep): do not run it", "warning")]
+    return [Line(f"checked again by MuJoCo: no link's capsule touches the cell or the floor on the {found.set_points} "
+                 "set-points")]
 
 
 def _cell(value, fmt: str = ".3g") -> str:
