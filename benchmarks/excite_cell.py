@@ -5,7 +5,7 @@ extra) stand on a table (``[workspace] floor`` at the base's height) with one bo
 seed, dynid designs the excitation twice: with the box and without it. Reported per arm:
 
 - how many designs with the box have a link capsule inside the box or a joint origin under the floor's clearance,
-  on a 1 kHz check of one period by an independent brute force (points every 0.5 mm along each link's segment, the
+  on a 1 kHz check of one period by an independent brute force (points every millimetre along each link's segment, the
   distance to the axis-aligned box by clipping) — target 0;
 - how many collision-free designs cross the box (the box binds for those seeds);
 - cond(W_base) with the box against without, on the seeds where the box does not bind (target ≤ 1.5×) and where it
@@ -95,7 +95,7 @@ def _brute_force(robot, q, ws: Workspace) -> tuple[float, float]:
     flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
     ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
     length = np.linalg.norm(ends - orig, axis=-1).max()
-    s = np.linspace(0.0, 1.0, max(2, int(length / 5e-4)))
+    s = np.linspace(0.0, 1.0, max(2, int(length / 1e-3)))
     box = ws.obstacles[0]
     best = np.inf
     for k in range(robot.n_dof):
