@@ -6,7 +6,9 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+from dynid.dynamics.regressor import regressor
 from dynid.io.replay import urdf_replay
 from dynid.io.urdf_write_back import urdf_written_back
 from dynid.model.description import load_robot
@@ -32,6 +34,23 @@ def test_the_written_urdf_reproduces_the_model_and_says_what_it_cannot_hold():
     assert check.relative_error < 1e-9
     assert check.missing == ("Ia", "offset")
     assert np.all(check.missing_share > 0) and check.missing_share.shape == (6,)
+
+
+def test_on_a_logs_states_the_replay_says_what_the_missing_terms_cost_against_the_measured_torque():
+    """States of a smooth motion, "measured" torque = dynid's whole model: the model is 0 % off and the URDF is off by
+    exactly the terms it cannot hold (Ia·q̈ + offset), computed here by hand."""
+    robot, phi = _estimate()
+    assert np.all(robot.coulomb_velocity == 0)  # the file's fc·sign(q̇) is the model's
+    t = np.linspace(0.0, 4.0, 400)[:, None]
+    w = np.arange(1, 7)[None, :]
+    q, dq, ddq = 0.5 * np.sin(w * t / 2), 0.25 * w * np.cos(w * t / 2), -0.125 * w**2 * np.sin(w * t / 2)
+    measured = regressor(robot, q, dq, ddq) @ phi
+    text, _ = urdf_written_back(URDF, robot, phi)
+    check = urdf_replay(text, robot, phi, states=(q, dq, ddq), measured=measured)
+    assert check.n_states == 400 and check.relative_error < 1e-9
+    assert check.model_vs_measured < 1e-9
+    by_hand = 100 * np.linalg.norm(0.2 * ddq + 0.5) / np.linalg.norm(measured)
+    assert check.file_vs_measured == pytest.approx(by_hand, rel=1e-6)
 
 
 def test_a_file_that_dropped_the_off_diagonal_inertia_is_caught():
@@ -61,6 +80,11 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     error = float(re.search(r"m\.xml read back by MuJoCo \(mj_inverse\): its torques equal dynid's model to (\S+) of "
                             r"their RMS", said).group(1))
     assert error < 1e-6 and "MuJoCo's frictionloss is a constraint" in said
+    # read back on the validation log's samples, and scored against its measured torques beside dynid's model
+    on_log = re.search(r"m\.urdf read back by Pinocchio: .*?\(the (\d+) samples of validation\).*?against the measured "
+                       r"torques the file is (\S+) % off, dynid's whole model (\S+) %", said)
+    assert on_log is not None and int(on_log.group(1)) > 100
+    assert float(on_log.group(2)) >= float(on_log.group(3)) > 0  # the file lacks the offset the model holds
     p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--mjcf", tmp_path / "f.xml", "--forward")
     assert p.returncode == 0, p.stderr
     simulated = re.search(r"f\.xml simulated in MuJoCo along validation \((\d+) samples.*? the torques it needs are (\S+) % "

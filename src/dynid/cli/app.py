@@ -383,9 +383,10 @@ def export(
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
         estimate = consistent_estimate(cfg.robot, identified, str(results))
-        checks = {path: _replayed(flag, text, estimate) for (flag, path), (_, text) in zip(targets, texts)}
+        log = _replay_log(cfg, identified, estimate[0])
+        checks = {path: _replayed(flag, text, estimate, log) for (flag, path), (_, text) in zip(targets, texts)}
         simulated = _simulated(cfg, identified, texts, targets, str(results)) if forward else None
-        return cfg, texts, moved, identified, checks, simulated
+        return cfg, texts, moved, identified, checks, simulated, None if log is None else log[0]
 
     def save(computed):
         from ..io.files import atomic_write_text
@@ -395,7 +396,7 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        cfg, _, moved, _, _, simulated = computed
+        cfg, _, moved, _, _, simulated, _ = computed
         robot = cfg.robot
         into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
@@ -416,8 +417,10 @@ def export(
                 rep.line(f"{path.name} not read back: {check}")
                 continue
             tool = "Pinocchio" if form == "URDF" else "MuJoCo (mj_inverse)"
+            where = (f"the {check.n_states} samples of {computed[6]}" if computed[6] else
+                     f"{check.n_states} random states within the joint limits")
             said = (f"{path.name} read back by {tool}: its torques equal dynid's model to {check.relative_error:.1e} "
-                    f"of their RMS ({check.n_states} random states within the joint limits)")
+                    f"of their RMS ({where})")
             if form == "MJCF" and check.frictionloss_gap:
                 said += (f"; MuJoCo's frictionloss is a constraint: its force there is {100 * check.frictionloss_gap:.3g} % "
                          "off frictionloss·sign(q̇)")
@@ -425,6 +428,9 @@ def export(
                 j = max(range(len(check.missing_share)), key=lambda k: check.missing_share[k])
                 said += (f"; what {form} cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
                          f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
+            if check.file_vs_measured is not None:
+                said += (f"; against the measured torques the file is {check.file_vs_measured:.3g} % off, dynid's whole "
+                         f"model {check.model_vs_measured:.3g} %")
             (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
         if simulated is not None:
             rep.line(simulated)
@@ -448,13 +454,30 @@ def _simulated(cfg, identified: dict, texts, targets, source: str) -> str:
             f"({check.simulated_vs_model:.3g} % between the two: MuJoCo's frictionloss, what MJCF cannot hold)")
 
 
-def _replayed(flag: str, text: str, estimate) -> tuple[str, object]:
+def _replay_log(cfg, identified: dict, robot):
+    """The states the written files are read back on: the config's first moving validation log
+    (:func:`dynid.identification.run.moving_validation`) as ``(name, (q, dq, ddq), tau)``, or None (random states)."""
+    from ..exceptions import DataError
+    from ..identification.run import moving_validation
+
+    try:
+        found = moving_validation(cfg, identified, robot) if cfg.validation else None
+    except DataError:  # a log that cannot be read here: the replay falls back to random states
+        return None
+    if found is None:
+        return None
+    name, (_, q, dq, ddq, tau) = found
+    return name, (q, dq, ddq), tau
+
+
+def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
     """The written file read back by its tool (:mod:`dynid.io.replay`): ``(format, ReplayCheck)``, or the format and
-    why it was not read back."""
+    why it was not read back. On ``log`` (:func:`_replay_log`) where given, else on random states."""
+    on = {} if log is None else {"states": log[1], "measured": log[2]}
     if flag == "--urdf":
         from ..io.replay import urdf_replay
 
-        return "URDF", urdf_replay(text, *estimate)
+        return "URDF", urdf_replay(text, *estimate, **on)
     try:
         import mujoco  # noqa: F401  the MJCF's own reader
     except ImportError:
@@ -462,7 +485,7 @@ def _replayed(flag: str, text: str, estimate) -> tuple[str, object]:
     from ..io.replay import mjcf_replay
 
     try:
-        return "MJCF", mjcf_replay(text, *estimate)
+        return "MJCF", mjcf_replay(text, *estimate, **on)
     except (ValueError, KeyError) as exc:  # a user's model whose meshes MuJoCo finds only beside the original
         return "MJCF", f"MuJoCo could not load it from its text ({str(exc).splitlines()[0]})"
 

@@ -443,17 +443,47 @@ def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str
     """
     from ..io.export import consistent_estimate
     from ..io.replay import mjcf_forward
-    from ..preprocessing.pipeline import prepare
 
     robot, phi = consistent_estimate(config.robot, identified, source)
+    found = moving_validation(config, identified, robot)
+    if found is None:
+        return None
+    name, (t, q, dq, ddq, tau) = found
+    return name, mjcf_forward(mjcf_text, robot, phi, t, q, dq, ddq, tau)
+
+
+def moving_validation(config: IdentificationConfig, identified: dict, robot=None):
+    """The config's first validation log that moves, prepared as ``dynid validate`` prepares it but without
+    decimation (every sample: a simulation or a replay follows them all).
+
+    Parameters
+    ----------
+    config : IdentificationConfig
+    identified : dict
+        results.json: the preparation it was identified with, carried over.
+    robot : Robot, optional
+        The model the log is read for (default the config's).
+
+    Returns
+    -------
+    (str, (t, q, dq, ddq, tau)) or None
+        The log's name and its arrays [s, rad, rad/s, rad/s², N·m]; None without a validation log that moves.
+
+    Raises
+    ------
+    DataError
+        A log that cannot be read.
+    """
+    from ..preprocessing.pipeline import prepare
+
+    robot = config.robot if robot is None else robot
     settings = replace(carried_over(stored_preprocessing(identified), config.preprocessing), decimation=1,
                        parallel_cutoff=0.0)  # every sample, as the simulation runs them
     for spec in config.validation:
         data = prepare(load_recording(spec, robot), settings, strict=False)
         if data.resting is not None and float(np.mean(data.resting)) >= 0.5:  # a log at rest shows no motion to follow
             continue
-        q, dq, ddq, tau = (np.asarray(x, dtype=float) for x in (data.q, data.dq, data.ddq, data.tau))
-        return spec.name, mjcf_forward(mjcf_text, robot, phi, np.asarray(data.t), q, dq, ddq, tau)
+        return spec.name, tuple(np.asarray(x, dtype=float) for x in (data.t, data.q, data.dq, data.ddq, data.tau))
     return None
 
 

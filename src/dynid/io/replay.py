@@ -46,6 +46,10 @@ class ReplayCheck:
     frictionloss_gap : float
         MJCF only: how far MuJoCo's ``frictionloss`` constraint force in ``mj_inverse`` is from
         ``frictionloss·sign(q̇)`` on the same states, over the norm of the latter (0 without dry friction).
+    file_vs_measured, model_vs_measured : float [%] or None
+        On a log's states (``measured`` given): the file's torques and dynid's whole model against the log's measured
+        torque, ``100·||τ - τ_measured|| / ||τ_measured||`` on the same samples. Their difference is what the format's
+        missing terms cost on that log.
     """
 
     relative_error: float
@@ -53,6 +57,8 @@ class ReplayCheck:
     missing_share: np.ndarray
     n_states: int
     frictionloss_gap: float = 0.0
+    file_vs_measured: float | None = None
+    model_vs_measured: float | None = None
 
 
 def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -67,7 +73,8 @@ def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray,
     return q, dq, ddq
 
 
-def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0) -> ReplayCheck:
+def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
+                measured=None) -> ReplayCheck:
     """Pinocchio's torques of a written URDF against dynid's torques of ``phi`` (module docstring).
 
     Parameters
@@ -82,6 +89,10 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         Random states compared.
     rng : int or Generator
         Seeds the states.
+    states : (q, dq, ddq) of (N, n_dof) arrays, optional
+        A log's states instead of random ones [rad, rad/s, rad/s²].
+    measured : (N, n_dof) array [N·m], optional
+        The log's measured torque on ``states``: the file and dynid's model are also scored against it.
 
     Returns
     -------
@@ -95,9 +106,9 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         model = pin.buildReducedModel(model, [model.getJointId(h) for h in robot.held], pin.neutral(model))
     data = model.createData()
     ids = [model.getJointId(j.name) for j in robot.joints]
-    q, dq, ddq = _states(robot, n_states, rng)
-    tau_file = np.empty((n_states, robot.n_dof))
-    for k in range(n_states):
+    q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
+    tau_file = np.empty(q.shape)
+    for k in range(q.shape[0]):
         qk, vk, ak = pin.neutral(model), np.zeros(model.nv), np.zeros(model.nv)
         for j, jid in enumerate(ids):
             iq, iv = model.joints[jid].idx_q, model.joints[jid].idx_v
@@ -109,12 +120,14 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         tau = pin.rnea(model, data, qk, vk, ak)
         idx = [model.joints[jid].idx_v for jid in ids]
         tau_file[k] = tau[idx] + model.damping[idx] * dq[k] + model.friction[idx] * np.sign(dq[k])
-    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS)
+    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS, measured)
 
 
-def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...]) -> ReplayCheck:
+def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...],
+              measured: np.ndarray | None = None) -> ReplayCheck:
     """The file's torques against dynid's of ``phi`` restricted to the links and the drive terms ``held_terms`` a format
-    holds (Coulomb friction with ``sign(q̇)``), and each joint's share of what the format cannot hold."""
+    holds (Coulomb friction with ``sign(q̇)``), each joint's share of what the format cannot hold, and both against
+    the ``measured`` torque where given."""
     q, dq, ddq = states
     full = regressor(robot, q, dq, ddq) @ phi
     coupled = set(robot.transmission.coupled_parameter_names) if robot.transmission.n_coupled_params else set()
@@ -129,10 +142,15 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
     rms = np.sqrt(np.mean(full**2, axis=0))
     share = 100.0 * np.sqrt(np.mean((full - model_tau) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     error = float(np.linalg.norm(tau_file - model_tau) / np.maximum(np.linalg.norm(model_tau), 1e-300))
-    return ReplayCheck(error, missing, share, q.shape[0])
+    if measured is None:
+        return ReplayCheck(error, missing, share, q.shape[0])
+    scale = max(float(np.linalg.norm(measured)), 1e-300)
+    return ReplayCheck(error, missing, share, q.shape[0], file_vs_measured=100.0 * float(np.linalg.norm(tau_file - measured)) / scale,
+                       model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale)
 
 
-def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0) -> ReplayCheck:
+def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
+                measured=None) -> ReplayCheck:
     """MuJoCo's torques of a written MJCF against dynid's torques of ``phi``: the links, ``armature`` (rotor inertia),
     ``damping`` (viscous friction) and ``frictionloss`` (Coulomb friction) (module docstring).
 
@@ -152,6 +170,10 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         The standard parameters written.
     n_states : int
     rng : int or Generator
+    states : (q, dq, ddq) of (N, n_dof) arrays, optional
+        A log's states instead of random ones [rad, rad/s, rad/s²].
+    measured : (N, n_dof) array [N·m], optional
+        The log's measured torque on ``states``: the file and dynid's model are also scored against it.
 
     Returns
     -------
@@ -170,18 +192,18 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     joints = [model.joint(j.name) for j in robot.joints]
     qadr = np.array([int(j.qposadr[0]) for j in joints])
     vadr = np.array([int(j.dofadr[0]) for j in joints])
-    q, dq, ddq = _states(robot, n_states, rng)
+    q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
     dry = model.dof_frictionloss[vadr].copy()
-    tau_file, with_constraint = np.empty((n_states, robot.n_dof)), np.empty((n_states, robot.n_dof))
+    tau_file, with_constraint = np.empty(q.shape), np.empty(q.shape)
     for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
         model.opt.disableflags = int(flags)
-        for k in range(n_states):
+        for k in range(q.shape[0]):
             data.qpos[:], data.qvel[:], data.qacc[:] = model.qpos0, 0.0, 0.0
             data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
             mujoco.mj_inverse(model, data)
             out[k] = data.qfrc_inverse[vadr]
     tau_file = tau_file + dry * np.sign(dq)
-    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS)
+    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured)
     sliding = dry * np.sign(dq)
     gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
     return replace(check, frictionloss_gap=gap)
