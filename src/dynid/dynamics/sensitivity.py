@@ -88,8 +88,21 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
     return y, d
 
 
-def _frames_and_axes(robot: Robot, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every link frame's rotation and origin in the base frame and every joint's axis there, (N, 3, n_dof)."""
+def frames_and_axes(robot: Robot, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every link frame's rotation and origin in the base frame, and every joint's axis there.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+
+    Returns
+    -------
+    rots : (N, n_dof, 3, 3) array
+    orig : (N, n_dof, 3) array [m]
+    axes : (N, 3, n_dof) array
+        Unit axes, one column per joint.
+    """
     q = check_trajectory_array(q, robot.n_dof, "q")
     rots, orig = forward_kinematics(robot, q)
     return rots, orig, np.stack([rots[:, j] @ robot.joints[j].axis for j in range(robot.n_dof)], axis=2)
@@ -110,7 +123,7 @@ def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
         Origins in the base frame.
     J : (N, n_dof, 3, n_dof) array [m/rad]
     """
-    _, orig, axes = _frames_and_axes(robot, q)
+    _, orig, axes = frames_and_axes(robot, q)
     lever = orig[:, :, :, None] - orig.transpose(0, 2, 1)[:, None]  # (N, k, 3, j): o_k - o_j
     jac = np.cross(axes[:, None], lever, axis=2)
     jac *= np.tril(np.ones((robot.n_dof, robot.n_dof)), -1)[None, :, None, :]  # only the joints before frame k
@@ -131,7 +144,7 @@ def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
         Tool (flange) point in the base frame.
     J : (N, 3, n_dof) array [m/rad]
     """
-    rots, orig, axes = _frames_and_axes(robot, q)
+    rots, orig, axes = frames_and_axes(robot, q)
     p = orig[:, -1] + rots[:, -1] @ robot.tool_translation
     lever = p[:, :, None] - orig.transpose(0, 2, 1)  # (N, 3, n)
     return p, np.cross(axes, lever, axis=1)

@@ -15,7 +15,8 @@ from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
 from .fourier import FourierTrajectory
-from .obstacles import Obstacle, obstacle_distances
+from .link_geometry import LinkGeometry, shape_distances
+from .obstacles import Obstacle, ObstacleDistances, obstacle_distances, reachable_pairs
 
 AXES = "xyz"
 
@@ -39,6 +40,9 @@ class Workspace:
     obstacles : tuple of Obstacle
         The cell's bodies (a table top, a fixture, a wall): every link's capsule stays off each
         (:mod:`dynid.excitation.obstacles`).
+    geometry : LinkGeometry or None
+        The links' own collision shapes (:mod:`dynid.excitation.link_geometry`): with them, every shape stays
+        ``clearance`` off each body instead of the capsules.
     """
 
     box_min: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
@@ -46,6 +50,7 @@ class Workspace:
     floor: float = -np.inf
     clearance: float = 0.05
     obstacles: tuple[Obstacle, ...] = ()
+    geometry: LinkGeometry | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
@@ -85,6 +90,44 @@ class Workspace:
         z = forward_kinematics(robot, q)[1][:, :, 2]
         return np.flatnonzero(z.max(axis=0) - z.min(axis=0) > 1e-6)
 
+    def cell_pairs(self, robot) -> list[tuple[int, int]]:
+        """The (link or shape, obstacle) pairs the cell's distances are measured for.
+
+        Parameters
+        ----------
+        robot : Robot
+
+        Returns
+        -------
+        list of (int, int)
+            (shape, obstacle) with :attr:`geometry`, else (link, obstacle) that can reach each other
+            (:func:`dynid.excitation.obstacles.reachable_pairs`).
+        """
+        if self.geometry is not None:
+            return [(g, i) for g in range(len(self.geometry.shapes)) for i in range(len(self.obstacles))]
+        return reachable_pairs(robot, self.obstacles, self.clearance)
+
+    def cell_distances(self, robot, q, *, pairs=None, gradient: bool = False) -> ObstacleDistances:
+        """The links' distances to the cell's bodies beyond the clearance (zero: the clearance kept), by their own
+        collision shapes with :attr:`geometry`, else by their capsules.
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+        pairs : list of (int, int), optional
+            Default :meth:`cell_pairs`.
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+        """
+        pairs = self.cell_pairs(robot) if pairs is None else pairs
+        if self.geometry is not None:
+            return shape_distances(robot, q, self.obstacles, self.geometry, self.clearance, pairs=pairs, gradient=gradient)
+        return obstacle_distances(robot, q, self.obstacles, self.clearance, pairs=pairs, gradient=gradient)
+
     def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """``G p <= h`` for the finite sides of the box and the floor.
 
@@ -121,7 +164,9 @@ class Workspace:
         fin = lambda v: [float(x) if np.isfinite(x) else None for x in v]  # noqa: E731
         return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
                 "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance),
-                **({"obstacles": [ob.to_dict() for ob in self.obstacles]} if self.obstacles else {})}
+                **({"obstacles": [ob.to_dict() for ob in self.obstacles]} if self.obstacles else {}),
+                **({"geometry": f"collision shapes of {self.geometry.source}"} if self.geometry is not None and self.obstacles
+                   else {})}
 
 
 @dataclass(frozen=True)
@@ -257,8 +302,8 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
 
 
 def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
-    """How close the links' capsules come to each of the cell's bodies along ``q``: one margin per body that a link
-    can reach, ``worst`` the smallest surface distance (limit 0: the skeleton ``clearance`` off the body).
+    """How close the links come to each of the cell's bodies along ``q``: one margin per body that a link can reach,
+    ``worst`` the smallest distance beyond the clearance (:meth:`Workspace.cell_distances`; limit 0).
 
     Parameters
     ----------
@@ -274,7 +319,8 @@ def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Work
     """
     if not workspace.obstacles:
         return []
-    found = obstacle_distances(robot, q, workspace.obstacles, workspace.clearance)
+    found = workspace.cell_distances(robot, q)
+    geometry = workspace.geometry
     out = []
     for i, ob in enumerate(workspace.obstacles):
         cols = [c for c, (_, o) in enumerate(found.pairs) if o == i]
@@ -283,6 +329,7 @@ def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Work
         d = found.distance[:, cols]
         n, c = np.unravel_index(int(np.argmin(d)), d.shape)
         worst = float(d[n, c])
-        out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {found.pairs[cols[c]][0] + 1} at "
+        shape = "" if geometry is None else f" ({geometry.names[found.pairs[cols[c]][0]]})"
+        out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {found.links[cols[c]] + 1}{shape} at "
                                     f"t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan))
     return out

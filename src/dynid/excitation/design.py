@@ -36,7 +36,6 @@ from ..threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
-from .obstacles import obstacle_distances, reachable_pairs
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -197,9 +196,10 @@ class ExcitationProblem:
         ws = self.workspace
         if not ws.obstacles:
             return
-        found = obstacle_distances(self.robot, q0[None], ws.obstacles, ws.clearance)
+        found = ws.cell_distances(self.robot, q0[None])
         if found.pairs and found.distance.min() < 0:
-            k, i = found.pairs[int(np.argmin(found.distance[0]))]
+            c = int(np.argmin(found.distance[0]))
+            k, i = found.links[c], found.pairs[c][1]
             raise ConfigError(f"workspace.obstacles: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) link "
                               f"{k + 1} comes within workspace.clearance = {ws.clearance:g} m of obstacle "
                               f"{ws.obstacles[i].name!r} (by {-found.distance.min():.3g} m): move the body, start "
@@ -441,7 +441,7 @@ class _Objective:
         ws = problem.workspace  # every link above the floor: its joints' origins (Workspace.clearance)
         self.origins = ws.moving_origins(problem.robot)
         self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
-        self.pairs = reachable_pairs(problem.robot, ws.obstacles, ws.clearance)  # every link off the cell's bodies
+        self.pairs = ws.cell_pairs(problem.robot) if ws.obstacles else []  # every link off the cell's bodies
         self.gap = s * reach
         self.crit = criterion_function(problem.criterion)
 
@@ -488,8 +488,7 @@ class _Objective:
         self._xg = True
 
     def _distances(self, *, gradient: bool):
-        ws = self.p.workspace
-        return obstacle_distances(self.p.robot, self.q, ws.obstacles, ws.clearance, pairs=self.pairs, gradient=gradient)
+        return self.p.workspace.cell_distances(self.p.robot, self.q, pairs=self.pairs, gradient=gradient)
 
     def fun(self, x):
         self._eval(x)

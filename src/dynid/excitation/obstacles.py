@@ -175,16 +175,30 @@ def reachable_pairs(robot: Robot, obstacles, radius: float) -> list[tuple[int, i
     return sorted(out)
 
 
+def away_from(result) -> np.ndarray:
+    """The unit vector from the first object's nearest point to the second's (coal's normal where they overlap).
+
+    Parameters
+    ----------
+    result : coal.DistanceResult
+
+    Returns
+    -------
+    (3,) array
+    """
+    near = result.getNearestPoint1()
+    gap = result.getNearestPoint2() - near
+    return gap / np.linalg.norm(gap) if result.min_distance > 1e-9 else np.asarray(result.normal)
+
+
 def _distance_gradient(result, seg: np.ndarray, jac: np.ndarray) -> np.ndarray:
     """(n_dof,) ``∂distance/∂q`` of one capsule from coal's result: the envelope theorem (module docstring)."""
     a, b = seg
     ab = b - a
     near = result.getNearestPoint1()
     s = float(np.clip((near - a) @ ab / (ab @ ab), 0.0, 1.0)) if ab @ ab > 1e-24 else 0.0
-    # from the capsule to the body (coal's normal where they overlap): moving away raises the distance
-    gap = result.getNearestPoint2() - near
-    normal = gap / np.linalg.norm(gap) if result.min_distance > 1e-9 else np.asarray(result.normal)
-    return -normal @ ((1 - s) * jac[0] + s * jac[1])
+    # moving the capsule away from the body raises the distance
+    return -away_from(result) @ ((1 - s) * jac[0] + s * jac[1])
 
 
 @dataclass(frozen=True)
@@ -194,16 +208,24 @@ class ObstacleDistances:
     Attributes
     ----------
     pairs : list of (int, int)
-        (link, obstacle), 0-based.
+        (link, obstacle), 0-based; (shape, obstacle) for a link's own collision shapes
+        (:func:`dynid.excitation.link_geometry.shape_distances`).
     distance : (N, n_pairs) array [m]
-        Capsule surface to the body's surface (negative: overlap).
+        Capsule surface to the body's surface (negative: overlap); a shape's distance less the clearance.
     gradient : (N, n_pairs, n_dof) array [m/rad] or None
         ``∂distance/∂q``.
+    links : tuple of int
+        The link (0-based) of each pair (default: the pair's first index).
     """
 
     pairs: list[tuple[int, int]]
     distance: np.ndarray
     gradient: np.ndarray | None = None
+    links: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.links:
+            object.__setattr__(self, "links", tuple(k for k, _ in self.pairs))
 
 
 def obstacle_distances(robot: Robot, q: np.ndarray, obstacles, radius: float, *, pairs=None,

@@ -37,9 +37,10 @@ class CellContacts:
     touching : int
         Set-points with at least one contact.
     first : dict or None
-        The first contact: ``link`` (1-based), ``body`` (an obstacle's name or "floor"), ``time`` [s], ``depth`` [m].
+        The first contact: ``link`` (1-based), ``body`` (an obstacle's name or "floor"), ``time`` [s], ``depth`` [m]
+        (how far inside the clearance).
     deepest : float [m]
-        The deepest penetration found (0 without contact).
+        The deepest a link came inside the clearance (0 without contact).
     """
 
     set_points: int
@@ -91,9 +92,12 @@ def cell_mjcf(robot: Robot, workspace: Workspace) -> str:
         shape = ({"type": "capsule", "fromto": f"0 0 0 {_vec(end)}"} if np.linalg.norm(end) > 1e-12
                  else {"type": "sphere"})
         common = {**shape, "size": f"{max(r, 1e-9):.17g}", "conaffinity": "0", "mass": "0", "group": "3"}
-        ET.SubElement(body, "geom", {"name": f"link{k + 1}", "contype": "1", **common})
+        if workspace.geometry is None:
+            ET.SubElement(body, "geom", {"name": f"link{k + 1}", "contype": "1", **common})
         if k in held and (k + 1 in held):
             ET.SubElement(body, "geom", {"name": f"link{k + 1}_floor", "contype": "2", **common})
+    if workspace.geometry is not None:
+        _shape_geoms(root, bodies, workspace.geometry)
     world = root.find("worldbody")
     assert world is not None  # mjcf_from_robot writes one
     for ob in workspace.obstacles:
@@ -104,6 +108,38 @@ def cell_mjcf(robot: Robot, workspace: Workspace) -> str:
         ET.SubElement(world, "geom", {"name": "floor", "type": "plane", "size": "0 0 1",
                                       "pos": f"0 0 {workspace.floor:.17g}", "contype": "0", "conaffinity": "2"})
     return ET.tostring(root, encoding="unicode")
+
+
+def _shape_geoms(root, bodies: dict, geometry) -> None:
+    """The links' own collision shapes as geoms of their bodies (a convex hull as a mesh of its points: MuJoCo
+    collides a mesh by its convex hull, the same one)."""
+    import coal
+
+    asset = root.find("asset")
+    if asset is None:
+        asset = ET.Element("asset")
+        root.insert(1, asset)
+    for g, (shape, k) in enumerate(zip(geometry.shapes, geometry.link)):
+        x = geometry.placement[g]
+        geom = {"name": f"link{k + 1}_shape{g}", "pos": _vec(x[:3, 3]), "quat": _quat_of(x[:3, :3]), "contype": "1",
+                "conaffinity": "0", "mass": "0", "group": "3"}
+        if isinstance(shape, coal.Box):
+            geom.update(type="box", size=_vec(shape.halfSide))
+        elif isinstance(shape, coal.Sphere):
+            geom.update(type="sphere", size=f"{shape.radius:.17g}")
+        elif isinstance(shape, (coal.Cylinder, coal.Capsule)):
+            geom.update(type="cylinder" if isinstance(shape, coal.Cylinder) else "capsule",
+                        size=f"{shape.radius:.17g} {shape.halfLength:.17g}")
+        else:
+            points = np.array([shape.point(i) for i in range(shape.num_points)])
+            ET.SubElement(asset, "mesh", {"name": f"shape{g}", "vertex": _vec(points.ravel())})
+            geom.update(type="mesh", mesh=f"shape{g}")
+        ET.SubElement(bodies[f"link{k + 1}"], "geom", geom)
+
+
+def _quat_of(rotation) -> str:
+    x, y, z, w = Rotation.from_matrix(rotation).as_quat()
+    return _vec([w, x, y, z])
 
 
 def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> CellContacts | None:
@@ -130,18 +166,24 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
     model = mujoco.MjModel.from_xml_string(cell_mjcf(robot, workspace))
     data = mujoco.MjData(model)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in range(model.ngeom)]
+    within = np.zeros(model.ngeom)  # a shape must keep the clearance itself; a capsule holds it in its radius
+    if workspace.geometry is not None:
+        shapes = np.array(["_shape" in (n or "") for n in names])
+        within[shapes] = workspace.clearance
+        model.geom_margin[shapes] = workspace.clearance  # MuJoCo reports contacts up to the margin apart
     touching, first, deepest = 0, None, 0.0
     for n in range(q.shape[0]):
         data.qpos[:robot.n_dof] = q[n]
         mujoco.mj_forward(model, data)
-        found = [c for c in data.contact[:data.ncon] if c.dist < 0]
+        found = [c for c in data.contact[:data.ncon] if c.dist < within[c.geom1] + within[c.geom2] - 1e-9]
         if not found:
             continue
         touching += 1
-        deepest = min(deepest, min(float(c.dist) for c in found))
+        depth = [float(within[c.geom1] + within[c.geom2] - c.dist) for c in found]
+        deepest = min(deepest, -max(depth))
         if first is None:
             a, b = names[found[0].geom1], names[found[0].geom2]
             link, body = (a, b) if a.startswith("link") else (b, a)
-            first = {"link": int(link.removeprefix("link").removesuffix("_floor")), "body": body,
-                     "time": float(t[n]), "depth": float(-found[0].dist)}
+            first = {"link": int(link.removeprefix("link").split("_")[0]), "body": body, "time": float(t[n]),
+                     "depth": depth[0]}
     return CellContacts(int(q.shape[0]), touching, first, max(0.0, -deepest))

@@ -293,6 +293,10 @@ class WorkspaceTable(Table, kw_only=True):
                                                          "radius about the segment between its joint origins); "
                                                          "default 0.05")] | None = None
     obstacles: Annotated[list[ObstacleTable], _d("the cell's bodies every link keeps `clearance` off")] | None = None
+    geometry: Annotated[Literal["auto", "capsules", "collision"],
+                        _d("what the links are against the obstacles: the robot URDF's own collision shapes "
+                           "(\"collision\"), capsules of `clearance` about the joint origins (\"capsules\"), or the "
+                           "first where the URDF has them (\"auto\", default)")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

@@ -52,13 +52,14 @@ from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationProblem
 from ..excitation.fourier import FourierTrajectory
+from ..excitation.link_geometry import link_geometry_from_urdf
 from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
 from ..typed import convert
 from .config_types import ExcitationDocument
-from .configs import config_robot, read_config
+from .configs import config_robot, config_urdf, read_config
 from .trajectories import load_trajectory
 
 DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
@@ -74,6 +75,25 @@ def _from_identification(doc: dict, path: Path) -> dict:
     excitation = dict(table)
     excitation.setdefault("trajectory", dict(DEFAULT_TRAJECTORY))
     return {"robot": doc.get("robot"), **excitation}
+
+
+def _link_geometry(setting: str, robot, urdf: Path | None):
+    """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`), or None (capsules).
+    "auto" takes them where the robot's URDF has them and they load; "collision" insists."""
+    if setting == "capsules" or (urdf is None and setting == "auto"):
+        return None
+    if urdf is None:
+        raise ConfigError('workspace.geometry = "collision" needs a robot read from a URDF with <collision> elements '
+                          "and [[workspace.obstacles]] to keep them off")
+    try:
+        found = link_geometry_from_urdf(robot, urdf)
+    except ConfigError:
+        if setting == "auto":
+            return None
+        raise
+    if found is None and setting == "collision":
+        raise ConfigError(f'workspace.geometry = "collision": {urdf} has no <collision> element on a moving link')
+    return found
 
 
 @dataclass(frozen=True)
@@ -180,6 +200,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
                                    ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
+        ws_kw["geometry"] = _link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path) if ws.obstacles else None)
         workspace = Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None

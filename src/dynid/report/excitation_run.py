@@ -8,7 +8,6 @@ import numpy as np
 
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
-from ..excitation.obstacles import obstacle_distances
 from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
@@ -71,7 +70,7 @@ def _clearance_series(robot, t: np.ndarray, q: np.ndarray, ws) -> dict:
     if moving.size:
         out["floor (lowest joint origin)"] = forward_kinematics(robot, q)[1][:, moving, 2].min(axis=1) - ws.floor - ws.clearance
     if ws.obstacles:
-        found = obstacle_distances(robot, q, ws.obstacles, ws.clearance)
+        found = ws.cell_distances(robot, q)
         for i, ob in enumerate(ws.obstacles):
             cols = [c for c, (_, o) in enumerate(found.pairs) if o == i]
             if cols:

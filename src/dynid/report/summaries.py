@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -1067,9 +1068,14 @@ def _cell_clearance_lines(run) -> list:
     if low.worst < 0:
         return [Line(f"a link comes within {radius:g} m of the cell at a set-point: {low.where} (by {-low.worst:.3g} m, "
                      "between the verification grid's samples): do not run it; raise design.grid_points", "warning")]
-    n = len(run.config.problem.workspace.obstacles)
-    return [Line(f"every link's {radius:g} m capsule stays {low.worst:.3g} m or more off the cell at the set-points "
-                 f"({n} {'body' if n == 1 else 'bodies'}; closest: {low.where})")]
+    ws = run.config.problem.workspace
+    n = len(ws.obstacles)
+    what = (f"every link's {radius:g} m capsule stays {low.worst:.3g} m" if ws.geometry is None else
+            f"every link's collision shapes (of {Path(ws.geometry.source).name}, convex hulls) stay "
+            f"{radius + low.worst:.3g} m")
+    beyond = "" if ws.geometry is None else f", {low.worst:.3g} m beyond the {radius:g} m clearance"
+    return [Line(f"{what} or more off the cell at the set-points{beyond} ({n} {'body' if n == 1 else 'bodies'}; "
+                 f"closest: {low.where})")]
 
 
 def _mujoco_lines(run) -> list:
@@ -1086,8 +1092,8 @@ def _mujoco_lines(run) -> list:
         f = found.first
         return [Line(f"MuJoCo finds link {f['link']} touching {f['body']} at t = {f['time']:.3g} s ({found.touching} of "
                      f"{found.set_points} set-points, up to {found.deepest:.3g} m deep): do not run it", "warning")]
-    return [Line(f"checked again by MuJoCo: no link's capsule touches the cell or the floor on the {found.set_points} "
-                 "set-points")]
+    return [Line(f"checked again by MuJoCo: no link comes within the clearance of the cell or the floor on the "
+                 f"{found.set_points} set-points")]
 
 
 def _cell(value, fmt: str = ".3g") -> str:

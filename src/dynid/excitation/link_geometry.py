@@ -1,0 +1,184 @@
+"""The links' own collision geometry, read from the robot's URDF, for the cell's distances (issue "An excitation safe
+to run on the real robot", item 1: distances from the description's collision meshes).
+
+Pinocchio reads the URDF's ``<collision>`` elements into a geometry model (Carpentier et al., "The Pinocchio C++
+library", SII 2019); coal holds the shapes. A mesh is replaced by its convex hull (coal's qhull), which contains it:
+a distance to the hull is never larger than the distance to the mesh, and GJK measures it in microseconds where the
+mesh's BVH takes a millisecond. Each shape rides on one of dynid's links: the joint that carries it in the URDF, or
+the nearest of its ancestors that is one of the robot's joints (a gripper held at 0 rides on the last link); shapes
+on the base are left out (no motion brings them anywhere). Its pose in that link's frame is read once at ``q = 0``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import coal
+import numpy as np
+
+from ..dynamics.kinematics import forward_kinematics
+from ..dynamics.sensitivity import frames_and_axes
+from ..exceptions import ConfigError
+from ..model.robot import Robot
+from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from
+
+__all__ = ["LinkGeometry", "link_geometry_from_urdf", "shape_distances"]
+
+
+@dataclass(frozen=True)
+class LinkGeometry:
+    """Collision shapes attached to the robot's links.
+
+    Attributes
+    ----------
+    shapes : tuple of coal.CollisionGeometry
+        Convex hulls of meshes, or the URDF's boxes, cylinders and spheres.
+    link : (m,) int array
+        The link (0-based: link ``k`` is the one joint ``k`` moves) each shape rides on.
+    placement : (m, 4, 4) array
+        Each shape's pose in its link's frame (dynid's joint frame) [m].
+    names : tuple of str
+        The URDF's collision names, named in messages.
+    source : str
+        The URDF.
+    """
+
+    shapes: tuple
+    link: np.ndarray
+    placement: np.ndarray
+    names: tuple[str, ...]
+    source: str
+
+    def poses(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every shape's rotation and position in the base frame.
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+
+        Returns
+        -------
+        rotation : (N, m, 3, 3) array
+        position : (N, m, 3) array [m]
+        """
+        rots, orig = forward_kinematics(robot, q)
+        r, p = rots[:, self.link], orig[:, self.link]
+        rotation = r @ self.placement[:, :3, :3]
+        position = p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3])
+        return rotation, position
+
+
+def _package_dirs(path: Path) -> list[str]:
+    """Folders ``package://name/...`` may be found under: the URDF's own ancestors (a description package)."""
+    return [str(p) for p in path.resolve().parents]
+
+
+def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
+    """The collision shapes of a URDF on the robot's links (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot read from that URDF (its joints carry the URDF's joint names).
+    path : str or Path
+        The URDF.
+
+    Returns
+    -------
+    LinkGeometry or None
+        None where the URDF has no collision element on a moving link.
+
+    Raises
+    ------
+    ConfigError
+        A collision mesh that cannot be found or read (the message names the file and the mesh).
+    """
+    import pinocchio as pin
+
+    path = Path(path)
+    model = pin.buildModelFromUrdf(str(path))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            geometry = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.COLLISION, package_dirs=_package_dirs(path))
+    except (ValueError, RuntimeError, OSError) as exc:
+        raise ConfigError(f"{path}: its collision geometry could not be read ({str(exc).splitlines()[0]}); give the "
+                          "meshes beside it, or set workspace.geometry = \"capsules\"") from None
+    index = {j.name: k for k, j in enumerate(robot.joints)}
+    data = model.createData()
+    geometry_data = pin.GeometryData(geometry)
+    pin.updateGeometryPlacements(model, data, geometry, geometry_data, pin.neutral(model))
+    rots, orig = forward_kinematics(robot, np.zeros((1, robot.n_dof)))
+    shapes, link, placement, names = [], [], [], []
+    for g, obj in enumerate(geometry.geometryObjects):
+        joint = obj.parentJoint
+        while joint > 0 and model.names[joint] not in index:
+            joint = model.parents[joint]
+        if joint == 0:
+            continue  # on the base
+        k = index[model.names[joint]]
+        frame = np.eye(4)
+        frame[:3, :3], frame[:3, 3] = rots[0, k], orig[0, k]
+        world = geometry_data.oMg[g].homogeneous
+        shape = obj.geometry
+        if isinstance(shape, coal.BVHModelBase):
+            shape.buildConvexHull(True, "Qt")
+            shape = shape.convex
+        shapes.append(shape)
+        link.append(k)
+        placement.append(np.linalg.solve(frame, world))
+        names.append(obj.name)
+    if not shapes:
+        return None
+    return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path))
+
+
+def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeometry, clearance: float, *,
+                    pairs=None, gradient: bool = False) -> ObstacleDistances:
+    """The links' collision shapes' distances to the cell's bodies along ``q``, less ``clearance`` (zero: the
+    clearance kept), with their gradient: moving the shape's nearest point ``p`` by joint ``j`` (``j`` up to the
+    shape's link) changes the distance by ``-n·(z_j × (p - o_j))``, ``n`` the unit vector from ``p`` to the body.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+    obstacles : sequence of Obstacle
+    geometry : LinkGeometry
+    clearance : float [m]
+    pairs : list of (int, int), optional
+        (shape, obstacle) pairs (default every one).
+    gradient : bool
+
+    Returns
+    -------
+    ObstacleDistances
+        ``pairs`` index the shapes; ``links`` names each pair's link.
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    pairs = [(g, i) for g in range(len(geometry.shapes)) for i in range(len(obstacles))] if pairs is None else list(pairs)
+    rotation, position = geometry.poses(robot, q)
+    bodies = [ob.geometry() for ob in obstacles]
+    dist = np.empty((q.shape[0], len(pairs)))
+    near, normal = np.zeros((2, q.shape[0], len(pairs), 3))
+    request = coal.DistanceRequest()
+    request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
+    for c, (g, i) in enumerate(pairs):
+        body, pose = bodies[i]
+        for n in range(q.shape[0]):
+            result = coal.DistanceResult()
+            coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]), body, pose, request, result)
+            dist[n, c] = result.min_distance - clearance
+            if gradient:
+                near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
+    grad = None
+    if gradient and pairs:  # -z_j·((p - o_j) × n) for the joints up to the shape's link
+        _, orig, axes = frames_and_axes(robot, q)
+        lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
+        grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
+        links = np.array([int(geometry.link[g]) for g, _ in pairs])
+        grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
+    return ObstacleDistances(pairs, dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))

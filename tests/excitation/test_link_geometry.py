@@ -1,0 +1,124 @@
+"""The links' own collision shapes against the cell (issue "An excitation safe to run on the real robot", item 1):
+read from a URDF whose collision meshes are boxes written here as STL files, placed as Pinocchio places them, their
+distances against a hand-computed truth, their gradients, and the config's geometry setting."""
+
+import re
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dynid.exceptions import ConfigError
+from dynid.excitation.constraints import Workspace
+from dynid.excitation.link_geometry import link_geometry_from_urdf
+from dynid.excitation.obstacles import Obstacle
+from dynid.io.cell_replay import cell_contacts
+from dynid.io.excitation_config import load_excitation_config
+from dynid.model.description import load_robot
+
+UR10E = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+HALF = np.array([0.06, 0.05, 0.12])  # every mesh is this box about its mesh frame's origin
+
+
+def _box_stl(path: Path) -> None:
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * HALF
+    faces = []
+    for axis in range(3):
+        for side in (-1, 1):
+            quad = [i for i in range(8) if np.sign(corners[i, axis]) == side]
+            a, b, c, d = sorted(quad, key=lambda i: np.arctan2(*np.delete(corners[i], axis)[::-1]))
+            faces += [(a, b, c), (a, c, d)]
+    triangles = np.array([[corners[i] for i in f] for f in faces], dtype="<f4")  # binary STL: header, count, facets
+    record = np.zeros(len(faces), dtype=[("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
+    record["vertices"] = triangles
+    path.write_bytes(b"box".ljust(80, b" ") + np.uint32(len(faces)).tobytes() + record.tobytes())
+
+
+@pytest.fixture(scope="module")
+def ur10e_with_meshes(tmp_path_factory):
+    """The built-in UR10e URDF with its collision meshes present, in a package layout ``package://`` resolves."""
+    root = tmp_path_factory.mktemp("pkg")
+    text = UR10E.read_text()
+    for name in set(re.findall(r"package://ur_e_description/meshes/ur10e/collision/(\w+)\.stl", text)):
+        target = root / "ur_e_description" / "meshes" / "ur10e" / "collision" / f"{name}.stl"
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _box_stl(target)
+    urdf = root / "ur_e_description" / "urdf" / "ur10e.urdf"
+    urdf.parent.mkdir(parents=True)
+    urdf.write_text(text)
+    return urdf
+
+
+def test_shapes_ride_on_the_links_where_pinocchio_places_them(ur10e_with_meshes, rng):
+    import pinocchio as pin
+
+    robot = load_robot(ur10e_with_meshes)
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    assert geometry is not None and len(geometry.shapes) >= robot.n_dof  # the base's shape is left out
+    model = pin.buildModelFromUrdf(str(ur10e_with_meshes))
+    geom = pin.buildGeomFromUrdf(model, str(ur10e_with_meshes), pin.GeometryType.COLLISION,
+                                 package_dirs=[str(p) for p in ur10e_with_meshes.parents])
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    q = rng.uniform(-2.0, 2.0, (5, robot.n_dof))
+    rotation, position = geometry.poses(robot, q)
+    for n in range(q.shape[0]):
+        pin.updateGeometryPlacements(model, data, geom, gdata, q[n])
+        for s, name in enumerate(geometry.names):
+            placed = gdata.oMg[geom.getGeometryId(name)]
+            np.testing.assert_allclose(position[n, s], placed.translation, atol=1e-12)
+            np.testing.assert_allclose(rotation[n, s], placed.rotation, atol=1e-12)
+
+
+def test_a_shapes_distance_and_gradient_against_a_hand_computed_truth(ur10e_with_meshes, rng):
+    """A ball against box meshes: the distance is the ball centre's distance to each box (clipped in the box's
+    frame) less the radius and the clearance; the gradient equals central differences."""
+    robot = load_robot(ur10e_with_meshes)
+    ball = Obstacle("sphere", np.array([0.25]), np.array([0.3, 0.2, 0.8]), name="ball")
+    ws = Workspace(clearance=0.03, obstacles=(ball,), geometry=link_geometry_from_urdf(robot, ur10e_with_meshes))
+    q = rng.uniform(-2.0, 2.0, (20, robot.n_dof))
+    found = ws.cell_distances(robot, q, gradient=True)
+    rotation, position = ws.geometry.poses(robot, q)
+    local = np.einsum("nsji,nsj->nsi", rotation, ball.position - position)  # the centre in each box's frame
+    half = np.array([np.asarray(s.halfSide) if hasattr(s, "halfSide") else HALF for s in ws.geometry.shapes])  # ee_link: a <box>
+    truth = np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=-1) - 0.25 - 0.03
+    outside = truth > 1e-3 - 0.28
+    np.testing.assert_allclose(found.distance[outside], truth[outside], atol=1e-7)
+    assert found.distance.min() < 0 < found.distance.max()
+    h = 1e-6
+    for j in range(robot.n_dof):
+        e = np.zeros(robot.n_dof)
+        e[j] = h
+        fd = (ws.cell_distances(robot, q + e).distance - ws.cell_distances(robot, q - e).distance) / (2 * h)
+        clear = found.distance > 1e-3 - 0.03
+        np.testing.assert_allclose(found.gradient[:, :, j][clear], fd[clear], atol=1e-6)
+    assert [found.links[c] for c in range(len(found.pairs))] == list(ws.geometry.link)
+
+
+def test_mujoco_sees_the_shapes_within_the_clearance_where_coal_does(ur10e_with_meshes, rng):
+    robot = load_robot(ur10e_with_meshes)
+    crate = Obstacle("box", np.array([0.5, 0.4, 0.4]), np.array([0.4, 0.2, 0.6]), np.array([0.2, 0.0, 0.5]), name="crate")
+    ws = Workspace(clearance=0.03, obstacles=(crate,), geometry=link_geometry_from_urdf(robot, ur10e_with_meshes))
+    q = rng.uniform(-2.0, 2.0, (120, robot.n_dof))
+    d = ws.cell_distances(robot, q).distance.min(axis=1)
+    clear = np.abs(d) > 1e-3
+    touching = np.array([cell_contacts(robot, np.zeros(1), q[n:n + 1], ws).touching > 0 for n in range(q.shape[0])])
+    assert (d[clear] < 0).sum() >= 10 and (d[clear] > 0).sum() >= 10
+    np.testing.assert_array_equal(touching[clear], d[clear] < 0)
+
+
+def _config(tmp_path: Path, urdf: Path, geometry: str | None) -> Path:
+    cfg = tmp_path / f"excite-{geometry}.toml"
+    cfg.write_text(f'robot = "{urdf}"\n[trajectory]\nharmonics = 2\nfrequency = 0.1\n'
+                   '[workspace]\n' + (f'geometry = "{geometry}"\n' if geometry else "")
+                   + '[[workspace.obstacles]]\nshape = "box"\nsize = [0.2, 0.2, 0.2]\nposition = [0.8, 0.6, 0.3]\n')
+    return cfg
+
+
+def test_the_config_takes_the_urdfs_shapes_by_default_and_says_when_it_cannot(ur10e_with_meshes, tmp_path):
+    assert load_excitation_config(_config(tmp_path, ur10e_with_meshes, None)).problem.workspace.geometry is not None
+    assert load_excitation_config(_config(tmp_path, ur10e_with_meshes, "capsules")).problem.workspace.geometry is None
+    # the shipped URDF names meshes that are not shipped: "auto" keeps the capsules, "collision" says why not
+    assert load_excitation_config(_config(tmp_path, UR10E, None)).problem.workspace.geometry is None
+    with pytest.raises(ConfigError, match=r"ur10e\.urdf: its collision geometry could not be read \(Mesh package://"):
+        load_excitation_config(_config(tmp_path, UR10E, "collision"))
