@@ -12,10 +12,13 @@ seed, dynid designs the excitation twice: with the box and without it. Reported 
   does;
 - the design time with the box against without, measured in this run (target ≤ 3×).
 
-Not checked here: the descriptions' own collision meshes and a MuJoCo contact check (the links are the capsules of
-:mod:`dynid.excitation.obstacles`).
+With ``--geometry collision`` the links are the descriptions' own collision meshes (their convex hulls,
+:mod:`dynid.excitation.link_geometry`), and the 1 kHz check is Pinocchio's: its geometry model of the same URDF placed
+by its own kinematics, each mesh's hull against the box by ``pinocchio.computeDistances``, less the clearance; the
+floor stays the joint origins'. With capsules the check is the brute force above.
 
     python benchmarks/excite_cell.py --seeds 20
+    python benchmarks/excite_cell.py --seeds 20 --geometry collision
 """
 
 from __future__ import annotations
@@ -46,10 +49,11 @@ CLEARANCE = 0.05
 HARMONICS, FREQUENCY, GRID, STARTS, MAXITER = 3, 0.1, 60, 2, 100
 
 
-def _arm(name: str, folder: Path):
+def _arm(name: str, folder: Path, meshes: bool = False):
     file, keep = ARMS[name]
     path = folder / f"{name.replace(' ', '_')}.urdf"
-    path.write_text(arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep))
+    text = (robots_folder() / file).read_text(encoding="utf-8")
+    path.write_text(_with_collisions(text, keep) if meshes else arm_urdf(text, keep))
     robot = load_robot(str(path))
     lim = robot.limits
     from dataclasses import replace
@@ -57,6 +61,58 @@ def _arm(name: str, folder: Path):
     # a first, cautious run: half the rated speed, 3 rad/s², the description's torques
     return replace(robot, limits=replace(lim, q_min=lo, q_max=hi, dq_max=np.minimum(0.5 * lim.dq_max, 1.5),
                                          ddq_max=np.full(robot.n_dof, 3.0)))
+
+
+def _with_collisions(text: str, keep: str) -> str:
+    """The URDF with every movable joint but the arm's made fixed, its collision meshes kept by absolute path."""
+    import re
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(text.replace("package://example-robot-data/robots/", f"{robots_folder()}/"))
+    for link in root.iter("link"):
+        for child in [c for c in link if c.tag == "visual"]:
+            link.remove(child)
+    for joint in root.iter("joint"):
+        if joint.get("type") in ("revolute", "continuous", "prismatic") and not re.search(keep, joint.get("name", "")):
+            joint.set("type", "fixed")
+            for child in [c for c in joint if c.tag in ("mimic", "limit", "dynamics", "axis", "safety_controller")]:
+                joint.remove(child)
+    for gazebo in [c for c in root if c.tag in ("gazebo", "transmission", "ros2_control")]:
+        root.remove(gazebo)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _pinocchio_check(path: Path, robot, q: np.ndarray, ws: Workspace) -> float:
+    """Smallest distance beyond the clearance from any moving collision hull to the box, by Pinocchio alone."""
+    import coal
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(path))
+    geom = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.COLLISION)
+    for obj in geom.geometryObjects:
+        if isinstance(obj.geometry, coal.BVHModelBase):
+            obj.geometry.buildConvexHull(True, "Qt")
+            obj.geometry = obj.geometry.convex
+    box = ws.obstacles[0]
+    placement = pin.SE3(pin.rpy.rpyToMatrix(*box.rpy), box.position)
+    bid = geom.addGeometryObject(pin.GeometryObject("box", 0, placement, coal.Box(*box.size)))
+    moving = [g for g, obj in enumerate(geom.geometryObjects) if obj.parentJoint > 0]
+    for g in moving:
+        geom.addCollisionPair(pin.CollisionPair(g, bid))
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    ids = [model.getJointId(j.name) for j in robot.joints]
+    best = np.inf
+    for n in range(q.shape[0]):
+        qn = pin.neutral(model)
+        for j, jid in enumerate(ids):
+            iq = model.joints[jid].idx_q
+            if model.joints[jid].nq == 2:  # continuous: (cos, sin)
+                qn[iq:iq + 2] = np.cos(q[n, j]), np.sin(q[n, j])
+            else:
+                qn[iq] = q[n, j]
+        pin.computeDistances(model, data, geom, gdata, qn)
+        best = min(best, min(r.min_distance for r in gdata.distanceResults))
+    return best - ws.clearance
 
 
 def _start(robot) -> np.ndarray:
@@ -116,9 +172,16 @@ def _design(robot, ws: Workspace, seed: int):
 
 
 @with_single_blas_thread
-def run_arm(name: str, seeds: int, folder: Path) -> dict:
-    robot = _arm(name, folder)
+def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False) -> dict:
+    robot = _arm(name, folder, meshes)
     ws = _cell(robot)
+    path = folder / f"{name.replace(' ', '_')}.urdf"
+    if meshes:
+        from dataclasses import replace
+
+        from dynid.excitation.link_geometry import link_geometry_from_urdf
+
+        ws = replace(ws, geometry=link_geometry_from_urdf(robot, path))
     free_ws = Workspace(floor=ws.floor, clearance=CLEARANCE)
     rows = []
     for seed in range(seeds):
@@ -130,8 +193,10 @@ def run_arm(name: str, seeds: int, folder: Path) -> dict:
             print(f"  {name} seed {seed}: refused: {exc}", flush=True)
             continue
         t = np.arange(int(round(1000 / FREQUENCY))) / 1000.0  # one period at 1 kHz
-        box_d, floor_d = _brute_force(robot, with_box.trajectory.evaluate(t)[0], ws)
-        free_d, _ = _brute_force(robot, without.trajectory.evaluate(t)[0], ws)
+        check = (lambda q: (_pinocchio_check(path, robot, q, ws), _brute_force(robot, q, ws)[1])) if meshes else (
+            lambda q: _brute_force(robot, q, ws))
+        box_d, floor_d = check(with_box.trajectory.evaluate(t)[0])
+        free_d, _ = check(without.trajectory.evaluate(t)[0])
         rows.append(dict(seed=seed, refused=None, box=box_d, floor=floor_d, crossed=free_d < 0, cond=with_box.cond,
                          cond_free=without.cond, time=t_box, time_free=t_free))
         print(f"  {name} seed {seed}: box {box_d:+.4f} m, floor {floor_d:+.4f} m, collision-free design "
@@ -143,9 +208,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--arms", default=",".join(CELL_ARMS))
+    parser.add_argument("--geometry", choices=("capsules", "collision"), default="capsules")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        results = [run_arm(name, args.seeds, Path(tmp)) for name in args.arms.split(",")]
+        results = [run_arm(name, args.seeds, Path(tmp), args.geometry == "collision") for name in args.arms.split(",")]
     print("\n| arm | joints | seeds | in the box or under the floor (1 kHz) | free design crosses the box | "
           "cond ratio, box does not bind | cond ratio, box binds | time ratio (median) |")
     print("|---|---|---|---|---|---|---|---|")

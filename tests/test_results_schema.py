@@ -50,4 +50,6 @@ def test_excite_output_follows_the_schema(tmp_path):
     assert p.returncode == 0, p.stderr
     _check(tmp_path / "ex" / "excitation.json", "excite")
     html = (tmp_path / "ex" / "report.html").read_text()
-    assert "Before / after" in html and "Constraint margins" in html and html.count("data:image/png;base64,") == 2
+    # the joints, the tool path, and (the config has a floor) how close the links come to it
+    assert "Before / after" in html and "Constraint margins" in html and html.count("data:image/png;base64,") == 3
+    assert "How close the links come to the floor and the cell" in html
