@@ -3,6 +3,7 @@ read from a URDF whose collision meshes are boxes written here as STL files, pla
 distances against a hand-computed truth, their gradients, and the config's geometry setting."""
 
 import re
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 
@@ -11,7 +12,8 @@ import pytest
 
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
-from dynid.excitation.link_geometry import link_geometry_from_urdf
+from dynid.excitation.design import ExcitationProblem, design_excitation
+from dynid.excitation.link_geometry import link_geometry_from_urdf, self_distances, self_pairs
 from dynid.excitation.obstacles import Obstacle
 from dynid.io.cell_replay import cell_contacts
 from dynid.io.excitation_config import load_excitation_config
@@ -55,7 +57,7 @@ def test_shapes_ride_on_the_links_where_pinocchio_places_them(ur10e_with_meshes,
 
     robot = load_robot(ur10e_with_meshes)
     geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
-    assert geometry is not None and len(geometry.shapes) >= robot.n_dof  # the base's shape is left out
+    assert geometry is not None and len(geometry.shapes) > robot.n_dof and list(geometry.link).count(-1) == 1  # the base's
     model = pin.buildModelFromUrdf(str(ur10e_with_meshes))
     geom = pin.buildGeomFromUrdf(model, str(ur10e_with_meshes), pin.GeometryType.COLLISION,
                                  package_dirs=[str(p) for p in ur10e_with_meshes.parents])
@@ -82,6 +84,9 @@ def test_a_shapes_distance_and_gradient_against_a_hand_computed_truth(ur10e_with
     local = np.einsum("nsji,nsj->nsi", rotation, ball.position - position)  # the centre in each box's frame
     half = np.array([np.asarray(s.halfSide) if hasattr(s, "halfSide") else HALF for s in ws.geometry.shapes])  # ee_link: a <box>
     truth = np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=-1) - 0.25 - 0.03
+    shapes = [g for g, _ in found.pairs]
+    assert shapes == np.flatnonzero(ws.geometry.link >= 0).tolist()  # every shape but the base's
+    truth = truth[:, shapes]
     outside = truth > 1e-3 - 0.28
     np.testing.assert_allclose(found.distance[outside], truth[outside], atol=1e-7)
     assert found.distance.min() < 0 < found.distance.max()
@@ -92,7 +97,7 @@ def test_a_shapes_distance_and_gradient_against_a_hand_computed_truth(ur10e_with
         fd = (ws.cell_distances(robot, q + e).distance - ws.cell_distances(robot, q - e).distance) / (2 * h)
         clear = found.distance > 1e-3 - 0.03
         np.testing.assert_allclose(found.gradient[:, :, j][clear], fd[clear], atol=1e-6)
-    assert [found.links[c] for c in range(len(found.pairs))] == list(ws.geometry.link)
+    assert list(found.links) == [int(ws.geometry.link[g]) for g in shapes]
 
 
 def test_mujoco_sees_the_shapes_within_the_clearance_where_coal_does(ur10e_with_meshes, rng):
@@ -122,3 +127,47 @@ def test_the_config_takes_the_urdfs_shapes_by_default_and_says_when_it_cannot(ur
     assert load_excitation_config(_config(tmp_path, UR10E, None)).problem.workspace.geometry is None
     with pytest.raises(ConfigError, match=r"ur10e\.urdf: its collision geometry could not be read \(Mesh package://"):
         load_excitation_config(_config(tmp_path, UR10E, "collision"))
+
+
+def test_self_distances_gradient_and_the_pairs_that_can_touch(ur10e_with_meshes, rng):
+    robot = load_robot(ur10e_with_meshes)
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    pairs = self_pairs(robot, geometry)
+    links = [(int(geometry.link[g]), int(geometry.link[h])) for g, h in pairs]
+    assert pairs and all(abs(a - b) >= 2 for a, b in links)  # never the same link or neighbours
+    assert any(a == -1 for a, _ in links)  # the base is kept off too
+    q = rng.uniform(-2.0, 2.0, (30, robot.n_dof))
+    found = self_distances(robot, q, geometry, pairs, gradient=True)
+    h = 1e-6
+    for j in range(robot.n_dof):
+        e = np.zeros(robot.n_dof)
+        e[j] = h
+        fd = (self_distances(robot, q + e, geometry, pairs).distance - self_distances(robot, q - e, geometry, pairs).distance) / (2 * h)
+        clear = found.distance > 1e-3
+        np.testing.assert_allclose(found.gradient[:, :, j][clear], fd[clear], atol=1e-6)
+
+
+def test_the_design_keeps_the_links_shapes_apart_by_pinocchios_own_check(ur10e_with_meshes):
+    """A design with the URDF's shapes: on a 10× finer grid, Pinocchio's geometry model of the same file (its own
+    kinematics and the meshes themselves) finds every checked pair apart."""
+    import pinocchio as pin
+
+    robot = load_robot(ur10e_with_meshes)
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    q0 = np.array([0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+    limits = replace(robot.limits, q_min=np.full(6, -np.pi), q_max=np.full(6, np.pi), ddq_max=np.full(6, 4.0))
+    prob = ExcitationProblem(robot, 2 * np.pi * 0.1, 2, limits=limits, offsets=q0, rest=True, grid_points=40,
+                             workspace=Workspace(geometry=geometry))
+    design = design_excitation(prob, n_starts=1, rng=0, maxiter=60)
+    assert design.feasible and [m for m in design.margins if m.constraint.startswith("self clearance")]
+    model = pin.buildModelFromUrdf(str(ur10e_with_meshes))
+    geom = pin.buildGeomFromUrdf(model, str(ur10e_with_meshes), pin.GeometryType.COLLISION,
+                                 package_dirs=[str(p) for p in ur10e_with_meshes.parents])
+    ids = {name: geom.getGeometryId(name) for name in geometry.names}
+    for g, h in self_pairs(robot, geometry):
+        geom.addCollisionPair(pin.CollisionPair(ids[geometry.names[g]], ids[geometry.names[h]]))
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    t = np.linspace(0, design.trajectory.period, 400, endpoint=False)
+    for qn in design.trajectory.evaluate(t)[0]:
+        pin.computeDistances(model, data, geom, gdata, qn)
+        assert min(r.min_distance for r in gdata.distanceResults) > -1e-6

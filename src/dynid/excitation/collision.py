@@ -19,8 +19,9 @@ import numpy as np
 
 from ..dynamics.kinematics import forward_kinematics
 from ..model.robot import Robot
+from .link_geometry import LinkGeometry, self_distances, self_pairs
 
-__all__ = ["SelfClearance", "self_clearance", "touching_pairs"]
+__all__ = ["SelfClearance", "self_clearance", "shape_clearance", "touching_pairs"]
 
 ALWAYS = 0.95
 """A pair whose capsules overlap on this share of random poses or more is in contact by construction: not checked."""
@@ -40,12 +41,15 @@ class SelfClearance:
         When.
     pairs : int
         How many pairs were checked.
+    shapes : tuple of str
+        The two collision shapes where the links are their URDF's own (:func:`shape_clearance`); empty for capsules.
     """
 
     distance: float
     pair: tuple[int, int]
     time: float
     pairs: int
+    shapes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready.
@@ -54,7 +58,8 @@ class SelfClearance:
         -------
         dict
         """
-        return {"distance": self.distance, "links": list(self.pair), "time": self.time, "pairs_checked": self.pairs}
+        return {"distance": self.distance, "links": list(self.pair), "time": self.time, "pairs_checked": self.pairs,
+                **({"shapes": list(self.shapes)} if self.shapes else {})}
 
 
 def _segments(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -140,3 +145,29 @@ def self_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, radius: float) ->
                 best = (d, (i, j), k)
     d, (i, j), k = best
     return SelfClearance(float(d), (i + 1, j + 1), float(np.asarray(t)[k]), len(pairs))
+
+
+def shape_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, geometry: LinkGeometry) -> SelfClearance | None:
+    """The smallest distance between the links' own collision shapes that can touch
+    (:func:`dynid.excitation.link_geometry.self_pairs`) along ``q``.
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+    geometry : LinkGeometry
+
+    Returns
+    -------
+    SelfClearance or None
+        ``pair`` the links (0 for the base); None where no pair can touch.
+    """
+    pairs = self_pairs(robot, geometry)
+    if not pairs:
+        return None
+    d = self_distances(robot, q, geometry, pairs).distance
+    n, c = np.unravel_index(int(np.argmin(d)), d.shape)
+    g, h = pairs[c]
+    return SelfClearance(float(d[n, c]), (int(geometry.link[g]) + 1, int(geometry.link[h]) + 1), float(np.asarray(t)[n]),
+                         len(pairs), (geometry.names[g], geometry.names[h]))

@@ -15,7 +15,7 @@ from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
 from .fourier import FourierTrajectory
-from .link_geometry import LinkGeometry, shape_distances
+from .link_geometry import LinkGeometry, self_distances, self_pairs, shape_distances
 from .obstacles import Obstacle, ObstacleDistances, obstacle_distances, reachable_pairs
 
 AXES = "xyz"
@@ -103,9 +103,24 @@ class Workspace:
             (shape, obstacle) with :attr:`geometry`, else (link, obstacle) that can reach each other
             (:func:`dynid.excitation.obstacles.reachable_pairs`).
         """
-        if self.geometry is not None:
-            return [(g, i) for g in range(len(self.geometry.shapes)) for i in range(len(self.obstacles))]
+        if self.geometry is not None:  # the base's shapes do not move
+            return [(g, i) for g in np.flatnonzero(self.geometry.link >= 0).tolist() for i in range(len(self.obstacles))]
         return reachable_pairs(robot, self.obstacles, self.clearance)
+
+    def self_pairs(self, robot) -> list[tuple[int, int]]:
+        """The pairs of the links' own collision shapes kept apart (:func:`dynid.excitation.link_geometry.self_pairs`);
+        none without :attr:`geometry` (the capsules' self-clearance is reported, not constrained:
+        :mod:`dynid.excitation.collision`).
+
+        Parameters
+        ----------
+        robot : Robot
+
+        Returns
+        -------
+        list of (int, int)
+        """
+        return [] if self.geometry is None else self_pairs(robot, self.geometry)
 
     def cell_distances(self, robot, q, *, pairs=None, gradient: bool = False) -> ObstacleDistances:
         """The links' distances to the cell's bodies beyond the clearance (zero: the clearance kept), by their own
@@ -298,7 +313,35 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
             m = float(hi - (p @ gi).max())
             sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
             out.append(ConstraintMargin("workspace [m]", f"tool {lbl}", sign * float(hi), sign * float(hi) - sign * m, m, np.nan))
-    return out + obstacle_margins(robot, t, q, workspace)
+    return out + obstacle_margins(robot, t, q, workspace) + self_margins(robot, t, q, workspace)
+
+
+def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
+    """How close the links' own collision shapes come to each other along ``q`` (:meth:`Workspace.self_pairs`):
+    one margin, ``worst`` the smallest distance (limit 0: contact); none without the shapes.
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+    workspace : Workspace
+
+    Returns
+    -------
+    list of ConstraintMargin
+        ``where`` names the two shapes and when.
+    """
+    pairs = workspace.self_pairs(robot)
+    if not pairs or workspace.geometry is None:
+        return []
+    d = self_distances(robot, q, workspace.geometry, pairs).distance
+    n, c = np.unravel_index(int(np.argmin(d)), d.shape)
+    g, h = pairs[c]
+    names = workspace.geometry.names
+    worst = float(d[n, c])
+    return [ConstraintMargin("self clearance [m]", f"{names[g]} and {names[h]} at t = {float(t[n]):.3g} s", 0.0,
+                             worst, worst, np.nan)]
 
 
 def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:

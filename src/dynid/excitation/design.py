@@ -36,6 +36,7 @@ from ..threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
+from .link_geometry import self_distances
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -192,8 +193,17 @@ class ExcitationProblem:
                               f"above its limit {lim.tau_max[j]:g} N·m")
 
     def _check_start_clear(self, q0: np.ndarray) -> None:
-        """Every link off the cell's bodies at the start pose: the optimiser cannot pull a link out of a body."""
+        """Every link off the cell's bodies, and the links' shapes off each other, at the start pose: the optimiser
+        cannot pull a link out of a body."""
         ws = self.workspace
+        pairs = ws.self_pairs(self.robot)
+        if pairs and ws.geometry is not None:
+            apart = self_distances(self.robot, q0[None], ws.geometry, pairs).distance[0]
+            if apart.min() < 0:
+                g, h = pairs[int(np.argmin(apart))]
+                raise ConfigError(f"trajectory.offsets: at the start pose (q_o = {np.round(q0, 4).tolist()} rad) the "
+                                  f"collision shapes {ws.geometry.names[g]!r} and {ws.geometry.names[h]!r} touch: start "
+                                  'elsewhere, or set workspace.geometry = "capsules"')
         if not ws.obstacles:
             return
         found = ws.cell_distances(self.robot, q0[None])
@@ -443,6 +453,10 @@ class _Objective:
         self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
         self.pairs = ws.cell_pairs(problem.robot) if ws.obstacles else []  # every link off the cell's bodies
         self.gap = s * reach
+        self.self_pairs = ws.self_pairs(problem.robot)  # and, by their own shapes, off each other: tightened as the
+        if self.self_pairs and ws.geometry is not None:  # cell's, but never past half a pair's distance at the start
+            start = self_distances(problem.robot, problem.start_pose()[None], ws.geometry, self.self_pairs).distance[0]
+            self.self_gap = np.minimum(self.gap, 0.5 * start)
         self.crit = criterion_function(problem.criterion)
 
     def _eval(self, x: np.ndarray) -> None:
@@ -461,6 +475,8 @@ class _Objective:
             self.lift = forward_kinematics(p.robot, self.q)[1][:, self.origins, 2] - self.floor  # (N, m)
         if self.pairs:
             self.clear = self._distances(gradient=False).distance - self.gap  # (N, pairs)
+        if self.self_pairs:
+            self.apart = self._apart(gradient=False).distance - self.self_gap
         self.nfev += 1
         self._x, self._xg = x.copy(), None
 
@@ -485,7 +501,14 @@ class _Objective:
             self.lift_jac = np.einsum("kmi,kix->kmx", jac[:, self.origins, 2, :], lay.lin[0])
         if self.pairs:
             self.clear_jac = np.einsum("kmi,kix->kmx", self._distances(gradient=True).gradient, lay.lin[0])
+        if self.self_pairs:
+            self.apart_jac = np.einsum("kmi,kix->kmx", self._apart(gradient=True).gradient, lay.lin[0])
         self._xg = True
+
+    def _apart(self, *, gradient: bool):
+        geometry = self.p.workspace.geometry
+        assert geometry is not None  # self_pairs are empty without it
+        return self_distances(self.p.robot, self.q, geometry, self.self_pairs, gradient=gradient)
 
     def _distances(self, *, gradient: bool):
         return self.p.workspace.cell_distances(self.p.robot, self.q, pairs=self.pairs, gradient=gradient)
@@ -508,6 +531,8 @@ class _Objective:
             parts.append(self.lift.ravel())
         if self.pairs:
             parts.append(self.clear.ravel())
+        if self.self_pairs:
+            parts.append(self.apart.ravel())
         return np.concatenate(parts)
 
     def cons_jac(self, x):
@@ -520,6 +545,8 @@ class _Objective:
             parts.append(self.lift_jac.reshape(-1, x.size))
         if self.pairs:
             parts.append(self.clear_jac.reshape(-1, x.size))
+        if self.self_pairs:
+            parts.append(self.apart_jac.reshape(-1, x.size))
         return np.concatenate(parts)
 
 

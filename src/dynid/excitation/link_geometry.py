@@ -5,8 +5,9 @@ Pinocchio reads the URDF's ``<collision>`` elements into a geometry model (Carpe
 library", SII 2019); coal holds the shapes. A mesh is replaced by its convex hull (coal's qhull), which contains it:
 a distance to the hull is never larger than the distance to the mesh, and GJK measures it in microseconds where the
 mesh's BVH takes a millisecond. Each shape rides on one of dynid's links: the joint that carries it in the URDF, or
-the nearest of its ancestors that is one of the robot's joints (a gripper held at 0 rides on the last link); shapes
-on the base are left out (no motion brings them anywhere). Its pose in that link's frame is read once at ``q = 0``.
+the nearest of its ancestors that is one of the robot's joints (a gripper held at 0 rides on the last link), or on
+the base (the links keep off it; the cell's bodies are not measured against it: no motion moves it). Its pose in
+that link's frame is read once at ``q = 0``.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ class LinkGeometry:
     shapes : tuple of coal.CollisionGeometry
         Convex hulls of meshes, or the URDF's boxes, cylinders and spheres.
     link : (m,) int array
-        The link (0-based: link ``k`` is the one joint ``k`` moves) each shape rides on.
+        The link (0-based: link ``k`` is the one joint ``k`` moves) each shape rides on; -1 for the base.
     placement : (m, 4, 4) array
         Each shape's pose in its link's frame (dynid's joint frame) [m].
     names : tuple of str
@@ -65,7 +66,9 @@ class LinkGeometry:
         position : (N, m, 3) array [m]
         """
         rots, orig = forward_kinematics(robot, q)
-        r, p = rots[:, self.link], orig[:, self.link]
+        base = self.link < 0  # on the base: its frame
+        r, p = rots[:, np.where(base, 0, self.link)], orig[:, np.where(base, 0, self.link)]
+        r[:, base], p[:, base] = np.eye(3), 0.0
         rotation = r @ self.placement[:, :3, :3]
         position = p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3])
         return rotation, position
@@ -117,11 +120,10 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
         joint = obj.parentJoint
         while joint > 0 and model.names[joint] not in index:
             joint = model.parents[joint]
-        if joint == 0:
-            continue  # on the base
-        k = index[model.names[joint]]
+        k = index[model.names[joint]] if joint > 0 else -1  # -1: on the base
         frame = np.eye(4)
-        frame[:3, :3], frame[:3, 3] = rots[0, k], orig[0, k]
+        if k >= 0:
+            frame[:3, :3], frame[:3, 3] = rots[0, k], orig[0, k]
         world = geometry_data.oMg[g].homogeneous
         shape = obj.geometry
         if isinstance(shape, coal.BVHModelBase):
@@ -131,7 +133,7 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
         link.append(k)
         placement.append(np.linalg.solve(frame, world))
         names.append(obj.name)
-    if not shapes:
+    if not any(k >= 0 for k in link):
         return None
     return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path))
 
@@ -159,7 +161,8 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
         ``pairs`` index the shapes; ``links`` names each pair's link.
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
-    pairs = [(g, i) for g in range(len(geometry.shapes)) for i in range(len(obstacles))] if pairs is None else list(pairs)
+    pairs = ([(g, i) for g in np.flatnonzero(geometry.link >= 0).tolist() for i in range(len(obstacles))]
+             if pairs is None else list(pairs))
     rotation, position = geometry.poses(robot, q)
     bodies = [ob.geometry() for ob in obstacles]
     dist = np.empty((q.shape[0], len(pairs)))
@@ -182,3 +185,83 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
         links = np.array([int(geometry.link[g]) for g, _ in pairs])
         grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
     return ObstacleDistances(pairs, dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+
+
+ALWAYS = 0.95
+"""A pair of shapes that touch on this share of random poses or more is in contact by construction (a joint's two
+housings), as MoveIt's setup assistant finds it: left out of the self-clearance."""
+
+
+def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=0) -> list[tuple[int, int]]:
+    """The pairs of shapes (indices into ``geometry``) whose distance the motion changes and that can touch: on links
+    that are not the same or neighbours in the chain, and not touching on :data:`ALWAYS` of random poses within the
+    joint limits (±π where there are none).
+
+    Parameters
+    ----------
+    robot : Robot
+    geometry : LinkGeometry
+    samples : int
+    rng : int or Generator
+
+    Returns
+    -------
+    list of (int, int)
+    """
+    candidates = [(g, h) for g in range(len(geometry.shapes)) for h in range(g + 1, len(geometry.shapes))
+                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2]
+    if not candidates:
+        return []
+    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
+    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
+    q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
+    touching = self_distances(robot, q, geometry, candidates).distance < 0
+    return [pair for pair, share in zip(candidates, touching.mean(axis=0)) if share < ALWAYS]
+
+
+def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *, gradient: bool = False) -> ObstacleDistances:
+    """Distances between pairs of the links' shapes along ``q`` (no clearance: zero is contact), with their gradient:
+    ``-n·(v_g - v_h)``, ``v`` each nearest point's velocity per joint (``z_j × (p - o_j)`` for the joints up to its
+    link), ``n`` the unit vector from ``g``'s nearest point to ``h``'s.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+    geometry : LinkGeometry
+    pairs : list of (int, int)
+        Shape indices (:func:`self_pairs`).
+    gradient : bool
+
+    Returns
+    -------
+    ObstacleDistances
+        ``pairs`` as given; ``links`` the first shape's link of each.
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    rotation, position = geometry.poses(robot, q)
+    dist = np.empty((q.shape[0], len(pairs)))
+    near = np.zeros((2, q.shape[0], len(pairs), 3))
+    normal = np.zeros((q.shape[0], len(pairs), 3))
+    request = coal.DistanceRequest()
+    request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
+    for c, (g, h) in enumerate(pairs):
+        for n in range(q.shape[0]):
+            result = coal.DistanceResult()
+            coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]),
+                          geometry.shapes[h], coal.Transform3s(rotation[n, h], position[n, h]), request, result)
+            dist[n, c] = result.min_distance
+            if gradient:
+                near[0, n, c], near[1, n, c], normal[n, c] = (result.getNearestPoint1(), result.getNearestPoint2(),
+                                                              away_from(result))
+    grad = None
+    if gradient and pairs:
+        _, orig, axes = frames_and_axes(robot, q)
+        joints = np.arange(robot.n_dof)[None, None, :]
+        grad = np.zeros((q.shape[0], len(pairs), robot.n_dof))
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            links = np.array([int(geometry.link[pair[side]]) for pair in pairs])
+            lever = near[side][:, :, None, :] - orig[:, None, :, :]
+            moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
+            grad += sign * moved * (joints <= links[None, :, None])
+    return ObstacleDistances(list(pairs), dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..excitation.collision import SelfClearance, self_clearance
+from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
 from ..excitation.constraints import ConstraintMargin, obstacle_margins
 from ..excitation.design import ExcitationDesign, design_excitation
 from ..io.cell_replay import CellContacts, cell_contacts
@@ -94,7 +94,8 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     q, dq, ddq = design.trajectory.evaluate(t)
     every = max(1, int(np.ceil(t.size / CLEARANCE_SAMPLES)))  # the set-points, at most this many of them
     p = config.problem
-    clearance = self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance)
+    clearance = (self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance) if p.workspace.geometry is None
+                 else shape_clearance(p.robot, t[::every], q[::every], p.workspace.geometry))
     cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
     return ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace))
 

@@ -120,6 +120,8 @@ def _shape_geoms(root, bodies: dict, geometry) -> None:
         asset = ET.Element("asset")
         root.insert(1, asset)
     for g, (shape, k) in enumerate(zip(geometry.shapes, geometry.link)):
+        if k < 0:
+            continue  # the base's: the cell is not measured against it
         x = geometry.placement[g]
         geom = {"name": f"link{k + 1}_shape{g}", "pos": _vec(x[:3, 3]), "quat": _quat_of(x[:3, :3]), "contype": "1",
                 "conaffinity": "0", "mass": "0", "group": "3"}

@@ -1048,6 +1048,10 @@ def _self_clearance_lines(run) -> list:
         return []
     radius = run.config.problem.workspace.clearance
     where = f"links {c.pair[0]} and {c.pair[1]} at t = {c.time:.3g} s"
+    if c.shapes:  # the URDF's own shapes, kept apart by the design
+        return [Line(f"the links' collision shapes stay {c.distance:.3g} m apart or more (closest: {c.shapes[0]} and "
+                     f"{c.shapes[1]} at t = {c.time:.3g} s; {c.pairs} pairs checked on the set-points)",
+                     "warning" if c.distance < 0 else "text")]
     if c.distance < 0:
         return [Line(f"links that can touch come within each other's {radius:g} m: their capsules overlap by "
                      f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): the design does not "
