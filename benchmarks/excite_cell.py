@@ -82,10 +82,14 @@ def _with_collisions(text: str, keep: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def _pinocchio_check(path: Path, robot, q: np.ndarray, ws: Workspace) -> float:
-    """Smallest distance beyond the clearance from any moving collision hull to the box, by Pinocchio alone."""
+def _pinocchio_check(path: Path, robot, q: np.ndarray, ws: Workspace) -> tuple[float, float]:
+    """By Pinocchio alone (its geometry model of the URDF, its kinematics, the meshes' hulls): the smallest distance
+    beyond the clearance from a moving shape to the box, and the smallest distance between the shape pairs dynid
+    keeps apart."""
     import coal
     import pinocchio as pin
+
+    from dynid.excitation.link_geometry import self_pairs
 
     model = pin.buildModelFromUrdf(str(path))
     geom = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.COLLISION)
@@ -99,9 +103,13 @@ def _pinocchio_check(path: Path, robot, q: np.ndarray, ws: Workspace) -> float:
     moving = [g for g, obj in enumerate(geom.geometryObjects) if obj.parentJoint > 0]
     for g in moving:
         geom.addCollisionPair(pin.CollisionPair(g, bid))
+    n_box = len(moving)
+    names = ws.geometry.names
+    for g, h in self_pairs(robot, ws.geometry):
+        geom.addCollisionPair(pin.CollisionPair(geom.getGeometryId(names[g]), geom.getGeometryId(names[h])))
     data, gdata = model.createData(), pin.GeometryData(geom)
     ids = [model.getJointId(j.name) for j in robot.joints]
-    best = np.inf
+    best, apart = np.inf, np.inf
     for n in range(q.shape[0]):
         qn = pin.neutral(model)
         for j, jid in enumerate(ids):
@@ -111,8 +119,10 @@ def _pinocchio_check(path: Path, robot, q: np.ndarray, ws: Workspace) -> float:
             else:
                 qn[iq] = q[n, j]
         pin.computeDistances(model, data, geom, gdata, qn)
-        best = min(best, min(r.min_distance for r in gdata.distanceResults))
-    return best - ws.clearance
+        d = [r.min_distance for r in gdata.distanceResults]
+        best = min(best, min(d[:n_box]))
+        apart = min(apart, min(d[n_box:], default=np.inf))
+    return best - ws.clearance, apart
 
 
 def _start(robot) -> np.ndarray:
@@ -193,13 +203,15 @@ def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False) -> dict:
             print(f"  {name} seed {seed}: refused: {exc}", flush=True)
             continue
         t = np.arange(int(round(1000 / FREQUENCY))) / 1000.0  # one period at 1 kHz
-        check = (lambda q: (_pinocchio_check(path, robot, q, ws), _brute_force(robot, q, ws)[1])) if meshes else (
-            lambda q: _brute_force(robot, q, ws))
-        box_d, floor_d = check(with_box.trajectory.evaluate(t)[0])
-        free_d, _ = check(without.trajectory.evaluate(t)[0])
-        rows.append(dict(seed=seed, refused=None, box=box_d, floor=floor_d, crossed=free_d < 0, cond=with_box.cond,
+        q_box, q_free = with_box.trajectory.evaluate(t)[0], without.trajectory.evaluate(t)[0]
+        if meshes:
+            (box_d, apart), floor_d = _pinocchio_check(path, robot, q_box, ws), _brute_force(robot, q_box, ws)[1]
+            free_d = _pinocchio_check(path, robot, q_free, ws)[0]
+        else:
+            (box_d, floor_d), (free_d, _), apart = _brute_force(robot, q_box, ws), _brute_force(robot, q_free, ws), np.inf
+        rows.append(dict(seed=seed, refused=None, box=box_d, apart=apart, floor=floor_d, crossed=free_d < 0, cond=with_box.cond,
                          cond_free=without.cond, time=t_box, time_free=t_free))
-        print(f"  {name} seed {seed}: box {box_d:+.4f} m, floor {floor_d:+.4f} m, collision-free design "
+        print(f"  {name} seed {seed}: box {box_d:+.4f} m, floor {floor_d:+.4f} m, shapes apart {apart:+.4f} m, collision-free design "
               f"{free_d:+.4f} m; cond {with_box.cond:.1f} / {without.cond:.1f}; {t_box:.1f} / {t_free:.1f} s", flush=True)
     return dict(name=name, n=robot.n_dof, rows=rows)
 
@@ -212,13 +224,13 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         results = [run_arm(name, args.seeds, Path(tmp), args.geometry == "collision") for name in args.arms.split(",")]
-    print("\n| arm | joints | seeds | in the box or under the floor (1 kHz) | free design crosses the box | "
+    print("\n| arm | joints | seeds | in the box, under the floor or shapes touching (1 kHz) | free design crosses the box | "
           "cond ratio, box does not bind | cond ratio, box binds | time ratio (median) |")
     print("|---|---|---|---|---|---|---|---|")
     for r in results:
         refused = sum(x["refused"] is not None for x in r["rows"])
         rows = [x for x in r["rows"] if x["refused"] is None]
-        bad = sum(x["box"] < -1e-6 or x["floor"] < -1e-6 for x in rows)
+        bad = sum(x["box"] < -1e-6 or x["floor"] < -1e-6 or x["apart"] < -1e-6 for x in rows)
         free = [x["cond"] / x["cond_free"] for x in rows if not x["crossed"]]
         bind = [x["cond"] / x["cond_free"] for x in rows if x["crossed"]]
         span = lambda v: f"{min(v):.2f}-{max(v):.2f}" if v else "—"  # noqa: E731

@@ -52,6 +52,27 @@ class LinkGeometry:
     names: tuple[str, ...]
     source: str
 
+    def spheres(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each shape's bounding sphere (coal's local box, half its diagonal) along ``q``.
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+
+        Returns
+        -------
+        centre : (N, m, 3) array [m]
+        radius : (m,) array [m]
+        """
+        rotation, position = self.poses(robot, q)
+        local, radius = [], []
+        for shape in self.shapes:
+            shape.computeLocalAABB()
+            local.append(np.asarray(shape.aabb_center, dtype=float))
+            radius.append(float(shape.aabb_radius))
+        return position + np.einsum("nmij,mj->nmi", rotation, np.array(local)), np.array(radius)
+
     def poses(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every shape's rotation and position in the base frame.
 
@@ -165,18 +186,22 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
              if pairs is None else list(pairs))
     rotation, position = geometry.poses(robot, q)
     bodies = [ob.geometry() for ob in obstacles]
-    dist = np.empty((q.shape[0], len(pairs)))
-    near, normal = np.zeros((2, q.shape[0], len(pairs), 3))
+    centre, radius = geometry.spheres(robot, q)
+    g_of, i_of = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
+    ob_centre = np.array([ob.position for ob in obstacles])[i_of] if pairs else np.zeros((0, 3))
+    ob_radius = np.array([ob.bounding_radius() for ob in obstacles])[i_of] if pairs else np.zeros(0)
+    gap = centre[:, g_of] - ob_centre[None]  # (N, P, 3): the bound's direction, body to shape
+    dist = np.linalg.norm(gap, axis=-1) - radius[g_of] - ob_radius - clearance  # a lower bound, exact far away
+    near, normal = centre[:, g_of].copy(), -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    for c, (g, i) in enumerate(pairs):
+    for n, c in zip(*np.nonzero(dist < FAR)):
+        g, i = pairs[c]
         body, pose = bodies[i]
-        for n in range(q.shape[0]):
-            result = coal.DistanceResult()
-            coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]), body, pose, request, result)
-            dist[n, c] = result.min_distance - clearance
-            if gradient:
-                near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
+        result = coal.DistanceResult()
+        coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]), body, pose, request, result)
+        dist[n, c] = result.min_distance - clearance
+        near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
     grad = None
     if gradient and pairs:  # -z_j·((p - o_j) × n) for the joints up to the shape's link
         _, orig, axes = frames_and_axes(robot, q)
@@ -186,6 +211,10 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
         grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
     return ObstacleDistances(pairs, dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))
 
+
+FAR = 0.1
+"""[m] Where two bounding spheres are this far apart, their distance stands for the shapes' (a lower bound, smooth,
+with its own gradient): the constraint is far from binding, and GJK runs only on the pairs that are near."""
 
 ALWAYS = 0.95
 """A pair of shapes that touch on this share of random poses or more is in contact by construction (a joint's two
@@ -240,20 +269,21 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
     rotation, position = geometry.poses(robot, q)
-    dist = np.empty((q.shape[0], len(pairs)))
-    near = np.zeros((2, q.shape[0], len(pairs), 3))
-    normal = np.zeros((q.shape[0], len(pairs), 3))
+    centre, radius = geometry.spheres(robot, q)
+    a, b = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
+    gap = centre[:, b] - centre[:, a]  # (N, P, 3)
+    dist = np.linalg.norm(gap, axis=-1) - radius[a] - radius[b]  # a lower bound, exact far away
+    near = np.stack([centre[:, a], centre[:, b]])
+    normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    for c, (g, h) in enumerate(pairs):
-        for n in range(q.shape[0]):
-            result = coal.DistanceResult()
-            coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]),
-                          geometry.shapes[h], coal.Transform3s(rotation[n, h], position[n, h]), request, result)
-            dist[n, c] = result.min_distance
-            if gradient:
-                near[0, n, c], near[1, n, c], normal[n, c] = (result.getNearestPoint1(), result.getNearestPoint2(),
-                                                              away_from(result))
+    for n, c in zip(*np.nonzero(dist < FAR)):
+        g, h = pairs[c]
+        result = coal.DistanceResult()
+        coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]),
+                      geometry.shapes[h], coal.Transform3s(rotation[n, h], position[n, h]), request, result)
+        dist[n, c] = result.min_distance
+        near[0, n, c], near[1, n, c], normal[n, c] = result.getNearestPoint1(), result.getNearestPoint2(), away_from(result)
     grad = None
     if gradient and pairs:
         _, orig, axes = frames_and_axes(robot, q)
