@@ -16,6 +16,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
+import coal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -113,8 +114,6 @@ def cell_mjcf(robot: Robot, workspace: Workspace) -> str:
 def _shape_geoms(root, bodies: dict, geometry) -> None:
     """The links' own collision shapes as geoms of their bodies (a convex hull as a mesh of its points: MuJoCo
     collides a mesh by its convex hull, the same one)."""
-    import coal
-
     asset = root.find("asset")
     if asset is None:
         asset = ET.Element("asset")
