@@ -1,6 +1,7 @@
 """A written URDF read back by Pinocchio, and a written MJCF by MuJoCo, reproduce dynid's model where the format can
 hold it (issue "The model proven where it goes", item 1); a file that lost a value does not, and the check says so."""
 
+import json
 import re
 from importlib import resources
 from pathlib import Path
@@ -68,8 +69,15 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
-    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", "-q")
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
     assert p.returncode == 0, p.stderr
+    # identify reads back the files it wrote, on the validation log: results.json, the terminal and the report say it
+    taken = json.loads((tmp_path / "out" / "results.json").read_text())["files_taken_away"]
+    assert taken["log"] == "validation" and [f["format"] for f in taken["files"]] == ["URDF", "MJCF"]
+    assert taken["files"][0]["equals_model_to"] < 1e-9 and taken["files"][0]["samples"] > 100
+    assert taken["files"][0]["file_vs_measured"] >= taken["files"][0]["model_vs_measured"] > 0
+    assert f"{taken['files'][0]['file']} read back by Pinocchio on validation" in " ".join(p.stdout.split())
+    assert "The files you take away" in (tmp_path / "out" / "report.html").read_text()
     p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "m.urdf",
               "--mjcf", tmp_path / "m.xml")
     assert p.returncode == 0, p.stderr
@@ -81,8 +89,8 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
                             r"their RMS", said).group(1))
     assert error < 1e-6 and "MuJoCo's frictionloss is a constraint" in said
     # read back on the validation log's samples, and scored against its measured torques beside dynid's model
-    on_log = re.search(r"m\.urdf read back by Pinocchio: .*?\(the (\d+) samples of validation\).*?against the measured "
-                       r"torques the file is (\S+) % off, dynid's whole model (\S+) %", said)
+    on_log = re.search(r"m\.urdf read back by Pinocchio: .*?\(the (\d+) samples of validation\).*?against the log's "
+                       r"unfiltered measured torques the file is (\S+) % off, dynid's whole model (\S+) %", said)
     assert on_log is not None and int(on_log.group(1)) > 100
     assert float(on_log.group(2)) >= float(on_log.group(3)) > 0  # the file lacks the offset the model holds
     p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--mjcf", tmp_path / "f.xml", "--forward")

@@ -281,16 +281,29 @@ def identify(
         urdf, mjcf = identified[2].urdf, identified[2].mjcf_model
         return save_identification(identified[1], out, figures, robot=identified[0], urdf=urdf,
                                    urdf_name=None if urdf is None else model_file_name(urdf, out), mjcf_model=mjcf,
-                                   mjcf_name=None if mjcf is None else model_file_name(mjcf, out), mjcf_folder=out)
+                                   mjcf_name=None if mjcf is None else model_file_name(mjcf, out), mjcf_folder=out,
+                                   config=identified[2])
 
     def show(rep, identified, paths):
         from ..report.summaries import identification_brief
 
         blocks = summary_blocks(identified[1]) if verbose else identification_brief(identified[1])
         rep.blocks(_runnable_advice(blocks, config, out))
+        rep.blocks(_taken_away(out))
         rep.wrote(paths)
 
     _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
+
+
+def _taken_away(out: Path) -> list:
+    """The lines on the files ``dynid identify`` wrote, read back (results.json's ``files_taken_away``)."""
+    import json
+
+    from ..report.summaries import taken_away_lines
+
+    path = out / "results.json"
+    taken = json.loads(path.read_text(encoding="utf-8")).get("files_taken_away") if path.is_file() else None
+    return taken_away_lines(taken) if taken else []
 
 
 def _runnable_advice(blocks, config: Path, out: Path) -> list:
@@ -429,8 +442,8 @@ def export(
                 said += (f"; what {form} cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
                          f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
             if check.file_vs_measured is not None:
-                said += (f"; against the measured torques the file is {check.file_vs_measured:.3g} % off, dynid's whole "
-                         f"model {check.model_vs_measured:.3g} %")
+                said += (f"; against the log's unfiltered measured torques the file is {check.file_vs_measured:.3g} % off, "
+                         f"dynid's whole model {check.model_vs_measured:.3g} %")
             (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
         if simulated is not None:
             rep.line(simulated)

@@ -205,7 +205,21 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     comparisons = ([d["identification"]] if "identification" in d else []) + list(d.get("validation", []))
     if comparisons:
         sections.append(Section("Measured against predicted torques", _comparison_tables(comparisons)))
+    if d.get("files_taken_away"):
+        sections.append(_taken_away_section(d["files_taken_away"]))
     return settings, sections
+
+
+def _taken_away_section(taken: dict) -> Section:
+    """"The files you take away": the URDF and MJCF written, read back by Pinocchio and MuJoCo."""
+    rows = [[f["file"], f["read_by"], "—" if "not_read_back" in f else _fmt(f["equals_model_to"], ".1e"),
+             _fmt(f.get("file_vs_measured")), _fmt(f.get("model_vs_measured")), ", ".join(f.get("cannot_hold", [])) or "—"]
+            for f in taken["files"]]
+    where = f"the validation log {taken['log']}" if taken["log"] else "random states within the joint limits"
+    return Section("The files you take away", [Table(
+        f"Read back on {where}", ["file", "read by", "equals dynid's model to", "vs unfiltered measured (%)",
+                                  "dynid's whole model vs the same (%)", "what the format cannot hold"], rows)],
+        [f["file"] + ": " + f["not_read_back"] for f in taken["files"] if "not_read_back" in f])
 
 
 def _identify_summary(d: dict) -> list[str]:

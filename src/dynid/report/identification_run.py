@@ -5,10 +5,12 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from ..exceptions import DynIdError
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
 from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot
 from ..io.mjcf_write_back import mjcf_written_back
+from ..io.replay import mjcf_replay, urdf_replay
 from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
 from . import figures
@@ -66,7 +68,7 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None,
                         urdf: str | Path | None = None, urdf_name: str | None = None,
                         mjcf_model: str | Path | None = None, mjcf_name: str | None = None,
-                        mjcf_folder: str | Path | None = None) -> list[Path]:
+                        mjcf_folder: str | Path | None = None, config=None) -> list[Path]:
     """Write an identification's results and figures.
 
     ``results.json``, ``report.html``, the identification fit figure and one figure per validation dataset; with
@@ -98,6 +100,9 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
     mjcf_folder : str or Path, optional
         The folder the MJCF ends up in, from which its relative paths (meshes, includes) are rewritten (default
         ``out``; the command's output folder when ``out`` is a staging folder inside it).
+    config : IdentificationConfig, optional
+        The config: the written files are read back on its first moving validation log (:func:`taken_away`;
+        results.json's ``files_taken_away``), else on random states.
     """
     out = Path(out)  # staged passes its staging folder
     paths = []
@@ -107,26 +112,85 @@ def save_identification(result: IdentificationResult, out: str | Path, figures_t
         paths = save_comparisons((result.fit, *result.validations), out, names=names)
     json_path = out / "results.json"
     data = result.to_dict()
+    models = _model_texts(data, out, robot, urdf, urdf_name, mjcf_model, mjcf_name, mjcf_folder)
+    if models:
+        data["files_taken_away"] = taken_away(models, robot, data, config)
     write_results(json_path, data, "identify")
     write_html_report(out / "report.html", data, "identify", paths, f"dynid identify — {result.robot}")
     paths.insert(0, out / "report.html")
-
-    sdp = stored_standard(data)
-    if robot is not None and sdp is not None and data["physically_consistent_verdict"].get(sdp[0]) == "yes":
-        fitted, phi = consistent_estimate(robot, data)
-        if urdf is None:
-            model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
-        else:
-            model = (out / (urdf_name or Path(urdf).name), urdf_written_back(urdf, fitted, phi)[0])
-        if mjcf_model is None:
-            mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi))
-        else:
-            mjcf = (out / (mjcf_name or Path(mjcf_model).name),
-                    mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out)[0])
-        paths[:0] = [model[0], mjcf[0]]
-        for path, text in (model, mjcf):
-            atomic_write_text(path, text)
+    paths[:0] = [path for path, _ in models]
+    for path, text in models:
+        atomic_write_text(path, text)
     return [json_path] + paths
+
+
+def _model_texts(data: dict, out: Path, robot, urdf, urdf_name, mjcf_model, mjcf_name, mjcf_folder) -> list:
+    """The URDF and the MJCF :func:`save_identification` writes, as ``[(path, text), ...]``: none unless the physically
+    consistent estimate passed its check."""
+    sdp = stored_standard(data)
+    if robot is None or sdp is None or data["physically_consistent_verdict"].get(sdp[0]) != "yes":
+        return []
+    fitted, phi = consistent_estimate(robot, data)
+    if urdf is None:
+        model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
+    else:
+        model = (out / (urdf_name or Path(urdf).name), urdf_written_back(urdf, fitted, phi)[0])
+    if mjcf_model is None:
+        mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi))
+    else:
+        mjcf = (out / (mjcf_name or Path(mjcf_model).name),
+                mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out)[0])
+    return [model, mjcf]
+
+
+def taken_away(models: list, robot, data: dict, config=None) -> dict:
+    """The files an identification writes read back by the tools they are for (issue "The model proven where it
+    goes", item 1): the URDF by Pinocchio, the MJCF by MuJoCo (:mod:`dynid.io.replay`), on the config's first moving
+    validation log where there is one (:func:`dynid.identification.run.moving_validation`), else on random states.
+
+    Parameters
+    ----------
+    models : list of (Path, str)
+        The URDF's and the MJCF's paths and texts.
+    robot : Robot
+        The identified robot.
+    data : dict
+        results.json.
+    config : IdentificationConfig, optional
+        Where the validation logs are.
+
+    Returns
+    -------
+    dict
+        ``log`` (None: random states), and per file its format, the tool, how closely it equals dynid's model, what
+        it cannot hold and, on a log, its error and dynid's whole model's against the measured torques [%].
+    """
+    from ..identification.run import moving_validation
+
+    fitted, phi = consistent_estimate(robot, data)
+    log = None
+    if config is not None and config.validation:
+        try:
+            log = moving_validation(config, data, fitted)
+        except DynIdError:  # a log that cannot be read again here: random states
+            log = None
+    on = {} if log is None else {"states": log[1][1:4], "measured": log[1][4]}
+    files = []
+    for (path, text), (form, tool, replay) in zip(models, (("URDF", "Pinocchio", urdf_replay),
+                                                           ("MJCF", "MuJoCo", mjcf_replay))):
+        entry: dict = {"file": path.name, "format": form, "read_by": tool}
+        try:
+            check = replay(text, fitted, phi, **on)
+        except ImportError:
+            entry["not_read_back"] = f"{tool} is not installed (pip install 'dynid[mujoco]')"
+        except (ValueError, KeyError) as exc:  # a user's model MuJoCo cannot load from its text alone
+            entry["not_read_back"] = f"{tool} could not load it from its text ({str(exc).splitlines()[0]})"
+        else:
+            entry.update(equals_model_to=check.relative_error, samples=check.n_states, cannot_hold=list(check.missing),
+                         cannot_hold_share=[float(x) for x in check.missing_share],
+                         file_vs_measured=check.file_vs_measured, model_vs_measured=check.model_vs_measured)
+        files.append(entry)
+    return {"log": None if log is None else log[0], "files": files}
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:

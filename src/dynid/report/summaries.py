@@ -338,6 +338,37 @@ def readiness(result) -> Line:
                 "CONFIG --urdf FILE --mjcf FILE)", "title")
 
 
+def taken_away_lines(taken: dict) -> list:
+    """What ``dynid identify`` says of the files it wrote, read back by their tools (results.json's
+    ``files_taken_away``, :func:`dynid.report.identification_run.taken_away`).
+
+    Parameters
+    ----------
+    taken : dict
+
+    Returns
+    -------
+    list of Line
+    """
+    where = f"on {taken['log']}" if taken["log"] else "on random states within the joint limits"
+    out = []
+    for f in taken["files"]:
+        if "not_read_back" in f:
+            out.append(Line(f"{f['file']} not read back: {f['not_read_back']}"))
+            continue
+        said = (f"{f['file']} read back by {f['read_by']} {where} ({f['samples']} samples): equals dynid's model to "
+                f"{f['equals_model_to']:.1e} of its RMS where {f['format']} can hold it")
+        if f.get("file_vs_measured") is not None:
+            said += (f"; against the log's unfiltered measured torques {f['file_vs_measured']:.3g} %, dynid's whole "
+                     f"model {f['model_vs_measured']:.3g} %")
+        if f["cannot_hold"]:
+            j = max(range(len(f["cannot_hold_share"])), key=lambda k: f["cannot_hold_share"][k])
+            said += (f"; it cannot hold {', '.join(f['cannot_hold'])} (up to {f['cannot_hold_share'][j]:.3g} % of "
+                     f"J{j + 1}'s RMS torque: the file's comments say how to add them)")
+        out.append(Line(said, "warning" if f["equals_model_to"] > 1e-6 else "text"))
+    return out
+
+
 def identification_brief(result) -> list:
     """What ``dynid identify`` prints without ``--verbose``: the title, how it went and what to do next
     (:func:`in_short`), the verdict's findings and the warnings; every table is in ``--verbose`` and the report.
