@@ -14,8 +14,9 @@ from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
+from .collision import shape_clearance
 from .fourier import FourierTrajectory
-from .link_geometry import LinkGeometry, self_distances, self_pairs, shape_distances
+from .link_geometry import LinkGeometry, self_pairs, shape_distances
 from .obstacles import Obstacle, ObstacleDistances, obstacle_distances, reachable_pairs
 
 AXES = "xyz"
@@ -332,16 +333,13 @@ def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspac
     list of ConstraintMargin
         ``where`` names the two shapes and when.
     """
-    pairs = workspace.self_pairs(robot)
-    if not pairs or workspace.geometry is None:
+    if workspace.geometry is None:
         return []
-    d = self_distances(robot, q, workspace.geometry, pairs).distance
-    n, c = np.unravel_index(int(np.argmin(d)), d.shape)
-    g, h = pairs[c]
-    names = workspace.geometry.names
-    worst = float(d[n, c])
-    return [ConstraintMargin("self clearance [m]", f"{names[g]} and {names[h]} at t = {float(t[n]):.3g} s", 0.0,
-                             worst, worst, np.nan)]
+    found = shape_clearance(robot, t, q, workspace.geometry)
+    if found is None:
+        return []
+    return [ConstraintMargin("self clearance [m]", f"{found.shapes[0]} and {found.shapes[1]} at t = {found.time:.3g} s",
+                             0.0, found.distance, found.distance, np.nan)]
 
 
 def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
