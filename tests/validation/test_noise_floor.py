@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from dynid.validation.noise_floor import torque_noise
+from dynid.validation.noise_floor import looks_filtered, torque_noise
 
 from ..cli.refusals import dynid
 from ..simulated_logs import simulated_case
@@ -52,3 +52,46 @@ def test_a_verdict_at_the_noise_floor_does_not_blame_the_model(tmp_path):
     assert err <= 1.5 * v["noise_floor"]["global_relative_error"]
     assert "floor" in kinds and "validation" not in kinds
     assert "at the noise floor" in " ".join(p.stdout.split())
+
+
+def test_torques_filtered_before_dynid_are_recognised(rng):
+    """White noise of 1 % of the RMS on a motion: raw, it is measured; low-pass filtered at 3 Hz of 100 Hz (as a
+    controller or a bag recorder may) or absent, the log is recognised and its floor is unknown."""
+    from scipy.signal import butter, filtfilt
+
+    t = np.arange(3000) / 100.0
+    motion = 40 * np.sin(2 * np.pi * 0.2 * t)[:, None] * np.array([1.0, 0.3]) + 5.0
+    raw = motion + rng.normal(size=motion.shape) * 0.01 * np.sqrt(np.mean(motion**2, axis=0))
+    b, a = butter(4, 3.0 / 50.0)
+    assert not looks_filtered(raw)
+    assert looks_filtered(filtfilt(b, a, raw, axis=0)) and looks_filtered(motion)
+    dead = raw.copy()
+    dead[:, 1] = 0.0  # a joint without torque neither hides nor shows the noise of the other
+    assert not looks_filtered(dead)
+    quiet = raw.copy()
+    quiet[:, 1] = motion[:, 1]  # the median joint decides, not the quietest
+    assert not looks_filtered(np.column_stack([raw, quiet[:, 1:]]))
+
+
+def test_a_log_filtered_before_dynid_gets_no_floor_and_a_finding(tmp_path):
+    """Simulated ER-16 logs at 100 Hz whose currents were low-pass filtered at 3 Hz before dynid read them: the verdict
+    names both logs, and no floor is claimed; the same logs unfiltered get their floor and no such finding."""
+    from scipy.signal import butter, filtfilt
+
+    cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", seed=2, duration=20.0)
+    p = dynid("identify", cfg, "--out", tmp_path / "raw", "--no-figures")
+    raw = json.loads((tmp_path / "raw" / "results.json").read_text())
+    assert p.returncode == 0 and "noise_floor" in raw["validation"][0]
+    assert not [f for f in raw["findings"] if f["kind"] == "filtered"]
+    b, a = butter(4, 3.0 / 50.0)
+    for name in ("ident.csv", "valid.csv"):  # time, 6 positions, 6 currents
+        log = np.loadtxt(tmp_path / name, delimiter=",")
+        log[:, 7:] = filtfilt(b, a, log[:, 7:], axis=0)
+        np.savetxt(tmp_path / name, log, delimiter=",", fmt="%.10g")
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    [found] = [f for f in results["findings"] if f["kind"] == "filtered"]
+    assert found["text"].startswith("identification, validation: the torques carry no measurable sample-to-sample noise")
+    assert "noise_floor" not in results["validation"][0]
+    assert "at the noise floor" not in " ".join(p.stdout.split())

@@ -30,6 +30,8 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over, yardstick_settings
 from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
+from ..validation.diagnostics import Finding
+from ..validation.noise_floor import SMOOTH, looks_filtered
 from .verdict import choose_main_estimate, nominal_set
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
@@ -168,6 +170,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     prepared = pipeline.prepare(recording, base, step)
     raw = recording if config.closed_loop else None  # the closed-loop estimators prepare the log themselves
     reference = yardstick_reference(recording) if validate and config.validation else None
+    smooth = filtered_finding([config.identification.name, *(spec.name for spec in config.validation if validate)],
+                              [recording, *checked])
     del recording  # the raw positions and velocities: only the filtered ones are used from here
     if prepared.base is not base:  # the friction models chosen changed the map: the references follow it
         refs = _references(replace(config, robot=prepared.robot), prepared.base)
@@ -180,7 +184,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
     if not validate or not config.validation:
-        return result
+        return replace(result, findings=tuple(result.findings) + smooth)
     sets = result.parameter_sets()
     nominal = nominal_set(robot, base, result.references)
     if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
@@ -198,7 +202,36 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), prepared.data.settings,
                                  reference, progress)
-    return with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick), yardstick)
+    result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick), yardstick)
+    return replace(result, findings=tuple(result.findings) + smooth)
+
+
+def filtered_finding(names: list, recordings: list) -> tuple:
+    """A finding naming the logs whose torques carry no measurable sample-to-sample noise
+    (:func:`dynid.validation.noise_floor.looks_filtered`: filtered before dynid read them, or simulated without
+    noise): their noise floor is unknown, and a fit near zero error there says little (issue "Never worse than the
+    description", item 5).
+
+    Parameters
+    ----------
+    names : list of str
+    recordings : list of Recording
+        As read, raw.
+
+    Returns
+    -------
+    tuple of Finding
+        Empty where every log carries noise.
+    """
+    smooth = [name for name, rec in zip(names, recordings) if looks_filtered(rec.tau)]
+    if not smooth:
+        return ()
+    return (Finding("filtered", f"{', '.join(smooth)}: the torques carry no measurable sample-to-sample noise (below "
+                                f"{SMOOTH:g} % of their RMS on the median joint; raw sensor logs show 2-4 %): they were "
+                                "low-pass filtered before dynid read them, or simulated without noise. Their noise floor "
+                                "is unknown, the errors measure the fit to an already smoothed torque, and the rest "
+                                "thresholds read from the same logs may be too low: log the raw torques (and positions) "
+                                "if the controller can, or give [preprocessing] rest_velocity for a joint that creeps"),)
 
 
 YARDSTICK = ("each validation log prepared by dynid's default rules (filters, samples kept, rest threshold), carried "

@@ -52,7 +52,8 @@ class Finding:
     kind : str
         "sign", "scale", "order", "friction", "position", "correlated", "excitation", "extrapolation", "validation",
         "delay", "main" (the verdict's choice), "drive" (a drive term no drive has:
-        :mod:`dynid.identification.plausibility`).
+        :mod:`dynid.identification.plausibility`), "filtered" (torques without measurable noise:
+        :func:`dynid.validation.noise_floor.looks_filtered`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None

@@ -11,6 +11,9 @@ the paper's eq. 17 preprocessing; Donoho & Johnstone 1994 for the MAD estimate o
 
 The floor of a joint is that filtered σ [N·m], as an RMSE, and ``100·σ / RMS τ`` as a relative error; over all joints
 ``100·sqrt(Σσ²) / sqrt(Σ RMS τ²)``. A set whose error is near its floor is as good as the samples allow.
+
+A log filtered before dynid read it keeps almost no sample-to-sample noise: its floor would read near 0 and say
+nothing of the sensor. Such a log is recognised (:func:`looks_filtered`) and its floor is unknown.
 """
 
 from __future__ import annotations
@@ -19,10 +22,39 @@ import numpy as np
 
 from ..preprocessing.bands import decimation_cutoff
 
-__all__ = ["AT_FLOOR", "torque_noise", "scored_bandwidth", "noise_floor"]
+__all__ = ["AT_FLOOR", "SMOOTH", "looks_filtered", "torque_noise", "scored_bandwidth", "noise_floor"]
 
 AT_FLOOR = 1.5
 """An error at most this many times the floor is "at the noise floor"."""
+
+
+SMOOTH = 0.1
+"""[%] A log whose torques' sample-to-sample noise (:func:`torque_noise`) is below this share of their RMS on the
+median joint was low-pass filtered before dynid read it, or simulated without noise. Measured (2026-11-26): the raw
+logs of ../shared/data show medians of 2.4-4.3 % (single joints 0.28-12 %); the UR10e's log filtered at 3 Hz 0.019 %,
+a simulated ER-16 log filtered at 3 Hz 0.034 %; the issue's ROS 2 bag of filtered currents reported 0.002 %. What is
+left in such a log is the motion's own second difference, not the sensor's noise: its noise floor cannot be read
+from it."""
+
+
+def looks_filtered(tau) -> bool:
+    """Whether a log's torques carry no measurable sample-to-sample noise (:data:`SMOOTH`).
+
+    Parameters
+    ----------
+    tau : (N, n_dof) array or StoredColumns [N·m]
+        Raw measured torques, as read.
+
+    Returns
+    -------
+    bool
+        False for a log of fewer than 3 samples or with no joint that carries torque.
+    """
+    noise = torque_noise(tau)
+    rms = np.array([float(np.sqrt(np.mean(np.square(np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j],
+                                                                 dtype=float))))) for j in range(tau.shape[1])])
+    live = rms > 0
+    return bool(live.any() and tau.shape[0] >= 3 and np.median(100.0 * noise[live] / rms[live]) < SMOOTH)
 
 
 def torque_noise(tau) -> np.ndarray:
@@ -78,7 +110,7 @@ def scored_bandwidth(settings, rate: float) -> float:
     return float(min(1.0, cutoff * _noise_bandwidth(int(settings.order)) / (rate / 2)))
 
 
-def noise_floor(data) -> np.ndarray:
+def noise_floor(data) -> np.ndarray | None:
     """Each joint's noise floor on the samples a prepared log is scored on (module docstring).
 
     Parameters
@@ -87,7 +119,10 @@ def noise_floor(data) -> np.ndarray:
 
     Returns
     -------
-    (n_dof,) ndarray [N·m]
-        The RMSE a perfect model would have there.
+    (n_dof,) ndarray [N·m] or None
+        The RMSE a perfect model would have there; None (unknown) for torques without measurable noise
+        (:func:`looks_filtered`: filtered before dynid read them, the floor is not in them any more).
     """
+    if looks_filtered(data.tau):
+        return None
     return torque_noise(data.tau) * np.sqrt(scored_bandwidth(data.settings, data.rate))
