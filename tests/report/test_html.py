@@ -48,7 +48,9 @@ def test_run_and_identify_reports_hold_their_tables_and_figures(tmp_path):
     assert p.returncode == 0, p.stderr
     report = _parse(tmp_path / "id" / "report.html")
     n_logs = 2  # the identification log and the validation log
-    assert report.tables == 2 + n_logs and not report.external  # parameters, verdicts, one per log
+    # parameters, verdicts, one per log, and the files it wrote read back (the SDP passed its check)
+    assert report.tables == 2 + n_logs + 1 and not report.external
+    assert "The files you take away" in " ".join(report.text)
     assert len(report.images) == len(list((tmp_path / "id").glob("*.png"))) == n_logs
     text = " ".join(report.text)
     assert "truth" in text and "dynid SDP" in text and "excitation band" in text
