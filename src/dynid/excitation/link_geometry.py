@@ -201,7 +201,8 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
         result = coal.DistanceResult()
         coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]), body, pose, request, result)
         dist[n, c] = result.min_distance - clearance
-        near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
+        if gradient:
+            near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
     grad = None
     if gradient and pairs:  # -z_j·((p - o_j) × n) for the joints up to the shape's link
         _, orig, axes = frames_and_axes(robot, q)
@@ -277,13 +278,21 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
+    placed: dict = {}  # (sample, shape) -> coal's pose, made once: a shape is in several pairs
+
+    def pose(n, g):
+        if (n, g) not in placed:
+            placed[n, g] = coal.Transform3s(rotation[n, g], position[n, g])
+        return placed[n, g]
+
     for n, c in zip(*np.nonzero(dist < FAR)):
         g, h = pairs[c]
         result = coal.DistanceResult()
-        coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]),
-                      geometry.shapes[h], coal.Transform3s(rotation[n, h], position[n, h]), request, result)
+        coal.distance(geometry.shapes[g], pose(n, g), geometry.shapes[h], pose(n, h), request, result)
         dist[n, c] = result.min_distance
-        near[0, n, c], near[1, n, c], normal[n, c] = result.getNearestPoint1(), result.getNearestPoint2(), away_from(result)
+        if gradient:
+            near[0, n, c], near[1, n, c], normal[n, c] = (result.getNearestPoint1(), result.getNearestPoint2(),
+                                                          away_from(result))
     grad = None
     if gradient and pairs:
         _, orig, axes = frames_and_axes(robot, q)
