@@ -195,3 +195,28 @@ def test_mujoco_and_coal_agree_on_a_turned_cylinder_and_box(er16, rng):
     touching = np.array([cell_contacts(er16, np.zeros(1), q[n:n + 1], ws).touching > 0 for n in range(q.shape[0])])
     assert (coal_d[clear] < 0).sum() >= 10 and (coal_d[clear] > 0).sum() >= 10
     np.testing.assert_array_equal(touching[clear], coal_d[clear] < 0)
+
+
+def test_a_trajectory_that_fails_at_the_set_points_is_not_written(tmp_path, monkeypatch):
+    """The set-points are checked after the design: a contact MuJoCo reports there, or a link inside the cell's
+    clearance between the verification grid's samples, stops the run before anything is written."""
+    import dynid.identification.excitation_run as er
+    from dynid.excitation.constraints import ConstraintMargin
+    from dynid.excitation.design import InfeasibleDesignError
+    from dynid.io.cell_replay import CellContacts
+
+    cfg = tmp_path / "excite.toml"
+    cfg.write_text('robot = "er16"\njoints = 3\n[design]\nstarts = 1\nmaxiter = 20\n[trajectory]\nharmonics = 2\n'
+                   'frequency = 0.1\n[[workspace.obstacles]]\nshape = "sphere"\nsize = [0.1]\nposition = [1.5, 1.5, 1.5]\n')
+    config = load_excitation_config(cfg)
+    assert run_excitation(config).mujoco_contacts.touching == 0  # clear: it runs
+    touching = CellContacts(10, 2, {"link": 3, "body": "ball", "time": 1.25, "depth": 0.01}, 0.01)
+    monkeypatch.setattr(er, "cell_contacts", lambda *a: touching)
+    with pytest.raises(InfeasibleDesignError, match=r"MuJoCo finds link 3 touching ball at t = 1.25 s on 2 set-points: "
+                                                    r"nothing written"):
+        run_excitation(config)
+    monkeypatch.setattr(er, "cell_contacts", lambda *a: None)
+    inside = ConstraintMargin("obstacle clearance [m]", "ball: link 3 at t = 2 s", 0.0, -0.004, -0.004, np.nan)
+    monkeypatch.setattr(er, "obstacle_margins", lambda *a: [inside])
+    with pytest.raises(InfeasibleDesignError, match=r"0.004 m inside the clearance .*ball: link 3 at t = 2 s"):
+        run_excitation(config)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
 from ..excitation.constraints import ConstraintMargin, obstacle_margins
-from ..excitation.design import ExcitationDesign, design_excitation
+from ..excitation.design import ExcitationDesign, InfeasibleDesignError, design_excitation
 from ..io.cell_replay import CellContacts, cell_contacts
 from ..io.excitation_config import ExcitationConfig
 
@@ -97,7 +97,31 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     clearance = (self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance) if p.workspace.geometry is None
                  else shape_clearance(p.robot, t[::every], q[::every], p.workspace.geometry))
     cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
-    return ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace))
+    run = ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace))
+    _refuse_unsafe(run)
+    return run
+
+
+def _refuse_unsafe(run: ExcitationRun) -> None:
+    """A trajectory whose set-points bring a link into the cell, or two of the links' own shapes together, is not
+    written as if it were safe (the design's verification grid is coarser than the set-points)."""
+    bad = [m for m in run.cell_clearance if m.worst < 0]
+    if bad:
+        m = min(bad, key=lambda m: m.worst)
+        raise InfeasibleDesignError(f"the designed trajectory brings a link {-m.worst:.3g} m inside the clearance of the cell "
+                                    f"at a set-point ({m.where}) between the verification grid's samples: nothing "
+                                    "written; raise design.grid_points")
+    found = run.mujoco_contacts
+    if found is not None and found.touching:
+        f = found.first or {}
+        raise InfeasibleDesignError(f"MuJoCo finds link {f.get('link')} touching {f.get('body')} at t = "
+                                    f"{f.get('time', float('nan')):.3g} s on {found.touching} set-points: nothing "
+                                    "written; raise design.grid_points or workspace.clearance")
+    c = run.self_clearance
+    if c is not None and c.shapes and c.distance < 0:
+        raise InfeasibleDesignError(f"the designed trajectory brings {c.shapes[0]} and {c.shapes[1]} together at t = "
+                                    f"{c.time:.3g} s, between the verification grid's samples: nothing written; raise "
+                                    "design.grid_points")
 
 
 CLEARANCE_SAMPLES = 2000
