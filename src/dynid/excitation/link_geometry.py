@@ -13,7 +13,7 @@ that link's frame is read once at ``q = 0``.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import coal
@@ -44,6 +44,8 @@ class LinkGeometry:
         The URDF's collision names, named in messages.
     source : str
         The URDF.
+    found : dict
+        The pairs :func:`self_pairs` found, per joint range and sample: found once per run.
     """
 
     shapes: tuple
@@ -51,6 +53,7 @@ class LinkGeometry:
     placement: np.ndarray
     names: tuple[str, ...]
     source: str
+    found: dict = field(default_factory=dict, compare=False, repr=False)
 
     def spheres(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each shape's bounding sphere (coal's local box, half its diagonal) along ``q``.
@@ -238,15 +241,21 @@ def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=
     -------
     list of (int, int)
     """
-    candidates = [(g, h) for g in range(len(geometry.shapes)) for h in range(g + 1, len(geometry.shapes))
-                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2]
-    if not candidates:
-        return []
     lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
     hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
-    q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
-    touching = self_distances(robot, q, geometry, candidates).distance < 0
-    return [pair for pair, share in zip(candidates, touching.mean(axis=0)) if share < ALWAYS]
+    key = (robot.n_dof, lo.tobytes(), hi.tobytes(), samples, rng if isinstance(rng, int) else None)
+    if key[-1] is not None and key in geometry.found:  # the design, its checks and the run ask for the same pairs
+        return list(geometry.found[key])
+    candidates = [(g, h) for g in range(len(geometry.shapes)) for h in range(g + 1, len(geometry.shapes))
+                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2]
+    pairs = []
+    if candidates:
+        q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
+        touching = self_distances(robot, q, geometry, candidates).distance < 0
+        pairs = [pair for pair, share in zip(candidates, touching.mean(axis=0)) if share < ALWAYS]
+    if key[-1] is not None:
+        geometry.found[key] = tuple(pairs)
+    return pairs
 
 
 def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *, gradient: bool = False) -> ObstacleDistances:
