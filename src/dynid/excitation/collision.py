@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
-from ..dynamics.kinematics import forward_kinematics
 from ..model.robot import Robot
 from .link_geometry import LinkGeometry, self_distances, self_pairs
+from .obstacles import _capsules, _segments
 
 __all__ = ["SelfClearance", "self_clearance", "shape_clearance", "touching_pairs"]
 
@@ -62,29 +62,11 @@ class SelfClearance:
                 **({"shapes": list(self.shapes)} if self.shapes else {})}
 
 
-def _segments(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(N, n_dof, 2, 3): each link's segment from its joint's origin to the next (the flange for the last)."""
-    rots, orig = forward_kinematics(robot, q)
-    flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
-    ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
-    return np.stack([orig, ends], axis=2)
-
-
 def _distance(a: np.ndarray, b: np.ndarray, radius: float) -> float:
     """Surface distance of two capsules of ``radius`` about segments ``a`` and ``b`` (2, 3) (coal)."""
-    shapes = []
-    for seg in (a, b):
-        axis = seg[1] - seg[0]
-        length = float(np.linalg.norm(axis))
-        rotation = np.eye(3)
-        if length > 1e-12:  # coal's capsule lies along z: turn z onto the segment
-            z = axis / length
-            x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
-            x /= np.linalg.norm(x)
-            rotation = np.column_stack([x, np.cross(z, x), z])
-        shapes.append((coal.Capsule(radius, length), coal.Transform3s(rotation, 0.5 * (seg[0] + seg[1]))))
+    (cap_a, [pose_a]), (cap_b, [pose_b]) = _capsules(a[None], radius), _capsules(b[None], radius)
     result = coal.DistanceResult()
-    coal.distance(shapes[0][0], shapes[0][1], shapes[1][0], shapes[1][1], coal.DistanceRequest(), result)
+    coal.distance(cap_a, pose_a, cap_b, pose_b, coal.DistanceRequest(), result)
     return float(result.min_distance)
 
 

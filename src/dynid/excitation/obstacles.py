@@ -133,13 +133,13 @@ def _segment_jacobians(robot: Robot, q: np.ndarray) -> np.ndarray:
 
 
 def _capsules(seg: np.ndarray, radius: float):
-    """coal's capsule of ``radius`` about one link's segments (N, 2, 3) and its N poses (a sphere for a segment of no
-    length). A link's segment keeps its length (revolute joints), so one shape serves every pose."""
+    """coal's capsule of ``radius`` about one link's segments (N, 2, 3) and its N poses (of no length, a sphere, for a
+    segment of no length). A link's segment keeps its length (revolute joints), so one shape serves every pose."""
     axis = seg[:, 1] - seg[:, 0]
     length = np.linalg.norm(axis, axis=1)
     if length.max() <= 1e-12:
         rotations = np.broadcast_to(np.eye(3), (seg.shape[0], 3, 3))
-        shape = coal.Sphere(max(radius, 1e-9))
+        shape = coal.Capsule(radius, 0.0)  # a sphere: coal measures it as the capsule of no length
     else:  # coal's capsule lies along z: turn z onto the segment
         z = axis / length[:, None]
         x = np.cross(z, np.where(np.abs(z[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
