@@ -55,3 +55,34 @@ class HyperParameters:
                 raise ValueError(f"{type(self).__name__} has no parameter {name!r}; expected one of {sorted(known)}")
             setattr(self, name, value)
         return self
+
+    def __repr__(self) -> str:
+        """scikit-learn's: the class and the parameters that differ from the constructor's defaults, an array by its
+        shape (``PhysicallyConsistentLeastSquares(prior_kind='geometric')``).
+
+        Returns
+        -------
+        str
+        """
+        defaults = {p.name: p.default for p in inspect.signature(type(self).__init__).parameters.values()}
+        shown = [f"{name}={_short(value)}" for name, value in self.get_params().items()
+                 if not _is_default(value, defaults.get(name, inspect.Parameter.empty))]
+        return f"{type(self).__name__}({', '.join(shown)})"
+
+
+def _is_default(value, default) -> bool:
+    """Whether a parameter's value is its default (an array never is, unless it is the default object)."""
+    if value is default:
+        return True
+    if hasattr(value, "shape") or hasattr(default, "shape"):
+        return False
+    try:
+        return bool(value == default)
+    except (TypeError, ValueError):
+        return False
+
+
+def _short(value) -> str:
+    """A parameter's value in a repr: an array by its shape, anything else by its own repr."""
+    shape = getattr(value, "shape", None)
+    return f"<array {tuple(shape)}>" if isinstance(shape, tuple) else repr(value)

@@ -88,6 +88,23 @@ def test_shared_contract(problem, standard_problem, kind):
         twin.set_params(nonsense=1)
 
 
+def test_an_estimators_repr_names_what_differs_from_its_defaults():
+    """scikit-learn's repr: the parameters set away from the constructor's defaults (an array by its shape), so that a
+    list of estimators given to the identification fits a line; an estimator of the problem's inputs alone (its search
+    box, its layout) needs none of them to be built, and refuses to fit without them, naming them."""
+    from dynid.estimators import BeeColonyEstimator, PhysicallyConsistentLeastSquares
+
+    assert repr(PhysicallyConsistentLeastSquares(prior_kind="geometric")) == "PhysicallyConsistentLeastSquares(prior_kind='geometric')"
+    assert repr(BeeColonyEstimator(bounds=np.zeros((3, 2)), colony_size=60)) == \
+        "BeeColonyEstimator(bounds=<array (3, 2)>, colony_size=60)"
+    assert repr(OrdinaryLeastSquares()) == "OrdinaryLeastSquares()"
+    w, tau = np.eye(6), np.ones(6)
+    with pytest.raises(ShapeError, match=r"BeeColonyEstimator: bounds, the search box of shape \(6, 2\), is needed"):
+        BeeColonyEstimator(n_dof=1).fit(w, tau)
+    with pytest.raises(ShapeError, match="PhysicallyConsistentLeastSquares: links, the columns of each link"):
+        PhysicallyConsistentLeastSquares().fit(w, tau)
+
+
 @pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
 def test_n_dof_is_inferred_from_tau_given_per_joint(problem, kind):
     w, beta = problem

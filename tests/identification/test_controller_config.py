@@ -142,7 +142,7 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
     arrays with the same numbers as ``dynid identify`` on the config that describes the same log and controller; the
     pipeline refuses them without a controller, in one line."""
     from dynid.exceptions import ConfigError
-    from dynid.identification.closed_loop import ClosedLoopSetup
+    from dynid.identification.closed_loop import ClosedLoopEstimator, ClosedLoopSetup
     from dynid.identification.pipeline import IdentificationPipeline
     from dynid.simulation.closed_loop import Controller
 
@@ -166,7 +166,9 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
     np.testing.assert_allclose(given.estimates_["dynid IDIM-IV"], by_config.estimates_["dynid IDIM-IV"], rtol=1e-12)
     _write(root, table, estimators='["wls", "idim-iv"]')
     with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller \(a ClosedLoopSetup"):
-        IdentificationPipeline(robot, closed_loop=("idim-iv",))
+        IdentificationPipeline(robot, estimators=("wls", "idim-iv"))
+    with pytest.raises(ConfigError, match="the first is the main estimate and starts the closed-loop ones"):
+        IdentificationPipeline(robot, estimators=(ClosedLoopEstimator("didim", setup),))
     short = ClosedLoopSetup(setup.controller, setup.reference[:-10], feedforward=True)
     from dynid.exceptions import DataError
 
@@ -175,8 +177,8 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
 
 
 def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_loop_log):
-    """IdentificationPipeline(closed_loop=..., controller=...) is made of ClosedLoopEstimator parts, each carrying the
-    controller: one such part added to the pipeline's open-loop result gives the pipeline's own IDIM-IV estimate, and
+    """IdentificationPipeline(estimators=("wls", "idim-iv"), controller=...) is made of ClosedLoopEstimator parts, each
+    carrying the controller, and takes such a part itself in its estimators: one such part added to the pipeline's open-loop result gives the pipeline's own IDIM-IV estimate, and
     an unknown method is refused in one line."""
     from dynid.exceptions import ConfigError
     from dynid.identification.closed_loop import ClosedLoopEstimator, ClosedLoopSetup
@@ -190,8 +192,11 @@ def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_lo
     setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
                             feedforward=True)
     recording = Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
-    pipeline = IdentificationPipeline(robot, closed_loop=("idim-iv",), controller=setup)
+    pipeline = IdentificationPipeline(robot, estimators=("wls", "idim-iv"), controller=setup)
     assert [(p.method, p.setup) for p in pipeline.closed_loop_estimators] == [("idim-iv", setup)]
+    assert pipeline.open_loop == ("wls",) and pipeline.closed_loop == ("idim-iv",)
+    as_part = IdentificationPipeline(robot, estimators=("wls", ClosedLoopEstimator("idim-iv", setup)))
+    assert as_part.closed_loop_estimators == pipeline.closed_loop_estimators
     prepared = pipeline.prepare(recording)
     whole = pipeline.estimate(prepared, recording=recording)
     open_loop = IdentificationPipeline(robot).estimate(prepared)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import ConfigError, DataError
+from dynid.exceptions import ConfigError, DataError, DynIdError
 
 from ..simulated_logs import simulated_case, truth_beta
 
@@ -94,7 +94,7 @@ def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
 def test_get_and_set_params_follow_scikit_learns_contract():
     ident = dynid.Identifier("er16", estimators=["ols"])
     assert ident.get_params() == {"robot": "er16", "estimators": ["ols"], "preprocessing": None, "friction": None, "seed": None,
-                                  "controller": None, "sdp_prior": None}
+                                  "controller": None}
     assert ident.set_params(seed=3, friction="auto") is ident and ident.get_params()["seed"] == 3
     with pytest.raises(ValueError, match="no parameter 'alpha'"):
         ident.set_params(alpha=1)
@@ -211,21 +211,37 @@ def test_load_recording_takes_a_logs_path_and_load_results_a_folder(tmp_path, fi
     assert dynid.load_results(tmp_path / "out").main == fitted.result_.main
 
 
-def test_the_sdp_prior_is_a_setting_of_the_identifier(er16):
-    """Identifier(sdp_prior=...) is the config's [estimation] sdp_prior: the geometric prior's SDP estimate is
-    identify_from_arrays's with that prior, not the Euclidean one's; an unknown prior is a one-line ConfigError."""
+def test_an_estimator_object_carries_its_hyperparameters_through_the_identifier(er16):
+    """issue "Parts carry their settings": the SDP given as an object with the geometric prior is the config's
+    [estimation] sdp_prior = "geometric" (the same estimate as identify_from_arrays given the same object, not the
+    Euclidean prior's); the object's settings are said in results.json; an object of a class not registered, or an
+    unknown prior, is a one-line error."""
+    from dynid.estimators import Estimator, PhysicallyConsistentLeastSquares
     from dynid.identification.run import identify_from_arrays
 
     robot, log, _ = er16
-    ident = dynid.Identifier(robot, estimators=["wls", "sdp"], sdp_prior="geometric")
-    assert ident.get_params()["sdp_prior"] == "geometric"
+    sdp = PhysicallyConsistentLeastSquares(prior_kind="geometric")
+    ident = dynid.Identifier(robot, estimators=["wls", sdp])
+    assert ident.get_params()["estimators"] == ["wls", sdp]
     geometric = ident.fit(log.t, log.q, log.tau).estimates_["dynid SDP"]
-    direct = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", "sdp"), sdp_prior="geometric")
+    assert ident.result_.settings["estimator_hyperparameters"]["sdp"]["prior_kind"] == "geometric"
+    direct = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", sdp))
     euclidean = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", "sdp"))
     np.testing.assert_array_equal(geometric, direct.estimates["dynid SDP"].params)
     assert not np.array_equal(geometric, euclidean.estimates["dynid SDP"].params)
-    with pytest.raises(ConfigError, match="sdp_prior=...\\): expected one of euclidean, geometric, got 'logdet'"):
-        dynid.Identifier(robot, estimators=["sdp"], sdp_prior="logdet").fit(log.t, log.q, log.tau)
+    assert sdp.links is None and sdp.prior is None  # the object given is not filled in
+    with pytest.raises(ConfigError, match="identify_from_arrays: unknown setting 'sdp_prior'; expected one of controller, "
+                                          "estimators, friction, preprocessing, seed"):
+        identify_from_arrays(robot, log.t, log.q, log.tau, sdp_prior="geometric")
+
+    class Mine(Estimator):
+        pass
+
+    with pytest.raises(ConfigError, match="Mine is not a registered estimator: dynid.estimators.register"):
+        dynid.Identifier(robot, estimators=["wls", Mine()]).fit(log.t, log.q, log.tau)
+    with pytest.raises(DynIdError, match="prior_kind: expected one of euclidean, geometric, got 'logdet'"):
+        dynid.Identifier(robot, estimators=["wls", PhysicallyConsistentLeastSquares(prior_kind="logdet")]).fit(
+            log.t, log.q, log.tau)
 
 
 def test_a_model_fitted_with_the_papers_preprocessing_scores_other_logs_filtered():

@@ -148,7 +148,7 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     for kind in ("euclidean", "geometric"):
         cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n'))
         config = load_identification_config(cfg)
-        assert config.sdp_prior == kind
+        assert config.hyperparameters == {"sdp": {"prior_kind": kind}}
         runs[kind] = (config, run_identification(config, validate=True))
     fit = {k: r.validations[0].metrics()["dynid SDP"]["global_relative_error"] for k, (_, r) in runs.items()}
     assert fit["geometric"] <= 1.01 * fit["euclidean"], fit

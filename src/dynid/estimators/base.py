@@ -499,6 +499,9 @@ class BoxSearchEstimator(Estimator):
         """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
         self.n_dof_ = infer_n_dof(self.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
+        if self.bounds is None:
+            raise ShapeError(f"{type(self).__name__}: bounds, the search box of shape ({w.shape[1]}, 2), is needed to fit "
+                             "(the identification pipeline builds it around the least-squares estimate)")
         bounds = np.asarray(self.bounds, dtype=float)
         if bounds.shape != (w.shape[1], 2):
             raise ShapeError(f"expected {type(self).__name__} bounds of shape ({w.shape[1]}, 2), got {bounds.shape}")

@@ -14,7 +14,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
     Parameters
     ----------
     bounds : (p, 2) array
-        Search box of the parameters (the paper's Table 3).
+        Search box of the parameters (the paper's Table 3); required to fit (the identification pipeline builds it
+        around the least-squares estimate).
     n_dof : int or None
         Joints per sample; None: inferred from tau given as (N, n_dof).
         Joints per sample in ``W``'s rows, for eq. 9.
@@ -31,7 +32,7 @@ class BeeColonyEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per iteration), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, colony_size: int = 30, limit: int = 15,
+    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, colony_size: int = 30, limit: int = 15,
                  maxiter: int = 50, rng=None, callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof

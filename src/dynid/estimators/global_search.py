@@ -21,7 +21,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     Parameters
     ----------
     bounds : (p, 2) array
-        Search box (the ABC's).
+        Search box (the ABC's); required to fit (the identification pipeline builds it).
     n_dof : int or None
         Joints per sample in ``W``'s rows; None: inferred from tau given as (N, n_dof).
     weights : (n_dof,) array, optional
@@ -43,7 +43,7 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
+    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
                  polish: bool = False, rng=None, callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof
@@ -85,6 +85,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     Parameters
     ----------
     bounds : (p, 2) array
+        Search box; required to fit (the identification pipeline builds it).
     n_dof : int or None
         Joints per sample; None: inferred from tau given as (N, n_dof).
     weights : (n_dof,) array, optional
@@ -101,7 +102,7 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_, n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds, n_dof: int | None = None, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
+    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
                  callback: Callable[[int, float], None] | None = None):
         self.bounds = bounds
         self.n_dof = n_dof

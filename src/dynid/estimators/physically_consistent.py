@@ -40,7 +40,8 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     Parameters
     ----------
     links : (n_links, 10) int array
-        Columns of ``W`` holding each link's ``XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M``.
+        Columns of ``W`` holding each link's ``XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M``; required to fit (the
+        identification pipeline fills it from the robot: :func:`dynid.dynamics.layout.consistency_layout`).
     nonnegative : sequence of int
         Columns constrained ``>= 0`` (viscous and Coulomb friction, rotor inertias).
     prior : (p,) array, optional
@@ -82,7 +83,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         If the layout does not fit ``W``.
     """
 
-    def __init__(self, *, links, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
+    def __init__(self, *, links=None, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
                  n_dof: int | None = None, joint_weights=None, prior_kind: str = PRIOR_KIND, prior_std=None):
         self.prior_std = prior_std
         self.prior_kind = prior_kind
@@ -126,6 +127,9 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
 
         w, tau = check_observations(w, tau)
         m, p = w.shape
+        if self.links is None:
+            raise ShapeError("PhysicallyConsistentLeastSquares: links, the columns of each link's 10 parameters, are "
+                             "needed to fit (dynid.dynamics.layout.consistency_layout of the robot)")
         links = np.asarray(self.links, dtype=int).reshape(-1, 10)
         nonneg = np.asarray(self.nonnegative, dtype=int)
         if links.size and (links.min() < 0 or links.max() >= p) or (nonneg.size and (nonneg.min() < 0 or nonneg.max() >= p)):

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import importlib.util
 import inspect
 import math
 import time
@@ -39,7 +40,8 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["EstimatorSpec", "SearchBudget", "FitData", "Fitted", "register", "unregister", "spec", "keys", "label",
-           "parse_estimators", "make_estimator", "fit_method", "fit_methods"]
+           "parse_estimators", "estimator_choices", "with_hyperparameters",
+           "make_estimator", "fit_method", "fit_methods"]
 
 
 @dataclass(frozen=True)
@@ -94,8 +96,9 @@ class FitData:
     joint_weights : (n_dof,) array, optional
         Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
         estimate on real logs).
-    prior_kind : {"euclidean", "geometric"}
-        How ``sdp`` pulls towards the prior (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
+    hyperparameters : dict
+        key -> the hyper-parameters an estimator is built with on top of its defaults (those of an estimator object
+        given in place of its key: :func:`estimator_choices`).
     base_prior : (n_base,) array, optional
         Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
     prior_std : (p,) array, optional
@@ -113,7 +116,7 @@ class FitData:
     prior: Any = None
     weights: Any = None
     joint_weights: Any = None
-    prior_kind: str = "euclidean"
+    hyperparameters: dict = dataclasses.field(default_factory=dict)
     base_prior: Any = None
     prior_std: Any = None
 
@@ -148,6 +151,9 @@ class EstimatorSpec:
         Cheap enough to refit on every bootstrap resample.
     options : dict
         Fixed hyper-parameters passed to the class.
+    makes : str
+        ``"module:attribute"`` of the class a function :attr:`build` makes: an object of that class given in place of
+        a key is this estimator (:func:`estimator_choices`).
     """
 
     key: str
@@ -159,6 +165,7 @@ class EstimatorSpec:
     needs_box: bool = False
     bootstrapped: bool = False
     options: dict = dataclasses.field(default_factory=dict)
+    makes: str = ""
 
     def builder(self) -> Builder:
         """The callable that builds an unfitted estimator from :class:`FitData`.
@@ -227,8 +234,7 @@ def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> Estimator:
         raise ConfigError("estimator sdp needs the parameter layout of the robot (links and non-negative columns)")
     links, nonneg = data.layout
     return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior, n_dof=data.n_dof,
-                                            joint_weights=data.joint_weights, prior_kind=data.prior_kind,
-                                            prior_std=data.prior_std)
+                                            joint_weights=data.joint_weights, prior_std=data.prior_std)
 
 
 _ESTIMATORS = Registry("estimator", builder=lambda entry: entry.build)
@@ -237,7 +243,7 @@ _REGISTRY: dict[str, EstimatorSpec] = _ESTIMATORS.entries
 
 def register(key: str, build, *, label: str | None = None, description: str = "", space: str = "base",
              cost: float = 1.0, needs_box: bool = False, bootstrapped: bool = False, replace: bool = False,
-             **options) -> EstimatorSpec:
+             makes: str = "", **options) -> EstimatorSpec:
     """Make an estimator known to every command and to :class:`dynid.Identifier` under ``key``.
 
     Parameters
@@ -251,6 +257,8 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
     replace : bool
         Replace an estimator registered under the same key (else a ``ValueError``, unless it is the same class of the
         same module: a plugin imported again).
+    makes : str
+        See :attr:`EstimatorSpec.makes` (a function ``build`` only).
     **options
         Fixed hyper-parameters of the class.
 
@@ -282,7 +290,8 @@ def register(key: str, build, *, label: str | None = None, description: str = ""
         raise ValueError(f"estimator key: expected letters, digits and _, got {key!r}")
     if space not in ("base", "standard"):
         raise ValueError(f"estimator {k}: space must be 'base' or 'standard', got {space!r}")
-    entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options))
+    entry = EstimatorSpec(k, label or k.upper(), description, build, space, cost, needs_box, bootstrapped, dict(options),
+                          makes)
     _ESTIMATORS.add(k, entry, replace=replace)
     return entry
 
@@ -310,16 +319,16 @@ register("irls", ".robust:IterativelyReweightedLeastSquares", label="IRLS",
          description="iteratively reweighted least squares (Huber)", cost=0.4)
 register("lad", ".least_absolute:LeastAbsoluteDeviations", label="LAD",
          description="least absolute deviations: exact minimum of eq. 9 in the search box (HiGHS)", cost=6, needs_box=True)
-register("sdp", _sdp, label="SDP", space="standard", cost=5,
+register("sdp", _sdp, label="SDP", space="standard", cost=5, makes=".physically_consistent:PhysicallyConsistentLeastSquares",
          description="physically consistent least squares (SDP, cvxpy + Clarabel), prior: nominal parameters × U(0.7, 1.3)")
 register("abc", _box_search("abc"), label="ABC", description="artificial bee colony, the paper's budget", cost=0.3,
-         needs_box=True)
+         needs_box=True, makes=".bee_colony:BeeColonyEstimator")
 register("abc10", _box_search("abc", 10), label="ABC×10", description="artificial bee colony, 10× the paper's iterations",
          cost=7, needs_box=True)
 register("de", _box_search("de"), label="DE", description="differential evolution (SciPy), the budget of ABC×10", cost=9,
-         needs_box=True)
+         needs_box=True, makes=".global_search:DifferentialEvolutionEstimator")
 register("pso", _box_search("pso"), label="PSO", description="particle swarm (constriction), the budget of ABC×10", cost=8,
-         needs_box=True)
+         needs_box=True, makes=".global_search:ParticleSwarmEstimator")
 
 BUILT_IN = _ESTIMATORS.seal()
 """The estimators dynid comes with (the others were registered by the user)."""
@@ -469,6 +478,11 @@ def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] 
         return keys()
     items = text.split(",") if isinstance(text, str) else list(text)
     if not all(isinstance(k, str) for k in items):
+        objects = [type(k).__name__ for k in items if hasattr(k, "get_params")]
+        if objects:
+            raise ConfigError(f"estimators: here only names of estimators (an estimator object, {objects[0]}, goes to "
+                              "the identification: dynid.Identifier, identify_from_arrays or IdentificationPipeline)",
+                              field="estimators")
         raise ConfigError(f"estimators: expected names of estimators, got {text!r}", field="estimators")
     found = [k.strip().lower() for k in items]
     if any(k not in _REGISTRY for k in found):
@@ -480,6 +494,101 @@ def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] 
     if len(set(found)) != len(found):
         raise ConfigError(f"estimators: each estimator once, got {text!r}", field="estimators")
     return tuple(found)
+
+
+PROBLEM_FILLED = frozenset({*_FILLED, "links", "nonnegative", "prior_std"})
+"""An estimator's constructor parameters that the identification fills from the problem (the robot's layout, the
+search box, the weights, the prior, the seeded generator): never taken from an estimator object given as a choice."""
+
+
+def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...], dict[str, dict]]:
+    """The estimators of a list of keys and estimator objects: their keys, and the hyper-parameters the objects carry
+    (scikit-learn's rule: an object holds its hyper-parameters; the problem comes to ``fit``).
+
+    Parameters
+    ----------
+    items : str, or sequence of str and Estimator
+        Keys (as :func:`parse_estimators` takes them) and unfitted estimators of registered classes, e.g.
+        ``["wls", PhysicallyConsistentLeastSquares(...)]``; the first is the main estimate.
+    where : str
+        Where the list was given, for the messages.
+
+    Returns
+    -------
+    keys : tuple of str
+    hyperparameters : dict
+        key -> each object's constructor parameters but those of :data:`PROBLEM_FILLED` (:attr:`FitData.hyperparameters`).
+
+    Raises
+    ------
+    ConfigError
+        An unknown key, an object of a class not registered, repeated or no estimator.
+    """
+    if items is None or isinstance(items, str):
+        return parse_estimators(items), {}
+    items = list(items)
+    objects = {i: _key_of(item, where) for i, item in enumerate(items) if not isinstance(item, str)}
+    keys_ = parse_estimators([objects.get(i, item) for i, item in enumerate(items)])
+    return keys_, {objects[i]: {name: value for name, value in items[i].get_params().items() if name not in PROBLEM_FILLED}
+                   for i in objects}
+
+
+def with_hyperparameters(items, hyperparameters: dict) -> tuple:
+    """``items`` with each key that ``hyperparameters`` names given as an unfitted estimator of its class carrying them
+    (a config's settings of an estimator, :meth:`dynid.io.config_types.EstimationTable.hyperparameters`, on whatever
+    list is identified).
+
+    Parameters
+    ----------
+    items : sequence of str and Estimator
+    hyperparameters : dict
+        key -> constructor parameters.
+
+    Returns
+    -------
+    tuple
+        Keys, and objects where the key had hyper-parameters (objects given stay as they are).
+
+    Raises
+    ------
+    ConfigError
+        Hyper-parameters for an estimator built by a function that names no class (:attr:`EstimatorSpec.makes`).
+    """
+    out = []
+    for item in items:
+        given = hyperparameters.get(item.strip().lower()) if isinstance(item, str) else None
+        out.append(_estimator_class(spec(item))(**given) if given else item)
+    return tuple(out)
+
+
+def _estimator_class(entry: EstimatorSpec) -> type:
+    """The class of a registered estimator (its :attr:`EstimatorSpec.build`, or what its function :attr:`~EstimatorSpec.makes`)."""
+    target = entry.build if isinstance(entry.build, (type, str)) else entry.makes
+    if isinstance(target, type):
+        return target
+    if not target:
+        raise ConfigError(f"estimator {entry.key}: its builder names no class to carry hyper-parameters", field="estimators")
+    module, attr = _class_name(target)
+    return getattr(importlib.import_module(module), attr)
+
+
+def _key_of(item, where: str) -> str:
+    """The registered key whose estimator is of ``item``'s class (exactly)."""
+    if not hasattr(item, "get_params"):
+        raise ConfigError(f"{where}: expected names of estimators or estimator objects, got {item!r}", field="estimators")
+    cls = type(item)
+    for key, entry in _REGISTRY.items():
+        target = entry.build if isinstance(entry.build, type) else entry.makes or entry.build
+        if target is cls or isinstance(target, str) and _class_name(target) == (cls.__module__, cls.__qualname__):
+            return key
+    raise ConfigError(f"{where}: {cls.__name__} is not a registered estimator: dynid.estimators.register(key, "
+                      f"{cls.__name__}) first, then give the object or its key", field="estimators")
+
+
+def _class_name(target: str) -> tuple[str, str]:
+    """``(module, attribute)`` of a ``"module:attribute"`` (a module relative to this package resolved)."""
+    module, _, attr = target.partition(":")
+    return importlib.util.resolve_name(module, __package__), attr
 
 
 def seed_index(key: str) -> int:
@@ -546,7 +655,10 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(
     ConfigError
         Unknown key, or ``sdp`` without the parameter layout.
     """
-    return spec(key).builder()(data, budget, rng, callback)
+    entry = spec(key)
+    est = entry.builder()(data, budget, rng, callback)
+    given = data.hyperparameters.get(entry.key)
+    return est.set_params(**given) if given else est
 
 
 def finish(key: str, est: Estimator, data: FitData, seconds: float) -> Fitted:

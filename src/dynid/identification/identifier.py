@@ -18,7 +18,6 @@ from typing import Any
 
 import numpy as np
 
-from ..estimators.physically_consistent import PRIOR_KINDS as SDP_PRIORS
 from ..exceptions import ConfigError, NotFittedError
 from ..hyperparameters import HyperParameters
 from ..keywords import keyword_only_after_data
@@ -36,9 +35,11 @@ class Identifier(HyperParameters):
     robot : Robot, str or path, optional
         The robot's description: a :class:`~dynid.model.robot.Robot`, a built-in name (``"ur10e"``) or a description
         TOML / URDF path. Required to fit arrays; a config names its own.
-    estimators : sequence of str, optional
-        Keys of :mod:`dynid.estimators.registry`, case-insensitive; the first is the main estimate (default
-        ``["wls"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
+    estimators : sequence of str and Estimator, optional
+        Keys of :mod:`dynid.estimators.registry`, case-insensitive, or unfitted estimators of registered classes
+        carrying their hyper-parameters (e.g. the SDP with the geometric prior:
+        :class:`~dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`); the first is the main
+        estimate (default ``["wls"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
         (``idim-iv``, ``didim``, ``didim-sdp``) too, with ``controller`` for arrays, or fitting a config with a
         ``[controller]`` table.
     preprocessing : Preprocessing or dict, optional
@@ -52,10 +53,6 @@ class Identifier(HyperParameters):
         How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`: the
         controller, one set-point per sample, the feed-forward), for the closed-loop estimators; a config gives its
         ``[controller]`` table instead.
-    sdp_prior : {"euclidean", "geometric"}, optional
-        How ``sdp`` keeps what the data do not determine near the description's nominal parameters: squared distance,
-        or the log-det divergence of each link's pseudo-inertia (Lee, Wensing & Park 2020); default "euclidean", or
-        the config's ``[estimation] sdp_prior``.
 
     Attributes
     ----------
@@ -76,14 +73,13 @@ class Identifier(HyperParameters):
     """
 
     def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
-                 friction: str | None = None, seed: int | None = None, controller=None, sdp_prior: str | None = None):
+                 friction: str | None = None, seed: int | None = None, controller=None):
         self.robot = robot
         self.estimators = estimators
         self.preprocessing = preprocessing
         self.friction = friction
         self.seed = seed
         self.controller = controller
-        self.sdp_prior = sdp_prior
 
     def __sklearn_is_fitted__(self) -> bool:
         """Whether :meth:`fit` ran (scikit-learn's ``check_is_fitted`` asks this).
@@ -110,8 +106,7 @@ class Identifier(HyperParameters):
     @classmethod
     def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:
         """Identify the robot of an identification config (TOML) as ``dynid identify`` does, the ``params`` given
-        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``,
-        ``sdp_prior``) over
+        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``) over
         the config's.
 
         Parameters
@@ -188,8 +183,7 @@ class Identifier(HyperParameters):
                                   "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
-                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller,
-                                          sdp_prior=self._sdp_prior() or "euclidean")
+                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller)
         return self._fitted(result)
 
     def _fitted(self, result) -> Identifier:
@@ -228,8 +222,6 @@ class Identifier(HyperParameters):
             changes["friction"] = self.friction
         if self.seed is not None:
             changes["seed"] = int(self.seed)
-        if self._sdp_prior() is not None:
-            changes["sdp_prior"] = self._sdp_prior()
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:
@@ -238,12 +230,6 @@ class Identifier(HyperParameters):
         if self.robot is None:
             raise ConfigError("Identifier(robot=...): the robot's description is needed to fit arrays", field="robot")
         return self.robot if isinstance(self.robot, Robot) else load_robot(self.robot)
-
-    def _sdp_prior(self) -> str | None:
-        if self.sdp_prior is None or self.sdp_prior in SDP_PRIORS:
-            return self.sdp_prior
-        raise ConfigError(f"Identifier(sdp_prior=...): expected one of {', '.join(SDP_PRIORS)}, got {self.sdp_prior!r}",
-                          field="sdp_prior")
 
     def _preprocessing(self) -> Preprocessing | None:
         p = self.preprocessing

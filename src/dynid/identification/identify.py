@@ -23,7 +23,7 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
-from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, parse_estimators, seed_index, spec
+from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, seed_index, spec
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
@@ -300,7 +300,7 @@ class IdentificationResult:
 
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",),
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
-             sdp_prior: str = "euclidean", observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
+             observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
     over its rows; check every estimate's physical consistency and give the verdict on the model.
 
@@ -312,9 +312,12 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         The base-parameter map of ``robot``.
     data : PreparedData
         From :func:`dynid.preprocessing.pipeline.prepare`.
-    estimators : sequence of str, or str
-        Keys of :mod:`dynid.estimators.registry` (case-insensitive; a text: comma-separated, ``"wls,sdp"``); the first
-        is the main estimate. A least-squares
+    estimators : sequence of str and Estimator, or str
+        Keys of :mod:`dynid.estimators.registry` (case-insensitive; a text: comma-separated, ``"wls,sdp"``) or unfitted
+        estimators of registered classes carrying their hyper-parameters
+        (:func:`dynid.estimators.registry.estimator_choices`; e.g. ``sdp`` with the geometric prior of Lee, Wensing &
+        Park 2020); the first is the main
+        estimate. A least-squares
         estimate is always computed (the first of OLS/WLS listed, else WLS): it gives σ, each joint's noise (and
         the SDP's row weights) and the box of LAD and the box searches (:func:`search_box`).
     references : tuple of ReferenceSet
@@ -328,10 +331,6 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         the physically consistent estimates by blocked cross-validation (:data:`HELD_OUT_FOLDS` contiguous blocks),
         and make the consistent one the main estimate when the least-squares one is not consistent and predicts the
         held-out blocks worse.
-
-    sdp_prior : {"euclidean", "geometric"}
-        How ``sdp`` pulls its unidentifiable directions towards the nominal parameters: squared distance, or the
-        log-det divergence of each link's pseudo-inertia (plausible links for export; Lee, Wensing & Park 2020).
     observers : tuple of callable
         ``observer(index, y, tau, keep)`` called with every block of base rows of the one pass (what else needs them,
         e.g. the delay check of :mod:`dynid.identification.pipeline`).
@@ -350,7 +349,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     IdentifiabilityError
         Too few rows or a rank-deficient base observation matrix (the log does not excite every base parameter).
     """
-    keys = parse_estimators(estimators if isinstance(estimators, str) else tuple(estimators))
+    keys, hyperparameters = estimator_choices(estimators)
     n = robot.n_dof
     sdp = "sdp" in keys
     prior = None
@@ -363,7 +362,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                 raise
         prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=prior, prior_kind=sdp_prior,
+                      prior=prior, hyperparameters=hyperparameters,
                       base_prior=base.base_from_standard(robot.standard_parameters()),
                       prior_std=robot.prior_sigmas() if robot.prior_sigma else None)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
@@ -424,9 +423,21 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
     return choose_main_estimate(IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
-        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate},
+        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
+                                                                  **_given_hyperparameters(hyperparameters)},
         warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
         model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative))
+
+
+def _given_hyperparameters(hyperparameters: dict) -> dict:
+    """results.json's ``settings.estimator_hyperparameters``: those of the estimator objects given (none: no key),
+    each value a JSON scalar or its ``repr``."""
+    if not hyperparameters:
+        return {}
+    plain = (str, int, float, bool, type(None))
+    return {"estimator_hyperparameters": {key: {name: value if isinstance(value, plain) else repr(value)
+                                                for name, value in given.items()}
+                                          for key, given in hyperparameters.items()}}
 
 
 class BlockScoring:

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
+from ..io.identification_config import split_estimators
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
@@ -91,57 +92,75 @@ class IdentificationPipeline:
         The robot's description.
     preprocessing : Preprocessing
         The settings as given (``None`` fields: derived from the data).
-    estimators : tuple of str
-        Keys of :mod:`dynid.estimators.registry`; the first is the main estimate.
+    estimators : tuple of str, Estimator and ClosedLoopEstimator
+        Keys of :mod:`dynid.estimators.registry`, or unfitted estimators of registered classes carrying their
+        hyper-parameters (:func:`dynid.estimators.registry.estimator_choices`); the first is the main estimate. The
+        closed-loop ones (IDIM-IV, DIDIM, DIDIM-SDP: :data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS` keys, with
+        ``controller``, or :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts) run after the others,
+        on the log as read, in order, as a config's ``[estimation] estimators`` lists them.
     friction : {"description", "auto"}
         The description's friction terms, or each joint's model chosen by cross-validation.
     seed : int
         Seeds the box searches and the bootstrap.
-    sdp_prior : {"euclidean", "geometric"}
-        The SDP's pull towards the nominal parameters.
     source : str
         Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
         :func:`dynid.load_results` finds it.
-    closed_loop : tuple of str
-        Closed-loop estimators run after the others, on the log as read
-        (:data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS`, in order).
     controller : ClosedLoopSetup or None
         How the log was recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`); needed
-        with ``closed_loop``.
+        with closed-loop keys among ``estimators``.
 
     Attributes
     ----------
+    open_loop : tuple
+        The open-loop estimators of ``estimators`` (keys and objects), fitted on the prepared log.
     closed_loop_estimators : tuple of ClosedLoopEstimator
-        The parts ``closed_loop`` and ``controller`` make (:class:`dynid.identification.closed_loop.ClosedLoopEstimator`,
-        each carrying the controller), run by :meth:`estimate` in order.
+        The closed-loop parts of ``estimators`` (a key's made with ``controller``), run by :meth:`estimate` in order.
+    closed_loop : tuple of str
+        Their methods.
 
     Raises
     ------
     ConfigError
-        An unknown ``friction`` or closed-loop estimator, closed-loop estimators without ``controller`` (when built), or
+        An unknown ``friction`` or estimator, a closed-loop estimator first or without ``controller`` (when built), or
         an unknown preprocessing strategy (when preparing).
     """
 
     robot: Robot
     preprocessing: Preprocessing = field(default_factory=Preprocessing)
-    estimators: tuple[str, ...] = ("wls",)
+    estimators: tuple = ("wls",)
     friction: str = "description"
     seed: int = 0
-    sdp_prior: str = "euclidean"
     source: str = ""
-    closed_loop: tuple[str, ...] = ()
     controller: Any = None
+    open_loop: tuple = field(init=False, repr=False, compare=False)
     closed_loop_estimators: tuple[ClosedLoopEstimator, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
-        parts = tuple(ClosedLoopEstimator(key, self.controller) for key in self.closed_loop)  # an unknown key: refused
-        if parts and self.controller is None:
-            raise ConfigError(f"estimators: {self.closed_loop[0]} simulates the run in closed loop and needs its "
+        items = (self.estimators,) if isinstance(self.estimators, str) else tuple(self.estimators)
+        if items and isinstance(items[0], ClosedLoopEstimator):
+            raise ConfigError(f"estimators: the first is the main estimate and starts the closed-loop ones: list ols or "
+                              f"wls before {items[0].method!r}", field="estimators")
+        open_loop, keys = split_estimators([e for e in items if not isinstance(e, ClosedLoopEstimator)], "estimators")
+        if keys and self.controller is None:
+            raise ConfigError(f"estimators: {keys[0]} simulates the run in closed loop and needs its "
                               "controller (a ClosedLoopSetup: the controller, the set-points, the feed-forward)",
                               field="controller")
+        parts = tuple(e if isinstance(e, ClosedLoopEstimator) else ClosedLoopEstimator(e.strip().lower(), self.controller)
+                      for e in items if isinstance(e, ClosedLoopEstimator) or isinstance(e, str) and e.strip().lower() in keys)
+        object.__setattr__(self, "open_loop", open_loop)
         object.__setattr__(self, "closed_loop_estimators", parts)
+
+    @property
+    def closed_loop(self) -> tuple[str, ...]:
+        """The closed-loop estimators' methods, in the order they run.
+
+        Returns
+        -------
+        tuple of str
+        """
+        return tuple(part.method for part in self.closed_loop_estimators)
 
     def prepare(self, recording, base: BaseParameters | None = None,
                 step: Callable[[str], Any] | None = None) -> PreparedIdentification:
@@ -246,8 +265,8 @@ class IdentificationPipeline:
         """
         blocks: list = []  # the delay check's rows, from the identification's own pass
         check = _delay_checked(prepared.data)
-        result = identify(prepared.robot, prepared.base, prepared.data, self.estimators, references, progress, self.seed,
-                          held_out=held_out, sdp_prior=self.sdp_prior,
+        result = identify(prepared.robot, prepared.base, prepared.data, self.open_loop, references, progress, self.seed,
+                          held_out=held_out,
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})

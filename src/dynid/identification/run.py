@@ -4,12 +4,13 @@
 from __future__ import annotations
 
 import contextlib
-from dataclasses import replace
+from dataclasses import fields, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..checks import check_trajectory_array
+from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
 from ..io.datasets import (
     GAP_FACTOR,
@@ -22,7 +23,7 @@ from ..io.datasets import (
     uniform_rate,
     unwrapped_positions,
 )
-from ..io.identification_config import IdentificationConfig, split_estimators, stored_preprocessing
+from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..keywords import keyword_only_after_data
 from ..model.description import builtin_robots
 from ..model.robot import Robot
@@ -328,8 +329,9 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     from .pipeline import IdentificationPipeline
 
     setup = None if config.controller is None or not config.closed_loop else ClosedLoopSetup(*config.controller)
-    return IdentificationPipeline(config.robot, config.preprocessing, tuple(config.estimators), config.friction, config.seed,
-                                  config.sdp_prior, config.robot_source, tuple(config.closed_loop), setup)
+    estimators = (*with_hyperparameters(config.estimators, config.hyperparameters), *config.closed_loop)
+    return IdentificationPipeline(config.robot, config.preprocessing, estimators, config.friction, config.seed,
+                                  config.robot_source, setup)
 
 
 @keyword_only_after_data
@@ -548,9 +550,7 @@ def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
 
 
 @with_single_blas_thread
-def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Preprocessing | None = None,
-                         estimators=("wls",), name: str = "arrays", friction: str = "description", seed: int = 0,
-                         sdp_prior: str = "euclidean", controller=None):
+def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "arrays", **settings):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
     (:class:`~dynid.identification.pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
     cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
@@ -568,22 +568,14 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
         Joint torques (e.g. drive gain × motor current, eq. 16).
     dq : (N, n_dof) array [rad/s], optional
         Measured velocities (default: differentiated from the filtered positions).
-    preprocessing : Preprocessing, optional
-        Default: every setting derived from the data.
-    estimators : sequence of str
-        As ``[estimation] estimators`` of a config (the first is the main estimate; the closed-loop ones with
-        ``controller``).
     name : str
         The dataset's name in tables and messages.
-    friction : {"description", "auto"}
-        The robot's friction terms as described, or each joint's model chosen by cross-validation.
-    seed : int
-        Seeds the box searches and the bootstrap (``[estimation] seed``).
-    sdp_prior : {"euclidean", "geometric"}
-        As ``[estimation] sdp_prior``.
-    controller : ClosedLoopSetup, optional
-        How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`), for
-        the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP) as a config's ``[controller]`` gives it.
+    **settings
+        The pipeline's settings, as :class:`~dynid.identification.pipeline.IdentificationPipeline` takes them:
+        ``preprocessing`` (default: every setting derived from the data), ``estimators`` (keys or objects, as a
+        config's ``[estimation] estimators``; the closed-loop ones with ``controller``), ``friction``
+        ({"description", "auto"}, default "description"), ``seed`` (default 0), ``controller``
+        (:class:`dynid.identification.closed_loop.ClosedLoopSetup`, as a config's ``[controller]`` gives it).
 
     Returns
     -------
@@ -596,19 +588,18 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, preprocessing: Pre
     DataError
         Time stamps that do not increase, a gap longer than 5 median steps, or set-points that are not one per sample.
     ConfigError
-        An unknown estimator or ``friction``, or closed-loop estimators without ``controller``.
+        An unknown estimator, setting or ``friction``, or closed-loop estimators without ``controller``.
     """
-    from ..estimators.instrumental import CLOSED_LOOP_METHODS
     from .pipeline import IdentificationPipeline
 
-    estimators = tuple(estimators)
-    closed_loop: tuple[str, ...] = ()
-    if any(str(k).strip().lower() in CLOSED_LOOP_METHODS for k in estimators):  # as a config splits its list
-
-        parsed, closed_loop = split_estimators(estimators, "estimators")
-        estimators = tuple(parsed)
-    pipeline = IdentificationPipeline(robot, preprocessing or Preprocessing(), estimators, friction, int(seed), sdp_prior,
-                                      robot.name if robot.name in builtin_robots() else "", closed_loop, controller)
+    known = {f.name for f in fields(IdentificationPipeline) if f.init} - {"robot", "source"}
+    unknown = sorted(set(settings) - known)
+    if unknown:
+        raise ConfigError(f"identify_from_arrays: unknown setting {unknown[0]!r}; expected one of {', '.join(sorted(known))}",
+                          field=unknown[0])
+    given = {"seed": int(settings.get("seed", 0)), "preprocessing": settings.get("preprocessing") or Preprocessing()}
+    pipeline = IdentificationPipeline(robot, **{**settings, **given},
+                                      source=robot.name if robot.name in builtin_robots() else "")
     return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))
 
 

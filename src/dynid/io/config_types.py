@@ -142,6 +142,17 @@ class EstimationTable(Table, kw_only=True):
                                                                "nominal values: squared distance (default) or the "
                                                                "pseudo-inertias' log-det divergence (plausible links)")] | None = None
 
+    def hyperparameters(self) -> dict[str, dict]:
+        """The estimators' hyper-parameters this table sets (:func:`dynid.estimators.registry.with_hyperparameters`).
+
+        Returns
+        -------
+        dict
+            key -> constructor parameters: ``sdp_prior`` is the SDP's ``prior_kind``
+            (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
+        """
+        return {"sdp": {"prior_kind": self.sdp_prior}} if self.sdp_prior is not None else {}
+
 
 class ReferenceTable(Table, kw_only=True):
     """``[[references]]``: a published parameter set (:mod:`dynid.io.references`)."""

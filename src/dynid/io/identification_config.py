@@ -64,14 +64,14 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 import msgspec
 import numpy as np
 
-from ..estimators.registry import estimate_label, keys, parse_estimators
+from ..estimators.registry import estimate_label, estimator_choices, keys
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
@@ -116,8 +116,9 @@ class IdentificationConfig:
         A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
     friction : str
         "auto": each joint's friction model by cross-validation; "description": as described.
-    sdp_prior : str
-        ``[estimation] sdp_prior``: how the SDP keeps unidentifiable directions near the nominal values.
+    hyperparameters : dict
+        Estimator key -> the hyper-parameters ``[estimation]`` sets for it
+        (:meth:`dynid.io.config_types.EstimationTable.hyperparameters`), applied to whatever estimator list is identified (:func:`dynid.estimators.registry.with_hyperparameters`).
     urdf : Path or None
         The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
@@ -143,7 +144,7 @@ class IdentificationConfig:
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
-    sdp_prior: str = "euclidean"  # [estimation] sdp_prior: "euclidean" or "geometric"
+    hyperparameters: dict = field(default_factory=dict)  # estimator key -> hyper-parameters [estimation] sets
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
     mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
     closed_loop: tuple[str, ...] = ()  # IDIM-IV / DIDIM asked for, run beside the estimators
@@ -233,15 +234,16 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
 
     Parameters
     ----------
-    asked : sequence of str
-        Estimator keys; the first is the main estimate.
+    asked : sequence of str and Estimator
+        Estimator keys, or estimator objects (:func:`dynid.estimators.registry.estimator_choices`); the first is the
+        main estimate.
     where : str
         Where the list was given, for the messages.
 
     Returns
     -------
     estimators : tuple
-        The parsed open-loop estimators.
+        The parsed open-loop estimators: keys in lower case, the objects as given.
     closed_loop : tuple of str
         The closed-loop keys, lower case.
 
@@ -252,13 +254,15 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
     """
     from ..estimators.instrumental import CLOSED_LOOP_METHODS
 
-    asked = [str(k).strip().lower() for k in asked]
-    closed_loop = tuple(k for k in asked if k in CLOSED_LOOP_METHODS)
-    if asked and asked[0] in CLOSED_LOOP_METHODS:
+    asked = [k.strip().lower() if isinstance(k, str) else k for k in asked]  # estimator objects stay as they are
+    closed_loop = tuple(k for k in asked if isinstance(k, str) and k in CLOSED_LOOP_METHODS)
+    if asked and isinstance(asked[0], str) and asked[0] in CLOSED_LOOP_METHODS:
         raise ConfigError(f"{where}: the first is the main estimate and starts the closed-loop ones: list ols or wls "
                           f"before {asked[0]!r}")
+    open_loop = [k for k in asked if not (isinstance(k, str) and k in CLOSED_LOOP_METHODS)]
     try:
-        estimators = parse_estimators([k for k in asked if k not in CLOSED_LOOP_METHODS])
+        keys_ = estimator_choices(open_loop, where)[0]
+        estimators = tuple(k if isinstance(o, str) else o for k, o in zip(keys_, open_loop))
     except ConfigError as exc:
         text = str(exc)
         if text.startswith("plugin "):  # a plugin that cannot be imported names itself and where it was named
@@ -329,7 +333,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     urdf = config_urdf(doc, path, root)
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
-                                urdf=urdf, sdp_prior=e.sdp_prior or "euclidean", closed_loop=closed_loop,
+                                urdf=urdf, hyperparameters=e.hyperparameters(), closed_loop=closed_loop,
                                 controller=controller,
                                 mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
 
