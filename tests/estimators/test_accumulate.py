@@ -163,3 +163,24 @@ def test_an_affine_subset_is_the_weighted_least_squares_of_its_coordinates(rng):
     np.testing.assert_array_equal(params[fixed], offset[fixed])
     sigma2 = res[0] / (a.shape[0] - 3)
     np.testing.assert_allclose(cov, basis @ (sigma2 * np.linalg.inv(a.T @ a)) @ basis.T, rtol=1e-7, atol=1e-14)
+
+
+def test_a_gaussian_prior_is_the_maximum_a_posteriori_estimate(rng):
+    """solve(gaussian=(values, sigmas)): the normal equations of the data plus ``(s/σ_i)²(x_i - v_i)²``, ``s`` the
+    unconstrained fit's residual σ, solved independently; parameters without a σ (NaN) are not pulled, and an
+    infinite-looking σ gives the fit without the prior."""
+    w = rng.normal(size=(400, 4)) * [1.0, 5.0, 0.2, 2.0]
+    tau = w @ np.array([1.0, -2.0, 3.0, 0.5]) + rng.normal(0.0, 0.3, 400)
+    acc = LeastSquaresAccumulator(4)
+    acc.add(w, tau)
+    plain = acc.solve()
+    values, sigmas = np.array([0.0, 0.0, 2.0, 0.0]), np.array([np.nan, np.nan, 0.05, np.nan])
+    s2 = plain.residual_std ** 2
+    lam = np.zeros(4)
+    lam[2] = s2 / sigmas[2] ** 2
+    expected = np.linalg.solve(w.T @ w + np.diag(lam), w.T @ tau + lam * values)
+    got = acc.solve(gaussian=(values, sigmas))
+    np.testing.assert_allclose(got.params, expected, rtol=1e-9)
+    assert abs(got.params[2] - 2.0) < abs(plain.params[2] - 2.0)
+    np.testing.assert_allclose(acc.solve(gaussian=(values, np.where(np.isnan(sigmas), np.nan, 1e9))).params,
+                               plain.params, rtol=1e-9)

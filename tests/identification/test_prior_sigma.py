@@ -1,7 +1,7 @@
 """A drive term stated with its uncertainty (issue "Never worse than the description", item 2): ``Ia = { value,
-sigma }`` in ``[[joints]]`` pulls the drive-only and the physically consistent estimates toward the value as a
-Gaussian prior: a σ of almost 0 holds the term at the value, a σ far above what the log determines leaves the
-estimate as without it."""
+sigma }`` in ``[[joints]]`` pulls the drive-only, the physically consistent and the least-squares estimates toward
+the value as a Gaussian prior: a σ of almost 0 holds the term at the value, a σ far above what the log determines
+leaves the estimate as without it; a term least squares holds regrouped with others is said."""
 
 from __future__ import annotations
 
@@ -47,3 +47,50 @@ def test_a_sigma_near_zero_holds_the_term_at_its_value(tmp_path, plain):
 def test_a_sigma_far_above_what_the_log_determines_changes_nothing(tmp_path, plain):
     drive_only, sdp, _ = _identify(tmp_path, 1e6)
     np.testing.assert_allclose([drive_only, sdp], plain[:2], rtol=1e-5, atol=1e-6)
+
+
+def _least_squares(tmp_path, sigma: float | None, term: str = "fv", joint: int = 2, value: float = 40.0):
+    """The WLS estimate's base parameter ``term+joint`` with ``term = { value, sigma }`` stated, its σ, and the run's
+    warnings."""
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+    from tests.simulated_logs import simulated_case
+
+    folder = tmp_path / f"ls{term}{joint}{sigma}"
+    folder.mkdir()
+    cfg, _ = simulated_case(folder, "er16", 125.0, "fourier", duration=10.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls"]'))
+    robot = re.search(r'^robot = "(.*)"', cfg.read_text(), flags=re.M).group(1)
+    text = open(robot).read()
+    given = f"{value}" if sigma is None else f"{{ value = {value}, sigma = {sigma} }}"
+    blocks = text.split("[[joints]]")
+    line = re.compile(rf"^{term} = .*$", flags=re.M)  # the simulated arm's own value, where it states one
+    block = blocks[joint]
+    blocks[joint] = line.sub(f"{term} = {given}", block) if line.search(block) else block.replace(
+        f'name = "joint{joint}"', f'name = "joint{joint}"\n{term} = {given}', 1)
+    open(robot, "w").write("[[joints]]".join(blocks))
+    result = run_identification(load_identification_config(cfg))
+    wls = result.estimates["dynid WLS"]
+    names = list(result.base.names)
+    k = names.index(f"{term}{joint}") if f"{term}{joint}" in names else None
+    return (None if k is None else wls.params[k]), (None if k is None else wls.std[k]), result.warnings
+
+
+def test_least_squares_pulls_a_stated_term_as_its_gaussian_prior(tmp_path):
+    """WLS with fv2 = { value = 40, sigma } where the simulated arm's is 6: a σ of almost 0 holds fv2 at 40 (its σ
+    the prior's, times the residual's growth), a σ far above what the log determines gives WLS's estimate without it, to 1e-6 (its σ too)."""
+    free, free_std, _ = _least_squares(tmp_path, None)
+    assert abs(free - 40.0) > 10.0  # the log sets fv2 near the simulated arm's own (7.8 on this 10 s log)
+    held, held_std, warnings = _least_squares(tmp_path, 1e-9)
+    assert abs(held - 40.0) < 1e-6 and held_std < 1e-4 * free_std  # σ: the prior's, scaled by the worse residual
+    assert not any("the σ stated" in w for w in warnings)
+    loose, loose_std, _ = _least_squares(tmp_path, 1e6)
+    np.testing.assert_allclose([loose, loose_std], [free, free_std], rtol=1e-6)
+
+
+def test_a_stated_term_least_squares_holds_regrouped_is_said(tmp_path):
+    """Ia1 is regrouped into ZZ1R (both multiply q̈1 alone): least squares cannot pull it, and says so."""
+    _, _, warnings = _least_squares(tmp_path, 0.01, "Ia", 1, 0.5)
+    said = [w for w in warnings if "the σ stated" in w]
+    assert said == ["Ia1: the σ stated for it is used by the SDP and the drive-only estimate, not by least squares, "
+                    "whose base parameters hold it regrouped with other terms"]

@@ -66,6 +66,34 @@ class BaseParameters:
         """
         return self.regrouping @ np.asarray(phi, dtype=float)
 
+    def base_std(self, std: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
+        """Standard deviations of the base parameters that are one standard parameter each, from the standard
+        parameters' (a prior's σ: the others' cannot be carried, since a regrouped one mixes terms without one).
+
+        Parameters
+        ----------
+        std : (n_params,) array
+            Each standard parameter's σ, NaN where none.
+
+        Returns
+        -------
+        base_std : (n_base,) ndarray
+            ``|c|·σ`` of a base parameter ``c·φ_k`` whose ``φ_k`` has a σ; NaN elsewhere.
+        not_carried : tuple of str
+            The standard parameters with a σ that no base parameter is alone (regrouped, or not in the model's
+            torques).
+        """
+        std = np.asarray(std, dtype=float)
+        out = np.full(self.n_base, np.nan)
+        not_carried = []
+        for k in np.flatnonzero(np.isfinite(std)):
+            rows = np.flatnonzero(self.regrouping[:, k])
+            if rows.size == 1 and np.count_nonzero(self.regrouping[rows[0]]) == 1:
+                out[rows[0]] = abs(self.regrouping[rows[0], k]) * std[k]
+            else:
+                not_carried.append(self.standard_names[k])
+        return out, tuple(not_carried)
+
     def base_from_named(self, values: dict) -> np.ndarray:
         """Base parameters of standard parameters given by name.
 

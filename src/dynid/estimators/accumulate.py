@@ -182,7 +182,7 @@ class LeastSquaresAccumulator:
         return _triangular(np.vstack([f * wj for f, wj in zip(self.factors, wts)]), self.n_params + 1)
 
     def solve(self, joint_weights=None, rcond: float | None = None, names=None, prior=None,
-              pairs=()) -> LeastSquaresSolution:
+              pairs=(), gaussian=None) -> LeastSquaresSolution:
         """OLS (default) or WLS with one weight per joint.
 
         Where the rows do not determine every parameter (a rank-deficient observation matrix) and a ``prior`` is given,
@@ -203,6 +203,9 @@ class LeastSquaresAccumulator:
             Values kept where the rows say nothing (the description's nominal parameters).
         pairs : sequence of (int, int)
             ``(free, anchored)`` parameter indices (with a prior only), as above.
+        gaussian : ((p,) array, (p,) array), optional
+            ``(values, sigmas)``: a Gaussian prior on the parameters whose σ is finite (a drive's data sheet), as
+            :meth:`solve_affine`'s (the maximum a posteriori estimate).
 
         Returns
         -------
@@ -225,13 +228,16 @@ class LeastSquaresAccumulator:
         tol = rcond if rcond is not None else max(m, p) * np.finfo(float).eps
         if sv[-1] <= tol * sv[0]:
             if prior is not None:
-                return _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs)
+                sol = _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs)
+                return _with_gaussian(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs, sol, gaussian)
             weak = _weak(vt[sv <= tol * sv[0]])
             what = (", ".join(str(names[i]) for i in np.flatnonzero(weak)) if names is not None
                     else f"{int(weak.sum())} parameter(s)")
             raise IdentifiabilityError(f"the data do not excite {what} (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): "
                                        "a richer excitation, or a longer log, is needed")
-        return _full_rank(r, rhs, rho, m, sv)
+        sol = _full_rank(r, rhs, rho, m, sv)
+        return _with_gaussian(r, rhs, rho, m, sol.params if prior is None else np.asarray(prior, dtype=float), pairs,
+                              sol, gaussian)
 
     def solve_affine(self, basis, offset, joint_weights=None, prior=None, pairs=(),
                      gaussian=None) -> tuple[np.ndarray, np.ndarray, LeastSquaresSolution]:
@@ -279,15 +285,23 @@ class LeastSquaresAccumulator:
         r, z, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
         prior = np.zeros(d) if prior is None else np.asarray(prior, dtype=float)
         a, b = r @ basis, z - r @ offset
-        sol = _about_prior(a, b, rho, m, prior, pairs)
-        if gaussian is not None and np.any(np.isfinite(gaussian[1])):
-            values, sigmas = (np.asarray(g, dtype=float) for g in gaussian)
-            held = np.flatnonzero(np.isfinite(sigmas))
-            rows = np.zeros((held.size, d))
-            rows[np.arange(held.size), held] = sol.residual_std / sigmas[held]
-            sol = _about_prior(np.vstack([a, rows]), np.concatenate([b, rows[np.arange(held.size), held] * values[held]]),
-                               rho, m, prior, pairs)
+        sol = _with_gaussian(a, b, rho, m, prior, pairs, _about_prior(a, b, rho, m, prior, pairs), gaussian)
         return offset + basis @ sol.params, basis @ sol.covariance @ basis.T, sol
+
+
+def _with_gaussian(a: np.ndarray, b: np.ndarray, rho: float, m: int, prior: np.ndarray, pairs, sol: LeastSquaresSolution,
+                   gaussian) -> LeastSquaresSolution:
+    """``sol`` of ``min ||a x - b||²`` again with a Gaussian prior ``(values, sigmas)`` on the entries whose σ is finite,
+    as rows ``(s/σ_i)·(x_i - value_i)`` beside the data's, ``s`` the residual σ of ``sol`` (so the rows weigh as ``1/σ_i²``
+    against the data's ``1/s²``: the maximum a posteriori estimate); ``sol`` itself without such a σ."""
+    if gaussian is None or not np.any(np.isfinite(gaussian[1])):
+        return sol
+    values, sigmas = (np.asarray(g, dtype=float) for g in gaussian)
+    held = np.flatnonzero(np.isfinite(sigmas))
+    rows = np.zeros((held.size, a.shape[1]))
+    rows[np.arange(held.size), held] = sol.residual_std / sigmas[held]
+    return _about_prior(np.vstack([a, rows]), np.concatenate([b, rows[np.arange(held.size), held] * values[held]]),
+                        rho, m, prior, pairs)
 
 
 def _full_rank(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, sv: np.ndarray) -> LeastSquaresSolution:

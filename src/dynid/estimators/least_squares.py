@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..conventions import split_name
+from ..exceptions import ShapeError
 from .base import AccumulatingEstimator
 
 
@@ -47,6 +48,11 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
         without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it. With the parameters'
         names given (``partial_fit(..., names=)``), a joint's Coulomb friction takes the one term it shares with its
         offset where only that term is determined (:func:`coulomb_offset_pairs`).
+    base_prior_std : (p,) array or None
+        Each parameter's prior standard deviation, NaN where none (a drive's data sheet,
+        ``Ia = { value = 0.3, sigma = 0.05 }``): such a parameter is pulled toward ``base_prior`` as a Gaussian prior,
+        rows ``(s/σ_i)·(p_i - prior_i)`` beside the data's, ``s`` the fit's residual σ (the maximum a posteriori
+        estimate; :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`'s ``gaussian``).
 
     Attributes
     ----------
@@ -76,17 +82,34 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
     robots", IJRR 11(4), 1992 (σ of the estimates).
     """
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
         self.n_dof = n_dof
         self.rcond = rcond
         self.base_prior = base_prior
+        self.base_prior_std = base_prior_std
 
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
-        sol = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=coulomb_offset_pairs(names))
+        sol = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=coulomb_offset_pairs(names),
+                        gaussian=_gaussian(self))
         _set_solution(self, sol)
         self.ols_params_ = sol.params
         self.joint_std_ = acc.joint_residual_std(sol.params)
+
+
+def _gaussian(est) -> tuple | None:
+    """``(values, sigmas)`` of an estimator's Gaussian prior (``base_prior`` with ``base_prior_std``), or None."""
+    if est.base_prior_std is None:
+        return None
+    sigmas = np.asarray(est.base_prior_std, dtype=float)
+    if not np.any(np.isfinite(sigmas)):
+        return None
+    if est.base_prior is None:
+        raise ShapeError("base_prior_std: a prior standard deviation needs base_prior, the values it is about")
+    values = np.asarray(est.base_prior, dtype=float)
+    if sigmas.shape != values.shape:
+        raise ShapeError(f"expected a base_prior_std of shape {values.shape}, got {sigmas.shape}")
+    return values, sigmas
 
 
 def _set_solution(est, sol) -> None:
@@ -110,8 +133,9 @@ class WeightedLeastSquares(AccumulatingEstimator):
         given as (N, n_dof).
     rcond : float or None
         As :class:`OrdinaryLeastSquares`.
-    base_prior : (p,) array or None
-        As :class:`OrdinaryLeastSquares`.
+    base_prior, base_prior_std : (p,) array or None
+        As :class:`OrdinaryLeastSquares` (the Gaussian prior on the weighted problem: the rows of the
+        stated parameters weigh ``1/σ_i²`` against the weighted residuals' unit variance).
 
     Attributes
     ----------
@@ -136,10 +160,11 @@ class WeightedLeastSquares(AccumulatingEstimator):
 
     needs_joints = True
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None):
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
         self.n_dof = n_dof
         self.rcond = rcond
         self.base_prior = base_prior
+        self.base_prior_std = base_prior_std
 
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
@@ -147,6 +172,6 @@ class WeightedLeastSquares(AccumulatingEstimator):
         ols = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=pairs)
         std = acc.joint_residual_std(ols.params)
         _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=self.base_prior,
-                                      pairs=pairs))
+                                      pairs=pairs, gaussian=_gaussian(self)))
         self.ols_params_ = ols.params
         self.joint_std_ = std

@@ -104,6 +104,9 @@ class FitData:
     prior_std : (p,) array, optional
         Standard deviation of ``prior``'s values where the description states one (NaN elsewhere): ``sdp`` pulls
         those as a Gaussian prior (:meth:`dynid.model.robot.Robot.prior_sigmas`).
+    base_prior_std : (n_base,) array, optional
+        The same of ``base_prior``'s values, for the base parameters that are one stated standard parameter each
+        (NaN elsewhere): least squares pulls those as a Gaussian prior.
     """
 
     w_base: Any
@@ -119,6 +122,7 @@ class FitData:
     hyperparameters: dict = dataclasses.field(default_factory=dict)
     base_prior: Any = None
     prior_std: Any = None
+    base_prior_std: Any = None
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -139,7 +143,8 @@ class EstimatorSpec:
     build : callable or str
         ``build(data, budget, rng, callback) -> Estimator``, or an :class:`~dynid.estimators.base.Estimator`
         subclass (its keyword hyper-parameters named ``n_dof``, ``bounds``, ``weights``, ``prior``, ``links``,
-        ``nonnegative``, ``joint_weights``, ``rng`` and ``callback`` are filled from the problem), or
+        ``nonnegative``, ``joint_weights``, ``base_prior``, ``base_prior_std``, ``rng`` and ``callback`` are filled
+        from the problem: :data:`PROBLEM_FILLED`), or
         ``"module:attribute"`` of either (imported when first built).
     space : {"base", "standard"}
         The parameters it estimates: base parameters, or standard ones (mapped to the base by the pipeline).
@@ -185,7 +190,7 @@ class EstimatorSpec:
         return target
 
 
-_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback", "base_prior")
+_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback", "base_prior", "base_prior_std")
 
 
 def _from_class(cls: type, options: dict) -> Builder:
@@ -194,7 +199,8 @@ def _from_class(cls: type, options: dict) -> Builder:
 
     def build(data: FitData, budget: SearchBudget, rng, callback):
         values = {"n_dof": data.n_dof, "bounds": data.bounds, "weights": data.weights, "prior": data.prior,
-                  "joint_weights": data.joint_weights, "rng": rng, "callback": callback, "base_prior": data.base_prior}
+                  "joint_weights": data.joint_weights, "rng": rng, "callback": callback, "base_prior": data.base_prior,
+                  "base_prior_std": data.base_prior_std}
         if data.layout is not None:
             values.update(links=data.layout[0], nonnegative=data.layout[1])
         kwargs = {k: v for k, v in values.items() if k in accepted and (k in _FILLED or v is not None)}

@@ -361,10 +361,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
             if sdp:
                 raise
         prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
+    base_std, not_carried = base.base_std(robot.prior_sigmas()) if robot.prior_sigma else (None, ())
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
                       prior=prior, hyperparameters=hyperparameters,
                       base_prior=base.base_from_standard(robot.standard_parameters()),
-                      prior_std=robot.prior_sigmas() if robot.prior_sigma else None)
+                      prior_std=robot.prior_sigmas() if robot.prior_sigma else None, base_prior_std=base_std)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
@@ -392,7 +393,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     for key in (*keys, *(() if ls_key in keys else (ls_key,))):
         estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
     warnings = list(robot.nominal_problems) + list(robot.nominal_notes) + list(prior_notes) + list(data.warnings) + \
-        [e.note for e in estimates.values() if e.note]
+        [e.note for e in estimates.values() if e.note] + _not_carried_note(not_carried)
     dropped = 1.0 - reference.accumulator_.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation or 1)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
@@ -427,6 +428,15 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                                                   **_given_hyperparameters(hyperparameters)},
         warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
         model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative))
+
+
+def _not_carried_note(names: tuple[str, ...]) -> list[str]:
+    """The warning for stated σ that least squares cannot use (:meth:`BaseParameters.base_std`)."""
+    if not names:
+        return []
+    return [f"{', '.join(names)}: the σ stated for {'it' if len(names) == 1 else 'them'} is used by the SDP and the "
+            "drive-only estimate, not by least squares, whose base parameters hold "
+            f"{'it' if len(names) == 1 else 'each'} regrouped with other terms"]
 
 
 def _given_hyperparameters(hyperparameters: dict) -> dict:
