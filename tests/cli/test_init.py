@@ -394,3 +394,27 @@ def test_init_asks_which_side_of_the_gear_measured_the_torques(tmp_path):
     assert SENSOR_HINT in text and text.index(SENSOR_HINT) > text.index("torques = {")
     joint = text.replace("] }\n" + SENSOR_HINT, '], sensor = "joint" }\n' + SENSOR_HINT)
     assert tomllib.loads(joint)["identification"]["torques"]["sensor"] == "joint"
+
+
+def test_init_infers_joint_torque_sensors_from_an_arm_that_has_them(tmp_path):
+    """issue "Never worse than the description", item 3: a URDF naming an arm with joint torque sensors on the link
+    side (a KUKA LBR Med here, by its robot name) gets sensor = "joint" in the torques table, said with how to undo it,
+    and identify reads it (no rotor inertia); another arm's URDF only gets the question."""
+    import tomllib
+
+    from dynid.io.identification_config import load_identification_config
+    from dynid.io.starter import SENSOR_HINT
+
+    log = _log(tmp_path, header=True)
+    med = tmp_path / "arm.urdf"
+    med.write_text(URDF.read_text().replace('<robot name="', '<robot name="lbr_med7_', 1))
+    assert '<robot name="lbr_med7_' in med.read_text()
+    p = run("init", str(med), str(log), "--out", str(tmp_path / "med.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "med.toml").read_text()
+    assert tomllib.loads(text)["identification"]["torques"]["sensor"] == "joint" and SENSOR_HINT not in text
+    assert 'sensor = "joint" inferred from the name "lbr_med7_' in text and 'write sensor = "drive" if' in text
+    assert "Ia" not in load_identification_config(tmp_path / "med.toml").robot.drive_terms
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "other.toml"))
+    other = (tmp_path / "other.toml").read_text()
+    assert SENSOR_HINT in other and "sensor" not in tomllib.loads(other)["identification"]["torques"]

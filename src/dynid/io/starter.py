@@ -231,8 +231,10 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                 table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
                 notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
                 taken += found[kind][:n_dof]
-                if kind == "torques":  # a log cannot tell which side of the gear measured them: the user says
-                    table.append(SENSOR_HINT)
+                if kind == "torques":  # a log cannot tell which side of the gear measured them: the arm may
+                    lines_, said = _torque_sensor(table.pop(), urdf)
+                    table += lines_
+                    notes += said
         left = [c for c in first if c not in taken]
         extra = [c for c in left if _kind(c) in ("positions", effort)]
         if extra:
@@ -277,6 +279,33 @@ def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
 SENSOR_HINT = ('# torques from joint torque sensors on the link side (a KUKA LBR, a Franka)? add sensor = "joint" to '
                "the torques table: no rotor inertia is then fitted")
 """The line under a config's torques that asks what a log cannot say: which side of the gear measured them."""
+
+
+JOINT_SENSED = re.compile(r"lbr|iiwa|med7|med14|panda|fr3|franka|kinova|gen3", re.IGNORECASE)
+"""Names of arms whose joint torques come from torque sensors on the link side of every gear: KUKA's LBR iiwa and
+LBR Med, Franka Emika's Panda and FR3, Kinova's Gen3 (in a URDF's robot name or its file's name)."""
+
+
+def _torque_sensor(line: str, urdf: Path) -> tuple[list[str], list[str]]:
+    """The torques' table line with ``sensor = "joint"`` where the URDF names an arm of :data:`JOINT_SENSED` (and the
+    comment that says so and how to undo it), else the line and :data:`SENSOR_HINT`; and the note for the header."""
+    named = next((n for n in (_robot_name(urdf), urdf.stem) if n and JOINT_SENSED.search(n)), None)
+    if named is None:
+        return [line, SENSOR_HINT], []
+    why = (f'sensor = "joint" inferred from the name "{named}" in {urdf.name}: an arm with joint torque sensors on the '
+           "link side of its gears, whose torques hold no rotor inertia")
+    return [line[: -len(" }")] + ', sensor = "joint" }',
+            f'# {why}; write sensor = "drive" if these are motor currents or a motor-side torque'], [why]
+
+
+def _robot_name(urdf: Path) -> str | None:
+    """The ``name`` of a URDF's (or xacro file's) ``<robot>`` element, read as text (nothing of it runs), or None."""
+    try:
+        head = urdf.read_text(errors="replace")[:20000]
+    except OSError:
+        return None
+    found = re.search(r"<robot\b[^>]*?\bname\s*=\s*[\"']([^\"']*)[\"']", head)
+    return found.group(1) if found else None
 
 
 def _found_columns(first: list[str], row: list[str], joints: tuple[str, ...], n_dof: int) -> tuple[dict, list[str]]:
