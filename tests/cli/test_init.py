@@ -418,3 +418,26 @@ def test_init_infers_joint_torque_sensors_from_an_arm_that_has_them(tmp_path):
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "other.toml"))
     other = (tmp_path / "other.toml").read_text()
     assert SENSOR_HINT in other and "sensor" not in tomllib.loads(other)["identification"]["torques"]
+
+
+def test_init_takes_the_rate_of_a_log_without_time_stamps(tmp_path):
+    """A log with a header and no time column (the LBR Med7's lbr-stack recordings): init refuses it naming --rate,
+    and with --rate writes rate = ..., which identify reads as one sample every 1/rate s (the log's own times)."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    log = _log(tmp_path, header=True)
+    rows = np.loadtxt(log, delimiter=",", skiprows=1)
+    rate = 1.0 / float(np.median(np.diff(rows[:, 0])))
+    header = log.read_text().splitlines()[0].split(",")[1:]
+    np.savetxt(log, rows[:, 1:], delimiter=",", comments="", header=",".join(header))
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 1 and "no time column" in p.stderr and "--rate HZ" in p.stderr
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"), "--rate", f"{rate!r}")
+    assert p.returncode == 0, p.stderr
+    assert f"rate = {rate!r}" in (tmp_path / "arm.toml").read_text()
+    config = load_identification_config(tmp_path / "arm.toml")
+    robot = config.robot
+    recording = load_recording(config.identification, robot)
+    np.testing.assert_allclose(recording.t - recording.t[0], rows[:, 0] - rows[0, 0], atol=1e-9)
+    np.testing.assert_allclose(recording.q, rows[:, 1:7], rtol=1e-12)

@@ -753,6 +753,8 @@ def init(
     validation: list[Path] | None = typer.Argument(None, help="Other logs of the same layout, to validate on."),
     out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
     force: bool = typer.Option(False, help="Overwrite --out if it exists."),
+    rate: float | None = typer.Option(None, help="The logs' sample rate [Hz], for CSV logs without a time column.",
+                                      min=1e-9),
     quiet: bool = QUIET,
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
@@ -773,7 +775,7 @@ def init(
             if not v.exists():
                 raise DynIdError(f"{v}: no such validation log")
         return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints),
-                              robot.held, robot=robot)
+                              robot.held, robot=robot, rate=rate)
 
     def save(written):
         from ..io.files import atomic_write_text

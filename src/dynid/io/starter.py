@@ -150,7 +150,8 @@ def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
-                   joints: tuple[str, ...] = (), held: tuple[str, ...] = (), robot=None) -> tuple[str, list[str]]:
+                   joints: tuple[str, ...] = (), held: tuple[str, ...] = (), robot=None, *,
+                   rate: float | None = None) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -174,6 +175,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     robot : Robot, optional
         The robot read from ``urdf``: a bag is then opened and read as identify reads it (its joint names against the
         robot's, its rate, length and effort range said).
+    rate : float, optional
+        The logs' sample rate [Hz], for a CSV log with a header and no time column (``rate =`` in the config; the
+        validation tables take it with the identification's columns).
 
     Returns
     -------
@@ -212,9 +216,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
     if header:
         found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
-        if "time" not in found:
-            raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; or write the config by "
-                            "hand with rate = ... (docs: Configuration files)")
+        if "time" not in found and rate is None:
+            raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
+                            "stamps give its sample rate: dynid init ... --rate HZ")
         effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
         missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
         if missing:
@@ -222,8 +226,10 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
             raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
                             f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
-        time_table, time_notes, taken = _time_lines(first, found["time"][0],
-                                                    [split(line) for line in lines[1:]])
+        time_table, time_notes, taken = (_time_lines(first, found["time"][0], [split(line) for line in lines[1:]])
+                                         if "time" in found else
+                                         ([f"rate = {float(rate)!r}                     # Hz: no time column (--rate)"],
+                                          [f"no time column: one sample every 1/{rate:g} s (--rate)"], []))
         table += ["header = true", *time_table]
         notes += time_notes
         for kind in ("positions", "velocities", effort):
