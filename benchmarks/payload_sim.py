@@ -1,7 +1,9 @@
 """Benchmark: `dynid payload` on simulated tools (issue "The model proven where it goes", item 4, targets).
 
 Two built-in arms (UR10e, ER-16; the TX40 is left out: tests/simulated_logs.py writes its currents without its
-coupled wrist, so its own truth scores 109 % on its simulated validation log and no payload could be judged on it),
+coupled wrist, so its own truth scores 109 % on its simulated validation log and no payload could be judged on it)
+and the zoo's Franka Panda (its vendor URDF, links made physical: a 7-joint arm from a URDF, with the zoo's torque
+noise, :data:`ZOO_NOISE`),
 each identified by `dynid identify` on a simulated 20 s log at 100 Hz with
 the zoo's noise (tests/simulated_logs.py: noisy currents, 20-bit encoders), then a tool of 0.5, 2, 5 and 10 kg put on
 the flange with its centre of mass up to 0.15 m off it (a seeded random direction, 0.05-0.15 m) and an inertia of a
@@ -27,14 +29,16 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from tests.cli.refusals import dynid  # noqa: E402
-from tests.simulated_logs import fourier_motion, simulated_case, write_log  # noqa: E402
+from tests.simulated_logs import fourier_motion, simulated_case, torques, truth_robot, write_log  # noqa: E402
 
 from dynid.dynamics.regressor import regressor  # noqa: E402
 from dynid.identification.run import run_payload  # noqa: E402
 from dynid.io.identification_config import dataset_for_file, load_identification_config  # noqa: E402
 from dynid.model.spatial import inertial_from_physical, transform_inertial  # noqa: E402
 
-ARMS = tuple(sys.argv[1].split(",")) if len(sys.argv) > 1 else ("ur10e", "er16")
+ARMS = tuple(sys.argv[1].split(",")) if len(sys.argv) > 1 else ("ur10e", "er16", "Panda")
+"""Built-in arms by name; a name of the zoo (benchmarks/zoo/zoo.py: "Panda", "UR5", ...) is its vendor URDF, grippers
+fixed and links made physical, the arm the log is simulated with and the description dynid is given."""
 MASSES = (0.5, 2.0, 5.0, 10.0)
 
 
@@ -53,14 +57,33 @@ def _loaded(truth, mass, com, inertia):
     return replace(truth, inertial=inertial)
 
 
-def _log(path, truth, loaded, seed):
+def _friction(truth):
+    return (truth.drive[:, 1] + truth.drive[:, 3], truth.drive[:, 1] - truth.drive[:, 3], truth.drive[:, 2],
+            truth.drive[:, 0])
+
+
+def _log(path, truth, loaded, seed, noise=0.02):
     rng = np.random.default_rng(seed)
     t = np.arange(2000) / 100.0
     q, dq, ddq = fourier_motion(loaded, t, rng)
-    friction = (truth.drive[:, 1] + truth.drive[:, 3], truth.drive[:, 1] - truth.drive[:, 3], truth.drive[:, 2],
-                truth.drive[:, 0])
-    write_log(path, loaded, t, q, dq, ddq, friction, rng)
+    write_log(path, loaded, t, q, dq, ddq, _friction(truth), rng, noise)
     return t, q, dq, ddq
+
+
+ZOO_NOISE = 0.03
+"""A zoo arm's current noise: this share of each joint's RMS torque on a 20 s Fourier motion (the zoo's 1-5 %; the
+built-ins keep the 0.02 A of tests/simulated_logs.py, 0.2-29 % of the UR10e's joints' RMS torques)."""
+
+
+def _noise(arm: str):
+    """The current noise [A] of an arm's logs (:data:`ZOO_NOISE`)."""
+    if arm in ("ur10e", "er16", "tx40"):
+        return 0.02
+    truth, friction = truth_robot(arm, np.random.default_rng(0))
+    t = np.arange(2000) / 100.0
+    q, dq, ddq = fourier_motion(truth, t, np.random.default_rng(1))
+    rms = np.sqrt(np.mean(torques(truth, q, dq, ddq, friction) ** 2, axis=0))
+    return ZOO_NOISE * rms / truth.drive_gains
 
 
 def _with_tool(robot, phi_arm, mass, com, inertia):
@@ -73,8 +96,23 @@ def _with_tool(robot, phi_arm, mass, com, inertia):
     return phi
 
 
+def _arm(name: str, folder: Path) -> str:
+    """A built-in's name as it is, or a zoo arm's physical vendor URDF written into ``folder`` (its path)."""
+    if name in ("ur10e", "er16", "tx40"):
+        return name
+    sys.path.insert(0, str(REPO / "benchmarks" / "zoo"))
+    from zoo import ARMS as ZOO, arm_urdf, physical_urdf, robots_folder
+
+    file, keep = ZOO[name]
+    path = folder / "arm.urdf"
+    path.write_text(physical_urdf(arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep))[0])
+    return str(path)
+
+
 def run_arm(name: str, folder: Path) -> list[dict]:
-    cfg, truth = simulated_case(folder, name, 100.0, "fourier", duration=20.0)
+    arm = _arm(name, folder)
+    noise = _noise(arm)
+    cfg, truth = simulated_case(folder, arm, 100.0, "fourier", duration=20.0, current_std=noise)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
     p = dynid("identify", cfg, "--out", folder / "out", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
@@ -85,9 +123,9 @@ def run_arm(name: str, folder: Path) -> list[dict]:
     for k, mass in enumerate(MASSES):
         com, inertia = _tool(mass, rng)
         loaded = _loaded(truth, mass, com, inertia)
-        _log(folder / "loaded.csv", truth, loaded, 100 + k)
+        _log(folder / "loaded.csv", truth, loaded, 100 + k, noise)
         found, _, _ = run_payload(config, results, dataset_for_file(config, folder / "loaded.csv"))
-        t, q, dq, ddq = _log(folder / "held_out.csv", truth, loaded, 200 + k)
+        t, q, dq, ddq = _log(folder / "held_out.csv", truth, loaded, 200 + k, noise)
         measured = np.loadtxt(folder / "held_out.csv", delimiter=",")[:, 1 + 2 * truth.n_dof - truth.n_dof:] \
             * truth.drive_gains
         y = regressor(truth, q, dq, ddq)

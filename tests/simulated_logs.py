@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dynid.model.description import load_robot
+from dynid.model.description import builtin_robots, load_robot
 
 
 def truth_robot(name: str, rng: np.random.Generator):
@@ -129,8 +129,9 @@ def write_truth(path, robot, names) -> None:
 
 def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, duration: float = 30.0,
                    current_std: float = 0.02):
-    """Identification and validation logs of robot ``name`` at ``rate`` Hz with ``motion`` ("fourier" or
-    "ptp"), their config (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot)."""
+    """Identification and validation logs of robot ``name`` (a built-in, or a URDF's path: its drive terms are
+    dynid's default for a URDF, Ia, fc, fv, offset) at ``rate`` Hz with ``motion`` ("fourier" or "ptp"), their config
+    (no [preprocessing]: the defaults) and the truth; returns (config path, truth robot)."""
     rng = np.random.default_rng(seed)
     robot, friction = truth_robot(name, rng)
     t = np.arange(int(duration * rate)) / rate
@@ -139,7 +140,7 @@ def simulated_case(folder, name: str, rate: float, motion: str, seed: int = 0, d
         q, dq, ddq = make(robot, t, rng)
         write_log(folder / f"{label}.csv", robot, t, q, dq, ddq, friction, rng, current_std)
     write_truth(folder / "truth.csv", robot, robot.parameter_names)
-    toml = robot_toml(name, folder)
+    toml = robot_toml(name, folder) if name in builtin_robots() else str(name)  # a URDF's path: as it is
     cfg = folder / "config.toml"
     cfg.write_text(config_text(toml, folder, "ident.csv", "valid.csv", robot.n_dof))
     return cfg, robot
