@@ -11,22 +11,30 @@ import numpy as np
 import pytest
 
 
-def _identify(tmp_path, sigma: float | None, value: float = 0.7):
+def _stated(folder, sigma: float | None, term: str, joint: int, value: float, estimators: str):
+    """The ER-16's simulated case in ``folder`` identified with ``term`` of ``joint`` stated as ``{ value, sigma }``
+    (``value`` alone without a σ) in place of the simulated arm's own, where it states one."""
     from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
     from tests.simulated_logs import simulated_case
 
-    folder = tmp_path / f"s{sigma}"
     folder.mkdir()
     cfg, _ = simulated_case(folder, "er16", 125.0, "fourier", duration=10.0)
-    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', f"estimators = {estimators}"))
     robot = re.search(r'^robot = "(.*)"', cfg.read_text(), flags=re.M).group(1)
-    text = open(robot).read()
-    given = f"{value}" if sigma is None else f"{{ value = {value}, sigma = {sigma} }}"  # the same nominal value
-    text = text.replace('name = "joint2"', f'name = "joint2"\nIa = {given}', 1)
-    assert f"Ia = {given}" in text
-    open(robot, "w").write(text)
-    result = run_identification(load_identification_config(cfg))
+    given = f"{value}" if sigma is None else f"{{ value = {value}, sigma = {sigma} }}"
+    blocks = open(robot).read().split("[[joints]]")
+    line = re.compile(rf"^{term} = .*$", flags=re.M)
+    block = blocks[joint]
+    blocks[joint] = line.sub(f"{term} = {given}", block) if line.search(block) else block.replace(
+        f'name = "joint{joint}"', f'name = "joint{joint}"\n{term} = {given}', 1)
+    assert f"{term} = {given}" in blocks[joint]
+    open(robot, "w").write("[[joints]]".join(blocks))
+    return run_identification(load_identification_config(cfg))
+
+
+def _identify(tmp_path, sigma: float | None, value: float = 0.7):
+    result = _stated(tmp_path / f"s{sigma}", sigma, "Ia", 2, value, '["wls", "sdp"]')  # the same nominal value
     k = list(result.model.parameter_names).index("Ia2")
     return result.drive_only.standard[k], result.estimates["dynid SDP"].standard[k], dict(result.model.prior_sigma)
 
@@ -52,24 +60,7 @@ def test_a_sigma_far_above_what_the_log_determines_changes_nothing(tmp_path, pla
 def _least_squares(tmp_path, sigma: float | None, term: str = "fv", joint: int = 2, value: float = 40.0):
     """The WLS estimate's base parameter ``term+joint`` with ``term = { value, sigma }`` stated, its σ, and the run's
     warnings."""
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
-    from tests.simulated_logs import simulated_case
-
-    folder = tmp_path / f"ls{term}{joint}{sigma}"
-    folder.mkdir()
-    cfg, _ = simulated_case(folder, "er16", 125.0, "fourier", duration=10.0)
-    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls"]'))
-    robot = re.search(r'^robot = "(.*)"', cfg.read_text(), flags=re.M).group(1)
-    text = open(robot).read()
-    given = f"{value}" if sigma is None else f"{{ value = {value}, sigma = {sigma} }}"
-    blocks = text.split("[[joints]]")
-    line = re.compile(rf"^{term} = .*$", flags=re.M)  # the simulated arm's own value, where it states one
-    block = blocks[joint]
-    blocks[joint] = line.sub(f"{term} = {given}", block) if line.search(block) else block.replace(
-        f'name = "joint{joint}"', f'name = "joint{joint}"\n{term} = {given}', 1)
-    open(robot, "w").write("[[joints]]".join(blocks))
-    result = run_identification(load_identification_config(cfg))
+    result = _stated(tmp_path / f"ls{term}{joint}{sigma}", sigma, term, joint, value, '["wls"]')
     wls = result.estimates["dynid WLS"]
     names = list(result.base.names)
     k = names.index(f"{term}{joint}") if f"{term}{joint}" in names else None
