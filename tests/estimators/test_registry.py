@@ -34,7 +34,7 @@ SCENARIO = textwrap.dedent('''
 
     try:
         fit_methods(("de", "pso"), data, budget, {"de": np.random.default_rng(1), "pso": np.random.default_rng(2)},
-                    progress, workers=2)
+                    progress=progress, workers=2)
         print("not interrupted", last, fired)
     except KeyboardInterrupt:
         for t in searchers:  # joined by fit_methods, unless Ctrl-C came while it was starting a thread

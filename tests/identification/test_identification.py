@@ -251,7 +251,7 @@ def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch
     read = []
     monkeypatch.setattr(datasets, "SPOOL_BYTES", 0)
     original = datasets._assemble
-    monkeypatch.setattr(datasets, "_assemble", lambda *a: read.append(original(*a)) or read[-1])
+    monkeypatch.setattr(datasets, "_assemble", lambda *a, **k: read.append(original(*a, **k)) or read[-1])
     spooled = without_wall_times(run_identification(cfg).to_dict())
     stored = {r.name for r in read if isinstance(r.q, StoredColumns) and isinstance(r.tau, StoredColumns)}
     assert stored == {"identification", *(v.name for v in cfg.validation)}  # the drive-gain runs stay in memory

@@ -177,7 +177,7 @@ def test_validate_opens_with_each_logs_errors_and_the_best_set(tmp_path):
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=20.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\n'))
     config = load_identification_config(cfg)
-    save_identification(run_identification(config, validate=False), tmp_path / "out", False)
+    save_identification(run_identification(config, validate=False), tmp_path / "out", figures_too=False)
     comparisons, _ = run_validation(config, json.loads((tmp_path / "out" / "results.json").read_text()))
     lines = render_text(validation_in_short(comparisons), 400).splitlines()
     assert lines[0].startswith("In short") and len(lines) == 1 + len(comparisons)

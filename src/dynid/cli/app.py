@@ -279,7 +279,7 @@ def identify(
         from ..report.identification_run import model_file_name, save_identification
 
         urdf, mjcf = identified[2].urdf, identified[2].mjcf_model
-        return save_identification(identified[1], out, figures, robot=identified[0], urdf=urdf,
+        return save_identification(identified[1], out, figures_too=figures, robot=identified[0], urdf=urdf,
                                    urdf_name=None if urdf is None else model_file_name(urdf, out), mjcf_model=mjcf,
                                    mjcf_name=None if mjcf is None else model_file_name(mjcf, out), mjcf_folder=out,
                                    config=identified[2])

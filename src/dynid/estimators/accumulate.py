@@ -229,15 +229,16 @@ class LeastSquaresAccumulator:
         if sv[-1] <= tol * sv[0]:
             if prior is not None:
                 sol = _about_prior(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs)
-                return _with_gaussian(r, rhs, rho, m, np.asarray(prior, dtype=float), pairs, sol, gaussian)
+                return _with_gaussian(r, rhs, rho, m, prior=np.asarray(prior, dtype=float), pairs=pairs, sol=sol,
+                                      gaussian=gaussian)
             weak = _weak(vt[sv <= tol * sv[0]])
             what = (", ".join(str(names[i]) for i in np.flatnonzero(weak)) if names is not None
                     else f"{int(weak.sum())} parameter(s)")
             raise IdentifiabilityError(f"the data do not excite {what} (cond = {sv[0] / max(sv[-1], 1e-300):.3g}): "
                                        "a richer excitation, or a longer log, is needed")
         sol = _full_rank(r, rhs, rho, m, sv)
-        return _with_gaussian(r, rhs, rho, m, sol.params if prior is None else np.asarray(prior, dtype=float), pairs,
-                              sol, gaussian)
+        return _with_gaussian(r, rhs, rho, m, prior=sol.params if prior is None else np.asarray(prior, dtype=float),
+                              pairs=pairs, sol=sol, gaussian=gaussian)
 
     def solve_affine(self, basis, offset, joint_weights=None, prior=None, pairs=(),
                      gaussian=None) -> tuple[np.ndarray, np.ndarray, LeastSquaresSolution]:
@@ -285,11 +286,12 @@ class LeastSquaresAccumulator:
         r, z, rho = r_all[:p, :p], r_all[:p, p], abs(r_all[p, p])
         prior = np.zeros(d) if prior is None else np.asarray(prior, dtype=float)
         a, b = r @ basis, z - r @ offset
-        sol = _with_gaussian(a, b, rho, m, prior, pairs, _about_prior(a, b, rho, m, prior, pairs), gaussian)
+        sol = _with_gaussian(a, b, rho, m, prior=prior, pairs=pairs, sol=_about_prior(a, b, rho, m, prior, pairs),
+                             gaussian=gaussian)
         return offset + basis @ sol.params, basis @ sol.covariance @ basis.T, sol
 
 
-def _with_gaussian(a: np.ndarray, b: np.ndarray, rho: float, m: int, prior: np.ndarray, pairs, sol: LeastSquaresSolution,
+def _with_gaussian(a: np.ndarray, b: np.ndarray, rho: float, m: int, *, prior: np.ndarray, pairs, sol: LeastSquaresSolution,
                    gaussian) -> LeastSquaresSolution:
     """``sol`` of ``min ||a x - b||²`` again with a Gaussian prior ``(values, sigmas)`` on the entries whose σ is finite,
     as rows ``(s/σ_i)·(x_i - value_i)`` beside the data's, ``s`` the residual σ of ``sol`` (so the rows weigh as ``1/σ_i²``
@@ -344,7 +346,7 @@ def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.n
     undetermined = _weak(vt[k:]) if k < p else np.zeros(p, dtype=bool)
     anchored = []
     for free, fixed in pairs:
-        moved = _anchor(rs, scale, vt[k:], sv[0], params, cov, prior, free, fixed)
+        moved = _anchor(rs, scale, vt[k:], sv[0], params, cov, prior=prior, free=free, fixed=fixed)
         if moved is not None:
             params, cov = moved
             undetermined[free] = False
@@ -357,7 +359,7 @@ def _about_prior(r: np.ndarray, rhs: np.ndarray, rho: float, m: int, prior: np.n
                                 tuple(int(i) for i in np.flatnonzero(undetermined)), tuple(anchored))
 
 
-def _anchor(rs, scale, null_rows, sv_max, params, cov, prior, free: int, fixed: int):
+def _anchor(rs, scale, null_rows, sv_max, params, cov, *, prior, free: int, fixed: int):
     """``params`` and ``cov`` with ``fixed`` at the prior and ``free`` taking the pair's determined combination, or None
     where the two columns are not collinear by themselves, the combination is not determined to
     :data:`ANCHOR_RELATIVE_STD`, or ``free`` would be negative (:meth:`LeastSquaresAccumulator.solve`)."""

@@ -151,7 +151,7 @@ class Estimation:
         """
         return self.reference.solve()
 
-    def fit(self, box: np.ndarray | None = None, rngs: dict | None = None, budget: SearchBudget = SearchBudget(),
+    def fit(self, box: np.ndarray | None = None, rngs: dict | None = None, *, budget: SearchBudget = SearchBudget(),
             joint_weights: np.ndarray | None = None, progress=None, keys: Iterable[str] | None = None,
             workers: int | None = None, extra: dict | None = None) -> dict[str, Fitted]:
         """Fit the estimators side by side (:func:`dynid.estimators.registry.fit_methods`).
@@ -201,7 +201,7 @@ class Estimation:
             if joint_weights is not None and "joint_weights" in est.get_params():
                 est.set_params(joint_weights=joint_weights)
             fed[key] = est
-        return fit_methods(chosen, data, budget, rngs or {}, progress, workers, extra, fed)
+        return fit_methods(chosen, data, budget, rngs or {}, progress=progress, workers=workers, extra=extra, fed=fed)
 
 
 def stream_rows(chunks, estimation: Estimation, base, observer: Callable | None = None, standard: bool | None = None) -> None:

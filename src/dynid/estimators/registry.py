@@ -762,7 +762,7 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
     return finish(key, est, data, time.perf_counter() - t0)
 
 
-def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs: dict, progress=None,
+def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs: dict, *, progress=None,
                 workers: int | None = None, extra: dict | None = None, fed: dict | None = None) -> dict:
     """Fit every estimator of ``keys_``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
     and numba, which release the GIL).

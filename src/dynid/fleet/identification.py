@@ -228,7 +228,7 @@ def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dic
     if not unit.config.validation:
         return {}
     config = replace(unit.config, robot=model)
-    comparisons, _ = validate_sets(config, base_parameters(model, rng=0), sets, config.validation, None, preprocessing)
+    comparisons, _ = validate_sets(config, base_parameters(model, rng=0), sets, config.validation, resolved=preprocessing)
     return {label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in comparisons])) for label in sets}
 
 

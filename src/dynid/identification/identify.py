@@ -27,6 +27,7 @@ from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estima
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
+from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
@@ -298,7 +299,8 @@ class IdentificationResult:
         }
 
 
-def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",),
+@keyword_only_after_data
+def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",), *,
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
              observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
@@ -412,7 +414,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring, fit, rng)
+    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
@@ -577,7 +579,7 @@ def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:
     return out
 
 
-def _verdict(robot, base, sol, ols_params, row_weights, scoring: BlockScoring, fit, rng):
+def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring, fit, rng):
     """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics."""
     n = robot.n_dof
     rms = fit.rms_torque

@@ -265,7 +265,8 @@ class IdentificationPipeline:
         """
         blocks: list = []  # the delay check's rows, from the identification's own pass
         check = _delay_checked(prepared.data)
-        result = identify(prepared.robot, prepared.base, prepared.data, self.open_loop, references, progress, self.seed,
+        result = identify(prepared.robot, prepared.base, prepared.data, self.open_loop, references=references,
+                          progress=progress, rng=self.seed,
                           held_out=held_out,
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)

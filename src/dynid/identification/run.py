@@ -70,7 +70,8 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple,
+@keyword_only_after_data
+def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
                   yardstick: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
@@ -196,9 +197,9 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         from .identify import DRIVE_ONLY_LABEL
 
         sets[DRIVE_ONLY_LABEL] = alt.params
-    scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress,
-                                         prepared.data.settings, result.joint_std,
-                                         {result.label: result.solution.covariance})
+    scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress=progress,
+                                         resolved=prepared.data.settings, noise=result.joint_std,
+                                         covariance={result.label: result.solution.covariance})
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), prepared.data.settings,
@@ -288,7 +289,8 @@ def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: t
     tuple of TorqueComparison
     """
     step = None if progress is None else (lambda label, done, total: progress(f"one yardstick: {label}", done, total))
-    return validate_sets(config, base, sets, datasets, step, resolved, yardstick=reference or Preprocessing())[0]
+    return validate_sets(config, base, sets, datasets, progress=step, resolved=resolved,
+                         yardstick=reference or Preprocessing())[0]
 
 
 def with_yardstick(result, scored: tuple):
@@ -381,8 +383,8 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     except (TypeError, ValueError):
         noise = None
     reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
-    comparisons, warnings = validate_sets(config, base, sets, datasets, progress, stored_preprocessing(identified), noise,
-                                          yardstick=reference)
+    comparisons, warnings = validate_sets(config, base, sets, datasets, progress=progress,
+                                          resolved=stored_preprocessing(identified), noise=noise, yardstick=reference)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 

@@ -286,7 +286,7 @@ IMPLAUSIBLE_EFFORT = 1e6
 industrial arms' joints carry about 1e5 N·m)."""
 
 
-def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, source: str, tau_source: str, warnings: list[str]) -> None:
+def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, tau_source: str, warnings: list[str]) -> None:
     """Refuse positions that cannot be radians and implausible efforts, warn about positions outside the joint limits,
     naming joint and time range (a current or torque held at its extreme is found where the log is prepared:
     :func:`dynid.preprocessing.prepared.clipped_samples`)."""
@@ -555,7 +555,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
         from .bags import read_joint_states
 
         t, raw, where = read_joint_states(spec.bag, robot, spec.name, warnings)
-        return _assemble(spec, robot, t, raw, where, True, str(spec.bag.path), str(spec.bag.path), warnings)
+        return _assemble(spec, robot, t, raw, where, timed=True, q_source=str(spec.bag.path),
+                         tau_source=str(spec.bag.path), warnings=warnings)
     requests: dict[Path, list] = {}
     for s in list(spec.signals.values()) + ([spec.time] if spec.time else []):
         requests.setdefault(s.file, [])
@@ -603,8 +604,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
     raw = {kind: get(s) for kind, s in spec.signals.items()}
     tables.clear()  # the files' columns are in t and raw now: a long log is not held twice
     tau_kind = "currents" if "currents" in spec.signals else "torques"
-    return _assemble(spec, robot, t, raw, where, spec.time is not None, str(spec.signals["positions"].file),
-                     str(spec.signals[tau_kind].file), warnings)
+    return _assemble(spec, robot, t, raw, where, timed=spec.time is not None, q_source=str(spec.signals["positions"].file),
+                     tau_source=str(spec.signals[tau_kind].file), warnings=warnings)
 
 
 def _increasing(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
@@ -764,7 +765,7 @@ def _check_clock_unit(step: float, source: str, table: str) -> None:
                     f"column's unit says otherwise, or give rate (Hz) in {table} instead of the time column")
 
 
-def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool, q_source: str, tau_source: str,
+def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bool, q_source: str, tau_source: str,
               warnings: list[str]) -> Recording:
     """Time checks, selection, gaps, resampling, transmission, drive gains and plausibility, shared by every
     kind of dataset; ``where(k)`` names sample k's place in the source (file and line, bag and message)."""
@@ -836,7 +837,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, timed: bool,
     else:
         motor_or_joint = raw["torques"]
     tau = _row_wise(tr.joint_torques, motor_or_joint) if side(kind) == "motor" else motor_or_joint
-    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], q_source, tau_source, warnings)
+    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
+                  tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
 

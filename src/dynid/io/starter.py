@@ -227,9 +227,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                             f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
         time_table, time_notes, taken = (_time_lines(first, found["time"][0], [split(line) for line in lines[1:]])
-                                         if "time" in found else
-                                         ([f"rate = {float(rate)!r}                     # Hz: no time column (--rate)"],
-                                          [f"no time column: one sample every 1/{rate:g} s (--rate)"], []))
+                                         if "time" in found else _rate_lines(float(rate or 0.0)))
         table += ["header = true", *time_table]
         notes += time_notes
         for kind in ("positions", "velocities", effort):
@@ -266,6 +264,12 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                  "positions for degrees")
     notes += _held_notes(urdf, held)
     return _config(urdf, log, out, validation, table, notes, held), notes
+
+
+def _rate_lines(rate: float) -> tuple[list[str], list[str], list[str]]:
+    """The dataset's lines, the notes and the columns taken for a log without a time column at ``--rate``."""
+    return ([f"rate = {rate!r}                     # Hz: no time column (--rate)"],
+            [f"no time column: one sample every 1/{rate:g} s (--rate)"], [])
 
 
 def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:

@@ -29,7 +29,7 @@ def save_unit(result, folder: Path, robot) -> list[Path]:
     -------
     list of Path
     """
-    return save_identification(result, folder, False, robot=robot)
+    return save_identification(result, folder, figures_too=False, robot=robot)
 
 
 HEADERS = {"payload_kg": "payload kg", "validation_error_pct": "error %", "pooled_validation_error_pct": "pooled error %",

@@ -13,6 +13,7 @@ from ..io.mjcf_write_back import mjcf_written_back
 from ..io.replay import mjcf_replay, urdf_replay
 from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
+from ..keywords import keyword_only_after_data
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, save_figure, staged, write_results
@@ -65,7 +66,8 @@ def _comparison_jobs(comparisons, paths, titles) -> list:
 
 
 @staged
-def save_identification(result: IdentificationResult, out: str | Path, figures_too: bool = True, robot=None,
+@keyword_only_after_data
+def save_identification(result: IdentificationResult, out: str | Path, *, figures_too: bool = True, robot=None,
                         urdf: str | Path | None = None, urdf_name: str | None = None,
                         mjcf_model: str | Path | None = None, mjcf_name: str | None = None,
                         mjcf_folder: str | Path | None = None, config=None) -> list[Path]:

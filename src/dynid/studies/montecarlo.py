@@ -214,7 +214,7 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     for i, key in enumerate(keys):
         generator = np.random.default_rng([cfg.seed, 11, level_index, realisation, seed_index(key)])
         try:
-            fit = estimation.fit(bounds, {key: generator}, budget, keys=(key,), workers=1)[key]
+            fit = estimation.fit(bounds, {key: generator}, budget=budget, keys=(key,), workers=1)[key]
         except DynIdError as exc:
             errors[key] = str(exc)
             continue

@@ -594,8 +594,8 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         return bs, time.perf_counter() - t_b
 
     boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in keys if spec(key).bootstrapped and config.bootstrap}
-    fits: dict[str, Any] = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys}, budget,
-                          progress=progress, extra=boots)
+    fits: dict[str, Any] = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys},
+                                          budget=budget, progress=progress, extra=boots)
     for key in keys:
         timings[key] = fits[key].seconds
         boot = None
