@@ -326,7 +326,7 @@ def test_init_sums_a_time_stamp_split_into_seconds_and_nanoseconds(tmp_path):
 
 def test_ros_style_indexed_headers_name_their_signal():
     """``/joint_states/position/0`` and ``position.0`` were refused ("found 0 positions columns")."""
-    from dynid.io.starter import _kind
+    from dynid.io.columns import _kind
 
     assert [_kind(h) for h in ("/joint_states/position/0", "position.0", "/joint_states/effort/5", "velocity.2",
                                "header.stamp.sec")] == ["positions", "positions", "torques", "velocities", "time"]
@@ -385,7 +385,7 @@ def test_init_asks_which_side_of_the_gear_measured_the_torques(tmp_path):
     the config init writes asks, beside the torques, with the setting that says it (read by identify)."""
     import tomllib
 
-    from dynid.io.starter import SENSOR_HINT
+    from dynid.io.columns import SENSOR_HINT
 
     log = _log(tmp_path, header=True)
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
@@ -402,8 +402,8 @@ def test_init_infers_joint_torque_sensors_from_an_arm_that_has_them(tmp_path):
     and identify reads it (no rotor inertia); another arm's URDF only gets the question."""
     import tomllib
 
+    from dynid.io.columns import SENSOR_HINT
     from dynid.io.identification_config import load_identification_config
-    from dynid.io.starter import SENSOR_HINT
 
     log = _log(tmp_path, header=True)
     med = tmp_path / "arm.urdf"

@@ -29,11 +29,9 @@ from ..model.robot import Robot
 from ..preprocessing.bands import capped
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
+from .estimates import DRIVE_ONLY_KEY
 
 __all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "preprocessing_variants"]
-
-DRIVE_ONLY_KEY = "drive-only"
-"""The estimate's key (label ``"dynid drive-only"``)."""
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from ..dynamics.layout import consistency_layout
 from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
-from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares, consistency_margin, consistency_verdict
+from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, seed_index, spec
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
@@ -42,17 +42,12 @@ from ..validation.diagnostics import (
     sign_findings,
 )
 from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
-from .drive_only import DRIVE_ONLY_KEY, DriveOnly, drive_only
+from .drive_only import DriveOnly, drive_only
+from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .verdict import choose_main_estimate
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
-
-SDP_LABEL = estimate_label("sdp")
-"""Label of the physically consistent estimate."""
-
-DRIVE_ONLY_LABEL = estimate_label(DRIVE_ONLY_KEY)
-"""Label of the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`)."""
 
 BOX_SIGMAS = 5.0
 BOX_FRACTION = 0.5
@@ -76,70 +71,6 @@ def search_box(params: np.ndarray, std: np.ndarray) -> np.ndarray:
     """
     half = np.maximum(BOX_SIGMAS * np.asarray(std) + BOX_FRACTION * np.abs(params), 1e-6)
     return np.column_stack([params - half, params + half])
-
-
-@dataclass(frozen=True)
-class Estimate:
-    """One estimate of the base parameters, whichever estimator made it.
-
-    Attributes
-    ----------
-    key : str
-        The estimator (:mod:`dynid.estimators.registry`).
-    params : (n_base,) array
-        Base parameters (units of :func:`dynid.conventions.unit_of`).
-    std : (n_base,) array or None
-        Standard deviations (least squares: from the covariance; None when the estimator gives none).
-    seconds : float
-        Wall time of the fit [s].
-    n_evaluations : int or None
-        Evaluations of eq. 9 (box searches).
-    standard : (n_params,) array or None
-        Standard parameters, for an estimator of the standard space (the SDP).
-    pseudo_inertia_min_eig : (n_links,) array or None
-        Smallest eigenvalue of each link's pseudo-inertia (the SDP).
-    note : str
-        What to know about it (a solver that ended inaccurately).
-    """
-
-    key: str
-    params: np.ndarray
-    std: np.ndarray | None = None
-    seconds: float = 0.0
-    n_evaluations: int | None = None
-    standard: np.ndarray | None = None
-    pseudo_inertia_min_eig: np.ndarray | None = None
-    note: str = ""
-
-    @property
-    def label(self) -> str:
-        """``"dynid <LABEL>"``."""
-        return estimate_label(self.key)
-
-    def to_dict(self, base: BaseParameters) -> dict:
-        """The estimate as results.json stores it (values and σ by base parameter name).
-
-        Parameters
-        ----------
-        base : BaseParameters
-
-        Returns
-        -------
-        dict
-        """
-        out = {"key": self.key, "values": dict(zip(base.names, self.params.tolist())), "seconds": self.seconds,
-               "n_evaluations": self.n_evaluations}
-        if self.std is not None:
-            out["std"] = dict(zip(base.names, self.std.tolist()))
-        if self.standard is not None:
-            out["standard_values"] = dict(zip(base.standard_names, self.standard.tolist()))
-        if self.pseudo_inertia_min_eig is not None:
-            out["pseudo_inertia_min_eig"] = self.pseudo_inertia_min_eig.tolist()
-        if self.key == "sdp":
-            out["prior"] = "the robot model's nominal parameters"
-        if self.note:
-            out["note"] = self.note
-        return out
 
 
 @dataclass(frozen=True)
@@ -650,36 +581,6 @@ def one_way_joints(data: PreparedData) -> list[int]:
         if signs.size and min(np.mean(signs > 0), np.mean(signs < 0)) < 0.01:
             out.append(j)
     return out
-
-
-def consistency_checks(robot: Robot, base: BaseParameters, sets: dict) -> tuple[dict, dict]:
-    """Each parameter set's consistency margin and verdict (:func:`dynid.estimators.consistency_margin`).
-
-    Parameters
-    ----------
-    robot : Robot
-    base : BaseParameters
-    sets : dict
-        label -> base parameters (n_base,).
-
-    Returns
-    -------
-    tuple of dict
-        label -> margin (NaN when the check failed), label -> verdict (one line).
-    """
-    links, nonneg = consistency_layout(robot)
-    margins, verdicts = {}, {}
-    for label, beta in sets.items():
-        try:
-            margins[label] = consistency_margin(base.regrouping, beta, links, nonneg)
-            verdicts[label] = consistency_verdict(margins[label], base.regrouping, beta, base.names, nonneg)
-        except DynIdError as exc:  # a failed check never stops the identification
-            margins[label], verdicts[label] = float("nan"), f"not checked: {exc}"
-    return margins, verdicts
-
-
-HELD_OUT_FOLDS = 5
-"""Contiguous blocks of the identification log that compare the estimates when no validation log does."""
 
 
 def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..estimators.registry import estimate_label
 from ..validation.diagnostics import Finding, nominal_gate, validation_findings
+from .estimates import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 
 __all__ = ["NOMINAL_KEY", "NOMINAL_LABEL", "choose_main_estimate", "nominal_set"]
 
@@ -106,7 +107,6 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         With ``main`` and ``findings`` set (and, with validation logs, ``diagnostics``), and the drive-only or nominal
         estimate among its estimates where it is the main one.
     """
-    from .identify import HELD_OUT_FOLDS, SDP_LABEL
 
     findings = [f for f in result.findings if f.kind not in ("main", "drive")]  # an earlier call's made again here
     ls, main = result.label, estimate_label(result.estimators[0])
@@ -156,7 +156,6 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
 def _with_nominal(result, nominal: tuple[str, np.ndarray]):
     """``result`` with the description's nominal model among its estimates, under the label its set is scored with:
     its standard values are the robot file's, which export writes."""
-    from .identify import Estimate, consistency_checks
 
     estimate = Estimate(NOMINAL_KEY, np.asarray(nominal[1], dtype=float), np.zeros_like(nominal[1]),
                         standard=result.model.standard_parameters())
@@ -219,7 +218,6 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple, weighe
     estimate's predictions there leave the range the identification log supports (its prediction σ from the
     parameters' covariance over 5× that on the identification log), so the log does not determine the directions those
     motions need. ``weighed``: the figures the choice weighs (the one yardstick's, else ``scored``)."""
-    from .identify import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, Estimate, consistency_checks
 
     alt = result.drive_only
     own, described = _mean_error(weighed, main), _mean_error(weighed, nominal)

@@ -53,6 +53,7 @@ from ..conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
 from ..exceptions import ConfigError, DataError
 from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
+from .columns import csv_table
 from .tables import read_table
 
 PRESETS: dict[str, dict] = {
@@ -368,14 +369,11 @@ def _position_step(column: np.ndarray, t: np.ndarray, limit: float, j: int, sour
 
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:
-    """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.starter.starter_config`)."""
-    from .starter import starter_config
-
-    if not log.is_file():
+    """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.columns.csv_table`)."""
+    if not log.is_file() or log.is_dir():
         raise DataError(f"{log}: no such log")
-    text, _ = starter_config(Path("robot.urdf"), log, robot.n_dof, log.parent / "detected.toml",
-                             joints=tuple(j.name for j in robot.joints))
-    return dataset_spec(tomllib.loads(text)["identification"], log.parent, str(log), log.stem, robot.n_dof)
+    table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints))
+    return dataset_spec(tomllib.loads("\n".join(table)), log.parent, str(log), log.stem, robot.n_dof)
 
 
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:

@@ -6,7 +6,6 @@ import contextlib
 import hashlib
 import json
 import os
-import re
 import sys
 import tempfile
 from pathlib import Path
@@ -16,15 +15,15 @@ import numpy as np
 
 from ..exceptions import ConfigError
 from ..extras import require
+from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
+from .robot_files import HELD_HINT, check_xml, is_mjcf
 from .xacro_expressions import guarded_xacro
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
-HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (a gripper's fingers)"
-"""What a refusal of a joint dynid cannot identify says to do (:func:`check_urdf_text`, :func:`joints_from_urdf`)."""
 
 
 _INERTIAL_VALUES = {"mass": ("value",), "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "origin": ("xyz", "rpy")}
@@ -97,47 +96,6 @@ def check_urdf_text(path: Path, held=()) -> None:
     check_xml(path, parser)
     if problems:
         raise ConfigError(f"{path}: {problems[0]}")
-
-
-def check_xml(path: Path, parser=None) -> None:
-    """Refuse a file that is not well-formed XML, naming the line and column.
-
-    Parameters
-    ----------
-    path : Path
-    parser : xml.parsers.expat.XMLParserType, optional
-        A parser with handlers set (a new one by default).
-
-    Raises
-    ------
-    ConfigError
-        ``FILE: line L, column C: malformed XML (reason)``.
-    """
-    parser = parser or expat.ParserCreate()
-    try:
-        parser.Parse(path.read_bytes(), True)
-    except expat.ExpatError as exc:
-        raise ConfigError(f"{path}: line {exc.lineno}, column {exc.offset + 1}: malformed XML "
-                          f"({expat.ErrorString(exc.code)})") from None
-
-
-def is_mjcf(path: str | Path) -> bool:
-    """Whether a robot file is a MuJoCo model (MJCF): a ``.xml`` or ``.mjcf`` file whose root element is ``<mujoco>``.
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    bool
-    """
-    path = Path(path)
-    if path.suffix.lower() not in (".xml", ".mjcf") or not path.is_file():
-        return False
-    with open(path, "rb") as f:
-        head = f.read(4096)
-    return re.search(rb"<mujoco[\s>]", re.sub(rb"<!--.*?-->", b"", head, flags=re.S)) is not None
 
 
 @contextlib.contextmanager
@@ -224,8 +182,6 @@ def joints_from_urdf(path: str | Path,
     if not path.is_file():
         raise ConfigError(f"{path}: URDF file not found")
     if is_mjcf(path):  # a MuJoCo model: as MuJoCo compiles it
-        from .mjcf import joints_from_mjcf
-
         return joints_from_mjcf(path, held)
     held = dict(held or {})
     check_urdf_text(path, held)
@@ -308,8 +264,6 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
     """
     path = Path(path)
     if is_mjcf(path):
-        from .mjcf import mjcf_joints_to_hold
-
         return mjcf_joints_to_hold(path)
     check_urdf_text(path, held=_mimic_joints(path))
     model = _pinocchio_model(path, {})
@@ -360,8 +314,6 @@ def urdf_joint_values(path: str | Path, held=None) -> dict:
         ``frictionloss``) [N·m]: 0 where the file gives none. Each (n_dof,).
     """
     if is_mjcf(path):
-        from .mjcf import mjcf_joint_values
-
         return mjcf_joint_values(path, held)
     with _silenced_stderr([]):
         model = _pinocchio_model(Path(path), dict(held or {}))

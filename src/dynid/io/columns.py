@@ -1,0 +1,353 @@
+"""Which column of a CSV log is which signal, as ``dynid init`` and :func:`dynid.load_recording` find them (module
+docstring of :mod:`dynid.io.starter`): header names, a URDF's joint names, a count of columns without a header, or a
+known logger's layout."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+from ..conventions import time_unit_of
+from ..exceptions import DataError
+from .files import text_encoding_hint
+from .tables import is_data_line
+
+
+def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,
+              rate: float | None = None) -> tuple[list[str], list[str]]:
+    """A CSV log's dataset table (TOML lines) with its columns detected, and what was detected.
+
+    Parameters
+    ----------
+    urdf : Path
+        The robot's URDF (its name, in hints and the torque sensor's inference; need not exist).
+    log : Path
+        A CSV log (comma, semicolon, tab or space separated).
+    n_dof : int
+    joints : tuple of str
+        The URDF's joint names, in the chain's order (columns naming them are taken in this order).
+    rate : float, optional
+        The log's sample rate [Hz] where it has no time column.
+
+    Returns
+    -------
+    table : list of str
+        The ``[identification]`` table's lines.
+    notes : list of str
+        What was detected, one line each.
+
+    Raises
+    ------
+    DataError
+        An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
+    """
+    lines, delimiter = _first_lines(log)
+    split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
+    first = split(lines[0])
+    header = not all(_number(c) for c in first)
+    n_columns = len(first)
+    notes: list[str] = [f"{log.name}: {n_columns} columns separated by {_named(delimiter)}, "
+                        + ("a header line" if header else "no header line")]
+    table = [f'file = "{log.name}"']
+    if delimiter != ",":
+        table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
+    if header:
+        found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
+        if "time" not in found and rate is None:
+            raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
+                            "stamps give its sample rate: dynid init ... --rate HZ")
+        effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
+        missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
+        if missing:
+            count = len(found.get(missing[0], []))
+            raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
+                            f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
+        notes += order_notes
+        time_table, time_notes, taken = (_time_lines(first, found["time"][0], [split(line) for line in lines[1:]])
+                                         if "time" in found else _rate_lines(float(rate or 0.0)))
+        table += ["header = true", *time_table]
+        notes += time_notes
+        for kind in ("positions", "velocities", effort):
+            if len(found.get(kind, [])) >= n_dof:
+                table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
+                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
+                taken += found[kind][:n_dof]
+                if kind == "torques":  # a log cannot tell which side of the gear measured them: the arm may
+                    lines_, said = _torque_sensor(table.pop(), urdf)
+                    table += lines_
+                    notes += said
+        left = [c for c in first if c not in taken]
+        extra = [c for c in left if _kind(c) in ("positions", effort)]
+        if extra:
+            notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
+                         f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
+        elif left:
+            notes.append(f"left: {', '.join(left)}")
+    elif n_columns == 31 and n_dof == 6:
+        table = ['preset = "ur-rtde"', f'file = "{log.name}"']
+        notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\"")
+    elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
+        blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
+        table += ["time = { column = 1 }"]
+        for b, kind in enumerate(blocks):
+            table.append(f"{kind} = {{ columns = [" + ", ".join(str(2 + b * n_dof + j) for j in range(n_dof)) + "] }")
+        notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
+    else:
+        fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
+        raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
+                        "signal (or name the columns in a header line: t, q1…, tau1…)"
+                        + _hold_hint(urdf, joints, fewer))
+    notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
+                 "positions for degrees")
+    return table, notes
+
+
+PATTERNS = {
+    "time": r"[_%]*(t|time|times?tamp|stamp|sec|seconds)",
+    "positions": r"(q|pos|position|positions|angle|joint_?pos|actual_q)",
+    "velocities": r"(dq|qd|qdot|vel|velocity|velocities|actual_qd)",
+    "torques": r"(tau|torque|torques|effort|moment|target_moment)",
+    "currents": r"(i|cur|current|currents|actual_current)",
+}
+"""Header-name stems of each signal (case-insensitive, followed by an optional separator and joint number)."""
+
+
+ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
+            "or i1…; or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, "
+            "<joint>.effort")
+"""The header patterns init accepts, named in its refusals."""
+
+
+_SEPARATORS = r"[\s/._\-\[\]()]"
+
+
+def _seconds_and_nanoseconds(header: list[str]) -> tuple[str, str] | None:
+    """The columns of a time stamp split into whole seconds and nanoseconds (ROS 2 ``header.stamp.sec`` and
+    ``header.stamp.nanosec``, ROS 1 ``secs`` and ``nsecs``), or None."""
+    low = {c.strip().lower(): c for c in header}
+    for c, name in low.items():
+        for sec, nsec in ((".sec", ".nanosec"), ("/sec", "/nanosec"), (".secs", ".nsecs"), ("/secs", "/nsecs"),
+                          ("_sec", "_nanosec")):
+            if c.endswith(sec) and c[:-len(sec)] + nsec in low:
+                return name, low[c[:-len(sec)] + nsec]
+    return None
+
+
+def _kind(name: str) -> str | None:
+    """The signal a column's name says, by its last path component (``/joint_states/position[0]`` → positions)."""
+    last = [part for part in re.split(r"[/.]", name.strip().lower()) if part] or [""]
+    if len(last) > 1 and last[-1].isdigit():  # ROS-style position/0 and position.0: the index is a part of its own
+        last = last[:-1]
+    stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", last[-1])
+    for kind, pattern in PATTERNS.items():
+        if re.fullmatch(pattern, stem):
+            return kind
+    return None
+
+
+def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
+    """``(signal, joint index)`` of a column that names one of the URDF's joints and a signal beside it
+    (``/joint_states/elbow_joint/position``, ``elbow_joint_pos``, ``elbow_joint.effort``); the longest joint name wins
+    (``joint_1`` against ``joint_10``)."""
+    low = name.strip().lower()
+    for j in sorted(range(len(joints)), key=lambda j: -len(joints[j])):
+        joint = joints[j].lower()
+        match = re.search(rf"(^|{_SEPARATORS}){re.escape(joint)}($|{_SEPARATORS})", low)
+        if not joint or match is None:
+            continue
+        rest = [part for part in re.split(rf"{_SEPARATORS}+", low[:match.start()] + " " + low[match.end():]) if part]
+        kinds = [k for k in (_kind(part) for part in reversed(rest)) if k not in (None, "time")]
+        if kinds:
+            return kinds[0], j
+    return None
+
+
+def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str],
+                    joints: tuple[str, ...]) -> list[str]:
+    """Where the log names its joints in columns of their own (``rostopic echo -p``'s ``field.name0``…, a JointState's
+    names in every row, often alphabetical), each signal's numbered columns reordered into the URDF's joint order, said;
+    ``found`` is changed in place."""
+    names = {int(m.group(1)): row[i] for i, c in enumerate(first) if i < len(row)
+             and (m := re.fullmatch(r".*name[\[_]?(\d+)\]?", c.strip().lower())) is not None}
+    order = [names[k] for k in sorted(names)]
+    if not set(joints) <= set(order) or order[:len(joints)] == list(joints):
+        return []
+    taken = [order.index(j) for j in joints]  # the log may name more joints (a gripper's): the URDF's are taken
+    moved = [kind for kind, columns in found.items() if kind != "time" and len(columns) == len(order)]
+    for kind in moved:
+        found[kind] = [found[kind][k] for k in taken]
+    return [f"{', '.join(moved)}: the log names its joints in {', '.join(f for f in first if 'name' in f.lower())} "
+            f"({', '.join(order)}): taken in the URDF's joint order ({', '.join(joints)})"] if moved else []
+
+
+COMMANDED = frozenset({"cmd", "command", "commanded", "commands", "desired", "des", "target", "targets", "setpoint",
+                       "setpoints", "sp", "ref", "reference", "goal", "demand", "demanded"})
+"""Words of a column name that make it a commanded signal (a controller's set-point), never a measured one."""
+
+
+def commanded(name: str, joints: tuple[str, ...] = ()) -> bool:
+    """Whether a column holds a commanded signal (:data:`COMMANDED` among its words, the joint names left out):
+    ``q_cmd1``, ``/joint_trajectory_controller/state/desired/positions/0``, ``elbow_joint/position_setpoint``.
+
+    Parameters
+    ----------
+    name : str
+    joints : tuple of str
+        The URDF's joint names (a word of one of them is no marker).
+
+    Returns
+    -------
+    bool
+    """
+    low = name.strip().lower()
+    for joint in sorted(joints, key=len, reverse=True):
+        low = low.replace(joint.lower(), " ") if joint else low
+    return bool(COMMANDED & set(re.split(r"[^a-z]+", low)))
+
+
+def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str, list[str]], list[str]]:
+    """Columns naming every joint of the URDF, per signal in the URDF's joint order, and a note per signal whose log
+    order differs; a commanded column (:func:`commanded`) is never taken."""
+    named: dict[str, dict[int, str]] = {}
+    twice: list[str] = []
+    for column in first:
+        hit = None if commanded(column, joints) else _named_joint(column, joints)
+        if hit is not None:
+            if hit[1] in named.get(hit[0], {}):
+                twice.append(f"{column} (J{hit[1] + 1} {hit[0]} again: {named[hit[0]][hit[1]]} taken)")
+            named.setdefault(hit[0], {}).setdefault(hit[1], column)
+    found, notes = {}, [f"a joint named twice: {', '.join(twice)}"] if twice else []
+    for kind, columns in named.items():
+        if len(columns) == len(joints):
+            found[kind] = [columns[j] for j in range(len(joints))]
+            if found[kind] != [c for c in first if c in found[kind]]:
+                notes.append(f"{kind}: taken in the URDF's joint order ({', '.join(joints)}), not the log's")
+    return found, notes
+
+
+def _rate_lines(rate: float) -> tuple[list[str], list[str], list[str]]:
+    """The dataset's lines, the notes and the columns taken for a log without a time column at ``--rate``."""
+    return ([f"rate = {rate!r}                     # Hz: no time column (--rate)"],
+            [f"no time column: one sample every 1/{rate:g} s (--rate)"], [])
+
+
+def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
+    """Where the log has the signals of fewer joints than the URDF: the URDF's last joints held (a gripper's), said."""
+    if not 0 < count < len(joints):
+        return ""
+    rest = ", ".join(json.dumps(j) for j in joints[count:])
+    return (f"; if the log holds the first {count} of {urdf.name}'s joints and the rest are a gripper's, hold them: "
+            f"[robot] urdf = \"{urdf.name}\", held = [{rest}] (docs: Your robot from a URDF)")
+
+
+SENSOR_HINT = ('# torques from joint torque sensors on the link side (a KUKA LBR, a Franka)? add sensor = "joint" to '
+               "the torques table: no rotor inertia is then fitted")
+"""The line under a config's torques that asks what a log cannot say: which side of the gear measured them."""
+
+
+JOINT_SENSED = re.compile(r"lbr|iiwa|med7|med14|panda|fr3|franka|kinova|gen3", re.IGNORECASE)
+"""Names of arms whose joint torques come from torque sensors on the link side of every gear: KUKA's LBR iiwa and
+LBR Med, Franka Emika's Panda and FR3, Kinova's Gen3 (in a URDF's robot name or its file's name)."""
+
+
+def _torque_sensor(line: str, urdf: Path) -> tuple[list[str], list[str]]:
+    """The torques' table line with ``sensor = "joint"`` where the URDF names an arm of :data:`JOINT_SENSED` (and the
+    comment that says so and how to undo it), else the line and :data:`SENSOR_HINT`; and the note for the header."""
+    named = next((n for n in (_robot_name(urdf), urdf.stem) if n and JOINT_SENSED.search(n)), None)
+    if named is None:
+        return [line, SENSOR_HINT], []
+    why = (f'sensor = "joint" inferred from the name "{named}" in {urdf.name}: an arm with joint torque sensors on the '
+           "link side of its gears, whose torques hold no rotor inertia")
+    return [line[: -len(" }")] + ', sensor = "joint" }',
+            f'# {why}; write sensor = "drive" if these are motor currents or a motor-side torque'], [why]
+
+
+def _robot_name(urdf: Path) -> str | None:
+    """The ``name`` of a URDF's (or xacro file's) ``<robot>`` element, read as text (nothing of it runs), or None."""
+    try:
+        head = urdf.read_text(errors="replace")[:20000]
+    except OSError:
+        return None
+    found = re.search(r"<robot\b[^>]*?\bname\s*=\s*[\"']([^\"']*)[\"']", head)
+    return found.group(1) if found else None
+
+
+def _found_columns(first: list[str], row: list[str], joints: tuple[str, ...], n_dof: int) -> tuple[dict, list[str]]:
+    """Each signal's columns in a header (by the URDF's joint names first, else by their names' stems), a commanded
+    column never taken (:func:`commanded`), and what was noticed."""
+    by_name, notes = _by_joint_names(first, joints) if len(joints) == n_dof else ({}, [])
+    named = {c for columns in by_name.values() for c in columns}
+    skipped = [name for name in first if commanded(name, joints)]
+    found: dict[str, list[str]] = {}
+    for name in first:
+        kind = _kind(name)
+        if kind and name not in named and name not in skipped:
+            found.setdefault(kind, []).append(name)
+    if skipped:
+        notes.append(f"commanded, never taken for a measured signal: {', '.join(skipped[:6])}"
+                     + (f" and {len(skipped) - 6} more" if len(skipped) > 6 else ""))
+    found.update(by_name)
+    return found, notes + _in_named_order(found, first, row, joints)
+
+
+def _time_lines(first: list[str], column: str, rows: list[list[str]]) -> tuple[list[str], list[str], list[str]]:
+    """The dataset table's ``time`` line, what was detected, and the columns taken: a time stamp split into whole
+    seconds and nanoseconds (ROS's ``header.stamp.sec`` and ``.nanosec``) is one time of two columns; a single column's
+    unit is told from its steps."""
+    split_stamp = _seconds_and_nanoseconds(first)
+    if split_stamp is not None:
+        seconds, nanoseconds = split_stamp
+        return ([f'time = {{ column = "{seconds}", nanoseconds = "{nanoseconds}" }}'],
+                [f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)"], [seconds, nanoseconds])
+    unit = _time_unit(rows, first.index(column))
+    return ([f'time = {{ column = "{column}"' + (f', unit = "{unit}" }}' if unit else " }")],
+            [f"time stamps: {column} steps as a controller's in {unit}: unit = \"{unit}\""] if unit else [], [column])
+
+
+def _first_lines(log: Path) -> tuple[list[str], str]:
+    """A text log's first non-blank lines from its header (or first data line) on, and its delimiter: comment lines
+    (``#`` first) left out, a header written as one (NumPy's ``# t,q1,…``) taken as the header."""
+    try:
+        lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
+    except UnicodeDecodeError:
+        raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None
+    except OSError as exc:
+        raise DataError(f"{log}: cannot read it ({exc.strerror or exc})") from None
+    comments = next((k for k, line in enumerate(lines) if not line.lstrip().startswith("#")), len(lines))
+    if len(lines) - comments < 2:
+        raise DataError(f"{log}: fewer than two lines: not a log")
+    delimiter = max((",", ";", "\t", " "), key=lambda d: lines[comments + 1].count(d))
+    if comments and is_data_line(lines[comments], delimiter):
+        comments -= 1
+        lines[comments] = lines[comments].lstrip()[1:].strip()
+    return lines[comments:], delimiter
+
+
+def _time_unit(rows: list[list[str]], column: int) -> str | None:
+    """The unit of a log's time column from its first rows (:func:`dynid.conventions.time_unit_of`)."""
+    values = []
+    for fields in rows:
+        try:
+            values.append(float(fields[column]))
+        except (ValueError, IndexError):
+            continue
+    steps = sorted(b - a for a, b in zip(values, values[1:]) if b > a)
+    return time_unit_of(steps[len(steps) // 2]) if steps else None
+
+
+def _shown(columns: list[str], most: int = 12) -> str:
+    """The header's first columns, for a message."""
+    return str(columns[:most])[:-1] + (f", … {len(columns) - most} more]" if len(columns) > most else "]")
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _named(delimiter: str) -> str:
+    return {",": "commas", ";": "semicolons", "\t": "tabs", " ": "spaces"}[delimiter]
