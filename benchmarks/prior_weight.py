@@ -165,7 +165,7 @@ def case(name: str, window, folder: Path) -> None:
     reference = yardstick_reference(load_recording(config.identification, config.robot))
     resolved = stored_preprocessing({"settings": result.settings})  # as dynid identify resolved them
     yard = with_yardstick(result, yardstick_scores(replace(config, robot=robot), base, scored, recordings,
-                                                   resolved, reference)).diagnostics["yardstick"]
+                                                   resolved=resolved, reference=reference)).diagnostics["yardstick"]
     yard = yard["mean_global_relative_error"]
     picks = []
     for kind in ("sdp", "geometric", "scaled", "ridge"):

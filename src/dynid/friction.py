@@ -54,7 +54,7 @@ def moving_sign(dq: np.ndarray, rest=0.0) -> np.ndarray:
     return out
 
 
-def held_direction(dq: np.ndarray, rest, decay=np.inf, presliding=0.0, rate: float = 1.0, guide=None,
+def held_direction(dq: np.ndarray, rest, decay=np.inf, *, presliding=0.0, rate: float = 1.0, guide=None,
                    min_travel=0.0) -> np.ndarray:
     """Direction of motion per joint: the state of the Coulomb-like friction terms, held or relaxed at rest and
     reversed over a presliding distance.
@@ -109,7 +109,7 @@ def held_direction(dq: np.ndarray, rest, decay=np.inf, presliding=0.0, rate: flo
     # decay 0: the sign of dq where the joint moves (the guide says where, with moving_sign's ramp), 0 at rest
     out = np.sign(dq) * np.abs(moving_sign(guide, np.where(tr > 0, 0.0, vr)))
     for j in np.flatnonzero(tr > 0):
-        out[:, j] = _held_column(dq[:, j], vr[j], tr[j], x0[j], rate, guide[:, j], travel[j])
+        out[:, j] = _held_column(dq[:, j], vr[j], tr[j], x0[j], rate=rate, guide=guide[:, j], min_travel=travel[j])
     return out
 
 
@@ -140,7 +140,7 @@ def _moving(v: np.ndarray, guide: np.ndarray, vr: float) -> np.ndarray:
     return np.where(np.abs(guide) > vr, np.sign(v), 0.0)
 
 
-def _held_column(v: np.ndarray, vr: float, tr: float, x0: float, rate: float, guide: np.ndarray,
+def _held_column(v: np.ndarray, vr: float, tr: float, x0: float, *, rate: float, guide: np.ndarray,
                  min_travel: float = 0.0) -> np.ndarray:
     """:func:`held_direction` of one joint. Runs of one direction of motion and runs of rest alternate; a rest run
     between motions in opposite directions is a reversal, which happens at the velocity's last sign change inside

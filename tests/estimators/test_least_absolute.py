@@ -21,7 +21,7 @@ def _direct(w, tau, bounds, n_dof):
     m = w.shape[0]
     row_w = np.full(m, 1.0 / (m // n_dof))
     none = np.array([], dtype=int)
-    beta, _ = la._dual_lp(w, tau, row_w, bounds[:, 0], bounds[:, 1], np.arange(m), none, none)
+    beta, _ = la._dual_lp(w, tau, row_w, bounds[:, 0], bounds[:, 1], rows=np.arange(m), fixed=none, fixed_y=none)
     return beta
 
 
@@ -31,7 +31,7 @@ def test_banded_lad_equals_the_lp_on_every_row(monkeypatch, band):
     w, tau, bounds, n_dof = _problem()
     calls = []
     real = la._dual_lp
-    monkeypatch.setattr(la, "_dual_lp", lambda *a: calls.append(a[5].size) or real(*a))
+    monkeypatch.setattr(la, "_dual_lp", lambda *a, **k: calls.append(k["rows"].size) or real(*a, **k))
     est = la.LeastAbsoluteDeviations(n_dof=n_dof, bounds=bounds).fit(w, tau)
     if band > 1:
         assert max(calls) < w.shape[0] // 2  # it solved on a band, not on every row
@@ -54,11 +54,11 @@ def test_a_wide_box_on_poorly_conditioned_rows_needs_one_band(monkeypatch):
 
     calls = []
     real = la._dual_lp
-    monkeypatch.setattr(la, "_dual_lp", lambda *a: calls.append(a) or real(*a))
+    monkeypatch.setattr(la, "_dual_lp", lambda *a, **k: calls.append((a, k)) or real(*a, **k))
     result = run_paper_experiment(PaperExperimentConfig(estimators=("lad",), bootstrap=0, rate=200.0,
                                                         abc_bounds="scaled"))
-    w, tau, row_w, lo, hi = calls[0][:5]
-    assert len(calls) == 2 and calls[1][5].size < w.shape[0] // 2
+    w, tau, row_w, lo, hi = calls[0][0][:5]
+    assert len(calls) == 2 and calls[1][1]["rows"].size < w.shape[0] // 2
     none = np.array([], dtype=int)
-    exact, _ = real(w, tau, row_w, lo, hi, np.arange(w.shape[0]), none, none)
+    exact, _ = real(w, tau, row_w, lo, hi, rows=np.arange(w.shape[0]), fixed=none, fixed_y=none)
     np.testing.assert_allclose(result.estimates["lad"].params, exact, atol=1e-8 * np.abs(exact).max())

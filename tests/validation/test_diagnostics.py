@@ -37,7 +37,7 @@ def test_residual_checks_find_a_position_dependence_and_friction_near_reversals(
     keep = np.ones((m, n), bool)
     for a in range(0, m, 1000):
         sl = slice(a, a + 1000)
-        sums.add(y[sl], tau[sl], q[sl], dq[sl], direction[sl], np.full(n, low), keep[sl])
+        sums.add(y[sl], tau[sl], q[sl], dq[sl], direction=direction[sl], low_speed=np.full(n, low), keep=keep[sl])
     beta_hat = np.linalg.lstsq(y.reshape(-1, p), tau.reshape(-1), rcond=None)[0]
     findings, stats = sums.residual_checks(beta_hat, np.sqrt((tau**2).mean(0)))
     kinds = {(f.kind, f.joint) for f in findings}
@@ -121,7 +121,7 @@ def test_a_position_finding_is_sized_by_what_it_explains(rng):
     effect = 0.05 * np.sin(40 * (q[:, 0] - 0.6))  # ±0.05 N·m over the swing
     tau[:, 0] += effect
     sums = ResidualSums(n, p)
-    sums.add(y, tau, q, dq, np.sign(dq), np.full(n, 1e-3), np.ones((m, n), bool))
+    sums.add(y, tau, q, dq, direction=np.sign(dq), low_speed=np.full(n, 1e-3), keep=np.ones((m, n), bool))
     beta_hat = np.linalg.lstsq(y.reshape(-1, p), tau.reshape(-1), rcond=None)[0]
     rms = np.sqrt((tau**2).mean(0))
     assert rms[0] < 1.0
@@ -160,7 +160,7 @@ def test_a_validation_error_far_above_the_fits_is_said_in_a_readable_figure():
     it "2056681467058500.0× worse"; such a ratio is now given to three digits, and an ordinary one as before."""
     from dynid.validation.diagnostics import validation_findings
 
-    (astray,) = validation_findings("validation", 1.11e15, 0.54, None, None, "dynid WLS")
+    (astray,) = validation_findings("validation", 1.11e15, 0.54, prediction_spread=None, fit_spread=None, label="dynid WLS")
     assert "predicts it 2.06e+15× worse than it fits the identification log (1.11e+15 % against 0.54 %)" in astray.text
-    (ordinary,) = validation_findings("validation", 12.3, 2.74, None, None, "dynid WLS")
+    (ordinary,) = validation_findings("validation", 12.3, 2.74, prediction_spread=None, fit_spread=None, label="dynid WLS")
     assert "predicts it 4.5× worse than it fits" in ordinary.text

@@ -98,7 +98,7 @@ BAND = 3
 """Rows kept in the LP: 3× the pilot's, those of smallest residual at the pilot's fit."""
 
 
-def _dual_lp(w, tau, row_w, lo, hi, rows, fixed, fixed_y):
+def _dual_lp(w, tau, row_w, lo, hi, *, rows, fixed, fixed_y):
     """The dual LP on ``rows`` with the dual variables of ``fixed`` rows set to ``fixed_y``: the parameters
     (minus the equality multipliers, clipped to the box) and SciPy's result.
 
@@ -126,7 +126,7 @@ def _pilot(w, tau, row_w, lo, hi, n_pilot):
     far off when the rows are poorly conditioned and no bound is active; least squares is then close to
     LAD (symmetric noise), but clipping it is no fit when bounds are active (a box that misses the truth)."""
     none = np.array([], dtype=int)
-    lad, _ = _dual_lp(w, tau, row_w, lo, hi, np.linspace(0, w.shape[0] - 1, n_pilot).astype(int), none, none)
+    lad, _ = _dual_lp(w, tau, row_w, lo, hi, rows=np.linspace(0, w.shape[0] - 1, n_pilot).astype(int), fixed=none, fixed_y=none)
     sw = np.sqrt(row_w)
     ls = np.clip(np.linalg.lstsq(w * sw[:, None], tau * sw, rcond=None)[0], lo, hi)
     return min((lad, ls), key=lambda b: float(row_w @ np.abs(tau - w @ b)))
@@ -139,16 +139,16 @@ def _lad_by_globbing(w, tau, row_w, lo, hi):
     n_pilot = max(50 * p, m // PILOT_FRACTION)
     keep = BAND * n_pilot
     if keep >= m // 2:
-        return _dual_lp(w, tau, row_w, lo, hi, np.arange(m), none, none)
+        return _dual_lp(w, tau, row_w, lo, hi, rows=np.arange(m), fixed=none, fixed_y=none)
     r = tau - w @ _pilot(w, tau, row_w, lo, hi, n_pilot)
     while keep < m // 2:
         band = np.zeros(m, dtype=bool)
         band[np.argpartition(np.abs(r), keep)[:keep]] = True
         fixed = np.flatnonzero(~band)
         fixed_y = np.where(r[fixed] > 0, row_w[fixed], -row_w[fixed])
-        beta, res = _dual_lp(w, tau, row_w, lo, hi, np.flatnonzero(band), fixed, fixed_y)
+        beta, res = _dual_lp(w, tau, row_w, lo, hi, rows=np.flatnonzero(band), fixed=fixed, fixed_y=fixed_y)
         r = tau - w @ beta
         if np.all(r[fixed] * fixed_y >= 0):  # complementary slackness on every fixed row: optimal
             return beta, res
         keep *= 2  # a fixed row crossed the fit: a wider band around the new fit
-    return _dual_lp(w, tau, row_w, lo, hi, np.arange(m), none, none)
+    return _dual_lp(w, tau, row_w, lo, hi, rows=np.arange(m), fixed=none, fixed_y=none)

@@ -149,7 +149,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
                 cost = cost + weight * cp.sum_squares(phi - prior)
             else:
                 raise ShapeError(f"prior_kind: expected one of {', '.join(PRIOR_KINDS)}, got {self.prior_kind!r}")
-            cost = cost + _gaussian_prior(cp, phi, prior, self.prior_std, r, z, tau / scale, n_rows or m)
+            cost = cost + _gaussian_prior(cp, phi, prior, self.prior_std, r=r, z=z, tau=tau / scale, n_rows=n_rows or m)
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
@@ -159,7 +159,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])
 
 
-def _gaussian_prior(cp, phi, prior: np.ndarray, prior_std, r: np.ndarray, z: np.ndarray, tau: np.ndarray, n_rows: int):
+def _gaussian_prior(cp, phi, prior: np.ndarray, prior_std, *, r: np.ndarray, z: np.ndarray, tau: np.ndarray, n_rows: int):
     """The cost of the parameters with a prior σ (:class:`PhysicallyConsistentLeastSquares`'s ``prior_std``) in the
     scaled problem ``||rφ - z||²`` of ``(w, τ)`` divided by ``√m``: ``Σ (s²/m)/σ_i² (φ_i - prior_i)²`` with ``s²`` the
     unconstrained least squares' residual variance on the ``n_rows`` rows the problem stands for."""

@@ -187,7 +187,7 @@ def _weighted_least_squares(w, tau, row_sigma, instants=None):
 
 
 def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
-                         methods=("idim-iv", "didim"), preprocessing: Preprocessing | None = None, max_iter: int = 10,
+                         *, methods=("idim-iv", "didim"), preprocessing: Preprocessing | None = None, max_iter: int = 10,
                          tol: float = 1e-4) -> dict[str, ClosedLoopEstimate]:
     """IDIM-WLS, then each closed-loop estimator of ``methods`` (module docstring).
 
@@ -273,7 +273,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     for key in keys:
         if key == "didim-sdp":
             out[key] = _didim_sdp(robot, base, simulated_rows, _rows(robot, base, data, standard=True)[0][keep], tau,
-                                  row_sigma, max_iter, tol)
+                                  row_sigma, max_iter=max_iter, tol=tol)
             continue
 
         def step(rows, key=key):
@@ -286,8 +286,8 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
             beta, std = _weighted_least_squares(ws, tau, np.where(moving, row_sigma, np.inf), instants)
             return beta, std, ws @ beta
 
-        run = _iterate(simulated_rows, step, start, base.base_from_standard(nominal), w @ start, max_iter, tol,
-                       "the least-squares estimate")
+        run = _iterate(simulated_rows, step, start, base.base_from_standard(nominal), w @ start, max_iter=max_iter, tol=tol,
+                       start_words="the least-squares estimate")
         out[key] = ClosedLoopEstimate(LABELS[key], run.x, start_std if run.std is None else run.std, len(run.changes),
                                       run.converged, run.changes, run.message)
     return out
@@ -305,7 +305,7 @@ class _Iterations:
     message: str
 
 
-def _iterate(simulate, step, start, fallback, previous, max_iter: int, tol: float, start_words: str) -> _Iterations:
+def _iterate(simulate, step, start, fallback, previous, *, max_iter: int, tol: float, start_words: str) -> _Iterations:
     """The iterations IDIM-IV, DIDIM and DIDIM-SDP share: simulate the closed loop with the current estimate, take a
     step on the simulated rows, until the modelled torques change by less than ``tol`` (or stall below
     :data:`STALLED`).
@@ -379,7 +379,7 @@ def _iterate(simulate, step, start, fallback, previous, max_iter: int, tol: floa
     return _Iterations(x, std, tuple(changes), converged, note + message)
 
 
-def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, tau, row_sigma, max_iter: int,
+def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, tau, row_sigma, *, max_iter: int,
                tol: float) -> ClosedLoopEstimate:
     """DIDIM with the physically consistent least squares at each step (module docstring), by :func:`_iterate` on
     standard parameter vectors, from the physically consistent least squares on the measured rows ``w_standard``
@@ -397,8 +397,8 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
         return phi, None, ws @ phi
 
     phi = fit(w_standard)
-    run = _iterate(lambda x: simulated_rows(x, standard=True), step, phi, nominal, w_standard @ phi, max_iter, tol,
-                   "the IDIM-SDP estimate")
+    run = _iterate(lambda x: simulated_rows(x, standard=True), step, phi, nominal, w_standard @ phi, max_iter=max_iter, tol=tol,
+                   start_words="the IDIM-SDP estimate")
     beta = base.base_from_standard(run.x)
     return ClosedLoopEstimate(LABELS["didim-sdp"], beta, np.full(beta.size, np.nan), len(run.changes), run.converged,
                               run.changes, run.message)
@@ -509,7 +509,7 @@ class ClosedLoopEstimator:
 
 
 def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording: Recording, setup: ClosedLoopSetup,
-                          keys: tuple[str, ...], preprocessing: Preprocessing):
+                          *, keys: tuple[str, ...], preprocessing: Preprocessing):
     """The closed-loop estimators of ``keys`` beside an identification's other estimates:
     :meth:`ClosedLoopEstimator.added_to` of each in turn.
 

@@ -114,7 +114,7 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
     return tuple(out)
 
 
-def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccumulator, joint_weights=None,
+def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccumulator, *, joint_weights=None,
                prior: np.ndarray | None = None, variants: tuple = (), one_way=()) -> DriveOnly | None:
     """Least squares of the drive terms with the links' inertial parameters at the description's values.
 
@@ -172,8 +172,8 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     drive = np.setdiff1d(np.arange(len(names)), links.ravel())
     if drive.size == 0:
         return None
-    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base, joint_weights,
-                            robot.prior_sigmas()[drive])
+    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base=base,
+                            joint_weights=joint_weights, sigmas=robot.prior_sigmas()[drive])
     x, params, cov = problem.fit(accumulator)
     moved_one_way = set(one_way)
     judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in moved_one_way]
@@ -218,7 +218,7 @@ class _DriveProblem:
     """The bounded fit of :func:`drive_only` on any accumulator of the same base rows' layout, some terms held at the
     description's values."""
 
-    def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, base: BaseParameters,
+    def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, *, base: BaseParameters,
                  joint_weights, sigmas: np.ndarray | None = None) -> None:
         self.names, self.drive, self.lower, self.phi0, self.joint_weights = names, drive, lower, phi0, joint_weights
         self.sigmas = np.full(drive.size, np.nan) if sigmas is None else np.asarray(sigmas, dtype=float)
@@ -252,12 +252,12 @@ class _DriveProblem:
             # value stays there, so that the bounded fit does not split that joint's one term otherwise
             kept = np.concatenate([free[[fixed_ for coulomb, fixed_ in pairs if coulomb in sol.anchored]], fixed])
             active |= below if active.any() else _at_bound(accumulator, self.basis, self.offset, self.lower,
-                                                            self.joint_weights, kept, phi0[drive[kept]]) | below
+                                                            joint_weights=self.joint_weights, fixed=kept, values=phi0[drive[kept]]) | below
         return x, params, cov
 
 
 def _at_bound(accumulator: LeastSquaresAccumulator, basis: np.ndarray, offset: np.ndarray, lower: np.ndarray,
-              joint_weights, fixed=(), values=()) -> np.ndarray:
+              *, joint_weights, fixed=(), values=()) -> np.ndarray:
     """The terms at their lower bound in the bounded least squares ``min ||D(τ - W(offset + basis x))||², x ≥ lower``
     (SciPy's BVLS on the column-scaled triangular factor; Stark & Parker 1995), the terms ``fixed`` held at
     ``values`` (never at bound): (d,) bool."""

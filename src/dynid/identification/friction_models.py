@@ -314,7 +314,7 @@ class _CrossValidation:
                 return self.block(start + a, start + b, directions, start)
 
             for idx, (y, bank, tau) in parallel_decimation(segment_block, stop - start, data.rate, s.decimation or 1,
-                                                           s.order, s.chunk, s.parallel_cutoff or None):
+                                                           order=s.order, chunk=s.chunk, cutoff=s.parallel_cutoff or None):
                 idx = idx + start
                 self._add(idx, y, bank, tau, fold_of(idx), vmin)
         if not self.n_rows.any():
@@ -425,7 +425,7 @@ def _directions(data: PreparedData, rest_v, decay, cutoff: float, start: int, st
     travel = rest_v / cutoff
     guide = data.motion if data.motion is not None else data.dq
     dq, guide = np.asarray(data.dq[start:stop]), np.asarray(guide[start:stop])  # stored columns: these rows read here
-    return held_direction(dq, rest_v, decay, 0.0, data.rate, guide, travel)
+    return held_direction(dq, rest_v, decay, presliding=0.0, rate=data.rate, guide=guide, min_travel=travel)
 
 
 def _pick(errors) -> int:

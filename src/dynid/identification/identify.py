@@ -341,7 +341,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
-    found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, row_weights,
+    found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, joint_weights=row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
@@ -440,7 +440,8 @@ class BlockScoring:
         elif scored.any():  # a clipped torque's samples count in no metric
             self.sums.add(data.t[index[scored]], y[scored], tau[scored], resting_rows(data, index[scored]))
         direction = np.asarray(data.direction[index]) if data.direction is not None else np.sign(np.asarray(data.dq[index]))
-        self.residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction, self.near_reversal, keep)
+        self.residuals.add(y, tau, np.asarray(data.q[index]), np.asarray(data.dq[index]), direction=direction,
+                           low_speed=self.near_reversal, keep=keep)
         if self.nominal is not None:
             self.order.add(y @ self.nominal, direction, np.asarray(data.dq[index]), tau)
         self.blocks.add(index, y, tau, keep)
@@ -538,7 +539,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
-        findings += prior_findings(base.names, sol.from_prior, one_way_joints(data), data.name, data.dead, still=data.still,
+        findings += prior_findings(base.names, sol.from_prior, one_way_joints(data), data.name, dead=data.dead, still=data.still,
                                    anchored=sol.anchored)
     if sol.anchored:
         stats["coulomb_from_one_term"] = [base.names[i] for i in sol.anchored]

@@ -121,7 +121,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
         data = prepare(recording, settings, strict=False)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
-                                   None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
+                                   progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                    noise=noise, covariance=covariance))
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
@@ -202,8 +202,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
                                          covariance={result.label: result.solution.covariance})
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), prepared.data.settings,
-                                 reference, progress)
+    yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), resolved=prepared.data.settings,
+                                 reference=reference, progress=progress)
     result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick), yardstick)
     return replace(result, findings=tuple(result.findings) + smooth)
 
@@ -263,7 +263,7 @@ def yardstick_reference(recording) -> Preprocessing | None:
         return None
 
 
-def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: tuple, resolved=None, reference=None,
+def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: tuple, *, resolved=None, reference=None,
                      progress=None) -> tuple:
     """Every set scored on the validation logs by the one yardstick (issue "Never worse than the description", item 5):
     each log prepared by dynid's default rules, whatever the identification's settings

@@ -203,8 +203,8 @@ def _validation_findings(result) -> list:
         err = v.metrics()[label]["global_relative_error"]
         moving = v.rest_share is None or float(np.mean(v.rest_share)) < 0.5  # a log mostly at rest: friction unknown
         floor = (v.floor_metrics() or {}).get("global_relative_error", np.nan)
-        out += validation_findings(v.name, err if moving else np.nan, fit_err, (v.spread or {}).get(label),
-                                   fit_spread, label, floor)
+        out += validation_findings(v.name, err if moving else np.nan, fit_err, prediction_spread=(v.spread or {}).get(label),
+                                   fit_spread=fit_spread, label=label, floor=floor)
     return out
 
 

@@ -222,7 +222,7 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
         phi[np.argmax(v, axis=1)] = b
         beta, rel = g @ phi, None
     else:
-        beta, rel = _match_base(v, b, s, g, basep.names, path, std_names)
+        beta, rel = _match_base(v, b, s, g, names=basep.names, path=path, std_names=std_names)
     return ReferenceSet(str(table["name"]), beta, rel if i_std is not None else None, str(path), tuple(warnings))
 
 
@@ -232,7 +232,7 @@ def _friction_like(name: str) -> bool:
     return split_name(name)[0] in COULOMB_LIKE[1:]
 
 
-def _match_base(v, b, s, g, names, path, std_names=()):
+def _match_base(v, b, s, g, *, names, path, std_names=()):
     """Match each of dynid's base parameters (rows of ``g``) to a row of ``v``; base parameters made only of
     friction terms the reference never mentions (:func:`_friction_like`) are 0 in it."""
     absent = [i for i, row in enumerate(g) if std_names and all(_friction_like(std_names[c]) and not v[:, c].any()
@@ -240,7 +240,7 @@ def _match_base(v, b, s, g, names, path, std_names=()):
     if absent:
         keep = np.setdiff1d(np.arange(g.shape[0]), absent)
         beta, rel = np.zeros(g.shape[0]), np.full(g.shape[0], np.nan)
-        beta[keep], rel[keep] = _match_base(v, b, s, g[keep], [names[i] for i in keep], path)
+        beta[keep], rel[keep] = _match_base(v, b, s, g[keep], names=[names[i] for i in keep], path=path)
         return beta, rel
     beta = np.full(g.shape[0], np.nan)
     rel = np.full(g.shape[0], np.nan)

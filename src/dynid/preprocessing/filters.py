@@ -247,7 +247,7 @@ def _on_cores(task: Callable, items: list, parallel: bool) -> None:
 
 
 def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int, rate: float, factor: int,
-                        order: int = 4, chunk: int = 20_000,
+                        *, order: int = 4, chunk: int = 20_000,
                         cutoff: float | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Low-pass filter and down-sample a signal that is computed chunk by chunk.
 

@@ -334,7 +334,7 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         return regressor(robot, q, dq, ddq, columns=columns, velocities=v), tau
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
-    for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, s.order, s.chunk, cutoff):
+    for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, order=s.order, chunk=s.chunk, cutoff=cutoff):
         keep = data.kept(index, vmin)
         if progress is not None:
             progress(int(index[-1]) + 1, n_s)

@@ -195,8 +195,8 @@ def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
     x0 = _per_joint(s.presliding, n, "presliding").astype(float)
     cutoff = s.band if s.fourier is not None else (s.velocity_cutoff or s.position_cutoff or rate / 4)
     travel = rest / cutoff  # a blip of the rest velocity's size lasts about 1/cutoff
-    return by_column(dq, lambda column, j: held_direction(column[:, None], rest[j], decay[j], x0[j], rate,
-                                                          np.asarray(guide[:, j])[:, None], travel[j])[:, 0])
+    return by_column(dq, lambda column, j: held_direction(column[:, None], rest[j], decay[j], presliding=x0[j], rate=rate,
+                                                          guide=np.asarray(guide[:, j])[:, None], min_travel=travel[j])[:, 0])
 
 
 def rest_decay(value, n: int) -> np.ndarray:

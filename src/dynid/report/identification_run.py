@@ -114,7 +114,7 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
         paths = save_comparisons((result.fit, *result.validations), out, names=names)
     json_path = out / "results.json"
     data = result.to_dict()
-    models = _model_texts(data, out, robot, urdf, urdf_name, mjcf_model, mjcf_name, mjcf_folder)
+    models = _model_texts(data, out, robot, urdf=urdf, urdf_name=urdf_name, mjcf_model=mjcf_model, mjcf_name=mjcf_name, mjcf_folder=mjcf_folder)
     if models:
         data["files_taken_away"] = taken_away(models, robot, data, config)
     write_results(json_path, data, "identify")
@@ -126,7 +126,7 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
     return [json_path] + paths
 
 
-def _model_texts(data: dict, out: Path, robot, urdf, urdf_name, mjcf_model, mjcf_name, mjcf_folder) -> list:
+def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, mjcf_name, mjcf_folder) -> list:
     """The URDF and the MJCF :func:`save_identification` writes, as ``[(path, text), ...]``: none unless the physically
     consistent estimate passed its check."""
     sdp = stored_standard(data)

@@ -108,7 +108,7 @@ class ResidualSums:
         self.gram = np.zeros((self.n_dof, size, size))
         self.lagged = np.zeros((self.n_dof, size, size))
 
-    def add(self, y: np.ndarray, tau: np.ndarray, q: np.ndarray, dq: np.ndarray, direction: np.ndarray,
+    def add(self, y: np.ndarray, tau: np.ndarray, q: np.ndarray, dq: np.ndarray, *, direction: np.ndarray,
             low_speed: np.ndarray, keep: np.ndarray) -> None:
         """Fold one block of rows into the sums.
 
@@ -422,7 +422,7 @@ def delay_findings(samples: float, std: float, determined: bool, rate: float, gi
                              "logs agree")]
 
 
-def validation_findings(name: str, global_error: float, fit_error: float, prediction_spread: np.ndarray | None,
+def validation_findings(name: str, global_error: float, fit_error: float, *, prediction_spread: np.ndarray | None,
                         fit_spread: np.ndarray | None, label: str, floor: float = float("nan")) -> list[Finding]:
     """Extrapolation and a validation error far above the identification's, for one validation log.
 
@@ -635,7 +635,7 @@ def bootstrap_finding(covariance_std: np.ndarray, bootstrap_std: np.ndarray) -> 
     return [], ratio
 
 
-def prior_findings(names, from_prior, one_way: list[int], dataset: str, dead: tuple[int, ...] = (),
+def prior_findings(names, from_prior, one_way: list[int], dataset: str, *, dead: tuple[int, ...] = (),
                    still: list[int] | tuple[int, ...] = (), anchored=()) -> list[Finding]:
     """The parameters a log does not determine, whose values are the description's nominal ones (least squares with a
     prior, :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`).

@@ -624,7 +624,7 @@ def static_friction(base: BaseParameters, parameter_sets: dict, n_dof: int) -> d
 
 
 def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, parameter_sets: dict,
-                    progress=None, noise: np.ndarray | None = None, covariance: dict | None = None) -> TorqueComparison:
+                    *, progress=None, noise: np.ndarray | None = None, covariance: dict | None = None) -> TorqueComparison:
     """Predict the torques of ``data`` with each base parameter vector of ``parameter_sets`` on the same
     parallel-decimated samples as the estimation, and score them (eq. 18, RMSE, relative error).
 
