@@ -101,7 +101,8 @@ def _arm(name: str, folder: Path) -> str:
     if name in ("ur10e", "er16", "tx40"):
         return name
     sys.path.insert(0, str(REPO / "benchmarks" / "zoo"))
-    from zoo import ARMS as ZOO, arm_urdf, physical_urdf, robots_folder
+    from zoo import ARMS as ZOO
+    from zoo import arm_urdf, physical_urdf, robots_folder
 
     file, keep = ZOO[name]
     path = folder / "arm.urdf"
