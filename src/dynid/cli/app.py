@@ -721,6 +721,8 @@ def excite(
     out: Path = typer.Option(Path("dynid-excite"), help="Output folder for excitation.json, excitation.csv and figures."),
     starts: int | None = typer.Option(None, help="Number of optimisation starts (overrides design.starts)."),
     seed: int | None = typer.Option(None, help="Seed of the random starts (overrides design.seed)."),
+    animation: bool = typer.Option(False, help="Also write excitation_animation.gif: the arm moving along one period "
+                                               "among the cell's bodies."),
     quiet: bool = QUIET,
 ) -> None:
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
@@ -741,7 +743,7 @@ def excite(
     def save(run):
         from ..report.excitation_run import save_excitation
 
-        return save_excitation(run, out)
+        return save_excitation(run, out, animation=animation)
 
     _Command("dynid excite", quiet, out).run(prepare, compute, save)
 

@@ -12,7 +12,7 @@ from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report
-from .output import save_figure, staged, write_results
+from .output import save_animation, save_figure, staged, write_results
 
 FIGURES = {
     "excitation_joints.png": "positions, velocities, accelerations and torques against their limits (cf. paper Fig. 4)",
@@ -22,15 +22,24 @@ FIGURES = {
 }
 
 
+ANIMATION = "excitation_animation.gif"
+"""The arm moving along one period of the design among the cell's bodies (``dynid excite --animation``)."""
+
+ANIMATION_FRAMES = 60
+"""Frames over one period (shown at 10 per second)."""
+
+
 @staged
-def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
-    """Write ``excitation.json``, ``excitation.csv`` and the figures.
+def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = False) -> list[Path]:
+    """Write ``excitation.json``, ``excitation.csv``, the figures and, asked for, :data:`ANIMATION`.
 
     Parameters
     ----------
     run : ExcitationRun
     out : str or Path
         Output folder.
+    animation : bool
+        Also write :data:`ANIMATION` (a few seconds more).
     """
     out = Path(out)  # staged passes its staging folder
     problem, design = run.config.problem, run.design
@@ -60,7 +69,24 @@ def save_excitation(run: ExcitationRun, out: str | Path) -> list[Path]:
     data = run.to_dict()
     write_results(json_path, data, "excite")
     write_html_report(out / "report.html", data, "excite", paths, f"dynid excite — {robot.name}")
-    return [json_path, csv_path, out / "report.html"] + paths
+    moving = [_animation(run, out / ANIMATION)] if animation else []
+    return [json_path, csv_path, out / "report.html"] + paths + moving
+
+
+def _animation(run: ExcitationRun, path: Path) -> Path:
+    """:data:`ANIMATION`: the skeleton (base, joint origins, tool point) on :data:`ANIMATION_FRAMES` instants."""
+    problem = run.config.problem
+    robot, ws = problem.robot, problem.workspace
+    t = np.arange(ANIMATION_FRAMES) * (problem.period / ANIMATION_FRAMES)
+    q = run.design.trajectory.evaluate(t)[0]
+    rots, origins = forward_kinematics(robot, q)
+    tip = origins[:, -1] + rots[:, -1] @ np.asarray(robot.tool_translation)
+    skeleton = np.concatenate([np.zeros((t.size, 1, 3)), origins, tip[:, None]], axis=1)
+    path_t = problem.verification_grid()
+    frames = figures.animate_arm(t, skeleton, tool_positions(robot, run.design.trajectory.evaluate(path_t)[0]),
+                                 title=robot.name, floor=ws.floor, obstacles=ws.obstacles)
+    save_animation(frames, path)
+    return path
 
 
 def _clearance_series(robot, t: np.ndarray, q: np.ndarray, ws) -> dict:

@@ -154,6 +154,57 @@ def _draw_obstacle(ax, ob, label=None) -> None:
     ax.plot_wireframe(pts[..., 0], pts[..., 1], pts[..., 2], color="tab:purple", lw=0.6, label=label)
 
 
+def animate_arm(t, skeleton, tool, title="The excitation, before it runs", floor=None, obstacles=()):
+    """The arm's skeleton moving along a trajectory among the cell's bodies, as frames of a GIF (issue "An excitation
+    safe to run on the real robot", item 3: seen before it runs).
+
+    Parameters
+    ----------
+    t : (F,) array [s]
+        Each frame's time.
+    skeleton : (F, P, 3) array [m]
+        Each frame's chain of points in the base frame: the base, the joint origins, the tool point.
+    tool : (N, 3) array [m]
+        The whole tool path, drawn thin under the arm.
+    title : str
+    floor : float, optional
+        Height of the floor plane [m].
+    obstacles : sequence of dynid.excitation.obstacles.Obstacle
+        The cell's bodies, drawn as wireframes.
+
+    Returns
+    -------
+    list of PIL.Image.Image
+        One RGB image per frame (:func:`dynid.report.output.save_animation` writes them).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image  # matplotlib's own dependency
+
+    ax = plot_tool_path(tool, title=title, floor=floor, obstacles=obstacles)
+    pts = np.concatenate([skeleton.reshape(-1, 3), tool])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    centre, half = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo)) + 0.05
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    (arm,) = ax.plot(*skeleton[0].T, color="black", lw=3, marker="o", ms=4, label="the arm (its joint origins)")
+    ax.get_legend().remove()
+    fig = ax.figure
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.set_size_inches(6, 5.5)
+    fig.set_dpi(80)
+    canvas = FigureCanvasAgg(fig)
+    frames = []
+    for k in range(skeleton.shape[0]):
+        arm.set_data_3d(*skeleton[k].T)
+        ax.set_title(f"{title}: t = {t[k]:.1f} s", y=1.0)
+        canvas.draw()
+        frames.append(Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba()).convert("RGB"))
+    plt.close(fig)
+    return frames
+
+
 def plot_clearance(t, series: dict, ax=None, title="How close the links come to the cell"):
     """Smallest distance over time to each of the cell's bodies and to the floor (issue "An excitation safe to run
     on the real robot", item 3).

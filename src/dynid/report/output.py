@@ -337,6 +337,25 @@ def figure_process(enabled: bool = True):
             worker.wait()
 
 
+def save_animation(frames, path: Path, fps: float = 10.0) -> None:
+    """Write frames as a looping GIF, atomically (Pillow, matplotlib's own dependency).
+
+    Parameters
+    ----------
+    frames : list of PIL.Image.Image
+        :func:`dynid.report.figures.animate_arm`'s.
+    path : Path
+    fps : float
+        Frames per second.
+    """
+    from PIL import Image
+
+    small = [f.quantize(colors=FIGURE_COLOURS, method=Image.Quantize.FASTOCTREE) for f in frames]
+    buf = io.BytesIO()
+    small[0].save(buf, format="GIF", save_all=True, append_images=small[1:], duration=int(round(1000 / fps)), loop=0)
+    atomic_write_bytes(path, buf.getvalue())
+
+
 def save_figure(fig_or_axes, path: Path) -> None:
     """Write a figure as PNG, atomically, in :data:`FIGURE_COLOURS` colours.
 
