@@ -90,7 +90,9 @@ def _sleeps():
 def test_a_child_whose_answer_is_not_taken_is_stopped_when_the_block_ends(forks):
     with pytest.raises(ValueError):
         with ForkedCall(_sleeps) as call:
-            pid = call._pid
+            child = call._child
+            assert child is not None and child.is_alive()
             raise ValueError("the work the answer was for failed")
+    assert child.exitcode == -signal.SIGKILL  # stopped and waited for, not left for a minute
     with pytest.raises(ChildProcessError):
-        os.waitpid(pid, os.WNOHANG)  # stopped and waited for, not left for a minute
+        os.waitpid(child.pid, os.WNOHANG)

@@ -12,8 +12,8 @@ depend on whether a child ran it.
 from __future__ import annotations
 
 import contextlib
+import multiprocessing
 import os
-import signal
 import sys
 
 from .exceptions import DynIdError
@@ -88,7 +88,8 @@ def read_all(fd: int) -> bytes:
 
 
 class ForkedCall:
-    """``fn(*args)`` computed in a forked child while this process goes on.
+    """``fn(*args)`` computed in a forked child while this process goes on (:mod:`multiprocessing`'s fork context,
+    the answer back through its pipe).
 
     :meth:`result` returns its value or raises its exception, as calling ``fn(*args)`` here would. Without a child
     (:func:`can_fork` false) or when the child leaves no answer, :meth:`result` calls ``fn(*args)`` here.
@@ -108,26 +109,26 @@ class ForkedCall:
 
     def __init__(self, fn, *args):
         self._call = (fn, args)
-        self._pid = None
+        self._child = None
         if not can_fork():
             return
-        read, write = os.pipe()
-        self._pid = fork()
-        if self._pid == 0:
-            os.close(read)
-            _child(write, fn, args)
-        os.close(write)
-        self._read = read
+        context = multiprocessing.get_context("fork")
+        self._answer, sending = context.Pipe(duplex=False)
+        sys.stdout.flush()  # not written twice
+        sys.stderr.flush()
+        self._child = context.Process(target=_child, args=(sending, fn, args), daemon=True)
+        self._child.start()
+        sending.close()  # the child's end: its exit closes the pipe, so a child without an answer is seen
 
     def __enter__(self) -> ForkedCall:
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._pid is not None:  # the answer was not taken: the child is stopped, not left behind
-            os.kill(self._pid, signal.SIGKILL)
-            os.waitpid(self._pid, 0)
-            os.close(self._read)
-            self._pid = None
+        if self._child is not None:  # the answer was not taken: the child is stopped, not left behind
+            self._child.kill()
+            self._child.join()
+            self._answer.close()
+            self._child = None
 
     def result(self):
         """The value of ``fn(*args)``; raises what it raised.
@@ -136,21 +137,17 @@ class ForkedCall:
         -------
         object
         """
-        import pickle
-
         fn, args = self._call
-        if self._pid is None:
+        if self._child is None:
             return fn(*args)
-        answer, self._pid, pid = None, None, self._pid
+        child, self._child = self._child, None
         try:
-            data = read_all(self._read)
+            answer = self._answer.recv()  # EOFError: the child left without one (killed, or its answer did not pickle)
+        except Exception:  # noqa: BLE001 - no answer, or one that does not unpickle: computed here instead
+            answer = None
         finally:
-            _, status = os.waitpid(pid, 0)
-        if os.waitstatus_to_exitcode(status) == 0 and data:
-            try:
-                answer = pickle.loads(data)  # our forked child's pipe (os.pipe), never a file
-            except Exception:  # noqa: BLE001 - an answer that does not unpickle: computed here instead
-                answer = None
+            child.join()
+            self._answer.close()
         if answer is None:
             return fn(*args)
         ok, value = answer
@@ -159,20 +156,12 @@ class ForkedCall:
         raise value
 
 
-def _child(write: int, fn, args):
-    """The child of :class:`ForkedCall`: compute, write the pickled ``(ok, value)`` and leave; never returns."""
-    code = 1
+def _child(sending, fn, args) -> None:
+    """The child of :class:`ForkedCall`: compute and send ``(ok, value)``; anything else leaves no answer. Its output
+    goes to /dev/null: a lock another thread of the parent held at the fork stays held in the child."""
+    sys.stdout = sys.stderr = open(os.devnull, "w")
     try:
-        import pickle
-
-        try:
-            answer = (True, fn(*args))
-        except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)
-            answer = (False, exc)
-        data = pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL)
-        with os.fdopen(write, "wb") as pipe:
-            pipe.write(data)
-        code = 0
-    except BaseException:  # noqa: BLE001 - no answer: the parent computes it itself
-        pass
-    os._exit(code)
+        answer = (True, fn(*args))
+    except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)
+        answer = (False, exc)
+    sending.send(answer)

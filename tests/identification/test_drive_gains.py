@@ -92,7 +92,14 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     cfg = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml",
                                       data_root=shared_data("ur10e_mamedov2020"))
     forks = []
-    monkeypatch.setattr(processes, "fork", lambda fork=processes.fork: forks.append(1) or fork())
+    real_init = processes.ForkedCall.__init__
+
+    def counted(call, *args):
+        real_init(call, *args)
+        if call._child is not None:  # a child was forked for it
+            forks.append(1)
+
+    monkeypatch.setattr(processes.ForkedCall, "__init__", counted)
     with allow_forks():  # as in the CLI
         beside = run_identification(cfg, validate=False)
     assert len(forks) == (1 if cores() >= 2 and sys.platform.startswith("linux") else 0)  # the gains went to a child
