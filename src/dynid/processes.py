@@ -52,39 +52,46 @@ def can_fork() -> bool:
     return _allowed and cores() >= 2 and sys.platform.startswith("linux")
 
 
-def fork() -> int:
-    """``os.fork()``, flushing the standard streams first (not written twice).
+def start_child(target, *args):
+    """A forked child running ``target(*args)``, started (:mod:`multiprocessing`'s fork context: the child shares the
+    imported modules and the data; its exit code is 0 when ``target`` returns, 1 when it raised, negative when killed).
 
-    The child's standard streams are fresh ones on /dev/null: a lock another thread of the parent held at the fork
-    stays held in the child.
-
-    Returns
-    -------
-    int
-        0 in the child, the child's pid in the parent.
-    """
-    sys.stdout.flush()
-    sys.stderr.flush()
-    pid = os.fork()
-    if pid == 0:
-        sys.stdout = sys.stderr = open(os.devnull, "w")
-    return pid
-
-
-def read_all(fd: int) -> bytes:
-    """Everything written to a pipe until its writer closes it (then closes it).
+    The standard streams are flushed first (not written twice), and the child's are /dev/null: a lock another thread
+    of the parent held at the fork stays held in the child.
 
     Parameters
     ----------
-    fd : int
-        The pipe's read end.
+    target : callable
+    *args
+        Its arguments (not pickled: the child is a fork).
 
     Returns
     -------
-    bytes
+    multiprocessing.Process
+        ``join()`` it; ``exitcode`` says how it ended.
     """
-    with os.fdopen(fd, "rb") as pipe:
-        return pipe.read()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    child = multiprocessing.get_context("fork").Process(target=_quiet, args=(target, args))
+    child.start()
+    return child
+
+
+def pipe():
+    """A one-way pipe between this process and a child of :func:`start_child` (:func:`multiprocessing.Pipe`).
+
+    Returns
+    -------
+    (Connection, Connection)
+        The receiving end, then the sending end; each side closes the end it does not use.
+    """
+    return multiprocessing.get_context("fork").Pipe(duplex=False)
+
+
+def _quiet(target, args) -> None:
+    """A child's entry: its output to /dev/null, then ``target(*args)``."""
+    sys.stdout = sys.stderr = open(os.devnull, "w")
+    target(*args)
 
 
 class ForkedCall:
@@ -112,12 +119,8 @@ class ForkedCall:
         self._child = None
         if not can_fork():
             return
-        context = multiprocessing.get_context("fork")
-        self._answer, sending = context.Pipe(duplex=False)
-        sys.stdout.flush()  # not written twice
-        sys.stderr.flush()
-        self._child = context.Process(target=_child, args=(sending, fn, args), daemon=True)
-        self._child.start()
+        self._answer, sending = pipe()
+        self._child = start_child(_child, sending, fn, args)
         sending.close()  # the child's end: its exit closes the pipe, so a child without an answer is seen
 
     def __enter__(self) -> ForkedCall:
@@ -157,9 +160,7 @@ class ForkedCall:
 
 
 def _child(sending, fn, args) -> None:
-    """The child of :class:`ForkedCall`: compute and send ``(ok, value)``; anything else leaves no answer. Its output
-    goes to /dev/null: a lock another thread of the parent held at the fork stays held in the child."""
-    sys.stdout = sys.stderr = open(os.devnull, "w")
+    """The child of :class:`ForkedCall`: compute and send ``(ok, value)``; anything else leaves no answer."""
     try:
         answer = (True, fn(*args))
     except DynIdError as exc:  # a user's mistake: the parent raises it (other errors: it calls fn itself)

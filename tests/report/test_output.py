@@ -165,7 +165,7 @@ def test_the_figure_process_draws_every_figure_and_leaves(tmp_path, forks):
 
     parent = os.getpid()
     with figure_process():
-        pid = output._waiting._pid
+        pid = output._waiting._child.pid
         draw_figures(_writer_jobs, tmp_path, 6)
         writers = set(_writers(tmp_path, 6))
         assert len(writers) == 2 and str(parent) not in writers and str(pid) in writers  # it and its fork drew
@@ -195,7 +195,7 @@ def test_an_unused_figure_process_leaves_with_the_block(tmp_path, forks):
 
     with pytest.raises(ValueError):
         with figure_process():
-            pid = output._waiting._pid
+            pid = output._waiting._child.pid
             raise ValueError("the computation failed")  # no figures sent
     with pytest.raises(ChildProcessError):
         os.waitpid(pid, os.WNOHANG)

@@ -8,7 +8,6 @@ import inspect
 import io
 import json
 import os
-import pickle
 import shutil
 import socket
 import tempfile
@@ -18,7 +17,7 @@ from pathlib import Path
 from .. import __version__
 from ..exceptions import ConfigError
 from ..io import atomic_write_bytes, atomic_write_text, write_json
-from ..processes import can_fork, fork, read_all
+from ..processes import can_fork, pipe, start_child
 
 MANIFEST = ".dynid-manifest.json"
 """Written last into an output folder: the files of the run that is there, whole."""
@@ -211,78 +210,62 @@ def _draw_jobs(jobs) -> None:
         for job in jobs:
             job()
         return
-    pid = fork()
-    if pid == 0:  # the child: its half, then leave at once (no atexit handlers, no buffers of the parent)
-        code = 0
-        try:
-            for job in jobs[1::2]:
-                job()
-        except BaseException:  # noqa: BLE001 - reported through the exit code; the parent redraws
-            code = 1
-        os._exit(code)
+    child = start_child(_run, jobs[1::2])  # its half; if it fails, this process draws that half too
     try:
         for job in jobs[0::2]:
             job()
     finally:
-        _, status = os.waitpid(pid, 0)
-    if os.waitstatus_to_exitcode(status) != 0:
+        child.join()
+    if child.exitcode != 0:
         for job in jobs[1::2]:
             job()
 
 
+def _run(jobs) -> None:
+    for job in jobs:
+        job()
+
+
 class _FigureProcess:
     """A forked child that imports matplotlib while its parent computes, then draws the figures the parent
-    sends it (pickled through a pipe) on two processes, and exits with 0 once every file is written."""
+    sends it (through a pipe) on two processes, and exits with 0 once every file is written."""
 
     def __init__(self):
-        read, self._write = os.pipe()
-        self._pid = fork()
-        if self._pid == 0:
-            os.close(self._write)
-            _figure_process_main(read)
-        os.close(read)
+        receiving, self._send = pipe()
+        self._child = start_child(_figure_process_main, receiving, self._send)
+        receiving.close()
 
     def draw(self, build, args) -> bool:
         """Send the jobs; return whether the child drew them all (false: this process draws them)."""
         try:
-            message = pickle.dumps((build, args), protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception:  # noqa: BLE001 - data that do not pickle: the child leaves, this process draws
+            self._send.send((build, args))
+        except Exception:  # noqa: BLE001 - data that do not pickle, or a child gone: this process draws
             self.wait()
             return False
-        fd, self._write = self._write, None
-        try:
-            with os.fdopen(fd, "wb") as pipe:
-                pipe.write(message)
-        except OSError:
-            pass  # the child died: its exit code says so
         return self.wait() == 0
 
     def wait(self) -> int:
         """Close the pipe if it is still open (the child then leaves without drawing), wait for the child and
         return its exit code."""
-        if self._write is not None:
-            os.close(self._write)
-            self._write = None
-        if self._pid is None:
+        if self._send is not None:
+            self._send.close()
+            self._send = None
+        if self._child is None:
             return 1
-        _, status = os.waitpid(self._pid, 0)
-        self._pid = None
-        return os.waitstatus_to_exitcode(status)
+        self._child.join()
+        code, self._child = self._child.exitcode, None
+        return int(code if code is not None else 1)
 
 
-def _figure_process_main(read: int):
-    """The figure process: import pyplot, wait for ``(build, args)`` and draw; never returns."""
-    code = 1
+def _figure_process_main(receiving, parents_end) -> None:
+    """The figure process: import pyplot, wait for ``(build, args)`` and draw (nothing: the parent closed the pipe)."""
+    parents_end.close()  # its copy of the sending end: the parent's close is then seen as the end of the pipe
+    _warm_up_drawing()
     try:
-        _warm_up_drawing()
-        data = read_all(read)
-        if data:  # empty: the parent closed the pipe without figures to draw
-            build, args = pickle.loads(data)  # the parent's own pipe (os.pipe before the fork), never a file
-            _draw_jobs(build(*args))
-        code = 0
-    except BaseException:  # noqa: BLE001 - reported through the exit code; the parent draws instead
-        pass
-    os._exit(code)
+        build, args = receiving.recv()
+    except EOFError:
+        return
+    _draw_jobs(build(*args))
 
 
 def _warm_up_drawing() -> None:
