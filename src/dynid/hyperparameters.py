@@ -58,7 +58,7 @@ class HyperParameters:
 
     def __repr__(self) -> str:
         """scikit-learn's: the class and the parameters that differ from the constructor's defaults, an array by its
-        shape (``PhysicallyConsistentLeastSquares(prior_kind='geometric')``).
+        shape (``BeeColonyEstimator(colony_size=60)``).
 
         Returns
         -------
