@@ -10,7 +10,8 @@ SCENARIO = textwrap.dedent('''
     # Ctrl-C raises KeyboardInterrupt here even when this process was started with SIGINT ignored (a background job
     # of a non-interactive shell, as a CI runner may start it): interrupt_main does nothing where SIGINT is ignored
     signal.signal(signal.SIGINT, signal.default_int_handler)
-    from dynid.estimators.registry import FitData, SearchBudget, fit_methods
+    from dynid.estimators.fitting import fit_methods
+    from dynid.estimators.problem import FitData, SearchBudget
 
     rng = np.random.default_rng(0)
     n, n_base, samples = 3, 10, 200

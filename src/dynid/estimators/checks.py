@@ -2,7 +2,7 @@
 (before registering it, or after) and for dynid's own tests (issue "Re-zone the top floors", item 6; scikit-learn's
 ``check_estimator`` is the model).
 
-The estimator is built and fitted the way the pipeline does (:func:`dynid.estimators.registry.fit_method`, the
+The estimator is built and fitted the way the pipeline does (:func:`dynid.estimators.fitting.fit_method`, the
 plugin guard included) on a small synthetic problem whose parameters are known: an observation matrix of two joints
 and six base parameters with correlated, unequally scaled columns, torques with 0.1 % noise, and a search box that
 holds the truth off its centre. What is checked:
@@ -27,7 +27,9 @@ import numpy as np
 
 from ..exceptions import DynIdError
 from .base import BoxSearchEstimator, Estimator, paper_objective
-from .registry import _REGISTRY, FitData, SearchBudget, fit_method, register, spec
+from .fitting import fit_method
+from .problem import FitData, SearchBudget
+from .registry import _REGISTRY, register, spec
 
 __all__ = ["EstimatorCheckError", "check_estimator"]
 

@@ -18,17 +18,9 @@ import numpy as np
 
 from ..exceptions import ConfigError
 from .base import AccumulatingEstimator
-from .registry import (
-    LEAST_SQUARES,
-    FitData,
-    Fitted,
-    SearchBudget,
-    _named,
-    fit_methods,
-    make_estimator,
-    parse_estimators,
-    spec,
-)
+from .fitting import Fitted, fit_methods, make_estimator
+from .problem import FitData, SearchBudget
+from .registry import LEAST_SQUARES, _named, parse_estimators, spec
 
 __all__ = ["Estimation", "stream_rows", "stacked_rows"]
 
@@ -154,7 +146,7 @@ class Estimation:
     def fit(self, box: np.ndarray | None = None, rngs: dict | None = None, *, budget: SearchBudget = SearchBudget(),
             joint_weights: np.ndarray | None = None, progress=None, keys: Iterable[str] | None = None,
             workers: int | None = None, extra: dict | None = None) -> dict[str, Fitted]:
-        """Fit the estimators side by side (:func:`dynid.estimators.registry.fit_methods`).
+        """Fit the estimators side by side (:func:`dynid.estimators.fitting.fit_methods`).
 
         Parameters
         ----------
@@ -177,7 +169,7 @@ class Estimation:
         Returns
         -------
         dict
-            key -> :class:`~dynid.estimators.registry.Fitted`, then the extra tasks' results.
+            key -> :class:`~dynid.estimators.fitting.Fitted`, then the extra tasks' results.
 
         Raises
         ------

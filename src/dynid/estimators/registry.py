@@ -1,7 +1,7 @@
 """The one registry of estimators, used by ``dynid run``, ``identify``, ``validate``, ``montecarlo`` and the API.
 
 Each estimator has a key (case-insensitive), a label for tables, a description, and is built from a
-:class:`FitData` (what it sees of the problem: the observation rows, the joints, the search box, the eq. 9
+:class:`~dynid.estimators.problem.FitData` (what it sees of the problem: the observation rows, the joints, the search box, the eq. 9
 weights, the SDP's prior and layout). Built in:
 
 - ``ols``, ``wls``, ``irls``: least squares, per-joint weighted least squares, Huber IRLS;
@@ -14,7 +14,8 @@ weights, the SDP's prior and layout). Built in:
 
 A new estimator is one file that subclasses :class:`dynid.estimators.base.Estimator` and calls :func:`register`;
 every command and :class:`dynid.Identifier` can then use its key. Reading the keys (a config check) imports
-no solver: the built-in classes load when first built.
+no solver: the built-in classes load when first built. The problem an estimator sees is
+:mod:`dynid.estimators.problem`'s; fitting them is :mod:`dynid.estimators.fitting`'s.
 """
 
 from __future__ import annotations
@@ -24,105 +25,21 @@ import importlib
 import importlib.util
 import inspect
 import math
-import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ..exceptions import ConfigError, DynIdError
+from ..exceptions import ConfigError
 from ..plugins import Registry, load_plugins, origin
-from ..threads import cores
+from .problem import FitData, SearchBudget
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from ..dynamics.base_parameters import BaseParameters
     from .base import Estimator
 
-__all__ = ["EstimatorSpec", "SearchBudget", "FitData", "Fitted", "register", "unregister", "spec", "keys", "label",
-           "parse_estimators", "estimator_choices", "with_hyperparameters",
-           "make_estimator", "fit_method", "fit_methods"]
-
-
-@dataclass(frozen=True)
-class SearchBudget:
-    """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations.
-
-    Attributes
-    ----------
-    colony_size : int
-        ABC's ``Ns`` (employed plus onlooker bees); PSO's swarm size.
-    limit : int
-        ABC's scout limit.
-    maxiter : int
-        ABC's ``Tmax``.
-    """
-
-    colony_size: int = 30
-    limit: int = 15
-    maxiter: int = 50
-
-    @property
-    def evaluations(self) -> int:
-        """Evaluations of eq. 9 given to DE and PSO: ``10 · colony_size · maxiter``."""
-        return 10 * self.colony_size * self.maxiter
-
-
-@dataclass
-class FitData:
-    """What the estimators see of one identification problem.
-
-    Attributes
-    ----------
-    w_base : (M, n_base) array, or None
-        Base observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j`` (None when the rows were streamed
-        into the estimators that accumulate, and none needs them in memory).
-    tau : (M,) array or None
-        Measured torques [N·m], same rows.
-    n_dof : int
-        Joints per sample.
-    bounds : (n_base, 2) array or None
-        Search box of the box searches and LAD.
-    base : BaseParameters or None
-        The base-parameter map (``sdp`` maps its standard estimate through it).
-    w_standard : (M, p) array, optional
-        Standard observation matrix (estimators of the standard space, ``sdp``, fitted on arrays).
-    layout : tuple, optional
-        ``(links, nonnegative)`` of :func:`dynid.dynamics.layout.consistency_layout` (``sdp``).
-    prior : (p,) array, optional
-        Standard parameters the SDP pulls unidentifiable directions towards.
-    weights : (n_dof,) array, optional
-        ``delta`` of eq. 9.
-    joint_weights : (n_dof,) array, optional
-        Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
-        estimate on real logs).
-    hyperparameters : dict
-        key -> the hyper-parameters an estimator is built with on top of its defaults (those of an estimator object
-        given in place of its key: :func:`estimator_choices`).
-    base_prior : (n_base,) array, optional
-        Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
-    prior_std : (p,) array, optional
-        Standard deviation of ``prior``'s values where the description states one (NaN elsewhere): ``sdp`` pulls
-        those as a Gaussian prior (:meth:`dynid.model.robot.Robot.prior_sigmas`).
-    base_prior_std : (n_base,) array, optional
-        The same of ``base_prior``'s values, for the base parameters that are one stated standard parameter each
-        (NaN elsewhere): least squares pulls those as a Gaussian prior.
-    """
-
-    w_base: Any
-    tau: Any
-    n_dof: int
-    bounds: Any
-    base: BaseParameters | None
-    w_standard: Any = None
-    layout: tuple | None = None
-    prior: Any = None
-    weights: Any = None
-    joint_weights: Any = None
-    hyperparameters: dict = dataclasses.field(default_factory=dict)
-    base_prior: Any = None
-    prior_std: Any = None
-    base_prior_std: Any = None
+__all__ = ["EstimatorSpec", "SearchBudget", "FitData", "register", "unregister", "spec", "keys", "label",
+           "parse_estimators", "estimator_choices", "with_hyperparameters"]
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -612,229 +529,3 @@ def seed_index(key: str) -> int:
     return keys().index(spec(key).key)
 
 
-@dataclass
-class Fitted:
-    """One estimator's fit.
-
-    Attributes
-    ----------
-    key : str
-    params : (n_base,) array
-        Base parameters (a standard-space estimator's mapped through the base-parameter map).
-    estimator : Estimator
-        The fitted estimator (its learned attributes: ``params_std_``, ``history_``, …).
-    seconds : float
-        Wall time of the fit [s].
-    n_evaluations : int or None
-        Evaluations of eq. 9 (box searches only).
-    """
-
-    key: str
-    params: np.ndarray
-    estimator: Estimator
-    seconds: float
-    n_evaluations: int | None
-
-
-def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-                   callback: Callable[[int, float], None] | None = None) -> Estimator:
-    """An unfitted estimator for a problem.
-
-    Parameters
-    ----------
-    key : str
-        A registered estimator (case-insensitive).
-    data : FitData
-    budget : SearchBudget
-        The box searches' budget.
-    rng : numpy.random.Generator, optional
-        Seeds the box searches.
-    callback : callable, optional
-        ``callback(iteration, best)`` of the box searches.
-
-    Returns
-    -------
-    Estimator
-
-    Raises
-    ------
-    ConfigError
-        Unknown key, or ``sdp`` without the parameter layout.
-    """
-    entry = spec(key)
-    est = entry.builder()(data, budget, rng, callback)
-    given = data.hyperparameters.get(entry.key)
-    return est.set_params(**given) if given else est
-
-
-def finish(key: str, est: Estimator, data: FitData, seconds: float) -> Fitted:
-    """A fitted estimator as :class:`Fitted`: its parameters in the base (a standard-space estimator's mapped).
-
-    Parameters
-    ----------
-    key : str
-    est : Estimator
-        Fitted.
-    data : FitData
-        The problem (its base map).
-    seconds : float
-        Wall time of the fit [s].
-
-    Returns
-    -------
-    Fitted
-
-    Raises
-    ------
-    ConfigError
-        A standard-space estimator without a base map.
-    """
-    import numpy as np
-
-    try:
-        params = np.asarray(est.params_, dtype=float)
-    except (AttributeError, TypeError, ValueError) as exc:
-        raise ConfigError(f"{_named(key)}: after fit, expected params_ as an array of numbers "
-                          f"({type(exc).__name__}: {exc})") from None
-    w = data.w_standard if spec(key).space == "standard" else data.w_base
-    expected = w.shape[1] if w is not None else (len(data.base.names) if data.base is not None and spec(key).space == "base"
-                                                 else params.size)
-    if params.shape != (expected,):
-        raise ConfigError(f"{_named(key)}: returned parameters of shape {params.shape}, expected ({expected},): one per "
-                          "column of the observation matrix it was given")
-    if not np.all(np.isfinite(params)):
-        bad = int(np.sum(~np.isfinite(params)))
-        raise ConfigError(f"{_named(key)}: returned {bad} NaN or infinite parameter(s) of {params.size}: no estimate")
-    if spec(key).space == "standard":
-        if data.base is None:
-            raise ConfigError(f"estimator {key} estimates standard parameters: the base-parameter map is needed")
-        params = data.base.base_from_standard(params)
-    return Fitted(spec(key).key, np.asarray(params, dtype=float), est, seconds, getattr(est, "n_evaluations_", None))
-
-
-def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-               callback: Callable[[int, float], None] | None = None, estimator: Estimator | None = None) -> Fitted:
-    """Fit estimator ``key`` on ``data`` and return its base parameters.
-
-    Parameters
-    ----------
-    key : str
-        A registered estimator.
-    data : FitData
-    budget : SearchBudget
-        The box searches' budget.
-    rng : numpy.random.Generator, optional
-        Seeds the box searches.
-    callback : callable, optional
-        ``callback(iteration, best)`` of the box searches.
-    estimator : Estimator, optional
-        One built and fed already (rows streamed by ``partial_fit``): only its solution is computed here.
-
-    Returns
-    -------
-    Fitted
-
-    Raises
-    ------
-    ConfigError
-        Unknown key, or a standard-space estimator without ``w_standard`` (or a base map).
-    DynIdError
-        From the estimator (rank deficiency, solver failure).
-    """
-    entry = spec(key)
-    t0 = time.perf_counter()
-    try:
-        if estimator is not None:
-            est = estimator.solve() if hasattr(estimator, "solve") else estimator
-        else:
-            est = make_estimator(key, data, budget, rng, callback)
-            w = data.w_standard if entry.space == "standard" else data.w_base
-            if w is None:
-                raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
-            est.fit(w, data.tau)
-    except (DynIdError, _Stopped):
-        raise
-    except Exception as exc:  # a plugin's own error, said in one line naming it (a built-in's is a bug: raised as is)
-        if not is_plugin(key):
-            raise
-        text = " ".join(str(exc).split()) or "no message"
-        raise ConfigError(f"{_named(key)}: its fit raised {type(exc).__name__}: {text[:200]}") from None
-    return finish(key, est, data, time.perf_counter() - t0)
-
-
-def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs: dict, *, progress=None,
-                workers: int | None = None, extra: dict | None = None, fed: dict | None = None) -> dict:
-    """Fit every estimator of ``keys_``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
-    and numba, which release the GIL).
-
-    Parameters
-    ----------
-    keys_ : sequence of str
-    data : FitData
-    budget : SearchBudget
-    rngs : dict
-        key -> generator of that estimator: the results depend neither on the order nor on the number of workers.
-    progress : callable, optional
-        ``progress(key, iteration, best)`` reports the box searches (and ``(key, None, None)`` as a fit starts).
-    workers : int, optional
-        Threads (default: the cores).
-    extra : dict, optional
-        name -> callable without arguments: independent tasks run in the same pool, after the three longest fits.
-    fed : dict, optional
-        key -> estimator already fed by ``partial_fit``: only solved.
-
-    Returns
-    -------
-    dict
-        key -> :class:`Fitted` in the order of ``keys_``, then the extra tasks' results under their names.
-        Each ``seconds`` is that fit's wall time while the others ran.
-
-    Notes
-    -----
-    When a fit fails, or this thread is interrupted (Ctrl-C), the box searches stop at their next iteration,
-    the fits not started are cancelled, and the error is raised once the running ones have ended.
-    """
-    import threading
-    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
-
-    keys_ = tuple(keys_)
-    fed = fed or {}
-    stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration
-
-    def fit(key):
-        if stop.is_set():
-            raise _Stopped
-        if progress is not None:
-            progress(key, None, None)
-
-        def callback(i, f, key=key):
-            if stop.is_set():
-                raise _Stopped
-            if progress is not None:
-                progress(key, i, f)
-
-        return fit_method(key, data, budget, rngs.get(key), callback, fed.get(key))
-
-    extra = extra or {}
-    tasks = [(-spec(k).cost, k, lambda k=k: fit(k)) for k in keys_] + [(-6.5, name, f) for name, f in extra.items()]
-    tasks.sort(key=lambda task: task[0])
-    pool = ThreadPoolExecutor(max_workers=max(1, min(workers or cores(), len(tasks))))
-    try:
-        futures = {name: pool.submit(f) for _, name, f in tasks}
-        pending = set(futures.values())
-        while pending:  # woken ten times a second: blocked on a lock, this thread would see Ctrl-C only at the end
-            finished, pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION)
-            for fut in finished:
-                if fut.exception() is not None:
-                    fut.result()  # raises the fit's error now; the other fits stop below
-        done = {name: fut.result() for name, fut in futures.items()}
-    except BaseException:
-        stop.set()  # a box search would otherwise run to its end (seconds) before the interrupt is seen
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    pool.shutdown()
-    return {**{key: done[key] for key in keys_}, **{name: done[name] for name in extra}}
-
-
-class _Stopped(Exception):
-    """Ends a fit of :func:`fit_methods` whose caller was interrupted (never seen by the caller)."""

@@ -24,8 +24,10 @@ from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.estimation import Estimation, stacked_rows, stream_rows
+from ..estimators.fitting import make_estimator
 from ..estimators.physically_consistent import CONSISTENCY_TOL, consistency_verdict
-from ..estimators.registry import FitData, SearchBudget, make_estimator, parse_estimators, seed_index, spec
+from ..estimators.problem import FitData, SearchBudget
+from ..estimators.registry import parse_estimators, seed_index, spec
 from ..exceptions import ConfigError
 from ..excitation.design import ExcitationProblem, base_condition_number, design_excitation
 from ..excitation.fourier import sample_times

@@ -1,0 +1,95 @@
+"""What an estimator sees of one identification problem (:class:`FitData`: the observation rows, the joints, the
+search box, the eq. 9 weights, the prior and the layout), and the box searches' budget (:class:`SearchBudget`, the
+paper's §4.1)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..dynamics.base_parameters import BaseParameters
+
+__all__ = ["SearchBudget", "FitData"]
+
+
+@dataclass(frozen=True)
+class SearchBudget:
+    """ABC settings of §4.1; DE and PSO get ``10 · colony_size · maxiter`` evaluations.
+
+    Attributes
+    ----------
+    colony_size : int
+        ABC's ``Ns`` (employed plus onlooker bees); PSO's swarm size.
+    limit : int
+        ABC's scout limit.
+    maxiter : int
+        ABC's ``Tmax``.
+    """
+
+    colony_size: int = 30
+    limit: int = 15
+    maxiter: int = 50
+
+    @property
+    def evaluations(self) -> int:
+        """Evaluations of eq. 9 given to DE and PSO: ``10 · colony_size · maxiter``."""
+        return 10 * self.colony_size * self.maxiter
+
+
+@dataclass
+class FitData:
+    """What the estimators see of one identification problem.
+
+    Attributes
+    ----------
+    w_base : (M, n_base) array, or None
+        Base observation matrix, row ``k·n_dof + j`` = sample ``k``, joint ``j`` (None when the rows were streamed
+        into the estimators that accumulate, and none needs them in memory).
+    tau : (M,) array or None
+        Measured torques [N·m], same rows.
+    n_dof : int
+        Joints per sample.
+    bounds : (n_base, 2) array or None
+        Search box of the box searches and LAD.
+    base : BaseParameters or None
+        The base-parameter map (``sdp`` maps its standard estimate through it).
+    w_standard : (M, p) array, optional
+        Standard observation matrix (estimators of the standard space, ``sdp``, fitted on arrays).
+    layout : tuple, optional
+        ``(links, nonnegative)`` of :func:`dynid.dynamics.layout.consistency_layout` (``sdp``).
+    prior : (p,) array, optional
+        Standard parameters the SDP pulls unidentifiable directions towards.
+    weights : (n_dof,) array, optional
+        ``delta`` of eq. 9.
+    joint_weights : (n_dof,) array, optional
+        Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
+        estimate on real logs).
+    hyperparameters : dict
+        key -> the hyper-parameters an estimator is built with on top of its defaults (those of an estimator object
+        given in place of its key: :func:`dynid.estimators.registry.estimator_choices`).
+    base_prior : (n_base,) array, optional
+        Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
+    prior_std : (p,) array, optional
+        Standard deviation of ``prior``'s values where the description states one (NaN elsewhere): ``sdp`` pulls
+        those as a Gaussian prior (:meth:`dynid.model.robot.Robot.prior_sigmas`).
+    base_prior_std : (n_base,) array, optional
+        The same of ``base_prior``'s values, for the base parameters that are one stated standard parameter each
+        (NaN elsewhere): least squares pulls those as a Gaussian prior.
+    """
+
+    w_base: Any
+    tau: Any
+    n_dof: int
+    bounds: Any
+    base: BaseParameters | None
+    w_standard: Any = None
+    layout: tuple | None = None
+    prior: Any = None
+    weights: Any = None
+    joint_weights: Any = None
+    hyperparameters: dict = dataclasses.field(default_factory=dict)
+    base_prior: Any = None
+    prior_std: Any = None
+    base_prior_std: Any = None
