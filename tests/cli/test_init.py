@@ -441,3 +441,14 @@ def test_init_takes_the_rate_of_a_log_without_time_stamps(tmp_path):
     recording = load_recording(config.identification, robot)
     np.testing.assert_allclose(recording.t - recording.t[0], rows[:, 0] - rows[0, 0], atol=1e-9)
     np.testing.assert_allclose(recording.q, rows[:, 1:7], rtol=1e-12)
+
+
+def test_only_arms_with_joint_torque_sensors_are_inferred_so():
+    """The names init takes as joint torque sensors: the LBRs, Franka's arms and Kinova's Gen3, not its Gen3 lite or
+    its other arms (whose logs are motor currents)."""
+    from dynid.io.columns import JOINT_SENSED
+
+    sensed = ["lbr_iiwa_14_r820", "med7dock", "panda", "fr3", "kinova_gen3", "GEN3_7dof"]
+    other = ["ur10e", "kinova", "j2s6s200", "gen3_lite", "gen3-lite", "xarm7", "staubli_tx40"]
+    assert [n for n in sensed if not JOINT_SENSED.search(n)] == []
+    assert [n for n in other if JOINT_SENSED.search(n)] == []

@@ -246,9 +246,10 @@ SENSOR_HINT = ('# torques from joint torque sensors on the link side (a KUKA LBR
 """The line under a config's torques that asks what a log cannot say: which side of the gear measured them."""
 
 
-JOINT_SENSED = re.compile(r"lbr|iiwa|med7|med14|panda|fr3|franka|kinova|gen3", re.IGNORECASE)
+JOINT_SENSED = re.compile(r"lbr|iiwa|med7|med14|panda|fr3|franka|gen3(?![_\-]?lite)", re.IGNORECASE)
 """Names of arms whose joint torques come from torque sensors on the link side of every gear: KUKA's LBR iiwa and
-LBR Med, Franka Emika's Panda and FR3, Kinova's Gen3 (in a URDF's robot name or its file's name)."""
+LBR Med, Franka Emika's Panda and FR3, Kinova's Gen3 (in a URDF's robot name or its file's name). Not Kinova's other
+arms: the Gen3 lite has no joint torque sensors, and a Jaco's logs are usually its motor currents."""
 
 
 def _torque_sensor(line: str, urdf: Path) -> tuple[list[str], list[str]]:

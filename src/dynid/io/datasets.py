@@ -370,7 +370,7 @@ def _position_step(column: np.ndarray, t: np.ndarray, limit: float, j: int, sour
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:
     """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.columns.csv_table`)."""
-    if not log.is_file() or log.is_dir():
+    if not log.is_file():
         raise DataError(f"{log}: no such log")
     table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints))
     return dataset_spec(tomllib.loads("\n".join(table)), log.parent, str(log), log.stem, robot.n_dof)
