@@ -1,4 +1,4 @@
-"""The links' own collision geometry, read from the robot's URDF, for the cell's distances (issue "An excitation safe
+"""The links' own collision geometry, read from the robot's URDF or MJCF, for the cell's distances (issue "An excitation safe
 to run on the real robot", item 1: distances from the description's collision meshes).
 
 Pinocchio reads the URDF's ``<collision>`` elements into a geometry model (Carpentier et al., "The Pinocchio C++
@@ -7,7 +7,9 @@ a distance to the hull is never larger than the distance to the mesh, and GJK me
 mesh's BVH takes a millisecond. Each shape rides on one of dynid's links: the joint that carries it in the URDF, or
 the nearest of its ancestors that is one of the robot's joints (a gripper held at 0 rides on the last link), or on
 the base (the links keep off it; the cell's bodies are not measured against it: no motion moves it). Its pose in
-that link's frame is read once at ``q = 0``.
+that link's frame is read once at ``q = 0``. An MJCF's collision geoms are read as MuJoCo compiles them
+(:func:`link_geometry_from_mjcf`), so that the MuJoCo check (:mod:`dynid.io.cell_replay`) collides the user's own
+shapes.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from ..exceptions import ConfigError
 from ..model.robot import Robot
 from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from
 
-__all__ = ["LinkGeometry", "link_geometry_from_urdf", "shape_distances"]
+__all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
 
 
 @dataclass(frozen=True)
@@ -160,6 +162,57 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
     if not any(k >= 0 for k in link):
         return None
     return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path))
+
+
+def link_geometry_from_mjcf(robot: Robot, path) -> LinkGeometry | None:
+    """The collision geoms of an MJCF on the robot's links (:func:`dynid.model.mjcf.collision_geoms`): boxes, spheres,
+    capsules, cylinders and ellipsoids as coal's shapes of the same size, a mesh as its convex hull (coal's qhull, the
+    hull MuJoCo collides it by), each at its pose in its link's frame; the robot's held joints at 0, as for a URDF.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot read from that MJCF.
+    path : str or Path
+        The MJCF.
+
+    Returns
+    -------
+    LinkGeometry or None
+        None where no geom on a moving link collides (every one ``contype = conaffinity = 0``).
+
+    Raises
+    ------
+    ConfigError
+        MuJoCo is not installed, or the file cannot be compiled.
+    """
+    from ..model.mjcf import collision_geoms
+
+    geoms = collision_geoms(path, dict.fromkeys(robot.held, 0.0))
+    if not any(g.link >= 0 for g in geoms):
+        return None
+    return LinkGeometry(tuple(_coal_shape(g) for g in geoms), np.array([g.link for g in geoms]),
+                        np.array([g.placement for g in geoms]), tuple(g.name for g in geoms), str(path))
+
+
+def _coal_shape(geom):
+    """coal's shape of an MJCF geom (MuJoCo's sizes are radii and half-lengths; coal's cylinders and capsules take
+    the whole length, its boxes the whole sides)."""
+    r = geom.size
+    if geom.kind == "sphere":
+        return coal.Sphere(r[0])
+    if geom.kind in ("capsule", "cylinder"):
+        return (coal.Capsule if geom.kind == "capsule" else coal.Cylinder)(r[0], 2 * r[1])
+    if geom.kind == "ellipsoid":
+        return coal.Ellipsoid(*r)
+    if geom.kind == "box":
+        return coal.Box(*(2 * r))
+    mesh = coal.BVHModelOBBRSS()
+    mesh.beginModel(0, len(geom.vertices))
+    mesh.addVertices(geom.vertices)
+    mesh.endModel()
+    mesh.buildConvexHull(True, "Qt")
+    return mesh.convex
 
 
 def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeometry, clearance: float, *,

@@ -128,6 +128,8 @@ def _shape_geoms(root, bodies: dict, geometry) -> None:
             geom.update(type="box", size=_vec(shape.halfSide))
         elif isinstance(shape, coal.Sphere):
             geom.update(type="sphere", size=f"{shape.radius:.17g}")
+        elif isinstance(shape, coal.Ellipsoid):
+            geom.update(type="ellipsoid", size=_vec(shape.radii))
         elif isinstance(shape, (coal.Cylinder, coal.Capsule)):
             geom.update(type="cylinder" if isinstance(shape, coal.Cylinder) else "capsule",
                         size=f"{shape.radius:.17g} {shape.halfLength:.17g}")

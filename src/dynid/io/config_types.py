@@ -305,9 +305,9 @@ class WorkspaceTable(Table, kw_only=True):
                                                          "default 0.05")] | None = None
     obstacles: Annotated[list[ObstacleTable], _d("the cell's bodies every link keeps `clearance` off")] | None = None
     geometry: Annotated[Literal["auto", "capsules", "collision"],
-                        _d("what the links are against the obstacles: the robot URDF's own collision shapes "
-                           "(\"collision\"), capsules of `clearance` about the joint origins (\"capsules\"), or the "
-                           "first where the URDF has them (\"auto\", default)")] | None = None
+                        _d("what the links are against the obstacles: the robot URDF's own collision shapes or its "
+                           "MJCF's colliding geoms (\"collision\"), capsules of `clearance` about the joint origins "
+                           "(\"capsules\"), or the first where the robot's file has them (\"auto\", default)")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

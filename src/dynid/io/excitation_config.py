@@ -52,14 +52,14 @@ from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationProblem
 from ..excitation.fourier import FourierTrajectory
-from ..excitation.link_geometry import link_geometry_from_urdf
+from ..excitation.link_geometry import link_geometry_from_mjcf, link_geometry_from_urdf
 from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
 from ..typed import convert
 from .config_types import ExcitationDocument
-from .configs import config_robot, config_urdf, read_config
+from .configs import config_mjcf, config_robot, config_urdf, read_config
 from .trajectories import load_trajectory
 
 DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
@@ -77,22 +77,26 @@ def _from_identification(doc: dict, path: Path) -> dict:
     return {"robot": doc.get("robot"), **excitation}
 
 
-def _link_geometry(setting: str, robot, urdf: Path | None):
-    """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`), or None (capsules).
-    "auto" takes them where the robot's URDF has them and they load; "collision" insists."""
-    if setting == "capsules" or (urdf is None and setting == "auto"):
+def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = None):
+    """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`) or the MJCF's collision
+    geoms (:func:`link_geometry_from_mjcf`), or None (capsules). "auto" takes them where the robot's file has them and
+    they load; "collision" insists."""
+    file = urdf or mjcf
+    if setting == "capsules" or (file is None and setting == "auto"):
         return None
-    if urdf is None:
+    if file is None:
         raise ConfigError('workspace.geometry = "collision" needs a robot read from a URDF with <collision> elements '
-                          "and [[workspace.obstacles]] to keep them off")
+                          "or an MJCF with colliding geoms, and [[workspace.obstacles]] to keep them off")
     try:
-        found = link_geometry_from_urdf(robot, urdf)
+        found = link_geometry_from_urdf(robot, file) if urdf is not None else link_geometry_from_mjcf(robot, file)
     except ConfigError:
         if setting == "auto":
             return None
         raise
     if found is None and setting == "collision":
-        raise ConfigError(f'workspace.geometry = "collision": {urdf} has no <collision> element on a moving link')
+        raise ConfigError(f'workspace.geometry = "collision": {file} has no '
+                          + ("<collision> element" if urdf is not None else "colliding geom (contype or conaffinity "
+                             "not 0)") + " on a moving link")
     return found
 
 
@@ -200,7 +204,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
                                    ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
-        ws_kw["geometry"] = _link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path) if ws.obstacles else None)
+        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path))
+                             if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
         workspace = Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None

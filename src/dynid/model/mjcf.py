@@ -11,6 +11,7 @@ given where MuJoCo normalises it (a 60° turn about (1, 0.5, 0) put the torques 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -198,6 +199,81 @@ def _lumped(mujoco, model, bodies, moving, owner, frames) -> np.ndarray:
                                      principal @ np.diag(model.body_inertia[b]) @ principal.T)
         out[link_of[owner[b]]] += transform_inertial(phi, rotations[b], translations[b])
     return out
+
+
+@dataclass(frozen=True)
+class CollisionGeom:
+    """One collision geom of an MJCF, on the link it rides on (:func:`collision_geoms`).
+
+    Attributes
+    ----------
+    name : str
+        The geom's name (``geom <id>`` where it has none).
+    kind : str
+        ``"sphere"``, ``"capsule"``, ``"ellipsoid"``, ``"cylinder"``, ``"box"`` or ``"mesh"``.
+    size : (3,) array [m]
+        MuJoCo's ``geom_size``: a radius; a radius and a half-length; three semi-axes or half-sides.
+    vertices : (m, 3) array or None [m]
+        A mesh's vertices in the geom's frame (None for the other kinds).
+    link : int
+        The link (0-based) the geom rides on; -1 for the base.
+    placement : (4, 4) array
+        The geom's pose in that link's joint frame (the base's: MuJoCo's world frame) [m].
+    """
+
+    name: str
+    kind: str
+    size: np.ndarray
+    vertices: np.ndarray | None
+    link: int
+    placement: np.ndarray
+
+
+GEOM_KINDS = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box", 7: "mesh"}
+"""MuJoCo's ``mjtGeom`` values of the shapes a link can carry (planes and height fields are the world's)."""
+
+
+def collision_geoms(path: str | Path, held=None) -> tuple[CollisionGeom, ...]:
+    """The geoms of an MJCF that collide (``contype`` or ``conaffinity`` not 0: not the visual-only ones, group
+    whatever), on the links of its chain (:func:`joints_from_mjcf`), as MuJoCo compiles them: a mesh's vertices in its
+    geom's frame (MuJoCo collides a mesh by their convex hull). The world body's geoms (a floor, a table) are left out:
+    the cell is stated in the excitation config.
+
+    Parameters
+    ----------
+    path : str or Path
+    held : dict, optional
+        Joint name -> position at which it is held fixed (its bodies ride on the link it is held to).
+
+    Returns
+    -------
+    tuple of CollisionGeom
+
+    Raises
+    ------
+    ConfigError
+        As :func:`joints_from_mjcf`.
+    """
+    path, held = Path(path), dict(held or {})
+    mujoco, model, moving, owner, names = _chain(path, held)
+    rotations, translations = _frames(mujoco, model, moving, held, names)
+    link_of = {k: i for i, k in enumerate(moving)}
+    out = []
+    for g in range(model.ngeom):
+        b, kind = int(model.geom_bodyid[g]), GEOM_KINDS.get(int(model.geom_type[g]))
+        if b == 0 or kind is None or not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        pose = np.eye(4)
+        pose[:3, :3] = rotations[b] @ _quat_matrix(mujoco, model.geom_quat[g])
+        pose[:3, 3] = rotations[b] @ np.array(model.geom_pos[g], dtype=float) + translations[b]
+        vertices = None
+        if kind == "mesh":
+            m = int(model.geom_dataid[g])
+            start = int(model.mesh_vertadr[m])
+            vertices = np.array(model.mesh_vert[start:start + int(model.mesh_vertnum[m])], dtype=float)
+        out.append(CollisionGeom(model.geom(g).name or f"geom {g}", kind, np.array(model.geom_size[g], dtype=float),
+                                 vertices, link_of[owner[b]] if owner[b] >= 0 else -1, pose))
+    return tuple(out)
 
 
 def mjcf_joint_values(path: str | Path, held=None) -> dict:

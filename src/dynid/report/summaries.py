@@ -1106,7 +1106,7 @@ def _cell_clearance_lines(run) -> list:
     ws = run.config.problem.workspace
     n = len(ws.obstacles)
     what = (f"every link's {radius:g} m capsule stays {low.worst:.3g} m" if ws.geometry is None else
-            f"every link's collision shapes (of {Path(ws.geometry.source).name}, convex hulls) stay "
+            f"every link's collision shapes (of {Path(ws.geometry.source).name}; a mesh as its convex hull) stay "
             f"{radius + low.worst:.3g} m")
     beyond = "" if ws.geometry is None else f", {low.worst:.3g} m beyond the {radius:g} m clearance"
     return [Line(f"{what} or more off the cell at the set-points{beyond} ({n} {'body' if n == 1 else 'bodies'}; "
