@@ -173,3 +173,36 @@ def test_the_design_keeps_the_links_shapes_apart_by_pinocchios_own_check(ur10e_w
     for qn in design.trajectory.evaluate(t)[0]:
         pin.computeDistances(model, data, geom, gdata, qn)
         assert min(r.min_distance for r in gdata.distanceResults) > -1e-6
+
+
+def test_an_srdfs_disabled_pairs_are_not_kept_apart(ur10e_with_meshes, tmp_path):
+    """MoveIt's SRDF: the shapes on the links a ``<disable_collisions>`` names are excluded from the self pairs, the
+    others kept; an SRDF of another robot and one given where it cannot apply are refused in one line."""
+    import pinocchio as pin
+
+    robot = load_robot(ur10e_with_meshes)
+    plain = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    model = pin.buildModelFromUrdf(str(ur10e_with_meshes))
+    geom = pin.buildGeomFromUrdf(model, str(ur10e_with_meshes), pin.GeometryType.COLLISION,
+                                 package_dirs=[str(p) for p in ur10e_with_meshes.parents])
+    link_of = [model.frames[o.parentFrame].name for o in geom.geometryObjects]  # each shape's URDF link
+    pairs = self_pairs(robot, plain)
+    disabled = {frozenset((link_of[g], link_of[h])) for g, h in pairs[:2]}
+    srdf = tmp_path / "ur10e.srdf"
+    srdf.write_text('<?xml version="1.0"?>\n<robot name="ur10e">\n' + "".join(
+        f'  <disable_collisions link1="{a}" link2="{b}" reason="Never"/>\n' for a, b in map(sorted, disabled)) + "</robot>\n")
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes, srdf)
+    assert {frozenset((link_of[g], link_of[h])) for g, h in geometry.excluded} == disabled
+    kept = self_pairs(robot, geometry)
+    assert set(kept) == {(g, h) for g, h in pairs if frozenset((link_of[g], link_of[h])) not in disabled}
+    other = tmp_path / "other.srdf"
+    other.write_text('<robot name="x"><disable_collisions link1="base_link" link2="gripper_palm" reason="Adjacent"/></robot>')
+    with pytest.raises(ConfigError, match=r"other\.srdf: <disable_collisions> names link 'gripper_palm', which the URDF "
+                                          r"does not have"):
+        link_geometry_from_urdf(robot, ur10e_with_meshes, other)
+    cfg = _config(tmp_path, ur10e_with_meshes, None)
+    cfg.write_text(cfg.read_text().replace("[workspace]\n", f'[workspace]\nsrdf = "{srdf.name}"\n'))
+    assert load_excitation_config(cfg).problem.workspace.geometry.excluded == geometry.excluded
+    cfg.write_text(cfg.read_text().replace("[workspace]\n", '[workspace]\ngeometry = "capsules"\n'))
+    with pytest.raises(ConfigError, match='workspace.geometry = "capsules" leaves them out'):
+        load_excitation_config(cfg)

@@ -11,7 +11,7 @@ import pytest
 
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
-from dynid.excitation.link_geometry import FAR, link_geometry_from_mjcf
+from dynid.excitation.link_geometry import FAR, link_geometry_from_mjcf, self_pairs
 from dynid.excitation.obstacles import Obstacle
 from dynid.io.cell_replay import cell_contacts
 from dynid.io.excitation_config import load_excitation_config
@@ -165,3 +165,21 @@ def test_the_config_takes_the_mjcfs_geoms_and_says_when_there_are_none(arm, tmp_
     with pytest.raises(ConfigError, match=r"visual_only\.xml has no colliding geom \(contype or conaffinity not 0\) on a "
                                           "moving link"):
         load_excitation_config(_config(tmp_path, bare, "collision"))
+
+
+def test_the_pairs_the_file_keeps_mujoco_from_colliding_are_not_kept_apart(arm, tmp_path):
+    """An ``<exclude>`` of two bodies and a geom whose bit masks meet no other's: their pairs, read off the file by
+    MuJoCo's rules (contype of one and conaffinity of the other share no bit), are excluded and left out of the self
+    pairs."""
+    text = (ARM.replace('<geom name="finger_pad" type="box"', '<geom name="finger_pad" contype="2" conaffinity="2" type="box"')
+            .replace("</worldbody>", '</worldbody>\n  <contact><exclude body1="base" body2="wrist"/></contact>'))
+    path = tmp_path / "excluding.xml"
+    path.write_text(text)
+    robot = load_robot(path, held=("finger_joint",))
+    geometry = link_geometry_from_mjcf(robot, path)
+    named = {frozenset((geometry.names[g], geometry.names[h])) for g, h in geometry.excluded}
+    expected = ({frozenset(("pedestal", w)) for w in ("wrist_egg", "wrist_mesh")}
+                | {frozenset(("finger_pad", other)) for other in COLLIDING if other != "finger_pad"})
+    assert named == expected
+    assert not set(self_pairs(robot, geometry)) & geometry.excluded
+    assert set(self_pairs(robot, link_geometry_from_mjcf(robot, arm))) & geometry.excluded  # the plain file checks some

@@ -24,7 +24,9 @@ import numpy as np
 from ..dynamics.kinematics import forward_kinematics
 from ..dynamics.sensitivity import frames_and_axes
 from ..exceptions import ConfigError
+from ..model.mjcf import collision_geoms, excluded_bodies
 from ..model.robot import Robot
+from ..model.srdf import disabled_link_pairs
 from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from
 
 __all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
@@ -46,6 +48,9 @@ class LinkGeometry:
         The URDF's collision names, named in messages.
     source : str
         The URDF.
+    excluded : frozenset of (int, int)
+        Pairs of shapes (``g < h``) the robot's files say never to check against each other: an SRDF's
+        ``<disable_collisions>`` (MoveIt's), an MJCF's ``<contact><exclude>`` or collision bit masks that do not meet.
     found : dict
         The pairs :func:`self_pairs` found, per joint range and sample: found once per run.
     """
@@ -55,6 +60,7 @@ class LinkGeometry:
     placement: np.ndarray
     names: tuple[str, ...]
     source: str
+    excluded: frozenset = frozenset()
     found: dict = field(default_factory=dict, compare=False, repr=False)
 
     def spheres(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -105,7 +111,7 @@ def _package_dirs(path: Path) -> list[str]:
     return [str(p) for p in path.resolve().parents]
 
 
-def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
+def link_geometry_from_urdf(robot: Robot, path, srdf=None) -> LinkGeometry | None:
     """The collision shapes of a URDF on the robot's links (module docstring).
 
     Parameters
@@ -114,6 +120,9 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
         The robot read from that URDF (its joints carry the URDF's joint names).
     path : str or Path
         The URDF.
+    srdf : str or Path, optional
+        MoveIt's semantic description of the robot: the pairs of links its ``<disable_collisions>`` name are
+        :attr:`LinkGeometry.excluded` (read by Pinocchio's ``removeCollisionPairs``).
 
     Returns
     -------
@@ -123,7 +132,8 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
     Raises
     ------
     ConfigError
-        A collision mesh that cannot be found or read (the message names the file and the mesh).
+        A collision mesh that cannot be found or read (the message names the file and the mesh), or an SRDF that is
+        not XML or names a link the URDF does not have.
     """
     import pinocchio as pin
 
@@ -161,7 +171,26 @@ def link_geometry_from_urdf(robot: Robot, path) -> LinkGeometry | None:
         names.append(obj.name)
     if not any(k >= 0 for k in link):
         return None
-    return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path))
+    excluded = _srdf_excluded(model, geometry, Path(srdf)) if srdf is not None else frozenset()
+    return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path), excluded)
+
+
+def _srdf_excluded(model, geometry, srdf: Path) -> frozenset:
+    """The pairs of ``geometry``'s objects an SRDF's ``<disable_collisions>`` leave out, as Pinocchio removes them from
+    every pair; an SRDF naming a link the URDF does not have is refused (it is another robot's)."""
+    import pinocchio as pin
+
+    links = {f.name for f in model.frames}
+    for pair in disabled_link_pairs(srdf):
+        unknown = sorted(pair - links)
+        if unknown:
+            raise ConfigError(f"{srdf}: <disable_collisions> names link {unknown[0]!r}, which the URDF does not have: "
+                              "is it this robot's SRDF?")
+    geometry.addAllCollisionPairs()
+    every = {(p.first, p.second) for p in geometry.collisionPairs}
+    pin.removeCollisionPairs(model, geometry, str(srdf))
+    kept = {(p.first, p.second) for p in geometry.collisionPairs}
+    return frozenset((min(a, b), max(a, b)) for a, b in every - kept)
 
 
 def link_geometry_from_mjcf(robot: Robot, path) -> LinkGeometry | None:
@@ -186,13 +215,14 @@ def link_geometry_from_mjcf(robot: Robot, path) -> LinkGeometry | None:
     ConfigError
         MuJoCo is not installed, or the file cannot be compiled.
     """
-    from ..model.mjcf import collision_geoms
-
     geoms = collision_geoms(path, dict.fromkeys(robot.held, 0.0))
     if not any(g.link >= 0 for g in geoms):
         return None
+    bodies = excluded_bodies(path)
+    excluded = frozenset((i, j) for i, a in enumerate(geoms) for j, b in enumerate(geoms) if i < j and (
+        not (a.contype & b.conaffinity or b.contype & a.conaffinity) or frozenset((a.body, b.body)) in bodies))
     return LinkGeometry(tuple(_coal_shape(g) for g in geoms), np.array([g.link for g in geoms]),
-                        np.array([g.placement for g in geoms]), tuple(g.name for g in geoms), str(path))
+                        np.array([g.placement for g in geoms]), tuple(g.name for g in geoms), str(path), excluded)
 
 
 def _coal_shape(geom):
@@ -280,8 +310,8 @@ housings), as MoveIt's setup assistant finds it: left out of the self-clearance.
 
 def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=0) -> list[tuple[int, int]]:
     """The pairs of shapes (indices into ``geometry``) whose distance the motion changes and that can touch: on links
-    that are not the same or neighbours in the chain, and not touching on :data:`ALWAYS` of random poses within the
-    joint limits (±π where there are none).
+    that are not the same or neighbours in the chain, not excluded by the robot's files (:attr:`LinkGeometry.excluded`)
+    and not touching on :data:`ALWAYS` of random poses within the joint limits (±π where there are none).
 
     Parameters
     ----------
@@ -300,7 +330,7 @@ def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=
     if key[-1] is not None and key in geometry.found:  # the design, its checks and the run ask for the same pairs
         return list(geometry.found[key])
     candidates = [(g, h) for g in range(len(geometry.shapes)) for h in range(g + 1, len(geometry.shapes))
-                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2]
+                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2 and (g, h) not in geometry.excluded]
     pairs = []
     if candidates:
         q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)

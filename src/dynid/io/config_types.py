@@ -308,6 +308,8 @@ class WorkspaceTable(Table, kw_only=True):
                         _d("what the links are against the obstacles: the robot URDF's own collision shapes or its "
                            "MJCF's colliding geoms (\"collision\"), capsules of `clearance` about the joint origins "
                            "(\"capsules\"), or the first where the robot's file has them (\"auto\", default)")] | None = None
+    srdf: Annotated[str, _d("MoveIt's SRDF of the robot's URDF (path relative to the config): the pairs of links its "
+                            "<disable_collisions> name are not kept apart")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

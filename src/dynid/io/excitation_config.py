@@ -77,10 +77,14 @@ def _from_identification(doc: dict, path: Path) -> dict:
     return {"robot": doc.get("robot"), **excitation}
 
 
-def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = None):
-    """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`) or the MJCF's collision
-    geoms (:func:`link_geometry_from_mjcf`), or None (capsules). "auto" takes them where the robot's file has them and
-    they load; "collision" insists."""
+def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = None, srdf: Path | None = None):
+    """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`, less ``srdf``'s
+    disabled pairs) or the MJCF's collision geoms (:func:`link_geometry_from_mjcf`), or None (capsules). "auto" takes
+    them where the robot's file has them and they load; "collision" insists."""
+    if srdf is not None and (urdf is None or setting == "capsules"):
+        raise ConfigError(f"workspace.srdf = {str(srdf)!r}: an SRDF names pairs of a URDF's collision shapes, but "
+                          + ("the robot is not read from a URDF" if urdf is None else
+                             'workspace.geometry = "capsules" leaves them out'))
     file = urdf or mjcf
     if setting == "capsules" or (file is None and setting == "auto"):
         return None
@@ -88,9 +92,9 @@ def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = N
         raise ConfigError('workspace.geometry = "collision" needs a robot read from a URDF with <collision> elements '
                           "or an MJCF with colliding geoms, and [[workspace.obstacles]] to keep them off")
     try:
-        found = link_geometry_from_urdf(robot, file) if urdf is not None else link_geometry_from_mjcf(robot, file)
+        found = link_geometry_from_urdf(robot, file, srdf) if urdf is not None else link_geometry_from_mjcf(robot, file)
     except ConfigError:
-        if setting == "auto":
+        if setting == "auto" and srdf is None:
             return None
         raise
     if found is None and setting == "collision":
@@ -204,8 +208,12 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
                                    ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
-        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path))
-                             if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
+        srdf = None if ws.srdf is None else (path.parent / ws.srdf).resolve()
+        if srdf is not None and not ws.obstacles:
+            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where "
+                              "[[workspace.obstacles]] are given (without them the links are capsules)")
+        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
+                                            srdf) if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
         workspace = Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None

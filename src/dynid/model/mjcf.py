@@ -219,6 +219,11 @@ class CollisionGeom:
         The link (0-based) the geom rides on; -1 for the base.
     placement : (4, 4) array
         The geom's pose in that link's joint frame (the base's: MuJoCo's world frame) [m].
+    body : str
+        The body it belongs to.
+    contype, conaffinity : int
+        Its collision bit masks: MuJoCo collides two geoms where one's ``contype`` and the other's ``conaffinity``
+        share a bit.
     """
 
     name: str
@@ -227,6 +232,9 @@ class CollisionGeom:
     vertices: np.ndarray | None
     link: int
     placement: np.ndarray
+    body: str = ""
+    contype: int = 1
+    conaffinity: int = 1
 
 
 GEOM_KINDS = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box", 7: "mesh"}
@@ -272,8 +280,31 @@ def collision_geoms(path: str | Path, held=None) -> tuple[CollisionGeom, ...]:
             start = int(model.mesh_vertadr[m])
             vertices = np.array(model.mesh_vert[start:start + int(model.mesh_vertnum[m])], dtype=float)
         out.append(CollisionGeom(model.geom(g).name or f"geom {g}", kind, np.array(model.geom_size[g], dtype=float),
-                                 vertices, link_of[owner[b]] if owner[b] >= 0 else -1, pose))
+                                 vertices, link_of[owner[b]] if owner[b] >= 0 else -1, pose, model.body(b).name,
+                                 int(model.geom_contype[g]), int(model.geom_conaffinity[g])))
     return tuple(out)
+
+
+def excluded_bodies(path: str | Path) -> frozenset[frozenset[str]]:
+    """The pairs of bodies an MJCF's ``<contact><exclude body1=... body2=...>`` keeps MuJoCo from colliding.
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    frozenset of frozenset of str
+        Body names, two to a pair.
+
+    Raises
+    ------
+    ConfigError
+        MuJoCo is not installed, or the file cannot be compiled.
+    """
+    _, model = _compiled(Path(path))
+    return frozenset(frozenset((model.body(int(sig) >> 16).name, model.body(int(sig) & 0xFFFF).name))
+                     for sig in model.exclude_signature)
 
 
 def mjcf_joint_values(path: str | Path, held=None) -> dict:
