@@ -25,7 +25,10 @@ identification log's residual plus the prediction variance on the validation log
 estimate on five of six windows of the LBR Med7's log, where it predicts 1.2-2.6× worse than the description; the same
 with blocked cross-validation in place of the residual lost the UR10e's short windows (SDP 6.4-10.1 % where the
 drive-only estimate scores 1.7-2.1 %); cross-validation between least squares and the SDP picks least squares on the
-KR 300 (55 % against 12 %).
+KR 300 (55 % against 12 %); a significance test of the candidates' differences on the validation states against their
+block-jackknife spread there (``benchmarks/torque_free.py``) keeps a drive-only estimate on the Med7's 60-63 s that is
+1.5× worse than the description, or, tuned to avoid it, keeps the description on four KR 300 windows where an estimate
+is three times better.
 """
 
 from __future__ import annotations
