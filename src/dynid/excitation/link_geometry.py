@@ -53,6 +53,8 @@ class LinkGeometry:
         ``<disable_collisions>`` (MoveIt's), an MJCF's ``<contact><exclude>`` or collision bit masks that do not meet.
     found : dict
         The pairs :func:`self_pairs` found, per joint range and sample: found once per run.
+    memo : dict
+        The shapes' local bounding boxes, and the last trajectory's poses, bounding spheres and coal transforms.
     """
 
     shapes: tuple
@@ -62,6 +64,7 @@ class LinkGeometry:
     source: str
     excluded: frozenset = frozenset()
     found: dict = field(default_factory=dict, compare=False, repr=False)
+    memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     def spheres(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each shape's bounding sphere (coal's local box, half its diagonal) along ``q``.
@@ -76,13 +79,15 @@ class LinkGeometry:
         centre : (N, m, 3) array [m]
         radius : (m,) array [m]
         """
-        rotation, position = self.poses(robot, q)
-        local, radius = [], []
-        for shape in self.shapes:
-            shape.computeLocalAABB()
-            local.append(np.asarray(shape.aabb_center, dtype=float))
-            radius.append(float(shape.aabb_radius))
-        return position + np.einsum("nmij,mj->nmi", rotation, np.array(local)), np.array(radius)
+        if "local" not in self.memo:  # the shapes do not change
+            for shape in self.shapes:
+                shape.computeLocalAABB()
+            self.memo["local"] = (np.array([np.asarray(shape.aabb_center, dtype=float) for shape in self.shapes]),
+                                  np.array([float(shape.aabb_radius) for shape in self.shapes]))
+        placed = self._placed(robot, q)
+        if "centre" not in placed:
+            placed["centre"] = placed["position"] + np.einsum("nmij,mj->nmi", placed["rotation"], self.memo["local"][0])
+        return placed["centre"], self.memo["local"][1]
 
     def poses(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every shape's rotation and position in the base frame.
@@ -97,13 +102,47 @@ class LinkGeometry:
         rotation : (N, m, 3, 3) array
         position : (N, m, 3) array [m]
         """
+        placed = self._placed(robot, q)
+        return placed["rotation"], placed["position"]
+
+    def transforms(self, robot: Robot, q: np.ndarray):
+        """coal's poses of the shapes along ``q``, each made once per trajectory (a shape is in several pairs).
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+
+        Returns
+        -------
+        callable
+            ``pose(n, g)``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
+        """
+        placed = self._placed(robot, q)
+        made, rotation, position = placed["transforms"], placed["rotation"], placed["position"]
+
+        def pose(n: int, g: int):
+            if (n, g) not in made:
+                made[n, g] = coal.Transform3s(rotation[n, g], position[n, g])
+            return made[n, g]
+        return pose
+
+    def _placed(self, robot: Robot, q: np.ndarray) -> dict:
+        """The shapes placed along ``q``: one entry of :attr:`memo` for the last trajectory asked (the design asks the
+        cell's and the self distances, each with the spheres, on the same grid), replaced whole, so that what it holds
+        is always of one trajectory."""
+        key = (id(robot), q.shape, q.tobytes())
+        last = self.memo.get("last")
+        if last is not None and last["key"] == key:
+            return last
         rots, orig = forward_kinematics(robot, q)
         base = self.link < 0  # on the base: its frame
         r, p = rots[:, np.where(base, 0, self.link)], orig[:, np.where(base, 0, self.link)]
         r[:, base], p[:, base] = np.eye(3), 0.0
-        rotation = r @ self.placement[:, :3, :3]
-        position = p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3])
-        return rotation, position
+        last = {"key": key, "rotation": r @ self.placement[:, :3, :3],
+                "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": {}}
+        self.memo["last"] = last
+        return last
 
 
 def _package_dirs(path: Path) -> list[str]:
@@ -281,11 +320,12 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     near, normal = centre[:, g_of].copy(), -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
+    placed = geometry.transforms(robot, q)
     for n, c in zip(*np.nonzero(dist < FAR)):
         g, i = pairs[c]
         body, pose = bodies[i]
         result = coal.DistanceResult()
-        coal.distance(geometry.shapes[g], coal.Transform3s(rotation[n, g], position[n, g]), body, pose, request, result)
+        coal.distance(geometry.shapes[g], placed(n, g), body, pose, request, result)
         dist[n, c] = result.min_distance - clearance
         if gradient:
             near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
@@ -370,13 +410,7 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    placed: dict = {}  # (sample, shape) -> coal's pose, made once: a shape is in several pairs
-
-    def pose(n, g):
-        if (n, g) not in placed:
-            placed[n, g] = coal.Transform3s(rotation[n, g], position[n, g])
-        return placed[n, g]
-
+    pose = geometry.transforms(robot, q)
     for n, c in zip(*np.nonzero(dist < FAR)):
         g, h = pairs[c]
         result = coal.DistanceResult()
