@@ -52,9 +52,8 @@ def _config_path(name: str, window, folder: Path) -> tuple[Path, Path]:
 def _fold_variants(robot, base, recording, data, given, one_way) -> tuple:
     """:func:`dynid.identification.drive_only.preprocessing_variants`, each variant's rows split into the folds."""
     from dynid.estimators.accumulate import LeastSquaresAccumulator
-    from dynid.identification.drive_only import CUTOFF_FACTORS
-    from dynid.preprocessing.bands import capped
-    from dynid.preprocessing.pipeline import base_chunks, prepare
+    from dynid.identification.drive_only import CUTOFF_FACTORS, prepared_variant
+    from dynid.preprocessing.pipeline import base_chunks
 
     s = data.settings
     if (not len(one_way) or not robot.drive_terms or not np.any(robot.inertial != 0) or s.strategy != "parallel"
@@ -62,12 +61,7 @@ def _fold_variants(robot, base, recording, data, given, one_way) -> tuple:
         return ()
     out = []
     for f in CUTOFF_FACTORS:
-        position, velocity, parallel = (None if c is None else capped(f * c, data.rate)
-                                        for c in (s.position_cutoff, s.velocity_cutoff, s.parallel_cutoff))
-        settings = replace(given, band=s.band, position_cutoff=position, velocity_cutoff=velocity,
-                           parallel_cutoff=parallel, min_speed=s.min_speed, rest_velocity=s.rest_velocity,
-                           coulomb_velocity=s.coulomb_velocity)
-        variant = prepare(recording, settings).with_rest_model(s.rest_friction, s.presliding)
+        variant = prepared_variant(recording, data, given, f)
         accs = [LeastSquaresAccumulator(base.n_base, robot.n_dof) for _ in range(FOLDS)]
         for index, y, tau, keep in base_chunks(robot, base, variant):
             fold = index * FOLDS // variant.t.shape[0]

@@ -31,7 +31,7 @@ from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 from .estimates import DRIVE_ONLY_KEY
 
-__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "preprocessing_variants"]
+__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "prepared_variant", "preprocessing_variants"]
 
 
 @dataclass(frozen=True)
@@ -101,17 +101,37 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
         return ()
     out = []
     for f in CUTOFF_FACTORS:
-        position, velocity, parallel = (None if c is None else capped(f * c, data.rate)
-                                        for c in (s.position_cutoff, s.velocity_cutoff, s.parallel_cutoff))
-        settings = replace(given, band=s.band, position_cutoff=position, velocity_cutoff=velocity,
-                           parallel_cutoff=parallel, min_speed=s.min_speed, rest_velocity=s.rest_velocity,
-                           coulomb_velocity=s.coulomb_velocity)
-        variant = prepare(recording, settings).with_rest_model(s.rest_friction, s.presliding)
         acc = LeastSquaresAccumulator(base.n_base, robot.n_dof)
-        for _, y, tau, keep in base_chunks(robot, base, variant):
+        for _, y, tau, keep in base_chunks(robot, base, prepared_variant(recording, data, given, f)):
             acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
         out.append((f, acc))
     return tuple(out)
+
+
+def prepared_variant(recording, data: PreparedData, given: Preprocessing, factor: float) -> PreparedData:
+    """The log prepared again with its position, velocity and parallel cutoffs at ``factor`` × its own (capped below
+    Nyquist), its other resolved settings and rest model kept (:func:`preprocessing_variants`).
+
+    Parameters
+    ----------
+    recording : dynid.io.datasets.Recording
+        The log as read.
+    data : PreparedData
+        The log as prepared (its resolved settings).
+    given : Preprocessing
+        The settings as given.
+    factor : float
+
+    Returns
+    -------
+    PreparedData
+    """
+    s = data.settings
+    position, velocity, parallel = (None if c is None else capped(factor * c, data.rate)
+                                    for c in (s.position_cutoff, s.velocity_cutoff, s.parallel_cutoff))
+    settings = replace(given, band=s.band, position_cutoff=position, velocity_cutoff=velocity, parallel_cutoff=parallel,
+                       min_speed=s.min_speed, rest_velocity=s.rest_velocity, coulomb_velocity=s.coulomb_velocity)
+    return prepare(recording, settings).with_rest_model(s.rest_friction, s.presliding)
 
 
 def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccumulator, *, joint_weights=None,
