@@ -206,3 +206,18 @@ def test_an_srdfs_disabled_pairs_are_not_kept_apart(ur10e_with_meshes, tmp_path)
     cfg.write_text(cfg.read_text().replace("[workspace]\n", '[workspace]\ngeometry = "capsules"\n'))
     with pytest.raises(ConfigError, match='workspace.geometry = "capsules" leaves them out'):
         load_excitation_config(cfg)
+
+
+def test_the_last_trajectorys_poses_are_reused_only_for_that_trajectory(ur10e_with_meshes, rng):
+    """The poses, spheres and coal transforms kept for the last trajectory asked are those of the trajectory asked:
+    alternating two trajectories, each answer equals a fresh geometry's."""
+    robot = load_robot(ur10e_with_meshes)
+    kept = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    one, two = rng.uniform(-2.0, 2.0, (2, 7, robot.n_dof))
+    for q in (one, two, one, two.copy()):
+        fresh = replace(kept, memo={})
+        for mine, theirs in zip(kept.poses(robot, q) + kept.spheres(robot, q), fresh.poses(robot, q) + fresh.spheres(robot, q)):
+            np.testing.assert_array_equal(mine, theirs)
+        pose = kept.transforms(robot, q)
+        np.testing.assert_array_equal(pose(3, 2).getTranslation(), fresh.poses(robot, q)[1][3, 2])
+    assert kept.memo["last"]["key"][2] == two.tobytes()
