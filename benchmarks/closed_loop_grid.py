@@ -23,7 +23,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def main(argv: list[str]) -> int:
-    from dynid.report.summaries import closed_loop_study_rows, closed_loop_verdict
+    from dynid.report.study_summaries import closed_loop_study_rows, closed_loop_verdict
     from dynid.studies.closed_loop import ENCODER_NOISE_DEG, TORQUE_NOISE, ClosedLoopStudyConfig, run_closed_loop_study
 
     parser = argparse.ArgumentParser()

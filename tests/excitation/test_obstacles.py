@@ -17,7 +17,7 @@ from dynid.io.cell_replay import cell_contacts, cell_mjcf
 from dynid.io.excitation_config import load_excitation_config
 from dynid.model.description import load_robot
 from dynid.report.excitation_run import save_excitation
-from dynid.report.summaries import excitation_blocks
+from dynid.report.excitation_summary import excitation_blocks
 
 RADIUS = 0.05
 

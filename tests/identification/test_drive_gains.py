@@ -118,7 +118,7 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
 
 def test_payload_parameters_the_loaded_run_does_not_determine_are_said_so():
     from dynid.identification.drive_gains import DriveGainEstimate, GainsAndPayload, PayloadEstimate
-    from dynid.report.summaries import drive_gains_blocks
+    from dynid.report.choice_tables import drive_gains_blocks
 
     payload = PayloadEstimate(("XX", "MX", "MY", "MZ", "M"), np.array([0.004, 0.03, -0.001, 0.17, 2.8]),
                               np.array([0.01, 0.002, 0.004, 0.003, 0.02]))
@@ -196,7 +196,7 @@ def test_gains_the_description_does_not_give_are_offered_to_it():
     """A URDF alone gives drive gains 1 (currents taken as N·m): where the runs determine gains far from 1, the report
     says so with the values to give; where the description gives gains, or the runs find 1, it says nothing more."""
     from dynid.identification.drive_gains import DriveGainEstimate, GainsAndPayload, PayloadEstimate
-    from dynid.report.summaries import drive_gains_blocks
+    from dynid.report.choice_tables import drive_gains_blocks
 
     payload = PayloadEstimate(("MX", "MY", "MZ", "M"), np.array([0.03, -0.001, 0.17, 2.8]), np.full(4, 0.001))
     k = np.array([np.nan, 11.83, 9.77, 10.27, 1.02, 10.30])

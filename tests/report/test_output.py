@@ -248,7 +248,7 @@ def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
 def test_a_cutoff_candidate_not_scored_shows_a_dash_not_inf():
     """A candidate whose folds could not be fitted is stored as null in results.json: the table shows "—" (it
     showed "inf" in every cell, under a title that said the cutoffs were chosen by cross-validation)."""
-    from dynid.report.summaries import filter_choice_table
+    from dynid.report.choice_tables import filter_choice_table
     from dynid.tables import render_text
 
     cv = {"chosen": 0, "candidates": [{"position_cutoff": 10.0, "parallel_cutoff": 10.0, "decimation": 39},

@@ -8,9 +8,9 @@ import math
 from pathlib import Path
 
 from ..fleet.identification import FleetResult
+from .fleet_summary import fleet_verdict
 from .identification_run import save_identification
 from .output import staged, write_results
-from .summaries import fleet_verdict
 
 __all__ = ["save_unit", "save_fleet"]
 

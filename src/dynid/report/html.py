@@ -366,7 +366,7 @@ def closed_loop_sections(d: dict) -> tuple[dict, list[Section]]:
         Setting -> value shown at the top.
     sections : list of Section
     """
-    from .summaries import closed_loop_study_rows, closed_loop_verdict
+    from .study_summaries import closed_loop_study_rows, closed_loop_verdict
 
     settings, _ = generic_sections(d)
     headers, rows, _ = closed_loop_study_rows(d)

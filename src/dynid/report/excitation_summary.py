@@ -1,0 +1,127 @@
+"""What ``dynid excite`` prints of a design (limits, margins, the cell's and the self clearances, MuJoCo's check), as
+blocks of :mod:`dynid.tables`; :func:`dynid.report.summaries.blocks` dispatches to it."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ..tables import Line, TextTable
+
+__all__ = ["excitation_blocks"]
+
+
+def excitation_blocks(run) -> list:
+    """What ``dynid excite`` prints: the design before and after, and the constraint margins.
+
+    Parameters
+    ----------
+    run : dynid.identification.excitation_run.ExcitationRun
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    d, p, c = run.design, run.config.problem, run.config
+    out: list = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
+                f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title"),
+           TextTable(f"Before / after (design grid of {p.grid_points} samples per period)", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
+                     ((f"initial: {c.initial_label}", f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),
+                      ("optimised", f"{d.cond:.2f}", f"{d.log_det:.2f}")))]
+    if d.initial_violations:
+        out.append(Line("the initial trajectory violates: " + "; ".join(
+            f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
+    else:
+        out.append(Line("the initial trajectory satisfies every constraint too (same limits for both)"))
+    out.append(Line(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
+                    f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)")
+                    + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
+                    + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s"))
+    rows = tuple((m.constraint, m.where, f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}",
+                  "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}") for m in d.margins)
+    out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
+                         ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
+    out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    free = p.unlimited_joints()
+    if free:
+        swing = ", ".join(f"J{j + 1} {run.q[:, j].min():.3g} to {run.q[:, j].max():.3g} rad" for j in free)
+        out.append(Line(f"no position limits on {', '.join(f'J{j + 1}' for j in free)} (continuous joints): the design "
+                        f"swings them about their offset within their velocity and acceleration limits only ({swing}); "
+                        "give q_min and q_max in [limits] to bound them", "warning"))
+    lifted = [m for m in d.margins if m.constraint.startswith("floor clearance")]
+    if lifted:
+        low = min(lifted, key=lambda m: m.worst)
+        out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
+                        f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
+                        f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
+    out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run)
+    relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
+    tight = min(relative, key=lambda m: m.relative) if relative else None
+    held = d.feasible
+    out.append(Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
+                    + ("every constraint holds" if held else "a constraint is violated (table above)")
+                    + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where}"), "title"))
+    if held:
+        out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
+                        "and currents, and dynid identify the log"))
+    return out
+
+
+def _self_clearance_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links come to each other
+    (:func:`dynid.excitation.collision.self_clearance`): a warning where their capsules overlap."""
+    c = getattr(run, "self_clearance", None)
+    if c is None:
+        return []
+    radius = run.config.problem.workspace.clearance
+    where = f"links {c.pair[0]} and {c.pair[1]} at t = {c.time:.3g} s"
+    if c.shapes:  # the URDF's own shapes, kept apart by the design
+        return [Line(f"the links' collision shapes stay {c.distance:.3g} m apart or more (closest: {c.shapes[0]} and "
+                     f"{c.shapes[1]} at t = {c.time:.3g} s; {c.pairs} pairs checked on the set-points)",
+                     "warning" if c.distance < 0 else "text")]
+    if c.distance < 0:
+        return [Line(f"links that can touch come within each other's {radius:g} m: their capsules overlap by "
+                     f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): the design does not "
+                     "avoid self-collision yet; check this pose on the robot (or in a simulator) before running it, or "
+                     "lower the amplitudes", "warning")]
+    return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:g} m capsules "
+                 f"(closest: {where}; {c.pairs} pairs checked on the set-points)")]
+
+
+def _cell_clearance_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links come to the cell's bodies at the set-points
+    (:func:`dynid.excitation.constraints.obstacle_margins`): a warning where a capsule reaches one."""
+    found = list(getattr(run, "cell_clearance", ()))
+    if not found:
+        return []
+    radius = run.config.problem.workspace.clearance
+    low = min(found, key=lambda m: m.worst)
+    if low.worst < 0:
+        return [Line(f"a link comes within {radius:g} m of the cell at a set-point: {low.where} (by {-low.worst:.3g} m, "
+                     "between the verification grid's samples): do not run it; raise design.grid_points", "warning")]
+    ws = run.config.problem.workspace
+    n = len(ws.obstacles)
+    what = (f"every link's {radius:g} m capsule stays {low.worst:.3g} m" if ws.geometry is None else
+            f"every link's collision shapes (of {Path(ws.geometry.source).name}; a mesh as its convex hull) stay "
+            f"{radius + low.worst:.3g} m")
+    beyond = "" if ws.geometry is None else f", {low.worst:.3g} m beyond the {radius:g} m clearance"
+    return [Line(f"{what} or more off the cell at the set-points{beyond} ({n} {'body' if n == 1 else 'bodies'}; "
+                 f"closest: {low.where})")]
+
+
+def _mujoco_lines(run) -> list:
+    """:func:`excitation_blocks`' line on the second check, MuJoCo's contacts at the set-points
+    (:func:`dynid.io.cell_replay.cell_contacts`)."""
+    ws = run.config.problem.workspace
+    if not ws.obstacles and not math.isfinite(ws.floor):
+        return []
+    found = getattr(run, "mujoco_contacts", None)
+    if found is None:
+        return [Line("the set-points were checked against the cell once: MuJoCo is not installed for the second check "
+                     "(pip install 'dynid[mujoco]')")]
+    if found.touching:
+        f = found.first
+        return [Line(f"MuJoCo finds link {f['link']} touching {f['body']} at t = {f['time']:.3g} s ({found.touching} of "
+                     f"{found.set_points} set-points, up to {found.deepest:.3g} m deep): do not run it", "warning")]
+    return [Line(f"checked again by MuJoCo: no link comes within the clearance of the cell or the floor on the "
+                 f"{found.set_points} set-points")]
