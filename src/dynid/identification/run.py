@@ -12,18 +12,17 @@ import numpy as np
 from ..checks import check_trajectory_array
 from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
-from ..io.datasets import (
+from ..io.dataset_specs import DatasetSpec
+from ..io.datasets import Recording, load_recording
+from ..io.identification_config import IdentificationConfig, stored_preprocessing
+from ..io.log_repairs import (
     GAP_FACTOR,
-    DatasetSpec,
-    Recording,
     check_position_steps,
-    load_recording,
     logged_velocities,
     resampled,
     uniform_rate,
     unwrapped_positions,
 )
-from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..keywords import keyword_only_after_data
 from ..model.description import builtin_robots
 from ..model.robot import Robot
@@ -631,7 +630,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
         Time stamps that do not increase, a gap longer than 5 median steps, or a position step no motion makes
-        (:func:`dynid.io.datasets.check_position_steps`).
+        (:func:`dynid.io.log_repairs.check_position_steps`).
     """
 
     t = np.asarray(t, dtype=float).reshape(-1)

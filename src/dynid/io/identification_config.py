@@ -80,7 +80,7 @@ from ..preprocessing.strategies import check_strategy
 from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
-from .datasets import DatasetSpec, SignalSpec, dataset_spec
+from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .tables import read_table
 from .trajectories import load_trajectory
 
