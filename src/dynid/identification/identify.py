@@ -127,6 +127,9 @@ class IdentificationResult:
     choices : ModelChoices or None
         What the data chose for :attr:`model` (:class:`dynid.identification.choices.ModelChoices`): set by
         :class:`dynid.identification.pipeline.IdentificationPipeline`, None where :func:`identify` is called alone.
+    sdp_refits : tuple of (n_base,) arrays
+        The physically consistent estimate refitted on all blocks of the log but one (``identify(jackknife=True)``);
+        empty otherwise.
     """
 
     robot: str
@@ -153,6 +156,7 @@ class IdentificationResult:
     main: str = ""
     drive_only: DriveOnly | None = None
     choices: Any = None
+    sdp_refits: tuple = ()
 
     @property
     def label(self) -> str:
@@ -233,7 +237,7 @@ class IdentificationResult:
 @keyword_only_after_data
 def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",), *,
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
-             observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
+             jackknife: bool = False, observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
     over its rows; check every estimate's physical consistency and give the verdict on the model.
 
@@ -264,6 +268,10 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         the physically consistent estimates by blocked cross-validation (:data:`HELD_OUT_FOLDS` contiguous blocks),
         and make the consistent one the main estimate when the least-squares one is not consistent and predicts the
         held-out blocks worse.
+    jackknife : bool
+        With ``sdp`` listed: refit the physically consistent estimate on every :data:`HELD_OUT_FOLDS` − 1 of the
+        contiguous blocks (:attr:`IdentificationResult.sdp_refits`), whose spread on the validation logs' states the
+        torque-free verdict weighs (:func:`dynid.identification.verdict.state_evidence`).
     observers : tuple of callable
         ``observer(index, y, tau, keep)`` called with every block of base rows of the one pass (what else needs them,
         e.g. the delay check of :mod:`dynid.identification.pipeline`).
@@ -302,7 +310,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
     estimation = Estimation(keys, problem, base.names, keep_rows=scored)
-    scoring = BlockScoring(robot, base, data, held_out=held_out and sdp, observers=observers)
+    scoring = BlockScoring(robot, base, data, held_out=(held_out or jackknife) and sdp, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
     stream_rows(chunks, estimation, base, scoring.add, standard=standard)
@@ -350,17 +358,16 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
     ls_label = estimate_label(ls_key)
-    if folds and not str(verdicts.get(ls_label, "yes")).startswith("yes"):  # the verdict's evidence on held-out blocks
-        if progress is not None:
-            progress("physically consistent SDP, held-out blocks", 0, 1)
-        own, held = _held_out_errors(robot, folds, row_weights)
-        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
+    inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
+    refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
+                                jackknife=jackknife, progress=progress)
     return choose_main_estimate(IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
         n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
                                                                   **_given_hyperparameters(hyperparameters)},
         warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
-        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative))
+        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
+        sdp_refits=refits))
 
 
 def _not_carried_note(names: tuple[str, ...]) -> list[str]:
@@ -584,13 +591,30 @@ def one_way_joints(data: PreparedData) -> list[int]:
     return out
 
 
-def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
+def _held_out_evidence(robot: Robot, base: BaseParameters, folds, row_weights, stats: dict, ls_label: str, *,
+                       held_out: bool, jackknife: bool, progress=None) -> tuple:
+    """What the held-out blocks say: with ``held_out``, the least-squares and SDP estimates' errors on them
+    (``stats["held_out_rms_error"]``); with ``jackknife``, the SDP refitted on all blocks but one (returned, base
+    parameters; empty otherwise)."""
+    if not folds or not (held_out or jackknife):
+        return ()
+    if progress is not None:
+        progress("physically consistent SDP, held-out blocks", 0, 1)
+    own, held, refitted = _held_out_errors(robot, folds, row_weights)
+    if held_out:
+        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
+    return tuple(base.base_from_standard(phi) for phi in refitted) if jackknife else ()
+
+
+def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float, list]:
     """RMS torque error on the held-out blocks of the unconstrained (OLS/WLS, minimum-norm over the standard
-    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others."""
+    parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others;
+    and the physically consistent estimate of each fold (standard parameters)."""
     p = robot.n_params
     links, nonneg = consistency_layout(robot)
     sse = np.zeros(2)
     rows = 0
+    fitted = []
     for k, held in enumerate(folds):
         rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
         reduced = rest.reduced(row_weights)
@@ -599,8 +623,9 @@ def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float]:
         est.fit(reduced[:, :p], reduced[:, p])
         sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
         rows += int(held.rows.sum())
+        fitted.append(est.params_)
     own, sdp = np.sqrt(sse / max(rows, 1))
-    return float(own), float(sdp)
+    return float(own), float(sdp), fitted
 
 
 def _step(progress, label: str):

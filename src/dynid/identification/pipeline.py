@@ -228,7 +228,7 @@ class IdentificationPipeline:
         return PreparedIdentification(robot, base, data, choices, variants)
 
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
-                 held_out: bool = False, recording=None):
+                 held_out: bool = False, recording=None, *, jackknife: bool = False):
         """Every estimator on the prepared data, the consistency checks and the verdict
         (:func:`dynid.identification.identify.identify`), then the closed-loop estimators.
 
@@ -244,6 +244,9 @@ class IdentificationPipeline:
             With ``sdp`` listed and no validation log to come: choose the estimate to trust on held-out blocks.
         recording : dynid.io.datasets.Recording, optional
             The log as read, which the closed-loop estimators simulate (needed with :attr:`closed_loop`).
+        jackknife : bool
+            Refit the SDP on all blocks of the log but one, for the torque-free verdict
+            (:func:`dynid.identification.identify.identify`).
 
         Returns
         -------
@@ -267,7 +270,7 @@ class IdentificationPipeline:
         check = _delay_checked(prepared.data)
         result = identify(prepared.robot, prepared.base, prepared.data, self.open_loop, references=references,
                           progress=progress, rng=self.seed,
-                          held_out=held_out,
+                          held_out=held_out, jackknife=jackknife,
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)
         findings, delay = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})

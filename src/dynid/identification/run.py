@@ -32,7 +32,8 @@ from ..processes import ForkedCall
 from ..threads import with_single_blas_thread
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
-from .verdict import choose_main_estimate, nominal_set
+from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
+from .verdict import choose_main_estimate, nominal_set, state_evidence
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -180,7 +181,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     # the drive gains need neither the identification nor its data: the second core computes them meanwhile
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
-        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw)
+        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw,
+                                   jackknife=validate and bool(config.validation) and config.choice == "states")
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
@@ -193,17 +195,23 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
 
     alt = result.drive_only if nominal is not None else None
     if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
-        from .identify import DRIVE_ONLY_LABEL
-
         sets[DRIVE_ONLY_LABEL] = alt.params
     scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress=progress,
                                          resolved=prepared.data.settings, noise=result.joint_std,
                                          covariance={result.label: result.solution.covariance})
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    yardstick = yardstick_scores(replace(config, robot=robot), base, sets, tuple(checked), resolved=prepared.data.settings,
-                                 reference=reference, progress=progress)
-    result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick), yardstick)
+    refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
+    yardstick = yardstick_scores(replace(config, robot=robot), base, {**sets, **refits}, tuple(checked),
+                                 resolved=prepared.data.settings, reference=reference, progress=progress)
+    states = None
+    if refits:  # [estimation] choice = "states": the verdict reads the validation logs' states, not their torques
+        assert nominal is not None
+        fallback = DRIVE_ONLY_LABEL if alt is not None and config.torque_sensor != "joint" else nominal[0]
+        states = state_evidence(yardstick, SDP_LABEL, fallback, tuple(refits), nominal[0])
+        for label in refits:
+            yardstick = tuple(v.without(label) for v in yardstick)
+    result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick, states=states), yardstick)
     return replace(result, findings=tuple(result.findings) + smooth)
 
 

@@ -41,7 +41,7 @@ from ..estimators.registry import estimate_label
 from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 from .estimates import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 
-__all__ = ["NOMINAL_KEY", "NOMINAL_LABEL", "choose_main_estimate", "nominal_set"]
+__all__ = ["NOMINAL_KEY", "NOMINAL_LABEL", "STATE_SIGMAS", "choose_main_estimate", "nominal_set", "state_evidence"]
 
 NOMINAL_KEY = "description"
 """The key of the description's nominal model's estimate when it is the main one."""
@@ -55,6 +55,54 @@ SAME_FIGURE = 1.02
 """Two mean validation errors within this ratio are the same figure for the choice: the physically consistent
 estimate (what ``dynid export`` writes) stays the main one where an inconsistent least-squares estimate predicts no
 better than this, so that the first line, the main estimate and the file exported name one estimate."""
+
+
+STATE_SIGMAS = 3.0
+"""With ``[estimation] choice = "states"``: the SDP is the main estimate where its predictions on the validation logs'
+states differ from the fallback's by more than this many times their own spread over refits on parts of the log
+(:func:`state_evidence`). Measured on the 4 real logs and 18 real windows (``benchmarks/torque_free.py``): any value
+from 2.3 to 3.5 keeps every main estimate within 2 % of the description or better; 3 is the middle, and the usual 3σ."""
+
+
+def state_evidence(comparisons, sdp: str, fallback: str, refits: tuple[str, ...], scale: str) -> dict:
+    """What the validation logs' states alone say of the SDP against a fallback (``[estimation] choice = "states"``):
+    the RMS difference of their predictions there, and the SDP's block-jackknife spread there (its refits on all blocks
+    of the identification log but one: ``sqrt((K-1)/K · Σ_k mean((P_k - P̄)²))``, the delete-one-block jackknife's
+    standard error; Efron & Tibshirani, *An Introduction to the Bootstrap*, 1993, §11), both in % of the ``scale``
+    set's RMS prediction, averaged over the logs by their samples. At rest, each prediction without its Coulomb-like
+    terms (what the one yardstick scores there is the distance to the static-friction band about it). No measured
+    torque is read.
+
+    Parameters
+    ----------
+    comparisons : sequence of TorqueComparison
+        The validation logs with ``sdp``, ``fallback``, ``refits`` and ``scale`` among their sets.
+    sdp, fallback : str
+        The two candidates' labels.
+    refits : tuple of str
+        The SDP refits' labels.
+    scale : str
+        The set whose RMS prediction is 100 % (the description's nominal model).
+
+    Returns
+    -------
+    dict
+        ``apart`` and ``spread`` [%], ``fallback``.
+    """
+    apart, spread, weight = [], [], []
+    for v in comparisons:
+        def pred(label):
+            centre = v.predicted[label] if v.centre is None else v.centre.get(label, v.predicted[label])
+            return v.predicted[label] if v.resting is None else np.where(v.resting, centre, v.predicted[label])
+
+        unit = 100.0 / max(float(np.sqrt(np.mean(pred(scale) ** 2))), 1e-12)
+        parts = np.array([pred(r) for r in refits])
+        k = len(refits)
+        spread.append(unit * np.sqrt((k - 1) / k * np.sum(np.mean((parts - parts.mean(axis=0)) ** 2, axis=(1, 2)))))
+        apart.append(unit * np.sqrt(np.mean((pred(sdp) - pred(fallback)) ** 2)))
+        weight.append(v.predicted[sdp].size)
+    return {"apart": float(np.average(apart, weights=weight)), "spread": float(np.average(spread, weights=weight)),
+            "fallback": fallback}
 
 
 def nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
@@ -86,7 +134,7 @@ def _mean_error(validations, label: str) -> float:
 
 
 def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, scored: tuple | None = None,
-                         judged: tuple | None = None):
+                         judged: tuple | None = None, states: dict | None = None):
     """The main estimate of an identification and, with validation logs, the verdict's findings on them (module
     docstring).
 
@@ -103,6 +151,9 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         The same sets scored on the one yardstick (:func:`dynid.identification.run.yardstick_scores`): where given,
         the choice weighs these figures, so that it does not depend on how the identification's settings filter the
         validation logs; default ``scored`` (and ``result.validations``).
+    states : dict, optional
+        :func:`state_evidence`: where given (``[estimation] choice = "states"``), the choice reads no validation torque:
+        the SDP where it stands :data:`STATE_SIGMAS` times its spread apart from the fallback, else the fallback.
 
     Returns
     -------
@@ -124,6 +175,21 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
                                                f"against {held[ls]:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
                                                "cross-validation)"))
         return replace(result, main=main, findings=tuple(findings + _drive_findings(result, main)))
+    if states is not None and nominal is not None and scored is not None:
+        result, chosen = _state_choice(result, nominal, scored, states)
+    else:
+        result, chosen = _torque_choice(result, main, rigid, nominal, scored, judged)
+    main = main if chosen is None else chosen[0]
+    if chosen is not None:
+        findings = [Finding("main", chosen[1])]
+    return _with_validation_findings(replace(result, main=main), findings, nominal)
+
+
+def _torque_choice(result, main: str, rigid: bool, nominal, scored, judged):
+    """The verdict on the validation logs' torques (:func:`choose_main_estimate`'s candidates 2-4): ``result`` (with
+    the drive-only or the nominal estimate among its estimates where chosen) and (label, finding), or None where the
+    first estimator listed stays."""
+    ls = result.label
     chosen: tuple[str, str] | None = None
     weighed = judged or result.validations
     avg = " on average, on one yardstick" if judged else " on average"  # the figures the choice weighed
@@ -144,16 +210,46 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         described, own = _mean_error(weighed, nominal[0]), _mean_error(weighed, main)
         if described < own and all(described < _mean_error(weighed, k) for k in result.estimates):
             result = _with_nominal(result, nominal)
-            main, chosen = nominal[0], (nominal[0], (
+            chosen = (nominal[0], (
                 f"main estimate: {nominal[0]}: keep your robot file's values, this log cannot improve them: the "
                 f"description's nominal model predicts the validation logs better than every estimate "
                 f"({_apart(described, own).replace(' against ', f' against {main} ')}{avg}); chosen on the "
                 "validation logs, so their "
                 "figures for it are not an independent test; what would improve it: a longer, richer excitation "
                 "(dynid excite) over the motions the robot will make"))
-    if chosen is not None:
-        findings = [Finding("main", chosen[1])]
-    return _with_validation_findings(replace(result, main=main), findings, nominal)
+    return result, chosen
+
+
+def _state_choice(result, nominal: tuple[str, np.ndarray], scored: tuple, states: dict):
+    """The torque-free verdict (``choose_main_estimate(states=...)``): ``result`` (with the chosen fallback among its
+    estimates, the evidence in its diagnostics) and (label, finding): the SDP, or the fallback (the description's
+    rigid body with the drive terms fitted on a motor-side log, the description itself on a joint torque sensor's)."""
+    apart, spread, fallback = states["apart"], states["spread"], states["fallback"]
+    ratio = apart / max(spread, 1e-12)
+    how = (f"chosen on the validation logs' states alone (estimation.choice = \"states\"), so their figures are an "
+           f"independent test: the SDP's predictions there differ from {fallback}'s by {apart:.3g} %, {ratio:.2g}× their "
+           f"own spread over refits on parts of this log ({spread:.3g} %")
+    if ratio > STATE_SIGMAS:
+        main, text = SDP_LABEL, (f"main estimate: {SDP_LABEL}, {how}; over {STATE_SIGMAS:g}×: the links this log found "
+                                 "are not the description's, beyond what it can tell)")
+    elif fallback == DRIVE_ONLY_LABEL and result.drive_only is not None:
+        alt = result.drive_only
+        margins, verdicts = consistency_checks(result.model, result.base, {DRIVE_ONLY_LABEL: alt.params})
+        result = replace(result, estimates={**result.estimates, DRIVE_ONLY_LABEL: Estimate(
+            DRIVE_ONLY_KEY, alt.params, alt.std, standard=alt.standard)}, fit=alt.fit, validations=scored,
+            consistency={**result.consistency, **margins}, consistency_verdicts={**result.consistency_verdicts, **verdicts})
+        main, text = DRIVE_ONLY_LABEL, (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive "
+                                        f"terms fitted to this log, {how}; within {STATE_SIGMAS:g}×: this log does not "
+                                        f"tell its links from the description's there){_held_note(alt.held, alt.undetermined)}")
+    else:
+        result = _with_nominal(result, nominal)
+        main, text = nominal[0], (f"main estimate: {nominal[0]}: keep your robot file's values, this log cannot improve "
+                                  f"them: {how}; within {STATE_SIGMAS:g}×: this log does not tell the links from the "
+                                  "description's there); what would improve them: a longer, richer excitation (dynid "
+                                  "excite) over the motions the robot will make")
+    evidence = {"apart_percent": apart, "spread_percent": spread, "ratio": ratio, "fallback": fallback,
+                "threshold": STATE_SIGMAS}
+    return replace(result, diagnostics={**result.diagnostics, "state_evidence": evidence}), (main, text)
 
 
 def _with_nominal(result, nominal: tuple[str, np.ndarray]):

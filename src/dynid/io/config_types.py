@@ -141,6 +141,10 @@ class EstimationTable(Table, kw_only=True):
     sdp_prior: Annotated[Literal["euclidean", "geometric"], _d("how sdp keeps what the data do not determine near the "
                                                                "nominal values: squared distance (default) or the "
                                                                "pseudo-inertias' log-det divergence (plausible links)")] | None = None
+    choice: Annotated[Literal["torques", "states"], _d(
+        "what chooses the main estimate among the SDP, the drive-only estimate and the description: the validation "
+        "logs' torques (default), or their states alone, so that their torques stay an independent test (needs sdp "
+        "among the estimators)")] | None = None
 
     def hyperparameters(self) -> dict[str, dict]:
         """The estimators' hyper-parameters this table sets (:func:`dynid.estimators.registry.with_hyperparameters`).

@@ -130,6 +130,11 @@ class IdentificationConfig:
         Closed-loop estimators asked for in ``[estimation] estimators`` (IDIM-IV, DIDIM), run beside the others.
     controller : tuple or None
         ``(Controller, reference DatasetSpec, feed-forward: bool)`` from ``[controller]``.
+    choice : str
+        ``[estimation] choice``: "torques", the main estimate chosen on the validation logs' torques; "states", on
+        their states alone (:func:`dynid.identification.verdict.choose_main_estimate`).
+    torque_sensor : str
+        The identification log's ``torques.sensor``: "joint" (a joint torque sensor on the link side) or "drive".
     """
 
     path: Path
@@ -149,6 +154,8 @@ class IdentificationConfig:
     mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
     closed_loop: tuple[str, ...] = ()  # IDIM-IV / DIDIM asked for, run beside the estimators
     controller: tuple | None = None  # (Controller, reference DatasetSpec, feed-forward) of [controller]
+    choice: str = "torques"  # [estimation] choice: the main estimate chosen on the validation logs' torques or states
+    torque_sensor: str = "drive"  # the identification log's torques.sensor: "joint" or "drive"
 
 
 REMOVED = {
@@ -327,6 +334,9 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
                           "controller: add a [controller] table (kp, kd, rate, the reference trajectory), or leave it out "
                           "(without the controller only the open-loop estimators can run)")
+    if e.choice == "states" and "sdp" not in estimators:
+        raise ConfigError(f"{path}: estimation.choice = \"states\" weighs the SDP's spread on the validation logs' "
+                          "states: add sdp to estimation.estimators, or leave choice out")
     refs = doc.get("references", [])
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
@@ -334,8 +344,15 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
                                 seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
                                 urdf=urdf, hyperparameters=e.hyperparameters(), closed_loop=closed_loop,
-                                controller=controller,
+                                controller=controller, choice=e.choice or "torques", torque_sensor=_torque_sensor(doc),
                                 mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
+
+
+def _torque_sensor(doc: dict) -> str:
+    """The identification log's ``torques.sensor`` ("drive" where not said)."""
+    table = doc.get("identification")
+    torques = table.get("torques") if isinstance(table, dict) else None
+    return "joint" if isinstance(torques, dict) and torques.get("sensor") == "joint" else "drive"
 
 
 JOINT_SENSOR_NOTE = ("a joint torque sensor on the link side of the gear (torques.sensor = \"joint\") measures no "
@@ -347,9 +364,7 @@ def _sensed_terms(robot: Robot, doc: dict, path: Path) -> Robot:
     "joint"`` (a joint torque sensor on the link side, e.g. a KUKA LBR's or a Franka's) no rotor inertia ``Ia``
     unless the config lists it in ``drive_terms`` itself, where it is said: the log's torque holds none, and a rotor
     inertia fitted to it takes up whatever else the log shows (issue "Never worse than the description", item 3)."""
-    table = doc.get("identification")
-    torques = table.get("torques") if isinstance(table, dict) else None
-    if not isinstance(torques, dict) or torques.get("sensor") != "joint" or "Ia" not in robot.drive_terms:
+    if _torque_sensor(doc) != "joint" or "Ia" not in robot.drive_terms:
         return robot
     own = doc.get("robot")
     given = isinstance(own, dict) and own.get("drive_terms") is not None
