@@ -52,12 +52,10 @@ def _config_path(name: str, window, folder: Path) -> tuple[Path, Path]:
 def _fold_variants(robot, base, recording, data, given, one_way) -> tuple:
     """:func:`dynid.identification.drive_only.preprocessing_variants`, each variant's rows split into the folds."""
     from dynid.estimators.accumulate import LeastSquaresAccumulator
-    from dynid.identification.drive_only import CUTOFF_FACTORS, prepared_variant
+    from dynid.identification.drive_only import CUTOFF_FACTORS, prepared_variant, variants_judge
     from dynid.preprocessing.pipeline import base_chunks
 
-    s = data.settings
-    if (not len(one_way) or not robot.drive_terms or not np.any(robot.inertial != 0) or s.strategy != "parallel"
-            or s.fourier is not None):
+    if not variants_judge(robot, data, one_way):
         return ()
     out = []
     for f in CUTOFF_FACTORS:

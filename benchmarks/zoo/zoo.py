@@ -312,6 +312,10 @@ def log_fitted_drive_terms(folder: Path, log: str, cutoff: float = 10.0, trim: f
     return out
 
 
+CHOICE: list[str] = []
+"""``--choice``: the ``[estimation] choice`` every config is written with (none: dynid's default)."""
+
+
 def config(folder: Path, n: int, ident: str, extra: str = "", valid: str = "valid.csv", truth: str = "truth.csv",
            sensor: bool = False) -> Path:
     cols = lambda a: "[" + ", ".join(str(a + j) for j in range(n)) + "]"  # noqa: E731
@@ -320,6 +324,7 @@ def config(folder: Path, n: int, ident: str, extra: str = "", valid: str = "vali
              f'torques = {{ columns = {cols(2 + n)}{side} }}\n')
     text = (f'data_root = "."\n[robot]\nurdf = "arm.urdf"\ndrive_terms = ["Ia", "fc", "fv", "offset"]\n'
             f'[identification]\n{table(ident)}[estimation]\nestimators = ["wls", "sdp"]\n'
+            + (f'choice = "{CHOICE[0]}"\n' if CHOICE else "") +
             f'[[validation]]\nname = "validation"\n{table(valid)}'
             f'[[references]]\nname = "truth"\nfile = "{truth}"\nformat = "standard"\nheader = true\nnames = "name"\n'
             'values = "value"\n[[references]]\nname = "nominal"\nformat = "nominal"\n' + extra)
@@ -460,7 +465,10 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--classes", default=",".join(CLASSES), help="comma-separated log classes to identify (every "
                         "class is simulated all the same, so a cell's log does not depend on this)")
+    parser.add_argument("--choice", choices=("torques", "states"), default=None,
+                        help="[estimation] choice of every config (default: not written, dynid's default)")
     args = parser.parse_args(argv)
+    CHOICE[:] = [args.choice] if args.choice else []
     out = Path(args.out)
     rows = []
     classes = tuple(c.strip() for c in args.classes.split(",") if c.strip())

@@ -31,7 +31,7 @@ from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 from .estimates import DRIVE_ONLY_KEY
 
-__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "prepared_variant", "preprocessing_variants"]
+__all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "prepared_variant", "preprocessing_variants", "variants_judge"]
 
 
 @dataclass(frozen=True)
@@ -95,9 +95,7 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
     tuple of (float, LeastSquaresAccumulator)
         Each factor with the rows its preparation gives, in ``base``'s layout.
     """
-    s = data.settings
-    if (not len(one_way) or not robot.drive_terms or not np.any(robot.inertial != 0) or s.strategy != "parallel"
-            or s.fourier is not None):
+    if not variants_judge(robot, data, one_way):
         return ()
     out = []
     for f in CUTOFF_FACTORS:
@@ -106,6 +104,25 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
             acc.add(y.reshape(-1, base.n_base), tau.reshape(-1), keep.reshape(-1))
         out.append((f, acc))
     return tuple(out)
+
+
+def variants_judge(robot: Robot, data: PreparedData, one_way) -> bool:
+    """Whether the preprocessing variants judge this log's drive terms (:func:`preprocessing_variants`): some joint moved
+    one way, the description has inertias and the robot drive terms, and the log was prepared by parallel filtering.
+
+    Parameters
+    ----------
+    robot : Robot
+    data : PreparedData
+    one_way : sequence of int
+
+    Returns
+    -------
+    bool
+    """
+    s = data.settings
+    return bool(len(one_way) and robot.drive_terms and np.any(robot.inertial != 0) and s.strategy == "parallel"
+                and s.fourier is None)
 
 
 def prepared_variant(recording, data: PreparedData, given: Preprocessing, factor: float) -> PreparedData:
