@@ -32,7 +32,18 @@ def coulomb_offset_pairs(names) -> tuple[tuple[int, int], ...]:
     return tuple((i, where[("offset", j)]) for (term, j), i in where.items() if term == "fc" and ("offset", j) in where)
 
 
-class OrdinaryLeastSquares(AccumulatingEstimator):
+class _LeastSquares(AccumulatingEstimator):
+    """What OLS and WLS share: their hyper-parameters (``rcond``, the prior of the directions the rows leave open and
+    the stated σ of some parameters); the problem's ``n_dof`` as scikit-learn's estimators take it."""
+
+    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
+        self.n_dof = n_dof
+        self.rcond = rcond
+        self.base_prior = base_prior
+        self.base_prior_std = base_prior_std
+
+
+class OrdinaryLeastSquares(_LeastSquares):
     """OLS: ``params_ = argmin ||tau - W p||²``.
 
     Parameters
@@ -82,12 +93,6 @@ class OrdinaryLeastSquares(AccumulatingEstimator):
     robots", IJRR 11(4), 1992 (σ of the estimates).
     """
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
-        self.n_dof = n_dof
-        self.rcond = rcond
-        self.base_prior = base_prior
-        self.base_prior_std = base_prior_std
-
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
         sol = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=coulomb_offset_pairs(names),
@@ -122,7 +127,7 @@ def _set_solution(est, sol) -> None:
     est.residual_std_ = sol.residual_std
 
 
-class WeightedLeastSquares(AccumulatingEstimator):
+class WeightedLeastSquares(_LeastSquares):
     """WLS with one weight per joint: each joint's rows are divided by that joint's residual standard
     deviation from a first OLS fit.
 
@@ -159,12 +164,6 @@ class WeightedLeastSquares(AccumulatingEstimator):
     """
 
     needs_joints = True
-
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
-        self.n_dof = n_dof
-        self.rcond = rcond
-        self.base_prior = base_prior
-        self.base_prior_std = base_prior_std
 
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
