@@ -221,3 +221,37 @@ def test_the_last_trajectorys_poses_are_reused_only_for_that_trajectory(ur10e_wi
         pose = kept.transforms(robot, q)
         np.testing.assert_array_equal(pose(3, 2).getTranslation(), fresh.poses(robot, q)[1][3, 2])
     assert kept.memo["last"]["key"][2] == two.tobytes()
+
+
+def test_the_same_arm_as_mjcf_has_the_same_shapes_where_it_matters(ur10e_with_meshes, tmp_path, rng):
+    """The URDF with its meshes read by MuJoCo and saved as MJCF (what a MuJoCo user holds): its collision geoms,
+    read through MuJoCo, measure the distances the URDF's, read through Pinocchio, measure, wherever a shape is near
+    the body (far away each stands by its own bounding sphere: MuJoCo moves a mesh's frame to its centre of mass)."""
+    import shutil
+
+    import mujoco
+
+    from dynid.excitation.link_geometry import link_geometry_from_mjcf
+
+    text = ur10e_with_meshes.read_text()
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    for name in set(re.findall(r"package://ur_e_description/meshes/ur10e/collision/(\w+\.stl)", text)):
+        shutil.copy(ur10e_with_meshes.parents[1] / "meshes" / "ur10e" / "collision" / name, meshes / name)
+    flat = re.sub(r'filename="package://[^"]*/([^"/]+)"', r'filename="\1"', text)
+    flat = re.sub(r"(<robot\b[^>]*>)", rf'\1<mujoco><compiler meshdir="{meshes}" discardvisual="true" '
+                  'fusestatic="false" balanceinertia="true"/></mujoco>', flat, count=1)
+    mujoco.mj_saveLastXML(str(tmp_path / "ur10e.xml"), mujoco.MjModel.from_xml_string(flat))
+    robot_u, robot_m = load_robot(ur10e_with_meshes), load_robot(tmp_path / "ur10e.xml")
+    from_urdf = link_geometry_from_urdf(robot_u, ur10e_with_meshes)
+    from_mjcf = link_geometry_from_mjcf(robot_m, tmp_path / "ur10e.xml")
+    assert sorted(from_urdf.link.tolist()) == sorted(from_mjcf.link.tolist())
+    ball = Obstacle("sphere", np.array([0.2]), np.array([0.4, 0.3, 0.6]), name="ball")
+    q = rng.uniform(-2.5, 2.5, (300, robot_u.n_dof))
+    near = []
+    for geometry, robot in ((from_urdf, robot_u), (from_mjcf, robot_m)):
+        found = Workspace(clearance=0.0, obstacles=(ball,), geometry=geometry).cell_distances(robot, q).distance
+        near.append(np.sort(found, axis=1)[:, 0])
+    close = (near[0] < FAR) & (near[1] < FAR)
+    assert close.sum() >= 10
+    np.testing.assert_allclose(near[1][close], near[0][close], atol=1e-6)
