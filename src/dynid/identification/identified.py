@@ -173,6 +173,29 @@ class IdentifiedModel:
     preprocessing: Preprocessing | None = None
     results: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return (f"IdentifiedModel(robot={self.robot.name!r}, {self.robot.n_dof} joints, {len(self.base.names)} base "
+                f"parameters, estimates={list(self.estimates)}, main={self.label()!r})")
+
+    def summary(self, estimate: str | None = None) -> str:
+        """What :func:`repr` says and an estimate's base parameters (name, value, σ, unit).
+
+        Parameters
+        ----------
+        estimate : str, optional
+            A label or key of :attr:`estimates` (default the main one).
+
+        Returns
+        -------
+        str
+
+        Raises
+        ------
+        ConfigError
+            An estimate the model does not hold.
+        """
+        return f"{self!r}\n{self.parameters(estimate)!r}"
+
     def label(self, estimate: str | None = None) -> str:
         """The label of an estimate.
 

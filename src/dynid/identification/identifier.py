@@ -249,6 +249,22 @@ class Identifier(HyperParameters):
                                  "first")
         return self.model_
 
+    def summary(self) -> str:
+        """The fitted identification in a few lines (:meth:`IdentificationResult.summary
+        <dynid.identification.identify.IdentificationResult.summary>`).
+
+        Returns
+        -------
+        str
+
+        Raises
+        ------
+        NotFittedError
+            Before :meth:`fit` or :meth:`from_config`.
+        """
+        self._model()
+        return self.result_.summary()
+
     def parameters(self, estimate: str | None = None):
         """The base parameters of an estimate by name, with σ where the estimator gives it.
 

@@ -10,6 +10,7 @@ on the model (:mod:`dynid.validation.diagnostics`). Validation on other logs is
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -44,6 +45,7 @@ from ..validation.diagnostics import (
 from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
+from .identified import Parameters
 from .verdict import choose_main_estimate
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
@@ -167,6 +169,27 @@ class IdentificationResult:
     def main_estimate(self) -> Estimate:
         """The estimate to trust (:attr:`main`)."""
         return self.estimates[self.main or estimate_label(self.estimators[0])]
+
+    def __repr__(self) -> str:
+        main = self.main or estimate_label(self.estimators[0])
+        fit = self.fit.metrics().get(main, {}).get("global_relative_error") if self.fit is not None else None
+        valid = [v.metrics()[main]["global_relative_error"] for v in self.validations if main in v.metrics()]
+        parts = [f"robot={self.robot!r}", f"main={main!r}", f"estimates={list(self.estimates)}", f"rows={self.n_rows}"]
+        parts += [f"fit {fit:.3g} %"] if fit is not None else []
+        parts += [f"validation {np.mean(valid):.3g} % ({len(valid)} log{'s' * (len(valid) != 1)})"] if valid else []
+        return f"IdentificationResult({', '.join(parts)}, {len(self.findings)} findings)"
+
+    def summary(self) -> str:
+        """A few lines: what :func:`repr` says, the verdict's first findings and the main estimate's base parameters
+        (the terminal's whole text: :func:`dynid.report.summaries.summary`).
+
+        Returns
+        -------
+        str
+        """
+        main = self.main_estimate
+        findings = [textwrap.fill(f.text, 100, initial_indent="  ", subsequent_indent="    ") for f in self.findings[:3]]
+        return "\n".join([repr(self), *findings, repr(Parameters(self.base.names, main.params, main.std))])
 
     def parameter_sets(self) -> dict:
         """Every parameter set compared: dynid's estimates, then each reference set.
