@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -44,11 +44,11 @@ from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..extras import require
 from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
-from ..identification.identify import identify
+from ..identification.pipeline import IdentificationPipeline
 from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import Preprocessing, prepare
+from ..preprocessing.pipeline import Preprocessing
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from ..threads import with_single_blas_thread
 from .paper import PaperExperimentConfig, identification_trajectory
@@ -245,7 +245,9 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     if open_keys:
         seed = int(np.random.default_rng([cfg.seed, 21, cell, realisation]).integers(2**31))
         try:
-            result = identify(setup.robot, setup.base, prepare(log, settings), cfg.open_loop, rng=seed)
+            pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False),
+                                              estimators=tuple(cfg.open_loop), seed=seed)  # the settings as given
+            result = pipeline.estimate(pipeline.prepare(log, setup.base))
         except DynIdError as exc:
             errors.update({k: str(exc) for k in open_keys})
         else:
