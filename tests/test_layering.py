@@ -110,4 +110,4 @@ def test_studies_and_fleet_stand_apart():
 
 def test_the_import_resolver_sees_relative_imports():
     found = dict(_imports_of("studies"))
-    assert "dynid.identification.identify" in set(m for _, m in _imports_of("studies")), found
+    assert "dynid.identification.pipeline" in set(m for _, m in _imports_of("studies")), found
