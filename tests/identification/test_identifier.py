@@ -279,6 +279,6 @@ def test_every_fitted_object_has_a_short_repr_and_a_summary(tmp_path):
     table = repr(ident.parameters_)
     for text in (ident.summary(), ident.result_.summary(), ident.model_.summary()):
         assert table in text and max(len(r) for r in text.splitlines()) <= 200
-    assert ident.model_.summary("dynid OLS").startswith(repr(ident.model_))
+    assert ident.model_.summary(estimate="dynid OLS").startswith(repr(ident.model_))
     with pytest.raises(NotFittedError):
         Identifier().summary()

@@ -177,7 +177,7 @@ class IdentifiedModel:
         return (f"IdentifiedModel(robot={self.robot.name!r}, {self.robot.n_dof} joints, {len(self.base.names)} base "
                 f"parameters, estimates={list(self.estimates)}, main={self.label()!r})")
 
-    def summary(self, estimate: str | None = None) -> str:
+    def summary(self, *, estimate: str | None = None) -> str:
         """What :func:`repr` says and an estimate's base parameters (name, value, σ, unit).
 
         Parameters
