@@ -309,7 +309,6 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     q = np.atleast_2d(np.asarray(q, dtype=float))
     pairs = ([(g, i) for g in np.flatnonzero(geometry.link >= 0).tolist() for i in range(len(obstacles))]
              if pairs is None else list(pairs))
-    rotation, position = geometry.poses(robot, q)
     bodies = [ob.geometry() for ob in obstacles]
     centre, radius = geometry.spheres(robot, q)
     g_of, i_of = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
@@ -401,7 +400,6 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
         ``pairs`` as given; ``links`` the first shape's link of each.
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
-    rotation, position = geometry.poses(robot, q)
     centre, radius = geometry.spheres(robot, q)
     a, b = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
     gap = centre[:, b] - centre[:, a]  # (N, P, 3)
