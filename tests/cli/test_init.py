@@ -1,5 +1,6 @@
 """dynid init: a starter config from a URDF and a log, which dynid identify then runs on as it stands."""
 
+import tomllib
 from importlib import resources
 from pathlib import Path
 
@@ -12,6 +13,11 @@ from .refusals import assert_refused
 from .refusals import dynid as run
 
 URDF = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+
+
+def _identification(text: str) -> dict:
+    """The ``[identification]`` table of a config's text."""
+    return tomllib.loads(text)["identification"]
 
 
 def _log(folder: Path, header: bool) -> Path:
@@ -31,8 +37,10 @@ def test_init_detects_the_columns_by_header_and_identify_runs_on_the_config(tmp_
     p = run("init", str(URDF), str(log), "--out", "arm.toml")
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "cfg" / "arm.toml").read_text()
-    assert 'positions = { columns = ["joint_pos_1", "joint_pos_2"' in text and 'torques = { columns = ["effort[0]"' in text
-    assert 'time = { column = "time" }' in text and 'data_root = "../logs"' in text
+    ident = _identification(text)
+    assert ident["positions"]["columns"][:2] == ["joint_pos_1", "joint_pos_2"]
+    assert ident["torques"]["columns"][0] == "effort[0]"
+    assert ident["time"] == {"column": "time"} and tomllib.loads(text)["data_root"] == "../logs"
     p = run("identify", "arm.toml", "--out", "id", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "cfg" / "id" / "results.json").is_file()
@@ -62,8 +70,9 @@ def test_init_without_a_header_takes_blocks_of_columns(tmp_path):
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "arm.toml").read_text()
-    assert "time = { column = 1 }" in text and "positions = { columns = [2, 3, 4, 5, 6, 7] }" in text
-    assert "torques = { columns = [8, 9, 10, 11, 12, 13] }" in text and "no header: column 1 taken as time" in p.stdout
+    ident = _identification(text)
+    assert ident["time"] == {"column": 1} and ident["positions"]["columns"] == [2, 3, 4, 5, 6, 7]
+    assert ident["torques"]["columns"] == [8, 9, 10, 11, 12, 13] and "no header: column 1 taken as time" in p.stdout
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
 
@@ -143,9 +152,10 @@ def test_init_reads_a_plotjuggler_export_of_joint_states_in_the_urdfs_joint_orde
     p = run("init", str(URDF), str(tmp_path / "logs" / "joint_states.csv"), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "arm.toml").read_text()
-    assert 'time = { column = "__time" }' in text
-    assert ('positions = { columns = ["/joint_states/shoulder_pan_joint/position", '
-            '"/joint_states/shoulder_lift_joint/position", "/joint_states/elbow_joint/position"') in text
+    assert _identification(text)["time"] == {"column": "__time"}
+    assert _identification(text)["positions"]["columns"][:3] == [
+        "/joint_states/shoulder_pan_joint/position", "/joint_states/shoulder_lift_joint/position",
+        "/joint_states/elbow_joint/position"]
     assert "taken in the URDF's joint order" in " ".join(p.stdout.split())
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
@@ -241,7 +251,7 @@ def test_init_reads_a_rostopic_export_with_nanosecond_time_stamps(tmp_path):
     (tmp_path / "js.csv").write_text("\n".join([",".join(header), *rows]) + "\n")
     p = run("init", str(URDF), str(tmp_path / "js.csv"), "--out", str(tmp_path / "ros.toml"))
     assert p.returncode == 0, p.stderr
-    assert 'time = { column = "%time", unit = "ns" }' in (tmp_path / "ros.toml").read_text()
+    assert _identification((tmp_path / "ros.toml").read_text())["time"] == {"column": "%time", "unit": "ns"}
     p = run("identify", str(tmp_path / "ros.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     results = json.loads((tmp_path / "id" / "results.json").read_text())
@@ -258,7 +268,7 @@ def test_init_reads_a_log_saved_by_numpy_with_its_header_as_a_comment(tmp_path):
     assert (tmp_path / "run.csv").read_text().startswith("# time,q1")
     p = run("init", str(URDF), str(tmp_path / "run.csv"), "--out", str(tmp_path / "np.toml"))
     assert p.returncode == 0, p.stderr
-    assert 'time = { column = "time" }' in (tmp_path / "np.toml").read_text()
+    assert _identification((tmp_path / "np.toml").read_text())["time"] == {"column": "time"}
     p = run("identify", str(tmp_path / "np.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "id" / "results.json").is_file()
@@ -286,7 +296,7 @@ def test_init_takes_a_rostopic_export_in_the_urdfs_joint_order_by_its_name_colum
     text = (tmp_path / "alphabetical.toml").read_text()
     assert "the log names its joints in field.name0" in p.stdout.replace("\n", " ")
     shuffled = sorted(range(6), key=lambda j: joints[j])
-    assert 'positions = { columns = [' + ", ".join(f'"field.position{shuffled.index(j)}"' for j in range(6)) in text
+    assert _identification(text)["positions"]["columns"] == [f"field.position{shuffled.index(j)}" for j in range(6)]
     plain, alpha = (load_identification_config(tmp_path / f"{n}.toml") for n in ("urdf", "alphabetical"))
     a, b = (load_recording(c.identification, c.robot) for c in (plain, alpha))
     np.testing.assert_array_equal(np.asarray(a.q), np.asarray(b.q))
@@ -310,7 +320,7 @@ def test_init_sums_a_time_stamp_split_into_seconds_and_nanoseconds(tmp_path):
     p = run("init", str(URDF), str(tmp_path / "js.csv"), "--out", str(tmp_path / "ros.toml"))
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "ros.toml").read_text()
-    assert 'time = { column = "header.stamp.sec", nanoseconds = "header.stamp.nanosec" }' in text
+    assert _identification(text)["time"] == {"column": "header.stamp.sec", "nanoseconds": "header.stamp.nanosec"}
     p = run("identify", str(tmp_path / "ros.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     results = json.loads((tmp_path / "id" / "results.json").read_text())
@@ -376,7 +386,7 @@ def test_init_never_takes_a_commanded_column_for_a_measured_signal(tmp_path, sty
     p = run("init", str(URDF), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "arm.toml").read_text()
-    assert "positions = { columns = [" + ", ".join(f'"{c}"' for c in measured) + "] }" in text
+    assert _identification(text)["positions"]["columns"] == measured
     assert f"# commanded, never taken for a measured signal: {cmd[0]}" in text
 
 
@@ -392,7 +402,7 @@ def test_init_asks_which_side_of_the_gear_measured_the_torques(tmp_path):
     assert p.returncode == 0, p.stderr
     text = (tmp_path / "arm.toml").read_text()
     assert SENSOR_HINT in text and text.index(SENSOR_HINT) > text.index("torques = {")
-    joint = text.replace("] }\n" + SENSOR_HINT, '], sensor = "joint" }\n' + SENSOR_HINT)
+    joint = text.replace("]}\n" + SENSOR_HINT, '], sensor = "joint"}\n' + SENSOR_HINT)
     assert tomllib.loads(joint)["identification"]["torques"]["sensor"] == "joint"
 
 
@@ -452,3 +462,23 @@ def test_only_arms_with_joint_torque_sensors_are_inferred_so():
     other = ["ur10e", "kinova", "j2s6s200", "gen3_lite", "gen3-lite", "xarm7", "staubli_tx40"]
     assert [n for n in sensed if not JOINT_SENSED.search(n)] == []
     assert [n for n in other if JOINT_SENSED.search(n)] == []
+
+
+def test_init_writes_any_path_as_a_toml_string_and_identify_reads_it(tmp_path):
+    """A log's folder and name holding a quote and a backslash: init wrote them unescaped (invalid TOML that identify
+    refused); tomlkit now writes every string escaped, so the config reads back the paths as they are."""
+    log = _log(tmp_path, header=True)
+    odd = tmp_path / 'we"ird\\logs'
+    odd.mkdir()
+    moved = log.rename(odd / 'run "1"\\a.csv')
+    other = odd / "other.csv"
+    other.write_bytes(moved.read_bytes())
+    p = run("init", str(URDF), str(moved), str(other), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    doc = tomllib.loads((tmp_path / "arm.toml").read_text())
+    assert doc["data_root"] == 'we"ird\\logs' and doc["identification"]["file"] == 'run "1"\\a.csv'
+    assert doc["validation"] == [{"name": "other", "file": "other.csv"}]
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    rec = dynid.load_recording(moved, dynid.load_robot(URDF))  # a log's path alone: its columns found as init finds them
+    assert np.asarray(rec.q).shape[1] == 6

@@ -8,6 +8,9 @@ import json
 import re
 from pathlib import Path
 
+import tomlkit
+from tomlkit.items import InlineTable, Table
+
 from ..conventions import time_unit_of
 from ..exceptions import DataError
 from .files import text_encoding_hint
@@ -15,8 +18,8 @@ from .tables import is_data_line
 
 
 def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,
-              rate: float | None = None) -> tuple[list[str], list[str]]:
-    """A CSV log's dataset table (TOML lines) with its columns detected, and what was detected.
+              rate: float | None = None) -> tuple[Table, list[str]]:
+    """A CSV log's dataset table with its columns detected, and what was detected.
 
     Parameters
     ----------
@@ -32,8 +35,9 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
 
     Returns
     -------
-    table : list of str
-        The ``[identification]`` table's lines.
+    table : tomlkit.items.Table
+        The ``[identification]`` table, with comments (tomlkit writes its strings escaped, whatever the log's file
+        and column names hold).
     notes : list of str
         What was detected, one line each.
 
@@ -49,9 +53,10 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
     n_columns = len(first)
     notes: list[str] = [f"{log.name}: {n_columns} columns separated by {_named(delimiter)}, "
                         + ("a header line" if header else "no header line")]
-    table = [f'file = "{log.name}"']
+    table = tomlkit.table()
+    table.add("file", log.name)
     if delimiter != ",":
-        table.append(f'delimiter = "{delimiter}"' if delimiter != "\t" else 'delimiter = "\\t"')
+        table.add("delimiter", delimiter)
     if header:
         found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
         if "time" not in found and rate is None:
@@ -64,19 +69,17 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
             raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
                             f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
         notes += order_notes
-        time_table, time_notes, taken = (_time_lines(first, found["time"][0], [split(line) for line in lines[1:]])
-                                         if "time" in found else _rate_lines(float(rate or 0.0)))
-        table += ["header = true", *time_table]
+        table.add("header", True)
+        time_notes, taken = (_time_entry(table, first, found["time"][0], [split(line) for line in lines[1:]])
+                             if "time" in found else _rate_entry(table, float(rate or 0.0)))
         notes += time_notes
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
-                table.append(f"{kind} = {{ columns = [" + ", ".join(f'"{c}"' for c in found[kind][:n_dof]) + "] }")
+                table.add(kind, _inline(columns=found[kind][:n_dof]))
                 notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
                 taken += found[kind][:n_dof]
                 if kind == "torques":  # a log cannot tell which side of the gear measured them: the arm may
-                    lines_, said = _torque_sensor(table.pop(), urdf)
-                    table += lines_
-                    notes += said
+                    notes += _torque_sensor(table, urdf)
         left = [c for c in first if c not in taken]
         extra = [c for c in left if _kind(c) in ("positions", effort)]
         if extra:
@@ -85,13 +88,15 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         elif left:
             notes.append(f"left: {', '.join(left)}")
     elif n_columns == 31 and n_dof == 6:
-        table = ['preset = "ur-rtde"', f'file = "{log.name}"']
+        table = tomlkit.table()
+        table.add("preset", "ur-rtde")
+        table.add("file", log.name)
         notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\"")
     elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
         blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
-        table += ["time = { column = 1 }"]
+        table.add("time", _inline(column=1))
         for b, kind in enumerate(blocks):
-            table.append(f"{kind} = {{ columns = [" + ", ".join(str(2 + b * n_dof + j) for j in range(n_dof)) + "] }")
+            table.add(kind, _inline(columns=[2 + b * n_dof + j for j in range(n_dof)]))
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
     else:
         fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
@@ -226,10 +231,19 @@ def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str
     return found, notes
 
 
-def _rate_lines(rate: float) -> tuple[list[str], list[str], list[str]]:
-    """The dataset's lines, the notes and the columns taken for a log without a time column at ``--rate``."""
-    return ([f"rate = {rate!r}                     # Hz: no time column (--rate)"],
-            [f"no time column: one sample every 1/{rate:g} s (--rate)"], [])
+def _inline(**entries) -> InlineTable:
+    """A TOML inline table of the entries (``{ columns = [...] }``)."""
+    table = tomlkit.inline_table()
+    table.update(entries)
+    return table
+
+
+def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
+    """``rate`` added to a dataset's table for a log without a time column at ``--rate``; the notes and the columns
+    taken."""
+    table.add("rate", rate)
+    table["rate"].comment("Hz: no time column (--rate)")
+    return [f"no time column: one sample every 1/{rate:g} s (--rate)"], []
 
 
 def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
@@ -252,16 +266,20 @@ LBR Med, Franka Emika's Panda and FR3, Kinova's Gen3 (in a URDF's robot name or 
 arms: the Gen3 lite has no joint torque sensors, and a Jaco's logs are usually its motor currents."""
 
 
-def _torque_sensor(line: str, urdf: Path) -> tuple[list[str], list[str]]:
-    """The torques' table line with ``sensor = "joint"`` where the URDF names an arm of :data:`JOINT_SENSED` (and the
-    comment that says so and how to undo it), else the line and :data:`SENSOR_HINT`; and the note for the header."""
+def _torque_sensor(table: Table, urdf: Path) -> list[str]:
+    """``sensor = "joint"`` added to a dataset's torques where the URDF names an arm of :data:`JOINT_SENSED`, with the
+    comment that says so and how to undo it, else :data:`SENSOR_HINT` under them; the note for the header."""
     named = next((n for n in (_robot_name(urdf), urdf.stem) if n and JOINT_SENSED.search(n)), None)
     if named is None:
-        return [line, SENSOR_HINT], []
+        table.add(tomlkit.comment(SENSOR_HINT[2:]))
+        return []
     why = (f'sensor = "joint" inferred from the name "{named}" in {urdf.name}: an arm with joint torque sensors on the '
            "link side of its gears, whose torques hold no rotor inertia")
-    return [line[: -len(" }")] + ', sensor = "joint" }',
-            f'# {why}; write sensor = "drive" if these are motor currents or a motor-side torque'], [why]
+    torques = table["torques"]
+    assert isinstance(torques, InlineTable)  # added by csv_table
+    torques["sensor"] = "joint"
+    table.add(tomlkit.comment(f'{why}; write sensor = "drive" if these are motor currents or a motor-side torque'))
+    return [why]
 
 
 def _robot_name(urdf: Path) -> str | None:
@@ -292,18 +310,18 @@ def _found_columns(first: list[str], row: list[str], joints: tuple[str, ...], n_
     return found, notes + _in_named_order(found, first, row, joints)
 
 
-def _time_lines(first: list[str], column: str, rows: list[list[str]]) -> tuple[list[str], list[str], list[str]]:
-    """The dataset table's ``time`` line, what was detected, and the columns taken: a time stamp split into whole
+def _time_entry(table: Table, first: list[str], column: str, rows: list[list[str]]) -> tuple[list[str], list[str]]:
+    """``time`` added to a dataset's table; what was detected, and the columns taken: a time stamp split into whole
     seconds and nanoseconds (ROS's ``header.stamp.sec`` and ``.nanosec``) is one time of two columns; a single column's
     unit is told from its steps."""
     split_stamp = _seconds_and_nanoseconds(first)
     if split_stamp is not None:
         seconds, nanoseconds = split_stamp
-        return ([f'time = {{ column = "{seconds}", nanoseconds = "{nanoseconds}" }}'],
-                [f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)"], [seconds, nanoseconds])
+        table.add("time", _inline(column=seconds, nanoseconds=nanoseconds))
+        return [f"time stamps: {seconds} + {nanoseconds} (whole seconds and nanoseconds, summed)"], [seconds, nanoseconds]
     unit = _time_unit(rows, first.index(column))
-    return ([f'time = {{ column = "{column}"' + (f', unit = "{unit}" }}' if unit else " }")],
-            [f"time stamps: {column} steps as a controller's in {unit}: unit = \"{unit}\""] if unit else [], [column])
+    table.add("time", _inline(column=column, **({"unit": unit} if unit else {})))
+    return [f"time stamps: {column} steps as a controller's in {unit}: unit = \"{unit}\""] if unit else [], [column]
 
 
 def _first_lines(log: Path) -> tuple[list[str], str]:

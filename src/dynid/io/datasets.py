@@ -4,7 +4,6 @@ applied on the way (:func:`load_recording`)."""
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -80,7 +79,7 @@ def _detected(log: Path, robot: Robot) -> DatasetSpec:
     if not log.is_file():
         raise DataError(f"{log}: no such log")
     table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints))
-    return dataset_spec(tomllib.loads("\n".join(table)), log.parent, str(log), log.stem, robot.n_dof)
+    return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, robot.n_dof)
 
 
 @keyword_only_after_data

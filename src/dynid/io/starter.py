@@ -13,11 +13,12 @@ config, to check before identifying.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
 import numpy as np
+import tomlkit
+from tomlkit.items import Table
 
 from ..exceptions import ConfigError, DataError
 from ..model.description import URDF_DRIVE_TERMS
@@ -75,8 +76,11 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         raise DataError(f"{(set(validation) - set(bags) or set(bags)).pop()}: the validation logs and {log.name} must be "
                         "of one kind (all ROS 2 bags or all CSV logs): they share the identification's reader")
     if _is_bag(log):
-        table = [f'bag = "{log.name}"                   # a ROS 2 bag: sensor_msgs/JointState on /joint_states',
-                 '# topic = "/joint_states"', '# effort = "torques"               # or "currents" (through the drive gains)']
+        table = tomlkit.table()
+        table.add("bag", log.name)
+        table["bag"].comment("a ROS 2 bag: sensor_msgs/JointState on /joint_states")
+        table.add(tomlkit.comment('topic = "/joint_states"'))
+        table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
         return _config(urdf, log, out, validation, table, said, held), said
@@ -108,33 +112,46 @@ def _bag_read(bag: Path, robot) -> str:
     return line
 
 
-def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: list[str], notes: list[str],
+def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str],
             held: tuple[str, ...] = ()) -> str:
-    """The config's text: what was detected in comments, the robot (a table where joints are held), the dataset
-    table, the validation logs."""
-    root = f'data_root = "{_relative(log.parent, out.parent)}"'
-    robot = [f'robot = "{_relative(urdf, out.parent)}"', root] if not held else [  # a key before the first table
-        root, "", "[robot]", f'urdf = "{_relative(urdf, out.parent)}"',
-        f"held = [{', '.join(json.dumps(h) for h in held)}]   # not the arm's joints: held fixed at 0",
-        f"drive_terms = [{', '.join(json.dumps(t) for t in URDF_DRIVE_TERMS)}]"]
-    return "\n".join([
-        "# dynid identification config, written by dynid init: check the columns and units below, then",
-        "#   dynid identify THIS_FILE",
-        *(f"# {n}" for n in notes),
-        *robot,
-        "",
-        "[identification]",
-        *table,
-        "",
-        *([line for v in validation for line in ("[[validation]]                    # the identification's reader",
-                                                   f'name = "{v.stem}"',
-                                                   f'{"bag" if _is_bag(v) else "file"} = "{_relative(v, log.parent)}"', "")]
-          or ["# [[validation]]                  # other logs, same layout, to check the model where it was not fitted",
-              '# name = "second_run"', '# file = "second_run.csv"', ""]),
-        "# [estimation]",
-        '# estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export',
-        "",
-    ])
+    """The config's text, written by tomlkit (every string escaped, whatever the paths and columns hold): what was
+    detected in comments, the robot (a table where joints are held), the dataset table, the validation logs."""
+    doc = tomlkit.document()
+    for line in ("dynid identification config, written by dynid init: check the columns and units below, then",
+                 "  dynid identify THIS_FILE", *notes):
+        doc.add(tomlkit.comment(" ".join(line.splitlines())))
+    if not held:  # keys before the first table
+        doc.add("robot", tomlkit.item(_relative(urdf, out.parent)))
+    doc.add("data_root", tomlkit.item(_relative(log.parent, out.parent)))
+    doc.add(tomlkit.nl())
+    if held:
+        robot = tomlkit.table()
+        robot.add("urdf", _relative(urdf, out.parent))
+        robot.add("held", list(held))
+        robot["held"].comment("not the arm's joints: held fixed at 0")
+        robot.add("drive_terms", list(URDF_DRIVE_TERMS))
+        robot.add(tomlkit.nl())
+        doc.add("robot", robot)
+    table.add(tomlkit.nl())
+    doc.add("identification", table)
+    if validation:
+        tables = tomlkit.aot()
+        for v in validation:
+            entry = tomlkit.table()
+            entry.comment("the identification's reader")
+            entry.add("name", v.stem)
+            entry.add("bag" if _is_bag(v) else "file", _relative(v, log.parent))
+            tables.append(entry)
+        doc.add("validation", tables)
+    else:
+        for line in ("[[validation]]                  # other logs, same layout, to check the model where it was not "
+                     "fitted", 'name = "second_run"', 'file = "second_run.csv"'):
+            table.add(tomlkit.comment(line))
+    last = tables[-1] if validation else table
+    last.add(tomlkit.nl())
+    last.add(tomlkit.comment("[estimation]"))
+    last.add(tomlkit.comment('estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export'))
+    return tomlkit.dumps(doc)
 
 
 def _relative(path: Path, folder: Path) -> str:
