@@ -35,9 +35,26 @@ def test_plain_text_rendering_holds_every_cell_and_warning():
 def test_the_rich_tables_are_as_wide_as_the_split_assumes():
     from rich.console import Console
 
-    from dynid.report.console import rich_tables
+    from dynid.tables import rich_tables
 
     console = Console(width=500)
     for part in _table().split(80):
         (table,) = rich_tables(part, 500)
         assert console.measure(table).maximum == sum(w + PADDING for w in part.widths()) + EDGES
+
+
+def test_the_plain_text_is_what_the_terminal_prints_without_colour():
+    """One table renderer (issue "Parts carry their settings, one route", item 5): the library's plain text and the
+    CLI's tables are rich's, so a table reads the same in a notebook and a terminal."""
+    import io
+
+    from rich.console import Console
+
+    from dynid.report.console import Reporter
+
+    for width in (60, 100):
+        buffer = io.StringIO()
+        Reporter(out=Console(file=buffer, width=width, color_system=None, force_terminal=False)).blocks([_table()])
+        printed = [line.rstrip() for line in buffer.getvalue().splitlines() if line.strip()]
+        plain = [line for line in render_text([_table()], width).splitlines() if line.strip()]
+        assert printed == plain and any("─" in line for line in plain)

@@ -1,8 +1,8 @@
 """Result tables as plain data, so that one description serves the terminal and the library.
 
 Results objects describe what they print as a list of *blocks* (a line of text or a :class:`TextTable`):
-``result.summary()`` renders them as plain text for a library user, :mod:`dynid.report.console` renders the
-same blocks as rich tables for the CLI. A table wider than the output is split into parts that repeat the
+``result.summary()`` renders them as plain text for a library user, :mod:`dynid.report.console` prints the same
+blocks in the terminal; both draw a table with rich (:func:`rich_tables`), the plain text without colour. A table wider than the output is split into parts that repeat the
 label columns, so that nothing is cut at 80 columns.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 import textwrap
 from dataclasses import dataclass, field, replace
 
-__all__ = ["TextTable", "Line", "render_text"]
+__all__ = ["TextTable", "Line", "render_text", "rich_tables"]
 
 PADDING = 2
 """Characters each column adds to its cells: the separator and one space (rich: collapsed padding)."""
@@ -101,7 +101,8 @@ class TextTable:
                 for k, g in enumerate(groups)]
 
     def render(self, width: int = 100) -> str:
-        """Plain text, split to a width.
+        """Plain text, split to a width: the terminal's tables (:func:`rich_tables`) rendered by rich without
+        colour.
 
         Parameters
         ----------
@@ -112,21 +113,44 @@ class TextTable:
         -------
         str
         """
-        parts = []
-        for part in self.split(width):
-            w = part.widths()
+        import io
 
-            def line(cells):
-                return "  ".join(c.ljust(x) if i < part.labels else c.rjust(x) for i, (c, x) in enumerate(zip(cells, w))).rstrip()
+        from rich.console import Console
 
-            rule = "  ".join("-" * x for x in w)
-            body = [part.title, line(part.columns), rule]
-            for i, r in enumerate(part.rows):
-                body.append(line(r))
-                if i in part.section_ends and i != len(part.rows) - 1:
-                    body.append("")
-            parts.append("\n".join(body))
-        return "\n\n".join(parts)
+        out = io.StringIO()
+        console = Console(file=out, width=width, color_system=None, force_terminal=False, highlight=False)
+        for k, table in enumerate(rich_tables(self, width)):
+            console.print(*([""] if k else []), table)
+        return "\n".join(line.rstrip() for line in out.getvalue().strip("\n").splitlines())
+
+
+def rich_tables(table: TextTable, width: int) -> list:
+    """A text table as rich tables no wider than a width: one renderer for the terminal and the plain text.
+
+    Parameters
+    ----------
+    table : TextTable
+    width : int
+        Columns available.
+
+    Returns
+    -------
+    list of rich.table.Table
+        Parts repeating the label columns.
+    """
+    from rich import box
+    from rich.markup import escape
+    from rich.table import Table
+
+    out = []
+    for part in table.split(width):
+        t = Table(title=escape(part.title), box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
+        for i, col in enumerate(part.columns):
+            t.add_column(escape(col), justify="left" if i < part.labels else "right", no_wrap=True)
+        for i, row in enumerate(part.rows):
+            t.add_row(*(escape(c) for c in row), end_section=i in part.section_ends)
+        out.append(t)
+    return out
 
 
 def render_text(blocks, width: int = 100) -> str:

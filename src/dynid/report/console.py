@@ -13,12 +13,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from rich import box
 from rich.console import Console
 from rich.markup import escape
-from rich.table import Table
 
-from ..tables import Line, TextTable
+from ..tables import Line, TextTable, rich_tables
 
 DEFAULT_WIDTH = 100
 """Columns of the output when it is not a terminal and ``COLUMNS`` is not set."""
@@ -41,31 +39,6 @@ def make_console(stderr: bool = False) -> Console:
         return c
     columns = os.environ.get("COLUMNS", "")
     return Console(stderr=stderr, width=int(columns) if columns.isdigit() else DEFAULT_WIDTH)
-
-
-def rich_tables(table: TextTable, width: int) -> list[Table]:
-    """A text table as rich tables no wider than a width.
-
-    Parameters
-    ----------
-    table : TextTable
-    width : int
-        Columns available.
-
-    Returns
-    -------
-    list of rich.table.Table
-        Parts repeating the label columns.
-    """
-    out = []
-    for part in table.split(width):
-        t = Table(title=escape(part.title), box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
-        for i, col in enumerate(part.columns):
-            t.add_column(escape(col), justify="left" if i < part.labels else "right", no_wrap=True)
-        for i, row in enumerate(part.rows):
-            t.add_row(*(escape(c) for c in row), end_section=i in part.section_ends)
-        out.append(t)
-    return out
 
 
 class Reporter:
