@@ -282,3 +282,34 @@ def test_every_fitted_object_has_a_short_repr_and_a_summary(tmp_path):
     assert ident.model_.summary(estimate="dynid OLS").startswith(repr(ident.model_))
     with pytest.raises(NotFittedError):
         Identifier().summary()
+
+
+def test_the_fitted_parts_are_kept_and_a_model_read_back_answers_by_the_same_names(tmp_path, er16):
+    """issue "Parts carry their settings, one route", item 6: the fitted estimator objects stay on the result (the bee
+    colony's history_ of eq. 9's best value per generation; the least squares' covariance), and the identified model
+    and a model read back from results.json answer by the Identifier's fitted attributes' names."""
+    from dynid.estimators import BeeColonyEstimator
+    from dynid.identification.identifier import FITTED
+
+    robot, log, _ = er16
+    given = BeeColonyEstimator(colony_size=20, maxiter=12)
+    ident = dynid.Identifier(robot, estimators=["wls", given]).fit(log.t, log.q, log.tau)
+    abc = ident.estimators_["dynid ABC"]
+    assert isinstance(abc, BeeColonyEstimator) and abc is not given and not hasattr(given, "history_")
+    history = np.asarray(abc.history_)
+    assert history.size >= 12 and np.all(np.diff(history) <= 0) and history[-1] == pytest.approx(abc.objective_)
+    np.testing.assert_array_equal(abc.params_, ident.estimates_["dynid ABC"])
+    assert ident.result_.estimates["dynid ABC"].estimator is abc
+    wls = ident.estimators_["dynid WLS"]
+    np.testing.assert_allclose(np.sqrt(np.diag(wls.covariance_)), ident.params_std_, rtol=1e-12)
+    model = dynid.load_results(ident.save(tmp_path / "results.json"))
+    for name in FITTED:
+        mine, kept, read = getattr(ident, name), getattr(ident.model_, name), getattr(model, name)
+        if name == "estimators_":
+            assert mine == kept and read == {}  # results.json holds values, not objects
+        elif name == "parameters_":
+            assert mine.names == read.names and np.array_equal(mine.values, read.values)
+        elif name == "estimates_":
+            assert list(mine) == list(read) and all(np.array_equal(mine[k], read[k]) for k in mine)
+        else:
+            np.testing.assert_array_equal(np.asarray(mine), np.asarray(read), err_msg=name)

@@ -4,7 +4,7 @@ consistency check (Sousa & Cortesão 2014; :func:`dynid.estimators.consistency_m
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -50,6 +50,10 @@ class Estimate:
         Smallest eigenvalue of each link's pseudo-inertia (the SDP).
     note : str
         What to know about it (a solver that ended inaccurately).
+    estimator : Estimator or None
+        The fitted estimator, with its learned attributes (the bee colony's ``history_``, the SDP's ``status_``, a
+        plugin's own); None for the estimates no estimator object makes (the description's nominal model, the
+        drive-only candidate, a closed-loop estimate). Not written to results.json.
     """
 
     key: str
@@ -60,6 +64,7 @@ class Estimate:
     standard: np.ndarray | None = None
     pseudo_inertia_min_eig: np.ndarray | None = None
     note: str = ""
+    estimator: object = field(default=None, repr=False, compare=False)
 
     @property
     def label(self) -> str:

@@ -163,6 +163,14 @@ class IdentifiedModel:
         The identification's resolved preprocessing (carried over to other logs).
     results : dict
         results.json as a dictionary.
+    estimators_ : dict
+        label -> the fitted estimator object of an estimate (its learned attributes: the bee colony's ``history_``, the
+        SDP's ``status_``, a plugin's own), for the estimates an estimator object made; empty for a model read back
+        from results.json (:func:`load_results`), which holds values, not objects.
+
+    The fitted attributes :class:`~dynid.identification.identifier.Identifier` has after ``fit`` are this model's
+    (``params_``, ``params_std_``, ``feature_names_out_``, ``parameters_``, ``estimates_``, ``estimators_``): a model
+    identified here and one read back answer by the same names.
     """
 
     robot: Robot
@@ -172,6 +180,33 @@ class IdentifiedModel:
     main: str = ""
     preprocessing: Preprocessing | None = None
     results: dict = field(default_factory=dict)
+    estimators_: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def params_(self) -> np.ndarray:
+        """(n_base,) base parameters of the main estimate (SI units, the base parameters' order)."""
+        return self.params()
+
+    @property
+    def params_std_(self) -> np.ndarray:
+        """(n_base,) standard deviations of the main estimate's base parameters (NaN where it has none)."""
+        std = self.std.get(self.main)
+        return np.full(self.params_.shape, np.nan) if std is None else np.asarray(std)
+
+    @property
+    def feature_names_out_(self) -> tuple[str, ...]:
+        """The base parameters' names, in their order."""
+        return tuple(self.base.names)
+
+    @property
+    def parameters_(self) -> Parameters:
+        """The main estimate's base parameters by name (:meth:`parameters`)."""
+        return self.parameters()
+
+    @property
+    def estimates_(self) -> dict:
+        """label -> (n_base,) base parameters of every estimate, the main one first."""
+        return dict(self.estimates)
 
     def __repr__(self) -> str:
         return (f"IdentifiedModel(robot={self.robot.name!r}, {self.robot.n_dof} joints, {len(self.base.names)} base "
@@ -572,7 +607,8 @@ class IdentifiedModel:
         """
         return cls(result.model, result.base, {label: e.params for label, e in result.estimates.items()},
                    {label: e.std for label, e in result.estimates.items() if e.std is not None},
-                   result.main_estimate.label, _stored(result.settings), json.loads(json.dumps(_plain(result.to_dict()))))
+                   result.main_estimate.label, _stored(result.settings), json.loads(json.dumps(_plain(result.to_dict()))),
+                   {label: e.estimator for label, e in result.estimates.items() if e.estimator is not None})
 
 
 def _stored(settings: dict) -> Preprocessing | None:

@@ -24,7 +24,11 @@ from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 
-__all__ = ["Identifier"]
+__all__ = ["Identifier", "FITTED"]
+
+FITTED = ("params_", "params_std_", "feature_names_out_", "parameters_", "estimates_", "estimators_")
+"""The fitted attributes an :class:`Identifier` takes from its :class:`~dynid.identification.identified.IdentifiedModel`
+(the same names on both)."""
 
 
 class Identifier(HyperParameters):
@@ -70,6 +74,11 @@ class Identifier(HyperParameters):
         The base parameters' names.
     estimates_ : dict
         label -> (n_base,) array of every estimate.
+    estimators_ : dict
+        label -> the fitted estimator object of an estimate (the bee colony's ``history_``, a plugin's attributes).
+
+    These fitted attributes but ``result_`` and ``model_`` are the model's own (:data:`FITTED`): a model read back
+    with :func:`dynid.load_results` answers by the same names (its ``estimators_`` empty: results.json holds values).
     """
 
     def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
@@ -191,13 +200,9 @@ class Identifier(HyperParameters):
         from .identified import IdentifiedModel
 
         self.result_ = result
-        self.model_ = IdentifiedModel.from_result(result)
-        main = result.main_estimate
-        self.params_ = main.params
-        self.params_std_ = main.std if main.std is not None else np.full(main.params.shape, np.nan)
-        self.feature_names_out_ = result.base.names
-        self.parameters_ = self.model_.parameters()
-        self.estimates_ = dict(self.model_.estimates)
+        self.model_ = model = IdentifiedModel.from_result(result)
+        for name in FITTED:  # the model's own fitted attributes: one set of names for both (IdentifiedModel)
+            setattr(self, name, getattr(model, name))
         return self
 
     def _config_result(self, path: Path, data_root, validate: bool):

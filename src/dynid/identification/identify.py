@@ -483,7 +483,7 @@ def _estimate(key: str, fitted, reference) -> Estimate:
     """The :class:`Estimate` of a fit (the least-squares reference's own when ``fitted`` is None)."""
     if fitted is None:
         sol = reference.solution_
-        return Estimate(key, sol.params, sol.params_std)
+        return Estimate(key, sol.params, sol.params_std, estimator=reference)
     est = fitted.estimator
     std = getattr(est, "params_std_", None)
     standard = est.params_ if spec(key).space == "standard" else None
@@ -495,7 +495,7 @@ def _estimate(key: str, fitted, reference) -> Estimate:
                 f"{estimate_label(key)}: the solver ended with status {status}")
     return Estimate(key, fitted.params, None if std is None or standard is not None else np.asarray(std), fitted.seconds,
                     fitted.n_evaluations, None if standard is None else np.asarray(standard),
-                    getattr(est, "pseudo_inertia_min_eig_", None), note)
+                    getattr(est, "pseudo_inertia_min_eig_", None), note, est)
 
 
 FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
