@@ -8,6 +8,7 @@ label columns, so that nothing is cut at 80 columns.
 
 from __future__ import annotations
 
+import io
 import textwrap
 from dataclasses import dataclass, field, replace
 
@@ -113,8 +114,6 @@ class TextTable:
         -------
         str
         """
-        import io
-
         from rich.console import Console
 
         out = io.StringIO()
