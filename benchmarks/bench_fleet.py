@@ -34,7 +34,7 @@ def fleet(units: int) -> None:
     try:
         t0 = time.perf_counter()
         simulate_fleet(folder, units=units, seconds=360.0, rate=500.0, validation_seconds=60.0, odd_unit=None,
-                       calibration=False, seed=0)
+                       calibration=False, rng=0)
         print(f"simulated {units} units (6 min at 500 Hz each) in {time.perf_counter() - t0:.0f} s")
         manifest = load_fleet_manifest(folder / "fleet.toml")
         walls = {}

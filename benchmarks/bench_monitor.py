@@ -33,7 +33,7 @@ def main(hours: float) -> None:
     try:
         logs = int(round(hours * 60))
         t0 = time.perf_counter()
-        simulate_service_life(folder, days=logs, logs_per_day=1, seconds=60.0, rate=250.0, wear_start_day=1e9, seed=0)
+        simulate_service_life(folder, days=logs, logs_per_day=1, seconds=60.0, rate=250.0, wear_start_day=1e9, rng=0)
         # the logs are named a day apart; only their order matters to the monitor
         print(f"simulated {logs} one-minute logs at 250 Hz in {time.perf_counter() - t0:.0f} s")
         config = load_identification_config(folder / "unit.toml")

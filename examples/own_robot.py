@@ -13,7 +13,7 @@ import numpy as np
 import dynid
 
 urdf = resources.files("dynid.model") / "robots" / "ur10e.urdf"            # your robot's URDF
-log = dynid.simulated_log(dynid.load_robot(str(urdf)), seconds=60, seed=3)  # your robot's log
+log = dynid.simulated_log(dynid.load_robot(str(urdf)), seconds=60, rng=3)  # your robot's log
 names = ["t"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
 np.savetxt("log.csv", np.column_stack([log.t, log.q, log.tau]), delimiter=",", header=",".join(names), comments="")
 

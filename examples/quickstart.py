@@ -3,7 +3,7 @@
 import dynid
 
 robot = dynid.load_robot("er16")
-log, other = dynid.simulated_log(robot, seconds=30, seed=1), dynid.simulated_log(robot, seconds=20, seed=2)
+log, other = dynid.simulated_log(robot, seconds=30, rng=1), dynid.simulated_log(robot, seconds=20, rng=2)
 ident = dynid.Identifier(robot, estimators=["wls", "sdp"]).fit(log.t, log.q, log.tau)
 print(ident.parameters("wls"))                                            # name, value, σ, unit
 print(f"main estimate {ident.result_.main}; R² of its torques on another log: {ident.score(other):.4f}")

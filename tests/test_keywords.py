@@ -58,3 +58,32 @@ def test_too_many_or_doubled_arguments_are_the_usual_type_errors():
     with pytest.raises(TypeError, match="got multiple values for argument 'a'"):
         f(1, 2, a=3)
     assert f(1, b=5) == 7
+
+
+def test_the_random_state_has_one_name_and_the_former_one_still_works_with_a_warning():
+    """issue "Parts carry their settings, one route", item 6: every public callable that takes a random state calls
+    it ``rng`` (NumPy's SPEC 7: an int or a Generator); ``seed=`` gives the same result with a FutureWarning naming
+    ``rng``, and both at once are refused. A config's ``seed`` key (a user's file) is unchanged."""
+    from dynid.estimators import check_estimator
+    from dynid.identification.pipeline import IdentificationPipeline
+    from dynid.studies.simulated_fleet import simulate_fleet, simulate_service_life
+
+    callables = [*(f for _, f in _public_callables()), dynid.Identifier.__init__, IdentificationPipeline.__init__,
+                 check_estimator, simulate_fleet, simulate_service_life]
+    named = {p for f in callables for p in inspect.signature(f).parameters}
+    assert "rng" in named and "seed" not in named
+    robot = dynid.load_robot("er16")
+    log = dynid.simulated_log(robot, seconds=2, rng=3)
+    with pytest.warns(FutureWarning, match="seed= is now rng="):
+        old = dynid.simulated_log(robot, seconds=2, seed=3)
+    np.testing.assert_array_equal(old.tau, log.tau)
+    assert old.name == log.name == "simulated er16, seed 3"
+    drawn = dynid.simulated_log(robot, seconds=2, rng=np.random.default_rng(3))  # a generator: SPEC 7
+    np.testing.assert_array_equal(drawn.tau, log.tau)
+    with pytest.raises(TypeError, match="give rng= only"):
+        dynid.simulated_log(robot, seconds=2, seed=3, rng=3)
+    with pytest.warns(FutureWarning, match="seed= is now rng="):
+        ident = dynid.Identifier(robot, seed=4)
+    assert ident.get_params()["rng"] == 4 and "seed" not in ident.get_params()
+    with pytest.warns(FutureWarning, match="seed= is now rng="):
+        assert IdentificationPipeline(robot, seed=5).rng == 5

@@ -52,7 +52,7 @@ def monitored(tmp_path_factory):
     from dynid.studies.simulated_fleet import simulate_service_life
 
     root = tmp_path_factory.mktemp("life")
-    simulate_service_life(root, days=6, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=5)
+    simulate_service_life(root, days=6, seconds=60.0, rate=100.0, wear_start_day=1e9, rng=5)
     p = dynid("identify", root / "unit.toml", "--out", root / "id", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     return root

@@ -52,3 +52,67 @@ def keyword_only_after_data(function: F) -> F:
         return function(*args[:len(positional)], **dict(zip(names, args[len(positional):])), **kwargs)
 
     return wrapper  # type: ignore[return-value]
+
+
+def renamed_keyword(old: str, new: str) -> Callable[[F], F]:
+    """Accept, with a ``FutureWarning``, a keyword argument under its former name.
+
+    Parameters
+    ----------
+    old : str
+        The former name (``"seed"``).
+    new : str
+        The name the function takes now (``"rng"``).
+
+    Returns
+    -------
+    callable
+        A decorator: the function it wraps maps ``old=`` onto ``new=`` and warns; both given is a ``TypeError``. Its
+        signature (``inspect.signature``, scikit-learn's ``get_params``) is the function's own.
+    """
+
+    def decorate(function: F) -> F:
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            if old in kwargs:
+                if new in kwargs:
+                    raise TypeError(f"{function.__qualname__}() got {old}= and {new}=: give {new}= only")
+                warnings.warn(f"{function.__qualname__}: {old}= is now {new}= (one name for the random state in dynid, as "
+                              f"NumPy's and SciPy's); {old}= is refused in the release after {SINCE}", FutureWarning,
+                              stacklevel=2)
+                kwargs[new] = kwargs.pop(old)
+            return function(*args, **kwargs)
+
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+def seed_of(rng, default: int = 0) -> int:
+    """The integer seed of a random state given as dynid's ``rng`` settings take it (NumPy's SPEC 7).
+
+    Parameters
+    ----------
+    rng : int, numpy.random.Generator or None
+        An integer is the seed itself; a generator gives one draw (so the same generator state gives the same seed);
+        None is ``default``.
+    default : int
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    TypeError
+        Anything else (a float, a legacy ``RandomState``).
+    """
+    import numpy as np
+
+    if rng is None:
+        return int(default)
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        return int(rng)
+    if isinstance(rng, np.random.Generator):
+        return int(rng.integers(2**31))
+    raise TypeError(f"rng: expected an int, a numpy.random.Generator or None, got {type(rng).__name__}")

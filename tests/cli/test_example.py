@@ -37,7 +37,7 @@ def test_the_example_folder_runs_identify_and_export_as_printed(tmp_path, monkey
 
 
 def test_the_example_files_are_the_same_for_the_same_seed_and_simulate_the_description():
-    a, b, c = example_files("er16", seed=2), example_files("er16", seed=2), example_files("er16", seed=3)
+    a, b, c = example_files("er16", rng=2), example_files("er16", rng=2), example_files("er16", rng=3)
     assert a == b and a["identification.csv"] != c["identification.csv"]
     assert set(a) == {"er16.toml", "identification.csv", "validation.csv"}  # a DH robot: no URDF, the built-in name
     rows = np.loadtxt(a["identification.csv"].splitlines()[1:], delimiter=",")

@@ -21,7 +21,7 @@ def _identification(text: str) -> dict:
 
 
 def _log(folder: Path, header: bool) -> Path:
-    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=30, seed=4)
+    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=30, rng=4)
     names = ["time"] + [f"joint_pos_{j}" for j in range(1, 7)] + [f"effort[{j}]" for j in range(6)]
     path = folder / "logs" / "run.csv"
     path.parent.mkdir()
@@ -114,7 +114,7 @@ def test_init_with_a_validation_log_writes_a_config_that_validates(tmp_path):
     """dynid init URDF LOG VALIDATION_LOG: the [[validation]] entry is a name and a file, which take the identification's
     columns (init's own template failed when uncommented: "expected 'positions'"); identify validates on it."""
     log = _log(tmp_path, header=True)
-    other = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=5)
+    other = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, rng=5)
     names = ["time"] + [f"joint_pos_{j}" for j in range(1, 7)] + [f"effort[{j}]" for j in range(6)]
     np.savetxt(log.parent / "other.csv", np.column_stack([other.t, other.q, other.tau]), delimiter=",", comments="",
                header=",".join(names))
@@ -138,7 +138,7 @@ def test_init_reads_a_plotjuggler_export_of_joint_states_in_the_urdfs_joint_orde
     import json
 
     robot = dynid.load_robot(URDF)
-    log = dynid.simulated_log(robot, seconds=30, seed=4)
+    log = dynid.simulated_log(robot, seconds=30, rng=4)
     joints = [j.name for j in robot.joints]
     order = sorted(range(6), key=lambda j: joints[j])  # elbow_joint, shoulder_lift_joint, shoulder_pan_joint, wrist_…
     assert order != list(range(6))
@@ -186,7 +186,7 @@ def test_init_on_a_ros2_mcap_bag_writes_a_config_identify_runs(tmp_path):
     from test_bags import _write_bag
 
     robot = dynid.load_robot(URDF)
-    log = dynid.simulated_log(robot, seconds=30, seed=4)
+    log = dynid.simulated_log(robot, seconds=30, rng=4)
     names = [j.name for j in robot.joints]
     order = sorted(range(6), key=lambda j: names[j])
     (tmp_path / "logs").mkdir()
@@ -242,7 +242,7 @@ def test_init_reads_a_rostopic_export_with_nanosecond_time_stamps(tmp_path):
     the config it wrote: "are they in milliseconds?"), and identify runs on the config as written."""
     import json
 
-    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=5)
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, rng=5)
     stamps = np.round((1.6e9 + sim.t) * 1e9).astype(np.int64)
     header = (["%time", "field.header.seq", "field.header.stamp"] + [f"field.name{j}" for j in range(6)]
               + [f"field.position{j}" for j in range(6)] + [f"field.effort{j}" for j in range(6)])
@@ -262,7 +262,7 @@ def test_init_reads_a_rostopic_export_with_nanosecond_time_stamps(tmp_path):
 def test_init_reads_a_log_saved_by_numpy_with_its_header_as_a_comment(tmp_path):
     """np.savetxt(..., header="time,q1,…") writes "# time,q1,…": init found "no time column among ['# time', …]" and
     identify "no column named 'time'"; both now take the comment as the header, and identify runs on the config."""
-    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=6)
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, rng=6)
     names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
     np.savetxt(tmp_path / "run.csv", np.column_stack([sim.t, sim.q, sim.tau]), delimiter=",", header=",".join(names))
     assert (tmp_path / "run.csv").read_text().startswith("# time,q1")
@@ -284,7 +284,7 @@ def test_init_takes_a_rostopic_export_in_the_urdfs_joint_order_by_its_name_colum
 
     robot = dynid.load_robot(URDF)
     joints = [j.name for j in robot.joints]
-    sim = dynid.simulated_log(robot, seconds=5, seed=6)
+    sim = dynid.simulated_log(robot, seconds=5, rng=6)
     for name, order in (("urdf", list(range(6))), ("alphabetical", sorted(range(6), key=lambda j: joints[j]))):
         header = (["%time"] + [f"field.name{k}" for k in range(6)] + [f"field.position{k}" for k in range(6)]
                   + [f"field.effort{k}" for k in range(6)])
@@ -309,7 +309,7 @@ def test_init_sums_a_time_stamp_split_into_seconds_and_nanoseconds(tmp_path):
     missed by 4.2 % instead of 0.06 %. Both columns now make the time, and identify fits the log as simulated."""
     import json
 
-    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, seed=7)
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, rng=7)
     keep = np.random.default_rng(3).random(sim.t.size) > 0.05  # 5 % of the messages lost
     ns = np.round((1.7e9 + sim.t[keep]) * 1e9).astype(np.int64)
     header = ["header.stamp.sec", "header.stamp.nanosec"] + [f"position.{j}" for j in range(6)] + \
@@ -348,7 +348,7 @@ def test_init_opens_a_bag_and_writes_bag_for_a_validation_bag(tmp_path):
     and identify runs on the config as written. A bag without one of the robot's joints is refused in one line."""
     from tests.io.test_bags import _write_bag
 
-    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, seed=8)
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, rng=8)
     names = [j.name for j in dynid.load_robot(URDF).joints]
     half = sim.t.size // 2
     dq = np.gradient(sim.q, sim.t, axis=0)  # the simulated log has none: the bag's velocity field
@@ -372,7 +372,7 @@ def test_init_never_takes_a_commanded_column_for_a_measured_signal(tmp_path, sty
     """A log holding commanded positions beside the measured ones (before them): init took the commanded column,
     and the fit missed by 1.4-1.7 % instead of 0.14 %, dynid suggesting a torque delay. It takes the measured one,
     and says which it left."""
-    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, seed=9)
+    sim = dynid.simulated_log(dynid.load_robot(URDF), seconds=12, rng=9)
     names = [j.name for j in dynid.load_robot(URDF).joints]
     lagged = np.roll(sim.q, 5, axis=0)  # a set-point runs ahead of the measured position
     if style == "plain":

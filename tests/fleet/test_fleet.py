@@ -17,7 +17,7 @@ pa = pytest.importorskip("pyarrow.parquet")
 
 def test_dynid_fleet_finds_the_unit_whose_drive_gain_is_off(tmp_path):
     truths = simulate_fleet(tmp_path / "fleet", units=6, seconds=20.0, rate=200.0, validation_seconds=10.0, odd_unit=2,
-                            odd_joint=2, gain_error=0.05, seed=0)
+                            odd_joint=2, gain_error=0.05, rng=0)
     assert truths[2].gain_factor[1] == pytest.approx(1.05) and all(t.gain_factor[1] == 1.0 for k, t in enumerate(truths) if k != 2)
     out = tmp_path / "out"
     p = dynid("fleet", tmp_path / "fleet" / "fleet.toml", "--out", out, "--workers", "2")
@@ -61,7 +61,7 @@ def test_a_tx40_fleet_finds_its_unit_whose_drive_gain_is_off(tmp_path):
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     truths = simulate_fleet(tmp_path, robot="tx40", units=6, seconds=20.0, rate=200.0, validation_seconds=10.0,
-                            odd_unit=2, odd_joint=2, seed=0)
+                            odd_unit=2, odd_joint=2, rng=0)
     result = run_fleet(load_fleet_manifest(tmp_path / "fleet.toml"), workers=2)
     assert [u.error for u in result.units] == [""] * 6
     for unit, truth in zip(result.units, truths):
@@ -83,7 +83,7 @@ def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
 
     root = tmp_path / "fleet"
     simulate_fleet(root, units=5, seconds=20.0, rate=200.0, validation_seconds=10.0, odd_unit=None, payload_max=0.0,
-                   validation_noise=NoiseModel(current_std=0.0), seed=1)
+                   validation_noise=NoiseModel(current_std=0.0), rng=1)
     text = (root / "fleet.toml").read_text().replace("drive_gains = ", "# drive_gains = ")
     for u in range(1, 6):
         lines = (root / f"r0{u}" / "identification.csv").read_text().splitlines()
@@ -106,7 +106,7 @@ def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
 
 
 def test_bad_manifests_are_refused_in_one_line(tmp_path):
-    simulate_fleet(tmp_path, units=4, seconds=12.0, rate=100.0, validation_seconds=4.0, odd_unit=None, seed=2)
+    simulate_fleet(tmp_path, units=4, seconds=12.0, rate=100.0, validation_seconds=4.0, odd_unit=None, rng=2)
     good = (tmp_path / "fleet.toml").read_text()
     cases = {
         "dup.toml": (good.replace('id = "r02"', 'id = "r01"'), "units[1].id: 'r01' names two units"),
@@ -140,9 +140,9 @@ def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_p
     from dynid.io.fleet_manifest import load_fleet_manifest
 
     simulate_fleet(tmp_path / "bare", units=4, seconds=20.0, rate=200.0, validation_seconds=6.0, odd_unit=None,
-                   payload_max=0.0, seed=3)
+                   payload_max=0.0, rng=3)
     (tooled,) = simulate_fleet(tmp_path / "tool", units=1, seconds=20.0, rate=200.0, validation_seconds=6.0,
-                               odd_unit=None, payload_max=8.0, seed=11)
+                               odd_unit=None, payload_max=8.0, rng=11)
     assert tooled.payload > 5.0
     shutil.copytree(tmp_path / "tool" / "r01", tmp_path / "bare" / "r05")
     unit = (tmp_path / "tool" / "fleet.toml").read_text().split("[[units]]")[1].replace("r01", "r05")
@@ -160,7 +160,7 @@ def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_p
 def test_a_units_warnings_reach_the_console_and_fleet_json(tmp_path):
     """One unit's identification log cut off mid-line (a copy that stopped): its warning was dropped from dynid fleet's
     console; now it is there, named by the unit, and in fleet.json."""
-    simulate_fleet(tmp_path / "fleet", units=3, seconds=12.0, rate=100.0, validation_seconds=4.0, odd_unit=None, seed=2)
+    simulate_fleet(tmp_path / "fleet", units=3, seconds=12.0, rate=100.0, validation_seconds=4.0, odd_unit=None, rng=2)
     log = tmp_path / "fleet" / "r02" / "identification.csv"
     data = log.read_bytes()
     log.write_bytes(data[: data.rindex(b"\n", 0, len(data) - 1) + 15])  # the last line cut short

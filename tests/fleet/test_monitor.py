@@ -65,7 +65,7 @@ def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(tmp_path):
     reference): the alarm names joint 3 and its viscous friction, within 60 s of logs of the change, with its size; no
     other term alarms."""
     simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
-                          step=0.10, coulomb=False, seed=3)
+                          step=0.10, coulomb=False, rng=3)
     results = _identified(tmp_path)
     p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
     assert p.returncode == 0, p.stderr
@@ -87,7 +87,7 @@ def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
     import shutil
 
     simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
-                          step=0.10, coulomb=False, seed=3)
+                          step=0.10, coulomb=False, rng=3)
     results = _identified(tmp_path)
     files = sorted((tmp_path / "logs").glob("*.csv"))
     growing = tmp_path / "growing"
@@ -128,7 +128,7 @@ def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
 def test_dynid_monitor_raises_no_alarm_where_nothing_changed(tmp_path):
     """Two hours of logs (120 one-minute logs at 100 Hz) of an unchanged robot: no alarm. The 24-hour figure is
     measured by benchmarks/bench_monitor.py."""
-    simulate_service_life(tmp_path, days=120, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=4)
+    simulate_service_life(tmp_path, days=120, seconds=60.0, rate=100.0, wear_start_day=1e9, rng=4)
     results = _identified(tmp_path)
     p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
     assert p.returncode == 0, p.stderr
@@ -138,7 +138,7 @@ def test_dynid_monitor_raises_no_alarm_where_nothing_changed(tmp_path):
 
 
 def test_monitor_refusals(tmp_path):
-    simulate_service_life(tmp_path, days=2, seconds=20.0, rate=100.0, seed=5)
+    simulate_service_life(tmp_path, days=2, seconds=20.0, rate=100.0, rng=5)
     (tmp_path / "empty").mkdir()
     p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "empty", "--results", tmp_path / "none.json",
               "--out", tmp_path / "m")
@@ -156,7 +156,7 @@ def test_a_log_still_being_written_is_left_for_the_next_run(tmp_path):
     never again). A log that changed after the monitor read it is refused in one line."""
     import shutil
 
-    simulate_service_life(tmp_path, days=8, seconds=60.0, rate=100.0, wear_start_day=1e9, seed=4)
+    simulate_service_life(tmp_path, days=8, seconds=60.0, rate=100.0, wear_start_day=1e9, rng=4)
     results = _identified(tmp_path)
     files = sorted((tmp_path / "logs").glob("*.csv"))
     growing = tmp_path / "growing"

@@ -130,7 +130,7 @@ def test_the_identifier_takes_every_estimator_a_config_takes(closed_loop_log):
     _write(root, "", estimators='["wls"]')
     with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: .*cl.toml has no \[controller\]"):
         dynid.Identifier.from_config(root / "cl.toml", estimators=["wls", "idim-iv"], validate=False)
-    log = dynid.simulated_log(dynid.load_robot("er16"), seconds=5, seed=1)
+    log = dynid.simulated_log(dynid.load_robot("er16"), seconds=5, rng=1)
     with pytest.raises(ConfigError, match=r"idim-iv simulates the run in closed loop and needs its controller: fit a config"):
         dynid.Identifier("er16", estimators=["wls", "idim-iv"]).fit(log.t, log.q, log.tau)
     with pytest.raises(ConfigError, match="list ols or wls before 'idim-iv'"):

@@ -15,7 +15,7 @@ def test_a_delay_of_a_fraction_of_a_sample_is_recovered(delay):
     samples late (read from the exact torques' band-limited interpolation): the estimate lies within 0.25
     samples, within 3σ, and once undone the log shows no delay beyond its σ."""
     robot = dynid.load_robot("ur10e")
-    log = simulated_log(robot, seconds=30.0, rate=250.0, seed=3)
+    log = simulated_log(robot, seconds=30.0, rate=250.0, rng=3)
     t, tau = log.t, np.asarray(log.tau)
     spectrum = np.fft.rfft(tau, axis=0)  # a delay in the frequency domain: exact for the periodic excitation
     f = np.fft.rfftfreq(t.size, 1.0 / log.rate)
@@ -40,7 +40,7 @@ def test_identify_says_which_torque_delay_to_give():
     setting that undoes it; identified again with that setting, or on the log without delay, no delay finding."""
 
     robot = dynid.load_robot("ur10e")
-    log = simulated_log(robot, seconds=30.0, rate=250.0, seed=3)
+    log = simulated_log(robot, seconds=30.0, rate=250.0, rng=3)
     tau = np.asarray(log.tau)
     spectrum = np.fft.rfft(tau, axis=0)
     f = np.fft.rfftfreq(log.t.size, 1.0 / log.rate)

@@ -15,7 +15,7 @@ from ..simulated_logs import simulated_case, truth_beta
 @pytest.fixture(scope="module")
 def er16():
     robot = dynid.load_robot("er16")
-    return robot, dynid.simulated_log(robot, seconds=30, seed=1), dynid.simulated_log(robot, seconds=20, seed=2)
+    return robot, dynid.simulated_log(robot, seconds=30, rng=1), dynid.simulated_log(robot, seconds=20, rng=2)
 
 
 @pytest.fixture(scope="module")
@@ -93,9 +93,9 @@ def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
 
 def test_get_and_set_params_follow_scikit_learns_contract():
     ident = dynid.Identifier("er16", estimators=["ols"])
-    assert ident.get_params() == {"robot": "er16", "estimators": ["ols"], "preprocessing": None, "friction": None, "seed": None,
+    assert ident.get_params() == {"robot": "er16", "estimators": ["ols"], "preprocessing": None, "friction": None, "rng": None,
                                   "controller": None}
-    assert ident.set_params(seed=3, friction="auto") is ident and ident.get_params()["seed"] == 3
+    assert ident.set_params(rng=3, friction="auto") is ident and ident.get_params()["rng"] == 3
     with pytest.raises(ValueError, match="no parameter 'alpha'"):
         ident.set_params(alpha=1)
     with pytest.raises(AttributeError, match="not fitted yet"):
@@ -121,7 +121,7 @@ def test_scikit_learns_check_is_fitted_and_clone(fitted):
     from sklearn.exceptions import NotFittedError
     from sklearn.utils.validation import check_is_fitted
 
-    fresh = dynid.Identifier("er16", estimators=["wls"], seed=3)
+    fresh = dynid.Identifier("er16", estimators=["wls"], rng=3)
     with pytest.raises(NotFittedError):
         check_is_fitted(fresh)
     check_is_fitted(fitted)
@@ -136,9 +136,9 @@ def test_scikit_learns_check_is_fitted_and_clone(fitted):
 
 def test_fit_on_a_config_with_the_identifiers_settings_on_top(tmp_path):
     cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
-    ident = dynid.Identifier.from_config(cfg, estimators=["wls", "ols"], seed=2)
+    ident = dynid.Identifier.from_config(cfg, estimators=["wls", "ols"], rng=2)
     with pytest.warns(FutureWarning, match=r"fit\(config_path\) is Identifier\.from_config"):  # the earlier form
-        earlier = dynid.Identifier(estimators=["wls", "ols"], seed=2).fit(cfg, validate=False)
+        earlier = dynid.Identifier(estimators=["wls", "ols"], rng=2).fit(cfg, validate=False)
     np.testing.assert_array_equal(earlier.params_, ident.params_)
     assert ident.result_.estimators == ("wls", "ols") and ident.result_.validations  # the config's validation log
     truth = truth_beta(ident.result_, truth_robot)
@@ -168,7 +168,7 @@ def test_predict_and_score_take_a_raw_log_as_fit_does(er16, fitted):
     from dynid.validation.noise_floor import torque_noise
 
     robot, _, _ = er16  # another log at 1 kHz with 16-bit encoders: differences of its positions are mostly noise
-    other = dynid.simulated_log(robot, seconds=10, rate=1000.0, seed=2,
+    other = dynid.simulated_log(robot, seconds=10, rate=1000.0, rng=2,
                                 noise=NoiseModel(encoder_resolution=2 * np.pi / 2**16))
     t, q, tau = other.t, np.asarray(other.q), np.asarray(other.tau)
     predicted = fitted.predict(t, q)
@@ -253,8 +253,8 @@ def test_a_model_fitted_with_the_papers_preprocessing_scores_other_logs_filtered
     from dynid.simulation.measurements import NoiseModel
 
     robot = dynid.load_robot("er16")
-    ident = dynid.simulated_log(robot, seconds=30, seed=1)
-    other = dynid.simulated_log(robot, seconds=30, seed=2, noise=NoiseModel(current_std=0.05, encoder_resolution=1e-4))
+    ident = dynid.simulated_log(robot, seconds=30, rng=1)
+    other = dynid.simulated_log(robot, seconds=30, rng=2, noise=NoiseModel(current_std=0.05, encoder_resolution=1e-4))
     paper = Preprocessing(strategy="paper", fourier=(2 * np.pi * 0.1, 5))  # the simulated excitation's harmonics
     model = dynid.Identifier(robot, estimators=["ols"], preprocessing=paper).fit(ident.t, ident.q, ident.tau)
     assert model.score(other.t, other.q, other.tau) > 0.999

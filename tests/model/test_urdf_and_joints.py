@@ -78,7 +78,7 @@ def test_the_sdp_runs_on_a_vendor_urdf_whose_inertia_no_body_has(tmp_path):
     from dynid.identification.identifier import Identifier
 
     truth = load_robot(str(ROBOTS / "ur10e.toml"))
-    log = dynid.simulated_log(truth, seconds=20, seed=3)
+    log = dynid.simulated_log(truth, seconds=20, rng=3)
     robot = load_robot(_description(tmp_path, _broken_urdf()))
     model = Identifier(robot, estimators=["wls", "sdp"]).fit(log.t, log.q, log.tau)
     notes = " ".join(model.result_.warnings)
@@ -157,7 +157,7 @@ def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_p
     import dynid
     from dynid.identification.identifier import Identifier
 
-    log = dynid.simulated_log(load_robot(str(ROBOTS / "ur10e.toml")), seconds=10, seed=3)
+    log = dynid.simulated_log(load_robot(str(ROBOTS / "ur10e.toml")), seconds=10, rng=3)
     said = Identifier(robot, estimators=["ols"]).fit(log.t, log.q, log.tau).result_.warnings
     assert robot.nominal_notes[0] in said  # the identification says it among its warnings
 

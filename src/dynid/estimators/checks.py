@@ -26,6 +26,7 @@ import inspect
 import numpy as np
 
 from ..exceptions import DynIdError
+from ..keywords import renamed_keyword, seed_of
 from .base import BoxSearchEstimator, Estimator, paper_objective
 from .fitting import fit_method
 from .problem import FitData, SearchBudget
@@ -67,7 +68,8 @@ def _problem(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     return w, tau, truth, bounds, sigma
 
 
-def check_estimator(estimator, seed: int = 0) -> None:
+@renamed_keyword("seed", "rng")
+def check_estimator(estimator, rng=0) -> None:
     """Check an estimator (module docstring), registered or not.
 
     Parameters
@@ -76,8 +78,9 @@ def check_estimator(estimator, seed: int = 0) -> None:
         A registry key (a plugin registers its estimator with :func:`dynid.estimators.register`), or the class itself,
         checked before it is registered, as registered with its defaults (a :class:`BoxSearchEstimator` as a box
         search); the registry is as it was afterwards.
-    seed : int
-        Seeds the synthetic problem and the estimator's ``rng``.
+    rng : int or numpy.random.Generator
+        Seeds the synthetic problem and the estimator's ``rng`` (a generator gives one draw as the seed). Was ``seed``
+        (still taken, with a FutureWarning).
 
     Raises
     ------
@@ -88,6 +91,7 @@ def check_estimator(estimator, seed: int = 0) -> None:
     EstimatorCheckError
         Every failed check, in one line.
     """
+    seed = seed_of(rng)
     if isinstance(estimator, str):
         _check(spec(estimator), seed)
         return

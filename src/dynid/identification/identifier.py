@@ -20,7 +20,7 @@ import numpy as np
 
 from ..exceptions import ConfigError, NotFittedError
 from ..hyperparameters import HyperParameters
-from ..keywords import keyword_only_after_data
+from ..keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 
@@ -51,8 +51,9 @@ class Identifier(HyperParameters):
     friction : {"auto", "description"}, optional
         Each joint's friction model chosen by cross-validation, or the description's terms (default: "description"
         for arrays, the config's for a config).
-    seed : int, optional
-        Seeds the box searches (default 0, or the config's).
+    rng : int or numpy.random.Generator, optional
+        Seeds the box searches (default 0, or the config's ``seed``); a generator gives one draw as the seed. Was
+        ``seed`` (still taken, with a FutureWarning).
     controller : ClosedLoopSetup, optional
         How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`: the
         controller, one set-point per sample, the feed-forward), for the closed-loop estimators; a config gives its
@@ -81,13 +82,14 @@ class Identifier(HyperParameters):
     with :func:`dynid.load_results` answers by the same names (its ``estimators_`` empty: results.json holds values).
     """
 
+    @renamed_keyword("seed", "rng")
     def __init__(self, robot: Robot | str | Path | None = None, *, estimators=None, preprocessing=None,
-                 friction: str | None = None, seed: int | None = None, controller=None):
+                 friction: str | None = None, rng=None, controller=None):
         self.robot = robot
         self.estimators = estimators
         self.preprocessing = preprocessing
         self.friction = friction
-        self.seed = seed
+        self.rng = rng
         self.controller = controller
 
     def __sklearn_is_fitted__(self) -> bool:
@@ -102,7 +104,7 @@ class Identifier(HyperParameters):
     def __sklearn_tags__(self):
         """scikit-learn's tags (asked by its ``check_is_fitted``, ``clone`` and meta-estimators; scikit-learn is then
         imported already): no estimator type of its own (it fits a robot's log, not ``X, y``), fitting required, its
-        input not validated by scikit-learn, its box searches seeded (``seed``), so deterministic.
+        input not validated by scikit-learn, its box searches seeded (``rng``), so deterministic.
 
         Returns
         -------
@@ -115,7 +117,7 @@ class Identifier(HyperParameters):
     @classmethod
     def from_config(cls, path: str | Path, *, data_root=None, validate: bool = True, **params) -> Identifier:
         """Identify the robot of an identification config (TOML) as ``dynid identify`` does, the ``params`` given
-        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``seed``, ``robot``, ``controller``) over
+        (the constructor's: ``estimators``, ``preprocessing``, ``friction``, ``rng``, ``robot``, ``controller``) over
         the config's.
 
         Parameters
@@ -192,7 +194,7 @@ class Identifier(HyperParameters):
                                   "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
                                           estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
-                                          seed=0 if self.seed is None else int(self.seed), controller=self.controller)
+                                          rng=seed_of(self.rng), controller=self.controller)
         return self._fitted(result)
 
     def _fitted(self, result) -> Identifier:
@@ -225,8 +227,8 @@ class Identifier(HyperParameters):
             changes["preprocessing"] = self._preprocessing()
         if self.friction is not None:
             changes["friction"] = self.friction
-        if self.seed is not None:
-            changes["seed"] = int(self.seed)
+        if self.rng is not None:  # the config's seed
+            changes["seed"] = seed_of(self.rng)
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:

@@ -34,6 +34,7 @@ import numpy as np
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
+from ..keywords import renamed_keyword
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
@@ -100,8 +101,9 @@ class IdentificationPipeline:
         on the log as read, in order, as a config's ``[estimation] estimators`` lists them.
     friction : {"description", "auto"}
         The description's friction terms, or each joint's model chosen by cross-validation.
-    seed : int
-        Seeds the box searches and the bootstrap.
+    rng : int
+        Seeds the box searches and the bootstrap (a config's ``seed``; ``seed=`` is still taken, with a
+        FutureWarning).
     source : str
         Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
         :func:`dynid.load_results` finds it.
@@ -129,7 +131,7 @@ class IdentificationPipeline:
     preprocessing: Preprocessing = field(default_factory=Preprocessing)
     estimators: tuple = ("wls",)
     friction: str = "description"
-    seed: int = 0
+    rng: int = 0
     source: str = ""
     controller: Any = None
     open_loop: tuple = field(init=False, repr=False, compare=False)
@@ -269,7 +271,7 @@ class IdentificationPipeline:
         blocks: list = []  # the delay check's rows, from the identification's own pass
         check = _delay_checked(prepared.data)
         result = identify(prepared.robot, prepared.base, prepared.data, self.open_loop, references=references,
-                          progress=progress, rng=self.seed,
+                          progress=progress, rng=self.rng,
                           held_out=held_out, jackknife=jackknife,
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)
@@ -320,6 +322,10 @@ class IdentificationPipeline:
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
         return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
+
+
+
+IdentificationPipeline.__init__ = renamed_keyword("seed", "rng")(IdentificationPipeline.__init__)  # type: ignore[method-assign]
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:

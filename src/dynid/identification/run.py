@@ -23,7 +23,7 @@ from ..io.log_repairs import (
     uniform_rate,
     unwrapped_positions,
 )
-from ..keywords import keyword_only_after_data
+from ..keywords import keyword_only_after_data, seed_of
 from ..model.description import builtin_robots
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -583,7 +583,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "array
         The pipeline's settings, as :class:`~dynid.identification.pipeline.IdentificationPipeline` takes them:
         ``preprocessing`` (default: every setting derived from the data), ``estimators`` (keys or objects, as a
         config's ``[estimation] estimators``; the closed-loop ones with ``controller``), ``friction``
-        ({"description", "auto"}, default "description"), ``seed`` (default 0), ``controller``
+        ({"description", "auto"}, default "description"), ``rng`` (default 0; an int or a generator), ``controller``
         (:class:`dynid.identification.closed_loop.ClosedLoopSetup`, as a config's ``[controller]`` gives it).
 
     Returns
@@ -602,11 +602,13 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "array
     from .pipeline import IdentificationPipeline
 
     known = {f.name for f in fields(IdentificationPipeline) if f.init} - {"robot", "source"}
-    unknown = sorted(set(settings) - known)
+    unknown = sorted(set(settings) - known - {"seed"})  # seed: rng's former name, taken with a FutureWarning
     if unknown:
         raise ConfigError(f"identify_from_arrays: unknown setting {unknown[0]!r}; expected one of {', '.join(sorted(known))}",
                           field=unknown[0])
-    given = {"seed": int(settings.get("seed", 0)), "preprocessing": settings.get("preprocessing") or Preprocessing()}
+    given = {"preprocessing": settings.get("preprocessing") or Preprocessing()}
+    if "seed" not in settings:
+        given["rng"] = seed_of(settings.get("rng"))
     pipeline = IdentificationPipeline(robot, **{**settings, **given},
                                       source=robot.name if robot.name in builtin_robots() else "")
     return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))

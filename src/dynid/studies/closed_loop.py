@@ -246,7 +246,7 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
         seed = int(np.random.default_rng([cfg.seed, 21, cell, realisation]).integers(2**31))
         try:
             pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False),
-                                              estimators=tuple(cfg.open_loop), seed=seed)  # the settings as given
+                                              estimators=tuple(cfg.open_loop), rng=seed)  # the settings as given
             result = pipeline.estimate(pipeline.prepare(log, setup.base))
         except DynIdError as exc:
             errors.update({k: str(exc) for k in open_keys})

@@ -17,6 +17,7 @@ from importlib import resources
 import numpy as np
 
 from ..exceptions import ConfigError
+from ..keywords import renamed_keyword, seed_of
 from ..model.description import builtin_robots, load_robot
 from .simulated_logs import simulated_log
 
@@ -55,15 +56,17 @@ def _csv(log, names: list[str]) -> str:
     return buffer.getvalue()
 
 
-def example_files(name: str, seed: int = 0) -> dict[str, str]:
+@renamed_keyword("seed", "rng")
+def example_files(name: str, rng=0) -> dict[str, str]:
     """The files of an example folder for a built-in robot: its URDF (where it has one), two simulated logs and a config.
 
     Parameters
     ----------
     name : str
         One of :data:`EXAMPLES`.
-    seed : int
-        Seeds the trajectories, the drive values and the noise (the same files for the same seed).
+    rng : int or numpy.random.Generator
+        Seeds the trajectories, the drive values and the noise (the same files for the same int; a generator gives one
+        draw as the seed). Was ``seed`` (still taken, with a FutureWarning).
 
     Returns
     -------
@@ -78,14 +81,15 @@ def example_files(name: str, seed: int = 0) -> dict[str, str]:
     """
     if name not in EXAMPLES or name not in builtin_robots():
         raise ConfigError(f"no example for robot {name!r}: choose one of {', '.join(EXAMPLES)}")
+    seed = seed_of(rng)
     rng = np.random.default_rng(seed)
     robot = _with_drives(load_robot(name), rng)
     files: dict[str, str] = {}
     if name in FROM_URDF:
         files[f"{name}.urdf"] = (resources.files("dynid.model") / "robots" / f"{name}.urdf").read_text(encoding="utf-8")
     names = [j.name for j in robot.joints]
-    files["identification.csv"] = _csv(simulated_log(robot, seconds=IDENTIFICATION_SECONDS, rate=RATE, seed=seed), names)
-    files["validation.csv"] = _csv(simulated_log(robot, seconds=VALIDATION_SECONDS, rate=RATE, seed=seed + 1), names)
+    files["identification.csv"] = _csv(simulated_log(robot, seconds=IDENTIFICATION_SECONDS, rate=RATE, rng=seed), names)
+    files["validation.csv"] = _csv(simulated_log(robot, seconds=VALIDATION_SECONDS, rate=RATE, rng=seed + 1), names)
     columns = lambda what: "[" + ", ".join(f'"{n}_{what}"' for n in names) + "]"  # noqa: E731
     layout = (f'header = true\ntime = {{ column = "time" }}\npositions = {{ columns = {columns("position")} }}\n'
               f'torques = {{ columns = {columns("effort")} }}\n')

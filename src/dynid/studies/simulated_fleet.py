@@ -22,6 +22,7 @@ import numpy as np
 
 from ..exceptions import ConfigError
 from ..excitation.fourier import FourierTrajectory
+from ..keywords import renamed_keyword, seed_of
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements
@@ -164,11 +165,12 @@ def _nominal_friction(robot: Robot, name: str) -> tuple[np.ndarray, np.ndarray]:
     return np.array(fc[:robot.n_dof]), np.array(fv[:robot.n_dof])
 
 
+@renamed_keyword("seed", "rng")
 def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, seconds: float = 30.0,
                    rate: float = 250.0, validation_seconds: float = 20.0, friction_spread: float = 0.2,
                    payload_max: float = 2.0, odd_unit: int | None = 2, odd_joint: int = 2, gain_error: float = 0.05,
                    calibration_payload: float = 5.0, noise: NoiseModel = NoiseModel(),
-                   validation_noise: NoiseModel | None = None, calibration: bool = True, seed: int = 0) -> list[UnitTruth]:
+                   validation_noise: NoiseModel | None = None, calibration: bool = True, rng=0) -> list[UnitTruth]:
     """Write a simulated fleet: its manifest ``fleet.toml``, the unit config template ``unit.toml``, each unit's logs
     and ``truth.json``.
 
@@ -200,7 +202,9 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
         Of the validation logs (default ``noise``); without current noise, a validation error is the model's alone.
     calibration : bool
         Write the drive-gain runs (and ``[drive_gains]`` in the template).
-    seed : int
+    rng : int or numpy.random.Generator
+        Seeds the units, their logs and noise (a generator gives one draw as the seed). Was ``seed`` (still taken, with
+        a FutureWarning).
 
     Returns
     -------
@@ -217,6 +221,7 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     fc, fv = _nominal_friction(nominal, robot)
     if odd_unit is not None and not (0 <= odd_unit < units and 1 <= odd_joint <= n):
         raise ConfigError(f"odd_unit {odd_unit} / odd_joint {odd_joint}: outside a fleet of {units} units of {n} joints")
+    seed = seed_of(rng)
     rng = np.random.default_rng(seed)
     truths = []
     lines = [f'name = "simulated {robot} fleet of {units} units (seed {seed})"', 'template = "unit.toml"', ""]
@@ -257,10 +262,11 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     return truths
 
 
+@renamed_keyword("seed", "rng")
 def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int = 28, logs_per_day: int = 1,
                           seconds: float = 60.0, rate: float = 250.0, wear_joint: int = 3, wear_start_day: float = 14.0,
                           wear_per_day: float = 0.02, step: float = 0.0, coulomb: bool = True,
-                          noise: NoiseModel = NoiseModel(), seed: int = 0) -> UnitTruth:
+                          noise: NoiseModel = NoiseModel(), rng=0) -> UnitTruth:
     """Write one unit's dated logs (``YYYY-MM-DDTHH-MM.csv``, from 2026-01-01) while a joint wears: from
     ``wear_start_day`` on, its viscous (and Coulomb) friction is ``1 + step + wear_per_day · days`` times its own.
 
@@ -283,7 +289,9 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
     coulomb : bool
         The Coulomb friction rises with the viscous one.
     noise : NoiseModel
-    seed : int
+    rng : int or numpy.random.Generator
+        Seeds the logs and noise (a generator gives one draw as the seed). Was ``seed`` (still taken, with a
+        FutureWarning).
 
     Returns
     -------
@@ -294,6 +302,7 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
     nominal = load_robot(robot)
     fc, fv = _nominal_friction(nominal, robot)
     truth = UnitTruth("unit", fc, fv, 0.0, np.ones(nominal.n_dof))
+    seed = seed_of(rng)
     rng = np.random.default_rng(seed)
     task = random_excitation(nominal, rng)
     _write_log(folder / "reference.csv", nominal, unit_robot(nominal, truth), nominal.drive_gains,

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..io.datasets import Recording
-from ..keywords import keyword_only_after_data
+from ..keywords import keyword_only_after_data, renamed_keyword
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from .simulated_fleet import random_excitation
@@ -18,8 +18,9 @@ from .simulated_fleet import random_excitation
 __all__ = ["simulated_log"]
 
 
+@renamed_keyword("seed", "rng")
 @keyword_only_after_data
-def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, seed: int = 0,
+def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, rng: int | np.random.Generator = 0,
                   noise: NoiseModel = NoiseModel()) -> Recording:
     """A log of ``robot`` running a random Fourier excitation.
 
@@ -31,8 +32,9 @@ def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, s
         Length [s].
     rate : float
         Sampling rate [Hz].
-    seed : int
-        Seeds the trajectory and the noise.
+    rng : int or numpy.random.Generator
+        Seeds the trajectory and the noise (an int: the same log for the same int). Was ``seed`` (still taken, with a
+        FutureWarning).
     noise : NoiseModel
         Current noise [A] and encoder resolution [rad] (default 0.05 A, 20-bit encoders).
 
@@ -47,10 +49,11 @@ def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, s
         A description without physical nominal parameters.
     """
     robot.require_physical_nominal("a simulated log (its truth is the description's parameters)")
-    rng = np.random.default_rng(seed)
-    trajectory = random_excitation(robot, rng)
+    generator = np.random.default_rng(rng)
+    trajectory = random_excitation(robot, generator)
     t = np.arange(int(round(seconds * rate))) / rate
     q, dq, ddq = trajectory.evaluate(t)
-    meas = simulate_measurements(robot, t, q, dq, ddq, noise, rng)
-    return Recording(f"simulated {robot.name}, seed {seed}", t, meas.q, None, torques_from_currents(meas.current, robot.drive_gains),
+    meas = simulate_measurements(robot, t, q, dq, ddq, noise, generator)
+    seeded = f", seed {int(rng)}" if isinstance(rng, (int, np.integer)) else ""
+    return Recording(f"simulated {robot.name}{seeded}", t, meas.q, None, torques_from_currents(meas.current, robot.drive_gains),
                      float(rate))
