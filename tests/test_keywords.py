@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.exceptions import ConfigError
 from dynid.keywords import keyword_only_after_data
 
 DATA = {"q", "dq", "ddq", "tau", "t", "phi", "q_rest", "config"}
@@ -87,3 +88,6 @@ def test_the_random_state_has_one_name_and_the_former_one_still_works_with_a_war
     assert ident.get_params()["rng"] == 4 and "seed" not in ident.get_params()
     with pytest.warns(FutureWarning, match="seed= is now rng="):
         assert IdentificationPipeline(robot, seed=5).rng == 5
+    with pytest.warns(FutureWarning, match="identify_from_arrays: seed= is now rng="):
+        with pytest.raises(ConfigError, match="unknown setting 'magic'"):
+            dynid.identify_from_arrays(robot, log.t, log.q, log.tau, seed=1, magic=2)

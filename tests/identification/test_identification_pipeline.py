@@ -81,7 +81,7 @@ def test_settings_given_to_the_arrays_path_are_applied(slow_quiet_log):
     assert smooth.model.coulomb_velocity.tolist() == [0.05] * 6
     assert not np.allclose(smooth.solution.params, sign.solution.params, rtol=1e-6)
     boot = lambda r: np.array(list(r.diagnostics["bootstrap_std"].values()))
-    one, again = fit(preprocessing=dynid.Preprocessing(auto=False), seed=1), fit(preprocessing=dynid.Preprocessing(auto=False), seed=1)
+    one, again = fit(preprocessing=dynid.Preprocessing(auto=False), rng=1), fit(preprocessing=dynid.Preprocessing(auto=False), rng=1)
     np.testing.assert_array_equal(boot(one), boot(again))
     assert not np.array_equal(boot(one), boot(sign))  # seed 0 against seed 1: another bootstrap
 

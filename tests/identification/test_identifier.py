@@ -231,7 +231,7 @@ def test_an_estimator_object_carries_its_hyperparameters_through_the_identifier(
     assert not np.array_equal(geometric, euclidean.estimates["dynid SDP"].params)
     assert sdp.links is None and sdp.prior is None  # the object given is not filled in
     with pytest.raises(ConfigError, match="identify_from_arrays: unknown setting 'sdp_prior'; expected one of controller, "
-                                          "estimators, friction, preprocessing, seed"):
+                                          "estimators, friction, preprocessing, rng"):
         identify_from_arrays(robot, log.t, log.q, log.tau, sdp_prior="geometric")
 
     class Mine(Estimator):

@@ -23,7 +23,7 @@ from ..io.log_repairs import (
     uniform_rate,
     unwrapped_positions,
 )
-from ..keywords import keyword_only_after_data, seed_of
+from ..keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..model.description import builtin_robots
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -558,6 +558,7 @@ def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
     return np.where(np.isfinite(gains) & (read > 0), gains / np.where(read > 0, read, 1.0), 1.0)
 
 
+@renamed_keyword("seed", "rng")
 @with_single_blas_thread
 def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "arrays", **settings):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
@@ -602,13 +603,11 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "array
     from .pipeline import IdentificationPipeline
 
     known = {f.name for f in fields(IdentificationPipeline) if f.init} - {"robot", "source"}
-    unknown = sorted(set(settings) - known - {"seed"})  # seed: rng's former name, taken with a FutureWarning
+    unknown = sorted(set(settings) - known)
     if unknown:
         raise ConfigError(f"identify_from_arrays: unknown setting {unknown[0]!r}; expected one of {', '.join(sorted(known))}",
                           field=unknown[0])
-    given = {"preprocessing": settings.get("preprocessing") or Preprocessing()}
-    if "seed" not in settings:
-        given["rng"] = seed_of(settings.get("rng"))
+    given = {"rng": seed_of(settings.get("rng")), "preprocessing": settings.get("preprocessing") or Preprocessing()}
     pipeline = IdentificationPipeline(robot, **{**settings, **given},
                                       source=robot.name if robot.name in builtin_robots() else "")
     return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))
