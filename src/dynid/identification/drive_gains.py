@@ -21,7 +21,7 @@ last link, about its origin, eq. 5 order).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -179,11 +179,6 @@ class PayloadEstimate:
         lost = set(self.not_determined)
         return {n: {"value": float(v), "std": float(s), "determined": n not in lost}
                 for n, v, s in zip(self.names, self.values, self.std)}
-
-
-def _current_robot(robot: Robot) -> Robot:
-    """The same robot with unit gains, so that its datasets' "torques" are the currents."""
-    return replace(robot, drive_gains=np.ones(robot.n_dof))
 
 
 def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedData, loaded: PreparedData,

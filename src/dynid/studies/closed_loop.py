@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -51,7 +51,7 @@ from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from ..threads import with_single_blas_thread
-from .paper import PaperExperimentConfig, identification_trajectory
+from .paper import PaperExperimentConfig, identification_trajectory, study_header
 
 __all__ = ["ENCODER_NOISE_DEG", "TORQUE_NOISE", "CLOSED_LOOP_ESTIMATORS", "ClosedLoopStudyConfig", "ClosedLoopStudyResult",
            "run_closed_loop_study", "simulate_realisation", "zero_order_hold_delay"]
@@ -417,9 +417,7 @@ class ClosedLoopStudyResult:
 
         return {
             "study": "closed loop",
-            "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self.config).items()},
-            "parameters": names,
-            "truth": dict(zip(names, self.truth.tolist())),
+            **study_header(self.config, names, self.truth),
             "cluster": self.cluster,
             "cells": [{"encoder_noise_deg": e, "torque_noise_Nm": s, "best": self.best(c, stats),
                        "cramer_rao_std": dict(zip(names, self.crb_std[c].tolist())),

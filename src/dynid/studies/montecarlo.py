@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,7 +42,14 @@ from ..model.robot import Robot
 from ..preprocessing import strategies
 from ..simulation.measurements import NoiseModel
 from ..threads import with_single_blas_thread
-from .paper import PaperExperimentConfig, identification_trajectory, paper_search_box, problem, simulate_dataset
+from .paper import (
+    PaperExperimentConfig,
+    identification_trajectory,
+    paper_search_box,
+    problem,
+    simulate_dataset,
+    study_header,
+)
 
 DEFAULT_ESTIMATORS = ("ols", "wls", "irls", "lad", "sdp", "abc")
 """The box searches at 10× budget (ABC×10, DE, PSO) are left out by default for time; ask for them with estimators."""
@@ -287,9 +294,7 @@ class MonteCarloResult:
         names = list(self.names)
         levels = [float(x) for x in self.config.noise_levels]
         return {
-            "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self.config).items()},
-            "parameters": names,
-            "truth": dict(zip(names, self.truth.tolist())),
+            **study_header(self.config, names, self.truth),
             "noise_levels_A": levels,
             "cluster": self.cluster,
             "cramer_rao_std": [dict(zip(names, row.tolist())) for row in self.crb_std],

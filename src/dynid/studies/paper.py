@@ -317,8 +317,7 @@ class PaperRunResult:
             "joints": self.config.joints,
             "plant": self.config.plant,
             "seed": self.config.seed,
-            "settings": {**{k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self.config).items()},
-                         "estimators": list(parse_estimators(self.config.estimators))},
+            "settings": {**settings_of(self.config), "estimators": list(parse_estimators(self.config.estimators))},
             "parameters": names,
             "units": {n: unit_of(n) for n in names},
             "paper_symbols": {n: ref.paper_symbol(n) for n in names},
@@ -520,6 +519,39 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     w, tau = rows
     assert w is not None and tau is not None  # kept rows: keep_rows=True
     return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool)
+
+
+def settings_of(config) -> dict:
+    """A study's settings as its JSON holds them: the config's fields, tuples as lists.
+
+    Parameters
+    ----------
+    config : dataclass
+        A study's config (:class:`PaperExperimentConfig`, the Monte Carlo's, the closed-loop study's).
+
+    Returns
+    -------
+    dict
+    """
+    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(config).items()}
+
+
+def study_header(config, names: list[str], truth: np.ndarray) -> dict:
+    """What a simulated study's JSON opens with: its settings, the base parameters' names and the truth.
+
+    Parameters
+    ----------
+    config : dataclass
+    names : list of str
+        Base parameter names.
+    truth : (n_base,) array
+
+    Returns
+    -------
+    dict
+        ``settings``, ``parameters``, ``truth`` (by name).
+    """
+    return {"settings": settings_of(config), "parameters": names, "truth": dict(zip(names, truth.tolist()))}
 
 
 def _metrics(tau: np.ndarray, pred: np.ndarray) -> dict:
