@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-import dynid.column_store as column_store
-from dynid.column_store import ColumnFile, StoredColumns, by_column, root_mean_square, select_rows
+import dynid._util.column_store as column_store
+from dynid._util.column_store import ColumnFile, StoredColumns, by_column, root_mean_square, select_rows
 from dynid.exceptions import DataError
 from dynid.io.tables import read_table
 

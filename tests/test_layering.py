@@ -5,10 +5,10 @@ from pathlib import Path
 
 import dynid
 
-ORDER = ["conventions", "exceptions", "checks", "friction", "threads", "tables", "model", "dynamics",
+ORDER = ["conventions", "exceptions", "_util", "friction", "runtime", "tables", "model", "dynamics",
          "excitation", "simulation", "preprocessing", "optim", "estimators", "validation", "io",
          "identification", "studies", "fleet", "report", "cli"]
-LEVEL = {"conventions": 0, "exceptions": 0, "checks": 0, "typed": 0, "friction": 0, "threads": 0, "tables": 0, "_lazy": 0, "keywords": 0, "hyperparameters": 0, "column_store": 0, "processes": 0, "extras": 0, "plugins": 0, "cluster": 0, "model": 1, "dynamics": 2, "excitation": 3, "simulation": 3,
+LEVEL = {"conventions": 0, "exceptions": 0, "_util": 0, "friction": 0, "runtime": 0, "tables": 0, "_lazy": 0, "plugins": 0, "model": 1, "dynamics": 2, "excitation": 3, "simulation": 3,
          "preprocessing": 3, "optim": 3, "estimators": 4, "validation": 5, "io": 5, "identification": 6, "studies": 7, "fleet": 7, "report": 8, "cli": 9,
          "warm_up": 9, "experiment": 9}
 FACADE = {"__init__", "__main__"}

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.processes import ForkedCall, allow_forks, can_fork
-from dynid.threads import cores
+from dynid.runtime.processes import ForkedCall, allow_forks, can_fork
+from dynid.runtime.threads import cores
 
 PARENT = os.getpid()
 needs_fork = pytest.mark.skipif(not (sys.platform.startswith("linux") and cores() >= 2), reason="needs fork and two cores")

@@ -33,7 +33,7 @@ def _hostile_pickle(marker) -> bytes:
 
 def test_no_loader_that_runs_code_in_the_package():
     """pickle, marshal, shelve, joblib, numpy's allow_pickle, yaml.load and eval/exec appear nowhere in src/dynid (the
-    forked children's answers come back through multiprocessing's pipes: dynid.processes)."""
+    forked children's answers come back through multiprocessing's pipes: dynid.runtime.processes)."""
     pattern = re.compile(r"\bpickle\.loads?\(|\bmarshal\.loads?\(|\bshelve\.open\(|\bjoblib\.load\(|allow_pickle\s*=\s*True"
                          r"|\byaml\.(load|unsafe_load)\(|(?<![\w.])eval\(|(?<![\w.])exec\(|dill\.|cloudpickle\.loads?\(")
     found = []

@@ -19,9 +19,16 @@ The main entry points, importable from the package (each loads its modules on fi
 ``examples/`` holds short scripts that use them.
 """
 
-from ._lazy import lazy_exports
+from ._lazy import alias_moved_modules, lazy_exports
 
 __version__ = "0.2.0"
+
+MOVED_MODULES = {f"dynid.{name}": f"dynid.{package}.{name}" for package, names in (
+    ("runtime", ("threads", "processes", "cluster", "extras")),
+    ("_util", ("keywords", "hyperparameters", "typed", "checks", "column_store"))) for name in names}
+"""Loose top-level modules grouped into packages in 0.2 -> where they went: their old paths import them, with a
+FutureWarning, for a release (docs/changelog.md)."""
+alias_moved_modules(MOVED_MODULES)
 
 _EXPORTS = {
     "load_robot": "dynid.model.description",

@@ -80,12 +80,12 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     import sys
     from pathlib import Path
 
-    from dynid import processes
+    from dynid.runtime import processes
     from dynid.identification.run import run_identification
     from dynid.io import write_json
     from dynid.io.identification_config import load_identification_config
-    from dynid.processes import allow_forks
-    from dynid.threads import cores
+    from dynid.runtime.processes import allow_forks
+    from dynid.runtime.threads import cores
 
     from ..conftest import shared_data, without_wall_times
 

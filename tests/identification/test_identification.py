@@ -239,10 +239,10 @@ def test_a_joint_that_never_moves_is_named_and_keeps_the_descriptions_drive_term
 
 
 def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch):
-    """A long log's signals are held in temporary files (dynid.column_store), read column by column and chunk
+    """A long log's signals are held in temporary files (dynid._util.column_store), read column by column and chunk
     by chunk: on the UR10e logs spooled that way, identification and validations give the results of the
     in-memory path, every number of results.json."""
-    from dynid.column_store import StoredColumns
+    from dynid._util.column_store import StoredColumns
     from dynid.io import datasets
 
     root = shared_data("ur10e_mamedov2020")

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from dynid.io.config_types import SCHEMAS
-from dynid.typed import json_schema
+from dynid._util.typed import json_schema
 
 jsonschema = pytest.importorskip("jsonschema")
 REPO = Path(__file__).resolve().parents[2]

@@ -263,9 +263,9 @@ def _motor_side(tmp_path, rng):
 @pytest.mark.parametrize("log", [_ur_jittered, _motor_side])
 def test_a_spooled_recording_equals_the_one_in_memory(tmp_path, rng, log, monkeypatch):
     """Read through temporary files (as a long log is), every step gives the numbers of the in-memory path."""
-    from dynid.column_store import StoredColumns
+    from dynid._util.column_store import StoredColumns
 
-    monkeypatch.setattr("dynid.column_store.ROW_CHUNK", 64)  # the transmission in several chunks
+    monkeypatch.setattr("dynid._util.column_store.ROW_CHUNK", 64)  # the transmission in several chunks
     robot, table = log(tmp_path, rng)
     spec = dataset_spec(table, tmp_path, "cfg", "ident", 6)
     memory, spooled = load_recording(spec, robot, spool=False), load_recording(spec, robot, spool=True)
@@ -322,7 +322,7 @@ def test_positions_logged_within_one_turn_are_taken_back(tmp_path, spool):
     """J6 turning on through ±π, logged in [-π, π) as a continuous joint is: every jump of a whole turn is taken back
     (the positions equal the turning angle again, as read and as stored for a long log), the warning names the joint
     and how often; J5's glitch of 4 rad, not a whole turn, is left for the other checks; the other joints untouched."""
-    from dynid.column_store import StoredColumns
+    from dynid._util.column_store import StoredColumns
 
     t = np.arange(600) * 0.01
     q = 0.3 * np.sin(np.outer(t, np.arange(1, 7)))

@@ -109,7 +109,7 @@ def test_parallel_filter_without_decimation_equals_scipy(rng):
 def test_band_of_stored_columns_equals_that_of_the_array(rng, tmp_path, monkeypatch):
     """The spectrum is summed one joint at a time (temporaries one column long): a log held in stored columns
     gives the same band and noise share as the same log in memory."""
-    from dynid.column_store import StoredColumns
+    from dynid._util.column_store import StoredColumns
 
     monkeypatch.setenv("TMPDIR", str(tmp_path))
     rate, n = 500.0, 20011

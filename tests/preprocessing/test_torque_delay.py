@@ -5,7 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dynid.column_store import StoredColumns
+from dynid._util.column_store import StoredColumns
 from dynid.exceptions import ConfigError
 from dynid.identification.closed_loop import _rows
 from dynid.io.datasets import Recording

@@ -10,7 +10,7 @@ import pytest
 from dynid.exceptions import ConfigError
 from dynid.report import output
 from dynid.report.output import MANIFEST, check_output_folder, staged
-from dynid.threads import cores
+from dynid.runtime.threads import cores
 
 
 @staged
@@ -141,7 +141,7 @@ FORKS = sys.platform.startswith("linux") and cores() >= 2
 @pytest.fixture
 def forks():
     """As in the CLI's commands, which run inside allow_forks (the library alone draws in its process)."""
-    from dynid.processes import allow_forks
+    from dynid.runtime.processes import allow_forks
 
     with allow_forks():
         yield

@@ -68,7 +68,7 @@ def test_bad_settings(kwargs, message):
 
 
 def test_unreachable_scheduler_is_a_one_line_error():
-    from dynid.cluster import dask_client
+    from dynid.runtime.cluster import dask_client
 
     with pytest.raises(ConfigError, match="cannot reach the Dask scheduler"):
         with dask_client(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0):

@@ -932,7 +932,7 @@ def montecarlo(
                                       estimators=parse_estimators(estimators, DEFAULT_ESTIMATORS), seed=seed, duration=duration,
                                       rate=200.0 if rate is None else rate, abc_bounds=abc_bounds, excitation=excitation, strategy=strategy)
             config.validate()  # every option checked before the workers start
-        from ..extras import require
+        from ..runtime.extras import require
 
         require("distributed", "montecarlo", "dynid montecarlo")
         return config
@@ -973,7 +973,7 @@ def fleet(
     def prepare():
         check_fleet_options(workers)
         parsed = load_fleet_manifest(manifest, data_root)  # every unit's config checked before the workers start
-        from ..extras import require
+        from ..runtime.extras import require
 
         require("distributed", "fleet", "dynid fleet")
         require("pyarrow", "fleet", "dynid fleet")
@@ -1092,7 +1092,7 @@ def main(argv: list[str] | None = None) -> int:
 
     os.environ.setdefault("MPLBACKEND", "Agg")  # figures go to files: no display needed, none opened
 
-    from ..processes import allow_forks
+    from ..runtime.processes import allow_forks
 
     handlers = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:

@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..threads import cores
+from ..runtime.threads import cores
 
 
 def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl):

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..threads import cores
+from ..runtime.threads import cores
 from . import _regressor_kernel
 
 LANES = 4

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import IdentifiabilityError
-from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from .regressor import observation_matrix
 

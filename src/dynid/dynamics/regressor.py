@@ -25,9 +25,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import check_states
+from .._util.checks import check_states
+from .._util.keywords import keyword_only_after_data
 from ..friction import drive_columns
-from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from . import _regressor_kernel as kernel
 from . import _regressor_simd

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..keywords import keyword_only_after_data
+from .._util.keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..model.urdf import pinocchio_from_inertial
 from .regressor import friction_torques

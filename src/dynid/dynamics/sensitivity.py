@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_states, check_trajectory_array
+from .._util.checks import check_states, check_trajectory_array
 from ..friction import drive_column_derivatives
 from ..model.robot import Robot
 from .kinematics import forward_kinematics

@@ -6,8 +6,8 @@ import inspect
 
 import numpy as np
 
+from .._util.hyperparameters import HyperParameters
 from ..exceptions import NotFittedError, ShapeError
-from ..hyperparameters import HyperParameters
 from .accumulate import LeastSquaresAccumulator
 
 

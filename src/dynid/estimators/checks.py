@@ -25,8 +25,8 @@ import inspect
 
 import numpy as np
 
+from .._util.keywords import renamed_keyword, seed_of
 from ..exceptions import DynIdError
-from ..keywords import renamed_keyword, seed_of
 from .base import BoxSearchEstimator, Estimator, paper_objective
 from .fitting import fit_method
 from .problem import FitData, SearchBudget

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..exceptions import ConfigError, DynIdError
-from ..threads import cores
+from ..runtime.threads import cores
 from .problem import FitData, SearchBudget
 from .registry import _named, is_plugin, spec
 

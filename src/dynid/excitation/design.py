@@ -25,14 +25,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..dynamics.sensitivity import origins_jacobian, regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
-from ..keywords import keyword_only_after_data
 from ..model.robot import Limits, Robot
-from ..threads import with_single_blas_thread
+from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory

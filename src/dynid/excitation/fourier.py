@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import ConfigError
-from ..keywords import keyword_only_after_data
 
 
 @dataclass(frozen=True)

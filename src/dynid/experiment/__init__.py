@@ -6,10 +6,8 @@ went with a ``FutureWarning``."""
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.util
-import sys
-import warnings
+
+from .._lazy import alias_moved_modules, moved
 
 MOVED = {
     "closed_loop": "dynid.identification.closed_loop",
@@ -36,37 +34,12 @@ _NAMES = {"PaperExperimentConfig": "dynid.studies.paper", "PaperRunResult": "dyn
           "run_paper_experiment": "dynid.studies.paper"}
 
 
-def _moved(old: str, new: str) -> None:
-    warnings.warn(f"{old} moved to {new}; the old name goes in a later release", FutureWarning, stacklevel=3)
-
-
-class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Imports ``dynid.experiment.<old>`` as the module it became (the same module object, so state is shared)."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        prefix = __name__ + "."
-        if fullname.startswith(prefix) and fullname[len(prefix):] in MOVED:
-            return importlib.util.spec_from_loader(fullname, self)
-        return None
-
-    def create_module(self, spec):
-        new = MOVED[spec.name.rsplit(".", 1)[1]]
-        _moved(spec.name, new)
-        module = importlib.import_module(new)
-        spec.loader_state = (module.__spec__, module.__loader__)  # the import system writes the alias's over them
-        return module
-
-    def exec_module(self, module):
-        module.__spec__, module.__loader__ = module.__spec__.loader_state
-
-
-if not any(isinstance(f, _Alias) for f in sys.meta_path):
-    sys.meta_path.append(_Alias())
+alias_moved_modules({f"{__name__}.{old}": new for old, new in MOVED.items()})
 
 
 def __getattr__(name):
     if name in _NAMES:
-        _moved(f"{__name__}.{name}", _NAMES[name])
+        moved(f"{__name__}.{name}", _NAMES[name])
         value = globals()[name] = getattr(importlib.import_module(_NAMES[name]), name)
         return value
     if name in MOVED:

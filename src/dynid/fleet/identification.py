@@ -20,15 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cluster import dask_client
 from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
-from ..extras import require
 from ..identification.run import run_identification, validate_sets
 from ..io.files import write_json
 from ..io.fleet_manifest import FleetManifest, FleetUnit
 from ..io.identification_config import stored_preprocessing
 from ..io.results import read_results
+from ..runtime.cluster import dask_client
+from ..runtime.extras import require
 from .outliers import fleet_outliers
 
 __all__ = ["UnitSummary", "FleetResult", "identify_unit", "run_fleet", "add_pooled_estimates"]

@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..column_store import root_mean_square
+from .._util.column_store import root_mean_square
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import regressor
 from ..exceptions import IdentifiabilityError

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from .._util.keywords import keyword_only_after_data
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import regressor
@@ -22,7 +23,6 @@ from ..exceptions import ConfigError, DataError
 from ..io.export import mjcf_from_results, urdf_from_results
 from ..io.files import _clean, write_json
 from ..io.results import check_fingerprint, read_results, stored_estimates
-from ..keywords import keyword_only_after_data
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from .._util.hyperparameters import HyperParameters
+from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..exceptions import ConfigError, NotFittedError
-from ..hyperparameters import HyperParameters
-from ..keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 

@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ..column_store import root_mean_square
+from .._util.column_store import root_mean_square
+from .._util.keywords import keyword_only_after_data
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
@@ -28,7 +29,6 @@ from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estima
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.references import ReferenceSet
-from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData

@@ -31,10 +31,10 @@ from typing import Any
 
 import numpy as np
 
+from .._util.keywords import renamed_keyword
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
-from ..keywords import renamed_keyword
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds

@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..checks import check_trajectory_array
+from .._util.checks import check_trajectory_array
+from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
 from ..io.dataset_specs import DatasetSpec
@@ -23,13 +24,12 @@ from ..io.log_repairs import (
     uniform_rate,
     unwrapped_positions,
 )
-from ..keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..model.description import builtin_robots
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over, yardstick_settings
-from ..processes import ForkedCall
-from ..threads import with_single_blas_thread
+from ..runtime.processes import ForkedCall
+from ..runtime.threads import with_single_blas_thread
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL

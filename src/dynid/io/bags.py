@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError
-from ..extras import require
+from ..runtime.extras import require
 
 
 def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None):

@@ -2,7 +2,7 @@
 with its type, its allowed values and a description (what editors show from the JSON Schemas in ``dynid/schema/``).
 
 The parsers (:mod:`dynid.io.identification_config`, :mod:`dynid.io.datasets`, :mod:`dynid.io.excitation_config`)
-convert a document into these structures first (:func:`dynid.typed.convert`: one-line messages naming file and
+convert a document into these structures first (:func:`dynid._util.typed.convert`: one-line messages naming file and
 field), then check what depends on the robot (one value per joint) and the files.
 """
 
@@ -16,10 +16,10 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, Union
 import msgspec
 from msgspec import Meta
 
+from .._util.typed import Table, json_schema
 from ..model.description_types import Angle
 from ..model.description_types import RobotDescription as _RobotDescription
 from ..preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
-from ..typed import Table, json_schema
 
 if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
     RobotDescription = Any

@@ -226,7 +226,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         Unknown preset, unit or side, a missing signal or file, a column list of the wrong length;
         the message names the config field.
     """
-    from ..typed import convert
+    from .._util.typed import convert
     from .config_types import DatasetTable
 
     source, _, inside = where.rpartition(": ")

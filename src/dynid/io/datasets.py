@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..column_store import SPOOL_BYTES, StoredColumns
+from .._util.column_store import SPOOL_BYTES, StoredColumns
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import DataError
-from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from .columns import csv_table
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
@@ -39,7 +39,7 @@ from .tables import read_table
 @dataclass(frozen=True)
 class Recording:
     """A measured dataset in SI joint quantities on a uniform time grid. The (N, n_dof) signals are arrays,
-    or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
+    or for a spooled long log :class:`dynid._util.column_store.StoredColumns` (``t`` is always an array).
 
     Attributes
     ----------
@@ -98,8 +98,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
         time, positions and torques or currents).
     robot : Robot
     spool : bool, optional
-        Hold the signals in temporary files (:mod:`dynid.column_store`) rather than in memory; by default when the
-        files hold more than :data:`dynid.column_store.SPOOL_BYTES` (an hour-long log). The numbers are the same
+        Hold the signals in temporary files (:mod:`dynid._util.column_store`) rather than in memory; by default when the
+        files hold more than :data:`dynid._util.column_store.SPOOL_BYTES` (an hour-long log). The numbers are the same
         either way.
 
     Returns

@@ -48,6 +48,7 @@ from typing import Any
 import msgspec
 import numpy as np
 
+from .._util.typed import convert
 from ..exceptions import ConfigError
 from ..excitation.constraints import Workspace
 from ..excitation.design import ExcitationProblem
@@ -57,7 +58,6 @@ from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
-from ..typed import convert
 from .config_types import ExcitationDocument
 from .configs import config_mjcf, config_robot, config_urdf, read_config
 from .trajectories import load_trajectory

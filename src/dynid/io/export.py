@@ -23,8 +23,8 @@ from html import escape
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import ConfigError
-from ..keywords import keyword_only_after_data
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems

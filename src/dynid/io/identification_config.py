@@ -71,13 +71,13 @@ from typing import Any
 import msgspec
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
+from .._util.typed import convert
 from ..estimators.registry import estimate_label, estimator_choices, keys
 from ..exceptions import ConfigError, DataError
-from ..keywords import keyword_only_after_data
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
-from ..typed import convert
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec

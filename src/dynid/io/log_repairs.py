@@ -9,7 +9,7 @@ from functools import partial
 
 import numpy as np
 
-from ..column_store import StoredColumns, by_column, select_rows
+from .._util.column_store import StoredColumns, by_column, select_rows
 from ..conventions import MOVING_SPAN, time_unit_of
 from ..exceptions import DataError
 from ..model.robot import Robot

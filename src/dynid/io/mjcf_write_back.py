@@ -19,10 +19,10 @@ import numpy as np
 
 from ..dynamics.kinematics import forward_kinematics
 from ..exceptions import ConfigError
-from ..extras import require
 from ..model.mjcf import held_inertials
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
+from ..runtime.extras import require
 from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia
 
 AXIS_TOLERANCE = 1e-4

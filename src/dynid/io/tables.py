@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..column_store import ColumnFile, StoredColumns
+from .._util.column_store import ColumnFile, StoredColumns
 from ..exceptions import DataError
-from ..threads import cores
+from ..runtime.threads import cores
 from .files import text_encoding_hint
 
 BLOCK = 100_000
@@ -173,7 +173,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     rows : (first, last), optional
         1-based, inclusive range of data rows (header excluded) to read; default all.
     spool : bool
-        Write each block's columns to temporary files (:mod:`dynid.column_store`) instead of holding
+        Write each block's columns to temporary files (:mod:`dynid._util.column_store`) instead of holding
         them: a long log's memory is then one block, whatever its length.
     missing : bool
         Read an empty field or NaN as NaN (a missing value, for the caller to fill or refuse) instead of refusing it.

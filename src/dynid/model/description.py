@@ -57,10 +57,10 @@ from typing import Any
 
 import numpy as np
 
+from .._util.typed import convert
 from ..conventions import COUPLING_TERMS, DEFAULT_DRIVE_TERMS
 from ..exceptions import ConfigError
 from ..friction import COUNTERBALANCE_TERMS, DEFAULT_STRIBECK_VELOCITY, TERMS, check_terms
-from ..typed import convert
 from .description_types import PayloadTable, TransmissionTable, description_types
 from .dh import joints_from_modified_dh, joints_from_standard_dh, standard_dh_link_offset
 from .robot import Limits, Robot

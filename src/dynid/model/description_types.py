@@ -12,8 +12,8 @@ from typing import Annotated, Literal, Union
 import msgspec
 from msgspec import Meta
 
+from .._util.typed import Table
 from ..friction import TERMS
-from ..typed import Table
 
 __all__ = ["RobotDescription", "JointTable", "ToolTable", "TransmissionTable", "CouplingTable", "PayloadTable"]
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import ConfigError
-from ..extras import require
+from ..runtime.extras import require
 from .robot import Joint
 from .robot_files import HELD_HINT, check_xml
 from .spatial import inertial_from_physical, rot_axis, transform_inertial

@@ -14,7 +14,7 @@ from xml.parsers import expat
 import numpy as np
 
 from ..exceptions import ConfigError
-from ..extras import require
+from ..runtime.extras import require
 from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
 from .robot_files import HELD_HINT, check_xml, is_mjcf

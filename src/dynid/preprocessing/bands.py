@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..column_store import StoredColumns
+from .._util.column_store import StoredColumns
 
 ENERGY_FRACTION = 0.99
 """Fraction of the velocity energy that defines the excitation band."""

@@ -12,9 +12,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..column_store import by_column
+from .._util.column_store import by_column
 from ..exceptions import ConfigError
-from ..threads import cores
+from ..runtime.threads import cores
 from .bands import decimation_cutoff
 
 
@@ -36,7 +36,7 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
 
     Parameters
     ----------
-    x : (N, ...) array, or StoredColumns (:mod:`dynid.column_store`: the result is stored too)
+    x : (N, ...) array, or StoredColumns (:mod:`dynid._util.column_store`: the result is stored too)
         Filtered one column at a time: the same numbers as the whole-array call along axis 0.
     rate : float
         Sampling rate [Hz].

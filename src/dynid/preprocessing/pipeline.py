@@ -21,7 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..column_store import StoredColumns, by_column, root_mean_square
+from .._util.column_store import StoredColumns, by_column, root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError

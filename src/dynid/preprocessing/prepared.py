@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..column_store import by_column
+from .._util.column_store import by_column
 from ..conventions import MOVING_SPAN
 from ..exceptions import ConfigError, DataError
 from ..friction import Velocities, held_direction
@@ -20,14 +20,14 @@ __all__ = ["check_velocities", "clipped_samples", "dead_channels", "PreparedData
            "min_speeds", "rest_decay", "rest_velocities"]
 
 Samples = Any
-"""An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid.column_store.StoredColumns`."""
+"""An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid._util.column_store.StoredColumns`."""
 
 
 @dataclass(frozen=True)
 class PreparedData:
     """Filtered joint signals on a uniform grid, ready for the regressor.
 
-    Signals are arrays, or for a spooled long log :class:`dynid.column_store.StoredColumns` (``t`` is always an array).
+    Signals are arrays, or for a spooled long log :class:`dynid._util.column_store.StoredColumns` (``t`` is always an array).
 
     Attributes
     ----------

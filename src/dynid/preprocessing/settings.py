@@ -7,8 +7,8 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import ConfigError
-from ..keywords import keyword_only_after_data
 from .bands import (
     PARALLEL_FACTOR,
     POSITION_FACTOR,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from .._util.keywords import keyword_only_after_data
 from ..exceptions import DynIdError
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
@@ -13,7 +14,6 @@ from ..io.mjcf_write_back import mjcf_written_back
 from ..io.replay import mjcf_replay, urdf_replay
 from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
-from ..keywords import keyword_only_after_data
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, save_figure, staged, write_results

@@ -17,7 +17,7 @@ from pathlib import Path
 from .. import __version__
 from ..exceptions import ConfigError
 from ..io import atomic_write_bytes, atomic_write_text, write_json
-from ..processes import can_fork, pipe, start_child
+from ..runtime.processes import can_fork, pipe, start_child
 
 MANIFEST = ".dynid-manifest.json"
 """Written last into an output folder: the files of the run that is there, whole."""
@@ -200,7 +200,7 @@ def draw_figures(build, *args) -> None:
 
 
 def _draw_jobs(jobs) -> None:
-    """Run figure jobs on two processes where :func:`dynid.processes.can_fork`: a forked child draws every
+    """Run figure jobs on two processes where :func:`dynid.runtime.processes.can_fork`: a forked child draws every
     other job while this process draws the rest (drawing is single-threaded Python; a fork shares the
     imported matplotlib and the data). If the child fails, this process draws its jobs too.
     Call it with no other thread of this process printing (the CLI ends its live progress line first).
@@ -293,7 +293,7 @@ def figure_process(enabled: bool = True):
     """A block within which :func:`draw_figures` hands the figures to a forked process.
 
     The process, forked on entry, imports matplotlib and warms up drawing while this process computes, so that both
-    are off the command's path. Nothing is forked where ``enabled`` is false or :func:`dynid.processes.can_fork` is
+    are off the command's path. Nothing is forked where ``enabled`` is false or :func:`dynid.runtime.processes.can_fork` is
     (outside the CLI's commands, on one core, not on Linux). Enter it with no other Python thread running (before the
     CLI's live progress line starts its thread). On exit the process is waited for (it leaves at once when nothing was
     sent).

@@ -12,13 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..conventions import split_name, unit_of
 from ..estimators.registry import OTHER_LABELS, label
 from ..friction import TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY
-from ..keywords import keyword_only_after_data
 from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
 from ..validation.noise_floor import AT_FLOOR

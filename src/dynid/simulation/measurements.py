@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_vector
+from .._util.checks import check_vector
 from ..dynamics.rnea import rnea_torques
 from ..exceptions import ConfigError
 from ..model.robot import Robot

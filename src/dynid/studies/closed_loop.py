@@ -33,7 +33,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..cluster import map_realisations
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..dynamics.rnea import rnea_torques
@@ -42,15 +41,16 @@ from ..estimators.registry import label, parse_estimators
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
-from ..extras import require
 from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
 from ..identification.pipeline import IdentificationPipeline
 from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing
+from ..runtime.cluster import map_realisations
+from ..runtime.extras import require
+from ..runtime.threads import with_single_blas_thread
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
-from ..threads import with_single_blas_thread
 from .paper import PaperExperimentConfig, identification_trajectory, study_header
 
 __all__ = ["ENCODER_NOISE_DEG", "TORQUE_NOISE", "CLOSED_LOOP_ESTIMATORS", "ClosedLoopStudyConfig", "ClosedLoopStudyResult",

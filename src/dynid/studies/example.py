@@ -16,8 +16,8 @@ from importlib import resources
 
 import numpy as np
 
+from .._util.keywords import renamed_keyword, seed_of
 from ..exceptions import ConfigError
-from ..keywords import renamed_keyword, seed_of
 from ..model.description import builtin_robots, load_robot
 from .simulated_logs import simulated_log
 

@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cluster import map_realisations
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..estimators import registry
@@ -36,12 +35,13 @@ from ..estimators.registry import SearchBudget, label, parse_estimators, seed_in
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import FourierTrajectory, sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
-from ..extras import require
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing import strategies
+from ..runtime.cluster import map_realisations
+from ..runtime.extras import require
+from ..runtime.threads import with_single_blas_thread
 from ..simulation.measurements import NoiseModel
-from ..threads import with_single_blas_thread
 from .paper import (
     PaperExperimentConfig,
     identification_trajectory,

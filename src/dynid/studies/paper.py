@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
@@ -40,14 +41,13 @@ from ..excitation.paper_trajectories import (
 )
 from ..io.datasets import Recording
 from ..io.trajectories import load_trajectory
-from ..keywords import keyword_only_after_data
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks, prepare
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
+from ..runtime.threads import with_single_blas_thread
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
-from ..threads import with_single_blas_thread
 from ..validation import correlation_coefficient, relative_error, rmse
 from . import paper_reference as ref
 

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util.keywords import renamed_keyword, seed_of
 from ..exceptions import ConfigError
 from ..excitation.fourier import FourierTrajectory
-from ..keywords import renamed_keyword, seed_of
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._util.keywords import keyword_only_after_data, renamed_keyword
 from ..io.datasets import Recording
-from ..keywords import keyword_only_after_data, renamed_keyword
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from .simulated_fleet import random_excitation

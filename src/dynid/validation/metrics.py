@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_same_length
+from .._util.checks import check_same_length
 from ..exceptions import ShapeError
 
 

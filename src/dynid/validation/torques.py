@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..column_store import root_mean_square
+from .._util.column_store import root_mean_square
 from ..dynamics.base_parameters import BaseParameters
 from ..model.friction_model import COULOMB_LIKE
 from ..model.robot import Robot

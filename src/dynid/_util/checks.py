@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .exceptions import ShapeError
+from ..exceptions import ShapeError
 
 
 def check_trajectory_array(x, n_dof: int, name: str = "q") -> np.ndarray:

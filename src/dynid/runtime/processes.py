@@ -16,7 +16,7 @@ import multiprocessing
 import os
 import sys
 
-from .exceptions import DynIdError
+from ..exceptions import DynIdError
 from .threads import cores
 
 _allowed = False

@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .exceptions import DataError
+from ..exceptions import DataError
 
 __all__ = ["SPOOL_BYTES", "ColumnFile", "StoredColumns", "by_column", "root_mean_square", "select_rows"]
 

@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 import msgspec
 from msgspec import inspect as mi
 
-from .exceptions import ConfigError
+from ..exceptions import ConfigError
 
 __all__ = ["Table", "convert", "json_schema", "field_path"]
 

@@ -8,9 +8,9 @@ import logging
 import os
 from collections.abc import Callable
 
-from .exceptions import ConfigError
+from ..exceptions import ConfigError
+from ..plugins import share_with
 from .extras import require
-from .plugins import share_with
 
 
 @contextlib.contextmanager

@@ -6,7 +6,7 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-from .exceptions import ConfigError
+from ..exceptions import ConfigError
 
 EXTRAS = {"montecarlo": ("distributed",), "fleet": ("distributed", "pyarrow"), "ros": ("rosbags",), "mujoco": ("mujoco",),
           "xacro": ("xacro",)}

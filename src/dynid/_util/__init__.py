@@ -1,0 +1,3 @@
+"""dynid's own helpers, below every other layer: how the public API takes its settings (:mod:`.keywords`,
+:mod:`.hyperparameters`), typed decoding of the configs (:mod:`.typed`), checks of the arrays a user gives
+(:mod:`.checks`), and the on-disk column store a long log is spooled to (:mod:`.column_store`)."""
