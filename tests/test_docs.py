@@ -46,10 +46,11 @@ def test_the_extending_pages_python_runs(tmp_path, monkeypatch, capsys):
     assert out[1] == str(namespace["prepared"].choices.to_dict()) and "coulomb_velocity" in out[1]
     ridge, ols = (float(x) for x in out[3].split()[:2])
     assert abs(ridge - ols) < 1e-6 * abs(ols)
-    sweep = {float(a): float(v) for a, v in (line.split() for line in out[4:6])}  # an object per value, one key
+    assert out[4] == f"Ridge ({len(namespace['ident'].feature_names_out_)},)"  # the fitted part, kept on the result
+    sweep = {float(a): float(v) for a, v in (line.split() for line in out[5:7])}  # an object per value, one key
     assert sweep[1e-9] == pytest.approx(ridge, rel=1e-9) and abs(sweep[1e-3] - ridge) > 1e-4 * abs(ridge)
-    assert "'sdp': {" in out[6] and "'prior_kind': 'geometric'" in out[6]
-    assert out[7] == "central differences, no filter"
+    assert "'sdp': {" in out[7] and "'prior_kind': 'geometric'" in out[7]
+    assert out[8] == "central differences, no filter"
 
 
 def test_every_page_of_the_site_is_in_its_navigation():
