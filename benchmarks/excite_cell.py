@@ -36,7 +36,6 @@ import numpy as np
 REPO = Path(__file__).resolve().parent
 sys.path.insert(0, str(REPO / "zoo"))
 
-from dynid.runtime.threads import with_single_blas_thread  # noqa: E402
 from zoo import ARMS, arm_urdf, robots_folder  # noqa: E402
 
 from dynid.dynamics.kinematics import forward_kinematics  # noqa: E402
@@ -46,6 +45,7 @@ from dynid.excitation.design import ExcitationProblem, InfeasibleDesignError, de
 from dynid.excitation.obstacles import Obstacle  # noqa: E402
 from dynid.io.cell_replay import cell_contacts  # noqa: E402
 from dynid.model.description import load_robot  # noqa: E402
+from dynid.runtime.threads import with_single_blas_thread  # noqa: E402
 
 CELL_ARMS = ("UR5", "Panda", "Kinova Jaco 2", "Unitree Z1")
 CLEARANCE = 0.05

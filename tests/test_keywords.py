@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import ConfigError
 from dynid._util.keywords import keyword_only_after_data
+from dynid.exceptions import ConfigError
 
 DATA = {"q", "dq", "ddq", "tau", "t", "phi", "q_rest", "config"}
 """Optional arguments that are data (a log's arrays, parameters, the experiment's config), positional by design."""

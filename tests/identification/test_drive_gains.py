@@ -80,10 +80,10 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
     import sys
     from pathlib import Path
 
-    from dynid.runtime import processes
     from dynid.identification.run import run_identification
     from dynid.io import write_json
     from dynid.io.identification_config import load_identification_config
+    from dynid.runtime import processes
     from dynid.runtime.processes import allow_forks
     from dynid.runtime.threads import cores
 

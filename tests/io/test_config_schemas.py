@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from dynid.io.config_types import SCHEMAS
 from dynid._util.typed import json_schema
+from dynid.io.config_types import SCHEMAS
 
 jsonschema = pytest.importorskip("jsonschema")
 REPO = Path(__file__).resolve().parents[2]
