@@ -48,7 +48,7 @@ class Identifier(HyperParameters):
         ``[controller]`` table.
     preprocessing : Preprocessing or dict, optional
         Preprocessing settings (default: every setting derived from the data, or the config's).
-    friction : {"auto", "description"}, optional
+    friction : {"description", "auto"}, optional
         Each joint's friction model chosen by cross-validation, or the description's terms (default: "description"
         for arrays, the config's for a config).
     rng : int or numpy.random.Generator, optional
