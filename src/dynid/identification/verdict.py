@@ -173,9 +173,9 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         if inconsistent and SDP_LABEL in held and held[SDP_LABEL] < held[ls]:
             main = SDP_LABEL
             findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not "
-                                               f"and predicts held-out blocks of the log worse ({held[SDP_LABEL]:.3g} "
-                                               f"against {held[ls]:.3g} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
-                                               "cross-validation)"))
+                                               "and predicts held-out blocks of the log worse ({} against {} N·m RMS, "
+                                               f"{HELD_OUT_FOLDS}-fold blocked cross-validation)".format(
+                                                   *_apart_figures(held[SDP_LABEL], held[ls]))))
         return replace(result, main=main, findings=tuple(findings + _drive_findings(result, main)))
     if states is not None and nominal is not None and scored is not None:
         result, chosen = _state_choice(result, nominal, scored, states)
@@ -348,9 +348,16 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple, weighe
 def _apart(better: float, worse: float) -> str:
     """"a % against b %" with as many significant digits (3 to 6) as it takes for the two to read differently: the
     main-estimate finding said "worse (1.11 % against 1.11 % on average)" on a zoo log."""
+    a, b = _apart_figures(better, worse)
+    return f"{a} % against {b} %"
+
+
+def _apart_figures(better: float, worse: float) -> tuple[str, str]:
+    """The two figures of :func:`_apart`, written (the held-out blocks' finding said "worse (0.208 against 0.208 N·m
+    RMS)")."""
     digits = next((d for d in range(3, 7) if f"{better:.{d}g}" != f"{worse:.{d}g}"), 6)
     form = f".{digits}g" if digits == 3 else f"#.{digits}g"  # past three digits, trailing zeros too: 1.110 against 1.114
-    return f"{better:{form}} % against {worse:{form}} %"
+    return f"{better:{form}}", f"{worse:{form}}"
 
 
 def _held_note(held: dict, undetermined: dict) -> str:
