@@ -139,7 +139,8 @@ class Parameters:
 
     def __repr__(self) -> str:
         rows = [f"{'name':>10s} {'value':>13s} {'σ':>10s}  unit"]
-        rows += [f"{n:>10s} {v:13.6g} {s:10.3g}  {unit_of(n)}" for n, v, s in zip(self.names, self.values, self.std)]
+        rows += [f"{n:>10s} {v:13.6g} {'—' if np.isnan(s) else f'{s:.3g}':>10s}  {unit_of(n)}"  # no σ: the SDP's
+                 for n, v, s in zip(self.names, self.values, self.std)]
         return "\n".join(rows)
 
 
