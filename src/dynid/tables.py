@@ -143,7 +143,8 @@ def rich_tables(table: TextTable, width: int) -> list:
 
     out = []
     for part in table.split(width):
-        t = Table(title=escape(part.title), box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
+        t = Table(title=escape(part.title), title_justify="left", box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True,
+                  pad_edge=False)  # a long title reads as a paragraph, not a centred column
         for i, col in enumerate(part.columns):
             t.add_column(escape(col), justify="left" if i < part.labels else "right", no_wrap=True)
         for i, row in enumerate(part.rows):
