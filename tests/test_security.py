@@ -186,16 +186,22 @@ def test_hostile_includes_and_yaml_are_refused(tmp_path, monkeypatch):
 
 
 def test_no_xacro_expression_reaches_eval(tmp_path, monkeypatch):
-    """Properties, math, comprehensions, a YAML file with a unit, $(eval ...) and $(arg ...) all expand while
-    Python's eval is taken away from both of xacro's evaluators: dynid's interpreter computes them."""
-    import xacro
-    from xacro import substitution_args
+    """Properties, math, comprehensions, a YAML file with a unit, $(eval ...) and $(arg ...) all expand while Python's
+    eval and the xacro package are out of reach: dynid expands the file and its interpreter computes the expressions."""
+    import builtins
 
     def no_eval(*args, **kwargs):
-        raise AssertionError("xacro's eval was reached")
+        raise AssertionError("Python's eval was reached")
 
-    monkeypatch.setattr(xacro, "eval", no_eval, raising=False)
-    monkeypatch.setattr(substitution_args, "eval", no_eval, raising=False)
+    real_import = builtins.__import__
+
+    def no_xacro(name, *args, **kwargs):
+        if name == "xacro" or name.startswith("xacro."):
+            raise AssertionError("the xacro package was imported")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "eval", no_eval)
+    monkeypatch.setattr(builtins, "__import__", no_xacro)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     from dynid.model.urdf import expand_xacro
 

@@ -14,11 +14,10 @@ from xml.parsers import expat
 import numpy as np
 
 from ..exceptions import ConfigError
-from ..runtime.extras import require
 from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
 from .robot_files import HELD_HINT, check_xml, is_mjcf
-from .xacro_expressions import guarded_xacro
+from .xacro_expansion import expand_xacro_text
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -358,10 +357,11 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     """The URDF a xacro file expands to, written once into dynid's cache (``$XDG_CACHE_HOME/dynid/xacro``, by default
     ``~/.cache/dynid/xacro``) under a name that changes with the file's contents, and reused after.
 
-    The ``xacro`` package (PyPI, no ROS needed) expands macros, properties, arguments, math and includes by relative
-    path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths stay as the file wrote them.
-    Every expression is checked before xacro evaluates it (:mod:`dynid.model.xacro_expressions`): a description that
-    would run code (files, introspection) is refused in one line.
+    dynid expands the file itself (:mod:`dynid.model.xacro_expansion`): macros, properties, arguments, conditionals,
+    math and includes by relative path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths
+    stay as the file wrote them. Every expression is computed by dynid's interpreter
+    (:mod:`dynid.model.xacro_expressions`), never by Python's ``eval``: a description that would run code (files,
+    introspection) is refused in one line.
 
     Parameters
     ----------
@@ -377,12 +377,11 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     Raises
     ------
     ConfigError
-        The ``xacro`` extra is missing, the file is unreadable, or xacro cannot expand it (the message names the file).
+        The file is unreadable or cannot be expanded (the message names the file).
     """
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: xacro file not found")
-    xacro = require("xacro", "xacro", f"{path.name} (a xacro robot description)")
     text = path.read_bytes()
     key = hashlib.sha256(text + repr(sorted((mappings or {}).items())).encode() + str(path.resolve()).encode()).hexdigest()[:16]
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid" / "xacro"
@@ -390,25 +389,8 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     for folder in (cache, _fallback_cache()):
         if _cached_and_current(folder / out.name):
             return folder / out.name
-    try:
-        xacro.all_includes = []  # type: ignore[attr-defined]  # the files an expansion reads besides the top one (includes, YAML), for the cache
-        with _silenced_stderr([]), guarded_xacro(xacro, str(path)) as refused:
-            try:
-                # xacro's macros and includes; its two evaluators are dynid's own interpreter here (guarded_xacro)
-                doc = xacro.process_file(str(path), mappings=dict(mappings or {}))
-            except Exception:
-                if refused:  # an expression the evaluator refused, wrapped by xacro: said as the evaluator said it
-                    raise refused[0] from None
-                raise
-        urdf = doc.toprettyxml(indent="  ")
-        read = sorted({str(Path(f).resolve()) for f in [path, *xacro.all_includes]})  # type: ignore[attr-defined]
-    except ConfigError:
-        raise
-    except Exception as exc:  # xacro raises its own exceptions, and ROS lookups fail in many ways without ROS
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        ros = "find" in message or "substitution args" in message or "ament_index" in message or "rospkg" in message
-        hint = " (a $(find ...) needs a ROS workspace: write the path relative to the file instead)" if ros else ""
-        raise ConfigError(f"{path}: xacro cannot expand it: {message}{hint}") from None
+    urdf, files = expand_xacro_text(path, mappings)
+    read = sorted({str(Path(f).resolve()) for f in files})
     try:
         cache.mkdir(parents=True, exist_ok=True)
     except OSError:  # an unwritable cache: the system's temporary folder instead

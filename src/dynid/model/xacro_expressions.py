@@ -1,17 +1,17 @@
 """xacro's expressions evaluated by dynid's own interpreter: a robot description computes, it never runs code.
 
-xacro evaluates ``${...}`` and ``$(eval ...)`` with Python's ``eval``, behind a guard that only refuses names starting
-with two underscores; its ``python`` namespace is a dict holding ``type`` and ``vars``, so a hostile description can
-reach any object by subscripts with strings (``python['vars'](...)['__subclasses__']``) and run programs. dynid never
-lets an expression reach ``eval``: while a xacro file expands, both of xacro's evaluators are replaced by
-:func:`evaluate`, an interpreter of a small part of Python's syntax tree (:mod:`ast`) that admits
+xacro 2.x evaluates ``${...}`` and ``$(eval ...)`` with Python's ``eval``, behind a guard that only refuses names starting
+with two underscores; its ``python`` namespace holds ``type`` and ``vars``, so a hostile description can reach any
+object by subscripts with strings (``python['vars'](...)['__subclasses__']``) and run programs. dynid expands xacro files
+itself (:mod:`dynid.model.xacro_expansion`), and every expression goes to :func:`evaluate`, an interpreter of a small
+part of Python's syntax tree (:mod:`ast`) that admits
 
 - literals (numbers, strings, booleans, ``None``), lists, tuples, dicts and sets of them;
 - the file's properties and arguments by name, and a namespace's or a YAML mapping's members (``math.pi``,
   ``props.link1.mass``, ``props['link1']['mass']``);
 - arithmetic, comparisons, ``and``/``or``/``not``, conditional expressions, subscripts and slices, comprehensions;
-- calls of an allow-list of functions (:data:`ALLOWED_BUILTINS`, the ``math`` module, xacro's own ``xacro.*``
-  helpers, ``arg``/``dirname``/``env``/``optenv`` inside ``$(eval ...)``) and of a few string and dict methods
+- calls of an allow-list of functions (:data:`ALLOWED_BUILTINS`, the ``math`` module, xacro's ``xacro.*`` helpers,
+  ``arg``/``dirname``/``env``/``optenv`` inside ``$(eval ...)``) and of a few string and dict methods
   (:data:`ALLOWED_METHODS`).
 
 Everything else (a lambda, an assignment expression, a name or member starting with an underscore, an attribute of any
@@ -25,18 +25,13 @@ loaded with ``xacro.load_yaml`` is read by ``yaml.safe_load`` (data only), and i
 from __future__ import annotations
 
 import ast
-import builtins
-import collections
-import contextlib
-import math
 import operator
-import types
 from collections.abc import Callable, Mapping
 from typing import Any
 
 from ..exceptions import ConfigError
 
-__all__ = ["ALLOWED_BUILTINS", "ALLOWED_METHODS", "evaluate", "guarded_xacro"]
+__all__ = ["ALLOWED_BUILTINS", "ALLOWED_METHODS", "evaluate"]
 
 ALLOWED_BUILTINS = ("abs", "all", "any", "bool", "complex", "dict", "divmod", "enumerate", "filter", "float",
                     "frozenset", "int", "isinstance", "len", "list", "map", "max", "min", "ord", "range", "repr",
@@ -305,7 +300,7 @@ def evaluate(text: str, symbols, allowed: Mapping[int, str], where: str = "") ->
         Names to values: a xacro property table (lazy properties are evaluated by xacro through this function), or
         ``$(eval ...)``'s arguments and functions.
     allowed : mapping of int to str
-        The ``id`` of each function an expression may call, to its name (:func:`allowed_functions`).
+        The ``id`` of each function an expression may call, to its name (:class:`dynid.model.xacro_expansion.XacroExpansion` builds it).
     where : str
         The file being expanded, for the message.
 
@@ -328,79 +323,3 @@ def evaluate(text: str, symbols, allowed: Mapping[int, str], where: str = "") ->
         raise ConfigError(f"{where + ': ' if where else ''}the xacro expression {_short(text)!r} uses {exc}, which a "
                           "robot description may not run in dynid (it reads descriptions as data: arithmetic, math "
                           "functions and the file's own properties only; docs/security.md)") from None
-
-
-def allowed_functions(xacro) -> dict[int, str]:
-    """The functions an expression may call, by ``id``: :data:`ALLOWED_BUILTINS`, the ``math`` module's, and
-    xacro's own helpers (its ``xacro`` namespace and the deprecated global names that wrap them).
-
-    Parameters
-    ----------
-    xacro : module
-        The imported ``xacro`` package.
-
-    Returns
-    -------
-    dict of int to str
-    """
-    functions: dict[str, Any] = {name: getattr(builtins, name) for name in ALLOWED_BUILTINS}
-    functions |= {f"math.{k}": v for k, v in vars(math).items() if callable(v) and not k.startswith("_")}
-    symbols = xacro._global_symbols
-    functions |= {f"xacro.{k}": v for k, v in symbols["xacro"].items() if callable(v)}
-    allowed = {id(v): k for k, v in functions.items()}
-    for name, v in symbols.items():  # xacro's global names: a builtin, a math function, or a wrapper of one
-        closure = v.__closure__ if isinstance(v, types.FunctionType) else None
-        wrapped = [c.cell_contents for c in closure or () if callable(c.cell_contents)]
-        if callable(v) and (id(v) in allowed or any(id(w) in allowed for w in wrapped)):
-            allowed[id(v)] = name
-    return allowed
-
-
-@contextlib.contextmanager
-def guarded_xacro(xacro, where: str = ""):
-    """xacro's two evaluators, ``${...}`` and ``$(eval ...)``, replaced by :func:`evaluate` while the context lasts:
-    no expression of the file reaches Python's ``eval``.
-
-    Parameters
-    ----------
-    xacro : module
-        The imported ``xacro`` package.
-    where : str
-        The file being expanded, for the messages.
-
-    Yields
-    ------
-    list of ConfigError
-        The refusals raised inside xacro (which wraps them in its own exceptions): the caller raises the first.
-    """
-    from xacro import substitution_args as sa
-
-    allowed = allowed_functions(xacro)
-    refused: list[ConfigError] = []
-
-    def checked(text: str, symbols, allowed: Mapping[int, str]) -> Any:
-        try:
-            return evaluate(text, symbols, allowed, where)
-        except ConfigError as exc:
-            refused.append(exc)
-            raise
-
-    def safe_eval(expr, globals, locals=None):
-        return checked(expr, globals if locals is None else collections.ChainMap(locals, globals), allowed)
-
-    def eval_arg(s, context):  # xacro's substitution_args._eval, with the same names
-        context.setdefault("arg", {})
-        functions = {"arg": lambda name: sa.convert_value(sa._eval_arg(name, args=context["arg"]), "auto"),
-                     "dirname": lambda: sa._eval_dirname(context["filename"]),
-                     "true": True, "false": False, "True": True, "False": False,
-                     "env": sa._eval_env, "optenv": sa._eval_optenv, "find": sa._eval_find}
-        functions |= {k: v for k, v in vars(math).items() if not k.startswith("_")}
-        here = dict(allowed) | {id(v): k for k, v in functions.items() if callable(v)}
-        return str(checked(s, sa._DictWrapper(context["arg"], functions), here))
-
-    saved = xacro.safe_eval, sa._eval
-    xacro.safe_eval, sa._eval = safe_eval, eval_arg
-    try:
-        yield refused
-    finally:
-        xacro.safe_eval, sa._eval = saved

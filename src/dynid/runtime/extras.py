@@ -9,7 +9,7 @@ from types import ModuleType
 from ..exceptions import ConfigError
 
 EXTRAS = {"montecarlo": ("distributed",), "fleet": ("distributed", "pyarrow"), "ros": ("rosbags",), "mujoco": ("mujoco",),
-          "xacro": ("xacro",)}
+          "xacro": ("yaml",)}
 """Extra (``pip install "dynid[extra]"``) -> the modules it brings."""
 
 
