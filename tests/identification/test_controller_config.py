@@ -207,3 +207,35 @@ def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_lo
     assert alone.consistency_verdicts["dynid IDIM-IV"] == whole.consistency_verdicts["dynid IDIM-IV"]
     with pytest.raises(ConfigError, match="closed_loop: 'idim' is not a closed-loop estimator"):
         ClosedLoopEstimator("idim", setup)
+
+
+def test_the_closed_loop_estimators_fit_the_rows_the_pipeline_prepared(closed_loop_log, monkeypatch):
+    """The pipeline's closed-loop parts take its prepared data (its chosen cutoffs, rest model and speeds): the
+    measured log is not prepared a second time, only the simulated ones are; the estimate is the one on that data."""
+    from dynid.identification import closed_loop
+    from dynid.identification.closed_loop import ClosedLoopSetup
+    from dynid.identification.pipeline import IdentificationPipeline
+    from dynid.io.datasets import Recording
+    from dynid.simulation.closed_loop import Controller
+
+    root, _, _ = closed_loop_log
+    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
+    robot = dynid.load_robot("er16")
+    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
+                            feedforward=True)
+    recording = Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
+    pipeline = IdentificationPipeline(robot, estimators=("wls", "idim-iv"), controller=setup)
+    prepared = pipeline.prepare(recording)
+    real_prepare, measured = closed_loop.prepare, []
+
+    def counted(log, *args, **kwargs):
+        measured.append(log.name == "cl")
+        return real_prepare(log, *args, **kwargs)
+
+    monkeypatch.setattr(closed_loop, "prepare", counted)
+    whole = pipeline.estimate(prepared, recording=recording)
+    assert measured and not any(measured)  # simulated logs prepared; the measured one never again
+    direct = closed_loop.closed_loop_identify(prepared.robot, prepared.base, recording,
+                                              pipeline.closed_loop_estimators[0].experiment(prepared.robot, recording),
+                                              methods=("idim-iv",), data=prepared.data)["idim-iv"]
+    np.testing.assert_array_equal(whole.estimates["dynid IDIM-IV"].params, direct.params)

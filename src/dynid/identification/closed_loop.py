@@ -188,7 +188,7 @@ def _weighted_least_squares(w, tau, row_sigma, instants=None):
 
 def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
                          *, methods=("idim-iv", "didim"), preprocessing: Preprocessing | None = None, max_iter: int = 10,
-                         tol: float = 1e-4) -> dict[str, ClosedLoopEstimate]:
+                         tol: float = 1e-4, data: PreparedData | None = None) -> dict[str, ClosedLoopEstimate]:
     """IDIM-WLS, then each closed-loop estimator of ``methods`` (module docstring).
 
     Parameters
@@ -207,6 +207,11 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         Closed-loop simulations per estimator at most.
     tol : float
         Relative change of the simulated torques that ends the iterations.
+    data : PreparedData, optional
+        ``recording`` as an identification prepared it already (:meth:`IdentificationPipeline.prepare
+        <dynid.identification.pipeline.IdentificationPipeline.prepare>`: its cross-validated cutoffs, rest model and
+        speeds): the measured rows are these, and the simulated logs are prepared with its settings. Default:
+        ``recording`` prepared here with ``preprocessing``.
 
     Returns
     -------
@@ -232,7 +237,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
     if abs(recording.rate - experiment.controller.rate) > 1e-6 * experiment.controller.rate:
         raise ShapeError(f"{recording.name}: logged at {recording.rate:.6g} Hz, the controller runs at {experiment.controller.rate:.6g} Hz: "
                          "the closed-loop estimators need the log at the control rate")
-    data = prepare(recording, preprocessing or Preprocessing())
+    data = data if data is not None else prepare(recording, preprocessing or Preprocessing())
     w, tau, keep = _rows(robot, base, data)
     n = robot.n_dof
     w, tau = w[keep], tau[keep]
@@ -468,7 +473,7 @@ class ClosedLoopEstimator:
         return ClosedLoopExperiment(controller, q_ref, dq_ref, ff)
 
     def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing,
-                 experiment: ClosedLoopExperiment | None = None):
+                 experiment: ClosedLoopExperiment | None = None, data: PreparedData | None = None):
         """An identification's result with this estimate beside its others, on its log as read, at the control rate.
 
         Parameters
@@ -483,6 +488,8 @@ class ClosedLoopEstimator:
             The settings as given (the simulated logs derive theirs as the measured one did).
         experiment : ClosedLoopExperiment, optional
             :meth:`experiment` when the caller has it already (estimators sharing a setup read its set-points once).
+        data : PreparedData, optional
+            The log as the identification prepared it (:func:`closed_loop_identify`): not prepared again.
 
         Returns
         -------
@@ -498,7 +505,8 @@ class ClosedLoopEstimator:
         t0 = time.perf_counter()
         experiment = experiment if experiment is not None else self.experiment(robot, recording)
         out = closed_loop_identify(robot, base, recording, experiment, methods=(self.method,),
-                                   preprocessing=preprocessing, max_iter=self.max_iter, tol=self.tol)[self.method]
+                                   preprocessing=preprocessing, max_iter=self.max_iter, tol=self.tol,
+                                   data=data)[self.method]
         std = out.params_std if np.all(np.isfinite(out.params_std)) else None  # DIDIM-SDP: no σ
         estimate = Estimate(self.method, out.params, std, time.perf_counter() - t0, note="" if out.converged else out.message)
         margins, verdicts = consistency_checks(robot, base, {estimate.label: estimate.params})

@@ -170,7 +170,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         checked.append(load_recording(spec, config.robot))
     pipeline = pipeline_of(config)
     prepared = pipeline.prepare(recording, base, step)
-    raw = recording if config.closed_loop else None  # the closed-loop estimators prepare the log themselves
+    raw = recording if config.closed_loop else None  # the closed-loop estimators simulate the log as read
     reference = yardstick_reference(recording) if validate and config.validation else None
     smooth = filtered_finding([config.identification.name, *(spec.name for spec in config.validation if validate)],
                               [recording, *checked])
