@@ -176,22 +176,28 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
         dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=short)
 
 
+def _setup_and_recording(root):
+    """The ER-16, the fixture's controller with its set-points, and its log as a Recording."""
+    from dynid.identification.closed_loop import ClosedLoopSetup
+    from dynid.io.datasets import Recording
+    from dynid.simulation.closed_loop import Controller
+
+    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
+    robot = dynid.load_robot("er16")
+    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
+                            feedforward=True)
+    return robot, setup, Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
+
+
 def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_loop_log):
     """IdentificationPipeline(estimators=("wls", "idim-iv"), controller=...) is made of ClosedLoopEstimator parts, each
     carrying the controller, and takes such a part itself in its estimators: one such part added to the pipeline's open-loop result gives the pipeline's own IDIM-IV estimate, and
     an unknown method is refused in one line."""
     from dynid.exceptions import ConfigError
-    from dynid.identification.closed_loop import ClosedLoopEstimator, ClosedLoopSetup
+    from dynid.identification.closed_loop import ClosedLoopEstimator
     from dynid.identification.pipeline import IdentificationPipeline
-    from dynid.io.datasets import Recording
-    from dynid.simulation.closed_loop import Controller
 
-    root, _, _ = closed_loop_log
-    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
-    robot = dynid.load_robot("er16")
-    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
-                            feedforward=True)
-    recording = Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
+    robot, setup, recording = _setup_and_recording(closed_loop_log[0])
     pipeline = IdentificationPipeline(robot, estimators=("wls", "idim-iv"), controller=setup)
     assert [(p.method, p.setup) for p in pipeline.closed_loop_estimators] == [("idim-iv", setup)]
     assert pipeline.open_loop == ("wls",) and pipeline.closed_loop == ("idim-iv",)
@@ -213,17 +219,9 @@ def test_the_closed_loop_estimators_fit_the_rows_the_pipeline_prepared(closed_lo
     """The pipeline's closed-loop parts take its prepared data (its chosen cutoffs, rest model and speeds): the
     measured log is not prepared a second time, only the simulated ones are; the estimate is the one on that data."""
     from dynid.identification import closed_loop
-    from dynid.identification.closed_loop import ClosedLoopSetup
     from dynid.identification.pipeline import IdentificationPipeline
-    from dynid.io.datasets import Recording
-    from dynid.simulation.closed_loop import Controller
 
-    root, _, _ = closed_loop_log
-    log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
-    robot = dynid.load_robot("er16")
-    setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
-                            feedforward=True)
-    recording = Recording("cl", log[:, 0], log[:, 1:N + 1], None, log[:, N + 1:], 1000.0)
+    robot, setup, recording = _setup_and_recording(closed_loop_log[0])
     pipeline = IdentificationPipeline(robot, estimators=("wls", "idim-iv"), controller=setup)
     prepared = pipeline.prepare(recording)
     real_prepare, measured = closed_loop.prepare, []
