@@ -52,7 +52,7 @@ from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from .identify import Estimate, consistency_checks
 
-__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopEstimator", "ClosedLoopSetup", "closed_loop_identify", "closed_loop_estimates",
+__all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopEstimator", "ClosedLoopSetup", "closed_loop_identify",
            "CLOSED_LOOP_METHODS"]
 
 
@@ -86,7 +86,7 @@ class ClosedLoopExperiment:
 @dataclass(frozen=True, eq=False)
 class ClosedLoopSetup:
     """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
-    config's ``[controller]`` table gives it (:func:`closed_loop_estimates`).
+    config's ``[controller]`` table gives it (:class:`ClosedLoopEstimator` parts carry it).
 
     Attributes
     ----------
@@ -514,36 +514,3 @@ class ClosedLoopEstimator:
                        warnings=result.warnings + (() if out.converged else (f"{estimate.label}: {out.message}",)),
                        consistency={**result.consistency, **margins},
                        consistency_verdicts={**result.consistency_verdicts, **verdicts})
-
-
-def closed_loop_estimates(robot: Robot, base: BaseParameters, result, recording: Recording, setup: ClosedLoopSetup,
-                          *, keys: tuple[str, ...], preprocessing: Preprocessing):
-    """The closed-loop estimators of ``keys`` beside an identification's other estimates:
-    :meth:`ClosedLoopEstimator.added_to` of each in turn.
-
-    Parameters
-    ----------
-    robot, base, result, recording, preprocessing
-        As :meth:`ClosedLoopEstimator.added_to`'s.
-    setup : ClosedLoopSetup
-        How the log was recorded, shared by the estimators.
-    keys : tuple of str
-        Among :data:`CLOSED_LOOP_METHODS`, in order.
-
-    Returns
-    -------
-    IdentificationResult
-        ``result`` with each estimate added.
-
-    Raises
-    ------
-    ConfigError
-        An unknown key.
-    DataError
-        A reference without one set-point per sample of the log.
-    """
-    parts = [ClosedLoopEstimator(key, setup) for key in keys]
-    experiment = parts[0].experiment(robot, recording) if parts else None  # the set-points read once for all
-    for part in parts:
-        result = part.added_to(result, robot, base, recording, preprocessing, experiment)
-    return result
