@@ -96,3 +96,30 @@ def test_init_holds_a_xacro_grippers_fingers(tmp_path, monkeypatch):
     assert p.returncode == 0, p.stderr
     robot = tomllib.loads((tmp_path / "arm.toml").read_text())["robot"]
     assert robot["urdf"] == "ur10e.urdf.xacro" and robot["held"] == ["f1", "f2"]
+
+
+def test_xacro_arguments_reach_the_expansion_from_a_config_and_the_api(tmp_path, monkeypatch):
+    """``xacro_args`` in a ``[robot]`` table (and ``load_robot(..., xacro_args=)``) are the file's ``name:=value``: the
+    robot and the URDF export writes into are the expansion with them; given for a file that is not xacro, refused."""
+    from dynid.io.configs import config_robot, config_urdf
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    path = _xacro_of_ur10e(tmp_path, "$(arg tool_mass)")
+    path.write_text(path.read_text(encoding="utf-8").replace(
+        '<xacro:property name="tool_mass"', '<xacro:arg name="tool_mass" default="0.202"/>\n  <xacro:property name="x"'),
+        encoding="utf-8")
+    masses = {}
+    for given in (None, {"tool_mass": "0.5"}):
+        doc = {"robot": {"urdf": path.name, **({"xacro_args": given} if given else {})}}
+        masses[str(given)] = (config_robot(doc, tmp_path / "c.toml").inertial[-1, 9],
+                              load_robot(path, xacro_args=given).inertial[-1, 9])
+        urdf = config_urdf(doc, tmp_path / "c.toml").read_text()
+        assert f'<mass value="{(given or {}).get("tool_mass", "0.202")}"/>' in urdf.replace("  ", "")
+    assert masses["None"] == pytest.approx((0.202, 0.202)) and masses["{'tool_mass': '0.5'}"] == pytest.approx((0.5, 0.5))
+    with pytest.raises(ConfigError, match=r"xacro arguments \['tool_mass'\] given, but ur10e.urdf is not a xacro file"):
+        load_robot(URDF, xacro_args={"tool_mass": "0.5"})
+    with pytest.raises(ConfigError, match=r"robot: xacro_args are a xacro file's arguments, but this description reads no "
+                                          "robot file"):
+        config_robot({"robot": {"joints": [{"a": 0.0, "alpha": 0.0, "d": 0.0, "mass": 1.0,
+                                            "com": [0, 0, 0], "inertia": [1, 1, 1, 0, 0, 0]}],
+                                "xacro_args": {"a": "1"}}}, tmp_path / "c.toml")

@@ -147,7 +147,21 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     file = _robot_file(doc, path, data_root)
     if file is None or is_mjcf(file):
         return None
-    return expand_xacro(file) if is_xacro(file) else file
+    return expand_xacro(file, _xacro_args(doc, path, data_root)) if is_xacro(file) else file
+
+
+def _xacro_args(doc: dict, path: Path, data_root: Path | None) -> dict | None:
+    """The ``xacro_args`` of a config's ``[robot]`` table, or of the description file its ``robot`` names."""
+    ref = doc.get("robot")
+    if isinstance(ref, dict):
+        return ref.get("xacro_args")
+    file = _located(ref, path.parent, data_root) if isinstance(ref, str) and ref not in builtin_robots() else None
+    if file is None or file.suffix.lower() != ".toml":
+        return None
+    try:
+        return tomllib.loads(file.read_text(encoding="utf-8")).get("xacro_args")
+    except (OSError, ValueError):
+        return None
 
 
 def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | None:

@@ -81,7 +81,7 @@ def builtin_robots() -> list[str]:
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
-def load_robot(name_or_path: str | Path, *, held=()) -> Robot:
+def load_robot(name_or_path: str | Path, *, held=(), xacro_args: dict | None = None) -> Robot:
     """A built-in robot by name (``"er16"``), a robot description TOML file, a URDF, xacro or MuJoCo (MJCF) file, or
     the robot of an identification config (``dynid init``'s: its ``robot = ...`` or ``[robot]`` table).
 
@@ -90,6 +90,8 @@ def load_robot(name_or_path: str | Path, *, held=()) -> Robot:
     name_or_path : str or Path
     held : sequence of str
         Joints of a URDF, xacro or MJCF held fixed at 0 (a gripper's fingers: :func:`dynid.model.urdf.joints_from_urdf`).
+    xacro_args : dict of str to str, optional
+        A xacro file's arguments (xacro's ``name:=value``); those not given take the file's defaults.
 
     Returns
     -------
@@ -100,11 +102,14 @@ def load_robot(name_or_path: str | Path, *, held=()) -> Robot:
     ------
     ConfigError
         Unknown robot, unreadable file, or a field with a wrong type or value (the message names the file and the
-        field); ``held`` for a robot that is not read from a URDF, xacro or MJCF file.
+        field); ``held`` for a robot that is not read from a URDF, xacro or MJCF file; ``xacro_args`` for one that is
+        not read from a xacro file.
     """
     text = str(name_or_path)
     path = Path(text)
     from .urdf import expand_xacro, is_mjcf, is_xacro
+
+    _check_xacro_args(xacro_args, path, text)
 
     if held and not ((path.suffix == ".urdf" or is_mjcf(path) or is_xacro(path)) and path.is_file()):
         raise ConfigError(f"{text}: held = {list(held)!r} needs a URDF, xacro or MJCF file (a description TOML or an "
@@ -115,7 +120,8 @@ def load_robot(name_or_path: str | Path, *, held=()) -> Robot:
     if (path.suffix == ".urdf" or is_mjcf(path)) and path.is_file():
         return robot_from_urdf(path, held=held)
     if is_xacro(path) and path.is_file():
-        return robot_from_urdf(expand_xacro(path), source=str(path), name=path.name.split(".")[0], held=held)
+        return robot_from_urdf(expand_xacro(path, xacro_args), source=str(path), name=path.name.split(".")[0],
+                               held=held)
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
                           "description file, a .urdf, a .xacro or a MuJoCo .xml file")
@@ -278,8 +284,11 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     urdf_model = None
     rows = d.joints
     held = _held(d.held, convention, source)
+    if d.xacro_args and convention != "urdf":
+        raise ConfigError(f"{source}: xacro_args are a xacro file's arguments, but this description reads no robot file "
+                          "(give urdf = \"arm.urdf.xacro\")")
     if convention == "urdf":
-        upath, urdf_model = _read_urdf(d.urdf, base, source, held)
+        upath, urdf_model = _read_urdf(d.urdf, base, source, held, d.xacro_args)
         if rows is None:
             rows = [joint_table() for _ in urdf_model[0]]
     if not rows:
@@ -367,8 +376,8 @@ def _held(held, convention: str, source: str) -> dict:
     return dict.fromkeys(held, 0.0) if isinstance(held, list) else {str(k): float(v) for k, v in held.items()}
 
 
-def _read_urdf(urdf: str | None, base: Path | None, source: str, held=None):
-    """The URDF a description names (relative to ``base``; a xacro file expanded) and its chain
+def _read_urdf(urdf: str | None, base: Path | None, source: str, held=None, xacro_args: dict | None = None):
+    """The URDF a description names (relative to ``base``; a xacro file expanded with ``xacro_args``) and its chain
     (:func:`dynid.model.urdf.joints_from_urdf`)."""
     from .urdf import expand_xacro, is_xacro, joints_from_urdf
 
@@ -377,9 +386,19 @@ def _read_urdf(urdf: str | None, base: Path | None, source: str, held=None):
     upath = Path(urdf)
     if not upath.is_absolute() and base is not None:
         upath = base / upath
+    _check_xacro_args(xacro_args, upath, f"{source}: xacro_args")
     if is_xacro(upath):
-        upath = expand_xacro(upath)
+        upath = expand_xacro(upath, xacro_args)
     return upath, joints_from_urdf(upath, held)
+
+
+def _check_xacro_args(xacro_args: dict | None, path: Path, where: str) -> None:
+    """Refuse arguments for a robot file that is not a xacro file (they would be ignored)."""
+    from .urdf import is_xacro
+
+    if xacro_args and not is_xacro(path):
+        raise ConfigError(f"{where}: xacro arguments {sorted(xacro_args)} given, but {path.name} is not a xacro file "
+                          "(.xacro): nothing would read them")
 
 
 def _dh_inertials(rows, where, convention: str, alpha, a, dd) -> np.ndarray:
