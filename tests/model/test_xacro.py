@@ -123,3 +123,33 @@ def test_xacro_arguments_reach_the_expansion_from_a_config_and_the_api(tmp_path,
         config_robot({"robot": {"joints": [{"a": 0.0, "alpha": 0.0, "d": 0.0, "mass": 1.0,
                                             "com": [0, 0, 0], "inertia": [1, 1, 1, 0, 0, 0]}],
                                 "xacro_args": {"a": "1"}}}, tmp_path / "c.toml")
+
+
+def test_init_writes_the_xacro_arguments_it_was_given(tmp_path, monkeypatch):
+    """``dynid init arm.urdf.xacro LOG --xacro-arg tool_mass:=0.5``: the config's ``[robot]`` table holds the argument
+    (with the URDF's drive terms), identify's robot is the expansion with it; a malformed one is one line."""
+    import tomllib
+
+    from dynid.io.configs import config_robot
+    from tests.cli.refusals import dynid as run
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    path = _xacro_of_ur10e(tmp_path, "$(arg tool_mass)")
+    path.write_text(path.read_text(encoding="utf-8").replace(
+        '<xacro:property name="tool_mass"', '<xacro:arg name="tool_mass" default="0.202"/>\n  <xacro:property name="x"'),
+        encoding="utf-8")
+    sim = np.column_stack([np.arange(200) * 0.01, np.zeros((200, 12))])
+    np.savetxt(tmp_path / "log.csv", sim, delimiter=",", comments="",
+               header=",".join(["t", *(f"q{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))]))
+    env = {"XDG_CACHE_HOME": str(tmp_path / "cache")}
+    p = run("init", str(path), str(tmp_path / "log.csv"), "--out", str(tmp_path / "arm.toml"), "--xacro-arg",
+            "tool_mass:=0.5", env=env)
+    assert p.returncode == 0, p.stderr
+    doc = tomllib.loads((tmp_path / "arm.toml").read_text())
+    assert doc["robot"]["urdf"] == "ur10e.urdf.xacro" and doc["robot"]["xacro_args"] == {"tool_mass": "0.5"}
+    assert config_robot(doc, tmp_path / "arm.toml").inertial[-1, 9] == pytest.approx(0.5)
+    p = run("init", str(path), str(tmp_path / "log.csv"), "--out", str(tmp_path / "b.toml"), "--xacro-arg", "0.5",
+            env=env)
+    assert p.returncode != 0 and p.stderr.strip().splitlines() == [
+        "error: --xacro-arg 0.5: expected name:=value (a xacro argument's name, then its value)"]
+    assert not (tmp_path / "b.toml").exists()

@@ -757,27 +757,32 @@ def init(
     force: bool = typer.Option(False, help="Overwrite --out if it exists."),
     rate: float | None = typer.Option(None, help="The logs' sample rate [Hz], for CSV logs without a time column.",
                                       min=1e-9),
+    xacro_arg: list[str] | None = typer.Option(None, "--xacro-arg",
+                                               help="A xacro file's argument, name:=value (repeat for several)."),
     quiet: bool = QUIET,
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
-    from ..io.starter import check_target, starter_config
+    from ..io.starter import check_target, starter_config, xacro_arguments
     from ..model.description import load_robot, robot_from_urdf
     from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
 
+    args: dict[str, str] = {}
+
     def prepare():
+        args.update(xacro_arguments(xacro_arg or []))  # a malformed one is refused in one line, as every mistake here
         check_target(out, force)
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
-        read = (expand_xacro(urdf) if is_xacro(urdf) else urdf) if urdf.is_file() else None
+        read = (expand_xacro(urdf, args) if is_xacro(urdf) else urdf) if urdf.is_file() else None
         held = joints_to_hold(read) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read)) else ()
-        return robot_from_urdf(urdf, held=held) if held else load_robot(urdf)
+        return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
 
     def compute(robot, progress):
         for v in validation or ():
             if not v.exists():
                 raise DynIdError(f"{v}: no such validation log")
         return starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()), tuple(j.name for j in robot.joints),
-                              robot.held, robot=robot, rate=rate)
+                              robot.held, robot=robot, rate=rate, xacro_args=args)
 
     def save(written):
         from ..io.files import atomic_write_text

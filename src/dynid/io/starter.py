@@ -28,7 +28,7 @@ from .datasets import dataset_spec, load_recording
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
                    joints: tuple[str, ...] = (), held: tuple[str, ...] = (), robot=None, *,
-                   rate: float | None = None) -> tuple[str, list[str]]:
+                   rate: float | None = None, xacro_args: dict | None = None) -> tuple[str, list[str]]:
     """A starter config for a URDF and a log.
 
     Parameters
@@ -55,6 +55,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     rate : float, optional
         The logs' sample rate [Hz], for a CSV log with a header and no time column (``rate =`` in the config; the
         validation tables take it with the identification's columns).
+    xacro_args : dict of str to str, optional
+        A xacro robot file's arguments: written as the ``[robot]`` table's ``xacro_args``.
 
     Returns
     -------
@@ -83,10 +85,37 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
-        return _config(urdf, log, out, validation, table, said, held), said
+        return _config(urdf, log, out, validation, table, said, held, xacro_args), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     notes += _held_notes(urdf, held)
-    return _config(urdf, log, out, validation, table, notes, held), notes
+    return _config(urdf, log, out, validation, table, notes, held, xacro_args), notes
+
+
+def xacro_arguments(given: list[str]) -> dict[str, str]:
+    """``--xacro-arg name:=value`` options as a dict (xacro's own spelling; ``name=value`` too).
+
+    Parameters
+    ----------
+    given : list of str
+
+    Returns
+    -------
+    dict of str to str
+
+    Raises
+    ------
+    ConfigError
+        An option without a name and a value, or a name given twice.
+    """
+    out: dict[str, str] = {}
+    for text in given:
+        name, sep, value = text.partition(":=") if ":=" in text else text.partition("=")
+        if not sep or not name.strip().isidentifier():
+            raise ConfigError(f"--xacro-arg {text}: expected name:=value (a xacro argument's name, then its value)")
+        if name.strip() in out:
+            raise ConfigError(f"--xacro-arg {text}: {name.strip()} is given twice")
+        out[name.strip()] = value
+    return out
 
 
 def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
@@ -113,22 +142,30 @@ def _bag_read(bag: Path, robot) -> str:
 
 
 def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str],
-            held: tuple[str, ...] = ()) -> str:
+            held: tuple[str, ...] = (), xacro_args: dict | None = None) -> str:
     """The config's text, written by tomlkit (every string escaped, whatever the paths and columns hold): what was
-    detected in comments, the robot (a table where joints are held), the dataset table, the validation logs."""
+    detected in comments, the robot (a table where joints are held or a xacro file takes arguments), the dataset
+    table, the validation logs."""
     doc = tomlkit.document()
     for line in ("dynid identification config, written by dynid init: check the columns and units below, then",
                  "  dynid identify THIS_FILE", *notes):
         doc.add(tomlkit.comment(" ".join(line.splitlines())))
-    if not held:  # keys before the first table
+    as_table = bool(held or xacro_args)
+    if not as_table:  # keys before the first table
         doc.add("robot", tomlkit.item(_relative(urdf, out.parent)))
     doc.add("data_root", tomlkit.item(_relative(log.parent, out.parent)))
     doc.add(tomlkit.nl())
-    if held:
+    if as_table:
         robot = tomlkit.table()
         robot.add("urdf", _relative(urdf, out.parent))
-        robot.add("held", list(held))
-        robot["held"].comment("not the arm's joints: held fixed at 0")
+        if held:
+            robot.add("held", list(held))
+            robot["held"].comment("not the arm's joints: held fixed at 0")
+        if xacro_args:
+            arguments = tomlkit.inline_table()
+            arguments.update({str(k): str(v) for k, v in xacro_args.items()})
+            arguments.comment("the xacro file's arguments (name:=value)")
+            robot.add("xacro_args", arguments)
         robot.add("drive_terms", list(URDF_DRIVE_TERMS))
         robot.add(tomlkit.nl())
         doc.add("robot", robot)

@@ -218,7 +218,8 @@ def robot_from_toml_text(text: str, source: str, base: Path | None) -> Robot:
     return robot_from_document(doc, source, base)
 
 
-def robot_from_urdf(path: str | Path, source: str | None = None, name: str | None = None, held=()) -> Robot:
+def robot_from_urdf(path: str | Path, source: str | None = None, name: str | None = None, held=(),
+                    xacro_args: dict | None = None) -> Robot:
     """A robot given by its URDF alone.
 
     Its chain, inertias and limits; drive terms :data:`URDF_DRIVE_TERMS`, gravity along -z, drive gains 1 (a log of
@@ -233,6 +234,8 @@ def robot_from_urdf(path: str | Path, source: str | None = None, name: str | Non
         The robot's name (default: the file's stem).
     held : sequence of str
         Joints held fixed at 0 (:func:`dynid.model.urdf.joints_from_urdf`).
+    xacro_args : dict of str to str, optional
+        A xacro file's arguments (``name:=value``).
 
     Returns
     -------
@@ -241,11 +244,12 @@ def robot_from_urdf(path: str | Path, source: str | None = None, name: str | Non
     Raises
     ------
     ConfigError
-        An unreadable URDF or one dynid cannot model.
+        An unreadable URDF or one dynid cannot model; ``xacro_args`` for a file that is not xacro.
     """
     path = Path(path)
     return robot_from_document({"convention": "urdf", "urdf": path.name, "drive_terms": list(URDF_DRIVE_TERMS),
-                                "name": name or path.stem, **({"held": list(held)} if held else {})},
+                                "name": name or path.stem, **({"held": list(held)} if held else {}),
+                                **({"xacro_args": dict(xacro_args)} if xacro_args else {})},
                                source or str(path), path.parent)  # the URDF relative to its folder
 
 
