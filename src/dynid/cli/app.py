@@ -750,7 +750,7 @@ def excite(
 
 @app.command()
 def init(
-    urdf: Path = typer.Argument(..., help="The robot's URDF, or its MuJoCo model (MJCF, .xml)."),
+    urdf: Path = typer.Argument(..., help="The robot's URDF (or xacro file), or its MuJoCo model (MJCF, .xml)."),
     log: Path = typer.Argument(..., help="A CSV log of the robot moving (time, joint angles, joint torques or currents), or a ROS 2 bag."),
     validation: list[Path] | None = typer.Argument(None, help="Other logs of the same layout, to validate on."),
     out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
