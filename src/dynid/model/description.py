@@ -287,10 +287,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         raise ConfigError(str(exc)) from None
     urdf_model = None
     rows = d.joints
-    held = _held(d.held, convention, source)
-    if d.xacro_args and convention != "urdf":
-        raise ConfigError(f"{source}: xacro_args are a xacro file's arguments, but this description reads no robot file "
-                          "(give urdf = \"arm.urdf.xacro\")")
+    held = _held(d.held, convention, source, d.xacro_args)
     if convention == "urdf":
         upath, urdf_model = _read_urdf(d.urdf, base, source, held, d.xacro_args)
         if rows is None:
@@ -370,8 +367,12 @@ def _nominal_problems(inertial: np.ndarray, link_names, source: str) -> tuple[st
                  for p in physical_problems(inertial[i]))
 
 
-def _held(held, convention: str, source: str) -> dict:
-    """``held`` as joint name -> position (a list holds each at 0); only a URDF has joints to hold."""
+def _held(held, convention: str, source: str, xacro_args=None) -> dict:
+    """``held`` as joint name -> position (a list holds each at 0); only a URDF has joints to hold (and only a robot
+    file has ``xacro_args``)."""
+    if xacro_args and convention != "urdf":
+        raise ConfigError(f"{source}: xacro_args are a xacro file's arguments, but this description reads no robot file "
+                          "(give urdf = \"arm.urdf.xacro\")")
     if held is None:
         return {}
     if convention != "urdf":
