@@ -158,7 +158,7 @@ def test_a_xacro_description_never_runs_code(tmp_path, monkeypatch, escape):
                                           "description may not run in dynid|xacro cannot expand it)") as caught:
         expand_xacro(path)
     assert "\n" not in str(caught.value) and not marker.exists()
-    assert not list(tmp_path.glob("cache/dynid/xacro/*.urdf"))  # nothing cached either
+    assert not list(tmp_path.glob("cache/dynid/xacro/**/*.urdf"))  # nothing cached either
 
 
 def test_hostile_includes_and_yaml_are_refused(tmp_path, monkeypatch):

@@ -36,9 +36,10 @@ def test_a_xacro_description_is_the_robot_of_its_urdf(tmp_path, monkeypatch):
         np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-12)
         np.testing.assert_allclose(a.translation, b.translation, atol=1e-12)
     np.testing.assert_allclose(from_xacro.limits.dq_max, from_urdf.limits.dq_max)
-    assert len(list((tmp_path / "cache" / "dynid" / "xacro").glob("*.urdf"))) == 1  # expanded once, into the cache
+    cached = list((tmp_path / "cache" / "dynid" / "xacro").glob("*/*.urdf"))
+    assert [p.name for p in cached] == ["ur10e.urdf"]  # expanded once, into the cache, under the robot's name
     load_robot(tmp_path / "ur10e.urdf.xacro")
-    assert len(list((tmp_path / "cache" / "dynid" / "xacro").glob("*.urdf"))) == 1  # and reused
+    assert list((tmp_path / "cache" / "dynid" / "xacro").glob("*/*.urdf")) == cached  # and reused
 
 
 def test_a_config_names_a_xacro_robot_and_export_writes_into_its_expansion(tmp_path, monkeypatch):
@@ -50,7 +51,8 @@ def test_a_config_names_a_xacro_robot_and_export_writes_into_its_expansion(tmp_p
     robot = config_robot(doc, tmp_path / "c.toml")
     assert robot.n_dof == 6
     urdf = config_urdf(doc, tmp_path / "c.toml")
-    assert urdf is not None and urdf.suffix == ".urdf" and "<mass value=\"0.202\"/>" in urdf.read_text().replace("  ", "")
+    assert urdf is not None and urdf.name == "ur10e.urdf"  # identify and export write the identified URDF by this name
+    assert "<mass value=\"0.202\"/>" in urdf.read_text().replace("  ", "")
 
 
 def test_a_xacro_that_cannot_be_expanded_is_refused_in_one_line(tmp_path, monkeypatch):

@@ -355,7 +355,9 @@ def is_xacro(path: str | Path) -> bool:
 
 def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     """The URDF a xacro file expands to, written once into dynid's cache (``$XDG_CACHE_HOME/dynid/xacro``, by default
-    ``~/.cache/dynid/xacro``) under a name that changes with the file's contents, and reused after.
+    ``~/.cache/dynid/xacro``) in a folder whose name changes with the file's contents and arguments, and reused after.
+    The expansion keeps the file's name less ``.xacro`` (``arm.urdf.xacro`` gives ``arm.urdf``), which is the name
+    ``dynid identify`` and ``dynid export`` write the identified URDF under.
 
     dynid expands the file itself (:mod:`dynid.model.xacro_expansion`): macros, properties, arguments, conditionals,
     math and includes by relative path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths
@@ -385,18 +387,19 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     text = path.read_bytes()
     key = hashlib.sha256(text + repr(sorted((mappings or {}).items())).encode() + str(path.resolve()).encode()).hexdigest()[:16]
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "dynid" / "xacro"
-    out = cache / f"{path.name[:-len('.xacro')].removesuffix('.urdf')}-{key}.urdf"
+    stem = path.name[:-len(".xacro")].removesuffix(".urdf")
+    name = Path(f"{stem}-{key}") / f"{stem}.urdf"  # the file keeps the robot's name: export writes "<stem>.urdf"
     for folder in (cache, _fallback_cache()):
-        if _cached_and_current(folder / out.name):
-            return folder / out.name
+        if _cached_and_current(folder / name):
+            return folder / name
     urdf, files = expand_xacro_text(path, mappings)
     read = sorted({str(Path(f).resolve()) for f in files})
+    out = cache / name
     try:
-        cache.mkdir(parents=True, exist_ok=True)
+        out.parent.mkdir(parents=True, exist_ok=True)
     except OSError:  # an unwritable cache: the system's temporary folder instead
-        cache = _fallback_cache()
-        cache.mkdir(parents=True, exist_ok=True)
-        out = cache / out.name
+        out = _fallback_cache() / name
+        out.parent.mkdir(parents=True, exist_ok=True)
     manifest = {f: hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in read if Path(f).is_file()}
     _write_atomically(out.with_suffix(".files.json"), json.dumps(manifest, indent=1))
     _write_atomically(out, urdf)
