@@ -111,13 +111,14 @@ def test_xacro_arguments_reach_the_expansion_from_a_config_and_the_api(tmp_path,
         '<xacro:property name="tool_mass"', '<xacro:arg name="tool_mass" default="0.202"/>\n  <xacro:property name="x"'),
         encoding="utf-8")
     masses = {}
-    for given in (None, {"tool_mass": "0.5"}):
+    for given in (None, {"tool_mass": "0.5"}, {"tool_mass": 0.5}):  # a TOML number is its text
         doc = {"robot": {"urdf": path.name, **({"xacro_args": given} if given else {})}}
         masses[str(given)] = (config_robot(doc, tmp_path / "c.toml").inertial[-1, 9],
                               load_robot(path, xacro_args=given).inertial[-1, 9])
         urdf = config_urdf(doc, tmp_path / "c.toml").read_text()
         assert f'<mass value="{(given or {}).get("tool_mass", "0.202")}"/>' in urdf.replace("  ", "")
-    assert masses["None"] == pytest.approx((0.202, 0.202)) and masses["{'tool_mass': '0.5'}"] == pytest.approx((0.5, 0.5))
+    assert masses["None"] == pytest.approx((0.202, 0.202))
+    assert masses["{'tool_mass': '0.5'}"] == masses["{'tool_mass': 0.5}"] == pytest.approx((0.5, 0.5))
     with pytest.raises(ConfigError, match=r"xacro arguments \['tool_mass'\] given, but ur10e.urdf is not a xacro file"):
         load_robot(URDF, xacro_args={"tool_mass": "0.5"})
     with pytest.raises(ConfigError, match=r"robot: xacro_args are a xacro file's arguments, but this description reads no "

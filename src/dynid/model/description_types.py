@@ -104,9 +104,10 @@ def _types(terms: tuple[str, ...]) -> tuple[type, type]:
             description="joints of the URDF held fixed, not identified (a gripper's fingers, mimic joints): a list of "
                         "names (held at 0) or a table name = position (rad or m); their links count with the link "
                         "they are held to")], None], None),
-        ("xacro_args", Union[Annotated[dict[str, str], Meta(
-            description="with a xacro file: its arguments, name = value (xacro's name:=value; an argument not given "
-                        "takes the file's default)")], None], None),
+        ("xacro_args", Union[Annotated[dict[str, Union[str, bool, int, float]], Meta(
+            description="with a xacro file: its arguments, name = value (xacro's name:=value; a number or a boolean "
+                        "is given as its text, true/false; an argument not given takes the file's default)")], None],
+         None),
         ("gravity", Annotated[Vector3, Meta(description="m/s², base frame")], msgspec.field(default_factory=lambda: [0.0, 0.0, -9.81])),
         ("drive_terms", Union[Annotated[list[str], Meta(description="drive/friction terms of every joint, e.g. [\"Ia\", \"fv\", \"fc\", \"off\"]")], None], None),
         ("notes", Annotated[str, Meta(description="where the values come from")], ""),

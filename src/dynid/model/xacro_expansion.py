@@ -243,11 +243,12 @@ class XacroExpansion:
     Parameters
     ----------
     arguments : dict of str to str, optional
-        xacro arguments (``name:=value`` on xacro's command line), which ``<xacro:arg>`` defaults do not override.
+        xacro arguments (``name:=value`` on xacro's command line), which ``<xacro:arg>`` defaults do not override (a
+        number or a boolean is taken as its text, ``true``/``false``).
     """
 
     def __init__(self, arguments: dict | None = None):
-        self.arguments = {str(k): str(v) for k, v in (arguments or {}).items()}
+        self.arguments = {str(k): _argument_text(v) for k, v in (arguments or {}).items()}
         self.files: list[str] = []
         self.read: list[str] = []
         self.depth = 0
@@ -678,6 +679,11 @@ class XacroExpansion:
             if attr.startswith("xmlns:") and not node.parentNode.hasAttribute(attr):
                 node.parentNode.setAttribute(attr, value)
         _replace(node, body, content_only=True)
+
+
+def _argument_text(value: Any) -> str:
+    """An argument as xacro's command line gives it: text (a TOML boolean as ``true``/``false``)."""
+    return ("true" if value else "false") if isinstance(value, bool) else str(value)
 
 
 def _any(node) -> tuple[str, ...]:
