@@ -144,24 +144,10 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     """
     from ..model.urdf import expand_xacro, is_mjcf, is_xacro
 
-    file = _robot_file(doc, path, data_root)
+    file, xacro_args = _robot_file(doc, path, data_root)
     if file is None or is_mjcf(file):
         return None
-    return expand_xacro(file, _xacro_args(doc, path, data_root)) if is_xacro(file) else file
-
-
-def _xacro_args(doc: dict, path: Path, data_root: Path | None) -> dict | None:
-    """The ``xacro_args`` of a config's ``[robot]`` table, or of the description file its ``robot`` names."""
-    ref = doc.get("robot")
-    if isinstance(ref, dict):
-        return ref.get("xacro_args")
-    file = _located(ref, path.parent, data_root) if isinstance(ref, str) and ref not in builtin_robots() else None
-    if file is None or file.suffix.lower() != ".toml":
-        return None
-    try:
-        return tomllib.loads(file.read_text(encoding="utf-8")).get("xacro_args")
-    except (OSError, ValueError):
-        return None
+    return expand_xacro(file, xacro_args) if is_xacro(file) else file
 
 
 def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | None:
@@ -185,30 +171,34 @@ def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
     """
     from ..model.urdf import is_mjcf
 
-    file = _robot_file(doc, path, data_root)
+    file, _ = _robot_file(doc, path, data_root)
     return file if file is not None and is_mjcf(file) else None
 
 
-def _robot_file(doc: dict, path: Path, data_root: Path | None) -> Path | None:
-    """The URDF, xacro or MJCF file a config's robot is read from (None: a built-in robot or a DH description)."""
+def _robot_file(doc: dict, path: Path, data_root: Path | None) -> tuple[Path | None, dict | None]:
+    """The URDF, xacro or MJCF file a config's robot is read from (None: a built-in robot or a DH description), and
+    the ``xacro_args`` its ``[robot]`` table or description file gives."""
     from ..model.urdf import is_mjcf, is_xacro
 
     ref = doc.get("robot")
     if isinstance(ref, dict):
-        return _located(str(ref["urdf"]), path.parent, data_root) if isinstance(ref.get("urdf"), str) else None
+        file = _located(str(ref["urdf"]), path.parent, data_root) if isinstance(ref.get("urdf"), str) else None
+        return file, ref.get("xacro_args")
     if not isinstance(ref, str) or ref in builtin_robots():
-        return None
+        return None, None
     file = _located(ref, path.parent, data_root)
     if file is None:
-        return None
+        return None, None
     if file.suffix.lower() == ".urdf" or is_xacro(file) or is_mjcf(file):
-        return file
+        return file, None
     try:
         described = tomllib.loads(file.read_text(encoding="utf-8"))
     except (OSError, ValueError):
-        return None
+        return None, None
     urdf = described.get("urdf")
-    return _located(urdf, file.parent, None) if described.get("convention") == "urdf" and isinstance(urdf, str) else None
+    if described.get("convention") != "urdf" or not isinstance(urdf, str):
+        return None, None
+    return _located(urdf, file.parent, None), described.get("xacro_args")
 
 
 def _not_found(path: Path, field: str, name: str, data_root: Path | None) -> str:

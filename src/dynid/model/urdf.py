@@ -360,8 +360,9 @@ def expand_xacro(path: str | Path, mappings: dict | None = None) -> Path:
     ``dynid identify`` and ``dynid export`` write the identified URDF under.
 
     dynid expands the file itself (:mod:`dynid.model.xacro_expansion`): macros, properties, arguments, conditionals,
-    math and includes by relative path; ``$(find pkg)`` needs a ROS workspace and is refused in one line. Mesh paths
-    stay as the file wrote them. Every expression is computed by dynid's interpreter
+    math and includes by relative path; ``$(find pkg)`` finds the package's folder without ROS
+    (:meth:`~dynid.model.xacro_expansion.XacroExpansion.find`), and where it cannot, the file is refused in one line
+    naming the package. Mesh paths stay as the file wrote them. Every expression is computed by dynid's interpreter
     (:mod:`dynid.model.xacro_expressions`), never by Python's ``eval``: a description that would run code (files,
     introspection) is refused in one line.
 

@@ -196,15 +196,18 @@ def _macro_params(text: str) -> tuple[list[str], dict[str, tuple[str | None, str
     return params, defaults
 
 
-def _replace(node, by=None, content_only: bool = False) -> None:
-    """Put ``by`` (a node, or its children) where ``node`` is, and take ``node`` out: one splice of the parent's
+def _taken(node) -> list:
+    """``node``'s children, taken out of it (to be put elsewhere by :func:`_replace`)."""
+    items = list(node.childNodes)
+    node.childNodes[:] = []
+    return items
+
+
+def _replace(node, items=()) -> None:
+    """Put ``items`` (nodes no other node holds) where ``node`` is, and take ``node`` out: one splice of the parent's
     children (minidom's ``insertBefore`` looks the place up again for every node it moves)."""
     parent = node.parentNode
-    items = [] if by is None else list(by.childNodes) if content_only else [by]
-    if by is not None and content_only:
-        by.childNodes[:] = []
-    elif by is not None and by.parentNode is not None:
-        by.parentNode.removeChild(by)
+    items = list(items)
     children = parent.childNodes
     at = children.index(node)
     children[at:at + 1] = items
@@ -351,18 +354,19 @@ class XacroExpansion:
 
     def _text(self, text: str, symbols) -> Any:
         """A text with its ``${...}`` and ``$(...)`` computed: a single expression's typed value, else a string."""
+        tokens = _TOKENS.findall(text)
+        if "".join(tokens) != text:  # a "$" the lexer cannot place (an unclosed "${")
+            raise XacroError(f"cannot read {text!r}")
         parts: list[Any] = []
-        for token in _TOKENS.findall(text):
+        for token in tokens:
             if token.startswith("$$"):
                 parts.append(token[1:])
             elif token.startswith("${"):
                 parts.append(self._expression(str(self._text(token[2:-1], symbols)), symbols))
-            elif token.startswith("$(") and token.endswith(")") and len(token) > 2:
+            elif token.startswith("$("):
                 parts.append(self._extension(str(self._text(token[2:-1], symbols))))
             else:
                 parts.append(token)
-        if "".join(_TOKENS.findall(text)) != text:
-            raise XacroError(f"cannot read {text!r}")
         return parts[0] if len(parts) == 1 else "".join(map(str, parts))
 
     def _expression(self, text: str, symbols, allowed: dict[int, str] | None = None, what: str = "") -> Any:
@@ -374,16 +378,20 @@ class XacroExpansion:
         except Exception as exc:
             raise XacroError(f"{exc} (in {what or 'the expression'} {' '.join(text.split())!r})") from None
 
+    def _argument(self, name: str) -> str:
+        """An argument's text (``$(arg name)``), refused in one line where neither the file nor the user gives it."""
+        if name not in self.arguments:
+            raise XacroError(f"the argument {name!r} is not defined (an <xacro:arg> or name:=value)")
+        return self.arguments[name]
+
     def _extension(self, text: str) -> str:
-        """A ``$(command ...)``: arg, eval, env, optenv, dirname, cwd; ``find`` needs ROS and is refused."""
+        """A ``$(command ...)``: arg, eval, env, optenv, dirname, cwd, find (:meth:`find`)."""
         command, _, rest = text.strip().partition(" ")
         words = rest.split()
         if command == "eval":
             return str(self._eval(rest))
         if command == "arg" and len(words) == 1:
-            if words[0] not in self.arguments:
-                raise XacroError(f"the argument {words[0]!r} is not defined (an <xacro:arg> or name:=value)")
-            return self.arguments[words[0]]
+            return self._argument(words[0])
         if command == "env" and len(words) == 1:
             if words[0] not in os.environ:
                 raise XacroError(f"the environment variable {words[0]} is not set")
@@ -419,15 +427,14 @@ class XacroExpansion:
             No such folder (the message says where dynid looked and what to set).
         """
         top = Path(self.files[0] if self.files else ".").resolve().parent
-        places = [folder / name for folder in (top, *top.parents) for name in ("", package)]
-        places += [folder / name for folder in (top, *top.parents) for name in ("src", "share")]
-        paths = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-        places += [p for root in paths for p in (root, root / package)]
-        places += [Path(p) / "share" / package for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
-        for place in places:
-            for folder in (place, place / package):
-                if folder.name == package and (folder / "package.xml").is_file():
-                    return str(folder)
+        around = [p for folder in (top, *top.parents) for p in (folder, folder / package, folder / "src" / package,
+                                                                folder / "share" / package)]
+        listed = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+        listed = [p for root in listed for p in (root, root / package)]
+        ament = [Path(p) / "share" / package for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+        for folder in (*around, *listed, *ament):
+            if folder.name == package and (folder / "package.xml").is_file():
+                return str(folder)
         raise XacroError(f"$(find {package}) names a ROS package dynid cannot find (no folder {package} with a "
                          "package.xml beside the file, on ROS_PACKAGE_PATH or AMENT_PREFIX_PATH): set "
                          "ROS_PACKAGE_PATH to the folder holding it, or write the path relative to the file")
@@ -436,9 +443,7 @@ class XacroExpansion:
         """``$(eval ...)``: the arguments by name (numbers and booleans typed), ``arg(name)``, ``dirname()``,
         ``env``/``optenv`` and ``math``'s names."""
         def typed(name: str) -> Any:
-            if name not in self.arguments:
-                raise XacroError(f"the argument {name!r} is not defined (an <xacro:arg> or name:=value)")
-            value = self.arguments[name]
+            value = self._argument(name)
             try:
                 return float(value) if "." in value else int(value)
             except ValueError:
@@ -499,7 +504,7 @@ class XacroExpansion:
             if key in symbols:
                 block = self._clone(symbols[key])
                 self._evaluate_all(block, macros, symbols)
-                _replace(node, block, content_only)
+                _replace(node, _taken(block) if content_only else [block])
                 return
         raise XacroError(f"<xacro:insert_block name={name!r}>: no such block")
 
@@ -524,6 +529,7 @@ class XacroExpansion:
         pattern = self._beside(str(self._text(spec, symbols)))
         names = sorted(glob.glob(pattern)) if re.search(r"[*?\[]", pattern) else [pattern]
         skip_missing = bool(optional) and _boolean(self._text(optional, symbols), optional)
+        included: list = []
         for name in names:
             if skip_missing and not os.path.isfile(name):
                 continue
@@ -532,12 +538,9 @@ class XacroExpansion:
                 root = self._parse(name).documentElement
                 self._count(root)
                 self._evaluate_all(root, macros, symbols)
-            for attr, value in root.attributes.items():
-                if attr.startswith("xmlns:") and not node.parentNode.hasAttribute(attr):
-                    node.parentNode.setAttribute(attr, value)
-            for child in list(root.childNodes):
-                node.parentNode.insertBefore(child, node)
-        _replace(node)
+            _lift_namespaces(root, node.parentNode)
+            included += _taken(root)
+        _replace(node, included)
 
     @contextlib.contextmanager
     def _deeper(self, name: str | None = None):
@@ -613,9 +616,7 @@ class XacroExpansion:
         keep = _boolean(self._text(condition, symbols), condition) != (node.tagName == "xacro:unless")
         if keep:
             self._evaluate_all(node, macros, symbols)
-            _replace(node, node, content_only=True)
-        else:
-            _replace(node)
+        _replace(node, _taken(node) if keep else ())
 
     def _call(self, node, macros: _Table, symbols: _Table) -> None:
         name = node.getAttribute("macro")
@@ -675,10 +676,15 @@ class XacroExpansion:
         body = self._clone(macro.body)
         with self._deeper():
             self._evaluate_all(body, local, scope)
-        for attr, value in body.attributes.items():
-            if attr.startswith("xmlns:") and not node.parentNode.hasAttribute(attr):
-                node.parentNode.setAttribute(attr, value)
-        _replace(node, body, content_only=True)
+        _lift_namespaces(body, node.parentNode)
+        _replace(node, _taken(body))
+
+
+def _lift_namespaces(source, target) -> None:
+    """The ``xmlns:`` declarations of an expanded body or included file, onto the element that takes its content."""
+    for attr, value in source.attributes.items():
+        if attr.startswith("xmlns:") and not target.hasAttribute(attr):
+            target.setAttribute(attr, value)
 
 
 def _argument_text(value: Any) -> str:
