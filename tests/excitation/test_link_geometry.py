@@ -10,10 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from dynid.dynamics.kinematics import forward_kinematics
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, design_excitation
-from dynid.excitation.link_geometry import FAR, link_geometry_from_urdf, self_distances, self_pairs
+from dynid.excitation.link_geometry import FAR, LinkGeometry, link_geometry_from_urdf, self_distances, self_pairs
 from dynid.excitation.obstacles import Obstacle
 from dynid.io.cell_replay import cell_contacts
 from dynid.io.excitation_config import load_excitation_config
@@ -255,3 +256,39 @@ def test_the_same_arm_as_mjcf_has_the_same_shapes_where_it_matters(ur10e_with_me
     close = (near[0] < FAR) & (near[1] < FAR)
     assert close.sum() >= 10
     np.testing.assert_allclose(near[1][close], near[0][close], atol=1e-6)
+
+
+def test_a_failed_penetration_depth_never_stands_as_a_distance():
+    """Two cylinders overlapping deeply (met on the Unitree Z1's base and forearm at random poses): coal's EPA, at the
+    tolerance dynid asks of it, returns -DBL_MAX. The distance dynid reports is finite, no further below zero than the
+    shapes can overlap, and coal's own at its default tolerance."""
+    import coal
+
+    robot = load_robot("ur10e")
+    q = np.zeros((1, robot.n_dof))
+    rots, orig = forward_kinematics(robot, q)
+    world_a = np.eye(4)
+    world_a[:3, :3] = _orthonormal([[-0.75376635, 0.64351775, 0.13312098], [-0.1012432, 0.08643501, -0.9910998],
+                                    [-0.64929662, -0.76053527, 0.0]])
+    world_a[:3, 3] = [0.0, 0.0, 0.1035]
+    world_b = np.eye(4)
+    world_b[:3, :3] = _orthonormal([[-0.03125238, 0.54853752, -0.83554167], [-0.13271962, 0.82627017, 0.54741494],
+                                    [0.99066078, 0.1280008, 0.04697878]])
+    world_b[:3, 3] = [0.00570798, 0.05004193, 0.15288241]
+    frame = np.eye(4)
+    frame[:3, :3], frame[:3, 3] = rots[0, 2], orig[0, 2]
+    shapes = (coal.Cylinder(0.0325, 0.102), coal.Cylinder(0.0325, 0.051))
+    geometry = LinkGeometry(shapes, np.array([-1, 2]), np.stack([world_a, np.linalg.solve(frame, world_b)]),
+                            ("base", "forearm"), "test")
+    found = self_distances(robot, q, geometry, [(0, 1)], gradient=True)
+    loose = coal.DistanceResult()
+    coal.distance(shapes[0], coal.Transform3s(world_a[:3, :3], world_a[:3, 3]), shapes[1],
+                  coal.Transform3s(world_b[:3, :3], world_b[:3, 3]), coal.DistanceRequest(), loose)
+    assert -0.0325 * 2 < found.distance[0, 0] < 0
+    np.testing.assert_allclose(found.distance[0, 0], loose.min_distance, atol=1e-5)
+    assert np.all(np.isfinite(found.gradient))
+
+
+def _orthonormal(rows) -> np.ndarray:
+    u, _, vt = np.linalg.svd(np.asarray(rows, dtype=float))
+    return u @ vt

@@ -84,6 +84,31 @@ def test_gradients_equal_finite_differences(er16, rng):
     np.testing.assert_allclose(found.gradient[cyl], fd[cyl], atol=1e-3)
 
 
+def test_where_coal_fails_on_an_overlap_the_bounding_spheres_stand(er16, rng, monkeypatch):
+    """coal's penetration depth can fail (it returns -DBL_MAX: tests/excitation/test_link_geometry.py has a case). Made
+    to fail on every call, the distance is the spheres' lower bound, finite, with that bound's own gradient."""
+    import coal
+
+    real = coal.distance
+
+    def failing(*args):
+        real(*args)
+        args[-1].min_distance = -np.finfo(float).max
+
+    q = rng.uniform(-1.5, 1.5, (10, er16.n_dof))
+    truth = obstacle_distances(er16, q, [BALL], RADIUS)
+    monkeypatch.setattr(coal, "distance", failing)
+    found = obstacle_distances(er16, q, [BALL], RADIUS, gradient=True)
+    assert np.all(np.isfinite(found.distance)) and np.all(found.distance <= truth.distance + 1e-9)
+    h = 1e-6
+    for j in range(er16.n_dof):
+        e = np.zeros(er16.n_dof)
+        e[j] = h
+        fd = (obstacle_distances(er16, q + e, [BALL], RADIUS, pairs=found.pairs).distance
+              - obstacle_distances(er16, q - e, [BALL], RADIUS, pairs=found.pairs).distance) / (2 * h)
+        np.testing.assert_allclose(found.gradient[:, :, j], fd, atol=1e-6)
+
+
 def test_the_reach_bound_leaves_out_only_pairs_that_cannot_touch(er16, rng):
     far = Obstacle("sphere", np.array([0.3]), np.array([1.9, 0.0, 0.5]), name="far")
     pairs = reachable_pairs(er16, [BOX, far], RADIUS)

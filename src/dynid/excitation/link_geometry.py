@@ -27,7 +27,7 @@ from ..exceptions import ConfigError
 from ..model.mjcf import collision_geoms, excluded_bodies
 from ..model.robot import Robot
 from ..model.srdf import disabled_link_pairs
-from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from
+from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from, distance_above
 
 __all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
 
@@ -323,8 +323,9 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     for n, c in zip(*np.nonzero(dist < FAR)):
         g, i = pairs[c]
         body, pose = bodies[i]
-        result = coal.DistanceResult()
-        coal.distance(geometry.shapes[g], placed(n, g), body, pose, request, result)
+        result = distance_above(geometry.shapes[g], placed(n, g), body, pose, request, dist[n, c] + clearance)
+        if result is None:  # coal failed on a deep overlap: the spheres' bound stands
+            continue
         dist[n, c] = result.min_distance - clearance
         if gradient:
             near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
@@ -411,8 +412,9 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     pose = geometry.transforms(robot, q)
     for n, c in zip(*np.nonzero(dist < FAR)):
         g, h = pairs[c]
-        result = coal.DistanceResult()
-        coal.distance(geometry.shapes[g], pose(n, g), geometry.shapes[h], pose(n, h), request, result)
+        result = distance_above(geometry.shapes[g], pose(n, g), geometry.shapes[h], pose(n, h), request, dist[n, c])
+        if result is None:  # coal failed on a deep overlap: the spheres' bound stands
+            continue
         dist[n, c] = result.min_distance
         if gradient:
             near[0, n, c], near[1, n, c], normal[n, c] = (result.getNearestPoint1(), result.getNearestPoint2(),

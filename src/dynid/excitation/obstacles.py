@@ -175,6 +175,34 @@ def reachable_pairs(robot: Robot, obstacles, radius: float) -> list[tuple[int, i
     return sorted(out)
 
 
+def distance_above(shape_a, pose_a, shape_b, pose_b, request, bound: float):
+    """coal's distance of two shapes where it is at least ``bound``, a lower bound of it (their bounding spheres'
+    distance). On a deep overlap coal's penetration depth (EPA) can fail at :data:`GJK_TOLERANCE` and return
+    ``-DBL_MAX`` (two cylinders of the Unitree Z1 do; coal-library/coal#325 describes another case), which a design
+    would take as an overlap of 1.8e308 m and a check would report: the distance is then asked again at coal's default
+    tolerances, and where that fails too, ``bound`` stands for it.
+
+    Parameters
+    ----------
+    shape_a, shape_b : coal.CollisionGeometry
+    pose_a, pose_b : coal.Transform3s
+    request : coal.DistanceRequest
+    bound : float [m]
+        A distance the shapes' cannot fall below (``-inf``: none known).
+
+    Returns
+    -------
+    coal.DistanceResult or None
+        None where coal's distance lies below ``bound`` by more than coal's tolerance: ``bound`` stands for it.
+    """
+    for asked in (request, coal.DistanceRequest()):
+        result = coal.DistanceResult()
+        coal.distance(shape_a, pose_a, shape_b, pose_b, asked, result)
+        if result.min_distance >= bound - 1e-6:
+            return result
+    return None
+
+
 def away_from(result) -> np.ndarray:
     """The unit vector from the first object's nearest point to the second's (coal's normal where they overlap).
 
@@ -199,6 +227,12 @@ def _distance_gradient(result, seg: np.ndarray, jac: np.ndarray) -> np.ndarray:
     s = float(np.clip((near - a) @ ab / (ab @ ab), 0.0, 1.0)) if ab @ ab > 1e-24 else 0.0
     # moving the capsule away from the body raises the distance
     return -away_from(result) @ ((1 - s) * jac[0] + s * jac[1])
+
+
+def _sphere_gradient(gap: np.ndarray, jac: np.ndarray) -> np.ndarray:
+    """(n_dof,) ``∂distance/∂q`` of the bounding spheres' distance, ``gap`` from the body's centre to the capsule's
+    middle, which moves as the mean of its segment's ends (``jac`` (2, 3, n_dof))."""
+    return gap / max(float(np.linalg.norm(gap)), 1e-12) @ (0.5 * (jac[0] + jac[1]))
 
 
 @dataclass(frozen=True)
@@ -263,10 +297,13 @@ def obstacle_distances(robot: Robot, q: np.ndarray, obstacles, radius: float, *,
         if k not in capsules:
             capsules[k] = _capsules(seg[:, k], radius)
         cap, cap_poses = capsules[k]
+        middle, half = seg[:, k].mean(axis=1), 0.5 * np.linalg.norm(seg[:, k, 1] - seg[:, k, 0], axis=1)
+        bound = (np.linalg.norm(middle - obstacles[i].position, axis=1) - half - radius
+                 - obstacles[i].bounding_radius())  # the spheres holding the capsule and the body
         for n in range(q.shape[0]):
-            result = coal.DistanceResult()
-            coal.distance(cap, cap_poses[n], body, pose, request, result)
-            dist[n, c] = result.min_distance
+            result = distance_above(cap, cap_poses[n], body, pose, request, bound[n])
+            dist[n, c] = bound[n] if result is None else result.min_distance
             if grad is not None and jac is not None:
-                grad[n, c] = _distance_gradient(result, seg[n, k], jac[n, k])
+                grad[n, c] = (_sphere_gradient(middle[n] - obstacles[i].position, jac[n, k]) if result is None
+                              else _distance_gradient(result, seg[n, k], jac[n, k]))
     return ObstacleDistances(pairs, dist, grad)
