@@ -111,3 +111,28 @@ def test_studies_and_fleet_stand_apart():
 def test_the_import_resolver_sees_relative_imports():
     found = dict(_imports_of("studies"))
     assert "dynid.identification.pipeline" in set(m for _, m in _imports_of("studies")), found
+
+
+HAND_ASSEMBLED = {("studies/paper.py", "Estimation"), ("studies/paper.py", "stream_rows"),
+                  ("studies/montecarlo.py", "Estimation")}
+"""Where code outside identification/ still assembles the estimation by hand (issue "Parts carry their settings, one
+route", item 3): the paper's experiment and its Monte Carlo stream a simulated recording's rows into the estimators
+with the paper's Table 3 search box and seeds of their own. Every other caller goes through the pipeline."""
+
+
+def test_only_the_known_callers_assemble_the_estimation_by_hand():
+    """Calls of the estimation's parts (``Estimation``, ``stream_rows``, ``identify``, ``closed_loop_identify``)
+    outside identification/: a new one fails here, and so does one that went away (drop it from the list)."""
+    root = Path(dynid.__file__).parent
+    parts = {"Estimation", "stream_rows", "identify", "closed_loop_identify"}
+    found = set()
+    for path in root.rglob("*.py"):
+        rel = path.relative_to(root)
+        if rel.parts[0] in ("identification", "estimators"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call):
+                name = node.func.id if isinstance(node.func, ast.Name) else getattr(node.func, "attr", None)
+                if name in parts:
+                    found.add((rel.as_posix(), name))
+    assert found == HAND_ASSEMBLED

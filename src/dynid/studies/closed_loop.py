@@ -6,9 +6,10 @@ nominal model's feed-forward, :meth:`~dynid.simulation.closed_loop.Controller.fo
 positions; the log (measured positions, commanded torques plus noise) is prepared as ``dynid identify`` prepares a
 real one, given the one thing known of its drives: each command is held over the control period, so the logged
 torques lead the motion by half a period (:func:`zero_order_hold_delay`, the ``torque_delay`` setting); and every
-estimator is fitted on it: the open-loop ones through
-:func:`dynid.identification.identify.identify` (OLS, WLS, IRLS, LAD, SDP, ABC, …) and IDIM-IV and DIDIM through
-:func:`dynid.identification.closed_loop.closed_loop_identify`. Per cell and estimator the study reports the bias and
+estimator is fitted on it by :class:`dynid.identification.pipeline.IdentificationPipeline`, as ``dynid identify`` fits
+them: the open-loop ones (OLS, WLS, IRLS, LAD, SDP, ABC, …) on the prepared log, then IDIM-IV and DIDIM
+(:class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts given the controller and the set-points) on the
+same rows, simulating the run. Per cell and estimator the study reports the bias and
 spread of each base parameter, against |β| and against the Cramér–Rao bound, and the coverage of the estimator's
 95 % intervals (``|β̂ − β| ≤ 1.96 σ̂``) where it gives σ.
 
@@ -41,7 +42,7 @@ from ..estimators.registry import label, parse_estimators
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
-from ..identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
+from ..identification.closed_loop import ClosedLoopEstimator, ClosedLoopExperiment, ClosedLoopSetup
 from ..identification.pipeline import IdentificationPipeline
 from ..io.datasets import Recording
 from ..model.description import load_robot
@@ -241,35 +242,25 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     converged, seconds = np.zeros(len(keys), dtype=bool), np.zeros(len(keys))
     errors: dict[str, str] = {}
 
-    open_keys = [k for k in keys if k not in CLOSED_LOOP_METHODS]
-    if open_keys:
-        seed = int(np.random.default_rng([cfg.seed, 21, cell, realisation]).integers(2**31))
-        try:
-            pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False),
-                                              estimators=tuple(cfg.open_loop), rng=seed)  # the settings as given
-            result = pipeline.estimate(pipeline.prepare(log, setup.base))
-        except DynIdError as exc:
-            errors.update({k: str(exc) for k in open_keys})
-        else:
-            by_key = {e.key: e for e in result.estimates.values()}
-            for i, key in enumerate(keys):
-                e = by_key.get(key)
-                if e is not None:
-                    params[i], converged[i], seconds[i] = e.params, True, e.seconds
-                    if e.std is not None:
-                        std[i] = e.std
-    for i, key in enumerate(keys):
-        if key not in CLOSED_LOOP_METHODS:
-            continue
-        start = time.perf_counter()
-        try:
-            out = closed_loop_identify(setup.robot, setup.base, log, exp, methods=(key,), preprocessing=settings)[key]
-        except DynIdError as exc:
-            errors[key] = str(exc)
-            continue
-        params[i], std[i], converged[i], seconds[i] = out.params, out.params_std, out.converged, time.perf_counter() - start
-        if not out.converged:
-            errors[key] = out.message
+    seed = int(np.random.default_rng([cfg.seed, 21, cell, realisation]).integers(2**31))
+    reference = ClosedLoopSetup(exp.controller, exp.q_ref, feedforward=exp.feedforward is not None)
+    try:  # dynid identify's route: the closed-loop parts on the rows the others fitted, the settings as given
+        pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False),
+                                          estimators=(*cfg.open_loop, *(ClosedLoopEstimator(k, reference) for k in keys
+                                                                        if k in CLOSED_LOOP_METHODS)), rng=seed)
+        result = pipeline.fit(log, held_out=False)
+    except DynIdError as exc:
+        errors.update({k: str(exc) for k in keys})
+    else:
+        by_key = {e.key: e for e in result.estimates.values()}
+        for i, key in enumerate(keys):
+            e = by_key[key]
+            stopped = key in CLOSED_LOOP_METHODS and bool(e.note)  # a closed-loop estimator stopped before converging
+            params[i], converged[i], seconds[i] = e.params, not stopped, e.seconds
+            if e.std is not None:
+                std[i] = e.std
+            if stopped:
+                errors[key] = e.note
     return {"params": params, "std": std, "converged": converged, "seconds": seconds, "errors": errors}
 
 
