@@ -714,8 +714,8 @@ def _yardstick_lines(r, label: str) -> list:
     nominal = r.diagnostics.get("nominal_set")
     beside = f", the description's nominal model {mean[nominal]:.3g} %" if nominal in mean and nominal != label else ""
     return [Line(f"on one yardstick (every validation log filtered by dynid's default rules, the same samples whatever the "
-                 f"settings): {label} {mean[label]:.3g} %{beside} (mean over "
-                 f"{len(r.validations)} logs)")]
+                 f"settings): {label} {mean[label]:.3g} %{beside} "
+                 + (f"(mean over {len(r.validations)} logs)" if len(r.validations) > 1 else "(one log)"))]
 
 
 CHOSEN_TERMS = ("fst", "fca", "fcl")
