@@ -6,7 +6,11 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import time
 from collections.abc import Callable
+from typing import Any
+
+import numpy as np
 
 from ..exceptions import ConfigError
 from ..plugins import share_with
@@ -102,3 +106,66 @@ def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], sto
             if progress is not None:
                 progress(done, len(futures))
     return cluster
+
+
+def realisations_on_grid(prepare: Callable, simulate: Callable, config, cells: int, fields: Callable[[Any], dict],
+                         error_row: Callable[[int, int, str, str], dict], what: str, scheduler: str | None = None,
+                         workers: int | None = None, progress: Callable[[int, int], None] | None = None):
+    """A Monte Carlo study's run: ``setup = prepare(config)`` made once, ``simulate(setup, cell, realisation)`` for
+    every cell and ``config.realisations`` realisations on a Dask cluster (:func:`map_realisations`), each result's
+    arrays stacked and its failures listed.
+
+    Parameters
+    ----------
+    prepare : callable
+        ``prepare(config) -> setup``, what every task shares.
+    simulate : callable
+        ``simulate(setup, cell, realisation) -> dict`` holding every name of ``fields`` and ``errors``
+        ({estimator: message}).
+    config : object
+        The study's settings, with ``realisations``.
+    cells : int
+        Cells of the grid (noise levels, noise pairs).
+    fields : callable
+        ``fields(setup)`` -> {name: (shape of one result's array, fill value where a task gave none)}.
+    error_row : callable
+        ``error_row(cell, realisation, estimator, message) -> dict``: one failure as the study's JSON lists it, its
+        sort keys first and the message last.
+    what : str
+        The command, for the message when Dask is missing.
+    scheduler, workers, progress :
+        As :func:`map_realisations`.
+
+    Returns
+    -------
+    setup : object
+    arrays : dict
+        name -> (cells, realisations, *shape) array.
+    errors : list of dict
+        The failures, sorted by their rows' values before the message.
+    cluster : str
+        The cluster the tasks ran on.
+    seconds : float
+        The whole run's time, the setup's included [s].
+
+    Raises
+    ------
+    ConfigError
+        Dask missing (:func:`dynid.runtime.extras.require`), or from :func:`dask_client`.
+    """
+    require("distributed", "montecarlo", what)
+    start = time.perf_counter()
+    setup = prepare(config)
+    grid = (cells, config.realisations)
+    arrays = {name: np.full(grid + tuple(shape), fill) for name, (shape, fill) in fields(setup).items()}
+    errors: list[dict] = []
+
+    def store(key, out):
+        for name, array in arrays.items():
+            array[key] = out[name]
+        errors.extend(error_row(*key, k, message) for k, message in out["errors"].items())
+
+    cluster = map_realisations(simulate, setup, [(c, r) for c in range(grid[0]) for r in range(grid[1])], store,
+                               scheduler, workers, what, progress)
+    errors.sort(key=lambda row: tuple(row.values())[:-1])
+    return setup, arrays, errors, cluster, time.perf_counter() - start

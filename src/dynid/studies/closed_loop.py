@@ -28,7 +28,6 @@ the tasks run.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -48,8 +47,7 @@ from ..io.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing
-from ..runtime.cluster import map_realisations
-from ..runtime.extras import require
+from ..runtime.cluster import realisations_on_grid
 from ..runtime.threads import with_single_blas_thread
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from .paper import PaperExperimentConfig, identification_trajectory, study_header
@@ -442,25 +440,14 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
     ConfigError
         Invalid settings, an unreachable scheduler, or Dask not installed.
     """
-    require("distributed", "montecarlo", "dynid montecarlo --closed-loop")
-
-    t0 = time.perf_counter()
-    setup = _prepare(config)
-    cells, n_real, n_methods, n_base = config.cells, config.realisations, len(config.estimators), setup.base.n_base
-    estimates = np.full((len(cells), n_real, n_methods, n_base), np.nan)
-    std = np.full_like(estimates, np.nan)
-    converged = np.zeros((len(cells), n_real, n_methods), dtype=bool)
-    seconds = np.zeros((len(cells), n_real, n_methods))
-    errors = []
-    def store(key, out):
-        c, r = key
-        estimates[c, r], std[c, r], converged[c, r], seconds[c, r] = out["params"], out["std"], out["converged"], out["seconds"]
-        errors.extend({"encoder_noise_deg": cells[c][0], "torque_noise_Nm": cells[c][1], "realisation": r, "estimator": k,
-                       "error": msg} for k, msg in out["errors"].items())
-
-    cluster = map_realisations(simulate_realisation, setup, [(c, r) for c in range(len(cells)) for r in range(n_real)],
-                               store, scheduler, workers, "dynid montecarlo --closed-loop", progress)
+    cells, n_methods = config.cells, len(config.estimators)
+    setup, arrays, errors, cluster, seconds = realisations_on_grid(
+        _prepare, simulate_realisation, config, len(cells),
+        lambda setup: {"params": ((n_methods, setup.base.n_base), np.nan), "std": ((n_methods, setup.base.n_base), np.nan),
+                       "converged": ((n_methods,), False), "seconds": ((n_methods,), 0.0)},
+        lambda c, r, k, msg: {"encoder_noise_deg": cells[c][0], "torque_noise_Nm": cells[c][1], "realisation": r,
+                              "estimator": k, "error": msg},
+        "dynid montecarlo --closed-loop", scheduler, workers, progress)
     crb_std = np.sqrt(np.outer(np.array([s for _, s in cells]) ** 2, np.diag(setup.unit_crb)))
-    errors.sort(key=lambda e: (e["encoder_noise_deg"], e["torque_noise_Nm"], e["realisation"], e["estimator"]))
-    return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, estimates, std, converged, seconds, crb_std,
-                                 errors, {"total": time.perf_counter() - t0}, cluster)
+    return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["std"],
+                                 arrays["converged"], arrays["seconds"], crb_std, errors, {"total": seconds}, cluster)

@@ -21,7 +21,6 @@ order tasks run.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -38,8 +37,7 @@ from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing import strategies
-from ..runtime.cluster import map_realisations
-from ..runtime.extras import require
+from ..runtime.cluster import realisations_on_grid
 from ..runtime.threads import with_single_blas_thread
 from ..simulation.measurements import NoiseModel
 from .paper import (
@@ -332,22 +330,13 @@ def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: 
     ConfigError
         Invalid settings or an unreachable scheduler.
     """
-    require("distributed", "montecarlo", "dynid montecarlo")
-    t0 = time.perf_counter()
-    setup = _prepare(config)
-    n_levels, n_real, n_methods = len(config.noise_levels), config.realisations, len(config.estimators)
-    estimates = np.full((n_levels, n_real, n_methods, setup.base.n_base), np.nan)
-    seconds = np.zeros((n_levels, n_real, n_methods))
-    errors = []
-    def store(key, out):
-        li, r = key
-        estimates[li, r], seconds[li, r] = out["params"], out["seconds"]
-        errors.extend({"noise_level_A": float(config.noise_levels[li]), "realisation": r, "method": k, "error": msg}
-                      for k, msg in out["errors"].items())
-
-    cluster = map_realisations(simulate_realisation, setup, [(li, r) for li in range(n_levels) for r in range(n_real)],
-                               store, scheduler, workers, progress=progress)
+    n_methods = len(config.estimators)
+    setup, arrays, errors, cluster, seconds = realisations_on_grid(
+        _prepare, simulate_realisation, config, len(config.noise_levels),
+        lambda setup: {"params": ((n_methods, setup.base.n_base), np.nan), "seconds": ((n_methods,), 0.0)},
+        lambda li, r, k, msg: {"noise_level_A": float(config.noise_levels[li]), "realisation": r, "method": k,
+                               "error": msg},
+        "dynid montecarlo", scheduler, workers, progress)
     crb_std = np.sqrt(np.outer(np.asarray(config.noise_levels, dtype=float) ** 2, np.diag(setup.unit_crb)))
-    errors.sort(key=lambda e: (e["noise_level_A"], e["realisation"], e["method"]))
-    return MonteCarloResult(config, tuple(setup.base.names), setup.truth, estimates, seconds, crb_std, errors,
-                            {"total": time.perf_counter() - t0}, cluster)
+    return MonteCarloResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["seconds"], crb_std,
+                            errors, {"total": seconds}, cluster)
