@@ -109,7 +109,7 @@ def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], sto
 
 
 def realisations_on_grid(prepare: Callable, simulate: Callable, config, cells: int, fields: Callable[[Any], dict],
-                         error_row: Callable[[int, int, str, str], dict], what: str, scheduler: str | None = None,
+                         error_row: Callable[[int, int, str, str], dict], *, what: str, scheduler: str | None = None,
                          workers: int | None = None, progress: Callable[[int, int], None] | None = None):
     """A Monte Carlo study's run: ``setup = prepare(config)`` made once, ``simulate(setup, cell, realisation)`` for
     every cell and ``config.realisations`` realisations on a Dask cluster (:func:`map_realisations`), each result's

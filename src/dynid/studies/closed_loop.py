@@ -447,7 +447,7 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
                        "converged": ((n_methods,), False), "seconds": ((n_methods,), 0.0)},
         lambda c, r, k, msg: {"encoder_noise_deg": cells[c][0], "torque_noise_Nm": cells[c][1], "realisation": r,
                               "estimator": k, "error": msg},
-        "dynid montecarlo --closed-loop", scheduler, workers, progress)
+        what="dynid montecarlo --closed-loop", scheduler=scheduler, workers=workers, progress=progress)
     crb_std = np.sqrt(np.outer(np.array([s for _, s in cells]) ** 2, np.diag(setup.unit_crb)))
     return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["std"],
                                  arrays["converged"], arrays["seconds"], crb_std, errors, {"total": seconds}, cluster)

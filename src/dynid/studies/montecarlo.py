@@ -336,7 +336,7 @@ def run_montecarlo(config: MonteCarloConfig = MonteCarloConfig(), *, scheduler: 
         lambda setup: {"params": ((n_methods, setup.base.n_base), np.nan), "seconds": ((n_methods,), 0.0)},
         lambda li, r, k, msg: {"noise_level_A": float(config.noise_levels[li]), "realisation": r, "method": k,
                                "error": msg},
-        "dynid montecarlo", scheduler, workers, progress)
+        what="dynid montecarlo", scheduler=scheduler, workers=workers, progress=progress)
     crb_std = np.sqrt(np.outer(np.asarray(config.noise_levels, dtype=float) ** 2, np.diag(setup.unit_crb)))
     return MonteCarloResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["seconds"], crb_std,
                             errors, {"total": seconds}, cluster)
