@@ -252,7 +252,9 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     else:
         by_key = {e.key: e for e in result.estimates.values()}
         for i, key in enumerate(keys):
-            e = by_key[key]
+            e = by_key.get(key)
+            if e is None:  # not estimated: its row stays NaN
+                continue
             stopped = key in CLOSED_LOOP_METHODS and bool(e.note)  # a closed-loop estimator stopped before converging
             params[i], converged[i], seconds[i] = e.params, not stopped, e.seconds
             if e.std is not None:
