@@ -41,13 +41,12 @@ def test_init_detects_the_columns_by_header_and_identify_runs_on_the_config(tmp_
     assert ident["positions"]["columns"][:2] == ["joint_pos_1", "joint_pos_2"]
     assert ident["torques"]["columns"][0] == "effort[0]"
     assert ident["time"] == {"column": "time"} and tomllib.loads(text)["data_root"] == "../logs"
+    # the physically consistent estimate listed beside WLS (the URDF's nominal values are consistent), so that the
+    # verdict can choose it and export has it
+    assert tomllib.loads(text)["estimation"]["estimators"] == ["wls", "sdp"]
     p = run("identify", "arm.toml", "--out", "id", "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "cfg" / "id" / "results.json").is_file()
-    assert '# [estimation]\n# estimators = ["wls", "sdp"]' in text  # the physically consistent estimate, as init says
-    (tmp_path / "cfg" / "arm.toml").write_text(text.replace('# [estimation]\n# estimators', '[estimation]\nestimators'))
-    p = run("identify", "arm.toml", "--out", "id", "--no-figures", "-q")
-    assert p.returncode == 0, p.stderr
     # one output folder, one model: the user's URDF with the identified values written in, under its own name, the
     # same file `dynid export --urdf` writes; every line but <inertial>/<dynamics> values and dynid's comments the user's
     written = tmp_path / "cfg" / "id" / URDF.name
@@ -217,8 +216,7 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     other.write_text(log.read_text())
     monkeypatch.chdir(tmp_path)
     assert run("init", str(URDF), str(log), str(other), "--out", "arm.toml").returncode == 0
-    text = (tmp_path / "arm.toml").read_text().replace('# [estimation]\n# estimators = ["wls", "sdp"]',
-                                                       '[estimation]\nestimators = ["wls", "sdp"]')
+    text = (tmp_path / "arm.toml").read_text()
     (tmp_path / "arm.toml").write_text(text + "\n[excitation.design]\nstarts = 1\nmaxiter = 3\n")
     p = run("excite", "arm.toml", "--out", "excitation", "-q")
     assert p.returncode == 0, p.stderr
@@ -482,3 +480,25 @@ def test_init_writes_any_path_as_a_toml_string_and_identify_reads_it(tmp_path):
     assert p.returncode == 0, p.stderr
     rec = dynid.load_recording(moved, dynid.load_robot(URDF))  # a log's path alone: its columns found as init finds them
     assert np.asarray(rec.q).shape[1] == 6
+
+
+def test_init_lists_the_sdp_only_where_the_descriptions_values_allow_it(tmp_path):
+    """A URDF whose nominal inertia breaks the triangle inequality: the SDP (whose prior needs consistent nominal
+    values) is not listed, a comment says why, and identify runs on WLS; with consistent values both are listed."""
+    import re
+
+    log = _log(tmp_path, header=True)
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(re.sub(r'<inertia ixx="[^"]*" ixy="[^"]*" ixz="[^"]*" iyy="[^"]*" iyz="[^"]*" izz="[^"]*"',
+                          '<inertia ixx="1.0" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"', URDF.read_text(), count=2))
+    p = run("init", str(bad), str(log), "--out", str(tmp_path / "bad.toml"))
+    assert p.returncode == 0, p.stderr
+    said = " ".join(p.stdout.split())
+    assert "the physically consistent SDP is not listed" in said and "triangle inequality" in said
+    text = (tmp_path / "bad.toml").read_text()
+    assert "estimation" not in tomllib.loads(text)
+    assert '# estimators = ["wls", "sdp"]' in text and "# not listed: " in text and "bad.urdf: link 1" in text
+    p = run("identify", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "good.toml"))
+    assert tomllib.loads((tmp_path / "good.toml").read_text())["estimation"]["estimators"] == ["wls", "sdp"]

@@ -51,7 +51,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         ``held``, and said.
     robot : Robot, optional
         The robot read from ``urdf``: a bag is then opened and read as identify reads it (its joint names against the
-        robot's, its rate, length and effort range said).
+        robot's, its rate, length and effort range said), and where its nominal values are physically consistent the
+        config lists ``estimators = ["wls", "sdp"]`` (without it, or with inconsistent values, the SDP is suggested
+        in a comment that says why it is not listed).
     rate : float, optional
         The logs' sample rate [Hz], for a CSV log with a header and no time column (``rate =`` in the config; the
         validation tables take it with the identification's columns).
@@ -85,10 +87,30 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
-        return _config(urdf, log, out, validation, table, said, held, xacro_args), said
+        said.append(_estimators_note(without := _without_sdp(robot)))
+        return _config(urdf, log, out, validation, table, said, held, xacro_args, without), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
-    notes += _held_notes(urdf, held)
-    return _config(urdf, log, out, validation, table, notes, held, xacro_args), notes
+    notes += [*_held_notes(urdf, held), _estimators_note(without := _without_sdp(robot))]
+    return _config(urdf, log, out, validation, table, notes, held, xacro_args, without), notes
+
+
+def _estimators_note(without_sdp: str | None) -> str:
+    if without_sdp is None:
+        return ("estimators: WLS and the physically consistent SDP (what dynid export writes); dynid identify chooses "
+                "the main estimate among them, the description's values and its drive terms")
+    return f"estimators: WLS; the physically consistent SDP is not listed ({without_sdp})"
+
+
+def _without_sdp(robot) -> str | None:
+    """Why the config cannot list the physically consistent estimate (``sdp``); None where it can: the robot read
+    from the file has physically consistent nominal values, which the SDP's prior needs."""
+    if robot is None:
+        return "the robot was not read"
+    try:
+        robot.require_physical_nominal("sdp (the physically consistent estimate)")
+    except ConfigError as exc:
+        return str(exc)
+    return None
 
 
 def xacro_arguments(given: list[str]) -> dict[str, str]:
@@ -142,10 +164,11 @@ def _bag_read(bag: Path, robot) -> str:
 
 
 def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str],
-            held: tuple[str, ...] = (), xacro_args: dict | None = None) -> str:
+            held: tuple[str, ...] = (), xacro_args: dict | None = None, without_sdp: str | None = None) -> str:
     """The config's text, written by tomlkit (every string escaped, whatever the paths and columns hold): what was
     detected in comments, the robot (a table where joints are held or a xacro file takes arguments), the dataset
-    table, the validation logs."""
+    table, the validation logs, and the estimators: WLS and the SDP, or, ``without_sdp`` saying why not, the SDP
+    suggested in a comment."""
     doc = tomlkit.document()
     for line in ("dynid identification config, written by dynid init: check the columns and units below, then",
                  "  dynid identify THIS_FILE", *notes):
@@ -185,9 +208,17 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
                      "fitted", 'name = "second_run"', 'file = "second_run.csv"'):
             table.add(tomlkit.comment(line))
     last = tables[-1] if validation else table
-    last.add(tomlkit.nl())
-    last.add(tomlkit.comment("[estimation]"))
-    last.add(tomlkit.comment('estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export'))
+    if without_sdp is None:  # both candidates of the verdict; the SDP is what dynid export writes
+        estimation = tomlkit.table()
+        estimation.add("estimators", ["wls", "sdp"])
+        estimation["estimators"].comment("sdp: physically consistent, what dynid export writes; the verdict chooses "
+                                         "the main estimate")
+        doc.add("estimation", estimation)
+    else:
+        last.add(tomlkit.nl())
+        last.add(tomlkit.comment("[estimation]"))
+        last.add(tomlkit.comment('estimators = ["wls", "sdp"]     # add sdp for a physically consistent estimate to export'))
+        last.add(tomlkit.comment(f"not listed: {' '.join(without_sdp.split())}"))
     return tomlkit.dumps(doc)
 
 
