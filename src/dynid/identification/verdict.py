@@ -9,7 +9,7 @@ logs are scored. The candidates, in the order they are weighed:
 2. the physically consistent SDP (where listed), where the first is least squares and is not physically consistent,
    and the SDP predicts as well (to :data:`SAME_FIGURE`) or better: the validation logs (mean global error) or,
    without validation logs, held-out contiguous blocks of the identification log
-   (:data:`dynid.identification.identify.HELD_OUT_FOLDS`-fold blocked cross-validation, strictly better);
+   (:data:`dynid.identification.identify.HELD_OUT_FOLDS`-fold blocked cross-validation);
 3. the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`), where the
    estimate so far is doubtful on the validation logs (the description's nominal model predicts them better, or least
    squares' predictions leave the range the identification log supports) and it predicts them better;
@@ -170,12 +170,14 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
     rigid = main == ls and SDP_LABEL in result.estimates and inconsistent
     if not result.validations:
         held = result.diagnostics.get("held_out_rms_error") or {}
-        if inconsistent and SDP_LABEL in held and held[SDP_LABEL] < held[ls]:
-            main = SDP_LABEL
+        if inconsistent and SDP_LABEL in held and held[SDP_LABEL] <= SAME_FIGURE * held[ls]:
+            main, sdp, own = SDP_LABEL, held[SDP_LABEL], held[ls]
+            how = "worse" if sdp < own else f"as well, to {100 * (SAME_FIGURE - 1):g} %"
             findings.insert(0, Finding("main", f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not "
-                                               "and predicts held-out blocks of the log worse ({} against {} N·m RMS, "
-                                               f"{HELD_OUT_FOLDS}-fold blocked cross-validation)".format(
-                                                   *_apart_figures(held[SDP_LABEL], held[ls]))))
+                                               f"and predicts held-out blocks of the log {how} ({{}} against {{}} N·m "
+                                               f"RMS, {HELD_OUT_FOLDS}-fold blocked cross-validation)".format(
+                                                   *_apart_figures(sdp, own))
+                                               + ("" if sdp < own else "; it is what dynid export writes")))
         return replace(result, main=main, findings=tuple(findings + _drive_findings(result, main)))
     if states is not None and nominal is not None and scored is not None:
         result, chosen = _state_choice(result, nominal, scored, states)
