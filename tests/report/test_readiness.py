@@ -57,5 +57,17 @@ def test_a_term_the_cross_validation_chose_is_not_called_undetermined_and_every_
     assert kept.endswith("fcl1, fst6: the log shows the effect, not its size; a richer excitation (dynid excite) sizes them")
     named = next(t for t in lines if t.startswith("the drive terms named: "))
     assert "fcl1, load-dependent Coulomb friction of J1" in named and "fst6, Stribeck friction of J6" in named
+    links = next(t for t in lines if t.startswith("the link parameters named: "))  # MX2, the one listed, written out
+    assert "MXj, MYj, MZj its first moments" in links and "inertia tensor" not in links and "trailing R" not in links
     r.choices = SimpleNamespace(friction=None)  # the description gave them
     assert any(t.startswith("kept by the description") for t in (line.text for line in _determined_lines(r, "dynid WLS")))
+
+
+def test_the_link_parameters_named_are_written_out_once():
+    """Every inertial name the console lists (ZZ1R, XX2R, MX5, M3) is explained in one line, the regrouped ones too."""
+    from dynid.report.summaries import _link_legend
+
+    line = _link_legend(["ZZ1R", "fv1", "XY2", "MX5", "M3"])
+    assert line.startswith("the link parameters named: XXj … ZZj the inertia tensor of link j")
+    assert "first moments (mass × centre of mass)" in line and "Mj its mass" in line and "trailing R: regrouped" in line
+    assert _link_legend(["fv1", "fc2", "offset3", "Ia4"]) == ""  # drive terms only: their own line

@@ -723,6 +723,25 @@ CHOSEN_TERMS = ("fst", "fca", "fcl")
 (or the description) chose them, so a loose σ does not make them "not determined"."""
 
 
+LINK_TERMS = {"XX": "inertia", "XY": "inertia", "XZ": "inertia", "YY": "inertia", "YZ": "inertia", "ZZ": "inertia",
+              "MX": "moment", "MY": "moment", "MZ": "moment", "M": "mass"}
+"""The standard inertial parameters' stems (Khalil's names) and what each is."""
+
+
+def _link_legend(names: list[str]) -> str:
+    """One line saying what the link parameters among ``names`` are (issue "Never worse than the description", item 4:
+    every name in the console explained once); empty where there are none."""
+    kinds = {LINK_TERMS[split_name(n)[0]] for n in names if split_name(n)[0] in LINK_TERMS}
+    if not kinds:
+        return ""
+    parts = [text for kind, text in (("inertia", "XXj … ZZj the inertia tensor of link j about its frame's origin"),
+                                     ("moment", "MXj, MYj, MZj its first moments (mass × centre of mass)"),
+                                     ("mass", "Mj its mass")) if kind in kinds]
+    regrouped = " (a trailing R: regrouped, holding parameters of the links after it; results.json: regrouping)" \
+        if any(n.endswith("R") and split_name(n)[0] in LINK_TERMS for n in names) else ""
+    return "the link parameters named: " + "; ".join(parts) + regrouped
+
+
 def _determined_lines(r, label: str) -> list:
     """:func:`in_short`'s lines on what the log determines. They read least squares' σ; where the main estimate is the
     drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
@@ -763,6 +782,9 @@ def _determined_lines(r, label: str) -> list:
     if named:
         out.append(Line("the drive terms named: " + "; ".join(
             f"{n}, {TERMS[split_name(n)[0]].description.split(',')[0]} of J{split_name(n)[1] + 1}" for n in named)))
+    legend = _link_legend([*loose, *chosen, *small])
+    if legend:
+        out.append(Line(legend))
     if small:
         out.append(Line(f"{whose}about 0 on this log's motion (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}, but ±σ "
                         f"under {NEGLIGIBLE_TORQUE:g} % of the joint's torque): {', '.join(small)}: a faster or wider "
