@@ -71,3 +71,12 @@ def test_the_link_parameters_named_are_written_out_once():
     assert line.startswith("the link parameters named: XXj … ZZj the inertia tensor of link j")
     assert "first moments (mass × centre of mass)" in line and "Mj its mass" in line and "trailing R: regrouped" in line
     assert _link_legend(["fv1", "fc2", "offset3", "Ia4"]) == ""  # drive terms only: their own line
+
+
+def test_the_counterbalances_terms_are_told_apart():
+    """cbsd2 and cbcd2 were both "counterbalance torque of J2" (the KR 300's summary)."""
+    from dynid.report.summaries import _term_words
+
+    words = {stem: _term_words(stem) for stem in ("cbs", "cbc", "cbsd", "cbcd")}
+    assert len(set(words.values())) == 4 and words["cbsd"] == "counterbalance torque (cbsd·sin(2q))"
+    assert _term_words("fv") == "viscous friction" and _term_words("fst") == "Stribeck friction"

@@ -15,7 +15,7 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from ..conventions import split_name, unit_of
 from ..estimators.registry import OTHER_LABELS, label
-from ..friction import TERMS
+from ..friction import COUNTERBALANCE_TERMS, TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY
@@ -728,6 +728,13 @@ LINK_TERMS = {"XX": "inertia", "XY": "inertia", "XZ": "inertia", "YY": "inertia"
 """The standard inertial parameters' stems (Khalil's names) and what each is."""
 
 
+def _term_words(stem: str) -> str:
+    """A drive term's name in words (its description before the formula); the counterbalance's four terms, which share
+    one name, with their formula (cbsd: "counterbalance torque (cbsd·sin(2q))")."""
+    text = TERMS[stem].description
+    return f"{text.split(',')[0]} ({text.split(': ')[1]})" if stem in COUNTERBALANCE_TERMS else text.split(",")[0]
+
+
 def _link_legend(names: list[str]) -> str:
     """One line saying what the link parameters among ``names`` are (issue "Never worse than the description", item 4:
     every name in the console explained once); empty where there are none."""
@@ -781,7 +788,7 @@ def _determined_lines(r, label: str) -> list:
     named = [n for n in [*loose, *chosen, *small] if split_name(n)[0] in TERMS]
     if named:
         out.append(Line("the drive terms named: " + "; ".join(
-            f"{n}, {TERMS[split_name(n)[0]].description.split(',')[0]} of J{split_name(n)[1] + 1}" for n in named)))
+            f"{n}, {_term_words(split_name(n)[0])} of J{split_name(n)[1] + 1}" for n in named)))
     legend = _link_legend([*loose, *chosen, *small])
     if legend:
         out.append(Line(legend))
