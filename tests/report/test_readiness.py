@@ -80,3 +80,13 @@ def test_the_counterbalances_terms_are_told_apart():
     words = {stem: _term_words(stem) for stem in ("cbs", "cbc", "cbsd", "cbcd")}
     assert len(set(words.values())) == 4 and words["cbsd"] == "counterbalance torque (cbsd·sin(2q))"
     assert _term_words("fv") == "viscous friction" and _term_words("fst") == "Stribeck friction"
+
+
+def test_the_terms_a_file_cannot_hold_are_written_out():
+    """The read-back line listed "Ia, Iam, fcm, fvm, offset" (the TX40), names the console explained nowhere."""
+    from dynid.report.summaries import _stem_words
+
+    assert _stem_words("Iam") == "Iam = a coupled motor's inertia" and _stem_words("fcm") == "fcm = its Coulomb friction"
+    assert _stem_words("Ia") == "Ia = rotor (reflected motor) inertia"
+    assert _stem_words("cbsd") == "cbsd = counterbalance torque (cbsd·sin(2q))"
+    assert _stem_words("unknown") == "unknown"

@@ -367,8 +367,9 @@ def taken_away_lines(taken: dict) -> list:
                      f"model {f['model_vs_measured']:.3g} %")
         if f["cannot_hold"]:
             j = max(range(len(f["cannot_hold_share"])), key=lambda k: f["cannot_hold_share"][k])
-            said += (f"; it cannot hold {', '.join(f['cannot_hold'])} (up to {f['cannot_hold_share'][j]:.3g} % of "
-                     f"J{j + 1}'s RMS torque: the file's comments say how to add them)")
+            said += (f"; it cannot hold {', '.join(_stem_words(k) for k in f['cannot_hold'])} (up to "
+                     f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: the file's comments say how to add "
+                     "them)")
         out.append(Line(said, "warning" if f["equals_model_to"] > 1e-6 else "text"))
     return out
 
@@ -726,6 +727,16 @@ CHOSEN_TERMS = ("fst", "fca", "fcl")
 LINK_TERMS = {"XX": "inertia", "XY": "inertia", "XZ": "inertia", "YY": "inertia", "YZ": "inertia", "ZZ": "inertia",
               "MX": "moment", "MY": "moment", "MZ": "moment", "M": "mass"}
 """The standard inertial parameters' stems (Khalil's names) and what each is."""
+
+
+COUPLING_WORDS = {"Iam": "a coupled motor's inertia", "fvm": "its viscous friction", "fcm": "its Coulomb friction"}
+"""A coupled motor's terms (:data:`dynid.conventions.COUPLING_TERMS`) in words."""
+
+
+def _stem_words(stem: str) -> str:
+    """``stem = what it is`` (a drive term, a coupled motor's), the stem alone where it has no words."""
+    words = _term_words(stem) if stem in TERMS else COUPLING_WORDS.get(stem)
+    return f"{stem} = {words}" if words else stem
 
 
 def _term_words(stem: str) -> str:
