@@ -34,7 +34,7 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
     from dynid.report.output import write_results
-    from dynid.report.summaries import identification_brief
+    from dynid.report.summaries import identification_brief, in_short
     from dynid.tables import render_text
     from tests.simulated_logs import simulated_case
 
@@ -57,6 +57,14 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     assert json.loads((tmp_path / "results.json").read_text())["main_estimate"] == nominal
     assert render_text(identification_brief(result), 400).splitlines()[0].startswith("keep your robot file's values")
     assert all(nominal in v.metrics() for v in result.validations)  # its figures are the description's own
+    # the summary names it as the first line does (it said "main estimate: dynid description", and gave no figures),
+    # says the lines on what the log determines are least squares', and no finding weighs the description against
+    # itself ("predicts no joint … worse than the description's nominal model")
+    said = render_text(in_short(result), 400)
+    assert f"main estimate: {nominal}" in said and "dynid description" not in said
+    assert "validation: torque error" in said and f"{nominal}: the robot file's own values" in said
+    assert all(not t.startswith("taken from") and not t.startswith("not determined") for t in said.splitlines())
+    assert not [f for f in result.findings if f.text.startswith(f"{nominal} predicts")]
 
 
 MED7 = REPO.parent / "shared" / "data" / "kuka_med7_lbrstack"

@@ -68,7 +68,7 @@ def test_the_link_parameters_named_are_written_out_once():
     from dynid.report.summaries import _link_legend
 
     line = _link_legend(["ZZ1R", "fv1", "XY2", "MX5", "M3"])
-    assert line.startswith("the link parameters named: XXj … ZZj the inertia tensor of link j")
+    assert line.startswith("the link parameters named: XXj, XYj, XZj, YYj, YZj, ZZj the inertia tensor of link j")
     assert "first moments (mass × centre of mass)" in line and "Mj its mass" in line and "trailing R: regrouped" in line
     assert _link_legend(["fv1", "fc2", "offset3", "Ia4"]) == ""  # drive terms only: their own line
 

@@ -277,7 +277,7 @@ def _with_validation_findings(result, chosen: list, nominal: tuple[str, np.ndarr
     diagnostics = dict(result.diagnostics)
     if nominal is not None:
         gate, stats = nominal_gate(result.validations, result.main, nominal[0])
-        findings += gate
+        findings += gate if result.main != nominal[0] else []  # the description against itself says nothing
         diagnostics.update({"nominal_set": nominal[0], "versus_nominal": stats})
     return replace(result, findings=tuple(findings), diagnostics=diagnostics)
 

@@ -672,7 +672,7 @@ def in_short(result) -> list:
     list of Line
     """
     r = result
-    label = r.main_estimate.label
+    label = getattr(r, "main", None) or r.main_estimate.label  # the description's values: its set's name
     verdict = r.consistency_verdicts.get(label, "")
     consistent = verdict.startswith("yes")
     exportable = _exportable(r)
@@ -752,7 +752,7 @@ def _link_legend(names: list[str]) -> str:
     kinds = {LINK_TERMS[split_name(n)[0]] for n in names if split_name(n)[0] in LINK_TERMS}
     if not kinds:
         return ""
-    parts = [text for kind, text in (("inertia", "XXj … ZZj the inertia tensor of link j about its frame's origin"),
+    parts = [text for kind, text in (("inertia", "XXj, XYj, XZj, YYj, YZj, ZZj the inertia tensor of link j about its frame's origin"),
                                      ("moment", "MXj, MYj, MZj its first moments (mass × centre of mass)"),
                                      ("mass", "Mj its mass")) if kind in kinds]
     regrouped = " (a trailing R: regrouped, holding parameters of the links after it; results.json: regrouping)" \
@@ -776,6 +776,9 @@ def _determined_lines(r, label: str) -> list:
                            f"{', '.join(loose)}" if loose else "")
                         + (" (a rotor inertia from the drive's data sheet: Ia = ... in [[robot.joints]])"
                            if any(k.startswith("Ia") for k in loose) else "")))
+        whose = f"{r.label}, beside it: "
+    elif getattr(getattr(r, "estimates", {}).get(label), "key", "") == NOMINAL_KEY:  # the robot file's values
+        out.append(Line(f"{label}: the robot file's own values, which this log does not improve"))
         whose = f"{r.label}, beside it: "
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
