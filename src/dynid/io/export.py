@@ -383,6 +383,28 @@ READINESS_KINDS = ("sign", "scale", "order")
 channels swapped): a model fitted to them is exported with a warning."""
 
 
+def description_note(results: dict) -> str | None:
+    """One line where the estimate exported is the robot file's own values (``dynid identify`` kept them as the main
+    estimate: its log could not improve them), so that the file written is not taken for an identified model; None
+    otherwise.
+
+    Parameters
+    ----------
+    results : dict
+        A parsed ``results.json`` of ``dynid identify``.
+
+    Returns
+    -------
+    str or None
+    """
+    found = stored_standard(results)
+    nominal = (results.get("diagnostics") or {}).get("nominal_set")
+    if found is None or found[0] != nominal:
+        return None
+    return (f"the estimate written is {nominal}, the robot file's own values: dynid identify kept them as the main "
+            "estimate, as its log could not improve them (its verdict says what would)")
+
+
 def verdict_warnings(results: dict) -> list[str]:
     """One line per finding of ``dynid identify``'s verdict that says the torques the model was fitted to are wrong
     (:data:`READINESS_KINDS`), for ``dynid export`` to repeat.
