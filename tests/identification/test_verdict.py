@@ -55,12 +55,12 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     assert len(main) == 1 and main[0].text.startswith(f"main estimate: {nominal}: keep your robot file's values")
     write_results(tmp_path / "results.json", result.to_dict(), "identify")  # as dynid identify writes it
     assert json.loads((tmp_path / "results.json").read_text())["main_estimate"] == nominal
-    from dynid.io.export import description_note  # what dynid export says before it writes the file's own values
+    from dynid.io.export import nominal_warning  # what dynid export says before it writes the file's own values
 
     stored = json.loads((tmp_path / "results.json").read_text())
-    assert description_note(stored).startswith(f"the estimate written is {nominal}, the robot file's own values")
-    stored["main_estimate"] = "dynid SDP"  # an identified estimate exported: nothing to say
-    assert description_note(stored) is None
+    assert nominal_warning(stored).startswith(f"the estimate written is {nominal}, the robot file's own values")
+    stored["main_estimate"] = "dynid SDP"  # an identified estimate exported: not that
+    assert not (nominal_warning(stored) or "").startswith("the estimate written is")
     assert render_text(identification_brief(result), 400).splitlines()[0].startswith("keep your robot file's values")
     assert all(nominal in v.metrics() for v in result.validations)  # its figures are the description's own
     # the summary names it as the first line does (it said "main estimate: dynid description", and gave no figures),

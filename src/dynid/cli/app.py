@@ -416,13 +416,10 @@ def export(
             ("MJCF", getattr(_users_mjcf(cfg), "name", ""), _users_mjcf(cfg) is not None and mjcf is not None)) if given)
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
-        from ..io.export import description_note, nominal_warning, verdict_warnings
+        from ..io.export import nominal_warning, verdict_warnings
 
         for line in verdict_warnings(computed[3]):
             rep.warning(line)
-        kept = description_note(computed[3])
-        if kept is not None:
-            rep.warning(kept)
         gate = nominal_warning(computed[3])
         if gate is not None:
             rep.warning(gate)

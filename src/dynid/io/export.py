@@ -346,7 +346,9 @@ weigh a few tonnes); export refuses it rather than write it."""
 
 def nominal_warning(results: dict) -> str | None:
     """One line when the exported (physically consistent) estimate predicted some joints of the validation logs worse
-    than the description's nominal model (the gate of ``dynid identify``), naming them; None otherwise.
+    than the description's nominal model (the gate of ``dynid identify``), naming them; or when it is the robot file's
+    own values (``dynid identify`` kept them as the main estimate: its log could not improve them), so that the file
+    written is not taken for an identified model; None otherwise.
 
     Parameters
     ----------
@@ -362,6 +364,9 @@ def nominal_warning(results: dict) -> str | None:
     if found is None or not isinstance(nominal, str):
         return None
     label, worse = found[0], []
+    if label == nominal:
+        return (f"the estimate written is {nominal}, the robot file's own values: dynid identify kept them as the main "
+                "estimate, as its log could not improve them (its verdict says what would)")
     for v in results.get("validation") or []:
         metrics = v.get("metrics") or {}
         if label not in metrics or nominal not in metrics:
@@ -381,28 +386,6 @@ def nominal_warning(results: dict) -> str | None:
 READINESS_KINDS = ("sign", "scale", "order")
 """Findings of ``dynid identify``'s verdict that say the torques themselves are wrong (a flipped sign, a unit or gain,
 channels swapped): a model fitted to them is exported with a warning."""
-
-
-def description_note(results: dict) -> str | None:
-    """One line where the estimate exported is the robot file's own values (``dynid identify`` kept them as the main
-    estimate: its log could not improve them), so that the file written is not taken for an identified model; None
-    otherwise.
-
-    Parameters
-    ----------
-    results : dict
-        A parsed ``results.json`` of ``dynid identify``.
-
-    Returns
-    -------
-    str or None
-    """
-    found = stored_standard(results)
-    nominal = (results.get("diagnostics") or {}).get("nominal_set")
-    if found is None or found[0] != nominal:
-        return None
-    return (f"the estimate written is {nominal}, the robot file's own values: dynid identify kept them as the main "
-            "estimate, as its log could not improve them (its verdict says what would)")
 
 
 def verdict_warnings(results: dict) -> list[str]:
