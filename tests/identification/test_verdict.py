@@ -94,3 +94,26 @@ def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it
               for k in result.validations[0].metrics()}
     assert result.main == nominal
     assert all(errors[nominal] <= errors[k] for k in result.estimates)
+
+
+KR300 = REPO.parent / "shared" / "data" / "kuka_kr300_weigand2021"
+
+
+@pytest.mark.skipif(not KR300.is_dir(), reason="needs ../shared/data (the real KUKA KR 300 logs)")
+def test_the_drive_only_estimate_calls_undetermined_only_terms_its_joints_have(tmp_path):
+    """Seconds 0-4 of the KR 300's log, where the drive-only estimate is the main one: it called fst1, fcl1, cbs1, cbc1,
+    cbsd1 and cbcd1 "not determined by this log": terms of other joints' friction models and of J2's counterbalance,
+    whose columns are zero on J1 (their fits 1e-12 to 1e-9). Only terms with a fit of their own are judged."""
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    text = (REPO / "configs" / "kuka_kr300.toml").read_text().replace(
+        'robot = "robots/kuka_kr300.toml"', f'robot = "{REPO / "configs" / "robots" / "kuka_kr300.toml"}"')
+    path = tmp_path / "kr300-0-4.toml"
+    path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [0.0, 4.0]", text, count=1,
+                           flags=re.M))
+    result = run_identification(load_identification_config(path, data_root=KR300))
+    assert result.main == "dynid drive-only"
+    loose = {k: v for k, v in (result.diagnostics.get("drive_only_undetermined") or {}).items() if k != "cutoff_factors"}
+    assert all(max(abs(x) for x in v) > 1e-8 for v in loose.values()), loose
+    assert not {"fst1", "fcl1", "cbs1", "cbc1", "cbsd1", "cbcd1"} & set(loose)

@@ -765,7 +765,7 @@ def _determined_lines(r, label: str) -> list:
     drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
     drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveOnly.held`)."""
     out = []
-    whose = ""
+    whose, listed = "", []
     if label == DRIVE_ONLY_LABEL:
         terms, loose = ([k for k in (r.diagnostics or {}).get(key) or {} if k != "cutoff_factors"]
                         for key in ("drive_only_held", "drive_only_undetermined"))
@@ -776,7 +776,7 @@ def _determined_lines(r, label: str) -> list:
                            f"{', '.join(loose)}" if loose else "")
                         + (" (a rotor inertia from the drive's data sheet: Ia = ... in [[robot.joints]])"
                            if any(k.startswith("Ia") for k in loose) else "")))
-        whose = f"{r.label}, beside it: "
+        whose, listed = f"{r.label}, beside it: ", [*terms, *loose]
     elif getattr(getattr(r, "estimates", {}).get(label), "key", "") == NOMINAL_KEY:  # the robot file's values
         out.append(Line(f"{label}: the robot file's own values, which this log does not improve"))
         whose = f"{r.label}, beside it: "
@@ -799,7 +799,7 @@ def _determined_lines(r, label: str) -> list:
               if getattr(getattr(r, "choices", None), "friction", None) is not None else "the description")
         out.append(Line(f"{whose}kept by {by}, their values loose (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): {', '.join(chosen)}: the log "
                         "shows the effect, not its size; a richer excitation (dynid excite) sizes them"))
-    named = [n for n in [*loose, *chosen, *small] if split_name(n)[0] in TERMS]
+    named = list(dict.fromkeys(n for n in [*listed, *loose, *chosen, *small] if split_name(n)[0] in TERMS))
     if named:
         out.append(Line("the drive terms named: " + "; ".join(
             f"{n}, {_term_words(split_name(n)[0])} of J{split_name(n)[1] + 1}" for n in named)))
