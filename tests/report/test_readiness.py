@@ -84,9 +84,9 @@ def test_the_counterbalances_terms_are_told_apart():
 
 def test_the_terms_a_file_cannot_hold_are_written_out():
     """The read-back line listed "Ia, Iam, fcm, fvm, offset" (the TX40), names the console explained nowhere."""
-    from dynid.report.summaries import _stem_words
+    from dynid.report.summaries import stem_words
 
-    assert _stem_words("Iam") == "Iam = a coupled motor's inertia" and _stem_words("fcm") == "fcm = its Coulomb friction"
-    assert _stem_words("Ia") == "Ia = rotor (reflected motor) inertia"
-    assert _stem_words("cbsd") == "cbsd = counterbalance torque (cbsd·sin(2q))"
-    assert _stem_words("unknown") == "unknown"
+    assert stem_words("Iam") == "Iam = a coupled motor's inertia" and stem_words("fcm") == "fcm = its Coulomb friction"
+    assert stem_words("Ia") == "Ia = rotor (reflected motor) inertia"
+    assert stem_words("cbsd") == "cbsd = counterbalance torque (cbsd·sin(2q))"
+    assert stem_words("unknown") == "unknown"

@@ -417,6 +417,7 @@ def export(
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
         from ..io.export import nominal_warning, verdict_warnings
+        from ..report.summaries import stem_words
 
         for line in verdict_warnings(computed[3]):
             rep.warning(line)
@@ -439,8 +440,9 @@ def export(
                          "off frictionloss·sign(q̇)")
             if check.missing:
                 j = max(range(len(check.missing_share)), key=lambda k: check.missing_share[k])
-                said += (f"; what {form} cannot hold ({', '.join(check.missing)}) is up to {check.missing_share[j]:.3g} % "
-                         f"of J{j + 1}'s RMS torque there: add it to the torques as the file's comments say")
+                said += (f"; what {form} cannot hold ({', '.join(stem_words(k) for k in check.missing)}) is up to "
+                         f"{check.missing_share[j]:.3g} % of J{j + 1}'s RMS torque there: add it to the torques as the "
+                         "file's comments say")
             if check.file_vs_measured is not None:
                 said += (f"; against the log's unfiltered measured torques the file is {check.file_vs_measured:.3g} % off, "
                          f"dynid's whole model {check.model_vs_measured:.3g} %")

@@ -367,7 +367,7 @@ def taken_away_lines(taken: dict) -> list:
                      f"model {f['model_vs_measured']:.3g} %")
         if f["cannot_hold"]:
             j = max(range(len(f["cannot_hold_share"])), key=lambda k: f["cannot_hold_share"][k])
-            said += (f"; it cannot hold {', '.join(_stem_words(k) for k in f['cannot_hold'])} (up to "
+            said += (f"; it cannot hold {', '.join(stem_words(k) for k in f['cannot_hold'])} (up to "
                      f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: the file's comments say how to add "
                      "them)")
         out.append(Line(said, "warning" if f["equals_model_to"] > 1e-6 else "text"))
@@ -733,8 +733,21 @@ COUPLING_WORDS = {"Iam": "a coupled motor's inertia", "fvm": "its viscous fricti
 """A coupled motor's terms (:data:`dynid.conventions.COUPLING_TERMS`) in words."""
 
 
-def _stem_words(stem: str) -> str:
-    """``stem = what it is`` (a drive term, a coupled motor's), the stem alone where it has no words."""
+def stem_words(stem: str) -> str:
+    """A drive term's or a coupled motor's stem written out, for a console line that lists them (issue "Never worse
+    than the description", item 4: every name explained once).
+
+    Parameters
+    ----------
+    stem : str
+        ``"Ia"``, ``"offset"``, ``"cbsd"``, ``"Iam"`` … (:data:`dynid.friction.TERMS`,
+        :data:`dynid.conventions.COUPLING_TERMS`).
+
+    Returns
+    -------
+    str
+        ``"Ia = rotor (reflected motor) inertia"``; the stem alone where it has no words.
+    """
     words = _term_words(stem) if stem in TERMS else COUPLING_WORDS.get(stem)
     return f"{stem} = {words}" if words else stem
 
