@@ -94,6 +94,15 @@ def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it
               for k in result.validations[0].metrics()}
     assert result.main == nominal
     assert all(errors[nominal] <= errors[k] for k in result.estimates)
+    # the report's base-parameter table shows the robot file's values once, marked as the main estimate (they stood
+    # twice: as the main estimate and as the config's reference set)
+    from dynid.report.html import identify_sections
+    from dynid.report.output import write_results
+
+    write_results(tmp_path / "results.json", result.to_dict(), "identify")  # as dynid identify writes it
+    stored = json.loads((tmp_path / "results.json").read_text())
+    table = next(s for s in identify_sections(stored)[1] if s.title == "Base parameters").tables[0]
+    assert [h for h in table.headers if h.startswith(nominal)] == [f"{nominal} (main)"]
 
 
 KR300 = REPO.parent / "shared" / "data" / "kuka_kr300_weigand2021"

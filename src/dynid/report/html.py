@@ -148,7 +148,8 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         boot = diagnostics.get("bootstrap_std") or {}
         rel = {p["name"]: larger_relative_std(p["name"], p["value"], p.get("relative_std_percent"), boot)
                for p in d["base_parameters"]}
-        beside = _beside_least_squares(d)
+        named = {r["name"] for r in refs}  # the description's values as the main estimate: its reference column says so
+        beside = [(h, v) for h, v in _beside_least_squares(d) if h.removesuffix(" (main)") not in named]
         rows = [[p["name"], p["unit"], _fmt(p["value"]),
                  "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
                  *(("prior" if p["name"] in kept else _fmt(boot.get(p["name"]), ".2g"),) if boot else ()),
@@ -168,7 +169,9 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
                                                           f"parameter whose ±σ is under {NEGLIGIBLE_TORQUE:g} % of its joint's torque on this "
                                                           "log (about 0 on this motion)",
                                                           ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
-                                                           *(name for name, _ in beside), *(r["name"] for r in refs),
+                                                           *(name for name, _ in beside),
+                                                           *(r["name"] + (" (main)" if r["name"] == d.get("main_estimate") else "")
+                                                             for r in refs),
                                                            "expression"], rows,
                                                           (column + 1 + len(beside) + len(refs),), flagged)]))
         verdicts = d.get("physically_consistent_verdict", {})
