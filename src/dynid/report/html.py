@@ -114,6 +114,51 @@ def _beside_least_squares(d: dict) -> list[tuple[str, dict]]:
                                                        or (label == main and e.get("key") != d.get("least_squares")))]
 
 
+def _base_parameter_section(d: dict) -> Section:
+    """The "Base parameters" section of ``dynid identify``'s report: least squares' values and σ, the estimates and
+    reference sets beside them, and the consistency verdicts."""
+    from .summaries import (  # summaries loads NumPy
+        BAD_RELATIVE_STD,
+        NEGLIGIBLE_TORQUE,
+        SIGMA_WORDS,
+        larger_relative_std,
+        undetermined,
+    )
+
+    refs = d.get("references", [])
+    diagnostics = d.get("diagnostics") or {}
+    kept = set(diagnostics.get("from_prior") or [])  # directions the log did not determine: the prior's
+    boot = diagnostics.get("bootstrap_std") or {}
+    rel = {p["name"]: larger_relative_std(p["name"], p["value"], p.get("relative_std_percent"), boot)
+           for p in d["base_parameters"]}
+    named = {r["name"] for r in refs}  # the description's values as the main estimate: its reference column says so
+    beside = [(h, v) for h, v in _beside_least_squares(d) if h.removesuffix(" (main)") not in named]
+    rows = [[p["name"], p["unit"], _fmt(p["value"]),
+             "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
+             *(("prior" if p["name"] in kept else _fmt(boot.get(p["name"]), ".2g"),) if boot else ()),
+             "—" if p["name"] in kept else _fmt(rel[p["name"]], ".3g"),
+             *(_fmt(values.get(p["name"])) for _, values in beside),
+             *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
+    share = diagnostics.get("sigma_torque_percent") or {}
+    column = 5 if boot else 4
+    loose, _ = undetermined([p["name"] for p in d["base_parameters"]], [p["value"] for p in d["base_parameters"]],
+                            [p.get("relative_std_percent") for p in d["base_parameters"]], kept, share, boot)
+    flagged = {(i, column) for i, p in enumerate(d["base_parameters"]) if p["name"] in loose}
+    ls_label = next((k for k, e in (d.get("estimates") or {}).items() if e.get("key") == d.get("least_squares")), "")
+    caption = (f"{ls_label + ' with ' if ls_label else ''}condition number {d['condition_number']:.4g}; {d['n_rows']} "
+               f"equations; σ{SIGMA_WORDS if boot else ''}; σ of {BAD_RELATIVE_STD:g} % and more (not determined by the "
+               f"data) highlighted, but a parameter whose ±σ is under {NEGLIGIBLE_TORQUE:g} % of its joint's torque on "
+               "this log (about 0 on this motion)")
+    headers = ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %", *(name for name, _ in beside),
+               *(r["name"] + (" (main)" if r["name"] == d.get("main_estimate") else "") for r in refs), "expression"]
+    section = Section("Base parameters", [Table(caption, headers, rows, (column + 1 + len(beside) + len(refs),), flagged)])
+    verdicts = d.get("physically_consistent_verdict", {})
+    if verdicts:
+        section.tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",
+                                    ["parameters", "verdict"], [[k, v] for k, v in verdicts.items()], (1,)))
+    return section
+
+
 def identify_sections(d: dict) -> tuple[dict, list[Section]]:
     """Settings and sections of ``dynid identify`` (or ``dynid validate``).
 
@@ -128,56 +173,13 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         Setting -> value shown at the top.
     sections : list of Section
     """
-    from .summaries import (  # summaries loads NumPy
-        BAD_RELATIVE_STD,
-        NEGLIGIBLE_TORQUE,
-        SIGMA_WORDS,
-        larger_relative_std,
-        undetermined,
-    )
-
     settings = {"robot": d.get("robot", ""), "estimators": _human(d.get("estimators", d.get("method", ""))),
                 "main estimate": d.get("main_estimate", ""),
                 "preprocessing": d.get("settings", {}).get("preprocessing", {}).get("derivation", ""),
                 "Coulomb smoothing velocity (rad/s)": _human(d.get("settings", {}).get("coulomb_velocity", ""))}
     sections = [Section("In short", [], _identify_summary(d))] if "identification" in d or "validation" in d else []
     if "base_parameters" in d:
-        refs = d.get("references", [])
-        diagnostics = d.get("diagnostics") or {}
-        kept = set(diagnostics.get("from_prior") or [])  # directions the log did not determine: the prior's
-        boot = diagnostics.get("bootstrap_std") or {}
-        rel = {p["name"]: larger_relative_std(p["name"], p["value"], p.get("relative_std_percent"), boot)
-               for p in d["base_parameters"]}
-        named = {r["name"] for r in refs}  # the description's values as the main estimate: its reference column says so
-        beside = [(h, v) for h, v in _beside_least_squares(d) if h.removesuffix(" (main)") not in named]
-        rows = [[p["name"], p["unit"], _fmt(p["value"]),
-                 "prior" if p["name"] in kept else _fmt(p["std"], ".2g"),
-                 *(("prior" if p["name"] in kept else _fmt(boot.get(p["name"]), ".2g"),) if boot else ()),
-                 "—" if p["name"] in kept else _fmt(rel[p["name"]], ".3g"),
-                 *(_fmt(values.get(p["name"])) for _, values in beside),
-                 *(_fmt(r["values"].get(p["name"])) for r in refs), p["expression"]] for p in d["base_parameters"]]
-        share = diagnostics.get("sigma_torque_percent") or {}
-        column = 5 if boot else 4
-        loose, _ = undetermined([p["name"] for p in d["base_parameters"]], [p["value"] for p in d["base_parameters"]],
-                                [p.get("relative_std_percent") for p in d["base_parameters"]], kept, share, boot)
-        flagged = {(i, column) for i, p in enumerate(d["base_parameters"]) if p["name"] in loose}
-        ls_label = next((k for k, e in (d.get("estimates") or {}).items() if e.get("key") == d.get("least_squares")), "")
-        sections.append(Section("Base parameters", [Table(f"{ls_label + ' with ' if ls_label else ''}"
-                                                          f"condition number {d['condition_number']:.4g}; {d['n_rows']} equations; "
-                                                          f"σ{SIGMA_WORDS if boot else ''}; "
-                                                          f"σ of {BAD_RELATIVE_STD:g} % and more (not determined by the data) highlighted, but a "
-                                                          f"parameter whose ±σ is under {NEGLIGIBLE_TORQUE:g} % of its joint's torque on this "
-                                                          "log (about 0 on this motion)",
-                                                          ["name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
-                                                           *(name for name, _ in beside),
-                                                           *(r["name"] + (" (main)" if r["name"] == d.get("main_estimate") else "")
-                                                             for r in refs),
-                                                           "expression"], rows,
-                                                          (column + 1 + len(beside) + len(refs),), flagged)]))
-        verdicts = d.get("physically_consistent_verdict", {})
-        if verdicts:
-            sections[-1].tables.append(Table("Physically consistent? (some mass distribution with friction, rotor inertias ≥ 0)",
-                                             ["parameters", "verdict"], [[k, v] for k, v in verdicts.items()], (1,)))
+        sections.append(_base_parameter_section(d))
     if d.get("objective_eq9"):
         others = d.get("estimates", {})
         rows = [[label, _fmt(f), _fmt(others.get(label, {}).get("n_evaluations")), _fmt(others.get(label, {}).get("seconds"), ".2f")]
