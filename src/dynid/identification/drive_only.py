@@ -213,7 +213,9 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
                             joint_weights=joint_weights, sigmas=robot.prior_sigmas()[drive])
     x, params, cov = problem.fit(accumulator)
     moved_one_way = set(one_way)
-    judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in moved_one_way]
+    # a term no base parameter holds (another joint's friction term, a counterbalance elsewhere) is not in the model
+    in_base = np.any(base.regrouping[:, drive] != 0, axis=0)
+    judged = [i for i, k in enumerate(drive) if split_name(names[k])[1] in moved_one_way and in_base[i]]
     held: dict[str, tuple[float, ...]] = {}
     loose: dict[str, tuple[float, ...]] = {}
     if variants and judged:
@@ -221,8 +223,7 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
         factors = sorted(fitted)
         runs = np.array([fitted[f] for f in factors])
         spread = runs.max(axis=0) - runs.min(axis=0)
-        unstable = [i for i in judged if spread[i] > 0 and spread[i] >= abs(x[i])
-                    and np.abs(runs[:, i]).max() > ABSENT]
+        unstable = [i for i in judged if spread[i] > 0 and spread[i] >= abs(x[i])]
         pinned = _pinned(unstable, [names[k] for k in drive], phi0[drive])
         said = lambda i: tuple(float(v) for v in runs[:, i])  # noqa: E731
         held = {names[drive[i]]: said(i) for i in pinned}
@@ -235,12 +236,6 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     standard = phi0.copy()
     standard[drive] = x
     return DriveOnly(params, np.sqrt(np.maximum(np.diag(cov), 0.0)), standard, held=held, undetermined=loose)
-
-
-ABSENT = 1e-8
-"""A drive term every preparation fits within this of 0 (SI units) is not in its joint's model (a term another joint's
-friction model has, whose column is zero here: its fits are rounding, 1e-12 to 1e-9 on the KR 300): it is not
-judged, so not said to be undetermined."""
 
 
 def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:

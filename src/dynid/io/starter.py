@@ -79,6 +79,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if _is_bag(log) and len(bags) != len(validation) or not _is_bag(log) and bags:
         raise DataError(f"{(set(validation) - set(bags) or set(bags)).pop()}: the validation logs and {log.name} must be "
                         "of one kind (all ROS 2 bags or all CSV logs): they share the identification's reader")
+    without = _without_sdp(robot)
     if _is_bag(log):
         table = tomlkit.table()
         table.add("bag", log.name)
@@ -87,10 +88,10 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
-        said.append(_estimators_note(without := _without_sdp(robot)))
+        said.append(_estimators_note(without))
         return _config(urdf, log, out, validation, table, said, held, xacro_args, without), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
-    notes += [*_held_notes(urdf, held), _estimators_note(without := _without_sdp(robot))]
+    notes += [*_held_notes(urdf, held), _estimators_note(without)]
     return _config(urdf, log, out, validation, table, notes, held, xacro_args, without), notes
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
-from ..conventions import split_name, unit_of
+from ..conventions import INERTIAL_TERMS, split_name, unit_of
 from ..estimators.registry import OTHER_LABELS, label
 from ..friction import COUNTERBALANCE_TERMS, TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
@@ -724,11 +724,6 @@ CHOSEN_TERMS = ("fst", "fca", "fcl")
 (or the description) chose them, so a loose σ does not make them "not determined"."""
 
 
-LINK_TERMS = {"XX": "inertia", "XY": "inertia", "XZ": "inertia", "YY": "inertia", "YZ": "inertia", "ZZ": "inertia",
-              "MX": "moment", "MY": "moment", "MZ": "moment", "M": "mass"}
-"""The standard inertial parameters' stems (Khalil's names) and what each is."""
-
-
 COUPLING_WORDS = {"Iam": "a coupled motor's inertia", "fvm": "its viscous friction", "fcm": "its Coulomb friction"}
 """A coupled motor's terms (:data:`dynid.conventions.COUPLING_TERMS`) in words."""
 
@@ -762,14 +757,15 @@ def _term_words(stem: str) -> str:
 def _link_legend(names: list[str]) -> str:
     """One line saying what the link parameters among ``names`` are (issue "Never worse than the description", item 4:
     every name in the console explained once); empty where there are none."""
-    kinds = {LINK_TERMS[split_name(n)[0]] for n in names if split_name(n)[0] in LINK_TERMS}
+    stems = {split_name(n)[0] for n in names} & set(INERTIAL_TERMS)  # eq. 5's order: tensor, first moments, mass
+    kinds = {"inertia" if s in INERTIAL_TERMS[:6] else "moment" if s in INERTIAL_TERMS[6:9] else "mass" for s in stems}
     if not kinds:
         return ""
     parts = [text for kind, text in (("inertia", "XXj, XYj, XZj, YYj, YZj, ZZj the inertia tensor of link j about its frame's origin"),
                                      ("moment", "MXj, MYj, MZj its first moments (mass × centre of mass)"),
                                      ("mass", "Mj its mass")) if kind in kinds]
     regrouped = " (a trailing R: regrouped, holding parameters of the links after it; results.json: regrouping)" \
-        if any(n.endswith("R") and split_name(n)[0] in LINK_TERMS for n in names) else ""
+        if any(n.endswith("R") and split_name(n)[0] in INERTIAL_TERMS for n in names) else ""
     return "the link parameters named: " + "; ".join(parts) + regrouped
 
 
