@@ -203,9 +203,6 @@ def held_out() -> int:
 def hand() -> int:
     """Every real short window with the defaults and with :data:`HAND`, all on the one yardstick: the defaults against
     the best hand setting (issue "Never worse than the description": target 1.2×)."""
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
-
     folder = Path(tempfile.mkdtemp())
     windows = [("ur10e", w) for w in WINDOWS] + [(n, w) for n, ws in OTHER_WINDOWS.items() for w in ws]
     print("config | window | defaults: main estimate, yardstick % | best hand setting | its yardstick % | defaults / best")
@@ -213,10 +210,7 @@ def hand() -> int:
     for name, window in windows:
         figures = []
         for pre, friction in [(None, None)] + [(h, f) for h in HAND for f in ("auto", "description")]:
-            path, root = _window_config(name, window, folder, pre, friction)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                result = run_identification(load_identification_config(path, data_root=root))
+            result = _identified(*_window_config(name, window, folder, pre, friction))
             figures.append((result.diagnostics["yardstick"]["mean_global_relative_error"][result.main], result.main,
                             pre, friction))
         best = min(figures[1:], key=lambda f: f[0])
