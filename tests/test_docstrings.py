@@ -57,8 +57,10 @@ def _problems(qualname: str, obj, owner) -> list[str]:
     fields = _field_names(obj) if inspect.isclass(obj) else []
     if fields:  # a record: its fields are documented as Attributes
         errors = [(c, m) for c, m in errors if c not in ("PR01", "PR02")]
-        doc = inspect.getdoc(obj) or ""
-        documented = _section_names(doc, "Attributes") | _section_names(doc, "Parameters") | _described_fields(obj)
+        documented = _described_fields(obj)
+        for cls in inspect.getmro(obj):  # a base's fields are documented on the base (a study's result)
+            doc = (cls.__doc__ and inspect.cleandoc(cls.__doc__)) or ""
+            documented |= _section_names(doc, "Attributes") | _section_names(doc, "Parameters")
         missing = [f for f in fields if f not in documented and not f.startswith("_")]
         if missing:
             errors.append(("PR01", f"fields not documented under Attributes: {missing}"))

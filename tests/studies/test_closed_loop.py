@@ -100,9 +100,9 @@ def test_statistics_on_constructed_estimates():
     sigma = np.array([0.1, 0.2, 0.4, 0.05])
     est = truth + 0.01 + z * sigma
     cfg = ClosedLoopStudyConfig(encoder_noise=(0.0,), torque_noise=(0.1,), realisations=10, estimators=("ols",))
-    result = ClosedLoopStudyResult(cfg, ("a", "b", "c", "d"), truth, est[None, :, None, :],
-                                   np.broadcast_to(sigma, est.shape)[None, :, None, :].copy(),
-                                   np.ones((1, 10, 1), dtype=bool), np.ones((1, 10, 1)), 0.5 * sigma[None, :])
+    result = ClosedLoopStudyResult(cfg, ("a", "b", "c", "d"), truth, est[None, :, None, :], np.ones((1, 10, 1)),
+                                   0.5 * sigma[None, :], std=np.broadcast_to(sigma, est.shape)[None, :, None, :].copy(),
+                                   converged=np.ones((1, 10, 1), dtype=bool))
     s = result.statistics()["ols"]
     np.testing.assert_allclose(s["bias"][0], 0.01 + z.mean(axis=0) * sigma)
     np.testing.assert_allclose(s["spread"][0], z.std(axis=0, ddof=1) * sigma)

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..dynamics.rnea import rnea_torques
 from ..estimators.instrumental import CLOSED_LOOP_METHODS
@@ -50,7 +50,7 @@ from ..preprocessing.pipeline import Preprocessing
 from ..runtime.cluster import realisations_on_grid
 from ..runtime.threads import with_single_blas_thread
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
-from .paper import PaperExperimentConfig, identification_trajectory, study_header
+from .paper import PaperExperimentConfig, StudyResult, StudySetup, identification_trajectory, study_header
 
 __all__ = ["ENCODER_NOISE_DEG", "TORQUE_NOISE", "CLOSED_LOOP_ESTIMATORS", "ClosedLoopStudyConfig", "ClosedLoopStudyResult",
            "run_closed_loop_study", "simulate_realisation", "zero_order_hold_delay"]
@@ -182,16 +182,10 @@ class ClosedLoopStudyConfig:
 
 
 @dataclass
-class _Setup:
-    """What every realisation shares (computed once, sent to the workers once)."""
+class _Setup(StudySetup):
+    """:class:`StudySetup` (``unit_crb`` for σ_τ = 1 N·m) and the set-points the controller follows."""
 
-    config: ClosedLoopStudyConfig
-    robot: Robot
-    base: BaseParameters
-    truth: np.ndarray
-    t: np.ndarray
     experiment: ClosedLoopExperiment
-    unit_crb: np.ndarray  # Cramér–Rao covariance for σ_τ = 1 N·m, (n_base, n_base)
 
 
 def _prepare(config: ClosedLoopStudyConfig) -> _Setup:
@@ -204,8 +198,8 @@ def _prepare(config: ClosedLoopStudyConfig) -> _Setup:
     experiment = ClosedLoopExperiment(controller, q, dq, rnea_torques(robot, q, dq, ddq))
     clean = simulate_closed_loop(robot, t, q, dq, controller, feedforward=experiment.feedforward)
     w = base.base_observation(observation_matrix(robot, clean.q_true, clean.dq_true, clean.ddq_true)).reshape(-1, base.n_base)
-    return _Setup(config, robot, base, base.base_from_standard(robot.standard_parameters()), t, experiment,
-                  np.linalg.inv(w.T @ w))
+    return _Setup(config, robot, base, base.base_from_standard(robot.standard_parameters()), t, np.linalg.inv(w.T @ w),
+                  experiment)
 
 
 @with_single_blas_thread
@@ -291,40 +285,19 @@ def _number(x) -> float | None:
 
 
 @dataclass
-class ClosedLoopStudyResult:
-    """Estimates of every (cell, realisation, estimator) and their statistics; :meth:`to_dict` is ``montecarlo.json``.
+class ClosedLoopStudyResult(StudyResult):
+    """Estimates of every (cell, realisation, estimator) and their statistics (:class:`StudyResult`);
+    :meth:`to_dict` is ``montecarlo.json``.
 
     Attributes
     ----------
-    config : ClosedLoopStudyConfig
-    names : tuple of str
-        Base parameter names.
-    truth : (n_base,) array
-    estimates, std : (n_cells, n_realisations, n_methods, n_base) arrays
-        NaN where an estimator failed (``std`` also where it gives no σ).
+    std : (n_cells, n_realisations, n_methods, n_base) array
+        The estimates' σ: NaN where an estimator failed or gives none.
     converged : (n_cells, n_realisations, n_methods) bool array
-    seconds : (n_cells, n_realisations, n_methods) array [s]
-    crb_std : (n_cells, n_base) array
-        Square roots of the Cramér–Rao bound's diagonal (module docstring).
-    errors : list
-        What failed or did not converge, with the message.
-    timings : dict
-        Step -> wall time [s].
-    cluster : str
-        The Dask cluster the study ran on.
     """
 
-    config: ClosedLoopStudyConfig
-    names: tuple
-    truth: np.ndarray
-    estimates: np.ndarray
-    std: np.ndarray
-    converged: np.ndarray
-    seconds: np.ndarray
-    crb_std: np.ndarray
-    errors: list = field(default_factory=list)
-    timings: dict = field(default_factory=dict)
-    cluster: str = ""
+    std: np.ndarray = field(kw_only=True)
+    converged: np.ndarray = field(kw_only=True)
 
     def statistics(self) -> dict:
         """Statistics of each estimator per cell, over the realisations it fitted.
@@ -451,5 +424,5 @@ def run_closed_loop_study(config: ClosedLoopStudyConfig = ClosedLoopStudyConfig(
                               "estimator": k, "error": msg},
         what="dynid montecarlo --closed-loop", scheduler=scheduler, workers=workers, progress=progress)
     crb_std = np.sqrt(np.outer(np.array([s for _, s in cells]) ** 2, np.diag(setup.unit_crb)))
-    return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["std"],
-                                 arrays["converged"], arrays["seconds"], crb_std, errors, {"total": seconds}, cluster)
+    return ClosedLoopStudyResult(config, tuple(setup.base.names), setup.truth, arrays["params"], arrays["seconds"], crb_std,
+                                 errors, {"total": seconds}, cluster, std=arrays["std"], converged=arrays["converged"])

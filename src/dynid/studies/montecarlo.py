@@ -22,11 +22,11 @@ order tasks run.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..estimators import registry
 from ..estimators.estimation import Estimation
@@ -42,6 +42,8 @@ from ..runtime.threads import with_single_blas_thread
 from ..simulation.measurements import NoiseModel
 from .paper import (
     PaperExperimentConfig,
+    StudyResult,
+    StudySetup,
     identification_trajectory,
     paper_search_box,
     problem,
@@ -150,18 +152,13 @@ class MonteCarloConfig:
 
 
 @dataclass
-class _Setup:
-    """What every realisation shares (computed once, sent to the workers once)."""
+class _Setup(StudySetup):
+    """:class:`StudySetup` (``unit_crb`` for σ = 1 A), one realisation's settings, the true standard parameters, the
+    excitation trajectory and the user's plugins."""
 
-    config: MonteCarloConfig
     run: PaperExperimentConfig
-    robot: Robot
-    base: BaseParameters
-    truth: np.ndarray
     phi_true: np.ndarray
     trajectory: FourierTrajectory
-    t: np.ndarray
-    unit_crb: np.ndarray  # Cramér–Rao covariance for σ = 1 A, (n_base, n_base)
     plugins: tuple = ({}, {})  # estimators and strategies registered by the user: the workers register them too
 
 
@@ -181,7 +178,7 @@ def _prepare(config: MonteCarloConfig) -> _Setup:
     info = np.einsum("kjp,kjq,j->pq", w, w, 1.0 / gains**2)
 
     plugins = (registry.registered_by_user(config.estimators), strategies.registered_by_user([config.strategy]))
-    return _Setup(config, run, robot, base, base.base_from_standard(phi_true), phi_true, traj, t, np.linalg.inv(info), plugins)
+    return _Setup(config, robot, base, base.base_from_standard(phi_true), t, np.linalg.inv(info), run, phi_true, traj, plugins)
 
 
 @with_single_blas_thread
@@ -228,37 +225,9 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
 
 
 @dataclass
-class MonteCarloResult:
-    """Estimates of every (level, realisation, method) and their statistics; :meth:`to_dict` is ``montecarlo.json``.
-
-    Attributes
-    ----------
-    config : MonteCarloConfig
-    names : tuple of str
-        Base parameter names.
-    truth : (n_base,) array
-    estimates : (n_levels, n_realisations, n_methods, n_base) array
-        NaN where a method failed.
-    seconds : (n_levels, n_realisations, n_methods) array
-    crb_std : (n_levels, n_base) array
-        Square roots of the Cramér–Rao bound's diagonal.
-    errors : list
-        What failed, with the message.
-    timings : dict
-        Step -> wall time [s].
-    cluster : str
-        The Dask cluster the study ran on.
-    """
-
-    config: MonteCarloConfig
-    names: tuple
-    truth: np.ndarray
-    estimates: np.ndarray
-    seconds: np.ndarray
-    crb_std: np.ndarray
-    errors: list = field(default_factory=list)
-    timings: dict = field(default_factory=dict)
-    cluster: str = ""
+class MonteCarloResult(StudyResult):
+    """Estimates of every (level, realisation, method) and their statistics (:class:`StudyResult`, a cell a noise
+    level); :meth:`to_dict` is ``montecarlo.json``."""
 
     def statistics(self) -> dict:
         """Statistics of each method over the realisations that succeeded.

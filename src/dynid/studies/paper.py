@@ -536,6 +536,67 @@ def settings_of(config) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(config).items()}
 
 
+@dataclass
+class StudySetup:
+    """What every realisation of a simulated study shares (computed once, sent to the workers once).
+
+    Attributes
+    ----------
+    config : dataclass
+        The study's settings.
+    robot : Robot
+    base : BaseParameters
+    truth : (n_base,) array
+        The true base parameters.
+    t : (N,) array [s]
+        The sample times.
+    unit_crb : (n_base, n_base) array
+        The Cramér–Rao covariance for a unit noise σ.
+    """
+
+    config: Any
+    robot: Robot
+    base: BaseParameters
+    truth: np.ndarray
+    t: np.ndarray
+    unit_crb: np.ndarray
+
+
+@dataclass
+class StudyResult:
+    """A simulated study's estimates, in the order of its grid's cells, its realisations and its estimators.
+
+    Attributes
+    ----------
+    config : dataclass
+        The study's settings.
+    names : tuple of str
+        Base parameter names.
+    truth : (n_base,) array
+    estimates : (n_cells, n_realisations, n_methods, n_base) array
+        NaN where an estimator failed.
+    seconds : (n_cells, n_realisations, n_methods) array [s]
+    crb_std : (n_cells, n_base) array
+        Square roots of the Cramér–Rao bound's diagonal.
+    errors : list
+        What failed, with the message.
+    timings : dict
+        Step -> wall time [s].
+    cluster : str
+        The Dask cluster the study ran on.
+    """
+
+    config: Any
+    names: tuple
+    truth: np.ndarray
+    estimates: np.ndarray
+    seconds: np.ndarray
+    crb_std: np.ndarray
+    errors: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    cluster: str = ""
+
+
 def study_header(config, names: list[str], truth: np.ndarray) -> dict:
     """What a simulated study's JSON opens with: its settings, the base parameters' names and the truth.
 
