@@ -58,7 +58,8 @@ def test_arrays_and_a_config_of_the_same_log_give_the_same_identification(slow_q
     config = slow_quiet_log
     from_config = dynid.run_identification(config, validate=False)
     recording = load_recording(config.identification, config.robot)
-    ident = dynid.Identifier(config.robot, estimators=list(config.estimators), friction=config.friction, rng=config.seed)
+    ident = dynid.Identifier(config.robot, estimators=list(config.estimation.estimators), friction=config.estimation.friction,
+                             rng=config.estimation.seed)
     from_arrays = ident.fit(recording.t, recording.q, recording.tau).result_
     cv = from_config.settings["preprocessing_cross_validation"]  # the case this test is about: the cutoffs were chosen
     assert len(cv["candidates"]) == 3

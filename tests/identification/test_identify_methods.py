@@ -20,7 +20,7 @@ def test_identify_runs_every_estimator_side_by_side(tmp_path):
     cfg, truth_robot = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', f'estimators = {json.dumps(ALL)}\nseed = 3\n'))
     config = load_identification_config(cfg)
-    assert config.estimators == tuple(ALL)
+    assert config.estimation.estimators == tuple(ALL)
     result = run_identification(config)
     labels = ["dynid WLS", "dynid OLS", "dynid SDP", "dynid IRLS", "dynid LAD", "dynid ABC", "dynid ABC×10", "dynid DE", "dynid PSO"]
     assert list(result.parameter_sets())[:9] == labels
@@ -76,7 +76,7 @@ def test_the_old_estimation_keys_say_how_to_write_them_now(tmp_path, old, new):
 def test_estimator_names_are_case_insensitive(tmp_path):
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["OLS", "Wls"]\n'))
-    assert load_identification_config(cfg).estimators == ("ols", "wls")
+    assert load_identification_config(cfg).estimation.estimators == ("ols", "wls")
 
 
 def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
@@ -148,7 +148,7 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     for kind in ("euclidean", "geometric"):
         cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n'))
         config = load_identification_config(cfg)
-        assert config.hyperparameters == {"sdp": {"prior_kind": kind}}
+        assert config.estimation.hyperparameters == {"sdp": {"prior_kind": kind}}
         runs[kind] = (config, run_identification(config, validate=True))
     fit = {k: r.validations[0].metrics()["dynid SDP"]["global_relative_error"] for k, (_, r) in runs.items()}
     assert fit["geometric"] <= 1.01 * fit["euclidean"], fit

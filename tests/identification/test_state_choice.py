@@ -80,6 +80,6 @@ def test_the_default_choice_is_unchanged(tmp_path):
     cfg = _states_config(tmp_path)
     cfg.write_text(re.sub(r'^choice = "states"\n', "", cfg.read_text(), flags=re.M))
     config = load_identification_config(cfg)
-    assert config.choice == "torques"
+    assert config.estimation.choice == "torques"
     result = run_identification(config)
     assert result.sdp_refits == () and "state_evidence" not in result.diagnostics

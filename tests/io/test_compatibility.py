@@ -61,4 +61,4 @@ def test_every_shipped_config_loads_as_it_is_or_after_migrate(path, tmp_path):
     else:
         assert migrated == text
     cfg = load_identification_config(config, data_root=root)
-    assert cfg.estimators and cfg.robot.n_dof in (6, 7)
+    assert cfg.estimation.estimators and cfg.robot.n_dof in (6, 7)

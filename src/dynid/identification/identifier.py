@@ -217,18 +217,21 @@ class Identifier(HyperParameters):
             changes["robot"] = self._robot()
         if self.controller is not None:  # the config's [controller] as a ClosedLoopSetup gives it
             changes["controller"] = (self.controller.controller, self.controller.reference, self.controller.feedforward)
-        if self.estimators is not None:
-            changes["estimators"], changes["closed_loop"] = split_estimators(self.estimators, "Identifier(estimators=...)")
-            if changes["closed_loop"] and config.controller is None and self.controller is None:
-                raise ConfigError(f"Identifier(estimators=...): {changes['closed_loop'][0]} simulates the run in closed loop "
-                                  f"and needs its controller: {path} has no [controller] table (kp, kd, rate, the "
-                                  "reference trajectory)", field="estimators")
         if self.preprocessing is not None:
             changes["preprocessing"] = self._preprocessing()
+        estimation: dict[str, Any] = {}  # over the config's [estimation]
+        if self.estimators is not None:
+            open_loop, closed_loop = split_estimators(self.estimators, "Identifier(estimators=...)")
+            estimation["estimators"] = (*open_loop, *closed_loop)
+            if closed_loop and config.controller is None and self.controller is None:
+                raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the run in closed loop "
+                                  f"and needs its controller: {path} has no [controller] table (kp, kd, rate, the "
+                                  "reference trajectory)", field="estimators")
         if self.friction is not None:
-            changes["friction"] = self.friction
+            estimation["friction"] = self.friction
         if self.rng is not None:  # the config's seed
-            changes["seed"] = seed_of(self.rng)
+            estimation["seed"] = seed_of(self.rng)
+        changes["estimation"] = replace(config.estimation, **estimation)
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:

@@ -59,7 +59,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     try:
         pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
         pre_l = prepare(load_recording(loaded, unit, spool=False), config.preprocessing)
-        gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.seed)
+        gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.estimation.seed)
         k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
         payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
     except DynIdError as exc:  # said with the runs it comes from, when the message names neither
@@ -170,7 +170,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         checked.append(load_recording(spec, config.robot))
     pipeline = pipeline_of(config)
     prepared = pipeline.prepare(recording, base, step)
-    raw = recording if config.closed_loop else None  # the closed-loop estimators simulate the log as read
+    raw = recording if pipeline.closed_loop else None  # the closed-loop estimators simulate the log as read
     reference = yardstick_reference(recording) if validate and config.validation else None
     smooth = filtered_finding([config.identification.name, *(spec.name for spec in config.validation if validate)],
                               [recording, *checked])
@@ -182,7 +182,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
     with gains or contextlib.nullcontext():
         result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw,
-                                   jackknife=validate and bool(config.validation) and config.choice == "states")
+                                   jackknife=validate and bool(config.validation) and config.estimation.choice == "states")
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
@@ -337,10 +337,10 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     from .closed_loop import ClosedLoopSetup
     from .pipeline import IdentificationPipeline
 
-    setup = None if config.controller is None or not config.closed_loop else ClosedLoopSetup(*config.controller)
-    estimators = (*with_hyperparameters(config.estimators, config.hyperparameters), *config.closed_loop)
-    return IdentificationPipeline(config.robot, config.preprocessing, estimators, config.friction, config.seed,
-                                  config.robot_source, setup)
+    e = config.estimation
+    setup = None if config.controller is None or not e.closed_loop else ClosedLoopSetup(*config.controller)
+    return IdentificationPipeline(config.robot, config.preprocessing, with_hyperparameters(e.estimators, e.hyperparameters),
+                                  e.friction, e.seed, config.robot_source, setup)
 
 
 @keyword_only_after_data
@@ -454,7 +454,7 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     recording = load_recording(dataset, config.robot)
     data = prepare(recording, carried_over(stored_preprocessing(identified), config.preprocessing), strict=False)
     ratio = identified_gain_ratio(identified, config.robot.n_dof)
-    found = payload_from_log(config.robot, base, estimates[label], data, rng=config.seed, gain_ratio=ratio)
+    found = payload_from_log(config.robot, base, estimates[label], data, rng=config.estimation.seed, gain_ratio=ratio)
     return found, label, ratio
 
 

@@ -91,6 +91,46 @@ DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
 
 @dataclass(frozen=True)
+class EstimationSettings:
+    """What a config's ``[estimation]`` table asks for (:class:`dynid.io.config_types.EstimationTable`), its defaults
+    filled in.
+
+    Attributes
+    ----------
+    estimators : tuple of str and Estimator
+        Estimator keys (lower case) or unfitted estimators, the first the main estimate, the closed-loop ones (IDIM-IV,
+        DIDIM: :attr:`closed_loop`) after the others.
+    seed : int
+        Seeds the box searches and the bootstrap.
+    friction : str
+        "auto": each joint's friction model by cross-validation; "description": as described.
+    hyperparameters : dict
+        Estimator key -> the hyper-parameters ``[estimation]`` sets for it
+        (:meth:`dynid.io.config_types.EstimationTable.hyperparameters`), applied to whatever estimator list is
+        identified (:func:`dynid.estimators.registry.with_hyperparameters`).
+    choice : str
+        "torques": the main estimate chosen on the validation logs' torques; "states": on their states alone
+        (:func:`dynid.identification.verdict.choose_main_estimate`).
+    """
+
+    estimators: tuple = ("wls",)
+    seed: int = 0
+    friction: str = "auto"
+    hyperparameters: dict = field(default_factory=dict)
+    choice: str = "torques"
+
+    @property
+    def closed_loop(self) -> tuple[str, ...]:
+        """The closed-loop estimators among :attr:`estimators` (IDIM-IV, DIDIM), in the order they run.
+
+        Returns
+        -------
+        tuple of str
+        """
+        return split_estimators(self.estimators, "[estimation] estimators")[1]
+
+
+@dataclass(frozen=True)
 class IdentificationConfig:
     """A parsed identification config (module docstring).
 
@@ -107,18 +147,12 @@ class IdentificationConfig:
         Reference parameter sets' tables.
     data_root : Path
         Folder the data files are relative to.
-    estimators : tuple of str
-        Estimator keys, the first the main estimate.
-    seed : int
+    estimation : EstimationSettings
+        What ``[estimation]`` asks for: the estimators, the seed, the friction models, the choice.
     drive_gains : tuple or None
         ``(payload_mass [kg], unloaded DatasetSpec, loaded DatasetSpec)``.
     robot_source : str
         A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
-    friction : str
-        "auto": each joint's friction model by cross-validation; "description": as described.
-    hyperparameters : dict
-        Estimator key -> the hyper-parameters ``[estimation]`` sets for it
-        (:meth:`dynid.io.config_types.EstimationTable.hyperparameters`), applied to whatever estimator list is identified (:func:`dynid.estimators.registry.with_hyperparameters`).
     urdf : Path or None
         The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
@@ -126,13 +160,8 @@ class IdentificationConfig:
         ``mjcf_model``: the user's own MuJoCo model of the arm, checked against the robot's joints
         (:func:`dynid.io.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
         values into a copy of it. Not given, the MJCF the robot was read from, if it was and holds no joint fixed.
-    closed_loop : tuple of str
-        Closed-loop estimators asked for in ``[estimation] estimators`` (IDIM-IV, DIDIM), run beside the others.
     controller : tuple or None
         ``(Controller, reference DatasetSpec, feed-forward: bool)`` from ``[controller]``.
-    choice : str
-        ``[estimation] choice``: "torques", the main estimate chosen on the validation logs' torques; "states", on
-        their states alone (:func:`dynid.identification.verdict.choose_main_estimate`).
     torque_sensor : str
         The identification log's ``torques.sensor``: "joint" (a joint torque sensor on the link side) or "drive".
     """
@@ -144,17 +173,12 @@ class IdentificationConfig:
     preprocessing: Preprocessing
     references: tuple[dict, ...]
     data_root: Path
-    estimators: tuple[str, ...] = ("wls",)
-    seed: int = 0
+    estimation: EstimationSettings = field(default_factory=lambda: EstimationSettings())
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
-    friction: str = "auto"  # "auto": each joint's friction model by cross-validation; "description": as described
-    hyperparameters: dict = field(default_factory=dict)  # estimator key -> hyper-parameters [estimation] sets
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
     mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
-    closed_loop: tuple[str, ...] = ()  # IDIM-IV / DIDIM asked for, run beside the estimators
     controller: tuple | None = None  # (Controller, reference DatasetSpec, feed-forward) of [controller]
-    choice: str = "torques"  # [estimation] choice: the main estimate chosen on the validation logs' torques or states
     torque_sensor: str = "drive"  # the identification log's torques.sensor: "joint" or "drive"
 
 
@@ -341,10 +365,11 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     urdf = config_urdf(doc, path, root)
-    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimators=estimators,
-                                seed=e.seed or 0, drive_gains=gains, friction=friction, robot_source=robot_source(doc, path, root),
-                                urdf=urdf, hyperparameters=e.hyperparameters(), closed_loop=closed_loop,
-                                controller=controller, choice=e.choice or "torques", torque_sensor=_torque_sensor(doc),
+    estimation = EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, e.hyperparameters(),
+                                    e.choice or "torques")
+    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimation, drive_gains=gains,
+                                robot_source=robot_source(doc, path, root), urdf=urdf, controller=controller,
+                                torque_sensor=_torque_sensor(doc),
                                 mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
 
 
