@@ -360,3 +360,16 @@ def test_abc_coordinate_moves_give_the_same_search_as_full_evaluations(problem):
     np.testing.assert_allclose(fast.x, full.x, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(fast.history, full.history, rtol=1e-10)
     assert fast.fun == pytest.approx(objective(fast.x), rel=1e-10)
+
+
+def test_a_fitted_estimator_summarises_what_it_learned(problem):
+    """summary() works on every estimator, fitted or not (issue "Parts carry their settings, one route", item 6):
+    before fit it says so; after, it gives each learned attribute (an array by its shape and range)."""
+    w, beta = problem
+    est = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=12, rng=3)
+    before = est.summary()
+    assert before.splitlines()[0] == repr(est) and before.endswith("not fitted yet: call fit(W, tau)")
+    after = est.fit(w, w @ beta).summary().splitlines()
+    learned = dict(line.strip().split(": ", 1) for line in after[1:])
+    assert learned["history_"].startswith(f"array ({len(est.history_)},) from ") and learned["objective_"] == f"{est.objective_:.4g}"
+    assert learned["params_"] == f"array ({beta.size},) from {est.params_.min():.4g} to {est.params_.max():.4g}"

@@ -319,6 +319,19 @@ class Estimator(HyperParameters):
             raise NotFittedError(f"{type(self).__name__} is not fitted yet: call fit(W, tau) first")
         return np.asarray(w, dtype=float) @ self.params_
 
+    def summary(self) -> str:
+        """The estimator and what it learned: its repr (the hyper-parameters that differ from the defaults), then one
+        line per learned attribute (those ending in ``_``: an array by its shape and range, a sequence by its length).
+
+        Returns
+        -------
+        str
+            Ends "not fitted yet" before :meth:`fit`.
+        """
+        learned = {k: v for k, v in vars(self).items() if k.endswith("_") and not k.startswith("_")}
+        lines = [repr(self)] + [f"  {k}: {_described(v)}" for k, v in learned.items()]
+        return "\n".join(lines if learned else lines + ["  not fitted yet: call fit(W, tau)"])
+
     def score(self, w, tau) -> float:
         """Coefficient of determination R² of the prediction (1: perfect).
 
@@ -334,6 +347,20 @@ class Estimator(HyperParameters):
         w, tau = check_observations(w, tau)
         res = tau - self.predict(w)
         return 1.0 - float(res @ res) / float(((tau - tau.mean()) ** 2).sum())
+
+
+def _described(value) -> str:
+    """A learned attribute in :meth:`Estimator.summary`: an array of numbers by its shape and range, a sequence by its
+    length, a number as it is, anything else by its type."""
+    if isinstance(value, (float, np.floating)):
+        return f"{value:.4g}"
+    if isinstance(value, (bool, int, np.integer, str)) or value is None:
+        return repr(value)
+    if isinstance(value, np.ndarray):
+        finite = value[np.isfinite(value)] if value.dtype.kind in "fiu" else value[:0]
+        span = f" from {finite.min():.4g} to {finite.max():.4g}" if finite.size else ""
+        return f"array {value.shape}{span}"
+    return f"{len(value)} entries" if isinstance(value, (list, tuple)) else type(value).__name__
 
 
 class AccumulatingEstimator(Estimator):
