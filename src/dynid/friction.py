@@ -361,7 +361,7 @@ TERMS: dict[str, FrictionTerm] = {t.name: t for t in (
     FrictionTerm("fv", "N·m·s/rad", True, lambda q, dq, ddq, v: dq, lambda q, dq, v: np.ones_like(dq), 0.0, ("Fv",),
                  "viscous friction, fv·dq (eq. 3)"),
     FrictionTerm("offset", "N·m", False, lambda q, dq, ddq, v: np.ones_like(dq), _zeros, 0.0,
-                 ("f0", "off"), "constant torque offset (current sensor offset), also at rest"),
+                 ("f0", "off"), "constant torque offset (a current or torque sensor's offset), also at rest"),
     FrictionTerm("fst", "N·m", False, lambda q, dq, ddq, v: _stribeck(q, dq, v), _stribeck_dq, 0.0, (),
                  "Stribeck friction, fst·sign(dq)·exp(-(dq/v_st)²) with a Stribeck velocity v_st: fst > 0, the static "
                  "friction fc + fst falls to fc as the joint speeds up; fst < 0, friction that builds up to fc over v_st "

@@ -85,7 +85,7 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     error = float(re.search(r"m\.urdf read back by Pinocchio: its torques equal dynid's model to (\S+) of their RMS",
                             said).group(1))
     assert error < 1e-9 and re.search(r"what URDF cannot hold \(Ia = rotor \(reflected motor\) inertia, (.+, )*offset = constant torque "
-                                        r"offset \(current sensor offset\)\) is up to \S+ % of J\d", said)
+                                        r"offset \(a current or torque sensor's offset\)\) is up to \S+ % of J\d", said)
     error = float(re.search(r"m\.xml read back by MuJoCo \(mj_inverse\): its torques equal dynid's model to (\S+) of "
                             r"their RMS", said).group(1))
     assert error < 1e-6 and "MuJoCo's frictionloss is a constraint" in said
