@@ -4,7 +4,7 @@ model fits."""
 import numpy as np
 import pytest
 
-from dynid.validation.diagnostics import BlockGrams, ResidualSums, sign_findings
+from dynid.validation.diagnostics import BlockGrams, ResidualSums, excitation_findings, sign_findings
 
 from ..simulated_logs import config_text, fourier_motion, robot_toml, truth_robot, write_truth
 
@@ -164,3 +164,15 @@ def test_a_validation_error_far_above_the_fits_is_said_in_a_readable_figure():
     assert "predicts it 2.06e+15× worse than it fits the identification log (1.11e+15 % against 0.54 %)" in astray.text
     (ordinary,) = validation_findings("validation", 12.3, 2.74, prediction_spread=None, fit_spread=None, label="dynid WLS")
     assert "predicts it 4.5× worse than it fits" in ordinary.text
+
+
+def test_a_weakly_excited_parameter_suggests_the_sdp_only_where_it_is_not_run():
+    """Findings agree with choices (issue "Never worse than the description", item 4): where the physically consistent
+    estimate is among the estimates, the finding on weakly excited parameters does not suggest adding it."""
+    names = ["ZZ1R", "MX2", "fv1"]
+    params, std = np.array([1.0, 0.2, 3.0]), np.array([0.01, 0.3, 0.01])  # MX2: σ above its value
+    column_rms = np.array([1.0, 2.0, 1.0])  # its ±σ is 0.6 N·m, above 5 % of a 1 N·m RMS torque
+    without = excitation_findings(names, params, std, column_rms, 1.0)[0].text
+    with_sdp = excitation_findings(names, params, std, column_rms, 1.0, consistent=True)[0].text
+    assert "hardly excites MX2 (" in without and 'add "sdp" to the estimators' in without
+    assert "hardly excites MX2 (" in with_sdp and "sdp" not in with_sdp and "keeps them plausible" in with_sdp

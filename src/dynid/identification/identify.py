@@ -376,7 +376,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng)
+    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng,
+                               consistent="sdp" in keys)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
         findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
@@ -541,8 +542,9 @@ def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:
     return out
 
 
-def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring, fit, rng):
-    """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics."""
+def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring, fit, rng, consistent: bool):
+    """The verdict's findings on the identification log (:mod:`dynid.validation.diagnostics`) and their statistics
+    (``consistent``: the physically consistent estimate is among the estimates)."""
     n = robot.n_dof
     rms = fit.rms_torque
     sums, residuals, blocks, data = scoring.sums, scoring.residuals, scoring.blocks, scoring.data
@@ -561,7 +563,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     raw = sums.m2 + sums.count * np.einsum("jc,jd->jcd", sums.mean, sums.mean)  # Σ z zᵀ per joint
     col_rms = np.sqrt(np.max(np.diagonal(raw, axis1=1, axis2=2)[:, :-1], axis=0) / max(sums.count, 1))
     rms_all = float(np.sqrt(np.mean(rms**2)))
-    findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, rms_all)
+    findings += excitation_findings(base.names, sol.params, sol.params_std, col_rms, rms_all, consistent=consistent)
     joint_col_rms = np.sqrt(np.diagonal(raw, axis1=1, axis2=2)[:, :-1] / max(sums.count, 1))  # (n_dof, p)
     with np.errstate(invalid="ignore"):  # σ NaN where the prior keeps a direction
         share = 100.0 * np.max(np.asarray(sol.params_std, dtype=float) * joint_col_rms

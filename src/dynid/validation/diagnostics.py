@@ -681,9 +681,11 @@ def prior_findings(names, from_prior, one_way: list[int], dataset: str, *, dead:
                              "with every torque channel live (dynid excite) determines them")]
 
 
-def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: np.ndarray, rms_torque: float) -> list[Finding]:
+def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: np.ndarray, rms_torque: float, *,
+                        consistent: bool = False) -> list[Finding]:
     """Parameters the log hardly excites yet that matter: relative σ above 50 % and a torque of ±σ above 5 % of
-    the RMS torque.
+    the RMS torque; the remedy a richer excitation and, where it is not among the estimates yet, the physically
+    consistent one.
 
     Parameters
     ----------
@@ -694,6 +696,9 @@ def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: 
     column_rms : (p,) array
         RMS of each regressor column (largest over the joints).
     rms_torque : float [N·m]
+    consistent : bool
+        The physically consistent estimate (SDP) is among the estimates: it is said to keep them plausible, not
+        suggested.
 
     Returns
     -------
@@ -704,6 +709,7 @@ def excitation_findings(names, params: np.ndarray, std: np.ndarray, column_rms: 
     if not weak:
         return []
     shown = ", ".join(names[i] for i in weak[:8]) + (f" and {len(weak) - 8} more" if len(weak) > 8 else "")
+    also = ("; the physically consistent estimate keeps them plausible meanwhile (near the description's values where "
+            "the log says little)") if consistent else ' or a physically consistent estimate (add "sdp" to the estimators)'
     return [Finding("excitation", f"the identification log hardly excites {shown} (σ above half their value, yet worth "
-                                  f"over 5 % of the torque): a richer excitation (dynid excite) or a physically "
-                                  "consistent estimate")]
+                                  f"over 5 % of the torque): a richer excitation (dynid excite){also}")]
