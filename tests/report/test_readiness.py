@@ -63,6 +63,18 @@ def test_a_term_the_cross_validation_chose_is_not_called_undetermined_and_every_
     assert any(t.startswith("kept by the description") for t in (line.text for line in _determined_lines(r, "dynid WLS")))
 
 
+def test_each_kind_of_drive_term_is_written_out_once():
+    """The KR 300's line explained "constant torque offset (…)" four times, once for each of offset2 to offset5."""
+    from dynid.report.summaries import _drive_legend
+
+    line = _drive_legend(["offset2", "cbsd2", "Ia3", "offset3", "offset5", "fst4"])
+    assert line.count("constant torque offset") == 1 and line.count("rotor (reflected motor) inertia") == 1
+    assert line.startswith("the drive terms named: offset2, offset3, offset5, constant torque offset (")
+    assert "; cbsd2, counterbalance torque (cbsd·sin(2q)) of J2; Ia3, rotor (reflected motor) inertia of J3; " in line
+    assert line.endswith("; fst4, Stribeck friction of J4") and "offset5, constant torque offset" in line
+    assert "offset (a current or torque sensor's offset) of their joint; " in line
+
+
 def test_the_link_parameters_named_are_written_out_once():
     """Every inertial name the console lists (ZZ1R, XX2R, MX5, M3) is explained in one line, the regrouped ones too."""
     from dynid.report.summaries import _link_legend

@@ -754,6 +754,17 @@ def _term_words(stem: str) -> str:
     return f"{text.split(',')[0]} ({text.split(': ')[1]})" if stem in COUNTERBALANCE_TERMS else text.split(",")[0]
 
 
+def _drive_legend(names: list[str]) -> str:
+    """One line saying what the drive terms ``names`` are, each kind once, its names before it in the order given
+    ("offset2, offset4, constant torque offset (…) of their joint; Ia3, rotor (reflected motor) inertia of J3")."""
+    stems: dict[str, list[str]] = {}
+    for n in names:
+        stems.setdefault(split_name(n)[0], []).append(n)
+    return "the drive terms named: " + "; ".join(
+        f"{', '.join(group)}, {_term_words(stem)} of "
+        + (f"J{split_name(group[0])[1] + 1}" if len(group) == 1 else "their joint") for stem, group in stems.items())
+
+
 def _link_legend(names: list[str]) -> str:
     """One line saying what the link parameters among ``names`` are (issue "Never worse than the description", item 4:
     every name in the console explained once); empty where there are none."""
@@ -810,8 +821,7 @@ def _determined_lines(r, label: str) -> list:
                         "shows the effect, not its size; a richer excitation (dynid excite) sizes them"))
     named = list(dict.fromkeys(n for n in [*listed, *loose, *chosen, *small] if split_name(n)[0] in TERMS))
     if named:
-        out.append(Line("the drive terms named: " + "; ".join(
-            f"{n}, {_term_words(split_name(n)[0])} of J{split_name(n)[1] + 1}" for n in named)))
+        out.append(Line(_drive_legend(named)))
     legend = _link_legend([*loose, *chosen, *small])
     if legend:
         out.append(Line(legend))
