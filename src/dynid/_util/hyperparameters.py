@@ -6,6 +6,8 @@ from __future__ import annotations
 import inspect
 from typing import Self
 
+from .reprs import short_value
+
 
 class HyperParameters:
     """Mixin: ``get_params`` / ``set_params`` over the constructor's parameters (scikit-learn's contract).
@@ -65,7 +67,7 @@ class HyperParameters:
         str
         """
         defaults = {p.name: p.default for p in inspect.signature(type(self).__init__).parameters.values()}
-        shown = [f"{name}={_short(value)}" for name, value in self.get_params().items()
+        shown = [f"{name}={short_value(value)}" for name, value in self.get_params().items()
                  if not _is_default(value, defaults.get(name, inspect.Parameter.empty))]
         return f"{type(self).__name__}({', '.join(shown)})"
 
@@ -80,9 +82,3 @@ def _is_default(value, default) -> bool:
         return bool(value == default)
     except (TypeError, ValueError):
         return False
-
-
-def _short(value) -> str:
-    """A parameter's value in a repr: an array by its shape, anything else by its own repr."""
-    shape = getattr(value, "shape", None)
-    return f"<array {tuple(shape)}>" if isinstance(shape, tuple) else repr(value)

@@ -16,11 +16,13 @@ import numpy as np
 import scipy.linalg
 
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
 from .regressor import observation_matrix
 
 
+@short_repr
 @dataclass(frozen=True)
 class BaseParameters:
     """Selection and regrouping of the standard parameters into the base parameters.

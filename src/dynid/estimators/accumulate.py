@@ -14,9 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..exceptions import IdentifiabilityError, ShapeError
 
 
+@short_repr
 @dataclass(frozen=True)
 class LeastSquaresSolution:
     """Solution of an accumulated (weighted) least-squares problem.

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..exceptions import ConfigError
 from .base import Estimator, check_observations
 from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
@@ -23,6 +24,7 @@ GRAM_CHUNK = 4096
 """Samples per step when the per-sample Gram matrices are formed."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class BootstrapIntervals:
     """Bootstrap distribution of the parameters.

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..exceptions import ShapeError
 
 __all__ = ["PooledEstimate", "pooled_estimate", "shared_parameters", "own_term"]
@@ -60,6 +61,7 @@ def shared_parameters(names) -> np.ndarray:
     return np.array([not own_term(n) for n in names])
 
 
+@short_repr
 @dataclass(frozen=True)
 class PooledEstimate:
     """Every unit's estimate with the fleet's help.

@@ -8,6 +8,8 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from .._util.reprs import short_repr
+
 if TYPE_CHECKING:
     from ..dynamics.base_parameters import BaseParameters
 
@@ -38,6 +40,7 @@ class SearchBudget:
         return 10 * self.colony_size * self.maxiter
 
 
+@short_repr
 @dataclass
 class FitData:
     """What the estimators see of one identification problem.

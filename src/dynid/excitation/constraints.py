@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
@@ -22,6 +23,7 @@ from .obstacles import Obstacle, ObstacleDistances, obstacle_distances, reachabl
 AXES = "xyz"
 
 
+@short_repr
 @dataclass(frozen=True)
 class Workspace:
     """Where the tool point may go (``W_o`` of eq. 15), in the base frame [m].

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
@@ -58,6 +59,7 @@ class InfeasibleDesignError(DynIdError, ValueError):
     """
 
 
+@short_repr
 @dataclass(frozen=True)
 class ExcitationProblem:
     """What to design: robot, Fourier series, criterion and the constraints of eq. 15.
@@ -315,6 +317,7 @@ def _stacked_base_observation(robot: Robot, base: BaseParameters, trajectory: Fo
     return base.base_observation(regressor(robot, *trajectory.evaluate(t))).reshape(-1, base.n_base)
 
 
+@short_repr
 @dataclass(frozen=True)
 class ExcitationDesign:
     """An optimised excitation trajectory and how good it is (``to_dict`` is JSON-ready).

@@ -7,9 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from ..exceptions import ConfigError
 
 
+@short_repr
 @dataclass(frozen=True)
 class FourierTrajectory:
     """``q_i(t) = q_io + sum_k a_ik sin(k w_f t) + b_ik cos(k w_f t)`` (paper eq. 14).

@@ -21,6 +21,7 @@ from pathlib import Path
 import coal
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.kinematics import forward_kinematics
 from ..dynamics.sensitivity import frames_and_axes
 from ..exceptions import ConfigError
@@ -32,6 +33,7 @@ from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from, distance_abo
 __all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class LinkGeometry:
     """Collision shapes attached to the robot's links.

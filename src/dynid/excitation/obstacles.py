@@ -19,6 +19,7 @@ import coal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .._util.reprs import short_repr
 from ..dynamics.kinematics import forward_kinematics
 from ..dynamics.sensitivity import origins_jacobian, tool_jacobian
 from ..exceptions import ConfigError
@@ -235,6 +236,7 @@ def _sphere_gradient(gap: np.ndarray, jac: np.ndarray) -> np.ndarray:
     return gap / max(float(np.linalg.norm(gap)), 1e-12) @ (0.5 * (jac[0] + jac[1]))
 
 
+@short_repr
 @dataclass(frozen=True)
 class ObstacleDistances:
     """Every checked link's signed distance to every body along a trajectory.

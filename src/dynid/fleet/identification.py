@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..identification.run import run_identification, validate_sets
@@ -37,6 +38,7 @@ POOLED = "pooled"
 """Label of the pooled estimate in the units' validations."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class UnitSummary:
     """What the fleet keeps of one unit's identification.
@@ -232,6 +234,7 @@ def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dic
     return {label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in comparisons])) for label in sets}
 
 
+@short_repr
 @dataclass(frozen=True)
 class FleetResult:
     """A fleet's identification.

@@ -36,6 +36,7 @@ from pathlib import Path
 import msgspec
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..estimators.pooled import own_term
 from ..estimators.recursive import RecursiveLeastSquares
 from ..exceptions import ConfigError, DataError
@@ -94,6 +95,7 @@ class MonitorSettings:
             raise ConfigError(f"false_alarm_days must be positive, got {self.false_alarm_days}", field="false_alarm_days")
 
 
+@short_repr
 @dataclass(frozen=True)
 class MonitorWindow:
     """One window's re-identified terms.
@@ -174,6 +176,7 @@ class DriftAlarm:
                 "value": self.value, "change_percent": self.change, "delay_s": self.delay, "message": str(self)}
 
 
+@short_repr
 @dataclass(frozen=True)
 class MonitorResult:
     """A monitored service life.

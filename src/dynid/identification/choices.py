@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..model.friction_model import smoothing_velocities
 from ..model.robot import Robot
 from .cross_validation import CoulombChoice, PreprocessingChoice
@@ -23,6 +24,7 @@ from .friction_models import FrictionChoice
 __all__ = ["ModelChoices"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class ModelChoices:
     """The settings an identification chose on its log (module docstring).

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
 from ..dynamics.rnea import rnea_torques
@@ -64,6 +65,7 @@ STALLED = 1e-3
 (measured: DIDIM on a 10 s, 6-joint ER-16 log settles into changes of 2.4e-4 at every iteration, above ``tol``)."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class ClosedLoopExperiment:
     """What the closed-loop estimators must know of an experiment to simulate it.
@@ -115,6 +117,7 @@ class ClosedLoopSetup:
         return np.asarray(read() if callable(read) else self.reference, dtype=float)
 
 
+@short_repr
 @dataclass(frozen=True)
 class ClosedLoopEstimate:
     """One estimate of the base parameters.

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._util.column_store import root_mean_square
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
@@ -34,6 +35,7 @@ COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
 FOLDS = 5
 
 
+@short_repr
 @dataclass(frozen=True)
 class CoulombChoice:
     """Per-joint Coulomb smoothing velocity chosen by blocked cross-validation.
@@ -158,6 +160,7 @@ SCORE_MARGIN = 0.1
 """A cutoff other than the rule's must lower the cross-validation score by this fraction to be chosen."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class PreprocessingChoice:
     """Filters chosen by blocked cross-validation (``preprocessing = "auto"``).

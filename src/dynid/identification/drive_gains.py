@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from .._util.reprs import short_repr
 from ..conventions import INERTIAL_TERMS
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
@@ -61,6 +62,7 @@ determined: below, model error, not the payload, sets the value (Gautier & Briot
 change each joint's torque well above the noise)."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class DriveGainEstimate:
     """Drive gains from a run without and one with a payload of known mass.
@@ -142,6 +144,7 @@ class DriveGainEstimate:
         return out
 
 
+@short_repr
 @dataclass(frozen=True)
 class PayloadEstimate:
     """Inertial parameters of a payload on the last link (its link frame, about its origin, eq. 5 order).
@@ -347,6 +350,7 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     return PayloadEstimate(names, sol.params, sol.params_std)
 
 
+@short_repr
 @dataclass(frozen=True)
 class GainsAndPayload:
     """What ``[drive_gains]`` of an identification config gives.

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..conventions import split_name
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
@@ -34,6 +35,7 @@ from .estimates import DRIVE_ONLY_KEY
 __all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "prepared_variant", "preprocessing_variants", "variants_judge"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class DriveOnly:
     """The description's rigid body with the drive terms fitted, ready to be made the main estimate.

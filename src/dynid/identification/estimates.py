@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.layout import consistency_layout
 from ..estimators.registry import estimate_label
 from ..exceptions import DynIdError
@@ -28,6 +29,7 @@ SDP_LABEL = estimate_label("sdp")
 DRIVE_ONLY_LABEL = estimate_label(DRIVE_ONLY_KEY)
 """Label of the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`)."""
 
+@short_repr
 @dataclass(frozen=True)
 class Estimate:
     """One estimate of the base parameters, whichever estimator made it.

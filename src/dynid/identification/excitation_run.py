@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
 from ..excitation.constraints import ConstraintMargin, obstacle_margins
 from ..excitation.design import ExcitationDesign, InfeasibleDesignError, design_excitation
@@ -15,6 +16,7 @@ from ..io.cell_replay import CellContacts, cell_contacts
 from ..io.excitation_config import ExcitationConfig
 
 
+@short_repr
 @dataclass(frozen=True)
 class ExcitationRun:
     """What ``dynid excite`` produced: the design and the sampled trajectory.

@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._util.column_store import root_mean_square
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import regressor
 from ..exceptions import IdentifiabilityError
@@ -91,6 +92,7 @@ SMOOTH_FIT_FACTOR = 2.0
 
 
 
+@short_repr
 @dataclass(frozen=True)
 class FrictionChoice:
     """Friction models chosen per joint, with the out-of-fold errors behind the choice.

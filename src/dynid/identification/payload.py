@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..conventions import INERTIAL_TERMS
 from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
@@ -31,6 +32,7 @@ from .drive_gains import _last_link_columns, identify_payload
 __all__ = ["Payload", "payload_from_log"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class Payload:
     """A payload identified from a log (module docstring).

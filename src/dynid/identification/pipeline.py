@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from .._util.keywords import renamed_keyword
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
@@ -55,6 +56,7 @@ FRICTION_CHOICES = ("auto", "description")
 """``friction``: each joint's model chosen by cross-validation, or the description's terms."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class PreparedIdentification:
     """A recording prepared for the estimators, with the model the data chose.
@@ -83,6 +85,7 @@ class PreparedIdentification:
     variants: tuple = ()
 
 
+@short_repr
 @dataclass(frozen=True)
 class IdentificationPipeline:
     """Identification of one robot from one recording (module docstring).

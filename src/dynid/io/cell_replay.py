@@ -20,6 +20,7 @@ import coal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .._util.reprs import short_repr
 from ..excitation.constraints import Workspace
 from ..model.robot import Robot
 from .export import mjcf_from_robot
@@ -27,6 +28,7 @@ from .export import mjcf_from_robot
 __all__ = ["CellContacts", "cell_contacts", "cell_mjcf"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class CellContacts:
     """MuJoCo's contacts between the links and the cell along a trajectory.

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._util.column_store import SPOOL_BYTES, StoredColumns
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from ..exceptions import DataError
 from ..model.robot import Robot
 from .columns import csv_table
@@ -36,6 +37,7 @@ from .log_repairs import (
 from .tables import read_table
 
 
+@short_repr
 @dataclass(frozen=True)
 class Recording:
     """A measured dataset in SI joint quantities on a uniform time grid. The (N, n_dof) signals are arrays,

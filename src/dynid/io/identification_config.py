@@ -72,6 +72,7 @@ import msgspec
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from .._util.typed import convert
 from ..estimators.registry import estimate_label, estimator_choices, keys
 from ..exceptions import ConfigError, DataError
@@ -130,6 +131,7 @@ class EstimationSettings:
         return split_estimators(self.estimators, "[estimation] estimators")[1]
 
 
+@short_repr
 @dataclass(frozen=True)
 class IdentificationConfig:
     """A parsed identification config (module docstring).

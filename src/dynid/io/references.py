@@ -42,12 +42,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..conventions import canonical_name, split_name
 from ..dynamics.base_parameters import BaseParameters
 from ..exceptions import ConfigError, DataError
 from ..model.friction_model import COULOMB_LIKE
 
 
+@short_repr
 @dataclass(frozen=True)
 class ReferenceSet:
     """A published parameter set expressed as dynid's base parameters.

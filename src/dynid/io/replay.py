@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.regressor import regressor
 from ..model.robot import Robot
 
@@ -30,6 +31,7 @@ MJCF_TERMS = ("Ia", "fc", "fv")
 """The drive terms an MJCF hinge holds (``armature``, ``frictionloss``, ``damping``)."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class ReplayCheck:
     """A written file's torques against dynid's model.

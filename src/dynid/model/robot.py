@@ -12,6 +12,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..conventions import DEFAULT_DRIVE_TERMS, INERTIAL_TERMS, parameter_name
 from ..exceptions import ConfigError
 from ..friction import DEFAULT_STRIBECK_VELOCITY, Velocities, check_terms
@@ -19,6 +20,7 @@ from .spatial import is_physically_consistent, nearest_consistent, rot_axis, tra
 from .transmission import Transmission
 
 
+@short_repr
 @dataclass(frozen=True)
 class Joint:
     """One revolute joint: placement in the parent link frame and rotation axis.
@@ -40,6 +42,7 @@ class Joint:
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
 
 
+@short_repr
 @dataclass(frozen=True)
 class Limits:
     """Joint limits; unknown limits are ``inf``.
@@ -77,6 +80,7 @@ class Limits:
         return Limits(*(getattr(self, f)[:k].copy() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")))
 
 
+@short_repr
 @dataclass(frozen=True)
 class Robot:
     """A serial robot arm with revolute joints (immutable).

@@ -23,10 +23,12 @@ from functools import cached_property
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..conventions import COUPLING_TERMS
 from ..exceptions import ConfigError
 
 
+@short_repr
 @dataclass(frozen=True)
 class Transmission:
     """Joint-to-motor transmission of an n-joint robot.

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from .._util.column_store import by_column
+from .._util.reprs import short_repr
 from ..conventions import MOVING_SPAN
 from ..exceptions import ConfigError, DataError
 from ..friction import Velocities, held_direction
@@ -23,6 +24,7 @@ Samples = Any
 """An (N, n_dof) signal: an array, or for a spooled long log :class:`dynid._util.column_store.StoredColumns`."""
 
 
+@short_repr
 @dataclass(frozen=True)
 class PreparedData:
     """Filtered joint signals on a uniform grid, ready for the regressor.

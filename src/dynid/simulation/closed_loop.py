@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.regressor import friction_torques
 from ..dynamics.rnea import pinocchio_model
 from ..exceptions import ConfigError, ShapeError
@@ -46,6 +47,7 @@ def _gains(value, n: int, name: str, positive: bool) -> np.ndarray:
     return arr
 
 
+@short_repr
 @dataclass(frozen=True)
 class Controller:
     """A joint-space PD/PID controller on the measured positions.
@@ -186,6 +188,7 @@ class ClosedLoopNoise:
         return np.round(y / self.encoder_resolution) * self.encoder_resolution if self.encoder_resolution > 0 else y
 
 
+@short_repr
 @dataclass(frozen=True)
 class ClosedLoopRun:
     """One closed-loop run, time-first arrays of shape (N, n_dof) unless noted.

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.checks import check_vector
+from .._util.reprs import short_repr
 from ..dynamics.rnea import rnea_torques
 from ..exceptions import ConfigError
 from ..model.robot import Robot
@@ -39,6 +40,7 @@ class NoiseModel:
             raise ConfigError(f"encoder resolution must be non-negative (rad), got {self.encoder_resolution}")
 
 
+@short_repr
 @dataclass(frozen=True)
 class Measurements:
     """One simulated recording. All arrays time-first, (N, n_dof) unless noted.

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..dynamics.rnea import rnea_torques
@@ -284,6 +285,7 @@ def _number(x) -> float | None:
     return x if np.isfinite(x) else None
 
 
+@short_repr
 @dataclass
 class ClosedLoopStudyResult(StudyResult):
     """Estimates of every (cell, realisation, estimator) and their statistics (:class:`StudyResult`);

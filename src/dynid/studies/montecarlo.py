@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..estimators import registry
@@ -224,6 +225,7 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     return {"params": params, "seconds": seconds, "errors": errors}
 
 
+@short_repr
 @dataclass
 class MonteCarloResult(StudyResult):
     """Estimates of every (level, realisation, method) and their statistics (:class:`StudyResult`, a cell a noise

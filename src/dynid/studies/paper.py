@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from .._util.reprs import short_repr
 from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
@@ -186,6 +187,7 @@ MIN_SAMPLES = 10
 """Samples a simulated recording needs at least (:func:`dynid.excitation.fourier.sample_times`)."""
 
 
+@short_repr
 @dataclass
 class Dataset:
     """One preprocessed recording and its observation matrix.
@@ -215,6 +217,7 @@ class Dataset:
     tool: np.ndarray         # (N, 3)
 
 
+@short_repr
 @dataclass
 class PaperEstimate:
     """What one estimator gave.
@@ -259,6 +262,7 @@ class PaperEstimate:
     consistency_margin: float | None = None
 
 
+@short_repr
 @dataclass
 class PaperRunResult:
     """Everything :func:`run_paper_experiment` measured; :meth:`to_dict` is ``results.json``.
@@ -536,6 +540,7 @@ def settings_of(config) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(config).items()}
 
 
+@short_repr
 @dataclass
 class StudySetup:
     """What every realisation of a simulated study shares (computed once, sent to the workers once).
@@ -562,6 +567,7 @@ class StudySetup:
     unit_crb: np.ndarray
 
 
+@short_repr
 @dataclass
 class StudyResult:
     """A simulated study's estimates, in the order of its grid's cells, its realisations and its estimators.

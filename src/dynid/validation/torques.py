@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._util.column_store import root_mean_square
+from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..model.friction_model import COULOMB_LIKE
 from ..model.robot import Robot
@@ -23,6 +24,7 @@ from .noise_floor import noise_floor
 __all__ = ["TorqueComparison", "TorqueSums", "compare_torques", "rests_throughout"]
 
 
+@short_repr
 @dataclass(frozen=True)
 class TorqueComparison:
     """Measured and predicted torques of one dataset (decimated), with per-joint metrics (eq. 18, RMSE, relative error).
