@@ -175,7 +175,7 @@ class IdentificationConfig:
     preprocessing: Preprocessing
     references: tuple[dict, ...]
     data_root: Path
-    estimation: EstimationSettings = field(default_factory=lambda: EstimationSettings())
+    estimation: EstimationSettings = field(default_factory=EstimationSettings)
     drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
