@@ -11,6 +11,7 @@ Dombre, "Modeling, Identification and Control of Robots", 2002, ch. 12.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import scipy.linalg
@@ -18,6 +19,7 @@ import scipy.linalg
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from ..exceptions import IdentifiabilityError
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from .regressor import observation_matrix
 
@@ -164,13 +166,14 @@ def _format_term(coef: float, name: str, first: bool) -> str:
 
 
 @keyword_only_after_data
-def base_parameters(robot: Robot, *, rng: np.random.Generator | int | None = 0, n_samples: int = 400,
+def base_parameters(robot: Robot | str | Path, *, rng: np.random.Generator | int | None = 0, n_samples: int = 400,
                     tol: float = 1e-8) -> BaseParameters:
     """Compute the base parameters of ``robot`` numerically.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     rng : Generator or int seed
         Random states are drawn uniformly within the joint limits (±π where unlimited).
     n_samples : int
@@ -187,6 +190,7 @@ def base_parameters(robot: Robot, *, rng: np.random.Generator | int | None = 0, 
     IdentifiabilityError
         If the rank found by QR disagrees with the SVD rank (numerically ill-posed chain).
     """
+    robot = as_robot(robot)
     rng = np.random.default_rng(rng)
     n = robot.n_dof
     lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)

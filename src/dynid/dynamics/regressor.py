@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import threading
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 from .._util.checks import check_states
 from .._util.keywords import keyword_only_after_data
 from ..friction import drive_columns
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from . import _regressor_kernel as kernel
 from . import _regressor_simd
@@ -49,12 +51,13 @@ _numpy_lock = threading.Lock()
 
 
 @keyword_only_after_data
-def regressor(robot: Robot, q, dq, ddq, *, columns=None, velocities=None) -> np.ndarray:
+def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities=None) -> np.ndarray:
     """Per-sample joint-torque regressor.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     q, dq, ddq : (N, n_dof) arrays
         Joint positions [rad], velocities [rad/s], accelerations [rad/s²].
     columns : (m,) int array, optional
@@ -76,6 +79,7 @@ def regressor(robot: Robot, q, dq, ddq, *, columns=None, velocities=None) -> np.
     ShapeError
         If an input is not (N, n_dof) or holds NaN.
     """
+    robot = as_robot(robot)
     n = robot.n_dof
     q, dq, ddq, n_s = check_states(q, dq, ddq, n)
     colmap = np.full(robot.n_params, -1, dtype=np.int64)

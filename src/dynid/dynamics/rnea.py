@@ -6,9 +6,12 @@ measurements never come from the model being identified.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..model.urdf import pinocchio_from_inertial
 from .regressor import friction_torques
@@ -52,12 +55,13 @@ def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
 
 
 @keyword_only_after_data
-def rnea_torques(robot: Robot, q, dq, ddq, *, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
+def rnea_torques(robot: Robot | str | Path, q, dq, ddq, *, inertial: np.ndarray | None = None, drive: np.ndarray | None = None) -> np.ndarray:
     """Joint torques: Pinocchio's RNEA for the rigid bodies plus the drive terms.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     q, dq, ddq : (N, n_dof) arrays
         [rad], [rad/s], [rad/s²].
     inertial : (n_dof, 10) array, optional
@@ -69,6 +73,7 @@ def rnea_torques(robot: Robot, q, dq, ddq, *, inertial: np.ndarray | None = None
     -------
     (N, n_dof) ndarray [N·m]
     """
+    robot = as_robot(robot)
     import pinocchio as pin
 
     model = pinocchio_model(robot, inertial)

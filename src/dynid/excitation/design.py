@@ -32,6 +32,7 @@ from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..dynamics.sensitivity import origins_jacobian, regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
+from ..model.loading import as_robot
 from ..model.robot import Limits, Robot
 from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
@@ -67,7 +68,8 @@ class ExcitationProblem:
     Attributes
     ----------
     robot : Robot
-        The identified model (e.g. ``er16.submodel(3)``).
+        The identified model (e.g. ``er16.submodel(3)``); given as a built-in robot's name or a description's path, it
+        is loaded (:func:`dynid.model.loading.as_robot`).
     omega_f : float
         Fundamental pulsation [rad/s]; the trajectory is periodic with period ``2π/omega_f``.
     n_harmonics : int
@@ -108,7 +110,8 @@ class ExcitationProblem:
     base: BaseParameters = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
-        robot = self.robot
+        robot = as_robot(self.robot)
+        object.__setattr__(self, "robot", robot)
         if self.limits is None:
             object.__setattr__(self, "limits", robot.limits)
         if self.phi is None:

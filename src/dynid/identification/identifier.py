@@ -21,6 +21,7 @@ import numpy as np
 from .._util.hyperparameters import HyperParameters
 from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..exceptions import ConfigError, NotFittedError
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 
@@ -235,11 +236,9 @@ class Identifier(HyperParameters):
         return run_identification(replace(config, **changes), validate=validate)
 
     def _robot(self) -> Robot:
-        from ..model.description import load_robot
-
         if self.robot is None:
             raise ConfigError("Identifier(robot=...): the robot's description is needed to fit arrays", field="robot")
-        return self.robot if isinstance(self.robot, Robot) else load_robot(self.robot)
+        return as_robot(self.robot, "Identifier(robot=...)")
 
     def _preprocessing(self) -> Preprocessing | None:
         p = self.preprocessing

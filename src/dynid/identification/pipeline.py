@@ -36,6 +36,7 @@ from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
@@ -93,7 +94,8 @@ class IdentificationPipeline:
     Parameters
     ----------
     robot : Robot
-        The robot's description.
+        The robot's description (a built-in robot's name or a description's path is loaded:
+        :func:`dynid.model.loading.as_robot`).
     preprocessing : Preprocessing
         The settings as given (``None`` fields: derived from the data).
     estimators : tuple of str, Estimator and ClosedLoopEstimator
@@ -141,6 +143,7 @@ class IdentificationPipeline:
     closed_loop_estimators: tuple[ClosedLoopEstimator, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        object.__setattr__(self, "robot", as_robot(self.robot))
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
         items = (self.estimators,) if isinstance(self.estimators, str) else tuple(self.estimators)

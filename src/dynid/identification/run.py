@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import fields, replace
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,6 +26,7 @@ from ..io.log_repairs import (
     unwrapped_positions,
 )
 from ..model.description import builtin_robots
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over, yardstick_settings
@@ -560,15 +562,16 @@ def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
 
 @renamed_keyword("seed", "rng")
 @with_single_blas_thread
-def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "arrays", **settings):
+def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name: str = "arrays", **settings):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
     (:class:`~dynid.identification.pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
     cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
         E.g. :func:`dynid.load_robot`.
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     t : (N,) array [s]
         Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step,
         as the log readers do (with a warning).
@@ -600,6 +603,7 @@ def identify_from_arrays(robot: Robot, t, q, tau, dq=None, *, name: str = "array
     ConfigError
         An unknown estimator, setting or ``friction``, or closed-loop estimators without ``controller``.
     """
+    robot = as_robot(robot)
     from .pipeline import IdentificationPipeline
 
     known = {f.name for f in fields(IdentificationPipeline) if f.init} - {"robot", "source"}

@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import re
 from html import escape
+from pathlib import Path
 
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
 from ..exceptions import ConfigError
 from ..model.friction_model import robot_from_settings
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
 from .results import LARGEST_VALUE, stored_standard
@@ -87,12 +89,13 @@ def quoteattr(value: str) -> str:
 
 
 @keyword_only_after_data
-def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
+def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
     """URDF text of ``robot`` with the standard parameters ``phi`` (default: its nominal ones).
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     phi : (n_params,) array, optional
         Standard parameters (eq. 5 order per link, then the drive terms), e.g. the physically consistent
         estimate of ``dynid identify``.
@@ -109,6 +112,7 @@ def urdf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
         A link whose parameters are those of no mass distribution (named with the broken rule), or a
         negative friction coefficient.
     """
+    robot = as_robot(robot)
     fitted = _exportable(robot, phi)
     lines = ['<?xml version="1.0"?>', f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
              f"<robot name={quoteattr(name or robot.name)}>", '  <link name="base_link"/>']
@@ -171,7 +175,7 @@ def _world_from_base(gravity: np.ndarray) -> np.ndarray | None:
 
 
 @keyword_only_after_data
-def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
+def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
     """MuJoCo MJCF text of a robot with given standard parameters.
 
     Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
@@ -186,7 +190,8 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     phi : (n_params,) array, optional
         Standard parameters (the robot's nominal ones by default).
     name : str, optional
@@ -202,6 +207,7 @@ def mjcf_from_robot(robot: Robot, phi: np.ndarray | None = None, *, name: str | 
     ConfigError
         As :func:`urdf_from_robot`.
     """
+    robot = as_robot(robot)
     import pinocchio as pin
 
     fitted = _exportable(robot, phi)

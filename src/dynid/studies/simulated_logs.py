@@ -7,10 +7,13 @@ quantised positions and torques from noisy motor currents through the drive gain
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data, renamed_keyword
 from ..io.datasets import Recording
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents
 from .simulated_fleet import random_excitation
@@ -20,14 +23,15 @@ __all__ = ["simulated_log"]
 
 @renamed_keyword("seed", "rng")
 @keyword_only_after_data
-def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, rng: int | np.random.Generator = 0,
+def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: float = 250.0, rng: int | np.random.Generator = 0,
                   noise: NoiseModel = NoiseModel()) -> Recording:
     """A log of ``robot`` running a random Fourier excitation.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot, str or Path
         The simulation truth is its description's parameters (``robot.standard_parameters()``).
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     seconds : float
         Length [s].
     rate : float
@@ -48,6 +52,7 @@ def simulated_log(robot: Robot, *, seconds: float = 30.0, rate: float = 250.0, r
     ConfigError
         A description without physical nominal parameters.
     """
+    robot = as_robot(robot)
     robot.require_physical_nominal("a simulated log (its truth is the description's parameters)")
     generator = np.random.default_rng(rng)
     trajectory = random_excitation(robot, generator)
