@@ -61,3 +61,15 @@ def test_a_design_fits_a_screen():
         text = repr(record)
         assert "\n" not in text and len(text) <= SCREEN, text[:200]
     assert "margins=<list of " in repr(design) and "a=<array (6, 2)>" in repr(design.trajectory)
+
+
+def test_a_design_made_from_the_library_has_a_summary():
+    """dynid.summary(design) refused a design made by design_excitation ("expected a result of dynid, got
+    ExcitationDesign"): it says the criterion before and after, the margins and whether every constraint holds."""
+    problem = ExcitationProblem(dynid.load_robot("er16"), 2 * np.pi * 0.1, 2)
+    design = design_excitation(problem, n_starts=1, rng=0, maxiter=5)
+    text = dynid.summary(design, width=300)
+    assert text.startswith("excitation design — criterion cond") and "Constraint margins on the verification grid" in text
+    last = text.rstrip().splitlines()[-1]
+    assert design.feasible and last.startswith(f"cond(W_base) {design.initial_cond:.2f} → {design.cond:.2f}")
+    assert "every constraint holds, the tightest: " in last

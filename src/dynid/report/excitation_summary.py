@@ -24,23 +24,8 @@ def excitation_blocks(run) -> list:
     """
     d, p, c = run.design, run.config.problem, run.config
     out: list = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
-                f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title"),
-           TextTable(f"Before / after (design grid of {p.grid_points} samples per period)", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
-                     ((f"initial: {c.initial_label}", f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),
-                      ("optimised", f"{d.cond:.2f}", f"{d.log_det:.2f}")))]
-    if d.initial_violations:
-        out.append(Line("the initial trajectory violates: " + "; ".join(
-            f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
-    else:
-        out.append(Line("the initial trajectory satisfies every constraint too (same limits for both)"))
-    out.append(Line(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
-                    f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)")
-                    + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
-                    + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s"))
-    rows = tuple((m.constraint, m.where, f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}",
-                  "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}") for m in d.margins)
-    out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
-                         ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
+                f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title")]
+    out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
     free = p.unlimited_joints()
     if free:
@@ -54,17 +39,57 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
                         f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
-    out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run)
-    relative = [m for m in d.margins if not math.isnan(m.relative)]  # margins in units of their limit, comparable
-    tight = min(relative, key=lambda m: m.relative) if relative else None
-    held = d.feasible
-    out.append(Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
-                    + ("every constraint holds" if held else "a constraint is violated (table above)")
-                    + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where}"), "title"))
-    if held:
+    out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
+    if d.feasible:
         out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
                         "and currents, and dynid identify the log"))
     return out
+
+
+def design_blocks(design) -> list:
+    """What an excitation design says of itself (:func:`dynid.excitation.design.design_excitation`'s result, designed
+    from the library: ``dynid.summary(design)``): the criterion before and after, the starts, the constraint margins.
+
+    Parameters
+    ----------
+    design : dynid.excitation.design.ExcitationDesign
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    return [Line(f"excitation design — criterion {design.criterion}", "title"), *_design_lines(design, "initial", ""),
+            _verdict_line(design)]
+
+
+def _design_lines(d, initial: str, grid: str) -> list:
+    """The before/after table, the initial trajectory's violations, the verification line and the margins table."""
+    out: list = [TextTable(f"Before / after{grid}", ("trajectory", "cond(W_base)", "log det(WᵀW/N)"),
+                           ((initial, f"{d.initial_cond:.2f}", f"{d.initial_log_det:.2f}"),
+                            ("optimised", f"{d.cond:.2f}", f"{d.log_det:.2f}")))]
+    if d.initial_violations:
+        out.append(Line("the initial trajectory violates: " + "; ".join(
+            f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
+    else:
+        out.append(Line("the initial trajectory satisfies every constraint too (same limits for both)"))
+    out.append(Line(f"cond on the 10× finer verification grid: {d.cond_verification:.2f}; ratio optimised/initial "
+                    f"{d.cond / d.initial_cond:.3f}; criterion from each start " + ("(cond)" if d.criterion == "cond" else "(−log det)")
+                    + ": " + ", ".join(f"{v:.2f}" for v in d.start_values)
+                    + f"; {d.nit} SLSQP iterations, {d.nfev} evaluations, {d.seconds:.1f} s"))
+    rows = tuple((m.constraint, m.where, f"{m.limit:.4g}", f"{m.worst:.4g}", f"{m.margin:.4g}",
+                  "" if math.isnan(m.relative) else f"{100 * m.relative:.1f}") for m in d.margins)
+    out.append(TextTable("Constraint margins on the verification grid (margin = limit − worst; ≥ 0 holds)",
+                         ("constraint", "where", "limit", "worst", "margin", "margin %"), rows, labels=2))
+    return out
+
+
+def _verdict_line(d) -> Line:
+    """cond before and after, whether every constraint holds and the tightest one (margins in units of their limit)."""
+    relative = [m for m in d.margins if not math.isnan(m.relative)]
+    tight = min(relative, key=lambda m: m.relative) if relative else None
+    return Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
+                + ("every constraint holds" if d.feasible else "a constraint is violated (table above)")
+                + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where}"), "title")
 
 
 def _self_clearance_lines(run) -> list:

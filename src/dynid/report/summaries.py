@@ -24,7 +24,7 @@ from ..validation.diagnostics import nominal_gate
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison, rests_throughout
 from .choice_tables import coulomb_choice_table, drive_gains_blocks, filter_choice_table, friction_choice_table
-from .excitation_summary import excitation_blocks
+from .excitation_summary import design_blocks, excitation_blocks
 from .fleet_summary import fleet_blocks, monitor_blocks
 from .paper_summary import run_summary_blocks
 from .study_summaries import closed_loop_study_blocks, montecarlo_blocks
@@ -150,7 +150,7 @@ def summary(result, *, width: int = 100) -> str:
 
     Parameters
     ----------
-    result : IdentificationResult, PaperRunResult, MonteCarloResult or ExcitationRun
+    result : IdentificationResult, PaperRunResult, MonteCarloResult, ExcitationRun or ExcitationDesign
     width : int
         Characters per line the tables are fitted to.
 
@@ -178,6 +178,7 @@ def blocks(result) -> list:
     TypeError
         Not a result of dynid.
     """
+    from ..excitation.design import ExcitationDesign
     from ..fleet.identification import FleetResult
     from ..fleet.monitor import MonitorResult
     from ..identification.excitation_run import ExcitationRun
@@ -187,7 +188,7 @@ def blocks(result) -> list:
 
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
                        (MonteCarloResult, montecarlo_blocks), (ClosedLoopStudyResult, closed_loop_study_blocks),
-                       (ExcitationRun, excitation_blocks),
+                       (ExcitationRun, excitation_blocks), (ExcitationDesign, design_blocks),
                        (FleetResult, fleet_blocks), (MonitorResult, monitor_blocks)):
         if isinstance(result, kind):
             return make(result)
