@@ -73,3 +73,14 @@ def test_a_design_made_from_the_library_has_a_summary():
     last = text.rstrip().splitlines()[-1]
     assert design.feasible and last.startswith(f"cond(W_base) {design.initial_cond:.2f} → {design.cond:.2f}")
     assert "every constraint holds, the tightest: " in last
+
+
+def test_a_models_validation_has_a_summary(fitted):
+    """dynid.summary(model.validate(log)) (a TorqueComparison, or a list of them) says what dynid validate says."""
+    from dynid.identification.identified import IdentifiedModel
+
+    robot, log, _, _, result = fitted
+    comparison = IdentifiedModel.from_result(result).validate(dynid.simulated_log(robot, seconds=4.0, rng=1))
+    text = dynid.summary(comparison, width=300)
+    assert text.startswith("In short (the tables follow)") and f"{comparison.name}: torque error over all joints: " in text
+    assert dynid.summary([comparison, comparison], width=300).count(f"{comparison.name}: torque error") == 2

@@ -135,6 +135,6 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     assert [v["name"] for v in moving] == ["ptp_10_points"]
     means = {name: np.mean([v["metrics"][name]["global_relative_error"] for v in moving]) for name in val[0]["metrics"]}
     assert len(p.stdout.strip().splitlines()) < 40 and "RMSE" not in text and "next:" in text
-    assert (f"mean torque error over the 1 log that moves ({len(val) - 1} at rest throughout left out: they check the "
+    assert (f"mean torque error over the one log that moves ({len(val) - 1} at rest throughout left out: they check the "
             "gravity model): ") in text and "best: dynid" in text
     assert all(f"{name} {m:.3g} %" in text for name, m in means.items())

@@ -209,7 +209,7 @@ def test_validate_sums_up_resting_logs_in_one_line_and_leaves_them_out_of_the_me
         "p1, p2 (2 logs at rest throughout): torque error over all joints: A 0 %; B 0 % (the distance to the "
         "static-friction band, a check of the gravity model to within friction, not of motion)"]
     a, b = (moving.metrics()[k]["global_relative_error"] for k in "AB")
-    assert f"mean torque error over the 1 log that moves (2 at rest throughout left out: they check the gravity model): " \
+    assert f"mean torque error over the one log that moves (2 at rest throughout left out: they check the gravity model): " \
            f"A {a:.3g} %; B {b:.3g} % — best: A" in lines
 
 

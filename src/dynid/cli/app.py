@@ -590,7 +590,6 @@ def validate(
     from ..exceptions import DataError
     from ..identification.run import run_validation
     from ..io.identification_config import dataset_for_file, load_identification_config
-    from ..report.summaries import comparison_table
 
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)
@@ -610,13 +609,12 @@ def validate(
 
     def show(rep, validated, paths):
         from ..identification.run import YARDSTICK
-        from ..report.summaries import validation_in_short, validation_verdict
+        from ..report.summaries import validation_blocks
         from ..tables import Line
 
         comparisons, warnings = validated
-        tables = [comparison_table(c) for c in comparisons] if verbose else []
         said = [Line(f"on one yardstick: {YARDSTICK}")] if yardstick else []
-        rep.blocks([*said, *validation_in_short(comparisons, tables_follow=verbose), *tables, *validation_verdict(comparisons)])
+        rep.blocks([*said, *validation_blocks(comparisons, tables=verbose)])
         for w in warnings:
             rep.warning(w)
         rep.wrote(paths)

@@ -167,7 +167,8 @@ def blocks(result) -> list:
     Parameters
     ----------
     result : object
-        Any result of dynid (identification, validation, drive gains, Monte Carlo, excitation, paper run).
+        Any result of dynid (identification, validation: one ``TorqueComparison`` or a list of them, drive gains,
+        Monte Carlo, excitation, paper run).
 
     Returns
     -------
@@ -186,6 +187,9 @@ def blocks(result) -> list:
     from ..studies.montecarlo import MonteCarloResult
     from ..studies.paper import PaperRunResult
 
+    if isinstance(result, TorqueComparison) or (isinstance(result, (list, tuple)) and result
+                                                and all(isinstance(c, TorqueComparison) for c in result)):
+        return validation_blocks(result if isinstance(result, (list, tuple)) else [result])
     for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
                        (MonteCarloResult, montecarlo_blocks), (ClosedLoopStudyResult, closed_loop_study_blocks),
                        (ExcitationRun, excitation_blocks), (ExcitationDesign, design_blocks),
@@ -588,6 +592,24 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     return out
 
 
+def validation_blocks(comparisons, *, tables: bool = True) -> list:
+    """What ``dynid validate`` prints of its comparisons (``IdentifiedModel.validate``'s too, through
+    :func:`summary`): how it went in short, each log's table, the set to use.
+
+    Parameters
+    ----------
+    comparisons : sequence of dynid.validation.torques.TorqueComparison
+    tables : bool
+        Each log's table of per-joint metrics (``dynid validate --verbose``).
+
+    Returns
+    -------
+    list of Line and TextTable
+    """
+    return [*validation_in_short(comparisons, tables_follow=tables), *(comparison_table(c) for c in comparisons if tables),
+            *validation_verdict(comparisons)]
+
+
 def validation_verdict(comparisons) -> list:
     """The last lines of ``dynid validate``: each parameter set's mean torque error over the logs that move (logs at
     rest throughout check the gravity model within friction and would dilute the mean), the set to use and the next
@@ -611,9 +633,8 @@ def validation_verdict(comparisons) -> list:
     means = {name: float(np.mean(v)) for name, v in errors.items()}
     best = min(means, key=lambda k: means[k])
     n, left = len(moving), len(comparisons) - len(moving)
-    what = f"the {n} log{'s' if n > 1 else ''}" if not left else \
-        (f"the {n} log{'s that move' if n > 1 else ' that moves'} ({left} at rest throughout left out: they check the "
-         "gravity model)")
+    logs = f"the {n} logs" + (" that move" if left else "") if n > 1 else "the one log" + (" that moves" if left else "")
+    what = logs + (f" ({left} at rest throughout left out: they check the gravity model)" if left else "")
     out = [Line(f"mean torque error over {what}: " + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
                 + _best(means, " — "), "title")]
     if not best.startswith("dynid"):
