@@ -371,5 +371,5 @@ def test_a_fitted_estimator_summarises_what_it_learned(problem):
     assert before.splitlines()[0] == repr(est) and before.endswith("not fitted yet: call fit(W, tau)")
     after = est.fit(w, w @ beta).summary().splitlines()
     learned = dict(line.strip().split(": ", 1) for line in after[1:])
-    assert learned["history_"].startswith(f"array ({len(est.history_)},) from ") and learned["objective_"] == f"{est.objective_:.4g}"
+    assert learned["history_"].startswith(f"array ({len(est.history_)},) from ") and learned["objective_"] == f"{est.objective_:.6g}"
     assert learned["params_"] == f"array ({beta.size},) from {est.params_.min():.4g} to {est.params_.max():.4g}"

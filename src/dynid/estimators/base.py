@@ -7,6 +7,7 @@ import inspect
 import numpy as np
 
 from .._util.hyperparameters import HyperParameters
+from .._util.reprs import short_value
 from ..exceptions import NotFittedError, ShapeError
 from .accumulate import LeastSquaresAccumulator
 
@@ -350,17 +351,14 @@ class Estimator(HyperParameters):
 
 
 def _described(value) -> str:
-    """A learned attribute in :meth:`Estimator.summary`: an array of numbers by its shape and range, a sequence by its
-    length, a number as it is, anything else by its type."""
-    if isinstance(value, (float, np.floating)):
-        return f"{value:.4g}"
-    if isinstance(value, (bool, int, np.integer, str)) or value is None:
-        return repr(value)
-    if isinstance(value, np.ndarray):
-        finite = value[np.isfinite(value)] if value.dtype.kind in "fiu" else value[:0]
-        span = f" from {finite.min():.4g} to {finite.max():.4g}" if finite.size else ""
-        return f"array {value.shape}{span}"
-    return f"{len(value)} entries" if isinstance(value, (list, tuple)) else type(value).__name__
+    """A learned attribute in :meth:`Estimator.summary`: an array of numbers by its shape and range, a number, a string
+    or a sequence as a record's repr shows it (:func:`dynid._util.reprs.short_value`), anything else by its type."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiu":
+        finite = value[np.isfinite(value)]
+        return f"array {value.shape}" + (f" from {finite.min():.4g} to {finite.max():.4g}" if finite.size else "")
+    if value is None or isinstance(value, (bool, int, float, np.number, str, list, tuple, np.ndarray)):
+        return short_value(value)
+    return type(value).__name__
 
 
 class AccumulatingEstimator(Estimator):
