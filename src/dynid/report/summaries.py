@@ -150,7 +150,8 @@ def summary(result, *, width: int = 100) -> str:
 
     Parameters
     ----------
-    result : IdentificationResult, PaperRunResult, MonteCarloResult, ExcitationRun or ExcitationDesign
+    result : IdentificationResult, PaperRunResult, MonteCarloResult, ExcitationRun, ExcitationDesign, TorqueComparison
+        or a list of TorqueComparison (:func:`blocks`).
     width : int
         Characters per line the tables are fitted to.
 
