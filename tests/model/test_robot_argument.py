@@ -27,6 +27,16 @@ def test_a_robot_by_name_gives_what_the_robot_gives(er16):
         np.testing.assert_array_equal(made.standard_parameters(), er16.standard_parameters())
 
 
+def test_a_log_is_read_for_a_robot_by_name(er16, tmp_path):
+    log = dynid.simulated_log(er16, seconds=2.0)
+    names = ["time", *(f"q{j + 1}" for j in range(6)), *(f"tau{j + 1}" for j in range(6))]
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([log.t, log.q, log.tau]), delimiter=",", header=",".join(names), comments="")
+    by_name, by_robot = dynid.load_recording(path, "er16"), dynid.load_recording(path, er16)
+    np.testing.assert_array_equal(by_name.tau, by_robot.tau)
+    np.testing.assert_array_equal(by_name.q, by_robot.q)
+
+
 def test_anything_else_is_refused_in_one_line_saying_what_is_expected():
     with pytest.raises(TypeError, match=r"^robot: expected a Robot \(dynid.load_robot\(...\)\), a built-in robot's name "
                                         r"or a description's path, got int$"):

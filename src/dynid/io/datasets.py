@@ -13,6 +13,7 @@ from .._util.column_store import SPOOL_BYTES, StoredColumns
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from ..exceptions import DataError
+from ..model.loading import as_robot
 from ..model.robot import Robot
 from .columns import csv_table
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
@@ -85,7 +86,7 @@ def _detected(log: Path, robot: Robot) -> DatasetSpec:
 
 
 @keyword_only_after_data
-def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool | None = None) -> Recording:
+def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *, spool: bool | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
@@ -98,7 +99,8 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
     spec : DatasetSpec, or a log's path
         A dataset of a config; or a CSV log whose columns are found as ``dynid init`` finds them (a header naming
         time, positions and torques or currents).
-    robot : Robot
+    robot : Robot, str or Path
+        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     spool : bool, optional
         Hold the signals in temporary files (:mod:`dynid._util.column_store`) rather than in memory; by default when the
         files hold more than :data:`dynid._util.column_store.SPOOL_BYTES` (an hour-long log). The numbers are the same
@@ -116,6 +118,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot, *, spool: bool 
     TypeError
         Neither a dataset nor a path (one line saying what was given).
     """
+    robot = as_robot(robot)
     if isinstance(spec, (str, Path)):
         spec = _detected(Path(spec), robot)
     elif not isinstance(spec, DatasetSpec):

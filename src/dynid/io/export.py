@@ -296,8 +296,9 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
 
     Parameters
     ----------
-    robot : Robot
-        The robot's description the results were identified for.
+    robot : Robot, str or Path
+        The robot's description the results were identified for (a built-in robot's name or a description's path is
+        loaded: :func:`dynid.model.loading.as_robot`).
     results : dict
         A parsed ``results.json`` of ``dynid identify``.
     source : str
@@ -412,7 +413,7 @@ def verdict_warnings(results: dict) -> list[str]:
 
 
 @keyword_only_after_data
-def urdf_from_results(robot: Robot, results: dict, *, source: str = "results") -> str:
+def urdf_from_results(robot: Robot | str | Path, results: dict, *, source: str = "results") -> str:
     """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
 
     Parameters
@@ -434,7 +435,7 @@ def urdf_from_results(robot: Robot, results: dict, *, source: str = "results") -
     ConfigError
         As :func:`consistent_estimate`.
     """
-    return urdf_from_robot(*consistent_estimate(robot, results, source))
+    return urdf_from_robot(*consistent_estimate(as_robot(robot), results, source))
 
 
 @keyword_only_after_data
