@@ -164,6 +164,8 @@ def test_a_validation_error_far_above_the_fits_is_said_in_a_readable_figure():
     assert "predicts it 2.06e+15× worse than it fits the identification log (1.11e+15 % against 0.54 %)" in astray.text
     (ordinary,) = validation_findings("validation", 12.3, 2.74, prediction_spread=None, fit_spread=None, label="dynid WLS")
     assert "predicts it 4.5× worse than it fits" in ordinary.text
+    (large,) = validation_findings("validation", 2980.0, 1.0055, prediction_spread=None, fit_spread=None, label="dynid WLS")
+    assert "predicts it 2964× worse than it fits" in large.text  # the Med7's 60-63 s window said "2963.8×"
 
 
 def test_a_weakly_excited_parameter_suggests_the_sdp_only_where_it_is_not_run():

@@ -462,7 +462,8 @@ def validation_findings(name: str, global_error: float, fit_error: float, *, pre
                                "identify on a log that covers this motion", j))
     if np.isfinite(global_error) and fit_error > 0 and global_error > 3 * fit_error:
         times = global_error / fit_error
-        shown = f"{times:.1f}" if times < 1e4 else f"{times:.3g}"  # not 13696171289551554.0 (an estimate gone astray)
+        # 4.5, 2964 (not 2963.8), 1.37e+16 (not 13696171289551554.0: an estimate gone astray)
+        shown = f"{times:.1f}" if times < 10 else f"{times:.0f}" if times < 1e4 else f"{times:.3g}"
         out.append(Finding("validation", f"{name}: {label} predicts it {shown}× worse than it fits the "
                            f"identification log ({global_error:.3g} % against {fit_error:.3g} %): over-fitting, "
                            "extrapolation or a model that misses something this motion shows"))
