@@ -14,7 +14,7 @@ INLINE = 80
 
 def short_value(value) -> str:
     """A value as a record's repr shows it: an array by its shape, a number, a short string or a short sequence as
-    itself, a record by its short repr, anything longer by its type and length.
+    itself, a record by its short repr, a long string by its beginning, anything longer by its type and length.
 
     Parameters
     ----------
@@ -34,7 +34,9 @@ def short_value(value) -> str:
     text = repr(value) if not _is_record(value) else short_repr_of(value)
     if len(text) <= INLINE:
         return text
-    if isinstance(value, (list, tuple, dict, set, frozenset, str)):
+    if isinstance(value, str):  # its beginning, which names it
+        return repr(value[:INLINE - 8] + "...")
+    if isinstance(value, (list, tuple, dict, set, frozenset)):
         kinds = sorted({type(v).__name__ for v in (value.values() if isinstance(value, dict) else value)})
         return f"<{type(value).__name__} of {len(value)}{' ' + kinds[0] if len(kinds) == 1 else ''}>"
     return f"<{type(value).__name__}>"

@@ -570,8 +570,8 @@ def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name:
     Parameters
     ----------
     robot : Robot, str or Path
-        E.g. :func:`dynid.load_robot`.
-        A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
+        E.g. :func:`dynid.load_robot`; a built-in robot's name or a description's path is loaded
+        (:func:`dynid.model.loading.as_robot`).
     t : (N,) array [s]
         Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step,
         as the log readers do (with a warning).

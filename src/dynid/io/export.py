@@ -296,9 +296,8 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
 
     Parameters
     ----------
-    robot : Robot, str or Path
-        The robot's description the results were identified for (a built-in robot's name or a description's path is
-        loaded: :func:`dynid.model.loading.as_robot`).
+    robot : Robot
+        The robot's description the results were identified for.
     results : dict
         A parsed ``results.json`` of ``dynid identify``.
     source : str
@@ -418,8 +417,9 @@ def urdf_from_results(robot: Robot | str | Path, results: dict, *, source: str =
 
     Parameters
     ----------
-    robot : Robot
-        The robot's description the results were identified for.
+    robot : Robot, str or Path
+        The robot's description the results were identified for (a built-in robot's name or a description's path is
+        loaded: :func:`dynid.model.loading.as_robot`).
     results : dict
         A parsed ``results.json`` of ``dynid identify``.
     source : str

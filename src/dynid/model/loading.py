@@ -1,4 +1,4 @@
-"""A robot as the functions of dynid take it: a :class:`~dynid.model.robot.Robot`, a built-in robot's name or a
+"""A robot as dynid's entry points take it: a :class:`~dynid.model.robot.Robot`, a built-in robot's name or a
 description's path (what :class:`dynid.Identifier` takes too)."""
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ __all__ = ["as_robot"]
 
 def as_robot(robot, what: str = "robot") -> Robot:
     """A robot given as a :class:`Robot`, a built-in name or a description's path
-    (:func:`dynid.model.description.load_robot`), as every function of dynid that takes a robot accepts it.
+    (:func:`dynid.model.description.load_robot`), as dynid's entry points take it (``Identifier``, ``simulated_log``,
+    ``regressor``, ``load_recording``, the exports …; lower-level functions take a :class:`Robot`).
 
     Parameters
     ----------
