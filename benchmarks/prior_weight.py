@@ -65,11 +65,12 @@ def _sdp(w, tau, layout, prior, weight, kind):
         _reduced_least_squares,
         _solve,
     )
+    from dynid.estimators.problem import FitData
 
     links, nonneg = layout
     if kind != "scaled":
-        return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=prior, prior_weight=weight,
-                                                prior_kind="euclidean" if kind == "sdp" else kind).fit(w, tau).params_
+        return PhysicallyConsistentLeastSquares(prior_weight=weight, prior_kind="euclidean" if kind == "sdp" else kind).fit(
+            w, tau, problem=FitData(layout=(links, nonneg), prior=prior)).params_
     m = w.shape[0]
     r, z = _reduced_least_squares(w / np.sqrt(m), tau / np.sqrt(m))
     d = np.sqrt(np.sum(r**2, axis=0)) + 1e-9

@@ -75,6 +75,7 @@ def collect(name: str, tag: str, window, folder: Path) -> None:
     from dynid.dynamics.layout import consistency_layout
     from dynid.estimators.accumulate import LeastSquaresAccumulator
     from dynid.estimators.physically_consistent import PhysicallyConsistentLeastSquares
+    from dynid.estimators.problem import FitData
     from dynid.identification.drive_only import drive_only
     from dynid.identification.estimates import DRIVE_ONLY_LABEL, SDP_LABEL
     from dynid.identification.identify import one_way_joints
@@ -123,8 +124,8 @@ def collect(name: str, tag: str, window, folder: Path) -> None:
         rest_s = LeastSquaresAccumulator.merged([a for i, a in enumerate(std_f) if i != k])
         sol = rest_b.solve(joint_weights=weights, prior=beta_nom)
         reduced = rest_s.reduced(weights)
-        est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters())
-        est.fit(reduced[:, :p], reduced[:, p])
+        est = PhysicallyConsistentLeastSquares()
+        est.fit(reduced[:, :p], reduced[:, p], problem=FitData(layout=(links, nonneg), prior=robot.standard_parameters()))
         fitted = drive_only(robot, base, rest_b, joint_weights=weights, one_way=one_way,
                             variants=tuple((f, LeastSquaresAccumulator.merged([a for i, a in enumerate(accs) if i != k]))
                                            for f, accs in variants))

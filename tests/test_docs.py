@@ -3,6 +3,7 @@
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
@@ -50,7 +51,10 @@ def test_the_extending_pages_python_runs(tmp_path, monkeypatch, capsys):
     sweep = {float(a): float(v) for a, v in (line.split() for line in out[5:7])}  # an object per value, one key
     assert sweep[1e-9] == pytest.approx(ridge, rel=1e-9) and abs(sweep[1e-3] - ridge) > 1e-4 * abs(ridge)
     assert "'sdp': {" in out[7] and "'prior_kind': 'geometric'" in out[7]
-    assert out[8] == "central differences, no filter"
+    robot, alone = namespace["robot"], namespace["alone"]  # the problem comes to fit: the prior the ridge pulls toward
+    assert np.isfinite(float(out[8])) and out[9] == f"({robot.n_params},) ({robot.n_params},)"
+    np.testing.assert_array_equal(alone.problem_.prior, robot.standard_parameters())
+    assert out[10] == "central differences, no filter"
 
 
 def test_every_page_of_the_site_is_in_its_navigation():

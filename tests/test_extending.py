@@ -104,16 +104,18 @@ def test_a_missing_optional_dependency_names_the_extra(monkeypatch, tmp_path):
     assert result.stderr.strip() == 'error: dynid montecarlo needs distributed, which is not installed: pip install "dynid[montecarlo]"'
 
 
-def test_a_plugin_gets_the_prior_it_documents_whatever_else_is_listed(tmp_path):
+@pytest.mark.parametrize("key, cls", [("prior_probe_test", "PriorProbe"), ("prior_probe_legacy_test", "LegacyPriorProbe")])
+def test_a_plugin_gets_the_prior_it_documents_whatever_else_is_listed(tmp_path, key, cls):
     """A plugin estimator asking for ``prior`` got None unless ``sdp`` was also listed (a "ridge toward the nominal
     values" then shrank toward zero): it gets the robot file's standard parameters (physically consistent) either
-    way."""
+    way, in the problem given to its ``fit`` or, written before ``fit`` took the problem, in its constructor."""
     import tests.plugins.prior_probe as probe
 
     cfg, _ = simulated_case(tmp_path, "er16", 100.0, "fourier", duration=8.0)
-    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "prior_probe_test"]'))
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', f'estimators = ["wls", "{key}"]'))
     config = load_identification_config(cfg)
-    probe.PriorProbe.seen.clear()
+    seen = getattr(probe, cls).seen
+    seen.clear()
     run_identification(config, validate=False)
-    assert probe.PriorProbe.seen and probe.PriorProbe.seen[-1] is not None
-    np.testing.assert_allclose(probe.PriorProbe.seen[-1], config.robot.physical_prior()[0], rtol=1e-12)
+    assert seen and seen[-1] is not None
+    np.testing.assert_allclose(seen[-1], config.robot.physical_prior()[0], rtol=1e-12)

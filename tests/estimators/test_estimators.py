@@ -6,6 +6,7 @@ from dynid.dynamics.regressor import observation_matrix
 from dynid.estimators import (
     BeeColonyEstimator,
     DifferentialEvolutionEstimator,
+    FitData,
     IterativelyReweightedLeastSquares,
     OrdinaryLeastSquares,
     ParticleSwarmEstimator,
@@ -29,22 +30,32 @@ def problem():
 
 
 def make(kind, beta):
+    """An unfitted estimator of ``kind`` with its hyper-parameters only (what it sees of the problem: :func:`given`)."""
     from dynid.estimators import LeastAbsoluteDeviations, WeightedLeastSquares
 
     if kind == "ols":
         return OrdinaryLeastSquares()
     if kind == "wls":
-        return WeightedLeastSquares(n_dof=3)
+        return WeightedLeastSquares()
     if kind == "lad":
-        return LeastAbsoluteDeviations(n_dof=3)
+        return LeastAbsoluteDeviations()
     if kind == "irls":
-        return IterativelyReweightedLeastSquares(n_dof=3)
-    bounds = np.stack([beta - 1.0, beta + 1.0], axis=1)
+        return IterativelyReweightedLeastSquares()
     if kind == "de":
-        return DifferentialEvolutionEstimator(bounds=bounds, n_dof=3, popsize=2, maxiter=5, rng=0)
+        return DifferentialEvolutionEstimator(popsize=2, maxiter=5, rng=0)
     if kind == "pso":
-        return ParticleSwarmEstimator(bounds=bounds, n_dof=3, maxiter=5, rng=0)
-    return BeeColonyEstimator(bounds=bounds, n_dof=3, maxiter=5, rng=0)
+        return ParticleSwarmEstimator(maxiter=5, rng=0)
+    return BeeColonyEstimator(maxiter=5, rng=0)
+
+
+def given(kind, beta, n_dof=3):
+    """The problem ``make(kind, beta)`` is fitted on: the joints per sample, and a box around ``beta`` for a search."""
+    return FitData(n_dof=n_dof, bounds=np.stack([beta - 1.0, beta + 1.0], axis=1) if kind in BOX_SEARCHES else None)
+
+
+PROBLEM_NAMES = {"n_dof", "bounds", "weights", "prior", "links", "nonnegative", "joint_weights", "base_prior",
+                 "base_prior_std", "prior_std", "layout"}
+"""What an estimator sees of the problem: never its hyper-parameters (issue "Parts carry their settings", item 1)."""
 
 
 BOX_SEARCHES = ["abc", "de", "pso"]
@@ -58,28 +69,28 @@ def standard_problem():
 
     robot = load_robot("er16").submodel(3)
     q, dq, ddq = random_states(np.random.default_rng(6), 400, 3)
-    links, nonneg = consistency_layout(robot)
-    return (observation_matrix(robot, q, dq, ddq), robot.standard_parameters(),
-            lambda: PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters()))
+    return (observation_matrix(robot, q, dq, ddq), robot.standard_parameters(), PhysicallyConsistentLeastSquares,
+            FitData(layout=consistency_layout(robot), prior=robot.standard_parameters()))
 
 
 @pytest.mark.parametrize("kind", ["ols", "wls", "lad", "irls", *BOX_SEARCHES, "sdp"])
 def test_shared_contract(problem, standard_problem, kind):
     if kind == "sdp":
-        w, beta, factory = standard_problem
+        w, beta, factory, seen = standard_problem
         est = factory()
     else:
         w, beta = problem
-        est = make(kind, beta)
+        est, seen = make(kind, beta), given(kind, beta)
     with pytest.raises(AttributeError, match="not fitted"):
         est.predict(w)
-    assert est.fit(w, w @ beta) is est
+    assert not PROBLEM_NAMES & set(est.get_params())  # the problem comes to fit
+    assert est.fit(w, w @ beta, problem=seen) is est
     assert est.params_.shape == beta.shape
     assert est.predict(w).shape == (w.shape[0],)
     assert est.score(w, w @ beta) <= 1.0
     assert est.score(w, est.predict(w)) == pytest.approx(1.0)  # R² of a perfect prediction
     with pytest.raises(ShapeError):
-        est.fit(w, (w @ beta)[:-1])
+        est.fit(w, (w @ beta)[:-1], problem=seen)
     # scikit-learn contract: hyper-parameters only, a clone is unfitted and refits to the same result
     twin = est.clone()
     assert type(twin) is type(est) and not hasattr(twin, "params_")
@@ -95,26 +106,26 @@ def test_an_estimators_repr_names_what_differs_from_its_defaults():
     from dynid.estimators import BeeColonyEstimator, PhysicallyConsistentLeastSquares
 
     assert repr(PhysicallyConsistentLeastSquares(prior_kind="geometric")) == "PhysicallyConsistentLeastSquares(prior_kind='geometric')"
-    assert repr(BeeColonyEstimator(bounds=np.zeros((3, 2)), colony_size=60)) == \
-        "BeeColonyEstimator(bounds=<array (3, 2)>, colony_size=60)"
+    assert repr(BeeColonyEstimator(colony_size=60, rng=np.arange(3))) == "BeeColonyEstimator(colony_size=60, rng=<array (3,)>)"
     assert repr(OrdinaryLeastSquares()) == "OrdinaryLeastSquares()"
     w, tau = np.eye(6), np.ones(6)
-    with pytest.raises(ShapeError, match=r"BeeColonyEstimator: bounds, the search box of shape \(6, 2\), is needed"):
-        BeeColonyEstimator(n_dof=1).fit(w, tau)
-    with pytest.raises(ShapeError, match="PhysicallyConsistentLeastSquares: links, the columns of each link"):
+    with pytest.raises(ShapeError, match=r"BeeColonyEstimator: the search box \(problem=FitData\(bounds=...\), of shape \(6, 2\)\)"):
+        BeeColonyEstimator().fit(w, tau, problem=FitData(n_dof=1))
+    with pytest.raises(ShapeError, match=r"PhysicallyConsistentLeastSquares: the parameter layout \(problem=FitData\(layout="):
         PhysicallyConsistentLeastSquares().fit(w, tau)
+    with pytest.raises(TypeError, match="problem is a dynid.estimators.FitData"):
+        OrdinaryLeastSquares().fit(w, tau, problem={"n_dof": 1})
 
 
 @pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
 def test_n_dof_is_inferred_from_tau_given_per_joint(problem, kind):
     w, beta = problem
-    given = make(kind, beta).fit(w, w @ beta)
-    inferred = make(kind, beta).set_params(n_dof=None)
-    inferred.fit(w, (w @ beta).reshape(-1, 3))
+    stated = make(kind, beta).fit(w, w @ beta, problem=given(kind, beta))
+    inferred = make(kind, beta).fit(w, (w @ beta).reshape(-1, 3), problem=given(kind, beta, n_dof=None))
     assert inferred.n_dof_ == 3
-    np.testing.assert_allclose(inferred.params_, given.params_, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(inferred.params_, stated.params_, rtol=1e-9, atol=1e-12)
     with pytest.raises(ShapeError, match=r"pass tau as \(N, n_dof\) or set n_dof"):
-        make(kind, beta).set_params(n_dof=None).fit(w, w @ beta)
+        make(kind, beta).fit(w, w @ beta, problem=given(kind, beta, n_dof=None))
 
 
 def test_ols_recovers_truth_exactly_from_noise_free_data(problem):
@@ -148,13 +159,14 @@ def test_paper_objective_is_eq9():
 def test_abc_never_worse_than_its_start_and_is_seeded(problem):
     w, beta = problem
     tau = w @ beta
-    a = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=30, rng=3).fit(w, tau)
-    b = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=30, rng=3).fit(w, tau)
+    box = FitData(n_dof=3, bounds=np.stack([beta - 2, beta + 2], 1))
+    a = BeeColonyEstimator(maxiter=30, rng=3).fit(w, tau, problem=box)
+    b = BeeColonyEstimator(maxiter=30, rng=3).fit(w, tau, problem=box)
     np.testing.assert_array_equal(a.params_, b.params_)
     assert a.objective_ == pytest.approx(paper_objective(tau - w @ a.params_, 3))
     assert a.history_[-1] < a.history_[0]
     with pytest.raises(ShapeError, match="bounds"):
-        BeeColonyEstimator(bounds=[(0, 1)], n_dof=3).fit(w, tau)
+        BeeColonyEstimator().fit(w, tau, problem=FitData(n_dof=3, bounds=[(0, 1)]))
 
 
 def _primal_lad(w, tau, n_dof, bounds=None):
@@ -176,7 +188,7 @@ def test_lad_matches_primal_linear_program(rng, bounded):
     w = rng.normal(size=(120, 4))
     tau = w @ np.array([1.0, -2.0, 0.5, 3.0]) + rng.standard_t(2, 120)
     bounds = np.array([[-5, 5], [-1.5, 0], [0, 1], [-5, 2.5]]) if bounded else None
-    lad = LeastAbsoluteDeviations(n_dof=3, bounds=bounds).fit(w, tau)
+    lad = LeastAbsoluteDeviations().fit(w, tau, problem=FitData(n_dof=3, bounds=bounds))
     assert lad.objective_ == pytest.approx(_primal_lad(w, tau, 3, bounds), rel=1e-6)
     if bounded:
         assert np.all(lad.params_ >= bounds[:, 0]) and np.all(lad.params_ <= bounds[:, 1])
@@ -191,10 +203,10 @@ def test_lad_objective_never_above_box_searches(problem, kind):
     rng = np.random.default_rng(8)
     tau = w @ beta + rng.normal(0, 1.0, w.shape[0])
     bounds = np.stack([beta - 3, beta + 3], 1)
-    lad = LeastAbsoluteDeviations(n_dof=3, bounds=bounds).fit(w, tau)
+    lad = LeastAbsoluteDeviations().fit(w, tau, problem=FitData(n_dof=3, bounds=bounds))
     cls = {"abc": BeeColonyEstimator, "de": DifferentialEvolutionEstimator, "pso": ParticleSwarmEstimator}[kind]
     for seed in range(3):
-        est = cls(bounds=bounds, n_dof=3, maxiter=20, rng=seed).fit(w, tau)
+        est = cls(maxiter=20, rng=seed).fit(w, tau, problem=FitData(n_dof=3, bounds=bounds))
         assert lad.objective_ <= est.objective_ + 1e-9
         assert est.objective_ == pytest.approx(paper_objective(tau - w @ est.params_, 3))
 
@@ -203,7 +215,7 @@ def test_lad_objective_never_above_box_searches(problem, kind):
 def test_box_searches_are_seeded_and_improve(problem, kind):
     w, beta = problem
     tau = w @ beta
-    a, b = make(kind, beta).fit(w, tau), make(kind, beta).fit(w, tau)
+    a, b = (make(kind, beta).fit(w, tau, problem=given(kind, beta)) for _ in range(2))
     np.testing.assert_array_equal(a.params_, b.params_)
     assert a.n_evaluations_ > 0 and a.history_[-1] <= a.history_[0]
     population = {"abc": None, "de": 2 * beta.size, "pso": 30}[kind]
@@ -219,10 +231,10 @@ def test_box_searches_approach_the_minimum_with_budget(problem):
     w, beta = problem
     tau = w @ beta + np.random.default_rng(4).normal(0, 0.5, w.shape[0])
     bounds = np.stack([beta - 0.5, beta + 0.5], 1)
-    f_lad = LeastAbsoluteDeviations(n_dof=3, bounds=bounds).fit(w, tau).objective_
+    f_lad = LeastAbsoluteDeviations().fit(w, tau, problem=FitData(n_dof=3, bounds=bounds)).objective_
     f_start = paper_objective(tau - w @ bounds.mean(axis=1), 3)
-    de = DifferentialEvolutionEstimator(bounds=bounds, n_dof=3, popsize=5, maxiter=400, rng=1).fit(w, tau)
-    pso = ParticleSwarmEstimator(bounds=bounds, n_dof=3, swarm_size=40, maxiter=500, rng=1).fit(w, tau)
+    de = DifferentialEvolutionEstimator(popsize=5, maxiter=400, rng=1).fit(w, tau, problem=FitData(n_dof=3, bounds=bounds))
+    pso = ParticleSwarmEstimator(swarm_size=40, maxiter=500, rng=1).fit(w, tau, problem=FitData(n_dof=3, bounds=bounds))
     for est in (de, pso):
         assert est.objective_ - f_lad < 0.1 * (f_start - f_lad)
 
@@ -234,11 +246,11 @@ def test_irls_ignores_outliers_that_pull_ols(problem):
     spikes = rng.choice(w.shape[0], w.shape[0] // 20, replace=False)
     tau[spikes] += rng.choice([-1, 1], spikes.size) * 40.0
     ols = OrdinaryLeastSquares().fit(w, tau)
-    irls = IterativelyReweightedLeastSquares(n_dof=3).fit(w, tau)
+    irls = IterativelyReweightedLeastSquares().fit(w, tau, problem=FitData(n_dof=3))
     assert irls.converged_
     assert np.linalg.norm(irls.params_ - beta) < 0.2 * np.linalg.norm(ols.params_ - beta)
     assert np.median(irls.row_weights_[spikes]) < 0.1
-    clean = IterativelyReweightedLeastSquares(n_dof=3).fit(w, w @ beta + rng.normal(0, 0.5, w.shape[0]))
+    clean = IterativelyReweightedLeastSquares().fit(w, w @ beta + rng.normal(0, 0.5, w.shape[0]), problem=FitData(n_dof=3))
     np.testing.assert_allclose(clean.joint_scale_, 0.5, rtol=0.15)
 
 
@@ -246,7 +258,7 @@ def test_irls_covariance_matches_spread_over_realisations(problem):
     """Huber's sandwich covariance predicts the scatter of IRLS estimates over noise realisations."""
     w, beta = problem
     rng = np.random.default_rng(13)
-    fits = [IterativelyReweightedLeastSquares(n_dof=3).fit(w, w @ beta + rng.standard_t(3, w.shape[0]))
+    fits = [IterativelyReweightedLeastSquares().fit(w, w @ beta + rng.standard_t(3, w.shape[0]), problem=FitData(n_dof=3))
             for _ in range(60)]
     spread = np.std([f.params_ for f in fits], axis=0, ddof=1)
     predicted = np.mean([f.params_std_ for f in fits], axis=0)
@@ -309,19 +321,19 @@ def test_wls_recovers_truth_and_weights_joints(problem):
     w, beta = problem
     rng = np.random.default_rng(9)
     noise = rng.normal(0, 1.0, (w.shape[0] // 3, 3)) * np.array([0.5, 5.0, 1.0])
-    wls = WeightedLeastSquares(n_dof=3).fit(w, w @ beta + noise.ravel())
+    wls = WeightedLeastSquares().fit(w, w @ beta + noise.ravel(), problem=FitData(n_dof=3))
     np.testing.assert_allclose(wls.joint_std_, [0.5, 5.0, 1.0], rtol=0.25)  # first-step OLS residuals leak noise across joints
     assert np.argsort(wls.joint_std_).tolist() == [0, 2, 1]
     z = np.abs(wls.params_ - beta) / wls.params_std_
     assert np.all(z < 4.5)
-    np.testing.assert_allclose(WeightedLeastSquares(n_dof=3).fit(w, w @ beta).params_, beta, rtol=1e-8, atol=1e-8)
+    np.testing.assert_allclose(WeightedLeastSquares().fit(w, w @ beta, problem=FitData(n_dof=3)).params_, beta, rtol=1e-8, atol=1e-8)
 
 
 @pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
 def test_rows_must_be_whole_samples(problem, kind):
     w, beta = problem
     with pytest.raises(ShapeError, match="multiple of n_dof"):
-        make(kind, beta).fit(w[:-1], (w @ beta)[:-1])
+        make(kind, beta).fit(w[:-1], (w @ beta)[:-1], problem=given(kind, beta))
 
 
 @pytest.mark.parametrize("kind", ["ols", "wls"])
@@ -338,9 +350,8 @@ def test_bootstrap_by_weighted_grams_equals_refitting_each_resample(problem, kin
 
     w, beta = problem
     tau = w @ beta + np.random.default_rng(4).normal(0, 1.0, w.shape[0])
-    args = {} if kind == "ols" else {"n_dof": 3}
-    fast = bootstrap_intervals(lambda: base_cls(**args), w, tau, 3, n_resamples=20, block_length=7, rng=5)
-    slow = bootstrap_intervals(lambda: Refit(**args), w, tau, 3, n_resamples=20, block_length=7, rng=5)
+    fast = bootstrap_intervals(base_cls, w, tau, 3, n_resamples=20, block_length=7, rng=5)  # the problem: n_dof = 3
+    slow = bootstrap_intervals(Refit, w, tau, 3, n_resamples=20, block_length=7, rng=5)
     np.testing.assert_allclose(fast.samples, slow.samples, rtol=1e-9, atol=1e-9 * np.abs(beta).max())
 
 
@@ -366,10 +377,10 @@ def test_a_fitted_estimator_summarises_what_it_learned(problem):
     """summary() works on every estimator, fitted or not (issue "Parts carry their settings, one route", item 6):
     before fit it says so; after, it gives each learned attribute (an array by its shape and range)."""
     w, beta = problem
-    est = BeeColonyEstimator(bounds=np.stack([beta - 2, beta + 2], 1), n_dof=3, maxiter=12, rng=3)
+    est = BeeColonyEstimator(maxiter=12, rng=3)
     before = est.summary()
     assert before.splitlines()[0] == repr(est) and before.endswith("not fitted yet: call fit(W, tau)")
-    after = est.fit(w, w @ beta).summary().splitlines()
+    after = est.fit(w, w @ beta, problem=FitData(n_dof=3, bounds=np.stack([beta - 2, beta + 2], 1))).summary().splitlines()
     learned = dict(line.strip().split(": ", 1) for line in after[1:])
     assert learned["history_"].startswith(f"array ({len(est.history_)},) from ") and learned["objective_"] == f"{est.objective_:.6g}"
     assert learned["params_"] == f"array ({beta.size},) from {est.params_.min():.4g} to {est.params_.max():.4g}"

@@ -5,6 +5,7 @@ import pytest
 
 from dynid.estimators import least_absolute as la
 from dynid.estimators.base import paper_objective
+from dynid.estimators.problem import FitData
 
 
 def _problem(m=30_000, p=8, n_dof=2, seed=0):
@@ -32,7 +33,7 @@ def test_banded_lad_equals_the_lp_on_every_row(monkeypatch, band):
     calls = []
     real = la._dual_lp
     monkeypatch.setattr(la, "_dual_lp", lambda *a, **k: calls.append(k["rows"].size) or real(*a, **k))
-    est = la.LeastAbsoluteDeviations(n_dof=n_dof, bounds=bounds).fit(w, tau)
+    est = la.LeastAbsoluteDeviations().fit(w, tau, problem=FitData(n_dof=n_dof, bounds=bounds))
     if band > 1:
         assert max(calls) < w.shape[0] // 2  # it solved on a band, not on every row
     else:

@@ -7,6 +7,7 @@ from dynid.dynamics.layout import consistency_layout
 from dynid.dynamics.regressor import observation_matrix
 from dynid.dynamics.rnea import rnea_torques
 from dynid.estimators.physically_consistent import PhysicallyConsistentLeastSquares
+from dynid.estimators.problem import FitData
 from dynid.model.description import load_robot
 from dynid.model.spatial import is_physically_consistent, pseudo_inertia
 
@@ -35,7 +36,7 @@ def test_sdp_is_physically_consistent_and_recovers_the_base_parameters(rng):
     links, nonneg = consistency_layout(robot)
     assert [robot.parameter_names[k] for k in nonneg][:2] == ["fc1", "fv1"]
     prior = robot.standard_parameters() * rng.uniform(0.7, 1.3, robot.n_params)  # a rough CAD guess
-    est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=prior).fit(w, tau)
+    est = PhysicallyConsistentLeastSquares().fit(w, tau, problem=FitData(layout=(links, nonneg), prior=prior))
     for idx in links:
         assert is_physically_consistent(est.params_[idx], tol=1e-7)
     assert np.all(est.params_[nonneg] >= -1e-9)
@@ -51,7 +52,7 @@ def test_constraints_bind_when_the_data_ask_for_negative_friction(rng):
     drive[1, robot.drive_terms.index("fv")] = -3.0
     w, tau = _data(robot.with_parameters(np.concatenate([np.concatenate([robot.inertial, drive], 1).ravel()])), rng, noise=0.0)
     links, nonneg = consistency_layout(robot)
-    est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters()).fit(w, tau)
+    est = PhysicallyConsistentLeastSquares().fit(w, tau, problem=FitData(layout=(links, nonneg), prior=robot.standard_parameters()))
     assert abs(est.params_[robot.parameter_names.index("fv2")]) < 1e-6
     assert est.pseudo_inertia_min_eig_.min() >= -1e-7
 

@@ -3,7 +3,7 @@ same candidates and return the same parameters however the rows are blocked."""
 
 import numpy as np
 
-from dynid.estimators import DifferentialEvolutionEstimator, ParticleSwarmEstimator
+from dynid.estimators import DifferentialEvolutionEstimator, FitData, ParticleSwarmEstimator
 from dynid.estimators.base import LinearAbsoluteObjective, paper_objective
 
 
@@ -29,8 +29,9 @@ def test_de_and_pso_do_not_depend_on_the_blocking(monkeypatch):
     results = []
     for block in (10**9, 1000):  # one block (the plain formula's order of operations), then nine
         monkeypatch.setattr(LinearAbsoluteObjective, "BLOCK", block)
-        de = DifferentialEvolutionEstimator(bounds=bounds, n_dof=n, popsize=3, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau)
-        pso = ParticleSwarmEstimator(bounds=bounds, n_dof=n, swarm_size=12, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau)
+        box = FitData(n_dof=n, bounds=bounds)
+        de = DifferentialEvolutionEstimator(popsize=3, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau, problem=box)
+        pso = ParticleSwarmEstimator(swarm_size=12, maxiter=30, rng=np.random.default_rng(4)).fit(w, tau, problem=box)
         results.append((de.params_, pso.params_))
     for a, b in zip(*results):
         np.testing.assert_allclose(a, b, rtol=1e-12)

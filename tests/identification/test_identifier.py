@@ -229,7 +229,7 @@ def test_an_estimator_object_carries_its_hyperparameters_through_the_identifier(
     euclidean = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", "sdp"))
     np.testing.assert_array_equal(geometric, direct.estimates["dynid SDP"].params)
     assert not np.array_equal(geometric, euclidean.estimates["dynid SDP"].params)
-    assert sdp.links is None and sdp.prior is None  # the object given is not filled in
+    assert not hasattr(sdp, "problem_") and not hasattr(sdp, "params_")  # the object given is not fitted itself
     with pytest.raises(ConfigError, match="identify_from_arrays: unknown setting 'sdp_prior'; expected one of controller, "
                                           "estimators, friction, preprocessing, rng"):
         identify_from_arrays(robot, log.t, log.q, log.tau, sdp_prior="geometric")

@@ -10,6 +10,7 @@ from .._util.hyperparameters import HyperParameters
 from .._util.reprs import short_value
 from ..exceptions import NotFittedError, ShapeError
 from .accumulate import LeastSquaresAccumulator
+from .problem import FitData
 
 
 def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -259,17 +260,46 @@ class ShiftedResidual:
 
 
 class Estimator(HyperParameters):
-    """Base class (scikit-learn contract): ``fit(W, tau)`` sets ``params_`` and returns self; ``predict(W)``;
-    ``score``; ``get_params``, ``set_params`` and ``clone``.
+    """Base class (scikit-learn contract): ``fit(W, tau, sample_weight=None, *, problem=None)`` sets ``params_`` and
+    returns self; ``predict(W)``; ``score``; ``get_params``, ``set_params`` and ``clone``.
 
-    Subclasses store only keyword hyper-parameters in ``__init__`` and set learned attributes
-    ending in ``_``. Those that split rows by joint take ``n_dof=None`` and infer it in ``fit`` from
-    ``tau`` given as (N, n_dof) (attribute ``n_dof_``).
+    Subclasses store only keyword hyper-parameters in ``__init__`` (budgets, the prior's kind and weight, ``rng``) and
+    set learned attributes ending in ``_``. What depends on the data comes to ``fit`` as ``problem``
+    (:class:`~dynid.estimators.problem.FitData`: the joints per sample, the search box, eq. 9's weights, the prior, the
+    parameter layout); each subclass names the fields it reads in :attr:`PROBLEM_FIELDS` and keeps them as
+    ``problem_``. The joints per sample are inferred from ``tau`` given as (N, n_dof) when the problem does not state
+    them (attribute ``n_dof_``).
     """
 
     params_: np.ndarray
     PARAMETER_KINDS = frozenset({inspect.Parameter.KEYWORD_ONLY})
     """Only the keyword hyper-parameters are parameters (a plugin's positional arguments are not)."""
+    PROBLEM_FIELDS: tuple[str, ...] = ()
+    """The fields of :class:`~dynid.estimators.problem.FitData` this estimator reads in ``fit`` (``problem=``)."""
+
+    def take_problem(self, problem) -> FitData:
+        """Keep the fields of ``problem`` this estimator reads (:attr:`PROBLEM_FIELDS`) as ``problem_`` and return it.
+
+        Parameters
+        ----------
+        problem : FitData or None
+            None: nothing stated (every field None).
+
+        Returns
+        -------
+        FitData
+
+        Raises
+        ------
+        TypeError
+            ``problem`` is not a FitData.
+        """
+        if problem is not None and not isinstance(problem, FitData):
+            raise TypeError(f"{type(self).__name__}.fit: problem is a dynid.estimators.FitData (the joints, search "
+                            f"box, weights, prior and layout), got {type(problem).__name__}")
+        kept = {} if problem is None else {name: getattr(problem, name) for name in self.PROBLEM_FIELDS}
+        self.problem_ = FitData(**kept)
+        return self.problem_
 
     def clone(self) -> Estimator:
         """An unfitted estimator with the same hyper-parameters.
@@ -283,7 +313,7 @@ class Estimator(HyperParameters):
     loss_power = 0.5
     """How ``sample_weight`` scales the rows (:func:`weighted_rows`): 0.5 for a squared loss, 1 for eq. 9's absolute one."""
 
-    def fit(self, w, tau, sample_weight=None):  # pragma: no cover - abstract
+    def fit(self, w, tau, sample_weight=None, *, problem=None):  # pragma: no cover - abstract
         """Fit the parameters to an observation matrix and torques (each estimator's own method).
 
         Parameters
@@ -293,6 +323,8 @@ class Estimator(HyperParameters):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row (:func:`weighted_rows`): 2 counts a row twice, 0 leaves it out.
+        problem : FitData, optional
+            What the estimator sees of the problem beside the rows (its :attr:`PROBLEM_FIELDS`; kept as ``problem_``).
 
         Returns
         -------
@@ -367,15 +399,16 @@ class AccumulatingEstimator(Estimator):
     (:class:`dynid.estimators.accumulate.LeastSquaresAccumulator`), and the solution is computed from the factors
     when a learned attribute is first read (or :meth:`solve` is called) after the last ``partial_fit``.
 
-    Subclasses implement ``_solve(accumulator)``, which sets the learned attributes. They take ``n_dof=None``
-    (joints per sample: inferred from ``tau`` given as (N, n_dof), else 1).
+    Subclasses implement ``_solve(accumulator)``, which sets the learned attributes from the rows and ``problem_``
+    (the problem given to the first ``partial_fit``, or to :meth:`solve` when it changed after the rows). The joints per
+    sample are the problem's ``n_dof``, else inferred from ``tau`` given as (N, n_dof), else 1.
     """
 
-    n_dof: int | None = None
+    PROBLEM_FIELDS: tuple[str, ...] = ("n_dof",)
     needs_joints = False
     """Whether the estimator weighs the joints' rows apart (then ``n_dof`` or ``tau`` as (N, n_dof) is required)."""
 
-    def partial_fit(self, w, tau, mask=None, *, names=None, sample_weight=None) -> AccumulatingEstimator:
+    def partial_fit(self, w, tau, mask=None, *, names=None, sample_weight=None, problem=None) -> AccumulatingEstimator:
         """Fold rows into the estimate.
 
         Parameters
@@ -390,6 +423,8 @@ class AccumulatingEstimator(Estimator):
             The parameters' names (said when the data do not excite some of them).
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the squared loss (:func:`weighted_rows`).
+        problem : FitData, optional
+            What the estimator reads of the problem (:attr:`PROBLEM_FIELDS`), kept from the first call that gives it.
 
         Returns
         -------
@@ -404,11 +439,13 @@ class AccumulatingEstimator(Estimator):
         w = np.asarray(w, dtype=np.float64)
         if w.ndim != 2:
             raise ShapeError(f"expected W with shape (N*n_dof, n_params), got {w.shape}")
+        if problem is not None or "problem_" not in self.__dict__:
+            self.take_problem(problem)
         acc = self.__dict__.get("accumulator_")
         if acc is None:
-            shape = np.shape(tau)
-            if self.n_dof is not None or len(shape) == 2 or not self.needs_joints:
-                n = self.n_dof if self.n_dof is not None else (shape[1] if len(shape) == 2 else 1)
+            shape, stated = np.shape(tau), self.problem_.n_dof
+            if stated is not None or len(shape) == 2 or not self.needs_joints:
+                n = stated if stated is not None else (shape[1] if len(shape) == 2 else 1)
             else:
                 n = infer_n_dof(None, tau)  # raises: the rows' joints are needed
             acc = LeastSquaresAccumulator(w.shape[1], n)
@@ -420,7 +457,7 @@ class AccumulatingEstimator(Estimator):
         acc.add(w, tau, mask)
         return self
 
-    def fit(self, w, tau, sample_weight=None):
+    def fit(self, w, tau, sample_weight=None, *, problem=None):
         """Fit on all rows at once: ``partial_fit`` on a fresh accumulator, then :meth:`solve`.
 
         Parameters
@@ -429,19 +466,28 @@ class AccumulatingEstimator(Estimator):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the squared loss (:func:`weighted_rows`).
+        problem : FitData, optional
+            What the estimator reads of the problem (:attr:`PROBLEM_FIELDS`).
 
         Returns
         -------
         self
         """
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
-        w, tau_flat = check_observations(w, tau, self.n_dof)
+        problem = self.take_problem(problem)
+        w, tau_flat = check_observations(w, tau, problem.n_dof)
         self.__dict__.pop("accumulator_", None)
-        self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat)
+        self.partial_fit(w, tau if np.ndim(tau) == 2 else tau_flat, problem=problem)
         return self.solve()
 
-    def solve(self) -> AccumulatingEstimator:
+    def solve(self, *, problem=None) -> AccumulatingEstimator:
         """Compute the learned attributes from the rows folded in so far.
+
+        Parameters
+        ----------
+        problem : FitData, optional
+            The problem as it stands after the rows (e.g. the joint weights of the least-squares reference), in place of
+            the one the rows came with.
 
         Returns
         -------
@@ -455,6 +501,8 @@ class AccumulatingEstimator(Estimator):
         acc = self.__dict__.get("accumulator_")
         if acc is None:
             raise AttributeError(f"{type(self).__name__} has no rows yet: call fit or partial_fit first")
+        if problem is not None:
+            self.take_problem(problem)
         self._solve(acc)
         self.__dict__["_solved"] = True
         return self
@@ -464,7 +512,7 @@ class AccumulatingEstimator(Estimator):
 
     def _forget(self) -> None:
         """Drop the learned attributes of an earlier solution (new rows came)."""
-        keep = {"accumulator_", "n_dof_", "names_in_"}
+        keep = {"accumulator_", "n_dof_", "names_in_", "problem_"}
         for name in [k for k in self.__dict__ if k.endswith("_") and not k.startswith("_") and k not in keep]:
             del self.__dict__[name]
         self.__dict__["_solved"] = False
@@ -482,17 +530,15 @@ class AccumulatingEstimator(Estimator):
 class BoxSearchEstimator(Estimator):
     """Base of the estimators that search a box for the minimum of eq. 9 (ABC, DE, PSO).
 
-    Subclasses set ``bounds`` (p, 2), ``n_dof`` (or None: inferred) and ``weights``, and implement ``_search(objective,
-    bounds)``: the minimum of eq. 9's ``F`` over the box as an ``OptimizeResult`` (``x``, ``fun``, ``nfev``,
-    ``history``).
+    The problem gives the box (``bounds``, (p, 2)), the joints per sample (``n_dof``, or None: inferred) and eq. 9's
+    ``weights``; subclasses implement ``_search(objective, bounds)``: the minimum of eq. 9's ``F`` over the box as an
+    ``OptimizeResult`` (``x``, ``fun``, ``nfev``, ``history``).
     """
 
-    bounds: object
-    n_dof: int | None
-    weights: object
+    PROBLEM_FIELDS = ("n_dof", "bounds", "weights")
     loss_power = 1.0  # eq. 9: sample_weight multiplies each absolute residual
 
-    def fit(self, w, tau, sample_weight=None):
+    def fit(self, w, tau, sample_weight=None, *, problem=None):
         """Search the box for the minimum of eq. 9 (each subclass's search).
 
         Parameters
@@ -502,6 +548,8 @@ class BoxSearchEstimator(Estimator):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`weighted_rows`).
+        problem : FitData
+            Its ``bounds`` (the search box, required), ``n_dof`` and ``weights`` (eq. 9's ``delta``, default 1).
 
         Returns
         -------
@@ -510,9 +558,10 @@ class BoxSearchEstimator(Estimator):
         Raises
         ------
         ShapeError
-            Wrong shapes, or a box that is not (p, 2).
+            Wrong shapes, no box, or a box that is not (p, 2).
         """
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
+        self.take_problem(problem)
         bounds, objective = self._objectives(w, tau)
         self._set_search_result(self._search(objective, bounds))
         return self
@@ -522,16 +571,18 @@ class BoxSearchEstimator(Estimator):
 
     def _objectives(self, w, tau):
         """Checked ``bounds`` (p, 2) and eq. 9 on ``(W, tau)`` as ``F(x)`` for ``x`` (p,) or (p, K) → float or (K,)."""
-        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        problem = self.problem_
+        self.n_dof_ = infer_n_dof(problem.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
-        if self.bounds is None:
-            raise ShapeError(f"{type(self).__name__}: bounds, the search box of shape ({w.shape[1]}, 2), is needed to fit "
-                             "(the identification pipeline builds it around the least-squares estimate)")
-        bounds = np.asarray(self.bounds, dtype=float)
+        if problem.bounds is None:
+            raise ShapeError(f"{type(self).__name__}: the search box (problem=FitData(bounds=...), of shape "
+                             f"({w.shape[1]}, 2)) is needed to fit (the identification pipeline builds it around the "
+                             "least-squares estimate)")
+        bounds = np.asarray(problem.bounds, dtype=float)
         if bounds.shape != (w.shape[1], 2):
             raise ShapeError(f"expected {type(self).__name__} bounds of shape ({w.shape[1]}, 2), got {bounds.shape}")
 
-        return bounds, LinearAbsoluteObjective(w, tau, self.n_dof_, self.weights)
+        return bounds, LinearAbsoluteObjective(w, tau, self.n_dof_, problem.weights)
 
     def _set_search_result(self, res) -> None:
         self.params_ = np.asarray(res.x, dtype=float)

@@ -11,16 +11,12 @@ from .base import BoxSearchEstimator
 class BeeColonyEstimator(BoxSearchEstimator):
     """ABC identification (paper §3.1, eqs. 7-13), defaults from §4.1.
 
+    The search box of the parameters (the paper's Table 3), the joints per sample and eq. 9's ``delta`` come to ``fit``
+    as ``problem=FitData(bounds=..., n_dof=..., weights=...)`` (the identification pipeline builds the box around the
+    least-squares estimate).
+
     Parameters
     ----------
-    bounds : (p, 2) array
-        Search box of the parameters (the paper's Table 3); required to fit (the identification pipeline builds it
-        around the least-squares estimate).
-    n_dof : int or None
-        Joints per sample; None: inferred from tau given as (N, n_dof).
-        Joints per sample in ``W``'s rows, for eq. 9.
-    weights : (n_dof,) array, optional
-        ``delta`` of eq. 9 (default 1).
     colony_size, limit, maxiter : int
         ``Ns = 30``, ``limit = 15``, ``Tmax = 50``.
     rng : Generator or seed
@@ -32,11 +28,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per iteration), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, colony_size: int = 30, limit: int = 15,
+    def __init__(self, *, colony_size: int = 30, limit: int = 15,
                  maxiter: int = 50, rng=None, callback: Callable[[int, float], None] | None = None):
-        self.bounds = bounds
-        self.n_dof = n_dof
-        self.weights = weights
         self.colony_size = colony_size
         self.limit = limit
         self.maxiter = maxiter

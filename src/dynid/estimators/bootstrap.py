@@ -19,6 +19,7 @@ from .._util.reprs import short_repr
 from ..exceptions import ConfigError
 from .base import Estimator, check_observations
 from .least_squares import OrdinaryLeastSquares, WeightedLeastSquares
+from .problem import FitData, with_problem
 
 GRAM_CHUNK = 4096
 """Samples per step when the per-sample Gram matrices are formed."""
@@ -52,7 +53,7 @@ class BootstrapIntervals:
 
 def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: int, *, n_resamples: int = 200,
                         block_length: int | None = None, level: float = 0.95,
-                        rng: np.random.Generator | int | None = None) -> BootstrapIntervals:
+                        rng: np.random.Generator | int | None = None, problem: FitData | None = None) -> BootstrapIntervals:
     """Moving-block bootstrap of an estimator's parameters.
 
     Parameters
@@ -70,6 +71,8 @@ def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: 
     level : float
         Confidence level in (0, 1).
     rng : Generator or seed
+    problem : FitData, optional
+        What each refit sees of the problem (its ``fit``'s ``problem=``); default ``FitData(n_dof=n_dof)``.
 
     Returns
     -------
@@ -99,23 +102,28 @@ def bootstrap_intervals(make_estimator: Callable[[], Estimator], w, tau, n_dof: 
         starts = rng.integers(0, n - length + 1, n_blocks)
         resamples.append((starts[:, None] + np.arange(length)).ravel()[:n])
     template = make_estimator()
+    problem = FitData(n_dof=n_dof) if problem is None else problem
+
+    def refit(est, idx):
+        return est.fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel(), **with_problem(est.fit, problem)).params_
+
     if type(template) in (OrdinaryLeastSquares, WeightedLeastSquares):
-        samples = _least_squares_resamples(template, w3, tau2, resamples, length)
+        samples = _least_squares_resamples(template, w3, tau2, resamples, length, lambda idx: refit(template.clone(), idx))
     else:
-        samples = np.array([make_estimator().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel()).params_
-                            for idx in resamples])
+        samples = np.array([refit(make_estimator(), idx) for idx in resamples])
     alpha = 100 * (1 - level) / 2
     lower, upper = np.percentile(samples, [alpha, 100 - alpha], axis=0)
     return BootstrapIntervals(samples, lower, upper, samples.std(axis=0, ddof=1), level, length)
 
 
-def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resamples, length: int) -> np.ndarray:
+def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resamples, length: int, refit) -> np.ndarray:
     """OLS/WLS refits of every resample without refactorising it. A resample is a sequence of blocks of
     consecutive samples, so each joint's Gram matrix of ``[W | τ]`` is a sum of block Grams, and a block
     Gram is the difference of two prefix sums of the per-sample Grams: ``P[s + L] − P[s]``. Each resample
     then costs one gather of ``2·N/L`` rows instead of a QR of all of its rows. The Cholesky factor of the
     Gram gives the least-squares solution, and the joints' residual sums of squares (the quadratic form of
-    each joint's Gram) give the WLS weights as :class:`WeightedLeastSquares` computes them (to round-off)."""
+    each joint's Gram) give the WLS weights as :class:`WeightedLeastSquares` computes them (to round-off). A resample
+    whose Gram is not numerically positive definite is refitted by ``refit(idx)``."""
     n, n_dof, p = w3.shape
     iu = np.triu_indices(p + 1)
     aug = np.concatenate([w3, tau2[..., None]], axis=2)  # (N, n_dof, p+1)
@@ -141,7 +149,7 @@ def _least_squares_resamples(template, w3: np.ndarray, tau2: np.ndarray, resampl
                 wts = 1.0 / np.where(std > 0, std, 1.0)
                 theta = _gram_solve(np.tensordot(wts**2, g, axes=1), p)
         except np.linalg.LinAlgError:  # not numerically positive definite: refactorise this resample
-            theta = template.clone().fit(w3[idx].reshape(n * n_dof, -1), tau2[idx].ravel()).params_
+            theta = refit(idx)
         out.append(theta)
     return np.array(out)
 

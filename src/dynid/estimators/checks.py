@@ -29,7 +29,7 @@ from .._util.keywords import renamed_keyword, seed_of
 from ..exceptions import DynIdError
 from .base import BoxSearchEstimator, Estimator, paper_objective
 from .fitting import fit_method
-from .problem import FitData, SearchBudget
+from .problem import FitData, SearchBudget, with_problem
 from .registry import _REGISTRY, register, spec
 
 __all__ = ["EstimatorCheckError", "check_estimator"]
@@ -151,14 +151,14 @@ def _check(entry, seed: int, name: str | None = None) -> None:
     else:
         if not isinstance(params_given, dict):
             failures.append("get_params did not return a dict")
-    failures += _sample_weight_failures(first.estimator, w, tau, seed)
+    failures += _sample_weight_failures(first.estimator, w, tau, seed, data)
     if failures:
         raise EstimatorCheckError(f"{said}: " + "; ".join(failures))
 
 
-def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int) -> list[str]:
-    """Refit a clone of ``fitted`` without weights and with weights of one (the same ``rng`` seed, if it has one):
-    the same parameters, or the failure in words."""
+def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int, data: FitData) -> list[str]:
+    """Refit a clone of ``fitted`` on the problem ``data`` without weights and with weights of one (the same ``rng``
+    seed, if it has one): the same parameters, or the failure in words."""
     if "sample_weight" not in inspect.signature(fitted.fit).parameters:
         return ["fit takes no sample_weight: the contract is fit(W, tau, sample_weight=None) (one weight >= 0 per row)"]
     fits = []
@@ -167,7 +167,7 @@ def _sample_weight_failures(fitted, w: np.ndarray, tau: np.ndarray, seed: int) -
         if "rng" in est.get_params():
             est.set_params(rng=np.random.default_rng([seed, 13]))
         try:
-            fits.append(np.asarray(est.fit(w, tau, sample_weight=weights).params_, dtype=float))
+            fits.append(np.asarray(est.fit(w, tau, sample_weight=weights, **with_problem(est.fit, data)).params_, dtype=float))
         except Exception as exc:  # noqa: BLE001  any failure is the check's finding
             return [f"fit(W, tau, sample_weight=...) failed: {type(exc).__name__}: {exc}"]
     if not np.allclose(fits[0], fits[1], rtol=1e-9, atol=1e-12 * (1.0 + np.abs(fits[0]).max())):

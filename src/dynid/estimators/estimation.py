@@ -19,7 +19,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from .base import AccumulatingEstimator
 from .fitting import Fitted, fit_methods, make_estimator
-from .problem import FitData, SearchBudget
+from .problem import FitData, SearchBudget, with_problem
 from .registry import LEAST_SQUARES, _named, parse_estimators, spec
 
 __all__ = ["Estimation", "stream_rows", "stacked_rows"]
@@ -99,15 +99,16 @@ class Estimation:
         t = np.asarray(tau).reshape(-1)
         k = None if keep is None else np.asarray(keep).reshape(-1)
         ws = None if y_standard is None else y_standard.reshape(-1, y_standard.shape[-1])
+        problem = self.problem
         if self.reference_key not in self.streamed:
-            self.reference.partial_fit(w, t, k, names=self.names)
+            self.reference.partial_fit(w, t, k, names=self.names, **with_problem(self.reference.partial_fit, problem))
         for key, est in self.streamed.items():
             if spec(key).space == "standard":
                 if ws is None:
                     raise ValueError(f"estimator {key} estimates standard parameters: pass y_standard")
-                est.partial_fit(ws, t, k)
+                est.partial_fit(ws, t, k, **with_problem(est.partial_fit, problem))
             else:
-                est.partial_fit(w, t, k, names=self.names)
+                est.partial_fit(w, t, k, names=self.names, **with_problem(est.partial_fit, problem))
         if self._stack_base or self._stack_standard:
             kk = np.ones(t.shape, dtype=bool) if k is None else k
             self._tau.append(t * kk)
@@ -180,19 +181,13 @@ class Estimation:
         """
         w, tau = self.rows()
         ws = np.concatenate(self._ws) if self._ws else None
-        data = replace(self.problem, w_base=w, tau=tau, bounds=box, w_standard=ws, joint_weights=joint_weights)
+        data = replace(self.problem, w_base=w, tau=tau, bounds=box, w_standard=ws,
+                       joint_weights=self.problem.joint_weights if joint_weights is None else joint_weights)
         chosen = self.keys if keys is None else tuple(keys)
         for key in chosen:
             if spec(key).needs_box and box is None:
                 raise ConfigError(f"estimator {key} searches a box: none was given")
-        fed = {}
-        for key in chosen:
-            est = self.streamed.get(key)
-            if est is None:
-                continue
-            if joint_weights is not None and "joint_weights" in est.get_params():
-                est.set_params(joint_weights=joint_weights)
-            fed[key] = est
+        fed = {key: self.streamed[key] for key in chosen if key in self.streamed}  # solved on ``data``, joint weights included
         return fit_methods(chosen, data, budget, rngs or {}, progress=progress, workers=workers, extra=extra, fed=fed)
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..exceptions import ConfigError, DynIdError
 from ..runtime.threads import cores
-from .problem import FitData, SearchBudget
+from .problem import FitData, SearchBudget, with_problem
 from .registry import _named, is_plugin, spec
 
 if TYPE_CHECKING:
@@ -154,13 +154,13 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
     t0 = time.perf_counter()
     try:
         if estimator is not None:
-            est = estimator.solve() if hasattr(estimator, "solve") else estimator
+            est = estimator.solve(**with_problem(estimator.solve, data)) if hasattr(estimator, "solve") else estimator
         else:
             est = make_estimator(key, data, budget, rng, callback)
             w = data.w_standard if entry.space == "standard" else data.w_base
             if w is None:
                 raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
-            est.fit(w, data.tau)
+            est.fit(w, data.tau, **with_problem(est.fit, data))
     except (DynIdError, _Stopped):
         raise
     except Exception as exc:  # a plugin's own error, said in one line naming it (a built-in's is a bug: raised as is)

@@ -18,14 +18,11 @@ from .base import BoxSearchEstimator
 class DifferentialEvolutionEstimator(BoxSearchEstimator):
     """SciPy's differential evolution (Storn & Price 1997, ``best1bin``) on eq. 9 over a box.
 
+    The search box (the ABC's), the joints per sample and eq. 9's ``delta`` come to ``fit`` as ``problem=``
+    (:class:`~dynid.estimators.base.BoxSearchEstimator`).
+
     Parameters
     ----------
-    bounds : (p, 2) array
-        Search box (the ABC's); required to fit (the identification pipeline builds it).
-    n_dof : int or None
-        Joints per sample in ``W``'s rows; None: inferred from tau given as (N, n_dof).
-    weights : (n_dof,) array, optional
-        ``delta`` of eq. 9 (default 1).
     popsize : int
         Population size as a multiple of ``p`` (SciPy's convention).
     maxiter : int
@@ -43,11 +40,8 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
+    def __init__(self, *, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
                  polish: bool = False, rng=None, callback: Callable[[int, float], None] | None = None):
-        self.bounds = bounds
-        self.n_dof = n_dof
-        self.weights = weights
         self.popsize = popsize
         self.maxiter = maxiter
         self.tol = tol
@@ -82,13 +76,11 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     """Global-best particle swarm with Clerc's constriction (:func:`dynid.optim.particle_swarm.minimize_particle_swarm`)
     on eq. 9 over a box.
 
+    The search box, the joints per sample and eq. 9's ``delta`` come to ``fit`` as ``problem=``
+    (:class:`~dynid.estimators.base.BoxSearchEstimator`).
+
     Parameters
     ----------
-    bounds : (p, 2) array
-        Search box; required to fit (the identification pipeline builds it).
-    n_dof : int or None
-        Joints per sample; None: inferred from tau given as (N, n_dof).
-    weights : (n_dof,) array, optional
     swarm_size : int
         Particles (default 30, the ABC's colony size).
     maxiter : int
@@ -102,11 +94,8 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_, n_evaluations_, result_.
     """
 
-    def __init__(self, *, bounds=None, n_dof: int | None = None, weights=None, swarm_size: int = 30, maxiter: int = 50, rng=None,
+    def __init__(self, *, swarm_size: int = 30, maxiter: int = 50, rng=None,
                  callback: Callable[[int, float], None] | None = None):
-        self.bounds = bounds
-        self.n_dof = n_dof
-        self.weights = weights
         self.swarm_size = swarm_size
         self.maxiter = maxiter
         self.rng = rng

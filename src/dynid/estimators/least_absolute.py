@@ -26,14 +26,8 @@ class LeastAbsoluteDeviations(Estimator):
     it is solved again, so the result is the exact minimiser of the whole problem (the KKT conditions hold
     on every row).
 
-    Parameters
-    ----------
-    n_dof : int or None
-        Joints per sample; None: inferred from tau given as (N, n_dof).
-        Joints per sample in ``W``'s rows.
-    weights : (n_dof,) array, optional
-        ``delta`` of eq. 9 (default 1).
-    bounds : (p, 2) array, optional
+    It has no hyper-parameters: the joints per sample, eq. 9's ``delta`` (default 1) and the box (default none) come
+    to ``fit`` as ``problem=FitData(n_dof=..., weights=..., bounds=...)``.
 
     Attributes
     ----------
@@ -46,13 +40,9 @@ class LeastAbsoluteDeviations(Estimator):
     """
 
     loss_power = 1.0  # eq. 9: sample_weight multiplies each absolute residual
+    PROBLEM_FIELDS = ("n_dof", "weights", "bounds")
 
-    def __init__(self, *, n_dof: int | None = None, weights=None, bounds=None):
-        self.n_dof = n_dof
-        self.weights = weights
-        self.bounds = bounds
-
-    def fit(self, w, tau, sample_weight=None) -> LeastAbsoluteDeviations:
+    def fit(self, w, tau, sample_weight=None, *, problem=None) -> LeastAbsoluteDeviations:
         """Minimise the weighted sum of absolute residuals (eq. 9) as a linear programme, within the box if given.
 
         Parameters
@@ -62,6 +52,8 @@ class LeastAbsoluteDeviations(Estimator):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the absolute residual (eq. 9) (:func:`dynid.estimators.base.weighted_rows`).
+        problem : FitData, optional
+            Its ``n_dof``, ``weights`` (eq. 9's ``delta``) and ``bounds`` (the box, (p, 2)).
 
         Returns
         -------
@@ -73,15 +65,16 @@ class LeastAbsoluteDeviations(Estimator):
             Wrong shapes, or bounds that are not (p, 2).
         """
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
-        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        problem = self.take_problem(problem)
+        self.n_dof_ = infer_n_dof(problem.n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape
-        delta = np.ones(self.n_dof_) if self.weights is None else np.asarray(self.weights, dtype=float)
+        delta = np.ones(self.n_dof_) if problem.weights is None else np.asarray(problem.weights, dtype=float)
         row_w = np.tile(delta, m // self.n_dof_) / (m // self.n_dof_)
-        if self.bounds is None:
+        if problem.bounds is None:
             lo, hi = np.full(p, -np.inf), np.full(p, np.inf)
         else:
-            b = np.asarray(self.bounds, dtype=float)
+            b = np.asarray(problem.bounds, dtype=float)
             if b.shape != (p, 2):
                 raise ShapeError(f"expected LAD bounds of shape ({p}, 2), got {b.shape}")
             lo, hi = b[:, 0], b[:, 1]

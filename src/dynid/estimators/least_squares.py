@@ -33,37 +33,36 @@ def coulomb_offset_pairs(names) -> tuple[tuple[int, int], ...]:
 
 
 class _LeastSquares(AccumulatingEstimator):
-    """What OLS and WLS share: their hyper-parameters (``rcond``, the prior of the directions the rows leave open and
-    the stated σ of some parameters); the problem's ``n_dof`` as scikit-learn's estimators take it."""
+    """What OLS and WLS share: their hyper-parameter ``rcond``, and what they read of the problem (the joints per
+    sample, the prior of the directions the rows leave open and the stated σ of some parameters)."""
 
-    def __init__(self, *, n_dof: int | None = None, rcond: float | None = None, base_prior=None, base_prior_std=None):
-        self.n_dof = n_dof
+    PROBLEM_FIELDS = ("n_dof", "base_prior", "base_prior_std")
+
+    def __init__(self, *, rcond: float | None = None):
         self.rcond = rcond
-        self.base_prior = base_prior
-        self.base_prior_std = base_prior_std
 
 
 class OrdinaryLeastSquares(_LeastSquares):
     """OLS: ``params_ = argmin ||tau - W p||²``.
 
+    What it reads of the problem (``fit(..., problem=FitData(...))``, or ``partial_fit``'s):
+
+    - ``n_dof``: joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau given
+      as (N, n_dof), else 1 (then :attr:`joint_std_` is the residual's standard deviation over all rows);
+    - ``base_prior``, (p,): values kept along the directions the rows do not determine (the description's nominal
+      base parameters); without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it. With
+      the parameters' names given (``partial_fit(..., names=)``), a joint's Coulomb friction takes the one term it
+      shares with its offset where only that term is determined (:func:`coulomb_offset_pairs`);
+    - ``base_prior_std``, (p,): each parameter's prior standard deviation, NaN where none (a drive's data sheet,
+      ``Ia = { value = 0.3, sigma = 0.05 }``): such a parameter is pulled toward ``base_prior`` as a Gaussian prior,
+      rows ``(s/σ_i)·(p_i - prior_i)`` beside the data's, ``s`` the fit's residual σ (the maximum a posteriori
+      estimate; :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`'s ``gaussian``).
+
     Parameters
     ----------
-    n_dof : int or None
-        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau given as
-        (N, n_dof), else 1 (then :attr:`joint_std_` is the residual's standard deviation over all rows).
     rcond : float or None
         Singular values below ``rcond`` × the largest count as zero (rank deficiency); default
         ``max(M, p) · eps``.
-    base_prior : (p,) array or None
-        Values kept along the directions the rows do not determine (the description's nominal base parameters);
-        without it a rank-deficient ``W`` is refused. A full-rank ``W`` is solved as without it. With the parameters'
-        names given (``partial_fit(..., names=)``), a joint's Coulomb friction takes the one term it shares with its
-        offset where only that term is determined (:func:`coulomb_offset_pairs`).
-    base_prior_std : (p,) array or None
-        Each parameter's prior standard deviation, NaN where none (a drive's data sheet,
-        ``Ia = { value = 0.3, sigma = 0.05 }``): such a parameter is pulled toward ``base_prior`` as a Gaussian prior,
-        rows ``(s/σ_i)·(p_i - prior_i)`` beside the data's, ``s`` the fit's residual σ (the maximum a posteriori
-        estimate; :meth:`dynid.estimators.accumulate.LeastSquaresAccumulator.solve`'s ``gaussian``).
 
     Attributes
     ----------
@@ -95,7 +94,7 @@ class OrdinaryLeastSquares(_LeastSquares):
 
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
-        sol = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=coulomb_offset_pairs(names),
+        sol = acc.solve(rcond=self.rcond, names=names, prior=self.problem_.base_prior, pairs=coulomb_offset_pairs(names),
                         gaussian=_gaussian(self))
         _set_solution(self, sol)
         self.ols_params_ = sol.params
@@ -103,15 +102,17 @@ class OrdinaryLeastSquares(_LeastSquares):
 
 
 def _gaussian(est) -> tuple | None:
-    """``(values, sigmas)`` of an estimator's Gaussian prior (``base_prior`` with ``base_prior_std``), or None."""
-    if est.base_prior_std is None:
+    """``(values, sigmas)`` of an estimator's Gaussian prior (its problem's ``base_prior`` with ``base_prior_std``), or
+    None."""
+    problem = est.problem_
+    if problem.base_prior_std is None:
         return None
-    sigmas = np.asarray(est.base_prior_std, dtype=float)
+    sigmas = np.asarray(problem.base_prior_std, dtype=float)
     if not np.any(np.isfinite(sigmas)):
         return None
-    if est.base_prior is None:
+    if problem.base_prior is None:
         raise ShapeError("base_prior_std: a prior standard deviation needs base_prior, the values it is about")
-    values = np.asarray(est.base_prior, dtype=float)
+    values = np.asarray(problem.base_prior, dtype=float)
     if sigmas.shape != values.shape:
         raise ShapeError(f"expected a base_prior_std of shape {values.shape}, got {sigmas.shape}")
     return values, sigmas
@@ -131,16 +132,14 @@ class WeightedLeastSquares(_LeastSquares):
     """WLS with one weight per joint: each joint's rows are divided by that joint's residual standard
     deviation from a first OLS fit.
 
+    It reads the problem's ``n_dof`` (required unless tau is given as (N, n_dof)), ``base_prior`` and
+    ``base_prior_std`` as :class:`OrdinaryLeastSquares` does (the Gaussian prior on the weighted problem: the rows of
+    the stated parameters weigh ``1/σ_i²`` against the weighted residuals' unit variance).
+
     Parameters
     ----------
-    n_dof : int or None
-        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau
-        given as (N, n_dof).
     rcond : float or None
         As :class:`OrdinaryLeastSquares`.
-    base_prior, base_prior_std : (p,) array or None
-        As :class:`OrdinaryLeastSquares` (the Gaussian prior on the weighted problem: the rows of the
-        stated parameters weigh ``1/σ_i²`` against the weighted residuals' unit variance).
 
     Attributes
     ----------
@@ -168,9 +167,10 @@ class WeightedLeastSquares(_LeastSquares):
     def _solve(self, acc) -> None:
         names = self.__dict__.get("names_in_")
         pairs = coulomb_offset_pairs(names)
-        ols = acc.solve(rcond=self.rcond, names=names, prior=self.base_prior, pairs=pairs)
+        prior = self.problem_.base_prior
+        ols = acc.solve(rcond=self.rcond, names=names, prior=prior, pairs=pairs)
         std = acc.joint_residual_std(ols.params)
-        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=self.base_prior,
+        _set_solution(self, acc.solve(1.0 / np.where(std > 0, std, 1.0), rcond=self.rcond, prior=prior,
                                       pairs=pairs, gaussian=_gaussian(self)))
         self.ols_params_ = ols.params
         self.joint_std_ = std

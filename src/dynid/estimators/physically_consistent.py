@@ -37,34 +37,32 @@ PRIOR_KINDS = ("euclidean", "geometric")
 class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """Least squares over the standard parameters with each link's pseudo-inertia positive semidefinite.
 
+    What it reads of the problem (``fit(..., problem=FitData(...))``, or ``partial_fit``'s and ``solve``'s):
+
+    - ``layout``, ``(links, nonnegative)``, required: ``links`` (n_links, 10) the columns of ``W`` holding each link's
+      ``XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M``, ``nonnegative`` the columns constrained ``>= 0`` (viscous and Coulomb
+      friction, rotor inertias); :func:`dynid.dynamics.layout.consistency_layout` builds it for a robot;
+    - ``prior``, (p,): the parameters the unidentifiable directions are pulled towards (nominal/CAD values);
+    - ``prior_std``, (p,): each parameter's prior standard deviation, NaN where none (a drive's data sheet:
+      :meth:`Robot.prior_sigmas`): such a parameter is pulled toward ``prior`` as a Gaussian prior,
+      ``(s/σ_i)²·(φ_i - prior_i)²`` beside the data's squared residuals, ``s`` the unconstrained least squares' residual
+      σ (the maximum a posteriori estimate under the constraints);
+    - ``n_dof``: joints per sample (rows given chunk by chunk by ``partial_fit`` are folded per joint);
+    - ``joint_weights``, (n_dof,): the weight of each joint's rows when solving rows given by ``partial_fit`` (e.g. the
+      WLS weights); default 1.
+
     Parameters
     ----------
-    links : (n_links, 10) int array
-        Columns of ``W`` holding each link's ``XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M``; required to fit (the
-        identification pipeline fills it from the robot: :func:`dynid.dynamics.layout.consistency_layout`).
-    nonnegative : sequence of int
-        Columns constrained ``>= 0`` (viscous and Coulomb friction, rotor inertias).
-    prior : (p,) array, optional
-        Parameters the unidentifiable directions are pulled towards (nominal/CAD values).
     prior_weight : float
         ``λ`` relative to the mean squared column norm of ``W``: 1e-6 barely moves the identifiable
         directions and fixes the unidentifiable ones at the prior's values.
     epsilon : float
         Smallest eigenvalue allowed for each pseudo-inertia [kg·m², kg].
-    n_dof : int or None
-        Joints per sample (rows given chunk by chunk by ``partial_fit`` are folded per joint).
-    joint_weights : (n_dof,) array or None
-        Weight of each joint's rows when solving rows given by ``partial_fit`` (e.g. the WLS weights); default 1.
     prior_kind : {"euclidean", "geometric"}
         How the prior pulls: the squared distance ``||φ - φ_prior||²``, or, for each link whose prior pseudo-inertia
         ``J₀`` is positive definite, the log-det divergence ``tr(J₀⁻¹ J) - log det J`` (up to constants; Lee, Wensing
         & Park, "Geometric robot dynamic identification", IEEE T-RO 2020), which keeps the unidentifiable directions
         at a plausible mass distribution (no vanishing principal inertia); the drive terms keep the squared distance.
-    prior_std : (p,) array, optional
-        Each parameter's prior standard deviation, NaN where none (a drive's data sheet: :meth:`Robot.prior_sigmas`):
-        such a parameter is pulled toward ``prior`` as a Gaussian prior, ``(s/σ_i)²·(φ_i - prior_i)²`` beside the
-        data's squared residuals, ``s`` the unconstrained least squares' residual σ (the maximum a posteriori
-        estimate under the constraints).
 
     Attributes
     ----------
@@ -83,19 +81,14 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         If the layout does not fit ``W``.
     """
 
-    def __init__(self, *, links=None, nonnegative=(), prior=None, prior_weight: float = 1e-6, epsilon: float = 0.0,
-                 n_dof: int | None = None, joint_weights=None, prior_kind: str = PRIOR_KIND, prior_std=None):
-        self.prior_std = prior_std
+    PROBLEM_FIELDS = ("n_dof", "layout", "prior", "prior_std", "joint_weights")
+
+    def __init__(self, *, prior_weight: float = 1e-6, epsilon: float = 0.0, prior_kind: str = PRIOR_KIND):
         self.prior_kind = prior_kind
-        self.links = links
-        self.nonnegative = nonnegative
-        self.prior = prior
         self.prior_weight = prior_weight
         self.epsilon = epsilon
-        self.n_dof = n_dof
-        self.joint_weights = joint_weights
 
-    def fit(self, w, tau, sample_weight=None) -> PhysicallyConsistentLeastSquares:
+    def fit(self, w, tau, sample_weight=None, *, problem=None) -> PhysicallyConsistentLeastSquares:
         """Solve the SDP on all rows at once (their QR factor).
 
         Parameters
@@ -105,12 +98,15 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the squared loss (:func:`dynid.estimators.base.weighted_rows`).
+        problem : FitData
+            Its ``layout`` (required), ``prior`` and ``prior_std`` (the class's docstring).
 
         Returns
         -------
         self
         """
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
+        self.take_problem(problem)
         self.__dict__.pop("accumulator_", None)
         self._fit_rows(w, tau)
         self.__dict__["_solved"] = True
@@ -119,7 +115,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     def _solve(self, acc) -> None:
         """The SDP on the accumulated triangular factor ``[R | z]`` of the (joint-weighted) rows."""
         p = acc.n_params
-        reduced = acc.reduced(self.joint_weights)
+        reduced = acc.reduced(self.problem_.joint_weights)
         self._fit_rows(reduced[:, :p], reduced[:, p], int(acc.rows.sum()))
 
     def _fit_rows(self, w, tau, n_rows: int | None = None) -> None:
@@ -127,19 +123,21 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
 
         w, tau = check_observations(w, tau)
         m, p = w.shape
-        if self.links is None:
-            raise ShapeError("PhysicallyConsistentLeastSquares: links, the columns of each link's 10 parameters, are "
-                             "needed to fit (dynid.dynamics.layout.consistency_layout of the robot)")
-        links = np.asarray(self.links, dtype=int).reshape(-1, 10)
-        nonneg = np.asarray(self.nonnegative, dtype=int)
+        problem = self.problem_
+        if problem.layout is None:
+            raise ShapeError("PhysicallyConsistentLeastSquares: the parameter layout (problem=FitData(layout=(links, "
+                             "nonnegative)): the columns of each link's 10 parameters) is needed to fit "
+                             "(dynid.dynamics.layout.consistency_layout of the robot)")
+        links = np.asarray(problem.layout[0], dtype=int).reshape(-1, 10)
+        nonneg = np.asarray(problem.layout[1], dtype=int)
         if links.size and (links.min() < 0 or links.max() >= p) or (nonneg.size and (nonneg.min() < 0 or nonneg.max() >= p)):
             raise ShapeError(f"parameter layout refers to columns outside W's {p}")
         scale = np.sqrt(m)
         r, z = _reduced_least_squares(w / scale, tau / scale)
         phi = cp.Variable(p)
         cost = cp.sum_squares(r @ phi - z)
-        if self.prior is not None:
-            prior = np.asarray(self.prior, dtype=float)
+        if problem.prior is not None:
+            prior = np.asarray(problem.prior, dtype=float)
             if prior.shape != (p,):
                 raise ShapeError(f"expected a prior of shape ({p},), got {prior.shape}")
             weight = self.prior_weight * float(np.mean(r**2) * r.shape[0])
@@ -149,7 +147,7 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
                 cost = cost + weight * cp.sum_squares(phi - prior)
             else:
                 raise ShapeError(f"prior_kind: expected one of {', '.join(PRIOR_KINDS)}, got {self.prior_kind!r}")
-            cost = cost + _gaussian_prior(cp, phi, prior, self.prior_std, r=r, z=z, tau=tau / scale, n_rows=n_rows or m)
+            cost = cost + _gaussian_prior(cp, phi, prior, problem.prior_std, r=r, z=z, tau=tau / scale, n_rows=n_rows or m)
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:

@@ -5,6 +5,7 @@ paper's §4.1)."""
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -13,7 +14,7 @@ from .._util.reprs import short_repr
 if TYPE_CHECKING:
     from ..dynamics.base_parameters import BaseParameters
 
-__all__ = ["SearchBudget", "FitData"]
+__all__ = ["SearchBudget", "FitData", "with_problem"]
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,18 @@ class SearchBudget:
 @short_repr
 @dataclass
 class FitData:
-    """What the estimators see of one identification problem.
+    """What the estimators see of one identification problem: given to an estimator's ``fit`` as ``problem=``
+    (each estimator reads the fields of its ``PROBLEM_FIELDS``), every field optional.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from dynid.estimators import BeeColonyEstimator, FitData
+    >>> w, beta = np.random.default_rng(0).normal(size=(60, 2)), np.array([1.0, -2.0])
+    >>> box = FitData(n_dof=3, bounds=np.array([[0.0, 2.0], [-3.0, -1.0]]))
+    >>> est = BeeColonyEstimator(maxiter=30, rng=0).fit(w, w @ beta, problem=box)
+    >>> bool(np.abs(est.params_ - beta).max() < 0.1)
+    True
 
     Attributes
     ----------
@@ -52,8 +64,8 @@ class FitData:
         into the estimators that accumulate, and none needs them in memory).
     tau : (M,) array or None
         Measured torques [N·m], same rows.
-    n_dof : int
-        Joints per sample.
+    n_dof : int or None
+        Joints per sample (None: inferred from torques given as (N, n_dof), else 1).
     bounds : (n_base, 2) array or None
         Search box of the box searches and LAD.
     base : BaseParameters or None
@@ -82,11 +94,11 @@ class FitData:
         (NaN elsewhere): least squares pulls those as a Gaussian prior.
     """
 
-    w_base: Any
-    tau: Any
-    n_dof: int
-    bounds: Any
-    base: BaseParameters | None
+    w_base: Any = None
+    tau: Any = None
+    n_dof: int | None = None
+    bounds: Any = None
+    base: BaseParameters | None = None
     w_standard: Any = None
     layout: tuple | None = None
     prior: Any = None
@@ -96,3 +108,22 @@ class FitData:
     base_prior: Any = None
     prior_std: Any = None
     base_prior_std: Any = None
+
+
+def with_problem(method, data: FitData) -> dict:
+    """``{"problem": data}`` when ``method`` (an estimator's ``fit`` or ``solve``) takes the problem, else nothing (a
+    plugin written before ``fit`` took it: :data:`dynid.estimators.registry.PROBLEM_FILLED`).
+
+    Parameters
+    ----------
+    method : callable
+    data : FitData
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``method``.
+    """
+    parameters = inspect.signature(method).parameters.values()
+    takes = any(p.name == "problem" or p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters)
+    return {"problem": data} if takes else {}

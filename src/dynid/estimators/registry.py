@@ -59,10 +59,11 @@ class EstimatorSpec:
         One line for reports.
     build : callable or str
         ``build(data, budget, rng, callback) -> Estimator``, or an :class:`~dynid.estimators.base.Estimator`
-        subclass (its keyword hyper-parameters named ``n_dof``, ``bounds``, ``weights``, ``prior``, ``links``,
-        ``nonnegative``, ``joint_weights``, ``base_prior``, ``base_prior_std``, ``rng`` and ``callback`` are filled
-        from the problem: :data:`PROBLEM_FILLED`), or
-        ``"module:attribute"`` of either (imported when first built).
+        subclass (its keyword hyper-parameters ``rng`` and ``callback`` are filled by the identification; the problem
+        comes to its ``fit`` as ``problem=``: :class:`FitData`), or ``"module:attribute"`` of either (imported when
+        first built). A plugin class written before ``fit`` took the problem, whose constructor names ``n_dof``,
+        ``bounds``, ``weights``, ``prior``, ``links``, ``nonnegative``, ``joint_weights``, ``base_prior`` or
+        ``base_prior_std``, still gets them there (:data:`PROBLEM_FILLED`).
     space : {"base", "standard"}
         The parameters it estimates: base parameters, or standard ones (mapped to the base by the pipeline).
     cost : float
@@ -131,21 +132,20 @@ def _box_search(kind: str, iterations: int = 1) -> Builder:
     :attr:`SearchBudget.evaluations`)."""
 
     def build(data: FitData, budget: SearchBudget, rng, callback):
-        n, wts, box = data.n_dof, data.weights, data.bounds
         if kind == "abc":
             from .bee_colony import BeeColonyEstimator
 
-            return BeeColonyEstimator(bounds=box, n_dof=n, weights=wts, colony_size=budget.colony_size, limit=budget.limit,
+            return BeeColonyEstimator(colony_size=budget.colony_size, limit=budget.limit,
                                       maxiter=budget.maxiter * iterations, rng=rng, callback=callback)
         from .global_search import DifferentialEvolutionEstimator, ParticleSwarmEstimator
 
         if kind == "pso":
-            return ParticleSwarmEstimator(bounds=box, n_dof=n, weights=wts, swarm_size=budget.colony_size,
+            return ParticleSwarmEstimator(swarm_size=budget.colony_size,
                                           maxiter=max(1, budget.evaluations // budget.colony_size - 1), rng=rng, callback=callback)
-        p = len(box)
+        p = len(data.bounds)  # DE's population is a multiple of the box's dimension (SciPy's convention)
         popsize = max(1, math.ceil(budget.colony_size / p))
-        return DifferentialEvolutionEstimator(bounds=box, n_dof=n, weights=wts, popsize=popsize,
-                                              maxiter=max(1, budget.evaluations // (popsize * p) - 1), rng=rng, callback=callback)
+        return DifferentialEvolutionEstimator(popsize=popsize, maxiter=max(1, budget.evaluations // (popsize * p) - 1),
+                                              rng=rng, callback=callback)
 
     return build
 
@@ -155,9 +155,7 @@ def _sdp(data: FitData, budget: SearchBudget, rng, callback) -> Estimator:
 
     if data.layout is None:
         raise ConfigError("estimator sdp needs the parameter layout of the robot (links and non-negative columns)")
-    links, nonneg = data.layout
-    return PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=data.prior, n_dof=data.n_dof,
-                                            joint_weights=data.joint_weights, prior_std=data.prior_std)
+    return PhysicallyConsistentLeastSquares()
 
 
 _ESTIMATORS = Registry("estimator", builder=lambda entry: entry.build)
@@ -420,8 +418,9 @@ def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] 
 
 
 PROBLEM_FILLED = frozenset({*_FILLED, "links", "nonnegative", "prior_std"})
-"""An estimator's constructor parameters that the identification fills from the problem (the robot's layout, the
-search box, the weights, the prior, the seeded generator): never taken from an estimator object given as a choice."""
+"""Constructor parameters the identification fills (the seeded generator, the progress callback; and, for a plugin
+class whose constructor still names them, the problem's layout, search box, weights and prior): never taken from an
+estimator object given as a choice."""
 
 
 def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...], dict[str, dict]]:

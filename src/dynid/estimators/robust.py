@@ -22,11 +22,11 @@ MAD_TO_STD = 1.4826
 class IterativelyReweightedLeastSquares(Estimator):
     """IRLS with Huber weights and one robust scale per joint, started from OLS.
 
+    The joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``) come to ``fit`` as
+    ``problem=FitData(n_dof=...)``, else are inferred from tau given as (N, n_dof).
+
     Parameters
     ----------
-    n_dof : int or None
-        Joints per sample in ``W``'s rows (row ``k·n_dof + j`` is joint ``j``); None: inferred from tau
-        given as (N, n_dof).
     tuning : float
         Huber's ``c`` (default 1.345); ``inf`` gives per-joint weighted least squares.
     max_iter : int
@@ -52,13 +52,14 @@ class IterativelyReweightedLeastSquares(Estimator):
         If ``W`` is rank-deficient.
     """
 
-    def __init__(self, *, n_dof: int | None = None, tuning: float = HUBER_C, max_iter: int = 50, tol: float = 1e-8):
-        self.n_dof = n_dof
+    PROBLEM_FIELDS = ("n_dof",)
+
+    def __init__(self, *, tuning: float = HUBER_C, max_iter: int = 50, tol: float = 1e-8):
         self.tuning = tuning
         self.max_iter = max_iter
         self.tol = tol
 
-    def fit(self, w, tau, sample_weight=None) -> IterativelyReweightedLeastSquares:
+    def fit(self, w, tau, sample_weight=None, *, problem=None) -> IterativelyReweightedLeastSquares:
         """Huber M-estimate by iteratively reweighted least squares, with its sandwich covariance.
 
         Parameters
@@ -68,6 +69,8 @@ class IterativelyReweightedLeastSquares(Estimator):
         tau : (M,) or (N, n_dof) array [N·m]
         sample_weight : (M,) or (N, n_dof) array, optional
             One weight ≥ 0 per row of the squared loss (:func:`dynid.estimators.base.weighted_rows`).
+        problem : FitData, optional
+            Its ``n_dof``.
 
         Returns
         -------
@@ -83,7 +86,7 @@ class IterativelyReweightedLeastSquares(Estimator):
         w, tau = weighted_rows(w, tau, sample_weight, self.loss_power)
         if not self.tuning > 0:
             raise ConfigError(f"IRLS tuning constant must be positive, got {self.tuning}")
-        self.n_dof_ = infer_n_dof(self.n_dof, tau)
+        self.n_dof_ = infer_n_dof(self.take_problem(problem).n_dof, tau)
         w, tau = check_observations(w, tau, self.n_dof_)
         m, p = w.shape
         if m <= p:

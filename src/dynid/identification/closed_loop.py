@@ -45,6 +45,7 @@ from ..dynamics.rnea import rnea_torques
 from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, long_run_covariance
 from ..estimators.least_squares import OrdinaryLeastSquares
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
+from ..estimators.problem import FitData
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
@@ -179,7 +180,7 @@ def _weighted_least_squares(w, tau, row_sigma, instants=None):
     weights ``1/σ²``), with its σ: the textbook ``σ² (AᵀA)⁻¹`` of the scaled rows ``A``, or with ``instants`` the
     sandwich whose middle is the long-run covariance of the scores
     (:func:`dynid.estimators.instrumental.long_run_covariance`)."""
-    fit = OrdinaryLeastSquares(n_dof=1).fit(w, tau, sample_weight=row_sigma**-2.0)
+    fit = OrdinaryLeastSquares().fit(w, tau, sample_weight=row_sigma**-2.0)
     if instants is None:
         return fit.params_, fit.params_std_
     a = w / row_sigma[:, None]
@@ -393,11 +394,11 @@ def _didim_sdp(robot: Robot, base: BaseParameters, simulated_rows, w_standard, t
     standard parameter vectors, from the physically consistent least squares on the measured rows ``w_standard``
     (IDIM-SDP); a mean of consistent models is consistent, so the halved steps stay physical."""
     nominal = robot.standard_parameters()
-    links, nonneg = consistency_layout(robot)
+    problem = FitData(layout=consistency_layout(robot), prior=nominal)
 
     def fit(w, weight=None):
-        sdp = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=nominal)
-        return sdp.fit(w / row_sigma[:, None], tau / row_sigma, sample_weight=weight).params_
+        sdp = PhysicallyConsistentLeastSquares()
+        return sdp.fit(w / row_sigma[:, None], tau / row_sigma, sample_weight=weight, problem=problem).params_
 
     def step(rows):
         ws, moving = rows

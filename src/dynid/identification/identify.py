@@ -347,7 +347,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None
     sol, ols_params, joint_std = reference.solution_, reference.ols_params_, reference.joint_std_
     if sol.anchored and "sdp" in estimation.streamed:  # the SDP splits Coulomb + offset as least squares did
-        _anchor_prior(estimation.streamed["sdp"], robot, base, sol)
+        estimation.problem = replace(problem, prior=_anchored_prior(problem.prior, robot, base, sol))
     row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     box = search_box(sol.params, sol.params_std) if any(spec(k).needs_box for k in keys) else None
     rngs = {k: np.random.default_rng([int(rng), seed_index(k)]) for k in keys}  # (seed, estimator): whatever else is asked for
@@ -581,15 +581,16 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     return findings, stats
 
 
-def _anchor_prior(sdp, robot: Robot, base: BaseParameters, sol) -> None:
-    """Set the physically consistent estimate's prior Coulomb friction of the joints whose Coulomb + offset term least
-    squares gave to Coulomb friction (:attr:`LeastSquaresSolution.anchored`) to that value, so that its pull toward the
-    prior splits the term as least squares did (offset at the description's value) rather than half and half."""
-    prior = np.array(sdp.get_params()["prior"], dtype=float)
+def _anchored_prior(prior, robot: Robot, base: BaseParameters, sol) -> np.ndarray:
+    """The physically consistent estimate's prior with the Coulomb friction of the joints whose Coulomb + offset term
+    least squares gave to Coulomb friction (:attr:`LeastSquaresSolution.anchored`) at that value, so that its pull
+    toward the prior splits the term as least squares did (offset at the description's value) rather than half and
+    half."""
+    prior = np.array(prior, dtype=float)
     names = robot.parameter_names
     for i in sol.anchored:
         prior[names.index(base.names[i])] = sol.params[i]
-    sdp.set_params(prior=prior)
+    return prior
 
 
 def one_way_joints(data: PreparedData) -> list[int]:
@@ -644,8 +645,8 @@ def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float, li
         rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
         reduced = rest.reduced(row_weights)
         phi = np.linalg.lstsq(reduced[:p, :p], reduced[:p, p], rcond=1e-10)[0]
-        est = PhysicallyConsistentLeastSquares(links=links, nonnegative=nonneg, prior=robot.standard_parameters())
-        est.fit(reduced[:, :p], reduced[:, p])
+        est = PhysicallyConsistentLeastSquares()
+        est.fit(reduced[:, :p], reduced[:, p], problem=FitData(layout=(links, nonneg), prior=robot.standard_parameters()))
         sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
         rows += int(held.rows.sum())
         fitted.append(est.params_)

@@ -23,6 +23,7 @@ from ..conventions import INERTIAL_TERMS
 from ..dynamics.base_parameters import BaseParameters
 from ..estimators.accumulate import LeastSquaresAccumulator
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
+from ..estimators.problem import FitData
 from ..model.robot import Robot
 from ..model.spatial import inertial_from_physical, physical_from_inertial, transform_inertial
 from ..preprocessing.pipeline import base_chunks
@@ -127,7 +128,8 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     first = np.array([values.get(k, 0.0) for k in ("MX", "MY", "MZ")])
     prior = inertial_from_physical(mass, first / mass if mass > 0 else np.zeros(3), np.zeros((3, 3)))
     reduced = acc.reduced()
-    sdp = PhysicallyConsistentLeastSquares(links=np.arange(10)[None, :], prior=prior).fit(reduced[:, :10], reduced[:, 10])
+    sdp = PhysicallyConsistentLeastSquares().fit(reduced[:, :10], reduced[:, 10],
+                                                 problem=FitData(layout=(np.arange(10)[None, :], ()), prior=prior))
     phi = sdp.params_
     sse[1] = float(np.sum(acc.joint_residual_sumsq(phi)))
     rotation, translation = np.asarray(robot.tool_rotation, dtype=float), np.asarray(robot.tool_translation, dtype=float)

@@ -690,7 +690,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
         if progress is not None:
             progress(f"bootstrap of {spec(key).label}", None, None)
         t_b = time.perf_counter()
-        bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k,
+        bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k, problem=data,
                                  n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, seed_index(key)]))
         return bs, time.perf_counter() - t_b
 
