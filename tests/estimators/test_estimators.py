@@ -115,6 +115,11 @@ def test_an_estimators_repr_names_what_differs_from_its_defaults():
         PhysicallyConsistentLeastSquares().fit(w, tau)
     with pytest.raises(TypeError, match="problem is a dynid.estimators.FitData"):
         OrdinaryLeastSquares().fit(w, tau, problem={"n_dof": 1})
+    with pytest.raises(TypeError, match=r"^BeeColonyEstimator\(bounds=...\): what depends on the data comes to fit now, "
+                                        r"fit\(W, tau, problem=dynid.estimators.FitData\(bounds=...\)\)$"):
+        BeeColonyEstimator(bounds=np.zeros((6, 2)), maxiter=3)
+    with pytest.raises(TypeError, match=r"FitData\(layout=...\)"):
+        PhysicallyConsistentLeastSquares(links=np.arange(10)[None, :])
 
 
 @pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])

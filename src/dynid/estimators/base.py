@@ -259,6 +259,11 @@ class ShiftedResidual:
         return self._array
 
 
+_MOVED_TO_PROBLEM = frozenset({"n_dof", "bounds", "weights", "prior", "links", "nonnegative", "joint_weights",
+                               "base_prior", "base_prior_std", "prior_std"})
+"""The constructors' former arguments that are the problem's (``fit(..., problem=FitData(...))``) since 0.2.0."""
+
+
 class Estimator(HyperParameters):
     """Base class (scikit-learn contract): ``fit(W, tau, sample_weight=None, *, problem=None)`` sets ``params_`` and
     returns self; ``predict(W)``; ``score``; ``get_params``, ``set_params`` and ``clone``.
@@ -276,6 +281,14 @@ class Estimator(HyperParameters):
     """Only the keyword hyper-parameters are parameters (a plugin's positional arguments are not)."""
     PROBLEM_FIELDS: tuple[str, ...] = ()
     """The fields of :class:`~dynid.estimators.problem.FitData` this estimator reads in ``fit`` (``problem=``)."""
+
+    def __new__(cls, *args, **kwargs):
+        moved = sorted(kwargs.keys() & _MOVED_TO_PROBLEM)
+        if moved and not set(moved) <= set(inspect.signature(cls.__init__).parameters):  # a plugin's own may stay
+            name = "layout" if moved[0] in ("links", "nonnegative") else moved[0]
+            raise TypeError(f"{cls.__name__}({moved[0]}=...): what depends on the data comes to fit now, "
+                            f"fit(W, tau, problem=dynid.estimators.FitData({name}=...))")
+        return super().__new__(cls)
 
     def take_problem(self, problem) -> FitData:
         """Keep the fields of ``problem`` this estimator reads (:attr:`PROBLEM_FIELDS`) as ``problem_`` and return it.
