@@ -29,7 +29,7 @@ def measure() -> dict:
     q, dq, ddq = paper_identification_trajectory(n_dof=3).evaluate(t)
     experiment = ClosedLoopExperiment(Controller.for_robot(robot), q, dq, rnea_torques(robot, q, dq, ddq))
     run = simulate_closed_loop(robot, t, q, dq, experiment.controller,
-                               ClosedLoopNoise(position_std=np.deg2rad(1e-2), torque_std=0.1), np.random.default_rng(0),
+                               ClosedLoopNoise(position_std=np.deg2rad(1e-2), torque_std=0.1), rng=np.random.default_rng(0),
                                feedforward=experiment.feedforward)
     log = Recording("closed loop", t, run.q, None, run.tau, 1000.0)
     base = base_parameters(robot, rng=0)

@@ -85,7 +85,7 @@ def numba_kernel(n: int = N, repeats: int = 3) -> float:
     robot = load_robot("er16")
     q, dq, ddq = (np.random.default_rng(0).uniform(-2, 2, (n, robot.n_dof)) for _ in range(3))
     return best_of(lambda: regressor_module._fill(robot, q, dq, ddq, np.empty((n, robot.n_dof, robot.n_params)),
-                                                  np.arange(robot.n_params), "numba"), repeats)
+                                                  np.arange(robot.n_params), form="numba"), repeats)
 
 
 def fill_floor(n: int = N, repeats: int = REPEATS, threads: int = 1) -> float:

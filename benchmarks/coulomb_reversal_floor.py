@@ -85,7 +85,7 @@ def reversal_keep(setup, data, index, keep):
 
 def log_of(setup, noise=None, rng=None):
     exp = setup.experiment
-    run = simulate_closed_loop(setup.robot, setup.t, exp.q_ref, exp.dq_ref, exp.controller, noise or ClosedLoopNoise(), rng,
+    run = simulate_closed_loop(setup.robot, setup.t, exp.q_ref, exp.dq_ref, exp.controller, noise or ClosedLoopNoise(), rng=rng,
                                feedforward=exp.feedforward)
     data = prepare(Recording("closed loop", setup.t, run.q, None, run.tau, setup.config.rate),
                    Preprocessing(torque_delay=zero_order_hold_delay(setup.config.rate)))

@@ -186,11 +186,11 @@ def test_the_robots_simd_code_gives_the_other_forms_numbers(name, monkeypatch):
         for form in ("numpy", "compiled", "numba"):
             forms[form] = np.full((q.shape[0], robot.n_dof, columns.size), np.nan)
             monkeypatch.setattr(module, "_simd", {"used": False, "failed": False})
-            module._fill(robot, q, dq, ddq, forms[form], colmap, form)
+            module._fill(robot, q, dq, ddq, forms[form], colmap, form=form)
             assert module._simd["used"] == (form == "compiled")  # the SIMD code ran, not numba's kernel
         monkeypatch.setattr(_regressor_simd, "PARALLEL_SAMPLES", 10**9)
         forms["one thread"] = np.full_like(forms["numpy"], np.nan)
-        module._fill(robot, q, dq, ddq, forms["one thread"], colmap, "compiled")
+        module._fill(robot, q, dq, ddq, forms["one thread"], colmap, form="compiled")
         monkeypatch.undo()
         for form, y in forms.items():
             np.testing.assert_array_equal(y, forms["numpy"], err_msg=form)

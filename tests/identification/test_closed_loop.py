@@ -30,7 +30,7 @@ def er16():
 
 def _log(robot, t, experiment, noise, seed):
     run = simulate_closed_loop(robot, t, experiment.q_ref, experiment.dq_ref, experiment.controller, noise,
-                               np.random.default_rng(seed), feedforward=experiment.feedforward)
+                               rng=np.random.default_rng(seed), feedforward=experiment.feedforward)
     return Recording("closed loop", t, run.q, None, run.tau, 1000.0)
 
 

@@ -42,7 +42,7 @@ def closed_loop_log(tmp_path_factory):
     q, dq, ddq = paper_identification_trajectory(n_dof=N).evaluate(t)
     c = Controller.for_robot(robot)
     run = simulate_closed_loop(robot, t, q, dq, c, ClosedLoopNoise(position_std=np.deg2rad(1e-3), torque_std=0.1),
-                               np.random.default_rng(0), feedforward=rnea_torques(robot, q, dq, ddq))
+                               rng=np.random.default_rng(0), feedforward=rnea_torques(robot, q, dq, ddq))
     header = "t," + ",".join(f"q{j}" for j in range(1, N + 1)) + "," + ",".join(f"tau{j}" for j in range(1, N + 1))
     np.savetxt(root / "log.csv", np.column_stack([t, run.q, run.tau]), delimiter=",", header=header, comments="", fmt="%.10g")
     np.savetxt(root / "ref.csv", q, delimiter=",", header=",".join(f"r{j}" for j in range(1, N + 1)), comments="",

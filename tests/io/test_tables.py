@@ -95,7 +95,7 @@ def test_pyarrow_reads_the_same_values_as_the_line_reader(tmp_path, monkeypatch)
             assert s.first_line == slow.first_line
             np.testing.assert_array_equal(np.asarray(s.data[:] if spool else s.data), slow.data)
         rows = kwargs["rows"] or (1, None)
-        assert tables._arrow_table(p, ["d", "t", "b"], True, ",", None, rows, False) is not None  # pyarrow read it
+        assert tables._arrow_table(p, ["d", "t", "b"], True, ",", None, rows=rows, spool=False) is not None  # pyarrow read it
         monkeypatch.setattr(tables, "ARROW_BYTES", 32 * 2**20)
         assert fast.first_line == slow.first_line and fast.warnings == slow.warnings
         assert np.array_equal(fast.data, slow.data) and fast.data.dtype == np.float64
@@ -140,8 +140,8 @@ def test_both_readers_refuse_a_row_range_past_the_end(tmp_path, reader):
     if reader == "pyarrow":
         import dynid.io.tables as tables
 
-        assert tables._arrow_table(p, [2, 1], False, ",", None, (2, 3), False) is not None
-        assert tables._arrow_table(p, [1], False, ",", None, (2, 9), False) is None  # past the end: the line reader
+        assert tables._arrow_table(p, [2, 1], False, ",", None, rows=(2, 3), spool=False) is not None
+        assert tables._arrow_table(p, [1], False, ",", None, rows=(2, 9), spool=False) is None  # past the end: the line reader
 
 
 def test_missing_values_are_read_as_nan_where_asked(tmp_path, reader):

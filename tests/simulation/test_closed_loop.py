@@ -38,7 +38,7 @@ def test_the_torques_applied_are_the_inverse_dynamics_of_the_simulated_motion(na
     assert JointDynamics(robot)._aba == (name == "er16")
     t, q, dq, ddq = _reference(robot, 2.0, 1000.0, rng)
     controller = Controller.for_robot(robot)
-    run = simulate_closed_loop(robot, t, q, dq, controller, ClosedLoopNoise(np.deg2rad(1e-2), np.deg2rad(1e-3), 0.1), rng,
+    run = simulate_closed_loop(robot, t, q, dq, controller, ClosedLoopNoise(np.deg2rad(1e-2), np.deg2rad(1e-3), 0.1), rng=rng,
                                feedforward=rnea_torques(robot, q, dq, ddq))
     expected = rnea_torques(robot, run.q_true, run.dq_true, run.ddq_true)
     np.testing.assert_allclose(run.tau_applied, expected, atol=1e-9 * np.abs(expected).max())
@@ -53,7 +53,7 @@ def test_the_loop_sees_the_noisy_positions(rng):
     t, q, dq, _ = _reference(robot, 1.0, 1000.0, rng)
     controller = Controller.for_robot(robot)
     quiet = simulate_closed_loop(robot, t, q, dq, controller)
-    noisy = simulate_closed_loop(robot, t, q, dq, controller, ClosedLoopNoise(position_std=np.deg2rad(1e-2)), rng)
+    noisy = simulate_closed_loop(robot, t, q, dq, controller, ClosedLoopNoise(position_std=np.deg2rad(1e-2)), rng=rng)
     assert np.abs(noisy.tau_applied - quiet.tau_applied).max() > 1.0
 
 

@@ -254,6 +254,7 @@ def run(
 @app.command()
 def identify(
     config: Path = typer.Argument(..., help="Identification config (TOML), e.g. configs/ur10e.toml."),
+    *,
     out: Path = typer.Option(Path("dynid-identify"), help="Output folder for results.json and figures."),
     data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
     validate: bool = typer.Option(True, help="Also validate on the config's [[validation]] datasets."),

@@ -119,14 +119,14 @@ def compile_kernels(robots) -> None:
     """
     def run(robot, form):
         z = np.zeros((8, robot.n_dof))
-        _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form)
+        _fill(robot, z, z, z, np.empty((8, robot.n_dof, robot.n_params)), np.arange(robot.n_params), form=form)
 
     run(robots[0], "numba")  # one robot is enough: numba's kernel is the same code for every robot
     for robot in robots:
         run(robot, "compiled")
 
 
-def _fill(robot: Robot, q, dq, ddq, out, colmap, form: str | None = None, velocities=None) -> None:
+def _fill(robot: Robot, q, dq, ddq, out, colmap, *, form: str | None = None, velocities=None) -> None:
     """Fill ``out`` by the NumPy form, the compiled regressor, or numba's kernel (``form``: "numpy",
     "compiled", "numba"; by default the NumPy form while the process's budget lasts, then the compiled one)."""
     rp = np.ascontiguousarray([jt.rotation for jt in robot.joints], dtype=np.float64)

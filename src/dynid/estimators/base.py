@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import inspect
 
 import numpy as np
@@ -282,13 +283,25 @@ class Estimator(HyperParameters):
     PROBLEM_FIELDS: tuple[str, ...] = ()
     """The fields of :class:`~dynid.estimators.problem.FitData` this estimator reads in ``fit`` (``problem=``)."""
 
-    def __new__(cls, *args, **kwargs):
-        moved = sorted(kwargs.keys() & _MOVED_TO_PROBLEM)
-        if moved and not set(moved) <= set(inspect.signature(cls.__init__).parameters):  # a plugin's own may stay
-            name = "layout" if moved[0] in ("links", "nonnegative") else moved[0]
-            raise TypeError(f"{cls.__name__}({moved[0]}=...): what depends on the data comes to fit now, "
-                            f"fit(W, tau, problem=dynid.estimators.FitData({name}=...))")
-        return super().__new__(cls)
+    def __init_subclass__(cls, **kwargs):
+        """A subclass's constructor given what is the problem's since 0.2.0 (``n_dof``, ``bounds``, ``prior``, …) says
+        in one line where it goes, unless the subclass takes it (a plugin written before)."""
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is None:
+            return
+        taken = set(inspect.signature(init).parameters)
+
+        @functools.wraps(init)
+        def checked(self, *args, **given):
+            moved = sorted(given.keys() & _MOVED_TO_PROBLEM - taken)
+            if moved:
+                name = "layout" if moved[0] in ("links", "nonnegative") else moved[0]
+                raise TypeError(f"{type(self).__name__}({moved[0]}=...): what depends on the data comes to fit now, "
+                                f"fit(W, tau, problem=dynid.estimators.FitData({name}=...))")
+            init(self, *args, **given)
+
+        cls.__init__ = checked  # type: ignore[method-assign]
 
     def take_problem(self, problem) -> FitData:
         """Keep the fields of ``problem`` this estimator reads (:attr:`PROBLEM_FIELDS`) as ``problem_`` and return it.

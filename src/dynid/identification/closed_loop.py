@@ -476,7 +476,7 @@ class ClosedLoopEstimator:
         ff = rnea_torques(robot, q_ref, dq_ref, np.gradient(dq_ref, dt, axis=0)) if self.setup.feedforward else None
         return ClosedLoopExperiment(controller, q_ref, dq_ref, ff)
 
-    def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing,
+    def added_to(self, result, robot: Robot, base: BaseParameters, recording: Recording, preprocessing: Preprocessing, *,
                  experiment: ClosedLoopExperiment | None = None, data: PreparedData | None = None):
         """An identification's result with this estimate beside its others, on its log as read, at the control rate.
 

@@ -298,8 +298,8 @@ class IdentificationPipeline:
             progress("closed-loop estimators (" + ", ".join(self.closed_loop) + ")", 0, 1)
         experiment = self.closed_loop_estimators[0].experiment(prepared.robot, recording)  # one reading for all
         for part in self.closed_loop_estimators:  # on the rows the other estimators fitted: the log is not prepared again
-            result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing, experiment,
-                                   data=prepared.data)
+            result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing,
+                                   experiment=experiment, data=prepared.data)
         return result
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,

@@ -198,7 +198,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     first, last = rows if rows is not None else (1, None)
     if first < 1 or (last is not None and last < first):
         raise DataError(f"{path}: rows: expected 1 <= first <= last, got {[first, last]}")
-    fast = _arrow_table(path, columns, header, delimiter, n_columns, (first, last), spool)
+    fast = _arrow_table(path, columns, header, delimiter, n_columns, rows=(first, last), spool=spool)
     if fast is not None:
         return fast
     warnings: list[str] = []
@@ -263,7 +263,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
 
 
-def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: int | None, rows: tuple,
+def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: int | None, *, rows: tuple,
                  spool: bool) -> Table | None:
     """:func:`read_table` by pyarrow's streaming CSV reader, or None where the line reader must read the file
     (pyarrow not installed, a file under :data:`ARROW_BYTES`, or anything the line reader may treat otherwise)."""

@@ -324,7 +324,7 @@ class JointDynamics:
 
 
 def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller, noise: ClosedLoopNoise = ClosedLoopNoise(),
-                         rng: np.random.Generator | None = None, phi: np.ndarray | None = None,
+                         *, rng: np.random.Generator | None = None, phi: np.ndarray | None = None,
                          feedforward=None) -> ClosedLoopRun:
     """Run the controller on the robot along a reference, at the control rate.
 
@@ -371,10 +371,10 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
     rng = rng if rng is not None else np.random.default_rng(0)
     dynamics = JointDynamics(robot, phi)
     with np.errstate(over="ignore", invalid="ignore"):  # a diverging run is refused in one line, not warned about
-        return _run_loop(t, q_ref, dq_ref, ff, controller, dynamics, noise, rng)
+        return _run_loop(t, q_ref, dq_ref, ff, controller=controller, dynamics=dynamics, noise=noise, rng=rng)
 
 
-def _run_loop(t, q_ref, dq_ref, ff, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
+def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
     """:func:`simulate_closed_loop`'s loop over the control instants."""
     n = q_ref.shape[1]
     h = 1.0 / controller.rate

@@ -227,7 +227,8 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     rng = np.random.default_rng([cfg.seed, 20, cell, realisation])
     noise = ClosedLoopNoise(position_std=float(np.deg2rad(encoder)), torque_std=torque)
     exp = setup.experiment
-    run = simulate_closed_loop(setup.robot, setup.t, exp.q_ref, exp.dq_ref, exp.controller, noise, rng, feedforward=exp.feedforward)
+    run = simulate_closed_loop(setup.robot, setup.t, exp.q_ref, exp.dq_ref, exp.controller, noise, rng=rng,
+                               feedforward=exp.feedforward)
     log = Recording(f"closed loop {cell}.{realisation}", setup.t, run.q, None, run.tau, cfg.rate)
     settings = Preprocessing(band=cfg.band, torque_delay=zero_order_hold_delay(cfg.rate))
     n_base = setup.base.n_base
