@@ -389,3 +389,4 @@ def test_a_fitted_estimator_summarises_what_it_learned(problem):
     learned = dict(line.strip().split(": ", 1) for line in after[1:])
     assert learned["history_"].startswith(f"array ({len(est.history_)},) from ") and learned["objective_"] == f"{est.objective_:.6g}"
     assert learned["params_"] == f"array ({beta.size},) from {est.params_.min():.4g} to {est.params_.max():.4g}"
+    assert learned["problem_"] == f"FitData(n_dof=3, bounds=<array ({beta.size}, 2)>)"  # what it read of the problem

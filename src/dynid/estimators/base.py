@@ -380,7 +380,7 @@ class Estimator(HyperParameters):
 
     def summary(self) -> str:
         """The estimator and what it learned: its repr (the hyper-parameters that differ from the defaults), then one
-        line per learned attribute (those ending in ``_``: an array by its shape and range, a sequence by its length).
+        line per learned attribute (those ending in ``_``: an array by its shape and range, a sequence by its length, the problem by the fields it read).
 
         Returns
         -------
@@ -416,6 +416,8 @@ def _described(value) -> str:
         return f"array {value.shape}" + (f" from {finite.min():.4g} to {finite.max():.4g}" if finite.size else "")
     if value is None or isinstance(value, (bool, int, float, np.number, str, list, tuple, np.ndarray)):
         return short_value(value)
+    if isinstance(value, FitData):  # the problem it was fitted on: the fields it read
+        return repr(value)
     return type(value).__name__
 
 

@@ -9,7 +9,7 @@ import inspect
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from .._util.reprs import short_repr
+from .._util.reprs import short_value
 
 if TYPE_CHECKING:
     from ..dynamics.base_parameters import BaseParameters
@@ -41,7 +41,6 @@ class SearchBudget:
         return 10 * self.colony_size * self.maxiter
 
 
-@short_repr
 @dataclass
 class FitData:
     """What the estimators see of one identification problem: given to an estimator's ``fit`` as ``problem=``
@@ -108,6 +107,18 @@ class FitData:
     base_prior: Any = None
     prior_std: Any = None
     base_prior_std: Any = None
+
+    def __repr__(self) -> str:
+        """The fields that are set, each as :func:`dynid._util.reprs.short_value` shows it (``FitData(n_dof=6,
+        prior=<array (72,)>)``).
+
+        Returns
+        -------
+        str
+        """
+        values = ((f.name, getattr(self, f.name)) for f in dataclasses.fields(self))
+        shown = [f"{name}={short_value(v)}" for name, v in values if v is not None and not (isinstance(v, dict) and not v)]
+        return f"FitData({', '.join(shown)})"
 
 
 def with_problem(method, data: FitData) -> dict:
