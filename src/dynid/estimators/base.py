@@ -380,7 +380,8 @@ class Estimator(HyperParameters):
 
     def summary(self) -> str:
         """The estimator and what it learned: its repr (the hyper-parameters that differ from the defaults), then one
-        line per learned attribute (those ending in ``_``: an array by its shape and range, a sequence by its length, the problem by the fields it read).
+        line per learned attribute (those ending in ``_``: an array by its shape and range, a sequence by its length,
+        the problem by the fields it read).
 
         Returns
         -------
