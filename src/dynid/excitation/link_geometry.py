@@ -28,7 +28,7 @@ from ..exceptions import ConfigError
 from ..model.mjcf import collision_geoms, excluded_bodies
 from ..model.robot import Robot
 from ..model.srdf import disabled_link_pairs
-from .obstacles import GJK_TOLERANCE, ObstacleDistances, away_from, distance_above
+from .obstacles import GJK_TOLERANCE, ObstacleDistances, distance_above, nearest_points
 
 __all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
 
@@ -121,12 +121,13 @@ class LinkGeometry:
             ``pose(n, g)``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
         """
         placed = self._placed(robot, q)
-        made, rotation, position = placed["transforms"], placed["rotation"], placed["position"]
+        if placed["transforms"] is None:  # every shape at every sample, once: the distances ask most of them
+            rotation, position = placed["rotation"], placed["position"]
+            placed["transforms"] = [[coal.Transform3s(r, p) for r, p in zip(rn, pn)] for rn, pn in zip(rotation, position)]
+        made = placed["transforms"]
 
         def pose(n: int, g: int):
-            if (n, g) not in made:
-                made[n, g] = coal.Transform3s(rotation[n, g], position[n, g])
-            return made[n, g]
+            return made[n][g]
         return pose
 
     def _placed(self, robot: Robot, q: np.ndarray) -> dict:
@@ -142,7 +143,7 @@ class LinkGeometry:
         r, p = rots[:, np.where(base, 0, self.link)], orig[:, np.where(base, 0, self.link)]
         r[:, base], p[:, base] = np.eye(3), 0.0
         last = {"key": key, "rotation": r @ self.placement[:, :3, :3],
-                "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": {}}
+                "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": None}
         self.memo["last"] = last
         return last
 
@@ -322,15 +323,23 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
     placed = geometry.transforms(robot, q)
-    for n, c in zip(*np.nonzero(dist < FAR)):
-        g, i = pairs[c]
-        body, pose = bodies[i]
-        result = distance_above(geometry.shapes[g], placed(n, g), body, pose, request, dist[n, c] + clearance)
+    shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
+    asked = np.nonzero(dist < FAR)
+    found, ends = [], []
+    for n, c, bound in zip(*asked, (dist[asked] + clearance).tolist()):
+        shape, g, body, pose = shapes[c]
+        result = distance_above(shape, placed(n, g), body, pose, request, bound)
         if result is None:  # coal failed on a deep overlap: the spheres' bound stands
             continue
-        dist[n, c] = result.min_distance - clearance
+        found.append((n, c, result.min_distance - clearance))
         if gradient:
-            near[n, c], normal[n, c] = result.getNearestPoint1(), away_from(result)
+            ends.append(nearest_points(result))
+    if found:
+        n_found, c_found, value = (np.array(x) for x in zip(*found))
+        dist[n_found, c_found] = value
+        if gradient:
+            first, _, unit = (np.array(x) for x in zip(*ends))
+            near[n_found, c_found], normal[n_found, c_found] = first, unit
     grad = None
     if gradient and pairs:  # -z_j·((p - o_j) × n) for the joints up to the shape's link
         _, orig, axes = frames_and_axes(robot, q)
@@ -412,15 +421,22 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
     pose = geometry.transforms(robot, q)
-    for n, c in zip(*np.nonzero(dist < FAR)):
-        g, h = pairs[c]
-        result = distance_above(geometry.shapes[g], pose(n, g), geometry.shapes[h], pose(n, h), request, dist[n, c])
+    shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
+    asked = np.nonzero(dist < FAR)
+    found, ends = [], []
+    for n, c, bound in zip(*asked, dist[asked].tolist()):
+        shape_g, g, shape_h, h = shapes[c]
+        result = distance_above(shape_g, pose(n, g), shape_h, pose(n, h), request, bound)
         if result is None:  # coal failed on a deep overlap: the spheres' bound stands
             continue
-        dist[n, c] = result.min_distance
+        found.append((n, c, result.min_distance))
         if gradient:
-            near[0, n, c], near[1, n, c], normal[n, c] = (result.getNearestPoint1(), result.getNearestPoint2(),
-                                                          away_from(result))
+            ends.append(nearest_points(result))
+    if found:
+        n_found, c_found, value = (np.array(x) for x in zip(*found))
+        dist[n_found, c_found] = value
+        if gradient:
+            near[0, n_found, c_found], near[1, n_found, c_found], normal[n_found, c_found] = (np.array(x) for x in zip(*ends))
     grad = None
     if gradient and pairs:
         _, orig, axes = frames_and_axes(robot, q)

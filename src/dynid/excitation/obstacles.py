@@ -196,12 +196,13 @@ def distance_above(shape_a, pose_a, shape_b, pose_b, request, bound: float):
     coal.DistanceResult or None
         None where coal's distance lies below ``bound`` by more than coal's tolerance: ``bound`` stands for it.
     """
-    for asked in (request, coal.DistanceRequest()):
-        result = coal.DistanceResult()
-        coal.distance(shape_a, pose_a, shape_b, pose_b, asked, result)
-        if result.min_distance >= bound - 1e-6:
-            return result
-    return None
+    result = coal.DistanceResult()
+    coal.distance(shape_a, pose_a, shape_b, pose_b, request, result)
+    if result.min_distance >= bound - 1e-6:
+        return result
+    result = coal.DistanceResult()  # again at coal's defaults (made only here: most distances are asked once)
+    coal.distance(shape_a, pose_a, shape_b, pose_b, coal.DistanceRequest(), result)
+    return result if result.min_distance >= bound - 1e-6 else None
 
 
 def away_from(result) -> np.ndarray:
@@ -215,9 +216,24 @@ def away_from(result) -> np.ndarray:
     -------
     (3,) array
     """
-    near = result.getNearestPoint1()
-    gap = result.getNearestPoint2() - near
-    return gap / np.linalg.norm(gap) if result.min_distance > 1e-9 else np.asarray(result.normal)
+    return nearest_points(result)[2]
+
+
+def nearest_points(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """coal's two nearest points and the unit vector from the first to the second (coal's normal where they overlap).
+
+    Parameters
+    ----------
+    result : coal.DistanceResult
+
+    Returns
+    -------
+    first, second : (3,) arrays [m]
+    unit : (3,) array
+    """
+    first, second = result.getNearestPoint1(), result.getNearestPoint2()
+    gap = second - first
+    return first, second, gap / np.linalg.norm(gap) if result.min_distance > 1e-9 else np.asarray(result.normal)
 
 
 def _distance_gradient(result, seg: np.ndarray, jac: np.ndarray) -> np.ndarray:
