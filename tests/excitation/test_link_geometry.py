@@ -219,8 +219,9 @@ def test_the_last_trajectorys_poses_are_reused_only_for_that_trajectory(ur10e_wi
         fresh = replace(kept, memo={})
         for mine, theirs in zip(kept.poses(robot, q) + kept.spheres(robot, q), fresh.poses(robot, q) + fresh.spheres(robot, q)):
             np.testing.assert_array_equal(mine, theirs)
-        pose = kept.transforms(robot, q)
-        np.testing.assert_array_equal(pose(3, 2).getTranslation(), fresh.poses(robot, q)[1][3, 2])
+        poses = kept.transforms(robot, q)
+        assert len(poses) == q.shape[0] and all(len(at) == len(kept.shapes) for at in poses)
+        np.testing.assert_array_equal(poses[3][2].getTranslation(), fresh.poses(robot, q)[1][3, 2])
     assert kept.memo["last"]["key"][2] == two.tobytes()
 
 

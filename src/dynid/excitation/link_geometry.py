@@ -117,18 +117,14 @@ class LinkGeometry:
 
         Returns
         -------
-        callable
-            ``pose(n, g)``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
+        list of lists
+            ``poses[n][g]``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
         """
         placed = self._placed(robot, q)
         if placed["transforms"] is None:  # every shape at every sample, once: the distances ask most of them
             rotation, position = placed["rotation"], placed["position"]
             placed["transforms"] = [[coal.Transform3s(r, p) for r, p in zip(rn, pn)] for rn, pn in zip(rotation, position)]
-        made = placed["transforms"]
-
-        def pose(n: int, g: int):
-            return made[n][g]
-        return pose
+        return placed["transforms"]
 
     def _placed(self, robot: Robot, q: np.ndarray) -> dict:
         """The shapes placed along ``q``: one entry of :attr:`memo` for the last trajectory asked (the design asks the
@@ -328,7 +324,7 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     found, ends = [], []
     for n, c, bound in zip(*asked, (dist[asked] + clearance).tolist()):
         shape, g, body, pose = shapes[c]
-        result = distance_above(shape, placed(n, g), body, pose, request, bound)
+        result = distance_above(shape, placed[n][g], body, pose, request, bound)
         if result is None:  # coal failed on a deep overlap: the spheres' bound stands
             continue
         found.append((n, c, result.min_distance - clearance))
@@ -420,13 +416,14 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    pose = geometry.transforms(robot, q)
+    poses = geometry.transforms(robot, q)
     shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
     asked = np.nonzero(dist < FAR)
     found, ends = [], []
     for n, c, bound in zip(*asked, dist[asked].tolist()):
         shape_g, g, shape_h, h = shapes[c]
-        result = distance_above(shape_g, pose(n, g), shape_h, pose(n, h), request, bound)
+        at = poses[n]
+        result = distance_above(shape_g, at[g], shape_h, at[h], request, bound)
         if result is None:  # coal failed on a deep overlap: the spheres' bound stands
             continue
         found.append((n, c, result.min_distance))

@@ -13,6 +13,7 @@ body, and that point moves with ``(1 - s) J_a + s J_b`` (``J`` the positional Ja
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import coal
@@ -232,8 +233,8 @@ def nearest_points(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     unit : (3,) array
     """
     first, second = result.getNearestPoint1(), result.getNearestPoint2()
-    gap = second - first
-    return first, second, gap / np.linalg.norm(gap) if result.min_distance > 1e-9 else np.asarray(result.normal)
+    gap = second - first  # divided by its norm as np.linalg.norm computes it (sqrt of the dot), without its checks
+    return first, second, gap / math.sqrt(gap.dot(gap)) if result.min_distance > 1e-9 else np.asarray(result.normal)
 
 
 def _distance_gradient(result, seg: np.ndarray, jac: np.ndarray) -> np.ndarray:
