@@ -17,8 +17,8 @@ from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
 from .collision import shape_clearance
 from .fourier import FourierTrajectory
-from .link_geometry import LinkGeometry, self_pairs, shape_distances
-from .obstacles import Obstacle, ObstacleDistances, obstacle_distances, reachable_pairs
+from .link_geometry import LinkGeometry, ShapeDistances, self_pairs
+from .obstacles import CapsuleDistances, Obstacle, ObstacleDistances, reachable_pairs
 
 AXES = "xyz"
 
@@ -141,10 +141,28 @@ class Workspace:
         -------
         ObstacleDistances
         """
+        return self.cell_measure(robot, q, pairs=pairs).distances(gradient=gradient)
+
+    def cell_measure(self, robot, q, *, pairs=None):
+        """:meth:`cell_distances` measured once: ``dist`` (N, pairs) [m], and ``distances(gradient=...)`` with their
+        gradient at the same ``q`` (by the collision shapes, from the same coal results; by the capsules, computed
+        again).
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+        pairs : list of (int, int), optional
+            Default :meth:`cell_pairs`.
+
+        Returns
+        -------
+        ShapeDistances or CapsuleDistances
+        """
         pairs = self.cell_pairs(robot) if pairs is None else pairs
         if self.geometry is not None:
-            return shape_distances(robot, q, self.obstacles, self.geometry, self.clearance, pairs=pairs, gradient=gradient)
-        return obstacle_distances(robot, q, self.obstacles, self.clearance, pairs=pairs, gradient=gradient)
+            return ShapeDistances(robot, q, self.obstacles, self.geometry, self.clearance, pairs=pairs)
+        return CapsuleDistances(robot, q, self.obstacles, self.clearance, pairs)
 
     def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """``G p <= h`` for the finite sides of the box and the floor.

@@ -38,7 +38,7 @@ from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
-from .link_geometry import self_distances
+from .link_geometry import SelfDistances, self_distances
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -479,10 +479,14 @@ class _Objective:
             self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
         if self.origins.size:
             self.lift = forward_kinematics(p.robot, self.q)[1][:, self.origins, 2] - self.floor  # (N, m)
-        if self.pairs:
-            self.clear = self._distances(gradient=False).distance - self.gap  # (N, pairs)
-        if self.self_pairs:
-            self.apart = self._apart(gradient=False).distance - self.self_gap
+        if self.pairs:  # measured once here, as the self distances below
+            self.cell = p.workspace.cell_measure(p.robot, self.q, pairs=self.pairs)
+            self.clear = self.cell.dist - self.gap  # (N, pairs)
+        if self.self_pairs:  # measured once here; their gradient at the same iterate from the same measurement
+            geometry = p.workspace.geometry
+            assert geometry is not None  # self_pairs are empty without it
+            self.measured = SelfDistances(p.robot, self.q, geometry, self.self_pairs)
+            self.apart = self.measured.dist - self.self_gap
         self.nfev += 1
         self._x, self._xg = x.copy(), None
 
@@ -506,18 +510,12 @@ class _Objective:
             _, jac = origins_jacobian(p.robot, self.q)
             self.lift_jac = np.einsum("kmi,kix->kmx", jac[:, self.origins, 2, :], lay.lin[0])
         if self.pairs:
-            self.clear_jac = np.einsum("kmi,kix->kmx", self._distances(gradient=True).gradient, lay.lin[0])
+            self.clear_jac = np.einsum("kmi,kix->kmx", self.cell.distances(gradient=True).gradient, lay.lin[0])
         if self.self_pairs:
-            self.apart_jac = np.einsum("kmi,kix->kmx", self._apart(gradient=True).gradient, lay.lin[0])
+            apart = self.measured.distances(gradient=True).gradient
+            assert apart is not None  # asked, with pairs
+            self.apart_jac = np.einsum("kmi,kix->kmx", apart, lay.lin[0])
         self._xg = True
-
-    def _apart(self, *, gradient: bool):
-        geometry = self.p.workspace.geometry
-        assert geometry is not None  # self_pairs are empty without it
-        return self_distances(self.p.robot, self.q, geometry, self.self_pairs, gradient=gradient)
-
-    def _distances(self, *, gradient: bool):
-        return self.p.workspace.cell_distances(self.p.robot, self.q, pairs=self.pairs, gradient=gradient)
 
     def fun(self, x):
         self._eval(x)

@@ -305,45 +305,89 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     ObstacleDistances
         ``pairs`` index the shapes; ``links`` names each pair's link.
     """
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    pairs = ([(g, i) for g in np.flatnonzero(geometry.link >= 0).tolist() for i in range(len(obstacles))]
-             if pairs is None else list(pairs))
-    bodies = [ob.geometry() for ob in obstacles]
-    centre, radius = geometry.spheres(robot, q)
-    g_of, i_of = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
-    ob_centre = np.array([ob.position for ob in obstacles])[i_of] if pairs else np.zeros((0, 3))
-    ob_radius = np.array([ob.bounding_radius() for ob in obstacles])[i_of] if pairs else np.zeros(0)
-    gap = centre[:, g_of] - ob_centre[None]  # (N, P, 3): the bound's direction, body to shape
-    dist = np.linalg.norm(gap, axis=-1) - radius[g_of] - ob_radius - clearance  # a lower bound, exact far away
-    near, normal = centre[:, g_of].copy(), -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
+    return ShapeDistances(robot, q, obstacles, geometry, clearance, pairs=pairs).distances(gradient=gradient)
+
+
+class ShapeDistances:
+    """The distances of :func:`shape_distances` measured once, their gradient given on demand from coal's results (a
+    design asks the values at an iterate, then their gradient at the same iterate: coal is not asked twice).
+
+    Parameters
+    ----------
+    robot, q, obstacles, geometry, clearance, pairs
+        As :func:`shape_distances`.
+    """
+
+    def __init__(self, robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeometry, clearance: float, *, pairs=None):
+        self.robot, self.geometry = robot, geometry
+        self.q = q = np.atleast_2d(np.asarray(q, dtype=float))
+        self.pairs = pairs = ([(g, i) for g in np.flatnonzero(geometry.link >= 0).tolist() for i in range(len(obstacles))]
+                              if pairs is None else list(pairs))
+        bodies = [ob.geometry() for ob in obstacles]
+        centre, radius = geometry.spheres(robot, q)
+        g_of, i_of = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
+        ob_centre = np.array([ob.position for ob in obstacles])[i_of] if pairs else np.zeros((0, 3))
+        ob_radius = np.array([ob.bounding_radius() for ob in obstacles])[i_of] if pairs else np.zeros(0)
+        gap = centre[:, g_of] - ob_centre[None]  # (N, P, 3): the bound's direction, body to shape
+        self.dist = np.linalg.norm(gap, axis=-1) - radius[g_of] - ob_radius - clearance  # a lower bound, exact far away
+        self._near = centre[:, g_of].copy()
+        self._normal = -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
+        placed = geometry.transforms(robot, q)
+        shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
+        self._found = _coal_results(self.dist, clearance, lambda n, c: (shapes[c][0], placed[n][shapes[c][1]],
+                                                                      shapes[c][2], shapes[c][3]))
+
+    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
+        """The distances, with their gradient if asked (``-z_j·((p - o_j) × n)`` for the joints up to the shape's link).
+
+        Parameters
+        ----------
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+        """
+        robot, geometry, pairs, q = self.robot, self.geometry, self.pairs, self.q
+        grad = None
+        if gradient and pairs:
+            near, normal = self._near.copy(), self._normal.copy()
+            if self._found:
+                n_found, c_found, ends = _found_ends(self._found)
+                near[n_found, c_found], normal[n_found, c_found] = ends[0], ends[2]
+            _, orig, axes = frames_and_axes(robot, q)
+            lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
+            grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
+            links = np.array([int(geometry.link[g]) for g, _ in pairs])
+            grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
+        return ObstacleDistances(pairs, self.dist.copy(), grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+
+
+def _coal_results(dist: np.ndarray, offset: float, shapes_at) -> list:
+    """coal's distance of every pair whose bounding spheres' bound ``dist`` (N, P) is below :data:`FAR`: ``dist``
+    takes each (less ``offset``, the clearance), and the list of ``(n, c, result)`` is returned (a pair coal fails on
+    keeps its bound). ``shapes_at(n, c)`` gives ``(shape_a, pose_a, shape_b, pose_b)``."""
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    placed = geometry.transforms(robot, q)
-    shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
     asked = np.nonzero(dist < FAR)
-    found, ends = [], []
-    for n, c, bound in zip(*asked, (dist[asked] + clearance).tolist()):
-        shape, g, body, pose = shapes[c]
-        result = distance_above(shape, placed[n][g], body, pose, request, bound)
-        if result is None:  # coal failed on a deep overlap: the spheres' bound stands
-            continue
-        found.append((n, c, result.min_distance - clearance))
-        if gradient:
-            ends.append(nearest_points(result))
+    found = []
+    for n, c, bound in zip(*asked, (dist[asked] + offset).tolist()):
+        shape_a, pose_a, shape_b, pose_b = shapes_at(n, c)
+        result = distance_above(shape_a, pose_a, shape_b, pose_b, request, bound)
+        if result is not None:  # else coal failed on a deep overlap: the spheres' bound stands
+            found.append((n, c, result))
     if found:
-        n_found, c_found, value = (np.array(x) for x in zip(*found))
-        dist[n_found, c_found] = value
-        if gradient:
-            first, _, unit = (np.array(x) for x in zip(*ends))
-            near[n_found, c_found], normal[n_found, c_found] = first, unit
-    grad = None
-    if gradient and pairs:  # -z_j·((p - o_j) × n) for the joints up to the shape's link
-        _, orig, axes = frames_and_axes(robot, q)
-        lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
-        grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
-        links = np.array([int(geometry.link[g]) for g, _ in pairs])
-        grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
-    return ObstacleDistances(pairs, dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+        n_found, c_found, results = zip(*found)
+        dist[np.array(n_found), np.array(c_found)] = [r.min_distance - offset for r in results]
+    return found
+
+
+def _found_ends(found: list) -> tuple:
+    """The samples, the pairs and coal's nearest points of :func:`_coal_results`' list: ``(first, second, unit)`` as
+    arrays (:func:`dynid.excitation.obstacles.nearest_points`)."""
+    samples, columns, results = zip(*found)
+    ends = tuple(np.array(x) for x in zip(*(nearest_points(r) for r in results)))
+    return np.array(samples), np.array(columns), ends
 
 
 FAR = 0.1
@@ -407,41 +451,60 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     ObstacleDistances
         ``pairs`` as given; ``links`` the first shape's link of each.
     """
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    centre, radius = geometry.spheres(robot, q)
-    a, b = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
-    gap = centre[:, b] - centre[:, a]  # (N, P, 3)
-    dist = np.linalg.norm(gap, axis=-1) - radius[a] - radius[b]  # a lower bound, exact far away
-    near = np.stack([centre[:, a], centre[:, b]])
-    normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
-    request = coal.DistanceRequest()
-    request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    poses = geometry.transforms(robot, q)
-    shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
-    asked = np.nonzero(dist < FAR)
-    found, ends = [], []
-    for n, c, bound in zip(*asked, dist[asked].tolist()):
-        shape_g, g, shape_h, h = shapes[c]
-        at = poses[n]
-        result = distance_above(shape_g, at[g], shape_h, at[h], request, bound)
-        if result is None:  # coal failed on a deep overlap: the spheres' bound stands
-            continue
-        found.append((n, c, result.min_distance))
-        if gradient:
-            ends.append(nearest_points(result))
-    if found:
-        n_found, c_found, value = (np.array(x) for x in zip(*found))
-        dist[n_found, c_found] = value
-        if gradient:
-            near[0, n_found, c_found], near[1, n_found, c_found], normal[n_found, c_found] = (np.array(x) for x in zip(*ends))
-    grad = None
-    if gradient and pairs:
-        _, orig, axes = frames_and_axes(robot, q)
-        joints = np.arange(robot.n_dof)[None, None, :]
-        grad = np.zeros((q.shape[0], len(pairs), robot.n_dof))
-        for side, sign in ((0, -1.0), (1, 1.0)):
-            links = np.array([int(geometry.link[pair[side]]) for pair in pairs])
-            lever = near[side][:, :, None, :] - orig[:, None, :, :]
-            moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
-            grad += sign * moved * (joints <= links[None, :, None])
-    return ObstacleDistances(list(pairs), dist, grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+    return SelfDistances(robot, q, geometry, pairs).distances(gradient=gradient)
+
+
+class SelfDistances:
+    """The distances of :func:`self_distances` measured once, their gradient given on demand from coal's results (a
+    design asks the values at an iterate, then their gradient at the same iterate: coal is not asked twice).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+    geometry : LinkGeometry
+    pairs : list of (int, int)
+        Shape indices (:func:`self_pairs`).
+    """
+
+    def __init__(self, robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs):
+        self.robot, self.geometry, self.pairs = robot, geometry, list(pairs)
+        self.q = q = np.atleast_2d(np.asarray(q, dtype=float))
+        centre, radius = geometry.spheres(robot, q)
+        a, b = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
+        gap = centre[:, b] - centre[:, a]  # (N, P, 3)
+        self.dist = np.linalg.norm(gap, axis=-1) - radius[a] - radius[b]  # a lower bound, exact far away
+        self._near = np.stack([centre[:, a], centre[:, b]])
+        self._normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
+        poses = geometry.transforms(robot, q)
+        shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
+        self._found = _coal_results(self.dist, 0.0, lambda n, c: (shapes[c][0], poses[n][shapes[c][1]], shapes[c][2],
+                                                                  poses[n][shapes[c][3]]))
+
+    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
+        """The distances, with their gradient if asked.
+
+        Parameters
+        ----------
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+        """
+        robot, geometry, pairs, q = self.robot, self.geometry, self.pairs, self.q
+        grad = None
+        if gradient and pairs:
+            near, normal = self._near.copy(), self._normal.copy()
+            if self._found:
+                n_found, c_found, ends = _found_ends(self._found)
+                near[0, n_found, c_found], near[1, n_found, c_found], normal[n_found, c_found] = ends
+            _, orig, axes = frames_and_axes(robot, q)
+            joints = np.arange(robot.n_dof)[None, None, :]
+            grad = np.zeros((q.shape[0], len(pairs), robot.n_dof))
+            for side, sign in ((0, -1.0), (1, 1.0)):
+                links = np.array([int(geometry.link[pair[side]]) for pair in pairs])
+                lever = near[side][:, :, None, :] - orig[:, None, :, :]
+                moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
+                grad += sign * moved * (joints <= links[None, :, None])
+        return ObstacleDistances(list(pairs), self.dist.copy(), grad, tuple(int(geometry.link[g]) for g, _ in pairs))

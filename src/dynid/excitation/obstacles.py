@@ -26,7 +26,7 @@ from ..dynamics.sensitivity import origins_jacobian, tool_jacobian
 from ..exceptions import ConfigError
 from ..model.robot import Robot
 
-__all__ = ["Obstacle", "ObstacleDistances", "obstacle_distances", "reachable_pairs"]
+__all__ = ["Obstacle", "ObstacleDistances", "CapsuleDistances", "obstacle_distances", "reachable_pairs"]
 
 SIZES = {"box": 3, "cylinder": 2, "sphere": 1}
 """How many numbers each shape's ``size`` holds: a box's full lengths along x, y, z; a cylinder's radius and length
@@ -279,6 +279,42 @@ class ObstacleDistances:
     def __post_init__(self) -> None:
         if not self.links:
             object.__setattr__(self, "links", tuple(k for k, _ in self.pairs))
+
+
+class CapsuleDistances:
+    """:func:`obstacle_distances` measured once along ``q`` (``dist``), with :meth:`distances` giving them again with
+    their gradient (:meth:`dynid.excitation.constraints.Workspace.cell_measure` by the links' capsules).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+    obstacles : sequence of Obstacle
+    clearance : float [m]
+    pairs : list of (int, int)
+        (link, obstacle) pairs.
+    """
+
+    def __init__(self, robot: Robot, q: np.ndarray, obstacles, clearance: float, pairs):
+        self._args = (robot, q, obstacles, clearance, pairs)
+        self._values = obstacle_distances(robot, q, obstacles, clearance, pairs=pairs)
+        self.dist = self._values.distance
+
+    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
+        """The distances, with their gradient if asked (computed again).
+
+        Parameters
+        ----------
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+        """
+        if not gradient:
+            return self._values
+        robot, q, obstacles, clearance, pairs = self._args
+        return obstacle_distances(robot, q, obstacles, clearance, pairs=pairs, gradient=True)
 
 
 def obstacle_distances(robot: Robot, q: np.ndarray, obstacles, radius: float, *, pairs=None,
