@@ -103,6 +103,33 @@ def test_a_shapes_distance_and_gradient_against_a_hand_computed_truth(ur10e_with
     assert list(found.links) == [int(ws.geometry.link[g]) for g in shapes]
 
 
+def test_a_measurement_gives_its_gradient_from_the_same_coal_results(ur10e_with_meshes, rng, monkeypatch):
+    """A design asks the distances at an iterate, then their gradient there: the measurement's gradient is the one
+    measured afresh with the gradient, to the bit, and coal is not asked again (each shape pair within FAR once)."""
+    from dynid.excitation import link_geometry as lg
+
+    robot = load_robot(ur10e_with_meshes)
+    ball = Obstacle("sphere", np.array([0.25]), np.array([0.3, 0.2, 0.8]), name="ball")
+    ws = Workspace(clearance=0.03, obstacles=(ball,), geometry=link_geometry_from_urdf(robot, ur10e_with_meshes))
+    pairs = self_pairs(robot, ws.geometry)
+    q = rng.uniform(-2.0, 2.0, (30, robot.n_dof))
+    fresh = [self_distances(robot, q, ws.geometry, pairs, gradient=True), ws.cell_distances(robot, q, gradient=True)]
+    calls = []
+    real = lg.distance_above
+    monkeypatch.setattr(lg, "distance_above", lambda *a: calls.append(1) or real(*a))
+    for measured, expected in zip((lambda: lg.SelfDistances(robot, q, ws.geometry, pairs), lambda: ws.cell_measure(robot, q)),
+                                  fresh):
+        measure = measured()
+        asked = len(calls)
+        assert asked > 0  # coal asked while measuring (pairs within FAR)
+        got = measure.distances(gradient=True)
+        assert len(calls) == asked  # and not again for the gradient
+        np.testing.assert_array_equal(got.distance, expected.distance)
+        np.testing.assert_array_equal(got.gradient, expected.gradient)
+        np.testing.assert_array_equal(measure.dist, expected.distance)
+        calls.clear()
+
+
 def test_mujoco_sees_the_shapes_within_the_clearance_where_coal_does(ur10e_with_meshes, rng):
     robot = load_robot(ur10e_with_meshes)
     crate = Obstacle("box", np.array([0.5, 0.4, 0.4]), np.array([0.4, 0.2, 0.6]), np.array([0.2, 0.0, 0.5]), name="crate")
