@@ -308,9 +308,53 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
     return ShapeDistances(robot, q, obstacles, geometry, clearance, pairs=pairs).distances(gradient=gradient)
 
 
-class ShapeDistances:
-    """The distances of :func:`shape_distances` measured once, their gradient given on demand from coal's results (a
-    design asks the values at an iterate, then their gradient at the same iterate: coal is not asked twice).
+class _CoalDistances:
+    """What :class:`ShapeDistances` and :class:`SelfDistances` share: the distances measured once (``dist`` (N, P),
+    coal's results ``_found`` where the bounding spheres are near, their nearest points and normal ``_near``,
+    ``_normal`` elsewhere), their gradient given on demand from the same results (a design asks the values at an
+    iterate, then their gradient at the same iterate: coal is not asked twice)."""
+
+    robot: Robot
+    geometry: LinkGeometry
+    pairs: list
+    q: np.ndarray
+    dist: np.ndarray
+    _near: np.ndarray
+    _normal: np.ndarray
+    _found: list
+
+    @staticmethod
+    def _take_ends(near, normal, n_found, c_found, ends) -> None:  # pragma: no cover - each subclass's own
+        raise NotImplementedError
+
+    def _gradient(self, near, normal, orig, axes) -> np.ndarray:  # pragma: no cover - each subclass's own
+        raise NotImplementedError
+
+    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
+        """The distances, with their gradient if asked.
+
+        Parameters
+        ----------
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+        """
+        grad = None
+        if gradient and self.pairs:
+            near, normal = self._near.copy(), self._normal.copy()
+            if self._found:
+                self._take_ends(near, normal, *_found_ends(self._found))
+            _, orig, axes = frames_and_axes(self.robot, self.q)
+            grad = self._gradient(near, normal, orig, axes)
+        return ObstacleDistances(list(self.pairs), self.dist.copy(), grad,
+                                 tuple(int(self.geometry.link[g]) for g, _ in self.pairs))
+
+
+class ShapeDistances(_CoalDistances):
+    """The distances of :func:`shape_distances` measured once, their gradient given on demand from coal's results
+    (:class:`_CoalDistances`).
 
     Parameters
     ----------
@@ -337,30 +381,17 @@ class ShapeDistances:
         self._found = _coal_results(self.dist, clearance, lambda n, c: (shapes[c][0], placed[n][shapes[c][1]],
                                                                       shapes[c][2], shapes[c][3]))
 
-    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
-        """The distances, with their gradient if asked (``-z_j·((p - o_j) × n)`` for the joints up to the shape's link).
+    @staticmethod
+    def _take_ends(near, normal, n_found, c_found, ends) -> None:
+        near[n_found, c_found], normal[n_found, c_found] = ends[0], ends[2]
 
-        Parameters
-        ----------
-        gradient : bool
-
-        Returns
-        -------
-        ObstacleDistances
-        """
-        robot, geometry, pairs, q = self.robot, self.geometry, self.pairs, self.q
-        grad = None
-        if gradient and pairs:
-            near, normal = self._near.copy(), self._normal.copy()
-            if self._found:
-                n_found, c_found, ends = _found_ends(self._found)
-                near[n_found, c_found], normal[n_found, c_found] = ends[0], ends[2]
-            _, orig, axes = frames_and_axes(robot, q)
-            lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
-            grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
-            links = np.array([int(geometry.link[g]) for g, _ in pairs])
-            grad *= np.arange(robot.n_dof)[None, None, :] <= links[None, :, None]
-        return ObstacleDistances(pairs, self.dist.copy(), grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+    def _gradient(self, near, normal, orig, axes) -> np.ndarray:
+        """``-z_j·((p - o_j) × n)`` for the joints up to the shape's link."""
+        lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
+        grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
+        links = np.array([int(self.geometry.link[g]) for g, _ in self.pairs])
+        grad *= np.arange(self.robot.n_dof)[None, None, :] <= links[None, :, None]
+        return grad
 
 
 def _coal_results(dist: np.ndarray, offset: float, shapes_at) -> list:
@@ -454,9 +485,9 @@ def self_distances(robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *
     return SelfDistances(robot, q, geometry, pairs).distances(gradient=gradient)
 
 
-class SelfDistances:
-    """The distances of :func:`self_distances` measured once, their gradient given on demand from coal's results (a
-    design asks the values at an iterate, then their gradient at the same iterate: coal is not asked twice).
+class SelfDistances(_CoalDistances):
+    """The distances of :func:`self_distances` measured once, their gradient given on demand from coal's results
+    (:class:`_CoalDistances`).
 
     Parameters
     ----------
@@ -481,30 +512,18 @@ class SelfDistances:
         self._found = _coal_results(self.dist, 0.0, lambda n, c: (shapes[c][0], poses[n][shapes[c][1]], shapes[c][2],
                                                                   poses[n][shapes[c][3]]))
 
-    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
-        """The distances, with their gradient if asked.
+    @staticmethod
+    def _take_ends(near, normal, n_found, c_found, ends) -> None:
+        near[0, n_found, c_found], near[1, n_found, c_found], normal[n_found, c_found] = ends
 
-        Parameters
-        ----------
-        gradient : bool
-
-        Returns
-        -------
-        ObstacleDistances
-        """
-        robot, geometry, pairs, q = self.robot, self.geometry, self.pairs, self.q
-        grad = None
-        if gradient and pairs:
-            near, normal = self._near.copy(), self._normal.copy()
-            if self._found:
-                n_found, c_found, ends = _found_ends(self._found)
-                near[0, n_found, c_found], near[1, n_found, c_found], normal[n_found, c_found] = ends
-            _, orig, axes = frames_and_axes(robot, q)
-            joints = np.arange(robot.n_dof)[None, None, :]
-            grad = np.zeros((q.shape[0], len(pairs), robot.n_dof))
-            for side, sign in ((0, -1.0), (1, 1.0)):
-                links = np.array([int(geometry.link[pair[side]]) for pair in pairs])
-                lever = near[side][:, :, None, :] - orig[:, None, :, :]
-                moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
-                grad += sign * moved * (joints <= links[None, :, None])
-        return ObstacleDistances(list(pairs), self.dist.copy(), grad, tuple(int(geometry.link[g]) for g, _ in pairs))
+    def _gradient(self, near, normal, orig, axes) -> np.ndarray:
+        """``-n·(v_g - v_h)``: each side's nearest point moved by the joints up to its shape's link."""
+        robot, pairs = self.robot, self.pairs
+        joints = np.arange(robot.n_dof)[None, None, :]
+        grad = np.zeros((self.q.shape[0], len(pairs), robot.n_dof))
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            links = np.array([int(self.geometry.link[pair[side]]) for pair in pairs])
+            lever = near[side][:, :, None, :] - orig[:, None, :, :]
+            moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
+            grad += sign * moved * (joints <= links[None, :, None])
+        return grad
