@@ -121,6 +121,12 @@ def test_an_estimators_repr_names_what_differs_from_its_defaults():
     with pytest.raises(TypeError, match=r"FitData\(layout=...\)"):
         PhysicallyConsistentLeastSquares(links=np.arange(10)[None, :])
 
+    class TakesAny(OrdinaryLeastSquares):  # a plugin's constructor that takes any keyword is left to take them
+        def __init__(self, **given):
+            self.given = given
+
+    assert TakesAny(n_dof=3).given == {"n_dof": 3}
+
 
 @pytest.mark.parametrize("kind", ["wls", "lad", "irls", *BOX_SEARCHES])
 def test_n_dof_is_inferred_from_tau_given_per_joint(problem, kind):

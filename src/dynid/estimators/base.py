@@ -290,7 +290,10 @@ class Estimator(HyperParameters):
         init = cls.__dict__.get("__init__")
         if init is None:
             return
-        taken = set(inspect.signature(init).parameters)
+        parameters = inspect.signature(init).parameters.values()
+        if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters):
+            return  # a plugin's constructor that takes any keyword takes these too
+        taken = {p.name for p in parameters}
 
         @functools.wraps(init)
         def checked(self, *args, **given):
