@@ -11,7 +11,7 @@ from .._util.hyperparameters import HyperParameters
 from .._util.reprs import short_value
 from ..exceptions import NotFittedError, ShapeError
 from .accumulate import LeastSquaresAccumulator
-from .problem import FitData
+from .problem import MOVED_TO_PROBLEM, FitData
 
 
 def check_observations(w, tau, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -260,11 +260,6 @@ class ShiftedResidual:
         return self._array
 
 
-_MOVED_TO_PROBLEM = frozenset({"n_dof", "bounds", "weights", "prior", "links", "nonnegative", "joint_weights",
-                               "base_prior", "base_prior_std", "prior_std"})
-"""The constructors' former arguments that are the problem's (``fit(..., problem=FitData(...))``) since 0.2.0."""
-
-
 class Estimator(HyperParameters):
     """Base class (scikit-learn contract): ``fit(W, tau, sample_weight=None, *, problem=None)`` sets ``params_`` and
     returns self; ``predict(W)``; ``score``; ``get_params``, ``set_params`` and ``clone``.
@@ -297,7 +292,7 @@ class Estimator(HyperParameters):
 
         @functools.wraps(init)
         def checked(self, *args, **given):
-            moved = sorted(given.keys() & _MOVED_TO_PROBLEM - taken)
+            moved = sorted(given.keys() & MOVED_TO_PROBLEM - taken)
             if moved:
                 name = "layout" if moved[0] in ("links", "nonnegative") else moved[0]
                 raise TypeError(f"{type(self).__name__}({moved[0]}=...): what depends on the data comes to fit now, "

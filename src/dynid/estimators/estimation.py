@@ -73,6 +73,8 @@ class Estimation:
             raise ConfigError(f"{_named(self.reference_key)}: replaces the least-squares reference of every "
                               "identification, which takes the rows block by block (partial_fit) and gives σ; register "
                               "it under a key of its own, or subclass dynid.estimators.AccumulatingEstimator")
+        fed = [self.reference, *self.streamed.values()]  # which take the problem with their rows (a plugin may not)
+        self._takes_problem = {id(est): bool(with_problem(est.partial_fit, problem)) for est in fed}
         self.standard = any(spec(k).space == "standard" for k in self.keys)
         in_memory = [k for k in self.keys if k not in self.streamed]
         self._stack_base = keep_rows or any(spec(k).space == "base" for k in in_memory)
@@ -99,16 +101,17 @@ class Estimation:
         t = np.asarray(tau).reshape(-1)
         k = None if keep is None else np.asarray(keep).reshape(-1)
         ws = None if y_standard is None else y_standard.reshape(-1, y_standard.shape[-1])
-        problem = self.problem
+        given = {"problem": self.problem}
         if self.reference_key not in self.streamed:
-            self.reference.partial_fit(w, t, k, names=self.names, **with_problem(self.reference.partial_fit, problem))
+            self.reference.partial_fit(w, t, k, names=self.names, **(given if self._takes_problem[id(self.reference)] else {}))
         for key, est in self.streamed.items():
+            with_it = given if self._takes_problem[id(est)] else {}
             if spec(key).space == "standard":
                 if ws is None:
                     raise ValueError(f"estimator {key} estimates standard parameters: pass y_standard")
-                est.partial_fit(ws, t, k, **with_problem(est.partial_fit, problem))
+                est.partial_fit(ws, t, k, **with_it)
             else:
-                est.partial_fit(w, t, k, names=self.names, **with_problem(est.partial_fit, problem))
+                est.partial_fit(w, t, k, names=self.names, **with_it)
         if self._stack_base or self._stack_standard:
             kk = np.ones(t.shape, dtype=bool) if k is None else k
             self._tau.append(t * kk)

@@ -14,7 +14,12 @@ from .._util.reprs import short_value
 if TYPE_CHECKING:
     from ..dynamics.base_parameters import BaseParameters
 
-__all__ = ["SearchBudget", "FitData", "with_problem"]
+__all__ = ["SearchBudget", "FitData", "with_problem", "MOVED_TO_PROBLEM"]
+
+MOVED_TO_PROBLEM = frozenset({"n_dof", "bounds", "weights", "prior", "links", "nonnegative", "joint_weights",
+                              "base_prior", "base_prior_std", "prior_std"})
+"""The estimators' constructor arguments that are the problem's since 0.2.0 (``fit(..., problem=FitData(...))``):
+refused by a built-in's constructor, still filled in a plugin's that names them."""
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError
 from ..plugins import Registry, load_plugins, origin
-from .problem import FitData, SearchBudget
+from .problem import MOVED_TO_PROBLEM, FitData, SearchBudget
 
 if TYPE_CHECKING:
     import numpy as np
@@ -108,7 +108,10 @@ class EstimatorSpec:
         return target
 
 
-_FILLED = ("n_dof", "bounds", "weights", "prior", "joint_weights", "rng", "callback", "base_prior", "base_prior_std")
+PROBLEM_FILLED = MOVED_TO_PROBLEM | {"rng", "callback"}
+"""Constructor parameters the identification fills (the seeded generator, the progress callback; and, for a plugin
+class whose constructor still names them, the problem's layout, search box, weights and prior): never taken from an
+estimator object given as a choice."""
 
 
 def _from_class(cls: type, options: dict) -> Builder:
@@ -121,7 +124,7 @@ def _from_class(cls: type, options: dict) -> Builder:
                   "base_prior_std": data.base_prior_std}
         if data.layout is not None:
             values.update(links=data.layout[0], nonnegative=data.layout[1])
-        kwargs = {k: v for k, v in values.items() if k in accepted and (k in _FILLED or v is not None)}
+        kwargs = {k: v for k, v in values.items() if k in accepted}
         return cls(**{**kwargs, **options})
 
     return build
@@ -415,12 +418,6 @@ def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] 
     if len(set(found)) != len(found):
         raise ConfigError(f"estimators: each estimator once, got {text!r}", field="estimators")
     return tuple(found)
-
-
-PROBLEM_FILLED = frozenset({*_FILLED, "links", "nonnegative", "prior_std"})
-"""Constructor parameters the identification fills (the seeded generator, the progress callback; and, for a plugin
-class whose constructor still names them, the problem's layout, search box, weights and prior): never taken from an
-estimator object given as a choice."""
 
 
 def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...], dict[str, dict]]:
