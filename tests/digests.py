@@ -51,11 +51,12 @@ against -0.0112 on the UR10e's resting log p2 between two machines), and it is n
 OPTIMISED = ("/design/", "/trajectory/")
 """An excitation design is a local optimum of a non-convex problem, reached from several starts (the UR10e's initial
 trajectory is itself searched for): on another CPU the last digits of one step send a start to another optimum
-(measured: cond 20.73 against 21.33 for excite-er16, the UR10e's initial cond 1246.4 against 1247.4). Its leaves are
-compared on the criterion alone (:data:`DESIGN_CHECKED`, within :data:`DESIGN_RTOL`); limits, settings and names as
-every other value."""
+(measured: cond 20.73 against 21.33 for excite-er16, the UR10e's initial cond 1246.4 against 1247.4; excite-ur10e's
+design cond 85.00 where the digests were made, 90.96 on an AVX-512 machine on 2026-11-27, 7.0 % apart, with the same
+code). Its leaves are compared on the criterion alone (:data:`DESIGN_CHECKED`, within :data:`DESIGN_RTOL`: another
+optimum, not another quality of design); limits, settings and names as every other value."""
 DESIGN_CHECKED = ("/design/cond", "/design/initial_cond", "/design/feasible")
-DESIGN_RTOL = 0.05
+DESIGN_RTOL = 0.15
 
 SCALED = "/estimates/"
 """An SDP estimate's values (:data:`SOLVER_PATHS` under this prefix) are compared to :data:`SOLVER_RTOL` of the
