@@ -130,6 +130,52 @@ def test_a_measurement_gives_its_gradient_from_the_same_coal_results(ur10e_with_
         calls.clear()
 
 
+def test_coal_measures_only_the_pairs_that_can_be_near_each_samples_nearest(ur10e_with_meshes, rng, monkeypatch):
+    """With ``within``, every sample's smallest distance is coal's, every pair coal was not asked for keeps its bounding
+    spheres' distance (a lower bound of coal's) and lies at least ``within`` above the sample's smallest; coal is asked
+    fewer times."""
+    from dynid.excitation import link_geometry as lg
+
+    robot = load_robot(ur10e_with_meshes)
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    pairs = self_pairs(robot, geometry)
+    q = rng.uniform(-2.0, 2.0, (40, robot.n_dof))
+    calls = []
+    real = lg.distance_above
+    monkeypatch.setattr(lg, "distance_above", lambda *a: calls.append(1) or real(*a))
+    exact = lg.SelfDistances(robot, q, geometry, pairs).dist
+    every = len(calls)
+    calls.clear()
+    within = 0.02
+    pruned = lg.SelfDistances(robot, q, geometry, pairs, within=within).dist
+    assert 0 < len(calls) < every
+    np.testing.assert_array_equal(pruned.min(axis=1), exact.min(axis=1))
+    kept = pruned != exact
+    assert kept.any()
+    assert np.all(pruned[kept] < exact[kept])  # the spheres' bound, below coal's distance
+    floor = np.broadcast_to(exact.min(axis=1)[:, None] + within, exact.shape)
+    assert np.all(pruned[kept] >= floor[kept] - 1e-12)
+
+
+def test_the_soft_minimum_is_a_smooth_lower_bound_of_the_minimum(rng):
+    """Kreisselmeier-Steinhauser: at most the minimum and at least ``log(P) / ρ`` below it; its gradient against
+    central differences."""
+    from dynid.excitation.design import soft_min
+
+    a = rng.normal(size=(8, 12, 5)) * 0.1
+    x = rng.normal(size=5)
+    values = lambda x: np.einsum("npx,x->np", a, x) + 0.05  # noqa: E731
+    soft, grad = soft_min(values(x), a, sharpness=300.0)
+    low = values(x).min(axis=1)
+    assert np.all(soft <= low) and np.all(soft >= low - np.log(12) / 300.0)
+    h = 1e-6
+    fd = np.stack([(soft_min(values(x + h * e), sharpness=300.0)[0] - soft_min(values(x - h * e), sharpness=300.0)[0])
+                   / (2 * h) for e in np.eye(5)], axis=1)
+    np.testing.assert_allclose(grad, fd, atol=1e-7)
+    one = np.array([[0.3, 0.5], [0.1, 0.1]])  # one pair far off: the minimum; two equal: log(2)/ρ below
+    np.testing.assert_allclose(soft_min(one, sharpness=1e3)[0], [0.3, 0.1 - np.log(2) / 1e3], atol=1e-12)
+
+
 def test_mujoco_sees_the_shapes_within_the_clearance_where_coal_does(ur10e_with_meshes, rng):
     robot = load_robot(ur10e_with_meshes)
     crate = Obstacle("box", np.array([0.5, 0.4, 0.4]), np.array([0.4, 0.2, 0.6]), np.array([0.2, 0.0, 0.5]), name="crate")

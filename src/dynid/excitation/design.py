@@ -440,6 +440,51 @@ class _Layout:
         return FourierTrajectory(self.omega_f, q0, a, b)
 
 
+SHARPNESS = 1000.0
+"""[1/m] The sharpness ρ of the soft minimum (:func:`soft_min`) of the links' own shapes' distances that the design
+keeps at or above zero, one row per design-grid sample in place of a row per pair (75 pairs on the Panda): it lies at
+most ``log(pairs) / ρ`` below the smallest distance (4.3 mm for the Panda's 75 pairs, where every pair is equally near),
+so the design is never less safe for it. The cell's bodies keep a row per pair: they are few, and where a body binds,
+its soft minimum took the optimiser more iterations (benchmarks/README.md)."""
+
+NEGLIGIBLE = 20.0
+"""A pair's weight in the soft minimum below ``exp(-NEGLIGIBLE)`` (a pair at least ``NEGLIGIBLE / SHARPNESS`` = 2 cm
+farther than a sample's nearest one): coal is not asked for its distance, its bounding spheres' (a lower bound) stands."""
+
+
+def soft_min(values: np.ndarray, jacobian: np.ndarray | None = None, *,
+             sharpness: float = SHARPNESS) -> tuple[np.ndarray, np.ndarray | None]:
+    """The Kreisselmeier-Steinhauser soft minimum of each row, ``m - log(sum(exp(-ρ (v - m)))) / ρ`` with ``m`` the
+    row's minimum, and its gradient, the rows' gradients weighted by ``softmax(-ρ v)``.
+
+    It is smooth and a lower bound of the minimum, within ``log(P) / ρ`` of it: constraining it at or above zero keeps
+    every value there (constraint aggregation; G. Kreisselmeier and R. Steinhauser, "Systematic control design by
+    optimizing a vector performance index", IFAC 1979; J. R. R. A. Martins and N. M. K. Poon, "On structural
+    optimization using constraint aggregation", WCSMO 2005).
+
+    Parameters
+    ----------
+    values : (N, P) array
+    jacobian : (N, P, nx) array, optional
+        Each value's gradient.
+    sharpness : float
+        ρ, in the inverse of the values' unit.
+
+    Returns
+    -------
+    soft : (N,) array
+    gradient : (N, nx) array or None
+        None without ``jacobian``.
+    """
+    low = values.min(axis=1, keepdims=True)
+    weight = np.exp(-sharpness * (values - low))
+    total = weight.sum(axis=1, keepdims=True)
+    soft = (low - np.log(total) / sharpness)[:, 0]
+    if jacobian is None:
+        return soft, None
+    return soft, np.einsum("np,npx->nx", weight / total, jacobian)
+
+
 class _Objective:
     """Criterion and nonlinear constraints with their gradients at one iterate (cached per ``x``)."""
 
@@ -485,7 +530,7 @@ class _Objective:
         if self.self_pairs:  # measured once here; their gradient at the same iterate from the same measurement
             geometry = p.workspace.geometry
             assert geometry is not None  # self_pairs are empty without it
-            self.measured = SelfDistances(p.robot, self.q, geometry, self.self_pairs)
+            self.measured = SelfDistances(p.robot, self.q, geometry, self.self_pairs, within=NEGLIGIBLE / SHARPNESS)
             self.apart = self.measured.dist - self.self_gap
         self.nfev += 1
         self._x, self._xg = x.copy(), None
@@ -535,8 +580,8 @@ class _Objective:
             parts.append(self.lift.ravel())
         if self.pairs:
             parts.append(self.clear.ravel())
-        if self.self_pairs:
-            parts.append(self.apart.ravel())
+        if self.self_pairs:  # one row per sample: the soft minimum over the pairs
+            parts.append(soft_min(self.apart)[0])
         return np.concatenate(parts)
 
     def cons_jac(self, x):
@@ -550,7 +595,7 @@ class _Objective:
         if self.pairs:
             parts.append(self.clear_jac.reshape(-1, x.size))
         if self.self_pairs:
-            parts.append(self.apart_jac.reshape(-1, x.size))
+            parts.append(soft_min(self.apart, self.apart_jac)[1])
         return np.concatenate(parts)
 
 

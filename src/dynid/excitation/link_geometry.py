@@ -394,13 +394,32 @@ class ShapeDistances(_CoalDistances):
         return grad
 
 
-def _coal_results(dist: np.ndarray, offset: float, shapes_at) -> list:
+def _coal_results(dist: np.ndarray, offset: float, shapes_at, *, within: float | None = None) -> list:
     """coal's distance of every pair whose bounding spheres' bound ``dist`` (N, P) is below :data:`FAR`: ``dist``
     takes each (less ``offset``, the clearance), and the list of ``(n, c, result)`` is returned (a pair coal fails on
-    keeps its bound). ``shapes_at(n, c)`` gives ``(shape_a, pose_a, shape_b, pose_b)``."""
+    keeps its bound). ``shapes_at(n, c)`` gives ``(shape_a, pose_a, shape_b, pose_b)``.
+
+    With ``within`` [m], coal measures first each sample's pair of the lowest bound, then only the pairs whose bound
+    lies within ``within`` of that pair's distance (an upper bound of the sample's smallest): the others are at least
+    ``within`` farther than the sample's nearest pair, and keep their bound."""
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    asked = np.nonzero(dist < FAR)
+    near = dist < FAR
+    found: list = []
+    if within is not None and dist.shape[1] > 1:
+        samples = np.flatnonzero(near.any(axis=1))
+        lowest = np.argmin(dist[samples], axis=1)
+        found = _measured(dist, offset, shapes_at, request, (samples, lowest))
+        nearest = np.full(dist.shape[0], np.inf)  # a sample whose first pair coal failed on keeps every near pair
+        for n, c, _ in found:
+            nearest[n] = dist[n, c]
+        near[samples, lowest] = False
+        near &= dist < nearest[:, None] + within
+    return found + _measured(dist, offset, shapes_at, request, np.nonzero(near))
+
+
+def _measured(dist: np.ndarray, offset: float, shapes_at, request, asked: tuple) -> list:
+    """coal's distances of the pairs ``asked`` (samples, columns), written into ``dist`` (:func:`_coal_results`)."""
     found = []
     for n, c, bound in zip(*asked, (dist[asked] + offset).tolist()):
         shape_a, pose_a, shape_b, pose_b = shapes_at(n, c)
@@ -496,9 +515,12 @@ class SelfDistances(_CoalDistances):
     geometry : LinkGeometry
     pairs : list of (int, int)
         Shape indices (:func:`self_pairs`).
+    within : float, optional
+        [m] coal measures only the pairs that can lie within this of each sample's nearest one; the others keep their
+        bounding spheres' distance (a lower bound). Default: every pair within :data:`FAR`.
     """
 
-    def __init__(self, robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs):
+    def __init__(self, robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *, within: float | None = None):
         self.robot, self.geometry, self.pairs = robot, geometry, list(pairs)
         self.q = q = np.atleast_2d(np.asarray(q, dtype=float))
         centre, radius = geometry.spheres(robot, q)
@@ -510,7 +532,7 @@ class SelfDistances(_CoalDistances):
         poses = geometry.transforms(robot, q)
         shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
         self._found = _coal_results(self.dist, 0.0, lambda n, c: (shapes[c][0], poses[n][shapes[c][1]], shapes[c][2],
-                                                                  poses[n][shapes[c][3]]))
+                                                                  poses[n][shapes[c][3]]), within=within)
 
     @staticmethod
     def _take_ends(near, normal, n_found, c_found, ends) -> None:
