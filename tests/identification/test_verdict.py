@@ -7,7 +7,8 @@ import re
 from pathlib import Path
 
 import numpy as np
-import pytest
+
+from ..conftest import shared_data
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "dynid"
 REPO = Path(__file__).resolve().parents[2]
@@ -73,10 +74,6 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     assert not [f for f in result.findings if f.text.startswith(f"{nominal} predicts")]
 
 
-MED7 = REPO.parent / "shared" / "data" / "kuka_med7_lbrstack"
-
-
-@pytest.mark.skipif(not MED7.is_dir(), reason="needs ../shared/data (the real LBR Med7 logs)")
 def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it(tmp_path):
     """Seconds 60-63 of the LBR Med7's identification log (joint torque sensors): before, the main estimate was the
     drive-only one, 31.6 % on the validation log against the description's 21.3 %; every estimate predicts worse than
@@ -88,7 +85,7 @@ def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it
     path = tmp_path / "med7-60-63.toml"
     path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [60.0, 63.0]", text, count=1,
                            flags=re.M))
-    result = run_identification(load_identification_config(path, data_root=MED7))
+    result = run_identification(load_identification_config(path, data_root=shared_data("kuka_med7_lbrstack")))
     nominal = result.diagnostics["nominal_set"]
     errors = {k: float(np.mean([v.metrics()[k]["global_relative_error"] for v in result.validations]))
               for k in result.validations[0].metrics()}
@@ -105,10 +102,6 @@ def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it
     assert [h for h in table.headers if h.startswith(nominal)] == [f"{nominal} (main)"]
 
 
-KR300 = REPO.parent / "shared" / "data" / "kuka_kr300_weigand2021"
-
-
-@pytest.mark.skipif(not KR300.is_dir(), reason="needs ../shared/data (the real KUKA KR 300 logs)")
 def test_the_drive_only_estimate_calls_undetermined_only_terms_its_joints_have(tmp_path):
     """Seconds 0-4 of the KR 300's log, where the drive-only estimate is the main one: it called fst1, fcl1, cbs1, cbc1,
     cbsd1 and cbcd1 "not determined by this log": terms of other joints' friction models and of J2's counterbalance,
@@ -121,7 +114,7 @@ def test_the_drive_only_estimate_calls_undetermined_only_terms_its_joints_have(t
     path = tmp_path / "kr300-0-4.toml"
     path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [0.0, 4.0]", text, count=1,
                            flags=re.M))
-    result = run_identification(load_identification_config(path, data_root=KR300))
+    result = run_identification(load_identification_config(path, data_root=shared_data("kuka_kr300_weigand2021")))
     assert result.main == "dynid drive-only"
     loose = {k: v for k, v in (result.diagnostics.get("drive_only_undetermined") or {}).items() if k != "cutoff_factors"}
     assert all(max(abs(x) for x in v) > 1e-8 for v in loose.values()), loose
