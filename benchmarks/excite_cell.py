@@ -21,6 +21,7 @@ floor stays the joint origins'. With capsules the check is the brute force above
 
     python benchmarks/excite_cell.py --seeds 20
     python benchmarks/excite_cell.py --seeds 20 --geometry collision
+    python benchmarks/excite_cell.py --seeds 20 --first-seed 20 --geometry collision   # seeds 20-39
 """
 
 from __future__ import annotations
@@ -185,7 +186,7 @@ def _design(robot, ws: Workspace, seed: int):
 
 
 @with_single_blas_thread
-def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False) -> dict:
+def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False, first: int = 0) -> dict:
     robot = _arm(name, folder, meshes)
     ws = _cell(robot)
     path = folder / f"{name.replace(' ', '_')}.urdf"
@@ -197,7 +198,7 @@ def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False) -> dict:
         ws = replace(ws, geometry=link_geometry_from_urdf(robot, path))
     free_ws = Workspace(floor=ws.floor, clearance=CLEARANCE)
     rows = []
-    for seed in range(seeds):
+    for seed in range(first, first + seeds):
         try:
             with_box, t_box = _design(robot, ws, seed)
             without, t_free = _design(robot, free_ws, seed)
@@ -224,11 +225,12 @@ def run_arm(name: str, seeds: int, folder: Path, meshes: bool = False) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--arms", default=",".join(CELL_ARMS))
     parser.add_argument("--geometry", choices=("capsules", "collision"), default="capsules")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        results = [run_arm(name, args.seeds, Path(tmp), args.geometry == "collision") for name in args.arms.split(",")]
+        results = [run_arm(name, args.seeds, Path(tmp), args.geometry == "collision", args.first_seed) for name in args.arms.split(",")]
     print("\n| arm | joints | seeds | in the box, under the floor or shapes touching (1 kHz) | MuJoCo: designs with a "
           "contact within the clearance (1 kHz) | free design crosses the box | cond ratio, box does not bind | cond "
           "ratio, box binds | time ratio (median) |")
