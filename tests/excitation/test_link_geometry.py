@@ -295,6 +295,9 @@ def test_the_last_trajectorys_poses_are_reused_only_for_that_trajectory(ur10e_wi
         poses = kept.transforms(robot, q)
         assert len(poses) == q.shape[0] and all(len(at) == len(kept.shapes) for at in poses)
         np.testing.assert_array_equal(poses[3][2].getTranslation(), fresh.poses(robot, q)[1][3, 2])
+        one_pose = fresh.pose_of(robot, q)(3, 2)  # made when asked, one shape at one sample
+        assert len(fresh.memo["last"]["transforms"]) == 1
+        np.testing.assert_array_equal(one_pose.getRotation(), poses[3][2].getRotation())
     assert kept.memo["last"]["key"][2] == two.tobytes()
 
 

@@ -15,8 +15,10 @@ shapes.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import coal
 import numpy as np
@@ -120,11 +122,35 @@ class LinkGeometry:
         list of lists
             ``poses[n][g]``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
         """
+        pose = self.pose_of(robot, q)
+        return [[pose(n, g) for g in range(len(self.shapes))] for n in range(q.shape[0])]
+
+    def pose_of(self, robot: Robot, q: np.ndarray) -> Callable[[int, int], Any]:
+        """coal's pose of one shape at one sample of ``q``, each made when first asked and kept with the trajectory's
+        placement (a design asks the pairs near each other only, a shape in several of them).
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+
+        Returns
+        -------
+        callable
+            ``pose(n, g)``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
+        """
         placed = self._placed(robot, q)
-        if placed["transforms"] is None:  # every shape at every sample, once: the distances ask most of them
-            rotation, position = placed["rotation"], placed["position"]
-            placed["transforms"] = [[coal.Transform3s(r, p) for r, p in zip(rn, pn)] for rn, pn in zip(rotation, position)]
-        return placed["transforms"]
+        made, rotation, position = placed["transforms"], placed["rotation"], placed["position"]
+        m = rotation.shape[1]
+
+        def pose(n: int, g: int):
+            key = n * m + g
+            found = made.get(key)
+            if found is None:
+                found = made[key] = coal.Transform3s(rotation[n, g], position[n, g])
+            return found
+
+        return pose
 
     def _placed(self, robot: Robot, q: np.ndarray) -> dict:
         """The shapes placed along ``q``: one entry of :attr:`memo` for the last trajectory asked (the design asks the
@@ -139,7 +165,7 @@ class LinkGeometry:
         r, p = rots[:, np.where(base, 0, self.link)], orig[:, np.where(base, 0, self.link)]
         r[:, base], p[:, base] = np.eye(3), 0.0
         last = {"key": key, "rotation": r @ self.placement[:, :3, :3],
-                "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": None}
+                "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": {}}
         self.memo["last"] = last
         return last
 
@@ -376,9 +402,9 @@ class ShapeDistances(_CoalDistances):
         self.dist = np.linalg.norm(gap, axis=-1) - radius[g_of] - ob_radius - clearance  # a lower bound, exact far away
         self._near = centre[:, g_of].copy()
         self._normal = -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
-        placed = geometry.transforms(robot, q)
+        pose = geometry.pose_of(robot, q)
         shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
-        self._found = _coal_results(self.dist, clearance, lambda n, c: (shapes[c][0], placed[n][shapes[c][1]],
+        self._found = _coal_results(self.dist, clearance, lambda n, c: (shapes[c][0], pose(n, shapes[c][1]),
                                                                       shapes[c][2], shapes[c][3]))
 
     @staticmethod
@@ -529,10 +555,10 @@ class SelfDistances(_CoalDistances):
         self.dist = np.linalg.norm(gap, axis=-1) - radius[a] - radius[b]  # a lower bound, exact far away
         self._near = np.stack([centre[:, a], centre[:, b]])
         self._normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
-        poses = geometry.transforms(robot, q)
+        pose = geometry.pose_of(robot, q)
         shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
-        self._found = _coal_results(self.dist, 0.0, lambda n, c: (shapes[c][0], poses[n][shapes[c][1]], shapes[c][2],
-                                                                  poses[n][shapes[c][3]]), within=within)
+        self._found = _coal_results(self.dist, 0.0, lambda n, c: (shapes[c][0], pose(n, shapes[c][1]), shapes[c][2],
+                                                                  pose(n, shapes[c][3])), within=within)
 
     @staticmethod
     def _take_ends(near, normal, n_found, c_found, ends) -> None:
