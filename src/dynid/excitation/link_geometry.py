@@ -109,22 +109,6 @@ class LinkGeometry:
         placed = self._placed(robot, q)
         return placed["rotation"], placed["position"]
 
-    def transforms(self, robot: Robot, q: np.ndarray):
-        """coal's poses of the shapes along ``q``, each made once per trajectory (a shape is in several pairs).
-
-        Parameters
-        ----------
-        robot : Robot
-        q : (N, n_dof) array [rad]
-
-        Returns
-        -------
-        list of lists
-            ``poses[n][g]``: shape ``g`` at sample ``n``, a ``coal.Transform3s``.
-        """
-        pose = self.pose_of(robot, q)
-        return [[pose(n, g) for g in range(len(self.shapes))] for n in range(q.shape[0])]
-
     def pose_of(self, robot: Robot, q: np.ndarray) -> Callable[[int, int], Any]:
         """coal's pose of one shape at one sample of ``q``, each made when first asked and kept with the trajectory's
         placement (a design asks the pairs near each other only, a shape in several of them).
