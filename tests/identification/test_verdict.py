@@ -106,15 +106,7 @@ def test_the_drive_only_estimate_calls_undetermined_only_terms_its_joints_have(t
     """Seconds 0-4 of the KR 300's log, where the drive-only estimate is the main one: it called fst1, fcl1, cbs1, cbc1,
     cbsd1 and cbcd1 "not determined by this log": terms of other joints' friction models and of J2's counterbalance,
     whose columns are zero on J1 (their fits 1e-12 to 1e-9). Only terms with a fit of their own are judged."""
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
-
-    text = (REPO / "configs" / "kuka_kr300.toml").read_text().replace(
-        'robot = "robots/kuka_kr300.toml"', f'robot = "{REPO / "configs" / "robots" / "kuka_kr300.toml"}"')
-    path = tmp_path / "kr300-0-4.toml"
-    path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [0.0, 4.0]", text, count=1,
-                           flags=re.M))
-    result = run_identification(load_identification_config(path, data_root=shared_data("kuka_kr300_weigand2021")))
+    result = _kr300_window(tmp_path, 0.0, 4.0)
     assert result.main == "dynid drive-only"
     loose = {k: v for k, v in (result.diagnostics.get("drive_only_undetermined") or {}).items() if k != "cutoff_factors"}
     assert all(max(abs(x) for x in v) > 1e-8 for v in loose.values()), loose
@@ -128,19 +120,25 @@ def test_the_sdp_of_a_heavy_arm_is_called_consistent_where_its_links_are(tmp_pat
     2,200) found a margin of -4e-7 and called it "no: ... not physically consistent", against the finding that chose
     it for being consistent."""
     from dynid.dynamics.layout import consistency_layout
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
     from dynid.model.spatial import pseudo_inertia
 
-    text = (REPO / "configs" / "kuka_kr300.toml").read_text().replace(
-        'robot = "robots/kuka_kr300.toml"', f'robot = "{REPO / "configs" / "robots" / "kuka_kr300.toml"}"')
-    path = tmp_path / "kr300-3.5-8.5.toml"
-    path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [3.5, 8.5]", text, count=1,
-                           flags=re.M))
-    result = run_identification(load_identification_config(path, data_root=shared_data("kuka_kr300_weigand2021")))
+    result = _kr300_window(tmp_path, 3.5, 8.5)
     sdp = result.estimates["dynid SDP"].standard
     links, nonnegative = consistency_layout(result.model)
     assert min(np.linalg.eigvalsh(pseudo_inertia(sdp[idx])).min() for idx in links) >= 0.0
     assert np.all(sdp[nonnegative] >= 0.0)
     assert result.consistency_verdicts["dynid SDP"] == "yes", result.consistency_verdicts["dynid SDP"]
     assert not str(result.consistency_verdicts[result.label]).startswith("yes")  # least squares' still is not
+
+
+def _kr300_window(tmp_path, start: float, stop: float):
+    """The KR 300's config identified on seconds ``start``-``stop`` of its identification log, with its validation logs."""
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    text = (REPO / "configs" / "kuka_kr300.toml").read_text().replace(
+        'robot = "robots/kuka_kr300.toml"', f'robot = "{REPO / "configs" / "robots" / "kuka_kr300.toml"}"')
+    path = tmp_path / f"kr300-{start:g}-{stop:g}.toml"
+    path.write_text(re.sub(r"^\[identification\]$", f"[identification]\ntime_range = [{start}, {stop}]", text, count=1,
+                           flags=re.M))
+    return run_identification(load_identification_config(path, data_root=shared_data("kuka_kr300_weigand2021")))
