@@ -78,14 +78,7 @@ def test_a_short_window_of_the_med7_keeps_the_description_where_nothing_beats_it
     """Seconds 60-63 of the LBR Med7's identification log (joint torque sensors): before, the main estimate was the
     drive-only one, 31.6 % on the validation log against the description's 21.3 %; every estimate predicts worse than
     the robot file, so the main estimate is the robot file's own values."""
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
-
-    text = (REPO / "configs" / "kuka_med7.toml").read_text()
-    path = tmp_path / "med7-60-63.toml"
-    path.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [60.0, 63.0]", text, count=1,
-                           flags=re.M))
-    result = run_identification(load_identification_config(path, data_root=shared_data("kuka_med7_lbrstack")))
+    result = _window(tmp_path, "kuka_med7", 60.0, 63.0)
     nominal = result.diagnostics["nominal_set"]
     errors = {k: float(np.mean([v.metrics()[k]["global_relative_error"] for v in result.validations]))
               for k in result.validations[0].metrics()}
@@ -106,7 +99,7 @@ def test_the_drive_only_estimate_calls_undetermined_only_terms_its_joints_have(t
     """Seconds 0-4 of the KR 300's log, where the drive-only estimate is the main one: it called fst1, fcl1, cbs1, cbc1,
     cbsd1 and cbcd1 "not determined by this log": terms of other joints' friction models and of J2's counterbalance,
     whose columns are zero on J1 (their fits 1e-12 to 1e-9). Only terms with a fit of their own are judged."""
-    result = _kr300_window(tmp_path, 0.0, 4.0)
+    result = _window(tmp_path, "kuka_kr300", 0.0, 4.0)
     assert result.main == "dynid drive-only"
     loose = {k: v for k, v in (result.diagnostics.get("drive_only_undetermined") or {}).items() if k != "cutoff_factors"}
     assert all(max(abs(x) for x in v) > 1e-8 for v in loose.values()), loose
@@ -122,7 +115,7 @@ def test_the_sdp_of_a_heavy_arm_is_called_consistent_where_its_links_are(tmp_pat
     from dynid.dynamics.layout import consistency_layout
     from dynid.model.spatial import pseudo_inertia
 
-    result = _kr300_window(tmp_path, 3.5, 8.5)
+    result = _window(tmp_path, "kuka_kr300", 3.5, 8.5)
     sdp = result.estimates["dynid SDP"].standard
     links, nonnegative = consistency_layout(result.model)
     assert min(np.linalg.eigvalsh(pseudo_inertia(sdp[idx])).min() for idx in links) >= 0.0
@@ -131,14 +124,34 @@ def test_the_sdp_of_a_heavy_arm_is_called_consistent_where_its_links_are(tmp_pat
     assert not str(result.consistency_verdicts[result.label]).startswith("yes")  # least squares' still is not
 
 
-def _kr300_window(tmp_path, start: float, stop: float):
-    """The KR 300's config identified on seconds ``start``-``stop`` of its identification log, with its validation logs."""
+def test_without_validation_logs_the_sdp_is_main_where_least_squares_is_not_consistent(tmp_path):
+    """Seconds 50-55 of the LBR Med7's log with no validation log: least squares predicts held-out blocks of the window
+    better than the SDP, and was the main estimate (results.json, the report's box) while the first line and export
+    named the SDP; on the config's validation logs it scores 661 % against the SDP's 22.4 %. The SDP, physically
+    consistent, is now the main estimate, and the finding gives the held-out figures."""
+    result = _window(tmp_path, "kuka_med7", 50.0, 55.0, validation=False)
+    held = result.diagnostics["held_out_rms_error"]
+    assert held["dynid WLS"] < held["dynid SDP"] / 1.02  # least squares ahead on the held-out blocks
+    assert not result.consistency_verdicts["dynid WLS"].startswith("yes")
+    assert result.consistency_verdicts["dynid SDP"] == "yes" and result.main == "dynid SDP"
+    said = next(f.text for f in result.findings if f.kind == "main")
+    assert said.startswith("main estimate: dynid SDP, physically consistent, where dynid WLS is not")
+    assert "validation logs ([[validation]], other motions) do" in said
+
+
+def _window(tmp_path, name: str, start: float, stop: float, validation: bool = True):
+    """A real config of configs/ identified on seconds ``start``-``stop`` of its identification log, with its validation
+    logs or none."""
+    from dataclasses import replace
+
     from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
 
-    text = (REPO / "configs" / "kuka_kr300.toml").read_text().replace(
+    folder = {"kuka_kr300": "kuka_kr300_weigand2021", "kuka_med7": "kuka_med7_lbrstack"}[name]
+    text = (REPO / "configs" / f"{name}.toml").read_text().replace(
         'robot = "robots/kuka_kr300.toml"', f'robot = "{REPO / "configs" / "robots" / "kuka_kr300.toml"}"')
-    path = tmp_path / f"kr300-{start:g}-{stop:g}.toml"
+    path = tmp_path / f"{name}-{start:g}-{stop:g}.toml"
     path.write_text(re.sub(r"^\[identification\]$", f"[identification]\ntime_range = [{start}, {stop}]", text, count=1,
                            flags=re.M))
-    return run_identification(load_identification_config(path, data_root=shared_data("kuka_kr300_weigand2021")))
+    config = load_identification_config(path, data_root=shared_data(folder))
+    return run_identification(config if validation else replace(config, validation=()))
