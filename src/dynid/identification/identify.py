@@ -287,10 +287,10 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     rng : int
         Seeds the box searches (each estimator draws from ``(rng, its registry index)``) and the bootstrap.
     held_out : bool
-        With ``sdp`` listed, when no validation log will say which estimate to trust: compare the least-squares and
-        the physically consistent estimates by blocked cross-validation (:data:`HELD_OUT_FOLDS` contiguous blocks),
-        and make the consistent one the main estimate when the least-squares one is not consistent and predicts the
-        held-out blocks worse.
+        With ``sdp`` listed, when no validation log will say which estimate to trust: the least-squares and the
+        physically consistent estimates' errors on held-out contiguous blocks (:data:`HELD_OUT_FOLDS`-fold blocked
+        cross-validation), which the main estimate's finding gives (the consistent one is the main estimate where
+        least squares is not consistent: :func:`dynid.identification.verdict.choose_main_estimate`).
     jackknife : bool
         With ``sdp`` listed: refit the physically consistent estimate on every :data:`HELD_OUT_FOLDS` − 1 of the
         contiguous blocks (:attr:`IdentificationResult.sdp_refits`), whose spread on the validation logs' states the

@@ -249,7 +249,8 @@ class IdentificationPipeline:
         progress : callable, optional
             ``progress(step, done, total)``.
         held_out : bool
-            With ``sdp`` listed and no validation log to come: choose the estimate to trust on held-out blocks.
+            With ``sdp`` listed and no validation log to come: score the least-squares and SDP estimates on held-out
+            blocks (said in the main estimate's finding; :func:`dynid.identification.identify.identify`).
         recording : dynid.io.datasets.Recording, optional
             The log as read, which the closed-loop estimators simulate (needed with :attr:`closed_loop`).
         jackknife : bool
