@@ -206,8 +206,8 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
                            f"blocks of the log {how} ({{}} against {{}} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
                            "cross-validation)".format(*_apart_figures(sdp, own))
                            + ("" if sdp < own else "; it is what dynid export writes"))
-    if not str(result.consistency_verdicts.get(SDP_LABEL, "")).startswith("yes"):
-        return main, ""
+    if main != ls or not str(result.consistency_verdicts.get(SDP_LABEL, "")).startswith("yes"):
+        return main, ""  # another estimator listed first keeps its place, as with validation logs
     return SDP_LABEL, (f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not; it is what dynid export "
                        f"writes. {ls} predicts held-out blocks of the log better ({{}} against {{}} N·m RMS, "
                        f"{HELD_OUT_FOLDS}-fold blocked cross-validation), but blocks of one excitation do not tell which "
