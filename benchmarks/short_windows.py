@@ -243,6 +243,7 @@ def fresh(windows: dict) -> int:
     validation logs (the choice then reads held-out blocks of the window), scored on the same yardstick."""
     from dynid.identification.run import run_identification
     from dynid.io.identification_config import load_identification_config
+    from dynid.report.summaries import _exportable  # what dynid export writes, as dynid identify says it
 
     folder = Path(tempfile.mkdtemp())
     exceptions: dict[str, list] = {"with": [], "alone": []}
@@ -258,9 +259,7 @@ def fresh(windows: dict) -> int:
                 alone = run_identification(replace(config, validation=()))
             yard = result.diagnostics["yardstick"]["mean_global_relative_error"]
             nominal = result.diagnostics["nominal_set"]
-            written = next((label for label, e in sorted(alone.estimates.items(), key=lambda item: item[0] != alone.main)
-                            if e.standard is not None and str(alone.consistency_verdicts.get(label, "")).startswith("yes")),
-                           alone.main)  # none consistent: the main estimate, as export then writes it with a warning
+            written = next(iter(_exportable(alone)), alone.main)  # none consistent: the main estimate, with a warning
             ratios = {"with": yard[result.main] / yard[nominal], "alone": yard[written] / yard[nominal]}
             for kind, ratio in ratios.items():
                 if ratio > 1.02:

@@ -24,7 +24,7 @@ from .base import AccumulatingEstimator, check_observations, weighted_rows
 
 CONSISTENCY_TOL = 1e-7
 """Base parameters count as physically consistent when their :func:`consistency_margin` is >= -1e-7 times the largest
-of them (at least 1: the solver's accuracy, :func:`consistency_verdict`), and an SDP result when its smallest
+of them (at least 1: the solver's accuracy, :func:`margin_is_consistent`), and an SDP result when its smallest
 pseudo-inertia eigenvalue is >= -1e-7."""
 
 
@@ -222,12 +222,31 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
     return float(t.value)
 
 
+def margin_is_consistent(margin: float, beta=None) -> bool:
+    """Whether a :func:`consistency_margin` says "physically consistent": at least ``-CONSISTENCY_TOL`` times the
+    largest ``|beta|`` where it exceeds 1 (the check's solver is accurate relative to the size of the parameters it is
+    given: a KR 300's base parameters reach 2,200, and its SDP estimate, consistent to 8e-10 link by link, had a
+    margin of -4e-7).
+
+    Parameters
+    ----------
+    margin : float [kg·m²]
+    beta : (n_base,) array, optional
+        The base parameters checked.
+
+    Returns
+    -------
+    bool
+    """
+    finite = beta is not None and np.size(beta) and np.all(np.isfinite(beta))
+    scale = max(1.0, float(np.max(np.abs(beta)))) if finite else 1.0
+    return bool(margin >= -CONSISTENCY_TOL * scale)
+
+
 def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), nonnegative=()) -> str:
     """A margin of :func:`consistency_margin` in words: "yes", or "no" with the reason.
 
-    Margins within ``CONSISTENCY_TOL`` of 0, times the largest ``|beta|`` where it exceeds 1, are "yes" (the solver's
-    round-off, relative to the size of the parameters it is given: a KR 300's base parameters reach 2,200, and its
-    SDP estimate, consistent to 8e-10 link by link, was judged "no" at a margin of -4e-7). An infeasible problem (margin -inf)
+    Margins within the solver's round-off of 0 are "yes" (:func:`margin_is_consistent`). An infeasible problem (margin -inf)
     names the base parameters that are a non-negative term alone (friction, rotor inertia) and are negative, e.g.
     ``no: fv4 = -0.02 < 0``; other negative margins give the margin: how far the closest mass distribution's smallest
     pseudo-inertia eigenvalue is below 0 [kg·m²].
@@ -247,8 +266,7 @@ def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), non
     -------
     str
     """
-    scale = max(1.0, float(np.max(np.abs(beta)))) if beta is not None and np.size(beta) and np.all(np.isfinite(beta)) else 1.0
-    if margin >= -CONSISTENCY_TOL * scale:  # the check's solver is accurate relative to the parameters' size
+    if margin_is_consistent(margin, beta):
         return "yes"
     if np.isfinite(margin):
         return f"no: some link's pseudo-inertia has an eigenvalue {margin:.3g} < 0 at best"

@@ -27,7 +27,7 @@ from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
 from ..estimators.estimation import Estimation, stacked_rows, stream_rows
 from ..estimators.fitting import make_estimator
-from ..estimators.physically_consistent import CONSISTENCY_TOL, consistency_verdict
+from ..estimators.physically_consistent import consistency_verdict, margin_is_consistent
 from ..estimators.problem import FitData, SearchBudget
 from ..estimators.registry import parse_estimators, seed_index, spec
 from ..exceptions import ConfigError
@@ -359,7 +359,7 @@ class PaperRunResult:
                 d["pseudo_inertia_min_eig"] = m.pseudo_inertia_min_eig.tolist()
             if m.consistency_margin is not None:
                 d["consistency_margin"] = m.consistency_margin
-                d["physically_consistent"] = bool(m.consistency_margin >= -CONSISTENCY_TOL)
+                d["physically_consistent"] = margin_is_consistent(m.consistency_margin, m.params)
             out["estimates"][key] = d
         return out
 
