@@ -157,6 +157,72 @@ def test_coal_measures_only_the_pairs_that_can_be_near_each_samples_nearest(ur10
     assert np.all(pruned[kept] >= floor[kept] - 1e-12)
 
 
+def test_the_nearest_points_of_two_segments_against_a_dense_search(rng):
+    """Ericson's closest points of two segments: their distance is the smallest over a dense grid of the first
+    segment (each grid point's exact distance to the second), on random segments and on parallel, collinear and
+    zero-length ones; each point lies on its segment."""
+    from dynid.excitation.link_geometry import _nearest_on_segments
+
+    p1, q1, p2, q2 = rng.uniform(-1.0, 1.0, (4, 40, 3))
+    q2[:8] = p2[:8] + (q1[:8] - p1[:8]) * rng.uniform(-2.0, 2.0, (8, 1))  # parallel, some reversed
+    p2[8:12] = p1[8:12] + 0.5 * (q1[8:12] - p1[8:12])  # collinear, overlapping
+    q2[8:12] = p1[8:12] + 1.7 * (q1[8:12] - p1[8:12])
+    q1[12:16] = p1[12:16]  # the first a point
+    q2[16:20] = p2[16:20]  # the second a point
+    q1[20:22], q2[20:22] = p1[20:22], p2[20:22]  # both
+    c1, c2 = _nearest_on_segments(p1, q1, p2, q2)
+    grid = p1[:, None] + np.linspace(0.0, 1.0, 4001)[None, :, None] * (q1 - p1)[:, None]  # (40, 4001, 3)
+    d = q2 - p2
+    t = np.clip(np.einsum("gki,gi->gk", grid - p2[:, None], d) / np.maximum(np.einsum("gi,gi->g", d, d), 1e-300)[:, None],
+                0.0, 1.0)
+    dense = np.linalg.norm(grid - p2[:, None] - t[..., None] * d[:, None], axis=-1).min(axis=1)
+    found = np.linalg.norm(c2 - c1, axis=-1)
+    assert np.all(found <= dense + 1e-12) and np.all(found >= dense - 1e-6)
+    for p, q, c in ((p1, q1, c1), (p2, q2, c2)):  # on the segment: its distances to the ends add up to the length
+        np.testing.assert_allclose(np.linalg.norm(c - p, axis=-1) + np.linalg.norm(q - c, axis=-1),
+                                   np.linalg.norm(q - p, axis=-1), atol=1e-12)
+
+
+def test_the_bounding_capsules_hold_their_shapes_and_tighten_the_spheres_bound(ur10e_with_meshes, rng, monkeypatch):
+    """Each shape's capsule holds its points (a hull's, a box's corners, a cylinder's rims); the self distances' bound
+    is the larger of the bounding spheres' and the capsules', never above coal's distance, and above the spheres'
+    alone on most pairs of these long boxes, so that coal is asked about fewer pairs."""
+    import coal
+
+    from dynid.excitation import link_geometry as lg
+    from dynid.excitation.link_geometry import _bounding_capsule
+
+    cylinder = coal.Cylinder(0.05, 0.4)
+    angle = np.linspace(0.0, 2 * np.pi, 50)
+    rims = np.concatenate([np.stack([0.05 * np.cos(angle), 0.05 * np.sin(angle), np.full(50, z)], axis=1)
+                           for z in (-0.2, 0.2)])
+    robot = load_robot(ur10e_with_meshes)
+    geometry = link_geometry_from_urdf(robot, ur10e_with_meshes)
+    shapes = [(s, np.asarray(s.points())) for s in geometry.shapes if isinstance(s, coal.ConvexBase)]
+    box = coal.Box(0.3, 0.1, 0.05)
+    shapes += [(box, np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * [0.15, 0.05, 0.025]),
+               (cylinder, rims)]
+    for shape, points in shapes:
+        (a, b), radius = _bounding_capsule(shape)
+        on = a + np.clip((points - a) @ (b - a) / max((b - a) @ (b - a), 1e-300), 0.0, 1.0)[:, None] * (b - a)
+        assert np.linalg.norm(points - on, axis=1).max() <= radius + 1e-12
+    assert _bounding_capsule(box)[1] == pytest.approx(np.hypot(0.05, 0.025))  # about the long axis
+    pairs = self_pairs(robot, geometry)
+    q = rng.uniform(-2.0, 2.0, (40, robot.n_dof))
+    centre, radius, _, _ = geometry.bounds(robot, q)
+    a, b = (np.array([p[k] for p in pairs]) for k in (0, 1))
+    spheres = np.linalg.norm(centre[:, b] - centre[:, a], axis=-1) - radius[a] - radius[b]
+    calls = []
+    real = lg.distance_above
+    monkeypatch.setattr(lg, "distance_above", lambda *args: calls.append(1) or real(*args))
+    measured = lg.SelfDistances(robot, q, geometry, pairs).dist
+    assert 0 < len(calls) < int((spheres < FAR).sum())  # coal was asked of every pair whose spheres are near
+    assert np.all(measured >= spheres - 1e-12)
+    monkeypatch.setattr(lg, "FAR", np.inf)  # coal's distance of every pair
+    exact = lg.SelfDistances(robot, q, geometry, pairs).dist
+    assert np.all(measured <= exact + 1e-9) and np.any(measured < exact - 1e-3)  # a lower bound where coal was not asked
+
+
 def test_the_soft_minimum_is_a_smooth_lower_bound_of_the_minimum(rng):
     """Kreisselmeier-Steinhauser: at most the minimum and at least ``log(P) / ρ`` below it; its gradient against
     central differences."""
@@ -283,14 +349,14 @@ def test_an_srdfs_disabled_pairs_are_not_kept_apart(ur10e_with_meshes, tmp_path)
 
 
 def test_the_last_trajectorys_poses_are_reused_only_for_that_trajectory(ur10e_with_meshes, rng):
-    """The poses, spheres and coal transforms kept for the last trajectory asked are those of the trajectory asked:
+    """The poses, bounding volumes and coal transforms kept for the last trajectory asked are those of the trajectory asked:
     alternating two trajectories, each answer equals a fresh geometry's."""
     robot = load_robot(ur10e_with_meshes)
     kept = link_geometry_from_urdf(robot, ur10e_with_meshes)
     one, two = rng.uniform(-2.0, 2.0, (2, 7, robot.n_dof))
     for q in (one, two, one, two.copy()):
         fresh = replace(kept, memo={})
-        for mine, theirs in zip(kept.poses(robot, q) + kept.spheres(robot, q), fresh.poses(robot, q) + fresh.spheres(robot, q)):
+        for mine, theirs in zip(kept.poses(robot, q) + kept.bounds(robot, q), fresh.poses(robot, q) + fresh.bounds(robot, q)):
             np.testing.assert_array_equal(mine, theirs)
         pose = kept.pose_of(robot, q)  # coal's, made when asked: one shape at one sample
         np.testing.assert_array_equal(pose(3, 2).getTranslation(), fresh.poses(robot, q)[1][3, 2])

@@ -449,7 +449,7 @@ its soft minimum took the optimiser more iterations (benchmarks/README.md)."""
 
 NEGLIGIBLE = 20.0
 """A pair's weight in the soft minimum below ``exp(-NEGLIGIBLE)`` (a pair at least ``NEGLIGIBLE / SHARPNESS`` = 2 cm
-farther than a sample's nearest one): coal is not asked for its distance, its bounding spheres' (a lower bound) stands."""
+farther than a sample's nearest one): coal is not asked for its distance, its bounding volumes' (a lower bound) stands."""
 
 
 def soft_min(values: np.ndarray, jacobian: np.ndarray | None = None, *,

@@ -58,7 +58,7 @@ class LinkGeometry:
     found : dict
         The pairs :func:`self_pairs` found, per joint range and sample: found once per run.
     memo : dict
-        The shapes' local bounding boxes, and the last trajectory's poses, bounding spheres and coal transforms.
+        The shapes' bounding volumes, and the last trajectory's poses, bounding volumes and coal transforms.
     """
 
     shapes: tuple
@@ -70,8 +70,10 @@ class LinkGeometry:
     found: dict = field(default_factory=dict, compare=False, repr=False)
     memo: dict = field(default_factory=dict, compare=False, repr=False)
 
-    def spheres(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Each shape's bounding sphere (coal's local box, half its diagonal) along ``q``.
+    def bounds(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Each shape's bounding sphere (coal's local box, half its diagonal) and bounding capsule
+        (:func:`_bounding_capsule`) along ``q``: two volumes that contain it, the sphere the tighter about a round
+        shape, the capsule about a long one.
 
         Parameters
         ----------
@@ -82,16 +84,23 @@ class LinkGeometry:
         -------
         centre : (N, m, 3) array [m]
         radius : (m,) array [m]
+        ends : (N, m, 2, 3) array [m]
+            The capsules' segments.
+        capsule_radius : (m,) array [m]
         """
         if "local" not in self.memo:  # the shapes do not change
             for shape in self.shapes:
                 shape.computeLocalAABB()
+            found = [_bounding_capsule(shape) for shape in self.shapes]
             self.memo["local"] = (np.array([np.asarray(shape.aabb_center, dtype=float) for shape in self.shapes]),
-                                  np.array([float(shape.aabb_radius) for shape in self.shapes]))
+                                  np.array([float(shape.aabb_radius) for shape in self.shapes]),
+                                  np.array([f[0] for f in found]), np.array([f[1] for f in found]))
+        centre, radius, ends, capsule_radius = self.memo["local"]
         placed = self._placed(robot, q)
         if "centre" not in placed:
-            placed["centre"] = placed["position"] + np.einsum("nmij,mj->nmi", placed["rotation"], self.memo["local"][0])
-        return placed["centre"], self.memo["local"][1]
+            placed["centre"] = placed["position"] + np.einsum("nmij,mj->nmi", placed["rotation"], centre)
+            placed["ends"] = placed["position"][:, :, None] + np.einsum("nmij,mkj->nmki", placed["rotation"], ends)
+        return placed["centre"], radius, placed["ends"], capsule_radius
 
     def poses(self, robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every shape's rotation and position in the base frame.
@@ -138,7 +147,7 @@ class LinkGeometry:
 
     def _placed(self, robot: Robot, q: np.ndarray) -> dict:
         """The shapes placed along ``q``: one entry of :attr:`memo` for the last trajectory asked (the design asks the
-        cell's and the self distances, each with the spheres, on the same grid), replaced whole, so that what it holds
+        cell's and the self distances, each with the bounding volumes, on the same grid), replaced whole, so that what it holds
         is always of one trajectory."""
         key = (id(robot), q.shape, q.tobytes())
         last = self.memo.get("last")
@@ -293,6 +302,58 @@ def _coal_shape(geom):
     return mesh.convex
 
 
+def _bounding_capsule(shape) -> tuple[np.ndarray, float]:
+    """A capsule that contains ``shape``, in its own frame: the ends of its segment (2, 3) and its radius. A cylinder
+    or a capsule gives its own; the points of a box or a convex hull give the capsule about their principal axis with
+    the smallest radius and the shortest segment that hold every point; any other shape, its local box's bounding
+    sphere (a segment of no length)."""
+    if isinstance(shape, (coal.Cylinder, coal.Capsule)):
+        return np.array([[0.0, 0.0, -shape.halfLength], [0.0, 0.0, shape.halfLength]]), float(shape.radius)
+    if isinstance(shape, coal.Box):
+        points = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * np.asarray(shape.halfSide)
+    elif isinstance(shape, coal.ConvexBase):
+        points = np.asarray(shape.points(), dtype=float)
+    else:  # a sphere, an ellipsoid
+        shape.computeLocalAABB()
+        return np.array([shape.aabb_center, shape.aabb_center], dtype=float), float(shape.aabb_radius)
+    middle = points.mean(axis=0)
+    axis = np.linalg.svd(points - middle, full_matrices=False)[2][0]
+    along = (points - middle) @ axis
+    off = np.linalg.norm(points - middle - along[:, None] * axis, axis=1)
+    radius = float(off.max())
+    slack = np.sqrt(np.maximum(radius**2 - off**2, 0.0))  # how far past each point the segment may stop
+    low, high = float(np.min(along + slack)), float(np.max(along - slack))
+    if low > high:  # every point within the radius of one point of the axis
+        low = high = 0.5 * (low + high)
+    return middle + np.array([low, high])[:, None] * axis, radius
+
+
+def _ratio(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+    """``num / den`` clipped to [0, 1], 0 where ``den`` vanishes (a segment of no length)."""
+    return np.where(den > 1e-18, np.clip(num / np.where(den > 1e-18, den, 1.0), 0.0, 1.0), 0.0)
+
+
+def _nearest_on_segments(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The nearest points of segments ``p1q1`` and ``p2q2`` (arrays (..., 3)), each pair's (C. Ericson, Real-Time
+    Collision Detection, 2005, §5.1.9, with its branches as masks)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e = np.einsum("...i,...i", d1, d1), np.einsum("...i,...i", d2, d2)
+    b, c, f = np.einsum("...i,...i", d1, d2), np.einsum("...i,...i", d1, r), np.einsum("...i,...i", d2, r)
+    s = _ratio(b * f - c * e, a * e - b * b)  # 0 where parallel
+    t = (b * s + f) / np.where(e > 1e-18, e, 1.0)
+    s = np.where(t < 0.0, _ratio(-c, a), np.where(t > 1.0, _ratio(b - c, a), s))
+    t = np.clip(t, 0.0, 1.0)
+    s, t = np.where(e > 1e-18, s, _ratio(-c, a)), np.where(e > 1e-18, t, 0.0)  # the second a point
+    s, t = np.where(a > 1e-18, s, 0.0), np.where(a > 1e-18, t, _ratio(f, e))  # the first a point
+    return p1 + s[..., None] * d1, p2 + t[..., None] * d2
+
+
+def _nearest_on_segment(p: np.ndarray, q: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The point of segment ``pq`` nearest ``x`` (arrays (..., 3))."""
+    d = q - p
+    return p + _ratio(np.einsum("...i,...i", x - p, d), np.einsum("...i,...i", d, d))[..., None] * d
+
+
 def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeometry, clearance: float, *,
                     pairs=None, gradient: bool = False) -> ObstacleDistances:
     """The links' collision shapes' distances to the cell's bodies along ``q``, less ``clearance`` (zero: the
@@ -320,7 +381,7 @@ def shape_distances(robot: Robot, q: np.ndarray, obstacles, geometry: LinkGeomet
 
 class _CoalDistances:
     """What :class:`ShapeDistances` and :class:`SelfDistances` share: the distances measured once (``dist`` (N, P),
-    coal's results ``_found`` where the bounding spheres are near, their nearest points and normal ``_near``,
+    coal's results ``_found`` where the bounding volumes are near, their nearest points and normal ``_near``,
     ``_normal`` elsewhere), their gradient given on demand from the same results (a design asks the values at an
     iterate, then their gradient at the same iterate: coal is not asked twice)."""
 
@@ -378,13 +439,16 @@ class ShapeDistances(_CoalDistances):
         self.pairs = pairs = ([(g, i) for g in np.flatnonzero(geometry.link >= 0).tolist() for i in range(len(obstacles))]
                               if pairs is None else list(pairs))
         bodies = [ob.geometry() for ob in obstacles]
-        centre, radius = geometry.spheres(robot, q)
+        centre, radius, ends, capsule_radius = geometry.bounds(robot, q)
         g_of, i_of = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
-        ob_centre = np.array([ob.position for ob in obstacles])[i_of] if pairs else np.zeros((0, 3))
+        ob_centre = np.array([ob.position for ob in obstacles])[i_of][None] if pairs else np.zeros((1, 0, 3))
         ob_radius = np.array([ob.bounding_radius() for ob in obstacles])[i_of] if pairs else np.zeros(0)
-        gap = centre[:, g_of] - ob_centre[None]  # (N, P, 3): the bound's direction, body to shape
-        self.dist = np.linalg.norm(gap, axis=-1) - radius[g_of] - ob_radius - clearance  # a lower bound, exact far away
-        self._near = centre[:, g_of].copy()
+        on_capsule = _nearest_on_segment(ends[:, g_of, 0], ends[:, g_of, 1], ob_centre)  # (N, P, 3)
+        sphere = np.linalg.norm(centre[:, g_of] - ob_centre, axis=-1) - radius[g_of]
+        capsule = np.linalg.norm(on_capsule - ob_centre, axis=-1) - capsule_radius[g_of]
+        self._near = np.where((capsule > sphere)[..., None], on_capsule, centre[:, g_of])  # the tighter bound's
+        gap = self._near - ob_centre  # the bound's direction, body to shape
+        self.dist = np.maximum(sphere, capsule) - ob_radius - clearance  # a lower bound, exact far away
         self._normal = -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
         pose = geometry.pose_of(robot, q)
         shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
@@ -405,7 +469,7 @@ class ShapeDistances(_CoalDistances):
 
 
 def _coal_results(dist: np.ndarray, offset: float, shapes_at, *, within: float | None = None) -> list:
-    """coal's distance of every pair whose bounding spheres' bound ``dist`` (N, P) is below :data:`FAR`: ``dist``
+    """coal's distance of every pair whose bounding volumes' bound ``dist`` (N, P) is below :data:`FAR`: ``dist``
     takes each (less ``offset``, the clearance), and the list of ``(n, c, result)`` is returned (a pair coal fails on
     keeps its bound). ``shapes_at(n, c)`` gives ``(shape_a, pose_a, shape_b, pose_b)``.
 
@@ -434,7 +498,7 @@ def _measured(dist: np.ndarray, offset: float, shapes_at, request, asked: tuple)
     for n, c, bound in zip(*asked, (dist[asked] + offset).tolist()):
         shape_a, pose_a, shape_b, pose_b = shapes_at(n, c)
         result = distance_above(shape_a, pose_a, shape_b, pose_b, request, bound)
-        if result is not None:  # else coal failed on a deep overlap: the spheres' bound stands
+        if result is not None:  # else coal failed on a deep overlap: the bounding volumes' bound stands
             found.append((n, c, result))
     if found:
         n_found, c_found, results = zip(*found)
@@ -451,7 +515,7 @@ def _found_ends(found: list) -> tuple:
 
 
 FAR = 0.1
-"""[m] Where two bounding spheres are this far apart, their distance stands for the shapes' (a lower bound, smooth,
+"""[m] Where two shapes' bounding volumes (:meth:`LinkGeometry.bounds`) are this far apart, their distance stands for the shapes' (a lower bound, continuous,
 with its own gradient): the constraint is far from binding, and GJK runs only on the pairs that are near."""
 
 ALWAYS = 0.95
@@ -527,17 +591,20 @@ class SelfDistances(_CoalDistances):
         Shape indices (:func:`self_pairs`).
     within : float, optional
         [m] coal measures only the pairs that can lie within this of each sample's nearest one; the others keep their
-        bounding spheres' distance (a lower bound). Default: every pair within :data:`FAR`.
+        bounding volumes' distance (a lower bound). Default: every pair within :data:`FAR`.
     """
 
     def __init__(self, robot: Robot, q: np.ndarray, geometry: LinkGeometry, pairs, *, within: float | None = None):
         self.robot, self.geometry, self.pairs = robot, geometry, list(pairs)
         self.q = q = np.atleast_2d(np.asarray(q, dtype=float))
-        centre, radius = geometry.spheres(robot, q)
+        centre, radius, ends, capsule_radius = geometry.bounds(robot, q)
         a, b = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
-        gap = centre[:, b] - centre[:, a]  # (N, P, 3)
-        self.dist = np.linalg.norm(gap, axis=-1) - radius[a] - radius[b]  # a lower bound, exact far away
-        self._near = np.stack([centre[:, a], centre[:, b]])
+        on_capsules = np.stack(_nearest_on_segments(ends[:, a, 0], ends[:, a, 1], ends[:, b, 0], ends[:, b, 1]))
+        sphere = np.linalg.norm(centre[:, b] - centre[:, a], axis=-1) - radius[a] - radius[b]
+        capsule = np.linalg.norm(on_capsules[1] - on_capsules[0], axis=-1) - capsule_radius[a] - capsule_radius[b]
+        self._near = np.where((capsule > sphere)[None, ..., None], on_capsules, np.stack([centre[:, a], centre[:, b]]))
+        gap = self._near[1] - self._near[0]  # (N, P, 3): the tighter bound's direction
+        self.dist = np.maximum(sphere, capsule)  # a lower bound, exact far away
         self._normal = gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
         pose = geometry.pose_of(robot, q)
         shapes = [(geometry.shapes[g], g, geometry.shapes[h], h) for g, h in pairs]
