@@ -19,13 +19,29 @@ from __future__ import annotations
 
 import threading
 from concurrent.futures import ThreadPoolExecutor
+from typing import NamedTuple
 
 import numpy as np
 
 from ..runtime.threads import cores
 
 
-def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl):
+class RobotArrays(NamedTuple):
+    """What the kernel reads of a robot: each joint's fixed rotation ``rp`` (n, 3, 3) and translation ``pp`` (n, 3)
+    from its parent's frame, its axis ``axes`` (n, 3), ``gravity`` (3,) [m/s²], the standard parameters per joint
+    ``npj``, where each standard column goes (``colmap`` (n_params,), skipped where negative) and where each joint's
+    drive columns go (``drive_map`` (n, T), skipped where negative)."""
+
+    rp: np.ndarray
+    pp: np.ndarray
+    axes: np.ndarray
+    gravity: np.ndarray
+    npj: int
+    colmap: np.ndarray
+    drive_map: np.ndarray
+
+
+def sample_columns(k, robot, motion, out, drive, scratch):
     """Fill ``out[k]`` (n, m): column ``colmap[c]`` holds standard column ``c`` of the ten inertial columns of
     each link (skipped where ``colmap[c] < 0``), column ``drive_map[i, t]`` of joint ``i`` its drive column
     ``drive[k, i, t]`` (skipped where ``drive_map[i, t] < 0``); the other columns hold 0.
@@ -34,21 +50,20 @@ def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive
     ----------
     k : int or slice
         The sample (compiled) or ``slice(None)``: every sample of ``q`` at once (NumPy).
-    rp, pp, axes : (n, 3, 3), (n, 3), (n, 3) arrays
-        Each joint's fixed rotation and translation from its parent's frame, and its axis.
-    gravity : (3,) array [m/s²]
-    q, dq, ddq : (N, n) arrays [rad, rad/s, rad/s²]
+    robot : RobotArrays
+    motion : tuple of (N, n) arrays
+        ``q, dq, ddq`` [rad, rad/s, rad/s²].
     out : (N, n, m) array
-    npj : int
-        Standard parameters per joint.
-    colmap : (n_params,) int array
     drive : (N, n, T) array
         Each joint's own drive columns (rotor inertia, friction, offset: :mod:`dynid.friction`), written here
         while the sample's row is in the cache.
-    drive_map : (n, T) int array
-    r0, o, w, dw, acc, z0, rl : scratch arrays (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample
-        axis when ``k`` is a slice.
+    scratch : tuple of arrays
+        ``r0, o, w, dw, acc, z0, rl``: (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample axis when ``k`` is
+        a slice.
     """
+    rp, pp, axes, gravity, npj, colmap, drive_map = robot
+    q, dq, ddq = motion
+    r0, o, w, dw, acc, z0, rl = scratch
     n = q.shape[1]
     m = out.shape[2]
     # ---- zero every entry first (links j < i stay zero), then each joint's drive columns -----------
@@ -161,16 +176,16 @@ def sample_columns(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive
                     out[k, i, dst] = values[t]
 
 
-def _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop, r0, o, w, dw, acc, z0, rl):
-    for k in range(start, stop):
-        _sample(k, rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, r0, o, w, dw, acc, z0, rl)
+def _chunk(robot, motion, out, drive, span, scratch):
+    for k in range(span[0], span[1]):
+        _sample(k, robot, motion, out, drive, scratch)
 
 
-def _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop):
+def _samples(robot, motion, out, drive, start, stop):
     """Samples ``start:stop`` with their own scratch arrays (releases the GIL: threads run ranges side by side)."""
-    n = q.shape[1]
-    _chunk(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, start, stop, np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
-           np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((3, 3)))
+    n = motion[0].shape[1]
+    _chunk(robot, motion, out, drive, (start, stop), (np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+                                                     np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((3, 3))))
 
 
 _sample = sample_columns  # load_compiled() binds these names to their compiled versions (numba resolves globals then)
@@ -202,19 +217,20 @@ NUMPY_BLOCK = 1024
 temporary block, 8 MB for a 6-joint arm's 87 columns, at 0.8 µs a sample more in ``bench_regressor.py``)."""
 
 
-def numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map):
+def numpy_regressor(robot: RobotArrays, motion, out, drive) -> None:
     """What :func:`joint_torque_regressor` computes, by :func:`sample_columns` on blocks of samples at once
     (NumPy vectors; 4.4-5.3 µs an er16 sample against the kernel's 0.8 µs in ``bench_regressor.py``, but no
     start-up). ``drive(a, b)`` gives the drive columns of samples ``a:b`` (block by block: no array of the whole
     call's)."""
+    q, dq, ddq = motion
     n_s, n = q.shape
     for a in range(0, n_s, NUMPY_BLOCK):
         b = min(a + NUMPY_BLOCK, n_s)
         m = b - a
         block = np.empty((n, out.shape[2], m))  # a column's samples side by side: written at full speed
-        sample_columns(slice(None), rp, pp, axes, gravity, q[a:b], dq[a:b], ddq[a:b], block.transpose(2, 0, 1), npj,
-                       colmap, drive(a, b), drive_map, np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
-                       np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((3, 3, m)))
+        scratch = (np.empty((n, 3, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((n, 3, m)),
+                   np.empty((n, 3, m)), np.empty((n, 3, m)), np.empty((3, 3, m)))
+        sample_columns(slice(None), robot, (q[a:b], dq[a:b], ddq[a:b]), block.transpose(2, 0, 1), drive(a, b), scratch)
         out[a:b] = block.transpose(2, 0, 1)
 
 
@@ -222,20 +238,18 @@ PARALLEL_SAMPLES = 4096
 """From this many samples on, the samples are split over the cores (threads); below, one call."""
 
 
-def joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map):
+def joint_torque_regressor(robot: RobotArrays, motion, out, drive) -> None:
     """Fill every entry of ``out`` (N, n, m): column ``colmap[c]`` holds standard column ``c`` (the ten
     inertial columns of each link; skipped where ``colmap[c] < 0``) and the drive columns of ``drive`` as
     ``drive_map`` places them (:func:`sample_columns`). Every sample is computed on its own, so the result does not
     depend on how the samples are split over threads."""
     load_compiled()
-    n_s = q.shape[0]
+    n_s = motion[0].shape[0]
     workers = min(cores(), max(1, n_s // PARALLEL_SAMPLES))
     if workers == 1:
-        _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, 0, n_s)
+        _samples(robot, motion, out, drive, 0, n_s)
         return
 
     bounds = np.linspace(0, n_s, workers + 1).astype(np.int64)
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        list(pool.map(lambda k: _samples(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map, int(bounds[k]),
-                                         int(bounds[k + 1])),
-                      range(workers)))
+        list(pool.map(lambda k: _samples(robot, motion, out, drive, int(bounds[k]), int(bounds[k + 1])), range(workers)))

@@ -139,9 +139,10 @@ def _trace(rp, pp, axes, gravity, npj: int, n_drive: int):
     out = _Output(n, n * npj)
     colmap = np.arange(n * npj)
     drive_map = np.arange(n)[:, None] * npj + 10 + np.arange(n_drive)
-    as_objects = [np.array(np.asarray(a, dtype=float).tolist(), dtype=object) for a in (rp, pp, axes, gravity)]
-    scratch = [np.empty(s, dtype=object) for s in ((n, 3, 3), (n, 3), (n, 3), (n, 3), (n, 3), (n, 3), (3, 3))]
-    _regressor_kernel.sample_columns(0, *as_objects, q, dq, ddq, out, npj, colmap, drive, drive_map, *scratch)  # type: ignore[call-arg]
+    rp_, pp_, axes_, gravity_ = (np.array(np.asarray(a, dtype=float).tolist(), dtype=object) for a in (rp, pp, axes, gravity))
+    scratch = tuple(np.empty(s, dtype=object) for s in ((n, 3, 3), (n, 3), (n, 3), (n, 3), (n, 3), (n, 3), (3, 3)))
+    robot = _regressor_kernel.RobotArrays(rp_, pp_, axes_, gravity_, npj, colmap, drive_map)
+    _regressor_kernel.sample_columns(0, robot, (q, dq, ddq), out, drive, scratch)
     return graph, {key: v for key, v in out.stores.items() if isinstance(v, _Sym) or v != 0.0}
 
 
@@ -343,12 +344,14 @@ PARALLEL_SAMPLES = 4096
 without the GIL); below, one call."""
 
 
-def simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map) -> None:
+def simd_regressor(robot, motion, out, drive) -> None:
     """What :func:`dynid.dynamics._regressor_kernel.joint_torque_regressor` computes (the same arguments, but
     ``drive(a, b)`` giving the drive columns (b - a, n, T) of samples ``a:b``; every entry of ``out``
     (N, n, m), C-ordered, is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
     samples after the last whole group of lanes go through it padded. ``colmap`` must place the drive
     columns where ``drive_map`` does (as :func:`dynid.dynamics.regressor.regressor` builds them)."""
+    rp, pp, axes, gravity, npj, colmap, drive_map = robot
+    q, dq, ddq = motion
     n_s, n = q.shape
     m, n_drive = out.shape[2], drive_map.shape[1]
     function = kernel(rp, pp, axes, gravity, npj, n_drive)

@@ -144,14 +144,14 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, *, form: str | None = None, vel
         return np.ascontiguousarray(drive_columns(robot.drive_terms, q[a:b], dq[a:b], ddq[a:b], v.rows(a, b)) * robot.drive_mask)
 
     drive_map = np.ascontiguousarray(colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(len(robot.drive_terms))])
+    arrays = kernel.RobotArrays(rp, pp, axes, gravity, npj, colmap, drive_map)
     form = form or ("numpy" if _numpy_form(q.shape[0]) else "compiled")
     if form == "compiled":
-        _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
+        _compiled_regressor(arrays, (q, dq, ddq), out, drive)
+    elif form == "numpy":
+        kernel.numpy_regressor(arrays, (q, dq, ddq), out, drive)
     else:
-        if form == "numpy":
-            kernel.numpy_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
-        else:
-            kernel.joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
+        kernel.joint_torque_regressor(arrays, (q, dq, ddq), out, drive(0, q.shape[0]))
     n_joint = robot.n_dof * npj
     if robot.n_params > n_joint:  # coupled motors (see dynid.model.transmission)
         src = np.arange(n_joint, robot.n_params)
@@ -163,18 +163,19 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, *, form: str | None = None, vel
 _simd = {"used": False, "failed": False}
 
 
-def _compiled_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map) -> None:
+def _compiled_regressor(arrays, motion, out, drive) -> None:
     """The compiled regressor: the robot's own SIMD code (:mod:`dynid.dynamics._regressor_simd`), or numba's
     kernel where that code cannot be built (no LLVM for this platform). Both give the NumPy form's numbers.
-    ``drive(a, b)`` gives the drive columns of samples ``a:b``."""
+    ``arrays`` is the robot's :class:`~dynid.dynamics._regressor_kernel.RobotArrays`, ``motion`` ``(q, dq, ddq)``,
+    and ``drive(a, b)`` gives the drive columns of samples ``a:b``."""
     if not _simd["failed"]:
         try:
-            _regressor_simd.simd_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive, drive_map)
+            _regressor_simd.simd_regressor(arrays, motion, out, drive)
             _simd["used"] = True
             return
         except Exception:  # noqa: BLE001 - llvmlite cannot build it here: numba's kernel computes the same numbers
             _simd["failed"] = True
-    kernel.joint_torque_regressor(rp, pp, axes, gravity, q, dq, ddq, out, npj, colmap, drive(0, q.shape[0]), drive_map)
+    kernel.joint_torque_regressor(arrays, motion, out, drive(0, motion[0].shape[0]))
 
 
 def _numpy_form(n_samples: int) -> bool:
