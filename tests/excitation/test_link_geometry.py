@@ -157,6 +157,44 @@ def test_coal_measures_only_the_pairs_that_can_be_near_each_samples_nearest(ur10
     assert np.all(pruned[kept] >= floor[kept] - 1e-12)
 
 
+def test_coal_measures_each_samples_pairs_in_the_order_of_their_bounds_until_none_can_be_nearest(rng):
+    """The branch and bound of ``within``: at each sample coal is asked exactly the pairs a plain loop over the bounds
+    in ascending order asks, stopping at the first bound ``within`` or more above the smallest distance found so far;
+    pairs of spheres at known distances, their bounds loose by up to 4 cm (so that the lowest bound is often not the
+    nearest pair)."""
+    import coal
+
+    from dynid.excitation import link_geometry as lg
+
+    n_samples, n_pairs, within, radius = 50, 8, 0.02, 0.05
+    true = rng.uniform(0.0, 0.08, (n_samples, n_pairs))
+    bounds = true - rng.uniform(0.0, 0.04, true.shape)
+    sphere = coal.Sphere(radius)
+    apart = [[(coal.Transform3s(np.eye(3), np.zeros(3)), coal.Transform3s(np.eye(3), np.array([d + 2 * radius, 0, 0])))
+              for d in row] for row in true]
+    asked: set = set()
+    dist = bounds.copy()
+
+    def shapes_at(n, c):
+        asked.add((n, c))
+        return sphere, apart[n][c][0], sphere, apart[n][c][1]
+
+    found = lg._coal_results(dist, 0.0, shapes_at, within=within)
+    expected = set()
+    for n in range(n_samples):
+        best = np.inf
+        for c in np.argsort(bounds[n], kind="stable"):
+            if bounds[n, c] >= lg.FAR or bounds[n, c] >= best + within:
+                break
+            expected.add((n, int(c)))
+            best = min(best, true[n, c])
+    assert asked == expected and len(found) == len(expected)
+    np.testing.assert_allclose(dist.min(axis=1), true.min(axis=1), atol=1e-9)  # every sample's nearest, coal's
+    unasked = np.ones(true.shape, bool)
+    unasked[tuple(np.array(sorted(expected)).T)] = False
+    np.testing.assert_array_equal(dist[unasked], bounds[unasked])
+    assert np.all(dist[unasked] >= true.min(axis=1, keepdims=True).repeat(n_pairs, 1)[unasked] + within - 1e-12)
+
 def test_the_nearest_points_of_two_segments_against_a_dense_search(rng):
     """Ericson's closest points of two segments: their distance is the smallest over a dense grid of the first
     segment (each grid point's exact distance to the second), on random segments and on parallel, collinear and

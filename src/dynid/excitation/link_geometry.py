@@ -473,23 +473,28 @@ def _coal_results(dist: np.ndarray, offset: float, shapes_at, *, within: float |
     takes each (less ``offset``, the clearance), and the list of ``(n, c, result)`` is returned (a pair coal fails on
     keeps its bound). ``shapes_at(n, c)`` gives ``(shape_a, pose_a, shape_b, pose_b)``.
 
-    With ``within`` [m], coal measures first each sample's pair of the lowest bound, then only the pairs whose bound
-    lies within ``within`` of that pair's distance (an upper bound of the sample's smallest): the others are at least
-    ``within`` farther than the sample's nearest pair, and keep their bound."""
+    With ``within`` [m], a branch and bound: coal measures each sample's pairs in the order of their bounds, and stops
+    at the first whose bound lies ``within`` or more above the smallest distance measured so far (an upper bound of the
+    sample's smallest): that pair and the rest are at least ``within`` farther than the sample's nearest pair, and keep
+    their bound. One round of coal's calls measures the next pair of every sample still open."""
     request = coal.DistanceRequest()
     request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    near = dist < FAR
+    if within is None or dist.shape[1] < 2:
+        return _measured(dist, offset, shapes_at, request, np.nonzero(dist < FAR))
+    order = np.argsort(dist, axis=1, kind="stable")
+    bound = np.take_along_axis(dist, order, axis=1)  # each sample's bounds, ascending (dist takes coal's below)
+    best = np.full(dist.shape[0], np.inf)  # a pair coal fails on keeps its bound and leaves the best as it was
     found: list = []
-    if within is not None and dist.shape[1] > 1:
-        samples = np.flatnonzero(near.any(axis=1))
-        lowest = np.argmin(dist[samples], axis=1)
-        found = _measured(dist, offset, shapes_at, request, (samples, lowest))
-        nearest = np.full(dist.shape[0], np.inf)  # a sample whose first pair coal failed on keeps every near pair
-        for n, c, _ in found:
-            nearest[n] = dist[n, c]
-        near[samples, lowest] = False
-        near &= dist < nearest[:, None] + within
-    return found + _measured(dist, offset, shapes_at, request, np.nonzero(near))
+    for k in range(dist.shape[1]):
+        samples = np.flatnonzero((bound[:, k] < FAR) & (bound[:, k] < best + within))
+        if not samples.size:
+            break
+        measured = _measured(dist, offset, shapes_at, request, (samples, order[samples, k]))
+        if measured:
+            n_found, c_found = (np.array(x) for x in tuple(zip(*measured))[:2])
+            best[n_found] = np.minimum(best[n_found], dist[n_found, c_found])
+        found += measured
+    return found
 
 
 def _measured(dist: np.ndarray, offset: float, shapes_at, request, asked: tuple) -> list:
