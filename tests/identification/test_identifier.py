@@ -148,6 +148,26 @@ def test_fit_on_a_config_with_the_identifiers_settings_on_top(tmp_path):
     np.testing.assert_array_equal(model.params(), ident.params_)
 
 
+def test_fit_takes_a_recording_as_the_readers_and_the_simulations_give_one(er16, fitted):
+    """A log from dynid.simulated_log or dynid.load_recording is fitted as it is (the Identifier refused it: "positions
+    and torques are needed with time stamps"): the same estimates as its arrays give (its rate exact, where the arrays'
+    is one over their median step), its name and its reader's warnings kept; arrays beside it, or time stamps alone,
+    are refused by a one-line ConfigError."""
+    from dataclasses import replace
+
+    robot, log, _ = er16
+    noted = replace(log, warnings=("a reader's note",))
+    ident = dynid.Identifier(robot, estimators=["WLS", "sdp"]).fit(noted)
+    assert ident.result_.main == fitted.result_.main and "a reader's note" in ident.result_.warnings
+    np.testing.assert_allclose(ident.params_, fitted.params_, rtol=1e-5, atol=1e-9 * np.abs(fitted.params_).max())
+    assert ident.result_.fit.name == log.name != fitted.result_.fit.name
+    with pytest.raises(ConfigError, match=f"^{log.name}: a recording holds its positions"):
+        dynid.Identifier(robot).fit(log, log.q, log.tau)
+    for call in (lambda: dynid.Identifier(robot).fit(log.t), lambda: dynid.identify_from_arrays(robot, log.t, log.q)):
+        with pytest.raises(ConfigError, match="^positions q and torques tau are needed with the time stamps t"):
+            call()
+
+
 def test_jittered_time_stamps_are_resampled_as_the_readers_do(er16):
     robot, log, _ = er16
     jitter = np.random.default_rng(7).uniform(-20e-6, 20e-6, log.t.shape)
@@ -189,6 +209,21 @@ def test_predict_and_score_take_a_raw_log_as_fit_does(er16, fitted):
     with pytest.warns(FutureWarning, match="predict\\(q, dq, ddq\\) is predict_states"):
         old = fitted.predict(q[:20], q[:20] * 0, q[:20] * 0)
     np.testing.assert_array_equal(old, fitted.predict_states(q[:20], q[:20] * 0, q[:20] * 0))
+
+
+def test_predict_of_a_recording_is_at_its_own_time_stamps_and_the_identifier_validates(er16, fitted):
+    """predict(recording) gave the torques at the samples a comparison keeps (263 rows for this log of 5,000: decimated
+    and trimmed), where predict(t, q) of the same log gives one row per time stamp: it is now predict(recording.t,
+    recording.q), row for row. The Identifier validates another log as its model does (it had no validate)."""
+    _, _, other = er16
+    by_arrays = fitted.predict(other.t, np.asarray(other.q))
+    assert fitted.predict(other).shape == np.shape(other.q) == by_arrays.shape
+    np.testing.assert_array_equal(fitted.predict(other), by_arrays)
+    np.testing.assert_array_equal(fitted.model_.predict(other), by_arrays)
+    comparison = fitted.validate(other)
+    label = fitted.model_.label()
+    assert comparison.metrics()[label]["global_relative_error"] == pytest.approx(fitted.model_.relative_error(other))
+    assert dynid.summary(comparison) == dynid.summary(fitted.model_.validate(other))
 
 
 def test_load_recording_takes_a_logs_path_and_load_results_a_folder(tmp_path, fitted):
@@ -282,6 +317,11 @@ def test_every_fitted_object_has_a_short_repr_and_a_summary(tmp_path):
     assert ident.model_.summary(estimate="dynid OLS").startswith(repr(ident.model_))
     with pytest.raises(NotFittedError):
         Identifier().summary()
+    # dynid.summary takes the fitted objects too: an Identifier's is its result's, a model's its summary()
+    assert dynid.summary(ident) == dynid.summary(ident.result_)
+    assert dynid.summary(ident.model_).split() == ident.model_.summary().split()  # its words, wrapped to the width
+    with pytest.raises(NotFittedError):
+        dynid.summary(Identifier())
 
 
 def test_the_fitted_parts_are_kept_and_a_model_read_back_answers_by_the_same_names(tmp_path, er16):

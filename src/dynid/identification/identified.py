@@ -307,7 +307,9 @@ class IdentifiedModel:
         (the fitted filters and derivatives): symmetric with ``Identifier.fit(t, q, tau)``.
 
         ``predict(t, q)`` takes a raw log's time stamps and positions (and measured velocities ``dq`` if the fit had
-        them); ``predict(recording)`` a log read with :func:`dynid.load_recording`. For states one has computed oneself,
+        them); ``predict(recording)`` a log read with :func:`dynid.load_recording`, at its own time stamps as
+        ``predict(recording.t, recording.q, recording.dq)`` (the samples a comparison keeps: :meth:`predict_log`). For
+        states one has computed oneself,
         :meth:`predict_states` (``predict(q, dq, ddq)``, the earlier form, still does that, with a FutureWarning).
 
         Parameters
@@ -335,8 +337,8 @@ class IdentifiedModel:
         DataError
             Time stamps that do not increase, or a gap in them.
         """
-        if hasattr(t, "tau") and hasattr(t, "rate"):
-            return self.predict_log(t, estimate=estimate)[1]
+        if hasattr(t, "tau") and hasattr(t, "rate"):  # a recording: at its own time stamps, as its arrays
+            return self.predict(t.t, np.asarray(t.q), None if t.dq is None else np.asarray(t.dq), estimate=estimate)
         if np.ndim(t) == 2 and q is not None and dq is not None:  # the earlier predict(q, dq, ddq)
 
             warnings.warn("predict(q, dq, ddq) is predict_states(q, dq, ddq): predict(t, q) prepares a raw log as the "

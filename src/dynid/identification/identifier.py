@@ -148,17 +148,18 @@ class Identifier(HyperParameters):
         return ident._fitted(ident._config_result(Path(path), data_root, validate))
 
     def fit(self, t, q=None, tau=None, dq=None, *, data_root=None, validate: bool = True) -> Identifier:
-        """Identify the robot from arrays (a config: :meth:`from_config`).
+        """Identify the robot from arrays or a recording (a config: :meth:`from_config`).
 
         Parameters
         ----------
-        t : (N,) array [s]
-            Time stamps (jittered ones are interpolated onto a uniform grid, as the log readers do). A config's path
-            here still works, with a FutureWarning: it is :meth:`from_config`.
+        t : (N,) array [s], or a recording
+            Time stamps (jittered ones are interpolated onto a uniform grid, as the log readers do), or a log as
+            :func:`dynid.load_recording` or :func:`dynid.simulated_log` give it (alone). A config's path here still
+            works, with a FutureWarning: it is :meth:`from_config`.
         q : (N, n_dof) array [rad]
-            Joint positions (arrays only).
+            Joint positions (with time stamps).
         tau : (N, n_dof) array [N·m]
-            Joint torques (arrays only).
+            Joint torques (with time stamps).
         dq : (N, n_dof) array [rad/s], optional
             Measured velocities.
         data_root : path, optional
@@ -173,7 +174,8 @@ class Identifier(HyperParameters):
         Raises
         ------
         ConfigError
-            A malformed config or setting, or no robot for arrays.
+            A malformed config or setting, no robot for arrays, time stamps without positions and torques, or arrays
+            beside a recording.
         DataError, ShapeError, IdentifiabilityError
             Data that cannot be identified from (the message says why).
         """
@@ -185,8 +187,6 @@ class Identifier(HyperParameters):
             from ..io.identification_config import split_estimators
             from .run import identify_from_arrays
 
-            if q is None or tau is None:
-                raise ConfigError("fit(t, q, tau): positions and torques are needed with time stamps (or give a config path)")
             closed_loop = () if self.estimators is None else split_estimators(self.estimators, "Identifier(estimators=...)")[1]
             if closed_loop and self.controller is None:
                 raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the "
@@ -254,7 +254,7 @@ class Identifier(HyperParameters):
 
     def _model(self):
         if not hasattr(self, "model_"):
-            raise NotFittedError("this Identifier is not fitted yet: call fit(t, q, tau), or Identifier.from_config(config), "
+            raise NotFittedError("this Identifier is not fitted yet: call fit(t, q, tau) or fit(recording), or Identifier.from_config(config), "
                                  "first")
         return self.model_
 
@@ -315,6 +315,30 @@ class Identifier(HyperParameters):
                           "fit did", FutureWarning, stacklevel=2)
             return self._model().predict_states(t, q, dq, estimate=estimate)
         return self._model().predict(t, q, dq, ddq, estimate=estimate)
+
+    @keyword_only_after_data
+    def validate(self, recording, *, estimate: str | None = None):
+        """The paper's metrics (eq. 18's correlation, RMSE, relative error) of the estimates on another log, on the
+        samples ``dynid validate`` scores (:meth:`dynid.identification.identified.IdentifiedModel.validate`).
+
+        Parameters
+        ----------
+        recording : dynid.io.datasets.Recording
+            E.g. :func:`dynid.load_recording` or :func:`dynid.simulated_log`.
+        estimate : str, optional
+            Only this estimate (default every one).
+
+        Returns
+        -------
+        dynid.validation.torques.TorqueComparison
+            ``dynid.summary`` of it prints what ``dynid validate`` does.
+
+        Raises
+        ------
+        NotFittedError
+            Before :meth:`fit` or :meth:`from_config`.
+        """
+        return self._model().validate(recording, estimate=estimate)
 
     @keyword_only_after_data
     def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:

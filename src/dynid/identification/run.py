@@ -562,7 +562,7 @@ def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
 
 @renamed_keyword("seed", "rng")
 @with_single_blas_thread
-def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name: str = "arrays", **settings):
+def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None, *, name: str = "arrays", **settings):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``
     (:class:`~dynid.identification.pipeline.IdentificationPipeline`: data-derived preprocessing and the choices
     cross-validated on the data, the estimators, the verdict), on arrays resampled as the log readers resample.
@@ -572,17 +572,18 @@ def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name:
     robot : Robot, str or Path
         E.g. :func:`dynid.load_robot`; a built-in robot's name or a description's path is loaded
         (:func:`dynid.model.loading.as_robot`).
-    t : (N,) array [s]
+    t : (N,) array [s], or a recording
         Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step,
-        as the log readers do (with a warning).
+        as the log readers do (with a warning). Or a log as :func:`dynid.load_recording` or
+        :func:`dynid.simulated_log` give it, identified as it is (its name and warnings kept; no arrays beside it).
     q : (N, n_dof) array [rad]
-        Joint positions.
+        Joint positions (with time stamps).
     tau : (N, n_dof) array [N·m]
-        Joint torques (e.g. drive gain × motor current, eq. 16).
+        Joint torques (e.g. drive gain × motor current, eq. 16; with time stamps).
     dq : (N, n_dof) array [rad/s], optional
         Measured velocities (default: differentiated from the filtered positions).
     name : str
-        The dataset's name in tables and messages.
+        The dataset's name in tables and messages (arrays only).
     **settings
         The pipeline's settings, as :class:`~dynid.identification.pipeline.IdentificationPipeline` takes them:
         ``preprocessing`` (default: every setting derived from the data), ``estimators`` (keys or objects, as a
@@ -601,9 +602,11 @@ def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name:
     DataError
         Time stamps that do not increase, a gap longer than 5 median steps, or set-points that are not one per sample.
     ConfigError
-        An unknown estimator, setting or ``friction``, or closed-loop estimators without ``controller``.
+        An unknown estimator, setting or ``friction``, closed-loop estimators without ``controller``, time stamps
+        without positions and torques, or arrays beside a recording.
     """
     robot = as_robot(robot)
+    recording = _given_log(robot, t, q, tau, dq, name)
     from .pipeline import IdentificationPipeline
 
     known = {f.name for f in fields(IdentificationPipeline) if f.init} - {"robot", "source"}
@@ -614,7 +617,20 @@ def identify_from_arrays(robot: Robot | str | Path, t, q, tau, dq=None, *, name:
     given = {"rng": seed_of(settings.get("rng")), "preprocessing": settings.get("preprocessing") or Preprocessing()}
     pipeline = IdentificationPipeline(robot, **{**settings, **given},
                                       source=robot.name if robot.name in builtin_robots() else "")
-    return pipeline.fit(recording_from_arrays(robot, t, q, tau, dq, name))
+    return pipeline.fit(recording)
+
+
+def _given_log(robot: Robot, t, q, tau, dq, name: str) -> Recording:
+    """A recording given as one (nothing beside it), or made of arrays (:func:`recording_from_arrays`)."""
+    if isinstance(t, Recording):
+        if not (q is None and tau is None and dq is None):
+            raise ConfigError(f"{t.name}: a recording holds its positions, velocities and torques: give it alone, "
+                              "or give the arrays t, q, tau")
+        return t
+    if q is None or tau is None:
+        raise ConfigError("positions q and torques tau are needed with the time stamps t (or give a recording, as "
+                          "dynid.load_recording reads one)")
+    return recording_from_arrays(robot, t, q, tau, dq, name)
 
 
 def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"):

@@ -15,8 +15,11 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from ..conventions import INERTIAL_TERMS, split_name, unit_of
 from ..estimators.registry import OTHER_LABELS, label
+from ..exceptions import NotFittedError
 from ..friction import COUNTERBALANCE_TERMS, TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
+from ..identification.identified import IdentifiedModel
+from ..identification.identifier import Identifier
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY
 from ..tables import Line, TextTable, render_text
@@ -151,7 +154,8 @@ def summary(result, *, width: int = 100) -> str:
     Parameters
     ----------
     result : IdentificationResult, PaperRunResult, MonteCarloResult, ExcitationRun, ExcitationDesign, TorqueComparison
-        or a list of TorqueComparison (:func:`blocks`).
+        or a list of TorqueComparison, or a fitted ``Identifier`` (its result's) or ``IdentifiedModel``
+        (:func:`blocks`).
     width : int
         Characters per line the tables are fitted to.
 
@@ -169,7 +173,10 @@ def blocks(result) -> list:
     ----------
     result : object
         Any result of dynid (identification, validation: one ``TorqueComparison`` or a list of them, drive gains,
-        Monte Carlo, excitation, paper run).
+        Monte Carlo, excitation, paper run), or a fitted object: a :class:`~dynid.identification.identifier.Identifier`
+        (its identification's result, as ``dynid identify`` prints it) or an
+        :class:`~dynid.identification.identified.IdentifiedModel` (its :meth:`summary
+        <dynid.identification.identified.IdentifiedModel.summary>`, one read back from results.json included).
 
     Returns
     -------
@@ -179,6 +186,8 @@ def blocks(result) -> list:
     ------
     TypeError
         Not a result of dynid.
+    NotFittedError
+        An ``Identifier`` not fitted yet.
     """
     from ..excitation.design import ExcitationDesign
     from ..fleet.identification import FleetResult
@@ -188,6 +197,12 @@ def blocks(result) -> list:
     from ..studies.montecarlo import MonteCarloResult
     from ..studies.paper import PaperRunResult
 
+    if isinstance(result, Identifier):
+        if not hasattr(result, "result_"):
+            raise NotFittedError("dynid.summary: this Identifier is not fitted yet: call its fit(...) first")
+        result = result.result_
+    if isinstance(result, IdentifiedModel):
+        return [Line(text) for text in result.summary().splitlines()]
     if isinstance(result, TorqueComparison) or (isinstance(result, (list, tuple)) and result
                                                 and all(isinstance(c, TorqueComparison) for c in result)):
         return validation_blocks(result if isinstance(result, (list, tuple)) else [result])
