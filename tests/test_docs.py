@@ -80,6 +80,24 @@ def test_the_readmes_python_runs(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "results.json").is_file()
 
 
+def test_the_workflow_tutorials_python_runs(tmp_path, monkeypatch, capsys):
+    """docs/tutorials/workflow.md's design tried on a simulated log: the design lowers the criterion, the log runs the
+    designed motion, and least squares finds the description's own base parameters within 5 σ."""
+    monkeypatch.chdir(tmp_path)
+    (code,) = _blocks(DOCS / "tutorials" / "workflow.md")
+    namespace: dict = {}
+    exec(compile(code, "workflow.md", "exec"), namespace)
+    design, log = namespace["design"], namespace["log"]
+    assert design.cond < design.initial_cond
+    q, _, _ = design.trajectory.evaluate(log.t)
+    assert np.abs(np.asarray(log.q) - q).max() <= np.pi / 2**20 + 1e-12  # the encoders' rounding alone
+    fitted = namespace["dynid"].Identifier("ur10e", estimators=["wls"]).fit(log)
+    truth = fitted.result_.base.base_from_standard(namespace["dynid"].load_robot("ur10e").standard_parameters())
+    wls = fitted.parameters()
+    assert np.all(np.abs(wls.values - truth) <= 5 * wls.std + 1e-9), np.abs(wls.values - truth) / wls.std
+    assert "name" in capsys.readouterr().out
+
+
 def test_the_readme_is_a_users_guide_under_250_lines():
     readme = (DOCS.parent / "README.md").read_text(encoding="utf-8")
     assert len(readme.splitlines()) < 250

@@ -1,6 +1,7 @@
 """Logs of a simulated robot, as a controller writes them: to try dynid without a robot, and for examples.
 
-A random Fourier excitation (eq. 14: 5 harmonics of 0.1 Hz, 60 % of each joint's range, within its speed limit),
+A random Fourier excitation (eq. 14: 5 harmonics of 0.1 Hz, 60 % of each joint's range, within its speed limit) or a
+given one (a designed excitation: eq. 15),
 quantised positions and torques from noisy motor currents through the drive gains (eq. 16), simulated by
 :func:`dynid.simulation.measurements.simulate_measurements` with the robot description's own parameters.
 """
@@ -12,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data, renamed_keyword
+from ..exceptions import ConfigError
+from ..excitation.fourier import FourierTrajectory
 from ..io.datasets import Recording
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -24,8 +27,8 @@ __all__ = ["simulated_log"]
 @renamed_keyword("seed", "rng")
 @keyword_only_after_data
 def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: float = 250.0, rng: int | np.random.Generator = 0,
-                  noise: NoiseModel = NoiseModel()) -> Recording:
-    """A log of ``robot`` running a random Fourier excitation.
+                  noise: NoiseModel = NoiseModel(), trajectory: FourierTrajectory | None = None) -> Recording:
+    """A log of ``robot`` running a Fourier excitation (eq. 14): a random one, or ``trajectory``.
 
     Parameters
     ----------
@@ -41,6 +44,9 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
         FutureWarning).
     noise : NoiseModel
         Current noise [A] and encoder resolution [rad] (default 0.05 A, 20-bit encoders).
+    trajectory : FourierTrajectory, optional
+        The motion, e.g. :func:`dynid.design_excitation`'s ``trajectory`` (eq. 15), from ``t = 0``; default a random
+        excitation drawn from ``rng`` (which then draws the noise alone).
 
     Returns
     -------
@@ -50,12 +56,16 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
     Raises
     ------
     ConfigError
-        A description without physical nominal parameters.
+        A description without physical nominal parameters, or a trajectory of another number of joints.
     """
     robot = as_robot(robot)
     robot.require_physical_nominal("a simulated log (its truth is the description's parameters)")
     generator = np.random.default_rng(rng)
-    trajectory = random_excitation(robot, generator)
+    if trajectory is None:
+        trajectory = random_excitation(robot, generator)
+    elif np.shape(trajectory.q0) != (robot.n_dof,):
+        raise ConfigError(f"simulated_log: the trajectory moves {np.size(trajectory.q0)} joints, {robot.name} has "
+                          f"{robot.n_dof}")
     t = np.arange(int(round(seconds * rate))) / rate
     q, dq, ddq = trajectory.evaluate(t)
     meas = simulate_measurements(robot, t, q, dq, ddq, noise, generator)
