@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import ConfigError, DataError, DynIdError
+from dynid.exceptions import ConfigError, DataError, DynIdError, ShapeError
 
 from ..simulated_logs import simulated_case, truth_beta
 
@@ -166,6 +166,15 @@ def test_fit_takes_a_recording_as_the_readers_and_the_simulations_give_one(er16,
     for call in (lambda: dynid.Identifier(robot).fit(log.t), lambda: dynid.identify_from_arrays(robot, log.t, log.q)):
         with pytest.raises(ConfigError, match="^positions q and torques tau are needed with the time stamps t"):
             call()
+    # a recording made by hand is checked as arrays are (it gave a NumPy broadcast error, or was fitted silently with
+    # three positions fewer than its time stamps)
+    n = log.t.size
+    for bad, what in ((replace(log, q=log.q[:, :5], tau=log.tau[:, :5]), f"q has shape \\({n}, 5\\), expected \\({n}, 6\\)"),
+                      (replace(log, q=log.q[:-3]), f"q has shape \\({n - 3}, 6\\), expected \\({n}, 6\\)"),
+                      (replace(log, tau=np.where(log.t[:, None] > 1.0, np.nan, log.tau)), "tau holds a NaN")):
+        for call in (lambda: dynid.Identifier(robot).fit(bad), lambda: fitted.validate(bad)):
+            with pytest.raises(ShapeError, match=f"^{log.name}: {what}"):
+                call()
 
 
 def test_jittered_time_stamps_are_resampled_as_the_readers_do(er16):

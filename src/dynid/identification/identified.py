@@ -307,9 +307,9 @@ class IdentifiedModel:
         (the fitted filters and derivatives): symmetric with ``Identifier.fit(t, q, tau)``.
 
         ``predict(t, q)`` takes a raw log's time stamps and positions (and measured velocities ``dq`` if the fit had
-        them); ``predict(recording)`` a log read with :func:`dynid.load_recording`, at its own time stamps as
-        ``predict(recording.t, recording.q, recording.dq)`` (the samples a comparison keeps: :meth:`predict_log`). For
-        states one has computed oneself,
+        them); ``predict(recording)`` a log read with :func:`dynid.load_recording`, at its own time stamps, as
+        ``predict(recording.t, recording.q, recording.dq)`` (:meth:`predict_log` gives the samples a comparison keeps).
+        For states one has computed oneself,
         :meth:`predict_states` (``predict(q, dq, ddq)``, the earlier form, still does that, with a FutureWarning).
 
         Parameters
@@ -441,7 +441,14 @@ class IdentifiedModel:
         Returns
         -------
         dynid.validation.torques.TorqueComparison
+
+        Raises
+        ------
+        ShapeError
+            A recording not one row per time stamp and one column per joint (:meth:`Recording.check
+            <dynid.io.datasets.Recording.check>`).
         """
+        recording.check(self.robot.n_dof)
         data = prepare(recording, self._settings(), strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
         return compare_torques(self.robot, self.base, data, sets)

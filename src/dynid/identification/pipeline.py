@@ -196,11 +196,15 @@ class IdentificationPipeline:
             A recording the strategy cannot prepare, or whose every torque channel is dead.
         IdentifiabilityError
             Too little motion to cross-validate a choice on.
+        ShapeError
+            A recording not one row per time stamp and one column per joint, or holding NaN
+            (:meth:`dynid.io.datasets.Recording.check`).
         """
         def say(label: str) -> None:
             if step is not None:
                 step(label)
 
+        recording.check(self.robot.n_dof)
         dead, _ = dead_channels(recording.tau, recording.label)
         if len(dead) == recording.tau.shape[1]:
             raise DataError(f"{recording.label}: every joint's torque reads one value throughout (dead channels, or "

@@ -12,7 +12,7 @@ import numpy as np
 from .._util.column_store import SPOOL_BYTES, StoredColumns
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
-from ..exceptions import DataError
+from ..exceptions import DataError, ShapeError
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from .columns import csv_table
@@ -75,6 +75,33 @@ class Recording:
     def label(self) -> str:
         """The dataset's name and the files it was read from, for messages: ``"identification (log.csv)"``."""
         return f"{self.name} ({self.source})" if self.source else self.name
+
+    def check(self, n_dof: int) -> None:
+        """Refuse a recording that is not one row per time stamp and one column per joint (a recording made by hand:
+        the readers' are), or whose arrays hold NaN.
+
+        Parameters
+        ----------
+        n_dof : int
+            The robot's number of joints.
+
+        Raises
+        ------
+        ShapeError
+            Naming the recording, the signal, its shape and the one expected.
+        """
+        n = np.shape(self.t)[0] if np.ndim(self.t) == 1 else -1
+        if n < 0:
+            raise ShapeError(f"{self.label}: t has shape {np.shape(self.t)}, expected (N,): one time stamp a sample")
+        for name, x in (("q", self.q), ("tau", self.tau), ("dq", self.dq)):
+            if x is None and name == "dq":
+                continue
+            shape = None if x is None else tuple(x.shape)
+            if shape != (n, n_dof):
+                raise ShapeError(f"{self.label}: {name} has shape {shape}, expected ({n}, {n_dof}): one row per time "
+                                 "stamp, one column per joint")
+            if isinstance(x, np.ndarray) and not np.all(np.isfinite(x)):
+                raise ShapeError(f"{self.label}: {name} holds a NaN or infinite value")
 
 
 def _detected(log: Path, robot: Robot) -> DatasetSpec:
