@@ -300,7 +300,8 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
         text = str(exc)
         if text.startswith("plugin "):  # a plugin that cannot be imported names itself and where it was named
             raise ConfigError(f"{where}: {text}") from None
-        raise ConfigError(f"{where}: {text.split(': ', 1)[1]}") from None
+        names = "(or all), or in closed loop " + ", ".join(CLOSED_LOOP_METHODS)  # the closed-loop ones are taken here too
+        raise ConfigError(f"{where}: {text.split(': ', 1)[1].replace('(or all)', names)}") from None
     return estimators, closed_loop
 
 
