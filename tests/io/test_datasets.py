@@ -558,3 +558,28 @@ def test_positions_and_velocities_in_degrees_are_read_in_radians(tmp_path):
     rec = load_recording(spec, load_robot("ur10e"))
     np.testing.assert_allclose(rec.q, np.deg2rad(deg), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(rec.dq, np.deg2rad(2 * deg), rtol=1e-12, atol=1e-12)
+
+
+def test_a_log_without_time_stamps_is_read_by_its_path_with_the_rate_given(tmp_path, rng):
+    """load_recording(path, robot) of a CSV without a time column said "give its sample rate: dynid init ... --rate HZ"
+    and had no way to take it: load_recording(path, robot, rate=HZ) reads it as dynid init --rate does (one sample
+    every 1/rate s, the values as written); a rate beside a config's dataset, or not above 0, is refused in one line."""
+    robot = load_robot("er16")
+    q, tau = rng.uniform(-1, 1, (40, 6)), rng.uniform(-50, 50, (40, 6))
+    log = tmp_path / "no_time.csv"
+    header = ",".join([f"q{j + 1}" for j in range(6)] + [f"tau{j + 1}" for j in range(6)])
+    log.write_text(header + "\n" + "\n".join(",".join(f"{x:.9f}" for x in row) for row in np.hstack([q, tau])) + "\n")
+    with pytest.raises(DataError, match=r"no time column .*give its sample rate: load_recording\(\.\.\., rate=HZ\)$"):
+        load_recording(log, robot)
+    recording = load_recording(log, robot, rate=50.0)
+    np.testing.assert_allclose(recording.t, np.arange(40) / 50.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(recording.q, q, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(recording.tau, tau, rtol=0, atol=1e-9)
+    assert recording.rate == 50.0
+    for rate in (0.0, -5.0, float("nan"), "50"):
+        with pytest.raises(ConfigError, match="^load_recording: rate: expected a sample rate in Hz above 0"):
+            load_recording(log, robot, rate=rate)
+    spec = dataset_spec({"file": "no_time.csv", "rate": 50.0, "positions": {"columns": list(range(1, 7))},
+                         "torques": {"columns": list(range(7, 13))}}, tmp_path, "cfg", "ident", 6)
+    with pytest.raises(ConfigError, match="^load_recording: rate is for a log given by its path"):
+        load_recording(spec, robot, rate=50.0)

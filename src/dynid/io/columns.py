@@ -18,7 +18,7 @@ from .tables import is_data_line
 
 
 def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,
-              rate: float | None = None) -> tuple[Table, list[str]]:
+              rate: float | None = None, rate_hint: str = "dynid init ... --rate HZ") -> tuple[Table, list[str]]:
     """A CSV log's dataset table with its columns detected, and what was detected.
 
     Parameters
@@ -32,6 +32,8 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         The URDF's joint names, in the chain's order (columns naming them are taken in this order).
     rate : float, optional
         The log's sample rate [Hz] where it has no time column.
+    rate_hint : str
+        How the caller's user gives that rate, for the message of a log without time stamps.
 
     Returns
     -------
@@ -61,7 +63,7 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
         if "time" not in found and rate is None:
             raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
-                            "stamps give its sample rate: dynid init ... --rate HZ")
+                            f"stamps give its sample rate: {rate_hint}")
         effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
         missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
         if missing:

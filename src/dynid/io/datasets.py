@@ -12,7 +12,7 @@ import numpy as np
 from .._util.column_store import SPOOL_BYTES, StoredColumns
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
-from ..exceptions import DataError, ShapeError
+from ..exceptions import ConfigError, DataError, ShapeError
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from .columns import csv_table
@@ -104,16 +104,18 @@ class Recording:
                 raise ShapeError(f"{self.label}: {name} holds a NaN or infinite value")
 
 
-def _detected(log: Path, robot: Robot) -> DatasetSpec:
+def _detected(log: Path, robot: Robot, rate: float | None = None) -> DatasetSpec:
     """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.columns.csv_table`)."""
     if not log.is_file():
         raise DataError(f"{log}: no such log")
-    table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints))
+    table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints), rate=rate,
+                         rate_hint="load_recording(..., rate=HZ)")
     return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, robot.n_dof)
 
 
 @keyword_only_after_data
-def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *, spool: bool | None = None) -> Recording:
+def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *, spool: bool | None = None,
+                   rate: float | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
@@ -132,6 +134,9 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
         Hold the signals in temporary files (:mod:`dynid._util.column_store`) rather than in memory; by default when the
         files hold more than :data:`dynid._util.column_store.SPOOL_BYTES` (an hour-long log). The numbers are the same
         either way.
+    rate : float, optional
+        [Hz] The sample rate of a CSV log given by its path that has no time column (as ``dynid init --rate``); a
+        dataset of a config states its own.
 
     Returns
     -------
@@ -144,13 +149,20 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
         implausible values, a log whose columns cannot be told.
     TypeError
         Neither a dataset nor a path (one line saying what was given).
+    ConfigError
+        A rate beside a config's dataset, or one that is not a positive number.
     """
     robot = as_robot(robot)
+    if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
+        raise ConfigError(f"load_recording: rate: expected a sample rate in Hz above 0, got {rate!r}", field="rate")
     if isinstance(spec, (str, Path)):
-        spec = _detected(Path(spec), robot)
+        spec = _detected(Path(spec), robot, rate)
     elif not isinstance(spec, DatasetSpec):
         raise TypeError(f"load_recording: expected a log's path or a DatasetSpec (a config's dataset), got "
                         f"{type(spec).__name__}")
+    elif rate is not None:
+        raise ConfigError(f"load_recording: rate is for a log given by its path; the dataset {spec.name!r} states its "
+                          "own (its rate or time column)", field="rate")
     warnings: list[str] = []
     if spec.bag is not None:
         from .bags import read_joint_states
