@@ -77,6 +77,21 @@ def test_save_and_load_back_give_the_same_model(tmp_path, er16, fitted):
     assert json.loads(path.read_text())["kind"] == "identify"
 
 
+def test_save_takes_a_folder_as_its_docstring_says_and_creates_a_missing_one(tmp_path, fitted):
+    """save(folder) raised IsADirectoryError naming a temporary file, and save("new/r.json") a FileNotFoundError:
+    a folder holds results.json, a missing folder is created, and a file standing where a folder must be is a
+    one-line ConfigError; each file written reads back as the same model."""
+    (tmp_path / "out").mkdir()
+    written = [fitted.save(tmp_path / "out"), fitted.model_.save(tmp_path / "new" / "deeper" / "r.json")]
+    assert written == [tmp_path / "out" / "results.json", tmp_path / "new" / "deeper" / "r.json"]
+    for path in written:
+        np.testing.assert_array_equal(dynid.load_results(path).params(), fitted.params_)
+    (tmp_path / "plain").write_text("not a folder")
+    with pytest.raises(ConfigError, match=r"plain: cannot create the folder for r.json"):
+        fitted.save(tmp_path / "plain" / "r.json")
+    assert (tmp_path / "plain").read_text() == "not a folder"
+
+
 def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
     data = json.loads(fitted.save(tmp_path / "r.json").read_text())
     data["settings"]["robot_source"] = ""

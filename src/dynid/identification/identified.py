@@ -551,15 +551,26 @@ class IdentifiedModel:
         Parameters
         ----------
         path : str or Path
-            A file, or a folder to hold ``results.json``.
+            A file, or a folder to hold ``results.json`` (a missing folder is created, as ``dynid identify --out``
+            creates its own).
 
         Returns
         -------
         Path
             The file written.
+
+        Raises
+        ------
+        ConfigError
+            A folder that cannot be created (a file stands in its place).
         """
         path = Path(path)
-
+        if path.is_dir():
+            path = path / "results.json"
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ConfigError(f"{path.parent}: cannot create the folder for {path.name} ({exc.strerror})") from None
         write_json(path, {**self.results, "schema_version": RESULTS_SCHEMA_VERSION, "dynid_version": __version__,
                           "kind": "identify"})
         return path

@@ -411,12 +411,19 @@ class Identifier(HyperParameters):
         Parameters
         ----------
         path : str or Path
-            A file, or a folder to hold ``results.json``.
+            A file, or a folder to hold ``results.json`` (a missing folder is created).
 
         Returns
         -------
         Path
             The file written.
+
+        Raises
+        ------
+        ConfigError
+            A folder that cannot be created.
+        NotFittedError
+            Before :meth:`fit` or :meth:`from_config`.
         """
         return self._model().save(path)
 
