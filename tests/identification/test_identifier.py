@@ -82,8 +82,10 @@ def test_save_takes_a_folder_as_its_docstring_says_and_creates_a_missing_one(tmp
     a folder holds results.json, a missing folder is created, and a file standing where a folder must be is a
     one-line ConfigError; each file written reads back as the same model."""
     (tmp_path / "out").mkdir()
-    written = [fitted.save(tmp_path / "out"), fitted.model_.save(tmp_path / "new" / "deeper" / "r.json")]
-    assert written == [tmp_path / "out" / "results.json", tmp_path / "new" / "deeper" / "r.json"]
+    written = [fitted.save(tmp_path / "out"), fitted.model_.save(tmp_path / "new" / "deeper" / "r.json"),
+               fitted.save(tmp_path / "fresh")]  # a path without a suffix is a folder (it wrote a file named "fresh")
+    assert written == [tmp_path / "out" / "results.json", tmp_path / "new" / "deeper" / "r.json",
+                       tmp_path / "fresh" / "results.json"]
     for path in written:
         np.testing.assert_array_equal(dynid.load_results(path).params(), fitted.params_)
     (tmp_path / "plain").write_text("not a folder")

@@ -551,8 +551,8 @@ class IdentifiedModel:
         Parameters
         ----------
         path : str or Path
-            A file, or a folder to hold ``results.json`` (a missing folder is created, as ``dynid identify --out``
-            creates its own).
+            A file, or a folder to hold ``results.json``: one that exists, or a path without a suffix (``"out"``). A
+            missing folder is created, as ``dynid identify --out`` creates its own.
 
         Returns
         -------
@@ -565,7 +565,7 @@ class IdentifiedModel:
             A folder that cannot be created (a file stands in its place).
         """
         path = Path(path)
-        if path.is_dir():
+        if path.is_dir() or (path.suffix == "" and not path.exists()):
             path = path / "results.json"
         try:
             path.parent.mkdir(parents=True, exist_ok=True)

@@ -411,7 +411,8 @@ class Identifier(HyperParameters):
         Parameters
         ----------
         path : str or Path
-            A file, or a folder to hold ``results.json`` (a missing folder is created).
+            A file, or a folder to hold ``results.json`` (one that exists, or a path without a suffix; a missing
+            folder is created).
 
         Returns
         -------
