@@ -5,6 +5,7 @@ applied on the way (:func:`load_recording`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from numbers import Real
 from pathlib import Path
 
 import numpy as np
@@ -153,7 +154,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
         A rate beside a config's dataset, or one that is not a positive number.
     """
     robot = as_robot(robot)
-    if rate is not None and not (isinstance(rate, (int, float)) and np.isfinite(rate) and rate > 0):
+    if rate is not None and not (isinstance(rate, Real) and not isinstance(rate, bool) and np.isfinite(rate) and rate > 0):
         raise ConfigError(f"load_recording: rate: expected a sample rate in Hz above 0, got {rate!r}", field="rate")
     if isinstance(spec, (str, Path)):
         spec = _detected(Path(spec), robot, rate)

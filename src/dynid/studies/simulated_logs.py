@@ -45,8 +45,8 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
     noise : NoiseModel
         Current noise [A] and encoder resolution [rad] (default 0.05 A, 20-bit encoders).
     trajectory : FourierTrajectory, optional
-        The motion, e.g. :func:`dynid.design_excitation`'s ``trajectory`` (eq. 15), from ``t = 0``; default a random
-        excitation drawn from ``rng`` (which then draws the noise alone).
+        The motion, e.g. :func:`dynid.design_excitation`'s ``trajectory`` (eq. 15), from ``t = 0`` (``rng`` then
+        draws the noise alone); default a random excitation drawn from ``rng``.
 
     Returns
     -------
