@@ -16,16 +16,21 @@ Four identification logs per arm and friction truth, each validated on the same 
 * ``ptp``: 40 s of point-to-point moves with rests;
 * ``dead``: the excitation log with one joint's torque channel reading 0.
 
-Two more classes look like reality (issue "Never worse than the description", item 6; ``--classes cad,cad-sensor``,
-with the ``sign`` friction truth only): the simulated arm is the vendor file with every link's mass, centre of mass
-and inertia off by 10-40 % (so the description dynid is given is CAD-like, not the truth), the identification log
+Three more classes look like reality (issue "Never worse than the description", item 6; ``--classes
+cad,cad-sensor,cad-gear``, with the ``sign`` friction truth only): the simulated arm is the vendor file with every
+link's mass, centre of mass and inertia off by 10-40 % (so the description dynid is given is CAD-like, not the truth), the identification log
 lasts 5 s (a Fourier excitation of 0.2 Hz), and the logged torques hold what the rigid-body model cannot express: a
 torque offset drifting over the log (about 1 % of each joint's RMS torque, another drift on the validation log) and a
 cable spring on the first and the second-to-last joint (3 % of their RMS torque). ``cad`` logs the motor-side torque
 (rotor inertia and friction included); ``cad-sensor`` the output side of a joint torque sensor (no rotor inertia, no
-friction: ``sensor = "joint"`` in the config, which drops the rotor inertia from the drive terms). Beside the truth each is
-scored against "truth, drive terms from the log": the true links with every joint's drive terms fitted on the
-identification log (what the log can determine; the target is dynid within 1.2× of it).
+friction: ``sensor = "joint"`` in the config, which drops the rotor inertia from the drive terms). A third,
+``cad-gear``, is ``cad`` with what a geared drive adds and the rigid-body model cannot express either: hysteresis of
+the dry friction (Dahl's model with a presliding distance of 2 mrad: after a reversal the friction turns over that
+distance instead of at once) and backlash read by a motor-side encoder (the logged angle is the link's plus half a
+lash of 1 mrad, 3.4 arcmin, turned over as the torque through the gear crosses ±2 % of the joint's RMS torque); its
+drifts and torque noise come from a stream of their own, so that the other two classes' logs do not change. Beside the
+truth each is scored against "truth, drive terms from the log": the true links with every joint's drive terms fitted
+on the identification log (what the log can determine; the target is dynid within 1.2× of it).
 
 Each is identified by ``dynid identify`` with the defaults (a ``[robot]`` table with drive terms Ia, fc, fv,
 offset; estimators WLS and SDP) and reports: the main estimate's validation error over the true parameters' on the
@@ -67,7 +72,7 @@ ARMS = {
     "TALOS left arm": ("talos_data/robots/talos_left_arm.urdf", r"^arm_left_[2-7]_joint$"),
 }
 CLASSES = ("excitation", "short", "ptp", "dead")
-CAD_CLASSES = ("cad", "cad-sensor")
+CAD_CLASSES = ("cad", "cad-sensor", "cad-gear")
 """The realistic classes (module docstring), run with the ``sign`` truth alone."""
 TRUTHS = ("frictionloss", "sign")
 RATE = 1000.0
@@ -206,6 +211,33 @@ def unmodelled(log, drives, rng, sensor: bool, spring: tuple) -> np.ndarray:
     return measured_side(log, drives, sensor) + drift + k * (log.q - q0)
 
 
+PRESLIDING, BACKLASH, LASH_BAND = 0.002, 0.001, 0.02
+"""``cad-gear``'s geared drive (module docstring): Dahl's presliding distance [rad], the gear's lash [rad] and the torque
+band, a share of each joint's RMS torque, over which the lash turns over."""
+
+
+def dahl_direction(q: np.ndarray, x0: float) -> np.ndarray:
+    """The state ``z`` of Dahl's friction model (α = 1) along the true positions: ``dz/ds = (σ − z)/x₀`` over the
+    distance ``s`` travelled in the direction ``σ``, so that ``z = σ + (z₀ − σ)·exp(−Δs/x₀)`` from sample to sample
+    (P. R. Dahl 1968); written here, not dynid's, so that the simulated truth does not borrow dynid's model."""
+    z = np.zeros_like(q)
+    step = np.diff(q, axis=0)
+    for k in range(1, q.shape[0]):
+        sigma = np.sign(step[k - 1])
+        z[k] = np.where(sigma != 0, sigma + (z[k - 1] - sigma) * np.exp(-np.abs(step[k - 1]) / x0), z[k - 1])
+    return z
+
+
+def geared(log, drives, spring: tuple):
+    """``cad-gear``'s log (module docstring): the dry friction's ``fc·sign(q̇)`` in the command replaced by Dahl's
+    ``fc·z``, and the logged angles those of a motor-side encoder across a backlash."""
+    rms = spring[0]
+    tau = log.tau + drives.fc * (dahl_direction(log.q, PRESLIDING) - np.sign(log.dq))
+    through = tau - drives.ia * log.ddq  # the torque the gear carries to the link
+    lash = 0.5 * BACKLASH * np.tanh(through / np.maximum(LASH_BAND * rms, 1e-9))
+    return replace(log, tau=tau, q_meas=log.q_meas + lash)
+
+
 def cable_spring(valid, drives, sensor: bool) -> tuple:
     """``(rms, k, q₀)``: each joint's RMS torque on the validation log, a cable spring on the first and the
     second-to-last joint whose torque has 3 % of that RMS over the validation motion, and its rest angle (the
@@ -249,9 +281,11 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
         sensor = kind == "cad-sensor"
         stem = kind.replace("-", "_")
         spring = cable_spring(valid, drives, sensor)
+        noise = np.random.default_rng([seed, 7, 3]) if kind == "cad-gear" else rng  # its own stream (module docstring)
         for label, log in (("valid", valid), ("ident", ident)):
-            noisy = replace(log, tau=unmodelled(log, drives, rng, sensor, spring))
-            write_log(folder / f"{stem}_{label}.csv", noisy, rng)
+            log = geared(log, drives, spring) if kind == "cad-gear" else log
+            noisy = replace(log, tau=unmodelled(log, drives, noise, sensor, spring))
+            write_log(folder / f"{stem}_{label}.csv", noisy, noise)
         drive = np.zeros((n, 4)) if sensor else np.column_stack([drives.ia, drives.fc, drives.fv, np.zeros(n)])
         values = np.concatenate([phi, drive], axis=1).ravel()
         (folder / f"{stem}_truth.csv").write_text("name,value\n" + "".join(f"{k},{v:.12g}\n" for k, v in zip(names, values)))
