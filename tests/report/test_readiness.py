@@ -73,6 +73,8 @@ def test_each_kind_of_drive_term_is_written_out_once():
     assert "; cbsd2, counterbalance torque (cbsd·sin(2q)) of J2; Ia3, rotor (reflected motor) inertia of J3; " in line
     assert line.endswith("; fst4, Stribeck friction of J4") and "offset5, constant torque offset" in line
     assert "offset (a current or torque sensor's offset) of their joint; " in line
+    # a Med7 window listed "fv1, fv3, fv5, fv2": the names by joint, whatever order the lines above met them in
+    assert _drive_legend(["fv1", "fv3", "fv5", "fv2"]).startswith("the drive terms named: fv1, fv2, fv3, fv5, viscous")
 
 
 def test_the_link_parameters_named_are_written_out_once():

@@ -793,10 +793,11 @@ def _term_words(stem: str) -> str:
 
 
 def _drive_legend(names: list[str]) -> str:
-    """One line saying what the drive terms ``names`` are, each kind once, its names before it in the order given
-    ("offset2, offset4, constant torque offset (…) of their joint; Ia3, rotor (reflected motor) inertia of J3")."""
+    """One line saying what the drive terms ``names`` are, each kind once, its names before it by joint ("offset2,
+    offset4, constant torque offset (…) of their joint; Ia3, rotor (reflected motor) inertia of J3"); the kinds by
+    their first joint."""
     stems: dict[str, list[str]] = {}
-    for n in names:
+    for n in sorted(names, key=lambda n: split_name(n)[1]):
         stems.setdefault(split_name(n)[0], []).append(n)
     return "the drive terms named: " + "; ".join(
         f"{', '.join(group)}, {_term_words(stem)} of "
