@@ -508,10 +508,11 @@ LAYOUT_KEYS = ("preset", "header", "n_columns", "delimiter", "gaps", "max_gap", 
 
 
 def with_inherited_layout(doc: dict) -> dict:
-    """The config with each ``[[validation]]`` table that states no signals of its own (no ``positions``, ``torques``,
-    ``currents``, ``preset`` or ``bag``) given the identification's column layout (:data:`LAYOUT_KEYS`); its own keys
-    (``file``, ``rows``, ``time_range``, ``name``...) stay. The identification's signals must then read its default
-    ``file`` (none of them naming a file of its own). Where the identification log is a ROS 2 bag, a validation table
+    """The config with each ``[[validation]]`` table that states no positions of its own (no ``positions``, ``preset`` or
+    ``bag``) given the identification's column layout (:data:`LAYOUT_KEYS`); its own keys (``file``, ``rows``,
+    ``time_range``, ``name``, and ``torques`` or ``currents``, e.g. to flip a sign: then neither of the
+    identification's) stay. The identification's signals must then read its default ``file`` (none of them naming a
+    file of its own). Where the identification log is a ROS 2 bag, a validation table
     that names no CSV file takes the bag's reader settings it does not state (:data:`BAG_READER_KEYS`).
 
     Parameters
@@ -537,8 +538,12 @@ def with_inherited_layout(doc: dict) -> dict:
         if reader and isinstance(v, dict) and not any(k in v for k in ("file", "positions", "preset")):
             merged.append({**reader, **v})  # a bag's table: the identification's bag, topic, joint names, effort
             continue
-        states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "torques", "currents", "preset", "bag"))
-        merged.append(v if states_its_own or own_files or "bag" in ident else {**layout, **v})
+        states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "preset", "bag"))
+        if states_its_own or own_files or "bag" in ident:
+            merged.append(v)
+            continue
+        torque = ("torques", "currents") if any(k in v for k in ("torques", "currents")) else ()  # its own: both left
+        merged.append({**{k: x for k, x in layout.items() if k not in torque}, **v})
     return {**doc, "validation": merged}
 
 

@@ -1,0 +1,55 @@
+"""What a ``[[validation]]`` table takes from the identification's column layout (README: "a name and a file are
+enough, the identification's columns are taken")."""
+
+import numpy as np
+
+HEADER = "t," + ",".join(f"q{j}" for j in range(1, 7)) + "," + ",".join(f"tau{j}" for j in range(1, 7))
+TORQUES = '["tau1", "tau2", "tau3", "tau4", "tau5", "tau6"]'
+
+
+def _config(tmp_path, validation: str):
+    rng = np.random.default_rng(0)
+    for name in ("ident.csv", "other.csv"):
+        t = np.arange(200) * 0.01
+        x = np.column_stack([t, 0.3 * np.sin(np.outer(t, np.arange(1, 7))), rng.normal(size=(200, 6))])
+        np.savetxt(tmp_path / name, x, delimiter=",", header=HEADER, comments="", fmt="%.9g")
+    (tmp_path / "c.toml").write_text(
+        'robot = "ur10e"\ndata_root = "."\n[identification]\nfile = "ident.csv"\nheader = true\ntime = { column = "t" }\n'
+        'positions = { columns = ["q1", "q2", "q3", "q4", "q5", "q6"] }\n'
+        f"torques = {{ columns = {TORQUES} }}\n[[validation]]\n" + validation)
+    return tmp_path / "c.toml"
+
+
+def test_a_validation_table_with_only_its_torques_takes_the_identifications_other_columns(tmp_path):
+    """A user flipping the sign of a validation log's torques (``torques = {..., sign = -1}``, the Med7's logs) was
+    told "validation[0]: expected 'positions'": a table that gave its torques took none of the identification's
+    columns. It now takes the time and positions it does not give; its own torques replace the identification's."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+    from dynid.model.description import load_robot
+
+    cfg = load_identification_config(_config(tmp_path, f'name = "other"\nfile = "other.csv"\ntorques = {{ columns = '
+                                                       f'{TORQUES}, sign = -1 }}\n'))
+    robot = load_robot("ur10e")
+    rec = load_recording(cfg.validation[0], robot)
+    x = np.loadtxt(tmp_path / "other.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(rec.t, x[:, 0] - x[0, 0], atol=1e-12)
+    np.testing.assert_allclose(rec.q, x[:, 1:7], atol=1e-9)
+    np.testing.assert_allclose(rec.tau, -x[:, 7:13], atol=1e-9)
+    ident = load_recording(cfg.identification, robot)  # the identification's own sign is untouched
+    np.testing.assert_allclose(ident.tau, np.loadtxt(tmp_path / "ident.csv", delimiter=",", skiprows=1)[:, 7:13], atol=1e-9)
+
+
+def test_a_validation_table_with_currents_does_not_also_take_the_identifications_torques(tmp_path):
+    """Its own signal kind replaces the identification's: currents there, no torques carried over beside them (which
+    would be two torque channels, refused)."""
+    from dynid.io.identification_config import with_inherited_layout
+
+    doc = {"identification": {"file": "a.csv", "header": True, "time": {"column": "t"}, "positions": {"columns": [1]},
+                              "torques": {"columns": [2]}},
+           "validation": [{"file": "b.csv", "currents": {"columns": [3]}}, {"file": "c.csv", "positions": {"columns": [4]},
+                                                                            "torques": {"columns": [5]}}]}
+    currents, own = with_inherited_layout(doc)["validation"]
+    assert currents == {"file": "b.csv", "header": True, "time": {"column": "t"}, "positions": {"columns": [1]},
+                        "currents": {"columns": [3]}}
+    assert own == {"file": "c.csv", "positions": {"columns": [4]}, "torques": {"columns": [5]}}  # its own layout, as given
