@@ -52,3 +52,26 @@ def test_a_sensor_on_another_signal_is_refused_in_one_line(tmp_path):
     with pytest.raises(ConfigError, match=r"identification.positions.sensor: only the torques have a sensor") as info:
         load_identification_config(path)
     assert "\n" not in str(info.value)
+
+
+def test_results_of_a_joint_sensor_log_read_back_with_the_robot_as_identified(tmp_path):
+    """``dynid.load_results`` on the results of a config that names a URDF with ``sensor = "joint"`` (what ``dynid
+    init`` writes for a KUKA LBR) refused them: "its base parameters (66) are not those of robot 'med7dock' (71)". It
+    rebuilt the robot from the URDF alone, with its rotor inertias, which the identification had left out. The
+    results now say the drive terms identified, and the model read back predicts what the one identified predicts."""
+    import dynid
+    from dynid.identification.identified import IdentifiedModel, load_results
+    from dynid.identification.run import run_identification
+
+    path = _config(tmp_path, 'robot = "arm.urdf"', ', sensor = "joint"')
+    log = dynid.simulated_log(load_robot(URDF).without_drive_terms(("Ia",)), seconds=20.0, rate=100.0, rng=3)
+    header = ",".join(["t", *(f"q{j}" for j in range(1, 7)), *(f"tau{j}" for j in range(1, 7))])
+    np.savetxt(tmp_path / "log.csv", np.column_stack([log.t, log.q, log.tau]), delimiter=",", header=header, comments="")
+    result = run_identification(load_identification_config(path), validate=False)
+    model = IdentifiedModel.from_result(result)
+    model.save(tmp_path / "out")
+    back = load_results(tmp_path / "out")
+    assert "Ia" not in result.settings["drive_terms"] and "fc" in result.settings["drive_terms"]
+    assert back.base.names == model.base.names
+    other = dynid.simulated_log(load_robot(URDF).without_drive_terms(("Ia",)), seconds=5.0, rate=100.0, rng=4)
+    np.testing.assert_allclose(back.predict(other), model.predict(other), rtol=1e-12, atol=1e-12)

@@ -267,7 +267,8 @@ class IdentificationPipeline:
             Its ``settings`` hold the resolved preprocessing, the preprocessing as given (``given_preprocessing``: what
             another log's preparation starts from, :func:`dynid.preprocessing.strategies.carried_over`),
             :attr:`PreparedIdentification.choices`,
-            ``robot_source`` and ``robot_fingerprint`` (:meth:`dynid.model.robot.Robot.kinematic_fingerprint`).
+            ``robot_source``, ``robot_fingerprint`` (:meth:`dynid.model.robot.Robot.kinematic_fingerprint`) and
+            ``drive_terms`` (the robot's before the friction models: a joint torque sensor's log drops ``Ia``).
 
         Raises
         ------
@@ -290,6 +291,7 @@ class IdentificationPipeline:
         result = replace(result, settings={**result.settings, "given_preprocessing": self.preprocessing.to_dict(),
                                            "robot_source": self.source,
                                            "robot_fingerprint": prepared.robot.kinematic_fingerprint(),
+                                           "drive_terms": list(self.robot.drive_terms),
                                            **prepared.choices.to_dict()},
                          findings=result.findings + tuple(findings), diagnostics={**result.diagnostics, "torque_delay": delay},
                          choices=prepared.choices)

@@ -147,8 +147,9 @@ def _model_terms(kind: str, robot: Robot) -> tuple[str, ...]:
 def robot_from_settings(robot: Robot, settings: dict) -> Robot:
     """A robot as a results.json's ``settings`` say it was identified.
 
-    Each joint's friction model (``friction_models``) or, in results of older versions, the Coulomb smoothing
-    velocities.
+    Without the description's drive terms the identification left out (``drive_terms``: a joint torque sensor's log
+    holds no rotor inertia ``Ia``), with each joint's friction model (``friction_models``) or, in results of older
+    versions, the Coulomb smoothing velocities.
 
     Parameters
     ----------
@@ -168,6 +169,9 @@ def robot_from_settings(robot: Robot, settings: dict) -> Robot:
     """
     if not isinstance(settings, dict):
         return robot
+    terms = settings.get("drive_terms")  # the description's drive terms that the identification left out (Ia, where a
+    if isinstance(terms, list):          # joint torque sensor measured the log) are left out again
+        robot = robot.without_drive_terms([t for t in robot.drive_terms if t not in terms])
     stored = settings.get("friction_models")
     if isinstance(stored, dict):
         models = stored.get("models")
