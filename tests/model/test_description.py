@@ -84,6 +84,10 @@ def test_bad_fields_name_file_and_field(tmp_path, field, value, message):
 def test_unknown_robot_and_bad_toml(tmp_path):
     with pytest.raises(ConfigError, match="unknown robot 'nosuch'"):
         load_robot("nosuch")
+    # a file's name that is not there is said so (`dynid init arm.urdf log.csv` said "unknown robot 'arm.urdf':
+    # expected ... a .urdf" of a missing arm.urdf)
+    with pytest.raises(ConfigError, match=r"missing.urdf: no such file \(the robot: a built-in robot"):
+        load_robot(tmp_path / "missing.urdf")
     p = tmp_path / "x.toml"
     p.write_text("[[joints]\n")
     with pytest.raises(ConfigError, match="invalid TOML"):

@@ -122,6 +122,9 @@ def load_robot(name_or_path: str | Path, *, held=(), xacro_args: dict | None = N
     if is_xacro(path) and path.is_file():
         return robot_from_urdf(expand_xacro(path, xacro_args), source=str(path), name=path.name.split(".")[0],
                                held=held)
+    if path.suffix.lower() in (".toml", ".urdf", ".xml", ".xacro", ".mjcf") and not path.is_file():  # a file, missing
+        raise ConfigError(f"{text}: no such file (the robot: a built-in robot ({', '.join(builtin_robots())}), or an "
+                          "existing .toml description, .urdf, .xacro or MuJoCo .xml file)")
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
                           "description file, a .urdf, a .xacro or a MuJoCo .xml file")
