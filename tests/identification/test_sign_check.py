@@ -171,6 +171,20 @@ def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
     assert scale_findings(np.full(5, 0.5), np.full(5, 1000.0), varies, "log") == []
 
 
+def test_a_scale_finding_names_each_joints_drive_gain_for_motor_currents():
+    """A UR10e's log of motor currents read with its URDF (no drive gains: 1 N·m/A) was told "set scale = 10" alone,
+    where its joints' gains differ (8.5-10.7 N·m/A). Each judged joint's gain is said: the one that brings its slope
+    on the nominal model to 1, from the gains the log was read through."""
+    from dynid.validation.diagnostics import scale_findings
+
+    rho, varies = np.array([0.95, 0.99, 0.99, 0.98, 0.5, 0.1]), np.ones(6, bool)
+    true = np.array([10.0, 10.6956, 8.4566, 9.0029, 9.48, 10.1232])  # the UR10e's (src/dynid/model/robots/ur10e.toml)
+    for given in (np.ones(6), np.full(6, 2.0)):  # read through 1 N·m/A (a URDF), or through gains 5x too small
+        (f,) = scale_findings(rho, given / true, varies, "identification", gains=given)
+        assert "about 10, 10.7, 8.46, 9 N·m/A on J1, J2, J3, J4 by the description's nominal model" in f.text, f.text
+    assert "N·m/A" not in scale_findings(rho, 1 / true, varies, "identification")[0].text  # no gains given: not said
+
+
 def test_currents_in_milliamperes_are_named_and_the_model_not_called_ready(tmp_path):
     """Every current of the logs written in mA (1000× the amperes the description's drive gains take): a fit absorbs
     the scale (it fits as well, with masses 1000× the arm's, and dynid called it ready); the verdict names the scale

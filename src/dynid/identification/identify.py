@@ -527,7 +527,7 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     # the correlation beyond friction judges where it is known, both ways: friction the nominal model lacks can run
     # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98)
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name)
-            + scale_findings(beyond_drive, slope_drive, varies, data.name))
+            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains))
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

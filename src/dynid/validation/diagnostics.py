@@ -259,7 +259,7 @@ slope between them is a scale."""
 
 
 def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
-                   table: str = "[identification]") -> list[Finding]:
+                   table: str = "[identification]", gains: np.ndarray | None = None) -> list[Finding]:
     """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
     of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
     that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``. A fit absorbs such a scale (a model with masses 1000× the
@@ -278,6 +278,9 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
         The log, named in the finding.
     table : str
         The config table to fix (its ``scale``).
+    gains : (n_dof,) array, optional
+        The drive gains the torques were read through [N·m/A]: each joint's gain that would bring its slope to 1 is
+        said, for a log of motor currents (eq. 16) whose description states none (a URDF's are 1).
 
     Returns
     -------
@@ -294,11 +297,15 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     power = round(float(np.log10(median)))
     fix = f"{10.0 ** -power:g}" if abs(np.log10(median) - power) < 0.1 else f"{1 / median:.3g}"
     joints = ", ".join(f"J{j + 1}" for j in judged)
+    per_joint = "" if gains is None else (
+        f" (motor currents: about {', '.join(f'{gains[j] / k[j]:.3g}' for j in judged)} N·m/A on {joints} by the "
+        "description's nominal model, as right as its masses; [drive_gains] identifies them from a run with a known "
+        "payload)")
     return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal "
                              f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): a "
                              f"unit (currents in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the "
                              f"torques (or currents) of {table} and the other datasets, or check drive_gain in the "
-                             "description")]
+                             f"description{per_joint}")]
 
 
 ORDER_GAIN = 0.25
