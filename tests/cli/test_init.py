@@ -523,3 +523,25 @@ def test_without_validation_logs_the_sdp_stays_main_where_held_out_blocks_score_
     said = " ".join(p.stdout.split())
     assert said.startswith("model ready to check: dynid SDP") and "main estimate: dynid SDP, physically consistent" in said
     assert "held-out blocks of the log as well, to 2 %" in said
+
+
+def test_init_says_a_log_of_motor_currents_needs_drive_gains_the_urdf_cannot_state(tmp_path):
+    """A UR10e's RTDE log (motor currents) with its URDF: init wrote the config without a word on the drive gains, and
+    identify then read each ampere as 1 N·m (its torques 0.108× the nominal model's). Init now says so, with the
+    built-in robot of the URDF's name that has them; a log of torques, or another arm, is not told of a built-in."""
+    from dynid.io.starter import starter_config
+
+    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=5, rng=1)
+    rows = np.column_stack([log.t, log.q, np.zeros_like(log.q), log.tau / 10.0, np.zeros((log.t.size, 12))])
+    np.savetxt(tmp_path / "rtde.csv", rows, delimiter=",")  # 31 columns: Universal Robots' RTDE layout
+    robot = dynid.load_robot(URDF)
+    _, notes = starter_config(URDF, tmp_path / "rtde.csv", 6, tmp_path / "a.toml", robot=robot)
+    (gains,) = [n for n in notes if n.startswith("motor currents")]
+    assert "ur10e.urdf states no drive gains" in gains and 'use the built-in robot = "ur10e"' in gains
+    other = tmp_path / "arm.urdf"
+    other.write_text(URDF.read_text().replace('<robot name="ur10e"', '<robot name="my_arm"', 1))
+    _, notes = starter_config(other, tmp_path / "rtde.csv", 6, tmp_path / "b.toml", robot=dynid.load_robot(other))
+    (gains,) = [n for n in notes if n.startswith("motor currents")]
+    assert "built-in" not in gains
+    _, notes = starter_config(URDF, _log(tmp_path, header=True), 6, tmp_path / "c.toml", robot=robot)
+    assert not [n for n in notes if n.startswith("motor currents")]  # torques: no gains needed

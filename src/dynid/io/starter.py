@@ -21,8 +21,9 @@ import tomlkit
 from tomlkit.items import Table
 
 from ..exceptions import ConfigError, DataError
-from ..model.description import URDF_DRIVE_TERMS
+from ..model.description import URDF_DRIVE_TERMS, builtin_robots
 from .columns import csv_table
+from .dataset_specs import PRESETS
 from .datasets import dataset_spec, load_recording
 
 
@@ -91,7 +92,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         said.append(_estimators_note(without))
         return _config(urdf, log, out, validation, table, said, held, xacro_args, without), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
-    notes += [*_held_notes(urdf, held), _estimators_note(without)]
+    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot), _estimators_note(without)]
     return _config(urdf, log, out, validation, table, notes, held, xacro_args, without), notes
 
 
@@ -144,6 +145,20 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
 def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
     return [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain of revolute joints (a gripper?): held fixed "
             "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
+
+
+def _gain_notes(table, urdf: Path, robot) -> list[str]:
+    """A log of motor currents with a description that states no drive gains (a URDF cannot: each is 1 N·m/A): said,
+    with where the gains go (eq. 16, τ = K·I) and the built-in robot of the same name that has them."""
+    preset = PRESETS.get(str(table.get("preset")), {})
+    if robot is None or "currents" not in table and "currents" not in preset or np.any(robot.drive_gains != 1.0):
+        return []
+    builtin = robot.name if robot.name in builtin_robots() else None
+    return [f"motor currents, and {urdf.name} states no drive gains: each joint's current is read as its torque in "
+            "N·m (1 N·m/A) until a [robot] table gives each joint's drive_gain (torque per ampere at the joint, eq. "
+            "16; [[robot.joints]])"
+            + (f', or use the built-in robot = "{builtin}", which has them' if builtin else "")
+            + "; dynid identify's verdict estimates them from the description's nominal model"]
 
 
 def _is_bag(path: Path) -> bool:
