@@ -399,8 +399,8 @@ def plot_noise_level_study(levels, labels, std_ratios, bias_ratios, ax=None,
 def _torque_axes(fig, n: int):
     """``n`` stacked axes sharing x, with a fixed layout (the automatic one costs more than drawing)."""
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
-    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n), bottom=0.5 / (2.4 * n), hspace=0.3)
-    return axes
+    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.45 / (2.4 * n), bottom=0.95 / (2.4 * n), hspace=0.3)
+    return axes  # the bottom inch holds the x label and the legend (:class:`TorqueFigure`), off the curves
 
 
 def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measured and predicted torques"):
@@ -420,12 +420,13 @@ def plot_torque_comparison(t, measured, predicted: dict, ax=None, title="Measure
     -------
     matplotlib.figure.Figure
     """
+    below = ax is None
     if ax is None:
         import matplotlib.pyplot as plt
 
         n = measured.shape[1]
         ax = _torque_axes(plt.figure(figsize=(9, 2.4 * n)), n)
-    figure = TorqueFigure(measured.shape[1], list(predicted), axes=ax)
+    figure = TorqueFigure(measured.shape[1], list(predicted), axes=ax, legend_below=below)
     figure.draw(t, measured, predicted, title)
     return figure.axes
 
@@ -442,9 +443,13 @@ class TorqueFigure:
         The predicted parameter sets, in the order of the ``predicted`` dicts given to :meth:`draw`.
     axes : sequence of ``n_dof`` Axes, optional
         Where to draw (default: a new figure, not managed by pyplot).
+    legend_below : bool, optional
+        The legend in a row under the axes, where :func:`_torque_axes` leaves room (default: on a new figure), rather
+        than in the first axes, where it hid the curves it names (a Med7 log's J1 from 13 s on).
     """
 
-    def __init__(self, n_dof: int, labels, axes=None):
+    def __init__(self, n_dof: int, labels, axes=None, *, legend_below: bool | None = None):
+        below = axes is None if legend_below is None else legend_below
         if axes is None:
             from matplotlib.figure import Figure
 
@@ -459,7 +464,11 @@ class TorqueFigure:
             self.lines.append(row)
             a.set_ylabel(f"τ{j + 1} [N·m]")
             a.grid(alpha=0.3)
-        self.axes[0].legend(loc="upper right", fontsize="small")
+        if below:
+            self.fig.legend(handles=self.lines[0], loc="lower center", ncol=min(len(self.lines[0]), 5), fontsize="small",
+                            frameon=False)
+        else:
+            self.axes[0].legend(loc="best", fontsize="small")
         self.axes[-1].set_xlabel("t [s]")
 
     def draw(self, t, measured, predicted: dict, title: str):
