@@ -36,6 +36,21 @@ def test_the_first_line_judges_the_estimate_export_writes(rng):
     assert readiness(_result(rng, 0.02)).text.startswith("model ready: dynid SDP")
 
 
+def test_a_library_users_first_line_names_the_models_methods_not_an_output_folder(rng):
+    """dynid.summary(ident) of a model fitted in Python said "its URDF and MJCF are in the output folder; add
+    [[validation]] logs": there is no output folder, and no config. It names the fitted model's urdf(), mjcf() and
+    validate(log) there; the terminal's line is unchanged."""
+    ready = _result(rng, 0.02)
+    said = readiness(ready, library=True).text
+    assert said == "model ready: dynid SDP (its URDF and MJCF: IdentifiedModel.urdf() and .mjcf(), an Identifier's model_)"
+    assert "output folder" in readiness(ready).text
+    ready.validations = ()
+    said = readiness(ready, library=True).text
+    assert said.startswith("model ready to check: dynid SDP is physically consistent (its URDF and MJCF: "
+                           "IdentifiedModel.urdf()") and said.endswith("; validate(log) on other motions before you use it")
+    assert "[[validation]]" in readiness(ready).text and "output folder" not in said
+
+
 def test_a_term_the_cross_validation_chose_is_not_called_undetermined_and_every_drive_term_is_named():
     """issue "Never worse than the description", item 4: load-dependent Coulomb friction on J1 and Stribeck friction on
     J6, chosen by dynid's own cross-validation, were listed as "not determined by this log", and fcl1, fst6 were not

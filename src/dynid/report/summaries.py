@@ -163,10 +163,10 @@ def summary(result, *, width: int = 100) -> str:
     -------
     str
     """
-    return render_text(blocks(result), width)
+    return render_text(blocks(result, library=True), width)
 
 
-def blocks(result) -> list:
+def blocks(result, *, library: bool = False) -> list:
     """The blocks of :func:`summary` (the terminal renders them with colours, :mod:`dynid.report.console`).
 
     Parameters
@@ -177,6 +177,10 @@ def blocks(result) -> list:
         (its identification's result, as ``dynid identify`` prints it) or an
         :class:`~dynid.identification.identified.IdentifiedModel` (its :meth:`summary
         <dynid.identification.identified.IdentifiedModel.summary>`, one read back from results.json included).
+
+    library : bool
+        Said to a library user (:func:`summary`): the first line names the fitted model's methods where the terminal's
+        names ``dynid identify``'s output folder (:func:`readiness`).
 
     Returns
     -------
@@ -206,7 +210,9 @@ def blocks(result) -> list:
     if isinstance(result, TorqueComparison) or (isinstance(result, (list, tuple)) and result
                                                 and all(isinstance(c, TorqueComparison) for c in result)):
         return validation_blocks(result if isinstance(result, (list, tuple)) else [result])
-    for kind, make in ((IdentificationResult, identification_blocks), (PaperRunResult, run_summary_blocks),
+    if isinstance(result, IdentificationResult):
+        return identification_blocks(result, library=library)
+    for kind, make in ((PaperRunResult, run_summary_blocks),
                        (MonteCarloResult, montecarlo_blocks), (ClosedLoopStudyResult, closed_loop_study_blocks),
                        (ExcitationRun, excitation_blocks), (ExcitationDesign, design_blocks),
                        (FleetResult, fleet_blocks), (MonitorResult, monitor_blocks)):
@@ -215,13 +221,15 @@ def blocks(result) -> list:
     raise TypeError(f"expected a result of dynid, got {type(result).__name__}")
 
 
-def identification_blocks(result) -> list:
+def identification_blocks(result, *, library: bool = False) -> list:
     """What ``dynid identify`` prints: how the data were prepared, the base parameters with σ beside the references,
     the estimators, the drive gains, the fit and validation tables and the verdict.
 
     Parameters
     ----------
     result : dynid.identification.identify.IdentificationResult
+    library : bool
+        Its first line as said to a library user (:func:`readiness`).
 
     Returns
     -------
@@ -229,7 +237,7 @@ def identification_blocks(result) -> list:
     """
     r = result
     sol, base = r.solution, r.base
-    out: list = [readiness(r), _identification_title(r)]
+    out: list = [readiness(r, library=library), _identification_title(r)]
     out.extend(in_short(r))  # how it went and what to do next, first; the details follow
     pre = r.settings.get("preprocessing", {})
     if pre.get("derivation"):
@@ -310,7 +318,7 @@ def _exportable(r) -> list[str]:
             and str(r.consistency_verdicts.get(n, "")).startswith("yes")]
 
 
-def readiness(result) -> Line:
+def readiness(result, *, library: bool = False) -> Line:
     """The first line of ``dynid identify``: whether the model is ready to use, and the one thing to do next.
 
     Ready: a physically consistent estimate (what ``dynid export`` writes), no torque running against the model, and
@@ -320,6 +328,11 @@ def readiness(result) -> Line:
     Parameters
     ----------
     result : dynid.identification.identify.IdentificationResult
+    library : bool
+        Said to a library user (:func:`summary`): the model's URDF and MJCF are
+        :meth:`~dynid.identification.identified.IdentifiedModel.urdf` and ``mjcf()`` (an Identifier's ``model_``), and
+        the check on other motions ``validate(log)``, not ``dynid identify``'s output folder and a config's
+        ``[[validation]]`` logs.
 
     Returns
     -------
@@ -356,9 +369,14 @@ def readiness(result) -> Line:
         return Line(f"not ready: the description's nominal model predicts {', '.join(f'J{j}' for j in joints)} of {log} "
                     f"better than {exportable[0]} (what dynid export writes); identify on a log that excites them "
                     "(dynid excite), or keep the nominal values there", "warning")
+    files = ("its URDF and MJCF: IdentifiedModel.urdf() and .mjcf(), an Identifier's model_" if library else
+             "its URDF and MJCF are in the output folder")
     if not r.validations:
-        return Line(f"model ready to check: {exportable[0]} is physically consistent (its URDF and MJCF are in the output "
-                    "folder); add [[validation]] logs (other motions) before you use it", "title")
+        check = "validate(log) on other motions" if library else "add [[validation]] logs (other motions)"
+        return Line(f"model ready to check: {exportable[0]} is physically consistent ({files}); {check} before you use "
+                    "it", "title")
+    if library:
+        return Line(f"model ready: {exportable[0]} ({files})", "title")
     return Line(f"model ready: {exportable[0]}, as the URDF and MJCF in the output folder (other names: dynid export "
                 "CONFIG --urdf FILE --mjcf FILE)", "title")
 
