@@ -53,3 +53,27 @@ def test_a_validation_table_with_currents_does_not_also_take_the_identifications
     assert currents == {"file": "b.csv", "header": True, "time": {"column": "t"}, "positions": {"columns": [1]},
                         "currents": {"columns": [3]}}
     assert own == {"file": "c.csv", "positions": {"columns": [4]}, "torques": {"columns": [5]}}  # its own layout, as given
+
+
+def test_a_validation_table_with_only_a_time_range_scores_another_stretch_of_the_identification_log(tmp_path):
+    """One long log split into an identification part and a validation part: ``[[validation]] name = "later",
+    time_range = [...]`` was refused ("validation[0].positions: expected a 'file'"), as a ROS 2 bag's table already
+    did right. It takes the identification's file and columns; with signals in files of their own (a motor-side log),
+    those files."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config, with_inherited_layout
+    from dynid.model.description import load_robot
+
+    cfg = load_identification_config(_config(tmp_path, 'name = "later"\ntime_range = [1.0, 1.5]\n'))
+    rec = load_recording(cfg.validation[0], load_robot("ur10e"))
+    x = np.loadtxt(tmp_path / "ident.csv", delimiter=",", skiprows=1)
+    part = (x[:, 0] >= 1.0 - 1e-9) & (x[:, 0] <= 1.5 + 1e-9)
+    np.testing.assert_allclose(rec.q, x[part, 1:7], atol=1e-9)
+    np.testing.assert_allclose(rec.tau, x[part, 7:13], atol=1e-9)
+    own = {"identification": {"header": True, "rate": 5000.0, "positions": {"file": "pos.csv", "columns": [1]},
+                              "torques": {"file": "cur.csv", "columns": [1]}, "time_range": [0.0, 6.0]},
+           "validation": [{"name": "end", "time_range": [6.0, 8.0]}, {"name": "other", "file": "b.csv"}]}
+    end, other = with_inherited_layout(own)["validation"]
+    assert end == {"header": True, "rate": 5000.0, "positions": {"file": "pos.csv", "columns": [1]},
+                   "torques": {"file": "cur.csv", "columns": [1]}, "name": "end", "time_range": [6.0, 8.0]}
+    assert other == {"name": "other", "file": "b.csv"}  # another file: the signals' own files are not its

@@ -512,8 +512,10 @@ def with_inherited_layout(doc: dict) -> dict:
     ``bag``) given the identification's column layout (:data:`LAYOUT_KEYS`); its own keys (``file``, ``rows``,
     ``time_range``, ``name``, and ``torques`` or ``currents``, e.g. to flip a sign: then neither of the
     identification's) stay. The identification's signals must then read its default ``file`` (none of them naming a
-    file of its own). Where the identification log is a ROS 2 bag, a validation table
-    that names no CSV file takes the bag's reader settings it does not state (:data:`BAG_READER_KEYS`).
+    file of its own). A table that names no file but ``rows`` or ``time_range`` is another stretch of the
+    identification's log: it takes its file (or its signals' own files) too. Where the identification log is a ROS 2
+    bag, a validation table that names no CSV file takes the bag's reader settings it does not state
+    (:data:`BAG_READER_KEYS`).
 
     Parameters
     ----------
@@ -539,6 +541,10 @@ def with_inherited_layout(doc: dict) -> dict:
             merged.append({**reader, **v})  # a bag's table: the identification's bag, topic, joint names, effort
             continue
         states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "preset", "bag"))
+        stretch = not states_its_own and "file" not in v and any(k in v for k in ("rows", "time_range"))
+        if stretch and "bag" not in ident:  # another stretch of the identification's own log: its file(s) too
+            merged.append({**layout, **({"file": ident["file"]} if "file" in ident else {}), **v})
+            continue
         if states_its_own or own_files or "bag" in ident:
             merged.append(v)
             continue
