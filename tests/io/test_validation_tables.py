@@ -77,3 +77,20 @@ def test_a_validation_table_with_only_a_time_range_scores_another_stretch_of_the
     assert end == {"header": True, "rate": 5000.0, "positions": {"file": "pos.csv", "columns": [1]},
                    "torques": {"file": "cur.csv", "columns": [1]}, "name": "end", "time_range": [6.0, 8.0]}
     assert other == {"name": "other", "file": "b.csv"}  # another file: the signals' own files are not its
+
+
+def test_validate_file_reads_the_whole_other_log_not_the_identifications_time_range(tmp_path):
+    """``dynid validate CONFIG --file LOG`` cut LOG to the identification's ``time_range`` (a Med7 config identified on
+    0-70 s scored a 16 s log with "time_range ends at 70 s, after the recording's end"); ``rows`` were already reset."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from dynid.model.description import load_robot
+
+    path = _config(tmp_path, 'name = "other"\nfile = "other.csv"\n')
+    path.write_text(path.read_text().replace('file = "ident.csv"\n', 'file = "ident.csv"\ntime_range = [0.5, 1.0]\n', 1))
+    config = load_identification_config(path)
+    robot = load_robot("ur10e")
+    assert load_recording(config.identification, robot).n_samples == 51  # the identification's part: 0.5-1.0 s
+    rec = load_recording(dataset_for_file(config, tmp_path / "other.csv"), robot)
+    assert rec.n_samples == 200 and not any("time_range" in w for w in rec.warnings)
+    assert load_recording(dataset_for_file(config, tmp_path / "other.csv", rows=(11, 60)), robot).n_samples == 50

@@ -610,7 +610,8 @@ def stored_preprocessing(identified: dict, key: str = "preprocessing") -> Prepro
 
 
 def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> DatasetSpec:
-    """The identification dataset's column map applied to another log.
+    """The identification dataset's column map applied to another log, the whole of it (or ``rows``): the part of the
+    identification log its ``rows`` or ``time_range`` select is not carried over.
 
     Parameters
     ----------
@@ -640,7 +641,7 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
             raise DataError(f"--file {file}: the config's logs are ROS 2 bags (bag = ...); expected a bag's folder or its "
                             ".mcap/.db3 file, or add a [[validation]] table for a CSV log", field="file")
         return replace(spec, name=file.name, bag=replace(spec.bag, path=file),
-                       rows=None if rows is None else tuple(rows))
+                       rows=None if rows is None else tuple(rows), time_range=None)
     if is_bag:
         raise DataError(f"--file {file}: a ROS 2 bag, but the config's logs are CSV files; add a [[validation]] table "
                         "with bag = ... for it", field="file")
@@ -649,5 +650,5 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
         raise DataError("file: the identification dataset reads several files; add a [[validation]] table to the config instead", field="file")
     signals = {k: SignalSpec(file, s.columns, s.scale, s.side) for k, s in spec.signals.items()}
     time = SignalSpec(file, spec.time.columns, spec.time.scale) if spec.time else None  # its unit too
-    return replace(spec, name=file.name, signals=signals, time=time,
-                   rows=None if rows is None else tuple(rows))
+    return replace(spec, name=file.name, signals=signals, time=time,  # the identification's part is not its
+                   rows=None if rows is None else tuple(rows), time_range=None)
