@@ -77,6 +77,9 @@ def test_a_validation_table_with_only_a_time_range_scores_another_stretch_of_the
     assert end == {"header": True, "rate": 5000.0, "positions": {"file": "pos.csv", "columns": [1]},
                    "torques": {"file": "cur.csv", "columns": [1]}, "name": "end", "time_range": [6.0, 8.0]}
     assert other == {"name": "other", "file": "b.csv"}  # another file: the signals' own files are not its
+    own["validation"] = [{"name": "end", "time_range": [6.0, 8.0], "currents": {"file": "i.csv", "columns": [1]}}]
+    (currents,) = with_inherited_layout(own)["validation"]
+    assert "torques" not in currents and currents["positions"] == {"file": "pos.csv", "columns": [1]}
 
 
 def test_validate_file_reads_the_whole_other_log_not_the_identifications_time_range(tmp_path):

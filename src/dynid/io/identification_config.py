@@ -541,15 +541,16 @@ def with_inherited_layout(doc: dict) -> dict:
             merged.append({**reader, **v})  # a bag's table: the identification's bag, topic, joint names, effort
             continue
         states_its_own = not isinstance(v, dict) or any(k in v for k in ("positions", "preset", "bag"))
-        stretch = not states_its_own and "file" not in v and any(k in v for k in ("rows", "time_range"))
-        if stretch and "bag" not in ident:  # another stretch of the identification's own log: its file(s) too
-            merged.append({**layout, **({"file": ident["file"]} if "file" in ident else {}), **v})
+        if states_its_own or "bag" in ident:
+            merged.append(v)
             continue
-        if states_its_own or own_files or "bag" in ident:
+        stretch = "file" not in v and any(k in v for k in ("rows", "time_range"))  # another stretch of the same log
+        if own_files and not stretch:
             merged.append(v)
             continue
         torque = ("torques", "currents") if any(k in v for k in ("torques", "currents")) else ()  # its own: both left
-        merged.append({**{k: x for k, x in layout.items() if k not in torque}, **v})
+        file = {"file": ident["file"]} if stretch and "file" in ident else {}  # the identification's file(s) too
+        merged.append({**{k: x for k, x in layout.items() if k not in torque}, **file, **v})
     return {**doc, "validation": merged}
 
 
