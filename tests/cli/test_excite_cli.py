@@ -42,6 +42,7 @@ def test_excite_ur10e_satisfies_every_constraint_on_a_10x_finer_grid(tmp_path):
     text = " ".join(p.stdout.split())
     assert f"cond(W_base) {doc['design']['initial_cond']:.2f} → {doc['design']['cond']:.2f}" in text
     assert "every constraint holds" in text and "next: play excitation.csv on the robot" in text
+    assert "log positions and torques (or motor currents)" in " ".join(text.split())  # a torque sensor's arm logs torques
     traj = load_trajectory(out / "excitation.json")
     config = load_excitation_config(cfg)
     lim, ws = config.problem.limits, config.problem.workspace

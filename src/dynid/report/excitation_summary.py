@@ -42,7 +42,7 @@ def excitation_blocks(run) -> list:
     out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
     if d.feasible:
         out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
-                        "and currents, and dynid identify the log"))
+                        "and torques (or motor currents), and dynid identify the log"))
     return out
 
 
