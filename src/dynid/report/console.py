@@ -111,7 +111,8 @@ class Reporter:
                 self.out.print(b.text, markup=False, highlight=False)
 
     def wrote(self, paths: list[Path]) -> None:
-        """One line: the first file, the other files by name, and how many figures, in which folder.
+        """One line: the first file, the other files by name, and how many figures (where there are any), in which
+        folder.
 
         Parameters
         ----------
@@ -120,7 +121,8 @@ class Reporter:
         """
         pngs = [p for p in paths if p.suffix == ".png"]
         others = "".join(f", {p.name}" for p in paths[1:] if p.suffix != ".png")
-        self.line(f"wrote {paths[0]}{others} and {count(len(pngs), 'figure')} in {paths[0].parent}/")
+        figures = f" and {count(len(pngs), 'figure')}" if pngs else ""  # "and no figures" read as a missing output
+        self.line(f"wrote {paths[0]}{others}{figures} in {paths[0].parent}/")
 
     def progress(self, command: str) -> Progress:
         """A progress reporter for a command.
