@@ -20,7 +20,9 @@ from ..io.identification_config import IdentificationConfig, stored_preprocessin
 from ..io.log_repairs import (
     GAP_FACTOR,
     check_position_steps,
+    limit_warnings,
     logged_velocities,
+    position_ranges,
     resampled,
     uniform_rate,
     unwrapped_positions,
@@ -679,6 +681,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     said: list[str] = []
     q = unwrapped_positions(q, name, said)
     check_position_steps(q, t - t[0], robot, name)
+    said += limit_warnings(robot, t - t[0], position_ranges(robot, t, q, name, degrees="numpy.radians(q)")[1], name)
     dq = logged_velocities(q, dq, name, said)
     warnings: tuple[str, ...] = tuple(said)
     rate = uniform_rate(t)

@@ -76,29 +76,14 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
     """Refuse positions that cannot be radians and implausible efforts, warn about positions outside the joint limits,
     naming joint and time range (a current or torque held at its extreme is found where the log is prepared:
     :func:`dynid.preprocessing.prepared.clipped_samples`)."""
-    lim = robot.limits
-    worst, outside, still = np.zeros(q.shape[1]), [], []
-    for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
-        column = q[:, j]
-        _position_step(column, t, float(lim.dq_max[j]), j, source)
-        worst[j] = np.abs(column).max()
-        still.append(bool(column.max() == column.min()))
-        k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
-        outside.append((k.size, k[0] if k.size else 0))
-    if np.any(worst > 4 * np.pi):
-        j = int(np.argmax(worst))
-        raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
-                        f"positions in degrees (positions = {{ ..., unit = \"deg\" }})?")
+    still, outside = position_ranges(robot, t, q, source, steps=True)
     if all(still):
         raise DataError(f"{source}: no joint's position ever changes ({spec.table or spec.name}): a frozen log, or the "
                         "wrong columns or rows?")
     for j in (j for j, s in enumerate(still) if s and spec.table == "[identification]"):
         warnings.append(f"{source}: joint {j + 1}'s position never changes in [identification] (a joint held still, or "
                         "the wrong column?): what only its motion shows keeps the description's values")
-    for j, (count, first) in enumerate(outside):
-        if count:
-            warnings.append(f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad "
-                            f"during {count} samples from t = {t[first]:.3f} s (units, encoder zero, position_offset?)")
+    warnings += limit_warnings(robot, t, outside, source)
     kind = "currents" if "currents" in spec.signals or (spec.bag is not None and spec.bag.effort == "currents") else "torques"
     for j in range(tau.shape[1]):
         x = tau[:, j]
@@ -107,6 +92,73 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
             top = int(np.argmax(np.abs(x)))
             raise DataError(f"{tau_source}: joint {j + 1}'s {kind} reach {x[top]:.4g} at t = {t[top]:.3f} s, implausible for "
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
+
+
+def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
+                    degrees: str = 'positions = { ..., unit = "deg" }') -> tuple[list[bool], list[tuple[int, int]]]:
+    """Refuse positions that cannot be radians; say which joints never move and which leave their limits.
+
+    Parameters
+    ----------
+    robot : Robot
+        Its position limits (and with ``steps`` its velocity limits).
+    t : (N,) array [s]
+    q : (N, n_dof) array or StoredColumns [rad]
+        Read one joint at a time.
+    source : str
+        The file or dataset, for the message.
+    steps : bool
+        Also refuse a step no motion makes (a reader's check, before the log is unwrapped).
+    degrees : str
+        How to give degrees, in the message (a config's unit; ``numpy.radians`` for arrays).
+
+    Returns
+    -------
+    still : list of bool
+        Per joint, whether its position never changes.
+    outside : list of (int, int)
+        Per joint, how many samples leave its limits (by more than 0.05 rad) and the first of them.
+
+    Raises
+    ------
+    DataError
+        A joint beyond 4π rad: degrees read as radians.
+    """
+    lim = robot.limits
+    worst, outside, still = np.zeros(q.shape[1]), [], []
+    for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
+        column = q[:, j]
+        if steps:
+            _position_step(column, t, float(lim.dq_max[j]), j, source)
+        worst[j] = np.abs(column).max()
+        still.append(bool(column.max() == column.min()))
+        k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
+        outside.append((k.size, k[0] if k.size else 0))
+    if np.any(worst > 4 * np.pi):
+        j = int(np.argmax(worst))
+        raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
+                        f"positions in degrees ({degrees})?")
+    return still, outside
+
+
+def limit_warnings(robot: Robot, t, outside: list[tuple[int, int]], source: str) -> list[str]:
+    """One warning per joint that leaves its position limits (:func:`position_ranges`' ``outside``).
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    outside : list of (int, int)
+    source : str
+
+    Returns
+    -------
+    list of str
+    """
+    lim = robot.limits
+    return [f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad during {count} "
+            f"samples from t = {t[first]:.3f} s (units, encoder zero, position_offset?)"
+            for j, (count, first) in enumerate(outside) if count]
 
 
 def check_position_steps(q, t, robot: Robot, source: str) -> None:

@@ -1,0 +1,31 @@
+"""Arrays given to the library are checked as the log readers check a file's positions: degrees read as radians are
+refused, positions outside the joint limits said."""
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.exceptions import DataError
+from dynid.identification.run import recording_from_arrays
+
+
+def test_positions_in_degrees_given_as_arrays_are_refused_as_a_files_are():
+    """``Identifier(robot).fit(t, numpy.degrees(q), tau)`` fitted without a word (torque error 97 %) and said "model
+    ready to check", where the same positions read from a file are refused: "implausible for radians"."""
+    robot = dynid.load_robot("ur10e")
+    log = dynid.simulated_log(robot, seconds=4, rng=1)
+    with pytest.raises(DataError, match=r"arrays: joint \d reaches [\d.]+ rad, implausible for radians: are the "
+                                        r"positions in degrees \(numpy.radians\(q\)\)\?"):
+        dynid.Identifier(robot).fit(log.t, np.degrees(log.q), log.tau)
+    assert recording_from_arrays(robot, log.t, log.q, log.tau).warnings == ()  # radians within the limits: nothing said
+
+
+def test_positions_outside_the_joint_limits_given_as_arrays_are_said():
+    robot = dynid.load_robot("ur10e")
+    log = dynid.simulated_log(robot, seconds=4, rng=1)
+    q = log.q.copy()
+    q[:, 1] += robot.limits.q_max[1] + 0.3 - q[:, 1].max()  # joint 2 shifted: its peak 0.3 rad beyond its upper limit
+    beyond = np.flatnonzero(q[:, 1] > robot.limits.q_max[1] + 0.05)
+    (said,) = recording_from_arrays(robot, log.t, q, log.tau, name="run").warnings
+    assert said.startswith(f"run: joint 2 leaves its limits [{robot.limits.q_min[1]:.3g}, {robot.limits.q_max[1]:.3g}] "
+                           f"rad during {beyond.size} samples from t = {log.t[beyond[0]] - log.t[0]:.3f} s")
