@@ -29,3 +29,13 @@ def test_positions_outside_the_joint_limits_given_as_arrays_are_said():
     (said,) = recording_from_arrays(robot, log.t, q, log.tau, name="run").warnings
     assert said.startswith(f"run: joint 2 leaves its limits [{robot.limits.q_min[1]:.3g}, {robot.limits.q_max[1]:.3g}] "
                            f"rad during {beyond.size} samples from t = {log.t[beyond[0]] - log.t[0]:.3f} s")
+
+
+def test_time_stamps_in_milliseconds_given_as_arrays_are_refused_as_a_files_are():
+    """``fit(t * 1000, q, tau)`` fitted a 20 000 s log without a word ("model ready to check"), where a file's time
+    column in milliseconds is refused with its unit."""
+    robot = dynid.load_robot("ur10e")
+    log = dynid.simulated_log(robot, seconds=4, rng=1)  # 250 Hz
+    with pytest.raises(DataError, match=r"^t: the time stamps step by 4 s \(0.25 Hz\), slower than any robot controller "
+                                        r"logs \(at least 5 Hz\): they look like ms \(give t × 0.001, in seconds\)$"):
+        dynid.Identifier(robot).fit(log.t * 1000.0, log.q, log.tau)

@@ -19,6 +19,7 @@ from ..io.datasets import Recording, load_recording
 from ..io.identification_config import IdentificationConfig, stored_preprocessing
 from ..io.log_repairs import (
     GAP_FACTOR,
+    check_clock_unit,
     check_position_steps,
     limit_warnings,
     logged_velocities,
@@ -674,6 +675,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     if t.size < 2 or not np.all(np.isfinite(t)) or np.any(steps <= 0):
         raise DataError("t: expected finite, increasing time stamps")
     median = float(np.median(steps))
+    check_clock_unit(median, "t", None)
     if np.any(steps > GAP_FACTOR * median):
         k = int(np.argmax(steps))
         raise DataError(f"t: a gap of {steps[k]:.3g} s after {t[k] - t[0]:.3f} s (median step {median:.3g} s): give the parts "

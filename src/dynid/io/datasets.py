@@ -22,7 +22,6 @@ from .log_repairs import (
     AUTO_GAP_SAMPLES,
     GAP_FACTOR,
     MIN_SELECTED,
-    _check_clock_unit,
     _despiked,
     _filled,
     _held_rows,
@@ -31,6 +30,7 @@ from .log_repairs import (
     _per_joint,
     _plausibility,
     _row_wise,
+    check_clock_unit,
     logged_velocities,
     resampled,
     uniform_rate,
@@ -246,7 +246,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     median = float(np.median(np.diff(t)))
     table = spec.table or spec.name
     if timed and spec.resample is None:  # before the gaps: a log in milliseconds has its gaps in seconds
-        _check_clock_unit(median, q_source, table)
+        check_clock_unit(median, q_source, table)
     if timed:
         steps = np.diff(t)
         gaps = np.flatnonzero(steps > GAP_FACTOR * median)
@@ -275,7 +275,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     rate = float(spec.rate or 0.0) if not timed else (spec.resample or uniform_rate(t))
     if timed and spec.resample is None:
-        _check_clock_unit(1.0 / rate, q_source, table)
+        check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
     tr = robot.transmission

@@ -10,7 +10,7 @@ from functools import partial
 import numpy as np
 
 from .._util.column_store import StoredColumns, by_column, select_rows
-from ..conventions import MOVING_SPAN, time_unit_of
+from ..conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
 from ..exceptions import DataError
 from ..model.robot import Robot
 from .dataset_specs import DatasetSpec
@@ -350,12 +350,31 @@ def _in_time_range(spec: DatasetSpec, t, raw: dict, where, warnings: list[str]):
     return t, raw, where
 
 
-def _check_clock_unit(step: float, source: str, table: str) -> None:
+def check_clock_unit(step: float, source: str, table: str | None) -> None:
     """Refuse time stamps ``step`` seconds apart when that is slower than any robot controller logs
-    (:data:`MIN_RATE`): they hold another unit, which the message guesses."""
+    (:data:`MIN_RATE`): they hold another unit, which the message guesses.
+
+    Parameters
+    ----------
+    step : float
+        The time stamps' median step, read as seconds.
+    source : str
+        The file or dataset, for the message.
+    table : str or None
+        The config table whose time column or rate to fix; None for arrays given to the library (which reads seconds).
+
+    Raises
+    ------
+    DataError
+        Time stamps slower than :data:`MIN_RATE`, with the unit they look like.
+    """
     if 1.0 / step >= MIN_RATE:
         return
     unit = time_unit_of(step)
+    if table is None:  # arrays: the library reads seconds
+        guess = f"they look like {unit} (give t × {TIME_UNITS[unit]:g}, in seconds)" if unit else "another unit?"
+        raise DataError(f"{source}: the time stamps step by {step:.4g} s ({1.0 / step:.4g} Hz), slower than any robot "
+                        f"controller logs (at least {MIN_RATE:g} Hz): {guess}")
     guess = f"they look like {unit} (time = {{ ..., unit = \"{unit}\" }})" if unit else "another unit?"
     raise DataError(f"{source}: the time stamps step by {step:.4g} s ({1.0 / step:.4g} Hz), slower than any robot "
                     f"controller logs (at least {MIN_RATE:g} Hz): {guess}; dynid reads seconds unless the time "
