@@ -661,8 +661,10 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     ShapeError
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
-        Time stamps that do not increase, a gap longer than 5 median steps, or a position step no motion makes
-        (:func:`dynid.io.log_repairs.check_position_steps`).
+        Time stamps that do not increase or are slower than any controller logs (another unit:
+        :func:`dynid.io.log_repairs.check_clock_unit`), a gap longer than 5 median steps, a position step no motion
+        makes (:func:`dynid.io.log_repairs.check_position_steps`), or positions beyond 4π rad (degrees:
+        :func:`dynid.io.log_repairs.position_ranges`, which also says the positions outside the joint limits).
     """
 
     t = np.asarray(t, dtype=float).reshape(-1)
