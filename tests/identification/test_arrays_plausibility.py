@@ -39,3 +39,18 @@ def test_time_stamps_in_milliseconds_given_as_arrays_are_refused_as_a_files_are(
     with pytest.raises(DataError, match=r"^t: the time stamps step by 4 s \(0.25 Hz\), slower than any robot controller "
                                         r"logs \(at least 5 Hz\): they look like ms \(give t × 0.001, in seconds\)$"):
         dynid.Identifier(robot).fit(log.t * 1000.0, log.q, log.tau)
+
+
+def test_arrays_of_a_robot_at_rest_throughout_are_refused_for_what_they_are():
+    """Positions that never change were answered "every joint's torque reads one value throughout (dead channels, or
+    not the torque or current columns?)": the torques were fine, the robot did not move. A file's frozen log was
+    already said so."""
+    robot = dynid.load_robot("ur10e")
+    log = dynid.simulated_log(robot, seconds=4, rng=1)
+    rest = np.tile(log.q[:1], (log.t.size, 1))
+    with pytest.raises(DataError, match=r"^arrays: no joint's position ever changes: a robot at rest throughout, or the "
+                                        r"wrong array\?$"):
+        dynid.Identifier(robot).fit(log.t, rest, np.tile(log.tau[:1], (log.t.size, 1)))
+    model = dynid.Identifier(robot).fit(log).model_  # a pose's torques are still predicted
+    predicted = model.predict(log.t, rest)
+    assert predicted.shape == rest.shape and np.any(np.isfinite(predicted))

@@ -633,7 +633,10 @@ def _given_log(robot: Robot, t, q, tau, dq, name: str) -> Recording:
     if q is None or tau is None:
         raise ConfigError("positions q and torques tau are needed with the time stamps t (or give a recording, as "
                           "dynid.load_recording reads one)")
-    return recording_from_arrays(robot, t, q, tau, dq, name)
+    recording = recording_from_arrays(robot, t, q, tau, dq, name)
+    if not np.any(np.ptp(recording.q, axis=0) > 0):  # to identify from (a pose's torques are predicted alright)
+        raise DataError(f"{name}: no joint's position ever changes: a robot at rest throughout, or the wrong array?")
+    return recording
 
 
 def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"):
