@@ -372,13 +372,14 @@ def check_clock_unit(step: float, source: str, table: str | None) -> None:
         return
     unit = time_unit_of(step)
     if table is None:  # arrays: the library reads seconds
-        guess = f"they look like {unit} (give t × {TIME_UNITS[unit]:g}, in seconds)" if unit else "another unit?"
-        raise DataError(f"{source}: the time stamps step by {step:.4g} s ({1.0 / step:.4g} Hz), slower than any robot "
-                        f"controller logs (at least {MIN_RATE:g} Hz): {guess}")
-    guess = f"they look like {unit} (time = {{ ..., unit = \"{unit}\" }})" if unit else "another unit?"
+        fix, then = f"give t × {TIME_UNITS.get(unit or 's', 1.0):g}, in seconds", ""
+    else:
+        fix = f'time = {{ ..., unit = "{unit}" }}'
+        then = (f"; dynid reads seconds unless the time column's unit says otherwise, or give rate (Hz) in {table} "
+                "instead of the time column")
+    guess = f"they look like {unit} ({fix})" if unit else "another unit?"
     raise DataError(f"{source}: the time stamps step by {step:.4g} s ({1.0 / step:.4g} Hz), slower than any robot "
-                    f"controller logs (at least {MIN_RATE:g} Hz): {guess}; dynid reads seconds unless the time "
-                    f"column's unit says otherwise, or give rate (Hz) in {table} instead of the time column")
+                    f"controller logs (at least {MIN_RATE:g} Hz): {guess}{then}")
 
 
 def logged_velocities(q, dq, name: str, warnings: list[str]):
