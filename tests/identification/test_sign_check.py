@@ -48,6 +48,27 @@ def test_a_flipped_torque_sign_is_still_named(tmp_path):
     assert "J2" in sign["text"] and "sign = [1, -1, 1, 1, 1, 1]" in sign["text"]
 
 
+def test_one_joints_flipped_sign_that_the_fit_cannot_follow_is_named(tmp_path):
+    """J3's torque negated in both logs of ``dynid example ur10e``: the fit cannot follow one joint's sign (the links
+    are shared), so J3's residual is as large as its torque, and the check that asked J3's torque to vary beyond that
+    residual judged nothing (ρ beyond friction -0.9999, no word, "ready"). Its torque is judged against the noise floor
+    of the samples: J3 is named, with the fix, and the model is not called ready."""
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    for name in ("identification.csv", "validation.csv"):
+        path = tmp_path / "try" / name
+        header = path.read_text().splitlines()[0]
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        data[:, header.split(",").index("elbow_joint_effort")] *= -1
+        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
+    p = dynid("identify", tmp_path / "try" / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["diagnostics"]["nominal_correlation_beyond_friction"][2] < -0.9  # what the check sees
+    (sign,) = [f for f in results["findings"] if f["kind"] == "sign"]
+    assert "J3" in sign["text"] and "sign = [1, 1, -1, 1, 1, 1]" in sign["text"]
+    assert "not ready: the measured torques run against the model" in " ".join((p.stdout + p.stderr).split())
+
+
 def test_a_flipped_sign_that_friction_hides_from_the_plain_correlation_is_named(tmp_path):
     """J1's current negated in the UR10e's identification log: J1's torque is mostly friction, which the nominal model
     lacks, so its plain correlation with that model is only -0.36, while beyond its friction it is -0.98. The check

@@ -42,7 +42,7 @@ from ..validation.diagnostics import (
     scale_findings,
     sign_findings,
 )
-from ..validation.torques import MEANINGFUL, TorqueComparison, TorqueSums, resting_rows
+from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .identified import Parameters
@@ -379,8 +379,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng,
                                consistent="sdp" in keys)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
-        floor = np.zeros(robot.n_dof) if fit.floor is None else np.asarray(fit.floor, dtype=float)
-        findings += scoring.order.findings(fit.torque_std >= MEANINGFUL * floor, data.name)
+        findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
     ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
@@ -523,11 +522,11 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     beyond_drive, slope_drive = sums.beyond(nominal, drive)
     stats["nominal_correlation_beyond_drive"] = beyond_drive
     stats["nominal_slope_beyond_drive"] = slope_drive
-    varies = fit.varies()
     # the correlation beyond friction judges where it is known, both ways: friction the nominal model lacks can run
-    # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98)
-    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name)
-            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains))
+    # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98).
+    # One joint's flipped sign fits badly, so its torque is judged against the noise floor, not the fit's residual
+    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), fit.varies(beyond="floor"), data.name)
+            + scale_findings(beyond_drive, slope_drive, fit.varies(), data.name, gains=scoring.robot.drive_gains))
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

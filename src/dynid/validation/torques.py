@@ -273,17 +273,25 @@ class TorqueComparison:
             return self.summary["torque_std"]
         return self.measured.std(axis=0)
 
-    def varies(self) -> np.ndarray:
+    def varies(self, beyond: str = "noise") -> np.ndarray:
         """Whether each joint's torque varies beyond its noise, so that its correlation coefficient (eq. 18) means
         something.
+
+        Parameters
+        ----------
+        beyond : {"noise", "floor"}
+            What it must vary beyond (:data:`MEANINGFUL` times): the residual level :attr:`noise` (the fit's, on an
+            identification log), or the noise floor of these samples :attr:`floor`, which a torque the model cannot
+            fit (a flipped sign, a swapped pair of columns) does not raise.
 
         Returns
         -------
         (n_dof,) bool array
         """
-        if self.noise is None:
+        level = self.noise if beyond == "noise" else self.floor
+        if level is None:
             return np.ones(self.rms_torque.shape, dtype=bool)
-        return self.torque_std >= MEANINGFUL * np.asarray(self.noise)
+        return self.torque_std >= MEANINGFUL * np.asarray(level)
 
     @property
     def rms_torque(self) -> np.ndarray:
