@@ -42,6 +42,7 @@ from ..validation.diagnostics import (
     scale_findings,
     sign_findings,
 )
+from ..validation.logged_angles import logged_angle_findings
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
@@ -504,7 +505,8 @@ FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 
 def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     """The torques against the description's nominal model (``scoring.nominal``): a flipped sign and a scale (unit or
-    gain) (:mod:`dynid.validation.diagnostics`); their statistics go into ``stats``."""
+    gain) (:mod:`dynid.validation.diagnostics`), logged angles that do not match the robot file
+    (:mod:`dynid.validation.logged_angles`); their statistics go into ``stats``."""
     nominal, sums, data = scoring.nominal, scoring.sums, scoring.data
     assert nominal is not None  # called only where the description has a nominal model
     corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
@@ -525,8 +527,9 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     # the correlation beyond friction judges where it is known, both ways: friction the nominal model lacks can run
     # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98).
     # One joint's flipped sign fits badly, so its torque is judged against the noise floor, not the fit's residual
+    angles, stats["logged_angles"] = logged_angle_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), fit.varies(beyond="floor"), data.name)
-            + scale_findings(beyond_drive, slope_drive, fit.varies(), data.name, gains=scoring.robot.drive_gains))
+            + scale_findings(beyond_drive, slope_drive, fit.varies(), data.name, gains=scoring.robot.drive_gains) + angles)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

@@ -389,13 +389,13 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("sign", "scale", "order")
-"""Findings of ``dynid identify``'s verdict that say the torques themselves are wrong (a flipped sign, a unit or gain,
-channels swapped): a model fitted to them is exported with a warning."""
+READINESS_KINDS = ("sign", "scale", "order", "angles")
+"""Findings of ``dynid identify``'s verdict that say the log itself is wrong (the torques' sign, unit or gain, channels
+swapped, angles that do not match the robot file): a model fitted to it is exported with a warning."""
 
 
 def verdict_warnings(results: dict) -> list[str]:
-    """One line per finding of ``dynid identify``'s verdict that says the torques the model was fitted to are wrong
+    """One line per finding of ``dynid identify``'s verdict that says the log the model was fitted to is wrong
     (:data:`READINESS_KINDS`), for ``dynid export`` to repeat.
 
     Parameters
@@ -407,7 +407,8 @@ def verdict_warnings(results: dict) -> list[str]:
     -------
     list of str
     """
-    return [f"the model was fitted to torques dynid identify doubts: {f.get('text')}"
+    return [f"the model was fitted to {'angles' if f.get('kind') == 'angles' else 'torques'} dynid identify doubts: "
+            f"{f.get('text')}"
             for f in results.get("findings") or [] if isinstance(f, dict) and f.get("kind") in READINESS_KINDS]
 
 

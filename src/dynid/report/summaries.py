@@ -354,6 +354,10 @@ def readiness(result, *, library: bool = False) -> Line:
                     "verdict at the end names it and the setting that fixes it", "warning")
     if "order" in kinds:
         return Line("not ready: the torques of some joints look swapped: the verdict at the end names them", "warning")
+    if "angles" in kinds:
+        return Line("not ready: the logged angles do not match the robot file (a joint's zero a quarter or half turn "
+                    "off, or two columns swapped?): the verdict at the end names them and the setting that fixes it",
+                    "warning")
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
