@@ -192,6 +192,37 @@ def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
     assert scale_findings(np.full(5, 0.5), np.full(5, 1000.0), varies, "log") == []
 
 
+def test_one_joints_scale_is_named_with_a_scale_per_joint():
+    """J2's torque 1000× the nominal model's where J1, J3 and J4 agree with theirs: "set scale = [1, 0.001, 1, ...]";
+    the median slope of the four (about 1) said nothing. One joint 4× off where only one other is judged: nothing (no
+    evidence which is right)."""
+    from dynid.validation.diagnostics import scale_findings
+
+    rho, varies = np.array([0.999, 0.99, 0.99, 0.98, 0.5, 0.1]), np.ones(6, bool)
+    (f,) = scale_findings(rho, np.array([1.0, 1000.0, 1.01, 0.99, 1.0, 1.3]), varies, "identification")
+    assert "on J2 (1e+03×), where the other joints' agree" in f.text and "scale = [1, 0.001, 1, 1, 1, 1]" in f.text
+    assert f.joint == 1
+    assert scale_findings(rho, np.array([1.0, 4.0, 1.01, 0.99, 1.0, 1.3]), np.array([1, 1, 0, 0, 0, 0], bool),
+                          "identification") == []
+
+
+def test_one_joints_torque_in_another_unit_in_a_simulated_log_is_named(tmp_path):
+    """J2's effort written in N·mm in both logs of ``dynid example ur10e``: the fit cannot follow one joint's scale,
+    so the other joints' residuals rose above their torque and only J2 was judged: "set scale = 0.001" for every
+    joint. Judged against the noise floor, J1-J4 agree but J2, and the per-joint scale is given."""
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    for name in ("identification.csv", "validation.csv"):
+        path = tmp_path / "try" / name
+        header = path.read_text().splitlines()[0]
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        data[:, header.split(",").index("shoulder_lift_joint_effort")] *= 1000
+        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
+    p = dynid("identify", tmp_path / "try" / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    (scale,) = [f for f in _findings(tmp_path / "out") if f["kind"] == "scale"]
+    assert "scale = [1, 0.001, 1, 1, 1, 1]" in scale["text"], scale["text"]
+
+
 def test_a_scale_finding_names_each_joints_drive_gain_for_motor_currents():
     """A UR10e's log of motor currents read with its URDF (no drive gains: 1 N·m/A) was told "set scale = 10" alone,
     where its joints' gains differ (8.5-10.7 N·m/A). Each judged joint's gain is said: the one that brings its slope

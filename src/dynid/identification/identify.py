@@ -526,10 +526,12 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     stats["nominal_slope_beyond_drive"] = slope_drive
     # the correlation beyond friction judges where it is known, both ways: friction the nominal model lacks can run
     # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98).
-    # One joint's flipped sign fits badly, so its torque is judged against the noise floor, not the fit's residual
+    # One joint's flipped sign or scale fits badly, so its torque is judged against the noise floor, not the fit's
+    # residual
     angles, stats["logged_angles"] = logged_angle_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
-    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), fit.varies(beyond="floor"), data.name)
-            + scale_findings(beyond_drive, slope_drive, fit.varies(), data.name, gains=scoring.robot.drive_gains) + angles)
+    varies = fit.varies(beyond="floor")
+    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name)
+            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains) + angles)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

@@ -263,8 +263,10 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
                    table: str = "[identification]", gains: np.ndarray | None = None) -> list[Finding]:
     """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
     of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
-    that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``. A fit absorbs such a scale (a model with masses 1000× the
-    robot's, from currents in mA, fits as well as the right one), so only the description can see it.
+    that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``; or, where the median is within, some joints' slopes are
+    outside while at least two others' are within (one channel's unit or gain). A fit absorbs such a scale (a model
+    with masses 1000× the robot's, from currents in mA, fits as well as the right one), so only the description can
+    see it.
 
     Parameters
     ----------
@@ -294,9 +296,8 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
         return []
     median = float(np.median(k[judged]))
     if 1 / SCALE_LIMIT <= median <= SCALE_LIMIT:
-        return []
-    power = round(float(np.log10(median)))
-    fix = f"{10.0 ** -power:g}" if abs(np.log10(median) - power) < 0.1 else f"{1 / median:.3g}"
+        return _joint_scale_findings(k, judged, dataset, table)
+    fix = _inverse_text(median)
     joints = ", ".join(f"J{j + 1}" for j in judged)
     per_joint = "" if gains is None else (
         f" (motor currents: about {', '.join(f'{gains[j] / k[j]:.3g}' for j in judged)} N·m/A on {joints} by the "
@@ -307,6 +308,27 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
                              f"unit (currents in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the "
                              f"torques (or currents) of {table} and the other datasets, or check drive_gain in the "
                              f"description{per_joint}")]
+
+
+def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: str) -> list[Finding]:
+    """Some joints' torques far from the nominal model's size where the other judged joints' agree with it (at least
+    two, median within ``[1/SCALE_LIMIT, SCALE_LIMIT]``): one channel in another unit or through another gain."""
+    off = [j for j in judged if not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
+    if not off or len(judged) - len(off) < 2:
+        return []
+    fixes = ", ".join(_inverse_text(slope[j]) if j in off else "1" for j in range(slope.size))
+    joints = ", ".join(f"J{j + 1} ({slope[j]:.3g}×)" for j in off)
+    return [Finding("scale", f"{dataset}: the measured torques are far from the description's nominal model's on "
+                             f"{joints}, where the other joints' agree with it (ρ ≥ {SCALE_SHAPE:g} beyond friction): "
+                             "a channel in another unit, or through another drive gain; set scale = "
+                             f"[{fixes}] in the torques (or currents) of {table} and the other datasets, or check "
+                             "those joints' drive_gain in the description", off[0])]
+
+
+def _inverse_text(slope: float) -> str:
+    """The scale that brings a slope to 1: a power of ten where the slope is one (to 0.1 decade), else 3 digits."""
+    power = round(float(np.log10(slope)))
+    return f"{10.0 ** -power:g}" if abs(np.log10(slope) - power) < 0.1 else f"{1 / slope:.3g}"
 
 
 ORDER_GAIN = 0.25
