@@ -132,3 +132,26 @@ def test_two_swapped_position_columns_of_a_simulated_log_are_named(tmp_path):
     (swap,) = [f for f in results["findings"] if f["kind"] == "angles"]
     assert "the logged angles of J2 and J3 swapped" in swap["text"] and "swap J2 and J3's in positions" in swap["text"]
     assert results["diagnostics"]["logged_angles"]["order"] == [0, 2, 1, 3, 4, 5]
+
+
+def test_a_quarter_turn_of_the_med7s_j2_is_named_by_the_torques_sign_not_its_half_turn_twin():
+    """On the LBR Med7 (J1 vertical), a half turn of J2 only flips every gravity torque, which each joint's free slope
+    takes up: J2 turned by +90° and by -90° explain its real log about as well (0.22 % and 0.24 % left). The one named
+    is the one whose nominal torques run with the measured ones: -90° for angles logged a quarter turn ahead (it named
+    +90°, which would turn the arm upside down)."""
+    from pathlib import Path
+
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.run import pipeline_of
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    shared_data("kuka_med7_lbrstack")
+    config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_med7.toml")
+    base = base_parameters(config.robot, rng=0)
+    data = pipeline_of(config).prepare(load_recording(config.identification, config.robot), base, lambda s: None).data
+    ahead = np.zeros(config.robot.n_dof)
+    ahead[1] = np.pi / 2
+    found, stats = logged_angle_findings(config.robot, data.q + ahead, data.dq, data.ddq, data.tau, "identification")
+    (angles,) = found
+    assert "angles of J2 turned by -90°" in angles.text and 'position_offset = "-pi/2" to J2' in angles.text

@@ -48,7 +48,7 @@ SAMPLES = (200, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
 
 
-def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None) -> np.ndarray:
+def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, *, signed: bool = False) -> np.ndarray:
     """What each change of the logged angles leaves of the torque, as a share of what the nuisance columns of the
     logged angles leave (module docstring).
 
@@ -65,6 +65,9 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None) -> np.
     orders : (S, n_dof) int array, optional
         For each change, the logged column each joint's states are read from (after the shift); the logged order by
         default.
+    signed : bool
+        Count a joint's nominal torque as explaining nothing where it runs against the measured torque (a negative
+        slope): tells apart two changes a half turn apart on a joint whose torques that half turn only flips.
 
     Returns
     -------
@@ -90,8 +93,8 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None) -> np.
             total += float(r @ r)
             if nominal is not None:
                 p = nominal[:, j] - basis @ (basis.T @ nominal[:, j])
-                pp = float(p @ p)
-                total -= float(p @ r) ** 2 / pp if pp > 1e-12 * max(float(r @ r), 1e-300) else 0.0
+                pp, pr = float(p @ p), float(p @ r)
+                total -= pr**2 / pp if pp > 1e-12 * max(float(r @ r), 1e-300) and (pr > 0 or not signed) else 0.0
         return total
 
     reference = left(q, dq, ddq, None)
@@ -168,6 +171,11 @@ def logged_angle_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[
     single = np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
     pick = two if scores[two] < SIMPLER * scores[one] else one
+    # a joint whose torques a half turn only flips leaves two changes a half turn apart about as good (within 5 % of the
+    # gain): the one whose nominal torques run with the measured ones, not against them
+    twins = np.flatnonzero((scores <= scores[pick] + 0.05 * (logged - scores[pick]) + 1e-12) & (single == single[pick]))
+    if len(twins) > 1:
+        pick = int(twins[np.argmin(unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins], signed=True))])
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), unexplained_changed=float(scores[pick]))
     if scores[pick] > CHANGE_GAIN * logged:
         return [], stats

@@ -1,0 +1,143 @@
+"""The check of the logged angles against the robot file (``dynid.validation.logged_angles``) on real logs: what it
+names and what it leaves, with the figures its rule reads.
+
+Cases, each prepared as ``dynid identify`` prepares it (its config's preprocessing):
+- the four real logs and the TX40's whole-motion config as configured (``configs/``), and the 36 windows of 3-6 s of
+  ``benchmarks/short_windows.py`` (``--alone`` and ``--fresh``'s): nothing must be named;
+- the TX40's log without the built-in description's offsets (-π/2 on J2, +π/2 on J3, which FIGAROH applies);
+- quarter and half turns put on J2, J3 and J4 of the UR10e's and J2, J3, J4 and J6 of the LBR Med7's logs (through
+  ``position_offset``), and four pairs of the Med7's position columns swapped: each must be named as its inverse,
+  where it changes the torque.
+
+From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/logged_angles.py`` (about a
+minute). It prints one row per case: the share of the torque beyond the nuisance columns that the description's
+nominal model leaves with the logged angles, the closest change and the share it leaves, their ratio (named at
+``CHANGE_GAIN`` or less), and the change named.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+TURNS = ("pi/2", "-pi/2", "pi")
+
+
+def _prepared(config):
+    """The config's identification log, prepared as ``dynid identify`` prepares it, and the robot it is fitted with."""
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.run import pipeline_of
+    from dynid.io.datasets import load_recording
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        base = base_parameters(config.robot, rng=0)
+        prepared = pipeline_of(config).prepare(load_recording(config.identification, config.robot), base, lambda s: None)
+    return prepared.robot, prepared.data
+
+
+def _row(label: str, config, expected: str) -> bool:
+    """One case's row; whether what was named is what was expected ("" for nothing)."""
+    from dynid.validation.logged_angles import logged_angle_findings
+
+    robot, data = _prepared(config)
+    found, stats = logged_angle_findings(robot, data.q, data.dq, data.ddq, data.tau, "log")
+    named = _change(stats) if found else ""
+    if "unexplained_changed" in stats:
+        ratio = stats["unexplained_changed"] / stats["unexplained"]
+        figures = f"{100 * stats['unexplained']:.3g} | {_change(stats)} | {100 * stats['unexplained_changed']:.3g} | {ratio:.2f}"
+    else:
+        figures = f"{100 * stats['unexplained']:.3g} | (below the search's start) | | "
+    ok = named == expected
+    print(f"| {label} | {figures} | {named or 'nothing'} | {'yes' if ok else 'NO: expected ' + (expected or 'nothing')} |",
+          flush=True)
+    return ok
+
+
+def _change(stats: dict) -> str:
+    """The change a search's statistics hold, as "J2 -90°" or "J2<->J3"."""
+    shift, order = np.asarray(stats["shift"]), np.asarray(stats["order"])
+    turned = [f"J{j + 1} {np.degrees(shift[j]):+.0f}°" for j in np.flatnonzero(shift)]
+    swapped = [j for j in range(order.size) if order[j] != j]
+    return " ".join(turned) if turned else (f"J{swapped[0] + 1}<->J{swapped[1] + 1}" if swapped else "none")
+
+
+def _inverse(j: int, turn: str) -> str:
+    """The change that undoes ``position_offset = turn`` on joint j (0-based)."""
+    degrees = {"pi/2": -90, "-pi/2": 90, "pi": 180}[turn]
+    return f"J{j + 1} {degrees:+d}°"
+
+
+def main() -> int:
+    from dynid.io.identification_config import load_identification_config
+
+    import short_windows as sw
+
+    folder = Path(tempfile.mkdtemp())
+    configs = REPO / "configs"
+    print("| case | left as logged, % | closest change | left so, % | ratio | named | as expected |")
+    print("|---|---|---|---|---|---|---|")
+    ok = []
+    for name in ("ur10e", "tx40", "tx40-full", "kuka_kr300", "kuka_med7"):
+        ok.append(_row(f"{name} as configured", load_identification_config(configs / f"{name}.toml"), ""))
+    windows = {"ur10e": sw.WINDOWS, **sw.OTHER_WINDOWS}
+    for key, more in sw.FRESH_WINDOWS.items():
+        windows[key] = tuple(windows.get(key, ())) + tuple(more)
+    for name, cut in windows.items():
+        for window in cut:
+            path, data_root = sw._window_config(name, window, folder)
+            ok.append(_row(f"{name} {window[0]:g}-{window[1]:g}", load_identification_config(path, data_root=data_root), ""))
+    robots = REPO / "src" / "dynid" / "model" / "robots"
+    tx40 = re.sub(r'^position_offset = .*\n', "", (robots / "tx40.toml").read_text(), flags=re.M)
+    (folder / "tx40.toml").write_text(tx40.replace('urdf = "tx40.urdf"', f'urdf = "{robots / "tx40.urdf"}"'))
+    text = (configs / "tx40.toml").read_text().replace('robot = "tx40"', f'robot = "{folder / "tx40.toml"}"')
+    ok.append(_row("tx40 without its offsets", _config(folder / "tx40-raw.toml", text, configs), "J2 -90° J3 +90°"))
+    ur10e = (robots / "ur10e.toml").read_text().replace('urdf = "ur10e.urdf"', f'urdf = "{robots / "ur10e.urdf"}"')
+    for j in (1, 2, 3):
+        for turn in TURNS:
+            parts = ur10e.split("[[joints]]")
+            parts[j + 1] = f'\nposition_offset = "{turn}"' + parts[j + 1]
+            robot = folder / f"ur10e-{j}-{turn.replace('/', '_')}.toml"
+            robot.write_text("[[joints]]".join(parts))
+            text = (configs / "ur10e.toml").read_text().replace('robot = "ur10e"', f'robot = "{robot}"')
+            expected = "" if j == 3 or (j == 1 and turn == "pi") else _inverse(j, turn)
+            ok.append(_row(f"ur10e J{j + 1} position_offset {turn}", _config(robot.with_suffix(".cfg.toml"), text, configs),
+                           expected))
+    med7 = (configs / "kuka_med7.toml").read_text()
+    for j in (1, 2, 3, 5):
+        for turn in TURNS:
+            tables = "".join("\n[[robot.joints]]\n" + (f'position_offset = "{turn}"\n' if k == j else "") for k in range(7))
+            text = med7.replace("\n[identification]", tables + "\n[identification]", 1)
+            expected = "" if j == 5 or (j == 1 and turn == "pi") else _inverse(j, turn)
+            ok.append(_row(f"kuka_med7 J{j + 1} position_offset {turn}",
+                           _config(folder / f"med7-{j}-{turn.replace('/', '_')}.toml", text, configs), expected))
+    columns = ["q_0", "q_1", "q_2", "q_3", "q_4", "q_5", "q_6"]
+    for a, b in ((0, 1), (1, 2), (1, 3), (3, 5)):
+        swapped = columns.copy()
+        swapped[a], swapped[b] = swapped[b], swapped[a]
+        text = med7.replace(", ".join(f'"{c}"' for c in columns), ", ".join(f'"{c}"' for c in swapped), 1)
+        ok.append(_row(f"kuka_med7 J{a + 1} and J{b + 1} columns swapped", _config(folder / f"med7-swap-{a}{b}.toml", text, configs),
+                       f"J{a + 1}<->J{b + 1}"))
+    print(f"\n{sum(ok)} of {len(ok)} cases as expected")
+    return 0 if all(ok) else 1
+
+
+def _config(path: Path, text: str, configs: Path):
+    """A config written beside the others' data: its data_root made absolute."""
+    from dynid.io.identification_config import load_identification_config
+
+    text = re.sub(r'^data_root = "(.*)"', lambda m: f'data_root = "{(configs / m.group(1)).resolve()}"', text, flags=re.M)
+    path.write_text(text)
+    return load_identification_config(path)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
