@@ -77,9 +77,9 @@ def _inverse(j: int, turn: str) -> str:
 
 
 def main() -> int:
-    from dynid.io.identification_config import load_identification_config
-
     import short_windows as sw
+
+    from dynid.io.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp())
     configs = REPO / "configs"

@@ -508,7 +508,7 @@ def main(argv=None) -> int:
     classes = tuple(c.strip() for c in args.classes.split(",") if c.strip())
     for name in [a.strip() for a in args.arms.split(",") if a.strip()]:
         if set(classes) & set(CLASSES):
-            rows += run_arm(name, out, args.seed, classes)
+            rows += run_arm(name, out, args.seed, tuple(c for c in classes if c in CLASSES))
         if set(classes) & set(CAD_CLASSES):
             rows += run_cad(name, out, args.seed, classes)
     out.mkdir(parents=True, exist_ok=True)

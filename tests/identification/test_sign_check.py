@@ -192,6 +192,24 @@ def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
     assert scale_findings(np.full(5, 0.5), np.full(5, 1000.0), varies, "log") == []
 
 
+def test_a_light_joint_whose_nominal_torque_the_description_misstates_is_not_a_flipped_sign():
+    """The zoo's Kinova Jaco 2 with a CAD-like description and joint torque sensors (class cad-sensor, simulated with
+    the right sign): J6's measured torque runs against its small nominal torque beyond friction (ρ -0.505) at 13.7
+    times its size, where the other joints' slopes are 0.66-0.80. It was called flipped and the model "not ready". A
+    flip keeps the channel's size: named only within 3× of the other joints' |slope|; the same ρ at the others' size
+    is named."""
+    from dynid.validation.diagnostics import sign_findings
+
+    rho = np.array([0.999, 0.999, 1.0, 0.997, 0.989, -0.505])
+    slope = np.array([0.799, 0.764, 0.698, 0.735, 0.658, -13.698])
+    varies = np.ones(6, bool)
+    assert len(sign_findings(rho, varies, "identification")) == 1  # without the slopes, as before
+    assert sign_findings(rho, varies, "identification", slope=slope) == []
+    slope[5] = -0.7
+    (f,) = sign_findings(rho, varies, "identification", slope=slope)
+    assert "J6:" in f.text and "sign = [1, 1, 1, 1, 1, -1]" in f.text
+
+
 def test_one_joints_scale_is_named_with_a_scale_per_joint():
     """J2's torque 1000× the nominal model's where J1, J3 and J4 agree with theirs: "set scale = [1, 0.001, 1, ...]";
     the median slope of the four (about 1) said nothing. One joint 4× off where only one other is judged: nothing (no

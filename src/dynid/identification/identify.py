@@ -530,7 +530,8 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     # residual
     angles, stats["logged_angles"] = logged_angle_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
     varies = fit.varies(beyond="floor")
-    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name)
+    return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
+                          slope=np.where(np.isfinite(beyond), slope, np.nan))
             + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains) + angles)
 
 

@@ -214,10 +214,10 @@ class ResidualSums:
         return findings, stats
 
 
-def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]"
-                  ) -> list[Finding]:
+def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]",
+                  slope: np.ndarray | None = None) -> list[Finding]:
     """A flipped torque sign: the measured torques of the joints whose torque varies correlate strongly
-    negatively (ρ < -0.5) with those of the description's nominal model.
+    negatively (ρ < -0.5) with those of the description's nominal model, with about the size the other joints' have.
 
     Parameters
     ----------
@@ -229,6 +229,11 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
         The log, named in the finding.
     table : str
         The config table to fix (its ``sign``).
+    slope : (n_dof,) array, optional
+        The slope of each joint's measured torque on the nominal model's (beside ``correlation``). Where given, a joint
+        is named only where its |slope| is within :data:`SCALE_LIMIT` of the median |slope| of the joints whose
+        |ρ| ≥ 0.5: a flipped channel keeps its size, while a joint whose small nominal torque the description misstates
+        (a light wrist of a CAD model: ρ -0.5, slope -13.7 where the others' are 0.7-0.8) is not a flip.
 
     Returns
     -------
@@ -236,6 +241,13 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     """
     corr = np.asarray(correlation, dtype=float)
     bad = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and corr[j] < -0.5]
+    if bad and slope is not None:
+        k = np.abs(np.asarray(slope, dtype=float))
+        sized = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and abs(corr[j]) >= 0.5
+                 and np.isfinite(k[j]) and k[j] > 0]
+        typical = float(np.median(k[sized])) if sized else float("nan")
+        bad = [j for j in bad if not np.isfinite(typical) or not np.isfinite(k[j])
+               or 1 / SCALE_LIMIT <= k[j] / typical <= SCALE_LIMIT]
     if not bad:
         return []
     n = corr.size
