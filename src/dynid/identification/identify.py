@@ -42,7 +42,7 @@ from ..validation.diagnostics import (
     scale_findings,
     sign_findings,
 )
-from ..validation.logged_angles import logged_angle_findings
+from ..validation.geometry_checks import geometry_findings
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
@@ -505,8 +505,8 @@ FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 
 def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     """The torques against the description's nominal model (``scoring.nominal``): a flipped sign and a scale (unit or
-    gain) (:mod:`dynid.validation.diagnostics`), logged angles that do not match the robot file
-    (:mod:`dynid.validation.logged_angles`); their statistics go into ``stats``."""
+    gain) (:mod:`dynid.validation.diagnostics`), a log whose geometry does not match the robot file's
+    (:mod:`dynid.validation.geometry_checks`); their statistics go into ``stats``."""
     nominal, sums, data = scoring.nominal, scoring.sums, scoring.data
     assert nominal is not None  # called only where the description has a nominal model
     corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
@@ -528,11 +528,11 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     # against it (a short log: plain ρ -0.87, beyond -0.09) or hide a flipped sign (the UR10e's J1: -0.36, beyond -0.98).
     # One joint's flipped sign or scale fits badly, so its torque is judged against the noise floor, not the fit's
     # residual
-    angles, stats["logged_angles"] = logged_angle_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
+    geometry, stats["geometry"] = geometry_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
     varies = fit.varies(beyond="floor")
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
-            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains) + angles)
+            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains) + geometry)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

@@ -389,9 +389,9 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("sign", "scale", "order", "angles")
+READINESS_KINDS = ("sign", "scale", "order", "angles", "gravity")
 """Findings of ``dynid identify``'s verdict that say the log itself is wrong (the torques' sign, unit or gain, channels
-swapped, angles that do not match the robot file): a model fitted to it is exported with a warning."""
+swapped, angles or a mounting that do not match the robot file): a model fitted to it is exported with a warning."""
 
 
 def verdict_warnings(results: dict) -> list[str]:
@@ -407,7 +407,8 @@ def verdict_warnings(results: dict) -> list[str]:
     -------
     list of str
     """
-    return [f"the model was fitted to {'angles' if f.get('kind') == 'angles' else 'torques'} dynid identify doubts: "
+    what = {"angles": "angles", "gravity": "a mounting"}
+    return [f"the model was fitted to {what.get(str(f.get('kind')), 'torques')} dynid identify doubts: "
             f"{f.get('text')}"
             for f in results.get("findings") or [] if isinstance(f, dict) and f.get("kind") in READINESS_KINDS]
 

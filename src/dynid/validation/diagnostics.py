@@ -53,7 +53,8 @@ class Finding:
         "sign", "scale", "order", "friction", "position", "correlated", "excitation", "extrapolation", "validation",
         "delay", "main" (the verdict's choice), "drive" (a drive term no drive has:
         :mod:`dynid.identification.plausibility`), "angles" (logged angles that do not match the robot file, a zero a
-        quarter or half turn off or two columns swapped: :mod:`dynid.validation.logged_angles`), "filtered" (torques without measurable noise:
+        quarter or half turn off or two columns swapped) and "gravity" (gravity along another axis of the base:
+        :mod:`dynid.validation.geometry_checks`), "filtered" (torques without measurable noise:
         :func:`dynid.validation.noise_floor.looks_filtered`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.

@@ -1,4 +1,4 @@
-"""The check of the logged angles against the robot file (``dynid.validation.logged_angles``) on real logs: what it
+"""The check of a log's geometry against the robot file (``dynid.validation.geometry_checks``) on real logs: what it
 names and what it leaves, with the figures its rule reads.
 
 Cases, each prepared as ``dynid identify`` prepares it (its config's preprocessing):
@@ -7,9 +7,11 @@ Cases, each prepared as ``dynid identify`` prepares it (its config's preprocessi
 - the TX40's log without the built-in description's offsets (-π/2 on J2, +π/2 on J3, which FIGAROH applies);
 - quarter and half turns put on J2, J3 and J4 of the UR10e's and J2, J3, J4 and J6 of the LBR Med7's logs (through
   ``position_offset``), and four pairs of the Med7's position columns swapped: each must be named as its inverse,
-  where it changes the torque.
+  where it changes the torque;
+- the UR10e's and the Med7's logs read with a description whose gravity is along +x or -y (a wall): each must be
+  named as the floor's gravity; along +z (a ceiling) it only flips the gravity torques, which the sign check names.
 
-From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/logged_angles.py`` (about a
+From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/geometry_checks.py`` (about a
 minute). It prints one row per case: the share of the torque beyond the nuisance columns that the description's
 nominal model leaves with the logged angles, the closest change and the share it leaves, their ratio (named at
 ``CHANGE_GAIN`` or less), and the change named.
@@ -46,10 +48,10 @@ def _prepared(config):
 
 def _row(label: str, config, expected: str) -> bool:
     """One case's row; whether what was named is what was expected ("" for nothing)."""
-    from dynid.validation.logged_angles import logged_angle_findings
+    from dynid.validation.geometry_checks import geometry_findings
 
     robot, data = _prepared(config)
-    found, stats = logged_angle_findings(robot, data.q, data.dq, data.ddq, data.tau, "log")
+    found, stats = geometry_findings(robot, data.q, data.dq, data.ddq, data.tau, "log")
     named = _change(stats) if found else ""
     if "unexplained_changed" in stats:
         ratio = stats["unexplained_changed"] / stats["unexplained"]
@@ -67,7 +69,8 @@ def _change(stats: dict) -> str:
     shift, order = np.asarray(stats["shift"]), np.asarray(stats["order"])
     turned = [f"J{j + 1} {np.degrees(shift[j]):+.0f}°" for j in np.flatnonzero(shift)]
     swapped = [j for j in range(order.size) if order[j] != j]
-    return " ".join(turned) if turned else (f"J{swapped[0] + 1}<->J{swapped[1] + 1}" if swapped else "none")
+    gravity = "gravity [" + ", ".join(f"{x:g}" for x in stats["gravity"]) + "]"
+    return " ".join(turned) if turned else (f"J{swapped[0] + 1}<->J{swapped[1] + 1}" if swapped else gravity)
 
 
 def _inverse(j: int, turn: str) -> str:
@@ -111,11 +114,20 @@ def main() -> int:
             expected = "" if j == 3 or (j == 1 and turn == "pi") else _inverse(j, turn)
             ok.append(_row(f"ur10e J{j + 1} position_offset {turn}", _config(robot.with_suffix(".cfg.toml"), text, configs),
                            expected))
-    med7 = (configs / "kuka_med7.toml").read_text()
+    med7_text = (configs / "kuka_med7.toml").read_text()
+
+    def med7(gravity: str) -> str:
+        return med7_text.replace('urdf = "urdf/med7dock.urdf"', f'urdf = "urdf/med7dock.urdf"\ngravity = {gravity}', 1)
+
+    def ur10e_config(gravity: str) -> str:
+        robot = folder / "ur10e-gravity.toml"
+        robot.write_text(ur10e.replace("gravity = [0.0, 0.0, -9.81]", f"gravity = {gravity}"))
+        return (configs / "ur10e.toml").read_text().replace('robot = "ur10e"', f'robot = "{robot}"')
+
     for j in (1, 2, 3, 5):
         for turn in TURNS:
             tables = "".join("\n[[robot.joints]]\n" + (f'position_offset = "{turn}"\n' if k == j else "") for k in range(7))
-            text = med7.replace("\n[identification]", tables + "\n[identification]", 1)
+            text = med7_text.replace("\n[identification]", tables + "\n[identification]", 1)
             expected = "" if j == 5 or (j == 1 and turn == "pi") else _inverse(j, turn)
             ok.append(_row(f"kuka_med7 J{j + 1} position_offset {turn}",
                            _config(folder / f"med7-{j}-{turn.replace('/', '_')}.toml", text, configs), expected))
@@ -123,9 +135,15 @@ def main() -> int:
     for a, b in ((0, 1), (1, 2), (1, 3), (3, 5)):
         swapped = columns.copy()
         swapped[a], swapped[b] = swapped[b], swapped[a]
-        text = med7.replace(", ".join(f'"{c}"' for c in columns), ", ".join(f'"{c}"' for c in swapped), 1)
+        text = med7_text.replace(", ".join(f'"{c}"' for c in columns), ", ".join(f'"{c}"' for c in swapped), 1)
         ok.append(_row(f"kuka_med7 J{a + 1} and J{b + 1} columns swapped", _config(folder / f"med7-swap-{a}{b}.toml", text, configs),
                        f"J{a + 1}<->J{b + 1}"))
+    for name, config in (("ur10e", ur10e_config), ("kuka_med7", med7)):
+        for k, gravity in enumerate(("[9.81, 0.0, 0.0]", "[0.0, -9.81, 0.0]", "[0.0, 0.0, 9.81]")):
+            # gravity reversed only flips the gravity torques: the sign check names that one
+            expected = "" if k == 2 else "gravity [0, 0, -9.81]"
+            ok.append(_row(f"{name} read with gravity = {gravity}", _config(folder / f"{name}-g{k}.toml", config(gravity),
+                                                                             configs), expected))
     print(f"\n{sum(ok)} of {len(ok)} cases as expected")
     return 0 if all(ok) else 1
 

@@ -1,24 +1,27 @@
-"""Logged angles that do not match the robot file: a joint's zero a quarter or half turn off, two columns swapped.
+"""A log whose geometry does not match the robot file: a joint's zero a quarter or half turn off, two position columns
+swapped, gravity along another axis of the base (a robot mounted on a wall or a ceiling).
 
 Encoders, drivers and robot files often count a joint's angle from different zeros: the Stäubli TX40's logged angles
-need -π/2 on J2 and +π/2 on J3 to match its URDF. And a log's columns need not come in the chain's order. A fit cannot
-tell: the base parameters absorb much of a rotated gravity load, and what they cannot absorb looks like misfit. The
-description's nominal model can: with the logged angles it explains little of the torque that gravity and inertia
-carry, with the right ones most of it.
+need -π/2 on J2 and +π/2 on J3 to match its URDF. A log's columns need not come in the chain's order, and a URDF
+says nothing of how its robot is mounted. A fit cannot tell: the base parameters absorb much of a rotated gravity
+load, and what they cannot absorb looks like misfit. The description's nominal model can: with the wrong geometry it
+explains little of the torque that gravity and inertia carry, with the right one most of it.
 
 Each joint's measured torque is regressed on the nominal model's torque of that joint beside nuisance columns that
 the nominal model does not hold (the joint's direction of motion, velocity and acceleration, a constant, and the
 sin/cos of its angle and twice its angle where it has a counterbalance: friction, rotor inertia, an offset and a
 counterbalance, whatever their size). What the nominal torque leaves unexplained of what the nuisance columns leave,
 summed over the joints, is compared for the logged angles and for the logged angles with one or two joints turned by
-±π/2 or π, or two joints' columns swapped (their nuisance columns swapped too; every figure over what the logged
-angles' nuisance columns leave, so that all are on one scale). A change is named where it leaves at most :data:`CHANGE_GAIN` of what the
-logged angles leave (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
+±π/2 or π, two joints' columns swapped (their nuisance columns swapped too; every figure over what the logged
+angles' nuisance columns leave, so that all are on one scale), or gravity along each axis of the base either way.
+A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
+(Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
 
 from __future__ import annotations
 
 import itertools
+from dataclasses import replace
 
 import numpy as np
 
@@ -48,7 +51,8 @@ SAMPLES = (200, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
 
 
-def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, *, signed: bool = False) -> np.ndarray:
+def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, *,
+                      signed: bool = False) -> np.ndarray:
     """What each change of the logged angles leaves of the torque, as a share of what the nuisance columns of the
     logged angles leave (module docstring).
 
@@ -65,6 +69,8 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, *, sig
     orders : (S, n_dof) int array, optional
         For each change, the logged column each joint's states are read from (after the shift); the logged order by
         default.
+    gravities : (S, 3) array, optional
+        For each change, the gravity vector in the base frame [m/s²]; the description's by default.
     signed : bool
         Count a joint's nominal torque as explaining nothing where it runs against the measured torque (a negative
         slope): tells apart two changes a half turn apart on a joint whose torques that half turn only flips.
@@ -79,6 +85,8 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, *, sig
     n = robot.n_dof
     shifts = np.asarray(shifts, dtype=float)
     orders = np.tile(np.arange(n), (len(shifts), 1)) if orders is None else np.asarray(orders, dtype=int)
+    gravities = (np.tile(np.asarray(robot.gravity, dtype=float), (len(shifts), 1)) if gravities is None
+                 else np.asarray(gravities, dtype=float))
     balanced = _counterbalanced(robot)
 
     def left(qi, dqi, ddqi, nominal) -> float:
@@ -99,45 +107,58 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, *, sig
 
     reference = left(q, dq, ddq, None)
     out = np.empty(len(shifts))
-    for i, (shift, order) in enumerate(zip(shifts, orders)):
+    for i, (shift, order, gravity) in enumerate(zip(shifts, orders, gravities)):
         qi, dqi, ddqi = (q + shift)[:, order], dq[:, order], ddq[:, order]
-        out[i] = left(qi, dqi, ddqi, nominal_rigid_torque(robot, qi, dqi, ddqi)) / reference if reference > 0 else 0.0
+        mounted = robot if np.array_equal(gravity, robot.gravity) else replace(robot, gravity=gravity)
+        out[i] = left(qi, dqi, ddqi, nominal_rigid_torque(mounted, qi, dqi, ddqi)) / reference if reference > 0 else 0.0
     return out
 
 
-def candidate_changes(n_dof: int) -> tuple[np.ndarray, np.ndarray]:
+def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """No change; every joint and every pair of joints turned by each of :data:`CANDIDATE_TURNS`; every pair of joints'
-    columns swapped.
+    columns swapped; gravity along each axis of the base either way (those other than the description's).
 
     Parameters
     ----------
-    n_dof : int
+    robot : Robot
 
     Returns
     -------
-    shifts : (1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) / 2, n_dof) ndarray [rad]
-    orders : the same shape, int
+    shifts : (S, n_dof) ndarray [rad]
+        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) / 2 + the gravities.
+    orders : (S, n_dof) int ndarray
         The logged column each joint is read from.
+    gravities : (S, 3) ndarray [m/s²]
     """
-    identity = np.arange(n_dof)
-    shifts, orders = [np.zeros(n_dof)], [identity]
+    n, g = robot.n_dof, np.asarray(robot.gravity, dtype=float)
+    identity = np.arange(n)
+    shifts, orders = [np.zeros(n)], [identity]
     for size in (1, 2):
-        for joints in itertools.combinations(range(n_dof), size):
+        for joints in itertools.combinations(range(n), size):
             for turns in itertools.product(CANDIDATE_TURNS, repeat=size):
-                row = np.zeros(n_dof)
+                row = np.zeros(n)
                 row[list(joints)] = turns
                 shifts.append(row)
                 orders.append(identity)
-    for a, b in itertools.combinations(range(n_dof), 2):
+    for a, b in itertools.combinations(range(n), 2):
         order = identity.copy()
         order[[a, b]] = b, a
-        shifts.append(np.zeros(n_dof))
+        shifts.append(np.zeros(n))
         orders.append(order)
-    return np.array(shifts), np.array(orders)
+    gravities = [g] * len(shifts)
+    for axis, sign in itertools.product(range(3), (1.0, -1.0)):
+        other = np.zeros(3)
+        other[axis] = sign * np.linalg.norm(g)
+        if not np.allclose(other, g):
+            shifts.append(np.zeros(n))
+            orders.append(identity)
+            gravities.append(other)
+    return np.array(shifts), np.array(orders), np.array(gravities)
 
 
-def logged_angle_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[list[Finding], dict]:
-    """A joint's zero a quarter or half turn from the robot file's, or two joints' columns swapped (module docstring).
+def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[list[Finding], dict]:
+    """A joint's zero a quarter or half turn from the robot file's, two joints' columns swapped, or gravity along
+    another axis of the base (module docstring).
 
     Parameters
     ----------
@@ -154,50 +175,63 @@ def logged_angle_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[
     Returns
     -------
     findings : list of Finding
-        One "angles" finding naming the joints, the change and the setting, or none.
+        One "angles" finding (a zero or a swap) or "gravity" finding naming the change and the setting, or none.
     stats : dict
-        ``unexplained`` (the share left with the logged angles) and, where the search ran, the closest change's
-        ``shift`` [rad], ``order`` and ``unexplained_changed``.
+        ``unexplained`` (the share left with the log and the description as they are) and, where the search ran,
+        the closest change's ``shift`` [rad], ``order``, ``gravity`` [m/s²] and ``unexplained_changed``.
     """
     q, dq, ddq, tau = (_spread(x) for x in (q, dq, ddq, tau))
     logged = float(unexplained_share(robot, q, dq, ddq, tau, np.zeros((1, robot.n_dof)))[0])
     stats: dict = {"unexplained": logged}
     if logged < UNEXPLAINED_FROM:
         return [], stats
-    shifts, orders = (x[1:] for x in candidate_changes(robot.n_dof))
-    scores = unexplained_share(robot, q, dq, ddq, tau, shifts, orders)
-    # one joint turned, unless two joints changed leave clearly less (a half turn of a joint whose torque only changes
-    # sign, which each joint's free slope takes up, is no evidence)
-    single = np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1) == 1
+    shifts, orders, gravities = (x[1:] for x in candidate_changes(robot))
+    scores = unexplained_share(robot, q, dq, ddq, tau, shifts, orders, gravities)
+    # one change, unless two joints changed leave clearly less
+    single = (np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1)
+              + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
     pick = two if scores[two] < SIMPLER * scores[one] else one
-    # a joint whose torques a half turn only flips leaves two changes a half turn apart about as good (within 5 % of the
-    # gain): the one whose nominal torques run with the measured ones, not against them
+    # a half turn of a joint, or gravity reversed, may only flip torques, which each joint's free slope takes up: of
+    # the changes within 5 % of the gain, the one whose nominal torques run with the measured ones
     twins = np.flatnonzero((scores <= scores[pick] + 0.05 * (logged - scores[pick]) + 1e-12) & (single == single[pick]))
     if len(twins) > 1:
-        pick = int(twins[np.argmin(unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins], signed=True))])
-    stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), unexplained_changed=float(scores[pick]))
+        pick = int(twins[np.argmin(unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins],
+                                                     gravities[twins], signed=True))])
+    stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
+                 unexplained_changed=float(scores[pick]))
     if scores[pick] > CHANGE_GAIN * logged:
         return [], stats
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
-             f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as logged")
-    if shifts[pick].any():
-        turned = np.flatnonzero(shifts[pick])
-        settings = " and ".join(f'position_offset = "{_pi_text(shifts[pick][j])}" to J{j + 1}' for j in turned)
-        text = (f"the description's nominal model fits the torques far better with the logged angles of "
-                f"{' and '.join(f'J{j + 1}' for j in turned)} turned by "
-                f"{' and '.join(f'{np.degrees(shifts[pick][j]):+.0f}°' for j in turned)}: {share}. Is each "
-                f"encoder's zero where the robot file's is? If not, give {settings} (added to the logged angles: in "
-                "a robot description's [[joints]] tables, or the config's [robot] table with one [[robot.joints]] "
-                "table per joint) and identify again")
-    else:
-        turned = np.flatnonzero(orders[pick] != np.arange(robot.n_dof))
-        pair = " and ".join(f"J{j + 1}" for j in turned)
-        text = (f"the description's nominal model fits the torques far better with the logged angles of {pair} "
-                f"swapped: {share}. Are the positions' columns in the order of the robot's joints? If not, swap "
-                f"{pair}'s in positions = {{ columns = [...] }} (and velocities', if given) of every dataset, and "
-                "identify again")
-    return [Finding("angles", f"{dataset}: {text}", int(turned[0]))], stats
+             f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as it is")
+    kind, text, joint = _change_text(robot, shifts[pick], orders[pick], gravities[pick])
+    return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {text[0]}: "
+                          f"{share}. {text[1]}, and identify again", joint)], stats
+
+
+def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray
+                 ) -> tuple[str, tuple, int | None]:
+    """The finding's kind, (what was changed, the question and the setting that fixes it), and its joint."""
+    if shift.any():
+        turned = np.flatnonzero(shift)
+        settings = " and ".join(f'position_offset = "{_pi_text(shift[j])}" to J{j + 1}' for j in turned)
+        return "angles", (f"the logged angles of {' and '.join(f'J{j + 1}' for j in turned)} turned by "
+                          f"{' and '.join(f'{np.degrees(shift[j]):+.0f}°' for j in turned)}",
+                          f"Is each encoder's zero where the robot file's is? If not, give {settings} (added to the "
+                          "logged angles: in a robot description's [[joints]] tables, or the config's [robot] table "
+                          "with one [[robot.joints]] table per joint)"), int(turned[0])
+    swapped = np.flatnonzero(order != np.arange(robot.n_dof))
+    if swapped.size:
+        pair = " and ".join(f"J{j + 1}" for j in swapped)
+        return "angles", (f"the logged angles of {pair} swapped",
+                          f"Are the positions' columns in the order of the robot's joints? If not, swap {pair}'s in "
+                          "positions = { columns = [...] } (and velocities', if given) of every dataset"), int(swapped[0])
+    axis = int(np.argmax(np.abs(gravity)))
+    vector = "[" + ", ".join(f"{x:g}" for x in gravity) + "]"
+    return "gravity", (f"gravity along {'+' if gravity[axis] > 0 else '-'}{'xyz'[axis]} of the base frame, not "
+                       "[" + ", ".join(f"{x:g}" for x in robot.gravity) + "] m/s²",
+                       "Is the robot mounted otherwise than the description says (on a wall, a ceiling)? If so, "
+                       f"give gravity = {vector} in the config's [robot] table (or the robot description)"), None
 
 
 def _counterbalanced(robot: Robot) -> set[int]:
