@@ -260,8 +260,8 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
         fix = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]"
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
-                            "other datasets (or check the description's gravity, and whether a joint's zero is a half turn from the "
-                            "robot file's: position_offset = \"pi\")")]
+                            "other datasets (or check the description's gravity, and whether a joint's zero is a half "
+                            'turn from the robot file\'s: position_offset = "pi")')]
 
 
 SCALE_LIMIT = 3.0
