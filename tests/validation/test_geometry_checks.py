@@ -102,9 +102,9 @@ def test_the_tx40s_logged_zeros_without_its_offsets_are_named_and_with_them_not(
     from dynid.io.datasets import load_recording
     from dynid.io.identification_config import load_identification_config
 
-    shared_data("staubli_tx40_figaroh")
+    root = shared_data("staubli_tx40_figaroh")  # wherever the data are, not only beside the repository
     configs = Path(__file__).resolve().parents[2] / "configs"
-    config = load_identification_config(configs / "tx40.toml")
+    config = load_identification_config(configs / "tx40.toml", data_root=root)
     base = base_parameters(config.robot, rng=0)
     data = pipeline_of(config).prepare(load_recording(config.identification, config.robot), base, lambda s: None).data
     robot = config.robot
@@ -151,8 +151,8 @@ def test_a_quarter_turn_of_the_med7s_j2_is_named_by_the_torques_sign_not_its_hal
     from dynid.io.datasets import load_recording
     from dynid.io.identification_config import load_identification_config
 
-    shared_data("kuka_med7_lbrstack")
-    config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_med7.toml")
+    root = shared_data("kuka_med7_lbrstack")
+    config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_med7.toml", data_root=root)
     base = base_parameters(config.robot, rng=0)
     data = pipeline_of(config).prepare(load_recording(config.identification, config.robot), base, lambda s: None).data
     ahead = np.zeros(config.robot.n_dof)
