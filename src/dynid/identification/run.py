@@ -107,6 +107,8 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
     -------
     comparisons : tuple of TorqueComparison
     warnings : tuple of str
+        Besides the logs' own, a log whose geometry does not match the robot file's
+        (:mod:`dynid.validation.geometry_checks`: a joint's zero, two columns swapped, gravity).
 
     Raises
     ------
@@ -114,6 +116,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         A log that cannot be read or prepared.
     """
     from ..preprocessing.pipeline import prepare
+    from ..validation.geometry_checks import geometry_findings
     from ..validation.torques import compare_torques
 
     out: list = []
@@ -125,6 +128,9 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
             progress(f"validation, {spec.name}", 0, 1)
         recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
         data = prepare(recording, settings, strict=False)
+        if yardstick is None and np.any(config.robot.inertial != 0):  # a log recorded otherwise than the fitted one
+            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
+            warnings.extend(f.text for f in found)
         out.append(compare_torques(config.robot, base, data, parameter_sets,
                                    progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                    noise=noise, covariance=covariance))

@@ -156,7 +156,8 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return np.array(shifts), np.array(orders), np.array(gravities)
 
 
-def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[list[Finding], dict]:
+def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bool = True
+                      ) -> tuple[list[Finding], dict]:
     """A joint's zero a quarter or half turn from the robot file's, two joints' columns swapped, or gravity along
     another axis of the base (module docstring).
 
@@ -171,6 +172,9 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[list
         Its measured joint torques [N·m].
     dataset : str
         The log, named in the finding.
+    fitted : bool
+        The log the model is fitted to (the finding gives the setting that fixes the description), or a validation log
+        (it asks whether the log was recorded otherwise than the identification's, which the robot file fits).
 
     Returns
     -------
@@ -205,8 +209,10 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str) -> tuple[list
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
              f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as it is")
     kind, text, joint = _change_text(robot, shifts[pick], orders[pick], gravities[pick])
+    fix = (f"{text[1]}, and identify again" if fitted else "Was this log recorded with other zeros, another column "
+           "order or another mounting than the identification log? Its scores say little until it is read as that one")
     return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {text[0]}: "
-                          f"{share}. {text[1]}, and identify again", joint)], stats
+                          f"{share}. {fix}", joint)], stats
 
 
 def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray
