@@ -106,6 +106,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
     Returns
     -------
     comparisons : tuple of TorqueComparison
+        A log whose geometry does not match the robot file's has its ``misread`` set.
     warnings : tuple of str
         Besides the logs' own, a log whose geometry does not match the robot file's
         (:mod:`dynid.validation.geometry_checks`: a joint's zero, two columns swapped, gravity).
@@ -128,12 +129,14 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
             progress(f"validation, {spec.name}", 0, 1)
         recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
         data = prepare(recording, settings, strict=False)
+        found: list = []
         if yardstick is None and np.any(config.robot.inertial != 0):  # a log recorded otherwise than the fitted one
             found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
             warnings.extend(f.text for f in found)
-        out.append(compare_torques(config.robot, base, data, parameter_sets,
-                                   progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
-                                   noise=noise, covariance=covariance))
+        scored = compare_torques(config.robot, base, data, parameter_sets,
+                                 progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
+                                 noise=noise, covariance=covariance)
+        out.append(replace(scored, misread=found[0].text) if found else scored)
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
 
@@ -219,7 +222,9 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     if refits:  # [estimation] choice = "states": the verdict reads the validation logs' states, not their torques
         assert nominal is not None
         fallback = DRIVE_ONLY_LABEL if alt is not None and config.torque_sensor != "joint" else nominal[0]
-        states = state_evidence(yardstick, SDP_LABEL, fallback, tuple(refits), nominal[0])
+        misread = {v.name for v in scored_all if v.misread}  # the verdict weighs no log read otherwise
+        trusted = tuple(v for v in yardstick if v.name not in misread)
+        states = state_evidence(trusted, SDP_LABEL, fallback, tuple(refits), nominal[0]) if trusted else None
         for label in refits:
             yardstick = tuple(v.without(label) for v in yardstick)
     result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick, states=states), yardstick)

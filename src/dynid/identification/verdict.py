@@ -166,7 +166,9 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         estimate among its estimates where it is the main one.
     """
 
-    findings = [f for f in result.findings if f.kind not in ("main", "drive")]  # an earlier call's made again here
+    if any(v.misread for v in result.validations):
+        return _without_misread(result, nominal, scored, judged, states)
+    findings = [f for f in result.findings if f.kind not in ("main", "drive", "misread")]  # an earlier call's again
     ls, main = result.label, estimate_label(result.estimators[0])
     inconsistent = not str(result.consistency_verdicts.get(ls, "yes")).startswith("yes")
     rigid = main == ls and SDP_LABEL in result.estimates and inconsistent
@@ -183,6 +185,36 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
     if chosen is not None:
         findings = [Finding("main", chosen[1])]
     return _with_validation_findings(replace(result, main=main), findings, nominal)
+
+
+def _without_misread(result, nominal, scored, judged, states):
+    """:func:`choose_main_estimate` on the validation logs whose geometry matches the robot file's alone (on the
+    identification log alone where none does), with a finding naming the others: a log recorded with other zeros, its
+    columns in another order or another mounting scores every estimate by that, not by how it predicts (a UR10e's
+    validation log with J2 a quarter turn off took the choice from the SDP, 0.2 % on the log as recorded, to the
+    description's links with the drive terms fitted, the one candidate that does not move its links: 108 % against
+    108.2 % on the misread log)."""
+    misread = [v for v in result.validations if v.misread]
+    names = {v.name for v in misread}
+
+    def kept(comparisons):
+        return None if comparisons is None else tuple(v for v in comparisons if v.name not in names)
+
+    trusted = kept(result.validations)
+    chosen = choose_main_estimate(replace(result, validations=trusted), nominal, kept(scored), kept(judged),
+                                  states if trusted else None)
+    on = "the other validation logs" if trusted else "the identification log alone"
+    if not trusted and _exported_instead(chosen, chosen.main) != chosen.main:
+        on += f": {SDP_LABEL}, physically consistent where {chosen.main} is not, and what dynid export writes"
+        chosen = replace(chosen, main=SDP_LABEL)
+    text = (f"the verdict leaves out {', '.join(sorted(names))}: {'its' if len(names) == 1 else 'their'} angles or "
+            "mounting do not match the robot file's (the warning says how), so its figures score every estimate by "
+            f"that, not by how it predicts; the main estimate is chosen on {on}: read the log as recorded and identify "
+            "again for a test on it")
+    findings = list(chosen.findings)
+    at = 1 if findings and findings[0].kind == "main" else 0
+    return replace(chosen, validations=result.validations, findings=tuple(findings[:at] + [Finding("misread", text)]
+                                                                           + findings[at:]))
 
 
 def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
@@ -206,13 +238,23 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
                            f"blocks of the log {how} ({{}} against {{}} N·m RMS, {HELD_OUT_FOLDS}-fold blocked "
                            "cross-validation)".format(*_apart_figures(sdp, own))
                            + ("" if sdp < own else "; it is what dynid export writes"))
-    if main != ls or not str(result.consistency_verdicts.get(SDP_LABEL, "")).startswith("yes"):
+    if _exported_instead(result, main) == main:
         return main, ""  # another estimator listed first keeps its place, as with validation logs
     return SDP_LABEL, (f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not; it is what dynid export "
                        f"writes. {ls} predicts held-out blocks of the log better ({{}} against {{}} N·m RMS, "
                        f"{HELD_OUT_FOLDS}-fold blocked cross-validation), but blocks of one excitation do not tell which "
                        "estimate predicts other motions: validation logs ([[validation]], other motions) do".format(
                            *_apart_figures(own, sdp)))
+
+
+def _exported_instead(result, main: str) -> str:
+    """The SDP where ``main`` is least squares, not physically consistent, and the SDP passed its own check (what
+    ``dynid export`` writes); else ``main``."""
+    verdicts = result.consistency_verdicts
+    if (main == result.label and not str(verdicts.get(main, "yes")).startswith("yes")
+            and str(verdicts.get(SDP_LABEL, "")).startswith("yes")):
+        return SDP_LABEL
+    return main
 
 
 def _torque_choice(result, main: str, rigid: bool, nominal, scored, judged):
@@ -298,7 +340,8 @@ def _with_validation_findings(result, chosen: list, nominal: tuple[str, np.ndarr
     """The findings: the choice's first, the identification's, then least squares' on each validation log
     (extrapolation, an error far above the fit's) and the main estimate against the description's nominal model, joint
     by joint (:func:`dynid.validation.diagnostics.nominal_gate`)."""
-    findings = [f for f in chosen if f.kind == "main"] + [f for f in result.findings if f.kind not in ("main", "drive")]
+    findings = [f for f in chosen if f.kind == "main"] + [f for f in result.findings
+                                                          if f.kind not in ("main", "drive", "misread")]
     findings += _drive_findings(result, result.main) + _validation_findings(result)
     diagnostics = dict(result.diagnostics)
     if nominal is not None:

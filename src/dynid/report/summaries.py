@@ -347,7 +347,8 @@ def readiness(result, *, library: bool = False) -> Line:
                                                   for s in (r.diagnostics.get("versus_nominal") or {}).values()):
         # the gate judged the main estimate; what is ready is what export writes (it warns on these joints)
 
-        worse = {log: s["worse_joints"] for log, s in nominal_gate(r.validations, exportable[0], nominal)[1].items()}
+        trusted = [v for v in r.validations if not v.misread]  # the verdict weighed these alone
+        worse = {log: s["worse_joints"] for log, s in nominal_gate(trusted, exportable[0], nominal)[1].items()}
     worse = {log: j for log, j in worse.items() if j}
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
@@ -365,6 +366,11 @@ def readiness(result, *, library: bool = False) -> Line:
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
+    misread = [v.name for v in r.validations if v.misread]
+    if misread:
+        return Line(f"not ready: {', '.join(misread)} {'does' if len(misread) == 1 else 'do'} not match the robot "
+                    "file's angles or mounting, so the model has no fair test on other motions: the warning names the "
+                    "change; read the log so and identify again", "warning")
     if getattr(r.estimates.get(getattr(r, "main", "")), "key", "") == NOMINAL_KEY:
         return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "
                     "says why and what would", "title")
@@ -751,7 +757,12 @@ def in_short(result) -> list:
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
                 >= errors.get(c.name, np.inf)}
-    far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9) and k not in at_floor]
+    misread = [c.name for c in r.validations if c.misread]
+    far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)
+           and k not in at_floor and k not in misread]
+    if misread:
+        out.append(Line(f"{', '.join(misread)}: angles or a mounting other than the robot file's (the warning says "
+                        "which): its figures say little of any estimate"))
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))

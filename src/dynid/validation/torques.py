@@ -64,6 +64,8 @@ class TorqueComparison:
     floor : (n_dof,) array [N·m] or None
         The noise floor of these samples (:func:`dynid.validation.noise_floor.noise_floor`): the RMSE a perfect model
         would have.
+    misread : str
+        Where the log's geometry does not match the robot file's, the warning that says how ("" where it does).
     """
 
     name: str
@@ -98,6 +100,10 @@ class TorqueComparison:
     band: np.ndarray | None = None
     """(n_dof,) [N·m]: the half-width ``f_s`` of that band, the same for every set (the robot's static friction as
     the first set, dynid's estimate, identified it): a set with more friction of its own gets no wider band."""
+    misread: str = ""
+    """Where the log's geometry does not match the robot file's (:mod:`dynid.validation.geometry_checks`: a joint's
+    zero, two columns swapped, gravity), the warning that says how: its figures say little of any estimate, and the
+    verdict does not weigh them."""
 
     def scored(self, label: str) -> np.ndarray:
         """The prediction the metrics score: the set's own while a joint moves; at rest, the measured torque moved
@@ -319,6 +325,8 @@ class TorqueComparison:
         floor = self.floor_metrics()
         if floor is not None:
             out["noise_floor"] = floor
+        if self.misread:
+            out["misread"] = self.misread
         return out
 
 
