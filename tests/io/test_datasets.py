@@ -203,6 +203,10 @@ def test_positions_in_degrees_are_refused_with_the_hint(tmp_path):
     q = np.outer(np.linspace(0, 90, 100), np.ones(6))
     with pytest.raises(DataError, match=r"ur.csv: joint 1 reaches 90 rad, implausible for radians: .*unit = \"deg\""):
         load_recording(_log(tmp_path, t, q, np.ones((100, 6))), load_robot("ur10e"))
+    q[:, :5] = 0.1  # the sixth joint alone in degrees: the unit would turn the others too
+    with pytest.raises(DataError, match=r"joint 6 reaches 90 rad, .*unit = \"deg\" }; for this joint alone positions "
+                                        r"= \{ ..., scale = \[1, 1, 1, 1, 1, 0.0174533\] \}\)\?$"):
+        load_recording(_log(tmp_path, t, q, np.ones((100, 6))), load_robot("ur10e"))
 
 
 def test_saturated_currents_and_positions_outside_the_limits_are_named(tmp_path, rng):

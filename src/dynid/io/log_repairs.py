@@ -67,6 +67,18 @@ SPIKE_SAMPLES = 5
 at (this many samples before and after it differ by more than the joint can move) is a step (:func:`_position_step`)."""
 
 
+DEGREE_SPEED = 3.0
+"""A joint whose positions move faster than this many times its velocity limit (the 99th percentile of its speed over
+:data:`SPEED_SPAN`) and within that limit read as degrees is logged in degrees: a joint that moves less than 4π
+degrees is not refused by its range (:func:`degree_speed_warnings`). The real logs' fastest joints move at 1.0× their
+limits (the TX40's), a joint in degrees 57×."""
+
+
+SPEED_SPAN = 0.02
+"""s: the span a joint's speed is measured over (not sample to sample, which the encoder's noise and resolution
+dominate at a high rate)."""
+
+
 IMPLAUSIBLE_EFFORT = 1e6
 """|torque| [N·m] or |current| [A] above which a log's value is refused: no robot joint comes near it (the largest
 industrial arms' joints carry about 1e5 N·m)."""
@@ -83,7 +95,7 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
     for j in (j for j, s in enumerate(still) if s and spec.table == "[identification]"):
         warnings.append(f"{source}: joint {j + 1}'s position never changes in [identification] (a joint held still, or "
                         "the wrong column?): what only its motion shows keeps the description's values")
-    warnings += limit_warnings(robot, t, outside, source)
+    warnings += limit_warnings(robot, t, outside, source) + degree_speed_warnings(robot, t, q, source)
     kind = "currents" if "currents" in spec.signals or (spec.bag is not None and spec.bag.effort == "currents") else "torques"
     for j in range(tau.shape[1]):
         x = tau[:, j]
@@ -137,8 +149,55 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
-                        f"positions in degrees ({degrees})?")
+                        f"positions in degrees ({_degrees_setting(np.flatnonzero(worst > 4 * np.pi), q.shape[1], degrees)})?")
     return still, outside
+
+
+def _degrees_setting(joints, n_dof: int, degrees: str) -> str:
+    """How to read ``joints``' positions as degrees: ``degrees`` (every joint's), and for some joints alone a config's
+    per-joint ``scale`` where ``degrees`` is a config's unit."""
+    if len(joints) == n_dof or "unit" not in degrees:
+        return degrees
+    factors = ", ".join(f"{np.pi / 180:.6g}" if j in joints else "1" for j in range(n_dof))
+    return f"{degrees}; for {'this joint' if len(joints) == 1 else 'these joints'} alone positions = {{ ..., scale = [{factors}] }}"
+
+
+def degree_speed_warnings(robot: Robot, t, q, source: str, *,
+                          degrees: str = 'positions = { ..., unit = "deg" }') -> list[str]:
+    """Joints whose positions move as if they were degrees (:data:`DEGREE_SPEED`): one warning each.
+
+    Parameters
+    ----------
+    robot : Robot
+        Its velocity limits (a joint without one is not checked).
+    t : (N,) array [s]
+    q : (N, n_dof) array or StoredColumns [rad]
+        Read one joint at a time.
+    source : str
+        The file or dataset, for the message.
+    degrees : str
+        How to give degrees, in the message.
+
+    Returns
+    -------
+    list of str
+    """
+    t = np.asarray(t, dtype=float)
+    span = max(1, int(round(SPEED_SPAN / float(np.median(np.diff(t)))))) if t.size > 1 else 1
+    if t.size <= span:
+        return []
+    limit, fast = np.asarray(robot.limits.dq_max, dtype=float), {}
+    for j in range(q.shape[1]):
+        if not 0 < limit[j] < np.inf:
+            continue
+        column = np.asarray(q[:, j], dtype=float)
+        speed = float(np.percentile(np.abs(column[span:] - column[:-span]) / (t[span:] - t[:-span]), 99))
+        if speed > DEGREE_SPEED * limit[j] and np.radians(speed) <= limit[j]:
+            fast[j] = speed
+    setting = _degrees_setting(list(fast), q.shape[1], degrees)
+    return [f"{source}: joint {j + 1} moves at {v:.3g} rad/s, {v / limit[j]:.0f}× its velocity limit ({limit[j]:.3g} "
+            f"rad/s) and within it read as degrees: are its positions in degrees ({setting})? Read as radians, its "
+            "inertia and friction come out scaled" for j, v in fast.items()]
 
 
 def limit_warnings(robot: Robot, t, outside: list[tuple[int, int]], source: str) -> list[str]:
