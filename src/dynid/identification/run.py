@@ -6,7 +6,7 @@ from __future__ import annotations
 import contextlib
 from dataclasses import fields, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -79,7 +79,8 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 @keyword_only_after_data
 def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
-                  yardstick: Preprocessing | None = None) -> tuple[tuple, tuple[str, ...]]:
+                  yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None
+                  ) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
     Parameters
@@ -103,14 +104,18 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         Prepare each log by the one yardstick instead of the identification's settings carried over: the
         identification log's settings resolved by dynid's default rules
         (:func:`dynid.preprocessing.strategies.yardstick_settings`).
+    fitted : (str, (n_dof,) array), optional
+        The estimate fitted to the identification log and its correlation with each joint's torque there: a log
+        whose torque channels run against it or swapped is said (:mod:`dynid.validation.channel_checks`).
 
     Returns
     -------
     comparisons : tuple of TorqueComparison
-        A log whose geometry does not match the robot file's has its ``misread`` set.
+        A log read otherwise than the identification log has its ``misread`` set.
     warnings : tuple of str
-        Besides the logs' own, a log whose geometry does not match the robot file's
-        (:mod:`dynid.validation.geometry_checks`: a joint's zero, two columns swapped, gravity).
+        Besides the logs' own, a log read otherwise: its torque channels flipped or swapped against the fitted estimate
+        (``fitted``), or its geometry not the robot file's (:mod:`dynid.validation.geometry_checks`: a joint's zero,
+        two columns swapped, gravity).
 
     Raises
     ------
@@ -118,6 +123,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         A log that cannot be read or prepared.
     """
     from ..preprocessing.pipeline import prepare
+    from ..validation.channel_checks import channel_findings
     from ..validation.geometry_checks import geometry_findings
     from ..validation.torques import compare_torques
 
@@ -130,13 +136,14 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
             progress(f"validation, {spec.name}", 0, 1)
         recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
         data = prepare(recording, settings, strict=False)
-        found: list = []
-        if yardstick is None and np.any(config.robot.inertial != 0):  # a log recorded otherwise than the fitted one
-            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
-            warnings.extend(f.text for f in found)
         scored = compare_torques(config.robot, base, data, parameter_sets,
                                  progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
+        # a log recorded otherwise than the fitted one: its torque channels, else its geometry
+        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted)
+        if not found and yardstick is None and np.any(config.robot.inertial != 0):
+            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
+        warnings.extend(f.text for f in found)
         out.append(replace(scored, misread=found[0].text) if found else scored)
         warnings.extend(data.warnings)
     return tuple(out), tuple(warnings)
@@ -213,7 +220,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         sets[DRIVE_ONLY_LABEL] = alt.params
     scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress=progress,
                                          resolved=prepared.data.settings, noise=result.joint_std,
-                                         covariance={result.label: result.solution.covariance})
+                                         covariance={result.label: result.solution.covariance},
+                                         fitted=(result.label, result.fit.metrics()[result.label]["correlation"]))
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
@@ -408,8 +416,21 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
         noise = None
     reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
     comparisons, warnings = validate_sets(config, base, sets, datasets, progress=progress,
-                                          resolved=stored_preprocessing(identified), noise=noise, yardstick=reference)
+                                          resolved=stored_preprocessing(identified), noise=noise, yardstick=reference,
+                                          fitted=_fitted_correlation(identified, sets, config.robot.n_dof))
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
+
+
+def _fitted_correlation(identified: dict, sets: dict, n_dof: int) -> tuple[str, np.ndarray] | None:
+    """The main estimate of a results.json and its correlation with each joint's torque on the identification log
+    (where the results hold them), for :func:`validate_sets`' check of a log's torque channels."""
+    main = identified.get("main_estimate")
+    metrics: Any = ((identified.get("identification") or {}).get("metrics") or {}).get(main)
+    try:
+        corr = np.asarray(metrics["correlation"], dtype=np.float64)
+    except (KeyError, TypeError, ValueError):
+        return None
+    return (str(main), corr) if main in sets and corr.shape == (n_dof,) else None
 
 
 def _identified_model(config: IdentificationConfig, identified: dict, source: str):

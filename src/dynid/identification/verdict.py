@@ -18,6 +18,11 @@ logs are scored. The candidates, in the order they are weighed:
 4. the description's nominal model itself, where it predicts the validation logs better than every estimate: the
    main estimate is then the robot file's values, and the first finding says to keep them.
 
+A validation log read otherwise than the identification log (``misread``: its torque channels flipped or swapped
+against the fitted estimate, :mod:`dynid.validation.channel_checks`; its geometry not the robot file's,
+:mod:`dynid.validation.geometry_checks`) is not weighed: the choice is made on the other logs, or on the
+identification log alone (the SDP where least squares is not physically consistent: what ``dynid export`` writes).
+
 The validation figures it weighs are the one yardstick's (:func:`dynid.identification.run.yardstick_scores`: every
 validation log prepared by dynid's default rules, whatever the identification's settings), so a setting that filters
 the validation logs differently does not move the choice (issue "Never worse than the description", item 5). The
@@ -188,9 +193,9 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
 
 
 def _without_misread(result, nominal, scored, judged, states):
-    """:func:`choose_main_estimate` on the validation logs whose geometry matches the robot file's alone (on the
-    identification log alone where none does), with a finding naming the others: a log recorded with other zeros, its
-    columns in another order or another mounting scores every estimate by that, not by how it predicts (a UR10e's
+    """:func:`choose_main_estimate` on the validation logs read as the identification log alone (on the identification
+    log alone where none is), with a finding naming the others: a log recorded with other zeros, its columns in another
+    order, another mounting or a torque channel flipped scores every estimate by that, not by how it predicts (a UR10e's
     validation log with J2 a quarter turn off took the choice from the SDP, 0.2 % on the log as recorded, to the
     description's links with the drive terms fitted, the one candidate that does not move its links: 108 % against
     108.2 % on the misread log)."""
@@ -201,16 +206,16 @@ def _without_misread(result, nominal, scored, judged, states):
         return None if comparisons is None else tuple(v for v in comparisons if v.name not in names)
 
     trusted = kept(result.validations)
-    chosen = choose_main_estimate(replace(result, validations=trusted), nominal, kept(scored), kept(judged),
-                                  states if trusted else None)
+    diagnostics = {**result.diagnostics, "misread": sorted(names)}  # without validation logs, held_out_choice reads it
+    chosen = choose_main_estimate(replace(result, validations=trusted, diagnostics=diagnostics), nominal, kept(scored),
+                                  kept(judged), states if trusted else None)
     on = "the other validation logs" if trusted else "the identification log alone"
-    if not trusted and _exported_instead(chosen, chosen.main) != chosen.main:
-        on += f": {SDP_LABEL}, physically consistent where {chosen.main} is not, and what dynid export writes"
-        chosen = replace(chosen, main=SDP_LABEL)
-    text = (f"the verdict leaves out {', '.join(sorted(names))}: {'its' if len(names) == 1 else 'their'} angles or "
-            "mounting do not match the robot file's (the warning says how), so its figures score every estimate by "
-            f"that, not by how it predicts; the main estimate is chosen on {on}: read the log as recorded and identify "
-            "again for a test on it")
+    if not trusted and chosen.main == SDP_LABEL != result.label:
+        on += f": {SDP_LABEL}, physically consistent where {result.label} is not, and what dynid export writes"
+    text = (f"the verdict leaves out {', '.join(sorted(names))}: read otherwise than the identification log (its "
+            "angles, mounting or torque channels: the warning says how), its figures score every estimate by that, "
+            f"not by how it predicts; the main estimate is chosen on {on}: read the log as the warning says and "
+            "identify again for a test on it")
     findings = list(chosen.findings)
     at = 1 if findings and findings[0].kind == "main" else 0
     return replace(chosen, validations=result.validations, findings=tuple(findings[:at] + [Finding("misread", text)]
@@ -229,6 +234,8 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
     full log 55.4 % against 11.8 %, the Med7's 50-55 s 661 % against 22.4 %)."""
     ls = result.label
     held = result.diagnostics.get("held_out_rms_error") or {}
+    if result.diagnostics.get("misread") and SDP_LABEL not in held:  # every validation log left out: what export writes
+        return _exported_instead(result, main), ""
     if not inconsistent or SDP_LABEL not in held:
         return main, ""
     sdp, own = held[SDP_LABEL], held[ls]

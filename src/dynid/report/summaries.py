@@ -368,9 +368,9 @@ def readiness(result, *, library: bool = False) -> Line:
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
     misread = [v.name for v in r.validations if v.misread]
     if misread:
-        return Line(f"not ready: {', '.join(misread)} {'does' if len(misread) == 1 else 'do'} not match the robot "
-                    "file's angles or mounting, so the model has no fair test on other motions: the warning names the "
-                    "change; read the log so and identify again", "warning")
+        return Line(f"not ready: {', '.join(misread)} {'is' if len(misread) == 1 else 'are'} read otherwise than the "
+                    "identification log (angles, mounting or torque channels), so the model has no fair test on other "
+                    "motions: the warning says how to read it; then identify again", "warning")
     if getattr(r.estimates.get(getattr(r, "main", "")), "key", "") == NOMINAL_KEY:
         return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "
                     "says why and what would", "title")
@@ -761,8 +761,8 @@ def in_short(result) -> list:
     far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)
            and k not in at_floor and k not in misread]
     if misread:
-        out.append(Line(f"{', '.join(misread)}: angles or a mounting other than the robot file's (the warning says "
-                        "which): its figures say little of any estimate"))
+        out.append(Line(f"{', '.join(misread)}: read otherwise than the identification log (angles, mounting or "
+                        "torque channels: the warning says how): its figures say little of any estimate"))
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))

@@ -65,7 +65,7 @@ class TorqueComparison:
         The noise floor of these samples (:func:`dynid.validation.noise_floor.noise_floor`): the RMSE a perfect model
         would have.
     misread : str
-        Where the log's geometry does not match the robot file's, the warning that says how ("" where it does).
+        Where the log is read otherwise than the identification log, the warning that says how ("" where it is not).
     """
 
     name: str
@@ -101,9 +101,9 @@ class TorqueComparison:
     """(n_dof,) [N·m]: the half-width ``f_s`` of that band, the same for every set (the robot's static friction as
     the first set, dynid's estimate, identified it): a set with more friction of its own gets no wider band."""
     misread: str = ""
-    """Where the log's geometry does not match the robot file's (:mod:`dynid.validation.geometry_checks`: a joint's
-    zero, two columns swapped, gravity), the warning that says how: its figures say little of any estimate, and the
-    verdict does not weigh them."""
+    """Where the log is read otherwise than the identification log (its torque channels flipped or swapped:
+    :mod:`dynid.validation.channel_checks`; its geometry not the robot file's: :mod:`dynid.validation.geometry_checks`),
+    the warning that says how: its figures say little of any estimate, and the verdict does not weigh them."""
 
     def scored(self, label: str) -> np.ndarray:
         """The prediction the metrics score: the set's own while a joint moves; at rest, the measured torque moved
