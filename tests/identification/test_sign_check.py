@@ -3,6 +3,7 @@ on any log"): a sign flipped in the log is still named; a short log whose fricti
 not called flipped."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -239,6 +240,34 @@ def test_one_joints_torque_in_another_unit_in_a_simulated_log_is_named(tmp_path)
     assert p.returncode == 0, p.stderr
     (scale,) = [f for f in _findings(tmp_path / "out") if f["kind"] == "scale"]
     assert "scale = [1, 0.001, 1, 1, 1, 1]" in scale["text"], scale["text"]
+
+
+def test_a_description_that_misstates_one_joints_torque_is_not_a_channels_scale(tmp_path):
+    """``dynid example ur10e`` with a description whose wrist links weigh 0.08 of the simulation's: J4's measured torque
+    is about 13× its nominal one where the other joints' agree, and dynid said "not ready ... set scale = [1, 1, 1,
+    0.0772, 1, 1]", advice that would spoil a log the fit follows to its noise floor (every joint at 0.96-1.04× it).
+    A channel's own scale is named only where the fit cannot follow it; the same log with J2 in N·mm still is (above)."""
+    from dynid.validation.diagnostics import scale_findings
+
+    rho, slope = np.array([0.999, 0.99, 0.99, 0.98, 0.5, 0.1]), np.array([1.0, 1000.0, 1.01, 0.99, 1.0, 1.3])
+    fitted = np.zeros(6, bool)
+    assert scale_findings(rho, slope, np.ones(6, bool), "identification", misfit=fitted) == []
+    assert len(scale_findings(rho, slope, np.ones(6, bool), "identification", misfit=fitted | [0, 1, 0, 0, 0, 0])) == 1
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    folder = tmp_path / "try"
+    text = (folder / "ur10e.urdf").read_text()
+    start = text.index('<link name="wrist_1_link">')
+    head, wrist = text[:start], text[start:]
+    for mass in sorted(set(re.findall(r'<mass value="([0-9.e+-]+)"/>', wrist[:wrist.index('<link name="ee_link">')]))):
+        wrist = wrist.replace(f'<mass value="{mass}"/>', f'<mass value="{0.08 * float(mass):.6g}"/>')
+    (folder / "ur10e.urdf").write_text(head + wrist)
+    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    slope = results["diagnostics"]["nominal_slope_beyond_drive"][3]
+    assert slope > 3, slope  # J4's torque far beyond its nominal one, as a channel in another unit would be
+    assert [f for f in results["findings"] if f["kind"] == "scale"] == []
+    assert "model ready" in " ".join(p.stdout.split())
 
 
 def test_a_scale_finding_names_each_joints_drive_gain_for_motor_currents():

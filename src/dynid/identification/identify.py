@@ -33,6 +33,7 @@ from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (
+    SCALE_MISFIT,
     BlockGrams,
     OrderSums,
     ResidualSums,
@@ -530,9 +531,13 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     # residual
     geometry, stats["geometry"] = geometry_findings(scoring.robot, data.q, data.dq, data.ddq, data.tau, data.name)
     varies = fit.varies(beyond="floor")
+    floor = fit.floor_metrics()  # one channel's own scale is one the fit cannot follow
+    misfit = None if floor is None else (np.min([m["rmse"] for m in fit.metrics().values()], axis=0)
+                                         > SCALE_MISFIT * np.asarray(floor["rmse"]))
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
-            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains) + geometry)
+            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains,
+                             misfit=misfit) + geometry)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

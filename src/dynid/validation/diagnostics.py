@@ -273,8 +273,16 @@ SCALE_SHAPE = 0.9
 slope between them is a scale."""
 
 
+SCALE_MISFIT = 2.0
+"""One joint's scale is named only where no estimate fits that joint's torque within this many times its noise floor.
+A channel in another unit is what a fit cannot follow (the links' parameters are shared with the other joints'); a
+description that misstates one joint's small torque leaves the fit at the floor (a UR10's URDF read for a UR10e's
+log: J4's torque 11.7× its nominal one, every joint fitted at 0.96-1.04× its floor; J2 in N·mm: 35× and more)."""
+
+
 def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
-                   table: str = "[identification]", gains: np.ndarray | None = None) -> list[Finding]:
+                   table: str = "[identification]", gains: np.ndarray | None = None,
+                   misfit: np.ndarray | None = None) -> list[Finding]:
     """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
     of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
     that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``; or, where the median is within, some joints' slopes are
@@ -298,6 +306,9 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     gains : (n_dof,) array, optional
         The drive gains the torques were read through [N·m/A]: each joint's gain that would bring its slope to 1 is
         said, for a log of motor currents (eq. 16) whose description states none (a URDF's are 1).
+    misfit : (n_dof,) bool array, optional
+        Joints that no estimate fits within :data:`SCALE_MISFIT` times their noise floor: only these may have a scale
+        of their own (default: every joint).
 
     Returns
     -------
@@ -310,7 +321,7 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
         return []
     median = float(np.median(k[judged]))
     if 1 / SCALE_LIMIT <= median <= SCALE_LIMIT:
-        return _joint_scale_findings(k, judged, dataset, table)
+        return _joint_scale_findings(k, judged, dataset, table, misfit)
     fix = _inverse_text(median)
     joints = ", ".join(f"J{j + 1}" for j in judged)
     per_joint = "" if gains is None else (
@@ -324,11 +335,14 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
                              f"description{per_joint}")]
 
 
-def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: str) -> list[Finding]:
+def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: str,
+                          misfit: np.ndarray | None = None) -> list[Finding]:
     """Some joints' torques far from the nominal model's size where the other judged joints' agree with it (at least
-    two, median within ``[1/SCALE_LIMIT, SCALE_LIMIT]``): one channel in another unit or through another gain."""
-    off = [j for j in judged if not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
-    if not off or len(judged) - len(off) < 2:
+    two, median within ``[1/SCALE_LIMIT, SCALE_LIMIT]``) and the fit cannot follow them (``misfit``): one channel in
+    another unit or through another gain."""
+    outside = [j for j in judged if not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
+    off = [j for j in outside if misfit is None or misfit[j]]
+    if not off or len(judged) - len(outside) < 2:
         return []
     fixes = ", ".join(_inverse_text(slope[j]) if j in off else "1" for j in range(slope.size))
     joints = ", ".join(f"J{j + 1} ({slope[j]:.3g}×)" for j in off)
