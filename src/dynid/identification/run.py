@@ -25,6 +25,7 @@ from ..io.log_repairs import (
     limit_warnings,
     logged_velocities,
     position_ranges,
+    repeated_share,
     resampled,
     uniform_rate,
     unwrapped_positions,
@@ -190,6 +191,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     for spec in config.validation if validate else ():
         step(f"reading {spec.name}")
         checked.append(load_recording(spec, config.robot))
+    config, checked, repeated = _distinct_validation(config, recording, checked)
     pipeline = pipeline_of(config)
     prepared = pipeline.prepare(recording, base, step)
     raw = recording if pipeline.closed_loop else None  # the closed-loop estimators simulate the log as read
@@ -208,6 +210,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         if gains is not None:
             step("drive gains and payload")
             result = replace(result, drive_gains=gains.result())
+    result = replace(result, warnings=result.warnings + repeated)
     if not validate or not config.validation:
         return replace(result, findings=tuple(result.findings) + smooth)
     sets = result.parameter_sets()
@@ -238,6 +241,24 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
             yardstick = tuple(v.without(label) for v in yardstick)
     result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick, states=states), yardstick)
     return replace(result, findings=tuple(result.findings) + smooth)
+
+
+def _distinct_validation(config: IdentificationConfig, recording, checked: list) -> tuple:
+    """The config and validation logs without those that repeat the identification log's samples
+    (:func:`dynid.io.log_repairs.repeated_share`), and a warning for each left out: their figures would be the fit's,
+    and the verdict would weigh them as a test of other motions."""
+    kept, said = [], []
+    for spec, log in zip(config.validation, checked):
+        share = repeated_share(recording, log)
+        if share >= 0.5:
+            said.append(f"{spec.name}: {100 * share:.0f} % of its sampled positions are samples of the identification "
+                        "log: left out of the validation, whose figures would be the fit's; give a log of other motions "
+                        "(or other rows of the log: rows, time_range)")
+        else:
+            kept.append(spec)
+    if not said:
+        return config, checked, ()
+    return replace(config, validation=tuple(kept)), [c for s, c in zip(config.validation, checked) if s in kept], tuple(said)
 
 
 def filtered_finding(names: list, recordings: list) -> tuple:

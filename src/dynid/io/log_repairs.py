@@ -651,3 +651,41 @@ def _per_joint(op, x, values):
     """``op(x, values)`` with one value per joint (an offset, a gain), column by column on stored columns."""
     values = np.broadcast_to(np.asarray(values, dtype=float), (x.shape[1],))
     return x.map_columns(lambda column, j: op(column, values[j])) if isinstance(x, StoredColumns) else op(x, values)
+
+
+REPEATED_ROWS = 20
+"""A validation log repeats the identification log where this many of its sampled positions (distinct rows, of
+:data:`REPEAT_SAMPLES`), and at least half of them, are rows of the identification log exactly: the same samples,
+whose figures would be the fit's (a log at rest has too few distinct rows to be judged)."""
+
+
+REPEAT_SAMPLES = 200
+"""The evenly spaced rows of a validation log :func:`repeated_share` looks up."""
+
+
+def repeated_share(reference, other) -> float:
+    """The share of ``other``'s sampled positions that are rows of ``reference``'s exactly (0 where fewer than
+    :data:`REPEATED_ROWS` of them are distinct).
+
+    Parameters
+    ----------
+    reference, other : Recording
+        Read logs (their positions arrays, or a spooled log's stored columns: one column of ``reference`` is read
+        whole, the rest at the candidate rows).
+
+    Returns
+    -------
+    float
+        In [0, 1].
+    """
+    n = len(other.q)
+    rows = np.unique(np.asarray(other.q[np.linspace(0, n - 1, min(n, REPEAT_SAMPLES)).astype(int)], dtype=float),
+                     axis=0)
+    if len(rows) < REPEATED_ROWS or other.q.shape[1] != reference.q.shape[1]:
+        return 0.0
+    first = np.asarray(reference.q[:, 0], dtype=float)
+    candidates = np.flatnonzero(np.isin(first, rows[:, 0]))
+    if candidates.size == 0:
+        return 0.0
+    found = {tuple(r) for r in np.asarray(reference.q[candidates], dtype=float)}
+    return sum(tuple(r) in found for r in rows) / len(rows)
