@@ -242,6 +242,8 @@ def _identify_summary(d: dict) -> list[str]:
     out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
                               else ", not physically consistent" + (f"; dynid export writes {export}, which is consistent."
                                                                     if export else "."))] if label else []
+    if d.get("readiness") and not str(d["readiness"]).startswith("model ready:"):  # the terminal's first line
+        out.insert(0, str(d["readiness"]) + ".")
     logs = []
     for c in ([d["identification"]] if "identification" in d else []) + list(d.get("validation", [])):
         m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)

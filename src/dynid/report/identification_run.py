@@ -17,6 +17,7 @@ from ..io.urdf_write_back import urdf_written_back
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, save_figure, staged, write_results
+from .summaries import readiness
 
 
 def _slug(name: str) -> str:
@@ -113,7 +114,7 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
             ("validation", f"validation_{_slug(v.name)}.png") for v in result.validations]
         paths = save_comparisons((result.fit, *result.validations), out, names=names)
     json_path = out / "results.json"
-    data = result.to_dict()
+    data = {**result.to_dict(), "readiness": readiness(result).text}  # the first line: the report's box starts with it
     models = _model_texts(data, out, robot, urdf=urdf, urdf_name=urdf_name, mjcf_model=mjcf_model, mjcf_name=mjcf_name, mjcf_folder=mjcf_folder)
     if models:
         data["files_taken_away"] = taken_away(models, robot, data, config)
