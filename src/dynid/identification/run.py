@@ -21,7 +21,6 @@ from ..io.log_repairs import (
     GAP_FACTOR,
     check_clock_unit,
     check_position_steps,
-    degree_speed_warnings,
     limit_warnings,
     logged_velocities,
     position_ranges,
@@ -742,8 +741,8 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     said: list[str] = []
     q = unwrapped_positions(q, name, said)
     check_position_steps(q, t - t[0], robot, name)
-    said += limit_warnings(robot, t - t[0], position_ranges(robot, t, q, name, degrees="numpy.radians(q)")[1], name)
-    said += degree_speed_warnings(robot, t, q, name, degrees="numpy.radians(q)")
+    said += limit_warnings(robot, t - t[0], position_ranges(robot, t, q, name, degrees="numpy.radians(q)"), name,
+                           degrees="numpy.radians(q)")
     dq = logged_velocities(q, dq, name, said)
     warnings: tuple[str, ...] = tuple(said)
     rate = uniform_rate(t)

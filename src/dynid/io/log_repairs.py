@@ -88,14 +88,15 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
     """Refuse positions that cannot be radians and implausible efforts, warn about positions outside the joint limits,
     naming joint and time range (a current or torque held at its extreme is found where the log is prepared:
     :func:`dynid.preprocessing.prepared.clipped_samples`)."""
-    still, outside = position_ranges(robot, t, q, source, steps=True)
+    ranges = position_ranges(robot, t, q, source, steps=True)
+    still = ranges[0]
     if all(still):
         raise DataError(f"{source}: no joint's position ever changes ({spec.table or spec.name}): a frozen log, or the "
                         "wrong columns or rows?")
     for j in (j for j, s in enumerate(still) if s and spec.table == "[identification]"):
         warnings.append(f"{source}: joint {j + 1}'s position never changes in [identification] (a joint held still, or "
                         "the wrong column?): what only its motion shows keeps the description's values")
-    warnings += limit_warnings(robot, t, outside, source) + degree_speed_warnings(robot, t, q, source)
+    warnings += limit_warnings(robot, t, ranges, source)
     kind = "currents" if "currents" in spec.signals or (spec.bag is not None and spec.bag.effort == "currents") else "torques"
     for j in range(tau.shape[1]):
         x = tau[:, j]
@@ -107,7 +108,8 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
 
 
 def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
-                    degrees: str = 'positions = { ..., unit = "deg" }') -> tuple[list[bool], list[tuple[int, int]]]:
+                    degrees: str = 'positions = { ..., unit = "deg" }'
+                    ) -> tuple[list[bool], list[tuple[int, int]], dict[int, float]]:
     """Refuse positions that cannot be radians; say which joints never move and which leave their limits.
 
     Parameters
@@ -130,6 +132,8 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
         Per joint, whether its position never changes.
     outside : list of (int, int)
         Per joint, how many samples leave its limits (by more than 0.05 rad) and the first of them.
+    fast : dict
+        Joint (0-based) -> its speed [rad/s] where it moves as if its positions were degrees (:data:`DEGREE_SPEED`).
 
     Raises
     ------
@@ -137,20 +141,26 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
         A joint beyond 4π rad: degrees read as radians.
     """
     lim = robot.limits
-    worst, outside, still = np.zeros(q.shape[1]), [], []
+    t = np.asarray(t, dtype=float)
+    span = max(1, int(round(SPEED_SPAN / float(np.median(np.diff(t)))))) if t.size > 1 else 1
+    worst, outside, still, fast = np.zeros(q.shape[1]), [], [], {}
     for j in range(q.shape[1]):  # one joint at a time, each read once: q may be stored
-        column = q[:, j]
+        column = np.asarray(q[:, j], dtype=float)
         if steps:
             _position_step(column, t, float(lim.dq_max[j]), j, source)
         worst[j] = np.abs(column).max()
         still.append(bool(column.max() == column.min()))
         k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
         outside.append((k.size, k[0] if k.size else 0))
+        if 0 < lim.dq_max[j] < np.inf and t.size > span:
+            speed = float(np.percentile(np.abs(column[span:] - column[:-span]) / (t[span:] - t[:-span]), 99))
+            if speed > DEGREE_SPEED * lim.dq_max[j] and np.radians(speed) <= lim.dq_max[j]:
+                fast[j] = speed
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
                         f"positions in degrees ({_degrees_setting(np.flatnonzero(worst > 4 * np.pi), q.shape[1], degrees)})?")
-    return still, outside
+    return still, outside, fast
 
 
 def _degrees_setting(joints, n_dof: int, degrees: str) -> str:
@@ -162,19 +172,18 @@ def _degrees_setting(joints, n_dof: int, degrees: str) -> str:
     return f"{degrees}; for {'this joint' if len(joints) == 1 else 'these joints'} alone positions = {{ ..., scale = [{factors}] }}"
 
 
-def degree_speed_warnings(robot: Robot, t, q, source: str, *,
-                          degrees: str = 'positions = { ..., unit = "deg" }') -> list[str]:
-    """Joints whose positions move as if they were degrees (:data:`DEGREE_SPEED`): one warning each.
+def limit_warnings(robot: Robot, t, ranges: tuple, source: str, *,
+                   degrees: str = 'positions = { ..., unit = "deg" }') -> list[str]:
+    """One warning per joint that leaves its position limits, and per joint that moves faster than its velocity limit
+    as if its positions were degrees (:func:`position_ranges`' ``outside`` and ``fast``).
 
     Parameters
     ----------
     robot : Robot
-        Its velocity limits (a joint without one is not checked).
     t : (N,) array [s]
-    q : (N, n_dof) array or StoredColumns [rad]
-        Read one joint at a time.
+    ranges : tuple
+        :func:`position_ranges`' result.
     source : str
-        The file or dataset, for the message.
     degrees : str
         How to give degrees, in the message.
 
@@ -182,42 +191,14 @@ def degree_speed_warnings(robot: Robot, t, q, source: str, *,
     -------
     list of str
     """
-    t = np.asarray(t, dtype=float)
-    span = max(1, int(round(SPEED_SPAN / float(np.median(np.diff(t)))))) if t.size > 1 else 1
-    if t.size <= span:
-        return []
-    limit, fast = np.asarray(robot.limits.dq_max, dtype=float), {}
-    for j in range(q.shape[1]):
-        if not 0 < limit[j] < np.inf:
-            continue
-        column = np.asarray(q[:, j], dtype=float)
-        speed = float(np.percentile(np.abs(column[span:] - column[:-span]) / (t[span:] - t[:-span]), 99))
-        if speed > DEGREE_SPEED * limit[j] and np.radians(speed) <= limit[j]:
-            fast[j] = speed
-    setting = _degrees_setting(list(fast), q.shape[1], degrees)
-    return [f"{source}: joint {j + 1} moves at {v:.3g} rad/s, {v / limit[j]:.0f}× its velocity limit ({limit[j]:.3g} "
-            f"rad/s) and within it read as degrees: are its positions in degrees ({setting})? Read as radians, its "
-            "inertia and friction come out scaled" for j, v in fast.items()]
-
-
-def limit_warnings(robot: Robot, t, outside: list[tuple[int, int]], source: str) -> list[str]:
-    """One warning per joint that leaves its position limits (:func:`position_ranges`' ``outside``).
-
-    Parameters
-    ----------
-    robot : Robot
-    t : (N,) array [s]
-    outside : list of (int, int)
-    source : str
-
-    Returns
-    -------
-    list of str
-    """
-    lim = robot.limits
+    lim, (_, outside, fast) = robot.limits, ranges
+    setting = _degrees_setting(list(fast), len(outside), degrees)
     return [f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad during {count} "
             f"samples from t = {t[first]:.3f} s (units, encoder zero, position_offset?)"
-            for j, (count, first) in enumerate(outside) if count]
+            for j, (count, first) in enumerate(outside) if count] + [
+        f"{source}: joint {j + 1} moves at {v:.3g} rad/s, {v / lim.dq_max[j]:.0f}× its velocity limit "
+        f"({lim.dq_max[j]:.3g} rad/s) and within it read as degrees: are its positions in degrees ({setting})? Read as "
+        "radians, its inertia and friction come out scaled" for j, v in fast.items()]
 
 
 def check_position_steps(q, t, robot: Robot, source: str) -> None:
