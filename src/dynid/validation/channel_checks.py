@@ -61,16 +61,6 @@ def channel_findings(comparison, label: str, fitted: np.ndarray) -> list[Finding
     power = np.maximum((p**2).sum(axis=0), 1e-300)
     slope = (m * p).sum(axis=0) / power
     rho = (m * p).sum(axis=0) / np.sqrt(np.maximum((m**2).sum(axis=0), 1e-300) * power)
-    flipped = [j for j in judged if rho[j] < AGAINST and 1 / SCALE_LIMIT <= abs(slope[j]) <= SCALE_LIMIT]
-    n = measured.shape[1]
-    if flipped and _others_predicted(rho, judged, flipped):
-        joints = " and ".join(f"J{j + 1}" for j in flipped)
-        fix = ", ".join("-1" if j in flipped else "1" for j in range(n))
-        return [Finding("misread", f"{comparison.name}: {joints}'s measured torque runs against {label}'s prediction "
-                                   f"(ρ = {', '.join(f'{rho[j]:.3f}' for j in flipped)}), which fits "
-                                   f"{'it' if len(flipped) == 1 else 'them'} on the identification log: is the sign "
-                                   f"flipped in this log? If so, torques = {{ ..., sign = [{fix}] }} in the "
-                                   "table that reads it", int(flipped[0]))]
     own = ((m - p) ** 2).sum(axis=0)  # about each channel's mean: an offset the estimate misses is no swap
     for a, b in ((a, b) for i, a in enumerate(judged) for b in judged[i + 1:]):
         cross = (((m[:, a] - p[:, b]) ** 2).sum(), ((m[:, b] - p[:, a]) ** 2).sum())
@@ -81,4 +71,14 @@ def channel_findings(comparison, label: str, fitted: np.ndarray) -> list[Finding
                                        f"{np.sqrt(cross[0] / own[a]):.2g}× and {np.sqrt(cross[1] / own[b]):.2g}×): are "
                                        "their columns swapped in this log? If so, swap them in torques = { columns = "
                                        "[...] } of the table that reads it", int(a))]
+    flipped = [j for j in judged if rho[j] < AGAINST and 1 / SCALE_LIMIT <= abs(slope[j]) <= SCALE_LIMIT]
+    n = measured.shape[1]
+    if flipped and _others_predicted(rho, judged, flipped):  # after the swaps: two swapped channels may run against
+        joints = " and ".join(f"J{j + 1}" for j in flipped)
+        fix = ", ".join("-1" if j in flipped else "1" for j in range(n))
+        return [Finding("misread", f"{comparison.name}: {joints}'s measured torque runs against {label}'s prediction "
+                                   f"(ρ = {', '.join(f'{rho[j]:.3f}' for j in flipped)}), which fits "
+                                   f"{'it' if len(flipped) == 1 else 'them'} on the identification log: is the sign "
+                                   f"flipped in this log? If so, torques = {{ ..., sign = [{fix}] }} in the "
+                                   "table that reads it", int(flipped[0]))]
     return []
