@@ -1,5 +1,6 @@
 """dynid init: a starter config from a URDF and a log, which dynid identify then runs on as it stands."""
 
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -20,8 +21,8 @@ def _identification(text: str) -> dict:
     return tomllib.loads(text)["identification"]
 
 
-def _log(folder: Path, header: bool) -> Path:
-    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=30, rng=4)
+def _log(folder: Path, header: bool, robot=URDF) -> Path:
+    log = dynid.simulated_log(dynid.load_robot(robot), seconds=30, rng=4)
     names = ["time"] + [f"joint_pos_{j}" for j in range(1, 7)] + [f"effort[{j}]" for j in range(6)]
     path = folder / "logs" / "run.csv"
     path.parent.mkdir()
@@ -211,9 +212,14 @@ def test_the_config_init_wrote_runs_excite_and_identifys_advice_runs_as_printed(
     just written and files to write, where it said CONFIG and FILE."""
     import shlex
 
-    log = _log(tmp_path, header=True)
-    other = log.with_name("other.csv")
-    other.write_text(log.read_text())
+    truth = tmp_path / "truth.urdf"  # the arm the logs come from: its links 20 % heavier than the URDF init is given says
+    truth.write_text(re.sub(r'<mass value="([0-9.e+-]+)"', lambda m: f'<mass value="{1.2 * float(m.group(1)):.6g}"',
+                            URDF.read_text()))
+    log = _log(tmp_path, header=True, robot=truth)
+    other = log.with_name("other.csv")  # another motion of the same layout (a copy of the log is no validation)
+    again = dynid.simulated_log(dynid.load_robot(truth), seconds=10, rng=5)
+    np.savetxt(other, np.column_stack([again.t, again.q, again.tau]), delimiter=",", comments="",
+               header=log.read_text().splitlines()[0])
     monkeypatch.chdir(tmp_path)
     assert run("init", str(URDF), str(log), str(other), "--out", "arm.toml").returncode == 0
     text = (tmp_path / "arm.toml").read_text()

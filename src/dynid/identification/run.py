@@ -79,8 +79,8 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 @keyword_only_after_data
 def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
-                  yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None
-                  ) -> tuple[tuple, tuple[str, ...]]:
+                  yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
+                  geometry: bool = True) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
     Parameters
@@ -107,6 +107,9 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
     fitted : (str, (n_dof,) array), optional
         The estimate fitted to the identification log and its correlation with each joint's torque there: a log
         whose torque channels run against it or swapped is said (:mod:`dynid.validation.channel_checks`).
+    geometry : bool
+        Check each log's geometry against the robot file's: not where the identification log's does not match it
+        either (its finding's setting is for every dataset, and the logs agree with each other).
 
     Returns
     -------
@@ -141,7 +144,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
         found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted)
-        if not found and yardstick is None and np.any(config.robot.inertial != 0):
+        if not found and geometry and yardstick is None and np.any(config.robot.inertial != 0):
             found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
         warnings.extend(f.text for f in found)
         out.append(replace(scored, misread=found[0].text) if found else scored)
@@ -223,7 +226,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
     scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress=progress,
                                          resolved=prepared.data.settings, noise=result.joint_std,
                                          covariance={result.label: result.solution.covariance},
-                                         fitted=(result.label, result.fit.metrics()[result.label]["correlation"]))
+                                         fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
+                                         geometry=not any(f.kind in ("angles", "gravity") for f in result.findings))
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}

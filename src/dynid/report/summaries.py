@@ -357,8 +357,8 @@ def readiness(result, *, library: bool = False) -> Line:
         return Line("not ready: the torques of some joints look swapped: the verdict at the end names them", "warning")
     if "angles" in kinds:
         return Line("not ready: the logged angles do not match the robot file (a joint's zero a quarter or half turn "
-                    "off, or two columns swapped?): the verdict at the end names them and the setting that fixes it",
-                    "warning")
+                    "off, a joint counted the other way round, or two columns swapped?): the verdict at the end names "
+                    "them and the setting that fixes it", "warning")
     if "gravity" in kinds:
         return Line("not ready: the torques fit the description far better with gravity along another axis (a robot "
                     "mounted on a wall or a ceiling?): the verdict at the end names it and the setting that fixes it",

@@ -1,5 +1,6 @@
-"""A log whose geometry does not match the robot file: a joint's zero a quarter or half turn off, two position columns
-swapped, gravity along another axis of the base (a robot mounted on a wall or a ceiling).
+"""A log whose geometry does not match the robot file: a joint's zero a quarter or half turn off, a joint counted the
+other way round (its encoder's axis opposite to the robot file's), two position columns swapped, gravity along another
+axis of the base (a robot mounted on a wall or a ceiling).
 
 Encoders, drivers and robot files often count a joint's angle from different zeros: the Stäubli TX40's logged angles
 need -π/2 on J2 and +π/2 on J3 to match its URDF. A log's columns need not come in the chain's order, and a URDF
@@ -13,7 +14,8 @@ sin/cos of its angle and twice its angle where it has a counterbalance: friction
 counterbalance, whatever their size). What the nominal torque leaves unexplained of what the nuisance columns leave,
 summed over the joints, is compared for the logged angles and for the logged angles with one or two joints turned by
 ±π/2 or π, two joints' columns swapped (their nuisance columns swapped too; every figure over what the logged
-angles' nuisance columns leave, so that all are on one scale), or gravity along each axis of the base either way.
+angles' nuisance columns leave, so that all are on one scale), one joint's states negated, or gravity along each axis
+of the base either way.
 A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
 (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
@@ -56,11 +58,15 @@ SIMPLER = 0.8
 """Two joints changed are named rather than one where they leave less than this share of what the best single turn
 leaves."""
 
+TWIN = 1.1
+"""Two changes whose nominal torques run with the measured ones and leave within this ratio of each other are twins
+the log cannot tell apart: a turn is named before a reversal, with the other beside it."""
+
 SAMPLES = (100, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
 
 
-def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, *,
+def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, directions=None, *,
                       signed: bool = False) -> np.ndarray:
     """What each change of the logged angles leaves of the torque, as a share of what the nuisance columns of the
     logged angles leave (module docstring).
@@ -80,6 +86,9 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravit
         default.
     gravities : (S, 3) array, optional
         For each change, the gravity vector in the base frame [m/s²]; the description's by default.
+    directions : (S, n_dof) array of ±1, optional
+        For each change, the factor each joint's logged states are read with: -1 for a joint counted the other way
+        round (its encoder's axis opposite to the robot file's); 1 by default.
     signed : bool
         Count a joint's nominal torque as explaining nothing where it runs against the measured torque (a negative
         slope): tells apart two changes a half turn apart on a joint whose torques that half turn only flips.
@@ -96,19 +105,24 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravit
     orders = np.tile(np.arange(n), (len(shifts), 1)) if orders is None else np.asarray(orders, dtype=int)
     gravities = (np.tile(np.asarray(robot.gravity, dtype=float), (len(shifts), 1)) if gravities is None
                  else np.asarray(gravities, dtype=float))
+    directions = np.ones((len(shifts), n)) if directions is None else np.asarray(directions, dtype=float)
     reference = _sums(robot, q, dq, ddq, tau, None)[0]
     out = np.empty(len(shifts))
-    for i, (shift, order, gravity) in enumerate(zip(shifts, orders, gravities)):
-        qi, dqi, ddqi = (q + shift)[:, order], dq[:, order], ddq[:, order]
+    for i, (shift, order, gravity, way) in enumerate(zip(shifts, orders, gravities, directions)):
+        qi, dqi, ddqi = way * (q + shift)[:, order], way * dq[:, order], way * ddq[:, order]
         mounted = robot if np.array_equal(gravity, robot.gravity) else replace(robot, gravity=gravity)
-        left = _sums(robot, qi, dqi, ddqi, tau, nominal_rigid_torque(mounted, qi, dqi, ddqi), signed=signed)[0]
+        # a joint counted the other way round may have its torque reversed with it: its slope's sign is free
+        left = _sums(robot, qi, dqi, ddqi, tau, nominal_rigid_torque(mounted, qi, dqi, ddqi), signed=signed,
+                     free=set(np.flatnonzero(way < 0).tolist()))[0]
         out[i] = left / reference if reference > 0 else 0.0
     return out
 
 
-def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False) -> tuple[float, float]:
+def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False, free: frozenset | set = frozenset()
+          ) -> tuple[float, float]:
     """Σ_j the residual sum of squares of joint j's torque on its nuisance columns (and its nominal torque, where
-    given), and Σ_j the nominal torque's own sum of squares beyond the nuisance columns."""
+    given: with ``signed``, only where it runs with the measured torque, but on the joints ``free``), and Σ_j the
+    nominal torque's own sum of squares beyond the nuisance columns."""
     balanced = _counterbalanced(robot)
     left = variation = 0.0
     for j in range(robot.n_dof):
@@ -122,13 +136,14 @@ def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False) -> tu
             p = nominal[:, j] - basis @ (basis.T @ nominal[:, j])
             pp, pr = float(p @ p), float(p @ r)
             variation += pp
-            left -= pr**2 / pp if pp > 1e-12 * max(float(r @ r), 1e-300) and (pr > 0 or not signed) else 0.0
+            left -= pr**2 / pp if pp > 1e-12 * max(float(r @ r), 1e-300) and (pr > 0 or not signed or j in free) else 0.0
     return left, variation
 
 
-def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """No change; every joint and every pair of joints turned by each of :data:`CANDIDATE_TURNS`; every pair of joints'
-    columns swapped; gravity along each axis of the base either way (those other than the description's).
+    columns swapped; every joint counted the other way round; gravity along each axis of the base either way (those
+    other than the description's).
 
     Parameters
     ----------
@@ -137,10 +152,12 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     Returns
     -------
     shifts : (S, n_dof) ndarray [rad]
-        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) / 2 + the gravities.
+        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) / 2 + n + the gravities.
     orders : (S, n_dof) int ndarray
         The logged column each joint is read from.
     gravities : (S, 3) ndarray [m/s²]
+    directions : (S, n_dof) ndarray of ±1
+        The factor each joint's logged states are read with.
     """
     n, g = robot.n_dof, np.asarray(robot.gravity, dtype=float)
     identity = np.arange(n)
@@ -157,6 +174,11 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]
         order[[a, b]] = b, a
         shifts.append(np.zeros(n))
         orders.append(order)
+    directions = [np.ones(n)] * len(shifts)
+    for j in range(n):
+        shifts.append(np.zeros(n))
+        orders.append(identity)
+        directions.append(np.where(identity == j, -1.0, 1.0))
     gravities = [g] * len(shifts)
     for axis, sign in itertools.product(range(3), (1.0, -1.0)):
         other = np.zeros(3)
@@ -165,7 +187,8 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]
             shifts.append(np.zeros(n))
             orders.append(identity)
             gravities.append(other)
-    return np.array(shifts), np.array(orders), np.array(gravities)
+            directions.append(np.ones(n))
+    return np.array(shifts), np.array(orders), np.array(gravities), np.array(directions)
 
 
 def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bool = True
@@ -204,38 +227,71 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     stats: dict = {"unexplained": logged, "nominal_variation": variation / reference if reference > 0 else 0.0}
     if logged < UNEXPLAINED_FROM or stats["nominal_variation"] < MOVED:
         return [], stats
-    shifts, orders, gravities = (x[1:] for x in candidate_changes(robot))
+    shifts, orders, gravities, ways = (x[1:] for x in candidate_changes(robot))
     # two joints turned only among the joints whose own turns explain most: the pairs are most of the candidates
     paired = np.count_nonzero(shifts, axis=1) == 2
     scores = np.full(len(shifts), np.inf)
-    scores[~paired] = unexplained_share(robot, q, dq, ddq, tau, shifts[~paired], orders[~paired], gravities[~paired])
+    scores[~paired] = unexplained_share(robot, q, dq, ddq, tau, shifts[~paired], orders[~paired], gravities[~paired],
+                                        ways[~paired])
     turned = (np.count_nonzero(shifts, axis=1) == 1) & ~paired
     best_turn = [scores[turned & (shifts[:, j] != 0)].min() for j in range(robot.n_dof)]
     top = np.argsort(best_turn, kind="stable")[:PAIRED_JOINTS]
     among = paired & np.all((shifts == 0) | np.isin(np.arange(robot.n_dof), top), axis=1)
-    scores[among] = unexplained_share(robot, q, dq, ddq, tau, shifts[among], orders[among], gravities[among])
+    scores[among] = unexplained_share(robot, q, dq, ddq, tau, shifts[among], orders[among], gravities[among],
+                                      ways[among])
     # one change, unless two joints changed leave clearly less
     single = (np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1)
-              + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
+              + np.count_nonzero(ways < 0, axis=1) + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
-    pick = two if scores[two] < SIMPLER * scores[one] else one
-    # a half turn of a joint, or gravity reversed, may only flip torques, which each joint's free slope takes up: of
-    # the changes within 5 % of the gain, the one whose nominal torques run with the measured ones
-    twins = np.flatnonzero((scores <= scores[pick] + 0.05 * (logged - scores[pick]) + 1e-12) & (single == single[pick]))
-    if len(twins) > 1:
-        pick = int(twins[np.argmin(unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins],
-                                                     gravities[twins], signed=True))])
+    pick, twin = _tie_break(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), scores, logged,
+                            two if scores[two] < SIMPLER * scores[one] else one, single)
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
-                 unexplained_changed=float(scores[pick]))
+                 direction=ways[pick].tolist(), unexplained_changed=float(scores[pick]))
+    if twin is not None:
+        stats["twin"] = {"shift": shifts[twin].tolist(), "order": orders[twin].tolist(),
+                         "gravity": gravities[twin].tolist(), "direction": ways[twin].tolist()}
     if scores[pick] > CHANGE_GAIN * logged:
         return [], stats
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
              f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as it is")
-    kind, text, joint = _change_text(robot, shifts[pick], orders[pick], gravities[pick])
+    kind, text, joint = _text_of(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), pick)
+    what = text[0] if twin is None else (f"{text[0]} (as well on this arm: "
+                                         f"{_text_of(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), twin)[1][0]})")
     fix = (f"{text[1]}, and identify again" if fitted else "Was this log recorded with other zeros, another column "
            "order or another mounting than the identification log? Its scores say little until it is read as that one")
-    return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {text[0]}: "
+    return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {what}: "
                           f"{share}. {fix}", joint)], stats
+
+
+def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, logged: float, pick: int, single
+               ) -> tuple[int, int | None]:
+    """The change named, and a twin as good that the log cannot tell from it (or None). A half turn of a joint, or
+    gravity reversed, may only flip torques, which each joint's free slope takes up: of the changes within 5 % of the
+    gain, the one whose nominal torques run with the measured ones (a joint counted the other way round may run
+    against them: its torque may be reversed with it). Another kind of change as good by that too (to :data:`TWIN`) is
+    the twin (the LBR Med7's J2 counted the other way round with its torque, and its J3 turned by 180°: its links nearly
+    symmetric)."""
+    twins = np.flatnonzero((scores <= scores[pick] + 0.05 * (logged - scores[pick]) + 1e-12) & (single == single[pick]))
+    if len(twins) < 2:
+        return pick, None
+    shifts, orders, gravities, ways = changes
+    q, dq, ddq, tau = log
+    signed = unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins], gravities[twins], ways[twins],
+                               signed=True)
+    reversal = np.any(ways[twins] < 0, axis=1)
+    tied = [k for k in range(len(twins)) if signed[k] <= TWIN * signed.min() + 1e-12]
+    best = min(tied, key=lambda k: (bool(reversal[k]), float(signed[k])))  # a turn before a reversal as good
+    other = [k for k in tied if reversal[k] != reversal[best]]
+    return int(twins[best]), (int(twins[min(other, key=lambda k: float(signed[k]))]) if other else None)
+
+
+def _text_of(robot: Robot, log: tuple, changes: tuple, k: int) -> tuple[str, tuple, int | None]:
+    """:func:`_change_text` or :func:`_reversed_text` of change ``k``."""
+    shifts, orders, gravities, ways = changes
+    if np.any(ways[k] < 0):
+        q, dq, ddq, tau = log
+        return _reversed_text(robot, q, dq, ddq, tau, ways[k])
+    return _change_text(robot, shifts[k], orders[k], gravities[k])
 
 
 def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray
@@ -261,6 +317,21 @@ def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np
                        "[" + ", ".join(f"{x:g}" for x in robot.gravity) + "] m/s²",
                        "Is the robot mounted otherwise than the description says (on a wall, a ceiling)? If so, "
                        f"give gravity = {vector} in the config's [robot] table (or the robot description)"), None
+
+
+def _reversed_text(robot: Robot, q, dq, ddq, tau, way: np.ndarray) -> tuple[str, tuple, int]:
+    """The finding's kind, (what was changed, the question and the setting), and the joint, for a joint counted the
+    other way round: its positions' sign, and its torque's where the nominal torque so runs against the measured one
+    (a drive whose whole convention is reversed)."""
+    j = int(np.flatnonzero(way < 0)[0])
+    signs = ", ".join("-1" if k == j else "1" for k in range(robot.n_dof))
+    nominal = nominal_rigid_torque(robot, way * q, way * dq, way * ddq)[:, j]
+    runs_against = _sums(robot, q, dq, ddq, tau, nominal[:, None] * (np.arange(robot.n_dof) == j), signed=True)[0] \
+        > _sums(robot, q, dq, ddq, tau, -nominal[:, None] * (np.arange(robot.n_dof) == j), signed=True)[0]
+    torques = f" and torques = {{ ..., sign = [{signs}] }} (its torque runs the other way too)" if runs_against else ""
+    return "angles", (f"the logged angles of J{j + 1} counted the other way round",
+                      f"Does J{j + 1}'s encoder count against the robot file's axis? If so, give positions = {{ ..., "
+                      f"sign = [{signs}] }}{torques} in every dataset (and velocities', if given)"), j
 
 
 def _counterbalanced(robot: Robot) -> set[int]:
