@@ -42,3 +42,10 @@ def test_a_validation_log_that_is_the_identification_log_is_left_out_and_said(tm
     assert "model ready to check" in said and "add [[validation]] logs (other motions)" in said
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     assert results.get("validation", []) == []
+    # beside a log of other motions: that one is kept, and scored as without the repeat
+    config.write_text(config.read_text() + '\n[[validation]]\nname = "other"\nfile = "validation.csv"\n')
+    p = dynid("identify", config, "--out", tmp_path / "both", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    both = json.loads((tmp_path / "both" / "results.json").read_text())
+    assert [v["name"] for v in both["validation"]] == ["other"]
+    assert "model ready:" in " ".join(p.stdout.split())

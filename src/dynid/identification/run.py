@@ -251,17 +251,18 @@ def _distinct_validation(config: IdentificationConfig, recording, checked: list)
     (:func:`dynid.io.log_repairs.repeated_share`), and a warning for each left out: their figures would be the fit's,
     and the verdict would weigh them as a test of other motions."""
     kept, said = [], []
-    for spec, log in zip(config.validation, checked):
+    for k, (spec, log) in enumerate(zip(config.validation, checked)):
         share = repeated_share(recording, log)
         if share >= 0.5:
             said.append(f"{spec.name}: {100 * share:.0f} % of its sampled positions are samples of the identification "
                         "log: left out of the validation, whose figures would be the fit's; give a log of other motions "
                         "(or other rows of the log: rows, time_range)")
         else:
-            kept.append(spec)
+            kept.append(k)
     if not said:
         return config, checked, ()
-    return replace(config, validation=tuple(kept)), [c for s, c in zip(config.validation, checked) if s in kept], tuple(said)
+    return (replace(config, validation=tuple(config.validation[k] for k in kept)), [checked[k] for k in kept],
+            tuple(said))
 
 
 def filtered_finding(names: list, recordings: list) -> tuple:
