@@ -15,6 +15,29 @@ from ..cli.refusals import dynid
 from ..conftest import shared_data
 
 
+def _example(tmp_path, change, names=("identification.csv", "validation.csv")):
+    """``dynid example ur10e``'s folder (tmp_path / "try"), each of its logs ``names`` changed in place by
+    ``change(data, header)``."""
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    folder = tmp_path / "try"
+    for name in names:
+        header = (folder / name).read_text().splitlines()[0]
+        data = np.loadtxt(folder / name, delimiter=",", skiprows=1)
+        change(data, header.split(","))
+        np.savetxt(folder / name, data, delimiter=",", header=header, comments="", fmt="%.10g")
+    return folder
+
+
+def _identified_with_angles(folder, out):
+    """``dynid identify`` on the example's config in ``folder``: what it said (one line), results.json, and the text
+    of its one "angles" finding."""
+    p = dynid("identify", folder / "ur10e.toml", "--out", out, "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((out / "results.json").read_text())
+    (finding,) = [f["text"] for f in results["findings"] if f["kind"] == "angles"]
+    return " ".join((p.stdout + p.stderr).split()), results, finding
+
+
 def test_the_unexplained_share_is_that_of_a_direct_regression_with_and_without_the_nominal_torque(rng):
     """Against np.linalg.lstsq on the whole columns: each joint's torque regressed on [nominal, sign(dq), dq, ddq, 1]
     with the changed states, and on the last four alone with the logged ones; the ratio of the summed residual sums of
@@ -66,20 +89,13 @@ def test_a_quarter_turn_on_one_joint_of_a_simulated_log_is_named_and_its_setting
     """J2's logged angles a quarter turn from the URDF's in both logs of ``dynid example ur10e``: the fit absorbs much of
     it (3 % torque error, against 0.2 %) and dynid called the model ready. The verdict names J2, -90° and the setting;
     with that setting in the config the finding is gone and the fit is back to the noise."""
-    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
-    folder = tmp_path / "try"
-    for name in ("identification.csv", "validation.csv"):
-        header = (folder / name).read_text().splitlines()[0]
-        data = np.loadtxt(folder / name, delimiter=",", skiprows=1)
-        data[:, header.split(",").index("shoulder_lift_joint_position")] += np.pi / 2
-        np.savetxt(folder / name, data, delimiter=",", header=header, comments="", fmt="%.10g")
-    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
-    assert p.returncode == 0, p.stderr
-    said = " ".join((p.stdout + p.stderr).split())
+    def turned(data, header):
+        data[:, header.index("shoulder_lift_joint_position")] += np.pi / 2
+
+    folder = _example(tmp_path, turned)
+    said, results, zero = _identified_with_angles(folder, tmp_path / "out")
     assert "not ready: the logged angles do not match the robot file (a joint's zero a quarter or half turn off" in said
-    results = json.loads((tmp_path / "out" / "results.json").read_text())
-    (zero,) = [f for f in results["findings"] if f["kind"] == "angles"]
-    assert "angles of J2 turned by -90°" in zero["text"] and 'position_offset = "-pi/2" to J2' in zero["text"]
+    assert "angles of J2 turned by -90°" in zero and 'position_offset = "-pi/2" to J2' in zero
     assert results["diagnostics"]["geometry"]["shift"] == pytest.approx([0, -np.pi / 2, 0, 0, 0, 0])
     text = (folder / "ur10e.toml").read_text().replace('robot = "ur10e.urdf"', "")
     tables = "".join("\n[[robot.joints]]\n" + ('position_offset = "-pi/2"\n' if j == 1 else "") for j in range(6))
@@ -121,24 +137,16 @@ def test_a_joint_counted_the_other_way_round_is_named_and_its_setting_clears_it(
     axis), alone or with its torque (a drive whose whole convention is reversed): dynid fitted 4.4 % or 5.5 % (0.19 %
     with the right sign) and said "model ready". The verdict names J2 and the positions' sign, with the torque's where
     it runs the other way too; with those signs in the config the finding is gone and the fit is at the noise."""
-    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
-    folder = tmp_path / "try"
-    columns = ["shoulder_lift_joint_position"] + (["shoulder_lift_joint_effort"] if torque_too else [])
-    for name in ("identification.csv", "validation.csv"):
-        header = (folder / name).read_text().splitlines()[0]
-        data = np.loadtxt(folder / name, delimiter=",", skiprows=1)
-        for column in columns:
-            data[:, header.split(",").index(column)] *= -1
-        np.savetxt(folder / name, data, delimiter=",", header=header, comments="", fmt="%.10g")
-    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
-    assert p.returncode == 0, p.stderr
-    said = " ".join((p.stdout + p.stderr).split())
+    def reversed_(data, header):
+        for column in ["shoulder_lift_joint_position"] + (["shoulder_lift_joint_effort"] if torque_too else []):
+            data[:, header.index(column)] *= -1
+
+    folder = _example(tmp_path, reversed_)
+    said, results, finding = _identified_with_angles(folder, tmp_path / "out")
     assert "not ready: the logged angles do not match the robot file" in said
-    results = json.loads((tmp_path / "out" / "results.json").read_text())
-    (finding,) = [f for f in results["findings"] if f["kind"] == "angles"]
-    assert "the logged angles of J2 counted the other way round" in finding["text"]
-    assert "positions = { ..., sign = [1, -1, 1, 1, 1, 1] }" in finding["text"]
-    assert ("torques = { ..., sign = [1, -1, 1, 1, 1, 1] }" in finding["text"]) is torque_too
+    assert "the logged angles of J2 counted the other way round" in finding
+    assert "positions = { ..., sign = [1, -1, 1, 1, 1, 1] }" in finding
+    assert ("torques = { ..., sign = [1, -1, 1, 1, 1, 1] }" in finding) is torque_too
     assert "validation" not in [v["name"] for v in results["validation"] if v.get("misread")]  # recorded alike
     text = (folder / "ur10e.toml").read_text()
     for signal in ("position", "effort") if torque_too else ("position",):
