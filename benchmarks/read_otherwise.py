@@ -8,9 +8,9 @@ swapped. A flipped joint must be named as flipped, a swapped pair as swapped (na
 at all. A flip or a swap the fitted estimate cannot tell (a joint whose torque does not vary on that log beyond its
 noise floor, or that the estimate does not fit on the identification log) is counted as "not judged", not as a miss.
 
-From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/read_otherwise.py`` (about a
-minute). The 36 short windows of ``benchmarks/short_windows.py`` as configured are checked by
-``--windows`` (about two minutes): none of their validation logs may be named.
+From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/read_otherwise.py``. The 36
+short windows of ``benchmarks/short_windows.py`` as configured are checked by ``--windows``: none of their validation
+logs may be named.
 """
 
 from __future__ import annotations
