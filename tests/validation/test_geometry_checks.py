@@ -283,5 +283,7 @@ def test_a_validation_log_recorded_with_another_zero_is_said(tmp_path):
     assert [v.get("misread", "") != "" for v in results["validation"]] == [True]
     assert "not ready: validation is read otherwise than the identification log" in said
     assert results["readiness"].startswith("not ready: validation is read otherwise")  # the report's box says it too
-    assert results["readiness"] in (tmp_path / "out" / "report.html").read_text()
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert results["readiness"] in report
+    assert "validation: read otherwise than the identification log (Findings and warnings say how)" in report
     assert [f for f in right["findings"] if f["kind"] == "misread"] == [] and "misread" not in right["validation"][0]

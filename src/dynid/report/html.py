@@ -257,6 +257,8 @@ def _identify_summary(d: dict) -> list[str]:
                               not fit and rests_throughout(c.get("rest_share")),
                               float("nan") if floor is None else float(floor), fit, tuple(c.get("dead_channels") or ())))
     out += [f"{line}." for line in log_summaries(logs)]
+    out += [f"{c['name']}: read otherwise than the identification log (Findings and warnings say how): its figures say "
+            "little of any estimate, and the verdict does not weigh them." for c in d.get("validation", []) if c.get("misread")]
     for k, why in (d.get("drive_gains") or {}).get("not_observable", {}).items():
         out.append(f"{k} not determined: {why}.")
     findings = d.get("findings") or []
