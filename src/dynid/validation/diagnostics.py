@@ -53,9 +53,10 @@ class Finding:
         "sign", "scale", "order", "friction", "position", "correlated", "excitation", "extrapolation", "validation",
         "delay", "main" (the verdict's choice), "drive" (a drive term no drive has:
         :mod:`dynid.identification.plausibility`), "angles" (logged angles that do not match the robot file, a zero a
-        quarter or half turn off or two columns swapped) and "gravity" (gravity along another axis of the base:
-        :mod:`dynid.validation.geometry_checks`), "filtered" (torques without measurable noise:
-        :func:`dynid.validation.noise_floor.looks_filtered`).
+        quarter or half turn off, a joint counted the other way round or two columns swapped) and "gravity" (gravity
+        along another axis of the base: :mod:`dynid.validation.geometry_checks`), "misread" (a validation log the verdict
+        leaves out, read otherwise than the identification log: :mod:`dynid.validation.channel_checks`), "filtered"
+        (torques without measurable noise: :func:`dynid.validation.noise_floor.looks_filtered`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None

@@ -193,8 +193,8 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 
 def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bool = True
                       ) -> tuple[list[Finding], dict]:
-    """A joint's zero a quarter or half turn from the robot file's, two joints' columns swapped, or gravity along
-    another axis of the base (module docstring).
+    """A joint's zero a quarter or half turn from the robot file's, a joint counted the other way round, two joints'
+    columns swapped, or gravity along another axis of the base (module docstring).
 
     Parameters
     ----------
@@ -214,11 +214,13 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     Returns
     -------
     findings : list of Finding
-        One "angles" finding (a zero or a swap) or "gravity" finding naming the change and the setting, or none.
+        One "angles" finding (a zero, a reversal or a swap) or "gravity" finding naming the change and the setting
+        (and a twin the log cannot tell from it), or none.
     stats : dict
         ``unexplained`` (the share left with the log and the description as they are), ``nominal_variation`` (how much
         of the torque beyond the nuisance columns the nominal model varies: :data:`MOVED`) and, where the search ran,
-        the closest change's ``shift`` [rad], ``order``, ``gravity`` [m/s²] and ``unexplained_changed``.
+        the closest change's ``shift`` [rad], ``order``, ``gravity`` [m/s²], ``direction`` (±1 per joint) and
+        ``unexplained_changed``, and its ``twin`` (the same keys) where there is one (:func:`_tie_break`).
     """
     raw = (q, dq, ddq, tau)
     q, dq, ddq, tau = (_spread(x) for x in raw)
@@ -244,20 +246,20 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     single = (np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1)
               + np.count_nonzero(ways < 0, axis=1) + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
-    pick, twin = _tie_break(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), scores, logged,
-                            two if scores[two] < SIMPLER * scores[one] else one, single)
+    log, changes = (q, dq, ddq, tau), (shifts, orders, gravities, ways)
+    pick, twin = _tie_break(robot, log, changes, scores, logged, two if scores[two] < SIMPLER * scores[one] else one,
+                            single)
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
                  direction=ways[pick].tolist(), unexplained_changed=float(scores[pick]))
     if twin is not None:
         stats["twin"] = {"shift": shifts[twin].tolist(), "order": orders[twin].tolist(),
                          "gravity": gravities[twin].tolist(), "direction": ways[twin].tolist()}
-    if scores[pick] > CHANGE_GAIN * logged or not _replicated(robot, raw, (shifts, orders, gravities, ways), pick):
+    if scores[pick] > CHANGE_GAIN * logged or not _replicated(robot, raw, changes, pick):
         return [], stats
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
              f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as it is")
-    kind, text, joint = _text_of(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), pick)
-    what = text[0] if twin is None else (f"{text[0]} (as well on this arm: "
-                                         f"{_text_of(robot, (q, dq, ddq, tau), (shifts, orders, gravities, ways), twin)[1][0]})")
+    kind, text, joint = _text_of(robot, log, changes, pick)
+    what = text[0] if twin is None else f"{text[0]} (as well on this arm: {_text_of(robot, log, changes, twin)[1][0]})"
     fix = (f"{text[1]}, and identify again" if fitted else "Was this log recorded with other zeros, another column "
            "order or another mounting than the identification log? Its scores say little until it is read as that one")
     return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {what}: "
