@@ -170,6 +170,32 @@ def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
     return None
 
 
+def named_out_of_order(columns, joints: tuple[str, ...]) -> list[int] | None:
+    """The robot's joint each of a signal's configured columns names, where they name every joint once but not in the
+    robot's order (``elbow_joint_position, shoulder_lift_joint_position, shoulder_pan_joint_position, ...``: a ROS
+    driver's alphabetical JointState order); else None.
+
+    Parameters
+    ----------
+    columns : sequence of str or int
+        A signal's columns as configured, one per joint (numbers name no joint: None).
+    joints : tuple of str
+        The description's joint names, in the chain's order.
+
+    Returns
+    -------
+    list of int or None
+        The 0-based joint each column names, in the columns' order.
+    """
+    if len(columns) != len(joints) or not all(isinstance(c, str) for c in columns):
+        return None
+    hits = [_named_joint(c, joints) for c in columns]
+    order = [hit[1] for hit in hits if hit is not None]
+    if len(order) != len(joints) or sorted(order) != list(range(len(joints))) or order == sorted(order):
+        return None
+    return order
+
+
 def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str],
                     joints: tuple[str, ...]) -> list[str]:
     """Where the log names its joints in columns of their own (``rostopic echo -p``'s ``field.name0``…, a JointState's

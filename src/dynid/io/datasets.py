@@ -16,7 +16,7 @@ from .._util.reprs import short_repr
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..model.loading import as_robot
 from ..model.robot import Robot
-from .columns import csv_table
+from .columns import csv_table, named_out_of_order
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .log_repairs import (
     AUTO_GAP_SAMPLES,
@@ -164,6 +164,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     elif rate is not None:
         raise ConfigError(f"load_recording: rate is for a log given by its path; the dataset {spec.name!r} states its "
                           "own (its rate or time column)", field="rate")
+    _check_named_order(spec, robot)
     warnings: list[str] = []
     if spec.bag is not None:
         from .bags import read_joint_states
@@ -220,6 +221,22 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     tau_kind = "currents" if "currents" in spec.signals else "torques"
     return _assemble(spec, robot, t, raw, where, timed=spec.time is not None, q_source=str(spec.signals["positions"].file),
                      tau_source=str(spec.signals[tau_kind].file), warnings=warnings)
+
+
+def _check_named_order(spec: DatasetSpec, robot: Robot) -> None:
+    """Refuse a signal whose columns name the description's joints in another order than its chain's
+    (:func:`dynid.io.columns.named_out_of_order`): read as listed, every joint would get another joint's signal."""
+    joints = tuple(j.name for j in robot.joints)
+    for kind, signal in spec.signals.items():
+        order = named_out_of_order(signal.columns, joints)
+        if order is None:
+            continue
+        listed = ", ".join(f"{c} is J{j + 1}'s" for k, (c, j) in enumerate(zip(signal.columns, order)) if j != k)
+        right = ", ".join(f'"{signal.columns[order.index(j)]}"' for j in range(len(joints)))
+        raise ConfigError(f"{spec.table or spec.name}: the {kind}' columns name the robot description's joints in another "
+                          f"order than its chain's ({listed}): each joint would be given another's signal; "
+                          f"list them in the chain's order, {kind} = {{ columns = [{right}] }} (column numbers are "
+                          "taken as listed)", field=f"{kind}.columns")
 
 
 def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bool, q_source: str, tau_source: str,
