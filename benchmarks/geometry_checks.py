@@ -6,8 +6,8 @@ Cases, each prepared as ``dynid identify`` prepares it (its config's preprocessi
   ``benchmarks/short_windows.py`` (``--alone`` and ``--fresh``'s): nothing must be named;
 - the TX40's log without the built-in description's offsets (-π/2 on J2, +π/2 on J3, which FIGAROH applies);
 - quarter and half turns put on J2, J3 and J4 of the UR10e's and J2, J3, J4 and J6 of the LBR Med7's logs (through
-  ``position_offset``), and four pairs of the Med7's position columns swapped: each must be named as its inverse,
-  where it changes the torque;
+  ``position_offset``), four pairs of the Med7's position columns swapped, and five pairs of its joints' position and
+  torque columns both swapped: each must be named as its inverse, where it changes the torque;
 - the UR10e's and the Med7's logs read with a description whose gravity is along +x or -y (a wall): each must be
   named as the floor's gravity; along +z (a ceiling) it only flips the gravity torques, which the sign check names;
 - J2, J3, J4 and J6 of the Med7 counted the other way round (its positions' sign, and its positions' and its torque's):
@@ -73,7 +73,8 @@ def _row(label: str, config, expected: str) -> bool:
 
 
 def _change(stats: dict) -> str:
-    """The change a search's statistics hold, as "J2 -90°", "J2<->J3" or "J2 reversed"."""
+    """The change a search's statistics hold, as "J2 -90°", "J2<->J3" (positions), "J2<->J3 with torques" or "J2
+    reversed"."""
     shift, order = np.asarray(stats["shift"]), np.asarray(stats["order"])
     turned = [f"J{j + 1} {np.degrees(shift[j]):+.0f}°" for j in np.flatnonzero(shift)]
     swapped = [j for j in range(order.size) if order[j] != j]
@@ -81,7 +82,9 @@ def _change(stats: dict) -> str:
     gravity = "gravity [" + ", ".join(f"{x:g}" for x in stats["gravity"]) + "]"
     if turned or reversed_:
         return " ".join(turned + reversed_)
-    return f"J{swapped[0] + 1}<->J{swapped[1] + 1}" if swapped else gravity
+    if swapped:
+        return f"J{swapped[0] + 1}<->J{swapped[1] + 1}" + (" with torques" if stats.get("channels") else "")
+    return gravity
 
 
 def _inverse(j: int, turn: str) -> str:
@@ -149,6 +152,15 @@ def main() -> int:
         text = med7_text.replace(", ".join(f'"{c}"' for c in columns), ", ".join(f'"{c}"' for c in swapped), 1)
         ok.append(_row(f"kuka_med7 J{a + 1} and J{b + 1} columns swapped", _config(folder / f"med7-swap-{a}{b}.toml", text, configs),
                        f"J{a + 1}<->J{b + 1}"))
+    for a, b in ((0, 1), (0, 2), (1, 2), (1, 3), (3, 5)):  # a joint's positions and torque in another's place
+        text = med7_text
+        for kind in ("q", "tau"):
+            names = [f"{kind}_{k}" for k in range(7)]
+            swapped = names.copy()
+            swapped[a], swapped[b] = swapped[b], swapped[a]
+            text = text.replace(", ".join(f'"{c}"' for c in names), ", ".join(f'"{c}"' for c in swapped))
+        ok.append(_row(f"kuka_med7 J{a + 1} and J{b + 1} positions and torques swapped",
+                       _config(folder / f"med7-channels-{a}{b}.toml", text, configs), f"J{a + 1}<->J{b + 1} with torques"))
     positions = 'positions = { columns = ["q_0", "q_1", "q_2", "q_3", "q_4", "q_5", "q_6"] }'
     torques = 'torques = { columns = ["tau_0", "tau_1", "tau_2", "tau_3", "tau_4", "tau_5", "tau_6"], sign = -1'
     for j in (1, 2, 3, 5):  # a joint counted the other way round: its positions, or its positions and torque

@@ -13,9 +13,9 @@ the nominal model does not hold (the joint's direction of motion, velocity and a
 sin/cos of its angle and twice its angle where it has a counterbalance: friction, rotor inertia, an offset and a
 counterbalance, whatever their size). What the nominal torque leaves unexplained of what the nuisance columns leave,
 summed over the joints, is compared for the logged angles and for the logged angles with one or two joints turned by
-±π/2 or π, two joints' columns swapped (their nuisance columns swapped too; every figure over what the logged
-angles' nuisance columns leave, so that all are on one scale), one joint's states negated, or gravity along each axis
-of the base either way.
+±π/2 or π, two joints' position columns swapped (their nuisance columns swapped too; every figure over what the logged
+angles' nuisance columns leave, so that all are on one scale), their position and torque columns swapped (a driver's
+alphabetical joint order), one joint's states negated, or gravity along each axis of the base either way.
 A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
 (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
@@ -36,10 +36,11 @@ CANDIDATE_TURNS = (0.5 * np.pi, -0.5 * np.pi, np.pi)
 """The offsets tried on each joint [rad]: zeros that differ by a quarter or a half turn (other conventions, a joint
 mounted the other way round)."""
 
-UNEXPLAINED_FROM = 0.1
+UNEXPLAINED_FROM = 0.05
 """The search runs where the nominal model leaves at least this share of the torque beyond the nuisance columns
-unexplained (the right angles leave 0.2-0.4 % on the UR10e's and the LBR Med7's real logs, 41 % and 55 % on the
-TX40's and the KR 300's, whose nominal values are rough guesses)."""
+unexplained (the right angles leave 0.2-0.4 % on the UR10e's and the LBR Med7's real logs, up to 8.8 % on windows of
+3-6 s of the UR10e's, 41 % and 55 % on the TX40's and the KR 300's, whose nominal values are rough guesses; the
+Med7's J1 and J3 positions and torques swapped leave 6.7 %: its J1 and J3 carry no gravity torque)."""
 
 MOVED = 0.01
 """The search runs where the nominal model's torque, as logged, varies beyond the nuisance columns by at least this
@@ -66,8 +67,8 @@ SAMPLES = (100, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
 
 
-def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, directions=None, *,
-                      signed: bool = False) -> np.ndarray:
+def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, directions=None,
+                      channels=None, *, signed: bool = False) -> np.ndarray:
     """What each change of the logged angles leaves of the torque, as a share of what the nuisance columns of the
     logged angles leave (module docstring).
 
@@ -89,6 +90,9 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravit
     directions : (S, n_dof) array of ±1, optional
         For each change, the factor each joint's logged states are read with: -1 for a joint counted the other way
         round (its encoder's axis opposite to the robot file's); 1 by default.
+    channels : (S,) bool array, optional
+        For each change, whether the torque columns are read in ``orders`` too (a joint's whole channels swapped with
+        another's, a driver's alphabetical joint order); the states alone by default.
     signed : bool
         Count a joint's nominal torque as explaining nothing where it runs against the measured torque (a negative
         slope): tells apart two changes a half turn apart on a joint whose torques that half turn only flips.
@@ -106,13 +110,15 @@ def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravit
     gravities = (np.tile(np.asarray(robot.gravity, dtype=float), (len(shifts), 1)) if gravities is None
                  else np.asarray(gravities, dtype=float))
     directions = np.ones((len(shifts), n)) if directions is None else np.asarray(directions, dtype=float)
+    channels = np.zeros(len(shifts), dtype=bool) if channels is None else np.asarray(channels, dtype=bool)
     reference = _sums(robot, q, dq, ddq, tau, None)[0]
     out = np.empty(len(shifts))
-    for i, (shift, order, gravity, way) in enumerate(zip(shifts, orders, gravities, directions)):
+    for i, (shift, order, gravity, way, channel) in enumerate(zip(shifts, orders, gravities, directions, channels)):
         qi, dqi, ddqi = way * (q + shift)[:, order], way * dq[:, order], way * ddq[:, order]
+        taui = tau[:, order] if channel else tau
         mounted = robot if np.array_equal(gravity, robot.gravity) else replace(robot, gravity=gravity)
         # a joint counted the other way round may have its torque reversed with it: its slope's sign is free
-        left = _sums(robot, qi, dqi, ddqi, tau, nominal_rigid_torque(mounted, qi, dqi, ddqi), signed=signed,
+        left = _sums(robot, qi, dqi, ddqi, taui, nominal_rigid_torque(mounted, qi, dqi, ddqi), signed=signed,
                      free=set(np.flatnonzero(way < 0).tolist()))[0]
         out[i] = left / reference if reference > 0 else 0.0
     return out
@@ -140,10 +146,10 @@ def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False, free:
     return left, variation
 
 
-def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """No change; every joint and every pair of joints turned by each of :data:`CANDIDATE_TURNS`; every pair of joints'
-    columns swapped; every joint counted the other way round; gravity along each axis of the base either way (those
-    other than the description's).
+    position columns swapped, and their position and torque columns swapped; every joint counted the other way round;
+    gravity along each axis of the base either way (those other than the description's).
 
     Parameters
     ----------
@@ -152,12 +158,14 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
     Returns
     -------
     shifts : (S, n_dof) ndarray [rad]
-        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) / 2 + n + the gravities.
+        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) + n + the gravities.
     orders : (S, n_dof) int ndarray
         The logged column each joint is read from.
     gravities : (S, 3) ndarray [m/s²]
     directions : (S, n_dof) ndarray of ±1
         The factor each joint's logged states are read with.
+    channels : (S,) bool ndarray
+        Whether the torque columns are read in ``orders`` too.
     """
     n, g = robot.n_dof, np.asarray(robot.gravity, dtype=float)
     identity = np.arange(n)
@@ -169,11 +177,13 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                 row[list(joints)] = turns
                 shifts.append(row)
                 orders.append(identity)
-    for a, b in itertools.combinations(range(n), 2):
+    channels = [False] * len(shifts)
+    for channel, (a, b) in itertools.product((False, True), itertools.combinations(range(n), 2)):
         order = identity.copy()
         order[[a, b]] = b, a
         shifts.append(np.zeros(n))
         orders.append(order)
+        channels.append(channel)
     directions = [np.ones(n)] * len(shifts)
     for j in range(n):
         shifts.append(np.zeros(n))
@@ -188,7 +198,8 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
             orders.append(identity)
             gravities.append(other)
             directions.append(np.ones(n))
-    return np.array(shifts), np.array(orders), np.array(gravities), np.array(directions)
+    channels += [False] * (len(shifts) - len(channels))
+    return np.array(shifts), np.array(orders), np.array(gravities), np.array(directions), np.array(channels)
 
 
 def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bool = True
@@ -219,8 +230,8 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     stats : dict
         ``unexplained`` (the share left with the log and the description as they are), ``nominal_variation`` (how much
         of the torque beyond the nuisance columns the nominal model varies: :data:`MOVED`) and, where the search ran,
-        the closest change's ``shift`` [rad], ``order``, ``gravity`` [m/s²], ``direction`` (±1 per joint) and
-        ``unexplained_changed``, and its ``twin`` (the same keys) where there is one (:func:`_tie_break`).
+        the closest change's ``shift`` [rad], ``order``, ``gravity`` [m/s²], ``direction`` (±1 per joint),
+        ``channels`` (the torque columns in ``order`` too) and ``unexplained_changed``, and its ``twin`` (the same keys) where there is one (:func:`_tie_break`).
     """
     raw = (q, dq, ddq, tau)
     q, dq, ddq, tau = (_spread(x) for x in raw)
@@ -230,30 +241,29 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     stats: dict = {"unexplained": logged, "nominal_variation": variation / reference if reference > 0 else 0.0}
     if logged < UNEXPLAINED_FROM or stats["nominal_variation"] < MOVED:
         return [], stats
-    shifts, orders, gravities, ways = (x[1:] for x in candidate_changes(robot))
+    log, changes = (q, dq, ddq, tau), tuple(x[1:] for x in candidate_changes(robot))
+    shifts, orders, gravities, ways, channels = changes
     # two joints turned only among the joints whose own turns explain most: the pairs are most of the candidates
     paired = np.count_nonzero(shifts, axis=1) == 2
     scores = np.full(len(shifts), np.inf)
-    scores[~paired] = unexplained_share(robot, q, dq, ddq, tau, shifts[~paired], orders[~paired], gravities[~paired],
-                                        ways[~paired])
+    scores[~paired] = _scored(robot, log, changes, ~paired)
     turned = (np.count_nonzero(shifts, axis=1) == 1) & ~paired
     best_turn = [scores[turned & (shifts[:, j] != 0)].min() for j in range(robot.n_dof)]
     top = np.argsort(best_turn, kind="stable")[:PAIRED_JOINTS]
     among = paired & np.all((shifts == 0) | np.isin(np.arange(robot.n_dof), top), axis=1)
-    scores[among] = unexplained_share(robot, q, dq, ddq, tau, shifts[among], orders[among], gravities[among],
-                                      ways[among])
+    scores[among] = _scored(robot, log, changes, among)
     # one change, unless two joints changed leave clearly less
     single = (np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1)
               + np.count_nonzero(ways < 0, axis=1) + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
-    log, changes = (q, dq, ddq, tau), (shifts, orders, gravities, ways)
     pick, twin = _tie_break(robot, log, changes, scores, logged, two if scores[two] < SIMPLER * scores[one] else one,
                             single)
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
-                 direction=ways[pick].tolist(), unexplained_changed=float(scores[pick]))
+                 direction=ways[pick].tolist(), channels=bool(channels[pick]), unexplained_changed=float(scores[pick]))
     if twin is not None:
         stats["twin"] = {"shift": shifts[twin].tolist(), "order": orders[twin].tolist(),
-                         "gravity": gravities[twin].tolist(), "direction": ways[twin].tolist()}
+                         "gravity": gravities[twin].tolist(), "direction": ways[twin].tolist(),
+                         "channels": bool(channels[twin])}
     if scores[pick] > CHANGE_GAIN * logged or not _replicated(robot, raw, changes, pick):
         return [], stats
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
@@ -273,12 +283,10 @@ def _replicated(robot: Robot, raw: tuple, changes: tuple, pick: int) -> bool:
     quarter turn off leaves 0.00-0.02 on any)."""
     if len(raw[0]) <= SAMPLES[0] * SAMPLES[1]:
         return True  # the search read every sample
-    q, dq, ddq, tau = (_spread(x, 0.5) for x in raw)
-    shifts, orders, gravities, ways = changes
     n = robot.n_dof
-    left = unexplained_share(robot, q, dq, ddq, tau, np.stack([np.zeros(n), shifts[pick]]),
-                             np.stack([np.arange(n), orders[pick]]), np.stack([robot.gravity, gravities[pick]]),
-                             np.stack([np.ones(n), ways[pick]]))
+    unchanged = (np.zeros(n), np.arange(n), np.asarray(robot.gravity, dtype=float), np.ones(n), False)
+    left = unexplained_share(robot, *(_spread(x, 0.5) for x in raw),
+                             *(np.stack([a, x[pick]]) for a, x in zip(unchanged, changes)))
     return bool(left[1] <= CHANGE_GAIN * left[0])
 
 
@@ -293,11 +301,8 @@ def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, log
     twins = np.flatnonzero((scores <= scores[pick] + 0.05 * (logged - scores[pick]) + 1e-12) & (single == single[pick]))
     if len(twins) < 2:
         return pick, None
-    shifts, orders, gravities, ways = changes
-    q, dq, ddq, tau = log
-    signed = unexplained_share(robot, q, dq, ddq, tau, shifts[twins], orders[twins], gravities[twins], ways[twins],
-                               signed=True)
-    reversal = np.any(ways[twins] < 0, axis=1)
+    signed = _scored(robot, log, changes, twins, signed=True)
+    reversal = np.any(changes[3][twins] < 0, axis=1)
     tied = [k for k in range(len(twins)) if signed[k] <= TWIN * signed.min() + 1e-12]
     best = min(tied, key=lambda k: (bool(reversal[k]), float(signed[k])))  # a turn before a reversal as good
     other = [k for k in tied if reversal[k] != reversal[best]]
@@ -306,14 +311,20 @@ def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, log
 
 def _text_of(robot: Robot, log: tuple, changes: tuple, k: int) -> tuple[str, tuple, int | None]:
     """:func:`_change_text` or :func:`_reversed_text` of change ``k``."""
-    shifts, orders, gravities, ways = changes
+    shifts, orders, gravities, ways, channels = changes
     if np.any(ways[k] < 0):
         q, dq, ddq, tau = log
         return _reversed_text(robot, q, dq, ddq, tau, ways[k])
-    return _change_text(robot, shifts[k], orders[k], gravities[k])
+    return _change_text(robot, shifts[k], orders[k], gravities[k], bool(channels[k]))
 
 
-def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray
+def _scored(robot: Robot, log: tuple, changes: tuple, which, *, signed: bool = False) -> np.ndarray:
+    """:func:`unexplained_share` of the changes ``which`` (a mask or indices) of ``changes``
+    (:func:`candidate_changes`' arrays) on ``log`` (q, dq, ddq, tau)."""
+    return unexplained_share(robot, *log, *(x[which] for x in changes), signed=signed)
+
+
+def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray, channels: bool = False
                  ) -> tuple[str, tuple, int | None]:
     """The finding's kind, (what was changed, the question and the setting that fixes it), and its joint."""
     if shift.any():
@@ -326,9 +337,14 @@ def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np
                           "with one [[robot.joints]] table per joint)"), int(turned[0])
     swapped = np.flatnonzero(order != np.arange(robot.n_dof))
     if swapped.size:
-        pair = " and ".join(f"J{j + 1}" for j in swapped)
+        pair, own = (" and ".join(f"J{j + 1}{mark}" for j in swapped) for mark in ("", "'s"))
+        if channels:
+            return "angles", (f"the columns of {pair} swapped, positions and torques alike",
+                              "Are the columns in the order of the robot's joints (a ROS driver may publish its joint "
+                              f"states in alphabetical order)? If not, swap {own} in every signal's columns = [...] "
+                              "(positions, torques or currents, velocities) of every dataset"), int(swapped[0])
         return "angles", (f"the logged angles of {pair} swapped",
-                          f"Are the positions' columns in the order of the robot's joints? If not, swap {pair}'s in "
+                          f"Are the positions' columns in the order of the robot's joints? If not, swap {own} in "
                           "positions = { columns = [...] } (and velocities', if given) of every dataset"), int(swapped[0])
     axis = int(np.argmax(np.abs(gravity)))
     vector = "[" + ", ".join(f"{x:g}" for x in gravity) + "]"
