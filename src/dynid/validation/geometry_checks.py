@@ -284,7 +284,7 @@ def _replicated(robot: Robot, raw: tuple, changes: tuple, pick: int) -> bool:
     if len(raw[0]) <= SAMPLES[0] * SAMPLES[1]:
         return True  # the search read every sample
     n = robot.n_dof
-    unchanged = (np.zeros(n), np.arange(n), np.asarray(robot.gravity, dtype=float), np.ones(n), False)
+    unchanged = (np.zeros(n), np.arange(n), np.asarray(robot.gravity, dtype=float), np.ones(n), np.array(False))
     left = unexplained_share(robot, *(_spread(x, 0.5) for x in raw),
                              *(np.stack([a, x[pick]]) for a, x in zip(unchanged, changes)))
     return bool(left[1] <= CHANGE_GAIN * left[0])
