@@ -201,3 +201,50 @@ def test_another_separator_is_named_with_the_setting_that_reads_it(tmp_path, rea
     with pytest.raises(DataError, match=re.escape(f"no column named 't' in the header {found}{hint}")):
         read_table(named, ["t", "a"], header=True)
     np.testing.assert_array_equal(read_table(p, [1, 2, 3], delimiter=tomllib.loads(setting)["delimiter"]).data, rows)
+
+
+def test_iso_date_times_in_a_stamps_column_are_posix_seconds_and_nowhere_else(tmp_path):
+    """A logger's ISO 8601 time stamps (with or without a zone, 'T' or a space) in the time column read as POSIX
+    seconds, as datetime counts them (UTC where no zone is named); the same text in another column is still refused,
+    naming the line and column."""
+    import datetime
+
+    stamps = ["2026-11-28T01:02:03.250", "2026-11-28 01:02:03.254", "2026-11-28T02:02:03.258+01:00",
+              "2026-11-28T01:02:03.262Z"]
+    p = _write(tmp_path, "time,q\n" + "".join(f"{s},{k}\n" for k, s in enumerate(stamps)))
+    tb = read_table(p, ["time", "q"], header=True, stamps=["time"])
+    start = datetime.datetime(2026, 11, 28, 1, 2, 3, 250000, tzinfo=datetime.UTC).timestamp()
+    np.testing.assert_allclose(tb.data[:, 0] - start, [0.0, 0.004, 0.008, 0.012], atol=1e-6)
+    np.testing.assert_array_equal(tb.data[:, 1], [0, 1, 2, 3])
+    with pytest.raises(DataError, match=re.escape(f"{p}: line 2, column 1: expected a number, got '{stamps[0]}'")):
+        read_table(p, ["time", "q"], header=True)
+
+
+@pytest.mark.parametrize("stamps", ["iso", "posix"])
+def test_a_log_with_iso_or_posix_time_stamps_identifies_as_the_same_log_in_seconds(tmp_path, stamps):
+    """``dynid example ur10e``'s identification log with its time column written as ISO date-times, or as POSIX seconds
+    to 17 digits: the first was refused ("expected a number"); the second was resampled, its stamps' last digits
+    (0.24 µs) taken for jitter, which moved the fit's figure by 5 %. Both now give the fit of the log in seconds."""
+    import datetime
+    import json
+
+    from ..cli.refusals import dynid
+
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    folder = tmp_path / "try"
+    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "seconds", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    lines = (folder / "identification.csv").read_text().splitlines()
+    start = datetime.datetime(2026, 11, 28, 1, 2, 3, tzinfo=datetime.UTC)
+
+    def stamp(seconds: float) -> str:
+        return ((start + datetime.timedelta(seconds=seconds)).isoformat() if stamps == "iso"
+                else f"{start.timestamp() + seconds:.17g}")
+
+    dated = [lines[0]] + [",".join([stamp(float(line.split(",")[0])), *line.split(",")[1:]]) for line in lines[1:]]
+    (folder / "identification.csv").write_text("\n".join(dated) + "\n")
+    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "dated", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    error = [json.loads((tmp_path / out / "results.json").read_text())["identification"]["metrics"]["dynid WLS"]
+             ["global_relative_error"] for out in ("seconds", "dated")]
+    assert error[1] == pytest.approx(error[0], rel=1e-4)

@@ -157,7 +157,7 @@ def resolve_columns(path: Path, columns, header: list[str] | None, delimiter: st
 
 def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
                n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False,
-               missing: bool = False) -> Table:
+               missing: bool = False, stamps=()) -> Table:
     """Read numeric columns from a delimited text file.
 
     Parameters
@@ -177,6 +177,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         them: a long log's memory is then one block, whatever its length.
     missing : bool
         Read an empty field or NaN as NaN (a missing value, for the caller to fill or refuse) instead of refusing it.
+    stamps : sequence of int or str
+        Columns of ``columns`` that may hold ISO 8601 dates and times (``2026-11-28T01:02:03.250``, a logger's time
+        stamps), read as POSIX seconds (UTC where the stamp names no zone).
 
     Returns
     -------
@@ -216,6 +219,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                 raise DataError(f"{path}: empty file, expected a header line")
             names = _split_header(head, delimiter)
         cols = resolve_columns(path, columns, names, delimiter)
+        dated = {cols[list(columns).index(c)] for c in stamps}
         pending: list[str] = []
         pending_start = None
         data_row = 0
@@ -223,7 +227,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         def flush():
             nonlocal files
             if pending:
-                block = _parse_block(path, pending, pending_start, cols, delimiter, missing)
+                block = _parse_block(path, pending, pending_start, cols, delimiter, missing, dated)
                 pending.clear()
                 if not spool:
                     blocks.append(block)
@@ -384,8 +388,19 @@ _DECIMAL_COMMA = re.compile(r"[+-]?\d*,\d+([eE][+-]?\d+)?")
 """A number written with a decimal comma (a spreadsheet's export in a European locale): ``-0,0131``."""
 
 
+def _posix_seconds(text: str) -> float | None:
+    """An ISO 8601 date and time as POSIX seconds (UTC where it names no zone), or None if it is not one."""
+    import datetime
+
+    try:
+        stamp = datetime.datetime.fromisoformat(text)
+    except ValueError:
+        return None
+    return (stamp if stamp.tzinfo is not None else stamp.replace(tzinfo=datetime.UTC)).timestamp()
+
+
 def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str,
-                 missing: bool = False) -> np.ndarray:
+                 missing: bool = False, dated: set[int] | frozenset = frozenset()) -> np.ndarray:
     try:
         block = np.loadtxt(lines, delimiter=delimiter, usecols=cols, ndmin=2, dtype=np.float64, comments=None)
     except ValueError:
@@ -397,6 +412,9 @@ def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], deli
                 try:
                     block[k, i] = np.nan if missing and not text else float(text)
                 except ValueError:
+                    if c in dated and (seconds := _posix_seconds(text)) is not None:
+                        block[k, i] = seconds
+                        continue
                     comma = _DECIMAL_COMMA.fullmatch(text) is not None
                     raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {text!r}"
                                     + (" (a decimal comma? dynid reads a decimal point: save the log with '.' as the "
