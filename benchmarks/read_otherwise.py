@@ -3,9 +3,10 @@ check on validation logs), on real logs: what is named, and that the logs as rec
 
 Each real config (``configs/ur10e.toml``, ``tx40.toml``, ``kuka_kr300.toml``, ``kuka_med7.toml``) is identified with its
 settings; then each of its validation logs whose torques vary is scored again (``run_validation``, as ``dynid validate``
-does) as recorded, with each joint's torque negated in turn, and with each pair of neighbouring joints' torque columns
-swapped. A flipped joint must be named as flipped, a swapped pair as swapped (naming the pair), the log as recorded not
-at all. A flip or a swap the fitted estimate cannot tell (a joint whose torque does not vary on that log beyond its
+does) as recorded, with each joint's torque negated in turn, with each pair of neighbouring joints' torque columns
+swapped, with every joint's torque times 0.1 and 1000 (another unit or drive gain), and with J2's times 1000 (N·mm). A
+flipped joint must be named as flipped, a swapped pair as swapped (naming the pair), a scale as a scale, the log as
+recorded not at all. A flip or a swap the fitted estimate cannot tell (a joint whose torque does not vary on that log beyond its
 noise floor, or that the estimate does not fit on the identification log) is counted as "not judged", not as a miss.
 
 From the repository root, with the shared data beside it: ``.venv/bin/python benchmarks/read_otherwise.py``. The 36
@@ -76,6 +77,8 @@ def real() -> int:
                        for j in range(n)]
             changes += [(f"J{j + 1}, J{j + 2} swapped", f"J{j + 1}'s and J{j + 2}'s measured torques fit each other's",
                          tau[:, [*range(j), j + 1, j, *range(j + 2, n)]]) for j in range(n - 1)]
+            changes += [(f"every joint ×{f:g}", "are that many times", tau * f) for f in (0.1, 1000.0)]
+            changes += [("J2 ×1000", "J2 (1e+03×)", tau * np.where(np.arange(n) == 1, 1000.0, 1.0))]
             for label, expected, changed in changes:
                 _, said = _case(config, identified, recording, changed, label)
                 said_right = expected in said

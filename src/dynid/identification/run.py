@@ -39,7 +39,7 @@ from ..runtime.threads import with_single_blas_thread
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
-from .verdict import choose_main_estimate, nominal_set, state_evidence
+from .verdict import NOMINAL_LABEL, choose_main_estimate, nominal_set, state_evidence
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -143,7 +143,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
                                  progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
-        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted)
+        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=NOMINAL_LABEL)
         if not found and geometry and yardstick is None and np.any(config.robot.inertial != 0):
             found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
         warnings.extend(f.text for f in found)

@@ -369,7 +369,7 @@ def readiness(result, *, library: bool = False) -> Line:
     misread = [v.name for v in r.validations if v.misread]
     if misread:
         return Line(f"not ready: {', '.join(misread)} {'is' if len(misread) == 1 else 'are'} read otherwise than the "
-                    "identification log (angles, mounting or torque channels), so the model has no fair test on other "
+                    "identification log (angles, mounting, torque channels or units), so the model has no fair test on other "
                     "motions: the warning says how to read it; then identify again", "warning")
     if getattr(r.estimates.get(getattr(r, "main", "")), "key", "") == NOMINAL_KEY:
         return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "

@@ -323,7 +323,7 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     median = float(np.median(k[judged]))
     if 1 / SCALE_LIMIT <= median <= SCALE_LIMIT:
         return _joint_scale_findings(k, judged, dataset, table, misfit)
-    fix = _inverse_text(median)
+    fix = scale_text(median)
     joints = ", ".join(f"J{j + 1}" for j in judged)
     per_joint = "" if gains is None else (
         f" (motor currents: about {', '.join(f'{gains[j] / k[j]:.3g}' for j in judged)} N·m/A on {joints} by the "
@@ -345,7 +345,7 @@ def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: 
     off = [j for j in outside if misfit is None or misfit[j]]
     if not off or len(judged) - len(outside) < 2:
         return []
-    fixes = ", ".join(_inverse_text(slope[j]) if j in off else "1" for j in range(slope.size))
+    fixes = ", ".join(scale_text(slope[j]) if j in off else "1" for j in range(slope.size))
     joints = ", ".join(f"J{j + 1} ({slope[j]:.3g}×)" for j in off)
     return [Finding("scale", f"{dataset}: the measured torques are far from the description's nominal model's on "
                              f"{joints}, where the other joints' agree with it (ρ ≥ {SCALE_SHAPE:g} beyond friction): "
@@ -354,8 +354,19 @@ def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: 
                              "those joints' drive_gain in the description", off[0])]
 
 
-def _inverse_text(slope: float) -> str:
-    """The scale that brings a slope to 1: a power of ten where the slope is one (to 0.1 decade), else 3 digits."""
+def scale_text(slope: float) -> str:
+    """The scale that brings a slope to 1: a power of ten where the slope is one (to 0.1 decade), else 3 digits.
+
+    Parameters
+    ----------
+    slope : float
+        A measured torque over a predicted one (> 0).
+
+    Returns
+    -------
+    str
+        ``"0.001"``, ``"10"``, ``"0.0855"``: the value of a ``scale`` setting.
+    """
     power = round(float(np.log10(slope)))
     return f"{10.0 ** -power:g}" if abs(np.log10(slope) - power) < 0.1 else f"{1 / slope:.3g}"
 
