@@ -160,7 +160,9 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
-                        f"positions in degrees ({_degrees_setting(np.flatnonzero(worst > 4 * np.pi), q.shape[1], degrees)})?")
+                        f"positions in degrees ({_degrees_setting(np.flatnonzero(worst > 4 * np.pi), q.shape[1], degrees)})? "
+                        "Or a motor's angle, before its gear (side = \"motor\" in the dataset's table, with the gear "
+                        "ratios in the robot description's [transmission] gear_ratios)?")
     return still, outside, fast
 
 
