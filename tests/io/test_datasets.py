@@ -205,7 +205,8 @@ def test_positions_in_degrees_are_refused_with_the_hint(tmp_path):
         load_recording(_log(tmp_path, t, q, np.ones((100, 6))), load_robot("ur10e"))
     q[:, :5] = 0.1  # the sixth joint alone in degrees: the unit would turn the others too
     with pytest.raises(DataError, match=r"joint 6 reaches 90 rad, .*unit = \"deg\" }; for this joint alone positions "
-                                        r"= \{ ..., scale = \[1, 1, 1, 1, 1, 0.0174533\] \}\)\?$"):
+                                        r"= \{ ..., scale = \[1, 1, 1, 1, 1, 0.0174533\] \}\)\? Or a motor's angle, before "
+                                        r"its gear \(side = \"motor\" in the dataset's table, .*\[transmission\] gear_ratios\)\?$"):
         load_recording(_log(tmp_path, t, q, np.ones((100, 6))), load_robot("ur10e"))
 
 
