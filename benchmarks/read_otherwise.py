@@ -78,7 +78,7 @@ def real() -> int:
             changes += [(f"J{j + 1}, J{j + 2} swapped", f"J{j + 1}'s and J{j + 2}'s measured torques fit each other's",
                          tau[:, [*range(j), j + 1, j, *range(j + 2, n)]]) for j in range(n - 1)]
             changes += [(f"every joint ×{f:g}", "are that many times", tau * f) for f in (0.1, 1000.0)]
-            changes += [("J2 ×1000", "J2 (1e+03×)", tau * np.where(np.arange(n) == 1, 1000.0, 1.0))]
+            changes += [("J2 ×1000", "the measured torques of J2 (", tau * np.where(np.arange(n) == 1, 1000.0, 1.0))]
             for label, expected, changed in changes:
                 _, said = _case(config, identified, recording, changed, label)
                 said_right = expected in said

@@ -39,7 +39,7 @@ from ..runtime.threads import with_single_blas_thread
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
-from .verdict import NOMINAL_LABEL, choose_main_estimate, nominal_set, state_evidence
+from .verdict import choose_main_estimate, nominal_set, state_evidence
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -80,7 +80,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
                   yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
-                  geometry: bool = True) -> tuple[tuple, tuple[str, ...]]:
+                  geometry: bool = True, nominal: str | None = None) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
     Parameters
@@ -106,10 +106,12 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
         (:func:`dynid.preprocessing.strategies.yardstick_settings`).
     fitted : (str, (n_dof,) array), optional
         The estimate fitted to the identification log and its correlation with each joint's torque there: a log
-        whose torque channels run against it or swapped is said (:mod:`dynid.validation.channel_checks`).
+        whose torque channels run against it, swapped or scaled is said (:mod:`dynid.validation.channel_checks`).
     geometry : bool
         Check each log's geometry against the robot file's: not where the identification log's does not match it
         either (its finding's setting is for every dataset, and the logs agree with each other).
+    nominal : str, optional
+        The description's nominal model among ``parameter_sets``: a log's scale is judged against it too.
 
     Returns
     -------
@@ -143,7 +145,7 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
                                  progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
-        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=NOMINAL_LABEL)
+        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=nominal)
         if not found and geometry and yardstick is None and np.any(config.robot.inertial != 0):
             found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
         warnings.extend(f.text for f in found)
@@ -227,7 +229,8 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
                                          resolved=prepared.data.settings, noise=result.joint_std,
                                          covariance={result.label: result.solution.covariance},
                                          fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
-                                         geometry=not any(f.kind in ("angles", "gravity") for f in result.findings))
+                                         geometry=not any(f.kind in ("angles", "gravity") for f in result.findings),
+                                         nominal=None if nominal is None else nominal[0])
     validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
     result = replace(result, validations=validations, warnings=result.warnings + warnings)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
@@ -440,9 +443,14 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     except (TypeError, ValueError):
         noise = None
     reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
-    comparisons, warnings = validate_sets(config, base, sets, datasets, progress=progress,
-                                          resolved=stored_preprocessing(identified), noise=noise, yardstick=reference,
-                                          fitted=_fitted_correlation(identified, sets, config.robot.n_dof))
+    label, beta = nominal_set(config.robot, base, refs) or (None, None)
+    beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
+    comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, datasets,
+                                          progress=progress, resolved=stored_preprocessing(identified), noise=noise,
+                                          yardstick=reference, fitted=_fitted_correlation(identified, sets, config.robot.n_dof),
+                                          nominal=label)
+    if beside:
+        comparisons = tuple(v.without(str(label)) for v in comparisons)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 
