@@ -14,6 +14,7 @@ sends the file to the line reader, which reads it, or refuses it with its messag
 
 from __future__ import annotations
 
+import datetime
 import json
 import re
 from dataclasses import dataclass
@@ -390,8 +391,6 @@ _DECIMAL_COMMA = re.compile(r"[+-]?\d*,\d+([eE][+-]?\d+)?")
 
 def _posix_seconds(text: str) -> float | None:
     """An ISO 8601 date and time as POSIX seconds (UTC where it names no zone), or None if it is not one."""
-    import datetime
-
     try:
         stamp = datetime.datetime.fromisoformat(text)
     except ValueError:
