@@ -3,6 +3,7 @@ gravity along another axis): named with the setting that fixes it, on simulated 
 not called wrong."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -290,6 +291,34 @@ def test_gravity_along_another_axis_than_the_descriptions_is_named(tmp_path):
     assert "with gravity along -z of the base frame, not [9.81, 0, 0] m/s²" in gravity["text"]
     assert "gravity = [0, 0, -9.81] in the config's [robot] table" in gravity["text"]
     assert results["diagnostics"]["geometry"]["gravity"] == pytest.approx([0, 0, -9.81])
+
+
+@pytest.mark.parametrize(("degrees", "axis"), [(30, 1), (45, 0), (5, 1)])
+def test_a_tilted_mount_is_named_with_its_gravity_and_that_gravity_clears_it(degrees, axis):
+    """A UR10e log simulated with its base tilted (gravity 5-45° from -z about y or x), read with the upright
+    description: only gravity along an axis of the base was a candidate, so nothing was named (the fit absorbs part of
+    it, the rest looks like misfit). The tilt is named with its gravity vector, within 3° of the truth; with that
+    gravity in the description nothing is named."""
+    from dataclasses import replace
+
+    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.settings import Preprocessing
+    from dynid.studies.simulated_logs import simulated_log
+
+    robot = load_robot("ur10e")
+    a = np.radians(degrees)
+    turn = (np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]]) if axis == 0 else
+            np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]]))
+    truth = turn @ np.asarray(robot.gravity)
+    data = prepare(simulated_log(replace(robot, gravity=truth), seconds=20, rng=1), Preprocessing())
+    (found,), stats = geometry_findings(robot, data.q, data.dq, data.ddq, data.tau, "log")
+    assert found.kind == "gravity" and "mounted tilted" in found.text
+    said = re.search(r"\((\d+)° from -z\)", found.text)
+    assert said is not None and abs(int(said.group(1)) - degrees) <= 2, found.text
+    named = np.asarray(stats["gravity"])
+    assert np.degrees(np.arccos(named @ truth / np.linalg.norm(named) / np.linalg.norm(truth))) < 3
+    assert "gravity = [" + ", ".join(f"{x:.2f}" for x in named) + "]" in found.text
+    assert geometry_findings(replace(robot, gravity=named), data.q, data.dq, data.ddq, data.tau, "log")[0] == []
 
 
 def test_a_validation_log_recorded_with_another_zero_is_said(tmp_path):

@@ -1,6 +1,7 @@
 """A log whose geometry does not match the robot file: a joint's zero a quarter or half turn off, a joint counted the
-other way round (its encoder's axis opposite to the robot file's), two position columns swapped, gravity along another
-axis of the base (a robot mounted on a wall or a ceiling).
+other way round (its encoder's axis opposite to the robot file's), two position columns swapped (or two joints'
+positions and torques), gravity along another axis of the base (a robot mounted on a wall or a ceiling) or along any
+direction (mounted tilted).
 
 Encoders, drivers and robot files often count a joint's angle from different zeros: the Stäubli TX40's logged angles
 need -π/2 on J2 and +π/2 on J3 to match its URDF. A log's columns need not come in the chain's order, and a URDF
@@ -15,7 +16,8 @@ counterbalance, whatever their size). What the nominal torque leaves unexplained
 summed over the joints, is compared for the logged angles and for the logged angles with one or two joints turned by
 ±π/2 or π, two joints' position columns swapped (their nuisance columns swapped too; every figure over what the logged
 angles' nuisance columns leave, so that all are on one scale), their position and torque columns swapped (a driver's
-alphabetical joint order), one joint's states negated, or gravity along each axis of the base either way.
+alphabetical joint order), one joint's states negated, gravity along each axis of the base either way, or along the
+direction that explains most (:func:`tilted_gravity`) where it is tilted from every axis.
 A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
 (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
@@ -62,6 +64,14 @@ leaves."""
 TWIN = 1.1
 """Two changes whose nominal torques run with the measured ones and leave within this ratio of each other are twins
 the log cannot tell apart: a turn is named before a reversal, with the other beside it."""
+
+TILT_DIRECTIONS = 20_000
+"""Gravity directions searched for a tilted mount (:func:`tilted_gravity`): a Fibonacci lattice on the sphere, its
+neighbours about 1.4° apart."""
+
+TILTED = (2.0, 10.0)
+"""Degrees from the description's gravity, and from every other axis of the base, beyond which the best gravity
+direction is a candidate of its own (a robot mounted tilted); nearer another axis, that axis's candidate names it."""
 
 SAMPLES = (100, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
@@ -132,10 +142,7 @@ def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False, free:
     balanced = _counterbalanced(robot)
     left = variation = 0.0
     for j in range(robot.n_dof):
-        nuisance = [np.sign(dq[:, j]), dq[:, j], ddq[:, j], np.ones(len(q))]
-        if j in balanced:  # spans the same space for any offset of the joint's angle
-            nuisance += [np.sin(q[:, j]), np.cos(q[:, j]), np.sin(2 * q[:, j]), np.cos(2 * q[:, j])]
-        basis = np.linalg.svd(np.column_stack(nuisance), full_matrices=False)[0]
+        basis = _nuisance(q, dq, ddq, j, j in balanced)
         r = tau[:, j] - basis @ (basis.T @ tau[:, j])
         left += float(r @ r)
         if nominal is not None:
@@ -144,6 +151,74 @@ def _sums(robot: Robot, q, dq, ddq, tau, nominal, *, signed: bool = False, free:
             variation += pp
             left -= pr**2 / pp if pp > 1e-12 * max(float(r @ r), 1e-300) and (pr > 0 or not signed or j in free) else 0.0
     return left, variation
+
+
+def _nuisance(q, dq, ddq, j: int, balanced: bool) -> np.ndarray:
+    """An orthonormal basis of joint j's nuisance columns (module docstring): its direction of motion, velocity,
+    acceleration and a constant, and with a counterbalance the sin/cos of its angle and twice its angle (they span the
+    same space for any offset of the angle)."""
+    nuisance = [np.sign(dq[:, j]), dq[:, j], ddq[:, j], np.ones(len(q))]
+    if balanced:
+        nuisance += [np.sin(q[:, j]), np.cos(q[:, j]), np.sin(2 * q[:, j]), np.cos(2 * q[:, j])]
+    return np.linalg.svd(np.column_stack(nuisance), full_matrices=False)[0]
+
+
+def tilted_gravity(robot: Robot, q, dq, ddq, tau) -> np.ndarray:
+    """The gravity vector, of the description's magnitude and along any direction of the base, with which the nominal
+    model's torque runs with the measured one and leaves least of it beyond the nuisance columns (a robot mounted
+    tilted: on a slanted pedestal, a wall at an angle).
+
+    The gravity torque is linear in the gravity vector, so each direction's torque is the inertial torque plus a
+    combination of the torques of gravity along the three axes: :data:`TILT_DIRECTIONS` directions cost four nominal
+    torques and each joint's 4×4 Gram matrix.
+
+    Parameters
+    ----------
+    robot : Robot
+        With its nominal inertial parameters.
+    q, dq, ddq : (N, n_dof) arrays
+        Logged states [rad], [rad/s], [rad/s²].
+    tau : (N, n_dof) array
+        Measured joint torques [N·m].
+
+    Returns
+    -------
+    (3,) ndarray [m/s²]
+        In the base frame.
+    """
+    g = float(np.linalg.norm(robot.gravity))
+    still = np.zeros_like(q)
+    columns = [nominal_rigid_torque(replace(robot, gravity=np.zeros(3)), q, dq, ddq)]
+    columns += [nominal_rigid_torque(replace(robot, gravity=g * axis), q, still, still) for axis in np.eye(3)]
+    k = np.arange(TILT_DIRECTIONS) + 0.5  # a Fibonacci lattice: evenly spread directions
+    z, turn = 1 - 2 * k / TILT_DIRECTIONS, np.pi * (1 + 5**0.5) * k
+    directions = np.column_stack([np.sqrt(1 - z**2) * np.cos(turn), np.sqrt(1 - z**2) * np.sin(turn), z])
+    weights = np.column_stack([np.ones(len(directions)), directions])  # the inertial torque, then gravity's
+    balanced = _counterbalanced(robot)
+    explained = np.zeros(len(directions))
+    for j in range(robot.n_dof):
+        basis = _nuisance(q, dq, ddq, j, j in balanced)
+        r = tau[:, j] - basis @ (basis.T @ tau[:, j])
+        b = np.column_stack([c[:, j] for c in columns])
+        b -= basis @ (basis.T @ b)
+        pp, pr = np.einsum("di,ij,dj->d", weights, b.T @ b, weights), weights @ (b.T @ r)
+        explained += np.where((pr > 0) & (pp > 1e-12 * max(float(r @ r), 1e-300)), pr**2 / np.maximum(pp, 1e-300), 0.0)
+    return g * directions[int(np.argmax(explained))]
+
+
+def _with_tilt(robot: Robot, changes: tuple, log: tuple) -> tuple:
+    """``changes`` with :func:`tilted_gravity` on ``log`` as one more, where it lies beyond :data:`TILTED` degrees
+    from the description's gravity and from every other axis of the base."""
+    g = tilted_gravity(robot, *log)
+    described = np.asarray(robot.gravity, dtype=float)
+    angles = np.degrees(np.arccos(np.clip(np.concatenate([np.eye(3), -np.eye(3)]) @ g / np.linalg.norm(g), -1, 1)))
+    nearest = np.concatenate([np.eye(3), -np.eye(3)])[int(np.argmin(angles))]
+    own = np.degrees(np.arccos(np.clip(g @ described / (np.linalg.norm(g) * np.linalg.norm(described)), -1, 1)))
+    if own <= TILTED[0] or (angles.min() <= TILTED[1] and not np.allclose(nearest * np.linalg.norm(described), described)):
+        return changes
+    n = robot.n_dof
+    added = (np.zeros(n), np.arange(n), g, np.ones(n), np.array(False))
+    return tuple(np.concatenate([x, a[None]]) for x, a in zip(changes, added))
 
 
 def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -241,7 +316,8 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     stats: dict = {"unexplained": logged, "nominal_variation": variation / reference if reference > 0 else 0.0}
     if logged < UNEXPLAINED_FROM or stats["nominal_variation"] < MOVED:
         return [], stats
-    log, changes = (q, dq, ddq, tau), tuple(x[1:] for x in candidate_changes(robot))
+    log = (q, dq, ddq, tau)
+    changes = _with_tilt(robot, tuple(x[1:] for x in candidate_changes(robot)), log)
     shifts, orders, gravities, ways, channels = changes
     # two joints turned only among the joints whose own turns explain most: the pairs are most of the candidates
     paired = np.count_nonzero(shifts, axis=1) == 2
@@ -347,6 +423,15 @@ def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np
                           f"Are the positions' columns in the order of the robot's joints? If not, swap {own} in "
                           "positions = { columns = [...] } (and velocities', if given) of every dataset"), int(swapped[0])
     axis = int(np.argmax(np.abs(gravity)))
+    tilt = float(np.degrees(np.arccos(min(1.0, abs(gravity[axis]) / np.linalg.norm(gravity)))))
+    if tilt > 1.0:
+        vector = "[" + ", ".join(f"{x:.2f}" for x in gravity) + "]"
+        return "gravity", (f"gravity along {vector} m/s² of the base frame ({tilt:.0f}° from "
+                           f"{'+' if gravity[axis] > 0 else '-'}{'xyz'[axis]}), not "
+                           "[" + ", ".join(f"{x:g}" for x in robot.gravity) + "] m/s²",
+                           "Is the robot mounted tilted (a slanted pedestal, a wall at an angle)? If so, give gravity = "
+                           f"{vector} in the config's [robot] table (or the robot description), or the mount's exact "
+                           "angle"), None
     vector = "[" + ", ".join(f"{x:g}" for x in gravity) + "]"
     return "gravity", (f"gravity along {'+' if gravity[axis] > 0 else '-'}{'xyz'[axis]} of the base frame, not "
                        "[" + ", ".join(f"{x:g}" for x in robot.gravity) + "] m/s²",
