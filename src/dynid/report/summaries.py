@@ -360,9 +360,9 @@ def readiness(result, *, library: bool = False) -> Line:
                     "off, a joint counted the other way round, or two columns swapped?): the verdict at the end names "
                     "them and the setting that fixes it", "warning")
     if "gravity" in kinds:
-        return Line("not ready: the torques fit the description far better with gravity along another axis (a robot "
-                    "mounted on a wall or a ceiling?): the verdict at the end names it and the setting that fixes it",
-                    "warning")
+        return Line("not ready: the torques fit the description far better with gravity along another direction (a "
+                    "robot mounted on a wall, a ceiling or tilted?): the verdict at the end names it and the setting that "
+                    "fixes it", "warning")
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
