@@ -43,6 +43,11 @@ def _rpy(rotation: np.ndarray) -> np.ndarray:
     return np.asarray(pin.rpy.matrixToRpy(np.asarray(rotation, dtype=float)))
 
 
+WORLD_JOINT = "world_to_base"
+"""The fixed joint by which :func:`urdf_from_robot` turns the base of a robot whose gravity is not along -z of its base,
+so that it is along -z of the URDF's root (a URDF has no gravity)."""
+
+
 def _vec(v) -> str:
     return " ".join(f"{x:.17g}" for x in np.asarray(v, dtype=float))
 
@@ -118,7 +123,7 @@ def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
              f"<robot name={quoteattr(name or robot.name)}>", '  <link name="base_link"/>']
     turn = _world_from_base(robot.gravity)
     if turn is not None:  # a URDF has no gravity: its users take -z of the root; the base turned so that it is
-        lines += ['  <link name="world"/>', '  <joint name="world_to_base" type="fixed">', '    <parent link="world"/>',
+        lines += ['  <link name="world"/>', f'  <joint name="{WORLD_JOINT}" type="fixed">', '    <parent link="world"/>',
                   '    <child link="base_link"/>', f'    <origin xyz="0 0 0" rpy="{_vec(_rpy(turn))}"/>',
                   f"    <!-- dynid: gravity is {_vec(robot.gravity)} m/s² in the model's base frame: the base is turned so "
                   "that it points along -z of world, as a URDF's users take it -->", "  </joint>"]

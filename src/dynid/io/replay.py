@@ -21,6 +21,7 @@ import numpy as np
 from .._util.reprs import short_repr
 from ..dynamics.regressor import regressor
 from ..model.robot import Robot
+from .export import WORLD_JOINT
 
 __all__ = ["MJCF_TERMS", "URDF_TERMS", "ForwardCheck", "ReplayCheck", "mjcf_forward", "mjcf_replay", "urdf_replay"]
 
@@ -106,6 +107,8 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     model = pin.buildModelFromXML(text)
     if robot.held:
         model = pin.buildReducedModel(model, [model.getJointId(h) for h in robot.held], pin.neutral(model))
+    if not model.existFrame(WORLD_JOINT):  # the user's URDF written back: its root is the base, the gravity the config's
+        model.gravity.linear = np.asarray(robot.gravity, dtype=float)
     data = model.createData()
     ids = [model.getJointId(j.name) for j in robot.joints]
     q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)

@@ -21,7 +21,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
-from .export import _exportable, identified_header, moved_far
+from .export import _exportable, _world_from_base, identified_header, moved_far
 
 __all__ = ["urdf_written_back"]
 
@@ -243,6 +243,11 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         moved.extend([far] if far else [])
     head = [_comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of every "
                                        "moving joint", estimate, moved, "URDF"))]
+    if _world_from_base(robot.gravity) is not None:  # the config's mounting, which a URDF cannot hold
+        vector = " ".join(f"{x:g}" for x in robot.gravity)
+        head.append(_comment(f" dynid: gravity is {vector} m/s² in this robot's base frame (the root "
+                             "link's), as identified: a URDF cannot hold it; give it to the simulator or controller that "
+                             "loads this file (Pinocchio: model.gravity.linear) "))
     if robot.transmission.n_coupled_params:
         names = robot.transmission.coupled_parameter_names
         head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
