@@ -102,21 +102,22 @@ def channel_findings(comparison, label: str, fitted: np.ndarray, nominal: str | 
 def _scale_findings(comparison, label: str, slope: np.ndarray, rho: np.ndarray, judged, nominal: str | None
                     ) -> list[Finding]:
     """Joints whose measured torque runs with the estimate's prediction (ρ ≥ :data:`FITTED`) at beyond
-    :data:`dynid.validation.diagnostics.SCALE_LIMIT` times or under its inverse (every judged joint, or some where the
-    estimate predicts the others), where the description's nominal model sees that scale too: on each of those joints
+    :data:`dynid.validation.diagnostics.SCALE_LIMIT` times or under its inverse (every joint it so runs with, or some
+    where the estimate predicts the others), where the description's nominal model sees that scale too: on each of those joints
     it follows (ρ ≥ :data:`NOMINAL_FOLLOWS`), its slope is nearer the estimate's than 1 (the UR10e example's validation
     torques at 0.1×: the estimate's slopes 0.100, the nominal model's 0.086-0.108 where it follows)."""
     if nominal is None or nominal not in comparison.predicted:
         return []
-    scaled = [j for j in judged if rho[j] >= FITTED and not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
-    if not scaled or not (len(scaled) == len(judged) >= 2 or _others_predicted(rho, judged, scaled)):
+    followed = [j for j in judged if rho[j] >= FITTED]
+    scaled = [j for j in followed if not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
+    if not scaled or not (len(scaled) == len(followed) >= 2 or _others_predicted(rho, judged, scaled)):
         return []
     k, r = _fit(np.asarray(comparison.measured, dtype=float), np.asarray(comparison.predicted[nominal], dtype=float))
     seen = [j for j in scaled if r[j] >= NOMINAL_FOLLOWS and k[j] > 0]
     if not seen or any(abs(np.log10(k[j] / slope[j])) >= abs(np.log10(k[j])) for j in seen):
         return []  # the description predicts this log at its size: the fit, not the log, is off
     n = slope.size
-    common = np.ptp(np.log10(slope[scaled])) < 0.1 and len(scaled) == len(judged)
+    common = np.ptp(np.log10(slope[scaled])) < 0.1 and len(scaled) == len(followed)
     fix = scale_text(float(np.median(slope[scaled]))) if common else \
         "[" + ", ".join(scale_text(float(slope[j])) if j in scaled else "1" for j in range(n)) + "]"
     joints = ", ".join(f"J{j + 1} ({slope[j]:.3g}×)" for j in scaled)
