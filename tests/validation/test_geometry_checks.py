@@ -284,7 +284,7 @@ def test_gravity_along_another_axis_than_the_descriptions_is_named(tmp_path):
     (folder / "wall.toml").write_text(text + '\n[robot]\nurdf = "ur10e.urdf"\ngravity = [9.81, 0.0, 0.0]\n')
     p = dynid("identify", folder / "wall.toml", "--out", tmp_path / "out", "--no-figures")
     assert p.returncode == 0, p.stderr
-    assert "not ready: the torques fit the description far better with gravity along another axis" in " ".join(
+    assert "not ready: the torques fit the description far better with gravity along another direction" in " ".join(
         (p.stdout + p.stderr).split())
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     (gravity,) = [f for f in results["findings"] if f["kind"] == "gravity"]
