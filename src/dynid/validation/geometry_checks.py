@@ -174,12 +174,9 @@ def tilted_gravity(robot: Robot, q, dq, ddq, tau) -> np.ndarray:
 
     Parameters
     ----------
-    robot : Robot
-        With its nominal inertial parameters.
-    q, dq, ddq : (N, n_dof) arrays
-        Logged states [rad], [rad/s], [rad/s²].
-    tau : (N, n_dof) array
-        Measured joint torques [N·m].
+    robot, q, dq, ddq, tau
+        The description with its nominal inertial parameters, the logged states [rad], [rad/s], [rad/s²] and the
+        measured joint torques [N·m], (N, n_dof) arrays: as :func:`unexplained_share` takes them.
 
     Returns
     -------
