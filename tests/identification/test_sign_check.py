@@ -347,3 +347,29 @@ def test_swapped_current_columns_are_named_and_the_model_not_called_ready(tmp_pa
     (order,) = [f for f in _findings(tmp_path / "out") if f["kind"] == "order"]
     assert "J2 and J3" in order["text"]
     assert "not ready: the torques of some joints look swapped" in " ".join((p.stdout + p.stderr).split())
+
+
+def test_a_description_in_grams_is_named_as_a_possible_cause_with_its_mass(tmp_path):
+    """``dynid example ur10e`` read with its URDF's masses and inertias in grams (a CAD export's unit): dynid said "a
+    unit (currents in mA? torques in N·mm?) or the drive gains; set scale = 1000", of torques 0.001× the description's,
+    where mA and N·mm would make them larger. Measured torques smaller than the description's name its masses first,
+    with their sum; larger ones name the log's unit first and the description's placeholders too."""
+    from dynid import load_robot
+    from dynid.validation.diagnostics import scale_findings
+
+    assert dynid("example", "ur10e", tmp_path / "try", "-q").returncode == 0
+    urdf = tmp_path / "try" / "ur10e.urdf"
+    text = urdf.read_text()
+    urdf.write_text(re.sub(r'((?:mass value|i[xyz]{2})=")([0-9.eE+-]+)(")',
+                              lambda m: f"{m.group(1)}{float(m.group(2)) * 1000!r}{m.group(3)}", text))
+    mass = float(np.sum(load_robot(urdf).inertial[:, 9]))
+    p = dynid("identify", tmp_path / "try" / "ur10e.toml", "--out", tmp_path / "out", "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    (scale,) = [f["text"] for f in json.loads((tmp_path / "out" / "results.json").read_text())["findings"]
+                if f["kind"] == "scale"]
+    assert f"the description's masses in another unit (grams?; its moving links weigh {mass:.3g} kg in all)" in scale
+    assert "currents in mA" not in scale and "scale = 1000" in scale
+    rho, varies = np.full(4, 0.99), np.ones(4, bool)
+    (larger,) = scale_findings(rho, np.full(4, 1000.0), varies, "log", mass=28.7)
+    assert "a unit (currents in mA? torques in N·mm?)" in larger.text
+    assert "the description's masses far too small (placeholders?; its moving links weigh 28.7 kg in all)" in larger.text

@@ -537,7 +537,7 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
             + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains,
-                             misfit=misfit) + geometry)
+                             misfit=misfit, mass=float(np.sum(scoring.robot.inertial[:, 9]))) + geometry)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

@@ -283,7 +283,7 @@ log: J4's torque 11.7× its nominal one, every joint fitted at 0.96-1.04× its f
 
 def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
                    table: str = "[identification]", gains: np.ndarray | None = None,
-                   misfit: np.ndarray | None = None) -> list[Finding]:
+                   misfit: np.ndarray | None = None, mass: float | None = None) -> list[Finding]:
     """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
     of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
     that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``; or, where the median is within, some joints' slopes are
@@ -310,6 +310,9 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     misfit : (n_dof,) bool array, optional
         Joints that no estimate fits within :data:`SCALE_MISFIT` times their noise floor: only these may have a scale
         of their own (default: every joint).
+    mass : float, optional
+        The description's moving links' mass in all [kg], said beside a scale of every joint: the description's
+        masses in another unit (grams) or placeholders are as likely as the log's unit.
 
     Returns
     -------
@@ -329,11 +332,14 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
         f" (motor currents: about {', '.join(f'{gains[j] / k[j]:.3g}' for j in judged)} N·m/A on {joints} by the "
         "description's nominal model, as right as its masses; [drive_gains] identifies them from a run with a known "
         "payload)")
+    said = "" if mass is None else f"; its moving links weigh {mass:.3g} kg in all"
+    cause = (f"a unit (currents in mA? torques in N·mm?), the drive gains, or the description's masses far too small "
+             f"(placeholders?{said})" if median > 1 else
+             f"the description's masses in another unit (grams?{said}) or far too large, or the log's unit or drive gains")
     return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal "
-                             f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): a "
-                             f"unit (currents in mA? torques in N·mm?) or the drive gains; set scale = {fix} in the "
-                             f"torques (or currents) of {table} and the other datasets, or check drive_gain in the "
-                             f"description{per_joint}")]
+                             f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): "
+                             f"{cause}; set scale = {fix} in the torques (or currents) of {table} and the other "
+                             f"datasets, or correct the description's masses or its drive_gain{per_joint}")]
 
 
 def _joint_scale_findings(slope: np.ndarray, judged: list, dataset: str, table: str,
