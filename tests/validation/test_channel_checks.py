@@ -123,9 +123,12 @@ def test_a_validation_log_in_another_unit_is_named_and_not_weighed(tmp_path):
     floor = scaled["validation"][0]["noise_floor"]["global_relative_error"]
     assert scaled["validation"][0]["metrics"][scaled["main_estimate"]]["global_relative_error"] < 1.5 * floor
     p = dynid("validate", folder / "ur10e.toml", "--results", tmp_path / "right" / "results.json", "--file",
-              folder / "validation.csv", "--out", tmp_path / "validated", "-q")  # dynid validate judges it too
+              folder / "validation.csv", "--out", tmp_path / "validated")  # dynid validate judges it too
     assert p.returncode == 0, p.stderr
     assert "are that many times dynid SDP's prediction" in " ".join(p.stderr.split()) and "scale = 10 }" in p.stderr
+    said = " ".join(p.stdout.split())
+    assert "validation.csv: read otherwise than the identification log" in said  # in short, not only at the end
+    assert "next: read validation.csv as the warning says, then validate again" in said and "dynid export" not in said
     (folder / "validation.csv").write_text(original)
     ident = np.loadtxt(folder / "identification.csv", delimiter=",", skiprows=1)
     ident[:, header.index("shoulder_lift_joint_effort")] *= 10

@@ -637,7 +637,15 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
                  for name, v in spans.items()]
         out.append(Line(f"{_resting([c.name for c in still])}: torque error over "
                         f"all joints: {'; '.join(parts)} ({_AT_REST})"))
-    return out
+    return out + _misread_lines([c.name for c in comparisons if c.misread])
+
+
+def _misread_lines(names: list) -> list:
+    """The line that says which logs are read otherwise than the identification log (none: no line)."""
+    if not names:
+        return []
+    return [Line(f"{', '.join(names)}: read otherwise than the identification log (angles, mounting, torque channels or "
+                 "units: the warning says how): its figures say little of any estimate")]
 
 
 def validation_blocks(comparisons, *, tables: bool = True) -> list:
@@ -685,7 +693,10 @@ def validation_verdict(comparisons) -> list:
     what = logs + (f" ({left} at rest throughout left out: they check the gravity model)" if left else "")
     out = [Line(f"mean torque error over {what}: " + "; ".join(f"{name} {v:.3g} %" for name, v in means.items())
                 + _best(means, " — "), "title")]
-    if not best.startswith("dynid"):
+    misread = [c.name for c in comparisons if c.misread]
+    if misread:
+        out.append(Line(f"next: read {', '.join(misread)} as the warning says, then validate again"))
+    elif not best.startswith("dynid"):
         out.append(Line(f"next: {best} predicts these logs better than dynid's estimates; identify on a log that moves "
                         "as these do, or add them to [[validation]] to choose among the estimates"))
     else:
@@ -760,9 +771,7 @@ def in_short(result) -> list:
     misread = [c.name for c in r.validations if c.misread]
     far = [k for k, v in errors.items() if k != r.fit.name and fit is not None and v > 3 * max(fit, 1e-9)
            and k not in at_floor and k not in misread]
-    if misread:
-        out.append(Line(f"{', '.join(misread)}: read otherwise than the identification log (angles, mounting or "
-                        "torque channels: the warning says how): its figures say little of any estimate"))
+    out += _misread_lines(misread)
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))
