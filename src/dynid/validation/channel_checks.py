@@ -44,9 +44,15 @@ def _others_predicted(rho: np.ndarray, judged, joints) -> bool:
     return bool(rest) and float(np.median(np.asarray(rho)[rest])) >= FITTED
 
 
-def _fit(measured: np.ndarray, predicted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each joint's slope of the measured torque on the predicted one and their correlation, about their means."""
-    m, p = measured - measured.mean(axis=0), predicted - predicted.mean(axis=0)
+def _centred(x) -> np.ndarray:
+    """An (N, n_dof) signal about each joint's mean."""
+    x = np.asarray(x, dtype=float)
+    return x - x.mean(axis=0)
+
+
+def _fit(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's slope of the measured torque ``m`` on the predicted one ``p`` and their correlation (both
+    :func:`_centred`)."""
     power = np.maximum((p**2).sum(axis=0), 1e-300)
     return (m * p).sum(axis=0) / power, (m * p).sum(axis=0) / np.sqrt(np.maximum((m**2).sum(axis=0), 1e-300) * power)
 
@@ -74,8 +80,8 @@ def channel_findings(comparison, label: str, fitted: np.ndarray, nominal: str | 
     predicted = np.asarray(comparison.predicted[label], dtype=float)
     judged = np.flatnonzero(comparison.varies(beyond="floor") & (np.asarray(fitted, dtype=float) >= FITTED)
                             & np.all(np.isfinite(predicted), axis=0))
-    m, p = measured - measured.mean(axis=0), predicted - predicted.mean(axis=0)
-    slope, rho = _fit(measured, predicted)
+    m, p = _centred(measured), _centred(predicted)
+    slope, rho = _fit(m, p)
     own = ((m - p) ** 2).sum(axis=0)  # about each channel's mean: an offset the estimate misses is no swap
     for a, b in ((a, b) for i, a in enumerate(judged) for b in judged[i + 1:]):
         cross = (((m[:, a] - p[:, b]) ** 2).sum(), ((m[:, b] - p[:, a]) ** 2).sum())
@@ -112,7 +118,7 @@ def _scale_findings(comparison, label: str, slope: np.ndarray, rho: np.ndarray, 
     scaled = [j for j in followed if not 1 / SCALE_LIMIT <= slope[j] <= SCALE_LIMIT]
     if not scaled or not (len(scaled) == len(followed) >= 2 or _others_predicted(rho, judged, scaled)):
         return []
-    k, r = _fit(np.asarray(comparison.measured, dtype=float), np.asarray(comparison.predicted[nominal], dtype=float))
+    k, r = _fit(_centred(comparison.measured), _centred(comparison.predicted[nominal]))
     seen = [j for j in scaled if r[j] >= NOMINAL_FOLLOWS and k[j] > 0]
     if not seen or any(abs(np.log10(k[j] / slope[j])) >= abs(np.log10(k[j])) for j in seen):
         return []  # the description predicts this log at its size: the fit, not the log, is off

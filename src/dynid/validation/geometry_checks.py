@@ -208,10 +208,10 @@ def _with_tilt(robot: Robot, changes: tuple, log: tuple) -> tuple:
     from the description's gravity and from every other axis of the base."""
     g = tilted_gravity(robot, *log)
     described = np.asarray(robot.gravity, dtype=float)
-    angles = np.degrees(np.arccos(np.clip(np.concatenate([np.eye(3), -np.eye(3)]) @ g / np.linalg.norm(g), -1, 1)))
-    nearest = np.concatenate([np.eye(3), -np.eye(3)])[int(np.argmin(angles))]
-    own = np.degrees(np.arccos(np.clip(g @ described / (np.linalg.norm(g) * np.linalg.norm(described)), -1, 1)))
-    if own <= TILTED[0] or (angles.min() <= TILTED[1] and not np.allclose(nearest * np.linalg.norm(described), described)):
+    axes = np.concatenate([np.eye(3), -np.eye(3)]) * np.linalg.norm(described)
+    degrees = lambda a: np.degrees(np.arccos(np.clip(a @ g / np.linalg.norm(g) ** 2, -1, 1)))  # noqa: E731
+    nearest = axes[int(np.argmin(degrees(axes)))]
+    if degrees(described) <= TILTED[0] or (degrees(nearest) <= TILTED[1] and not np.allclose(nearest, described)):
         return changes
     n = robot.n_dof
     added = (np.zeros(n), np.arange(n), g, np.ones(n), np.array(False))
