@@ -242,27 +242,32 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     list of Finding
     """
     corr = np.asarray(correlation, dtype=float)
-    bad = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and corr[j] < -0.5]
-    if bad and slope is not None:
+    judged = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and abs(corr[j]) >= 0.5]
+    if slope is not None:
         k = np.abs(np.asarray(slope, dtype=float))
-        sized = [j for j in range(corr.size) if varies[j] and np.isfinite(corr[j]) and abs(corr[j]) >= 0.5
-                 and np.isfinite(k[j]) and k[j] > 0]
+        sized = [j for j in judged if np.isfinite(k[j]) and k[j] > 0]
         typical = float(np.median(k[sized])) if sized else float("nan")
-        bad = [j for j in bad if not np.isfinite(typical) or not np.isfinite(k[j])
-               or 1 / SCALE_LIMIT <= k[j] / typical <= SCALE_LIMIT]
+        judged = [j for j in judged if not np.isfinite(typical) or not np.isfinite(k[j])
+                  or 1 / SCALE_LIMIT <= k[j] / typical <= SCALE_LIMIT]
+    bad = [j for j in judged if corr[j] < -0.5]
     if not bad:
         return []
     n = corr.size
     joints = ", ".join(f"J{j + 1}" for j in bad)
     values = ", ".join(f"{corr[j]:.3f}" for j in bad)
-    if len(bad) >= max(2, sum(bool(v) for v in varies) - 1):
+    unjudged = [j for j in range(n) if j not in judged]
+    why = ""
+    if len(bad) >= 2 and len(bad) == len(judged):  # every joint the nominal model judges: one convention for the log
         fix = "sign = -1"
+        if unjudged:
+            why = (f"every joint's: the nominal model cannot judge {', '.join(f'J{j + 1}' for j in unjudged)}, whose "
+                   "torques it barely predicts, and a log's torques usually share one sign convention; ")
     else:
         fix = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]"
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
-                            "other datasets (or check the description's gravity, and whether a joint's zero is a half "
-                            'turn from the robot file\'s: position_offset = "pi")')]
+                            f"other datasets ({why}or check the description's gravity, and whether a joint's zero is a "
+                            'half turn from the robot file\'s: position_offset = "pi")')]
 
 
 SCALE_LIMIT = 3.0
