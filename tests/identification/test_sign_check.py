@@ -373,3 +373,33 @@ def test_a_description_in_grams_is_named_as_a_possible_cause_with_its_mass(tmp_p
     (larger,) = scale_findings(rho, np.full(4, 1000.0), varies, "log", mass=28.7)
     assert "a unit (currents in mA? torques in N·mm?)" in larger.text
     assert "the description's masses far too small (placeholders?; its moving links weigh 28.7 kg in all)" in larger.text
+
+
+@pytest.mark.parametrize("flipped", [None, 5])
+def test_a_flipped_sign_the_nominal_model_cannot_judge_is_named_by_the_consistent_refit(flipped):
+    """A UR10e whose wrist torque is friction and rotor inertia its description lacks: the nominal model cannot judge
+    J6's sign (its torque barely varies in the model), so a J6 read with the wrong sign was silent; least squares fits
+    it either way (its friction negative), the SDP cannot, and with J6 negated it follows it again. Read right: no
+    finding (the SDP fits every joint within 2× least squares)."""
+    import dynid
+    from dynid.identification.flipped_joints import MISFIT
+    from dynid.identification.identifier import Identifier
+    from dynid.model.description import load_robot
+
+    from ..simulated_logs import truth_robot
+
+    truth, _ = truth_robot("ur10e", np.random.default_rng(0))
+    log = dynid.simulated_log(truth, seconds=10, rng=3)
+    tau = log.tau.copy()
+    if flipped is not None:
+        tau[:, flipped] *= -1
+    result = Identifier(load_robot("ur10e"), estimators=["wls", "sdp"]).fit(log.t, log.q, tau).result_
+    signs = [f.text for f in result.findings if f.kind == "sign"]
+    errors = {k: np.asarray(v["relative_error"]) for k, v in result.fit.metrics().items()}
+    if flipped is None:
+        assert signs == [] and np.all(errors["dynid SDP"] < MISFIT * errors["dynid WLS"])
+        return
+    (text,) = signs
+    assert text.startswith("arrays: J6: the physically consistent estimate cannot follow") and "Negate its entry" in text
+    rms = [float(x) for x in re.findall(r"J6 ([0-9.e+-]+) N·m RMS as read, ([0-9.e+-]+) flipped", text)[0]]
+    assert rms[1] < 0.5 * rms[0]  # the refit with J6 negated follows it

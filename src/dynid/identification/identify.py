@@ -47,6 +47,7 @@ from ..validation.geometry_checks import geometry_findings
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
 from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
+from .flipped_joints import flipped_joint_findings
 from .identified import Parameters
 from .verdict import choose_main_estimate
 
@@ -382,6 +383,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                consistent="sdp" in keys)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
+    if SDP_LABEL in estimates and not any(f.kind in READ_OTHERWISE for f in findings):  # the log read right first
+        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
     ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
@@ -499,6 +502,10 @@ def _estimate(key: str, fitted, reference) -> Estimate:
                     fitted.n_evaluations, None if standard is None else np.asarray(standard),
                     getattr(est, "pseudo_inertia_min_eig_", None), note, est)
 
+
+READ_OTHERWISE = ("sign", "angles", "gravity", "scale", "order")
+"""Findings of a log read otherwise than the description (a sign, zeros, gravity, a unit, the columns' order): with
+one, no joint's sign is tried by refitting (:mod:`dynid.identification.flipped_joints`)."""
 
 FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 """Drive terms that are friction (not the rotor inertia, not a counterbalance): the sign check looks beyond them."""
