@@ -533,21 +533,28 @@ def test_without_validation_logs_the_sdp_stays_main_where_held_out_blocks_score_
 
 def test_init_says_a_log_of_motor_currents_needs_drive_gains_the_urdf_cannot_state(tmp_path):
     """A UR10e's RTDE log (motor currents) with its URDF: init wrote the config without a word on the drive gains, and
-    identify then read each ampere as 1 N·m (its torques 0.108× the nominal model's). Init now says so, with the
-    built-in robot of the URDF's name that has them; a log of torques, or another arm, is not told of a built-in."""
+    identify then read each ampere as 1 N·m. Init said so and named the built-in robot of the URDF's name that has
+    them; it now writes that robot's gains in [[robot.joints]] (the real UR10e log read at 1 N·m/A predicted its
+    validation log 8.86 %, with them 2.22 %). Another arm's URDF gets the note alone; a log of torques nothing."""
+    from dynid.io.identification_config import load_identification_config
     from dynid.io.starter import starter_config
 
-    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=5, rng=1)
-    rows = np.column_stack([log.t, log.q, np.zeros_like(log.q), log.tau / 10.0, np.zeros((log.t.size, 12))])
+    builtin = dynid.load_robot("ur10e").drive_gains
+    log = dynid.simulated_log(dynid.load_robot("ur10e"), seconds=5, rng=1)
+    rows = np.column_stack([log.t, log.q, np.zeros_like(log.q), log.tau / builtin, np.zeros((log.t.size, 12))])
     np.savetxt(tmp_path / "rtde.csv", rows, delimiter=",")  # 31 columns: Universal Robots' RTDE layout
     robot = dynid.load_robot(URDF)
-    _, notes = starter_config(URDF, tmp_path / "rtde.csv", 6, tmp_path / "a.toml", robot=robot)
+    text, notes = starter_config(URDF, tmp_path / "rtde.csv", 6, tmp_path / "a.toml", robot=robot)
     (gains,) = [n for n in notes if n.startswith("motor currents")]
-    assert "ur10e.urdf states no drive gains" in gains and 'use the built-in robot = "ur10e"' in gains
+    assert "ur10e.urdf states no drive gains" in gains and 'the built-in robot "ur10e"\'s are written' in gains
+    (tmp_path / "a.toml").write_text(text)
+    read = load_identification_config(tmp_path / "a.toml").robot
+    np.testing.assert_array_equal(read.drive_gains, builtin)
+    np.testing.assert_array_equal(read.inertial, robot.inertial)  # the user's URDF, the built-in's gains
     other = tmp_path / "arm.urdf"
     other.write_text(URDF.read_text().replace('<robot name="ur10e"', '<robot name="my_arm"', 1))
-    _, notes = starter_config(other, tmp_path / "rtde.csv", 6, tmp_path / "b.toml", robot=dynid.load_robot(other))
+    text, notes = starter_config(other, tmp_path / "rtde.csv", 6, tmp_path / "b.toml", robot=dynid.load_robot(other))
     (gains,) = [n for n in notes if n.startswith("motor currents")]
-    assert "built-in" not in gains
+    assert "built-in" not in gains and "drive_gain" not in tomllib.loads(text).get("robot", {}).__repr__()
     _, notes = starter_config(URDF, _log(tmp_path, header=True), 6, tmp_path / "c.toml", robot=robot)
     assert not [n for n in notes if n.startswith("motor currents")]  # torques: no gains needed

@@ -90,10 +90,13 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
         said.append(_estimators_note(without))
-        return _config(urdf, log, out, validation, table, said, held, xacro_args, without), said
+        return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
+                       without_sdp=without), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
-    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot), _estimators_note(without)]
-    return _config(urdf, log, out, validation, table, notes, held, xacro_args, without), notes
+    gains = _builtin_gains(table, robot)
+    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without)]
+    return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
+                   gains=gains), notes
 
 
 def _estimators_note(without_sdp: str | None) -> str:
@@ -147,18 +150,36 @@ def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
             "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
 
 
-def _gain_notes(table, urdf: Path, robot) -> list[str]:
+def _reads_currents(table) -> bool:
+    """Whether the dataset table reads motor currents (its own ``currents`` or its preset's)."""
+    return "currents" in table or "currents" in PRESETS.get(str(table.get("preset")), {})
+
+
+def _builtin_gains(table, robot) -> tuple[float, ...] | None:
+    """The drive gains of the built-in robot of the description's name (a UR10e's URDF: the built-in ``ur10e``'s),
+    where the log holds motor currents and the description states none (a URDF cannot); else None."""
+    if robot is None or not _reads_currents(table) or np.any(robot.drive_gains != 1.0) \
+            or robot.name not in builtin_robots():
+        return None
+    from ..model.description import load_robot
+
+    gains = np.asarray(load_robot(robot.name).drive_gains, dtype=float)
+    return tuple(float(g) for g in gains) if gains.shape == (robot.n_dof,) and np.any(gains != 1.0) else None
+
+
+def _gain_notes(table, urdf: Path, robot, gains: tuple[float, ...] | None) -> list[str]:
     """A log of motor currents with a description that states no drive gains (a URDF cannot: each is 1 N·m/A): said,
-    with where the gains go (eq. 16, τ = K·I) and the built-in robot of the same name that has them."""
-    preset = PRESETS.get(str(table.get("preset")), {})
-    if robot is None or "currents" not in table and "currents" not in preset or np.any(robot.drive_gains != 1.0):
+    with the built-in robot's gains written in their place (``gains``), or where the gains go (eq. 16, τ = K·I)."""
+    if robot is None or not _reads_currents(table) or np.any(robot.drive_gains != 1.0):
         return []
-    builtin = robot.name if robot.name in builtin_robots() else None
+    if gains is not None:
+        return [f"motor currents, and {urdf.name} states no drive gains: the built-in robot \"{robot.name}\"'s are "
+                f"written in [[robot.joints]] ({', '.join(f'{g:.6g}' for g in gains)} N·m/A, eq. 16, τ = K·I); check "
+                "them against your controller's. Read as 1 N·m/A, each joint's current scales its rows differently "
+                "and no rigid body fits them all"]
     return [f"motor currents, and {urdf.name} states no drive gains: each joint's current is read as its torque in "
             "N·m (1 N·m/A) until a [robot] table gives each joint's drive_gain (torque per ampere at the joint, eq. "
-            "16; [[robot.joints]])"
-            + (f', or use the built-in robot = "{builtin}", which has them' if builtin else "")
-            + "; dynid identify's verdict estimates them from the description's nominal model"]
+            "16; [[robot.joints]]); dynid identify's verdict estimates them from the description's nominal model"]
 
 
 def _is_bag(path: Path) -> bool:
@@ -179,17 +200,18 @@ def _bag_read(bag: Path, robot) -> str:
     return line
 
 
-def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str],
-            held: tuple[str, ...] = (), xacro_args: dict | None = None, without_sdp: str | None = None) -> str:
+def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str], *,
+            held: tuple[str, ...] = (), xacro_args: dict | None = None, without_sdp: str | None = None,
+            gains: tuple[float, ...] | None = None) -> str:
     """The config's text, written by tomlkit (every string escaped, whatever the paths and columns hold): what was
-    detected in comments, the robot (a table where joints are held or a xacro file takes arguments), the dataset
-    table, the validation logs, and the estimators: WLS and the SDP, or, ``without_sdp`` saying why not, the SDP
-    suggested in a comment."""
+    detected in comments, the robot (a table where joints are held, a xacro file takes arguments or ``gains`` give
+    each joint's drive gain in ``[[robot.joints]]``), the dataset table, the validation logs, and the estimators: WLS
+    and the SDP, or, ``without_sdp`` saying why not, the SDP suggested in a comment."""
     doc = tomlkit.document()
     for line in ("dynid identification config, written by dynid init: check the columns and units below, then",
                  "  dynid identify THIS_FILE", *notes):
         doc.add(tomlkit.comment(" ".join(line.splitlines())))
-    as_table = bool(held or xacro_args)
+    as_table = bool(held or xacro_args or gains)
     if not as_table:  # keys before the first table
         doc.add("robot", tomlkit.item(_relative(urdf, out.parent)))
     doc.add("data_root", tomlkit.item(_relative(log.parent, out.parent)))
@@ -206,6 +228,14 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
             arguments.comment("the xacro file's arguments (name:=value)")
             robot.add("xacro_args", arguments)
         robot.add("drive_terms", list(URDF_DRIVE_TERMS))
+        if gains:
+            joints = tomlkit.aot()
+            for g in gains:
+                entry = tomlkit.table()
+                entry.add("drive_gain", g)
+                joints.append(entry)
+            robot.add("joints", joints)
+            robot["joints"][0]["drive_gain"].comment("N·m/A at the joint (eq. 16): the built-in robot's")
         robot.add(tomlkit.nl())
         doc.add("robot", robot)
     table.add(tomlkit.nl())
