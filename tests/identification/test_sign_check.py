@@ -193,6 +193,24 @@ def test_a_scale_far_from_the_descriptions_is_named_with_its_fix():
     assert scale_findings(np.full(5, 0.5), np.full(5, 1000.0), varies, "log") == []
 
 
+def test_currents_read_through_no_drive_gains_are_told_to_take_each_joints_gain():
+    """The real UR10e's RTDE log with its URDF (no drive gains: each ampere read as 1 N·m): J1-J4 at 0.096, 0.085,
+    0.121 and 0.121× the nominal model's. "set scale = 10" changes no fit's relative error (8.86 % on its validation
+    log, as at 1); each joint's gain does (the nominal model's estimates: 6.62 %, the built-in robot's: 2.22 %). A
+    log whose joints agree on one scale, or one read through gains, still gets the scale."""
+    from dynid.validation.diagnostics import scale_findings
+
+    rho, varies = np.array([0.99, 0.99, 0.98, 0.97, 0.3, 0.2]), np.ones(6, bool)
+    slope = np.array([0.096, 0.085, 0.121, 0.121, 0.1, 0.1])
+    (f,) = scale_findings(rho, slope, varies, "identification", gains=np.ones(6))
+    assert "Give each joint's drive_gain in [[robot.joints]]" in f.text and "set scale" not in f.text
+    assert "about 10.4, 11.8, 8.26, 8.26 N·m/A on J1, J2, J3, J4" in f.text
+    (g,) = scale_findings(rho, np.full(6, 0.1), varies, "identification", gains=np.ones(6))
+    assert "set scale = 10 " in g.text and "Give each joint's" not in g.text
+    (h,) = scale_findings(rho, slope, varies, "identification", gains=np.full(6, 9.0))
+    assert "set scale = 10 " in h.text
+
+
 def test_a_light_joint_whose_nominal_torque_the_description_misstates_is_not_a_flipped_sign():
     """The zoo's Kinova Jaco 2 with a CAD-like description and joint torque sensors (class cad-sensor, simulated with
     the right sign): J6's measured torque runs against its small nominal torque beyond friction (ρ -0.505) at 13.7

@@ -274,6 +274,10 @@ SCALE_LIMIT = 3.0
 """The measured torques this many times the nominal model's, or less than its inverse, on the joints where their
 shapes agree, are a unit or gain error (:func:`scale_findings`): a description's masses are rarely that far off."""
 
+GAINS_APART = 1.2
+"""Joints whose torques stand to the nominal model's in ratios this far apart, read through no drive gains (each
+1 N·m/A), are motor currents through gains of their own (a UR10e's 8.5-10.7 N·m/A): one scale cannot read them."""
+
 SCALE_SHAPE = 0.9
 """Correlation beyond friction from which a joint's torque and the nominal model's have the same shape, so that the
 slope between them is a scale."""
@@ -341,6 +345,15 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     cause = (f"a unit (currents in mA? torques in N·mm?), the drive gains, or the description's masses far too small "
              f"(placeholders?{said})" if median > 1 else
              f"the description's masses in another unit (grams?{said}) or far too large, or the log's unit or drive gains")
+    low, high = float(np.min(k[judged])), float(np.max(k[judged]))
+    if gains is not None and np.all(np.asarray(gains) == 1.0) and high > GAINS_APART * low:
+        # currents read at 1 N·m/A: one scale leaves each joint's rows scaled by its own gain, which no rigid body fits
+        return [Finding("scale", f"{dataset}: the measured torques are {low:.3g}-{high:.3g}× the description's nominal "
+                                 f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}), "
+                                 "and the description states no drive gains: are these motor currents? Give each "
+                                 f"joint's drive_gain in [[robot.joints]]{per_joint}: one scale = {fix} would leave "
+                                 "the joints' rows scaled apart by their gains, which no rigid body fits (else "
+                                 f"{cause})")]
     return [Finding("scale", f"{dataset}: the measured torques are about {median:.3g}× the description's nominal "
                              f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}): "
                              f"{cause}; set scale = {fix} in the torques (or currents) of {table} and the other "
