@@ -28,6 +28,7 @@ from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, seed_index, spec
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
+from ..io.export import READINESS_KINDS
 from ..io.references import ReferenceSet
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
@@ -383,7 +384,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                consistent="sdp" in keys)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
-    if SDP_LABEL in estimates and not any(f.kind in READ_OTHERWISE for f in findings):  # the log read right first
+    if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
         findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
     ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
@@ -502,10 +503,6 @@ def _estimate(key: str, fitted, reference) -> Estimate:
                     fitted.n_evaluations, None if standard is None else np.asarray(standard),
                     getattr(est, "pseudo_inertia_min_eig_", None), note, est)
 
-
-READ_OTHERWISE = ("sign", "angles", "gravity", "scale", "order")
-"""Findings of a log read otherwise than the description (a sign, zeros, gravity, a unit, the columns' order): with
-one, no joint's sign is tried by refitting (:mod:`dynid.identification.flipped_joints`)."""
 
 FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 """Drive terms that are friction (not the rotor inertia, not a counterbalance): the sign check looks beyond them."""
