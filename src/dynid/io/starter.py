@@ -21,7 +21,7 @@ import tomlkit
 from tomlkit.items import Table
 
 from ..exceptions import ConfigError, DataError
-from ..model.description import URDF_DRIVE_TERMS, builtin_robots
+from ..model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
 from .columns import csv_table
 from .dataset_specs import PRESETS
 from .datasets import dataset_spec, load_recording
@@ -161,8 +161,6 @@ def _builtin_gains(table, robot) -> tuple[float, ...] | None:
     if robot is None or not _reads_currents(table) or np.any(robot.drive_gains != 1.0) \
             or robot.name not in builtin_robots():
         return None
-    from ..model.description import load_robot
-
     gains = np.asarray(load_robot(robot.name).drive_gains, dtype=float)
     return tuple(float(g) for g in gains) if gains.shape == (robot.n_dof,) and np.any(gains != 1.0) else None
 
