@@ -47,6 +47,14 @@ def test_a_flipped_torque_sign_is_still_named(tmp_path):
     findings = json.loads((tmp_path / "out" / "results.json").read_text())["findings"]
     (sign,) = [f for f in findings if f["kind"] == "sign"]
     assert "J2" in sign["text"] and "sign = [1, -1, 1, 1, 1, 1]" in sign["text"]
+    # a model fitted to a log read otherwise is not the robot's: no URDF or MJCF beside the results (they were
+    # written, and their header said nothing of it); dynid export writes it when asked, with the finding as a warning
+    assert not list((tmp_path / "out").glob("*.urdf")) and not list((tmp_path / "out").glob("*.xml"))
+    said = " ".join(p.stderr.split())
+    assert "no URDF or MJCF written: the log identification is read otherwise than the robot file (a torque's sign" in said
+    assert "files_withheld" in json.loads((tmp_path / "out" / "results.json").read_text())
+    e = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "asked.urdf")
+    assert e.returncode == 0 and (tmp_path / "asked.urdf").is_file() and "dynid identify doubts" in e.stderr
 
 
 def test_one_joints_flipped_sign_that_the_fit_cannot_follow_is_named(tmp_path):

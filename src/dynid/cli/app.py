@@ -297,14 +297,17 @@ def identify(
 
 
 def _taken_away(out: Path) -> list:
-    """The lines on the files ``dynid identify`` wrote, read back (results.json's ``files_taken_away``)."""
+    """The lines on the files ``dynid identify`` wrote, read back (results.json's ``files_taken_away``), or why it wrote
+    none (``files_withheld``)."""
     import json
 
     from ..report.summaries import taken_away_lines
+    from ..tables import Line
 
     path = out / "results.json"
-    taken = json.loads(path.read_text(encoding="utf-8")).get("files_taken_away") if path.is_file() else None
-    return taken_away_lines(taken) if taken else []
+    data = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    withheld = [Line(data["files_withheld"], "warning")] if data.get("files_withheld") else []
+    return withheld + (taken_away_lines(data["files_taken_away"]) if data.get("files_taken_away") else [])
 
 
 def _runnable_advice(blocks, config: Path, out: Path) -> list:

@@ -418,6 +418,34 @@ def verdict_warnings(results: dict) -> list[str]:
             for f in results.get("findings") or [] if isinstance(f, dict) and f.get("kind") in READINESS_KINDS]
 
 
+def withheld_files(results: dict) -> str | None:
+    """Why ``dynid identify`` writes no URDF or MJCF of a model: the identification log is read otherwise than the robot
+    file (a :data:`READINESS_KINDS` finding of its own, not only of a validation log), so the model fitted to it is not
+    the robot's; ``dynid export`` still writes it when asked, with the findings as warnings.
+
+    Parameters
+    ----------
+    results : dict
+        A parsed ``results.json`` of ``dynid identify`` (its ``findings``, each ``kind`` and ``text``).
+
+    Returns
+    -------
+    str or None
+        One line, or None where the files are written.
+    """
+    name = str((results.get("identification") or {}).get("name") or "identification")
+    kinds = sorted({str(f.get("kind")) for f in results.get("findings") or [] if isinstance(f, dict)
+                    and f.get("kind") in READINESS_KINDS and str(f.get("text", "")).startswith(f"{name}:")})
+    if not kinds:
+        return None
+    what = {"sign": "a torque's sign", "scale": "the torques' unit or drive gains", "order": "torque columns swapped",
+            "angles": "its angles", "gravity": "the mounting"}
+    return (f"no URDF or MJCF written: the log {name} is read otherwise than the robot file "
+            f"({', '.join(what[k] for k in kinds)}: the verdict names the setting that fixes it), so a model fitted to "
+            "it is not the robot's; identify again with that setting (dynid export CONFIG --urdf FILE writes this one "
+            "all the same)")
+
+
 @keyword_only_after_data
 def urdf_from_results(robot: Robot | str | Path, results: dict, *, source: str = "results") -> str:
     """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).

@@ -212,6 +212,8 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
         sections.append(Section("Measured against predicted torques", _comparison_tables(comparisons)))
     if d.get("files_taken_away"):
         sections.append(_taken_away_section(d["files_taken_away"]))
+    elif d.get("files_withheld"):
+        sections.append(Section("The files you take away", [], [d["files_withheld"]]))
     return settings, sections
 
 

@@ -9,7 +9,7 @@ from .._util.keywords import keyword_only_after_data
 from ..exceptions import DynIdError
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
-from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot
+from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot, withheld_files
 from ..io.mjcf_write_back import mjcf_written_back
 from ..io.replay import mjcf_replay, urdf_replay
 from ..io.results import stored_standard
@@ -115,7 +115,11 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
         paths = save_comparisons((result.fit, *result.validations), out, names=names)
     json_path = out / "results.json"
     data = {**result.to_dict(), "readiness": readiness(result).text}  # the first line: the report's box starts with it
-    models = _model_texts(data, out, robot, urdf=urdf, urdf_name=urdf_name, mjcf_model=mjcf_model, mjcf_name=mjcf_name, mjcf_folder=mjcf_folder)
+    withheld = withheld_files(data)
+    if withheld:
+        data["files_withheld"] = withheld
+    models = [] if withheld else _model_texts(data, out, robot, urdf=urdf, urdf_name=urdf_name, mjcf_model=mjcf_model,
+                                              mjcf_name=mjcf_name, mjcf_folder=mjcf_folder)
     if models:
         data["files_taken_away"] = taken_away(models, robot, data, config)
     write_results(json_path, data, "identify")
