@@ -228,12 +228,13 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
         robot.add("drive_terms", list(URDF_DRIVE_TERMS))
         if gains:
             joints = tomlkit.aot()
-            for g in gains:
+            for j, g in enumerate(gains):
                 entry = tomlkit.table()
-                entry.add("drive_gain", g)
+                entry.add("drive_gain", tomlkit.item(g))
+                if j == 0:
+                    entry["drive_gain"].comment("N·m/A at the joint (eq. 16): the built-in robot's")
                 joints.append(entry)
             robot.add("joints", joints)
-            robot["joints"][0]["drive_gain"].comment("N·m/A at the joint (eq. 16): the built-in robot's")
         robot.add(tomlkit.nl())
         doc.add("robot", robot)
     table.add(tomlkit.nl())
