@@ -89,6 +89,20 @@ def test_init_refusals(tmp_path):
     assert not (tmp_path / "x.toml").exists() and not (tmp_path / "y.toml").exists()
 
 
+def test_init_says_a_file_of_one_signal_per_joint_needs_one_file_per_signal(tmp_path):
+    """FIGAROH's TX40 log: one file of positions and one of currents, each headed Joint_1 … Joint_6. Init said "found 0
+    positions column(s)" of the file of positions (with --rate; without it, "no time column"); it now says the columns
+    name joints, not a signal, and how a config gives each signal its file. Six columns that name signals still pass."""
+    joints = tmp_path / "pos.csv"
+    joints.write_text("Joint_1,Joint_2,Joint_3,Joint_4,Joint_5,Joint_6\n" + "0.1,0.2,0.3,0.4,0.5,0.6\n" * 5)
+    for extra in ((), ("--rate", "5000")):
+        p = run("init", str(URDF), str(joints), "--out", str(tmp_path / "x.toml"), *extra)
+        assert_refused(p, "pos.csv: its 6 columns")
+        said = " ".join(p.stderr.split())
+        assert "name the joints, not a signal" in said and 'positions = { file = "pos.csv", columns = [...] }' in said
+    assert not (tmp_path / "x.toml").exists()
+
+
 def test_init_says_which_columns_it_took_and_which_it_left(tmp_path):
     """A log of six joints for a robot of three (a URDF that is not the whole arm): init took q1-q3 and tau1-tau3 and
     left q4-q6 and tau4-tau6 without a word; now it names what it left and asks whether the URDF is the whole arm."""

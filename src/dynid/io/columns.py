@@ -61,6 +61,7 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         table.add("delimiter", delimiter)
     if header:
         found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
+        _check_one_signal(log, first, found, n_dof)
         if "time" not in found and rate is None:
             raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
                             f"stamps give its sample rate: {rate_hint}")
@@ -272,6 +273,20 @@ def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
     table.add("rate", rate)
     table["rate"].comment("Hz: no time column (--rate)")
     return [f"no time column: one sample every 1/{rate:g} s (--rate)"], []
+
+
+def _check_one_signal(log: Path, first: list[str], found: dict, n_dof: int) -> None:
+    """A log whose header names one column per joint and no signal (FIGAROH's ``Joint_1`` … ``Joint_6``, one file of
+    positions and one of currents): refused with how a config reads one file per signal, which ``dynid init`` does not
+    write (it was told "found 0 positions column(s)", of a file of positions)."""
+    signals = [k for k in found if k != "time"]
+    if signals or len(first) - len(found.get("time", [])) != n_dof:
+        return
+    raise DataError(f"{log}: its {n_dof} columns ({_shown(first)}) name the joints, not a signal: a file of one signal "
+                    "(positions, or torques or currents)? dynid init reads one log holding both; for one file per "
+                    "signal write the [identification] table by hand, each signal with its file: positions = { file = "
+                    f'"{log.name}", columns = [...] }}, torques = {{ file = "...", columns = [...] }} (or currents), '
+                    "header = true, rate = HZ without a time column (docs: configuration, dataset tables)")
 
 
 def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
