@@ -53,6 +53,7 @@ def test_a_flipped_torque_sign_is_still_named(tmp_path):
     said = " ".join(p.stderr.split())
     assert "no URDF or MJCF written: the log identification is read otherwise than the robot file (a torque's sign" in said
     assert "files_withheld" in json.loads((tmp_path / "out" / "results.json").read_text())
+    assert "No URDF or MJCF written: the log identification is read otherwise" in (tmp_path / "out" / "report.html").read_text()
     e = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--urdf", tmp_path / "asked.urdf")
     assert e.returncode == 0 and (tmp_path / "asked.urdf").is_file() and "dynid identify doubts" in e.stderr
 

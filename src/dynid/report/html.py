@@ -246,6 +246,9 @@ def _identify_summary(d: dict) -> list[str]:
                                                                     if export else "."))] if label else []
     if d.get("readiness") and not str(d["readiness"]).startswith("model ready:"):  # the terminal's first line
         out.insert(0, str(d["readiness"]) + ".")
+    if d.get("files_withheld"):  # its first clause: what was not written and why
+        withheld = str(d["files_withheld"]).split(";")[0]
+        out.append(withheld[:1].upper() + withheld[1:] + ".")
     logs = []
     for c in ([d["identification"]] if "identification" in d else []) + list(d.get("validation", [])):
         m = c["metrics"].get(label) or next(iter(c["metrics"].values()), None)
