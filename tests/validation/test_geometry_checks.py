@@ -357,3 +357,24 @@ def test_a_validation_log_recorded_with_another_zero_is_said(tmp_path):
     assert results["readiness"] in report
     assert "validation: read otherwise than the identification log (Findings and warnings say how)" in report
     assert [f for f in right["findings"] if f["kind"] == "misread"] == [] and "misread" not in right["validation"][0]
+
+
+def test_a_log_read_at_ten_times_its_rate_is_named_and_no_model_written(tmp_path):
+    """Both logs of ``dynid example ur10e`` with their time stamps a tenth of the truth (a log without time stamps
+    given rate = 10 times its own, as the LBR Med7's 100 Hz read at 1000 Hz: "model ready" with the validation log
+    at 299 %). The velocities are 10× and the accelerations 100× the robot's; the nominal model fits the torques far
+    better with the motion 10× slower, which is named; the model is not called ready, and no URDF or MJCF is written."""
+    def hurried(data, header):
+        data[:, header.index("time")] *= 0.1
+
+    folder = _example(tmp_path, hurried)
+    p = dynid("identify", folder / "ur10e.toml", "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    said = " ".join((p.stdout + p.stderr).split())
+    assert "not ready: the torques fit the description far better with the motion faster or slower than logged" in said
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    (rate,) = [f["text"] for f in results["findings"] if f["kind"] == "rate"]
+    assert rate.startswith("identification: the description's nominal model fits the torques far better with the "
+                           "motion about 10× slower than logged")
+    assert results["diagnostics"]["geometry"]["time_scale"] == 10.0
+    assert not list((tmp_path / "out").glob("*.urdf"))

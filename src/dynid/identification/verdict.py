@@ -213,7 +213,7 @@ def _without_misread(result, nominal, scored, judged, states):
     if not trusted and chosen.main == SDP_LABEL != result.label:
         on += f": {SDP_LABEL}, physically consistent where {result.label} is not, and what dynid export writes"
     text = (f"the verdict leaves out {', '.join(sorted(names))}: read otherwise than the identification log (its "
-            "angles, mounting, torque channels or units: the warning says how), its figures score every estimate by that, "
+            "angles, mounting, torque channels, units or rate: the warning says how), its figures score every estimate by that, "
             f"not by how it predicts; the main estimate is chosen on {on}: read the log as the warning says and "
             "identify again for a test on it")
     findings = list(chosen.findings)

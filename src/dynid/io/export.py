@@ -394,9 +394,10 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("sign", "scale", "order", "angles", "gravity")
+READINESS_KINDS = ("sign", "scale", "order", "angles", "gravity", "rate")
 """Findings of ``dynid identify``'s verdict that say the log itself is wrong (the torques' sign, unit or gain, channels
-swapped, angles or a mounting that do not match the robot file): a model fitted to it is exported with a warning."""
+swapped, angles or a mounting that do not match the robot file, its sample rate): a model fitted to it is exported with
+a warning."""
 
 
 def verdict_warnings(results: dict) -> list[str]:
@@ -412,7 +413,7 @@ def verdict_warnings(results: dict) -> list[str]:
     -------
     list of str
     """
-    what = {"angles": "angles", "gravity": "a mounting"}
+    what = {"angles": "angles", "gravity": "a mounting", "rate": "a sample rate"}
     return [f"the model was fitted to {what.get(str(f.get('kind')), 'torques')} dynid identify doubts: "
             f"{f.get('text')}"
             for f in results.get("findings") or [] if isinstance(f, dict) and f.get("kind") in READINESS_KINDS]
@@ -439,7 +440,7 @@ def withheld_files(results: dict) -> str | None:
     if not kinds:
         return None
     what = {"sign": "a torque's sign", "scale": "the torques' unit or drive gains", "order": "torque columns swapped",
-            "angles": "its angles", "gravity": "the mounting"}
+            "angles": "its angles", "gravity": "the mounting", "rate": "its sample rate"}
     return (f"no URDF or MJCF written: the log {name} is read otherwise than the robot file "
             f"({', '.join(what[k] for k in kinds)}: the verdict names the setting that fixes it), so a model fitted to "
             "it is not the robot's; identify again with that setting (dynid export CONFIG --urdf FILE writes this one "

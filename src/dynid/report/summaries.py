@@ -359,6 +359,9 @@ def readiness(result, *, library: bool = False) -> Line:
         return Line("not ready: the logged angles do not match the robot file (a joint's zero a quarter or half turn "
                     "off, a joint counted the other way round, or two columns swapped?): the verdict at the end names "
                     "them and the setting that fixes it", "warning")
+    if "rate" in kinds:
+        return Line("not ready: the torques fit the description far better with the motion faster or slower than logged "
+                    "(the log's sample rate or time unit?): the verdict at the end says how much", "warning")
     if "gravity" in kinds:
         return Line("not ready: the torques fit the description far better with gravity along another direction (a "
                     "robot mounted on a wall, a ceiling or tilted?): the verdict at the end names it and the setting that "
@@ -369,7 +372,7 @@ def readiness(result, *, library: bool = False) -> Line:
     misread = [v.name for v in r.validations if v.misread]
     if misread:
         return Line(f"not ready: {', '.join(misread)} {'is' if len(misread) == 1 else 'are'} read otherwise than the "
-                    "identification log (angles, mounting, torque channels or units), so the model has no fair test on other "
+                    "identification log (angles, mounting, torque channels, units or rate), so the model has no fair test on other "
                     "motions: the warning says how to read it; then identify again", "warning")
     if getattr(r.estimates.get(getattr(r, "main", "")), "key", "") == NOMINAL_KEY:
         return Line(f"keep your robot file's values ({r.main}): this log cannot improve them; the verdict at the end "

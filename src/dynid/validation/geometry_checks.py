@@ -17,7 +17,9 @@ summed over the joints, is compared for the logged angles and for the logged ang
 ±π/2 or π, two joints' position columns swapped (their nuisance columns swapped too; every figure over what the logged
 angles' nuisance columns leave, so that all are on one scale), their position and torque columns swapped (a driver's
 alphabetical joint order), one joint's states negated, gravity along each axis of the base either way, or along the
-direction that explains most (:func:`tilted_gravity`) where it is tilted from every axis.
+direction that explains most (:func:`tilted_gravity`) where it is tilted from every axis. Before them, the motion
+faster or slower than logged (:func:`time_scale`: a log's sample rate or time unit misread scales its velocities and
+accelerations, not its angles).
 A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
 (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
@@ -72,6 +74,20 @@ neighbours about 1.4° apart."""
 TILTED = (2.0, 10.0)
 """Degrees from the description's gravity, and from every other axis of the base, beyond which the best gravity
 direction is a candidate of its own (a robot mounted tilted); nearer another axis, that axis's candidate names it."""
+
+ROUND_SCALES = np.array([2.0, 3.0, 4.0, 5.0, 10.0, 20.0, 50.0, 60.0, 100.0, 1000.0])
+"""Time scales a misread rate or unit makes (half or twice the rate, 100 Hz read as 1 kHz, ms as s, minutes):
+preferred among those that fit as well."""
+
+TIME_SCALES = np.unique(np.concatenate([10.0 ** np.linspace(-3.0, 3.0, 61), ROUND_SCALES, 1 / ROUND_SCALES]))
+"""The time scales :func:`time_scale` tries: from 1000× faster to 1000× slower than logged, 10^0.1 apart, and
+:data:`ROUND_SCALES` both ways."""
+
+TIME_SCALE_TIE = 1.25
+"""Scales that leave within this ratio of the least are as good (the slowest log's inertial torques are small)."""
+
+RATE_FACTOR = 1.5
+"""A time scale is named where the motion is at least this many times slower or faster than logged."""
 
 SAMPLES = (100, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
@@ -337,8 +353,9 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
         stats["twin"] = {"shift": shifts[twin].tolist(), "order": orders[twin].tolist(),
                          "gravity": gravities[twin].tolist(), "direction": ways[twin].tolist(),
                          "channels": bool(channels[twin])}
-    if scores[pick] > CHANGE_GAIN * logged or not _replicated(robot, raw, changes, pick):
-        return [], stats
+    rate = _rate_finding(robot, (log, raw), logged, float(scores[pick]), dataset, stats)
+    if rate or scores[pick] > CHANGE_GAIN * logged or not _replicated(robot, raw, changes, pick):
+        return rate, stats
     share = (f"of the torque that friction, rotor inertia and an offset leave, it explains all but "
              f"{100 * scores[pick]:.2g} % so, all but {100 * logged:.2g} % as it is")
     kind, text, joint = _text_of(robot, log, changes, pick)
@@ -347,6 +364,68 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
            "order or another mounting than the identification log? Its scores say little until it is read as that one")
     return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {what}: "
                           f"{share}. {fix}", joint)], stats
+
+
+def time_scale(robot: Robot, q, dq, ddq, tau) -> tuple[float, float]:
+    """The time scale ``c`` of the log that the description's nominal model explains best: its torque with the motion
+    ``c`` times slower than logged is the gravity torque plus the rest divided by ``c²`` (velocities and accelerations
+    are derivatives in time), scored as the geometry's candidates are (module docstring), over ``c`` from 1/1000 to
+    1000 (:data:`TIME_SCALES`).
+
+    Parameters
+    ----------
+    robot : Robot
+    q, dq, ddq, tau : (N, n_dof) arrays
+        The log's states [rad, rad/s, rad/s²] and torques [N·m].
+
+    Returns
+    -------
+    c : float
+        The scale nearest 1 that leaves within :data:`TIME_SCALE_TIE` of the least any scale leaves (a slow log whose
+        inertial torques are small fits any slower motion as well: the least slowing that does), a round one
+        (:data:`ROUND_SCALES`) where one does.
+    share : float
+        What the nominal model leaves at ``c``, of what the nuisance columns leave.
+    """
+    left = _time_scaled_shares(robot, (q, dq, ddq, tau), TIME_SCALES)
+    near = np.flatnonzero(left <= TIME_SCALE_TIE * left.min())
+    rounded = [k for k in near if np.any(np.isclose(TIME_SCALES[k], np.concatenate([ROUND_SCALES, 1 / ROUND_SCALES])))]
+    near = np.asarray(rounded or near)
+    k = int(near[np.argmin(np.abs(np.log(TIME_SCALES[near])))])
+    return float(TIME_SCALES[k]), float(left[k])
+
+
+def _time_scaled_shares(robot: Robot, log: tuple, scales) -> np.ndarray:
+    """What the nominal model leaves of the torque beyond the nuisance columns with the motion of ``log`` (q, dq, ddq,
+    tau) each of ``scales`` times slower (:func:`time_scale`)."""
+    q, dq, ddq, tau = log
+    reference = _sums(robot, q, dq, ddq, tau, None)[0]
+    still = np.zeros_like(dq)
+    gravity = nominal_rigid_torque(robot, q, still, still)
+    moving = nominal_rigid_torque(robot, q, dq, ddq) - gravity
+    return np.array([_sums(robot, q, dq, ddq, tau, gravity + moving / c**2)[0] for c in scales]) / max(reference, 1e-300)
+
+
+def _rate_finding(robot: Robot, logs: tuple, logged: float, changed: float, dataset: str, stats: dict) -> list:
+    """A "rate" finding where the nominal model explains the torques far better with the motion at another speed
+    (:func:`time_scale`) than as logged and than the closest change of geometry (``changed``), on the samples searched
+    and on another set of them (:func:`_replicated`'s): the log's sample rate or its time column's unit misread."""
+    log, raw = logs
+    c, share = time_scale(robot, *log)
+    stats.update(time_scale=c, unexplained_time_scaled=share)
+    if share > CHANGE_GAIN * logged or share >= changed or abs(np.log(c)) < np.log(RATE_FACTOR):
+        return []
+    if len(raw[0]) > SAMPLES[0] * SAMPLES[1]:
+        again = _time_scaled_shares(robot, tuple(_spread(x, 0.5) for x in raw), (1.0, c))
+        if again[1] > CHANGE_GAIN * again[0]:
+            return []
+    way = "slower" if c > 1 else "faster"
+    factor = c if c > 1 else 1 / c
+    return [Finding("rate", f"{dataset}: the description's nominal model fits the torques far better with the motion "
+                            f"about {factor:.3g}× {way} than logged ({100 * share:.2g} % of the torque beyond friction, "
+                            f"rotor inertia and an offset left so, {100 * logged:.2g} % as logged): is the log's sample "
+                            f"rate (rate = ...) or its time column's unit right? Read at {1 / c:.3g}× the rate it is "
+                            "read at now, its velocities and accelerations are the robot's")]
 
 
 def _replicated(robot: Robot, raw: tuple, changes: tuple, pick: int) -> bool:
