@@ -382,14 +382,14 @@ def time_scale(robot: Robot, q, dq, ddq, tau) -> tuple[float, float]:
     -------
     c : float
         The scale nearest 1 that leaves within :data:`TIME_SCALE_TIE` of the least any scale leaves (a slow log whose
-        inertial torques are small fits any slower motion as well: the least slowing that does), a round one
+        inertial torques are small fits any slower motion as well: the least slowing that does), 1 or a round one
         (:data:`ROUND_SCALES`) where one does.
     share : float
         What the nominal model leaves at ``c``, of what the nuisance columns leave.
     """
     left = _time_scaled_shares(robot, (q, dq, ddq, tau), TIME_SCALES)
     near = np.flatnonzero(left <= TIME_SCALE_TIE * left.min())
-    rounded = [k for k in near if np.any(np.isclose(TIME_SCALES[k], np.concatenate([ROUND_SCALES, 1 / ROUND_SCALES])))]
+    rounded = [k for k in near if np.any(np.isclose(TIME_SCALES[k], np.concatenate([[1.0], ROUND_SCALES, 1 / ROUND_SCALES])))]
     near = np.asarray(rounded or near)
     k = int(near[np.argmin(np.abs(np.log(TIME_SCALES[near])))])
     return float(TIME_SCALES[k]), float(left[k])
