@@ -17,9 +17,9 @@ summed over the joints, is compared for the logged angles and for the logged ang
 ±π/2 or π, two joints' position columns swapped (their nuisance columns swapped too; every figure over what the logged
 angles' nuisance columns leave, so that all are on one scale), their position and torque columns swapped (a driver's
 alphabetical joint order), one joint's states negated, gravity along each axis of the base either way, or along the
-direction that explains most (:func:`tilted_gravity`) where it is tilted from every axis. Before them, the motion
+direction that explains most (:func:`tilted_gravity`) where it is tilted from every axis. Beside them, the motion
 faster or slower than logged (:func:`time_scale`: a log's sample rate or time unit misread scales its velocities and
-accelerations, not its angles).
+accelerations, not its angles), named only where it leaves less than every change of geometry.
 A change is named where it leaves at most :data:`CHANGE_GAIN` of what the log and the description as they are leave
 (Frisch-Waugh: the nominal column is regressed out of the nuisance columns' residual).
 """
