@@ -647,8 +647,8 @@ def _misread_lines(names: list) -> list:
     """The line that says which logs are read otherwise than the identification log (none: no line)."""
     if not names:
         return []
-    return [Line(f"{', '.join(names)}: read otherwise than the identification log (angles, mounting, torque channels or "
-                 "units: the warning says how): its figures say little of any estimate")]
+    return [Line(f"{', '.join(names)}: read otherwise than the identification log (angles, mounting, torque channels, "
+                 "units or rate: the warning says how): its figures say little of any estimate")]
 
 
 def validation_blocks(comparisons, *, tables: bool = True) -> list:
