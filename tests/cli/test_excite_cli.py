@@ -1,9 +1,11 @@
 """`dynid excite` as a user runs it, and `dynid run --excitation` on its output."""
 
 import json
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from dynid.dynamics.kinematics import tool_positions
@@ -83,7 +85,7 @@ def test_excite_er16_then_run_on_the_designed_trajectory(tmp_path):
      "limits: joint 2 has q_max = 1 rad not above q_min = 2 rad"),
     ({"floor = -0.5": "floor = 1.5"}, "workspace excludes the start pose"),
     ({"harmonics = 5": "harmonics = 0"}, "trajectory.harmonics: expected an integer >= 1, got 0"),
-    ({"frequency = 0.05": "omega_f = 0.3\nfrequency = 0.05"}, "give exactly one of frequency"),
+    ({"frequency = 0.05": "omega_f = 0.3\nfrequency = 0.05"}, "give one of frequency (Hz) or omega_f (rad/s), not both"),
     ({"[design]": "[design]\ncolour = 1"}, "design: unknown field 'colour', expected some of criterion"),
     ({'initial = "paper"': 'initial = "nosuch.json"'}, "nosuch.json: trajectory file not found"),
 ])
@@ -104,8 +106,6 @@ def test_run_excitation_file_with_wrong_joint_count(tmp_path):
 def test_a_continuous_joint_is_said_in_one_line_not_a_numpy_warning(tmp_path):
     """issue "An excitation safe to run", item 4: a URDF joint without position limits leaked NumPy's RuntimeWarning
     (``mid = 0.5*(q_min+q_max)`` of ±inf); it is said in one line with the range the trajectory takes."""
-    from importlib import resources
-
     urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8")
     old = '<joint name="wrist_3_joint" type="revolute">'
     assert urdf.count(old) == 1
@@ -120,3 +120,53 @@ def test_a_continuous_joint_is_said_in_one_line_not_a_numpy_warning(tmp_path):
     assert "no position limits on J6 (continuous joints)" in said
     q = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)[:, 6]
     assert f"J6 {q.min():.3g} to {q.max():.3g} rad" in said
+
+
+def _robot_only(tmp_path, extra: str = "") -> Path:
+    """A config naming the robot and nothing of the trajectory: a user's first excitation."""
+    path = tmp_path / "excite.toml"
+    path.write_text('robot = "ur10e"\n[design]\nstarts = 1\nmaxiter = 5\n[output]\nrate = 100\n' + extra)
+    return path
+
+
+def test_a_config_naming_only_the_robot_designs_the_default_trajectory(tmp_path):
+    """A ``dynid excite`` config without ``[trajectory]`` was refused ("expected a [trajectory] table") where an
+    identification config without ``[excitation]`` designs 5 harmonics of 0.1 Hz from and to rest: now both do."""
+    p = dynid("excite", str(_robot_only(tmp_path)), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0, p.stderr
+    doc = json.loads((tmp_path / "out" / "excitation.json").read_text())
+    assert doc["harmonics"] == 5 and doc["rest"] is True
+    assert doc["omega_f"] == pytest.approx(2 * np.pi * 0.1, rel=1e-12)
+    csv = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)
+    assert csv[-1, 0] == pytest.approx(10.0) and np.allclose(csv[[0, -1], 7:], 0.0, atol=1e-7)  # at rest at both ends
+
+
+def test_without_a_floor_the_arm_going_below_its_base_is_said(tmp_path):
+    """issue "Nothing runs, nothing silent": a design without ``[workspace] floor`` keeps nothing off the table the
+    robot stands on. Where its set-points take a joint below the base frame's origin, that is said with where and
+    when, checked against Pinocchio's kinematics of the robot's URDF; with a floor given it is not."""
+    p = dynid("excite", str(_robot_only(tmp_path)), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0, p.stderr
+    lowest = json.loads((tmp_path / "out" / "excitation.json").read_text())["lowest"]
+    csv = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)
+    model = pin.buildModelFromUrdf(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
+    data = model.createData()
+    z = np.empty((csv.shape[0], 6))
+    for n, q in enumerate(csv[:, 1:7]):
+        pin.forwardKinematics(model, data, q)
+        z[n] = [data.oMi[j].translation[2] for j in range(1, 7)]
+    assert lowest["height"] < 0 and lowest["height"] <= z.min() + 1e-9
+    if lowest["point"] != "the tool point":
+        k = int(lowest["point"].split()[1].removesuffix("'s")) - 1
+        n = int(np.argmin(np.abs(csv[:, 0] - lowest["time"])))
+        assert lowest["height"] == pytest.approx(z[n, k], abs=1e-9)
+    said = " ".join((p.stdout + p.stderr).split())
+    assert (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {lowest['point']} "
+            f"goes {-lowest['height']:.3g} m below the base frame's origin at t = {lowest['time']:.3g} s") in said
+    assert "give its height in the base frame as [workspace] floor" in said
+    assert "no floor given" in (tmp_path / "out" / "report.html").read_text().replace("&#39;", "'")
+
+    p = dynid("excite", str(_robot_only(tmp_path, "[workspace]\nfloor = -2.0\n")), "--out", str(tmp_path / "floor"))
+    assert p.returncode == 0, p.stderr
+    assert "no floor given" not in p.stdout + p.stderr
+    assert "lowest" not in json.loads((tmp_path / "floor" / "excitation.json").read_text())

@@ -394,3 +394,56 @@ def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Work
         out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {found.links[cols[c]] + 1}{shape} at "
                                     f"t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan))
     return out
+
+
+@dataclass(frozen=True)
+class LowestPoint:
+    """The lowest point the arm reaches along a trajectory: its joint origins and tool point, against gravity.
+
+    Attributes
+    ----------
+    height : float [m]
+        Above the base frame's origin, along the robot's up (``-gravity``); below 0, the arm goes below its base.
+    point : str
+        "the tool point" or "joint k's origin".
+    time : float [s]
+        When.
+    """
+
+    height: float
+    point: str
+    time: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready.
+
+        Returns
+        -------
+        dict
+        """
+        return {"height": self.height, "point": self.point, "time": self.time}
+
+
+def lowest_point(robot: Robot, t: np.ndarray, q: np.ndarray) -> LowestPoint:
+    """Where a trajectory takes the arm lowest: what a design without a floor (:attr:`Workspace.floor`) leaves
+    unchecked, the surface the robot stands on.
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+
+    Returns
+    -------
+    LowestPoint
+        Heights along ``-robot.gravity`` (``+z`` without gravity), from the base frame's origin.
+    """
+    g = np.asarray(robot.gravity, dtype=float)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    rots, origins = forward_kinematics(robot, q)
+    tool = origins[:, -1] + rots[:, -1] @ np.asarray(robot.tool_translation, dtype=float)
+    heights = np.concatenate([origins @ up, (tool @ up)[:, None]], axis=1)  # (N, n_dof + 1)
+    n, k = np.unravel_index(int(np.argmin(heights)), heights.shape)
+    return LowestPoint(float(heights[n, k]), "the tool point" if k == robot.n_dof else f"joint {k + 1}'s origin",
+                       float(t[n]))

@@ -10,7 +10,7 @@ import numpy as np
 
 from .._util.reprs import short_repr
 from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
-from ..excitation.constraints import ConstraintMargin, obstacle_margins
+from ..excitation.constraints import ConstraintMargin, LowestPoint, lowest_point, obstacle_margins
 from ..excitation.design import ExcitationDesign, InfeasibleDesignError, design_excitation
 from ..io.cell_replay import CellContacts, cell_contacts
 from ..io.excitation_config import ExcitationConfig
@@ -38,6 +38,9 @@ class ExcitationRun:
     mujoco_contacts : CellContacts or None
         The set-points checked a second time by MuJoCo (:func:`dynid.io.cell_replay.cell_contacts`; None without a
         floor or bodies, or without MuJoCo).
+    lowest : LowestPoint or None
+        Without a floor (``[workspace] floor``): where the set-points take the arm lowest, which nothing in the design
+        kept off the surface the robot stands on (:func:`dynid.excitation.constraints.lowest_point`).
     """
 
     config: ExcitationConfig
@@ -49,6 +52,7 @@ class ExcitationRun:
     self_clearance: SelfClearance | None = None
     cell_clearance: tuple[ConstraintMargin, ...] = ()
     mujoco_contacts: CellContacts | None = None
+    lowest: LowestPoint | None = None
 
     def to_dict(self) -> dict:
         """The run as ``excitation.json``.
@@ -73,6 +77,7 @@ class ExcitationRun:
             **({} if self.self_clearance is None else {"self_clearance": self.self_clearance.to_dict()}),
             **({"cell_clearance": [m.to_dict() for m in self.cell_clearance]} if self.cell_clearance else {}),
             **({} if self.mujoco_contacts is None else {"mujoco_contacts": self.mujoco_contacts.to_dict()}),
+            **({} if self.lowest is None else {"lowest": self.lowest.to_dict()}),
         }
 
 
@@ -99,7 +104,8 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     clearance = (self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance) if p.workspace.geometry is None
                  else shape_clearance(p.robot, t[::every], q[::every], p.workspace.geometry))
     cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
-    run = ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace))
+    lowest = None if np.isfinite(p.workspace.floor) else lowest_point(p.robot, t, q)
+    run = ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace), lowest)
     _refuse_unsafe(run)
     return run
 

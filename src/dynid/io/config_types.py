@@ -267,8 +267,8 @@ PerJointNumber = Union[float, list[float]]
 class TrajectoryTable(Table, kw_only=True):
     """``[trajectory]`` of an excitation (eq. 14)."""
 
-    harmonics: Annotated[int, Meta(ge=1, description="N of eq. 14")]
-    frequency: Annotated[float, Meta(gt=0, description="fundamental frequency, Hz")] | None = None
+    harmonics: Annotated[int, Meta(ge=1, description="N of eq. 14 (default 5)")] | None = None
+    frequency: Annotated[float, Meta(gt=0, description="fundamental frequency, Hz (default 0.1 without omega_f)")] | None = None
     omega_f: Annotated[float, Meta(gt=0, description="fundamental pulsation, rad/s")] | None = None
     form: Annotated[Literal["paper", "swevers"], _d("how the coefficients are written: eq. 14 or the Swevers form")] | None = None
     offsets: Annotated[PerJointAngle, _d("fixed q_o [rad]; omit to optimise them")] | None = None
@@ -354,7 +354,8 @@ class ExcitationDocument(Table, kw_only=True):
     joints: Annotated[int, Meta(ge=1, description="identify the first joints (default all)")] | None = None
     name: Annotated[str, _d("the config's name")] | None = None
     notes: Annotated[str, _d("free text")] | None = None
-    trajectory: Annotated[TrajectoryTable, _d("the Fourier trajectory (eq. 14)")]
+    trajectory: Annotated[TrajectoryTable, _d("the Fourier trajectory (eq. 14); without it 5 harmonics of 0.1 Hz, "
+                                             "starting and ending at rest")] | None = None
     limits: Annotated[LimitsTable, _d("limits overriding the robot's")] = msgspec.field(default_factory=LimitsTable)
     workspace: Annotated[WorkspaceTable, _d("where the tool may go")] = msgspec.field(default_factory=WorkspaceTable)
     design: Annotated[DesignTable, _d("the optimisation")] = msgspec.field(default_factory=DesignTable)

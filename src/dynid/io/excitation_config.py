@@ -34,9 +34,10 @@ Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to t
     rate = 500                   # controller rate of the CSV [Hz]
     periods = 1
 
+Every table is optional: without ``[trajectory]`` the design has :data:`DEFAULT_TRAJECTORY` (5 harmonics of 0.1 Hz,
+from and to rest), and a ``[trajectory]`` table without ``harmonics`` or a frequency takes those two from it.
 An identification config (``dynid identify``'s) is an excitation config too: its robot, and its optional
-``[excitation]`` table holding the tables above (``joints``, ``[excitation.trajectory]``, ``[excitation.limits]`` …);
-without ``[excitation.trajectory]`` the design has :data:`DEFAULT_TRAJECTORY`.
+``[excitation]`` table holding the tables above (``joints``, ``[excitation.trajectory]``, ``[excitation.limits]`` …).
 """
 
 from __future__ import annotations
@@ -58,13 +59,14 @@ from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
-from .config_types import ExcitationDocument
+from .config_types import ExcitationDocument, TrajectoryTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config
 from .trajectories import load_trajectory
 
 DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
-"""The trajectory designed for an identification config without ``[excitation.trajectory]``: 5 harmonics of 0.1 Hz
-(a 10 s period, as the UR10e's example) starting and ending at rest at offsets chosen by the design."""
+"""The trajectory designed without a ``[trajectory]`` table (``[excitation.trajectory]`` of an identification config):
+5 harmonics of 0.1 Hz (a 10 s period, as the UR10e's example) starting and ending at rest at offsets chosen by the
+design."""
 
 
 def _from_identification(doc: dict, path: Path) -> dict:
@@ -72,9 +74,7 @@ def _from_identification(doc: dict, path: Path) -> dict:
     table = doc.get("excitation", {})
     if not isinstance(table, dict):
         raise ConfigError(f"{path}: excitation: expected a table ([excitation]), got {type(table).__name__}")
-    excitation = dict(table)
-    excitation.setdefault("trajectory", dict(DEFAULT_TRAJECTORY))
-    return {"robot": doc.get("robot"), **excitation}
+    return {"robot": doc.get("robot"), **table}
 
 
 def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = None, srdf: Path | None = None):
@@ -182,11 +182,12 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         raise ConfigError(f"{path}: joints: robot {full.name!r} has {full.n_dof} joints, got {k}")
     robot = full.submodel(k) if k < full.n_dof else full
 
-    tr = c.trajectory
-    harmonics = tr.harmonics
-    if (tr.frequency is None) == (tr.omega_f is None):
-        raise ConfigError(f"{path}: trajectory: give exactly one of frequency (Hz) or omega_f (rad/s)")
-    omega_f = 2 * np.pi * tr.frequency if tr.frequency is not None else float(tr.omega_f or 0.0)
+    tr = c.trajectory if c.trajectory is not None else convert(DEFAULT_TRAJECTORY, TrajectoryTable, str(path))
+    harmonics = int(tr.harmonics if tr.harmonics is not None else DEFAULT_TRAJECTORY["harmonics"])
+    if tr.frequency is not None and tr.omega_f is not None:
+        raise ConfigError(f"{path}: trajectory: give one of frequency (Hz) or omega_f (rad/s), not both")
+    frequency = tr.frequency if tr.frequency is not None or tr.omega_f is not None else DEFAULT_TRAJECTORY["frequency"]
+    omega_f = 2 * np.pi * frequency if frequency is not None else float(tr.omega_f or 0.0)
     form = tr.form or "paper"
     offsets = _per_joint(tr.offsets, k, f"{path}: trajectory.offsets", angle=True) if tr.offsets is not None else None
     rest = bool(tr.rest)

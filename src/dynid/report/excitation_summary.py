@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..tables import Line, TextTable
 
-__all__ = ["excitation_blocks"]
+__all__ = ["excitation_blocks", "no_floor_line"]
 
 
 def excitation_blocks(run) -> list:
@@ -39,11 +39,40 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
                         f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
+    lowest = getattr(run, "lowest", None)
+    if lowest is not None:
+        text, warned = no_floor_line(lowest.to_dict())
+        out.append(Line(text, "warning" if warned else "text"))
     out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
     if d.feasible:
         out.append(Line("next: play excitation.csv on the robot at its rate (docs: the workflow tutorial), log positions "
                         "and torques (or motor currents), and dynid identify the log"))
     return out
+
+
+def no_floor_line(lowest: dict) -> tuple[str, bool]:
+    """What a design without a floor says of the surface the robot stands on: where the arm goes lowest
+    (:func:`dynid.excitation.constraints.lowest_point`), a warning where that is below the base frame's origin.
+
+    Parameters
+    ----------
+    lowest : dict
+        excitation.json's ``lowest``: ``height`` [m], ``point``, ``time`` [s].
+
+    Returns
+    -------
+    text : str
+    warning : bool
+        Whether the arm goes below the base frame's origin.
+    """
+    h, point, t = float(lowest["height"]), lowest["point"], float(lowest["time"])
+    if h >= 0:
+        return (f"no floor given ([workspace] floor): the lowest point, {point}, stays {h:.3g} m above the base frame's "
+                f"origin (t = {t:.3g} s)"), False
+    return (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {point} goes "
+            f"{-h:.3g} m below the base frame's origin at t = {t:.3g} s. If the robot stands on a table or the floor, "
+            "give its height in the base frame as [workspace] floor (0 where the base frame sits on it; every link then "
+            "stays workspace.clearance above it) and design again"), True
 
 
 def design_blocks(design) -> list:

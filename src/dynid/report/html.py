@@ -14,6 +14,7 @@ from pathlib import Path
 from .. import __version__
 from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
+from .excitation_summary import no_floor_line
 
 
 @dataclass
@@ -362,8 +363,10 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
                     ["constraint", "where", "limit", "worst", "margin", "margin %"],
                     [[m["constraint"], m["where"], _fmt(m["limit"]), _fmt(m["worst"]), _fmt(m["margin"]),
                       _fmt(None if m.get("relative") is None else 100 * m["relative"], ".3g")] for m in g.get("margins", [])], (1,))
-    return settings, [Section("Design", [before], [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the "
-                                                   f"10× grid: {g['feasible']}"]), Section("Constraints", [margins])]
+    notes = [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the 10× grid: {g['feasible']}"]
+    if "lowest" in d:
+        notes.append(no_floor_line(d["lowest"])[0])
+    return settings, [Section("Design", [before], notes), Section("Constraints", [margins])]
 
 
 def closed_loop_sections(d: dict) -> tuple[dict, list[Section]]:
