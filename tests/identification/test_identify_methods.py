@@ -1,6 +1,8 @@
 """Every estimator on a log (the paper's ABC included): one registry for run and identify."""
 
 import json
+import re
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -136,7 +138,7 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
 
 
 def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accuracy(tmp_path):
-    """[estimation] sdp_prior = "geometric": the SDP keeps what the data do not determine near the nominal links by
+    """``estimators = ["ols", { key = "sdp", prior_kind = "geometric" }]``: the SDP keeps what the data do not determine near the nominal links by
     the pseudo-inertias' log-det divergence (Lee, Wensing & Park 2020): the fit is the Euclidean prior's, and every
     link of the estimate is a non-degenerate mass distribution (principal inertias of the nominal's order)."""
     from dynid.io.export import consistent_estimate
@@ -146,7 +148,7 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     text = cfg.read_text()
     runs = {}
     for kind in ("euclidean", "geometric"):
-        cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", "sdp"]\nsdp_prior = "{kind}"\n'))
+        cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", {{ key = "sdp", prior_kind = "{kind}" }}]\n'))
         config = load_identification_config(cfg)
         assert config.estimation.hyperparameters == {"sdp": {"prior_kind": kind}}
         runs[kind] = (config, run_identification(config, validate=True))
@@ -163,11 +165,63 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
         assert smallest > 1e-3 * nominal, (j, smallest, nominal)
 
 
-def test_an_unknown_sdp_prior_is_refused(tmp_path):
+@pytest.mark.parametrize("estimation, message", [
+    ('estimators = ["ols", { key = "sdp", prior_kind = "round" }]',
+     "estimation.estimators[1]: sdp's prior_kind: expected one of euclidean, geometric, got 'round'"),
+    ('estimators = ["ols"]\nsdp_prior = "round"', "estimation.estimators: sdp's prior_kind: expected one of euclidean"),
+    ('estimators = ["ols", { key = "abc", colonysize = 8 }]',
+     "estimation.estimators[1]: abc has no hyper-parameter 'colonysize'; expected some of colony_size, limit, maxiter"),
+    ('estimators = ["ols", { key = "abc", rng = 8 }]', "abc has no hyper-parameter 'rng' (dynid fills it"),
+    ('estimators = ["ols", { prior_kind = "geometric" }]', 'estimation.estimators[1]: a table in the list names its '
+                                                          'estimator, { key = "sdp"'),
+    ('estimators = ["ols", { key = "nosuch" }]', "nosuch"),
+])
+def test_an_estimators_bad_hyperparameters_are_refused_in_one_line(tmp_path, estimation, message):
+    """An estimator's hyper-parameters in the estimators list: a name its class does not take, a value outside its
+    choices, a table naming no estimator are said with the entry, when the config is read."""
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
-    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols"]\nsdp_prior = "round"\n'))
-    with pytest.raises(ConfigError, match=r"estimation.sdp_prior"):
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n', estimation + "\n"))
+    with pytest.raises(ConfigError, match=re.escape(message)), warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
         load_identification_config(cfg)
+
+
+def test_sdp_prior_is_still_read_with_a_warning_and_means_the_same(tmp_path):
+    """``[estimation] sdp_prior`` (before: the SDP's one hyper-parameter a config could set) is now said in the
+    estimators list; the old key gives the same settings, with a FutureWarning naming the new spelling, and
+    ``dynid migrate`` rewrites it to a config that loads to the same settings without the warning."""
+    from dynid.io.migrate import migrate_text
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    text = cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\nsdp_prior = "geometric"\n')
+    cfg.write_text(text)
+    with pytest.warns(FutureWarning, match=r'sdp_prior = .geometric. is now said in the estimators list, as '
+                                           r'\{ key = "sdp", prior_kind = .geometric. \}.*dynid migrate'):
+        old = load_identification_config(cfg).estimation
+    migrated, changes = migrate_text(text, str(cfg))
+    assert 'estimators = ["ols", {key = "sdp", prior_kind = "geometric"}]' in migrated and "sdp_prior =" not in migrated
+    assert changes and changes[0].startswith("[estimation] sdp_prior")
+    cfg.write_text(migrated)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FutureWarning)
+        new = load_identification_config(cfg).estimation
+    assert old == new and new.hyperparameters == {"sdp": {"prior_kind": "geometric"}}
+
+
+def test_a_box_searchs_hyperparameters_reach_it_from_the_config(tmp_path):
+    """``{ key = "abc", colony_size = 8, maxiter = 4 }``: the paper's bee colony with its Table 3 settings of the
+    user's, which a config could not set before (only the SDP's prior): the colony searched 8 food sources for 4
+    cycles, as results.json's settings and the fitted estimator's history say."""
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n',
+                                           'estimators = ["ols", { key = "abc", colony_size = 8, maxiter = 4 }]\n'))
+    config = load_identification_config(cfg)
+    assert config.estimation.hyperparameters == {"abc": {"colony_size": 8, "maxiter": 4}}
+    result = run_identification(config, validate=False)
+    given = result.settings["estimator_hyperparameters"]["abc"]
+    assert given["colony_size"] == 8 and given["maxiter"] == 4
+    fitted = result.estimates["dynid ABC"].estimator
+    assert fitted.colony_size == 8 and len(fitted.history_) <= 4 + 1  # the best before the first cycle, one per cycle
 
 
 def test_validate_opens_with_each_logs_errors_and_the_best_set(tmp_path):

@@ -6,6 +6,7 @@ Exit codes: 0 success, 1 user or data error (one-line message), 2 usage error.
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 
 import typer
@@ -1080,6 +1081,15 @@ def _interrupt(signum, frame):
     raise Interrupted(signum)
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python's warnings as a command prints them: a setting that changed (a ``FutureWarning``: it names the
+    setting and the new spelling) as one warning line; any other as Python shows it, with where it came from."""
+    if issubclass(category, FutureWarning):
+        Reporter().warning(str(message))
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console-script entry point.
 
@@ -1105,7 +1115,9 @@ def main(argv: list[str] | None = None) -> int:
 
     handlers = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with allow_forks():  # this process is dynid's: figures and drive gains may go to forked children
+        # this process is dynid's: figures and drive gains may go to forked children
+        with allow_forks(), warnings.catch_warnings():
+            warnings.showwarning = _show_warning
             app(args=argv, prog_name="dynid")
     except SystemExit as exc:  # typer ends every command this way
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)

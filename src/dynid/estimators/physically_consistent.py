@@ -84,6 +84,10 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
 
     PROBLEM_FIELDS = ("n_dof", "layout", "prior", "prior_std", "joint_weights")
 
+    PARAMETER_CHOICES = {"prior_kind": PRIOR_KINDS}
+    """The values each hyper-parameter may take, checked where a config gives them
+    (:func:`dynid.estimators.registry.configured_estimator`)."""
+
     def __init__(self, *, prior_weight: float = 1e-6, epsilon: float = 0.0, prior_kind: str = PRIOR_KIND):
         self.prior_kind = prior_kind
         self.prior_weight = prior_weight

@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["EstimatorSpec", "SearchBudget", "FitData", "register", "unregister", "spec", "keys", "label",
-           "parse_estimators", "estimator_choices", "with_hyperparameters"]
+           "parse_estimators", "estimator_choices", "with_hyperparameters", "configured_estimator"]
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]
@@ -454,8 +454,8 @@ def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...]
 
 def with_hyperparameters(items, hyperparameters: dict) -> tuple:
     """``items`` with each key that ``hyperparameters`` names given as an unfitted estimator of its class carrying them
-    (a config's settings of an estimator, :meth:`dynid.io.config_types.EstimationTable.hyperparameters`, on whatever
-    list is identified).
+    (a config's settings of an estimator, ``{ key = "abc", colony_size = 60 }`` in its estimators list, on whatever
+    list is identified: :func:`configured_estimator`).
 
     Parameters
     ----------
@@ -471,13 +471,55 @@ def with_hyperparameters(items, hyperparameters: dict) -> tuple:
     Raises
     ------
     ConfigError
-        Hyper-parameters for an estimator built by a function that names no class (:attr:`EstimatorSpec.makes`).
+        As :func:`configured_estimator`.
     """
     out = []
     for item in items:
         given = hyperparameters.get(item.strip().lower()) if isinstance(item, str) else None
-        out.append(_estimator_class(spec(item))(**given) if given else item)
+        out.append(configured_estimator(item.strip().lower(), given, "estimators") if given else item)
     return tuple(out)
+
+
+def configured_estimator(key: str, given: dict, where: str):
+    """An unfitted estimator of a registered key carrying hyper-parameters given by name (a config's
+    ``{ key = "abc", colony_size = 60 }``): each name one of its class's constructor parameters that the problem does
+    not fill (:data:`PROBLEM_FILLED`), each value among the class's ``PARAMETER_CHOICES`` where it lists them.
+
+    Parameters
+    ----------
+    key : str
+        A registered estimator key (lower case).
+    given : dict
+        Parameter name -> value.
+    where : str
+        Where they were given, for the messages.
+
+    Returns
+    -------
+    Estimator
+
+    Raises
+    ------
+    ConfigError
+        An unknown key or parameter name, a value outside the class's choices, a value its constructor refuses, or
+        an estimator built by a function that names no class.
+    """
+    cls = _estimator_class(spec(key))
+    settable = [p.name for p in inspect.signature(cls).parameters.values()
+                if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in PROBLEM_FILLED]
+    for name, value in given.items():
+        if name not in settable:
+            filled = " (dynid fills it: the config's seed, the log)" if name in PROBLEM_FILLED else ""
+            raise ConfigError(f"{where}: {key} has no hyper-parameter {name!r}{filled}; expected some of "
+                              f"{', '.join(settable) or 'none'}", field="estimators")
+        choices = getattr(cls, "PARAMETER_CHOICES", {}).get(name)
+        if choices is not None and value not in choices:
+            raise ConfigError(f"{where}: {key}'s {name}: expected one of {', '.join(map(str, choices))}, got {value!r}",
+                              field="estimators")
+    try:
+        return cls(**given)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{where}: {key}: {exc}", field="estimators") from None
 
 
 def _estimator_class(entry: EstimatorSpec) -> type:

@@ -133,29 +133,17 @@ class PreprocessingTable(Table, kw_only=True):
 class EstimationTable(Table, kw_only=True):
     """``[estimation]``."""
 
-    estimators: Annotated[list[str], Meta(min_length=1, description="the first is the main estimate: ols, wls, irls, "
-                                                                    "lad, sdp, abc, abc10, de, pso or one registered")] | None = None
+    estimators: Annotated[list[Union[str, dict[str, Any]]], Meta(
+        min_length=1, description="the first is the main estimate: ols, wls, irls, lad, sdp, abc, abc10, de, pso or one "
+                                  "registered; an inline table { key = ..., name = value } gives one its class's "
+                                  "hyper-parameters")] | None = None
     seed: Annotated[int, Meta(ge=0, description="seeds the box searches (default 0)")] | None = None
     friction: Annotated[Literal["auto", "description"], _d("each joint's friction model by cross-validation, or the "
                                                            "description's terms")] | None = None
-    sdp_prior: Annotated[Literal["euclidean", "geometric"], _d("how sdp keeps what the data do not determine near the "
-                                                               "nominal values: squared distance (default) or the "
-                                                               "pseudo-inertias' log-det divergence (plausible links)")] | None = None
     choice: Annotated[Literal["torques", "states"], _d(
         "what chooses the main estimate among the SDP, the drive-only estimate and the description: the validation "
         "logs' torques (default), or their states alone, so that their torques stay an independent test (needs sdp "
         "among the estimators)")] | None = None
-
-    def hyperparameters(self) -> dict[str, dict]:
-        """The estimators' hyper-parameters this table sets (:func:`dynid.estimators.registry.with_hyperparameters`).
-
-        Returns
-        -------
-        dict
-            key -> constructor parameters: ``sdp_prior`` is the SDP's ``prior_kind``
-            (:class:`dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`).
-        """
-        return {"sdp": {"prior_kind": self.sdp_prior}} if self.sdp_prior is not None else {}
 
 
 class ReferenceTable(Table, kw_only=True):

@@ -63,7 +63,9 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 
 from __future__ import annotations
 
+import json
 import os
+import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -74,7 +76,7 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from .._util.typed import convert
-from ..estimators.registry import estimate_label, estimator_choices, keys
+from ..estimators.registry import configured_estimator, estimate_label, estimator_choices, keys
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -106,9 +108,9 @@ class EstimationSettings:
     friction : str
         "auto": each joint's friction model by cross-validation; "description": as described.
     hyperparameters : dict
-        Estimator key -> the hyper-parameters ``[estimation]`` sets for it
-        (:meth:`dynid.io.config_types.EstimationTable.hyperparameters`), applied to whatever estimator list is
-        identified (:func:`dynid.estimators.registry.with_hyperparameters`).
+        Estimator key -> the hyper-parameters ``[estimation]`` sets for it (an inline table of the estimators list,
+        ``{ key = "abc", colony_size = 60 }``), applied to whatever estimator list is identified
+        (:func:`dynid.estimators.registry.with_hyperparameters`).
     choice : str
         "torques": the main estimate chosen on the validation logs' torques; "states": on their states alone
         (:func:`dynid.identification.verdict.choose_main_estimate`).
@@ -191,6 +193,11 @@ REMOVED = {
 }
 """Fields that no longer exist, and what to write instead (said before the typed check, which would only call them
 unknown); ``[estimation] method``, ``methods`` and ``physically_consistent`` are said by :func:`_estimators_from_old`."""
+
+MOVED_INTO_ESTIMATORS = {"sdp_prior": ("sdp", "prior_kind")}
+"""``[estimation]`` keys that set one estimator's hyper-parameter, now given in the estimators list
+(``{ key = "sdp", prior_kind = "geometric" }``): old key -> (estimator key, hyper-parameter). Still read, with a
+FutureWarning; ``dynid migrate`` rewrites them."""
 
 
 def _per_joint(value, n: int, where: str):
@@ -335,6 +342,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     if old and isinstance(est, dict):
         raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
                           f"estimators = {_estimators_from_old(est)} (dynid migrate {path} rewrites it)")
+    doc, moved = _moved_into_estimators(doc, path)
     # the robot table is checked by the description's own parser (its drive terms are those registered now)
     typed = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, IdentificationDocument, str(path))
     here = path.parent
@@ -354,7 +362,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     e = typed.estimation or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
-    asked = [str(k).strip().lower() for k in e.estimators] if e.estimators is not None else ["wls"]
+    asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], moved, f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof)
     if closed_loop and controller is None:
@@ -368,12 +376,56 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
     urdf = config_urdf(doc, path, root)
-    estimation = EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, e.hyperparameters(),
+    estimation = EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, hyperparameters,
                                     e.choice or "torques")
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimation, drive_gains=gains,
                                 robot_source=robot_source(doc, path, root), urdf=urdf, controller=controller,
                                 torque_sensor=_torque_sensor(doc),
                                 mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
+
+
+def _moved_into_estimators(doc: dict, path: Path) -> tuple[dict, dict]:
+    """``doc`` without the keys of :data:`MOVED_INTO_ESTIMATORS` (each said with a FutureWarning), and the
+    hyper-parameters they set: estimator key -> {name: value}."""
+    est = doc.get("estimation")
+    found = [k for k in MOVED_INTO_ESTIMATORS if isinstance(est, dict) and k in est]
+    if not found or not isinstance(est, dict):
+        return doc, {}
+    moved: dict[str, dict] = {}
+    for old in found:
+        key, name = MOVED_INTO_ESTIMATORS[old]
+        moved.setdefault(key, {})[name] = est[old]
+        value = json.dumps(est[old])  # as TOML writes a string or a number
+        warnings.warn(f"{path}: [estimation] {old} = {value} is now said in the estimators list, as "
+                      f'{{ key = "{key}", {name} = {value} }} in place of "{key}" (its meaning is the same; dynid '
+                      f"migrate {path} rewrites it)", FutureWarning, stacklevel=4)
+    return {**doc, "estimation": {k: v for k, v in est.items() if k not in found}}, moved
+
+
+def _estimator_entries(entries: list, moved: dict, where: str) -> tuple[list[str], dict[str, dict]]:
+    """The estimators list's keys (lower case), and the hyper-parameters its inline tables and the moved keys
+    (:func:`_moved_into_estimators`) give: key -> {name: value}, each checked against the estimator's class
+    (:func:`dynid.estimators.registry.configured_estimator`)."""
+    asked, hyperparameters = [], {k: dict(v) for k, v in moved.items()}
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict):
+            asked.append(str(entry).strip().lower())
+            continue
+        key = entry.get("key")
+        if not isinstance(key, str):
+            raise ConfigError(f'{where}[{i}]: a table in the list names its estimator, {{ key = "sdp", prior_kind = '
+                              f'"geometric" }}, got {entry!r}')
+        key = key.strip().lower()
+        asked.append(key)
+        given = {k: v for k, v in entry.items() if k != "key"}
+        twice = sorted(set(given) & set(hyperparameters.get(key, {})))
+        if twice:
+            raise ConfigError(f"{where}[{i}]: {key}'s {twice[0]} is given twice (here and by an older [estimation] key): "
+                              "keep the one here")
+        hyperparameters[key] = {**hyperparameters.get(key, {}), **given}
+    for key, given in hyperparameters.items():
+        configured_estimator(key, given, f"{where}[{asked.index(key)}]" if key in asked else where)
+    return asked, {k: v for k, v in hyperparameters.items() if v}
 
 
 def _torque_sensor(doc: dict) -> str:
