@@ -430,3 +430,27 @@ def test_a_flipped_sign_the_nominal_model_cannot_judge_is_named_by_the_consisten
     assert text.startswith("arrays: J6: the physically consistent estimate cannot follow") and "Negate its entry" in text
     rms = [float(x) for x in re.findall(r"J6 ([0-9.e+-]+) N·m RMS as read, ([0-9.e+-]+) flipped", text)[0]]
     assert rms[1] < 0.5 * rms[0]  # the refit with J6 negated follows it
+
+
+def test_motor_currents_given_as_torques_are_told_the_descriptions_gains_were_not_applied(tmp_path):
+    """A UR10e's motor currents given as torques (a researcher's arrays: the Identifier takes N·m) were told "drive_gain
+    about 126, 69.6, 74.5 N·m/A": the description's gains times the ratio, as if they had been applied. The
+    recording now carries the gains it was read through (none here), and the finding names the description's gains
+    and how to apply them; the config that reads the same columns as currents, through those gains, has no finding."""
+    import dynid
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    cfg, truth = simulated_case(tmp_path, "ur10e", 125.0, "fourier", duration=20.0)
+    config = load_identification_config(cfg)
+    recording = load_recording(config.identification, config.robot)
+    np.testing.assert_array_equal(recording.drive_gains, config.robot.drive_gains)  # read as currents, eq. 16
+    currents = recording.tau / config.robot.drive_gains
+    ident = dynid.Identifier("ur10e", estimators=["ols"]).fit(recording.t, recording.q, currents)
+    (f,) = [f for f in ident.result_.findings if f.kind == "scale"]
+    gains = ", ".join(f"{g:.4g}" for g in config.robot.drive_gains)
+    assert f"were read as torques: are these motor currents? The description's drive gains ({gains} N·m/A) were " \
+           "not applied" in f.text, f.text
+    assert "states no drive gains" not in f.text and "set scale" not in f.text
+    read = dynid.Identifier("ur10e", estimators=["ols"]).fit(recording.t, recording.q, recording.tau)
+    assert [f for f in read.result_.findings if f.kind == "scale"] == []

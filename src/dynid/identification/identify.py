@@ -540,8 +540,10 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
                                          > SCALE_MISFIT * np.asarray(floor["rmse"]))
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
-            + scale_findings(beyond_drive, slope_drive, varies, data.name, gains=scoring.robot.drive_gains,
-                             misfit=misfit, mass=float(np.sum(scoring.robot.inertial[:, 9]))) + geometry)
+            + scale_findings(beyond_drive, slope_drive, varies, data.name,
+                             gains=data.drive_gains if data.drive_gains is not None else np.ones(scoring.robot.n_dof),
+                             misfit=misfit, mass=float(np.sum(scoring.robot.inertial[:, 9])),
+                             described=scoring.robot.drive_gains) + geometry)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:

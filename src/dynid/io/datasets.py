@@ -56,6 +56,9 @@ class Recording:
     warnings : tuple of str
     source : str
         The files (or bag) it was read from.
+    drive_gains : (n_dof,) array or None
+        The drive gains ``tau`` was read through [N·m/A] (motor currents times these, eq. 16); None where it was
+        logged or given as torques.
     """
 
     name: str
@@ -66,6 +69,7 @@ class Recording:
     rate: float
     warnings: tuple[str, ...] = field(default=())
     source: str = ""
+    drive_gains: np.ndarray | None = None
 
     @property
     def n_samples(self) -> int:
@@ -318,6 +322,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
                   tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
-    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source)
+    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
+                     robot.drive_gains.copy() if kind == "currents" else None)
 
 

@@ -67,7 +67,7 @@ class PaperSmoothing(Strategy):
                                f"{omega_f:.4g} rad/s; eq. 17 applied {settings.smoothing_passes} time(s) to the torques and "
                                "every regressor column")
         return PreparedData(recording.name, recording.t, q, dq, ddq, np.asarray(recording.tau, dtype=float), recording.rate, s,
-                            tuple(recording.warnings))
+                            tuple(recording.warnings), drive_gains=getattr(recording, "drive_gains", None))
 
     def chunks(self, robot, base, data, progress=None, standard=False):
         """One block: the whole log, its regressor and torques smoothed alike by eq. 17; every row kept.

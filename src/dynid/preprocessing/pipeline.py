@@ -261,7 +261,8 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
                   if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
                         tuple(recording.warnings) + s.warnings + dead_words + clipped_words,
-                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped)
+                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped,
+                        getattr(recording, "drive_gains", None))
 
 
 

@@ -57,6 +57,9 @@ class PreparedData:
         Joints whose position never changes in the log.
     clipped : (N, n_dof) bool array or None
         Samples where a joint's measured torque is held at its extreme (:func:`clipped_samples`).
+    drive_gains : (n_dof,) array or None
+        The drive gains the torques were read through (the recording's: motor currents times these, eq. 16); None
+        where they were logged or given as torques.
     """
 
     name: str
@@ -84,6 +87,8 @@ class PreparedData:
     clipped: np.ndarray | None = None
     """(N, n_dof) bool, or None where nothing is: samples where a joint's measured torque is held at its extreme
     (:func:`clipped_samples`): that joint's rows there are used by no estimate, and those samples by no metric."""
+    drive_gains: np.ndarray | None = None
+    """(n_dof,) the drive gains the torques were read through (eq. 16), or None: logged or given as torques."""
 
     def kept(self, index: np.ndarray, vmin: np.ndarray) -> np.ndarray:
         """The rows an estimate uses: joints moving at least ``vmin``, none of a dead channel or of a joint held still,

@@ -290,9 +290,21 @@ description that misstates one joint's small torque leaves the fit at the floor 
 log: J4's torque 11.7× its nominal one, every joint fitted at 0.96-1.04× its floor; J2 in N·mm: 35× and more)."""
 
 
+def _unapplied_gains(dataset: str, low: float, high: float, joints: str, described: np.ndarray, table: str) -> str:
+    """:func:`scale_findings`' text where the torques look like motor currents and the description's drive gains
+    were not applied (they were read, or given, as torques)."""
+    said = ", ".join(f"{g:.4g}" for g in described)
+    return (f"{dataset}: the measured torques are {low:.3g}-{high:.3g}× the description's nominal model's on {joints}, "
+            f"where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}), and they were read as torques: are these "
+            f"motor currents? The description's drive gains ({said} N·m/A) were not applied; read them as currents "
+            f"(currents = {{ ... }} in place of torques in {table} and the other datasets), or, for arrays, pass the "
+            "currents times the robot's drive_gains (eq. 16)")
+
+
 def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
                    table: str = "[identification]", gains: np.ndarray | None = None,
-                   misfit: np.ndarray | None = None, mass: float | None = None) -> list[Finding]:
+                   misfit: np.ndarray | None = None, mass: float | None = None,
+                   described: np.ndarray | None = None) -> list[Finding]:
     """Torques in the wrong unit or through the wrong drive gains: on the joints whose measured torque has the shape
     of the description's nominal model beyond friction (ρ ≥ :data:`SCALE_SHAPE`), the median slope of the torque on
     that model is outside ``[1/SCALE_LIMIT, SCALE_LIMIT]``; or, where the median is within, some joints' slopes are
@@ -322,6 +334,9 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     mass : float, optional
         The description's moving links' mass in all [kg], said beside a scale of every joint: the description's
         masses in another unit (grams) or placeholders are as likely as the log's unit.
+    described : (n_dof,) array, optional
+        The description's drive gains [N·m/A]. Where the torques were read through none (``gains`` all 1) and these
+        are not all 1, torques that look like motor currents are said to be read as currents through them.
 
     Returns
     -------
@@ -348,6 +363,8 @@ def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarra
     low, high = float(np.min(k[judged])), float(np.max(k[judged]))
     if gains is not None and np.all(np.asarray(gains) == 1.0) and high > GAINS_APART * low:
         # currents read at 1 N·m/A: one scale leaves each joint's rows scaled by its own gain, which no rigid body fits
+        if described is not None and not np.all(np.asarray(described) == 1.0):
+            return [Finding("scale", _unapplied_gains(dataset, low, high, joints, np.asarray(described), table))]
         return [Finding("scale", f"{dataset}: the measured torques are {low:.3g}-{high:.3g}× the description's nominal "
                                  f"model's on {joints}, where their shapes agree beyond friction (ρ ≥ {SCALE_SHAPE:g}), "
                                  "and the description states no drive gains: are these motor currents? Give each "
