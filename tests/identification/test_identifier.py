@@ -252,6 +252,24 @@ def test_predict_of_a_recording_is_at_its_own_time_stamps_and_the_identifier_val
     assert dynid.summary(comparison) == dynid.summary(fitted.model_.validate(other))
 
 
+def test_validate_takes_a_raw_logs_arrays_as_score_and_relative_error_do(er16, fitted):
+    """``ident.validate(t, q, tau)`` raised "takes 2 positional arguments but 4 were given" where ``score(t, q, tau)``
+    and ``relative_error(t, q, tau)`` take a raw log's arrays: it takes them too, and scores the samples the log's
+    recording gives (the arrays made into a recording as the log readers make one)."""
+    from dynid.identification.run import recording_from_arrays
+
+    _, _, other = er16
+    t, q, tau = other.t, np.asarray(other.q), np.asarray(other.tau)
+    by_arrays = fitted.validate(t, q, tau)
+    label = fitted.model_.label()
+    expected = fitted.relative_error(t, q, tau)
+    assert by_arrays.metrics()[label]["global_relative_error"] == pytest.approx(expected, rel=1e-12)
+    made = fitted.model_.validate(recording_from_arrays(fitted.model_.robot, t, q, tau, name="validate"))
+    assert dynid.summary(by_arrays) == dynid.summary(made)
+    with pytest.raises(ValueError, match=r"validate\(t, q, tau\): positions and measured torques are needed"):
+        fitted.validate(t)
+
+
 def test_load_recording_takes_a_logs_path_and_load_results_a_folder(tmp_path, fitted):
     """dynid.load_recording("log.csv", robot) raised a raw AttributeError: a path is read with the columns dynid init
     finds, anything else refused in one line; load_results takes the folder dynid identify wrote."""

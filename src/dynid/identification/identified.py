@@ -429,12 +429,17 @@ class IdentifiedModel:
         return comparison.t, comparison.predicted[self.label(estimate)], comparison.measured
 
     @keyword_only_after_data
-    def validate(self, recording, *, estimate: str | None = None):
+    @keyword_only_after_data
+    def validate(self, t, q=None, tau=None, *, estimate: str | None = None):
         """The paper's metrics (eq. 18, RMSE, relative error) of the estimates on a log.
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        t : (N,) array [s], or a recording
+            A raw log's time stamps (with ``q`` and ``tau``, as :meth:`score` takes them), or a log read with
+            :func:`dynid.load_recording`.
+        q, tau : (N, n_dof) arrays [rad, N·m], optional
+            Its positions and measured torques (with time stamps).
         estimate : str, optional
             Only this estimate (default every one).
 
@@ -447,7 +452,10 @@ class IdentifiedModel:
         ShapeError
             A recording not one row per time stamp and one column per joint (:meth:`Recording.check
             <dynid.io.datasets.Recording.check>`).
+        ValueError
+            Time stamps without positions and torques.
         """
+        recording = self._scored_log(t, q, tau, "validate")
         recording.check(self.robot.n_dof)
         data = prepare(recording, self._settings(), strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}

@@ -317,14 +317,18 @@ class Identifier(HyperParameters):
         return self._model().predict(t, q, dq, ddq, estimate=estimate)
 
     @keyword_only_after_data
-    def validate(self, recording, *, estimate: str | None = None):
+    @keyword_only_after_data
+    def validate(self, t, q=None, tau=None, *, estimate: str | None = None):
         """The paper's metrics (eq. 18's correlation, RMSE, relative error) of the estimates on another log, on the
         samples ``dynid validate`` scores (:meth:`dynid.identification.identified.IdentifiedModel.validate`).
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
-            E.g. :func:`dynid.load_recording` or :func:`dynid.simulated_log`.
+        t : (N,) array [s], or a recording
+            A raw log's time stamps (with ``q`` and ``tau``, as :meth:`score` takes them), or a log as
+            :func:`dynid.load_recording` or :func:`dynid.simulated_log` give it.
+        q, tau : (N, n_dof) arrays [rad, N·m], optional
+            Its positions and measured torques (with time stamps).
         estimate : str, optional
             Only this estimate (default every one).
 
@@ -338,7 +342,7 @@ class Identifier(HyperParameters):
         NotFittedError
             Before :meth:`fit` or :meth:`from_config`.
         """
-        return self._model().validate(recording, estimate=estimate)
+        return self._model().validate(t, q, tau, estimate=estimate)
 
     @keyword_only_after_data
     def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
