@@ -170,3 +170,23 @@ def test_without_a_floor_the_arm_going_below_its_base_is_said(tmp_path):
     assert p.returncode == 0, p.stderr
     assert "no floor given" not in p.stdout + p.stderr
     assert "lowest" not in json.loads((tmp_path / "floor" / "excitation.json").read_text())
+
+
+def test_capsules_kept_apart_when_asked_and_said_otherwise(tmp_path):
+    """The ER-16's design folds link 3 onto link 1 (their capsules overlap at the set-points) and says so. With
+    ``[workspace] avoid_self_collision = true`` the design keeps the capsules apart, as coal's check of the set-points
+    finds; the warning then names the option no longer, and excitation.json says it was asked."""
+    plain = _small(tmp_path, "excite-er16.toml", {"starts = 6": "starts = 1"})
+    p = dynid("excite", str(plain), "--out", str(tmp_path / "plain"))
+    assert p.returncode == 0, p.stderr
+    before = json.loads((tmp_path / "plain" / "excitation.json").read_text())
+    assert before["self_clearance"]["distance"] < 0
+    assert "[workspace] avoid_self_collision = true" in " ".join((p.stdout + p.stderr).split())
+    kept = _small(tmp_path, "excite-er16.toml", {"starts = 6": "starts = 1",
+                                                 "floor = -0.5": "floor = -0.5\navoid_self_collision = true"})
+    p = dynid("excite", str(kept), "--out", str(tmp_path / "kept"))
+    assert p.returncode == 0, p.stderr
+    after = json.loads((tmp_path / "kept" / "excitation.json").read_text())
+    assert after["self_clearance"]["distance"] >= 0 and after["workspace"]["avoid_self_collision"] is True
+    assert any(m["constraint"] == "self clearance [m]" and m["worst"] >= 0 for m in after["design"]["margins"])
+    assert "avoid_self_collision" not in before["workspace"]

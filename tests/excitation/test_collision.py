@@ -37,3 +37,47 @@ def test_the_closest_pair_along_a_trajectory_is_found():
     seg = _segments(robot, q)
     brute = min((_brute(seg[k, i], seg[k, j], 0.05), (i + 1, j + 1), t[k]) for k in range(20) for i, j in pairs)
     assert abs(found.distance - brute[0]) < 2e-3 and found.pair == brute[1] and found.time == brute[2]
+
+
+def test_the_segments_closest_points_equal_a_dense_search_in_every_case(rng):
+    """``closest_points`` (Ericson's, for arrays of segments) against sampling both segments densely: random pairs,
+    parallel ones, crossing ones, a point against a segment and two points."""
+    from dynid.excitation.collision import closest_points
+
+    cases = [(rng.normal(size=(2, 3)), rng.normal(size=(2, 3)) + rng.normal(size=3)) for _ in range(30)]
+    cases += [(np.array([[0.0, 0, 0], [1, 0, 0]]), np.array([[0.2, 0.3, 0], [1.5, 0.3, 0]])),  # parallel, overlapping
+              (np.array([[0.0, 0, 0], [1, 0, 0]]), np.array([[2.0, 0.3, 0], [3, 0.3, 0]])),  # parallel, apart
+              (np.array([[-1.0, 0, 0], [1, 0, 0]]), np.array([[0.0, -1, 0], [0, 1, 0]])),  # crossing
+              (np.array([[0.3, 0.2, 0.1], [0.3, 0.2, 0.1]]), np.array([[0.0, -1, 0.5], [0, 1, 0.5]])),  # a point
+              (np.array([[0.0, -1, 0.5], [0, 1, 0.5]]), np.array([[0.3, 0.2, 0.1], [0.3, 0.2, 0.1]])),
+              (np.array([[0.1, 0, 0], [0.1, 0, 0]]), np.array([[0.0, 0.4, 0], [0.0, 0.4, 0]]))]  # two points
+    a = np.array([c[0] for c in cases])
+    b = np.array([c[1] for c in cases])
+    s, t = closest_points(a[:, 0], a[:, 1], b[:, 0], b[:, 1])
+    assert np.all((0 <= s) & (s <= 1) & (0 <= t) & (t <= 1))
+    found = np.linalg.norm(a[:, 0] + s[:, None] * (a[:, 1] - a[:, 0]) - b[:, 0] - t[:, None] * (b[:, 1] - b[:, 0]), axis=1)
+    dense = np.array([_brute(x, y, 0.0) for x, y in cases])
+    assert np.all(found <= dense + 1e-12) and np.all(found >= dense - 2e-3), np.c_[found, dense]
+
+
+def test_capsule_self_distances_are_coals_and_their_gradient_the_finite_differences():
+    """What the design keeps apart with ``avoid_self_collision``: the capsules' surface distances equal coal's (the
+    set-points' check), and their gradient the distances' central differences."""
+    from dynid.excitation.collision import CapsuleSelfDistances, _distance, _segments, touching_pairs
+    from dynid.model.description import load_robot
+
+    robot = load_robot("ur10e")
+    q = np.random.default_rng(7).uniform(-2.5, 2.5, (30, robot.n_dof))
+    pairs = touching_pairs(robot, 0.05)
+    measured = CapsuleSelfDistances(robot, q, 0.05, pairs)
+    seg = _segments(robot, q)
+    coal_d = np.array([[_distance(seg[k, i], seg[k, j], 0.05) for i, j in pairs] for k in range(q.shape[0])])
+    np.testing.assert_allclose(measured.dist, coal_d, atol=1e-9)
+    grad = measured.distances(gradient=True).gradient
+    h = 1e-6
+    for d in range(robot.n_dof):
+        step = np.zeros(robot.n_dof)
+        step[d] = h
+        central = (CapsuleSelfDistances(robot, q + step, 0.05, pairs).dist
+                   - CapsuleSelfDistances(robot, q - step, 0.05, pairs).dist) / (2 * h)
+        np.testing.assert_allclose(grad[:, :, d], central, atol=1e-6)

@@ -5,7 +5,9 @@ Each link is a capsule of radius ``clearance`` (:attr:`dynid.excitation.constrai
 segment from its joint's origin to the next joint's (the last link's to the flange): the robot's skeleton, which a
 description without collision meshes still gives. Distances between capsules are coal's (the collision library of
 Pinocchio's geometry models; Pan, Chitta & Manocha, "FCL: a general purpose library for collision and proximity
-queries", ICRA 2012). The pairs that can touch are, as MoveIt's setup assistant finds them, every pair of links that
+queries", ICRA 2012) for the checks; the design keeps the capsules apart by the segments' closest points
+(:func:`closest_points`, Ericson, "Real-Time Collision Detection", 2005, §5.1.9) with their gradient, every sample
+of its grid at once (:class:`CapsuleSelfDistances`), so that the check measures with another code. The pairs that can touch are, as MoveIt's setup assistant finds them, every pair of links that
 are not neighbours in the chain, less the pairs whose capsules overlap on almost every pose of a random sample (a
 wrist whose axes meet: such a pair is in contact by construction of the skeleton, not by the motion).
 """
@@ -19,9 +21,10 @@ import numpy as np
 
 from ..model.robot import Robot
 from .link_geometry import LinkGeometry, self_distances, self_pairs
-from .obstacles import _capsules, _segments
+from .obstacles import ObstacleDistances, _capsules, _segment_jacobians, _segments
 
-__all__ = ["SelfClearance", "self_clearance", "shape_clearance", "touching_pairs"]
+__all__ = ["CapsuleSelfDistances", "SelfClearance", "closest_points", "self_clearance", "shape_clearance",
+           "touching_pairs"]
 
 ALWAYS = 0.95
 """A pair whose capsules overlap on this share of random poses or more is in contact by construction: not checked."""
@@ -88,14 +91,11 @@ def touching_pairs(robot: Robot, radius: float, samples: int = 200, rng=0) -> li
     lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
     hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
     q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
-    seg = _segments(robot, q)
-    out = []
-    for i in range(robot.n_dof):
-        for j in range(i + 2, robot.n_dof):
-            overlap = np.mean([_distance(seg[k, i], seg[k, j], radius) < 0 for k in range(samples)])
-            if overlap < ALWAYS:
-                out.append((i, j))
-    return out
+    candidates = [(i, j) for i in range(robot.n_dof) for j in range(i + 2, robot.n_dof)]
+    if not candidates:
+        return []
+    overlap = (CapsuleSelfDistances(robot, q, radius, candidates).dist < 0).mean(axis=0)
+    return [pair for pair, share in zip(candidates, overlap) if share < ALWAYS]
 
 
 def self_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, radius: float) -> SelfClearance | None:
@@ -153,3 +153,83 @@ def shape_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, geometry: LinkGe
     g, h = pairs[c]
     return SelfClearance(float(d[n, c]), (int(geometry.link[g]) + 1, int(geometry.link[h]) + 1), float(np.asarray(t)[n]),
                          len(pairs), (geometry.names[g], geometry.names[h]))
+
+
+def closest_points(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The parameters of the closest points of segments ``p1 q1`` and ``p2 q2`` (Ericson 2005, §5.1.9), for arrays of
+    segments at once.
+
+    Parameters
+    ----------
+    p1, q1, p2, q2 : (..., 3) arrays
+        The segments' ends.
+
+    Returns
+    -------
+    s, t : (...) arrays in [0, 1]
+        The closest points are ``p1 + s (q1 - p1)`` and ``p2 + t (q2 - p2)``; a segment of no length has 0.
+    """
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e = np.einsum("...i,...i", d1, d1), np.einsum("...i,...i", d2, d2)
+    b, c, f = np.einsum("...i,...i", d1, d2), np.einsum("...i,...i", d1, r), np.einsum("...i,...i", d2, r)
+    tiny = 1e-24
+    a_safe, e_safe = np.where(a > tiny, a, 1.0), np.where(e > tiny, e, 1.0)
+    denom = a * e - b * b
+    s = np.where(denom > tiny * np.maximum(a * e, tiny), np.clip((b * f - c * e) / np.where(denom > 0, denom, 1.0), 0, 1), 0.0)
+    t = (b * s + f) / e_safe
+    s = np.where(t < 0, np.clip(-c / a_safe, 0, 1), np.where(t > 1, np.clip((b - c) / a_safe, 0, 1), s))
+    t = np.clip(t, 0, 1)
+    s = np.where(a > tiny, s, 0.0)  # a point: s = 0, t its projection on the other
+    t = np.where(e > tiny, np.where(a > tiny, t, np.clip(f / e_safe, 0, 1)), 0.0)
+    s = np.where((e <= tiny) & (a > tiny), np.clip(-c / a_safe, 0, 1), s)
+    return s, t
+
+
+class CapsuleSelfDistances:
+    """Surface distances between pairs of the links' capsules of radius ``radius`` along ``q`` (the segments' distance
+    less ``2·radius``: zero is contact), measured once (``dist``), with their gradient on demand: ``n·(v_i - v_j)``,
+    ``v`` each closest point's velocity per joint (the envelope theorem: the closest points' parameters held), ``n``
+    the unit vector from ``j``'s closest point to ``i``'s. The interface of
+    :class:`dynid.excitation.link_geometry.SelfDistances`, for a design without collision shapes.
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+    radius : float [m]
+    pairs : list of (int, int)
+        Links, 0-based (:func:`touching_pairs`).
+    """
+
+    def __init__(self, robot: Robot, q: np.ndarray, radius: float, pairs):
+        self.robot, self.q, self.pairs = robot, np.atleast_2d(np.asarray(q, dtype=float)), list(pairs)
+        seg = _segments(robot, self.q)  # (N, n_dof, 2, 3)
+        i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
+        a, b = seg[:, i], seg[:, j]  # (N, P, 2, 3)
+        self._s, self._t = closest_points(a[..., 0, :], a[..., 1, :], b[..., 0, :], b[..., 1, :])
+        self._gap = (a[..., 0, :] + self._s[..., None] * (a[..., 1, :] - a[..., 0, :])
+                     - b[..., 0, :] - self._t[..., None] * (b[..., 1, :] - b[..., 0, :]))
+        self.dist = np.linalg.norm(self._gap, axis=-1) - 2.0 * radius
+
+    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
+        """The distances, with their gradient if asked.
+
+        Parameters
+        ----------
+        gradient : bool
+
+        Returns
+        -------
+        ObstacleDistances
+            ``pairs`` as given, ``links`` the first link of each.
+        """
+        if not gradient:
+            return ObstacleDistances(self.pairs, self.dist)
+        jac = _segment_jacobians(self.robot, self.q)  # (N, n_dof, 2, 3, n_dof)
+        i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
+        s, t = self._s[..., None, None], self._t[..., None, None]
+        vi = (1 - s) * jac[:, i, 0] + s * jac[:, i, 1]  # (N, P, 3, n_dof)
+        vj = (1 - t) * jac[:, j, 0] + t * jac[:, j, 1]
+        norm = np.linalg.norm(self._gap, axis=-1, keepdims=True)
+        n = self._gap / np.where(norm > 1e-12, norm, 1.0)  # segments that meet: no direction, no gradient
+        return ObstacleDistances(self.pairs, self.dist, np.einsum("npx,npxd->npd", n, vi - vj))

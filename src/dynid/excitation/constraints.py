@@ -15,9 +15,9 @@ from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
-from .collision import shape_clearance
+from .collision import CapsuleSelfDistances, shape_clearance, touching_pairs
 from .fourier import FourierTrajectory
-from .link_geometry import LinkGeometry, ShapeDistances, self_pairs
+from .link_geometry import LinkGeometry, SelfDistances, ShapeDistances, self_pairs
 from .obstacles import CapsuleDistances, Obstacle, ObstacleDistances, reachable_pairs
 
 AXES = "xyz"
@@ -46,6 +46,11 @@ class Workspace:
     geometry : LinkGeometry or None
         The links' own collision shapes (:mod:`dynid.excitation.link_geometry`): with them, every shape stays
         ``clearance`` off each body instead of the capsules.
+    avoid_self_collision : bool or None
+        Whether the design keeps the links off each other (:meth:`self_pairs`): their collision shapes with
+        :attr:`geometry`, else their capsules. None (default): the shapes yes, the capsules no (their self clearance
+        is checked on the set-points and said; keeping them apart costs the design time and some conditioning:
+        docs, the workflow tutorial). False: neither.
     """
 
     box_min: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
@@ -54,6 +59,7 @@ class Workspace:
     clearance: float = 0.05
     obstacles: tuple[Obstacle, ...] = ()
     geometry: LinkGeometry | None = None
+    avoid_self_collision: bool | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
@@ -111,9 +117,9 @@ class Workspace:
         return reachable_pairs(robot, self.obstacles, self.clearance)
 
     def self_pairs(self, robot) -> list[tuple[int, int]]:
-        """The pairs of the links' own collision shapes kept apart (:func:`dynid.excitation.link_geometry.self_pairs`);
-        none without :attr:`geometry` (the capsules' self-clearance is reported, not constrained:
-        :mod:`dynid.excitation.collision`).
+        """The pairs the design keeps apart: of the links' own collision shapes with :attr:`geometry`
+        (:func:`dynid.excitation.link_geometry.self_pairs`), else of the links' capsules
+        (:func:`dynid.excitation.collision.touching_pairs`) where :attr:`avoid_self_collision` asks for them.
 
         Parameters
         ----------
@@ -122,8 +128,35 @@ class Workspace:
         Returns
         -------
         list of (int, int)
+            Shape indices with :attr:`geometry`, else links (0-based).
         """
-        return [] if self.geometry is None else self_pairs(robot, self.geometry)
+        if self.avoid_self_collision is False or (self.geometry is None and self.avoid_self_collision is None):
+            return []
+        return touching_pairs(robot, self.clearance) if self.geometry is None else self_pairs(robot, self.geometry)
+
+    def self_measure(self, robot, q, pairs, *, within: float | None = None):
+        """The distances of :meth:`self_pairs` along ``q``, measured once, their gradient on demand: the shapes'
+        (:class:`dynid.excitation.link_geometry.SelfDistances`) or the capsules'
+        (:class:`dynid.excitation.collision.CapsuleSelfDistances`).
+
+        Parameters
+        ----------
+        robot : Robot
+        q : (N, n_dof) array [rad]
+        pairs : list of (int, int)
+            From :meth:`self_pairs`.
+        within : float, optional
+            [m] The shapes' pairs measured exactly only within this of each sample's nearest
+            (:class:`~dynid.excitation.link_geometry.SelfDistances`); the capsules' are all measured.
+
+        Returns
+        -------
+        SelfDistances or CapsuleSelfDistances
+            ``dist`` (N, n_pairs) [m], zero at contact (the capsules' surfaces); ``distances(gradient=True)``.
+        """
+        if self.geometry is None:
+            return CapsuleSelfDistances(robot, q, self.clearance, pairs)
+        return SelfDistances(robot, q, self.geometry, pairs, within=within)
 
     def cell_distances(self, robot, q, *, pairs=None, gradient: bool = False) -> ObstacleDistances:
         """The links' distances to the cell's bodies beyond the clearance (zero: the clearance kept), by their own
@@ -202,7 +235,8 @@ class Workspace:
                 "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance),
                 **({"obstacles": [ob.to_dict() for ob in self.obstacles]} if self.obstacles else {}),
                 **({"geometry": f"collision shapes of {self.geometry.source}"} if self.geometry is not None and self.obstacles
-                   else {})}
+                   else {}),
+                **({} if self.avoid_self_collision is None else {"avoid_self_collision": self.avoid_self_collision})}
 
 
 @dataclass(frozen=True)
@@ -338,8 +372,9 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
 
 
 def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
-    """How close the links' own collision shapes come to each other along ``q`` (:meth:`Workspace.self_pairs`):
-    one margin, ``worst`` the smallest distance (limit 0: contact); none without the shapes.
+    """How close the links' own collision shapes come to each other along ``q`` (:meth:`Workspace.self_pairs`), or
+    their capsules where the design keeps them apart: one margin, ``worst`` the smallest distance (limit 0: contact);
+    none for capsules the design does not keep apart (:attr:`Workspace.avoid_self_collision`).
 
     Parameters
     ----------
@@ -354,7 +389,14 @@ def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspac
         ``where`` names the two shapes and when.
     """
     if workspace.geometry is None:
-        return []
+        pairs = workspace.self_pairs(robot)
+        if not pairs:
+            return []
+        d = CapsuleSelfDistances(robot, q, workspace.clearance, pairs).dist
+        n, c = np.unravel_index(int(np.argmin(d)), d.shape)
+        worst = float(d[n, c])
+        return [ConstraintMargin("self clearance [m]", f"links {pairs[c][0] + 1} and {pairs[c][1] + 1}' capsules at t = "
+                                 f"{float(t[n]):.3g} s", 0.0, worst, worst, np.nan)]
     found = shape_clearance(robot, t, q, workspace.geometry)
     if found is None:
         return []

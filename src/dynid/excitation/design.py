@@ -38,7 +38,7 @@ from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
 from .fourier import FourierTrajectory
-from .link_geometry import SelfDistances, self_distances
+from .link_geometry import self_distances
 
 VERIFY_REFINEMENT = 10
 """The verification grid is this many times finer than the design grid."""
@@ -504,9 +504,12 @@ class _Objective:
         self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
         self.pairs = ws.cell_pairs(problem.robot) if ws.obstacles else []  # every link off the cell's bodies
         self.gap = s * reach
-        self.self_pairs = ws.self_pairs(problem.robot)  # and, by their own shapes, off each other: tightened as the
-        if self.self_pairs and ws.geometry is not None:  # cell's, but never past half a pair's distance at the start
-            start = self_distances(problem.robot, problem.start_pose()[None], ws.geometry, self.self_pairs).distance[0]
+        self.self_pairs = ws.self_pairs(problem.robot)  # and off each other (shapes or capsules): tightened as the
+        if self.self_pairs:  # cell's, but never past half a pair's distance at the start
+            start = ws.self_measure(problem.robot, problem.start_pose()[None], self.self_pairs).dist[0]
+            if ws.geometry is None:  # capsules that overlap at the start are the skeleton's, not the motion's
+                self.self_pairs = [pair for pair, d in zip(self.self_pairs, start) if d >= 0]
+                start = start[start >= 0]
             self.self_gap = np.minimum(self.gap, 0.5 * start)
         self.crit = criterion_function(problem.criterion)
 
@@ -528,9 +531,7 @@ class _Objective:
             self.cell = p.workspace.cell_measure(p.robot, self.q, pairs=self.pairs)
             self.clear = self.cell.dist - self.gap  # (N, pairs)
         if self.self_pairs:  # measured once here; their gradient at the same iterate from the same measurement
-            geometry = p.workspace.geometry
-            assert geometry is not None  # self_pairs are empty without it
-            self.measured = SelfDistances(p.robot, self.q, geometry, self.self_pairs, within=NEGLIGIBLE / SHARPNESS)
+            self.measured = p.workspace.self_measure(p.robot, self.q, self.self_pairs, within=NEGLIGIBLE / SHARPNESS)
             self.apart = self.measured.dist - self.self_gap
         self.nfev += 1
         self._x, self._xg = x.copy(), None

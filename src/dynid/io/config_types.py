@@ -302,6 +302,9 @@ class WorkspaceTable(Table, kw_only=True):
                            "(\"capsules\"), or the first where the robot's file has them (\"auto\", default)")] | None = None
     srdf: Annotated[str, _d("MoveIt's SRDF of the robot's URDF (path relative to the config): the pairs of links its "
                             "<disable_collisions> name are not kept apart")] | None = None
+    avoid_self_collision: Annotated[bool, _d("the design keeps the links `clearance` off each other: true, by their "
+                                             "collision shapes or else their capsules; false, neither (checked and "
+                                             "said only); default: the collision shapes yes, the capsules no")] | None = None
 
 
 class DesignTable(Table, kw_only=True):

@@ -205,6 +205,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         ws_kw["floor"] = float(ws.floor)
     if ws.clearance is not None:
         ws_kw["clearance"] = float(ws.clearance)
+    if ws.avoid_self_collision is not None:
+        ws_kw["avoid_self_collision"] = bool(ws.avoid_self_collision)
     try:
         ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),

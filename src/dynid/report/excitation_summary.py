@@ -134,10 +134,13 @@ def _self_clearance_lines(run) -> list:
                      f"{c.shapes[1]} at t = {c.time:.3g} s; {c.pairs} pairs checked on the set-points)",
                      "warning" if c.distance < 0 else "text")]
     if c.distance < 0:
+        kept = run.config.problem.workspace.avoid_self_collision
+        how = ("the design kept them apart on its grid, not between its samples: raise design.grid_points" if kept else
+               "the design keeps the capsules apart where asked: [workspace] avoid_self_collision = true (a slower "
+               "design); else check this pose on the robot (or in a simulator) before running it, or lower the "
+               "amplitudes")
         return [Line(f"links that can touch come within each other's {radius:g} m: their capsules overlap by "
-                     f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): the design does not "
-                     "avoid self-collision yet; check this pose on the robot (or in a simulator) before running it, or "
-                     "lower the amplitudes", "warning")]
+                     f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): {how}", "warning")]
     return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:g} m capsules "
                  f"(closest: {where}; {c.pairs} pairs checked on the set-points)")]
 
