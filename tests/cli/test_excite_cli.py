@@ -164,6 +164,7 @@ def test_without_a_floor_the_arm_going_below_its_base_is_said(tmp_path):
     assert (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {lowest['point']} "
             f"goes {-lowest['height']:.3g} m below the base frame's origin at t = {lowest['time']:.3g} s") in said
     assert "give its height in the base frame as [workspace] floor" in said
+    assert "next: settle the warnings above (what the arm stands on" in said  # not "play excitation.csv" at once
     assert "no floor given" in (tmp_path / "out" / "report.html").read_text().replace("&#39;", "'")
 
     p = dynid("excite", str(_robot_only(tmp_path, "[workspace]\nfloor = -2.0\n")), "--out", str(tmp_path / "floor"))
