@@ -191,3 +191,27 @@ def test_capsules_kept_apart_when_asked_and_said_otherwise(tmp_path):
     assert after["self_clearance"]["distance"] >= 0 and after["workspace"]["avoid_self_collision"] is True
     assert any(m["constraint"] == "self clearance [m]" and m["worst"] >= 0 for m in after["design"]["margins"])
     assert "avoid_self_collision" not in before["workspace"]
+
+
+def test_a_robots_urdf_alone_is_a_config_of_it(tmp_path):
+    """``dynid excite arm.urdf``, the first step with nothing but the robot's file: refused as "invalid TOML"; it now
+    designs the default trajectory for that robot, as a config naming the URDF alone does."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8"))
+    p = dynid("excite", str(urdf), "--out", str(tmp_path / "out"), "--starts", "1")
+    assert p.returncode == 0, p.stderr
+    doc = json.loads((tmp_path / "out" / "excitation.json").read_text())
+    assert doc["joints"] == 6 and doc["harmonics"] == 5 and doc["rest"] is True
+    assert doc["omega_f"] == pytest.approx(2 * np.pi * 0.1)
+
+
+@pytest.mark.parametrize("height, warned, said", [
+    (-0.1234, True, "joint 6's origin goes 0.123 m below the base frame's origin at t = 2.5 s"),
+    (0.0123, True, "joint 6's origin comes 0.0123 m above the base frame's origin, its link within its 0.05 m clearance"),
+    (0.25, False, "the lowest point, joint 6's origin, stays 0.25 m above the base frame's origin (t = 2.5 s)"),
+])
+def test_the_lowest_point_is_a_warning_below_the_links_clearance(height, warned, said):
+    from dynid.report.excitation_summary import no_floor_line
+
+    text, warning = no_floor_line({"height": height, "point": "joint 6's origin", "time": 2.5}, 0.05)
+    assert warning is warned and said in text

@@ -722,7 +722,8 @@ def _last_link(cfg) -> str:
 
 @app.command()
 def excite(
-    config: Path = typer.Argument(..., help="Excitation config (TOML), e.g. configs/excite-er16.toml."),
+    config: Path = typer.Argument(..., help="Excitation config (TOML), e.g. configs/excite-er16.toml, or the robot's URDF "
+                                            "(xacro) or MJCF alone: the default design for it."),
     out: Path = typer.Option(Path("dynid-excite"), help="Output folder for excitation.json, excitation.csv and figures."),
     starts: int | None = typer.Option(None, help="Number of optimisation starts (overrides design.starts)."),
     seed: int | None = typer.Option(None, help="Seed of the random starts (overrides design.seed)."),

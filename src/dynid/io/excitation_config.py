@@ -34,7 +34,8 @@ Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to t
     rate = 500                   # controller rate of the CSV [Hz]
     periods = 1
 
-Every table is optional: without ``[trajectory]`` the design has :data:`DEFAULT_TRAJECTORY` (5 harmonics of 0.1 Hz,
+Every table is optional (a robot's URDF, xacro or MJCF given in place of the config is a config of it alone): without
+``[trajectory]`` the design has :data:`DEFAULT_TRAJECTORY` (5 harmonics of 0.1 Hz,
 from and to rest), and a ``[trajectory]`` table without ``harmonics`` or a frequency takes those two from it.
 An identification config (``dynid identify``'s) is an excitation config too: its robot, and its optional
 ``[excitation]`` table holding the tables above (``joints``, ``[excitation.trajectory]``, ``[excitation.limits]`` …).
@@ -67,6 +68,10 @@ DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
 """The trajectory designed without a ``[trajectory]`` table (``[excitation.trajectory]`` of an identification config):
 5 harmonics of 0.1 Hz (a 10 s period, as the UR10e's example) starting and ending at rest at offsets chosen by the
 design."""
+
+
+DESCRIPTION_SUFFIXES = (".urdf", ".xacro", ".xml")
+"""A robot's description given to ``dynid excite`` in place of a config: its default design (``robot`` alone)."""
 
 
 def _from_identification(doc: dict, path: Path) -> dict:
@@ -158,7 +163,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     Parameters
     ----------
     path : str or Path
-        An excitation config, or an identification config (its robot and ``[excitation]`` table).
+        An excitation config, an identification config (its robot and ``[excitation]`` table), or a robot's
+        description (:data:`DESCRIPTION_SUFFIXES`: a config of its ``robot`` alone).
 
     Returns
     -------
@@ -171,7 +177,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         (q_max <= q_min, a workspace that excludes the start pose …); the message names the file and the field.
     """
     path = Path(path)
-    doc = read_config(path, None)
+    doc = {"robot": path.name} if path.suffix.lower() in DESCRIPTION_SUFFIXES and path.is_file() else read_config(path, None)
     if "identification" in doc:  # dynid identify's config: its robot, and its [excitation] table
         doc = _from_identification(doc, path)
     c = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, ExcitationDocument, str(path))

@@ -41,11 +41,11 @@ def excitation_blocks(run) -> list:
                         f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
     lowest = getattr(run, "lowest", None)
     if lowest is not None:
-        text, warned = no_floor_line(lowest.to_dict())
+        text, warned = no_floor_line(lowest.to_dict(), p.workspace.clearance)
         out.append(Line(text, "warning" if warned else "text"))
     out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
     if d.feasible:
-        below = lowest is not None and lowest.height < 0
+        below = lowest is not None and lowest.height < p.workspace.clearance
         c = getattr(run, "self_clearance", None)
         first = ("settle the warnings above (what the arm stands on, the links' clearance), then "
                  if below or (c is not None and c.distance < 0) else "")
@@ -54,27 +54,32 @@ def excitation_blocks(run) -> list:
     return out
 
 
-def no_floor_line(lowest: dict) -> tuple[str, bool]:
+def no_floor_line(lowest: dict, clearance: float) -> tuple[str, bool]:
     """What a design without a floor says of the surface the robot stands on: where the arm goes lowest
-    (:func:`dynid.excitation.constraints.lowest_point`), a warning where that is below the base frame's origin.
+    (:func:`dynid.excitation.constraints.lowest_point`), a warning where that is below the base frame's origin or
+    within the links' clearance (their capsules' radius) above it.
 
     Parameters
     ----------
     lowest : dict
         excitation.json's ``lowest``: ``height`` [m], ``point``, ``time`` [s].
+    clearance : float [m]
+        The links' clearance (``workspace.clearance``).
 
     Returns
     -------
     text : str
     warning : bool
-        Whether the arm goes below the base frame's origin.
+        Whether the arm's links reach below the base frame's origin.
     """
     h, point, t = float(lowest["height"]), lowest["point"], float(lowest["time"])
-    if h >= 0:
+    if h >= clearance:
         return (f"no floor given ([workspace] floor): the lowest point, {point}, stays {h:.3g} m above the base frame's "
                 f"origin (t = {t:.3g} s)"), False
-    return (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {point} goes "
-            f"{-h:.3g} m below the base frame's origin at t = {t:.3g} s. If the robot stands on a table or the floor, "
+    where = (f"goes {-h:.3g} m below the base frame's origin" if h < 0 else
+             f"comes {h:.3g} m above the base frame's origin, its link within its {clearance:g} m clearance of that level")
+    return (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {point} {where} at "
+            f"t = {t:.3g} s. If the robot stands on a table or the floor, "
             "give its height in the base frame as [workspace] floor (0 where the base frame sits on it; every link then "
             "stays workspace.clearance above it) and design again"), True
 

@@ -365,7 +365,7 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
                       _fmt(None if m.get("relative") is None else 100 * m["relative"], ".3g")] for m in g.get("margins", [])], (1,))
     notes = [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the 10× grid: {g['feasible']}"]
     if "lowest" in d:
-        notes.append(no_floor_line(d["lowest"])[0])
+        notes.append(no_floor_line(d["lowest"], d["workspace"]["clearance"])[0])
     return settings, [Section("Design", [before], notes), Section("Constraints", [margins])]
 
 
