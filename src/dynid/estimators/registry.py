@@ -497,6 +497,7 @@ def configured_estimator(key: str, given: dict, where: str):
     Returns
     -------
     Estimator
+        Unfitted; the problem comes to its ``fit``.
 
     Raises
     ------

@@ -212,19 +212,22 @@ class CapsuleSelfDistances:
         self.dist = np.linalg.norm(self._gap, axis=-1) - 2.0 * radius
 
     def distances(self, *, gradient: bool = False) -> ObstacleDistances:
-        """The distances, with their gradient if asked.
+        """:attr:`dist` with the pairs (the class docstring).
 
         Parameters
         ----------
         gradient : bool
+            Also ``∂distance/∂q`` (N, n_pairs, n_dof) [m/rad].
 
         Returns
         -------
         ObstacleDistances
             ``pairs`` as given, ``links`` the first link of each.
         """
-        if not gradient:
-            return ObstacleDistances(self.pairs, self.dist)
+        return ObstacleDistances(self.pairs, self.dist, self._gradient() if gradient else None)
+
+    def _gradient(self) -> np.ndarray:
+        """(N, n_pairs, n_dof) ``∂distance/∂q``: ``n·(v_i - v_j)`` at the closest points."""
         jac = _segment_jacobians(self.robot, self.q)  # (N, n_dof, 2, 3, n_dof)
         i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
         s, t = self._s[..., None, None], self._t[..., None, None]
@@ -232,4 +235,4 @@ class CapsuleSelfDistances:
         vj = (1 - t) * jac[:, j, 0] + t * jac[:, j, 1]
         norm = np.linalg.norm(self._gap, axis=-1, keepdims=True)
         n = self._gap / np.where(norm > 1e-12, norm, 1.0)  # segments that meet: no direction, no gradient
-        return ObstacleDistances(self.pairs, self.dist, np.einsum("npx,npxd->npd", n, vi - vj))
+        return np.einsum("npx,npxd->npd", n, vi - vj)
