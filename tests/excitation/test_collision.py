@@ -81,3 +81,22 @@ def test_capsule_self_distances_are_coals_and_their_gradient_the_finite_differen
         central = (CapsuleSelfDistances(robot, q + step, 0.05, pairs).dist
                    - CapsuleSelfDistances(robot, q - step, 0.05, pairs).dist) / (2 * h)
         np.testing.assert_allclose(grad[:, :, d], central, atol=1e-6)
+
+
+def test_a_row_per_window_holds_every_sample_of_it():
+    """The capsules' constraint rows of ``CAPSULE_WINDOW`` samples: each row's soft minimum lies at or below the
+    smallest value of its samples (so a row at or above zero holds each of them), the last row padded; the gradient
+    rows are the weighted sums of their samples' gradients."""
+    from dynid.excitation.design import _windows, soft_min
+
+    rng = np.random.default_rng(3)
+    values, jac = rng.normal(size=(23, 4)) * 0.05, rng.normal(size=(23, 4, 7))
+    v, j = _windows(values, jac, 10)
+    assert v.shape == (3, 40) and j.shape == (3, 40, 7)
+    soft, grad = soft_min(v, j)
+    for r, rows in enumerate((slice(0, 10), slice(10, 20), slice(20, 23))):
+        assert soft[r] <= values[rows].min() + 1e-15
+        assert soft[r] >= values[rows].min() - np.log(values[rows].size) / 1000.0
+    step = 1e-7 * rng.normal(size=7)
+    moved = soft_min(*_windows(values + np.einsum("npx,x->np", jac, step), None, 10))[0]
+    np.testing.assert_allclose(moved - soft, grad @ step, atol=1e-10)
