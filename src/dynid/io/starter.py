@@ -267,6 +267,37 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
     return tomlkit.dumps(doc)
 
 
+def with_torque_setting(text: str, name: str, value, why: str) -> str | None:
+    """A starter config's text with ``name = value`` in its identification log's torques (or currents) table and
+    ``why`` beside it (tomlkit keeps the rest as written).
+
+    Parameters
+    ----------
+    text : str
+        The config :func:`starter_config` wrote.
+    name : str
+        The setting (``sign``).
+    value : int, float or list
+    why : str
+        A comment on the line.
+
+    Returns
+    -------
+    str or None
+        None where the log's torques are no table of their own (a bag's efforts).
+    """
+    doc = tomlkit.parse(text)
+    ident = doc.get("identification")
+    key = next((k for k in ("torques", "currents") if ident is not None and k in ident), None)
+    if ident is None or key is None or not isinstance(ident[key], dict):
+        return None
+    table = tomlkit.inline_table()  # written afresh, so that the new key is spaced as the others
+    table.update({**dict(ident[key]), name: value})
+    table.comment(" ".join(why.split()))
+    ident[key] = table
+    return tomlkit.dumps(doc)
+
+
 def _relative(path: Path, folder: Path) -> str:
     return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
 

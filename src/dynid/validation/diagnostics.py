@@ -61,11 +61,15 @@ class Finding:
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
         0-based joint, when the finding is about one.
+    fix : dict or None
+        The dataset setting the finding asks for, where it names one (a sign finding's ``{"sign": -1}`` or
+        ``{"sign": [1, -1, ...]}``): what ``dynid init`` writes (not in results.json, whose ``text`` says it).
     """
 
     kind: str
     text: str
     joint: int | None = None
+    fix: dict | None = field(default=None, compare=False)
 
     def to_dict(self) -> dict:
         """The finding as results.json stores it.
@@ -257,17 +261,18 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     values = ", ".join(f"{corr[j]:.3f}" for j in bad)
     unjudged = [j for j in range(n) if j not in judged]
     why = ""
+    setting: int | list[int]
     if len(bad) >= 2 and len(bad) == len(judged):  # every joint the nominal model judges: one convention for the log
-        fix = "sign = -1"
+        fix, setting = "sign = -1", -1
         if unjudged:
             why = (f"every joint's: the nominal model cannot judge {', '.join(f'J{j + 1}' for j in unjudged)}, whose "
                    "torques it barely predicts, and a log's torques usually share one sign convention; ")
     else:
-        fix = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]"
+        fix, setting = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]", [-1 if j in bad else 1 for j in range(n)]
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
                             f"other datasets ({why}or check the description's gravity, and whether a joint's zero is a "
-                            'half turn from the robot file\'s: position_offset = "pi")')]
+                            'half turn from the robot file\'s: position_offset = "pi")', fix={"sign": setting})]
 
 
 SCALE_LIMIT = 3.0
