@@ -429,7 +429,6 @@ class IdentifiedModel:
         return comparison.t, comparison.predicted[self.label(estimate)], comparison.measured
 
     @keyword_only_after_data
-    @keyword_only_after_data
     def validate(self, t, q=None, tau=None, *, estimate: str | None = None):
         """The paper's metrics (eq. 18, RMSE, relative error) of the estimates on a log.
 
