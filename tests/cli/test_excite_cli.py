@@ -215,3 +215,20 @@ def test_the_lowest_point_is_a_warning_below_the_links_clearance(height, warned,
 
     text, warning = no_floor_line({"height": height, "point": "joint 6's origin", "time": 2.5}, 0.05)
     assert warning is warned and said in text
+
+
+def test_a_robots_urdf_alone_holds_a_grippers_finger_as_init_does(tmp_path):
+    """``dynid excite arm.urdf`` of an arm with a gripper's finger (a prismatic joint past the wrist): refused with
+    "hold it fixed with held = [...] in the config's [robot] table"; the finger is now held as dynid init holds it,
+    and said."""
+    text = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8")
+    finger = ('<link name="finger"><inertial><origin xyz="0 0 0"/><mass value="0.1"/><inertia ixx="1e-4" ixy="0" '
+              'ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link><joint name="finger_joint" type="prismatic">'
+              '<parent link="wrist_3_link"/><child link="finger"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" '
+              'effort="20" velocity="0.2"/></joint></robot>')
+    assert text.count("</robot>") == 1 and 'link name="wrist_3_link"' in text
+    (tmp_path / "arm.urdf").write_text(text.replace("</robot>", finger))
+    p = dynid("excite", str(tmp_path / "arm.urdf"), "--out", str(tmp_path / "out"), "--starts", "1")
+    assert p.returncode == 0, p.stderr
+    assert "held fixed at 0, not the arm's joints: finger_joint" in " ".join(p.stdout.split())
+    assert json.loads((tmp_path / "out" / "excitation.json").read_text())["joints"] == 6

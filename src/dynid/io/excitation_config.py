@@ -60,6 +60,7 @@ from ..excitation.obstacles import Obstacle
 from ..excitation.paper_trajectories import paper_identification_trajectory
 from ..model.description import parse_angle
 from ..model.robot import Robot
+from ..model.urdf import joints_to_hold
 from .config_types import ExcitationDocument, TrajectoryTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config
 from .trajectories import load_trajectory
@@ -72,6 +73,13 @@ design."""
 
 DESCRIPTION_SUFFIXES = (".urdf", ".xacro", ".xml")
 """A robot's description given to ``dynid excite`` in place of a config: its default design (``robot`` alone)."""
+
+
+def _description_alone(path: Path) -> dict:
+    """A config of a robot's description alone: its robot, with the joints off the arm held fixed as ``dynid init``
+    holds them (:func:`dynid.model.urdf.joints_to_hold`: a gripper's fingers) for a URDF or MJCF."""
+    held = () if path.suffix.lower() == ".xacro" else joints_to_hold(path)
+    return {"robot": {"urdf": path.name, "held": list(held)}} if held else {"robot": path.name}
 
 
 def _from_identification(doc: dict, path: Path) -> dict:
@@ -177,7 +185,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         (q_max <= q_min, a workspace that excludes the start pose …); the message names the file and the field.
     """
     path = Path(path)
-    doc = {"robot": path.name} if path.suffix.lower() in DESCRIPTION_SUFFIXES and path.is_file() else read_config(path, None)
+    doc = _description_alone(path) if path.suffix.lower() in DESCRIPTION_SUFFIXES and path.is_file() else read_config(path, None)
     if "identification" in doc:  # dynid identify's config: its robot, and its [excitation] table
         doc = _from_identification(doc, path)
     c = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, ExcitationDocument, str(path))

@@ -25,6 +25,9 @@ def excitation_blocks(run) -> list:
     d, p, c = run.design, run.config.problem, run.config
     out: list = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
                 f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title")]
+    held = tuple(getattr(c.full_robot, "held", ()) or ())
+    if held:
+        out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
     out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
     free = p.unlimited_joints()
