@@ -185,3 +185,27 @@ def test_a_log_still_being_written_is_left_for_the_next_run(tmp_path):
     with open(growing / files[0].name, "ab") as fh:  # an old log written to again
         fh.write(whole.splitlines(keepends=True)[-1])
     assert_refused(run(growing, tmp_path / "daily"), f"{files[0].name}: changed since the monitor read it")
+
+
+def test_only_the_newest_log_is_left_as_still_being_written_and_only_while_it_changes(tmp_path):
+    """A log whose last line has no newline was taken as still being written wherever it stood: the UR10e's RTDE logs
+    of Mamedov & Mikhel end without one, and the first of them left every log for the next run ("0 windows"). Only the
+    newest log may be in progress, and only while it changes (:data:`WRITING_AGE`): an older one, or one unchanged for
+    longer, is read."""
+    import os
+
+    from dynid.fleet.monitor import WRITING_AGE, _complete
+
+    logs = []
+    for i, ending in enumerate((b"1,2\n3,4", b"1,2\n3,4\n", b"1,2\n3,")):  # no newline, one, a row cut short
+        path = tmp_path / f"log{i}.csv"
+        path.write_bytes(ending)
+        logs.append(path)
+    now = logs[-1].stat().st_mtime + 1.0
+    kept, deferred = _complete(logs, now=now)
+    assert kept == logs[:2] and deferred == ("log2.csv: still being written (its last line is unfinished): left for "
+                                             "the next run",)
+    old = now - 2 * WRITING_AGE
+    os.utime(logs[-1], (old, old))
+    assert _complete(logs, now=now) == (logs, ())
+    assert _complete(logs[:1], now=logs[0].stat().st_mtime + 2 * WRITING_AGE) == (logs[:1], ())

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+import time
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
@@ -830,24 +831,46 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
         monitor.feed(prepare(recording, prep, strict=False), path.name)
         monitor.sizes[path.name] = size
     if len(monitor.windows) <= settings.reference_windows:
+        left = f"; {deferred[0]}" if deferred else ""
         raise DataError(f"{len(monitor.windows)} windows of {settings.window:g} s in the logs: the reference needs "
-                        f"{settings.reference_windows} and monitoring more (give more logs, or --reference-windows)")
+                        f"{settings.reference_windows} and monitoring more (give more logs, or --reference-windows){left}")
     return replace(monitor.result(), state=None if fingerprint is None else monitor.state(fingerprint), resumed=resumed,
                    deferred=deferred)
 
 
-def _complete(logs: list[Path]) -> tuple[list[Path], tuple[str, ...]]:
-    """The logs a run may read, in order, and the line that names those left for the next run: from the first log whose
-    last line is unfinished (no newline at its end: a logger still writing it), that log and every later one (a monitor
-    follows time: none may be read before it)."""
-    for i, path in enumerate(logs):
-        size = path.stat().st_size
-        with open(path, "rb") as fh:
-            if size:
-                fh.seek(-1, 2)
-            unfinished = size == 0 or fh.read(1) != b"\n"
-        if unfinished:
-            later = f" (and the {len(logs) - i - 1} after it)" if len(logs) > i + 1 else ""
-            return logs[:i], (f"{path.name}: still being written (its last line is unfinished): left for the next "
-                              f"run{later}",)
+WRITING_AGE = 300.0
+"""[s] The newest log, its last line without a newline, is taken as still being written where it changed this
+recently. A log that a later one follows, or that has not changed for longer, is complete: a logger writes the newest,
+and a finished log may just end without a newline (the UR10e's RTDE logs of Mamedov & Mikhel 2020 do: the first of
+them read as "still being written" left every log for the next run, and the monitor said "0 windows")."""
+
+
+def _complete(logs: list[Path], now: float | None = None) -> tuple[list[Path], tuple[str, ...]]:
+    """The logs a run may read, in order, and the line that names the one left for the next run: the newest where its
+    last line is unfinished (no newline at its end, or empty) and it changed within :data:`WRITING_AGE` (a logger still
+    writing it).
+
+    Parameters
+    ----------
+    logs : list of Path
+        In time order.
+    now : float, optional
+        The time [s since the epoch] the age is measured at (default: now).
+
+    Returns
+    -------
+    logs : list of Path
+    deferred : tuple of str
+        The line naming the log left, or nothing.
+    """
+    if not logs:
+        return logs, ()
+    path = logs[-1]
+    stat = path.stat()
+    with open(path, "rb") as fh:
+        if stat.st_size:
+            fh.seek(-1, 2)
+        unfinished = stat.st_size == 0 or fh.read(1) != b"\n"
+    if unfinished and (time.time() if now is None else now) - stat.st_mtime < WRITING_AGE:
+        return logs[:-1], (f"{path.name}: still being written (its last line is unfinished): left for the next run",)
     return logs, ()
