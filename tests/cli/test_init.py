@@ -617,3 +617,26 @@ def test_init_writes_the_lbr_med7s_torque_sign_and_identify_reaches_the_expert_f
     assert [f for f in results["findings"] if f["kind"] == "sign"] == []
     mean = results["diagnostics"]["yardstick"]["mean_global_relative_error"]
     assert mean[results["main_estimate"]] < 0.5 * mean["description (nominal)"], mean
+
+
+def test_init_reads_the_units_a_logs_column_names_carry(tmp_path):
+    """Columns named with their unit (``t_s``, ``q1_deg``, ``tau1_Nm``): refused ("no time column"); the unit words are
+    now read beside the signal and the joint, the positions' degrees written as ``unit = "deg"``, and dynid identify
+    reads the log right (no finding on the angles or the torques' size). The name helper is checked on each form."""
+    from dynid.io.columns import _kind_and_unit
+
+    assert _kind_and_unit("time [s]") == ("time", "s") and _kind_and_unit("q_deg1") == ("positions", "deg")
+    assert _kind_and_unit("pos3 [rad]") == ("positions", "rad") and _kind_and_unit("i2_mA") == ("currents", "mA")
+    assert _kind_and_unit("dq1_degps") == ("velocities", "deg/s") and _kind_and_unit("tau1") == ("torques", None)
+    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=20, rng=4)
+    names = ["t_s"] + [f"q{j}_deg" for j in range(1, 7)] + [f"tau{j}_Nm" for j in range(1, 7)]
+    (tmp_path / "run.csv").write_text(",".join(names) + "\n" + "\n".join(
+        ",".join(f"{v:.10g}" for v in row) for row in np.column_stack([log.t, np.degrees(log.q), log.tau])) + "\n")
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    ident = _identification((tmp_path / "arm.toml").read_text())
+    assert ident["time"] == {"column": "t_s"} and ident["positions"]["unit"] == "deg" and "unit" not in ident["torques"]
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
+    assert not [f for f in findings if f["kind"] in ("angles", "scale", "sign", "rate")], findings

@@ -78,8 +78,9 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         notes += time_notes
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
-                table.add(kind, _inline(columns=found[kind][:n_dof]))
-                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]))
+                unit = _named_unit(found[kind][:n_dof])
+                table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {})))
+                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]) + (f" (in {unit}, as their names say)" if unit else ""))
                 taken += found[kind][:n_dof]
                 if kind == "torques":  # a log cannot tell which side of the gear measured them: the arm may
                     notes += _torque_sensor(table, urdf)
@@ -122,8 +123,8 @@ PATTERNS = {
 
 
 ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
-            "or i1…; or the URDF's joint names: /joint_states/<joint>/position|velocity|effort, <joint>_pos, "
-            "<joint>.effort")
+            "or i1…, each with a unit beside it or not (t_s, q1_deg, tau1_Nm); or the URDF's joint names: "
+            "/joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
 """The header patterns init accepts, named in its refusals."""
 
 
@@ -142,16 +143,48 @@ def _seconds_and_nanoseconds(header: list[str]) -> tuple[str, str] | None:
     return None
 
 
+UNITS = {"s": "s", "sec": "s", "ms": "ms", "us": "us", "ns": "ns", "rad": "rad", "deg": "deg", "degrees": "deg",
+         "rad/s": "rad/s", "rads": "rad/s", "rad_s": "rad/s", "radps": "rad/s", "deg/s": "deg/s", "degps": "deg/s",
+         "deg_s": "deg/s", "dps": "deg/s", "nm": "N*m", "n_m": "N*m", "n*m": "N*m", "a": "A", "ma": "mA"}
+"""Unit words a column's name may carry beside its signal and joint (``t_s``, ``q1_deg``, ``pos [rad]``,
+``tau_Nm3``): the unit the config's signal table takes."""
+
+_UNIT = r"[\s_\-\[\(]*(" + "|".join(sorted((re.escape(u) for u in UNITS), key=len, reverse=True)) + r")[\]\)]?$"
+_JOINT = r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$"
+
+
+DEFAULT_UNITS = ("rad", "rad/s", "N*m", "A")
+"""The units a signal table takes without ``unit``."""
+
+
+def _named_unit(columns: list[str]) -> str | None:
+    """The unit every one of a signal's columns names (:func:`_kind_and_unit`), where it is not the table's default."""
+    units = {_kind_and_unit(c)[1] for c in columns}
+    unit = units.pop() if len(units) == 1 else None
+    return unit if unit not in (None, *DEFAULT_UNITS) else None
+
+
 def _kind(name: str) -> str | None:
     """The signal a column's name says, by its last path component (``/joint_states/position[0]`` → positions)."""
+    return _kind_and_unit(name)[0]
+
+
+def _kind_and_unit(name: str) -> tuple[str | None, str | None]:
+    """The signal a column's name says and the unit it names (:data:`UNITS`), if any: ``q_deg1`` and ``q1_deg`` are
+    positions in degrees."""
     last = [part for part in re.split(r"[/.]", name.strip().lower()) if part] or [""]
     if len(last) > 1 and last[-1].isdigit():  # ROS-style position/0 and position.0: the index is a part of its own
         last = last[:-1]
-    stem = re.sub(r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$", "", last[-1])
+    stem = re.sub(_JOINT, "", last[-1])
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
-            return kind
-    return None
+            return kind, None
+    unit = re.search(_UNIT, stem) or re.search(_UNIT, last[-1])
+    if unit is None:
+        return None, None
+    bare = re.sub(_JOINT, "", re.sub(_UNIT, "", re.sub(_JOINT, "", last[-1])))
+    return next(((kind, UNITS[unit.group(1)]) for kind, pattern in PATTERNS.items() if re.fullmatch(pattern, bare)),
+                (None, None))
 
 
 def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
