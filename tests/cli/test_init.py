@@ -640,3 +640,27 @@ def test_init_reads_the_units_a_logs_column_names_carry(tmp_path):
     assert p.returncode == 0, p.stderr
     findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
     assert not [f for f in findings if f["kind"] in ("angles", "scale", "sign", "rate")], findings
+
+
+def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path):
+    """A UR10e hanging from a ceiling (gravity along +z of its base; the URDF says -z): dynid init's check finds the
+    mounting, writes gravity = [0, 0, 9.81] in [robot], and judges the torques' sign again with it: against the
+    upright model J3-J5 ran against the torques, which are not flipped. The first dynid identify then reads the log
+    right: no gravity, angles or sign finding."""
+    from dataclasses import replace
+
+    hanging = replace(dynid.load_robot(URDF), gravity=np.array([0.0, 0.0, 9.81]))
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    for name, seed, seconds in (("run.csv", 4, 30), ("val.csv", 5, 20)):
+        log = dynid.simulated_log(hanging, seconds=seconds, rng=seed)
+        np.savetxt(tmp_path / name, np.column_stack([log.t, log.q, log.tau]), delimiter=",", comments="",
+                   header=",".join(names))
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    config = tomllib.loads((tmp_path / "arm.toml").read_text())
+    assert config["robot"]["gravity"] == [0.0, 0.0, 9.81] and "sign" not in config["identification"]["torques"]
+    assert "robot: gravity = [0.0, 0.0, 9.81] written" in " ".join((p.stdout + p.stderr).split())
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
+    assert not [f for f in findings if f["kind"] in ("gravity", "angles", "sign")], findings

@@ -298,6 +298,38 @@ def with_torque_setting(text: str, name: str, value, why: str) -> str | None:
     return tomlkit.dumps(doc)
 
 
+def with_robot_setting(text: str, name: str, value, why: str) -> str:
+    """A starter config's text with ``name = value`` in its ``[robot]`` table (a ``robot = "..."`` key made that table,
+    its file as ``urdf``) and ``why`` beside it.
+
+    Parameters
+    ----------
+    text : str
+        The config :func:`starter_config` wrote.
+    name : str
+        The setting (``gravity``).
+    value : list or float
+    why : str
+        A comment on the line.
+
+    Returns
+    -------
+    str
+    """
+    doc = tomlkit.parse(text)
+    robot = doc.get("robot")
+    if isinstance(robot, str):
+        doc.remove("robot")
+        table = tomlkit.table()
+        table.add("urdf", robot)
+        doc.add("robot", table)
+        robot = doc["robot"]
+    assert isinstance(robot, dict)  # a table dynid init wrote
+    robot[name] = value
+    robot[name].comment(" ".join(why.split()))
+    return tomlkit.dumps(doc)
+
+
 def _relative(path: Path, folder: Path) -> str:
     return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
 

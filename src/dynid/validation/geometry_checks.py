@@ -362,8 +362,9 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     what = text[0] if twin is None else f"{text[0]} (as well on this arm: {_text_of(robot, log, changes, twin)[1][0]})"
     fix = (f"{text[1]}, and identify again" if fitted else "Was this log recorded with other zeros, another column "
            "order or another mounting than the identification log? Its scores say little until it is read as that one")
+    setting = {"gravity": [float(x) for x in gravities[pick]]} if kind == "gravity" and fitted and twin is None else None
     return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {what}: "
-                          f"{share}. {fix}", joint)], stats
+                          f"{share}. {fix}", joint, fix=setting)], stats
 
 
 def time_scale(robot: Robot, q, dq, ddq, tau) -> tuple[float, float]:
