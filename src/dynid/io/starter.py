@@ -305,12 +305,11 @@ def with_robot_setting(text: str, name: str, value, why: str) -> str:
     Parameters
     ----------
     text : str
-        The config :func:`starter_config` wrote.
-    name : str
-        The setting (``gravity``).
-    value : list or float
+        What dynid init is about to write.
+    name, value : str, list
+        The robot's setting and its value: ``gravity`` and three numbers [m/s²] in the base frame.
     why : str
-        A comment on the line.
+        The comment written beside it.
 
     Returns
     -------
