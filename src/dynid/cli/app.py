@@ -787,11 +787,11 @@ def init(
         for v in validation or ():
             if not v.exists():
                 raise DynIdError(f"{v}: no such validation log")
-        from ..identification.starter_check import checked_torque_sign
+        from ..identification.starter_check import checked_against_description
 
         text, notes = starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()),
                                      tuple(j.name for j in robot.joints), robot.held, robot=robot, rate=rate, xacro_args=args)
-        text, found = checked_torque_sign(text, out)
+        text, found = checked_against_description(text, out)
         return text, notes + found
 
     def save(written):

@@ -18,7 +18,7 @@ from ..io.identification_config import config_from_document
 from ..io.starter import with_robot_setting, with_torque_setting
 from .run import pipeline_of
 
-__all__ = ["checked_torque_sign"]
+__all__ = ["checked_against_description"]
 
 
 def _findings(text: str, path: Path) -> tuple:
@@ -28,7 +28,7 @@ def _findings(text: str, path: Path) -> tuple:
     return replace(pipeline_of(config), estimators=("wls",)).fit(recording, held_out=False).findings
 
 
-def checked_torque_sign(text: str, path: Path) -> tuple[str, list[str]]:
+def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
     """The starter config with the robot's gravity and its identification log's torque sign set where the log's own
     check finds them otherwise (the sign judged again once the gravity is set).
 

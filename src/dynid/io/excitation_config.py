@@ -200,8 +200,8 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     harmonics = int(tr.harmonics if tr.harmonics is not None else DEFAULT_TRAJECTORY["harmonics"])
     if tr.frequency is not None and tr.omega_f is not None:
         raise ConfigError(f"{path}: trajectory: give one of frequency (Hz) or omega_f (rad/s), not both")
-    frequency = tr.frequency if tr.frequency is not None or tr.omega_f is not None else DEFAULT_TRAJECTORY["frequency"]
-    omega_f = 2 * np.pi * frequency if frequency is not None else float(tr.omega_f or 0.0)
+    omega_f = (float(tr.omega_f) if tr.omega_f is not None
+               else 2 * np.pi * (tr.frequency if tr.frequency is not None else DEFAULT_TRAJECTORY["frequency"]))
     form = tr.form or "paper"
     offsets = _per_joint(tr.offsets, k, f"{path}: trajectory.offsets", angle=True) if tr.offsets is not None else None
     rest = bool(tr.rest)

@@ -49,9 +49,9 @@ def excitation_blocks(run) -> list:
     out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
     if d.feasible:
         below = lowest is not None and lowest.height < p.workspace.clearance
-        c = getattr(run, "self_clearance", None)
+        apart = getattr(run, "self_clearance", None)
         first = ("settle the warnings above (what the arm stands on, the links' clearance), then "
-                 if below or (c is not None and c.distance < 0) else "")
+                 if below or (apart is not None and apart.distance < 0) else "")
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
