@@ -80,3 +80,35 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
     scored = json.loads((checked / "validation.json").read_text())["validation"][0]["metrics"]
     for label in ("dynid OLS", "dynid SDP", "truth"):
         np.testing.assert_allclose(scored[label]["global_relative_error"], yard[label], rtol=1e-9)
+
+
+def test_logs_at_rest_throughout_do_not_dilute_the_yardstick_headline():
+    """The UR10e's validation logs are one motion (ptp_10_points) and ten static holds, each scored as the distance to
+    the static-friction band (0 for a set inside it). The mean over all eleven is about a tenth of the motion's
+    error; the yardstick also gives the mean over the logs that move, and the terminal's line quotes that one, with
+    how many rests each set keeps within the band."""
+    from pathlib import Path
+
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+    from dynid.report.summaries import in_short
+    from dynid.validation.torques import rests_throughout
+    from tests.conftest import shared_data
+
+    repo = Path(__file__).resolve().parents[2]
+    cfg = load_identification_config(repo / "configs" / "ur10e.toml", data_root=shared_data("ur10e_mamedov2020"))
+    r = run_identification(cfg)
+    yard = r.diagnostics["yardstick"]
+    moving = [v.name for v in r.validations if not rests_throughout(v.rest_share)]
+    assert moving == ["ptp_10_points"] and len(r.validations) == 11
+    per_log = yard["global_relative_error"]
+    over = yard["mean_over_logs_that_move"]
+    assert over["logs"] == moving
+    for label in (r.main, r.diagnostics["nominal_set"]):
+        assert over[label] == per_log["ptp_10_points"][label]
+        assert over[label] > 5 * yard["mean_global_relative_error"][label]  # the rests' zeros dilute the all-logs mean
+    rests = [per_log[name] for name in per_log if name not in moving]
+    kept = sum(e[r.main] == 0 for e in rests)
+    line = next(b.text for b in in_short(r) if b.text.startswith("on one yardstick"))
+    assert f"{r.main} {over[r.main]:.3g} %" in line and "over the one log that moves" in line
+    assert f"of the 10 at rest throughout, within the static-friction band: {r.main} on {kept}" in line

@@ -367,11 +367,23 @@ def with_yardstick(result, scored: tuple):
     Returns
     -------
     IdentificationResult
+        Where some logs rest throughout and others move, ``"mean_over_logs_that_move"`` gives the mean over those
+        that move (``"logs"`` names them): a log at rest scores the distance to the static-friction band about its
+        gravity torque (:func:`dynid.validation.torques.rests_throughout`), another unit than a motion's error, and
+        ten of them at 0 would make the mean a tenth of the motion's.
     """
+    from ..validation.torques import rests_throughout
+
     logs = {c.name: {label: float(m["global_relative_error"]) for label, m in c.metrics().items()} for c in scored}
     labels = [label for label in (scored[0].metrics() if scored else {})]
-    mean = {label: float(np.mean([errors[label] for errors in logs.values()])) for label in labels}
-    figures = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean}
+
+    def mean(names) -> dict:
+        return {label: float(np.mean([logs[name][label] for name in names])) for label in labels}
+
+    figures = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean(logs)}
+    moving = [c.name for c in scored if not rests_throughout(c.rest_share)]
+    if moving and len(moving) < len(scored):  # a log at rest throughout scores the distance to the static-friction band
+        figures["mean_over_logs_that_move"] = {"logs": moving, **mean(moving)}
     return replace(result, diagnostics={**result.diagnostics, "yardstick": figures})
 
 

@@ -795,15 +795,28 @@ def in_short(result) -> list:
 
 def _yardstick_lines(r, label: str) -> list:
     """:func:`in_short`'s line on the one yardstick (:func:`dynid.identification.run.with_yardstick`): the main
-    estimate's and the description's mean validation errors with every log prepared by dynid's default rules alone."""
-    mean = (r.diagnostics.get("yardstick") or {}).get("mean_global_relative_error") or {}
+    estimate's and the description's mean validation errors with every log prepared by dynid's default rules alone;
+    over the logs that move where others rest throughout (those say how many sets stay within the static-friction
+    band, which is what they score)."""
+    yard = r.diagnostics.get("yardstick") or {}
+    moving = yard.get("mean_over_logs_that_move")
+    mean = moving or yard.get("mean_global_relative_error") or {}
     if label not in mean:
         return []
     nominal = r.diagnostics.get("nominal_set")
     beside = f", the description's nominal model {mean[nominal]:.3g} %" if nominal in mean and nominal != label else ""
+    n = len(r.validations)
+    over = f"(mean over {n} logs)" if n > 1 else "(one log)"
+    if moving:
+        rests = [errors for name, errors in yard["global_relative_error"].items() if name not in moving["logs"]]
+        within = "; ".join(f"{who} on {sum(e.get(key, np.nan) == 0 for e in rests)}"
+                           for who, key in ((label, label), ("the description", nominal))
+                           if key in rests[0] and (who == label or key != label))
+        k = len(moving["logs"])
+        over = (("(over the one log that moves" if k == 1 else f"(mean over the {k} logs that move")
+                + f"; of the {len(rests)} at rest throughout, within the static-friction band: {within})")
     return [Line(f"on one yardstick (every validation log filtered by dynid's default rules, the same samples whatever the "
-                 f"settings): {label} {mean[label]:.3g} %{beside} "
-                 + (f"(mean over {len(r.validations)} logs)" if len(r.validations) > 1 else "(one log)"))]
+                 f"settings): {label} {mean[label]:.3g} %{beside} {over}")]
 
 
 CHOSEN_TERMS = ("fst", "fca", "fcl")
