@@ -659,6 +659,10 @@ def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path)
     assert p.returncode == 0, p.stderr
     config = tomllib.loads((tmp_path / "arm.toml").read_text())
     assert config["robot"]["gravity"] == [0.0, 0.0, 9.81] and "sign" not in config["identification"]["torques"]
+    from dynid.io.identification_config import load_identification_config
+
+    written = load_identification_config(tmp_path / "arm.toml").robot
+    assert written.drive_terms == dynid.load_robot(URDF).drive_terms  # the [robot] table keeps the file's drive terms
     assert "robot: gravity = [0.0, 0.0, 9.81] written" in " ".join((p.stdout + p.stderr).split())
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr

@@ -215,8 +215,7 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
     doc.add("data_root", tomlkit.item(_relative(log.parent, out.parent)))
     doc.add(tomlkit.nl())
     if as_table:
-        robot = tomlkit.table()
-        robot.add("urdf", _relative(urdf, out.parent))
+        robot = _robot_table(_relative(urdf, out.parent))
         if held:
             robot.add("held", list(held))
             robot["held"].comment("not the arm's joints: held fixed at 0")
@@ -225,7 +224,6 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
             arguments.update({str(k): str(v) for k, v in xacro_args.items()})
             arguments.comment("the xacro file's arguments (name:=value)")
             robot.add("xacro_args", arguments)
-        robot.add("drive_terms", list(URDF_DRIVE_TERMS))
         if gains:
             joints = tomlkit.aot()
             for j, g in enumerate(gains):
@@ -319,14 +317,21 @@ def with_robot_setting(text: str, name: str, value, why: str) -> str:
     robot = doc.get("robot")
     if isinstance(robot, str):
         doc.remove("robot")
-        table = tomlkit.table()
-        table.add("urdf", robot)
-        doc.add("robot", table)
+        doc.add("robot", _robot_table(robot))
         robot = doc["robot"]
     assert isinstance(robot, dict)  # a table dynid init wrote
     robot[name] = value
     robot[name].comment(" ".join(why.split()))
     return tomlkit.dumps(doc)
+
+
+def _robot_table(urdf: str):
+    """A ``[robot]`` table for a robot file: its path and the drive terms ``robot = "file"`` gives it
+    (:data:`dynid.model.description.URDF_DRIVE_TERMS`; a table without them would have the paper's two)."""
+    table = tomlkit.table()
+    table.add("urdf", urdf)
+    table.add("drive_terms", list(URDF_DRIVE_TERMS))
+    return table
 
 
 def _relative(path: Path, folder: Path) -> str:
