@@ -668,3 +668,29 @@ def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path)
     assert p.returncode == 0, p.stderr
     findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
     assert not [f for f in findings if f["kind"] in ("gravity", "angles", "sign")], findings
+
+
+def test_init_writes_a_joints_zero_a_quarter_turn_off_and_identify_reads_the_log_right(tmp_path):
+    """A UR10e log whose J2 encoder counts from a zero a quarter turn from the URDF's (logged angle = the URDF's − π/2):
+    dynid init's check finds it, writes position_offset = "pi/2" in J2's [[robot.joints]] table (one table per joint,
+    the others empty, the file's drive terms kept), and the first dynid identify has no angles finding."""
+    from dynid.io.identification_config import load_identification_config
+
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    for name, seed, seconds in (("run.csv", 4, 30), ("val.csv", 5, 20)):
+        log = dynid.simulated_log(dynid.load_robot(URDF), seconds=seconds, rng=seed)
+        logged = log.q - np.array([0.0, np.pi / 2, 0, 0, 0, 0])
+        np.savetxt(tmp_path / name, np.column_stack([log.t, logged, log.tau]), delimiter=",", comments="",
+                   header=",".join(names))
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    joints = tomllib.loads((tmp_path / "arm.toml").read_text())["robot"]["joints"]
+    assert joints == [{}, {"position_offset": "pi/2"}, {}, {}, {}, {}]
+    robot = load_identification_config(tmp_path / "arm.toml").robot
+    assert np.allclose(robot.transmission.position_offset, [0, np.pi / 2, 0, 0, 0, 0])
+    assert robot.drive_terms == dynid.load_robot(URDF).drive_terms
+    assert 'robot: J2 position_offset = "pi/2" written' in " ".join((p.stdout + p.stderr).split())
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
+    assert not [f for f in findings if f["kind"] in ("gravity", "angles", "sign")], findings

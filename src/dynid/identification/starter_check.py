@@ -1,10 +1,12 @@
 """What ``dynid init`` checks of the log before it writes the config: the identification log identified as the config
-it is about to write would have it (least squares alone), then the robot's mounting and the torques' sign set where
-that check finds them otherwise than the robot file says (:func:`dynid.validation.geometry_checks.geometry_findings`'s
-gravity, :func:`dynid.validation.diagnostics.sign_findings`), so that the first ``dynid identify`` reads the log
-right (issue "Never worse than the description": on the LBR Med7's log the config without the sign scored 20.0 % and
-needed a second run). The sign is judged with the mounting set (a ceiling-mounted arm's torques run against an upright
-model on some joints, and are not flipped)."""
+it is about to write would have it (least squares alone), then the robot's mounting, its joints' zeros and the
+torques' sign set where that check finds them otherwise than the robot file says
+(:func:`dynid.validation.geometry_checks.geometry_findings`' gravity and turned zeros,
+:func:`dynid.validation.diagnostics.sign_findings`), so that the first ``dynid identify`` reads the log right (issue
+"Never worse than the description": on the LBR Med7's log the config without the sign scored 20.0 % and needed a
+second run). The sign is judged with the geometry set (a ceiling-mounted arm's torques run against an upright model
+on some joints, and are not flipped). A reversed joint or swapped columns are left to ``dynid identify``'s finding:
+the reader's columns are the user's to check."""
 
 from __future__ import annotations
 
@@ -15,22 +17,42 @@ from pathlib import Path
 from ..exceptions import DynIdError
 from ..io.datasets import load_recording
 from ..io.identification_config import config_from_document
-from ..io.starter import with_robot_setting, with_torque_setting
+from ..io.starter import with_joint_setting, with_robot_setting, with_torque_setting
 from .run import pipeline_of
 
 __all__ = ["checked_against_description"]
 
+GEOMETRY_FIXES = 2
+"""Geometry settings written one after the other, each checked again: the mounting, then a joint's zero (or the other
+way round)."""
 
-def _findings(text: str, path: Path) -> tuple:
-    """The identification log's findings with the config ``text`` says, least squares alone."""
+
+def _findings(text: str, path: Path) -> tuple[tuple, int]:
+    """The identification log's findings with the config ``text`` says, least squares alone, and the robot's joints."""
     config = config_from_document(tomllib.loads(text), path)
     recording = load_recording(config.identification, config.robot)
-    return replace(pipeline_of(config), estimators=("wls",)).fit(recording, held_out=False).findings
+    fitted = replace(pipeline_of(config), estimators=("wls",)).fit(recording, held_out=False)
+    return fitted.findings, config.robot.n_dof
+
+
+def _with_geometry(text: str, found) -> tuple[str, str]:
+    """``text`` with the setting a gravity or angles finding names (its ``fix``), and the line that says so."""
+    why = "the measured torques fit the description's model so (dynid init's check)"
+    said = " ".join(found.text.split()).split(". ")[0]  # what was found; the question and the setting it asks for follow
+    if "gravity" in found.fix:
+        vector = [round(x, 4) for x in found.fix["gravity"]]
+        return (with_robot_setting(text, "gravity", vector, f"m/s² in the base frame: {why}"),
+                f"robot: gravity = {vector} written: {said}")
+    offsets = found.fix["position_offset"]
+    written = with_joint_setting(text, "position_offset", offsets, found.fix["n_dof"],
+                                 f"added to the logged angles: {why}; remove it if the encoders' zeros are the file's")
+    listed = ", ".join(f'J{j + 1} position_offset = "{v}"' for j, v in sorted(offsets.items()))
+    return written, f"robot: {listed} written in [[robot.joints]]: {said}"
 
 
 def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
-    """The starter config with the robot's gravity and its identification log's torque sign set where the log's own
-    check finds them otherwise (the sign judged again once the gravity is set).
+    """The starter config with the robot's gravity, its joints' zeros and its identification log's torque sign set
+    where the log's own check finds them otherwise (the sign judged again once the geometry is set).
 
     Parameters
     ----------
@@ -42,21 +64,22 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
     Returns
     -------
     text : str
-        As given, or with ``gravity = [...]`` in ``[robot]`` and ``sign = ...`` in ``[identification]``'s torques (or
-        currents), each with why beside it.
+        As given, or with ``gravity = [...]`` in ``[robot]``, ``position_offset = "pi/2"`` (a quarter or half turn)
+        in a joint's ``[[robot.joints]]`` table and ``sign = ...`` in ``[identification]``'s torques (or currents),
+        each with why beside it.
     notes : list of str
         What was found, a line each (none where the log reads as the robot file says).
     """
     notes: list[str] = []
     try:
-        findings = _findings(text, path)
-        tilted = next((f for f in findings if f.kind == "gravity" and f.fix is not None), None)
-        if tilted is not None and tilted.fix is not None:
-            vector = [round(x, 4) for x in tilted.fix["gravity"]]
-            text = with_robot_setting(text, "gravity", vector, "m/s² in the base frame: the measured torques fit the "
-                                                               "description's model so (dynid init's check)")
-            notes.append(f"robot: gravity = {vector} written: {' '.join(tilted.text.split())}")
-            findings = _findings(text, path)
+        findings, n_dof = _findings(text, path)
+        for _ in range(GEOMETRY_FIXES):  # the mounting and a zero can both differ: one found, set and checked again
+            found = next((f for f in findings if f.kind in ("gravity", "angles") and f.fix is not None), None)
+            if found is None or found.fix is None:
+                break
+            text, note = _with_geometry(text, replace(found, fix={**found.fix, "n_dof": n_dof}))
+            notes.append(note)
+            findings, _ = _findings(text, path)
     except DynIdError as exc:
         first = " ".join(str(exc).split())
         return text, notes + [f"torque signs not checked against the description ({first}): dynid identify checks them"]

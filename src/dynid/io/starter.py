@@ -314,15 +314,57 @@ def with_robot_setting(text: str, name: str, value, why: str) -> str:
     str
     """
     doc = tomlkit.parse(text)
+    robot = _robot_of(doc)
+    robot[name] = value
+    robot[name].comment(" ".join(why.split()))
+    return tomlkit.dumps(doc)
+
+
+def with_joint_setting(text: str, name: str, values: dict, n_dof: int, why: str) -> str:
+    """A starter config's text with ``name = value`` in some joints' ``[[robot.joints]]`` tables (made, one per joint,
+    where the config has none; the ``[robot]`` table made as :func:`with_robot_setting` makes it) and ``why`` beside
+    the first.
+
+    Parameters
+    ----------
+    text : str
+        What dynid init is about to write.
+    name : str
+        A joint's setting: ``position_offset``.
+    values : dict of int to value
+        0-based joint -> its value (an angle as ``"pi/2"``).
+    n_dof : int
+        The robot's joints (the tables made).
+    why : str
+        The comment written beside the first value.
+
+    Returns
+    -------
+    str
+    """
+    doc = tomlkit.parse(text)
+    robot = _robot_of(doc)
+    if "joints" not in robot:
+        tables = tomlkit.aot()
+        for _ in range(n_dof):
+            tables.append(tomlkit.table())
+        robot.add("joints", tables)
+    for k, (j, value) in enumerate(sorted(values.items())):
+        robot["joints"][j][name] = value
+        if k == 0:
+            robot["joints"][j][name].comment(" ".join(why.split()))
+    return tomlkit.dumps(doc)
+
+
+def _robot_of(doc):
+    """A starter config's ``[robot]`` table, made from its ``robot = "file"`` key where it has none."""
     robot = doc.get("robot")
     if isinstance(robot, str):
         doc.remove("robot")
         doc.add("robot", _robot_table(robot))
         robot = doc["robot"]
     assert isinstance(robot, dict)  # a table dynid init wrote
-    robot[name] = value
-    robot[name].comment(" ".join(why.split()))
-    return tomlkit.dumps(doc)
+    return robot
 
 
 def _robot_table(urdf: str):

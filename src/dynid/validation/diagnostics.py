@@ -62,8 +62,9 @@ class Finding:
     joint : int or None
         0-based joint, when the finding is about one.
     fix : dict or None
-        The dataset setting the finding asks for, where it names one (a sign finding's ``{"sign": -1}`` or
-        ``{"sign": [1, -1, ...]}``): what ``dynid init`` writes (not in results.json, whose ``text`` says it).
+        The setting the finding asks for, where it names one (a sign finding's ``{"sign": -1}`` or
+        ``{"sign": [1, -1, ...]}``, a geometry finding's ``{"gravity": [...]}`` or ``{"position_offset": {joint:
+        "pi/2"}}``): what ``dynid init`` writes (not in results.json, whose ``text`` says it).
     """
 
     kind: str

@@ -362,9 +362,22 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     what = text[0] if twin is None else f"{text[0]} (as well on this arm: {_text_of(robot, log, changes, twin)[1][0]})"
     fix = (f"{text[1]}, and identify again" if fitted else "Was this log recorded with other zeros, another column "
            "order or another mounting than the identification log? Its scores say little until it is read as that one")
-    setting = {"gravity": [float(x) for x in gravities[pick]]} if kind == "gravity" and fitted and twin is None else None
     return [Finding(kind, f"{dataset}: the description's nominal model fits the torques far better with {what}: "
-                          f"{share}. {fix}", joint, fix=setting)], stats
+                          f"{share}. {fix}", joint, fix=_setting(robot, changes, pick) if fitted and twin is None else None
+                    )], stats
+
+
+def _setting(robot: Robot, changes: tuple, pick: int) -> dict | None:
+    """The setting that makes the description read the log as change ``pick`` does, where one setting does it:
+    ``{"gravity": [gx, gy, gz]}`` (the mounting) or ``{"position_offset": {joint: "pi/2", ...}}`` (zeros turned,
+    nothing else changed); None for a reversal or a swap (the columns' order and direction are the reader's)."""
+    shifts, orders, gravities, ways, channels = (x[pick] for x in changes)
+    if np.any(orders != np.arange(robot.n_dof)) or np.any(ways < 0) or channels:
+        return None
+    if shifts.any():
+        same_mount = np.array_equal(gravities, np.asarray(robot.gravity, dtype=float))
+        return {"position_offset": {int(j): _pi_text(shifts[j]) for j in np.flatnonzero(shifts)}} if same_mount else None
+    return {"gravity": [float(x) for x in gravities]}
 
 
 def time_scale(robot: Robot, q, dq, ddq, tau) -> tuple[float, float]:
