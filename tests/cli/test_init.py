@@ -694,3 +694,47 @@ def test_init_writes_a_joints_zero_a_quarter_turn_off_and_identify_reads_the_log
     assert p.returncode == 0, p.stderr
     findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
     assert not [f for f in findings if f["kind"] in ("gravity", "angles", "sign")], findings
+
+
+def test_init_reads_the_kr300s_qualified_headers_as_its_expert_config_does(tmp_path):
+    """The KUKA KR 300's log (Weigand et al.) names two encoders (q_se_deg1… on the link side, J4-J6 all zero;
+    q_mot_deg1…, the motor encoders divided by the gear ratios), two motor-side torques (tau_mot_abs_Nm1…,
+    tau_mot_rel_Nm1…) and commanded signals (q_ref…, tau_ff_mot…). dynid init passes over the encoder group with dead
+    channels, reads the torques through the gear ratios (side = "motor"), never takes a feed-forward column, and
+    writes the columns the hand-written config (configs/kuka_kr300.toml, from the data's SOURCE.md) reads."""
+    from dynid.io.identification_config import load_identification_config
+
+    from ..conftest import shared_data
+
+    root = Path(__file__).resolve().parents[2]
+    data = shared_data("kuka_kr300_weigand2021") / "recorded"
+    expert = load_identification_config(root / "configs" / "kuka_kr300.toml", data_root=data.parent)
+    p = run("init", str(root / "configs" / "robots" / "kuka_kr300.toml"), str(data / "traj_A.csv"),
+            str(data / "traj_B.csv"), "--out", str(tmp_path / "kr.toml"))
+    assert p.returncode == 0, p.stderr
+    written = load_identification_config(tmp_path / "kr.toml")
+    for signal in ("positions", "torques"):
+        mine, theirs = (c.identification.signals[signal] for c in (written, expert))
+        assert (mine.columns, mine.scale, mine.side) == (theirs.columns, theirs.scale, theirs.side)  # scale: the unit's
+    said = " ".join((p.stdout + p.stderr).split())
+    assert "q_se_deg4, q_se_deg5, q_se_deg6 read one value throughout" in said
+    assert not {"tau_ff_mot_Nm1", "q_ref_deg1"} & {c for s in written.identification.signals.values() for c in s.columns}
+    assert "the log has more joint columns" not in said  # the groups left are said as such, not as extra joints
+
+
+def test_init_takes_the_link_side_where_a_log_names_both_sides_of_the_gear(tmp_path):
+    """A log with each joint's angle and torque named for both sides of its gear (``q_mot_1…`` beside ``q_link_1…``,
+    ``tau_mot_1…`` beside ``tau_link_1…``), every channel alive: the link side is taken, the motor side's columns
+    are said as left, and the torques get no side = "motor"."""
+    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=10, rng=3)
+    names = (["t"] + [f"q_mot_{j}" for j in range(1, 7)] + [f"q_link_{j}" for j in range(1, 7)]
+             + [f"tau_mot_{j}" for j in range(1, 7)] + [f"tau_link_{j}" for j in range(1, 7)])
+    np.savetxt(tmp_path / "run.csv", np.column_stack([log.t, log.q, log.q, log.tau / 100, log.tau]), delimiter=",",
+               comments="", header=",".join(names))
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    table = _identification((tmp_path / "arm.toml").read_text())
+    assert table["positions"] == {"columns": [f"q_link_{j}" for j in range(1, 7)]}
+    assert table["torques"]["columns"] == [f"tau_link_{j}" for j in range(1, 7)] and "side" not in table["torques"]
+    said = " ".join((p.stdout + p.stderr).split())
+    assert "positions also in the log, left: q_mot_1…q_mot_6" in said and "tau_mot_1…tau_mot_6" in said

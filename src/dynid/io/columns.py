@@ -8,13 +8,14 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import tomlkit
 from tomlkit.items import InlineTable, Table
 
 from ..conventions import time_unit_of
 from ..exceptions import DataError
 from .files import text_encoding_hint
-from .tables import is_data_line
+from .tables import is_data_line, read_table
 
 
 def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,
@@ -61,6 +62,8 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         table.add("delimiter", delimiter)
     if header:
         found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
+        group_notes, passed = _one_group_each(found, log, delimiter, n_dof)
+        order_notes += group_notes
         _check_one_signal(log, first, found, n_dof)
         if "time" not in found and rate is None:
             raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
@@ -79,13 +82,16 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
                 unit = _named_unit(found[kind][:n_dof])
-                table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {})))
-                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]) + (f" (in {unit}, as their names say)" if unit else ""))
+                motor = bool(_qualifiers(found[kind][0]) & MOTOR_SIDE)
+                side = {"side": "motor"} if motor and kind == "torques" else {}
+                table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {}), **side))
+                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]) + (f" (in {unit}, as their names say)" if unit else "")
+                             + _side_note(kind, motor))
                 taken += found[kind][:n_dof]
-                if kind == "torques":  # a log cannot tell which side of the gear measured them: the arm may
+                if kind == "torques" and not motor:  # a log cannot tell which side of the gear measured them: the arm may
                     notes += _torque_sensor(table, urdf)
         left = [c for c in first if c not in taken]
-        extra = [c for c in left if _kind(c) in ("positions", effort)]
+        extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
         if extra:
             notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
                          f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
@@ -123,7 +129,8 @@ PATTERNS = {
 
 
 ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
-            "or i1…, each with a unit beside it or not (t_s, q1_deg, tau1_Nm); or the URDF's joint names: "
+            "or i1…, each with a unit beside it or not (t_s, q1_deg, tau1_Nm) and a side of the gear or a variant or not "
+            "(q_link_1, tau_mot_abs_Nm1); or the URDF's joint names: "
             "/joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
 """The header patterns init accepts, named in its refusals."""
 
@@ -179,12 +186,84 @@ def _kind_and_unit(name: str) -> tuple[str | None, str | None]:
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
             return kind, None
-    unit = re.search(_UNIT, stem) or re.search(_UNIT, last[-1])
+    unit = None if _qualified(stem) else re.search(_UNIT, stem) or re.search(_UNIT, last[-1])
     if unit is None:
-        return None, None
+        return _qualified(stem), None
     bare = re.sub(_JOINT, "", re.sub(_UNIT, "", re.sub(_JOINT, "", last[-1])))
-    return next(((kind, UNITS[unit.group(1)]) for kind, pattern in PATTERNS.items() if re.fullmatch(pattern, bare)),
-                (None, None))
+    signal = next((k for k, pattern in PATTERNS.items() if re.fullmatch(pattern, bare)), None) or _qualified(bare)
+    return (signal, UNITS[unit.group(1)]) if signal else (None, None)
+
+
+MOTOR_SIDE = frozenset({"mot", "motor", "rotor"})
+"""Words of a column's name that say the motor side of the gear (``tau_mot_Nm1``)."""
+LINK_SIDE = frozenset({"se", "link", "load", "output", "secondary"})
+"""Words that say the link side (``q_se_deg1``: a secondary, link-side encoder)."""
+QUALIFIERS = MOTOR_SIDE | LINK_SIDE | frozenset({"abs", "rel", "meas", "measured", "msr", "act", "actual", "fb",
+                                                 "feedback", "raw"})
+"""Words a signal's stem may carry beside it (``q_se_deg1``, ``tau_mot_abs_Nm1``, ``q_meas_1``): its side of the gear
+or a variant; columns of one signal that differ by them are groups of their own (:func:`_one_group_each`)."""
+
+
+def _one_group_each(found: dict, log: Path, delimiter: str, n_dof: int) -> tuple[list[str], list[str]]:
+    """Where a signal's columns make several groups of one column per joint that differ by their names'
+    :data:`QUALIFIERS` (a KR 300's ``q_se_deg1…`` and ``q_mot_deg1…``), one group taken (``found`` changed in place),
+    and said: a group with a channel that reads one value throughout the log is passed over, then the link side is
+    taken before an unnamed side and the motor side, then the header's order; the notes, and the columns passed over."""
+    notes: list[str] = []
+    passed: list[str] = []
+    for kind, columns in found.items():
+        groups: dict[frozenset, list[str]] = {}
+        for c in columns:
+            groups.setdefault(_qualifiers(c), []).append(c)
+        if kind == "time" or len(groups) < 2 or any(len(g) != n_dof for g in groups.values()):
+            continue
+        complete = list(groups.values())
+        dead = _constant_columns(log, delimiter, [c for g in complete for c in g])
+
+        def rank(g: list[str]) -> tuple:
+            words = _qualifiers(g[0])
+            return any(c in dead for c in g), 0 if words & LINK_SIDE else 2 if words & MOTOR_SIDE else 1, complete.index(g)
+
+        chosen = min(complete, key=rank)
+        found[kind] = chosen
+        left = [f"{g[0]}…{g[-1]}" + (f" ({', '.join(c for c in g if c in dead)} read one value throughout)"
+                                     if any(c in dead for c in g) else "") for g in complete if g is not chosen]
+        notes.append(f"{kind} also in the log, left: {'; '.join(left)} (give their columns to take them)")
+        passed += [c for g in complete if g is not chosen for c in g]
+    return notes, passed
+
+
+def _constant_columns(log: Path, delimiter: str, columns: list[str]) -> set[str]:
+    """The columns of a log that read one value throughout (none where the log cannot be read: its reader says why)."""
+    try:
+        data = np.asarray(read_table(log, columns, header=True, delimiter=delimiter).data)
+    except DataError:
+        return set()
+    return {c for c, x in zip(columns, data.T) if np.ptp(x) == 0}
+
+
+def _side_note(kind: str, motor: bool) -> str:
+    """What a signal's columns named for the motor side are taken as: torques through the gear ratios, angles and
+    speeds as the joint's (a drive's motor angle divided by its ratio), with how to say otherwise."""
+    if not motor:
+        return ""
+    if kind == "torques":
+        return ' (named for the motor side: side = "motor", taken through the description\'s gear ratios)'
+    return (' (named for the motor side, taken as the joint\'s: the motor\'s divided by its gear ratio; if they are '
+            'the motor\'s own, add side = "motor")')
+
+
+def _qualified(stem: str) -> str | None:
+    """The signal of a stem written as a signal's word and :data:`QUALIFIERS` (``q_se``, ``tau_mot_abs``), or None."""
+    words = [w for w in re.split(r"[\s_\-]+", stem) if w]
+    if len(words) < 2 or not set(words[1:]) <= QUALIFIERS:
+        return None
+    return next((kind for kind, pattern in PATTERNS.items() if kind != "time" and re.fullmatch(pattern, words[0])), None)
+
+
+def _qualifiers(name: str) -> frozenset:
+    """The :data:`QUALIFIERS` among a column name's words."""
+    return frozenset(re.split(r"[^a-z]+", name.strip().lower())) & QUALIFIERS
 
 
 def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
@@ -249,8 +328,9 @@ def _in_named_order(found: dict[str, list[str]], first: list[str], row: list[str
 
 
 COMMANDED = frozenset({"cmd", "command", "commanded", "commands", "desired", "des", "target", "targets", "setpoint",
-                       "setpoints", "sp", "ref", "reference", "goal", "demand", "demanded"})
-"""Words of a column name that make it a commanded signal (a controller's set-point), never a measured one."""
+                       "setpoints", "sp", "ref", "reference", "goal", "demand", "demanded", "ff", "feedforward"})
+"""Words of a column name that make it a commanded signal (a controller's set-point or feed-forward), never a measured
+one."""
 
 
 def commanded(name: str, joints: tuple[str, ...] = ()) -> bool:
