@@ -720,6 +720,7 @@ def test_init_reads_the_kr300s_qualified_headers_as_its_expert_config_does(tmp_p
     assert "q_se_deg4, q_se_deg5, q_se_deg6 read one value throughout" in said
     assert not {"tau_ff_mot_Nm1", "q_ref_deg1"} & {c for s in written.identification.signals.values() for c in s.columns}
     assert "the log has more joint columns" not in said  # the groups left are said as such, not as extra joints
+    assert "units assumed" not in said  # every signal's columns name their unit (deg, Nm)
 
 
 def test_init_takes_the_link_side_where_a_log_names_both_sides_of_the_gear(tmp_path):
@@ -738,3 +739,4 @@ def test_init_takes_the_link_side_where_a_log_names_both_sides_of_the_gear(tmp_p
     assert table["torques"]["columns"] == [f"tau_link_{j}" for j in range(1, 7)] and "side" not in table["torques"]
     said = " ".join((p.stdout + p.stderr).split())
     assert "positions also in the log, left: q_mot_1…q_mot_6" in said and "tau_mot_1…tau_mot_6" in said
+    assert "units assumed: positions in rad, torques in N·m" in said  # no unit in the names

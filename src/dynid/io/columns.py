@@ -79,9 +79,11 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         time_notes, taken = (_time_entry(table, first, found["time"][0], [split(line) for line in lines[1:]])
                              if "time" in found else _rate_entry(table, float(rate or 0.0)))
         notes += time_notes
+        assumed = []
         for kind in ("positions", "velocities", effort):
             if len(found.get(kind, [])) >= n_dof:
                 unit = _named_unit(found[kind][:n_dof])
+                assumed += [] if unit or _kind_and_unit(found[kind][0])[1] else [kind]
                 motor = bool(_qualifiers(found[kind][0]) & MOTOR_SIDE)
                 side = {"side": "motor"} if motor and kind == "torques" else {}
                 table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {}), **side))
@@ -97,25 +99,28 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
                          f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
         elif left:
             notes.append(f"left: {', '.join(left)}")
+        notes += [_assumed_units(assumed)] if assumed else []
+        return table, notes
     elif n_columns == 31 and n_dof == 6:
         table = tomlkit.table()
         table.add("preset", "ur-rtde")
         table.add("file", log.name)
-        notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\"")
+        notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" "
+                     "(its units: s, rad, rad/s, A)")
+        return table, notes
     elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
         blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
         table.add("time", _inline(column=1))
         for b, kind in enumerate(blocks):
             table.add(kind, _inline(columns=[2 + b * n_dof + j for j in range(n_dof)]))
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
+        notes.append("units assumed: s, " + _assumed_units(blocks).removeprefix("units assumed: "))
+        return table, notes
     else:
         fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
         raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
                         "signal (or name the columns in a header line: t, q1…, tau1…)"
                         + _hold_hint(urdf, joints, fewer))
-    notes.append("units assumed: s, rad, N·m (or A: currents through the drive gains); add unit = \"deg\" to "
-                 "positions for degrees")
-    return table, notes
 
 
 PATTERNS = {
@@ -378,6 +383,16 @@ def _inline(**entries) -> InlineTable:
     table = tomlkit.inline_table()
     table.update(entries)
     return table
+
+
+ASSUMED_UNITS = {"positions": "rad", "velocities": "rad/s", "torques": "N·m", "currents": "A (through the drive gains)"}
+"""The unit each signal's table takes where neither the config nor the column's name gives one."""
+
+
+def _assumed_units(kinds: list[str]) -> str:
+    """The note on the units taken for signals whose columns name none."""
+    return ("units assumed: " + ", ".join(f"{kind} in {ASSUMED_UNITS[kind]}" for kind in kinds)
+            + ("; add unit = \"deg\" to positions for degrees" if "positions" in kinds else ""))
 
 
 def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
