@@ -267,8 +267,10 @@ def _qualified(stem: str) -> str | None:
 
 
 def _qualifiers(name: str) -> frozenset:
-    """The :data:`QUALIFIERS` among a column name's words."""
-    return frozenset(re.split(r"[^a-z]+", name.strip().lower())) & QUALIFIERS
+    """The :data:`QUALIFIERS` among the words of a column name's last path component (``tau_mot_abs_Nm1``; not a
+    topic's or a joint's name before it: ``/motor_states/elbow/effort`` has none)."""
+    last = [part for part in re.split(r"[/.]", name.strip().lower()) if part and not part.isdigit()] or [""]
+    return frozenset(re.split(r"[^a-z]+", last[-1])) & QUALIFIERS
 
 
 def _named_joint(name: str, joints: tuple[str, ...]) -> tuple[str, int] | None:
