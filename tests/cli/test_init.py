@@ -649,14 +649,7 @@ def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path)
     right: no gravity, angles or sign finding."""
     from dataclasses import replace
 
-    hanging = replace(dynid.load_robot(URDF), gravity=np.array([0.0, 0.0, 9.81]))
-    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
-    for name, seed, seconds in (("run.csv", 4, 30), ("val.csv", 5, 20)):
-        log = dynid.simulated_log(hanging, seconds=seconds, rng=seed)
-        np.savetxt(tmp_path / name, np.column_stack([log.t, log.q, log.tau]), delimiter=",", comments="",
-                   header=",".join(names))
-    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
-    assert p.returncode == 0, p.stderr
+    p = _simulated_init(tmp_path, replace(dynid.load_robot(URDF), gravity=np.array([0.0, 0.0, 9.81])))
     config = tomllib.loads((tmp_path / "arm.toml").read_text())
     assert config["robot"]["gravity"] == [0.0, 0.0, 9.81] and "sign" not in config["identification"]["torques"]
     from dynid.io.identification_config import load_identification_config
@@ -664,6 +657,24 @@ def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path)
     written = load_identification_config(tmp_path / "arm.toml").robot
     assert written.drive_terms == dynid.load_robot(URDF).drive_terms  # the [robot] table keeps the file's drive terms
     assert "robot: gravity = [0.0, 0.0, 9.81] written" in " ".join((p.stdout + p.stderr).split())
+    _identify_reads_it_right(tmp_path)
+
+
+def _simulated_init(tmp_path, robot, logged=lambda q: q):
+    """``dynid init`` on two logs simulated from ``robot`` (30 s to identify, 20 s to validate), their angles as
+    ``logged`` writes them, with the URDF: its run, checked."""
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    for name, seed, seconds in (("run.csv", 4, 30), ("val.csv", 5, 20)):
+        log = dynid.simulated_log(robot, seconds=seconds, rng=seed)
+        np.savetxt(tmp_path / name, np.column_stack([log.t, logged(log.q), log.tau]), delimiter=",", comments="",
+                   header=",".join(names))
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    return p
+
+
+def _identify_reads_it_right(tmp_path):
+    """``dynid identify`` on the config init wrote: no gravity, angles or sign finding."""
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
     findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
@@ -676,24 +687,14 @@ def test_init_writes_a_joints_zero_a_quarter_turn_off_and_identify_reads_the_log
     the others empty, the file's drive terms kept), and the first dynid identify has no angles finding."""
     from dynid.io.identification_config import load_identification_config
 
-    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
-    for name, seed, seconds in (("run.csv", 4, 30), ("val.csv", 5, 20)):
-        log = dynid.simulated_log(dynid.load_robot(URDF), seconds=seconds, rng=seed)
-        logged = log.q - np.array([0.0, np.pi / 2, 0, 0, 0, 0])
-        np.savetxt(tmp_path / name, np.column_stack([log.t, logged, log.tau]), delimiter=",", comments="",
-                   header=",".join(names))
-    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
-    assert p.returncode == 0, p.stderr
+    p = _simulated_init(tmp_path, dynid.load_robot(URDF), lambda q: q - np.array([0.0, np.pi / 2, 0, 0, 0, 0]))
     joints = tomllib.loads((tmp_path / "arm.toml").read_text())["robot"]["joints"]
     assert joints == [{}, {"position_offset": "pi/2"}, {}, {}, {}, {}]
     robot = load_identification_config(tmp_path / "arm.toml").robot
     assert np.allclose(robot.transmission.position_offset, [0, np.pi / 2, 0, 0, 0, 0])
     assert robot.drive_terms == dynid.load_robot(URDF).drive_terms
     assert 'robot: J2 position_offset = "pi/2" written' in " ".join((p.stdout + p.stderr).split())
-    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
-    assert p.returncode == 0, p.stderr
-    findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
-    assert not [f for f in findings if f["kind"] in ("gravity", "angles", "sign")], findings
+    _identify_reads_it_right(tmp_path)
 
 
 def test_init_reads_the_kr300s_qualified_headers_as_its_expert_config_does(tmp_path):
