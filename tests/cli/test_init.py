@@ -741,3 +741,31 @@ def test_init_takes_the_link_side_where_a_log_names_both_sides_of_the_gear(tmp_p
     said = " ".join((p.stdout + p.stderr).split())
     assert "positions also in the log, left: q_mot_1…q_mot_6" in said and "tau_mot_1…tau_mot_6" in said
     assert "units assumed: positions in rad, torques in N·m" in said  # no unit in the names
+
+
+def test_init_reads_a_headerless_19_column_log_of_a_ur_arm_as_rtde_currents(tmp_path):
+    """A UR arm's RTDE log of 19 columns without a header (time, q, qd, motor currents: the UR10e's 2019 logs of
+    Mamedov & Mikhel) was taken as time, positions, velocities and torques in N·m: each ampere read as 1 N·m, and the
+    first identify found the torques a tenth of the model's. init now reads it by the 19-column RTDE preset and writes
+    the built-in UR10e's drive gains, a 31-column validation log gets its own reader (it took the identification's),
+    and identify finds no scale; another 6-joint arm's 19 columns stay blocks."""
+    ur = dynid.load_robot(URDF)
+    gains = dynid.load_robot("ur10e").drive_gains
+    log = dynid.simulated_log(ur, seconds=30, rng=4)
+    rtde = np.column_stack([log.t, log.q, np.gradient(log.q, log.t, axis=0), log.tau / gains])
+    np.savetxt(tmp_path / "run.csv", rtde, delimiter=",")
+    np.savetxt(tmp_path / "val.csv", np.column_stack([rtde, np.zeros((log.t.size, 12))]), delimiter=",")  # + targets
+    p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    config = tomllib.loads((tmp_path / "arm.toml").read_text())
+    assert config["identification"]["preset"] == "ur-rtde-19"
+    assert config["validation"][0]["preset"] == "ur-rtde"  # 31 columns: its own reader, not the 19 columns'
+    assert np.allclose([j["drive_gain"] for j in config["robot"]["joints"]], gains)
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    findings = json.loads((tmp_path / "id" / "results.json").read_text())["findings"]
+    assert not [f for f in findings if f["kind"] in ("scale", "sign", "angles", "gravity")], findings
+    other = Path(__file__).resolve().parents[2] / "configs" / "robots" / "tx40_simulation.toml"
+    p = run("init", str(other), str(tmp_path / "run.csv"), "--out", str(tmp_path / "other.toml"))
+    assert p.returncode == 0, p.stderr
+    assert _identification((tmp_path / "other.toml").read_text())["torques"] == {"columns": list(range(14, 20))}

@@ -108,6 +108,14 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" "
                      "(its units: s, rad, rad/s, A)")
         return table, notes
+    elif n_columns == 19 and n_dof == 6 and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
+        table = tomlkit.table()
+        table.add("preset", "ur-rtde-19")
+        table.add("file", log.name)
+        notes.append("19 columns and a Universal Robots arm: its RTDE layout without targets (time, q, qd, motor "
+                     "currents): preset = \"ur-rtde-19\" (its units: s, rad, rad/s, A); if the last six are torques in "
+                     "N·m, give time, positions, velocities and torques in blocks of 6 columns instead")
+        return table, notes
     elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
         blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
         table.add("time", _inline(column=1))
@@ -432,6 +440,10 @@ SENSOR_HINT = ('# torques from joint torque sensors on the link side (a KUKA LBR
                "the torques table: no rotor inertia is then fitted")
 """The line under a config's torques that asks what a log cannot say: which side of the gear measured them."""
 
+
+UNIVERSAL_ROBOTS = re.compile(r"(^|[^a-z0-9])ur(3|5|7|8|10|12|15|16|18|20|30)e?($|[^a-z0-9])", re.IGNORECASE)
+"""A description's robot name of a Universal Robots arm (``ur10e``, ``ur5``, ``ur20``), whose RTDE logs have a layout
+of their own."""
 
 JOINT_SENSED = re.compile(r"lbr|iiwa|med7|med14|panda|fr3|franka|gen3(?![_\-]?lite)", re.IGNORECASE)
 """Names of arms whose joint torques come from torque sensors on the link side of every gear: KUKA's LBR iiwa and

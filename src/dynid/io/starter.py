@@ -93,10 +93,24 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
                        without_sdp=without), said
     table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
+    readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
     notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without)]
+    notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
-                   gains=gains), notes
+                   gains=gains, readers=readers), notes
+
+
+def _own_reader(table: Table, log: Path, urdf: Path, n_dof: int, joints: tuple[str, ...], rate: float | None) -> Table | None:
+    """A validation log's dataset table where its layout differs from the identification log's ``table`` (a UR's
+    19-column RTDE log validated on a 31-column one), else None (it takes the identification's reader); None too
+    where its columns cannot be told: identify then says what it cannot read."""
+    try:
+        own, _ = csv_table(urdf, log, n_dof, joints, rate=rate)
+    except DataError:
+        return None
+    same = {k: v for k, v in own.items() if k != "file"} == {k: v for k, v in table.items() if k != "file"}
+    return None if same else own
 
 
 def _estimators_note(without_sdp: str | None) -> str:
@@ -200,7 +214,7 @@ def _bag_read(bag: Path, robot) -> str:
 
 def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], table: Table, notes: list[str], *,
             held: tuple[str, ...] = (), xacro_args: dict | None = None, without_sdp: str | None = None,
-            gains: tuple[float, ...] | None = None) -> str:
+            gains: tuple[float, ...] | None = None, readers: tuple = ()) -> str:
     """The config's text, written by tomlkit (every string escaped, whatever the paths and columns hold): what was
     detected in comments, the robot (a table where joints are held, a xacro file takes arguments or ``gains`` give
     each joint's drive gain in ``[[robot.joints]]``), the dataset table, the validation logs, and the estimators: WLS
@@ -239,11 +253,14 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
     doc.add("identification", table)
     if validation:
         tables = tomlkit.aot()
-        for v in validation:
+        for v, reader in zip(validation, readers or (None,) * len(validation)):
             entry = tomlkit.table()
-            entry.comment("the identification's reader")
+            entry.comment("the identification's reader" if reader is None else "its own reader: another layout")
             entry.add("name", v.stem)
             entry.add("bag" if _is_bag(v) else "file", _relative(v, log.parent))
+            for key, value in ({} if reader is None else reader).items():
+                if key != "file" and key is not None:
+                    entry.add(key, value)
             tables.append(entry)
         doc.add("validation", tables)
     else:
