@@ -769,3 +769,16 @@ def test_init_reads_a_headerless_19_column_log_of_a_ur_arm_as_rtde_currents(tmp_
     p = run("init", str(other), str(tmp_path / "run.csv"), "--out", str(tmp_path / "other.toml"))
     assert p.returncode == 0, p.stderr
     assert _identification((tmp_path / "other.toml").read_text())["torques"] == {"columns": list(range(14, 20))}
+
+
+def test_the_torque_sign_init_writes_reaches_a_validation_log_read_by_its_own_columns():
+    """A validation log of another layout has a torques table of its own (init writes it): the sign the
+    identification log's check found is written there too; a validation log that takes the identification's reader
+    gets none of its own."""
+    from dynid.io.starter import with_torque_setting
+
+    text = ('[identification]\nfile = "a.csv"\ntorques = {columns = [1, 2]}\n\n[[validation]]\nname = "b"\nfile = '
+            '"b.csv"\n\n[[validation]]\nname = "c"\nfile = "c.csv"\ntorques = {columns = ["x", "y"]}\n')
+    config = tomllib.loads(with_torque_setting(text, "sign", -1, "why"))
+    assert config["identification"]["torques"]["sign"] == -1 and "torques" not in config["validation"][0]
+    assert config["validation"][1]["torques"] == {"columns": ["x", "y"], "sign": -1}

@@ -283,8 +283,9 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
 
 
 def with_torque_setting(text: str, name: str, value, why: str) -> str | None:
-    """A starter config's text with ``name = value`` in its identification log's torques (or currents) table and
-    ``why`` beside it (tomlkit keeps the rest as written).
+    """A starter config's text with ``name = value`` in its identification log's torques (or currents) table, and in
+    those of the validation logs read by their own columns (:func:`starter_config`: a log of another layout, from the
+    same drives), with ``why`` beside it (tomlkit keeps the rest as written).
 
     Parameters
     ----------
@@ -303,14 +304,24 @@ def with_torque_setting(text: str, name: str, value, why: str) -> str | None:
     """
     doc = tomlkit.parse(text)
     ident = doc.get("identification")
-    key = next((k for k in ("torques", "currents") if ident is not None and k in ident), None)
-    if ident is None or key is None or not isinstance(ident[key], dict):
+    if ident is None or _with_signal_setting(ident, name, value, why) is None:
         return None
-    table = tomlkit.inline_table()  # written afresh, so that the new key is spaced as the others
-    table.update({**dict(ident[key]), name: value})
-    table.comment(" ".join(why.split()))
-    ident[key] = table
+    for entry in doc.get("validation", []):
+        _with_signal_setting(entry, name, value, why)
     return tomlkit.dumps(doc)
+
+
+def _with_signal_setting(dataset, name: str, value, why: str):
+    """``name = value`` in a dataset table's own torques (or currents) table, written afresh (the new key spaced as
+    the others) with ``why`` beside it; None where it has none of its own."""
+    key = next((k for k in ("torques", "currents") if k in dataset), None)
+    if key is None or not isinstance(dataset[key], dict):
+        return None
+    table = tomlkit.inline_table()
+    table.update({**dict(dataset[key]), name: value})
+    table.comment(" ".join(why.split()))
+    dataset[key] = table
+    return table
 
 
 def with_robot_setting(text: str, name: str, value, why: str) -> str:
