@@ -259,7 +259,7 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
             entry.add("name", v.stem)
             entry.add("bag" if _is_bag(v) else "file", _relative(v, log.parent))
             for key, value in ({} if reader is None else reader).items():
-                if key != "file" and key is not None:
+                if key != "file":  # the file is the entry's own, relative to the data root
                     entry.add(key, value)
             tables.append(entry)
         doc.add("validation", tables)
