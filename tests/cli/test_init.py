@@ -782,3 +782,45 @@ def test_the_torque_sign_init_writes_reaches_a_validation_log_read_by_its_own_co
     config = tomllib.loads(with_torque_setting(text, "sign", -1, "why"))
     assert config["identification"]["torques"]["sign"] == -1 and "torques" not in config["validation"][0]
     assert config["validation"][1]["torques"] == {"columns": ["x", "y"], "sign": -1}
+
+
+def test_init_takes_figaroh_s_pair_of_one_signal_files_and_finds_the_motor_side(tmp_path):
+    """FIGAROH's TX40 recording: positions and currents in two files headed Joint_1 … Joint_6, 5 kHz, no time column,
+    the motors' angles (50.3 rad = 32 · π/2). Given both (``pos_read_data.csv curr_data.csv --rate 5000``), init
+    writes each signal with its file and side = "motor" (the angles reach tens of times the joints' limits): the columns
+    and side the hand-written config (configs/tx40.toml, its preset) reads."""
+    from dynid.io.identification_config import load_identification_config
+
+    from ..conftest import shared_data
+
+    root = Path(__file__).resolve().parents[2]
+    data = shared_data("staubli_tx40_figaroh")
+    p = run("init", "tx40", str(data / "pos_read_data.csv"), str(data / "curr_data.csv"), "--rate", "5000",
+            "--out", str(tmp_path / "tx.toml"))
+    assert p.returncode == 0, p.stderr
+    written = load_identification_config(tmp_path / "tx.toml").identification
+    expert = load_identification_config(root / "configs" / "tx40.toml", data_root=data).identification
+    effort = "currents" if "currents" in written.signals else "torques"
+    assert written.side == expert.side == "motor" and written.rate == expert.rate == 5000.0
+    for mine, theirs in ((written.signals["positions"], expert.signals["positions"]),
+                         (written.signals[effort], expert.signals["torques"])):
+        assert (mine.file.name, mine.columns) == (theirs.file.name, theirs.columns)
+    assert "validation" not in tomllib.loads((tmp_path / "tx.toml").read_text())  # the second file is a signal
+
+
+def test_init_names_a_built_in_robot_as_given_and_leaves_its_mounting_to_a_description(tmp_path):
+    """``dynid init ur10e LOG`` (a built-in robot by name) writes robot = "ur10e" wherever the config goes (it wrote a
+    path relative to the working folder, which identify could not read), and a mounting the check finds otherwise is
+    said, not written into a table that would take the name for a file."""
+    from dataclasses import replace
+
+    hanging = replace(dynid.load_robot("ur10e"), gravity=np.array([0.0, 0.0, 9.81]))
+    names = ["time"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    log = dynid.simulated_log(hanging, seconds=30, rng=4)
+    np.savetxt(tmp_path / "run.csv", np.column_stack([log.t, log.q, log.tau]), delimiter=",", comments="",
+               header=",".join(names))
+    (tmp_path / "cfg").mkdir()
+    p = run("init", "ur10e", str(tmp_path / "run.csv"), "--out", str(tmp_path / "cfg" / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads((tmp_path / "cfg" / "arm.toml").read_text())["robot"] == "ur10e"
+    assert "(a built-in robot: give it in a description file)" in " ".join((p.stdout + p.stderr).split())

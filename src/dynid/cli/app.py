@@ -758,7 +758,8 @@ def excite(
 def init(
     urdf: Path = typer.Argument(..., help="The robot's URDF (or xacro file), or its MuJoCo model (MJCF, .xml)."),
     log: Path = typer.Argument(..., help="A CSV log of the robot moving (time, joint angles, joint torques or currents), or a ROS 2 bag."),
-    validation: list[Path] | None = typer.Argument(None, help="Other logs of the same layout, to validate on."),
+    validation: list[Path] | None = typer.Argument(None, help="Other logs, to validate on (one of another layout gets its own reader); where the log holds one signal per "
+                                                    "file (Joint_1 … Joint_n), the first is its other signal's file (pos_… and curr_…)."),
     out: Path = typer.Option(Path("arm.toml"), help="The config to write."),
     force: bool = typer.Option(False, help="Overwrite --out if it exists."),
     rate: float | None = typer.Option(None, help="The logs' sample rate [Hz], for CSV logs without a time column.",

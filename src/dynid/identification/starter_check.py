@@ -18,6 +18,7 @@ from ..exceptions import DynIdError
 from ..io.datasets import load_recording
 from ..io.identification_config import config_from_document
 from ..io.starter import with_joint_setting, with_robot_setting, with_torque_setting
+from ..model.description import builtin_robots
 from .run import pipeline_of
 
 __all__ = ["checked_against_description"]
@@ -76,6 +77,9 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
         for _ in range(GEOMETRY_FIXES):  # the mounting and a zero can both differ: one found, set and checked again
             found = next((f for f in findings if f.kind in ("gravity", "angles") and f.fix is not None), None)
             if found is None or found.fix is None:
+                break
+            if tomllib.loads(text).get("robot") in builtin_robots():  # no file of its own to set it in
+                notes.append(f"{' '.join(found.text.split())} (a built-in robot: give it in a description file)")
                 break
             text, note = _with_geometry(text, replace(found, fix={**found.fix, "n_dof": n_dof}))
             notes.append(note)

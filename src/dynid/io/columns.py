@@ -405,6 +405,69 @@ def _assumed_units(kinds: list[str]) -> str:
             + ("; add unit = \"deg\" to positions for degrees" if "positions" in kinds else ""))
 
 
+SIGNAL_FILE_WORDS = {"positions": frozenset({"pos", "position", "positions", "angle", "angles", "encoder", "q"}),
+                     "torques": frozenset({"tau", "torque", "torques", "effort", "efforts", "moment"}),
+                     "currents": frozenset({"curr", "current", "currents", "amp", "amps"})}
+"""Words of a file's name that say the one signal it holds (FIGAROH's ``pos_read_data.csv`` and ``curr_data.csv``)."""
+
+
+def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tuple[Table, list[str]] | None:
+    """A dataset table for a log split into one file per signal, where ``log`` and ``other`` are such a pair: each a
+    column per joint under the same header that names no signal (``Joint_1`` … ``Joint_6``), as many rows, and file
+    names that say which holds the angles and which the torques or currents; else None.
+
+    Parameters
+    ----------
+    log, other : Path
+        The logs given first and second.
+    n_dof : int
+    rate : float or None
+        Their sample rate [Hz] (``--rate``): such files have no time column.
+
+    Returns
+    -------
+    (table, notes) or None
+
+    Raises
+    ------
+    DataError
+        Such a pair without ``rate``.
+    """
+    heads = []
+    for path in (log, other):
+        lines, delimiter = _first_lines(path)
+        header = lines[0].split() if delimiter == " " else [c.strip() for c in lines[0].split(delimiter)]
+        if len(header) != n_dof or any(_number(c) or _kind(c) is not None for c in header):
+            return None
+        heads.append((header, delimiter))
+    kinds = [next((k for k, words in SIGNAL_FILE_WORDS.items() if set(re.split(r"[^a-z]+", p.stem.lower())) & words),
+                  None) for p in (log, other)]
+    if heads[0] != heads[1] or sorted(map(str, kinds)) not in (["positions", "torques"], ["currents", "positions"]):
+        return None
+    if _row_count(log) != _row_count(other):
+        return None
+    if rate is None:
+        raise DataError(f"{log} and {other}: one signal per file without time stamps: give their sample rate, "
+                        "dynid init ... --rate HZ")
+    (header, delimiter), table = heads[0], tomlkit.table()
+    table.add("header", True)
+    if delimiter != ",":
+        table.add("delimiter", delimiter)
+    table.add("rate", float(rate))
+    table["rate"].comment("Hz: no time column (--rate)")
+    for kind, path in sorted(zip(map(str, kinds), (log, other)), key=lambda kp: kp[0] != "positions"):
+        table.add(kind, _inline(file=path.name, columns=header))
+    effort = kinds[1] if kinds[0] == "positions" else kinds[0]
+    return table, [f"{log.name} and {other.name}: one signal per file ({', '.join(header)}): the positions and the "
+                   f"{effort} by the files' names, row by row at {rate:g} Hz"]
+
+
+def _row_count(path: Path) -> int:
+    """A text log's lines with something on them."""
+    with open(path, encoding="utf-8", errors="replace") as f:
+        return sum(1 for line in f if line.strip())
+
+
 def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
     """``rate`` added to a dataset's table for a log without a time column at ``--rate``; the notes and the columns
     taken."""
@@ -415,14 +478,16 @@ def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
 
 def _check_one_signal(log: Path, first: list[str], found: dict, n_dof: int) -> None:
     """A log whose header names one column per joint and no signal (FIGAROH's ``Joint_1`` … ``Joint_6``, one file of
-    positions and one of currents): refused with how a config reads one file per signal, which ``dynid init`` does not
-    write (it was told "found 0 positions column(s)", of a file of positions)."""
+    positions and one of currents) given without its other signal's file (:func:`signal_files`): refused with how
+    ``dynid init`` takes the pair and how a config reads one file per signal (it was told "found 0 positions
+    column(s)", of a file of positions)."""
     signals = [k for k in found if k != "time"]
     if signals or len(first) - len(found.get("time", [])) != n_dof:
         return
     raise DataError(f"{log}: its {n_dof} columns ({_shown(first)}) name the joints, not a signal: a file of one signal "
-                    "(positions, or torques or currents)? dynid init reads one log holding both; for one file per "
-                    "signal write the [identification] table by hand, each signal with its file: positions = { file = "
+                    "(positions, or torques or currents)? Give its other signal's file second, named for its signal "
+                    "(dynid init ROBOT pos_data.csv curr_data.csv --rate HZ), or write the [identification] table by "
+                    "hand, each signal with its file: positions = { file = "
                     f'"{log.name}", columns = [...] }}, torques = {{ file = "...", columns = [...] }} (or currents), '
                     "header = true, rate = HZ without a time column (docs: configuration, dataset tables)")
 

@@ -22,9 +22,10 @@ from tomlkit.items import Table
 
 from ..exceptions import ConfigError, DataError
 from ..model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
-from .columns import csv_table
+from .columns import csv_table, signal_files
 from .dataset_specs import PRESETS
 from .datasets import dataset_spec, load_recording
+from .tables import read_table
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),
@@ -92,13 +93,41 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         said.append(_estimators_note(without))
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
                        without_sdp=without), said
-    table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
+    pair = signal_files(log, validation[0], n_dof, rate) if validation else None
+    if pair is not None:  # one signal per file: the second log is the first's other signal
+        (table, notes), validation = pair, validation[1:]
+        notes += _motor_side(table, log.parent, robot)
+    else:
+        table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
     notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without)]
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
                    gains=gains, readers=readers), notes
+
+
+MOTOR_ANGLES = 2.0
+"""Logged angles beyond this many times a joint's largest limit are taken as its motor's (before the gear)."""
+
+
+def _motor_side(table: Table, folder: Path, robot) -> list[str]:
+    """``side = "motor"`` on a dataset table whose angles reach :data:`MOTOR_ANGLES` times a joint's limits where the
+    robot has gear ratios (FIGAROH's TX40 files: 50.3 rad = 32 · π/2), said; nothing otherwise."""
+    positions = table["positions"]
+    assert isinstance(positions, dict)  # written by signal_files
+    if robot is None or np.allclose(np.abs(np.diag(robot.transmission.motor_from_joint)), 1.0):
+        return []
+    delimiter = str(table.get("delimiter", ","))
+    q = np.asarray(read_table(folder / str(positions["file"]), list(positions["columns"]), header=True,
+                              delimiter=delimiter).data)
+    reach = np.abs(q).max(axis=0) / np.maximum(np.abs(robot.limits.q_min), np.abs(robot.limits.q_max))
+    if not np.any(reach > MOTOR_ANGLES):
+        return []
+    table.add("side", "motor")
+    j = int(np.argmax(reach))
+    return [f"side = \"motor\": the angles reach {reach[j]:.3g}× J{j + 1}'s limit: the motors' (through the description's "
+            "gear ratios)"]
 
 
 def _own_reader(table: Table, log: Path, urdf: Path, n_dof: int, joints: tuple[str, ...], rate: float | None) -> Table | None:
@@ -225,11 +254,11 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
         doc.add(tomlkit.comment(" ".join(line.splitlines())))
     as_table = bool(held or xacro_args or gains)
     if not as_table:  # keys before the first table
-        doc.add("robot", tomlkit.item(_relative(urdf, out.parent)))
+        doc.add("robot", tomlkit.item(_robot_ref(urdf, out.parent)))
     doc.add("data_root", tomlkit.item(_relative(log.parent, out.parent)))
     doc.add(tomlkit.nl())
     if as_table:
-        robot = _robot_table(_relative(urdf, out.parent))
+        robot = _robot_table(_robot_ref(urdf, out.parent))
         if held:
             robot.add("held", list(held))
             robot["held"].comment("not the arm's joints: held fixed at 0")
@@ -402,6 +431,11 @@ def _robot_table(urdf: str):
     table.add("urdf", urdf)
     table.add("drive_terms", list(URDF_DRIVE_TERMS))
     return table
+
+
+def _robot_ref(urdf: Path, folder: Path) -> str:
+    """How the config names the robot: a built-in robot's name as given (``tx40``), a file relative to ``folder``."""
+    return str(urdf) if str(urdf) in builtin_robots() and not urdf.exists() else _relative(urdf, folder)
 
 
 def _relative(path: Path, folder: Path) -> str:
