@@ -36,8 +36,9 @@ def _findings(text: str, path: Path) -> tuple[tuple, int]:
     return fitted.findings, config.robot.n_dof
 
 
-def _with_geometry(text: str, found) -> tuple[str, str]:
-    """``text`` with the setting a gravity or angles finding names (its ``fix``), and the line that says so."""
+def _with_geometry(text: str, found, n_dof: int) -> tuple[str, str]:
+    """``text`` with the setting a gravity or angles finding names (its ``fix``; ``n_dof`` the robot's joints, the
+    ``[[robot.joints]]`` tables made for a zero), and the line that says so."""
     why = "the measured torques fit the description's model so (dynid init's check)"
     said = " ".join(found.text.split()).split(". ")[0]  # what was found; the question and the setting it asks for follow
     if "gravity" in found.fix:
@@ -45,7 +46,7 @@ def _with_geometry(text: str, found) -> tuple[str, str]:
         return (with_robot_setting(text, "gravity", vector, f"m/s² in the base frame: {why}"),
                 f"robot: gravity = {vector} written: {said}")
     offsets = found.fix["position_offset"]
-    written = with_joint_setting(text, "position_offset", offsets, found.fix["n_dof"],
+    written = with_joint_setting(text, "position_offset", offsets, n_dof,
                                  f"added to the logged angles: {why}; remove it if the encoders' zeros are the file's")
     listed = ", ".join(f'J{j + 1} position_offset = "{v}"' for j, v in sorted(offsets.items()))
     return written, f"robot: {listed} written in [[robot.joints]]: {said}"
@@ -81,7 +82,7 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
             if tomllib.loads(text).get("robot") in builtin_robots():  # no file of its own to set it in
                 notes.append(f"{' '.join(found.text.split())} (a built-in robot: give it in a description file)")
                 break
-            text, note = _with_geometry(text, replace(found, fix={**found.fix, "n_dof": n_dof}))
+            text, note = _with_geometry(text, found, n_dof)
             notes.append(note)
             findings, _ = _findings(text, path)
     except DynIdError as exc:
@@ -95,5 +96,4 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
                                                       "model (dynid init's check): remove it if the log's sign is right")
     if written is None:
         return text, notes + [found.text]
-    said = "sign = -1" if sign == -1 else f"sign = {sign}"
-    return written, notes + [f"torques: {said} written: {' '.join(found.text.split())}"]
+    return written, notes + [f"torques: sign = {sign} written: {' '.join(found.text.split())}"]

@@ -50,7 +50,10 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
     lines, delimiter = _first_lines(log)
-    split = (lambda s: s.split()) if delimiter == " " else (lambda s: [c.strip() for c in s.split(delimiter)])
+
+    def split(line: str) -> list[str]:
+        return _fields(line, delimiter)
+
     first = split(lines[0])
     header = not all(_number(c) for c in first)
     n_columns = len(first)
@@ -102,27 +105,21 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         notes += [_assumed_units(assumed)] if assumed else []
         return table, notes
     elif n_columns == 31 and n_dof == 6:
-        table = tomlkit.table()
-        table.add("preset", "ur-rtde")
-        table.add("file", log.name)
-        notes.append("31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" "
-                     "(its units: s, rad, rad/s, A)")
-        return table, notes
+        return _preset_table("ur-rtde", log), notes + [
+            "31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" (its units: s, "
+            "rad, rad/s, A)"]
     elif n_columns == 19 and n_dof == 6 and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
-        table = tomlkit.table()
-        table.add("preset", "ur-rtde-19")
-        table.add("file", log.name)
-        notes.append("19 columns and a Universal Robots arm: its RTDE layout without targets (time, q, qd, motor "
-                     "currents): preset = \"ur-rtde-19\" (its units: s, rad, rad/s, A); if the last six are torques in "
-                     "N·m, give time, positions, velocities and torques in blocks of 6 columns instead")
-        return table, notes
+        return _preset_table("ur-rtde-19", log), notes + [
+            "19 columns and a Universal Robots arm: its RTDE layout without targets (time, q, qd, motor currents): "
+            "preset = \"ur-rtde-19\" (its units: s, rad, rad/s, A); if the last six are torques in N·m, give time, "
+            "positions, velocities and torques in blocks of 6 columns instead"]
     elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
         blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
         table.add("time", _inline(column=1))
         for b, kind in enumerate(blocks):
             table.add(kind, _inline(columns=[2 + b * n_dof + j for j in range(n_dof)]))
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
-        notes.append("units assumed: s, " + _assumed_units(blocks).removeprefix("units assumed: "))
+        notes.append(_assumed_units(blocks, time=True))
         return table, notes
     else:
         fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
@@ -199,9 +196,10 @@ def _kind_and_unit(name: str) -> tuple[str | None, str | None]:
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
             return kind, None
-    unit = None if _qualified(stem) else re.search(_UNIT, stem) or re.search(_UNIT, last[-1])
+    qualified = _qualified(stem)  # q_meas: a qualifier, not a unit (s) at its end
+    unit = None if qualified else re.search(_UNIT, stem) or re.search(_UNIT, last[-1])
     if unit is None:
-        return _qualified(stem), None
+        return qualified, None
     bare = re.sub(_JOINT, "", re.sub(_UNIT, "", re.sub(_JOINT, "", last[-1])))
     signal = next((k for k, pattern in PATTERNS.items() if re.fullmatch(pattern, bare)), None) or _qualified(bare)
     return (signal, UNITS[unit.group(1)]) if signal else (None, None)
@@ -399,9 +397,9 @@ ASSUMED_UNITS = {"positions": "rad", "velocities": "rad/s", "torques": "N·m", "
 """The unit each signal's table takes where neither the config nor the column's name gives one."""
 
 
-def _assumed_units(kinds: list[str]) -> str:
-    """The note on the units taken for signals whose columns name none."""
-    return ("units assumed: " + ", ".join(f"{kind} in {ASSUMED_UNITS[kind]}" for kind in kinds)
+def _assumed_units(kinds: list[str], time: bool = False) -> str:
+    """The note on the units taken for signals whose columns name none (and for the time, ``time``)."""
+    return ("units assumed: " + ("s, " if time else "") + ", ".join(f"{kind} in {ASSUMED_UNITS[kind]}" for kind in kinds)
             + ("; add unit = \"deg\" to positions for degrees" if "positions" in kinds else ""))
 
 
@@ -436,7 +434,7 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
     heads = []
     for path in (log, other):
         lines, delimiter = _first_lines(path)
-        header = lines[0].split() if delimiter == " " else [c.strip() for c in lines[0].split(delimiter)]
+        header = _fields(lines[0], delimiter)
         if len(header) != n_dof or any(_number(c) or _kind(c) is not None for c in header):
             return None
         heads.append((header, delimiter))
@@ -460,6 +458,19 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
     effort = kinds[1] if kinds[0] == "positions" else kinds[0]
     return table, [f"{log.name} and {other.name}: one signal per file ({', '.join(header)}): the positions and the "
                    f"{effort} by the files' names, row by row at {rate:g} Hz"]
+
+
+def _fields(line: str, delimiter: str) -> list[str]:
+    """A line's fields: split at runs of spaces for a space-separated log, else at the delimiter, stripped."""
+    return line.split() if delimiter == " " else [c.strip() for c in line.split(delimiter)]
+
+
+def _preset_table(preset: str, log: Path) -> Table:
+    """A dataset table that reads ``log`` by one of :data:`dynid.io.dataset_specs.PRESETS`."""
+    table = tomlkit.table()
+    table.add("preset", preset)
+    table.add("file", log.name)
+    return table
 
 
 def _row_count(path: Path) -> int:

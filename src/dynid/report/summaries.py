@@ -809,9 +809,8 @@ def _yardstick_lines(r, label: str) -> list:
     over = f"(mean over {n} logs)" if n > 1 else "(one log)"
     if moving:
         rests = [errors for name, errors in yard["global_relative_error"].items() if name not in moving["logs"]]
-        within = "; ".join(f"{who} on {sum(e.get(key, np.nan) == 0 for e in rests)}"
-                           for who, key in ((label, label), ("the description", nominal))
-                           if key in rests[0] and (who == label or key != label))
+        sets = [(label, label)] + ([("the description", nominal)] if nominal in rests[0] and nominal != label else [])
+        within = "; ".join(f"{who} on {sum(e[key] == 0 for e in rests)}" for who, key in sets)
         k = len(moving["logs"])
         over = (("(over the one log that moves" if k == 1 else f"(mean over the {k} logs that move")
                 + f"; of the {len(rests)} at rest throughout, within the static-friction band: {within})")

@@ -264,12 +264,13 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     why = ""
     setting: int | list[int]
     if len(bad) >= 2 and len(bad) == len(judged):  # every joint the nominal model judges: one convention for the log
-        fix, setting = "sign = -1", -1
+        setting = -1
         if unjudged:
             why = (f"every joint's: the nominal model cannot judge {', '.join(f'J{j + 1}' for j in unjudged)}, whose "
                    "torques it barely predicts, and a log's torques usually share one sign convention; ")
     else:
-        fix, setting = "sign = [" + ", ".join("-1" if j in bad else "1" for j in range(n)) + "]", [-1 if j in bad else 1 for j in range(n)]
+        setting = [-1 if j in bad else 1 for j in range(n)]
+    fix = "sign = " + (str(setting) if isinstance(setting, int) else "[" + ", ".join(map(str, setting)) + "]")
     return [Finding("sign", f"{dataset}: {joints}: the measured torques run against the description's nominal model "
                             f"(ρ = {values}): is their sign flipped? Set torques = {{ ..., {fix} }} in {table} and the "
                             f"other datasets ({why}or check the description's gravity, and whether a joint's zero is a "
