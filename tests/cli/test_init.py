@@ -808,6 +808,21 @@ def test_init_takes_figaroh_s_pair_of_one_signal_files_and_finds_the_motor_side(
     assert "validation" not in tomllib.loads((tmp_path / "tx.toml").read_text())  # the second file is a signal
 
 
+def test_init_says_a_pair_of_one_signal_files_of_different_lengths(tmp_path):
+    """Two one-signal files (``pos_…``, ``curr_…``, headers Joint_1 … Joint_6) whose rows differ: a one-line error naming
+    both files and both lengths (it said the second file was missing), and no config written."""
+    header = ",".join(f"Joint_{j}" for j in range(1, 7))
+    rng = np.random.default_rng(0)
+    for name, rows in (("pos_run.csv", 120), ("curr_run.csv", 100)):
+        np.savetxt(tmp_path / name, rng.normal(size=(rows, 6)), delimiter=",", header=header, comments="")
+    p = run("init", "tx40", str(tmp_path / "pos_run.csv"), str(tmp_path / "curr_run.csv"), "--rate", "5000",
+            "--out", str(tmp_path / "tx.toml"))
+    assert p.returncode == 1 and "Traceback" not in p.stderr
+    message = " ".join(p.stderr.split())
+    assert "pos_run.csv" in message and "curr_run.csv" in message and "120 rows against 100" in message
+    assert not (tmp_path / "tx.toml").exists()
+
+
 def test_init_names_a_built_in_robot_as_given_and_leaves_its_mounting_to_a_description(tmp_path):
     """``dynid init ur10e LOG`` (a built-in robot by name) writes robot = "ur10e" wherever the config goes (it wrote a
     path relative to the working folder, which identify could not read), and a mounting the check finds otherwise is

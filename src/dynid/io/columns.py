@@ -429,7 +429,7 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
     Raises
     ------
     DataError
-        Such a pair without ``rate``.
+        Such a pair without ``rate``, or of different lengths.
     """
     heads = []
     for path in (log, other):
@@ -442,8 +442,10 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
                   None) for p in (log, other)]
     if heads[0] != heads[1] or sorted(map(str, kinds)) not in (["positions", "torques"], ["currents", "positions"]):
         return None
-    if _row_count(log) != _row_count(other):
-        return None
+    rows = _row_count(log) - 1, _row_count(other) - 1  # under the header
+    if rows[0] != rows[1]:
+        raise DataError(f"{log} and {other}: one signal per file, read row by row, but {rows[0]} rows against "
+                        f"{rows[1]} under the header: expected the two signals of the same samples (one file cut short?)")
     if rate is None:
         raise DataError(f"{log} and {other}: one signal per file without time stamps: give their sample rate, "
                         "dynid init ... --rate HZ")
