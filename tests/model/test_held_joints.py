@@ -2,10 +2,12 @@
 
 import re
 import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import dynid
 from dynid.exceptions import ConfigError, DataError
 from dynid.io.starter import starter_config
 from dynid.io.urdf_write_back import urdf_written_back
@@ -136,3 +138,14 @@ def test_init_names_the_joints_to_hold_where_the_log_has_fewer(tmp_path, header)
     with pytest.raises(DataError, match=r"if the log holds the first 2 of arm.urdf's joints and the rest are a "
                                         r"gripper's, hold them: \[robot\] urdf = \"arm.urdf\", held = \[\"gripper\"\]"):
         starter_config(urdf, tmp_path / "log.csv", 3, tmp_path / "arm.toml", joints=("j1", "j2", "gripper"))
+
+
+def test_init_offers_no_held_joints_for_a_built_in_robot(tmp_path):
+    """``dynid init ur10e`` on a log of one joint: refused as having too few columns, without the hint that holds a
+    URDF's gripper joints (it offered ``[robot] urdf = "ur10e", held = [5 of the arm's joints]``: no such file, and
+    no gripper on a built-in arm)."""
+    (tmp_path / "log.csv").write_text("t,q1,tau1\n0,1,2\n0.1,1.1,2.1\n")
+    ur10e = tuple(j.name for j in dynid.load_robot("ur10e").joints)
+    with pytest.raises(DataError, match="found 1 positions column") as caught:
+        starter_config(Path("ur10e"), tmp_path / "log.csv", 6, tmp_path / "arm.toml", joints=ur10e)
+    assert "held = " not in str(caught.value) and "gripper" not in str(caught.value)

@@ -506,8 +506,9 @@ def _check_one_signal(log: Path, first: list[str], found: dict, n_dof: int) -> N
 
 
 def _hold_hint(urdf: Path, joints: tuple[str, ...], count: int) -> str:
-    """Where the log has the signals of fewer joints than the URDF: the URDF's last joints held (a gripper's), said."""
-    if not 0 < count < len(joints):
+    """Where the log has the signals of fewer joints than the URDF: the URDF's last joints held (a gripper's), said;
+    nothing for a built-in robot (no file whose joints a config could hold)."""
+    if not 0 < count < len(joints) or not urdf.is_file():
         return ""
     rest = ", ".join(json.dumps(j) for j in joints[count:])
     return (f"; if the log holds the first {count} of {urdf.name}'s joints and the rest are a gripper's, hold them: "
