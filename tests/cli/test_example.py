@@ -36,6 +36,21 @@ def test_the_example_folder_runs_identify_and_export_as_printed(tmp_path, monkey
     assert pin.buildModelFromUrdf(str(tmp_path / "try" / "ur10e-identified.urdf")).nq == 6
 
 
+def test_the_tx40_example_is_logged_at_its_encoders_zeros_and_identifies_ready(tmp_path, monkeypatch):
+    """The TX40's description puts J2's and J3's encoder zeros a quarter turn from its DH table's (position_offset
+    -pi/2, pi/2), which a reader adds to the logged angles: the example's log holds the encoders' angles, so identify
+    reads the simulated motion and says "model ready" (it read the DH angles turned again, and said "not ready: the
+    logged angles do not match the robot file", J2 and J3 turned by +90° and -90°)."""
+    monkeypatch.chdir(tmp_path)
+    assert run("example", "tx40", "try").returncode == 0
+    monkeypatch.chdir(tmp_path / "try")
+    p = run("identify", "tx40.toml", "--no-figures")
+    said = " ".join((p.stdout + p.stderr).split())
+    assert p.returncode == 0, p.stderr
+    assert "model ready" in said and "not ready" not in said, said[:300]
+    assert "turned by" not in said and "leaves its limits" not in said
+
+
 def test_the_example_files_are_the_same_for_the_same_seed_and_simulate_the_description():
     a, b, c = example_files("er16", rng=2), example_files("er16", rng=2), example_files("er16", rng=3)
     assert a == b and a["identification.csv"] != c["identification.csv"]

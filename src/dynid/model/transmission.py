@@ -188,6 +188,20 @@ class Transmission:
         """
         return np.linalg.solve(self.motor_from_joint, np.asarray(theta_m, dtype=float).T).T + self.position_offset
 
+    def logged_positions(self, q: np.ndarray) -> np.ndarray:
+        """The angles the joints' encoders (and their controller) read at model joint angles ``q``: ``q - offset``,
+        what a log holds and a reader adds ``position_offset`` back to (:func:`dynid.io.datasets.load_recording`).
+
+        Parameters
+        ----------
+        q : (N, n) array [rad]
+
+        Returns
+        -------
+        (N, n) array [rad]
+        """
+        return np.asarray(q, dtype=float) - self.position_offset
+
     def joint_velocities(self, dtheta_m: np.ndarray) -> np.ndarray:
         """Joint velocities (or accelerations) from motor ones: ``R⁻¹ dtheta_m``.
 

@@ -48,11 +48,14 @@ def _with_drives(robot, rng):
     return replace(robot, drive=drive * robot.drive_mask)
 
 
-def _csv(log, names: list[str]) -> str:
+def _csv(log, robot) -> str:
+    """The log as the robot's encoders and drives write it: the angles without the description's position offsets
+    (the TX40's J2 and J3 zeros a quarter turn from its DH table's), which ``dynid identify`` adds back."""
     buffer = io.StringIO()
+    names = [j.name for j in robot.joints]
     header = ["time"] + [f"{n}_position" for n in names] + [f"{n}_effort" for n in names]
-    np.savetxt(buffer, np.column_stack([log.t, log.q, log.tau]), delimiter=",", fmt="%.9g", header=",".join(header),
-               comments="")
+    np.savetxt(buffer, np.column_stack([log.t, robot.transmission.logged_positions(log.q), log.tau]), delimiter=",",
+               fmt="%.9g", header=",".join(header), comments="")
     return buffer.getvalue()
 
 
@@ -88,8 +91,8 @@ def example_files(name: str, rng=0) -> dict[str, str]:
     if name in FROM_URDF:
         files[f"{name}.urdf"] = (resources.files("dynid.model") / "robots" / f"{name}.urdf").read_text(encoding="utf-8")
     names = [j.name for j in robot.joints]
-    files["identification.csv"] = _csv(simulated_log(robot, seconds=IDENTIFICATION_SECONDS, rate=RATE, rng=seed), names)
-    files["validation.csv"] = _csv(simulated_log(robot, seconds=VALIDATION_SECONDS, rate=RATE, rng=seed + 1), names)
+    files["identification.csv"] = _csv(simulated_log(robot, seconds=IDENTIFICATION_SECONDS, rate=RATE, rng=seed), robot)
+    files["validation.csv"] = _csv(simulated_log(robot, seconds=VALIDATION_SECONDS, rate=RATE, rng=seed + 1), robot)
     columns = lambda what: "[" + ", ".join(f'"{n}_{what}"' for n in names) + "]"  # noqa: E731
     layout = (f'header = true\ntime = {{ column = "time" }}\npositions = {{ columns = {columns("position")} }}\n'
               f'torques = {{ columns = {columns("effort")} }}\n')

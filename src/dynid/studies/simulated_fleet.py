@@ -147,8 +147,7 @@ def _write_log(path: Path, robot: Robot, truth_robot: Robot, gains: np.ndarray, 
     n = robot.n_dof
     header = ",".join(["t"] + [f"q{j + 1}" for j in range(n)] + [f"i{j + 1}" for j in range(n)])
     path.parent.mkdir(parents=True, exist_ok=True)
-    # the log holds the encoders' angles: a reader adds the description's position offsets back (io.datasets)
-    logged = meas.q - robot.transmission.position_offset
+    logged = robot.transmission.logged_positions(meas.q)  # a reader adds the position offsets back
     np.savetxt(path, np.column_stack([t, logged, meas.current]), delimiter=",", header=header, comments="", fmt="%.9g")
 
 
