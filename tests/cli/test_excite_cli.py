@@ -232,3 +232,21 @@ def test_a_robots_urdf_alone_holds_a_grippers_finger_as_init_does(tmp_path):
     assert p.returncode == 0, p.stderr
     assert "held fixed at 0, not the arm's joints: finger_joint" in " ".join(p.stdout.split())
     assert json.loads((tmp_path / "out" / "excitation.json").read_text())["joints"] == 6
+
+
+def test_excitation_csv_holds_the_encoders_angles_where_the_description_offsets_them(tmp_path):
+    """The TX40's description puts J2's and J3's encoder zeros a quarter turn from its DH table's
+    (``position_offset = "-pi/2"``, ``"pi/2"``: a log's angles plus the offset are the model's). excitation.csv is what
+    the controller plays: the design's angles minus the offset, and said; excitation.json keeps the model's (it wrote
+    the model's angles, a quarter turn off on J2 and J3 for the robot's controller)."""
+    robot = REPO / "configs" / "robots" / "tx40_simulation.toml"
+    config = _small(tmp_path, "excite-tx40.toml", {"starts = 4": "starts = 1\nmaxiter = 5",
+                                                   '"robots/tx40_simulation.toml"': f'"{robot.as_posix()}"'})
+    p = dynid("excite", str(config), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0, p.stderr
+    assert "at the angles the joints' encoders read" in " ".join(p.stdout.split())
+    csv = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)
+    q, _, _ = load_trajectory(tmp_path / "out" / "excitation.json").evaluate(csv[:, 0])
+    assert np.allclose(csv[:, 1:7] - q, [0.0, np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0], atol=1e-8)
+    assert np.allclose(csv[:, 7:13], load_trajectory(tmp_path / "out" / "excitation.json").evaluate(csv[:, 0])[1],
+                       atol=1e-7)

@@ -237,3 +237,30 @@ def test_the_closed_loop_estimators_fit_the_rows_the_pipeline_prepared(closed_lo
                                               pipeline.closed_loop_estimators[0].experiment(prepared.robot, recording),
                                               methods=("idim-iv",), data=prepared.data)["idim-iv"]
     np.testing.assert_array_equal(whole.estimates["dynid IDIM-IV"].params, direct.params)
+
+
+def test_the_reference_is_read_at_the_angles_the_log_is(tmp_path):
+    """A description whose J2 encoder zero is a quarter turn from its model's (``position_offset = "pi/2"``): a log's
+    angles get the offset, and the controller's set-points (the same encoders' angles) get it too. They were read as
+    given, a quarter turn from the log's motion, which IDIM-IV and DIDIM would simulate as the reference."""
+    from importlib import resources
+
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    text = (resources.files("dynid.model") / "robots" / "er16.toml").read_text()
+    head, first, rest = text.partition('[[joints]]\nname = "joint2"\n')
+    (tmp_path / "arm.toml").write_text(head + first + 'position_offset = "pi/2"\n' + rest)
+    t = np.arange(200) / 1000.0
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, N + 1)))
+    header = "t," + ",".join(f"q{j}" for j in range(1, N + 1)) + "," + ",".join(f"tau{j}" for j in range(1, N + 1))
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, q, np.cos(q)]), delimiter=",", header=header, comments="")
+    np.savetxt(tmp_path / "ref.csv", q, delimiter=",", header=",".join(f"r{j}" for j in range(1, N + 1)), comments="")
+    _write(tmp_path, "[controller]\nkp = 100.0\nkd = 10.0\nrate = 1000.0\n"
+                     f"reference = {{ file = \"ref.csv\", header = true, positions = [{COLUMNS.replace('q', 'r')}] }}\n")
+    (tmp_path / "cl.toml").write_text((tmp_path / "cl.toml").read_text().replace('robot = "er16"', 'robot = "arm.toml"'))
+    config = load_identification_config(tmp_path / "cl.toml")
+    logged = load_recording(config.identification, config.robot).q
+    reference = config.controller[1].read()
+    assert np.allclose(reference, logged, atol=1e-9)
+    assert np.allclose(reference[:, 1] - q[:, 1], np.pi / 2)

@@ -364,7 +364,8 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
     asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], moved, f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
-    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof)
+    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
+                             robot.transmission.position_offset)
     if closed_loop and controller is None:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
                           "controller: add a [controller] table (kp, kd, rate, the reference trajectory), or leave it out "
@@ -482,8 +483,9 @@ def _robots_mjcf(doc: dict, path: Path, root: Path, robot) -> Path | None:
     return None if mjcf is None or robot.held else _mjcf_model(str(mjcf), path.parent, robot, None, path)
 
 
-def _controller(table, root: Path, where: str, n: int):
-    """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None."""
+def _controller(table, root: Path, where: str, n: int, offset=None):
+    """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None; the
+    set-points are read as the logs' angles are, the robot's position offsets ``offset`` (n,) added."""
     if table is None:
         return None
     from ..simulation.closed_loop import Controller
@@ -498,7 +500,8 @@ def _controller(table, root: Path, where: str, n: int):
         raise ConfigError(f"{where}.reference.positions: expected {n} columns (one per joint), got {ref['positions']!r}")
     reference = ReferenceTrajectory(root / ref["file"], tuple(ref["positions"]), bool(ref.get("header", False)),
                                     np.pi / 180 if ref.get("unit") == "deg" else 1.0,
-                                    None if ref.get("rows") is None else (int(ref["rows"][0]), int(ref["rows"][1])))
+                                    None if ref.get("rows") is None else (int(ref["rows"][0]), int(ref["rows"][1])),
+                                    None if offset is None else tuple(float(x) for x in offset))
     return controller, reference, table.get("feedforward", "none") == "model"
 
 
@@ -515,6 +518,9 @@ class ReferenceTrajectory:
     scale : float
         To radians.
     rows : (first, last) or None
+    offset : tuple of float or None
+        The robot's position offsets [rad], added as to a log's angles (the controller's set-points are its encoders'
+        angles: :func:`dynid.io.datasets.load_recording`).
     """
 
     file: Path
@@ -522,6 +528,7 @@ class ReferenceTrajectory:
     header: bool = False
     scale: float = 1.0
     rows: tuple[int, int] | None = None
+    offset: tuple[float, ...] | None = None
 
     def read(self) -> np.ndarray:
         """The set-points.
@@ -536,7 +543,8 @@ class ReferenceTrajectory:
             A missing or malformed file (named, with the line).
         """
         table = read_table(self.file, list(self.positions), header=self.header, rows=self.rows)
-        return np.asarray(table.data, dtype=float) * self.scale
+        q = np.asarray(table.data, dtype=float) * self.scale
+        return q if self.offset is None else q + np.asarray(self.offset)
 
 
 def _check_reference_names(refs: list, path: Path) -> None:

@@ -64,7 +64,8 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
         save_figure(figures.plot_clearance(t, clearance, title=f"{robot.name}: how close the links come to the cell "
                                                                f"(beyond their {ws.clearance:g} m capsules)"), paths[2])
     csv_path = out / "excitation.csv"
-    write_trajectory_csv(csv_path, run.t, run.q, run.dq, run.ddq)
+    # the controller's angles: the encoders' zeros where the description sets position offsets (excitation_summary)
+    write_trajectory_csv(csv_path, run.t, robot.transmission.logged_positions(run.q), run.dq, run.ddq)
     json_path = out / "excitation.json"
     data = run.to_dict()
     write_results(json_path, data, "excite")

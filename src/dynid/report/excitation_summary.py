@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 from ..tables import Line, TextTable
 
 __all__ = ["excitation_blocks", "no_floor_line"]
@@ -29,7 +31,7 @@ def excitation_blocks(run) -> list:
     if held:
         out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
     out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
-    out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz"))
+    out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz" + _encoder_zeros(p.robot)))
     free = p.unlimited_joints()
     if free:
         swing = ", ".join(f"J{j + 1} {run.q[:, j].min():.3g} to {run.q[:, j].max():.3g} rad" for j in free)
@@ -55,6 +57,16 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
+
+
+def _encoder_zeros(robot) -> str:
+    """Where the description sets joints' position offsets: that excitation.csv holds the encoders' angles."""
+    offset = np.asarray(robot.transmission.position_offset, dtype=float)
+    if not offset.any():
+        return ""
+    turned = ", ".join(f"J{j + 1} {math.degrees(-offset[j]):+.4g}°" for j in np.flatnonzero(offset))
+    return (f", at the angles the joints' encoders read (the description's minus its position_offset: {turned}), as "
+            "the controller takes them; excitation.json and the figures hold the description's")
 
 
 def no_floor_line(lowest: dict, clearance: float) -> tuple[str, bool]:
