@@ -157,7 +157,9 @@ class Identifier(HyperParameters):
             :func:`dynid.load_recording` or :func:`dynid.simulated_log` give it (alone). A config's path here still
             works, with a FutureWarning: it is :meth:`from_config`.
         q : (N, n_dof) array [rad]
-            Joint positions (with time stamps).
+            Joint positions (with time stamps), the description's angles: a log's with the description's
+            ``position_offset`` added, as :func:`dynid.load_recording` reads them (the TX40's and the KR 300's J2 and
+            J3 a quarter turn from their encoders').
         tau : (N, n_dof) array [N·m]
             Joint torques (with time stamps).
         dq : (N, n_dof) array [rad/s], optional

@@ -727,6 +727,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     t : (N,) array [s]
         Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step.
     q : (N, n_dof) array [rad]
+        The description's angles (a log's plus the description's ``position_offset``: nothing is added here).
     tau : (N, n_dof) array [N·m]
     dq : (N, n_dof) array [rad/s], optional
     name : str
