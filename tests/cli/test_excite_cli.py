@@ -250,3 +250,23 @@ def test_excitation_csv_holds_the_encoders_angles_where_the_description_offsets_
     assert np.allclose(csv[:, 1:7] - q, [0.0, np.pi / 2, -np.pi / 2, 0.0, 0.0, 0.0], atol=1e-8)
     assert np.allclose(csv[:, 7:13], load_trajectory(tmp_path / "out" / "excitation.json").evaluate(csv[:, 0])[1],
                        atol=1e-7)
+
+
+def test_the_start_pose_is_said_and_a_start_in_motion_is_a_warning(tmp_path):
+    """A controller handed excitation.csv's first row from another pose jumps there: dynid excite says where it starts
+    (the first row, in degrees), and warns where the design starts moving (the paper's ER-16 trajectory, not from
+    rest: a step in speed for a controller at rest there)."""
+    config = _small(tmp_path, "excite-tx40.toml", {"starts = 4": "starts = 1\nmaxiter = 5",
+                                                   '"robots/tx40_simulation.toml"':
+                                                   f'"{(REPO / "configs" / "robots" / "tx40_simulation.toml").as_posix()}"'})
+    p = dynid("excite", str(config), "--out", str(tmp_path / "rest"))
+    said = " ".join(p.stdout.split())
+    assert p.returncode == 0 and "it starts at rest at J1 0.0°, J2 90.0°, J3 -90.0°" in said, said
+    first = np.loadtxt(tmp_path / "rest" / "excitation.csv", delimiter=",", skiprows=1)[0]
+    assert np.allclose(np.degrees(first[1:4]), [0.0, 90.0, -90.0], atol=0.05) and np.allclose(first[7:13], 0.0)
+    p = dynid("excite", str(REPO / "configs" / "excite-er16.toml"), "--out", str(tmp_path / "moving"), "--starts", "1")
+    said = " ".join((p.stdout + p.stderr).split())
+    first = np.loadtxt(tmp_path / "moving" / "excitation.csv", delimiter=",", skiprows=1)[0]
+    j = int(np.argmax(np.abs(first[4:7])))
+    assert p.returncode == 0 and f"warning: it starts moving ({abs(first[4 + j]):.3g} rad/s on J{j + 1})" in said, said
+    assert "then play excitation.csv" in said and "the start), then" in said

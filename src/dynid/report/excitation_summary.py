@@ -32,6 +32,7 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
     out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
     out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz" + _encoder_zeros(p.robot)))
+    out.append(_start_line(run))
     free = p.unlimited_joints()
     if free:
         swing = ", ".join(f"J{j + 1} {run.q[:, j].min():.3g} to {run.q[:, j].max():.3g} rad" for j in free)
@@ -52,11 +53,32 @@ def excitation_blocks(run) -> list:
     if d.feasible:
         below = lowest is not None and lowest.height < p.workspace.clearance
         apart = getattr(run, "self_clearance", None)
-        first = ("settle the warnings above (what the arm stands on, the links' clearance), then "
-                 if below or (apart is not None and apart.distance < 0) else "")
+        moving = float(np.abs(run.dq[0]).max()) > START_AT_REST
+        first = ("settle the warnings above (what the arm stands on, the links' clearance, the start), then "
+                 if below or (apart is not None and apart.distance < 0) or moving else "")
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
+
+
+START_AT_REST = 1e-6
+"""A speed [rad/s] below which the first set-point is taken as at rest."""
+
+
+def _start_line(run) -> Line:
+    """Where the first set-point puts the arm, in excitation.csv's angles: a position controller handed it from
+    another pose jumps there, so the arm is brought there first; a design that starts moving is said, as a warning."""
+    robot = run.config.problem.robot
+    first = robot.transmission.logged_positions(run.q[:1])[0]
+    pose = ", ".join(f"J{j + 1} {math.degrees(v) + 0.0:.1f}°" for j, v in enumerate(np.round(first, 6)))
+    speed = float(np.abs(run.dq[0]).max())
+    if speed <= START_AT_REST:
+        return Line(f"it starts at rest at {pose} (its first row, in radians there): bring the arm there with a slow "
+                    "point-to-point move before playing it")
+    j = int(np.argmax(np.abs(run.dq[0])))
+    return Line(f"it starts moving ({speed:.3g} rad/s on J{j + 1}) at {pose} (its first row, in radians there): a "
+                "controller at rest there takes that step in speed; bring the arm there slowly and ramp in, or design "
+                "from rest ([trajectory] rest = true)", "warning")
 
 
 def _encoder_zeros(robot) -> str:
