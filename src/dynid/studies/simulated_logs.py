@@ -51,7 +51,9 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
     Returns
     -------
     Recording
-        ``t`` (N,) [s], ``q`` (N, n_dof) [rad], ``tau`` (N, n_dof) [N·m] (``dq`` None: not logged).
+        ``t`` (N,) [s], ``q`` (N, n_dof) [rad], ``tau`` (N, n_dof) [N·m] (``dq`` None: not logged); ``q`` the
+        description's angles, as :func:`dynid.load_recording` gives a log's (the encoders' angles a CSV of it holds:
+        :meth:`dynid.model.transmission.Transmission.logged_positions`).
 
     Raises
     ------
