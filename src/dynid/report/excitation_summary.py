@@ -6,8 +6,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-
 from ..tables import Line, TextTable
 
 __all__ = ["excitation_blocks", "no_floor_line"]
@@ -53,7 +51,7 @@ def excitation_blocks(run) -> list:
     if d.feasible:
         below = lowest is not None and lowest.height < p.workspace.clearance
         apart = getattr(run, "self_clearance", None)
-        moving = float(np.abs(run.dq[0]).max()) > START_AT_REST
+        moving = float(abs(run.dq[0]).max()) > START_AT_REST
         first = ("settle the warnings above (what the arm stands on, the links' clearance, the start), then "
                  if below or (apart is not None and apart.distance < 0) or moving else "")
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
@@ -70,12 +68,12 @@ def _start_line(run) -> Line:
     another pose jumps there, so the arm is brought there first; a design that starts moving is said, as a warning."""
     robot = run.config.problem.robot
     first = robot.transmission.logged_positions(run.q[:1])[0]
-    pose = ", ".join(f"J{j + 1} {math.degrees(v) + 0.0:.1f}°" for j, v in enumerate(np.round(first, 6)))
-    speed = float(np.abs(run.dq[0]).max())
+    pose = ", ".join(f"J{j + 1} {math.degrees(v) + 0.0:.1f}°" for j, v in enumerate(first.round(6)))
+    speed = float(abs(run.dq[0]).max())
     if speed <= START_AT_REST:
         return Line(f"it starts at rest at {pose} (its first row, in radians there): bring the arm there with a slow "
                     "point-to-point move before playing it")
-    j = int(np.argmax(np.abs(run.dq[0])))
+    j = int(abs(run.dq[0]).argmax())
     return Line(f"it starts moving ({speed:.3g} rad/s on J{j + 1}) at {pose} (its first row, in radians there): a "
                 "controller at rest there takes that step in speed; bring the arm there slowly and ramp in, or design "
                 "from rest ([trajectory] rest = true)", "warning")
@@ -83,10 +81,10 @@ def _start_line(run) -> Line:
 
 def _encoder_zeros(robot) -> str:
     """Where the description sets joints' position offsets: that excitation.csv holds the encoders' angles."""
-    offset = np.asarray(robot.transmission.position_offset, dtype=float)
+    offset = robot.transmission.position_offset
     if not offset.any():
         return ""
-    turned = ", ".join(f"J{j + 1} {math.degrees(-offset[j]):+.4g}°" for j in np.flatnonzero(offset))
+    turned = ", ".join(f"J{j + 1} {math.degrees(-v):+.4g}°" for j, v in enumerate(offset) if v)
     return (f", at the angles the joints' encoders read (the description's minus its position_offset: {turned}), as "
             "the controller takes them; excitation.json and the figures hold the description's")
 
