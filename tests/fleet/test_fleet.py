@@ -171,3 +171,7 @@ def test_a_units_warnings_reach_the_console_and_fleet_json(tmp_path):
     assert list(fleet["warnings"]) == ["r02"], fleet["warnings"]
     said = " ".join((p.stdout + p.stderr).split())
     assert all(f"r02: {' '.join(w.split())}" in said for w in fleet["warnings"]["r02"])
+    # three units: none has the 3 others a comparison needs, said rather than "none stands out ... |z| > inf"
+    assert "3 of 3 units identified; none can be told to stand out (3 units identified: each is compared with at " \
+           "least 3 others, so a fleet of 4 units or more is needed)" in said
+    assert "no flags: 3 units identified" in said and "|z| > inf" not in said

@@ -32,7 +32,8 @@ def fleet_verdict(result) -> str:
     helped = [u for u, e in result.pooled_errors.items() if e < ok[u].validation_error]
     return (f"{len(ok)} of {len(result.units)} units identified; "
             + (f"{len(flagged)} {'stands' if len(flagged) == 1 else 'stand'} out from the fleet: {', '.join(flagged)}"
-               if flagged else "none stands out from the fleet")
+               if flagged else "none stands out from the fleet" if math.isfinite(result.threshold)
+               else f"none can be told to stand out ({_unflaggable(len(ok))})")
             + (f"; pooling improved {len(helped)} of {len(result.pooled_errors)} units' validation error"
                if result.pooled_errors else (f"; not pooled: {result.pooled_note}" if result.pooled_note else "")))
 
@@ -79,9 +80,19 @@ def fleet_blocks(result) -> list:
             out.append(Line(f"{s.id}: not identified: {s.error}", "warning"))
         for w in s.warnings:  # each unit's own warnings (a truncated log, gaps filled), named by the unit
             out.append(Line(f"{s.id}: {w}", "warning"))
-    out.append(Line(f"ran on {result.cluster} in {result.seconds:.1f} s; flag threshold |z| > {result.threshold:.2f} (1 % "
-                    "chance of any false flag in a fleet whose units differ only at random)"))
+    flags = (f"flag threshold |z| > {result.threshold:.2f} (1 % chance of any false flag in a fleet whose units differ "
+             "only at random)" if math.isfinite(result.threshold) else f"no flags: {_unflaggable(len(result.identified))}")
+    out.append(Line(f"ran on {result.cluster} in {result.seconds:.1f} s; {flags}"))
     return out
+
+
+def _unflaggable(identified: int) -> str:
+    """Why no unit of a fleet could be flagged (:func:`dynid.fleet.outliers.fleet_z`: a unit against 3 others or more,
+    units of one robot model)."""
+    if identified < 4:
+        return (f"{identified} units identified: each is compared with at least 3 others, so a fleet of 4 units or more "
+                "is needed")
+    return "the units' base parameters differ (friction models or robot descriptions): they are not compared"
 
 
 def monitor_blocks(result) -> list:
