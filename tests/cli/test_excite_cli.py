@@ -264,6 +264,9 @@ def test_the_start_pose_is_said_and_a_start_in_motion_is_a_warning(tmp_path):
     assert p.returncode == 0 and "it starts at rest at J1 0.0°, J2 90.0°, J3 -90.0°" in said, said
     first = np.loadtxt(tmp_path / "rest" / "excitation.csv", delimiter=",", skiprows=1)[0]
     assert np.allclose(np.degrees(first[1:4]), [0.0, 90.0, -90.0], atol=0.05) and np.allclose(first[7:13], 0.0)
+    kept = json.loads((tmp_path / "rest" / "excitation.json").read_text())["set_points"]  # report.html says it too
+    assert np.allclose(kept["first"], first[1:7], atol=1e-8) and kept["position_offset"][1:3] == [-np.pi / 2, np.pi / 2]
+    assert "it starts at rest at J1 0.0°, J2 90.0°" in (tmp_path / "rest" / "report.html").read_text()
     p = dynid("excite", str(REPO / "configs" / "excite-er16.toml"), "--out", str(tmp_path / "moving"), "--starts", "1")
     said = " ".join((p.stdout + p.stderr).split())
     first = np.loadtxt(tmp_path / "moving" / "excitation.csv", delimiter=",", skiprows=1)[0]

@@ -78,7 +78,21 @@ class ExcitationRun:
             **({"cell_clearance": [m.to_dict() for m in self.cell_clearance]} if self.cell_clearance else {}),
             **({} if self.mujoco_contacts is None else {"mujoco_contacts": self.mujoco_contacts.to_dict()}),
             **({} if self.lowest is None else {"lowest": self.lowest.to_dict()}),
+            "set_points": self.set_points(),
         }
+
+    def set_points(self) -> dict:
+        """What excitation.csv holds beside the design: the description's position offsets taken off its angles (the
+        joints' encoders', which the controller plays), its first row's angles and velocities.
+
+        Returns
+        -------
+        dict
+            ``position_offset`` (n_dof,) [rad], ``first`` (n_dof,) [rad] and ``first_velocity`` (n_dof,) [rad/s].
+        """
+        transmission = self.config.problem.robot.transmission
+        return {"position_offset": transmission.position_offset.tolist(),
+                "first": transmission.logged_positions(self.q[:1])[0].tolist(), "first_velocity": self.dq[0].tolist()}
 
 
 def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:

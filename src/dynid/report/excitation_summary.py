@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..tables import Line, TextTable
 
-__all__ = ["excitation_blocks", "no_floor_line"]
+__all__ = ["excitation_blocks", "no_floor_line", "set_point_lines"]
 
 
 def excitation_blocks(run) -> list:
@@ -29,8 +29,8 @@ def excitation_blocks(run) -> list:
     if held:
         out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
     out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
-    out.append(Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz" + _encoder_zeros(p.robot)))
-    out.append(_start_line(run))
+    encoders, (start, kind) = set_point_lines(run.set_points())
+    out += [Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz" + encoders), Line(start, kind)]
     free = p.unlimited_joints()
     if free:
         swing = ", ".join(f"J{j + 1} {run.q[:, j].min():.3g} to {run.q[:, j].max():.3g} rad" for j in free)
@@ -51,9 +51,8 @@ def excitation_blocks(run) -> list:
     if d.feasible:
         below = lowest is not None and lowest.height < p.workspace.clearance
         apart = getattr(run, "self_clearance", None)
-        moving = float(abs(run.dq[0]).max()) > START_AT_REST
         first = ("settle the warnings above (what the arm stands on, the links' clearance, the start), then "
-                 if below or (apart is not None and apart.distance < 0) or moving else "")
+                 if below or (apart is not None and apart.distance < 0) or kind == "warning" else "")
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
@@ -63,30 +62,38 @@ START_AT_REST = 1e-6
 """A speed [rad/s] below which the first set-point is taken as at rest."""
 
 
-def _start_line(run) -> Line:
-    """Where the first set-point puts the arm, in excitation.csv's angles: a position controller handed it from
-    another pose jumps there, so the arm is brought there first; a design that starts moving is said, as a warning."""
-    robot = run.config.problem.robot
-    first = robot.transmission.logged_positions(run.q[:1])[0]
-    pose = ", ".join(f"J{j + 1} {math.degrees(v) + 0.0:.1f}°" for j, v in enumerate(first.round(6)))
-    speed = float(abs(run.dq[0]).max())
-    if speed <= START_AT_REST:
-        return Line(f"it starts at rest at {pose} (its first row, in radians there): bring the arm there with a slow "
-                    "point-to-point move before playing it")
-    j = int(abs(run.dq[0]).argmax())
-    return Line(f"it starts moving ({speed:.3g} rad/s on J{j + 1}) at {pose} (its first row, in radians there): a "
-                "controller at rest there takes that step in speed; bring the arm there slowly and ramp in, or design "
-                "from rest ([trajectory] rest = true)", "warning")
+def set_point_lines(set_points: dict) -> tuple[str, tuple[str, str]]:
+    """What excitation.csv's angles are and where it starts, from :meth:`ExcitationRun.set_points
+    <dynid.identification.excitation_run.ExcitationRun.set_points>` (excitation.json's ``set_points``).
 
+    A position controller handed the first row from another pose jumps there, so the arm is brought there first; a
+    design that starts moving is a warning.
 
-def _encoder_zeros(robot) -> str:
-    """Where the description sets joints' position offsets: that excitation.csv holds the encoders' angles."""
-    offset = robot.transmission.position_offset
-    if not offset.any():
-        return ""
+    Parameters
+    ----------
+    set_points : dict
+        ``position_offset``, ``first`` [rad] and ``first_velocity`` [rad/s], one per joint.
+
+    Returns
+    -------
+    encoders : str
+        Appended to the excitation.csv line where the description sets position offsets (the file then holds the
+        encoders' angles); empty otherwise.
+    start : (str, str)
+        The line on the start and its kind ("text" or "warning").
+    """
+    offset, speeds = set_points["position_offset"], [abs(v) for v in set_points["first_velocity"]]
     turned = ", ".join(f"J{j + 1} {math.degrees(-v):+.4g}°" for j, v in enumerate(offset) if v)
-    return (f", at the angles the joints' encoders read (the description's minus its position_offset: {turned}), as "
-            "the controller takes them; excitation.json and the figures hold the description's")
+    encoders = (f", at the angles the joints' encoders read (the description's minus its position_offset: {turned}), "
+                "as the controller takes them; excitation.json and the figures hold the description's" if turned else "")
+    pose = ", ".join(f"J{j + 1} {math.degrees(round(v, 6)) + 0.0:.1f}°" for j, v in enumerate(set_points["first"]))
+    if max(speeds) <= START_AT_REST:
+        return encoders, (f"it starts at rest at {pose} (its first row, in radians there): bring the arm there with a "
+                          "slow point-to-point move before playing it", "text")
+    j = speeds.index(max(speeds))
+    return encoders, (f"it starts moving ({speeds[j]:.3g} rad/s on J{j + 1}) at {pose} (its first row, in radians there): "
+                      "a controller at rest there takes that step in speed; bring the arm there slowly and ramp in, or "
+                      "design from rest ([trajectory] rest = true)", "warning")
 
 
 def no_floor_line(lowest: dict, clearance: float) -> tuple[str, bool]:

@@ -14,7 +14,7 @@ from pathlib import Path
 from .. import __version__
 from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
-from .excitation_summary import no_floor_line
+from .excitation_summary import no_floor_line, set_point_lines
 
 
 @dataclass
@@ -364,6 +364,9 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
                     [[m["constraint"], m["where"], _fmt(m["limit"]), _fmt(m["worst"]), _fmt(m["margin"]),
                       _fmt(None if m.get("relative") is None else 100 * m["relative"], ".3g")] for m in g.get("margins", [])], (1,))
     notes = [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the 10× grid: {g['feasible']}"]
+    if "set_points" in d:
+        encoders, (start, _) = set_point_lines(d["set_points"])
+        notes += ([f"excitation.csv{encoders}"] if encoders else []) + [start]
     if "lowest" in d:
         notes.append(no_floor_line(d["lowest"], d["workspace"]["clearance"])[0])
     return settings, [Section("Design", [before], notes), Section("Constraints", [margins])]
