@@ -62,7 +62,7 @@ def test_the_unexplained_share_is_that_of_a_direct_regression_with_and_without_t
     shifts, orders = np.zeros((3, n)), np.tile(np.arange(n), (3, 1))
     shifts[1, 1] = np.pi / 2
     orders[2, [1, 2]] = 2, 1
-    got = unexplained_share(robot, q, dq, ddq, tau, shifts, orders)
+    got = unexplained_share(robot, q, dq, ddq, tau, shifts, orders=orders)
     for shift, order, value in zip(shifts, orders, got):
         qi, dqi, ddqi = (q + shift)[:, order], dq[:, order], ddq[:, order]
         nominal = nominal_rigid_torque(robot, qi, dqi, ddqi)

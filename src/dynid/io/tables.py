@@ -228,7 +228,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         def flush():
             nonlocal files
             if pending:
-                block = _parse_block(path, pending, pending_start, cols, delimiter, missing, dated)
+                block = _parse_block(path, pending, pending_start, cols, delimiter, missing=missing, dated=dated)
                 pending.clear()
                 if not spool:
                     blocks.append(block)
@@ -254,7 +254,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                     raise DataError(f"{path}: line {line_no}: column {max(cols) + 1} requested but the lines have "
                                 f"{expected} columns" + (_separator_hint(line, delimiter) if n_fields == 1 else ""))
             if n_fields != expected:  # the truncated last line (a warning), or a mistake (refused)
-                _odd_line(path, line, line_no, n_fields, expected, delimiter, warnings)
+                _odd_line(path, line, line_no, n_fields, expected, delimiter=delimiter, warnings=warnings)
                 break
             if first_line is None:
                 first_line = line_no
@@ -302,7 +302,8 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
     try:
         with pa.OSFile(str(path)) as source:
             source.seek(offset)
-            blocks, files, n = _arrow_blocks(pa, pc, source, cols, order, wanted, delimiter, count, spool)
+            blocks, files, n = _arrow_blocks(pa, pc, source, cols, order, wanted=wanted, delimiter=delimiter, count=count,
+                                             spool=spool)
         pa.default_memory_pool().release_unused()  # its parsing buffers, which the pool would keep for reuse
     except (pa.ArrowException, KeyError, ValueError):  # anything it parses otherwise: the line reader decides
         return None
@@ -311,7 +312,7 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
     return Table(StoredColumns(files) if spool else _stack(blocks), int(header) + first)
 
 
-def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], wanted: list[int], delimiter: str,
+def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: list[int], delimiter: str,
                   count: int | None, spool: bool) -> tuple[list, list | None, int]:
     """The blocks of :func:`_arrow_table` (kept, or appended to column files with ``spool``), and their rows;
     ValueError at a value that is not finite."""
@@ -341,7 +342,7 @@ def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], wanted: lis
     return blocks, files, n
 
 
-def _odd_line(path: Path, line: str, line_no: int, n_fields: int, expected: int | None, delimiter: str,
+def _odd_line(path: Path, line: str, line_no: int, n_fields: int, expected: int | None, *, delimiter: str,
               warnings: list) -> None:
     """A line with another number of fields than the first: the file's truncated last line (no newline: a warning;
     reading stops there) or a mistake (DataError, with a hint where another delimiter is in the line)."""
@@ -398,7 +399,7 @@ def _posix_seconds(text: str) -> float | None:
     return (stamp if stamp.tzinfo is not None else stamp.replace(tzinfo=datetime.UTC)).timestamp()
 
 
-def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str,
+def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], delimiter: str, *,
                  missing: bool = False, dated: set[int] | frozenset = frozenset()) -> np.ndarray:
     try:
         block = np.loadtxt(lines, delimiter=delimiter, usecols=cols, ndmin=2, dtype=np.float64, comments=None)

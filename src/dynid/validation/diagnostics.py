@@ -308,7 +308,7 @@ def _unapplied_gains(dataset: str, low: float, high: float, joints: str, describ
             "currents times the robot's drive_gains (eq. 16)")
 
 
-def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str,
+def scale_findings(correlation: np.ndarray, slope: np.ndarray, varies: np.ndarray, dataset: str, *,
                    table: str = "[identification]", gains: np.ndarray | None = None,
                    misfit: np.ndarray | None = None, mass: float | None = None,
                    described: np.ndarray | None = None) -> list[Finding]:

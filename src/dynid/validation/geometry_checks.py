@@ -93,8 +93,8 @@ SAMPLES = (100, 5)
 """The samples of the log the search reads: this many stretches of this many rows each, evenly spaced."""
 
 
-def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, orders=None, gravities=None, directions=None,
-                      channels=None, *, signed: bool = False) -> np.ndarray:
+def unexplained_share(robot: Robot, q, dq, ddq, tau, shifts, *, orders=None, gravities=None, directions=None,
+                      channels=None, signed: bool = False) -> np.ndarray:
     """What each change of the logged angles leaves of the torque, as a share of what the nuisance columns of the
     logged angles leave (module docstring).
 
@@ -346,7 +346,7 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
               + np.count_nonzero(ways < 0, axis=1) + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
     one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
     pick, twin = _tie_break(robot, log, changes, scores, logged, two if scores[two] < SIMPLER * scores[one] else one,
-                            single)
+                            single=single)
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
                  direction=ways[pick].tolist(), channels=bool(channels[pick]), unexplained_changed=float(scores[pick]))
     if twin is not None:
@@ -452,11 +452,11 @@ def _replicated(robot: Robot, raw: tuple, changes: tuple, pick: int) -> bool:
     n = robot.n_dof
     unchanged = (np.zeros(n), np.arange(n), np.asarray(robot.gravity, dtype=float), np.ones(n), np.array(False))
     left = unexplained_share(robot, *(_spread(x, 0.5) for x in raw),
-                             *(np.stack([a, x[pick]]) for a, x in zip(unchanged, changes)))
+                             **_named(np.stack([a, x[pick]]) for a, x in zip(unchanged, changes)))
     return bool(left[1] <= CHANGE_GAIN * left[0])
 
 
-def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, logged: float, pick: int, single
+def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, logged: float, pick: int, *, single
                ) -> tuple[int, int | None]:
     """The change named, and a twin as good that the log cannot tell from it (or None). A half turn of a joint, or
     gravity reversed, may only flip torques, which each joint's free slope takes up: of the changes within 5 % of the
@@ -487,7 +487,12 @@ def _text_of(robot: Robot, log: tuple, changes: tuple, k: int) -> tuple[str, tup
 def _scored(robot: Robot, log: tuple, changes: tuple, which, *, signed: bool = False) -> np.ndarray:
     """:func:`unexplained_share` of the changes ``which`` (a mask or indices) of ``changes``
     (:func:`candidate_changes`' arrays) on ``log`` (q, dq, ddq, tau)."""
-    return unexplained_share(robot, *log, *(x[which] for x in changes), signed=signed)
+    return unexplained_share(robot, *log, **_named(x[which] for x in changes), signed=signed)
+
+
+def _named(changes) -> dict:
+    """:func:`candidate_changes`' five arrays (or rows of them) as :func:`unexplained_share`'s keywords."""
+    return dict(zip(("shifts", "orders", "gravities", "directions", "channels"), changes, strict=True))
 
 
 def _change_text(robot: Robot, shift: np.ndarray, order: np.ndarray, gravity: np.ndarray, channels: bool = False
