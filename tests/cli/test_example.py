@@ -25,6 +25,7 @@ def test_the_example_folder_runs_identify_and_export_as_printed(tmp_path, monkey
     out = tmp_path / "try" / "dynid-identify"
     assert (out / "results.json").is_file() and (out / "report.html").is_file()
     assert (out / "ur10e.urdf").is_file() and (out / "dynid-model.xml").is_file()  # the user's URDF, values written in
+    assert "position_offset" not in (out / "ur10e.urdf").read_text()  # no offsets: nothing said of them
     p = run("identify", "ur10e.toml", "--no-figures")
     said = " ".join(p.stdout.split())
     start = said.index("dynid export")
@@ -49,6 +50,10 @@ def test_the_tx40_example_is_logged_at_its_encoders_zeros_and_identifies_ready(t
     assert p.returncode == 0, p.stderr
     assert "model ready" in said and "not ready" not in said, said[:300]
     assert "turned by" not in said and "leaves its limits" not in said
+    # the written URDF and MJCF say their angles are the description's, the encoders' plus the offsets
+    for name in ("dynid-model.urdf", "dynid-model.xml"):
+        assert "encoder angle (what a log and the controller hold) plus its position_offset (J2 -90°, J3 +90°)" in (
+            tmp_path / "try" / "dynid-identify" / name).read_text(), name
 
 
 def test_the_example_files_are_the_same_for_the_same_seed_and_simulate_the_description():

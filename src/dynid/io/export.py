@@ -155,6 +155,7 @@ def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         names = robot.transmission.coupled_parameter_names
         lines.append("  <!-- dynid: coupled motors (not representable in URDF), add their torques: "
                      + ", ".join(f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " -->")
+    lines += [f"  <!--{note}-->" for note in (position_offset_note(robot),) if note]
     lines += ['  <link name="flange"/>', '  <joint name="flange_fixed" type="fixed">', f'    <parent link="link{robot.n_dof}"/>',
               '    <child link="flange"/>',
               f'    <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(robot.tool_rotation))}"/>', "  </joint>", "</robot>", ""]
@@ -254,6 +255,7 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                      + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                                                   fitted.transmission.coupled_values.ravel()))
                      + " -->")
+    lines += [f"  <!--{note}-->" for note in (position_offset_note(robot),) if note]
     lines += ["</mujoco>", ""]
     return "\n".join(lines)
 
@@ -531,6 +533,26 @@ def moved_far(link: str, mass: float, com: np.ndarray, nominal_mass: float, nomi
 
     return (f"{link}: mass {mass:.4g} kg (the {form}'s {nominal_mass:.4g}), centre of mass at ({point(com)}) m "
             f"(the {form}'s ({point(nominal_com)}))")
+
+
+def position_offset_note(robot: Robot) -> str:
+    """A written description's comment where the robot sets joints' position offsets, else "": its joint angles are
+    the description's, a joint's encoder angle plus the offset (as dynid reads a log; a controller's angles take it
+    off: :meth:`dynid.model.transmission.Transmission.logged_positions`).
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    str
+        The comment's text, spaces about it.
+    """
+    offset = robot.transmission.position_offset
+    turned = ", ".join(f"J{j + 1} {np.degrees(v):+.4g}°" for j, v in enumerate(offset) if v)
+    return (f" dynid: the joint angles of this file are the description's: a joint's encoder angle (what a log and the "
+            f"controller hold) plus its position_offset ({turned}) " if turned else "")
 
 
 def identified_header(file: str, replaced: str, estimate: str, moved: list[str], form: str) -> str:

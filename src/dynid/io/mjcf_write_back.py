@@ -23,7 +23,7 @@ from ..model.mjcf import held_inertials
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
 from ..runtime.extras import require
-from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia
+from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia, position_offset_note
 
 AXIS_TOLERANCE = 1e-4
 """[rad, m] How far a joint axis of the MJCF may lie from the robot's, once the arms are aligned."""
@@ -173,6 +173,8 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                               fitted.transmission.coupled_values.ravel())) + " "))
+    if position_offset_note(robot):
+        root.append(ET.Comment(position_offset_note(robot)))
     _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
     header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
                                "frictionloss of every joint", estimate, moved, "MJCF")

@@ -21,7 +21,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
-from .export import _exportable, _world_from_base, identified_header, moved_far
+from .export import _exportable, _world_from_base, identified_header, moved_far, position_offset_note
 
 __all__ = ["urdf_written_back"]
 
@@ -248,6 +248,8 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         head.append(_comment(f" dynid: gravity is {vector} m/s² in this robot's base frame (the root "
                              "link's), as identified: a URDF cannot hold it; give it to the simulator or controller that "
                              "loads this file (Pinocchio: model.gravity.linear) "))
+    if position_offset_note(robot):
+        head.append(_comment(position_offset_note(robot)))
     if robot.transmission.n_coupled_params:
         names = robot.transmission.coupled_parameter_names
         head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
