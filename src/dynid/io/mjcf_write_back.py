@@ -173,8 +173,8 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                               fitted.transmission.coupled_values.ravel())) + " "))
-    if position_offset_note(robot):
-        root.append(ET.Comment(position_offset_note(robot)))
+    if note := position_offset_note(robot):
+        root.append(ET.Comment(note))
     _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
     header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
                                "frictionloss of every joint", estimate, moved, "MJCF")

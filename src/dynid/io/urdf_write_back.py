@@ -248,8 +248,8 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         head.append(_comment(f" dynid: gravity is {vector} m/s² in this robot's base frame (the root "
                              "link's), as identified: a URDF cannot hold it; give it to the simulator or controller that "
                              "loads this file (Pinocchio: model.gravity.linear) "))
-    if position_offset_note(robot):
-        head.append(_comment(position_offset_note(robot)))
+    if note := position_offset_note(robot):
+        head.append(_comment(note))
     if robot.transmission.n_coupled_params:
         names = robot.transmission.coupled_parameter_names
         head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
