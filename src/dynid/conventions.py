@@ -11,6 +11,8 @@ followed by the drive terms the robot declares (a subset of ``DRIVE_TERMS``, in 
 
 from __future__ import annotations
 
+import math
+
 from . import friction
 
 INERTIAL_TERMS: tuple[str, ...] = ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M")
@@ -166,3 +168,20 @@ def time_unit_of(step: float) -> str | None:
         return None
     return next((u for u, f in TIME_UNITS.items() if f < 1.0 and low <= step * f <= high), None)
 
+
+
+def joint_angles_text(angles) -> str:
+    """The joints whose angle is not zero, in degrees (``"J2 -90°, J3 +90°"``): how a description's position offsets
+    are said wherever dynid writes angles that hold them or not (excitation.csv, a written URDF or MJCF).
+
+    Parameters
+    ----------
+    angles : sequence of float
+        One per joint [rad].
+
+    Returns
+    -------
+    str
+        Empty where every angle is zero.
+    """
+    return ", ".join(f"J{j + 1} {math.degrees(v):+.4g}°" for j, v in enumerate(angles) if v)

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
+from ..conventions import joint_angles_text
 from ..exceptions import ConfigError
 from ..model.friction_model import robot_from_settings
 from ..model.loading import as_robot
@@ -549,8 +550,7 @@ def position_offset_note(robot: Robot) -> str:
     str
         The comment's text, spaces about it.
     """
-    offset = robot.transmission.position_offset
-    turned = ", ".join(f"J{j + 1} {np.degrees(v):+.4g}°" for j, v in enumerate(offset) if v)
+    turned = joint_angles_text(robot.transmission.position_offset)
     return (f" dynid: the joint angles of this file are the description's: a joint's encoder angle (what a log and the "
             f"controller hold) plus its position_offset ({turned}) " if turned else "")
 

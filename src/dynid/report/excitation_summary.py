@@ -82,9 +82,11 @@ def set_point_lines(set_points: dict) -> tuple[str, tuple[str, str]]:
     start : (str, str)
         The line on the start and its kind ("text" or "warning").
     """
+    from ..conventions import joint_angles_text  # numpy's import kept from report.html's
+
     offset, speeds = set_points["position_offset"], [abs(v) for v in set_points["first_velocity"]]
-    turned = ", ".join(f"J{j + 1} {math.degrees(-v):+.4g}°" for j, v in enumerate(offset) if v)
-    encoders = (f", at the angles the joints' encoders read (the description's minus its position_offset: {turned}), "
+    turned = joint_angles_text(offset)
+    encoders = (f", at the angles the joints' encoders read (the description's minus its position_offset, {turned}), "
                 "as the controller takes them; excitation.json and the figures hold the description's" if turned else "")
     pose = ", ".join(f"J{j + 1} {math.degrees(round(v, 6)) + 0.0:.1f}°" for j, v in enumerate(set_points["first"]))
     if max(speeds) <= START_AT_REST:
