@@ -113,11 +113,11 @@ def test_the_import_resolver_sees_relative_imports():
     assert "dynid.identification.pipeline" in set(m for _, m in _imports_of("studies")), found
 
 
-HAND_ASSEMBLED = {("studies/paper.py", "Estimation"), ("studies/paper.py", "stream_rows"),
-                  ("studies/montecarlo.py", "Estimation")}
+HAND_ASSEMBLED: set = set()
 """Where code outside identification/ still assembles the estimation by hand (issue "Parts carry their settings, one
-route", item 3): the paper's experiment and its Monte Carlo stream a simulated recording's rows into the estimators
-with the paper's Table 3 search box and seeds of their own. Every other caller goes through the pipeline."""
+route", item 3): nowhere. The paper's experiment and its Monte Carlo prepare their simulated recordings through the
+pipeline and have it feed their estimators (``IdentificationPipeline.estimation``), then fit them in the paper's Table 3
+search box with seeds of their own."""
 
 
 def test_only_the_known_callers_assemble_the_estimation_by_hand():

@@ -147,13 +147,13 @@ def test_the_base_regressor_smoothed_alone_equals_the_smoothed_standard_ones_col
     t = np.arange(2000) / 500.0
     args = (robot, base, paper_validation_trajectory(0.1 * np.pi, 6), t, NoiseModel(0.05, 1e-5))
     rest = (robot.standard_parameters(), 2, "validation", [])
-    alone = simulate_dataset(*args, np.random.default_rng(4), *rest)
+    alone, none = simulate_dataset(*args, np.random.default_rng(4), *rest)
     from dynid.dynamics.layout import consistency_layout
-    from dynid.estimators.estimation import Estimation
     from dynid.estimators.registry import FitData
 
-    with_sdp = Estimation(("ols", "sdp"), FitData(None, None, 6, None, base, layout=consistency_layout(robot)), keep_rows=True)
-    kept = simulate_dataset(*args, np.random.default_rng(4), *rest, with_sdp)
+    problem = FitData(None, None, 6, None, base, layout=consistency_layout(robot))
+    kept, with_sdp = simulate_dataset(*args, np.random.default_rng(4), *rest, problem, estimators=("ols", "sdp"))
+    assert none is None and with_sdp is not None
     assert with_sdp.standard and with_sdp.streamed["sdp"].accumulator_.n_params == robot.n_params
     np.testing.assert_allclose(alone.w_base, kept.w_base, rtol=1e-12, atol=1e-12 * np.abs(kept.w_base).max())
     np.testing.assert_array_equal(alone.tau, kept.tau)

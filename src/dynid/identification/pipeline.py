@@ -21,6 +21,9 @@ Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
 the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop.ClosedLoopEstimator`,
 each carrying the log's controller) when the pipeline has them; the result's ``settings`` say every choice and why. Reading logs
 and configs, drive gains and validation on other logs are the callers' (:mod:`dynid.identification.run`).
+
+An experiment that sets its own search box and seeds (the paper's, :mod:`dynid.studies.paper`) takes the estimators
+fed and unfitted from :meth:`~IdentificationPipeline.estimation` instead of :meth:`~IdentificationPipeline.estimate`.
 """
 
 from __future__ import annotations
@@ -34,11 +37,13 @@ import numpy as np
 from .._util.keywords import renamed_keyword
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..estimators.estimation import Estimation, stream_rows
+from ..estimators.registry import FitData, estimator_choices
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
 from ..model.loading import as_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import prepare
+from ..preprocessing.pipeline import base_chunks, prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
@@ -308,6 +313,39 @@ class IdentificationPipeline:
             result = part.added_to(result, prepared.robot, prepared.base, recording, self.preprocessing,
                                    experiment=experiment, data=prepared.data)
         return result
+
+    def estimation(self, prepared: PreparedIdentification, problem: FitData, *, keep_rows: bool = False) -> Estimation:
+        """The open-loop estimators fed every block of the prepared log's base rows in one pass, not yet fitted: for an
+        experiment that sets its own search box and seeds (the paper's Table 3 box and per-estimator seeds,
+        :func:`dynid.studies.paper.run_paper_experiment`), where :meth:`estimate` gives the verdict's.
+
+        Parameters
+        ----------
+        prepared : PreparedIdentification
+            From :meth:`prepare`.
+        problem : FitData
+            What the estimators know before any row (joints, base map, layout, prior, eq. 9 weights); the estimator
+            objects' hyper-parameters are added to it.
+        keep_rows : bool
+            Keep the stacked base rows (:meth:`dynid.estimators.estimation.Estimation.rows`).
+
+        Returns
+        -------
+        dynid.estimators.estimation.Estimation
+            Fit it with a box and generators (:meth:`~dynid.estimators.estimation.Estimation.fit`).
+
+        Raises
+        ------
+        ConfigError
+            An estimator that cannot take the rows block by block as the least-squares reference.
+        """
+        keys, hyperparameters = estimator_choices(self.open_loop)
+        if hyperparameters:
+            problem = replace(problem, hyperparameters={**problem.hyperparameters, **hyperparameters})
+        estimation = Estimation(keys, problem, prepared.base.names, keep_rows=keep_rows)
+        chunks = base_chunks(prepared.robot, prepared.base, prepared.data, standard=estimation.standard)
+        stream_rows(chunks, estimation, prepared.base)
+        return estimation
 
     def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
             held_out: bool = True):

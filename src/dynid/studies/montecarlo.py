@@ -30,7 +30,6 @@ from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..estimators import registry
-from ..estimators.estimation import Estimation
 from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import FourierTrajectory, sample_times
@@ -206,9 +205,11 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     strategies.ensure_registered(setup.plugins[1])
     rng = np.random.default_rng([cfg.seed, 10, level_index, realisation])
     keys = parse_estimators(cfg.estimators)
-    estimation = Estimation(keys, problem(setup.run, setup.robot, setup.base), setup.base.names, keep_rows=True)
-    ds = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t, NoiseModel(level, cfg.encoder_resolution), rng,
-                          setup.phi_true, cfg.smoothing_passes, "identification", [], estimation, cfg.strategy)
+    ds, estimation = simulate_dataset(setup.robot, setup.base, setup.trajectory, setup.t,
+                                      NoiseModel(level, cfg.encoder_resolution), rng, setup.phi_true, cfg.smoothing_passes,
+                                      "identification", [], problem(setup.run, setup.robot, setup.base), cfg.strategy,
+                                      estimators=keys)
+    assert estimation is not None  # fed: a problem was given
     bounds = paper_search_box(setup.run, setup.robot, setup.base, ds.w_base, ds.tau.ravel())
     budget = SearchBudget(cfg.colony_size, cfg.limit, cfg.maxiter)
     params = np.full((len(keys), setup.base.n_base), np.nan)

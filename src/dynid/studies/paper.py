@@ -25,7 +25,7 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
-from ..estimators.estimation import Estimation, stacked_rows, stream_rows
+from ..estimators.estimation import Estimation, stacked_rows
 from ..estimators.fitting import make_estimator
 from ..estimators.physically_consistent import consistency_verdict, margin_is_consistent
 from ..estimators.problem import FitData, SearchBudget
@@ -40,11 +40,12 @@ from ..excitation.paper_trajectories import (
     paper_identification_trajectory,
     paper_validation_trajectory,
 )
+from ..identification.pipeline import IdentificationPipeline
 from ..io.datasets import Recording
 from ..io.trajectories import load_trajectory
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import base_chunks, prepare
+from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
 from ..runtime.threads import with_single_blas_thread
@@ -468,18 +469,19 @@ def paper_preprocessing(traj, passes: int, strategy: str = "paper") -> Preproces
     passes : int
         Applications of eq. 17.
     strategy : str
-        A registered preprocessing strategy.
+        A registered preprocessing strategy: its rule, never cross-validated cutoffs (``auto`` false).
 
     Returns
     -------
     Preprocessing
     """
-    return Preprocessing(strategy=strategy, fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes)
+    return Preprocessing(strategy=strategy, fourier=(traj.omega_f, traj.n_harmonics), smoothing_passes=passes, auto=False)
 
 
-def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, estimation: Estimation | None = None,
-                     strategy: str = "paper") -> Dataset:
-    """Simulate one recording of a trajectory (currents with noise, eq. 16) and prepare it by a strategy.
+def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, warnings, problem: FitData | None = None,
+                     strategy: str = "paper", *, estimators: tuple = ("ols",)) -> tuple[Dataset, Estimation | None]:
+    """Simulate one recording of a trajectory (currents with noise, eq. 16) and prepare it by a strategy, through the
+    identification pipeline (:class:`dynid.identification.pipeline.IdentificationPipeline`).
 
     By default the strategy "paper": the Fourier fit for the derivatives, eq. 17 ``passes`` times on the torques **and
     every column of the observation matrix** (parallel filtering: smoothing the torques alone makes measured and
@@ -503,26 +505,28 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
         The recording's name, prefixing warnings.
     warnings : list of str
         Limit violations of the commanded motion are appended.
-    estimation : Estimation, optional
-        Its estimators are fed the recording's rows.
+    problem : FitData, optional
+        With it, ``estimators`` are fed the recording's rows
+        (:meth:`~dynid.identification.pipeline.IdentificationPipeline.estimation`).
     strategy : str
         A registered preprocessing strategy.
+    estimators : tuple of str
+        Keys of :mod:`dynid.estimators.registry`.
 
     Returns
     -------
     Dataset
+    Estimation or None
+        The estimators fed, unfitted; None without ``problem``.
     """
     recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
-    data = prepare(recording, paper_preprocessing(traj, passes, strategy))
-    rows: tuple[np.ndarray | None, np.ndarray | None]
-    if estimation is None:
-        rows = stacked_rows(base_chunks(robot, base, data), base.n_base)
-    else:
-        stream_rows(base_chunks(robot, base, data, standard=estimation.standard), estimation, base)
-        rows = estimation.rows()
-    w, tau = rows
+    pipeline = IdentificationPipeline(robot, paper_preprocessing(traj, passes, strategy), estimators=estimators)
+    prepared = pipeline.prepare(recording, base)
+    estimation = None if problem is None else pipeline.estimation(prepared, problem, keep_rows=True)
+    w, tau = stacked_rows(base_chunks(robot, base, prepared.data), base.n_base) if estimation is None else estimation.rows()
     assert w is not None and tau is not None  # kept rows: keep_rows=True
-    return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool)
+    data = prepared.data
+    return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool), estimation
 
 
 def settings_of(config) -> dict:
@@ -666,11 +670,12 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     t_sim = time.perf_counter()
     if progress is not None:
         progress("simulation and preprocessing", None, None)
-    estimation = Estimation(keys, problem(config, robot, base), base.names, keep_rows=True)
-    ident = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes, "identification (β1)", warnings,
-                             estimation, config.strategy)
-    valid = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)", warnings,
-                             strategy=config.strategy)
+    ident, estimation = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes,
+                                         "identification (β1)", warnings, problem(config, robot, base), config.strategy,
+                                         estimators=keys)
+    assert estimation is not None  # fed: a problem was given
+    valid, _ = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)",
+                                warnings, strategy=config.strategy)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
     y = ident.tau.ravel()
