@@ -322,11 +322,11 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     problem, prior_notes, not_carried = _estimation_problem(robot, base, keys, hyperparameters)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
-    estimation, scoring = _one_pass(robot, base, data, Estimation(keys, problem, base.names, keep_rows=scored),
+    estimation, scoring = _one_pass(robot, base, data, keys, problem, keep_rows=scored,
                                     held_out=(held_out or jackknife) and sdp, observers=observers, progress=progress)
     sums, folds = scoring.sums, scoring.folds
     reference, estimates, box, row_weights = _estimates(estimation, robot, base, data, ls_key, rng=rng, progress=progress)
-    sol, ols_params, joint_std = reference.solution_, reference.ols_params_, reference.joint_std_
+    sol, joint_std = reference.solution_, reference.joint_std_
     warnings = _identification_warnings(robot, data, reference, prior_notes=prior_notes, not_carried=not_carried,
                                         notes=[e.note for e in estimates.values() if e.note], references=references)
     sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
@@ -334,12 +334,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
     alternative = None if scoring.nominal is None else _drive_only_alternative(
         robot, base, data, reference, sets, fit=fit, sums=sums, joint_weights=row_weights, variants=variants)
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng,
-                               consistent="sdp" in keys)
-    if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
-        findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
-    if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
-        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
+    findings, stats = _model_findings(robot, base, reference, estimates, data.name, scoring=scoring, fit=fit, rng=rng,
+                                      joint_weights=row_weights, consistent=sdp)
     ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
@@ -375,10 +371,11 @@ def _estimation_problem(robot: Robot, base: BaseParameters, keys: tuple[str, ...
     return problem, prior_notes, not_carried
 
 
-def _one_pass(robot: Robot, base: BaseParameters, data: PreparedData, estimation: Estimation, *, held_out: bool,
-              observers: tuple, progress) -> tuple[Estimation, BlockScoring]:
-    """The log's base rows in one pass: fed to the estimators and to the fit's metrics, the verdict's statistics and
-    the held-out blocks (:class:`BlockScoring`)."""
+def _one_pass(robot: Robot, base: BaseParameters, data: PreparedData, keys: tuple[str, ...], problem: FitData, *,
+              keep_rows: bool, held_out: bool, observers: tuple, progress) -> tuple[Estimation, BlockScoring]:
+    """The log's base rows in one pass: fed to the estimators ``keys`` and to the fit's metrics, the verdict's
+    statistics and the held-out blocks (:class:`BlockScoring`)."""
+    estimation = Estimation(keys, problem, base.names, keep_rows=keep_rows)
     scoring = BlockScoring(robot, base, data, held_out=held_out, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
@@ -408,6 +405,20 @@ def _drive_only_alternative(robot: Robot, base: BaseParameters, data: PreparedDa
                        one_way=one_way_joints(data))
     return None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=fit.noise, speed=fit.speed))
+
+
+def _model_findings(robot: Robot, base: BaseParameters, reference, estimates: dict, name: str, *, scoring: BlockScoring,
+                    fit, rng: int, joint_weights, consistent: bool) -> tuple[list, dict]:
+    """The verdict's findings and statistics (:func:`_verdict`), then what the log says of the joints' order and
+    directions: a swapped pair, and (once the log reads right) a flipped joint seen by the SDP."""
+    sol = reference.solution_
+    findings, stats = _verdict(robot, base, sol, reference.ols_params_, joint_weights, scoring=scoring, fit=fit, rng=rng,
+                               consistent=consistent)
+    if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
+        findings += scoring.order.findings(fit.varies(beyond="floor"), name)
+    if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
+        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, name)
+    return findings, stats
 
 
 def _solved_reference(estimation: Estimation, data: PreparedData):

@@ -50,70 +50,89 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
     lines, delimiter = _first_lines(log)
-
-    def split(line: str) -> list[str]:
-        return _fields(line, delimiter)
-
-    first = split(lines[0])
+    first = _fields(lines[0], delimiter)
     header = not all(_number(c) for c in first)
-    n_columns = len(first)
-    notes: list[str] = [f"{log.name}: {n_columns} columns separated by {_named(delimiter)}, "
+    notes: list[str] = [f"{log.name}: {len(first)} columns separated by {_named(delimiter)}, "
                         + ("a header line" if header else "no header line")]
     table = tomlkit.table()
     table.add("file", log.name)
     if delimiter != ",":
         table.add("delimiter", delimiter)
     if header:
-        found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
-        group_notes, passed = _one_group_each(found, log, delimiter, n_dof)
-        order_notes += group_notes
-        _check_one_signal(log, first, found, n_dof)
-        if "time" not in found and rate is None:
-            raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
-                            f"stamps give its sample rate: {rate_hint}")
-        effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
-        missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
-        if missing:
-            count = len(found.get(missing[0], []))
-            raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
-                            f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
-        notes += order_notes
-        table.add("header", True)
-        time_notes, taken = (_time_entry(table, first, found["time"][0], [split(line) for line in lines[1:]])
-                             if "time" in found else _rate_entry(table, float(rate or 0.0)))
-        notes += time_notes
-        assumed = []
-        for kind in ("positions", "velocities", effort):
-            if len(found.get(kind, [])) >= n_dof:
-                unit = _named_unit(found[kind][:n_dof])
-                assumed += [] if unit or _kind_and_unit(found[kind][0])[1] else [kind]
-                motor = bool(_qualifiers(found[kind][0]) & MOTOR_SIDE)
-                side = {"side": "motor"} if motor and kind == "torques" else {}
-                table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {}), **side))
-                notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]) + (f" (in {unit}, as their names say)" if unit else "")
-                             + _side_note(kind, motor))
-                taken += found[kind][:n_dof]
-                if kind == "torques" and not motor:  # a log cannot tell which side of the gear measured them: the arm may
-                    notes += _torque_sensor(table, urdf)
-        left = [c for c in first if c not in taken]
-        extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
-        if extra:
-            notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
-                         f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
-        elif left:
-            notes.append(f"left: {', '.join(left)}")
-        notes += [_assumed_units(assumed)] if assumed else []
-        return table, notes
-    elif n_columns == 31 and n_dof == 6:
+        return table, notes + _header_entries(table, urdf, log, lines, delimiter, n_dof=n_dof, joints=joints, rate=rate,
+                                              rate_hint=rate_hint)
+    return _headerless_table(table, notes, urdf, log, len(first), n_dof=n_dof, joints=joints)
+
+
+def _header_entries(table, urdf: Path, log: Path, lines: list[str], delimiter: str, *, n_dof: int, joints: tuple[str, ...],
+                    rate: float | None, rate_hint: str) -> list[str]:
+    """A log with a header line: its columns found and checked, their entries added to ``table``, what was found."""
+    def split(line: str) -> list[str]:
+        return _fields(line, delimiter)
+
+    first = split(lines[0])
+    found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
+    group_notes, passed = _one_group_each(found, log, delimiter, n_dof)
+    _check_one_signal(log, first, found, n_dof)
+    if "time" not in found and rate is None:
+        raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
+                        f"stamps give its sample rate: {rate_hint}")
+    effort = "torques" if len(found.get("torques", [])) >= n_dof else "currents"
+    missing = [k for k in ("positions", effort) if len(found.get(k, [])) < n_dof]
+    if missing:
+        count = len(found.get(missing[0], []))
+        raise DataError(f"{log}: found {count} {missing[0]} column(s) of the {n_dof} the robot needs among "
+                        f"{_shown(first)}; accepted: {ACCEPTED}" + _hold_hint(urdf, joints, count))
+    table.add("header", True)
+    time_notes, taken = (_time_entry(table, first, found["time"][0], [split(line) for line in lines[1:]])
+                         if "time" in found else _rate_entry(table, float(rate or 0.0)))
+    signal_notes, signals, assumed = _signal_entries(table, found, ("positions", "velocities", effort), urdf, n_dof)
+    notes = order_notes + group_notes + time_notes + signal_notes
+    left = [c for c in first if c not in taken + signals]
+    extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
+    if extra:
+        notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
+                     f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
+    elif left:
+        notes.append(f"left: {', '.join(left)}")
+    return notes + ([_assumed_units(assumed)] if assumed else [])
+
+
+def _signal_entries(table, found: dict, kinds: tuple[str, ...], urdf: Path, n_dof: int) -> tuple[list[str], list[str], list[str]]:
+    """Each signal found for every joint as its entry of ``table`` (columns, the unit their names say, the gear's side):
+    what was found, the columns taken, the signals whose units are assumed."""
+    notes: list[str] = []
+    taken: list[str] = []
+    assumed: list[str] = []
+    for kind in kinds:
+        if len(found.get(kind, [])) >= n_dof:
+            unit = _named_unit(found[kind][:n_dof])
+            assumed += [] if unit or _kind_and_unit(found[kind][0])[1] else [kind]
+            motor = bool(_qualifiers(found[kind][0]) & MOTOR_SIDE)
+            side = {"side": "motor"} if motor and kind == "torques" else {}
+            table.add(kind, _inline(columns=found[kind][:n_dof], **({"unit": unit} if unit else {}), **side))
+            notes.append(f"{kind}: " + ", ".join(found[kind][:n_dof]) + (f" (in {unit}, as their names say)" if unit else "")
+                         + _side_note(kind, motor))
+            taken += found[kind][:n_dof]
+            if kind == "torques" and not motor:  # a log cannot tell which side of the gear measured them: the arm may
+                notes += _torque_sensor(table, urdf)
+    return notes, taken, assumed
+
+
+def _headerless_table(table, notes: list[str], urdf: Path, log: Path, n_columns: int, *, n_dof: int,
+                      joints: tuple[str, ...]):
+    """A log without a header line: a layout told by its number of columns (an RTDE preset, or time then blocks of
+    ``n_dof`` columns per signal)."""
+    if n_columns == 31 and n_dof == 6:
         return _preset_table("ur-rtde", log), notes + [
             "31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" (its units: s, "
             "rad, rad/s, A)"]
-    elif n_columns == 19 and n_dof == 6 and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
+    if n_columns == 19 and n_dof == 6 and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
         return _preset_table("ur-rtde-19", log), notes + [
             "19 columns and a Universal Robots arm: its RTDE layout without targets (time, q, qd, motor currents): "
             "preset = \"ur-rtde-19\" (its units: s, rad, rad/s, A); if the last six are torques in N·m, give time, "
             "positions, velocities and torques in blocks of 6 columns instead"]
-    elif n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
+    if n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
         blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
         table.add("time", _inline(column=1))
         for b, kind in enumerate(blocks):
@@ -121,11 +140,10 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
         notes.append(_assumed_units(blocks, time=True))
         return table, notes
-    else:
-        fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
-        raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
-                        "signal (or name the columns in a header line: t, q1…, tau1…)"
-                        + _hold_hint(urdf, joints, fewer))
+    fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
+    raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
+                    "signal (or name the columns in a header line: t, q1…, tau1…)"
+                    + _hold_hint(urdf, joints, fewer))
 
 
 PATTERNS = {

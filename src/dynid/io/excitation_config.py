@@ -212,28 +212,7 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
         if val is not None:
             limits = replace(limits, **{f.name: _per_joint(val, k, f"{path}: limits.{f.name}", angle=f.name.startswith("q_"))})
 
-    ws = c.workspace
-    ws_kw: dict[str, Any] = {key: np.asarray(getattr(ws, key), dtype=float) for key in ("box_min", "box_max")
-                             if getattr(ws, key) is not None}
-    if ws.floor is not None:
-        ws_kw["floor"] = float(ws.floor)
-    if ws.clearance is not None:
-        ws_kw["clearance"] = float(ws.clearance)
-    if ws.avoid_self_collision is not None:
-        ws_kw["avoid_self_collision"] = bool(ws.avoid_self_collision)
-    try:
-        ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
-                                   np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
-                                   ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
-        srdf = None if ws.srdf is None else (path.parent / ws.srdf).resolve()
-        if srdf is not None and not ws.obstacles:
-            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where "
-                              "[[workspace.obstacles]] are given (without them the links are capsules)")
-        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
-                                            srdf) if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
-        workspace = Workspace(**ws_kw)
-    except ConfigError as exc:
-        raise ConfigError(f"{path}: {exc}") from None
+    workspace = _workspace(c.workspace, doc, path, robot)
 
     de = c.design
     starts = de.starts if de.starts is not None else 6
@@ -260,3 +239,29 @@ def load_excitation_config(path: str | Path) -> ExcitationConfig:
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
     return ExcitationConfig(path, full, problem, form, starts, seed, maxiter, initial, initial_label, rate, periods)
+
+
+def _workspace(ws, doc: dict, path: Path, robot) -> Workspace:
+    """The ``[workspace]`` table: its box, floor, clearance, obstacles and the links' geometry that keeps clear of them
+    (the robot file's collision shapes, the SRDF's pairs) or of each other."""
+    ws_kw: dict[str, Any] = {key: np.asarray(getattr(ws, key), dtype=float) for key in ("box_min", "box_max")
+                             if getattr(ws, key) is not None}
+    if ws.floor is not None:
+        ws_kw["floor"] = float(ws.floor)
+    if ws.clearance is not None:
+        ws_kw["clearance"] = float(ws.clearance)
+    if ws.avoid_self_collision is not None:
+        ws_kw["avoid_self_collision"] = bool(ws.avoid_self_collision)
+    try:
+        ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
+                                   np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
+                                   ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
+        srdf = None if ws.srdf is None else (path.parent / ws.srdf).resolve()
+        if srdf is not None and not ws.obstacles:
+            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where "
+                              "[[workspace.obstacles]] are given (without them the links are capsules)")
+        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
+                                            srdf) if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
+        return Workspace(**ws_kw)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None

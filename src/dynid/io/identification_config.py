@@ -333,16 +333,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     ConfigError
         As :func:`load_identification_config`.
     """
-    doc = with_inherited_layout(doc)
-    for (section, key), why in REMOVED.items():
-        if isinstance(doc.get(section), dict) and key in doc[section]:
-            raise ConfigError(f"{path}: {section}.{key}: {why} (dynid migrate {path} rewrites it)")
-    est = doc.get("estimation")
-    old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
-    if old and isinstance(est, dict):
-        raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
-                          f"estimators = {_estimators_from_old(est)} (dynid migrate {path} rewrites it)")
-    doc, moved = _moved_into_estimators(doc, path)
+    doc, moved = _current_document(doc, path)
     # the robot table is checked by the description's own parser (its drive terms are those registered now)
     typed = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, IdentificationDocument, str(path))
     here = path.parent
@@ -360,29 +351,61 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     given = typed.preprocessing
     table = PreprocessingTable(auto=True, coulomb_velocity="auto") if given == "auto" else given or PreprocessingTable()
     pre = _preprocessing(table, f"{path}: preprocessing", n, here)
-    e = typed.estimation or EstimationTable()
+    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
+                             robot.transmission.position_offset)
+    estimation = _estimation_settings(typed.estimation, pre, moved, path, controller is not None)
+    refs = doc.get("references", [])
+    _check_reference_names(refs, path)
+    gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
+    source, urdf, mjcf = _robot_files(doc, typed, path, root, robot)
+    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimation, drive_gains=gains,
+                                robot_source=source, urdf=urdf, controller=controller, torque_sensor=_torque_sensor(doc),
+                                mjcf_model=mjcf)
+
+
+def _current_document(doc: dict, path: Path) -> tuple[dict, dict]:
+    """A config's document as read today: the layout a validation table inherits filled in, a removed key refused
+    (saying what replaced it), the keys moved into the estimators list taken out
+    (:func:`_moved_into_estimators`: the hyper-parameters they set)."""
+    doc = with_inherited_layout(doc)
+    for (section, key), why in REMOVED.items():
+        if isinstance(doc.get(section), dict) and key in doc[section]:
+            raise ConfigError(f"{path}: {section}.{key}: {why} (dynid migrate {path} rewrites it)")
+    est = doc.get("estimation")
+    old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
+    if old and isinstance(est, dict):
+        raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
+                          f"estimators = {_estimators_from_old(est)} (dynid migrate {path} rewrites it)")
+    return _moved_into_estimators(doc, path)
+
+
+def _estimation_settings(e, pre, moved: dict, path: Path, controlled: bool) -> EstimationSettings:
+    """The ``[estimation]`` table as settings: the estimators (closed-loop ones only with a controller) and their
+    hyper-parameters, the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
+    the choice of the main estimate (``e`` None: the table left out)."""
+    e = e or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
     asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], moved, f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
-    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
-                             robot.transmission.position_offset)
-    if closed_loop and controller is None:
+    if closed_loop and not controlled:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
                           "controller: add a [controller] table (kp, kd, rate, the reference trajectory), or leave it out "
                           "(without the controller only the open-loop estimators can run)")
     if e.choice == "states" and "sdp" not in estimators:
         raise ConfigError(f"{path}: estimation.choice = \"states\" weighs the SDP's spread on the validation logs' "
                           "states: add sdp to estimation.estimators, or leave choice out")
-    refs = doc.get("references", [])
-    _check_reference_names(refs, path)
-    gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
+    return EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, hyperparameters, e.choice or "torques")
+
+
+def _robot_files(doc: dict, typed, path: Path, root: Path, robot):
+    """Where the robot's description comes from (results.json's ``robot_source``), its URDF and its MuJoCo model
+    (``mjcf_model``, else the description's own MJCF), as the config names them.
+
+    Returns ``(source, urdf, mjcf_model)``.
+    """
     urdf = config_urdf(doc, path, root)
-    estimation = EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, hyperparameters,
-                                    e.choice or "torques")
-    return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimation, drive_gains=gains,
-                                robot_source=robot_source(doc, path, root), urdf=urdf, controller=controller,
-                                torque_sensor=_torque_sensor(doc),
-                                mjcf_model=_mjcf_model(typed.mjcf_model, here, robot, urdf, path) or _robots_mjcf(doc, path, root, robot))
+    mjcf = _mjcf_model(typed.mjcf_model, path.parent, robot, urdf, path) or _robots_mjcf(doc, path, root, robot)
+    return robot_source(doc, path, root), urdf, mjcf
 
 
 def _moved_into_estimators(doc: dict, path: Path) -> tuple[dict, dict]:

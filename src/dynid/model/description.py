@@ -289,6 +289,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     urdf_model = None
+    upath: Any = None
     rows = d.joints
     held = _held(d.held, convention, source, d.xacro_args)
     if convention == "urdf":
@@ -304,21 +305,47 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         if bad:
             raise ConfigError(f"{w}: field(s) {bad} are drive terms the robot does not have (drive_terms = {list(terms)})")
     names = [r.name if r.name is not None else f"joint{i + 1}" for i, r in enumerate(rows)]
+    joints, inertial, (tool_r, tool_t), dh, urdf_lim, links = _chain(d, rows, where, names, convention=convention,
+                                                                     urdf=(upath, urdf_model), held=held, source=source)
+    terms, mask, drive, gains, transmission, stated = _drives(d, rows, where, terms, urdf=(upath, urdf_lim),
+                                                              source=source)
+    limits = _limits(rows, where, urdf_lim)
+    gravity = np.asarray(d.gravity, dtype=float)
+    if urdf_lim is not None and "gravity" in urdf_lim and "gravity" not in doc and not np.allclose(urdf_lim["gravity"], gravity):
+        stated += (f"{source}: {upath.name}'s <option gravity> is {_vector(urdf_lim['gravity'])} m/s², not taken: the robot's "
+                   f"gravity is {_vector(gravity)} (gravity = [x, y, z] in the [robot] table, or the description, sets it)",)
+    if d.payload is not None:
+        inertial = inertial.copy()
+        inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, *dh)
+    link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
+    problems = _nominal_problems(inertial, link_names, source)
+    return Robot(
+        name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
+        drive_gains=gains, limits=limits, tool_rotation=tool_r, tool_translation=tool_t,
+        notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
+        stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
+        prior_sigma=_prior_sigma(rows, terms), held=tuple(held), nominal_notes=stated)
 
+
+def _chain(d, rows, where: list[str], names: list[str], *, convention: str, urdf: tuple, held: dict, source: str):
+    """The joints, their nominal inertial parameters and the tool frame, from the URDF (with its joints' own values:
+    limits, friction, gravity) or from a DH table (its α, a, d, which a payload's frame needs).
+
+    Returns ``(joints, inertial, (tool_rotation, tool_translation), (alpha, a, d), urdf_values, link_names)``.
+    """
     tool_t = np.asarray(d.tool.translation, dtype=float)
     tool_r = np.eye(3)
-
     alpha = a = dd = None
     urdf_lim = None
     links: tuple[str, ...] = ()
     if convention == "urdf":
-        assert urdf_model is not None
-        joints, inertial, _, links = urdf_model
+        upath, (joints, inertial, _, links) = urdf
         from .urdf import urdf_joint_values
 
         urdf_lim = urdf_joint_values(upath, held)
-        if len(joints) != n:
-            raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {n} [[joints]] tables are given")
+        if len(joints) != len(rows):
+            raise ConfigError(f"{source}: {upath} has {len(joints)} revolute joints but {len(rows)} [[joints]] tables are "
+                              "given")
         inertial = _merged_inertials(rows, where, inertial, upath)
     else:
         alpha = [parse_angle(_or(r.alpha, 0.0), f"{w}.alpha") for r, w in zip(rows, where)]
@@ -332,31 +359,25 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
             tool_t = tool_t0 + tool_r0 @ tool_t
             tool_r = tool_r0
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
+    return joints, inertial, (tool_r, tool_t), (alpha, a, dd), urdf_lim, links
 
+
+def _drives(d, rows, where: list[str], terms: tuple[str, ...], *, urdf: tuple, source: str):
+    """Each joint's drive: its friction terms (and those the URDF states), drive gain, transmission with the encoders'
+    position offsets.
+
+    Returns ``(terms, mask, drive, gains, transmission, notes)``: the notes say the URDF's friction values taken.
+    """
+    upath, urdf_lim = urdf
     terms, mask, drive = _drive_terms(rows, where, terms, source)
     stated = () if urdf_lim is None else _urdf_friction(rows, terms, urdf_lim, upath, source)
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
-    transmission = _transmission(d.transmission, n, offsets, source)
+    transmission = _transmission(d.transmission, len(rows), offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
     if np.any(gains <= 0):
         i = int(np.argmax(gains <= 0))
         raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
-    lim = _limits(rows, where, urdf_lim)
-    gravity = np.asarray(d.gravity, dtype=float)
-    if urdf_lim is not None and "gravity" in urdf_lim and "gravity" not in doc and not np.allclose(urdf_lim["gravity"], gravity):
-        stated += (f"{source}: {upath.name}'s <option gravity> is {_vector(urdf_lim['gravity'])} m/s², not taken: the robot's "
-                   f"gravity is {_vector(gravity)} (gravity = [x, y, z] in the [robot] table, or the description, sets it)",)
-    if d.payload is not None:
-        inertial = inertial.copy()
-        inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, alpha, a, dd)
-    link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
-    problems = _nominal_problems(inertial, link_names, source)
-    return Robot(
-        name=str(name), joints=joints, gravity=gravity, inertial=inertial, drive_terms=terms, drive=drive,
-        drive_gains=gains, limits=Limits(**lim), tool_rotation=tool_r, tool_translation=tool_t,
-        notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
-        stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
-        prior_sigma=_prior_sigma(rows, terms), held=tuple(held), nominal_notes=stated)
+    return terms, mask, drive, gains, transmission, stated
 
 
 def _nominal_problems(inertial: np.ndarray, link_names, source: str) -> tuple[str, ...]:
@@ -489,7 +510,7 @@ def _urdf_friction(rows, terms: tuple, stated: dict, urdf: Path, source: str) ->
     return (f"{source}: {where} state {'; '.join(parts)}: {URDF_DYNAMICS_NOTE.format(keys=' and '.join(keys))}",)
 
 
-def _limits(rows, where, urdf_lim) -> dict:
+def _limits(rows, where, urdf_lim) -> Limits:
     """Each joint's limits: its table's, else the URDF's (``urdf_lim``), else none (±inf); checked."""
     inf = np.inf
     default = (lambda k, j, dflt: dflt) if urdf_lim is None else (lambda k, j, dflt: urdf_lim[k][j])  # noqa: E731
@@ -503,7 +524,7 @@ def _limits(rows, where, urdf_lim) -> dict:
         for k in ("dq_max", "ddq_max", "tau_max"):
             if not lim[k][i] > 0:
                 raise ConfigError(f"{where[i]}.{k}: expected a positive limit, got {lim[k][i]}")
-    return lim
+    return Limits(**lim)
 
 
 def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarray:

@@ -657,49 +657,22 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     config.validate(full)
     keys = parse_estimators(config.estimators)
     robot = full.submodel(config.joints) if config.joints < full.n_dof else full
-    k = config.joints
-    rng = np.random.default_rng(config.seed)
     base = base_parameters(robot, rng=np.random.default_rng([config.seed, 1]))
     warnings: list[str] = []
 
     truth, phi_true = _plant(config, robot, base)
-    t = sample_times(config.duration, config.rate)
-    noise = NoiseModel(config.current_noise, config.encoder_resolution)
-    traj_id, excitation_info = identification_trajectory(config, robot, base)
-    traj_val = paper_validation_trajectory(config.omega_f, k)
     t_sim = time.perf_counter()
     if progress is not None:
         progress("simulation and preprocessing", None, None)
-    ident, estimation = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes,
-                                         "identification (β1)", warnings, problem(config, robot, base), config.strategy,
-                                         estimators=keys)
-    assert estimation is not None  # fed: a problem was given
-    valid, _ = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)",
-                                warnings, strategy=config.strategy)
+    ident, valid, estimation, trajectories = _simulated_datasets(config, robot, base, keys, phi_true, warnings)
     timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
 
-    y = ident.tau.ravel()
-    bounds = paper_search_box(config, robot, base, ident.w_base, y)
-    outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
-    if outside and any(spec(m).needs_box for m in keys):  # only the box searches and LAD use it
-        warnings.append("truth outside the ABC search box for " + ", ".join(outside))
-    budget = SearchBudget(config.colony_size, config.limit, config.maxiter)
+    data, budget = _search_problem(config, robot, base, ident, estimation.problem, truth=truth, keys=keys, warnings=warnings)
+    bounds = data.bounds
     layout = consistency_layout(robot)
-    data = FitData(ident.w_base, y, k, bounds, base, None, estimation.problem.layout, estimation.problem.prior, config.weights)
 
-    result = PaperRunResult(config, robot, base, truth, bounds, ident, valid,
-                            {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(),
-                             "excitation": excitation_info},
-                            warnings=warnings)
-    def bootstrap(key):  # independent of the fit: it refits on resamples, so it runs in the same pool
-        if progress is not None:
-            progress(f"bootstrap of {spec(key).label}", None, None)
-        t_b = time.perf_counter()
-        bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), ident.w_base, y, k, problem=data,
-                                 n_resamples=config.bootstrap, rng=np.random.default_rng([config.seed, 5, seed_index(key)]))
-        return bs, time.perf_counter() - t_b
-
-    boots = {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in keys if spec(key).bootstrapped and config.bootstrap}
+    result = PaperRunResult(config, robot, base, truth, bounds, ident, valid, trajectories, warnings=warnings)
+    boots = _bootstrap_tasks(config, keys, data, budget, progress)
     fits: dict[str, Any] = estimation.fit(bounds, {m: np.random.default_rng([config.seed, 2, seed_index(m)]) for m in keys},
                                           budget=budget, progress=progress, extra=boots)
     for key in keys:
@@ -710,12 +683,67 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
             boot = {"resamples": config.bootstrap, "block_length": bs.block_length, "level": bs.level,
                     "lower": bs.lower, "upper": bs.upper, "std": bs.std}
         result.estimates[key] = _paper_estimate(fits[key], ident, valid, config, base, layout, boot)
-    result.truth_consistency_margin = consistency_margin(base.regrouping, truth, *layout)
-    result.truth_consistency = consistency_verdict(result.truth_consistency_margin, base.regrouping, truth, base.names,
-                                                   layout[1])
+    result.truth_consistency_margin, result.truth_consistency = _truth_verdict(base, truth, layout)
     timings["total"] = time.perf_counter() - t0
     result.timings = timings
     return result
+
+
+def _search_problem(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, ident: Dataset, fed: FitData, *,
+                    truth: np.ndarray, keys: tuple[str, ...], warnings: list[str]) -> tuple[FitData, SearchBudget]:
+    """The identification rows with the run's search box (:func:`paper_search_box`; a warning where the truth lies
+    outside it and a box search runs) and the box searches' budget."""
+    y = ident.tau.ravel()
+    bounds = paper_search_box(config, robot, base, ident.w_base, y)
+    outside = [n for n, v, (lo, hi) in zip(base.names, truth, bounds) if not lo <= v <= hi]
+    if outside and any(spec(m).needs_box for m in keys):  # only the box searches and LAD use it
+        warnings.append("truth outside the ABC search box for " + ", ".join(outside))
+    data = FitData(ident.w_base, y, config.joints, bounds, base, None, fed.layout, fed.prior, config.weights)
+    return data, SearchBudget(config.colony_size, config.limit, config.maxiter)
+
+
+def _simulated_datasets(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, keys: tuple[str, ...],
+                        phi_true: np.ndarray, warnings: list[str]):
+    """The identification (β1) and validation (β2) recordings simulated with one generator and prepared, the
+    estimators fed the first's rows; the trajectories as results.json holds them.
+
+    Returns ``(identification, validation, estimation, trajectories)``.
+    """
+    rng = np.random.default_rng(config.seed)
+    t = sample_times(config.duration, config.rate)
+    noise = NoiseModel(config.current_noise, config.encoder_resolution)
+    traj_id, excitation_info = identification_trajectory(config, robot, base)
+    traj_val = paper_validation_trajectory(config.omega_f, config.joints)
+    ident, estimation = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes,
+                                         "identification (β1)", warnings, problem(config, robot, base), config.strategy,
+                                         estimators=keys)
+    assert estimation is not None  # fed: a problem was given
+    valid, _ = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)",
+                                warnings, strategy=config.strategy)
+    trajectories = {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(), "excitation": excitation_info}
+    return ident, valid, estimation, trajectories
+
+
+def _bootstrap_tasks(config: PaperExperimentConfig, keys: tuple[str, ...], data: FitData, budget: SearchBudget,
+                     progress) -> dict:
+    """The bootstrap of each bootstrapped estimator as a task of the estimators' pool (independent of the fit: it refits
+    on resamples of ``data``'s rows), each seeded by ``(seed, 5, its registry index)``."""
+    def bootstrap(key):
+        if progress is not None:
+            progress(f"bootstrap of {spec(key).label}", None, None)
+        t_b = time.perf_counter()
+        bs = bootstrap_intervals(lambda: make_estimator(key, data, budget, None), data.w_base, data.tau, config.joints,
+                                 problem=data, n_resamples=config.bootstrap,
+                                 rng=np.random.default_rng([config.seed, 5, seed_index(key)]))
+        return bs, time.perf_counter() - t_b
+
+    return {f"{key}_bootstrap": (lambda key=key: bootstrap(key)) for key in keys if spec(key).bootstrapped and config.bootstrap}
+
+
+def _truth_verdict(base: BaseParameters, truth: np.ndarray, layout) -> tuple[float, str]:
+    """The true parameters' physical-consistency margin and its verdict in words (the paper's Table 2 is not consistent)."""
+    margin = consistency_margin(base.regrouping, truth, *layout)
+    return margin, consistency_verdict(margin, base.regrouping, truth, base.names, layout[1])
 
 
 def _plant(config: PaperExperimentConfig, robot: Robot, base: BaseParameters) -> tuple[np.ndarray, np.ndarray]:
