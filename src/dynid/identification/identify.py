@@ -25,7 +25,7 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
-from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, seed_index, spec
+from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, spec
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.export import READINESS_KINDS
@@ -318,41 +318,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         Too few rows or a rank-deficient base observation matrix (the log does not excite every base parameter).
     """
     keys, hyperparameters = estimator_choices(estimators)
-    sdp = "sdp" in keys
-    problem, prior_notes, not_carried = _estimation_problem(robot, base, keys, hyperparameters)
-    ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
-    scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
-    estimation, scoring = _one_pass(robot, base, data, keys, problem, keep_rows=scored,
-                                    held_out=(held_out or jackknife) and sdp, observers=observers, progress=progress)
-    sums, folds = scoring.sums, scoring.folds
-    reference, estimates, box, row_weights = _estimates(estimation, robot, base, data, ls_key, rng=rng, progress=progress)
-    sol, joint_std = reference.solution_, reference.joint_std_
-    warnings = _identification_warnings(robot, data, reference, prior_notes=prior_notes, not_carried=not_carried,
-                                        notes=[e.note for e in estimates.values() if e.note], references=references)
-    sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
-    objective, margins, verdicts = _scores(estimation if scored else None, robot, base, sets, progress)
-    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
-    alternative = None if scoring.nominal is None else _drive_only_alternative(
-        robot, base, data, reference, sets, fit=fit, sums=sums, joint_weights=row_weights, variants=variants)
-    findings, stats = _model_findings(robot, base, reference, estimates, data.name, scoring=scoring, fit=fit, rng=rng,
-                                      joint_weights=row_weights, consistent=sdp)
-    ls_label = estimate_label(ls_key)
-    inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
-    refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
-                                jackknife=jackknife, progress=progress)
-    return choose_main_estimate(IdentificationResult(
-        robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
-        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
-                                                                  **_given_hyperparameters(hyperparameters)},
-        warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
-        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
-        sdp_refits=refits))
-
-
-def _estimation_problem(robot: Robot, base: BaseParameters, keys: tuple[str, ...],
-                        hyperparameters: dict) -> tuple[FitData, tuple[str, ...], tuple[str, ...]]:
-    """What every estimator knows before any row (the layout where one is consistent or standard, the description's
-    prior and σ), the prior's notes (said where the SDP pulls toward it) and the σ least squares cannot use."""
+    n = robot.n_dof
     sdp = "sdp" in keys
     prior = None
     prior_notes: tuple[str, ...] = ()
@@ -364,112 +330,72 @@ def _estimation_problem(robot: Robot, base: BaseParameters, keys: tuple[str, ...
                 raise
         prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
     base_std, not_carried = base.base_std(robot.prior_sigmas()) if robot.prior_sigma else (None, ())
-    layout = consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None
-    problem = FitData(None, None, robot.n_dof, None, base, layout=layout, prior=prior, hyperparameters=hyperparameters,
+    problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
+                      prior=prior, hyperparameters=hyperparameters,
                       base_prior=base.base_from_standard(robot.standard_parameters()),
                       prior_std=robot.prior_sigmas() if robot.prior_sigma else None, base_prior_std=base_std)
-    return problem, prior_notes, not_carried
-
-
-def _one_pass(robot: Robot, base: BaseParameters, data: PreparedData, keys: tuple[str, ...], problem: FitData, *,
-              keep_rows: bool, held_out: bool, observers: tuple, progress) -> tuple[Estimation, BlockScoring]:
-    """The log's base rows in one pass: fed to the estimators ``keys`` and to the fit's metrics, the verdict's
-    statistics and the held-out blocks (:class:`BlockScoring`)."""
-    estimation = Estimation(keys, problem, base.names, keep_rows=keep_rows)
-    scoring = BlockScoring(robot, base, data, held_out=held_out, observers=observers)
+    ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
+    scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
+    estimation = Estimation(keys, problem, base.names, keep_rows=scored)
+    scoring = BlockScoring(robot, base, data, held_out=(held_out or jackknife) and sdp, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
     stream_rows(chunks, estimation, base, scoring.add, standard=standard)
-    return estimation, scoring
-
-
-def _estimates(estimation: Estimation, robot: Robot, base: BaseParameters, data: PreparedData, ls_key: str, *, rng: int,
-               progress) -> tuple[Any, dict, np.ndarray | None, np.ndarray | None]:
-    """The least-squares reference solved, then every estimate (the reference's too where not listed), the box the
-    searches had and the WLS row weights (None for OLS)."""
-    reference = _solved_reference(estimation, data)
-    joint_std = reference.joint_std_
-    row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
-    fitted, box = _fitted(estimation, robot, base, reference.solution_, rng=rng, joint_weights=row_weights, progress=progress)
-    estimates = {}
-    for key in (*estimation.keys, *(() if ls_key in estimation.keys else (ls_key,))):
-        estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
-    return reference, estimates, box, row_weights
-
-
-def _drive_only_alternative(robot: Robot, base: BaseParameters, data: PreparedData, reference, sets: dict, *, fit, sums,
-                            joint_weights, variants):
-    """The drive-only estimate (:func:`dynid.identification.drive_only.drive_only`) with its fit beside every set's, or
-    None where it does not apply."""
-    found = drive_only(robot, base, reference.accumulator_, joint_weights=joint_weights, variants=variants,
-                       one_way=one_way_joints(data))
-    return None if found is None else replace(found, fit=replace(
-        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=fit.noise, speed=fit.speed))
-
-
-def _model_findings(robot: Robot, base: BaseParameters, reference, estimates: dict, name: str, *, scoring: BlockScoring,
-                    fit, rng: int, joint_weights, consistent: bool) -> tuple[list, dict]:
-    """The verdict's findings and statistics (:func:`_verdict`), then what the log says of the joints' order and
-    directions: a swapped pair, and (once the log reads right) a flipped joint seen by the SDP."""
-    sol = reference.solution_
-    findings, stats = _verdict(robot, base, sol, reference.ols_params_, joint_weights, scoring=scoring, fit=fit, rng=rng,
-                               consistent=consistent)
-    if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
-        findings += scoring.order.findings(fit.varies(beyond="floor"), name)
-    if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
-        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, name)
-    return findings, stats
-
-
-def _solved_reference(estimation: Estimation, data: PreparedData):
-    """The least-squares reference solved, or the log's name and the joints that barely move in its error."""
+    sums, folds = scoring.sums, scoring.folds
     try:
-        return estimation.solve_reference()
+        reference = estimation.solve_reference()
     except IdentifiabilityError as exc:
         speed = root_mean_square(data.dq)
         still = [f"J{j + 1}" for j in np.flatnonzero(speed < 1e-3 * max(speed.max(), 1e-12))]
         hint = f"; joint(s) {', '.join(still)} barely move" if still else ""
         raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None
-
-
-def _fitted(estimation: Estimation, robot: Robot, base: BaseParameters, sol, *, rng: int, joint_weights, progress):
-    """Every estimator fitted beside the solved reference: the SDP's prior anchored where least squares split a Coulomb +
-    offset term, the box searches in :func:`search_box`, each estimator seeded by ``(rng, its registry index)``."""
+    sol, ols_params, joint_std = reference.solution_, reference.ols_params_, reference.joint_std_
     if sol.anchored and "sdp" in estimation.streamed:  # the SDP splits Coulomb + offset as least squares did
-        estimation.problem = replace(estimation.problem, prior=_anchored_prior(estimation.problem.prior, robot, base, sol))
-    keys = estimation.keys
-    box = search_box(sol.params, sol.params_std) if any(spec(k).needs_box for k in keys) else None
-    rngs = {k: np.random.default_rng([int(rng), seed_index(k)]) for k in keys}  # (seed, estimator): whatever else is asked for
+        estimation.problem = replace(problem, prior=_anchored_prior(problem.prior, robot, base, sol))
+    row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
+    box = search_box(sol.params, sol.params_std) if estimation.needs_box else None
     report = None if progress is None else (lambda key, i, f: progress(f"estimators: {estimator_label(key)}", 0 if i is None else i, 0))
-    return estimation.fit(box, rngs, joint_weights=joint_weights, progress=report), box
-
-
-def _identification_warnings(robot: Robot, data: PreparedData, reference, *, prior_notes, notes, not_carried,
-                             references) -> list[str]:
-    """The result's warnings: the description's, its prior's, the log's, the estimates' ``notes``, the σ least squares
-    cannot use, the rows left out below the minimum speed, the reference sets'."""
-    warnings = [*robot.nominal_problems, *robot.nominal_notes, *prior_notes, *data.warnings, *notes,
-                *_not_carried_note(not_carried)]
-    n_rows = robot.n_dof * len(range(0, data.t.shape[0], data.settings.decimation or 1))
-    dropped = 1.0 - reference.accumulator_.rows.sum() / n_rows
+    fitted = estimation.fit(box, seed=(int(rng),), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
+    estimates = {}
+    for key in (*keys, *(() if ls_key in keys else (ls_key,))):
+        estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
+    warnings = list(robot.nominal_problems) + list(robot.nominal_notes) + list(prior_notes) + list(data.warnings) + \
+        [e.note for e in estimates.values() if e.note] + _not_carried_note(not_carried)
+    dropped = 1.0 - reference.accumulator_.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation or 1)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
     for r in references:
         warnings.extend(r.warnings)
-    return warnings
-
-
-def _scores(estimation: Estimation | None, robot: Robot, base: BaseParameters, sets: dict, progress) -> tuple[dict, dict, dict]:
-    """Eq. 9's F of every set on the kept rows (none without ``estimation``) and every set's consistency margin and
-    verdict (:func:`dynid.identification.estimates.consistency_checks`)."""
+    sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
     objective = {}
-    if estimation is not None:
+    if scored:
         w_all, tau_all = estimation.rows()
-        objective = {label: float(paper_objective(tau_all - w_all @ beta, robot.n_dof)) for label, beta in sets.items()}
+        objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
     if progress is not None:
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
-    return objective, margins, verdicts
+    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
+    found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, joint_weights=row_weights,
+                                                            variants=variants, one_way=one_way_joints(data))
+    alternative = None if found is None else replace(found, fit=replace(
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
+    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng,
+                               consistent="sdp" in keys)
+    if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
+        findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
+    if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
+        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
+    ls_label = estimate_label(ls_key)
+    inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
+    refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
+                                jackknife=jackknife, progress=progress)
+    return choose_main_estimate(IdentificationResult(
+        robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
+        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
+                                                                  **_given_hyperparameters(hyperparameters)},
+        warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
+        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
+        sdp_refits=refits))
 
 
 def _not_carried_note(names: tuple[str, ...]) -> list[str]:

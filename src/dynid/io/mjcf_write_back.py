@@ -135,27 +135,11 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         body = bodies.get(name)
         if body is None:
             raise ConfigError(f"{path}: the body of joint {joint.name!r} has no name: name it to write into it")
-        body_r = data.xmat[body_id].reshape(3, 3)
-        frame_r, frame_p = r @ rotations[k], r @ origins[k] + t  # the robot's joint frame in MuJoCo's world
-        alone = fitted.inertial[k] - own[k]  # the held bodies keep their own inertials (a gripper's fingers)
-        if np.any(own[k] != 0) and not is_physically_consistent(alone):
-            alone = nearest_consistent(alone)
-            moved.append(f"{name}: its identified values less the held bodies' own are not physically consistent; the "
-                         "nearest consistent ones are written (the held bodies keep the file's)")
-        in_body = transform_inertial(alone, body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
-        mass, com, inertia = physical_from_inertial(in_body)
-        inertia = mujoco_inertia(inertia)
+        frame = (r @ rotations[k], r @ origins[k] + t)  # the robot's joint frame in MuJoCo's world
+        mass, com, notes = _write_inertial(model, data, (body_id, body), bodies, fitted.inertial[k] - own[k], frame=frame,
+                                           moving=moving, held=bool(np.any(own[k] != 0)))
+        moved += notes
         nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
-        _replace(body, "inertial", ET.Element("inertial", pos=_vec(com), mass=f"{mass:.17g}", fullinertia=" ".join(
-            f"{v:.17g}" for v in (inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]))))
-        welded = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}" for b in range(model.nbody)
-                  if b not in moving and _carried_by(model, b, body_id, moving)]
-        for other in welded:
-            if other in bodies:
-                _replace(bodies[other], "inertial", ET.Element("inertial", pos="0 0 0", mass="0", diaginertia="0 0 0"))
-        if welded:
-            body.insert(0, ET.Comment(f" dynid: {', '.join(welded)} (welded to this body) identified with it: their "
-                                      "mass is written here "))
         terms = dict(zip(robot.drive_terms, fitted.drive[k]))
         element = elements[joint.name]
         element.set("armature", f"{terms.get('Ia', 0.0):.17g}")
@@ -182,6 +166,41 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     if root[0].tail is None or not root[0].tail.strip():
         root[0].tail = "\n  "
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", moved
+
+
+def _write_inertial(model, data, body: tuple, bodies: dict, alone: np.ndarray, *, frame: tuple, moving: set, held: bool):
+    """One moving body's ``<inertial>`` replaced by a link's identified values (``alone``: less what the held bodies keep
+    of their own, made consistent where that leaves them not), expressed in the body's frame from the robot's joint
+    frame ``(rotation, origin)`` in MuJoCo's world; the bodies welded to it made massless, with a comment.
+
+    Returns ``(mass, com, notes)``: the written mass and centre of mass, and a note where the values were made
+    consistent.
+    """
+    import mujoco
+
+    body_id, element = body
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body_id)
+    notes = []
+    if held and not is_physically_consistent(alone):
+        alone = nearest_consistent(alone)
+        notes.append(f"{name}: its identified values less the held bodies' own are not physically consistent; the "
+                     "nearest consistent ones are written (the held bodies keep the file's)")
+    body_r = data.xmat[body_id].reshape(3, 3)
+    frame_r, frame_p = frame
+    in_body = transform_inertial(alone, body_r.T @ frame_r, body_r.T @ (frame_p - data.xpos[body_id]))
+    mass, com, inertia = physical_from_inertial(in_body)
+    inertia = mujoco_inertia(inertia)
+    _replace(element, "inertial", ET.Element("inertial", pos=_vec(com), mass=f"{mass:.17g}", fullinertia=" ".join(
+        f"{v:.17g}" for v in (inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]))))
+    welded = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}" for b in range(model.nbody)
+              if b not in moving and _carried_by(model, b, body_id, moving)]
+    for other in welded:
+        if other in bodies:
+            _replace(bodies[other], "inertial", ET.Element("inertial", pos="0 0 0", mass="0", diaginertia="0 0 0"))
+    if welded:
+        element.insert(0, ET.Comment(f" dynid: {', '.join(welded)} (welded to this body) identified with it: their "
+                                     "mass is written here "))
+    return mass, com, notes
 
 
 def read_users_mjcf(path: Path, robot: Robot):

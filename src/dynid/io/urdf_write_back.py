@@ -241,6 +241,15 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
         far = moved_far(link_name, mass, com, m0, c0, "URDF")
         moved.extend([far] if far else [])
+    head = _header_comments(path, robot, fitted, estimate, moved)
+    inner = text.indent_in(root)
+    text.insert(root.open_end, "".join(f"\n{inner}{h}" for h in head))
+    return text.result(), moved
+
+
+def _header_comments(path: Path, robot: Robot, fitted, estimate: str, moved: list[str]) -> list[str]:
+    """The comments written at the top of the robot element: what was identified and where it moved far, then what a URDF
+    cannot hold (the mounting's gravity, the encoders' position offsets, coupled motors' terms)."""
     head = [_comment(identified_header(path.name, "the <inertial> of every moving link and the <dynamics> of every "
                                        "moving joint", estimate, moved, "URDF"))]
     if _world_from_base(robot.gravity) is not None:  # the config's mounting, which a URDF cannot hold
@@ -254,9 +263,7 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
         names = robot.transmission.coupled_parameter_names
         head.append(_comment(" dynid: coupled motors (not representable in URDF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(names, fitted.transmission.coupled_values.ravel())) + " "))
-    inner = text.indent_in(root)
-    text.insert(root.open_end, "".join(f"\n{inner}{h}" for h in head))
-    return text.result(), moved
+    return head
 
 
 class _TextEdits:

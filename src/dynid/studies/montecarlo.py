@@ -30,7 +30,7 @@ from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import observation_matrix
 from ..estimators import registry
-from ..estimators.registry import SearchBudget, label, parse_estimators, seed_index
+from ..estimators.registry import SearchBudget, label, parse_estimators
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import FourierTrajectory, sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
@@ -216,9 +216,9 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     seconds = np.zeros(len(keys))
     errors = {}
     for i, key in enumerate(keys):
-        generator = np.random.default_rng([cfg.seed, 11, level_index, realisation, seed_index(key)])
         try:
-            fit = estimation.fit(bounds, {key: generator}, budget=budget, keys=(key,), workers=1)[key]
+            fit = estimation.fit(bounds, seed=(cfg.seed, 11, level_index, realisation), budget=budget, keys=(key,),
+                                 workers=1)[key]
         except DynIdError as exc:
             errors[key] = str(exc)
             continue
