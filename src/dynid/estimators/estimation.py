@@ -157,7 +157,7 @@ class Estimation:
         """
         return any(spec(k).needs_box for k in self.keys)
 
-    def fit(self, box: np.ndarray | None = None, rngs: dict | None = None, *, seed: tuple[int, ...] | None = None,
+    def fit(self, box: np.ndarray | None = None, rngs: dict | None = None, *, rng: int | tuple[int, ...] | None = None,
             budget: SearchBudget = SearchBudget(), joint_weights: np.ndarray | None = None, progress=None,
             keys: Iterable[str] | None = None, workers: int | None = None, extra: dict | None = None) -> dict[str, Fitted]:
         """Fit the estimators side by side (:func:`dynid.estimators.fitting.fit_methods`).
@@ -168,9 +168,9 @@ class Estimation:
             Search box of the estimators that need one.
         rngs : dict, optional
             key -> generator of that estimator.
-        seed : tuple of int, optional
-            Without ``rngs``: each estimator's generator is ``numpy.random.default_rng([*seed, its registry index])``
-            (:func:`dynid.estimators.registry.seed_index`), whichever others are fitted beside it.
+        rng : int or tuple of int, optional
+            A seed, without ``rngs``: each estimator's generator is ``numpy.random.default_rng([*rng, its registry
+            index])`` (:func:`dynid.estimators.registry.seed_index`), whichever others are fitted beside it.
         budget : SearchBudget
         joint_weights : (n_dof,) array, optional
             Row weights of the estimators that take them (``sdp``: the reference's WLS weights).
@@ -200,7 +200,8 @@ class Estimation:
         data = replace(self.problem, w_base=w, tau=tau, bounds=box, w_standard=ws,
                        joint_weights=self.problem.joint_weights if joint_weights is None else joint_weights)
         chosen = self.keys if keys is None else tuple(keys)
-        if rngs is None and seed is not None:
+        if rngs is None and rng is not None:
+            seed = (int(rng),) if np.ndim(rng) == 0 else tuple(int(x) for x in rng)
             rngs = {key: np.random.default_rng([*seed, seed_index(key)]) for key in chosen}
         for key in chosen:
             if spec(key).needs_box and box is None:

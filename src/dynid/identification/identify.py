@@ -355,7 +355,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
     box = search_box(sol.params, sol.params_std) if estimation.needs_box else None
     report = None if progress is None else (lambda key, i, f: progress(f"estimators: {estimator_label(key)}", 0 if i is None else i, 0))
-    fitted = estimation.fit(box, seed=(int(rng),), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
+    fitted = estimation.fit(box, rng=int(rng), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
     estimates = {}
     for key in (*keys, *(() if ls_key in keys else (ls_key,))):
         estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)

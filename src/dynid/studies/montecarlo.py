@@ -217,7 +217,7 @@ def simulate_realisation(setup: _Setup, level_index: int, realisation: int) -> d
     errors = {}
     for i, key in enumerate(keys):
         try:
-            fit = estimation.fit(bounds, seed=(cfg.seed, 11, level_index, realisation), budget=budget, keys=(key,),
+            fit = estimation.fit(bounds, rng=(cfg.seed, 11, level_index, realisation), budget=budget, keys=(key,),
                                  workers=1)[key]
         except DynIdError as exc:
             errors[key] = str(exc)

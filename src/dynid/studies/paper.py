@@ -673,7 +673,7 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
 
     result = PaperRunResult(config, robot, base, truth, bounds, ident, valid, trajectories, warnings=warnings)
     boots = _bootstrap_tasks(config, keys, data, budget, progress)
-    fits: dict[str, Any] = estimation.fit(bounds, seed=(config.seed, 2), budget=budget, progress=progress, extra=boots)
+    fits: dict[str, Any] = estimation.fit(bounds, rng=(config.seed, 2), budget=budget, progress=progress, extra=boots)
     for key in keys:
         timings[key] = fits[key].seconds
         boot = None
