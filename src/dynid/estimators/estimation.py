@@ -201,7 +201,7 @@ class Estimation:
                        joint_weights=self.problem.joint_weights if joint_weights is None else joint_weights)
         chosen = self.keys if keys is None else tuple(keys)
         if rngs is None and rng is not None:
-            seed = (int(rng),) if np.ndim(rng) == 0 else tuple(int(x) for x in rng)
+            seed = tuple(int(x) for x in np.atleast_1d(rng))
             rngs = {key: np.random.default_rng([*seed, seed_index(key)]) for key in chosen}
         for key in chosen:
             if spec(key).needs_box and box is None:
