@@ -120,3 +120,31 @@ def test_what_the_data_chose_is_a_value_of_the_result_and_the_description_stays_
     for key, value in choices.to_dict().items():
         _same(_plain(result.settings[key]), _plain(value), key)
     assert result.settings["coulomb_velocity"] == list(expected)
+
+
+def test_the_estimators_the_pipeline_feeds_unfitted_hold_the_rows_its_estimate_fits(slow_quiet_log):
+    """``IdentificationPipeline.estimation`` (what dynid run and montecarlo fit in their own box) feeds the prepared log's
+    rows: least squares on them is numpy's on the kept rows, and it is the OLS estimate ``estimate`` gives; a seed
+    given as ``rng`` draws each estimator's generator from (seed..., its registry index), as a dict of generators does."""
+    from dynid.estimators.registry import FitData, SearchBudget, estimate_label, seed_index
+    from dynid.identification.identify import search_box
+    from dynid.preprocessing.settings import Preprocessing
+
+    config = slow_quiet_log
+    recording = load_recording(config.identification, config.robot)
+    pipeline = IdentificationPipeline(config.robot, Preprocessing(auto=False), estimators=("ols", "abc"))
+    prepared = pipeline.prepare(recording)
+    fed = pipeline.estimation(prepared, FitData(n_dof=config.robot.n_dof, base=prepared.base), keep_rows=True)
+    w, tau = fed.rows()
+    sol = fed.solve_reference().solution_
+    np.testing.assert_allclose(sol.params, np.linalg.lstsq(w, tau, rcond=None)[0], rtol=1e-7,
+                               atol=1e-9 * np.abs(sol.params).max())
+    ols = pipeline.estimate(prepared).estimates[estimate_label("ols")].params
+    np.testing.assert_allclose(ols, sol.params, rtol=1e-10, atol=1e-12 * np.abs(sol.params).max())
+
+    box, budget = search_box(sol.params, sol.params_std), SearchBudget(8, 5, 3)
+    by_seed = fed.fit(box, rng=(7, 2), budget=budget, keys=("abc",), workers=1)["abc"].params
+    given = {"abc": np.random.default_rng([7, 2, seed_index("abc")])}
+    np.testing.assert_array_equal(by_seed, fed.fit(box, given, budget=budget, keys=("abc",), workers=1)["abc"].params)
+    other = fed.fit(box, rng=(8, 2), budget=budget, keys=("abc",), workers=1)["abc"].params
+    assert not np.array_equal(by_seed, other)
