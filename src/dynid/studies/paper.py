@@ -661,11 +661,9 @@ def run_paper_experiment(config: PaperExperimentConfig = PaperExperimentConfig()
     warnings: list[str] = []
 
     truth, phi_true = _plant(config, robot, base)
-    t_sim = time.perf_counter()
-    if progress is not None:
-        progress("simulation and preprocessing", None, None)
-    ident, valid, estimation, trajectories = _simulated_datasets(config, robot, base, keys, phi_true, warnings)
-    timings = {"simulation_and_preprocessing": time.perf_counter() - t_sim}
+    ident, valid, estimation, trajectories, seconds = _simulated_datasets(config, robot, base, keys, phi_true, warnings,
+                                                                          progress)
+    timings = {"simulation_and_preprocessing": seconds}
 
     data, budget = _search_problem(config, robot, base, ident, estimation.problem, truth=truth, keys=keys, warnings=warnings)
     bounds = data.bounds
@@ -702,25 +700,30 @@ def _search_problem(config: PaperExperimentConfig, robot: Robot, base: BaseParam
 
 
 def _simulated_datasets(config: PaperExperimentConfig, robot: Robot, base: BaseParameters, keys: tuple[str, ...],
-                        phi_true: np.ndarray, warnings: list[str]):
+                        phi_true: np.ndarray, warnings: list[str], progress):
     """The identification (β1) and validation (β2) recordings simulated with one generator and prepared, the
     estimators fed the first's rows; the trajectories as results.json holds them.
 
-    Returns ``(identification, validation, estimation, trajectories)``.
+    Returns ``(identification, validation, estimation, trajectories, seconds)``: the seconds of the simulation and
+    preprocessing (an excitation designed for the run not counted).
     """
     rng = np.random.default_rng(config.seed)
     t = sample_times(config.duration, config.rate)
     noise = NoiseModel(config.current_noise, config.encoder_resolution)
     traj_id, excitation_info = identification_trajectory(config, robot, base)
     traj_val = paper_validation_trajectory(config.omega_f, config.joints)
+    t_sim = time.perf_counter()
+    if progress is not None:
+        progress("simulation and preprocessing", None, None)
     ident, estimation = simulate_dataset(robot, base, traj_id, t, noise, rng, phi_true, config.smoothing_passes,
                                          "identification (β1)", warnings, problem(config, robot, base), config.strategy,
                                          estimators=keys)
     assert estimation is not None  # fed: a problem was given
     valid, _ = simulate_dataset(robot, base, traj_val, t, noise, rng, phi_true, config.smoothing_passes, "validation (β2)",
                                 warnings, strategy=config.strategy)
+    seconds = time.perf_counter() - t_sim
     trajectories = {"identification": traj_id.to_dict(), "validation": traj_val.to_dict(), "excitation": excitation_info}
-    return ident, valid, estimation, trajectories
+    return ident, valid, estimation, trajectories, seconds
 
 
 def _bootstrap_tasks(config: PaperExperimentConfig, keys: tuple[str, ...], data: FitData, budget: SearchBudget,
