@@ -59,18 +59,19 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
     if delimiter != ",":
         table.add("delimiter", delimiter)
     if header:
-        return table, notes + _header_entries(table, urdf, log, lines, delimiter, n_dof=n_dof, joints=joints, rate=rate,
-                                              rate_hint=rate_hint)
+        return table, notes + _header_entries(table, urdf, log, (first, lines), delimiter, n_dof=n_dof, joints=joints,
+                                              rate=rate, rate_hint=rate_hint)
     return _headerless_table(table, notes, urdf, log, len(first), n_dof=n_dof, joints=joints)
 
 
-def _header_entries(table, urdf: Path, log: Path, lines: list[str], delimiter: str, *, n_dof: int, joints: tuple[str, ...],
+def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *, n_dof: int, joints: tuple[str, ...],
                     rate: float | None, rate_hint: str) -> list[str]:
-    """A log with a header line: its columns found and checked, their entries added to ``table``, what was found."""
+    """A log with a header line (``read``: its header's fields and its first lines): its columns found and checked,
+    their entries added to ``table``, what was found."""
     def split(line: str) -> list[str]:
         return _fields(line, delimiter)
 
-    first = split(lines[0])
+    first, lines = read
     found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
     group_notes, passed = _one_group_each(found, log, delimiter, n_dof)
     _check_one_signal(log, first, found, n_dof)

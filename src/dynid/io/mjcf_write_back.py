@@ -136,8 +136,8 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         if body is None:
             raise ConfigError(f"{path}: the body of joint {joint.name!r} has no name: name it to write into it")
         frame = (r @ rotations[k], r @ origins[k] + t)  # the robot's joint frame in MuJoCo's world
-        mass, com, notes = _write_inertial(model, data, (body_id, body), bodies, fitted.inertial[k] - own[k], frame=frame,
-                                           moving=moving, held=bool(np.any(own[k] != 0)))
+        mass, com, notes = _write_inertial(model, data, (body_id, name, body), bodies, fitted.inertial[k] - own[k],
+                                           frame=frame, moving=moving, held=bool(np.any(own[k] != 0)))
         moved += notes
         nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
         terms = dict(zip(robot.drive_terms, fitted.drive[k]))
@@ -169,7 +169,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
 
 
 def _write_inertial(model, data, body: tuple, bodies: dict, alone: np.ndarray, *, frame: tuple, moving: set, held: bool):
-    """One moving body's ``<inertial>`` replaced by a link's identified values (``alone``: less what the held bodies keep
+    """One moving body's (``(id, name, element)``) ``<inertial>`` replaced by a link's identified values (``alone``: less what the held bodies keep
     of their own, made consistent where that leaves them not), expressed in the body's frame from the robot's joint
     frame ``(rotation, origin)`` in MuJoCo's world; the bodies welded to it made massless, with a comment.
 
@@ -178,8 +178,7 @@ def _write_inertial(model, data, body: tuple, bodies: dict, alone: np.ndarray, *
     """
     import mujoco
 
-    body_id, element = body
-    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body_id)
+    body_id, name, element = body
     notes = []
     if held and not is_physically_consistent(alone):
         alone = nearest_consistent(alone)
