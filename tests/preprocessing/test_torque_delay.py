@@ -7,9 +7,8 @@ import pytest
 
 from dynid._util.column_store import StoredColumns
 from dynid.exceptions import ConfigError
-from dynid.identification.closed_loop import _rows
 from dynid.io.datasets import Recording
-from dynid.preprocessing.pipeline import Preprocessing, prepare, torque_delayed
+from dynid.preprocessing.pipeline import Preprocessing, prepare, prepared_rows, torque_delayed
 from dynid.simulation.closed_loop import simulate_closed_loop
 from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 
@@ -59,7 +58,7 @@ def test_the_zero_order_hold_of_a_closed_loop_log_is_half_a_period():
     big = np.abs(setup.truth) > 1e-6 * np.abs(setup.truth).max()
 
     def error(delay):
-        w, tau, keep = _rows(setup.robot, setup.base, prepare(log, Preprocessing(torque_delay=delay)))
+        w, tau, keep = prepared_rows(setup.robot, setup.base, prepare(log, Preprocessing(torque_delay=delay)))
         beta = np.linalg.lstsq(w[keep], tau[keep], rcond=None)[0]
         return float(np.median(np.abs(beta - setup.truth)[big] / np.abs(setup.truth)[big]))
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..exceptions import IdentifiabilityError, ShapeError
 from .base import check_observations
+from .least_squares import OrdinaryLeastSquares
 
 CLOSED_LOOP_METHODS = ("idim-iv", "didim", "didim-sdp")
 """Keys of the closed-loop estimators (:mod:`dynid.identification.closed_loop`; case-insensitive): they need the
@@ -230,3 +231,45 @@ def instrumental_variables(w, tau, z, instants=None, kernel: str = "bartlett") -
     middle = sigma2 * (z.T @ z) if instants is None else long_run_covariance(z * residual[:, None], instants, kernel=kernel)
     covariance = inverse @ middle @ inverse.T
     return InstrumentalSolution(params, np.sqrt(np.maximum(np.diag(covariance), 0.0)), covariance, float(np.sqrt(sigma2)), cond)
+
+
+def weighted_least_squares(w, tau, row_sigma, instants=None, kernel: str = "parzen") -> tuple[np.ndarray, np.ndarray]:
+    """Weighted least squares with its standard deviations, the estimate the closed-loop estimators start from and
+    DIDIM's step (:mod:`dynid.identification.closed_loop`).
+
+    The estimate is the package's :class:`~dynid.estimators.least_squares.OrdinaryLeastSquares` with the weights
+    ``1/σ²``; its σ is the textbook ``σ² (AᵀA)⁻¹`` of the scaled rows ``A = W/σ``, or with ``instants`` the sandwich
+    ``(AᵀA)⁻¹ S (AᵀA)⁻¹`` whose middle ``S`` is the long-run covariance of the scores ``a_i r_i``
+    (:func:`long_run_covariance` with ``kernel``), for residuals correlated in time and between joints.
+
+    Parameters
+    ----------
+    w : (M, p) array
+        Observation matrix.
+    tau : (M,) array [N·m]
+        Torques, same rows.
+    row_sigma : (M,) array [N·m]
+        Each row's noise standard deviation; ``inf`` leaves a row out.
+    instants : (M,) int array, optional
+        The instant of each row; default: rows independent.
+    kernel : {"bartlett", "parzen"}
+        The lag window of the sandwich (with ``instants``).
+
+    Returns
+    -------
+    params : (p,) array
+    params_std : (p,) array
+
+    Raises
+    ------
+    ShapeError
+        Shapes that do not match, or values that are not finite.
+    """
+    fit = OrdinaryLeastSquares().fit(w, tau, sample_weight=row_sigma**-2.0)
+    if instants is None:
+        return fit.params_, fit.params_std_
+    a = w / row_sigma[:, None]
+    r = tau / row_sigma - a @ fit.params_
+    inverse = np.linalg.pinv(a.T @ a)
+    cov = inverse @ long_run_covariance(a * r[:, None], instants, kernel=kernel) @ inverse
+    return fit.params_, np.sqrt(np.maximum(np.diag(cov), 0.0))

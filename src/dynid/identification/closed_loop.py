@@ -42,14 +42,13 @@ from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
 from ..dynamics.rnea import rnea_torques
-from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, long_run_covariance
-from ..estimators.least_squares import OrdinaryLeastSquares
+from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variables, weighted_least_squares
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..estimators.problem import FitData
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.datasets import Recording
 from ..model.robot import Robot
-from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.pipeline import Preprocessing, prepare, prepared_rows
 from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 from .identify import Estimate, consistency_checks
@@ -164,32 +163,6 @@ class ClosedLoopEstimate:
                                for n, v, s in zip(names, self.params, self.params_std)]}
 
 
-def _rows(robot: Robot, base: BaseParameters, data: PreparedData,
-          standard: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Base (or standard) rows, torques and the rows kept (M,), of a prepared recording."""
-    ws, taus, keeps = [], [], []
-    for _, y, tau, keep in base_chunks(robot, base, data, standard=standard):
-        ws.append(y.reshape(-1, y.shape[-1]))
-        taus.append(np.asarray(tau).reshape(-1))
-        keeps.append(np.asarray(keep).reshape(-1))
-    return np.concatenate(ws), np.concatenate(taus), np.concatenate(keeps)
-
-
-def _weighted_least_squares(w, tau, row_sigma, instants=None):
-    """Weighted least squares, the package's (:class:`~dynid.estimators.least_squares.OrdinaryLeastSquares` with the
-    weights ``1/σ²``), with its σ: the textbook ``σ² (AᵀA)⁻¹`` of the scaled rows ``A``, or with ``instants`` the
-    sandwich whose middle is the long-run covariance of the scores
-    (:func:`dynid.estimators.instrumental.long_run_covariance`)."""
-    fit = OrdinaryLeastSquares().fit(w, tau, sample_weight=row_sigma**-2.0)
-    if instants is None:
-        return fit.params_, fit.params_std_
-    a = w / row_sigma[:, None]
-    r = tau / row_sigma - a @ fit.params_
-    inverse = np.linalg.pinv(a.T @ a)
-    cov = inverse @ long_run_covariance(a * r[:, None], instants, kernel="parzen") @ inverse
-    return fit.params_, np.sqrt(np.maximum(np.diag(cov), 0.0))
-
-
 def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recording, experiment: ClosedLoopExperiment,
                          *, methods=("idim-iv", "didim"), preprocessing: Preprocessing | None = None, max_iter: int = 10,
                          tol: float = 1e-4, data: PreparedData | None = None) -> dict[str, ClosedLoopEstimate]:
@@ -242,16 +215,16 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         raise ShapeError(f"{recording.name}: logged at {recording.rate:.6g} Hz, the controller runs at {experiment.controller.rate:.6g} Hz: "
                          "the closed-loop estimators need the log at the control rate")
     data = data if data is not None else prepare(recording, preprocessing or Preprocessing())
-    w, tau, keep = _rows(robot, base, data)
+    w, tau, keep = prepared_rows(robot, base, data)
     n = robot.n_dof
     w, tau = w[keep], tau[keep]
     joint = np.tile(np.arange(n), keep.size // n)[keep]
     instants = np.repeat(np.arange(keep.size // n), n)[keep]
-    params, _ = _weighted_least_squares(w, tau, np.ones(tau.size))
+    params, _ = weighted_least_squares(w, tau, np.ones(tau.size))
     residual = tau - w @ params
     sigma = np.array([np.sqrt(np.mean(residual[joint == j] ** 2)) if np.any(joint == j) else 1.0 for j in range(n)])
     row_sigma = np.maximum(sigma, 1e-12)[joint]
-    start, start_std = _weighted_least_squares(w, tau, row_sigma)
+    start, start_std = weighted_least_squares(w, tau, row_sigma)
     out = {"wls": ClosedLoopEstimate(LABELS["wls"], start, start_std, message="least squares on the measured rows")}
     nominal = robot.standard_parameters()
     simulated: dict = {}  # the estimators all start from the same estimate: its closed loop is simulated once
@@ -273,7 +246,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
                                    ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
         sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate)
-        ws, _, moving = _rows(robot, base, prepare(sim, data.settings, strict=False), standard)
+        ws, _, moving = prepared_rows(robot, base, prepare(sim, data.settings, strict=False), standard)
         if ws.shape[0] != keep.size:
             raise DataError(f"{recording.name}: the simulated log prepares to {ws.shape[0] // n} samples, the measured one to "
                             f"{keep.size // n}")
@@ -281,7 +254,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
 
     for key in keys:
         if key == "didim-sdp":
-            out[key] = _didim_sdp(robot, base, simulated_rows, _rows(robot, base, data, standard=True)[0][keep], tau,
+            out[key] = _didim_sdp(robot, base, simulated_rows, prepared_rows(robot, base, data, standard=True)[0][keep], tau,
                                   row_sigma, max_iter=max_iter, tol=tol)
             continue
 
@@ -292,7 +265,7 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
                                              kernel="parzen")
                 return sol.params, sol.params_std, w @ sol.params
             # a row where the simulated joint is slower than min_speed fits nothing, as a measured one does not
-            beta, std = _weighted_least_squares(ws, tau, np.where(moving, row_sigma, np.inf), instants)
+            beta, std = weighted_least_squares(ws, tau, np.where(moving, row_sigma, np.inf), instants)
             return beta, std, ws @ beta
 
         run = _iterate(simulated_rows, step, start, base.base_from_standard(nominal), w @ start, max_iter=max_iter, tol=tol,

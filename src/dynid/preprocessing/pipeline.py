@@ -49,7 +49,7 @@ from .prepared import (
 from .settings import Preprocessing
 from .strategies import Strategy, strategy_for
 
-__all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare", "torque_delayed"]
+__all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare", "prepared_rows", "torque_delayed"]
 
 def prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
     """Filtered joint signals of a recording, by the strategy ``settings.strategy`` names
@@ -131,6 +131,34 @@ def base_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
         ``standard``), torques (M, n_dof) [N·m], rows used by the estimation (M, n_dof) bool.
     """
     return strategy_for(data.settings).chunks(robot, base, data, progress, standard)
+
+
+def prepared_rows(robot: Robot, base: BaseParameters, data: PreparedData,
+                  standard: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every row of ``data`` for the estimators in memory, one per joint and sample (:func:`base_chunks` stacked).
+
+    Parameters
+    ----------
+    robot : Robot
+    base : BaseParameters
+    data : PreparedData
+    standard : bool
+        The standard regressor's rows instead of the base one's.
+
+    Returns
+    -------
+    w : (M, n_base) array
+        (M, n_params) with ``standard``.
+    tau : (M,) array [N·m]
+    keep : (M,) bool array
+        The rows the estimation uses.
+    """
+    ws, taus, keeps = [], [], []
+    for _, y, tau, keep in base_chunks(robot, base, data, standard=standard):
+        ws.append(y.reshape(-1, y.shape[-1]))
+        taus.append(np.asarray(tau).reshape(-1))
+        keeps.append(np.asarray(keep).reshape(-1))
+    return np.concatenate(ws), np.concatenate(taus), np.concatenate(keeps)
 
 
 class ParallelFiltering(Strategy):
