@@ -261,6 +261,6 @@ def test_the_reference_is_read_at_the_angles_the_log_is(tmp_path):
     (tmp_path / "cl.toml").write_text((tmp_path / "cl.toml").read_text().replace('robot = "er16"', 'robot = "arm.toml"'))
     config = load_identification_config(tmp_path / "cl.toml")
     logged = load_recording(config.identification, config.robot).q
-    reference = config.controller[1].read()
+    reference = config.controller.reference.read()
     assert np.allclose(reference, logged, atol=1e-9)
     assert np.allclose(reference[:, 1] - q[:, 1], np.pi / 2)

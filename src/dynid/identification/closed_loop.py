@@ -50,7 +50,7 @@ from ..io.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare, prepared_rows
 from ..preprocessing.prepared import PreparedData
-from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
+from ..simulation.closed_loop import ClosedLoopNoise, ClosedLoopSetup, Controller, simulate_closed_loop
 from .identify import Estimate, consistency_checks
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopEstimator", "ClosedLoopSetup", "closed_loop_identify",
@@ -83,38 +83,6 @@ class ClosedLoopExperiment:
     q_ref: np.ndarray
     dq_ref: np.ndarray
     feedforward: np.ndarray | None = None
-
-
-@dataclass(frozen=True, eq=False)
-class ClosedLoopSetup:
-    """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
-    config's ``[controller]`` table gives it (:class:`ClosedLoopEstimator` parts carry it).
-
-    Attributes
-    ----------
-    controller : Controller
-        The joint controller and its rate.
-    reference : (N, n_dof) array [rad], or an object with ``read() -> (N, n_dof) array``
-        The position set-points, one per sample of the log as read (a config's reference file is read when the
-        estimators run).
-    feedforward : bool
-        Whether the controller added the model's torques along the reference (computed with the identified model's
-        description, :func:`dynid.dynamics.rnea.rnea_torques`).
-    """
-
-    controller: Controller
-    reference: object
-    feedforward: bool = False
-
-    def reference_positions(self) -> np.ndarray:
-        """The set-points as an array.
-
-        Returns
-        -------
-        (N, n_dof) array [rad]
-        """
-        read = getattr(self.reference, "read", None)
-        return np.asarray(read() if callable(read) else self.reference, dtype=float)
 
 
 @short_repr

@@ -56,7 +56,7 @@ class Identifier(HyperParameters):
         Seeds the box searches (default 0, or the config's ``seed``); a generator gives one draw as the seed. Was
         ``seed`` (still taken, with a FutureWarning).
     controller : ClosedLoopSetup, optional
-        How the arrays were recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`: the
+        How the arrays were recorded in closed loop (:class:`dynid.simulation.closed_loop.ClosedLoopSetup`: the
         controller, one set-point per sample, the feed-forward), for the closed-loop estimators; a config gives its
         ``[controller]`` table instead.
 
@@ -218,8 +218,8 @@ class Identifier(HyperParameters):
         changes: dict[str, Any] = {}
         if self.robot is not None:
             changes["robot"] = self._robot()
-        if self.controller is not None:  # the config's [controller] as a ClosedLoopSetup gives it
-            changes["controller"] = (self.controller.controller, self.controller.reference, self.controller.feedforward)
+        if self.controller is not None:  # in place of the config's [controller]
+            changes["controller"] = self.controller
         if self.preprocessing is not None:
             changes["preprocessing"] = self._preprocessing()
         estimation: dict[str, Any] = {}  # over the config's [estimation]

@@ -118,7 +118,7 @@ class IdentificationPipeline:
         Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
         :func:`dynid.load_results` finds it.
     controller : ClosedLoopSetup or None
-        How the log was recorded in closed loop (:class:`dynid.identification.closed_loop.ClosedLoopSetup`); needed
+        How the log was recorded in closed loop (:class:`dynid.simulation.closed_loop.ClosedLoopSetup`); needed
         with closed-loop keys among ``estimators``.
 
     Attributes

@@ -58,14 +58,14 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     from ..preprocessing.pipeline import prepare
     from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
 
-    assert config.drive_gains is not None  # called only when the config has [drive_gains]
-    mass, unloaded, loaded = config.drive_gains
+    runs = config.drive_gains
+    assert runs is not None  # called only when the config has [drive_gains]
     unit = replace(robot, drive_gains=np.ones(robot.n_dof))  # so that the recordings' "torques" are the currents
-    files = [str(s.file) for spec in (unloaded, loaded) for s in list(spec.signals.values())[:1]]
+    files = [str(s.file) for spec in (runs.unloaded, runs.loaded) for s in list(spec.signals.values())[:1]]
     try:
-        pre_u = prepare(load_recording(unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
-        pre_l = prepare(load_recording(loaded, unit, spool=False), config.preprocessing)
-        gains = identify_drive_gains(robot, base, pre_u, pre_l, mass, rng=config.estimation.seed)
+        pre_u = prepare(load_recording(runs.unloaded, unit, spool=False), config.preprocessing)  # in memory: scaled below
+        pre_l = prepare(load_recording(runs.loaded, unit, spool=False), config.preprocessing)
+        gains = identify_drive_gains(robot, base, pre_u, pre_l, runs.payload_mass, rng=config.estimation.seed)
         k = np.where(np.isfinite(gains.gains), gains.gains, robot.drive_gains)
         payload = identify_payload(robot, base, gains.base, replace(pre_l, tau=pre_l.tau * k))
     except DynIdError as exc:  # said with the runs it comes from, when the message names neither
@@ -399,13 +399,11 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     -------
     IdentificationPipeline
     """
-    from .closed_loop import ClosedLoopSetup
     from .pipeline import IdentificationPipeline
 
     e = config.estimation
-    setup = None if config.controller is None or not e.closed_loop else ClosedLoopSetup(*config.controller)
     return IdentificationPipeline(config.robot, config.preprocessing, with_hyperparameters(e.estimators, e.hyperparameters),
-                                  e.friction, e.seed, config.robot_source, setup)
+                                  e.friction, e.seed, config.robot_source, config.controller if e.closed_loop else None)
 
 
 @keyword_only_after_data
@@ -670,7 +668,7 @@ def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None
         ``preprocessing`` (default: every setting derived from the data), ``estimators`` (keys or objects, as a
         config's ``[estimation] estimators``; the closed-loop ones with ``controller``), ``friction``
         ({"description", "auto"}, default "description"), ``rng`` (default 0; an int or a generator), ``controller``
-        (:class:`dynid.identification.closed_loop.ClosedLoopSetup`, as a config's ``[controller]`` gives it).
+        (:class:`dynid.simulation.closed_loop.ClosedLoopSetup`, as a config's ``[controller]`` gives it).
 
     Returns
     -------

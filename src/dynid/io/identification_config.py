@@ -68,7 +68,7 @@ import os
 import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 import numpy as np
@@ -86,6 +86,9 @@ from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .tables import read_table
 from .trajectories import load_trajectory
+
+if TYPE_CHECKING:
+    from ..simulation.closed_loop import ClosedLoopSetup
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.
@@ -133,6 +136,23 @@ class EstimationSettings:
         return split_estimators(self.estimators, "[estimation] estimators")[1]
 
 
+@dataclass(frozen=True)
+class DriveGainsSettings:
+    """What a config's ``[drive_gains]`` table asks for: drive gains K (eq. 16) from a run without and one with a
+    known payload (:func:`dynid.identification.drive_gains.identify_drive_gains`).
+
+    Attributes
+    ----------
+    payload_mass : float [kg]
+    unloaded, loaded : DatasetSpec
+        The runs without and with the payload; both hold motor currents.
+    """
+
+    payload_mass: float
+    unloaded: DatasetSpec
+    loaded: DatasetSpec
+
+
 @short_repr
 @dataclass(frozen=True)
 class IdentificationConfig:
@@ -153,8 +173,8 @@ class IdentificationConfig:
         Folder the data files are relative to.
     estimation : EstimationSettings
         What ``[estimation]`` asks for: the estimators, the seed, the friction models, the choice.
-    drive_gains : tuple or None
-        ``(payload_mass [kg], unloaded DatasetSpec, loaded DatasetSpec)``.
+    drive_gains : DriveGainsSettings or None
+        ``[drive_gains]``: the payload's mass and the runs without and with it.
     robot_source : str
         A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
     urdf : Path or None
@@ -164,8 +184,9 @@ class IdentificationConfig:
         ``mjcf_model``: the user's own MuJoCo model of the arm, checked against the robot's joints
         (:func:`dynid.io.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
         values into a copy of it. Not given, the MJCF the robot was read from, if it was and holds no joint fixed.
-    controller : tuple or None
-        ``(Controller, reference DatasetSpec, feed-forward: bool)`` from ``[controller]``.
+    controller : dynid.simulation.closed_loop.ClosedLoopSetup or None
+        ``[controller]``: the controller, the set-points' :class:`ReferenceTrajectory` and whether the model's torque
+        was fed forward.
     torque_sensor : str
         The identification log's ``torques.sensor``: "joint" (a joint torque sensor on the link side) or "drive".
     """
@@ -178,11 +199,11 @@ class IdentificationConfig:
     references: tuple[dict, ...]
     data_root: Path
     estimation: EstimationSettings = field(default_factory=EstimationSettings)
-    drive_gains: tuple | None = None  # (payload_mass, unloaded DatasetSpec, loaded DatasetSpec)
+    drive_gains: DriveGainsSettings | None = None
     robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
     urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
     mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
-    controller: tuple | None = None  # (Controller, reference DatasetSpec, feed-forward) of [controller]
+    controller: ClosedLoopSetup | None = None
     torque_sensor: str = "drive"  # the identification log's torques.sensor: "joint" or "drive"
 
 
@@ -507,11 +528,11 @@ def _robots_mjcf(doc: dict, path: Path, root: Path, robot) -> Path | None:
 
 
 def _controller(table, root: Path, where: str, n: int, offset=None):
-    """``(Controller, reference DatasetSpec, feed-forward)`` of a ``[controller]`` table (typed already), or None; the
-    set-points are read as the logs' angles are, the robot's position offsets ``offset`` (n,) added."""
+    """The :class:`~dynid.simulation.closed_loop.ClosedLoopSetup` of a ``[controller]`` table (typed already), or None;
+    the set-points are read as the logs' angles are, the robot's position offsets ``offset`` (n,) added."""
     if table is None:
         return None
-    from ..simulation.closed_loop import Controller
+    from ..simulation.closed_loop import ClosedLoopSetup, Controller
 
     try:
         controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),
@@ -525,7 +546,7 @@ def _controller(table, root: Path, where: str, n: int, offset=None):
                                     np.pi / 180 if ref.get("unit") == "deg" else 1.0,
                                     None if ref.get("rows") is None else (int(ref["rows"][0]), int(ref["rows"][1])),
                                     None if offset is None else tuple(float(x) for x in offset))
-    return controller, reference, table.get("feedforward", "none") == "model"
+    return ClosedLoopSetup(controller, reference, feedforward=table.get("feedforward", "none") == "model")
 
 
 @dataclass(frozen=True)
@@ -654,7 +675,7 @@ def _estimators_from_old(est: dict) -> str:
 
 
 def _drive_gains(table, root: Path, where: str, n: int):
-    """``(payload_mass, unloaded DatasetSpec, loaded DatasetSpec)`` of a ``[drive_gains]`` table (typed already)."""
+    """The :class:`DriveGainsSettings` of a ``[drive_gains]`` table (typed already), or None."""
     if table is None:
         return None
     specs = []
@@ -663,7 +684,7 @@ def _drive_gains(table, root: Path, where: str, n: int):
         if "currents" not in spec.signals:
             raise ConfigError(f"{where}.{key}: expected motor currents (a currents column map or a preset with currents)")
         specs.append(spec)
-    return float(table["payload_mass"]), specs[0], specs[1]
+    return DriveGainsSettings(float(table["payload_mass"]), specs[0], specs[1])
 
 
 def stored_preprocessing(identified: dict, key: str = "preprocessing") -> Preprocessing | None:

@@ -32,7 +32,7 @@ from ..dynamics.rnea import pinocchio_model
 from ..exceptions import ConfigError, ShapeError
 from ..model.robot import Robot
 
-__all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "JointDynamics", "simulate_closed_loop"]
+__all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "ClosedLoopSetup", "JointDynamics", "simulate_closed_loop"]
 
 _FAST_TERMS = frozenset({"Ia", "fc", "fv", "offset"})
 
@@ -141,6 +141,39 @@ class Controller:
                               f"got {velocity_cutoff!r}", field="velocity_cutoff")
         return cls(_gains(kp, n_dof, "kp", True), _gains(kd, n_dof, "kd", True), _gains(ki, n_dof, "ki", False), float(rate),
                    float(velocity_cutoff))
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedLoopSetup:
+    """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
+    config's ``[controller]`` table gives it (:attr:`dynid.io.identification_config.IdentificationConfig.controller`;
+    :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts carry it).
+
+    Attributes
+    ----------
+    controller : Controller
+        The joint controller and its rate.
+    reference : (N, n_dof) array [rad], or an object with ``read() -> (N, n_dof) array``
+        The position set-points, one per sample of the log as read (a config's reference file is read when the
+        estimators run).
+    feedforward : bool
+        Whether the controller added the model's torques along the reference (computed with the identified model's
+        description, :func:`dynid.dynamics.rnea.rnea_torques`).
+    """
+
+    controller: Controller
+    reference: object
+    feedforward: bool = False
+
+    def reference_positions(self) -> np.ndarray:
+        """The set-points as an array.
+
+        Returns
+        -------
+        (N, n_dof) array [rad]
+        """
+        read = getattr(self.reference, "read", None)
+        return np.asarray(read() if callable(read) else self.reference, dtype=float)
 
 
 @dataclass(frozen=True)
