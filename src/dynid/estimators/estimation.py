@@ -22,7 +22,7 @@ from .fitting import Fitted, fit_methods, make_estimator
 from .problem import FitData, SearchBudget, with_problem
 from .registry import LEAST_SQUARES, _named, parse_estimators, seed_index, spec
 
-__all__ = ["Estimation", "stream_rows", "stacked_rows"]
+__all__ = ["Estimation", "stream_rows"]
 
 
 class Estimation:
@@ -234,29 +234,3 @@ def stream_rows(chunks, estimation: Estimation, base, observer: Callable | None 
         estimation.add(y, tau, keep, y_standard if estimation.standard else None)
         if observer is not None:
             observer(index, y, tau, keep, y_standard)
-
-
-def stacked_rows(chunks, n_base: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The base rows and torques of a strategy's ``chunks`` stacked in memory (rows not kept zeroed).
-
-    Parameters
-    ----------
-    chunks : iterable of (index, y, tau, keep)
-        Base regressor blocks (:meth:`dynid.preprocessing.strategies.Strategy.chunks`).
-    n_base : int, optional
-        Columns expected (checked).
-
-    Returns
-    -------
-    w : (M, n_base) array
-    tau : (M,) array [N·m]
-    """
-    ws, taus = [], []
-    for _, y, tau, keep in chunks:
-        k = np.asarray(keep).reshape(-1)
-        w = y.reshape(-1, y.shape[-1])
-        if n_base is not None and w.shape[1] != n_base:
-            raise ValueError(f"expected base regressor blocks of {n_base} columns, got {w.shape[1]}")
-        ws.append(w * k[:, None])
-        taus.append(np.asarray(tau).reshape(-1) * k)
-    return np.concatenate(ws), np.concatenate(taus)

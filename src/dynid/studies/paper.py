@@ -25,7 +25,7 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.kinematics import tool_positions
 from ..dynamics.layout import consistency_layout
 from ..estimators import OrdinaryLeastSquares, bootstrap_intervals, consistency_margin, paper_objective
-from ..estimators.estimation import Estimation, stacked_rows
+from ..estimators.estimation import Estimation
 from ..estimators.fitting import make_estimator
 from ..estimators.physically_consistent import consistency_verdict, margin_is_consistent
 from ..estimators.problem import FitData, SearchBudget
@@ -45,7 +45,7 @@ from ..io.datasets import Recording
 from ..io.trajectories import load_trajectory
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.pipeline import prepared_rows
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
 from ..runtime.threads import with_single_blas_thread
@@ -523,10 +523,15 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
     pipeline = IdentificationPipeline(robot, paper_preprocessing(traj, passes, strategy), estimators=estimators)
     prepared = pipeline.prepare(recording, base)
     estimation = None if problem is None else pipeline.estimation(prepared, problem, keep_rows=True)
-    w, tau = stacked_rows(base_chunks(robot, base, prepared.data), base.n_base) if estimation is None else estimation.rows()
+    w, tau = estimation.rows() if estimation is not None else _zeroed(*prepared_rows(robot, base, prepared.data))
     assert w is not None and tau is not None  # kept rows: keep_rows=True
     data = prepared.data
     return Dataset(t, data.q, data.dq, data.ddq, tau.reshape(-1, robot.n_dof), tau_true, w, tool), estimation
+
+
+def _zeroed(w: np.ndarray, tau: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows the estimation does not use zeroed, as :meth:`Estimation.rows` keeps them."""
+    return w * keep[:, None], tau * keep
 
 
 def settings_of(config) -> dict:
