@@ -84,3 +84,13 @@ def test_a_models_validation_has_a_summary(fitted):
     text = dynid.summary(comparison, width=300)
     assert text.startswith("In short (the tables follow)") and f"{comparison.name}: torque error over all joints: " in text
     assert dynid.summary([comparison, comparison], width=300).count(f"{comparison.name}: torque error") == 2
+
+
+def test_a_closed_loop_setup_fits_a_screen():
+    """A setup holding its set-points as an array (Identifier(controller=...)) printed the array over seven lines."""
+    from dynid.simulation.closed_loop import ClosedLoopSetup, Controller
+
+    robot = dynid.load_robot("er16")
+    text = repr(ClosedLoopSetup(Controller.for_robot(robot), np.zeros((5000, 6)), feedforward=True))
+    assert "\n" not in text and len(text) <= SCREEN, text[:200]
+    assert "reference=<array (5000, 6)>" in text and "feedforward=True" in text

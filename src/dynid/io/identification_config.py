@@ -136,6 +136,7 @@ class EstimationSettings:
         return split_estimators(self.estimators, "[estimation] estimators")[1]
 
 
+@short_repr
 @dataclass(frozen=True)
 class DriveGainsSettings:
     """What a config's ``[drive_gains]`` table asks for: drive gains K (eq. 16) from a run without and one with a

@@ -143,6 +143,7 @@ class Controller:
                    float(velocity_cutoff))
 
 
+@short_repr
 @dataclass(frozen=True, eq=False)
 class ClosedLoopSetup:
     """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
