@@ -148,3 +148,5 @@ def test_the_estimators_the_pipeline_feeds_unfitted_hold_the_rows_its_estimate_f
     np.testing.assert_array_equal(by_seed, fed.fit(box, given, budget=budget, keys=("abc",), workers=1)["abc"].params)
     other = fed.fit(box, rng=(8, 2), budget=budget, keys=("abc",), workers=1)["abc"].params
     assert not np.array_equal(by_seed, other)
+    with pytest.raises(TypeError, match="rng .* or rngs .*, not both"):
+        fed.fit(box, given, rng=(7, 2), budget=budget, keys=("abc",), workers=1)

@@ -192,6 +192,8 @@ class Estimation:
         ------
         ConfigError
             A box search without a box.
+        TypeError
+            Both ``rng`` and ``rngs``.
         DynIdError
             From an estimator.
         """
@@ -200,7 +202,9 @@ class Estimation:
         data = replace(self.problem, w_base=w, tau=tau, bounds=box, w_standard=ws,
                        joint_weights=self.problem.joint_weights if joint_weights is None else joint_weights)
         chosen = self.keys if keys is None else tuple(keys)
-        if rngs is None and rng is not None:
+        if rngs is not None and rng is not None:
+            raise TypeError("Estimation.fit: give rng (a seed) or rngs (a generator per estimator), not both")
+        if rng is not None:
             seed = tuple(int(x) for x in np.atleast_1d(rng))
             rngs = {key: np.random.default_rng([*seed, seed_index(key)]) for key in chosen}
         for key in chosen:
