@@ -433,52 +433,6 @@ def check_terms(terms, where: str) -> tuple[str, ...]:
     return tuple(t for t in TERMS if t in terms)
 
 
-def drive_columns(terms, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, velocities: Velocities) -> np.ndarray:
-    """Columns of the drive terms for every joint (eqs. 3-6 of the paper's friction model).
-
-    Parameters
-    ----------
-    terms : sequence of str
-        Drive term names (:data:`TERMS`).
-    q, dq, ddq : (N, n_dof) arrays
-        [rad], [rad/s], [rad/s²].
-    velocities : Velocities
-
-    Returns
-    -------
-    (N, n_dof, len(terms)) ndarray
-        Column of each term for each joint and sample.
-    """
-    q, dq, ddq = (np.asarray(x, dtype=float) for x in (q, dq, ddq))
-    if not terms:
-        return np.zeros(dq.shape + (0,))
-    return np.stack([TERMS[t].column(q, dq, ddq, velocities) for t in terms], axis=-1)
-
-
-def drive_column_derivatives(terms, q: np.ndarray, dq: np.ndarray, velocities: Velocities
-                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Derivatives of the drive columns with respect to each joint's own position, velocity and acceleration.
-
-    Parameters
-    ----------
-    terms : sequence of str
-        Drive term names (:data:`TERMS`).
-    q, dq : (N, n_dof) arrays
-        [rad], [rad/s].
-    velocities : Velocities
-
-    Returns
-    -------
-    d_q, d_dq, d_ddq : (N, n_dof, len(terms)) ndarray
-        Each column's derivative (the unit of the column per rad, rad/s and rad/s²).
-    """
-    q, dq = np.asarray(q, dtype=float), np.asarray(dq, dtype=float)
-    d_q = np.stack([(TERMS[t].d_q or _zeros)(q, dq, velocities) for t in terms], axis=-1)
-    d_dq = np.stack([TERMS[t].d_dq(q, dq, velocities) for t in terms], axis=-1)
-    d_ddq = np.broadcast_to(np.array([TERMS[t].d_ddq for t in terms]), dq.shape + (len(terms),))
-    return d_q, d_dq, d_ddq
-
-
 def nonnegative_terms() -> tuple[str, ...]:
     """Names of the terms that are non-negative on a physical robot (viscous and Coulomb friction…).
 

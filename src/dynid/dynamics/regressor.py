@@ -28,7 +28,7 @@ import numpy as np
 
 from .._util.checks import check_states
 from .._util.keywords import keyword_only_after_data
-from ..friction import drive_columns
+from ..friction import TERMS, Velocities
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from . import _regressor_kernel as kernel
@@ -190,6 +190,28 @@ def _numpy_form(n_samples: int) -> bool:
             return False
         _numpy_used += cost
         return True
+
+
+def drive_columns(terms, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, velocities: Velocities) -> np.ndarray:
+    """Columns of the drive terms for every joint (eqs. 3-6 of the paper's friction model).
+
+    Parameters
+    ----------
+    terms : sequence of str
+        Drive term names (:data:`dynid.friction.TERMS`).
+    q, dq, ddq : (N, n_dof) arrays
+        [rad], [rad/s], [rad/s²].
+    velocities : dynid.friction.Velocities
+
+    Returns
+    -------
+    (N, n_dof, len(terms)) ndarray
+        Column of each term for each joint and sample.
+    """
+    q, dq, ddq = (np.asarray(x, dtype=float) for x in (q, dq, ddq))
+    if not terms:
+        return np.zeros(dq.shape + (0,))
+    return np.stack([TERMS[t].column(q, dq, ddq, velocities) for t in terms], axis=-1)
 
 
 def nominal_rigid_torque(robot: Robot, q, dq, ddq) -> np.ndarray:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._util.checks import check_states, check_trajectory_array
-from ..friction import drive_column_derivatives
+from ..friction import TERMS, Velocities
 from ..model.robot import Robot
 from .kinematics import forward_kinematics
 from .regressor import regressor
@@ -86,6 +86,30 @@ def regressor_state_derivatives(robot: Robot, q, dq, ddq) -> tuple[np.ndarray, n
             d[1, i, :, i, block] = d_dq[:, i] * robot.drive_mask[i]
             d[2, i, :, i, block] = d_ddq[:, i] * robot.drive_mask[i]
     return y, d
+
+
+def drive_column_derivatives(terms, q: np.ndarray, dq: np.ndarray, velocities: Velocities
+                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Derivatives of the drive columns with respect to each joint's own position, velocity and acceleration.
+
+    Parameters
+    ----------
+    terms : sequence of str
+        Drive term names (:data:`dynid.friction.TERMS`).
+    q, dq : (N, n_dof) arrays
+        [rad], [rad/s].
+    velocities : dynid.friction.Velocities
+
+    Returns
+    -------
+    d_q, d_dq, d_ddq : (N, n_dof, len(terms)) ndarray
+        Each column's derivative (the unit of the column per rad, rad/s and rad/s²).
+    """
+    q, dq = np.asarray(q, dtype=float), np.asarray(dq, dtype=float)
+    d_q = np.stack([np.zeros_like(dq) if x.d_q is None else x.d_q(q, dq, velocities) for x in (TERMS[t] for t in terms)], axis=-1)
+    d_dq = np.stack([TERMS[t].d_dq(q, dq, velocities) for t in terms], axis=-1)
+    d_ddq = np.broadcast_to(np.array([TERMS[t].d_ddq for t in terms]), dq.shape + (len(terms),))
+    return d_q, d_dq, d_ddq
 
 
 def frames_and_axes(robot: Robot, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
