@@ -24,6 +24,7 @@ from .._util.reprs import short_repr
 from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..identification.run import run_identification, validate_sets
+from ..io.datasets import load_recording
 from ..io.files import write_json
 from ..io.fleet_manifest import FleetManifest, FleetUnit
 from ..io.identification_config import stored_preprocessing
@@ -230,7 +231,8 @@ def validate_unit(unit: FleetUnit, model, sets: dict, preprocessing=None) -> dic
     if not unit.config.validation:
         return {}
     config = replace(unit.config, robot=model)
-    comparisons, _ = validate_sets(config, base_parameters(model, rng=0), sets, config.validation, resolved=preprocessing)
+    logs = (load_recording(spec, model) for spec in config.validation)
+    comparisons, _ = validate_sets(config, base_parameters(model, rng=0), sets, logs, resolved=preprocessing)
     return {label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in comparisons])) for label in sets}
 
 

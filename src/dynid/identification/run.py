@@ -77,7 +77,7 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
 
 
 @keyword_only_after_data
-def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, datasets: tuple, *,
+def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, recordings, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
                   yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
                   geometry: bool = True, nominal: str | None = None) -> tuple[tuple, tuple[str, ...]]:
@@ -90,8 +90,9 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
     base : BaseParameters
     parameter_sets : dict
         label -> (n_base,) base parameters.
-    datasets : tuple
-        DatasetSpec (read here) or Recording (read already).
+    recordings : iterable of Recording
+        The logs, read (:func:`dynid.io.datasets.load_recording`); a generator's are read one at a time, as each is
+        scored.
     progress : callable, optional
         ``progress(step, done, total)``.
     resolved : Preprocessing, optional
@@ -136,18 +137,17 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, data
     warnings: list[str] = []
     settings = (carried_over(resolved, config.preprocessing) if yardstick is None else
                 yardstick_settings(resolved, config.preprocessing, yardstick))
-    for spec in datasets:
-        if progress is not None:  # one step per log: reading, filtering and predicting it
-            progress(f"validation, {spec.name}", 0, 1)
-        recording = load_recording(spec, config.robot) if isinstance(spec, DatasetSpec) else spec
+    for recording in recordings:
+        if progress is not None:  # one step per log: filtering and predicting it
+            progress(f"validation, {recording.name}", 0, 1)
         data = prepare(recording, settings, strict=False)
         scored = compare_torques(config.robot, base, data, parameter_sets,
-                                 progress=None if progress is None else (lambda d, t, s=spec.name: progress(f"validation, {s}", d, t)),
+                                 progress=None if progress is None else (lambda d, t, s=recording.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
         found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=nominal)
         if not found and geometry and yardstick is None and np.any(config.robot.inertial != 0):
-            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, spec.name, fitted=False)
+            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, recording.name, fitted=False)
         warnings.extend(f.text for f in found)
         out.append(replace(scored, misread=found[0].text) if found else scored)
         warnings.extend(data.warnings)
@@ -323,7 +323,7 @@ def yardstick_reference(recording) -> Preprocessing | None:
         return None
 
 
-def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: tuple, *, resolved=None, reference=None,
+def yardstick_scores(config: IdentificationConfig, base, sets: dict, recordings, *, resolved=None, reference=None,
                      progress=None) -> tuple:
     """Every set scored on the validation logs by the one yardstick (issue "Never worse than the description", item 5):
     each log prepared by dynid's default rules, whatever the identification's settings
@@ -336,8 +336,8 @@ def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: t
     base : BaseParameters
     sets : dict
         label -> (n_base,) base parameters.
-    datasets : tuple
-        The validation logs (Recording or DatasetSpec).
+    recordings : iterable of Recording
+        The validation logs, read.
     resolved : Preprocessing, optional
         The identification's resolved settings (only what describes the model is kept from them).
     reference : Preprocessing, optional
@@ -349,7 +349,7 @@ def yardstick_scores(config: IdentificationConfig, base, sets: dict, datasets: t
     tuple of TorqueComparison
     """
     step = None if progress is None else (lambda label, done, total: progress(f"one yardstick: {label}", done, total))
-    return validate_sets(config, base, sets, datasets, progress=step, resolved=resolved,
+    return validate_sets(config, base, sets, recordings, progress=step, resolved=resolved,
                          yardstick=reference or Preprocessing())[0]
 
 
@@ -455,13 +455,22 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
-    comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, datasets,
+    logs = _read_as_scored(datasets, config.robot, progress)
+    comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
                                           progress=progress, resolved=stored_preprocessing(identified), noise=noise,
                                           yardstick=reference, fitted=_fitted_correlation(identified, sets, config.robot.n_dof),
                                           nominal=label)
     if beside:
         comparisons = tuple(v.without(str(label)) for v in comparisons)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
+
+
+def _read_as_scored(specs, robot, progress):
+    """Each log read as :func:`validate_sets` reaches it (one in memory at a time), its step said before the read."""
+    for spec in specs:
+        if progress is not None:
+            progress(f"validation, {spec.name}", 0, 1)
+        yield load_recording(spec, robot)
 
 
 def _fitted_correlation(identified: dict, sets: dict, n_dof: int) -> tuple[str, np.ndarray] | None:
