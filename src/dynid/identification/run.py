@@ -126,7 +126,9 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, reco
     Raises
     ------
     DataError
-        A log that cannot be read or prepared.
+        A log that cannot be prepared.
+    TypeError
+        A log not read (a ``DatasetSpec``: :func:`dynid.io.datasets.load_recording` reads it).
     """
     from ..preprocessing.pipeline import prepare
     from ..validation.channel_checks import channel_findings
@@ -138,6 +140,8 @@ def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, reco
     settings = (carried_over(resolved, config.preprocessing) if yardstick is None else
                 yardstick_settings(resolved, config.preprocessing, yardstick))
     for recording in recordings:
+        if not isinstance(recording, Recording):
+            raise TypeError(f"validate_sets: expected read logs (dynid.load_recording(spec, robot)), got {type(recording).__name__}")
         if progress is not None:  # one step per log: filtering and predicting it
             progress(f"validation, {recording.name}", 0, 1)
         data = prepare(recording, settings, strict=False)

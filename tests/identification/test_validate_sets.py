@@ -1,0 +1,39 @@
+"""validate_sets scores read logs: a generator's are read one at a time, as each is scored; a log not read is refused
+in one line."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+
+def test_validate_sets_reads_a_generator_one_log_at_a_time_and_refuses_a_log_not_read(tmp_path):
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.run import validate_sets
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+    from tests.simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=6.0)
+    config = load_identification_config(cfg)
+    base = base_parameters(config.robot, rng=0)
+    sets = {"nominal": base.base_from_standard(config.robot.standard_parameters())}
+    spec = config.validation[0]
+    events: list[str] = []
+
+    def logs():
+        for k in range(2):  # the same log twice: two logs to score
+            events.append(f"read {k}")
+            yield load_recording(spec, config.robot)
+
+    def progress(step, done, total):
+        events.append("scoring")
+
+    scored, _ = validate_sets(config, base, sets, logs(), progress=progress)
+    assert [c.name for c in scored] == [spec.name, spec.name]
+    # the second log is read after the first one was scored, not before (not all read first)
+    assert events[0] == "read 0" and "scoring" in events[:events.index("read 1")]
+    first, second = (c.metrics()["nominal"]["global_relative_error"] for c in scored)
+    assert np.isfinite(first) and first == second  # the same log, the same figure
+    with pytest.raises(TypeError, match=r"validate_sets: expected read logs \(dynid.load_recording"):
+        validate_sets(config, base, sets, config.validation)
