@@ -411,7 +411,7 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
 
 
 @keyword_only_after_data
-def run_validation(config: IdentificationConfig, identified: dict, *, datasets: tuple[DatasetSpec, ...] | None = None,
+def run_validation(config: IdentificationConfig, identified: dict, *, datasets: tuple[DatasetSpec | Recording, ...] | None = None,
                    progress=None, source: str = "results", yardstick: bool = False) -> tuple[tuple, tuple[str, ...]]:
     """Validate identified base parameters and the config's reference sets on the config's validation datasets (or on
     ``datasets``).
@@ -421,8 +421,9 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     config : IdentificationConfig
     identified : dict
         The results.json of ``dynid identify`` (every estimate in it is scored).
-    datasets : tuple of DatasetSpec, optional
-        Logs to validate on instead of the config's ``[[validation]]`` ones.
+    datasets : tuple of DatasetSpec or Recording, optional
+        Logs to validate on instead of the config's ``[[validation]]`` ones (each read as it is scored), or logs read
+        already (:func:`dynid.io.datasets.load_recording`).
     progress : callable, optional
         ``progress(step, done, total)``.
     source : str
@@ -469,12 +470,13 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
 
 
-def _read_as_scored(specs, robot, progress):
-    """Each log read as :func:`validate_sets` reaches it (one in memory at a time), its step said before the read."""
-    for spec in specs:
+def _read_as_scored(datasets, robot, progress):
+    """Each log read as :func:`validate_sets` reaches it (one in memory at a time), its step said before the read; a
+    log read already passes as it is."""
+    for spec in datasets:
         if progress is not None:
             progress(f"validation, {spec.name}", 0, 1)
-        yield load_recording(spec, robot)
+        yield spec if isinstance(spec, Recording) else load_recording(spec, robot)
 
 
 def _fitted_correlation(identified: dict, sets: dict, n_dof: int) -> tuple[str, np.ndarray] | None:
