@@ -168,7 +168,6 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
 @pytest.mark.parametrize("estimation, message", [
     ('estimators = ["ols", { key = "sdp", prior_kind = "round" }]',
      "estimation.estimators[1]: sdp's prior_kind: expected one of euclidean, geometric, got 'round'"),
-    ('estimators = ["ols"]\nsdp_prior = "round"', "estimation.estimators: sdp's prior_kind: expected one of euclidean"),
     ('estimators = ["ols", { key = "abc", colonysize = 8 }]',
      "estimation.estimators[1]: abc has no hyper-parameter 'colonysize'; expected some of colony_size, limit, maxiter"),
     ('estimators = ["ols", { key = "abc", rng = 8 }]', "abc has no hyper-parameter 'rng' (dynid fills it"),
@@ -186,26 +185,21 @@ def test_an_estimators_bad_hyperparameters_are_refused_in_one_line(tmp_path, est
         load_identification_config(cfg)
 
 
-def test_sdp_prior_is_still_read_with_a_warning_and_means_the_same(tmp_path):
-    """``[estimation] sdp_prior`` (before: the SDP's one hyper-parameter a config could set) is now said in the
-    estimators list; the old key gives the same settings, with a FutureWarning naming the new spelling, and
-    ``dynid migrate`` rewrites it to a config that loads to the same settings without the warning."""
+def test_a_drafts_sdp_prior_is_refused_in_one_line_saying_the_estimators_entry(tmp_path):
+    """``[estimation] sdp_prior`` (an earlier 0.2.0 draft's key; no release had it) is refused when the config is read,
+    in one line naming the file, the key and the estimators list's entry that says it; that entry gives the SDP its
+    prior."""
     from dynid.io.migrate import migrate_text
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     text = cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\nsdp_prior = "geometric"\n')
     cfg.write_text(text)
-    with pytest.warns(FutureWarning, match=r'sdp_prior = .geometric. is now said in the estimators list, as '
-                                           r'\{ key = "sdp", prior_kind = .geometric. \}.*dynid migrate'):
-        old = load_identification_config(cfg).estimation
-    migrated, changes = migrate_text(text, str(cfg))
-    assert 'estimators = ["ols", {key = "sdp", prior_kind = "geometric"}]' in migrated and "sdp_prior =" not in migrated
-    assert changes and changes[0].startswith("[estimation] sdp_prior")
-    cfg.write_text(migrated)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", FutureWarning)
-        new = load_identification_config(cfg).estimation
-    assert old == new and new.hyperparameters == {"sdp": {"prior_kind": "geometric"}}
+    with pytest.raises(ConfigError, match=re.escape(f'{cfg}: estimation.sdp_prior: no longer exists') + r'.*'
+                       + re.escape('{ key = "sdp", prior_kind = "geometric" } in place of "sdp"')):
+        load_identification_config(cfg)
+    assert migrate_text(text, str(cfg)) == (text, [])  # nothing a release wrote: dynid migrate leaves it
+    cfg.write_text(text.replace('["ols", "sdp"]\nsdp_prior = "geometric"', '["ols", { key = "sdp", prior_kind = "geometric" }]'))
+    assert load_identification_config(cfg).estimation.hyperparameters == {"sdp": {"prior_kind": "geometric"}}
 
 
 def test_a_box_searchs_hyperparameters_reach_it_from_the_config(tmp_path):

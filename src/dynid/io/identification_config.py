@@ -63,9 +63,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
 
 from __future__ import annotations
 
-import json
 import os
-import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -211,15 +209,12 @@ class IdentificationConfig:
 REMOVED = {
     ("preprocessing", "torque_cutoff"): "no longer exists, because a filter on the torques alone biases the estimate near "
                                         "velocity reversals; use parallel_cutoff (torques and every regressor column), or "
-                                        "leave it out for the data-derived default",
+                                        "leave it out for the data-derived default (dynid migrate {path} rewrites it)",
+    ("estimation", "sdp_prior"): "no longer exists (an earlier 0.2.0 draft's): the SDP's prior is its entry's in the "
+                                 'estimators list, { key = "sdp", prior_kind = "geometric" } in place of "sdp"',
 }
 """Fields that no longer exist, and what to write instead (said before the typed check, which would only call them
 unknown); ``[estimation] method``, ``methods`` and ``physically_consistent`` are said by :func:`_estimators_from_old`."""
-
-MOVED_INTO_ESTIMATORS = {"sdp_prior": ("sdp", "prior_kind")}
-"""``[estimation]`` keys that set one estimator's hyper-parameter, now given in the estimators list
-(``{ key = "sdp", prior_kind = "geometric" }``): old key -> (estimator key, hyper-parameter). Still read, with a
-FutureWarning; ``dynid migrate`` rewrites them."""
 
 
 def _per_joint(value, n: int, where: str):
@@ -355,7 +350,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     ConfigError
         As :func:`load_identification_config`.
     """
-    doc, moved = _current_document(doc, path)
+    doc = _current_document(doc, path)
     # the robot table is checked by the description's own parser (its drive terms are those registered now)
     typed = convert({**doc, "robot": "-"} if isinstance(doc.get("robot"), dict) else doc, IdentificationDocument, str(path))
     here = path.parent
@@ -375,7 +370,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     pre = _preprocessing(table, f"{path}: preprocessing", n, here)
     controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
                              robot.transmission.position_offset)
-    estimation = _estimation_settings(typed.estimation, pre, moved, path, controller is not None)
+    estimation = _estimation_settings(typed.estimation, pre, path, controller is not None)
     refs = doc.get("references", [])
     _check_reference_names(refs, path)
     gains = _drive_gains(doc.get("drive_gains"), root, f"{path}: drive_gains", n)
@@ -385,29 +380,28 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
                                 mjcf_model=mjcf)
 
 
-def _current_document(doc: dict, path: Path) -> tuple[dict, dict]:
+def _current_document(doc: dict, path: Path) -> dict:
     """A config's document as read today: the layout a validation table inherits filled in, a removed key refused
-    (saying what replaced it), the keys moved into the estimators list taken out
-    (:func:`_moved_into_estimators`: the hyper-parameters they set)."""
+    (saying what replaced it)."""
     doc = with_inherited_layout(doc)
     for (section, key), why in REMOVED.items():
         if isinstance(doc.get(section), dict) and key in doc[section]:
-            raise ConfigError(f"{path}: {section}.{key}: {why} (dynid migrate {path} rewrites it)")
+            raise ConfigError(f"{path}: {section}.{key}: {why.replace('{path}', str(path))}")
     est = doc.get("estimation")
     old = [k for k in ("method", "physically_consistent", "methods") if isinstance(est, dict) and k in est]
     if old and isinstance(est, dict):
         raise ConfigError(f"{path}: estimation.{old[0]}: no longer exists; list the estimators, the main one first: "
                           f"estimators = {_estimators_from_old(est)} (dynid migrate {path} rewrites it)")
-    return _moved_into_estimators(doc, path)
+    return doc
 
 
-def _estimation_settings(e, pre, moved: dict, path: Path, controlled: bool) -> EstimationSettings:
+def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSettings:
     """The ``[estimation]`` table as settings: the estimators (closed-loop ones only with a controller) and their
     hyper-parameters, the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
     the choice of the main estimate (``e`` None: the table left out)."""
     e = e or EstimationTable()
     friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
-    asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], moved, f"{path}: estimation.estimators")
+    asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     if closed_loop and not controlled:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
@@ -430,29 +424,11 @@ def _robot_files(doc: dict, typed, path: Path, root: Path, robot):
     return robot_source(doc, path, root), urdf, mjcf
 
 
-def _moved_into_estimators(doc: dict, path: Path) -> tuple[dict, dict]:
-    """``doc`` without the keys of :data:`MOVED_INTO_ESTIMATORS` (each said with a FutureWarning), and the
-    hyper-parameters they set: estimator key -> {name: value}."""
-    est = doc.get("estimation")
-    found = [k for k in MOVED_INTO_ESTIMATORS if isinstance(est, dict) and k in est]
-    if not found or not isinstance(est, dict):
-        return doc, {}
-    moved: dict[str, dict] = {}
-    for old in found:
-        key, name = MOVED_INTO_ESTIMATORS[old]
-        moved.setdefault(key, {})[name] = est[old]
-        value = json.dumps(est[old])  # as TOML writes a string or a number
-        warnings.warn(f"{path}: [estimation] {old} = {value} is now said in the estimators list, as "
-                      f'{{ key = "{key}", {name} = {value} }} in place of "{key}" (its meaning is the same; dynid '
-                      f"migrate {path} rewrites it)", FutureWarning, stacklevel=4)
-    return {**doc, "estimation": {k: v for k, v in est.items() if k not in found}}, moved
-
-
-def _estimator_entries(entries: list, moved: dict, where: str) -> tuple[list[str], dict[str, dict]]:
-    """The estimators list's keys (lower case), and the hyper-parameters its inline tables and the moved keys
-    (:func:`_moved_into_estimators`) give: key -> {name: value}, each checked against the estimator's class
-    (:func:`dynid.estimators.registry.configured_estimator`)."""
-    asked, hyperparameters = [], {k: dict(v) for k, v in moved.items()}
+def _estimator_entries(entries: list, where: str) -> tuple[list[str], dict[str, dict]]:
+    """The estimators list's keys (lower case), and the hyper-parameters its inline tables give: key -> {name: value},
+    each checked against the estimator's class (:func:`dynid.estimators.registry.configured_estimator`)."""
+    asked: list[str] = []
+    hyperparameters: dict[str, dict] = {}
     for i, entry in enumerate(entries):
         if not isinstance(entry, dict):
             asked.append(str(entry).strip().lower())
@@ -463,12 +439,7 @@ def _estimator_entries(entries: list, moved: dict, where: str) -> tuple[list[str
                               f'"geometric" }}, got {entry!r}')
         key = key.strip().lower()
         asked.append(key)
-        given = {k: v for k, v in entry.items() if k != "key"}
-        twice = sorted(set(given) & set(hyperparameters.get(key, {})))
-        if twice:
-            raise ConfigError(f"{where}[{i}]: {key}'s {twice[0]} is given twice (here and by an older [estimation] key): "
-                              "keep the one here")
-        hyperparameters[key] = {**hyperparameters.get(key, {}), **given}
+        hyperparameters[key] = {**hyperparameters.get(key, {}), **{k: v for k, v in entry.items() if k != "key"}}
     for key, given in hyperparameters.items():
         configured_estimator(key, given, f"{where}[{asked.index(key)}]" if key in asked else where)
     return asked, {k: v for k, v in hyperparameters.items() if v}

@@ -8,10 +8,7 @@ What an earlier release accepted and this one does not:
   ``estimators = ["wls", "sdp"]``);
 * ``[preprocessing] torque_cutoff`` (a filter on the torques alone, which biased the estimate near velocity
   reversals): ``parallel_cutoff``, the same cutoff on the torques and every regressor column, a changed meaning the
-  migration names;
-* the ``[estimation]`` keys that set one estimator's hyper-parameter
-  (:data:`dynid.io.identification_config.MOVED_INTO_ESTIMATORS`, still read with a warning): that estimator's entry of
-  the estimators list carries it, ``{ key = ..., name = value }``, as any estimator's hyper-parameters are given.
+  migration names.
 
 The settings whose meaning changed while their spelling stayed are listed in the changelog under "Changed"; the
 migration names them in its report when a config uses them (:data:`CHANGED_MEANINGS`).
@@ -94,47 +91,18 @@ def migrate_text(text: str, where: str = "config") -> tuple[str, list[str]]:
                 _replace(edited[table], [key], new_key, section[key])
                 changes.append(f"[{table}] {key} = {_toml(section[key])} -> {new_key} = {_toml(section[key])}: its "
                                f"meaning changed: {why}")
-    moved = _moved_into_estimators(doc, edited, changes)
     for (table, key), why in CHANGED_MEANINGS.items():
         if isinstance(doc.get(table), dict) and key in doc[table]:
             changes.append(f"[{table}] {key} = {_toml(doc[table][key])}: its meaning changed: {why} (kept as written)")
     renamed = [(t, k) for t, k in RENAMED if isinstance(doc.get(t), dict) and k in doc[t]]
-    if not old and not renamed and not moved:
+    if not old and not renamed:
         return text, changes
     out = tomlkit.dumps(edited)
     after = tomllib.loads(out)
-    left = [f"[{t}] {k}" for t, k in [*(("estimation", k) for k in old + moved), *renamed] if k in (after.get(t) or {})]
+    left = [f"[{t}] {k}" for t, k in [*(("estimation", k) for k in old), *renamed] if k in (after.get(t) or {})]
     if left:  # never report a rewrite that was not made
         raise ConfigError(f"{where}: cannot rewrite {', '.join(left)}: edit it by hand as the changelog says")
     return out, changes
-
-
-def _moved_into_estimators(doc: dict, edited, changes: list[str]) -> list[str]:
-    """The ``[estimation]`` keys that set one estimator's hyper-parameter
-    (:data:`dynid.io.identification_config.MOVED_INTO_ESTIMATORS`) rewritten into its entry of the estimators list
-    (``"key"`` -> ``{ key = "key", name = value }``), a line each in ``changes``; those rewritten.
-    Where the estimator is not listed the key stays (it still works, with a warning), and ``changes`` says so."""
-    from .identification_config import MOVED_INTO_ESTIMATORS
-
-    est = doc.get("estimation")
-    done = []
-    for old, (key, name) in MOVED_INTO_ESTIMATORS.items():
-        if not isinstance(est, dict) or old not in est:
-            continue
-        listed = edited["estimation"].get("estimators")
-        at = [i for i, e in enumerate(listed or []) if isinstance(e, str) and e.strip().lower() == key]
-        if not at:
-            changes.append(f"[estimation] {old} = {_toml(est[old])} kept: {key} is not in estimators, where "
-                           f'{{ key = "{key}", {name} = {_toml(est[old])} }} would say it')
-            continue
-        entry = tomlkit.inline_table()
-        entry.update({"key": key, name: est[old]})
-        listed[at[0]] = entry
-        del edited["estimation"][old]
-        changes.append(f'[estimation] {old} = {_toml(est[old])} -> estimators = [... {{ key = "{key}", {name} = '
-                       f"{_toml(est[old])} }} ...] (the same meaning)")
-        done.append(old)
-    return done
 
 
 def _replace(table, keys: list[str], new_key: str | None, value) -> None:
