@@ -63,8 +63,8 @@ def test_too_many_or_doubled_arguments_are_the_usual_type_errors():
 
 def test_the_random_state_has_one_name_and_the_former_one_still_works_with_a_warning():
     """issue "Parts carry their settings, one route", item 6: every public callable that takes a random state calls
-    it ``rng`` (NumPy's SPEC 7: an int or a Generator); ``seed=`` gives the same result with a FutureWarning naming
-    ``rng``, and both at once are refused. A config's ``seed`` key (a user's file) is unchanged."""
+    it ``rng`` (NumPy's SPEC 7: an int or a Generator); ``seed=`` of those 0.1.0 had gives the same result with a
+    FutureWarning naming ``rng``, and both at once are refused. A config's ``seed`` key (a user's file) is unchanged."""
     from dynid.estimators import check_estimator
     from dynid.identification.pipeline import IdentificationPipeline
     from dynid.studies.simulated_fleet import simulate_fleet, simulate_service_life
@@ -86,8 +86,10 @@ def test_the_random_state_has_one_name_and_the_former_one_still_works_with_a_war
     with pytest.warns(FutureWarning, match="seed= is now rng="):
         ident = dynid.Identifier(robot, seed=4)
     assert ident.get_params()["rng"] == 4 and "seed" not in ident.get_params()
-    with pytest.warns(FutureWarning, match="seed= is now rng="):
-        assert IdentificationPipeline(robot, seed=5).rng == 5
-    with pytest.warns(FutureWarning, match="identify_from_arrays: seed= is now rng="):
-        with pytest.raises(ConfigError, match="unknown setting 'magic'"):
-            dynid.identify_from_arrays(robot, log.t, log.q, log.tau, seed=1, magic=2)
+    # seed= of callables no release had (an earlier 0.2.0 draft's): refused as any unknown keyword
+    with pytest.raises(TypeError, match="unexpected keyword argument 'seed'"):
+        IdentificationPipeline(robot, seed=5)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'seed'"):
+        check_estimator("ols", seed=1)
+    with pytest.raises(ConfigError, match="unknown setting 'seed'"):
+        dynid.identify_from_arrays(robot, log.t, log.q, log.tau, seed=1)

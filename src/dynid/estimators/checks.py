@@ -25,7 +25,7 @@ import inspect
 
 import numpy as np
 
-from .._util.keywords import renamed_keyword, seed_of
+from .._util.keywords import seed_of
 from ..exceptions import DynIdError
 from .base import BoxSearchEstimator, Estimator, paper_objective
 from .fitting import fit_method
@@ -68,7 +68,6 @@ def _problem(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     return w, tau, truth, bounds, sigma
 
 
-@renamed_keyword("seed", "rng")
 def check_estimator(estimator, rng=0) -> None:
     """Check an estimator (module docstring), registered or not.
 
@@ -79,8 +78,7 @@ def check_estimator(estimator, rng=0) -> None:
         checked before it is registered, as registered with its defaults (a :class:`BoxSearchEstimator` as a box
         search); the registry is as it was afterwards.
     rng : int or numpy.random.Generator
-        Seeds the synthetic problem and the estimator's ``rng`` (a generator gives one draw as the seed). Was ``seed``
-        (still taken, with a FutureWarning).
+        Seeds the synthetic problem and the estimator's ``rng`` (a generator gives one draw as the seed).
 
     Raises
     ------

@@ -1,4 +1,4 @@
-"""Former home of the identification route, the simulated studies and the fleet tools (dynid ≤ 0.8), kept so that old
+"""Former home of the identification route, the simulated studies and the fleet tools (dynid 0.1.0), kept so that old
 imports still work for one release: ``dynid.experiment.X`` now lives in :mod:`dynid.identification`,
 :mod:`dynid.studies` or :mod:`dynid.fleet` (docs/changelog.md). Each old name imports the new module and says where it
 went with a ``FutureWarning``."""
@@ -10,25 +10,19 @@ import importlib
 from .._lazy import alias_moved_modules, moved
 
 MOVED = {
-    "closed_loop": "dynid.identification.closed_loop",
-    "closed_loop_study": "dynid.studies.closed_loop",
-    "delay": "dynid.identification.delay",
     "drive_gains": "dynid.identification.drive_gains",
     "excitation": "dynid.identification.excitation_run",
-    "fleet": "dynid.fleet.identification",
     "identification": "dynid.identification.identify",
-    "identification_pipeline": "dynid.identification.pipeline",
     "identification_run": "dynid.identification.run",
     "identified": "dynid.identification.identified",
     "identifier": "dynid.identification.identifier",
-    "monitor": "dynid.fleet.monitor",
     "montecarlo": "dynid.studies.montecarlo",
     "paper": "dynid.studies.paper",
     "paper_reference": "dynid.studies.paper_reference",
-    "simulated_fleet": "dynid.studies.simulated_fleet",
     "simulated_logs": "dynid.studies.simulated_logs",
 }
-"""Old submodule of ``dynid.experiment`` → the module it became."""
+"""Submodule of ``dynid.experiment`` in 0.1.0 → the module it became (those an earlier 0.2.0 draft added there and
+moved on have no old path: no release had them)."""
 
 _NAMES = {"PaperExperimentConfig": "dynid.studies.paper", "PaperRunResult": "dynid.studies.paper",
           "run_paper_experiment": "dynid.studies.paper"}

@@ -362,7 +362,6 @@ class IdentifiedModel:
         return np.column_stack([np.interp(at, data.t, pred[:, j], left=np.nan, right=np.nan)
                                 for j in range(pred.shape[1])])
 
-    @keyword_only_after_data
     def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the model at given states (inverse dynamics with friction: ``Y(q, q̇, q̈)·β``), as they are.
 

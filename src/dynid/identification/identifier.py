@@ -345,7 +345,6 @@ class Identifier(HyperParameters):
         """
         return self._model().validate(t, q, tau, estimate=estimate)
 
-    @keyword_only_after_data
     def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques at states one computed oneself (:meth:`dynid.identification.identified.IdentifiedModel.predict_states`).
 

@@ -34,7 +34,6 @@ from typing import Any
 
 import numpy as np
 
-from .._util.keywords import renamed_keyword
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.estimation import Estimation, stream_rows
@@ -112,8 +111,7 @@ class IdentificationPipeline:
     friction : {"description", "auto"}
         The description's friction terms, or each joint's model chosen by cross-validation.
     rng : int
-        Seeds the box searches and the bootstrap (a config's ``seed``; ``seed=`` is still taken, with a
-        FutureWarning).
+        Seeds the box searches and the bootstrap (a config's ``seed``).
     source : str
         Where the robot's description comes from (results.json's ``robot_source``: a built-in name, a path), so that
         :func:`dynid.load_results` finds it.
@@ -376,8 +374,6 @@ class IdentificationPipeline:
         return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
 
 
-
-IdentificationPipeline.__init__ = renamed_keyword("seed", "rng")(IdentificationPipeline.__init__)  # type: ignore[method-assign]
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:

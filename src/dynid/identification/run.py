@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._util.checks import check_trajectory_array
-from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
+from .._util.keywords import keyword_only_after_data, seed_of
 from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError, ShapeError
 from ..io.dataset_specs import DatasetSpec
@@ -76,7 +76,6 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-@keyword_only_after_data
 def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, recordings, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
                   yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
@@ -507,7 +506,6 @@ def _identified_model(config: IdentificationConfig, identified: dict, source: st
 
 
 @with_single_blas_thread
-@keyword_only_after_data
 def run_payload(config: IdentificationConfig, identified: dict, dataset: DatasetSpec, *, source: str = "results"):
     """A tool's payload from a log with it, the arm's model taken from an identification's results (issue "The model
     proven where it goes", item 4; :func:`dynid.identification.payload.payload_from_log`).
@@ -654,7 +652,6 @@ def identified_gain_ratio(identified: dict, n_dof: int) -> np.ndarray | None:
     return np.where(np.isfinite(gains) & (read > 0), gains / np.where(read > 0, read, 1.0), 1.0)
 
 
-@renamed_keyword("seed", "rng")
 @with_single_blas_thread
 def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None, *, name: str = "arrays", **settings):
     """Identify a robot from arrays, without a config file or a CSV: the pipeline of ``dynid identify``

@@ -16,7 +16,7 @@ from importlib import resources
 
 import numpy as np
 
-from .._util.keywords import renamed_keyword, seed_of
+from .._util.keywords import seed_of
 from ..exceptions import ConfigError
 from ..model.description import builtin_robots, load_robot
 from .simulated_logs import simulated_log
@@ -59,7 +59,6 @@ def _csv(log, robot) -> str:
     return buffer.getvalue()
 
 
-@renamed_keyword("seed", "rng")
 def example_files(name: str, rng=0) -> dict[str, str]:
     """The files of an example folder for a built-in robot: its URDF (where it has one), two simulated logs and a config.
 
@@ -69,7 +68,7 @@ def example_files(name: str, rng=0) -> dict[str, str]:
         One of :data:`EXAMPLES`.
     rng : int or numpy.random.Generator
         Seeds the trajectories, the drive values and the noise (the same files for the same int; a generator gives one
-        draw as the seed). Was ``seed`` (still taken, with a FutureWarning).
+        draw as the seed).
 
     Returns
     -------

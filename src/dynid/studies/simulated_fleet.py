@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.keywords import renamed_keyword, seed_of
+from .._util.keywords import seed_of
 from ..exceptions import ConfigError
 from ..excitation.fourier import FourierTrajectory
 from ..model.description import load_robot
@@ -164,7 +164,6 @@ def _nominal_friction(robot: Robot, name: str) -> tuple[np.ndarray, np.ndarray]:
     return np.array(fc[:robot.n_dof]), np.array(fv[:robot.n_dof])
 
 
-@renamed_keyword("seed", "rng")
 def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, seconds: float = 30.0,
                    rate: float = 250.0, validation_seconds: float = 20.0, friction_spread: float = 0.2,
                    payload_max: float = 2.0, odd_unit: int | None = 2, odd_joint: int = 2, gain_error: float = 0.05,
@@ -202,8 +201,7 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     calibration : bool
         Write the drive-gain runs (and ``[drive_gains]`` in the template).
     rng : int or numpy.random.Generator
-        Seeds the units, their logs and noise (a generator gives one draw as the seed). Was ``seed`` (still taken, with
-        a FutureWarning).
+        Seeds the units, their logs and noise (a generator gives one draw as the seed).
 
     Returns
     -------
@@ -261,7 +259,6 @@ def simulate_fleet(folder: str | Path, robot: str = "ur10e", units: int = 6, *, 
     return truths
 
 
-@renamed_keyword("seed", "rng")
 def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int = 28, logs_per_day: int = 1,
                           seconds: float = 60.0, rate: float = 250.0, wear_joint: int = 3, wear_start_day: float = 14.0,
                           wear_per_day: float = 0.02, step: float = 0.0, coulomb: bool = True,
@@ -289,8 +286,7 @@ def simulate_service_life(folder: str | Path, robot: str = "ur10e", *, days: int
         The Coulomb friction rises with the viscous one.
     noise : NoiseModel
     rng : int or numpy.random.Generator
-        Seeds the logs and noise (a generator gives one draw as the seed). Was ``seed`` (still taken, with a
-        FutureWarning).
+        Seeds the logs and noise (a generator gives one draw as the seed).
 
     Returns
     -------
