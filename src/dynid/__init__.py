@@ -14,7 +14,7 @@ The main entry points, importable from the package (each loads its modules on fi
     comparisons, warnings = dynid.run_validation(config, results_json_dict)
     design = dynid.design_excitation(dynid.ExcitationProblem(robot, omega_f, n_harmonics))
     urdf_text = dynid.urdf_from_robot(robot, standard_parameters)
-    run = dynid.run_paper_experiment(dynid.PaperExperimentConfig(methods=("ols", "abc")))
+    run = dynid.run_paper_experiment(dynid.PaperExperimentConfig(estimators=("ols", "abc")))
 
 ``examples/`` holds short scripts that use them.
 """
