@@ -486,7 +486,6 @@ class IdentifiedModel:
         res = meas - pred
         return 1.0 - float(np.sum(res**2)) / float(np.sum((meas - meas.mean(axis=0)) ** 2))
 
-    @keyword_only_after_data
     def relative_error(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:
         """The global relative torque error [%] ``dynid validate`` prints for a log, on the same samples (the log
         prepared as the identification's settings carry over to it): ``100·||τ - τ̂|| / ||τ||`` over its joints.

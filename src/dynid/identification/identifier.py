@@ -318,7 +318,6 @@ class Identifier(HyperParameters):
             return self._model().predict_states(t, q, dq, estimate=estimate)
         return self._model().predict(t, q, dq, ddq, estimate=estimate)
 
-    @keyword_only_after_data
     def validate(self, t, q=None, tau=None, *, estimate: str | None = None):
         """The paper's metrics (eq. 18's correlation, RMSE, relative error) of the estimates on another log, on the
         samples ``dynid validate`` scores (:meth:`dynid.identification.identified.IdentifiedModel.validate`).
