@@ -210,8 +210,8 @@ REMOVED = {
     ("preprocessing", "torque_cutoff"): "no longer exists, because a filter on the torques alone biases the estimate near "
                                         "velocity reversals; use parallel_cutoff (torques and every regressor column), or "
                                         "leave it out for the data-derived default (dynid migrate {path} rewrites it)",
-    ("estimation", "sdp_prior"): "no longer exists (an earlier 0.2.0 draft's): the SDP's prior is its entry's in the "
-                                 'estimators list, { key = "sdp", prior_kind = "geometric" } in place of "sdp"',
+    ("estimation", "sdp_prior"): "no longer exists (a key of an unreleased 0.2.0 draft): the SDP's prior is given in its "
+                                 'entry of the estimators list, { key = "sdp", prior_kind = "geometric" } in place of "sdp"',
 }
 """Fields that no longer exist, and what to write instead (said before the typed check, which would only call them
 unknown); ``[estimation] method``, ``methods`` and ``physically_consistent`` are said by :func:`_estimators_from_old`."""
