@@ -374,8 +374,6 @@ class IdentificationPipeline:
         return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
 
 
-
-
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:
     """``data`` with each joint's slowest fitted speed raised where its chosen smooth Coulomb term needs it
     (:meth:`dynid.identification.friction_models.FrictionChoice.fit_speeds`), said in the settings' derivation, and in
