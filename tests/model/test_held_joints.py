@@ -111,6 +111,26 @@ def test_write_back_keeps_the_held_fingers_inertials_and_the_model_loads(tmp_pat
         assert np.all(np.isfinite(pin.aba(model, data, q, np.zeros(model.nv), np.zeros(model.nv))))
 
 
+def test_a_branch_before_the_arm_in_pinocchios_order_is_the_joint_held(tmp_path):
+    """A revolute joint on a branch of its own from the base (a camera's pan joint) named so that Pinocchio's
+    depth-first order puts it before the arm's first joint: the arm is the longest chain, so the branch is what dynid
+    init holds and what the refusal names, never the arm."""
+    camera = _link("camera", 0.3, "0 0 0.02") + _revolute("a_camera_pan", "base", "camera", "0.1 0 0.1", "0 0 1")
+    urdf = _urdf(tmp_path, ARM + camera)
+    import pinocchio as pin
+
+    assert list(pin.buildModelFromUrdf(str(urdf)).names)[1:] == ["a_camera_pan", "j1", "j2"]  # the branch first
+    assert joints_to_hold(urdf) == ("a_camera_pan",)
+    with pytest.raises(ConfigError, match=re.escape("arm.urdf: joints 'a_camera_pan', 'j1' all ride on the base, and "
+                                                    "dynid identifies one serial chain: hold the joints that are not "
+                                                    "the arm's fixed in the config's [robot] table, held = "
+                                                    '["a_camera_pan"] for the longest chain (j1 to j2;')):
+        joints_from_urdf(urdf)
+    assert joints_from_urdf(urdf, {"a_camera_pan": 0.0})[2] == ("j1", "j2")
+    gripper = _urdf(tmp_path, ARM + camera + FINGERS, "gripper.urdf")
+    assert joints_to_hold(gripper) == ("a_camera_pan", "f1", "f2")
+
+
 def test_init_holds_the_joints_off_the_arm(tmp_path):
     """dynid init on a URDF with a gripper: the config's [robot] table holds the fingers, and it reads as a robot of
     the arm's joints."""

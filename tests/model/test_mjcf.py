@@ -155,12 +155,25 @@ def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tm
      r"joint 'j3' has ref = 0.1745"),
     (('<body name="l3"', '<body name="side" pos="0 0.1 0"><joint name="jb" axis="0 0 1"/>'
       '<inertial pos="0 0 0" mass="0.5" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l3"'),
-     r"joint 'j3' does not continue a serial chain"),
+     r"arm.xml: joints 'jb', 'j3' all ride on joint 'j2', and dynid identifies one serial chain: hold the joints that "
+     r"are not the arm's fixed in the config's \[robot\] table, held = \[\"j3\"\] for one of the longest chains "
+     r"\(j1 to jb;"),
+    (('<body name="l1"', '<body name="camera" pos="0 0.2 0.1"><joint name="pan" axis="0 0 1"/>'
+      '<inertial pos="0 0 0" mass="0.3" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l1"'),
+     r"joints 'pan', 'j1' all ride on the base, .*held = \[\"pan\"\] for the longest chain \(j1 to j3;"),
 ])
 def test_an_mjcf_chain_dynid_cannot_identify_is_refused_naming_the_joint(tmp_path, change, message):
+    """A branch is refused naming the joints that ride on the same one and the held that keeps the longest chain (a
+    camera's pan joint written before the arm is the one to hold, and dynid init holds it)."""
+    from dynid.model.urdf import joints_to_hold
+
     (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace(*change))
     with pytest.raises(ConfigError, match=message):
         load_robot(tmp_path / "arm.xml")
+    if "camera" in change[1]:
+        assert joints_to_hold(tmp_path / "arm.xml") == ("pan",)
+        robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["pan"]}}, tmp_path / "c.toml")
+        assert robot.n_dof == 3 and [j.name for j in robot.joints] == ["j1", "j2", "j3"]
 
 
 def test_an_mjcfs_gravity_other_than_the_robots_is_said(tmp_path):

@@ -19,7 +19,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from ..runtime.extras import require
 from .robot import Joint
-from .robot_files import HELD_HINT, check_xml
+from .robot_files import HELD_HINT, arm_chain, branch_refusal, check_xml
 from .spatial import inertial_from_physical, rot_axis, transform_inertial
 
 
@@ -66,8 +66,7 @@ def _chain(path: Path, held: dict):
                                   "dynid identifies one revolute joint per link; " + HELD_HINT.format(names=f'"{name}"'))
             previous = moving[-1] if moving else -1
             if owner[b] != previous:
-                raise ConfigError(f"{path}: joint {name!r} does not continue a serial chain: "
-                                  + HELD_HINT.format(names=f'"{name}"'))
+                raise ConfigError(branch_refusal(path, *_tree(mujoco, model, held), k))
             if abs(model.qpos0[model.jnt_qposadr[k]]) > 0:
                 raise ConfigError(f"{path}: joint {name!r} has ref = {model.qpos0[model.jnt_qposadr[k]]:g}: dynid's "
                                   "joint angle is 0 where the body's frame is as written; remove ref (and offset the "
@@ -343,8 +342,8 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
 
 
 def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
-    """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: from the first joint that is not a
-    hinge or does not continue a serial chain of hinges from the base (a gripper's fingers), every joint after it.
+    """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest chain of
+    hinges from the base (a gripper's fingers, a camera's pan joint on a branch of its own, wherever the file puts it).
 
     Parameters
     ----------
@@ -361,12 +360,21 @@ def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
         MuJoCo is not installed, or the file cannot be compiled.
     """
     mujoco, model = _compiled(Path(path))
+    _, parents, revolute = _tree(mujoco, model)
+    arm = arm_chain(parents, revolute)
+    return tuple(model.joint(k).name for k in parents if k not in arm)
+
+
+def _tree(mujoco, model, held=()) -> tuple[dict[int, str], dict[int, int], set[int]]:
+    """The MJCF's moving joints (not ``held``) as :func:`dynid.model.robot_files.arm_chain` reads them: each riding on
+    the last joint of the bodies above it; the hinges are the revolute ones."""
+    names: dict[int, str] = {}
+    parents: dict[int, int] = {}
     owner = np.full(model.nbody, -1)
-    last = -1
     for b in range(1, model.nbody):
         owner[b] = owner[model.body_parentid[b]]
         for k in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
-            if model.jnt_type[k] != mujoco.mjtJoint.mjJNT_HINGE or owner[b] != last:
-                return tuple(model.joint(j).name for j in range(k, model.njnt))
-            owner[b] = last = k
-    return ()
+            name = model.joint(k).name or f"joint {k + 1}"
+            if name not in held:
+                names[k], parents[k], owner[b] = name, int(owner[b]), k
+    return names, parents, {k for k in names if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_HINGE}

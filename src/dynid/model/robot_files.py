@@ -14,6 +14,63 @@ HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (
 :func:`dynid.model.urdf.joints_from_urdf`, :mod:`dynid.model.mjcf`)."""
 
 
+def arm_chain(parents: dict[int, int], revolute: set[int]) -> list[int]:
+    """The arm's joints in a robot file's tree of moving joints: the longest chain from the base of revolute joints,
+    each riding on the one before (of chains as long, the first in the file's reading order).
+
+    Parameters
+    ----------
+    parents : dict of int to int
+        Every moving joint -> the moving joint it rides on (-1: the base), in reading order: a joint after its parent.
+    revolute : set of int
+        The joints that can be the arm's (revolute, not mimicking another).
+
+    Returns
+    -------
+    list of int
+        From the base outwards.
+    """
+    return max(_chains(parents, revolute).values(), key=len)
+
+
+def _chains(parents: dict[int, int], revolute: set[int]) -> dict[int, list[int]]:
+    """Each revolute joint reached from the base through revolute joints -> that chain (``-1``: the empty one)."""
+    chains: dict[int, list[int]] = {-1: []}
+    for k, parent in parents.items():
+        if k in revolute and parent in chains:
+            chains[k] = chains[parent] + [k]
+    return chains
+
+
+def branch_refusal(path, names: dict[int, str], parents: dict[int, int], revolute: set[int], at: int) -> str:
+    """The one line refusing a tree of joints that branches: the joints riding on the same one as joint ``at``, and
+    the ``held`` that keeps the longest chain (:func:`arm_chain`).
+
+    Parameters
+    ----------
+    path : path
+    names : dict of int to str
+        Every moving joint's name.
+    parents, revolute
+        As :func:`arm_chain`.
+    at : int
+        A joint that rides on another than the joint before it.
+
+    Returns
+    -------
+    str
+    """
+    siblings = [names[k] for k, parent in parents.items() if parent == parents[at]]
+    chains = _chains(parents, revolute)
+    arm = max(chains.values(), key=len)
+    one = "one of the longest chains" if sum(len(c) == len(arm) for c in chains.values()) > 1 else "the longest chain"
+    off = ", ".join(f'"{names[k]}"' for k in parents if k not in arm)
+    where = "the base" if parents[at] < 0 else f"joint {names[parents[at]]!r}"
+    return (f"{path}: joints {', '.join(map(repr, siblings))} all ride on {where}, and dynid identifies one serial "
+            f"chain: hold the joints that are not the arm's fixed in the config's [robot] table, held = [{off}] for "
+            f"{one} ({names[arm[0]]} to {names[arm[-1]]}; a gripper's fingers, a camera's pan joint)")
+
+
 def check_xml(path: Path, parser=None) -> None:
     """Refuse a file that is not well-formed XML, naming the line and column.
 

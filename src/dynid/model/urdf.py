@@ -16,7 +16,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
-from .robot_files import HELD_HINT, check_xml, is_mjcf
+from .robot_files import HELD_HINT, arm_chain, branch_refusal, check_xml, is_mjcf
 from .xacro_expansion import expand_xacro_text
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
@@ -190,8 +190,7 @@ def joints_from_urdf(path: str | Path,
         jm = model.joints[j]
         short = jm.shortname()
         if model.parents[j] != j - 1:
-            raise ConfigError(f"{path}: joint {model.names[j]!r} does not continue a serial chain: "
-                              + HELD_HINT.format(names=f'"{model.names[j]}"'))
+            raise ConfigError(branch_refusal(path, *_tree(model), j - 1))
         if short.startswith("JointModelR") and short[-2:] in _AXES and "Unbounded" not in short:
             axis = np.array(_AXES[short[-2:]])  # revolute, or continuous (RUB: unbounded, same dynamics)
         elif short.startswith("JointModelRUB") and "R" + short[-1] in _AXES:  # continuous joint about x, y or z
@@ -243,9 +242,9 @@ def _pinocchio_model(path: Path, held: dict):
 
 
 def joints_to_hold(path: str | Path) -> tuple[str, ...]:
-    """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: from the first joint that does
-    not continue a serial chain of revolute joints from the base (a gripper's fingers, prismatic or on a branch) or
-    that mimics another, every joint after it in Pinocchio's depth-first order.
+    """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest
+    chain of revolute joints from the base, none mimicking another (a gripper's fingers, prismatic or on a branch; a
+    camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it).
 
     Parameters
     ----------
@@ -264,14 +263,22 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
     path = Path(path)
     if is_mjcf(path):
         return mjcf_joints_to_hold(path)
-    check_urdf_text(path, held=_mimic_joints(path))
-    model = _pinocchio_model(path, {})
     mimic = _mimic_joints(path)
-    for j in range(1, model.njoints):
-        if (model.parents[j] != j - 1 or not model.joints[j].shortname().startswith("JointModelR")
-                or model.names[j] in mimic):
-            return tuple(model.names[j:])
-    return ()
+    check_urdf_text(path, held=mimic)
+    model = _pinocchio_model(path, {})
+    names, parents, revolute = _tree(model, mimic)
+    arm = arm_chain(parents, revolute)
+    return tuple(names[k] for k in parents if k not in arm)
+
+
+def _tree(model, mimic=frozenset()) -> tuple[dict[int, str], dict[int, int], set[int]]:
+    """Pinocchio's moving joints as :func:`dynid.model.robot_files.arm_chain` reads them (numbered from 0; a
+    mimic joint is no revolute joint of the arm)."""
+    names = {j - 1: model.names[j] for j in range(1, model.njoints)}
+    parents = {j - 1: model.parents[j] - 1 for j in range(1, model.njoints)}
+    revolute = {j - 1 for j in range(1, model.njoints)
+                if model.joints[j].shortname().startswith("JointModelR") and model.names[j] not in mimic}
+    return names, parents, revolute
 
 
 def _mimic_joints(path: Path) -> set[str]:
