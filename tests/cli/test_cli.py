@@ -173,13 +173,21 @@ def test_a_config_is_checked_before_any_heavy_import(tmp_path):
     assert "identificaton" in p.stderr
 
 
-def test_a_setting_said_otherwise_now_is_one_warning_line(capfd):
+def test_a_setting_said_otherwise_now_is_one_warning_line(capfd, monkeypatch):
     """A setting that changed (a ``FutureWarning``: it names the setting and the new spelling) is said as the command's
     other warnings are, one line, not as Python's FutureWarning with a source line; any other warning as Python shows
-    it, with where it came from."""
+    it, with where it came from. ``main`` shows a command's warnings this way."""
     import warnings
 
+    from dynid.cli import app as cli
     from dynid.cli.app import _show_warning
+
+    def command(args, prog_name):  # a command whose library call warns of a changed setting
+        warnings.warn("f: seed= is now rng=", FutureWarning, stacklevel=1)
+
+    monkeypatch.setattr(cli, "app", command)
+    assert cli.main([]) == 0
+    assert capfd.readouterr().err.splitlines() == ["warning: f: seed= is now rng="]
 
     _show_warning(FutureWarning('f: seed= is now rng='), FutureWarning, "lib.py", 7)
     err = capfd.readouterr().err
