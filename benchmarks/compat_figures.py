@@ -24,9 +24,11 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from dynid.io.results import global_errors
-
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from tests.results_figures import global_errors  # noqa: E402 - the repository's root on the path first
+
 CORPUS = REPO / "tests" / "data" / "compat"
 DATA = {"ur10e": "ur10e_mamedov2020", "tx40": "staubli_tx40_figaroh", "tx40-full": "staubli_tx40_figaroh",
         "kuka_kr300": "kuka_kr300_weigand2021", "kuka_med7": "kuka_med7_lbrstack"}

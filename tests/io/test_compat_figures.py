@@ -15,9 +15,9 @@ import pytest
 from dynid.identification.run import run_identification
 from dynid.io.identification_config import load_identification_config
 from dynid.io.migrate import migrate_text
-from dynid.io.results import global_errors
 
 from ..conftest import shared_data
+from ..results_figures import global_errors
 
 REPO = Path(__file__).resolve().parents[2]
 RECORDED = json.loads((REPO / "tests" / "data" / "compat" / "figures.json").read_text(encoding="utf-8"))

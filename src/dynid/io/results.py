@@ -123,37 +123,6 @@ def schema_problem(data: dict) -> str:
     return f"{where or 'the file'}: {error.message}"
 
 
-def global_errors(results: dict) -> dict[tuple[str, str], float]:
-    """Every global relative torque error a results.json holds, of any schema: the identification log's and each
-    validation log's, per parameter set.
-
-    ``100·‖τ − τ̂‖_F / ‖τ‖_F`` (:func:`dynid.validation.metrics.global_relative_error`), recomputed from the per-joint
-    RMSE and RMS torque where an early results.json stored no global figure.
-
-    Parameters
-    ----------
-    results : dict
-        A parsed results.json of ``dynid identify`` (any release).
-
-    Returns
-    -------
-    dict
-        ``(log name, set label) -> error [%]``.
-    """
-    out = {}
-    for part in [results.get("identification")] + list(results.get("validation", [])):
-        if not part:
-            continue
-        rms = part.get("rms_torque")
-        for label, m in part.get("metrics", {}).items():
-            value = m.get("global_relative_error")
-            if value is None and m.get("rmse") is not None and rms is not None:
-                value = 100.0 * float(np.sqrt(sum(e * e for e in m["rmse"]) / sum(r * r for r in rms)))
-            if value is not None:
-                out[(part["name"], label)] = float(value)
-    return out
-
-
 def stored_estimates(identified: dict, names, source: str = "results", robot: str = "") -> dict:
     """label -> base parameter vector of every estimate in a results.json.
 
