@@ -22,7 +22,7 @@ from ..estimators.registry import label
 from ..exceptions import ConfigError, DataError
 from ..io.export import mjcf_from_results, urdf_from_results
 from ..io.files import _clean, write_json
-from ..io.results import check_fingerprint, read_results, stored_estimates
+from ..io.results import check_fingerprint, read_results, stored_estimates, stored_residual_level
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepare
@@ -457,7 +457,8 @@ class IdentifiedModel:
         recording.check(self.robot.n_dof)
         data = prepare(recording, self._settings(), strict=False)
         sets = self.estimates if estimate is None else {self.label(estimate): self.params(estimate)}
-        return compare_torques(self.robot, self.base, data, sets)
+        # the identification's residual level says which joints' errors and correlations mean something, as in dynid validate
+        return compare_torques(self.robot, self.base, data, sets, noise=stored_residual_level(self.results, self.robot.n_dof))
 
     @keyword_only_after_data
     def score(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:

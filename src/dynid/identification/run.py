@@ -29,6 +29,7 @@ from ..io.log_repairs import (
     uniform_rate,
     unwrapped_positions,
 )
+from ..io.results import stored_estimates, stored_residual_level
 from ..model.description import builtin_robots
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -451,17 +452,13 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    try:
-        noise = np.asarray(identified.get("joint_residual_std"), dtype=float) if "joint_residual_std" in identified else None
-        noise = noise if noise is not None and noise.shape == (config.robot.n_dof,) else None
-    except (TypeError, ValueError):
-        noise = None
     reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
     logs = _read_as_scored(datasets, config.robot, progress)
     comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
-                                          progress=progress, resolved=stored_preprocessing(identified), noise=noise,
+                                          progress=progress, resolved=stored_preprocessing(identified),
+                                          noise=stored_residual_level(identified, config.robot.n_dof),
                                           yardstick=reference, fitted=_fitted_correlation(identified, sets, config.robot.n_dof),
                                           nominal=label)
     if beside:
@@ -494,7 +491,6 @@ def _identified_model(config: IdentificationConfig, identified: dict, source: st
     """``(config, base, estimates)``: the config with its robot as the results identified it (their friction model),
     the base-parameter map, and every estimate of results.json (label -> base parameters)."""
     from ..dynamics.base_parameters import base_parameters
-    from ..io.results import stored_estimates
     from ..model.friction_model import robot_from_settings
 
     try:

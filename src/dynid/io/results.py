@@ -15,7 +15,7 @@ import numpy as np
 
 from ..exceptions import DataError
 
-__all__ = ["read_results", "stored_estimates", "stored_standard"]
+__all__ = ["read_results", "stored_estimates", "stored_standard", "stored_residual_level"]
 
 OLD_LAYOUT = 1
 """``schema_version`` of results written before the estimates table: read without the schema's check."""
@@ -204,6 +204,30 @@ def stored_standard(identified: dict) -> tuple[str, dict] | None:
     if isinstance(sdp, dict) and isinstance(sdp.get("standard_values"), dict):
         return str(sdp.get("label", "dynid SDP")), sdp["standard_values"]
     return None
+
+
+def stored_residual_level(identified: dict, n_dof: int) -> np.ndarray | None:
+    """Each joint's residual standard deviation on the identification log, as a results.json holds it
+    (``joint_residual_std``): what a validation log's torque must exceed for its relative error and its correlation
+    coefficient (eq. 18) to mean something (:meth:`dynid.validation.torques.TorqueComparison.meaningful`, ``varies``).
+
+    Parameters
+    ----------
+    identified : dict
+        The parsed results.json of ``dynid identify``.
+    n_dof : int
+        The robot's joints.
+
+    Returns
+    -------
+    (n_dof,) array [N·m] or None
+        None where the results hold no such figure, or not one per joint.
+    """
+    try:
+        level = np.asarray(identified.get("joint_residual_std"), dtype=float)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    return level if level.shape == (n_dof,) else None
 
 
 def _vector(entry, names: tuple, where: str) -> np.ndarray:
