@@ -24,5 +24,8 @@ def test_a_log_runs_the_trajectory_given_and_its_torques_are_the_models():
     np.testing.assert_allclose(log.tau, torque, rtol=0, atol=1e-9 * np.abs(torque).max())
     noisy = dynid.simulated_log(robot, seconds=10.0, rate=100.0, trajectory=motion, rng=1)
     assert np.abs(noisy.q - q).max() <= np.pi / 2**20 + 1e-15  # the default 20-bit encoders' rounding, no other motion
-    with pytest.raises(ConfigError, match="^simulated_log: the trajectory moves 2 joints, er16 has 6$"):
+    with pytest.raises(ConfigError, match=r"^simulated_log: the trajectory moves 2 joints, er16 has 6 \(its first 2 joints: the robot's submodel\(2\)\)$"):
         dynid.simulated_log(robot, trajectory=FourierTrajectory(1.0, np.zeros(2), np.zeros((2, 5)), np.zeros((2, 5))))
+    two = dynid.simulated_log(robot.submodel(2), seconds=1.0, trajectory=FourierTrajectory(1.0, np.zeros(2), np.zeros((2, 5)),
+                                                                                           np.zeros((2, 5))))
+    assert two.q.shape[1] == 2 and two.tau.shape == two.q.shape  # what the message says to do works

@@ -66,8 +66,9 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
     if trajectory is None:
         trajectory = random_excitation(robot, generator)
     elif np.shape(trajectory.q0) != (robot.n_dof,):
-        raise ConfigError(f"simulated_log: the trajectory moves {np.size(trajectory.q0)} joints, {robot.name} has "
-                          f"{robot.n_dof}")
+        moved = np.size(trajectory.q0)
+        first = f" (its first {moved} joints: the robot's submodel({moved}))" if moved < robot.n_dof else ""
+        raise ConfigError(f"simulated_log: the trajectory moves {moved} joints, {robot.name} has {robot.n_dof}{first}")
     t = np.arange(int(round(seconds * rate))) / rate
     q, dq, ddq = trajectory.evaluate(t)
     meas = simulate_measurements(robot, t, q, dq, ddq, noise, generator)
