@@ -839,3 +839,45 @@ def test_init_names_a_built_in_robot_as_given_and_leaves_its_mounting_to_a_descr
     assert p.returncode == 0, p.stderr
     assert tomllib.loads((tmp_path / "cfg" / "arm.toml").read_text())["robot"] == "ur10e"
     assert "(a built-in robot: give it in a description file)" in " ".join((p.stdout + p.stderr).split())
+
+
+@pytest.mark.parametrize("header", [True, False])
+def test_init_reads_a_european_spreadsheets_export_as_the_same_log(tmp_path, header):
+    """A log saved by a spreadsheet in a European locale (semicolons between the fields, decimal commas): init took the
+    commas for the delimiter (one field named 'time;joint_pos_1;…'); it now writes delimiter = ";" and decimal = ",",
+    and the log reads as the same numbers as the one written with points and commas."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    log = _log(tmp_path, header=header)
+    european = tmp_path / "european.csv"
+    european.write_text(log.read_text().replace(",", ";").replace(".", ","))
+    p = run("init", str(URDF), str(european), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    ident = _identification((tmp_path / "arm.toml").read_text())
+    assert ident["delimiter"] == ";" and ident["decimal"] == "," and "separated by semicolons" in p.stdout
+    assert "decimal commas" in p.stdout
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "plain.toml"))
+    assert p.returncode == 0, p.stderr
+    config, plain = (load_identification_config(tmp_path / name) for name in ("arm.toml", "plain.toml"))
+    ours, theirs = (load_recording(c.identification, c.robot) for c in (config, plain))
+    for signal in ("t", "q", "tau"):
+        np.testing.assert_array_equal(getattr(ours, signal), getattr(theirs, signal))
+
+
+def test_a_decimal_separator_that_is_the_delimiter_is_refused(tmp_path):
+    """``decimal = ","`` beside the default comma delimiter cannot be read: refused in one line naming the field."""
+    from dynid.exceptions import ConfigError
+    from dynid.io.identification_config import load_identification_config
+
+    log = _log(tmp_path, header=True)
+    p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "arm.toml").read_text().replace("[identification]\n", '[identification]\ndecimal = ","\n', 1)
+    (tmp_path / "arm.toml").write_text(text)
+    with pytest.raises(ConfigError, match=r"arm.toml: identification.decimal: the numbers' decimal separator cannot be "
+                                          r"the delimiter ','"):
+        load_identification_config(tmp_path / "arm.toml")
+    (tmp_path / "arm.toml").write_text(text.replace('decimal = ","', 'decimal = "x"'))
+    with pytest.raises(ConfigError, match=r"decimal"):
+        load_identification_config(tmp_path / "arm.toml")

@@ -175,14 +175,28 @@ def test_comment_lines_and_a_header_written_as_one(tmp_path, reader):
         read_table(_write(tmp_path, "# t,a,b\n1,2,3\n4,5,6\n7,8,9\n1,x,3\n"), ["a"], header=True)
 
 
-def test_a_decimal_comma_is_named(tmp_path, reader):
-    """A spreadsheet's export in a European locale (semicolons, decimal commas): the refusal says what to change."""
+def test_a_decimal_comma_is_named_and_read_with_its_setting(tmp_path, reader):
+    """A spreadsheet's export in a European locale (semicolons, decimal commas): the refusal says what to change, and
+    with ``decimal = ","`` the log reads as the same numbers written with points."""
     p = _write(tmp_path, "1;2,5;3\n4;5,5;6\n")
-    with pytest.raises(DataError, match=r"line 1, column 2: expected a number, got '2,5' \(a decimal comma\? dynid "
-                                        r"reads a decimal point"):
+    with pytest.raises(DataError, match=r"line 1, column 2: expected a number, got '2,5' \(a decimal comma\? give "
+                                        r'decimal = "," in the dataset\'s table\)$'):
         read_table(p, [1, 2, 3], delimiter=";")
     with pytest.raises(DataError, match=r"expected a number, got 'x'$"):
         read_table(_write(tmp_path, "1;2;3\n4;x;6\n"), [1, 2, 3], delimiter=";")
+    rng = np.random.default_rng(5)
+    values = np.column_stack([np.arange(40) * 0.004, rng.normal(size=(40, 3)) * [1.0, 1e-4, 3e5]])
+    pointed = _write(tmp_path, "t;a;b;c\n" + "".join(";".join(repr(float(x)) for x in r) + "\n" for r in values), "p.csv")
+    comma = _write(tmp_path, pointed.read_text().replace(".", ","), "c.csv")
+    read = read_table(comma, ["a", "c", "t"], header=True, delimiter=";", decimal=",", rows=(3, 38)).data
+    np.testing.assert_array_equal(read, values[2:38][:, [1, 3, 0]])
+    np.testing.assert_array_equal(read, read_table(pointed, ["a", "c", "t"], header=True, delimiter=";", rows=(3, 38)).data)
+    if reader == "pyarrow":  # read by pyarrow itself, not handed back to the line reader
+        import dynid.io.tables as tables
+
+        assert tables._arrow_table(comma, ["a"], True, ";", None, rows=(1, None), spool=False, decimal=",") is not None
+    with pytest.raises(ValueError, match="decimal: expected '.' or ',' and not the delimiter ','"):
+        read_table(comma, [1], decimal=",")
 
 
 @pytest.mark.parametrize(("separator", "setting"), [(";", 'delimiter = ";"'), ("\t", 'delimiter = "\\t"')])

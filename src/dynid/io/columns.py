@@ -4,6 +4,7 @@ known logger's layout."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import re
 from pathlib import Path
@@ -15,7 +16,7 @@ from tomlkit.items import InlineTable, Table
 from ..conventions import time_unit_of
 from ..exceptions import DataError
 from .files import text_encoding_hint
-from .tables import is_data_line, read_table
+from .tables import decimal_commas, is_data_line, read_table
 
 
 def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,
@@ -49,15 +50,15 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
     DataError
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
-    lines, delimiter = _first_lines(log)
+    lines, delimiter, decimal = _first_lines(log)
     first = _fields(lines[0], delimiter)
     header = not all(_number(c) for c in first)
     notes: list[str] = [f"{log.name}: {len(first)} columns separated by {_named(delimiter)}, "
-                        + ("a header line" if header else "no header line")]
+                        + ("a header line" if header else "no header line")
+                        + (", decimal commas" if decimal == "," else "")]
     table = tomlkit.table()
     table.add("file", log.name)
-    if delimiter != ",":
-        table.add("delimiter", delimiter)
+    _add_separators(table, delimiter, decimal)
     if header:
         return table, notes + _header_entries(table, urdf, log, (first, lines), delimiter, n_dof=n_dof, joints=joints,
                                               rate=rate, rate_hint=rate_hint)
@@ -73,7 +74,7 @@ def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *
 
     first, lines = read
     found, order_notes = _found_columns(first, split(lines[1]) if len(lines) > 1 else [], joints, n_dof)
-    group_notes, passed = _one_group_each(found, log, delimiter, n_dof)
+    group_notes, passed = _one_group_each(found, log, (delimiter, str(table.get("decimal", "."))), n_dof)
     _check_one_signal(log, first, found, n_dof)
     if "time" not in found and rate is None:
         raise DataError(f"{log}: no time column among {_shown(first)}; accepted: {ACCEPTED}; for a log without time "
@@ -234,7 +235,7 @@ QUALIFIERS = MOTOR_SIDE | LINK_SIDE | frozenset({"abs", "rel", "meas", "measured
 or a variant; columns of one signal that differ by them are groups of their own (:func:`_one_group_each`)."""
 
 
-def _one_group_each(found: dict, log: Path, delimiter: str, n_dof: int) -> tuple[list[str], list[str]]:
+def _one_group_each(found: dict, log: Path, separators: tuple[str, str], n_dof: int) -> tuple[list[str], list[str]]:
     """Where a signal's columns make several groups of one column per joint that differ by their names'
     :data:`QUALIFIERS` (a KR 300's ``q_se_deg1…`` and ``q_mot_deg1…``), one group taken (``found`` changed in place),
     and said: a group with a channel that reads one value throughout the log is passed over, then the link side is
@@ -248,7 +249,7 @@ def _one_group_each(found: dict, log: Path, delimiter: str, n_dof: int) -> tuple
         if kind == "time" or len(groups) < 2 or any(len(g) != n_dof for g in groups.values()):
             continue
         complete = list(groups.values())
-        dead = _constant_columns(log, delimiter, [c for g in complete for c in g])
+        dead = _constant_columns(log, separators, [c for g in complete for c in g])
 
         def rank(g: list[str]) -> tuple:
             words = _qualifiers(g[0])
@@ -263,10 +264,11 @@ def _one_group_each(found: dict, log: Path, delimiter: str, n_dof: int) -> tuple
     return notes, passed
 
 
-def _constant_columns(log: Path, delimiter: str, columns: list[str]) -> set[str]:
-    """The columns of a log that read one value throughout (none where the log cannot be read: its reader says why)."""
+def _constant_columns(log: Path, separators: tuple[str, str], columns: list[str]) -> set[str]:
+    """The columns of a log that read one value throughout (none where the log cannot be read: its reader says why);
+    ``separators``: the delimiter and the decimal separator."""
     try:
-        data = np.asarray(read_table(log, columns, header=True, delimiter=delimiter).data)
+        data = np.asarray(read_table(log, columns, header=True, delimiter=separators[0], decimal=separators[1]).data)
     except DataError:
         return set()
     return {c for c, x in zip(columns, data.T) if np.ptp(x) == 0}
@@ -452,11 +454,11 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
     """
     heads = []
     for path in (log, other):
-        lines, delimiter = _first_lines(path)
+        lines, delimiter, decimal = _first_lines(path)
         header = _fields(lines[0], delimiter)
         if len(header) != n_dof or any(_number(c) or _kind(c) is not None for c in header):
             return None
-        heads.append((header, delimiter))
+        heads.append((header, delimiter, decimal))
     kinds = [next((k for k, words in SIGNAL_FILE_WORDS.items() if set(re.split(r"[^a-z]+", p.stem.lower())) & words),
                   None) for p in (log, other)]
     if heads[0] != heads[1] or sorted(map(str, kinds)) not in (["positions", "torques"], ["currents", "positions"]):
@@ -468,10 +470,9 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
     if rate is None:
         raise DataError(f"{log} and {other}: one signal per file without time stamps: give their sample rate, "
                         "dynid init ... --rate HZ")
-    (header, delimiter), table = heads[0], tomlkit.table()
+    (header, delimiter, decimal), table = heads[0], tomlkit.table()
     table.add("header", True)
-    if delimiter != ",":
-        table.add("delimiter", delimiter)
+    _add_separators(table, delimiter, decimal)
     table.add("rate", float(rate))
     table["rate"].comment("Hz: no time column (--rate)")
     for kind, path in sorted(zip(map(str, kinds), (log, other)), key=lambda kp: kp[0] != "positions"):
@@ -607,11 +608,13 @@ def _time_entry(table: Table, first: list[str], column: str, rows: list[list[str
     return [f"time stamps: {column} steps as a controller's in {unit}: unit = \"{unit}\""] if unit else [], [column]
 
 
-def _first_lines(log: Path) -> tuple[list[str], str]:
-    """A text log's first non-blank lines from its header (or first data line) on, and its delimiter: comment lines
-    (``#`` first) left out, a header written as one (NumPy's ``# t,q1,…``) taken as the header."""
+def _first_lines(log: Path) -> tuple[list[str], str, str]:
+    """A text log's first non-blank lines from its header (or first data line) on, its delimiter and its decimal
+    separator: comment lines (``#`` first) left out, a header written as one (NumPy's ``# t,q1,…``) taken as the
+    header, data lines written with decimal commas given decimal points."""
     try:
-        lines = [line for line in log.read_text(encoding="utf-8").splitlines()[:50] if line.strip()]
+        with log.open(encoding="utf-8") as fh:  # the first lines only: an hour-long log is half a gigabyte
+            lines = [line.rstrip("\r\n") for line in itertools.islice(fh, 50) if line.strip()]
     except UnicodeDecodeError:
         raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None
     except OSError as exc:
@@ -619,11 +622,28 @@ def _first_lines(log: Path) -> tuple[list[str], str]:
     comments = next((k for k, line in enumerate(lines) if not line.lstrip().startswith("#")), len(lines))
     if len(lines) - comments < 2:
         raise DataError(f"{log}: fewer than two lines: not a log")
-    delimiter = max((",", ";", "\t", " "), key=lambda d: lines[comments + 1].count(d))
+    # the separator that splits the first two lines alike: a header's names hold no decimal comma, which a
+    # spreadsheet's export in a European locale puts in every number beside its semicolons
+    first, second = lines[comments], lines[comments + 1]
+    delimiter = next((d for d in (";", "\t", " ") if len(_fields(second, d)) > 1 and decimal_commas(_fields(second, d))),
+                     None)
+    decimal = "." if delimiter is None else ","
+    if delimiter is None:
+        delimiter = max((",", ";", "\t", " "), key=lambda d: (min(first.count(d), second.count(d)), second.count(d)))
+    else:
+        lines = [line.replace(",", ".") if is_data_line(line.replace(",", "."), delimiter) else line for line in lines]
     if comments and is_data_line(lines[comments], delimiter):
         comments -= 1
         lines[comments] = lines[comments].lstrip()[1:].strip()
-    return lines[comments:], delimiter
+    return lines[comments:], delimiter, decimal
+
+
+def _add_separators(table, delimiter: str, decimal: str) -> None:
+    """A dataset table's ``delimiter`` and ``decimal`` where they are not the defaults (a comma, a point)."""
+    if delimiter != ",":
+        table.add("delimiter", delimiter)
+    if decimal != ".":
+        table.add("decimal", decimal)
 
 
 def _time_unit(rows: list[list[str]], column: int) -> str | None:

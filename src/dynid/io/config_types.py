@@ -77,6 +77,8 @@ class DatasetTable(Table, kw_only=True):
     header: Annotated[bool, _d("the first line holds column names")] | None = None
     n_columns: Annotated[int, Meta(ge=1, description="columns every line has")] | None = None
     delimiter: Annotated[str, _d("field separator (default ',')")] | None = None
+    decimal: Annotated[Literal[".", ","], _d("the numbers' decimal separator: '.' (default) or ',' (a spreadsheet's "
+                                             "export in a European locale, with another delimiter)")] | None = None
     rows: Annotated[list[Annotated[int, Meta(ge=1)]], Meta(min_length=2, max_length=2,
                                                            description="[first, last] 1-based inclusive data rows")] | None = None
     time_range: Annotated[list[float], Meta(min_length=2, max_length=2,

@@ -127,6 +127,8 @@ class DatasetSpec:
     rows : (first, last) or None
         1-based inclusive data rows.
     delimiter : str
+    decimal : str
+        The numbers' decimal separator, "." or "," (:func:`dynid.io.tables.read_table`).
     time_range : (start, stop) or None [s]
         From the first row read.
     gaps : str
@@ -153,6 +155,7 @@ class DatasetSpec:
     n_columns: int | None = None
     rows: tuple[int, int] | None = None
     delimiter: str = ","
+    decimal: str = "."
     time_range: tuple[float, float] | None = None
     gaps: str = "auto"
     bag: BagSpec | None = None
@@ -298,13 +301,23 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         TIME_UNITS[t.time.unit or "s"] if t.time.nanoseconds is None else (TIME_UNITS[t.time.unit or "s"], 1e-9))
     if (time is None) == (t.rate is None):
         raise ConfigError(f"{where}: expected either a 'time' column or a sampling 'rate' [Hz]")
+    delimiter, decimal = _separators(t, where)
     return DatasetSpec(
         name=str(t.name if t.name is not None else name), signals=signals, time=time,
         rate=None if t.rate is None else float(t.rate), resample=None if t.resample is None else float(t.resample),
         side=t.side or "joint", header=bool(t.header), n_columns=t.n_columns,
-        rows=_rows(t.rows, where), delimiter=t.delimiter if t.delimiter is not None else ",",
+        rows=_rows(t.rows, where), delimiter=delimiter, decimal=decimal,
         time_range=_time_range(t.time_range, where), gaps=t.gaps or "auto",
         table=_table_name(where), max_gap=float(t.max_gap) if t.max_gap is not None else 0.1, held=t.held or "interpolate")
+
+
+def _separators(t, where: str) -> tuple[str, str]:
+    """A dataset table's delimiter and decimal separator (a comma and a point by default), refused where they are one."""
+    delimiter, decimal = t.delimiter if t.delimiter is not None else ",", t.decimal or "."
+    if decimal == delimiter:
+        raise ConfigError(f"{where}.decimal: the numbers' decimal separator cannot be the delimiter {delimiter!r}: give "
+                          "the delimiter that separates the fields (delimiter = \";\" in a European spreadsheet's export)")
+    return delimiter, decimal
 
 
 def _table_name(where: str) -> str:
@@ -319,7 +332,7 @@ def _table_name(where: str) -> str:
 
 def _bag_spec(t, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
     """A dataset read from a ROS 2 bag: ``bag = "folder"``, optional ``topic``, ``joint_names``, ``effort``."""
-    extra = [k for k in ("file", "header", "n_columns", "delimiter", "rows", "time", "rate", "max_gap", "held", *_SIGNALS)
+    extra = [k for k in ("file", "header", "n_columns", "delimiter", "decimal", "rows", "time", "rate", "max_gap", "held", *_SIGNALS)
              if getattr(t, k) is not None]
     if extra:
         raise ConfigError(f"{where}: field(s) {extra} do not apply to a ROS 2 bag; expected some of bag, topic, joint_names, "

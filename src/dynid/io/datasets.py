@@ -188,7 +188,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     for path, cols in requests.items():
         dated = spec.time.columns if spec.time is not None and spec.time.file == path and len(spec.time.columns) == 1 else ()
         table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows,
-                           spool=spool, missing=True, stamps=dated)
+                           spool=spool, missing=True, stamps=dated, decimal=spec.decimal)
         tables[path] = (table, cols)
         warnings.extend(table.warnings)
     del table

@@ -578,7 +578,7 @@ def _check_reference_names(refs: list, path: Path) -> None:
         seen[name] = i
 
 
-LAYOUT_KEYS = ("preset", "header", "n_columns", "delimiter", "gaps", "max_gap", "held", "time", "rate", "resample", "side",
+LAYOUT_KEYS = ("preset", "header", "n_columns", "delimiter", "decimal", "gaps", "max_gap", "held", "time", "rate", "resample", "side",
                "positions", "velocities", "currents", "torques")
 """The keys of a dataset table that say how its file is laid out (the rest say which file and which part of it)."""
 

@@ -120,7 +120,7 @@ def _motor_side(table: Table, folder: Path, robot) -> list[str]:
         return []
     delimiter = str(table.get("delimiter", ","))
     q = np.asarray(read_table(folder / str(positions["file"]), list(positions["columns"]), header=True,
-                              delimiter=delimiter).data)
+                              delimiter=delimiter, decimal=str(table.get("decimal", "."))).data)
     reach = np.abs(q).max(axis=0) / np.maximum(np.abs(robot.limits.q_min), np.abs(robot.limits.q_max))
     if not np.any(reach > MOTOR_ANGLES):
         return []

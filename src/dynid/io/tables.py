@@ -158,7 +158,7 @@ def resolve_columns(path: Path, columns, header: list[str] | None, delimiter: st
 
 def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
                n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False,
-               missing: bool = False, stamps=()) -> Table:
+               missing: bool = False, stamps=(), decimal: str = ".") -> Table:
     """Read numeric columns from a delimited text file.
 
     Parameters
@@ -181,6 +181,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     stamps : sequence of int or str
         Columns of ``columns`` that may hold ISO 8601 dates and times (``2026-11-28T01:02:03.250``, a logger's time
         stamps), read as POSIX seconds (UTC where the stamp names no zone).
+    decimal : {".", ","}
+        The numbers' decimal separator: "," for a spreadsheet's export in a European locale (``0,25;-1,5``), whose
+        delimiter is then not a comma.
 
     Returns
     -------
@@ -202,7 +205,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     first, last = rows if rows is not None else (1, None)
     if first < 1 or (last is not None and last < first):
         raise DataError(f"{path}: rows: expected 1 <= first <= last, got {[first, last]}")
-    fast = _arrow_table(path, columns, header, delimiter, n_columns, rows=(first, last), spool=spool)
+    if decimal not in (".", ",") or decimal == delimiter:
+        raise ValueError(f"decimal: expected '.' or ',' and not the delimiter {delimiter!r}, got {decimal!r}")
+    fast = _arrow_table(path, columns, header, delimiter, n_columns, rows=(first, last), spool=spool, decimal=decimal)
     if fast is not None:
         return fast
     warnings: list[str] = []
@@ -260,7 +265,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                 first_line = line_no
             if not pending:
                 pending_start = line_no
-            pending.append(line)
+            pending.append(line if decimal == "." else line.replace(",", "."))
             if len(pending) >= BLOCK:
                 flush()
         flush()
@@ -269,7 +274,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
 
 
 def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: int | None, *, rows: tuple,
-                 spool: bool) -> Table | None:
+                 spool: bool, decimal: str = ".") -> Table | None:
     """:func:`read_table` by pyarrow's streaming CSV reader, or None where the line reader must read the file
     (pyarrow not installed, a file under :data:`ARROW_BYTES`, or anything the line reader may treat otherwise)."""
     if path.stat().st_size <= max(ARROW_BYTES, 0):
@@ -303,7 +308,7 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
         with pa.OSFile(str(path)) as source:
             source.seek(offset)
             blocks, files, n = _arrow_blocks(pa, pc, source, cols, order, wanted=wanted, delimiter=delimiter, count=count,
-                                             spool=spool)
+                                             spool=spool, decimal=decimal)
         pa.default_memory_pool().release_unused()  # its parsing buffers, which the pool would keep for reuse
     except (pa.ArrowException, KeyError, ValueError):  # anything it parses otherwise: the line reader decides
         return None
@@ -313,7 +318,7 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
 
 
 def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: list[int], delimiter: str,
-                  count: int | None, spool: bool) -> tuple[list, list | None, int]:
+                  count: int | None, spool: bool, decimal: str = ".") -> tuple[list, list | None, int]:
     """The blocks of :func:`_arrow_table` (kept, or appended to column files with ``spool``), and their rows;
     ValueError at a value that is not finite."""
     reader = pc.open_csv(
@@ -322,7 +327,8 @@ def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: 
         parse_options=pc.ParseOptions(delimiter=delimiter, quote_char=False, ignore_empty_lines=False),
         convert_options=pc.ConvertOptions(include_columns=[f"f{c}" for c in wanted], null_values=[],
                                           column_types={f"f{c}": pa.float64() for c in wanted},
-                                          strings_can_be_null=False, quoted_strings_can_be_null=False))
+                                          strings_can_be_null=False, quoted_strings_can_be_null=False,
+                                          decimal_point=decimal))
     blocks, files, n = [], None, 0
     for batch in reader:
         block = np.column_stack([batch.column(k).to_numpy() for k in order]).astype(np.float64, copy=False)
@@ -390,6 +396,22 @@ _DECIMAL_COMMA = re.compile(r"[+-]?\d*,\d+([eE][+-]?\d+)?")
 """A number written with a decimal comma (a spreadsheet's export in a European locale): ``-0,0131``."""
 
 
+def decimal_commas(fields: list[str]) -> bool:
+    """Whether a data line's fields write their numbers with a decimal comma (``-0,0131``; none with a point).
+
+    Parameters
+    ----------
+    fields : list of str
+        A data line split at its delimiter.
+
+    Returns
+    -------
+    bool
+    """
+    commas = sum(_DECIMAL_COMMA.fullmatch(f.strip()) is not None for f in fields)
+    return commas > 0 and not any("." in f for f in fields)
+
+
 def _posix_seconds(text: str) -> float | None:
     """An ISO 8601 date and time as POSIX seconds (UTC where it names no zone), or None if it is not one."""
     try:
@@ -417,8 +439,7 @@ def _parse_block(path: Path, lines: list[str], start: int, cols: list[int], deli
                         continue
                     comma = _DECIMAL_COMMA.fullmatch(text) is not None
                     raise DataError(f"{path}: line {start + k}, column {c + 1}: expected a number, got {text!r}"
-                                    + (" (a decimal comma? dynid reads a decimal point: save the log with '.' as the "
-                                       "decimal separator)" if comma else "")) from None
+                                    + (" (a decimal comma? give decimal = \",\" in the dataset's table)" if comma else "")) from None
     bad = np.isinf(block) if missing else ~np.isfinite(block)
     if bad.any():
         k, c = np.argwhere(bad)[0]
