@@ -881,3 +881,24 @@ def test_a_decimal_separator_that_is_the_delimiter_is_refused(tmp_path):
     (tmp_path / "arm.toml").write_text(text.replace('decimal = ","', 'decimal = "x"'))
     with pytest.raises(ConfigError, match=r"decimal"):
         load_identification_config(tmp_path / "arm.toml")
+
+
+def test_init_and_identify_read_a_log_and_a_config_that_start_with_a_byte_order_mark(tmp_path):
+    """A spreadsheet's "CSV UTF-8" starts with a byte-order mark (and an editor may save a TOML so): init read the
+    first column as '\\ufefftime' and found no time column; the log now reads as the same numbers, the config too."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+
+    log = _log(tmp_path, header=True)
+    marked = tmp_path / "marked.csv"
+    marked.write_bytes(b"\xef\xbb\xbf" + log.read_bytes())
+    p = run("init", str(URDF), str(marked), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    assert _identification((tmp_path / "arm.toml").read_text())["time"] == {"column": "time"}
+    (tmp_path / "plain.toml").write_text((tmp_path / "arm.toml").read_text().replace("marked.csv", "logs/run.csv"))
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "arm.toml").read_bytes())
+    ours, marked_config, theirs = (load_identification_config(tmp_path / n) for n in ("arm.toml", "bom.toml", "plain.toml"))
+    assert marked_config.identification == ours.identification
+    a, b = (load_recording(c.identification, c.robot) for c in (ours, theirs))
+    for signal in ("t", "q", "tau"):
+        np.testing.assert_array_equal(getattr(a, signal), getattr(b, signal))

@@ -262,3 +262,12 @@ def test_a_log_with_iso_or_posix_time_stamps_identifies_as_the_same_log_in_secon
     error = [json.loads((tmp_path / out / "results.json").read_text())["identification"]["metrics"]["dynid WLS"]
              ["global_relative_error"] for out in ("seconds", "dated")]
     assert error[1] == pytest.approx(error[0], rel=1e-4)
+
+
+@pytest.mark.parametrize("text", ["t,a\n1.5,2\n3,4\n", "1.5,2\n3,4\n", "# t,a\n1.5,2\n3,4\n"])
+def test_a_byte_order_mark_is_not_part_of_the_first_field(tmp_path, reader, text):
+    """A spreadsheet's "CSV UTF-8" begins with a byte-order mark: the first column's name or number is read without it."""
+    p = tmp_path / "marked.csv"
+    p.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    header = not text[0].isdigit()
+    np.testing.assert_array_equal(read_table(p, ["t", "a"] if header else [1, 2], header=header).data, [[1.5, 2], [3, 4]])

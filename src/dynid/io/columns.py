@@ -497,7 +497,7 @@ def _preset_table(preset: str, log: Path) -> Table:
 
 def _row_count(path: Path) -> int:
     """A text log's lines with something on them."""
-    with open(path, encoding="utf-8", errors="replace") as f:
+    with open(path, encoding="utf-8-sig", errors="replace") as f:
         return sum(1 for line in f if line.strip())
 
 
@@ -613,7 +613,7 @@ def _first_lines(log: Path) -> tuple[list[str], str, str]:
     separator: comment lines (``#`` first) left out, a header written as one (NumPy's ``# t,q1,…``) taken as the
     header, data lines written with decimal commas given decimal points."""
     try:
-        with log.open(encoding="utf-8") as fh:  # the first lines only: an hour-long log is half a gigabyte
+        with log.open(encoding="utf-8-sig") as fh:  # the first lines only (an hour-long log is half a gigabyte); -sig: a BOM
             lines = [line.rstrip("\r\n") for line in itertools.islice(fh, 50) if line.strip()]
     except UnicodeDecodeError:
         raise DataError(f"{log}: not a UTF-8 text table{text_encoding_hint(log)}") from None

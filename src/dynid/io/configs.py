@@ -32,7 +32,7 @@ def read_config(path: Path, known: set[str] | None) -> dict:
     if not path.is_file():
         raise ConfigError(f"{path}: config file not found")
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # -sig: an editor's byte-order mark
     except UnicodeDecodeError:
         raise ConfigError(f"{path}: not UTF-8 text{text_encoding_hint(path)}") from None
     except tomllib.TOMLDecodeError as exc:

@@ -167,7 +167,7 @@ def load_reference(table: dict, base: Path, where: str, basep: BaseParameters, n
     path = path if path.is_absolute() else base / path
     if not path.is_file():
         raise DataError(f"{path}: reference file not found")
-    with open(path, newline="", encoding="utf-8") as fh:
+    with open(path, newline="", encoding="utf-8-sig") as fh:
         rows = [r for r in csv.reader(fh) if any(f.strip() for f in r)]
     header = [h.strip() for h in rows.pop(0)] if table.get("header", False) and rows else None
     i_name = _column(header, table.get("names", 1), path, f"{where}.names")

@@ -218,7 +218,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     cols: list[int] | None = None
     expected = n_columns
     first_line = None
-    with open(path, encoding="utf-8", errors="replace", newline="") as fh:
+    with open(path, encoding="utf-8-sig", errors="replace", newline="") as fh:  # -sig: a spreadsheet's byte-order mark
         head, line_no = table_head(fh, delimiter, header)
         if header:
             if head is None:
@@ -286,7 +286,7 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
         return None
     first, last = rows
     with open(path, "rb") as fh:  # lines up to the first data line, by "\n" as pyarrow and the line reader count them
-        if fh.read(1) == b"#":  # comment lines, or a header written as one: the line reader
+        if fh.read(1) in (b"#", b"\xef"):  # comment lines, a header written as one, a byte-order mark: the line reader
             return None
         fh.seek(0)
         head = [fh.readline() for _ in range(int(header) + first - 1)]

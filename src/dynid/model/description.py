@@ -128,7 +128,7 @@ def load_robot(name_or_path: str | Path, *, held=(), xacro_args: dict | None = N
     if not path.suffix == ".toml" or not path.is_file():
         raise ConfigError(f"unknown robot {text!r}: expected a built-in robot ({', '.join(builtin_robots())}), a .toml "
                           "description file, a .urdf, a .xacro or a MuJoCo .xml file")
-    body = path.read_text(encoding="utf-8")
+    body = path.read_text(encoding="utf-8-sig")  # -sig: an editor's byte-order mark
     config = _config_robot(body, path)
     return config if config is not None else robot_from_toml_text(body, source=str(path), base=path.parent)
 
