@@ -902,3 +902,18 @@ def test_init_and_identify_read_a_log_and_a_config_that_start_with_a_byte_order_
     a, b = (load_recording(c.identification, c.robot) for c in (ours, theirs))
     for signal in ("t", "q", "tau"):
         np.testing.assert_array_equal(getattr(a, signal), getattr(b, signal))
+
+
+def test_init_takes_a_header_whose_names_are_quoted(tmp_path):
+    """A spreadsheet or pandas with quoting writes "time","joint_pos_1",…: init looked for '"time"' and found no time
+    column, where the reader itself takes the names without their quotes."""
+    log = _log(tmp_path, header=True)
+    lines = log.read_text().splitlines(keepends=True)
+    quoted = tmp_path / "quoted.csv"
+    quoted.write_text(",".join(f'"{name}"' for name in lines[0].strip().split(",")) + "\n" + "".join(lines[1:]))
+    p = run("init", str(URDF), str(quoted), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    ident = _identification((tmp_path / "arm.toml").read_text())
+    assert ident["time"] == {"column": "time"} and ident["positions"]["columns"][0] == "joint_pos_1"
+    p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr

@@ -483,8 +483,9 @@ def signal_files(log: Path, other: Path, n_dof: int, rate: float | None) -> tupl
 
 
 def _fields(line: str, delimiter: str) -> list[str]:
-    """A line's fields: split at runs of spaces for a space-separated log, else at the delimiter, stripped."""
-    return line.split() if delimiter == " " else [c.strip() for c in line.split(delimiter)]
+    """A line's fields: split at runs of spaces for a space-separated log, else at the delimiter, stripped of spaces
+    and of the double quotes a spreadsheet puts around a name (as the reader's header, :func:`read_table`)."""
+    return line.split() if delimiter == " " else [c.strip().strip('"') for c in line.split(delimiter)]
 
 
 def _preset_table(preset: str, log: Path) -> Table:
