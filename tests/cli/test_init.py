@@ -917,3 +917,18 @@ def test_init_takes_a_header_whose_names_are_quoted(tmp_path):
     assert ident["time"] == {"column": "time"} and ident["positions"]["columns"][0] == "joint_pos_1"
     p = run("identify", str(tmp_path / "arm.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
     assert p.returncode == 0, p.stderr
+
+
+@pytest.mark.parametrize(("position", "torque"), [("A{}_pos", "A{}_tau"), ("axis{}_position", "axis{}_torque"),
+                                                  ("JointPosition{}", "JointTorque{}"), ("J{} position", "J{} torque")])
+def test_init_takes_columns_named_joint_first_or_in_camel_case(tmp_path, position, torque):
+    """KUKA's axes (A1_pos … A6_tau), axis1_position, JointPosition1: the joint before the signal, or the words run
+    together, were refused ("found 0 positions columns"); init now takes them, in the header's order."""
+    log = dynid.simulated_log(dynid.load_robot(URDF), seconds=5, rng=4)
+    names = ["time"] + [position.format(j) for j in range(1, 7)] + [torque.format(j) for j in range(1, 7)]
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([log.t, log.q, log.tau]), delimiter=",", comments="", header=",".join(names))
+    p = run("init", str(URDF), str(path), "--out", str(tmp_path / "arm.toml"))
+    assert p.returncode == 0, p.stderr
+    ident = _identification((tmp_path / "arm.toml").read_text())
+    assert ident["positions"]["columns"] == names[1:7] and ident["torques"]["columns"] == names[7:]

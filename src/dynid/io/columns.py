@@ -150,9 +150,9 @@ def _headerless_table(table, notes: list[str], urdf: Path, log: Path, n_columns:
 
 PATTERNS = {
     "time": r"[_%]*(t|time|times?tamp|stamp|sec|seconds)",
-    "positions": r"(q|pos|position|positions|angle|joint_?pos|actual_q)",
-    "velocities": r"(dq|qd|qdot|vel|velocity|velocities|actual_qd)",
-    "torques": r"(tau|torque|torques|effort|moment|target_moment)",
+    "positions": r"(joint_?)?(q|pos|position|positions|angle)|actual_q",
+    "velocities": r"(joint_?)?(dq|qd|qdot|vel|velocity|velocities)|actual_qd",
+    "torques": r"(joint_?)?(tau|torque|torques|effort|moment)|target_moment",
     "currents": r"(i|cur|current|currents|actual_current)",
 }
 """Header-name stems of each signal (case-insensitive, followed by an optional separator and joint number)."""
@@ -160,7 +160,7 @@ PATTERNS = {
 
 ACCEPTED = ("t, time, timestamp, __time or %time for the time; q1…/pos1…/position[0]…, dq1…/vel1…, tau1…/effort[0]… "
             "or i1…, each with a unit beside it or not (t_s, q1_deg, tau1_Nm) and a side of the gear or a variant or not "
-            "(q_link_1, tau_mot_abs_Nm1); or the URDF's joint names: "
+            "(q_link_1, tau_mot_abs_Nm1), the joint first or not (A1_pos, axis1_torque, JointPosition1); or the URDF's joint names: "
             "/joint_states/<joint>/position|velocity|effort, <joint>_pos, <joint>.effort")
 """The header patterns init accepts, named in its refusals."""
 
@@ -188,6 +188,8 @@ UNITS = {"s": "s", "sec": "s", "ms": "ms", "us": "us", "ns": "ns", "rad": "rad",
 
 _UNIT = r"[\s_\-\[\(]*(" + "|".join(sorted((re.escape(u) for u in UNITS), key=len, reverse=True)) + r")[\]\)]?$"
 _JOINT = r"[\s_\-\[\(]*(j(oint)?)?_?\d+[\]\)]?$"
+_LEADING_JOINT = r"^(a|axis|j|joint)[\s_\-]?\d+[\s_\-]+"
+"""A joint named before the signal: ``A1_pos`` (KUKA's axes A1…A7), ``axis1_torque``, ``J1 position``."""
 
 
 DEFAULT_UNITS = ("rad", "rad/s", "N*m", "A")
@@ -212,6 +214,7 @@ def _kind_and_unit(name: str) -> tuple[str | None, str | None]:
     last = [part for part in re.split(r"[/.]", name.strip().lower()) if part] or [""]
     if len(last) > 1 and last[-1].isdigit():  # ROS-style position/0 and position.0: the index is a part of its own
         last = last[:-1]
+    last[-1] = re.sub(_LEADING_JOINT, "", last[-1])
     stem = re.sub(_JOINT, "", last[-1])
     for kind, pattern in PATTERNS.items():
         if re.fullmatch(pattern, stem):
