@@ -138,3 +138,14 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     assert (f"mean torque error over the one log that moves ({len(val) - 1} at rest throughout left out: they check the "
             "gravity model): ") in text and "best: dynid" in text
     assert all(f"{name} {m:.3g} %" in text for name, m in means.items())
+
+
+@pytest.mark.parametrize(("name", "content"), [("run.csv", b"t,q1,tau1\n0,0.1,2.0\n"), ("run.mcap", b"\x89MCAP0\r\n\xff\xfe")])
+@pytest.mark.parametrize("command", ["identify", "validate", "export"])
+def test_a_log_given_for_the_config_is_told_how_to_get_one(tmp_path, name, content, command):
+    """``dynid identify run.csv`` (a log where the config goes) said 'invalid TOML (Expected '=' after a key …)', or
+    'not UTF-8 text' for a bag: it now names the log and the command that writes a config for it."""
+    log = tmp_path / name
+    log.write_bytes(content)
+    assert_refused(dynid(command, log), f"{log}: a log, not a config (TOML): dynid init ROBOT {log} writes an "
+                                        "identification config that reads it")

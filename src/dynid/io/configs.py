@@ -10,6 +10,9 @@ from ..model.description import builtin_robots, load_robot, robot_from_document
 from ..model.robot import Robot
 from .files import text_encoding_hint
 
+LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".mcap", ".db3")
+"""File names of logs, which a command given one for its config says how to read."""
+
 
 def read_config(path: Path, known: set[str] | None) -> dict:
     """A TOML config, its top-level fields checked.
@@ -33,9 +36,12 @@ def read_config(path: Path, known: set[str] | None) -> dict:
         raise ConfigError(f"{path}: config file not found")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # -sig: an editor's byte-order mark
-    except UnicodeDecodeError:
-        raise ConfigError(f"{path}: not UTF-8 text{text_encoding_hint(path)}") from None
-    except tomllib.TOMLDecodeError as exc:
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        if path.suffix.lower() in LOG_SUFFIXES:
+            raise ConfigError(f"{path}: a log, not a config (TOML): dynid init ROBOT {path} writes an identification "
+                              "config that reads it") from None
+        if isinstance(exc, UnicodeDecodeError):
+            raise ConfigError(f"{path}: not UTF-8 text{text_encoding_hint(path)}") from None
         raise ConfigError(f"{path}: invalid TOML ({exc})") from None
     unknown = sorted(set(doc) - known) if known is not None else []
     if unknown:
