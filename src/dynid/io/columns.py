@@ -62,7 +62,7 @@ def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *
     if header:
         return table, notes + _header_entries(table, urdf, log, (first, lines), delimiter, n_dof=n_dof, joints=joints,
                                               rate=rate, rate_hint=rate_hint)
-    return _headerless_table(table, notes, urdf, log, len(first), n_dof=n_dof, joints=joints)
+    return _headerless_table(table, notes, urdf, log, len(first), n_dof=n_dof, joints=joints, rate=rate)
 
 
 def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *, n_dof: int, joints: tuple[str, ...],
@@ -88,6 +88,7 @@ def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *
     table.add("header", True)
     time_notes, taken = (_time_entry(table, first, found["time"][0], [split(line) for line in lines[1:]])
                          if "time" in found else _rate_entry(table, float(rate or 0.0)))
+    time_notes += _rate_unused(rate, found["time"][0]) if "time" in found else []
     signal_notes, signals, assumed = _signal_entries(table, found, ("positions", "velocities", effort), urdf, n_dof)
     notes = order_notes + group_notes + time_notes + signal_notes
     left = [c for c in first if c not in taken + signals]
@@ -122,9 +123,16 @@ def _signal_entries(table, found: dict, kinds: tuple[str, ...], urdf: Path, n_do
 
 
 def _headerless_table(table, notes: list[str], urdf: Path, log: Path, n_columns: int, *, n_dof: int,
-                      joints: tuple[str, ...]):
+                      joints: tuple[str, ...], rate: float | None = None):
     """A log without a header line: a layout told by its number of columns (an RTDE preset, or time then blocks of
-    ``n_dof`` columns per signal)."""
+    ``n_dof`` columns per signal; the blocks alone with ``rate``, a log without time stamps)."""
+    if rate is not None and n_columns in (2 * n_dof, 3 * n_dof):
+        blocks = ["positions", "torques"] if n_columns == 2 * n_dof else ["positions", "velocities", "torques"]
+        rate_notes, _ = _rate_entry(table, rate)
+        for b, kind in enumerate(blocks):
+            table.add(kind, _inline(columns=[1 + b * n_dof + j for j in range(n_dof)]))
+        return table, notes + rate_notes + [f"no header: {', '.join(blocks)} in blocks of {n_dof}",
+                                            _assumed_units(blocks)] + _torque_sensor(table, urdf)
     if n_columns == 31 and n_dof == 6:
         return _preset_table("ur-rtde", log), notes + [
             "31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" (its units: s, "
@@ -141,10 +149,10 @@ def _headerless_table(table, notes: list[str], urdf: Path, log: Path, n_columns:
             table.add(kind, _inline(columns=[2 + b * n_dof + j for j in range(n_dof)]))
         notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
         notes.append(_assumed_units(blocks, time=True))
-        return table, notes
+        return table, notes + _rate_unused(rate, "column 1") + _torque_sensor(table, urdf)
     fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
     raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
-                    "signal (or name the columns in a header line: t, q1…, tau1…)"
+                    f"signal, or those alone with --rate HZ (or name the columns in a header line: t, q1…, tau1…)"
                     + _hold_hint(urdf, joints, fewer))
 
 
@@ -503,6 +511,11 @@ def _row_count(path: Path) -> int:
     """A text log's lines with something on them."""
     with open(path, encoding="utf-8-sig", errors="replace") as f:
         return sum(1 for line in f if line.strip())
+
+
+def _rate_unused(rate: float | None, column: str) -> list[str]:
+    """The note that ``--rate`` is not used where the log has a time column (none without ``--rate``)."""
+    return [] if rate is None else [f"--rate {rate:g} not used: the log's time column ({column}) gives its times"]
 
 
 def _rate_entry(table: Table, rate: float) -> tuple[list[str], list[str]]:
