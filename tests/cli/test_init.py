@@ -959,3 +959,36 @@ def test_init_takes_a_headerless_log_without_time_stamps_at_its_rate_and_says_an
     p = run("init", str(URDF), str(timed), "--out", str(tmp_path / "timed.toml"), "--rate", "500")
     assert p.returncode == 0 and "--rate 500 not used: the log's time column (time) gives its times" in p.stdout
     assert "rate" not in _identification((tmp_path / "timed.toml").read_text())
+
+
+def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_as_chosen(tmp_path, monkeypatch):
+    """init's check of the log against the description fitted the whole of an hour-long log (init took 48 s): it fits
+    the first CHECKED_SECONDS of a log (here made 4 s of a 30 s log, whose torques run against the description), finds
+    the flipped sign there as on the whole log, and reads a stretch the config chose (rows) as chosen."""
+    import dynid.identification.starter_check as check
+    from dynid.io import datasets
+
+    log = _log(tmp_path, header=True)
+    text = log.read_text().splitlines()
+    flipped = tmp_path / "flipped.csv"
+    flipped.write_text("\n".join([text[0]] + [",".join(f[:7] + [str(-float(x)) for x in f[7:]])
+                                             for f in (line.split(",") for line in text[1:])]) + "\n")
+    assert run("init", str(URDF), str(flipped), "--out", str(tmp_path / "whole.toml")).returncode == 0
+    seen = []
+    real = datasets.load_recording
+
+    def spy(spec, robot, **kw):
+        recording = real(spec, robot, **kw)
+        seen.append((spec.time_range, spec.rows, recording.t[-1] - recording.t[0]))
+        return recording
+
+    monkeypatch.setattr(check, "load_recording", spy)
+    monkeypatch.setattr(check, "CHECKED_SECONDS", 4.0)
+    config_text = (tmp_path / "whole.toml").read_text().replace(", sign = -1", "")
+    checked, notes = check.checked_against_description(config_text, tmp_path / "whole.toml")
+    assert seen[0][0] == (0.0, 4.0) and seen[0][2] <= 4.0
+    assert "sign = -1" in checked and "sign = -1" in (tmp_path / "whole.toml").read_text()
+    seen.clear()
+    chosen = config_text.replace("[identification]\n", "[identification]\nrows = [1, 2000]\n", 1)
+    check.checked_against_description(chosen, tmp_path / "whole.toml")
+    assert seen[0][:2] == (None, (1, 2000))
