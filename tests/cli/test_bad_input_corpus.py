@@ -125,6 +125,7 @@ LOGS = {
                            "log.csv): every joint's torque reads one value throughout"),
     "UTF-16": (None, "log.csv: not a UTF-8 text table (it looks like UTF-16: save it as UTF-8)"),
     "a binary file": (None, "log.csv: not a UTF-8 text table (a binary file?)"),
+    "a spreadsheet's workbook": (None, "log.csv: not a UTF-8 text table (a spreadsheet's workbook? save the sheet as CSV)"),
 }
 
 
@@ -136,6 +137,8 @@ def test_damaged_logs(ur, case):
         (ur.folder / "log.csv").write_text(_text(GOOD[:200]), encoding="utf-16")
     elif case == "a binary file":
         (ur.folder / "log.csv").write_bytes(bytes(range(256)) * 40)
+    elif case == "a spreadsheet's workbook":  # an .xlsx saved under the log's name: a zip archive
+        (ur.folder / "log.csv").write_bytes(b"PK\x03\x04" + bytes(range(256)) * 40)
     else:
         (ur.folder / "log.csv").write_text(text)
     out = ur.folder / "out"

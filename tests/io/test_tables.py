@@ -271,3 +271,14 @@ def test_a_byte_order_mark_is_not_part_of_the_first_field(tmp_path, reader, text
     p.write_bytes(b"\xef\xbb\xbf" + text.encode())
     header = not text[0].isdigit()
     np.testing.assert_array_equal(read_table(p, ["t", "a"] if header else [1, 2], header=header).data, [[1.5, 2], [3, 4]])
+
+
+def test_a_spreadsheets_workbook_is_told_to_be_saved_as_csv(tmp_path):
+    """An .xlsx (a zip archive) given for a log was "not a UTF-8 text table (a binary file?)": now it says what to do."""
+    import zipfile
+
+    book = tmp_path / "log.xlsx"
+    with zipfile.ZipFile(book, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("xl/worksheets/sheet1.xml", bytes(range(256)) * 20)
+    with pytest.raises(DataError, match=r"log.xlsx: not a UTF-8 text table \(a spreadsheet's workbook\? save the sheet as CSV\)$"):
+        read_table(book, [1])

@@ -82,7 +82,8 @@ def text_encoding_hint(path: Path) -> str:
     Returns
     -------
     str
-        ``" (UTF-16: save it as UTF-8)"``, ``" (a binary file?)"``, or ``""`` if neither applies.
+        ``" (UTF-16: save it as UTF-8)"``, ``" (a spreadsheet's workbook? save the sheet as CSV)"``,
+        ``" (a binary file?)"``, or ``""`` if none applies.
     """
     try:
         with open(path, "rb") as fh:
@@ -91,6 +92,8 @@ def text_encoding_hint(path: Path) -> str:
         return ""
     if head.startswith((b"\xff\xfe", b"\xfe\xff")) or (len(head) > 3 and head[1:2] == b"\x00" and head[3:4] == b"\x00"):
         return " (it looks like UTF-16: save it as UTF-8)"
+    if head.startswith((b"PK\x03\x04", b"\xd0\xcf\x11\xe0")):  # a zip archive (.xlsx, .ods), an OLE file (.xls)
+        return " (a spreadsheet's workbook? save the sheet as CSV)"
     if b"\x00" in head:
         return " (a binary file?)"
     return ""
