@@ -992,3 +992,7 @@ def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_a
     chosen = config_text.replace("[identification]\n", "[identification]\nrows = [1, 2000]\n", 1)
     check.checked_against_description(chosen, tmp_path / "whole.toml")
     assert seen[0][:2] == (None, (1, 2000))
+    tiny = tmp_path / "tiny.csv"  # too short for a stretch of it: read whole, not refused for a time_range never given
+    tiny.write_text("\n".join(text[:31]) + "\n")
+    _, notes = check.checked_against_description(config_text.replace("flipped.csv", "tiny.csv"), tmp_path / "whole.toml")
+    assert not any("time_range" in n for n in notes), notes
