@@ -1,4 +1,4 @@
-"""ROS 2 bags of sensor_msgs/JointState as datasets: a bag written here, read back through a config."""
+"""ROS bags of sensor_msgs/JointState as datasets (ROS 2, and ROS 1 .bag files): a bag written here, read back through a config."""
 
 import numpy as np
 import pytest
@@ -54,7 +54,7 @@ def test_bag_errors_name_the_bag_topic_and_joint(tmp_path):
         load_recording(dataset_spec({"bag": "bag"}, tmp_path, "cfg", "ident", 6), robot)
     with pytest.raises(DataError, match=r"no topic '/other' in the bag \(it has /joint_states\)"):
         load_recording(dataset_spec({"bag": "bag", "topic": "/other"}, tmp_path, "cfg", "ident", 6), robot)
-    with pytest.raises(DataError, match=r"nosuch: ROS 2 bag not found"):
+    with pytest.raises(DataError, match=r"nosuch: ROS bag not found"):
         load_recording(dataset_spec({"bag": "nosuch"}, tmp_path, "cfg", "ident", 6), robot)
     with pytest.raises(ConfigError, match=r"cfg.joint_names: expected 6 joint names"):
         dataset_spec({"bag": "bag", "joint_names": ["a"]}, tmp_path, "cfg", "ident", 6)
@@ -130,7 +130,7 @@ def test_validate_file_reads_the_file_it_is_given_with_the_configs_reader(tmp_pa
     cfg = load_identification_config(tmp_path / "csv.toml")
     spec = dataset_for_file(cfg, tmp_path / "log.csv")
     assert spec.time.scale == cfg.identification.time.scale == 1e-3
-    with pytest.raises(DataError, match="a ROS 2 bag, but the config's logs are CSV files"):
+    with pytest.raises(DataError, match="a ROS bag, but the config's logs are CSV files"):
         dataset_for_file(cfg, tmp_path / "other")
 
 
@@ -153,3 +153,41 @@ def test_a_bag_without_message_definitions_is_read_with_humbles_types(tmp_path, 
     rec = load_recording(spec, robot)
     np.testing.assert_allclose(rec.q, q, atol=1e-12)
     assert any("holds no message definitions" in w and "ROS 2 Humble's standard types" in w for w in rec.warnings)
+
+
+def _write_ros1_bag(path, t, names, q, dq, effort, topic="/joint_states"):
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    JointState, Header, Time = ts.types["sensor_msgs/msg/JointState"], ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    with Writer(path) as writer:
+        conn = writer.add_connection(topic, JointState.__msgtype__, typestore=ts)
+        for k, tk in enumerate(t):
+            stamp = Time(sec=int(tk), nanosec=int(round((tk - int(tk)) * 1e9)))
+            row = lambda x: np.ascontiguousarray(x[k], dtype=np.float64).copy()  # noqa: E731
+            msg = JointState(header=Header(seq=k, stamp=stamp, frame_id=""), name=list(names), position=row(q),
+                             velocity=row(dq), effort=row(effort))
+            writer.write(conn, int(tk * 1e9), ts.serialize_ros1(msg, JointState.__msgtype__))
+
+
+def test_a_ros1_bag_reads_like_a_ros2_bag_and_init_takes_it(tmp_path, rng):
+    """A ROS 1 .bag of JointState messages (rosbags reads ROS 1 too): read by bag = "run.bag" as the same numbers as a
+    ROS 2 bag of the same messages; dynid init took the .bag for a CSV ("not a UTF-8 text table (a binary file?)")."""
+    from tests.cli.refusals import dynid as run
+
+    robot = load_robot("ur10e")
+    names = [j.name for j in robot.joints]
+    t = 100.0 + np.arange(200) * 0.008
+    q = np.outer(np.sin(t), np.arange(1, 7) * 0.1)
+    dq = np.outer(np.cos(t), np.arange(1, 7) * 0.1)
+    tau = rng.normal(0, 1, (200, 6))
+    _write_ros1_bag(tmp_path / "run.bag", t, names, q, dq, tau)
+    _write_bag(tmp_path / "ros2", t, names, q, dq, tau)
+    one, two = (load_recording(dataset_spec({"bag": b}, tmp_path, "cfg: identification", "ident", 6), robot)
+                for b in ("run.bag", "ros2"))
+    for signal in ("t", "q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(one, signal), getattr(two, signal))
+    p = run("init", "ur10e", tmp_path / "run.bag", "--out", tmp_path / "arm.toml")
+    assert p.returncode == 0, p.stderr
+    assert "run.bag: a ROS 1 bag" in p.stdout and 'bag = "run.bag"' in (tmp_path / "arm.toml").read_text()

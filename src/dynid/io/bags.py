@@ -1,4 +1,5 @@
-"""ROS 2 bags of ``sensor_msgs/JointState`` as datasets (the rosbags library: no ROS installation needed).
+"""ROS bags of ``sensor_msgs/JointState`` as datasets: ROS 2 bags (SQLite or MCAP) and ROS 1 ``.bag`` files (the rosbags
+library: no ROS installation needed).
 
 Each message gives one sample: its header stamp (seconds), and for the robot's joints, found by name,
 ``position`` [rad], ``velocity`` [rad/s] when every message has it, and ``effort`` (joint torques in N·m,
@@ -16,9 +17,26 @@ import numpy as np
 from ..exceptions import DataError
 from ..runtime.extras import require
 
+BAG_SUFFIXES = (".mcap", ".db3", ".bag")
+"""A ROS 2 bag's storage files (MCAP, SQLite) and a ROS 1 bag's file."""
+
+
+def is_bag(path: Path) -> bool:
+    """Whether a log is a ROS bag: a folder (a ROS 2 bag's), or a file of :data:`BAG_SUFFIXES`.
+
+    Parameters
+    ----------
+    path : Path
+
+    Returns
+    -------
+    bool
+    """
+    return path.is_dir() or path.suffix.lower() in BAG_SUFFIXES
+
 
 def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None):
-    """Time stamps and raw signals of a ROS 2 bag's JointState messages.
+    """Time stamps and raw signals of a ROS bag's JointState messages (ROS 2, or a ROS 1 ``.bag``).
 
     Parameters
     ----------
@@ -45,11 +63,11 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
         messages without positions or efforts.
     """
     path = spec.path
-    require("rosbags.highlevel", "ros", f"{path}: reading a ROS 2 bag")
+    require("rosbags.highlevel", "ros", f"{path}: reading a ROS bag")
     from rosbags.highlevel import AnyReader
 
     if not path.exists():
-        raise DataError(f"{path}: ROS 2 bag not found")
+        raise DataError(f"{path}: ROS bag not found")
     wanted = list(spec.joint_names or [j.name for j in robot.joints])
     stamps, pos, vel, eff = [], [], [], []
     try:
@@ -81,7 +99,7 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
     except DataError:
         raise
     except Exception as exc:  # rosbags' own errors: a damaged or foreign file
-        raise DataError(f"{path}: cannot read it as a ROS 2 bag ({_one_line(str(exc))})") from None
+        raise DataError(f"{path}: cannot read it as a ROS bag ({_one_line(str(exc))})") from None
     if len(stamps) < 2:
         raise DataError(f"{path}: {len(stamps)} JointState message(s) on {spec.topic}, expected at least 2")
     signals: dict[str, np.ndarray] = {"positions": np.array(pos), ("currents" if spec.effort == "currents" else "torques"): np.array(eff)}

@@ -99,7 +99,7 @@ class DatasetTable(Table, kw_only=True):
     )] | None = None
     currents: Annotated[SignalTable, _d("motor currents: torque = drive gain · current (eq. 16)")] | None = None
     torques: Annotated[SignalTable, _d("torques [N·m], instead of currents")] | None = None
-    bag: Annotated[str, _d("a ROS 2 bag's folder, relative to the data root")] | None = None
+    bag: Annotated[str, _d("a ROS 2 bag's folder or a ROS 1 .bag file, relative to the data root")] | None = None
     topic: Annotated[str, _d("the bag's JointState topic (default /joint_states)")] | None = None
     joint_names: Annotated[list[str], _d("the bag's joint names, in the robot's order")] | None = None
     effort: Annotated[Literal["torques", "currents"], _d("what the bag's effort holds")] | None = None

@@ -10,7 +10,7 @@ from ..model.description import builtin_robots, load_robot, robot_from_document
 from ..model.robot import Robot
 from .files import text_encoding_hint
 
-LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".mcap", ".db3")
+LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".mcap", ".db3", ".bag")
 """File names of logs, which a command given one for its config says how to read."""
 
 

@@ -16,6 +16,7 @@ from .._util.reprs import short_repr
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..model.loading import as_robot
 from ..model.robot import Robot
+from .bags import read_joint_states
 from .columns import csv_table, named_out_of_order
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .log_repairs import (
@@ -171,8 +172,6 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     _check_named_order(spec, robot)
     warnings: list[str] = []
     if spec.bag is not None:
-        from .bags import read_joint_states
-
         t, raw, where = read_joint_states(spec.bag, robot, spec.name, warnings)
         return _assemble(spec, robot, t, raw, where, timed=True, q_source=str(spec.bag.path),
                          tau_source=str(spec.bag.path), warnings=warnings)

@@ -79,6 +79,7 @@ from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
+from .bags import is_bag
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
@@ -712,15 +713,14 @@ def dataset_for_file(config: IdentificationConfig, file: Path, rows=None) -> Dat
     file = Path(file)
     if not file.exists():
         raise DataError(f"--file {file}: no such file or bag", field="file")
-    is_bag = file.is_dir() or file.suffix.lower() in (".mcap", ".db3")
     if spec.bag is not None:  # read with the identification's bag reader: its topic, joint names, effort
-        if not is_bag:
-            raise DataError(f"--file {file}: the config's logs are ROS 2 bags (bag = ...); expected a bag's folder or its "
-                            ".mcap/.db3 file, or add a [[validation]] table for a CSV log", field="file")
+        if not is_bag(file):
+            raise DataError(f"--file {file}: the config's logs are ROS bags (bag = ...); expected a bag's folder or its "
+                            ".mcap/.db3 file or a ROS 1 .bag, or add a [[validation]] table for a CSV log", field="file")
         return replace(spec, name=file.name, bag=replace(spec.bag, path=file),
                        rows=None if rows is None else tuple(rows), time_range=None)
-    if is_bag:
-        raise DataError(f"--file {file}: a ROS 2 bag, but the config's logs are CSV files; add a [[validation]] table "
+    if is_bag(file):
+        raise DataError(f"--file {file}: a ROS bag, but the config's logs are CSV files; add a [[validation]] table "
                         "with bag = ... for it", field="file")
     files = {s.file for s in spec.signals.values()} | ({spec.time.file} if spec.time else set())
     if len(files) > 1:

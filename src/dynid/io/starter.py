@@ -22,6 +22,7 @@ from tomlkit.items import Table
 
 from ..exceptions import ConfigError, DataError
 from ..model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
+from .bags import is_bag
 from .columns import csv_table, signal_files
 from .dataset_specs import PRESETS
 from .datasets import dataset_spec, load_recording
@@ -38,8 +39,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     urdf : Path
         The robot's URDF.
     log : Path
-        A CSV log (comma, semicolon, tab or space separated), or a ROS 2 bag (its folder, or its ``.mcap``/``.db3``
-        file).
+        A CSV log (comma, semicolon, tab or space separated), or a ROS bag: a ROS 2 bag (its folder, or its
+        ``.mcap``/``.db3`` file) or a ROS 1 ``.bag`` file.
     n_dof : int
         The robot's joints.
     out : Path
@@ -77,18 +78,19 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     if log.is_dir() and not (log / "metadata.yaml").is_file():
         raise DataError(f"{log}: a folder without metadata.yaml, not a ROS 2 bag: give a CSV log, or a bag's folder or "
                         "its .mcap/.db3 file")
-    bags = [v for v in validation if _is_bag(v)]
-    if _is_bag(log) and len(bags) != len(validation) or not _is_bag(log) and bags:
+    bags = [v for v in validation if is_bag(v)]
+    if is_bag(log) and len(bags) != len(validation) or not is_bag(log) and bags:
         raise DataError(f"{(set(validation) - set(bags) or set(bags)).pop()}: the validation logs and {log.name} must be "
                         "of one kind (all ROS 2 bags or all CSV logs): they share the identification's reader")
     without = _without_sdp(robot)
-    if _is_bag(log):
+    if is_bag(log):
         table = tomlkit.table()
         table.add("bag", log.name)
-        table["bag"].comment("a ROS 2 bag: sensor_msgs/JointState on /joint_states")
+        table["bag"].comment("a ROS bag: sensor_msgs/JointState on /joint_states")
         table.add(tomlkit.comment('topic = "/joint_states"'))
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
-        said = [f"{log.name}: a ROS 2 bag (rosbag2, SQLite or MCAP): the joints are taken by the URDF's joint names",
+        kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
+        said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
         said.append(_estimators_note(without))
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
@@ -223,11 +225,6 @@ def _gain_notes(table, urdf: Path, robot, gains: tuple[float, ...] | None) -> li
             "16; [[robot.joints]]); dynid identify's verdict estimates them from the description's nominal model"]
 
 
-def _is_bag(path: Path) -> bool:
-    """Whether a log is a ROS 2 bag: its folder, or its ``.mcap``/``.db3`` storage file."""
-    return path.is_dir() or path.suffix.lower() in (".mcap", ".db3")
-
-
 def _bag_read(bag: Path, robot) -> str:
     """A bag read as ``dynid identify`` reads it (its JointState messages' joints by the robot's joint names): one
     line with its samples, duration, rate and effort range; a bag that cannot be read is refused in one line."""
@@ -286,7 +283,7 @@ def _config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], tabl
             entry = tomlkit.table()
             entry.comment("the identification's reader" if reader is None else "its own reader: another layout")
             entry.add("name", v.stem)
-            entry.add("bag" if _is_bag(v) else "file", _relative(v, log.parent))
+            entry.add("bag" if is_bag(v) else "file", _relative(v, log.parent))
             for key, value in ({} if reader is None else reader).items():
                 if key != "file":  # the file is the entry's own, relative to the data root
                     entry.add(key, value)
