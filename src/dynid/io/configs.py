@@ -8,9 +8,10 @@ from pathlib import Path
 from ..exceptions import ConfigError
 from ..model.description import builtin_robots, load_robot, robot_from_document
 from ..model.robot import Robot
+from .bags import BAG_SUFFIXES
 from .files import text_encoding_hint
 
-LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".mcap", ".db3", ".bag")
+LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", *BAG_SUFFIXES)
 """File names of logs, which a command given one for its config says how to read."""
 
 
