@@ -899,6 +899,16 @@ def test_init_and_identify_read_a_log_and_a_config_that_start_with_a_byte_order_
     (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "arm.toml").read_bytes())
     ours, marked_config, theirs = (load_identification_config(tmp_path / n) for n in ("arm.toml", "bom.toml", "plain.toml"))
     assert marked_config.identification == ours.identification
+    p = run("migrate", str(tmp_path / "bom.toml"))  # migrate reads the config as identify does
+    assert p.returncode == 0 and "nothing to rewrite" in p.stdout, p.stderr
+    import tomlkit
+
+    doc = tomlkit.parse((tmp_path / "arm.toml").read_text())  # the robot in a [robot] table: results name the config
+    doc["robot"] = {"urdf": str(doc.pop("robot"))}
+    (tmp_path / "table.toml").write_bytes(b"\xef\xbb\xbf" + tomlkit.dumps(doc).encode())
+    p = run("identify", str(tmp_path / "table.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert p.returncode == 0, p.stderr
+    assert dynid.load_results(tmp_path / "id" / "results.json").robot.n_dof == 6  # its robot read from that config
     a, b = (load_recording(c.identification, c.robot) for c in (ours, theirs))
     for signal in ("t", "q", "tau"):
         np.testing.assert_array_equal(getattr(a, signal), getattr(b, signal))

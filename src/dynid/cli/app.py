@@ -863,7 +863,7 @@ def migrate(
         if out is not None and not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
         try:
-            return config.read_text(encoding="utf-8")
+            return config.read_text(encoding="utf-8-sig")  # as identify reads a config: a byte-order mark skipped
         except UnicodeDecodeError as exc:
             raise DynIdError(f"{config}: not a text file (byte {exc.start} is no UTF-8): expected a TOML config") from None
 
@@ -873,7 +873,7 @@ def migrate(
     def save(migrated):
         from ..io.files import atomic_write_text
 
-        if migrated[0] == config.read_text(encoding="utf-8") and out is None:
+        if migrated[0] == config.read_text(encoding="utf-8-sig") and out is None:
             return []
         atomic_write_text(target, migrated[0])
         return [target]

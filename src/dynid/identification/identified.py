@@ -698,7 +698,7 @@ def _robot(robot, results: dict, path: Path) -> Robot:
 
         config = Path(source[len("config:"):])
         if config.is_file():
-            doc = tomllib.loads(config.read_text(encoding="utf-8"))
+            doc = tomllib.loads(config.read_text(encoding="utf-8-sig"))  # as the config was read (io.configs)
             return config_robot(doc, config, config.parent / str(doc.get("data_root", ".")))
     elif isinstance(source, str) and source:
         try:

@@ -11,8 +11,9 @@ from ..model.robot import Robot
 from .bags import BAG_SUFFIXES
 from .files import text_encoding_hint
 
-LOG_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", *BAG_SUFFIXES)
-"""File names of logs, which a command given one for its config says how to read."""
+LOG_SUFFIXES = (".csv", ".tsv", *BAG_SUFFIXES)
+"""File names of logs, which a command given one for its config says how to read (not ``.txt``: a config may be
+named so, and its TOML error is what to say)."""
 
 
 def read_config(path: Path, known: set[str] | None) -> dict:
@@ -199,7 +200,7 @@ def _robot_file(doc: dict, path: Path, data_root: Path | None) -> tuple[Path | N
     if file.suffix.lower() == ".urdf" or is_xacro(file) or is_mjcf(file):
         return file, None
     try:
-        described = tomllib.loads(file.read_text(encoding="utf-8"))
+        described = tomllib.loads(file.read_text(encoding="utf-8-sig"))
     except (OSError, ValueError):
         return None, None
     urdf = described.get("urdf")

@@ -81,7 +81,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     bags = [v for v in validation if is_bag(v)]
     if is_bag(log) and len(bags) != len(validation) or not is_bag(log) and bags:
         raise DataError(f"{(set(validation) - set(bags) or set(bags)).pop()}: the validation logs and {log.name} must be "
-                        "of one kind (all ROS 2 bags or all CSV logs): they share the identification's reader")
+                        "of one kind (all ROS bags or all CSV logs): they share the identification's reader")
     without = _without_sdp(robot)
     if is_bag(log):
         table = tomlkit.table()
