@@ -33,11 +33,12 @@ def _finite_difference(f, x, h=1e-5):
 def test_gradients_equal_finite_differences_of_the_whole_problem(er16_3, rng, criterion):
     """The chain-rule gradients (criterion, torque, workspace and obstacle constraints) against central differences."""
     ball = Obstacle("sphere", np.array([0.2]), np.array([0.6, 0.4, 1.0]))
-    ws = Workspace(box_min=np.array([-3.0, -3.0, -3.0]), box_max=np.array([3.0, 3.0, 3.0]), floor=-1.5, obstacles=(ball,))
+    ws = Workspace(box_min=np.array([-3.0, -3.0, -3.0]), box_max=np.array([3.0, 3.0, 3.0]), floor=-1.5, obstacles=(ball,),
+                   link_radius=0.02)
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 2, workspace=ws, criterion=criterion, grid_points=24)
     lay = _Layout(prob, prob.design_grid())
     obj = _Objective(prob, lay)
-    assert obj.pairs
+    assert obj.pairs and obj.needs is not None and obj.needs.shapes.tolist() == [1, 2]  # link 1 turns about z
     x = np.concatenate([prob.start_pose(), 0.3 * rng.standard_normal(lay.nx - 3)])
     np.testing.assert_allclose(obj.jac(x), _finite_difference(obj.fun, x), rtol=1e-5, atol=1e-6)
     np.testing.assert_allclose(obj.cons_jac(x), _finite_difference(obj.cons, x).reshape(-1, x.size), rtol=1e-5, atol=1e-6)
@@ -54,9 +55,21 @@ def _check_every_constraint_independently(robot, prob, traj):
     p = tool_positions(robot, q)
     ws = prob.workspace
     assert np.all(p >= ws.box_min) and np.all(p <= ws.box_max) and np.all(p[:, 2] >= ws.floor)
-    z = forward_kinematics(robot, q)[1][:, :, 2]  # every link's joint origins above the floor by the clearance
-    moving = np.ptp(z, axis=0) > 1e-6
-    assert np.all(z[:, moving] >= ws.floor + ws.clearance - 1e-9)
+    if np.isfinite(ws.floor):  # every link's capsule above the floor by the clearance, or as high as it starts
+        low = _capsule_bottoms(robot, q, ws.capsule_radius(robot))
+        start = _capsule_bottoms(robot, prob.start_pose()[None], ws.capsule_radius(robot))[0]
+        moving = np.ptp(low, axis=0) > 1e-6
+        need = np.minimum(ws.floor + ws.clearance, start - 1e-3)
+        assert np.all(low[:, moving] >= need[moving] - 1e-9)
+
+
+def _capsule_bottoms(robot, q, radius):
+    """(N, n_dof) the lowest point of each link's capsule of ``radius`` about its joint origin and the next's (the
+    flange's for the last), by forward kinematics alone: a segment's lowest point is one of its ends."""
+    rots, orig = forward_kinematics(robot, q)
+    flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
+    ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
+    return np.minimum(orig[..., 2], ends[..., 2]) - radius
 
 
 def test_er16_design_halves_cond_of_beta1_and_satisfies_every_constraint(er16_3):
@@ -123,17 +136,20 @@ def test_the_origins_jacobian_equals_finite_differences(er16_3, rng):
         np.testing.assert_allclose(jac[k], fd, rtol=1e-6, atol=1e-8)
 
 
-def test_a_floor_keeps_every_link_above_it_not_only_the_tool(er16_3):
-    """The paper's β1 trajectory, its offsets kept, designed over a floor 0.45 m below the base: before, only the tool
-    point was held above it, and the er16's elbow (joint 3's origin) went 9 cm through the floor of
-    configs/excite-er16.toml (-0.589 m against -0.5). Now every link's joint origins stay the clearance above it,
-    checked on a 10× finer grid by forward kinematics; a clearance the start pose breaks is refused."""
+def test_a_floor_keeps_every_links_shape_above_it_not_only_the_tool(er16_3):
+    """The paper's β1 trajectory, its offsets kept, designed over a floor 0.65 m below the base: the er16 has no
+    collision shapes, so each link is a capsule about its joint origins (radius estimated, 0.255 m), and β1 takes link
+    3's capsule to -0.661 m, under the floor, though joint 3's origin never goes below 0.44 m (what the floor was kept
+    on before). The design holds every capsule the clearance above the floor, checked on a
+    10× finer grid by forward kinematics alone."""
     beta1 = paper_identification_trajectory()
-    ws = Workspace(floor=-0.45, clearance=0.05)
+    ws = Workspace(floor=-0.65, clearance=0.05)
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0, workspace=ws)
-    assert [m.where for m in prob.margins(beta1) if m.constraint.startswith("floor clearance")] == ["joint 3's origin"]
+    [floor] = [m for m in prob.margins(beta1) if m.constraint.startswith("floor clearance")]
+    assert floor.where.startswith("link 3 capsule") and floor.worst < 0 and floor.margin < -0.05
+    q = beta1.evaluate(prob.verification_grid())[0]
+    assert floor.worst == pytest.approx(float(_capsule_bottoms(er16_3, q, 0.255)[:, 2].min()) + 0.65, abs=2e-3)
+    assert forward_kinematics(er16_3, q)[1][:, 2, 2].min() > -0.65 + 0.05 + 1.0  # the origin was far above it
     design = design_excitation(prob, n_starts=2, rng=0, initial=beta1)
     assert design.feasible
     _check_every_constraint_independently(er16_3, prob, design.trajectory)
-    with pytest.raises(ConfigError, match="joint 3's origin is less than workspace.clearance"):
-        ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0, workspace=Workspace(floor=-0.45, clearance=2.0))

@@ -1,5 +1,6 @@
-"""The cell's bodies in the excitation design: distances against a brute-force truth, their gradients, the reach
-bound, a design that keeps clear of a body its collision-free counterpart crosses, and the errors a user sees."""
+"""The cell's bodies in the excitation design: distances of the links' capsules (a robot file without collision
+shapes) against a brute-force truth, their gradients, a design that keeps clear of a body its collision-free
+counterpart crosses, and the errors a user sees."""
 
 from pathlib import Path
 
@@ -10,7 +11,7 @@ from dynid.dynamics.kinematics import forward_kinematics
 from dynid.exceptions import ConfigError
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, design_excitation
-from dynid.excitation.obstacles import Obstacle, obstacle_distances, reachable_pairs
+from dynid.excitation.obstacles import Obstacle
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
 from dynid.identification.excitation_run import run_excitation
 from dynid.io.cell_replay import cell_contacts, cell_mjcf
@@ -20,6 +21,11 @@ from dynid.report.excitation_run import save_excitation
 from dynid.report.excitation_summary import excitation_blocks
 
 RADIUS = 0.05
+
+
+def _capsule_distances(robot, q, bodies, *, gradient=False):
+    """The links' capsules of :data:`RADIUS`, surface to surface, as the design measures them (no clearance beyond)."""
+    return Workspace(obstacles=tuple(bodies), clearance=0.0, link_radius=RADIUS).cell_distances(robot, q, gradient=gradient)
 
 
 @pytest.fixture(scope="module")
@@ -51,9 +57,12 @@ BALL = Obstacle("sphere", np.array([0.2]), np.array([0.6, 0.4, 1.0]), name="ball
 POST = Obstacle("cylinder", np.array([0.1, 1.0]), np.array([0.5, -0.6, 0.5]), np.array([0.3, 0.0, 0.2]), name="post")
 
 
-def test_distances_equal_a_brute_force_segment_distance(er16, rng):
+def test_distances_equal_a_brute_force_segment_distance(er16, rng, monkeypatch):
+    import dynid.excitation.link_geometry as link_geometry
+
+    monkeypatch.setattr(link_geometry, "FAR", 10.0)  # every pair measured by coal, none left at its bounding volumes'
     q = rng.uniform(-1.5, 1.5, (40, er16.n_dof))
-    found = obstacle_distances(er16, q, [BOX, BALL], RADIUS)
+    found = _capsule_distances(er16, q, [BOX, BALL])
     truth = {i: _brute_force(er16, q, ob) for i, ob in enumerate([BOX, BALL])}
     checked = 0
     for c, (k, i) in enumerate(found.pairs):
@@ -68,57 +77,19 @@ def test_distances_equal_a_brute_force_segment_distance(er16, rng):
 def test_gradients_equal_finite_differences(er16, rng):
     q = rng.uniform(-1.5, 1.5, (25, er16.n_dof))
     bodies = [BOX, BALL, POST]
-    found = obstacle_distances(er16, q, bodies, RADIUS, gradient=True)
+    found = _capsule_distances(er16, q, bodies, gradient=True)
     h = 1e-6
     fd = np.zeros_like(found.gradient)
     for j in range(er16.n_dof):
         e = np.zeros(er16.n_dof)
         e[j] = h
-        up = obstacle_distances(er16, q + e, bodies, RADIUS, pairs=found.pairs).distance
-        down = obstacle_distances(er16, q - e, bodies, RADIUS, pairs=found.pairs).distance
-        fd[:, :, j] = (up - down) / (2 * h)
+        fd[:, :, j] = (_capsule_distances(er16, q + e, bodies).distance
+                       - _capsule_distances(er16, q - e, bodies).distance) / (2 * h)
     outside = found.distance > 1e-3  # away from contact: overlap depth is not smooth where the medial axis turns
-    exact = np.array([i != 2 for _, i in found.pairs])[None, :] & outside
+    exact = np.array([i == 1 for _, i in found.pairs])[None, :] & outside  # a ball: coal's closed form
     np.testing.assert_allclose(found.gradient[exact], fd[exact], atol=1e-7)
-    cyl = np.array([i == 2 for _, i in found.pairs])[None, :] & outside  # coal measures a cylinder by GJK, to 1e-9
-    np.testing.assert_allclose(found.gradient[cyl], fd[cyl], atol=1e-3)
-
-
-def test_where_coal_fails_on_an_overlap_the_bounding_spheres_stand(er16, rng, monkeypatch):
-    """coal's penetration depth can fail (it returns -DBL_MAX: tests/excitation/test_link_geometry.py has a case). Made
-    to fail on every call, the distance is the spheres' lower bound, finite, with that bound's own gradient."""
-    import coal
-
-    real = coal.distance
-
-    def failing(*args):
-        real(*args)
-        args[-1].min_distance = -np.finfo(float).max
-
-    q = rng.uniform(-1.5, 1.5, (10, er16.n_dof))
-    truth = obstacle_distances(er16, q, [BALL], RADIUS)
-    monkeypatch.setattr(coal, "distance", failing)
-    found = obstacle_distances(er16, q, [BALL], RADIUS, gradient=True)
-    assert np.all(np.isfinite(found.distance)) and np.all(found.distance <= truth.distance + 1e-9)
-    h = 1e-6
-    for j in range(er16.n_dof):
-        e = np.zeros(er16.n_dof)
-        e[j] = h
-        fd = (obstacle_distances(er16, q + e, [BALL], RADIUS, pairs=found.pairs).distance
-              - obstacle_distances(er16, q - e, [BALL], RADIUS, pairs=found.pairs).distance) / (2 * h)
-        np.testing.assert_allclose(found.gradient[:, :, j], fd, atol=1e-6)
-
-
-def test_the_reach_bound_leaves_out_only_pairs_that_cannot_touch(er16, rng):
-    far = Obstacle("sphere", np.array([0.3]), np.array([1.9, 0.0, 0.5]), name="far")
-    pairs = reachable_pairs(er16, [BOX, far], RADIUS)
-    left_out = [(k, i) for k in range(er16.n_dof) for i in range(2) if (k, i) not in pairs]
-    assert any(i == 1 for _, i in left_out) and any(i == 1 for _, i in pairs)  # the far body: only the outer links
-    lo = np.where(np.isfinite(er16.limits.q_min), er16.limits.q_min, -np.pi)
-    hi = np.where(np.isfinite(er16.limits.q_max), er16.limits.q_max, np.pi)
-    q = lo + rng.random((500, er16.n_dof)) * (hi - lo)
-    every = obstacle_distances(er16, q, [BOX, far], RADIUS, pairs=left_out)
-    assert every.distance.min() > 0
+    gjk = np.array([i != 1 for _, i in found.pairs])[None, :] & outside  # a box and a cylinder by GJK, to 1e-9
+    np.testing.assert_allclose(found.gradient[gjk], fd[gjk], atol=1e-3)
 
 
 def test_the_design_keeps_clear_of_a_body_beta1_passes_through():
@@ -154,7 +125,7 @@ def test_mujoco_places_the_capsules_on_dynids_skeleton(er16, rng):
         data.qpos[:] = q[n]
         mujoco.mj_forward(model, data)
         for k in range(er16.n_dof):
-            g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"link{k + 1}")
+            g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"link{k + 1}_shape{k}")
             np.testing.assert_allclose(data.geom_xpos[g], pts[n, k, 1], atol=1e-9)
 
 
@@ -170,6 +141,8 @@ def test_a_start_pose_inside_a_body_is_refused_in_one_line(er16):
 def test_config_reads_obstacles_and_names_a_bad_one(tmp_path: Path):
     body = """robot = "er16"
 joints = 3
+[workspace]
+link_radius = 0.05
 [design]
 starts = 1
 maxiter = 20
@@ -184,7 +157,7 @@ position = [0.0, 1.2, -0.3]
 [[workspace.obstacles]]
 shape = "cylinder"
 size = [0.1, 1.5]
-position = [1.0, 0.0, 0.0]
+position = [1.1, 0.0, 0.0]
 rpy = [0.0, 1.5707963, 0.0]
 """
     good = tmp_path / "good.toml"
@@ -194,9 +167,10 @@ rpy = [0.0, 1.5707963, 0.0]
     assert ws.to_dict()["obstacles"][1]["rpy"] == [0.0, 1.5707963, 0.0]
     run = run_excitation(load_excitation_config(good))  # the set-points checked again, and said
     table = [m for m in run.cell_clearance if m.where.startswith("table")]
-    assert table and table[0].worst == pytest.approx(
-        obstacle_distances(run.config.problem.robot, run.q, ws.obstacles, ws.clearance).distance[
-            :, [c for c, (_, i) in enumerate(reachable_pairs(run.config.problem.robot, ws.obstacles, ws.clearance)) if i == 0]].min())
+    pts = _segment_points(run.config.problem.robot, run.q[::10], samples=401)  # the brute force, every 10th set-point
+    gap = np.maximum(np.abs(pts - ws.obstacles[0].position) - 0.5 * ws.obstacles[0].size, 0.0)
+    brute = float(np.linalg.norm(gap, axis=-1).min()) - ws.capsule_radius(run.config.problem.robot) - ws.clearance
+    assert table and table[0].worst <= brute + 1e-6 and table[0].worst == pytest.approx(brute, abs=5e-3)
     assert run.to_dict()["cell_clearance"][0]["where"].startswith("table")
     assert any("off the cell at the set-points" in getattr(line, "text", "") for line in excitation_blocks(run))
     written = {p.name for p in save_excitation(run, tmp_path / "out")}  # seen before it runs: the cell and the distances
@@ -214,9 +188,9 @@ def test_mujoco_and_coal_agree_on_a_turned_cylinder_and_box(er16, rng):
     turned_box = Obstacle("box", np.array([0.5, 0.2, 0.3]), np.array([0.7, 0.2, 0.4]), np.array([0.0, 0.4, 0.8]), name="crate")
     bodies = (POST, turned_box)
     q = rng.uniform(-1.5, 1.5, (120, er16.n_dof))
-    coal_d = obstacle_distances(er16, q, bodies, RADIUS).distance.min(axis=1)
+    ws = Workspace(obstacles=bodies, link_radius=RADIUS)
+    coal_d = ws.cell_distances(er16, q).distance.min(axis=1)
     clear = np.abs(coal_d) > 1e-3
-    ws = Workspace(obstacles=bodies)
     touching = np.array([cell_contacts(er16, np.zeros(1), q[n:n + 1], ws).touching > 0 for n in range(q.shape[0])])
     assert (coal_d[clear] < 0).sum() >= 10 and (coal_d[clear] > 0).sum() >= 10
     np.testing.assert_array_equal(touching[clear], coal_d[clear] < 0)
@@ -243,5 +217,5 @@ def test_a_trajectory_that_fails_at_the_set_points_is_not_written(tmp_path, monk
     monkeypatch.setattr(er, "cell_contacts", lambda *a: None)
     inside = ConstraintMargin("obstacle clearance [m]", "ball: link 3 at t = 2 s", 0.0, -0.004, -0.004, np.nan)
     monkeypatch.setattr(er, "obstacle_margins", lambda *a: [inside])
-    with pytest.raises(InfeasibleDesignError, match=r"0.004 m inside the clearance .*ball: link 3 at t = 2 s"):
+    with pytest.raises(InfeasibleDesignError, match=r"0.004 m inside the cell's clearance .*ball: link 3 at t = 2 s"):
         run_excitation(config)

@@ -11,14 +11,22 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._util.reprs import short_repr
-from ..dynamics.kinematics import forward_kinematics, tool_positions
+from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
 from .collision import CapsuleSelfDistances, shape_clearance, touching_pairs
+from .floor import FloorDistances, FloorNeeds, floor_needs, lowest_points
 from .fourier import FourierTrajectory
-from .link_geometry import LinkGeometry, SelfDistances, ShapeDistances, self_pairs
-from .obstacles import CapsuleDistances, Obstacle, ObstacleDistances, reachable_pairs
+from .link_geometry import (
+    LinkGeometry,
+    SelfDistances,
+    ShapeDistances,
+    capsule_geometry,
+    estimated_link_radius,
+    self_pairs,
+)
+from .obstacles import Obstacle, ObstacleDistances
 
 AXES = "xyz"
 
@@ -34,18 +42,23 @@ class Workspace:
         Axis-aligned box; ``±inf`` leaves a side open.
     floor : float
         Height of a horizontal floor plane (a table, the floor); the tool point stays at ``z >= floor``, and every
-        link at least ``clearance`` above it (``-inf``: none).
+        link's shape (:meth:`shapes`) at least ``clearance`` above it, measured from its lowest point
+        (:mod:`dynid.excitation.floor`; ``-inf``: none).
     clearance : float [m]
-        How far every link stays above the floor: each link is taken as a capsule of this radius about the segment
-        between its joint's origin and the next (the flange for the last), so its joints' origins staying
-        ``clearance`` above the plane keeps the whole capsule above it (a plane and a segment: the lowest point is
-        an end). Default 0.05 m. The same capsules keep clear of :attr:`obstacles`.
+        How far the links' shapes keep off the floor and the cell's bodies: their surface-to-surface distance (default
+        0.05 m). A shape that starts within it of the floor (a shoulder housing just above the table) is held no lower
+        than it starts.
     obstacles : tuple of Obstacle
-        The cell's bodies (a table top, a fixture, a wall): every link's capsule stays off each
+        The cell's bodies (a table top, a fixture, a wall): every link's shape stays ``clearance`` off each
         (:mod:`dynid.excitation.obstacles`).
     geometry : LinkGeometry or None
-        The links' own collision shapes (:mod:`dynid.excitation.link_geometry`): with them, every shape stays
-        ``clearance`` off each body instead of the capsules.
+        The links' own collision shapes (:mod:`dynid.excitation.link_geometry`); None: each link is a capsule of
+        :attr:`link_radius` about its joint origins (:func:`~dynid.excitation.link_geometry.capsule_geometry`).
+    link_radius : float or None [m]
+        The capsules' radius without :attr:`geometry`; None (default): estimated,
+        :func:`~dynid.excitation.link_geometry.estimated_link_radius` (said as an estimate).
+    made : dict
+        The capsules :meth:`shapes` made, per robot (not compared).
     avoid_self_collision : bool or None
         Whether the design keeps the links off each other (:meth:`self_pairs`): their collision shapes with
         :attr:`geometry`, else their capsules. None (default): the shapes yes, the capsules no (their self clearance
@@ -60,6 +73,8 @@ class Workspace:
     obstacles: tuple[Obstacle, ...] = ()
     geometry: LinkGeometry | None = None
     avoid_self_collision: bool | None = None
+    link_radius: float | None = None
+    made: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
@@ -76,11 +91,12 @@ class Workspace:
             raise ConfigError(f"workspace.floor: expected a height in metres, got {self.floor}")
         if not (np.isfinite(self.clearance) and self.clearance >= 0):
             raise ConfigError(f"workspace.clearance: expected a distance of at least 0 m, got {self.clearance}")
+        if self.link_radius is not None and not (np.isfinite(self.link_radius) and self.link_radius > 0):
+            raise ConfigError(f"workspace.link_radius: expected a radius above 0 m, got {self.link_radius}")
 
-    def moving_origins(self, robot) -> np.ndarray:
-        """The joint frames whose origins the floor constraint holds: those whose height changes with the joints
-        (a point on the first joint's axis, or the base's, never moves and is not constrained); none without a
-        floor.
+    def shapes(self, robot) -> LinkGeometry:
+        """The links' shapes every distance is measured on: :attr:`geometry`, else capsules of :meth:`capsule_radius`
+        (made once per robot).
 
         Parameters
         ----------
@@ -88,16 +104,44 @@ class Workspace:
 
         Returns
         -------
-        (m,) int array
-            Joint frame indices (0-based).
+        LinkGeometry
+        """
+        if self.geometry is not None:
+            return self.geometry
+        key = (id(robot), self.capsule_radius(robot))
+        if key not in self.made:  # the robot is kept with its capsules: its id stays its own
+            self.made[key] = (robot, capsule_geometry(robot, key[1], estimated=self.link_radius is None))
+        return self.made[key][1]
+
+    def capsule_radius(self, robot) -> float:
+        """The links' capsule radius without collision shapes: :attr:`link_radius`, else the estimate.
+
+        Parameters
+        ----------
+        robot : Robot
+
+        Returns
+        -------
+        float [m]
+        """
+        return float(self.link_radius) if self.link_radius is not None else estimated_link_radius(robot)
+
+    def floor_needs(self, robot, start_pose: np.ndarray) -> FloorNeeds | None:
+        """The shapes the floor holds and the height each keeps (:func:`dynid.excitation.floor.floor_needs`); None
+        without a floor.
+
+        Parameters
+        ----------
+        robot : Robot
+        start_pose : (n_dof,) array [rad]
+
+        Returns
+        -------
+        FloorNeeds or None
         """
         if not np.isfinite(self.floor):
-            return np.zeros(0, dtype=int)
-        lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
-        hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
-        q = lo + np.random.default_rng(0).random((24, robot.n_dof)) * (hi - lo)
-        z = forward_kinematics(robot, q)[1][:, :, 2]
-        return np.flatnonzero(z.max(axis=0) - z.min(axis=0) > 1e-6)
+            return None
+        return floor_needs(robot, self.shapes(robot), self.floor, self.clearance, start_pose)
 
     def cell_pairs(self, robot) -> list[tuple[int, int]]:
         """The (link or shape, obstacle) pairs the cell's distances are measured for.
@@ -109,12 +153,10 @@ class Workspace:
         Returns
         -------
         list of (int, int)
-            (shape, obstacle) with :attr:`geometry`, else (link, obstacle) that can reach each other
-            (:func:`dynid.excitation.obstacles.reachable_pairs`).
+            (shape, obstacle) of :meth:`shapes` on a moving link (the base's shapes do not move).
         """
-        if self.geometry is not None:  # the base's shapes do not move
-            return [(g, i) for g in np.flatnonzero(self.geometry.link >= 0).tolist() for i in range(len(self.obstacles))]
-        return reachable_pairs(robot, self.obstacles, self.clearance)
+        shapes = self.shapes(robot)
+        return [(g, i) for g in np.flatnonzero(shapes.link >= 0).tolist() for i in range(len(self.obstacles))]
 
     def self_pairs(self, robot) -> list[tuple[int, int]]:
         """The pairs the design keeps apart: of the links' own collision shapes with :attr:`geometry`
@@ -132,7 +174,7 @@ class Workspace:
         """
         if self.avoid_self_collision is False or (self.geometry is None and self.avoid_self_collision is None):
             return []
-        return touching_pairs(robot, self.clearance) if self.geometry is None else self_pairs(robot, self.geometry)
+        return touching_pairs(robot, self.capsule_radius(robot)) if self.geometry is None else self_pairs(robot, self.geometry)
 
     def self_measure(self, robot, q, pairs, *, within: float | None = None):
         """The distances of :meth:`self_pairs` along ``q``, measured once, their gradient on demand: the shapes'
@@ -155,12 +197,12 @@ class Workspace:
             ``dist`` (N, n_pairs) [m], zero at contact (the capsules' surfaces); ``distances(gradient=True)``.
         """
         if self.geometry is None:
-            return CapsuleSelfDistances(robot, q, self.clearance, pairs)
+            return CapsuleSelfDistances(robot, q, self.capsule_radius(robot), pairs)
         return SelfDistances(robot, q, self.geometry, pairs, within=within)
 
     def cell_distances(self, robot, q, *, pairs=None, gradient: bool = False) -> ObstacleDistances:
-        """The links' distances to the cell's bodies beyond the clearance (zero: the clearance kept), by their own
-        collision shapes with :attr:`geometry`, else by their capsules.
+        """The links' shapes' (:meth:`shapes`) distances to the cell's bodies beyond the clearance (zero: the
+        clearance kept).
 
         Parameters
         ----------
@@ -178,8 +220,7 @@ class Workspace:
 
     def cell_measure(self, robot, q, *, pairs=None):
         """:meth:`cell_distances` measured once: ``dist`` (N, pairs) [m], and ``distances(gradient=...)`` with their
-        gradient at the same ``q`` (by the collision shapes, from the same coal results; by the capsules, computed
-        again).
+        gradient at the same ``q``, from the same coal results.
 
         Parameters
         ----------
@@ -190,12 +231,10 @@ class Workspace:
 
         Returns
         -------
-        ShapeDistances or CapsuleDistances
+        ShapeDistances
         """
         pairs = self.cell_pairs(robot) if pairs is None else pairs
-        if self.geometry is not None:
-            return ShapeDistances(robot, q, self.obstacles, self.geometry, self.clearance, pairs=pairs)
-        return CapsuleDistances(robot, q, self.obstacles, self.clearance, pairs)
+        return ShapeDistances(robot, q, self.obstacles, self.shapes(robot), self.clearance, pairs=pairs)
 
     def inequalities(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """``G p <= h`` for the finite sides of the box and the floor.
@@ -223,6 +262,19 @@ class Workspace:
             labels.append(f"z >= floor {self.floor:g} m")
         return np.array(rows).reshape(-1, 3), np.array(h, dtype=float), labels
 
+    def shapes_said(self) -> str:
+        """What the floor's and the cell's distances are measured on, in words (:meth:`shapes`).
+
+        Returns
+        -------
+        str
+        """
+        if self.geometry is not None:
+            return f"collision shapes of {self.geometry.source}"
+        if self.link_radius is not None:
+            return f"capsules of radius {self.link_radius:g} m about the joint origins ([workspace] link_radius)"
+        return "capsules about the joint origins, their radius estimated (no collision shapes; [workspace] link_radius)"
+
     def to_dict(self) -> dict:
         """JSON-ready workspace (infinite sides as None).
 
@@ -234,8 +286,7 @@ class Workspace:
         return {"box_min": fin(self.box_min), "box_max": fin(self.box_max),
                 "floor": float(self.floor) if np.isfinite(self.floor) else None, "clearance": float(self.clearance),
                 **({"obstacles": [ob.to_dict() for ob in self.obstacles]} if self.obstacles else {}),
-                **({"geometry": f"collision shapes of {self.geometry.source}"} if self.geometry is not None and self.obstacles
-                   else {}),
+                **({"geometry": self.shapes_said()} if self.obstacles or np.isfinite(self.floor) else {}),
                 **({} if self.avoid_self_collision is None else {"avoid_self_collision": self.avoid_self_collision})}
 
 
@@ -312,7 +363,8 @@ def check_limits(limits: Limits, n_dof: int, source: str = "limits") -> None:
 
 
 def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarray, limits: Limits,
-                       workspace: Workspace, phi: np.ndarray | None = None) -> list[ConstraintMargin]:
+                       workspace: Workspace, phi: np.ndarray | None = None, *,
+                       start_pose: np.ndarray | None = None) -> list[ConstraintMargin]:
     """Margin of every finite constraint of eq. 15, per joint (per side for the workspace), on times ``t``.
 
     Parameters
@@ -325,6 +377,8 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
     workspace : Workspace
     phi : (n_params,) array, optional
         Parameters the torques are computed with (default: the robot's nominal ones).
+    start_pose : (n_dof,) array [rad], optional
+        The pose a shape that starts within the clearance of the floor is held at (default the trajectory's offsets).
 
     Returns
     -------
@@ -353,14 +407,7 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
             if np.isfinite(lim[j]):
                 worst = float(np.abs(values[:, j]).max())
                 out.append(ConstraintMargin(name, f"joint {j + 1}", float(lim[j]), worst, float(lim[j] - worst), float((lim[j] - worst) / lim[j])))
-    moving = workspace.moving_origins(robot)
-    if moving.size:  # every link above the floor by the clearance: its joints' origins (the tool point's row below)
-        z = forward_kinematics(robot, q)[1][:, :, 2]
-        limit = float(workspace.floor + workspace.clearance)
-        for k in moving:
-            worst = float(z[:, k].min())
-            out.append(ConstraintMargin("floor clearance [m]", f"joint {k + 1}'s origin", limit, worst,
-                                        worst - limit, np.nan))
+    out += floor_margins(robot, t, q, workspace, trajectory.q0 if start_pose is None else start_pose)
     g, h, labels = workspace.inequalities()
     if len(h):
         p = tool_positions(robot, q)
@@ -369,6 +416,34 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
             sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
             out.append(ConstraintMargin("workspace [m]", f"tool {lbl}", sign * float(hi), sign * float(hi) - sign * m, m, np.nan))
     return out + obstacle_margins(robot, t, q, workspace) + self_margins(robot, t, q, workspace)
+
+
+def floor_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace,
+                  start_pose: np.ndarray) -> list[ConstraintMargin]:
+    """How close the links' shapes (:meth:`Workspace.shapes`) come to the floor along ``q``: one margin, the shape whose
+    height above the floor is least beyond what it must keep (:mod:`dynid.excitation.floor`); none without a floor.
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s]
+    q : (N, n_dof) array [rad]
+    workspace : Workspace
+    start_pose : (n_dof,) array [rad]
+
+    Returns
+    -------
+    list of ConstraintMargin
+        ``limit`` the height above the floor the shape keeps, ``worst`` its lowest; ``where`` names it and when.
+    """
+    needs = workspace.floor_needs(robot, start_pose)
+    if needs is None or not needs.shapes.size:
+        return []
+    found = FloorDistances(robot, q, workspace.shapes(robot), workspace.floor, needs)
+    n, c = np.unravel_index(int(np.argmin(found.dist)), found.dist.shape)
+    name = workspace.shapes(robot).names[int(needs.shapes[c])]
+    return [ConstraintMargin("floor clearance [m]", f"{name} at t = {float(t[n]):.3g} s", float(needs.height[c]),
+                             float(found.height[n, c]), float(found.dist[n, c]), np.nan)]
 
 
 def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> list[ConstraintMargin]:
@@ -422,32 +497,30 @@ def obstacle_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Work
     """
     if not workspace.obstacles:
         return []
-    found = workspace.cell_distances(robot, q)
-    geometry = workspace.geometry
+    found = workspace.cell_measure(robot, q)
+    shapes = workspace.shapes(robot)
     out = []
     for i, ob in enumerate(workspace.obstacles):
         cols = [c for c, (_, o) in enumerate(found.pairs) if o == i]
         if not cols:
             continue
-        d = found.distance[:, cols]
-        n, c = np.unravel_index(int(np.argmin(d)), d.shape)
-        worst = float(d[n, c])
-        shape = "" if geometry is None else f" ({geometry.names[found.pairs[cols[c]][0]]})"
-        out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {found.links[cols[c]] + 1}{shape} at "
-                                    f"t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan))
+        n, c, worst = found.smallest(cols)
+        g = found.pairs[c][0]
+        out.append(ConstraintMargin("obstacle clearance [m]", f"{ob.name}: link {int(shapes.link[g]) + 1} "
+                                    f"({shapes.names[g]}) at t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan))
     return out
 
 
 @dataclass(frozen=True)
 class LowestPoint:
-    """The lowest point the arm reaches along a trajectory: its joint origins and tool point, against gravity.
+    """The lowest point the arm's shapes reach along a trajectory, against gravity.
 
     Attributes
     ----------
     height : float [m]
         Above the base frame's origin, along the robot's up (``-gravity``); below 0, the arm goes below its base.
     point : str
-        "the tool point" or "joint k's origin".
+        The shape's name (:meth:`Workspace.shapes`).
     time : float [s]
         When.
     """
@@ -466,15 +539,16 @@ class LowestPoint:
         return {"height": self.height, "point": self.point, "time": self.time}
 
 
-def lowest_point(robot: Robot, t: np.ndarray, q: np.ndarray) -> LowestPoint:
-    """Where a trajectory takes the arm lowest: what a design without a floor (:attr:`Workspace.floor`) leaves
-    unchecked, the surface the robot stands on.
+def lowest_point(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> LowestPoint:
+    """Where a trajectory takes the arm's shapes (:meth:`Workspace.shapes`) lowest: what a design without a floor
+    (:attr:`Workspace.floor`) leaves unchecked, the surface the robot stands on.
 
     Parameters
     ----------
     robot : Robot
     t : (N,) array [s]
     q : (N, n_dof) array [rad]
+    workspace : Workspace
 
     Returns
     -------
@@ -483,9 +557,8 @@ def lowest_point(robot: Robot, t: np.ndarray, q: np.ndarray) -> LowestPoint:
     """
     g = np.asarray(robot.gravity, dtype=float)
     up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    rots, origins = forward_kinematics(robot, q)
-    tool = origins[:, -1] + rots[:, -1] @ np.asarray(robot.tool_translation, dtype=float)
-    heights = np.concatenate([origins @ up, (tool @ up)[:, None]], axis=1)  # (N, n_dof + 1)
+    shapes = workspace.shapes(robot)
+    moving = np.flatnonzero(shapes.link >= 0)
+    heights = lowest_points(robot, q, shapes, moving, up=up) @ up  # (N, m)
     n, k = np.unravel_index(int(np.argmin(heights)), heights.shape)
-    return LowestPoint(float(heights[n, k]), "the tool point" if k == robot.n_dof else f"joint {k + 1}'s origin",
-                       float(t[n]))
+    return LowestPoint(float(heights[n, k]), shapes.names[int(moving[k])], float(t[n]))

@@ -28,15 +28,16 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
-from ..dynamics.kinematics import forward_kinematics, tool_positions
+from ..dynamics.kinematics import tool_positions
 from ..dynamics.regressor import regressor
-from ..dynamics.sensitivity import origins_jacobian, regressor_state_derivatives, tool_jacobian
+from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..model.loading import as_robot
 from ..model.robot import Limits, Robot
 from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
+from .floor import FloorDistances
 from .fourier import FourierTrajectory
 from .link_geometry import self_distances
 
@@ -182,12 +183,13 @@ class ExcitationProblem:
         if out:
             raise ConfigError(f"workspace excludes the start pose: at the offsets q_o = {np.round(q0, 4).tolist()} rad the tool "
                               f"point is at {np.round(p, 3).tolist()} m, which violates {', '.join(out)}")
-        low = [int(k) for k in self.workspace.moving_origins(self.robot)
-               if forward_kinematics(self.robot, q0[None])[1][0, k, 2] < self.workspace.floor + self.workspace.clearance]
-        if low:
-            raise ConfigError(f"workspace: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) joint {low[0] + 1}'s "
-                              f"origin is less than workspace.clearance = {self.workspace.clearance:g} m above the floor "
-                              f"({self.workspace.floor:g} m): start higher, or lower the clearance")
+        needs = self.workspace.floor_needs(self.robot, q0)
+        if needs is not None and needs.shapes.size and needs.start.min() < 0 and self.workspace.geometry is not None:
+            c = int(np.argmin(needs.start))
+            raise ConfigError(f"workspace: at the start pose (offsets q_o = {np.round(q0, 4).tolist()} rad) "
+                              f"{self.workspace.shapes(self.robot).names[int(needs.shapes[c])]} is {-needs.start[c]:.3g} m "
+                              f"under the floor ({self.workspace.floor:g} m): start higher, or give the floor's height "
+                              "in the base frame")
         self._check_start_clear(q0)
         zero = np.zeros((1, self.robot.n_dof))
         tau = (regressor(self.robot, q0[None], zero, zero) @ self.phi)[0]
@@ -253,7 +255,8 @@ class ExcitationProblem:
         list of ConstraintMargin
         """
         t = self.verification_grid() if t is None else t
-        return constraint_margins(self.robot, trajectory, t, self.limits, self.workspace, self.phi)
+        return constraint_margins(self.robot, trajectory, t, self.limits, self.workspace, self.phi,
+                                  start_pose=self.start_pose())
 
     def criterion_value(self, trajectory: FourierTrajectory) -> float:
         """The design criterion of a trajectory on the design grid.
@@ -520,9 +523,10 @@ class _Objective:
         g, h, _ = problem.workspace.inequalities()
         reach = sum(float(np.linalg.norm(jt.translation)) for jt in problem.robot.joints) + float(np.linalg.norm(problem.robot.tool_translation))
         self.ws_g, self.ws_h = g, h - s * reach
-        ws = problem.workspace  # every link above the floor: its joints' origins (Workspace.clearance)
-        self.origins = ws.moving_origins(problem.robot)
-        self.floor = float(ws.floor + ws.clearance + s * reach) if self.origins.size else 0.0
+        ws = problem.workspace  # every link's shape above the floor (Workspace.floor_needs), tightened as the cell's
+        found = ws.floor_needs(problem.robot, problem.start_pose())
+        self.needs = None if found is None or not found.shapes.size else replace(
+            found, height=np.where(found.height < ws.clearance, found.height, found.height + s * reach))
         self.pairs = ws.cell_pairs(problem.robot) if ws.obstacles else []  # every link off the cell's bodies
         self.gap = s * reach
         self.self_pairs = ws.self_pairs(problem.robot)  # and off each other (shapes or capsules): tightened as the
@@ -547,8 +551,8 @@ class _Objective:
         self.tau = y[:, self.tau_idx, :] @ p.phi
         if self.ws_h.size:
             self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
-        if self.origins.size:
-            self.lift = forward_kinematics(p.robot, self.q)[1][:, self.origins, 2] - self.floor  # (N, m)
+        if self.needs is not None:
+            self.lifted = FloorDistances(p.robot, self.q, p.workspace.shapes(p.robot), p.workspace.floor, self.needs)
         if self.pairs:  # measured once here, as the self distances below
             self.cell = p.workspace.cell_measure(p.robot, self.q, pairs=self.pairs)
             self.clear = self.cell.dist - self.gap  # (N, pairs)
@@ -574,9 +578,10 @@ class _Objective:
         if self.ws_h.size:
             _, jac = tool_jacobian(p.robot, self.q)
             self.ws_jac = -np.einsum("md,kdi,kix->kmx", self.ws_g, jac, lay.lin[0])
-        if self.origins.size:
-            _, jac = origins_jacobian(p.robot, self.q)
-            self.lift_jac = np.einsum("kmi,kix->kmx", jac[:, self.origins, 2, :], lay.lin[0])
+        if self.needs is not None:
+            lift = self.lifted.distances(gradient=True).gradient
+            assert lift is not None  # asked, with shapes
+            self.lift_jac = np.einsum("kmi,kix->kmx", lift, lay.lin[0])
         if self.pairs:
             self.clear_jac = np.einsum("kmi,kix->kmx", self.cell.distances(gradient=True).gradient, lay.lin[0])
         if self.self_pairs:
@@ -599,8 +604,8 @@ class _Objective:
         parts = [((lim - self.tau) / lim).ravel(), ((lim + self.tau) / lim).ravel()]
         if self.ws_h.size:
             parts.append(self.ws.ravel())
-        if self.origins.size:
-            parts.append(self.lift.ravel())
+        if self.needs is not None:
+            parts.append(self.lifted.dist.ravel())
         if self.pairs:
             parts.append(self.clear.ravel())
         if self.self_pairs:  # one row per sample: the soft minimum over the pairs
@@ -613,7 +618,7 @@ class _Objective:
         parts = [(-self.tau_jac / lim).reshape(-1, x.size), (self.tau_jac / lim).reshape(-1, x.size)]
         if self.ws_h.size:
             parts.append(self.ws_jac.reshape(-1, x.size))
-        if self.origins.size:
+        if self.needs is not None:
             parts.append(self.lift_jac.reshape(-1, x.size))
         if self.pairs:
             parts.append(self.clear_jac.reshape(-1, x.size))

@@ -32,7 +32,15 @@ from ..model.robot import Robot
 from ..model.srdf import disabled_link_pairs
 from .obstacles import GJK_TOLERANCE, ObstacleDistances, distance_above, nearest_points
 
-__all__ = ["LinkGeometry", "link_geometry_from_mjcf", "link_geometry_from_urdf", "shape_distances"]
+__all__ = ["LINK_RADIUS_SHARE", "LinkGeometry", "capsule_geometry", "estimated_link_radius", "link_geometry_from_mjcf",
+           "link_geometry_from_urdf", "shape_distances"]
+
+LINK_RADIUS_SHARE = 0.15
+"""The links' capsule radius, as a share of the arm's reach (the sum of its joint offsets and the flange's), where the
+robot file has no collision shapes and ``[workspace] link_radius`` is not given. On the collision meshes of the nine
+public arms of benchmarks/zoo (UR3, UR5, UR10, Panda, Kinova Jaco 2, xArm7, Unitree Z1, SO-100, TALOS's arm), a capsule
+of this radius about the joint origins holds the whole mesh of 45 of the 55 links; the other ten are hands, grippers
+and offset housings (up to 0.37 of the reach): an estimate, said as one wherever it is used."""
 
 
 @short_repr
@@ -161,6 +169,56 @@ class LinkGeometry:
                 "position": p + np.einsum("nmij,mj->nmi", r, self.placement[:, :3, 3]), "transforms": {}}
         self.memo["last"] = last
         return last
+
+
+def estimated_link_radius(robot: Robot) -> float:
+    """:data:`LINK_RADIUS_SHARE` of the arm's reach.
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    float [m]
+    """
+    reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
+    return LINK_RADIUS_SHARE * reach
+
+
+def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> LinkGeometry:
+    """Each link as a capsule of ``radius`` about the segment from its joint's origin to the next joint's (the last
+    link's to the flange; a sphere where they coincide): the shapes of a robot whose file has none.
+
+    Parameters
+    ----------
+    robot : Robot
+    radius : float [m]
+    estimated : bool
+        Whether ``radius`` is :func:`estimated_link_radius` (said in :attr:`LinkGeometry.source`).
+
+    Returns
+    -------
+    LinkGeometry
+        ``names`` "link k capsule", ``source`` what they are.
+    """
+    ends = [np.asarray(j.translation, dtype=float) for j in robot.joints[1:]] + [np.asarray(robot.tool_translation, dtype=float)]
+    shapes, placement = [], []
+    for end in ends:  # in the link's own frame the segment runs from its origin to the next joint's translation
+        length = float(np.linalg.norm(end))
+        frame = np.eye(4)
+        if length > 1e-12:
+            z = end / length
+            x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
+            x /= np.linalg.norm(x)
+            frame[:3, :3] = np.stack([x, np.cross(z, x), z], axis=1)
+            frame[:3, 3] = 0.5 * end
+        shapes.append(coal.Capsule(float(radius), length))
+        placement.append(frame)
+    how = "estimated: [workspace] link_radius sets it" if estimated else "[workspace] link_radius"
+    return LinkGeometry(tuple(shapes), np.arange(robot.n_dof), np.array(placement),
+                        tuple(f"link {k + 1} capsule" for k in range(robot.n_dof)),
+                        f"capsules of radius {radius:.3g} m about the joint origins ({how})")
 
 
 def _package_dirs(path: Path) -> list[str]:
@@ -452,8 +510,41 @@ class ShapeDistances(_CoalDistances):
         self._normal = -gap / np.maximum(np.linalg.norm(gap, axis=-1, keepdims=True), 1e-12)
         pose = geometry.pose_of(robot, q)
         shapes = [(geometry.shapes[g], g, *bodies[i]) for g, i in pairs]
-        self._found = _coal_results(self.dist, clearance, lambda n, c: (shapes[c][0], pose(n, shapes[c][1]),
-                                                                      shapes[c][2], shapes[c][3]))
+        self._clearance = clearance
+        self._shapes_at = lambda n, c: (shapes[c][0], pose(n, shapes[c][1]), shapes[c][2], shapes[c][3])
+        self._found = _coal_results(self.dist, clearance, self._shapes_at)
+
+    def smallest(self, columns) -> tuple[int, int, float]:
+        """The smallest distance of the pairs ``columns`` over the samples, measured by coal where the bounding
+        volumes' bound stood (:data:`FAR` apart or more): samples are measured in the order of their bounds until the
+        next bound lies above the smallest found, so the figure is a distance, never a bound.
+
+        Parameters
+        ----------
+        columns : sequence of int
+            Pairs (into :attr:`pairs`).
+
+        Returns
+        -------
+        sample : int
+        column : int
+        distance : float [m]
+            Less the clearance.
+        """
+        columns = np.asarray(columns, dtype=int)
+        bound = self.dist[:, columns]
+        request = coal.DistanceRequest()
+        request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
+        best = (0, int(columns[0]), np.inf)
+        for flat in np.argsort(bound, axis=None, kind="stable"):
+            n, k = np.unravel_index(int(flat), bound.shape)
+            if bound[n, k] >= best[2]:
+                break
+            result = distance_above(*self._shapes_at(n, int(columns[k])), request, bound[n, k] + self._clearance)
+            exact = bound[n, k] if result is None else float(result.min_distance) - self._clearance
+            if exact < best[2]:
+                best = (int(n), int(columns[k]), exact)
+        return best
 
     @staticmethod
     def _take_ends(near, normal, n_found, c_found, ends) -> None:

@@ -1,14 +1,9 @@
 """The cell's bodies an excitation trajectory keeps its links clear of (issue "An excitation safe to run on the real
-robot", item 1): boxes, cylinders and spheres placed in the base frame, and every link's signed distance to them with
-its gradient in the joint angles.
+robot", item 1): boxes, cylinders and spheres placed in the base frame, and what measuring against them shares.
 
-Each link is the capsule of radius ``clearance`` about the segment from its joint's origin to the next joint's (the
-last link's to the flange), as in :mod:`dynid.excitation.collision`; a distance of zero is the skeleton ``clearance``
-from the body's surface. Distances are coal's (Pan, Chitta & Manocha, "FCL: a general purpose library for collision
-and proximity queries", ICRA 2012), signed (negative: overlap). Their gradient is the envelope theorem's: moving the
-segment's point nearest to the body by ``δ`` changes the distance by ``n·δ``, ``n`` the unit normal away from the
-body, and that point moves with ``(1 - s) J_a + s J_b`` (``J`` the positional Jacobians of the segment's ends,
-:func:`dynid.dynamics.sensitivity.origins_jacobian`).
+The links' distances to the bodies are measured on the links' shapes (:mod:`dynid.excitation.link_geometry`: the
+robot file's collision shapes, or capsules about the joint origins). Distances are coal's (Pan, Chitta & Manocha,
+"FCL: a general purpose library for collision and proximity queries", ICRA 2012), signed (negative: overlap).
 """
 
 from __future__ import annotations
@@ -26,7 +21,7 @@ from ..dynamics.sensitivity import origins_jacobian, tool_jacobian
 from ..exceptions import ConfigError
 from ..model.robot import Robot
 
-__all__ = ["Obstacle", "ObstacleDistances", "CapsuleDistances", "obstacle_distances", "reachable_pairs"]
+__all__ = ["Obstacle", "ObstacleDistances"]
 
 SIZES = {"box": 3, "cylinder": 2, "sphere": 1}
 """How many numbers each shape's ``size`` holds: a box's full lengths along x, y, z; a cylinder's radius and length
@@ -152,31 +147,6 @@ def _capsules(seg: np.ndarray, radius: float):
     return shape, [coal.Transform3s(r, c) for r, c in zip(rotations, centres)]
 
 
-def reachable_pairs(robot: Robot, obstacles, radius: float) -> list[tuple[int, int]]:
-    """The (link, obstacle) pairs (0-based) that can come within ``radius`` of each other: a link whose segment moves
-    and whose reach from the first joint's origin (the sum of the joint offsets up to its far end) meets the body's
-    bounding sphere. A bound, not a sample: a pair left out cannot touch on any pose.
-
-    Parameters
-    ----------
-    robot : Robot
-    obstacles : sequence of Obstacle
-    radius : float [m]
-
-    Returns
-    -------
-    list of (int, int)
-    """
-    lengths = [float(np.linalg.norm(jt.translation)) for jt in robot.joints[1:]] + [float(np.linalg.norm(robot.tool_translation))]
-    reach = np.cumsum(lengths)  # link k's far end is at most reach[k] from joint 1's origin
-    centre = forward_kinematics(robot, np.zeros((1, robot.n_dof)))[1][0, 0]
-    out = []
-    for i, ob in enumerate(obstacles):
-        gap = float(np.linalg.norm(ob.position - centre)) - ob.bounding_radius() - radius
-        out += [(k, i) for k in range(robot.n_dof) if reach[k] >= gap]
-    return sorted(out)
-
-
 def distance_above(shape_a, pose_a, shape_b, pose_b, request, bound: float):
     """coal's distance of two shapes where it is at least ``bound``, a lower bound of it (their bounding spheres'
     distance). On a deep overlap coal's penetration depth (EPA) can fail at :data:`GJK_TOLERANCE` and return
@@ -206,20 +176,6 @@ def distance_above(shape_a, pose_a, shape_b, pose_b, request, bound: float):
     return result if result.min_distance >= bound - 1e-6 else None
 
 
-def away_from(result) -> np.ndarray:
-    """The unit vector from the first object's nearest point to the second's (coal's normal where they overlap).
-
-    Parameters
-    ----------
-    result : coal.DistanceResult
-
-    Returns
-    -------
-    (3,) array
-    """
-    return nearest_points(result)[2]
-
-
 def nearest_points(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """coal's two nearest points and the unit vector from the first to the second (coal's normal where they overlap).
 
@@ -235,22 +191,6 @@ def nearest_points(result) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     first, second = result.getNearestPoint1(), result.getNearestPoint2()
     gap = second - first  # divided by its norm as np.linalg.norm computes it (sqrt of the dot), without its checks
     return first, second, gap / math.sqrt(gap.dot(gap)) if result.min_distance > 1e-9 else np.asarray(result.normal)
-
-
-def _distance_gradient(result, seg: np.ndarray, jac: np.ndarray) -> np.ndarray:
-    """(n_dof,) ``∂distance/∂q`` of one capsule from coal's result: the envelope theorem (module docstring)."""
-    a, b = seg
-    ab = b - a
-    near = result.getNearestPoint1()
-    s = float(np.clip((near - a) @ ab / (ab @ ab), 0.0, 1.0)) if ab @ ab > 1e-24 else 0.0
-    # moving the capsule away from the body raises the distance
-    return -away_from(result) @ ((1 - s) * jac[0] + s * jac[1])
-
-
-def _sphere_gradient(gap: np.ndarray, jac: np.ndarray) -> np.ndarray:
-    """(n_dof,) ``∂distance/∂q`` of the bounding spheres' distance, ``gap`` from the body's centre to the capsule's
-    middle, which moves as the mean of its segment's ends (``jac`` (2, 3, n_dof))."""
-    return gap / max(float(np.linalg.norm(gap)), 1e-12) @ (0.5 * (jac[0] + jac[1]))
 
 
 @short_repr
@@ -279,86 +219,3 @@ class ObstacleDistances:
     def __post_init__(self) -> None:
         if not self.links:
             object.__setattr__(self, "links", tuple(k for k, _ in self.pairs))
-
-
-class CapsuleDistances:
-    """:func:`obstacle_distances` measured once along ``q`` (``dist``), with :meth:`distances` giving them again with
-    their gradient (:meth:`dynid.excitation.constraints.Workspace.cell_measure` by the links' capsules).
-
-    Parameters
-    ----------
-    robot : Robot
-    q : (N, n_dof) array [rad]
-    obstacles : sequence of Obstacle
-    clearance : float [m]
-    pairs : list of (int, int)
-        (link, obstacle) pairs.
-    """
-
-    def __init__(self, robot: Robot, q: np.ndarray, obstacles, clearance: float, pairs):
-        self._args = (robot, q, obstacles, clearance, pairs)
-        self._values = obstacle_distances(robot, q, obstacles, clearance, pairs=pairs)
-        self.dist = self._values.distance
-
-    def distances(self, *, gradient: bool = False) -> ObstacleDistances:
-        """The distances, with their gradient if asked (computed again).
-
-        Parameters
-        ----------
-        gradient : bool
-
-        Returns
-        -------
-        ObstacleDistances
-        """
-        if not gradient:
-            return self._values
-        robot, q, obstacles, clearance, pairs = self._args
-        return obstacle_distances(robot, q, obstacles, clearance, pairs=pairs, gradient=True)
-
-
-def obstacle_distances(robot: Robot, q: np.ndarray, obstacles, radius: float, *, pairs=None,
-                       gradient: bool = False) -> ObstacleDistances:
-    """Signed distances of the links' capsules to the cell's bodies along ``q`` (module docstring).
-
-    Parameters
-    ----------
-    robot : Robot
-    q : (N, n_dof) array [rad]
-    obstacles : sequence of Obstacle
-    radius : float [m]
-        The links' capsule radius (:attr:`dynid.excitation.constraints.Workspace.clearance`).
-    pairs : list of (int, int), optional
-        (link, obstacle) pairs to check (default :func:`reachable_pairs`).
-    gradient : bool
-        Also the distances' gradient in ``q``.
-
-    Returns
-    -------
-    ObstacleDistances
-    """
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    pairs = reachable_pairs(robot, obstacles, radius) if pairs is None else list(pairs)
-    seg = _segments(robot, q)
-    jac = _segment_jacobians(robot, q) if gradient and pairs else None
-    bodies = [ob.geometry() for ob in obstacles]
-    dist = np.empty((q.shape[0], len(pairs)))
-    grad = np.zeros((q.shape[0], len(pairs), robot.n_dof)) if jac is not None else None
-    request = coal.DistanceRequest()
-    request.gjk_tolerance, request.epa_tolerance = GJK_TOLERANCE, GJK_TOLERANCE
-    capsules: dict = {}
-    for c, (k, i) in enumerate(pairs):
-        body, pose = bodies[i]
-        if k not in capsules:
-            capsules[k] = _capsules(seg[:, k], radius)
-        cap, cap_poses = capsules[k]
-        middle, half = seg[:, k].mean(axis=1), 0.5 * np.linalg.norm(seg[:, k, 1] - seg[:, k, 0], axis=1)
-        bound = (np.linalg.norm(middle - obstacles[i].position, axis=1) - half - radius
-                 - obstacles[i].bounding_radius())  # the spheres holding the capsule and the body
-        for n in range(q.shape[0]):
-            result = distance_above(cap, cap_poses[n], body, pose, request, bound[n])
-            dist[n, c] = bound[n] if result is None else result.min_distance
-            if grad is not None and jac is not None:
-                grad[n, c] = (_sphere_gradient(middle[n] - obstacles[i].position, jac[n, k]) if result is None
-                              else _distance_gradient(result, seg[n, k], jac[n, k]))
-    return ObstacleDistances(pairs, dist, grad)

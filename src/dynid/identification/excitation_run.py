@@ -10,7 +10,7 @@ import numpy as np
 
 from .._util.reprs import short_repr
 from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
-from ..excitation.constraints import ConstraintMargin, LowestPoint, lowest_point, obstacle_margins
+from ..excitation.constraints import ConstraintMargin, LowestPoint, floor_margins, lowest_point, obstacle_margins
 from ..excitation.design import ExcitationDesign, InfeasibleDesignError, design_excitation
 from ..io.cell_replay import CellContacts, cell_contacts
 from ..io.excitation_config import ExcitationConfig
@@ -33,8 +33,9 @@ class ExcitationRun:
         The smallest distance between links that can touch, over the set-points
         (:func:`dynid.excitation.collision.self_clearance`; None for a chain too short to fold onto itself).
     cell_clearance : list of ConstraintMargin
-        The links' smallest distance to each of the cell's bodies over the set-points
-        (:func:`dynid.excitation.constraints.obstacle_margins`; empty without ``[[workspace.obstacles]]``).
+        The links' shapes' smallest distance to the floor and to each of the cell's bodies over the set-points
+        (:func:`dynid.excitation.constraints.floor_margins`, :func:`~dynid.excitation.constraints.obstacle_margins`;
+        empty without a floor and ``[[workspace.obstacles]]``).
     mujoco_contacts : CellContacts or None
         The set-points checked a second time by MuJoCo (:func:`dynid.io.cell_replay.cell_contacts`; None without a
         floor or bodies, or without MuJoCo).
@@ -115,11 +116,13 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
     q, dq, ddq = design.trajectory.evaluate(t)
     every = max(1, int(np.ceil(t.size / CLEARANCE_SAMPLES)))  # the set-points, at most this many of them
     p = config.problem
-    clearance = (self_clearance(p.robot, t[::every], q[::every], p.workspace.clearance) if p.workspace.geometry is None
-                 else shape_clearance(p.robot, t[::every], q[::every], p.workspace.geometry))
-    cell = tuple(obstacle_margins(p.robot, t, q, p.workspace))  # every set-point: a few µs per link and body
-    lowest = None if np.isfinite(p.workspace.floor) else lowest_point(p.robot, t, q)
-    run = ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, p.workspace), lowest)
+    ws, start = p.workspace, p.start_pose()
+    clearance = (self_clearance(p.robot, t[::every], q[::every], ws.capsule_radius(p.robot)) if ws.geometry is None
+                 else shape_clearance(p.robot, t[::every], q[::every], ws.geometry))
+    # every set-point: a few µs per shape and body
+    cell = tuple(floor_margins(p.robot, t, q, ws, start) + obstacle_margins(p.robot, t, q, ws))
+    lowest = None if np.isfinite(ws.floor) else lowest_point(p.robot, t, q, ws)
+    run = ExcitationRun(config, design, t, q, dq, ddq, clearance, cell, cell_contacts(p.robot, t, q, ws, start), lowest)
     _refuse_unsafe(run)
     return run
 
@@ -127,12 +130,13 @@ def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float
 def _refuse_unsafe(run: ExcitationRun) -> None:
     """A trajectory whose set-points bring a link into the cell, or two of the links' own shapes together, is not
     written as if it were safe (the design's verification grid is coarser than the set-points)."""
-    bad = [m for m in run.cell_clearance if m.worst < 0]
+    bad = [m for m in run.cell_clearance if m.margin < 0]
     if bad:
-        m = min(bad, key=lambda m: m.worst)
-        raise InfeasibleDesignError(f"the designed trajectory brings a link {-m.worst:.3g} m inside the clearance of the cell "
-                                    f"at a set-point ({m.where}) between the verification grid's samples: nothing "
-                                    "written; raise design.grid_points")
+        m = min(bad, key=lambda m: m.margin)
+        body = "the floor's" if m.constraint.startswith("floor") else "the cell's"
+        raise InfeasibleDesignError(f"the designed trajectory brings a link's shape {-m.margin:.3g} m inside {body} "
+                                    f"clearance at a set-point ({m.where}) between the verification grid's samples: "
+                                    "nothing written; raise design.grid_points")
     found = run.mujoco_contacts
     if found is not None and found.touching:
         f = found.first or {}

@@ -1,14 +1,15 @@
 """An excitation checked a second time, by MuJoCo's collision detection (issue "An excitation safe to run on the real
 robot", item 2: checked twice).
 
-The robot is written as MJCF (:func:`dynid.io.export.mjcf_from_robot`) with each link's capsule as a geom (radius
-``clearance`` about the segment from its joint's origin to the next, the last to the flange: the capsules of
-:mod:`dynid.excitation.obstacles`), the cell's bodies as geoms of the world, and the floor as a plane. MuJoCo places
-the links at every set-point (``mj_forward``) and reports its contacts: a link's capsule touching a body or the floor
-is a failure. Links collide with the cell only, not with each other (:mod:`dynid.excitation.collision` reports
-those). The floor is checked against the links whose two ends the design holds above it (joint origins that move);
-a link with a fixed end (the first, on the base) rests where the description puts it. Reference: Todorov, Erez &
-Tassa, "MuJoCo: a physics engine for model-based control", IROS 2012.
+The robot is written as MJCF (:func:`dynid.io.export.mjcf_from_robot`) with the shapes the design measured as geoms
+of its links (:meth:`dynid.excitation.constraints.Workspace.shapes`: the robot file's collision shapes, or the
+capsules about the joint origins), the cell's bodies as geoms of the world, and the floor as a plane. Every shape's
+``margin`` is the clearance, so MuJoCo reports each contact up to that far apart. MuJoCo places the links at every
+set-point (``mj_forward``): a shape within the clearance of a body, or within its own floor height
+(:mod:`dynid.excitation.floor`: the clearance, or its start height for a shape that starts within it) of the floor,
+is a failure. Shapes whose lowest point never moves rest where the description puts them and are not checked against
+the floor. Links collide with the cell only, not with each other (:mod:`dynid.excitation.collision` reports those).
+Reference: Todorov, Erez & Tassa, "MuJoCo: a physics engine for model-based control", IROS 2012.
 """
 
 from __future__ import annotations
@@ -70,37 +71,26 @@ def _quat(rpy) -> str:
     return _vec([w, x, y, z])
 
 
-def cell_mjcf(robot: Robot, workspace: Workspace) -> str:
-    """The robot with its links' capsules, the cell's bodies and the floor, as MJCF (module docstring).
+def cell_mjcf(robot: Robot, workspace: Workspace, floor_shapes=()) -> str:
+    """The robot with its links' shapes, the cell's bodies and the floor, as MJCF (module docstring).
 
     Parameters
     ----------
     robot : Robot
     workspace : Workspace
-        Its ``clearance`` is the capsules' radius; its ``obstacles`` and ``floor`` the cell.
+        Its shapes (:meth:`~dynid.excitation.constraints.Workspace.shapes`), ``obstacles`` and ``floor``.
+    floor_shapes : collection of int
+        The shapes checked against the floor.
 
     Returns
     -------
     str
-        An MJCF document: geoms named ``link<k>`` (contype 1, conaffinity 0; ``link<k>_floor`` for the floor's
-        check, contype 2), the bodies by their names (conaffinity 1), ``floor`` (conaffinity 2).
+        An MJCF document: geoms named ``link<k>_shape<g>`` (contype 1, conaffinity 0; contype 3 for those checked
+        against the floor), the bodies by their names (conaffinity 1), ``floor`` (conaffinity 2).
     """
     root = ET.fromstring(mjcf_from_robot(robot))
     bodies = {b.get("name"): b for b in root.iter("body")}
-    ends = [jt.translation for jt in robot.joints[1:]] + [robot.tool_translation]
-    r = workspace.clearance
-    held = set(int(k) for k in workspace.moving_origins(robot))  # joint origins the design holds above the floor
-    for k, end in enumerate(ends):
-        body = bodies[f"link{k + 1}"]
-        shape = ({"type": "capsule", "fromto": f"0 0 0 {_vec(end)}"} if np.linalg.norm(end) > 1e-12
-                 else {"type": "sphere"})
-        common = {**shape, "size": f"{max(r, 1e-9):.17g}", "conaffinity": "0", "mass": "0", "group": "3"}
-        if workspace.geometry is None:
-            ET.SubElement(body, "geom", {"name": f"link{k + 1}", "contype": "1", **common})
-        if k in held and (k + 1 in held):
-            ET.SubElement(body, "geom", {"name": f"link{k + 1}_floor", "contype": "2", **common})
-    if workspace.geometry is not None:
-        _shape_geoms(root, bodies, workspace.geometry)
+    _shape_geoms(root, bodies, workspace.shapes(robot), set(int(g) for g in floor_shapes))
     world = root.find("worldbody")
     assert world is not None  # mjcf_from_robot writes one
     for ob in workspace.obstacles:
@@ -113,9 +103,9 @@ def cell_mjcf(robot: Robot, workspace: Workspace) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def _shape_geoms(root, bodies: dict, geometry) -> None:
-    """The links' own collision shapes as geoms of their bodies (a convex hull as a mesh of its points: MuJoCo
-    collides a mesh by its convex hull, the same one)."""
+def _shape_geoms(root, bodies: dict, geometry, floor_shapes: set) -> None:
+    """The links' shapes as geoms of their bodies (a convex hull as a mesh of its points: MuJoCo collides a mesh by
+    its convex hull, the same one); those in ``floor_shapes`` collide with the floor too."""
     asset = root.find("asset")
     if asset is None:
         asset = ET.Element("asset")
@@ -124,7 +114,8 @@ def _shape_geoms(root, bodies: dict, geometry) -> None:
         if k < 0:
             continue  # the base's: the cell is not measured against it
         x = geometry.placement[g]
-        geom = {"name": f"link{k + 1}_shape{g}", "pos": _vec(x[:3, 3]), "quat": _quat_of(x[:3, :3]), "contype": "1",
+        geom = {"name": f"link{k + 1}_shape{g}", "pos": _vec(x[:3, 3]), "quat": _quat_of(x[:3, :3]),
+                "contype": "3" if g in floor_shapes else "1",
                 "conaffinity": "0", "mass": "0", "group": "3"}
         if isinstance(shape, coal.Box):
             geom.update(type="box", size=_vec(shape.halfSide))
@@ -132,6 +123,8 @@ def _shape_geoms(root, bodies: dict, geometry) -> None:
             geom.update(type="sphere", size=f"{shape.radius:.17g}")
         elif isinstance(shape, coal.Ellipsoid):
             geom.update(type="ellipsoid", size=_vec(shape.radii))
+        elif isinstance(shape, coal.Capsule) and shape.halfLength <= 0:  # MuJoCo wants a length: a sphere
+            geom.update(type="sphere", size=f"{shape.radius:.17g}")
         elif isinstance(shape, (coal.Cylinder, coal.Capsule)):
             geom.update(type="cylinder" if isinstance(shape, coal.Cylinder) else "capsule",
                         size=f"{shape.radius:.17g} {shape.halfLength:.17g}")
@@ -147,8 +140,9 @@ def _quat_of(rotation) -> str:
     return _vec([w, x, y, z])
 
 
-def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace) -> CellContacts | None:
-    """MuJoCo's contacts between the links' capsules and the cell at every set-point.
+def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspace,
+                  start_pose: np.ndarray | None = None) -> CellContacts | None:
+    """MuJoCo's contacts between the links' shapes and the cell at every set-point (module docstring).
 
     Parameters
     ----------
@@ -156,6 +150,8 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
     t : (N,) array [s]
     q : (N, n_dof) array [rad]
     workspace : Workspace
+    start_pose : (n_dof,) array [rad], optional
+        The pose a shape that starts within the clearance of the floor is held at (default ``q[0]``).
 
     Returns
     -------
@@ -168,27 +164,32 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
         import mujoco
     except ImportError:
         return None
-    model = mujoco.MjModel.from_xml_string(cell_mjcf(robot, workspace))
+    needs = workspace.floor_needs(robot, q[0] if start_pose is None else start_pose)
+    floor_height = {} if needs is None else {int(g): float(h) for g, h in zip(needs.shapes, needs.height)}
+    model = mujoco.MjModel.from_xml_string(cell_mjcf(robot, workspace, floor_height))
     data = mujoco.MjData(model)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in range(model.ngeom)]
-    within = np.zeros(model.ngeom)  # a shape must keep the clearance itself; a capsule holds it in its radius
-    if workspace.geometry is not None:
-        shapes = np.array(["_shape" in (n or "") for n in names])
-        within[shapes] = workspace.clearance
-        model.geom_margin[shapes] = workspace.clearance  # MuJoCo reports contacts up to the margin apart
+    shape_of = {g: int(n.split("_shape")[1]) for g, n in enumerate(names) if n and "_shape" in n}
+    model.geom_margin[list(shape_of)] = workspace.clearance  # MuJoCo reports contacts up to the margin apart
+    floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+
+    def kept(c) -> float:
+        """How far apart the contact's two geoms must stay."""
+        shape = shape_of.get(c.geom1, shape_of.get(c.geom2, -1))
+        return floor_height.get(shape, 0.0) if floor in (c.geom1, c.geom2) else workspace.clearance
+
     touching, first, deepest = 0, None, 0.0
     for n in range(q.shape[0]):
         data.qpos[:robot.n_dof] = q[n]
         mujoco.mj_forward(model, data)
-        found = [c for c in data.contact[:data.ncon] if c.dist < within[c.geom1] + within[c.geom2] - 1e-9]
+        found = [(c, kept(c) - c.dist) for c in data.contact[:data.ncon] if c.dist < kept(c) - 1e-9]
         if not found:
             continue
         touching += 1
-        depth = [float(within[c.geom1] + within[c.geom2] - c.dist) for c in found]
-        deepest = min(deepest, -max(depth))
+        deepest = max(deepest, max(depth for _, depth in found))
         if first is None:
-            a, b = names[found[0].geom1], names[found[0].geom2]
+            a, b = names[found[0][0].geom1], names[found[0][0].geom2]
             link, body = (a, b) if a.startswith("link") else (b, a)
-            first = {"link": int(link.removeprefix("link").split("_")[0]), "body": body, "time": float(t[n]),
-                     "depth": depth[0]}
-    return CellContacts(int(q.shape[0]), touching, first, max(0.0, -deepest))
+            first = {"link": int(link.removeprefix("link").split("_")[0]), "shape": link, "body": body,
+                     "time": float(t[n]), "depth": float(found[0][1])}
+    return CellContacts(int(q.shape[0]), touching, first, float(deepest))

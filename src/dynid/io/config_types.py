@@ -293,18 +293,19 @@ class WorkspaceTable(Table, kw_only=True):
     box_min: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
     box_max: Annotated[list[float], Meta(min_length=3, max_length=3, description="[x, y, z] m (inf: open)")] | None = None
     floor: Annotated[float, _d("height of the floor or table the arm stands over, m: the tool point stays above it and "
-                                "every link `clearance` above it")] | None = None
-    clearance: Annotated[float, Meta(ge=0.0, description="how far every link stays above the floor, m (its capsule's "
-                                                         "radius about the segment between its joint origins); "
-                                                         "default 0.05")] | None = None
-    obstacles: Annotated[list[ObstacleTable], _d("the cell's bodies every link keeps `clearance` off")] | None = None
+                                "every link's shape `clearance` above it")] | None = None
+    clearance: Annotated[float, Meta(ge=0.0, description="how far the links' shapes keep off the floor and the cell's "
+                                                         "bodies, m (surface to surface); default 0.05")] | None = None
+    obstacles: Annotated[list[ObstacleTable], _d("the cell's bodies every link's shape keeps `clearance` off")] | None = None
     geometry: Annotated[Literal["auto", "capsules", "collision"],
-                        _d("what the links are against the obstacles: the robot URDF's own collision shapes or its "
-                           "MJCF's colliding geoms (\"collision\"), capsules of `clearance` about the joint origins "
-                           "(\"capsules\"), or the first where the robot's file has them (\"auto\", default)")] | None = None
+                        _d("what the links' shapes are: the robot URDF's own collision shapes or its MJCF's colliding "
+                           "geoms (\"collision\"), capsules of `link_radius` about the joint origins (\"capsules\"), "
+                           "or the first where the robot's file has them (\"auto\", default)")] | None = None
+    link_radius: Annotated[float, Meta(gt=0.0, description="the links' capsule radius, m, without collision shapes; "
+                                                           "default: 15 % of the arm's reach, said as an estimate")] | None = None
     srdf: Annotated[str, _d("MoveIt's SRDF of the robot's URDF (path relative to the config): the pairs of links its "
                             "<disable_collisions> name are not kept apart")] | None = None
-    avoid_self_collision: Annotated[bool, _d("the design keeps the links `clearance` off each other: true, by their "
+    avoid_self_collision: Annotated[bool, _d("the design keeps the links off each other: true, by their "
                                              "collision shapes or else their capsules; false, neither (checked and "
                                              "said only); default: the collision shapes yes, the capsules no")] | None = None
 

@@ -252,16 +252,19 @@ def _workspace(ws, doc: dict, path: Path, robot) -> Workspace:
         ws_kw["clearance"] = float(ws.clearance)
     if ws.avoid_self_collision is not None:
         ws_kw["avoid_self_collision"] = bool(ws.avoid_self_collision)
+    if ws.link_radius is not None:
+        ws_kw["link_radius"] = float(ws.link_radius)
     try:
         ws_kw["obstacles"] = [Obstacle(ob.shape, np.asarray(ob.size, dtype=float), np.asarray(ob.position, dtype=float),
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
                                    ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
         srdf = None if ws.srdf is None else (path.parent / ws.srdf).resolve()
-        if srdf is not None and not ws.obstacles:
-            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where "
-                              "[[workspace.obstacles]] are given (without them the links are capsules)")
+        cell = bool(ws.obstacles) or ws.floor is not None  # the links' shapes are read where something is kept off
+        if srdf is not None and not cell:
+            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where a floor "
+                              "or [[workspace.obstacles]] are given (without them the links are capsules)")
         ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
-                                            srdf) if ws.obstacles else _link_geometry(ws.geometry or "auto", robot, None))
+                                            srdf) if cell else _link_geometry(ws.geometry or "auto", robot, None))
         return Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None

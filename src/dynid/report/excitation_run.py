@@ -8,6 +8,7 @@ import numpy as np
 
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
+from ..excitation.floor import FloorDistances
 from ..identification.excitation_run import ExcitationRun
 from ..io.trajectories import write_trajectory_csv
 from . import figures
@@ -50,7 +51,7 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
         q, dq, ddq = traj.evaluate(t)
         states[label] = (q, dq, ddq, regressor(robot, q, dq, ddq) @ problem.phi)
     ws = problem.workspace
-    clearance = _clearance_series(robot, t, states["optimised"][0], ws)
+    clearance = _clearance_series(robot, t, states["optimised"][0], ws, problem.start_pose())
     paths = [out / name for name in FIGURES if clearance or name != "excitation_clearance.png"]
     save_figure(figures.plot_excitation_states(
         t, states, problem.limits, title=f"{robot.name}: optimised excitation, cond(W_base) {design.initial_cond:.1f} → "
@@ -90,12 +91,13 @@ def _animation(run: ExcitationRun, path: Path) -> Path:
     return path
 
 
-def _clearance_series(robot, t: np.ndarray, q: np.ndarray, ws) -> dict:
-    """label -> (N,) the links' smallest distance beyond their capsules to the floor and to each body, on ``t``."""
+def _clearance_series(robot, t: np.ndarray, q: np.ndarray, ws, start: np.ndarray) -> dict:
+    """label -> (N,) the links' shapes' smallest distance beyond what they keep to the floor and to each body, on
+    ``t``."""
     out = {}
-    moving = ws.moving_origins(robot)
-    if moving.size:
-        out["floor (lowest joint origin)"] = forward_kinematics(robot, q)[1][:, moving, 2].min(axis=1) - ws.floor - ws.clearance
+    needs = ws.floor_needs(robot, start)
+    if needs is not None and needs.shapes.size:
+        out["floor (lowest shape)"] = FloorDistances(robot, q, ws.shapes(robot), ws.floor, needs).dist.min(axis=1)
     if ws.obstacles:
         found = ws.cell_distances(robot, q)
         for i, ob in enumerate(ws.obstacles):

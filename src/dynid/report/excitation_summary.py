@@ -4,7 +4,6 @@ blocks of :mod:`dynid.tables`; :func:`dynid.report.summaries.blocks` dispatches 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 from ..tables import Line, TextTable
 
@@ -37,22 +36,15 @@ def excitation_blocks(run) -> list:
         out.append(Line(f"no position limits on {', '.join(f'J{j + 1}' for j in free)} (continuous joints): the design "
                         f"swings them about their offset within their velocity and acceleration limits only ({swing}); "
                         "give q_min and q_max in [limits] to bound them", "warning"))
-    lifted = [m for m in d.margins if m.constraint.startswith("floor clearance")]
-    if lifted:
-        low = min(lifted, key=lambda m: m.worst)
-        out.append(Line(f"every link stays {p.workspace.clearance:g} m above the floor ({p.workspace.floor:g} m; "
-                        f"workspace.clearance), not only the tool point as before 0.2.0: the lowest joint origin is "
-                        f"{low.where.removesuffix(' origin').removesuffix(chr(39) + 's')}'s, at {low.worst:.3g} m", "warning"))
     lowest = getattr(run, "lowest", None)
     if lowest is not None:
         text, warned = no_floor_line(lowest.to_dict(), p.workspace.clearance)
         out.append(Line(text, "warning" if warned else "text"))
-    out += _self_clearance_lines(run) + _cell_clearance_lines(run) + _mujoco_lines(run) + [_verdict_line(d)]
+    out += (_shapes_lines(run) + _self_clearance_lines(run) + _floor_lines(run) + _cell_clearance_lines(run)
+            + _mujoco_lines(run) + [_verdict_line(d)])
     if d.feasible:
-        below = lowest is not None and lowest.height < p.workspace.clearance
-        apart = getattr(run, "self_clearance", None)
-        first = ("settle the warnings above (what the arm stands on, the links' clearance, the start), then "
-                 if below or (apart is not None and apart.distance < 0) or kind == "warning" else "")
+        warned = any(isinstance(line, Line) and line.kind == "warning" for line in out)
+        first = "settle the warnings above, then " if warned else ""
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
@@ -101,7 +93,7 @@ def set_point_lines(set_points: dict) -> tuple[str, tuple[str, str]]:
 def no_floor_line(lowest: dict, clearance: float) -> tuple[str, bool]:
     """What a design without a floor says of the surface the robot stands on: where the arm goes lowest
     (:func:`dynid.excitation.constraints.lowest_point`), a warning where that is below the base frame's origin or
-    within the links' clearance (their capsules' radius) above it.
+    within the links' clearance above it.
 
     Parameters
     ----------
@@ -124,8 +116,8 @@ def no_floor_line(lowest: dict, clearance: float) -> tuple[str, bool]:
              f"comes {h:.3g} m above the base frame's origin, its link within its {clearance:g} m clearance of that level")
     return (f"no floor given ([workspace] floor), so nothing kept the arm off what it stands on: {point} {where} at "
             f"t = {t:.3g} s. If the robot stands on a table or the floor, "
-            "give its height in the base frame as [workspace] floor (0 where the base frame sits on it; every link then "
-            "stays workspace.clearance above it) and design again"), True
+            "give its height in the base frame as [workspace] floor (0 where the base frame sits on it; every link's "
+            "shape then stays workspace.clearance above it) and design again"), True
 
 
 def design_blocks(design) -> list:
@@ -180,7 +172,8 @@ def _self_clearance_lines(run) -> list:
     c = getattr(run, "self_clearance", None)
     if c is None:
         return []
-    radius = run.config.problem.workspace.clearance
+    p = run.config.problem
+    radius = p.workspace.capsule_radius(p.robot)
     where = f"links {c.pair[0]} and {c.pair[1]} at t = {c.time:.3g} s"
     if c.shapes:  # the URDF's own shapes, kept apart by the design
         return [Line(f"the links' collision shapes stay {c.distance:.3g} m apart or more (closest: {c.shapes[0]} and "
@@ -192,31 +185,67 @@ def _self_clearance_lines(run) -> list:
                "the design keeps the capsules apart where asked: [workspace] avoid_self_collision = true (a slower "
                "design); else check this pose on the robot (or in a simulator) before running it, or lower the "
                "amplitudes")
-        return [Line(f"links that can touch come within each other's {radius:g} m: their capsules overlap by "
+        return [Line(f"links that can touch come together: their {radius:.3g} m capsules overlap by "
                      f"{-c.distance:.3g} m ({where}; {c.pairs} pairs checked on the set-points): {how}", "warning")]
-    return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:g} m capsules "
+    return [Line(f"links that can touch stay {c.distance:.3g} m apart or more beyond their {radius:.3g} m capsules "
                  f"(closest: {where}; {c.pairs} pairs checked on the set-points)")]
 
 
-def _cell_clearance_lines(run) -> list:
-    """:func:`excitation_blocks`' line on how close the links come to the cell's bodies at the set-points
-    (:func:`dynid.excitation.constraints.obstacle_margins`): a warning where a capsule reaches one."""
-    found = list(getattr(run, "cell_clearance", ()))
+def _shapes_lines(run) -> list:
+    """:func:`excitation_blocks`' warning where the floor's and the cell's distances are measured on estimated capsules
+    (the robot file has no collision shapes that load, and no ``[workspace] link_radius``)."""
+    ws = run.config.problem.workspace
+    if ws.geometry is not None or ws.link_radius is not None or not (ws.obstacles or math.isfinite(ws.floor)):
+        return []
+    r = ws.capsule_radius(run.config.problem.robot)
+    return [Line(f"the robot file has no collision shapes dynid could read: the floor and the cell are kept off capsules "
+                 f"of radius {r:.3g} m about the joint origins, an estimate (15 % of the arm's reach) that a hand, a "
+                 "gripper or a wide housing can exceed; give [workspace] link_radius, or a URDF with <collision> "
+                 "shapes and its meshes", "warning")]
+
+
+def _floor_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links' shapes come to the floor at the set-points
+    (:func:`dynid.excitation.constraints.floor_margins`): a warning where one comes within what it must keep."""
+    found = [m for m in getattr(run, "cell_clearance", ()) if m.constraint.startswith("floor")]
     if not found:
         return []
-    radius = run.config.problem.workspace.clearance
+    p = run.config.problem
+    ws, low = p.workspace, found[0]
+    if low.margin < 0:
+        return [Line(f"a link's shape comes within the floor's clearance at a set-point: {low.where} at {low.worst:.3g} m "
+                     f"above the floor, {-low.margin:.3g} m inside (between the verification grid's samples): do not "
+                     "run it; raise design.grid_points", "warning")]
+    needs = ws.floor_needs(p.robot, p.start_pose())
+    names = ws.shapes(p.robot).names
+    held = [] if needs is None else needs.within
+    within = "" if not held else (
+        " (those that start within it, no lower than they start: "
+        + ", ".join(f"{names[int(needs.shapes[c])]} at {needs.start[c]:.3g} m" for c in held) + ")")
+    under = needs is not None and any(needs.start[c] < 0 for c in held)  # estimated capsules only: shapes are refused
+    return [Line(f"every link's shape stays {ws.clearance:g} m or more above the floor ({ws.floor:g} m) at the set-points"
+                 f"{within}; the tightest: {low.where}, {low.worst:.3g} m above it (measured on the {ws.shapes_said()})"
+                 + ("; a capsule that starts under the floor is wider than the link or the floor is set too high: "
+                    "give [workspace] link_radius or the robot's collision shapes" if under else ""),
+                 "warning" if under else "text")]
+
+
+def _cell_clearance_lines(run) -> list:
+    """:func:`excitation_blocks`' line on how close the links' shapes come to the cell's bodies at the set-points
+    (:func:`dynid.excitation.constraints.obstacle_margins`): a warning where one comes within the clearance."""
+    found = [m for m in getattr(run, "cell_clearance", ()) if not m.constraint.startswith("floor")]
+    if not found:
+        return []
+    ws = run.config.problem.workspace
     low = min(found, key=lambda m: m.worst)
     if low.worst < 0:
-        return [Line(f"a link comes within {radius:g} m of the cell at a set-point: {low.where} (by {-low.worst:.3g} m, "
-                     "between the verification grid's samples): do not run it; raise design.grid_points", "warning")]
-    ws = run.config.problem.workspace
+        return [Line(f"a link's shape comes within {ws.clearance:g} m of the cell at a set-point: {low.where} (by "
+                     f"{-low.worst:.3g} m, between the verification grid's samples): do not run it; raise "
+                     "design.grid_points", "warning")]
     n = len(ws.obstacles)
-    what = (f"every link's {radius:g} m capsule stays {low.worst:.3g} m" if ws.geometry is None else
-            f"every link's collision shapes (of {Path(ws.geometry.source).name}; a mesh as its convex hull) stay "
-            f"{radius + low.worst:.3g} m")
-    beyond = "" if ws.geometry is None else f", {low.worst:.3g} m beyond the {radius:g} m clearance"
-    return [Line(f"{what} or more off the cell at the set-points{beyond} ({n} {'body' if n == 1 else 'bodies'}; "
-                 f"closest: {low.where})")]
+    return [Line(f"every link's shape stays {ws.clearance + low.worst:.3g} m or more off the cell at the set-points, "
+                 f"{low.worst:.3g} m beyond the {ws.clearance:g} m clearance ({n} {'body' if n == 1 else 'bodies'}; "
+                 f"closest: {low.where}; measured on the {ws.shapes_said()})")]
 
 
 def _mujoco_lines(run) -> list:
@@ -231,7 +260,8 @@ def _mujoco_lines(run) -> list:
                      "(pip install 'dynid[mujoco]')")]
     if found.touching:
         f = found.first
-        return [Line(f"MuJoCo finds link {f['link']} touching {f['body']} at t = {f['time']:.3g} s ({found.touching} of "
-                     f"{found.set_points} set-points, up to {found.deepest:.3g} m deep): do not run it", "warning")]
-    return [Line(f"checked again by MuJoCo: no link comes within the clearance of the cell or the floor on the "
-                 f"{found.set_points} set-points")]
+        return [Line(f"MuJoCo finds link {f['link']}'s shape within the clearance of {f['body']} at t = {f['time']:.3g} s "
+                     f"({found.touching} of {found.set_points} set-points, up to {found.deepest:.3g} m inside): do not "
+                     "run it", "warning")]
+    return [Line(f"checked again by MuJoCo on the same shapes (the floor as a plane, each shape's margin the clearance): "
+                 f"none comes within the clearance of the cell or the floor on the {found.set_points} set-points")]
