@@ -13,7 +13,7 @@ shrink toward the description's nominal parameters are fitted, each over a grid 
 
 Each weight is chosen by 5-fold blocked cross-validation on the identification log (contiguous blocks, the rule a
 user could run without validation logs); ``ridge``'s also by the marginal likelihood (type-II maximum likelihood of a
-Gaussian prior). Every set is scored on the one yardstick (``dynid.identification.run.yardstick_scores``). Prints, per
+Gaussian prior). Every set is scored on the one yardstick (``dynid.identification.evidence.yardstick_scores``). Prints, per
 case: the main estimate today, the nominal model, each family's pick and the best weight of its grid (an oracle that
 reads the validation logs). From the repository root: ``.venv/bin/python benchmarks/prior_weight.py`` (about 3 min).
 """
@@ -117,7 +117,8 @@ def _rows(config, result):
 def case(name: str, window, folder: Path) -> None:
     from dynid.dynamics.layout import consistency_layout
     from dynid.exceptions import DynIdError
-    from dynid.identification.run import run_identification, with_yardstick, yardstick_reference, yardstick_scores
+    from dynid.identification.evidence import with_yardstick, yardstick_reference, yardstick_scores
+    from dynid.identification.run import run_identification
     from dynid.io.datasets import load_recording
     from dynid.io.identification_config import load_identification_config, stored_preprocessing
 

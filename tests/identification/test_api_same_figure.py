@@ -59,3 +59,30 @@ def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path):
     np.testing.assert_array_equal(api.meaningful(), cli.meaningful())
     np.testing.assert_array_equal(api.varies(), cli.varies())
     assert "1.0000" not in dynid.summary(api, width=300)
+
+
+def test_every_route_gives_one_model_and_one_figure_with_the_defaults(tmp_path):
+    """issue "Every assurance checked on what the user meets", item 4: a config without [estimation] friction, the
+    :class:`Identifier` on arrays and :func:`identify_from_arrays` on the same samples share one set of defaults (the
+    friction models chosen by cross-validation: arrays took the description's terms), so they give the same estimate
+    and the same figure to 1e-9."""
+    from dynid import Identifier, identify_from_arrays
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+    from tests.simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)
+    config = load_identification_config(cfg)
+    assert config.estimation.friction == "auto"
+    log = load_recording(config.identification, config.robot)
+    by_config = Identifier.from_config(cfg, validate=False)
+    by_arrays = Identifier(config.robot, estimators=["ols"]).fit(log.t, log.q, log.tau)
+    direct = identify_from_arrays(config.robot, log.t, log.q, log.tau, estimators=("ols",))
+    chosen = [m["label"] for m in by_config.result_.settings["friction_models"]["models"]]
+    assert [m["label"] for m in by_arrays.result_.settings["friction_models"]["models"]] == chosen
+    for other in (by_arrays.result_, direct):
+        assert other.main == by_config.result_.main
+        np.testing.assert_allclose(other.main_estimate.params, by_config.result_.main_estimate.params, rtol=1e-9,
+                                   atol=1e-12)
+        ours, theirs = other.fit.metrics()[other.main], by_config.result_.fit.metrics()[other.main]
+        np.testing.assert_allclose(ours["global_relative_error"], theirs["global_relative_error"], rtol=1e-9)

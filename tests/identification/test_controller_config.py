@@ -154,12 +154,13 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
     setup = ClosedLoopSetup(Controller.for_robot(robot), np.loadtxt(root / "ref.csv", delimiter=",", skiprows=1),
                             feedforward=True)
     t, q, tau = log[:, 0], log[:, 1:N + 1], log[:, N + 1:]
-    ident = dynid.Identifier(robot, estimators=["wls", "idim-iv"], controller=setup).fit(t, q, tau)
+    ident = dynid.Identifier(robot, estimators=["wls", "idim-iv"], controller=setup, friction="description").fit(t, q, tau)
     assert list(ident.estimates_) == ["dynid WLS", "dynid IDIM-IV"]
     for label in ident.estimates_:  # the same to rounding (the arrays' route resamples as the config's reader does)
         expected = by_config.estimates_[label]
         np.testing.assert_allclose(ident.estimates_[label], expected, rtol=1e-7, atol=1e-10 * np.abs(expected).max())
-    result = dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=setup)
+    result = dynid.identify_from_arrays(robot, t, q, tau, estimators=["wls", "idim-iv"], controller=setup,
+                                        friction="description")
     np.testing.assert_allclose(result.estimates["dynid IDIM-IV"].params, ident.estimates_["dynid IDIM-IV"], rtol=0)
     _write(root, "", estimators='["wls"]')  # a config without [controller]: the one given is used
     given = dynid.Identifier.from_config(root / "cl.toml", estimators=["wls", "idim-iv"], controller=setup, validate=False)

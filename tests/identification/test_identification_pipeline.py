@@ -75,7 +75,8 @@ def test_settings_given_to_the_arrays_path_are_applied(slow_quiet_log):
     """A Coulomb smoothing velocity and a seed given with arrays: the arrays' path used to ignore both."""
     config = slow_quiet_log
     rec = load_recording(config.identification, config.robot)
-    fit = lambda **kw: dynid.identify_from_arrays(config.robot, rec.t, rec.q, rec.tau, estimators=("ols",), **kw)
+    fit = lambda **kw: dynid.identify_from_arrays(config.robot, rec.t, rec.q, rec.tau, estimators=("ols",),
+                                                  friction="description", **kw)  # the description's terms: sign(q̇)
     smooth = fit(preprocessing=dynid.Preprocessing(coulomb_velocity=0.05, auto=False))
     sign = fit(preprocessing=dynid.Preprocessing(auto=False))
     assert smooth.settings["coulomb_velocity"] == [0.05] * 6 and sign.settings["coulomb_velocity"] == [0.0] * 6

@@ -9,7 +9,7 @@ import pytest
 
 def test_validate_sets_reads_a_generator_one_log_at_a_time_and_refuses_a_log_not_read(tmp_path):
     from dynid.dynamics.base_parameters import base_parameters
-    from dynid.identification.run import validate_sets
+    from dynid.identification.evidence import validate_sets
     from dynid.io.datasets import load_recording
     from dynid.io.identification_config import load_identification_config
     from tests.simulated_logs import simulated_case

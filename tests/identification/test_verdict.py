@@ -27,6 +27,35 @@ def test_one_function_sets_the_main_estimate():
                                ("identification/verdict.py", "main"), ("identification/verdict.py", "main")]
 
 
+def _callers(name: str) -> list[tuple[str, str]]:
+    """(module, enclosing function) of every call of ``name`` in dynid's source."""
+    found = []
+    for path in SRC.rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for func in ast.walk(tree):
+            if isinstance(func, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for node in ast.walk(func):
+                    if isinstance(node, ast.Call) and (getattr(node.func, "id", None) == name
+                                                       or getattr(node.func, "attr", None) == name):
+                        found.append((path.relative_to(SRC).as_posix(), func.name))
+    return sorted(set(found))
+
+
+def test_the_route_is_the_only_route():
+    """issue "One route, four named parts": the evidence is gathered and the verdict given by
+    ``IdentificationPipeline.fit`` alone, the main estimate chosen by the verdict alone, and the estimation called by
+    ``fit`` (the closed-loop study's simulated runs too go through ``fit``); ``run_identification``,
+    ``identify_from_arrays`` and ``Identifier`` fit through it. A second route anywhere fails this test."""
+    assert _callers("gather_evidence") == [("identification/pipeline.py", "fit")]
+    assert _callers("decide") == [("identification/pipeline.py", "fit")]
+    assert [c for c in _callers("choose_main_estimate") if c[0] != "identification/verdict.py" or c[1] != "_without_misread"] \
+        == [("identification/verdict.py", "decide")]
+    assert _callers("identify") == [("identification/pipeline.py", "estimate")]
+    fitted = {c for c in _callers("fit") if c[0].startswith("identification/") and c[1] in
+              ("run_identification", "identify_from_arrays")}
+    assert fitted == {("identification/run.py", "run_identification"), ("identification/run.py", "identify_from_arrays")}
+
+
 def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_path, monkeypatch):
     """Where the description's nominal model predicts the validation logs better than every estimate, it is the main
     estimate: its base and standard parameters are the description's (export writes the file's own values), the first

@@ -47,7 +47,7 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
 
     from typer.testing import CliRunner
 
-    import dynid.identification.run as run
+    import dynid.identification.evidence as evidence
     import dynid.identification.verdict as verdict
     from dynid.cli.app import app
     from tests.simulated_logs import simulated_case
@@ -55,7 +55,7 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=10.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["ols", "sdp"]'))
     made, weighed = [], []
-    real_scores, real_mean = run.yardstick_scores, verdict._mean_error
+    real_scores, real_mean = evidence.yardstick_scores, verdict._mean_error
 
     def scores(*args, **kwargs):
         made.append(real_scores(*args, **kwargs))
@@ -65,7 +65,7 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
         weighed.append(validations)
         return real_mean(validations, label)
 
-    monkeypatch.setattr(run, "yardstick_scores", scores)
+    monkeypatch.setattr(evidence, "yardstick_scores", scores)
     monkeypatch.setattr(verdict, "_mean_error", mean)
     out = tmp_path / "out"
     assert CliRunner().invoke(app, ["identify", str(cfg), "--out", str(out), "--no-figures", "-q"]).exit_code == 0

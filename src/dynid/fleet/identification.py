@@ -23,7 +23,8 @@ import numpy as np
 from .._util.reprs import short_repr
 from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_parameters
 from ..exceptions import ConfigError, DataError, DynIdError
-from ..identification.run import run_identification, validate_sets
+from ..identification.evidence import validate_sets
+from ..identification.run import run_identification
 from ..io.datasets import load_recording
 from ..io.files import write_json
 from ..io.fleet_manifest import FleetManifest, FleetUnit

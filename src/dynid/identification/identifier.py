@@ -50,8 +50,8 @@ class Identifier(HyperParameters):
     preprocessing : Preprocessing or dict, optional
         Preprocessing settings (default: every setting derived from the data, or the config's).
     friction : {"description", "auto"}, optional
-        Each joint's friction model chosen by cross-validation, or the description's terms (default: "description"
-        for arrays, the config's for a config).
+        Each joint's friction model chosen by cross-validation, or the description's terms (default: as a config
+        without the setting: "auto" unless a Coulomb smoothing velocity is given; the config's for a config).
     rng : int or numpy.random.Generator, optional
         Seeds the box searches (default 0, or the config's ``seed``); a generator gives one draw as the seed. Was
         ``seed`` (still taken, with a FutureWarning).
@@ -196,7 +196,7 @@ class Identifier(HyperParameters):
                                   "(Identifier.from_config('arm.toml', estimators=...)), give "
                                   "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
-                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction or "description",
+                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction,
                                           rng=seed_of(self.rng), controller=self.controller)
         return self._fitted(result)
 

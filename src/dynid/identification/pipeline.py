@@ -1,33 +1,37 @@
 """The identification pipeline, assembled from its parts: a robot model, a preprocessing strategy with the choices it
-derives from the data, the base-parameter map, and the estimators.
+derives from the data, the base-parameter map, the estimators, the evidence and the verdict.
 
 One recording goes through it the same way whoever calls it (``dynid identify`` from a config,
-:func:`dynid.identify_from_arrays` and :class:`dynid.Identifier` from arrays)::
+:func:`dynid.identify_from_arrays` and :class:`dynid.Identifier` from arrays, the studies)::
 
     pipeline = IdentificationPipeline(robot, preprocessing, estimators=("wls", "sdp"), friction="auto")
-    prepared = pipeline.prepare(recording)          # filters, Coulomb smoothing, friction models: chosen on the data
-    result = pipeline.estimate(prepared)            # every estimator, the consistency checks, the verdict
+    result = pipeline.fit(recording, validation=(log_b, log_c))
 
-:meth:`~IdentificationPipeline.prepare` (Gautier's parallel filtering and decimation, or the paper's eq. 17 with
-Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`):
+:meth:`~IdentificationPipeline.fit` calls its four parts once each, in order (pysindy's ``SINDy.fit``):
 
-1. the filters: the strategy's rule on the excitation band, or, when the positions' noise knee lies far above it,
-   cutoffs chosen by blocked cross-validation (:func:`dynid.identification.cross_validation.choose_preprocessing`);
-2. the Coulomb smoothing velocity (``preprocessing.coulomb_velocity``: given, or "auto" by cross-validation);
-3. each joint's friction model and its state at rest (``friction = "auto"``,
-   :func:`dynid.identification.friction_models.choose_friction`), which may change the base-parameter map.
+1. **preparation**, :meth:`~IdentificationPipeline.prepare` (Gautier's parallel filtering and decimation, or the
+   paper's eq. 17 with Fourier-fit derivatives, :mod:`dynid.preprocessing.strategies`): the filters (the strategy's
+   rule on the excitation band, or cutoffs chosen by blocked cross-validation where the positions' noise knee lies far
+   above it, :func:`dynid.identification.cross_validation.choose_preprocessing`), the Coulomb smoothing velocity
+   (``preprocessing.coulomb_velocity``: given, or "auto" by cross-validation), and each joint's friction model and
+   its state at rest (``friction = "auto"``, :func:`dynid.identification.friction_models.choose_friction`), which
+   may change the base-parameter map;
+2. **estimation**, :meth:`~IdentificationPipeline.estimate`: every estimator in one pass over the rows
+   (:func:`dynid.identification.identify.identify`), the consistency checks and what the log itself says (held-out
+   blocks, the drive-only candidate, the SDP's refits, the torque delay), then the closed-loop estimators (IDIM-IV,
+   DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop.ClosedLoopEstimator`);
+3. **evidence**, :func:`dynid.identification.evidence.gather_evidence`: every candidate scored on the validation logs
+   given, as prepared and on the one yardstick;
+4. **verdict**, :func:`dynid.identification.verdict.decide`: the main estimate, chosen once.
 
-:meth:`~IdentificationPipeline.estimate` is :func:`dynid.identification.identify.identify` on the prepared data, then
-the closed-loop estimators (IDIM-IV, DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop.ClosedLoopEstimator`,
-each carrying the log's controller) when the pipeline has them; the result's ``settings`` say every choice and why. Reading logs
-and configs, drive gains and validation on other logs are the callers' (:mod:`dynid.identification.run`).
-
-An experiment that sets its own search box and seeds (the paper's, :mod:`dynid.studies.paper`) takes the estimators
-fed and unfitted from :meth:`~IdentificationPipeline.estimation` instead of :meth:`~IdentificationPipeline.estimate`.
+The result's ``settings`` say every choice and why. Reading logs and configs and the drive gains' runs are the
+callers' (:mod:`dynid.identification.run`). An experiment that sets its own search box and seeds (the paper's,
+:mod:`dynid.studies.paper`) takes the estimators fed and unfitted from :meth:`~IdentificationPipeline.estimation`.
 """
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -46,14 +50,17 @@ from ..preprocessing.pipeline import base_chunks, prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
+from ..runtime.processes import ForkedCall
 from ..validation.diagnostics import delay_findings
 from .choices import ModelChoices
 from .closed_loop import ClosedLoopEstimator
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
+from .evidence import filtered_finding, gather_evidence, yardstick_reference
 from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
 from .identify import identify, one_way_joints
+from .verdict import decide
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
 
@@ -108,8 +115,10 @@ class IdentificationPipeline:
         closed-loop ones (IDIM-IV, DIDIM, DIDIM-SDP: :data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS` keys, with
         ``controller``, or :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts) run after the others,
         on the log as read, in order, as a config's ``[estimation] estimators`` lists them.
-    friction : {"description", "auto"}
-        The description's friction terms, or each joint's model chosen by cross-validation.
+    friction : {"description", "auto"} or None
+        The description's friction terms, or each joint's model chosen by cross-validation; None (default): as a
+        config without the setting (:attr:`dynid.preprocessing.settings.Preprocessing.friction_default`: "auto" unless a
+        Coulomb smoothing velocity is given), whichever route fits.
     rng : int
         Seeds the box searches and the bootstrap (a config's ``seed``).
     source : str
@@ -118,6 +127,12 @@ class IdentificationPipeline:
     controller : ClosedLoopSetup or None
         How the log was recorded in closed loop (:class:`dynid.simulation.closed_loop.ClosedLoopSetup`); needed
         with closed-loop keys among ``estimators``.
+    choice : {"torques", "states"}
+        What the verdict weighs on the validation logs: their torques, or (with ``sdp``) the SDP's refits' spread on
+        their states (a config's ``[estimation] choice``).
+    torque_sensor : str or None
+        "joint" for a log of joint torque sensors: the states' fallback is then the description, not the drive-only
+        estimate (a config's ``torque_sensor``).
 
     Attributes
     ----------
@@ -138,15 +153,19 @@ class IdentificationPipeline:
     robot: Robot
     preprocessing: Preprocessing = field(default_factory=Preprocessing)
     estimators: tuple = ("wls",)
-    friction: str = "description"
+    friction: str | None = None
     rng: int = 0
     source: str = ""
     controller: Any = None
+    choice: str = "torques"
+    torque_sensor: str | None = None
     open_loop: tuple = field(init=False, repr=False, compare=False)
     closed_loop_estimators: tuple[ClosedLoopEstimator, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         object.__setattr__(self, "robot", as_robot(self.robot))
+        if self.friction is None:
+            object.__setattr__(self, "friction", self.preprocessing.friction_default)
         if self.friction not in FRICTION_CHOICES:
             raise ConfigError(f'friction: expected "description" or "auto", got {self.friction!r}', field="friction")
         items = (self.estimators,) if isinstance(self.estimators, str) else tuple(self.estimators)
@@ -345,19 +364,27 @@ class IdentificationPipeline:
         stream_rows(chunks, estimation, prepared.base)
         return estimation
 
-    def fit(self, recording, references: Callable[[Robot, BaseParameters], tuple] | None = None, progress=None,
-            held_out: bool = True):
-        """:meth:`prepare` then :meth:`estimate`.
+    def fit(self, recording, *, validation: tuple = (), references: Callable[[Robot, BaseParameters], tuple] | None = None,
+            progress=None, held_out: bool | None = None,
+            drive_gains: Callable[[Robot, BaseParameters], Any] | None = None):
+        """Identify: the four parts, once each (module docstring).
 
         Parameters
         ----------
         recording : dynid.io.datasets.Recording
+            The identification log, as read.
+        validation : tuple of Recording
+            Logs of other motions, read: the verdict's evidence.
         references : callable, optional
             ``references(robot, base)`` -> the reference sets in the prepared model's layout.
         progress : callable, optional
             ``progress(step, done, total)``.
-        held_out : bool
-            As :meth:`estimate`'s (default true: no validation log).
+        held_out : bool, optional
+            Score the least-squares and SDP estimates on held-out blocks of the log (default: without validation logs,
+            where they are the evidence).
+        drive_gains : callable, optional
+            ``drive_gains(robot, base)`` for the prepared model, computed on the second core while the estimators run,
+            its value the result's ``drive_gains``.
 
         Returns
         -------
@@ -366,12 +393,26 @@ class IdentificationPipeline:
         Raises
         ------
         DynIdError
-            As :meth:`prepare` and :meth:`estimate`.
+            As :meth:`prepare`, :meth:`estimate` and the validation logs' scoring.
         """
         step = None if progress is None else (lambda label: progress(label, 0, 1))
+        validation = tuple(validation)
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
-        return self.estimate(prepared, refs, progress, held_out, recording if self.closed_loop else None)
+        reference = yardstick_reference(recording) if validation else None
+        smooth = filtered_finding([recording.name, *(log.name for log in validation)], [recording, *validation])
+        beside = None if drive_gains is None else ForkedCall(drive_gains, prepared.robot, prepared.base)
+        with beside or contextlib.nullcontext():
+            result = self.estimate(prepared, refs, progress, held_out=not validation if held_out is None else held_out,
+                                   recording=recording if self.closed_loop else None,
+                                   jackknife=bool(validation) and self.choice == "states")
+            if beside is not None:
+                if step is not None:
+                    step("drive gains and payload")
+                result = replace(result, drive_gains=beside.result())
+        evidence = gather_evidence(self, prepared, result, validation, reference=reference, progress=progress) if validation else None
+        result = decide(result, evidence)
+        return replace(result, findings=tuple(result.findings) + smooth)
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:

@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-import contextlib
 from dataclasses import fields, replace
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,13 +34,9 @@ from ..model.description import builtin_robots
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
-from ..preprocessing.strategies import carried_over, yardstick_settings
-from ..runtime.processes import ForkedCall
+from ..preprocessing.strategies import carried_over
 from ..runtime.threads import with_single_blas_thread
-from ..validation.diagnostics import Finding
-from ..validation.noise_floor import SMOOTH, looks_filtered
-from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
-from .verdict import choose_main_estimate, nominal_set, state_evidence
+from .evidence import nominal_set, validate_sets, yardstick_reference
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -77,87 +73,6 @@ def _gains_and_payload(config: IdentificationConfig, robot, base):
     return GainsAndPayload(gains, payload, tuple(robot.drive_gains.tolist()))
 
 
-def validate_sets(config: IdentificationConfig, base, parameter_sets: dict, recordings, *,
-                  progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
-                  yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
-                  geometry: bool = True, nominal: str | None = None) -> tuple[tuple, tuple[str, ...]]:
-    """Score parameter sets on logs: their predicted torques against the measured ones.
-
-    Parameters
-    ----------
-    config : IdentificationConfig
-        Its robot (as identified: friction terms, Coulomb smoothing) and preprocessing.
-    base : BaseParameters
-    parameter_sets : dict
-        label -> (n_base,) base parameters.
-    recordings : iterable of Recording
-        The logs, read (:func:`dynid.io.datasets.load_recording`); a generator's are read one at a time, as each is
-        scored.
-    progress : callable, optional
-        ``progress(step, done, total)``.
-    resolved : Preprocessing, optional
-        The identification's resolved preprocessing, carried over to these logs.
-    noise : (n_dof,) array [N·m], optional
-        Each joint's residual σ (for the prediction bands).
-    covariance : dict, optional
-        label -> covariance of that set.
-    yardstick : Preprocessing, optional
-        Prepare each log by the one yardstick instead of the identification's settings carried over: the
-        identification log's settings resolved by dynid's default rules
-        (:func:`dynid.preprocessing.strategies.yardstick_settings`).
-    fitted : (str, (n_dof,) array), optional
-        The estimate fitted to the identification log and its correlation with each joint's torque there: a log
-        whose torque channels run against it, swapped or scaled is said (:mod:`dynid.validation.channel_checks`).
-    geometry : bool
-        Check each log's geometry against the robot file's: not where the identification log's does not match it
-        either (its finding's setting is for every dataset, and the logs agree with each other).
-    nominal : str, optional
-        The description's nominal model among ``parameter_sets``: a log's scale is judged against it too.
-
-    Returns
-    -------
-    comparisons : tuple of TorqueComparison
-        A log read otherwise than the identification log has its ``misread`` set.
-    warnings : tuple of str
-        Besides the logs' own, a log read otherwise: its torque channels flipped or swapped against the fitted estimate
-        (``fitted``), or its geometry not the robot file's (:mod:`dynid.validation.geometry_checks`: a joint's zero,
-        two columns swapped, gravity).
-
-    Raises
-    ------
-    DataError
-        A log that cannot be prepared.
-    TypeError
-        A log not read (a ``DatasetSpec``: :func:`dynid.io.datasets.load_recording` reads it).
-    """
-    from ..preprocessing.pipeline import prepare
-    from ..validation.channel_checks import channel_findings
-    from ..validation.geometry_checks import geometry_findings
-    from ..validation.torques import compare_torques
-
-    out: list = []
-    warnings: list[str] = []
-    settings = (carried_over(resolved, config.preprocessing) if yardstick is None else
-                yardstick_settings(resolved, config.preprocessing, yardstick))
-    for recording in recordings:
-        if not isinstance(recording, Recording):
-            raise TypeError(f"validate_sets: expected read logs (dynid.load_recording(spec, robot)), got {type(recording).__name__}")
-        if progress is not None:  # one step per log: filtering and predicting it
-            progress(f"validation, {recording.name}", 0, 1)
-        data = prepare(recording, settings, strict=False)
-        scored = compare_torques(config.robot, base, data, parameter_sets,
-                                 progress=None if progress is None else (lambda d, t, s=recording.name: progress(f"validation, {s}", d, t)),
-                                 noise=noise, covariance=covariance)
-        # a log recorded otherwise than the fitted one: its torque channels, else its geometry
-        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=nominal)
-        if not found and geometry and yardstick is None and np.any(config.robot.inertial != 0):
-            found, _ = geometry_findings(config.robot, data.q, data.dq, data.ddq, data.tau, recording.name, fitted=False)
-        warnings.extend(f.text for f in found)
-        out.append(replace(scored, misread=found[0].text) if found else scored)
-        warnings.extend(data.warnings)
-    return tuple(out), tuple(warnings)
-
-
 @with_single_blas_thread
 @keyword_only_after_data
 def run_identification(config: IdentificationConfig, *, progress=None, validate: bool = True):
@@ -183,74 +98,26 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         Bad data (:class:`DataError`), settings (:class:`ConfigError`) or a problem the data do not identify
         (:class:`IdentifiabilityError`), each one line.
     """
-    from ..dynamics.base_parameters import base_parameters
-
     def step(label):
         if progress is not None:
             progress(label, 0, 1)
 
-    step("base parameters and references")
-    base = base_parameters(config.robot, rng=0)
-    refs = _references(config, base)  # read here to report a bad reference file before any computation
+    if config.references:  # a bad reference file is said before any computation
+        from ..dynamics.base_parameters import base_parameters
+
+        _references(config, base_parameters(config.robot, rng=0))
     step(f"reading {config.identification.name}")
     recording = load_recording(config.identification, config.robot)
-    # every dataset is read (its gaps, rates and ranges checked) before any computation
-    checked = []
+    checked = []  # every dataset is read (its gaps, rates and ranges checked) before any computation
     for spec in config.validation if validate else ():
         step(f"reading {spec.name}")
         checked.append(load_recording(spec, config.robot))
     config, checked, repeated = _distinct_validation(config, recording, checked)
-    pipeline = pipeline_of(config)
-    prepared = pipeline.prepare(recording, base, step)
-    raw = recording if pipeline.closed_loop else None  # the closed-loop estimators simulate the log as read
-    reference = yardstick_reference(recording) if validate and config.validation else None
-    smooth = filtered_finding([config.identification.name, *(spec.name for spec in config.validation if validate)],
-                              [recording, *checked])
-    del recording  # the raw positions and velocities: only the filtered ones are used from here
-    if prepared.base is not base:  # the friction models chosen changed the map: the references follow it
-        refs = _references(replace(config, robot=prepared.robot), prepared.base)
-    robot, base = prepared.robot, prepared.base
-    # the drive gains need neither the identification nor its data: the second core computes them meanwhile
-    gains = None if config.drive_gains is None else ForkedCall(_gains_and_payload, config, robot, base)
-    with gains or contextlib.nullcontext():
-        result = pipeline.estimate(prepared, refs, progress, held_out=validate and not config.validation, recording=raw,
-                                   jackknife=validate and bool(config.validation) and config.estimation.choice == "states")
-        if gains is not None:
-            step("drive gains and payload")
-            result = replace(result, drive_gains=gains.result())
-    result = replace(result, warnings=result.warnings + repeated)
-    if not validate or not config.validation:
-        return replace(result, findings=tuple(result.findings) + smooth)
-    sets = result.parameter_sets()
-    nominal = nominal_set(robot, base, result.references)
-    if nominal is not None and nominal[0] not in sets:  # scored beside, for the gate against the nominal model
-        sets[nominal[0]] = nominal[1]
-
-    alt = result.drive_only if nominal is not None else None
-    if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
-        sets[DRIVE_ONLY_LABEL] = alt.params
-    scored_all, warnings = validate_sets(replace(config, robot=robot), base, sets, tuple(checked), progress=progress,
-                                         resolved=prepared.data.settings, noise=result.joint_std,
-                                         covariance={result.label: result.solution.covariance},
-                                         fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
-                                         geometry=not any(f.kind in ("angles", "gravity") for f in result.findings),
-                                         nominal=None if nominal is None else nominal[0])
-    validations = scored_all if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored_all)
-    result = replace(result, validations=validations, warnings=result.warnings + warnings)
-    refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
-    yardstick = yardstick_scores(replace(config, robot=robot), base, {**sets, **refits}, tuple(checked),
-                                 resolved=prepared.data.settings, reference=reference, progress=progress)
-    states = None
-    if refits:  # [estimation] choice = "states": the verdict reads the validation logs' states, not their torques
-        assert nominal is not None
-        fallback = DRIVE_ONLY_LABEL if alt is not None and config.torque_sensor != "joint" else nominal[0]
-        misread = {v.name for v in scored_all if v.misread}  # the verdict weighs no log read otherwise
-        trusted = tuple(v for v in yardstick if v.name not in misread)
-        states = state_evidence(trusted, SDP_LABEL, fallback, tuple(refits), nominal[0]) if trusted else None
-        for label in refits:
-            yardstick = tuple(v.without(label) for v in yardstick)
-    result = with_yardstick(choose_main_estimate(result, nominal, scored_all, yardstick, states=states), yardstick)
-    return replace(result, findings=tuple(result.findings) + smooth)
+    gains = None if config.drive_gains is None else partial(_gains_and_payload, config)
+    result = pipeline_of(config).fit(recording, validation=tuple(checked), progress=progress, drive_gains=gains,
+                                     references=lambda robot, base: _references(replace(config, robot=robot), base),
+                                     held_out=validate and not config.validation)
+    return replace(result, warnings=result.warnings + repeated)
 
 
 def _distinct_validation(config: IdentificationConfig, recording, checked: list) -> tuple:
@@ -272,125 +139,6 @@ def _distinct_validation(config: IdentificationConfig, recording, checked: list)
             tuple(said))
 
 
-def filtered_finding(names: list, recordings: list) -> tuple:
-    """A finding naming the logs whose torques carry no measurable sample-to-sample noise
-    (:func:`dynid.validation.noise_floor.looks_filtered`: filtered before dynid read them, or simulated without
-    noise): their noise floor is unknown, and a fit near zero error there says little (issue "Never worse than the
-    description", item 5).
-
-    Parameters
-    ----------
-    names : list of str
-    recordings : list of Recording
-        As read, raw.
-
-    Returns
-    -------
-    tuple of Finding
-        Empty where every log carries noise.
-    """
-    smooth = [name for name, rec in zip(names, recordings) if looks_filtered(rec.tau)]
-    if not smooth:
-        return ()
-    return (Finding("filtered", f"{', '.join(smooth)}: the torques carry no measurable sample-to-sample noise (below "
-                                f"{SMOOTH:g} % of their RMS on the median joint; raw sensor logs show 2-4 %): they were "
-                                "low-pass filtered before dynid read them, or simulated without noise. Their noise floor "
-                                "is unknown, the errors measure the fit to an already smoothed torque, and the rest "
-                                "thresholds read from the same logs may be too low: log the raw torques (and positions) "
-                                "if the controller can, or give [preprocessing] rest_velocity for a joint that creeps"),)
-
-
-YARDSTICK = ("each validation log prepared by dynid's default rules (filters, samples kept, rest threshold), carried "
-             "over from the identification log prepared by the same rules, whatever the identification's settings")
-"""What the one yardstick is, as results.json and the terminal say it (:func:`with_yardstick`)."""
-
-
-def yardstick_reference(recording) -> Preprocessing | None:
-    """The identification log's settings resolved by dynid's default rules: what the one yardstick carries over to the
-    validation logs (:func:`dynid.preprocessing.strategies.yardstick_settings`).
-
-    Parameters
-    ----------
-    recording : dynid.io.datasets.Recording
-        The identification log, as read.
-
-    Returns
-    -------
-    Preprocessing or None
-        None where the default rules cannot prepare the log (the validation logs then take them alone).
-    """
-    from ..preprocessing.pipeline import prepare
-
-    try:
-        return prepare(recording, Preprocessing(), strict=False).settings
-    except DynIdError:
-        return None
-
-
-def yardstick_scores(config: IdentificationConfig, base, sets: dict, recordings, *, resolved=None, reference=None,
-                     progress=None) -> tuple:
-    """Every set scored on the validation logs by the one yardstick (issue "Never worse than the description", item 5):
-    each log prepared by dynid's default rules, whatever the identification's settings
-    (:func:`dynid.preprocessing.strategies.yardstick_settings`).
-
-    Parameters
-    ----------
-    config : IdentificationConfig
-        As identified (its robot's friction model).
-    base : BaseParameters
-    sets : dict
-        label -> (n_base,) base parameters.
-    recordings : iterable of Recording
-        The validation logs, read.
-    resolved : Preprocessing, optional
-        The identification's resolved settings (only what describes the model is kept from them).
-    reference : Preprocessing, optional
-        The identification log's settings resolved by the default rules (:func:`yardstick_reference`).
-    progress : callable, optional
-
-    Returns
-    -------
-    tuple of TorqueComparison
-    """
-    step = None if progress is None else (lambda label, done, total: progress(f"one yardstick: {label}", done, total))
-    return validate_sets(config, base, sets, recordings, progress=step, resolved=resolved,
-                         yardstick=reference or Preprocessing())[0]
-
-
-def with_yardstick(result, scored: tuple):
-    """``result`` with the sets' errors on the one yardstick in its diagnostics (``"yardstick"``: the global relative
-    error [%] of each set on each log and their mean over the logs), beside the figures on the identification's own
-    settings.
-
-    Parameters
-    ----------
-    result : IdentificationResult
-    scored : tuple of TorqueComparison
-        From :func:`yardstick_scores`.
-
-    Returns
-    -------
-    IdentificationResult
-        Where some logs rest throughout and others move, ``"mean_over_logs_that_move"`` gives the mean over those
-        that move (``"logs"`` names them): a log at rest scores the distance to the static-friction band about its
-        gravity torque (:func:`dynid.validation.torques.rests_throughout`), another unit than a motion's error, and
-        ten of them at 0 would make the mean a tenth of the motion's.
-    """
-    from ..validation.torques import rests_throughout
-
-    logs = {c.name: {label: float(m["global_relative_error"]) for label, m in c.metrics().items()} for c in scored}
-    labels = [label for label in (scored[0].metrics() if scored else {})]
-
-    def mean(names) -> dict:
-        return {label: float(np.mean([logs[name][label] for name in names])) for label in labels}
-
-    figures = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean(logs)}
-    moving = [c.name for c in scored if not rests_throughout(c.rest_share)]
-    if moving and len(moving) < len(scored):  # a log at rest throughout scores the distance to the static-friction band
-        figures["mean_over_logs_that_move"] = {"logs": moving, **mean(moving)}
-    return replace(result, diagnostics={**result.diagnostics, "yardstick": figures})
-
-
 def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     """The identification pipeline a config describes: its robot, preprocessing, estimators (the closed-loop ones with
     the ``[controller]``), friction choice, seed.
@@ -407,7 +155,8 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
 
     e = config.estimation
     return IdentificationPipeline(config.robot, config.preprocessing, with_hyperparameters(e.estimators, e.hyperparameters),
-                                  e.friction, e.seed, config.robot_source, config.controller if e.closed_loop else None)
+                                  e.friction, e.seed, config.robot_source, config.controller if e.closed_loop else None,
+                                  e.choice, config.torque_sensor)
 
 
 @keyword_only_after_data
@@ -675,7 +424,7 @@ def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None
         The pipeline's settings, as :class:`~dynid.identification.pipeline.IdentificationPipeline` takes them:
         ``preprocessing`` (default: every setting derived from the data), ``estimators`` (keys or objects, as a
         config's ``[estimation] estimators``; the closed-loop ones with ``controller``), ``friction``
-        ({"description", "auto"}, default "description"), ``rng`` (default 0; an int or a generator), ``controller``
+        ({"description", "auto"}, default as a config's: "auto" unless a Coulomb smoothing velocity is given), ``rng`` (default 0; an int or a generator), ``controller``
         (:class:`dynid.simulation.closed_loop.ClosedLoopSetup`, as a config's ``[controller]`` gives it).
 
     Returns

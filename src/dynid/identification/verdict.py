@@ -1,9 +1,9 @@
 """The one verdict: which estimate is the main one, the description's nominal model among the candidates (issue "Never
 worse than the description", item 1).
 
-:func:`choose_main_estimate` is the only function that chooses; :func:`dynid.identification.identify.identify` calls
-it on the identification log alone, :func:`dynid.identification.run.run_identification` again once the validation
-logs are scored. The candidates, in the order they are weighed:
+:func:`choose_main_estimate` is the only function that chooses, and :func:`decide` its one caller, the last part of
+:meth:`dynid.identification.pipeline.IdentificationPipeline.fit`, once the evidence is gathered
+(:mod:`dynid.identification.evidence`). The candidates, in the order they are weighed:
 
 1. the first estimator listed;
 2. the physically consistent SDP (where listed), where the first is least squares and is not physically consistent,
@@ -23,19 +23,11 @@ against the fitted estimate, :mod:`dynid.validation.channel_checks`; its geometr
 :mod:`dynid.validation.geometry_checks`) is not weighed: the choice is made on the other logs, or on the
 identification log alone (the SDP where least squares is not physically consistent: what ``dynid export`` writes).
 
-The validation figures it weighs are the one yardstick's (:func:`dynid.identification.run.yardstick_scores`: every
+The validation figures it weighs are the one yardstick's (:func:`dynid.identification.evidence.yardstick_scores`: every
 validation log prepared by dynid's default rules, whatever the identification's settings), so a setting that filters
 the validation logs differently does not move the choice (issue "Never worse than the description", item 5). The
 choice reads the validation logs' torques, and says so: where a candidate was chosen on them, their figures for it
-are not an independent test. Torque-free evidence was measured and rejected (benchmarks/README.md): the
-identification log's residual plus the prediction variance on the validation logs' states chose the drive-only
-estimate on five of six windows of the LBR Med7's log, where it predicts 1.2-2.6× worse than the description; the same
-with blocked cross-validation in place of the residual lost the UR10e's short windows (SDP 6.4-10.1 % where the
-drive-only estimate scores 1.7-2.1 %); cross-validation between least squares and the SDP picks least squares on the
-KR 300 (55 % against 12 %); a significance test of the candidates' differences on the validation states against their
-block-jackknife spread there (``benchmarks/torque_free.py``) keeps a drive-only estimate on the Med7's 60-63 s that is
-1.5× worse than the description, or, tuned to avoid it, keeps the description on four KR 300 windows where an estimate
-is three times better.
+are not an independent test. The alternatives measured and rejected are in benchmarks/NOTEBOOK.md.
 """
 
 from __future__ import annotations
@@ -47,16 +39,13 @@ import numpy as np
 from ..estimators.registry import estimate_label
 from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 from .estimates import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
+from .evidence import with_yardstick
+from .plausibility import drive_term_findings
 
-__all__ = ["NOMINAL_KEY", "NOMINAL_LABEL", "STATE_SIGMAS", "choose_main_estimate", "nominal_set", "state_evidence"]
+__all__ = ["NOMINAL_KEY", "STATE_SIGMAS", "choose_main_estimate", "decide"]
 
 NOMINAL_KEY = "description"
 """The key of the description's nominal model's estimate when it is the main one."""
-
-NOMINAL_LABEL = "description (nominal)"
-"""The set of the description's own nominal values, scored on the validation logs beside the estimates when no
-reference set of the config is that."""
-
 
 SAME_FIGURE = 1.02
 """Two mean validation errors within this ratio are the same figure for the choice: the physically consistent
@@ -67,74 +56,33 @@ better than this, so that the first line, the main estimate and the file exporte
 STATE_SIGMAS = 3.0
 """With ``[estimation] choice = "states"``: the SDP is the main estimate where its predictions on the validation logs'
 states differ from the fallback's by more than this many times their own spread over refits on parts of the log
-(:func:`state_evidence`). Measured on the 4 real logs and 18 real windows (``benchmarks/torque_free.py``): any value
+(:func:`dynid.identification.evidence.state_evidence`). Measured on the 4 real logs and 18 real windows (``benchmarks/torque_free.py``): any value
 from 2.3 to 3.7 keeps every main estimate within 2 % of the description or better; 3 is the usual 3σ. On simulated
 short logs whose description's links are exact the SDP's refits share its bias, and ratios of 3.3-6.8 kept a wrong
-SDP (benchmarks/README.md): no threshold serves both, which is why this choice is an option, not the default."""
+SDP (benchmarks/NOTEBOOK.md): no threshold serves both, which is why this choice is an option, not the default."""
 
 
-def state_evidence(comparisons, sdp: str, fallback: str, refits: tuple[str, ...], scale: str) -> dict:
-    """What the validation logs' states alone say of the SDP against a fallback (``[estimation] choice = "states"``):
-    the RMS difference of their predictions there, and the SDP's block-jackknife spread there (its refits on all blocks
-    of the identification log but one: ``sqrt((K-1)/K · Σ_k mean((P_k - P̄)²))``, the delete-one-block jackknife's
-    standard error; Efron & Tibshirani, *An Introduction to the Bootstrap*, 1993, §11), both in % of the ``scale``
-    set's RMS prediction, averaged over the logs by their samples. At rest, each prediction without its Coulomb-like
-    terms (what the one yardstick scores there is the distance to the static-friction band about it). No measured
-    torque is read.
+def decide(result, evidence=None):
+    """The verdict of :meth:`dynid.identification.pipeline.IdentificationPipeline.fit`: the main estimate chosen once,
+    on the evidence gathered (:func:`choose_main_estimate`), the one yardstick's figures added.
 
     Parameters
     ----------
-    comparisons : sequence of TorqueComparison
-        The validation logs with ``sdp``, ``fallback``, ``refits`` and ``scale`` among their sets.
-    sdp, fallback : str
-        The two candidates' labels.
-    refits : tuple of str
-        The SDP refits' labels.
-    scale : str
-        The set whose RMS prediction is 100 % (the description's nominal model).
+    result : IdentificationResult
+        The estimates, as :meth:`~dynid.identification.pipeline.IdentificationPipeline.estimate` gives them.
+    evidence : Evidence, optional
+        The validation logs' (:func:`dynid.identification.evidence.gather_evidence`); None without validation logs
+        (the identification log's own held-out blocks are then the evidence).
 
     Returns
     -------
-    dict
-        ``apart`` and ``spread`` [%], ``fallback``.
+    IdentificationResult
     """
-    apart, spread, weight = [], [], []
-    for v in comparisons:
-        def pred(label):
-            centre = v.predicted[label] if v.centre is None else v.centre.get(label, v.predicted[label])
-            return v.predicted[label] if v.resting is None else np.where(v.resting, centre, v.predicted[label])
-
-        unit = 100.0 / max(float(np.sqrt(np.mean(pred(scale) ** 2))), 1e-12)
-        parts = np.array([pred(r) for r in refits])
-        k = len(refits)
-        spread.append(unit * np.sqrt((k - 1) / k * np.sum(np.mean((parts - parts.mean(axis=0)) ** 2, axis=(1, 2)))))
-        apart.append(unit * np.sqrt(np.mean((pred(sdp) - pred(fallback)) ** 2)))
-        weight.append(v.predicted[sdp].size)
-    return {"apart": float(np.average(apart, weights=weight)), "spread": float(np.average(spread, weights=weight)),
-            "fallback": fallback}
-
-
-def nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
-    """The description's nominal model as a base-parameter set: a reference set of the config that is it, else
-    :data:`NOMINAL_LABEL`.
-
-    Parameters
-    ----------
-    robot : Robot
-    base : BaseParameters
-    references : sequence of ReferenceSet
-
-    Returns
-    -------
-    (str, (n_base,) ndarray) or None
-        Its label and base parameters; None for a description without inertias.
-    """
-    if not np.any(robot.inertial != 0):
-        return None
-    beta = base.base_from_standard(robot.standard_parameters())
-    same = next((r.name for r in references if r.beta.shape == beta.shape and
-                 np.allclose(r.beta, beta, rtol=1e-9, atol=1e-12)), None)
-    return (same or NOMINAL_LABEL), beta
+    if evidence is None:
+        return choose_main_estimate(result)
+    result = replace(result, validations=evidence.validations, warnings=result.warnings + evidence.warnings)
+    chosen = choose_main_estimate(result, evidence.nominal, evidence.scored, evidence.yardstick, states=evidence.states)
+    return with_yardstick(chosen, evidence.yardstick)
 
 
 def _mean_error(validations, label: str) -> float:
@@ -157,7 +105,7 @@ def choose_main_estimate(result, nominal: tuple[str, np.ndarray] | None = None, 
         The validation logs with every set scored, the drive-only one (:attr:`IdentificationResult.drive_only`)
         included.
     judged : tuple of TorqueComparison, optional
-        The same sets scored on the one yardstick (:func:`dynid.identification.run.yardstick_scores`): where given,
+        The same sets scored on the one yardstick (:func:`dynid.identification.evidence.yardstick_scores`): where given,
         the choice weighs these figures, so that it does not depend on how the identification's settings filter the
         validation logs; default ``scored`` (and ``result.validations``).
     states : dict, optional
@@ -229,7 +177,7 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
 
     Where least squares predicts the held-out blocks better, the physically consistent SDP is still the main estimate
     when it passed its own check: it is what ``dynid export`` writes, and blocks of one excitation do not tell which
-    estimate extrapolates. Measured (benchmarks/README.md, "without validation logs"): on the five real logs and windows
+    estimate extrapolates. Measured (benchmarks/NOTEBOOK.md, "without validation logs"): on the five real logs and windows
     where held-out blocks kept least squares, it predicted the validation logs 5-30× worse than the SDP (the KR 300's
     full log 55.4 % against 11.8 %, the Med7's 50-55 s 661 % against 22.4 %)."""
     ls = result.label
@@ -361,8 +309,6 @@ def _with_validation_findings(result, chosen: list, nominal: tuple[str, np.ndarr
 def _drive_findings(result, main: str) -> list:
     """The main estimate's implausible drive terms (:func:`dynid.identification.plausibility.drive_term_findings`):
     its standard parameters where it has them, else its base parameters."""
-    from .plausibility import drive_term_findings
-
     estimate = result.estimates.get(main)
     if estimate is None or getattr(estimate, "key", "") == NOMINAL_KEY:  # the robot file's own values: not fitted
         return []

@@ -401,7 +401,7 @@ def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSett
     hyper-parameters, the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
     the choice of the main estimate (``e`` None: the table left out)."""
     e = e or EstimationTable()
-    friction = e.friction or ("description" if pre.coulomb_velocity != 0.0 else "auto")
+    friction = e.friction or pre.friction_default
     asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     if closed_loop and not controlled:

@@ -267,6 +267,17 @@ class Preprocessing:
         chosen.append(f"decimation by {dec}" + ("" if self.decimation is not None else " (down to the parallel band)"))
         return "; ".join(chosen)
 
+    @property
+    def friction_default(self) -> str:
+        """The friction setting every route takes where none is given: "auto" (each joint's model chosen by
+        cross-validation), or "description" where a Coulomb smoothing velocity is given (its terms are the user's).
+
+        Returns
+        -------
+        str
+        """
+        return "description" if self.coulomb_velocity != 0.0 else "auto"
+
     def to_dict(self) -> dict:
         """The settings as results.json stores them (``warnings`` go to the result's own warnings).
 

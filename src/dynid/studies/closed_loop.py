@@ -239,7 +239,7 @@ def simulate_realisation(setup: _Setup, cell: int, realisation: int) -> dict:
     seed = int(np.random.default_rng([cfg.seed, 21, cell, realisation]).integers(2**31))
     reference = ClosedLoopSetup(exp.controller, exp.q_ref, feedforward=exp.feedforward is not None)
     try:  # dynid identify's route: the closed-loop parts on the rows the others fitted, the settings as given
-        pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False),
+        pipeline = IdentificationPipeline(setup.robot, preprocessing=replace(settings, auto=False), friction="description",
                                           estimators=(*cfg.open_loop, *(ClosedLoopEstimator(k, reference) for k in keys
                                                                         if k in CLOSED_LOOP_METHODS)), rng=seed)
         result = pipeline.fit(log, held_out=False)

@@ -520,7 +520,8 @@ def simulate_dataset(robot, base, traj, t, noise, rng, phi_true, passes, label, 
         The estimators fed, unfitted; None without ``problem``.
     """
     recording, tau_true, tool = simulate_recording(robot, traj, t, noise, rng, phi_true, label, warnings)
-    pipeline = IdentificationPipeline(robot, paper_preprocessing(traj, passes, strategy), estimators=estimators)
+    pipeline = IdentificationPipeline(robot, paper_preprocessing(traj, passes, strategy), estimators=estimators,
+                                      friction="description")  # the paper's model: the description's friction terms
     prepared = pipeline.prepare(recording, base)
     estimation = None if problem is None else pipeline.estimation(prepared, problem, keep_rows=True)
     w, tau = estimation.rows() if estimation is not None else _zeroed(*prepared_rows(robot, base, prepared.data))
