@@ -43,6 +43,7 @@ from ..validation.diagnostics import (
     prior_findings,
     scale_findings,
     sign_findings,
+    unlike_nominal_findings,
 )
 from ..validation.geometry_checks import geometry_findings
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
@@ -50,7 +51,6 @@ from .drive_only import DriveOnly, drive_only
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .flipped_joints import flipped_joint_findings
 from .identified import Parameters
-from .verdict import choose_main_estimate
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
 
@@ -266,7 +266,10 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
              jackknife: bool = False, observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
-    over its rows; check every estimate's physical consistency and give the verdict on the model.
+    over its rows; check every estimate's physical consistency and gather what the log itself says for the verdict
+    (its findings, held-out blocks, the drive-only candidate, the SDP's refits). The main estimate is the first listed
+    until :func:`dynid.identification.verdict.decide` chooses
+    (:meth:`dynid.identification.pipeline.IdentificationPipeline.fit`).
 
     Parameters
     ----------
@@ -389,13 +392,13 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
                                 jackknife=jackknife, progress=progress)
-    return choose_main_estimate(IdentificationResult(
+    return IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
         n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
                                                                   **_given_hyperparameters(hyperparameters)},
         warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
         model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
-        sdp_refits=refits))
+        sdp_refits=refits)
 
 
 def _not_carried_note(names: tuple[str, ...]) -> list[str]:
@@ -537,6 +540,10 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     floor = fit.floor_metrics()  # one channel's own scale is one the fit cannot follow
     misfit = None if floor is None else (np.min([m["rmse"] for m in fit.metrics().values()], axis=0)
                                          > SCALE_MISFIT * np.asarray(floor["rmse"]))
+    unlike = unlike_nominal_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name, q=data.q, dq=data.dq,
+                                     tau=data.tau)
+    if unlike:  # not torques: no sign, scale or geometry of them can be judged
+        return unlike
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
             + scale_findings(beyond_drive, slope_drive, varies, data.name,

@@ -190,7 +190,8 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments: the torque offset, the
     Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's ``frictionloss`` is a dry-friction
     *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but its force in ``mj_inverse`` comes from the
-    constraint solver, so only the other terms reproduce dynid's torques exactly (see the round-trip test). Massless
+    constraint solver, so only the other terms reproduce dynid's torques exactly (see the round-trip test); its
+    ``solreffriction`` is written as stiff as MuJoCo's default 2 ms step allows (:data:`FRICTION_TIME_STEPS`). Massless
     links and point masses get MuJoCo's smallest mass and inertia (``boundmass``, ``boundinertia`` of 1e-9); a full
     inertia at the limit of a real link (a point mass, a thin rod) is written as MuJoCo loads it
     (:func:`mujoco_inertia`).
@@ -235,7 +236,7 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         lines += [f'{indent}<body name="link{j + 1}" pos="{_vec(joint.translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
                   f'{indent}  <joint name={quoteattr(joint.name)} type="hinge" axis="{_vec(joint.axis)}"{limit} '
                   f'armature="{terms.get("Ia", 0.0):.17g}" damping="{terms.get("fv", 0.0):.17g}" '
-                  f'frictionloss="{terms.get("fc", 0.0):.17g}"/>',
+                  f'frictionloss="{terms.get("fc", 0.0):.17g}" solreffriction="{friction_solref(0.002)}"/>',
                   f'{indent}  <inertial pos="{_vec(com)}" mass="{max(mass, 0.0):.17g}" fullinertia="{inertia[0, 0]:.17g} '
                   f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>']
         extra = {k: v for k, v in terms.items() if k not in ("Ia", "fc", "fv") and v != 0}
@@ -259,6 +260,30 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     lines += [f"  <!--{note}-->" for note in (position_offset_note(robot),) if note]
     lines += ["</mujoco>", ""]
     return "\n".join(lines)
+
+
+FRICTION_TIME_STEPS = 2.0
+"""The time constant of MuJoCo's dry-friction constraint (``solreffriction``) dynid writes, in the file's timesteps: the
+smallest MuJoCo keeps without ``refsafe`` disabled, where its ``frictionloss`` force comes closest to
+``frictionloss·sign(q̇)``. On the UR10e example's validation states, MuJoCo's own ``mj_inverse`` of the written file
+was 9.9, 0.9, 1.0, 9.1, 11.9, 8.4 % of each joint's RMS torque off dynid's model with MuJoCo's default (0.02 s), and
+4.4, 0.3, 0.4, 4.0, 5.3, 3.8 % with 2 steps (0.004 s); stiffer ones with ``refsafe`` disabled closed the gap in
+``mj_inverse`` but made a resting wrist jitter at the default 2 ms step (benchmarks/NOTEBOOK.md)."""
+
+
+def friction_solref(timestep: float) -> str:
+    """The ``solreffriction`` dynid writes for a file stepping at ``timestep`` [s] (:data:`FRICTION_TIME_STEPS`).
+
+    Parameters
+    ----------
+    timestep : float [s]
+
+    Returns
+    -------
+    str
+        ``"timeconst dampratio"``.
+    """
+    return f"{FRICTION_TIME_STEPS * timestep:.6g} 1"
 
 
 BOUND_INERTIA = 1e-9
@@ -397,7 +422,7 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("sign", "scale", "order", "angles", "gravity", "rate")
+READINESS_KINDS = ("columns", "sign", "scale", "order", "angles", "gravity", "rate")
 """Findings of ``dynid identify``'s verdict that say the log itself is wrong (the torques' sign, unit or gain, channels
 swapped, angles or a mounting that do not match the robot file, its sample rate): a model fitted to it is exported with
 a warning."""
@@ -442,7 +467,7 @@ def withheld_files(results: dict) -> str | None:
                     and f.get("kind") in READINESS_KINDS and str(f.get("text", "")).startswith(f"{name}:")})
     if not kinds:
         return None
-    what = {"sign": "a torque's sign", "scale": "the torques' unit or drive gains", "order": "torque columns swapped",
+    what = {"columns": "columns that are not its torques", "sign": "a torque's sign", "scale": "the torques' unit or drive gains", "order": "torque columns swapped",
             "angles": "its angles", "gravity": "the mounting", "rate": "its sample rate"}
     return (f"no URDF or MJCF written: the log {name} is read otherwise than the robot file "
             f"({', '.join(what[k] for k in kinds)}: the verdict names the setting that fixes it), so a model fitted to "

@@ -23,7 +23,16 @@ from ..model.mjcf import held_inertials
 from ..model.robot import Robot
 from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
 from ..runtime.extras import require
-from .export import _exportable, _replace, _vec, identified_header, moved_far, mujoco_inertia, position_offset_note
+from .export import (
+    _exportable,
+    _replace,
+    _vec,
+    friction_solref,
+    identified_header,
+    moved_far,
+    mujoco_inertia,
+    position_offset_note,
+)
 
 AXIS_TOLERANCE = 1e-4
 """[rad, m] How far a joint axis of the MJCF may lie from the robot's, once the arms are aligned."""
@@ -145,6 +154,9 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         element.set("armature", f"{terms.get('Ia', 0.0):.17g}")
         element.set("damping", f"{terms.get('fv', 0.0):.17g}")
         element.set("frictionloss", f"{terms.get('fc', 0.0):.17g}")
+        dof = int(model.jnt_dofadr[jid])
+        if element.get("solreffriction") is None and np.allclose(model.dof_solref[dof], (0.02, 1.0)):  # MuJoCo's default
+            element.set("solreffriction", friction_solref(float(model.opt.timestep)))
         extra = {n: v for n, v in terms.items() if n not in ("Ia", "fc", "fv") and v != 0}
         if extra:
             body.append(ET.Comment(" dynid: drive terms MJCF cannot hold, add them to the torques: "

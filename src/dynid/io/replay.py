@@ -50,9 +50,13 @@ class ReplayCheck:
         MJCF only: how far MuJoCo's ``frictionloss`` constraint force in ``mj_inverse`` is from
         ``frictionloss·sign(q̇)`` on the same states, over the norm of the latter (0 without dry friction).
     file_vs_measured, model_vs_measured : float [%] or None
-        On a log's states (``measured`` given): the file's torques and dynid's whole model against the log's measured
-        torque, ``100·||τ - τ_measured|| / ||τ_measured||`` on the same samples. Their difference is what the format's
+        On a log's states (``measured`` given): the file's torques as its simulator computes them (MuJoCo's
+        ``frictionloss`` its constraint's) and dynid's whole model against the log's measured torque, ``100·||τ - τ_measured|| / ||τ_measured||`` on the same samples. Their difference is what the format's
         missing terms cost on that log.
+    simulator_gap : (n_dof,) array [%]
+        What the target simulator computes from the file, with its own semantics (Pinocchio's RNEA and the URDF's
+        ``<dynamics>``; MuJoCo's ``mj_inverse`` with its ``frictionloss`` constraint as MuJoCo solves it), against
+        dynid's whole model on the same states: each joint's RMS difference over its RMS torque.
     """
 
     relative_error: float
@@ -62,6 +66,7 @@ class ReplayCheck:
     frictionloss_gap: float = 0.0
     file_vs_measured: float | None = None
     model_vs_measured: float | None = None
+    simulator_gap: np.ndarray | None = None
 
 
 def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -129,10 +134,10 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
 
 
 def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...],
-              measured: np.ndarray | None = None) -> ReplayCheck:
+              measured: np.ndarray | None = None, simulated: np.ndarray | None = None) -> ReplayCheck:
     """The file's torques against dynid's of ``phi`` restricted to the links and the drive terms ``held_terms`` a format
-    holds (Coulomb friction with ``sign(q̇)``), each joint's share of what the format cannot hold, and both against
-    the ``measured`` torque where given."""
+    holds (Coulomb friction with ``sign(q̇)``), each joint's share of what the format cannot hold, both against the
+    ``measured`` torque where given, and the ``simulated`` torque (default the file's) against dynid's whole model."""
     q, dq, ddq = states
     full = regressor(robot, q, dq, ddq) @ phi
     coupled = set(robot.transmission.coupled_parameter_names) if robot.transmission.n_coupled_params else set()
@@ -147,11 +152,13 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
     rms = np.sqrt(np.mean(full**2, axis=0))
     share = 100.0 * np.sqrt(np.mean((full - model_tau) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     error = float(np.linalg.norm(tau_file - model_tau) / np.maximum(np.linalg.norm(model_tau), 1e-300))
+    simulated = tau_file if simulated is None else simulated
+    gap = 100.0 * np.sqrt(np.mean((full - simulated) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     if measured is None:
-        return ReplayCheck(error, missing, share, q.shape[0])
+        return ReplayCheck(error, missing, share, q.shape[0], simulator_gap=gap)
     scale = max(float(np.linalg.norm(measured)), 1e-300)
-    return ReplayCheck(error, missing, share, q.shape[0], file_vs_measured=100.0 * float(np.linalg.norm(tau_file - measured)) / scale,
-                       model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale)
+    return ReplayCheck(error, missing, share, q.shape[0], file_vs_measured=100.0 * float(np.linalg.norm(simulated - measured)) / scale,
+                       model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale, simulator_gap=gap)
 
 
 def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
@@ -208,7 +215,7 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
             mujoco.mj_inverse(model, data)
             out[k] = data.qfrc_inverse[vadr]
     tau_file = tau_file + dry * np.sign(dq)
-    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured)
+    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured, simulated=with_constraint)
     sliding = dry * np.sign(dq)
     gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
     return replace(check, frictionloss_gap=gap)

@@ -11,7 +11,7 @@ from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
 from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot, withheld_files
 from ..io.mjcf_write_back import mjcf_written_back
-from ..io.replay import mjcf_replay, urdf_replay
+from ..io.replay import ReplayCheck, mjcf_replay, urdf_replay
 from ..io.results import stored_standard
 from ..io.urdf_write_back import urdf_written_back
 from . import figures
@@ -170,7 +170,9 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
     -------
     dict
         ``log`` (None: random states), and per file its format, the tool, how closely it equals dynid's model, what
-        it cannot hold and, on a log, its error and dynid's whole model's against the measured torques [%].
+        it cannot hold, what the tool computes from it against dynid's whole model per joint (``simulator_gap`` [%],
+        :attr:`dynid.io.replay.ReplayCheck.simulator_gap`) and, on a log, its error and dynid's whole model's against
+        the measured torques [%].
     """
     from ..identification.run import moving_validation
 
@@ -185,19 +187,39 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
     files = []
     for (path, text), (form, tool, replay) in zip(models, (("URDF", "Pinocchio", urdf_replay),
                                                            ("MJCF", "MuJoCo", mjcf_replay))):
-        entry: dict = {"file": path.name, "format": form, "read_by": tool}
+        check: ReplayCheck | str
         try:
             check = replay(text, fitted, phi, **on)
         except ImportError:
-            entry["not_read_back"] = f"{tool} is not installed (pip install 'dynid[mujoco]')"
+            check = f"{tool} is not installed (pip install 'dynid[mujoco]')"
         except (ValueError, KeyError) as exc:  # a user's model MuJoCo cannot load from its text alone
-            entry["not_read_back"] = f"{tool} could not load it from its text ({str(exc).splitlines()[0]})"
-        else:
-            entry.update(equals_model_to=check.relative_error, samples=check.n_states, cannot_hold=list(check.missing),
-                         cannot_hold_share=[float(x) for x in check.missing_share],
-                         file_vs_measured=check.file_vs_measured, model_vs_measured=check.model_vs_measured)
-        files.append(entry)
+            check = f"{tool} could not load it from its text ({str(exc).splitlines()[0]})"
+        files.append(read_back_entry(path.name, form, check))
     return {"log": None if log is None else log[0], "files": files}
+
+
+def read_back_entry(name: str, form: str, check) -> dict:
+    """One written file read back by its tool, as results.json's ``files_taken_away`` holds it.
+
+    Parameters
+    ----------
+    name : str
+        The file's name.
+    form : {"URDF", "MJCF"}
+    check : ReplayCheck or str
+        :func:`dynid.io.replay.urdf_replay` or :func:`~dynid.io.replay.mjcf_replay`'s check, or why there is none.
+
+    Returns
+    -------
+    dict
+    """
+    entry: dict = {"file": name, "format": form, "read_by": "Pinocchio" if form == "URDF" else "MuJoCo"}
+    if isinstance(check, str):
+        return {**entry, "not_read_back": check}
+    return {**entry, "equals_model_to": check.relative_error, "samples": check.n_states,
+            "cannot_hold": list(check.missing), "cannot_hold_share": [float(x) for x in check.missing_share],
+            "file_vs_measured": check.file_vs_measured, "model_vs_measured": check.model_vs_measured,
+            "simulator_gap": [float(x) for x in check.simulator_gap]}
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:

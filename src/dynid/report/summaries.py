@@ -353,6 +353,10 @@ def readiness(result, *, library: bool = False) -> Line:
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
                     "verdict at the end names it and the setting that fixes it", "warning")
+    if "columns" in kinds:
+        return Line("not ready: the torque columns do not follow the robot file's model on any joint (velocities, "
+                    "positions or another signal read as torques?): the verdict at the end says what they look like",
+                    "warning")
     if "order" in kinds:
         return Line("not ready: the torques of some joints look swapped: the verdict at the end names them", "warning")
     if "angles" in kinds:
@@ -418,6 +422,10 @@ def taken_away_lines(taken: dict) -> list:
             continue
         said = (f"{f['file']} read back by {f['read_by']} {where} ({f['samples']} samples): equals dynid's model to "
                 f"{f['equals_model_to']:.1e} of its RMS where {f['format']} can hold it")
+        gap = f.get("simulator_gap")
+        if gap is not None:
+            said += (f"; what {SIMULATES[f['format']]} computes from it is off dynid's whole model by "
+                     + ", ".join(f"J{j + 1} {g:.2g}" for j, g in enumerate(gap)) + " % of each joint's RMS torque")
         if f.get("file_vs_measured") is not None:
             said += (f"; against the log's unfiltered measured torques {f['file_vs_measured']:.3g} %, dynid's whole "
                      f"model {f['model_vs_measured']:.3g} %")
@@ -426,8 +434,18 @@ def taken_away_lines(taken: dict) -> list:
             said += (f"; it cannot hold {', '.join(stem_words(k) for k in f['cannot_hold'])} (up to "
                      f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: the file's comments say how to add "
                      "them)")
-        out.append(Line(said, "warning" if f["equals_model_to"] > 1e-6 else "text"))
+        off = f["equals_model_to"] > 1e-6 or max(f.get("simulator_gap") or [0.0]) > SIMULATOR_GAP
+        out.append(Line(said, "warning" if off else "text"))
     return out
+
+
+SIMULATES = {"URDF": "Pinocchio (RNEA and the joints' <dynamics>)",
+             "MJCF": "MuJoCo (mj_inverse, its frictionloss a constraint as MuJoCo solves it)"}
+"""What computes a written file's torques, with its own semantics (:attr:`dynid.io.replay.ReplayCheck.simulator_gap`)."""
+
+SIMULATOR_GAP = 2.0
+"""[%] A joint whose simulated torque is further than this off dynid's model (of its RMS torque) makes the read-back
+line a warning: a user simulating the file meets a model that much off the one identified."""
 
 
 def identification_brief(result) -> list:
@@ -794,7 +812,7 @@ def in_short(result) -> list:
 
 
 def _yardstick_lines(r, label: str) -> list:
-    """:func:`in_short`'s line on the one yardstick (:func:`dynid.identification.run.with_yardstick`): the main
+    """:func:`in_short`'s line on the one yardstick (:func:`dynid.identification.evidence.with_yardstick`): the main
     estimate's and the description's mean validation errors with every log prepared by dynid's default rules alone;
     over the logs that move where others rest throughout (those say how many sets stay within the static-friction
     band, which is what they score)."""

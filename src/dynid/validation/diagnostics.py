@@ -28,8 +28,8 @@ import numpy as np
 
 from .noise_floor import AT_FLOOR
 
-__all__ = ["Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "validation_findings",
-           "prior_findings", "nominal_gate"]
+__all__ = ["Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
+           "validation_findings", "prior_findings", "nominal_gate"]
 
 SIGNIFICANT = 4.0
 """|t| above which a residual's correlation with a feature is reported."""
@@ -56,7 +56,8 @@ class Finding:
         quarter or half turn off, a joint counted the other way round or two columns swapped) and "gravity" (gravity
         along another axis of the base: :mod:`dynid.validation.geometry_checks`), "misread" (a validation log the verdict
         leaves out, read otherwise than the identification log: :mod:`dynid.validation.channel_checks`), "filtered"
-        (torques without measurable noise: :func:`dynid.validation.noise_floor.looks_filtered`).
+        (torques without measurable noise: :func:`dynid.validation.noise_floor.looks_filtered`), "columns" (torques
+        that follow the description on no joint: :func:`unlike_nominal_findings`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None
@@ -219,6 +220,65 @@ class ResidualSums:
                                         f"t = {t_pos:.1f}): a counterbalance, a cable, a wrong mass or gravity? "
                                         "(counterbalance = true in the description models one)", j))
         return findings, stats
+
+
+UNLIKE_NOMINAL = 0.5
+"""A log whose measured torque correlates with the description's nominal model below this on every joint that varies
+(beyond friction where that is known) is not read as torques. On the real logs of ../shared/data the largest of
+these correlations is 0.96-1.0 (the KR 300, the TX40, the UR10e; the LBR Med7's plain correlation 1.0); the UR10e
+example's log with its joint velocities read as torques reaches 0.06."""
+
+LIKE_A_STATE = 0.995
+"""A torque column whose correlation with its joint's velocity or position reaches this is said to be that signal."""
+
+
+def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, *, q: np.ndarray,
+                            dq: np.ndarray, tau: np.ndarray, table: str = "[identification]") -> list[Finding]:
+    """Torques that are not torques: the measured torque follows the description's nominal model on no joint that
+    varies (:data:`UNLIKE_NOMINAL`), so no scale, sign or order of the columns can be judged and a fit of another
+    signal (a log's velocities read as torques fit to 0.0007 % by the viscous terms) would look perfect; or every
+    joint's torque column equals its velocity or position (:data:`LIKE_A_STATE`; positions can follow gravity's shape).
+    The columns that equal a state are named.
+
+    Parameters
+    ----------
+    correlation : (n_dof,) array
+        Each joint's correlation of the measured torque with the nominal model's (beyond friction where known).
+    varies : (n_dof,) bool array
+        Joints whose measured torque varies beyond its noise.
+    dataset : str
+    q, dq, tau : (N, n_dof) arrays
+        The log's positions [rad], velocities [rad/s] and torques [N·m], as prepared.
+    table : str
+        The config table whose columns to check.
+
+    Returns
+    -------
+    list of Finding
+        One finding of kind "columns" (the log is not read as the robot file says), or none.
+    """
+    rho = np.asarray(correlation, dtype=float)
+    judged = [j for j in range(rho.size) if varies[j] and np.isfinite(rho[j])]
+    if not judged:
+        return []
+    named = []
+    for j in judged:
+        for signal, values in (("velocity", dq[:, j]), ("position", q[:, j])):
+            if np.std(values) > 0 and np.std(tau[:, j]) > 0 and np.corrcoef(values, tau[:, j])[0, 1] >= LIKE_A_STATE:
+                named.append(f"J{j + 1}'s is its {signal}")
+                break
+    best = max(rho[j] for j in judged)
+    if best >= UNLIKE_NOMINAL and len(named) < len(judged):  # a torque column of each joint equal to a state: not
+        return []                                            # torques, whatever gravity's shape makes them look like
+    which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
+    return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
+                               f"largest correlation with them {best:.2f}, where a log of the robot's torques reaches "
+                               f"0.96-1.0){which}: these columns are not read as the robot's torques; check the torques "
+                               f"(or currents) columns of {table} and the robot file before trusting any fit of them")
+            if best < UNLIKE_NOMINAL else
+            Finding("columns", f"{dataset}: every joint's measured torque equals one of its states ({', '.join(named)}): "
+                               f"these columns are not read as the robot's torques; check the torques (or currents) "
+                               f"columns of {table}")]
 
 
 def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]",
