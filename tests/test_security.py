@@ -143,6 +143,10 @@ ESCAPES = {
     "eval open": "$(eval ${{'open\\x28\\x27{marker}\\x27, \\x27w\\x27\\x29.write\\x28\\x27x\\x27\\x29'}})",
     "eval dunder": "$(eval ${{'\\x28\\x29.\\x5f\\x5fclass\\x5f\\x5f'}})",
     "huge power": "${{9**9**9}}",
+    # round five: each ran past 120 s (a power whose exponent is small but whose base is huge, a comprehension
+    # whose loops are each bounded but whose product is not)
+    "power of a power": "${{(10**2499999)**64}}",
+    "nested comprehension": "${{len([x for x in range(9999999) for y in range(9999999)])}}",
 }
 
 
@@ -183,6 +187,40 @@ def test_hostile_includes_and_yaml_are_refused(tmp_path, monkeypatch):
         with pytest.raises(ConfigError, match=r"(may not run in dynid|xacro cannot expand it)") as caught:
             expand_xacro(path)
         assert "\n" not in str(caught.value) and not marker.exists(), name
+
+
+def test_files_a_description_may_not_read_are_refused_quickly_and_never_quoted(tmp_path, monkeypatch):
+    """Round five: an include of a FIFO hung dynid (its reader blocks forever); ``load_yaml('/etc/passwd')`` as a
+    joint's type put that whole file into the error message. A FIFO is refused as not a regular file, a data file
+    outside the description's folders is refused, and a value read from a file is cut in a message."""
+    import os
+    import time
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    from dynid.model.description import load_robot
+    from dynid.model.urdf import expand_xacro
+
+    os.mkfifo(tmp_path / "fifo.xacro")
+    outside = tmp_path.parent / f"{tmp_path.name}-secret.yaml"
+    outside.write_text("a secret line " * 40 + "\n")
+    cases = {
+        "fifo": ('<xacro:include filename="fifo.xacro"/>', r"fifo.xacro is not a regular file"),
+        "outside": (f'<xacro:property name="y" value="${{xacro.load_yaml(\'{outside}\')}}" lazy_eval="false"/>',
+                    r"secret.yaml is outside the robot description's folders"),
+    }
+    for name, (element, message) in cases.items():
+        path = tmp_path / f"{name}.urdf.xacro"
+        path.write_text(XACRO.format(value="1.0").replace("<link", element + "\n  <link", 1))
+        start = time.monotonic()
+        with pytest.raises(ConfigError, match=message) as caught:
+            expand_xacro(path)
+        assert time.monotonic() - start < 10 and "a secret line" not in str(caught.value), name
+    path = tmp_path / "long.urdf"  # a value read from a file is cut when a message quotes it
+    path.write_text('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="' + "x" * 500 + '">'
+                    '<parent link="a"/><child link="b"/></joint></robot>')
+    with pytest.raises(ConfigError, match=r"has type 'x{37}\.\.\.'") as caught:
+        load_robot(path)
+    assert "x" * 41 not in str(caught.value)
 
 
 def test_no_xacro_expression_reaches_eval(tmp_path, monkeypatch):

@@ -5,6 +5,8 @@ input refused cleanly"). The commands run in-process (typer's runner), which kee
 from __future__ import annotations
 
 import json
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +14,8 @@ import pytest
 from typer.testing import CliRunner
 
 from dynid.cli.app import app
+from dynid.exceptions import DataError
+from dynid.io.files import atomic_write_text
 
 from .refusals import check_refusal
 
@@ -395,9 +399,14 @@ def test_export_targets_are_checked_before_any_work(identified):
     ]
     (folder / "other.xml").write_text("<mujoco><worldbody><body name='b'><joint name='x'/><geom size='.1'/></body></worldbody></mujoco>")
     (folder / "bad.xml").write_text("<mujoco><worldbody>")
+    os.mkfifo(folder / "pipe.urdf")  # a device node or a FIFO is never replaced by a regular file (/dev/null as root)
+    cases.append((["--urdf", folder / "pipe.urdf"], "pipe.urdf: not a regular file (a device, a FIFO or a socket)"))
     for args, message in cases:
         assert_refused(invoke("export", cfg, "--results", results, *args), message)
-    assert sorted(p.name for p in folder.iterdir() if p.suffix in (".urdf", ".xml")) == ["bad.xml", "other.xml"]
+    assert sorted(p.name for p in folder.iterdir() if p.suffix in (".urdf", ".xml")) == ["bad.xml", "other.xml", "pipe.urdf"]
+    assert stat.S_ISFIFO((folder / "pipe.urdf").stat().st_mode)
+    with pytest.raises(DataError, match="pipe.urdf: not a regular file"):  # every file dynid writes goes through it
+        atomic_write_text(folder / "pipe.urdf", "<robot/>")
 
 
 def test_an_earlier_runs_folder_holding_a_folder_where_a_file_goes(ur):

@@ -462,6 +462,10 @@ def test_init_takes_the_rate_of_a_log_without_time_stamps(tmp_path):
     np.savetxt(log, rows[:, 1:], delimiter=",", comments="", header=",".join(header))
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 1 and "no time column" in p.stderr and "--rate HZ" in p.stderr
+    for bad in ("nan", "inf"):  # "nan" wrote rate = nan (a negative or zero rate is the option's usage error)
+        p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"), "--rate", bad)
+        assert p.returncode == 1 and "--rate: expected the logs' sample rate, a positive number of Hz" in p.stderr
+        assert "Traceback" not in p.stderr and not (tmp_path / "arm.toml").exists()
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"), "--rate", f"{rate!r}")
     assert p.returncode == 0, p.stderr
     assert f"rate = {rate!r}" in (tmp_path / "arm.toml").read_text()

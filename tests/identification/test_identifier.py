@@ -2,6 +2,7 @@
 the simulation's truth and Pinocchio's inverse dynamics."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -92,6 +93,24 @@ def test_save_takes_a_folder_as_its_docstring_says_and_creates_a_missing_one(tmp
     with pytest.raises(ConfigError, match=r"plain: cannot create the folder for r.json"):
         fitted.save(tmp_path / "plain" / "r.json")
     assert (tmp_path / "plain").read_text() == "not a folder"
+
+
+def test_a_parameter_without_a_standard_deviation_reads_back_as_not_known(tmp_path, fitted):
+    """issue "The better model wins", item 4: results.json writes a σ that is not known as null (an estimate of a
+    prior-only direction, a drive-only term); load_results raised TypeError (float(None)) on it. It reads as NaN; a σ
+    that is neither is one line naming it (the results' schema)."""
+    data = json.loads(fitted.save(tmp_path / "r.json").read_text())
+    key = next(k for k, e in data["estimates"].items() if isinstance(e.get("std"), dict))
+    name = next(iter(data["estimates"][key]["std"]))
+    data["estimates"][key]["std"][name] = None
+    (tmp_path / "r.json").write_text(json.dumps(data))
+    model = dynid.load_results(tmp_path / "r.json")
+    std = model.parameters(key).std
+    assert np.isnan(std[model.base.names.index(name)]) and np.isfinite(np.delete(std, model.base.names.index(name))).all()
+    data["estimates"][key]["std"][name] = "big"
+    (tmp_path / "r.json").write_text(json.dumps(data))
+    with pytest.raises(DataError, match=rf"r.json: estimates.{re.escape(key)}.std.{name}: 'big' is not of type 'number'"):
+        dynid.load_results(tmp_path / "r.json")
 
 
 def test_load_results_says_when_the_robot_cannot_be_found(tmp_path, fitted):
@@ -309,8 +328,8 @@ def test_an_estimator_object_carries_its_hyperparameters_through_the_identifier(
     np.testing.assert_array_equal(geometric, direct.estimates["dynid SDP"].params)
     assert not np.array_equal(geometric, euclidean.estimates["dynid SDP"].params)
     assert not hasattr(sdp, "problem_") and not hasattr(sdp, "params_")  # the object given is not fitted itself
-    with pytest.raises(ConfigError, match="identify_from_arrays: unknown setting 'sdp_prior'; expected one of controller, "
-                                          "estimators, friction, preprocessing, rng"):
+    with pytest.raises(ConfigError, match="identify_from_arrays: unknown setting 'sdp_prior'; expected one of choice, "
+                                          "controller, estimators, friction, preprocessing, rng, torque_sensor"):
         identify_from_arrays(robot, log.t, log.q, log.tau, sdp_prior="geometric")
 
     class Mine(Estimator):

@@ -3,9 +3,13 @@ parameters back from the attributes of the same names, ``set_params`` sets them 
 
 from __future__ import annotations
 
+import functools
 import inspect
+import math
+import numbers
 from typing import Self
 
+from ..exceptions import ConfigError
 from .reprs import short_value
 
 
@@ -17,6 +21,47 @@ class HyperParameters:
     """
 
     PARAMETER_KINDS = frozenset({inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY})
+
+    CONSTRAINTS: dict[str, tuple[str, float | None, float | None]] = {}
+    """Name -> ``(kind, low, high)`` (scikit-learn's ``_parameter_constraints``): ``"int"`` an integer (not a bool, not a
+    float like 6.0), ``"real"`` a finite number, within ``[low, high]`` (None: unbounded). Checked where the object is
+    built and by :meth:`set_params`; a parameter whose default is None may be None."""
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is None:
+            return
+
+        @functools.wraps(init)
+        def checked(self, *args, **kw):
+            init(self, *args, **kw)
+            self.check_params()
+
+        cls.__init__ = checked  # type: ignore[method-assign]
+
+    def check_params(self) -> None:
+        """Refuse a parameter outside :attr:`CONSTRAINTS` in one line naming the class, the parameter and what was
+        expected.
+
+        Raises
+        ------
+        ConfigError
+            ``field`` the parameter's name.
+        """
+        defaults = {p.name: p.default for p in inspect.signature(type(self).__init__).parameters.values()}
+        for name, (kind, low, high) in self.CONSTRAINTS.items():
+            if not hasattr(self, name) or (getattr(self, name) is None and defaults.get(name) is None):
+                continue
+            value = getattr(self, name)
+            number = isinstance(value, numbers.Real) and not isinstance(value, bool)
+            ok = number and (isinstance(value, numbers.Integral) if kind == "int" else math.isfinite(value))
+            if ok and (low is None or value >= low) and (high is None or value <= high):
+                continue
+            what = "an integer" if kind == "int" else "a finite number"
+            span = (f" from {low:g} to {high:g}" if low is not None and high is not None else
+                    f" of at least {low:g}" if low is not None else f" of at most {high:g}" if high is not None else "")
+            raise ConfigError(f"{type(self).__name__}: {name}: expected {what}{span}, got {value!r}", field=name)
 
     def get_params(self, deep: bool = True) -> dict:
         """The constructor's parameters and their values.
@@ -56,6 +101,7 @@ class HyperParameters:
             if name not in known:
                 raise ValueError(f"{type(self).__name__} has no parameter {name!r}; expected one of {sorted(known)}")
             setattr(self, name, value)
+        self.check_params()
         return self
 
     def __repr__(self) -> str:

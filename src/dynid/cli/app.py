@@ -5,6 +5,7 @@ Exit codes: 0 success, 1 user or data error (one-line message), 2 usage error.
 
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -358,6 +359,9 @@ def _check_targets(targets: list) -> None:
     for flag, path in targets:
         if path.is_dir():
             raise DataError(f"{flag} {path}: a folder; give the name of the file to write")
+        if path.exists() and not path.is_file():  # /dev/null as root would be replaced by a regular file
+            raise DataError(f"{flag} {path}: not a regular file (a device, a FIFO or a socket): give the name of a "
+                            "file to write")
         if not path.parent.is_dir():
             raise DataError(f"{flag} {path}: its folder does not exist")
         if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
@@ -422,7 +426,6 @@ def export(
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
         from ..io.export import nominal_warning, verdict_warnings
-        from ..report.summaries import stem_words
 
         for line in verdict_warnings(computed[3]):
             rep.warning(line)
@@ -431,27 +434,12 @@ def export(
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
-        for path, (form, check) in computed[4].items():
-            if isinstance(check, str):
-                rep.line(f"{path.name} not read back: {check}")
-                continue
-            tool = "Pinocchio" if form == "URDF" else "MuJoCo (mj_inverse)"
-            where = (f"the {check.n_states} samples of {computed[6]}" if computed[6] else
-                     f"{check.n_states} random states within the joint limits")
-            said = (f"{path.name} read back by {tool}: its torques equal dynid's model to {check.relative_error:.1e} "
-                    f"of their RMS ({where})")
-            if form == "MJCF" and check.frictionloss_gap:
-                said += (f"; MuJoCo's frictionloss is a constraint: its force there is {100 * check.frictionloss_gap:.3g} % "
-                         "off frictionloss·sign(q̇)")
-            if check.missing:
-                j = max(range(len(check.missing_share)), key=lambda k: check.missing_share[k])
-                said += (f"; what {form} cannot hold ({', '.join(stem_words(k) for k in check.missing)}) is up to "
-                         f"{check.missing_share[j]:.3g} % of J{j + 1}'s RMS torque there: add it to the torques as the "
-                         "file's comments say")
-            if check.file_vs_measured is not None:
-                said += (f"; against the log's unfiltered measured torques the file is {check.file_vs_measured:.3g} % off, "
-                         f"dynid's whole model {check.model_vs_measured:.3g} %")
-            (rep.warning if check.relative_error > 1e-6 else rep.line)(said)
+        from ..report.identification_run import read_back_entry
+        from ..report.summaries import taken_away_lines
+
+        files = [read_back_entry(path.name, form, check) for path, (form, check) in computed[4].items()]
+        for line in taken_away_lines({"log": computed[6], "files": files}):
+            (rep.warning if line.kind == "warning" else rep.line)(line.text)
         if simulated is not None:
             rep.line(simulated)
 
@@ -613,7 +601,7 @@ def validate(
         return save_validation(validated[0], out, validated[1])
 
     def show(rep, validated, paths):
-        from ..identification.run import YARDSTICK
+        from ..identification.evidence import YARDSTICK
         from ..report.summaries import validation_blocks
         from ..tables import Line
 
@@ -777,6 +765,8 @@ def init(
 
     def prepare():
         args.update(xacro_arguments(xacro_arg or []))  # a malformed one is refused in one line, as every mistake here
+        if rate is not None and not (math.isfinite(rate) and rate > 0):
+            raise DynIdError(f"--rate: expected the logs' sample rate, a positive number of Hz, got {rate:g}")
         check_target(out, force)
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")

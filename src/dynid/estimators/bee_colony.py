@@ -28,6 +28,8 @@ class BeeColonyEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per iteration), n_evaluations_, result_.
     """
 
+    CONSTRAINTS = {"colony_size": ("int", 2, 100_000), "limit": ("int", 1, None), "maxiter": ("int", 1, 1_000_000)}
+
     def __init__(self, *, colony_size: int = 30, limit: int = 15,
                  maxiter: int = 50, rng=None, callback: Callable[[int, float], None] | None = None):
         self.colony_size = colony_size

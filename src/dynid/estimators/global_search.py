@@ -40,6 +40,8 @@ class DifferentialEvolutionEstimator(BoxSearchEstimator):
     params_, objective_ (eq. 9), history_ (best objective per generation), n_evaluations_, result_.
     """
 
+    CONSTRAINTS = {"popsize": ("int", 1, 10_000), "maxiter": ("int", 1, 1_000_000), "tol": ("real", 0.0, None)}
+
     def __init__(self, *, popsize: int = 15, maxiter: int = 1000, tol: float = 1e-8,
                  polish: bool = False, rng=None, callback: Callable[[int, float], None] | None = None):
         self.popsize = popsize
@@ -93,6 +95,8 @@ class ParticleSwarmEstimator(BoxSearchEstimator):
     ----------
     params_, objective_ (eq. 9), history_, n_evaluations_, result_.
     """
+
+    CONSTRAINTS = {"swarm_size": ("int", 2, 100_000), "maxiter": ("int", 1, 1_000_000)}
 
     def __init__(self, *, swarm_size: int = 30, maxiter: int = 50, rng=None,
                  callback: Callable[[int, float], None] | None = None):

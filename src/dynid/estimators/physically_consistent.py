@@ -88,6 +88,8 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
     """The values each hyper-parameter may take, checked where a config gives them
     (:func:`dynid.estimators.registry.configured_estimator`)."""
 
+    CONSTRAINTS = {"prior_weight": ("real", 0.0, None), "epsilon": ("real", 0.0, None)}
+
     def __init__(self, *, prior_weight: float = 1e-6, epsilon: float = 0.0, prior_kind: str = PRIOR_KIND):
         self.prior_kind = prior_kind
         self.prior_weight = prior_weight

@@ -54,6 +54,8 @@ class IterativelyReweightedLeastSquares(Estimator):
 
     PROBLEM_FIELDS = ("n_dof",)
 
+    CONSTRAINTS = {"tuning": ("real", 1e-12, None), "max_iter": ("int", 1, 1_000_000), "tol": ("real", 0.0, None)}
+
     def __init__(self, *, tuning: float = HUBER_C, max_iter: int = 50, tol: float = 1e-8):
         self.tuning = tuning
         self.max_iter = max_iter

@@ -613,8 +613,8 @@ class IdentifiedModel:
         estimates = stored_estimates(results, base.names, source, robot.name)
         std = {}
         for key, e in (results.get("estimates") or {}).items():
-            if isinstance(e, dict) and isinstance(e.get("std"), dict):
-                std[str(key)] = np.array([float(e["std"].get(n, np.nan)) for n in base.names])
+            if isinstance(e, dict) and isinstance(e.get("std"), dict):  # a σ written as null is not known: NaN
+                std[str(key)] = np.array([np.nan if e["std"].get(n) is None else float(e["std"][n]) for n in base.names])
         stated = results.get("main_estimate")
         main = str(stated) if stated in estimates else next(iter(estimates))
         return cls(robot, base, estimates, std, main, stored_preprocessing(results), results)

@@ -8,6 +8,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from ..exceptions import DataError
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -25,8 +27,15 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     ----------
     path : str or Path
     data : bytes
+
+    Raises
+    ------
+    DataError
+        ``path`` exists and is not a regular file (a device such as /dev/null, a FIFO, a socket): it is never replaced.
     """
     path = Path(path)
+    if path.exists() and not path.is_file():
+        raise DataError(f"{path}: not a regular file (a device, a FIFO or a socket): give the name of a file to write")
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:

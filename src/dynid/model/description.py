@@ -178,7 +178,10 @@ def parse_angle(value, where: str) -> float:
             sign = -1.0 if m.group(1) == "-" else 1.0
             num = float(m.group(2)) if m.group(2) not in ("", ".") else 1.0
             den = float(m.group(3)) if m.group(3) else 1.0
-            return sign * num * np.pi / den
+            angle = sign * num * np.pi / den if den != 0 else np.inf
+            if np.isfinite(angle):
+                return angle
+            raise ConfigError(f"{where}: expected a finite angle like 'pi/2', got {value!r}")
     raise ConfigError(f"{where}: expected a number or an angle like 'pi/2', got {value!r}")
 
 
@@ -374,9 +377,10 @@ def _drives(d, rows, where: list[str], terms: tuple[str, ...], *, urdf: tuple, s
     offsets = np.array([parse_angle(_or(r.position_offset, 0.0), f"{w}.position_offset") for r, w in zip(rows, where)])
     transmission = _transmission(d.transmission, len(rows), offsets, source)
     gains = np.array([float(_or(r.drive_gain, 1.0)) for r in rows])
-    if np.any(gains <= 0):
-        i = int(np.argmax(gains <= 0))
-        raise ConfigError(f"{where[i]}.drive_gain: expected a positive gain (N·m/A), got {gains[i]}")
+    bad = ~(np.isfinite(gains) & (gains > 0))  # NaN compares false: a NaN gain passed and gave "model ready"
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise ConfigError(f"{where[i]}.drive_gain: expected a finite, positive gain (N·m/A), got {gains[i]}")
     return terms, mask, drive, gains, transmission, stated
 
 

@@ -249,6 +249,10 @@ class Robot:
             raise ConfigError(f"robot {self.name!r}: expected drive parameters of shape ({n}, {len(self.drive_terms)}), got {self.drive.shape}")
         if np.any(self.drive[~mask] != 0):
             raise ConfigError(f"robot {self.name!r}: a drive term a joint does not have must have the value 0")
+        gains = np.asarray(self.drive_gains, dtype=float)
+        if gains.shape != (n,) or not np.all(np.isfinite(gains)) or np.any(gains == 0):  # a robot built by the API
+            raise ConfigError(f"robot {self.name!r}: drive_gains: expected {n} finite, non-zero gains (N·m per A), "
+                              f"got {np.asarray(self.drive_gains).tolist()}", field="drive_gains")
         for a in (self.gravity, self.inertial, self.drive, self.drive_gains, self.tool_rotation, self.tool_translation, mask, vs, vst):
             a.setflags(write=False)
 

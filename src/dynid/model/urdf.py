@@ -30,6 +30,14 @@ _INERTIAL_VALUES = {"mass": ("value",), "inertia": ("ixx", "ixy", "ixz", "iyy", 
 a massless link)."""
 
 
+
+def _said(value, quote: str = "'") -> str:
+    """A value read from a file, for a message: quoted, and cut at 40 characters (a value expanded from a xacro
+    file may be a whole file's text)."""
+    text = str(value)
+    return quote + (text if len(text) <= 40 else text[:37] + "...") + quote
+
+
 def check_urdf_text(path: Path, held=()) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
@@ -63,12 +71,12 @@ def check_urdf_text(path: Path, held=()) -> None:
                 except ValueError:
                     finite = False
                 if not finite:
-                    problems.append(f"line {parser.CurrentLineNumber}: link {link[0]!r}: <{name} {key}=\"{text}\">, "
+                    problems.append(f"line {parser.CurrentLineNumber}: link {_said(link[0])}: <{name} {key}={_said(text, chr(34))}>, "
                                     "expected finite numbers (a link's inertial values are read, never guessed)")
         if name == "joint" and "type" in attrs:
             joint[:] = [attrs.get("name", "?"), attrs["type"]]
             if attrs["type"] not in URDF_JOINT_TYPES:
-                problems.append(f"line {parser.CurrentLineNumber}: joint {attrs.get('name', '?')!r} has type {attrs['type']!r}, "
+                problems.append(f"line {parser.CurrentLineNumber}: joint {_said(attrs.get('name', '?'))} has type {_said(attrs['type'])}, "
                                 f"expected one of {', '.join(URDF_JOINT_TYPES)}")
         elif name == "axis" and joint and joint[1] in ("revolute", "continuous", "prismatic"):
             try:
@@ -76,7 +84,7 @@ def check_urdf_text(path: Path, held=()) -> None:
             except ValueError:
                 xyz = []
             if len(xyz) != 3 or not all(np.isfinite(xyz)) or float(np.linalg.norm(xyz)) < 1e-9:
-                problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} has axis xyz=\"{attrs.get('xyz')}\", "
+                problems.append(f"line {parser.CurrentLineNumber}: joint {_said(joint[0])} has axis xyz={_said(attrs.get('xyz'), chr(34))}, "
                                 "expected three numbers not all zero (the direction it turns about)")
         elif name == "mimic" and joint and joint[1] != "fixed" and joint[0] not in held:
             both = ", ".join(f'"{n}"' for n in dict.fromkeys([attrs.get("joint", "?"), joint[0]]))

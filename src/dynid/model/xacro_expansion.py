@@ -43,6 +43,20 @@ __all__ = ["MAX_DEPTH", "MAX_ELEMENTS", "XacroExpansion", "expand_xacro_text"]
 
 MAX_DEPTH = 200
 """Macro calls and includes nested deeper than this refuse the file (a macro or a file that calls itself)."""
+
+LARGEST_FILE = 64 * 2**20
+"""[bytes] A file a xacro description includes or loads as YAML: larger ones are refused (a robot description's
+files are kilobytes; a 2 GB file or /dev/zero would fill the memory)."""
+
+
+def _regular(path: str, what: str) -> None:
+    """Refuse what is not a regular file of at most :data:`LARGEST_FILE` bytes: a FIFO blocks its reader forever, a
+    device never ends."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        raise XacroError(f"{what}: {path} is not a regular file (a device, a FIFO or a socket)")
+    if os.path.isfile(path) and os.path.getsize(path) > LARGEST_FILE:
+        raise XacroError(f"{what}: {path} is {os.path.getsize(path) / 2**20:.0f} MiB, more than a robot description "
+                         f"reads ({LARGEST_FILE // 2**20} MiB)")
 MAX_ELEMENTS = 50_000
 """Elements one expansion may make (a URDF of a robot arm has a few hundred, with its ROS 2 control and Gazebo tags a
 few thousand)."""
@@ -254,6 +268,7 @@ class XacroExpansion:
         self.arguments = {str(k): _argument_text(v) for k, v in (arguments or {}).items()}
         self.files: list[str] = []
         self.read: list[str] = []
+        self.found: list[Path] = []
         self.depth = 0
         self.made = 0
         self.symbols, self.allowed = self._globals()
@@ -300,6 +315,8 @@ class XacroExpansion:
             Loader.add_constructor(tag, lambda loader, node, f=factor: f * float(
                 evaluate(loader.construct_scalar(node), self.symbols, self.allowed, where)))
         self.read.append(path)
+        self._beside_description(path, "xacro.load_yaml")
+        _regular(path, "xacro.load_yaml")
         with open(path, encoding="utf-8") as stream:
             loader = Loader(stream)  # safe_load's own steps, with the subclass: data only
             try:
@@ -307,8 +324,20 @@ class XacroExpansion:
             finally:
                 loader.dispose()
 
+    def _beside_description(self, path: str, what: str) -> None:
+        """Refuse a data file outside the description's folders: the top file's folder and its package (the nearest
+        folder above it with a package.xml), and the packages ``$(find)`` found. A YAML file's values end up in the
+        robot file and in messages: ``load_yaml('/etc/passwd')`` put that file into one."""
+        top = Path(self.files[0]).resolve().parent if self.files else Path.cwd()
+        package = next((f for f in (top, *top.parents) if (f / "package.xml").is_file()), top)
+        target = Path(path).resolve()
+        if not any(target.is_relative_to(root) for root in (top, package, *self.found)):
+            raise XacroError(f"{what}: {path} is outside the robot description's folders ({package}, and the packages "
+                             "$(find) names): dynid reads only files beside the description")
+
     def _parse(self, path: str):
         """A file's XML (minidom; expat resolves no external entity)."""
+        _regular(path, "xacro")
         try:
             with open(path, "rb") as stream:
                 return xml.dom.minidom.parse(stream)
@@ -434,6 +463,7 @@ class XacroExpansion:
         ament = [Path(p) / "share" / package for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         for folder in (*around, *listed, *ament):
             if folder.name == package and (folder / "package.xml").is_file():
+                self.found.append(folder.resolve())  # a package whose files the description may read
                 return str(folder)
         raise XacroError(f"$(find {package}) names a ROS package dynid cannot find (no folder {package} with a "
                          "package.xml beside the file, on ROS_PACKAGE_PATH or AMENT_PREFIX_PATH): set "

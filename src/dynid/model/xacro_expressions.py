@@ -48,7 +48,8 @@ ALLOWED_METHODS = {
 }
 """Methods an expression may call on a value of each type (never ``format``, which reaches attributes itself)."""
 
-_LARGEST = 10_000_000  # elements or characters one operation may make, and the largest integer exponent's bits
+_LARGEST = 10_000_000  # elements or characters one operation may make, and the largest integer power's bits
+_STEPS = 1_000_000  # the steps of an expression's comprehensions, all loops counted (a few seconds of this interpreter)
 _BINARY: dict[type, Callable[[Any, Any], Any]] = {
     ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
     ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: operator.pow, ast.BitAnd: operator.and_,
@@ -74,6 +75,7 @@ class _Interpreter:
     def __init__(self, symbols, allowed: Mapping[int, str]):
         self.symbols, self.allowed = symbols, allowed
         self.scopes: list[dict[str, Any]] = []
+        self.steps = 0
 
     def value(self, v: Any) -> Any:
         """Every value an expression makes passes here: a callable outside the allow-list is refused at once, so it
@@ -172,9 +174,9 @@ class _Interpreter:
         op = type(node.op)
         if op not in _BINARY:
             raise _Refused(f"the operator {op.__name__}")
-        if op is ast.Pow and isinstance(left, int) and isinstance(right, int) and abs(right) > 64 and \
-                abs(right) * max(abs(left), 2).bit_length() > _LARGEST:
-            raise _Refused(f"the power {left}**{right}")
+        if op is ast.Pow and isinstance(left, int) and isinstance(right, int) and abs(left) > 1 and \
+                abs(right) * abs(left).bit_length() > _LARGEST:  # the result's bits, whatever the exponent
+            raise _Refused(f"the power {_digits(left)}**{_digits(right)}")
         if op is ast.LShift and isinstance(right, int) and right > _LARGEST:
             raise _Refused(f"the shift by {right}")
         if op is ast.Mult:
@@ -239,6 +241,9 @@ class _Interpreter:
         if first.is_async:
             raise _Refused("an async comprehension")
         for item in self._bounded(list(self.run(first.iter))):
+            self.steps += 1
+            if self.steps > _STEPS:  # nested loops multiply: each is bounded, their product is not
+                raise _Refused(f"a comprehension of more than {_STEPS:,} steps")
             self._bind(first.target, item)
             if not all(self.run(cond) for cond in first.ifs):
                 continue
@@ -282,6 +287,11 @@ class _Interpreter:
 
     def _DictComp(self, node: ast.DictComp) -> dict:
         return dict(self._collect(node))
+
+
+def _digits(n: int) -> str:
+    """An integer for a message: its digits, or how many it has."""
+    return str(n) if n.bit_length() < 64 else f"<an integer of {n.bit_length()} bits>"
 
 
 def _short(text: str) -> str:
