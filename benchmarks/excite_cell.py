@@ -168,10 +168,15 @@ def _start(robot) -> np.ndarray:
 
 
 def _cell(robot, geometry=None) -> Workspace:
-    """A table at the base's height and a box of a fifth of the reach, half the reach from the base, off the start."""
+    """A table under the base (where its collision shapes end, or at the base frame's origin) and a box of a fifth of the
+    reach, half the reach from the base, a quarter of the reach above the table, off the start."""
     reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
     q0 = _start(robot)
-    base_z = float(forward_kinematics(robot, np.zeros((1, robot.n_dof)))[1][0, 0, 2])
+    base_z = 0.0  # the table: the base frame's origin, or the bottom of the base's own collision shapes
+    if geometry is not None and np.any(geometry.link < 0):
+        from dynid.excitation.floor import lowest_points
+
+        base_z = float(lowest_points(robot, np.zeros((1, robot.n_dof)), geometry, np.flatnonzero(geometry.link < 0))[..., 2].min())
     for angle in np.linspace(0, 2 * np.pi, 12, endpoint=False):
         centre = np.array([0.5 * reach * np.cos(angle), 0.5 * reach * np.sin(angle), base_z + 0.25 * reach])
         box = Obstacle("box", np.full(3, 0.2 * reach), centre, name="box")

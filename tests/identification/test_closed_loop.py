@@ -54,7 +54,7 @@ def test_iv_and_didim_remove_the_closed_loop_bias_of_least_squares(er16):
     of it. Least squares here is even too biased to be simulated: both start from the description and say so.
     IDIM-IV's intervals cover the truth. DIDIM's cover it but for its friction pairs: at this noise the loop's velocity
     jitter smooths the Coulomb friction, which the model has as a sign, and DIDIM's fc and fv carry that bias (2.8-3.5
-    σ here; 64 % coverage over 40 realisations of the study, benchmarks/README.md), which no σ of the estimate can
+    σ here; 64 % coverage over 40 realisations of the study, benchmarks/NOTEBOOK.md), which no σ of the estimate can
     cover. Their σ was 3x too wide before the Parzen window and hid it. The commands are held over the control
     period: the torques are given their half-period lead, as the study gives them."""
     robot, base, t, experiment, truth = er16

@@ -133,7 +133,7 @@ def _with_dynamics(joint: str, damping: str, friction: str) -> str:
 
 def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_path):
     """A URDF joint's <dynamics> damping and friction are named in one line (joint, value) and left out of the nominal
-    friction, which stays 0 (vendor files hold simulator settings there: benchmarks/README.md), with the way to take
+    friction, which stays 0 (vendor files hold simulator settings there: benchmarks/NOTEBOOK.md), with the way to take
     them; a [[joints]] table's fv or fc is the nominal value and silences the line for that term; a URDF stating only
     zeros (most vendor files) says nothing."""
     from dynid.model.description import URDF_DYNAMICS_NOTE

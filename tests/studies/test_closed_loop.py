@@ -81,7 +81,7 @@ def test_didim_holds_the_truth_with_30_hz_cutoffs_at_the_highest_encoder_noise()
     hold the truth in 92-99 % of the (realisation, parameter) pairs over 12 realisations, and its median |bias| is below
     0.1 %. The rows where the simulated joint is slower than min_speed fit nothing, as the measured ones do not;
     before, the loop's velocity jitter near reversals, which the noise-free simulation lacks, pulled fc 1 % low and
-    fv 1 % high: 88.9 % and 0.126 % here (87 % over 40 realisations, benchmarks/README.md)."""
+    fv 1 % high: 88.9 % and 0.126 % here (87 % over 40 realisations, benchmarks/NOTEBOOK.md)."""
     cfg = ClosedLoopStudyConfig(encoder_noise=(1e-2,), torque_noise=(0.1,), realisations=12, estimators=("didim",),
                                 band=3.0)
     stats = run_closed_loop_study(cfg, workers=2).statistics()["didim"]

@@ -195,7 +195,7 @@ def test_the_line_on_the_search_box_names_the_searches_that_ran():
 
 def test_the_papers_figure_beside_the_abc_says_it_is_one_draw_of_a_stochastic_search():
     """On seed 0 the ABC at the paper's budget gives ρ on β2 0.9311 beside the paper's 0.9471, though 9 of 10 seeds
-    reach it (benchmarks/README.md): the line says the figure is one draw, which seed, and how to draw others."""
+    reach it (benchmarks/NOTEBOOK.md): the line says the figure is one draw, which seed, and how to draw others."""
     from dynid.report.paper_summary import _verdict
 
     abc = {"parameter_error_norm_percent": 61.8, "correlation": {"validation": [0.8682, 0.9834, 0.9417]},

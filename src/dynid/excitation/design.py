@@ -448,12 +448,12 @@ SHARPNESS = 1000.0
 keeps at or above zero, one row per design-grid sample in place of a row per pair (75 pairs on the Panda): it lies at
 most ``log(pairs) / ρ`` below the smallest distance (4.3 mm for the Panda's 75 pairs, where every pair is equally near),
 so the design is never less safe for it. The cell's bodies keep a row per pair: they are few, and where a body binds,
-its soft minimum took the optimiser more iterations (benchmarks/README.md)."""
+its soft minimum took the optimiser more iterations (benchmarks/NOTEBOOK.md)."""
 
 CAPSULE_WINDOW = 10
 """Design-grid samples whose capsules' distances (``avoid_self_collision`` without collision shapes) one constraint row
 holds: their soft minimum over the samples and the pairs, a lower bound of each, so every sample is held as with a
-row per sample. Measured on the shipped configs (benchmarks/README.md, stop 86): with a row per sample the TX40's
+row per sample. Measured on the shipped configs (benchmarks/NOTEBOOK.md, stop 86): with a row per sample the TX40's
 design ended infeasible from 3 of its 4 starts at cond(W_base) 1.14× the design without the constraint; with rows of
 10 samples from 1, at 1.03×."""
 

@@ -8,7 +8,7 @@ than the description on five of six (5.5-22.2 % against 3.4-4.5 %), the descript
 fitted better than both (2.1-3.5 %), and on the sixth better than the full estimate (1.68 % against 1.78 %).
 Nothing in the identification log alone says which of the two predicts other motions better (a blocked
 cross-validation, a stronger prior and an F test of the restriction were measured and rejected:
-benchmarks/README.md), so :func:`dynid.identification.run.run_identification` scores this estimate beside the others
+benchmarks/NOTEBOOK.md), so :func:`dynid.identification.run.run_identification` scores this estimate beside the others
 on the validation logs and makes it the main one where the identified rigid body is doubtful there (the nominal model
 predicts them better, or the least-squares estimate extrapolates) and this one predicts them better than the main
 estimate does.
@@ -170,13 +170,13 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     min ≥ |x|, the spread read as a σ of 100 % or more, the threshold at which dynid calls a parameter not
     determined) is not determined by the log, whatever its covariance says. A joint that crawls one way barely
     accelerates, so its rotor inertia (and the split of its Coulomb friction and offset) is set by the filters' shaping
-    of a tiny acceleration, not by the robot: on the zoo's 5 s logs (benchmarks/README.md) a shoulder's rotor inertia
+    of a tiny acceleration, not by the robot: on the zoo's 5 s logs (benchmarks/NOTEBOOK.md) a shoulder's rotor inertia
     fitted outside dynid with the TRUE links came out at 0.48, 0.18 and -0.23 kg·m² at 5, 10 and 20 Hz (truth 0.025,
     covariance σ 0.04). Such a term is held at the description's value where the description gives one; a one-way
     joint's unstable Coulomb friction or offset holds the offset at the description's value, so that their sum stays
     Coulomb friction; any other keeps the log's value and is said (:attr:`DriveOnly.undetermined`): a description
     without the term (a URDF has no rotor inertia) is no knowledge of it, and holding such terms at 0 made the zoo's
-    short logs better in 14 cells and worse in 9 (benchmarks/README.md). A term the description states with a σ
+    short logs better in 14 cells and worse in 9 (benchmarks/NOTEBOOK.md). A term the description states with a σ
     (``Ia = { value = 0.3, sigma = 0.05 }``, :attr:`Robot.prior_sigma`) is pulled toward its value with that Gaussian
     prior (:meth:`LeastSquaresAccumulator.solve_affine`'s ``gaussian``).
 

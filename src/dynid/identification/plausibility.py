@@ -5,7 +5,7 @@ or where the model misses what the term takes up. The physically consistent esti
 that has one is said, with the figure.
 
 A rotor inertia "larger than the links' own inertia about the axis" is not judged: measured on the real logs of
-``configs/`` (benchmarks/README.md), the physically consistent estimates' wrist rotor inertias are 32-1954× the links'
+``configs/`` (benchmarks/NOTEBOOK.md), the physically consistent estimates' wrist rotor inertias are 32-1954× the links'
 inertia about those axes (UR10e J5 and J6, TX40 J5, KR 300 J6), as a drive behind a gear ratio of 100 has
 (``Ia = J_m·N²``): no ratio separates those from an implausible one. A joint torque sensor's log, which holds no rotor
 inertia, is said by the config instead (``torques = { ..., sensor = "joint" }``).

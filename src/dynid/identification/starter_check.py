@@ -30,7 +30,7 @@ way round)."""
 
 CHECKED_SECONDS = 300.0
 """The stretch of a log the check identifies [s], from its first sample: fitting the whole of an hour-long log at 1 kHz
-made init take 46.8 s, this stretch 8.5 s (benchmarks/README.md); every real log dynid ships configs for is shorter."""
+made init take 46.8 s, this stretch 8.5 s (benchmarks/NOTEBOOK.md); every real log dynid ships configs for is shorter."""
 
 
 def _findings(text: str, path: Path) -> tuple[tuple, int]:
