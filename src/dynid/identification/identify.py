@@ -541,7 +541,7 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     misfit = None if floor is None else (np.min([m["rmse"] for m in fit.metrics().values()], axis=0)
                                          > SCALE_MISFIT * np.asarray(floor["rmse"]))
     unlike = unlike_nominal_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name, q=data.q, dq=data.dq,
-                                     tau=data.tau)
+                                     tau=data.tau, explained=bool(geometry))
     if unlike:  # not torques: no sign, scale or geometry of them can be judged
         return unlike
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,

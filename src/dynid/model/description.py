@@ -287,8 +287,11 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     d: Any = convert(doc, robot_table, source)
     name = d.name if d.name is not None else Path(source).stem
     convention = d.convention or ("urdf" if d.urdf is not None else "modified")
+    # a description read from a URDF fits what the URDF alone (robot = "arm.urdf") fits: moving it into a [robot]
+    # table (to hold a gripper, give gains) dropped the rotor inertia and the offset in silence
+    default = URDF_DRIVE_TERMS if convention == "urdf" else DEFAULT_DRIVE_TERMS
     try:
-        terms = check_terms(d.drive_terms if d.drive_terms is not None else DEFAULT_DRIVE_TERMS, f"{source}: drive_terms")
+        terms = check_terms(d.drive_terms if d.drive_terms is not None else default, f"{source}: drive_terms")
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     urdf_model = None

@@ -109,7 +109,7 @@ def _types(terms: tuple[str, ...]) -> tuple[type, type]:
                         "is given as its text, true/false; an argument not given takes the file's default)")], None],
          None),
         ("gravity", Annotated[Vector3, Meta(description="m/s², base frame")], msgspec.field(default_factory=lambda: [0.0, 0.0, -9.81])),
-        ("drive_terms", Union[Annotated[list[str], Meta(description="drive/friction terms of every joint, e.g. [\"Ia\", \"fv\", \"fc\", \"off\"]")], None], None),
+        ("drive_terms", Union[Annotated[list[str], Meta(description="drive/friction terms of every joint, e.g. [\"Ia\", \"fv\", \"fc\", \"off\"] (default: Ia, fc, fv, offset from a URDF or MJCF; fc, fv for a DH table)")], None], None),
         ("notes", Annotated[str, Meta(description="where the values come from")], ""),
         ("tool", Annotated[ToolTable, Meta(description="the flange in the last link's frame")], msgspec.field(default_factory=ToolTable)),
         ("transmission", Annotated[TransmissionTable, Meta(description="gear ratios and coupled motors")],

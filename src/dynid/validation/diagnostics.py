@@ -224,7 +224,7 @@ class ResidualSums:
 
 UNLIKE_NOMINAL = 0.5
 """A log whose measured torque correlates with the description's nominal model below this on every joint that varies
-(beyond friction where that is known) is not read as torques. On the real logs of ../shared/data the largest of
+(beyond friction where that is known; either sign: a flipped sign is another finding's) is not read as torques. On the real logs of ../shared/data the largest of
 these correlations is 0.96-1.0 (the KR 300, the TX40, the UR10e; the LBR Med7's plain correlation 1.0); the UR10e
 example's log with its joint velocities read as torques reaches 0.06."""
 
@@ -233,7 +233,8 @@ LIKE_A_STATE = 0.995
 
 
 def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, *, q: np.ndarray,
-                            dq: np.ndarray, tau: np.ndarray, table: str = "[identification]") -> list[Finding]:
+                            dq: np.ndarray, tau: np.ndarray, table: str = "[identification]",
+                            explained: bool = False) -> list[Finding]:
     """Torques that are not torques: the measured torque follows the description's nominal model on no joint that
     varies (:data:`UNLIKE_NOMINAL`), so no scale, sign or order of the columns can be judged and a fit of another
     signal (a log's velocities read as torques fit to 0.0007 % by the viscous terms) would look perfect; or every
@@ -251,6 +252,9 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
         The log's positions [rad], velocities [rad/s] and torques [N·m], as prepared.
     table : str
         The config table whose columns to check.
+    explained : bool
+        Another check explains why the torques do not follow the nominal model (the log's geometry: gravity along
+        another axis, a joint's zero): only columns that equal a state are then said.
 
     Returns
     -------
@@ -267,15 +271,15 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
             if np.std(values) > 0 and np.std(tau[:, j]) > 0 and np.corrcoef(values, tau[:, j])[0, 1] >= LIKE_A_STATE:
                 named.append(f"J{j + 1}'s is its {signal}")
                 break
-    best = max(rho[j] for j in judged)
-    if best >= UNLIKE_NOMINAL and len(named) < len(judged):  # a torque column of each joint equal to a state: not
-        return []                                            # torques, whatever gravity's shape makes them look like
+    best = max(abs(rho[j]) for j in judged)  # a torque whose sign is flipped follows the model all the same
+    if (best >= UNLIKE_NOMINAL or explained) and len(named) < len(judged):  # a torque column of each joint equal to
+        return []                                   # a state: not torques, whatever gravity's shape makes them look like
     which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
     return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
                                f"largest correlation with them {best:.2f}, where a log of the robot's torques reaches "
                                f"0.96-1.0){which}: these columns are not read as the robot's torques; check the torques "
                                f"(or currents) columns of {table} and the robot file before trusting any fit of them")
-            if best < UNLIKE_NOMINAL else
+            if best < UNLIKE_NOMINAL and len(named) < len(judged) else
             Finding("columns", f"{dataset}: every joint's measured torque equals one of its states ({', '.join(named)}): "
                                f"these columns are not read as the robot's torques; check the torques (or currents) "
                                f"columns of {table}")]
