@@ -20,6 +20,7 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import regressor
 from ..estimators.registry import label
 from ..exceptions import ConfigError, DataError
+from ..io.datasets import recording_from_arrays
 from ..io.export import mjcf_from_results, urdf_from_results
 from ..io.files import _clean, write_json
 from ..io.results import check_fingerprint, read_results, stored_estimates, stored_residual_level
@@ -346,7 +347,6 @@ class IdentifiedModel:
             return self.predict_states(t, q, dq, estimate=estimate)
         if q is None:
             raise ValueError("predict(t, q): the positions are needed with the time stamps (or give a log)")
-        from .run import recording_from_arrays
 
         q = np.asarray(q, dtype=float)
         times = np.asarray(t, dtype=float).reshape(-1)
@@ -517,7 +517,6 @@ class IdentifiedModel:
             return t
         if q is None or tau is None:
             raise ValueError(f"{what}(t, q, tau): positions and measured torques are needed with the time stamps")
-        from .run import recording_from_arrays
 
         return recording_from_arrays(self.robot, t, q, tau, name=what)
 

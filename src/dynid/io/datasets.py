@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util.checks import check_trajectory_array
 from .._util.column_store import SPOOL_BYTES, StoredColumns
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
@@ -32,7 +33,10 @@ from .log_repairs import (
     _plausibility,
     _row_wise,
     check_clock_unit,
+    check_position_steps,
+    limit_warnings,
     logged_velocities,
+    position_ranges,
     resampled,
     uniform_rate,
     unwrapped_positions,
@@ -325,3 +329,102 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
                      robot.drive_gains.copy() if kind == "currents" else None)
 
 
+def given_recording(robot: Robot, t, q, tau, dq, name: str) -> Recording:
+    """A recording given as one (nothing beside it), or made of arrays (:func:`recording_from_arrays`).
+
+    Parameters
+    ----------
+    robot : Robot
+    t : (N,) array [s], or a Recording
+    q, tau, dq : (N, n_dof) arrays or None
+    name : str
+
+    Returns
+    -------
+    Recording
+
+    Raises
+    ------
+    ConfigError
+        Arrays beside a recording, or time stamps without positions and torques.
+    DataError
+        No joint's position ever changes.
+    """
+    if isinstance(t, Recording):
+        if not (q is None and tau is None and dq is None):
+            raise ConfigError(f"{t.name}: a recording holds its positions, velocities and torques: give it alone, "
+                              "or give the arrays t, q, tau")
+        return t
+    if q is None or tau is None:
+        raise ConfigError("positions q and torques tau are needed with the time stamps t (or give a recording, as "
+                          "dynid.load_recording reads one)")
+    recording = recording_from_arrays(robot, t, q, tau, dq, name)
+    if not np.any(np.ptp(recording.q, axis=0) > 0):  # to identify from (a pose's torques are predicted alright)
+        raise DataError(f"{name}: no joint's position ever changes: a robot at rest throughout, or the wrong array?")
+    return recording
+
+
+def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"):
+    """A recording of arrays, checked and on a uniform grid as the log readers give one.
+
+    Parameters
+    ----------
+    robot : Robot
+        Its number of joints is the arrays' width.
+    t : (N,) array [s]
+        Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step.
+    q : (N, n_dof) array [rad]
+        The description's angles (a log's plus the description's ``position_offset``: nothing is added here).
+    tau : (N, n_dof) array [N·m]
+    dq : (N, n_dof) array [rad/s], optional
+    name : str
+        The dataset's name in messages.
+
+    Returns
+    -------
+    dynid.io.datasets.Recording
+        Starting at t = 0; a warning when the time stamps were interpolated.
+
+    Raises
+    ------
+    ShapeError
+        Arrays of inconsistent shapes, not time-first, or not finite.
+    DataError
+        Time stamps that do not increase or are slower than any controller logs (another unit:
+        :func:`dynid.io.log_repairs.check_clock_unit`), a gap longer than 5 median steps, a position step no motion
+        makes (:func:`dynid.io.log_repairs.check_position_steps`), or positions beyond 4π rad (degrees:
+        :func:`dynid.io.log_repairs.position_ranges`, which also says the positions outside the joint limits).
+    """
+
+    t = np.asarray(t, dtype=float).reshape(-1)
+    q = check_trajectory_array(q, robot.n_dof, "q")
+    tau = check_trajectory_array(tau, robot.n_dof, "tau")
+    dq = None if dq is None else check_trajectory_array(dq, robot.n_dof, "dq")
+    if not (q.shape[0] == tau.shape[0] == t.shape[0] and (dq is None or dq.shape[0] == t.shape[0])):
+        raise ShapeError(f"expected t, q, tau (and dq) with the same number of samples, got {t.shape[0]}, {q.shape[0]}, {tau.shape[0]}")
+    steps = np.diff(t)
+    if t.size < 2 or not np.all(np.isfinite(t)) or np.any(steps <= 0):
+        raise DataError("t: expected finite, increasing time stamps")
+    median = float(np.median(steps))
+    check_clock_unit(median, "t", None)
+    if np.any(steps > GAP_FACTOR * median):
+        k = int(np.argmax(steps))
+        raise DataError(f"t: a gap of {steps[k]:.3g} s after {t[k] - t[0]:.3f} s (median step {median:.3g} s): give the parts "
+                        "on each side of it separately")
+    said: list[str] = []
+    q = unwrapped_positions(q, name, said)
+    check_position_steps(q, t - t[0], robot, name)
+    said += limit_warnings(robot, t - t[0], position_ranges(robot, t, q, name, degrees="numpy.radians(q)"), name,
+                           degrees="numpy.radians(q)")
+    dq = logged_velocities(q, dq, name, said)
+    warnings: tuple[str, ...] = tuple(said)
+    rate = uniform_rate(t)
+    if np.ptp(steps) > 1e-6 * median:
+        signals = {"q": q, "tau": tau, **({} if dq is None else {"dq": dq})}
+        t, signals = resampled(t, signals, rate)
+        q, tau, dq = signals["q"], signals["tau"], signals.get("dq")
+        warnings += (f"{name}: time stamps jitter by up to {np.ptp(steps) / median:.2g} median steps: interpolated "
+                     f"onto a uniform grid at {rate:.6g} Hz",)
+    else:
+        rate = 1.0 / median
+    return Recording(name, t - t[0], q, dq, tau, rate, warnings)
