@@ -222,6 +222,26 @@ def test_a_config_that_does_not_exist(tmp_path):
     assert_refused(invoke("identify", tmp_path / "nosuch.toml", "--out", tmp_path / "o"), "nosuch.toml", tmp_path / "o")
 
 
+def test_a_fifo_or_a_folder_given_as_a_log_is_said_as_such(ur):
+    """Round five: a FIFO given as a log was "not found" to identify and hung dynid init (its reader blocks); an empty
+    folder was called a ROS bag. Each is one line saying what the path is, before any read."""
+    from importlib import resources
+
+    cfg = ur(replace={'file = "log.csv"': 'file = "pipe.csv"'})
+    os.mkfifo(cfg.parent / "pipe.csv")
+    (cfg.parent / "empty").mkdir()
+    out = cfg.parent / "o"
+    assert_refused(invoke("identify", cfg, "--out", out), "pipe.csv: not a regular file (a device, a FIFO or a socket)", out)
+    cfg.write_text(cfg.read_text().replace('file = "pipe.csv"', 'file = "empty"'))
+    assert_refused(invoke("identify", cfg, "--out", out), "empty: not a regular file (a folder)", out)
+    urdf = resources.files("dynid.model") / "robots" / "ur10e.urdf"
+    target = cfg.parent / "arm.toml"
+    assert_refused(invoke("init", urdf, cfg.parent / "pipe.csv", "--out", target),
+                   "pipe.csv: not a regular file (a device, a FIFO or a socket)", target)
+    assert_refused(invoke("init", urdf, cfg.parent / "empty", "--out", target),
+                   "empty: a folder without metadata.yaml, not a ROS 2 bag", target)
+
+
 def test_a_config_in_utf16(ur):
     cfg = ur()
     cfg.write_text(cfg.read_text(), encoding="utf-16")

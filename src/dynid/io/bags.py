@@ -22,7 +22,8 @@ BAG_SUFFIXES = (".mcap", ".db3", ".bag")
 
 
 def is_bag(path: Path) -> bool:
-    """Whether a log is a ROS bag: a folder (a ROS 2 bag's), or a file of :data:`BAG_SUFFIXES`.
+    """Whether a log is a ROS bag: a folder holding a ROS 2 bag (its ``metadata.yaml``, or a ``.db3`` or ``.mcap``
+    file), or a file of :data:`BAG_SUFFIXES`. An empty folder, or one of CSV logs, is none.
 
     Parameters
     ----------
@@ -32,7 +33,9 @@ def is_bag(path: Path) -> bool:
     -------
     bool
     """
-    return path.is_dir() or path.suffix.lower() in BAG_SUFFIXES
+    if path.is_dir():
+        return (path / "metadata.yaml").is_file() or any(f.suffix.lower() in (".db3", ".mcap") for f in path.iterdir())
+    return path.suffix.lower() in BAG_SUFFIXES
 
 
 def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None):

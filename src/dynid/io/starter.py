@@ -75,6 +75,9 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     DataError
         An unreadable log, or columns from which no layout can be told (the message says which columns were seen).
     """
+    for given in (log, *validation):  # a FIFO blocks its reader forever; a device never ends
+        if given.exists() and not (given.is_file() or given.is_dir()):
+            raise DataError(f"{given}: not a regular file (a device, a FIFO or a socket): give the log's file")
     if log.is_dir() and not (log / "metadata.yaml").is_file():
         raise DataError(f"{log}: a folder without metadata.yaml, not a ROS 2 bag: give a CSV log, or a bag's folder or "
                         "its .mcap/.db3 file")

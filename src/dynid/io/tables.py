@@ -197,6 +197,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         infinity; an empty selection. The message names the file, the line and, where it applies, the column.
     """
     path = Path(path)
+    if path.exists() and not path.is_file():  # a FIFO or a device: never "not found", never read (a FIFO blocks)
+        raise DataError(f"{path}: not a regular file ({'a folder' if path.is_dir() else 'a device, a FIFO or a socket'})"
+                        ": give the log's file")
     if not path.is_file():
         raise DataError(f"{path}: file not found")
     hint = text_encoding_hint(path)
