@@ -147,6 +147,7 @@ ESCAPES = {
     # whose loops are each bounded but whose product is not)
     "power of a power": "${{(10**2499999)**64}}",
     "nested comprehension": "${{len([x for x in range(9999999) for y in range(9999999)])}}",
+    "format width": "${{'%100000000d' % 1}}",  # wrote a 100 MB URDF
 }
 
 
@@ -221,6 +222,21 @@ def test_files_a_description_may_not_read_are_refused_quickly_and_never_quoted(t
     with pytest.raises(ConfigError, match=r"has type 'x{37}\.\.\.'") as caught:
         load_robot(path)
     assert "x" * 41 not in str(caught.value)
+
+
+def test_properties_that_double_themselves_are_refused_before_the_file_grows(tmp_path, monkeypatch):
+    """Round five: 24 properties each the sum of the one before with itself wrote a 168 MB URDF; the sum is refused
+    where it passes 10,000,000 characters."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    from dynid.model.urdf import expand_xacro
+
+    doubling = "\n".join(['<xacro:property name="p0" value="abcdefgh"/>'] +
+                          [f'<xacro:property name="p{i}" value="${{p{i - 1} + p{i - 1}}}"/>' for i in range(1, 25)])
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text(XACRO.format(value="1.0").replace("<link", doubling + '\n  <link name="${p24}"/>\n  <link', 1))
+    with pytest.raises(ConfigError, match=r"uses a value of \d+ elements, which a robot description may not run"):
+        expand_xacro(path)
+    assert not list(tmp_path.glob("cache/dynid/xacro/**/*.urdf"))
 
 
 def test_no_xacro_expression_reaches_eval(tmp_path, monkeypatch):

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import ast
 import operator
+import re
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -183,7 +184,11 @@ class _Interpreter:
             for seq, n in ((left, right), (right, left)):
                 if isinstance(seq, (str, list, tuple)) and isinstance(n, int) and len(seq) * n > _LARGEST:
                     raise _Refused(f"a repetition of {len(seq) * n} elements")
-        return _BINARY[op](left, right)
+        if op is ast.Mod and isinstance(left, str):  # printf-style widths and precisions allocate before any check
+            for width in re.findall(r"%[-#0 +]*(\d*)(?:\.(\d*))?", left):
+                if any(w and int(w) > _LARGEST for w in width):
+                    raise _Refused(f"a format width of {max(int(w) for w in width if w)} characters")
+        return self._bounded(_BINARY[op](left, right))  # a sum of strings doubling itself stops at the bound
 
     def _UnaryOp(self, node: ast.UnaryOp) -> Any:
         return _UNARY[type(node.op)](self.run(node.operand))
