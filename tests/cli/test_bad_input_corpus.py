@@ -242,6 +242,22 @@ def test_a_fifo_or_a_folder_given_as_a_log_is_said_as_such(ur):
                    "empty: a folder without metadata.yaml, not a ROS 2 bag", target)
 
 
+def test_a_column_name_the_header_holds_twice_is_refused(ur, tmp_path):
+    """Round five (an earlier corpus's silent case): two ROS-style CSV columns of one name, the first taken in
+    silence. Now one line naming the columns; by number the intended one is read."""
+    rows = _log_rows()
+    names = ["t"] + [f"q{j}" for j in range(1, 7)] + [f"tau{j}" for j in range(1, 7)]
+    names[7] = "q1"  # tau1's column carries q1's name again
+    (tmp_path / "dup.csv").write_text(",".join(names) + "\n" + "".join(",".join(f"{x:.9g}" for x in r[:13]) + "\n"
+                                                                    for r in rows))
+    cfg = ur()
+    cfg.write_text('robot = "ur10e"\ndata_root = "."\n[identification]\nfile = "dup.csv"\nheader = true\n'
+                   'time = { column = "t" }\npositions = { columns = ["q1", "q2", "q3", "q4", "q5", "q6"] }\n'
+                   'torques = { columns = [8, 9, 10, 11, 12, 13] }\n')
+    out = tmp_path / "o"
+    assert_refused(invoke("identify", cfg, "--out", out), "dup.csv: the header names 2 columns 'q1' (columns 2, 8)", out)
+
+
 def test_a_config_in_utf16(ur):
     cfg = ur()
     cfg.write_text(cfg.read_text(), encoding="utf-16")

@@ -185,3 +185,27 @@ def test_without_collision_shapes_the_capsules_are_an_estimate_said_as_one(tmp_p
     said = " ".join((p.stdout + p.stderr).split())
     assert "no collision shapes dynid could read" not in said
     assert "capsules of radius 0.08 m about the joint origins ([workspace] link_radius)" in said
+
+
+def test_a_collision_mesh_that_is_a_device_is_named_and_a_point_arm_still_has_capsules(tmp_path):
+    """Round five: a collision mesh that is /dev/zero (or 2 GB) was refused naming a C++ source file of Pinocchio's; it
+    is named now. Read as capsules, an arm whose joints sit at one point had capsules of radius 0, which MuJoCo's
+    check refused with a traceback."""
+    from dynid.exceptions import ConfigError
+    from dynid.excitation.link_geometry import SMALLEST_LINK_RADIUS
+
+    urdf = tmp_path / "point.urdf"
+    urdf.write_text('<robot name="r"><link name="base"/><link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" '
+                    'iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><mesh '
+                    'filename="/dev/zero"/></geometry></collision></link><joint name="j1" type="revolute"><parent '
+                    'link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" '
+                    'velocity="1"/></joint></robot>')
+    robot = load_robot(urdf)
+    with pytest.raises(ConfigError, match=r"point.urdf: collision mesh /dev/zero: /dev/zero is not a regular file"):
+        link_geometry_from_urdf(robot, urdf)
+    assert Workspace().capsule_radius(robot) == SMALLEST_LINK_RADIUS
+    cfg = tmp_path / "excite.toml"
+    cfg.write_text(f'robot = "{urdf}"\n[trajectory]\nharmonics = 2\nfrequency = 0.2\n[workspace]\nfloor = -1.0\n'
+                   "[design]\nstarts = 1\nmaxiter = 5\n[output]\nrate = 50\n")
+    p = dynid("excite", str(cfg), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr

@@ -171,8 +171,12 @@ class LinkGeometry:
         return last
 
 
+SMALLEST_LINK_RADIUS = 0.01
+"""[m] The estimate's floor: an arm whose joints all sit at one point (no offsets) still has links."""
+
+
 def estimated_link_radius(robot: Robot) -> float:
-    """:data:`LINK_RADIUS_SHARE` of the arm's reach.
+    """:data:`LINK_RADIUS_SHARE` of the arm's reach, at least :data:`SMALLEST_LINK_RADIUS`.
 
     Parameters
     ----------
@@ -183,7 +187,7 @@ def estimated_link_radius(robot: Robot) -> float:
     float [m]
     """
     reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
-    return LINK_RADIUS_SHARE * reach
+    return max(LINK_RADIUS_SHARE * reach, SMALLEST_LINK_RADIUS)
 
 
 def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> LinkGeometry:
@@ -253,6 +257,7 @@ def link_geometry_from_urdf(robot: Robot, path, srdf=None) -> LinkGeometry | Non
     import pinocchio as pin
 
     path = Path(path)
+    _check_meshes(path)
     model = pin.buildModelFromUrdf(str(path))
     try:
         with warnings.catch_warnings():
@@ -288,6 +293,37 @@ def link_geometry_from_urdf(robot: Robot, path, srdf=None) -> LinkGeometry | Non
         return None
     excluded = _srdf_excluded(model, geometry, Path(srdf)) if srdf is not None else frozenset()
     return LinkGeometry(tuple(shapes), np.array(link), np.array(placement), tuple(names), str(path), excluded)
+
+
+LARGEST_MESH = 256 * 2**20
+"""[bytes] A collision mesh larger than this is refused before it is read (a robot's are a few MB; /dev/zero never
+ends)."""
+
+
+def _check_meshes(path: Path) -> None:
+    """Refuse a ``<collision>`` mesh that is not a regular file or is over :data:`LARGEST_MESH`, naming it (Pinocchio's
+    own message named a C++ source file): ``package://`` found as Pinocchio finds it, among the URDF's ancestors."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError):
+        return  # Pinocchio's parser says why
+    for mesh in root.iterfind("./link/collision/geometry/mesh"):
+        name = mesh.get("filename", "")
+        rest = name.removeprefix("file://")
+        candidates = ([Path(d) / rest.removeprefix("package://") for d in _package_dirs(path)]
+                      if rest.startswith("package://") else [path.parent / rest])
+        found = next((c for c in candidates if c.exists()), None)
+        if found is None:
+            continue
+        if not found.is_file():
+            raise ConfigError(f"{path}: collision mesh {name}: {found} is not a regular file (a device, a FIFO or a "
+                              "folder)")
+        if found.stat().st_size > LARGEST_MESH:
+            raise ConfigError(f"{path}: collision mesh {name}: {found.stat().st_size / 2**20:.0f} MiB, more than a "
+                              f"collision mesh dynid reads ({LARGEST_MESH // 2**20} MiB): give a simplified mesh, or "
+                              'set workspace.geometry = "capsules"')
 
 
 def _srdf_excluded(model, geometry, srdf: Path) -> frozenset:

@@ -148,6 +148,10 @@ def resolve_columns(path: Path, columns, header: list[str] | None, delimiter: st
             if c not in header:
                 raise DataError(f"{path}: no column named {c!r} in the header (found {', '.join(header)})"
                                 + (_separator_hint(header[0], delimiter) if len(header) == 1 else ""))
+            if header.count(c) > 1:  # the first was taken in silence (a ROS-style export repeats names)
+                where = [str(k + 1) for k, name in enumerate(header) if name == c]
+                raise DataError(f"{path}: the header names {header.count(c)} columns {c!r} (columns {', '.join(where)}): "
+                                "give the one meant by its 1-based number, or rename the others")
             out.append(header.index(c))
         else:
             if int(c) < 1:
