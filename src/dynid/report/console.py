@@ -23,7 +23,8 @@ DEFAULT_WIDTH = 100
 
 
 def make_console(stderr: bool = False) -> Console:
-    """A console of the terminal's width, or, for pipes and logs, of ``COLUMNS`` (else 100 columns).
+    """A console of the terminal's width, or, for pipes and logs, of ``COLUMNS`` (else 100 columns: the tables' width;
+    without ``COLUMNS`` lines are not wrapped there, :class:`Reporter`).
 
     Parameters
     ----------
@@ -58,6 +59,8 @@ class Reporter:
         self.quiet = quiet
         self.out = out or make_console()
         self.err = err or make_console(stderr=True)
+        # a pipe or a log file gets one line a line, unless COLUMNS asks for a width (a terminal wraps at its own)
+        self.unwrapped = not (self.out.is_terminal or os.environ.get("COLUMNS", "").isdigit())
 
     def warning(self, text: str) -> None:
         """Print a warning on standard error.
@@ -87,7 +90,7 @@ class Reporter:
         text : str
         """
         if not self.quiet:
-            self.out.print(text, markup=False, highlight=False)
+            self.out.print(text, markup=False, highlight=False, soft_wrap=self.unwrapped)
 
     def blocks(self, blocks) -> None:
         """Print a summary: tables split to the console's width, titles in bold, warnings on standard error.
@@ -106,9 +109,9 @@ class Reporter:
                 for t in rich_tables(b, self.out.width):
                     self.out.print(t)
             elif b.kind == "title":
-                self.out.print("\n" + escape(b.text), style="bold", highlight=False)
-            else:
-                self.out.print(b.text, markup=False, highlight=False)
+                self.out.print("\n" + escape(b.text), style="bold", highlight=False, soft_wrap=self.unwrapped)
+            else:  # a pipe or a log file: one line a line (a terminal wraps at its width)
+                self.out.print(b.text, markup=False, highlight=False, soft_wrap=self.unwrapped)
 
     def wrote(self, paths: list[Path]) -> None:
         """One line: the first file, the other files by name, and how many figures (where there are any), in which
