@@ -15,6 +15,7 @@ shapes.
 from __future__ import annotations
 
 import warnings
+import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -303,8 +304,6 @@ ends)."""
 def _check_meshes(path: Path) -> None:
     """Refuse a ``<collision>`` mesh that is not a regular file or is over :data:`LARGEST_MESH`, naming it (Pinocchio's
     own message named a C++ source file): ``package://`` found as Pinocchio finds it, among the URDF's ancestors."""
-    import xml.etree.ElementTree as ET
-
     try:
         root = ET.parse(path).getroot()
     except (ET.ParseError, OSError):
