@@ -89,3 +89,28 @@ def test_dynid_payload_writes_a_link_and_a_body_that_load(identified, tmp_path):
            f'<child link="{parent}"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
            f'<link name="{parent}"/>{urdf}</robot>')
     assert parent and abs(pin.buildModelFromXML(arm).inertias[1].mass - mass) < 1e-9  # the fixed link merged in
+
+
+def test_a_fit_far_above_the_noise_floor_is_said(identified, tmp_path):
+    """issue "Every assurance checked on what the user meets", item 5: a payload fit far above its noise floor was
+    unflagged (a gripper jaw as the last link, torques negated: 2.49 kg with its centre of mass 1.5 m off). The
+    simulated payload fits near the floor and is not flagged; the same log with its torques negated is."""
+    from dynid.identification.run import run_payload
+    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from tests.cli.refusals import dynid
+
+    cfg, truth, folder, results = identified
+    config = load_identification_config(cfg)
+    log = _loaded_log(folder, truth)
+    right, _, _ = run_payload(config, results, dataset_for_file(config, log))
+    assert np.isfinite(right.error_floor) and not right.misfit
+    rows = np.loadtxt(log, delimiter=",")
+    n = (rows.shape[1] - 1) // 2
+    rows[:, 1 + n:] *= -1.0  # the torque channels read with the wrong sign
+    flipped = tmp_path / "negated.csv"
+    np.savetxt(flipped, rows, delimiter=",")
+    wrong, _, _ = run_payload(config, results, dataset_for_file(config, flipped))
+    assert wrong.misfit and wrong.error_with > 3 * wrong.error_floor
+    p = dynid("payload", cfg, "--results", folder / "out" / "results.json", "--file", flipped, "--out", tmp_path / "pay")
+    assert p.returncode == 0, p.stderr
+    assert "times the log's noise floor" in " ".join(p.stderr.split())

@@ -28,7 +28,12 @@ from ..model.robot import Robot
 from ..model.spatial import inertial_from_physical, physical_from_inertial, transform_inertial
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData
+from ..validation.noise_floor import noise_floor
 from .drive_gains import _last_link_columns, identify_payload
+
+FLOOR_FACTOR = 3.0
+"""A payload fit over this many times the log's noise floor is said: a rigid payload on the flange leaves the noise;
+the issue's gripper jaw as the last link left 7 times it (0.337 kg for 0.400 kg)."""
 
 __all__ = ["Payload", "payload_from_log"]
 
@@ -56,6 +61,9 @@ class Payload:
         The consistent estimate about the last link's frame (eq. 5 order).
     error_without, error_with : float [%]
         The log's global relative torque error of the arm's model alone and with the payload.
+    error_floor : float [%]
+        What a perfect model would leave of the log's torques, on the same samples (the noise floor,
+        :func:`dynid.validation.noise_floor.noise_floor`); NaN where the torques carry no measurable noise.
     """
 
     mass: float
@@ -67,6 +75,13 @@ class Payload:
     parameters: np.ndarray
     error_without: float
     error_with: float
+    error_floor: float = float("nan")
+
+    @property
+    def misfit(self) -> bool:
+        """Whether the fit with the payload stays over :data:`FLOOR_FACTOR` times the noise floor: something beyond a
+        rigid payload on the flange (the arm's model off, a last link that moves, torques read otherwise)."""
+        return bool(np.isfinite(self.error_floor) and self.error_with > FLOOR_FACTOR * self.error_floor)
 
     def to_dict(self) -> dict:
         """JSON-ready payload.
@@ -80,7 +95,8 @@ class Payload:
                 "mass_std": self.mass_std, "com": self.com.tolist(), "com_std": self.com_std.tolist(),
                 "inertia": self.inertia.tolist(), "not_determined": list(self.not_determined),
                 "last_link_parameters": dict(zip(INERTIAL_TERMS, self.parameters.tolist())),
-                "global_relative_error_without": self.error_without, "global_relative_error_with": self.error_with}
+                "global_relative_error_without": self.error_without, "global_relative_error_with": self.error_with,
+                "global_relative_error_floor": None if not np.isfinite(self.error_floor) else self.error_floor}
 
 
 def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, *, rng=0,
@@ -118,11 +134,13 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     acc = LeastSquaresAccumulator(10, robot.n_dof)
     sse = np.zeros(2)
     total = 0.0
+    kept = np.zeros(robot.n_dof)
     for _, y, tau, keep in base_chunks(robot, base, loaded, standard=True):
         extra = (tau - base.base_observation(y) @ beta) * ratio
         acc.add(y[:, :, cols].reshape(-1, 10), extra.reshape(-1), keep.reshape(-1))
         total += float(np.sum((tau * ratio)[keep] ** 2))
         sse[0] += float(np.sum(extra[keep] ** 2))
+        kept += keep.sum(axis=0)
     values = dict(zip(ls.names, ls.values))
     mass = max(values.get("M", 0.0), 0.0)
     first = np.array([values.get(k, 0.0) for k in ("MX", "MY", "MZ")])
@@ -140,4 +158,6 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     com_std = np.abs(rotation.T @ np.array([std.get(k, np.nan) for k in ("MX", "MY", "MZ")])) / max(m, 1e-12)
     lost = tuple(k for k in INERTIAL_TERMS if k not in ls.names) + ls.not_determined
     error = 100.0 * np.sqrt(sse / max(total, 1e-300))
-    return Payload(m, com, inertia, mass_std, com_std, lost, phi, float(error[0]), float(error[1]))
+    floor = noise_floor(loaded)  # each joint's RMSE of a perfect model there [N·m]
+    at_floor = np.nan if floor is None else 100.0 * float(np.sqrt(np.sum((floor * ratio) ** 2 * kept) / max(total, 1e-300)))
+    return Payload(m, com, inertia, mass_std, com_std, lost, phi, float(error[0]), float(error[1]), at_floor)
