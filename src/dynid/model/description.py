@@ -474,8 +474,12 @@ def _drive_terms(rows, where, terms: tuple, source: str) -> tuple[tuple, np.ndar
                 raise ConfigError(f"{w}.drive_terms: expected a list drawn from the robot's drive terms {list(terms)}, "
                                   f"got {r.drive_terms!r}")
             mask[i] = [t in r.drive_terms or (t in COUNTERBALANCE_TERMS and i in balanced) for t in terms]
-    drive = np.array([[float(_value(getattr(r, t))) for t in terms] for r in rows]).reshape(n, len(terms)) * mask
-    return terms, mask, drive
+    drive = np.array([[float(_value(getattr(r, t))) for t in terms] for r in rows]).reshape(n, len(terms))
+    bad = np.argwhere(~np.isfinite(drive))  # a NaN nominal value became a NaN prior that named no field
+    if bad.size:
+        i, k = bad[0]
+        raise ConfigError(f"{where[i]}.{terms[k]}: expected a finite nominal value, got {drive[i, k]}")
+    return terms, mask, drive * mask
 
 
 def _value(given) -> float:
