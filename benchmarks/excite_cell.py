@@ -170,7 +170,7 @@ def _start(robot) -> np.ndarray:
 def _cell(robot, geometry=None) -> Workspace:
     """A table under the base (where its collision shapes end, or at the base frame's origin) and a box of a fifth of the
     reach, half the reach from the base, a quarter of the reach above the table, off the start."""
-    reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
+    reach = robot.reach
     q0 = _start(robot)
     base_z = 0.0  # the table: the base frame's origin, or the bottom of the base's own collision shapes
     if geometry is not None and np.any(geometry.link < 0):

@@ -114,3 +114,19 @@ def test_a_fit_far_above_the_noise_floor_is_said(identified, tmp_path):
     p = dynid("payload", cfg, "--results", folder / "out" / "results.json", "--file", flipped, "--out", tmp_path / "pay")
     assert p.returncode == 0, p.stderr
     assert "times the log's noise floor" in " ".join(p.stderr.split())
+
+
+def test_a_right_payload_on_a_real_arm_is_judged_against_the_arms_own_residual():
+    """On the UR10e's real log with its 2.805 kg payload (``dynid payload configs/ur10e.toml --file
+    ur-20_02_19_14harm50secLoad.csv``) the fit is 2.55 %, 7.7 times the log's noise floor (0.333 %): the arm's model
+    itself leaves 1.11 % there, so the noise floor alone flagged a right payload. Judged against the larger of the two,
+    it is not flagged; the same fit where the arm's residual is not known is."""
+    from dynid.identification.payload import FLOOR_FACTOR, Payload
+
+    def payload(error_arm: float) -> Payload:
+        return Payload(2.70, np.zeros(3), np.eye(3) * 0.01, 0.0065, np.full(3, 0.002), (), np.zeros(10), 20.7, 2.55,
+                       0.333, error_arm)
+
+    assert payload(1.11).expected == 1.11 and not payload(1.11).misfit
+    assert payload(np.nan).expected == 0.333 and payload(np.nan).misfit
+    assert payload(0.5).misfit and 2.55 > FLOOR_FACTOR * 0.5

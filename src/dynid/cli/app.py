@@ -649,10 +649,11 @@ def payload(
         for line in payload_lines(found, label, ratio):
             rep.line(line)
         if found.misfit:  # a rigid payload on the flange leaves the log's noise
-            rep.warning(f"the fit with the payload is {found.error_with / found.error_floor:.2g} times the log's noise "
-                        f"floor ({found.error_with:.3g} % against {found.error_floor:.3g} %): something beyond a rigid "
-                        "payload on the flange (a last link that moves, such as a gripper's jaw; the arm's model; "
-                        "torques read otherwise): check it before using the payload")
+            rep.warning(f"the fit with the payload is {found.error_with / found.expected:.2g} times the log's noise floor "
+                        f"or the arm model's own residual, the larger ({found.error_with:.3g} % against "
+                        f"{found.expected:.3g} %): something beyond a rigid payload on the flange (a last link that moves, "
+                        "such as a gripper's jaw; the arm's model; torques read otherwise): check it before using the "
+                        "payload")
         rep.wrote(paths)
 
     _Command("dynid payload", quiet, out).run(prepare, compute, save, show)

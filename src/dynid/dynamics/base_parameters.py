@@ -193,8 +193,7 @@ def base_parameters(robot: Robot | str | Path, *, rng: np.random.Generator | int
     robot = as_robot(robot)
     rng = np.random.default_rng(rng)
     n = robot.n_dof
-    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
-    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
+    lo, hi = robot.limits.position_span()
     q = rng.uniform(lo, hi, (n_samples, n))
     dq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 2.0
     ddq = rng.uniform(-1.0, 1.0, (n_samples, n)) * 5.0

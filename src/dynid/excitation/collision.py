@@ -88,9 +88,7 @@ def touching_pairs(robot: Robot, radius: float, samples: int = 200, rng=0) -> li
     -------
     list of (int, int)
     """
-    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
-    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
-    q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
+    q = robot.limits.random_positions(samples, rng)
     candidates = [(i, j) for i in range(robot.n_dof) for j in range(i + 2, robot.n_dof)]
     if not candidates:
         return []

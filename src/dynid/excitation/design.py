@@ -521,7 +521,7 @@ class _Objective:
         self.tau_idx = np.flatnonzero(np.isfinite(lim.tau_max))
         self.tau_lim = lim.tau_max[self.tau_idx] * (1 - s)
         g, h, _ = problem.workspace.inequalities()
-        reach = sum(float(np.linalg.norm(jt.translation)) for jt in problem.robot.joints) + float(np.linalg.norm(problem.robot.tool_translation))
+        reach = problem.robot.reach
         self.ws_g, self.ws_h = g, h - s * reach
         ws = problem.workspace  # every link's shape above the floor (Workspace.floor_needs), tightened as the cell's
         found = ws.floor_needs(problem.robot, problem.start_pose())

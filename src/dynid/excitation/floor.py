@@ -134,9 +134,7 @@ def floor_needs(robot: Robot, geometry, floor: float, clearance: float, start_po
     -------
     FloorNeeds
     """
-    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
-    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
-    q = lo + np.random.default_rng(0).random((24, robot.n_dof)) * (hi - lo)
+    q = robot.limits.random_positions(24, 0)
     on_links = np.flatnonzero(np.asarray(geometry.link) >= 0)
     z = lowest_points(robot, q, geometry, on_links)[..., 2]
     moves = np.ptp(z, axis=0) > 1e-6

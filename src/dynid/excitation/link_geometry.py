@@ -187,8 +187,7 @@ def estimated_link_radius(robot: Robot) -> float:
     -------
     float [m]
     """
-    reach = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
-    return max(LINK_RADIUS_SHARE * reach, SMALLEST_LINK_RADIUS)
+    return max(LINK_RADIUS_SHARE * robot.reach, SMALLEST_LINK_RADIUS)
 
 
 def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> LinkGeometry:
@@ -670,8 +669,7 @@ def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=
     -------
     list of (int, int)
     """
-    lo = np.where(np.isfinite(robot.limits.q_min), robot.limits.q_min, -np.pi)
-    hi = np.where(np.isfinite(robot.limits.q_max), robot.limits.q_max, np.pi)
+    lo, hi = robot.limits.position_span()
     key = (robot.n_dof, lo.tobytes(), hi.tobytes(), samples, rng if isinstance(rng, int) else None)
     if key[-1] is not None and key in geometry.found:  # the design, its checks and the run ask for the same pairs
         return list(geometry.found[key])
@@ -679,7 +677,7 @@ def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=
                   if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2 and (g, h) not in geometry.excluded]
     pairs = []
     if candidates:
-        q = lo + np.random.default_rng(rng).random((samples, robot.n_dof)) * (hi - lo)
+        q = robot.limits.random_positions(samples, rng)
         touching = self_distances(robot, q, geometry, candidates).distance < 0
         pairs = [pair for pair, share in zip(candidates, touching.mean(axis=0)) if share < ALWAYS]
     if key[-1] is not None:

@@ -283,7 +283,8 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     recording = load_recording(dataset, config.robot)
     data = prepare(recording, carried_over(stored_preprocessing(identified), config.preprocessing), strict=False)
     ratio = identified_gain_ratio(identified, config.robot.n_dof)
-    found = payload_from_log(config.robot, base, estimates[label], data, rng=config.estimation.seed, gain_ratio=ratio)
+    found = payload_from_log(config.robot, base, estimates[label], data, rng=config.estimation.seed, gain_ratio=ratio,
+                             residual=stored_residual_level(identified, config.robot.n_dof))
     return found, label, ratio
 
 

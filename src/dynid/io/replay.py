@@ -73,9 +73,7 @@ def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray,
     """Random states: positions within the joint limits (±π where there are none), velocities and accelerations of a
     few rad/s and rad/s² (within their limits where given)."""
     lim = robot.limits
-    lo = np.where(np.isfinite(lim.q_min), lim.q_min, -np.pi)
-    hi = np.where(np.isfinite(lim.q_max), lim.q_max, np.pi)
-    q = lo + rng.random((n, robot.n_dof)) * (hi - lo)
+    q = lim.random_positions(n, rng)
     dq = rng.uniform(-1.0, 1.0, (n, robot.n_dof)) * np.minimum(np.where(np.isfinite(lim.dq_max), lim.dq_max, 2.0), 2.0)
     ddq = rng.uniform(-1.0, 1.0, (n, robot.n_dof)) * np.minimum(np.where(np.isfinite(lim.ddq_max), lim.ddq_max, 5.0), 5.0)
     return q, dq, ddq

@@ -79,6 +79,31 @@ class Limits:
         """
         return Limits(*(getattr(self, f)[:k].copy() for f in ("q_min", "q_max", "dq_max", "ddq_max", "tau_max")))
 
+    def position_span(self) -> tuple[np.ndarray, np.ndarray]:
+        """The position limits with ±π where a joint has none (a continuous joint's one turn).
+
+        Returns
+        -------
+        lo, hi : (n_dof,) arrays [rad]
+        """
+        return (np.where(np.isfinite(self.q_min), self.q_min, -np.pi),
+                np.where(np.isfinite(self.q_max), self.q_max, np.pi))
+
+    def random_positions(self, n: int, rng) -> np.ndarray:
+        """``n`` poses drawn uniformly within :meth:`position_span`.
+
+        Parameters
+        ----------
+        n : int
+        rng : Generator or int seed
+
+        Returns
+        -------
+        (n, n_dof) array [rad]
+        """
+        lo, hi = self.position_span()
+        return lo + np.random.default_rng(rng).random((n, lo.size)) * (hi - lo)
+
 
 @short_repr
 @dataclass(frozen=True)
@@ -260,6 +285,12 @@ class Robot:
     def n_dof(self) -> int:
         """Number of joints."""
         return len(self.joints)
+
+    @property
+    def reach(self) -> float:
+        """[m] The sum of the joints' offsets and the flange's: no point of the arm's skeleton is farther than this from
+        the first joint's origin."""
+        return sum(float(np.linalg.norm(j.translation)) for j in self.joints) + float(np.linalg.norm(self.tool_translation))
 
     @property
     def n_params_per_joint(self) -> int:

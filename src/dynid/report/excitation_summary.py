@@ -197,11 +197,13 @@ def _shapes_lines(run) -> list:
     ws = run.config.problem.workspace
     if ws.geometry is not None or ws.link_radius is not None or not (ws.obstacles or math.isfinite(ws.floor)):
         return []
+    from ..excitation.link_geometry import LINK_RADIUS_SHARE  # coal's import stays out of a summary's
+
     r = ws.capsule_radius(run.config.problem.robot)
     return [Line(f"the robot file has no collision shapes dynid could read: the floor and the cell are kept off capsules "
-                 f"of radius {r:.3g} m about the joint origins, an estimate (15 % of the arm's reach) that a hand, a "
-                 "gripper or a wide housing can exceed; give [workspace] link_radius, or a URDF with <collision> "
-                 "shapes and its meshes", "warning")]
+                 f"of radius {r:.3g} m about the joint origins, an estimate ({100 * LINK_RADIUS_SHARE:g} % of the arm's "
+                 "reach) that a hand, a gripper or a wide housing can exceed; give [workspace] link_radius, or a URDF "
+                 "with <collision> shapes and its meshes", "warning")]
 
 
 def _floor_lines(run) -> list:

@@ -224,9 +224,10 @@ class ResidualSums:
 
 UNLIKE_NOMINAL = 0.5
 """A log whose measured torque correlates with the description's nominal model below this on every joint that varies
-(beyond friction where that is known; either sign: a flipped sign is another finding's) is not read as torques. On the real logs of ../shared/data the largest of
-these correlations is 0.96-1.0 (the KR 300, the TX40, the UR10e; the LBR Med7's plain correlation 1.0); the UR10e
-example's log with its joint velocities read as torques reaches 0.06."""
+(beyond friction where that is known; either sign: a flipped sign is another finding's) is not read as torques. The
+largest of these correlations is 0.97-1.0 on the five real configs of configs/ and 0.68-1.0 on the 36 windows of 3-6
+s that benchmarks/short_windows.py cuts from them (the KR 300's 7-10 s the lowest); the UR10e example's log with its
+joint velocities read as torques reaches 0.06."""
 
 LIKE_A_STATE = 0.995
 """A torque column whose correlation with its joint's velocity or position reaches this is said to be that signal."""
@@ -271,18 +272,18 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
             if np.std(values) > 0 and np.std(tau[:, j]) > 0 and np.corrcoef(values, tau[:, j])[0, 1] >= LIKE_A_STATE:
                 named.append(f"J{j + 1}'s is its {signal}")
                 break
+    if len(named) == len(judged):  # each joint's column a state: not torques, whatever shape gravity gives them
+        return [Finding("columns", f"{dataset}: every joint's measured torque equals one of its states "
+                                   f"({', '.join(named)}): these columns are not read as the robot's torques; check "
+                                   f"the torques (or currents) columns of {table}")]
     best = max(abs(rho[j]) for j in judged)  # a torque whose sign is flipped follows the model all the same
-    if (best >= UNLIKE_NOMINAL or explained) and len(named) < len(judged):  # a torque column of each joint equal to
-        return []                                   # a state: not torques, whatever gravity's shape makes them look like
+    if best >= UNLIKE_NOMINAL or explained:
+        return []
     which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
     return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
-                               f"largest correlation with them {best:.2f}, where a log of the robot's torques reaches "
-                               f"0.96-1.0){which}: these columns are not read as the robot's torques; check the torques "
-                               f"(or currents) columns of {table} and the robot file before trusting any fit of them")
-            if best < UNLIKE_NOMINAL and len(named) < len(judged) else
-            Finding("columns", f"{dataset}: every joint's measured torque equals one of its states ({', '.join(named)}): "
-                               f"these columns are not read as the robot's torques; check the torques (or currents) "
-                               f"columns of {table}")]
+                               f"largest correlation with them {best:.2f}, where the real logs' reach 0.68-1.0){which}: "
+                               "these columns are not read as the robot's torques; check the torques (or currents) "
+                               f"columns of {table} and the robot file before trusting any fit of them")]
 
 
 def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]",
