@@ -80,15 +80,28 @@ def test_a_short_real_log_gets_the_descriptions_body_with_its_drive_terms(tmp_pa
 
 
 def test_drive_only_is_chosen_where_it_predicts_better_even_when_the_description_alone_does_not(tmp_path):
-    """Rows 1060-1560 (J2 one way): least squares and the SDP predict the validation logs better than the description's
-    nominal model (no friction, no rotor inertia), and the description's rigid body with the drive terms fitted better
+    """The KUKA KR 300's identification log cut to 5-10 s: the SDP predicts the validation logs (trajectories B and C)
+    better than the description's nominal model, and the description's rigid body with the drive terms fitted better
     still: it is the main estimate, the candidate the same validation pass scored; the finding gives the three
-    figures and the reason: least squares extrapolates there (the finding ``extrapolation``). (Until the commit after
-    e88fa23 it was scored only where the nominal model beat the main estimate.)"""
-    _, r, others = _identified(tmp_path, 1060, 1560)
+    figures and the reason: least squares extrapolates there (the finding ``extrapolation``). (The UR10e's rows
+    1060-1560 showed it until the verdict weighed a mean with ten static holds: on the moving log least squares
+    predicts better, tests/identification/test_yardstick.py.)"""
+    root = shared_data("kuka_kr300_weigand2021")
+    repo = Path(__file__).resolve().parents[2]
+    text = (repo / "configs" / "kuka_kr300.toml").read_text()
+    text = text.replace('robot = "robots/', f'robot = "{repo / "configs" / "robots"}/').replace(
+        'data_root = "../../shared/data/kuka_kr300_weigand2021"', f'data_root = "{root}"')
+    config = tmp_path / "c.toml"
+    config.write_text(re.sub(r"^\[identification\]$", "[identification]\ntime_range = [5.0, 10.0]", text, count=1, flags=re.M))
+    p = dynid("identify", config, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    r = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert r["main_estimate"] == LABEL
     nominal = r["diagnostics"]["nominal_set"]
-    assert max(_mean(r, k) for k in others) < _mean(r, nominal)
+    others = [k for k in r["estimates"] if k not in (LABEL, nominal)]
+    assert all(_mean(r, LABEL) < _mean(r, k) for k in others)
+    assert _mean(r, "dynid SDP") < _mean(r, nominal)
     assert any(f["kind"] == "extrapolation" for f in r["findings"])
     said = next(f["text"] for f in r["findings"] if f["kind"] == "main")
     assert said.startswith(f"main estimate: {LABEL}") and "leave the range the identification log supports" in said
-    assert f"{_mean(r, nominal):.3g} %" in said and "not an independent test" in said
+    assert "not an independent test" in said

@@ -69,7 +69,8 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
     monkeypatch.setattr(verdict, "_mean_error", mean)
     out = tmp_path / "out"
     assert CliRunner().invoke(app, ["identify", str(cfg), "--out", str(out), "--no-figures", "-q"]).exit_code == 0
-    assert len(made) == 1 and weighed and all(v is made[0] for v in weighed)
+    every = {id(c) for one in made[0] for c in one}  # each log under each state filter, nothing else
+    assert len(made) == 1 and len(made[0]) == 3 and weighed and all({id(c) for c in v} == every for v in weighed)
     identified = json.loads((out / "results.json").read_text())
     yard = identified["diagnostics"]["yardstick"]["global_relative_error"]["validation"]
     checked = tmp_path / "checked"
@@ -112,3 +113,85 @@ def test_logs_at_rest_throughout_do_not_dilute_the_yardstick_headline():
     line = next(b.text for b in in_short(r) if b.text.startswith("on one yardstick"))
     assert f"{r.main} {over[r.main]:.3g} %" in line and "over the one log that moves" in line
     assert f"of the 10 at rest throughout, within the static-friction band: {r.main} on {kept}" in line
+
+
+def test_the_yardstick_scores_the_torques_as_measured(tmp_path):
+    """On a log whose measured torques carry white noise, the truth's error on the one yardstick is the noise's share
+    of the torque, under every state filter: the noise, which no model predicts, is not filtered away (a yardstick
+    that low-passed the torques scored the truth at 28 % of it). The noise is measured independently from the
+    log's second differences (white noise: var(Δ²τ) = 6σ²)."""
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+    from tests.simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=10.0, current_std=0.5)
+    config = load_identification_config(cfg)
+    tau = np.asarray(load_recording(config.validation[0], config.robot).tau, dtype=float)
+    sigma = np.std(np.diff(tau, 2, axis=0), axis=0) / np.sqrt(6.0)
+    floor = 100.0 * np.sqrt(np.sum(sigma**2) / np.mean(np.sum(tau**2, axis=1)))
+    assert floor > 2.0  # the noise dominates what the state filters and the drive model leave
+    r = _identify(cfg)
+    shown = r.diagnostics["yardstick"]["mean_global_relative_error"]["truth"]
+    assert 0.9 * floor <= shown <= 1.25 * floor, (shown, floor)
+    filters = r.diagnostics["yardstick"]["filters"]
+    assert [f["cutoff_factor"] for f in filters] == [1.0, 0.5, 2.0]
+    for f in filters:
+        truth = f["mean_global_relative_error"]["truth"]
+        assert 0.9 * floor <= truth <= 1.25 * floor, (truth, floor)
+
+
+def test_the_verdict_chooses_what_predicts_the_raw_torques_on_a_real_window(tmp_path):
+    """The UR10e's identification log cut to rows 1060-1560: scored on ptp_10_points' raw measured torques (states
+    low-passed at 5 Hz, torques untouched), least squares predicts 8.3 %, the SDP 8.8 %, the description's rigid body
+    with the drive terms fitted 11.9 %. The verdict weighed a mean with ten static holds (the distance to the
+    static-friction band, another unit) and a filtered torque, and handed on the drive-only estimate (1.43× the best);
+    it now hands on one within 5 % of the best candidate."""
+    import re
+    from pathlib import Path
+
+    from dynid.identification.estimates import DRIVE_ONLY_LABEL
+    from dynid.identification.evidence import NOMINAL_LABEL
+    from dynid.identification.run import run_identification
+    from dynid.io.datasets import load_recording
+    from dynid.io.identification_config import load_identification_config
+    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.settings import Preprocessing
+    from dynid.validation.torques import compare_torques
+    from tests.conftest import shared_data
+
+    root = shared_data("ur10e_mamedov2020")
+    repo = Path(__file__).resolve().parents[2]
+    text = (repo / "configs" / "ur10e.toml").read_text()
+    text = re.sub(r'^robot = "(.*)"$', lambda m: f'robot = "{(repo / "configs" / m.group(1)).resolve()}"'
+                  if (repo / "configs" / m.group(1)).is_file() else m.group(0), text, flags=re.M)
+    text = text.replace("rows = [635, 3510]", "rows = [1060, 1560]", 1)
+    cfg = tmp_path / "window.toml"
+    cfg.write_text(text)
+    config = load_identification_config(cfg, data_root=root)
+    r = run_identification(config)
+    sets = {label: e.params for label, e in r.estimates.items()}
+    sets[NOMINAL_LABEL] = r.base.base_from_standard(r.model.standard_parameters())
+    sets[DRIVE_ONLY_LABEL] = r.drive_only.params
+    spec = next(s for s in config.validation if s.name == "ptp_10_points")
+    raw = Preprocessing(position_cutoff=5.0, velocity_cutoff=5.0, parallel_cutoff=0.0, decimation=1, trim=0.6, min_speed=0.0)
+    data = prepare(load_recording(spec, config.robot), raw, strict=False)
+    errors = {k: m["global_relative_error"] for k, m in compare_torques(r.model, r.base, data, sets).metrics().items()}
+    main = errors[r.main] if r.main in errors else errors[DRIVE_ONLY_LABEL]
+    assert main <= 1.05 * min(errors.values()), (r.main, errors)
+
+
+def test_a_ranking_that_hangs_on_the_state_filter_is_said():
+    """The finding appears where another candidate beats the main estimate by more than 2 % under one state filter,
+    and is withdrawn where the candidates stay within 2 % (the TX40's three within 0.1 % of each other) or the main
+    estimate is best under every filter."""
+    from dynid.identification.verdict import _ranking_finding
+
+    def filters(*means):
+        return [{"cutoff_factor": k, "mean_global_relative_error": m, "best": min(m, key=m.get)}
+                for k, m in zip((1.0, 0.5, 2.0), means)]
+
+    split = filters({"A": 10.0, "B": 11.0}, {"A": 10.0, "B": 11.0}, {"A": 12.0, "B": 10.0})
+    found = _ranking_finding(split, "A")
+    assert len(found) == 1 and found[0].kind == "yardstick" and "at 2× the cutoffs B 10 % against 12 % for A" in found[0].text
+    assert _ranking_finding(filters({"A": 15.63, "B": 15.64}, {"A": 15.86, "B": 15.87}, {"A": 15.77, "B": 15.75}), "A") == ()
+    assert _ranking_finding(filters({"A": 10.0, "B": 11.0}, {"A": 10.0, "B": 11.0}, {"A": 10.0, "B": 10.5}), "A") == ()

@@ -15,12 +15,13 @@ from .._util.reprs import short_repr
 from ..exceptions import DynIdError
 from ..io.datasets import Recording
 from ..preprocessing.settings import Preprocessing
-from ..preprocessing.strategies import carried_over, yardstick_settings
+from ..preprocessing.strategies import YARDSTICK_FILTERS, carried_over, yardstick_filters, yardstick_settings
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
 
-__all__ = ["NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "nominal_set", "state_evidence", "validate_sets", "with_yardstick",
+__all__ = ["NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
+           "state_evidence", "validate_sets", "with_yardstick",
            "yardstick_reference", "yardstick_scores"]
 
 
@@ -43,7 +44,15 @@ class Evidence:
     validations : tuple of TorqueComparison
         The same without the drive-only candidate: what results.json shows.
     yardstick : tuple of TorqueComparison
-        Every candidate on the one yardstick (:func:`yardstick_scores`), the SDP's refits left out.
+        Every candidate on the one yardstick (:func:`yardstick_scores`), the states filtered at the default rules'
+        cutoffs, the SDP's refits left out.
+    filters : tuple of tuple of TorqueComparison
+        The same under each state filter of :data:`dynid.preprocessing.strategies.YARDSTICK_FILTERS` (the first is
+        ``yardstick``): the verdict weighs their mean.
+    best : tuple of str
+        The candidate (estimate, the description's nominal model, the drive-only estimate) with the lowest mean error
+        under each filter, over the logs read as the identification log: where they differ, the ranking depends on the
+        filter, and the verdict says so.
     states : dict or None
         With ``choice = "states"``: the SDP's refits' spread on the validation states
         (:func:`state_evidence`).
@@ -55,6 +64,8 @@ class Evidence:
     scored: tuple
     validations: tuple
     yardstick: tuple
+    filters: tuple
+    best: tuple[str, ...]
     states: dict | None
     warnings: tuple[str, ...]
 
@@ -98,23 +109,33 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
                                      nominal=None if nominal is None else nominal[0])
     validations = scored if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
-    yardstick = yardstick_scores(setup, base, {**sets, **refits}, validation, resolved=prepared.data.settings,
-                                 reference=reference, progress=progress)
+    filters = yardstick_scores(setup, base, {**sets, **refits}, validation, resolved=prepared.data.settings,
+                               reference=reference, progress=progress)
+    yardstick = filters[0]
+    misread = {v.name for v in scored if v.misread}  # the verdict weighs no log read otherwise
+    candidates = [k for k in sets if k in result.estimates or k in (DRIVE_ONLY_LABEL, None if nominal is None else nominal[0])]
+    best = tuple(_best(tuple(v for v in one if v.name not in misread), candidates) for one in filters)
     states = None
     if refits:  # [estimation] choice = "states": the verdict reads the validation logs' states, not their torques
         assert nominal is not None
         fallback = DRIVE_ONLY_LABEL if alt is not None and pipeline.torque_sensor != "joint" else nominal[0]
-        misread = {v.name for v in scored if v.misread}  # the verdict weighs no log read otherwise
         trusted = tuple(v for v in yardstick if v.name not in misread)
         states = state_evidence(trusted, SDP_LABEL, fallback, tuple(refits), nominal[0]) if trusted else None
-        for label in refits:
-            yardstick = tuple(v.without(label) for v in yardstick)
-    return Evidence(nominal, scored, validations, yardstick, states, tuple(warnings))
+        filters = tuple(tuple(v.without(*refits) for v in one) for one in filters)
+    return Evidence(nominal, scored, validations, filters[0], filters, best, states, tuple(warnings))
+
+
+def _best(comparisons: tuple, candidates: list) -> str:
+    """The candidate with the lowest mean global error over ``comparisons`` ("" where there is none)."""
+    if not comparisons or not candidates:
+        return ""
+    moving = moving_logs(comparisons)
+    return min(candidates, key=lambda k: float(np.mean([v.metrics()[k]["global_relative_error"] for v in moving])))
 
 
 def validate_sets(setup, base, parameter_sets: dict, recordings, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
-                  yardstick: Preprocessing | None = None, fitted: tuple[str, np.ndarray] | None = None,
+                  fitted: tuple[str, np.ndarray] | None = None,
                   geometry: bool = True, nominal: str | None = None) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
@@ -136,10 +157,6 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
         Each joint's residual σ (for the prediction bands).
     covariance : dict, optional
         label -> covariance of that set.
-    yardstick : Preprocessing, optional
-        Prepare each log by the one yardstick instead of the identification's settings carried over: the
-        identification log's settings resolved by dynid's default rules
-        (:func:`dynid.preprocessing.strategies.yardstick_settings`).
     fitted : (str, (n_dof,) array), optional
         The estimate fitted to the identification log and its correlation with each joint's torque there: a log
         whose torque channels run against it, swapped or scaled is said (:mod:`dynid.validation.channel_checks`).
@@ -172,8 +189,7 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
 
     out: list = []
     warnings: list[str] = []
-    settings = (carried_over(resolved, setup.preprocessing) if yardstick is None else
-                yardstick_settings(resolved, setup.preprocessing, yardstick))
+    settings = carried_over(resolved, setup.preprocessing)
     for recording in recordings:
         if not isinstance(recording, Recording):
             raise TypeError(f"validate_sets: expected read logs (dynid.load_recording(spec, robot)), got {type(recording).__name__}")
@@ -184,8 +200,8 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
                                  progress=None if progress is None else (lambda d, t, s=recording.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
-        found = [] if yardstick is not None or fitted is None else channel_findings(scored, *fitted, nominal=nominal)
-        if not found and geometry and yardstick is None and np.any(setup.robot.inertial != 0):
+        found = [] if fitted is None else channel_findings(scored, *fitted, nominal=nominal)
+        if not found and geometry and np.any(setup.robot.inertial != 0):
             found, _ = geometry_findings(setup.robot, data.q, data.dq, data.ddq, data.tau, recording.name, fitted=False)
         warnings.extend(f.text for f in found)
         out.append(replace(scored, misread=found[0].text) if found else scored)
@@ -221,8 +237,9 @@ def filtered_finding(names: list, recordings: list) -> tuple:
                                 "if the controller can, or give [preprocessing] rest_velocity for a joint that creeps"),)
 
 
-YARDSTICK = ("each validation log prepared by dynid's default rules (filters, samples kept, rest threshold), carried "
-             "over from the identification log prepared by the same rules, whatever the identification's settings")
+YARDSTICK = ("each validation log's torques as measured (no filter), its states filtered by dynid's default rules "
+             "carried over from the identification log, whatever the identification's settings; the candidates ranked "
+             "with the states filtered at half and twice those cutoffs too")
 """What the one yardstick is, as results.json and the terminal say it (:func:`with_yardstick`)."""
 
 
@@ -249,10 +266,19 @@ def yardstick_reference(recording) -> Preprocessing | None:
 
 
 def yardstick_scores(setup, base, sets: dict, recordings, *, resolved=None, reference=None,
-                     progress=None) -> tuple:
-    """Every set scored on the validation logs by the one yardstick (issue "Never worse than the description", item 5):
-    each log prepared by dynid's default rules, whatever the identification's settings
-    (:func:`dynid.preprocessing.strategies.yardstick_settings`).
+                     progress=None) -> tuple[tuple, ...]:
+    """Every set scored on the validation logs by the one yardstick (issues "Never worse than the description", item 5,
+    and "The better model wins", item 1): each log's torques as measured, its states prepared by dynid's default
+    rules whatever the identification's settings, under each state filter of
+    :data:`dynid.preprocessing.strategies.YARDSTICK_FILTERS`
+    (:func:`dynid.preprocessing.strategies.yardstick_filters`), on the same samples and rest threshold for every
+    filter and set.
+
+    Why it is fair: every set is scored on the same samples against the same measured torque, which no filter of
+    the yardstick's touches, so the torque's noise adds the same to every set's squared error and no set gains by a
+    filter that smooths the measured torque alongside its own predictions; the accelerations' noise, which a set with
+    larger inertial terms turns into more predicted noise, is what the state filter sets, and a ranking that holds
+    under half and twice the rule's cutoff does not hang on it.
 
     Parameters
     ----------
@@ -271,23 +297,39 @@ def yardstick_scores(setup, base, sets: dict, recordings, *, resolved=None, refe
 
     Returns
     -------
-    tuple of TorqueComparison
+    tuple of tuple of TorqueComparison
+        One tuple (a comparison per log) per state filter, in the order of
+        :data:`~dynid.preprocessing.strategies.YARDSTICK_FILTERS`.
     """
-    step = None if progress is None else (lambda label, done, total: progress(f"one yardstick: {label}", done, total))
-    return validate_sets(setup, base, sets, recordings, progress=step, resolved=resolved,
-                         yardstick=reference or Preprocessing())[0]
+    from ..preprocessing.pipeline import prepare
+    from ..validation.torques import compare_torques
+
+    treated = yardstick_settings(resolved, setup.preprocessing, reference or Preprocessing())
+    out: list[list] = [[] for _ in YARDSTICK_FILTERS]
+    for recording in recordings:
+        if progress is not None:
+            progress(f"one yardstick: {recording.name}", 0, 1)
+        rest = None
+        for k, settings in enumerate(yardstick_filters(treated, recording)):
+            data = prepare(recording, settings if rest is None else replace(settings, rest_velocity=rest), strict=False)
+            rest = data.settings.rest_velocity  # the first filter's rest threshold for every filter: the same samples
+            out[k].append(compare_torques(setup.robot, base, data, sets))
+    return tuple(tuple(one) for one in out)
 
 
-def with_yardstick(result, scored: tuple):
+def with_yardstick(result, filters: tuple, best: tuple[str, ...] = ()):
     """``result`` with the sets' errors on the one yardstick in its diagnostics (``"yardstick"``: the global relative
-    error [%] of each set on each log and their mean over the logs), beside the figures on the identification's own
-    settings.
+    error [%] of each set on each log and their mean over the logs, with the states filtered by the default rules;
+    ``"filters"``: each state filter's multiple of those cutoffs, the sets' mean errors under it and the best
+    candidate), beside the figures on the identification's own settings.
 
     Parameters
     ----------
     result : IdentificationResult
-    scored : tuple of TorqueComparison
+    filters : tuple of tuple of TorqueComparison
         From :func:`yardstick_scores`.
+    best : tuple of str
+        :attr:`Evidence.best`.
 
     Returns
     -------
@@ -299,6 +341,7 @@ def with_yardstick(result, scored: tuple):
     """
     from ..validation.torques import rests_throughout
 
+    scored = filters[0] if filters else ()
     logs = {c.name: {label: float(m["global_relative_error"]) for label, m in c.metrics().items()} for c in scored}
     labels = [label for label in (scored[0].metrics() if scored else {})]
 
@@ -309,7 +352,30 @@ def with_yardstick(result, scored: tuple):
     moving = [c.name for c in scored if not rests_throughout(c.rest_share)]
     if moving and len(moving) < len(scored):  # a log at rest throughout scores the distance to the static-friction band
         figures["mean_over_logs_that_move"] = {"logs": moving, **mean(moving)}
+    if len(filters) > 1:
+        figures["filters"] = [{"cutoff_factor": f, "mean_global_relative_error": {
+            label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in moving_logs(one)])) for label in labels},
+            **({"best": b} if b else {})} for f, one, b in zip(YARDSTICK_FILTERS, filters, best or ("",) * len(filters))]
     return replace(result, diagnostics={**result.diagnostics, "yardstick": figures})
+
+
+def moving_logs(comparisons: tuple) -> tuple:
+    """The logs that move, where some rest throughout: those score the distance to the static-friction band about
+    their gravity torque (:func:`dynid.validation.torques.rests_throughout`), another unit than a motion's error.
+
+    Parameters
+    ----------
+    comparisons : tuple of TorqueComparison
+
+    Returns
+    -------
+    tuple of TorqueComparison
+        All of them where none moves.
+    """
+    from ..validation.torques import rests_throughout
+
+    moving = tuple(c for c in comparisons if not rests_throughout(c.rest_share))
+    return moving or comparisons
 
 
 def state_evidence(comparisons, sdp: str, fallback: str, refits: tuple[str, ...], scale: str) -> dict:

@@ -26,7 +26,7 @@ from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over
 from ..runtime.threads import with_single_blas_thread
-from .evidence import nominal_set, validate_sets, yardstick_reference
+from .evidence import nominal_set, validate_sets, yardstick_reference, yardstick_scores
 
 if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it is imported
     from .pipeline import IdentificationPipeline
@@ -168,10 +168,10 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     source : str
         Where the results come from (their file), named in errors.
     yardstick : bool
-        Prepare every log by the one yardstick (dynid's default rules, carried over from the config's identification
-        log prepared by them: :func:`dynid.preprocessing.strategies.yardstick_settings`) instead of the results'
-        settings, so that results identified with other settings, or another tool's model, are scored on the same
-        samples treated the same way.
+        Score every log by the one yardstick (its torques as measured, its states filtered by dynid's default rules
+        carried over from the config's identification log: :func:`dynid.identification.evidence.yardstick_scores`,
+        the first state filter) instead of the results' settings, so that results identified with other settings, or
+        another tool's model, are scored on the same samples treated the same way.
 
     Returns
     -------
@@ -191,14 +191,17 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    reference = yardstick_reference(load_recording(config.identification, config.robot)) or Preprocessing() if yardstick else None
+    logs = _read_as_scored(datasets, config.robot, progress)
+    if yardstick:
+        reference = yardstick_reference(load_recording(config.identification, config.robot))
+        filters = yardstick_scores(config, base, sets, logs, resolved=stored_preprocessing(identified), reference=reference)
+        return filters[0], tuple(w for r in refs for w in r.warnings)
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
-    logs = _read_as_scored(datasets, config.robot, progress)
     comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
                                           progress=progress, resolved=stored_preprocessing(identified),
                                           noise=stored_residual_level(identified, config.robot.n_dof),
-                                          yardstick=reference, fitted=_fitted_correlation(identified, sets, config.robot.n_dof),
+                                          fitted=_fitted_correlation(identified, sets, config.robot.n_dof),
                                           nominal=label)
     if beside:
         comparisons = tuple(v.without(str(label)) for v in comparisons)

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..exceptions import ConfigError
 from ..plugins import Registry
+from .bands import capped
 from .settings import Preprocessing
 
 if TYPE_CHECKING:
@@ -39,7 +40,8 @@ if TYPE_CHECKING:
     from ..model.robot import Robot
     from .prepared import PreparedData
 
-__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for", "carried_over", "yardstick_settings"]
+__all__ = ["Strategy", "register_strategy", "strategy_names", "strategy_for", "carried_over", "yardstick_filters",
+           "yardstick_settings"]
 
 Chunk = tuple["np.ndarray", "np.ndarray", "np.ndarray", "np.ndarray"]
 
@@ -265,18 +267,27 @@ YARDSTICK_DEFAULTS = (*HARMONICS_RESOLVED, "order", "strategy", "smoothing_passe
 samples kept (trim, decimation) and the rest threshold."""
 
 
+YARDSTICK_FILTERS = (1.0, 0.5, 2.0)
+"""The one yardstick's state filters: each validation log's positions (and measured velocities) low-passed at these
+multiples of the cutoff dynid's default rules give it, the first the one shown (:func:`yardstick_filters`). The
+candidates are ranked under each: a ranking that changes with the filter is said, and the choice weighs their mean
+(issue "The better model wins", item 1). Half to twice the rule's cutoff spans the 2-20 Hz the issue's real arm was
+checked over, and keeps the slowest filter 5× above the excitation's band (the rule's cutoff is
+:data:`~dynid.preprocessing.bands.POSITION_FACTOR` × the band)."""
+
+
 def yardstick_settings(resolved: Preprocessing | None, given: Preprocessing,
                        reference: Preprocessing | None) -> Preprocessing:
-    """Settings of the one yardstick: a validation log prepared the same way whatever the identification's settings
-    (issue "Never worse than the description", item 5).
+    """The treatment the one yardstick starts from: a validation log prepared the same way whatever the
+    identification's settings (issue "Never worse than the description", item 5); :func:`yardstick_filters` then
+    leaves its torques as measured.
 
     Every filter, the trim, the decimation and the rest threshold (:data:`YARDSTICK_DEFAULTS`) are those dynid's
     default rules give the validation log, carried over from the identification log prepared by the same default
     rules (``reference``: the faster band of the two, the identification's rest velocity as the floor, as
-    :func:`carried_over` does), so two settings, two estimates, a reference set and another tool's model are scored on
-    the same samples with the measured torque treated the same way. What describes the model rather than the
-    treatment of the log stays as the identification gives it: the torque channel's delay, the Coulomb smoothing, the
-    friction at rest and the presliding distance.
+    :func:`carried_over` does). What describes the model rather than the treatment of the log stays as the
+    identification gives it: the torque channel's delay, the Coulomb smoothing, the friction at rest and the
+    presliding distance.
 
     Parameters
     ----------
@@ -294,6 +305,43 @@ def yardstick_settings(resolved: Preprocessing | None, given: Preprocessing,
     """
     treatment = carried_over(reference, Preprocessing())
     return replace(carried_over(resolved, given), **{f: getattr(treatment, f) for f in YARDSTICK_DEFAULTS})
+
+
+def yardstick_filters(treated: Preprocessing, recording) -> tuple[Preprocessing, ...]:
+    """The one yardstick's settings for one validation log, one per state filter of :data:`YARDSTICK_FILTERS` (issue
+    "The better model wins", item 1).
+
+    The torques are scored as measured: no parallel filter and no decimation (the torque delay, which describes the
+    sensor, stays), so that a model whose inertial terms are larger is not judged against a torque the yardstick
+    itself smoothed while its accelerations keep the differentiation's noise, and the noise of the measured torque,
+    which no model predicts, adds the same to every candidate's squared error. The states are low-passed at each
+    multiple of the cutoffs the default rules give this log (``treated`` resolved on it), on the same samples: the
+    trim of the slowest filter, at most a tenth of the log at each end.
+
+    Parameters
+    ----------
+    treated : Preprocessing
+        :func:`yardstick_settings`.
+    recording : dynid.io.datasets.Recording
+        The validation log, read.
+
+    Returns
+    -------
+    tuple of Preprocessing
+        Settings for :func:`dynid.preprocessing.pipeline.prepare` (``strict=False``), in the order of
+        :data:`YARDSTICK_FILTERS`; the rest threshold is each log's own ("auto"): give the first's resolved value to
+        the others for the same rest samples.
+    """
+    rate, duration = recording.rate, recording.n_samples / recording.rate
+    own = treated.resolved(rate, recording.q, measured_velocity=recording.dq is not None, name=recording.label,
+                           strict=False)
+    pos, vel = float(own.position_cutoff or 0.0), float(own.velocity_cutoff or 0.0)  # resolved: numbers
+    on = [c for c in (pos, vel if recording.dq is not None else 0.0) if c > 0]
+    trim = min(3.0 / (min(YARDSTICK_FILTERS) * min(on)), 0.1 * duration) if on else 0.0
+    return tuple(replace(own, position_cutoff=capped(f * pos, rate), velocity_cutoff=capped(f * vel, rate),
+                         parallel_cutoff=0.0, decimation=1,
+                         trim=trim, rest_velocity=treated.rest_velocity, min_speed=0.0, warnings=())
+                 for f in YARDSTICK_FILTERS)
 
 
 def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Preprocessing:

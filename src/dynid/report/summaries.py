@@ -832,8 +832,8 @@ def _yardstick_lines(r, label: str) -> list:
         k = len(moving["logs"])
         over = (("(over the one log that moves" if k == 1 else f"(mean over the {k} logs that move")
                 + f"; of the {len(rests)} at rest throughout, within the static-friction band: {within})")
-    return [Line(f"on one yardstick (every validation log filtered by dynid's default rules, the same samples whatever the "
-                 f"settings): {label} {mean[label]:.3g} %{beside} {over}")]
+    return [Line(f"on one yardstick (every validation log's torques as measured, its states filtered by dynid's default "
+                 f"rules whatever the settings): {label} {mean[label]:.3g} %{beside} {over}")]
 
 
 CHOSEN_TERMS = ("fst", "fca", "fcl")

@@ -57,7 +57,8 @@ class Finding:
         along another axis of the base: :mod:`dynid.validation.geometry_checks`), "misread" (a validation log the verdict
         leaves out, read otherwise than the identification log: :mod:`dynid.validation.channel_checks`), "filtered"
         (torques without measurable noise: :func:`dynid.validation.noise_floor.looks_filtered`), "columns" (torques
-        that follow the description on no joint: :func:`unlike_nominal_findings`).
+        that follow the description on no joint: :func:`unlike_nominal_findings`), "yardstick" (the validation logs rank
+        the candidates differently under another state filter: :func:`dynid.identification.verdict.decide`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
     joint : int or None

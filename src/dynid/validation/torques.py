@@ -191,12 +191,12 @@ class TorqueComparison:
             out[label] = m
         return out
 
-    def without(self, label: str) -> TorqueComparison:
-        """The same comparison with the set ``label`` left out (a candidate scored beside the others and not kept).
+    def without(self, *labels: str) -> TorqueComparison:
+        """The same comparison with the sets ``labels`` left out (candidates scored beside the others and not kept).
 
         Parameters
         ----------
-        label : str
+        *labels : str
 
         Returns
         -------
@@ -205,7 +205,7 @@ class TorqueComparison:
             the first set's).
         """
         def drop(d):
-            return d if d is None else {k: v for k, v in d.items() if k != label}
+            return d if d is None else {k: v for k, v in d.items() if k not in labels}
 
         summary = self.summary if self.summary is None else {**self.summary, "metrics": drop(self.summary["metrics"])}
         return replace(self, predicted=drop(self.predicted), summary=summary, static=drop(self.static),
