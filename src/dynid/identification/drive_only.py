@@ -30,7 +30,7 @@ from ..model.robot import Robot
 from ..preprocessing.bands import capped
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
-from .estimates import DRIVE_ONLY_KEY
+from .estimates import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, NOMINAL_LABEL
 
 __all__ = ["CUTOFF_FACTORS", "DRIVE_ONLY_KEY", "DriveOnly", "drive_only", "prepared_variant", "preprocessing_variants", "variants_judge"]
 
@@ -211,7 +211,7 @@ def drive_only(robot: Robot, base: BaseParameters, accumulator: LeastSquaresAccu
     drive = np.setdiff1d(np.arange(len(names)), links.ravel())
     if drive.size == 0:
         return None
-    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, base=base,
+    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0, regrouping=base.regrouping,
                             joint_weights=joint_weights, sigmas=robot.prior_sigmas()[drive])
     x, params, cov = problem.fit(accumulator)
     moved_one_way = set(one_way)
@@ -255,17 +255,59 @@ def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:
     return sorted(out)
 
 
-class _DriveProblem:
-    """The bounded fit of :func:`drive_only` on any accumulator of the same base rows' layout, some terms held at the
-    description's values."""
+def held_out_errors(robot: Robot, folds, joint_weights=None) -> dict[str, float]:
+    """The description's candidates on held-out blocks of the identification log: the RMS torque error [N·m] of the
+    description's rigid body with its drive terms fitted on all blocks but one (as :func:`drive_only` fits them, the
+    one-way joints' terms not judged), and of the description's nominal values, each on the block left out, over all
+    blocks (issue "The better model wins", item 3).
 
-    def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, *, base: BaseParameters,
+    Parameters
+    ----------
+    robot : Robot
+        With nominal inertial parameters.
+    folds : sequence of LeastSquaresAccumulator
+        The log's contiguous blocks of standard rows
+        (:class:`dynid.identification.identify.BlockScoring`'s ``folds``).
+    joint_weights : (n_dof,) array, optional
+        WLS weights, as the least-squares estimate's.
+
+    Returns
+    -------
+    dict
+        :data:`~dynid.identification.estimates.DRIVE_ONLY_LABEL` and
+        :data:`~dynid.identification.estimates.NOMINAL_LABEL` -> RMS error [N·m]; empty for a description without
+        inertial parameters.
+    """
+    if not np.any(robot.inertial != 0) or not folds:
+        return {}
+    names, phi0 = robot.parameter_names, robot.physical_prior()[0]
+    links, nonnegative = consistency_layout(robot)
+    drive = np.setdiff1d(np.arange(len(names)), links.ravel())
+    problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0,
+                            regrouping=np.eye(len(names)), joint_weights=joint_weights, sigmas=robot.prior_sigmas()[drive])
+    nominal = robot.standard_parameters()
+    sse, rows = np.zeros(2), 0
+    for k, held in enumerate(folds):
+        phi = phi0.copy()
+        if drive.size:
+            phi[drive] = problem.fit(LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k]))[0]
+        sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(nominal).sum()]
+        rows += int(held.rows.sum())
+    rms = np.sqrt(sse / max(rows, 1))
+    return {DRIVE_ONLY_LABEL: float(rms[0]), NOMINAL_LABEL: float(rms[1])}
+
+
+class _DriveProblem:
+    """The bounded fit of :func:`drive_only` on any accumulator of the rows ``regrouping`` maps the standard parameters
+    to (the base map's; the identity for standard rows), some terms held at the description's values."""
+
+    def __init__(self, names, drive: np.ndarray, lower: np.ndarray, phi0: np.ndarray, *, regrouping: np.ndarray,
                  joint_weights, sigmas: np.ndarray | None = None) -> None:
         self.names, self.drive, self.lower, self.phi0, self.joint_weights = names, drive, lower, phi0, joint_weights
         self.sigmas = np.full(drive.size, np.nan) if sigmas is None else np.asarray(sigmas, dtype=float)
         rigid = phi0.copy()
         rigid[drive] = 0.0
-        self.basis, self.offset = base.regrouping[:, drive], base.regrouping @ rigid
+        self.basis, self.offset = regrouping[:, drive], regrouping @ rigid
 
     def fit(self, accumulator: LeastSquaresAccumulator, fixed=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(x, params, covariance)``: the drive terms (``fixed`` ones at the description's values), the base

@@ -127,5 +127,9 @@ def consistency_checks(robot: Robot, base: BaseParameters, sets: dict) -> tuple[
     return margins, verdicts
 
 
+NOMINAL_LABEL = "description (nominal)"
+"""The set of the description's own nominal values, scored on the validation logs beside the estimates when no
+reference set of the config is that."""
+
 HELD_OUT_FOLDS = 5
 """Contiguous blocks of the identification log that compare the estimates when no validation log does."""

@@ -18,16 +18,11 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import YARDSTICK_FILTERS, carried_over, yardstick_filters, yardstick_settings
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
-from .estimates import DRIVE_ONLY_LABEL, SDP_LABEL
+from .estimates import DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
 
 __all__ = ["NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
            "state_evidence", "validate_sets", "with_yardstick",
            "yardstick_reference", "yardstick_scores"]
-
-
-NOMINAL_LABEL = "description (nominal)"
-"""The set of the description's own nominal values, scored on the validation logs beside the estimates when no
-reference set of the config is that."""
 
 
 @short_repr

@@ -47,7 +47,7 @@ from ..validation.diagnostics import (
 )
 from ..validation.geometry_checks import geometry_findings
 from ..validation.torques import TorqueComparison, TorqueSums, resting_rows
-from .drive_only import DriveOnly, drive_only
+from .drive_only import DriveOnly, drive_only, held_out_errors
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .flipped_joints import flipped_joint_findings
 from .identified import Parameters
@@ -392,6 +392,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
                                 jackknife=jackknife, progress=progress)
+    if "held_out_rms_error" in stats:
+        stats["held_out_block_seconds"] = float(data.t[-1] - data.t[0]) / HELD_OUT_FOLDS
     return IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
         n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
@@ -641,16 +643,17 @@ def one_way_joints(data: PreparedData) -> list[int]:
 
 def _held_out_evidence(robot: Robot, base: BaseParameters, folds, row_weights, stats: dict, ls_label: str, *,
                        held_out: bool, jackknife: bool, progress=None) -> tuple:
-    """What the held-out blocks say: with ``held_out``, the least-squares and SDP estimates' errors on them
-    (``stats["held_out_rms_error"]``); with ``jackknife``, the SDP refitted on all blocks but one (returned, base
-    parameters; empty otherwise)."""
+    """What the held-out blocks say: with ``held_out``, the least-squares and SDP estimates' errors on them and the
+    description's candidates' (:func:`dynid.identification.drive_only.held_out_errors`; ``stats["held_out_rms_error"]``,
+    and ``stats["held_out_block_seconds"]``, each block's length); with ``jackknife``, the SDP refitted on all blocks
+    but one (returned, base parameters; empty otherwise)."""
     if not folds or not (held_out or jackknife):
         return ()
     if progress is not None:
         progress("physically consistent SDP, held-out blocks", 0, 1)
     own, held, refitted = _held_out_errors(robot, folds, row_weights)
     if held_out:
-        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held}
+        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held, **held_out_errors(robot, folds, row_weights)}
     return tuple(base.base_from_standard(phi) for phi in refitted) if jackknife else ()
 
 

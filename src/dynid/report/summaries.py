@@ -18,10 +18,11 @@ from ..estimators.registry import OTHER_LABELS, label
 from ..exceptions import NotFittedError
 from ..friction import COUNTERBALANCE_TERMS, TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
+from ..identification.estimates import HELD_OUT_FOLDS, NOMINAL_LABEL
 from ..identification.identified import IdentifiedModel
 from ..identification.identifier import Identifier
 from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
-from ..identification.verdict import NOMINAL_KEY
+from ..identification.verdict import NOMINAL_KEY, held_out_best
 from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
 from ..validation.noise_floor import AT_FLOOR
@@ -310,6 +311,21 @@ def _verdict(r) -> list:
             *(Line(f.text) for f in r.findings)]
 
 
+def _held_out_clause(r, label: str) -> str:
+    """The first line's words on held-out blocks of the identification log, where they were scored (without
+    validation logs): how ``label`` predicts them against the best candidate, and over how much time."""
+    held = (getattr(r, "diagnostics", None) or {}).get("held_out_rms_error") or {}
+    if label not in held:
+        return ""
+    seconds = r.diagnostics.get("held_out_block_seconds")
+    blocks = f"{HELD_OUT_FOLDS} × {seconds:.3g} s" if seconds else f"{HELD_OUT_FOLDS} blocks"
+    best = held_out_best(held, label)
+    said = (f"it predicts them as well as any candidate ({held[label]:.3g} N·m RMS)" if best == label else
+            f"{'the description' if best == NOMINAL_LABEL else best} predicts them better ({held[best]:.3g} against "
+            f"{held[label]:.3g} N·m RMS)")
+    return f"; on held-out blocks of this log ({blocks}, weaker evidence than another motion) {said}"
+
+
 def _exportable(r) -> list[str]:
     """The estimates ``dynid export`` can write: standard parameters that passed the consistency check (the SDP's, the
     drive-only one's), the main estimate first as export takes it (:func:`dynid.io.results.stored_standard`)."""
@@ -394,8 +410,8 @@ def readiness(result, *, library: bool = False) -> Line:
              "its URDF and MJCF are in the output folder")
     if not r.validations:
         check = "validate(log) on other motions" if library else "add [[validation]] logs (other motions)"
-        return Line(f"model ready to check: {exportable[0]} is physically consistent ({files}); {check} before you use "
-                    "it", "title")
+        return Line(f"model ready to check: {exportable[0]} is physically consistent ({files}){_held_out_clause(r, exportable[0])}; "
+                    f"{check} before you use it", "title")
     if library:
         return Line(f"model ready: {exportable[0]} ({files})", "title")
     return Line(f"model ready: {exportable[0]}, as the URDF and MJCF in the output folder (other names: dynid export "
