@@ -390,13 +390,19 @@ def _edited(results: Path, folder: Path, edit) -> Path:
 
 
 def _first_estimate(d):
-    return next(iter(d["estimates"].values()))
+    """The estimate ``dynid export`` writes (``stored_standard``'s: the main one where it has standard values, else
+    the first that has; the first listed where none has); the edit nulls its base and its standard values."""
+    estimates = d["estimates"]
+    ordered = sorted(estimates, key=lambda k: k != d.get("main_estimate"))
+    return next((estimates[k] for k in ordered if isinstance(estimates[k].get("standard_values"), dict)),
+                estimates[ordered[0]])
 
 
 RESULTS_EDITS = {
     "a value null": (lambda d: d["base_parameters"][0].__setitem__("value", None), "edited.json: base_parameters[0].value"),
     "a value as text": (lambda d: d["base_parameters"][1].__setitem__("value", "0.5"), "edited.json: base_parameters[1].value"),
-    "an estimate's value null": (lambda d: _first_estimate(d)["values"].__setitem__(next(iter(_first_estimate(d)["values"])), None),
+    "an estimate's value null": (lambda d: [table.__setitem__(next(iter(table)), None) for key in ("values", "standard_values")
+                                            if isinstance(table := _first_estimate(d).get(key), dict)],
                                  "edited.json: "),
     "a setting of the wrong type": (lambda d: d["settings"]["preprocessing"].__setitem__("order", "four"),
                                     "edited.json: settings.preprocessing.order"),

@@ -507,9 +507,12 @@ def test_init_writes_any_path_as_a_toml_string_and_identify_reads_it(tmp_path):
     assert np.asarray(rec.q).shape[1] == 6
 
 
-def test_init_lists_the_sdp_only_where_the_descriptions_values_allow_it(tmp_path):
-    """A URDF whose nominal inertia breaks the triangle inequality: the SDP (whose prior needs consistent nominal
-    values) is not listed, a comment says why, and identify runs on WLS; with consistent values both are listed."""
+def test_init_lists_the_sdp_also_where_the_descriptions_values_are_not_consistent(tmp_path):
+    """A URDF whose nominal inertia breaks the triangle inequality: the SDP is listed (it was left out, so no
+    consistent estimate was tried: issue "The better model wins", item 2), init says its prior and the nominal
+    candidate are the nearest consistent ones, and identify names the link and runs both; with consistent values both
+    are listed, without that note."""
+    import json
     import re
 
     log = _log(tmp_path, header=True)
@@ -519,14 +522,16 @@ def test_init_lists_the_sdp_only_where_the_descriptions_values_allow_it(tmp_path
     p = run("init", str(bad), str(log), "--out", str(tmp_path / "bad.toml"))
     assert p.returncode == 0, p.stderr
     said = " ".join(p.stdout.split())
-    assert "the physically consistent SDP is not listed" in said and "triangle inequality" in said
-    text = (tmp_path / "bad.toml").read_text()
-    assert "estimation" not in tomllib.loads(text)
-    assert '# estimators = ["wls", "sdp"]' in text and "# not listed: " in text and "bad.urdf: link 1" in text
-    p = run("identify", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "id"), "--no-figures", "-q")
+    assert "not physically consistent: the SDP's prior and the nominal candidate are the nearest consistent ones" in said
+    assert tomllib.loads((tmp_path / "bad.toml").read_text())["estimation"]["estimators"] == ["wls", "sdp"]
+    p = run("identify", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "id"), "--no-figures")
     assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "id" / "results.json").read_text())
+    assert "dynid SDP" in results["estimates"]
+    assert "nominal candidate take the nearest consistent link" in " ".join(p.stderr.split() + p.stdout.split())
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "good.toml"))
     assert tomllib.loads((tmp_path / "good.toml").read_text())["estimation"]["estimators"] == ["wls", "sdp"]
+    assert "not physically consistent" not in " ".join(p.stdout.split())
 
 
 def test_without_validation_logs_the_sdp_stays_main_where_held_out_blocks_score_it_as_well(tmp_path, monkeypatch):

@@ -206,7 +206,7 @@ def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_lo
     assert as_part.closed_loop_estimators == pipeline.closed_loop_estimators
     prepared = pipeline.prepare(recording)
     whole = pipeline.estimate(prepared, recording=recording)
-    open_loop = IdentificationPipeline(robot).estimate(prepared)
+    open_loop = IdentificationPipeline(robot, estimators=("wls",)).estimate(prepared)
     alone = ClosedLoopEstimator("idim-iv", setup).added_to(open_loop, prepared.robot, prepared.base, recording,
                                                            pipeline.preprocessing)
     assert list(alone.estimates) == ["dynid WLS", "dynid IDIM-IV"]

@@ -38,8 +38,14 @@ if TYPE_CHECKING:
 
     from .base import Estimator
 
-__all__ = ["EstimatorSpec", "SearchBudget", "FitData", "register", "unregister", "spec", "keys", "label",
-           "parse_estimators", "estimator_choices", "with_hyperparameters", "configured_estimator"]
+__all__ = ["DEFAULT_ESTIMATORS", "EstimatorSpec", "SearchBudget", "FitData", "register", "unregister", "spec", "keys",
+           "label", "parse_estimators", "estimator_choices", "with_hyperparameters", "configured_estimator"]
+
+DEFAULT_ESTIMATORS = ("wls", "sdp")
+"""The estimators an identification runs where none are listed: weighted least squares (the main estimate) and the
+physically consistent SDP, pulled toward the description's values made consistent where they are not
+(:meth:`dynid.model.robot.Robot.physical_prior`), so that a consistent estimate competes in the verdict on every arm
+(issue "The better model wins", item 2). Until 0.2 the default was least squares alone."""
 
 
 Builder = Callable[["FitData", SearchBudget, "np.random.Generator | None", "Callable[[int, float], None] | None"], "Estimator"]

@@ -258,7 +258,8 @@ def _pinned(unstable: list, names: list, prior: np.ndarray) -> list:
 def held_out_errors(robot: Robot, folds, joint_weights=None) -> dict[str, float]:
     """The description's candidates on held-out blocks of the identification log: the RMS torque error [N·m] of the
     description's rigid body with its drive terms fitted on all blocks but one (as :func:`drive_only` fits them, the
-    one-way joints' terms not judged), and of the description's nominal values, each on the block left out, over all
+    one-way joints' terms not judged), and of the description's nominal values (made physically consistent where they
+    are not, as :func:`dynid.identification.evidence.nominal_set`'s), each on the block left out, over all
     blocks (issue "The better model wins", item 3).
 
     Parameters
@@ -285,7 +286,7 @@ def held_out_errors(robot: Robot, folds, joint_weights=None) -> dict[str, float]
     drive = np.setdiff1d(np.arange(len(names)), links.ravel())
     problem = _DriveProblem(names, drive, np.where(np.isin(drive, nonnegative), 0.0, -np.inf), phi0,
                             regrouping=np.eye(len(names)), joint_weights=joint_weights, sigmas=robot.prior_sigmas()[drive])
-    nominal = robot.standard_parameters()
+    nominal = phi0  # the nominal candidate: the file's values, made consistent where they are not (nominal_set)
     sse, rows = np.zeros(2), 0
     for k, held in enumerate(folds):
         phi = phi0.copy()

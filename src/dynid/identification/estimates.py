@@ -131,5 +131,10 @@ NOMINAL_LABEL = "description (nominal)"
 """The set of the description's own nominal values, scored on the validation logs beside the estimates when no
 reference set of the config is that."""
 
+CONSISTENT_NOMINAL_LABEL = "description (nominal, made consistent)"
+"""The description's nominal values with each physically impossible link replaced by its nearest consistent one
+(:meth:`dynid.model.robot.Robot.physical_prior`): the nominal candidate where the robot file's values are not
+physically consistent."""
+
 HELD_OUT_FOLDS = 5
 """Contiguous blocks of the identification log that compare the estimates when no validation log does."""

@@ -18,9 +18,9 @@ from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import YARDSTICK_FILTERS, carried_over, yardstick_filters, yardstick_settings
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
-from .estimates import DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
+from .estimates import CONSISTENT_NOMINAL_LABEL, DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
 
-__all__ = ["NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
+__all__ = ["CONSISTENT_NOMINAL_LABEL", "NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
            "state_evidence", "validate_sets", "with_yardstick",
            "yardstick_reference", "yardstick_scores"]
 
@@ -427,11 +427,14 @@ def nominal_set(robot, base, references) -> tuple[str, np.ndarray] | None:
     Returns
     -------
     (str, (n_base,) ndarray) or None
-        Its label and base parameters; None for a description without inertias.
+        Its label and base parameters; None for a description without inertias. Where a link's nominal values are
+        those of no mass distribution, the nearest physically consistent ones (:meth:`Robot.physical_prior`, said in
+        its notes), labelled :data:`CONSISTENT_NOMINAL_LABEL` (issue "The better model wins", item 2).
     """
     if not np.any(robot.inertial != 0):
         return None
-    beta = base.base_from_standard(robot.standard_parameters())
+    phi, made = robot.physical_prior()
+    beta = base.base_from_standard(phi)
     same = next((r.name for r in references if r.beta.shape == beta.shape and
                  np.allclose(r.beta, beta, rtol=1e-9, atol=1e-12)), None)
-    return (same or NOMINAL_LABEL), beta
+    return (same or (CONSISTENT_NOMINAL_LABEL if made else NOMINAL_LABEL)), beta

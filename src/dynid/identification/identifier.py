@@ -20,6 +20,7 @@ import numpy as np
 
 from .._util.hyperparameters import HyperParameters
 from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
+from ..estimators.registry import DEFAULT_ESTIMATORS
 from ..exceptions import ConfigError, NotFittedError
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -44,7 +45,7 @@ class Identifier(HyperParameters):
         Keys of :mod:`dynid.estimators.registry`, case-insensitive, or unfitted estimators of registered classes
         carrying their hyper-parameters (e.g. the SDP with the geometric prior:
         :class:`~dynid.estimators.physically_consistent.PhysicallyConsistentLeastSquares`); the first is the main
-        estimate (default ``["wls"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
+        estimate (default ``["wls", "sdp"]``, or the config's). Every list a config's ``[estimation] estimators`` takes: the closed-loop ones
         (``idim-iv``, ``didim``, ``didim-sdp``) too, with ``controller`` for arrays, or fitting a config with a
         ``[controller]`` table.
     preprocessing : Preprocessing or dict, optional
@@ -196,7 +197,7 @@ class Identifier(HyperParameters):
                                   "(Identifier.from_config('arm.toml', estimators=...)), give "
                                   "Identifier(controller=ClosedLoopSetup(...)), or leave it out", field="estimators")
             result = identify_from_arrays(self._robot(), t, q, tau, dq, preprocessing=self._preprocessing(),
-                                          estimators=tuple(self.estimators or ("wls",)), friction=self.friction,
+                                          estimators=tuple(self.estimators or DEFAULT_ESTIMATORS), friction=self.friction,
                                           rng=seed_of(self.rng), controller=self.controller)
         return self._fitted(result)
 

@@ -25,7 +25,7 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
-from ..estimators.registry import LEAST_SQUARES, FitData, estimate_label, estimator_choices, spec
+from ..estimators.registry import DEFAULT_ESTIMATORS, LEAST_SQUARES, FitData, estimate_label, estimator_choices, spec
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.export import READINESS_KINDS
@@ -262,7 +262,7 @@ class IdentificationResult:
 
 
 @keyword_only_after_data
-def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=("wls",), *,
+def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=DEFAULT_ESTIMATORS, *,
              references: tuple[ReferenceSet, ...] = (), progress=None, rng: int = 0, held_out: bool = False,
              jackknife: bool = False, observers: tuple = (), variants: tuple = ()) -> IdentificationResult:
     """Estimate the base parameters from one prepared recording with every estimator of ``estimators``, in one pass
@@ -331,7 +331,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         except DynIdError:
             if sdp:
                 raise
-        prior_notes = prior_notes if sdp else ()  # said where the SDP pulls toward it (as before)
+        # said wherever the description has inertial values: the nominal candidate takes them too (nominal_set)
     base_std, not_carried = base.base_std(robot.prior_sigmas()) if robot.prior_sigma else (None, ())
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
                       prior=prior, hyperparameters=hyperparameters,
@@ -391,9 +391,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
-                                jackknife=jackknife, progress=progress)
-    if "held_out_rms_error" in stats:
-        stats["held_out_block_seconds"] = float(data.t[-1] - data.t[0]) / HELD_OUT_FOLDS
+                                jackknife=jackknife, progress=progress, span=float(data.t[-1] - data.t[0]))
     return IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
         n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
@@ -642,10 +640,10 @@ def one_way_joints(data: PreparedData) -> list[int]:
 
 
 def _held_out_evidence(robot: Robot, base: BaseParameters, folds, row_weights, stats: dict, ls_label: str, *,
-                       held_out: bool, jackknife: bool, progress=None) -> tuple:
+                       held_out: bool, jackknife: bool, progress=None, span: float = 0.0) -> tuple:
     """What the held-out blocks say: with ``held_out``, the least-squares and SDP estimates' errors on them and the
     description's candidates' (:func:`dynid.identification.drive_only.held_out_errors`; ``stats["held_out_rms_error"]``,
-    and ``stats["held_out_block_seconds"]``, each block's length); with ``jackknife``, the SDP refitted on all blocks
+    and ``stats["held_out_block_seconds"]``, each block's length: ``span`` over the blocks); with ``jackknife``, the SDP refitted on all blocks
     but one (returned, base parameters; empty otherwise)."""
     if not folds or not (held_out or jackknife):
         return ()
@@ -654,6 +652,7 @@ def _held_out_evidence(robot: Robot, base: BaseParameters, folds, row_weights, s
     own, held, refitted = _held_out_errors(robot, folds, row_weights)
     if held_out:
         stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held, **held_out_errors(robot, folds, row_weights)}
+        stats["held_out_block_seconds"] = span / HELD_OUT_FOLDS  # the log's span [s] over the blocks
     return tuple(base.base_from_standard(phi) for phi in refitted) if jackknife else ()
 
 

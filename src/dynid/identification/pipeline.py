@@ -41,7 +41,7 @@ import numpy as np
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.estimation import Estimation, stream_rows
-from ..estimators.registry import FitData, estimator_choices
+from ..estimators.registry import DEFAULT_ESTIMATORS, FitData, estimator_choices
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.identification_config import split_estimators
 from ..model.loading import as_robot
@@ -152,7 +152,7 @@ class IdentificationPipeline:
 
     robot: Robot
     preprocessing: Preprocessing = field(default_factory=Preprocessing)
-    estimators: tuple = ("wls",)
+    estimators: tuple = DEFAULT_ESTIMATORS
     friction: str | None = None
     rng: int = 0
     source: str = ""

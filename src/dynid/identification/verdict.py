@@ -348,10 +348,10 @@ def _state_choice(result, nominal: tuple[str, np.ndarray], scored: tuple, states
 
 def _with_nominal(result, nominal: tuple[str, np.ndarray]):
     """``result`` with the description's nominal model among its estimates, under the label its set is scored with:
-    its standard values are the robot file's, which export writes."""
+    its standard values are the robot file's (made physically consistent where they are not), which export writes."""
 
     estimate = Estimate(NOMINAL_KEY, np.asarray(nominal[1], dtype=float), np.zeros_like(nominal[1]),
-                        standard=result.model.standard_parameters())
+                        standard=result.model.physical_prior()[0])
     margins, verdicts = consistency_checks(result.model, result.base, {nominal[0]: estimate.params})
     return replace(result, estimates={**result.estimates, nominal[0]: estimate},
                    consistency={**result.consistency, **margins},

@@ -30,7 +30,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
                                          # by a Fourier fit on its harmonics instead of filters
 
     [estimation]
-    estimators = ["wls", "sdp"]          # the first is the main estimate (default ["wls"]); any of ols, wls, irls,
+    estimators = ["wls", "sdp"]          # the first is the main estimate (default ["wls", "sdp"]); any of ols, wls, irls,
                                          # lad, sdp (physically consistent), abc, abc10, de, pso, or one registered
     seed = 0                             # seeds the box searches (ABC, ABC×10, DE, PSO)
     friction = "auto"                    # each joint's friction model and its state at rest chosen by
@@ -74,7 +74,7 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from .._util.typed import convert
-from ..estimators.registry import configured_estimator, estimate_label, estimator_choices, keys
+from ..estimators.registry import DEFAULT_ESTIMATORS, configured_estimator, estimate_label, estimator_choices, keys
 from ..exceptions import ConfigError, DataError
 from ..model.robot import Robot
 from ..preprocessing.settings import Preprocessing
@@ -118,7 +118,7 @@ class EstimationSettings:
         (:func:`dynid.identification.verdict.choose_main_estimate`).
     """
 
-    estimators: tuple = ("wls",)
+    estimators: tuple = DEFAULT_ESTIMATORS
     seed: int = 0
     friction: str = "auto"
     hyperparameters: dict = field(default_factory=dict)
@@ -402,7 +402,7 @@ def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSett
     the choice of the main estimate (``e`` None: the table left out)."""
     e = e or EstimationTable()
     friction = e.friction or pre.friction_default
-    asked, hyperparameters = _estimator_entries(e.estimators or ["wls"], f"{path}: estimation.estimators")
+    asked, hyperparameters = _estimator_entries(e.estimators or list(DEFAULT_ESTIMATORS), f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     if closed_loop and not controlled:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "

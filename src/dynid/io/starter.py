@@ -55,8 +55,8 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
     robot : Robot, optional
         The robot read from ``urdf``: a bag is then opened and read as identify reads it (its joint names against the
         robot's, its rate, length and effort range said), and where its nominal values are physically consistent the
-        config lists ``estimators = ["wls", "sdp"]`` (without it, or with inconsistent values, the SDP is suggested
-        in a comment that says why it is not listed).
+        config lists ``estimators = ["wls", "sdp"]`` (its values made consistent for the SDP's prior where they are
+        not; without the robot, the SDP is suggested in a comment that says why it is not listed).
     rate : float, optional
         The logs' sample rate [Hz], for a CSV log with a header and no time column (``rate =`` in the config; the
         validation tables take it with the identification's columns).
@@ -95,7 +95,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
         said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
                 *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
-        said.append(_estimators_note(without))
+        said.append(_estimators_note(without, robot))
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
                        without_sdp=without), said
     pair = signal_files(log, validation[0], n_dof, rate) if validation else None
@@ -106,7 +106,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
-    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without)]
+    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without, robot)]
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
                    gains=gains, readers=readers), notes
@@ -147,23 +147,21 @@ def _own_reader(table: Table, log: Path, urdf: Path, n_dof: int, joints: tuple[s
     return None if same else own
 
 
-def _estimators_note(without_sdp: str | None) -> str:
+def _estimators_note(without_sdp: str | None, robot=None) -> str:
     if without_sdp is None:
+        made = ("" if robot is None or not robot.physical_prior()[1] else
+                "; the description's inertial values are not physically consistent: the SDP's prior and the nominal "
+                "candidate are the nearest consistent ones (identify names the links)")
         return ("estimators: WLS and the physically consistent SDP (what dynid export writes); dynid identify chooses "
-                "the main estimate among them, the description's values and its drive terms")
+                "the main estimate among them, the description's values and its drive terms" + made)
     return f"estimators: WLS; the physically consistent SDP is not listed ({without_sdp})"
 
 
 def _without_sdp(robot) -> str | None:
-    """Why the config cannot list the physically consistent estimate (``sdp``); None where it can: the robot read
-    from the file has physically consistent nominal values, which the SDP's prior needs."""
-    if robot is None:
-        return "the robot was not read"
-    try:
-        robot.require_physical_nominal("sdp (the physically consistent estimate)")
-    except ConfigError as exc:
-        return str(exc)
-    return None
+    """Why the config cannot list the physically consistent estimate (``sdp``); None where it can: the robot was read
+    (the SDP's prior is its nominal values, made physically consistent where they are not:
+    :meth:`dynid.model.robot.Robot.physical_prior`)."""
+    return "the robot was not read" if robot is None else None
 
 
 def xacro_arguments(given: list[str]) -> dict[str, str]:

@@ -218,8 +218,8 @@ class Robot:
         for j in bad:
             fixed[j] = nearest_consistent(self.inertial[j])
             said = [p for p in self.nominal_problems if f"link {j + 1} " in p] or [f"link {j + 1}: nominal inertial parameters"]
-            notes.append(f"{said[0]}: the physically consistent estimate's prior is the nearest consistent link "
-                         "(its pseudo-inertia's negative eigenvalues raised to zero)")
+            notes.append(f"{said[0]}: the physically consistent estimate's prior and the nominal candidate take the "
+                         "nearest consistent link (its pseudo-inertia's negative eigenvalues raised to zero)")
         return replace(self, inertial=fixed).standard_parameters(), tuple(notes)
 
     def require_physical_nominal(self, use: str) -> None:
