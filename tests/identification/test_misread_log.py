@@ -49,3 +49,29 @@ def test_positions_read_as_torques_are_named_as_positions(tmp_path):
     result = run_identification(load_identification_config(cfg), validate=False)
     [found] = [f.text for f in result.findings if f.kind == "columns"]
     assert "every joint's measured torque equals one of its states (J1's is its position" in found
+
+
+def test_a_joints_torque_read_from_another_joints_column_is_not_ready(tmp_path):
+    """J2's torque column read from J3's (benchmarks/misread_logs.py: the one misreading of 72 that kept "model
+    ready", on all four real arms): the two columns are one signal, which two joints of an arm never log; the first
+    line is not "ready", the finding names the pair, and no model file is written. Without validation logs, as a user
+    with one log."""
+    from tests.simulated_logs import simulated_case
+
+    cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)
+    cfg.write_text(cfg.read_text().split("[[validation]]")[0] + "[[references]]" + cfg.read_text().split("[[references]]")[1])
+
+    def copied(t, tau):
+        tau = tau.copy()
+        tau[:, 1] = tau[:, 2]
+        return tau
+
+    _with_columns_replaced(tmp_path / "ident.csv", lambda t, q: copied(t, np.loadtxt(tmp_path / "ident.csv", delimiter=",")[:, 7:]))
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    said = " ".join((p.stdout + p.stderr).split())
+    assert "model ready" not in said and "not ready: the torque columns" in said
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    [found] = [f["text"] for f in results["findings"] if f["kind"] == "columns"]
+    assert "J2 and J3 log one torque" in found
+    assert not list((tmp_path / "out").glob("*.urdf")) and not list((tmp_path / "out").glob("*.xml"))

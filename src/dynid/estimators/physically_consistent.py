@@ -158,7 +158,10 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
         problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
                          "physically consistent least squares")
         if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
-            raise DynIdError(f"physically consistent least squares: solver status {problem.status}")
+            raise DynIdError(f"physically consistent least squares (sdp): the solver found no physically consistent "
+                             f"parameters for these torques (status {problem.status}); torque columns that are not the "
+                             "robot's torques (another signal, or far off in size) do this: check the torques (or "
+                             "currents) columns and their units, or list the estimators without sdp")
         self.params_ = np.asarray(phi.value, dtype=float)
         self.status_ = problem.status
         self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])

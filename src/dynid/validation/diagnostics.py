@@ -240,8 +240,9 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     """Torques that are not torques: the measured torque follows the description's nominal model on no joint that
     varies (:data:`UNLIKE_NOMINAL`), so no scale, sign or order of the columns can be judged and a fit of another
     signal (a log's velocities read as torques fit to 0.0007 % by the viscous terms) would look perfect; or every
-    joint's torque column equals its velocity or position (:data:`LIKE_A_STATE`; positions can follow gravity's shape).
-    The columns that equal a state are named.
+    joint's torque column equals its velocity or position (:data:`LIKE_A_STATE`; positions can follow gravity's shape);
+    or two joints' columns are one signal (:data:`SAME_SIGNAL`: a column read for another joint's). The columns that
+    equal a state or each other are named.
 
     Parameters
     ----------
@@ -263,6 +264,11 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     list of Finding
         One finding of kind "columns" (the log is not read as the robot file says), or none.
     """
+    same = _same_columns(tau, varies)
+    if same:
+        return [Finding("columns", f"{dataset}: {', '.join(f'J{j + 1} and J{k + 1}' for j, k in same)} log one torque "
+                                   f"(their columns correlate to {SAME_SIGNAL} or more): a column read for another "
+                                   f"joint's; check the torques (or currents) columns of {table}")]
     rho = np.asarray(correlation, dtype=float)
     judged = [j for j in range(rho.size) if varies[j] and np.isfinite(rho[j])]
     if not judged:
@@ -285,6 +291,21 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
                                f"largest correlation with them {best:.2f}, where the real logs' reach 0.68-1.0){which}: "
                                "these columns are not read as the robot's torques; check the torques (or currents) "
                                f"columns of {table} and the robot file before trusting any fit of them")]
+
+
+SAME_SIGNAL = 0.9999
+"""Two joints' torque columns that correlate to this or more log one signal (a column read for another joint's): two
+joints of a real arm move different links, and no real log in ../shared/data comes near (benchmarks/misread_logs.py
+runs the logs as recorded)."""
+
+
+def _same_columns(tau: np.ndarray, varies) -> list[tuple[int, int]]:
+    """Pairs of joints (0-based, j < k) whose varying torque columns correlate to :data:`SAME_SIGNAL` or more."""
+    moving = [j for j in range(tau.shape[1]) if varies[j] and np.std(tau[:, j]) > 0]
+    if len(moving) < 2:
+        return []
+    rho = np.corrcoef(np.asarray(tau, dtype=float)[:, moving].T)
+    return [(moving[a], moving[b]) for a in range(len(moving)) for b in range(a + 1, len(moving)) if rho[a, b] >= SAME_SIGNAL]
 
 
 def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, table: str = "[identification]",
