@@ -149,3 +149,25 @@ def test_a_log_given_for_the_config_is_told_how_to_get_one(tmp_path, name, conte
     log.write_bytes(content)
     assert_refused(dynid(command, log), f"{log}: a log, not a config (TOML): dynid init ROBOT {log} writes an "
                                         "identification config that reads it")
+
+
+def test_no_next_step_when_nothing_is_left_to_do(tmp_path, monkeypatch):
+    """The UR10e example identified with its validation log: every finding is good news (the choice, a fit at the
+    noise floor, every joint better than the description) and the URDF and MJCF are written; "next: read the
+    verdict's findings … where the model misses the data" was printed all the same (issue "Fast where users wait",
+    item 4). Without the validation log there is a next step (add one), and the yardstick line gives the measured
+    torques' own noise floor beside the main estimate's figure."""
+    monkeypatch.chdir(tmp_path)
+    assert dynid("example", "ur10e", "try", "-q").returncode == 0
+    monkeypatch.chdir(tmp_path / "try")
+    p = dynid("identify", "ur10e.toml", "--out", "id", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    results = json.loads((tmp_path / "try" / "id" / "results.json").read_text())
+    assert {f["kind"] for f in results["findings"]} <= {"main", "floor", "nominal"}
+    assert "next:" not in p.stdout and p.stdout.lstrip().startswith("model ready: dynid SDP")
+    floor = results["diagnostics"]["yardstick"]["noise_floor"]
+    assert f"(noise floor {floor:.3g} %: the measured torques' own noise)" in " ".join(p.stdout.split())
+    text = (tmp_path / "try" / "ur10e.toml").read_text()
+    (tmp_path / "try" / "alone.toml").write_text(text[:text.index("[[validation]]")] + text[text.index("[estimation]"):])
+    p = dynid("identify", "alone.toml", "--out", "id2", "--no-figures")
+    assert p.returncode == 0 and "next: add [[validation]] logs" in " ".join(p.stdout.split())

@@ -32,7 +32,7 @@ def test_velocities_read_as_torques_are_not_ready_and_no_model_is_written(tmp_pa
     assert p.returncode == 0, p.stderr
     said = " ".join((p.stdout + p.stderr).split())
     assert "not ready: the torque columns do not follow the robot file's model on any joint" in said
-    assert "model ready" not in said
+    assert "model ready" not in said and "next: read the verdict's findings at the end" in said
     results = json.loads((tmp_path / "out" / "results.json").read_text())
     [found] = [f["text"] for f in results["findings"] if f["kind"] == "columns"]
     assert all(f"J{j}'s is its velocity" in found for j in range(1, 7))

@@ -315,6 +315,8 @@ def yardstick_scores(setup, base, sets: dict, recordings, *, resolved=None, refe
 def with_yardstick(result, filters: tuple, best: tuple[str, ...] = ()):
     """``result`` with the sets' errors on the one yardstick in its diagnostics (``"yardstick"``: the global relative
     error [%] of each set on each log and their mean over the logs, with the states filtered by the default rules;
+    ``"noise_floor"``: what a perfect model scores on the same samples, from the measured torques' own noise
+    (:mod:`dynid.validation.noise_floor`), mean over the logs that move;
     ``"filters"``: each state filter's multiple of those cutoffs, the sets' mean errors under it and the best
     candidate), beside the figures on the identification's own settings.
 
@@ -343,10 +345,13 @@ def with_yardstick(result, filters: tuple, best: tuple[str, ...] = ()):
     def mean(names) -> dict:
         return {label: float(np.mean([logs[name][label] for name in names])) for label in labels}
 
-    figures = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean(logs)}
+    figures: dict = {"settings": YARDSTICK, "global_relative_error": logs, "mean_global_relative_error": mean(logs)}
     moving = [c.name for c in scored if not rests_throughout(c.rest_share)]
     if moving and len(moving) < len(scored):  # a log at rest throughout scores the distance to the static-friction band
         figures["mean_over_logs_that_move"] = {"logs": moving, **mean(moving)}
+    floors = [(c.floor_metrics() or {}).get("global_relative_error", np.nan) for c in moving_logs(scored)]
+    if floors and np.all(np.isfinite(floors)):  # what a perfect model scores on the same samples: the torques' noise
+        figures["noise_floor"] = float(np.mean(floors))
     if len(filters) > 1:
         figures["filters"] = [{"cutoff_factor": f, "mean_global_relative_error": {
             label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in moving_logs(one)])) for label in labels},

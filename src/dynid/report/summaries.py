@@ -812,19 +812,30 @@ def in_short(result) -> list:
     if far:
         out.append(Line(f"{', '.join(far)}: over 3x the fit's error: motions unlike the identification log's (speeds, "
                         "rests; the report shows where)"))
-    if r.findings:
+    if _to_do(r):
         step = "read the verdict's findings at the end: they say where the model misses the data"
     elif not r.validations:
         step = "add [[validation]] logs (other motions) to check the model where it was not fitted"
-    elif exportable:
-        step = (f"{exportable[0]} is physically consistent: export it for a simulator or a controller with "
-                "dynid export CONFIG --urdf FILE --mjcf FILE")
+    elif exportable:  # written already, the first line says where: nothing to do
+        return out
     elif "sdp" not in r.estimators:
         step = 'for a model to simulate, add "sdp" to [estimation] estimators (a physically consistent estimate)'
     else:
         step = "use the model to predict torques; no estimate is physically consistent, so none is exported"
     out.append(Line("next: " + step))
     return out
+
+
+GOOD_NEWS = ("main", "floor")
+"""Finding kinds that ask nothing of the user: the verdict's choice, a fit at the noise floor (and a nominal gate
+that every joint passes: :func:`_to_do`)."""
+
+
+def _to_do(r) -> bool:
+    """Whether some finding asks something of the user (not :data:`GOOD_NEWS`, nor the nominal gate where the main
+    estimate predicts every joint better than the description)."""
+    worse = any(s.get("worse_joints") for s in (r.diagnostics.get("versus_nominal") or {}).values())
+    return any(f.kind not in GOOD_NEWS and (f.kind != "nominal" or worse) for f in r.findings)
 
 
 def _yardstick_lines(r, label: str) -> list:
@@ -848,8 +859,10 @@ def _yardstick_lines(r, label: str) -> list:
         k = len(moving["logs"])
         over = (("(over the one log that moves" if k == 1 else f"(mean over the {k} logs that move")
                 + f"; of the {len(rests)} at rest throughout, within the static-friction band: {within})")
+    floor = yard.get("noise_floor")
+    floor = "" if floor is None else f" (noise floor {floor:.3g} %: the measured torques' own noise)"
     return [Line(f"on one yardstick (every validation log's torques as measured, its states filtered by dynid's default "
-                 f"rules whatever the settings): {label} {mean[label]:.3g} %{beside} {over}")]
+                 f"rules whatever the settings): {label} {mean[label]:.3g} %{floor}{beside} {over}")]
 
 
 CHOSEN_TERMS = ("fst", "fca", "fcl")
