@@ -56,3 +56,57 @@ def test_identify_says_which_torque_delay_to_give():
                                        preprocessing=dynid.Preprocessing(torque_delay=given))
     assert delays(again) == [] and abs(again.diagnostics["torque_delay"]["samples"]) < 0.25
     assert delays(dynid.identify_from_arrays(robot, log.t, log.q, tau, estimators=("ols",))) == []
+
+
+def _late(log, samples: float):
+    from dataclasses import replace
+
+    tau = np.asarray(log.tau)
+    f = np.fft.rfftfreq(log.t.size, 1.0 / log.rate)
+    late = np.fft.irfft(np.fft.rfft(tau, axis=0) * np.exp(-2j * np.pi * f * samples / log.rate)[:, None], n=log.t.size,
+                        axis=0)
+    return replace(log, tau=late, name=f"{log.name} late")
+
+
+def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
+    """Issue "Every assurance checked on what the user meets", item 5. A simulated UR10e whose identification and
+    validation logs both log the torques 2.5 samples late: the finding is kept, saying that the log identified again
+    with the delay predicts the validation log better. The LBR Med7's real log shows a 1.9-sample lead that its own
+    held-out blocks favour by 11 %; identified again with it (an independent run of the config with
+    [preprocessing] torque_delay set), its validation log is predicted worse: the finding is withdrawn, its figures
+    kept in the diagnostics."""
+    import re
+    from pathlib import Path
+
+    from dynid.identification.pipeline import IdentificationPipeline
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+    from tests.conftest import shared_data
+
+    robot = dynid.load_robot("ur10e")
+    ident = _late(simulated_log(robot, seconds=30.0, rate=250.0, rng=3), 2.5)
+    check = _late(simulated_log(robot, seconds=20.0, rate=250.0, rng=4), 2.5)
+    result = IdentificationPipeline(robot, estimators=("ols",)).fit(ident, validation=(check,))
+    [found] = [f.text for f in result.findings if f.kind == "delay"]
+    weighed = result.diagnostics["torque_delay"]["validation"]
+    assert weighed["with"] * 1.02 < weighed["without"] and "identify again with it: the validation logs agree" in found
+    assert f"{weighed['with']:.3g} % against {weighed['without']:.3g} %" in found
+
+    repo = Path(__file__).resolve().parents[2]
+    text = (repo / "configs" / "kuka_med7.toml").read_text().replace('robot = "robots/', f'robot = "{repo}/configs/robots/')
+    root = shared_data("kuka_med7_lbrstack")
+    path = tmp_path / "med7.toml"
+    path.write_text(text)
+    r = run_identification(load_identification_config(path, data_root=root))
+    delay = r.diagnostics["torque_delay"]
+    assert not [f for f in r.findings if f.kind == "delay"] and delay["held_out_ratio"] < 0.95
+    path.write_text(re.sub(r"^\[estimation\]", f"[preprocessing]\ntorque_delay = {delay['seconds']!r}\n[estimation]",
+                           text, count=1, flags=re.M))
+    again = run_identification(load_identification_config(path, data_root=root))
+
+    def mean(res):
+        yard = res.diagnostics["yardstick"]
+        return (yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"])[res.main]
+
+    assert mean(again) >= mean(r) / 1.02  # the delay does not make the validation log's prediction better
+    np.testing.assert_allclose(delay["validation"]["with"], mean(again), rtol=1e-9)

@@ -28,7 +28,7 @@ import numpy as np
 
 from .noise_floor import AT_FLOOR
 
-__all__ = ["Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
+__all__ = ["DELAY_ADVICE", "Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
            "validation_findings", "prior_findings", "nominal_gate"]
 
 SIGNIFICANT = 4.0
@@ -590,7 +590,13 @@ DELAY_MIN_SAMPLES = 0.25
 0.13 %)."""
 
 
-def delay_findings(samples: float, std: float, determined: bool, rate: float, given: float, dataset: str) -> list[Finding]:
+DELAY_ADVICE = "identify again with it, and keep it if validation logs (other motions) agree"
+"""The delay finding's last words, which :meth:`dynid.identification.pipeline.IdentificationPipeline.fit` replaces
+with the validation logs' answer where it has them."""
+
+
+def delay_findings(samples: float, std: float, determined: bool, rate: float, given: float, dataset: str,
+                   held_out: float = float("nan")) -> list[Finding]:
     """A delay between the torque (current) and position channels that the log determines and that matters.
 
     Worded as what to try: a real log's residual is also smallest at a delay that trades off against a misfit of the
@@ -609,22 +615,26 @@ def delay_findings(samples: float, std: float, determined: bool, rate: float, gi
         ``preprocessing.torque_delay`` already applied.
     dataset : str
         The log, named in the finding.
+    held_out : float
+        The held-out residual with the delay over that without (:attr:`dynid.identification.delay.DelayEstimate.held_out`):
+        no finding unless it is below 1 (a delay that does not improve what the model predicts of blocks of the log it
+        was not fitted on is a trade-off with a misfit of the model, not a delay of the drive); NaN: not measured.
 
     Returns
     -------
     list of Finding
         One finding with the ``torque_delay`` to try, or none when the log determines no delay that matters.
     """
-    if not determined or abs(samples) < max(DELAY_SIGNIFICANT * std, DELAY_MIN_SAMPLES):
+    if not determined or abs(samples) < max(DELAY_SIGNIFICANT * std, DELAY_MIN_SAMPLES) or not held_out < 1.0:
         return []
     way = "lag" if samples > 0 else "lead"
     total = given + samples / rate
     more = " more than the torque_delay given" if given else ""
     return [Finding("delay", f"{dataset}: the residual is smallest with the torques read as if they {way} the positions by "
-                             f"{abs(samples):.2g} ± {std:.1g} samples ({1e3 * abs(samples) / rate:.3g} ms{more}): if the "
+                             f"{abs(samples):.2g} ± {std:.1g} samples ({1e3 * abs(samples) / rate:.3g} ms{more}), and so "
+                             f"its squared residual on held-out blocks of the log is {100 * (1 - held_out):.2g} % smaller: if the "
                              f"drive logs them so, give [preprocessing] torque_delay = {total:.4g} (seconds; "
-                             "Preprocessing(torque_delay=...) for arrays), identify again and keep it if the validation "
-                             "logs agree")]
+                             f"Preprocessing(torque_delay=...) for arrays) and {DELAY_ADVICE}")]
 
 
 def validation_findings(name: str, global_error: float, fit_error: float, *, prediction_spread: np.ndarray | None,
