@@ -65,9 +65,8 @@ def measure(path: Path, data: Path) -> tuple[float, str, np.ndarray]:
 
 def main() -> None:
     folder = Path(tempfile.mkdtemp())
-    print("Each setting's own figure (its validation logs filtered by its settings) and the one yardstick's (every log "
-          "filtered by dynid's default rules, the same samples for every setting; issue \"Never worse than the "
-          "description\", item 5).")
+    print("Each setting's own figure (its validation logs filtered by its settings) and the one yardstick's (every log's "
+          "torques as measured, its states filtered by dynid's default rules, the same samples for every setting).")
     print("robot | defaults: main estimate, own % / yardstick % | best hand setting by its own figure: own % / "
           "yardstick % | best by the yardstick: yardstick % | defaults / best, on the yardstick | nominal on the "
           "yardstick, min-max over the settings %")

@@ -23,6 +23,10 @@ defaults, and lists those whose main estimate is worse than the description's no
 one yardstick; and, identified again without the config's validation logs (as a user with one log), those where the
 estimate ``dynid export`` writes is (about a minute). ``--alone`` does the same on the 18 windows above.
 
+``--blocks`` asks whether held-out blocks of a window would choose a better model for a user with one log: every
+candidate's error on them, and how many windows switching from the SDP on them makes better or worse (about two
+minutes).
+
 ``--held-out`` asks whether the window itself holds what would choose the best hand setting: it scores the defaults
 and every hand setting of ``--hand`` on four folds of the window (fitted on the rest of it, scored on its last or
 first 20 % or 30 % on the one yardstick), prints the best hand setting's rank among the seven on each fold, and the
@@ -273,7 +277,53 @@ def fresh(windows: dict) -> int:
     return 0
 
 
+def blocks() -> int:
+    """``--blocks``: would held-out blocks of a window choose a better model for a user with one log? Each of the 36
+    windows identified with its validation logs (the candidates' figures on the one yardstick, over the logs that move)
+    and without (every candidate's error on the window's held-out blocks, ``diagnostics.held_out_rms_error``); the
+    SDP (what export writes) switched for the drive-only estimate or the description's values where one of them
+    predicts the blocks better than the SDP times a margin: how many windows that makes better and worse, and how many
+    stay worse than the description by more than 2 % (issue "The better model wins", item 3)."""
+    from dynid.identification.estimates import DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    folder = Path(tempfile.mkdtemp())
+    rows = []
+    for group in ({"ur10e": WINDOWS, **OTHER_WINDOWS}, FRESH_WINDOWS):
+        for name, cut in group.items():
+            for window in cut:
+                path, root = _window_config(name, window, folder)
+                config = load_identification_config(path, data_root=root)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    result = run_identification(config)
+                    alone = run_identification(replace(config, validation=()))
+                yard = result.diagnostics["yardstick"]
+                rows.append((f"{name} {window[0]:g}-{window[1]:g}", result.diagnostics["nominal_set"],
+                             yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"],
+                             alone.diagnostics.get("held_out_rms_error") or {}))
+    for margin in (1.0, 0.9, 0.5):
+        better, worse, off = [], [], []
+        for case, nominal, yard, held in rows:
+            alternatives = {k: held[k] for k in (DRIVE_ONLY_LABEL, NOMINAL_LABEL) if k in held}
+            chosen = SDP_LABEL
+            if alternatives and SDP_LABEL in held:
+                best = min(alternatives, key=alternatives.get)
+                chosen = (nominal if best == NOMINAL_LABEL else best) if alternatives[best] < margin * held[SDP_LABEL] else SDP_LABEL
+            if yard[chosen] > 1.02 * yard[nominal]:
+                off.append(case)
+            if chosen != SDP_LABEL:
+                (better if yard[chosen] < yard[SDP_LABEL] else worse).append(f"{case} {yard[SDP_LABEL]:.1f} -> {yard[chosen]:.1f}")
+        print(f"margin {margin:g}: better on {len(better)} ({', '.join(better) or 'none'}); worse on {len(worse)} "
+              f"({', '.join(worse) or 'none'}); worse than the description by more than 2 %: {len(off)} "
+              f"({', '.join(off) or 'none'})", flush=True)
+    return 0
+
+
 def main() -> int:
+    if "--blocks" in sys.argv[1:]:
+        return blocks()
     if "--fresh" in sys.argv[1:]:
         return fresh(FRESH_WINDOWS)
     if "--alone" in sys.argv[1:]:
