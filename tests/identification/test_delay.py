@@ -72,9 +72,10 @@ def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
     """Issue "Every assurance checked on what the user meets", item 5. A simulated UR10e whose identification and
     validation logs both log the torques 2.5 samples late: the finding is kept, saying that the log identified again
     with the delay predicts the validation log better. The LBR Med7's real log shows a 1.9-sample lead that its own
-    held-out blocks favour by 11 %; identified again with it (an independent run of the config with
-    [preprocessing] torque_delay set), its validation log is predicted worse: the finding is withdrawn, its figures
-    kept in the diagnostics."""
+    held-out blocks favour by 11 %; identified again with it (dynid's second identification keeps the first's cutoffs
+    and friction models; an independent run of the config with [preprocessing] torque_delay set, which chooses them
+    anew, agrees), its validation log is predicted worse: the finding is withdrawn, its figures kept in the
+    diagnostics."""
     import re
     from pathlib import Path
 
@@ -109,4 +110,5 @@ def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
         return (yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"])[res.main]
 
     assert mean(again) >= mean(r) / 1.02  # the delay does not make the validation log's prediction better
-    np.testing.assert_allclose(delay["validation"]["with"], mean(again), rtol=1e-9)
+    assert delay["validation"]["with"] >= delay["validation"]["without"] / 1.02
+    np.testing.assert_allclose(delay["validation"]["without"], mean(r), rtol=1e-9)
