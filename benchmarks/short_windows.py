@@ -221,8 +221,9 @@ def hand() -> int:
         figures = []
         for pre, friction in [(None, None)] + [(h, f) for h in HAND for f in ("auto", "description")]:
             result = _identified(*_window_config(name, window, folder, pre, friction))
-            figures.append((result.diagnostics["yardstick"]["mean_global_relative_error"][result.main], result.main,
-                            pre, friction))
+            yard = result.diagnostics["yardstick"]  # over the logs that move, as the verdict weighs them
+            figures.append(((yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"])[result.main],
+                            result.main, pre, friction))
         best = min(figures[1:], key=lambda f: f[0])
         worst = max(worst, figures[0][0] / best[0])
         print(f"{name} | {window[0]:g}-{window[1]:g} | {figures[0][1]}: {figures[0][0]:.2f} | {best[2]}, friction {best[3]} "

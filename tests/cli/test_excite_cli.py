@@ -36,17 +36,24 @@ def test_excite_ur10e_satisfies_every_constraint_on_a_10x_finer_grid(tmp_path):
     out = tmp_path / "ur"
     p = dynid("excite", str(cfg), "--out", str(out))
     assert p.returncode == 0, p.stderr
-    assert "Before / after" in p.stdout and "Constraint margins" in p.stdout and "q_min [rad]" in p.stdout
+    # the verdict first, the tables behind --verbose and in the report (issue "Fast where users wait", item 4)
+    assert "Before / after" not in p.stdout and "Constraint margins" not in p.stdout
+    assert len((p.stdout + p.stderr).strip().splitlines()) <= 20 + 2 + 2  # + the two starts' and the writing's lines
+    report = (out / "report.html").read_text()
+    assert "Before / after" in report and "Constraint margins" in report and "q_min [rad]" in report
     doc = json.loads((out / "excitation.json").read_text())
     assert doc["trajectory"]["form"] == "swevers" and doc["design"]["feasible"]
     assert doc["design"]["cond"] < doc["design"]["initial_cond"]
-    # the verdict closes the output: the conditioning before and after, the constraints, the next step
+    # the verdict opens the output: the conditioning before and after, the constraints; the next step closes it
     text = " ".join(p.stdout.split())
-    assert f"cond(W_base) {doc['design']['initial_cond']:.2f} → {doc['design']['cond']:.2f}" in text
-    assert "every constraint holds" in text and "play excitation.csv on the robot" in text
+    verdict = " ".join((p.stderr + p.stdout).split())  # with warnings standing, the verdict is one: standard error
+    assert f"cond(W_base) {doc['design']['initial_cond']:.2f} → {doc['design']['cond']:.2f}" in verdict
+    assert "every constraint holds" in verdict and "play excitation.csv on the robot" in text
     # the built-in UR10e's meshes are not shipped: the table is kept off estimated capsules, said as a warning first
     said = " ".join((p.stdout + p.stderr).split())  # a warning line goes to standard error
     assert "no collision shapes dynid could read" in said and "next: settle the warnings above, then play" in text
+    warned = [line for line in p.stderr.splitlines() if line.startswith("warning:")]  # in the order printed
+    assert warned[0].startswith("warning: cond(W_base)") and "warnings below to settle before it runs" in warned[0]
     assert "log positions and torques (or motor currents)" in " ".join(text.split())  # a torque sensor's arm logs torques
     traj = load_trajectory(out / "excitation.json")
     config = load_excitation_config(cfg)

@@ -723,6 +723,8 @@ def excite(
     seed: int | None = typer.Option(None, help="Seed of the random starts (overrides design.seed)."),
     animation: bool = typer.Option(False, help="Also write excitation_animation.gif: the arm moving along one period "
                                                "among the cell's bodies."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Print the design's before/after and constraint "
+                                                                 "margins tables; report.html has them too."),
     quiet: bool = QUIET,
 ) -> None:
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
@@ -745,7 +747,13 @@ def excite(
 
         return save_excitation(run, out, animation=animation)
 
-    _Command("dynid excite", quiet, out).run(prepare, compute, save)
+    def show(rep, run, paths):
+        from ..report.excitation_summary import excitation_blocks
+
+        rep.blocks(excitation_blocks(run, tables=verbose))
+        rep.wrote(paths)
+
+    _Command("dynid excite", quiet, out).run(prepare, compute, save, show)
 
 
 @app.command()

@@ -10,24 +10,32 @@ from ..tables import Line, TextTable
 __all__ = ["excitation_blocks", "no_floor_line", "set_point_lines"]
 
 
-def excitation_blocks(run) -> list:
-    """What ``dynid excite`` prints: the design before and after, and the constraint margins.
+def excitation_blocks(run, tables: bool = True) -> list:
+    """What ``dynid excite`` prints: the verdict first (the criterion before and after, whether every constraint holds
+    and the tightest), how close the links' shapes come to the floor, the cell and each other, the set-points and the
+    next step; with ``tables``, the design before and after and every constraint's margin (issue "Fast where users
+    wait", item 4: ``dynid excite`` shows them with ``--verbose``, report.html always).
 
     Parameters
     ----------
     run : dynid.identification.excitation_run.ExcitationRun
+    tables : bool
+        The before/after and margins tables (else one line on the design's search).
 
     Returns
     -------
     list of Line and TextTable
     """
     d, p, c = run.design, run.config.problem, run.config
-    out: list = [Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
-                f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, criterion {p.criterion}", "title")]
+    out: list = [_verdict_line(d, tables),
+                 Line(f"dynid excite — robot {c.full_robot.name}, joints 1-{p.robot.n_dof}, {p.n_harmonics} harmonics, "
+                      f"ω_f = {p.omega_f:.4g} rad/s (period {p.period:.4g} s), {p.base.n_base} base parameters, "
+                      f"criterion {p.criterion}")]
     held = tuple(getattr(c.full_robot, "held", ()) or ())
     if held:
         out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
-    out += _design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
+    out += (_design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
+            if tables else _search_lines(d))
     encoders, (start, kind) = set_point_lines(run.set_points())
     out += [Line(f"excitation.csv: {run.t.size} set-points at {c.rate:g} Hz" + encoders), Line(start, kind)]
     free = p.unlimited_joints()
@@ -41,10 +49,13 @@ def excitation_blocks(run) -> list:
         text, warned = no_floor_line(lowest.to_dict(), p.workspace.clearance)
         out.append(Line(text, "warning" if warned else "text"))
     out += (_shapes_lines(run) + _self_clearance_lines(run) + _floor_lines(run) + _cell_clearance_lines(run)
-            + _mujoco_lines(run) + [_verdict_line(d)])
+            + _mujoco_lines(run))
+    warnings = sum(isinstance(line, Line) and line.kind == "warning" for line in out)
+    if warnings:  # the first line says it too: "every constraint holds" is not "safe to run" while a warning stands
+        out[0] = Line(f"{out[0].text}; {warnings} warning{'s' if warnings > 1 else ''} below to settle before it runs",
+                      "warning")
     if d.feasible:
-        warned = any(isinstance(line, Line) and line.kind == "warning" for line in out)
-        first = "settle the warnings above, then " if warned else ""
+        first = "settle the warnings above, then " if warnings else ""
         out.append(Line(f"next: {first}play excitation.csv on the robot at its rate (docs: the workflow tutorial), log "
                         "positions and torques (or motor currents), and dynid identify the log"))
     return out
@@ -157,13 +168,28 @@ def _design_lines(d, initial: str, grid: str) -> list:
     return out
 
 
-def _verdict_line(d) -> Line:
+def _verdict_line(d, tables: bool = True) -> Line:
     """cond before and after, whether every constraint holds and the tightest one (margins in units of their limit)."""
     relative = [m for m in d.margins if not math.isnan(m.relative)]
     tight = min(relative, key=lambda m: m.relative) if relative else None
+    where = "the margins table" if tables else "dynid excite --verbose, or report.html"
+    violated = [m for m in d.margins if m.margin < 0]
     return Line(f"cond(W_base) {d.initial_cond:.2f} → {d.cond:.2f} ({d.initial_cond / d.cond:.2g}× better conditioned); "
-                + ("every constraint holds" if d.feasible else "a constraint is violated (table above)")
-                + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where}"), "title")
+                + ("every constraint holds" if d.feasible else
+                   f"a constraint is violated ({', '.join(f'{m.constraint} on {m.where}' for m in violated[:2])}: {where})")
+                + ("" if tight is None else f", the tightest: {tight.constraint} on {tight.where} "
+                                            f"({100 * tight.relative:.1f} % of its limit to spare)"), "title")
+
+
+def _search_lines(d) -> list:
+    """One line on the design's search, for the terminal without its tables: the verification grid's figure, the
+    starts, the iterations and the time; the initial trajectory's violations where it has any."""
+    out = [Line(f"cond on the 10× finer verification grid {d.cond_verification:.2f}; {len(d.start_values)} starts, "
+                f"{d.nit} SLSQP iterations, {d.seconds:.1f} s (the tables: --verbose, and report.html)")]
+    if d.initial_violations:
+        out.append(Line("the initial trajectory violates: " + "; ".join(
+            f"{m.constraint} on {m.where} ({m.worst:.4g} against {m.limit:.4g})" for m in d.initial_violations), "warning"))
+    return out
 
 
 def _self_clearance_lines(run) -> list:
