@@ -41,6 +41,9 @@ def test_excite_ur10e_satisfies_every_constraint_on_a_10x_finer_grid(tmp_path):
     assert len((p.stdout + p.stderr).strip().splitlines()) <= 20 + 2 + 2  # + the two starts' and the writing's lines
     report = (out / "report.html").read_text()
     assert "Before / after" in report and "Constraint margins" in report and "q_min [rad]" in report
+    # the report reads like identify's: the verdict first, margins as numbers (item 5: "nan" for the floor's row)
+    assert report.index("every constraint holds on the 10× verification grid") < report.index("Before / after")
+    assert ">nan<" not in report and "checked again by MuJoCo on" in report
     doc = json.loads((out / "excitation.json").read_text())
     assert doc["trajectory"]["form"] == "swevers" and doc["design"]["feasible"]
     assert doc["design"]["cond"] < doc["design"]["initial_cond"]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import base64
 import datetime
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -362,14 +363,48 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
     margins = Table(f"Constraint margins on the verification grid (cond there: {g['cond_verification_grid']:.2f})",
                     ["constraint", "where", "limit", "worst", "margin", "margin %"],
                     [[m["constraint"], m["where"], _fmt(m["limit"]), _fmt(m["worst"]), _fmt(m["margin"]),
-                      _fmt(None if m.get("relative") is None else 100 * m["relative"], ".3g")] for m in g.get("margins", [])], (1,))
+                      _fmt(_percent(m.get("relative")), ".3g")] for m in g.get("margins", [])], (1,))
     notes = [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the 10× grid: {g['feasible']}"]
     if "set_points" in d:
         encoders, (start, _) = set_point_lines(d["set_points"])
         notes += ([f"excitation.csv{encoders}"] if encoders else []) + [start]
     if "lowest" in d:
         notes.append(no_floor_line(d["lowest"], d["workspace"]["clearance"])[0])
-    return settings, [Section("Design", [before], notes), Section("Constraints", [margins])]
+    return settings, [Section("In short", [], _excite_verdict(d)), Section("Design", [before], notes),
+                      Section("Constraints", [margins])]
+
+
+def _percent(relative) -> float | None:
+    """A margin's share of its limit in %, None for a constraint without one (an absolute distance: NaN or null)."""
+    return None if relative is None or not math.isfinite(relative) else 100 * relative
+
+
+def _excite_verdict(d: dict) -> list[str]:
+    """report.html's first lines for ``dynid excite`` (issue "Fast where users wait", item 5): the constraints and the
+    tightest, the smallest distances to the floor and the cell and between the links' shapes, MuJoCo's check."""
+    g = d["design"]
+    relative = [m for m in g.get("margins", []) if _percent(m.get("relative")) is not None]
+    tight = min(relative, key=lambda m: m["relative"]) if relative else None
+    out = [f"cond(W_base) {g['initial_cond']:.2f} → {g['cond']:.2f}; "
+           + ("every constraint holds on the 10× verification grid" if g["feasible"] else "a constraint is violated (table below)")
+           + ("" if tight is None else f", the tightest: {tight['constraint']} on {tight['where']} "
+                                       f"({100 * tight['relative']:.1f} % of its limit to spare)")]
+    for m in d.get("cell_clearance") or []:
+        verdict = "holds" if m["margin"] >= 0 else "VIOLATED"
+        out.append(f"{m['constraint']}: the closest, {m['where']}, {m['worst']:.4g} against {m['limit']:.4g} ({verdict})")
+    own = d.get("self_clearance") or {}
+    if own.get("links"):
+        a, b = own["links"]
+        gap = own["distance"]
+        out.append(f"the links' own shapes: links {a} and {b} come closest at t = {own['time']:.3g} s, "
+                   + (f"{gap:.3g} m apart" if gap >= 0 else f"overlapping by {-gap:.3g} m: check them before it runs"))
+    contacts = d.get("mujoco_contacts") or {}
+    if contacts:
+        out.append(f"checked again by MuJoCo on {contacts['set_points']} set-points: "
+                   + ("no shape within the clearance of the cell, the floor or another" if not contacts["touching"] else
+                      f"{contacts['touching']} set-points with a shape within the clearance (the deepest "
+                      f"{contacts['deepest']:.3g} m): do not run it as is"))
+    return out
 
 
 def closed_loop_sections(d: dict) -> tuple[dict, list[Section]]:
