@@ -137,23 +137,72 @@ def _headerless_table(table, notes: list[str], urdf: Path, log: Path, n_columns:
         return _preset_table("ur-rtde", log), notes + [
             "31 columns: Universal Robots' RTDE layout (time, q, qd, currents, …): preset = \"ur-rtde\" (its units: s, "
             "rad, rad/s, A)"]
-    if n_columns == 19 and n_dof == 6 and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
+    order, said = _velocity_block(log, table, n_dof) if n_columns == 1 + 3 * n_dof else ([], "")
+    swapped = order[1:2] == ["torques"]  # the third block is the velocities: no preset of (t, q, q̇, …) fits
+    if n_columns == 19 and n_dof == 6 and not swapped and UNIVERSAL_ROBOTS.search(_robot_name(urdf) or urdf.stem):
         return _preset_table("ur-rtde-19", log), notes + [
             "19 columns and a Universal Robots arm: its RTDE layout without targets (time, q, qd, motor currents): "
             "preset = \"ur-rtde-19\" (its units: s, rad, rad/s, A); if the last six are torques in N·m, give time, "
             "positions, velocities and torques in blocks of 6 columns instead"]
     if n_columns in (1 + 2 * n_dof, 1 + 3 * n_dof):
-        blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else ["positions", "velocities", "torques"]
+        # which block is the velocities: the one that follows the positions' derivative (_velocity_block)
+        blocks = ["positions", "torques"] if n_columns == 1 + 2 * n_dof else order
         table.add("time", _inline(column=1))
         for b, kind in enumerate(blocks):
             table.add(kind, _inline(columns=[2 + b * n_dof + j for j in range(n_dof)]))
-        notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}")
+        notes.append(f"no header: column 1 taken as time, then {', '.join(blocks)} in blocks of {n_dof}{said}")
         notes.append(_assumed_units(blocks, time=True))
         return table, notes + _rate_unused(rate, "column 1") + _torque_sensor(table, urdf)
     fewer = next((k for k in range(n_dof - 1, 0, -1) if n_columns in (1 + 2 * k, 1 + 3 * k)), 0)
     raise DataError(f"{log}: {n_columns} columns without a header: expected a time column and {n_dof} columns per "
                     f"signal, or those alone with --rate HZ (or name the columns in a header line: t, q1…, tau1…)"
                     + _hold_hint(urdf, joints, fewer))
+
+
+VELOCITY_LIKE = 0.95
+"""A block of a headerless log whose columns correlate with the positions' derivative this much or more (median over
+the joints that move) is the velocities (:func:`_velocity_block`)."""
+
+VELOCITY_ROWS = 20_000
+"""Rows :func:`_velocity_block` reads: a few seconds of any log, never the whole of an hour-long one."""
+
+
+def _velocity_block(log: Path, table, n_dof: int) -> tuple[list[str], str]:
+    """The order of a headerless log's two blocks after the positions (issue "Every assurance checked on what the user
+    meets", item 2): the one whose columns follow the positions' derivative is the velocities, the other the torques.
+    Returns the blocks' names and the note's words on that guess and its confidence (a log written t, q, τ, q̇ was
+    read as t, q, q̇, τ, and its velocities fitted as torques)."""
+    delimiter = table.get("delimiter", ",")
+    try:
+        with log.open(encoding="utf-8-sig") as fh:
+            rows = [_fields(line.rstrip("\r\n").replace(",", ".") if table.get("decimal") == "," else line.rstrip("\r\n"),
+                            delimiter) for line in itertools.islice(fh, VELOCITY_ROWS) if line.strip()
+                    and not line.lstrip().startswith("#")]
+        data = np.array([[float(x) for x in r] for r in rows if len(r) == 1 + 3 * n_dof], dtype=float)
+    except (OSError, UnicodeDecodeError, ValueError):
+        data = np.empty((0, 1 + 3 * n_dof))
+    order = ["positions", "velocities", "torques"]
+    if data.shape[0] < 20 or not np.all(np.isfinite(data)):
+        return order, " (the second block taken as velocities by its place: too few rows to tell)"
+    t, q = data[:, 0], data[:, 1:1 + n_dof]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        derivative = np.gradient(q, t, axis=0) if np.all(np.diff(t) > 0) else np.gradient(q, axis=0)
+    moving = [j for j in range(n_dof) if np.std(derivative[:, j]) > 0]
+
+    def follows(block: int) -> float:
+        cols = data[:, 1 + block * n_dof:1 + (block + 1) * n_dof]
+        rho = [np.corrcoef(derivative[:, j], cols[:, j])[0, 1] for j in moving if np.std(cols[:, j]) > 0]
+        return float(np.median(rho)) if rho else float("nan")
+
+    second, third = follows(1), follows(2)
+    if third >= VELOCITY_LIKE and not second >= VELOCITY_LIKE:
+        return (["positions", "torques", "velocities"],
+                f" (the third block follows the positions' derivative, correlation {third:.3f}, the second "
+                f"{second:.2f}: the velocities are the third)")
+    if second >= VELOCITY_LIKE:
+        return order, f" (the second block follows the positions' derivative: correlation {second:.3f})"
+    return order, (f" (a guess by place: neither block follows the positions' derivative, correlations {second:.2f} "
+                   f"and {third:.2f}: check which is which)")
 
 
 PATTERNS = {
