@@ -99,7 +99,10 @@ def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], sto
 
     with dask_client(scheduler, workers, what=what) as client:
         cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
-        shared = client.scatter(setup, broadcast=True)
+        # a key of its own, not the content's hash: a second study of the same setup in one process (another test,
+        # another run) scattered the same key, and its release cancelled this one's tasks ("already forgotten";
+        # dask/distributed#4612)
+        shared = client.scatter(setup, broadcast=True, hash=False)
         futures = {client.submit(function, shared, *key, pure=False): key for key in keys}
         for done, fut in enumerate(as_completed(futures), start=1):
             store(futures[fut], fut.result())
