@@ -213,6 +213,8 @@ def held_out() -> int:
 def hand() -> int:
     """Every real short window with the defaults and with :data:`HAND`, all on the one yardstick: the defaults against
     the best hand setting (issue "Never worse than the description": target 1.2×)."""
+    from dynid.identification.evidence import weighed_means
+
     folder = Path(tempfile.mkdtemp())
     windows = [("ur10e", w) for w in WINDOWS] + [(n, w) for n, ws in OTHER_WINDOWS.items() for w in ws]
     print("config | window | defaults: main estimate, yardstick % | best hand setting | its yardstick % | defaults / best")
@@ -221,9 +223,7 @@ def hand() -> int:
         figures = []
         for pre, friction in [(None, None)] + [(h, f) for h in HAND for f in ("auto", "description")]:
             result = _identified(*_window_config(name, window, folder, pre, friction))
-            yard = result.diagnostics["yardstick"]  # over the logs that move, as the verdict weighs them
-            figures.append(((yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"])[result.main],
-                            result.main, pre, friction))
+            figures.append((weighed_means(result.diagnostics["yardstick"])[result.main], result.main, pre, friction))
         best = min(figures[1:], key=lambda f: f[0])
         worst = max(worst, figures[0][0] / best[0])
         print(f"{name} | {window[0]:g}-{window[1]:g} | {figures[0][1]}: {figures[0][0]:.2f} | {best[2]}, friction {best[3]} "
@@ -242,12 +242,23 @@ FRESH_WINDOWS = {
 seconds), each 3-6 s."""
 
 
+def _with_and_alone(name: str, window, folder: Path) -> tuple:
+    """A window identified with its config's validation logs and without any (a user with one log)."""
+    from dynid.identification.run import run_identification
+    from dynid.io.identification_config import load_identification_config
+
+    path, root = _window_config(name, window, folder)
+    config = load_identification_config(path, data_root=root)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return run_identification(config), run_identification(replace(config, validation=()))
+
+
 def fresh(windows: dict) -> int:
     """The verdict on windows (:data:`FRESH_WINDOWS`, or with ``--alone`` the 18 above): the main estimate against the
     description's nominal model on the one yardstick, and what ``dynid export`` writes when the config has no
     validation logs (the choice then reads held-out blocks of the window), scored on the same yardstick."""
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.identification.evidence import weighed_means
     from dynid.report.summaries import _exportable  # what dynid export writes, as dynid identify says it
 
     folder = Path(tempfile.mkdtemp())
@@ -256,20 +267,16 @@ def fresh(windows: dict) -> int:
           "exported / nominal | the other sets %")
     for name, cut in windows.items():
         for window in cut:
-            path, root = _window_config(name, window, folder)
-            config = load_identification_config(path, data_root=root)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                result = run_identification(config)
-                alone = run_identification(replace(config, validation=()))
-            yard = result.diagnostics["yardstick"]["mean_global_relative_error"]
+            result, alone = _with_and_alone(name, window, folder)
+            yard = weighed_means(result.diagnostics["yardstick"])
             nominal = result.diagnostics["nominal_set"]
             written = next(iter(_exportable(alone)), alone.main)  # none consistent: the main estimate, with a warning
             ratios = {"with": yard[result.main] / yard[nominal], "alone": yard[written] / yard[nominal]}
             for kind, ratio in ratios.items():
                 if ratio > 1.02:
                     exceptions[kind].append(f"{name} {window[0]:g}-{window[1]:g}")
-            others = ", ".join(f"{k} {v:.2f}" for k, v in yard.items() if k not in (result.main, nominal) and "refit" not in k)
+            others = ", ".join(f"{k} {v:.2f}" for k, v in yard.items() if k not in (result.main, nominal, "logs")
+                               and "refit" not in k)
             print(f"{name} | {window[0]:g}-{window[1]:g} | {result.main} {yard[result.main]:.2f} | {yard[nominal]:.2f} | "
                   f"{ratios['with']:.2f} | {written} {yard[written]:.2f} | {ratios['alone']:.2f} | {others}", flush=True)
     for kind, what in (("with", "the main estimate"), ("alone", "without validation logs, the estimate exported")):
@@ -286,23 +293,16 @@ def blocks() -> int:
     predicts the blocks better than the SDP times a margin: how many windows that makes better and worse, and how many
     stay worse than the description by more than 2 % (issue "The better model wins", item 3)."""
     from dynid.identification.estimates import DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
-    from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.identification.evidence import weighed_means
 
     folder = Path(tempfile.mkdtemp())
     rows = []
     for group in ({"ur10e": WINDOWS, **OTHER_WINDOWS}, FRESH_WINDOWS):
         for name, cut in group.items():
             for window in cut:
-                path, root = _window_config(name, window, folder)
-                config = load_identification_config(path, data_root=root)
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    result = run_identification(config)
-                    alone = run_identification(replace(config, validation=()))
-                yard = result.diagnostics["yardstick"]
+                result, alone = _with_and_alone(name, window, folder)
                 rows.append((f"{name} {window[0]:g}-{window[1]:g}", result.diagnostics["nominal_set"],
-                             yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"],
+                             weighed_means(result.diagnostics["yardstick"]),
                              alone.diagnostics.get("held_out_rms_error") or {}))
     for margin in (1.0, 0.9, 0.5):
         better, worse, off = [], [], []

@@ -180,27 +180,32 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
     instants = np.repeat(np.arange(keep.size // n), n)[keep]
     spread = float(long_run_covariance((slope * residual(d))[:, None], instants)[0, 0])
     std = float(np.sqrt(max(spread, 0.0)) / information)
-    held = _held_out_ratio(w[keep], lambda x: shift.read(x, at=rows_index).reshape(-1)[keep], d, instants)
+    held = _held_out_ratio(w, keep, np.column_stack([shift.read(x, at=rows_index).reshape(-1)[keep] for x in (0.0, d)]),
+                           instants)
     return DelayEstimate(d, std, d / data.rate, bool(abs(d) > bound - 0.5), held)
 
 
-def _held_out_ratio(w: np.ndarray, torques, d: float, instants: np.ndarray) -> float:
-    """The least-squares residual on :data:`DELAY_FOLDS` contiguous blocks of rows (``instants``: each row's sample,
-    in time order), each predicted by the fit on the others, with the torques read at ``d`` over that at 0
-    (``torques(delay)`` -> the rows' torques)."""
+def _held_out_ratio(w: np.ndarray, keep: np.ndarray, y: np.ndarray, instants: np.ndarray) -> float:
+    """The least-squares residual on :data:`DELAY_FOLDS` contiguous blocks of the kept rows (``instants``: each kept
+    row's sample, in time order), each predicted by the fit on the others, with the torques read at the delay
+    (``y[:, 1]``) over that with them read as given (``y[:, 0]``). Each block's rows enter once, as the triangular
+    factor of ``[W | y]``: the fit on the other blocks solves their stacked factors, and the block's residual is its
+    own factor times ``[β; -1]`` (the orthogonal factor keeps the norms)."""
     folds = instants * DELAY_FOLDS // (int(instants.max()) + 1)
-    sse = []
-    for delay in (0.0, d):
-        y = torques(delay)
-        total = 0.0
-        for k in range(DELAY_FOLDS):
-            held = folds == k
-            if not held.any() or (~held).sum() <= w.shape[1]:
-                return float("nan")
-            beta = np.linalg.lstsq(w[~held], y[~held], rcond=None)[0]
-            total += float(np.sum((y[held] - w[held] @ beta) ** 2))
-        sse.append(total)
-    return sse[1] / sse[0] if sse[0] > 0 else float("nan")
+    p = w.shape[1]
+    rows = w[keep]
+    factors = []
+    for k in range(DELAY_FOLDS):
+        held = folds == k
+        if not held.any():
+            return float("nan")
+        factors.append(np.linalg.qr(np.column_stack([rows[held], y[held]]), mode="r"))
+    sse = np.zeros(2)
+    for k in range(DELAY_FOLDS):
+        rest = np.vstack([f for i, f in enumerate(factors) if i != k])
+        beta = np.linalg.lstsq(rest[:, :p], rest[:, p:], rcond=None)[0]
+        sse += np.sum((factors[k] @ np.vstack([beta, -np.eye(2)])) ** 2, axis=0)
+    return float(sse[1] / sse[0]) if sse[0] > 0 else float("nan")
 
 
 def delayed(recording: Recording, samples: float) -> Recording:

@@ -21,7 +21,7 @@ from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import CONSISTENT_NOMINAL_LABEL, DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
 
 __all__ = ["CONSISTENT_NOMINAL_LABEL", "NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
-           "state_evidence", "validate_sets", "with_yardstick",
+           "state_evidence", "validate_sets", "weighed_means", "with_yardstick",
            "yardstick_reference", "yardstick_scores"]
 
 
@@ -38,12 +38,10 @@ class Evidence:
         Every candidate on each validation log as the identification prepared it (the drive-only one included).
     validations : tuple of TorqueComparison
         The same without the drive-only candidate: what results.json shows.
-    yardstick : tuple of TorqueComparison
-        Every candidate on the one yardstick (:func:`yardstick_scores`), the states filtered at the default rules'
-        cutoffs, the SDP's refits left out.
     filters : tuple of tuple of TorqueComparison
-        The same under each state filter of :data:`dynid.preprocessing.strategies.YARDSTICK_FILTERS` (the first is
-        ``yardstick``): the verdict weighs their mean.
+        Every candidate on the one yardstick (:func:`yardstick_scores`) under each state filter of
+        :data:`dynid.preprocessing.strategies.YARDSTICK_FILTERS` (the first: the default rules' cutoffs), the SDP's
+        refits left out: the verdict weighs their mean.
     best : tuple of str
         The candidate (estimate, the description's nominal model, the drive-only estimate) with the lowest mean error
         under each filter, over the logs read as the identification log: where they differ, the ranking depends on the
@@ -58,7 +56,6 @@ class Evidence:
     nominal: tuple | None
     scored: tuple
     validations: tuple
-    yardstick: tuple
     filters: tuple
     best: tuple[str, ...]
     states: dict | None
@@ -117,7 +114,7 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
         trusted = tuple(v for v in yardstick if v.name not in misread)
         states = state_evidence(trusted, SDP_LABEL, fallback, tuple(refits), nominal[0]) if trusted else None
         filters = tuple(tuple(v.without(*refits) for v in one) for one in filters)
-    return Evidence(nominal, scored, validations, filters[0], filters, best, states, tuple(warnings))
+    return Evidence(nominal, scored, validations, filters, best, states, tuple(warnings))
 
 
 def _best(comparisons: tuple, candidates: list) -> str:
@@ -357,6 +354,23 @@ def with_yardstick(result, filters: tuple, best: tuple[str, ...] = ()):
             label: float(np.mean([c.metrics()[label]["global_relative_error"] for c in moving_logs(one)])) for label in labels},
             **({"best": b} if b else {})} for f, one, b in zip(YARDSTICK_FILTERS, filters, best or ("",) * len(filters))]
     return replace(result, diagnostics={**result.diagnostics, "yardstick": figures})
+
+
+def weighed_means(yardstick: dict) -> dict:
+    """The one yardstick's mean error of each set over the logs that move, as the verdict weighs them (over every log
+    where none rests throughout, or every one does), from results' ``diagnostics["yardstick"]``
+    (:func:`with_yardstick`).
+
+    Parameters
+    ----------
+    yardstick : dict
+
+    Returns
+    -------
+    dict
+        label -> mean global relative error [%] (``"logs"`` names the logs where some rest).
+    """
+    return yardstick.get("mean_over_logs_that_move") or yardstick["mean_global_relative_error"]
 
 
 def moving_logs(comparisons: tuple) -> tuple:

@@ -57,7 +57,7 @@ from .closed_loop import ClosedLoopEstimator
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
-from .evidence import filtered_finding, gather_evidence, yardstick_reference
+from .evidence import filtered_finding, gather_evidence, weighed_means, yardstick_reference
 from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
 from .identify import identify, one_way_joints
 from .verdict import SAME_FIGURE, decide
@@ -426,9 +426,9 @@ class IdentificationPipeline:
         torques read at the delay found (every validation log's too), and the main estimate's mean error over the
         logs that move on the one yardstick compared, better by more than
         :data:`~dynid.identification.verdict.SAME_FIGURE` to keep it (issue "Every assurance checked on what the user
-        meets", item 5). The UR10e's log showed a 0.55-sample lag that its held-out blocks favoured by 4.9 % and its
-        validation logs by 0.6 %; the LBR Med7's a 1.9-sample lead favoured by 11 %, and its validation log was
-        predicted worse with it (9.99 % against 9.90 %). The figures are in ``diagnostics["torque_delay"]``.
+        meets", item 5): held-out blocks of the log favoured the delays the real UR10e's and LBR Med7's logs show,
+        which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). The figures are in
+        ``diagnostics["torque_delay"]``.
 
         The second identification keeps the first's choices (its cutoffs, the friction model of each joint: the
         prepared robot as the description), so that the delay alone differs, and checks no delay of its own."""
@@ -442,8 +442,7 @@ class IdentificationPipeline:
         other = again.fit(recording, validation=validation, weigh_delay=False)
 
         def mean(r) -> float:
-            yard = r.diagnostics["yardstick"]
-            return float((yard.get("mean_over_logs_that_move") or yard["mean_global_relative_error"])[r.main])
+            return float(weighed_means(r.diagnostics["yardstick"])[r.main])
 
         figures = {"without": mean(result), "with": mean(other), "main_with": other.main}
         kept = figures["with"] * SAME_FIGURE < figures["without"]

@@ -104,7 +104,7 @@ def _ranking_finding(filters: list, main: str) -> tuple:
     """A finding where, with the validation logs' states filtered at another cutoff
     (:func:`dynid.identification.evidence.with_yardstick`'s ``"filters"``), another candidate predicts them better than
     the main estimate by more than :data:`SAME_FIGURE`: the choice rests on the mean over the filters, not on one, and
-    the logs do not settle it (on the TX40's, three candidates within 0.1 % of each other rank differently: not said)."""
+    the logs do not settle it (candidates within it of each other that rank differently are not said)."""
     beaten = [(f["cutoff_factor"], f["best"], f["mean_global_relative_error"]) for f in filters
               if f.get("best") and f["best"] != main and main in f["mean_global_relative_error"]
               and f["mean_global_relative_error"][main] > SAME_FIGURE * f["mean_global_relative_error"][f["best"]]]
@@ -212,9 +212,9 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
     estimate when it passed its own check: it is what ``dynid export`` writes, and blocks of one excitation do not tell
     which estimate extrapolates. Measured (benchmarks/NOTEBOOK.md, "without validation logs"): on the five real logs
     and windows where held-out blocks kept least squares, it predicted the validation logs 5-30× worse than the SDP
-    (the KR 300's full log 55.4 % against 11.8 %, the Med7's 50-55 s 661 % against 22.4 %); on the 36 real windows,
-    choosing among the SDP, the drive-only estimate and the description's values on them handed on a better model on
-    3 and a worse one on 6 (the KR 300's 1.5-7.5 s 12.5 % → 40.4 % on the raw torques of its validation logs)."""
+    (the KR 300's full log 55.4 % against 11.8 %, the Med7's 50-55 s 661 % against 22.4 %); choosing among the SDP,
+    the drive-only estimate and the description's values on them made more of the 36 real windows worse than better
+    (``benchmarks/short_windows.py --blocks``; the figures in benchmarks/NOTEBOOK.md)."""
     ls = result.label
     held = result.diagnostics.get("held_out_rms_error") or {}
     if result.diagnostics.get("misread") and SDP_LABEL not in held:  # every validation log left out: what export writes
@@ -246,8 +246,8 @@ def _held_out_words(held: dict, seconds: float | None, main: str) -> str:
            + " N·m RMS")
     if best != main:
         out += (f"; {main} is kept: blocks of one excitation do not tell which model predicts other motions (on 36 "
-                "real windows, choosing on them handed on a worse model as often as a better one); a validation log "
-                "([[validation]]) would")
+                "real windows, choosing on them handed on a worse model more often than a better one); a validation "
+                "log ([[validation]]) would")
     return out
 
 
