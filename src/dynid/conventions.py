@@ -123,20 +123,31 @@ def canonical_name(name: str) -> str:
     return f"{term}{int(joint)}"
 
 
-def unit_of(name: str) -> str:
+LINEAR_UNITS: dict[str, str] = {"kg·m²": "kg", "N·m": "N", "N·m·s/rad": "N·s/m"}
+"""A drive term's unit on a prismatic joint, where its revolute unit differs: the rotor inertia reflected as a mass,
+forces for torques, per metre for per radian."""
+
+
+def unit_of(name: str, prismatic=()) -> str:
     """Unit of a (standard or base) parameter from its leading term, e.g. ``"ZZ1R" -> "kg·m²"``.
 
     Parameters
     ----------
     name : str
         A standard or base parameter's name.
+    prismatic : sequence of bool, optional
+        Which joints slide (:attr:`dynid.model.robot.Robot.prismatic`): a drive term of such a joint has its linear
+        unit (:data:`LINEAR_UNITS`; ``"fv1" -> "N·s/m"``).
 
     Returns
     -------
     str
     """
-    term, _ = split_name(name)
-    return friction.TERMS[term].unit if term in friction.TERMS else UNITS.get(term, "")
+    term, joint = split_name(name)
+    if term not in friction.TERMS:
+        return UNITS.get(term, "")
+    unit = friction.TERMS[term].unit
+    return LINEAR_UNITS.get(unit, unit) if 0 <= joint < len(prismatic) and prismatic[joint] else unit
 
 
 MOVING_SPAN = 0.05

@@ -29,8 +29,9 @@ from ..runtime.threads import cores
 class RobotArrays(NamedTuple):
     """What the kernel reads of a robot: each joint's fixed rotation ``rp`` (n, 3, 3) and translation ``pp`` (n, 3)
     from its parent's frame, its axis ``axes`` (n, 3), ``gravity`` (3,) [m/s²], the standard parameters per joint
-    ``npj``, where each standard column goes (``colmap`` (n_params,), skipped where negative) and where each joint's
-    drive columns go (``drive_map`` (n, T), skipped where negative)."""
+    ``npj``, where each standard column goes (``colmap`` (n_params,), skipped where negative), where each joint's
+    drive columns go (``drive_map`` (n, T), skipped where negative) and which joints slide (``prismatic`` (n,): 1.0
+    for a prismatic joint, 0.0 for a revolute one)."""
 
     rp: np.ndarray
     pp: np.ndarray
@@ -39,6 +40,7 @@ class RobotArrays(NamedTuple):
     npj: int
     colmap: np.ndarray
     drive_map: np.ndarray
+    prismatic: np.ndarray
 
 
 def sample_columns(k, robot, motion, out, drive, scratch):
@@ -46,13 +48,18 @@ def sample_columns(k, robot, motion, out, drive, scratch):
     each link (skipped where ``colmap[c] < 0``), column ``drive_map[i, t]`` of joint ``i`` its drive column
     ``drive[k, i, t]`` (skipped where ``drive_map[i, t] < 0``); the other columns hold 0.
 
+    A revolute joint ``i`` feels ``z·n_j + l·f_j`` of each link ``j >= i``; a prismatic one, the force along its
+    axis, ``z·f_j``. A prismatic joint's link does not turn with ``q``: its origin moves by ``q`` along the axis,
+    and its origin's acceleration gains ``ddq·z + 2 w × (dq·z)`` (Khalil & Dombre, *Modeling, Identification and
+    Control of Robots*, §9.3).
+
     Parameters
     ----------
     k : int or slice
         The sample (compiled) or ``slice(None)``: every sample of ``q`` at once (NumPy).
     robot : RobotArrays
     motion : tuple of (N, n) arrays
-        ``q, dq, ddq`` [rad, rad/s, rad/s²].
+        ``q, dq, ddq`` [rad, rad/s, rad/s²; m, m/s, m/s² for a prismatic joint].
     out : (N, n, m) array
     drive : (N, n, T) array
         Each joint's own drive columns (rotor inertia, friction, offset: :mod:`dynid.friction`), written here
@@ -61,7 +68,7 @@ def sample_columns(k, robot, motion, out, drive, scratch):
         ``r0, o, w, dw, acc, z0, rl``: (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample axis when ``k`` is
         a slice.
     """
-    rp, pp, axes, gravity, npj, colmap, drive_map = robot
+    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic = robot
     q, dq, ddq = motion
     r0, o, w, dw, acc, z0, rl = scratch
     n = q.shape[1]
@@ -77,30 +84,41 @@ def sample_columns(k, robot, motion, out, drive, scratch):
     # ---- forward recursion -------------------------------------------------------------
     for j in range(n):
         ax0, ax1, ax2 = axes[j, 0], axes[j, 1], axes[j, 2]
-        c = np.cos(q[k, j])
-        s = np.sin(q[k, j])
-        v = 1.0 - c
-        # Rodrigues rotation about the joint axis
-        m00 = c + v * ax0 * ax0
-        m01 = v * ax0 * ax1 - s * ax2
-        m02 = v * ax0 * ax2 + s * ax1
-        m10 = v * ax0 * ax1 + s * ax2
-        m11 = c + v * ax1 * ax1
-        m12 = v * ax1 * ax2 - s * ax0
-        m20 = v * ax0 * ax2 - s * ax1
-        m21 = v * ax1 * ax2 + s * ax0
-        m22 = c + v * ax2 * ax2
-        for a in range(3):  # rl = rp_j @ rot
-            rl[a, 0] = rp[j, a, 0] * m00 + rp[j, a, 1] * m10 + rp[j, a, 2] * m20
-            rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
-            rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
-        px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
+        if prismatic[j] > 0.0:  # the link slides along the axis: rl = rp_j, its origin moves by q
+            for a in range(3):
+                for b in range(3):
+                    rl[a, b] = rp[j, a, b]
+            qj = q[k, j]
+            px = pp[j, 0] + qj * (rp[j, 0, 0] * ax0 + rp[j, 0, 1] * ax1 + rp[j, 0, 2] * ax2)
+            py = pp[j, 1] + qj * (rp[j, 1, 0] * ax0 + rp[j, 1, 1] * ax1 + rp[j, 1, 2] * ax2)
+            pz = pp[j, 2] + qj * (rp[j, 2, 0] * ax0 + rp[j, 2, 1] * ax1 + rp[j, 2, 2] * ax2)
+        else:
+            c = np.cos(q[k, j])
+            s = np.sin(q[k, j])
+            v = 1.0 - c
+            # Rodrigues rotation about the joint axis
+            m00 = c + v * ax0 * ax0
+            m01 = v * ax0 * ax1 - s * ax2
+            m02 = v * ax0 * ax2 + s * ax1
+            m10 = v * ax0 * ax1 + s * ax2
+            m11 = c + v * ax1 * ax1
+            m12 = v * ax1 * ax2 - s * ax0
+            m20 = v * ax0 * ax2 - s * ax1
+            m21 = v * ax1 * ax2 + s * ax0
+            m22 = c + v * ax2 * ax2
+            for a in range(3):  # rl = rp_j @ rot
+                rl[a, 0] = rp[j, a, 0] * m00 + rp[j, a, 1] * m10 + rp[j, a, 2] * m20
+                rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
+                rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
+            px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
         if j == 0:
             wpx = wpy = wpz = 0.0
             dwx = dwy = dwz = 0.0
             apx, apy, apz = -gravity[0], -gravity[1], -gravity[2]
+            o[0, 0] = px
+            o[0, 1] = py
+            o[0, 2] = pz
             for a in range(3):
-                o[0, a] = pp[0, a]
                 for b in range(3):
                     r0[0, a, b] = rl[a, b]
         else:
@@ -119,19 +137,30 @@ def sample_columns(k, robot, motion, out, drive, scratch):
         hy = apy + (dwz * px - dwx * pz) + (wpz * cx - wpx * cz)
         hz = apz + (dwx * py - dwy * px) + (wpx * cy - wpy * cx)
         qd, qdd = dq[k, j], ddq[k, j]
+        slides = prismatic[j] > 0.0
         for b in range(3):  # rotate into link j frame (rl^T)
             wi = rl[0, b] * wpx + rl[1, b] * wpy + rl[2, b] * wpz
             w[j, b] = wi
-            dw[j, b] = rl[0, b] * dwx + rl[1, b] * dwy + rl[2, b] * dwz + qdd * axes[j, b]
-            acc[j, b] = rl[0, b] * hx + rl[1, b] * hy + rl[2, b] * hz
-        # dw += w_in × (qd axis), then w += qd axis
+            dwi = rl[0, b] * dwx + rl[1, b] * dwy + rl[2, b] * dwz
+            acci = rl[0, b] * hx + rl[1, b] * hy + rl[2, b] * hz
+            if slides:
+                dw[j, b] = dwi
+                acc[j, b] = acci + qdd * axes[j, b]
+            else:
+                dw[j, b] = dwi + qdd * axes[j, b]
+                acc[j, b] = acci
         wix, wiy, wiz = w[j, 0], w[j, 1], w[j, 2]
-        dw[j, 0] += qd * (wiy * ax2 - wiz * ax1)
-        dw[j, 1] += qd * (wiz * ax0 - wix * ax2)
-        dw[j, 2] += qd * (wix * ax1 - wiy * ax0)
-        w[j, 0] += qd * ax0
-        w[j, 1] += qd * ax1
-        w[j, 2] += qd * ax2
+        if slides:  # acc += 2 w × (qd axis): the sliding origin's Coriolis term
+            acc[j, 0] += 2.0 * qd * (wiy * ax2 - wiz * ax1)
+            acc[j, 1] += 2.0 * qd * (wiz * ax0 - wix * ax2)
+            acc[j, 2] += 2.0 * qd * (wix * ax1 - wiy * ax0)
+        else:  # dw += w_in × (qd axis), then w += qd axis
+            dw[j, 0] += qd * (wiy * ax2 - wiz * ax1)
+            dw[j, 1] += qd * (wiz * ax0 - wix * ax2)
+            dw[j, 2] += qd * (wix * ax1 - wiy * ax0)
+            w[j, 0] += qd * ax0
+            w[j, 1] += qd * ax1
+            w[j, 2] += qd * ax2
         for a in range(3):
             z0[j, a] = r0[j, a, 0] * ax0 + r0[j, a, 1] * ax1 + r0[j, a, 2] * ax2
     # ---- regressor columns -------------------------------------------------------------
@@ -152,23 +181,31 @@ def sample_columns(k, robot, motion, out, drive, scratch):
             rx = r0[j, 0, 0] * dx + r0[j, 1, 0] * dy + r0[j, 2, 0] * dz
             ry = r0[j, 0, 1] * dx + r0[j, 1, 1] * dy + r0[j, 2, 1] * dz
             rz = r0[j, 0, 2] * dx + r0[j, 1, 2] * dy + r0[j, 2, 2] * dz
-            lx = zy * rz - zz * ry
-            ly = zz * rx - zx * rz
-            lz = zx * ry - zy * rx
-            ux = zy * wz - zz * wy
-            uy = zz * wx - zx * wz
-            uz = zx * wy - zy * wx
-            c0 = zx * ex + ux * wx
-            c1 = zx * ey + zy * ex + ux * wy + uy * wx
-            c2 = zx * ez + zz * ex + ux * wz + uz * wx
-            c3 = zy * ey + uy * wy
-            c4 = zy * ez + zz * ey + uy * wz + uz * wy
-            c5 = zz * ez + uz * wz
-            lw = lx * wx + ly * wy + lz * wz
-            c6 = (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy)
-            c7 = (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz)
-            c8 = (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx)
-            c9 = lx * gx + ly * gy + lz * gz
+            if prismatic[i] > 0.0:  # the force along the axis: z·f_j
+                c0 = c1 = c2 = c3 = c4 = c5 = 0.0
+                lw = zx * wx + zy * wy + zz * wz
+                c6 = (zy * ez - zz * ey) + lw * wx - w2 * zx
+                c7 = (zz * ex - zx * ez) + lw * wy - w2 * zy
+                c8 = (zx * ey - zy * ex) + lw * wz - w2 * zz
+                c9 = zx * gx + zy * gy + zz * gz
+            else:  # z·n_j + l·f_j
+                lx = zy * rz - zz * ry
+                ly = zz * rx - zx * rz
+                lz = zx * ry - zy * rx
+                ux = zy * wz - zz * wy
+                uy = zz * wx - zx * wz
+                uz = zx * wy - zy * wx
+                c0 = zx * ex + ux * wx
+                c1 = zx * ey + zy * ex + ux * wy + uy * wx
+                c2 = zx * ez + zz * ex + ux * wz + uz * wx
+                c3 = zy * ey + uy * wy
+                c4 = zy * ez + zz * ey + uy * wz + uz * wy
+                c5 = zz * ez + uz * wz
+                lw = lx * wx + ly * wy + lz * wz
+                c6 = (ly * ez - lz * ey) + lw * wx - w2 * lx + (gy * zz - gz * zy)
+                c7 = (lz * ex - lx * ez) + lw * wy - w2 * ly + (gz * zx - gx * zz)
+                c8 = (lx * ey - ly * ex) + lw * wz - w2 * lz + (gx * zy - gy * zx)
+                c9 = lx * gx + ly * gy + lz * gz
             values = (c0, c1, c2, c3, c4, c5, c6, c7, c8, c9)
             for t in range(10):
                 dst = colmap[col + t]

@@ -129,7 +129,7 @@ class _Output:
         self.stores[tuple(int(i) for i in index[1:])] = value if isinstance(value, _Sym) else float(value)
 
 
-def _trace(rp, pp, axes, gravity, npj: int, n_drive: int):
+def _trace(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
     """The operations of one sample and, for each (joint, standard column) that some column of the
     regressor takes, the value stored there (a symbol, or a constant)."""
     n = rp.shape[0]
@@ -141,7 +141,8 @@ def _trace(rp, pp, axes, gravity, npj: int, n_drive: int):
     drive_map = np.arange(n)[:, None] * npj + 10 + np.arange(n_drive)
     rp_, pp_, axes_, gravity_ = (np.array(np.asarray(a, dtype=float).tolist(), dtype=object) for a in (rp, pp, axes, gravity))
     scratch = tuple(np.empty(s, dtype=object) for s in ((n, 3, 3), (n, 3), (n, 3), (n, 3), (n, 3), (n, 3), (3, 3)))
-    robot = _regressor_kernel.RobotArrays(rp_, pp_, axes_, gravity_, npj, colmap, drive_map)
+    robot = _regressor_kernel.RobotArrays(rp_, pp_, axes_, gravity_, npj, colmap, drive_map,
+                                          np.asarray(prismatic, dtype=float))
     _regressor_kernel.sample_columns(0, robot, (q, dq, ddq), out, drive, scratch)
     return graph, {key: v for key, v in out.stores.items() if isinstance(v, _Sym) or v != 0.0}
 
@@ -327,14 +328,14 @@ def _compile(ir: str):
     return function, engine
 
 
-def kernel(rp, pp, axes, gravity, npj: int, n_drive: int):
-    """The compiled regressor of a robot (its joints' fixed geometry and gravity), compiled or loaded once
+def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
+    """The compiled regressor of a robot (its joints' fixed geometry and kinds, gravity), compiled or loaded once
     per process."""
     key = (np.asarray(rp, float).tobytes(), np.asarray(pp, float).tobytes(), np.asarray(axes, float).tobytes(),
-           np.asarray(gravity, float).tobytes(), int(npj), int(n_drive))
+           np.asarray(gravity, float).tobytes(), int(npj), int(n_drive), np.asarray(prismatic, float).tobytes())
     with _lock:
         if key not in _kernels:
-            graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive)
+            graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
             _kernels[key] = _compile(_ir(graph, stores, len(rp), npj, n_drive))
         return _kernels[key][0]
 
@@ -350,11 +351,11 @@ def simd_regressor(robot, motion, out, drive) -> None:
     (N, n, m), C-ordered, is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
     samples after the last whole group of lanes go through it padded. ``colmap`` must place the drive
     columns where ``drive_map`` does (as :func:`dynid.dynamics.regressor.regressor` builds them)."""
-    rp, pp, axes, gravity, npj, colmap, drive_map = robot
+    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic = robot
     q, dq, ddq = motion
     n_s, n = q.shape
     m, n_drive = out.shape[2], drive_map.shape[1]
-    function = kernel(rp, pp, axes, gravity, npj, n_drive)
+    function = kernel(rp, pp, axes, gravity, npj, n_drive, prismatic)
     columns = np.ascontiguousarray(colmap[:n * npj], dtype=np.int64)
     q, dq, ddq = (np.ascontiguousarray(a, dtype=float) for a in (q, dq, ddq))
     drives = np.empty((n_s, n, n_drive))

@@ -18,6 +18,7 @@ import scipy.linalg
 
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
+from ..conventions import unit_of
 from ..exceptions import IdentifiabilityError
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -43,6 +44,8 @@ class BaseParameters:
         ``beta = regrouping @ phi``.
     expressions : tuple of str
         Readable regroupings, e.g. ``"ZZ1R = ZZ1 + YY2 + 0.4624·M3"``.
+    prismatic : tuple of bool
+        Which joints slide (their drive terms in N, kg, N·s/m: :meth:`unit`); empty for a revolute chain.
     """
 
     names: tuple[str, ...]
@@ -50,6 +53,20 @@ class BaseParameters:
     independent: np.ndarray
     regrouping: np.ndarray
     expressions: tuple[str, ...]
+    prismatic: tuple[bool, ...] = ()
+
+    def unit(self, name: str) -> str:
+        """The unit of a base or standard parameter (:func:`dynid.conventions.unit_of`).
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        str
+        """
+        return unit_of(name, self.prismatic)
 
     @property
     def n_base(self) -> int:
@@ -229,4 +246,5 @@ def base_parameters(robot: Robot | str | Path, *, rng: np.random.Generator | int
         names.append(name)
         expr = names_std[col] + "".join(_format_term(cf, nm, False) for cf, nm in others)
         exprs.append(f"{name} = {expr}")
-    return BaseParameters(tuple(names), names_std, indep, regroup, tuple(exprs))
+    sliding = tuple(bool(p) for p in robot.prismatic) if robot.prismatic.any() else ()
+    return BaseParameters(tuple(names), names_std, indep, regroup, tuple(exprs), sliding)

@@ -5,12 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.robot import Robot
-from ..model.spatial import rot_axis
-
-
-def _local_rotations(robot: Robot, q: np.ndarray) -> list[np.ndarray]:
-    """``[(N, 3, 3)]``: orientation of link j in link j-1 for every sample."""
-    return [jt.rotation @ rot_axis(jt.axis, q[:, j]) for j, jt in enumerate(robot.joints)]
 
 
 def forward_kinematics(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -20,7 +14,7 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     ----------
     robot : Robot
     q : (N, n_dof) array
-        Joint positions [rad].
+        Joint positions [rad, or m for a prismatic joint].
 
     Returns
     -------
@@ -31,8 +25,9 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     rots = np.empty((n_s, robot.n_dof, 3, 3))
     orig = np.empty((n_s, robot.n_dof, 3))
     r_prev, p_prev = np.broadcast_to(np.eye(3), (n_s, 3, 3)), np.zeros((n_s, 3))
-    for j, rl in enumerate(_local_rotations(robot, q)):
-        p_prev = p_prev + r_prev @ robot.joints[j].translation
+    for j, jt in enumerate(robot.joints):
+        rl, pl = jt.placement(q[:, j])
+        p_prev = p_prev + (np.einsum("nij,nj->ni", r_prev, pl) if jt.prismatic else r_prev @ jt.translation)
         r_prev = r_prev @ rl
         rots[:, j], orig[:, j] = r_prev, p_prev
     return rots, orig

@@ -40,18 +40,21 @@ def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
     parent = 0
     for j, jt in enumerate(robot.joints):
         placement = pin.SE3(np.asarray(jt.rotation), np.asarray(jt.translation))
-        ax = np.asarray(jt.axis, dtype=float)
-        if np.allclose(ax, [0, 0, 1]):
-            jm = pin.JointModelRZ()
-        elif np.allclose(ax, [1, 0, 0]):
-            jm = pin.JointModelRX()
-        elif np.allclose(ax, [0, 1, 0]):
-            jm = pin.JointModelRY()
-        else:
-            jm = pin.JointModelRevoluteUnaligned(ax)
-        parent = model.addJoint(parent, jm, placement, jt.name)
+        parent = model.addJoint(parent, _joint_model(jt), placement, jt.name)
         model.appendBodyToJoint(parent, pin.Inertia.FromDynamicParameters(pinocchio_from_inertial(inertial[j])), pin.SE3.Identity())
     return model
+
+
+def _joint_model(joint):
+    """Pinocchio's joint model of a joint: about (revolute) or along (prismatic) its axis."""
+    import pinocchio as pin
+
+    ax = np.asarray(joint.axis, dtype=float)
+    kind = "P" if joint.prismatic else "R"
+    for name, unit in (("X", [1, 0, 0]), ("Y", [0, 1, 0]), ("Z", [0, 0, 1])):
+        if np.allclose(ax, unit):
+            return getattr(pin, f"JointModel{kind}{name}")()
+    return pin.JointModelPrismaticUnaligned(ax) if joint.prismatic else pin.JointModelRevoluteUnaligned(ax)
 
 
 @keyword_only_after_data
@@ -63,7 +66,7 @@ def rnea_torques(robot: Robot | str | Path, q, dq, ddq, *, inertial: np.ndarray 
     robot : Robot, str or Path
         A built-in robot's name or a description's path is loaded (:func:`dynid.model.loading.as_robot`).
     q, dq, ddq : (N, n_dof) arrays
-        [rad], [rad/s], [rad/s²].
+        [rad], [rad/s], [rad/s²] ([m], [m/s], [m/s²] for a prismatic joint).
     inertial : (n_dof, 10) array, optional
         eq. 5 order (the robot's nominal ones by default).
     drive : (n_dof, n_drive) array, optional
@@ -71,7 +74,7 @@ def rnea_torques(robot: Robot | str | Path, q, dq, ddq, *, inertial: np.ndarray 
 
     Returns
     -------
-    (N, n_dof) ndarray [N·m]
+    (N, n_dof) ndarray [N·m] ([N] for a prismatic joint)
     """
     robot = as_robot(robot)
     import pinocchio as pin

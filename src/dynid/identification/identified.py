@@ -79,6 +79,8 @@ class Parameters:
         Standard deviations, NaN where the estimator gives none.
     expressions : sequence of str, optional
         Each base parameter's regrouping of standard parameters.
+    units : sequence of str, optional
+        Each parameter's unit (by default from its name, a revolute joint's: :func:`dynid.conventions.unit_of`).
 
     Attributes
     ----------
@@ -88,8 +90,9 @@ class Parameters:
         NaN where the estimator gives none.
     """
 
-    def __init__(self, names, values, std=None, expressions=None):
+    def __init__(self, names, values, std=None, expressions=None, units=None):
         self.names = tuple(names)
+        self.units = tuple(units) if units is not None else tuple(map(unit_of, self.names))
         self.values = np.asarray(values, dtype=float)
         self.std = np.full(self.values.shape, np.nan) if std is None else np.asarray(std, dtype=float)
         self._expressions = tuple(expressions) if expressions is not None else ("",) * len(self.names)
@@ -98,7 +101,7 @@ class Parameters:
         i = self.names.index(name) if name in self.names else None
         if i is None:
             raise KeyError(f"no base parameter {name!r}; expected one of {', '.join(self.names)}")
-        return Parameter(name, float(self.values[i]), float(self.std[i]), unit_of(name), self._expressions[i])
+        return Parameter(name, float(self.values[i]), float(self.std[i]), self.units[i], self._expressions[i])
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.names)
@@ -135,13 +138,13 @@ class Parameters:
         dict
             name -> {"value", "std", "unit"}; a missing σ is None.
         """
-        return {n: {"value": float(v), "std": None if np.isnan(s) else float(s), "unit": unit_of(n)}
-                for n, v, s in zip(self.names, self.values, self.std)}
+        return {n: {"value": float(v), "std": None if np.isnan(s) else float(s), "unit": u}
+                for n, v, s, u in zip(self.names, self.values, self.std, self.units)}
 
     def __repr__(self) -> str:
         rows = [f"{'name':>10s} {'value':>13s} {'σ':>10s}  unit"]
-        rows += [f"{n:>10s} {v:13.6g} {'—' if np.isnan(s) else f'{s:.3g}':>10s}  {unit_of(n)}"  # no σ: the SDP's
-                 for n, v, s in zip(self.names, self.values, self.std)]
+        rows += [f"{n:>10s} {v:13.6g} {'—' if np.isnan(s) else f'{s:.3g}':>10s}  {u}"  # no σ: the SDP's
+                 for n, v, s, u in zip(self.names, self.values, self.std, self.units)]
         return "\n".join(rows)
 
 
@@ -300,7 +303,7 @@ class IdentifiedModel:
         """
         label = self.label(estimate)
         return Parameters(self.base.names, self.params(label), self.std.get(label),
-                          [e.split(" = ", 1)[1] for e in self.base.expressions])
+                          [e.split(" = ", 1)[1] for e in self.base.expressions], map(self.base.unit, self.base.names))
 
     @keyword_only_after_data
     def predict(self, t, q=None, dq=None, ddq=None, *, estimate: str | None = None) -> np.ndarray:

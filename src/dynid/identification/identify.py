@@ -18,7 +18,6 @@ import numpy as np
 
 from .._util.column_store import root_mean_square
 from .._util.keywords import keyword_only_after_data
-from ..conventions import unit_of
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.layout import consistency_layout
 from ..estimators import paper_objective
@@ -193,7 +192,7 @@ class IdentificationResult:
         """
         main = self.main_estimate
         findings = [textwrap.fill(f.text, 100, initial_indent="  ", subsequent_indent="    ") for f in self.findings[:3]]
-        return "\n".join([repr(self), *findings, repr(Parameters(self.base.names, main.params, main.std))])
+        return "\n".join([repr(self), *findings, repr(Parameters(self.base.names, main.params, main.std, units=tuple(map(self.base.unit, self.base.names))))])
 
     def parameter_sets(self) -> dict:
         """Every parameter set compared: dynid's estimates, then each reference set.
@@ -233,7 +232,7 @@ class IdentificationResult:
         dict
         """
         sol = self.solution
-        params = [{"name": n, "value": float(v), "std": float(s), "relative_std_percent": float(r), "unit": unit_of(n),
+        params = [{"name": n, "value": float(v), "std": float(s), "relative_std_percent": float(r), "unit": self.base.unit(n),
                    "expression": e.split(" = ", 1)[1]}
                   for n, v, s, r, e in zip(self.base.names, sol.params, sol.params_std, sol.relative_std, self.base.expressions)]
         refs = []

@@ -1,8 +1,8 @@
-"""What a robot is: an immutable serial chain of revolute joints with its parameters.
+"""What a robot is: an immutable serial chain of revolute and prismatic joints with its parameters.
 
 Every joint ``j`` has a fixed placement ``(R_j, p_j)`` of its frame in the frame of link ``j-1``
-(the base for ``j = 0``) and a unit rotation axis in its own frame; link ``j``'s frame is the joint
-frame after the rotation by ``q_j``. Modified DH (Khalil/Craig, the paper's Table 1), standard DH
+(the base for ``j = 0``) and a unit axis in its own frame; link ``j``'s frame is the joint frame after the
+rotation by ``q_j`` about the axis (revolute) or the translation by ``q_j`` along it (prismatic). Modified DH (Khalil/Craig, the paper's Table 1), standard DH
 and URDF chains all reduce to this form (see :mod:`dynid.model.dh` and :mod:`dynid.model.urdf`).
 """
 
@@ -23,7 +23,7 @@ from .transmission import Transmission
 @short_repr
 @dataclass(frozen=True)
 class Joint:
-    """One revolute joint: placement in the parent link frame and rotation axis.
+    """One joint: placement in the parent link frame and axis (of rotation, or of translation if prismatic).
 
     Attributes
     ----------
@@ -33,13 +33,35 @@ class Joint:
     translation : (3,) array
         Origin of the joint frame in the parent link frame [m].
     axis : (3,) array
-        Unit rotation axis in the joint frame (``(0, 0, 1)`` for DH chains).
+        Unit axis in the joint frame (``(0, 0, 1)`` for DH chains).
+    prismatic : bool
+        The joint slides along its axis (position [m], force [N]) instead of turning about it.
     """
 
     name: str
     rotation: np.ndarray
     translation: np.ndarray
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    prismatic: bool = False
+
+    def placement(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The frame of the joint's link in its parent's, at positions ``q``.
+
+        Parameters
+        ----------
+        q : (N,) array
+            Joint position [rad], or [m] if prismatic.
+
+        Returns
+        -------
+        rotations : (N, 3, 3) array
+        translations : (N, 3) array [m]
+        """
+        q = np.asarray(q, dtype=float)
+        if self.prismatic:
+            return (np.broadcast_to(self.rotation, (q.size, 3, 3)).copy(),
+                    self.translation + q[:, None] * (self.rotation @ self.axis))
+        return self.rotation @ rot_axis(self.axis, q), np.broadcast_to(self.translation, (q.size, 3)).copy()
 
 
 @short_repr
@@ -108,7 +130,7 @@ class Limits:
 @short_repr
 @dataclass(frozen=True)
 class Robot:
-    """A serial robot arm with revolute joints (immutable).
+    """A serial robot arm with revolute and prismatic joints (immutable).
 
     Attributes
     ----------
@@ -287,6 +309,11 @@ class Robot:
         return len(self.joints)
 
     @property
+    def prismatic(self) -> np.ndarray:
+        """(n_dof,) bool: which joints slide (position [m], force [N]) rather than turn."""
+        return np.array([j.prismatic for j in self.joints], dtype=bool)
+
+    @property
     def reach(self) -> float:
         """[m] The sum of the joints' offsets and the flange's: no point of the arm's skeleton is farther than this from
         the first joint's origin."""
@@ -326,6 +353,8 @@ class Robot:
         values = [np.asarray(x, dtype=float).ravel() for j in self.joints for x in (j.rotation, j.translation, j.axis)]
         values += [np.asarray(x, dtype=float).ravel() for x in (self.tool_rotation, self.tool_translation, self.gravity,
                                                                  self.transmission.motor_from_joint)]
+        if self.prismatic.any():  # a revolute chain's fingerprint stays what it was
+            values.append(self.prismatic.astype(float))
         flat = np.concatenate(values)
         text = ",".join(f"{0.0 if abs(v) < 1e-12 else v:.12g}" for v in flat)
         return hashlib.sha256(f"{self.n_dof};{text}".encode()).hexdigest()[:16]
@@ -378,8 +407,8 @@ class Robot:
         p : (3,) ndarray
             Origin [m].
         """
-        jt = self.joints[j]
-        return jt.rotation @ rot_axis(jt.axis, np.array([qj]))[0], jt.translation.copy()
+        r, p = self.joints[j].placement(np.array([qj]))
+        return r[0], p[0]
 
     def submodel(self, k: int, q_rest: np.ndarray | None = None) -> Robot:
         """The first ``k`` joints, the others held still.

@@ -14,35 +14,49 @@ HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (
 :func:`dynid.model.urdf.joints_from_urdf`, :mod:`dynid.model.mjcf`)."""
 
 
-def arm_chain(parents: dict[int, int], revolute: set[int]) -> list[int]:
-    """The arm's joints in a robot file's tree of moving joints: the longest chain from the base of revolute joints,
-    each riding on the one before (of chains as long, the first in the file's reading order).
+def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> list[int]:
+    """The arm's joints in a robot file's tree of moving joints: the longest chain from the base of revolute and
+    prismatic joints, each riding on the one before (of chains as long, the first in the file's reading order). A
+    gripper's fingers at a chain's tip (prismatic joints beside another on the same link) are not the arm's.
 
     Parameters
     ----------
     parents : dict of int to int
         Every moving joint -> the moving joint it rides on (-1: the base), in reading order: a joint after its parent.
     revolute : set of int
-        The joints that can be the arm's (revolute, not mimicking another).
+        The revolute joints that can be the arm's (not mimicking another).
+    sliding : set of int
+        The prismatic joints that can be the arm's (a linear track, a lift, a SCARA's vertical axis).
 
     Returns
     -------
     list of int
         From the base outwards.
     """
-    return max(_chains(parents, revolute).values(), key=len)
+    return max(_chains(parents, revolute, sliding).values(), key=len)
 
 
-def _chains(parents: dict[int, int], revolute: set[int]) -> dict[int, list[int]]:
-    """Each revolute joint reached from the base through revolute joints -> that chain (``-1``: the empty one)."""
+def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> dict[int, list[int]]:
+    """Each joint reached from the base through revolute and prismatic joints -> that chain less the fingers at its
+    tip (prismatic joints beside another on one link), unless they are all it has (``-1``: the empty one)."""
     chains: dict[int, list[int]] = {-1: []}
     for k, parent in parents.items():
-        if k in revolute and parent in chains:
+        if (k in revolute or k in sliding) and parent in chains:
             chains[k] = chains[parent] + [k]
-    return chains
+    def finger(k):  # a prismatic joint beside another on the same link (a gripper's fingers, one may mimic the other)
+        return k in sliding and sum(p == parents[k] for p in parents.values()) > 1
+
+    trimmed = {}
+    for k, chain in chains.items():
+        end = len(chain)
+        while end and finger(chain[end - 1]):
+            end -= 1
+        trimmed[k] = chain[:end] if end else chain
+    return trimmed
 
 
-def branch_refusal(path, names: dict[int, str], parents: dict[int, int], revolute: set[int], at: int) -> str:
+def branch_refusal(path, names: dict[int, str], parents: dict[int, int], revolute: set[int], at: int,
+                   sliding=frozenset()) -> str:
     """The one line refusing a tree of joints that branches: the joints riding on the same one as joint ``at``, and
     the ``held`` that keeps the longest chain (:func:`arm_chain`).
 
@@ -55,13 +69,15 @@ def branch_refusal(path, names: dict[int, str], parents: dict[int, int], revolut
         As :func:`arm_chain`.
     at : int
         A joint that rides on another than the joint before it.
+    sliding : set of int
+        As :func:`arm_chain`.
 
     Returns
     -------
     str
     """
     siblings = [names[k] for k, parent in parents.items() if parent == parents[at]]
-    chains = _chains(parents, revolute)
+    chains = _chains(parents, revolute, sliding)
     arm = max(chains.values(), key=len)
     one = "one of the longest chains" if sum(len(c) == len(arm) for c in chains.values()) > 1 else "the longest chain"
     off = ", ".join(f'"{names[k]}"' for k in parents if k not in arm)

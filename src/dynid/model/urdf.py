@@ -1,4 +1,4 @@
-"""Serial revolute chains from URDF files, parsed by Pinocchio (a MuJoCo model, MJCF: :mod:`dynid.model.mjcf`)."""
+"""Serial chains of revolute and prismatic joints from URDF files, parsed by Pinocchio (a MuJoCo model, MJCF: :mod:`dynid.model.mjcf`)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,8 @@ from .robot import Joint
 from .robot_files import HELD_HINT, arm_chain, branch_refusal, check_xml, is_mjcf
 from .xacro_expansion import expand_xacro_text
 
-_AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0)}
+_AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0),
+         "PX": (1.0, 0.0, 0.0), "PY": (0.0, 1.0, 0.0), "PZ": (0.0, 0.0, 1.0)}
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 
 
@@ -198,25 +199,28 @@ def joints_from_urdf(path: str | Path,
         jm = model.joints[j]
         short = jm.shortname()
         if model.parents[j] != j - 1:
-            raise ConfigError(branch_refusal(path, *_tree(model), j - 1))
-        if short.startswith("JointModelR") and short[-2:] in _AXES and "Unbounded" not in short:
-            axis = np.array(_AXES[short[-2:]])  # revolute, or continuous (RUB: unbounded, same dynamics)
+            names, parents, revolute, sliding = _tree(model)
+            raise ConfigError(branch_refusal(path, names, parents, revolute, j - 1, sliding))
+        prismatic = short.startswith("JointModelP")
+        if short[-2:] in _AXES and short in (f"JointModel{short[-2:]}",):
+            axis = np.array(_AXES[short[-2:]])  # revolute or prismatic about/along x, y or z
         elif short.startswith("JointModelRUB") and "R" + short[-1] in _AXES:  # continuous joint about x, y or z
             axis = np.array(_AXES["R" + short[-1]])
-        elif short == "JointModelRevoluteUnaligned":
+        elif short in ("JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned"):
             axis = np.asarray(jm.extract().axis, dtype=float).ravel()
         elif short == "JointModelRevoluteUnboundedUnaligned":  # continuous, unaligned: the axis is its motion subspace
             data = model.createData()
             pin.forwardKinematics(model, data, pin.neutral(model))
             axis = np.asarray(data.joints[j].S, dtype=float).ravel()[3:]
         else:
-            raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute joint; "
+            raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute or prismatic joint; "
                               + HELD_HINT.format(names=f'"{model.names[j]}"'))
         placement = model.jointPlacements[j]
-        joints.append(Joint(model.names[j], np.array(placement.rotation), np.array(placement.translation), axis))
+        joints.append(Joint(model.names[j], np.array(placement.rotation), np.array(placement.translation), axis,
+                            prismatic))
         inertial.append(inertial_from_pinocchio(model.inertias[j]))
     if not joints:
-        raise ConfigError(f"{path}: expected at least one revolute joint, found none")
+        raise ConfigError(f"{path}: expected at least one revolute or prismatic joint, found none")
     links = tuple(next((f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == j),
                        model.names[j]) for j in range(1, model.njoints))
     return tuple(joints), np.array(inertial), tuple(model.names[1:]), links
@@ -274,19 +278,20 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
     mimic = _mimic_joints(path)
     check_urdf_text(path, held=mimic)
     model = _pinocchio_model(path, {})
-    names, parents, revolute = _tree(model, mimic)
-    arm = arm_chain(parents, revolute)
+    names, parents, revolute, sliding = _tree(model, mimic)
+    arm = arm_chain(parents, revolute, sliding)
     return tuple(names[k] for k in parents if k not in arm)
 
 
-def _tree(model, mimic=frozenset()) -> tuple[dict[int, str], dict[int, int], set[int]]:
+def _tree(model, mimic=frozenset()) -> tuple[dict[int, str], dict[int, int], set[int], set[int]]:
     """Pinocchio's moving joints as :func:`dynid.model.robot_files.arm_chain` reads them (numbered from 0; a
-    mimic joint is no revolute joint of the arm)."""
+    mimic joint is none of the arm's): names, parents, the revolute joints and the prismatic ones."""
     names = {j - 1: model.names[j] for j in range(1, model.njoints)}
     parents = {j - 1: model.parents[j] - 1 for j in range(1, model.njoints)}
-    revolute = {j - 1 for j in range(1, model.njoints)
-                if model.joints[j].shortname().startswith("JointModelR") and model.names[j] not in mimic}
-    return names, parents, revolute
+    kinds = {j - 1: model.joints[j].shortname() for j in range(1, model.njoints) if model.names[j] not in mimic}
+    revolute = {k for k, short in kinds.items() if short.startswith("JointModelR")}
+    sliding = {k for k, short in kinds.items() if short.startswith("JointModelP")}
+    return names, parents, revolute, sliding
 
 
 def _mimic_joints(path: Path) -> set[str]:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
-from ..conventions import INERTIAL_TERMS, split_name, unit_of
+from ..conventions import INERTIAL_TERMS, split_name
 from ..estimators.registry import OTHER_LABELS, label
 from ..exceptions import NotFittedError
 from ..friction import COUNTERBALANCE_TERMS, TERMS
@@ -256,7 +256,7 @@ def identification_blocks(result, *, library: bool = False) -> list:
               or (e is main and e.key != r.least_squares)]
     kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}
-    rows = tuple((n, unit_of(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
+    rows = tuple((n, base.unit(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
                   *(("prior" if i in kept else f"{boot.get(n, math.nan):.2g}",) if boot else ()),
                   "—" if i in kept else f"{larger_relative_std(n, sol.params[i], sol.relative_std[i], boot):.1f}",
                   *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))

@@ -1,0 +1,144 @@
+"""Prismatic joints (issue "Every arm a user has", item 1): a linear track under an arm, a SCARA's vertical axis and a
+lift, against Pinocchio's own reading of the same URDF (its regressor and RNEA, not dynid's)."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from dynid.conventions import unit_of
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.kinematics import forward_kinematics
+from dynid.dynamics.regressor import _fill
+from dynid.model.description import load_robot
+from dynid.model.urdf import inertial_from_pinocchio, joints_to_hold
+
+
+def _link(name, mass, com, inertia):
+    ixx, iyy, izz, ixy, ixz, iyz = inertia
+    return (f'<link name="{name}"><inertial><origin xyz="{com}" rpy="0 0 0"/><mass value="{mass}"/>'
+            f'<inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/></inertial></link>')
+
+
+def _joint(name, kind, parent, child, xyz, rpy, axis, lower=-2.0, upper=2.0, mimic=""):
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="500" velocity="2"/>{mimic}</joint>')
+
+
+def _urdf(links, joints):
+    return '<robot name="r"><link name="base"/>' + "".join(links) + "".join(joints) + "</robot>"
+
+
+TRACKED = _urdf(
+    [_link("carriage", 30.0, "0.05 0.01 0.1", (1.2, 1.5, 1.1, 0.02, -0.01, 0.03)),
+     _link("l1", 8.0, "0 0.02 0.15", (0.3, 0.35, 0.2, 0.01, 0.0, -0.02)),
+     _link("l2", 6.0, "0.25 0 0.02", (0.05, 0.4, 0.42, 0.0, 0.01, 0.0)),
+     _link("l3", 3.0, "0.2 0.01 0", (0.02, 0.15, 0.16, 0.0, 0.0, 0.01)),
+     _link("l4", 1.5, "0 0 0.05", (0.01, 0.012, 0.008, 0.0, 0.0, 0.0))],
+    [_joint("track", "prismatic", "base", "carriage", "0.1 -0.2 0.3", "0 0 0.3", "1 0 0", 0.0, 3.0),
+     _joint("j1", "revolute", "carriage", "l1", "0 0 0.4", "0 0 0", "0 0 1"),
+     _joint("j2", "revolute", "l1", "l2", "0 0.1 0.3", "1.5708 0 0", "0 0 1"),
+     _joint("j3", "revolute", "l2", "l3", "0.5 0 0", "0 0 0", "0 0 1"),
+     _joint("j4", "prismatic", "l3", "l4", "0.4 0 0", "0.1 0.2 0", "0.3 0.4 0.866", -0.1, 0.2)])
+"""A 3-axis arm on a linear track, its tip sliding along an unaligned axis."""
+
+SCARA = _urdf(
+    [_link("l1", 12.0, "0.2 0 0.05", (0.1, 0.5, 0.55, 0.0, 0.01, 0.0)),
+     _link("l2", 8.0, "0.15 0.01 0", (0.05, 0.3, 0.32, 0.01, 0.0, 0.0)),
+     _link("quill", 2.0, "0 0 -0.1", (0.02, 0.02, 0.001, 0.0, 0.0, 0.0)),
+     _link("tool", 0.8, "0 0.01 -0.02", (0.002, 0.002, 0.001, 0.0, 0.0, 0.0)),
+     _link("finger_a", 0.05, "0 0 -0.01", (1e-5, 1e-5, 1e-5, 0.0, 0.0, 0.0)),
+     _link("finger_b", 0.05, "0 0 -0.01", (1e-5, 1e-5, 1e-5, 0.0, 0.0, 0.0))],
+    [_joint("j1", "revolute", "base", "l1", "0 0 0.4", "0 0 0", "0 0 1"),
+     _joint("j2", "revolute", "l1", "l2", "0.4 0 0", "0 0 0", "0 0 1"),
+     _joint("j3", "prismatic", "l2", "quill", "0.35 0 0", "0 0 0", "0 0 -1", 0.0, 0.3),
+     _joint("j4", "revolute", "quill", "tool", "0 0 -0.2", "0 0 0", "0 0 1"),
+     _joint("finger_a_joint", "prismatic", "tool", "finger_a", "0 0.02 -0.05", "0 0 0", "0 1 0", 0.0, 0.02),
+     _joint("finger_b_joint", "prismatic", "tool", "finger_b", "0 -0.02 -0.05", "0 0 0", "0 -1 0", 0.0, 0.02,
+            '<mimic joint="finger_a_joint"/>')])
+"""A SCARA: two revolute axes, a vertical quill sliding down, a revolute tool and a gripper whose fingers slide."""
+
+
+@pytest.fixture(params=["tracked", "scara"])
+def urdf(request, tmp_path):
+    path = tmp_path / f"{request.param}.urdf"
+    path.write_text(TRACKED if request.param == "tracked" else SCARA)
+    return path
+
+
+def _states(robot, rng, n):
+    lo, hi = robot.limits.position_span()
+    return rng.uniform(lo, hi, (n, robot.n_dof)), rng.normal(size=(n, robot.n_dof)), rng.normal(size=(n, robot.n_dof)) * 3
+
+
+def test_the_arm_is_every_joint_but_a_grippers_fingers(urdf):
+    """The track, the quill and the arm's joints are the arm's; a finger at the tip is held."""
+    held = joints_to_hold(urdf)
+    robot = load_robot(urdf, held=held)
+    if urdf.stem == "tracked":
+        assert held == () and robot.prismatic.tolist() == [True, False, False, False, True]
+    else:
+        assert held == ("finger_a_joint", "finger_b_joint")
+        assert robot.prismatic.tolist() == [False, False, True, False]
+
+
+@pytest.mark.parametrize("form", ["numpy", "compiled", "numba"])
+def test_the_regressor_equals_pinocchios_on_1000_random_states(urdf, form, rng):
+    """Each link's ten columns equal Pinocchio's joint-torque regressor of its own URDF model (its parameter order
+    mapped to eq. 5), and Y·φ its RNEA, to 1e-10 of the RMS torque: prismatic joints feel the force along their axis."""
+    held = joints_to_hold(urdf)
+    robot = load_robot(urdf, held=held)
+    model = pin.buildReducedModel(pin.buildModelFromUrdf(str(urdf)),
+                                  [pin.buildModelFromUrdf(str(urdf)).getJointId(h) for h in held],
+                                  np.zeros(robot.n_dof + len(held)))
+    data = model.createData()
+    q, dq, ddq = _states(robot, rng, 1000)
+    y = np.empty((1000, robot.n_dof, robot.n_params))
+    _fill(robot, q, dq, ddq, y, np.arange(robot.n_params), form=form)
+    pin_y = np.array([pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k]) for k in range(1000)])
+    tau = np.array([pin.rnea(model, data, q[k], dq[k], ddq[k]) for k in range(1000)])
+    perm = [4, 5, 7, 6, 8, 9, 1, 2, 3, 0]  # Pinocchio's [m, mc, I(xx xy yy xz yz zz)] -> eq. 5's (XX XY XZ YY YZ ZZ MX MY MZ M)
+    np.testing.assert_allclose(inertial_from_pinocchio(pin.Inertia.FromDynamicParameters(np.arange(1.0, 11.0))),
+                               np.array(perm) + 1.0, rtol=1e-12)
+    npj = robot.n_params_per_joint
+    inertial_columns = y.reshape(1000, robot.n_dof, robot.n_dof, npj)[..., :10].reshape(1000, robot.n_dof, -1)
+    expected = pin_y.reshape(1000, robot.n_dof, robot.n_dof, 10)[..., perm].reshape(1000, robot.n_dof, -1)
+    rms = np.sqrt(np.mean(tau ** 2))
+    assert np.abs(inertial_columns - expected).max() < 1e-10 * np.sqrt(np.mean(expected ** 2))
+    rigid = y[..., [c for c in range(robot.n_params) if c % npj < 10]] @ robot.inertial.ravel()
+    assert np.abs(rigid - tau).max() < 1e-10 * rms
+
+
+def test_the_number_of_base_parameters_is_the_rank_of_pinocchios_regressor(urdf, rng):
+    held = joints_to_hold(urdf)
+    robot = load_robot(urdf, held=held)
+    full = pin.buildModelFromUrdf(str(urdf))
+    model = pin.buildReducedModel(full, [full.getJointId(h) for h in held], np.zeros(full.nq))
+    data = model.createData()
+    q, dq, ddq = _states(robot, rng, 300)
+    w = np.vstack([pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k]) for k in range(300)])
+    rigid = robot.without_drive_terms(robot.drive_terms)
+    assert base_parameters(rigid).n_base == np.linalg.matrix_rank(w)
+
+
+def test_forward_kinematics_follows_pinocchio(urdf, rng):
+    held = joints_to_hold(urdf)
+    robot = load_robot(urdf, held=held)
+    full = pin.buildModelFromUrdf(str(urdf))
+    model = pin.buildReducedModel(full, [full.getJointId(h) for h in held], np.zeros(full.nq))
+    data = model.createData()
+    q = _states(robot, rng, 20)[0]
+    rots, origins = forward_kinematics(robot, q)
+    for k in range(20):
+        pin.forwardKinematics(model, data, q[k])
+        for j in range(robot.n_dof):
+            np.testing.assert_allclose(origins[k, j], data.oMi[j + 1].translation, atol=1e-12)
+            np.testing.assert_allclose(rots[k, j], data.oMi[j + 1].rotation, atol=1e-12)
+
+
+def test_a_prismatic_joints_drive_terms_are_in_linear_units(urdf):
+    robot = load_robot(urdf, held=joints_to_hold(urdf))
+    base = base_parameters(robot)
+    j = int(np.flatnonzero(robot.prismatic)[0]) + 1
+    assert [base.unit(f"{t}{j}") for t in ("fv", "fc", "Ia", "M")] == ["N·s/m", "N", "kg", "kg"]
+    assert unit_of(f"fv{j}") == "N·m·s/rad"  # a name alone is a revolute joint's
