@@ -202,7 +202,7 @@ def _time_range(value, where: str):
     return (float(value[0]), float(value[1]))
 
 
-def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> DatasetSpec:
+def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sliding=()) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring; its structure:
     :class:`dynid.io.config_types.DatasetTable`); paths are relative to ``base``.
 
@@ -218,6 +218,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         The dataset's name when the table gives none.
     n_dof : int
         The robot's joints (one column each).
+    sliding : sequence of bool, optional
+        Which joints are prismatic: a position unit in degrees leaves their metres as they are.
 
     Returns
     -------
@@ -279,6 +281,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int) -> 
         if unit not in units:
             raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
         factor = np.full(n_dof, units[unit])
+        if kind in ("positions", "velocities") and len(sliding) == n_dof:
+            factor[np.asarray(sliding, dtype=bool)] = 1.0  # a prismatic joint's metres are no angle
         for key in ("sign", "scale"):
             v = getattr(sig, key)
             if v is None:

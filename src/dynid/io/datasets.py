@@ -120,7 +120,7 @@ def _detected(log: Path, robot: Robot, rate: float | None = None) -> DatasetSpec
         raise DataError(f"{log}: no such log")
     table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints), rate=rate,
                          rate_hint="load_recording(..., rate=HZ)")
-    return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, robot.n_dof)
+    return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, robot.n_dof, robot.prismatic)
 
 
 @keyword_only_after_data

@@ -138,7 +138,8 @@ def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
         fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
         parent = "base_link" if j == 0 else f"link{j}"
-        lines += [f"  <joint name={quoteattr(joint.name)} type=\"revolute\">", f'    <parent link="{parent}"/>', f'    <child link="{link}"/>',
+        kind = "prismatic" if joint.prismatic else "revolute"
+        lines += [f"  <joint name={quoteattr(joint.name)} type=\"{kind}\">", f'    <parent link="{parent}"/>', f'    <child link="{link}"/>',
                   f'    <origin xyz="{_vec(joint.translation)}" rpy="{_vec(_rpy(joint.rotation))}"/>',
                   f'    <axis xyz="{_vec(joint.axis)}"/>',
                   '    <limit lower="{:.17g}" upper="{:.17g}" effort="{:.17g}" velocity="{:.17g}"/>'.format(
@@ -234,7 +235,8 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         lo, hi = robot.limits.q_min[j], robot.limits.q_max[j]
         limit = f' range="{lo:.17g} {hi:.17g}"' if np.isfinite(lo) and np.isfinite(hi) else ""
         lines += [f'{indent}<body name="link{j + 1}" pos="{_vec(joint.translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
-                  f'{indent}  <joint name={quoteattr(joint.name)} type="hinge" axis="{_vec(joint.axis)}"{limit} '
+                  f'{indent}  <joint name={quoteattr(joint.name)} type="{"slide" if joint.prismatic else "hinge"}" '
+                  f'axis="{_vec(joint.axis)}"{limit} '
                   f'armature="{terms.get("Ia", 0.0):.17g}" damping="{terms.get("fv", 0.0):.17g}" '
                   f'frictionloss="{terms.get("fc", 0.0):.17g}" solreffriction="{friction_solref(0.002)}"/>',
                   f'{indent}  <inertial pos="{_vec(com)}" mass="{max(mass, 0.0):.17g}" fullinertia="{inertia[0, 0]:.17g} '

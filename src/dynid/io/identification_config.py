@@ -361,8 +361,9 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
     robot = _sensed_terms(config_robot(doc, path, root), doc, path)
     n = robot.n_dof
-    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n)
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n) for i, v in enumerate(doc.get("validation", [])))
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic)
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic)
+                       for i, v in enumerate(doc.get("validation", [])))
     names = [v.name for v in validation]
     if len(set(names)) != len(names):
         raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")

@@ -108,6 +108,10 @@ def _plausibility(spec: DatasetSpec, robot: Robot, t, q, tau, *, source: str, ta
                             f"any robot joint (above {IMPLAUSIBLE_EFFORT:.0e}): check the column, its unit and scale")
 
 
+MAX_STROKE = 100.0
+"""[m] A prismatic joint's positions beyond this (or ten times its limits) are refused as millimetres read as metres."""
+
+
 def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
                     degrees: str = 'positions = { ..., unit = "deg" }'
                     ) -> tuple[list[bool], list[tuple[int, int]], dict[int, float]]:
@@ -139,7 +143,8 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
     Raises
     ------
     DataError
-        A joint beyond 4π rad: degrees read as radians.
+        A revolute joint beyond 4π rad: degrees read as radians; a prismatic one beyond ten times its limits (or
+        :data:`MAX_STROKE`): millimetres read as metres.
     """
     lim = robot.limits
     t = np.asarray(t, dtype=float)
@@ -153,10 +158,20 @@ def position_ranges(robot: Robot, t, q, source: str, *, steps: bool = False,
         still.append(bool(column.max() == column.min()))
         k = np.flatnonzero((column < lim.q_min[j] - 0.05) | (column > lim.q_max[j] + 0.05))
         outside.append((k.size, k[0] if k.size else 0))
-        if 0 < lim.dq_max[j] < np.inf and t.size > span:
+        if 0 < lim.dq_max[j] < np.inf and t.size > span and not robot.joints[j].prismatic:
             speed = float(np.percentile(np.abs(column[span:] - column[:-span]) / (t[span:] - t[:-span]), 75))
             if speed > DEGREE_SPEED * lim.dq_max[j] and np.radians(speed) <= lim.dq_max[j]:
                 fast[j] = speed
+    slides = robot.prismatic
+    reach = np.maximum(np.abs(lim.q_min), np.abs(lim.q_max))
+    metres = np.minimum(MAX_STROKE, np.maximum(1.0, 10 * np.where(np.isfinite(reach), reach, np.inf)))
+    if np.any(slides & (worst > metres)):
+        j = int(np.argmax(slides & (worst > metres)))
+        factors = ", ".join("0.001" if k == j else "1" for k in range(q.shape[1]))
+        raise DataError(f"{source}: joint {j + 1} (prismatic) reaches {worst[j]:.4g} m, implausible for metres (its "
+                        f"limits reach {reach[j]:.3g} m): are its positions in millimetres (positions = {{ ..., scale = "
+                        f"[{factors}] }})?")
+    worst[slides] = 0.0  # metres: no angle
     if np.any(worst > 4 * np.pi):
         j = int(np.argmax(worst))
         raise DataError(f"{source}: joint {j + 1} reaches {worst[j]:.4g} rad, implausible for radians: are the "
@@ -196,7 +211,8 @@ def limit_warnings(robot: Robot, t, ranges: tuple, source: str, *,
     """
     lim, (_, outside, fast) = robot.limits, ranges
     setting = _degrees_setting(list(fast), len(outside), degrees)
-    return [f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] rad during {count} "
+    return [f"{source}: joint {j + 1} leaves its limits [{lim.q_min[j]:.3g}, {lim.q_max[j]:.3g}] "
+            f"{'m' if robot.joints[j].prismatic else 'rad'} during {count} "
             f"samples from t = {t[first]:.3f} s (units, encoder zero, position_offset?)"
             for j, (count, first) in enumerate(outside) if count] + [
         f"{source}: joint {j + 1} moves at {v:.3g} rad/s, {v / lim.dq_max[j]:.0f}× its velocity limit "

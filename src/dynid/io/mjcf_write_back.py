@@ -248,8 +248,10 @@ def read_users_mjcf(path: Path, robot: Robot):
         if k < 0:
             raise ConfigError(f"{path}: has no joint {joint.name!r}: the robot identified (joints "
                               f"{', '.join(j.name for j in robot.joints)}) is another than this MJCF's")
-        if model.jnt_type[k] != mujoco.mjtJoint.mjJNT_HINGE:
-            raise ConfigError(f"{path}: joint {joint.name!r} is not a hinge, the robot's joint is revolute")
+        kind = mujoco.mjtJoint.mjJNT_SLIDE if joint.prismatic else mujoco.mjtJoint.mjJNT_HINGE
+        if model.jnt_type[k] != kind:
+            raise ConfigError(f"{path}: joint {joint.name!r} is not a {'slide' if joint.prismatic else 'hinge'}, the "
+                              f"robot's joint is {'prismatic' if joint.prismatic else 'revolute'}")
         if joint.name not in named:
             raise ConfigError(f"{path}: joint {joint.name!r} is in an included file: write back into one file holding the arm")
         ids.append(k)

@@ -106,10 +106,20 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
-    notes += [*_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains), _estimators_note(without, robot)]
+    notes += [*_sliding_note(robot), *_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains),
+              _estimators_note(without, robot)]
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
                    gains=gains, readers=readers), notes
+
+
+def _sliding_note(robot) -> list[str]:
+    """The line naming the prismatic joints and their units (nothing for a revolute arm)."""
+    if robot is None or not robot.prismatic.any():
+        return []
+    names = ", ".join(j.name for j in robot.joints if j.prismatic)
+    return [f"prismatic: {names}: positions in m, velocities in m/s, forces in N (a column in mm: scale = 0.001 for it "
+            "in positions' scale list)"]
 
 
 MOTOR_ANGLES = 2.0

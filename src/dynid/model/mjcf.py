@@ -57,16 +57,17 @@ def _chain(path: Path, held: dict):
             if name in held:
                 continue
             kind = int(model.jnt_type[k])
-            if kind != mujoco.mjtJoint.mjJNT_HINGE:
-                what = {0: "a free joint (a floating base)", 1: "a ball joint", 2: "a slide joint"}.get(kind, "not a hinge")
-                raise ConfigError(f"{path}: joint {name!r} is {what}, expected a hinge (revolute joint); "
+            if kind not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+                what = {0: "a free joint (a floating base)", 1: "a ball joint"}.get(kind, "neither hinge nor slide")
+                raise ConfigError(f"{path}: joint {name!r} is {what}, expected a hinge or a slide joint; "
                                   + HELD_HINT.format(names=f'"{name}"'))
             if owner[b] >= 0 and _body(model, owner[b]) == b:
                 raise ConfigError(f"{path}: body {model.body(b).name!r} has more than one moving joint ({name!r}): "
                                   "dynid identifies one revolute joint per link; " + HELD_HINT.format(names=f'"{name}"'))
             previous = moving[-1] if moving else -1
             if owner[b] != previous:
-                raise ConfigError(branch_refusal(path, *_tree(mujoco, model, held), k))
+                names_, parents, revolute, sliding = _tree(mujoco, model, held)
+                raise ConfigError(branch_refusal(path, names_, parents, revolute, k, sliding))
             if abs(model.qpos0[model.jnt_qposadr[k]]) > 0:
                 raise ConfigError(f"{path}: joint {name!r} has ref = {model.qpos0[model.jnt_qposadr[k]]:g}: dynid's "
                                   "joint angle is 0 where the body's frame is as written; remove ref (and offset the "
@@ -74,7 +75,7 @@ def _chain(path: Path, held: dict):
             moving.append(k)
             owner[b] = k
     if not moving:
-        raise ConfigError(f"{path}: expected at least one hinge joint, found none")
+        raise ConfigError(f"{path}: expected at least one hinge or slide joint, found none")
     return mujoco, model, moving, owner, names
 
 
@@ -152,7 +153,8 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
         r_parent, t_parent = rotations[parent], translations[parent]  # parent body in the previous link's frame
         rotation, translation = r_parent @ r, r_parent @ (t + r @ np.array(model.jnt_pos[k])) + t_parent
         axis = np.array(model.jnt_axis[k], dtype=float)
-        joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis)))
+        joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis),
+                            bool(model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE)))
     return (tuple(joints), inertial, tuple(j.name for j in joints),
             tuple(model.body(_body(model, k)).name for k in moving))
 
@@ -360,14 +362,14 @@ def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
         MuJoCo is not installed, or the file cannot be compiled.
     """
     mujoco, model = _compiled(Path(path))
-    _, parents, revolute = _tree(mujoco, model)
-    arm = arm_chain(parents, revolute)
+    _, parents, revolute, sliding = _tree(mujoco, model)
+    arm = arm_chain(parents, revolute, sliding)
     return tuple(model.joint(k).name for k in parents if k not in arm)
 
 
-def _tree(mujoco, model, held=()) -> tuple[dict[int, str], dict[int, int], set[int]]:
+def _tree(mujoco, model, held=()) -> tuple[dict[int, str], dict[int, int], set[int], set[int]]:
     """The MJCF's moving joints (not ``held``) as :func:`dynid.model.robot_files.arm_chain` reads them: each riding on
-    the last joint of the bodies above it; the hinges are the revolute ones."""
+    the last joint of the bodies above it; the hinges are the revolute ones, the slides the prismatic ones."""
     names: dict[int, str] = {}
     parents: dict[int, int] = {}
     owner = np.full(model.nbody, -1)
@@ -377,4 +379,5 @@ def _tree(mujoco, model, held=()) -> tuple[dict[int, str], dict[int, int], set[i
             name = model.joint(k).name or f"joint {k + 1}"
             if name not in held:
                 names[k], parents[k], owner[b] = name, int(owner[b]), k
-    return names, parents, {k for k in names if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_HINGE}
+    return (names, parents, {k for k in names if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_HINGE},
+            {k for k in names if model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE})
