@@ -354,7 +354,8 @@ URDF = """<?xml version="1.0"?>
 URDFS = {
     "malformed XML": ({"</joint>\n</robot>": "</joint>\n</robt>"}, "r.urdf: line 8, column 3: malformed XML (mismatched tag)"),
     "unknown joint type": ({'name="j2" type="revolute"': 'name="j2" type="hinge"'}, "r.urdf: line 7: joint 'j2' has type 'hinge'"),
-    "prismatic joint": ({'name="j2" type="revolute"': 'name="j2" type="prismatic"'}, "r.urdf: joint 'j2' is JointModelPY, expected a revolute joint"),
+    "planar joint": ({'name="j2" type="revolute"': 'name="j2" type="planar"'},
+                     "r.urdf: joint 'j2' is JointModelPlanar, expected a revolute or prismatic joint"),
     "a parent link that does not exist": ({'<parent link="l1"/>': '<parent link="nolink"/>'}, "parent link [nolink] of joint [j2] not found"),
     "negative mass": ({'<mass value="1"/>': '<mass value="-1"/>'}, "mass"),
 }

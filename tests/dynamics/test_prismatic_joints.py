@@ -19,10 +19,10 @@ def _link(name, mass, com, inertia):
             f'<inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/></inertial></link>')
 
 
-def _joint(name, kind, parent, child, xyz, rpy, axis, lower=-2.0, upper=2.0, mimic=""):
+def _joint(name, kind, parent, child, xyz, rpy, axis, lower=-2.0, upper=2.0, mimic="", effort=500):
     return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
             f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>'
-            f'<limit lower="{lower}" upper="{upper}" effort="500" velocity="2"/>{mimic}</joint>')
+            f'<limit lower="{lower}" upper="{upper}" effort="{effort}" velocity="2"/>{mimic}</joint>')
 
 
 def _urdf(links, joints):
@@ -34,13 +34,15 @@ TRACKED = _urdf(
      _link("l1", 8.0, "0 0.02 0.15", (0.3, 0.35, 0.2, 0.01, 0.0, -0.02)),
      _link("l2", 6.0, "0.25 0 0.02", (0.05, 0.4, 0.42, 0.0, 0.01, 0.0)),
      _link("l3", 3.0, "0.2 0.01 0", (0.05, 0.15, 0.16, 0.0, 0.0, 0.01)),
-     _link("l4", 1.5, "0 0 0.05", (0.01, 0.012, 0.008, 0.0, 0.0, 0.0))],
+     _link("l4", 1.5, "0 0 0.05", (0.01, 0.012, 0.008, 0.0, 0.0, 0.0)),
+     _link("l5", 0.7, "0.01 0 0.03", (0.004, 0.005, 0.003, 0.0, 0.0, 0.0))],
     [_joint("track", "prismatic", "base", "carriage", "0.1 -0.2 0.3", "0 0 0.3", "1 0 0", 0.0, 3.0),
      _joint("j1", "revolute", "carriage", "l1", "0 0 0.4", "0 0 0", "0 0 1"),
      _joint("j2", "revolute", "l1", "l2", "0 0.1 0.3", "1.5708 0 0", "0 0 1"),
      _joint("j3", "revolute", "l2", "l3", "0.5 0 0", "0 0 0", "0 0 1"),
-     _joint("j4", "prismatic", "l3", "l4", "0.4 0 0", "0.1 0.2 0", "0.3 0.4 0.866", -0.1, 0.2)])
-"""A 3-axis arm on a linear track, its tip sliding along an unaligned axis."""
+     _joint("j4", "prismatic", "l3", "l4", "0.4 0 0", "0.1 0.2 0", "0.3 0.4 0.866", -0.1, 0.2, effort=100),
+     _joint("j5", "revolute", "l4", "l5", "0 0 0.1", "0 0 0", "0 0 1", effort=20)])
+"""A 3-axis arm on a linear track, then a joint sliding along an unaligned axis and a turning tool."""
 
 SCARA = _urdf(
     [_link("l1", 12.0, "0.2 0 0.05", (0.1, 0.5, 0.55, 0.0, 0.01, 0.0)),
@@ -72,11 +74,11 @@ def _states(robot, rng, n):
 
 
 def test_the_arm_is_every_joint_but_a_grippers_fingers(urdf):
-    """The track, the quill and the arm's joints are the arm's; a finger at the tip is held."""
+    """The track, the quill and the arm's joints are the arm's; the fingers at the tip are held."""
     held = joints_to_hold(urdf)
     robot = load_robot(urdf, held=held)
     if urdf.stem == "tracked":
-        assert held == () and robot.prismatic.tolist() == [True, False, False, False, True]
+        assert held == () and robot.prismatic.tolist() == [True, False, False, False, True, False]
     else:
         assert held == ("finger_a_joint", "finger_b_joint")
         assert robot.prismatic.tolist() == [False, False, True, False]

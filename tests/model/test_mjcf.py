@@ -117,9 +117,9 @@ def test_a_config_names_an_mjcf_as_its_robot(tmp_path):
 @pytest.mark.parametrize("body, message", [
     ('<mujoco><worldbody><body name="a"><joint name="j1" type="hinge"/></worldbody></mujoco>',
      r"arm.xml: line 1, column \d+: malformed XML \(mismatched tag\)"),
-    ('<mujoco><worldbody><body name="a"><joint name="j1" type="slide" axis="0 0 1"/>'
+    ('<mujoco><worldbody><body name="a"><joint name="j1" type="ball"/>'
      '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></worldbody></mujoco>',
-     r"arm.xml: joint 'j1' is a slide joint, expected a hinge \(revolute joint\); hold it fixed with held = \[\"j1\"\]"),
+     r"arm.xml: joint 'j1' is a ball joint, expected a hinge or a slide joint; hold it fixed with held = \[\"j1\"\]"),
 ])
 def test_an_mjcf_dynid_cannot_model_is_one_line(tmp_path, body, message):
     (tmp_path / "arm.xml").write_text(body)
@@ -129,7 +129,7 @@ def test_an_mjcf_dynid_cannot_model_is_one_line(tmp_path, body, message):
 
 
 def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tmp_path):
-    """Two finger bodies on slide joints after the arm: refused naming the first, found by dynid init's helper, and
+    """Two finger bodies on slide joints after the arm: refused as a branch naming both, found by dynid init's helper, and
     held fixed through a [robot] table; their masses then belong to the last link (as a URDF's held joints do)."""
     from dynid.model.urdf import joints_to_hold
 
@@ -140,7 +140,7 @@ def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tm
     text = HAND_WRITTEN.replace('fullinertia="0.01 0.012 0.013 0.001 0 0"/>',
                                 'fullinertia="0.01 0.012 0.013 0.001 0 0"/>' + fingers)
     (tmp_path / "arm.xml").write_text(text)
-    with pytest.raises(ConfigError, match=r"joint 'finger1' is a slide joint"):
+    with pytest.raises(ConfigError, match=r"joints 'finger1', 'finger2' all ride on joint 'j3'.* held = \[\"finger1\", \"finger2\"\]"):
         load_robot(tmp_path / "arm.xml")
     assert joints_to_hold(tmp_path / "arm.xml") == ("finger1", "finger2")
     robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["finger1", "finger2"]}}, tmp_path / "c.toml")

@@ -34,8 +34,11 @@ def log_condition_number(w: np.ndarray) -> tuple[float, np.ndarray]:
     gradient : (M, p) ndarray
     """
     lam, v = np.linalg.eigh(w.T @ w)
-    if lam[0] <= lam[-1] * 1e-24:
-        return float(np.log(1e12)), np.zeros_like(w)  # rank-deficient: flat, the constraints move on
+    if lam[0] <= lam[-1] * 1e-24:  # beyond what W^T W resolves (cond 1e12): the singular triplets of W itself
+        u, s, vt = np.linalg.svd(w, full_matrices=False)
+        if s[-1] <= s[0] * 1e-15:
+            return float(np.log(1e15)), np.zeros_like(w)  # rank-deficient: flat, the constraints move on
+        return float(np.log(s[0] / s[-1])), np.outer(u[:, 0], vt[0]) / s[0] - np.outer(u[:, -1], vt[-1]) / s[-1]
     grad = np.outer(w @ v[:, -1], v[:, -1]) / lam[-1] - np.outer(w @ v[:, 0], v[:, 0]) / lam[0]
     return float(0.5 * np.log(lam[-1] / lam[0])), grad
 

@@ -16,8 +16,9 @@ HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (
 
 def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> list[int]:
     """The arm's joints in a robot file's tree of moving joints: the longest chain from the base of revolute and
-    prismatic joints, each riding on the one before (of chains as long, the first in the file's reading order). A
-    gripper's fingers at a chain's tip (prismatic joints beside another on the same link) are not the arm's.
+    prismatic joints, each riding on the one before (of chains as long, the first in the file's reading order). The
+    prismatic joints at a chain's tip are taken for a gripper's fingers, not the arm's, unless the chain has nothing
+    else (a gantry); a SCARA whose quill ends the arm gives it back by its config's ``held``.
 
     Parameters
     ----------
@@ -37,19 +38,16 @@ def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset()) 
 
 
 def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> dict[int, list[int]]:
-    """Each joint reached from the base through revolute and prismatic joints -> that chain less the fingers at its
-    tip (prismatic joints beside another on one link), unless they are all it has (``-1``: the empty one)."""
+    """Each joint reached from the base through revolute and prismatic joints -> that chain less the prismatic joints
+    at its tip (a gripper's fingers), unless they are all it has (``-1``: the empty one)."""
     chains: dict[int, list[int]] = {-1: []}
     for k, parent in parents.items():
         if (k in revolute or k in sliding) and parent in chains:
             chains[k] = chains[parent] + [k]
-    def finger(k):  # a prismatic joint beside another on the same link (a gripper's fingers, one may mimic the other)
-        return k in sliding and sum(p == parents[k] for p in parents.values()) > 1
-
     trimmed = {}
     for k, chain in chains.items():
         end = len(chain)
-        while end and finger(chain[end - 1]):
+        while end and chain[end - 1] in sliding:
             end -= 1
         trimmed[k] = chain[:end] if end else chain
     return trimmed
