@@ -132,9 +132,33 @@ def frames_and_axes(robot: Robot, q) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return rots, orig, np.stack([rots[:, j] @ robot.joints[j].axis for j in range(robot.n_dof)], axis=2)
 
 
+def point_motion(robot: Robot, axes: np.ndarray, lever: np.ndarray) -> np.ndarray:
+    """How points riding on the arm move with each joint: ``∂p/∂q_j = z_j × (p - o_j)`` about a revolute joint,
+    ``z_j`` along a prismatic one (whichever link a point rides on: the caller keeps the joints before it).
+
+    Parameters
+    ----------
+    robot : Robot
+    axes : (N, 3, n_dof) array
+        The joints' unit axes in the base frame (:func:`frames_and_axes`).
+    lever : (N, m, n_dof, 3) array [m]
+        Each point less each joint frame's origin, ``p - o_j``.
+
+    Returns
+    -------
+    (N, m, n_dof, 3) ndarray [m/rad, or m/m]
+    """
+    z = np.moveaxis(axes, 1, 2)[:, None]  # (N, 1, n_dof, 3)
+    moved = np.cross(z, lever)
+    slides = robot.prismatic
+    if slides.any():
+        moved[:, :, slides] = np.broadcast_to(z[:, :, slides], moved[:, :, slides].shape)
+    return moved
+
+
 def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     """Every joint frame's origin and its positional Jacobian ``∂o_k/∂q_j = z_j × (o_k - o_j)`` for ``j < k``
-    (revolute joints; a joint does not move its own frame's origin).
+    (a revolute joint does not move its own frame's origin), ``z_j`` for ``j <= k`` (a prismatic joint).
 
     Parameters
     ----------
@@ -151,11 +175,13 @@ def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     lever = orig[:, :, :, None] - orig.transpose(0, 2, 1)[:, None]  # (N, k, 3, j): o_k - o_j
     jac = np.cross(axes[:, None], lever, axis=2)
     jac *= np.tril(np.ones((robot.n_dof, robot.n_dof)), -1)[None, :, None, :]  # only the joints before frame k
+    for j in np.flatnonzero(robot.prismatic):  # a prismatic joint moves its own frame and those after it along z_j
+        jac[:, j:, :, j] = axes[:, None, :, j]
     return orig, jac
 
 
 def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
-    """Tool point and its positional Jacobian ``∂p/∂q_j = z_j × (p - o_j)`` (revolute joints).
+    """Tool point and its positional Jacobian ``∂p/∂q_j = z_j × (p - o_j)`` (revolute joints), ``z_j`` (prismatic).
 
     Parameters
     ----------
@@ -166,9 +192,12 @@ def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     -------
     p : (N, 3) array [m]
         Tool (flange) point in the base frame.
-    J : (N, 3, n_dof) array [m/rad]
+    J : (N, 3, n_dof) array [m/rad, or m/m for a prismatic joint]
     """
     rots, orig, axes = frames_and_axes(robot, q)
     p = orig[:, -1] + rots[:, -1] @ robot.tool_translation
     lever = p[:, :, None] - orig.transpose(0, 2, 1)  # (N, 3, n)
-    return p, np.cross(axes, lever, axis=1)
+    jac = np.cross(axes, lever, axis=1)
+    slides = robot.prismatic
+    jac[:, :, slides] = axes[:, :, slides]
+    return p, jac

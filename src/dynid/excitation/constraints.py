@@ -393,20 +393,22 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
     span = limits.q_max - limits.q_min
     for j in range(robot.n_dof):
         lbl = f"joint {j + 1}"
+        unit = "m" if robot.joints[j].prismatic else "rad"
         if np.isfinite(limits.q_min[j]):
             worst = float(q[:, j].min())
             m = worst - limits.q_min[j]
-            out.append(ConstraintMargin("q_min [rad]", lbl, float(limits.q_min[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
+            out.append(ConstraintMargin(f"q_min [{unit}]", lbl, float(limits.q_min[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
         if np.isfinite(limits.q_max[j]):
             worst = float(q[:, j].max())
             m = limits.q_max[j] - worst
-            out.append(ConstraintMargin("q_max [rad]", lbl, float(limits.q_max[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
+            out.append(ConstraintMargin(f"q_max [{unit}]", lbl, float(limits.q_max[j]), worst, float(m), float(m / span[j]) if np.isfinite(span[j]) else np.nan))
     for name, values, lim in (("|dq| [rad/s]", dq, limits.dq_max), ("|ddq| [rad/s²]", ddq, limits.ddq_max),
                               ("|tau| [N·m]", tau, limits.tau_max)):
         for j in range(robot.n_dof):
             if np.isfinite(lim[j]):
                 worst = float(np.abs(values[:, j]).max())
-                out.append(ConstraintMargin(name, f"joint {j + 1}", float(lim[j]), worst, float(lim[j] - worst), float((lim[j] - worst) / lim[j])))
+                label = name.replace("rad", "m").replace("N·m", "N") if robot.joints[j].prismatic else name
+                out.append(ConstraintMargin(label, f"joint {j + 1}", float(lim[j]), worst, float(lim[j] - worst), float((lim[j] - worst) / lim[j])))
     out += floor_margins(robot, t, q, workspace, trajectory.q0 if start_pose is None else start_pose)
     g, h, labels = workspace.inequalities()
     if len(h):

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import coal
 import numpy as np
 
-from ..dynamics.sensitivity import frames_and_axes
+from ..dynamics.sensitivity import frames_and_axes, point_motion
 from ..model.robot import Robot
 from .obstacles import ObstacleDistances
 
@@ -181,6 +181,6 @@ class FloorDistances:
         if gradient and links:
             _, orig, axes = frames_and_axes(self.robot, self.q)
             lever = self.points[:, :, None, :] - orig[:, None, :, :]  # (N, m, n_dof, 3)
-            moved = np.cross(np.moveaxis(axes, 1, 2)[:, None], lever)  # z_j × (p - o_j)
+            moved = point_motion(self.robot, axes, lever)  # z_j × (p - o_j), or z_j along a prismatic joint
             grad = moved[..., 2] * (np.arange(self.robot.n_dof)[None, None, :] <= np.array(links)[None, :, None])
         return ObstacleDistances([(int(g), -1) for g in self.needs.shapes], self.dist.copy(), grad, links)

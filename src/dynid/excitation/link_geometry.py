@@ -588,6 +588,7 @@ class ShapeDistances(_CoalDistances):
         """``-z_j·((p - o_j) × n)`` for the joints up to the shape's link."""
         lever = near[:, :, None, :] - orig[:, None, :, :]  # (N, P, n_dof, 3)
         grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
+        _along_sliding(self.robot, grad, normal, axes, -1.0)
         links = np.array([int(self.geometry.link[g]) for g, _ in self.pairs])
         grad *= np.arange(self.robot.n_dof)[None, None, :] <= links[None, :, None]
         return grad
@@ -753,5 +754,15 @@ class SelfDistances(_CoalDistances):
             links = np.array([int(self.geometry.link[pair[side]]) for pair in pairs])
             lever = near[side][:, :, None, :] - orig[:, None, :, :]
             moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
+            _along_sliding(robot, moved, normal, axes, 1.0)
             grad += sign * moved * (joints <= links[None, :, None])
         return grad
+
+
+def _along_sliding(robot, grad: np.ndarray, normal: np.ndarray, axes: np.ndarray, sign: float) -> None:
+    """A distance gradient's columns of the prismatic joints, in place: a point moves along ``z_j`` with them, so the
+    distance along ``n`` changes by ``sign · n·z_j`` (the revolute columns' ``z_j·((p - o_j) × n)`` is for turning).
+    ``grad`` (N, P, n_dof), ``normal`` (N, P, 3), ``axes`` (N, 3, n_dof)."""
+    slides = robot.prismatic
+    if slides.any():
+        grad[:, :, slides] = sign * np.einsum("npk,nkj->npj", normal, axes[:, :, slides])

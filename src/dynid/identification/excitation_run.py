@@ -89,11 +89,14 @@ class ExcitationRun:
         Returns
         -------
         dict
-            ``position_offset`` (n_dof,) [rad], ``first`` (n_dof,) [rad] and ``first_velocity`` (n_dof,) [rad/s].
+            ``position_offset`` (n_dof,) [rad], ``first`` (n_dof,) [rad] and ``first_velocity`` (n_dof,) [rad/s]
+            ([m], [m/s] for a prismatic joint), and ``prismatic`` (n_dof,) bool where a joint slides.
         """
-        transmission = self.config.problem.robot.transmission
+        robot = self.config.problem.robot
+        transmission = robot.transmission
         return {"position_offset": transmission.position_offset.tolist(),
-                "first": transmission.logged_positions(self.q[:1])[0].tolist(), "first_velocity": self.dq[0].tolist()}
+                "first": transmission.logged_positions(self.q[:1])[0].tolist(), "first_velocity": self.dq[0].tolist(),
+                **({"prismatic": robot.prismatic.tolist()} if robot.prismatic.any() else {})}
 
 
 def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:

@@ -91,12 +91,16 @@ def set_point_lines(set_points: dict) -> tuple[str, tuple[str, str]]:
     turned = joint_angles_text(offset)
     encoders = (f", at the angles the joints' encoders read (the description's minus its position_offset, {turned}), "
                 "as the controller takes them; excitation.json and the figures hold the description's" if turned else "")
-    pose = ", ".join(f"J{j + 1} {math.degrees(round(v, 6)) + 0.0:.1f}°" for j, v in enumerate(set_points["first"]))
+    sliding = set_points.get("prismatic") or [False] * len(speeds)
+    pose = ", ".join(f"J{j + 1} {v:.3f} m" if sliding[j] else f"J{j + 1} {math.degrees(round(v, 6)) + 0.0:.1f}°"
+                     for j, v in enumerate(set_points["first"]))
+    units = "in radians there, metres for a prismatic joint" if any(sliding) else "in radians there"
     if max(speeds) <= START_AT_REST:
-        return encoders, (f"it starts at rest at {pose} (its first row, in radians there): bring the arm there with a "
+        return encoders, (f"it starts at rest at {pose} (its first row, {units}): bring the arm there with a "
                           "slow point-to-point move before playing it", "text")
     j = speeds.index(max(speeds))
-    return encoders, (f"it starts moving ({speeds[j]:.3g} rad/s on J{j + 1}) at {pose} (its first row, in radians there): "
+    return encoders, (f"it starts moving ({speeds[j]:.3g} {'m/s' if sliding[j] else 'rad/s'} on J{j + 1}) at {pose} "
+                      f"(its first row, {units}): "
                       "a controller at rest there takes that step in speed; bring the arm there slowly and ramp in, or "
                       "design from rest ([trajectory] rest = true)", "warning")
 
