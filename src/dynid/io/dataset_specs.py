@@ -202,6 +202,29 @@ def _time_range(value, where: str):
     return (float(value[0]), float(value[1]))
 
 
+def _factor(sig, kind: str, w: str, n_dof: int, sliding) -> np.ndarray:
+    """(n_dof,): a signal's unit's factor (an angle's, not on a prismatic joint's metres) times its sign and scale."""
+    units = _UNITS[kind]
+    unit = sig.unit if sig.unit is not None else next(iter(units))
+    if unit not in units:
+        raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
+    factor = np.full(n_dof, units[unit])
+    if kind in ("positions", "velocities") and len(sliding) == n_dof:
+        factor[np.asarray(sliding, dtype=bool)] = 1.0  # a prismatic joint's metres are no angle
+    for key in ("sign", "scale"):
+        v = getattr(sig, key)
+        if v is None:
+            continue
+        many = isinstance(v, list)
+        values = v if many else [v]
+        ok = all(np.isfinite(x) and x != 0 for x in values) and (key != "sign" or all(x in (1, -1) for x in values))
+        if not ok or (many and len(v) != n_dof):
+            what = "1 or -1" if key == "sign" else "a non-zero number"
+            raise ConfigError(f"{w}.{key}: expected {what} or a list of {n_dof} of them (one per joint), got {v!r}")
+        factor = factor * np.asarray(values, dtype=float)
+    return factor
+
+
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sliding=()) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring; its structure:
     :class:`dynid.io.config_types.DatasetTable`); paths are relative to ``base``.
@@ -276,24 +299,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sli
             raise ConfigError(f"{w}.sensor: only the torques have a sensor (joint or drive), got it on the {kind}")
         if len(sig.columns) != n_dof:
             raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {sig.columns!r}")
-        units = _UNITS[kind]
-        unit = sig.unit if sig.unit is not None else next(iter(units))
-        if unit not in units:
-            raise ConfigError(f"{w}.unit: expected one of {', '.join(units)}, got {unit!r}")
-        factor = np.full(n_dof, units[unit])
-        if kind in ("positions", "velocities") and len(sliding) == n_dof:
-            factor[np.asarray(sliding, dtype=bool)] = 1.0  # a prismatic joint's metres are no angle
-        for key in ("sign", "scale"):
-            v = getattr(sig, key)
-            if v is None:
-                continue
-            many = isinstance(v, list)
-            values = v if many else [v]
-            ok = all(np.isfinite(x) and x != 0 for x in values) and (key != "sign" or all(x in (1, -1) for x in values))
-            if not ok or (many and len(v) != n_dof):
-                what = "1 or -1" if key == "sign" else "a non-zero number"
-                raise ConfigError(f"{w}.{key}: expected {what} or a list of {n_dof} of them (one per joint), got {v!r}")
-            factor = factor * np.asarray(values, dtype=float)
+        factor = _factor(sig, kind, w, n_dof, sliding)
         scale = float(factor[0]) if np.all(factor == factor[0]) else tuple(float(x) for x in factor)
         signals[kind] = SignalSpec(path_of(sig.file, w), tuple(sig.columns), scale, sig.side)
     if "positions" not in signals:
