@@ -43,7 +43,7 @@ class Drives:
 
 
 def mujoco_model(urdf_text: str, drives: Drives | None, timestep: float):
-    """A MuJoCo model of the URDF with the drives' armature, damping and frictionloss on its hinges."""
+    """A MuJoCo model of the URDF with the drives' armature, damping and frictionloss on its hinges and slides."""
     import mujoco
 
     # MuJoCo's URDF extension: its compiler tag sits inside <robot>
@@ -52,7 +52,7 @@ def mujoco_model(urdf_text: str, drives: Drives | None, timestep: float):
     spec = mujoco.MjSpec.from_string(xml)
     spec.option.timestep = timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    hinges = [j for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE]
+    hinges = [j for j in spec.joints if j.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)]
     if drives is not None:
         for j, h in enumerate(hinges):
             h.armature = float(drives.ia[j])

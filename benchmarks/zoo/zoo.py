@@ -1,7 +1,8 @@
 """The zoo: dynid's defaults on public arm descriptions it was never tuned on (issue "Honest on any log").
 
-Nine arms from the ``example-robot-data`` package (PyPI; ``pip install -e ".[zoo]"``): UR3, UR5, UR10, Franka Panda,
-Kinova Jaco 2 (j2s6s200), UFACTORY xArm7, Unitree Z1, SO-100 and TALOS's left arm, their grippers made fixed joints.
+Eleven arms from the ``example-robot-data`` package (PyPI; ``pip install -e ".[zoo]"``): UR3, UR5, UR10, Franka Panda,
+Kinova Jaco 2 (j2s6s200), UFACTORY xArm7, Unitree Z1, SO-100, TALOS's left arm, TIAGo's torso lift and arm (a
+prismatic joint first) and the UR5 on a 2 m linear track (:func:`on_a_track`), their grippers made fixed joints.
 Each is simulated in MuJoCo (its own URDF parser, not dynid's or Pinocchio's; tests/mujoco_logs.py) under a
 joint-space PID loop at 1 kHz, with MuJoCo's armature (rotor inertia) and damping (viscous friction) and, as the dry
 friction truth, either MuJoCo's ``frictionloss`` constraint or ``fc·sign(q̇)``; encoder quantisation (20 bits) and
@@ -70,7 +71,12 @@ ARMS = {
     "Unitree Z1": ("z1_description/urdf/z1.urdf", r"^joint[1-6]$"),
     "SO-100": ("so_arm_description/urdf/so100.urdf", r"^(shoulder_pan|shoulder_lift|elbow_flex|wrist_flex|wrist_roll)$"),
     "TALOS left arm": ("talos_data/robots/talos_left_arm.urdf", r"^arm_left_[2-7]_joint$"),
+    "TIAGo torso + arm": ("tiago_description/robots/tiago_no_hand.urdf", r"^(torso_lift_joint|arm_[1-7]_joint)$"),
+    "UR5 on a track": ("ur_description/urdf/ur5_robot.urdf",
+                       r"^(track_joint|shoulder_pan|shoulder_lift|elbow|wrist_1|wrist_2|wrist_3)(_joint)?$"),
 }
+TRACKED = ("UR5 on a track",)
+"""Arms put on a linear track here (:func:`on_a_track`): no public description has one."""
 CLASSES = ("excitation", "short", "ptp", "dead")
 CAD_CLASSES = ("cad", "cad-sensor", "cad-gear")
 """The realistic classes (module docstring), run with the ``sign`` truth alone."""
@@ -89,6 +95,37 @@ def robots_folder() -> Path:
         if folder.is_dir():
             return folder
     raise SystemExit("example-robot-data is not installed: pip install -e '.[zoo]'" + ("" if spec else " (no cmeel)"))
+
+
+def on_a_track(text: str) -> str:
+    """The URDF with its arm on a 2 m linear track along x: a prismatic joint ``track_joint`` from the root link to a
+    25 kg carriage, which carries what the root carried (an industrial track's)."""
+    root = ET.fromstring(text)
+    joints = root.findall("joint")  # not a <transmission>'s joints
+    children = {j.find("child").get("link") for j in joints}
+    base = next(link for link in root.findall("link") if link.get("name") not in children).get("name")
+    for joint in joints:
+        if joint.find("parent").get("link") == base:
+            joint.find("parent").set("link", "carriage")
+    carriage = ET.SubElement(root, "link", name="carriage")
+    inertial = ET.SubElement(carriage, "inertial")
+    ET.SubElement(inertial, "origin", xyz="0 0 -0.05", rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value="25")
+    ET.SubElement(inertial, "inertia", ixx="0.6", ixy="0", ixz="0", iyy="0.9", iyz="0", izz="1.2")
+    track = ET.SubElement(root, "joint", name="track_joint", type="prismatic")
+    ET.SubElement(track, "parent", link=base)
+    ET.SubElement(track, "child", link="carriage")
+    ET.SubElement(track, "origin", xyz="0 0 0.3", rpy="0 0 0")
+    ET.SubElement(track, "axis", xyz="1 0 0")
+    ET.SubElement(track, "limit", lower="0", upper="2", effort="2000", velocity="1.5")
+    return ET.tostring(root, encoding="unicode")
+
+
+def arm_text(name: str) -> str:
+    """The arm's URDF as :data:`ARMS` names it (on a track for :data:`TRACKED`), its other joints fixed."""
+    file, keep = ARMS[name]
+    text = (robots_folder() / file).read_text(encoding="utf-8")
+    return arm_urdf(on_a_track(text) if name in TRACKED else text, keep)
 
 
 def arm_urdf(text: str, keep: str) -> str:
@@ -254,8 +291,7 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
     """The realistic classes of one arm (module docstring), with the ``sign`` dry-friction truth."""
     from dynid.model.description import load_robot
 
-    file, keep = ARMS[name]
-    text = arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep)
+    text = arm_text(name)
     physical, repaired = physical_urdf(text)
     folder = out / re.sub(r"\W+", "_", name.lower()) / "cad"
     folder.mkdir(parents=True, exist_ok=True)
@@ -371,8 +407,7 @@ def run_arm(name: str, out: Path, seed: int, classes=CLASSES) -> list[dict]:
     """Every friction truth and log class of one arm (module docstring)."""
     from dynid.model.description import load_robot
 
-    file, keep = ARMS[name]
-    text = arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep)
+    text = arm_text(name)
     truth_text, repaired = physical_urdf(text)
     rows = []
     for truth_kind in TRUTHS:
