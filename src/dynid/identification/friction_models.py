@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._util.column_store import root_mean_square
+from .._util.grams import joint_gram
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import base_parameters
 from ..dynamics.regressor import regressor
@@ -291,9 +292,9 @@ class _CrossValidation:
         for f in np.unique(fold):
             sel = fold == f
             zf = z[sel]
-            self.score[f] += np.einsum("mjc,mjd->jcd", zf, zf)
+            self.score[f] += joint_gram(zf)
             zk = zf * keep[sel][:, :, None]
-            self.fit[f] += np.einsum("mjc,mjd->jcd", zk, zk)
+            self.fit[f] += joint_gram(zk)
             bf = band[sel]
             slow = keep[sel] & (bf < len(SMOOTH_GRID))
             for j in np.flatnonzero(slow.any(axis=0)):

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._util.grams import joint_gram
 from .noise_floor import AT_FLOOR
 
 __all__ = ["DELAY_ADVICE", "Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
@@ -143,11 +144,11 @@ class ResidualSums:
         low = (np.abs(dq) < low_speed) * direction
         f = np.stack([low, np.sin(q), np.cos(q), np.sin(2 * q), np.cos(2 * q)], axis=2)
         z = np.concatenate([y, tau[:, :, None], f, np.ones((m, self.n_dof, 1))], axis=2) * keep[:, :, None]
-        self.gram += np.einsum("mjc,mjd->jcd", z, z)
+        self.gram += joint_gram(z)
         if self._last is not None:
             self.lagged += np.einsum("jc,jd->jcd", z[0], self._last)
         if m > 1:
-            self.lagged += np.einsum("mjc,mjd->jcd", z[1:], z[:-1])
+            self.lagged += joint_gram(z[1:], z[:-1])
         self._last = z[-1].copy()
         self.count += m
 
@@ -793,7 +794,7 @@ class BlockGrams:
         block = np.minimum(index * self.blocks // self.n_samples, self.blocks - 1)
         for b in np.unique(block):
             zb = z[block == b]
-            self.gram[b] += np.einsum("mjc,mjd->jcd", zb, zb)
+            self.gram[b] += joint_gram(zb)
 
     def bootstrap_std(self, weights: np.ndarray | None = None, rng=0, resamples: int = BOOTSTRAP_RESAMPLES) -> np.ndarray:
         """Moving-block bootstrap standard deviation of the (weighted) least-squares parameters: the blocks' Gram

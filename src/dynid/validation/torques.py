@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._util.column_store import root_mean_square
+from .._util.grams import joint_gram
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..model.friction_model import COULOMB_LIKE
@@ -445,11 +446,11 @@ class TorqueSums:
         z = np.concatenate([y, tau[:, :, None]], axis=2)
         if resting is not None and resting.any():
             zr = z * resting[:, :, None]
-            self.rest_gram += np.einsum("mjc,mjd->jcd", zr, zr)
+            self.rest_gram += joint_gram(zr)
             self.rest_count += resting.sum(axis=0)
         mean = z.mean(axis=0)
         zc = z - mean
-        m2 = np.einsum("mjc,mjd->jcd", zc, zc)
+        m2 = joint_gram(zc)
         n = self.count
         delta = mean - self.mean
         self.mean += delta * (m / (n + m))
