@@ -159,9 +159,10 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
         shifted = shift.read(d, at=rows_index).reshape(-1)[keep]
         return shifted - q_factor @ (q_factor.T @ shifted)
 
-    def rss(d: float) -> float:
-        r = residual(d)
-        return float(r @ r)
+    def rss(d: float) -> float:  # |s|² - |Qᵀs|²: one product with Q, not two (the residual at the noise floor is
+        shifted = shift.read(d, at=rows_index).reshape(-1)[keep]  # 1e-4 of |s|² or more: 12 digits are left)
+        projected = q_factor.T @ shifted
+        return float(shifted @ shifted - projected @ projected)
 
     bound = float(max_samples)
     grid = np.linspace(-bound, bound, int(4 * bound) + 1)  # a coarse scan first: RSS need not be convex far away
