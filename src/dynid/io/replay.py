@@ -115,19 +115,21 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     data = model.createData()
     ids = [model.getJointId(j.name) for j in robot.joints]
     q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
+    n_s = q.shape[0]
+    big_q = np.tile(pin.neutral(model), (n_s, 1))  # every sample's configuration, velocity, acceleration at once
+    big_v, big_a = np.zeros((n_s, model.nv)), np.zeros((n_s, model.nv))
+    idx = [model.joints[jid].idx_v for jid in ids]
+    for j, jid in enumerate(ids):
+        iq = model.joints[jid].idx_q
+        if model.joints[jid].nq == 2:  # continuous: (cos, sin)
+            big_q[:, iq], big_q[:, iq + 1] = np.cos(q[:, j]), np.sin(q[:, j])
+        else:
+            big_q[:, iq] = q[:, j]
+    big_v[:, idx], big_a[:, idx] = dq, ddq
     tau_file = np.empty(q.shape)
-    for k in range(q.shape[0]):
-        qk, vk, ak = pin.neutral(model), np.zeros(model.nv), np.zeros(model.nv)
-        for j, jid in enumerate(ids):
-            iq, iv = model.joints[jid].idx_q, model.joints[jid].idx_v
-            if model.joints[jid].nq == 2:  # continuous: (cos, sin)
-                qk[iq:iq + 2] = np.cos(q[k, j]), np.sin(q[k, j])
-            else:
-                qk[iq] = q[k, j]
-            vk[iv], ak[iv] = dq[k, j], ddq[k, j]
-        tau = pin.rnea(model, data, qk, vk, ak)
-        idx = [model.joints[jid].idx_v for jid in ids]
-        tau_file[k] = tau[idx] + model.damping[idx] * dq[k] + model.friction[idx] * np.sign(dq[k])
+    for k in range(n_s):
+        tau_file[k] = pin.rnea(model, data, big_q[k], big_v[k], big_a[k])[idx]
+    tau_file += model.damping[idx] * dq + model.friction[idx] * np.sign(dq)
     return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS, measured)
 
 
