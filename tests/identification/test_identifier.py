@@ -425,3 +425,36 @@ def test_a_parameter_without_a_standard_deviation_reads_as_a_dash():
     rows = repr(Parameters(("ZZ1R", "fc1"), np.array([1.5, 2.0]), np.array([np.nan, 0.01]))).splitlines()
     assert rows[1].split() == ["ZZ1R", "1.5", "—", "kg·m²"] and rows[2].split() == ["fc1", "2", "0.01", "N·m"]
     assert "nan" not in "\n".join(rows)
+
+
+def test_the_estimator_object_given_is_the_one_fitted(er16):
+    """A clone of the object given is fitted (scikit-learn's rule), not a new object of its registered key with the
+    object's parameters set on it afterwards: a class whose constructor derives what ``fit`` reads from a parameter (here
+    the ridge penalty from ``alpha``) fitted its default's derivation before. The fitted object is of the class given,
+    with its parameters; the object given is left unfitted."""
+    from dynid.estimators import Estimator, register, unregister, weighted_rows
+    from dynid.identification.run import identify_from_arrays
+
+    class Shrunk(Estimator):
+        def __init__(self, *, alpha=1e-6):
+            self.alpha = alpha
+            self.penalty_ = alpha ** 2  # derived once, where the object is built
+
+        def fit(self, w, tau, sample_weight=None):
+            w, tau = weighted_rows(w, tau, sample_weight, 0.5)
+            self.params_ = np.linalg.solve(w.T @ w + self.penalty_ * np.eye(w.shape[1]), w.T @ tau)
+            return self
+
+    robot, log, _ = er16
+    register("shrunk", Shrunk, description="ridge whose penalty is derived in its constructor")
+    try:
+        given = Shrunk(alpha=300.0)
+        result = identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("wls", given))
+        fitted = result.estimates["dynid SHRUNK"].estimator
+        assert type(fitted) is Shrunk and fitted is not given and fitted.get_params() == given.get_params()
+        assert fitted.penalty_ == 300.0 ** 2  # its constructor ran with the parameters given
+        assert not hasattr(given, "params_")
+        w = result.estimates["dynid WLS"].params  # the ridge at 300² pulls the estimate off least squares by far
+        assert np.linalg.norm(result.estimates["dynid SHRUNK"].params - w) > 1e-3 * np.linalg.norm(w)
+    finally:
+        unregister("shrunk")

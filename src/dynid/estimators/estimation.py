@@ -55,20 +55,23 @@ class Estimation:
         An unknown or repeated estimator.
     """
 
-    def __init__(self, keys: Iterable[str], problem: FitData, names=None, keep_rows: bool = False):
+    def __init__(self, keys: Iterable[str], problem: FitData, names=None, keep_rows: bool = False,
+                 given: dict | None = None):
         self.keys = parse_estimators(tuple(keys))
         self.problem = problem
+        self.given = dict(given or {})
         self.names = None if names is None else tuple(names)
         self.reference_key = next((k for k in self.keys if k in LEAST_SQUARES), "wls")
         self.streamed: dict[str, AccumulatingEstimator] = {}
         for key in self.keys:
             if spec(key).needs_box:
                 continue
-            est = make_estimator(key, problem)
+            est = make_estimator(key, problem, template=self.given.get(key))
             if isinstance(est, AccumulatingEstimator):
                 self.streamed[key] = est
         ref = self.streamed.get(self.reference_key)
-        self.reference: Any = ref if ref is not None else make_estimator(self.reference_key, problem)
+        self.reference: Any = ref if ref is not None else make_estimator(self.reference_key, problem,
+                                                                         template=self.given.get(self.reference_key))
         if not isinstance(self.reference, AccumulatingEstimator):
             raise ConfigError(f"{_named(self.reference_key)}: replaces the least-squares reference of every "
                               "identification, which takes the rows block by block (partial_fit) and gives σ; register "
@@ -211,7 +214,8 @@ class Estimation:
             if spec(key).needs_box and box is None:
                 raise ConfigError(f"estimator {key} searches a box: none was given")
         fed = {key: self.streamed[key] for key in chosen if key in self.streamed}  # solved on ``data``, joint weights included
-        return fit_methods(chosen, data, budget, rngs or {}, progress=progress, workers=workers, extra=extra, fed=fed)
+        return fit_methods(chosen, data, budget, rngs or {}, progress=progress, workers=workers, extra=extra, fed=fed,
+                           given=self.given)
 
 
 def stream_rows(chunks, estimation: Estimation, base, observer: Callable | None = None, standard: bool | None = None) -> None:

@@ -3,6 +3,7 @@ side by side on the cores, each reported as base parameters with its wall time."
 
 from __future__ import annotations
 
+import copy
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -15,7 +16,7 @@ import numpy as np
 from ..exceptions import ConfigError, DynIdError
 from ..runtime.threads import cores
 from .problem import FitData, SearchBudget, with_problem
-from .registry import _named, is_plugin, spec
+from .registry import PROBLEM_FILLED, _named, is_plugin, spec
 
 if TYPE_CHECKING:
     from .base import Estimator
@@ -48,8 +49,8 @@ class Fitted:
 
 
 def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-                   callback: Callable[[int, float], None] | None = None) -> Estimator:
-    """An unfitted estimator for a problem.
+                   callback: Callable[[int, float], None] | None = None, template: Estimator | None = None) -> Estimator:
+    """An unfitted estimator for a problem: the registry's for ``key``, or a clone of the object given.
 
     Parameters
     ----------
@@ -57,11 +58,16 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(
         A registered estimator (case-insensitive).
     data : FitData
     budget : SearchBudget
-        The box searches' budget.
+        The box searches' budget (of the registry's estimators: an object given carries its own).
     rng : numpy.random.Generator, optional
         Seeds the box searches.
     callback : callable, optional
         ``callback(iteration, best)`` of the box searches.
+    template : Estimator, optional
+        An unfitted estimator given in place of ``key`` (:func:`dynid.estimators.registry.estimator_choices`): its
+        clone is returned, of its class and with its hyper-parameters (scikit-learn's ``clone``), the seeded generator,
+        the callback and what the problem fills for a plugin class (:data:`dynid.estimators.registry.PROBLEM_FILLED`)
+        set on it.
 
     Returns
     -------
@@ -73,9 +79,13 @@ def make_estimator(key: str, data: FitData, budget: SearchBudget = SearchBudget(
         Unknown key, or ``sdp`` without the parameter layout.
     """
     entry = spec(key)
-    est = entry.builder()(data, budget, rng, callback)
-    given = data.hyperparameters.get(entry.key)
-    return est.set_params(**given) if given else est
+    built = entry.builder()(data, budget, rng, callback)
+    if template is None:
+        return built
+    params = template.get_params()
+    filled = built.get_params() if hasattr(built, "get_params") else {}
+    own = copy.deepcopy({k: v for k, v in params.items() if k not in PROBLEM_FILLED})
+    return type(template)(**own, **{k: filled[k] for k in PROBLEM_FILLED if k in params and k in filled})
 
 
 def finish(key: str, est: Estimator, data: FitData, seconds: float) -> Fitted:
@@ -122,7 +132,8 @@ def finish(key: str, est: Estimator, data: FitData, seconds: float) -> Fitted:
 
 
 def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), rng=None,
-               callback: Callable[[int, float], None] | None = None, estimator: Estimator | None = None) -> Fitted:
+               callback: Callable[[int, float], None] | None = None, estimator: Estimator | None = None,
+               template: Estimator | None = None) -> Fitted:
     """Fit estimator ``key`` on ``data`` and return its base parameters.
 
     Parameters
@@ -138,6 +149,8 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
         ``callback(iteration, best)`` of the box searches.
     estimator : Estimator, optional
         One built and fed already (rows streamed by ``partial_fit``): only its solution is computed here.
+    template : Estimator, optional
+        The object given in place of ``key``: a clone of it is fitted (:func:`make_estimator`).
 
     Returns
     -------
@@ -156,7 +169,7 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
         if estimator is not None:
             est = estimator.solve(**with_problem(estimator.solve, data)) if hasattr(estimator, "solve") else estimator
         else:
-            est = make_estimator(key, data, budget, rng, callback)
+            est = make_estimator(key, data, budget, rng, callback, template)
             w = data.w_standard if entry.space == "standard" else data.w_base
             if w is None:
                 raise ConfigError(f"estimator {entry.key} needs the {entry.space} observation matrix")
@@ -172,7 +185,8 @@ def fit_method(key: str, data: FitData, budget: SearchBudget = SearchBudget(), r
 
 
 def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs: dict, *, progress=None,
-                workers: int | None = None, extra: dict | None = None, fed: dict | None = None) -> dict:
+                workers: int | None = None, extra: dict | None = None, fed: dict | None = None,
+                given: dict | None = None) -> dict:
     """Fit every estimator of ``keys_``, side by side on the cores (threads: the work is in BLAS, LAPACK, HiGHS
     and numba, which release the GIL).
 
@@ -191,6 +205,8 @@ def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs:
         name -> callable without arguments: independent tasks run in the same pool, after the three longest fits.
     fed : dict, optional
         key -> estimator already fed by ``partial_fit``: only solved.
+    given : dict, optional
+        key -> the estimator object given in place of the key: a clone of it is fitted (:func:`make_estimator`).
 
     Returns
     -------
@@ -204,7 +220,7 @@ def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs:
     the fits not started are cancelled, and the error is raised once the running ones have ended.
     """
     keys_ = tuple(keys_)
-    fed = fed or {}
+    fed, given = fed or {}, given or {}
     stop = threading.Event()  # set when this thread is interrupted (Ctrl-C): the searches end at their next iteration
 
     def fit(key):
@@ -219,7 +235,7 @@ def fit_methods(keys_: Iterable[str], data: FitData, budget: SearchBudget, rngs:
             if progress is not None:
                 progress(key, i, f)
 
-        return fit_method(key, data, budget, rngs.get(key), callback, fed.get(key))
+        return fit_method(key, data, budget, rngs.get(key), callback, fed.get(key), given.get(key))
 
     extra = extra or {}
     tasks = [(-spec(k).cost, k, lambda k=k: fit(k)) for k in keys_] + [(-6.5, name, f) for name, f in extra.items()]

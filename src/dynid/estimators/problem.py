@@ -85,9 +85,6 @@ class FitData:
     joint_weights : (n_dof,) array, optional
         Row weight of each joint for the estimators that take them (``sdp``: the WLS weights of the main
         estimate on real logs).
-    hyperparameters : dict
-        key -> the hyper-parameters an estimator is built with on top of its defaults (those of an estimator object
-        given in place of its key: :func:`dynid.estimators.registry.estimator_choices`).
     base_prior : (n_base,) array, optional
         Base parameters least squares keeps along the directions the rows do not determine (the nominal ones).
     prior_std : (p,) array, optional
@@ -108,7 +105,6 @@ class FitData:
     prior: Any = None
     weights: Any = None
     joint_weights: Any = None
-    hyperparameters: dict = dataclasses.field(default_factory=dict)
     base_prior: Any = None
     prior_std: Any = None
     base_prior_std: Any = None

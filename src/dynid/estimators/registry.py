@@ -426,9 +426,10 @@ def parse_estimators(text: str | Iterable[str] | None, default: tuple[str, ...] 
     return tuple(found)
 
 
-def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...], dict[str, dict]]:
-    """The estimators of a list of keys and estimator objects: their keys, and the hyper-parameters the objects carry
-    (scikit-learn's rule: an object holds its hyper-parameters; the problem comes to ``fit``).
+def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...], dict]:
+    """The estimators of a list of keys and estimator objects: their keys, and the objects by key (scikit-learn's
+    rule: an object holds its hyper-parameters, the problem comes to ``fit``; a clone of each object is what is fitted,
+    :func:`dynid.estimators.fitting.make_estimator`).
 
     Parameters
     ----------
@@ -441,8 +442,8 @@ def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...]
     Returns
     -------
     keys : tuple of str
-    hyperparameters : dict
-        key -> each object's constructor parameters but those of :data:`PROBLEM_FILLED` (:attr:`FitData.hyperparameters`).
+    given : dict
+        key -> the estimator object given for it (keys given as names are not in it).
 
     Raises
     ------
@@ -454,8 +455,7 @@ def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...]
     items = list(items)
     objects = {i: _key_of(item, where) for i, item in enumerate(items) if not isinstance(item, str)}
     keys_ = parse_estimators([objects.get(i, item) for i, item in enumerate(items)])
-    return keys_, {objects[i]: {name: value for name, value in items[i].get_params().items() if name not in PROBLEM_FILLED}
-                   for i in objects}
+    return keys_, {objects[i]: items[i] for i in objects}
 
 
 def with_hyperparameters(items, hyperparameters: dict) -> tuple:

@@ -24,7 +24,15 @@ from ..estimators import paper_objective
 from ..estimators.accumulate import LeastSquaresAccumulator, LeastSquaresSolution
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
-from ..estimators.registry import DEFAULT_ESTIMATORS, LEAST_SQUARES, FitData, estimate_label, estimator_choices, spec
+from ..estimators.registry import (
+    DEFAULT_ESTIMATORS,
+    LEAST_SQUARES,
+    PROBLEM_FILLED,
+    FitData,
+    estimate_label,
+    estimator_choices,
+    spec,
+)
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.export import READINESS_KINDS
@@ -319,7 +327,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     IdentifiabilityError
         Too few rows or a rank-deficient base observation matrix (the log does not excite every base parameter).
     """
-    keys, hyperparameters = estimator_choices(estimators)
+    keys, given = estimator_choices(estimators)
     n = robot.n_dof
     sdp = "sdp" in keys
     prior = None
@@ -333,12 +341,12 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         # said wherever the description has inertial values: the nominal candidate takes them too (nominal_set)
     base_std, not_carried = base.base_std(robot.prior_sigmas()) if robot.prior_sigma else (None, ())
     problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=prior, hyperparameters=hyperparameters,
+                      prior=prior,
                       base_prior=base.base_from_standard(robot.standard_parameters()),
                       prior_std=robot.prior_sigmas() if robot.prior_sigma else None, base_prior_std=base_std)
     ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
     scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
-    estimation = Estimation(keys, problem, base.names, keep_rows=scored)
+    estimation = Estimation(keys, problem, base.names, keep_rows=scored, given=given)
     scoring = BlockScoring(robot, base, data, held_out=(held_out or jackknife) and sdp, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
@@ -394,7 +402,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     return IdentificationResult(
         robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
         n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
-                                                                  **_given_hyperparameters(hyperparameters)},
+                                                                  **_given_settings(given)},
         warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
         model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
         sdp_refits=refits)
@@ -409,15 +417,16 @@ def _not_carried_note(names: tuple[str, ...]) -> list[str]:
             f"{'it' if len(names) == 1 else 'each'} regrouped with other terms"]
 
 
-def _given_hyperparameters(hyperparameters: dict) -> dict:
-    """results.json's ``settings.estimator_hyperparameters``: those of the estimator objects given (none: no key),
-    each value a JSON scalar or its ``repr``."""
-    if not hyperparameters:
+def _given_settings(given: dict) -> dict:
+    """results.json's ``settings.estimator_hyperparameters``: those of the estimator objects given (none: no key), but
+    what the identification fills (:data:`dynid.estimators.registry.PROBLEM_FILLED`), each value a JSON scalar or its
+    ``repr``."""
+    if not given:
         return {}
     plain = (str, int, float, bool, type(None))
     return {"estimator_hyperparameters": {key: {name: value if isinstance(value, plain) else repr(value)
-                                                for name, value in given.items()}
-                                          for key, given in hyperparameters.items()}}
+                                                for name, value in est.get_params().items() if name not in PROBLEM_FILLED}
+                                          for key, est in given.items()}}
 
 
 class BlockScoring:

@@ -344,7 +344,7 @@ class IdentificationPipeline:
             From :meth:`prepare`.
         problem : FitData
             What the estimators know before any row (joints, base map, layout, prior, eq. 9 weights); the estimator
-            objects' hyper-parameters are added to it.
+            objects given are cloned and fitted on it.
         keep_rows : bool
             Keep the stacked base rows (:meth:`dynid.estimators.estimation.Estimation.rows`).
 
@@ -358,10 +358,8 @@ class IdentificationPipeline:
         ConfigError
             An estimator that cannot take the rows block by block as the least-squares reference.
         """
-        keys, hyperparameters = estimator_choices(self.open_loop)
-        if hyperparameters:
-            problem = replace(problem, hyperparameters={**problem.hyperparameters, **hyperparameters})
-        estimation = Estimation(keys, problem, prepared.base.names, keep_rows=keep_rows)
+        keys, given = estimator_choices(self.open_loop)
+        estimation = Estimation(keys, problem, prepared.base.names, keep_rows=keep_rows, given=given)
         chunks = base_chunks(prepared.robot, prepared.base, prepared.data, standard=estimation.standard)
         stream_rows(chunks, estimation, prepared.base)
         return estimation
