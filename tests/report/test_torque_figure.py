@@ -35,3 +35,17 @@ def test_the_legend_stands_below_the_axes_not_over_the_curves(n_sets):
         assert not _overlaps(box, ax[-1].xaxis.label.get_window_extent())
         assert all(a.get_legend() is None for a in ax)
     plt.close("all")
+
+
+def test_a_prismatic_joints_axes_say_newtons_and_metres():
+    """A sliding joint's force and position are drawn in N and m, the turning ones' in N·m and rad."""
+    from dynid.model.robot import default_limits
+    from dynid.report.figures import TorqueFigure, plot_excitation_states
+
+    figure = TorqueFigure(3, ["model"], prismatic=(True, False, False))
+    assert [a.get_ylabel() for a in figure.axes] == ["f1 [N]", "τ2 [N·m]", "τ3 [N·m]"]
+    t = np.linspace(0.0, 1.0, 20)
+    x = np.zeros((20, 2))
+    ax = plot_excitation_states(t, {"optimised": (x, x, x, x)}, default_limits(2), prismatic=(True, False))
+    assert [a.get_ylabel() for a in ax[0]] == ["joint 1: q [m]", "dq [m/s]", "ddq [m/s²]", "f [N]"]
+    assert [a.get_ylabel() for a in ax[1]] == ["joint 2: q [rad]", "dq [rad/s]", "ddq [rad/s²]", "τ [N·m]"]

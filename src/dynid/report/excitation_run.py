@@ -55,7 +55,7 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
     paths = [out / name for name in FIGURES if clearance or name != "excitation_clearance.png"]
     save_figure(figures.plot_excitation_states(
         t, states, problem.limits, title=f"{robot.name}: optimised excitation, cond(W_base) {design.initial_cond:.1f} → "
-                                          f"{design.cond:.1f} (dotted: limits)"), paths[0])
+                                          f"{design.cond:.1f} (dotted: limits)", prismatic=robot.prismatic), paths[0])
     box = (problem.workspace.box_min, problem.workspace.box_max)
     paths_xyz = {label: tool_positions(robot, s[0]) for label, s in states.items()}
     optimised = paths_xyz.pop("optimised")

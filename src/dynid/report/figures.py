@@ -446,9 +446,11 @@ class TorqueFigure:
     legend_below : bool, optional
         The legend in a row under the axes, where :func:`_torque_axes` leaves room (default: on a new figure), rather
         than in the first axes, where it hid the curves it names (a Med7 log's J1 from 13 s on).
+    prismatic : sequence of bool, optional
+        Which joints slide: their axes say force [N] rather than torque [N·m].
     """
 
-    def __init__(self, n_dof: int, labels, axes=None, *, legend_below: bool | None = None):
+    def __init__(self, n_dof: int, labels, axes=None, *, legend_below: bool | None = None, prismatic=()):
         below = axes is None if legend_below is None else legend_below
         if axes is None:
             from matplotlib.figure import Figure
@@ -462,7 +464,7 @@ class TorqueFigure:
             row = [a.plot([], [], color="black", lw=1.0, label="measured")[0]]
             row += [a.plot([], [], lw=1.0, ls="--", label=label)[0] for label in self.labels]
             self.lines.append(row)
-            a.set_ylabel(f"τ{j + 1} [N·m]")
+            a.set_ylabel(f"f{j + 1} [N]" if j < len(prismatic) and prismatic[j] else f"τ{j + 1} [N·m]")
             a.grid(alpha=0.3)
         if below:
             self.fig.legend(handles=self.lines[0], loc="lower center", ncol=min(len(self.lines[0]), 5), fontsize="small",
@@ -496,7 +498,7 @@ class TorqueFigure:
         return self.fig
 
 
-def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation trajectory and its limits"):
+def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation trajectory and its limits", prismatic=()):
     """Positions, velocities, accelerations and torques of each joint with their limits (paper Fig. 4).
 
     Parameters
@@ -535,7 +537,8 @@ def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation t
             for lim in (lo[j], hi[j]):
                 if np.isfinite(lim):
                     a.axhline(lim, color="tab:red", ls=":", lw=0.9)
-            a.set_ylabel(f"joint {j + 1}: {unit}" if c == 0 else unit)
+            said = unit.replace("rad", "m").replace("τ [N·m]", "f [N]") if j < len(prismatic) and prismatic[j] else unit
+            a.set_ylabel(f"joint {j + 1}: {said}" if c == 0 else said)  # metres and newtons along a sliding joint
             a.grid(alpha=0.3)
         ax[-1, c].set_xlabel("t [s]")
     ax[0, 0].legend(loc="upper right", fontsize="small")

@@ -24,7 +24,7 @@ def _slug(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_").lower() or "dataset"
 
 
-def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=None) -> list[Path]:
+def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=None, prismatic=()) -> list[Path]:
     """One PNG per dataset: measured vs predicted torques of every parameter set.
 
     Drawn on one figure that is redrawn for each dataset.
@@ -38,6 +38,8 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=N
         Files are ``{prefix}_{dataset}.png`` unless ``names`` says otherwise.
     names : sequence of str, optional
         File name of each comparison.
+    prismatic : sequence of bool, optional
+        Which joints slide: their axes say force [N].
 
     Returns
     -------
@@ -49,18 +51,18 @@ def save_comparisons(comparisons, out: Path, prefix: str = "validation", names=N
         paths.append(out / (f"{prefix}_{_slug(cmp.name)}.png" if names is None else names[i][1]))
         titles.append(f"{kind} — {cmp.name}: measured vs predicted torques")
     if paths:
-        draw_figures(_comparison_jobs, list(comparisons), paths, titles)
+        draw_figures(_comparison_jobs, list(comparisons), paths, titles, tuple(bool(p) for p in prismatic))
     return paths
 
 
-def _comparison_jobs(comparisons, paths, titles) -> list:
+def _comparison_jobs(comparisons, paths, titles, prismatic=()) -> list:
     """The jobs that write the comparison figures (:func:`dynid.report.output.draw_figures`)."""
     cache = {}
 
     def job(cmp, path, title):
         key = (cmp.measured.shape[1], tuple(cmp.predicted))
         if key not in cache:  # one figure per process and layout, redrawn for each dataset
-            cache[key] = figures.TorqueFigure(*key)
+            cache[key] = figures.TorqueFigure(*key, prismatic=prismatic)
         save_figure(cache[key].draw(cmp.t, cmp.measured, cmp.predicted, title), path)
 
     return [lambda c=c, p=p, t=t: job(c, p, t) for c, p, t in zip(comparisons, paths, titles)]
@@ -112,7 +114,7 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
     if figures_too:
         names = [("identification", "identification_fit.png")] + [
             ("validation", f"validation_{_slug(v.name)}.png") for v in result.validations]
-        paths = save_comparisons((result.fit, *result.validations), out, names=names)
+        paths = save_comparisons((result.fit, *result.validations), out, names=names, prismatic=result.base.prismatic)
     json_path = out / "results.json"
     data = {**result.to_dict(), "readiness": readiness(result).text}  # the first line: the report's box starts with it
     withheld = withheld_files(data)
