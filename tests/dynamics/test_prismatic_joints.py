@@ -144,3 +144,18 @@ def test_a_prismatic_joints_drive_terms_are_in_linear_units(urdf):
     j = int(np.flatnonzero(robot.prismatic)[0]) + 1
     assert [base.unit(f"{t}{j}") for t in ("fv", "fc", "Ia", "M")] == ["N·s/m", "N", "kg", "kg"]
     assert unit_of(f"fv{j}") == "N·m·s/rad"  # a name alone is a revolute joint's
+
+
+def test_a_sliding_joint_is_never_tried_a_quarter_turn_off_and_its_stroke_counts_in_the_reach(urdf):
+    """The check of a log read otherwise than the robot file tries each revolute joint's zero a quarter or half turn
+    off; a prismatic joint's zero is a length, so it is tried on none (it was shifted by π/2 m as if turned). The reach
+    (the capsules' and the workspace's scale) holds each prismatic joint's stroke."""
+    from dynid.validation.geometry_checks import candidate_changes
+
+    robot = load_robot(urdf, held=joints_to_hold(urdf))
+    shifts = candidate_changes(robot)[0]
+    assert np.all(shifts[:, robot.prismatic] == 0.0)
+    assert np.any(shifts[:, ~robot.prismatic] != 0.0)
+    stroke = np.maximum(np.abs(robot.limits.q_min), np.abs(robot.limits.q_max))[robot.prismatic].sum()
+    skeleton = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
+    assert robot.reach == pytest.approx(skeleton + stroke)

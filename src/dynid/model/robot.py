@@ -315,9 +315,12 @@ class Robot:
 
     @property
     def reach(self) -> float:
-        """[m] The sum of the joints' offsets and the flange's: no point of the arm's skeleton is farther than this from
-        the first joint's origin."""
-        return sum(float(np.linalg.norm(j.translation)) for j in self.joints) + float(np.linalg.norm(self.tool_translation))
+        """[m] The sum of the joints' offsets, the flange's and each prismatic joint's stroke (its farther limit): no point
+        of the arm's skeleton is farther than this from the first joint's origin (a prismatic joint without limits
+        adds nothing)."""
+        stroke = np.where(self.prismatic, np.maximum(np.abs(self.limits.q_min), np.abs(self.limits.q_max)), 0.0)
+        return (sum(float(np.linalg.norm(j.translation)) for j in self.joints) + float(np.linalg.norm(self.tool_translation))
+                + float(np.sum(np.where(np.isfinite(stroke), stroke, 0.0))))
 
     @property
     def n_params_per_joint(self) -> int:

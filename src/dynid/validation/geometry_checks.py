@@ -246,7 +246,8 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
     Returns
     -------
     shifts : (S, n_dof) ndarray [rad]
-        S = 1 + 3 n + 9 n (n - 1) / 2 + n (n - 1) + n + the gravities.
+        S = 1 + 3 r + 9 r (r - 1) / 2 + n (n - 1) + n + the gravities, r the revolute joints (a prismatic joint's zero
+        is not turned).
     orders : (S, n_dof) int ndarray
         The logged column each joint is read from.
     gravities : (S, 3) ndarray [m/s²]
@@ -258,8 +259,9 @@ def candidate_changes(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray,
     n, g = robot.n_dof, np.asarray(robot.gravity, dtype=float)
     identity = np.arange(n)
     shifts, orders = [np.zeros(n)], [identity]
+    turning = [j for j in range(n) if not robot.joints[j].prismatic]  # a sliding joint's zero is no turn
     for size in (1, 2):
-        for joints in itertools.combinations(range(n), size):
+        for joints in itertools.combinations(turning, size):
             for turns in itertools.product(CANDIDATE_TURNS, repeat=size):
                 row = np.zeros(n)
                 row[list(joints)] = turns
