@@ -68,6 +68,14 @@ def urdf(request, tmp_path):
     return path
 
 
+def _both(urdf):
+    """dynid's robot of the URDF (its fingers held) and Pinocchio's own model of it, the same joints locked at 0."""
+    held = joints_to_hold(urdf)
+    full = pin.buildModelFromUrdf(str(urdf))
+    model = pin.buildReducedModel(full, [full.getJointId(h) for h in held], np.zeros(full.nq))
+    return load_robot(urdf, held=held), model, model.createData()
+
+
 def _states(robot, rng, n):
     lo, hi = robot.limits.position_span()
     return rng.uniform(lo, hi, (n, robot.n_dof)), rng.normal(size=(n, robot.n_dof)), rng.normal(size=(n, robot.n_dof)) * 3
@@ -88,12 +96,7 @@ def test_the_arm_is_every_joint_but_a_grippers_fingers(urdf):
 def test_the_regressor_equals_pinocchios_on_1000_random_states(urdf, form, rng):
     """Each link's ten columns equal Pinocchio's joint-torque regressor of its own URDF model (its parameter order
     mapped to eq. 5), and Y·φ its RNEA, to 1e-10 of the RMS torque: prismatic joints feel the force along their axis."""
-    held = joints_to_hold(urdf)
-    robot = load_robot(urdf, held=held)
-    model = pin.buildReducedModel(pin.buildModelFromUrdf(str(urdf)),
-                                  [pin.buildModelFromUrdf(str(urdf)).getJointId(h) for h in held],
-                                  np.zeros(robot.n_dof + len(held)))
-    data = model.createData()
+    robot, model, data = _both(urdf)
     q, dq, ddq = _states(robot, rng, 1000)
     y = np.empty((1000, robot.n_dof, robot.n_params))
     _fill(robot, q, dq, ddq, y, np.arange(robot.n_params), form=form)
@@ -112,11 +115,7 @@ def test_the_regressor_equals_pinocchios_on_1000_random_states(urdf, form, rng):
 
 
 def test_the_number_of_base_parameters_is_the_rank_of_pinocchios_regressor(urdf, rng):
-    held = joints_to_hold(urdf)
-    robot = load_robot(urdf, held=held)
-    full = pin.buildModelFromUrdf(str(urdf))
-    model = pin.buildReducedModel(full, [full.getJointId(h) for h in held], np.zeros(full.nq))
-    data = model.createData()
+    robot, model, data = _both(urdf)
     q, dq, ddq = _states(robot, rng, 300)
     w = np.vstack([pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k]) for k in range(300)])
     rigid = robot.without_drive_terms(robot.drive_terms)
@@ -124,11 +123,7 @@ def test_the_number_of_base_parameters_is_the_rank_of_pinocchios_regressor(urdf,
 
 
 def test_forward_kinematics_follows_pinocchio(urdf, rng):
-    held = joints_to_hold(urdf)
-    robot = load_robot(urdf, held=held)
-    full = pin.buildModelFromUrdf(str(urdf))
-    model = pin.buildReducedModel(full, [full.getJointId(h) for h in held], np.zeros(full.nq))
-    data = model.createData()
+    robot, model, data = _both(urdf)
     q = _states(robot, rng, 20)[0]
     rots, origins = forward_kinematics(robot, q)
     for k in range(20):
