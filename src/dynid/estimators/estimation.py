@@ -38,6 +38,9 @@ class Estimation:
         Base parameters' names (said when the data do not excite some of them).
     keep_rows : bool
         Keep every block's base rows in memory even when no estimator needs them (:meth:`rows`).
+    given : dict, optional
+        key -> the estimator object given in place of the key: a clone of it is what is fed and fitted
+        (:func:`dynid.estimators.fitting.make_estimator`).
 
     Attributes
     ----------

@@ -512,6 +512,8 @@ def plot_excitation_states(t, states: dict, limits, ax=None, title="Excitation t
     ax : matplotlib Axes, optional
         Where to draw (default: a new figure).
     title : str
+    prismatic : sequence of bool, optional
+        Which joints slide: their rows say m, m/s, m/s² and N.
 
     Returns
     -------
