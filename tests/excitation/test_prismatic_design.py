@@ -61,15 +61,17 @@ def test_the_design_gradients_of_a_tracked_arm_equal_finite_differences(tracked,
 
 def test_dynid_excite_designs_a_tracked_arm_and_says_metres(tracked, tmp_path):
     """`dynid excite arm.urdf` on a tracked arm: the design improves on its start (a flat criterion ended it there,
-    cond 1.9e10 kept), the first row's track position is said in metres, the margins in m and m/s."""
+    cond 1.9e10 kept), the first row's track position is said in metres, the margins in m and m/s; each start's
+    progress line says the best design so far (issue "Fast where users wait", item 3)."""
     import json
 
     from ..cli.refusals import dynid
 
     _, path = tracked
-    p = dynid("excite", str(path), "--out", str(tmp_path / "out"), "--starts", "1")
+    p = dynid("excite", str(path), "--out", str(tmp_path / "out"), "--starts", "2")
     said = " ".join(p.stdout.split())
     assert p.returncode == 0, p.stderr
+    assert re.search(r"^dynid excite: design, start 2 of 2, best cond so far \d", p.stderr, re.M), p.stderr  # a pipe
     assert re.search(r"it starts at rest at J1 \d\.\d{3} m, J2 -?\d+\.\d°", said), said
     design = json.loads((tmp_path / "out" / "excitation.json").read_text())["design"]
     assert design["cond"] < 0.5 * design["initial_cond"]

@@ -739,8 +739,12 @@ def excite(
 
     def compute(cfg, progress):
         progress.update(f"design, start 1 of {cfg.starts}")
-        return run_excitation(cfg, callback=lambda i, n, c: progress.update(
-            f"design, start {min(i + 1, n)} of {n}", f"best cond = {c:.4g}"))
+
+        def started(done: int, n: int, best: float) -> None:  # each start's line says the best design so far
+            if done < n:
+                progress.update(f"design, start {done + 1} of {n}, best cond so far {best:.4g}")
+
+        return run_excitation(cfg, callback=started)
 
     def save(run):
         from ..report.excitation_run import save_excitation
