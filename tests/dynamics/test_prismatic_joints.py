@@ -154,3 +154,24 @@ def test_a_sliding_joint_is_never_tried_a_quarter_turn_off_and_its_stroke_counts
     stroke = np.maximum(np.abs(robot.limits.q_min), np.abs(robot.limits.q_max))[robot.prismatic].sum()
     skeleton = sum(float(np.linalg.norm(j.translation)) for j in robot.joints) + float(np.linalg.norm(robot.tool_translation))
     assert robot.reach == pytest.approx(skeleton + stroke)
+
+
+def test_a_quarter_turn_on_a_tracked_arms_revolute_joint_is_named_and_the_track_never_turned(tmp_path):
+    """The check of a log read otherwise runs on an arm with a prismatic joint: a log whose J3 angles are a quarter turn
+    from the URDF's is named so, and the track, which is never tried turned, does not stop the search (it raised
+    "zero-size array" there, a traceback through dynid identify on the zoo's tracked arm and TIAGo)."""
+    from dynid.dynamics.regressor import nominal_rigid_torque
+    from dynid.validation.geometry_checks import geometry_findings
+
+    (tmp_path / "tracked.urdf").write_text(TRACKED)
+    robot = load_robot(tmp_path / "tracked.urdf")
+    t = np.arange(5000) * 0.004
+    omega = 2 * np.pi * np.array([0.1, 0.13, 0.17, 0.21, 0.23, 0.27])
+    centre = (robot.limits.q_min + robot.limits.q_max) / 2
+    amp = np.minimum(0.8, 0.3 * (robot.limits.q_max - robot.limits.q_min))
+    q = centre + amp * np.sin(omega * t[:, None] + np.arange(6))
+    dq, ddq = amp * omega * np.cos(omega * t[:, None] + np.arange(6)), -(omega**2) * (q - centre)
+    tau = nominal_rigid_torque(robot, q + np.array([0, 0, np.pi / 2, 0, 0, 0]), dq, ddq)
+    found, stats = geometry_findings(robot, q, dq, ddq, tau, "log")
+    assert [f.kind for f in found] == ["angles"], found
+    assert stats["shift"] == pytest.approx([0, 0, np.pi / 2, 0, 0, 0])

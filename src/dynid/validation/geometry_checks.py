@@ -339,7 +339,8 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     scores = np.full(len(shifts), np.inf)
     scores[~paired] = _scored(robot, log, changes, ~paired)
     turned = (np.count_nonzero(shifts, axis=1) == 1) & ~paired
-    best_turn = [scores[turned & (shifts[:, j] != 0)].min() for j in range(robot.n_dof)]
+    best_turn = [scores[turned & (shifts[:, j] != 0)].min(initial=np.inf) for j in range(robot.n_dof)]  # a sliding
+    # joint is never turned: it ranks last
     top = np.argsort(best_turn, kind="stable")[:PAIRED_JOINTS]
     among = paired & np.all((shifts == 0) | np.isin(np.arange(robot.n_dof), top), axis=1)
     scores[among] = _scored(robot, log, changes, among)
