@@ -1,8 +1,9 @@
 """The terminal side of the commands: summaries (blocks of :mod:`dynid.tables`) as rich tables that fit the
 terminal, warnings, the "wrote …" line, and progress.
 
-Progress goes to standard error: on a terminal a live line (description, detail, elapsed time); when standard
-error is a pipe or a file, one plain line each time a step starts, so a log shows what ran and when. ``quiet``
+Progress goes to standard error: on a terminal a live line (description, detail, elapsed time; a step's share done as
+a bar with the time left at its pace so far); when standard error is a pipe or a file, one plain line each time a step
+starts, so a log shows what ran and when. ``quiet``
 silences progress and summaries; warnings and errors are still printed (on standard error).
 """
 
@@ -157,6 +158,38 @@ def count(n: int, noun: str) -> str:
     return f"no {noun}s" if n == 0 else f"1 {noun}" if n == 1 else f"{n} {noun}s"
 
 
+BAR_CELLS = 20
+"""Cells of the progress bar a step with a share done shows on a terminal."""
+
+
+def bar(detail: str, seconds: float) -> str:
+    """A step's detail as the terminal shows it: a share done (``"40 %"``) as a bar with the time left at the step's
+    pace so far, anything else as it is.
+
+    Parameters
+    ----------
+    detail : str
+        The step's detail (:meth:`Progress.update`).
+    seconds : float
+        The step's time so far [s].
+
+    Returns
+    -------
+    str
+    """
+    text = detail.strip()
+    if not text.endswith("%"):
+        return detail
+    try:
+        share = float(text[:-1]) / 100.0
+    except ValueError:
+        return detail
+    share = min(max(share, 0.0), 1.0)
+    filled = int(round(share * BAR_CELLS))
+    left = f", about {seconds * (1 - share) / share:.0f} s left" if 0 < share < 1 and seconds >= 1.0 else ""
+    return f"{'█' * filled}{'░' * (BAR_CELLS - filled)} {100 * share:.0f} %{left}"
+
+
 class Progress:
     """Progress of a command on standard error.
 
@@ -179,6 +212,7 @@ class Progress:
         self.seen: set[str] = set()
         self.t0 = time.perf_counter()
         self._status: Any = None
+        self._started: dict[str, float] = {}  # each step's start [s since t0]: its time left from its share done
 
     def __enter__(self) -> Progress:
         if self.live:
@@ -203,8 +237,9 @@ class Progress:
         if self.quiet:
             return
         elapsed = time.perf_counter() - self.t0
+        start = self._started.setdefault(step, elapsed)
         if self.live:
-            self._status.update(escape(f"{self.command}: {step} {detail}  {elapsed:.0f} s"))
+            self._status.update(escape(f"{self.command}: {step} {bar(detail, elapsed - start)}  {elapsed:.0f} s"))
         elif step not in self.seen:  # steps may run side by side: each is announced once
             self.console.print(f"{self.command}: {step} (at {elapsed:.1f} s)", markup=False, highlight=False)
         self.seen.add(step)
