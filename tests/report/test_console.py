@@ -34,6 +34,7 @@ def test_a_steps_share_done_is_a_bar_with_the_time_left_on_a_terminal():
     assert bar("40 %", 6.0) == "████████░░░░░░░░░░░░ 40 %, about 9 s left"
     assert bar("100 %", 6.0) == "████████████████████ 100 %" and bar("best cond = 12", 6.0) == "best cond = 12"
     assert bar("5 %", 0.2) == "█░░░░░░░░░░░░░░░░░░░ 5 %"  # under a second: no estimate yet
+    assert bar("0 %", 3.0) == ""  # a step that says only that it started
     terminal = Console(file=io.StringIO(), force_terminal=True, width=120)
     with Progress("dynid identify", terminal) as p:
         p.update("regressor", "0 %")

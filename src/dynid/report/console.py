@@ -164,7 +164,7 @@ BAR_CELLS = 20
 
 def bar(detail: str, seconds: float) -> str:
     """A step's detail as the terminal shows it: a share done (``"40 %"``) as a bar with the time left at the step's
-    pace so far, anything else as it is.
+    pace so far (nothing at 0 %, which most steps say only as they start), anything else as it is.
 
     Parameters
     ----------
@@ -185,6 +185,8 @@ def bar(detail: str, seconds: float) -> str:
     except ValueError:
         return detail
     share = min(max(share, 0.0), 1.0)
+    if share == 0.0:  # a step that announces its start alone: no bar to read yet
+        return ""
     filled = int(round(share * BAR_CELLS))
     left = f", about {seconds * (1 - share) / share:.0f} s left" if 0 < share < 1 and seconds >= 1.0 else ""
     return f"{'█' * filled}{'░' * (BAR_CELLS - filled)} {100 * share:.0f} %{left}"
