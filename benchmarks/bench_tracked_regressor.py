@@ -4,7 +4,7 @@ The er16 (6 revolute joints, built as the tracked one is: its joints, links and 
 er16 on a linear track (a prismatic joint along x under its base, 7 joints),
 25,000 random samples each, the full (N, n_dof, n_params) array by the compiled form (each robot's SIMD code; the
 NumPy budget is spent first), best of 10 rounds in which the two are timed in turn (each first in half of them: the one timed first in a
-round ran up to 25 % slower), each after a warm-up. Prints the time per sample and per sample and joint of each,
+round ran slower, NOTEBOOK.md), each after a warm-up. Prints the time per sample and per sample and joint of each,
 and their ratio (target: the tracked arm's per joint within 1.3x the arm's; the pairs of joints alone make it
 (7·8/2/7)/(6·7/2/6) = 1.14x). Checks first that the tracked arm's torques equal Pinocchio's RNEA.
 """

@@ -7,7 +7,7 @@ import numpy as np
 
 def joint_gram(a: np.ndarray, b: np.ndarray | None = None) -> np.ndarray:
     """``Σ_m a[m, j, :]ᵀ b[m, j, :]`` for every joint ``j``: ``einsum("mjc,mjd->jcd", a, b)`` as one batched matrix
-    product (BLAS, about 13x faster than NumPy's einsum on a block of 5,000 rows of 60 columns; equal to rounding).
+    product (BLAS; equal to rounding, and faster: benchmarks/NOTEBOOK.md).
 
     Parameters
     ----------
