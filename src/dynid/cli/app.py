@@ -398,13 +398,14 @@ def export(
         return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
 
     def compute(prepared, progress):
-        from ..io.export import consistent_estimate
+        from ..io.export import consistent_estimate, file_parameters
 
         cfg, identified, targets = prepared
         moved: list[str] = []
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
         estimate = consistent_estimate(cfg.robot, identified, str(results))
+        estimate = (*estimate, file_parameters(*estimate, identified, str(results))[0])
         log = _replay_log(cfg, identified, estimate[0])
         checks = {path: _replayed(flag, text, estimate, log) for (flag, path), (_, text) in zip(targets, texts)}
         simulated = _simulated(cfg, identified, texts, targets, str(results)) if forward else None
@@ -434,10 +435,10 @@ def export(
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
-        from ..report.identification_run import read_back_entry
+        from ..report.identification_run import folded, read_back_entry
         from ..report.summaries import taken_away_lines
 
-        files = [read_back_entry(path.name, form, check) for path, (form, check) in computed[4].items()]
+        files = [read_back_entry(path.name, form, check, folded(computed[3])) for path, (form, check) in computed[4].items()]
         for line in taken_away_lines({"log": computed[6], "files": files}):
             (rep.warning if line.kind == "warning" else rep.line)(line.text)
         if simulated is not None:
@@ -480,12 +481,14 @@ def _replay_log(cfg, identified: dict, robot):
 
 def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
     """The written file read back by its tool (:mod:`dynid.io.replay`): ``(format, ReplayCheck)``, or the format and
-    why it was not read back. On ``log`` (:func:`_replay_log`) where given, else on random states."""
-    on = {} if log is None else {"states": log[1], "measured": log[2]}
+    why it was not read back. ``estimate``: the robot, dynid's whole model and the parameters the file holds
+    (:func:`dynid.io.export.file_parameters`). On ``log`` (:func:`_replay_log`) where given, else on random states."""
+    robot, whole, held = estimate
+    on = {"whole": whole} if log is None else {"states": log[1], "measured": log[2], "whole": whole}
     if flag == "--urdf":
         from ..io.replay import urdf_replay
 
-        return "URDF", urdf_replay(text, *estimate, **on)
+        return "URDF", urdf_replay(text, robot, held, **on)
     try:
         import mujoco  # noqa: F401  the MJCF's own reader
     except ImportError:
@@ -493,7 +496,7 @@ def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
     from ..io.replay import mjcf_replay
 
     try:
-        return "MJCF", mjcf_replay(text, *estimate, **on)
+        return "MJCF", mjcf_replay(text, robot, held, **on)
     except (ValueError, KeyError) as exc:  # a user's model whose meshes MuJoCo finds only beside the original
         return "MJCF", f"MuJoCo could not load it from its text ({str(exc).splitlines()[0]})"
 
@@ -523,7 +526,7 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
     """The text of one ``dynid export`` file (``flag``: "--urdf" or "--mjcf"): the user's URDF or MJCF with the
     identified values written in, or a file of dynid's own where the description has none; values far from the
     description's own are appended to ``moved``."""
-    from ..io.export import consistent_estimate, mjcf_from_results, urdf_from_results
+    from ..io.export import consistent_estimate, file_parameters, mjcf_from_results, urdf_from_results, with_note
 
     robot = cfg.robot
     if flag == "--urdf":
@@ -532,6 +535,7 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
         from ..io.urdf_write_back import urdf_written_back
 
         fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
+        phi, note = file_parameters(fitted, phi, identified, source)
         text, far = urdf_written_back(cfg.urdf, fitted, phi)
     else:
         if users_mjcf is None:
@@ -539,9 +543,10 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
         from ..io.mjcf_write_back import mjcf_written_back
 
         fitted, phi = consistent_estimate(robot, identified, source)
+        phi, note = file_parameters(fitted, phi, identified, source)
         text, far = mjcf_written_back(users_mjcf, fitted, phi, out_dir=mjcf.parent if mjcf else None)
     moved.extend(far)
-    return text
+    return with_note(text, note)
 
 
 def _read_results(results: Path, robot) -> dict:

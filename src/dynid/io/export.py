@@ -381,6 +381,81 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     return robot, phi
 
 
+def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = "results") -> tuple[np.ndarray, str]:
+    """The standard parameters the written URDF and MJCF hold: ``phi`` with the joints whose friction the validation logs
+    chose folded (results' ``diagnostics.file_friction``, :mod:`dynid.identification.file_friction`) holding the folded
+    Coulomb and viscous pair and no Stribeck or load-dependent Coulomb term.
+
+    Parameters
+    ----------
+    robot : Robot
+        As :func:`consistent_estimate` gives it.
+    phi : (n_params,) array
+        The physically consistent estimate's standard parameters.
+    results : dict
+        results.json.
+    source : str
+        Where the results come from, named in errors.
+
+    Returns
+    -------
+    phi : (n_params,) ndarray
+        What the files hold (``phi`` itself where nothing is folded).
+    note : str
+        What the files' friction holds, for a comment in them ("" where nothing is folded).
+
+    Raises
+    ------
+    ConfigError
+        A ``file_friction`` entry that is not one non-negative ``fc`` and ``fv`` and a ``folded`` flag per joint.
+    """
+    found = (results.get("diagnostics") or {}).get("file_friction")
+    if found is None:
+        return np.asarray(phi, dtype=float), ""
+    n = robot.n_dof
+    try:
+        fc, fv = (np.array(found[k], dtype=float) for k in ("fc", "fv"))
+        folded = [j for j, f in enumerate(found["folded"]) if f is True]
+        ok = fc.shape == fv.shape == (n,) == (len(found["folded"]),) and np.all(np.isfinite(fc + fv)) and np.all(fc >= 0) and np.all(fv >= 0)
+    except (KeyError, TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ConfigError(f"{source}: diagnostics.file_friction: expected fc, fv (finite, >= 0) and folded (true or false) "
+                          f"for each of the {n} joints")
+    out = np.array(phi, dtype=float)
+    names = list(robot.parameter_names)
+    for j in folded:
+        for term in ("fc", "fv", "fst", "fcl"):
+            if f"{term}{j + 1}" in names:
+                out[names.index(f"{term}{j + 1}")] = {"fc": fc[j], "fv": fv[j]}.get(term, 0.0)
+    if not folded:
+        return out, ""
+    joints = ", ".join(f"J{j + 1}" for j in folded)
+    terms = " and ".join(found.get("terms") or ["Stribeck", "load-dependent Coulomb"])
+    return out, (f"dynid: the friction of {joints} holds its {terms} terms folded into the Coulomb and viscous pair (the "
+                 "nearest pair on the identification log, written where the validation logs say it predicts the joint "
+                 "better); dynid's own values are in results.json")
+
+
+def with_note(text: str, note: str) -> str:
+    """A written URDF or MJCF with ``note`` as a comment after its root element.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+    note : str
+        The comment ("" leaves the text as it is; ``--`` is written ``-``, which an XML comment cannot hold).
+
+    Returns
+    -------
+    str
+    """
+    if not note:
+        return text
+    return text.rstrip("\n") + f"\n<!-- {note.replace('--', '-')} -->\n"
+
+
 LARGEST_LINK_MASS = 1e5
 """kg: a robot link's mass above this in a results file is no identification (the largest industrial arms' links
 weigh a few tonnes); export refuses it rather than write it."""
@@ -479,7 +554,8 @@ def withheld_files(results: dict) -> str | None:
 
 @keyword_only_after_data
 def urdf_from_results(robot: Robot | str | Path, results: dict, *, source: str = "results") -> str:
-    """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
+    """URDF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`), its friction as
+    the results chose to write it (:func:`file_parameters`).
 
     Parameters
     ----------
@@ -501,12 +577,15 @@ def urdf_from_results(robot: Robot | str | Path, results: dict, *, source: str =
     ConfigError
         As :func:`consistent_estimate`.
     """
-    return urdf_from_robot(*consistent_estimate(as_robot(robot), results, source))
+    fitted, phi = consistent_estimate(as_robot(robot), results, source)
+    phi, note = file_parameters(fitted, phi, results, source)
+    return with_note(urdf_from_robot(fitted, phi), note)
 
 
 @keyword_only_after_data
 def mjcf_from_results(robot: Robot, results: dict, *, source: str = "results") -> str:
-    """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`).
+    """MJCF of the physically consistent estimate of a ``results.json`` (:func:`consistent_estimate`), its friction as
+    the results chose to write it (:func:`file_parameters`).
 
     Parameters
     ----------
@@ -527,7 +606,9 @@ def mjcf_from_results(robot: Robot, results: dict, *, source: str = "results") -
     ConfigError
         As :func:`consistent_estimate`.
     """
-    return mjcf_from_robot(*consistent_estimate(robot, results, source))
+    fitted, phi = consistent_estimate(robot, results, source)
+    phi, note = file_parameters(fitted, phi, results, source)
+    return with_note(mjcf_from_robot(fitted, phi), note)
 
 
 MOVED_MASS = 0.5

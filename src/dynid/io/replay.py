@@ -80,7 +80,7 @@ def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray,
 
 
 def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
-                measured=None) -> ReplayCheck:
+                measured=None, whole=None) -> ReplayCheck:
     """Pinocchio's torques of a written URDF against dynid's torques of ``phi`` (module docstring).
 
     Parameters
@@ -99,6 +99,9 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         A log's states instead of random ones [rad, rad/s, rad/s²].
     measured : (N, n_dof) array [N·m], optional
         The log's measured torque on ``states``: the file and dynid's model are also scored against it.
+    whole : (n_params,) array, optional
+        dynid's whole model, where the file holds another set (its friction folded,
+        :func:`dynid.io.export.file_parameters`); default ``phi``.
 
     Returns
     -------
@@ -130,16 +133,19 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     for k in range(n_s):
         tau_file[k] = pin.rnea(model, data, big_q[k], big_v[k], big_a[k])[idx]
     tau_file += model.damping[idx] * dq + model.friction[idx] * np.sign(dq)
-    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS, measured)
+    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS, measured, whole=whole)
 
 
 def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...],
-              measured: np.ndarray | None = None, simulated: np.ndarray | None = None) -> ReplayCheck:
+              measured: np.ndarray | None = None, simulated: np.ndarray | None = None,
+              whole: np.ndarray | None = None) -> ReplayCheck:
     """The file's torques against dynid's of ``phi`` restricted to the links and the drive terms ``held_terms`` a format
     holds (Coulomb friction with ``sign(q̇)``), each joint's share of what the format cannot hold, both against the
-    ``measured`` torque where given, and the ``simulated`` torque (default the file's) against dynid's whole model."""
+    ``measured`` torque where given, and the ``simulated`` torque (default the file's) against dynid's whole model
+    (``whole``, default ``phi``: the model the file was written from, where its friction is folded)."""
     q, dq, ddq = states
-    full = regressor(robot, q, dq, ddq) @ phi
+    whole = phi if whole is None else np.asarray(whole, dtype=float)
+    full = regressor(robot, q, dq, ddq) @ whole
     coupled = set(robot.transmission.coupled_parameter_names) if robot.transmission.n_coupled_params else set()
     drive = set(robot.drive_terms)
     kept = np.array([n not in coupled and (n.rstrip("0123456789") not in drive or n.rstrip("0123456789") in held_terms)
@@ -147,7 +153,7 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
     held_phi = np.where(kept, phi, 0.0)
     plain = replace(robot, coulomb_velocity=np.zeros(robot.n_dof))  # the formats' friction is fc·sign(q̇)
     model_tau = regressor(plain, q, dq, ddq) @ held_phi
-    missing = tuple(sorted({n.rstrip("0123456789") for n, v, k in zip(robot.parameter_names, phi, kept)
+    missing = tuple(sorted({n.rstrip("0123456789") for n, v, k in zip(robot.parameter_names, whole, kept)
                             if not k and v != 0} | ({"smooth Coulomb"} if np.any(robot.coulomb_velocity > 0) else set())))
     rms = np.sqrt(np.mean(full**2, axis=0))
     share = 100.0 * np.sqrt(np.mean((full - model_tau) ** 2, axis=0)) / np.maximum(rms, 1e-300)
@@ -162,7 +168,7 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
 
 
 def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
-                measured=None) -> ReplayCheck:
+                measured=None, whole=None) -> ReplayCheck:
     """MuJoCo's torques of a written MJCF against dynid's torques of ``phi``: the links, ``armature`` (rotor inertia),
     ``damping`` (viscous friction) and ``frictionloss`` (Coulomb friction) (module docstring).
 
@@ -186,6 +192,9 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         A log's states instead of random ones [rad, rad/s, rad/s²].
     measured : (N, n_dof) array [N·m], optional
         The log's measured torque on ``states``: the file and dynid's model are also scored against it.
+    whole : (n_params,) array, optional
+        dynid's whole model, where the file holds another set (its friction folded,
+        :func:`dynid.io.export.file_parameters`); default ``phi``.
 
     Returns
     -------
@@ -215,7 +224,7 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
             mujoco.mj_inverse(model, data)
             out[k] = data.qfrc_inverse[vadr]
     tau_file = tau_file + dry * np.sign(dq)
-    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured, simulated=with_constraint)
+    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured, simulated=with_constraint, whole=whole)
     sliding = dry * np.sign(dq)
     gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
     return replace(check, frictionloss_gap=gap)

@@ -9,7 +9,15 @@ from .._util.keywords import keyword_only_after_data
 from ..exceptions import DynIdError
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
-from ..io.export import consistent_estimate, mjcf_from_robot, payload_files, urdf_from_robot, withheld_files
+from ..io.export import (
+    consistent_estimate,
+    file_parameters,
+    mjcf_from_robot,
+    payload_files,
+    urdf_from_robot,
+    with_note,
+    withheld_files,
+)
 from ..io.mjcf_write_back import mjcf_written_back
 from ..io.replay import ReplayCheck, mjcf_replay, urdf_replay
 from ..io.results import stored_standard
@@ -140,6 +148,7 @@ def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, m
     if robot is None or sdp is None or data["physically_consistent_verdict"].get(sdp[0]) != "yes":
         return []
     fitted, phi = consistent_estimate(robot, data)
+    phi, note = file_parameters(fitted, phi, data)
     if urdf is None:
         model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
     else:
@@ -149,7 +158,7 @@ def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, m
     else:
         mjcf = (out / (mjcf_name or Path(mjcf_model).name),
                 mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out)[0])
-    return [model, mjcf]
+    return [(path, with_note(text, note)) for path, text in (model, mjcf)]
 
 
 def taken_away(models: list, robot, data: dict, config=None) -> dict:
@@ -178,7 +187,8 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
     """
     from ..identification.run import moving_validation
 
-    fitted, phi = consistent_estimate(robot, data)
+    fitted, whole = consistent_estimate(robot, data)
+    phi = file_parameters(fitted, whole, data)[0]
     log = None
     if config is not None and config.validation:
         try:
@@ -191,16 +201,33 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
                                                            ("MJCF", "MuJoCo", mjcf_replay))):
         check: ReplayCheck | str
         try:
-            check = replay(text, fitted, phi, **on)
+            check = replay(text, fitted, phi, whole=whole, **on)
         except ImportError:
             check = f"{tool} is not installed (pip install 'dynid[mujoco]')"
         except (ValueError, KeyError) as exc:  # a user's model MuJoCo cannot load from its text alone
             check = f"{tool} could not load it from its text ({str(exc).splitlines()[0]})"
-        files.append(read_back_entry(path.name, form, check))
+        files.append(read_back_entry(path.name, form, check, folded(data)))
     return {"log": None if log is None else log[0], "files": files}
 
 
-def read_back_entry(name: str, form: str, check) -> dict:
+def folded(results: dict) -> list[int]:
+    """The joints whose friction the written files hold folded (results' ``diagnostics.file_friction``).
+
+    Parameters
+    ----------
+    results : dict
+        results.json.
+
+    Returns
+    -------
+    list of int
+        Joint numbers, from 1.
+    """
+    found = (results.get("diagnostics") or {}).get("file_friction") or {}
+    return [j + 1 for j, f in enumerate(found.get("folded") or []) if f is True]
+
+
+def read_back_entry(name: str, form: str, check, folded_joints: tuple[int, ...] | list[int] = ()) -> dict:
     """One written file read back by its tool, as results.json's ``files_taken_away`` holds it.
 
     Parameters
@@ -210,6 +237,8 @@ def read_back_entry(name: str, form: str, check) -> dict:
     form : {"URDF", "MJCF"}
     check : ReplayCheck or str
         :func:`dynid.io.replay.urdf_replay` or :func:`~dynid.io.replay.mjcf_replay`'s check, or why there is none.
+    folded_joints : list of int
+        The joints (from 1) whose friction the file holds folded (:func:`folded`).
 
     Returns
     -------
@@ -221,7 +250,7 @@ def read_back_entry(name: str, form: str, check) -> dict:
     return {**entry, "equals_model_to": check.relative_error, "samples": check.n_states,
             "cannot_hold": list(check.missing), "cannot_hold_share": [float(x) for x in check.missing_share],
             "file_vs_measured": check.file_vs_measured, "model_vs_measured": check.model_vs_measured,
-            "simulator_gap": [float(x) for x in check.simulator_gap]}
+            "simulator_gap": [float(x) for x in check.simulator_gap], "friction_folded": list(folded_joints)}
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:
