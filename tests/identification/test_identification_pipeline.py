@@ -151,3 +151,19 @@ def test_the_estimators_the_pipeline_feeds_unfitted_hold_the_rows_its_estimate_f
     assert not np.array_equal(by_seed, other)
     with pytest.raises(TypeError, match="rng .* or rngs .*, not both"):
         fed.fit(box, given, rng=(7, 2), budget=budget, keys=("abc",), workers=1)
+
+
+def test_the_cross_validations_say_their_share_done_as_they_go(slow_quiet_log):
+    """Issue "Fast where users wait", item 3: the cutoffs' and the friction models' cross-validations report how much
+    is done (a terminal's bar and time left come from it), rising to the whole, not only that they started."""
+    from dynid.identification.pipeline import IdentificationPipeline
+
+    config = slow_quiet_log
+    calls = []
+    pipeline = IdentificationPipeline(config.robot, estimators=("ols",), friction="auto")
+    pipeline.prepare(load_recording(config.identification, config.robot),
+                     step=lambda label, done=0, total=1: calls.append((label, done, total)))
+    for step in ("preprocessing (cross-validation of the cutoffs)", "friction model of each joint (cross-validation)"):
+        shares = [done / total for label, done, total in calls if label == step]
+        assert shares[0] == 0 and shares[-1] == 1.0 and len(shares) >= 3, (step, shares)
+        assert all(b >= a for a, b in zip(shares, shares[1:])), (step, shares)

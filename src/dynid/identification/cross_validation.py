@@ -15,6 +15,7 @@ cannot look better by filtering its own test samples more.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -223,8 +224,8 @@ def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: 
     return accs, np.sqrt(sumsq / max(count, 1))
 
 
-def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS
-                         ) -> PreprocessingChoice:
+def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS,
+                         progress: Callable[[int, int], None] | None = None) -> PreprocessingChoice:
     """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation, when
     there is a choice to make.
 
@@ -244,12 +245,16 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     given : Preprocessing
         The config's settings (``None`` fields are chosen).
     folds : int
+    progress : callable, optional
+        ``progress(done, total)`` in preparations of the log: the reference, each candidate, and on a long log the
+        chosen one's of the whole log.
 
     Returns
     -------
     PreprocessingChoice
         With one candidate (the default rule's) when there was nothing to choose.
     """
+    said = progress if progress is not None else (lambda done, total: None)
     reference = prepare(recording, given)
     rs = reference.settings
     band, knee = rs.band, rs.knee
@@ -261,6 +266,8 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     if recording is not full:
         reference = prepare(recording, replace(given, band=band))
     cutoffs = (default, float(np.sqrt(default * knee)), knee)
+    steps = 1 + len(cutoffs) + (recording is not full)
+    said(1, steps)
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
     prior = base.base_from_standard(robot.standard_parameters())  # as the estimate: undetermined directions kept there
@@ -283,6 +290,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
             errors.append(np.full(robot.n_dof, np.inf))
         candidates.append(data.settings)
         prepared.append(data)
+        said(1 + len(prepared), steps)
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
     scored = bool(np.all(np.isfinite(score)))
@@ -300,5 +308,6 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
         chosen = candidates[best]
         data = prepare(full, replace(given, band=band, position_cutoff=chosen.position_cutoff,
                                      parallel_cutoff=chosen.parallel_cutoff))
+        said(steps, steps)
     data = replace(data, settings=replace(data.settings, derivation=f"{data.settings.derivation}; {note}"))
     return PreprocessingChoice(data.settings, tuple(candidates), error, score, note, data)

@@ -32,6 +32,7 @@ estimation's rows), so each candidate costs one small solve per block, not a pas
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -177,7 +178,8 @@ class FrictionChoice:
                 "load_candidate": None if self.load_candidate is None else self.load_candidate.tolist()}
 
 
-def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> FrictionChoice:
+def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS,
+                    progress: Callable[[int, int], None] | None = None) -> FrictionChoice:
     """Choose each joint's friction model by blocked cross-validation (module docstring).
 
     Parameters
@@ -189,13 +191,15 @@ def choose_friction(robot: Robot, data: PreparedData, folds: int = FOLDS) -> Fri
         The identification log after :func:`dynid.preprocessing.prepare`.
     folds : int
         Contiguous blocks (at least 2).
+    progress : callable, optional
+        ``progress(done, total)`` in samples of the log's one pass (most of the time the choice takes).
 
     Returns
     -------
     FrictionChoice
     """
     cv = _CrossValidation(robot, data, folds)
-    cv.accumulate()
+    cv.accumulate(progress)
     n = robot.n_dof
     # Stage 1: the state at rest, with the plain model; stage 2: the family, with each joint's state at rest.
     # Each candidate is first tried on all joints at once (a table of how each fares), then each joint's choice is
@@ -303,14 +307,17 @@ class _CrossValidation:
                     self.slow[i, f, j] += rows.T @ rows
             self.n_rows[f] += sel.sum()
 
-    def accumulate(self) -> None:
+    def accumulate(self, progress: Callable[[int, int], None] | None = None) -> None:
         """The one pass over the log (or a segment of each block of a long one), parallel-filtered and decimated as
-        the estimation's; then what the choice needs to know of the log (rests, load, reversals)."""
+        the estimation's; then what the choice needs to know of the log (rests, load, reversals). ``progress(done,
+        total)`` in samples."""
         data, s, n = self.data, self.data.settings, self.robot.n_dof
         decays = [rest_decay(r, n) for r in REST_GRID]
         cutoff = s.velocity_cutoff or s.position_cutoff or data.rate / 4
         vmin = min_speeds(s, n)
-        for start, stop, fold_of in _segments(data.t.shape[0], self.n_folds):
+        segments = list(_segments(data.t.shape[0], self.n_folds))
+        total, done = sum(stop - start for start, stop, _ in segments), 0
+        for start, stop, fold_of in segments:
             directions = [_directions(data, self.rest_v, d, cutoff, start, stop) for d in decays]  # from its start
 
             def segment_block(a: int, b: int, start: int = start, directions: list = directions):
@@ -320,6 +327,11 @@ class _CrossValidation:
                                                            order=s.order, chunk=s.chunk, cutoff=s.parallel_cutoff or None):
                 idx = idx + start
                 self._add(idx, y, bank, tau, fold_of(idx), vmin)
+                if progress is not None:
+                    progress(done + int(idx[-1]) + 1 - start, total)
+            done += stop - start
+            if progress is not None:
+                progress(done, total)
         if not self.n_rows.any():
             raise IdentifiabilityError(f"{data.name}: no samples left for the friction models' cross-validation")
         self.total = self.fit.sum(axis=0)

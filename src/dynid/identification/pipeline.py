@@ -193,7 +193,7 @@ class IdentificationPipeline:
         return tuple(part.method for part in self.closed_loop_estimators)
 
     def prepare(self, recording, base: BaseParameters | None = None,
-                step: Callable[[str], Any] | None = None) -> PreparedIdentification:
+                step: Callable[..., Any] | None = None) -> PreparedIdentification:
         """Filter a recording and make the choices that depend on it (module docstring, steps 1-3).
 
         Parameters
@@ -204,7 +204,8 @@ class IdentificationPipeline:
         base : BaseParameters, optional
             The description's base-parameter map, when the caller has it already.
         step : callable, optional
-            ``step(label)`` before each step that takes time.
+            ``step(label, done=0, total=1)`` before each step that takes time, and as the cross-validations go
+            (their share done).
 
         Returns
         -------
@@ -222,9 +223,11 @@ class IdentificationPipeline:
             A recording not one row per time stamp and one column per joint, or holding NaN
             (:meth:`dynid.io.datasets.Recording.check`).
         """
-        def say(label: str) -> None:
-            if step is not None:
-                step(label)
+        def say(label: str) -> Callable[[int, int], None] | None:
+            if step is None:
+                return None
+            step(label)
+            return lambda done, total: step(label, done, total)
 
         recording.check(self.robot.n_dof)
         dead, _ = dead_channels(recording.tau, recording.label)
@@ -234,8 +237,8 @@ class IdentificationPipeline:
         settings = self.preprocessing
         base = base if base is not None else base_parameters(self.robot, rng=0)
         auto = settings.auto and strategy_for(settings).chooses_cutoffs
-        say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
-        filters = choose_preprocessing(self.robot, base, recording, settings) if auto else None
+        share = say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
+        filters = choose_preprocessing(self.robot, base, recording, settings, progress=share) if auto else None
         if filters is not None:
             assert filters.data is not None  # the chosen candidate's prepared data
             data = filters.data
@@ -250,8 +253,8 @@ class IdentificationPipeline:
                                else np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,)),
                                filters if filters is not None and filters.chose else None, coulomb)
         if self.friction == "auto":
-            say("friction model of each joint (cross-validation)")
-            friction = choose_friction(choices.model(self.robot), data)
+            share = say("friction model of each joint (cross-validation)")
+            friction = choose_friction(choices.model(self.robot), data, progress=share)
             data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
             data = _fitted_speeds(data, friction, given=self.preprocessing.min_speed != "auto")
             choices = replace(choices, friction=friction)
@@ -398,7 +401,7 @@ class IdentificationPipeline:
         DynIdError
             As :meth:`prepare`, :meth:`estimate` and the validation logs' scoring.
         """
-        step = None if progress is None else (lambda label: progress(label, 0, 1))
+        step = None if progress is None else (lambda label, done=0, total=1: progress(label, done, total))
         validation = tuple(validation)
         prepared = self.prepare(recording, step=step)
         refs = () if references is None else references(prepared.robot, prepared.base)
