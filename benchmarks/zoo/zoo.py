@@ -31,7 +31,10 @@ distance instead of at once) and backlash read by a motor-side encoder (the logg
 lash of 1 mrad, 3.4 arcmin, turned over as the torque through the gear crosses ±2 % of the joint's RMS torque); its
 drifts and torque noise come from a stream of their own, so that the other two classes' logs do not change. Beside the
 truth each is scored against "truth, drive terms from the log": the true links with every joint's drive terms fitted
-on the identification log (what the log can determine; the target is dynid within 1.2× of it).
+on the identification log (what the log can determine; the target is dynid within 1.2× of it). A fourth,
+``cad-inconsistent`` (issue "The better model wins", item 2), is ``cad`` identified with a careless description
+(:func:`inconsistent_urdf`: one link's inertia outside the triangle inequality, another's mass doubled); its target is
+the main estimate beating that file's nominal model on the validation log.
 
 Each is identified by ``dynid identify`` with the defaults (a ``[robot]`` table with drive terms Ia, fc, fv,
 offset; estimators WLS and SDP) and reports: the main estimate's validation error over the true parameters' on the
@@ -78,7 +81,7 @@ ARMS = {
 TRACKED = ("UR5 on a track",)
 """Arms put on a linear track here (:func:`on_a_track`): no public description has one."""
 CLASSES = ("excitation", "short", "ptp", "dead")
-CAD_CLASSES = ("cad", "cad-sensor", "cad-gear")
+CAD_CLASSES = ("cad", "cad-sensor", "cad-gear", "cad-inconsistent")
 """The realistic classes (module docstring), run with the ``sign`` truth alone."""
 TRUTHS = ("frictionloss", "sign")
 RATE = 1000.0
@@ -228,6 +231,31 @@ def cad_urdf(text: str, rng) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def inconsistent_urdf(text: str) -> tuple[str, list[str]]:
+    """The vendor file as a careless CAD export leaves it (``cad-inconsistent``, issue "The better model wins", item 2):
+    the second moving link's inertia outside the triangle inequality (its ``ixx`` 1.2 times ``iyy + izz``, no mass
+    distribution has that) and the third's mass doubled. Returns the text and what was changed, one line each."""
+    root = ET.fromstring(text)
+    links = {link.get("name"): link for link in root.iter("link")}
+    moving = [j.find("child").get("link") for j in root.iter("joint")
+              if j.get("type") in ("revolute", "continuous", "prismatic") and j.find("child") is not None]
+    said = []
+    for k, link in enumerate(links.get(name) for name in moving[1:3]):
+        inertial = None if link is None else link.find("inertial")
+        if inertial is None:
+            continue
+        if k == 0 and inertial.find("inertia") is not None:
+            inertia = inertial.find("inertia")
+            iyy, izz = float(inertia.get("iyy", 0.0)), float(inertia.get("izz", 0.0))
+            inertia.set("ixx", repr(1.2 * (iyy + izz) + 1e-4))
+            said.append(f"{link.get('name')}: ixx {inertia.get('ixx')} > iyy + izz")
+        elif k == 1 and inertial.find("mass") is not None:
+            mass = inertial.find("mass")
+            mass.set("value", repr(2.0 * float(mass.get("value", 0.0))))
+            said.append(f"{link.get('name')}: mass doubled")
+    return ET.tostring(root, encoding="unicode"), said
+
+
 def measured_side(log, drives, sensor: bool) -> np.ndarray:
     """The torque a log holds: the motor side (the simulated command) or, with ``sensor``, a joint torque sensor's
     output side (the command less the rotor's inertia torque and the friction, with the ``sign`` truth's exact dry
@@ -299,6 +327,8 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
     truth_text = cad_urdf(physical, rng)
     (folder / "arm.urdf").write_text(text)  # the vendor file: the description dynid is given
     (folder / "truth.urdf").write_text(truth_text)
+    careless, changed = inconsistent_urdf(text)
+    (folder / "arm_inconsistent.urdf").write_text(careless)
     robot, truth_robot = load_robot(str(folder / "arm.urdf")), load_robot(str(folder / "truth.urdf"))
     n = robot.n_dof
     drives = drives_for(robot, rng)
@@ -332,9 +362,10 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
         extra = (f'[[references]]\nname = "{DRIVE_FITTED}"\nfile = "{stem}_fitted.csv"\nformat = "standard"\n'
                  'header = true\nnames = "name"\nvalues = "value"\n')
         cfg = config(folder, n, f"{stem}_ident.csv", extra, valid=f"{stem}_valid.csv", truth=f"{stem}_truth.csv",
-                     sensor=sensor)
+                     sensor=sensor, urdf="arm_inconsistent.urdf" if kind == "cad-inconsistent" else "arm.urdf")
         rows.append(identify_cell(cfg, folder, kind, {"arm": name, "joints": n, "truth": "sign", "class": kind,
-                                                      "repaired_links": repaired, "simulation_seconds": simulated}))
+                                                      "repaired_links": repaired, "simulation_seconds": simulated,
+                                                      **({"file_changed": changed} if kind == "cad-inconsistent" else {})}))
     return rows
 
 
@@ -387,12 +418,12 @@ CHOICE: list[str] = []
 
 
 def config(folder: Path, n: int, ident: str, extra: str = "", valid: str = "valid.csv", truth: str = "truth.csv",
-           sensor: bool = False) -> Path:
+           sensor: bool = False, urdf: str = "arm.urdf") -> Path:
     cols = lambda a: "[" + ", ".join(str(a + j) for j in range(n)) + "]"  # noqa: E731
     side = ', sensor = "joint"' if sensor else ""
     table = (lambda f: f'file = "{f}"\ntime = {{ column = 1 }}\npositions = {{ columns = {cols(2)} }}\n'
              f'torques = {{ columns = {cols(2 + n)}{side} }}\n')
-    text = (f'data_root = "."\n[robot]\nurdf = "arm.urdf"\ndrive_terms = ["Ia", "fc", "fv", "offset"]\n'
+    text = (f'data_root = "."\n[robot]\nurdf = "{urdf}"\ndrive_terms = ["Ia", "fc", "fv", "offset"]\n'
             f'[identification]\n{table(ident)}[estimation]\nestimators = ["wls", "sdp"]\n'
             + (f'choice = "{CHOICE[0]}"\n' if CHOICE else "") +
             f'[[validation]]\nname = "validation"\n{table(valid)}'
