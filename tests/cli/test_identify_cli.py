@@ -57,7 +57,11 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     ours, theirs = (mujoco.MjModel.from_xml_path(str(f)) for f in (out / "dynid-model.xml", tmp_path / "mine_identified.xml"))
     np.testing.assert_allclose(theirs.dof_damping, ours.dof_damping)
     np.testing.assert_allclose(theirs.body_subtreemass[theirs.jnt_bodyid[0]], ours.body_subtreemass[ours.jnt_bodyid[0]])
-    assert theirs.nmesh == 1 and theirs.nu == 1
+    # the user's actuator kept first, then one of constant bias per torque offset the validation logs chose to hold
+    held = [j for j, f in enumerate(json.loads((out / "results.json").read_text())["diagnostics"]["file_terms"]["offset"]) if f]
+    assert theirs.nmesh == 1 and theirs.nu == 1 + len(held) and ours.nu == len(held)
+    assert theirs.actuator(0).name == "m1" and f"{len(held)} actuator(s) of constant bias added" in " ".join(p.stdout.split())
+    np.testing.assert_allclose(theirs.actuator_biasprm[1:, 0], ours.actuator_biasprm[:, 0])
     # validate the result on another log given on the command line: the truncated-line log
     log = root / "identification_data" / "ur-20_02_19_15harm50secLoad.csv"
     p = dynid("validate", str(REPO / "configs" / "ur10e.toml"), "--results", str(out / "results.json"), "--file", str(log),

@@ -33,7 +33,12 @@ def test_identify_writes_the_values_into_the_users_mjcf_and_export_does_the_same
     assert (out / "arm.xml").is_file() and not (out / "dynid-model.xml").exists()
     written = mujoco.MjModel.from_xml_path(str(out / "arm.xml"))  # the meshes found from the output folder
     users = mujoco.MjModel.from_xml_path(str(tmp_path / "mine" / "arm.xml"))
-    assert written.nmesh == users.nmesh == 1 and written.nu == users.nu == 1 and written.nbody == users.nbody
+    import json
+
+    held = sum(json.loads((out / "results.json").read_text())["diagnostics"]["file_terms"]["offset"])
+    # the user's actuator kept first, one of constant bias after it per torque offset the validation log chose to hold
+    assert written.nmesh == users.nmesh == 1 and written.nu == users.nu + held and written.nbody == users.nbody
+    assert mujoco.mj_id2name(written, mujoco.mjtObj.mjOBJ_ACTUATOR, 0) == mujoco.mj_id2name(users, mujoco.mjtObj.mjOBJ_ACTUATOR, 0)
     assert not np.allclose(written.body_mass, users.body_mass)  # the values are the identified ones
     p = dynid("export", cfg, "--results", out / "results.json", "--mjcf", tmp_path / "exported" / "arm.xml")
     assert p.returncode != 0  # its folder does not exist: refused, as any --mjcf
@@ -42,7 +47,7 @@ def test_identify_writes_the_values_into_the_users_mjcf_and_export_does_the_same
     assert p.returncode == 0, p.stderr
     assert "the MJCF is arm.xml with only its inertials and joint dynamics replaced" in " ".join(p.stdout.split())
     exported = mujoco.MjModel.from_xml_path(str(tmp_path / "exported" / "arm.xml"))
-    for field in ("body_mass", "body_inertia", "body_ipos", "dof_damping", "dof_armature", "dof_frictionloss"):
+    for field in ("body_mass", "body_inertia", "body_ipos", "dof_damping", "dof_armature", "dof_frictionloss", "actuator_biasprm"):
         np.testing.assert_allclose(getattr(exported, field), getattr(written, field), err_msg=field)
 
 

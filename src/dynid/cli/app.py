@@ -398,16 +398,15 @@ def export(
         return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
 
     def compute(prepared, progress):
-        from ..io.export import consistent_estimate, file_parameters
+        from ..io.export import consistent_estimate
 
         cfg, identified, targets = prepared
         moved: list[str] = []
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
         estimate = consistent_estimate(cfg.robot, identified, str(results))
-        estimate = (*estimate, file_parameters(*estimate, identified, str(results))[0])
         log = _replay_log(cfg, identified, estimate[0])
-        checks = {path: _replayed(flag, text, estimate, log) for (flag, path), (_, text) in zip(targets, texts)}
+        checks = {path: _replayed(flag, text, (*estimate, identified), log) for (flag, path), (_, text) in zip(targets, texts)}
         simulated = _simulated(cfg, identified, texts, targets, str(results)) if forward else None
         return cfg, texts, moved, identified, checks, simulated, None if log is None else log[0]
 
@@ -421,7 +420,12 @@ def export(
     def show(rep, computed, paths):
         cfg, _, moved, _, _, simulated, _ = computed
         robot = cfg.robot
-        into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced" for form, name, given in (
+        from ..report.identification_run import file_choice
+
+        held = file_choice(computed[3], "MJCF")["offsets_held"]
+        added = {"URDF": "", "MJCF": f", and {len(held)} actuator(s) of constant bias added after its own for the torque "
+                 "offsets" if held else ""}
+        into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced{added[form]}" for form, name, given in (
             ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
             ("MJCF", getattr(_users_mjcf(cfg), "name", ""), _users_mjcf(cfg) is not None and mjcf is not None)) if given)
         for line in moved:
@@ -435,10 +439,10 @@ def export(
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
                  "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
-        from ..report.identification_run import folded, read_back_entry
+        from ..report.identification_run import file_choice, read_back_entry
         from ..report.summaries import taken_away_lines
 
-        files = [read_back_entry(path.name, form, check, folded(computed[3])) for path, (form, check) in computed[4].items()]
+        files = [read_back_entry(path.name, form, check, file_choice(computed[3], form)) for path, (form, check) in computed[4].items()]
         for line in taken_away_lines({"log": computed[6], "files": files}):
             (rep.warning if line.kind == "warning" else rep.line)(line.text)
         if simulated is not None:
@@ -481,10 +485,13 @@ def _replay_log(cfg, identified: dict, robot):
 
 def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
     """The written file read back by its tool (:mod:`dynid.io.replay`): ``(format, ReplayCheck)``, or the format and
-    why it was not read back. ``estimate``: the robot, dynid's whole model and the parameters the file holds
-    (:func:`dynid.io.export.file_parameters`). On ``log`` (:func:`_replay_log`) where given, else on random states."""
-    robot, whole, held = estimate
+    why it was not read back. ``estimate``: the robot, dynid's whole model and results.json (what the file holds:
+    :func:`dynid.io.export.file_parameters`). On ``log`` (:func:`_replay_log`) where given, else on random states."""
+    from ..io.export import file_parameters
+
+    robot, whole, identified = estimate
     on = {"whole": whole} if log is None else {"states": log[1], "measured": log[2], "whole": whole}
+    held = file_parameters(robot, whole, identified, form="URDF" if flag == "--urdf" else "MJCF")[0]
     if flag == "--urdf":
         from ..io.replay import urdf_replay
 
@@ -543,8 +550,8 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
         from ..io.mjcf_write_back import mjcf_written_back
 
         fitted, phi = consistent_estimate(robot, identified, source)
-        phi, note = file_parameters(fitted, phi, identified, source)
-        text, far = mjcf_written_back(users_mjcf, fitted, phi, out_dir=mjcf.parent if mjcf else None)
+        phi, note = file_parameters(fitted, phi, identified, source, "MJCF")
+        text, far = mjcf_written_back(users_mjcf, fitted, phi, out_dir=mjcf.parent if mjcf else None, offsets_held=True)
     moved.extend(far)
     return with_note(text, note)
 

@@ -19,7 +19,7 @@ from ..preprocessing.strategies import YARDSTICK_FILTERS, carried_over, yardstic
 from ..validation.diagnostics import Finding
 from ..validation.noise_floor import SMOOTH, looks_filtered
 from .estimates import CONSISTENT_NOMINAL_LABEL, DRIVE_ONLY_LABEL, NOMINAL_LABEL, SDP_LABEL
-from .file_friction import file_candidates, file_friction
+from .file_terms import file_candidates, file_terms
 
 __all__ = ["CONSISTENT_NOMINAL_LABEL", "NOMINAL_LABEL", "YARDSTICK", "Evidence", "filtered_finding", "gather_evidence", "moving_logs", "nominal_set",
            "state_evidence", "validate_sets", "weighed_means", "with_yardstick",
@@ -52,10 +52,9 @@ class Evidence:
         (:func:`state_evidence`).
     warnings : tuple of str
         The logs' own and those of a log read otherwise.
-    file_friction : dict or None
-        Which joints the written files hold with their Stribeck and load-dependent Coulomb friction folded into the
-        Coulomb and viscous pair (:func:`dynid.identification.file_friction.file_friction`); None where nothing is to
-        fold.
+    file_terms : dict or None
+        How the written files hold each joint's drive terms: friction folded or not, the MJCF's torque offset held or not
+        (:func:`dynid.identification.file_terms.file_terms`); None where there is no choice or no validation log moves.
     """
 
     nominal: tuple | None
@@ -65,7 +64,7 @@ class Evidence:
     best: tuple[str, ...]
     states: dict | None
     warnings: tuple[str, ...]
-    file_friction: dict | None = None
+    file_terms: dict | None = None
 
 
 def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference: Preprocessing | None = None,
@@ -101,19 +100,18 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
     if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
         sets[DRIVE_ONLY_LABEL] = alt.params
     consistent = next((e.standard for e in result.estimates.values() if e.standard is not None), None)
-    files = {} if consistent is None else file_candidates(robot, base, consistent, prepared.data)
-    folded = files.pop("standard", None)
+    files, folded = ({}, None) if consistent is None else file_candidates(robot, base, consistent, prepared.data)
     scored, warnings = validate_sets(setup, base, {**sets, **files}, validation, progress=progress, resolved=prepared.data.settings,
                                      noise=result.joint_std, covariance={result.label: result.solution.covariance},
                                      fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
                                      geometry=not any(f.kind in ("angles", "gravity") for f in result.findings),
                                      nominal=None if nominal is None else nominal[0])
     file_choice = None
-    if files:  # scored beside, for the files' friction alone (module docstring of file_friction)
+    if files:  # scored beside, for what the files hold alone (dynid.identification.file_terms)
         from ..validation.torques import rests_throughout
 
         moving = tuple(v for v in scored if not v.misread and not rests_throughout(v.rest_share))
-        file_choice = file_friction(robot, folded, moving) if moving else None
+        file_choice = file_terms(robot, folded, list(files), moving) if moving else None
         scored = tuple(v.without(*files) for v in scored)
     validations = scored if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}

@@ -91,8 +91,8 @@ def decide(result, evidence=None):
     if evidence is None:
         return choose_main_estimate(result)
     result = replace(result, validations=evidence.validations, warnings=result.warnings + evidence.warnings)
-    if evidence.file_friction is not None:  # what the written files hold: results.json, for identify's and export's writers
-        result = replace(result, diagnostics={**result.diagnostics, "file_friction": evidence.file_friction})
+    if evidence.file_terms is not None:  # what the written files hold: results.json, for identify's and export's writers
+        result = replace(result, diagnostics={**result.diagnostics, "file_terms": evidence.file_terms})
     # every log that moves (a log at rest throughout scores the distance to the static-friction band, another unit)
     # under every state filter: their mean
     judged = tuple(c for one in evidence.filters for c in moving_logs(one))

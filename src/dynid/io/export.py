@@ -183,7 +183,8 @@ def _world_from_base(gravity: np.ndarray) -> np.ndarray | None:
 
 
 @keyword_only_after_data
-def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *, name: str | None = None) -> str:
+def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *, name: str | None = None,
+                    offsets_held: bool = False) -> str:
     """MuJoCo MJCF text of a robot with given standard parameters.
 
     Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
@@ -205,6 +206,8 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         Standard parameters (the robot's nominal ones by default).
     name : str, optional
         The model's name (the robot's by default).
+    offsets_held : bool
+        Hold the torque offsets as actuators of constant bias (:func:`offset_actuators`) instead of comments.
 
     Returns
     -------
@@ -241,7 +244,7 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                   f'frictionloss="{terms.get("fc", 0.0):.17g}" solreffriction="{friction_solref(0.002)}"/>',
                   f'{indent}  <inertial pos="{_vec(com)}" mass="{max(mass, 0.0):.17g}" fullinertia="{inertia[0, 0]:.17g} '
                   f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>']
-        extra = {k: v for k, v in terms.items() if k not in ("Ia", "fc", "fv") and v != 0}
+        extra = {k: v for k, v in terms.items() if k not in ("Ia", "fc", "fv", *(("offset",) if offsets_held else ())) and v != 0}
         if extra:
             lines.append(f"{indent}  <!-- dynid: terms MJCF cannot hold, add them to the torques: "
                          + ", ".join(f"{k}{j + 1} = {v:.17g}" for k, v in extra.items()) + " -->")
@@ -253,6 +256,9 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     lines.append(f'{tip}<site name="flange" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}"/>')
     lines += closing[::-1]
     lines.append("  </worldbody>")
+    actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
+    if actuators:
+        lines += ["  <actuator>"] + [f"    <general {' '.join(f'{k}={quoteattr(v)}' for k, v in a.items())}/>" for a in actuators] + ["  </actuator>"]
     n_coupled = robot.transmission.n_coupled_params
     if n_coupled:
         lines.append("  <!-- dynid: coupled motors (not representable here), add their torques: "
@@ -381,10 +387,13 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
     return robot, phi
 
 
-def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = "results") -> tuple[np.ndarray, str]:
-    """The standard parameters the written URDF and MJCF hold: ``phi`` with the joints whose friction the validation logs
-    chose folded (results' ``diagnostics.file_friction``, :mod:`dynid.identification.file_friction`) holding the folded
-    Coulomb and viscous pair and no Stribeck or load-dependent Coulomb term.
+def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = "results", form: str = "URDF"
+                    ) -> tuple[np.ndarray, str]:
+    """The standard parameters a written URDF or MJCF holds, as the validation logs chose joint by joint (results'
+    ``diagnostics.file_terms``, :mod:`dynid.identification.file_terms`): the joints whose friction is folded hold the
+    folded Coulomb and viscous pair and no Stribeck or load-dependent Coulomb term; in an MJCF, the torque offsets not
+    held are 0 (those held become actuators' constant bias, :func:`offset_actuators`); a URDF keeps every offset, as
+    its comments say.
 
     Parameters
     ----------
@@ -396,45 +405,97 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
         results.json.
     source : str
         Where the results come from, named in errors.
+    form : {"URDF", "MJCF"}
 
     Returns
     -------
     phi : (n_params,) ndarray
-        What the files hold (``phi`` itself where nothing is folded).
+        What the file holds (``phi`` itself where the results chose nothing).
     note : str
-        What the files' friction holds, for a comment in them ("" where nothing is folded).
+        What differs from dynid's model, for a comment in the file ("" where nothing does).
 
     Raises
     ------
     ConfigError
-        A ``file_friction`` entry that is not one non-negative ``fc`` and ``fv`` and a ``folded`` flag per joint.
+        A ``file_terms`` entry that is not a ``folded`` and an ``offset`` flag per joint, with a non-negative ``fc`` and
+        ``fv`` per joint where a joint is folded.
     """
-    found = (results.get("diagnostics") or {}).get("file_friction")
+    out = np.array(phi, dtype=float)
+    found = (results.get("diagnostics") or {}).get("file_terms")
     if found is None:
-        return np.asarray(phi, dtype=float), ""
+        return out, ""
     n = robot.n_dof
     try:
-        fc, fv = (np.array(found[k], dtype=float) for k in ("fc", "fv"))
         folded = [j for j, f in enumerate(found["folded"]) if f is True]
-        ok = fc.shape == fv.shape == (n,) == (len(found["folded"]),) and np.all(np.isfinite(fc + fv)) and np.all(fc >= 0) and np.all(fv >= 0)
+        held = [j for j, f in enumerate(found["offset"]) if f is True]
+        ok = len(found["folded"]) == len(found["offset"]) == n
+        if folded:
+            fc, fv = (np.array(found[k], dtype=float) for k in ("fc", "fv"))
+            ok = ok and fc.shape == fv.shape == (n,) and bool(np.all(np.isfinite(fc + fv)) and np.all(fc >= 0) and np.all(fv >= 0))
     except (KeyError, TypeError, ValueError):
         ok = False
     if not ok:
-        raise ConfigError(f"{source}: diagnostics.file_friction: expected fc, fv (finite, >= 0) and folded (true or false) "
-                          f"for each of the {n} joints")
-    out = np.array(phi, dtype=float)
+        raise ConfigError(f"{source}: diagnostics.file_terms: expected folded and offset (true or false) for each of "
+                          f"the {n} joints, and fc, fv (finite, >= 0) for each where one is folded")
     names = list(robot.parameter_names)
     for j in folded:
         for term in ("fc", "fv", "fst", "fcl"):
             if f"{term}{j + 1}" in names:
                 out[names.index(f"{term}{j + 1}")] = {"fc": fc[j], "fv": fv[j]}.get(term, 0.0)
-    if not folded:
+    said = []
+    if folded:
+        terms = " and ".join(found.get("terms") or ["Stribeck", "load-dependent Coulomb"])
+        said.append(f"the friction of {_joints(folded)} holds its {terms} terms folded into the Coulomb and viscous "
+                    "pair (the nearest pair on the identification log)")
+    if form == "MJCF":
+        left = [j for j in range(n) if j not in held and f"offset{j + 1}" in names and out[names.index(f"offset{j + 1}")] != 0]
+        for j in left:
+            out[names.index(f"offset{j + 1}")] = 0.0
+        if held:
+            said.append(f"the torque offsets of {_joints(held)} are held by actuators of constant bias "
+                        f"({', '.join(OFFSET_ACTUATOR.format(joint=robot.joints[j].name) for j in held)})")
+        if left:
+            said.append(f"the torque offsets of {_joints(left)} are left out")
+    if not said:
         return out, ""
-    joints = ", ".join(f"J{j + 1}" for j in folded)
-    terms = " and ".join(found.get("terms") or ["Stribeck", "load-dependent Coulomb"])
-    return out, (f"dynid: the friction of {joints} holds its {terms} terms folded into the Coulomb and viscous pair (the "
-                 "nearest pair on the identification log, written where the validation logs say it predicts the joint "
-                 "better); dynid's own values are in results.json")
+    return out, ("dynid: " + "; ".join(said) + ", where the validation logs say that predicts the joint better; "
+                 "dynid's own values are in results.json")
+
+
+def _joints(indices) -> str:
+    return ", ".join(f"J{j + 1}" for j in indices)
+
+
+OFFSET_ACTUATOR = "dynid_offset_{joint}"
+"""The name of the MJCF actuator that holds a joint's torque offset (:func:`offset_actuators`)."""
+
+
+def offset_actuators(robot: Robot, phi: np.ndarray) -> list[dict[str, str]]:
+    """The MJCF actuators that hold the torque offsets of ``phi``: per joint with a non-zero offset, a ``general``
+    actuator of gain 0 and constant bias ``-offset`` (MuJoCo: force = gain·ctrl + bias), so that a torque that includes
+    the offset, as the measured torques do, moves the simulated arm as it moves the real one (issue "Every assurance
+    checked on what the user meets", item 3). Their ``ctrl`` does nothing; :func:`dynid.io.replay.mjcf_replay` and
+    ``mjcf_forward`` subtract their force from the torque the file needs.
+
+    Parameters
+    ----------
+    robot : Robot
+    phi : (n_params,) array
+        Standard parameters.
+
+    Returns
+    -------
+    list of dict
+        Each actuator's attributes, in joint order.
+    """
+    names = list(robot.parameter_names)
+    out = []
+    for j, joint in enumerate(robot.joints):
+        value = float(phi[names.index(f"offset{j + 1}")]) if f"offset{j + 1}" in names else 0.0
+        if value != 0.0:
+            out.append({"name": OFFSET_ACTUATOR.format(joint=joint.name), "joint": joint.name, "gainprm": "0",
+                        "biastype": "affine", "biasprm": f"{-value:.17g} 0 0"})
+    return out
 
 
 def with_note(text: str, note: str) -> str:
@@ -607,8 +668,8 @@ def mjcf_from_results(robot: Robot, results: dict, *, source: str = "results") -
         As :func:`consistent_estimate`.
     """
     fitted, phi = consistent_estimate(robot, results, source)
-    phi, note = file_parameters(fitted, phi, results, source)
-    return with_note(mjcf_from_robot(fitted, phi), note)
+    phi, note = file_parameters(fitted, phi, results, source, "MJCF")
+    return with_note(mjcf_from_robot(fitted, phi, offsets_held=True), note)
 
 
 MOVED_MASS = 0.5

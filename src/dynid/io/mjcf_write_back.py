@@ -31,6 +31,7 @@ from .export import (
     identified_header,
     moved_far,
     mujoco_inertia,
+    offset_actuators,
     position_offset_note,
 )
 
@@ -71,7 +72,8 @@ def _rebased(source_dir: Path, out_dir: Path, value: str | None) -> str:
 
 
 def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: str | Path | None = None,
-                      estimate: str = "the physically consistent estimate") -> tuple[str, list[str]]:
+                      estimate: str = "the physically consistent estimate", *, offsets_held: bool = False
+                      ) -> tuple[str, list[str]]:
     """The user's MJCF with each moving body's ``<inertial>`` and each joint's ``armature``, ``damping`` and
     ``frictionloss`` replaced by the identified values; every other element kept (names, frames, geoms, meshes,
     sites, actuators, sensors, defaults, comments).
@@ -98,6 +100,9 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         Folder the result will be written to (default: the MJCF's own).
     estimate : str
         What the values are, for the header comment.
+    offsets_held : bool
+        Hold the torque offsets as actuators of constant bias (:func:`dynid.io.export.offset_actuators`), added to the
+        model's ``<actuator>`` after its own (their indices in ``ctrl`` unchanged), instead of comments.
 
     Returns
     -------
@@ -157,7 +162,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         dof = int(model.jnt_dofadr[jid])
         if element.get("solreffriction") is None and np.allclose(model.dof_solref[dof], (0.02, 1.0)):  # MuJoCo's default
             element.set("solreffriction", friction_solref(float(model.opt.timestep)))
-        extra = {n: v for n, v in terms.items() if n not in ("Ia", "fc", "fv") and v != 0}
+        extra = {n: v for n, v in terms.items() if n not in ("Ia", "fc", "fv", *(("offset",) if offsets_held else ())) and v != 0}
         if extra:
             body.append(ET.Comment(" dynid: drive terms MJCF cannot hold, add them to the torques: "
                                    + ", ".join(f"{n}{k + 1} = {v:.17g}" for n, v in extra.items()) + " "))
@@ -171,6 +176,13 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
                                               fitted.transmission.coupled_values.ravel())) + " "))
     if note := position_offset_note(robot):
         root.append(ET.Comment(note))
+    actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
+    if actuators:
+        section = root.find("actuator")
+        if section is None:
+            section = ET.SubElement(root, "actuator")
+        for attributes in actuators:
+            ET.SubElement(section, "general", attributes)
     _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
     header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
                                "frictionloss of every joint", estimate, moved, "MJCF")

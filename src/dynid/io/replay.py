@@ -21,7 +21,7 @@ import numpy as np
 from .._util.reprs import short_repr
 from ..dynamics.regressor import regressor
 from ..model.robot import Robot
-from .export import WORLD_JOINT
+from .export import OFFSET_ACTUATOR, WORLD_JOINT
 
 __all__ = ["MJCF_TERMS", "URDF_TERMS", "ForwardCheck", "ReplayCheck", "mjcf_forward", "mjcf_replay", "urdf_replay"]
 
@@ -167,10 +167,25 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
                        model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale, simulator_gap=gap)
 
 
+def _offset_forces(model, robot: Robot, vadr: np.ndarray) -> np.ndarray:
+    """(n_dof,) [N·m]: the constant joint forces of the actuators that hold torque offsets
+    (:func:`dynid.io.export.offset_actuators`, named by :data:`dynid.io.export.OFFSET_ACTUATOR`), 0 where there is none:
+    the torque a joint needs is MuJoCo's inverse dynamics less this force."""
+    import mujoco
+
+    out = np.zeros(robot.n_dof)
+    for j, joint in enumerate(robot.joints):
+        k = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, OFFSET_ACTUATOR.format(joint=joint.name))
+        if k >= 0:
+            out[j] = float(model.actuator_biasprm[k, 0]) * float(model.actuator_gear[k, 0])
+    return out
+
+
 def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
                 measured=None, whole=None) -> ReplayCheck:
     """MuJoCo's torques of a written MJCF against dynid's torques of ``phi``: the links, ``armature`` (rotor inertia),
-    ``damping`` (viscous friction) and ``frictionloss`` (Coulomb friction) (module docstring).
+    ``damping`` (viscous friction), ``frictionloss`` (Coulomb friction) and, where the file has dynid's offset actuators
+    (:func:`dynid.io.export.offset_actuators`), the torque offsets (module docstring).
 
     MuJoCo's inverse dynamics (``mj_inverse``) is evaluated with the dry-friction constraint off, and the file's
     ``frictionloss`` added as ``frictionloss·sign(q̇)``: that checks the value the file holds. How MuJoCo's own
@@ -215,6 +230,7 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     vadr = np.array([int(j.dofadr[0]) for j in joints])
     q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
     dry = model.dof_frictionloss[vadr].copy()
+    bias = _offset_forces(model, robot, vadr)
     tau_file, with_constraint = np.empty(q.shape), np.empty(q.shape)
     for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
         model.opt.disableflags = int(flags)
@@ -222,9 +238,10 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
             data.qpos[:], data.qvel[:], data.qacc[:] = model.qpos0, 0.0, 0.0
             data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
             mujoco.mj_inverse(model, data)
-            out[k] = data.qfrc_inverse[vadr]
+            out[k] = data.qfrc_inverse[vadr] - bias
     tau_file = tau_file + dry * np.sign(dq)
-    check = _compared(tau_file, robot, phi, (q, dq, ddq), MJCF_TERMS, measured, simulated=with_constraint, whole=whole)
+    held = MJCF_TERMS + (("offset",) if np.any(bias) else ())
+    check = _compared(tau_file, robot, phi, (q, dq, ddq), held, measured, simulated=with_constraint, whole=whole)
     sliding = dry * np.sign(dq)
     gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
     return replace(check, frictionloss_gap=gap)
@@ -307,6 +324,7 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # stable where a light wrist meets its frictionloss
     inverse = mujoco.MjData(model)
     dry = model.dof_frictionloss[vadr].copy()
+    bias = _offset_forces(model, robot, vadr)  # the offset actuators act in the simulation: the torque applied is less
 
     def feed_forward(qk, vk, ak):
         model.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
@@ -314,7 +332,7 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
         inverse.qpos[qadr], inverse.qvel[vadr], inverse.qacc[vadr] = qk, vk, ak
         mujoco.mj_inverse(model, inverse)
         model.opt.disableflags = 0
-        return inverse.qfrc_inverse[vadr] + dry * np.sign(vk)
+        return inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias
 
     data.qpos[:] = model.qpos0
     data.qpos[qadr], data.qvel[vadr] = q[0], dq[0]

@@ -147,18 +147,19 @@ def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, m
     sdp = stored_standard(data)
     if robot is None or sdp is None or data["physically_consistent_verdict"].get(sdp[0]) != "yes":
         return []
-    fitted, phi = consistent_estimate(robot, data)
-    phi, note = file_parameters(fitted, phi, data)
+    fitted, whole = consistent_estimate(robot, data)
+    phi, note = file_parameters(fitted, whole, data)
     if urdf is None:
-        model = (out / "dynid-model.urdf", urdf_from_robot(fitted, phi))
+        model = (out / "dynid-model.urdf", with_note(urdf_from_robot(fitted, phi), note))
     else:
-        model = (out / (urdf_name or Path(urdf).name), urdf_written_back(urdf, fitted, phi)[0])
+        model = (out / (urdf_name or Path(urdf).name), with_note(urdf_written_back(urdf, fitted, phi)[0], note))
+    phi, note = file_parameters(fitted, whole, data, form="MJCF")
     if mjcf_model is None:
-        mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi))
+        mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi, offsets_held=True))
     else:
         mjcf = (out / (mjcf_name or Path(mjcf_model).name),
-                mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out)[0])
-    return [(path, with_note(text, note)) for path, text in (model, mjcf)]
+                mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out, offsets_held=True)[0])
+    return [model, (mjcf[0], with_note(mjcf[1], note))]
 
 
 def taken_away(models: list, robot, data: dict, config=None) -> dict:
@@ -188,7 +189,6 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
     from ..identification.run import moving_validation
 
     fitted, whole = consistent_estimate(robot, data)
-    phi = file_parameters(fitted, whole, data)[0]
     log = None
     if config is not None and config.validation:
         try:
@@ -201,33 +201,36 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
                                                            ("MJCF", "MuJoCo", mjcf_replay))):
         check: ReplayCheck | str
         try:
-            check = replay(text, fitted, phi, whole=whole, **on)
+            check = replay(text, fitted, file_parameters(fitted, whole, data, form=form)[0], whole=whole, **on)
         except ImportError:
             check = f"{tool} is not installed (pip install 'dynid[mujoco]')"
         except (ValueError, KeyError) as exc:  # a user's model MuJoCo cannot load from its text alone
             check = f"{tool} could not load it from its text ({str(exc).splitlines()[0]})"
-        files.append(read_back_entry(path.name, form, check, folded(data)))
+        files.append(read_back_entry(path.name, form, check, file_choice(data, form)))
     return {"log": None if log is None else log[0], "files": files}
 
 
-def folded(results: dict) -> list[int]:
-    """The joints whose friction the written files hold folded (results' ``diagnostics.file_friction``).
+def file_choice(results: dict, form: str) -> dict:
+    """What a written file holds otherwise than dynid's model, as the validation logs chose (results'
+    ``diagnostics.file_terms``, :mod:`dynid.identification.file_terms`).
 
     Parameters
     ----------
     results : dict
         results.json.
+    form : {"URDF", "MJCF"}
 
     Returns
     -------
-    list of int
-        Joint numbers, from 1.
+    dict
+        ``friction_folded`` and, for an MJCF, ``offsets_held``: joint numbers, from 1.
     """
-    found = (results.get("diagnostics") or {}).get("file_friction") or {}
-    return [j + 1 for j, f in enumerate(found.get("folded") or []) if f is True]
+    found = (results.get("diagnostics") or {}).get("file_terms") or {}
+    joints = lambda key: [j + 1 for j, f in enumerate(found.get(key) or []) if f is True]  # noqa: E731
+    return {"friction_folded": joints("folded"), **({"offsets_held": joints("offset")} if form == "MJCF" else {})}
 
 
-def read_back_entry(name: str, form: str, check, folded_joints: tuple[int, ...] | list[int] = ()) -> dict:
+def read_back_entry(name: str, form: str, check, chosen: dict | None = None) -> dict:
     """One written file read back by its tool, as results.json's ``files_taken_away`` holds it.
 
     Parameters
@@ -237,8 +240,8 @@ def read_back_entry(name: str, form: str, check, folded_joints: tuple[int, ...] 
     form : {"URDF", "MJCF"}
     check : ReplayCheck or str
         :func:`dynid.io.replay.urdf_replay` or :func:`~dynid.io.replay.mjcf_replay`'s check, or why there is none.
-    folded_joints : list of int
-        The joints (from 1) whose friction the file holds folded (:func:`folded`).
+    chosen : dict, optional
+        What the file holds otherwise than dynid's model (:func:`file_choice`).
 
     Returns
     -------
@@ -250,7 +253,7 @@ def read_back_entry(name: str, form: str, check, folded_joints: tuple[int, ...] 
     return {**entry, "equals_model_to": check.relative_error, "samples": check.n_states,
             "cannot_hold": list(check.missing), "cannot_hold_share": [float(x) for x in check.missing_share],
             "file_vs_measured": check.file_vs_measured, "model_vs_measured": check.model_vs_measured,
-            "simulator_gap": [float(x) for x in check.simulator_gap], "friction_folded": list(folded_joints)}
+            "simulator_gap": [float(x) for x in check.simulator_gap], **(chosen or {})}
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:

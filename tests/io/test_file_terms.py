@@ -1,6 +1,6 @@
-"""The friction the written URDF and MJCF hold: Stribeck and load-dependent Coulomb friction folded into the pair the
-formats hold, joint by joint where the validation logs say so (issue "Every assurance checked on what the user meets",
-item 3)."""
+"""What the written URDF and MJCF hold: Stribeck and load-dependent Coulomb friction folded into the pair the formats
+hold, torque offsets as an MJCF actuator's constant bias, joint by joint where the validation logs say so (issue "Every
+assurance checked on what the user meets", item 3)."""
 
 import json
 from pathlib import Path
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
-from dynid.identification.file_friction import FILE_AS_IDENTIFIED, FILE_FOLDED, file_friction, folded_parameters
+from dynid.identification.file_terms import file_terms, folded_parameters, variant_label
 from dynid.model.friction_model import JointFriction, robot_with
 
 from ..cli.refusals import assert_refused, dynid
@@ -71,20 +71,23 @@ def test_the_fold_is_the_nearest_non_negative_pair_to_the_joints_whole_friction(
     assert np.any(folded[[names.index(f"fc{j + 1}") for j in range(robot.n_dof)]] == 0.0)  # a bound was met
 
 
-def test_a_joint_is_folded_only_where_the_validation_logs_say_it_predicts_better():
+def test_each_joint_is_written_as_the_variant_the_validation_logs_say_predicts_it_best():
     robot = _robot("load")
+    labels = [variant_label(f, o) for f in (False, True) for o in (False, True)]
 
-    def log(name, now, fold):
-        metrics = {FILE_AS_IDENTIFIED: {"relative_error": now}, FILE_FOLDED: {"relative_error": fold}}
+    def log(name, *errors):
+        metrics = {k: {"relative_error": e} for k, e in zip(labels, errors)}
         return SimpleNamespace(name=name, metrics=lambda: metrics)
 
     phi = robot.standard_parameters()
-    # joint 1 better folded on both logs, joint 2 worse on average, joint 3 the same: written as identified
-    one = log("a", [10.0, 5.0, 4.0, 1, 1, 1], [8.0, 4.0, 4.0, 1, 1, 1])
-    two = log("b", [10.0, 5.0, 4.0, 1, 1, 1], [9.0, 7.0, 4.0, 1, 1, 1])
-    chosen = file_friction(robot, phi, (one, two))
-    assert chosen["folded"] == [True, False, False, False, False, False]
-    assert chosen["error_folded"][1] == pytest.approx(5.5) and chosen["logs"] == ["a", "b"]
+    # per joint (columns): J1 folded with its offset, J2 folded alone, J3 its offset alone, J4 a tie (as identified),
+    # J5 folded better on one log and worse on average
+    one = log("a", [9, 9, 9, 1, 5, 1], [8, 9, 7, 1, 5, 1], [7, 4, 9, 1, 3, 1], [6, 5, 8, 1, 3, 1])
+    two = log("b", [9, 9, 9, 1, 5, 1], [8, 9, 7, 1, 5, 1], [7, 4, 9, 1, 9, 1], [6, 5, 8, 1, 9, 1])
+    chosen = file_terms(robot, phi, labels, (one, two))
+    assert chosen["folded"] == [True, True, False, False, False, False]
+    assert chosen["offset"] == [True, False, True, False, False, False]
+    assert chosen["errors"][labels[3]][4] == pytest.approx(6.0) and chosen["logs"] == ["a", "b"]
 
 
 @pytest.fixture(scope="module")
@@ -103,7 +106,7 @@ def _frictionloss(path):
     return model.dof_frictionloss.copy(), model.dof_damping.copy()
 
 
-def test_the_real_ur10es_files_hold_the_folded_friction_and_predict_its_validation_log_better(ur10e, tmp_path):
+def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_log_better(ur10e, tmp_path):
     from dynid import load_identification_config
     from dynid.identification.run import moving_validation
     from dynid.io.export import consistent_estimate, mjcf_from_robot
@@ -111,9 +114,12 @@ def test_the_real_ur10es_files_hold_the_folded_friction_and_predict_its_validati
 
     root, out, p = ur10e
     res = json.loads((out / "results.json").read_text())
-    chosen = res["diagnostics"]["file_friction"]
+    chosen = res["diagnostics"]["file_terms"]
     folded = [j for j, f in enumerate(chosen["folded"]) if f]
-    assert folded and all(chosen["error_folded"][j] < chosen["error_as_identified"][j] for j in folded)
+    held = [j for j, f in enumerate(chosen["offset"]) if f]
+    plain = chosen["errors"][variant_label(False, False)]
+    best = [chosen["errors"][variant_label(j in folded, j in held)][j] for j in range(6)]
+    assert folded and held and all(b < p for b, p, j in zip(best, plain, range(6)) if j in folded or j in held)
     # the MJCF holds the folded pair on those joints, the estimate's own elsewhere
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
     robot, phi = consistent_estimate(cfg.robot, res)
@@ -122,15 +128,27 @@ def test_the_real_ur10es_files_hold_the_folded_friction_and_predict_its_validati
     for j in range(robot.n_dof):
         fc, fv = (chosen["fc"][j], chosen["fv"][j]) if j in folded else (phi[names.index(f"fc{j + 1}")], phi[names.index(f"fv{j + 1}")])
         assert loss[j] == pytest.approx(fc, rel=1e-12) and damping[j] == pytest.approx(fv, rel=1e-12)
+    # the offsets held: one actuator each, of constant force -offset whatever its ctrl (MuJoCo's own forward dynamics)
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(out / "dynid-model.xml"))
+    assert model.nu == len(held)
+    data = mujoco.MjData(model)
+    data.ctrl[:] = 5.0
+    mujoco.mj_forward(model, data)
+    expected = np.zeros(6)
+    expected[held] = [-phi[names.index(f"offset{j + 1}")] for j in held]
+    np.testing.assert_allclose(data.qfrc_actuator, expected, rtol=1e-12, atol=1e-12)
     # MuJoCo's own torques of the written file against the log's measured ones: better than the file as identified
     name, (t, q, dq, ddq, tau) = moving_validation(cfg, res, robot)
     written = mjcf_replay((out / "dynid-model.xml").read_text(), robot, phi, states=(q, dq, ddq), measured=tau)
     as_identified = mjcf_replay(mjcf_from_robot(robot, phi), robot, phi, states=(q, dq, ddq), measured=tau)
     assert written.file_vs_measured < 0.8 * as_identified.file_vs_measured
     assert f"the friction of {', '.join(f'J{j + 1}' for j in folded)} holds" in p.stderr + p.stdout
+    assert f"the torque offsets of {', '.join(f'J{j + 1}' for j in held)} are held" in p.stderr + p.stdout
     # export writes the same files; with the choice withdrawn it writes the pair as identified and says nothing of it
     for j in range(robot.n_dof):
-        chosen["folded"][j] = False
+        chosen["folded"][j] = chosen["offset"][j] = False
     (tmp_path / "results.json").write_text(json.dumps(res))
     e = dynid("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(tmp_path / "results.json"), "--mjcf",
               str(tmp_path / "m.xml"), "--data-root", str(root))
@@ -138,14 +156,16 @@ def test_the_real_ur10es_files_hold_the_folded_friction_and_predict_its_validati
     assert "holds its Stribeck" not in e.stdout + e.stderr and "folded" not in (tmp_path / "m.xml").read_text()
     loss, _ = _frictionloss(tmp_path / "m.xml")
     np.testing.assert_allclose(loss, [phi[names.index(f"fc{j + 1}")] for j in range(robot.n_dof)], rtol=1e-12)
+    assert mujoco.MjModel.from_xml_path(str(tmp_path / "m.xml")).nu == 0
+    assert "the torque offsets of J1, J2, J3, J4, J5, J6 are left out" in (tmp_path / "m.xml").read_text()
 
 
 def test_a_results_files_friction_that_is_no_pair_per_joint_is_refused_in_one_line(ur10e, tmp_path):
     root, out, _ = ur10e
     res = json.loads((out / "results.json").read_text())
-    res["diagnostics"]["file_friction"]["fc"][0] = -1.0
+    res["diagnostics"]["file_terms"]["fc"][0] = -1.0
     (tmp_path / "results.json").write_text(json.dumps(res))
     p = dynid("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(tmp_path / "results.json"), "--mjcf",
               str(tmp_path / "m.xml"), "--data-root", str(root))
-    assert_refused(p, "diagnostics.file_friction")
+    assert_refused(p, "diagnostics.file_terms")
     assert not (tmp_path / "m.xml").exists()
