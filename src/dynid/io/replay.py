@@ -322,16 +322,18 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     step = float(np.median(np.diff(t))) / substeps
     model.opt.timestep = step
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # stable where a light wrist meets its frictionloss
-    inverse = mujoco.MjData(model)
+    frictionless = mujoco.MjModel.from_xml_string(text)  # the file's inverse dynamics, its dry friction as sign(q̇)
+    frictionless.opt.timestep, frictionless.opt.integrator = model.opt.timestep, model.opt.integrator
+    frictionless.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
+    inverse = mujoco.MjData(frictionless)
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)  # the offset actuators act in the simulation: the torque applied is less
 
+    inverse.qpos[:], inverse.qvel[:], inverse.qacc[:] = model.qpos0, 0.0, 0.0  # mj_inverse reads them, never writes
+
     def feed_forward(qk, vk, ak):
-        model.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
-        inverse.qpos[:], inverse.qvel[:], inverse.qacc[:] = model.qpos0, 0.0, 0.0
         inverse.qpos[qadr], inverse.qvel[vadr], inverse.qacc[vadr] = qk, vk, ak
-        mujoco.mj_inverse(model, inverse)
-        model.opt.disableflags = 0
+        mujoco.mj_inverse(frictionless, inverse)
         return inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias
 
     data.qpos[:] = model.qpos0
@@ -345,9 +347,11 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     kp, kd = inertia * (2 * np.pi * bandwidth) ** 2, 2 * 0.9 * inertia * 2 * np.pi * bandwidth
     applied = np.empty_like(tau)
     worst = np.zeros(robot.n_dof)
+    weights = _hermite_weights(substeps)
     for k in range(t.size):
+        references = _between(t, q, dq, ddq, k, weights if k < t.size - 1 else weights[:, :1])
         for s in range(substeps if k < t.size - 1 else 1):
-            ref = _between(t, q, dq, ddq, k, s / substeps)
+            ref = [x[s] for x in references]
             u = feed_forward(*ref) + kp * (ref[0] - data.qpos[qadr]) + kd * (ref[1] - data.qvel[vadr])
             if s == 0:
                 applied[k] = u
@@ -360,13 +364,24 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     return ForwardCheck(rel(applied, tau), rel(modelled, tau), rel(applied, modelled), worst, int(t.size))
 
 
-def _between(t, q, dq, ddq, k: int, w: float) -> list:
-    """The reference a fraction ``w`` of the way from sample ``k`` to the next: positions and velocities from the
-    cubic Hermite of the two samples' positions and velocities, accelerations linear."""
+def _hermite_weights(substeps: int) -> np.ndarray:
+    """(9, substeps, 1): for each fraction ``w = s / substeps`` of a sample interval, the cubic Hermite basis of the
+    positions, its derivative's, and ``w`` itself (Python floats, as :func:`_between` weighed one fraction at a time)."""
+    rows = []
+    for s in range(substeps):
+        w = s / substeps
+        rows.append((2 * w**3 - 3 * w**2 + 1, w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2, w**3 - w**2,
+                     6 * w**2 - 6 * w, 3 * w**2 - 4 * w + 1, -6 * w**2 + 6 * w, 3 * w**2 - 2 * w, w))
+    return np.array(rows, dtype=float).T[:, :, None]
+
+
+def _between(t, q, dq, ddq, k: int, weights: np.ndarray) -> list:
+    """The references at the fractions of :func:`_hermite_weights` of the way from sample ``k`` to the next: positions
+    and velocities from the cubic Hermite of the two samples' positions and velocities, accelerations linear; each
+    (substeps, n_dof)."""
     nxt = min(k + 1, t.size - 1)
     h = t[nxt] - t[k]
-    h00, h10, h01, h11 = 2 * w**3 - 3 * w**2 + 1, w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2, w**3 - w**2
-    d00, d10, d01, d11 = 6 * w**2 - 6 * w, 3 * w**2 - 4 * w + 1, -6 * w**2 + 6 * w, 3 * w**2 - 2 * w
+    h00, h10, h01, h11, d00, d10, d01, d11, w = weights
     position = h00 * q[k] + h10 * h * dq[k] + h01 * q[nxt] + h11 * h * dq[nxt]
-    velocity = (d00 * q[k] + d01 * q[nxt]) / h + d10 * dq[k] + d11 * dq[nxt] if h > 0 else dq[k]
+    velocity = (d00 * q[k] + d01 * q[nxt]) / h + d10 * dq[k] + d11 * dq[nxt] if h > 0 else np.broadcast_to(dq[k], position.shape)
     return [position, velocity, (1 - w) * ddq[k] + w * ddq[nxt]]
