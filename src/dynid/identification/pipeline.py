@@ -192,8 +192,8 @@ class IdentificationPipeline:
         """
         return tuple(part.method for part in self.closed_loop_estimators)
 
-    def prepare(self, recording, base: BaseParameters | None = None,
-                step: Callable[..., Any] | None = None) -> PreparedIdentification:
+    def prepare(self, recording, base: BaseParameters | None = None, step: Callable[[str], Any] | None = None,
+                progress: Callable[[str, int, int], Any] | None = None) -> PreparedIdentification:
         """Filter a recording and make the choices that depend on it (module docstring, steps 1-3).
 
         Parameters
@@ -204,8 +204,10 @@ class IdentificationPipeline:
         base : BaseParameters, optional
             The description's base-parameter map, when the caller has it already.
         step : callable, optional
-            ``step(label, done=0, total=1)`` before each step that takes time, and as the cross-validations go
-            (their share done).
+            ``step(label)`` before each step that takes time.
+        progress : callable, optional
+            ``progress(label, done, total)``: each step as it starts (``0, 1``), and the cross-validations' share done
+            as they go.
 
         Returns
         -------
@@ -224,10 +226,12 @@ class IdentificationPipeline:
             (:meth:`dynid.io.datasets.Recording.check`).
         """
         def say(label: str) -> Callable[[int, int], None] | None:
-            if step is None:
+            if step is not None:
+                step(label)
+            if progress is None:
                 return None
-            step(label)
-            return lambda done, total: step(label, done, total)
+            progress(label, 0, 1)
+            return lambda done, total: progress(label, done, total)
 
         recording.check(self.robot.n_dof)
         dead, _ = dead_channels(recording.tau, recording.label)
@@ -401,9 +405,9 @@ class IdentificationPipeline:
         DynIdError
             As :meth:`prepare`, :meth:`estimate` and the validation logs' scoring.
         """
-        step = None if progress is None else (lambda label, done=0, total=1: progress(label, done, total))
+        step = None if progress is None else (lambda label: progress(label, 0, 1))
         validation = tuple(validation)
-        prepared = self.prepare(recording, step=step)
+        prepared = self.prepare(recording, progress=progress)
         refs = () if references is None else references(prepared.robot, prepared.base)
         reference = yardstick_reference(recording) if validation else None
         smooth = filtered_finding([recording.name, *(log.name for log in validation)], [recording, *validation])
