@@ -77,6 +77,7 @@ ARMS = {
     "TIAGo torso + arm": ("tiago_description/robots/tiago_no_hand.urdf", r"^(torso_lift_joint|arm_[1-7]_joint)$"),
     "UR5 on a track": ("ur_description/urdf/ur5_robot.urdf",
                        r"^(track_joint|shoulder_pan|shoulder_lift|elbow|wrist_1|wrist_2|wrist_3)(_joint)?$"),
+    "SCARA": ("", r"^j[1-4]$"),
 }
 TRACKED = ("UR5 on a track",)
 """Arms put on a linear track here (:func:`on_a_track`): no public description has one."""
@@ -124,10 +125,36 @@ def on_a_track(text: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def scara_urdf() -> str:
+    """A SCARA (issue "Every arm a user has", item 4): two revolute axes about the vertical (arms of 0.325 and 0.275 m),
+    a quill sliding 0.2 m down and a turning tool; each link a solid box of its size and mass (6, 4, 1 and 0.3 kg), so
+    its inertia is a real one. example-robot-data has no SCARA, and no public SCARA description was found: this is an
+    arm of a common small SCARA's proportions, not a vendor's."""
+    def link(name, mass, size, com):
+        a, b, c = size
+        ixx, iyy, izz = (mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12, mass * (a * a + b * b) / 12)
+        return (f'<link name="{name}"><inertial><origin xyz="{com}" rpy="0 0 0"/><mass value="{mass}"/><inertia '
+                f'ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/></inertial></link>')
+
+    def joint(name, kind, parent, child, xyz, axis, lower, upper, velocity):
+        return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><origin xyz="{xyz}" '
+                f'rpy="0 0 0"/><axis xyz="{axis}"/><limit lower="{lower}" upper="{upper}" effort="400" '
+                f'velocity="{velocity}"/></joint>')
+
+    return ('<robot name="scara"><link name="base"/>'
+            + link("arm1", 6.0, (0.42, 0.12, 0.1), "0.16 0 0.05") + link("arm2", 4.0, (0.36, 0.1, 0.15), "0.14 0 0.02")
+            + link("quill", 1.0, (0.03, 0.03, 0.35), "0 0 -0.1") + link("tool", 0.3, (0.06, 0.06, 0.05), "0 0.01 -0.02")
+            + joint("j1", "revolute", "base", "arm1", "0 0 0.4", "0 0 1", -2.6, 2.6, 7.0)
+            + joint("j2", "revolute", "arm1", "arm2", "0.325 0 0", "0 0 1", -2.5, 2.5, 7.0)
+            + joint("j3", "prismatic", "arm2", "quill", "0.275 0 0", "0 0 -1", 0.0, 0.2, 1.0)
+            + joint("j4", "revolute", "quill", "tool", "0 0 -0.25", "0 0 1", -3.14, 3.14, 12.0) + "</robot>")
+
+
 def arm_text(name: str) -> str:
-    """The arm's URDF as :data:`ARMS` names it (on a track for :data:`TRACKED`), its other joints fixed."""
+    """The arm's URDF as :data:`ARMS` names it (on a track for :data:`TRACKED`; :func:`scara_urdf` for the SCARA), its
+    other joints fixed."""
     file, keep = ARMS[name]
-    text = (robots_folder() / file).read_text(encoding="utf-8")
+    text = scara_urdf() if name == "SCARA" else (robots_folder() / file).read_text(encoding="utf-8")
     return arm_urdf(on_a_track(text) if name in TRACKED else text, keep)
 
 
