@@ -982,8 +982,9 @@ def test_init_takes_a_headerless_log_without_time_stamps_at_its_rate_and_says_an
 
 def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_as_chosen(tmp_path, monkeypatch):
     """init's check of the log against the description fitted the whole of an hour-long log (init took 48 s): it fits
-    the first CHECKED_SECONDS of a log (here made 4 s of a 30 s log, whose torques run against the description), finds
-    the flipped sign there as on the whole log, and reads a stretch the config chose (rows) as chosen."""
+    the first CHECKED_SECONDS of a log (here made 4 s of a 30 s log, whose torques run against the description), reading
+    only the rows that hold them, finds the flipped sign there as on the whole log, and reads a stretch the config
+    chose (rows) as chosen."""
     import dynid.identification.starter_check as check
     from dynid.io import datasets
 
@@ -1005,7 +1006,9 @@ def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_a
     monkeypatch.setattr(check, "CHECKED_SECONDS", 4.0)
     config_text = (tmp_path / "whole.toml").read_text().replace(", sign = -1", "")
     checked, notes = check.checked_against_description(config_text, tmp_path / "whole.toml")
-    assert seen[0][0] == (0.0, 4.0) and seen[0][2] <= 4.0
+    stretch = next(s for s in seen if s[0] is not None)  # after the first rows, which tell the sample step
+    assert stretch[0] == (0.0, 4.0) and stretch[2] <= 4.0
+    assert stretch[1] is not None and stretch[1][1] < len(text) / 2  # its rows alone are read, not the rest of the log
     assert "sign = -1" in checked and "sign = -1" in (tmp_path / "whole.toml").read_text()
     seen.clear()
     chosen = config_text.replace("[identification]\n", "[identification]\nrows = [1, 2000]\n", 1)
