@@ -1004,16 +1004,28 @@ def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_a
 
     monkeypatch.setattr(check, "load_recording", spy)
     monkeypatch.setattr(check, "CHECKED_SECONDS", 4.0)
+    monkeypatch.setattr(check, "SEARCHED_SECONDS", 8.0)
     config_text = (tmp_path / "whole.toml").read_text().replace(", sign = -1", "")
     checked, notes = check.checked_against_description(config_text, tmp_path / "whole.toml")
     stretch = next(s for s in seen if s[0] is not None)  # after the first rows, which tell the sample step
-    assert stretch[0] == (0.0, 4.0) and stretch[2] <= 4.0
+    assert stretch[0] == (0.0, 8.0) and stretch[2] <= 8.0
     assert stretch[1] is not None and stretch[1][1] < len(text) / 2  # its rows alone are read, not the rest of the log
     assert "sign = -1" in checked and "sign = -1" in (tmp_path / "whole.toml").read_text()
     seen.clear()
     chosen = config_text.replace("[identification]\n", "[identification]\nrows = [1, 2000]\n", 1)
     check.checked_against_description(chosen, tmp_path / "whole.toml")
     assert seen[0][:2] == (None, (1, 2000))
+    # a log that starts at rest for longer than the stretch: the stretch starts where it moves, and finds the sign
+    resting = tmp_path / "resting.csv"
+    rows = text[1:]
+    first = rows[0].split(",")
+    still = [",".join([f"{0.004 * k:.6g}"] + first[1:7] + [str(-float(x)) for x in first[7:]]) for k in range(2500)]
+    moving = [",".join([f"{10.0 + float(f[0]):.6g}"] + f[1:7] + [str(-float(x)) for x in f[7:]])
+              for f in (line.split(",") for line in rows)]
+    resting.write_text("\n".join([text[0]] + still + moving) + "\n")
+    monkeypatch.setattr(check, "SEARCHED_SECONDS", 20.0)  # 10 s at rest, then the motion
+    checked, _ = check.checked_against_description(config_text.replace("flipped.csv", "resting.csv"), tmp_path / "whole.toml")
+    assert "sign = -1" in checked
     tiny = tmp_path / "tiny.csv"  # too short for a stretch of it: read whole, not refused for a time_range never given
     tiny.write_text("\n".join(text[:31]) + "\n")
     _, notes = check.checked_against_description(config_text.replace("flipped.csv", "tiny.csv"), tmp_path / "whole.toml")
@@ -1047,3 +1059,24 @@ def test_init_tells_the_velocities_from_the_torques_in_a_headerless_log(tmp_path
     p = run("init", "ur10e.urdf", "placed.csv", "--out", "placed.toml")
     assert p.returncode == 0, p.stderr
     assert tomllib.loads((tmp_path / "try" / "placed.toml").read_text())["identification"].get("preset") == "ur-rtde-19"
+
+
+def test_inits_check_starts_its_stretch_where_a_long_log_first_moves(monkeypatch):
+    """A long log that starts at rest is checked on its motion: the stretch begins a second before a joint first moves
+    (it began at the log's first sample, 120 s of rest checked nothing); a log no longer than the stretch is kept whole,
+    and a stretch never runs past the log's end."""
+    import dynid.identification.starter_check as check
+    from dynid.io.datasets import Recording
+
+    monkeypatch.setattr(check, "CHECKED_SECONDS", 4.0)
+    t = np.arange(0.0, 20.0, 0.01)
+    q = np.zeros((t.size, 2))
+    q[t >= 10.0, 1] = np.sin(t[t >= 10.0] - 10.0)  # at rest for 10 s, then joint 2 moves
+    rec = Recording("log", t, q, None, np.ones((t.size, 2)), 100.0)
+    cut = check._moving(rec)
+    assert cut.t[0] == pytest.approx(10.01 - 1.0, abs=0.011) and cut.t[-1] - cut.t[0] == pytest.approx(4.0, abs=0.011)
+    assert cut.q.shape == (cut.t.size, 2) and cut.tau.shape == (cut.t.size, 2)
+    late = Recording("log", t, np.where(t[:, None] >= 18.0, 1.0, 0.0) * np.ones((1, 2)), None, np.ones((t.size, 2)), 100.0)
+    assert check._moving(late).t[-1] == t[-1] and check._moving(late).t[0] == pytest.approx(16.0, abs=0.011)
+    short = Recording("log", t[:300], q[:300], None, np.ones((300, 2)), 100.0)
+    assert check._moving(short) is short

@@ -31,10 +31,17 @@ way round)."""
 
 
 CHECKED_SECONDS = 120.0
-"""The stretch of a log the check identifies [s], from its first sample: several periods of any excitation dynid designs
-(10-20 s each), and longer than every real log dynid ships configs for (the LBR Med7's 100 s the longest), which are
-checked whole. On the hour-long log at 1 kHz the whole log made init take 46.8 s, 300 s of it 8.5 s, these 120 s read
-alone 4.8 s (benchmarks/README.md)."""
+"""The stretch of a log the check identifies [s]: several periods of any excitation dynid designs (10-20 s each), and
+longer than every real log dynid ships configs for (the LBR Med7's 100 s the longest), which are checked whole. On the
+hour-long log at 1 kHz the whole log made init take 46.8 s, 300 s of it 8.6 s, these 120 s 4.7 s
+(benchmarks/README.md)."""
+
+SEARCHED_SECONDS = 300.0
+"""The first seconds of a log read for the check [s]: its stretch starts where the arm first moves in them (a second
+before), so that a long log that starts at rest is checked on its motion."""
+
+MOVED = 0.01
+"""[rad, or m for a sliding joint] How far a joint goes from its first position for the log to move."""
 
 
 def _findings(text: str, path: Path) -> tuple[tuple, int]:
@@ -46,6 +53,8 @@ def _findings(text: str, path: Path) -> tuple[tuple, int]:
         recording = load_recording(_stretch(spec, config.robot), config.robot)
     except DataError:
         recording = load_recording(spec, config.robot)
+    if spec.time_range is None and spec.rows is None:
+        recording = _moving(recording)
     fitted = replace(pipeline_of(config), estimators=("wls",)).fit(recording, held_out=False)
     return fitted.findings, config.robot.n_dof
 
@@ -55,7 +64,7 @@ HEAD_ROWS = 2000
 
 
 def _stretch(spec, robot):
-    """``spec``'s first :data:`CHECKED_SECONDS` (``spec`` itself where it selects rows or a time range): its rows up to
+    """``spec``'s first :data:`SEARCHED_SECONDS` (``spec`` itself where it selects rows or a time range): its rows up to
     that time with a tenth to spare, from the step of its first :data:`HEAD_ROWS` rows, then the time range; a log
     too short for those rows raises DataError (read whole by the caller). Before, the check read the whole of an
     hour-long log (709 MB at 1 kHz) and then cut it: 3.0 s of init's 8.5 s."""
@@ -63,8 +72,22 @@ def _stretch(spec, robot):
         return spec
     head = load_recording(replace(spec, rows=(1, HEAD_ROWS)), robot)
     step = float(np.median(np.diff(head.t)))
-    rows = int(np.ceil(1.1 * CHECKED_SECONDS / step)) + 1
-    return replace(spec, rows=(1, rows), time_range=(0.0, CHECKED_SECONDS))
+    rows = int(np.ceil(1.1 * SEARCHED_SECONDS / step)) + 1
+    return replace(spec, rows=(1, rows), time_range=(0.0, SEARCHED_SECONDS))
+
+
+def _moving(recording):
+    """:data:`CHECKED_SECONDS` of ``recording`` from a second before a joint first moves :data:`MOVED` from its first
+    position (the whole of a shorter log, and the stretch ending at its end where the motion starts later)."""
+    t = np.asarray(recording.t, dtype=float)
+    if t[-1] - t[0] <= CHECKED_SECONDS:
+        return recording
+    q = np.asarray(recording.q, dtype=float)
+    moved = np.flatnonzero(np.any(np.abs(q - q[0]) > MOVED, axis=1))
+    start = t[0] if moved.size == 0 else max(t[0], min(t[moved[0]] - 1.0, t[-1] - CHECKED_SECONDS))
+    a, b = int(np.searchsorted(t, start)), int(np.searchsorted(t, start + CHECKED_SECONDS, side="right"))
+    return replace(recording, t=t[a:b], q=q[a:b], tau=recording.tau[a:b],
+                   dq=None if recording.dq is None else recording.dq[a:b])
 
 
 def _with_geometry(text: str, found, n_dof: int) -> tuple[str, str]:
