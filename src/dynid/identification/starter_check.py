@@ -32,9 +32,8 @@ way round)."""
 
 CHECKED_SECONDS = 120.0
 """The stretch of a log the check identifies [s]: several periods of any excitation dynid designs (10-20 s each), and
-longer than every real log dynid ships configs for (the LBR Med7's 100 s the longest), which are checked whole. On the
-hour-long log at 1 kHz the whole log made init take 46.8 s, 300 s of it 8.6 s, these 120 s 4.7 s
-(benchmarks/README.md)."""
+longer than every real log dynid ships configs for, which are checked whole; fitting the whole of an hour-long log
+made init take tens of seconds (the figures: benchmarks/README.md)."""
 
 SEARCHED_SECONDS = 300.0
 """The first seconds of a log read for the check [s]: its stretch starts where the arm first moves in them (a second
@@ -66,8 +65,8 @@ HEAD_ROWS = 2000
 def _stretch(spec, robot):
     """``spec``'s first :data:`SEARCHED_SECONDS` (``spec`` itself where it selects rows or a time range): its rows up to
     that time with a tenth to spare, from the step of its first :data:`HEAD_ROWS` rows, then the time range; a log
-    too short for those rows raises DataError (read whole by the caller). Before, the check read the whole of an
-    hour-long log (709 MB at 1 kHz) and then cut it: 3.0 s of init's 8.5 s."""
+    too short for those rows raises DataError (read whole by the caller), so that a long log's other rows are never
+    read."""
     if spec.time_range is not None or spec.rows is not None:
         return spec
     head = load_recording(replace(spec, rows=(1, HEAD_ROWS)), robot)
