@@ -5,17 +5,16 @@ choice made by the validation logs.
 A URDF's ``<dynamics friction damping>`` and an MJCF's ``frictionloss`` and ``damping`` hold a constant Coulomb and a
 viscous coefficient per joint; dynid's model may also hold Stribeck friction (``fst``) and load-dependent Coulomb friction
 (``fcl``), which no format holds, and a torque offset, which an MJCF can hold as an actuator's constant bias
-(:func:`dynid.io.export.offset_actuators`) and a URDF cannot. Written as identified, the files leave those terms out:
-on the real UR10e's validation log that is 3.4 % of the torque (8.4 % against 5.0 % for dynid's whole model), on the
-LBR Med7's 4.3 % (its joint torque sensors' offsets). Folded into the two coefficients the formats hold (the nearest
-Coulomb and viscous pair, by non-negative least squares, to the joint's whole friction on the identification log's
-motion) and with the offsets held, the files come closer; but a load-dependent term's nearest constant depends on the
-load the motion carries (on the Med7's faster validation run it would make joint 3 worse), and a torque offset is not
-always the validation logs' (the UR10e's J4-J6 predict better without theirs). So each is a candidate, not a rule:
+(:func:`dynid.io.export.offset_actuators`) and a URDF cannot. Written as identified, the files leave those terms out.
+Folded into the two coefficients the formats hold (the nearest Coulomb and viscous pair, by non-negative least
+squares, to the joint's whole friction on the identification log's motion) and with the offsets held, the files come
+closer to the measured torques on some logs; but a load-dependent term's nearest constant depends on the load the
+motion carries, and a torque offset does not predict every log better. So each is a candidate, not a rule:
 the consistent estimate is scored on the validation logs that move as the files would hold it, friction as identified
 or folded, offset left out or held (four sets, each scored as the identification prepared the logs), and each joint is
 written as the set that predicts it best (the first, as identified without the offset, on a tie). Without validation
-logs the files hold the terms as identified and no offset. The figures: the changelog, benchmarks/README.md.
+logs the files hold the terms as identified and no offset. The figures: the changelog, benchmarks/README.md and
+NOTEBOOK.md.
 """
 
 from __future__ import annotations
