@@ -101,18 +101,19 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
         sets[DRIVE_ONLY_LABEL] = alt.params
     consistent = next((e.standard for e in result.estimates.values() if e.standard is not None), None)
     files, folded = ({}, None) if consistent is None else file_candidates(robot, base, consistent, prepared.data)
-    scored, warnings = validate_sets(setup, base, {**sets, **files}, validation, progress=progress, resolved=prepared.data.settings,
+    scored, warnings = validate_sets(setup, base, sets, validation, progress=progress, resolved=prepared.data.settings,
                                      noise=result.joint_std, covariance={result.label: result.solution.covariance},
                                      fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
                                      geometry=not any(f.kind in ("angles", "gravity") for f in result.findings),
-                                     nominal=None if nominal is None else nominal[0])
+                                     nominal=None if nominal is None else nominal[0], beside=files)
     file_choice = None
     if files:  # scored beside, for what the files hold alone (dynid.identification.file_terms)
         from ..validation.torques import rests_throughout
 
-        moving = tuple(v for v in scored if not v.misread and not rests_throughout(v.rest_share))
+        moving = tuple(v for v in scored if not v.misread and not rests_throughout(v.rest_share)
+                       and all(k in v.metrics() for k in files))
         file_choice = file_terms(robot, folded, list(files), moving) if moving else None
-        scored = tuple(v.without(*files) for v in scored)
+        scored = tuple(v.without(*(k for k in files if k in v.metrics())) for v in scored)
     validations = scored if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
     filters = yardstick_scores(setup, base, {**sets, **refits}, validation, resolved=prepared.data.settings,
@@ -142,7 +143,7 @@ def _best(comparisons: tuple, candidates: list) -> str:
 def validate_sets(setup, base, parameter_sets: dict, recordings, *,
                   progress=None, resolved: Preprocessing | None = None, noise=None, covariance=None,
                   fitted: tuple[str, np.ndarray] | None = None,
-                  geometry: bool = True, nominal: str | None = None) -> tuple[tuple, tuple[str, ...]]:
+                  geometry: bool = True, nominal: str | None = None, beside: dict | None = None) -> tuple[tuple, tuple[str, ...]]:
     """Score parameter sets on logs: their predicted torques against the measured ones.
 
     Parameters
@@ -171,6 +172,10 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
         either (its finding's setting is for every dataset, and the logs agree with each other).
     nominal : str, optional
         The description's nominal model among ``parameter_sets``: a log's scale is judged against it too.
+    beside : dict, optional
+        More sets, scored on the logs that move only (every joint at rest in less than
+        :data:`~dynid.validation.torques.AT_REST_SHARE` of the prepared samples; the written files' variants,
+        :mod:`dynid.identification.file_terms`).
 
     Returns
     -------
@@ -191,7 +196,7 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
     from ..preprocessing.pipeline import prepare
     from ..validation.channel_checks import channel_findings
     from ..validation.geometry_checks import geometry_findings
-    from ..validation.torques import compare_torques
+    from ..validation.torques import compare_torques, rests_throughout
 
     out: list = []
     warnings: list[str] = []
@@ -202,7 +207,9 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
         if progress is not None:  # one step per log: filtering and predicting it
             progress(f"validation, {recording.name}", 0, 1)
         data = prepare(recording, settings, strict=False)
-        scored = compare_torques(setup.robot, base, data, parameter_sets,
+        resting = None if data.resting is None else np.mean(np.asarray(data.resting, dtype=float).reshape(len(data.t), -1), axis=0)
+        sets = parameter_sets if not beside or rests_throughout(resting) else {**parameter_sets, **beside}
+        scored = compare_torques(setup.robot, base, data, sets,
                                  progress=None if progress is None else (lambda d, t, s=recording.name: progress(f"validation, {s}", d, t)),
                                  noise=noise, covariance=covariance)
         # a log recorded otherwise than the fitted one: its torque channels, else its geometry
