@@ -146,6 +146,10 @@ def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_l
     assert written.file_vs_measured < 0.8 * as_identified.file_vs_measured
     assert f"the friction of {', '.join(f'J{j + 1}' for j in folded)} holds" in p.stderr + p.stdout
     assert f"the torque offsets of {', '.join(f'J{j + 1}' for j in held)} are held" in p.stderr + p.stdout
+    said = " ".join((p.stderr + p.stdout).split())
+    for line in ("dynid-model.urdf read back by Pinocchio on ptp_10_points", "dynid-model.xml read back by MuJoCo on ptp_10_points"):
+        assert line in said, said  # each file's line names the log it was read back on
+    assert "results.json for the joints whose friction is folded, say how to add them" in said
     # export writes the same files; with the choice withdrawn it writes the pair as identified and says nothing of it
     for j in range(robot.n_dof):
         chosen["folded"][j] = chosen["offset"][j] = False

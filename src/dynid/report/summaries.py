@@ -447,9 +447,10 @@ def taken_away_lines(taken: dict) -> list:
                      f"model {f['model_vs_measured']:.3g} %")
         if f["cannot_hold"]:
             j = max(range(len(f["cannot_hold_share"])), key=lambda k: f["cannot_hold_share"][k])
+            how = ("the file's comments, and results.json for the joints whose friction is folded, say how to add them"
+                   if f.get("friction_folded") else "the file's comments say how to add them")
             said += (f"; it cannot hold {', '.join(stem_words(k) for k in f['cannot_hold'])} (up to "
-                     f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: the file's comments say how to add "
-                     "them)")
+                     f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: {how})")
         chosen = [text for key, text in (("friction_folded", "the friction of {} holds its Stribeck and load-dependent "
                                                                "Coulomb terms folded into its Coulomb and viscous pair"),
                                          ("offsets_held", "the torque offsets of {} are held by actuators of constant "
