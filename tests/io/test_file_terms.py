@@ -150,6 +150,9 @@ def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_l
     for line in ("dynid-model.urdf read back by Pinocchio on ptp_10_points", "dynid-model.xml read back by MuJoCo on ptp_10_points"):
         assert line in said, said  # each file's line names the log it was read back on
     assert "results.json for the joints whose friction is folded, say how to add them" in said
+    report = (out / "report.html").read_text()  # the report's table says it too
+    assert f"friction folded on {', '.join(f'J{j + 1}' for j in folded)}" in report
+    assert f"offsets held on {', '.join(f'J{j + 1}' for j in held)}" in report
     # export writes the same files; with the choice withdrawn it writes the pair as identified and says nothing of it
     for j in range(robot.n_dof):
         chosen["folded"][j] = chosen["offset"][j] = False

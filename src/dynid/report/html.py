@@ -221,13 +221,19 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
 
 def _taken_away_section(taken: dict) -> Section:
     """"The files you take away": the URDF and MJCF written, read back by Pinocchio and MuJoCo."""
+    def chosen(f: dict) -> str:  # what the validation logs chose the file to hold otherwise (dynid.identification.file_terms)
+        said = [f"{what} {', '.join(f'J{j}' for j in f[key])}" for key, what in (
+            ("friction_folded", "friction folded on"), ("offsets_held", "offsets held on")) if f.get(key)]
+        return "; ".join(said) or "—"
+
     rows = [[f["file"], f["read_by"], "—" if "not_read_back" in f else _fmt(f["equals_model_to"], ".1e"),
-             _fmt(f.get("file_vs_measured")), _fmt(f.get("model_vs_measured")), ", ".join(f.get("cannot_hold", [])) or "—"]
-            for f in taken["files"]]
+             _fmt(f.get("file_vs_measured")), _fmt(f.get("model_vs_measured")), ", ".join(f.get("cannot_hold", [])) or "—",
+             chosen(f)] for f in taken["files"]]
     where = f"the validation log {taken['log']}" if taken["log"] else "random states within the joint limits"
     return Section("The files you take away", [Table(
         f"Read back on {where}", ["file", "read by", "equals dynid's model to", "vs unfiltered measured (%)",
-                                  "dynid's whole model vs the same (%)", "what the format cannot hold"], rows)],
+                                  "dynid's whole model vs the same (%)", "what the format cannot hold",
+                                  "chosen by the validation logs"], rows)],
         [f["file"] + ": " + f["not_read_back"] for f in taken["files"] if "not_read_back" in f])
 
 
