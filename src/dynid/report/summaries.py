@@ -454,7 +454,7 @@ def taken_away_lines(taken: dict) -> list:
         chosen = [text for key, text in (("friction_folded", "the friction of {} holds its Stribeck and load-dependent "
                                                                "Coulomb terms folded into its Coulomb and viscous pair"),
                                          ("offsets_held", "the torque offsets of {} are held by actuators of constant "
-                                                          "bias")) if f.get(key)
+                                                          "bias (the others left out)")) if f.get(key)
                   for text in [text.format(", ".join(f"J{j}" for j in f[key]))]]
         if chosen:
             said += f"; {' and '.join(chosen)}, where the validation logs say that predicts the joint better (results.json: diagnostics.file_terms)"
