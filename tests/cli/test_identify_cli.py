@@ -58,7 +58,10 @@ def test_identify_and_validate_ur10e_from_the_readme(tmp_path):
     np.testing.assert_allclose(theirs.dof_damping, ours.dof_damping)
     np.testing.assert_allclose(theirs.body_subtreemass[theirs.jnt_bodyid[0]], ours.body_subtreemass[ours.jnt_bodyid[0]])
     # the user's actuator kept first, then one of constant bias per torque offset the validation logs chose to hold
-    held = [j for j, f in enumerate(json.loads((out / "results.json").read_text())["diagnostics"]["file_terms"]["offset"]) if f]
+    from dynid.io.results import stored_standard
+
+    res = json.loads((out / "results.json").read_text())
+    held = [j for j, f in enumerate(res["diagnostics"]["file_terms"][stored_standard(res)[0]]["offset"]) if f]
     assert theirs.nmesh == 1 and theirs.nu == 1 + len(held) and ours.nu == len(held)
     assert theirs.actuator(0).name == "m1" and f"{len(held)} actuator(s) of constant bias added" in " ".join(p.stdout.split())
     np.testing.assert_allclose(theirs.actuator_biasprm[1:, 0], ours.actuator_biasprm[:, 0])

@@ -114,11 +114,14 @@ def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_l
 
     root, out, p = ur10e
     res = json.loads((out / "results.json").read_text())
-    chosen = res["diagnostics"]["file_terms"]
+    from dynid.io.results import stored_standard
+
+    written = stored_standard(res)[0]  # the estimate the files are written from: its own choice
+    chosen = res["diagnostics"]["file_terms"][written]
     folded = [j for j, f in enumerate(chosen["folded"]) if f]
     held = [j for j, f in enumerate(chosen["offset"]) if f]
-    plain = chosen["errors"][variant_label(False, False)]
-    best = [chosen["errors"][variant_label(j in folded, j in held)][j] for j in range(6)]
+    plain = chosen["errors"][variant_label(False, False, written)]
+    best = [chosen["errors"][variant_label(j in folded, j in held, written)][j] for j in range(6)]
     assert folded and held and all(b < p for b, p, j in zip(best, plain, range(6)) if j in folded or j in held)
     # the MJCF holds the folded pair on those joints, the estimate's own elsewhere
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
@@ -170,9 +173,30 @@ def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_l
 def test_a_results_files_friction_that_is_no_pair_per_joint_is_refused_in_one_line(ur10e, tmp_path):
     root, out, _ = ur10e
     res = json.loads((out / "results.json").read_text())
-    res["diagnostics"]["file_terms"]["fc"][0] = -1.0
+    for entry in res["diagnostics"]["file_terms"].values():
+        entry["fc"][0] = -1.0
     (tmp_path / "results.json").write_text(json.dumps(res))
     p = dynid("export", str(REPO / "configs" / "ur10e.toml"), "--results", str(tmp_path / "results.json"), "--mjcf",
               str(tmp_path / "m.xml"), "--data-root", str(root))
     assert_refused(p, "diagnostics.file_terms")
     assert not (tmp_path / "m.xml").exists()
+
+
+def test_the_files_take_the_choice_made_for_the_estimate_they_are_written_from(ur10e):
+    """Each estimate the files may be written from has its own choice (the physically consistent one, the drive-only
+    candidate): a choice made for another estimate is not applied to this one."""
+    from dynid import load_identification_config
+    from dynid.io.export import consistent_estimate, file_parameters
+    from dynid.io.results import stored_standard
+
+    root, out, _ = ur10e
+    res = json.loads((out / "results.json").read_text())
+    cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
+    robot, phi = consistent_estimate(cfg.robot, res)
+    written = stored_standard(res)[0]
+    held, note = file_parameters(robot, phi, res, form="MJCF")
+    assert not np.array_equal(held, phi) and note  # its own choice applies
+    res["diagnostics"]["file_terms"] = {"another estimate": res["diagnostics"]["file_terms"][written]}
+    other, note = file_parameters(robot, phi, res, form="MJCF")
+    np.testing.assert_array_equal(other, phi)
+    assert note == ""

@@ -53,8 +53,9 @@ class Evidence:
     warnings : tuple of str
         The logs' own and those of a log read otherwise.
     file_terms : dict or None
-        How the written files hold each joint's drive terms: friction folded or not, the MJCF's torque offset held or not
-        (:func:`dynid.identification.file_terms.file_terms`); None where there is no choice or no validation log moves.
+        Per estimate the files may be written from, how they hold each joint's drive terms: friction folded or not, the
+        MJCF's torque offset held or not (:func:`dynid.identification.file_terms.file_terms`); None where there is no
+        choice or no validation log moves.
     """
 
     nominal: tuple | None
@@ -99,8 +100,11 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
     alt = result.drive_only if nominal is not None else None
     if alt is not None:  # a candidate scored in the same pass, kept only where the verdict chooses it
         sets[DRIVE_ONLY_LABEL] = alt.params
-    consistent = next((e.standard for e in result.estimates.values() if e.standard is not None), None)
-    files, folded = ({}, None) if consistent is None else file_candidates(robot, base, consistent, prepared.data)
+    standards = {k: e.standard for k, e in result.estimates.items() if e.standard is not None}
+    if alt is not None and alt.standard is not None:
+        standards[DRIVE_ONLY_LABEL] = alt.standard
+    variants = {k: file_candidates(robot, base, phi, prepared.data, estimate=k) for k, phi in standards.items()}
+    files = {label: beta for found, _ in variants.values() for label, beta in found.items()}
     scored, warnings = validate_sets(setup, base, sets, validation, progress=progress, resolved=prepared.data.settings,
                                      noise=result.joint_std, covariance={result.label: result.solution.covariance},
                                      fitted=(result.label, result.fit.metrics()[result.label]["correlation"]),
@@ -112,7 +116,8 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
 
         moving = tuple(v for v in scored if not v.misread and not rests_throughout(v.rest_share)
                        and all(k in v.metrics() for k in files))
-        file_choice = file_terms(robot, folded, list(files), moving) if moving else None
+        file_choice = {k: file_terms(robot, folded, list(found), moving) for k, (found, folded) in variants.items()
+                       if found} if moving else None
         scored = tuple(v.without(*(k for k in files if k in v.metrics())) for v in scored)
     validations = scored if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}

@@ -10,9 +10,9 @@ Folded into the two coefficients the formats hold (the nearest Coulomb and visco
 squares, to the joint's whole friction on the identification log's motion) and with the offsets held, the files come
 closer to the measured torques on some logs; but a load-dependent term's nearest constant depends on the load the
 motion carries, and a torque offset does not predict every log better. So each is a candidate, not a rule:
-the consistent estimate is scored on the validation logs that move as the files would hold it, friction as identified
-or folded, offset left out or held (four sets, each scored as the identification prepared the logs), and each joint is
-written as the set that predicts it best (the first, as identified without the offset, on a tie). Without validation
+each estimate the files may be written from (the physically consistent one, the drive-only candidate) is scored on the
+validation logs that move as the files would hold it, friction as identified or folded, offset left out or held (four
+sets each, scored as the identification prepared the logs), and each joint is written as the set that predicts it best (the first, as identified without the offset, on a tie). Without validation
 logs the files hold the terms as identified and no offset. The figures: the changelog, benchmarks/README.md and
 NOTEBOOK.md.
 """
@@ -32,8 +32,8 @@ LARGEST_SAMPLES = 20_000
 """The identification log's samples the fold is fitted on, evenly spread (every sample of a shorter log)."""
 
 
-def variant_label(folded: bool, offset: bool) -> str:
-    """The label of the consistent estimate as the files would hold it (scored beside the candidates, never kept).
+def variant_label(folded: bool, offset: bool, estimate: str = "") -> str:
+    """The label of an estimate as the files would hold it (scored beside the candidates, never kept).
 
     Parameters
     ----------
@@ -41,12 +41,15 @@ def variant_label(folded: bool, offset: bool) -> str:
         Its Stribeck and load-dependent Coulomb friction folded into the Coulomb and viscous pair.
     offset : bool
         Its torque offsets held.
+    estimate : str
+        The estimate's label (each estimate the files may be written from has its own variants).
 
     Returns
     -------
     str
     """
-    return f"the files' terms: friction {'folded' if folded else 'as identified'}, offset {'held' if offset else 'left out'}"
+    said = f"the files' terms: friction {'folded' if folded else 'as identified'}, offset {'held' if offset else 'left out'}"
+    return f"{estimate}: {said}" if estimate else said
 
 
 def _index(robot, term: str, j: int) -> int | None:
@@ -100,9 +103,9 @@ def folded_parameters(robot, phi: np.ndarray, q, dq, ddq) -> np.ndarray | None:
     return out
 
 
-def file_candidates(robot, base, phi: np.ndarray, data) -> tuple[dict, np.ndarray | None]:
-    """The physically consistent estimate as the files would hold it, every way (module docstring), as base parameter
-    sets to score on the validation logs.
+def file_candidates(robot, base, phi: np.ndarray, data, estimate: str = "") -> tuple[dict, np.ndarray | None]:
+    """An estimate the files may be written from, as they would hold it, every way (module docstring), as base
+    parameter sets to score on the validation logs.
 
     Parameters
     ----------
@@ -113,11 +116,13 @@ def file_candidates(robot, base, phi: np.ndarray, data) -> tuple[dict, np.ndarra
         The physically consistent estimate's standard parameters.
     data : PreparedData
         The identification log as prepared.
+    estimate : str
+        Its label (:func:`variant_label`).
 
     Returns
     -------
     sets : dict
-        ``{variant_label(folded, offset): beta}``, empty where there is no choice (no Stribeck, load-dependent
+        ``{variant_label(folded, offset, estimate): beta}``, empty where there is no choice (no Stribeck, load-dependent
         Coulomb or offset term).
     folded : (n_params,) ndarray or None
         :func:`folded_parameters` on the identification log's states, None where nothing is folded.
@@ -134,7 +139,7 @@ def file_candidates(robot, base, phi: np.ndarray, data) -> tuple[dict, np.ndarra
     for fold, offset in itertools.product((False, True) if folded is not None else (False,),
                                           (False, True) if np.any(phi[offsets]) else (False,)):
         values = np.where(np.isin(stems, FOLDED_TERMS), 0.0, folded if fold and folded is not None else phi)
-        sets[variant_label(fold, offset)] = base.base_from_standard(np.where(offsets & (not offset), 0.0, values))
+        sets[variant_label(fold, offset, estimate)] = base.base_from_standard(np.where(offsets & (not offset), 0.0, values))
     return sets, folded
 
 
@@ -156,7 +161,7 @@ def file_terms(robot, folded: np.ndarray | None, labels, scored: tuple) -> dict:
     Returns
     -------
     dict
-        results.json's ``diagnostics["file_terms"]``: ``folded`` and ``offset`` (per joint: friction folded, torque
+        An estimate's entry in results.json's ``diagnostics["file_terms"]``: ``folded`` and ``offset`` (per joint: friction folded, torque
         offset held in the MJCF), ``fc``, ``fv`` (the folded pair per joint [N·m, N·m·s/rad]; with a fold only),
         ``errors`` (each variant's mean relative error per joint over the logs [%]), ``terms`` (what is folded),
         ``logs`` (their names).

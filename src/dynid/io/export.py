@@ -389,8 +389,8 @@ def consistent_estimate(robot: Robot, results: dict, source: str = "results") ->
 
 def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = "results", form: str = "URDF"
                     ) -> tuple[np.ndarray, str]:
-    """The standard parameters a written URDF or MJCF holds, as the validation logs chose joint by joint (results'
-    ``diagnostics.file_terms``, :mod:`dynid.identification.file_terms`): the joints whose friction is folded hold the
+    """The standard parameters a written URDF or MJCF holds, as the validation logs chose joint by joint for the estimate
+    it is written from (results' ``diagnostics.file_terms``, :mod:`dynid.identification.file_terms`): the joints whose friction is folded hold the
     folded Coulomb and viscous pair and no Stribeck or load-dependent Coulomb term; in an MJCF, the torque offsets not
     held are 0 (those held become actuators' constant bias, :func:`offset_actuators`); a URDF keeps every offset, as
     its comments say.
@@ -421,7 +421,9 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
         ``fv`` per joint where a joint is folded.
     """
     out = np.array(phi, dtype=float)
-    found = (results.get("diagnostics") or {}).get("file_terms")
+    chosen = (results.get("diagnostics") or {}).get("file_terms")
+    written = stored_standard(results)  # the estimate the files are written from: its own choice
+    found = chosen.get(written[0]) if isinstance(chosen, dict) and written is not None else None
     if found is None:
         return out, ""
     n = robot.n_dof
@@ -435,7 +437,7 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
     except (KeyError, TypeError, ValueError):
         ok = False
     if not ok:
-        raise ConfigError(f"{source}: diagnostics.file_terms: expected folded and offset (true or false) for each of "
+        raise ConfigError(f"{source}: diagnostics.file_terms.{written[0] if written else ''}: expected folded and offset (true or false) for each of "
                           f"the {n} joints, and fc, fv (finite, >= 0) for each where one is folded")
     names = list(robot.parameter_names)
     for j in folded:

@@ -225,7 +225,9 @@ def file_choice(results: dict, form: str) -> dict:
     dict
         ``friction_folded`` and, for an MJCF, ``offsets_held``: joint numbers, from 1.
     """
-    found = (results.get("diagnostics") or {}).get("file_terms") or {}
+    chosen = (results.get("diagnostics") or {}).get("file_terms") or {}
+    written = stored_standard(results)
+    found = chosen.get(written[0]) or {} if isinstance(chosen, dict) and written is not None else {}
     joints = lambda key: [j + 1 for j, f in enumerate(found.get(key) or []) if f is True]  # noqa: E731
     return {"friction_folded": joints("folded"), **({"offsets_held": joints("offset")} if form == "MJCF" else {})}
 
