@@ -69,7 +69,7 @@ class Evidence:
 
 
 def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference: Preprocessing | None = None,
-                    progress=None) -> Evidence:
+                    progress=None, file_variants: bool = True) -> Evidence:
     """Score the identification's candidates on the validation logs (module docstring).
 
     Parameters
@@ -86,6 +86,8 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
         The identification log's settings by dynid's default rules (:func:`yardstick_reference`).
     progress : callable, optional
         ``progress(step, done, total)``.
+    file_variants : bool
+        Score the estimates as the written files would hold them (:mod:`dynid.identification.file_terms`).
 
     Returns
     -------
@@ -103,7 +105,7 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
     standards = {k: e.standard for k, e in result.estimates.items() if e.standard is not None}
     if alt is not None and alt.standard is not None:
         standards[DRIVE_ONLY_LABEL] = alt.standard
-    variants = {k: file_candidates(robot, base, phi, prepared.data, estimate=k) for k, phi in standards.items()}
+    variants = {k: file_candidates(robot, base, phi, prepared.data, estimate=k) for k, phi in standards.items()} if file_variants else {}
     files = {label: beta for found, _ in variants.values() for label, beta in found.items()}
     scored, warnings = validate_sets(setup, base, sets, validation, progress=progress, resolved=prepared.data.settings,
                                      noise=result.joint_std, covariance={result.label: result.solution.covariance},

@@ -373,7 +373,8 @@ class IdentificationPipeline:
 
     def fit(self, recording, *, validation: tuple = (), references: Callable[[Robot, BaseParameters], tuple] | None = None,
             progress=None, held_out: bool | None = None,
-            drive_gains: Callable[[Robot, BaseParameters], Any] | None = None, weigh_delay: bool = True):
+            drive_gains: Callable[[Robot, BaseParameters], Any] | None = None, weigh_delay: bool = True,
+            files: bool = True):
         """Identify: the four parts, once each (module docstring).
 
         Parameters
@@ -395,6 +396,9 @@ class IdentificationPipeline:
         weigh_delay : bool
             With validation logs, weigh a delay finding on them (:meth:`_delay_weighed`: the log identified again with
             the delay); default true.
+        files : bool
+            With validation logs, choose what the written files hold of each estimate
+            (:mod:`dynid.identification.file_terms`); default true (the delay's second identification writes none).
 
         Returns
         -------
@@ -420,7 +424,8 @@ class IdentificationPipeline:
                 if step is not None:
                     step("drive gains and payload")
                 result = replace(result, drive_gains=beside.result())
-        evidence = gather_evidence(self, prepared, result, validation, reference=reference, progress=progress) if validation else None
+        evidence = (gather_evidence(self, prepared, result, validation, reference=reference, progress=progress, file_variants=files)
+                    if validation else None)
         result = decide(result, evidence)
         if validation and weigh_delay and any(f.kind == "delay" for f in result.findings):
             result = self._delay_weighed(result, prepared, recording, validation, step)
@@ -444,7 +449,7 @@ class IdentificationPipeline:
                         position_cutoff=s.position_cutoff, velocity_cutoff=s.velocity_cutoff,
                         parallel_cutoff=s.parallel_cutoff, decimation=s.decimation)
         again = replace(self, robot=prepared.robot, friction="description", preprocessing=fixed)
-        other = again.fit(recording, validation=validation, weigh_delay=False)
+        other = again.fit(recording, validation=validation, weigh_delay=False, files=False)
 
         def mean(r) -> float:
             return float(weighed_means(r.diagnostics["yardstick"])[r.main])
