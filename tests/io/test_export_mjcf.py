@@ -17,8 +17,9 @@ mujoco = pytest.importorskip("mujoco")
 @pytest.mark.parametrize("name", ["ur10e", "tx40", "er16"])
 def test_mujoco_inverse_dynamics_of_the_exported_model_equals_dynid(rng, name):
     """mj_inverse on random states: MuJoCo's torques without its dry-friction constraint force (rigid bodies,
-    armature = rotor inertia, damping = viscous) plus the terms stated in comments (offset, the TX40's
-    coupled motor) equal dynid's prediction with the base parameters β = Kφ, less its Coulomb term fc·sign(q̇).
+    armature = rotor inertia, damping = viscous, the TX40's coupled motor's viscous friction as a fixed tendon's damping)
+    plus the terms stated in comments (offset, the coupled motor's inertia) and the dry friction the constraints hold
+    (the joints' and the tendon's) equal dynid's prediction with the base parameters β = Kφ, less its Coulomb term fc·sign(q̇).
     MuJoCo's ``frictionloss`` (= fc, checked) is a soft constraint: in inverse dynamics its force is what
     the constraint solver finds, up to fc, so it is not compared. Tolerance 1e-8 relative; the TX40's
     point-mass link 6 gets MuJoCo's smallest inertia (1e-9)."""
@@ -29,8 +30,13 @@ def test_mujoco_inverse_dynamics_of_the_exported_model_equals_dynid(rng, name):
     data = mujoco.MjData(model)
     assert model.nv == robot.n_dof
     terms = dict(zip(robot.drive_terms, robot.drive.T))
+    tr = robot.transmission
+    coupled = dict(zip(tr.coupled_parameter_names, tr.coupled_values.ravel()))
+    # a coupled motor's viscous and dry friction are a fixed tendon (c·q): the joints' damping less its diagonal share
+    tendon_diagonal = sum((coupled[f"fvm{k + 1}"] * tr.ratios(k) ** 2 for k in tr.coupled_motors), np.zeros(robot.n_dof))
     np.testing.assert_allclose(model.dof_frictionloss, terms.get("fc", 0.0))
-    np.testing.assert_allclose(model.dof_damping, terms.get("fv", 0.0))
+    np.testing.assert_allclose(model.dof_damping, terms.get("fv", 0.0) - tendon_diagonal)
+    assert model.ntendon == len(tr.coupled_motors)
     np.testing.assert_allclose(model.dof_armature, terms.get("Ia", 0.0))
     for _ in range(20):
         q, ddq = rng.uniform(-1.5, 1.5, (2, robot.n_dof))
@@ -38,8 +44,9 @@ def test_mujoco_inverse_dynamics_of_the_exported_model_equals_dynid(rng, name):
         data.qpos[:], data.qvel[:], data.qacc[:] = q, dq, ddq
         mujoco.mj_inverse(model, data)
         tau = data.qfrc_inverse + data.qfrc_constraint + terms.get("fc", 0.0) * np.sign(dq) + terms.get("offset", 0.0)
-        if robot.transmission.n_coupled_params:
-            tau = tau + robot.transmission.coupling_columns(dq[None], ddq[None])[0] @ robot.transmission.coupled_values.ravel()
+        if tr.n_coupled_params:  # the motor's inertia (a comment) and its dry friction (the tendon's constraint, taken out)
+            held = np.array([not n.startswith("fvm") for n in tr.coupled_parameter_names])
+            tau = tau + tr.coupling_columns(dq[None], ddq[None])[0] @ np.where(held, tr.coupled_values.ravel(), 0.0)
         predicted = base.base_observation(regressor(robot, q[None], dq[None], ddq[None]))[0] @ base.base_from_standard(phi)
         np.testing.assert_allclose(tau, predicted, atol=1e-8 * max(1.0, np.abs(predicted).max()))
 
@@ -50,3 +57,15 @@ def test_mjcf_refuses_inconsistent_parameters():
     phi[robot.parameter_names.index("M3")] = -1.0
     with pytest.raises(ConfigError, match=r"export: link 3 \(joint3\): mass -1 kg is not positive"):
         mjcf_from_robot(robot, phi)
+
+
+def test_the_tx40s_coupled_motor_friction_is_read_back_as_held_and_its_inertia_as_missing(rng):
+    """The TX40's motor 6 turns with joints 5 and 6: its viscous and dry friction are a fixed tendon of the MJCF, read
+    back by MuJoCo as part of the model the file holds (to round-off); its inertia is not held and is said."""
+    from dynid.io.replay import mjcf_replay
+
+    robot = _with_friction(load_robot("tx40"), rng)
+    phi = robot.standard_parameters()
+    check = mjcf_replay(mjcf_from_robot(robot, phi), robot, phi, n_states=50, rng=1)
+    assert check.relative_error < 1e-8
+    assert "Iam" in check.missing and "fvm" not in check.missing and "fcm" not in check.missing

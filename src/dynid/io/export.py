@@ -182,6 +182,49 @@ def _world_from_base(gravity: np.ndarray) -> np.ndarray | None:
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
+COUPLED_TENDON = "dynid_motor_{motor}"
+"""The name of the MJCF fixed tendon that holds a coupled motor's friction (:func:`coupled_tendons`)."""
+
+
+def coupled_tendons(robot: Robot, fitted: Robot) -> tuple[list, np.ndarray, dict] | None:
+    """The MJCF fixed tendons that hold the coupled motors' friction (a coupled wrist, :mod:`dynid.model.transmission`):
+    per coupled motor ``k`` with ratios ``c``, a tendon of length ``c·q`` with ``damping = fvm_k`` and
+    ``frictionloss = fcm_k``. MuJoCo's tendon adds ``fvm·c cᵀ q̇ + fcm·c·sign(c·q̇)``; dynid's viscous column holds the
+    off-diagonal part of the first (the diagonal is in the joints' ``fv``), so the joints' damping is written less
+    ``fvm·c_j²``. The motor's inertia ``Iam`` stays a comment: its diagonal share is in the joints' ``Ia``, which the
+    physically consistent estimate may hold at 0 (a joint's armature would then be negative).
+
+    Parameters
+    ----------
+    robot : Robot
+    fitted : Robot
+        ``robot`` with the values to write (:func:`_exportable`).
+
+    Returns
+    -------
+    (tendons, damping, left) or None
+        ``tendons``: per motor its attributes and its ``(joint name, coef)`` pairs; ``damping``: (n_dof,) the joints'
+        damping to write; ``left``: the coupled parameters the tendons do not hold, name -> value. None without
+        coupled motors, or where a joint's damping would be negative (the coupling then stays a comment).
+    """
+    tr = robot.transmission
+    if not tr.n_coupled_params or not {"fvm", "fcm"} & set(tr.coupled_terms):
+        return None
+    damping = np.array(dict(zip(robot.drive_terms, fitted.drive.T)).get("fv", np.zeros(robot.n_dof)), dtype=float)
+    tendons, left = [], {}
+    for k, values in zip(tr.coupled_motors, fitted.transmission.coupled_values):
+        c = tr.ratios(k)
+        value = dict(zip(tr.coupled_terms, values))
+        damping -= value.get("fvm", 0.0) * c**2
+        left.update({f"{t}{k + 1}": v for t, v in value.items() if t not in ("fvm", "fcm") and v != 0})
+        attributes = {"name": COUPLED_TENDON.format(motor=k + 1), "damping": f"{value.get('fvm', 0.0):.17g}",
+                      "frictionloss": f"{value.get('fcm', 0.0):.17g}"}
+        tendons.append((attributes, [(robot.joints[j].name, float(c[j])) for j in np.flatnonzero(c)]))
+    if np.any(damping < 0):
+        return None
+    return tendons, damping, left
+
+
 @keyword_only_after_data
 def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *, name: str | None = None,
                     offsets_held: bool = False) -> str:
@@ -189,8 +232,9 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
 
     Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
     (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping`` (viscous ``fv``)
-    and ``frictionloss`` (Coulomb ``fc``). What MuJoCo cannot represent is stated in comments: the torque offset, the
-    Stribeck term, a smooth Coulomb term, and coupled motors. MuJoCo's ``frictionloss`` is a dry-friction
+    and ``frictionloss`` (Coulomb ``fc``); a coupled motor's friction is a fixed tendon (:func:`coupled_tendons`). What
+    MuJoCo cannot represent is stated in comments: the torque offset (unless ``offsets_held``), the Stribeck term, a
+    smooth Coulomb term, and a coupled motor's inertia. MuJoCo's ``frictionloss`` is a dry-friction
     *constraint*: it matches ``fc·sign(q̇)`` while the joint slides, but its force in ``mj_inverse`` comes from the
     constraint solver, so only the other terms reproduce dynid's torques exactly (see the round-trip test); its
     ``solreffriction`` is written as stiff as MuJoCo's default 2 ms step allows (:data:`FRICTION_TIME_STEPS`). Massless
@@ -223,6 +267,7 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     import pinocchio as pin
 
     fitted = _exportable(robot, phi)
+    coupled = coupled_tendons(robot, fitted)
     g = np.asarray(robot.gravity, dtype=float)
     lines = [f"<!-- written by dynid from robot {robot.name!r}: identified inertial and friction parameters -->",
              f"<mujoco model={quoteattr(name or robot.name)}>",
@@ -235,6 +280,8 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
         mass, com, inertia = physical_from_inertial(fitted.inertial[j])
         inertia = mujoco_inertia(inertia)
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
+        if coupled is not None:  # the coupled motors' viscous diagonal goes with their tendons
+            terms["fv"] = coupled[1][j]
         lo, hi = robot.limits.q_min[j], robot.limits.q_max[j]
         limit = f' range="{lo:.17g} {hi:.17g}"' if np.isfinite(lo) and np.isfinite(hi) else ""
         lines += [f'{indent}<body name="link{j + 1}" pos="{_vec(joint.translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
@@ -259,8 +306,17 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
     if actuators:
         lines += ["  <actuator>"] + [f"    <general {' '.join(f'{k}={quoteattr(v)}' for k, v in a.items())}/>" for a in actuators] + ["  </actuator>"]
-    n_coupled = robot.transmission.n_coupled_params
-    if n_coupled:
+    if coupled is not None:
+        lines.append("  <tendon>")
+        for attributes, joints in coupled[0]:
+            lines.append(f"    <fixed {' '.join(f'{k}={quoteattr(v)}' for k, v in attributes.items())}>")
+            lines += [f'      <joint joint={quoteattr(name)} coef="{coef:.17g}"/>' for name, coef in joints]
+            lines.append("    </fixed>")
+        lines.append("  </tendon>")
+        if coupled[2]:
+            lines.append("  <!-- dynid: coupled motors' terms MJCF cannot hold, add their torques: "
+                         + ", ".join(f"{n} = {v:.17g}" for n, v in coupled[2].items()) + " -->")
+    elif robot.transmission.n_coupled_params:
         lines.append("  <!-- dynid: coupled motors (not representable here), add their torques: "
                      + ", ".join(f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                                                   fitted.transmission.coupled_values.ravel()))

@@ -27,6 +27,7 @@ from .export import (
     _exportable,
     _replace,
     _vec,
+    coupled_tendons,
     friction_solref,
     identified_header,
     moved_far,
@@ -142,6 +143,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
                           "another robot, another zero position or joints turning the other way")
     moving = set(model.jnt_bodyid[ids])
     moved: list[str] = []
+    coupled = coupled_tendons(robot, fitted)
     own = held_inertials(path, dict.fromkeys(robot.held, 0.0)) if robot.held else np.zeros((robot.n_dof, 10))
     for k, (joint, jid) in enumerate(zip(robot.joints, ids)):
         body_id = int(model.jnt_bodyid[jid])
@@ -155,6 +157,8 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         moved += notes
         nominal_mass, nominal_com = float(model.body_mass[body_id]), np.array(model.body_ipos[body_id])
         terms = dict(zip(robot.drive_terms, fitted.drive[k]))
+        if coupled is not None:  # the coupled motors' viscous diagonal goes with their tendons
+            terms["fv"] = coupled[1][k]
         element = elements[joint.name]
         element.set("armature", f"{terms.get('Ia', 0.0):.17g}")
         element.set("damping", f"{terms.get('fv', 0.0):.17g}")
@@ -170,7 +174,17 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
             body.append(ET.Comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
         far = moved_far(name, mass, com, nominal_mass, nominal_com, "MJCF")
         moved.extend([far] if far else [])
-    if robot.transmission.n_coupled_params:
+    if coupled is not None:
+        section = root.find("tendon")
+        section = ET.SubElement(root, "tendon") if section is None else section
+        for attributes, joints in coupled[0]:
+            tendon = ET.SubElement(section, "fixed", attributes)
+            for name, coef in joints:
+                ET.SubElement(tendon, "joint", {"joint": name, "coef": f"{coef:.17g}"})
+        if coupled[2]:
+            root.append(ET.Comment(" dynid: coupled motors' terms MJCF cannot hold, add their torques: "
+                                   + ", ".join(f"{n} = {v:.17g}" for n, v in coupled[2].items()) + " "))
+    elif robot.transmission.n_coupled_params:
         root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                               fitted.transmission.coupled_values.ravel())) + " "))

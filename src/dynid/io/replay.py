@@ -21,7 +21,7 @@ import numpy as np
 from .._util.reprs import short_repr
 from ..dynamics.regressor import regressor
 from ..model.robot import Robot
-from .export import OFFSET_ACTUATOR, WORLD_JOINT
+from .export import COUPLED_TENDON, OFFSET_ACTUATOR, WORLD_JOINT
 
 __all__ = ["MJCF_TERMS", "URDF_TERMS", "ForwardCheck", "ReplayCheck", "mjcf_forward", "mjcf_replay", "urdf_replay"]
 
@@ -146,7 +146,7 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
     q, dq, ddq = states
     whole = phi if whole is None else np.asarray(whole, dtype=float)
     full = regressor(robot, q, dq, ddq) @ whole
-    coupled = set(robot.transmission.coupled_parameter_names) if robot.transmission.n_coupled_params else set()
+    coupled = {n for n in robot.transmission.coupled_parameter_names if n.rstrip("0123456789") not in held_terms}
     drive = set(robot.drive_terms)
     kept = np.array([n not in coupled and (n.rstrip("0123456789") not in drive or n.rstrip("0123456789") in held_terms)
                      for n in robot.parameter_names])
@@ -179,6 +179,30 @@ def _offset_forces(model, robot: Robot, vadr: np.ndarray) -> np.ndarray:
         if k >= 0:
             out[j] = float(model.actuator_biasprm[k, 0]) * float(model.actuator_gear[k, 0])
     return out
+
+
+def _tendon_friction(tendons: tuple, qvel: np.ndarray, vadr: np.ndarray) -> np.ndarray:
+    """(n_dof,) [N·m]: the dry friction of dynid's coupled-motor tendons (:func:`_coupled_tendons`) as
+    ``frictionloss·sign(J·q̇)·Jᵀ`` at the velocities ``qvel`` (nv,): what MuJoCo's constraint holds, as a joint's
+    ``frictionloss·sign(q̇)`` is."""
+    loss, jac = tendons
+    return ((loss * np.sign(jac @ qvel)) @ jac)[vadr]
+
+
+def _coupled_tendons(model) -> tuple | None:
+    """dynid's coupled-motor tendons in a model (named by :data:`dynid.io.export.COUPLED_TENDON`): their
+    ``frictionloss`` (n,) and Jacobians (n, nv), a fixed tendon's coefficients on its joints' dofs; None without one."""
+    import mujoco
+
+    stem = COUPLED_TENDON.split("{")[0]
+    ids = [t for t in range(model.ntendon) if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_TENDON, t) or "").startswith(stem)]
+    if not ids:
+        return None
+    jac = np.zeros((len(ids), model.nv))
+    for row, t in enumerate(ids):
+        for w in range(int(model.tendon_adr[t]), int(model.tendon_adr[t] + model.tendon_num[t])):
+            jac[row, int(model.jnt_dofadr[model.wrap_objid[w]])] += float(model.wrap_prm[w])
+    return np.array([float(model.tendon_frictionloss[t]) for t in ids]), jac
 
 
 def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200, rng=0, states=None,
@@ -231,7 +255,8 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)
-    tau_file, with_constraint = np.empty(q.shape), np.empty(q.shape)
+    coupled = _coupled_tendons(model)
+    tau_file, with_constraint, tendons = np.empty(q.shape), np.empty(q.shape), np.zeros(q.shape)
     for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
         model.opt.disableflags = int(flags)
         for k in range(q.shape[0]):
@@ -239,8 +264,10 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
             data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
             mujoco.mj_inverse(model, data)
             out[k] = data.qfrc_inverse[vadr] - bias
-    tau_file = tau_file + dry * np.sign(dq)
-    held = MJCF_TERMS + (("offset",) if np.any(bias) else ())
+            if flags and coupled is not None:
+                tendons[k] = _tendon_friction(coupled, data.qvel, vadr)
+    tau_file = tau_file + dry * np.sign(dq) + tendons
+    held = MJCF_TERMS + (("offset",) if np.any(bias) else ()) + (("fvm", "fcm") if coupled is not None else ())
     check = _compared(tau_file, robot, phi, (q, dq, ddq), held, measured, simulated=with_constraint, whole=whole)
     sliding = dry * np.sign(dq)
     gap = float(np.linalg.norm(with_constraint - tau_file) / np.maximum(np.linalg.norm(sliding), 1e-300)) if np.any(dry) else 0.0
@@ -328,13 +355,14 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     inverse = mujoco.MjData(frictionless)
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)  # the offset actuators act in the simulation: the torque applied is less
+    coupled = _coupled_tendons(model)
 
     inverse.qpos[:], inverse.qvel[:], inverse.qacc[:] = model.qpos0, 0.0, 0.0  # mj_inverse reads them, never writes
 
     def feed_forward(qk, vk, ak):
         inverse.qpos[qadr], inverse.qvel[vadr], inverse.qacc[vadr] = qk, vk, ak
         mujoco.mj_inverse(frictionless, inverse)
-        return inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias
+        return inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias + (_tendon_friction(coupled, inverse.qvel, vadr) if coupled is not None else 0.0)
 
     data.qpos[:] = model.qpos0
     data.qpos[qadr], data.qvel[vadr] = q[0], dq[0]
