@@ -69,3 +69,35 @@ def test_the_tx40s_coupled_motor_friction_is_read_back_as_held_and_its_inertia_a
     check = mjcf_replay(mjcf_from_robot(robot, phi), robot, phi, n_states=50, rng=1)
     assert check.relative_error < 1e-8
     assert "Iam" in check.missing and "fvm" not in check.missing and "fcm" not in check.missing
+
+
+def test_a_users_mjcf_written_back_holds_the_coupled_motor_as_dynids_own_does(rng, tmp_path):
+    """The TX40's coupled motor's friction written into a user's own MJCF: the same tendon, the joints' damping less its
+    diagonal share: MuJoCo's viscous torques of the two files equal."""
+    from dynid.io.mjcf_write_back import mjcf_written_back
+
+    from .test_mjcf_write_back import TETRAHEDRON, _users_mjcf
+
+    robot = _with_friction(load_robot("tx40"), rng)
+    phi = robot.standard_parameters()
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "piece.obj").write_text(TETRAHEDRON)
+    (tmp_path / "arm.xml").write_text(_users_mjcf(robot, np.random.default_rng(3)))
+    text, _ = mjcf_written_back(tmp_path / "arm.xml", robot, phi)
+    (tmp_path / "written.xml").write_text(text)
+    theirs = mujoco.MjModel.from_xml_path(str(tmp_path / "written.xml"))
+    ours = mujoco.MjModel.from_xml_string(mjcf_from_robot(robot, phi))
+    assert theirs.ntendon == ours.ntendon == 1
+    np.testing.assert_allclose(theirs.tendon_damping, ours.tendon_damping)
+    np.testing.assert_allclose(theirs.tendon_frictionloss, ours.tendon_frictionloss)
+    ids = [theirs.joint(j.name).dofadr[0] for j in robot.joints]
+    np.testing.assert_allclose(theirs.dof_damping[ids], ours.dof_damping)
+    # the viscous torque each file's joints and tendon give at the same velocities (MuJoCo's passive forces)
+    a, b = mujoco.MjData(theirs), mujoco.MjData(ours)
+    for _ in range(5):
+        dq = rng.uniform(-1.5, 1.5, robot.n_dof)
+        a.qvel[:], b.qvel[:] = 0.0, dq
+        a.qvel[ids] = dq
+        mujoco.mj_forward(theirs, a)
+        mujoco.mj_forward(ours, b)
+        np.testing.assert_allclose(a.qfrc_passive[ids], b.qfrc_passive, rtol=1e-12, atol=1e-12)

@@ -175,28 +175,15 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
         far = moved_far(name, mass, com, nominal_mass, nominal_com, "MJCF")
         moved.extend([far] if far else [])
     if coupled is not None:
-        section = root.find("tendon")
-        section = ET.SubElement(root, "tendon") if section is None else section
-        for attributes, joints in coupled[0]:
-            tendon = ET.SubElement(section, "fixed", attributes)
-            for name, coef in joints:
-                ET.SubElement(tendon, "joint", {"joint": name, "coef": f"{coef:.17g}"})
-        if coupled[2]:
-            root.append(ET.Comment(" dynid: coupled motors' terms MJCF cannot hold, add their torques: "
-                                   + ", ".join(f"{n} = {v:.17g}" for n, v in coupled[2].items()) + " "))
+        _append_tendons(root, coupled)
     elif robot.transmission.n_coupled_params:
         root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
             f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
                                               fitted.transmission.coupled_values.ravel())) + " "))
     if note := position_offset_note(robot):
         root.append(ET.Comment(note))
-    actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
-    if actuators:
-        section = root.find("actuator")
-        if section is None:
-            section = ET.SubElement(root, "actuator")
-        for attributes in actuators:
-            ET.SubElement(section, "general", attributes)
+    for attributes in offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []:
+        ET.SubElement(_section(root, "actuator"), "general", attributes)
     _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
     header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
                                "frictionloss of every joint", estimate, moved, "MJCF")
@@ -204,6 +191,24 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     if root[0].tail is None or not root[0].tail.strip():
         root[0].tail = "\n  "
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n", moved
+
+
+def _section(root, tag: str):
+    """The MJCF's ``<tag>`` section (its first), made at the end where it has none."""
+    found = root.find(tag)
+    return ET.SubElement(root, tag) if found is None else found
+
+
+def _append_tendons(root, coupled: tuple) -> None:
+    """The coupled motors' tendons (:func:`dynid.io.export.coupled_tendons`) added to the MJCF's ``<tendon>``, and
+    what they do not hold as a comment."""
+    for attributes, joints in coupled[0]:
+        tendon = ET.SubElement(_section(root, "tendon"), "fixed", attributes)
+        for name, coef in joints:
+            ET.SubElement(tendon, "joint", {"joint": name, "coef": f"{coef:.17g}"})
+    if coupled[2]:
+        root.append(ET.Comment(" dynid: coupled motors' terms MJCF cannot hold, add their torques: "
+                               + ", ".join(f"{n} = {v:.17g}" for n, v in coupled[2].items()) + " "))
 
 
 def _write_inertial(model, data, body: tuple, bodies: dict, alone: np.ndarray, *, frame: tuple, moving: set, held: bool):
