@@ -69,6 +69,8 @@ def _stretch(spec, robot):
     read."""
     if spec.time_range is not None or spec.rows is not None:
         return spec
+    if spec.bag is not None:  # a bag is read whole whatever its rows: its time range alone
+        return replace(spec, time_range=(0.0, SEARCHED_SECONDS))
     head = load_recording(replace(spec, rows=(1, HEAD_ROWS)), robot)
     step = float(np.median(np.diff(head.t)))
     rows = int(np.ceil(1.1 * SEARCHED_SECONDS / step)) + 1
