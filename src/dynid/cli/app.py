@@ -438,7 +438,7 @@ def export(
         if gate is not None:
             rep.warning(gate)
         rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
-                 "format cannot hold, e.g. offsets and coupled motors, is stated in comments)")
+                 "format cannot hold, e.g. a URDF's offsets, is stated in comments)")
         from ..report.identification_run import file_choice, read_back_entry
         from ..report.summaries import taken_away_lines
 
@@ -533,27 +533,15 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
     """The text of one ``dynid export`` file (``flag``: "--urdf" or "--mjcf"): the user's URDF or MJCF with the
     identified values written in, or a file of dynid's own where the description has none; values far from the
     description's own are appended to ``moved``."""
-    from ..io.export import consistent_estimate, file_parameters, mjcf_from_results, urdf_from_results, with_note
+    from ..io.model_files import written_model
 
-    robot = cfg.robot
-    if flag == "--urdf":
-        if cfg.urdf is None:  # a DH description: a URDF of its own
-            return urdf_from_results(robot, identified, source=source)
-        from ..io.urdf_write_back import urdf_written_back
-
-        fitted, phi = consistent_estimate(robot, identified, source)  # the user's URDF, the values written in
-        phi, note = file_parameters(fitted, phi, identified, source)
-        text, far = urdf_written_back(cfg.urdf, fitted, phi)
+    if flag == "--urdf":  # the user's URDF, the values written in; a DH description: a URDF of its own
+        text, far = written_model("URDF", cfg.robot, identified, source, users_file=cfg.urdf)
     else:
-        if users_mjcf is None:
-            return mjcf_from_results(robot, identified, source=source)
-        from ..io.mjcf_write_back import mjcf_written_back
-
-        fitted, phi = consistent_estimate(robot, identified, source)
-        phi, note = file_parameters(fitted, phi, identified, source, "MJCF")
-        text, far = mjcf_written_back(users_mjcf, fitted, phi, out_dir=mjcf.parent if mjcf else None, offsets_held=True)
+        text, far = written_model("MJCF", cfg.robot, identified, source, users_file=users_mjcf,
+                                  out_dir=mjcf.parent if mjcf else None)
     moved.extend(far)
-    return with_note(text, note)
+    return text
 
 
 def _read_results(results: Path, robot) -> dict:

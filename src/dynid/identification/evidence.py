@@ -120,7 +120,7 @@ def gather_evidence(pipeline, prepared, result, validation: tuple, *, reference:
                        and all(k in v.metrics() for k in files))
         file_choice = {k: file_terms(robot, folded, list(found), moving) for k, (found, folded) in variants.items()
                        if found} if moving else None
-        scored = tuple(v.without(*(k for k in files if k in v.metrics())) for v in scored)
+        scored = tuple(v.without(*files) for v in scored)
     validations = scored if alt is None else tuple(v.without(DRIVE_ONLY_LABEL) for v in scored)
     refits = {f"{SDP_LABEL} refit {k + 1}": beta for k, beta in enumerate(result.sdp_refits)} if nominal else {}
     filters = yardstick_scores(setup, base, {**sets, **refits}, validation, resolved=prepared.data.settings,

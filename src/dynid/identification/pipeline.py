@@ -374,7 +374,7 @@ class IdentificationPipeline:
     def fit(self, recording, *, validation: tuple = (), references: Callable[[Robot, BaseParameters], tuple] | None = None,
             progress=None, held_out: bool | None = None,
             drive_gains: Callable[[Robot, BaseParameters], Any] | None = None, weigh_delay: bool = True,
-            files: bool = True):
+            file_variants: bool = True):
         """Identify: the four parts, once each (module docstring).
 
         Parameters
@@ -396,7 +396,7 @@ class IdentificationPipeline:
         weigh_delay : bool
             With validation logs, weigh a delay finding on them (:meth:`_delay_weighed`: the log identified again with
             the delay); default true.
-        files : bool
+        file_variants : bool
             With validation logs, choose what the written files hold of each estimate
             (:mod:`dynid.identification.file_terms`); default true (the delay's second identification writes none).
 
@@ -424,7 +424,7 @@ class IdentificationPipeline:
                 if step is not None:
                     step("drive gains and payload")
                 result = replace(result, drive_gains=beside.result())
-        evidence = (gather_evidence(self, prepared, result, validation, reference=reference, progress=progress, file_variants=files)
+        evidence = (gather_evidence(self, prepared, result, validation, reference=reference, progress=progress, file_variants=file_variants)
                     if validation else None)
         result = decide(result, evidence)
         if validation and weigh_delay and any(f.kind == "delay" for f in result.findings):
@@ -449,7 +449,7 @@ class IdentificationPipeline:
                         position_cutoff=s.position_cutoff, velocity_cutoff=s.velocity_cutoff,
                         parallel_cutoff=s.parallel_cutoff, decimation=s.decimation)
         again = replace(self, robot=prepared.robot, friction="description", preprocessing=fixed)
-        other = again.fit(recording, validation=validation, weigh_delay=False, files=False)
+        other = again.fit(recording, validation=validation, weigh_delay=False, file_variants=False)
 
         def mean(r) -> float:
             return float(weighed_means(r.diagnostics["yardstick"])[r.main])

@@ -21,6 +21,7 @@ from __future__ import annotations
 import re
 from html import escape
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -477,9 +478,7 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
         ``fv`` per joint where a joint is folded.
     """
     out = np.array(phi, dtype=float)
-    chosen = (results.get("diagnostics") or {}).get("file_terms")
-    written = stored_standard(results)  # the estimate the files are written from: its own choice
-    found = chosen.get(written[0]) if isinstance(chosen, dict) and written is not None else None
+    written, found = file_terms_entry(results)
     if found is None:
         return out, ""
     n = robot.n_dof
@@ -493,7 +492,7 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
     except (KeyError, TypeError, ValueError):
         ok = False
     if not ok:
-        raise ConfigError(f"{source}: diagnostics.file_terms.{written[0] if written else ''}: expected folded and offset (true or false) for each of "
+        raise ConfigError(f"{source}: diagnostics.file_terms.{written}: expected folded and offset (true or false) for each of "
                           f"the {n} joints, and fc, fv (finite, >= 0) for each where one is folded")
     names = list(robot.parameter_names)
     for j in folded:
@@ -518,6 +517,29 @@ def file_parameters(robot: Robot, phi: np.ndarray, results: dict, source: str = 
         return out, ""
     return out, ("dynid: " + "; ".join(said) + ", where the validation logs say that predicts the joint better; "
                  "dynid's own values are in results.json")
+
+
+def file_terms_entry(results: dict) -> tuple[str, Any]:
+    """The choice results.json holds of what the files hold (``diagnostics.file_terms``,
+    :mod:`dynid.identification.file_terms`) for the estimate they are written from (:func:`stored_standard`).
+
+    Parameters
+    ----------
+    results : dict
+        results.json.
+
+    Returns
+    -------
+    label : str
+        The estimate the files are written from ("" where there is none).
+    entry : object or None
+        Its entry as stored (checked by :func:`file_parameters`); None where the results chose nothing for it.
+    """
+    chosen = (results.get("diagnostics") or {}).get("file_terms")
+    written = stored_standard(results)
+    if written is None or not isinstance(chosen, dict):
+        return "" if written is None else written[0], None
+    return written[0], chosen.get(written[0])
 
 
 def _joints(indices) -> str:

@@ -12,16 +12,13 @@ from ..io import atomic_write_text
 from ..io.export import (
     consistent_estimate,
     file_parameters,
-    mjcf_from_robot,
+    file_terms_entry,
     payload_files,
-    urdf_from_robot,
-    with_note,
     withheld_files,
 )
-from ..io.mjcf_write_back import mjcf_written_back
+from ..io.model_files import written_model
 from ..io.replay import ReplayCheck, mjcf_replay, urdf_replay
 from ..io.results import stored_standard
-from ..io.urdf_write_back import urdf_written_back
 from . import figures
 from .html import write_html_report
 from .output import draw_figures, save_figure, staged, write_results
@@ -147,19 +144,11 @@ def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, m
     sdp = stored_standard(data)
     if robot is None or sdp is None or data["physically_consistent_verdict"].get(sdp[0]) != "yes":
         return []
-    fitted, whole = consistent_estimate(robot, data)
-    phi, note = file_parameters(fitted, whole, data)
-    if urdf is None:
-        model = (out / "dynid-model.urdf", with_note(urdf_from_robot(fitted, phi), note))
-    else:
-        model = (out / (urdf_name or Path(urdf).name), with_note(urdf_written_back(urdf, fitted, phi)[0], note))
-    phi, note = file_parameters(fitted, whole, data, form="MJCF")
-    if mjcf_model is None:
-        mjcf = (out / "dynid-model.xml", mjcf_from_robot(fitted, phi, offsets_held=True))
-    else:
-        mjcf = (out / (mjcf_name or Path(mjcf_model).name),
-                mjcf_written_back(mjcf_model, fitted, phi, out_dir=mjcf_folder or out, offsets_held=True)[0])
-    return [model, (mjcf[0], with_note(mjcf[1], note))]
+    model = (out / ("dynid-model.urdf" if urdf is None else urdf_name or Path(urdf).name),
+             written_model("URDF", robot, data, users_file=urdf)[0])
+    mjcf = (out / ("dynid-model.xml" if mjcf_model is None else mjcf_name or Path(mjcf_model).name),
+            written_model("MJCF", robot, data, users_file=mjcf_model, out_dir=mjcf_folder or out)[0])
+    return [model, mjcf]
 
 
 def taken_away(models: list, robot, data: dict, config=None) -> dict:
@@ -225,9 +214,8 @@ def file_choice(results: dict, form: str) -> dict:
     dict
         ``friction_folded`` and, for an MJCF, ``offsets_held``: joint numbers, from 1.
     """
-    chosen = (results.get("diagnostics") or {}).get("file_terms") or {}
-    written = stored_standard(results)
-    found = chosen.get(written[0]) or {} if isinstance(chosen, dict) and written is not None else {}
+    found = file_terms_entry(results)[1]
+    found = found if isinstance(found, dict) else {}
     joints = lambda key: [j + 1 for j, f in enumerate(found.get(key) or []) if f is True]  # noqa: E731
     return {"friction_folded": joints("folded"), **({"offsets_held": joints("offset")} if form == "MJCF" else {})}
 

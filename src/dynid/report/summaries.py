@@ -451,17 +451,18 @@ def taken_away_lines(taken: dict) -> list:
                    if f.get("friction_folded") else "the file's comments say how to add them")
             said += (f"; it cannot hold {', '.join(stem_words(k) for k in f['cannot_hold'])} (up to "
                      f"{f['cannot_hold_share'][j]:.3g} % of J{j + 1}'s RMS torque: {how})")
-        chosen = [text for key, text in (("friction_folded", "the friction of {} holds its Stribeck and load-dependent "
-                                                               "Coulomb terms folded into its Coulomb and viscous pair"),
-                                         ("offsets_held", "the torque offsets of {} are held by actuators of constant "
-                                                          "bias (the others left out)")) if f.get(key)
-                  for text in [text.format(", ".join(f"J{j}" for j in f[key]))]]
+        chosen = [text.format(", ".join(f"J{j}" for j in f[key])) for key, text in FILE_CHOICES if f.get(key)]
         if chosen:
             said += f"; {' and '.join(chosen)}, where the validation logs say that predicts the joint better (results.json: diagnostics.file_terms)"
         off = f["equals_model_to"] > 1e-6 or max(f.get("simulator_gap") or [0.0]) > SIMULATOR_GAP
         out.append(Line(said, "warning" if off else "text"))
     return out
 
+
+FILE_CHOICES = (("friction_folded", "the friction of {} holds its Stribeck and load-dependent Coulomb terms folded into "
+                                    "its Coulomb and viscous pair"),
+                ("offsets_held", "the torque offsets of {} are held by actuators of constant bias (the others left out)"))
+"""What a read-back line says of a file's ``files_taken_away`` keys (:func:`dynid.report.identification_run.file_choice`)."""
 
 SIMULATES = {"URDF": "Pinocchio (RNEA and the joints' <dynamics>)",
              "MJCF": "MuJoCo (mj_inverse, its frictionloss a constraint as MuJoCo solves it)"}
