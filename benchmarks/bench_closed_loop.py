@@ -21,7 +21,7 @@ def measure() -> dict:
     from dynid.dynamics.rnea import rnea_torques
     from dynid.excitation.paper_trajectories import paper_identification_trajectory
     from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
     from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 
     robot = dynid.load_robot("er16").submodel(3)

@@ -16,7 +16,7 @@ from timing import best_of  # benchmarks/timing.py (run as scripts from benchmar
 
 from dynid.excitation.design import _Layout, _Objective
 from dynid.identification.excitation_run import run_excitation
-from dynid.io.excitation_config import load_excitation_config
+from dynid.io.config.excitation_config import load_excitation_config
 
 CONFIG = Path(__file__).resolve().parents[1] / "configs" / "excite-er16-6dof.toml"
 TARGET_SECONDS = 60.0

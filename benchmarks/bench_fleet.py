@@ -27,7 +27,7 @@ import numpy as np  # noqa: E402
 
 def fleet(units: int) -> None:
     from dynid.fleet.identification import run_fleet
-    from dynid.io.fleet_manifest import load_fleet_manifest
+    from dynid.io.config.fleet_manifest import load_fleet_manifest
     from dynid.studies.simulated_fleet import simulate_fleet
 
     folder = Path(tempfile.mkdtemp(prefix="dynid-fleet-bench-"))

@@ -26,7 +26,7 @@ def main(hours: float) -> None:
     from dynid.fleet.monitor import dated_logs, monitor_logs
     from dynid.identification.identified import IdentifiedModel
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.studies.simulated_fleet import simulate_service_life
 
     folder = Path(tempfile.mkdtemp(prefix="dynid-monitor-bench-"))

@@ -31,7 +31,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 from scipy import signal  # noqa: E402
 
-from dynid.io.datasets import Recording  # noqa: E402
+from dynid.io.logs.datasets import Recording  # noqa: E402
 from dynid.preprocessing.pipeline import Preprocessing, prepare  # noqa: E402
 from dynid.preprocessing.strategies import strategy_for  # noqa: E402
 from dynid.simulation.closed_loop import ClosedLoopNoise, simulate_closed_loop  # noqa: E402

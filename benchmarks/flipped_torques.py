@@ -50,7 +50,7 @@ def _case(config, label: str, right: float | None) -> float:
 
 
 def main() -> int:
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     print("case | sign findings (which check) | other reading findings | main estimate, mean validation error % on "
           "the one yardstick | against the log read right")

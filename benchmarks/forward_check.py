@@ -24,8 +24,8 @@ CONFIGS = ("ur10e", "tx40", "kuka_kr300", "kuka_med7")
 
 def main() -> int:
     from dynid.identification.run import forward_check, run_identification
-    from dynid.io.export import consistent_estimate, mjcf_from_robot
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.exported.export import consistent_estimate, mjcf_from_robot
     from dynid.report.output import write_results
 
     folder = Path(tempfile.mkdtemp())

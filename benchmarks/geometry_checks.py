@@ -45,7 +45,7 @@ def _prepared(config):
     """The config's identification log, prepared as ``dynid identify`` prepares it, and the robot it is fitted with."""
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.run import pipeline_of
-    from dynid.io.datasets import load_recording
+    from dynid.io.logs.datasets import load_recording
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -110,7 +110,7 @@ def _inverse(j: int, turn: str) -> str:
 def main() -> int:
     import short_windows as sw
 
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp())
     configs = REPO / "configs"
@@ -206,7 +206,7 @@ def main() -> int:
 
 def _config(path: Path, text: str, configs: Path):
     """A config written beside the others' data: its data_root made absolute."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     text = re.sub(r'^data_root = "(.*)"', lambda m: f'data_root = "{(configs / m.group(1)).resolve()}"', text, flags=re.M)
     path.write_text(text)

@@ -46,7 +46,7 @@ def _against_raw(result, log, half) -> tuple[np.ndarray, np.ndarray]:
 
 def main(seeds=(1, 2, 3)) -> None:
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     for case in CASES:
         ratios, globals_, kinds, overall, rest = [], [], set(), [], []

@@ -69,8 +69,8 @@ def first_line(config, recording, validation: tuple) -> str:
 
 
 def main() -> int:
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     folder = Path(tempfile.mkdtemp())
     ready, alarms, total = [], [], 0

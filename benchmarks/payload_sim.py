@@ -33,7 +33,7 @@ from tests.simulated_logs import fourier_motion, simulated_case, torques, truth_
 
 from dynid.dynamics.regressor import regressor  # noqa: E402
 from dynid.identification.run import run_payload  # noqa: E402
-from dynid.io.identification_config import dataset_for_file, load_identification_config  # noqa: E402
+from dynid.io.config.identification_config import dataset_for_file, load_identification_config  # noqa: E402
 from dynid.model.spatial import inertial_from_physical, transform_inertial  # noqa: E402
 
 ARMS = tuple(sys.argv[1].split(",")) if len(sys.argv) > 1 else ("ur10e", "er16", "Panda")

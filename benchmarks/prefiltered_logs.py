@@ -38,7 +38,7 @@ def _filtered(x: np.ndarray, rate: float, causal: bool) -> np.ndarray:
 def identify(name: str, filtering: str | None, rest=None):
     """The config identified with its identification log filtered (``None``: raw) and the rest thresholds given."""
     import dynid.identification.run as run
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     config = load_identification_config(REPO / "configs" / f"{name}.toml", data_root=DATA / CONFIGS[name])
     if rest is not None:

@@ -98,7 +98,7 @@ def _evidence(x, y, a, d, b0, weight):
 def _rows(config, result):
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.run import pipeline_of
-    from dynid.io.datasets import load_recording
+    from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.pipeline import base_chunks
 
     base = base_parameters(config.robot, rng=0)
@@ -119,8 +119,8 @@ def case(name: str, window, folder: Path) -> None:
     from dynid.exceptions import DynIdError
     from dynid.identification.evidence import with_yardstick, yardstick_reference, yardstick_scores
     from dynid.identification.run import run_identification
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config, stored_preprocessing
+    from dynid.io.config.identification_config import load_identification_config, stored_preprocessing
+    from dynid.io.logs.datasets import load_recording
 
     path, root = _config(name, window, folder)
     config = load_identification_config(path, data_root=root)

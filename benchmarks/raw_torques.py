@@ -64,7 +64,7 @@ def measure(path: Path, root: Path) -> list[tuple]:
     """Per validation log: (name, main, {label: errors per cutoff}, share of samples at rest)."""
     import dynid.identification.pipeline as pipeline_module
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     seen = {}
     gather = pipeline_module.gather_evidence

@@ -48,9 +48,9 @@ def _case(config, identified, recording, tau, label: str):
 def real() -> int:
     """Flips and swaps on the real configs' validation logs (module docstring)."""
     from dynid.identification.run import run_identification
-    from dynid.io.datasets import load_recording
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.io.files import write_json
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     counts = {"named right": 0, "named wrong": 0, "not judged": 0, "as recorded, named": 0, "as recorded": 0}
     print("config | log | change | named")
@@ -95,7 +95,7 @@ def windows() -> int:
     import short_windows as sw
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp())
     cases = [("ur10e", w) for w in sw.WINDOWS] + [(n, w) for n, ws in sw.OTHER_WINDOWS.items() for w in ws]

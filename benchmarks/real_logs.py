@@ -53,7 +53,7 @@ def _config(name: str, folder: Path, pre: dict | None, friction: str | None) -> 
 
 def measure(path: Path, data: Path) -> tuple[float, str, np.ndarray]:
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -72,7 +72,7 @@ OTHER_WINDOWS = {
 def others() -> int:
     """The Med7's and the KR 300's windows (module docstring)."""
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp())
     exceptions = []
@@ -158,7 +158,7 @@ def _held_out(path: Path, window, fold: int, share: float = 0.2) -> Path:
 
 def _identified(path: Path, root: Path):
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -245,7 +245,7 @@ seconds), each 3-6 s."""
 def _with_and_alone(name: str, window, folder: Path) -> tuple:
     """A window identified with its config's validation logs and without any (a user with one log)."""
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     path, root = _window_config(name, window, folder)
     config = load_identification_config(path, data_root=root)
@@ -336,7 +336,7 @@ def main() -> int:
     if "--others" in sys.argv[1:]:
         return others()
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     if not DATA.is_dir():
         print(f"{DATA} not found (set DYNID_SHARED_DATA to the shared/data folder)")

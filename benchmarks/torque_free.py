@@ -81,8 +81,8 @@ def collect(name: str, tag: str, window, folder: Path) -> None:
     from dynid.identification.evidence import yardstick_reference, yardstick_scores
     from dynid.identification.identify import one_way_joints
     from dynid.identification.run import pipeline_of, run_identification
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.pipeline import base_chunks
 
     path, root = _config_path(name, window, folder)
@@ -242,7 +242,7 @@ def product() -> int:
     import re
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     folder = Path(tempfile.mkdtemp())
     bad, ratios = [], []

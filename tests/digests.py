@@ -110,7 +110,7 @@ def compute(case: str) -> dict:
         return _clean(run_identification(load_identification_config(path, data_root=root)).to_dict())
     if kind == "excite":
         from dynid.identification.excitation_run import run_excitation
-        from dynid.io.excitation_config import load_excitation_config
+        from dynid.io.config.excitation_config import load_excitation_config
 
         return _clean(run_excitation(load_excitation_config(ROOT / "configs" / f"{name}.toml")).to_dict())
     if kind == "run":

@@ -10,7 +10,7 @@ import pytest
 import tests.plugins.central_differences  # noqa: F401  registers "central_differences_test"
 import tests.plugins.ridge  # noqa: F401  registers "ridge_test"
 from dynid.identification.run import run_identification, run_validation
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.report.identification_run import save_identification
 from dynid.studies.montecarlo import MonteCarloConfig, run_montecarlo
 from dynid.studies.paper import PaperExperimentConfig, run_paper_experiment

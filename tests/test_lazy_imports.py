@@ -31,7 +31,7 @@ HEAVY = {"numpy", "scipy", "pinocchio", "numba", "llvmlite", "cvxpy", "matplotli
 """Third-party packages whose import is a start-up cost worth keeping away from the commands that do not need them
 (NumPy too: 0.1 s, and ``dynid --help`` loads none of these)."""
 
-CONFIG_CHECK = ("dynid.cli.app", "dynid.identification.run", "dynid.io.identification_config")
+CONFIG_CHECK = ("dynid.cli.app", "dynid.identification.run", "dynid.io.config.identification_config")
 """What ``dynid identify`` imports before it reads and checks a config (tests/cli/test_cli.py)."""
 
 EXEMPT = ("dynid.cli",)

@@ -63,3 +63,33 @@ def test_a_loose_top_level_module_grouped_into_a_package_keeps_its_old_path_for_
     assert aliased is new and new.__name__ == new_name
     root = Path(dynid.__file__).parent
     assert not (root / f"{old.rsplit('.', 1)[1]}.py").exists() and Path(new.__file__).parent.name == new_name.split(".")[1]
+
+
+@pytest.mark.parametrize("old", sorted(__import__("dynid.io").io.MOVED))
+def test_an_io_module_of_0_1_0_keeps_its_old_path_for_a_release(old):
+    """issue "One route, four named parts", item 3: ``dynid.io`` grouped by job into ``config``, ``logs`` and
+    ``exported``; each module 0.1.0 had imports from its old path as the very same module, with a FutureWarning naming
+    the new one, and no file is left at the old path."""
+    from pathlib import Path
+
+    import dynid.io
+
+    new_name = dynid.io.MOVED[old]
+    new = importlib.import_module(new_name)
+    sys.modules.pop(old, None)
+    with pytest.warns(FutureWarning, match=f"{old} moved to {new_name}"):
+        aliased = importlib.import_module(old)
+    assert aliased is new and new.__name__ == new_name
+    root = Path(dynid.io.__file__).parent
+    assert not (root / f"{old.rsplit('.', 1)[1]}.py").exists()
+    assert Path(new.__file__).parent.name == new_name.split(".")[2]
+
+
+def test_io_holds_only_its_rooms_and_the_two_modules_every_room_shares():
+    from pathlib import Path
+
+    import dynid.io
+
+    root = Path(dynid.io.__file__).parent
+    assert sorted(p.name for p in root.glob("*.py")) == ["__init__.py", "files.py", "results.py"]
+    assert sorted(p.name for p in root.iterdir() if (p / "__init__.py").exists()) == ["config", "exported", "logs"]

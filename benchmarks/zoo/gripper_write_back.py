@@ -25,7 +25,7 @@ def main() -> int:
     from tests.mujoco_logs import stripped_urdf
     from zoo import robots_folder
 
-    from dynid.io.mjcf_write_back import mjcf_written_back
+    from dynid.io.exported.mjcf_write_back import mjcf_written_back
     from dynid.model.description import load_robot
 
     text = stripped_urdf((robots_folder() / "panda_description/urdf/panda.urdf").read_text(encoding="utf-8"))

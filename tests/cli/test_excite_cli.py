@@ -10,8 +10,8 @@ import pytest
 
 from dynid.dynamics.kinematics import tool_positions
 from dynid.dynamics.rnea import rnea_torques
-from dynid.io.excitation_config import load_excitation_config
-from dynid.io.trajectories import load_trajectory
+from dynid.io.config.excitation_config import load_excitation_config
+from dynid.io.logs.trajectories import load_trajectory
 from dynid.model.description import load_robot
 
 from .refusals import assert_refused, dynid

@@ -298,8 +298,8 @@ def test_init_takes_a_rostopic_export_in_the_urdfs_joint_order_by_its_name_colum
     first), which `rostopic echo -p` writes as field.name0… text columns beside field.position0…: init took
     field.position0 for the URDF's first joint (the UR10e log so fitted at 29.7 % instead of 1.77 %). Now each signal's
     columns are taken in the URDF's order by the names, said, and the log reads as the one written in that order."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     robot = dynid.load_robot(URDF)
     joints = [j.name for j in robot.joints]
@@ -355,7 +355,7 @@ def test_init_sums_a_time_stamp_split_into_seconds_and_nanoseconds(tmp_path):
 
 def test_ros_style_indexed_headers_name_their_signal():
     """``/joint_states/position/0`` and ``position.0`` were refused ("found 0 positions columns")."""
-    from dynid.io.columns import _kind
+    from dynid.io.logs.columns import _kind
 
     assert [_kind(h) for h in ("/joint_states/position/0", "position.0", "/joint_states/effort/5", "velocity.2",
                                "header.stamp.sec")] == ["positions", "positions", "torques", "velocities", "time"]
@@ -414,7 +414,7 @@ def test_init_asks_which_side_of_the_gear_measured_the_torques(tmp_path):
     the config init writes asks, beside the torques, with the setting that says it (read by identify)."""
     import tomllib
 
-    from dynid.io.columns import SENSOR_HINT
+    from dynid.io.logs.columns import SENSOR_HINT
 
     log = _log(tmp_path, header=True)
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
@@ -431,8 +431,8 @@ def test_init_infers_joint_torque_sensors_from_an_arm_that_has_them(tmp_path):
     and identify reads it (no rotor inertia); another arm's URDF only gets the question."""
     import tomllib
 
-    from dynid.io.columns import SENSOR_HINT
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.columns import SENSOR_HINT
 
     log = _log(tmp_path, header=True)
     med = tmp_path / "arm.urdf"
@@ -452,8 +452,8 @@ def test_init_infers_joint_torque_sensors_from_an_arm_that_has_them(tmp_path):
 def test_init_takes_the_rate_of_a_log_without_time_stamps(tmp_path):
     """A log with a header and no time column (the LBR Med7's lbr-stack recordings): init refuses it naming --rate,
     and with --rate writes rate = ..., which identify reads as one sample every 1/rate s (the log's own times)."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     log = _log(tmp_path, header=True)
     rows = np.loadtxt(log, delimiter=",", skiprows=1)
@@ -479,7 +479,7 @@ def test_init_takes_the_rate_of_a_log_without_time_stamps(tmp_path):
 def test_only_arms_with_joint_torque_sensors_are_inferred_so():
     """The names init takes as joint torque sensors: the LBRs, Franka's arms and Kinova's Gen3, not its Gen3 lite or
     its other arms (whose logs are motor currents)."""
-    from dynid.io.columns import JOINT_SENSED
+    from dynid.io.logs.columns import JOINT_SENSED
 
     sensed = ["lbr_iiwa_14_r820", "med7dock", "panda", "fr3", "kinova_gen3", "GEN3_7dof"]
     other = ["ur10e", "kinova", "j2s6s200", "gen3_lite", "gen3-lite", "xarm7", "staubli_tx40"]
@@ -560,8 +560,8 @@ def test_init_says_a_log_of_motor_currents_needs_drive_gains_the_urdf_cannot_sta
     identify then read each ampere as 1 N·m. Init said so and named the built-in robot of the URDF's name that has
     them; it now writes that robot's gains in [[robot.joints]] (the real UR10e log read at 1 N·m/A predicted its
     validation log 8.86 %, with them 2.22 %). Another arm's URDF gets the note alone; a log of torques nothing."""
-    from dynid.io.identification_config import load_identification_config
-    from dynid.io.starter import starter_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.config.starter import starter_config
 
     builtin = dynid.load_robot("ur10e").drive_gains
     log = dynid.simulated_log(dynid.load_robot("ur10e"), seconds=5, rng=1)
@@ -632,7 +632,7 @@ def test_init_reads_the_units_a_logs_column_names_carry(tmp_path):
     """Columns named with their unit (``t_s``, ``q1_deg``, ``tau1_Nm``): refused ("no time column"); the unit words are
     now read beside the signal and the joint, the positions' degrees written as ``unit = "deg"``, and dynid identify
     reads the log right (no finding on the angles or the torques' size). The name helper is checked on each form."""
-    from dynid.io.columns import _kind_and_unit
+    from dynid.io.logs.columns import _kind_and_unit
 
     assert _kind_and_unit("time [s]") == ("time", "s") and _kind_and_unit("q_deg1") == ("positions", "deg")
     assert _kind_and_unit("pos3 [rad]") == ("positions", "rad") and _kind_and_unit("i2_mA") == ("currents", "mA")
@@ -661,7 +661,7 @@ def test_init_writes_a_ceiling_mounts_gravity_and_then_judges_the_sign(tmp_path)
     p = _simulated_init(tmp_path, replace(dynid.load_robot(URDF), gravity=np.array([0.0, 0.0, 9.81])))
     config = tomllib.loads((tmp_path / "arm.toml").read_text())
     assert config["robot"]["gravity"] == [0.0, 0.0, 9.81] and "sign" not in config["identification"]["torques"]
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     written = load_identification_config(tmp_path / "arm.toml").robot
     assert written.drive_terms == dynid.load_robot(URDF).drive_terms  # the [robot] table keeps the file's drive terms
@@ -694,7 +694,7 @@ def test_init_writes_a_joints_zero_a_quarter_turn_off_and_identify_reads_the_log
     """A UR10e log whose J2 encoder counts from a zero a quarter turn from the URDF's (logged angle = the URDF's − π/2):
     dynid init's check finds it, writes position_offset = "pi/2" in J2's [[robot.joints]] table (one table per joint,
     the others empty, the file's drive terms kept), and the first dynid identify has no angles finding."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     p = _simulated_init(tmp_path, dynid.load_robot(URDF), lambda q: q - np.array([0.0, np.pi / 2, 0, 0, 0, 0]))
     joints = tomllib.loads((tmp_path / "arm.toml").read_text())["robot"]["joints"]
@@ -712,7 +712,7 @@ def test_init_reads_the_kr300s_qualified_headers_as_its_expert_config_does(tmp_p
     tau_mot_rel_Nm1…) and commanded signals (q_ref…, tau_ff_mot…). dynid init passes over the encoder group with dead
     channels, reads the torques through the gear ratios (side = "motor"), never takes a feed-forward column, and
     writes the columns the hand-written config (configs/kuka_kr300.toml, from the data's SOURCE.md) reads."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..conftest import shared_data
 
@@ -784,7 +784,7 @@ def test_the_torque_sign_init_writes_reaches_a_validation_log_read_by_its_own_co
     """A validation log of another layout has a torques table of its own (init writes it): the sign the
     identification log's check found is written there too; a validation log that takes the identification's reader
     gets none of its own."""
-    from dynid.io.starter import with_torque_setting
+    from dynid.io.config.starter import with_torque_setting
 
     text = ('[identification]\nfile = "a.csv"\ntorques = {columns = [1, 2]}\n\n[[validation]]\nname = "b"\nfile = '
             '"b.csv"\n\n[[validation]]\nname = "c"\nfile = "c.csv"\ntorques = {columns = ["x", "y"]}\n')
@@ -798,7 +798,7 @@ def test_init_takes_figaroh_s_pair_of_one_signal_files_and_finds_the_motor_side(
     the motors' angles (50.3 rad = 32 · π/2). Given both (``pos_read_data.csv curr_data.csv --rate 5000``), init
     writes each signal with its file and side = "motor" (the angles reach tens of times the joints' limits): the columns
     and side the hand-written config (configs/tx40.toml, its preset) reads."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..conftest import shared_data
 
@@ -855,8 +855,8 @@ def test_init_reads_a_european_spreadsheets_export_as_the_same_log(tmp_path, hea
     """A log saved by a spreadsheet in a European locale (semicolons between the fields, decimal commas): init took the
     commas for the delimiter (one field named 'time;joint_pos_1;…'); it now writes delimiter = ";" and decimal = ",",
     and the log reads as the same numbers as the one written with points and commas."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     log = _log(tmp_path, header=header)
     european = tmp_path / "european.csv"
@@ -877,7 +877,7 @@ def test_init_reads_a_european_spreadsheets_export_as_the_same_log(tmp_path, hea
 def test_a_decimal_separator_that_is_the_delimiter_is_refused(tmp_path):
     """``decimal = ","`` beside the default comma delimiter cannot be read: refused in one line naming the field."""
     from dynid.exceptions import ConfigError
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     log = _log(tmp_path, header=True)
     p = run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml"))
@@ -895,8 +895,8 @@ def test_a_decimal_separator_that_is_the_delimiter_is_refused(tmp_path):
 def test_init_and_identify_read_a_log_and_a_config_that_start_with_a_byte_order_mark(tmp_path):
     """A spreadsheet's "CSV UTF-8" starts with a byte-order mark (and an editor may save a TOML so): init read the
     first column as '\\ufefftime' and found no time column; the log now reads as the same numbers, the config too."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     log = _log(tmp_path, header=True)
     marked = tmp_path / "marked.csv"
@@ -957,8 +957,8 @@ def test_init_takes_a_headerless_log_without_time_stamps_at_its_rate_and_says_an
     """A log of bare numbers, positions then torques, without time stamps (the Med7's recordings without their header
     line): refused even with --rate ("expected a time column"); it is now read at that rate, the arm's joint torque
     sensors inferred as for a log with a header. A --rate beside a time column was dropped without a word: said."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     log = dynid.simulated_log(dynid.load_robot(URDF), seconds=5, rng=4)
     bare = tmp_path / "bare.csv"
@@ -986,7 +986,7 @@ def test_inits_check_identifies_a_long_logs_first_minutes_and_a_chosen_stretch_a
     only the rows that hold them, finds the flipped sign there as on the whole log, and reads a stretch the config
     chose (rows) as chosen."""
     import dynid.identification.starter_check as check
-    from dynid.io import datasets
+    from dynid.io.logs import datasets
 
     log = _log(tmp_path, header=True)
     text = log.read_text().splitlines()
@@ -1066,7 +1066,7 @@ def test_inits_check_starts_its_stretch_where_a_long_log_first_moves(monkeypatch
     (it began at the log's first sample, 120 s of rest checked nothing); a log no longer than the stretch is kept whole,
     and a stretch never runs past the log's end."""
     import dynid.identification.starter_check as check
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
 
     monkeypatch.setattr(check, "CHECKED_SECONDS", 4.0)
     t = np.arange(0.0, 20.0, 0.01)

@@ -50,7 +50,7 @@ def test_migrate_rewrites_an_inline_table(tmp_path):
     the user back to migrate; the inline table is now rewritten (tomlkit), its comments kept."""
     import tomllib
 
-    from dynid.io.migrate import migrate_text
+    from dynid.io.config.migrate import migrate_text
 
     text = ('# my arm\nrobot = "ur10e"\nestimation = { method = "wls", physically_consistent = true }  # as in 0.1\n'
             'preprocessing = { torque_cutoff = 5.0 }\n[identification]\nfile = "log.csv"  # the run of May\n')

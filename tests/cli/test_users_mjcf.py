@@ -5,7 +5,7 @@ by default; a model that is not the robot's is refused in one line before any wo
 import numpy as np
 import pytest
 
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 
 from ..io.test_mjcf_write_back import TETRAHEDRON, _users_mjcf
 from ..simulated_logs import simulated_case

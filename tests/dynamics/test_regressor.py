@@ -120,7 +120,7 @@ import sys
 import numpy as np
 from dynid.dynamics import regressor as module
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.model.description import load_robot
 run_identification(load_identification_config(sys.argv[1], data_root=sys.argv[2]))
 assert "numba" not in sys.modules, "numba loaded"

@@ -17,7 +17,7 @@ from dynid.dynamics.kinematics import forward_kinematics
 from dynid.excitation.constraints import Workspace, floor_margins
 from dynid.excitation.floor import FloorDistances, floor_needs, lowest_points
 from dynid.excitation.link_geometry import LinkGeometry, link_geometry_from_urdf
-from dynid.io.cell_replay import cell_contacts
+from dynid.io.exported.cell_replay import cell_contacts
 from dynid.model.description import load_robot
 
 from ..cli.refusals import dynid

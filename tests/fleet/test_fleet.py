@@ -58,7 +58,7 @@ def test_a_tx40_fleet_finds_its_unit_whose_drive_gain_is_off(tmp_path):
     as an encoder reads them): the gains identified against the truth (1, one unit's K2 5 % off), friction within 5 %,
     joint 6's gain undetermined (the calibration payload sits on its axis), and the odd unit flagged on K2 first."""
     from dynid.fleet.identification import run_fleet
-    from dynid.io.fleet_manifest import load_fleet_manifest
+    from dynid.io.config.fleet_manifest import load_fleet_manifest
 
     truths = simulate_fleet(tmp_path, robot="tx40", units=6, seconds=20.0, rate=200.0, validation_seconds=10.0,
                             odd_unit=2, odd_joint=2, rng=0)
@@ -79,7 +79,7 @@ def test_the_fleet_helps_a_unit_with_a_short_log(tmp_path):
     """Five units, each identified from half of its log: pooled with the others, each predicts its validation motion
     (noise-free, so the error is the model's alone) better than from its half log alone."""
     from dynid.fleet.identification import run_fleet
-    from dynid.io.fleet_manifest import load_fleet_manifest
+    from dynid.io.config.fleet_manifest import load_fleet_manifest
 
     root = tmp_path / "fleet"
     simulate_fleet(root, units=5, seconds=20.0, rate=200.0, validation_seconds=10.0, odd_unit=None, payload_max=0.0,
@@ -137,7 +137,7 @@ def test_a_units_stated_tool_is_taken_into_its_model_before_the_comparison(tmp_p
     import shutil
 
     from dynid.fleet.identification import run_fleet
-    from dynid.io.fleet_manifest import load_fleet_manifest
+    from dynid.io.config.fleet_manifest import load_fleet_manifest
 
     simulate_fleet(tmp_path / "bare", units=4, seconds=20.0, rate=200.0, validation_seconds=6.0, odd_unit=None,
                    payload_max=0.0, rng=3)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 
 from ..simulated_logs import simulated_case, truth_beta
 

@@ -12,8 +12,8 @@ import numpy as np
 
 def test_a_given_decimation_keeps_the_clis_samples_and_relative_error_is_its_figure(tmp_path):
     from dynid.identification.identified import load_results
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from tests.cli.refusals import dynid
     from tests.simulated_logs import simulated_case
 
@@ -44,8 +44,8 @@ def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path):
     import dynid
     from dynid.identification.identified import IdentifiedModel
     from dynid.identification.run import run_identification, run_validation
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from tests.conftest import shared_data
 
     repo = Path(__file__).resolve().parents[2]
@@ -67,8 +67,8 @@ def test_every_route_gives_one_model_and_one_figure_with_the_defaults(tmp_path):
     friction models chosen by cross-validation: arrays took the description's terms), so they give the same estimate
     and the same figure to 1e-9."""
     from dynid import Identifier, identify_from_arrays
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from tests.simulated_logs import simulated_case
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)
@@ -94,7 +94,7 @@ def test_a_robot_table_of_a_urdf_fits_what_the_urdf_alone_fits(tmp_path):
     silence (validation 0.292 % -> 0.716 %): the table's default drive terms are now the URDF's, and both give one
     model."""
     from dynid import Identifier
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.cli.refusals import dynid
 
     folder = tmp_path / "try"

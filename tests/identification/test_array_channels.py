@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import DataError
-from dynid.io.datasets import recording_from_arrays
+from dynid.io.logs.datasets import recording_from_arrays
 from dynid.model.description import load_robot
 
 

@@ -6,7 +6,7 @@ import pytest
 
 import dynid
 from dynid.exceptions import DataError
-from dynid.io.datasets import recording_from_arrays
+from dynid.io.logs.datasets import recording_from_arrays
 
 
 def test_positions_in_degrees_given_as_arrays_are_refused_as_a_files_are():

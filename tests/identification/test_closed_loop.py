@@ -9,7 +9,7 @@ from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError, ShapeError
 from dynid.excitation.paper_trajectories import paper_identification_trajectory
 from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
-from dynid.io.datasets import Recording
+from dynid.io.logs.datasets import Recording
 from dynid.preprocessing.bands import estimate_band
 from dynid.preprocessing.pipeline import Preprocessing
 from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop

@@ -17,7 +17,7 @@ def test_an_inconsistent_file_gets_a_consistent_candidate_by_default(tmp_path):
     from dynid.dynamics.layout import consistency_layout
     from dynid.identification.estimates import CONSISTENT_NOMINAL_LABEL, SDP_LABEL
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.model.spatial import is_physically_consistent
     from tests.simulated_logs import simulated_case
 

@@ -180,7 +180,7 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
 def _setup_and_recording(root):
     """The ER-16, the fixture's controller with its set-points, and its log as a Recording."""
     from dynid.identification.closed_loop import ClosedLoopSetup
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
     from dynid.simulation.closed_loop import Controller
 
     log = np.loadtxt(root / "log.csv", delimiter=",", skiprows=1)
@@ -246,8 +246,8 @@ def test_the_reference_is_read_at_the_angles_the_log_is(tmp_path):
     given, a quarter turn from the log's motion, which IDIM-IV and DIDIM would simulate as the reference."""
     from importlib import resources
 
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     text = (resources.files("dynid.model") / "robots" / "er16.toml").read_text()
     head, first, rest = text.partition('[[joints]]\nname = "joint2"\n')

@@ -81,7 +81,7 @@ def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
 
     from dynid.identification.pipeline import IdentificationPipeline
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.conftest import shared_data
 
     robot = dynid.load_robot("ur10e")

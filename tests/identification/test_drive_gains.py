@@ -8,7 +8,7 @@ import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.identification.drive_gains import identify_drive_gains, identify_payload
-from dynid.io.datasets import Recording
+from dynid.io.logs.datasets import Recording
 from dynid.model.spatial import inertial_from_physical
 from dynid.preprocessing.pipeline import Preprocessing, prepare
 
@@ -53,7 +53,7 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     from pathlib import Path
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..conftest import shared_data
 
@@ -82,7 +82,7 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
 
     from dynid.identification.run import run_identification
     from dynid.io import write_json
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.runtime import processes
     from dynid.runtime.processes import allow_forks
     from dynid.runtime.threads import cores
@@ -177,7 +177,7 @@ def test_a_drive_gains_error_names_the_runs_it_comes_from(tmp_path):
 
     from dynid.exceptions import DynIdError
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..conftest import shared_data
 

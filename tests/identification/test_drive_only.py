@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 
 from ..cli.refusals import dynid
 from ..conftest import shared_data

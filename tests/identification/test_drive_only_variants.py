@@ -19,8 +19,8 @@ import pytest
 import dynid.identification.pipeline as pipeline_module
 from dynid.dynamics.regressor import regressor
 from dynid.identification.run import pipeline_of, run_identification
-from dynid.io.datasets import load_recording
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
+from dynid.io.logs.datasets import load_recording
 from dynid.report.summaries import in_short
 
 from ..cli.refusals import dynid

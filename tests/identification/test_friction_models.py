@@ -32,7 +32,7 @@ def test_stribeck_and_load_dependent_friction_are_found_where_they_are(tmp_path)
     from dataclasses import replace
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     rng = np.random.default_rng(7)
     robot, _ = truth_robot("er16", rng)
@@ -79,7 +79,7 @@ def test_the_state_at_rest_is_judged_only_on_a_log_with_rests(tmp_path):
     motion only while it moves): the cross-validation chooses "zero" (or a quick relaxation) at rest on the joints
     with a large Coulomb torque; on a Fourier log without rests, every joint stays "held"."""
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     rng = np.random.default_rng(11)
     robot, _ = truth_robot("er16", rng)

@@ -7,7 +7,7 @@ from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.model.description import load_robot
 
 from ..conftest import shared_data, sine_motion, without_wall_times
@@ -244,7 +244,7 @@ def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch
     by chunk: on the UR10e logs spooled that way, identification and validations give the results of the
     in-memory path, every number of results.json."""
     from dynid._util.column_store import StoredColumns
-    from dynid.io import datasets
+    from dynid.io.logs import datasets
 
     root = shared_data("ur10e_mamedov2020")
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)

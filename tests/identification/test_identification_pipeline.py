@@ -9,8 +9,8 @@ import pytest
 import dynid
 from dynid.exceptions import ConfigError
 from dynid.identification.pipeline import IdentificationPipeline
-from dynid.io.datasets import load_recording
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
+from dynid.io.logs.datasets import load_recording
 
 from ..simulated_logs import config_text, point_to_point_motion, robot_toml, truth_robot, write_log, write_truth
 

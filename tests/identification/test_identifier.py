@@ -275,7 +275,7 @@ def test_validate_takes_a_raw_logs_arrays_as_score_and_relative_error_do(er16, f
     """``ident.validate(t, q, tau)`` raised "takes 2 positional arguments but 4 were given" where ``score(t, q, tau)``
     and ``relative_error(t, q, tau)`` take a raw log's arrays: it takes them too, and scores the samples the log's
     recording gives (the arrays made into a recording as the log readers make one)."""
-    from dynid.io.datasets import recording_from_arrays
+    from dynid.io.logs.datasets import recording_from_arrays
 
     _, _, other = er16
     t, q, tau = other.t, np.asarray(other.q), np.asarray(other.tau)

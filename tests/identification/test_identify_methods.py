@@ -10,7 +10,7 @@ import pytest
 
 from dynid.exceptions import ConfigError
 from dynid.identification.run import run_identification, run_validation
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.report.identification_run import save_identification
 
 from ..simulated_logs import simulated_case, truth_beta
@@ -85,7 +85,7 @@ def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
     """``identify(..., "wls")`` is WLS, not the estimators "w", "l", "s"."""
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.identify import identify
-    from dynid.io.datasets import load_recording
+    from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.pipeline import prepare
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
@@ -142,7 +142,7 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     """``estimators = ["ols", { key = "sdp", prior_kind = "geometric" }]``: the SDP keeps what the data do not determine near the nominal links by
     the pseudo-inertias' log-det divergence (Lee, Wensing & Park 2020): the fit is the Euclidean prior's, and every
     link of the estimate is a non-degenerate mass distribution (principal inertias of the nominal's order)."""
-    from dynid.io.export import consistent_estimate
+    from dynid.io.exported.export import consistent_estimate
     from dynid.model.spatial import physical_from_inertial
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 125.0, "fourier", seed=4, duration=30.0)
@@ -190,7 +190,7 @@ def test_a_drafts_sdp_prior_is_refused_in_one_line_saying_the_estimators_entry(t
     """``[estimation] sdp_prior`` (an earlier 0.2.0 draft's key; no release had it) is refused when the config is read,
     in one line naming the file, the key and the estimators list's entry that says it; that entry gives the SDP its
     prior."""
-    from dynid.io.migrate import migrate_text
+    from dynid.io.config.migrate import migrate_text
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     text = cfg.read_text().replace('estimators = ["ols"]\n', 'estimators = ["ols", "sdp"]\nsdp_prior = "geometric"\n')

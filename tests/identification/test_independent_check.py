@@ -23,7 +23,7 @@ import pytest
 
 from dynid.dynamics.regressor import regressor
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.model.description import load_robot
 
 from ..mujoco_logs import Drives, simulate, write_csv

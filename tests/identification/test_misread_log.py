@@ -41,7 +41,7 @@ def test_velocities_read_as_torques_are_not_ready_and_no_model_is_written(tmp_pa
 
 def test_positions_read_as_torques_are_named_as_positions(tmp_path):
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.simulated_logs import simulated_case
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)

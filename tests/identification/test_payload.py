@@ -48,7 +48,7 @@ def identified(tmp_path_factory):
 
 def test_the_payload_is_found_in_the_flanges_frame(identified):
     from dynid.identification.run import run_payload
-    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from dynid.io.config.identification_config import dataset_for_file, load_identification_config
 
     cfg, truth, folder, results = identified
     config = load_identification_config(cfg)
@@ -96,7 +96,7 @@ def test_a_fit_far_above_the_noise_floor_is_said(identified, tmp_path):
     unflagged (a gripper jaw as the last link, torques negated: 2.49 kg with its centre of mass 1.5 m off). The
     simulated payload fits near the floor and is not flagged; the same log with its torques negated is."""
     from dynid.identification.run import run_payload
-    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from dynid.io.config.identification_config import dataset_for_file, load_identification_config
     from tests.cli.refusals import dynid
 
     cfg, truth, folder, results = identified

@@ -18,7 +18,7 @@ def test_the_main_estimates_negative_friction_is_a_finding_of_the_verdict(tmp_pa
     the joint; the same result with that friction positive gets none."""
     from dynid.identification.run import run_identification
     from dynid.identification.verdict import choose_main_estimate
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.simulated_logs import simulated_case
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=10.0)

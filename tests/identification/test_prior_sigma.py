@@ -15,7 +15,7 @@ def _stated(folder, sigma: float | None, term: str, joint: int, value: float, es
     """The ER-16's simulated case in ``folder`` identified with ``term`` of ``joint`` stated as ``{ value, sigma }``
     (``value`` alone without a σ) in place of the simulated arm's own, where it states one."""
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.simulated_logs import simulated_case
 
     folder.mkdir()

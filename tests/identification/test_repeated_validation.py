@@ -5,8 +5,8 @@ import json
 
 import numpy as np
 
-from dynid.io.datasets import Recording
-from dynid.io.log_repairs import repeated_share
+from dynid.io.logs.datasets import Recording
+from dynid.io.logs.log_repairs import repeated_share
 
 from ..cli.refusals import dynid
 

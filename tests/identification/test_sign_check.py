@@ -438,8 +438,8 @@ def test_motor_currents_given_as_torques_are_told_the_descriptions_gains_were_no
     recording now carries the gains it was read through (none here), and the finding names the description's gains
     and how to apply them; the config that reads the same columns as currents, through those gains, has no finding."""
     import dynid
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     cfg, truth = simulated_case(tmp_path, "ur10e", 125.0, "fourier", duration=20.0)
     config = load_identification_config(cfg)

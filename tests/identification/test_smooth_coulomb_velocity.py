@@ -12,7 +12,7 @@ from importlib import resources
 import numpy as np
 
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 
 from ..mujoco_logs import Drives, simulate, write_csv
 

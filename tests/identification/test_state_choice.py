@@ -11,7 +11,7 @@ from dynid.exceptions import ConfigError
 from dynid.identification.evidence import state_evidence
 from dynid.identification.run import run_identification
 from dynid.identification.verdict import STATE_SIGMAS
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from tests.simulated_logs import simulated_case
 
 

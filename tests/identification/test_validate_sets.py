@@ -10,8 +10,8 @@ import pytest
 def test_validate_sets_reads_a_generator_one_log_at_a_time_and_refuses_a_log_not_read(tmp_path):
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.evidence import validate_sets
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from tests.simulated_logs import simulated_case
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=6.0)
@@ -45,8 +45,8 @@ def test_run_validation_takes_a_log_read_already_as_its_config_dataset(tmp_path)
     import json
 
     from dynid.identification.run import run_identification, run_validation
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.report.identification_run import save_identification
     from tests.simulated_logs import simulated_case
 

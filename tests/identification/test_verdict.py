@@ -62,7 +62,7 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     finding says to keep them, and the first line, results.json and the validation figures name the same set."""
     import dynid.identification.verdict as verdict
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.report.output import write_results
     from dynid.report.summaries import identification_brief, in_short
     from dynid.tables import render_text
@@ -85,7 +85,9 @@ def test_the_description_itself_is_the_main_estimate_where_it_predicts_best(tmp_
     assert len(main) == 1 and main[0].text.startswith(f"main estimate: {nominal}: keep your robot file's values")
     write_results(tmp_path / "results.json", result.to_dict(), "identify")  # as dynid identify writes it
     assert json.loads((tmp_path / "results.json").read_text())["main_estimate"] == nominal
-    from dynid.io.export import nominal_warning  # what dynid export says before it writes the file's own values
+    from dynid.io.exported.export import (
+        nominal_warning,  # what dynid export says before it writes the file's own values
+    )
 
     stored = json.loads((tmp_path / "results.json").read_text())
     assert nominal_warning(stored).startswith(f"the estimate written is {nominal}, the robot file's own values")
@@ -174,7 +176,7 @@ def _window(tmp_path, name: str, start: float, stop: float, validation: bool = T
     from dataclasses import replace
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     folder = {"kuka_kr300": "kuka_kr300_weigand2021", "kuka_med7": "kuka_med7_lbrstack"}[name]
     text = (REPO / "configs" / f"{name}.toml").read_text().replace(
@@ -197,8 +199,8 @@ def test_a_one_log_user_reads_what_held_out_blocks_say_of_every_candidate(tmp_pa
 
     from dynid.identification.estimates import DRIVE_ONLY_LABEL, NOMINAL_LABEL
     from dynid.identification.run import pipeline_of, run_identification
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.pipeline import prepared_rows
     from dynid.report.summaries import readiness
 

@@ -38,7 +38,7 @@ def test_a_joint_logged_within_one_turn_is_identified_as_the_one_that_runs_on(tm
 
 def test_arrays_within_one_turn_are_taken_back_too():
     """The same rule where the arrays are given (Identifier, identify_arrays): positions equal the turning angle."""
-    from dynid.io.datasets import recording_from_arrays
+    from dynid.io.logs.datasets import recording_from_arrays
     from dynid.model.description import load_robot
 
     robot = load_robot("ur10e")

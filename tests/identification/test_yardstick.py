@@ -10,7 +10,7 @@ import numpy as np
 
 def _identify(cfg, preprocessing: str = ""):
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     text = cfg.read_text()
     if preprocessing:
@@ -91,7 +91,7 @@ def test_logs_at_rest_throughout_do_not_dilute_the_yardstick_headline():
     from pathlib import Path
 
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from dynid.report.summaries import in_short
     from dynid.validation.torques import rests_throughout
     from tests.conftest import shared_data
@@ -120,8 +120,8 @@ def test_the_yardstick_scores_the_torques_as_measured(tmp_path):
     of the torque, under every state filter: the noise, which no model predicts, is not filtered away (a yardstick
     that low-passed the torques scored the truth at 28 % of it). The noise is measured independently from the
     log's second differences (white noise: var(Δ²τ) = 6σ²)."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from tests.simulated_logs import simulated_case
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=10.0, current_std=0.5)
@@ -152,8 +152,8 @@ def test_the_verdict_chooses_what_predicts_the_raw_torques_on_a_real_window(tmp_
     from dynid.identification.estimates import DRIVE_ONLY_LABEL
     from dynid.identification.evidence import NOMINAL_LABEL
     from dynid.identification.run import run_identification
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.pipeline import prepare
     from dynid.preprocessing.settings import Preprocessing
     from dynid.validation.torques import compare_torques

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError, DataError
-from dynid.io.datasets import dataset_spec, load_recording
+from dynid.io.logs.datasets import dataset_spec, load_recording
 from dynid.model.description import load_robot
 
 
@@ -89,7 +89,7 @@ def test_a_bag_with_missing_efforts_is_filled_as_a_log_is(tmp_path):
 def test_a_validation_table_of_a_bag_config_inherits_the_bags_reader_settings(tmp_path):
     """issue "Nothing runs, nothing silent": a [[validation]] bag table inherited neither ``bag`` nor ``joint_names``
     (a table with only ``time_range`` was refused, one naming another bag read it with the default joint order)."""
-    from dynid.io.identification_config import with_inherited_layout
+    from dynid.io.config.identification_config import with_inherited_layout
 
     names = list("abcdef")
     doc = {"identification": {"bag": "ident", "topic": "/arm/joint_states", "joint_names": names, "effort": "currents",
@@ -108,7 +108,7 @@ def test_validate_file_reads_the_file_it_is_given_with_the_configs_reader(tmp_pa
     """``dynid validate CONFIG --file LOG`` on a bag config scored the identification bag and labelled it LOG, even
     for a LOG that did not exist; a CSV config's --file lost its time unit (milliseconds read as seconds)."""
     from dynid.exceptions import DataError
-    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from dynid.io.config.identification_config import dataset_for_file, load_identification_config
 
     names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
     t = np.arange(50) * 0.01

@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from dynid.io.columns import named_out_of_order
+from dynid.io.logs.columns import named_out_of_order
 
 from ..cli.refusals import dynid, snapshot
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 
 from dynid.identification.run import run_identification
-from dynid.io.identification_config import load_identification_config
-from dynid.io.migrate import migrate_text
+from dynid.io.config.identification_config import load_identification_config
+from dynid.io.config.migrate import migrate_text
 
 from ..conftest import shared_data
 from ..results_figures import global_errors

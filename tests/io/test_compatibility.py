@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.io.identification_config import load_identification_config
-from dynid.io.migrate import migrate_text
+from dynid.io.config.identification_config import load_identification_config
+from dynid.io.config.migrate import migrate_text
 
 from ..cli.refusals import dynid
 from ..conftest import shared_data

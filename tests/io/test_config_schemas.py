@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from dynid._util.typed import json_schema
-from dynid.io.config_types import SCHEMAS
+from dynid.io.config.config_types import SCHEMAS
 
 jsonschema = pytest.importorskip("jsonschema")
 REPO = Path(__file__).resolve().parents[2]
@@ -30,7 +30,7 @@ def _validator(name):
 def test_the_shipped_schema_is_the_structure_dynid_parses_with(name):
     kind, title, description = SCHEMAS[name]
     assert _schema(name) == json.loads(json.dumps(json_schema(kind, title, description))), \
-        "regenerate with: python -m dynid.io.config_types"
+        "regenerate with: python -m dynid.io.config.config_types"
 
 
 def _kind(path: Path) -> str:
@@ -73,7 +73,7 @@ IDENT = '[identification]\npreset = "ur-rtde"\nfile = "x.csv"\n'
 ])
 def test_the_schema_refuses_what_dynid_refuses(tmp_path, text, where):
     from dynid.exceptions import ConfigError
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     (tmp_path / "x.csv").write_text("0\n")
     (tmp_path / "c.toml").write_text(BASE + text)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError, DataError
-from dynid.io.datasets import dataset_spec, load_recording
+from dynid.io.logs.datasets import dataset_spec, load_recording
 from dynid.model.description import load_robot
 from dynid.preprocessing.pipeline import prepare
 from dynid.preprocessing.settings import Preprocessing
@@ -511,7 +511,7 @@ def test_isolated_spikes_in_the_currents_are_replaced_and_said(tmp_path, rng, sp
     as torque: on a simulated UR5 log 50 such spikes tripled the validation error and made a 11-sample torque delay
     finding up. Each is now replaced by the median of the five samples around it, one warning naming the log, the
     joint, the count and the largest; the other samples, and a log without spikes, are read bit for bit as before."""
-    from dynid.io.log_repairs import SPIKE_SPREADS
+    from dynid.io.logs.log_repairs import SPIKE_SPREADS
 
     t = np.arange(600) * 0.01
     q = 0.3 * np.sin(np.outer(t, np.arange(1, 7)))

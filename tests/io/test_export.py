@@ -9,7 +9,7 @@ import pytest
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.export import urdf_from_results, urdf_from_robot
+from dynid.io.exported.export import urdf_from_results, urdf_from_robot
 from dynid.model.description import load_robot
 
 
@@ -88,7 +88,7 @@ def test_the_users_urdf_gets_the_identified_values_and_keeps_everything_else(tmp
     from importlib import resources
 
     import dynid
-    from dynid.io.urdf_write_back import urdf_written_back
+    from dynid.io.exported.urdf_write_back import urdf_written_back
 
     urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
     robot = dynid.load_robot(urdf)
@@ -119,7 +119,7 @@ def test_a_link_far_from_the_urdfs_values_is_said(tmp_path):
     from importlib import resources
 
     import dynid
-    from dynid.io.urdf_write_back import urdf_written_back
+    from dynid.io.exported.urdf_write_back import urdf_written_back
 
     urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))
     robot = dynid.load_robot(urdf)

@@ -6,7 +6,7 @@ import pytest
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.export import mjcf_from_robot
+from dynid.io.exported.export import mjcf_from_robot
 from dynid.model.description import load_robot
 
 from .test_export import _with_friction
@@ -62,7 +62,7 @@ def test_mjcf_refuses_inconsistent_parameters():
 def test_the_tx40s_coupled_motor_friction_is_read_back_as_held_and_its_inertia_as_missing(rng):
     """The TX40's motor 6 turns with joints 5 and 6: its viscous and dry friction are a fixed tendon of the MJCF, read
     back by MuJoCo as part of the model the file holds (to round-off); its inertia is not held and is said."""
-    from dynid.io.replay import mjcf_replay
+    from dynid.io.exported.replay import mjcf_replay
 
     robot = _with_friction(load_robot("tx40"), rng)
     phi = robot.standard_parameters()
@@ -74,7 +74,7 @@ def test_the_tx40s_coupled_motor_friction_is_read_back_as_held_and_its_inertia_a
 def test_a_users_mjcf_written_back_holds_the_coupled_motor_as_dynids_own_does(rng, tmp_path):
     """The TX40's coupled motor's friction written into a user's own MJCF: the same tendon, the joints' damping less its
     diagonal share: MuJoCo's viscous torques of the two files equal."""
-    from dynid.io.mjcf_write_back import mjcf_written_back
+    from dynid.io.exported.mjcf_write_back import mjcf_written_back
 
     from .test_mjcf_write_back import TETRAHEDRON, _users_mjcf
 

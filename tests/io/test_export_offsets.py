@@ -4,7 +4,7 @@ from importlib import resources
 
 import pinocchio as pin
 
-from dynid.io.export import mjcf_from_robot, urdf_from_robot
+from dynid.io.exported.export import mjcf_from_robot, urdf_from_robot
 from dynid.model.description import load_robot
 
 NOTE = "encoder angle (what a log and the controller hold) plus its position_offset (J2 +90°)"

@@ -109,8 +109,8 @@ def _frictionloss(path):
 def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_log_better(ur10e, tmp_path):
     from dynid import load_identification_config
     from dynid.identification.run import moving_validation
-    from dynid.io.export import consistent_estimate, mjcf_from_robot
-    from dynid.io.replay import mjcf_replay
+    from dynid.io.exported.export import consistent_estimate, mjcf_from_robot
+    from dynid.io.exported.replay import mjcf_replay
 
     root, out, p = ur10e
     res = json.loads((out / "results.json").read_text())
@@ -186,7 +186,7 @@ def test_the_files_take_the_choice_made_for_the_estimate_they_are_written_from(u
     """Each estimate the files may be written from has its own choice (the physically consistent one, the drive-only
     candidate): a choice made for another estimate is not applied to this one."""
     from dynid import load_identification_config
-    from dynid.io.export import consistent_estimate, file_parameters
+    from dynid.io.exported.export import consistent_estimate, file_parameters
     from dynid.io.results import stored_standard
 
     root, out, _ = ur10e

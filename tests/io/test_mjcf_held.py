@@ -42,7 +42,7 @@ def test_the_write_back_into_an_mjcf_with_a_held_gripper_loads_and_reproduces_th
     import mujoco
 
     from dynid.dynamics.regressor import regressor
-    from dynid.io.mjcf_write_back import mjcf_written_back
+    from dynid.io.exported.mjcf_write_back import mjcf_written_back
     from dynid.model.description import load_robot
 
     path = tmp_path / "arm.xml"

@@ -13,7 +13,7 @@ from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.kinematics import forward_kinematics
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.mjcf_write_back import mjcf_written_back
+from dynid.io.exported.mjcf_write_back import mjcf_written_back
 
 from .test_export import _with_friction
 

@@ -3,7 +3,7 @@ import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.exceptions import DataError
-from dynid.io.references import load_reference, parse_expression
+from dynid.io.config.references import load_reference, parse_expression
 from dynid.model.description import load_robot
 
 
@@ -45,7 +45,7 @@ def test_base_set_matched_to_dynid_regrouping(tmp_path):
 
 def test_nominal_reference_is_the_descriptions_own_values(tmp_path):
     from dynid.dynamics.base_parameters import base_parameters
-    from dynid.io.references import load_reference
+    from dynid.io.config.references import load_reference
     from dynid.model.description import load_robot
 
     robot = load_robot("er16")

@@ -9,7 +9,7 @@ from pathlib import Path
 import msgspec
 import pytest
 
-from dynid.io import config_types
+from dynid.io.config import config_types
 from dynid.simulation.closed_loop import Controller
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "configuration.md"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
-from dynid.io.identification_config import load_identification_config
+from dynid.io.config.identification_config import load_identification_config
 from dynid.model.description import load_robot
 
 URDF = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))

@@ -9,7 +9,7 @@ import pytest
 
 import dynid
 from dynid.exceptions import ConfigError
-from dynid.io.urdf_write_back import urdf_written_back
+from dynid.io.exported.urdf_write_back import urdf_written_back
 
 # A URDF as vendors write them: a declaration and comments before <robot> (one with a non-ASCII letter, so byte and
 # character offsets differ), " />" and "/>" mixed, an inertial spread over lines with <mass> first, a moving link with
@@ -167,7 +167,7 @@ def test_a_robot_mounted_otherwise_keeps_its_gravity_in_a_comment_and_is_read_ba
     -z gets no such comment."""
     from dataclasses import replace
 
-    from dynid.io.replay import urdf_replay
+    from dynid.io.exported.replay import urdf_replay
 
     users = tmp_path / "arm3.urdf"
     users.write_text(USERS, encoding="utf-8")

@@ -24,8 +24,8 @@ def test_a_validation_table_with_only_its_torques_takes_the_identifications_othe
     """A user flipping the sign of a validation log's torques (``torques = {..., sign = -1}``, the Med7's logs) was
     told "validation[0]: expected 'positions'": a table that gave its torques took none of the identification's
     columns. It now takes the time and positions it does not give; its own torques replace the identification's."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.model.description import load_robot
 
     cfg = load_identification_config(_config(tmp_path, f'name = "other"\nfile = "other.csv"\ntorques = {{ columns = '
@@ -43,7 +43,7 @@ def test_a_validation_table_with_only_its_torques_takes_the_identifications_othe
 def test_a_validation_table_with_currents_does_not_also_take_the_identifications_torques(tmp_path):
     """Its own signal kind replaces the identification's: currents there, no torques carried over beside them (which
     would be two torque channels, refused)."""
-    from dynid.io.identification_config import with_inherited_layout
+    from dynid.io.config.identification_config import with_inherited_layout
 
     doc = {"identification": {"file": "a.csv", "header": True, "time": {"column": "t"}, "positions": {"columns": [1]},
                               "torques": {"columns": [2]}},
@@ -60,8 +60,8 @@ def test_a_validation_table_with_only_a_time_range_scores_another_stretch_of_the
     time_range = [...]`` was refused ("validation[0].positions: expected a 'file'"), as a ROS 2 bag's table already
     did right. It takes the identification's file and columns; with signals in files of their own (a motor-side log),
     those files."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config, with_inherited_layout
+    from dynid.io.config.identification_config import load_identification_config, with_inherited_layout
+    from dynid.io.logs.datasets import load_recording
     from dynid.model.description import load_robot
 
     cfg = load_identification_config(_config(tmp_path, 'name = "later"\ntime_range = [1.0, 1.5]\n'))
@@ -85,8 +85,8 @@ def test_a_validation_table_with_only_a_time_range_scores_another_stretch_of_the
 def test_validate_file_reads_the_whole_other_log_not_the_identifications_time_range(tmp_path):
     """``dynid validate CONFIG --file LOG`` cut LOG to the identification's ``time_range`` (a Med7 config identified on
     0-70 s scored a 16 s log with "time_range ends at 70 s, after the recording's end"); ``rows`` were already reset."""
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import dataset_for_file, load_identification_config
+    from dynid.io.config.identification_config import dataset_for_file, load_identification_config
+    from dynid.io.logs.datasets import load_recording
     from dynid.model.description import load_robot
 
     path = _config(tmp_path, 'name = "other"\nfile = "other.csv"\n')

@@ -9,8 +9,8 @@ import pytest
 
 import dynid
 from dynid.exceptions import ConfigError, DataError
-from dynid.io.starter import starter_config
-from dynid.io.urdf_write_back import urdf_written_back
+from dynid.io.config.starter import starter_config
+from dynid.io.exported.urdf_write_back import urdf_written_back
 from dynid.model.description import robot_from_document
 from dynid.model.urdf import joints_from_urdf, joints_to_hold
 

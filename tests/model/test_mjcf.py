@@ -12,8 +12,8 @@ import pytest
 
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.configs import config_mjcf, config_robot, config_urdf
-from dynid.io.export import mjcf_from_robot
+from dynid.io.config.configs import config_mjcf, config_robot, config_urdf
+from dynid.io.exported.export import mjcf_from_robot
 from dynid.model.description import URDF_DYNAMICS_NOTE, load_robot
 
 ROBOTS = resources.files("dynid.model") / "robots"
@@ -196,7 +196,7 @@ def test_identify_writes_into_a_copy_of_the_mjcf_the_robot_was_read_from(tmp_pat
     """As a URDF the robot comes from gets the identified values written into a copy of it, so does an MJCF: the
     config's mjcf_model defaults to it (given, the given one); a robot holding joints fixed gets a new MJCF instead
     (writing into the file would count the held bodies twice)."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     path = _mujoco_written(tmp_path, "ur10e")
     (tmp_path / "log.csv").write_text("".join(f"{k * 0.01}" + ",0" * 12 + "\n" for k in range(50)))
@@ -234,7 +234,7 @@ def test_a_hinge_held_at_an_angle_is_the_arm_with_that_joint_at_that_angle(tmp_p
 def test_init_holds_an_mjcfs_gripper_and_writes_a_config_that_loads(tmp_path):
     """dynid init on an MJCF with two fingers after the arm writes held = [...] (it refused before: "joint 'finger1'
     is a slide joint"), and the config it writes reads the three-joint arm."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..cli.refusals import dynid as run
 

@@ -165,7 +165,7 @@ def test_a_urdfs_joint_dynamics_are_said_and_not_taken_as_nominal_friction(tmp_p
 def test_load_robot_holds_a_grippers_joints_and_reads_inits_config(tmp_path):
     """issue "Nothing runs, nothing silent": ``load_robot("arm.urdf")`` refused a gripper and had no ``held=``, and
     refused the config ``dynid init`` wrote; both now give the arm with the fingers held, as identify reads it."""
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
     from tests.cli.refusals import dynid as run
 
     urdf = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf")).read_text(encoding="utf-8")

@@ -43,7 +43,7 @@ def test_a_xacro_description_is_the_robot_of_its_urdf(tmp_path, monkeypatch):
 
 
 def test_a_config_names_a_xacro_robot_and_export_writes_into_its_expansion(tmp_path, monkeypatch):
-    from dynid.io.configs import config_robot, config_urdf
+    from dynid.io.config.configs import config_robot, config_urdf
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     _xacro_of_ur10e(tmp_path)
@@ -103,7 +103,7 @@ def test_init_holds_a_xacro_grippers_fingers(tmp_path, monkeypatch):
 def test_xacro_arguments_reach_the_expansion_from_a_config_and_the_api(tmp_path, monkeypatch):
     """``xacro_args`` in a ``[robot]`` table (and ``load_robot(..., xacro_args=)``) are the file's ``name:=value``: the
     robot and the URDF export writes into are the expansion with them; given for a file that is not xacro, refused."""
-    from dynid.io.configs import config_robot, config_urdf
+    from dynid.io.config.configs import config_robot, config_urdf
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     path = _xacro_of_ur10e(tmp_path, "$(arg tool_mass)")
@@ -133,7 +133,7 @@ def test_init_writes_the_xacro_arguments_it_was_given(tmp_path, monkeypatch):
     (with the URDF's drive terms), identify's robot is the expansion with it; a malformed one is one line."""
     import tomllib
 
-    from dynid.io.configs import config_robot
+    from dynid.io.config.configs import config_robot
     from tests.cli.refusals import dynid as run
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))

@@ -81,7 +81,7 @@ def test_the_metrics_keep_half_the_samples_the_longest_clipped_joint_left_out_fi
 
 def test_a_log_whose_every_joint_is_dead_or_saturated_is_refused_in_one_line(rng):
     """Nothing can be estimated: one line naming the log, no traceback."""
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
     from dynid.preprocessing.pipeline import prepare
     from dynid.preprocessing.settings import Preprocessing
 
@@ -102,7 +102,7 @@ def test_measured_velocities_in_another_unit_sign_or_side_are_refused(rng, facto
     """Measured velocities that are not the positions' derivative (deg/s read as rad/s, a flipped sign, a motor-side
     velocity through a gear of 100): refused in one line naming the dataset, the joint and the ratio; the same
     velocities in rad/s pass (they were taken as they were, and every velocity-dependent term fitted to them)."""
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
     from dynid.preprocessing.pipeline import prepare
     from dynid.preprocessing.settings import Preprocessing
 
@@ -124,7 +124,7 @@ def test_measured_velocities_unlike_the_positions_are_refused_where_the_joint_mo
     """Joint 2's velocity column holding joint 3's velocities, or its motor current (which a viscous term then fits as
     the torque, below the noise floor): refused naming the joint and the correlation, with the setting that leaves
     them out. A joint that hardly moves (positions spanning 0.02 rad) is not required to follow."""
-    from dynid.io.datasets import Recording
+    from dynid.io.logs.datasets import Recording
     from dynid.preprocessing.pipeline import prepare
     from dynid.preprocessing.settings import Preprocessing
 

@@ -7,7 +7,7 @@ import pytest
 
 from dynid._util.column_store import StoredColumns
 from dynid.exceptions import ConfigError
-from dynid.io.datasets import Recording
+from dynid.io.logs.datasets import Recording
 from dynid.preprocessing.pipeline import Preprocessing, prepare, prepared_rows, torque_delayed
 from dynid.simulation.closed_loop import simulate_closed_loop
 from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay

@@ -89,7 +89,7 @@ def test_a_well_fitted_simulated_log_has_no_finding_and_a_counterbalance_is_foun
     not declare: the position finding names J2, with a size below the spring's (least squares takes most of it into
     the gravity parameters)."""
     from dynid.identification.run import run_identification
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
 
     from ..simulated_logs import write_log
 

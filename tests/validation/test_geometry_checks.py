@@ -179,8 +179,8 @@ def test_the_tx40s_logged_zeros_without_its_offsets_are_named_and_with_them_not(
 
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.run import pipeline_of
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     root = shared_data("staubli_tx40_figaroh")  # wherever the data are, not only beside the repository
     configs = Path(__file__).resolve().parents[2] / "configs"
@@ -259,8 +259,8 @@ def test_a_quarter_turn_of_the_med7s_j2_is_named_by_the_torques_sign_not_its_hal
 
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.run import pipeline_of
-    from dynid.io.datasets import load_recording
-    from dynid.io.identification_config import load_identification_config
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
 
     root = shared_data("kuka_med7_lbrstack")
     config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_med7.toml", data_root=root)

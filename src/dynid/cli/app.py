@@ -267,7 +267,7 @@ def identify(
 ) -> None:
     """Identify a robot's base parameters from its logs (OLS/WLS with σ), then validate them."""
     from ..identification.run import run_identification
-    from ..io.identification_config import load_identification_config
+    from ..io.config.identification_config import load_identification_config
 
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)  # a mistake is reported before any heavy import
@@ -383,7 +383,7 @@ def export(
     quiet: bool = QUIET,
 ) -> None:
     """Export the physically consistent estimate as URDF and/or MuJoCo MJCF (for Pinocchio, simulators, controllers)."""
-    from ..io.identification_config import load_identification_config
+    from ..io.config.identification_config import load_identification_config
 
     def _users_mjcf(cfg):  # the model --mjcf writes into: --mjcf-model, else the config's mjcf_model
         return mjcf_model if mjcf_model is not None else cfg.mjcf_model
@@ -398,7 +398,7 @@ def export(
         return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
 
     def compute(prepared, progress):
-        from ..io.export import consistent_estimate
+        from ..io.exported.export import consistent_estimate
 
         cfg, identified, targets = prepared
         moved: list[str] = []
@@ -430,7 +430,7 @@ def export(
             ("MJCF", getattr(_users_mjcf(cfg), "name", ""), _users_mjcf(cfg) is not None and mjcf is not None)) if given)
         for line in moved:
             rep.warning(f"far from the description's own values: {line}")
-        from ..io.export import nominal_warning, verdict_warnings
+        from ..io.exported.export import nominal_warning, verdict_warnings
 
         for line in verdict_warnings(computed[3]):
             rep.warning(line)
@@ -484,23 +484,23 @@ def _replay_log(cfg, identified: dict, robot):
 
 
 def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
-    """The written file read back by its tool (:mod:`dynid.io.replay`): ``(format, ReplayCheck)``, or the format and
+    """The written file read back by its tool (:mod:`dynid.io.exported.replay`): ``(format, ReplayCheck)``, or the format and
     why it was not read back. ``estimate``: the robot, dynid's whole model and results.json (what the file holds:
-    :func:`dynid.io.export.file_parameters`). On ``log`` (:func:`_replay_log`) where given, else on random states."""
-    from ..io.export import file_parameters
+    :func:`dynid.io.exported.export.file_parameters`). On ``log`` (:func:`_replay_log`) where given, else on random states."""
+    from ..io.exported.export import file_parameters
 
     robot, whole, identified = estimate
     on = {"whole": whole} if log is None else {"states": log[1], "measured": log[2], "whole": whole}
     held = file_parameters(robot, whole, identified, form="URDF" if flag == "--urdf" else "MJCF")[0]
     if flag == "--urdf":
-        from ..io.replay import urdf_replay
+        from ..io.exported.replay import urdf_replay
 
         return "URDF", urdf_replay(text, robot, held, **on)
     try:
         import mujoco  # noqa: F401  the MJCF's own reader
     except ImportError:
         return "MJCF", "MuJoCo is not installed (pip install 'dynid[mujoco]')"
-    from ..io.replay import mjcf_replay
+    from ..io.exported.replay import mjcf_replay
 
     try:
         return "MJCF", mjcf_replay(text, robot, held, **on)
@@ -521,7 +521,7 @@ def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | Non
     if mjcf_model is not None and not mjcf_model.is_file():
         raise DataError(f"--mjcf-model {mjcf_model}: no such file")
     if mjcf_model is not None:
-        from ..io.mjcf_write_back import read_users_mjcf
+        from ..io.exported.mjcf_write_back import read_users_mjcf
 
         read_users_mjcf(mjcf_model, robot)  # its joints are the robot's, before any work
     _check_targets(targets)
@@ -533,7 +533,7 @@ def _export_text(flag: str, cfg, identified: dict, source: str, users_mjcf: Path
     """The text of one ``dynid export`` file (``flag``: "--urdf" or "--mjcf"): the user's URDF or MJCF with the
     identified values written in, or a file of dynid's own where the description has none; values far from the
     description's own are appended to ``moved``."""
-    from ..io.model_files import written_model
+    from ..io.exported.model_files import written_model
 
     if flag == "--urdf":  # the user's URDF, the values written in; a DH description: a URDF of its own
         text, far = written_model("URDF", cfg.robot, identified, source, users_file=cfg.urdf)
@@ -582,7 +582,7 @@ def validate(
     """Validate identified parameters (and the config's reference sets) on other logs."""
     from ..exceptions import DataError
     from ..identification.run import run_validation
-    from ..io.identification_config import dataset_for_file, load_identification_config
+    from ..io.config.identification_config import dataset_for_file, load_identification_config
 
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)
@@ -629,7 +629,7 @@ def payload(
 ) -> None:
     """Identify a tool's payload (mass, centre of mass, inertia) from a log with it, the arm's model known."""
     from ..identification.run import run_payload
-    from ..io.identification_config import dataset_for_file, load_identification_config
+    from ..io.config.identification_config import dataset_for_file, load_identification_config
 
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)
@@ -731,7 +731,7 @@ def excite(
     from dataclasses import replace
 
     from ..identification.excitation_run import run_excitation
-    from ..io.excitation_config import load_excitation_config
+    from ..io.config.excitation_config import load_excitation_config
 
     def prepare():
         cfg = load_excitation_config(config)
@@ -775,7 +775,7 @@ def init(
     quiet: bool = QUIET,
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
-    from ..io.starter import check_target, starter_config, xacro_arguments
+    from ..io.config.starter import check_target, starter_config, xacro_arguments
     from ..model.description import load_robot, robot_from_urdf
     from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
 
@@ -861,7 +861,7 @@ def migrate(
 ) -> None:
     """Rewrite an identify config of an earlier release for this one (renamed keys), keeping its comments and layout,
     and name the settings it uses whose meaning changed."""
-    from ..io.migrate import migrate_text
+    from ..io.config.migrate import migrate_text
 
     target = out or config
 
@@ -992,7 +992,7 @@ def fleet(
 ) -> None:
     """Identify every unit of a fleet on a Dask cluster, flag the units that stand out, pool their estimates."""
     from ..fleet.identification import check_fleet_options, run_fleet
-    from ..io.fleet_manifest import load_fleet_manifest
+    from ..io.config.fleet_manifest import load_fleet_manifest
 
     def prepare():
         check_fleet_options(workers)
@@ -1047,7 +1047,7 @@ def monitor(
         monitor_logs,
         resumed_monitor,
     )
-    from ..io.identification_config import load_identification_config
+    from ..io.config.identification_config import load_identification_config
 
     def prepare():
         settings = MonitorSettings(window, reference_windows, false_alarm_days)

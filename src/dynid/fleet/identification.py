@@ -25,10 +25,10 @@ from ..estimators.pooled import PooledEstimate, pooled_estimate, shared_paramete
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..identification.evidence import validate_sets
 from ..identification.run import run_identification
-from ..io.datasets import load_recording
+from ..io.config.fleet_manifest import FleetManifest, FleetUnit
+from ..io.config.identification_config import stored_preprocessing
 from ..io.files import write_json
-from ..io.fleet_manifest import FleetManifest, FleetUnit
-from ..io.identification_config import stored_preprocessing
+from ..io.logs.datasets import load_recording
 from ..io.results import read_results
 from ..runtime.cluster import dask_client
 from ..runtime.extras import require

@@ -42,8 +42,8 @@ from ..estimators.pooled import own_term
 from ..estimators.recursive import RecursiveLeastSquares
 from ..exceptions import ConfigError, DataError
 from ..friction import TERMS
-from ..io.datasets import load_recording
-from ..io.identification_config import dataset_for_file
+from ..io.config.identification_config import dataset_for_file
+from ..io.logs.datasets import load_recording
 from ..preprocessing.strategies import carried_over
 from .change_detection import Cusum, CusumAlarm, cusum_threshold
 

@@ -46,7 +46,7 @@ from ..estimators.instrumental import CLOSED_LOOP_METHODS, instrumental_variable
 from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..estimators.problem import FitData
 from ..exceptions import ConfigError, DataError, ShapeError
-from ..io.datasets import Recording
+from ..io.logs.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing, prepare, prepared_rows
 from ..preprocessing.prepared import PreparedData

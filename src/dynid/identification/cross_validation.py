@@ -240,7 +240,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     Parameters
     ----------
     robot, base
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         The raw identification log.
     given : Preprocessing
         The config's settings (``None`` fields are chosen).

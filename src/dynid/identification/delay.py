@@ -22,7 +22,7 @@ import numpy as np
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.instrumental import long_run_covariance
 from ..exceptions import ConfigError, IdentifiabilityError
-from ..io.datasets import Recording
+from ..io.logs.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
 from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare

@@ -83,7 +83,7 @@ def preprocessing_variants(robot: Robot, base: BaseParameters, recording, data: 
     ----------
     robot, base
         The model as identified (the chosen friction models) and its base-parameter map.
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         The log as read.
     data : PreparedData
         The log as prepared for the estimation (its resolved settings and rest model).
@@ -133,7 +133,7 @@ def prepared_variant(recording, data: PreparedData, given: Preprocessing, factor
 
     Parameters
     ----------
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         The log as read.
     data : PreparedData
         The log as prepared (its resolved settings).

@@ -13,7 +13,7 @@ import numpy as np
 
 from .._util.reprs import short_repr
 from ..exceptions import DynIdError
-from ..io.datasets import Recording
+from ..io.logs.datasets import Recording
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import YARDSTICK_FILTERS, carried_over, yardstick_filters, yardstick_settings
 from ..validation.diagnostics import Finding
@@ -161,7 +161,7 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
     parameter_sets : dict
         label -> (n_base,) base parameters.
     recordings : iterable of Recording
-        The logs, read (:func:`dynid.io.datasets.load_recording`); a generator's are read one at a time, as each is
+        The logs, read (:func:`dynid.io.logs.datasets.load_recording`); a generator's are read one at a time, as each is
         scored.
     progress : callable, optional
         ``progress(step, done, total)``.
@@ -198,7 +198,7 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
     DataError
         A log that cannot be prepared.
     TypeError
-        A log not read (a ``DatasetSpec``: :func:`dynid.io.datasets.load_recording` reads it).
+        A log not read (a ``DatasetSpec``: :func:`dynid.io.logs.datasets.load_recording` reads it).
     """
     from ..preprocessing.pipeline import prepare
     from ..validation.channel_checks import channel_findings
@@ -269,7 +269,7 @@ def yardstick_reference(recording) -> Preprocessing | None:
 
     Parameters
     ----------
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         The identification log, as read.
 
     Returns

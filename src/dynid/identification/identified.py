@@ -20,9 +20,9 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import regressor
 from ..estimators.registry import label
 from ..exceptions import ConfigError, DataError
-from ..io.datasets import recording_from_arrays
-from ..io.export import mjcf_from_results, urdf_from_results
+from ..io.exported.export import mjcf_from_results, urdf_from_results
 from ..io.files import _clean, write_json
+from ..io.logs.datasets import recording_from_arrays
 from ..io.results import check_fingerprint, read_results, stored_estimates, stored_residual_level
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
@@ -402,7 +402,7 @@ class IdentifiedModel:
     def _settings(self):
         """The preprocessing a log other than the identification one gets (:meth:`validate`): the settings as given,
         carried over as ``dynid validate`` does, so that the API and the CLI keep the same samples of a log."""
-        from ..io.identification_config import stored_preprocessing
+        from ..io.config.identification_config import stored_preprocessing
 
         given = stored_preprocessing(self.results, "given_preprocessing") if self.results else None
         if given is None:  # results written before they held it: the resolved settings stand for the config's, the
@@ -417,7 +417,7 @@ class IdentifiedModel:
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
         estimate : str, optional
 
         Returns
@@ -452,7 +452,7 @@ class IdentifiedModel:
         ------
         ShapeError
             A recording not one row per time stamp and one column per joint (:meth:`Recording.check
-            <dynid.io.datasets.Recording.check>`).
+            <dynid.io.logs.datasets.Recording.check>`).
         ValueError
             Time stamps without positions and torques.
         """
@@ -524,7 +524,7 @@ class IdentifiedModel:
         return recording_from_arrays(self.robot, t, q, tau, name=what)
 
     def urdf(self) -> str:
-        """The physically consistent estimate as URDF text (:func:`dynid.io.export.urdf_from_results`).
+        """The physically consistent estimate as URDF text (:func:`dynid.io.exported.export.urdf_from_results`).
 
         Returns
         -------
@@ -539,7 +539,7 @@ class IdentifiedModel:
         return urdf_from_results(self.robot, self.results)
 
     def mjcf(self) -> str:
-        """The physically consistent estimate as MuJoCo MJCF text (:func:`dynid.io.export.mjcf_from_results`).
+        """The physically consistent estimate as MuJoCo MJCF text (:func:`dynid.io.exported.export.mjcf_from_results`).
 
         Returns
         -------
@@ -605,7 +605,7 @@ class IdentifiedModel:
         DataError
             Results of another robot, or malformed.
         """
-        from ..io.identification_config import stored_preprocessing
+        from ..io.config.identification_config import stored_preprocessing
 
         try:
             robot = robot_from_settings(robot, results.get("settings", {}))
@@ -641,7 +641,7 @@ class IdentifiedModel:
 
 
 def _stored(settings: dict) -> Preprocessing | None:
-    from ..io.identification_config import stored_preprocessing
+    from ..io.config.identification_config import stored_preprocessing
 
     return stored_preprocessing({"settings": settings})
 
@@ -696,7 +696,7 @@ def _robot(robot, results: dict, path: Path) -> Robot:
     settings: dict = results["settings"] if isinstance(results.get("settings"), dict) else {}
     source = settings.get("robot_source")
     if isinstance(source, str) and source.startswith("config:"):
-        from ..io.configs import config_robot
+        from ..io.config.configs import config_robot
 
         config = Path(source[len("config:"):])
         if config.is_file():

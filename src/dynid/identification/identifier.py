@@ -187,7 +187,7 @@ class Identifier(HyperParameters):
                           "arrays t, q, tau", FutureWarning, stacklevel=2)
             result = self._config_result(Path(t), data_root, validate)
         else:
-            from ..io.identification_config import split_estimators
+            from ..io.config.identification_config import split_estimators
             from .run import identify_from_arrays
 
             closed_loop = () if self.estimators is None else split_estimators(self.estimators, "Identifier(estimators=...)")[1]
@@ -212,7 +212,7 @@ class Identifier(HyperParameters):
         return self
 
     def _config_result(self, path: Path, data_root, validate: bool):
-        from ..io.identification_config import load_identification_config, split_estimators
+        from ..io.config.identification_config import load_identification_config, split_estimators
         from .run import run_identification
 
         config = load_identification_config(path, data_root=data_root)

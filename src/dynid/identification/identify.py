@@ -35,8 +35,8 @@ from ..estimators.registry import (
 )
 from ..estimators.registry import label as estimator_label
 from ..exceptions import DynIdError, IdentifiabilityError
-from ..io.export import READINESS_KINDS
-from ..io.references import ReferenceSet
+from ..io.config.references import ReferenceSet
+from ..io.exported.export import READINESS_KINDS
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks
 from ..preprocessing.prepared import PreparedData

@@ -43,7 +43,7 @@ from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.registry import DEFAULT_ESTIMATORS, FitData, estimator_choices
 from ..exceptions import ConfigError, DataError, DynIdError
-from ..io.identification_config import split_estimators
+from ..io.config.identification_config import split_estimators
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import base_chunks, prepare
@@ -198,7 +198,7 @@ class IdentificationPipeline:
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
             Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``; ``tau`` [N·m] with the
             drive gains applied (eq. 16).
         base : BaseParameters, optional
@@ -223,7 +223,7 @@ class IdentificationPipeline:
             Too little motion to cross-validate a choice on.
         ShapeError
             A recording not one row per time stamp and one column per joint, or holding NaN
-            (:meth:`dynid.io.datasets.Recording.check`).
+            (:meth:`dynid.io.logs.datasets.Recording.check`).
         """
         def say(label: str) -> Callable[[int, int], None] | None:
             if step is not None:
@@ -284,7 +284,7 @@ class IdentificationPipeline:
         held_out : bool
             With ``sdp`` listed and no validation log to come: score the least-squares and SDP estimates on held-out
             blocks (said in the main estimate's finding; :func:`dynid.identification.identify.identify`).
-        recording : dynid.io.datasets.Recording, optional
+        recording : dynid.io.logs.datasets.Recording, optional
             The log as read, which the closed-loop estimators simulate (needed with :attr:`closed_loop`).
         jackknife : bool
             Refit the SDP on all blocks of the log but one, for the torque-free verdict
@@ -379,7 +379,7 @@ class IdentificationPipeline:
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
             The identification log, as read.
         validation : tuple of Recording
             Logs of other motions, read: the verdict's evidence.

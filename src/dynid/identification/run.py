@@ -1,5 +1,5 @@
 """The runs ``dynid identify`` and ``dynid validate`` describe: identification from a parsed config
-(:mod:`dynid.io.identification_config`) or from arrays, then validation on other logs beside the reference sets."""
+(:mod:`dynid.io.config.identification_config`) or from arrays, then validation on other logs beside the reference sets."""
 
 from __future__ import annotations
 
@@ -13,10 +13,10 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data, seed_of
 from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError
-from ..io.dataset_specs import DatasetSpec
-from ..io.datasets import Recording, given_recording, load_recording
-from ..io.identification_config import IdentificationConfig, stored_preprocessing
-from ..io.log_repairs import (
+from ..io.config.dataset_specs import DatasetSpec
+from ..io.config.identification_config import IdentificationConfig, stored_preprocessing
+from ..io.logs.datasets import Recording, given_recording, load_recording
+from ..io.logs.log_repairs import (
     repeated_share,
 )
 from ..io.results import stored_estimates, stored_residual_level
@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # the pipeline imports SciPy: a config is checked before it i
 
 
 def _references(config: IdentificationConfig, base):
-    from ..io.references import load_reference
+    from ..io.config.references import load_reference
 
     nominal = config.robot.standard_parameters()
     return tuple(load_reference(r, config.data_root, f"{config.path}: references[{i}]", base, nominal)
@@ -112,7 +112,7 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
 
 def _distinct_validation(config: IdentificationConfig, recording, checked: list) -> tuple:
     """The config and validation logs without those that repeat the identification log's samples
-    (:func:`dynid.io.log_repairs.repeated_share`), and a warning for each left out: their figures would be the fit's,
+    (:func:`dynid.io.logs.log_repairs.repeated_share`), and a warning for each left out: their figures would be the fit's,
     and the verdict would weigh them as a test of other motions."""
     kept, said = [], []
     for k, (spec, log) in enumerate(zip(config.validation, checked)):
@@ -162,7 +162,7 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
         The results.json of ``dynid identify`` (every estimate in it is scored).
     datasets : tuple of DatasetSpec or Recording, optional
         Logs to validate on instead of the config's ``[[validation]]`` ones (each read as it is scored), or logs read
-        already (:func:`dynid.io.datasets.load_recording`).
+        already (:func:`dynid.io.logs.datasets.load_recording`).
     progress : callable, optional
         ``progress(step, done, total)``.
     source : str
@@ -258,7 +258,7 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
         The results.json of ``dynid identify``: its main estimate is the arm without the payload (the description's
         nominal model where that is the main one).
     dataset : DatasetSpec
-        The log with the payload (:func:`dynid.io.identification_config.dataset_for_file`).
+        The log with the payload (:func:`dynid.io.config.identification_config.dataset_for_file`).
     source : str
         Where the results come from, named in errors.
 
@@ -293,7 +293,7 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
 
 def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str, *, source: str = "results"):
     """An exported MJCF simulated along the config's first moving validation log (issue "The model proven where it
-    goes", item 3; :func:`dynid.io.replay.mjcf_forward`): the log prepared as ``dynid validate`` prepares it, without
+    goes", item 3; :func:`dynid.io.exported.replay.mjcf_forward`): the log prepared as ``dynid validate`` prepares it, without
     decimation, so the simulation follows every sample.
 
     Parameters
@@ -318,8 +318,8 @@ def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str
     ValueError
         MuJoCo cannot load the text.
     """
-    from ..io.export import consistent_estimate
-    from ..io.replay import mjcf_forward
+    from ..io.exported.export import consistent_estimate
+    from ..io.exported.replay import mjcf_forward
 
     robot, phi = consistent_estimate(config.robot, identified, source)
     found = moving_validation(config, identified, robot)

@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from ..exceptions import DataError, DynIdError
-from ..io.datasets import load_recording
-from ..io.identification_config import config_from_document
-from ..io.starter import with_joint_setting, with_robot_setting, with_torque_setting
+from ..io.config.identification_config import config_from_document
+from ..io.config.starter import with_joint_setting, with_robot_setting, with_torque_setting
+from ..io.logs.datasets import load_recording
 from ..model.description import builtin_robots
 from .run import pipeline_of
 
@@ -119,7 +119,7 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
     Parameters
     ----------
     text : str
-        The config :func:`dynid.io.starter.starter_config` wrote.
+        The config :func:`dynid.io.config.starter.starter_config` wrote.
     path : Path
         Where it will be written (its relative paths start from its folder).
 

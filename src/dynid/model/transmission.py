@@ -190,7 +190,7 @@ class Transmission:
 
     def logged_positions(self, q: np.ndarray) -> np.ndarray:
         """The angles the joints' encoders (and their controller) read at model joint angles ``q``: ``q - offset``,
-        what a log holds and a reader adds ``position_offset`` back to (:func:`dynid.io.datasets.load_recording`).
+        what a log holds and a reader adds ``position_offset`` back to (:func:`dynid.io.logs.datasets.load_recording`).
 
         Parameters
         ----------

@@ -33,7 +33,7 @@ class PaperSmoothing(Strategy):
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
         settings : Preprocessing
             ``fourier`` = (ω_f [rad/s], harmonics) is required (``[preprocessing] excitation`` in a config).
         strict : bool

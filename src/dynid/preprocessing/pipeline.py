@@ -57,7 +57,7 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
 
     Parameters
     ----------
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``.
     settings : Preprocessing
         Unset values are derived from this recording (:meth:`Preprocessing.resolved`).
@@ -85,13 +85,13 @@ def torque_delayed(recording, delay: float):
 
     Parameters
     ----------
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
     delay : float [s]
         The torque channel's lag behind the positions (negative: it leads).
 
     Returns
     -------
-    dynid.io.datasets.Recording
+    dynid.io.logs.datasets.Recording
         ``tau(t + delay)`` by a band-limited shift (:class:`dynid.preprocessing.filters.FractionalShift`); at the ends,
         where the log holds no torque that late (or early), its mirror image. Stored columns stay stored.
 
@@ -175,7 +175,7 @@ class ParallelFiltering(Strategy):
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
         settings : Preprocessing
         strict : bool
             Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning).

@@ -74,7 +74,7 @@ class Strategy:
 
         Parameters
         ----------
-        recording : dynid.io.datasets.Recording
+        recording : dynid.io.logs.datasets.Recording
             Anything with ``name, label, t, q, dq (or None), tau, rate, n_samples, warnings``.
         settings : Preprocessing
             Unset values are derived from the recording; the resolved settings travel with the result.
@@ -322,7 +322,7 @@ def yardstick_filters(treated: Preprocessing, recording) -> tuple[Preprocessing,
     ----------
     treated : Preprocessing
         :func:`yardstick_settings`.
-    recording : dynid.io.datasets.Recording
+    recording : dynid.io.logs.datasets.Recording
         The validation log, read.
 
     Returns

@@ -10,7 +10,7 @@ from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..excitation.floor import FloorDistances
 from ..identification.excitation_run import ExcitationRun
-from ..io.trajectories import write_trajectory_csv
+from ..io.logs.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report
 from .output import save_animation, save_figure, staged, write_results

@@ -9,15 +9,15 @@ from .._util.keywords import keyword_only_after_data
 from ..exceptions import DynIdError
 from ..identification.identify import IdentificationResult
 from ..io import atomic_write_text
-from ..io.export import (
+from ..io.exported.export import (
     consistent_estimate,
     file_parameters,
     file_terms_entry,
     payload_files,
     withheld_files,
 )
-from ..io.model_files import written_model
-from ..io.replay import ReplayCheck, mjcf_replay, urdf_replay
+from ..io.exported.model_files import written_model
+from ..io.exported.replay import ReplayCheck, mjcf_replay, urdf_replay
 from ..io.results import stored_standard
 from . import figures
 from .html import write_html_report
@@ -84,9 +84,9 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
     ``results.json``, ``report.html``, the identification fit figure and one figure per validation dataset; with
     ``robot`` (the identified robot), when the physically consistent estimate passed the consistency check, the model
     to use: the user's own URDF with the identified values written into it (``urdf``: the same file name, only its
-    ``<inertial>`` and ``<dynamics>`` values changed, :func:`dynid.io.urdf_write_back.urdf_written_back`) or, for a
+    ``<inertial>`` and ``<dynamics>`` values changed, :func:`dynid.io.exported.urdf_write_back.urdf_written_back`) or, for a
     robot described otherwise, ``dynid-model.urdf`` of dynid's own naming; and the MJCF: the user's own MuJoCo model
-    with the identified values written into it (``mjcf_model``, :func:`dynid.io.mjcf_write_back.mjcf_written_back`)
+    with the identified values written into it (``mjcf_model``, :func:`dynid.io.exported.mjcf_write_back.mjcf_written_back`)
     or ``dynid-model.xml``.
 
     Parameters
@@ -99,12 +99,12 @@ def save_identification(result: IdentificationResult, out: str | Path, *, figure
     robot : Robot, optional
         The identified robot, for the exports.
     urdf : str or Path, optional
-        The URDF the robot was read from (:attr:`dynid.io.identification_config.IdentificationConfig.urdf`).
+        The URDF the robot was read from (:attr:`dynid.io.config.identification_config.IdentificationConfig.urdf`).
     urdf_name : str, optional
         The written-back URDF's file name (default the user's; :func:`model_file_name` keeps a user's URDF in the
         output folder from being replaced).
     mjcf_model : str or Path, optional
-        The user's own MJCF of the arm (:attr:`dynid.io.identification_config.IdentificationConfig.mjcf_model`).
+        The user's own MJCF of the arm (:attr:`dynid.io.config.identification_config.IdentificationConfig.mjcf_model`).
     mjcf_name : str, optional
         The written-back MJCF's file name (default the user's; :func:`model_file_name`).
     mjcf_folder : str or Path, optional
@@ -153,7 +153,7 @@ def _model_texts(data: dict, out: Path, robot, *, urdf, urdf_name, mjcf_model, m
 
 def taken_away(models: list, robot, data: dict, config=None) -> dict:
     """The files an identification writes read back by the tools they are for (issue "The model proven where it
-    goes", item 1): the URDF by Pinocchio, the MJCF by MuJoCo (:mod:`dynid.io.replay`), on the config's first moving
+    goes", item 1): the URDF by Pinocchio, the MJCF by MuJoCo (:mod:`dynid.io.exported.replay`), on the config's first moving
     validation log where there is one (:func:`dynid.identification.run.moving_validation`), else on random states.
 
     Parameters
@@ -172,7 +172,7 @@ def taken_away(models: list, robot, data: dict, config=None) -> dict:
     dict
         ``log`` (None: random states), and per file its format, the tool, how closely it equals dynid's model, what
         it cannot hold, what the tool computes from it against dynid's whole model per joint (``simulator_gap`` [%],
-        :attr:`dynid.io.replay.ReplayCheck.simulator_gap`) and, on a log, its error and dynid's whole model's against
+        :attr:`dynid.io.exported.replay.ReplayCheck.simulator_gap`) and, on a log, its error and dynid's whole model's against
         the measured torques [%].
     """
     from ..identification.run import moving_validation
@@ -229,7 +229,7 @@ def read_back_entry(name: str, form: str, check, chosen: dict | None = None) -> 
         The file's name.
     form : {"URDF", "MJCF"}
     check : ReplayCheck or str
-        :func:`dynid.io.replay.urdf_replay` or :func:`~dynid.io.replay.mjcf_replay`'s check, or why there is none.
+        :func:`dynid.io.exported.replay.urdf_replay` or :func:`~dynid.io.exported.replay.mjcf_replay`'s check, or why there is none.
     chosen : dict, optional
         What the file holds otherwise than dynid's model (:func:`file_choice`).
 
@@ -291,7 +291,7 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
 @staged
 def save_payload(payload, out: str | Path, robot=None, parent: str = "", estimate: str = "") -> list[Path]:
     """Write ``payload.json``, ``payload.urdf`` (a link on a fixed joint to paste into the arm's URDF) and
-    ``payload.xml`` (an MJCF body to put inside the arm's last body) (:func:`dynid.io.export.payload_files`).
+    ``payload.xml`` (an MJCF body to put inside the arm's last body) (:func:`dynid.io.exported.export.payload_files`).
 
     Parameters
     ----------

@@ -466,7 +466,7 @@ FILE_CHOICES = (("friction_folded", "the friction of {} holds its Stribeck and l
 
 SIMULATES = {"URDF": "Pinocchio (RNEA and the joints' <dynamics>)",
              "MJCF": "MuJoCo (mj_inverse, its frictionloss a constraint as MuJoCo solves it)"}
-"""What computes a written file's torques, with its own semantics (:attr:`dynid.io.replay.ReplayCheck.simulator_gap`)."""
+"""What computes a written file's torques, with its own semantics (:attr:`dynid.io.exported.replay.ReplayCheck.simulator_gap`)."""
 
 SIMULATOR_GAP = 2.0
 """[%] A joint whose simulated torque is further than this off dynid's model (of its RMS torque) makes the read-back

@@ -147,7 +147,7 @@ class Controller:
 @dataclass(frozen=True, eq=False)
 class ClosedLoopSetup:
     """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
-    config's ``[controller]`` table gives it (:attr:`dynid.io.identification_config.IdentificationConfig.controller`;
+    config's ``[controller]`` table gives it (:attr:`dynid.io.config.identification_config.IdentificationConfig.controller`;
     :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts carry it).
 
     Attributes

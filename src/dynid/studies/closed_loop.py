@@ -44,7 +44,7 @@ from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
 from ..identification.closed_loop import ClosedLoopEstimator, ClosedLoopExperiment, ClosedLoopSetup
 from ..identification.pipeline import IdentificationPipeline
-from ..io.datasets import Recording
+from ..io.logs.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import Preprocessing

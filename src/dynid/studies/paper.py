@@ -41,8 +41,8 @@ from ..excitation.paper_trajectories import (
     paper_validation_trajectory,
 )
 from ..identification.pipeline import IdentificationPipeline
-from ..io.datasets import Recording
-from ..io.trajectories import load_trajectory
+from ..io.logs.datasets import Recording
+from ..io.logs.trajectories import load_trajectory
 from ..model.description import load_robot
 from ..model.robot import Robot
 from ..preprocessing.pipeline import prepared_rows

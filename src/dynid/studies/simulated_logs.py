@@ -15,7 +15,7 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data, renamed_keyword
 from ..exceptions import ConfigError
 from ..excitation.fourier import FourierTrajectory
-from ..io.datasets import Recording
+from ..io.logs.datasets import Recording
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..simulation.measurements import NoiseModel, simulate_measurements, torques_from_currents

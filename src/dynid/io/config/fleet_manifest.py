@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.typed import convert
-from ..exceptions import ConfigError
-from ..model.spatial import inertial_from_physical
+from ..._util.typed import convert
+from ...exceptions import ConfigError
+from ...model.spatial import inertial_from_physical
 from .config_types import FleetDocument, UnitTable
 from .configs import read_config
 from .identification_config import IdentificationConfig, config_from_document, load_identification_config

@@ -1,5 +1,5 @@
 """The model files a results.json hands on, in dynid's own files or written into the user's
-(:mod:`dynid.io.export`, :mod:`dynid.io.urdf_write_back`, :mod:`dynid.io.mjcf_write_back`): the one place
+(:mod:`dynid.io.exported.export`, :mod:`dynid.io.exported.urdf_write_back`, :mod:`dynid.io.exported.mjcf_write_back`): the one place
 ``dynid identify`` and ``dynid export`` get their URDF and MJCF texts from."""
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ __all__ = ["written_model"]
 def written_model(form: str, robot, results: dict, source: str = "results", *, users_file=None,
                   out_dir=None) -> tuple[str, list[str]]:
     """The URDF or MJCF text a results.json hands on: its physically consistent estimate
-    (:func:`dynid.io.export.consistent_estimate`) as the results chose the files to hold it
-    (:func:`dynid.io.export.file_parameters`), in dynid's own file (:func:`dynid.io.export.urdf_from_results`,
-    :func:`~dynid.io.export.mjcf_from_results`) or written into the user's, with the note of what differs from dynid's
+    (:func:`dynid.io.exported.export.consistent_estimate`) as the results chose the files to hold it
+    (:func:`dynid.io.exported.export.file_parameters`), in dynid's own file (:func:`dynid.io.exported.export.urdf_from_results`,
+    :func:`~dynid.io.exported.export.mjcf_from_results`) or written into the user's, with the note of what differs from dynid's
     model at its end.
 
     Parameters
@@ -42,7 +42,7 @@ def written_model(form: str, robot, results: dict, source: str = "results", *, u
     Raises
     ------
     ConfigError
-        As :func:`dynid.io.export.consistent_estimate` and :func:`~dynid.io.export.file_parameters`, or a user's file
+        As :func:`dynid.io.exported.export.consistent_estimate` and :func:`~dynid.io.exported.export.file_parameters`, or a user's file
         that is not the robot's.
     """
     if users_file is None:

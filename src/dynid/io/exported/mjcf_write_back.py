@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dynamics.kinematics import forward_kinematics
-from ..exceptions import ConfigError
-from ..model.mjcf import held_inertials
-from ..model.robot import Robot
-from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
-from ..runtime.extras import require
+from ...dynamics.kinematics import forward_kinematics
+from ...exceptions import ConfigError
+from ...model.mjcf import held_inertials
+from ...model.robot import Robot
+from ...model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
+from ...runtime.extras import require
 from .export import (
     _exportable,
     _replace,
@@ -87,7 +87,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     (:func:`dynid.model.mjcf.held_inertials`), so that the full model's mass matrix stays positive definite. A compiler told to take inertias from geoms (``inertiafromgeom="true"``) would ignore the written values: it
     is set to ``"auto"``. Relative file paths (``meshdir``, ``texturedir``, ``assetdir``, ``<include file>``) are
     rewritten for the folder the result is written to. The header comment says what was identified, as in
-    :func:`dynid.io.urdf_write_back.urdf_written_back`.
+    :func:`dynid.io.exported.urdf_write_back.urdf_written_back`.
 
     Parameters
     ----------
@@ -102,7 +102,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     estimate : str
         What the values are, for the header comment.
     offsets_held : bool
-        Hold the torque offsets as actuators of constant bias (:func:`dynid.io.export.offset_actuators`), added to the
+        Hold the torque offsets as actuators of constant bias (:func:`dynid.io.exported.export.offset_actuators`), added to the
         model's ``<actuator>`` after its own (their indices in ``ctrl`` unchanged), instead of comments.
 
     Returns
@@ -110,7 +110,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     text : str
         The MJCF.
     moved : list of str
-        Links whose values moved far from the MJCF's own (:data:`dynid.io.export.MOVED_MASS`, ``MOVED_COM``).
+        Links whose values moved far from the MJCF's own (:data:`dynid.io.exported.export.MOVED_MASS`, ``MOVED_COM``).
 
     Raises
     ------
@@ -200,7 +200,7 @@ def _section(root, tag: str):
 
 
 def _append_tendons(root, coupled: tuple) -> None:
-    """The coupled motors' tendons (:func:`dynid.io.export.coupled_tendons`) added to the MJCF's ``<tendon>``, and
+    """The coupled motors' tendons (:func:`dynid.io.exported.export.coupled_tendons`) added to the MJCF's ``<tendon>``, and
     what they do not hold as a comment."""
     for attributes, joints in coupled[0]:
         tendon = ET.SubElement(_section(root, "tendon"), "fixed", attributes)

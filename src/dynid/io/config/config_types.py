@@ -1,7 +1,7 @@
 """The structure of the configs of ``dynid identify``/``validate`` and ``dynid excite``, typed: each table and field
 with its type, its allowed values and a description (what editors show from the JSON Schemas in ``dynid/schema/``).
 
-The parsers (:mod:`dynid.io.identification_config`, :mod:`dynid.io.datasets`, :mod:`dynid.io.excitation_config`)
+The parsers (:mod:`dynid.io.config.identification_config`, :mod:`dynid.io.logs.datasets`, :mod:`dynid.io.config.excitation_config`)
 convert a document into these structures first (:func:`dynid._util.typed.convert`: one-line messages naming file and
 field), then check what depends on the robot (one value per joint) and the files.
 """
@@ -16,10 +16,10 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, Union
 import msgspec
 from msgspec import Meta
 
-from .._util.typed import Table, json_schema
-from ..model.description_types import Angle
-from ..model.description_types import RobotDescription as _RobotDescription
-from ..preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
+from ..._util.typed import Table, json_schema
+from ...model.description_types import Angle
+from ...model.description_types import RobotDescription as _RobotDescription
+from ...preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
 
 if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
     RobotDescription = Any
@@ -69,7 +69,7 @@ class TimeTable(Table, kw_only=True):
 
 
 class DatasetTable(Table, kw_only=True):
-    """A dataset: columns of CSV files, or a ROS 2 bag of sensor_msgs/JointState (:mod:`dynid.io.datasets`)."""
+    """A dataset: columns of CSV files, or a ROS 2 bag of sensor_msgs/JointState (:mod:`dynid.io.logs.datasets`)."""
 
     preset: Annotated[str, _d("ur-rtde, ur-rtde-19 or motor-side: fills in the other fields")] | None = None
     name: Annotated[str, _d("the dataset's name in tables and messages")] | None = None
@@ -149,7 +149,7 @@ class EstimationTable(Table, kw_only=True):
 
 
 class ReferenceTable(Table, kw_only=True):
-    """``[[references]]``: a published parameter set (:mod:`dynid.io.references`)."""
+    """``[[references]]``: a published parameter set (:mod:`dynid.io.config.references`)."""
 
     name: Annotated[str, _d("the set's name in tables")]
     file: Annotated[str, _d("CSV of the set, relative to the data root")] | None = None
@@ -198,7 +198,7 @@ class ControllerTable(Table, kw_only=True):
 
 
 class IdentificationDocument(Table, kw_only=True):
-    """A config of ``dynid identify`` and ``dynid validate`` (:mod:`dynid.io.identification_config`)."""
+    """A config of ``dynid identify`` and ``dynid validate`` (:mod:`dynid.io.config.identification_config`)."""
 
     robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML, URDF or MuJoCo MJCF, or a table")]
     mjcf_model: Annotated[str, _d("your own MuJoCo model of the arm (MJCF), relative to this file: identify and export "
@@ -241,7 +241,7 @@ class UnitTable(Table, kw_only=True):
 
 
 class FleetDocument(Table, kw_only=True):
-    """A fleet manifest of ``dynid fleet`` (:mod:`dynid.io.fleet_manifest`)."""
+    """A fleet manifest of ``dynid fleet`` (:mod:`dynid.io.config.fleet_manifest`)."""
 
     name: Annotated[str, _d("the fleet's name")] | None = None
     notes: Annotated[str, _d("free text")] | None = None
@@ -342,7 +342,7 @@ class ExcitationTable(Table, kw_only=True):
 
 
 class ExcitationDocument(Table, kw_only=True):
-    """A config of ``dynid excite`` (:mod:`dynid.io.excitation_config`)."""
+    """A config of ``dynid excite`` (:mod:`dynid.io.config.excitation_config`)."""
 
     robot: Annotated[Union[str, RobotDescription], _d("built-in name, description TOML, URDF or MuJoCo MJCF, or a table")]
     joints: Annotated[int, Meta(ge=1, description="identify the first joints (default all)")] | None = None
@@ -390,6 +390,6 @@ def write_schemas(folder=None) -> list:
     return paths
 
 
-if __name__ == "__main__":  # python -m dynid.io.config_types: regenerate the shipped schemas
+if __name__ == "__main__":  # python -m dynid.io.config.config_types: regenerate the shipped schemas
     for p in write_schemas():
         print(p)

@@ -10,7 +10,7 @@ viscous (``damping``) and Coulomb (``friction``) coefficients. URDF has no field
 a torque offset, the Stribeck term or a coupled motor: they are written as XML comments on the joint,
 and the model's torques then need them added (``τ = RNEA + Ia·q̈ + fc·sign(q̇) + fv·q̇ + offset``).
 Visual and collision geometry is not copied: for a robot described by a URDF, the identified values are
-written into the user's own file instead (:func:`dynid.io.urdf_write_back.urdf_written_back`).
+written into the user's own file instead (:func:`dynid.io.exported.urdf_write_back.urdf_written_back`).
 
 Only physically consistent parameters are exported: a URDF with a negative mass or an impossible
 inertia makes simulators fail or behave wrongly.
@@ -25,14 +25,14 @@ from typing import Any
 
 import numpy as np
 
-from .._util.keywords import keyword_only_after_data
-from ..conventions import joint_angles_text
-from ..exceptions import ConfigError
-from ..model.friction_model import robot_from_settings
-from ..model.loading import as_robot
-from ..model.robot import Robot
-from ..model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
-from .results import LARGEST_VALUE, stored_standard
+from ..._util.keywords import keyword_only_after_data
+from ...conventions import joint_angles_text
+from ...exceptions import ConfigError
+from ...model.friction_model import robot_from_settings
+from ...model.loading import as_robot
+from ...model.robot import Robot
+from ...model.spatial import is_physically_consistent, physical_from_inertial, physical_problems
+from ..results import LARGEST_VALUE, stored_standard
 
 CONSISTENCY_TOL = 1e-7
 """Smallest pseudo-inertia eigenvalue tolerated (the SDP solver's accuracy) [kg·m², kg]."""
@@ -554,7 +554,7 @@ def offset_actuators(robot: Robot, phi: np.ndarray) -> list[dict[str, str]]:
     """The MJCF actuators that hold the torque offsets of ``phi``: per joint with a non-zero offset, a ``general``
     actuator of gain 0 and constant bias ``-offset`` (MuJoCo: force = gain·ctrl + bias), so that a torque that includes
     the offset, as the measured torques do, moves the simulated arm as it moves the real one (issue "Every assurance
-    checked on what the user meets", item 3). Their ``ctrl`` does nothing; :func:`dynid.io.replay.mjcf_replay` and
+    checked on what the user meets", item 3). Their ``ctrl`` does nothing; :func:`dynid.io.exported.replay.mjcf_replay` and
     ``mjcf_forward`` subtract their force from the torque the file needs.
 
     Parameters

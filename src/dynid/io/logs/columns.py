@@ -1,5 +1,5 @@
 """Which column of a CSV log is which signal, as ``dynid init`` and :func:`dynid.load_recording` find them (module
-docstring of :mod:`dynid.io.starter`): header names, a URDF's joint names, a count of columns without a header, or a
+docstring of :mod:`dynid.io.config.starter`): header names, a URDF's joint names, a count of columns without a header, or a
 known logger's layout."""
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import numpy as np
 import tomlkit
 from tomlkit.items import InlineTable, Table
 
-from ..conventions import time_unit_of
-from ..exceptions import DataError
-from .files import text_encoding_hint
+from ...conventions import time_unit_of
+from ...exceptions import DataError
+from ..files import text_encoding_hint
 from .tables import decimal_commas, is_data_line, read_table
 
 
@@ -549,7 +549,7 @@ def _fields(line: str, delimiter: str) -> list[str]:
 
 
 def _preset_table(preset: str, log: Path) -> Table:
-    """A dataset table that reads ``log`` by one of :data:`dynid.io.dataset_specs.PRESETS`."""
+    """A dataset table that reads ``log`` by one of :data:`dynid.io.config.dataset_specs.PRESETS`."""
     table = tomlkit.table()
     table.add("preset", preset)
     table.add("file", log.name)

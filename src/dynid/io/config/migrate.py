@@ -21,7 +21,7 @@ import tomllib
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
-from ..exceptions import ConfigError
+from ...exceptions import ConfigError
 
 __all__ = ["OLD_ESTIMATION_KEYS", "CHANGED_MEANINGS", "migrate_text"]
 

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.column_store import ColumnFile, StoredColumns
-from ..exceptions import DataError
-from ..runtime.threads import cores
-from .files import text_encoding_hint
+from ..._util.column_store import ColumnFile, StoredColumns
+from ...exceptions import DataError
+from ...runtime.threads import cores
+from ..files import text_encoding_hint
 
 BLOCK = 100_000
 

@@ -20,13 +20,13 @@ import numpy as np
 import tomlkit
 from tomlkit.items import Table
 
-from ..exceptions import ConfigError, DataError
-from ..model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
-from .bags import is_bag
-from .columns import csv_table, signal_files
+from ...exceptions import ConfigError, DataError
+from ...model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
+from ..logs.bags import is_bag
+from ..logs.columns import csv_table, signal_files
+from ..logs.datasets import dataset_spec, load_recording
+from ..logs.tables import read_table
 from .dataset_specs import PRESETS
-from .datasets import dataset_spec, load_recording
-from .tables import read_table
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),

@@ -18,9 +18,9 @@ from xml.parsers.expat import ExpatError
 
 import numpy as np
 
-from ..exceptions import ConfigError
-from ..model.robot import Robot
-from ..model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
+from ...exceptions import ConfigError
+from ...model.robot import Robot
+from ...model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
 from .export import _exportable, _world_from_base, identified_header, moved_far, position_offset_note
 
 __all__ = ["urdf_written_back"]
@@ -187,14 +187,14 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     text : str
         The URDF.
     moved : list of str
-        One line per link whose values moved far from the URDF's own (:func:`dynid.io.export.moved_far`), also in the
+        One line per link whose values moved far from the URDF's own (:func:`dynid.io.exported.export.moved_far`), also in the
         header comment.
 
     Raises
     ------
     ConfigError
         The URDF cannot be read, its joints are not the robot's, or the values are not exportable
-        (:func:`dynid.io.export.urdf_from_robot`'s checks).
+        (:func:`dynid.io.exported.export.urdf_from_robot`'s checks).
     """
     path = Path(urdf)
     fitted = _exportable(robot, phi)
@@ -340,7 +340,7 @@ def _held_contributions(path: Path, data: bytes, text: _TextEdits, links: dict, 
     the file has them and gives the moving link the identified values less this share, so that the full model's
     mass matrix stays positive definite (with the lumped values written into the last link and the fingers massless,
     a 9-joint Panda's was singular)."""
-    from ..model.description import robot_from_urdf
+    from ...model.description import robot_from_urdf
 
     bare = _TextEdits(data, text.root)
     for name in held_links:

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import DataError
-from ..runtime.extras import require
+from ...exceptions import DataError
+from ...runtime.extras import require
 
 BAG_SUFFIXES = (".mcap", ".db3", ".bag")
 """A ROS 2 bag's storage files (MCAP, SQLite) and a ROS 1 bag's file."""

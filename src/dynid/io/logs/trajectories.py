@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..exceptions import ConfigError
-from ..excitation.fourier import FourierTrajectory, trajectory_from_dict
-from .files import atomic_write_text
+from ...exceptions import ConfigError
+from ...excitation.fourier import FourierTrajectory, trajectory_from_dict
+from ..files import atomic_write_text
 
 
 def load_trajectory(path: str | Path) -> FourierTrajectory:

@@ -1,5 +1,5 @@
-"""Measured datasets read: a log's columns (:mod:`dynid.io.dataset_specs` says which hold what, and in which units)
-converted to SI joint quantities on a uniform time grid, the checks and repairs of :mod:`dynid.io.log_repairs`
+"""Measured datasets read: a log's columns (:mod:`dynid.io.config.dataset_specs` says which hold what, and in which units)
+converted to SI joint quantities on a uniform time grid, the checks and repairs of :mod:`dynid.io.logs.log_repairs`
 applied on the way (:func:`load_recording`)."""
 
 from __future__ import annotations
@@ -10,16 +10,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.checks import check_trajectory_array
-from .._util.column_store import SPOOL_BYTES, StoredColumns
-from .._util.keywords import keyword_only_after_data
-from .._util.reprs import short_repr
-from ..exceptions import ConfigError, DataError, ShapeError
-from ..model.loading import as_robot
-from ..model.robot import Robot
+from ..._util.checks import check_trajectory_array
+from ..._util.column_store import SPOOL_BYTES, StoredColumns
+from ..._util.keywords import keyword_only_after_data
+from ..._util.reprs import short_repr
+from ...exceptions import ConfigError, DataError, ShapeError
+from ...model.loading import as_robot
+from ...model.robot import Robot
+from ..config.dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .bags import read_joint_states
 from .columns import csv_table, named_out_of_order
-from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .log_repairs import (
     AUTO_GAP_SAMPLES,
     GAP_FACTOR,
@@ -115,7 +115,7 @@ class Recording:
 
 
 def _detected(log: Path, robot: Robot, rate: float | None = None) -> DatasetSpec:
-    """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.columns.csv_table`)."""
+    """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.logs.columns.csv_table`)."""
     if not log.is_file():
         raise DataError(f"{log}: no such log")
     table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints), rate=rate,
@@ -128,7 +128,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
                    rate: float | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
-    Steps: read the columns (:func:`dynid.io.tables.read_table`) or the ROS 2 bag's JointState messages, scale
+    Steps: read the columns (:func:`dynid.io.logs.tables.read_table`) or the ROS 2 bag's JointState messages, scale
     units, check the time stamps, resample jittered time stamps linearly onto a uniform grid, convert motor-side
     signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``), currents to torques with the
     drive gains (eq. 16).
@@ -233,7 +233,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
 
 def _check_named_order(spec: DatasetSpec, robot: Robot) -> None:
     """Refuse a signal whose columns name the description's joints in another order than its chain's
-    (:func:`dynid.io.columns.named_out_of_order`): read as listed, every joint would get another joint's signal."""
+    (:func:`dynid.io.logs.columns.named_out_of_order`): read as listed, every joint would get another joint's signal."""
     joints = tuple(j.name for j in robot.joints)
     for kind, signal in spec.signals.items():
         order = named_out_of_order(signal.columns, joints)
@@ -382,7 +382,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
 
     Returns
     -------
-    dynid.io.datasets.Recording
+    dynid.io.logs.datasets.Recording
         Starting at t = 0; a warning when the time stamps were interpolated.
 
     Raises
@@ -391,9 +391,9 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
         Arrays of inconsistent shapes, not time-first, or not finite.
     DataError
         Time stamps that do not increase or are slower than any controller logs (another unit:
-        :func:`dynid.io.log_repairs.check_clock_unit`), a gap longer than 5 median steps, a position step no motion
-        makes (:func:`dynid.io.log_repairs.check_position_steps`), or positions beyond 4π rad (degrees:
-        :func:`dynid.io.log_repairs.position_ranges`, which also says the positions outside the joint limits).
+        :func:`dynid.io.logs.log_repairs.check_clock_unit`), a gap longer than 5 median steps, a position step no motion
+        makes (:func:`dynid.io.logs.log_repairs.check_position_steps`), or positions beyond 4π rad (degrees:
+        :func:`dynid.io.logs.log_repairs.position_ranges`, which also says the positions outside the joint limits).
     """
 
     t = np.asarray(t, dtype=float).reshape(-1)

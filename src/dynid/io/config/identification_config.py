@@ -5,7 +5,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     robot = "ur10e"                      # built-in robot name or description TOML
     data_root = "../../shared/data/ur10e_mamedov2020"   # overridden by DYNID_DATA_ROOT (dynid: --data-root)
 
-    [identification]                     # a dataset table (dynid.io.datasets)
+    [identification]                     # a dataset table (dynid.io.logs.datasets)
     preset = "ur-rtde"
     file = "identification_data/ur-20_02_10-30sec_12harm.csv"
     rows = [635, 3510]
@@ -53,7 +53,7 @@ Layout (paths relative to the config file; data paths relative to ``data_root``)
     file = "validation_data/ur-20_01_17-ptp_10_points.csv"
     rows = [700, 4200]
 
-    [[references]]                       # published parameter sets (dynid.io.references)
+    [[references]]                       # published parameter sets (dynid.io.config.references)
     name = "Mamedov & Mikhel 2020"
     file = "ur10e_reference_parameters.csv"
     header = true
@@ -71,23 +71,23 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 import numpy as np
 
-from .._util.keywords import keyword_only_after_data
-from .._util.reprs import short_repr
-from .._util.typed import convert
-from ..estimators.registry import DEFAULT_ESTIMATORS, configured_estimator, estimate_label, estimator_choices, keys
-from ..exceptions import ConfigError, DataError
-from ..model.robot import Robot
-from ..preprocessing.settings import Preprocessing
-from ..preprocessing.strategies import check_strategy
-from .bags import is_bag
+from ..._util.keywords import keyword_only_after_data
+from ..._util.reprs import short_repr
+from ..._util.typed import convert
+from ...estimators.registry import DEFAULT_ESTIMATORS, configured_estimator, estimate_label, estimator_choices, keys
+from ...exceptions import ConfigError, DataError
+from ...model.robot import Robot
+from ...preprocessing.settings import Preprocessing
+from ...preprocessing.strategies import check_strategy
+from ..logs.bags import is_bag
+from ..logs.tables import read_table
+from ..logs.trajectories import load_trajectory
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
 from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
-from .tables import read_table
-from .trajectories import load_trajectory
 
 if TYPE_CHECKING:
-    from ..simulation.closed_loop import ClosedLoopSetup
+    from ...simulation.closed_loop import ClosedLoopSetup
 
 # Parsing a config imports nothing heavy (no SciPy, compiled kernels or solvers), so that a mistake in it
 # is reported at once; the identification itself imports them when it runs.
@@ -97,7 +97,7 @@ DATA_ROOT_ENV = "DYNID_DATA_ROOT"
 
 @dataclass(frozen=True)
 class EstimationSettings:
-    """What a config's ``[estimation]`` table asks for (:class:`dynid.io.config_types.EstimationTable`), its defaults
+    """What a config's ``[estimation]`` table asks for (:class:`dynid.io.config.config_types.EstimationTable`), its defaults
     filled in.
 
     Attributes
@@ -176,13 +176,13 @@ class IdentificationConfig:
     drive_gains : DriveGainsSettings or None
         ``[drive_gains]``: the payload's mass and the runs without and with it.
     robot_source : str
-        A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.configs.robot_source`).
+        A built-in name, a description's path or ``"config:<path>"`` (:func:`dynid.io.config.configs.robot_source`).
     urdf : Path or None
-        The URDF the robot comes from, if it does (:func:`dynid.io.configs.config_urdf`): ``dynid export`` writes the
+        The URDF the robot comes from, if it does (:func:`dynid.io.config.configs.config_urdf`): ``dynid export`` writes the
         identified values back into it.
     mjcf_model : Path or None
         ``mjcf_model``: the user's own MuJoCo model of the arm, checked against the robot's joints
-        (:func:`dynid.io.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
+        (:func:`dynid.io.exported.mjcf_write_back.read_users_mjcf`); ``dynid identify`` and ``dynid export`` write the identified
         values into a copy of it. Not given, the MJCF the robot was read from, if it was and holds no joint fixed.
     controller : dynid.simulation.closed_loop.ClosedLoopSetup or None
         ``[controller]``: the controller, the set-points' :class:`ReferenceTrajectory` and whether the model's torque
@@ -200,8 +200,8 @@ class IdentificationConfig:
     data_root: Path
     estimation: EstimationSettings = field(default_factory=EstimationSettings)
     drive_gains: DriveGainsSettings | None = None
-    robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.configs.robot_source)
-    urdf: Path | None = None  # the URDF the robot comes from (dynid.io.configs.config_urdf): export writes into it
+    robot_source: str = ""  # a built-in name, a description's path or "config:<path>" (dynid.io.config.configs.robot_source)
+    urdf: Path | None = None  # the URDF the robot comes from (dynid.io.config.configs.config_urdf): export writes into it
     mjcf_model: Path | None = None  # the user's own MJCF: identify and export write the values into a copy of it
     controller: ClosedLoopSetup | None = None
     torque_sensor: str = "drive"  # the identification log's torques.sensor: "joint" or "drive"
@@ -279,7 +279,7 @@ def load_identification_config(path: str | Path, *, data_root: str | Path | None
     ------
     ConfigError
         Unreadable file, invalid TOML, unknown or malformed fields (the message names file and field;
-        the structure: :class:`dynid.io.config_types.IdentificationDocument`).
+        the structure: :class:`dynid.io.config.config_types.IdentificationDocument`).
     """
     path = Path(path)
     return config_from_document(read_config(path, None), path, data_root)
@@ -310,7 +310,7 @@ def split_estimators(asked, where: str) -> tuple[tuple, tuple[str, ...]]:
     ConfigError
         An unknown key, or a closed-loop estimator first (it starts from the first's estimate).
     """
-    from ..estimators.instrumental import CLOSED_LOOP_METHODS
+    from ...estimators.instrumental import CLOSED_LOOP_METHODS
 
     asked = [k.strip().lower() if isinstance(k, str) else k for k in asked]  # estimator objects stay as they are
     closed_loop = tuple(k for k in asked if isinstance(k, str) and k in CLOSED_LOOP_METHODS)
@@ -484,7 +484,7 @@ def _mjcf_model(given: str | None, here: Path, robot, urdf: Path | None, path: P
     if urdf is not None and urdf.name == file.name:
         raise ConfigError(f"{path}: mjcf_model: {file.name} is also the URDF's file name, and identify writes both into "
                           "one folder: give the MJCF another name", field="mjcf_model")
-    from .mjcf_write_back import read_users_mjcf
+    from ..exported.mjcf_write_back import read_users_mjcf
 
     try:
         read_users_mjcf(file, robot)
@@ -506,7 +506,7 @@ def _controller(table, root: Path, where: str, n: int, offset=None):
     the set-points are read as the logs' angles are, the robot's position offsets ``offset`` (n,) added."""
     if table is None:
         return None
-    from ..simulation.closed_loop import ClosedLoopSetup, Controller
+    from ...simulation.closed_loop import ClosedLoopSetup, Controller
 
     try:
         controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),
@@ -538,7 +538,7 @@ class ReferenceTrajectory:
     rows : (first, last) or None
     offset : tuple of float or None
         The robot's position offsets [rad], added as to a log's angles (the controller's set-points are its encoders'
-        angles: :func:`dynid.io.datasets.load_recording`).
+        angles: :func:`dynid.io.logs.datasets.load_recording`).
     """
 
     file: Path

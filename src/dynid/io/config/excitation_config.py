@@ -50,20 +50,20 @@ from typing import Any
 import msgspec
 import numpy as np
 
-from .._util.typed import convert
-from ..exceptions import ConfigError
-from ..excitation.constraints import Workspace
-from ..excitation.design import ExcitationProblem
-from ..excitation.fourier import FourierTrajectory
-from ..excitation.link_geometry import link_geometry_from_mjcf, link_geometry_from_urdf
-from ..excitation.obstacles import Obstacle
-from ..excitation.paper_trajectories import paper_identification_trajectory
-from ..model.description import parse_angle
-from ..model.robot import Robot
-from ..model.urdf import joints_to_hold
+from ..._util.typed import convert
+from ...exceptions import ConfigError
+from ...excitation.constraints import Workspace
+from ...excitation.design import ExcitationProblem
+from ...excitation.fourier import FourierTrajectory
+from ...excitation.link_geometry import link_geometry_from_mjcf, link_geometry_from_urdf
+from ...excitation.obstacles import Obstacle
+from ...excitation.paper_trajectories import paper_identification_trajectory
+from ...model.description import parse_angle
+from ...model.robot import Robot
+from ...model.urdf import joints_to_hold
+from ..logs.trajectories import load_trajectory
 from .config_types import ExcitationDocument, TrajectoryTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config
-from .trajectories import load_trajectory
 
 DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
 """The trajectory designed without a ``[trajectory]`` table (``[excitation.trajectory]`` of an identification config):

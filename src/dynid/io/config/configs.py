@@ -5,11 +5,11 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from ..exceptions import ConfigError
-from ..model.description import builtin_robots, load_robot, robot_from_document
-from ..model.robot import Robot
-from .bags import BAG_SUFFIXES
-from .files import text_encoding_hint
+from ...exceptions import ConfigError
+from ...model.description import builtin_robots, load_robot, robot_from_document
+from ...model.robot import Robot
+from ..files import text_encoding_hint
+from ..logs.bags import BAG_SUFFIXES
 
 LOG_SUFFIXES = (".csv", ".tsv", *BAG_SUFFIXES)
 """File names of logs, which a command given one for its config says how to read (not ``.txt``: a config may be
@@ -150,7 +150,7 @@ def config_urdf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         ``convention = "urdf"`` (a xacro file: the URDF it expands to); None for a built-in robot, a DH description or
         a MuJoCo model (:func:`config_mjcf`).
     """
-    from ..model.urdf import expand_xacro, is_mjcf, is_xacro
+    from ...model.urdf import expand_xacro, is_mjcf, is_xacro
 
     file, xacro_args = _robot_file(doc, path, data_root)
     if file is None or is_mjcf(file):
@@ -177,7 +177,7 @@ def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
         The file of ``robot = "arm.xml"``, ``[robot] urdf = "arm.xml"`` or a description's ``urdf``, where it is an
         MJCF (:func:`dynid.model.urdf.is_mjcf`); None otherwise.
     """
-    from ..model.urdf import is_mjcf
+    from ...model.urdf import is_mjcf
 
     file, _ = _robot_file(doc, path, data_root)
     return file if file is not None and is_mjcf(file) else None
@@ -186,7 +186,7 @@ def config_mjcf(doc: dict, path: Path, data_root: Path | None = None) -> Path | 
 def _robot_file(doc: dict, path: Path, data_root: Path | None) -> tuple[Path | None, dict | None]:
     """The URDF, xacro or MJCF file a config's robot is read from (None: a built-in robot or a DH description), and
     the ``xacro_args`` its ``[robot]`` table or description file gives."""
-    from ..model.urdf import is_mjcf, is_xacro
+    from ...model.urdf import is_mjcf, is_xacro
 
     ref = doc.get("robot")
     if isinstance(ref, dict):

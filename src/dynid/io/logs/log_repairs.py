@@ -1,4 +1,4 @@
-"""The checks and repairs of a log as it is read (:func:`dynid.io.datasets.load_recording`): a clock that restarts or
+"""The checks and repairs of a log as it is read (:func:`dynid.io.logs.datasets.load_recording`): a clock that restarts or
 stalls, gaps and empty fields, rows a faster logger repeated, spikes, wrapped angles, position steps, implausible
 efforts, logged velocities that disagree with the positions, jittered time stamps put on a uniform grid. Each says
 what it did in the recording's warnings, or refuses the log in one line naming it."""
@@ -9,11 +9,11 @@ from functools import partial
 
 import numpy as np
 
-from .._util.column_store import StoredColumns, by_column, select_rows
-from ..conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
-from ..exceptions import DataError
-from ..model.robot import Robot
-from .dataset_specs import DatasetSpec
+from ..._util.column_store import StoredColumns, by_column, select_rows
+from ...conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
+from ...exceptions import DataError
+from ...model.robot import Robot
+from ..config.dataset_specs import DatasetSpec
 
 GAP_FACTOR = 5.0
 """A time step longer than this many median steps is a gap in the log (a lost connection, a pause)."""

@@ -28,7 +28,7 @@ A dataset is described by a table of the experiment config (TOML)::
     held = "interpolate"             # rows that repeat the previous one exactly (a logger faster than its
                                      # source): replaced by interpolation (default) or "keep"
 
-or a ROS 2 bag of ``sensor_msgs/JointState`` (:mod:`dynid.io.bags`)::
+or a ROS 2 bag of ``sensor_msgs/JointState`` (:mod:`dynid.io.logs.bags`)::
 
     bag = "run_01"                   # the bag's folder, relative to the data root
     topic = "/joint_states"          # default
@@ -46,8 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import TIME_UNITS
-from ..exceptions import ConfigError
+from ...conventions import TIME_UNITS
+from ...exceptions import ConfigError
 
 PRESETS: dict[str, dict] = {
     "ur-rtde": {
@@ -128,7 +128,7 @@ class DatasetSpec:
         1-based inclusive data rows.
     delimiter : str
     decimal : str
-        The numbers' decimal separator, "." or "," (:func:`dynid.io.tables.read_table`).
+        The numbers' decimal separator, "." or "," (:func:`dynid.io.logs.tables.read_table`).
     time_range : (start, stop) or None [s]
         From the first row read.
     gaps : str
@@ -227,7 +227,7 @@ def _factor(sig, kind: str, w: str, n_dof: int, sliding) -> np.ndarray:
 
 def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sliding=()) -> DatasetSpec:
     """Parse a dataset table of a config (module docstring; its structure:
-    :class:`dynid.io.config_types.DatasetTable`); paths are relative to ``base``.
+    :class:`dynid.io.config.config_types.DatasetTable`); paths are relative to ``base``.
 
     Parameters
     ----------
@@ -254,7 +254,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sli
         Unknown preset, unit or side, a missing signal or file, a column list of the wrong length;
         the message names the config field.
     """
-    from .._util.typed import convert
+    from ..._util.typed import convert
     from .config_types import DatasetTable
 
     source, _, inside = where.rpartition(": ")

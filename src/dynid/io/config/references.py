@@ -42,11 +42,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.reprs import short_repr
-from ..conventions import canonical_name, split_name
-from ..dynamics.base_parameters import BaseParameters
-from ..exceptions import ConfigError, DataError
-from ..model.friction_model import COULOMB_LIKE
+from ..._util.reprs import short_repr
+from ...conventions import canonical_name, split_name
+from ...dynamics.base_parameters import BaseParameters
+from ...exceptions import ConfigError, DataError
+from ...model.friction_model import COULOMB_LIKE
 
 
 @short_repr
