@@ -14,7 +14,7 @@ seed, dynid designs the excitation twice: with the box and without it. Reported 
 - cond(W_base) with the box against without, on the seeds where the box does not bind and where it does;
 - the design time with the box against without, measured in this run;
 - how many designs with the box MuJoCo's own collision detection finds a shape within the clearance of the box or
-  the table on, at 1 kHz (:func:`dynid.io.exported.cell_replay.cell_contacts`, as ``dynid excite`` checks; target 0).
+  the table on, at 1 kHz (:func:`dynid.excitation.cell_replay.cell_contacts`, as ``dynid excite`` checks; target 0).
 
 With ``--geometry collision`` (default) the links are the descriptions' own collision meshes (their convex hulls,
 :mod:`dynid.excitation.link_geometry`), and the independent pass is Pinocchio's: its geometry model of the same URDF
@@ -44,10 +44,10 @@ from zoo import ARMS, arm_urdf, robots_folder  # noqa: E402
 
 from dynid.dynamics.kinematics import forward_kinematics  # noqa: E402
 from dynid.exceptions import ConfigError  # noqa: E402
+from dynid.excitation.cell_replay import cell_contacts  # noqa: E402
 from dynid.excitation.constraints import Workspace  # noqa: E402
 from dynid.excitation.design import ExcitationProblem, InfeasibleDesignError, design_excitation  # noqa: E402
 from dynid.excitation.obstacles import Obstacle  # noqa: E402
-from dynid.io.exported.cell_replay import cell_contacts  # noqa: E402
 from dynid.model.description import load_robot  # noqa: E402
 from dynid.runtime.threads import with_single_blas_thread  # noqa: E402
 

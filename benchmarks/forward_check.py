@@ -25,7 +25,8 @@ CONFIGS = ("ur10e", "tx40", "kuka_kr300", "kuka_med7")
 def main() -> int:
     from dynid.identification.run import forward_check, run_identification
     from dynid.io.config.identification_config import load_identification_config
-    from dynid.io.exported.export import consistent_estimate, mjcf_from_robot
+    from dynid.io.exported.export import consistent_estimate
+    from dynid.model.description_files import mjcf_from_robot
     from dynid.report.output import write_results
 
     folder = Path(tempfile.mkdtemp())

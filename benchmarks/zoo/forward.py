@@ -35,8 +35,9 @@ def forward(folder: Path) -> dict:
     """The forward check of one zoo cell's identified MJCF and of its truth's."""
     from dynid.identification.run import forward_check, moving_validation
     from dynid.io.config.identification_config import load_identification_config
-    from dynid.io.exported.export import consistent_estimate, mjcf_from_robot
+    from dynid.io.exported.export import consistent_estimate
     from dynid.io.exported.replay import mjcf_forward
+    from dynid.model.description_files import mjcf_from_robot
 
     config = load_identification_config(folder / "excitation.toml")
     identified = json.loads((folder / "out-excitation" / "results.json").read_text())

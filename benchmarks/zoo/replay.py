@@ -65,8 +65,8 @@ def without(robot, phi, terms) -> np.ndarray:
 
 def run_arm(name: str, folder: Path, seed: int = 0) -> list[dict]:
     from dynid.dynamics.regressor import regressor
-    from dynid.io.exported.export import mjcf_from_robot, urdf_from_robot
     from dynid.io.exported.replay import _states, mjcf_replay, urdf_replay
+    from dynid.model.description_files import mjcf_from_robot, urdf_from_robot
 
     rng = np.random.default_rng(seed)
     robot, phi = arm_model(name, folder, rng)

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from dynid.dynamics.kinematics import forward_kinematics
+from dynid.excitation.cell_replay import cell_contacts
 from dynid.excitation.constraints import Workspace, floor_margins
 from dynid.excitation.floor import FloorDistances, floor_needs, lowest_points
 from dynid.excitation.link_geometry import LinkGeometry, link_geometry_from_urdf
-from dynid.io.exported.cell_replay import cell_contacts
 from dynid.model.description import load_robot
 
 from ..cli.refusals import dynid

@@ -12,12 +12,12 @@ import pytest
 
 from dynid.dynamics.kinematics import forward_kinematics
 from dynid.exceptions import ConfigError
+from dynid.excitation.cell_replay import cell_contacts
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, design_excitation
 from dynid.excitation.link_geometry import FAR, LinkGeometry, link_geometry_from_urdf, self_distances, self_pairs
 from dynid.excitation.obstacles import Obstacle
 from dynid.io.config.excitation_config import load_excitation_config
-from dynid.io.exported.cell_replay import cell_contacts
 from dynid.model.description import load_robot
 
 UR10E = Path(str(resources.files("dynid.model") / "robots" / "ur10e.urdf"))

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import ConfigError
+from dynid.excitation.cell_replay import cell_contacts
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.link_geometry import FAR, link_geometry_from_mjcf, self_pairs
 from dynid.excitation.obstacles import Obstacle
 from dynid.io.config.excitation_config import load_excitation_config
-from dynid.io.exported.cell_replay import cell_contacts
 from dynid.model.description import load_robot
 
 ARM = """<mujoco model="cell-arm">

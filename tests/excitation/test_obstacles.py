@@ -9,13 +9,13 @@ import pytest
 
 from dynid.dynamics.kinematics import forward_kinematics
 from dynid.exceptions import ConfigError
+from dynid.excitation.cell_replay import cell_contacts, cell_mjcf
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, design_excitation
 from dynid.excitation.obstacles import Obstacle
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
 from dynid.identification.excitation_run import run_excitation
 from dynid.io.config.excitation_config import load_excitation_config
-from dynid.io.exported.cell_replay import cell_contacts, cell_mjcf
 from dynid.model.description import load_robot
 from dynid.report.excitation_run import save_excitation
 from dynid.report.excitation_summary import excitation_blocks
@@ -200,9 +200,9 @@ def test_a_trajectory_that_fails_at_the_set_points_is_not_written(tmp_path, monk
     """The set-points are checked after the design: a contact MuJoCo reports there, or a link inside the cell's
     clearance between the verification grid's samples, stops the run before anything is written."""
     import dynid.identification.excitation_run as er
+    from dynid.excitation.cell_replay import CellContacts
     from dynid.excitation.constraints import ConstraintMargin
     from dynid.excitation.design import InfeasibleDesignError
-    from dynid.io.exported.cell_replay import CellContacts
 
     cfg = tmp_path / "excite.toml"
     cfg.write_text('robot = "er16"\njoints = 3\n[design]\nstarts = 1\nmaxiter = 20\n[trajectory]\nharmonics = 2\n'

@@ -9,8 +9,9 @@ import pytest
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.exported.export import urdf_from_results, urdf_from_robot
+from dynid.io.exported.export import urdf_from_results
 from dynid.model.description import load_robot
+from dynid.model.description_files import urdf_from_robot
 
 
 def _with_friction(robot, rng):

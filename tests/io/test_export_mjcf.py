@@ -6,8 +6,8 @@ import pytest
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
-from dynid.io.exported.export import mjcf_from_robot
 from dynid.model.description import load_robot
+from dynid.model.description_files import mjcf_from_robot
 
 from .test_export import _with_friction
 

@@ -4,8 +4,8 @@ from importlib import resources
 
 import pinocchio as pin
 
-from dynid.io.exported.export import mjcf_from_robot, urdf_from_robot
 from dynid.model.description import load_robot
+from dynid.model.description_files import mjcf_from_robot, urdf_from_robot
 
 NOTE = "encoder angle (what a log and the controller hold) plus its position_offset (J2 +90°)"
 

@@ -109,8 +109,9 @@ def _frictionloss(path):
 def test_the_real_ur10es_files_hold_what_was_chosen_and_predict_its_validation_log_better(ur10e, tmp_path):
     from dynid import load_identification_config
     from dynid.identification.run import moving_validation
-    from dynid.io.exported.export import consistent_estimate, mjcf_from_robot
+    from dynid.io.exported.export import consistent_estimate
     from dynid.io.exported.replay import mjcf_replay
+    from dynid.model.description_files import mjcf_from_robot
 
     root, out, p = ur10e
     res = json.loads((out / "results.json").read_text())

@@ -113,7 +113,7 @@ def test_a_model_whose_gravity_is_not_minus_z_is_written_with_its_base_turned():
     """The KR 300's model has gravity along +z of its base frame (the authors' base is turned half a turn about x); a
     URDF has no gravity field and its users take -z, so the URDF dynid wrote gave torques 71 % off its model. The
     base is now turned under a world link, and the file reproduces the model."""
-    from dynid.io.exported.export import urdf_from_robot
+    from dynid.model.description_files import urdf_from_robot
 
     robot = load_robot(Path(__file__).resolve().parents[2] / "configs" / "robots" / "kuka_kr300.toml")
     assert np.allclose(robot.gravity, [0.0, 0.0, 9.81])
@@ -129,8 +129,8 @@ def test_the_written_mjcf_read_back_by_mujoco_reproduces_the_model_and_a_lost_va
     """MuJoCo's mj_inverse of the MJCF dynid writes (armature = Ia, damping = fv, frictionloss = fc) equals dynid's
     model of those terms; a file that dropped the off-diagonal inertia, or the armature, is caught; what MJCF cannot
     hold is the offset alone; MuJoCo's frictionloss constraint is measured apart, and is not fc·sign(q̇)."""
-    from dynid.io.exported.export import mjcf_from_robot
     from dynid.io.exported.replay import mjcf_replay
+    from dynid.model.description_files import mjcf_from_robot
 
     robot, phi = _estimate()
     text = mjcf_from_robot(robot, phi)
@@ -155,11 +155,11 @@ def test_a_link_at_the_limit_of_a_real_one_is_written_so_that_mujoco_loads_it():
     """A physically consistent estimate may hold a link at the limit (the TX40's link 6 from the SDP: a point mass, a
     singular inertia); MuJoCo refuses a fullinertia that is not positive definite, so the MJCF dynid wrote did not
     load; a simulated UR10e's SDP wrist broke MuJoCo's triangle inequality by round-off. The inertia is now written
-    as MuJoCo loads it (dynid.io.exported.export.mujoco_inertia), the torques unchanged to 1e-6."""
+    as MuJoCo loads it (dynid.model.description_files.mujoco_inertia), the torques unchanged to 1e-6."""
     import mujoco
 
-    from dynid.io.exported.export import mjcf_from_robot
     from dynid.io.exported.replay import mjcf_replay
+    from dynid.model.description_files import mjcf_from_robot
     from dynid.model.spatial import inertial_from_physical
 
     robot, phi = _estimate()
@@ -181,8 +181,8 @@ def test_the_written_mjcf_simulated_along_a_motion_needs_the_models_torques():
     the simulated-against-measured figure is the same. With a torque offset the file cannot hold, the gap is that
     offset's share."""
     from dynid.dynamics.regressor import regressor
-    from dynid.io.exported.export import mjcf_from_robot
     from dynid.io.exported.replay import mjcf_forward
+    from dynid.model.description_files import mjcf_from_robot
 
     robot, phi = _estimate()
     names = robot.parameter_names

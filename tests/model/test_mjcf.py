@@ -13,8 +13,8 @@ import pytest
 from dynid.dynamics.regressor import regressor
 from dynid.exceptions import ConfigError
 from dynid.io.config.configs import config_mjcf, config_robot, config_urdf
-from dynid.io.exported.export import mjcf_from_robot
 from dynid.model.description import URDF_DYNAMICS_NOTE, load_robot
+from dynid.model.description_files import mjcf_from_robot
 
 ROBOTS = resources.files("dynid.model") / "robots"
 

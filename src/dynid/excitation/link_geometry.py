@@ -8,7 +8,7 @@ mesh's BVH takes a millisecond. Each shape rides on one of dynid's links: the jo
 the nearest of its ancestors that is one of the robot's joints (a gripper held at 0 rides on the last link), or on
 the base (the links keep off it; the cell's bodies are not measured against it: no motion moves it). Its pose in
 that link's frame is read once at ``q = 0``. An MJCF's collision geoms are read as MuJoCo compiles them
-(:func:`link_geometry_from_mjcf`), so that the MuJoCo check (:mod:`dynid.io.exported.cell_replay`) collides the user's own
+(:func:`link_geometry_from_mjcf`), so that the MuJoCo check (:mod:`dynid.excitation.cell_replay`) collides the user's own
 shapes.
 """
 

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.reprs import short_repr
+from ..excitation.cell_replay import CellContacts, cell_contacts
 from ..excitation.collision import SelfClearance, self_clearance, shape_clearance
 from ..excitation.constraints import ConstraintMargin, LowestPoint, floor_margins, lowest_point, obstacle_margins
 from ..excitation.design import ExcitationDesign, InfeasibleDesignError, design_excitation
 from ..io.config.excitation_config import ExcitationConfig
-from ..io.exported.cell_replay import CellContacts, cell_contacts
 
 
 @short_repr
@@ -37,7 +37,7 @@ class ExcitationRun:
         (:func:`dynid.excitation.constraints.floor_margins`, :func:`~dynid.excitation.constraints.obstacle_margins`;
         empty without a floor and ``[[workspace.obstacles]]``).
     mujoco_contacts : CellContacts or None
-        The set-points checked a second time by MuJoCo (:func:`dynid.io.exported.cell_replay.cell_contacts`; None without a
+        The set-points checked a second time by MuJoCo (:func:`dynid.excitation.cell_replay.cell_contacts`; None without a
         floor or bodies, or without MuJoCo).
     lowest : LowestPoint or None
         Without a floor (``[workspace] floor``): where the set-points take the arm lowest, which nothing in the design

@@ -5,7 +5,7 @@ choice made by the validation logs.
 A URDF's ``<dynamics friction damping>`` and an MJCF's ``frictionloss`` and ``damping`` hold a constant Coulomb and a
 viscous coefficient per joint; dynid's model may also hold Stribeck friction (``fst``) and load-dependent Coulomb friction
 (``fcl``), which no format holds, and a torque offset, which an MJCF can hold as an actuator's constant bias
-(:func:`dynid.io.exported.export.offset_actuators`) and a URDF cannot. Written as identified, the files leave those terms out.
+(:func:`dynid.model.description_files.offset_actuators`) and a URDF cannot. Written as identified, the files leave those terms out.
 Folded into the two coefficients the formats hold (the nearest Coulomb and viscous pair, by non-negative least
 squares, to the joint's whole friction on the identification log's motion) and with the offsets held, the files come
 closer to the measured torques on some logs; but a load-dependent term's nearest constant depends on the load the

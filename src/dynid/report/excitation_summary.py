@@ -282,7 +282,7 @@ def _cell_clearance_lines(run) -> list:
 
 def _mujoco_lines(run) -> list:
     """:func:`excitation_blocks`' line on the second check, MuJoCo's contacts at the set-points
-    (:func:`dynid.io.exported.cell_replay.cell_contacts`)."""
+    (:func:`dynid.excitation.cell_replay.cell_contacts`)."""
     ws = run.config.problem.workspace
     if not ws.obstacles and not math.isfinite(ws.floor):
         return []

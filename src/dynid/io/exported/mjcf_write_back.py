@@ -19,22 +19,20 @@ import numpy as np
 
 from ...dynamics.kinematics import forward_kinematics
 from ...exceptions import ConfigError
-from ...model.mjcf import held_inertials
-from ...model.robot import Robot
-from ...model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
-from ...runtime.extras import require
-from .export import (
+from ...model.description_files import (
     _exportable,
-    _replace,
     _vec,
     coupled_tendons,
     friction_solref,
-    identified_header,
-    moved_far,
     mujoco_inertia,
     offset_actuators,
     position_offset_note,
 )
+from ...model.mjcf import held_inertials
+from ...model.robot import Robot
+from ...model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial, transform_inertial
+from ...runtime.extras import require
+from .export import _replace, identified_header, moved_far
 
 AXIS_TOLERANCE = 1e-4
 """[rad, m] How far a joint axis of the MJCF may lie from the robot's, once the arms are aligned."""
@@ -102,7 +100,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     estimate : str
         What the values are, for the header comment.
     offsets_held : bool
-        Hold the torque offsets as actuators of constant bias (:func:`dynid.io.exported.export.offset_actuators`), added to the
+        Hold the torque offsets as actuators of constant bias (:func:`dynid.model.description_files.offset_actuators`), added to the
         model's ``<actuator>`` after its own (their indices in ``ctrl`` unchanged), instead of comments.
 
     Returns
@@ -200,7 +198,7 @@ def _section(root, tag: str):
 
 
 def _append_tendons(root, coupled: tuple) -> None:
-    """The coupled motors' tendons (:func:`dynid.io.exported.export.coupled_tendons`) added to the MJCF's ``<tendon>``, and
+    """The coupled motors' tendons (:func:`dynid.model.description_files.coupled_tendons`) added to the MJCF's ``<tendon>``, and
     what they do not hold as a comment."""
     for attributes, joints in coupled[0]:
         tendon = ET.SubElement(_section(root, "tendon"), "fixed", attributes)

@@ -20,8 +20,8 @@ import numpy as np
 
 from ..._util.reprs import short_repr
 from ...dynamics.regressor import regressor
+from ...model.description_files import COUPLED_TENDON, OFFSET_ACTUATOR, WORLD_JOINT
 from ...model.robot import Robot
-from .export import COUPLED_TENDON, OFFSET_ACTUATOR, WORLD_JOINT
 
 __all__ = ["MJCF_TERMS", "URDF_TERMS", "ForwardCheck", "ReplayCheck", "mjcf_forward", "mjcf_replay", "urdf_replay"]
 
@@ -169,7 +169,7 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
 
 def _offset_forces(model, robot: Robot, vadr: np.ndarray) -> np.ndarray:
     """(n_dof,) [N·m]: the constant joint forces of the actuators that hold torque offsets
-    (:func:`dynid.io.exported.export.offset_actuators`, named by :data:`dynid.io.exported.export.OFFSET_ACTUATOR`), 0 where there is none:
+    (:func:`dynid.model.description_files.offset_actuators`, named by :data:`dynid.model.description_files.OFFSET_ACTUATOR`), 0 where there is none:
     the torque a joint needs is MuJoCo's inverse dynamics less this force."""
     import mujoco
 
@@ -190,7 +190,7 @@ def _tendon_friction(tendons: tuple, qvel: np.ndarray, vadr: np.ndarray) -> np.n
 
 
 def _coupled_tendons(model) -> tuple | None:
-    """dynid's coupled-motor tendons in a model (named by :data:`dynid.io.exported.export.COUPLED_TENDON`): their
+    """dynid's coupled-motor tendons in a model (named by :data:`dynid.model.description_files.COUPLED_TENDON`): their
     ``frictionloss`` (n,) and Jacobians (n, nv), a fixed tendon's coefficients on its joints' dofs; None without one."""
     import mujoco
 
@@ -209,7 +209,7 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
                 measured=None, whole=None) -> ReplayCheck:
     """MuJoCo's torques of a written MJCF against dynid's torques of ``phi``: the links, ``armature`` (rotor inertia),
     ``damping`` (viscous friction), ``frictionloss`` (Coulomb friction) and, where the file has dynid's offset actuators
-    (:func:`dynid.io.exported.export.offset_actuators`), the torque offsets (module docstring).
+    (:func:`dynid.model.description_files.offset_actuators`), the torque offsets (module docstring).
 
     MuJoCo's inverse dynamics (``mj_inverse``) is evaluated with the dry-friction constraint off, and the file's
     ``frictionloss`` added as ``frictionloss·sign(q̇)``: that checks the value the file holds. How MuJoCo's own

@@ -19,9 +19,10 @@ from xml.parsers.expat import ExpatError
 import numpy as np
 
 from ...exceptions import ConfigError
+from ...model.description_files import _exportable, _world_from_base, position_offset_note
 from ...model.robot import Robot
 from ...model.spatial import is_physically_consistent, nearest_consistent, physical_from_inertial
-from .export import _exportable, _world_from_base, identified_header, moved_far, position_offset_note
+from .export import identified_header, moved_far
 
 __all__ = ["urdf_written_back"]
 
@@ -194,7 +195,7 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     ------
     ConfigError
         The URDF cannot be read, its joints are not the robot's, or the values are not exportable
-        (:func:`dynid.io.exported.export.urdf_from_robot`'s checks).
+        (:func:`dynid.model.description_files.urdf_from_robot`'s checks).
     """
     path = Path(urdf)
     fitted = _exportable(robot, phi)

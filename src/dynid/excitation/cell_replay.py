@@ -1,7 +1,7 @@
 """An excitation checked a second time, by MuJoCo's collision detection (issue "An excitation safe to run on the real
 robot", item 2: checked twice).
 
-The robot is written as MJCF (:func:`dynid.io.exported.export.mjcf_from_robot`) with the shapes the design measured as geoms
+The robot is written as MJCF (:func:`dynid.model.description_files.mjcf_from_robot`) with the shapes the design measured as geoms
 of its links (:meth:`dynid.excitation.constraints.Workspace.shapes`: the robot file's collision shapes, or the
 capsules about the joint origins), the cell's bodies as geoms of the world, and the floor as a plane. Every shape's
 ``margin`` is the clearance, so MuJoCo reports each contact up to that far apart. MuJoCo places the links at every
@@ -21,10 +21,10 @@ import coal
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..._util.reprs import short_repr
-from ...excitation.constraints import Workspace
-from ...model.robot import Robot
-from .export import mjcf_from_robot
+from .._util.reprs import short_repr
+from ..model.description_files import mjcf_from_robot
+from ..model.robot import Robot
+from .constraints import Workspace
 
 __all__ = ["CellContacts", "cell_contacts", "cell_mjcf"]
 
