@@ -20,7 +20,7 @@ def measure() -> dict:
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.dynamics.rnea import rnea_torques
     from dynid.excitation.paper_trajectories import paper_identification_trajectory
-    from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
+    from dynid.identification.closed_loop_estimators import ClosedLoopExperiment, closed_loop_identify
     from dynid.io.logs.datasets import Recording
     from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 

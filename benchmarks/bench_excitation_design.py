@@ -15,7 +15,7 @@ import numpy as np
 from timing import best_of  # benchmarks/timing.py (run as scripts from benchmarks/)
 
 from dynid.excitation.design import _Layout, _Objective
-from dynid.identification.excitation_run import run_excitation
+from dynid.identification.excite import run_excitation
 from dynid.io.config.excitation_config import load_excitation_config
 
 CONFIG = Path(__file__).resolve().parents[1] / "configs" / "excite-er16-6dof.toml"

@@ -21,7 +21,7 @@ import numpy as np
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.identification.identify import identify
 from dynid.model.description import load_robot
-from dynid.preprocessing.pipeline import PreparedData, Preprocessing
+from dynid.preprocessing.preparation import PreparedData, Preprocessing
 
 RATE = 1000.0
 DECIMATION = 10

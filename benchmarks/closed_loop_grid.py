@@ -1,5 +1,5 @@
 """Closed-loop Monte Carlo on BIRDy's noise grid (Leboutet et al., Applied Sciences 2021), on a Dask local cluster of 2
-workers: ``dynid montecarlo --closed-loop`` (:mod:`dynid.studies.closed_loop`) with its table as Markdown.
+workers: ``dynid montecarlo --closed-loop`` (:mod:`dynid.studies.closed_loop_montecarlo`) with its table as Markdown.
 
 The paper's ER-16 (3 joints, its excitation β1, 25 s at 1 kHz) driven by a PID with model feed-forward (5 Hz
 bandwidth, velocity filtered at 50 Hz); encoder noise 1e-4, 1e-3, 1e-2 degrees; torque noise 0.05 and 0.1 N·m; every
@@ -24,7 +24,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 def main(argv: list[str]) -> int:
     from dynid.report.study_summaries import closed_loop_study_rows, closed_loop_verdict
-    from dynid.studies.closed_loop import ENCODER_NOISE_DEG, TORQUE_NOISE, ClosedLoopStudyConfig, run_closed_loop_study
+    from dynid.studies.closed_loop_montecarlo import (
+        ENCODER_NOISE_DEG,
+        TORQUE_NOISE,
+        ClosedLoopStudyConfig,
+        run_closed_loop_study,
+    )
 
     parser = argparse.ArgumentParser()
     parser.add_argument("realisations", type=int, nargs="?", default=10)

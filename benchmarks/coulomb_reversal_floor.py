@@ -32,10 +32,10 @@ import numpy as np  # noqa: E402
 from scipy import signal  # noqa: E402
 
 from dynid.io.logs.datasets import Recording  # noqa: E402
-from dynid.preprocessing.pipeline import Preprocessing, prepare  # noqa: E402
+from dynid.preprocessing.preparation import Preprocessing, prepare  # noqa: E402
 from dynid.preprocessing.strategies import strategy_for  # noqa: E402
 from dynid.simulation.closed_loop import ClosedLoopNoise, simulate_closed_loop  # noqa: E402
-from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay  # noqa: E402
+from dynid.studies.closed_loop_montecarlo import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay  # noqa: E402
 
 SHARE = 0.95
 

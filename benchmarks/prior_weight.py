@@ -99,7 +99,7 @@ def _rows(config, result):
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.run import pipeline_of
     from dynid.io.logs.datasets import load_recording
-    from dynid.preprocessing.pipeline import base_chunks
+    from dynid.preprocessing.preparation import base_chunks
 
     base = base_parameters(config.robot, rng=0)
     prepared = pipeline_of(config).prepare(load_recording(config.identification, config.robot), base, lambda s: None)

@@ -37,7 +37,7 @@ NEAR = 1.05
 def raw_scores(robot, base, sets: dict, recording, resolved) -> dict:
     """label -> (len(CUTOFFS),) global relative error [%] on ``recording``'s raw torques, and the share of the
     joints' samples at rest."""
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
     from dynid.preprocessing.strategies import carried_over
     from dynid.validation.torques import compare_torques

@@ -53,7 +53,7 @@ def _fold_variants(robot, base, recording, data, given, one_way) -> tuple:
     """:func:`dynid.identification.drive_only.preprocessing_variants`, each variant's rows split into the folds."""
     from dynid.estimators.accumulate import LeastSquaresAccumulator
     from dynid.identification.drive_only import CUTOFF_FACTORS, prepared_variant, variants_judge
-    from dynid.preprocessing.pipeline import base_chunks
+    from dynid.preprocessing.preparation import base_chunks
 
     if not variants_judge(robot, data, one_way):
         return ()
@@ -83,7 +83,7 @@ def collect(name: str, tag: str, window, folder: Path) -> None:
     from dynid.identification.run import pipeline_of, run_identification
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording
-    from dynid.preprocessing.pipeline import base_chunks
+    from dynid.preprocessing.preparation import base_chunks
 
     path, root = _config_path(name, window, folder)
     config = load_identification_config(path, data_root=root)

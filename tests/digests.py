@@ -109,7 +109,7 @@ def compute(case: str) -> dict:
             raise FileNotFoundError(f"data of {path.name} not found")
         return _clean(run_identification(load_identification_config(path, data_root=root)).to_dict())
     if kind == "excite":
-        from dynid.identification.excitation_run import run_excitation
+        from dynid.identification.excite import run_excitation
         from dynid.io.config.excitation_config import load_excitation_config
 
         return _clean(run_excitation(load_excitation_config(ROOT / "configs" / f"{name}.toml")).to_dict())

@@ -6,7 +6,7 @@ import pytest
 import dynid._util.column_store as column_store
 from dynid._util.column_store import ColumnFile, StoredColumns, by_column, root_mean_square, select_rows
 from dynid.exceptions import DataError
-from dynid.io.logs.tables import read_table
+from dynid.io.logs.table_files import read_table
 
 
 @pytest.fixture
@@ -56,7 +56,7 @@ def test_column_and_row_maps_equal_the_array_operations(x, stored):
 
 
 def test_a_table_read_spooled_equals_the_one_read_in_memory(tmp_path, rng, monkeypatch):
-    monkeypatch.setattr("dynid.io.logs.tables.BLOCK", 37)  # several blocks
+    monkeypatch.setattr("dynid.io.logs.table_files.BLOCK", 37)  # several blocks
     data = rng.normal(size=(200, 5))
     path = tmp_path / "log.csv"
     np.savetxt(path, data, delimiter=",", header="a,b,c,d,e", comments="")

@@ -62,7 +62,7 @@ def test_a_loose_top_level_module_grouped_into_a_package_keeps_its_old_path_for_
         aliased = importlib.import_module(old)
     assert aliased is new and new.__name__ == new_name
     root = Path(dynid.__file__).parent
-    assert not (root / f"{old.rsplit('.', 1)[1]}.py").exists() and Path(new.__file__).parent.name == new_name.split(".")[1]
+    assert not (root.parent / (old.replace(".", "/") + ".py")).exists() and Path(new.__file__).parent.name == new_name.split(".")[1]
 
 
 @pytest.mark.parametrize("old", sorted(__import__("dynid.io").io.MOVED))
@@ -93,3 +93,16 @@ def test_io_holds_only_its_rooms_and_the_two_modules_every_room_shares():
     root = Path(dynid.io.__file__).parent
     assert sorted(p.name for p in root.glob("*.py")) == ["__init__.py", "files.py", "results.py"]
     assert sorted(p.name for p in root.iterdir() if (p / "__init__.py").exists()) == ["config", "exported", "logs"]
+
+
+def test_no_two_modules_share_a_name_unless_they_are_one_kind_of_thing():
+    """issue "One route, four named parts", item 3: a module's name says which it is wherever it is imported from; the
+    artificial bee colony's optimiser (``optim``) and its estimator (``estimators``) keep the one name the field gives
+    them."""
+    from collections import Counter
+    from pathlib import Path
+
+    import dynid
+
+    names = Counter(p.name for p in Path(dynid.__file__).parent.rglob("*.py") if p.name != "__init__.py")
+    assert {name for name, n in names.items() if n > 1} == {"bee_colony.py"}

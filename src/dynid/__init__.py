@@ -24,9 +24,11 @@ from ._lazy import alias_moved_modules, lazy_exports
 __version__ = "0.2.0"
 
 MOVED_MODULES = {f"dynid.{name}": f"dynid.{package}.{name}" for package, names in (
-    ("runtime", ("threads", "processes")), ("_util", ("typed", "checks", "column_store"))) for name in names}
-"""Top-level modules of 0.1.0 grouped into packages in 0.2 -> where they went: their old paths import them, with a
-FutureWarning, for a release (docs/changelog.md)."""
+    ("runtime", ("threads", "processes")), ("_util", ("typed", "checks", "column_store"))) for name in names} | {
+    "dynid.preprocessing.pipeline": "dynid.preprocessing.preparation"}
+"""Modules of 0.1.0 grouped into packages or renamed in 0.2 (``preprocessing.pipeline``: the identification's
+pipeline has that name) -> where they went: their old paths import them, with a FutureWarning, for a release
+(docs/changelog.md)."""
 alias_moved_modules(MOVED_MODULES)
 
 _EXPORTS = {

@@ -7,7 +7,7 @@ import pytest
 from dynid.estimators import Estimator, check_estimator, register, unregister
 from dynid.estimators import registry as reg
 from dynid.estimators.base import weighted_rows
-from dynid.estimators.checks import EstimatorCheckError
+from dynid.estimators.contract import EstimatorCheckError
 
 BASE_SPACE = [k for k in reg.keys() if reg.spec(k).space == "base"]
 

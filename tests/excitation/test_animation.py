@@ -5,7 +5,7 @@ import numpy as np
 from PIL import Image, ImageChops
 
 from dynid.excitation.obstacles import Obstacle
-from dynid.identification.excitation_run import run_excitation
+from dynid.identification.excite import run_excitation
 from dynid.io.config.excitation_config import load_excitation_config
 from dynid.report.excitation_run import ANIMATION, ANIMATION_FRAMES, save_excitation
 from dynid.report.figures import animate_arm

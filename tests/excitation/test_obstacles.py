@@ -14,7 +14,7 @@ from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, design_excitation
 from dynid.excitation.obstacles import Obstacle
 from dynid.excitation.paper_trajectories import PAPER_OMEGA_F, paper_identification_trajectory
-from dynid.identification.excitation_run import run_excitation
+from dynid.identification.excite import run_excitation
 from dynid.io.config.excitation_config import load_excitation_config
 from dynid.model.description import load_robot
 from dynid.report.excitation_run import save_excitation
@@ -199,7 +199,7 @@ def test_mujoco_and_coal_agree_on_a_turned_cylinder_and_box(er16, rng):
 def test_a_trajectory_that_fails_at_the_set_points_is_not_written(tmp_path, monkeypatch):
     """The set-points are checked after the design: a contact MuJoCo reports there, or a link inside the cell's
     clearance between the verification grid's samples, stops the run before anything is written."""
-    import dynid.identification.excitation_run as er
+    import dynid.identification.excite as er
     from dynid.excitation.cell_replay import CellContacts
     from dynid.excitation.constraints import ConstraintMargin
     from dynid.excitation.design import InfeasibleDesignError

@@ -8,10 +8,10 @@ from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError, ShapeError
 from dynid.excitation.paper_trajectories import paper_identification_trajectory
-from dynid.identification.closed_loop import ClosedLoopExperiment, closed_loop_identify
+from dynid.identification.closed_loop_estimators import ClosedLoopExperiment, closed_loop_identify
 from dynid.io.logs.datasets import Recording
 from dynid.preprocessing.bands import estimate_band
-from dynid.preprocessing.pipeline import Preprocessing
+from dynid.preprocessing.preparation import Preprocessing
 from dynid.simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop
 
 ENCODER_NOISE = np.deg2rad(1e-2)
@@ -100,7 +100,7 @@ def test_didim_sdp_keeps_every_simulated_model_physically_consistent():
     tolerance) and it converged. Independent truth: the feasibility SDP of Sousa & Cortesão (2014)."""
     from dynid.dynamics.layout import consistency_layout
     from dynid.estimators.physically_consistent import consistency_margin
-    from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
+    from dynid.studies.closed_loop_montecarlo import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 
     setup = _prepare(ClosedLoopStudyConfig(joints=6, realisations=2))
     exp = setup.experiment

@@ -142,7 +142,7 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
     arrays with the same numbers as ``dynid identify`` on the config that describes the same log and controller; the
     pipeline refuses them without a controller, in one line."""
     from dynid.exceptions import ConfigError
-    from dynid.identification.closed_loop import ClosedLoopEstimator, ClosedLoopSetup
+    from dynid.identification.closed_loop_estimators import ClosedLoopEstimator, ClosedLoopSetup
     from dynid.identification.pipeline import IdentificationPipeline
     from dynid.simulation.closed_loop import Controller
 
@@ -179,7 +179,7 @@ def test_the_closed_loop_estimators_run_from_arrays_as_from_a_config(closed_loop
 
 def _setup_and_recording(root):
     """The ER-16, the fixture's controller with its set-points, and its log as a Recording."""
-    from dynid.identification.closed_loop import ClosedLoopSetup
+    from dynid.identification.closed_loop_estimators import ClosedLoopSetup
     from dynid.io.logs.datasets import Recording
     from dynid.simulation.closed_loop import Controller
 
@@ -195,7 +195,7 @@ def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_lo
     carrying the controller, and takes such a part itself in its estimators: one such part added to the pipeline's open-loop result gives the pipeline's own IDIM-IV estimate, and
     an unknown method is refused in one line."""
     from dynid.exceptions import ConfigError
-    from dynid.identification.closed_loop import ClosedLoopEstimator
+    from dynid.identification.closed_loop_estimators import ClosedLoopEstimator
     from dynid.identification.pipeline import IdentificationPipeline
 
     robot, setup, recording = _setup_and_recording(closed_loop_log[0])

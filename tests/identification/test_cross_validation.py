@@ -37,7 +37,7 @@ def test_coulomb_cross_validation_prefers_smoothing_when_the_truth_is_smooth(tmp
     from dynid.dynamics.rnea import rnea_torques
     from dynid.identification.cross_validation import choose_coulomb_velocity
     from dynid.model.description import load_robot
-    from dynid.preprocessing.pipeline import Preprocessing
+    from dynid.preprocessing.preparation import Preprocessing
     from dynid.preprocessing.prepared import PreparedData
 
     from ..conftest import sine_motion

@@ -10,7 +10,7 @@ from dynid.dynamics.base_parameters import base_parameters
 from dynid.identification.drive_gains import identify_drive_gains, identify_payload
 from dynid.io.logs.datasets import Recording
 from dynid.model.spatial import inertial_from_physical
-from dynid.preprocessing.pipeline import Preprocessing, prepare
+from dynid.preprocessing.preparation import Preprocessing, prepare
 
 from ..simulated_logs import fourier_motion, torques, truth_robot
 

@@ -86,7 +86,7 @@ def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
     from dynid.dynamics.base_parameters import base_parameters
     from dynid.identification.identify import identify
     from dynid.io.logs.datasets import load_recording
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
 
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     config = load_identification_config(cfg)

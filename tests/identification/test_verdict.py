@@ -201,7 +201,7 @@ def test_a_one_log_user_reads_what_held_out_blocks_say_of_every_candidate(tmp_pa
     from dynid.identification.run import pipeline_of, run_identification
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording
-    from dynid.preprocessing.pipeline import prepared_rows
+    from dynid.preprocessing.preparation import prepared_rows
     from dynid.report.summaries import readiness
 
     text = (REPO / "configs" / "ur10e.toml").read_text().replace("rows = [635, 3510]", "rows = [785, 1285]", 1)

@@ -154,7 +154,7 @@ def test_the_verdict_chooses_what_predicts_the_raw_torques_on_a_real_window(tmp_
     from dynid.identification.run import run_identification
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
     from dynid.validation.torques import compare_torques
     from tests.conftest import shared_data

@@ -7,7 +7,7 @@ import pytest
 from dynid.exceptions import ConfigError, DataError
 from dynid.io.logs.datasets import dataset_spec, load_recording
 from dynid.model.description import load_robot
-from dynid.preprocessing.pipeline import prepare
+from dynid.preprocessing.preparation import prepare
 from dynid.preprocessing.settings import Preprocessing
 
 

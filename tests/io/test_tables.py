@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from dynid.exceptions import DataError
-from dynid.io.logs.tables import read_table
+from dynid.io.logs.table_files import read_table
 
 
 def _write(tmp_path, text, name="log.csv"):
@@ -53,7 +53,7 @@ def test_column_errors(tmp_path):
 def test_blocks_are_stacked_into_the_same_array_as_one_parse(tmp_path, monkeypatch):
     """Blocks are copied into the result one by one and released (no second copy of a long log): the data
     equal one ``np.loadtxt`` of the whole file, with the requested columns in the requested order."""
-    import dynid.io.logs.tables as tables
+    import dynid.io.logs.table_files as tables
 
     monkeypatch.setattr(tables, "BLOCK", 7)
     values = np.random.default_rng(0).normal(size=(50, 4)).round(6)
@@ -65,7 +65,7 @@ def test_blocks_are_stacked_into_the_same_array_as_one_parse(tmp_path, monkeypat
 @pytest.fixture(params=["line reader", "pyarrow"])
 def reader(request, monkeypatch):
     """Both readers of read_table: the line reader, and pyarrow's for every file (its size threshold at 0)."""
-    import dynid.io.logs.tables as tables
+    import dynid.io.logs.table_files as tables
 
     if request.param == "pyarrow":
         pytest.importorskip("pyarrow", exc_type=ImportError)
@@ -77,7 +77,7 @@ def test_pyarrow_reads_the_same_values_as_the_line_reader(tmp_path, monkeypatch)
     """Numbers written every way a log writes them (17 digits, exponents, signs, integers, '.5'): pyarrow's reader
     and NumPy's line reader give the same float64, bit for bit, with row ranges and columns in any order."""
     pytest.importorskip("pyarrow", exc_type=ImportError)
-    import dynid.io.logs.tables as tables
+    import dynid.io.logs.table_files as tables
 
     rng = np.random.default_rng(3)
     x = rng.normal(size=(3000, 5)) * 10.0 ** rng.integers(-12, 12, size=(3000, 5))
@@ -138,7 +138,7 @@ def test_both_readers_refuse_a_row_range_past_the_end(tmp_path, reader):
     np.testing.assert_array_equal(read_table(p, [2, 1], rows=(2, 3)).data, [[4, 3], [6, 5]])
     assert read_table(p, [2], rows=(2, 3)).first_line == 2
     if reader == "pyarrow":
-        import dynid.io.logs.tables as tables
+        import dynid.io.logs.table_files as tables
 
         assert tables._arrow_table(p, [2, 1], False, ",", None, rows=(2, 3), spool=False) is not None
         assert tables._arrow_table(p, [1], False, ",", None, rows=(2, 9), spool=False) is None  # past the end: the line reader
@@ -192,7 +192,7 @@ def test_a_decimal_comma_is_named_and_read_with_its_setting(tmp_path, reader):
     np.testing.assert_array_equal(read, values[2:38][:, [1, 3, 0]])
     np.testing.assert_array_equal(read, read_table(pointed, ["a", "c", "t"], header=True, delimiter=";", rows=(3, 38)).data)
     if reader == "pyarrow":  # read by pyarrow itself, not handed back to the line reader
-        import dynid.io.logs.tables as tables
+        import dynid.io.logs.table_files as tables
 
         assert tables._arrow_table(comma, ["a"], True, ";", None, rows=(1, None), spool=False, decimal=",") is not None
     with pytest.raises(ValueError, match="decimal: expected '.' or ',' and not the delimiter ','"):

@@ -13,7 +13,7 @@ from dynid.preprocessing.bands import (
     excitation_band,
 )
 from dynid.preprocessing.filters import decimation_cutoff, edge_padding, parallel_decimation
-from dynid.preprocessing.pipeline import Preprocessing
+from dynid.preprocessing.preparation import Preprocessing
 
 
 @pytest.mark.parametrize("f_top", [0.3, 1.2, 4.0])

@@ -82,7 +82,7 @@ def test_the_metrics_keep_half_the_samples_the_longest_clipped_joint_left_out_fi
 def test_a_log_whose_every_joint_is_dead_or_saturated_is_refused_in_one_line(rng):
     """Nothing can be estimated: one line naming the log, no traceback."""
     from dynid.io.logs.datasets import Recording
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
 
     rate = 200.0
@@ -103,7 +103,7 @@ def test_measured_velocities_in_another_unit_sign_or_side_are_refused(rng, facto
     velocity through a gear of 100): refused in one line naming the dataset, the joint and the ratio; the same
     velocities in rad/s pass (they were taken as they were, and every velocity-dependent term fitted to them)."""
     from dynid.io.logs.datasets import Recording
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
 
     rate = 200.0
@@ -125,7 +125,7 @@ def test_measured_velocities_unlike_the_positions_are_refused_where_the_joint_mo
     the torque, below the noise floor): refused naming the joint and the correlation, with the setting that leaves
     them out. A joint that hardly moves (positions spanning 0.02 rad) is not required to follow."""
     from dynid.io.logs.datasets import Recording
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
 
     rate = 200.0

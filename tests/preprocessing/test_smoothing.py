@@ -63,7 +63,7 @@ def test_the_paper_strategy_needs_no_scipy_signal():
     import sys
 
     code = ("import sys, numpy as np, dynid\n"
-            "from dynid.preprocessing.pipeline import Preprocessing, prepare\n"
+            "from dynid.preprocessing.preparation import Preprocessing, prepare\n"
             "robot = dynid.load_robot('er16').submodel(3)\n"
             "log = dynid.simulated_log(robot, seconds=10, seed=1)\n"
             "prepare(log, Preprocessing(strategy='paper', fourier=(0.1 * np.pi, 5)))\n"

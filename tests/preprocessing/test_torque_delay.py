@@ -8,9 +8,9 @@ import pytest
 from dynid._util.column_store import StoredColumns
 from dynid.exceptions import ConfigError
 from dynid.io.logs.datasets import Recording
-from dynid.preprocessing.pipeline import Preprocessing, prepare, prepared_rows, torque_delayed
+from dynid.preprocessing.preparation import Preprocessing, prepare, prepared_rows, torque_delayed
 from dynid.simulation.closed_loop import simulate_closed_loop
-from dynid.studies.closed_loop import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
+from dynid.studies.closed_loop_montecarlo import ClosedLoopStudyConfig, _prepare, zero_order_hold_delay
 
 
 def _log(n=500, rate=100.0, seed=0):

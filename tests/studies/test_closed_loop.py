@@ -11,7 +11,7 @@ from dynid.cli.app import main
 from dynid.dynamics.regressor import observation_matrix
 from dynid.exceptions import ConfigError
 from dynid.simulation.closed_loop import simulate_closed_loop
-from dynid.studies.closed_loop import (
+from dynid.studies.closed_loop_montecarlo import (
     ClosedLoopStudyConfig,
     ClosedLoopStudyResult,
     _prepare,

@@ -300,7 +300,7 @@ def test_a_tilted_mount_is_named_with_its_gravity_and_that_gravity_clears_it(deg
     gravity in the description nothing is named."""
     from dataclasses import replace
 
-    from dynid.preprocessing.pipeline import prepare
+    from dynid.preprocessing.preparation import prepare
     from dynid.preprocessing.settings import Preprocessing
     from dynid.studies.simulated_logs import simulated_log
 

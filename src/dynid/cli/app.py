@@ -730,7 +730,7 @@ def excite(
     """Design an optimal excitation trajectory (min cond(W_base) under the constraints of eq. 15)."""
     from dataclasses import replace
 
-    from ..identification.excitation_run import run_excitation
+    from ..identification.excite import run_excitation
     from ..io.config.excitation_config import load_excitation_config
 
     def prepare():
@@ -903,7 +903,7 @@ def _parse_levels(text: str, option: str = "--noise-levels", unit: str = "A", ex
 
 def _closed_loop_estimators(text: str | None) -> tuple[str, ...]:
     """The estimators of a closed-loop study (checked by :meth:`ClosedLoopStudyConfig.validate`)."""
-    from ..studies.closed_loop import CLOSED_LOOP_ESTIMATORS
+    from ..studies.closed_loop_montecarlo import CLOSED_LOOP_ESTIMATORS
 
     return CLOSED_LOOP_ESTIMATORS if text is None else tuple(k.strip().lower() for k in text.split(","))
 
@@ -942,7 +942,7 @@ def montecarlo(
     def prepare():
         _renamed(methods)
         if closed_loop:
-            from ..studies.closed_loop import ClosedLoopStudyConfig
+            from ..studies.closed_loop_montecarlo import ClosedLoopStudyConfig
 
             study = ClosedLoopStudyConfig(robot=robot, joints=joints, encoder_noise=_parse_levels(encoder_noise, "--encoder-noise", "°", "1e-4,1e-3,1e-2"),
                                           torque_noise=_parse_levels(torque_noise, "--torque-noise", "N·m", "0.05,0.1"),
@@ -965,7 +965,7 @@ def montecarlo(
         progress.update("starting the workers")
         report = lambda i, n: progress.update(f"realisations, {10 * (10 * i // max(n, 1))} % done", f"{i}/{n}")  # noqa: E731
         if closed_loop:
-            from ..studies.closed_loop import run_closed_loop_study
+            from ..studies.closed_loop_montecarlo import run_closed_loop_study
 
             return run_closed_loop_study(cfg, scheduler=scheduler, workers=workers, progress=report)
         return run_montecarlo(cfg, scheduler=scheduler, workers=workers, progress=report)

@@ -18,7 +18,7 @@ _EXPORTS = {
     "AccumulatingEstimator": "base",
     "register": "registry", "unregister": "registry", "EstimatorSpec": "registry", "FitData": "registry",
     "Estimation": "estimation",
-    "check_estimator": "checks", "EstimatorCheckError": "checks",
+    "check_estimator": "contract", "EstimatorCheckError": "contract",
 }
 
 __all__ = list(_EXPORTS)

@@ -22,7 +22,7 @@ from .base import check_observations
 from .least_squares import OrdinaryLeastSquares
 
 CLOSED_LOOP_METHODS = ("idim-iv", "didim", "didim-sdp")
-"""Keys of the closed-loop estimators (:mod:`dynid.identification.closed_loop`; case-insensitive): they need the
+"""Keys of the closed-loop estimators (:mod:`dynid.identification.closed_loop_estimators`; case-insensitive): they need the
 controller that drove the run (``[controller]`` of a config)."""
 
 
@@ -235,7 +235,7 @@ def instrumental_variables(w, tau, z, instants=None, kernel: str = "bartlett") -
 
 def weighted_least_squares(w, tau, row_sigma, instants=None, kernel: str = "parzen") -> tuple[np.ndarray, np.ndarray]:
     """Weighted least squares with its standard deviations, the estimate the closed-loop estimators start from and
-    DIDIM's step (:mod:`dynid.identification.closed_loop`).
+    DIDIM's step (:mod:`dynid.identification.closed_loop_estimators`).
 
     The estimate is the package's :class:`~dynid.estimators.least_squares.OrdinaryLeastSquares` with the weights
     ``1/σ²``; its σ is the textbook ``σ² (AᵀA)⁻¹`` of the scaled rows ``A = W/σ``, or with ``instants`` the sandwich

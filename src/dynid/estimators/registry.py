@@ -349,7 +349,7 @@ def keys() -> tuple[str, ...]:
 
 
 OTHER_LABELS = {"idim-iv": "IDIM-IV", "didim": "DIDIM", "didim-sdp": "DIDIM-SDP"}
-"""Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.identification.closed_loop`)."""
+"""Labels of estimators that run outside the registry (the closed-loop ones, :mod:`dynid.identification.closed_loop_estimators`)."""
 
 
 def label(key: str) -> str:

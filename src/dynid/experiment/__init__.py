@@ -11,7 +11,7 @@ from .._lazy import alias_moved_modules, moved
 
 MOVED = {
     "drive_gains": "dynid.identification.drive_gains",
-    "excitation": "dynid.identification.excitation_run",
+    "excitation": "dynid.identification.excite",
     "identification": "dynid.identification.identify",
     "identification_run": "dynid.identification.run",
     "identified": "dynid.identification.identified",

@@ -364,7 +364,7 @@ class FrictionMonitor:
         list of DriftAlarm
             The alarms this log raised.
         """
-        from ..preprocessing.pipeline import base_chunks
+        from ..preprocessing.preparation import base_chunks
 
         n, q = self.robot.n_dof, self.q
         self.logs.append(name)
@@ -803,7 +803,7 @@ def monitor_logs(config, model, logs: Iterable[Path], settings: MonitorSettings 
         A log that cannot be read, too few windows for the reference, or (resuming) a new log that sorts before the
         last one the monitor saw.
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
 
     logs = list(logs)
     monitor = resume if resume is not None else FrictionMonitor(model.robot, model.base, model.params(), settings)

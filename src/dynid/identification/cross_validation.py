@@ -27,7 +27,7 @@ from ..estimators.accumulate import LeastSquaresAccumulator
 from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
 from ..preprocessing.bands import POSITION_FACTOR, capped
-from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.preparation import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
 COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)

@@ -25,7 +25,7 @@ from ..exceptions import ConfigError, IdentifiabilityError
 from ..io.logs.datasets import Recording
 from ..model.robot import Robot
 from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
-from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.preparation import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
 __all__ = ["DelayEstimate", "estimate_delay", "delay_from_rows", "delayed"]
@@ -117,9 +117,9 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
     Parameters
     ----------
     data : PreparedData
-        From :func:`dynid.preprocessing.pipeline.prepare` (its torques at the log's rate, not yet filtered).
+        From :func:`dynid.preprocessing.preparation.prepare` (its torques at the log's rate, not yet filtered).
     blocks : iterable of tuple
-        ``(index, y, tau, keep)`` as :func:`dynid.preprocessing.pipeline.base_chunks` yields them (``tau`` unused).
+        ``(index, y, tau, keep)`` as :func:`dynid.preprocessing.preparation.base_chunks` yields them (``tau`` unused).
     max_samples : float
         Largest delay searched, either way [samples].
 

@@ -35,7 +35,7 @@ from ..exceptions import IdentifiabilityError
 from ..model.robot import Robot
 from ..preprocessing.bands import difference_noise_std
 from ..preprocessing.filters import decimation_cutoff, velocity_noise_std
-from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 
 

@@ -28,7 +28,7 @@ from ..estimators.accumulate import LeastSquaresAccumulator
 from ..estimators.least_squares import coulomb_offset_pairs
 from ..model.robot import Robot
 from ..preprocessing.bands import capped
-from ..preprocessing.pipeline import Preprocessing, base_chunks, prepare
+from ..preprocessing.preparation import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 from .estimates import DRIVE_ONLY_KEY, DRIVE_ONLY_LABEL, NOMINAL_LABEL
 

@@ -200,7 +200,7 @@ def validate_sets(setup, base, parameter_sets: dict, recordings, *,
     TypeError
         A log not read (a ``DatasetSpec``: :func:`dynid.io.logs.datasets.load_recording` reads it).
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
     from ..validation.channel_checks import channel_findings
     from ..validation.geometry_checks import geometry_findings
     from ..validation.torques import compare_torques, rests_throughout
@@ -277,7 +277,7 @@ def yardstick_reference(recording) -> Preprocessing | None:
     Preprocessing or None
         None where the default rules cannot prepare the log (the validation logs then take them alone).
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
 
     try:
         return prepare(recording, Preprocessing(), strict=False).settings
@@ -321,7 +321,7 @@ def yardstick_scores(setup, base, sets: dict, recordings, *, resolved=None, refe
         One tuple (a comparison per log) per state filter, in the order of
         :data:`~dynid.preprocessing.strategies.YARDSTICK_FILTERS`.
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
     from ..validation.torques import compare_torques
 
     treated = yardstick_settings(resolved, setup.preprocessing, reference or Preprocessing())

@@ -26,7 +26,7 @@ from ..io.logs.datasets import recording_from_arrays
 from ..io.results import check_fingerprint, read_results, stored_estimates, stored_residual_level
 from ..model.friction_model import robot_from_settings
 from ..model.robot import Robot
-from ..preprocessing.pipeline import prepare
+from ..preprocessing.preparation import prepare
 from ..preprocessing.prepared import rest_velocities
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import carried_over

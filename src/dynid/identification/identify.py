@@ -38,7 +38,7 @@ from ..exceptions import DynIdError, IdentifiabilityError
 from ..io.config.references import ReferenceSet
 from ..io.exported.export import READINESS_KINDS
 from ..model.robot import Robot
-from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import (
     SCALE_MISFIT,
@@ -285,7 +285,7 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
     base : BaseParameters
         The base-parameter map of ``robot``.
     data : PreparedData
-        From :func:`dynid.preprocessing.pipeline.prepare`.
+        From :func:`dynid.preprocessing.preparation.prepare`.
     estimators : sequence of str and Estimator, or str
         Keys of :mod:`dynid.estimators.registry` (case-insensitive; a text: comma-separated, ``"wls,sdp"``) or unfitted
         estimators of registered classes carrying their hyper-parameters

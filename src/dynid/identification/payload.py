@@ -26,7 +26,7 @@ from ..estimators.physically_consistent import PhysicallyConsistentLeastSquares
 from ..estimators.problem import FitData
 from ..model.robot import Robot
 from ..model.spatial import inertial_from_physical, physical_from_inertial, transform_inertial
-from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.noise_floor import noise_floor
 from .drive_gains import _last_link_columns, identify_payload

@@ -19,7 +19,7 @@ One recording goes through it the same way whoever calls it (``dynid identify`` 
 2. **estimation**, :meth:`~IdentificationPipeline.estimate`: every estimator in one pass over the rows
    (:func:`dynid.identification.identify.identify`), the consistency checks and what the log itself says (held-out
    blocks, the drive-only candidate, the SDP's refits, the torque delay), then the closed-loop estimators (IDIM-IV,
-   DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop.ClosedLoopEstimator`);
+   DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop_estimators.ClosedLoopEstimator`);
 3. **evidence**, :func:`dynid.identification.evidence.gather_evidence`: every candidate scored on the validation logs
    given, as prepared and on the one yardstick;
 4. **verdict**, :func:`dynid.identification.verdict.decide`: the main estimate, chosen once.
@@ -46,14 +46,14 @@ from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.config.identification_config import split_estimators
 from ..model.loading import as_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import base_chunks, prepare
+from ..preprocessing.preparation import base_chunks, prepare
 from ..preprocessing.prepared import PreparedData, dead_channels, min_speeds
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import strategy_for
 from ..runtime.processes import ForkedCall
 from ..validation.diagnostics import DELAY_ADVICE, delay_findings
 from .choices import ModelChoices
-from .closed_loop import ClosedLoopEstimator
+from .closed_loop_estimators import ClosedLoopEstimator
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
@@ -113,7 +113,7 @@ class IdentificationPipeline:
         Keys of :mod:`dynid.estimators.registry`, or unfitted estimators of registered classes carrying their
         hyper-parameters (:func:`dynid.estimators.registry.estimator_choices`); the first is the main estimate. The
         closed-loop ones (IDIM-IV, DIDIM, DIDIM-SDP: :data:`dynid.estimators.instrumental.CLOSED_LOOP_METHODS` keys, with
-        ``controller``, or :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts) run after the others,
+        ``controller``, or :class:`dynid.identification.closed_loop_estimators.ClosedLoopEstimator` parts) run after the others,
         on the log as read, in order, as a config's ``[estimation] estimators`` lists them.
     friction : {"description", "auto"} or None
         The description's friction terms, or each joint's model chosen by cross-validation; None (default): as a

@@ -42,7 +42,7 @@ def _references(config: IdentificationConfig, base):
 
 def _gains_and_payload(config: IdentificationConfig, robot, base):
     """Drive gains from the two runs, then the payload from the loaded run with those gains."""
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
     from .drive_gains import GainsAndPayload, identify_drive_gains, identify_payload
 
     runs = config.drive_gains
@@ -276,7 +276,7 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     IdentifiabilityError
         A log whose motion determines none of the payload's parameters.
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
     from .payload import payload_from_log
 
     config, base, estimates = _identified_model(config, identified, source)
@@ -351,7 +351,7 @@ def moving_validation(config: IdentificationConfig, identified: dict, robot=None
     DataError
         A log that cannot be read.
     """
-    from ..preprocessing.pipeline import prepare
+    from ..preprocessing.preparation import prepare
 
     robot = config.robot if robot is None else robot
     settings = replace(carried_over(stored_preprocessing(identified), config.preprocessing), decimation=1,

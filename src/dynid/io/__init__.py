@@ -8,7 +8,8 @@ __all__ = ["atomic_write_bytes", "atomic_write_text", "write_json", "MOVED"]
 
 MOVED = {f"dynid.io.{name}": f"dynid.io.{package}.{name}" for package, names in (
     ("config", ("config_types", "configs", "excitation_config", "identification_config", "references")),
-    ("logs", ("bags", "datasets", "tables", "trajectories")), ("exported", ("export",))) for name in names}
+    ("logs", ("bags", "datasets", "trajectories")), ("exported", ("export",))) for name in names} | {
+    "dynid.io.tables": "dynid.io.logs.table_files"}
 """Modules of ``dynid.io`` in 0.1.0 grouped by job in 0.2 -> where they went: their old paths import them, with a
 FutureWarning, for a release (docs/changelog.md). Those an earlier 0.2.0 draft added have no old path."""
 alias_moved_modules(MOVED)

@@ -9,8 +9,8 @@ _EXPORTS = {
     "fourier_fit_derivatives": "fourier_fit",
     "PreparedData": "prepared",
     "Preprocessing": "settings",
-    "base_chunks": "pipeline",
-    "prepare": "pipeline",
+    "base_chunks": "preparation",
+    "prepare": "preparation",
     "five_point_cubic_smoothing": "smoothing",
 }
 

@@ -1,5 +1,5 @@
 """Preprocessing settings (light: no SciPy, no compiled kernels, so that a config is checked before any
-heavy import); the pipeline that applies them is :mod:`dynid.preprocessing.pipeline`."""
+heavy import); the pipeline that applies them is :mod:`dynid.preprocessing.preparation`."""
 
 from __future__ import annotations
 

@@ -11,7 +11,7 @@ alike:
 
 Built in:
 
-- ``"parallel"`` (default, :class:`dynid.preprocessing.pipeline.ParallelFiltering`): zero-phase low-pass of the
+- ``"parallel"`` (default, :class:`dynid.preprocessing.preparation.ParallelFiltering`): zero-phase low-pass of the
   positions, central differences, the same low-pass on the torques and every regressor column, decimation; every
   cutoff from the data's excitation band; streams long logs chunk by chunk;
 - ``"paper"`` (:class:`dynid.preprocessing.paper_smoothing.PaperSmoothing`): the paper's §3.3, derivatives from a
@@ -157,7 +157,7 @@ def unregister_strategy(name: str) -> None:
     _REGISTRY.remove(name)
 
 
-register_strategy("parallel", ".pipeline:ParallelFiltering")
+register_strategy("parallel", ".preparation:ParallelFiltering")
 register_strategy("paper", ".paper_smoothing:PaperSmoothing")
 
 
@@ -301,7 +301,7 @@ def yardstick_settings(resolved: Preprocessing | None, given: Preprocessing,
     Returns
     -------
     Preprocessing
-        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the validation log (``strict=False``).
+        Settings for :func:`dynid.preprocessing.preparation.prepare` on the validation log (``strict=False``).
     """
     treatment = carried_over(reference, Preprocessing())
     return replace(carried_over(resolved, given), **{f: getattr(treatment, f) for f in YARDSTICK_DEFAULTS})
@@ -328,7 +328,7 @@ def yardstick_filters(treated: Preprocessing, recording) -> tuple[Preprocessing,
     Returns
     -------
     tuple of Preprocessing
-        Settings for :func:`dynid.preprocessing.pipeline.prepare` (``strict=False``), in the order of
+        Settings for :func:`dynid.preprocessing.preparation.prepare` (``strict=False``), in the order of
         :data:`YARDSTICK_FILTERS`; the rest threshold is each log's own ("auto"): give the first's resolved value to
         the others for the same rest samples.
     """
@@ -367,7 +367,7 @@ def carried_over(resolved: Preprocessing | None, given: Preprocessing) -> Prepro
     Returns
     -------
     Preprocessing
-        Settings for :func:`dynid.preprocessing.pipeline.prepare` on the other log.
+        Settings for :func:`dynid.preprocessing.preparation.prepare` on the other log.
     """
     if strategy_for(given).needs_harmonics:  # the excitation's harmonics fit only its own log: parallel filtering,
         # its filters derived from this log; the harmonics strategy's own resolved zeros (no filter at all: raw

@@ -9,7 +9,7 @@ import numpy as np
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..excitation.floor import FloorDistances
-from ..identification.excitation_run import ExcitationRun
+from ..identification.excite import ExcitationRun
 from ..io.logs.trajectories import write_trajectory_csv
 from . import figures
 from .html import write_html_report

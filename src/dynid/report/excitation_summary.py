@@ -18,7 +18,7 @@ def excitation_blocks(run, tables: bool = True) -> list:
 
     Parameters
     ----------
-    run : dynid.identification.excitation_run.ExcitationRun
+    run : dynid.identification.excite.ExcitationRun
     tables : bool
         The before/after and margins tables (else one line on the design's search).
 
@@ -67,7 +67,7 @@ START_AT_REST = 1e-6
 
 def set_point_lines(set_points: dict) -> tuple[str, tuple[str, str]]:
     """What excitation.csv's angles are and where it starts, from :meth:`ExcitationRun.set_points
-    <dynid.identification.excitation_run.ExcitationRun.set_points>` (excitation.json's ``set_points``).
+    <dynid.identification.excite.ExcitationRun.set_points>` (excitation.json's ``set_points``).
 
     A position controller handed the first row from another pose jumps there, so the arm is brought there first; a
     design that starts moving is a warning.

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..estimators.registry import label
 from ..io import atomic_write_text
-from ..studies.closed_loop import ClosedLoopStudyResult
+from ..studies.closed_loop_montecarlo import ClosedLoopStudyResult
 from ..studies.montecarlo import MonteCarloResult
 from . import figures
 from .html import write_html_report

@@ -65,7 +65,7 @@ def closed_loop_study_rows(data: dict) -> tuple[tuple[str, ...], list[tuple[str,
     Parameters
     ----------
     data : dict
-        :meth:`dynid.studies.closed_loop.ClosedLoopStudyResult.to_dict`.
+        :meth:`dynid.studies.closed_loop_montecarlo.ClosedLoopStudyResult.to_dict`.
 
     Returns
     -------
@@ -96,7 +96,7 @@ def closed_loop_verdict(data: dict) -> list[str]:
     Parameters
     ----------
     data : dict
-        :meth:`dynid.studies.closed_loop.ClosedLoopStudyResult.to_dict`.
+        :meth:`dynid.studies.closed_loop_montecarlo.ClosedLoopStudyResult.to_dict`.
 
     Returns
     -------
@@ -123,7 +123,7 @@ def closed_loop_study_blocks(result) -> list:
 
     Parameters
     ----------
-    result : dynid.studies.closed_loop.ClosedLoopStudyResult
+    result : dynid.studies.closed_loop_montecarlo.ClosedLoopStudyResult
 
     Returns
     -------

@@ -197,8 +197,8 @@ def blocks(result, *, library: bool = False) -> list:
     from ..excitation.design import ExcitationDesign
     from ..fleet.identification import FleetResult
     from ..fleet.monitor import MonitorResult
-    from ..identification.excitation_run import ExcitationRun
-    from ..studies.closed_loop import ClosedLoopStudyResult
+    from ..identification.excite import ExcitationRun
+    from ..studies.closed_loop_montecarlo import ClosedLoopStudyResult
     from ..studies.montecarlo import MonteCarloResult
     from ..studies.paper import PaperRunResult
 

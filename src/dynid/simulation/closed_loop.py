@@ -148,7 +148,7 @@ class Controller:
 class ClosedLoopSetup:
     """How the identification log was recorded in closed loop: what IDIM-IV and DIDIM need beside the log, as a
     config's ``[controller]`` table gives it (:attr:`dynid.io.config.identification_config.IdentificationConfig.controller`;
-    :class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts carry it).
+    :class:`dynid.identification.closed_loop_estimators.ClosedLoopEstimator` parts carry it).
 
     Attributes
     ----------

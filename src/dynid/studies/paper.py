@@ -45,7 +45,7 @@ from ..io.logs.datasets import Recording
 from ..io.logs.trajectories import load_trajectory
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import prepared_rows
+from ..preprocessing.preparation import prepared_rows
 from ..preprocessing.settings import Preprocessing
 from ..preprocessing.strategies import check_strategy
 from ..runtime.threads import with_single_blas_thread

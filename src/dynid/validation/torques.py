@@ -17,7 +17,7 @@ from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters
 from ..model.friction_model import COULOMB_LIKE
 from ..model.robot import Robot
-from ..preprocessing.pipeline import base_chunks
+from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 from .metrics import correlation_coefficient, correlation_from_sums, global_relative_error, relative_error, rmse
 from .noise_floor import noise_floor
@@ -658,7 +658,7 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
     base : BaseParameters
         Its base-parameter map.
     data : PreparedData
-        The prepared log (:func:`dynid.preprocessing.pipeline.prepare`).
+        The prepared log (:func:`dynid.preprocessing.preparation.prepare`).
     parameter_sets : dict
         label -> (n_base,) base parameters.
     progress : callable, optional

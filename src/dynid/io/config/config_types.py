@@ -185,7 +185,7 @@ GainValues = Union[Annotated[float, Meta(ge=0)], list[Annotated[float, Meta(ge=0
 
 class ControllerTable(Table, kw_only=True):
     """``[controller]``: the joint controller that drove the identification run, for the closed-loop estimators
-    (IDIM-IV, DIDIM: :mod:`dynid.identification.closed_loop`)."""
+    (IDIM-IV, DIDIM: :mod:`dynid.identification.closed_loop_estimators`)."""
 
     kp: Annotated[GainValues, _d("N·m/rad: proportional gain, one value or one per joint")]
     kd: Annotated[GainValues, _d("N·m·s/rad: derivative gain, one value or one per joint")]

@@ -128,7 +128,7 @@ class DatasetSpec:
         1-based inclusive data rows.
     delimiter : str
     decimal : str
-        The numbers' decimal separator, "." or "," (:func:`dynid.io.logs.tables.read_table`).
+        The numbers' decimal separator, "." or "," (:func:`dynid.io.logs.table_files.read_table`).
     time_range : (start, stop) or None [s]
         From the first row read.
     gaps : str

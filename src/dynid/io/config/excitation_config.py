@@ -1,5 +1,5 @@
 """Configs of ``dynid excite`` (TOML): design an excitation trajectory for a robot (paper §3.2, eq. 15).
-Parsing only; :mod:`dynid.identification.excitation_run` runs them.
+Parsing only; :mod:`dynid.identification.excite` runs them.
 
 Layout (SI units, radians; angles may be written ``"pi/2"``; paths relative to the config file)::
 

@@ -80,7 +80,7 @@ from ...model.robot import Robot
 from ...preprocessing.settings import Preprocessing
 from ...preprocessing.strategies import check_strategy
 from ..logs.bags import is_bag
-from ..logs.tables import read_table
+from ..logs.table_files import read_table
 from ..logs.trajectories import load_trajectory
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source

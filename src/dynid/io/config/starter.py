@@ -25,7 +25,7 @@ from ...model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
 from ..logs.bags import is_bag
 from ..logs.columns import csv_table, signal_files
 from ..logs.datasets import dataset_spec, load_recording
-from ..logs.tables import read_table
+from ..logs.table_files import read_table
 from .dataset_specs import PRESETS
 
 

@@ -16,7 +16,7 @@ from tomlkit.items import InlineTable, Table
 from ...conventions import time_unit_of
 from ...exceptions import DataError
 from ..files import text_encoding_hint
-from .tables import decimal_commas, is_data_line, read_table
+from .table_files import decimal_commas, is_data_line, read_table
 
 
 def csv_table(urdf: Path, log: Path, n_dof: int, joints: tuple[str, ...] = (), *,

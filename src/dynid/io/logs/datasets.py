@@ -41,7 +41,7 @@ from .log_repairs import (
     uniform_rate,
     unwrapped_positions,
 )
-from .tables import read_table
+from .table_files import read_table
 
 
 @short_repr
@@ -128,7 +128,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
                    rate: float | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
-    Steps: read the columns (:func:`dynid.io.logs.tables.read_table`) or the ROS 2 bag's JointState messages, scale
+    Steps: read the columns (:func:`dynid.io.logs.table_files.read_table`) or the ROS 2 bag's JointState messages, scale
     units, check the time stamps, resample jittered time stamps linearly onto a uniform grid, convert motor-side
     signals through the transmission (``q = R⁻¹ theta_m + offset``, ``tau = Rᵀ tau_m``), currents to torques with the
     drive gains (eq. 16).

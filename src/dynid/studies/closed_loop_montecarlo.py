@@ -8,7 +8,7 @@ real one, given the one thing known of its drives: each command is held over the
 torques lead the motion by half a period (:func:`zero_order_hold_delay`, the ``torque_delay`` setting); and every
 estimator is fitted on it by :class:`dynid.identification.pipeline.IdentificationPipeline`, as ``dynid identify`` fits
 them: the open-loop ones (OLS, WLS, IRLS, LAD, SDP, ABC, …) on the prepared log, then IDIM-IV and DIDIM
-(:class:`dynid.identification.closed_loop.ClosedLoopEstimator` parts given the controller and the set-points) on the
+(:class:`dynid.identification.closed_loop_estimators.ClosedLoopEstimator` parts given the controller and the set-points) on the
 same rows, simulating the run. Per cell and estimator the study reports the bias and
 spread of each base parameter, against |β| and against the Cramér–Rao bound, and the coverage of the estimator's
 95 % intervals (``|β̂ − β| ≤ 1.96 σ̂``) where it gives σ.
@@ -42,12 +42,12 @@ from ..estimators.registry import label, parse_estimators
 from ..exceptions import ConfigError, DynIdError
 from ..excitation.fourier import sample_times
 from ..excitation.paper_trajectories import PAPER_OMEGA_F
-from ..identification.closed_loop import ClosedLoopEstimator, ClosedLoopExperiment, ClosedLoopSetup
+from ..identification.closed_loop_estimators import ClosedLoopEstimator, ClosedLoopExperiment, ClosedLoopSetup
 from ..identification.pipeline import IdentificationPipeline
 from ..io.logs.datasets import Recording
 from ..model.description import load_robot
 from ..model.robot import Robot
-from ..preprocessing.pipeline import Preprocessing
+from ..preprocessing.preparation import Preprocessing
 from ..runtime.cluster import realisations_on_grid
 from ..runtime.threads import with_single_blas_thread
 from ..simulation.closed_loop import ClosedLoopNoise, Controller, simulate_closed_loop

@@ -48,7 +48,7 @@ from ..estimators.problem import FitData
 from ..exceptions import ConfigError, DataError, ShapeError
 from ..io.logs.datasets import Recording
 from ..model.robot import Robot
-from ..preprocessing.pipeline import Preprocessing, prepare, prepared_rows
+from ..preprocessing.preparation import Preprocessing, prepare, prepared_rows
 from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, ClosedLoopSetup, Controller, simulate_closed_loop
 from .identify import Estimate, consistency_checks
