@@ -219,7 +219,7 @@ def test_a_closed_loop_estimator_is_a_part_that_carries_its_controller(closed_lo
 def test_the_closed_loop_estimators_fit_the_rows_the_pipeline_prepared(closed_loop_log, monkeypatch):
     """The pipeline's closed-loop parts take its prepared data (its chosen cutoffs, rest model and speeds): the
     measured log is not prepared a second time, only the simulated ones are; the estimate is the one on that data."""
-    from dynid.identification import closed_loop
+    from dynid.identification import closed_loop_estimators as closed_loop
     from dynid.identification.pipeline import IdentificationPipeline
 
     robot, setup, recording = _setup_and_recording(closed_loop_log[0])

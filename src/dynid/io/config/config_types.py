@@ -381,7 +381,7 @@ def write_schemas(folder=None) -> list:
     -------
     list of Path
     """
-    folder = Path(folder) if folder is not None else Path(__file__).resolve().parents[1] / "schema"
+    folder = Path(folder) if folder is not None else Path(__file__).resolve().parents[2] / "schema"
     paths = []
     for name, (kind, title, description) in SCHEMAS.items():
         path = folder / f"{name}.schema.json"
