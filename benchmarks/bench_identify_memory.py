@@ -2,7 +2,7 @@
 
 Synthetic 6-DOF er16 logs at 1 kHz of 6 minutes and of 1 hour (smooth multi-sine motion, torques from
 dynid's regressor — the values do not matter here, only the sizes). Each is identified by
-``dynid.identification.identify.identify`` (parallel decimation by 10, WLS by incremental QR).
+``dynid.identification.estimation_pass.identify`` (parallel decimation by 10, WLS by incremental QR).
 Prints the peak memory allocated during the identification (tracemalloc; the input signals are
 allocated before and not counted), the time, and the ratios: 1-hour peak / 6-minute peak, and the
 1-hour peak against the size the stacked base observation matrix would have (the reference: what a
@@ -19,7 +19,7 @@ import tracemalloc
 import numpy as np
 
 from dynid.dynamics.base_parameters import base_parameters
-from dynid.identification.identify import identify
+from dynid.identification.estimation_pass import identify
 from dynid.model.description import load_robot
 from dynid.preprocessing.preparation import PreparedData, Preprocessing
 

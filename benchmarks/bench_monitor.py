@@ -24,7 +24,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 def main(hours: float) -> None:
     from dynid.fleet.monitor import dated_logs, monitor_logs
-    from dynid.identification.identified import IdentifiedModel
+    from dynid.identification.fitted_model import IdentifiedModel
     from dynid.identification.run import run_identification
     from dynid.io.config.identification_config import load_identification_config
     from dynid.studies.simulated_fleet import simulate_service_life

@@ -78,8 +78,8 @@ def collect(name: str, tag: str, window, folder: Path) -> None:
     from dynid.estimators.problem import FitData
     from dynid.identification.drive_only import drive_only
     from dynid.identification.estimates import DRIVE_ONLY_LABEL, SDP_LABEL
+    from dynid.identification.estimation_pass import one_way_joints
     from dynid.identification.evidence import yardstick_reference, yardstick_scores
-    from dynid.identification.identify import one_way_joints
     from dynid.identification.run import pipeline_of, run_identification
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording

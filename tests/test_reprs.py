@@ -77,7 +77,7 @@ def test_a_design_made_from_the_library_has_a_summary():
 
 def test_a_models_validation_has_a_summary(fitted):
     """dynid.summary(model.validate(log)) (a TorqueComparison, or a list of them) says what dynid validate says."""
-    from dynid.identification.identified import IdentifiedModel
+    from dynid.identification.fitted_model import IdentifiedModel
 
     robot, log, _, _, result = fitted
     comparison = IdentifiedModel.from_result(result).validate(dynid.simulated_log(robot, seconds=4.0, rng=1))

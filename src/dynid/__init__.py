@@ -52,8 +52,8 @@ _EXPORTS = {
     "run_paper_experiment": "dynid.studies.paper",
     "summary": "dynid.report.summaries",
     "Identifier": "dynid.identification.identifier",
-    "IdentifiedModel": "dynid.identification.identified",
-    "load_results": "dynid.identification.identified",
+    "IdentifiedModel": "dynid.identification.fitted_model",
+    "load_results": "dynid.identification.fitted_model",
     "simulated_log": "dynid.studies.simulated_logs",
     "load_recording": "dynid.io.logs.datasets",
 }

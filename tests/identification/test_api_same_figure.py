@@ -11,7 +11,7 @@ import numpy as np
 
 
 def test_a_given_decimation_keeps_the_clis_samples_and_relative_error_is_its_figure(tmp_path):
-    from dynid.identification.identified import load_results
+    from dynid.identification.fitted_model import load_results
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording
     from tests.cli.refusals import dynid
@@ -42,7 +42,7 @@ def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path):
     from pathlib import Path
 
     import dynid
-    from dynid.identification.identified import IdentifiedModel
+    from dynid.identification.fitted_model import IdentifiedModel
     from dynid.identification.run import run_identification, run_validation
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording

@@ -128,7 +128,7 @@ def test_the_estimators_the_pipeline_feeds_unfitted_hold_the_rows_its_estimate_f
     rows: least squares on them is numpy's on the kept rows, and it is the OLS estimate ``estimate`` gives; a seed
     given as ``rng`` draws each estimator's generator from (seed..., its registry index), as a dict of generators does."""
     from dynid.estimators.registry import FitData, SearchBudget, estimate_label, seed_index
-    from dynid.identification.identify import search_box
+    from dynid.identification.result import search_box
     from dynid.preprocessing.settings import Preprocessing
 
     config = slow_quiet_log

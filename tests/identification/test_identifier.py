@@ -420,7 +420,7 @@ def test_the_fitted_parts_are_kept_and_a_model_read_back_answers_by_the_same_nam
 
 def test_a_parameter_without_a_standard_deviation_reads_as_a_dash():
     """The SDP's parameters have no σ: its summary printed "nan" in every row of the σ column."""
-    from dynid.identification.identified import Parameters
+    from dynid.identification.fitted_model import Parameters
 
     rows = repr(Parameters(("ZZ1R", "fc1"), np.array([1.5, 2.0]), np.array([np.nan, 0.01]))).splitlines()
     assert rows[1].split() == ["ZZ1R", "1.5", "—", "kg·m²"] and rows[2].split() == ["fc1", "2", "0.01", "N·m"]

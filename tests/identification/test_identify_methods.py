@@ -84,7 +84,7 @@ def test_estimator_names_are_case_insensitive(tmp_path):
 def test_identify_takes_the_estimators_as_a_text_too(tmp_path):
     """``identify(..., "wls")`` is WLS, not the estimators "w", "l", "s"."""
     from dynid.dynamics.base_parameters import base_parameters
-    from dynid.identification.identify import identify
+    from dynid.identification.estimation_pass import identify
     from dynid.io.logs.datasets import load_recording
     from dynid.preprocessing.preparation import prepare
 

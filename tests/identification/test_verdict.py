@@ -23,7 +23,7 @@ def test_one_function_sets_the_main_estimate():
             if isinstance(node, ast.Call):
                 setters += [(path.relative_to(SRC).as_posix(), ast.unparse(k.value)) for k in node.keywords
                             if k.arg == "main"]
-    assert sorted(setters) == [("identification/identify.py", "estimate_label(keys[0])"),
+    assert sorted(setters) == [("identification/estimation_pass.py", "estimate_label(keys[0])"),
                                ("identification/verdict.py", "main"), ("identification/verdict.py", "main")]
 
 

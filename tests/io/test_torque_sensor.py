@@ -60,7 +60,7 @@ def test_results_of_a_joint_sensor_log_read_back_with_the_robot_as_identified(tm
     rebuilt the robot from the URDF alone, with its rotor inertias, which the identification had left out. The
     results now say the drive terms identified, and the model read back predicts what the one identified predicts."""
     import dynid
-    from dynid.identification.identified import IdentifiedModel, load_results
+    from dynid.identification.fitted_model import IdentifiedModel, load_results
     from dynid.identification.run import run_identification
 
     path = _config(tmp_path, 'robot = "arm.urdf"', ', sensor = "joint"')

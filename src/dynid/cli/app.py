@@ -1053,7 +1053,7 @@ def monitor(
         settings = MonitorSettings(window, reference_windows, false_alarm_days)
         cfg = load_identification_config(config, data_root=data_root)
         files = dated_logs(logs)
-        from ..identification.identified import load_results
+        from ..identification.fitted_model import load_results
 
         model = load_results(results, robot=cfg.robot)
         fingerprint = monitor_fingerprint(results, settings)

@@ -12,9 +12,9 @@ from .._lazy import alias_moved_modules, moved
 MOVED = {
     "drive_gains": "dynid.identification.drive_gains",
     "excitation": "dynid.identification.excite",
-    "identification": "dynid.identification.identify",
+    "identification": "dynid.identification.estimation_pass",
     "identification_run": "dynid.identification.run",
-    "identified": "dynid.identification.identified",
+    "identified": "dynid.identification.fitted_model",
     "identifier": "dynid.identification.identifier",
     "montecarlo": "dynid.studies.montecarlo",
     "paper": "dynid.studies.paper",

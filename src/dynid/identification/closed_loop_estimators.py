@@ -51,7 +51,7 @@ from ..model.robot import Robot
 from ..preprocessing.preparation import Preprocessing, prepare, prepared_rows
 from ..preprocessing.prepared import PreparedData
 from ..simulation.closed_loop import ClosedLoopNoise, ClosedLoopSetup, Controller, simulate_closed_loop
-from .identify import Estimate, consistency_checks
+from .estimation_pass import Estimate, consistency_checks
 
 __all__ = ["ClosedLoopExperiment", "ClosedLoopEstimate", "ClosedLoopEstimator", "ClosedLoopSetup", "closed_loop_identify",
            "CLOSED_LOOP_METHODS"]
@@ -423,7 +423,7 @@ class ClosedLoopEstimator:
 
         Parameters
         ----------
-        result : dynid.identification.identify.IdentificationResult
+        result : dynid.identification.result.IdentificationResult
             The estimates so far.
         robot, base : Robot, BaseParameters
             The model as identified (with the choices the data made) and its base-parameter map.

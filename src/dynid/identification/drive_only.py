@@ -268,7 +268,7 @@ def held_out_errors(robot: Robot, folds, joint_weights=None) -> dict[str, float]
         With nominal inertial parameters.
     folds : sequence of LeastSquaresAccumulator
         The log's contiguous blocks of standard rows
-        (:class:`dynid.identification.identify.BlockScoring`'s ``folds``).
+        (:class:`dynid.identification.estimation_pass.BlockScoring`'s ``folds``).
     joint_weights : (n_dof,) array, optional
         WLS weights, as the least-squares estimate's.
 

@@ -29,7 +29,7 @@ from ..preprocessing.settings import Preprocessing
 __all__ = ["Identifier", "FITTED"]
 
 FITTED = ("params_", "params_std_", "feature_names_out_", "parameters_", "estimates_", "estimators_")
-"""The fitted attributes an :class:`Identifier` takes from its :class:`~dynid.identification.identified.IdentifiedModel`
+"""The fitted attributes an :class:`Identifier` takes from its :class:`~dynid.identification.fitted_model.IdentifiedModel`
 (the same names on both)."""
 
 
@@ -63,9 +63,9 @@ class Identifier(HyperParameters):
 
     Attributes
     ----------
-    result_ : dynid.identification.identify.IdentificationResult
+    result_ : dynid.identification.result.IdentificationResult
         Everything the identification found (fit, validations, verdict).
-    model_ : dynid.identification.identified.IdentifiedModel
+    model_ : dynid.identification.fitted_model.IdentifiedModel
         The identified model (predict, validate, export, save).
     params_ : (n_base,) array
         The main estimate's base parameters.
@@ -203,7 +203,7 @@ class Identifier(HyperParameters):
 
     def _fitted(self, result) -> Identifier:
         """Set the fitted attributes from an identification's result."""
-        from .identified import IdentifiedModel
+        from .fitted_model import IdentifiedModel
 
         self.result_ = result
         self.model_ = model = IdentifiedModel.from_result(result)
@@ -263,7 +263,7 @@ class Identifier(HyperParameters):
 
     def summary(self) -> str:
         """The fitted identification in a few lines (:meth:`IdentificationResult.summary
-        <dynid.identification.identify.IdentificationResult.summary>`).
+        <dynid.identification.result.IdentificationResult.summary>`).
 
         Returns
         -------
@@ -287,14 +287,14 @@ class Identifier(HyperParameters):
 
         Returns
         -------
-        dynid.identification.identified.Parameters
+        dynid.identification.fitted_model.Parameters
         """
         return self._model().parameters(estimate)
 
     @keyword_only_after_data
     def predict(self, t, q=None, dq=None, ddq=None, *, estimate: str | None = None) -> np.ndarray:
         """Joint torques of the identified model along a raw log, prepared as the fit prepared its own
-        (:meth:`dynid.identification.identified.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
+        (:meth:`dynid.identification.fitted_model.IdentifiedModel.predict`): ``predict(t, q)``, symmetric with
         ``fit(t, q, tau)``; ``predict(recording)``; states of one's own: :meth:`predict_states`.
 
         Parameters
@@ -321,7 +321,7 @@ class Identifier(HyperParameters):
 
     def validate(self, t, q=None, tau=None, *, estimate: str | None = None):
         """The paper's metrics (eq. 18's correlation, RMSE, relative error) of the estimates on another log, on the
-        samples ``dynid validate`` scores (:meth:`dynid.identification.identified.IdentifiedModel.validate`).
+        samples ``dynid validate`` scores (:meth:`dynid.identification.fitted_model.IdentifiedModel.validate`).
 
         Parameters
         ----------
@@ -346,7 +346,7 @@ class Identifier(HyperParameters):
         return self._model().validate(t, q, tau, estimate=estimate)
 
     def predict_states(self, q, dq, ddq, *, estimate: str | None = None) -> np.ndarray:
-        """Joint torques at states one computed oneself (:meth:`dynid.identification.identified.IdentifiedModel.predict_states`).
+        """Joint torques at states one computed oneself (:meth:`dynid.identification.fitted_model.IdentifiedModel.predict_states`).
 
         Parameters
         ----------
@@ -362,7 +362,7 @@ class Identifier(HyperParameters):
     def score(self, t, q=None, tau=None, *args, estimate: str | None = None) -> float:
         """R² of the predicted torques of a raw log (``score(t, q, tau)``, symmetric with ``fit``) or of a recording
         (``score(recording)``), on the samples ``dynid validate`` scores
-        (:meth:`dynid.identification.identified.IdentifiedModel.score`).
+        (:meth:`dynid.identification.fitted_model.IdentifiedModel.score`).
 
         The earlier form ``score(q, dq, ddq, tau)`` on states of one's own still works, with a FutureWarning.
 
@@ -393,7 +393,7 @@ class Identifier(HyperParameters):
     def relative_error(self, t, q=None, tau=None, *, estimate: str | None = None) -> float:
         """The global relative torque error [%] ``dynid validate`` prints for a raw log (``relative_error(t, q, tau)``)
         or a recording, on the same samples
-        (:meth:`dynid.identification.identified.IdentifiedModel.relative_error`).
+        (:meth:`dynid.identification.fitted_model.IdentifiedModel.relative_error`).
 
         Parameters
         ----------

@@ -17,7 +17,7 @@ One recording goes through it the same way whoever calls it (``dynid identify`` 
    its state at rest (``friction = "auto"``, :func:`dynid.identification.friction_models.choose_friction`), which
    may change the base-parameter map;
 2. **estimation**, :meth:`~IdentificationPipeline.estimate`: every estimator in one pass over the rows
-   (:func:`dynid.identification.identify.identify`), the consistency checks and what the log itself says (held-out
+   (:func:`dynid.identification.estimation_pass.identify`), the consistency checks and what the log itself says (held-out
    blocks, the drive-only candidate, the SDP's refits, the torque delay), then the closed-loop estimators (IDIM-IV,
    DIDIM, DIDIM-SDP: :class:`dynid.identification.closed_loop_estimators.ClosedLoopEstimator`);
 3. **evidence**, :func:`dynid.identification.evidence.gather_evidence`: every candidate scored on the validation logs
@@ -57,9 +57,9 @@ from .closed_loop_estimators import ClosedLoopEstimator
 from .cross_validation import choose_coulomb_velocity, choose_preprocessing
 from .delay import delay_from_rows
 from .drive_only import preprocessing_variants
+from .estimation_pass import identify, one_way_joints
 from .evidence import filtered_finding, gather_evidence, weighed_means, yardstick_reference
 from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
-from .identify import identify, one_way_joints
 from .verdict import SAME_FIGURE, decide
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
@@ -271,7 +271,7 @@ class IdentificationPipeline:
     def estimate(self, prepared: PreparedIdentification, references: tuple = (), progress=None,
                  held_out: bool = False, recording=None, *, jackknife: bool = False, delay: bool = True):
         """Every estimator on the prepared data, the consistency checks and the verdict
-        (:func:`dynid.identification.identify.identify`), then the closed-loop estimators.
+        (:func:`dynid.identification.estimation_pass.identify`), then the closed-loop estimators.
 
         Parameters
         ----------
@@ -283,18 +283,18 @@ class IdentificationPipeline:
             ``progress(step, done, total)``.
         held_out : bool
             With ``sdp`` listed and no validation log to come: score the least-squares and SDP estimates on held-out
-            blocks (said in the main estimate's finding; :func:`dynid.identification.identify.identify`).
+            blocks (said in the main estimate's finding; :func:`dynid.identification.estimation_pass.identify`).
         recording : dynid.io.logs.datasets.Recording, optional
             The log as read, which the closed-loop estimators simulate (needed with :attr:`closed_loop`).
         jackknife : bool
             Refit the SDP on all blocks of the log but one, for the torque-free verdict
-            (:func:`dynid.identification.identify.identify`).
+            (:func:`dynid.identification.estimation_pass.identify`).
         delay : bool
             Check the log for a delay between its torque and position channels (default true).
 
         Returns
         -------
-        dynid.identification.identify.IdentificationResult
+        dynid.identification.result.IdentificationResult
             Its ``settings`` hold the resolved preprocessing, the preprocessing as given (``given_preprocessing``: what
             another log's preparation starts from, :func:`dynid.preprocessing.strategies.carried_over`),
             :attr:`PreparedIdentification.choices`,
@@ -402,7 +402,7 @@ class IdentificationPipeline:
 
         Returns
         -------
-        dynid.identification.identify.IdentificationResult
+        dynid.identification.result.IdentificationResult
 
         Raises
         ------

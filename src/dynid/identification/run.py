@@ -423,7 +423,7 @@ def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None
 
     Returns
     -------
-    dynid.identification.identify.IdentificationResult
+    dynid.identification.result.IdentificationResult
 
     Raises
     ------

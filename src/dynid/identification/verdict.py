@@ -9,7 +9,7 @@ worse than the description", item 1).
 2. the physically consistent SDP (where listed), where the first is least squares and is not physically consistent,
    and the SDP predicts the validation logs as well (to :data:`SAME_FIGURE`, mean global error) or better; without
    validation logs, wherever it passed its own consistency check (what ``dynid export`` writes), the held-out
-   contiguous blocks of the identification log (:data:`dynid.identification.identify.HELD_OUT_FOLDS`-fold blocked
+   contiguous blocks of the identification log (:data:`dynid.identification.estimation_pass.HELD_OUT_FOLDS`-fold blocked
    cross-validation) said in its finding but not deciding: they kept least squares on five real logs and windows
    where it predicted the validation logs 5-30× worse;
 3. the description's rigid body with the drive terms fitted (:mod:`dynid.identification.drive_only`), where the

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from .._util.keywords import keyword_only_after_data
 from ..exceptions import DynIdError
-from ..identification.identify import IdentificationResult
+from ..identification.result import IdentificationResult
 from ..io import atomic_write_text
 from ..io.exported.export import (
     consistent_estimate,

@@ -371,7 +371,7 @@ FIGURE_COLOURS = 32
 """Colours of a figure's PNG (:func:`save_figure`)."""
 
 
-from ..identification.identified import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # noqa: E402  one number for both
+from ..identification.fitted_model import RESULTS_SCHEMA_VERSION as SCHEMA_VERSION  # noqa: E402  one number for both
 
 """Version of the layout of the JSON files dynid writes; raised when a field changes meaning or goes."""
 

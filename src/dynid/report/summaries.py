@@ -19,9 +19,10 @@ from ..exceptions import NotFittedError
 from ..friction import COUNTERBALANCE_TERMS, TERMS
 from ..identification.drive_only import DRIVE_ONLY_KEY
 from ..identification.estimates import HELD_OUT_FOLDS, NOMINAL_LABEL
-from ..identification.identified import IdentifiedModel
+from ..identification.estimation_pass import DRIVE_ONLY_LABEL
+from ..identification.fitted_model import IdentifiedModel
 from ..identification.identifier import Identifier
-from ..identification.identify import BOX_FRACTION, BOX_SIGMAS, DRIVE_ONLY_LABEL, IdentificationResult
+from ..identification.result import BOX_FRACTION, BOX_SIGMAS, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY, held_out_best
 from ..tables import Line, TextTable, render_text
 from ..validation.diagnostics import nominal_gate
@@ -176,8 +177,8 @@ def blocks(result, *, library: bool = False) -> list:
         Any result of dynid (identification, validation: one ``TorqueComparison`` or a list of them, drive gains,
         Monte Carlo, excitation, paper run), or a fitted object: a :class:`~dynid.identification.identifier.Identifier`
         (its identification's result, as ``dynid identify`` prints it) or an
-        :class:`~dynid.identification.identified.IdentifiedModel` (its :meth:`summary
-        <dynid.identification.identified.IdentifiedModel.summary>`, one read back from results.json included).
+        :class:`~dynid.identification.fitted_model.IdentifiedModel` (its :meth:`summary
+        <dynid.identification.fitted_model.IdentifiedModel.summary>`, one read back from results.json included).
 
     library : bool
         Said to a library user (:func:`summary`): the first line names the fitted model's methods where the terminal's
@@ -228,7 +229,7 @@ def identification_blocks(result, *, library: bool = False) -> list:
 
     Parameters
     ----------
-    result : dynid.identification.identify.IdentificationResult
+    result : dynid.identification.result.IdentificationResult
     library : bool
         Its first line as said to a library user (:func:`readiness`).
 
@@ -343,10 +344,10 @@ def readiness(result, *, library: bool = False) -> Line:
 
     Parameters
     ----------
-    result : dynid.identification.identify.IdentificationResult
+    result : dynid.identification.result.IdentificationResult
     library : bool
         Said to a library user (:func:`summary`): the model's URDF and MJCF are
-        :meth:`~dynid.identification.identified.IdentifiedModel.urdf` and ``mjcf()`` (an Identifier's ``model_``), and
+        :meth:`~dynid.identification.fitted_model.IdentifiedModel.urdf` and ``mjcf()`` (an Identifier's ``model_``), and
         the check on other motions ``validate(log)``, not ``dynid identify``'s output folder and a config's
         ``[[validation]]`` logs.
 
@@ -479,7 +480,7 @@ def identification_brief(result) -> list:
 
     Parameters
     ----------
-    result : dynid.identification.identify.IdentificationResult
+    result : dynid.identification.result.IdentificationResult
 
     Returns
     -------
@@ -792,7 +793,7 @@ def in_short(result) -> list:
 
     Parameters
     ----------
-    result : dynid.identification.identify.IdentificationResult
+    result : dynid.identification.result.IdentificationResult
 
     Returns
     -------

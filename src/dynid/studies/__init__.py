@@ -1,5 +1,5 @@
 """Simulated experiments: the paper's run (:mod:`.paper`), the Monte Carlo study (:mod:`.montecarlo`), the closed-loop
-grid (:mod:`.closed_loop`), simulated fleets and service lives (:mod:`.simulated_fleet`, :mod:`.simulated_logs`)."""
+grid (:mod:`.closed_loop_montecarlo`), simulated fleets and service lives (:mod:`.simulated_fleet`, :mod:`.simulated_logs`)."""
 
 from .._lazy import lazy_exports
 
