@@ -72,7 +72,7 @@ def test_a_track_logged_in_millimetres_is_refused_with_its_scale(tmp_path):
 
 def test_degrees_leave_a_prismatic_joints_metres_alone(tmp_path):
     """unit = "deg" converts the revolute joints' columns, not the track's metres."""
-    from dynid.io.config.dataset_specs import dataset_spec
+    from dynid.io.logs.dataset_specs import dataset_spec
 
     table = {"file": "x.csv", "time": {"column": 1}, "positions": {"columns": [2, 3, 4], "unit": "deg"},
              "torques": {"columns": [5, 6, 7]}}

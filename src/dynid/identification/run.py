@@ -13,8 +13,8 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data, seed_of
 from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError
-from ..io.config.dataset_specs import DatasetSpec
 from ..io.config.identification_config import IdentificationConfig, stored_preprocessing
+from ..io.logs.dataset_specs import DatasetSpec
 from ..io.logs.datasets import Recording, given_recording, load_recording
 from ..io.logs.log_repairs import (
     repeated_share,

@@ -80,11 +80,11 @@ from ...model.robot import Robot
 from ...preprocessing.settings import Preprocessing
 from ...preprocessing.strategies import check_strategy
 from ..logs.bags import is_bag
+from ..logs.dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from ..logs.table_files import read_table
 from ..logs.trajectories import load_trajectory
 from .config_types import EstimationTable, IdentificationDocument, PreprocessingTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config, robot_source
-from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 
 if TYPE_CHECKING:
     from ...simulation.closed_loop import ClosedLoopSetup

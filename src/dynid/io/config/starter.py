@@ -24,9 +24,9 @@ from ...exceptions import ConfigError, DataError
 from ...model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
 from ..logs.bags import is_bag
 from ..logs.columns import csv_table, signal_files
+from ..logs.dataset_specs import PRESETS
 from ..logs.datasets import dataset_spec, load_recording
 from ..logs.table_files import read_table
-from .dataset_specs import PRESETS
 
 
 def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tuple[Path, ...] = (),

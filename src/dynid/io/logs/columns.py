@@ -549,7 +549,7 @@ def _fields(line: str, delimiter: str) -> list[str]:
 
 
 def _preset_table(preset: str, log: Path) -> Table:
-    """A dataset table that reads ``log`` by one of :data:`dynid.io.config.dataset_specs.PRESETS`."""
+    """A dataset table that reads ``log`` by one of :data:`dynid.io.logs.dataset_specs.PRESETS`."""
     table = tomlkit.table()
     table.add("preset", preset)
     table.add("file", log.name)

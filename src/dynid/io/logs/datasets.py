@@ -1,4 +1,4 @@
-"""Measured datasets read: a log's columns (:mod:`dynid.io.config.dataset_specs` says which hold what, and in which units)
+"""Measured datasets read: a log's columns (:mod:`dynid.io.logs.dataset_specs` says which hold what, and in which units)
 converted to SI joint quantities on a uniform time grid, the checks and repairs of :mod:`dynid.io.logs.log_repairs`
 applied on the way (:func:`load_recording`)."""
 
@@ -17,9 +17,9 @@ from ..._util.reprs import short_repr
 from ...exceptions import ConfigError, DataError, ShapeError
 from ...model.loading import as_robot
 from ...model.robot import Robot
-from ..config.dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .bags import read_joint_states
 from .columns import csv_table, named_out_of_order
+from .dataset_specs import DatasetSpec, SignalSpec, dataset_spec
 from .log_repairs import (
     AUTO_GAP_SAMPLES,
     GAP_FACTOR,

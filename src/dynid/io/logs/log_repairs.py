@@ -13,7 +13,7 @@ from ..._util.column_store import StoredColumns, by_column, select_rows
 from ...conventions import MOVING_SPAN, TIME_UNITS, time_unit_of
 from ...exceptions import DataError
 from ...model.robot import Robot
-from ..config.dataset_specs import DatasetSpec
+from .dataset_specs import DatasetSpec
 
 GAP_FACTOR = 5.0
 """A time step longer than this many median steps is a gap in the log (a lost connection, a pause)."""

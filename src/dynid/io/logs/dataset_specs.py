@@ -36,7 +36,9 @@ or a ROS 2 bag of ``sensor_msgs/JointState`` (:mod:`dynid.io.logs.bags`)::
     effort = "torques"               # or "currents" (through the drive gains, eq. 16)
 
 Columns are 1-based numbers or header names. Drive gains multiply currents on the side where they
-are measured.
+are measured. The table is converted into a :class:`DatasetSpec` here (:func:`dataset_spec`), beside the log readers that take the
+spec, through its typed structure (:mod:`dynid.io.logs.dataset_tables`); the configs (:mod:`dynid.io.config`) decode
+their tables into them.
 """
 
 from __future__ import annotations
@@ -255,7 +257,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sli
         the message names the config field.
     """
     from ..._util.typed import convert
-    from .config_types import DatasetTable
+    from .dataset_tables import DatasetTable
 
     source, _, inside = where.rpartition(": ")
     if not isinstance(table, dict):
