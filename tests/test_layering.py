@@ -141,27 +141,7 @@ def test_only_the_known_callers_assemble_the_estimation_by_hand():
 def test_io_rooms_import_downwards_only():
     """issue "One route, four named parts", item 3: ``dynid.io`` by job, the configs above the logs and the exported
     model, which import neither the configs nor each other (the configs decode into the logs' dataset spec)."""
-    root = Path(dynid.__file__).parent / "io"
     below = {"logs": ("config", "exported"), "exported": ("config", "logs")}
-    bad = []
-    for room, forbidden in below.items():
-        for path in (root / room).glob("*.py"):
-            rel = ("io", room, path.name)
-            for node in ast.walk(ast.parse(path.read_text())):
-                if isinstance(node, ast.ImportFrom):
-                    name = ("." * node.level) + (node.module or "")
-                    resolved = _absolute(name, rel)
-                    if any(resolved == f"dynid.io.{f}" or resolved.startswith(f"dynid.io.{f}.") for f in forbidden):
-                        bad.append(f"io/{room}/{path.name} imports {resolved}")
+    bad = [f"{f} imports {m}" for room, forbidden in below.items() for f, m in _imports_of(f"io/{room}")
+           if any(m == f"dynid.io.{o}" or m.startswith(f"dynid.io.{o}.") for o in forbidden)]
     assert not bad, bad
-
-
-def _absolute(name: str, rel: tuple) -> str:
-    """The dotted module an import names, from a file at ``rel`` (parts under dynid/)."""
-    level = len(name) - len(name.lstrip("."))
-    if not level:
-        return name
-    package = ["dynid", *rel[:-1]]
-    base = package[:len(package) - (level - 1)]
-    rest = name[level:]
-    return ".".join(base + ([rest] if rest else []))
