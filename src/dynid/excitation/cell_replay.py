@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .._util.reprs import short_repr
-from ..model.description_files import mjcf_from_robot
+from ..model.description_files import _vec, mjcf_from_robot
 from ..model.robot import Robot
 from .constraints import Workspace
 
@@ -60,10 +60,6 @@ class CellContacts:
         dict
         """
         return {"set_points": self.set_points, "touching": self.touching, "first": self.first, "deepest": self.deepest}
-
-
-def _vec(v) -> str:
-    return " ".join(f"{float(x):.17g}" for x in v)
 
 
 def _quat(rpy) -> str:

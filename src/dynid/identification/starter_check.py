@@ -1,8 +1,8 @@
 """What ``dynid init`` checks of the log before it writes the config: the identification log identified as the config
 it is about to write would have it, least squares alone on the rule's cutoffs and the description's friction terms
 (neither cross-validated: the check finds how the log reads against the robot file, which a few percent of fit do not
-change, and the cross-validations took two thirds of init's time on the TX40's log), then the robot's mounting, its
-joints' zeros and the torques' sign set where that check finds them otherwise than the robot file says
+change), then the robot's mounting, its joints' zeros and the torques' sign set where that check finds them otherwise
+than the robot file says
 (:func:`dynid.validation.geometry_checks.geometry_findings`' gravity and turned zeros,
 :func:`dynid.validation.diagnostics.sign_findings`), so that the first ``dynid identify`` reads the log right (issue
 "Never worse than the description": on the LBR Med7's log the config without the sign scored 20.0 % and needed a
