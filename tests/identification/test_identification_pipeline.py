@@ -167,35 +167,3 @@ def test_the_cross_validations_say_their_share_done_as_they_go(slow_quiet_log):
         shares = [done / total for label, done, total in calls if label == step]
         assert shares[0] == 0 and shares[-1] == 1.0 and len(shares) >= 3, (step, shares)
         assert all(b >= a for a, b in zip(shares, shares[1:])), (step, shares)
-
-
-def test_a_long_log_is_prepared_whole_once_at_the_cutoffs_its_middle_chose(slow_quiet_log, monkeypatch):
-    """A log longer than the cross-validation's window: its band and knee come from the whole log, its candidates
-    from the middle, and the whole log is filtered once, at the cutoffs chosen (not also at the rule's first)."""
-    from dataclasses import replace
-
-    from dynid.dynamics.base_parameters import base_parameters
-    from dynid.identification import cross_validation
-    from dynid.preprocessing.preparation import prepare
-
-    config = slow_quiet_log
-    recording = load_recording(config.identification, config.robot)
-    given = config.preprocessing
-    monkeypatch.setattr(cross_validation, "MAX_SAMPLES", recording.n_samples // 2)
-    prepared = []
-
-    def counted(rec, settings, strict=True):
-        prepared.append(rec.n_samples)
-        return prepare(rec, settings, strict)
-
-    monkeypatch.setattr(cross_validation, "prepare", counted)
-    base = base_parameters(config.robot, rng=0)
-    choice = cross_validation.choose_preprocessing(config.robot, base, recording, given)
-    assert len(choice.candidates) == 3 and "middle" in choice.note  # the long log's branch was taken
-    assert prepared.count(recording.n_samples) == 1  # the whole log once
-    whole = given.resolved(recording.rate, recording.q, measured_velocity=recording.dq is not None)
-    assert choice.settings.band == whole.band
-    again = prepare(recording, replace(given, band=whole.band, position_cutoff=choice.settings.position_cutoff,
-                                       parallel_cutoff=choice.settings.parallel_cutoff))
-    np.testing.assert_array_equal(choice.data.q, again.q)
-    np.testing.assert_array_equal(choice.data.ddq, again.ddq)

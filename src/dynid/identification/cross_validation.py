@@ -255,18 +255,12 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
         With one candidate (the default rule's) when there was nothing to choose.
     """
     said = progress if progress is not None else (lambda done, total: None)
-    if recording.n_samples > MAX_SAMPLES:  # the band and knee alone: the whole log is prepared once, at the cutoffs chosen
-        reference, rs = None, given.resolved(recording.rate, recording.q, measured_velocity=recording.dq is not None,
-                                             name=recording.label)
-    else:
-        reference = prepare(recording, given)
-        rs = reference.settings
+    reference = prepare(recording, given)
+    rs = reference.settings
     band, knee = rs.band, rs.knee
     default = POSITION_FACTOR * (band or 0.0)
     if (given.position_cutoff is not None or given.parallel_cutoff is not None or rs.fourier is not None or knee is None
             or knee < KNEE_MARGIN * default):
-        reference = reference if reference is not None else prepare(recording, given)
-        rs = reference.settings
         return PreprocessingChoice(rs, (rs,), np.zeros((1, robot.n_dof)), np.zeros(1), "", reference)
     full, recording = recording, _middle(recording, MAX_SAMPLES)  # a long log: its middle minute decides
     if recording is not full:
