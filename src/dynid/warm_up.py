@@ -15,7 +15,7 @@ from __future__ import annotations
 def warm_up() -> None:
     """Compile the regressors of the built-in robots (their SIMD code, and numba's kernel), then run a 2 s,
     200 Hz paper experiment with every estimator (2 ABC iterations, 2 bootstrap resamples), and compile the recursive
-    least squares of ``dynid monitor``."""
+    least squares of ``dynid monitor`` and the closed-loop simulator's steps."""
     from .dynamics import regressor
     from .model.description import load_robot
 
@@ -29,6 +29,10 @@ def warm_up() -> None:
     from .estimators.recursive import RecursiveLeastSquares
 
     RecursiveLeastSquares(np.zeros((6, 3))).update(np.ones((2, 6, 3)), np.ones((2, 6)))  # dynid monitor's kernel
+    from .simulation.closed_loop import Controller, simulate_closed_loop
+
+    t = np.arange(10) / 1000.0  # the closed-loop simulator's steps (IDIM-IV, DIDIM)
+    simulate_closed_loop(er16, t, np.zeros((10, 6)), np.zeros((10, 6)), Controller.for_robot(er16))
 
 
 if __name__ == "__main__":

@@ -73,3 +73,26 @@ def test_controller_and_simulation_refusals(rng):
         simulate_closed_loop(robot, t, q, dq, controller, ClosedLoopNoise(torque_std=0.1))
     with pytest.raises(ConfigError, match="diverged"):
         simulate_closed_loop(robot, t, q, dq, Controller.of(3, kp=1e9, kd=1e7))
+
+
+def test_the_compiled_stages_run_as_the_dynamics_own_accelerations(rng, monkeypatch):
+    """The simulator's compiled stages add the drive terms (Coulomb, viscous, offset) themselves before Pinocchio's
+    ABA; the same run through the dynamics' own accelerations (their NumPy drive torques) is the same to the bit."""
+    from dynid.simulation.closed_loop import JointDynamics
+
+    robot = dynid.load_robot("ur10e")
+    phi = robot.standard_parameters().copy()
+    names = list(robot.parameter_names)
+    for j in range(robot.n_dof):  # every term the stages add, non-zero, and the rotor inertia (ABA's armature)
+        for term, value in (("Ia", 0.05), ("fc", 2.0), ("fv", 0.7), ("offset", 0.3)):
+            phi[names.index(f"{term}{j + 1}")] = value
+    robot = robot.with_parameters(phi)
+    assert JointDynamics(robot).simple_drive_terms() is not None
+    t, q, dq, _ = _reference(robot, 1.0, 1000.0, rng)
+    noise = ClosedLoopNoise(np.deg2rad(1e-2), np.deg2rad(1e-3), 0.1)
+    seed = int(rng.integers(1 << 30))
+    compiled = simulate_closed_loop(robot, t, q, dq, Controller.for_robot(robot), noise, rng=np.random.default_rng(seed))
+    monkeypatch.setattr(JointDynamics, "simple_drive_terms", lambda self: None)
+    general = simulate_closed_loop(robot, t, q, dq, Controller.for_robot(robot), noise, rng=np.random.default_rng(seed))
+    for key in ("q", "tau", "q_true", "dq_true", "ddq_true", "tau_applied"):
+        np.testing.assert_array_equal(getattr(compiled, key), getattr(general, key), err_msg=key)

@@ -31,6 +31,7 @@ from ..dynamics.regressor import friction_torques
 from ..dynamics.rnea import pinocchio_model
 from ..exceptions import ConfigError, ShapeError
 from ..model.robot import Robot
+from ._step_kernel import compiled
 
 __all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "ClosedLoopSetup", "JointDynamics", "simulate_closed_loop"]
 
@@ -300,6 +301,19 @@ class JointDynamics:
         if self._aba:
             self.model.armature = np.diag(self.drive_inertia).copy()
 
+    def simple_drive_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The drive terms as three per-joint vectors, when they are only these and the rotor inertias (Pinocchio's
+        armature): the simulator's compiled stages then add them (:mod:`dynid.simulation._step_kernel`).
+
+        Returns
+        -------
+        (fc, fv, offset) : (n_dof,) arrays [N·m, N·m·s/rad, N·m], or None
+            None with coupled motors, a smoothed Coulomb friction or other drive terms.
+        """
+        if self._aba and self._fast and not self._smooth and not self._coupled:
+            return self._fc, self._fv, self._offset
+        return None
+
     def drive_torques(self, dq: np.ndarray) -> np.ndarray:
         """Torques of the drive terms at zero acceleration (friction, offset, coupled motors' friction).
 
@@ -409,40 +423,48 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
 
 
 def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
-    """:func:`simulate_closed_loop`'s loop over the control instants."""
+    """:func:`simulate_closed_loop`'s loop over the control instants (the arithmetic between two calls of the direct
+    dynamics in :mod:`dynid.simulation._step_kernel`, in place)."""
+    control, stage, first_input, advance = compiled()
     n = q_ref.shape[1]
     h = 1.0 / controller.rate
-    accelerations = dynamics.accelerations
     kp, kd, ki = controller.kp, controller.kd, controller.ki
     # first-order low-pass of the differenced positions (backward Euler): v ← v + α (raw − v)
     alpha = 1.0 if controller.velocity_cutoff == 0 else 1.0 - np.exp(-2 * np.pi * controller.velocity_cutoff * h)
     position_noise = noise.position_std > 0 or noise.encoder_resolution > 0
     q_true, dq_true, ddq_true, tau_applied, q_meas = (np.empty((t.size, n)) for _ in range(5))
     q, dq = q_ref[0].copy(), dq_ref[0].copy()
-    integral = np.zeros(n)
-    previous = None
-    velocity = dq_ref[0].copy()
+    integral, previous, velocity = np.zeros(n), np.zeros(n), dq_ref[0].copy()
+    tau, u, qs, v2, v3, v4 = (np.empty(n) for _ in range(6))
+    drive = dynamics.simple_drive_terms()
+    if drive is not None:  # the drive terms in the stages, the rigid body by Pinocchio's ABA
+        fc, fv, offset = drive
+        aba, model, data = dynamics._pin.aba, dynamics.model, dynamics.data
+
+        def accelerations(x, v, tau, u):
+            return aba(model, data, x, v, u)
+    else:  # coupled motors, smoothed Coulomb friction, other drive terms: the dynamics' own
+        fc = fv = offset = np.zeros(n)
+
+        def accelerations(x, v, tau, u):
+            return dynamics.accelerations(x, v, tau)
     # the encoder's noise drawn at once: the same numbers as one draw per instant (a Generator's stream)
     draws = rng.normal(0.0, noise.position_std, (t.size, n)) if noise.position_std > 0 else None
     for k in range(t.size):
-        y = noise.measured_positions(q, rng, None if draws is None else draws[k]) if position_noise else q
-        if previous is not None:  # the first instant: no difference yet, the reference's velocity
-            velocity = velocity + alpha * ((y - previous) / h - velocity)
-        error = q_ref[k] - y
-        integral += error * h
-        tau = ff[k] + kp * error + kd * (dq_ref[k] - velocity) + ki * integral
-        a1 = accelerations(q, dq, tau)
+        y = noise.measured_positions(q, rng, None if draws is None else draws[k]) if position_noise else q.copy()
+        control(y, previous, k == 0, velocity, alpha, h, q_ref[k], dq_ref[k], ff[k], kp, kd, ki, integral, tau)
+        first_input(dq, tau, fc, fv, offset, u)
+        a1 = accelerations(q, dq, tau, u)
         q_true[k], dq_true[k], ddq_true[k], tau_applied[k], q_meas[k] = q, dq, a1, tau, y
         previous = y
         # classic Runge-Kutta on (q, q̇) with the torque held
-        v2 = dq + 0.5 * h * a1
-        a2 = accelerations(q + 0.5 * h * dq, v2, tau)
-        v3 = dq + 0.5 * h * a2
-        a3 = accelerations(q + 0.5 * h * v2, v3, tau)
-        v4 = dq + h * a3
-        a4 = accelerations(q + h * v3, v4, tau)
-        q = q + h / 6.0 * (dq + 2 * v2 + 2 * v3 + v4)
-        dq = dq + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+        stage(q, dq, dq, a1, 0.5 * h, tau, fc, fv, offset, qs, v2, u)
+        a2 = accelerations(qs, v2, tau, u)
+        stage(q, v2, dq, a2, 0.5 * h, tau, fc, fv, offset, qs, v3, u)
+        a3 = accelerations(qs, v3, tau, u)
+        stage(q, v3, dq, a3, h, tau, fc, fv, offset, qs, v4, u)
+        a4 = accelerations(qs, v4, tau, u)
+        advance(q, dq, v2, v3, v4, a1, a2, a3, a4, h)
         if not math.isfinite(q.dot(q) + dq.dot(dq)):  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
             raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
                               "or a model that cannot be simulated")
