@@ -690,9 +690,10 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
         ts.append(data.t[index])
         meas.append(tau)
         rest.append(resting_rows(data, index) if at_rest is None else at_rest[index])
+        held = y * holding  # once a block, not once a set
         for label, beta in parameter_sets.items():
             preds[label].append(y @ beta)
-            centres[label].append(preds[label][-1] - (y * holding) @ beta)
+            centres[label].append(preds[label][-1] - held @ beta)
         for label, cov in covariance.items():
             var[label] += np.einsum("mjc,cd,mjd->j", y, cov, y)
 
