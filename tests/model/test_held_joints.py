@@ -169,3 +169,56 @@ def test_init_offers_no_held_joints_for_a_built_in_robot(tmp_path):
     with pytest.raises(DataError, match="found 1 positions column") as caught:
         starter_config(Path("ur10e"), tmp_path / "log.csv", 6, tmp_path / "arm.toml", joints=ur10e)
     assert "held = " not in str(caught.value) and "gripper" not in str(caught.value)
+
+
+def _two_arms():
+    """A torso with two arms of two joints each (``l1``, ``l2`` and ``r1``, ``r2``), the left one first in the file."""
+    arms = []
+    for side, y in (("l", 0.3), ("r", -0.3)):
+        arms += [_link(f"{side}_link1", 2.5, "0 0 0.15"), _link(f"{side}_link2", 1.5, "0.15 0 0"),
+                 _revolute(f"{side}1", "base", f"{side}_link1", f"0 {y} 0.5", "0 0 1"),
+                 _revolute(f"{side}2", f"{side}_link1", f"{side}_link2", "0 0 0.3", "0 1 0")]
+    return _link("base", 10.0, "0 0 0.2") + "".join(arms)
+
+
+def _arm_log(path, robot, columns):
+    """A log of ``robot``'s motion and its inverse dynamics, under the given column names."""
+    from dynid.dynamics.rnea import rnea_torques
+
+    t = np.arange(2000) / 100.0
+    w = 2 * np.pi * np.array([0.1, 0.13])
+    q = 0.8 * np.sin(w * t[:, None])
+    dq, ddq = 0.8 * w * np.cos(w * t[:, None]), -0.8 * w**2 * np.sin(w * t[:, None])
+    tau = rnea_torques(robot, q, dq, ddq)
+    np.savetxt(path, np.column_stack([t, q, tau]), delimiter=",", header=",".join(["time", *columns]), comments="")
+
+
+def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
+    """A two-arm robot and a log of its right arm: init takes the arm whose joints the log's columns name (it took the
+    first arm as long, whose columns the log has not, and refused the log), holds the other; a log of both arms takes
+    one and says the other's columns are there."""
+    from dynid.io.logs.columns import joints_named
+
+    from ..cli.refusals import dynid as run
+
+    urdf = _urdf(tmp_path, _two_arms(), "torso.urdf")
+    assert joints_to_hold(urdf) == ("r1", "r2")  # no log: the first of the longest chains, as before
+    right = dynid.load_robot(urdf, held=("l1", "l2"))
+    _arm_log(tmp_path / "right.csv", right, ["r1_pos", "r2_pos", "r1_effort", "r2_effort"])
+    assert joints_named(tmp_path / "right.csv", ("l1", "l2", "r1", "r2")) == {"r1", "r2"}
+    assert joints_to_hold(urdf, lambda names: joints_named(tmp_path / "right.csv", names)) == ("l1", "l2")
+    p = run("init", urdf, tmp_path / "right.csv", "--out", tmp_path / "right.toml")
+    assert p.returncode == 0, p.stderr
+    doc = tomllib.loads((tmp_path / "right.toml").read_text())
+    assert doc["robot"]["held"] == ["l1", "l2"]
+    assert doc["identification"]["positions"]["columns"] == ["r1_pos", "r2_pos"]
+    assert "another branch" not in p.stdout
+    both = tmp_path / "both.csv"
+    _arm_log(both, right, ["l1_pos", "l2_pos", "l1_effort", "l2_effort"])
+    lines = both.read_text().splitlines()
+    both.write_text("\n".join([lines[0] + ",r1_pos,r2_pos,r1_effort,r2_effort"]
+                              + [row + "," + row.split(",", 1)[1] for row in lines[1:]]) + "\n")
+    p = run("init", urdf, both, "--out", tmp_path / "both.toml")
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
+    assert "both.csv also holds columns of r1, r2, on another branch of torso.urdf" in " ".join(p.stdout.split())

@@ -252,3 +252,23 @@ def test_init_holds_an_mjcfs_gripper_and_writes_a_config_that_loads(tmp_path):
     assert 'held = ["finger1", "finger2"]' in (tmp_path / "arm.toml").read_text()
     config = load_identification_config(tmp_path / "arm.toml")
     assert config.robot.n_dof == 3 and config.robot.held == ("finger1", "finger2") and config.mjcf_model is None
+
+
+def test_an_mjcf_with_two_arms_holds_the_arm_the_log_does_not_name(tmp_path):
+    """Two arms on one body: without a log the first is the arm (the other held); a log whose columns name the second
+    arm's joints makes it the arm."""
+    from dynid.io.logs.columns import joints_named
+    from dynid.model.mjcf import mjcf_joints_to_hold
+
+    def arm(side, y):
+        return (f'<body name="{side}_link1" pos="0 {y} 0.5"><joint name="{side}1" type="hinge" axis="0 0 1" range="-3 3"/>'
+                f'<inertial pos="0 0 0.15" mass="2.5" diaginertia="0.01 0.02 0.015"/>'
+                f'<body name="{side}_link2" pos="0 0 0.3"><joint name="{side}2" type="hinge" axis="0 1 0" range="-3 3"/>'
+                f'<inertial pos="0.15 0 0" mass="1.5" diaginertia="0.01 0.02 0.015"/></body></body>')
+
+    path = tmp_path / "two.xml"
+    path.write_text(f'<mujoco model="two"><worldbody><body name="base"><inertial pos="0 0 0.2" mass="10" '
+                    f'diaginertia="0.1 0.1 0.1"/>{arm("l", 0.3)}{arm("r", -0.3)}</body></worldbody></mujoco>')
+    (tmp_path / "r.csv").write_text("time,r1_pos,r2_pos,r1_effort,r2_effort\n0,0,0,0,0\n0.01,0,0,0,0\n")
+    assert mjcf_joints_to_hold(path) == ("r1", "r2")
+    assert mjcf_joints_to_hold(path, lambda names: joints_named(tmp_path / "r.csv", names)) == ("l1", "l2")

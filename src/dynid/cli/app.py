@@ -776,6 +776,7 @@ def init(
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
     from ..io.config.starter import check_target, starter_config, xacro_arguments
+    from ..io.logs.columns import joints_named
     from ..model.description import load_robot, robot_from_urdf
     from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
 
@@ -789,7 +790,8 @@ def init(
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
         read = (expand_xacro(urdf, args) if is_xacro(urdf) else urdf) if urdf.is_file() else None
-        held = joints_to_hold(read) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read)) else ()
+        held = (joints_to_hold(read, lambda names: joints_named(log, names))
+                if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read)) else ())
         return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
 
     def compute(robot, progress):

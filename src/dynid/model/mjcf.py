@@ -11,6 +11,7 @@ given where MuJoCo normalises it (a 60° turn about (1, 0.5, 0) put the torques 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -343,13 +344,16 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
             "gravity": np.array(model.opt.gravity, dtype=float)}
 
 
-def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
+def mjcf_joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str]] | None = None) -> tuple[str, ...]:
     """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest chain of
-    hinges from the base (a gripper's fingers, a camera's pan joint on a branch of its own, wherever the file puts it).
+    hinges from the base (a gripper's fingers, a camera's pan joint on a branch of its own, wherever the file puts it),
+    or off the chain that holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`).
 
     Parameters
     ----------
     path : str or Path
+    logged : callable, optional
+        ``logged(names)`` -> the names among the file's moving joints that the log names.
 
     Returns
     -------
@@ -363,7 +367,8 @@ def mjcf_joints_to_hold(path: str | Path) -> tuple[str, ...]:
     """
     mujoco, model = _compiled(Path(path))
     _, parents, revolute, sliding = _tree(mujoco, model)
-    arm = arm_chain(parents, revolute, sliding)
+    named = set() if logged is None else logged(tuple(model.joint(k).name for k in parents))
+    arm = arm_chain(parents, revolute, sliding, {k for k in parents if model.joint(k).name in named})
     return tuple(model.joint(k).name for k in parents if k not in arm)
 
 

@@ -14,11 +14,13 @@ HELD_HINT = "hold it fixed with held = [{names}] in the config's [robot] table (
 :func:`dynid.model.urdf.joints_from_urdf`, :mod:`dynid.model.mjcf`)."""
 
 
-def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> list[int]:
+def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset(), named=frozenset()) -> list[int]:
     """The arm's joints in a robot file's tree of moving joints: the longest chain from the base of revolute and
-    prismatic joints, each riding on the one before (of chains as long, the first in the file's reading order). The
-    prismatic joints at a chain's tip are taken for a gripper's fingers, not the arm's, unless the chain has nothing
-    else (a gantry); a SCARA whose quill ends the arm gives it back by its config's ``held``.
+    prismatic joints, each riding on the one before (of chains as long, the first in the file's reading order); where
+    a log names joints, the chain that holds most of them (of those, the longest: the right arm of a two-arm robot
+    whose log is the right arm's). The prismatic joints at a chain's tip are taken for a gripper's fingers, not the
+    arm's, unless the chain has nothing else (a gantry); a SCARA whose quill ends the arm gives it back by its config's
+    ``held``.
 
     Parameters
     ----------
@@ -28,13 +30,15 @@ def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset()) 
         The revolute joints that can be the arm's (not mimicking another).
     sliding : set of int
         The prismatic joints that can be the arm's (a linear track, a lift, a SCARA's vertical axis).
+    named : set of int
+        The joints a log names (none: the longest chain).
 
     Returns
     -------
     list of int
         From the base outwards.
     """
-    return max(_chains(parents, revolute, sliding).values(), key=len)
+    return max(_chains(parents, revolute, sliding).values(), key=lambda chain: (len(named.intersection(chain)), len(chain)))
 
 
 def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) -> dict[int, list[int]]:

@@ -8,6 +8,7 @@ import json
 import os
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from xml.parsers import expat
 
@@ -253,14 +254,17 @@ def _pinocchio_model(path: Path, held: dict):
     return pin.buildReducedModel(model, ids, q)
 
 
-def joints_to_hold(path: str | Path) -> tuple[str, ...]:
+def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str]] | None = None) -> tuple[str, ...]:
     """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest
     chain of revolute joints from the base, none mimicking another (a gripper's fingers, prismatic or on a branch; a
-    camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it).
+    camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it), or off the chain that
+    holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`).
 
     Parameters
     ----------
     path : str or Path
+    logged : callable, optional
+        ``logged(names)`` -> the names among the file's moving joints that the log names.
 
     Returns
     -------
@@ -274,12 +278,13 @@ def joints_to_hold(path: str | Path) -> tuple[str, ...]:
     """
     path = Path(path)
     if is_mjcf(path):
-        return mjcf_joints_to_hold(path)
+        return mjcf_joints_to_hold(path, logged)
     mimic = _mimic_joints(path)
     check_urdf_text(path, held=mimic)
     model = _pinocchio_model(path, {})
     names, parents, revolute, sliding = _tree(model, mimic)
-    arm = arm_chain(parents, revolute, sliding)
+    named = set() if logged is None else logged(tuple(names[k] for k in parents))
+    arm = arm_chain(parents, revolute, sliding, {k for k in parents if names[k] in named})
     return tuple(names[k] for k in parents if k not in arm)
 
 

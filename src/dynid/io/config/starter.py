@@ -23,7 +23,7 @@ from tomlkit.items import Table
 from ...exceptions import ConfigError, DataError
 from ...model.description import URDF_DRIVE_TERMS, builtin_robots, load_robot
 from ..logs.bags import is_bag
-from ..logs.columns import csv_table, signal_files
+from ..logs.columns import csv_table, joints_named, signal_files
 from ..logs.dataset_specs import PRESETS
 from ..logs.datasets import dataset_spec, load_recording
 from ..logs.table_files import read_table
@@ -106,7 +106,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
-    notes += [*_sliding_note(robot), *_held_notes(urdf, held), *_gain_notes(table, urdf, robot, gains),
+    notes += [*_sliding_note(robot), *_held_notes(urdf, held, log), *_gain_notes(table, urdf, robot, gains),
               _estimators_note(without, robot)]
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
@@ -201,9 +201,19 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
     return out
 
 
-def _held_notes(urdf: Path, held: tuple[str, ...]) -> list[str]:
-    return [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain of revolute joints (a gripper?): held fixed "
-            "at 0, their links counted with the link they hang on (held in [robot])"] if held else []
+def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None) -> list[str]:
+    """The lines of the joints held: which, and those of them the log holds columns of (another arm of a two-arm
+    robot), which a config of their own identifies."""
+    if not held:
+        return []
+    notes = [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain (a gripper, a head, another arm): held fixed "
+             "at 0, their links counted with the link they hang on (held in [robot])"]
+    logged = sorted(joints_named(log, held), key=held.index) if log is not None else []
+    if log is not None and logged:
+        notes.append(f"{log.name} also holds columns of {', '.join(logged)}, on another branch of {urdf.name}: dynid "
+                     "identifies one serial chain at a time; identify them with a config of their own (its [robot] "
+                     "table's held naming this arm's joints instead)")
+    return notes
 
 
 def _reads_currents(table) -> bool:

@@ -447,6 +447,37 @@ def commanded(name: str, joints: tuple[str, ...] = ()) -> bool:
     return bool(COMMANDED & set(re.split(r"[^a-z]+", low)))
 
 
+def joints_named(log: Path, joints: tuple[str, ...]) -> set[str]:
+    """The joints of ``joints`` that a CSV log's header names beside a signal (``right_s0_pos``,
+    ``/joint_states/elbow/effort``; commanded columns left out), for ``dynid init`` to take the arm the log holds
+    among a robot file's branches.
+
+    Parameters
+    ----------
+    log : Path
+        A CSV log (a ROS bag, a folder or a headerless log name no joint: the empty set).
+    joints : tuple of str
+        The robot file's moving joints.
+
+    Returns
+    -------
+    set of str
+
+    Raises
+    ------
+    DataError
+        A text log that cannot be read.
+    """
+    if not log.is_file() or log.suffix.lower() in (".bag", ".mcap", ".db3"):
+        return set()
+    lines, delimiter, _ = _first_lines(log)
+    first = _fields(lines[0], delimiter)
+    if all(_number(c) for c in first):
+        return set()
+    hits = (None if commanded(c, joints) else _named_joint(c, joints) for c in first)
+    return {joints[hit[1]] for hit in hits if hit is not None}
+
+
 def _by_joint_names(first: list[str], joints: tuple[str, ...]) -> tuple[dict[str, list[str]], list[str]]:
     """Columns naming every joint of the URDF, per signal in the URDF's joint order, and a note per signal whose log
     order differs; a commanded column (:func:`commanded`) is never taken."""
