@@ -205,10 +205,13 @@ def _self_clearance_lines(run) -> list:
     p = run.config.problem
     radius = p.workspace.capsule_radius(p.robot)
     where = f"links {c.pair[0]} and {c.pair[1]} at t = {c.time:.3g} s"
-    if c.shapes:  # the URDF's own shapes, kept apart by the design
+    if c.shapes and c.distance < 0:  # the URDF's own shapes (a held arm's among them), kept apart by the design
+        return [Line(f"the links' collision shapes meet: {c.shapes[0]} and {c.shapes[1]} overlap by {-c.distance:.3g} m "
+                     f"at t = {c.time:.3g} s ({c.pairs} pairs checked on the set-points): check this pose on the robot "
+                     "(or in a simulator) before running it, or lower the amplitudes", "warning")]
+    if c.shapes:
         return [Line(f"the links' collision shapes stay {c.distance:.3g} m apart or more (closest: {c.shapes[0]} and "
-                     f"{c.shapes[1]} at t = {c.time:.3g} s; {c.pairs} pairs checked on the set-points)",
-                     "warning" if c.distance < 0 else "text")]
+                     f"{c.shapes[1]} at t = {c.time:.3g} s; {c.pairs} pairs checked on the set-points)")]
     if c.distance < 0:
         kept = run.config.problem.workspace.avoid_self_collision
         how = ("the design kept them apart on its grid, not between its samples: raise design.grid_points" if kept else

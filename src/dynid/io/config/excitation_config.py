@@ -259,12 +259,14 @@ def _workspace(ws, doc: dict, path: Path, robot) -> Workspace:
                                    np.zeros(3) if ob.rpy is None else np.asarray(ob.rpy, dtype=float),
                                    ob.name or f"obstacle {i + 1}") for i, ob in enumerate(ws.obstacles or [])]
         srdf = None if ws.srdf is None else (path.parent / ws.srdf).resolve()
-        cell = bool(ws.obstacles) or ws.floor is not None  # the links' shapes are read where something is kept off
-        if srdf is not None and not cell:
-            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where a floor "
-                              "or [[workspace.obstacles]] are given (without them the links are capsules)")
+        # the links' shapes are read where something is kept off: a floor, obstacles, or the links of held joints (a
+        # second arm, a head, a gripper), which capsules about the arm's joint origins leave out
+        shaped = bool(ws.obstacles) or ws.floor is not None or bool(robot.held)
+        if srdf is not None and not shaped:
+            raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where a floor, "
+                              "[[workspace.obstacles]] or held joints are given (without them the links are capsules)")
         ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
-                                            srdf) if cell else _link_geometry(ws.geometry or "auto", robot, None))
+                                            srdf) if shaped else _link_geometry(ws.geometry or "auto", robot, None))
         return Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
