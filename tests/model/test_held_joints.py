@@ -222,3 +222,33 @@ def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
     assert p.returncode == 0, p.stderr
     assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
     assert "both.csv also holds columns of r1, r2, on another branch of torso.urdf" in " ".join(p.stdout.split())
+
+
+def test_the_second_arm_identified_on_the_first_arms_written_urdf_holds_both(tmp_path):
+    """The docs' two-arm recipe: the right arm identified, then the left arm with the URDF that run wrote as its robot
+    file: the file the second run writes holds the first run's right arm and the second run's left arm."""
+    from ..cli.refusals import dynid as run
+
+    urdf = _urdf(tmp_path, _two_arms(), "torso.urdf")
+    rng = np.random.default_rng(5)
+    for side, other in (("r", "l"), ("l", "r")):  # the logs of a robot whose links are 10-40 % off the file's
+        truth = dynid.load_robot(urdf, held=(f"{other}1", f"{other}2"))
+        phi = truth.standard_parameters() * np.repeat(rng.uniform(0.6, 1.4, truth.n_dof), truth.n_params_per_joint)
+        _arm_log(tmp_path / f"{side}.csv", truth.with_parameters(phi), [f"{side}1_pos", f"{side}2_pos", f"{side}1_effort",
+                                                                          f"{side}2_effort"])
+    assert run("init", urdf, tmp_path / "r.csv", "--out", tmp_path / "r.toml", "-q").returncode == 0
+    assert run("identify", tmp_path / "r.toml", "--out", tmp_path / "r_id", "--no-figures", "-q").returncode == 0
+    first = tmp_path / "right-identified.urdf"
+    first.write_text((tmp_path / "r_id" / "torso.urdf").read_text())
+    assert run("init", first, tmp_path / "l.csv", "--out", tmp_path / "l.toml", "-q").returncode == 0
+    assert run("identify", tmp_path / "l.toml", "--out", tmp_path / "l_id", "--no-figures", "-q").returncode == 0
+    both = tmp_path / "l_id" / "right-identified.urdf"
+
+    def arm(path, side):
+        other = "l" if side == "r" else "r"
+        return dynid.load_robot(path, held=(f"{other}1", f"{other}2")).inertial
+
+    np.testing.assert_allclose(arm(both, "r"), arm(first, "r"), rtol=1e-12, atol=1e-12)  # the first run's right arm
+    assert not np.allclose(arm(first, "r"), arm(urdf, "r"))  # identified by it
+    np.testing.assert_allclose(arm(first, "l"), arm(urdf, "l"), rtol=1e-12, atol=1e-12)  # the left as the file had it
+    assert not np.allclose(arm(both, "l"), arm(urdf, "l"))  # then identified by the second run

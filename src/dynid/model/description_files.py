@@ -60,16 +60,22 @@ def _exportable(robot: Robot, phi: np.ndarray | None) -> Robot:
     phi = robot.standard_parameters() if phi is None else np.asarray(phi, dtype=float)
     if phi.shape != (robot.n_params,):
         raise ConfigError(f"export: expected {robot.n_params} standard parameters for robot {robot.name!r}, got {phi.shape}")
+    phi = phi.copy()
+    names = robot.parameter_names
+    tol = CONSISTENCY_TOL * max(1.0, float(np.abs(phi).max()))  # the SDP solver's round-off on its bound at 0
+    for j in range(robot.n_dof):
+        found = {term: names.index(f"{term}{j + 1}") for term in ("fc", "fv") if f"{term}{j + 1}" in names}
+        if any(phi[k] < -tol for k in found.values()):
+            fc, fv = (phi[found[t]] if t in found else 0.0 for t in ("fc", "fv"))
+            raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
+        for k in found.values():
+            phi[k] = max(phi[k], 0.0)  # -1e-11 is the solver's 0: written as 0
     fitted = robot.with_parameters(phi)
     for j, joint in enumerate(robot.joints):
         if not is_physically_consistent(fitted.inertial[j], tol=CONSISTENCY_TOL):
             rule = (physical_problems(fitted.inertial[j]) or ["a pseudo-inertia that is not positive semidefinite"])[0]
             raise ConfigError(f"export: link {j + 1} ({joint.name}): {rule}; only physically consistent parameters can be "
                               "exported (the physically consistent estimate of dynid identify is)")
-        terms = dict(zip(robot.drive_terms, fitted.drive[j]))
-        fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
-        if fc < 0 or fv < 0:
-            raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
     return fitted
 
 
