@@ -345,3 +345,13 @@ def test_a_design_keeps_the_arm_off_a_held_arms_shapes_and_says_how_close_it_com
     said = json.loads((tmp_path / "ex" / "excitation.json").read_text())["self_clearance"]
     assert abs(said["distance"] - independent) < 1e-3
     assert "the links' collision shapes stay" in " ".join(p.stdout.split())
+
+
+def test_an_excitation_table_at_the_top_of_an_identification_config_is_refused_naming_its_place(tmp_path):
+    """`[workspace]` at the top of an identification config: dynid identify refuses it, and dynid excite read past it
+    (its floor, SRDF and obstacles unused, in silence)."""
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text('robot = "ur10e"\n\n[identification]\nfile = "log.csv"\n\n[workspace]\nfloor = 0.0\n')
+    assert_refused(dynid("excite", cfg, "--out", tmp_path / "ex"),
+                   "arm.toml: workspace: an identification config holds the excitation's settings in its [excitation] "
+                   "table: [excitation.workspace]")

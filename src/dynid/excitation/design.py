@@ -210,7 +210,9 @@ class ExcitationProblem:
                 g, h = pairs[int(np.argmin(apart))]
                 raise ConfigError(f"trajectory.offsets: at the start pose (q_o = {np.round(q0, 4).tolist()} rad) the "
                                   f"collision shapes {ws.geometry.names[g]!r} and {ws.geometry.names[h]!r} touch: start "
-                                  'elsewhere, or set workspace.geometry = "capsules"')
+                                  "elsewhere; where they touch by construction (a convex hull over a housing), give the "
+                                  "robot's SRDF as workspace.srdf (its <disable_collisions> leave such pairs out); or set "
+                                  'workspace.geometry = "capsules"')
         if not ws.obstacles:
             return
         found = ws.cell_distances(self.robot, q0[None])

@@ -62,7 +62,7 @@ from ...model.description import parse_angle
 from ...model.robot import Robot
 from ...model.urdf import joints_to_hold
 from ..logs.trajectories import load_trajectory
-from .config_types import ExcitationDocument, TrajectoryTable
+from .config_types import ExcitationDocument, IdentificationDocument, TrajectoryTable
 from .configs import config_mjcf, config_robot, config_urdf, read_config
 
 DEFAULT_TRAJECTORY = {"harmonics": 5, "frequency": 0.1, "rest": True}
@@ -83,7 +83,12 @@ def _description_alone(path: Path) -> dict:
 
 
 def _from_identification(doc: dict, path: Path) -> dict:
-    """An identification config as an excitation document: its robot and its ``[excitation]`` table."""
+    """An identification config as an excitation document: its robot and its ``[excitation]`` table (an excitation
+    table at its top, which ``dynid identify`` refuses and this would leave unread, is refused naming its place)."""
+    misplaced = [k for k in doc if k in ExcitationDocument.__struct_fields__ and k not in IdentificationDocument.__struct_fields__]
+    if misplaced:
+        raise ConfigError(f"{path}: {misplaced[0]}: an identification config holds the excitation's settings in its "
+                          f"[excitation] table: [excitation.{misplaced[0]}]")
     table = doc.get("excitation", {})
     if not isinstance(table, dict):
         raise ConfigError(f"{path}: excitation: expected a table ([excitation]), got {type(table).__name__}")
