@@ -252,3 +252,33 @@ def test_the_second_arm_identified_on_the_first_arms_written_urdf_holds_both(tmp
     assert not np.allclose(arm(first, "r"), arm(urdf, "r"))  # identified by it
     np.testing.assert_allclose(arm(first, "l"), arm(urdf, "l"), rtol=1e-12, atol=1e-12)  # the left as the file had it
     assert not np.allclose(arm(both, "l"), arm(urdf, "l"))  # then identified by the second run
+
+
+def test_init_on_a_bag_of_one_arm_takes_that_arm_and_names_the_others_joints(tmp_path):
+    """ROS bags of a two-arm robot: a bag of the right arm's joints makes it the arm (init took the first arm and the
+    bag's read refused the joints it lacks); a bag of both arms takes the first and says the bag holds the other's."""
+    import sys
+
+    from dynid.dynamics.rnea import rnea_torques
+
+    from ..cli.refusals import dynid as run
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "io"))
+    from test_bags import _write_bag
+
+    urdf = _urdf(tmp_path, _two_arms(), "torso.urdf")
+    right = dynid.load_robot(urdf, held=("l1", "l2"))
+    t = np.arange(2000) / 100.0
+    w = 2 * np.pi * np.array([0.1, 0.13])
+    q, dq, ddq = 0.8 * np.sin(w * t[:, None]), 0.8 * w * np.cos(w * t[:, None]), -0.8 * w**2 * np.sin(w * t[:, None])
+    tau = rnea_torques(right, q, dq, ddq)
+    _write_bag(tmp_path / "right_bag", t + 100.0, ["r1", "r2"], q, dq, tau)
+    p = run("init", urdf, tmp_path / "right_bag", "--out", tmp_path / "right.toml")
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads((tmp_path / "right.toml").read_text())["robot"]["held"] == ["l1", "l2"]
+    both = np.hstack([q, q])
+    _write_bag(tmp_path / "both_bag", t + 100.0, ["l1", "l2", "r1", "r2"], both, np.hstack([dq, dq]), np.hstack([tau, tau]))
+    p = run("init", urdf, tmp_path / "both_bag", "--out", tmp_path / "both.toml")
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
+    assert "both_bag also holds columns of r1, r2, on another branch of torso.urdf" in " ".join(p.stdout.split())

@@ -94,7 +94,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
         said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
-                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held)]
+                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held, log)]
         said.append(_estimators_note(without, robot))
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
                        without_sdp=without), said

@@ -122,6 +122,34 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
     return np.array(stamps), signals, lambda k: f"{path}: message {k + 1} on {spec.topic}"
 
 
+def joint_state_names(path: Path, topic: str = "/joint_states") -> list[str]:
+    """The joint names of a ROS bag's first JointState message on ``topic`` (``dynid init``'s choice of the arm among
+    a robot file's branches); empty where the bag cannot be read so (reading it as a dataset then says why).
+
+    Parameters
+    ----------
+    path : Path
+        A ROS 2 bag (its folder, or its ``.mcap``/``.db3`` file) or a ROS 1 ``.bag`` file.
+    topic : str
+
+    Returns
+    -------
+    list of str
+    """
+    try:
+        require("rosbags.highlevel", "ros", f"{path}: reading a ROS bag")
+        from rosbags.highlevel import AnyReader
+
+        with AnyReader([path], default_typestore=_typestore_for(path, AnyReader)) as reader:
+            connections = [c for c in reader.connections if c.topic == topic and c.msgtype == "sensor_msgs/msg/JointState"]
+            for conn, _, raw in reader.messages(connections=connections):
+                msg: Any = reader.deserialize(raw, conn.msgtype)
+                return list(msg.name)
+    except Exception:  # noqa: BLE001 - a bag read otherwise says what is wrong with it
+        return []
+    return []
+
+
 def _typestore_for(path: Path, reader_class):
     """None for a bag that carries its message definitions (every bag since ROS 2 Iron), ROS 2 Humble's standard
     typestore for one that does not (rosbags would refuse it: "Bag contains no type definitions")."""

@@ -16,6 +16,7 @@ from tomlkit.items import InlineTable, Table
 from ...conventions import time_unit_of
 from ...exceptions import DataError
 from ..files import text_encoding_hint
+from .bags import is_bag, joint_state_names
 from .table_files import decimal_commas, is_data_line, read_table
 
 
@@ -455,7 +456,7 @@ def joints_named(log: Path, joints: tuple[str, ...]) -> set[str]:
     Parameters
     ----------
     log : Path
-        A CSV log (a ROS bag, a folder or a headerless log name no joint: the empty set).
+        A CSV log, or a ROS bag (its first JointState message's names); a headerless log names no joint.
     joints : tuple of str
         The robot file's moving joints.
 
@@ -468,7 +469,9 @@ def joints_named(log: Path, joints: tuple[str, ...]) -> set[str]:
     DataError
         A text log that cannot be read.
     """
-    if not log.is_file() or log.suffix.lower() in (".bag", ".mcap", ".db3"):
+    if is_bag(log):  # the names of its first JointState message
+        return set(joints) & set(joint_state_names(log))
+    if not log.is_file():
         return set()
     lines, delimiter, _ = _first_lines(log)
     first = _fields(lines[0], delimiter)
