@@ -199,6 +199,7 @@ def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
     one and says the other's columns are there."""
     from dynid.io.logs.columns import joints_named
 
+    from ..cli.refusals import assert_refused
     from ..cli.refusals import dynid as run
 
     urdf = _urdf(tmp_path, _two_arms(), "torso.urdf")
@@ -221,7 +222,20 @@ def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
     p = run("init", urdf, both, "--out", tmp_path / "both.toml")
     assert p.returncode == 0, p.stderr
     assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
-    assert "both.csv also holds columns of r1, r2, on another branch of torso.urdf" in " ".join(p.stdout.split())
+    said = " ".join(p.stdout.split())
+    assert "both.csv also holds columns of r1, r2, on another branch of torso.urdf" in said
+    assert "their config: dynid init torso.urdf both.csv --arm r1 --out <another config>" in said
+    p = run("init", urdf, both, "--arm", "r1", "--out", tmp_path / "other.toml")  # as the line says
+    assert p.returncode == 0, p.stderr
+    doc = tomllib.loads((tmp_path / "other.toml").read_text())
+    assert doc["robot"]["held"] == ["l1", "l2"]
+    assert doc["identification"]["positions"]["columns"] == ["r1_pos", "r2_pos"]
+    assert "also holds columns of l1, l2" in " ".join(p.stdout.split())
+    assert_refused(run("init", urdf, both, "--arm", "r3", "--out", tmp_path / "x.toml"),
+                   "--arm r3: no moving joint of torso.urdf is named so (it has l1, l2, r1, r2)")
+    single = _urdf(tmp_path, ARM, "single.urdf")
+    assert_refused(run("init", single, both, "--arm", "j1", "--out", tmp_path / "y.toml"),
+                   "--arm j1: single.urdf is one serial chain (no other arm to leave out); leave --arm out")
 
 
 def test_the_second_arm_identified_on_the_first_arms_written_urdf_holds_both(tmp_path):

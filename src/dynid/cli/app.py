@@ -772,6 +772,8 @@ def init(
                                       min=1e-9),
     xacro_arg: list[str] | None = typer.Option(None, "--xacro-arg",
                                                help="A xacro file's argument, name:=value (repeat for several)."),
+    arm: str | None = typer.Option(None, help="A joint of the arm to identify, where the robot file has several "
+                                   "(two arms): the chain holding it (default: the one whose joints the log names)."),
     quiet: bool = QUIET,
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
@@ -790,8 +792,17 @@ def init(
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
         read = (expand_xacro(urdf, args) if is_xacro(urdf) else urdf) if urdf.is_file() else None
-        held = (joints_to_hold(read, lambda names: joints_named(log, names))
-                if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read)) else ())
+        def logged(names: tuple[str, ...]) -> set[str]:
+            if arm is None:
+                return joints_named(log, names)
+            if arm not in names:
+                raise DynIdError(f"--arm {arm}: no moving joint of {urdf.name} is named so (it has {', '.join(names)})")
+            return {arm}
+
+        held = (joints_to_hold(read, logged) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read))
+                else ())
+        if arm is not None and not held:
+            raise DynIdError(f"--arm {arm}: {urdf.name} is one serial chain (no other arm to leave out); leave --arm out")
         return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
 
     def compute(robot, progress):

@@ -211,8 +211,8 @@ def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None) -> l
     logged = sorted(joints_named(log, held), key=held.index) if log is not None else []
     if log is not None and logged:
         notes.append(f"{log.name} also holds columns of {', '.join(logged)}, on another branch of {urdf.name}: dynid "
-                     "identifies one serial chain at a time; identify them with a config of their own (its [robot] "
-                     "table's held naming this arm's joints instead)")
+                     f"identifies one serial chain at a time; their config: dynid init {urdf.name} {log.name} --arm "
+                     f"{logged[0]} --out <another config>")
     return notes
 
 
