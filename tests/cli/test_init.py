@@ -121,7 +121,7 @@ def test_init_says_which_columns_it_took_and_which_it_left(tmp_path):
     assert p.returncode == 0, p.stderr
     said = " ".join(p.stdout.split())
     assert "positions: q1, q2, q3" in said
-    assert ("left: q4, q5, q6, tau4, tau5, tau6, temperature — the log has more joint columns than the robot's 3 "
+    assert ("not read: q4, q5, q6, tau4, tau5, tau6, temperature — the log has more joint columns than the robot's 3 "
             "joints (q4, q5, q6, tau4, tau5, tau6): is arm3.urdf the whole arm") in said
 
 
@@ -748,7 +748,7 @@ def test_init_takes_the_link_side_where_a_log_names_both_sides_of_the_gear(tmp_p
     assert table["positions"] == {"columns": [f"q_link_{j}" for j in range(1, 7)]}
     assert table["torques"]["columns"] == [f"tau_link_{j}" for j in range(1, 7)] and "side" not in table["torques"]
     said = " ".join((p.stdout + p.stderr).split())
-    assert "positions also in the log, left: q_mot_1…q_mot_6" in said and "tau_mot_1…tau_mot_6" in said
+    assert "positions also in the log, not read: q_mot_1…q_mot_6" in said and "tau_mot_1…tau_mot_6" in said
     assert "units assumed: positions in rad, torques in N·m" in said  # no unit in the names
 
 

@@ -95,10 +95,10 @@ def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *
     left = [c for c in first if c not in taken + signals]
     extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
     if extra:
-        notes.append(f"left: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
+        notes.append(f"not read: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
                      f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
     elif left:
-        notes.append(f"left: {', '.join(left)}")
+        notes.append(f"not read: {', '.join(left)}")
     return notes + ([_assumed_units(assumed)] if assumed else [])
 
 
@@ -320,7 +320,7 @@ def _one_group_each(found: dict, log: Path, separators: tuple[str, str], n_dof: 
         found[kind] = chosen
         left = [f"{g[0]}…{g[-1]}" + (f" ({', '.join(c for c in g if c in dead)} read one value throughout)"
                                      if any(c in dead for c in g) else "") for g in complete if g is not chosen]
-        notes.append(f"{kind} also in the log, left: {'; '.join(left)} (give their columns to take them)")
+        notes.append(f"{kind} also in the log, not read: {'; '.join(left)} (give their columns to take them)")
         passed += [c for g in complete if g is not chosen for c in g]
     return notes, passed
 
