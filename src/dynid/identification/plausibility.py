@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..conventions import split_name
-from ..estimators.physically_consistent import CONSISTENCY_TOL
+from ..estimators.physically_consistent import margin_is_consistent
 from ..validation.diagnostics import Finding
 
 __all__ = ["drive_term_findings"]
@@ -41,12 +41,11 @@ def drive_term_findings(label: str, names, values) -> list[Finding]:
     """
     out = []
     values = np.asarray(values, dtype=float)
-    tol = CONSISTENCY_TOL * max(1.0, float(np.abs(values).max(initial=0.0)))  # a solver's 0 is no negative friction
     for name, value in zip(names, values):
         if not name[-1:].isdigit():
             continue
         term, j = split_name(name)
-        if term in ("fv", "fc") and value < -tol:
+        if term in ("fv", "fc") and not margin_is_consistent(value, values):  # a solver's 0 is no negative friction
             what = "viscous" if term == "fv" else "Coulomb"
             out.append(Finding("drive", (
                 f"{label}: J{j + 1}'s {what} friction {name} = {value:.3g} is negative: no friction is; the log does not "
