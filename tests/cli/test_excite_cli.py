@@ -355,3 +355,24 @@ def test_an_excitation_table_at_the_top_of_an_identification_config_is_refused_n
     assert_refused(dynid("excite", cfg, "--out", tmp_path / "ex"),
                    "arm.toml: workspace: an identification config holds the excitation's settings in its [excitation] "
                    "table: [excitation.workspace]")
+
+
+def test_held_links_left_unchecked_when_the_shapes_do_not_load_are_said(tmp_path):
+    """The two-arm torso whose held arm's collision mesh is not beside the URDF: the shapes cannot be read, the design
+    falls back to capsules about the moving arm's joint origins, and the held arm is in no check. That was said
+    nowhere (the capsule warning came only with a floor or obstacles); a warning names the held joints now, and with
+    the shapes readable it is not printed."""
+    _two_arm_torso(tmp_path / "torso.urdf")
+    text = (tmp_path / "torso.urdf").read_text()
+    (tmp_path / "torso.urdf").write_text(text.replace('<box size="0.6 0.8 0.05"/>', '<mesh filename="plate.stl"/>'))
+    (tmp_path / "excite.toml").write_text('[robot]\nurdf = "torso.urdf"\nheld = ["l1", "l2"]\n\n'
+                                          '[trajectory]\nharmonics = 2\nfrequency = 0.2\n[design]\nmaxiter = 20\n')
+    p = dynid("excite", tmp_path / "excite.toml", "--out", tmp_path / "ex", "--starts", "1", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    said = " ".join((p.stdout + p.stderr).split())
+    assert "warning: the robot file has no collision shapes dynid could read: the held joints' links (l1, l2" in said, said
+    assert "the links' collision shapes stay" not in said
+    (tmp_path / "torso.urdf").write_text(text)
+    p = dynid("excite", tmp_path / "excite.toml", "--out", tmp_path / "ok", "--starts", "1", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "held joints' links" not in " ".join((p.stdout + p.stderr).split())

@@ -225,18 +225,27 @@ def _self_clearance_lines(run) -> list:
 
 
 def _shapes_lines(run) -> list:
-    """:func:`excitation_blocks`' warning where the floor's and the cell's distances are measured on estimated capsules
-    (the robot file has no collision shapes that load, and no ``[workspace] link_radius``)."""
+    """:func:`excitation_blocks`' warning where the robot file's collision shapes did not load: the floor's and the
+    cell's distances are then measured on estimated capsules (unless ``[workspace] link_radius`` is given), and the
+    links of held joints (another arm, a head) are in no check at all."""
     ws = run.config.problem.workspace
-    if ws.geometry is not None or ws.link_radius is not None or not (ws.obstacles or math.isfinite(ws.floor)):
+    held = getattr(run.config.problem.robot, "held", ())
+    capsules = ws.link_radius is None and bool(ws.obstacles or math.isfinite(ws.floor))
+    if ws.geometry is not None or not (held or capsules):
         return []
     from ..excitation.link_geometry import LINK_RADIUS_SHARE  # coal's import stays out of a summary's
 
-    r = ws.capsule_radius(run.config.problem.robot)
-    return [Line(f"the robot file has no collision shapes dynid could read: the floor and the cell are kept off capsules "
-                 f"of radius {r:.3g} m about the joint origins, an estimate ({100 * LINK_RADIUS_SHARE:g} % of the arm's "
-                 "reach) that a hand, a gripper or a wide housing can exceed; give [workspace] link_radius, or a URDF "
-                 "with <collision> shapes and its meshes", "warning")]
+    said = ["the robot file has no collision shapes dynid could read"]
+    if capsules:
+        r = ws.capsule_radius(run.config.problem.robot)
+        said.append(f"the floor and the cell are kept off capsules of radius {r:.3g} m about the joint origins, an "
+                    f"estimate ({100 * LINK_RADIUS_SHARE:g} % of the arm's reach) that a hand, a gripper or a wide "
+                    "housing can exceed; give [workspace] link_radius, or a URDF with <collision> shapes and its meshes")
+    if held:
+        said.append(f"the held joints' links ({', '.join(held)}: another arm, a head, a gripper) are in no clearance "
+                    'check; set [workspace] geometry = "collision" to see which mesh fails, give it beside the URDF, '
+                    "and design again")
+    return [Line(": ".join(said[:2]) + "".join(f"; {x}" for x in said[2:]), "warning")]
 
 
 def _floor_lines(run) -> list:
