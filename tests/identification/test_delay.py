@@ -82,6 +82,7 @@ def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
     from dynid.identification.pipeline import IdentificationPipeline
     from dynid.identification.run import run_identification
     from dynid.io.config.identification_config import load_identification_config
+    from dynid.runtime.processes import allow_forks, can_fork
     from tests.conftest import shared_data
 
     robot = dynid.load_robot("ur10e")
@@ -92,6 +93,11 @@ def test_a_delay_is_proposed_only_where_the_validation_logs_agree(tmp_path):
     weighed = result.diagnostics["torque_delay"]["validation"]
     assert weighed["with"] * 1.02 < weighed["without"] and "identify again with it: the validation logs agree" in found
     assert f"{weighed['with']:.3g} % against {weighed['without']:.3g} %" in found
+    with allow_forks():  # the CLI's way: the second identification on the second core, the same figures
+        assert can_fork()
+        forked = IdentificationPipeline(robot, estimators=("ols",)).fit(ident, validation=(check,))
+    assert forked.diagnostics["torque_delay"] == result.diagnostics["torque_delay"]
+    assert [f.text for f in forked.findings] == [f.text for f in result.findings]
 
     repo = Path(__file__).resolve().parents[2]
     text = (repo / "configs" / "kuka_med7.toml").read_text().replace('robot = "robots/', f'robot = "{repo}/configs/robots/')

@@ -394,7 +394,7 @@ class IdentificationPipeline:
             ``drive_gains(robot, base)`` for the prepared model, computed on the second core while the estimators run,
             its value the result's ``drive_gains``.
         weigh_delay : bool
-            With validation logs, weigh a delay finding on them (:meth:`_delay_weighed`: the log identified again with
+            With validation logs, weigh a delay finding on them (:func:`_delay_weighed`: the log identified again with
             the delay); default true.
         file_variants : bool
             With validation logs, choose what the written files hold of each estimate
@@ -424,44 +424,56 @@ class IdentificationPipeline:
                 if step is not None:
                     step("drive gains and payload")
                 result = replace(result, drive_gains=beside.result())
-        evidence = (gather_evidence(self, prepared, result, validation, reference=reference, progress=progress, file_variants=file_variants)
-                    if validation else None)
-        result = decide(result, evidence)
-        if validation and weigh_delay and any(f.kind == "delay" for f in result.findings):
-            result = self._delay_weighed(result, prepared, recording, validation, step)
+        # a delay finding is weighed by identifying the log again with it (:func:`_delay_weighed`), on the second core
+        # while this one gathers the first identification's evidence; the verdict never adds or removes the finding
+        weigh = bool(validation) and weigh_delay and any(f.kind == "delay" for f in result.findings)
+        again = ForkedCall(self._identified_again, result, prepared, recording, validation) if weigh else None
+        with again or contextlib.nullcontext():
+            evidence = (gather_evidence(self, prepared, result, validation, reference=reference, progress=progress,
+                                        file_variants=file_variants) if validation else None)
+            result = decide(result, evidence)
+            if again is not None:
+                if step is not None:
+                    step("the delay found, weighed on the validation logs")
+                result = _delay_weighed(result, *again.result())
         return replace(result, findings=tuple(result.findings) + smooth)
 
-    def _delay_weighed(self, result, prepared, recording, validation: tuple, step):
-        """The delay finding kept where the validation logs agree, withdrawn otherwise: the log identified again with its
-        torques read at the delay found (every validation log's too), and the main estimate's mean error over the
-        logs that move on the one yardstick compared, better by more than
-        :data:`~dynid.identification.verdict.SAME_FIGURE` to keep it (issue "Every assurance checked on what the user
-        meets", item 5): held-out blocks of the log favoured the delays the real UR10e's and LBR Med7's logs show,
-        which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). The figures are in
-        ``diagnostics["torque_delay"]``.
+    def _identified_again(self, result, prepared, recording, validation: tuple) -> tuple[float, str]:
+        """The log identified again with its torques read at the delay ``result`` found (every validation log's too):
+        the main estimate's mean error over the validation logs that move on the one yardstick, and its name.
 
         The second identification keeps the first's choices (its cutoffs, the friction model of each joint: the
         prepared robot as the description), so that the delay alone differs, and checks no delay of its own."""
-        if step is not None:
-            step("the delay found, weighed on the validation logs")
         delay, s = result.diagnostics["torque_delay"], prepared.data.settings
         fixed = replace(self.preprocessing, torque_delay=self.preprocessing.torque_delay + delay["seconds"], auto=False,
                         position_cutoff=s.position_cutoff, velocity_cutoff=s.velocity_cutoff,
                         parallel_cutoff=s.parallel_cutoff, decimation=s.decimation)
         again = replace(self, robot=prepared.robot, friction="description", preprocessing=fixed)
         other = again.fit(recording, validation=validation, weigh_delay=False, file_variants=False)
+        return _yardstick_mean(other), other.main
 
-        def mean(r) -> float:
-            return float(weighed_means(r.diagnostics["yardstick"])[r.main])
 
-        figures = {"without": mean(result), "with": mean(other), "main_with": other.main}
-        kept = figures["with"] * SAME_FIGURE < figures["without"]
-        said = (f"identify again with it: the validation logs agree (the main estimate so, {other.main}, predicts them "
-                f"{figures['with']:.3g} % against {figures['without']:.3g} %, on one yardstick)")
-        findings = tuple(replace(f, text=f.text.replace(DELAY_ADVICE, said)) if f.kind == "delay" else f
-                         for f in result.findings if kept or f.kind != "delay")
-        return replace(result, findings=findings,
-                       diagnostics={**result.diagnostics, "torque_delay": {**delay, "validation": figures}})
+def _yardstick_mean(result) -> float:
+    """The main estimate's mean error over the validation logs that move, on the one yardstick [%]."""
+    return float(weighed_means(result.diagnostics["yardstick"])[result.main])
+
+
+def _delay_weighed(result, with_delay: float, main_with: str):
+    """The delay finding kept where the validation logs agree, withdrawn otherwise: the main estimate's mean error on
+    the one yardstick with the delay (``with_delay``, :meth:`IdentificationPipeline._identified_again`) and without,
+    better by more than :data:`~dynid.identification.verdict.SAME_FIGURE` to keep it (issue "Every assurance checked on
+    what the user meets", item 5): held-out blocks of the log favoured the delays the real UR10e's and LBR Med7's logs
+    show, which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). The figures are in
+    ``diagnostics["torque_delay"]``."""
+    delay = result.diagnostics["torque_delay"]
+    figures = {"without": _yardstick_mean(result), "with": with_delay, "main_with": main_with}
+    kept = figures["with"] * SAME_FIGURE < figures["without"]
+    said = (f"identify again with it: the validation logs agree (the main estimate so, {main_with}, predicts them "
+            f"{figures['with']:.3g} % against {figures['without']:.3g} %, on one yardstick)")
+    findings = tuple(replace(f, text=f.text.replace(DELAY_ADVICE, said)) if f.kind == "delay" else f
+                     for f in result.findings if kept or f.kind != "delay")
+    return replace(result, findings=findings,
+                   diagnostics={**result.diagnostics, "torque_delay": {**delay, "validation": figures}})
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:
