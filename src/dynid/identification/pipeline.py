@@ -466,10 +466,11 @@ def _delay_weighed(result, with_delay: float, main_with: str):
     show, which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). The figures are in
     ``diagnostics["torque_delay"]``."""
     delay = result.diagnostics["torque_delay"]
-    figures = {"without": _yardstick_mean(result), "with": with_delay, "main_with": main_with}
-    kept = figures["with"] * SAME_FIGURE < figures["without"]
+    without = _yardstick_mean(result)
+    figures = {"without": without, "with": with_delay, "main_with": main_with}
+    kept = with_delay * SAME_FIGURE < without
     said = (f"identify again with it: the validation logs agree (the main estimate so, {main_with}, predicts them "
-            f"{figures['with']:.3g} % against {figures['without']:.3g} %, on one yardstick)")
+            f"{with_delay:.3g} % against {without:.3g} %, on one yardstick)")
     findings = tuple(replace(f, text=f.text.replace(DELAY_ADVICE, said)) if f.kind == "delay" else f
                      for f in result.findings if kept or f.kind != "delay")
     return replace(result, findings=findings,
