@@ -312,13 +312,27 @@ def test_bad_montecarlo_options(tmp_path, case):
     assert_refused(invoke("montecarlo", "--out", out, "--duration", "2", "--realisations", "2", *args), message, out)
 
 
-@pytest.fixture()
-def identified(ur):
-    """A config and the results.json of a successful identification."""
-    cfg = ur(config_extra="[[validation]]\nname = \"same\"\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n")
-    result = invoke("identify", cfg, "--out", ur.folder / "id", "--no-figures", "--no-validate")
+@pytest.fixture(scope="module")
+def identified_once(tmp_path_factory):
+    """The folder of one successful identification (log.csv, c.toml, id/results.json), run once for the module's
+    tests, which each take a copy (:func:`identified`)."""
+    folder = tmp_path_factory.mktemp("identified")
+    _write_log(folder / "log.csv", GOOD)
+    cfg = folder / "c.toml"
+    cfg.write_text(CONFIG + "[[validation]]\nname = \"same\"\npreset = \"ur-rtde\"\nfile = \"log.csv\"\n")
+    result = invoke("identify", cfg, "--out", folder / "id", "--no-figures", "--no-validate")
     assert result.exit_code == 0, result.stderr
-    return cfg, ur.folder / "id" / "results.json"
+    return folder
+
+
+@pytest.fixture()
+def identified(identified_once, tmp_path):
+    """A config and the results.json of a successful identification, in this test's own folder."""
+    import shutil
+
+    folder = tmp_path / "ur"
+    shutil.copytree(identified_once, folder)
+    return folder / "c.toml", folder / "id" / "results.json"
 
 
 def test_validate_and_export_refusals(identified, tmp_path):
