@@ -372,6 +372,9 @@ def test_held_links_left_unchecked_when_the_shapes_do_not_load_are_said(tmp_path
     said = " ".join((p.stdout + p.stderr).split())
     assert "warning: the robot file has no collision shapes dynid could read: the held joints' links (l1, l2" in said, said
     assert "the links' collision shapes stay" not in said
+    written = json.loads((tmp_path / "ex" / "excitation.json").read_text())["warnings"]  # and so say the files
+    assert any("the held joints' links (l1, l2" in w for w in written)
+    assert "the held joints&#39; links (l1, l2" in (tmp_path / "ex" / "report.html").read_text()
     (tmp_path / "torso.urdf").write_text(text)
     p = dynid("excite", tmp_path / "excite.toml", "--out", tmp_path / "ok", "--starts", "1", cwd=tmp_path)
     assert p.returncode == 0, p.stderr

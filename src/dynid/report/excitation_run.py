@@ -11,7 +11,9 @@ from ..dynamics.regressor import regressor
 from ..excitation.floor import FloorDistances
 from ..identification.excite import ExcitationRun
 from ..io.logs.trajectories import write_trajectory_csv
+from ..tables import Line
 from . import figures
+from .excitation_summary import excitation_blocks
 from .html import write_html_report
 from .output import save_animation, save_figure, staged, write_results
 
@@ -68,7 +70,10 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
     # the controller's angles: the encoders' zeros where the description sets position offsets (excitation_summary)
     write_trajectory_csv(csv_path, run.t, robot.transmission.logged_positions(run.q), run.dq, run.ddq)
     json_path = out / "excitation.json"
-    data = run.to_dict()
+    # the terminal's warnings below its verdict line (the floor, the cell, the links' shapes, the held links, the
+    # start) in the file and the report too: what a user reads later says what the terminal said
+    data = {**run.to_dict(), "warnings": [line.text for line in excitation_blocks(run, tables=False)[1:]
+                                          if isinstance(line, Line) and line.kind == "warning"]}
     write_results(json_path, data, "excite")
     write_html_report(out / "report.html", data, "excite", paths, f"dynid excite — {robot.name}")
     moving = [_animation(run, out / ANIMATION)] if animation else []
