@@ -15,7 +15,7 @@ from __future__ import annotations
 def warm_up() -> None:
     """Compile the regressors of the built-in robots (their SIMD code, and numba's kernel), then run a 2 s,
     200 Hz paper experiment with every estimator (2 ABC iterations, 2 bootstrap resamples), and compile the recursive
-    least squares of ``dynid monitor`` and the closed-loop simulator's steps."""
+    least squares of ``dynid monitor``, the closed-loop simulator's steps and a long log's parallel filter."""
     from .dynamics import regressor
     from .model.description import load_robot
 
@@ -33,6 +33,12 @@ def warm_up() -> None:
 
     t = np.arange(10) / 1000.0  # the closed-loop simulator's steps (IDIM-IV, DIDIM)
     simulate_closed_loop(er16, t, np.zeros((10, 6)), np.zeros((10, 6)), Controller.for_robot(er16))
+    from scipy import signal
+
+    from .preprocessing._filter_kernel import zero_phase
+
+    sos = signal.butter(4, 0.1, output="sos")  # a long log's parallel filter
+    zero_phase(sos, np.ones((20, 3)), 5, signal.sosfilt_zi(sos))
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ import numpy as np
 from .._util.column_store import by_column
 from ..exceptions import ConfigError
 from ..runtime.threads import cores
+from ._filter_kernel import zero_phase
 from .bands import decimation_cutoff
 
 
@@ -148,6 +149,14 @@ COLUMN_BLOCK = 2
 temporary copies: 16 rather than 64 took 33 MB off the TX40 identification's peak, 8 rather than 16 another 4 MB; on
 two cores' threads blocks of 2 keep the peak 3 MB above one thread's blocks of 8, blocks of 4 7 MB). Each column is
 filtered on its own, so the numbers do not depend on the blocks or the cores."""
+
+COMPILED_FILTER_VALUES = 50_000_000
+"""From this many values (the log's samples × a chunk's live columns) on, :func:`parallel_decimation` filters with the
+compiled filter (:mod:`dynid.preprocessing._filter_kernel`, SciPy's numbers bit for bit): an hour at 1 kHz. Below it,
+SciPy's ``sosfiltfilt``, and the process never loads numba."""
+
+COMPILED_COLUMN_BLOCK = 16
+"""Columns the compiled filter takes at once (it runs along a row's columns, so more than :data:`COLUMN_BLOCK`)."""
 
 PARALLEL_VALUES = 200_000
 """From this many values (samples × columns to filter) on, :func:`parallel_decimation` filters its column blocks on
@@ -296,6 +305,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     _check_cutoff(rate, cutoff, "parallel filter")
     signal = _signal()
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    zi = signal.sosfilt_zi(sos)
     margin = int(np.ceil(10 * order * 0.4 * rate / cutoff))  # the filter's transient, as 10·factor·order at the decimation's cutoff
     for start in range(0, n_samples, chunk):
         stop = min(start + chunk, n_samples)
@@ -311,11 +321,15 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
             # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a
             # regressor has many (joint i does not see the links before it), so only the others are filtered.
             live = np.flatnonzero(np.any(flat, axis=0))  # no (samples, columns) temporary: any() casts by buffers
+            # a long log's columns through the compiled filter (the same numbers as SciPy's, bit for bit)
+            fast = n_samples * live.size >= COMPILED_FILTER_VALUES
+            width = COMPILED_COLUMN_BLOCK if fast else COLUMN_BLOCK
 
             def one(cols):  # a column block: the filter's copies stay small; blocks write disjoint columns of out
-                out[:, cols] = signal.sosfiltfilt(sos, flat[:, cols], axis=0, padtype="even", padlen=padlen)[index - lo]
+                out[:, cols] = (zero_phase(sos, flat, padlen, zi, cols, index - lo) if fast else
+                                signal.sosfiltfilt(sos, flat[:, cols], axis=0, padtype="even", padlen=padlen)[index - lo])
 
-            _on_cores(one, [live[c:c + COLUMN_BLOCK] for c in range(0, live.size, COLUMN_BLOCK)],
+            _on_cores(one, [live[c:c + width] for c in range(0, live.size, width)],
                       flat.shape[0] * live.size >= PARALLEL_VALUES)
             return out.reshape((index.size,) + v.shape[1:])
 

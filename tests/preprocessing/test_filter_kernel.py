@@ -1,0 +1,48 @@
+"""The compiled zero-phase filter of the parallel decimation against SciPy's ``sosfiltfilt``: the same numbers bit for
+bit (an independent implementation: SciPy's own), whatever the order, cutoff, padding, columns and values."""
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from dynid.preprocessing._filter_kernel import zero_phase
+
+
+@pytest.mark.parametrize(("order", "cutoff", "rate", "n", "c", "padlen"),
+                         [(4, 20.0, 1000.0, 3000, 7, 300), (2, 5.0, 250.0, 800, 1, 0), (6, 40.0, 500.0, 1200, 33, 1199),
+                          (4, 1.0, 1000.0, 5000, 16, 2600)])
+def test_the_compiled_filter_is_scipys_sosfiltfilt_bit_for_bit(order, cutoff, rate, n, c, padlen):
+    rng = np.random.default_rng(order + c)
+    x = rng.standard_normal((n, c)) * np.logspace(-6, 4, c) + np.linspace(0, 50, n)[:, None]
+    x[:, 0] = 0.0 if c > 2 else x[:, 0]  # a dead column stays zero
+    sos = signal.butter(order, cutoff, fs=rate, output="sos")
+    expected = signal.sosfiltfilt(sos, x, axis=0, padtype="even", padlen=padlen)
+    got = zero_phase(sos, x, padlen, signal.sosfilt_zi(sos))
+    assert got.shape == expected.shape
+    assert np.array_equal(got, expected)
+    assert not np.array_equal(got, x)  # it filtered
+    cols, rows = np.array([c - 1, 0]), np.array([0, n // 2, n - 1])  # columns read in place, rows picked
+    assert np.array_equal(zero_phase(sos, x, padlen, signal.sosfilt_zi(sos), cols, rows), expected[rows][:, cols])
+
+
+def test_the_parallel_decimation_of_a_long_log_is_the_same_through_either_filter(monkeypatch):
+    """The compiled filter takes over from the log's length (:data:`COMPILED_FILTER_VALUES`): chunk by chunk, with
+    their margins and the log's padded ends, the kept samples are SciPy's to the last bit."""
+    from dynid.preprocessing import filters
+
+    rng = np.random.default_rng(5)
+    x = np.cumsum(rng.standard_normal((9000, 12)), axis=0)
+    x[:, 3] = 0.0
+
+    def run():
+        return [(i.copy(), v.copy()) for i, v in filters.parallel_decimation(lambda a, b: x[a:b], 9000, 500.0, 5,
+                                                                             chunk=2000)]
+
+    monkeypatch.setattr(filters, "COMPILED_FILTER_VALUES", 10**12)
+    scipys = run()
+    monkeypatch.setattr(filters, "COMPILED_FILTER_VALUES", 0)
+    compiled = run()
+    assert len(scipys) == len(compiled) == 5
+    for (i, a), (j, b) in zip(scipys, compiled):
+        assert np.array_equal(i, j) and np.array_equal(a, b)
+    assert np.all(np.concatenate([v for _, v in compiled])[:, 3] == 0.0) and np.ptp(compiled[0][1][:, 0]) > 0
