@@ -47,6 +47,7 @@ def _extended(x, cols, padlen, ext):  # pragma: no cover - compiled
 
 
 sections = extended = None
+_kernels = None  # the pair, set at once: two threads may ask for it together
 
 
 def compiled():
@@ -58,13 +59,15 @@ def compiled():
     tuple
         ``(sections, extended)``: ``sections(sos, x, z0, z1, reverse)``, ``extended(x, cols, padlen, ext)``.
     """
-    global sections, extended
-    if sections is None:
+    global sections, extended, _kernels
+    if _kernels is None:
         import numba
 
         jit = numba.njit(cache=True, nogil=True)
-        sections, extended = jit(_sections), jit(_extended)
-    return sections, extended
+        pair = (jit(_sections), jit(_extended))
+        sections, extended = pair
+        _kernels = pair
+    return _kernels
 
 
 def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols: np.ndarray | None = None,
