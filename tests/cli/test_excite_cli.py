@@ -370,7 +370,8 @@ def test_held_links_left_unchecked_when_the_shapes_do_not_load_are_said(tmp_path
     p = dynid("excite", tmp_path / "excite.toml", "--out", tmp_path / "ex", "--starts", "1", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     said = " ".join((p.stdout + p.stderr).split())
-    assert "warning: the robot file has no collision shapes dynid could read: the held joints' links (l1, l2" in said, said
+    assert "warning: the robot file has no collision shapes dynid could read" in said and "Mesh plate.stl could not be found" in said
+    assert "the held joints' links (l1, l2: another arm, a head, a gripper) are in no clearance check" in said, said
     assert "the links' collision shapes stay" not in said
     written = json.loads((tmp_path / "ex" / "excitation.json").read_text())["warnings"]  # and so say the files
     assert any("the held joints' links (l1, l2" in w for w in written)

@@ -57,6 +57,9 @@ class Workspace:
     link_radius : float or None [m]
         The capsules' radius without :attr:`geometry`; None (default): estimated,
         :func:`~dynid.excitation.link_geometry.estimated_link_radius` (said as an estimate).
+    unread : str
+        Why the robot file's collision shapes were not read, where it names some that do not load (a mesh missing
+        beside the URDF); "" otherwise.
     made : dict
         The capsules :meth:`shapes` made, per robot (not compared).
     avoid_self_collision : bool or None
@@ -74,6 +77,7 @@ class Workspace:
     geometry: LinkGeometry | None = None
     avoid_self_collision: bool | None = None
     link_radius: float | None = None
+    unread: str = ""
     made: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:

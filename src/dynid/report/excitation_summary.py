@@ -235,7 +235,7 @@ def _shapes_lines(run) -> list:
         return []
     from ..excitation.link_geometry import LINK_RADIUS_SHARE  # coal's import stays out of a summary's
 
-    said = ["the robot file has no collision shapes dynid could read"]
+    said = ["the robot file has no collision shapes dynid could read" + (f" ({ws.unread})" if ws.unread else "")]
     if capsules:
         r = ws.capsule_radius(run.config.problem.robot)
         said.append(f"the floor and the cell are kept off capsules of radius {r:.3g} m about the joint origins, an "
@@ -243,8 +243,7 @@ def _shapes_lines(run) -> list:
                     "housing can exceed; give [workspace] link_radius, or a URDF with <collision> shapes and its meshes")
     if held:
         said.append(f"the held joints' links ({', '.join(held)}: another arm, a head, a gripper) are in no clearance "
-                    'check; set [workspace] geometry = "collision" to see which mesh fails, give it beside the URDF, '
-                    "and design again")
+                    "check; give the robot file's meshes beside it, and design again")
     return [Line(": ".join(said[:2]) + "".join(f"; {x}" for x in said[2:]), "warning")]
 
 

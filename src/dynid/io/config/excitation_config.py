@@ -97,29 +97,30 @@ def _from_identification(doc: dict, path: Path) -> dict:
 
 def _link_geometry(setting: str, robot, urdf: Path | None, mjcf: Path | None = None, srdf: Path | None = None):
     """``[workspace] geometry``: the URDF's collision shapes (:func:`link_geometry_from_urdf`, less ``srdf``'s
-    disabled pairs) or the MJCF's collision geoms (:func:`link_geometry_from_mjcf`), or None (capsules). "auto" takes
-    them where the robot's file has them and they load; "collision" insists."""
+    disabled pairs) or the MJCF's collision geoms (:func:`link_geometry_from_mjcf`), or None (capsules), and why they
+    were not read ("" where they were, or where the file has none). "auto" takes them where the robot's file has them
+    and they load; "collision" insists."""
     if srdf is not None and (urdf is None or setting == "capsules"):
         raise ConfigError(f"workspace.srdf = {str(srdf)!r}: an SRDF names pairs of a URDF's collision shapes, but "
                           + ("the robot is not read from a URDF" if urdf is None else
                              'workspace.geometry = "capsules" leaves them out'))
     file = urdf or mjcf
     if setting == "capsules" or (file is None and setting == "auto"):
-        return None
+        return None, ""
     if file is None:
         raise ConfigError('workspace.geometry = "collision" needs a robot read from a URDF with <collision> elements '
                           "or an MJCF with colliding geoms, and [[workspace.obstacles]] to keep them off")
     try:
         found = link_geometry_from_urdf(robot, file, srdf) if urdf is not None else link_geometry_from_mjcf(robot, file)
-    except ConfigError:
+    except ConfigError as exc:
         if setting == "auto" and srdf is None:
-            return None
+            return None, str(exc).split("; ")[0]  # what failed, without the advice for a config that insists
         raise
     if found is None and setting == "collision":
         raise ConfigError(f'workspace.geometry = "collision": {file} has no '
                           + ("<collision> element" if urdf is not None else "colliding geom (contype or conaffinity "
                              "not 0)") + " on a moving link")
-    return found
+    return found, ""
 
 
 @dataclass(frozen=True)
@@ -270,8 +271,9 @@ def _workspace(ws, doc: dict, path: Path, robot) -> Workspace:
         if srdf is not None and not shaped:
             raise ConfigError(f"workspace.srdf = {ws.srdf!r}: the links' own shapes are kept apart only where a floor, "
                               "[[workspace.obstacles]] or held joints are given (without them the links are capsules)")
-        ws_kw["geometry"] = (_link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path),
-                                            srdf) if shaped else _link_geometry(ws.geometry or "auto", robot, None))
+        ws_kw["geometry"], ws_kw["unread"] = (
+            _link_geometry(ws.geometry or "auto", robot, config_urdf(doc, path), config_mjcf(doc, path), srdf) if shaped
+            else _link_geometry(ws.geometry or "auto", robot, None))
         return Workspace(**ws_kw)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
