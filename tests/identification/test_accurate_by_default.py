@@ -88,3 +88,18 @@ def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path)
     assert "coulomb_cross_validation" in result.settings
     m = result.validations[0].metrics()
     assert m["dynid OLS"]["global_relative_error"] <= 1.2 * m["truth"]["global_relative_error"]
+    # the candidates after the first are prepared and scored in forked children where the CLI allows it: the same
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.cross_validation import choose_preprocessing
+    from dynid.io.logs.datasets import load_recording
+    from dynid.runtime.processes import allow_forks, can_fork
+
+    config = load_identification_config(cfg)
+    recording, base = load_recording(config.identification, config.robot), base_parameters(config.robot)
+    here = choose_preprocessing(config.robot, base, recording, config.preprocessing)
+    with allow_forks():
+        assert can_fork()
+        forked = choose_preprocessing(config.robot, base, recording, config.preprocessing)
+    assert len(forked.candidates) == 3 and forked.candidates == here.candidates and forked.note == here.note
+    assert np.array_equal(forked.error, here.error) and np.array_equal(forked.score, here.score)
+    assert np.array_equal(forked.data.tau, here.data.tau) and np.array_equal(forked.data.ddq, here.data.ddq)

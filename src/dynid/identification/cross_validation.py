@@ -15,6 +15,7 @@ cannot look better by filtering its own test samples more.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -29,6 +30,7 @@ from ..model.robot import Robot
 from ..preprocessing.bands import POSITION_FACTOR, capped
 from ..preprocessing.preparation import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
+from ..runtime.processes import ForkedCall
 
 COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
 """Candidate smoothing velocities, as fractions of each joint's RMS speed (0: sign)."""
@@ -208,6 +210,24 @@ class PreprocessingChoice:
                 "out_of_fold_rms_error": self.error, "score": self.score}
 
 
+def _candidate(robot, base, recording, settings: Preprocessing, evaluation: list, prior: np.ndarray, duration: float,
+               folds: int) -> tuple[PreparedData, np.ndarray]:
+    """One candidate of :func:`choose_preprocessing`: the log prepared with ``settings``, and each joint's RMS error
+    over the folds of the parameters fitted on the other folds (``inf`` where a fold's complement does not determine
+    them), scored on ``evaluation``'s rows."""
+    data = prepare(recording, settings)
+    fitted, _ = _fold_accumulators(robot, base, data, duration, folds)
+    sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
+    try:
+        for k in range(folds):
+            params = LeastSquaresAccumulator.merged([a for i, a in enumerate(fitted) if i != k]).solve(prior=prior).params
+            sumsq += evaluation[k].joint_residual_sumsq(params)
+            rows += evaluation[k].rows
+    except IdentifiabilityError:
+        return data, np.full(robot.n_dof, np.inf)
+    return data, np.sqrt(sumsq / np.maximum(rows, 1))
+
+
 def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: int):
     """One accumulator per block of ``duration / folds`` seconds (blocks by time, so that candidates trimmed
     differently share their block boundaries), and each joint's RMS torque."""
@@ -271,26 +291,25 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
     prior = base.base_from_standard(robot.standard_parameters())  # as the estimate: undetermined directions kept there
+    settings = [replace(given, position_cutoff=given.position_cutoff if given.position_cutoff is not None else cutoff,
+                        parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else cutoff)
+                for cutoff in (capped(f, recording.rate) for f in cutoffs)]
+    # the candidates after the first on the second core (forked children) where the log is in memory; the same numbers
+    stored = any(x is not None and not isinstance(x, np.ndarray) for x in (recording.q, recording.dq, recording.tau))
+    beside = [None if stored else ForkedCall(_candidate, robot, base, recording, s, evaluation, prior, duration, folds)
+              for s in settings[1:]]
     candidates, errors, prepared = [], [], []
-    for f in cutoffs:
-        cutoff = capped(f, recording.rate)
-        settings = replace(given,
-                           position_cutoff=given.position_cutoff if given.position_cutoff is not None else cutoff,
-                           parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else cutoff)
-        data = prepare(recording, settings)
-        fitted, _ = _fold_accumulators(robot, base, data, duration, folds)
-        sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
-        try:
-            for k in range(folds):
-                params = LeastSquaresAccumulator.merged([a for i, a in enumerate(fitted) if i != k]).solve(prior=prior).params
-                sumsq += evaluation[k].joint_residual_sumsq(params)
-                rows += evaluation[k].rows
-            errors.append(np.sqrt(sumsq / np.maximum(rows, 1)))
-        except IdentifiabilityError:
-            errors.append(np.full(robot.n_dof, np.inf))
-        candidates.append(data.settings)
-        prepared.append(data)
-        said(1 + len(prepared), steps)
+    with contextlib.ExitStack() as stack:
+        for call in beside:
+            if call is not None:
+                stack.enter_context(call)
+        for s, call in zip(settings, [None, *beside]):
+            data, error = (_candidate(robot, base, recording, s, evaluation, prior, duration, folds) if call is None
+                           else call.result())
+            candidates.append(data.settings)
+            prepared.append(data)
+            errors.append(error)
+            said(1 + len(prepared), steps)
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
     scored = bool(np.all(np.isfinite(score)))
