@@ -373,7 +373,8 @@ def excite_sections(d: dict) -> tuple[dict, list[Section]]:
     notes = [f"{g['nit']} iterations, {g['nfev']} evaluations; feasible on the 10× grid: {g['feasible']}"]
     if "set_points" in d:
         encoders, (start, _) = set_point_lines(d["set_points"])
-        notes += ([f"excitation.csv{encoders}"] if encoders else []) + [start]
+        said_already = start in (d.get("warnings") or [])  # a start in motion: under "Findings and warnings"
+        notes += ([f"excitation.csv{encoders}"] if encoders else []) + ([] if said_already else [start])
     if "lowest" in d:
         notes.append(no_floor_line(d["lowest"], d["workspace"]["clearance"])[0])
     return settings, [Section("In short", [], _excite_verdict(d)), Section("Design", [before], notes),
