@@ -94,3 +94,16 @@ def test_the_summary_names_the_estimator_nearest_the_bound_at_each_level(study):
         scores = {k: np.nanmedian(stats[k]["rmse"][li] / study.crb_std[li]) for k in SMALL.estimators}
         best = min(scores, key=scores.get)
         assert f"{level:g} A: {best.upper()} ({scores[best]:.3g}× √CRB)" in text
+
+
+def test_the_local_clusters_tasks_start_no_thread_pools():
+    """The local cluster's workers share the machine's cores, one task each: dynid's own thread pools take one core
+    in a task (they took every core in each worker, and a task starting one hung once in a test run)."""
+    import os
+
+    from dynid.runtime.cluster import dask_client
+    from dynid.runtime.threads import cores
+
+    assert cores() == len(os.sched_getaffinity(0)) >= 2  # this process: every core it may use
+    with dask_client(workers=1) as client:
+        assert client.submit(cores, pure=False).result() == 1

@@ -15,6 +15,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from ..plugins import share_with
 from .extras import require
+from .threads import ONE_CORE_ENV
 
 
 @contextlib.contextmanager
@@ -27,7 +28,8 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     scheduler : str, optional
         An address like ``tcp://host:8786``; default: a new :class:`distributed.LocalCluster`.
     workers : int, optional
-        Single-threaded worker processes of the local cluster (default: the local cores).
+        Single-threaded worker processes of the local cluster (default: the local cores); dynid's own thread pools
+        take one core in each (:data:`dynid.runtime.threads.ONE_CORE_ENV`).
     connect_timeout : float [s]
         Time the scheduler is given to answer.
     extra, what : str
@@ -57,8 +59,10 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
     n = workers if workers is not None else (os.cpu_count() or 1)
     if n < 1:
         raise ConfigError(f"workers must be at least 1, got {workers}", field="workers")
+    # the workers share the machine's cores, one task each: no thread pools inside a task (they oversubscribed the
+    # cores, and a task starting one hung once against distributed's garbage-collection callback in a test run)
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      silence_logs=logging.ERROR, env={ONE_CORE_ENV: "1"}) as cluster, Client(cluster) as client:
         share_with(client)
         yield client
 

@@ -43,13 +43,20 @@ def with_single_blas_thread(func):
     return wrapper
 
 
+ONE_CORE_ENV = "DYNID_ONE_CORE"
+"""Set (to any value) in a process that shares the machine's cores with its siblings (the workers of the local Dask
+cluster, :func:`dynid.runtime.cluster.dask_client`): :func:`cores` is then 1, so the process starts no thread pools."""
+
+
 def cores() -> int:
-    """Cores this process may use.
+    """Cores this process may use: its CPU affinity, 1 where :data:`ONE_CORE_ENV` is set.
 
     Returns
     -------
     int
     """
+    if os.environ.get(ONE_CORE_ENV):
+        return 1
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
