@@ -49,6 +49,7 @@ def _advance(q, dq, v2, v3, v4, a1, a2, a3, a4, h):  # pragma: no cover - compil
 
 
 control = stage = first_input = advance = None
+_kernels = None  # the four, set at once: IDIM-IV and DIDIM run side by side on two threads
 
 
 def compiled():
@@ -59,10 +60,12 @@ def compiled():
     tuple
         ``(control, stage, first_input, advance)``.
     """
-    global control, stage, first_input, advance
-    if control is None:
+    global control, stage, first_input, advance, _kernels
+    if _kernels is None:
         import numba
 
         jit = numba.njit(cache=True, nogil=True)
-        control, stage, first_input, advance = (jit(f) for f in (_control, _stage, _first_input, _advance))
-    return control, stage, first_input, advance
+        four = tuple(jit(f) for f in (_control, _stage, _first_input, _advance))
+        control, stage, first_input, advance = four
+        _kernels = four
+    return _kernels
