@@ -19,14 +19,9 @@ import warnings
 import numpy as np
 
 from ..exceptions import DynIdError, ShapeError
-from ..model.spatial import pseudo_inertia
+from ..model.spatial import CONSISTENCY_TOL as CONSISTENCY_TOL  # the solver's accuracy, defined with the rule using it
+from ..model.spatial import pseudo_inertia, within_round_off
 from .base import AccumulatingEstimator, check_observations, weighted_rows
-
-CONSISTENCY_TOL = 1e-7
-"""Base parameters count as physically consistent when their :func:`consistency_margin` is >= -1e-7 times the largest
-of them (at least 1: the solver's accuracy, :func:`margin_is_consistent`), and an SDP result when its smallest
-pseudo-inertia eigenvalue is >= -1e-7."""
-
 
 PRIOR_KIND = "euclidean"
 """The SDP's prior by default (:class:`PhysicallyConsistentLeastSquares`)."""
@@ -232,10 +227,8 @@ def consistency_margin(regrouping, beta, links, nonnegative=(), bound: float = 1
 
 
 def margin_is_consistent(margin: float, beta=None) -> bool:
-    """Whether a :func:`consistency_margin` says "physically consistent": at least ``-CONSISTENCY_TOL`` times the
-    largest ``|beta|`` where it exceeds 1 (the check's solver is accurate relative to the size of the parameters it is
-    given: a KR 300's base parameters reach 2,200, and its SDP estimate, consistent to 8e-10 link by link, had a
-    margin of -4e-7).
+    """Whether a :func:`consistency_margin` says "physically consistent": at least 0 to the solver's round-off
+    relative to the base parameters checked (:func:`dynid.model.spatial.within_round_off`).
 
     Parameters
     ----------
@@ -247,9 +240,7 @@ def margin_is_consistent(margin: float, beta=None) -> bool:
     -------
     bool
     """
-    finite = beta is not None and np.size(beta) and np.all(np.isfinite(beta))
-    scale = max(1.0, float(np.max(np.abs(beta)))) if finite else 1.0
-    return bool(margin >= -CONSISTENCY_TOL * scale)
+    return within_round_off(margin, beta)
 
 
 def consistency_verdict(margin: float, regrouping=None, beta=None, names=(), nonnegative=()) -> str:

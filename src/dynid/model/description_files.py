@@ -26,10 +26,13 @@ from ..conventions import joint_angles_text
 from ..exceptions import ConfigError
 from .loading import as_robot
 from .robot import Robot
-from .spatial import is_physically_consistent, physical_from_inertial, physical_problems
-
-CONSISTENCY_TOL = 1e-7
-"""Smallest pseudo-inertia eigenvalue tolerated (the SDP solver's accuracy) [kg·m², kg]."""
+from .spatial import (
+    CONSISTENCY_TOL,
+    is_physically_consistent,
+    physical_from_inertial,
+    physical_problems,
+    within_round_off,
+)
 
 
 def _rpy(rotation: np.ndarray) -> np.ndarray:
@@ -62,10 +65,9 @@ def _exportable(robot: Robot, phi: np.ndarray | None) -> Robot:
         raise ConfigError(f"export: expected {robot.n_params} standard parameters for robot {robot.name!r}, got {phi.shape}")
     phi = phi.copy()
     names = robot.parameter_names
-    tol = CONSISTENCY_TOL * max(1.0, float(np.abs(phi).max()))  # the SDP solver's round-off on its bound at 0
     for j in range(robot.n_dof):
         found = {term: names.index(f"{term}{j + 1}") for term in ("fc", "fv") if f"{term}{j + 1}" in names}
-        if any(phi[k] < -tol for k in found.values()):
+        if not all(within_round_off(phi[k], phi) for k in found.values()):  # the SDP solver's round-off on its bound
             fc, fv = (phi[found[t]] if t in found else 0.0 for t in ("fc", "fv"))
             raise ConfigError(f"export: joint {j + 1}: negative friction (fc = {fc:.4g}, fv = {fv:.4g}) cannot be exported")
         for k in found.values():

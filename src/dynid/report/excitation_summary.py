@@ -229,7 +229,7 @@ def _shapes_lines(run) -> list:
     cell's distances are then measured on estimated capsules (unless ``[workspace] link_radius`` is given), and the
     links of held joints (another arm, a head) are in no check at all."""
     ws = run.config.problem.workspace
-    held = getattr(run.config.problem.robot, "held", ())
+    held = run.config.problem.robot.held
     capsules = ws.link_radius is None and bool(ws.obstacles or math.isfinite(ws.floor))
     if ws.geometry is not None or not (held or capsules):
         return []

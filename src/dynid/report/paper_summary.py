@@ -4,8 +4,8 @@ OLS/WLS uncertainties and the timings."""
 
 from __future__ import annotations
 
-from ..estimators.physically_consistent import CONSISTENCY_TOL
 from ..estimators.registry import spec
+from ..model.spatial import CONSISTENCY_TOL
 from ..studies import paper_reference as ref
 from ..tables import Line, TextTable
 
