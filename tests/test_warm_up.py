@@ -13,7 +13,7 @@ import dynid.dynamics._regressor_kernel as r, dynid.estimators._objective_kernel
 import dynid.simulation._step_kernel as cl, dynid.preprocessing._filter_kernel as fk
 kernels = {f"{m.__name__}.{k}": v for m in (r, o, rls, cl, fk) for k, v in vars(m).items()
            if isinstance(v, numba.core.registry.CPUDispatcher) and v.targetoptions.get("inline", "never") == "never"}
-assert len(kernels) >= 11 and "dynid.preprocessing._filter_kernel.sections" in kernels, sorted(kernels)
+assert len(kernels) >= 12 and {"dynid.preprocessing._filter_kernel.sections", "dynid.preprocessing._filter_kernel.symmetric"} <= set(kernels), sorted(kernels)
 missing = [k for k, v in kernels.items() if not v.signatures]
 assert not missing, missing
 print(len(kernels))

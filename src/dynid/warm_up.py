@@ -35,10 +35,11 @@ def warm_up() -> None:
     simulate_closed_loop(er16, t, np.zeros((10, 6)), np.zeros((10, 6)), Controller.for_robot(er16))
     from scipy import signal
 
-    from .preprocessing._filter_kernel import zero_phase
+    from .preprocessing._filter_kernel import gaussian_nearest, gaussian_weights, zero_phase
 
-    sos = signal.butter(4, 0.1, output="sos")  # a long log's parallel filter
+    sos = signal.butter(4, 0.1, output="sos")  # a long log's parallel filter and Gaussian smoothing
     zero_phase(sos, np.ones((20, 3)), 5, signal.sosfilt_zi(sos))
+    gaussian_nearest(np.ones(20), gaussian_weights(2.0))
 
 
 if __name__ == "__main__":

@@ -1,11 +1,13 @@
-"""The compiled zero-phase filter of the parallel decimation against SciPy's ``sosfiltfilt``: the same numbers bit for
-bit (an independent implementation: SciPy's own), whatever the order, cutoff, padding, columns and values."""
+"""The compiled filters of long logs against SciPy's own (an independent implementation): the parallel decimation's
+zero-phase filter against ``sosfiltfilt``, the Gaussian smoothing against ``gaussian_filter1d``, the same numbers bit for
+bit whatever the order, cutoff, width, padding, columns, threads and values."""
 
 import numpy as np
 import pytest
 from scipy import signal
+from scipy.ndimage import gaussian_filter1d
 
-from dynid.preprocessing._filter_kernel import zero_phase
+from dynid.preprocessing._filter_kernel import gaussian_nearest, gaussian_weights, zero_phase
 
 
 @pytest.mark.parametrize(("order", "cutoff", "rate", "n", "c", "padlen"),
@@ -46,3 +48,37 @@ def test_the_parallel_decimation_of_a_long_log_is_the_same_through_either_filter
     for (i, a), (j, b) in zip(scipys, compiled):
         assert np.array_equal(i, j) and np.array_equal(a, b)
     assert np.all(np.concatenate([v for _, v in compiled])[:, 3] == 0.0) and np.ptp(compiled[0][1][:, 0]) > 0
+
+
+@pytest.mark.parametrize(("n", "sigma", "workers"), [(5000, 13.25, 1), (9000, 66.3, 2), (4099, 0.7, 2), (300, 40.0, 2),
+                                                      (1, 3.0, 1), (2, 150.0, 2)])
+def test_the_compiled_gaussian_smoothing_is_scipys_bit_for_bit(n, sigma, workers):
+    rng = np.random.default_rng(n)
+    x = np.cumsum(rng.standard_normal(n)) * 1e3 + np.sin(np.arange(n) / 50.0)  # the ends differ: "nearest" matters
+    weights = gaussian_weights(sigma)
+    assert weights.size % 2 == 1 and np.array_equal(weights, weights[::-1]) and np.isclose(weights.sum(), 1.0)
+    expected = gaussian_filter1d(x, sigma, mode="nearest")
+    got = gaussian_nearest(x, weights, workers)
+    assert np.array_equal(got, expected)
+    assert n < 3 or not np.array_equal(got, x)  # it smoothed
+
+
+def test_gaussian_smoothing_is_the_same_through_either_path(monkeypatch):
+    """The compiled smoothing takes over from the work's size (:data:`COMPILED_GAUSSIAN_WORK`), on arrays in memory and
+    on a long log's stored columns alike."""
+    from dynid._util.column_store import StoredColumns
+    from dynid.preprocessing import filters
+
+    rng = np.random.default_rng(3)
+    x = np.cumsum(rng.standard_normal((6000, 4)), axis=0)
+    stored = StoredColumns.from_columns(x.T)
+    monkeypatch.setattr(filters, "COMPILED_GAUSSIAN_WORK", 10**15)
+    scipys = filters.gaussian_smooth(x, 1000.0, 2.0), np.asarray(filters.gaussian_smooth(stored, 1000.0, 2.0))
+    calls = []
+    monkeypatch.setattr(filters, "gaussian_nearest", lambda *a: calls.append(1) or gaussian_nearest(*a))
+    monkeypatch.setattr(filters, "COMPILED_GAUSSIAN_WORK", 0)
+    compiled = filters.gaussian_smooth(x, 1000.0, 2.0), np.asarray(filters.gaussian_smooth(stored, 1000.0, 2.0))
+    assert len(calls) == 8  # four columns, twice
+    for a, b in zip(scipys, compiled):
+        assert np.array_equal(a, b)
+    assert not np.array_equal(scipys[0], x)

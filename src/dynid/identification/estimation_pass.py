@@ -430,12 +430,13 @@ def one_way_joints(data: PreparedData) -> list[int]:
     list of int
         The joints, 0-based.
     """
-    dq = np.asarray(data.dq)
-    moving = np.abs(dq) > np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (dq.shape[1],))
+    n = data.dq.shape[1]
+    speed = np.broadcast_to(np.asarray(data.settings.min_speed, dtype=float), (n,))
     out = []
-    for j in (j for j in range(dq.shape[1]) if j not in data.still):
-        signs = np.sign(dq[moving[:, j], j])
-        if signs.size and min(np.mean(signs > 0), np.mean(signs < 0)) < 0.01:
+    for j in (j for j in range(n) if j not in data.still):  # a column at a time: a long log's are stored
+        column = np.asarray(data.dq[:, j], dtype=float)
+        moved = column[np.abs(column) > speed[j]]
+        if moved.size and min(np.count_nonzero(moved > 0), np.count_nonzero(moved < 0)) / moved.size < 0.01:
             out.append(j)
     return out
 

@@ -1,4 +1,5 @@
-"""The zero-phase Butterworth filter of the parallel decimation, compiled (numba) for long logs.
+"""The zero-phase filters of long logs, compiled (numba): the parallel decimation's Butterworth filter and the
+direction of motion's Gaussian smoothing.
 
 :func:`dynid.preprocessing.filters.parallel_decimation` filters every live column of the base regressor at the log's
 rate; on an hour at 1 kHz that is about 10⁹ values, which SciPy's ``sosfiltfilt`` takes one column block at a time with
@@ -7,13 +8,19 @@ padlen=padlen)`` computes, with the same operations in the same order (each sect
 SciPy's ``_sosfilt`` runs it, its initial state ``sosfilt_zi(sos)`` times the first value, no fast-math): the same
 numbers to the last bit (tests/preprocessing/test_filter_kernel.py). It runs along the columns of one row at a time,
 which the compiler vectorises.
+
+:func:`gaussian_nearest` computes what ``scipy.ndimage.gaussian_filter1d(x, sigma, mode="nearest")`` computes, for
+SciPy's own weights: each output sums the same products in the same order as SciPy's correlation of a symmetric kernel
+(the centre's product, then the pairs of samples ``k`` either side from the outermost in), so the numbers are SciPy's
+to the last bit; the outputs go a block at a time, which the compiler vectorises, and the column's halves on two
+threads.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["compiled", "zero_phase"]
+__all__ = ["compiled", "gaussian_nearest", "gaussian_weights", "zero_phase"]
 
 
 def _sections(sos, x, z0, z1, reverse):  # pragma: no cover - compiled
@@ -46,28 +53,112 @@ def _extended(x, cols, padlen, ext):  # pragma: no cover - compiled
             out[j] = row[cols[j]]
 
 
-sections = extended = None
-_kernels = None  # the pair, set at once: two threads may ask for it together
+GAUSSIAN_BLOCK = 1024
+"""Outputs :func:`gaussian_nearest` sums at once (8 kB of partial sums, beside the 2·radius + 1024 samples they read)."""
+
+
+def _symmetric(x, w, out, start, stop):  # pragma: no cover - compiled
+    """``out[i]`` for ``start <= i < stop``: the correlation of ``x`` (padded by the radius ``r`` at both ends) with
+    the symmetric weights ``w`` (2r + 1), in SciPy's order: ``x[i]·w[r]``, then ``+ (x[i-k] + x[i+k])·w[r-k]`` for
+    ``k = r … 1``."""
+    r = (w.shape[0] - 1) // 2
+    acc = np.empty(GAUSSIAN_BLOCK)
+    for a in range(start, stop, GAUSSIAN_BLOCK):
+        m = min(GAUSSIAN_BLOCK, stop - a)
+        centre = x[a + r:a + r + m]
+        for i in range(m):
+            acc[i] = centre[i] * w[r]
+        for k in range(r, 0, -1):
+            wk = w[r - k]
+            left = x[a + r - k:a + r - k + m]
+            right = x[a + r + k:a + r + k + m]
+            for i in range(m):
+                acc[i] += (left[i] + right[i]) * wk
+        for i in range(m):
+            out[a + i] = acc[i]
+
+
+sections = extended = symmetric = None
+_kernels = None  # the three, set at once: two threads may ask for them together
 
 
 def compiled():
-    """The section pass and the extension, compiled on first use into numba's on-disk cache (:mod:`dynid.warm_up`
-    compiles them at installation).
+    """The section pass, the extension and the symmetric correlation, compiled on first use into numba's on-disk cache
+    (:mod:`dynid.warm_up` compiles them at installation).
 
     Returns
     -------
     tuple
-        ``(sections, extended)``: ``sections(sos, x, z0, z1, reverse)``, ``extended(x, cols, padlen, ext)``.
+        ``(sections, extended, symmetric)``: ``sections(sos, x, z0, z1, reverse)``, ``extended(x, cols, padlen,
+        ext)``, ``symmetric(x, w, out, start, stop)``.
     """
-    global sections, extended, _kernels
+    global sections, extended, symmetric, _kernels
     if _kernels is None:
         import numba
 
         jit = numba.njit(cache=True, nogil=True)
-        pair = (jit(_sections), jit(_extended))
-        sections, extended = pair
-        _kernels = pair
+        three = (jit(_sections), jit(_extended), jit(_symmetric))
+        sections, extended, symmetric = three
+        _kernels = three
     return _kernels
+
+
+def gaussian_weights(sigma: float) -> np.ndarray:
+    """The weights of ``scipy.ndimage.gaussian_filter1d`` at standard deviation ``sigma`` [samples]: its response to a
+    unit impulse, over its support (SciPy's own numbers, whatever radius and normalisation it uses).
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation [samples], > 0.
+
+    Returns
+    -------
+    (2r + 1,) ndarray
+        Symmetric weights summing to 1.
+    """
+    from scipy.ndimage import gaussian_filter1d
+
+    reach = int(5 * sigma) + 10  # beyond SciPy's radius of 4 σ
+    impulse = np.zeros(2 * reach + 1)
+    impulse[reach] = 1.0
+    response = gaussian_filter1d(impulse, sigma, mode="constant")
+    r = reach - int(np.flatnonzero(response)[0])
+    return response[reach - r:reach + r + 1].copy()
+
+
+def gaussian_nearest(x: np.ndarray, weights: np.ndarray, workers: int = 1) -> np.ndarray:
+    """``scipy.ndimage.gaussian_filter1d(x, sigma, mode="nearest")`` for ``weights = gaussian_weights(sigma)``, bit for
+    bit.
+
+    Parameters
+    ----------
+    x : (N,) array
+        One signal.
+    weights : (2r + 1,) array
+        Symmetric weights (:func:`gaussian_weights`).
+    workers : int
+        Threads, each computing a contiguous part of the outputs (the numbers do not depend on it).
+
+    Returns
+    -------
+    (N,) ndarray
+    """
+    correlate = compiled()[2]
+    x = np.asarray(x, dtype=float).reshape(-1)
+    r = (weights.shape[0] - 1) // 2
+    padded = np.concatenate([np.full(r, x[0]), x, np.full(r, x[-1])]) if x.size else x
+    out = np.empty(x.size)
+    w = np.ascontiguousarray(weights, dtype=float)
+    bounds = np.linspace(0, x.size, max(1, min(workers, x.size // GAUSSIAN_BLOCK)) + 1).astype(int)
+    if bounds.size <= 2:
+        correlate(padded, w, out, 0, x.size)
+        return out
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=bounds.size - 1) as pool:
+        list(pool.map(lambda ab: correlate(padded, w, out, ab[0], ab[1]), zip(bounds[:-1], bounds[1:])))
+    return out
 
 
 def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols: np.ndarray | None = None,
@@ -94,7 +185,7 @@ def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols
     (r, c) ndarray
         The filtered signals.
     """
-    run, extend = compiled()
+    run, extend = compiled()[:2]
     x = np.ascontiguousarray(x, dtype=float)
     cols = np.arange(x.shape[1]) if cols is None else np.asarray(cols, dtype=np.int64)
     ext = np.empty((x.shape[0] + 2 * padlen, cols.size))

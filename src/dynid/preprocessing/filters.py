@@ -15,7 +15,7 @@ import numpy as np
 from .._util.column_store import by_column
 from ..exceptions import ConfigError
 from ..runtime.threads import cores
-from ._filter_kernel import zero_phase
+from ._filter_kernel import gaussian_nearest, gaussian_weights, zero_phase
 from .bands import decimation_cutoff
 
 
@@ -105,7 +105,17 @@ def gaussian_smooth(x, rate: float, cutoff: float):
     if not 0 < cutoff < rate / 2:
         return x
     sigma = GAUSS_CUTOFF / cutoff * rate
+    if x.shape[0] * int(np.prod(x.shape[1:])) * 8 * sigma >= COMPILED_GAUSSIAN_WORK:
+        weights, workers = gaussian_weights(sigma), cores()
+        return by_column(x, lambda column, j: gaussian_nearest(column, weights, workers))
     return by_column(x, lambda column, j: gaussian_filter1d(column, sigma, mode="nearest"))
+
+
+COMPILED_GAUSSIAN_WORK = 2_000_000_000
+"""From this many products (samples × columns × the kernel's 8σ + 1 weights) on, :func:`gaussian_smooth` runs the
+compiled correlation (:func:`dynid.preprocessing._filter_kernel.gaussian_nearest`, SciPy's numbers bit for bit, on the
+process's cores): about a second of SciPy's ``gaussian_filter1d``, an hour of six joints at 1 kHz smoothed at 2 Hz is
+5.7·10⁹. Below it SciPy's, and the process never loads numba."""
 
 
 def velocity_noise_std(sigma: np.ndarray, rate: float, cutoff: float, order: int, differentiated: bool,

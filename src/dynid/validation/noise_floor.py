@@ -37,20 +37,22 @@ left in such a log is the motion's own second difference, not the sensor's noise
 from it."""
 
 
-def looks_filtered(tau) -> bool:
+def looks_filtered(tau, noise: np.ndarray | None = None) -> bool:
     """Whether a log's torques carry no measurable sample-to-sample noise (:data:`SMOOTH`).
 
     Parameters
     ----------
     tau : (N, n_dof) array or StoredColumns [N·m]
         Raw measured torques, as read.
+    noise : (n_dof,) array [N·m], optional
+        Their :func:`torque_noise`, where the caller has it (computed here otherwise).
 
     Returns
     -------
     bool
         False for a log of fewer than 3 samples or with no joint that carries torque.
     """
-    noise = torque_noise(tau)
+    noise = torque_noise(tau) if noise is None else noise
     rms = np.array([float(np.sqrt(np.mean(np.square(np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j],
                                                                  dtype=float))))) for j in range(tau.shape[1])])
     live = rms > 0
@@ -123,6 +125,7 @@ def noise_floor(data) -> np.ndarray | None:
         The RMSE a perfect model would have there; None (unknown) for torques without measurable noise
         (:func:`looks_filtered`: filtered before dynid read them, the floor is not in them any more).
     """
-    if looks_filtered(data.tau):
+    noise = torque_noise(data.tau)
+    if looks_filtered(data.tau, noise):
         return None
-    return torque_noise(data.tau) * np.sqrt(scored_bandwidth(data.settings, data.rate))
+    return noise * np.sqrt(scored_bandwidth(data.settings, data.rate))
