@@ -18,6 +18,8 @@ threads.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 __all__ = ["compiled", "gaussian_nearest", "gaussian_weights", "zero_phase"]
@@ -154,8 +156,6 @@ def gaussian_nearest(x: np.ndarray, weights: np.ndarray, workers: int = 1) -> np
     if bounds.size <= 2:
         correlate(padded, w, out, 0, x.size)
         return out
-    from concurrent.futures import ThreadPoolExecutor
-
     with ThreadPoolExecutor(max_workers=bounds.size - 1) as pool:
         list(pool.map(lambda ab: correlate(padded, w, out, ab[0], ab[1]), zip(bounds[:-1], bounds[1:])))
     return out
