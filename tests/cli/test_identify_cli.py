@@ -124,7 +124,7 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     lines = p.stdout.strip().splitlines()
     assert len(lines) < 60, len(lines)
     text = " ".join(p.stdout.split())
-    assert "In short (every table: --verbose, and report.html)" in text and "Verdict on the model" in text
+    assert "In short (every table and finding: --verbose, and report.html)" in text and "Verdict on the model" in text
     assert "ptp_10_points: torque error" in text and "payload, from the loaded run" in text
     # the ten logs that hold the arm still share one line (they took twenty to say "0 %" ten times)
     assert "p1, p2, p3, p4, p5, p6, p7, p8, p9, p10 (10 logs at rest throughout): torque error 0 % over all joints" in text
@@ -145,6 +145,32 @@ def test_identify_prints_how_it_went_and_the_tables_only_with_verbose(tmp_path):
     assert (f"mean torque error over the one log that moves ({len(val) - 1} at rest throughout left out: they check the "
             "gravity model): ") in text and "best: dynid" in text
     assert all(f"{name} {m:.3g} %" in text for name, m in means.items())
+
+
+def test_identify_says_its_verdict_in_25_lines_and_every_finding_with_verbose(tmp_path):
+    """issue "Fast where users wait", item 4 (at most 25 lines): on the LBR Med7's config dynid identify printed 26
+    lines besides its progress: one naming the 27 parameters the log leaves open and two more saying what each name
+    means, and all 8 findings. Without --verbose it counts the parameters and prints the verdict's choice and the two
+    findings that ask most, counting the others by kind; --verbose prints them all."""
+    root = shared_data("kuka_med7_lbrstack")
+    args = ("identify", str(REPO / "configs" / "kuka_med7.toml"), "--data-root", str(root), "--no-figures")
+    wide = {"COLUMNS": "10000"}  # a pipe: one line per line
+    p = dynid(*args, "--out", str(tmp_path / "brief"), env=wide)
+    assert p.returncode == 0, p.stderr
+    said = [ln for ln in (p.stdout + p.stderr).splitlines() if ln.strip() and not ln.startswith("dynid identify: ")]
+    assert len(said) <= 25, said
+    findings = json.loads((tmp_path / "brief" / "results.json").read_text())["findings"]
+    assert len(findings) > 3
+    printed = [f for f in findings if f["text"] in p.stdout]
+    (more,) = [ln for ln in said if ln.startswith("and ") and ln.endswith(": --verbose, or report.html")]
+    assert int(more.split()[1]) == len(findings) - len(printed) and len(printed) == 3, more
+    hidden = [f["kind"] for f in findings if f not in printed]
+    assert all(kind in more for kind in hidden) and printed[0]["kind"] == "main"
+    assert "base parameters this log leaves open: " in p.stdout and "the link parameters named" not in p.stdout
+    v = dynid(*args, "--out", str(tmp_path / "verbose"), "--verbose", env=wide)
+    assert v.returncode == 0, v.stderr
+    assert all(f["text"] in v.stdout for f in findings) and ": --verbose, or report.html" not in v.stdout
+    assert "the link parameters named" in v.stdout
 
 
 @pytest.mark.parametrize(("name", "content"), [("run.csv", b"t,q1,tau1\n0,0.1,2.0\n"), ("run.mcap", b"\x89MCAP0\r\n\xff\xfe")])

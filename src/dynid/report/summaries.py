@@ -306,10 +306,24 @@ def _identification_title(r) -> Line:
                 f"parameters from {r.n_rows} equations, cond = {r.solution.condition_number:.4g}", "title")
 
 
-def _verdict(r) -> list:
-    return [Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
-                                            if not r.findings else f"{len(r.findings)} finding(s)"), "title"),
-            *(Line(f.text) for f in r.findings)]
+def _verdict(r, brief: bool = False) -> list:
+    """The verdict's title and findings; ``brief``: the verdict's choice and :data:`BRIEF_FINDINGS` more (those that
+    ask something first), the rest counted by kind."""
+    title = Line("Verdict on the model: " + ("no finding: the residuals show no structure the checks look for"
+                                            if not r.findings else f"{len(r.findings)} finding(s)"), "title")
+    shown = list(r.findings)
+    if brief:
+        first = [f for f in shown if f.kind == "main" or f.kind in NOT_READY_KINDS]  # what the first line points to
+        asks = [f for f in shown if _asks(r, f) and f not in first]
+        rest = [f for f in shown if f not in first and f not in asks]
+        picked = (asks + rest)[:BRIEF_FINDINGS]
+        shown = [f for f in shown if f in first or f in picked]  # the verdict's order
+        left = [f.kind for f in r.findings if f not in shown]
+        if left:
+            kinds = ", ".join(f"{k} ({left.count(k)})" if left.count(k) > 1 else k for k in dict.fromkeys(left))
+            return [title, *(Line(f.text) for f in shown),
+                    Line(f"and {len(left)} more ({kinds}): --verbose, or report.html")]
+    return [title, *(Line(f.text) for f in shown)]
 
 
 def _held_out_clause(r, label: str) -> str:
@@ -487,10 +501,22 @@ def identification_brief(result) -> list:
     list of Line
     """
     r = result
-    short = in_short(r)
-    short[0] = Line("In short (every table: --verbose, and report.html)", "title")
+    short = in_short(r, brief=True)
+    short[0] = Line("In short (every table and finding: --verbose, and report.html)", "title")
     drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
-    return [readiness(r), _identification_title(r), *short, *drive, *_verdict(r), *(Line(w, "warning") for w in r.warnings)]
+    return [readiness(r), _identification_title(r), *short, *drive, *_verdict(r, brief=True),
+            *(Line(w, "warning") for w in r.warnings)]
+
+
+BRIEF_FINDINGS = 2
+"""Findings ``dynid identify`` prints without ``--verbose`` besides the verdict's choice and those the first line
+points to (:data:`NOT_READY_KINDS`; :func:`_verdict`): those that ask something of the user first, in the verdict's
+order; the others are counted by kind (issue "Fast where users wait", item 4: the verdict in a screenful).
+``--verbose`` and report.html list every one."""
+
+NOT_READY_KINDS = ("sign", "columns", "order", "angles", "rate", "gravity", "scale")
+"""Finding kinds that make :func:`readiness`'s first line "not ready: … the verdict at the end names it": always
+printed."""
 
 
 def worst_joint(relative_error, meaningful) -> tuple[int, float] | None:
@@ -787,13 +813,15 @@ def undetermined(names, params, relative_std, kept, share: dict, boot: dict) -> 
     return loose, small
 
 
-def in_short(result) -> list:
+def in_short(result, *, brief: bool = False) -> list:
     """How an identification went, in a few lines: the estimate to use and whether it is physically consistent, each
     log's global error and worst joint, and what to do next.
 
     Parameters
     ----------
     result : dynid.identification.result.IdentificationResult
+    brief : bool
+        What the log does not determine counted in one line (``dynid identify`` without ``--verbose``), not listed.
 
     Returns
     -------
@@ -811,7 +839,7 @@ def in_short(result) -> list:
                                              f", not physically consistent{export}"))]
     lines, errors = _log_lines(r, label)
     out += lines + _yardstick_lines(r, label)
-    out += _determined_lines(r, label)
+    out += _determined_lines(r, label, brief=brief)
     fit = errors.get(r.fit.name)
     at_floor = {c.name for c in r.validations if (c.floor_metrics() or {}).get("global_relative_error", np.nan) * AT_FLOOR
                 >= errors.get(c.name, np.inf)}
@@ -842,10 +870,15 @@ that every joint passes: :func:`_to_do`)."""
 
 
 def _to_do(r) -> bool:
-    """Whether some finding asks something of the user (not :data:`GOOD_NEWS`, nor the nominal gate where the main
-    estimate predicts every joint better than the description)."""
+    """Whether some finding asks something of the user (:func:`_asks`)."""
+    return any(_asks(r, f) for f in r.findings)
+
+
+def _asks(r, finding) -> bool:
+    """Whether a finding asks something of the user: not :data:`GOOD_NEWS`, nor the nominal gate where the main
+    estimate predicts every joint better than the description."""
     worse = any(s.get("worse_joints") for s in (r.diagnostics.get("versus_nominal") or {}).values())
-    return any(f.kind not in GOOD_NEWS and (f.kind != "nominal" or worse) for f in r.findings)
+    return finding.kind not in GOOD_NEWS and (finding.kind != "nominal" or worse)
 
 
 def _yardstick_lines(r, label: str) -> list:
@@ -937,10 +970,23 @@ def _link_legend(names: list[str]) -> str:
     return "the link parameters named: " + "; ".join(parts) + regrouped
 
 
-def _determined_lines(r, label: str) -> list:
+def _determined_count(whose: str, loose: list, chosen: list, small: list) -> list:
+    """The brief's one line on the base parameters the log leaves loose: how many are not determined, kept loose by the
+    friction models' choice, and about 0 on its motion (those taken from the description keep their own line)."""
+    parts = [f"{len(names)} {what}" for names, what in ((loose, f"not determined (σ ≥ {BAD_RELATIVE_STD:g} % of the value)"),
+                                                        (chosen, "friction terms kept loose"),
+                                                        (small, "about 0 on its motion")) if names]
+    if not parts:
+        return []
+    advice = ": a richer excitation (dynid excite) determines them" if loose or chosen else ""
+    return [Line(f"{whose}base parameters this log leaves open: {', '.join(parts)} (--verbose names them){advice}")]
+
+
+def _determined_lines(r, label: str, brief: bool = False) -> list:
     """:func:`in_short`'s lines on what the log determines. They read least squares' σ; where the main estimate is the
     drive-only one, whose links are the description's, they say so first and name least squares as theirs, and the
-    drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveOnly.held`)."""
+    drive terms the drive-only fit kept at the description's values (:attr:`dynid.identification.drive_only.DriveOnly.held`).
+    ``brief``: one line that counts them (:func:`_determined_count`)."""
     out = []
     whose, listed = "", []
     if label == DRIVE_ONLY_LABEL:
@@ -967,6 +1013,8 @@ def _determined_lines(r, label: str) -> list:
     which = "; σ the larger of the covariance's and the bootstrap's" if boot else ""
     chosen = [n for n in loose if split_name(n)[0] in CHOSEN_TERMS]  # the friction models' cross-validation kept them
     loose = [n for n in loose if n not in chosen]
+    if brief:
+        return out + _determined_count(whose, loose, chosen, small)
     if loose:
         out.append(Line(f"{whose}not determined by this log (σ ≥ {BAD_RELATIVE_STD:g} % of the value{which}): "
                         f"{', '.join(loose)}: their values are set by the noise and the misfit; a richer excitation "
