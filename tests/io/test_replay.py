@@ -3,6 +3,7 @@ hold it (issue "The model proven where it goes", item 1); a file that lost a val
 
 import json
 import re
+import shlex
 from importlib import resources
 from pathlib import Path
 
@@ -79,6 +80,13 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     said = " ".join((p.stdout + p.stderr).split())  # a warning line goes to standard error
     assert f"{taken['files'][0]['file']} read back by Pinocchio on validation" in said
     assert "The files you take away" in (tmp_path / "out" / "report.html").read_text()
+    # the MJCF was read back, not simulated: said, with the command that simulates it, which runs as printed
+    forward = re.search(r"dynid-model\.xml not simulated forward by dynid identify \(.*?\): dynid (export .*? --forward) "
+                        r"runs it", said)
+    assert forward is not None, said
+    f = dynid(*shlex.split(forward.group(1)), cwd=tmp_path)
+    assert f.returncode == 0, f.stderr
+    assert "simulated in MuJoCo along validation" in " ".join(f.stdout.split()) and (tmp_path / "config-identified.xml").is_file()
     # what each simulator computes from its file, per joint, against dynid's whole model: said, and a warning where
     # a joint is more than 2 % off (the URDF cannot hold the rotor inertia and the offset; MuJoCo's frictionloss)
     gaps = [f["simulator_gap"] for f in taken["files"]]

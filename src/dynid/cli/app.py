@@ -292,16 +292,18 @@ def identify(
 
         blocks = summary_blocks(identified[1]) if verbose else identification_brief(identified[1])
         rep.blocks(_runnable_advice(blocks, config, out))
-        rep.blocks(_taken_away(out))
+        rep.blocks(_taken_away(out, config))
         rep.wrote(paths)
 
     _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
 
 
-def _taken_away(out: Path) -> list:
+def _taken_away(out: Path, config: Path) -> list:
     """The lines on the files ``dynid identify`` wrote, read back (results.json's ``files_taken_away``), or why it wrote
-    none (``files_withheld``)."""
+    none (``files_withheld``); and, for an MJCF read back on a validation log, that it was not simulated forward here,
+    with the command that does (issue "Every assurance checked on what the user meets", item 3)."""
     import json
+    import shlex
 
     from ..report.summaries import taken_away_lines
     from ..tables import Line
@@ -309,7 +311,18 @@ def _taken_away(out: Path) -> list:
     path = out / "results.json"
     data = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
     withheld = [Line(data["files_withheld"], "warning")] if data.get("files_withheld") else []
-    return withheld + (taken_away_lines(data["files_taken_away"]) if data.get("files_taken_away") else [])
+    taken = data.get("files_taken_away")
+    if not taken:
+        return withheld
+    lines = taken_away_lines(taken)
+    mjcf = next((f for f in taken["files"] if f["format"] == "MJCF" and "not_read_back" not in f), None)
+    if mjcf is not None and taken.get("log"):
+        command = (f"dynid export {shlex.quote(str(config))} --results {shlex.quote(str(path))} --mjcf "
+                   f"{shlex.quote(config.stem)}-identified.xml --forward")
+        lines.append(Line(f"{mjcf['file']} not simulated forward by dynid identify (MuJoCo stepping the file along "
+                          f"{taken['log']} under a PD loop: the torques a simulated arm needs against the measured ones): "
+                          f"{command} runs it"))
+    return withheld + lines
 
 
 def _runnable_advice(blocks, config: Path, out: Path) -> list:
