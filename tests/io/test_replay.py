@@ -70,7 +70,7 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
 
     cfg, _ = simulated_case(tmp_path, "ur10e", 100.0, "fourier", duration=10.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]', 'estimators = ["wls", "sdp"]'))
-    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures")
+    p = dynid("identify", cfg, "--out", tmp_path / "out", "--no-figures", env={"COLUMNS": "10000"})  # a pipe: unwrapped
     assert p.returncode == 0, p.stderr
     # identify reads back the files it wrote, on the validation log: results.json, the terminal and the report say it
     taken = json.loads((tmp_path / "out" / "results.json").read_text())["files_taken_away"]
