@@ -219,9 +219,11 @@ def test_the_simd_code_is_cached_on_disk_and_loaded_from_there(tmp_path):
         assert out.returncode == 0, out.stderr[-2000:]
         cached = list((tmp_path / "cache" / "dynid").glob("regressor-*.o"))
         assert len(cached) == 1 and cached[0].stat().st_size > 1000
+        (traced,) = (tmp_path / "cache" / "dynid").glob("regressor-ir-*.ll")  # the traced IR, kept beside it
+        assert "define void @kernel" in traced.read_text(errors="replace")
         if run == "first":
-            stamp = cached[0].stat().st_mtime_ns
-    assert cached[0].stat().st_mtime_ns == stamp  # loaded, not written again
+            stamp, ir_stamp = cached[0].stat().st_mtime_ns, traced.stat().st_mtime_ns
+    assert cached[0].stat().st_mtime_ns == stamp and traced.stat().st_mtime_ns == ir_stamp  # loaded, not written again
     np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "second.npy"))
     cached[0].write_bytes(cached[0].read_bytes()[:-100])  # cut short (a full disk, say): ignored, compiled again
     out = subprocess.run([sys.executable, "-c", SIMD_CACHE, str(tmp_path / "third.npy")], env=env, capture_output=True,
@@ -229,3 +231,9 @@ def test_the_simd_code_is_cached_on_disk_and_loaded_from_there(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     assert cached[0].stat().st_mtime_ns != stamp  # written again, whole
     np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "third.npy"))
+    traced.write_bytes(traced.read_bytes()[:-100])  # the IR cut short too: traced again, the same numbers
+    out = subprocess.run([sys.executable, "-c", SIMD_CACHE, str(tmp_path / "fourth.npy")], env=env, capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert traced.stat().st_mtime_ns != ir_stamp and "define void @kernel" in traced.read_text(errors="replace")
+    np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "fourth.npy"))

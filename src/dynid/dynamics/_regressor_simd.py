@@ -17,8 +17,10 @@ function per robot serves every column selection: a column that is not selected 
 into a scratch slot. Each block of samples is zeroed first; the entries no column writes stay zero.
 
 Machine code is cached on disk (``$XDG_CACHE_HOME/dynid`` or ``~/.cache/dynid``) under a hash of the IR, the
-CPU and llvmlite's version. Compiling takes 0.4-0.5 s for a 6-joint arm; loading from the cache, about
-0.015 s.
+CPU and llvmlite's version, and the IR under a hash of the robot's constants and of the two modules' source, so that
+a process neither traces nor compiles a robot it has met before (a TX40 identification builds nine: its model, the
+description's rigid body and the gravity directions the geometry checks try; tracing them took 0.17 s). Compiling
+takes 0.4-0.5 s for a 6-joint arm; loading from the cache, about 0.015 s.
 """
 
 from __future__ import annotations
@@ -335,9 +337,28 @@ def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
            np.asarray(gravity, float).tobytes(), int(npj), int(n_drive), np.asarray(prismatic, float).tobytes())
     with _lock:
         if key not in _kernels:
-            graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
-            _kernels[key] = _compile(_ir(graph, stores, len(rp), npj, n_drive))
+            folder = _cache_folder()
+            path = None if folder is None else folder / f"regressor-ir-{_ir_key(key)}.ll"
+            cached = _read_cache(path)
+            if cached is None:
+                graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
+                ir = _ir(graph, stores, len(rp), npj, n_drive)
+                _write_cache(path, ir.encode())
+            else:
+                ir = cached.decode()
+            _kernels[key] = _compile(ir)
         return _kernels[key][0]
+
+
+def _ir_key(key: tuple) -> str:
+    """The name of a robot's traced IR in the cache: its constants and kinds (``key``) and the source of the tracing
+    and of the arithmetic traced, so that a change of either traces again."""
+    digest = hashlib.sha256()
+    for part in key:
+        digest.update(repr(part).encode())
+    for module in (__file__, _regressor_kernel.__file__):
+        digest.update(Path(module).read_bytes())
+    return digest.hexdigest()[:32]
 
 
 PARALLEL_SAMPLES = 4096
