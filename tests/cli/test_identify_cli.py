@@ -204,3 +204,22 @@ def test_no_next_step_when_nothing_is_left_to_do(tmp_path, monkeypatch):
     (tmp_path / "try" / "alone.toml").write_text(text[:text.index("[[validation]]")] + text[text.index("[estimation]"):])
     p = dynid("identify", "alone.toml", "--out", "id2", "--no-figures")
     assert p.returncode == 0 and "next: add [[validation]] logs" in " ".join(p.stdout.split())
+
+
+def test_with_no_validate_the_first_line_says_to_run_with_the_configs_validation_logs(rng):
+    """``dynid identify --no-validate`` on a config that has validation logs said "add [[validation]] logs (other
+    motions) before you use it": the config has them; the line says to run again without the flag."""
+    from dynid.cli.app import _runnable_advice
+    from dynid.report.summaries import readiness
+
+    from ..report.test_readiness import _result
+
+    ready = _result(rng, 0.02)
+    ready.validations = ()  # as --no-validate leaves them
+    line = readiness(ready)
+    assert "add [[validation]] logs (other motions)" in line.text
+    (told,) = _runnable_advice([line], Path("arm.toml"), Path("out"), skipped=2)
+    assert told.text.startswith("model ready to check: dynid SDP is physically consistent") and "[[validation]]" not in told.text
+    assert "run again without --no-validate (the config's 2 validation logs: other motions) before you use it" in told.text
+    (same,) = _runnable_advice([line], Path("arm.toml"), Path("out"))  # a config without validation logs: as before
+    assert same.text == line.text

@@ -291,7 +291,7 @@ def identify(
         from ..report.summaries import identification_brief
 
         blocks = summary_blocks(identified[1]) if verbose else identification_brief(identified[1])
-        rep.blocks(_runnable_advice(blocks, config, out))
+        rep.blocks(_runnable_advice(blocks, config, out, skipped=0 if validate else len(identified[2].validation)))
         rep.blocks(_taken_away(out, config))
         rep.wrote(paths)
 
@@ -325,7 +325,7 @@ def _taken_away(out: Path, config: Path) -> list:
     return withheld + lines
 
 
-def _runnable_advice(blocks, config: Path, out: Path) -> list:
+def _runnable_advice(blocks, config: Path, out: Path, skipped: int = 0) -> list:
     """The summary's advice as commands that run as printed: ``dynid export CONFIG --urdf FILE [--mjcf FILE]`` with
     this config, the results just written and files named after the config; ``(dynid excite)`` as ``dynid excite
     CONFIG`` (an identification config is an excitation config: its robot and ``[excitation]`` table).
@@ -338,6 +338,8 @@ def _runnable_advice(blocks, config: Path, out: Path) -> list:
         The config ``dynid identify`` was given.
     out : Path
         Its output folder.
+    skipped : int
+        The config's validation logs ``--no-validate`` left out: the advice to add some says to run with them instead.
 
     Returns
     -------
@@ -353,6 +355,9 @@ def _runnable_advice(blocks, config: Path, out: Path) -> list:
     export = f"dynid export {cfg} --results {shlex.quote(str(out / 'results.json'))} --urdf {stem}-identified.urdf"
     words = {"dynid export CONFIG --urdf FILE --mjcf FILE": f"{export} --mjcf {stem}-identified.xml",
              "dynid export CONFIG --urdf FILE": export, "(dynid excite)": f"(dynid excite {cfg})"}
+    if skipped:
+        words["add [[validation]] logs (other motions)"] = (f"run again without --no-validate (the config's {skipped} "
+                                                            f"validation log{'s' if skipped > 1 else ''}: other motions)")
 
     def concrete(text: str) -> str:
         for placeholder, command in words.items():
