@@ -148,9 +148,9 @@ def _noise_floor(power: np.ndarray, f: np.ndarray, nyquist: float) -> float:
     medians = []
     hi = 0.7 * nyquist
     while hi > nyquist / 64:
-        sel = (f > hi / 2) & (f <= hi)
-        if sel.sum() >= 16:
-            medians.append(np.median(power[sel]))
+        a, b = np.searchsorted(f, [hi / 2, hi], side="right")  # f ascending: the bins hi/2 < f <= hi
+        if b - a >= 16:
+            medians.append(np.median(power[a:b]))
         hi /= 2
     if not medians:
         sel = f > nyquist / 4
@@ -200,17 +200,19 @@ def estimate_band(q: np.ndarray, rate: float, fraction: float = ENERGY_FRACTION)
     kernel = np.ones(9) / 9
     floors, powers = [], []
     grid = np.unique(np.searchsorted(f, np.geomspace(max(f[1], 1e-12), f[-1], 400)))  # 400 points, ~ 1/40 octave
+    bounds = _octave_bounds(f)  # the same for every joint
     for j in range(q.shape[1]):  # one joint at a time: the spectrum's temporaries are one column long
         x = _detrended(np.asarray(q[:, j], dtype=float), ramp) * window
         power = np.abs(np.fft.rfft(x)) ** 2
         floor = _noise_floor(power, f, rate / 2)
         floors.append(floor)
-        powers.append(_octave_smoothed(power, f)[grid])  # on a log-spaced grid: a long log's spectrum is not kept
+        octaves = _octave_smoothed(power, bounds)
+        powers.append(octaves[grid])  # on a log-spaced grid: a long log's spectrum is not kept
         total += f2 * power
         if floor > 0:
             smooth = np.convolve(power, kernel, mode="same")
             above = (power > NOISE_BIN_FACTOR * floor) | (smooth > NOISE_SMOOTH_FACTOR * floor)
-            above &= f < _first_gap(_octave_smoothed(power, f), f, floor)
+            above &= f < _first_gap(octaves, f, floor)
             motion += np.where(above, f2 * np.maximum(power - floor, 0.0), 0.0)
             noise += float(f2.sum() * floor)
         else:
@@ -247,10 +249,16 @@ def _first_gap(smoothed: np.ndarray, f: np.ndarray, floor: float) -> float:
     return float(f[starts[wide][0]]) if wide.any() else np.inf
 
 
-def _octave_smoothed(power: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """The mean of ``power`` over a sixth of an octave around each frequency (a running sum: O(N))."""
-    lo = np.searchsorted(f, f / 2 ** (1 / 12))
-    hi = np.searchsorted(f, f * 2 ** (1 / 12), side="right")
+def _octave_bounds(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each frequency of ``f`` (ascending), the first and one past the last bin within a twelfth of an octave
+    either side of it (:func:`_octave_smoothed`)."""
+    return np.searchsorted(f, f / 2 ** (1 / 12)), np.searchsorted(f, f * 2 ** (1 / 12), side="right")
+
+
+def _octave_smoothed(power: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """The mean of ``power`` over a sixth of an octave around each frequency (a running sum: O(N); ``bounds``:
+    :func:`_octave_bounds` of the frequencies)."""
+    lo, hi = bounds
     c = np.concatenate([[0.0], np.cumsum(power)])
     return (c[hi] - c[lo]) / np.maximum(hi - lo, 1)
 
