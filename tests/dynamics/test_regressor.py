@@ -237,3 +237,24 @@ def test_the_simd_code_is_cached_on_disk_and_loaded_from_there(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     assert traced.stat().st_mtime_ns != ir_stamp and "define void @kernel" in traced.read_text(errors="replace")
     np.testing.assert_array_equal(np.load(tmp_path / "first.npy"), np.load(tmp_path / "fourth.npy"))
+
+
+def test_without_its_source_the_simd_code_is_traced_each_time_with_the_same_numbers(tmp_path, monkeypatch):
+    """The traced IR is cached under a hash of the tracing's source; where that source cannot be read (an install
+    without the .py files), the IR is not cached, the machine code still is, and the numbers are the same."""
+    from dynid.dynamics import _regressor_simd as simd
+    from dynid.dynamics import regressor as module
+    from dynid.model.description import load_robot
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setattr(module, "NUMPY_SAMPLES", 0)
+    robot = load_robot("er16").submodel(3)
+    q = np.random.default_rng(2).uniform(-2, 2, (40, 3))
+    found, source = {}, simd._source_digest
+    for readable in (False, True):
+        monkeypatch.setattr(simd, "_kernels", {})  # a fresh process's kernels
+        monkeypatch.setattr(simd, "_source_digest", source if readable else (lambda: None))
+        found[readable] = module.regressor(robot, q, q, q)
+        traced = list((tmp_path / "dynid").glob("regressor-ir-*.ll"))
+        assert len(traced) == int(readable) and list((tmp_path / "dynid").glob("regressor-*.o"))
+    np.testing.assert_array_equal(found[False], found[True])

@@ -26,6 +26,7 @@ takes 0.4-0.5 s for a 6-joint arm; loading from the cache, about 0.015 s.
 from __future__ import annotations
 
 import ctypes
+import functools
 import hashlib
 import os
 import struct
@@ -337,8 +338,8 @@ def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
            np.asarray(gravity, float).tobytes(), int(npj), int(n_drive), np.asarray(prismatic, float).tobytes())
     with _lock:
         if key not in _kernels:
-            folder = _cache_folder()
-            path = None if folder is None else folder / f"regressor-ir-{_ir_key(key)}.ll"
+            folder, name = _cache_folder(), _ir_key(key)
+            path = None if folder is None or name is None else folder / f"regressor-ir-{name}.ll"
             cached = _read_cache(path)
             if cached is None:
                 graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
@@ -350,15 +351,29 @@ def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
         return _kernels[key][0]
 
 
-def _ir_key(key: tuple) -> str:
+def _ir_key(key: tuple) -> str | None:
     """The name of a robot's traced IR in the cache: its constants and kinds (``key``) and the source of the tracing
-    and of the arithmetic traced, so that a change of either traces again."""
-    digest = hashlib.sha256()
+    and of the arithmetic traced, so that a change of either traces again; None where the source cannot be read (the
+    IR is then traced every time, as the machine code's own cache still works)."""
+    source = _source_digest()
+    if source is None:
+        return None
+    digest = hashlib.sha256(source)
     for part in key:
         digest.update(repr(part).encode())
-    for module in (__file__, _regressor_kernel.__file__):
-        digest.update(Path(module).read_bytes())
     return digest.hexdigest()[:32]
+
+
+@functools.cache
+def _source_digest() -> bytes | None:
+    """SHA-256 of this module's and :mod:`dynid.dynamics._regressor_kernel`'s source, read once per process."""
+    digest = hashlib.sha256()
+    try:
+        for module in (__file__, _regressor_kernel.__file__):
+            digest.update(Path(module).read_bytes())
+    except OSError:
+        return None
+    return digest.digest()
 
 
 PARALLEL_SAMPLES = 4096
