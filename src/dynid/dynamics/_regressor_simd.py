@@ -17,10 +17,10 @@ function per robot serves every column selection: a column that is not selected 
 into a scratch slot. Each block of samples is zeroed first; the entries no column writes stay zero.
 
 Machine code is cached on disk (``$XDG_CACHE_HOME/dynid`` or ``~/.cache/dynid``) under a hash of the IR, the
-CPU and llvmlite's version, and the IR (compressed) under a hash of the robot's constants and of the two modules' source, so that
-a process neither traces nor compiles a robot it has met before (a TX40 identification builds nine: its model, the
-description's rigid body and the gravity directions the geometry checks try; tracing them took 0.17 s). Compiling
-takes 0.4-0.5 s for a 6-joint arm; loading from the cache, about 0.015 s.
+CPU and llvmlite's version, and the IR (zlib-compressed) under a hash of the robot's constants and of the two modules'
+source, so that a process neither traces nor compiles a robot it has met before (an identification builds several:
+its model, the description's rigid body, the gravity directions the geometry checks try). Compiling takes 0.4-0.5 s
+for a 6-joint arm; loading from the cache, about 0.015 s.
 """
 
 from __future__ import annotations
@@ -345,7 +345,7 @@ def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
             if cached is None:
                 graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
                 ir = _ir(graph, stores, len(rp), npj, n_drive)
-                _write_cache(path, zlib.compress(ir.encode()))  # a 6-joint arm's IR: 340 kB, 7x less compressed
+                _write_cache(path, zlib.compress(ir.encode()))
             else:
                 ir = zlib.decompress(cached).decode()
             _kernels[key] = _compile(ir)
