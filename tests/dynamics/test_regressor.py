@@ -96,6 +96,13 @@ def test_selected_columns_are_the_same_numbers_as_the_full_regressor(name):
     np.testing.assert_array_equal(regressor(robot, q, dq, ddq, columns=cols), full[..., cols])
     some = np.array([robot.n_params - 1, 3, 0])  # any order, drive and coupled columns included
     np.testing.assert_array_equal(regressor(robot, q, dq, ddq, columns=some), full[..., some])
+    held = np.full((300, robot.n_dof, cols.size), np.nan)  # a buffer given is written over and returned
+    assert regressor(robot, q, dq, ddq, columns=cols, out=held) is held
+    np.testing.assert_array_equal(held, full[..., cols])
+    for bad in (np.empty((300, robot.n_dof, cols.size + 1)), np.empty((300, robot.n_dof, cols.size), dtype=np.float32),
+                np.empty((cols.size, robot.n_dof, 300)).T):
+        with pytest.raises(ShapeError, match="out: expected a C-contiguous float64 array"):
+            regressor(robot, q, dq, ddq, columns=cols, out=bad)
 
 
 @pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])

@@ -113,3 +113,32 @@ def test_parallel_decimation_gives_the_same_numbers_on_any_number_of_cores(rng, 
     sos = signal.butter(4, decimation_cutoff(1000.0, 5), fs=1000.0, output="sos")
     whole = signal.sosfiltfilt(sos, x, axis=0, padtype="even", padlen=edge_padding(1000.0, decimation_cutoff(1000.0, 5), 4))[::5]
     np.testing.assert_allclose(one, whole, rtol=0, atol=1e-9 * np.abs(whole).max())
+
+
+@pytest.mark.parametrize("decimation,cutoff", [(1, 0.0), (5, 0.0), (1, 20.0)])  # 0: no filter but decimation's
+def test_every_chunk_of_the_prepared_rows_keeps_its_values_after_the_next_is_computed(decimation, cutoff):
+    """The parallel filter's chunks computed into one buffer (a new array each time is memory the system clears
+    again): what each chunk yields is its own, filtered or not."""
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.dynamics.regressor import regressor
+    from dynid.io.logs.datasets import Recording
+    from dynid.model.description import load_robot
+    from dynid.preprocessing.preparation import ParallelFiltering
+    from dynid.preprocessing.settings import Preprocessing
+
+    from ..conftest import sine_motion
+
+    robot = load_robot("er16")
+    base = base_parameters(robot, rng=0)
+    t = np.arange(6000) / 1000.0
+    q, dq, ddq = sine_motion(np.random.default_rng(4), t, robot.n_dof)
+    tau = np.einsum("kjp,p->kj", regressor(robot, q, dq, ddq), robot.standard_parameters())
+    strategy = ParallelFiltering()
+    settings = Preprocessing(decimation=decimation, parallel_cutoff=cutoff, chunk=1000).resolved(1000.0, q)
+    data = strategy.prepare(Recording("sine", t, q, dq, tau, 1000.0), settings)
+    seen = []
+    kept = [(index, y, tau_) for index, y, tau_, _ in strategy.chunks(robot, base, data)
+            if not seen.append(y.copy())]  # each chunk as it was yielded, kept before the next one is computed
+    assert len(kept) >= 5
+    for (_, y, _), first in zip(kept, seen):
+        np.testing.assert_array_equal(y, first)

@@ -28,6 +28,7 @@ import numpy as np
 
 from .._util.checks import check_states
 from .._util.keywords import keyword_only_after_data
+from ..exceptions import ShapeError
 from ..friction import TERMS, Velocities
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -51,7 +52,8 @@ _numpy_lock = threading.Lock()
 
 
 @keyword_only_after_data
-def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities=None) -> np.ndarray:
+def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities=None,
+              out: np.ndarray | None = None) -> np.ndarray:
     """Per-sample joint-torque regressor.
 
     Parameters
@@ -67,6 +69,9 @@ def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities
         The friction columns' velocities (default ``robot.friction_velocities``; a log's rest velocity and held
         direction of motion are properties of the log, :func:`dynid.friction.held_direction`); a direction has
         the samples' rows (N, n_dof).
+    out : (N, n_dof, n_params) or (N, n_dof, m) C-contiguous float64 array, optional
+        Written and returned instead of a new array (a loop over a long log's chunks keeps one, so that the memory
+        of each chunk is not handed back to the system and cleared again).
 
     Returns
     -------
@@ -77,7 +82,7 @@ def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities
     Raises
     ------
     ShapeError
-        If an input is not (N, n_dof) or holds NaN.
+        If an input is not (N, n_dof) or holds NaN, or ``out`` is not a C-contiguous float64 array of that shape.
     """
     robot = as_robot(robot)
     n = robot.n_dof
@@ -85,7 +90,11 @@ def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities
     colmap = np.full(robot.n_params, -1, dtype=np.int64)
     columns = np.arange(robot.n_params) if columns is None else np.asarray(columns, dtype=np.int64)
     colmap[columns] = np.arange(columns.size)
-    out = np.empty((n_s, n, columns.size))
+    if out is None:
+        out = np.empty((n_s, n, columns.size))
+    elif out.shape != (n_s, n, columns.size) or out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ShapeError(f"out: expected a C-contiguous float64 array of shape {(n_s, n, columns.size)}, "
+                         f"got {out.dtype} {out.shape}")
     _fill(robot, q, dq, ddq, out, colmap, velocities=velocities)
     return out
 
