@@ -1155,6 +1155,10 @@ def main(argv: list[str] | None = None) -> int:
     import signal
 
     os.environ.setdefault("MPLBACKEND", "Agg")  # figures go to files: no display needed, none opened
+    if argv is None:  # the console script's own process: freed memory kept for reuse (a caller's allocator is its own)
+        from ..runtime.memory import keep_freed_memory
+
+        keep_freed_memory()
 
     from ..runtime.processes import allow_forks
 
