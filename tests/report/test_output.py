@@ -147,16 +147,18 @@ def forks():
         yield
 
 
-def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path, forks):
+@pytest.mark.parametrize("n", [1, 2, 6])
+def test_figures_drawn_on_two_processes_are_all_written_even_if_the_child_fails(tmp_path, forks, n):
+    """From two figures on (an identification without validation logs draws two: 0.3 s less on the UR10e example)."""
     from dynid.report.output import draw_figures
 
     parent = os.getpid()
-    draw_figures(_writer_jobs, tmp_path, 6)
-    assert len(set(_writers(tmp_path, 6))) == (2 if FORKS else 1)  # both processes drew
+    draw_figures(_writer_jobs, tmp_path, n)
+    assert len(set(_writers(tmp_path, n))) == (2 if FORKS and n > 1 else 1)  # both processes drew
     for p in tmp_path.glob("*.png"):
         p.unlink()
-    draw_figures(_writer_jobs, tmp_path, 6, parent)
-    assert set(_writers(tmp_path, 6)) == {str(parent)}  # the parent redrew the child's half
+    draw_figures(_writer_jobs, tmp_path, n, parent)
+    assert set(_writers(tmp_path, n)) == {str(parent)}  # the parent redrew the child's half
 
 
 @pytest.mark.skipif(not FORKS, reason="the figure process needs fork and two cores")

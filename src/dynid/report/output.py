@@ -206,7 +206,7 @@ def _draw_jobs(jobs) -> None:
     Call it with no other thread of this process printing (the CLI ends its live progress line first).
     """
     jobs = list(jobs)
-    if len(jobs) < 4 or not can_fork():
+    if len(jobs) < 2 or not can_fork():
         for job in jobs:
             job()
         return
