@@ -3,10 +3,9 @@
 glibc's ``malloc`` gives freed memory back to the system as soon as more than its trim threshold lies free at the top
 of the heap, and that threshold follows the largest block freed so far (twice the mmap threshold, 64 MB at most). A
 long log's preparation makes and frees column arrays of tens of megabytes again and again, so the system hands the
-same memory back and clears it again for each new array: on the hour-long 1 kHz log that was about 16 GB cleared anew,
-a third of the run's system time. :func:`keep_freed_memory` fixes both thresholds instead: blocks up to
-:data:`MMAP_BYTES` from the heap, and up to :data:`TRIM_BYTES` kept free there. The command's peak memory grows by
-about the blocks kept (benchmarks/README.md: the hour-long log's figures).
+same memory back and clears it again for each new array (benchmarks/NOTEBOOK.md, stop 106, says how much).
+:func:`keep_freed_memory` fixes both thresholds instead: blocks up to :data:`MMAP_BYTES` from the heap, and up to
+:data:`TRIM_BYTES` kept free there. The command's peak memory grows by about the memory kept (benchmarks/README.md).
 
 Only the command line calls it (:func:`dynid.cli.app.main`): a library leaves its caller's allocator as it is.
 """
