@@ -7,7 +7,7 @@ relative error of 1500 %."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -105,6 +105,8 @@ class TorqueComparison:
     """Where the log is read otherwise than the identification log (its torque channels flipped or swapped:
     :mod:`dynid.validation.channel_checks`; its geometry not the robot file's: :mod:`dynid.validation.geometry_checks`),
     the warning that says how: its figures say little of any estimate, and the verdict does not weigh them."""
+    _computed: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    """label -> the metrics :meth:`metrics` computed for that set (the evidence and the verdict read them many times)."""
 
     def scored(self, label: str) -> np.ndarray:
         """The prediction the metrics score: the set's own while a joint moves; at rest, the measured torque moved
@@ -166,7 +168,13 @@ class TorqueComparison:
         """
         if self.summary is not None:
             return self.summary["metrics"]
-        out = {}
+        for label in self.predicted:
+            if label not in self._computed:
+                self._computed[label] = self._set_metrics(label)
+        return {label: dict(self._computed[label]) for label in self.predicted}  # a caller's change stays its own
+
+    def _set_metrics(self, label: str) -> dict:
+        """:meth:`metrics` of the set ``label``, computed."""
         live = np.ones(self.measured.shape[1], dtype=bool)
         live[list(self.dead)] = False
 
@@ -175,22 +183,20 @@ class TorqueComparison:
             full[live] = values
             return full
 
-        for label in self.predicted:
-            p = self.scored(label)
-            mm, pp = self.measured[:, live], p[:, live]
-            m = {"relative_error": joints(relative_error(mm, pp)), "rmse": joints(rmse(mm, pp)),
-                 "correlation": joints(correlation_coefficient(mm, pp)),
-                 "global_relative_error": global_relative_error(mm, pp)}
-            if self.centre is not None and self.resting is not None and self.resting.any():
-                # the literature's figure: the set's own prediction at rest too (to compare with published errors)
-                raw = self.predicted[label][:, live]
-                m.update(plain_relative_error=joints(relative_error(mm, raw)),
-                         plain_global_relative_error=global_relative_error(mm, raw))
-            if self.resting is not None and self.resting.any():
-                m.update(_moving_and_rest(self.measured, self.predicted[label], self.resting,
-                                          None if self.static is None else self.static.get(label)))
-            out[label] = m
-        return out
+        p = self.scored(label)
+        mm, pp = self.measured[:, live], p[:, live]
+        m = {"relative_error": joints(relative_error(mm, pp)), "rmse": joints(rmse(mm, pp)),
+             "correlation": joints(correlation_coefficient(mm, pp)),
+             "global_relative_error": global_relative_error(mm, pp)}
+        if self.centre is not None and self.resting is not None and self.resting.any():
+            # the literature's figure: the set's own prediction at rest too (to compare with published errors)
+            raw = self.predicted[label][:, live]
+            m.update(plain_relative_error=joints(relative_error(mm, raw)),
+                     plain_global_relative_error=global_relative_error(mm, raw))
+        if self.resting is not None and self.resting.any():
+            m.update(_moving_and_rest(self.measured, self.predicted[label], self.resting,
+                                      None if self.static is None else self.static.get(label)))
+        return m
 
     def without(self, *labels: str) -> TorqueComparison:
         """The same comparison with the sets ``labels`` left out (candidates scored beside the others and not kept).
