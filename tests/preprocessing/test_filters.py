@@ -21,6 +21,21 @@ def test_filtfilt_keeps_slow_sine_without_phase_lag_and_removes_fast_one():
     np.testing.assert_allclose(y[inner], slow[inner], atol=2e-3)
 
 
+@pytest.mark.parametrize("shape", [(3000,), (3000, 6), (800, 3, 2)])
+def test_the_filter_gives_each_columns_own_numbers_in_one_call_or_column_by_column(shape, monkeypatch):
+    """An array filtered in one call along time (up to WHOLE_ARRAY_VALUES) or a column at a time: SciPy's numbers for
+    each column filtered alone, to the last bit."""
+    import dynid.preprocessing.filters as filters
+
+    x = np.random.default_rng(6).standard_normal(shape)
+    sos = signal.butter(4, 20.0, btype="low", fs=500.0, output="sos")
+    flat = x.reshape(shape[0], -1)
+    alone = np.column_stack([signal.sosfiltfilt(sos, flat[:, c]) for c in range(flat.shape[1])]).reshape(shape)
+    for limit in (x.size, x.size - 1):  # one call, then column by column
+        monkeypatch.setattr(filters, "WHOLE_ARRAY_VALUES", limit)
+        np.testing.assert_array_equal(butterworth_filtfilt(x, 500.0, 20.0), alone)
+
+
 def test_differentiate_sine():
     rate = 500.0
     t = np.arange(2000) / rate

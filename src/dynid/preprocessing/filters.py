@@ -58,7 +58,16 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
     _check_cutoff(rate, cutoff, "Butterworth filter")
     signal = _signal()
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    if isinstance(x, np.ndarray) and 0 < x.size <= WHOLE_ARRAY_VALUES:  # one call: its set-up paid once, not per column
+        return signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=0)
     return by_column(x, lambda column, j: signal.sosfiltfilt(sos, column))
+
+
+WHOLE_ARRAY_VALUES = 500_000
+"""Up to this many values, :func:`butterworth_filtfilt` filters an array in one call along its first axis (the same
+numbers as column by column, about three times faster on a few thousand samples of six joints: SciPy computes the
+filter's initial state and pads once per call); above it, a column at a time, so that SciPy's copies stay one
+column's."""
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:
