@@ -4,6 +4,7 @@ capsule distances against a brute-force distance between the skeleton's segments
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 
 def _brute(a, b, radius: float) -> float:
@@ -37,6 +38,28 @@ def test_the_closest_pair_along_a_trajectory_is_found():
     seg = _segments(robot, q)
     brute = min((_brute(seg[k, i], seg[k, j], 0.05), (i + 1, j + 1), t[k]) for k in range(20) for i, j in pairs)
     assert abs(found.distance - brute[0]) < 2e-3 and found.pair == brute[1] and found.time == brute[2]
+
+
+@pytest.mark.parametrize("name,radius,spread", [("ur10e", 0.05, 2.5), ("ur10e", 0.12, 3.0), ("er16", 0.3, 2.0)])
+def test_coal_is_asked_where_the_closest_pair_can_be_and_finds_what_asking_it_everywhere_finds(name, radius, spread):
+    """The clearance coal measures at the samples and pairs the closed form screens equals, to the bit, coal asked at
+    every sample and pair (capsules apart, and overlapping: the ER-16's forearm and base, as in its digest)."""
+    from dynid.excitation.collision import _distance, _segments, self_clearance, touching_pairs
+    from dynid.model.description import load_robot
+
+    robot = load_robot(name)
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-spread, spread, (300, robot.n_dof))
+    t = np.arange(300) * 0.002
+    found = self_clearance(robot, t, q, radius)
+    pairs, seg = touching_pairs(robot, radius), _segments(robot, q)
+    best = (np.inf, None, None)
+    for k in range(300):  # coal at every sample and pair, the first smallest kept
+        for i, j in pairs:
+            d = _distance(seg[k, i], seg[k, j], radius)
+            if d < best[0]:
+                best = (d, (i + 1, j + 1), t[k])
+    assert (found.distance, found.pair, found.time) == best
 
 
 def test_the_segments_closest_points_equal_a_dense_search_in_every_case(rng):
