@@ -169,23 +169,27 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
     model.geom_margin[list(shape_of)] = workspace.clearance  # MuJoCo reports contacts up to the margin apart
     floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
 
-    def kept(c) -> float:
-        """How far apart the contact's two geoms must stay."""
-        shape = shape_of.get(c.geom1, shape_of.get(c.geom2, -1))
-        return floor_height.get(shape, 0.0) if floor in (c.geom1, c.geom2) else workspace.clearance
+    def kept(g1: int, g2: int) -> float:
+        """How far apart a contact's two geoms must stay."""
+        shape = shape_of.get(g1, shape_of.get(g2, -1))
+        return floor_height.get(shape, 0.0) if floor in (g1, g2) else workspace.clearance
 
     touching, first, deepest = 0, None, 0.0
     for n in range(q.shape[0]):
         data.qpos[:robot.n_dof] = q[n]
         mujoco.mj_forward(model, data)
-        found = [(c, kept(c) - c.dist) for c in data.contact[:data.ncon] if c.dist < kept(c) - 1e-9]
+        if not data.ncon:
+            continue
+        contacts = data.contact  # read as arrays: a contact's own Python object costs more than MuJoCo's step
+        dist, geom = contacts.dist[:data.ncon], contacts.geom[:data.ncon]
+        found = [(g1, g2, kept(g1, g2) - d) for d, (g1, g2) in zip(dist.tolist(), geom.tolist()) if d < kept(g1, g2) - 1e-9]
         if not found:
             continue
         touching += 1
-        deepest = max(deepest, max(depth for _, depth in found))
+        deepest = max(deepest, max(depth for _, _, depth in found))
         if first is None:
-            a, b = names[found[0][0].geom1], names[found[0][0].geom2]
+            a, b = names[found[0][0]], names[found[0][1]]
             link, body = (a, b) if a.startswith("link") else (b, a)
             first = {"link": int(link.removeprefix("link").split("_")[0]), "shape": link, "body": body,
-                     "time": float(t[n]), "depth": float(found[0][1])}
+                     "time": float(t[n]), "depth": float(found[0][2])}
     return CellContacts(int(q.shape[0]), touching, first, float(deepest))
