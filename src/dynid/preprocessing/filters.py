@@ -65,9 +65,8 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
 
 WHOLE_ARRAY_VALUES = 500_000
 """Up to this many values, :func:`butterworth_filtfilt` filters an array in one call along its first axis (the same
-numbers as column by column, about three times faster on a few thousand samples of six joints: SciPy computes the
-filter's initial state and pads once per call); above it, a column at a time, so that SciPy's copies stay one
-column's."""
+numbers as column by column; SciPy computes the filter's initial state and pads once per call, not once per column);
+above it, a column at a time, so that SciPy's copies stay one column's."""
 
 
 def differentiate(x: np.ndarray, rate: float) -> np.ndarray:

@@ -358,16 +358,17 @@ def _parallel_chunks(robot: Robot, base: BaseParameters, data: PreparedData,
 
     cutoff = s.parallel_cutoff if s.parallel_cutoff else None
     filtered = (s.decimation or 1) > 1 or cutoff is not None  # the chunks are filtered into new arrays: one buffer
-    held: list[np.ndarray] = []  # serves every chunk's regressor (a new one per chunk is memory the system clears again)
+    columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
+    held = None  # serves every chunk's regressor (a new one per chunk is memory the system clears again)
 
     def block(a, b):  # the regressor and the torques, filtered alike but never copied into one array
-        columns = None if standard else base.independent  # the base regressor directly: no full array, no copy
+        nonlocal held
         q, dq, ddq, tau = (np.asarray(x[a:b]) for x in (data.q, data.dq, data.ddq, data.tau))  # stored columns: read here
         v = velocities if data.direction is None else replace(velocities, direction=np.asarray(data.direction[a:b]))
-        shape = (b - a, n, robot.n_params if standard else base.n_base)
-        if filtered and (not held or held[0].shape != shape):
-            held[:] = [np.empty(shape)]
-        return regressor(robot, q, dq, ddq, columns=columns, velocities=v, out=held[0] if filtered else None), tau
+        shape = (b - a, n, robot.n_params if columns is None else columns.size)
+        if filtered and (held is None or held.shape != shape):
+            held = np.empty(shape)
+        return regressor(robot, q, dq, ddq, columns=columns, velocities=v, out=held if filtered else None), tau
 
     for index, (y, tau) in parallel_decimation(block, n_s, data.rate, s.decimation or 1, order=s.order, chunk=s.chunk, cutoff=cutoff):
         keep = data.kept(index, vmin)
