@@ -207,3 +207,38 @@ def test_the_written_mjcf_simulated_along_a_motion_needs_the_models_torques():
     phi[names.index("offset2")] = 5.0  # N·m the MJCF cannot hold: the simulator needs that much less on J2
     off = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, q, dq, ddq, regressor(robot, q, dq, ddq) @ phi)
     assert off.simulated_vs_model > 10 * check.simulated_vs_model
+
+
+def test_the_forward_checks_reference_is_the_logs_own_state_and_acceleration_at_every_sample():
+    """The reference between two samples is the quintic Hermite of their positions, velocities and accelerations
+    (independent truth: a quintic polynomial motion is reproduced exactly, with its derivatives); so on a log whose
+    positions carry sensor noise that its filtered accelerations do not, the PD loop does not make the arm follow an
+    acceleration of the interpolant's own and the simulated torques stay the model's (the cubic of positions and
+    velocities alone put 6·noise/Δt² into the acceleration asked for)."""
+    from dynid.dynamics.regressor import regressor
+    from dynid.io.exported.replay import _between, _hermite_weights, mjcf_forward
+    from dynid.model.description_files import mjcf_from_robot
+
+    coefficients = np.array([0.1, -0.4, 0.7, 0.3, -0.9, 0.5])  # q(t) = Σ c_i t^i on every joint, scaled per joint
+    scale = np.linspace(0.5, 1.5, 3)
+    t = np.array([0.2, 0.27])
+    poly = np.polynomial.Polynomial(coefficients)
+    states = [np.outer(poly.deriv(d)(t), scale) if d else np.outer(poly(t), scale) for d in range(3)]
+    weights = _hermite_weights(8)
+    position, velocity, acceleration = _between(t, *states, 0, weights)
+    inside = t[0] + np.arange(8) / 8 * (t[1] - t[0])
+    for got, d in ((position, 0), (velocity, 1), (acceleration, 2)):
+        assert np.allclose(got, np.outer(poly.deriv(d)(inside) if d else poly(inside), scale), rtol=0, atol=1e-12)
+
+    robot, phi = _estimate()
+    names = robot.parameter_names
+    for j in range(1, 7):
+        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
+    t = np.arange(0.0, 4.0, 0.004)
+    w = 2 * np.pi * 0.5
+    amp = np.linspace(0.3, 0.8, 6)
+    q, dq, ddq = amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+    noisy = q + np.random.default_rng(3).normal(0.0, 2e-5, q.shape)  # an encoder's noise; the states are filtered
+    tau = regressor(robot, noisy, dq, ddq) @ phi
+    check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, noisy, dq, ddq, tau)
+    assert check.simulated_vs_model < 0.5
