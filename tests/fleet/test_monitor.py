@@ -209,3 +209,28 @@ def test_only_the_newest_log_is_left_as_still_being_written_and_only_while_it_ch
     os.utime(logs[-1], (old, old))
     assert _complete(logs, now=now) == (logs, ())
     assert _complete(logs[:1], now=logs[0].stat().st_mtime + 2 * WRITING_AGE) == (logs[:1], ())
+
+
+def test_a_term_that_keeps_drifting_is_read_against_its_first_reference_and_its_level_now(tmp_path):
+    """Joint 3's friction rising 3 % a day from day 10 for 30 days: every rise is said (the chart follows the term's
+    new level after each alarm), and the table, the title and monitor.json read the term against the reference it
+    first learned (the first 60 windows) and at its level now (the windows of the last minute), both against the
+    simulated truth; the relearned level is no reference."""
+    truth = simulate_service_life(tmp_path, days=40, seconds=60.0, rate=100.0, wear_joint=3, wear_start_day=10.0,
+                                  wear_per_day=0.03, coulomb=True, rng=3)
+    results = _identified(tmp_path)
+    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
+    assert p.returncode == 0, p.stderr
+    report = json.loads((tmp_path / "m" / "monitor.json").read_text())
+    factor = json.loads((tmp_path / "truth.json").read_text())["logs"][-1]["friction_factor"]
+    assert factor > 1.8
+    first = [w["terms"]["fc3"] for w in report["windows"][:60]]
+    for term, value in (("fc3", truth.coulomb[2]), ("fv3", truth.viscous[2])):
+        assert sum(a["term"] == term for a in report["alarms"]) >= 2
+        assert report["reference"][term]["mean"] == pytest.approx(value, rel=0.03)
+        assert report["latest"][term] == pytest.approx(value * factor, rel=0.03)
+        assert report["changed_percent"][term] == pytest.approx(100 * (factor - 1), abs=6.0)
+    assert report["reference"]["fc3"]["mean"] == pytest.approx(np.mean(first), rel=1e-9)
+    text = " ".join(p.stdout.split())
+    change = report["changed_percent"]["fc3"]
+    assert f"joint 3 fc3 {change:+.3g} % since the reference" in text

@@ -202,6 +202,8 @@ class MonitorResult:
         Logs of an earlier run this one went on from (0: a new monitor).
     deferred : tuple of str
         Logs still being written, left for the next run (one line each, naming them).
+    latest : (n_terms,) array
+        Each term's level now (:func:`recent_level`: the window estimates of the last ``forgetting_seconds`` of log).
     """
 
     terms: tuple[str, ...]
@@ -216,6 +218,20 @@ class MonitorResult:
     state: bytes | None = field(default=None, repr=False, compare=False)
     resumed: int = 0
     deferred: tuple[str, ...] = ()
+    latest: np.ndarray = field(default_factory=lambda: np.full(0, np.nan), compare=False)
+
+    def changes(self) -> dict[str, float]:
+        """Each term that alarmed, with how far its level now is from its reference [%] (every alarm in between
+        counted in).
+
+        Returns
+        -------
+        dict
+            term -> relative change [%], in the order of the terms.
+        """
+        alarmed = {a.term for a in self.alarms}
+        return {t: 100 * float(x - m) / abs(float(m)) if m else float("inf")
+                for t, m, x in zip(self.terms, self.reference_mean, self.latest) if t in alarmed}
 
     def to_dict(self) -> dict:
         """JSON-ready: the alarms, the reference, every window's terms.
@@ -227,6 +243,8 @@ class MonitorResult:
         return {"kind": "monitor", "terms": list(self.terms), "alarms": [a.to_dict() for a in self.alarms],
                 "reference": {t: {"mean": float(m), "std": float(s)} for t, m, s in
                               zip(self.terms, self.reference_mean, self.reference_std)},
+                "latest": {t: float(x) for t, x in zip(self.terms, self.latest)},
+                "changed_percent": self.changes(),
                 "cusum_threshold": self.threshold,
                 "settings": {"window_s": self.settings.window, "reference_windows": self.settings.reference_windows,
                              "shift": self.settings.shift,
@@ -261,6 +279,63 @@ def determined(sigmas: np.ndarray) -> np.ndarray:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             return np.asarray(sigmas <= UNDETERMINED * np.nanmedian(finite, axis=0), dtype=bool)
+
+
+def reference_level(windows) -> tuple[np.ndarray, np.ndarray]:
+    """Each term's reference mean and spread over the reference windows.
+
+    A window that did not determine a term (:func:`determined`: a joint that kept one direction, whose Coulomb friction
+    and offset are then one column) is left out of that term's reference. The spread is itself estimated from the
+    windows: its upper 95 % confidence bound, at least the windows' median σ, widened by the mean's own uncertainty,
+    so that the charts' false-alarm rate holds (a spread 15 % low would make false alarms some 40 times as frequent).
+
+    Parameters
+    ----------
+    windows : sequence of MonitorWindow
+        The reference windows.
+
+    Returns
+    -------
+    mean, spread : (n_terms,) arrays
+    """
+    from scipy.stats import chi2
+
+    ref = len(windows)
+    values = np.array([w.theta for w in windows])
+    sigmas = np.array([w.std for w in windows])
+    values = np.where(determined(sigmas), values, np.nan)
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean = np.nanmean(values, axis=0)
+        upper = np.sqrt((ref - 1) / chi2.ppf(0.05, ref - 1))
+        spread = np.fmax(np.nanstd(values, axis=0, ddof=1) * upper,
+                         np.nanmedian(np.where(np.isfinite(sigmas), sigmas, np.nan), axis=0)) * np.sqrt(1 + 1 / ref)
+    return mean, spread
+
+
+def recent_level(windows, seconds: float) -> np.ndarray:
+    """Each term's level now: the mean of the window estimates in the last ``seconds`` of log (at least the last
+    window), the windows that did not determine a term (:func:`determined`, over every window) left out; NaN where
+    none did. What the monitor's figure shows at its right end.
+
+    Parameters
+    ----------
+    windows : sequence of MonitorWindow
+    seconds : float [s]
+
+    Returns
+    -------
+    (n_terms,) array
+    """
+    if not windows:
+        return np.full(0, np.nan)
+    values = np.array([w.theta for w in windows])
+    values = np.where(determined(np.array([w.std for w in windows])), values, np.nan)
+    elapsed = np.cumsum([w.end - w.start for w in windows][::-1])
+    last = max(int(np.searchsorted(elapsed, seconds - 1e-9)) + 1, 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(values[-last:], axis=0)
 
 
 def dated_logs(folder: str | Path, pattern: str = "*.csv") -> list[Path]:
@@ -417,28 +492,12 @@ class FrictionMonitor:
         return np.concatenate(theta), np.concatenate(std)
 
     def _chart(self) -> list[DriftAlarm]:
-        from scipy.stats import chi2
-
         count = len(self.windows)
         ref = self.settings.reference_windows
         if count < ref:
             return []
         if count == ref:
-            values = np.array([w.theta for w in self.windows])
-            sigmas = np.array([w.std for w in self.windows])
-            # a window that did not determine a term (a joint that kept one direction: its Coulomb friction and its
-            # offset are then one column) is left out of that term's reference
-            values = np.where(determined(sigmas), values, np.nan)
-            with np.errstate(all="ignore"):
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", RuntimeWarning)
-                    self.mean = np.nanmean(values, axis=0)
-                    # the spread is itself estimated from `ref` windows: its upper 95 % confidence bound, and the
-                    # mean's own uncertainty, so that the charts' false-alarm rate holds (a spread 15 % low would
-                    # make false alarms some 40 times as frequent)
-                    upper = np.sqrt((ref - 1) / chi2.ppf(0.05, ref - 1))
-                    self.std = np.fmax(np.nanstd(values, axis=0, ddof=1) * upper,
-                                       np.nanmedian(np.where(np.isfinite(sigmas), sigmas, np.nan), axis=0)) * np.sqrt(1 + 1 / ref)
+            self.mean, self.std = reference_level(self.windows)
             per_day = 86400.0 / self.settings.window
             k = self.settings.shift / 2
             self.threshold = cusum_threshold(self.settings.false_alarm_days * per_day, 2 * len(self.terms), k)
@@ -559,8 +618,13 @@ class FrictionMonitor:
         -------
         MonitorResult
         """
-        return MonitorResult(self.terms, self.joints, tuple(self.windows), self.mean, self.std, self.threshold,
-                             tuple(self.alarms), self.settings, tuple(self.logs))
+        ref = self.settings.reference_windows
+        # the reference as first learned: a term that alarmed follows its new level in self.mean, and a table, figure
+        # or change read against that level would hide how far the term has gone in all
+        mean = reference_level(self.windows[:ref])[0] if len(self.windows) >= ref else self.mean
+        return MonitorResult(self.terms, self.joints, tuple(self.windows), mean, self.std, self.threshold,
+                             tuple(self.alarms), self.settings, tuple(self.logs),
+                             latest=recent_level(self.windows, self.settings.forgetting_seconds))
 
 
 def monitor_fingerprint(results: str | Path, settings: MonitorSettings) -> str:

@@ -107,20 +107,20 @@ def monitor_blocks(result) -> list:
     list of Line and TextTable
     """
     hours = sum(w.end - w.start for w in result.windows) / 3600
-    first: dict = {}
-    for a in result.alarms:
-        first.setdefault(a.term, a)
-    verdict = (f"{len(first)} term(s) changed: " + ", ".join(f"joint {a.joint} {a.term} {a.change:+.3g} %" for a in first.values())
-               if first else "no change")
+    count = {t: sum(a.term == t for a in result.alarms) for t in result.terms}
+    joint = dict(zip(result.terms, result.joints))
+    changes = result.changes()
+    verdict = (f"{len(changes)} term(s) changed: " + ", ".join(
+        f"joint {joint[t]} {t} {c:+.3g} % since the reference" + (f" ({count[t]} alarms)" if count[t] > 1 else "")
+        for t, c in changes.items()) if changes else "no change")
     out: list = [Line(f"dynid monitor — {len(result.logs)} logs, {len(result.windows)} windows of {result.settings.window:g} s "
                       f"({hours:.3g} h of logs): {verdict}", "title")]
-    latest = result.windows[-1].tracked if result.windows else np.full(len(result.terms), np.nan)
-    rows = tuple((t, f"joint {j}", _cell(float(m), ".4g"), _cell(float(s), ".2g"), _cell(float(x), ".4g"),
-                  str(sum(a.term == t for a in result.alarms)))
+    latest = result.latest if result.latest.size else np.full(len(result.terms), np.nan)
+    rows = tuple((t, f"joint {j}", _cell(float(m), ".4g"), _cell(float(s), ".2g"), _cell(float(x), ".4g"), str(count[t]))
                  for t, j, m, s, x in zip(result.terms, result.joints, result.reference_mean, result.reference_std, latest))
     out.append(TextTable(f"Terms: reference over the first {result.settings.reference_windows} windows (mean, spread), the "
-                         "recursive estimate at the end, alarms", ("term", "joint", "reference", "spread", "latest", "alarms"),
-                         rows))
+                         f"level now (the windows of the last {result.settings.forgetting_seconds:g} s), alarms",
+                         ("term", "joint", "reference", "spread", "now", "alarms"), rows))
     for a in result.alarms:
         out.append(Line(f"alarm: {a}", "warning"))
     for line in result.deferred:
