@@ -130,3 +130,37 @@ def test_a_right_payload_on_a_real_arm_is_judged_against_the_arms_own_residual()
     assert payload(1.11).expected == 1.11 and not payload(1.11).misfit
     assert payload(np.nan).expected == 0.333 and payload(np.nan).misfit
     assert payload(0.5).misfit and 2.55 > FLOOR_FACTOR * 0.5
+
+
+@pytest.mark.parametrize("held", [("finger_b_joint",), ("finger_a_joint", "finger_b_joint")])
+def test_a_payload_fitted_on_a_link_that_slides_is_said(tmp_path, held):
+    """issue "Every assurance checked on what the user meets", item 5: a chain whose last link is a gripper's jaw (a
+    SCARA's finger left in the chain: its prismatic joint moves in the log) puts the payload on the jaw; the payload
+    says how far that link slid (the log's own range of the joint, independent truth) and dynid payload warns. With
+    the fingers held, the last joint turns and nothing is said."""
+    from dynid.cli.app import payload_warnings
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.payload import payload_from_log
+    from dynid.model.description import load_robot
+    from dynid.preprocessing.preparation import prepare
+    from dynid.preprocessing.settings import Preprocessing
+    from dynid.studies.example import _with_drives
+    from dynid.studies.simulated_logs import simulated_log
+
+    from ..dynamics.test_prismatic_joints import SCARA
+
+    (tmp_path / "scara.urdf").write_text(SCARA)
+    robot = _with_drives(load_robot(tmp_path / "scara.urdf", held=list(held)), np.random.default_rng(0))
+    base = base_parameters(robot, rng=0)
+    data = prepare(simulated_log(robot, seconds=20.0, rate=250.0, rng=4), Preprocessing(), strict=False)
+    found = payload_from_log(robot, base, base.base_from_standard(robot.standard_parameters()), data, rng=0)
+    said = " ".join(payload_warnings(found, f"joint {robot.n_dof} ({robot.joints[-1].name})"))
+    if len(held) == 1:
+        assert robot.joints[-1].name == "finger_a_joint" and robot.joints[-1].prismatic
+        travel = float(np.ptp(np.asarray(data.q)[:, -1]))
+        assert travel > 0.005 and found.last_joint_travel == pytest.approx(travel, rel=1e-12)
+        assert found.rides_a_sliding_link and found.to_dict()["last_joint_travel"] == found.last_joint_travel
+        assert f"joint 5 (finger_a_joint), which is prismatic and slid {1000 * travel:.3g} mm" in said
+    else:
+        assert not robot.joints[-1].prismatic and found.last_joint_travel == 0.0
+        assert "prismatic and slid" not in said

@@ -663,18 +663,44 @@ def payload(
         return save_payload(found, out, robot=cfg.robot, parent=_last_link(cfg), estimate=label)
 
     def show(rep, computed, paths):
-        _, (found, label, ratio) = computed
+        cfg, (found, label, ratio) = computed
         for line in payload_lines(found, label, ratio):
             rep.line(line)
-        if found.misfit:  # a rigid payload on the flange leaves the log's noise
-            rep.warning(f"the fit with the payload is {found.error_with / found.expected:.2g} times the log's noise floor "
-                        f"or the arm model's own residual, the larger ({found.error_with:.3g} % against "
-                        f"{found.expected:.3g} %): something beyond a rigid payload on the flange (a last link that moves, "
-                        "such as a gripper's jaw; the arm's model; torques read otherwise): check it before using the "
-                        "payload")
+        for line in payload_warnings(found, f"joint {cfg.robot.n_dof} ({cfg.robot.joints[-1].name})"):
+            rep.warning(line)
         rep.wrote(paths)
 
     _Command("dynid payload", quiet, out).run(prepare, compute, save, show)
+
+
+def payload_warnings(found, last_joint: str) -> list[str]:
+    """What ``dynid payload`` warns of: a fit far above what a right payload leaves
+    (:attr:`~dynid.identification.payload.Payload.misfit`), and a last link that slid during the log
+    (:attr:`~dynid.identification.payload.Payload.rides_a_sliding_link`).
+
+    Parameters
+    ----------
+    found : dynid.identification.payload.Payload
+    last_joint : str
+        The chain's last joint, as named in the warning.
+
+    Returns
+    -------
+    list of str
+    """
+    out = []
+    if found.misfit:  # a rigid payload on the flange leaves the log's noise
+        out.append(f"the fit with the payload is {found.error_with / found.expected:.2g} times the log's noise floor "
+                   f"or the arm model's own residual, the larger ({found.error_with:.3g} % against "
+                   f"{found.expected:.3g} %): something beyond a rigid payload on the flange (a last link that moves, "
+                   "such as a gripper's jaw; the arm's model; torques read otherwise): check it before using the "
+                   "payload")
+    if found.rides_a_sliding_link:
+        out.append(f"the payload is fitted on the link of {last_joint}, which is prismatic and slid "
+                   f"{1000 * found.last_joint_travel:.3g} mm during this log (a gripper's jaw?): a tool on the flange "
+                   "rides on the link before it, so these figures are not a rigid tool's; hold that joint ([robot] "
+                   "held) and identify the arm and its payload again")
+    return out
 
 
 def payload_lines(found, label: str, ratio=None) -> list[str]:

@@ -37,6 +37,10 @@ floor, or the arm model's own residual on its identification log where that is l
 its 2.805 kg payload the fit is 7.7 times the noise floor (the arm model itself leaves more than the noise): the floor
 alone would flag a right payload."""
 
+SLID = 1e-3
+"""[m] A last link that slides on its prismatic joint by more than this during the payload's log moves relative to
+the flange (a gripper's jaw): said (:attr:`Payload.rides_a_sliding_link`)."""
+
 __all__ = ["Payload", "payload_from_log"]
 
 
@@ -69,6 +73,9 @@ class Payload:
     error_arm : float [%]
         What the arm's model leaves of its own identification log (its residual σ per joint), on the same samples;
         NaN where the results hold no such figure.
+    last_joint_travel : float [m]
+        How far the link the payload is put on slid on its joint during the log, where that joint is prismatic (a
+        gripper's jaw as the chain's last link; :attr:`rides_a_sliding_link`); 0 for a revolute last joint.
     """
 
     mass: float
@@ -82,6 +89,7 @@ class Payload:
     error_with: float
     error_floor: float = float("nan")
     error_arm: float = float("nan")
+    last_joint_travel: float = 0.0
 
     @property
     def expected(self) -> float:
@@ -95,6 +103,12 @@ class Payload:
         """Whether the fit with the payload stays over :data:`FLOOR_FACTOR` times :attr:`expected`: something beyond a
         rigid payload on the flange (the arm's model off, a last link that moves, torques read otherwise)."""
         return bool(np.isfinite(self.expected) and self.error_with > FLOOR_FACTOR * self.expected)
+
+    @property
+    def rides_a_sliding_link(self) -> bool:
+        """Whether the link the payload was fitted on slid by more than :data:`SLID` during the log: a tool on the
+        flange rides on the link before it, and this payload's figures are not a rigid tool's."""
+        return self.last_joint_travel > SLID
 
     def to_dict(self) -> dict:
         """JSON-ready payload.
@@ -110,7 +124,8 @@ class Payload:
                 "last_link_parameters": dict(zip(INERTIAL_TERMS, self.parameters.tolist())),
                 "global_relative_error_without": self.error_without, "global_relative_error_with": self.error_with,
                 "global_relative_error_floor": None if not np.isfinite(self.error_floor) else self.error_floor,
-                "global_relative_error_arm": None if not np.isfinite(self.error_arm) else self.error_arm}
+                "global_relative_error_arm": None if not np.isfinite(self.error_arm) else self.error_arm,
+                "last_joint_travel": self.last_joint_travel}
 
 
 def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, *, rng=0,
@@ -178,5 +193,7 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     def share(sigma) -> float:  # each joint's σ on the samples kept, as a global relative error [%]
         return np.nan if sigma is None else 100.0 * float(np.sqrt(np.sum((sigma * ratio) ** 2 * kept) / max(total, 1e-300)))
 
+    travel = float(np.ptp(np.asarray(loaded.q)[:, -1])) if robot.joints[-1].prismatic else 0.0
     return Payload(m, com, inertia, mass_std, com_std, lost, phi, float(error[0]), float(error[1]),
-                   share(noise_floor(loaded)), share(None if residual is None else np.asarray(residual, dtype=float)))
+                   share(noise_floor(loaded)), share(None if residual is None else np.asarray(residual, dtype=float)),
+                   travel)
