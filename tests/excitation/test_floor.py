@@ -126,16 +126,18 @@ def test_a_mesh_under_the_table_with_every_joint_origin_above_it_is_found(ur10e_
     assert contacts.touching == 1 and contacts.first["body"] == "floor" and contacts.deepest > 0.05
 
 
-def test_dynid_excite_over_a_table_holds_every_shape_by_pinocchio_and_coal(ur10e_with_meshes, tmp_path):  # noqa: F811
+@pytest.mark.parametrize("clearance", [0.05, 0.2])
+def test_dynid_excite_over_a_table_holds_every_shape_by_pinocchio_and_coal(ur10e_with_meshes, tmp_path, clearance):  # noqa: F811
     """``dynid excite`` with ``[workspace] floor = 0.0`` under the UR10e's base: at every set-point of excitation.csv
-    each moving collision shape stays the clearance above the table (or, a housing that starts within it, no lower
-    than it starts), by Pinocchio's placement of the URDF's meshes and coal's distance to the plane; the printed lowest
-    shape and height are that pass's to 1 mm, and MuJoCo's check is said to be on the same shapes."""
+    each moving collision shape stays the clearance above the table (or, a housing that starts within it, no more than
+    1 mm lower than it starts, which the output says with the start heights), by Pinocchio's placement of the URDF's
+    meshes and coal's distance to the plane; the printed lowest shape and height are that pass's to 1 mm, and MuJoCo's
+    check is said to be on the same shapes. With a clearance of 0.2 m the upper arm starts within it."""
     cfg = tmp_path / "excite.toml"
     cfg.write_text(f'robot = "{ur10e_with_meshes}"\n[trajectory]\nharmonics = 2\nfrequency = 0.1\n'
                    f"offsets = {HOME.tolist()}\nrest = true\n"
                    '[limits]\nq_min = ["-pi", "-pi", "-pi", "-pi", "-pi", "-pi"]\nq_max = ["pi", 0.0, "pi", "pi", "pi", "pi"]\n'
-                   "dq_max = 1.0\nddq_max = 4.0\n[workspace]\nfloor = 0.0\n"
+                   f"dq_max = 1.0\nddq_max = 4.0\n[workspace]\nfloor = 0.0\nclearance = {clearance}\n"
                    "[design]\nstarts = 1\nmaxiter = 60\ngrid_points = 40\n[output]\nrate = 100\n")
     p = dynid("excite", str(cfg), "--out", str(tmp_path / "out"))
     assert p.returncode == 0, p.stderr
@@ -147,7 +149,7 @@ def test_dynid_excite_over_a_table_holds_every_shape_by_pinocchio_and_coal(ur10e
         for name, (d, joint) in heights(row[1:7], 0.0).items():
             if joint == 0 or abs(d - start[name][0]) < 1e-9 and joint == 1:
                 continue  # the base's and the first link's (turning about the vertical axis) never move down
-            need = min(0.05, start[name][0] - 1e-3)
+            need = min(clearance, start[name][0] - 1e-3)
             assert d >= need - 1e-6, (name, row[0], d)
             if d - need < tightest[0]:
                 tightest = (d - need, name, row[0], d)
@@ -158,6 +160,13 @@ def test_dynid_excite_over_a_table_holds_every_shape_by_pinocchio_and_coal(ur10e
     row = csv[int(np.argmin(np.abs(csv[:, 0] - float(found.group(1)))))]
     assert heights(row[1:7], 0.0)[name][0] == pytest.approx(lowest, abs=1e-3)
     assert "measured on the collision shapes of" in said
+    # a shape that starts within the clearance is said with the start height the pass finds and what it is held to
+    held = re.search(r"those that start within it, at most 1 mm lower than they start: ([^)]*)\)", said)
+    within = {n: d for n, (d, joint) in start.items() if joint > 1 and d < clearance}
+    assert bool(held) == bool(within), said
+    for part in held.group(1).split(", ") if held else ():
+        shape, height = re.fullmatch(r"(\S+) from ([0-9.e-]+) m", part).groups()
+        assert start[shape][0] == pytest.approx(float(height), abs=1e-3)
     doc = json.loads((tmp_path / "out" / "excitation.json").read_text())
     [floor] = [m for m in doc["cell_clearance"] if m["constraint"].startswith("floor")]
     assert floor["worst"] == pytest.approx(lowest, abs=1e-3)

@@ -259,12 +259,14 @@ def _floor_lines(run) -> list:
         return [Line(f"a link's shape comes within the floor's clearance at a set-point: {low.where} at {low.worst:.3g} m "
                      f"above the floor, {-low.margin:.3g} m inside (between the verification grid's samples): do not "
                      "run it; raise design.grid_points", "warning")]
+    from ..excitation.floor import START_SLACK  # coal's import stays out of a summary's
+
     needs = ws.floor_needs(p.robot, p.start_pose())
     names = ws.shapes(p.robot).names
     held = [] if needs is None else needs.within
     within = "" if not held else (
-        " (those that start within it, no lower than they start: "
-        + ", ".join(f"{names[int(needs.shapes[c])]} at {needs.start[c]:.3g} m" for c in held) + ")")
+        f" (those that start within it, at most {1000 * START_SLACK:g} mm lower than they start: "
+        + ", ".join(f"{names[int(needs.shapes[c])]} from {needs.start[c]:.3g} m" for c in held) + ")")
     under = needs is not None and any(needs.start[c] < 0 for c in held)  # estimated capsules only: shapes are refused
     return [Line(f"every link's shape stays {ws.clearance:g} m or more above the floor ({ws.floor:g} m) at the set-points"
                  f"{within}; the tightest: {low.where}, {low.worst:.3g} m above it (measured on the {ws.shapes_said()})"
