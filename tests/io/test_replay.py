@@ -242,3 +242,29 @@ def test_the_forward_checks_reference_is_the_logs_own_state_and_acceleration_at_
     tau = regressor(robot, noisy, dq, ddq) @ phi
     check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, noisy, dq, ddq, tau)
     assert check.simulated_vs_model < 0.5
+
+
+def test_the_forward_checks_steps_follow_the_logs_rate():
+    """By default the simulation takes 40 steps a sample, none shorter than MIN_STEP (25 µs): a 5 kHz log takes 8
+    where it took 40, a 100 Hz one 40 as before; the torques the simulated arm needs are those of a simulation at 40
+    steps a sample (the independent reference, 5 times finer) to 1e-3 of the model's RMS torque."""
+    from dynid.dynamics.regressor import regressor
+    from dynid.io.exported.replay import MIN_STEP, mjcf_forward
+    from dynid.model.description_files import mjcf_from_robot
+
+    robot, phi = _estimate()
+    names = robot.parameter_names
+    for j in range(1, 7):
+        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
+    text = mjcf_from_robot(robot, phi)
+    w = 2 * np.pi * 0.5
+    amp = np.linspace(0.3, 0.8, 6)
+    for rate, expected in ((5000.0, 8), (100.0, 40)):
+        t = np.arange(0.0, 1.0, 1.0 / rate)
+        q, dq, ddq = amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+        tau = regressor(robot, q, dq, ddq) @ phi
+        default = mjcf_forward(text, robot, phi, t, q, dq, ddq, tau)
+        assert default.substeps == expected and 1.0 / rate / expected >= MIN_STEP * (1 - 1e-9)
+        if expected < 40:
+            fine = mjcf_forward(text, robot, phi, t, q, dq, ddq, tau, substeps=40)
+            assert abs(default.simulated_vs_model - fine.simulated_vs_model) < 0.1  # [%] of the model's torque
