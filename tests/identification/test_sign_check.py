@@ -238,6 +238,23 @@ def test_a_light_joint_whose_nominal_torque_the_description_misstates_is_not_a_f
     assert "J6:" in f.text and "sign = [1, 1, 1, 1, 1, -1]" in f.text
 
 
+def test_a_joint_is_judged_against_the_other_joints_size_not_its_own():
+    """The zoo's SCARA with a CAD-like description and a geared drive (class cad-gear, simulated with the right
+    sign): its vertical quill's force beyond friction runs against its small nominal inertial force (ρ -0.691) at 10.1
+    times its size; the one other joint the nominal model judges has a slope of 0.978. The quill was called flipped
+    and the model "not ready": its own slope made half of the median it was judged against (5.5). Against the other
+    joint's size it is no flip; a quill at that size is."""
+    from dynid.validation.diagnostics import sign_findings
+
+    rho = np.array([0.831, 0.405, -0.691, 0.047])
+    slope = np.array([0.978, 0.682, -10.06, 56.377])
+    varies = np.ones(4, bool)
+    assert sign_findings(rho, varies, "identification", slope=slope) == []
+    slope[2] = -1.1
+    (f,) = sign_findings(rho, varies, "identification", slope=slope)
+    assert "J3:" in f.text and "sign = [1, 1, -1, 1]" in f.text
+
+
 def test_one_joints_scale_is_named_with_a_scale_per_joint():
     """J2's torque 1000× the nominal model's where J1, J3 and J4 agree with theirs: "set scale = [1, 0.001, 1, ...]";
     the median slope of the four (about 1) said nothing. One joint 4× off where only one other is judged: nothing (no

@@ -326,9 +326,10 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
         The config table to fix (its ``sign``).
     slope : (n_dof,) array, optional
         The slope of each joint's measured torque on the nominal model's (beside ``correlation``). Where given, a joint
-        is named only where its |slope| is within :data:`SCALE_LIMIT` of the median |slope| of the joints whose
+        is named only where its |slope| is within :data:`SCALE_LIMIT` of the median |slope| of the other joints whose
         |ρ| ≥ 0.5: a flipped channel keeps its size, while a joint whose small nominal torque the description misstates
-        (a light wrist of a CAD model: ρ -0.5, slope -13.7 where the others' are 0.7-0.8) is not a flip.
+        (a light wrist of a CAD model: ρ -0.5, slope -13.7 where the others' are 0.7-0.8) is not a flip. The other
+        joints': with two such joints, a joint's own slope was half the median it was judged against.
 
     Returns
     -------
@@ -339,9 +340,13 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
     if slope is not None:
         k = np.abs(np.asarray(slope, dtype=float))
         sized = [j for j in judged if np.isfinite(k[j]) and k[j] > 0]
-        typical = float(np.median(k[sized])) if sized else float("nan")
-        judged = [j for j in judged if not np.isfinite(typical) or not np.isfinite(k[j])
-                  or 1 / SCALE_LIMIT <= k[j] / typical <= SCALE_LIMIT]
+
+        def typical(j: int) -> float:  # the other joints' size: a joint's own slope is no yardstick for itself
+            others = [i for i in sized if i != j]
+            return float(np.median(k[others])) if others else float("nan")
+
+        judged = [j for j in judged if not np.isfinite(typical(j)) or not np.isfinite(k[j])
+                  or 1 / SCALE_LIMIT <= k[j] / typical(j) <= SCALE_LIMIT]
     bad = [j for j in judged if corr[j] < -0.5]
     if not bad:
         return []
