@@ -29,6 +29,21 @@ def _estimate():
     return robot, phi
 
 
+def _without_dry_friction():
+    """:func:`_estimate` with no Coulomb friction or offset (all the MJCF holds as dynid's model)."""
+    robot, phi = _estimate()
+    names = robot.parameter_names
+    for j in range(1, 7):
+        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
+    return robot, phi
+
+
+def _sines(t: np.ndarray):
+    """Each joint's sine of 0.5 Hz (amplitudes 0.3-0.8 rad) at ``t``: q, dq, ddq."""
+    w, amp = 2 * np.pi * 0.5, np.linspace(0.3, 0.8, 6)
+    return amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+
+
 def test_the_written_urdf_reproduces_the_model_and_says_what_it_cannot_hold():
     robot, phi = _estimate()
     text, _ = urdf_written_back(URDF, robot, phi)
@@ -192,14 +207,10 @@ def test_the_written_mjcf_simulated_along_a_motion_needs_the_models_torques():
     from dynid.io.exported.replay import mjcf_forward
     from dynid.model.description_files import mjcf_from_robot
 
-    robot, phi = _estimate()
+    robot, phi = _without_dry_friction()
     names = robot.parameter_names
-    for j in range(1, 7):
-        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
     t = np.arange(0.0, 4.0, 0.01)
-    w = 2 * np.pi * 0.5
-    amp = np.linspace(0.3, 0.8, 6)
-    q, dq, ddq = amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+    q, dq, ddq = _sines(t)
     tau = regressor(robot, q, dq, ddq) @ phi
     check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, q, dq, ddq, tau)
     assert check.simulated_vs_model < 0.5 and check.model_vs_measured < 1e-9
@@ -230,14 +241,9 @@ def test_the_forward_checks_reference_is_the_logs_own_state_and_acceleration_at_
     for got, d in ((position, 0), (velocity, 1), (acceleration, 2)):
         assert np.allclose(got, np.outer(poly.deriv(d)(inside) if d else poly(inside), scale), rtol=0, atol=1e-12)
 
-    robot, phi = _estimate()
-    names = robot.parameter_names
-    for j in range(1, 7):
-        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
+    robot, phi = _without_dry_friction()
     t = np.arange(0.0, 4.0, 0.004)
-    w = 2 * np.pi * 0.5
-    amp = np.linspace(0.3, 0.8, 6)
-    q, dq, ddq = amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+    q, dq, ddq = _sines(t)
     noisy = q + np.random.default_rng(3).normal(0.0, 2e-5, q.shape)  # an encoder's noise; the states are filtered
     tau = regressor(robot, noisy, dq, ddq) @ phi
     check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, noisy, dq, ddq, tau)
@@ -252,16 +258,11 @@ def test_the_forward_checks_steps_follow_the_logs_rate():
     from dynid.io.exported.replay import MIN_STEP, mjcf_forward
     from dynid.model.description_files import mjcf_from_robot
 
-    robot, phi = _estimate()
-    names = robot.parameter_names
-    for j in range(1, 7):
-        phi[names.index(f"fc{j}")] = phi[names.index(f"offset{j}")] = 0.0
+    robot, phi = _without_dry_friction()
     text = mjcf_from_robot(robot, phi)
-    w = 2 * np.pi * 0.5
-    amp = np.linspace(0.3, 0.8, 6)
     for rate, expected in ((5000.0, 8), (100.0, 40)):
         t = np.arange(0.0, 1.0, 1.0 / rate)
-        q, dq, ddq = amp * np.sin(w * t)[:, None], amp * w * np.cos(w * t)[:, None], -amp * w**2 * np.sin(w * t)[:, None]
+        q, dq, ddq = _sines(t)
         tau = regressor(robot, q, dq, ddq) @ phi
         default = mjcf_forward(text, robot, phi, t, q, dq, ddq, tau)
         assert default.substeps == expected and 1.0 / rate / expected >= MIN_STEP * (1 - 1e-9)
