@@ -121,30 +121,67 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         Too few rows or a rank-deficient base observation matrix (the log does not excite every base parameter).
     """
     keys, given = estimator_choices(estimators)
-    n = robot.n_dof
+    problem, prior_notes, not_carried = _fit_problem(robot, base, keys)
+    ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
+    scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
+    estimation, scoring = _one_pass(robot, base, data, Estimation(keys, problem, base.names, keep_rows=scored, given=given),
+                                    held_out=(held_out or jackknife) and "sdp" in keys, observers=observers,
+                                    progress=progress)
+    reference = _solved_reference(robot, base, estimation, data)
+    row_weights = None if ls_key == "ols" else 1.0 / np.where(reference.joint_std_ > 0, reference.joint_std_, 1.0)
+    estimates, box = _fitted_estimates(estimation, reference, keys, ls_key, row_weights, rng=rng, progress=progress)
+    warnings = _log_warnings(robot, data, estimates, reference, references, prior_notes=prior_notes, not_carried=not_carried)
+    sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
+    objective = {}
+    if scored:
+        w_all, tau_all = estimation.rows()
+        objective = {label: float(paper_objective(tau_all - w_all @ beta, robot.n_dof)) for label, beta in sets.items()}
+    evidence = _log_evidence(robot, base, data, scoring, reference, estimates, sets, row_weights, rng=rng,
+                             ls_label=estimate_label(ls_key), held_out=held_out, jackknife=jackknife,
+                             variants=variants, progress=progress)
+    return IdentificationResult(
+        robot.name, base, keys, ls_key, reference.solution_, reference.joint_std_, estimates, tuple(references),
+        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
+                                                                  **_given_settings(given)},
+        warnings=tuple(warnings), objective=objective, box=box, model=robot, main=estimate_label(keys[0]), **evidence)
+
+
+def _fit_problem(robot: Robot, base: BaseParameters, keys) -> tuple[FitData, tuple[str, ...], tuple[str, ...]]:
+    """:func:`identify`'s problem for the estimators ``keys``: the description's prior (the documented prior of every
+    estimator that asks for one, said wherever the description has inertial values: the nominal candidate takes them
+    too), the consistency layout where an estimate is checked link by link, the stated σ; with the prior's notes and
+    the names of the σ least squares cannot carry."""
     sdp = "sdp" in keys
     prior = None
     prior_notes: tuple[str, ...] = ()
-    if sdp or np.any(robot.inertial != 0):  # the documented prior of every estimator that asks for one, SDP or not
+    if sdp or np.any(robot.inertial != 0):
         try:
             prior, prior_notes = robot.physical_prior()
         except DynIdError:
             if sdp:
                 raise
-        # said wherever the description has inertial values: the nominal candidate takes them too (nominal_set)
     base_std, not_carried = base.base_std(robot.prior_sigmas()) if robot.prior_sigma else (None, ())
-    problem = FitData(None, None, n, None, base, layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
-                      prior=prior,
-                      base_prior=base.base_from_standard(robot.standard_parameters()),
+    problem = FitData(None, None, robot.n_dof, None, base,
+                      layout=consistency_layout(robot) if sdp or any(spec(k).space == "standard" for k in keys) else None,
+                      prior=prior, base_prior=base.base_from_standard(robot.standard_parameters()),
                       prior_std=robot.prior_sigmas() if robot.prior_sigma else None, base_prior_std=base_std)
-    ls_key = next((k for k in keys if k in LEAST_SQUARES), "wls")
-    scored = any(k not in (ls_key, "sdp") for k in keys)  # F of eq. 9 for every set: the rows in memory
-    estimation = Estimation(keys, problem, base.names, keep_rows=scored, given=given)
-    scoring = BlockScoring(robot, base, data, held_out=(held_out or jackknife) and sdp, observers=observers)
+    return problem, prior_notes, not_carried
+
+
+def _one_pass(robot: Robot, base: BaseParameters, data: PreparedData, estimation: Estimation, *, held_out: bool,
+              observers: tuple, progress) -> tuple[Estimation, BlockScoring]:
+    """:func:`identify`'s one pass over the log's rows: every block of base (and, where an estimator or the held-out
+    blocks need them, standard) rows into the estimators and the verdict's sums."""
+    scoring = BlockScoring(robot, base, data, held_out=held_out, observers=observers)
     standard = estimation.standard or bool(scoring.folds)
     chunks = base_chunks(robot, base, data, _step(progress, f"regressor, {data.name}"), standard=standard)
     stream_rows(chunks, estimation, base, scoring.add, standard=standard)
-    sums, folds = scoring.sums, scoring.folds
+    return estimation, scoring
+
+
+def _solved_reference(robot: Robot, base: BaseParameters, estimation: Estimation, data: PreparedData):
+    """The least-squares reference of the pass (its error names the joints that barely move); the SDP's prior then
+    splits Coulomb friction and offset as least squares did where it anchored them."""
     try:
         reference = estimation.solve_reference()
     except IdentifiabilityError as exc:
@@ -152,28 +189,47 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
         still = [f"J{j + 1}" for j in np.flatnonzero(speed < 1e-3 * max(speed.max(), 1e-12))]
         hint = f"; joint(s) {', '.join(still)} barely move" if still else ""
         raise IdentifiabilityError(f"{data.name}: {exc}{hint}") from None
-    sol, ols_params, joint_std = reference.solution_, reference.ols_params_, reference.joint_std_
-    if sol.anchored and "sdp" in estimation.streamed:  # the SDP splits Coulomb + offset as least squares did
-        estimation.problem = replace(problem, prior=_anchored_prior(problem.prior, robot, base, sol))
-    row_weights = None if ls_key == "ols" else 1.0 / np.where(joint_std > 0, joint_std, 1.0)
+    sol = reference.solution_
+    if sol.anchored and "sdp" in estimation.streamed:
+        estimation.problem = replace(estimation.problem, prior=_anchored_prior(estimation.problem.prior, robot, base, sol))
+    return reference
+
+
+def _fitted_estimates(estimation: Estimation, reference, keys, ls_key: str, row_weights, *, rng: int,
+                      progress) -> tuple[dict, np.ndarray | None]:
+    """Every estimator's estimate by label (least squares' the reference's own), and the box the box searches drew
+    from (:func:`search_box`; None where no estimator needs one)."""
+    sol = reference.solution_
     box = search_box(sol.params, sol.params_std) if estimation.needs_box else None
     report = None if progress is None else (lambda key, i, f: progress(f"estimators: {estimator_label(key)}", 0 if i is None else i, 0))
     fitted = estimation.fit(box, rng=int(rng), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
-    estimates = {}
-    for key in (*keys, *(() if ls_key in keys else (ls_key,))):
-        estimates[estimate_label(key)] = _estimate(key, fitted.get(key), reference if key == ls_key else None)
+    estimates = {estimate_label(key): _estimate(key, fitted.get(key), reference if key == ls_key else None)
+                 for key in (*keys, *(() if ls_key in keys else (ls_key,)))}
+    return estimates, box
+
+
+def _log_warnings(robot: Robot, data: PreparedData, estimates: dict, reference, references, *,
+                  prior_notes: tuple[str, ...], not_carried: tuple[str, ...]) -> list[str]:
+    """:func:`identify`'s warnings, in this order: the description's, the prior's, the log's, the estimators', the σ
+    least squares cannot carry, rows mostly left out as too slow, and the reference sets'."""
     warnings = list(robot.nominal_problems) + list(robot.nominal_notes) + list(prior_notes) + list(data.warnings) + \
         [e.note for e in estimates.values() if e.note] + _not_carried_note(not_carried)
+    n = robot.n_dof
     dropped = 1.0 - reference.accumulator_.rows.sum() / (n * len(range(0, data.t.shape[0], data.settings.decimation or 1)))
     if dropped > 0.5:
         warnings.append(f"{data.name}: {100 * dropped:.0f}% of the rows are below preprocessing.min_speed and were left out")
     for r in references:
         warnings.extend(r.warnings)
-    sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
-    objective = {}
-    if scored:
-        w_all, tau_all = estimation.rows()
-        objective = {label: float(paper_objective(tau_all - w_all @ beta, n)) for label, beta in sets.items()}
+    return warnings
+
+
+def _log_evidence(robot: Robot, base: BaseParameters, data: PreparedData, scoring: BlockScoring, reference,
+                  estimates: dict, sets: dict, row_weights, *, rng: int, ls_label: str, held_out: bool, jackknife: bool,
+                  variants: tuple, progress) -> dict:
+    """What the log itself says for the verdict (:func:`identify`'s fields of the result): every set's consistency
+    and fit, the drive-only candidate, the findings (the model's, a swapped pair's, a flipped joint's where the log is
+    read right) and the held-out blocks' refits."""
+    sums, joint_std = scoring.sums, reference.joint_std_
     if progress is not None:
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
@@ -182,23 +238,17 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
-    findings, stats = _verdict(robot, base, sol, ols_params, row_weights, scoring=scoring, fit=fit, rng=rng,
-                               consistent="sdp" in keys)
+    findings, stats = _verdict(robot, base, reference.solution_, reference.ols_params_, row_weights, scoring=scoring,
+                               fit=fit, rng=rng, consistent=SDP_LABEL in estimates)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
     if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
         findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
-    ls_label = estimate_label(ls_key)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
-    refits = _held_out_evidence(robot, base, folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
+    refits = _held_out_evidence(robot, base, scoring.folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
                                 jackknife=jackknife, progress=progress, span=float(data.t[-1] - data.t[0]))
-    return IdentificationResult(
-        robot.name, base, keys, ls_key, sol, joint_std, estimates, tuple(references), fit,
-        n_rows=int(reference.accumulator_.rows.sum()), settings={"preprocessing": data.settings.to_dict(), "rate": data.rate,
-                                                                  **_given_settings(given)},
-        warnings=tuple(warnings), consistency=margins, consistency_verdicts=verdicts, objective=objective, box=box,
-        model=robot, findings=tuple(findings), diagnostics=stats, main=estimate_label(keys[0]), drive_only=alternative,
-        sdp_refits=refits)
+    return {"fit": fit, "consistency": margins, "consistency_verdicts": verdicts, "findings": tuple(findings),
+            "diagnostics": stats, "drive_only": alternative, "sdp_refits": refits}
 
 
 def _not_carried_note(names: tuple[str, ...]) -> list[str]:
