@@ -224,6 +224,36 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
         raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
                         f"(at least {3 * (2 * settings.order + 1) + 1} for preprocessing.order = {settings.order})")
     s = settings.resolved(rate, recording.q, measured_velocity=recording.dq is not None, name=recording.label, strict=strict)
+    q, dq, ddq = _filtered_states(recording, s)
+    tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
+    moving = _direction_velocity(recording, s, dq)
+    s, rest = _rest_and_speed(recording, s, dq, strict)
+    if ddq is None:
+        ddq = differentiate(dq, rate)
+    t = recording.t
+    cut = int(round(s.trim * rate))
+    if cut:
+        if 2 * cut >= t.shape[0] - 2:
+            raise DataError(f"{recording.label}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
+                            f"the {t[-1] - t[0]:.3f} s recording")
+        t, q, dq, ddq, tau, moving = (x[cut:-cut] for x in (t, q, dq, ddq, tau, moving))
+    resting = np.empty(dq.shape, dtype=bool)  # one byte a sample and joint, whatever the log's length
+    for j in range(dq.shape[1]):
+        resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
+    dead, clipped, channel_words = _channel_checks(tau, t, recording.label, s, rate)
+    positions = recording.q[cut:-cut] if cut else recording.q
+    still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
+                  if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
+    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
+                        tuple(recording.warnings) + s.warnings + channel_words,
+                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped,
+                        getattr(recording, "drive_gains", None))
+
+
+def _filtered_states(recording, s: Preprocessing):
+    """:func:`_parallel_prepare`'s positions and velocities, low-passed (the measured velocities checked against the
+    positions' derivative) or from the Fourier fit with their accelerations (None: differentiated later)."""
+    rate = recording.rate
 
     def lowpass(x, cutoff, what):
         if cutoff <= 0:
@@ -233,16 +263,19 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
         except ConfigError as exc:
             raise ConfigError(f"preprocessing.{what}_cutoff: {exc}") from None
 
-    ddq = None
     if s.fourier is not None:
         q, dq, ddq, _ = fourier_fit_derivatives(recording.t, recording.q, *s.fourier)
-    else:
-        q = lowpass(recording.q, s.position_cutoff, "position")
-        dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
-        if recording.dq is not None:
-            check_velocities(dq, differentiate(q, rate), recording.label, positions=q)
-    tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
-    moving = _direction_velocity(recording, s, dq)
+        return q, dq, ddq
+    q = lowpass(recording.q, s.position_cutoff, "position")
+    dq = lowpass(recording.dq, s.velocity_cutoff, "velocity") if recording.dq is not None else differentiate(q, rate)
+    if recording.dq is not None:
+        check_velocities(dq, differentiate(q, rate), recording.label, positions=q)
+    return q, dq, None
+
+
+def _rest_and_speed(recording, s: Preprocessing, dq, strict: bool) -> tuple[Preprocessing, np.ndarray]:
+    """:func:`_parallel_prepare`'s rest velocity and minimum speed, derived where "auto" (said in the derivation), a
+    given minimum speed above every speed of a joint refused where ``strict``; with each joint's rest velocity."""
     if s.rest_velocity == "auto":
         rest = np.maximum(REST_FACTOR * _velocity_noise(recording, s), np.asarray(s.rest_floor, dtype=float))
         s = replace(s, rest_velocity=tuple(float(v) for v in rest),
@@ -264,35 +297,21 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
             raise ConfigError(f"preprocessing.min_speed: {vmin[j]:.4g} rad/s is above every speed of joint {j + 1} in "
                               f"{recording.label} (at most {peak[j]:.4g} rad/s), which leaves it no row; lower it, or "
                               f"leave it out ({100 * MIN_SPEED_FRACTION:g} % of each joint's RMS speed)")
-    if ddq is None:
-        ddq = differentiate(dq, rate)
-    t = recording.t
-    cut = int(round(s.trim * rate))
-    if cut:
-        if 2 * cut >= t.shape[0] - 2:
-            raise DataError(f"{recording.label}: preprocessing.trim = {s.trim:.3g} s at both ends leaves no samples of "
-                            f"the {t[-1] - t[0]:.3f} s recording")
-        t, q, dq, ddq, tau, moving = (x[cut:-cut] for x in (t, q, dq, ddq, tau, moving))
-    resting = np.empty(dq.shape, dtype=bool)  # one byte a sample and joint, whatever the log's length
-    for j in range(dq.shape[1]):
-        resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
-    dead, dead_words = dead_channels(tau, recording.label)
+    return s, rest
+
+
+def _channel_checks(tau, t, label: str, s: Preprocessing, rate: float) -> tuple[tuple, object, tuple]:
+    """:func:`_parallel_prepare`'s dead, saturated and clipped torque channels (a joint at its limit throughout is
+    left out as a dead one; every joint so is refused), and their words."""
+    dead, dead_words = dead_channels(tau, label)
     reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
-    clipped, clipped_words, saturated = clipped_samples(tau, t, recording.label, reach)
+    clipped, clipped_words, saturated = clipped_samples(tau, t, label, reach)
     dead = tuple(sorted(set(dead) | set(saturated)))  # a joint at its limit throughout is left out as a dead one
     if saturated and len(dead) == tau.shape[1]:  # (torques all dead, e.g. none given to predict: refused upstream)
-        raise DataError(f"{recording.label}: every joint's torque reads one value or its limit throughout (dead or "
+        raise DataError(f"{label}: every joint's torque reads one value or its limit throughout (dead or "
                         "saturated channels): nothing can be identified from this log; a log where the drives are "
                         "within their limits is needed")
-    positions = recording.q[cut:-cut] if cut else recording.q
-    still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
-                  if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
-    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
-                        tuple(recording.warnings) + s.warnings + dead_words + clipped_words,
-                        direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped,
-                        getattr(recording, "drive_gains", None))
-
-
+    return dead, clipped, dead_words + clipped_words
 
 
 def _direction_velocity(recording, s: Preprocessing, dq):
