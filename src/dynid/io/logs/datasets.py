@@ -260,10 +260,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         t, raw, where = _in_time_range(spec, t, raw, where, warnings)
     t, raw, where = _filled(spec, t, raw, where, warnings)
     side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
-    if "positions" in raw and side("positions") != "motor":  # a motor may turn near a whole turn between samples
-        raw["positions"] = unwrapped_positions(raw["positions"], spec.name, warnings)
-    raw = _held_rows(spec, t, raw, warnings)
-    raw = _despiked(spec, raw, warnings)
+    raw = _cleaned(spec, t, raw, side("positions") != "motor", warnings)
     if (spec.time_range is not None or spec.rows is not None) and t.size < MIN_SELECTED:
         which, value = ("time_range", list(spec.time_range)) if spec.time_range is not None else ("rows", list(spec.rows or ()))
         raise DataError(f"{spec.table or spec.name}: {which} = {value} selects {t.size} samples; at least {MIN_SELECTED} "
@@ -273,30 +270,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     if timed and spec.resample is None:  # before the gaps: a log in milliseconds has its gaps in seconds
         check_clock_unit(median, q_source, table)
     if timed:
-        steps = np.diff(t)
-        gaps = np.flatnonzero(steps > GAP_FACTOR * median)
-        if gaps.size and spec.gaps == "auto" and float(steps[gaps].max()) > AUTO_GAP_SAMPLES * median:
-            k = int(gaps[np.argmax(steps[gaps])])
-            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s, "
-                            f"{steps[k] / median:.0f} samples) after the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s "
-                            f"into the selected rows), longer than the {AUTO_GAP_SAMPLES} samples dynid fills by itself; set "
-                            f"gaps = \"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select "
-                            "rows on one side of it")
-        if gaps.size and spec.gaps == "refuse":
-            k = int(gaps[0])
-            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s) after "
-                            f"the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s into the selected rows); set gaps = "
-                            f"\"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select rows "
-                            "on one side of it")
-        if gaps.size:
-            k = int(gaps[np.argmax(steps[gaps])])
-            if steps[k] > spec.max_gap:
-                raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps after {t[k] - t[0]:.3f} s of "
-                                f"the selected rows is longer than max_gap = {spec.max_gap:g} s, the most gaps = \"interpolate\" "
-                                f"fills with invented samples; select rows on one side of it, or raise max_gap in {table}")
-            warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
-                            f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"{spec.gaps}\" in {table}; \"refuse\" "
-                            "refuses them)")
+        _check_gaps(spec, t, where, median, warnings)
     uniform = not timed or np.ptp(np.diff(t)) <= 1e-6 * median
     if timed and not uniform and np.ptp(np.diff(t)) <= 1e-6 * median + 4 * float(np.spacing(np.abs(t).max())):
         # a uniform grid whose stamps' digits run out (POSIX seconds, a date and time: 0.24 µs at 2026's): put back on it
@@ -306,6 +280,57 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
+    q, dq, tau, kind = _joint_side(spec, robot, raw, side, warnings)
+    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
+                  tau_source=tau_source, warnings=warnings)
+    source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
+    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
+                     robot.drive_gains.copy() if kind == "currents" else None)
+
+
+def _cleaned(spec: DatasetSpec, t: np.ndarray, raw: dict, joint_side: bool, warnings: list[str]) -> dict:
+    """:func:`_assemble`'s raw signals with joint-side positions unwrapped (a motor may turn near a whole turn between
+    samples: not those), rows a logger held repaired and spikes removed, each said in ``warnings``."""
+    if "positions" in raw and joint_side:
+        raw["positions"] = unwrapped_positions(raw["positions"], spec.name, warnings)
+    raw = _held_rows(spec, t, raw, warnings)
+    return _despiked(spec, raw, warnings)
+
+
+def _check_gaps(spec: DatasetSpec, t: np.ndarray, where, median: float, warnings: list[str]) -> None:
+    """:func:`_assemble`'s gaps in the time stamps: refused where the spec's ``gaps`` asks, or longer than dynid fills
+    by itself or than ``max_gap``; else said (they are filled by the resampling)."""
+    table = spec.table or spec.name
+    steps = np.diff(t)
+    gaps = np.flatnonzero(steps > GAP_FACTOR * median)
+    if gaps.size and spec.gaps == "auto" and float(steps[gaps].max()) > AUTO_GAP_SAMPLES * median:
+        k = int(gaps[np.argmax(steps[gaps])])
+        raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s, "
+                        f"{steps[k] / median:.0f} samples) after the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s "
+                        f"into the selected rows), longer than the {AUTO_GAP_SAMPLES} samples dynid fills by itself; set "
+                        f"gaps = \"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select "
+                        "rows on one side of it")
+    if gaps.size and spec.gaps == "refuse":
+        k = int(gaps[0])
+        raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps (median step {median:.3g} s) after "
+                        f"the time stamp {float(t[k]):.6g} s ({t[k] - t[0]:.3f} s into the selected rows); set gaps = "
+                        f"\"interpolate\" in {table} to fill gaps up to max_gap = {spec.max_gap:g} s, or select rows "
+                        "on one side of it")
+    if gaps.size:
+        k = int(gaps[np.argmax(steps[gaps])])
+        if steps[k] > spec.max_gap:
+            raise DataError(f"{where(k + 1)}: a gap of {steps[k]:.3g} s in the time stamps after {t[k] - t[0]:.3f} s of "
+                            f"the selected rows is longer than max_gap = {spec.max_gap:g} s, the most gaps = \"interpolate\" "
+                            f"fills with invented samples; select rows on one side of it, or raise max_gap in {table}")
+        warnings.append(f"{spec.name}: {gaps.size} gap(s) in the time stamps filled by interpolation, the longest "
+                        f"{steps[k]:.3g} s after {t[k] - t[0]:.3f} s (gaps = \"{spec.gaps}\" in {table}; \"refuse\" "
+                        "refuses them)")
+
+
+def _joint_side(spec: DatasetSpec, robot: Robot, raw: dict, side, warnings: list[str]):
+    """:func:`_assemble`'s joint-side positions, velocities and torques (motor-side signals through the transmission,
+    currents through the drive gains; each raw signal popped as soon as its joint-side one exists), and whether the
+    log gave currents or torques."""
     tr = robot.transmission
     if side("positions") == "motor":  # popped: each raw signal is released as soon as its joint-side one exists
         q = _row_wise(tr.joint_positions, raw.pop("positions"))
@@ -322,11 +347,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     else:
         motor_or_joint = raw["torques"]
     tau = _row_wise(tr.joint_torques, motor_or_joint) if side(kind) == "motor" else motor_or_joint
-    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
-                  tau_source=tau_source, warnings=warnings)
-    source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
-    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
-                     robot.drive_gains.copy() if kind == "currents" else None)
+    return q, dq, tau, kind
 
 
 def given_recording(robot: Robot, t, q, tau, dq, name: str) -> Recording:
