@@ -359,17 +359,10 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     root = Path(override) if override else here / (typed.data_root or ".")  # an absolute path stays as is
     if not root.is_dir():
         raise ConfigError(f"{path}: data_root {root} is not a folder (set data_root in the config, or {DATA_ROOT_ENV})", field="data_root")
-    robot = _sensed_terms(config_robot(doc, path, root), doc, path)
+    robot = _robot_of(doc, path, root)
     n = robot.n_dof
-    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic)
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic)
-                       for i, v in enumerate(doc.get("validation", [])))
-    names = [v.name for v in validation]
-    if len(set(names)) != len(names):
-        raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
-    given = typed.preprocessing
-    table = PreprocessingTable(auto=True, coulomb_velocity="auto") if given == "auto" else given or PreprocessingTable()
-    pre = _preprocessing(table, f"{path}: preprocessing", n, here)
+    ident, validation = _datasets(doc, path, root, robot)
+    pre = _preprocessing_of(typed.preprocessing, path, n)
     controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
                              robot.transmission.position_offset)
     estimation = _estimation_settings(typed.estimation, pre, path, controller is not None)
@@ -380,6 +373,31 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     return IdentificationConfig(path, robot, ident, validation, pre, tuple(refs), root, estimation, drive_gains=gains,
                                 robot_source=source, urdf=urdf, controller=controller, torque_sensor=_torque_sensor(doc),
                                 mjcf_model=mjcf)
+
+
+def _robot_of(doc: dict, path: Path, root: Path):
+    """:func:`config_from_document`'s robot: its table or file (:func:`config_robot`), with the drive terms a joint
+    torque sensor does not see (:func:`_sensed_terms`)."""
+    return _sensed_terms(config_robot(doc, path, root), doc, path)
+
+
+def _datasets(doc: dict, path: Path, root: Path, robot) -> tuple:
+    """:func:`config_from_document`'s identification dataset and validation datasets (their names unique)."""
+    n = robot.n_dof
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic)
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic)
+                       for i, v in enumerate(doc.get("validation", [])))
+    names = [v.name for v in validation]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{path}: validation: dataset names must be unique, got {names}")
+    return ident, validation
+
+
+def _preprocessing_of(given, path: Path, n: int):
+    """:func:`config_from_document`'s preprocessing: the table given, ``"auto"`` (every choice made on the data), or
+    the defaults."""
+    table = PreprocessingTable(auto=True, coulomb_velocity="auto") if given == "auto" else given or PreprocessingTable()
+    return _preprocessing(table, f"{path}: preprocessing", n, path.parent)
 
 
 def _current_document(doc: dict, path: Path) -> dict:
