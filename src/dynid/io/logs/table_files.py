@@ -277,6 +277,11 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
                 flush()
         flush()
     _check_selection(path, not blocks and files is None, data_row, header, rows, bool(warnings))
+    return _table_of(blocks, files, first_line, warnings)
+
+
+def _table_of(blocks: list, files: list | None, first_line: int | None, warnings: list[str]) -> Table:
+    """:func:`read_table`'s table: its blocks stacked in memory, or its columns' files (a spooled log)."""
     return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
 
 
