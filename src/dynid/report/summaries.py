@@ -238,37 +238,10 @@ def identification_blocks(result, *, library: bool = False) -> list:
     list of Line and TextTable
     """
     r = result
-    sol, base = r.solution, r.base
     out: list = [readiness(r, library=library), _identification_title(r)]
     out.extend(in_short(r))  # how it went and what to do next, first; the details follow
-    pre = r.settings.get("preprocessing", {})
-    if pre.get("derivation"):
-        out.append(Line("preprocessing: " + pre["derivation"]))
-    if r.settings.get("preprocessing_cross_validation") is not None:
-        out.append(filter_choice_table(r.settings["preprocessing_cross_validation"]))
-    if r.settings.get("coulomb_cross_validation") is not None:
-        out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
-    if r.settings.get("friction_models") is not None:
-        out.append(friction_choice_table(r.settings["friction_models"]))
-
-    # IDIM-IV, DIDIM, the drive-only estimate and any other main estimate (the SDP): beside least squares
-    main = r.main_estimate
-    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY
-              or (e is main and e.key != r.least_squares)]
-    kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
-    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
-    rows = tuple((n, base.unit(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
-                  *(("prior" if i in kept else f"{boot.get(n, math.nan):.2g}",) if boot else ()),
-                  "—" if i in kept else f"{larger_relative_std(n, sol.params[i], sol.relative_std[i], boot):.1f}",
-                  *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
-                 for i, n in enumerate(base.names))
-    out.append(TextTable(f"Base parameters, {r.label} (σ: standard deviation{SIGMA_WORDS if boot else ''}; "
-                         + ("closed-loop estimates and " if any(e.key in OTHER_LABELS for e in closed) else
-                            "the main estimate and " if closed else "") + "reference values beside)",
-                         ("name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
-                          *(label(e.key) + (" (main)" if e is main else "") for e in closed),
-                          *(ref.name for ref in r.references)),
-                         rows, labels=2))
+    out.extend(_preparation_blocks(r))
+    out.append(_base_table(r))
     for ref in r.references:
         if ref.relative_std is not None:
             a = r.reference_agreement(ref)
@@ -299,6 +272,46 @@ def identification_blocks(result, *, library: bool = False) -> list:
     out.extend(_verdict(r))
     out.extend(Line(w, "warning") for w in r.warnings)
     return out
+
+
+def _preparation_blocks(r) -> list:
+    """:func:`identification_blocks`' lines on how the data were prepared and the tables of the choices made on them
+    (cutoffs, the Coulomb smoothing, the friction models)."""
+    out: list = []
+    pre = r.settings.get("preprocessing", {})
+    if pre.get("derivation"):
+        out.append(Line("preprocessing: " + pre["derivation"]))
+    if r.settings.get("preprocessing_cross_validation") is not None:
+        out.append(filter_choice_table(r.settings["preprocessing_cross_validation"]))
+    if r.settings.get("coulomb_cross_validation") is not None:
+        out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
+    if r.settings.get("friction_models") is not None:
+        out.append(friction_choice_table(r.settings["friction_models"]))
+    return out
+
+
+def _base_table(r) -> TextTable:
+    """:func:`identification_blocks`' table of the base parameters: least squares' values and σ (bootstrap's beside),
+    the closed-loop, drive-only and other main estimates, and the reference sets."""
+    sol, base = r.solution, r.base
+    # IDIM-IV, DIDIM, the drive-only estimate and any other main estimate (the SDP): beside least squares
+    main = r.main_estimate
+    closed = [e for e in r.estimates.values() if e.key in OTHER_LABELS or e.key == DRIVE_ONLY_KEY
+              or (e is main and e.key != r.least_squares)]
+    kept = set(sol.from_prior)  # directions the log did not determine: the prior's (finding "prior")
+    boot = (r.diagnostics or {}).get("bootstrap_std") or {}
+    rows = tuple((n, base.unit(n), f"{sol.params[i]:.4g}", "prior" if i in kept else f"{sol.params_std[i]:.2g}",
+                  *(("prior" if i in kept else f"{boot.get(n, math.nan):.2g}",) if boot else ()),
+                  "—" if i in kept else f"{larger_relative_std(n, sol.params[i], sol.relative_std[i], boot):.1f}",
+                  *(f"{e.params[i]:.4g}" for e in closed), *(f"{ref.beta[i]:.4g}" for ref in r.references))
+                 for i, n in enumerate(base.names))
+    return TextTable(f"Base parameters, {r.label} (σ: standard deviation{SIGMA_WORDS if boot else ''}; "
+                     + ("closed-loop estimates and " if any(e.key in OTHER_LABELS for e in closed) else
+                        "the main estimate and " if closed else "") + "reference values beside)",
+                     ("name", "unit", "value", "σ", *(("σ boot.",) if boot else ()), "σ %",
+                      *(label(e.key) + (" (main)" if e is main else "") for e in closed),
+                      *(ref.name for ref in r.references)),
+                     rows, labels=2)
 
 
 def _identification_title(r) -> Line:
