@@ -294,14 +294,7 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         terms = check_terms(d.drive_terms if d.drive_terms is not None else default, f"{source}: drive_terms")
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
-    urdf_model = None
-    upath: Any = None
-    rows = d.joints
-    held = _held(d.held, convention, source, d.xacro_args)
-    if convention == "urdf":
-        upath, urdf_model = _read_urdf(d.urdf, base, source, held, d.xacro_args)
-        if rows is None:
-            rows = [joint_table() for _ in urdf_model[0]]
+    held, upath, urdf_model, rows = _urdf_and_rows(d, convention, base, source, joint_table)
     if not rows:
         raise ConfigError(f"{source}: expected one or more [[joints]] tables")
     n = len(rows)
@@ -316,13 +309,8 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
     terms, mask, drive, gains, transmission, stated = _drives(d, rows, where, terms, urdf=(upath, urdf_lim),
                                                               source=source)
     limits = _limits(rows, where, urdf_lim)
-    gravity = np.asarray(d.gravity, dtype=float)
-    if urdf_lim is not None and "gravity" in urdf_lim and "gravity" not in doc and not np.allclose(urdf_lim["gravity"], gravity):
-        stated += (f"{source}: {upath.name}'s <option gravity> is {_vector(urdf_lim['gravity'])} m/s², not taken: the robot's "
-                   f"gravity is {_vector(gravity)} (gravity = [x, y, z] in the [robot] table, or the description, sets it)",)
-    if d.payload is not None:
-        inertial = inertial.copy()
-        inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, *dh)
+    gravity, inertial, stated = _gravity_and_payload(d, doc, inertial, stated, convention=convention, dh=dh,
+                                                     urdf=(upath, urdf_lim), source=source)
     link_names = links if convention == "urdf" else names  # a URDF's own link names; a DH table's joint names
     problems = _nominal_problems(inertial, link_names, source)
     return Robot(
@@ -331,6 +319,35 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         notes=d.notes, transmission=transmission, drive_mask=mask, nominal_problems=problems,
         stribeck_velocity=np.array([float(_or(r.stribeck_velocity, DEFAULT_STRIBECK_VELOCITY)) for r in rows]),
         prior_sigma=_prior_sigma(rows, terms), held=tuple(held), nominal_notes=stated)
+
+
+def _urdf_and_rows(d, convention: str, base, source: str, joint_table):
+    """:func:`robot_from_document`'s held joints, and for a URDF convention the file read (its path and Pinocchio's
+    model), with one joint row per joint of its chain where the table gives none."""
+    urdf_model = None
+    upath: Any = None
+    rows = d.joints
+    held = _held(d.held, convention, source, d.xacro_args)
+    if convention == "urdf":
+        upath, urdf_model = _read_urdf(d.urdf, base, source, held, d.xacro_args)
+        if rows is None:
+            rows = [joint_table() for _ in urdf_model[0]]
+    return held, upath, urdf_model, rows
+
+
+def _gravity_and_payload(d, doc: dict, inertial: np.ndarray, stated: tuple, *, convention: str, dh, urdf: tuple,
+                         source: str) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """:func:`robot_from_document`'s gravity (a URDF's MJCF-style gravity option not taken, said) and the last link's
+    inertial values with the table's payload added."""
+    upath, urdf_lim = urdf
+    gravity = np.asarray(d.gravity, dtype=float)
+    if urdf_lim is not None and "gravity" in urdf_lim and "gravity" not in doc and not np.allclose(urdf_lim["gravity"], gravity):
+        stated += (f"{source}: {upath.name}'s <option gravity> is {_vector(urdf_lim['gravity'])} m/s², not taken: the robot's "
+                   f"gravity is {_vector(gravity)} (gravity = [x, y, z] in the [robot] table, or the description, sets it)",)
+    if d.payload is not None:
+        inertial = inertial.copy()
+        inertial[-1] = inertial[-1] + _payload(d.payload, f"{source}: payload", convention, *dh)
+    return gravity, inertial, stated
 
 
 def _chain(d, rows, where: list[str], names: list[str], *, convention: str, urdf: tuple, held: dict, source: str):

@@ -300,7 +300,7 @@ def _rest_and_speed(recording, s: Preprocessing, dq, strict: bool) -> tuple[Prep
     return s, rest
 
 
-def _channel_checks(tau, t, label: str, s: Preprocessing, rate: float) -> tuple[tuple, object, tuple]:
+def _channel_checks(tau, t, label: str, s: Preprocessing, rate: float) -> tuple[tuple, np.ndarray | None, tuple]:
     """:func:`_parallel_prepare`'s dead, saturated and clipped torque channels (a joint at its limit throughout is
     left out as a dead one; every joint so is refused), and their words."""
     dead, dead_words = dead_channels(tau, label)
