@@ -157,6 +157,25 @@ def _comment(text: str) -> str:
     return "<!--" + text.replace("--", "- -") + "-->"
 
 
+def _write_joint(text, links: dict, children: dict, joint, link_name: str, robot, fitted, k: int, own) -> list[str]:
+    """:func:`urdf_written_back`'s joint ``k``: its child link's identified inertial values (less its held links' own,
+    ``own``, the nearest consistent ones where that is not physically consistent; the fixed links merged into it
+    emptied) and its ``<dynamics>``; what moved far from the file's values, said."""
+    moved = []
+    alone = fitted.inertial[k] - (0.0 if own is None else own)
+    if own is not None and np.any(own != 0) and not is_physically_consistent(alone):
+        alone = nearest_consistent(alone)  # the identified link lighter than its held links' nominal values
+        moved.append(f"{link_name}: its identified values less the held links' own are not physically consistent; "
+                     "the nearest consistent ones are written (the held links keep the file's)")
+    mass, com, inertia = physical_from_inertial(alone)
+    merged = _remove_fixed_inertials(text, links, children, link_name)
+    _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged)
+    _write_dynamics(text, joint, robot, fitted, k)
+    m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
+    far = moved_far(link_name, mass, com, m0, c0, "URDF")
+    return moved + ([far] if far else [])
+
+
 def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate: str = "the physically consistent "
                       "estimate") -> tuple[str, list[str]]:
     """The user's own URDF with the identified values written into it, and nothing else changed.
@@ -229,19 +248,8 @@ def urdf_written_back(urdf: str | Path, robot: Robot, phi: np.ndarray, estimate:
     own = _held_contributions(path, data, text, links, held_links, robot) if held_links else None
     moved: list[str] = []
     for k, joint in enumerate(robot.joints):
-        link_name = end(joints[joint.name], "child")
-        alone = fitted.inertial[k] - (0.0 if own is None else own[k])
-        if own is not None and np.any(own[k] != 0) and not is_physically_consistent(alone):
-            alone = nearest_consistent(alone)  # the identified link lighter than its held links' nominal values
-            moved.append(f"{link_name}: its identified values less the held links' own are not physically consistent; "
-                         "the nearest consistent ones are written (the held links keep the file's)")
-        mass, com, inertia = physical_from_inertial(alone)
-        merged = _remove_fixed_inertials(text, links, children, link_name)
-        _write_inertial(text, links[link_name], _inertial_values(mass, com, inertia), merged)
-        _write_dynamics(text, joints[joint.name], robot, fitted, k)
-        m0, c0, _ = physical_from_inertial(robot.inertial[k]) if robot.inertial[k][9] > 0 else (0.0, np.zeros(3), None)
-        far = moved_far(link_name, mass, com, m0, c0, "URDF")
-        moved.extend([far] if far else [])
+        moved.extend(_write_joint(text, links, children, joints[joint.name], end(joints[joint.name], "child"), robot,
+                                  fitted, k, None if own is None else own[k]))
     head = _header_comments(path, robot, fitted, estimate, moved)
     inner = text.indent_in(root)
     text.insert(root.open_end, "".join(f"\n{inner}{h}" for h in head))
