@@ -70,6 +70,38 @@ def _rebased(source_dir: Path, out_dir: Path, value: str | None) -> str:
     return os.path.relpath(source_dir / target, out_dir)
 
 
+def _aligned(path: Path, robot: Robot, data, ids) -> tuple:
+    """:func:`mjcf_written_back`'s robot joint frames and the rotation and translation that place them on the MJCF's
+    joints at q = 0 (``data`` after ``mj_kinematics`` there); a file whose axes are not the robot's is refused."""
+    rotations, origins = _joint_frames(robot)
+    axes_robot = np.einsum("kij,kj->ki", rotations, np.array([j.axis for j in robot.joints], dtype=float))
+    axes_robot /= np.linalg.norm(axes_robot, axis=1, keepdims=True)
+    try:
+        r, t, misfit = _alignment(axes_robot, origins, data.xaxis[ids], data.xanchor[ids])
+    except ValueError:
+        raise ConfigError(f"{path}: every joint axis is parallel, so the axes cannot place the arm: write back needs "
+                          "two joints that are not parallel") from None
+    if misfit > AXIS_TOLERANCE:
+        raise ConfigError(f"{path}: its joint axes at q = 0 are not the robot's (off by {misfit:.3g}, in m or rad): "
+                          "another robot, another zero position or joints turning the other way")
+    return rotations, origins, r, t
+
+
+def _append_model_terms(root, robot: Robot, fitted, coupled, *, offsets_held: bool) -> None:
+    """:func:`mjcf_written_back`'s model-wide terms: the coupled motors' tendons (or a comment with their terms where
+    they are not held), the joints' position offsets (a comment), and the offsets' actuators where they are held."""
+    if coupled is not None:
+        _append_tendons(root, coupled)
+    elif robot.transmission.n_coupled_params:
+        root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
+            f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
+                                              fitted.transmission.coupled_values.ravel())) + " "))
+    if note := position_offset_note(robot):
+        root.append(ET.Comment(note))
+    for attributes in offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []:
+        ET.SubElement(_section(root, "actuator"), "general", attributes)
+
+
 def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: str | Path | None = None,
                       estimate: str = "the physically consistent estimate", *, offsets_held: bool = False
                       ) -> tuple[str, list[str]]:
@@ -128,17 +160,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
     data.qpos[:] = model.qpos0
     data.qpos[model.jnt_qposadr[ids]] = 0.0
     mujoco.mj_kinematics(model, data)
-    rotations, origins = _joint_frames(robot)
-    axes_robot = np.einsum("kij,kj->ki", rotations, np.array([j.axis for j in robot.joints], dtype=float))
-    axes_robot /= np.linalg.norm(axes_robot, axis=1, keepdims=True)
-    try:
-        r, t, misfit = _alignment(axes_robot, origins, data.xaxis[ids], data.xanchor[ids])
-    except ValueError:
-        raise ConfigError(f"{path}: every joint axis is parallel, so the axes cannot place the arm: write back needs "
-                          "two joints that are not parallel") from None
-    if misfit > AXIS_TOLERANCE:
-        raise ConfigError(f"{path}: its joint axes at q = 0 are not the robot's (off by {misfit:.3g}, in m or rad): "
-                          "another robot, another zero position or joints turning the other way")
+    rotations, origins, r, t = _aligned(path, robot, data, ids)
     moving = set(model.jnt_bodyid[ids])
     moved: list[str] = []
     coupled = coupled_tendons(robot, fitted)
@@ -172,16 +194,7 @@ def mjcf_written_back(mjcf: str | Path, robot: Robot, phi: np.ndarray, out_dir: 
             body.append(ET.Comment(f" dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[k]:.6g}) instead of sign(dq) "))
         far = moved_far(name, mass, com, nominal_mass, nominal_com, "MJCF")
         moved.extend([far] if far else [])
-    if coupled is not None:
-        _append_tendons(root, coupled)
-    elif robot.transmission.n_coupled_params:
-        root.append(ET.Comment(" dynid: coupled motors (not representable in MJCF), add their torques: " + ", ".join(
-            f"{n} = {v:.17g}" for n, v in zip(robot.transmission.coupled_parameter_names,
-                                              fitted.transmission.coupled_values.ravel())) + " "))
-    if note := position_offset_note(robot):
-        root.append(ET.Comment(note))
-    for attributes in offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []:
-        ET.SubElement(_section(root, "actuator"), "general", attributes)
+    _append_model_terms(root, robot, fitted, coupled, offsets_held=offsets_held)
     _compiler_for(root, path.parent.resolve(), Path(out_dir).resolve() if out_dir is not None else path.parent.resolve())
     header = identified_header(path.name, "the <inertial> of every body a joint moves and the armature, damping and "
                                "frictionloss of every joint", estimate, moved, "MJCF")
