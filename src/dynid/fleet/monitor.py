@@ -202,8 +202,6 @@ class MonitorResult:
         Logs of an earlier run this one went on from (0: a new monitor).
     deferred : tuple of str
         Logs still being written, left for the next run (one line each, naming them).
-    latest : (n_terms,) array
-        Each term's level now (:func:`recent_level`: the window estimates of the last ``forgetting_seconds`` of log).
     """
 
     terms: tuple[str, ...]
@@ -218,7 +216,14 @@ class MonitorResult:
     state: bytes | None = field(default=None, repr=False, compare=False)
     resumed: int = 0
     deferred: tuple[str, ...] = ()
-    latest: np.ndarray = field(default_factory=lambda: np.full(0, np.nan), compare=False)
+
+    @property
+    def latest(self) -> np.ndarray:
+        """(n_terms,) Each term's level now (:func:`recent_level`: the window estimates of the last
+        ``settings.forgetting_seconds`` of log); NaN before the first window."""
+        if not self.windows:
+            return np.full(len(self.terms), np.nan)
+        return recent_level(self.windows, self.settings.forgetting_seconds)
 
     def changes(self) -> dict[str, float]:
         """Each term that alarmed, with how far its level now is from its reference [%] (every alarm in between
@@ -321,18 +326,17 @@ def recent_level(windows, seconds: float) -> np.ndarray:
     Parameters
     ----------
     windows : sequence of MonitorWindow
+        At least one.
     seconds : float [s]
 
     Returns
     -------
     (n_terms,) array
     """
-    if not windows:
-        return np.full(0, np.nan)
     values = np.array([w.theta for w in windows])
     values = np.where(determined(np.array([w.std for w in windows])), values, np.nan)
     elapsed = np.cumsum([w.end - w.start for w in windows][::-1])
-    last = max(int(np.searchsorted(elapsed, seconds - 1e-9)) + 1, 1)
+    last = int(np.searchsorted(elapsed, seconds - 1e-9)) + 1
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return np.nanmean(values[-last:], axis=0)
@@ -623,8 +627,7 @@ class FrictionMonitor:
         # or change read against that level would hide how far the term has gone in all
         mean = reference_level(self.windows[:ref])[0] if len(self.windows) >= ref else self.mean
         return MonitorResult(self.terms, self.joints, tuple(self.windows), mean, self.std, self.threshold,
-                             tuple(self.alarms), self.settings, tuple(self.logs),
-                             latest=recent_level(self.windows, self.settings.forgetting_seconds))
+                             tuple(self.alarms), self.settings, tuple(self.logs))
 
 
 def monitor_fingerprint(results: str | Path, settings: MonitorSettings) -> str:

@@ -193,7 +193,7 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     def share(sigma) -> float:  # each joint's σ on the samples kept, as a global relative error [%]
         return np.nan if sigma is None else 100.0 * float(np.sqrt(np.sum((sigma * ratio) ** 2 * kept) / max(total, 1e-300)))
 
-    travel = float(np.ptp(np.asarray(loaded.q)[:, -1])) if robot.joints[-1].prismatic else 0.0
+    travel = float(np.ptp(np.asarray(loaded.q[:, -1]))) if robot.joints[-1].prismatic else 0.0  # one column read
     return Payload(m, com, inertia, mass_std, com_std, lost, phi, float(error[0]), float(error[1]),
                    share(noise_floor(loaded)), share(None if residual is None else np.asarray(residual, dtype=float)),
                    travel)

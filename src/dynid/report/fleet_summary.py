@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..tables import Line, TextTable
 
 __all__ = ["fleet_blocks", "fleet_verdict", "monitor_blocks"]
@@ -115,9 +113,9 @@ def monitor_blocks(result) -> list:
         for t, c in changes.items()) if changes else "no change")
     out: list = [Line(f"dynid monitor — {len(result.logs)} logs, {len(result.windows)} windows of {result.settings.window:g} s "
                       f"({hours:.3g} h of logs): {verdict}", "title")]
-    latest = result.latest if result.latest.size else np.full(len(result.terms), np.nan)
     rows = tuple((t, f"joint {j}", _cell(float(m), ".4g"), _cell(float(s), ".2g"), _cell(float(x), ".4g"), str(count[t]))
-                 for t, j, m, s, x in zip(result.terms, result.joints, result.reference_mean, result.reference_std, latest))
+                 for t, j, m, s, x in zip(result.terms, result.joints, result.reference_mean, result.reference_std,
+                                          result.latest))
     out.append(TextTable(f"Terms: reference over the first {result.settings.reference_windows} windows (mean, spread), the "
                          f"level now (the windows of the last {result.settings.forgetting_seconds:g} s), alarms",
                          ("term", "joint", "reference", "spread", "now", "alarms"), rows))

@@ -341,12 +341,10 @@ def sign_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, tab
         k = np.abs(np.asarray(slope, dtype=float))
         sized = [j for j in judged if np.isfinite(k[j]) and k[j] > 0]
 
-        def typical(j: int) -> float:  # the other joints' size: a joint's own slope is no yardstick for itself
-            others = [i for i in sized if i != j]
-            return float(np.median(k[others])) if others else float("nan")
-
-        judged = [j for j in judged if not np.isfinite(typical(j)) or not np.isfinite(k[j])
-                  or 1 / SCALE_LIMIT <= k[j] / typical(j) <= SCALE_LIMIT]
+        others = {j: [i for i in sized if i != j] for j in judged}  # a joint's own slope is no yardstick for itself
+        typical = {j: float(np.median(k[o])) if o else float("nan") for j, o in others.items()}
+        judged = [j for j in judged if not np.isfinite(typical[j]) or not np.isfinite(k[j])
+                  or 1 / SCALE_LIMIT <= k[j] / typical[j] <= SCALE_LIMIT]
     bad = [j for j in judged if corr[j] < -0.5]
     if not bad:
         return []

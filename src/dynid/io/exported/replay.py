@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.polynomial import polynomial
 
 from ..._util.reprs import short_repr
 from ...dynamics.regressor import regressor
@@ -299,14 +300,13 @@ class ForwardCheck:
     simulated_vs_model: float
     tracking_error: np.ndarray
     n_samples: int
-    substeps: int = 40
+    substeps: int
 
 
 SUBSTEPS, MIN_STEP = 40, 25e-6
-"""[1, s] :func:`mjcf_forward`'s integration steps per log sample by default: 40, none shorter than 25 µs. 40 track every
-real log at 100-250 Hz (with 10 on a 100 Hz log and a 10 Hz loop the LBR Med7's simulation lost stability slowly); a
-5 kHz log (the TX40's) takes 8, which gives its figure to 1e-3 % of what 40 (5 µs steps) give, in a quarter of the
-time."""
+"""[1, s] :func:`mjcf_forward`'s integration steps per log sample by default: 40, none shorter than 25 µs (a 5 kHz log
+takes 8). 40 track every real log at 100-250 Hz; 10 on a 100 Hz log with a 10 Hz loop let the LBR Med7's simulation
+lose stability (benchmarks/NOTEBOOK.md, "Stop 108", has the step sweep)."""
 
 
 def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *, substeps: int | None = None,
@@ -416,11 +416,7 @@ def _hermite_weights(substeps: int) -> np.ndarray:
     """(3, 6, substeps, 1): for each fraction ``w = s / substeps`` of a sample interval, the quintic Hermite basis
     (:data:`_QUINTIC`) and its first and second derivatives in ``w``."""
     w = np.arange(substeps, dtype=float) / substeps
-    basis = [_QUINTIC]
-    for _ in range(2):
-        basis.append(np.hstack([basis[-1][:, 1:] * np.arange(1, 6), np.zeros((6, 1))]))
-    powers = w[None, :] ** np.arange(6)[:, None]  # (6, substeps)
-    return np.stack([b @ powers for b in basis])[..., None]
+    return np.stack([polynomial.polyval(w, polynomial.polyder(_QUINTIC, d, axis=1).T) for d in range(3)])[..., None]
 
 
 def _between(t, q, dq, ddq, k: int, weights: np.ndarray) -> list:
@@ -428,7 +424,7 @@ def _between(t, q, dq, ddq, k: int, weights: np.ndarray) -> list:
     quintic Hermite of the two samples' positions, velocities and accelerations, and its derivatives; each
     (substeps, n_dof). At each sample the reference is the log's state itself, its acceleration the one the
     feed-forward is computed from (a cubic of positions and velocities alone has an acceleration of its own there,
-    which a stiff loop then makes the arm follow: the UR10e's 30 Hz loop added 1.1 points of torque error so)."""
+    encoder noise over Δt², which a stiff loop then makes the arm follow)."""
     nxt = min(k + 1, t.size - 1)
     h = t[nxt] - t[k]
     if h <= 0:
