@@ -114,19 +114,17 @@ def test_write_back_keeps_the_held_fingers_inertials_and_the_model_loads(tmp_pat
 def test_a_branch_before_the_arm_in_pinocchios_order_is_the_joint_held(tmp_path):
     """A revolute joint on a branch of its own from the base (a camera's pan joint) named so that Pinocchio's
     depth-first order puts it before the arm's first joint: the arm is the longest chain, so the branch is what dynid
-    init holds and what the refusal names, never the arm."""
+    init holds, never the arm; read whole, the file is a tree whose arm rides on the base beside the branch."""
     camera = _link("camera", 0.3, "0 0 0.02") + _revolute("a_camera_pan", "base", "camera", "0.1 0 0.1", "0 0 1")
     urdf = _urdf(tmp_path, ARM + camera)
     import pinocchio as pin
 
     assert list(pin.buildModelFromUrdf(str(urdf)).names)[1:] == ["a_camera_pan", "j1", "j2"]  # the branch first
     assert joints_to_hold(urdf) == ("a_camera_pan",)
-    with pytest.raises(ConfigError, match=re.escape("arm.urdf: joints 'a_camera_pan', 'j1' all ride on the base, and "
-                                                    "dynid identifies one serial chain: hold the joints that are not "
-                                                    "the arm's fixed in the config's [robot] table, held = "
-                                                    '["a_camera_pan"] for the longest chain (j1 to j2;')):
-        joints_from_urdf(urdf)
+    joints = joints_from_urdf(urdf)[0]  # the whole tree, the arm's first joint on the base beside the branch
+    assert [(j.name, j.parent) for j in joints] == [("a_camera_pan", None), ("j1", -1), ("j2", None)]
     assert joints_from_urdf(urdf, {"a_camera_pan": 0.0})[2] == ("j1", "j2")
+    assert joints_to_hold(urdf, lambda names: {"a_camera_pan", "j1", "j2"}) == ()  # a log of every joint: the tree
     gripper = _urdf(tmp_path, ARM + camera + FINGERS, "gripper.urdf")
     assert joints_to_hold(gripper) == ("a_camera_pan", "f1", "f2")
 
@@ -196,7 +194,7 @@ def _arm_log(path, robot, columns):
 def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
     """A two-arm robot and a log of its right arm: init takes the arm whose joints the log's columns name (it took the
     first arm as long, whose columns the log has not, and refused the log), holds the other; a log of both arms takes
-    one and says the other's columns are there."""
+    both as one robot (a tree), and ``--arm`` one of them, saying the other's columns are there."""
     from dynid.io.logs.columns import joints_named
 
     from ..cli.refusals import assert_refused
@@ -221,16 +219,18 @@ def test_init_takes_the_arm_the_log_names_and_holds_the_other(tmp_path):
                               + [row + "," + row.split(",", 1)[1] for row in lines[1:]]) + "\n")
     p = run("init", urdf, both, "--out", tmp_path / "both.toml")
     assert p.returncode == 0, p.stderr
-    assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
-    said = " ".join(p.stdout.split())
-    assert "both.csv also holds columns of r1, r2, on another branch of torso.urdf" in said
-    assert "their config: dynid init torso.urdf both.csv --arm r1 --out <another config>" in said
-    p = run("init", urdf, both, "--arm", "r1", "--out", tmp_path / "other.toml")  # as the line says
+    doc = tomllib.loads((tmp_path / "both.toml").read_text())  # both arms as one robot: nothing held
+    assert doc["robot"] == "torso.urdf"
+    assert doc["identification"]["positions"]["columns"] == ["l1_pos", "l2_pos", "r1_pos", "r2_pos"]
+    assert "another branch" not in p.stdout
+    p = run("init", urdf, both, "--arm", "r1", "--out", tmp_path / "other.toml")  # one arm, as asked
     assert p.returncode == 0, p.stderr
     doc = tomllib.loads((tmp_path / "other.toml").read_text())
     assert doc["robot"]["held"] == ["l1", "l2"]
     assert doc["identification"]["positions"]["columns"] == ["r1_pos", "r2_pos"]
-    assert "also holds columns of l1, l2" in " ".join(p.stdout.split())
+    said = " ".join(p.stdout.split())
+    assert "both.csv also holds columns of l1, l2, on another branch of torso.urdf: held as --arm asks" in said
+    assert "dynid init torso.urdf both.csv --arm l1 --out <another config>" in said
     assert_refused(run("init", urdf, both, "--arm", "r3", "--out", tmp_path / "x.toml"),
                    "--arm r3: no moving joint of torso.urdf is named so (it has l1, l2, r1, r2)")
     single = _urdf(tmp_path, ARM, "single.urdf")
@@ -270,7 +270,7 @@ def test_the_second_arm_identified_on_the_first_arms_written_urdf_holds_both(tmp
 
 def test_init_on_a_bag_of_one_arm_takes_that_arm_and_names_the_others_joints(tmp_path):
     """ROS bags of a two-arm robot: a bag of the right arm's joints makes it the arm (init took the first arm and the
-    bag's read refused the joints it lacks); a bag of both arms takes the first and says the bag holds the other's."""
+    bag's read refused the joints it lacks); a bag of both arms takes both as one robot (a tree)."""
     import sys
 
     from dynid.dynamics.rnea import rnea_torques
@@ -294,5 +294,5 @@ def test_init_on_a_bag_of_one_arm_takes_that_arm_and_names_the_others_joints(tmp
     _write_bag(tmp_path / "both_bag", t + 100.0, ["l1", "l2", "r1", "r2"], both, np.hstack([dq, dq]), np.hstack([tau, tau]))
     p = run("init", urdf, tmp_path / "both_bag", "--out", tmp_path / "both.toml")
     assert p.returncode == 0, p.stderr
-    assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"]["held"] == ["r1", "r2"]
-    assert "both_bag also holds columns of r1, r2, on another branch of torso.urdf" in " ".join(p.stdout.split())
+    assert tomllib.loads((tmp_path / "both.toml").read_text())["robot"] == "torso.urdf"  # both arms, one robot
+    assert "another branch" not in p.stdout

@@ -176,8 +176,8 @@ def test_load_robot_holds_a_grippers_joints_and_reads_inits_config(tmp_path):
         '</joint>' for n in ("f1", "f2"))
     path = tmp_path / "arm.urdf"
     path.write_text(urdf.replace("</robot>", fingers + "</robot>"), encoding="utf-8")
-    with pytest.raises(ConfigError):
-        load_robot(path)  # a prismatic finger is no joint of the arm: said, with what to hold
+    whole = load_robot(path)  # the fingers are a branch of the wrist: read whole, the file is a tree of 8 joints
+    assert whole.n_dof == 8 and whole.parents.tolist()[-2:] == [5, 5]
     arm = load_robot(path, held=["f1", "f2"])
     assert arm.n_dof == 6 and arm.held == ("f1", "f2")
     sim = np.column_stack([np.arange(200) * 0.01, np.zeros((200, 12))])

@@ -30,8 +30,9 @@ class RobotArrays(NamedTuple):
     """What the kernel reads of a robot: each joint's fixed rotation ``rp`` (n, 3, 3) and translation ``pp`` (n, 3)
     from its parent's frame, its axis ``axes`` (n, 3), ``gravity`` (3,) [m/s²], the standard parameters per joint
     ``npj``, where each standard column goes (``colmap`` (n_params,), skipped where negative), where each joint's
-    drive columns go (``drive_map`` (n, T), skipped where negative) and which joints slide (``prismatic`` (n,): 1.0
-    for a prismatic joint, 0.0 for a revolute one)."""
+    drive columns go (``drive_map`` (n, T), skipped where negative), which joints slide (``prismatic`` (n,): 1.0
+    for a prismatic joint, 0.0 for a revolute one) and which joint carries each (``parent`` (n,) int, -1: the base;
+    ``j - 1`` along a serial chain)."""
 
     rp: np.ndarray
     pp: np.ndarray
@@ -41,6 +42,7 @@ class RobotArrays(NamedTuple):
     colmap: np.ndarray
     drive_map: np.ndarray
     prismatic: np.ndarray
+    parent: np.ndarray
 
 
 def sample_columns(k, robot, motion, out, drive, scratch):
@@ -48,8 +50,9 @@ def sample_columns(k, robot, motion, out, drive, scratch):
     each link (skipped where ``colmap[c] < 0``), column ``drive_map[i, t]`` of joint ``i`` its drive column
     ``drive[k, i, t]`` (skipped where ``drive_map[i, t] < 0``); the other columns hold 0.
 
-    A revolute joint ``i`` feels ``z·n_j + l·f_j`` of each link ``j >= i``; a prismatic one, the force along its
-    axis, ``z·f_j``. A prismatic joint's link does not turn with ``q``: its origin moves by ``q`` along the axis,
+    A revolute joint ``i`` feels ``z·n_j + l·f_j`` of each link ``j`` it carries (``j`` itself and every link after
+    it along a serial chain; on a robot with branches, the links of its own branch); a prismatic one, the force along
+    its axis, ``z·f_j``. A prismatic joint's link does not turn with ``q``: its origin moves by ``q`` along the axis,
     and its origin's acceleration gains ``ddq·z + 2 w × (dq·z)`` (Khalil & Dombre, *Modeling, Identification and
     Control of Robots*, §9.3).
 
@@ -68,12 +71,12 @@ def sample_columns(k, robot, motion, out, drive, scratch):
         ``r0, o, w, dw, acc, z0, rl``: (n, 3, 3), (n, 3) ×5, (3, 3), each with a trailing sample axis when ``k`` is
         a slice.
     """
-    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic = robot
+    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic, parent = robot
     q, dq, ddq = motion
     r0, o, w, dw, acc, z0, rl = scratch
     n = q.shape[1]
     m = out.shape[2]
-    # ---- zero every entry first (links j < i stay zero), then each joint's drive columns -----------
+    # ---- zero every entry first (links joint i does not carry stay zero), then each joint's drive columns
     for i in range(n):
         for c in range(m):
             out[k, i, c] = 0.0
@@ -111,24 +114,25 @@ def sample_columns(k, robot, motion, out, drive, scratch):
                 rl[a, 1] = rp[j, a, 0] * m01 + rp[j, a, 1] * m11 + rp[j, a, 2] * m21
                 rl[a, 2] = rp[j, a, 0] * m02 + rp[j, a, 1] * m12 + rp[j, a, 2] * m22
             px, py, pz = pp[j, 0], pp[j, 1], pp[j, 2]
-        if j == 0:
+        p = parent[j]
+        if p < 0:
             wpx = wpy = wpz = 0.0
             dwx = dwy = dwz = 0.0
             apx, apy, apz = -gravity[0], -gravity[1], -gravity[2]
-            o[0, 0] = px
-            o[0, 1] = py
-            o[0, 2] = pz
+            o[j, 0] = px
+            o[j, 1] = py
+            o[j, 2] = pz
             for a in range(3):
                 for b in range(3):
-                    r0[0, a, b] = rl[a, b]
+                    r0[j, a, b] = rl[a, b]
         else:
-            wpx, wpy, wpz = w[j - 1, 0], w[j - 1, 1], w[j - 1, 2]
-            dwx, dwy, dwz = dw[j - 1, 0], dw[j - 1, 1], dw[j - 1, 2]
-            apx, apy, apz = acc[j - 1, 0], acc[j - 1, 1], acc[j - 1, 2]
+            wpx, wpy, wpz = w[p, 0], w[p, 1], w[p, 2]
+            dwx, dwy, dwz = dw[p, 0], dw[p, 1], dw[p, 2]
+            apx, apy, apz = acc[p, 0], acc[p, 1], acc[p, 2]
             for a in range(3):
-                o[j, a] = o[j - 1, a] + r0[j - 1, a, 0] * px + r0[j - 1, a, 1] * py + r0[j - 1, a, 2] * pz
+                o[j, a] = o[p, a] + r0[p, a, 0] * px + r0[p, a, 1] * py + r0[p, a, 2] * pz
                 for b in range(3):
-                    r0[j, a, b] = r0[j - 1, a, 0] * rl[0, b] + r0[j - 1, a, 1] * rl[1, b] + r0[j - 1, a, 2] * rl[2, b]
+                    r0[j, a, b] = r0[p, a, 0] * rl[0, b] + r0[p, a, 1] * rl[1, b] + r0[p, a, 2] * rl[2, b]
         # acceleration of the new origin, parent frame: a + dw×p + w×(w×p)
         cx = wpy * pz - wpz * py
         cy = wpz * px - wpx * pz
@@ -170,7 +174,8 @@ def sample_columns(k, robot, motion, out, drive, scratch):
         gx, gy, gz = acc[j, 0], acc[j, 1], acc[j, 2]
         w2 = wx * wx + wy * wy + wz * wz
         col = j * npj
-        for i in range(j + 1):
+        i = j
+        while i >= 0:  # the joints that carry link j: j itself, then each parent back to the base
             # axis of joint i and o_j - o_i, in frame j
             dx = o[j, 0] - o[i, 0]
             dy = o[j, 1] - o[i, 1]
@@ -211,6 +216,7 @@ def sample_columns(k, robot, motion, out, drive, scratch):
                 dst = colmap[col + t]
                 if dst >= 0:
                     out[k, i, dst] = values[t]
+            i = parent[i]
 
 
 def _chunk(robot, motion, out, drive, span, scratch):

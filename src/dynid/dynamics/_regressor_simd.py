@@ -133,7 +133,7 @@ class _Output:
         self.stores[tuple(int(i) for i in index[1:])] = value if isinstance(value, _Sym) else float(value)
 
 
-def _trace(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
+def _trace(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic, parent):
     """The operations of one sample and, for each (joint, standard column) that some column of the
     regressor takes, the value stored there (a symbol, or a constant)."""
     n = rp.shape[0]
@@ -146,7 +146,7 @@ def _trace(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
     rp_, pp_, axes_, gravity_ = (np.array(np.asarray(a, dtype=float).tolist(), dtype=object) for a in (rp, pp, axes, gravity))
     scratch = tuple(np.empty(s, dtype=object) for s in ((n, 3, 3), (n, 3), (n, 3), (n, 3), (n, 3), (n, 3), (3, 3)))
     robot = _regressor_kernel.RobotArrays(rp_, pp_, axes_, gravity_, npj, colmap, drive_map,
-                                          np.asarray(prismatic, dtype=float))
+                                          np.asarray(prismatic, dtype=float), np.asarray(parent, dtype=np.int64))
     _regressor_kernel.sample_columns(0, robot, (q, dq, ddq), out, drive, scratch)
     return graph, {key: v for key, v in out.stores.items() if isinstance(v, _Sym) or v != 0.0}
 
@@ -332,18 +332,19 @@ def _compile(ir: str):
     return function, engine
 
 
-def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic):
-    """The compiled regressor of a robot (its joints' fixed geometry and kinds, gravity), compiled or loaded once
-    per process."""
+def kernel(rp, pp, axes, gravity, npj: int, n_drive: int, prismatic, parent):
+    """The compiled regressor of a robot (its joints' fixed geometry, kinds and parents, gravity), compiled or loaded
+    once per process."""
     key = (np.asarray(rp, float).tobytes(), np.asarray(pp, float).tobytes(), np.asarray(axes, float).tobytes(),
-           np.asarray(gravity, float).tobytes(), int(npj), int(n_drive), np.asarray(prismatic, float).tobytes())
+           np.asarray(gravity, float).tobytes(), int(npj), int(n_drive), np.asarray(prismatic, float).tobytes(),
+           np.asarray(parent, np.int64).tobytes())
     with _lock:
         if key not in _kernels:
             folder, name = _cache_folder(), _ir_key(key)
             path = None if folder is None or name is None else folder / f"regressor-ir-{name}.ll.z"
             cached = _read_cache(path)
             if cached is None:
-                graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic)
+                graph, stores = _trace(rp, pp, axes, gravity, npj, n_drive, prismatic, parent)
                 ir = _ir(graph, stores, len(rp), npj, n_drive)
                 _write_cache(path, zlib.compress(ir.encode()))
             else:
@@ -388,11 +389,11 @@ def simd_regressor(robot, motion, out, drive) -> None:
     (N, n, m), C-ordered, is written), by the compiled code of :func:`kernel`, :data:`LANES` samples at a time. The
     samples after the last whole group of lanes go through it padded. ``colmap`` must place the drive
     columns where ``drive_map`` does (as :func:`dynid.dynamics.regressor.regressor` builds them)."""
-    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic = robot
+    rp, pp, axes, gravity, npj, colmap, drive_map, prismatic, parent = robot
     q, dq, ddq = motion
     n_s, n = q.shape
     m, n_drive = out.shape[2], drive_map.shape[1]
-    function = kernel(rp, pp, axes, gravity, npj, n_drive, prismatic)
+    function = kernel(rp, pp, axes, gravity, npj, n_drive, prismatic, parent)
     columns = np.ascontiguousarray(colmap[:n * npj], dtype=np.int64)
     q, dq, ddq = (np.ascontiguousarray(a, dtype=float) for a in (q, dq, ddq))
     drives = np.empty((n_s, n, n_drive))

@@ -24,12 +24,12 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     n_s = q.shape[0]
     rots = np.empty((n_s, robot.n_dof, 3, 3))
     orig = np.empty((n_s, robot.n_dof, 3))
-    r_prev, p_prev = np.broadcast_to(np.eye(3), (n_s, 3, 3)), np.zeros((n_s, 3))
-    for j, jt in enumerate(robot.joints):
+    base_r, base_p = np.broadcast_to(np.eye(3), (n_s, 3, 3)), np.zeros((n_s, 3))
+    for j, (jt, parent) in enumerate(zip(robot.joints, robot.parents)):
+        r_prev, p_prev = (base_r, base_p) if parent < 0 else (rots[:, parent], orig[:, parent])
         rl, pl = jt.placement(q[:, j])
-        p_prev = p_prev + (np.einsum("nij,nj->ni", r_prev, pl) if jt.prismatic else r_prev @ jt.translation)
-        r_prev = r_prev @ rl
-        rots[:, j], orig[:, j] = r_prev, p_prev
+        orig[:, j] = p_prev + (np.einsum("nij,nj->ni", r_prev, pl) if jt.prismatic else r_prev @ jt.translation)
+        rots[:, j] = r_prev @ rl
     return rots, orig
 
 

@@ -153,7 +153,8 @@ def _fill(robot: Robot, q, dq, ddq, out, colmap, *, form: str | None = None, vel
         return np.ascontiguousarray(drive_columns(robot.drive_terms, q[a:b], dq[a:b], ddq[a:b], v.rows(a, b)) * robot.drive_mask)
 
     drive_map = np.ascontiguousarray(colmap[np.arange(robot.n_dof)[:, None] * npj + 10 + np.arange(len(robot.drive_terms))])
-    arrays = kernel.RobotArrays(rp, pp, axes, gravity, npj, colmap, drive_map, robot.prismatic.astype(np.float64))
+    arrays = kernel.RobotArrays(rp, pp, axes, gravity, npj, colmap, drive_map, robot.prismatic.astype(np.float64),
+                                robot.parents)
     form = form or ("numpy" if _numpy_form(q.shape[0]) else "compiled")
     if form == "compiled":
         _compiled_regressor(arrays, (q, dq, ddq), out, drive)

@@ -37,11 +37,10 @@ def pinocchio_model(robot: Robot, inertial: np.ndarray | None = None):
     inertial = robot.inertial if inertial is None else inertial
     model = pin.Model()
     model.gravity.linear = np.asarray(robot.gravity, dtype=float)
-    parent = 0
-    for j, jt in enumerate(robot.joints):
+    for j, (jt, parent) in enumerate(zip(robot.joints, robot.parents)):
         placement = pin.SE3(np.asarray(jt.rotation), np.asarray(jt.translation))
-        parent = model.addJoint(parent, _joint_model(jt), placement, jt.name)
-        model.appendBodyToJoint(parent, pin.Inertia.FromDynamicParameters(pinocchio_from_inertial(inertial[j])), pin.SE3.Identity())
+        joint = model.addJoint(int(parent) + 1, _joint_model(jt), placement, jt.name)  # Pinocchio's 0 is the base
+        model.appendBodyToJoint(joint, pin.Inertia.FromDynamicParameters(pinocchio_from_inertial(inertial[j])), pin.SE3.Identity())
     return model
 
 

@@ -140,7 +140,8 @@ def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                   "    </inertial>", "  </link>"]
         terms = dict(zip(robot.drive_terms, fitted.drive[j]))
         fc, fv = terms.get("fc", 0.0), terms.get("fv", 0.0)
-        parent = "base_link" if j == 0 else f"link{j}"
+        carrier = int(robot.parents[j])  # the joint before it along a chain; on a tree, the joint its branch rides on
+        parent = "base_link" if carrier < 0 else f"link{carrier + 1}"
         kind = "prismatic" if joint.prismatic else "revolute"
         lines += [f"  <joint name={quoteattr(joint.name)} type=\"{kind}\">", f'    <parent link="{parent}"/>', f'    <child link="{link}"/>',
                   f'    <origin xyz="{_vec(joint.translation)}" rpy="{_vec(_rpy(joint.rotation))}"/>',
@@ -233,7 +234,7 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                     offsets_held: bool = False) -> str:
     """MuJoCo MJCF text of a robot with given standard parameters.
 
-    Bodies are nested at dynid's joint frames; each carries its mass, centre of mass and full inertia about it
+    Bodies are nested at dynid's joint frames (a branch's in the body of the joint it rides on); each carries its mass, centre of mass and full inertia about it
     (``<inertial fullinertia>``); each hinge carries ``armature`` (rotor inertia ``Ia``), ``damping`` (viscous ``fv``)
     and ``frictionloss`` (Coulomb ``fc``); a coupled motor's friction is a fixed tendon (:func:`coupled_tendons`). What
     MuJoCo cannot represent is stated in comments: the torque offset (unless ``offsets_held``), the Stribeck term, a
@@ -276,9 +277,15 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
              f"<mujoco model={quoteattr(name or robot.name)}>",
              '  <compiler angle="radian" autolimits="true" boundmass="1e-9" boundinertia="1e-9"/>',
              f'  <option gravity="{_vec(g)}"/>', "  <worldbody>"]
-    closing = []
+    parents = robot.parents
+    depth = [0] * robot.n_dof
+    for j in range(robot.n_dof):  # a body's depth in the tree (j along a serial chain)
+        depth[j] = 0 if parents[j] < 0 else depth[parents[j]] + 1
+    closing: list[tuple[int, str]] = []  # bodies still open: (joint, line), innermost last
     for j, joint in enumerate(robot.joints):
-        indent = "    " + "  " * j
+        while closing and closing[-1][0] != parents[j]:  # a branch ends: close up to the body this joint rides on
+            lines.append(closing.pop()[1])
+        indent = "    " + "  " * depth[j]
         q = pin.Quaternion(np.asarray(joint.rotation, dtype=float))
         mass, com, inertia = physical_from_inertial(fitted.inertial[j])
         inertia = mujoco_inertia(inertia)
@@ -300,11 +307,11 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                          + ", ".join(f"{k}{j + 1} = {v:.17g}" for k, v in extra.items()) + " -->")
         if robot.coulomb_velocity[j] > 0:
             lines.append(f"{indent}  <!-- dynid: Coulomb term tanh(dq/{robot.coulomb_velocity[j]:.6g}) instead of sign(dq) -->")
-        closing.append(f"{indent}</body>")
-    tip = "    " + "  " * robot.n_dof
+        closing.append((j, f"{indent}</body>"))
+    tip = "    " + "  " * (depth[-1] + 1)  # the tool frame rides on the last joint (the last branch's tip)
     q = pin.Quaternion(np.asarray(robot.tool_rotation, dtype=float))
     lines.append(f'{tip}<site name="flange" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}"/>')
-    lines += closing[::-1]
+    lines += [line for _, line in closing[::-1]]
     lines.append("  </worldbody>")
     actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
     if actuators:

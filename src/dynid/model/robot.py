@@ -36,6 +36,9 @@ class Joint:
         Unit axis in the joint frame (``(0, 0, 1)`` for DH chains).
     prismatic : bool
         The joint slides along its axis (position [m], force [N]) instead of turning about it.
+    parent : int or None
+        The index of the joint whose link carries this joint (-1: the base), for a robot with branches (two arms on a
+        torso); ``None``: the joint before it in the robot's order (a serial chain).
     """
 
     name: str
@@ -43,6 +46,7 @@ class Joint:
     translation: np.ndarray
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     prismatic: bool = False
+    parent: int | None = None
 
     def placement(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The frame of the joint's link in its parent's, at positions ``q``.
@@ -286,6 +290,10 @@ class Robot:
         object.__setattr__(self, "drive_mask", mask)
         if n == 0:
             raise ConfigError(f"robot {self.name!r}: expected at least one joint, got none")
+        for j, jt in enumerate(self.joints):
+            if jt.parent is not None and not -1 <= jt.parent < j:
+                raise ConfigError(f"robot {self.name!r}: joint {jt.name!r} is carried by joint {jt.parent}: expected a "
+                                  f"joint before it (0 to {j - 1}) or -1, the base (joints in depth-first order)")
         if self.inertial.shape != (n, 10):
             raise ConfigError(f"robot {self.name!r}: expected inertial parameters of shape ({n}, 10), got {self.inertial.shape}")
         try:
@@ -307,6 +315,17 @@ class Robot:
     def n_dof(self) -> int:
         """Number of joints."""
         return len(self.joints)
+
+    @property
+    def parents(self) -> np.ndarray:
+        """(n_dof,) int: the joint whose link carries each joint (-1: the base); ``j - 1`` along a serial chain, and
+        each joint's :attr:`Joint.parent` on a robot with branches (a tree, joints in depth-first order)."""
+        return np.array([j - 1 if jt.parent is None else jt.parent for j, jt in enumerate(self.joints)], dtype=np.int64)
+
+    @property
+    def is_tree(self) -> bool:
+        """Whether the robot has branches (two arms on a torso): a joint not carried by the joint before it."""
+        return bool(np.any(self.parents != np.arange(self.n_dof) - 1))
 
     @property
     def prismatic(self) -> np.ndarray:
@@ -358,6 +377,8 @@ class Robot:
                                                                  self.transmission.motor_from_joint)]
         if self.prismatic.any():  # a revolute chain's fingerprint stays what it was
             values.append(self.prismatic.astype(float))
+        if self.is_tree:  # so does a serial chain's
+            values.append(self.parents.astype(float))
         flat = np.concatenate(values)
         text = ",".join(f"{0.0 if abs(v) < 1e-12 else v:.12g}" for v in flat)
         return hashlib.sha256(f"{self.n_dof};{text}".encode()).hexdigest()[:16]
@@ -440,6 +461,9 @@ class Robot:
         n = self.n_dof
         if not 1 <= k <= n:
             raise ConfigError(f"joints must be between 1 and {n} for robot {self.name!r}, got {k}")
+        if self.is_tree and k < n:
+            raise ConfigError(f"robot {self.name!r} has branches: holding its last {n - k} joints onto joint {k} "
+                              "applies to a serial chain; hold a branch's joints in its description (held = [...])")
         q_rest = np.zeros(n - k) if q_rest is None else np.asarray(q_rest, dtype=float)
         if q_rest.shape != (n - k,):
             raise ConfigError(f"expected {n - k} rest angles for the held joints, got {q_rest.shape}")

@@ -17,7 +17,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
-from .robot_files import HELD_HINT, arm_chain, branch_refusal, check_xml, is_mjcf
+from .robot_files import HELD_HINT, arm_chain, check_xml, is_mjcf
 from .xacro_expansion import expand_xacro_text
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0),
@@ -158,7 +158,8 @@ def pinocchio_from_inertial(phi: np.ndarray) -> np.ndarray:
 
 def joints_from_urdf(path: str | Path,
                      held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
-    """Joints and link inertial parameters of a URDF serial chain of revolute joints.
+    """Joints and link inertial parameters of a URDF's revolute and prismatic joints: a serial chain, or a tree (two
+    arms on a torso), each joint then naming the joint that carries it (:attr:`dynid.model.robot.Joint.parent`).
 
     Fixed joints are merged by Pinocchio into the parent link, and so are ``held`` joints (a gripper's fingers, mimic
     joints: locked at their position by Pinocchio's ``buildReducedModel``). Continuous joints (unbounded revolute)
@@ -183,7 +184,7 @@ def joints_from_urdf(path: str | Path,
     Raises
     ------
     ConfigError
-        If the file cannot be parsed, a held joint is not in it, or the chain is not serial or has non-revolute joints.
+        If the file cannot be parsed, a held joint is not in it, or a joint is neither revolute nor prismatic.
     """
     import pinocchio as pin
 
@@ -199,9 +200,6 @@ def joints_from_urdf(path: str | Path,
     for j in range(1, model.njoints):
         jm = model.joints[j]
         short = jm.shortname()
-        if model.parents[j] != j - 1:
-            names, parents, revolute, sliding = _tree(model)
-            raise ConfigError(branch_refusal(path, names, parents, revolute, j - 1, sliding))
         prismatic = short.startswith("JointModelP")
         if short[-2:] in _AXES and short in (f"JointModel{short[-2:]}",):
             axis = np.array(_AXES[short[-2:]])  # revolute or prismatic about/along x, y or z
@@ -217,8 +215,9 @@ def joints_from_urdf(path: str | Path,
             raise ConfigError(f"{path}: joint {model.names[j]!r} is {short}, expected a revolute or prismatic joint; "
                               + HELD_HINT.format(names=f'"{model.names[j]}"'))
         placement = model.jointPlacements[j]
+        parent = model.parents[j] - 1  # a branch (two arms on a torso): the joint that carries it, -1 the base
         joints.append(Joint(model.names[j], np.array(placement.rotation), np.array(placement.translation), axis,
-                            prismatic))
+                            prismatic, None if parent == j - 2 else int(parent)))
         inertial.append(inertial_from_pinocchio(model.inertias[j]))
     if not joints:
         raise ConfigError(f"{path}: expected at least one revolute or prismatic joint, found none")
@@ -258,7 +257,9 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
     """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest
     chain of revolute joints from the base, none mimicking another (a gripper's fingers, prismatic or on a branch; a
     camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it), or off the chain that
-    holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`).
+    holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`); where the log names joints on
+    several branches (both arms of a two-arm robot), every joint it does not name (the robot is then the tree of the
+    joints it names).
 
     Parameters
     ----------
@@ -284,7 +285,10 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
     model = _pinocchio_model(path, {})
     names, parents, revolute, sliding = _tree(model, mimic)
     named = set() if logged is None else logged(tuple(names[k] for k in parents))
-    arm = arm_chain(parents, revolute, sliding, {k for k in parents if names[k] in named})
+    logged_joints = {k for k in parents if names[k] in named}
+    arm = arm_chain(parents, revolute, sliding, logged_joints)
+    if logged_joints - set(arm):  # the log names joints on several branches (two arms): the tree is its robot
+        return tuple(names[k] for k in parents if k not in logged_joints)
     return tuple(names[k] for k in parents if k not in arm)
 
 

@@ -203,16 +203,16 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
 
 def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None) -> list[str]:
     """The lines of the joints held: which, and those of them the log holds columns of (another arm of a two-arm
-    robot), which a config of their own identifies."""
+    robot that ``--arm`` left out), which a config of their own identifies."""
     if not held:
         return []
     notes = [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain (a gripper, a head, another arm): held fixed "
              "at 0, their links counted with the link they hang on (held in [robot])"]
     logged = sorted(joints_named(log, held), key=held.index) if log is not None else []
-    if log is not None and logged:
-        notes.append(f"{log.name} also holds columns of {', '.join(logged)}, on another branch of {urdf.name}: dynid "
-                     f"identifies one serial chain at a time; their config: dynid init {urdf.name} {log.name} --arm "
-                     f"{logged[0]} --out <another config>")
+    if log is not None and logged:  # --arm chose one arm of a log of several
+        notes.append(f"{log.name} also holds columns of {', '.join(logged)}, on another branch of {urdf.name}: held as "
+                     f"--arm asks; their config: dynid init {urdf.name} {log.name} --arm {logged[0]} --out <another "
+                     "config>, or without --arm every branch the log names as one robot")
     return notes
 
 

@@ -1,0 +1,40 @@
+"""A two-arm robot on a turning torso through `dynid init` and `dynid identify` as a user runs them (issue "Every arm a
+user has", item 3): one log of both arms simulated by Pinocchio's RNEA, identified as one model whose rows are every
+joint, as good as the truth on another motion, and written back as the tree it is."""
+
+import json
+import re
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from dynid.model.description import load_robot
+from dynid.studies.example import _csv, _with_drives
+from dynid.studies.simulated_logs import simulated_log
+
+from ..dynamics.test_tree_robots import TWO_ARMS
+from .refusals import dynid as run
+
+
+def test_two_arms_on_a_torso_are_identified_as_one_model_from_init_to_its_written_files(tmp_path):
+    (tmp_path / "two_arms.urdf").write_text(TWO_ARMS)
+    robot = _with_drives(load_robot(tmp_path / "two_arms.urdf"), np.random.default_rng(0))
+    for file, seconds, seed in (("identification.csv", 60.0, 1), ("validation.csv", 20.0, 2)):
+        (tmp_path / file).write_text(_csv(simulated_log(robot, seconds=seconds, rate=250.0, rng=seed), robot))
+    p = run("init", "two_arms.urdf", "identification.csv", "validation.csv", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    p = run("identify", "arm.toml", "--no-figures", cwd=tmp_path)
+    said = " ".join((p.stdout + p.stderr).split())
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("model ready") or "\nmodel ready" in p.stdout, said[:400]
+    results = json.loads((tmp_path / "dynid-identify" / "results.json").read_text())
+    validation = results["validation"][0]
+    main = validation["metrics"][results["main_estimate"]]["global_relative_error"]
+    assert main <= 1.5 * validation["noise_floor"]["global_relative_error"]  # near the truth on another motion
+    # written back as the tree: each joint on the link it rode on; Pinocchio and MuJoCo read it as dynid's model
+    source = {e.get("name"): e.find("parent").get("link") for e in ET.parse(tmp_path / "two_arms.urdf").getroot().iter("joint")}
+    written = ET.parse(tmp_path / "dynid-identify" / "two_arms.urdf").getroot()
+    assert {e.get("name"): e.find("parent").get("link") for e in written.iter("joint")} == source
+    assert "equals dynid's model to" in said and "read back by MuJoCo" in said
+    figures = re.findall(r"equals dynid's model to ([0-9.e+-]+) of its RMS", said)
+    assert len(figures) == 2 and all(float(f) < 1e-9 for f in figures), figures
