@@ -38,3 +38,24 @@ def test_two_arms_on_a_torso_are_identified_as_one_model_from_init_to_its_writte
     assert "equals dynid's model to" in said and "read back by MuJoCo" in said
     figures = re.findall(r"equals dynid's model to ([0-9.e+-]+) of its RMS", said)
     assert len(figures) == 2 and all(float(f) < 1e-9 for f in figures), figures
+
+
+def test_a_config_whose_log_covers_one_branch_is_refused_naming_the_joints_to_hold(tmp_path):
+    """A config written by hand for a robot with branches, its log one arm's: refused in one line that names the robot's
+    joints and the ``held`` list that keeps its longest chain (before trees were read, the URDF itself was refused with
+    that list)."""
+    from .refusals import assert_refused
+
+    (tmp_path / "two_arms.urdf").write_text(TWO_ARMS)
+    robot = load_robot(tmp_path / "two_arms.urdf", held={"right_j1": 0.0, "right_j2": 0.0, "right_j3": 0.0})
+    (tmp_path / "log.csv").write_text(_csv(simulated_log(robot, seconds=5.0, rate=100.0, rng=1), robot))
+    names = [j.name for j in robot.joints]
+    (tmp_path / "arm.toml").write_text(
+        'robot = "two_arms.urdf"\ndata_root = "."\n[identification]\nfile = "log.csv"\nheader = true\n'
+        'time = { column = "time" }\n'
+        f'positions = {{ columns = {[n + "_position" for n in names]!r} }}\n'.replace("'", '"')
+        + f'torques = {{ columns = {[n + "_effort" for n in names]!r} }}\n'.replace("'", '"'))
+    p = run("identify", "arm.toml", "--no-figures", cwd=tmp_path)
+    assert_refused(p, "identification.positions.columns: expected 7 columns (one per joint)")
+    assert ('hold those the log has no columns for in the config\'s [robot] table, held = ["right_j1", "right_j2", '
+            '"right_j3"] for its longest chain') in p.stderr

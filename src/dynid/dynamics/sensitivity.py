@@ -157,8 +157,9 @@ def point_motion(robot: Robot, axes: np.ndarray, lever: np.ndarray) -> np.ndarra
 
 
 def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
-    """Every joint frame's origin and its positional Jacobian ``∂o_k/∂q_j = z_j × (o_k - o_j)`` for ``j < k``
-    (a revolute joint does not move its own frame's origin), ``z_j`` for ``j <= k`` (a prismatic joint).
+    """Every joint frame's origin and its positional Jacobian ``∂o_k/∂q_j = z_j × (o_k - o_j)`` for the joints ``j``
+    before ``k`` (a revolute joint does not move its own frame's origin), ``z_j`` for ``k`` too (a prismatic joint);
+    zero for the joints that do not carry ``k`` (:attr:`dynid.model.robot.Robot.carries`: another arm's).
 
     Parameters
     ----------
@@ -174,9 +175,10 @@ def origins_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     _, orig, axes = frames_and_axes(robot, q)
     lever = orig[:, :, :, None] - orig.transpose(0, 2, 1)[:, None]  # (N, k, 3, j): o_k - o_j
     jac = np.cross(axes[:, None], lever, axis=2)
-    jac *= np.tril(np.ones((robot.n_dof, robot.n_dof)), -1)[None, :, None, :]  # only the joints before frame k
-    for j in np.flatnonzero(robot.prismatic):  # a prismatic joint moves its own frame and those after it along z_j
-        jac[:, j:, :, j] = axes[:, None, :, j]
+    carries = robot.carries
+    jac *= (carries & ~np.eye(robot.n_dof, dtype=bool)).T[None, :, None, :]  # only the joints before frame k
+    for j in np.flatnonzero(robot.prismatic):  # a prismatic joint moves its own frame and those it carries along z_j
+        jac[..., j] = np.where(carries[j][None, :, None], axes[:, None, :, j], jac[..., j])
     return orig, jac
 
 
@@ -200,4 +202,6 @@ def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     jac = np.cross(axes, lever, axis=1)
     slides = robot.prismatic
     jac[:, :, slides] = axes[:, :, slides]
+    if robot.is_tree:  # the tool rides on the last joint: the other branches' joints do not move it
+        jac *= robot.carries[:, -1][None, None, :]
     return p, jac

@@ -182,5 +182,5 @@ class FloorDistances:
             _, orig, axes = frames_and_axes(self.robot, self.q)
             lever = self.points[:, :, None, :] - orig[:, None, :, :]  # (N, m, n_dof, 3)
             moved = point_motion(self.robot, axes, lever)  # z_j × (p - o_j), or z_j along a prismatic joint
-            grad = moved[..., 2] * (np.arange(self.robot.n_dof)[None, None, :] <= np.array(links)[None, :, None])
+            grad = moved[..., 2] * self.robot.carries[:, list(links)].T[None]
         return ObstacleDistances([(int(g), -1) for g in self.needs.shapes], self.dist.copy(), grad, links)

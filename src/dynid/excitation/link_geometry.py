@@ -192,7 +192,8 @@ def estimated_link_radius(robot: Robot) -> float:
 
 def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> LinkGeometry:
     """Each link as a capsule of ``radius`` about the segment from its joint's origin to the next joint's (the last
-    link's to the flange; a sphere where they coincide): the shapes of a robot whose file has none.
+    link's to the flange; a sphere where they coincide; a link that carries two branches, one capsule to each, and a
+    branch's tip other than the last a sphere): the shapes of a robot whose file has none.
 
     Parameters
     ----------
@@ -206,9 +207,14 @@ def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> 
     LinkGeometry
         ``names`` "link k capsule", ``source`` what they are.
     """
-    ends = [np.asarray(j.translation, dtype=float) for j in robot.joints[1:]] + [np.asarray(robot.tool_translation, dtype=float)]
+    parents, n = robot.parents, robot.n_dof
+    children = [[c for c in range(n) if parents[c] == k] for k in range(n)]
+    tool, still = np.asarray(robot.tool_translation, dtype=float), np.zeros(3)  # a branch's tip other than the last: a sphere
+    ends = [(k, np.asarray(robot.joints[c].translation, dtype=float)) for k in range(n) for c in children[k]]
+    ends += [(k, tool if k == n - 1 else still) for k in range(n) if not children[k]]
+    ends.sort(key=lambda e: e[0])  # stable: a link's capsules in its children's order
     shapes, placement = [], []
-    for end in ends:  # in the link's own frame the segment runs from its origin to the next joint's translation
+    for _, end in ends:  # in the link's own frame the segment runs from its origin to the next joint's translation
         length = float(np.linalg.norm(end))
         frame = np.eye(4)
         if length > 1e-12:
@@ -220,8 +226,10 @@ def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> 
         shapes.append(coal.Capsule(float(radius), length))
         placement.append(frame)
     how = "estimated: [workspace] link_radius sets it" if estimated else "[workspace] link_radius"
-    return LinkGeometry(tuple(shapes), np.arange(robot.n_dof), np.array(placement),
-                        tuple(f"link {k + 1} capsule" for k in range(robot.n_dof)),
+    links = [k for k, _ in ends]
+    return LinkGeometry(tuple(shapes), np.array(links), np.array(placement),
+                        tuple(f"link {k + 1} capsule" + (f" {links[:i].count(k) + 1}" if links.count(k) > 1 else "")
+                              for i, k in enumerate(links)),
                         f"capsules of radius {radius:.3g} m about the joint origins ({how})")
 
 
@@ -590,7 +598,7 @@ class ShapeDistances(_CoalDistances):
         grad = -np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)
         _along_sliding(self.robot, grad, normal, axes, -1.0)
         links = np.array([int(self.geometry.link[g]) for g, _ in self.pairs])
-        grad *= np.arange(self.robot.n_dof)[None, None, :] <= links[None, :, None]
+        grad *= self.robot.carries[:, links].T[None]
         return grad
 
 
@@ -674,8 +682,13 @@ def self_pairs(robot: Robot, geometry: LinkGeometry, *, samples: int = 200, rng=
     key = (robot.n_dof, lo.tobytes(), hi.tobytes(), samples, rng if isinstance(rng, int) else None)
     if key[-1] is not None and key in geometry.found:  # the design, its checks and the run ask for the same pairs
         return list(geometry.found[key])
+    parents = {k: int(p) for k, p in enumerate(robot.parents)}
+
+    def neighbours(a: int, b: int) -> bool:  # the same link, or one carried by the other's joint (the base is -1)
+        return a == b or parents.get(a, -2) == b or parents.get(b, -2) == a
+
     candidates = [(g, h) for g in range(len(geometry.shapes)) for h in range(g + 1, len(geometry.shapes))
-                  if abs(int(geometry.link[g]) - int(geometry.link[h])) >= 2 and (g, h) not in geometry.excluded]
+                  if not neighbours(int(geometry.link[g]), int(geometry.link[h])) and (g, h) not in geometry.excluded]
     pairs = []
     if candidates:
         q = robot.limits.random_positions(samples, rng)
@@ -748,14 +761,14 @@ class SelfDistances(_CoalDistances):
     def _gradient(self, near, normal, orig, axes) -> np.ndarray:
         """``-n·(v_g - v_h)``: each side's nearest point moved by the joints up to its shape's link."""
         robot, pairs = self.robot, self.pairs
-        joints = np.arange(robot.n_dof)[None, None, :]
+        carries = np.c_[robot.carries, np.zeros(robot.n_dof, dtype=bool)]  # link -1 (the base): no joint moves it
         grad = np.zeros((self.q.shape[0], len(pairs), robot.n_dof))
         for side, sign in ((0, -1.0), (1, 1.0)):
             links = np.array([int(self.geometry.link[pair[side]]) for pair in pairs])
             lever = near[side][:, :, None, :] - orig[:, None, :, :]
             moved = np.einsum("npjk,nkj->npj", np.cross(lever, normal[:, :, None, :]), axes)  # z_j·((p - o_j) × n)
             _along_sliding(robot, moved, normal, axes, 1.0)
-            grad += sign * moved * (joints <= links[None, :, None])
+            grad += sign * moved * carries[:, links].T[None]
         return grad
 
 

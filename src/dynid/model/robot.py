@@ -323,6 +323,20 @@ class Robot:
         return np.array([j - 1 if jt.parent is None else jt.parent for j, jt in enumerate(self.joints)], dtype=np.int64)
 
     @property
+    def carries(self) -> np.ndarray:
+        """(n_dof, n_dof) bool: ``carries[j, k]``, whether joint ``j`` moves link ``k`` (``j`` is ``k`` or a joint on
+        the way from the base to it): ``j <= k`` along a serial chain; on a robot with branches, one arm's joints do
+        not move the other arm."""
+        parents = self.parents
+        out = np.zeros((self.n_dof, self.n_dof), dtype=bool)
+        for k in range(self.n_dof):
+            j = k
+            while j >= 0:
+                out[j, k] = True
+                j = parents[j]
+        return out
+
+    @property
     def is_tree(self) -> bool:
         """Whether the robot has branches (two arms on a torso): a joint not carried by the joint before it."""
         return bool(np.any(self.parents != np.arange(self.n_dof) - 1))
@@ -336,10 +350,15 @@ class Robot:
     def reach(self) -> float:
         """[m] The sum of the joints' offsets, the flange's and each prismatic joint's stroke (its farther limit): no point
         of the arm's skeleton is farther than this from the first joint's origin (a prismatic joint without limits
-        adds nothing)."""
+        adds nothing); on a robot with branches, that sum along the longest way from the base to a branch's tip."""
         stroke = np.where(self.prismatic, np.maximum(np.abs(self.limits.q_min), np.abs(self.limits.q_max)), 0.0)
-        return (sum(float(np.linalg.norm(j.translation)) for j in self.joints) + float(np.linalg.norm(self.tool_translation))
-                + float(np.sum(np.where(np.isfinite(stroke), stroke, 0.0))))
+        if not self.is_tree:
+            return (sum(float(np.linalg.norm(j.translation)) for j in self.joints) + float(np.linalg.norm(self.tool_translation))
+                    + float(np.sum(np.where(np.isfinite(stroke), stroke, 0.0))))
+        # a robot with branches: the longest way from the base to a branch's tip (the tool on the last joint's)
+        step = np.array([float(np.linalg.norm(j.translation)) for j in self.joints]) + np.where(np.isfinite(stroke), stroke, 0.0)
+        step[-1] += float(np.linalg.norm(self.tool_translation))
+        return float(np.max(self.carries.T.astype(float) @ step))
 
     @property
     def n_params_per_joint(self) -> int:

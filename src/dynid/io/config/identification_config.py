@@ -381,11 +381,28 @@ def _robot_of(doc: dict, path: Path, root: Path):
     return _sensed_terms(config_robot(doc, path, root), doc, path)
 
 
+def _branches_hint(robot) -> str:
+    """For a robot with branches, what a refusal of a column list of the wrong length adds: its joints, and the
+    ``held`` that keeps its longest chain (:func:`dynid.model.robot_files.arm_chain`: a gripper's fingers, another arm
+    the log has no columns for)."""
+    if not robot.is_tree:
+        return ""
+    from ...model.robot_files import arm_chain
+
+    parents = {k: int(p) for k, p in enumerate(robot.parents)}
+    arm = arm_chain(parents, set(np.flatnonzero(~robot.prismatic).tolist()), set(np.flatnonzero(robot.prismatic).tolist()))
+    off = ", ".join(f'"{robot.joints[k].name}"' for k in parents if k not in arm)
+    return (f" ({robot.name} has branches, {robot.n_dof} joints: {', '.join(j.name for j in robot.joints)}; hold those "
+            f"the log has no columns for in the config's [robot] table, held = [{off}] for its longest chain, or let "
+            "dynid init write the config)")
+
+
 def _datasets(doc: dict, path: Path, root: Path, robot) -> tuple:
     """:func:`config_from_document`'s identification dataset and validation datasets (their names unique)."""
-    n = robot.n_dof
-    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic)
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic)
+    n, joints = robot.n_dof, _branches_hint(robot)
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic,
+                         joints)
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic, joints)
                        for i, v in enumerate(doc.get("validation", [])))
     names = [v.name for v in validation]
     if len(set(names)) != len(names):

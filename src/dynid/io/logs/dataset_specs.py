@@ -227,7 +227,7 @@ def _factor(sig, kind: str, w: str, n_dof: int, sliding) -> np.ndarray:
     return factor
 
 
-def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sliding=()) -> DatasetSpec:
+def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sliding=(), joints: str = "") -> DatasetSpec:
     """Parse a dataset table of a config (module docstring; its structure:
     :class:`dynid.io.config.config_types.DatasetTable`); paths are relative to ``base``.
 
@@ -245,6 +245,8 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sli
         The robot's joints (one column each).
     sliding : sequence of bool, optional
         Which joints are prismatic: a position unit in degrees leaves their metres as they are.
+    joints : str
+        Added to the refusal of a column list of the wrong length (a robot with branches: its joints and what to hold).
 
     Returns
     -------
@@ -300,7 +302,7 @@ def dataset_spec(table: dict, base: Path, where: str, name: str, n_dof: int, sli
         if sig.sensor is not None and kind != "torques":
             raise ConfigError(f"{w}.sensor: only the torques have a sensor (joint or drive), got it on the {kind}")
         if len(sig.columns) != n_dof:
-            raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {sig.columns!r}")
+            raise ConfigError(f"{w}.columns: expected {n_dof} columns (one per joint), got {sig.columns!r}{joints}")
         factor = _factor(sig, kind, w, n_dof, sliding)
         scale = float(factor[0]) if np.all(factor == factor[0]) else tuple(float(x) for x in factor)
         signals[kind] = SignalSpec(path_of(sig.file, w), tuple(sig.columns), scale, sig.side)

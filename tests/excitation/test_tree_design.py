@@ -1,0 +1,98 @@
+"""The excitation design of two arms on a turning torso (issue "Every arm a user has", item 3): one design for every
+branch at once, each arm's joints moving its own links only, and the arms kept apart from each other."""
+
+import json
+
+import numpy as np
+import pytest
+
+from dynid.dynamics.kinematics import forward_kinematics, tool_positions
+from dynid.dynamics.sensitivity import origins_jacobian, tool_jacobian
+from dynid.excitation.constraints import Workspace
+from dynid.excitation.design import ExcitationProblem, _Layout, _Objective
+from dynid.excitation.link_geometry import capsule_geometry, self_pairs
+from dynid.excitation.obstacles import Obstacle
+from dynid.model.description import load_robot
+
+from ..dynamics.test_tree_robots import TWO_ARMS
+from .test_design import _finite_difference
+
+
+@pytest.fixture(scope="module")
+def two_arms(tmp_path_factory):
+    path = tmp_path_factory.mktemp("tree") / "two_arms.urdf"
+    path.write_text(TWO_ARMS)
+    return load_robot(path), path
+
+
+def test_the_jacobians_of_two_arms_equal_finite_differences(two_arms, rng):
+    """Each origin moves with the joints that carry it alone (the left arm's joints do not move the right arm), and the
+    tool (on the last joint) with its own branch's."""
+    robot, _ = two_arms
+    q = robot.limits.random_positions(4, rng)
+    _, jo = origins_jacobian(robot, q)
+    _, jt = tool_jacobian(robot, q)
+    for k in range(4):
+        np.testing.assert_allclose(jo[k], _finite_difference(lambda x: forward_kinematics(robot, x[None])[1][0], q[k]),
+                                   atol=1e-8)
+        np.testing.assert_allclose(jt[k], _finite_difference(lambda x: tool_positions(robot, x[None])[0], q[k]),
+                                   atol=1e-8)
+    assert np.all(jt[:, :, 1:4] == 0.0) and np.all(jo[:, 4:, :, 1:4] == 0.0)  # the left arm moves no right-arm point
+
+
+def test_the_torso_carries_a_capsule_to_each_arm_and_the_arms_are_kept_apart(two_arms):
+    """Capsules about the joint origins: the torso's link one to each arm's shoulder, a hand (no joint after it) a
+    sphere; the self-collision pairs hold shapes of the two arms, never a link and the one that carries it."""
+    robot, _ = two_arms
+    geometry = capsule_geometry(robot, 0.03)
+    assert geometry.link.tolist() == [0, 0, 1, 2, 3, 4, 5, 6]
+    assert geometry.names[:2] == ("link 1 capsule 1", "link 1 capsule 2")
+    assert geometry.shapes[4].halfLength == 0.0 < geometry.shapes[3].halfLength  # the left hand a sphere, its forearm not
+    length = [float(np.linalg.norm(j.translation)) for j in robot.joints]
+    assert robot.reach == pytest.approx(max(sum(length[:4]), length[0] + sum(length[4:]) + 0.2))  # the longest branch
+    pairs = self_pairs(robot, geometry)
+    links = [(int(geometry.link[g]), int(geometry.link[h])) for g, h in pairs]
+    parents = robot.parents
+    assert (3, 6) in links and (2, 5) in links  # the hands, the forearms
+    assert all(a != b and parents[a] != b and parents[b] != a for a, b in links)
+
+
+def test_the_design_gradients_of_two_arms_equal_finite_differences(two_arms, rng):
+    """Criterion, torques, workspace box, floor, a cell's body and the arms' distance to each other, by the chain rule
+    through the tree."""
+    robot, _ = two_arms
+    robot = robot.without_drive_terms(robot.drive_terms)
+    ball = Obstacle("sphere", np.array([0.2]), np.array([1.6, 0.9, 0.9]))
+    ws = Workspace(box_min=np.array([-5.0, -5.0, -5.0]), box_max=np.array([5.0, 5.0, 5.0]), floor=-0.3,
+                   obstacles=(ball,), link_radius=0.03, avoid_self_collision=True)
+    prob = ExcitationProblem(robot, 2 * np.pi / 10, 3, workspace=ws, grid_points=36)
+    lay = _Layout(prob, prob.design_grid())
+    obj = _Objective(prob, lay)
+    assert obj.pairs and obj.needs is not None
+    x = np.concatenate([prob.start_pose(), 0.3 * rng.standard_normal(lay.nx - robot.n_dof)])
+    assert np.exp(obj.fun(x)) < 1e7
+    np.testing.assert_allclose(obj.jac(x), _finite_difference(obj.fun, x), rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(obj.cons_jac(x), _finite_difference(obj.cons, x).reshape(-1, x.size), rtol=1e-4,
+                               atol=1e-6)
+
+
+def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_arms, tmp_path):
+    """A config whose robot is the whole tree (as dynid init writes for a log of both arms): one design of every joint, every
+    constraint held on the 10× finer check, the prismatic lift's margins in metres, the arms' distance to each other
+    among the margins."""
+    from ..cli.refusals import dynid
+
+    _, path = two_arms
+    config = tmp_path / "arm.toml"
+    config.write_text(f'robot = "{path}"\n\n[design]\nstarts = 2\n\n[workspace]\nfloor = 0.0\nlink_radius = 0.04\n'
+                      'avoid_self_collision = true\n')
+    p = dynid("excite", str(config), "--out", str(tmp_path / "out"))
+    assert p.returncode == 0, p.stderr
+    design = json.loads((tmp_path / "out" / "excitation.json").read_text())["design"]
+    assert design["cond"] < 0.5 * design["initial_cond"] and design["feasible"]
+    assert all(m["margin"] >= 0 for m in design["margins"] if m["margin"] is not None and np.isfinite(m["margin"]))
+    assert {"q_min [m]", "q_max [m]"} <= {m["constraint"] for m in design["margins"] if m["where"] == "joint 6"}
+    apart = [m for m in design["margins"] if m["constraint"] == "self clearance [m]"]
+    assert len(apart) == 1 and apart[0]["margin"] >= 0, apart
+    said = " ".join(p.stdout.split())
+    assert "joints 1-7" in said, said
