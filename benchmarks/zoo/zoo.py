@@ -1,9 +1,10 @@
 """The zoo: dynid's defaults on public arm descriptions it was never tuned on (issue "Honest on any log").
 
-Eleven arms from the ``example-robot-data`` package (PyPI; ``pip install -e ".[zoo]"``): UR3, UR5, UR10, Franka Panda,
+Arms from the ``example-robot-data`` package (PyPI; ``pip install -e ".[zoo]"``): UR3, UR5, UR10, Franka Panda,
 Kinova Jaco 2 (j2s6s200), UFACTORY xArm7, Unitree Z1, SO-100, TALOS's left arm, TIAGo's torso lift and arm (a
-prismatic joint first), Baxter's right arm (a two-arm robot: its left arm, head and grippers fixed) and the UR5 on a
-2 m linear track (:func:`on_a_track`), their grippers made fixed joints.
+prismatic joint first), Baxter's right arm (a two-arm robot: its left arm, head and grippers fixed), Baxter's two arms
+as one model (a tree of 14 joints) and the UR5 on a 2 m linear track (:func:`on_a_track`), their grippers made fixed
+joints.
 Each is simulated in MuJoCo (its own URDF parser, not dynid's or Pinocchio's; tests/mujoco_logs.py) under a
 joint-space PID loop at 1 kHz, with MuJoCo's armature (rotor inertia) and damping (viscous friction) and, as the dry
 friction truth, either MuJoCo's ``frictionloss`` constraint or ``fc·sign(q̇)``; encoder quantisation (20 bits) and
@@ -77,6 +78,7 @@ ARMS = {
     "TALOS left arm": ("talos_data/robots/talos_left_arm.urdf", r"^arm_left_[2-7]_joint$"),
     "TIAGo torso + arm": ("tiago_description/robots/tiago_no_hand.urdf", r"^(torso_lift_joint|arm_[1-7]_joint)$"),
     "Baxter right arm": ("baxter_description/urdf/baxter.urdf", r"^right_(s0|s1|e0|e1|w0|w1|w2)$"),  # two arms: the left held
+    "Baxter both arms": ("baxter_description/urdf/baxter.urdf", r"^(left|right)_(s0|s1|e0|e1|w0|w1|w2)$"),  # a tree
     "UR5 on a track": ("ur_description/urdf/ur5_robot.urdf",
                        r"^(track_joint|shoulder_pan|shoulder_lift|elbow|wrist_1|wrist_2|wrist_3)(_joint)?$"),
     "SCARA": ("", r"^j[1-4]$"),

@@ -129,8 +129,8 @@ def test_an_mjcf_dynid_cannot_model_is_one_line(tmp_path, body, message):
 
 
 def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tmp_path):
-    """Two finger bodies on slide joints after the arm: refused as a branch naming both, found by dynid init's helper, and
-    held fixed through a [robot] table; their masses then belong to the last link (as a URDF's held joints do)."""
+    """Two finger bodies on slide joints after the arm: read whole as a tree's branches, found by dynid init's helper,
+    and held fixed through a [robot] table; their masses then belong to the last link (as a URDF's held joints do)."""
     from dynid.model.urdf import joints_to_hold
 
     fingers = ('<body name="f1" pos="0.2 0 0"><joint name="finger1" type="slide" axis="0 1 0"/>'
@@ -140,8 +140,8 @@ def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tm
     text = HAND_WRITTEN.replace('fullinertia="0.01 0.012 0.013 0.001 0 0"/>',
                                 'fullinertia="0.01 0.012 0.013 0.001 0 0"/>' + fingers)
     (tmp_path / "arm.xml").write_text(text)
-    with pytest.raises(ConfigError, match=r"joints 'finger1', 'finger2' all ride on joint 'j3'.* held = \[\"finger1\", \"finger2\"\]"):
-        load_robot(tmp_path / "arm.xml")
+    whole = load_robot(tmp_path / "arm.xml")  # read whole, the fingers are a branch of the last link: a tree
+    assert whole.n_dof == 5 and whole.parents.tolist() == [-1, 0, 1, 2, 2]
     assert joints_to_hold(tmp_path / "arm.xml") == ("finger1", "finger2")
     robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["finger1", "finger2"]}}, tmp_path / "c.toml")
     (tmp_path / "bare.xml").write_text(HAND_WRITTEN)
@@ -150,26 +150,40 @@ def test_a_gripper_in_an_mjcf_is_held_and_its_bodies_count_with_the_last_link(tm
     assert robot.held == ("finger1", "finger2")
 
 
-@pytest.mark.parametrize("change, message", [
-    (('<joint name="j3" axis="1 0 0" pos="0.02 0 0"/>', '<joint name="j3" axis="1 0 0" pos="0.02 0 0" ref="10"/>'),
-     r"joint 'j3' has ref = 0.1745"),
+def test_a_hinge_with_a_reference_angle_is_refused_naming_the_joint(tmp_path):
+    (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace('<joint name="j3" axis="1 0 0" pos="0.02 0 0"/>',
+                                                           '<joint name="j3" axis="1 0 0" pos="0.02 0 0" ref="10"/>'))
+    with pytest.raises(ConfigError, match=r"joint 'j3' has ref = 0.1745"):
+        load_robot(tmp_path / "arm.xml")
+
+
+@pytest.mark.parametrize("change, parents", [
     (('<body name="l3"', '<body name="side" pos="0 0.1 0"><joint name="jb" axis="0 0 1"/>'
-      '<inertial pos="0 0 0" mass="0.5" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l3"'),
-     r"arm.xml: joints 'jb', 'j3' all ride on joint 'j2', and dynid identifies one serial chain: hold the joints that "
-     r"are not the arm's fixed in the config's \[robot\] table, held = \[\"j3\"\] for one of the longest chains "
-     r"\(j1 to jb;"),
+      '<inertial pos="0 0 0" mass="0.5" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l3"'), [-1, 0, 1, 1]),
     (('<body name="l1"', '<body name="camera" pos="0 0.2 0.1"><joint name="pan" axis="0 0 1"/>'
-      '<inertial pos="0 0 0" mass="0.3" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l1"'),
-     r"joints 'pan', 'j1' all ride on the base, .*held = \[\"pan\"\] for the longest chain \(j1 to j3;"),
+      '<inertial pos="0 0 0" mass="0.3" diaginertia="1e-3 1e-3 1e-3"/></body><body name="l1"'), [-1, -1, 1, 2]),
 ])
-def test_an_mjcf_chain_dynid_cannot_identify_is_refused_naming_the_joint(tmp_path, change, message):
-    """A branch is refused naming the joints that ride on the same one and the held that keeps the longest chain (a
-    camera's pan joint written before the arm is the one to hold, and dynid init holds it)."""
+def test_an_mjcf_with_a_branch_is_a_tree_that_predicts_mujocos_inverse_dynamics(tmp_path, rng, change, parents):
+    """A branch (a side link on the elbow, a camera's pan joint on the base written before the arm) is read whole: each
+    joint on the joint its body rides on, and dynid's regressor times the nominal parameters equals MuJoCo's recursive
+    Newton-Euler on the file at random states; dynid init holds the branch the log has no columns for (the camera's pan
+    joint, written first, is the one held, never the arm)."""
     from dynid.model.urdf import joints_to_hold
 
     (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace(*change))
-    with pytest.raises(ConfigError, match=message):
-        load_robot(tmp_path / "arm.xml")
+    robot = load_robot(tmp_path / "arm.xml")
+    assert robot.parents.tolist() == parents
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml"))
+    data = mujoco.MjData(model)
+    q, dq, ddq = (rng.uniform(-1.5, 1.5, (20, robot.n_dof)) for _ in range(3))
+    predicted = np.einsum("njp,p->nj", regressor(robot, q, dq, ddq), robot.standard_parameters())
+    expected = np.empty_like(predicted)
+    for k in range(q.shape[0]):
+        data.qpos[:], data.qvel[:] = q[k], dq[k]
+        mujoco.mj_forward(model, data)
+        data.qacc[:] = ddq[k]
+        mujoco.mj_rne(model, data, 1, expected[k])
+    np.testing.assert_allclose(predicted, expected, atol=1e-9 * np.abs(expected).max())
     if "camera" in change[1]:
         assert joints_to_hold(tmp_path / "arm.xml") == ("pan",)
         robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["pan"]}}, tmp_path / "c.toml")
@@ -256,7 +270,7 @@ def test_init_holds_an_mjcfs_gripper_and_writes_a_config_that_loads(tmp_path):
 
 def test_an_mjcf_with_two_arms_holds_the_arm_the_log_does_not_name(tmp_path):
     """Two arms on one body: without a log the first is the arm (the other held); a log whose columns name the second
-    arm's joints makes it the arm."""
+    arm's joints makes it the arm; a log of both arms, both (read whole, the file is a tree of both)."""
     from dynid.io.logs.columns import joints_named
     from dynid.model.mjcf import mjcf_joints_to_hold
 
@@ -272,3 +286,7 @@ def test_an_mjcf_with_two_arms_holds_the_arm_the_log_does_not_name(tmp_path):
     (tmp_path / "r.csv").write_text("time,r1_pos,r2_pos,r1_effort,r2_effort\n0,0,0,0,0\n0.01,0,0,0,0\n")
     assert mjcf_joints_to_hold(path) == ("r1", "r2")
     assert mjcf_joints_to_hold(path, lambda names: joints_named(tmp_path / "r.csv", names)) == ("l1", "l2")
+    (tmp_path / "both.csv").write_text("time,l1_pos,l2_pos,r1_pos,r2_pos,l1_effort,l2_effort,r1_effort,r2_effort\n"
+                                       "0,0,0,0,0,0,0,0,0\n0.01,0,0,0,0,0,0,0,0\n")
+    assert mjcf_joints_to_hold(path, lambda names: joints_named(tmp_path / "both.csv", names)) == ()  # the tree
+    assert load_robot(path).parents.tolist() == [-1, 0, -1, 2]

@@ -20,7 +20,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from ..runtime.extras import require
 from .robot import Joint
-from .robot_files import HELD_HINT, arm_chain, branch_refusal, check_xml
+from .robot_files import HELD_HINT, check_xml, joints_off_arm
 from .spatial import inertial_from_physical, rot_axis, transform_inertial
 
 
@@ -65,10 +65,6 @@ def _chain(path: Path, held: dict):
             if owner[b] >= 0 and _body(model, owner[b]) == b:
                 raise ConfigError(f"{path}: body {model.body(b).name!r} has more than one moving joint ({name!r}): "
                                   "dynid identifies one revolute joint per link; " + HELD_HINT.format(names=f'"{name}"'))
-            previous = moving[-1] if moving else -1
-            if owner[b] != previous:
-                names_, parents, revolute, sliding = _tree(mujoco, model, held)
-                raise ConfigError(branch_refusal(path, names_, parents, revolute, k, sliding))
             if abs(model.qpos0[model.jnt_qposadr[k]]) > 0:
                 raise ConfigError(f"{path}: joint {name!r} has ref = {model.qpos0[model.jnt_qposadr[k]]:g}: dynid's "
                                   "joint angle is 0 where the body's frame is as written; remove ref (and offset the "
@@ -117,7 +113,8 @@ def _frames(mujoco, model, moving, held, names):
 
 
 def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np.ndarray, tuple[str, ...], tuple[str, ...]]:
-    """Joints and link inertial parameters of an MJCF serial chain of hinge joints, as MuJoCo compiles the file.
+    """Joints and link inertial parameters of an MJCF's hinge and slide joints, as MuJoCo compiles the file: a serial
+    chain, or a tree (two arms on a torso), each joint then naming the joint that carries it.
 
     Parameters
     ----------
@@ -139,8 +136,8 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
     Raises
     ------
     ConfigError
-        MuJoCo is not installed (names the extra), the file cannot be compiled, a held joint is not in it, or the
-        chain is not serial, has joints other than hinges, or a hinge with a reference angle (``ref``).
+        MuJoCo is not installed (names the extra), the file cannot be compiled, a held joint is not in it, a joint is
+        neither hinge nor slide, a body has two moving joints, or a hinge has a reference angle (``ref``).
     """
     path, held = Path(path), dict(held or {})
     mujoco, model, moving, owner, names = _chain(path, held)
@@ -154,8 +151,9 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
         r_parent, t_parent = rotations[parent], translations[parent]  # parent body in the previous link's frame
         rotation, translation = r_parent @ r, r_parent @ (t + r @ np.array(model.jnt_pos[k])) + t_parent
         axis = np.array(model.jnt_axis[k], dtype=float)
+        carrier = moving.index(owner[parent]) if owner[parent] >= 0 else -1  # a branch: the joint its body rides on
         joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis),
-                            bool(model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE)))
+                            bool(model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE), None if carrier == i - 1 else carrier))
     return (tuple(joints), inertial, tuple(j.name for j in joints),
             tuple(model.body(_body(model, k)).name for k in moving))
 
@@ -347,7 +345,8 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
 def mjcf_joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str]] | None = None) -> tuple[str, ...]:
     """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest chain of
     hinges from the base (a gripper's fingers, a camera's pan joint on a branch of its own, wherever the file puts it),
-    or off the chain that holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`).
+    or off the chain that holds most of the joints the log names, or those the log does not name where it names
+    joints on several branches (:func:`dynid.model.robot_files.joints_off_arm`).
 
     Parameters
     ----------
@@ -368,8 +367,8 @@ def mjcf_joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], se
     mujoco, model = _compiled(Path(path))
     _, parents, revolute, sliding = _tree(mujoco, model)
     named = set() if logged is None else logged(tuple(model.joint(k).name for k in parents))
-    arm = arm_chain(parents, revolute, sliding, {k for k in parents if model.joint(k).name in named})
-    return tuple(model.joint(k).name for k in parents if k not in arm)
+    return tuple(model.joint(k).name
+                 for k in joints_off_arm(parents, revolute, sliding, {k for k in parents if model.joint(k).name in named}))
 
 
 def _tree(mujoco, model, held=()) -> tuple[dict[int, str], dict[int, int], set[int], set[int]]:

@@ -57,36 +57,27 @@ def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) ->
     return trimmed
 
 
-def branch_refusal(path, names: dict[int, str], parents: dict[int, int], revolute: set[int], at: int,
-                   sliding=frozenset()) -> str:
-    """The one line refusing a tree of joints that branches: the joints riding on the same one as joint ``at``, and
-    the ``held`` that keeps the longest chain (:func:`arm_chain`).
+def joints_off_arm(parents: dict[int, int], revolute: set[int], sliding=frozenset(), logged=frozenset()) -> list[int]:
+    """The joints ``dynid init`` holds: those off the arm (:func:`arm_chain`); where the joints a log names lie on
+    several branches (both arms of a two-arm robot), those the log does not name (the robot is then the tree of the
+    joints it names).
 
     Parameters
     ----------
-    path : path
-    names : dict of int to str
-        Every moving joint's name.
-    parents, revolute
+    parents, revolute, sliding
         As :func:`arm_chain`.
-    at : int
-        A joint that rides on another than the joint before it.
-    sliding : set of int
-        As :func:`arm_chain`.
+    logged : set of int
+        The joints a log names (none: the longest chain's).
 
     Returns
     -------
-    str
+    list of int
+        In reading order.
     """
-    siblings = [names[k] for k, parent in parents.items() if parent == parents[at]]
-    chains = _chains(parents, revolute, sliding)
-    arm = max(chains.values(), key=len)
-    one = "one of the longest chains" if sum(len(c) == len(arm) for c in chains.values()) > 1 else "the longest chain"
-    off = ", ".join(f'"{names[k]}"' for k in parents if k not in arm)
-    where = "the base" if parents[at] < 0 else f"joint {names[parents[at]]!r}"
-    return (f"{path}: joints {', '.join(map(repr, siblings))} all ride on {where}, and dynid identifies one serial "
-            f"chain: hold the joints that are not the arm's fixed in the config's [robot] table, held = [{off}] for "
-            f"{one} ({names[arm[0]]} to {names[arm[-1]]}; a gripper's fingers, a camera's pan joint)")
+    arm = arm_chain(parents, revolute, sliding, set(logged))
+    if set(logged) - set(arm):
+        return [k for k in parents if k not in logged]
+    return [k for k in parents if k not in arm]
 
 
 def check_xml(path: Path, parser=None) -> None:

@@ -17,7 +17,7 @@ import numpy as np
 from ..exceptions import ConfigError
 from .mjcf import joints_from_mjcf, mjcf_joint_values, mjcf_joints_to_hold
 from .robot import Joint
-from .robot_files import HELD_HINT, arm_chain, check_xml, is_mjcf
+from .robot_files import HELD_HINT, check_xml, is_mjcf, joints_off_arm
 from .xacro_expansion import expand_xacro_text
 
 _AXES = {"RX": (1.0, 0.0, 0.0), "RY": (0.0, 1.0, 0.0), "RZ": (0.0, 0.0, 1.0),
@@ -285,11 +285,7 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
     model = _pinocchio_model(path, {})
     names, parents, revolute, sliding = _tree(model, mimic)
     named = set() if logged is None else logged(tuple(names[k] for k in parents))
-    logged_joints = {k for k in parents if names[k] in named}
-    arm = arm_chain(parents, revolute, sliding, logged_joints)
-    if logged_joints - set(arm):  # the log names joints on several branches (two arms): the tree is its robot
-        return tuple(names[k] for k in parents if k not in logged_joints)
-    return tuple(names[k] for k in parents if k not in arm)
+    return tuple(names[k] for k in joints_off_arm(parents, revolute, sliding, {k for k in parents if names[k] in named}))
 
 
 def _tree(model, mimic=frozenset()) -> tuple[dict[int, str], dict[int, int], set[int], set[int]]:

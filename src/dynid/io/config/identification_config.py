@@ -383,15 +383,15 @@ def _robot_of(doc: dict, path: Path, root: Path):
 
 def _branches_hint(robot) -> str:
     """For a robot with branches, what a refusal of a column list of the wrong length adds: its joints, and the
-    ``held`` that keeps its longest chain (:func:`dynid.model.robot_files.arm_chain`: a gripper's fingers, another arm
+    ``held`` that keeps its longest chain (:func:`dynid.model.robot_files.joints_off_arm`: a gripper's fingers, another arm
     the log has no columns for)."""
     if not robot.is_tree:
         return ""
-    from ...model.robot_files import arm_chain
+    from ...model.robot_files import joints_off_arm
 
     parents = {k: int(p) for k, p in enumerate(robot.parents)}
-    arm = arm_chain(parents, set(np.flatnonzero(~robot.prismatic).tolist()), set(np.flatnonzero(robot.prismatic).tolist()))
-    off = ", ".join(f'"{robot.joints[k].name}"' for k in parents if k not in arm)
+    off = ", ".join(f'"{robot.joints[k].name}"' for k in joints_off_arm(
+        parents, set(np.flatnonzero(~robot.prismatic).tolist()), set(np.flatnonzero(robot.prismatic).tolist())))
     return (f" ({robot.name} has branches, {robot.n_dof} joints: {', '.join(j.name for j in robot.joints)}; hold those "
             f"the log has no columns for in the config's [robot] table, held = [{off}] for its longest chain, or let "
             "dynid init write the config)")
