@@ -23,6 +23,7 @@ def test_two_arms_on_a_torso_are_identified_as_one_model_from_init_to_its_writte
         (tmp_path / file).write_text(_csv(simulated_log(robot, seconds=seconds, rate=250.0, rng=seed), robot))
     p = run("init", "two_arms.urdf", "identification.csv", "validation.csv", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
+    assert "the log's joints are on several branches: one model of its 7 joints (a tree" in " ".join(p.stdout.split())
     p = run("identify", "arm.toml", "--no-figures", cwd=tmp_path)
     said = " ".join((p.stdout + p.stderr).split())
     assert p.returncode == 0, p.stderr

@@ -94,7 +94,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
         kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
         said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
-                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held, log)]
+                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held, log, robot)]
         said.append(_estimators_note(without, robot))
         return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
                        without_sdp=without), said
@@ -106,7 +106,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
-    notes += [*_sliding_note(robot), *_held_notes(urdf, held, log), *_gain_notes(table, urdf, robot, gains),
+    notes += [*_sliding_note(robot), *_held_notes(urdf, held, log, robot), *_gain_notes(table, urdf, robot, gains),
               _estimators_note(without, robot)]
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
@@ -201,13 +201,17 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
     return out
 
 
-def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None) -> list[str]:
+def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None, robot=None) -> list[str]:
     """The lines of the joints held: which, and those of them the log holds columns of (another arm of a two-arm
     robot that ``--arm`` left out), which a config of their own identifies."""
+    tree = robot is not None and robot.is_tree
+    notes = [f"{urdf.name}: the log's joints are on several branches: one model of its {robot.n_dof} joints (a tree, "
+             "each joint feeling the links it carries)"] if tree else []
     if not held:
-        return []
-    notes = [f"{urdf.name}: {', '.join(held)} not on the arm's serial chain (a gripper, a head, another arm): held fixed "
-             "at 0, their links counted with the link they hang on (held in [robot])"]
+        return notes
+    where = "no columns in the log (a gripper, a head)" if tree else "not on the arm's serial chain (a gripper, a head, another arm)"
+    notes.append(f"{urdf.name}: {', '.join(held)} {where}: held fixed at 0, their links counted with the link they hang "
+                 "on (held in [robot])")
     logged = sorted(joints_named(log, held), key=held.index) if log is not None else []
     if log is not None and logged:  # --arm chose one arm of a log of several
         notes.append(f"{log.name} also holds columns of {', '.join(logged)}, on another branch of {urdf.name}: held as "
