@@ -60,3 +60,36 @@ def test_a_config_whose_log_covers_one_branch_is_refused_naming_the_joints_to_ho
     assert_refused(p, "identification.positions.columns: expected 7 columns (one per joint)")
     assert ('hold those the log has no columns for in the config\'s [robot] table, held = ["right_j1", "right_j2", '
             '"right_j3"] for its longest chain') in p.stderr
+
+
+def _two_arms_mjcf() -> str:
+    """A torso turning about z with two three-hinge arms, as an MJCF (MuJoCo compiles its bodies' tree)."""
+    def arm(side, y):
+        return (f'<body name="{side}_link1" pos="0 {y} 0.5"><joint name="{side}1" axis="0 0 1" range="-3 3"/>'
+                f'<inertial pos="0.02 0.01 0.15" mass="2.5" diaginertia="0.01 0.02 0.015"/>'
+                f'<body name="{side}_link2" pos="0 0 0.3"><joint name="{side}2" axis="0 1 0" range="-3 3"/>'
+                f'<inertial pos="0.15 0 0.01" mass="1.5" diaginertia="0.01 0.02 0.015"/>'
+                f'<body name="{side}_link3" pos="0.3 0 0"><joint name="{side}3" axis="1 0 0" range="-3 3"/>'
+                f'<inertial pos="0.05 0.02 0" mass="0.8" diaginertia="0.003 0.004 0.002"/></body></body></body>')
+
+    return (f'<mujoco model="two"><worldbody><body name="torso" pos="0 0 0.3"><joint name="yaw" axis="0 0 1" '
+            f'range="-3 3"/><inertial pos="0 0 0.2" mass="10" diaginertia="0.3 0.3 0.1"/>{arm("l", 0.3)}'
+            f'{arm("r", -0.3)}</body></worldbody></mujoco>')
+
+
+def test_an_mjcf_of_two_arms_is_identified_as_one_model_and_written_back_into_it(tmp_path):
+    """The same from an MJCF: its bodies' tree read as MuJoCo compiles it, the user's file written back with both
+    arms' identified bodies, and the URDF dynid writes from the model; MuJoCo and Pinocchio read both as dynid's
+    model."""
+    (tmp_path / "two.xml").write_text(_two_arms_mjcf())
+    robot = _with_drives(load_robot(tmp_path / "two.xml"), np.random.default_rng(0))
+    assert robot.parents.tolist() == [-1, 0, 1, 2, 0, 4, 5]
+    for file, seconds, seed in (("identification.csv", 60.0, 1), ("validation.csv", 20.0, 2)):
+        (tmp_path / file).write_text(_csv(simulated_log(robot, seconds=seconds, rate=250.0, rng=seed), robot))
+    assert run("init", "two.xml", "identification.csv", "validation.csv", cwd=tmp_path).returncode == 0
+    p = run("identify", "arm.toml", "--no-figures", cwd=tmp_path)
+    said = " ".join((p.stdout + p.stderr).split())
+    assert p.returncode == 0 and "\nmodel ready" in "\n" + p.stdout, said[:400]
+    assert "two.xml read back by MuJoCo" in said and "dynid-model.urdf read back by Pinocchio" in said
+    figures = re.findall(r"equals dynid's model to ([0-9.e+-]+) of its RMS", said)
+    assert len(figures) == 2 and all(float(f) < 1e-9 for f in figures), figures
