@@ -122,15 +122,20 @@ def test_the_number_of_base_parameters_is_the_rank_of_pinocchios_regressor(urdf,
     assert base_parameters(rigid).n_base == np.linalg.matrix_rank(w)
 
 
-def test_forward_kinematics_follows_pinocchio(urdf, rng):
-    robot, model, data = _both(urdf)
-    q = _states(robot, rng, 20)[0]
+def assert_kinematics_follow_pinocchio(robot, model, q):
+    """dynid's link frames at ``q`` (N, n_dof) equal Pinocchio's ``oMi`` of ``model`` to 1e-12."""
+    data = model.createData()
     rots, origins = forward_kinematics(robot, q)
-    for k in range(20):
+    for k in range(q.shape[0]):
         pin.forwardKinematics(model, data, q[k])
         for j in range(robot.n_dof):
             np.testing.assert_allclose(origins[k, j], data.oMi[j + 1].translation, atol=1e-12)
             np.testing.assert_allclose(rots[k, j], data.oMi[j + 1].rotation, atol=1e-12)
+
+
+def test_forward_kinematics_follows_pinocchio(urdf, rng):
+    robot, model, _ = _both(urdf)
+    assert_kinematics_follow_pinocchio(robot, model, _states(robot, rng, 20)[0])
 
 
 def test_a_prismatic_joints_drive_terms_are_in_linear_units(urdf):

@@ -7,14 +7,13 @@ import pinocchio as pin
 import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
-from dynid.dynamics.kinematics import forward_kinematics
 from dynid.dynamics.regressor import _fill
 from dynid.dynamics.rnea import rnea_torques
 from dynid.exceptions import ConfigError
 from dynid.model.description import load_robot
 from dynid.model.urdf import inertial_from_pinocchio
 
-from .test_prismatic_joints import _joint, _link, _urdf
+from .test_prismatic_joints import _joint, _link, _urdf, assert_kinematics_follow_pinocchio
 
 
 def _arm(side: str, y: float, lift: bool = False) -> tuple[list, list]:
@@ -99,15 +98,7 @@ def test_the_number_of_base_parameters_is_the_rank_of_pinocchios_regressor(urdf,
 
 def test_forward_kinematics_follows_pinocchio(urdf, rng):
     robot = load_robot(urdf)
-    model = pin.buildModelFromUrdf(str(urdf))
-    data = model.createData()
-    q = _states(robot, rng, 20)[0]
-    rots, origins = forward_kinematics(robot, q)
-    for k in range(20):
-        pin.forwardKinematics(model, data, q[k])
-        for j in range(robot.n_dof):
-            np.testing.assert_allclose(origins[k, j], data.oMi[j + 1].translation, atol=1e-12)
-            np.testing.assert_allclose(rots[k, j], data.oMi[j + 1].rotation, atol=1e-12)
+    assert_kinematics_follow_pinocchio(robot, pin.buildModelFromUrdf(str(urdf)), _states(robot, rng, 20)[0])
 
 
 def test_a_serial_chains_numbers_and_fingerprint_do_not_change_with_its_parents_stated(urdf, rng):

@@ -29,6 +29,22 @@ def _finite_difference(f, x, h=1e-5):
     return np.stack(cols, axis=-1)
 
 
+def jacobians_checked(robot, q):
+    """The joint origins' and the tool point's Jacobians at ``q`` (N, n_dof), each checked against central
+    differences of the kinematics to 1e-8; returned ``(origins', tool's)``."""
+    from dynid.dynamics.kinematics import forward_kinematics, tool_positions
+    from dynid.dynamics.sensitivity import origins_jacobian, tool_jacobian
+
+    _, jo = origins_jacobian(robot, q)
+    _, jt = tool_jacobian(robot, q)
+    for k in range(q.shape[0]):
+        np.testing.assert_allclose(jo[k], _finite_difference(lambda x: forward_kinematics(robot, x[None])[1][0], q[k]),
+                                   atol=1e-8)
+        np.testing.assert_allclose(jt[k], _finite_difference(lambda x: tool_positions(robot, x[None])[0], q[k]),
+                                   atol=1e-8)
+    return jo, jt
+
+
 @pytest.mark.parametrize("criterion", ["cond", "d-optimal"])
 def test_gradients_equal_finite_differences_of_the_whole_problem(er16_3, rng, criterion):
     """The chain-rule gradients (criterion, torque, workspace and obstacle constraints) against central differences."""

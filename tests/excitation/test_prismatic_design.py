@@ -6,8 +6,6 @@ import re
 import numpy as np
 import pytest
 
-from dynid.dynamics.kinematics import forward_kinematics, tool_positions
-from dynid.dynamics.sensitivity import origins_jacobian, tool_jacobian
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, _Layout, _Objective
 from dynid.excitation.link_geometry import link_geometry_from_urdf
@@ -15,7 +13,7 @@ from dynid.excitation.obstacles import Obstacle
 from dynid.model.description import load_robot
 
 from ..dynamics.test_prismatic_joints import TRACKED
-from .test_design import _finite_difference
+from .test_design import _finite_difference, jacobians_checked
 
 BOXES = '<collision><origin xyz="0 0 0.05"/><geometry><box size="0.12 0.1 0.2"/></geometry></collision></link>'
 
@@ -29,14 +27,7 @@ def tracked(tmp_path_factory):
 
 def test_the_jacobians_of_a_tracked_arm_equal_finite_differences(tracked, rng):
     robot, _ = tracked
-    q = robot.limits.random_positions(4, rng)
-    _, jo = origins_jacobian(robot, q)
-    _, jt = tool_jacobian(robot, q)
-    for k in range(4):
-        np.testing.assert_allclose(jo[k], _finite_difference(lambda x: forward_kinematics(robot, x[None])[1][0], q[k]),
-                                   atol=1e-8)
-        np.testing.assert_allclose(jt[k], _finite_difference(lambda x: tool_positions(robot, x[None])[0], q[k]),
-                                   atol=1e-8)
+    jacobians_checked(robot, robot.limits.random_positions(4, rng))
 
 
 @pytest.mark.parametrize("shapes", ["capsules", "collision boxes"])

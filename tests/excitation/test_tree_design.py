@@ -6,8 +6,6 @@ import json
 import numpy as np
 import pytest
 
-from dynid.dynamics.kinematics import forward_kinematics, tool_positions
-from dynid.dynamics.sensitivity import origins_jacobian, tool_jacobian
 from dynid.excitation.constraints import Workspace
 from dynid.excitation.design import ExcitationProblem, _Layout, _Objective
 from dynid.excitation.link_geometry import capsule_geometry, self_pairs
@@ -15,7 +13,7 @@ from dynid.excitation.obstacles import Obstacle
 from dynid.model.description import load_robot
 
 from ..dynamics.test_tree_robots import TWO_ARMS
-from .test_design import _finite_difference
+from .test_design import _finite_difference, jacobians_checked
 
 
 @pytest.fixture(scope="module")
@@ -29,14 +27,7 @@ def test_the_jacobians_of_two_arms_equal_finite_differences(two_arms, rng):
     """Each origin moves with the joints that carry it alone (the left arm's joints do not move the right arm), and the
     tool (on the last joint) with its own branch's."""
     robot, _ = two_arms
-    q = robot.limits.random_positions(4, rng)
-    _, jo = origins_jacobian(robot, q)
-    _, jt = tool_jacobian(robot, q)
-    for k in range(4):
-        np.testing.assert_allclose(jo[k], _finite_difference(lambda x: forward_kinematics(robot, x[None])[1][0], q[k]),
-                                   atol=1e-8)
-        np.testing.assert_allclose(jt[k], _finite_difference(lambda x: tool_positions(robot, x[None])[0], q[k]),
-                                   atol=1e-8)
+    jo, jt = jacobians_checked(robot, robot.limits.random_positions(4, rng))
     assert np.all(jt[:, :, 1:4] == 0.0) and np.all(jo[:, 4:, :, 1:4] == 0.0)  # the left arm moves no right-arm point
 
 

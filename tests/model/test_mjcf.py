@@ -61,15 +61,10 @@ def _mujoco_written(tmp_path, name: str) -> str:
     return str(path)
 
 
-@pytest.mark.parametrize("name", ["ur10e", "er16", "hand"])
-def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
-    """dynid's regressor times the MJCF robot's nominal parameters equals MuJoCo's recursive Newton-Euler (mj_rne,
-    gravity included) on the same file, at random states."""
-    path = _mujoco_written(tmp_path, name)
-    robot = load_robot(path)
-    model = mujoco.MjModel.from_xml_path(path)
+def assert_predicts_mujocos_rne(robot, model, rng) -> None:
+    """dynid's regressor times the robot's nominal parameters equals MuJoCo's recursive Newton-Euler (``mj_rne``,
+    gravity included) of ``model`` at 20 random states, to 1e-9 of the largest torque."""
     data = mujoco.MjData(model)
-    assert robot.n_dof == model.nv
     q, dq, ddq = (rng.uniform(-1.5, 1.5, (20, robot.n_dof)) for _ in range(3))
     predicted = np.einsum("njp,p->nj", regressor(robot, q, dq, ddq), robot.standard_parameters())
     expected = np.empty_like(predicted)
@@ -79,6 +74,17 @@ def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
         data.qacc[:] = ddq[k]
         mujoco.mj_rne(model, data, 1, expected[k])
     np.testing.assert_allclose(predicted, expected, atol=1e-9 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("name", ["ur10e", "er16", "hand"])
+def test_an_mjcf_robot_predicts_mujocos_inverse_dynamics(tmp_path, rng, name):
+    """dynid's regressor times the MJCF robot's nominal parameters equals MuJoCo's recursive Newton-Euler (mj_rne,
+    gravity included) on the same file, at random states."""
+    path = _mujoco_written(tmp_path, name)
+    robot = load_robot(path)
+    model = mujoco.MjModel.from_xml_path(path)
+    assert robot.n_dof == model.nv
+    assert_predicts_mujocos_rne(robot, model, rng)
     assert np.isfinite(robot.limits.q_min[0]) and (name == "hand") != np.all(np.isfinite(robot.limits.q_min))  # ranges
     assert (robot.nominal_notes == ()) == (name == "ur10e")  # the UR10e's URDF states no friction, the others do
 
@@ -173,17 +179,7 @@ def test_an_mjcf_with_a_branch_is_a_tree_that_predicts_mujocos_inverse_dynamics(
     (tmp_path / "arm.xml").write_text(HAND_WRITTEN.replace(*change))
     robot = load_robot(tmp_path / "arm.xml")
     assert robot.parents.tolist() == parents
-    model = mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml"))
-    data = mujoco.MjData(model)
-    q, dq, ddq = (rng.uniform(-1.5, 1.5, (20, robot.n_dof)) for _ in range(3))
-    predicted = np.einsum("njp,p->nj", regressor(robot, q, dq, ddq), robot.standard_parameters())
-    expected = np.empty_like(predicted)
-    for k in range(q.shape[0]):
-        data.qpos[:], data.qvel[:] = q[k], dq[k]
-        mujoco.mj_forward(model, data)
-        data.qacc[:] = ddq[k]
-        mujoco.mj_rne(model, data, 1, expected[k])
-    np.testing.assert_allclose(predicted, expected, atol=1e-9 * np.abs(expected).max())
+    assert_predicts_mujocos_rne(robot, mujoco.MjModel.from_xml_path(str(tmp_path / "arm.xml")), rng)
     if "camera" in change[1]:
         assert joints_to_hold(tmp_path / "arm.xml") == ("pan",)
         robot = config_robot({"robot": {"urdf": "arm.xml", "held": ["pan"]}}, tmp_path / "c.toml")
