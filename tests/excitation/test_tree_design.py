@@ -75,8 +75,8 @@ def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_a
 
     _, path = two_arms
     config = tmp_path / "arm.toml"
-    config.write_text(f'robot = "{path}"\n\n[design]\nstarts = 2\n\n[workspace]\nfloor = 0.0\nlink_radius = 0.04\n'
-                      'avoid_self_collision = true\n')
+    config.write_text(f'robot = "{path}"\n\n[design]\nstarts = 1\n\n[trajectory]\nharmonics = 3\n\n[workspace]\n'
+                      'floor = 0.0\nlink_radius = 0.04\navoid_self_collision = true\n')
     p = dynid("excite", str(config), "--out", str(tmp_path / "out"))
     assert p.returncode == 0, p.stderr
     design = json.loads((tmp_path / "out" / "excitation.json").read_text())["design"]
