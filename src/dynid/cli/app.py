@@ -436,37 +436,65 @@ def export(
         return [path for path, _ in computed[1]]
 
     def show(rep, computed, paths):
-        cfg, _, moved, _, _, simulated, _ = computed
-        robot = cfg.robot
-        from ..report.identification_run import file_choice
-
-        held = file_choice(computed[3], "MJCF")["offsets_held"]
-        added = {"URDF": "", "MJCF": f", and {len(held)} actuator(s) of constant bias added after its own for the torque "
-                 "offsets" if held else ""}
-        into = "".join(f"; the {form} is {name} with only its inertials and joint dynamics replaced{added[form]}" for form, name, given in (
-            ("URDF", cfg.urdf.name if cfg.urdf else "", cfg.urdf is not None and urdf is not None),
-            ("MJCF", getattr(_users_mjcf(cfg), "name", ""), _users_mjcf(cfg) is not None and mjcf is not None)) if given)
-        for line in moved:
-            rep.warning(f"far from the description's own values: {line}")
-        from ..io.exported.export import nominal_warning, verdict_warnings
-
-        for line in verdict_warnings(computed[3]):
-            rep.warning(line)
-        gate = nominal_warning(computed[3])
-        if gate is not None:
-            rep.warning(gate)
-        rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
-                 "format cannot hold, e.g. a URDF's offsets, is stated in comments)")
-        from ..report.identification_run import file_choice, read_back_entry
-        from ..report.summaries import taken_away_lines
-
-        files = [read_back_entry(path.name, form, check, file_choice(computed[3], form)) for path, (form, check) in computed[4].items()]
-        for line in taken_away_lines({"log": computed[6], "files": files}):
-            (rep.warning if line.kind == "warning" else rep.line)(line.text)
-        if simulated is not None:
-            rep.line(simulated)
+        cfg = computed[0]
+        _export_report(rep, computed, paths, urdf=cfg.urdf if urdf is not None else None,
+                       mjcf=_users_mjcf(cfg) if mjcf is not None else None)
 
     _Command("dynid export", quiet).run(prepare, compute, save, show)
+
+
+def _export_report(rep, computed, paths, *, urdf: Path | None, mjcf: Path | None) -> None:
+    """``dynid export``'s lines: the files written (``urdf``, ``mjcf``: the user's files written into, if any), the
+    warnings of the estimate and the results, what each file's tool reads back, and the forward simulation's line."""
+    from ..io.exported.export import nominal_warning, verdict_warnings
+    from ..report.identification_run import file_choice, read_back_entry
+    from ..report.summaries import taken_away_lines
+
+    cfg, _, moved, identified, checks, simulated, log = computed
+    robot = cfg.robot
+    held = file_choice(identified, "MJCF")["offsets_held"]
+    added = {"URDF": "", "MJCF": f", and {len(held)} actuator(s) of constant bias added after its own for the torque "
+             "offsets" if held else ""}
+    into = "".join(f"; the {form} is {given.name} with only its inertials and joint dynamics replaced{added[form]}"
+                   for form, given in (("URDF", urdf), ("MJCF", mjcf)) if given is not None)
+    for line in moved:
+        rep.warning(f"far from the description's own values: {line}")
+    for line in verdict_warnings(identified):
+        rep.warning(line)
+    gate = nominal_warning(identified)
+    if gate is not None:
+        rep.warning(gate)
+    rep.line(f"wrote {', '.join(str(p) for p in paths)} (robot {robot.name}, {robot.n_dof} joints{into}; what the "
+             "format cannot hold, e.g. a URDF's offsets, is stated in comments)")
+    files = [read_back_entry(path.name, form, check, file_choice(identified, form)) for path, (form, check) in checks.items()]
+    for line in taken_away_lines({"log": log, "files": files}):
+        (rep.warning if line.kind == "warning" else rep.line)(line.text)
+    if simulated is not None:
+        rep.line(simulated)
+
+
+def _init_robot(urdf: Path, log: Path, arm: str | None, args: dict):
+    """``dynid init``'s robot: the robot file with the joints held that are not the arm's (those off the chain the log
+    names, or the chain holding ``arm``; on a log of several branches, those it does not name:
+    :func:`dynid.model.urdf.joints_to_hold`)."""
+    from ..io.logs.columns import joints_named
+    from ..model.description import load_robot, robot_from_urdf
+    from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
+
+    read = (expand_xacro(urdf, args) if is_xacro(urdf) else urdf) if urdf.is_file() else None
+
+    def logged(names: tuple[str, ...]) -> set[str]:
+        if arm is None:
+            return joints_named(log, names)
+        if arm not in names:
+            raise DynIdError(f"--arm {arm}: no moving joint of {urdf.name} is named so (it has {', '.join(names)})")
+        return {arm}
+
+    held = (joints_to_hold(read, logged) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read))
+            else ())
+    if arm is not None and not held:
+        raise DynIdError(f"--arm {arm}: {urdf.name} is one serial chain (no other arm to leave out); leave --arm out")
+    return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
 
 
 def _simulated(cfg, identified: dict, texts, targets, source: str) -> str:
@@ -822,9 +850,6 @@ def init(
 ) -> None:
     """Write a starter identification config for a URDF and a log, with the columns it detected."""
     from ..io.config.starter import check_target, starter_config, xacro_arguments
-    from ..io.logs.columns import joints_named
-    from ..model.description import load_robot, robot_from_urdf
-    from ..model.urdf import expand_xacro, is_mjcf, is_xacro, joints_to_hold
 
     args: dict[str, str] = {}
 
@@ -835,19 +860,7 @@ def init(
         check_target(out, force)
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
-        read = (expand_xacro(urdf, args) if is_xacro(urdf) else urdf) if urdf.is_file() else None
-        def logged(names: tuple[str, ...]) -> set[str]:
-            if arm is None:
-                return joints_named(log, names)
-            if arm not in names:
-                raise DynIdError(f"--arm {arm}: no moving joint of {urdf.name} is named so (it has {', '.join(names)})")
-            return {arm}
-
-        held = (joints_to_hold(read, logged) if read is not None and (read.suffix.lower() == ".urdf" or is_mjcf(read))
-                else ())
-        if arm is not None and not held:
-            raise DynIdError(f"--arm {arm}: {urdf.name} is one serial chain (no other arm to leave out); leave --arm out")
-        return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
+        return _init_robot(urdf, log, arm, args)
 
     def compute(robot, progress):
         for v in validation or ():

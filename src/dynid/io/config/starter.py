@@ -87,17 +87,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
                         "of one kind (all ROS bags or all CSV logs): they share the identification's reader")
     without = _without_sdp(robot)
     if is_bag(log):
-        table = tomlkit.table()
-        table.add("bag", log.name)
-        table["bag"].comment("a ROS bag: sensor_msgs/JointState on /joint_states")
-        table.add(tomlkit.comment('topic = "/joint_states"'))
-        table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
-        kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
-        said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
-                *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held, log, robot)]
-        said.append(_estimators_note(without, robot))
-        return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
-                       without_sdp=without), said
+        return _bag_config(urdf, log, out, validation, held, robot, xacro_args=xacro_args, without_sdp=without)
     pair = signal_files(log, validation[0], n_dof, rate) if validation else None
     if pair is not None:  # one signal per file: the second log is the first's other signal
         (table, notes), validation = pair, validation[1:]
@@ -106,8 +96,7 @@ def starter_config(urdf: Path, log: Path, n_dof: int, out: Path, validation: tup
         table, notes = csv_table(urdf, log, n_dof, joints, rate=rate)
     readers = tuple(_own_reader(table, v, urdf, n_dof, joints, rate) for v in validation)
     gains = _builtin_gains(table, robot)
-    notes += [*_sliding_note(robot), *_held_notes(urdf, held, log, robot), *_gain_notes(table, urdf, robot, gains),
-              _estimators_note(without, robot)]
+    notes += _robot_notes(urdf, log, table, held, robot, gains, without)
     notes += [f"{v.name}: another layout than {log.name}'s, read by its own columns" for v, r in zip(validation, readers) if r]
     return _config(urdf, log, out, validation, table, notes, held=held, xacro_args=xacro_args, without_sdp=without,
                    gains=gains, readers=readers), notes
@@ -199,6 +188,30 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
             raise ConfigError(f"--xacro-arg {text}: {name.strip()} is given twice")
         out[name.strip()] = value
     return out
+
+
+def _robot_notes(urdf: Path, log: Path, table, held: tuple[str, ...], robot, gains, without_sdp: str | None) -> list[str]:
+    """:func:`starter_config`'s lines on the robot for a CSV log: its prismatic joints, the joints held, the drive gains
+    and the estimators listed."""
+    return [*_sliding_note(robot), *_held_notes(urdf, held, log, robot), *_gain_notes(table, urdf, robot, gains),
+            _estimators_note(without_sdp, robot)]
+
+
+def _bag_config(urdf: Path, log: Path, out: Path, validation: tuple[Path, ...], held: tuple[str, ...], robot, *,
+                xacro_args: dict | None, without_sdp: str | None) -> tuple[str, list[str]]:
+    """:func:`starter_config` for a ROS bag: the joints taken by the robot file's names, each bag read as identify reads
+    it where the robot is given."""
+    table = tomlkit.table()
+    table.add("bag", log.name)
+    table["bag"].comment("a ROS bag: sensor_msgs/JointState on /joint_states")
+    table.add(tomlkit.comment('topic = "/joint_states"'))
+    table.add(tomlkit.comment('effort = "torques"               # or "currents" (through the drive gains)'))
+    kind = "a ROS 1 bag" if log.suffix.lower() == ".bag" else "a ROS 2 bag (rosbag2, SQLite or MCAP)"
+    said = [f"{log.name}: {kind}: the joints are taken by the URDF's joint names",
+            *([] if robot is None else [_bag_read(b, robot) for b in (log, *validation)]), *_held_notes(urdf, held, log, robot)]
+    said.append(_estimators_note(without_sdp, robot))
+    return _config(urdf, log, out, validation, table, said, held=held, xacro_args=xacro_args,
+                   without_sdp=without_sdp), said
 
 
 def _held_notes(urdf: Path, held: tuple[str, ...], log: Path | None = None, robot=None) -> list[str]:
