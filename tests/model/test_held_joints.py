@@ -46,6 +46,21 @@ def _urdf(tmp_path, body, name="arm.urdf"):
     return path
 
 
+def test_a_log_that_names_the_fingers_too_still_has_them_held(tmp_path):
+    """A log from ROS's joint_states names a gripper's fingers beside the arm's joints: the fingers (prismatic, one a
+    mimic) are on no arm's chain and stay held, and a log of both arms of a robot with a gripper on each takes both arms
+    as one model with every finger held (the rule that takes a log's branches as a tree looks at the arms' chains)."""
+    urdf = _urdf(tmp_path, ARM + FINGERS)
+    assert joints_to_hold(urdf, lambda names: {"j1", "j2", "f1", "f2"}) == ("f1", "f2")
+    gripper = ('<link name="{s}hand"/><joint name="{s}hand_joint" type="fixed"><parent link="{s}_link2"/>'
+               '<child link="{s}hand"/><origin xyz="0.15 0 0"/></joint>'
+               + _link("{s}f_link", 0.1, "0 0.01 0.05")
+               + '<joint name="{s}f" type="prismatic"><parent link="{s}hand"/><child link="{s}f_link"/><axis xyz="0 1 0"/>'
+               '<limit lower="0" upper="0.04" effort="20" velocity="0.2"/></joint>')
+    two = _urdf(tmp_path, _two_arms() + gripper.format(s="l") + gripper.format(s="r"), "two.urdf")
+    assert joints_to_hold(two, lambda names: set(names)) == ("lf", "rf")
+
+
 def test_held_fingers_are_merged_as_fixed_ones_are(tmp_path):
     """The arm with its two prismatic fingers (one mimicking the other) held at 0 has the joints and inertial parameters
     of the same file with the fingers written as fixed joints (Pinocchio merging them either way); without held it is

@@ -59,8 +59,8 @@ def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) ->
 
 def joints_off_arm(parents: dict[int, int], revolute: set[int], sliding=frozenset(), logged=frozenset()) -> list[int]:
     """The joints ``dynid init`` holds: those off the arm (:func:`arm_chain`); where the joints a log names lie on
-    several branches (both arms of a two-arm robot), those the log does not name (the robot is then the tree of the
-    joints it names).
+    several branches' chains (both arms of a two-arm robot), every joint but those (the robot is then their tree). A
+    gripper's prismatic fingers and a mimic joint are on no chain: held, whether the log names them or not.
 
     Parameters
     ----------
@@ -75,8 +75,9 @@ def joints_off_arm(parents: dict[int, int], revolute: set[int], sliding=frozense
         In reading order.
     """
     arm = arm_chain(parents, revolute, sliding, set(logged))
-    if set(logged) - set(arm):
-        return [k for k in parents if k not in logged]
+    on_chains = set(logged) & set().union(*_chains(parents, revolute, sliding).values())
+    if on_chains - set(arm):
+        return [k for k in parents if k not in on_chains]
     return [k for k in parents if k not in arm]
 
 
