@@ -92,7 +92,11 @@ def test_er16_design_halves_cond_of_beta1_and_satisfies_every_constraint(er16_3)
     beta1 = paper_identification_trajectory()
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0)
     assert not [m for m in prob.margins(beta1) if not m.satisfied]  # β1 satisfies the robot's limits
-    design = design_excitation(prob, n_starts=2, rng=0, initial=beta1)
+    said = []  # every SLSQP iteration said as it ends: each run counts 1, 2, …, at most maxiter, one run per start or more
+    design = design_excitation(prob, n_starts=2, rng=0, initial=beta1, iteration=lambda k, most: said.append((k, most)))
+    assert said[0][0] == 1 and all(k == 1 or k == before + 1 for (before, _), (k, _) in zip(said, said[1:]))
+    assert all(most == 150 and k <= most for k, most in said) and sum(k == 1 for k, _ in said) >= 2
+    assert len(said) <= design.nit  # SciPy's count holds each run's last steps too (134 against 128 said here)
     assert design.initial_cond == pytest.approx(condition_number(prob, beta1))
     assert design.cond <= 0.5 * design.initial_cond
     assert design.cond == pytest.approx(condition_number(prob, design.trajectory))

@@ -50,16 +50,26 @@ def test_the_design_gradients_of_a_tracked_arm_equal_finite_differences(tracked,
                                atol=1e-4 if geometry else 1e-6)
 
 
-def test_dynid_excite_designs_a_tracked_arm_and_says_metres(tracked, tmp_path):
+def test_dynid_excite_designs_a_tracked_arm_and_says_metres(tracked, tmp_path, monkeypatch):
     """`dynid excite arm.urdf` on a tracked arm: the design improves on its start (a flat criterion ended it there,
     cond 1.9e10 kept), the first row's track position is said in metres, the margins in m and m/s; each start's
-    progress line says the best design so far (issue "Fast where users wait", item 3)."""
+    progress line says the best design so far, and on a terminal each SLSQP iteration of it (issue "Fast where users
+    wait", item 3)."""
     import json
+
+    from dynid.report.console import Progress
 
     from ..cli.refusals import dynid
 
+    shown = []  # what a terminal's live line is given: a long start says its SLSQP iterations
+    update = Progress.update
+    monkeypatch.setattr(Progress, "update", lambda self, step, detail="": (shown.append((step, detail)),
+                                                                          update(self, step, detail))[1])
     _, path = tracked
     p = dynid("excite", str(path), "--out", str(tmp_path / "out"), "--starts", "2")
+    assert ("design, start 1 of 2", "(SLSQP iteration 1, at most 150)") in shown, shown[:5]
+    assert any(step.startswith("design, start 2 of 2, best cond so far") and detail.startswith("(SLSQP iteration")
+               for step, detail in shown)
     said = " ".join(p.stdout.split())
     assert p.returncode == 0, p.stderr
     assert re.search(r"^dynid excite: design, start 2 of 2, best cond so far \d", p.stderr, re.M), p.stderr  # a pipe

@@ -810,13 +810,18 @@ def excite(
         return replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
 
     def compute(cfg, progress):
-        progress.update(f"design, start 1 of {cfg.starts}")
+        step = [f"design, start 1 of {cfg.starts}"]
+        progress.update(step[0])
 
         def started(done: int, n: int, best: float) -> None:  # each start's line says the best design so far
             if done < n:
-                progress.update(f"design, start {done + 1} of {n}, best cond so far {best:.4g}")
+                step[0] = f"design, start {done + 1} of {n}, best cond so far {best:.4g}"
+                progress.update(step[0])
 
-        return run_excitation(cfg, callback=started)
+        def iterated(k: int, maxiter: int) -> None:  # a long start says how far it has come (on a terminal)
+            progress.update(step[0], f"(SLSQP iteration {k}, at most {maxiter})")
+
+        return run_excitation(cfg, callback=started, iteration=iterated)
 
     def save(run):
         from ..report.excitation_run import save_excitation

@@ -691,7 +691,8 @@ def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
 @keyword_only_after_data
 def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
                       initial: FourierTrajectory | None = None, maxiter: int = 150,
-                      callback: Callable[[int, int, float], None] | None = None) -> ExcitationDesign:
+                      callback: Callable[[int, int, float], None] | None = None,
+                      iteration: Callable[[int, int], None] | None = None) -> ExcitationDesign:
     """Optimise an excitation trajectory for ``problem`` (paper eq. 15).
 
     Parameters
@@ -707,6 +708,9 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
         SLSQP iterations per start.
     callback : callable, optional
         ``callback(done_starts, n_starts, best_cond)`` after every start.
+    iteration : callable, optional
+        ``iteration(k, maxiter)`` after every SLSQP iteration (``k`` from 1 in each SLSQP run; a start polished again
+        with tighter limits is a run of its own), so that a long start can say how far it has come.
 
     Returns
     -------
@@ -753,6 +757,13 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
                                     initial.a, initial.b)
     best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
     nit = 0
+    done = [0]  # iterations of the current SLSQP run
+
+    def iterated(_x) -> None:
+        done[0] += 1
+        if iteration is not None:
+            iteration(done[0], maxiter)
+
     for i in range(n_starts):
         objective, a_lin, c_lin, _ = solver(problem.safety)
         x0 = lay.to_x(initial) if (i == 0 and initial is not None) else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng)
@@ -761,8 +772,9 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
         safety = problem.safety
         for _ in range(RETRIES + 1):
             objective, _, _, cons = solver(safety)
+            done[0] = 0
             res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=cons,
-                           options={"maxiter": maxiter, "ftol": 1e-7})
+                           options={"maxiter": maxiter, "ftol": 1e-7}, callback=iterated)
             nit += int(res.nit)
             traj = lay.to_trajectory(res.x, problem.offsets)
             margins = problem.margins(traj)

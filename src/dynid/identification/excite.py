@@ -99,21 +99,25 @@ class ExcitationRun:
                 **({"prismatic": robot.prismatic.tolist()} if robot.prismatic.any() else {})}
 
 
-def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None) -> ExcitationRun:
+def run_excitation(config: ExcitationConfig, callback: Callable[[int, int, float], None] | None = None,
+                   iteration: Callable[[int, int], None] | None = None) -> ExcitationRun:
     """Design the trajectory of a config and sample it at the controller's rate.
 
     Parameters
     ----------
     config : ExcitationConfig
     callback : callable, optional
-        ``callback(start, iteration, best)`` reports the optimisation's progress.
+        ``callback(done_starts, n_starts, best_cond)`` after every start of the design.
+    iteration : callable, optional
+        ``iteration(k, maxiter)`` after every SLSQP iteration of a start
+        (:func:`dynid.excitation.design.design_excitation`).
 
     Returns
     -------
     ExcitationRun
     """
     design = design_excitation(config.problem, n_starts=config.starts, rng=config.seed, initial=config.initial,
-                               maxiter=config.maxiter, callback=callback)
+                               maxiter=config.maxiter, callback=callback, iteration=iteration)
     n = int(round(config.periods * config.problem.period * config.rate))
     t = np.arange(n + 1) / config.rate  # both ends: the controller's last set-point is the start again
     q, dq, ddq = design.trajectory.evaluate(t)
