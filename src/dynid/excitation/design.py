@@ -687,6 +687,21 @@ def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
     return x
 
 
+def _slsqp(objective, x0: np.ndarray, cons: list, maxiter: int, iteration: Callable[[int, int], None] | None):
+    """One SLSQP run of :func:`design_excitation`, ``iteration(k, maxiter)`` said after its ``k``-th iteration."""
+    from scipy.optimize import minimize  # here: checking a config or computing cond(W_base) needs no optimiser
+
+    done = [0]
+
+    def iterated(_x) -> None:
+        done[0] += 1
+        if iteration is not None:
+            iteration(done[0], maxiter)
+
+    return minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=cons,
+                    options={"maxiter": maxiter, "ftol": 1e-7}, callback=iterated)
+
+
 @with_single_blas_thread
 @keyword_only_after_data
 def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
@@ -731,7 +746,6 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     eq = _rest_equalities(lay) if problem.rest else None
     solvers = {}
 
-    from scipy.optimize import minimize  # here: checking a config or computing cond(W_base) needs no optimiser
 
     def solver(safety: float):
         """Objective and constraints with the limits tightened by ``safety`` (built once per value)."""
@@ -757,13 +771,6 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
                                     initial.a, initial.b)
     best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
     nit = 0
-    done = [0]  # iterations of the current SLSQP run
-
-    def iterated(_x) -> None:
-        done[0] += 1
-        if iteration is not None:
-            iteration(done[0], maxiter)
-
     for i in range(n_starts):
         objective, a_lin, c_lin, _ = solver(problem.safety)
         x0 = lay.to_x(initial) if (i == 0 and initial is not None) else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng)
@@ -772,9 +779,7 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
         safety = problem.safety
         for _ in range(RETRIES + 1):
             objective, _, _, cons = solver(safety)
-            done[0] = 0
-            res = minimize(objective.fun, x0, jac=objective.jac, method="SLSQP", constraints=cons,
-                           options={"maxiter": maxiter, "ftol": 1e-7}, callback=iterated)
+            res = _slsqp(objective, x0, cons, maxiter, iteration)
             nit += int(res.nit)
             traj = lay.to_trajectory(res.x, problem.offsets)
             margins = problem.margins(traj)
