@@ -475,7 +475,7 @@ def _export_report(rep, computed, paths, *, urdf: Path | None, mjcf: Path | None
 
 def _init_robot(urdf: Path, log: Path, arm: str | None, args: dict):
     """``dynid init``'s robot: the robot file with the joints held that are not the arm's (those off the chain the log
-    names, or the chain holding ``arm``; on a log of several branches, those it does not name:
+    names, or the chain holding ``arm``; on a log of several branches' chains, every joint but those:
     :func:`dynid.model.urdf.joints_to_hold`)."""
     from ..io.logs.columns import joints_named
     from ..model.description import load_robot, robot_from_urdf

@@ -345,8 +345,8 @@ def mjcf_joint_values(path: str | Path, held=None) -> dict:
 def mjcf_joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str]] | None = None) -> tuple[str, ...]:
     """The MJCF's joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest chain of
     hinges from the base (a gripper's fingers, a camera's pan joint on a branch of its own, wherever the file puts it),
-    or off the chain that holds most of the joints the log names, or those the log does not name where it names
-    joints on several branches (:func:`dynid.model.robot_files.joints_off_arm`).
+    or off the chain that holds most of the joints the log names, or, where the log names joints on several branches'
+    chains, every joint but those (:func:`dynid.model.robot_files.joints_off_arm`).
 
     Parameters
     ----------

@@ -258,8 +258,8 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
     chain of revolute joints from the base, none mimicking another (a gripper's fingers, prismatic or on a branch; a
     camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it), or off the chain that
     holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`); where the log names joints on
-    several branches (both arms of a two-arm robot), every joint it does not name (the robot is then the tree of the
-    joints it names).
+    several branches' chains (both arms of a two-arm robot), every joint but those (the robot is then their tree; a
+    gripper's fingers stay held: :func:`dynid.model.robot_files.joints_off_arm`).
 
     Parameters
     ----------
