@@ -20,15 +20,19 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
 
     [[joints]]                     # one table per joint, base to tip
     name = "joint1"
+    type = "revolute"              # or "prismatic": d is the joint variable (a linear track, a SCARA's z axis)
     alpha = "pi"                   # DH: alpha (alpha_{i-1} for modified), a, d, theta_offset
     a = 0.0
-    d = 0.0
+    d = 0.0                        # a prismatic joint's d at q = 0
     theta_offset = 0.0
-    q_min = -2.9                   # rad
+    parent = "base"                # optional, modified DH: the joint carrying this one (a robot with branches;
+    gamma = 0.0                    # default the joint before it), with Khalil-Kleinfinger's gamma [rad] and b [m]
+    b = 0.0                        # (RotZ(gamma) TransZ(b) before RotX(alpha))
+    q_min = -2.9                   # rad (m if prismatic)
     q_max = 2.9
-    dq_max = 3.0                   # rad/s
-    ddq_max = 15.0                 # rad/s²
-    tau_max = 800.0                # N·m
+    dq_max = 3.0                   # rad/s (m/s)
+    ddq_max = 15.0                 # rad/s² (m/s²)
+    tau_max = 800.0                # N·m (N)
     drive_gain = 20.0              # N·m/A, eq. 16: joint torque per measured current
     drive_terms = ["fv"]           # optional: this joint has only these of the robot's drive terms
     counterbalance = true          # optional: a weight counterbalance (spring, hydraulic cylinder) acts on this
@@ -375,14 +379,42 @@ def _chain(d, rows, where: list[str], names: list[str], *, convention: str, urdf
         a = [float(_or(r.a, 0.0)) for r in rows]
         dd = [float(_or(r.d, 0.0)) for r in rows]
         off = [parse_angle(_or(r.theta_offset, 0.0), f"{w}.theta_offset") for r, w in zip(rows, where)]
+        prismatic = [r.type == "prismatic" for r in rows]
         if convention == "modified":
-            joints = joints_from_modified_dh(alpha, a, dd, off, names)
+            joints = joints_from_modified_dh(alpha, a, dd, off, names, prismatic=prismatic, **_branches(rows, where, names))
         else:
-            joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, dd, off, names)
+            for r, w in zip(rows, where):
+                given = [k for k in ("parent", "gamma", "b") if getattr(r, k) is not None]
+                if given:
+                    raise ConfigError(f"{w}: {', '.join(given)} given, but a branch is placed in modified DH only: "
+                                      "write the table with convention = \"modified\" (Khalil-Kleinfinger's gamma, b)")
+            joints, tool_r0, tool_t0 = joints_from_standard_dh(alpha, a, dd, off, names, prismatic=prismatic)
             tool_t = tool_t0 + tool_r0 @ tool_t
             tool_r = tool_r0
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
     return joints, inertial, (tool_r, tool_t), (alpha, a, dd), urdf_lim, links
+
+
+def _branches(rows, where: list[str], names: list[str]) -> dict:
+    """A modified-DH table's antecedents (``parent``, a joint named before it or ``"base"``) and Khalil-Kleinfinger's
+    gamma and b, as :func:`dynid.model.dh.joints_from_modified_dh` takes them."""
+    parents: list = []
+    for i, (r, w) in enumerate(zip(rows, where)):
+        if r.parent is None:
+            parents.append(None)
+        elif r.parent in names[:i]:
+            parents.append(names.index(r.parent))
+        elif r.parent == "base":
+            parents.append(-1)
+        else:
+            raise ConfigError(f"{w}.parent: expected \"base\" or the name of a joint before it ({', '.join(names[:i]) or 'none'}"
+                              f"), got {r.parent!r}")
+    gamma = [parse_angle(_or(r.gamma, 0.0), f"{w}.gamma") for r, w in zip(rows, where)]
+    b = [float(_or(r.b, 0.0)) for r in rows]
+    for v, w in zip(b, where):
+        if not np.isfinite(v):
+            raise ConfigError(f"{w}.b: expected a finite offset (m), got {v}")
+    return {"parents": parents, "gamma": gamma, "b": b}
 
 
 def _drives(d, rows, where: list[str], terms: tuple[str, ...], *, urdf: tuple, source: str):
@@ -561,7 +593,7 @@ def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarr
     link's; the DH geometry fields are refused (the URDF gives the chain)."""
     out = inertial.copy()
     for i, (r, w) in enumerate(zip(rows, where)):
-        geometry = [k for k in ("alpha", "a", "d", "theta_offset") if getattr(r, k) is not None]
+        geometry = [k for k in ("alpha", "a", "d", "theta_offset", "type", "parent", "gamma", "b") if getattr(r, k) is not None]
         if geometry:
             raise ConfigError(f"{w}: {', '.join(geometry)} describe a DH chain, but the chain is {urdf.name}'s: leave "
                               "them out (the URDF's joints give the geometry)")

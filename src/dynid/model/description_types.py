@@ -59,15 +59,25 @@ class PayloadTable(Table, kw_only=True):
 
 _JOINT_FIELDS = [
     ("name", Union[Annotated[str, Meta(description="the joint's name in tables")], None], None),
+    ("type", Union[Annotated[Literal["revolute", "prismatic"], Meta(
+        description="revolute (theta is the joint variable) or prismatic (d is: a linear track, a SCARA's "
+                    "vertical axis); a URDF or MJCF gives its own")], None], None),
+    ("parent", Union[Annotated[str, Meta(
+        description="modified DH: the name of the joint that carries this one, or \"base\" (a robot with "
+                    "branches, Khalil-Kleinfinger's antecedent; default: the joint before it)")], None], None),
+    ("gamma", Union[Angle, None], None),
+    ("b", Union[Annotated[float, Meta(description="m: Khalil-Kleinfinger's offset along the parent's z, with gamma "
+                                                  "its rotation about it (modified DH, a branch's first joint)")], None],
+     None),
     ("alpha", Union[Angle, None], None),
     ("a", Union[Annotated[float, Meta(description="m")], None], None),
     ("d", Union[Annotated[float, Meta(description="m")], None], None),
     ("theta_offset", Union[Angle, None], None),
     ("q_min", Union[Angle, None], None),
     ("q_max", Union[Angle, None], None),
-    ("dq_max", Union[Annotated[float, Meta(description="rad/s")], None], None),
-    ("ddq_max", Union[Annotated[float, Meta(description="rad/s²")], None], None),
-    ("tau_max", Union[Annotated[float, Meta(description="N·m")], None], None),
+    ("dq_max", Union[Annotated[float, Meta(description="rad/s (m/s if prismatic)")], None], None),
+    ("ddq_max", Union[Annotated[float, Meta(description="rad/s² (m/s² if prismatic)")], None], None),
+    ("tau_max", Union[Annotated[float, Meta(description="N·m (N if prismatic)")], None], None),
     ("drive_gain", Union[Annotated[float, Meta(description="N·m/A: joint torque per measured current (eq. 16)")], None], None),
     ("drive_terms", Union[Annotated[list[str], Meta(description="this joint's drive terms (default: the robot's)")], None], None),
     ("counterbalance", Annotated[bool, Meta(description="a spring counterbalance (its terms cbs, cbc, cbsd, cbcd)")], False),
