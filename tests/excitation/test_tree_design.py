@@ -87,3 +87,62 @@ def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_a
     assert len(apart) == 1 and apart[0]["margin"] >= 0, apart
     said = " ".join(p.stdout.split())
     assert "joints 1-7" in said, said
+
+
+def _skeleton_from_pinocchio(urdf, q):
+    """Every link's segments by Pinocchio's kinematics of the URDF: from its joint's origin to each child joint's (or,
+    a tip, to itself; the last joint's link to the flange, at its origin here: no tool)."""
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(urdf))
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    parents = [p - 1 for p in model.parents[1:]]
+    n = len(parents)
+    out = []
+    for k in range(n):
+        children = [c for c in range(n) if parents[c] == k] or [k]
+        out += [(k, data.oMi[k + 1].translation.copy(), data.oMi[c + 1].translation.copy()) for c in children]
+    return out, parents
+
+
+def test_each_capsule_runs_on_its_own_link_across_every_pose(two_arms, rng):
+    """The capsules the self-collision check measures without collision shapes: one per link and joint it carries,
+    their ends where Pinocchio puts the link's origin and its child's (a capsule from the left hand to the right
+    shoulder, which the serial rule drew, changed length as the arms moved)."""
+    from dynid.excitation.obstacles import _segments
+
+    robot, path = two_arms
+    q = robot.limits.random_positions(20, rng)
+    seg = _segments(robot, q)
+    for k in range(q.shape[0]):
+        truth, _ = _skeleton_from_pinocchio(path, q[k])
+        assert seg.shape[1] == len(truth) == 8
+        for (_, start, stop), s in zip(truth, seg[k]):
+            np.testing.assert_allclose(s[0], start, atol=1e-12)
+            np.testing.assert_allclose(s[1], stop, atol=1e-12)
+
+
+def test_the_arms_capsule_clearance_is_the_closest_pair_of_their_links(two_arms, rng):
+    """The self clearance said for capsules (coal, the pairs that can touch) equals a brute-force measure on Pinocchio's
+    skeleton, 400 points per segment, over every pair of links that are neither one link nor a link and its carrier."""
+    from dynid.excitation.collision import self_clearance
+
+    robot, path = two_arms
+    radius = 0.04
+    q = robot.limits.random_positions(12, rng)
+    found = self_clearance(robot, np.arange(12.0), q, radius)
+    measured = {}
+    s = np.linspace(0.0, 1.0, 400)[:, None]
+    for k in range(q.shape[0]):
+        truth, parents = _skeleton_from_pinocchio(path, q[k])
+        points = [(link, a + s * (b - a)) for link, a, b in truth]
+        for i, (li, pi) in enumerate(points):
+            for lj, pj in points[i + 1:]:
+                if li == lj or parents[lj] == li or parents[li] == lj:
+                    continue
+                d = np.linalg.norm(pi[:, None] - pj[None], axis=-1).min() - 2 * radius
+                measured[li + 1, lj + 1] = min(measured.get((li + 1, lj + 1), np.inf), d)
+    best = min(measured.values())
+    assert found is not None and abs(found.distance - best) < 2e-3, (found, best)
+    assert measured[found.pair] < best + 2e-3  # a hand's point ends its forearm: either may be named

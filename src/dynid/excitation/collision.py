@@ -2,13 +2,14 @@
 real robot", item 2: checked at the controller's rate, said before it runs).
 
 Each link is a capsule of radius ``clearance`` (:attr:`dynid.excitation.constraints.Workspace.clearance`) about the
-segment from its joint's origin to the next joint's (the last link's to the flange): the robot's skeleton, which a
+segment from its joint's origin to the next joint's (the last link's to the flange; on a robot with branches, one to
+each joint the link carries, :func:`~dynid.excitation.obstacles.capsule_ends`): the robot's skeleton, which a
 description without collision meshes still gives. Distances between capsules are coal's (the collision library of
 Pinocchio's geometry models; Pan, Chitta & Manocha, "FCL: a general purpose library for collision and proximity
 queries", ICRA 2012) for the checks; the design keeps the capsules apart by the segments' closest points
 (:func:`closest_points`, Ericson, "Real-Time Collision Detection", 2005, §5.1.9) with their gradient, every sample
 of its grid at once (:class:`CapsuleSelfDistances`), so that the check measures with another code. The pairs that can touch are, as MoveIt's setup assistant finds them, every pair of links that
-are not neighbours in the chain, less the pairs whose capsules overlap on almost every pose of a random sample (a
+are not neighbours (a link and the one that carries it), less the pairs whose capsules overlap on almost every pose of a random sample (a
 wrist whose axes meet: such a pair is in contact by construction of the skeleton, not by the motion).
 """
 
@@ -21,7 +22,7 @@ import numpy as np
 
 from ..model.robot import Robot
 from .link_geometry import LinkGeometry, self_distances, self_pairs
-from .obstacles import ObstacleDistances, _capsules, _segment_jacobians, _segments
+from .obstacles import ObstacleDistances, _capsules, _segment_jacobians, _segments, capsule_ends
 
 __all__ = ["CapsuleSelfDistances", "SelfClearance", "closest_points", "self_clearance", "shape_clearance",
            "touching_pairs"]
@@ -74,8 +75,9 @@ def _distance(a: np.ndarray, b: np.ndarray, radius: float) -> float:
 
 
 def touching_pairs(robot: Robot, radius: float, samples: int = 200, rng=0) -> list[tuple[int, int]]:
-    """The pairs of links (0-based) that can touch: not neighbours, and not overlapping on :data:`ALWAYS` of random
-    poses within the joint limits (module docstring).
+    """The pairs of the links' capsules (0-based, :func:`~dynid.excitation.obstacles.capsule_ends`: one per link on a
+    serial chain) that can touch: not on one link or on neighbours (a link and the one that carries it), and not
+    overlapping on :data:`ALWAYS` of random poses within the joint limits (module docstring).
 
     Parameters
     ----------
@@ -89,7 +91,9 @@ def touching_pairs(robot: Robot, radius: float, samples: int = 200, rng=0) -> li
     list of (int, int)
     """
     q = robot.limits.random_positions(samples, rng)
-    candidates = [(i, j) for i in range(robot.n_dof) for j in range(i + 2, robot.n_dof)]
+    links, parents = [k for k, _ in capsule_ends(robot)], robot.parents
+    candidates = [(a, b) for a in range(len(links)) for b in range(a + 1, len(links))
+                  if links[a] != links[b] and parents[links[b]] != links[a] and parents[links[a]] != links[b]]
     if not candidates:
         return []
     overlap = (CapsuleSelfDistances(robot, q, radius, candidates).dist < 0).mean(axis=0)
@@ -133,7 +137,8 @@ def self_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, radius: float) ->
         if d < best[0]:
             best = (d, (i, j), int(k))
     d, (i, j), k = best
-    return SelfClearance(float(d), (i + 1, j + 1), float(np.asarray(t)[k]), len(pairs))
+    links = capsule_ends(robot)
+    return SelfClearance(float(d), (links[i][0] + 1, links[j][0] + 1), float(np.asarray(t)[k]), len(pairs))
 
 
 def shape_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, geometry: LinkGeometry) -> SelfClearance | None:
@@ -205,12 +210,12 @@ class CapsuleSelfDistances:
     q : (N, n_dof) array [rad]
     radius : float [m]
     pairs : list of (int, int)
-        Links, 0-based (:func:`touching_pairs`).
+        Capsules, 0-based (:func:`touching_pairs`; one per link on a serial chain).
     """
 
     def __init__(self, robot: Robot, q: np.ndarray, radius: float, pairs):
         self.robot, self.q, self.pairs = robot, np.atleast_2d(np.asarray(q, dtype=float)), list(pairs)
-        seg = _segments(robot, self.q)  # (N, n_dof, 2, 3)
+        seg = _segments(robot, self.q)  # (N, n_segments, 2, 3)
         i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
         a, b = seg[:, i], seg[:, j]  # (N, P, 2, 3)
         self._s, self._t = closest_points(a[..., 0, :], a[..., 1, :], b[..., 0, :], b[..., 1, :])
@@ -231,11 +236,13 @@ class CapsuleSelfDistances:
         ObstacleDistances
             ``pairs`` as given, ``links`` the first link of each.
         """
-        return ObstacleDistances(self.pairs, self.dist, self._gradient() if gradient else None)
+        links = capsule_ends(self.robot)
+        return ObstacleDistances(self.pairs, self.dist, self._gradient() if gradient else None,
+                                 tuple(links[a][0] for a, _ in self.pairs))
 
     def _gradient(self) -> np.ndarray:
         """(N, n_pairs, n_dof) ``∂distance/∂q``: ``n·(v_i - v_j)`` at the closest points."""
-        jac = _segment_jacobians(self.robot, self.q)  # (N, n_dof, 2, 3, n_dof)
+        jac = _segment_jacobians(self.robot, self.q)  # (N, n_segments, 2, 3, n_dof)
         i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
         s, t = self._s[..., None, None], self._t[..., None, None]
         vi = (1 - s) * jac[:, i, 0] + s * jac[:, i, 1]  # (N, P, 3, n_dof)

@@ -26,7 +26,7 @@ from .link_geometry import (
     estimated_link_radius,
     self_pairs,
 )
-from .obstacles import Obstacle, ObstacleDistances
+from .obstacles import Obstacle, ObstacleDistances, capsule_ends
 
 AXES = "xyz"
 
@@ -475,9 +475,9 @@ def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspac
             return []
         d = CapsuleSelfDistances(robot, q, workspace.clearance, pairs).dist
         n, c = np.unravel_index(int(np.argmin(d)), d.shape)
-        worst = float(d[n, c])
-        return [ConstraintMargin("self clearance [m]", f"links {pairs[c][0] + 1} and {pairs[c][1] + 1}' capsules at t = "
-                                 f"{float(t[n]):.3g} s", 0.0, worst, worst, np.nan)]
+        worst, links = float(d[n, c]), capsule_ends(robot)
+        return [ConstraintMargin("self clearance [m]", f"links {links[pairs[c][0]][0] + 1} and {links[pairs[c][1]][0] + 1}' "
+                                 f"capsules at t = {float(t[n]):.3g} s", 0.0, worst, worst, np.nan)]
     found = shape_clearance(robot, t, q, workspace.geometry)
     if found is None:
         return []

@@ -31,7 +31,7 @@ from ..exceptions import ConfigError
 from ..model.mjcf import collision_geoms, excluded_bodies
 from ..model.robot import Robot
 from ..model.srdf import disabled_link_pairs
-from .obstacles import GJK_TOLERANCE, ObstacleDistances, distance_above, nearest_points
+from .obstacles import GJK_TOLERANCE, ObstacleDistances, capsule_ends, distance_above, nearest_points
 
 __all__ = ["LINK_RADIUS_SHARE", "LinkGeometry", "capsule_geometry", "estimated_link_radius", "link_geometry_from_mjcf",
            "link_geometry_from_urdf", "shape_distances"]
@@ -207,12 +207,9 @@ def capsule_geometry(robot: Robot, radius: float, *, estimated: bool = True) -> 
     LinkGeometry
         ``names`` "link k capsule", ``source`` what they are.
     """
-    parents, n = robot.parents, robot.n_dof
-    children = [[c for c in range(n) if parents[c] == k] for k in range(n)]
     tool, still = np.asarray(robot.tool_translation, dtype=float), np.zeros(3)  # a branch's tip other than the last: a sphere
-    ends = [(k, np.asarray(robot.joints[c].translation, dtype=float)) for k in range(n) for c in children[k]]
-    ends += [(k, tool if k == n - 1 else still) for k in range(n) if not children[k]]
-    ends.sort(key=lambda e: e[0])  # stable: a link's capsules in its children's order
+    ends = [(k, np.asarray(robot.joints[c].translation, dtype=float) if c >= 0 else tool if k == robot.n_dof - 1 else still)
+            for k, c in capsule_ends(robot)]
     shapes, placement = [], []
     for _, end in ends:  # in the link's own frame the segment runs from its origin to the next joint's translation
         length = float(np.linalg.norm(end))

@@ -113,20 +113,43 @@ distance a staircase too coarse for the optimiser's line search."""
 _SIZE_TEXT = {"box": "lengths along x, y, z", "cylinder": "radius, length", "sphere": "radius"}
 
 
+def capsule_ends(robot: Robot) -> list[tuple[int, int]]:
+    """The links' skeleton as segments: ``(link, end)`` for each, 0-based, in the links' order. A link runs from its
+    joint's origin to each joint it carries (``end`` that joint), or, carrying none, to the flange (the last link) or
+    nowhere (another branch's tip: ``end`` -1, a point). A serial chain has one segment per link, ``(k, k + 1)`` and
+    ``(n - 1, -1)``; a torso that carries two arms has one to each arm's first joint.
+
+    Parameters
+    ----------
+    robot : Robot
+
+    Returns
+    -------
+    list of (int, int)
+    """
+    parents, n = robot.parents, robot.n_dof
+    ends = [(k, c) for k in range(n) for c in range(n) if parents[c] == k]
+    ends += [(k, -1) for k in range(n) if not np.any(parents == k)]
+    return sorted(ends, key=lambda e: e[0])  # stable: a link's segments in its children's order
+
+
 def _segments(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(N, n_dof, 2, 3): each link's segment from its joint's origin to the next (the flange for the last)."""
+    """(N, n_segments, 2, 3): the segments of :func:`capsule_ends` along ``q`` (the last link's to the flange)."""
     rots, orig = forward_kinematics(robot, q)
     flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
-    ends = np.concatenate([orig[:, 1:], flange[:, None]], axis=1)
-    return np.stack([orig, ends], axis=2)
+    ends = capsule_ends(robot)
+    start = orig[:, [k for k, _ in ends]]
+    stop = np.stack([orig[:, c] if c >= 0 else flange if k == robot.n_dof - 1 else orig[:, k] for k, c in ends], axis=1)
+    return np.stack([start, stop], axis=2)
 
 
 def _segment_jacobians(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(N, n_dof, 2, 3, n_dof): the positional Jacobians of each link segment's two ends."""
+    """(N, n_segments, 2, 3, n_dof): the positional Jacobians of each :func:`_segments` segment's two ends."""
     _, jo = origins_jacobian(robot, q)
     _, jt = tool_jacobian(robot, q)
-    ends = np.concatenate([jo[:, 1:], jt[:, None]], axis=1)
-    return np.stack([jo, ends], axis=2)
+    ends = capsule_ends(robot)
+    stop = np.stack([jo[:, c] if c >= 0 else jt if k == robot.n_dof - 1 else jo[:, k] for k, c in ends], axis=1)
+    return np.stack([jo[:, [k for k, _ in ends]], stop], axis=2)
 
 
 def _capsules(seg: np.ndarray, radius: float):
