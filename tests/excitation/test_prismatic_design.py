@@ -52,7 +52,7 @@ def test_the_design_gradients_of_a_tracked_arm_equal_finite_differences(tracked,
 
 def test_dynid_excite_designs_a_tracked_arm_and_says_metres(tracked, tmp_path, monkeypatch):
     """`dynid excite arm.urdf` on a tracked arm: the design improves on its start (a flat criterion ended it there,
-    cond 1.9e10 kept), the first row's track position is said in metres, the margins in m and m/s; each start's
+    cond 1.9e10 kept), the first row's track position is said in metres, the margins and excitation.csv's columns in m and m/s; each start's
     progress line says the best design so far, and on a terminal each SLSQP iteration of it (issue "Fast where users
     wait", item 3)."""
     import json
@@ -78,3 +78,5 @@ def test_dynid_excite_designs_a_tracked_arm_and_says_metres(tracked, tmp_path, m
     assert design["cond"] < 0.5 * design["initial_cond"]
     track = {m["constraint"] for m in design["margins"] if m["where"] == "joint 1"}
     assert {"q_min [m]", "q_max [m]", "|dq| [m/s]", "|tau| [N]"} <= track, track
+    header = (tmp_path / "out" / "excitation.csv").read_text().splitlines()[0].split(",")  # the set-points' units
+    assert {"q1 [m]", "dq1 [m/s]", "ddq1 [m/s^2]", "q2 [rad]", "dq2 [rad/s]"} <= set(header), header

@@ -70,13 +70,17 @@ def test_the_design_gradients_of_two_arms_equal_finite_differences(two_arms, rng
 def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_arms, tmp_path):
     """A config whose robot is the whole tree (as dynid init writes for a log of both arms): one design of every joint, every
     constraint held on the 10× finer check, the prismatic lift's margins in metres, the arms' distance to each other
-    among the margins."""
+    among the margins, and the workspace's box kept by both hands, as Pinocchio places them along excitation.csv (the
+    box held the tool alone: the left hand rose to 1.66 m under a 1.6 m ceiling while every constraint was said to
+    hold)."""
+    import pinocchio as pin
+
     from ..cli.refusals import dynid
 
     _, path = two_arms
     config = tmp_path / "arm.toml"
     config.write_text(f'robot = "{path}"\n\n[design]\nstarts = 1\n\n[trajectory]\nharmonics = 3\n\n[workspace]\n'
-                      'floor = 0.0\nlink_radius = 0.04\navoid_self_collision = true\n')
+                      'floor = 0.0\nlink_radius = 0.04\navoid_self_collision = true\nbox_max = [inf, inf, 1.6]\n')
     p = dynid("excite", str(config), "--out", str(tmp_path / "out"))
     assert p.returncode == 0, p.stderr
     design = json.loads((tmp_path / "out" / "excitation.json").read_text())["design"]
@@ -87,6 +91,14 @@ def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_a
     assert len(apart) == 1 and apart[0]["margin"] >= 0, apart
     said = " ".join(p.stdout.split())
     assert "joints 1-7" in said, said
+    boxed = {m["where"] for m in design["margins"] if m["constraint"] == "workspace [m]"}
+    assert {"tip of left_j3 z <= 1.6 m", "tool z <= 1.6 m"} <= boxed, boxed
+    q = np.loadtxt(tmp_path / "out" / "excitation.csv", delimiter=",", skiprows=1)[:, 1:8]
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    for k in range(q.shape[0]):
+        pin.forwardKinematics(model, data, q[k])
+        assert max(data.oMi[4].translation[2], data.oMi[7].translation[2]) <= 1.6, k  # the left hand, the right
 
 
 def _skeleton_from_pinocchio(urdf, q):

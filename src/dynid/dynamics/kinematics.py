@@ -47,3 +47,23 @@ def tool_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
     """
     rots, orig = forward_kinematics(robot, q)
     return orig[:, -1] + rots[:, -1] @ robot.tool_translation
+
+
+def tip_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Each branch's tip in the base frame (:attr:`dynid.model.robot.Robot.tips`): the tool point on the last joint's
+    link, the link's origin on another branch's (its file states no tool there).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad, or m for a prismatic joint]
+
+    Returns
+    -------
+    (N, n_tips, 3) ndarray [m]
+        The tool point last; ``(N, 1, 3)`` on a serial chain.
+    """
+    rots, orig = forward_kinematics(robot, q)
+    out = orig[:, robot.tips]
+    out[:, -1] = orig[:, -1] + rots[:, -1] @ robot.tool_translation
+    return out

@@ -205,3 +205,26 @@ def tool_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
     if robot.is_tree:  # the tool rides on the last joint: the other branches' joints do not move it
         jac *= robot.carries[:, -1][None, None, :]
     return p, jac
+
+
+def tips_jacobian(robot: Robot, q) -> tuple[np.ndarray, np.ndarray]:
+    """Each branch's tip (:func:`dynid.dynamics.kinematics.tip_positions`) and its positional Jacobian: the tool point's
+    (:func:`tool_jacobian`) last, another branch's tip its link origin's (:func:`origins_jacobian`).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad]
+
+    Returns
+    -------
+    p : (N, n_tips, 3) array [m]
+    J : (N, n_tips, 3, n_dof) array [m/rad, or m/m for a prismatic joint]
+    """
+    tool, jt = tool_jacobian(robot, q)
+    if not robot.is_tree:
+        return tool[:, None], jt[:, None]
+    orig, jo = origins_jacobian(robot, q)
+    p, jac = orig[:, robot.tips], jo[:, robot.tips]
+    p[:, -1], jac[:, -1] = tool, jt
+    return p, jac

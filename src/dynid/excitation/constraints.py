@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._util.reprs import short_repr
-from ..dynamics.kinematics import tool_positions
+from ..dynamics.kinematics import tip_positions
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError
 from ..model.robot import Limits, Robot
@@ -34,7 +34,8 @@ AXES = "xyz"
 @short_repr
 @dataclass(frozen=True)
 class Workspace:
-    """Where the tool point may go (``W_o`` of eq. 15), in the base frame [m].
+    """Where the tool point may go (``W_o`` of eq. 15), in the base frame [m]; on a robot with branches, each branch's tip
+    (:attr:`dynid.model.robot.Robot.tips`) too.
 
     Attributes
     ----------
@@ -416,11 +417,13 @@ def constraint_margins(robot: Robot, trajectory: FourierTrajectory, t: np.ndarra
     out += floor_margins(robot, t, q, workspace, trajectory.q0 if start_pose is None else start_pose)
     g, h, labels = workspace.inequalities()
     if len(h):
-        p = tool_positions(robot, q)
-        for gi, hi, lbl in zip(g, h, labels):
-            m = float(hi - (p @ gi).max())
-            sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
-            out.append(ConstraintMargin("workspace [m]", f"tool {lbl}", sign * float(hi), sign * float(hi) - sign * m, m, np.nan))
+        for tip, p in zip(robot.tips, np.moveaxis(tip_positions(robot, q), 1, 0)):  # each branch's, the tool last
+            what = "tool" if tip == robot.n_dof - 1 else f"tip of {robot.joints[tip].name}"
+            for gi, hi, lbl in zip(g, h, labels):
+                m = float(hi - (p @ gi).max())
+                sign = float(gi.sum())  # +1: upper side, -1: lower side (limit and worst in the axis' own sign)
+                out.append(ConstraintMargin("workspace [m]", f"{what} {lbl}", sign * float(hi), sign * float(hi) - sign * m,
+                                            m, np.nan))
     return out + obstacle_margins(robot, t, q, workspace) + self_margins(robot, t, q, workspace)
 
 

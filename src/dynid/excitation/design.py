@@ -28,9 +28,9 @@ import numpy as np
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
-from ..dynamics.kinematics import tool_positions
+from ..dynamics.kinematics import tip_positions
 from ..dynamics.regressor import regressor
-from ..dynamics.sensitivity import regressor_state_derivatives, tool_jacobian
+from ..dynamics.sensitivity import regressor_state_derivatives, tips_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..model.loading import as_robot
 from ..model.robot import Limits, Robot
@@ -177,12 +177,13 @@ class ExcitationProblem:
             j = bad[0]
             raise ConfigError(f"trajectory.offsets: joint {j + 1} offset {q0[j]:g} rad is not inside its limits "
                               f"[{lim.q_min[j]:g}, {lim.q_max[j]:g}] rad")
-        p = tool_positions(self.robot, q0[None])[0]
         g, h, labels = self.workspace.inequalities()
-        out = [lbl for gi, hi, lbl in zip(g, h, labels) if gi @ p > hi]
-        if out:
-            raise ConfigError(f"workspace excludes the start pose: at the offsets q_o = {np.round(q0, 4).tolist()} rad the tool "
-                              f"point is at {np.round(p, 3).tolist()} m, which violates {', '.join(out)}")
+        for tip, p in zip(self.robot.tips[::-1], tip_positions(self.robot, q0[None])[0][::-1]):  # the tool's first
+            out = [lbl for gi, hi, lbl in zip(g, h, labels) if gi @ p > hi]
+            if out:
+                what = "the tool point" if tip == self.robot.n_dof - 1 else f"the tip of {self.robot.joints[tip].name}"
+                raise ConfigError(f"workspace excludes the start pose: at the offsets q_o = {np.round(q0, 4).tolist()} rad "
+                                  f"{what} is at {np.round(p, 3).tolist()} m, which violates {', '.join(out)}")
         needs = self.workspace.floor_needs(self.robot, q0)
         if needs is not None and needs.shapes.size and needs.start.min() < 0 and self.workspace.geometry is not None:
             c = int(np.argmin(needs.start))
@@ -551,8 +552,8 @@ class _Objective:
         idx = p.base.independent
         self.value, self.m = self.crit(y[..., idx].reshape(-1, idx.size))
         self.tau = y[:, self.tau_idx, :] @ p.phi
-        if self.ws_h.size:
-            self.ws = self.ws_h - tool_positions(p.robot, self.q) @ self.ws_g.T  # (N, m)
+        if self.ws_h.size:  # every branch's tip (the tool alone on a chain): (N, tips · m)
+            self.ws = (self.ws_h - tip_positions(p.robot, self.q) @ self.ws_g.T).reshape(self.q.shape[0], -1)
         if self.needs is not None:
             self.lifted = FloorDistances(p.robot, self.q, p.workspace.shapes(p.robot), p.workspace.floor, self.needs)
         if self.pairs:  # measured once here, as the self distances below
@@ -578,8 +579,8 @@ class _Objective:
         tau_sens = dy[..., self.tau_idx, :] @ p.phi  # (3, n, N, n_tau)
         self.tau_jac = np.einsum("cikj,ckix->kjx", tau_sens, lay.lin)
         if self.ws_h.size:
-            _, jac = tool_jacobian(p.robot, self.q)
-            self.ws_jac = -np.einsum("md,kdi,kix->kmx", self.ws_g, jac, lay.lin[0])
+            _, jac = tips_jacobian(p.robot, self.q)
+            self.ws_jac = -np.einsum("md,ktdi,kix->ktmx", self.ws_g, jac, lay.lin[0]).reshape(self.q.shape[0], -1, x.size)
         if self.needs is not None:
             lift = self.lifted.distances(gradient=True).gradient
             assert lift is not None  # asked, with shapes

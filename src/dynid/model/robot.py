@@ -342,6 +342,12 @@ class Robot:
         return bool(np.any(self.parents != np.arange(self.n_dof) - 1))
 
     @property
+    def tips(self) -> np.ndarray:
+        """(n_tips,) int: the joints whose link carries no other joint (each branch's hand), in the robot's order; the
+        last joint alone on a serial chain (the tool's, always the last of them)."""
+        return np.setdiff1d(np.arange(self.n_dof), self.parents)
+
+    @property
     def prismatic(self) -> np.ndarray:
         """(n_dof,) bool: which joints slide (position [m], force [N]) rather than turn."""
         return np.array([j.prismatic for j in self.joints], dtype=bool)

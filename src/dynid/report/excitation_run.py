@@ -68,7 +68,7 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
                                                                f"(beyond their {ws.clearance:g} m capsules)"), paths[2])
     csv_path = out / "excitation.csv"
     # the controller's angles: the encoders' zeros where the description sets position offsets (excitation_summary)
-    write_trajectory_csv(csv_path, run.t, robot.transmission.logged_positions(run.q), run.dq, run.ddq)
+    write_trajectory_csv(csv_path, run.t, robot.transmission.logged_positions(run.q), run.dq, run.ddq, robot.prismatic)
     json_path = out / "excitation.json"
     # the terminal's warnings below its verdict line (the floor, the cell, the links' shapes, the held links, the
     # start) in the file and the report too: what a user reads later says what the terminal said

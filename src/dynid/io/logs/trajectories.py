@@ -44,21 +44,26 @@ def load_trajectory(path: str | Path) -> FourierTrajectory:
     return trajectory_from_dict(doc, str(path))
 
 
-def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> None:
+def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray,
+                         prismatic=None) -> None:
     """Write set-points for a controller, atomically.
 
-    Columns ``t [s], q1..qn [rad], dq1..dqn [rad/s], ddq1..ddqn [rad/s²]``.
+    Columns ``t [s], q1..qn [rad], dq1..dqn [rad/s], ddq1..ddqn [rad/s^2]`` (``[m]``, ``[m/s]``, ``[m/s^2]`` for a
+    prismatic joint).
 
     Parameters
     ----------
     path : str or Path
     t : (N,) array [s]
     q, dq, ddq : (N, n_dof) arrays
-        [rad], [rad/s], [rad/s²].
+        [rad], [rad/s], [rad/s²] (or m, m/s, m/s²).
+    prismatic : (n_dof,) bools, optional
+        Which joints slide (default: none).
     """
     n = q.shape[1]
-    header = ["t [s]"] + [f"q{j + 1} [rad]" for j in range(n)] + [f"dq{j + 1} [rad/s]" for j in range(n)] + \
-             [f"ddq{j + 1} [rad/s^2]" for j in range(n)]
+    unit = ["m" if s else "rad" for s in (np.zeros(n, dtype=bool) if prismatic is None else prismatic)]
+    header = ["t [s]"] + [f"q{j + 1} [{unit[j]}]" for j in range(n)] + [f"dq{j + 1} [{unit[j]}/s]" for j in range(n)] + \
+             [f"ddq{j + 1} [{unit[j]}/s^2]" for j in range(n)]
     buf = io.StringIO()
     np.savetxt(buf, np.column_stack([t, q, dq, ddq]), fmt="%.9g", delimiter=",", header=",".join(header), comments="")
     atomic_write_text(path, buf.getvalue())
