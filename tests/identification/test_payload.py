@@ -164,3 +164,45 @@ def test_a_payload_fitted_on_a_link_that_slides_is_said(tmp_path, held):
     else:
         assert not robot.joints[-1].prismatic and found.last_joint_travel == 0.0
         assert "prismatic and slid" not in said
+
+
+def test_a_payload_in_the_other_hand_of_a_two_arm_robot_is_found_on_that_link(tmp_path):
+    """issue "Every arm a user has", item 3: on two arms on a torso, a tool in the left hand (not on the last joint,
+    the right arm's) is found with ``link`` naming the left hand's joint, in that link's frame; put on the right hand,
+    the same log's fit says it misses (the payload moves joints the right hand does not). The log is simulated by
+    Pinocchio's RNEA of the robot with the payload added to the left hand's link."""
+    from dynid.dynamics.base_parameters import base_parameters
+    from dynid.identification.payload import payload_from_log
+    from dynid.model.description import load_robot
+    from dynid.model.spatial import inertial_from_physical
+    from dynid.preprocessing.preparation import prepare
+    from dynid.preprocessing.settings import Preprocessing
+    from dynid.studies.example import _with_drives
+    from dynid.studies.simulated_logs import simulated_log
+
+    from ..dynamics.test_tree_robots import TWO_ARMS
+
+    (tmp_path / "two_arms.urdf").write_text(TWO_ARMS)
+    robot = _with_drives(load_robot(tmp_path / "two_arms.urdf"), np.random.default_rng(0))
+    hand = [jt.name for jt in robot.joints].index("left_j3")
+    inertial = robot.inertial.copy()
+    inertial[hand] += inertial_from_physical(MASS, COM, INERTIA)  # the hand's frame is the payload's: no tool there
+    data = prepare(simulated_log(replace(robot, inertial=inertial), seconds=30.0, rate=250.0, rng=3), Preprocessing(),
+                   strict=False)
+    base = base_parameters(robot, rng=0)
+    beta = base.base_from_standard(robot.standard_parameters())
+    found = payload_from_log(robot, base, beta, data, rng=0, link=hand)
+    assert abs(found.mass - MASS) < 0.02 * MASS, found.mass
+    np.testing.assert_allclose(found.com, COM, atol=0.005)
+    assert not found.misfit and found.error_with < 0.3 * found.error_without
+    elsewhere = payload_from_log(robot, base, beta, data, rng=0)  # the last joint's link: the right hand
+    assert elsewhere.misfit and elsewhere.error_with > 3 * found.error_with
+
+
+def test_dynid_payload_names_the_joints_it_takes(identified, tmp_path):
+    from tests.cli.refusals import assert_refused, dynid
+
+    cfg, truth, folder, _ = identified
+    p = dynid("payload", cfg, "--results", folder / "out" / "results.json", "--file", _loaded_log(folder, truth),
+              "--out", tmp_path / "pay", "--joint", "wrist_9")
+    assert_refused(p, "--joint: expected one of ur10e's joints (", out=tmp_path / "pay", before=None)

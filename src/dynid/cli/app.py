@@ -671,6 +671,8 @@ def payload(
     rows: str | None = typer.Option(None, help="Rows of --file, 1-based inclusive: first,last."),
     out: Path = typer.Option(Path("dynid-payload"), help="Output folder for payload.json, payload.urdf and payload.xml."),
     data_root: Path | None = typer.Option(None, help="Folder of the data files (overrides the config's data_root)."),
+    joint: str | None = typer.Option(None, help="The joint whose link carries the tool (default: the last; on a robot "
+                                                "with branches, the last joint of the other arm)."),
     quiet: bool = QUIET,
 ) -> None:
     """Identify a tool's payload (mass, centre of mass, inertia) from a log with it, the arm's model known."""
@@ -679,22 +681,26 @@ def payload(
 
     def prepare():
         cfg = load_identification_config(config, data_root=data_root)
-        return cfg, _read_results(results, cfg.robot), dataset_for_file(cfg, file, _parse_rows(rows))
+        return cfg, _read_results(results, cfg.robot), dataset_for_file(cfg, file, _parse_rows(rows)), \
+            _payload_link(cfg.robot, joint)
 
     def compute(p, progress):
-        return p[0], run_payload(p[0], p[1], p[2], source=str(results))
+        return p[0], p[3], run_payload(p[0], p[1], p[2], source=str(results), link=p[3])
 
     def save(computed):
         from ..report.identification_run import save_payload
 
-        cfg, (found, label, _) = computed
-        return save_payload(found, out, robot=cfg.robot, parent=_last_link(cfg), estimate=label)
+        cfg, link, (found, label, _) = computed
+        return save_payload(found, out, robot=cfg.robot, parent=_last_link(cfg, link), estimate=label, link=link)
 
     def show(rep, computed, paths):
-        cfg, (found, label, ratio) = computed
+        cfg, link, (found, label, ratio) = computed
         for line in payload_lines(found, label, ratio):
             rep.line(line)
-        for line in payload_warnings(found, f"joint {cfg.robot.n_dof} ({cfg.robot.joints[-1].name})"):
+        if cfg.robot.is_tree:  # which hand: the last joint's unless named
+            rep.line(f"on the link of {cfg.robot.joints[link].name}" + ("" if joint is not None else
+                     ", the robot's last joint (--joint names another arm's)"))
+        for line in payload_warnings(found, f"joint {link + 1} ({cfg.robot.joints[link].name})"):
             rep.warning(line)
         rep.wrote(paths)
 
@@ -770,11 +776,31 @@ def payload_lines(found, label: str, ratio=None) -> list[str]:
     return lines
 
 
-def _last_link(cfg) -> str:
-    """The URDF link of the arm's last joint (its child) where the config has a URDF, else dynid's own name for it."""
+def _payload_link(robot, joint: str | None) -> int:
+    """``dynid payload --joint``: the link carrying the tool, 0-based (the last joint's by default).
+
+    Raises
+    ------
+    ConfigError
+        A name that is not one of the robot's joints.
+    """
+    from ..exceptions import ConfigError
+
+    names = [jt.name for jt in robot.joints]
+    if joint is None:
+        return robot.n_dof - 1
+    if joint not in names:
+        raise ConfigError(f"--joint: expected one of {robot.name}'s joints ({', '.join(names)}), got {joint!r}")
+    return names.index(joint)
+
+
+def _last_link(cfg, link: int | None = None) -> str:
+    """The URDF link of the arm's last joint (or joint ``link``, 0-based; its child) where the config has a URDF, else
+    dynid's own name for it."""
     import xml.etree.ElementTree as ET
 
-    last = cfg.robot.joints[-1].name
+    link = cfg.robot.n_dof - 1 if link is None else link
+    last = cfg.robot.joints[link].name
     if cfg.urdf is not None:
         try:
             for joint in ET.parse(cfg.urdf).getroot().iter("joint"):
@@ -783,7 +809,7 @@ def _last_link(cfg) -> str:
                     return child.get("link", "")
         except (OSError, ET.ParseError):
             pass
-    return f"link{cfg.robot.n_dof}"
+    return f"link{link + 1}"
 
 
 @app.command()

@@ -39,9 +39,9 @@ from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 
 
-def _last_link_columns(robot: Robot) -> np.ndarray:
-    """Indices of the last link's ten inertial parameters in the standard vector."""
-    start = (robot.n_dof - 1) * robot.n_params_per_joint
+def _last_link_columns(robot: Robot, link: int | None = None) -> np.ndarray:
+    """Indices of the last link's (or link ``link``'s, 0-based) ten inertial parameters in the standard vector."""
+    start = (robot.n_dof - 1 if link is None else link) * robot.n_params_per_joint
     return np.arange(start, start + 10)
 
 
@@ -312,7 +312,7 @@ def _compensated(sol, acc: LeastSquaresAccumulator, noise_sumsq: np.ndarray):
 
 
 def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, rng=0,
-                     gain_ratio=None) -> PayloadEstimate:
+                     gain_ratio=None, link: int | None = None) -> PayloadEstimate:
     """A payload's identifiable inertial parameters from a loaded run.
 
     Parameters
@@ -328,17 +328,22 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     gain_ratio : (n_dof,) array, optional
         Each joint's torque beyond ``beta`` multiplied by it (identified drive gains over those the torques were read
         with; default 1).
+    link : int, optional
+        The link carrying the payload, 0-based (the one its joint moves; default the last: on a robot with branches,
+        another arm's hand).
 
     Returns
     -------
     PayloadEstimate
+        About that link's frame.
 
     Raises
     ------
     IdentifiabilityError
         Too few rows or a rank-deficient problem.
     """
-    cols = _independent(_last_link_columns(robot), np.random.default_rng(rng), robot)
+    own = _last_link_columns(robot, link)
+    cols = _independent(own, np.random.default_rng(rng), robot)
     acc = LeastSquaresAccumulator(cols.size, robot.n_dof)
     for _, y, tau, keep in base_chunks(robot, base, loaded, standard=True):
         extra = tau - base.base_observation(y) @ beta
@@ -346,7 +351,7 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
             extra = extra * np.asarray(gain_ratio, dtype=float)
         acc.add(y[:, :, cols].reshape(-1, cols.size), extra.reshape(-1), keep.reshape(-1))
     sol = acc.solve()
-    names = tuple(INERTIAL_TERMS[i - _last_link_columns(robot)[0]] for i in cols)
+    names = tuple(INERTIAL_TERMS[i - own[0]] for i in cols)
     return PayloadEstimate(names, sol.params, sol.params_std)
 
 

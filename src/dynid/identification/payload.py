@@ -129,7 +129,7 @@ class Payload:
 
 
 def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loaded: PreparedData, *, rng=0,
-                     gain_ratio=None, residual=None) -> Payload:
+                     gain_ratio=None, residual=None, link: int | None = None) -> Payload:
     """The payload a log shows beyond the arm's model (module docstring).
 
     Parameters
@@ -150,6 +150,9 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     residual : (n_dof,) array [N·m], optional
         Each joint's residual σ of the arm's model on its identification log (results.json's ``joint_residual_std``):
         what a right payload's fit leaves at least, beside the noise floor.
+    link : int, optional
+        The link carrying the payload, 0-based (default: the last, whose flange is the robot's tool frame). On a
+        robot with branches, another arm's hand: the payload is then given in that link's own frame.
 
     Returns
     -------
@@ -161,8 +164,9 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
         Too few rows, or a motion that determines none of the payload's parameters.
     """
     ratio = np.ones(robot.n_dof) if gain_ratio is None else np.asarray(gain_ratio, dtype=float)
-    ls = identify_payload(robot, base, beta, loaded, rng=rng, gain_ratio=ratio)
-    cols = _last_link_columns(robot)
+    link = robot.n_dof - 1 if link is None else int(link)
+    ls = identify_payload(robot, base, beta, loaded, rng=rng, gain_ratio=ratio, link=link)
+    cols = _last_link_columns(robot, link)
     acc = LeastSquaresAccumulator(10, robot.n_dof)
     sse = np.zeros(2)
     total = 0.0
@@ -182,7 +186,7 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
                                                  problem=FitData(layout=(np.arange(10)[None, :], ()), prior=prior))
     phi = sdp.params_
     sse[1] = float(np.sum(acc.joint_residual_sumsq(phi)))
-    rotation, translation = np.asarray(robot.tool_rotation, dtype=float), np.asarray(robot.tool_translation, dtype=float)
+    rotation, translation = robot.flange(link=link)
     in_flange = transform_inertial(phi, rotation.T, -rotation.T @ translation)
     m, com, inertia = physical_from_inertial(in_flange)
     std = dict(zip(ls.names, ls.std))
@@ -193,7 +197,7 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     def share(sigma) -> float:  # each joint's σ on the samples kept, as a global relative error [%]
         return np.nan if sigma is None else 100.0 * float(np.sqrt(np.sum((sigma * ratio) ** 2 * kept) / max(total, 1e-300)))
 
-    travel = float(np.ptp(np.asarray(loaded.q[:, -1]))) if robot.joints[-1].prismatic else 0.0  # one column read
+    travel = float(np.ptp(np.asarray(loaded.q[:, link]))) if robot.joints[link].prismatic else 0.0  # one column read
     return Payload(m, com, inertia, mass_std, com_std, lost, phi, float(error[0]), float(error[1]),
                    share(noise_floor(loaded)), share(None if residual is None else np.asarray(residual, dtype=float)),
                    travel)

@@ -244,7 +244,8 @@ def _identified_model(config: IdentificationConfig, identified: dict, source: st
 
 
 @with_single_blas_thread
-def run_payload(config: IdentificationConfig, identified: dict, dataset: DatasetSpec, *, source: str = "results"):
+def run_payload(config: IdentificationConfig, identified: dict, dataset: DatasetSpec, *, source: str = "results",
+                link: int | None = None):
     """A tool's payload from a log with it, the arm's model taken from an identification's results (issue "The model
     proven where it goes", item 4; :func:`dynid.identification.payload.payload_from_log`).
 
@@ -261,6 +262,8 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
         The log with the payload (:func:`dynid.io.config.identification_config.dataset_for_file`).
     source : str
         Where the results come from, named in errors.
+    link : int, optional
+        The link carrying the tool, 0-based (default the last; on a robot with branches, another arm's hand).
 
     Returns
     -------
@@ -287,7 +290,7 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     data = prepare(recording, carried_over(stored_preprocessing(identified), config.preprocessing), strict=False)
     ratio = identified_gain_ratio(identified, config.robot.n_dof)
     found = payload_from_log(config.robot, base, estimates[label], data, rng=config.estimation.seed, gain_ratio=ratio,
-                             residual=stored_residual_level(identified, config.robot.n_dof))
+                             residual=stored_residual_level(identified, config.robot.n_dof), link=link)
     return found, label, ratio
 
 

@@ -341,6 +341,23 @@ class Robot:
         """Whether the robot has branches (two arms on a torso): a joint not carried by the joint before it."""
         return bool(np.any(self.parents != np.arange(self.n_dof) - 1))
 
+    def flange(self, *, link: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The frame a tool or payload on link ``link`` (0-based; default the last) is given in, in that link's frame:
+        the tool frame on the last link, the link's own frame on another (a robot with branches states no tool there).
+
+        Parameters
+        ----------
+        link : int, optional
+
+        Returns
+        -------
+        rotation : (3, 3) array
+        translation : (3,) array [m]
+        """
+        if link is None or link in (-1, self.n_dof - 1):
+            return np.asarray(self.tool_rotation, dtype=float), np.asarray(self.tool_translation, dtype=float)
+        return np.eye(3), np.zeros(3)
+
     @property
     def tips(self) -> np.ndarray:
         """(n_tips,) int: the joints whose link carries no other joint (each branch's hand), in the robot's order; the

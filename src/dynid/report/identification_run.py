@@ -289,7 +289,8 @@ def save_validation(comparisons, out: str | Path, warnings=()) -> list[Path]:
 
 
 @staged
-def save_payload(payload, out: str | Path, robot=None, parent: str = "", estimate: str = "") -> list[Path]:
+def save_payload(payload, out: str | Path, robot=None, parent: str = "", estimate: str = "",
+                 link: int | None = None) -> list[Path]:
     """Write ``payload.json``, ``payload.urdf`` (a link on a fixed joint to paste into the arm's URDF) and
     ``payload.xml`` (an MJCF body to put inside the arm's last body) (:func:`dynid.io.exported.export.payload_files`).
 
@@ -304,9 +305,11 @@ def save_payload(payload, out: str | Path, robot=None, parent: str = "", estimat
         The URDF link the payload is fixed to.
     estimate : str
         The arm's estimate the payload was taken beyond, stored in the file.
+    link : int, optional
+        The link carrying it, 0-based (default the last).
     """
     out = Path(out)  # staged passes its staging folder
-    urdf, mjcf = payload_files(payload, robot, parent)
+    urdf, mjcf = payload_files(payload, robot, parent, link)
     write_results(out / "payload.json", {"payload": payload.to_dict(), "arm_estimate": estimate, "urdf_parent": parent},
                   "payload")
     atomic_write_text(out / "payload.urdf", urdf)

@@ -446,10 +446,10 @@ def _replace(parent, tag: str, new) -> None:
         parent.insert(0, new)
 
 
-def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
+def payload_files(payload, robot: Robot, parent: str, link: int | None = None) -> tuple[str, str]:
     """A payload (:class:`dynid.identification.payload.Payload`) as a URDF link on a fixed joint and as an MJCF body,
-    each to paste into the arm's file: the body sits at the flange (the robot's tool frame in its last link), its
-    inertial in the flange's frame.
+    each to paste into the arm's file: the body sits at the flange (the robot's tool frame in its last link; another
+    link's own frame, :meth:`dynid.model.robot.Robot.flange`), its inertial in the flange's frame.
 
     Parameters
     ----------
@@ -457,7 +457,9 @@ def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
     robot : Robot
         Its tool frame is the flange.
     parent : str
-        The URDF link the payload is fixed to (the arm's last link).
+        The URDF link the payload is fixed to (the arm's last link, or ``link``'s).
+    link : int, optional
+        The link carrying the payload, 0-based (default the last).
 
     Returns
     -------
@@ -467,7 +469,7 @@ def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
     import pinocchio as pin
 
     inertia = mujoco_inertia(np.asarray(payload.inertia, dtype=float))
-    rotation = np.asarray(robot.tool_rotation, dtype=float)
+    rotation, translation = robot.flange(link=link)
     q = pin.Quaternion(rotation)
     head = (f"identified by dynid payload: {payload.mass:.6g} kg (σ {payload.mass_std:.2g}); "
             f"not determined by the log, kept at a point mass's values: {', '.join(payload.not_determined) or 'none'}")
@@ -476,7 +478,7 @@ def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
         '<joint name="payload_joint" type="fixed">',
         f"  <parent link={quoteattr(parent)}/>",
         '  <child link="payload"/>',
-        f'  <origin xyz="{_vec(robot.tool_translation)}" rpy="{_vec(_rpy(rotation))}"/>',
+        f'  <origin xyz="{_vec(translation)}" rpy="{_vec(_rpy(rotation))}"/>',
         "</joint>",
         '<link name="payload">',
         "  <inertial>",
@@ -487,8 +489,8 @@ def payload_files(payload, robot: Robot, parent: str) -> tuple[str, str]:
         "  </inertial>",
         "</link>", ""])
     mjcf = "\n".join([
-        f"<!-- {head}; put this body inside the arm's last body -->",
-        f'<body name="payload" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
+        f"<!-- {head}; put this body inside the body of {parent} -->",
+        f'<body name="payload" pos="{_vec(translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}">',
         f'  <inertial pos="{_vec(payload.com)}" mass="{payload.mass:.17g}" fullinertia="{inertia[0, 0]:.17g} '
         f'{inertia[1, 1]:.17g} {inertia[2, 2]:.17g} {inertia[0, 1]:.17g} {inertia[0, 2]:.17g} {inertia[1, 2]:.17g}"/>',
         "</body>", ""])
