@@ -122,11 +122,11 @@ def test_each_capsule_runs_on_its_own_link_across_every_pose(two_arms, rng):
     """The capsules the self-collision check measures without collision shapes: one per link and joint it carries,
     their ends where Pinocchio puts the link's origin and its child's (a capsule from the left hand to the right
     shoulder, which the serial rule drew, changed length as the arms moved)."""
-    from dynid.excitation.obstacles import _segments
+    from dynid.excitation.obstacles import link_segments
 
     robot, path = two_arms
     q = robot.limits.random_positions(20, rng)
-    seg = _segments(robot, q)
+    seg = link_segments(robot, q)
     for k in range(q.shape[0]):
         truth, _ = _skeleton_from_pinocchio(path, q[k])
         assert seg.shape[1] == len(truth) == 8
@@ -158,3 +158,31 @@ def test_the_arms_capsule_clearance_is_the_closest_pair_of_their_links(two_arms,
     best = min(measured.values())
     assert found is not None and abs(found.distance - best) < 2e-3, (found, best)
     assert measured[found.pair] < best + 2e-3  # a hand's point ends its forearm: either may be named
+
+
+def test_the_animation_draws_each_arm_on_its_own_links(two_arms, rng):
+    """The animation's lines (consecutive points between NaN breaks) are the base to the torso and each link to the
+    joints it carries, where Pinocchio puts them: none joins the left hand to the right shoulder, as the serial
+    polyline did. A serial chain keeps its polyline: the base, the joint origins, the tool point."""
+    import pinocchio as pin
+
+    from dynid.dynamics.kinematics import forward_kinematics
+    from dynid.report.excitation_run import arm_skeleton
+
+    robot, path = two_arms
+    q = robot.limits.random_positions(3, rng)
+    skeleton = arm_skeleton(robot, q)
+    for k in range(3):
+        truth, _ = _skeleton_from_pinocchio(path, q[k])
+        model = pin.buildModelFromUrdf(str(path))
+        data = model.createData()
+        pin.forwardKinematics(model, data, q[k])
+        expected = {(tuple(np.round(a, 9)), tuple(np.round(b, 9))) for _, a, b in truth}
+        expected.add(((0.0, 0.0, 0.0), tuple(np.round(data.oMi[1].translation, 9))))  # the base to the torso
+        drawn = {(tuple(np.round(a, 9)), tuple(np.round(b, 9))) for a, b in zip(skeleton[k, :-1], skeleton[k, 1:])
+                 if np.isfinite(a).all() and np.isfinite(b).all()}
+        assert drawn == expected
+    er16 = load_robot("er16")
+    q = er16.limits.random_positions(2, rng)
+    rots, origins = forward_kinematics(er16, q)
+    np.testing.assert_array_equal(arm_skeleton(er16, q)[:, 1:-1], origins)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..model.robot import Robot
 from .link_geometry import LinkGeometry, self_distances, self_pairs
-from .obstacles import ObstacleDistances, _capsules, _segment_jacobians, _segments, capsule_ends
+from .obstacles import ObstacleDistances, _capsules, _segment_jacobians, capsule_ends, link_segments
 
 __all__ = ["CapsuleSelfDistances", "SelfClearance", "closest_points", "self_clearance", "shape_clearance",
            "touching_pairs"]
@@ -128,7 +128,7 @@ def self_clearance(robot: Robot, t: np.ndarray, q: np.ndarray, radius: float) ->
     if not pairs:
         return None
     q = np.asarray(q, dtype=float)
-    seg = _segments(robot, q)
+    seg = link_segments(robot, q)
     closed_form = CapsuleSelfDistances(robot, q, radius, pairs).dist  # (N, pairs): where to ask coal
     best = (np.inf, pairs[0], 0)
     for k, p in np.argwhere(closed_form <= closed_form.min() + SCREEN):  # in the order of every sample and pair
@@ -215,7 +215,7 @@ class CapsuleSelfDistances:
 
     def __init__(self, robot: Robot, q: np.ndarray, radius: float, pairs):
         self.robot, self.q, self.pairs = robot, np.atleast_2d(np.asarray(q, dtype=float)), list(pairs)
-        seg = _segments(robot, self.q)  # (N, n_segments, 2, 3)
+        seg = link_segments(robot, self.q)  # (N, n_segments, 2, 3)
         i, j = np.array([p[0] for p in self.pairs], dtype=int), np.array([p[1] for p in self.pairs], dtype=int)
         a, b = seg[:, i], seg[:, j]  # (N, P, 2, 3)
         self._s, self._t = closest_points(a[..., 0, :], a[..., 1, :], b[..., 0, :], b[..., 1, :])

@@ -21,7 +21,7 @@ from ..dynamics.sensitivity import origins_jacobian, tool_jacobian
 from ..exceptions import ConfigError
 from ..model.robot import Robot
 
-__all__ = ["Obstacle", "ObstacleDistances"]
+__all__ = ["Obstacle", "ObstacleDistances", "capsule_ends", "link_segments"]
 
 SIZES = {"box": 3, "cylinder": 2, "sphere": 1}
 """How many numbers each shape's ``size`` holds: a box's full lengths along x, y, z; a cylinder's radius and length
@@ -133,8 +133,19 @@ def capsule_ends(robot: Robot) -> list[tuple[int, int]]:
     return sorted(ends, key=lambda e: e[0])  # stable: a link's segments in its children's order
 
 
-def _segments(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(N, n_segments, 2, 3): the segments of :func:`capsule_ends` along ``q`` (the last link's to the flange)."""
+def link_segments(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """The links' segments of :func:`capsule_ends` along ``q`` (the last link's to the flange).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (N, n_dof) array [rad, or m for a prismatic joint]
+
+    Returns
+    -------
+    (N, n_segments, 2, 3) ndarray [m]
+        Each segment's two ends in the base frame.
+    """
     rots, orig = forward_kinematics(robot, q)
     flange = orig[:, -1] + rots[:, -1] @ robot.tool_translation
     ends = capsule_ends(robot)
@@ -144,7 +155,7 @@ def _segments(robot: Robot, q: np.ndarray) -> np.ndarray:
 
 
 def _segment_jacobians(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(N, n_segments, 2, 3, n_dof): the positional Jacobians of each :func:`_segments` segment's two ends."""
+    """(N, n_segments, 2, 3, n_dof): the positional Jacobians of each :func:`link_segments` segment's two ends."""
     _, jo = origins_jacobian(robot, q)
     _, jt = tool_jacobian(robot, q)
     ends = capsule_ends(robot)

@@ -9,6 +9,7 @@ import numpy as np
 from ..dynamics.kinematics import forward_kinematics, tool_positions
 from ..dynamics.regressor import regressor
 from ..excitation.floor import FloorDistances
+from ..excitation.obstacles import link_segments
 from ..identification.excite import ExcitationRun
 from ..io.logs.trajectories import write_trajectory_csv
 from ..tables import Line
@@ -80,15 +81,37 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
     return [json_path, csv_path, out / "report.html"] + paths + moving
 
 
+def arm_skeleton(robot, q: np.ndarray) -> np.ndarray:
+    """The lines the animation draws at each of ``q``'s rows: the base, the joint origins and the tool point in turn
+    on a serial chain; on a robot with branches, the base to each branch's first joint and each link's segments
+    (:func:`dynid.excitation.obstacles.link_segments`), broken by NaN rows (a hand joined to the other arm's shoulder
+    before).
+
+    Parameters
+    ----------
+    robot : Robot
+    q : (F, n_dof) array [rad]
+
+    Returns
+    -------
+    (F, P, 3) array [m]
+    """
+    rots, origins = forward_kinematics(robot, q)
+    if not robot.is_tree:
+        tip = origins[:, -1] + rots[:, -1] @ np.asarray(robot.tool_translation)
+        return np.concatenate([np.zeros((q.shape[0], 1, 3)), origins, tip[:, None]], axis=1)
+    roots = origins[:, robot.parents == -1]
+    pieces = np.concatenate([np.stack([np.zeros_like(roots), roots], axis=2), link_segments(robot, q)], axis=1)
+    gaps = np.full(pieces.shape[:2] + (1, 3), np.nan)
+    return np.concatenate([pieces, gaps], axis=2).reshape(q.shape[0], -1, 3)
+
+
 def _animation(run: ExcitationRun, path: Path) -> Path:
     """:data:`ANIMATION`: the skeleton (base, joint origins, tool point) on :data:`ANIMATION_FRAMES` instants."""
     problem = run.config.problem
     robot, ws = problem.robot, problem.workspace
     t = np.arange(ANIMATION_FRAMES) * (problem.period / ANIMATION_FRAMES)
-    q = run.design.trajectory.evaluate(t)[0]
-    rots, origins = forward_kinematics(robot, q)
-    tip = origins[:, -1] + rots[:, -1] @ np.asarray(robot.tool_translation)
-    skeleton = np.concatenate([np.zeros((t.size, 1, 3)), origins, tip[:, None]], axis=1)
+    skeleton = arm_skeleton(robot, run.design.trajectory.evaluate(t)[0])
     path_t = problem.verification_grid()
     frames = figures.animate_arm(t, skeleton, tool_positions(robot, run.design.trajectory.evaluate(path_t)[0]),
                                  title=robot.name, floor=ws.floor, obstacles=ws.obstacles)

@@ -163,7 +163,8 @@ def animate_arm(t, skeleton, tool, title="The excitation, before it runs", floor
     t : (F,) array [s]
         Each frame's time.
     skeleton : (F, P, 3) array [m]
-        Each frame's chain of points in the base frame: the base, the joint origins, the tool point.
+        Each frame's chain of points in the base frame: the base, the joint origins, the tool point (NaN rows break
+        the line: a robot's branches).
     tool : (N, 3) array [m]
         The whole tool path, drawn thin under the arm.
     title : str
@@ -183,7 +184,7 @@ def animate_arm(t, skeleton, tool, title="The excitation, before it runs", floor
 
     ax = plot_tool_path(tool, title=title, floor=floor, obstacles=obstacles)
     pts = np.concatenate([skeleton.reshape(-1, 3), tool])
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    lo, hi = np.nanmin(pts, axis=0), np.nanmax(pts, axis=0)  # NaN rows break the lines between branches
     centre, half = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo)) + 0.05
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
