@@ -89,6 +89,8 @@ def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_a
     assert {"q_min [m]", "q_max [m]"} <= {m["constraint"] for m in design["margins"] if m["where"] == "joint 6"}
     apart = [m for m in design["margins"] if m["constraint"] == "self clearance [m]"]
     assert len(apart) == 1 and apart[0]["margin"] >= 0, apart
+    said_apart = json.loads((tmp_path / "out" / "excitation.json").read_text())["self_clearance"]["distance"]
+    assert abs(apart[0]["worst"] - said_apart) < 1e-6  # one figure: the 0.04 m capsules the design keeps apart
     said = " ".join(p.stdout.split())
     assert "joints 1-7" in said, said
     boxed = {m["where"] for m in design["margins"] if m["constraint"] == "workspace [m]"}

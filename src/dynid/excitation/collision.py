@@ -1,7 +1,7 @@
 """How close an excitation trajectory brings the arm's links to each other (issue "An excitation safe to run on the
 real robot", item 2: checked at the controller's rate, said before it runs).
 
-Each link is a capsule of radius ``clearance`` (:attr:`dynid.excitation.constraints.Workspace.clearance`) about the
+Each link is a capsule of the workspace's radius (:meth:`dynid.excitation.constraints.Workspace.capsule_radius`) about the
 segment from its joint's origin to the next joint's (the last link's to the flange; on a robot with branches, one to
 each joint the link carries, :func:`~dynid.excitation.obstacles.capsule_ends`): the robot's skeleton, which a
 description without collision meshes still gives. Distances between capsules are coal's (the collision library of

@@ -476,7 +476,7 @@ def self_margins(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspac
         pairs = workspace.self_pairs(robot)
         if not pairs:
             return []
-        d = CapsuleSelfDistances(robot, q, workspace.clearance, pairs).dist
+        d = CapsuleSelfDistances(robot, q, workspace.capsule_radius(robot), pairs).dist  # the design's own capsules
         n, c = np.unravel_index(int(np.argmin(d)), d.shape)
         worst, links = float(d[n, c]), capsule_ends(robot)
         return [ConstraintMargin("self clearance [m]", f"links {links[pairs[c][0]][0] + 1} and {links[pairs[c][1]][0] + 1}' "
