@@ -25,7 +25,8 @@ def test_coals_capsule_distances_equal_the_segments_own(rng):
 
 
 def test_the_closest_pair_along_a_trajectory_is_found():
-    from dynid.excitation.collision import _segments, self_clearance, touching_pairs
+    from dynid.excitation.collision import self_clearance, touching_pairs
+    from dynid.excitation.obstacles import link_segments
     from dynid.model.description import load_robot
 
     robot = load_robot("ur10e")
@@ -35,7 +36,7 @@ def test_the_closest_pair_along_a_trajectory_is_found():
     found = self_clearance(robot, t, q, 0.05)
     pairs = touching_pairs(robot, 0.05)
     assert found.pairs == len(pairs) and all(j - i >= 2 for i, j in pairs)
-    seg = _segments(robot, q)
+    seg = link_segments(robot, q)
     brute = min((_brute(seg[k, i], seg[k, j], 0.05), (i + 1, j + 1), t[k]) for k in range(20) for i, j in pairs)
     assert abs(found.distance - brute[0]) < 2e-3 and found.pair == brute[1] and found.time == brute[2]
 
@@ -44,7 +45,8 @@ def test_the_closest_pair_along_a_trajectory_is_found():
 def test_coal_is_asked_where_the_closest_pair_can_be_and_finds_what_asking_it_everywhere_finds(name, radius, spread):
     """The clearance coal measures at the samples and pairs the closed form screens equals, to the bit, coal asked at
     every sample and pair (capsules apart, and overlapping: the ER-16's forearm and base, as in its digest)."""
-    from dynid.excitation.collision import _distance, _segments, self_clearance, touching_pairs
+    from dynid.excitation.collision import _distance, self_clearance, touching_pairs
+    from dynid.excitation.obstacles import link_segments
     from dynid.model.description import load_robot
 
     robot = load_robot(name)
@@ -52,7 +54,7 @@ def test_coal_is_asked_where_the_closest_pair_can_be_and_finds_what_asking_it_ev
     q = rng.uniform(-spread, spread, (300, robot.n_dof))
     t = np.arange(300) * 0.002
     found = self_clearance(robot, t, q, radius)
-    pairs, seg = touching_pairs(robot, radius), _segments(robot, q)
+    pairs, seg = touching_pairs(robot, radius), link_segments(robot, q)
     best = (np.inf, None, None)
     for k in range(300):  # coal at every sample and pair, the first smallest kept
         for i, j in pairs:
@@ -86,14 +88,15 @@ def test_the_segments_closest_points_equal_a_dense_search_in_every_case(rng):
 def test_capsule_self_distances_are_coals_and_their_gradient_the_finite_differences():
     """What the design keeps apart with ``avoid_self_collision``: the capsules' surface distances equal coal's (the
     set-points' check), and their gradient the distances' central differences."""
-    from dynid.excitation.collision import CapsuleSelfDistances, _distance, _segments, touching_pairs
+    from dynid.excitation.collision import CapsuleSelfDistances, _distance, touching_pairs
+    from dynid.excitation.obstacles import link_segments
     from dynid.model.description import load_robot
 
     robot = load_robot("ur10e")
     q = np.random.default_rng(7).uniform(-2.5, 2.5, (30, robot.n_dof))
     pairs = touching_pairs(robot, 0.05)
     measured = CapsuleSelfDistances(robot, q, 0.05, pairs)
-    seg = _segments(robot, q)
+    seg = link_segments(robot, q)
     coal_d = np.array([[_distance(seg[k, i], seg[k, j], 0.05) for i, j in pairs] for k in range(q.shape[0])])
     np.testing.assert_allclose(measured.dist, coal_d, atol=1e-9)
     grad = measured.distances(gradient=True).gradient
