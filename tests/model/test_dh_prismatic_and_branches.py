@@ -174,6 +174,7 @@ def test_the_regressor_of_a_dh_table_equals_pinocchios_of_its_urdf(tmp_path, rng
     ("modified", {"parent": "j2"}, "joints[1].parent: expected \"base\" or the name of a joint before it (j1)"),
     ("standard", {"parent": "j1"}, "joints[1]: parent given, but a branch is placed in modified DH only"),
     ("modified", {"type": "spherical"}, "joints[1].type"),
+    ("modified", {"name": "j1"}, "joints[1].name: 'j1' names joints[0] too: expected each joint's own name"),
 ])
 def test_a_wrong_joint_type_or_parent_is_one_line_naming_the_field(tmp_path, convention, row, expected):
     rows = [SCARA[0], {**SCARA[1], **row}]

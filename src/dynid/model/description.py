@@ -308,6 +308,10 @@ def robot_from_document(doc: dict, source: str, base: Path | None) -> Robot:
         if bad:
             raise ConfigError(f"{w}: field(s) {bad} are drive terms the robot does not have (drive_terms = {list(terms)})")
     names = [r.name if r.name is not None else f"joint{i + 1}" for i, r in enumerate(rows)]
+    for i, joint in enumerate(names):  # a branch's parent, a log's columns and the tables name joints: one each
+        if joint in names[:i]:
+            raise ConfigError(f"{where[i]}.name: {joint!r} names joints[{names.index(joint)}] too: expected each joint's "
+                              "own name")
     joints, inertial, (tool_r, tool_t), dh, urdf_lim, links = _chain(d, rows, where, names, convention=convention,
                                                                      urdf=(upath, urdf_model), held=held, source=source)
     terms, mask, drive, gains, transmission, stated = _drives(d, rows, where, terms, urdf=(upath, urdf_lim),
