@@ -691,7 +691,7 @@ def payload(
         from ..report.identification_run import save_payload
 
         cfg, link, (found, label, _) = computed
-        return save_payload(found, out, robot=cfg.robot, parent=_last_link(cfg, link), estimate=label, link=link)
+        return save_payload(found, out, robot=cfg.robot, parent=_urdf_link(cfg, link), estimate=label, link=link)
 
     def show(rep, computed, paths):
         cfg, link, (found, label, ratio) = computed
@@ -794,12 +794,11 @@ def _payload_link(robot, joint: str | None) -> int:
     return names.index(joint)
 
 
-def _last_link(cfg, link: int | None = None) -> str:
-    """The URDF link of the arm's last joint (or joint ``link``, 0-based; its child) where the config has a URDF, else
-    dynid's own name for it."""
+def _urdf_link(cfg, link: int) -> str:
+    """The URDF link joint ``link`` (0-based) moves (its child) where the config has a URDF, else dynid's own name for
+    it."""
     import xml.etree.ElementTree as ET
 
-    link = cfg.robot.n_dof - 1 if link is None else link
     last = cfg.robot.joints[link].name
     if cfg.urdf is not None:
         try:

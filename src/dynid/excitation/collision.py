@@ -92,8 +92,8 @@ def touching_pairs(robot: Robot, radius: float, samples: int = 200, rng=0) -> li
     """
     q = robot.limits.random_positions(samples, rng)
     links, parents = [k for k, _ in capsule_ends(robot)], robot.parents
-    candidates = [(a, b) for a in range(len(links)) for b in range(a + 1, len(links))
-                  if links[a] != links[b] and parents[links[b]] != links[a] and parents[links[a]] != links[b]]
+    candidates = [(a, b) for a in range(len(links)) for b in range(a + 1, len(links))  # links[a] <= links[b]: the
+                  if links[a] != links[b] and parents[links[b]] != links[a]]  # carrier comes first
     if not candidates:
         return []
     overlap = (CapsuleSelfDistances(robot, q, radius, candidates).dist < 0).mean(axis=0)

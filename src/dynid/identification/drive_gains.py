@@ -39,8 +39,8 @@ from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 
 
-def _last_link_columns(robot: Robot, link: int | None = None) -> np.ndarray:
-    """Indices of the last link's (or link ``link``'s, 0-based) ten inertial parameters in the standard vector."""
+def _link_columns(robot: Robot, link: int | None = None) -> np.ndarray:
+    """Indices of link ``link``'s (0-based; default the last) ten inertial parameters in the standard vector."""
     start = (robot.n_dof - 1 if link is None else link) * robot.n_params_per_joint
     return np.arange(start, start + 10)
 
@@ -209,8 +209,8 @@ def identify_drive_gains(robot: Robot, base: BaseParameters, unloaded: PreparedD
         Too few rows, or nothing makes the gains observable.
     """
     n = robot.n_dof
-    last = _independent(_last_link_columns(robot)[:9], np.random.default_rng(rng), robot)
-    mass_col = _last_link_columns(robot)[9]
+    last = _independent(_link_columns(robot)[:9], np.random.default_rng(rng), robot)
+    mass_col = _link_columns(robot)[9]
     nb, nl = base.n_base, last.size
     p = n + nb + nl
     acc = LeastSquaresAccumulator(p, n)
@@ -342,7 +342,7 @@ def identify_payload(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     IdentifiabilityError
         Too few rows or a rank-deficient problem.
     """
-    own = _last_link_columns(robot, link)
+    own = _link_columns(robot, link)
     cols = _independent(own, np.random.default_rng(rng), robot)
     acc = LeastSquaresAccumulator(cols.size, robot.n_dof)
     for _, y, tau, keep in base_chunks(robot, base, loaded, standard=True):

@@ -1,14 +1,14 @@
 """A tool's payload from a short log with the arm's model known (issue "The model proven where it goes", item 4).
 
 The arm's identified (or nominal) base parameters predict the torques of the arm alone; what the log holds beyond them
-is the payload's, linear in its ten inertial parameters about the last link's frame: ``τ - Y β = Y_L φ_payload`` with
-``Y_L`` the last link's ten standard regressor columns (Khalil & Dombre, "Modeling, Identification and Control of
+is the payload's, linear in its ten inertial parameters about the frame of the link carrying it (the last by default):
+``τ - Y β = Y_L φ_payload`` with ``Y_L`` that link's ten standard regressor columns (Khalil & Dombre, "Modeling, Identification and Control of
 Robots", 2002, §12.5: payload identification with the robot's parameters known). Least squares on the identifiable
 ones gives σ (:func:`dynid.identification.drive_gains.identify_payload`); the estimate handed on is physically
 consistent: the same rows solved with the payload's pseudo-inertia positive semidefinite (Wensing, Kim & Slotine 2018),
 pulled by a weak prior toward a point mass of least squares' mass at least squares' centre of mass, so that what the log
 does not determine (a payload turned about one axis only leaves some inertia undetermined) stays at that point mass's
-values rather than at noise. It is given in the flange's frame (the robot's tool frame), as a controller's payload
+values rather than at noise. It is given in the flange's frame (the robot's tool frame; another link's own frame), as a controller's payload
 setting takes it, and as a URDF link and an MJCF body to attach.
 """
 
@@ -29,7 +29,7 @@ from ..model.spatial import inertial_from_physical, physical_from_inertial, tran
 from ..preprocessing.preparation import base_chunks
 from ..preprocessing.prepared import PreparedData
 from ..validation.noise_floor import noise_floor
-from .drive_gains import _last_link_columns, identify_payload
+from .drive_gains import _link_columns, identify_payload
 
 FLOOR_FACTOR = 3.0
 """A payload fit over this many times what a right payload leaves is said (:attr:`Payload.misfit`): the log's noise
@@ -61,10 +61,10 @@ class Payload:
     com_std : (3,) array [m]
         σ of the centre of mass from least squares' σ of the first moments over the mass.
     not_determined : tuple of str
-        The last link's parameters (eq. 5 names, about the last link's frame) the log does not determine: σ at least
+        The payload's link's parameters (eq. 5 names, about that link's frame) the log does not determine: σ at least
         their value, or no action on the joints at all; the consistent estimate keeps the point mass's values there.
     parameters : (10,) array
-        The consistent estimate about the last link's frame (eq. 5 order).
+        The consistent estimate about the frame of the link carrying it (the last by default; eq. 5 order).
     error_without, error_with : float [%]
         The log's global relative torque error of the arm's model alone and with the payload.
     error_floor : float [%]
@@ -166,7 +166,7 @@ def payload_from_log(robot: Robot, base: BaseParameters, beta: np.ndarray, loade
     ratio = np.ones(robot.n_dof) if gain_ratio is None else np.asarray(gain_ratio, dtype=float)
     link = robot.n_dof - 1 if link is None else int(link)
     ls = identify_payload(robot, base, beta, loaded, rng=rng, gain_ratio=ratio, link=link)
-    cols = _last_link_columns(robot, link)
+    cols = _link_columns(robot, link)
     acc = LeastSquaresAccumulator(10, robot.n_dof)
     sse = np.zeros(2)
     total = 0.0

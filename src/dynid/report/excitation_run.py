@@ -84,8 +84,7 @@ def save_excitation(run: ExcitationRun, out: str | Path, *, animation: bool = Fa
 def arm_skeleton(robot, q: np.ndarray) -> np.ndarray:
     """The lines the animation draws at each of ``q``'s rows: the base, the joint origins and the tool point in turn
     on a serial chain; on a robot with branches, the base to each branch's first joint and each link's segments
-    (:func:`dynid.excitation.obstacles.link_segments`), broken by NaN rows (a hand joined to the other arm's shoulder
-    before).
+    (:func:`dynid.excitation.obstacles.link_segments`), broken by NaN rows.
 
     Parameters
     ----------
