@@ -59,7 +59,7 @@ def test_a_torque_only_filter_is_refused_with_the_reason(tmp_path):
         load_identification_config(cfg)
 
 
-def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path):
+def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path, monkeypatch):
     """preprocessing = "auto" (quiet positions: the noise knee far above 10× the band, so the cutoffs are
     cross-validated): every candidate scored on the same held-out samples, the rule's cutoff kept unless another
     scores 10 % better; as accurate as the defaults' on this log (validation within 1.2x of the true parameters'
@@ -103,3 +103,23 @@ def test_preprocessing_auto_chooses_filters_on_common_held_out_samples(tmp_path)
     assert len(forked.candidates) == 3 and forked.candidates == here.candidates and forked.note == here.note
     assert np.array_equal(forked.error, here.error) and np.array_equal(forked.score, here.score)
     assert np.array_equal(forked.data.tau, here.data.tau) and np.array_equal(forked.data.ddq, here.data.ddq)
+    # the rule's candidate is the reference preparation, not prepared again (the log prepared once for each of the
+    # three candidates), and scored as a preparation of its own at the rule's cutoffs scores it
+    from dataclasses import replace
+
+    from dynid.identification import cross_validation
+    from dynid.preprocessing.preparation import prepare
+
+    prepared = []
+    monkeypatch.setattr(cross_validation, "prepare", lambda *a, **k: prepared.append(a[1]) or prepare(*a, **k))
+    again = choose_preprocessing(config.robot, base, recording, config.preprocessing)
+    assert len(prepared) == 3 and np.array_equal(again.error, here.error)
+    rule = here.candidates[0].position_cutoff
+    duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
+    reference = prepare(recording, config.preprocessing)
+    evaluation, _ = cross_validation._fold_accumulators(config.robot, base, reference, duration, cross_validation.FOLDS)
+    _, alone = cross_validation._candidate(config.robot, base, recording,
+                                           replace(config.preprocessing, position_cutoff=rule, parallel_cutoff=rule),
+                                           evaluation, base.base_from_standard(config.robot.standard_parameters()),
+                                           duration, cross_validation.FOLDS)
+    assert np.array_equal(here.error[0], alone)

@@ -213,10 +213,15 @@ class PreprocessingChoice:
 def _candidate(robot, base, recording, settings: Preprocessing, evaluation: list, prior: np.ndarray, duration: float,
                folds: int) -> tuple[PreparedData, np.ndarray]:
     """One candidate of :func:`choose_preprocessing`: the log prepared with ``settings``, and each joint's RMS error
-    over the folds of the parameters fitted on the other folds (``inf`` where a fold's complement does not determine
-    them), scored on ``evaluation``'s rows."""
+    over the folds of the parameters fitted on the other folds (:func:`_out_of_fold_error`)."""
     data = prepare(recording, settings)
     fitted, _ = _fold_accumulators(robot, base, data, duration, folds)
+    return data, _out_of_fold_error(robot, fitted, evaluation, prior, folds)
+
+
+def _out_of_fold_error(robot, fitted: list, evaluation: list, prior: np.ndarray, folds: int) -> np.ndarray:
+    """Each joint's RMS error over the folds of the parameters fitted on the other folds of ``fitted``, scored on
+    ``evaluation``'s rows (``inf`` where a fold's complement does not determine them)."""
     sumsq, rows = np.zeros(robot.n_dof), np.zeros(robot.n_dof)
     try:
         for k in range(folds):
@@ -224,8 +229,8 @@ def _candidate(robot, base, recording, settings: Preprocessing, evaluation: list
             sumsq += evaluation[k].joint_residual_sumsq(params)
             rows += evaluation[k].rows
     except IdentifiabilityError:
-        return data, np.full(robot.n_dof, np.inf)
-    return data, np.sqrt(sumsq / np.maximum(rows, 1))
+        return np.full(robot.n_dof, np.inf)
+    return np.sqrt(sumsq / np.maximum(rows, 1))
 
 
 def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: int):
@@ -294,18 +299,28 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     settings = [replace(given, position_cutoff=given.position_cutoff if given.position_cutoff is not None else cutoff,
                         parallel_cutoff=given.parallel_cutoff if given.parallel_cutoff is not None else cutoff)
                 for cutoff in (capped(f, recording.rate) for f in cutoffs)]
-    # the candidates after the first on the second core (forked children) where the log is in memory; the same numbers
+    # the rule's candidate is the reference itself (the same arrays: only its derivation says "10× band") where the
+    # reference resolved the same cutoffs: its folds are the evaluation's, and it needs no pass of its own
+    rs = reference.settings
+    same = rs.position_cutoff == settings[0].position_cutoff and rs.parallel_cutoff == settings[0].parallel_cutoff
+    # the other candidates on the cores (forked children) where the log is in memory; the same numbers
     stored = any(x is not None and not isinstance(x, np.ndarray) for x in (recording.q, recording.dq, recording.tau))
-    beside = [None if stored else ForkedCall(_candidate, robot, base, recording, s, evaluation, prior, duration, folds)
-              for s in settings[1:]]
+    beside = [None if stored or (k == 0 and not same) else
+              ForkedCall(_candidate, robot, base, recording, s, evaluation, prior, duration, folds)
+              for k, s in enumerate(settings) if k > 0 or not same]
     candidates, errors, prepared = [], [], []
     with contextlib.ExitStack() as stack:
         for call in beside:
             if call is not None:
                 stack.enter_context(call)
-        for s, call in zip(settings, [None, *beside]):
-            data, error = (_candidate(robot, base, recording, s, evaluation, prior, duration, folds) if call is None
-                           else call.result())
+        calls = iter(beside)
+        for k, s in enumerate(settings):
+            call = None if k == 0 and same else next(calls)
+            if k == 0 and same:
+                data, error = reference, _out_of_fold_error(robot, evaluation, evaluation, prior, folds)
+            else:
+                data, error = (_candidate(robot, base, recording, s, evaluation, prior, duration, folds) if call is None
+                               else call.result())
             candidates.append(data.settings)
             prepared.append(data)
             errors.append(error)
