@@ -123,9 +123,71 @@ def canonical_name(name: str) -> str:
     return f"{term}{int(joint)}"
 
 
-LINEAR_UNITS: dict[str, str] = {"kg·m²": "kg", "N·m": "N", "N·m·s/rad": "N·s/m"}
-"""A drive term's unit on a prismatic joint, where its revolute unit differs: the rotor inertia reflected as a mass,
-forces for torques, per metre for per radian."""
+LINEAR_UNITS: dict[str, str] = {"kg·m²": "kg", "N·m": "N", "N·m·s/rad": "N·s/m", "rad": "m", "rad/s": "m/s",
+                                 "rad/s²": "m/s²"}
+"""A quantity's unit on a prismatic joint, where its revolute unit differs: the rotor inertia reflected as a mass,
+forces for torques, per metre for per radian, positions and their derivatives in metres."""
+
+
+def joint_unit(unit: str, prismatic, j: int) -> str:
+    """The unit of joint ``j``'s quantity whose unit on a revolute joint is ``unit``: its linear unit
+    (:data:`LINEAR_UNITS`) where the joint slides.
+
+    Parameters
+    ----------
+    unit : str
+        E.g. ``"N·m"`` for a torque, ``"rad/s"`` for a velocity.
+    prismatic : sequence of bool
+        Which joints slide (:attr:`dynid.model.robot.Robot.prismatic`); empty: none.
+    j : int
+        The joint, 0-based.
+
+    Returns
+    -------
+    str
+    """
+    return LINEAR_UNITS.get(unit, unit) if 0 <= j < len(prismatic) and prismatic[j] else unit
+
+
+def joints_unit(unit: str, prismatic) -> str:
+    """The unit of a figure over all joints (an RMS over them) whose unit on revolute joints is ``unit``: ``"N·m/N"``
+    where some joints slide and others turn, the linear unit where all slide.
+
+    Parameters
+    ----------
+    unit : str
+    prismatic : sequence of bool
+
+    Returns
+    -------
+    str
+    """
+    linear = LINEAR_UNITS.get(unit, unit)
+    if not any(prismatic) or linear == unit:
+        return unit
+    return linear if all(prismatic) else f"{unit}/{linear}"
+
+
+def sliding_note(unit: str, prismatic, *, inside: bool = False) -> str:
+    """What a list or table of per-joint figures in ``unit`` adds where some joints slide, e.g. ``" (J3 in N)"``, or
+    ``"; J3 in N"`` ``inside`` parentheses that name the unit; ``""`` on a robot of revolute joints.
+
+    Parameters
+    ----------
+    unit : str
+        The figures' unit on a revolute joint.
+    prismatic : sequence of bool
+    inside : bool
+
+    Returns
+    -------
+    str
+    """
+    joints = [f"J{j + 1}" for j, p in enumerate(prismatic) if p]
+    if not joints:
+        return ""
+    said = f"{', '.join(joints)} in {LINEAR_UNITS.get(unit, unit)}"
+    return f"; {said}" if inside else f" ({said})"
 
 
 def unit_of(name: str, prismatic=()) -> str:
@@ -146,8 +208,7 @@ def unit_of(name: str, prismatic=()) -> str:
     term, joint = split_name(name)
     if term not in friction.TERMS:
         return UNITS.get(term, "")
-    unit = friction.TERMS[term].unit
-    return LINEAR_UNITS.get(unit, unit) if 0 <= joint < len(prismatic) and prismatic[joint] else unit
+    return joint_unit(friction.TERMS[term].unit, prismatic, joint)
 
 
 MOVING_SPAN = 0.05

@@ -56,6 +56,14 @@ def test_a_prismatic_arm_is_identified_from_init_to_its_written_files(tmp_path, 
     assert [kinds[j.name] for j in robot.joints] == ["slide" if j.prismatic else "hinge" for j in robot.joints]
     figures = re.findall(r"equals dynid's model to ([0-9.e+-]+) of its RMS", said)
     assert len(figures) == 2 and all(float(f) < 1e-9 for f in figures), figures
+    # the sliding joint's figures are forces: results.json names it, the tables and lines say N for it
+    slide = np.flatnonzero(robot.prismatic).tolist()
+    joints = ", ".join(f"J{k + 1}" for k in slide)
+    assert results["identification"]["prismatic_joints"] == validation["prismatic_joints"] == slide
+    assert f"RMSE N·m ({joints} in N)" in (tmp_path / "dynid-identify" / "report.html").read_text()
+    p = run("validate", "arm.toml", "-v", cwd=tmp_path)
+    said = " ".join(p.stdout.split())
+    assert p.returncode == 0 and re.search(rf"RMS torque [0-9.e+-]+(, [0-9.e+-]+)* N·m \({joints} in N\)", said), said[:500]
 
 
 def test_a_track_logged_in_millimetres_is_refused_with_its_scale(tmp_path):

@@ -146,6 +146,38 @@ def test_a_prismatic_joints_drive_terms_are_in_linear_units(urdf):
     assert unit_of(f"fv{j}") == "N·m·s/rad"  # a name alone is a revolute joint's
 
 
+def test_per_joint_figures_say_their_units_where_joints_slide():
+    from dynid.conventions import joint_unit, joints_unit, sliding_note
+
+    sliding = (False, False, True, False)
+    assert [joint_unit("N·m", sliding, j) for j in range(4)] == ["N·m", "N·m", "N", "N·m"]
+    assert joint_unit("rad/s", sliding, 2) == "m/s" and joint_unit("rad/s", (), 2) == "rad/s"
+    assert joints_unit("N·m", sliding) == "N·m/N" and joints_unit("N·m", (True,)) == "N" and joints_unit("N·m", ()) == "N·m"
+    assert sliding_note("N·m", sliding) == " (J3 in N)" and sliding_note("N·m", sliding, inside=True) == "; J3 in N"
+    assert sliding_note("N·m", (False, False)) == ""
+
+
+def test_a_residual_finding_on_a_sliding_joint_says_its_position_and_newtons(rng):
+    """The verdict's finding on a residual that follows a joint's position (diagnostics' harmonic features): on a
+    prismatic joint it says the position and N, not the angle and N·m."""
+    from dynid.validation.diagnostics import ResidualSums
+
+    n, m = 2, 4000
+    q = np.column_stack([np.linspace(-1.5, 1.5, m), np.linspace(0.0, 1.5, m)])  # a turning joint, a 1.5 m track
+    dq = np.ones((m, n))
+    y = rng.normal(size=(m, n, 1))
+    tau = y[:, :, 0] * 2.0 + 0.5 * np.sin(2 * q) + rng.normal(0, 0.01, (m, n))  # a residual that follows the position
+    said = {}
+    for sliding in ((False, False), (False, True)):
+        stats = ResidualSums(n, 1)
+        stats.add(y, tau, q, dq, direction=np.ones((m, n)), low_speed=np.zeros(n), keep=np.ones((m, n), dtype=bool))
+        findings, _ = stats.residual_checks(np.array([2.0]), np.sqrt(np.mean(tau**2, axis=0)), prismatic=sliding)
+        said[sliding] = {f.joint: f.text for f in findings if f.kind == "position"}
+    assert "joint's angle" in said[(False, False)][1] and " N·m over its angles" in said[(False, False)][1]
+    assert "joint's position" in said[(False, True)][1] and " N over its positions" in said[(False, True)][1]
+    assert said[(False, True)][0] == said[(False, False)][0]  # the revolute joint's line is as it was
+
+
 def test_a_sliding_joint_is_never_tried_a_quarter_turn_off_and_its_stroke_counts_in_the_reach(urdf):
     """The check of a log read otherwise than the robot file tries each revolute joint's zero a quarter or half turn
     off; a prismatic joint's zero is a length, so it is tried on none (it was shifted by π/2 m as if turned). The reach

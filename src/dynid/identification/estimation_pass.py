@@ -233,17 +233,19 @@ def _log_evidence(robot: Robot, base: BaseParameters, data: PreparedData, scorin
     if progress is not None:
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
-    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq))
+    sliding = tuple(robot.prismatic.tolist())
+    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq), prismatic=sliding)
     found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, joint_weights=row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
-        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed))
+        sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed,
+        prismatic=sliding))
     findings, stats = _verdict(robot, base, reference.solution_, reference.ols_params_, row_weights, scoring=scoring,
                                fit=fit, rng=rng, consistent=SDP_LABEL in estimates)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
         findings += scoring.order.findings(fit.varies(beyond="floor"), data.name)
     if SDP_LABEL in estimates and not any(f.kind in READINESS_KINDS for f in findings):  # the log read right first
-        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name)
+        findings += flipped_joint_findings(estimates[SDP_LABEL].estimator, reference, data.name, prismatic=sliding)
     inconsistent = not str(verdicts.get(ls_label, "yes")).startswith("yes")
     refits = _held_out_evidence(robot, base, scoring.folds, row_weights, stats, ls_label, held_out=held_out and inconsistent,
                                 jackknife=jackknife, progress=progress, span=float(data.t[-1] - data.t[0]))
@@ -426,7 +428,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     if scoring.nominal is not None:  # the description's nominal model: does the data run against it?
         findings += _nominal_checks(base, scoring, fit, stats)
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
-    more, res_stats = residuals.residual_checks(ols_params, rms, fc)
+    more, res_stats = residuals.residual_checks(ols_params, rms, fc, prismatic=robot.prismatic)
     findings += more
     stats.update(res_stats)
     boot = blocks.bootstrap_std(row_weights, rng=rng)

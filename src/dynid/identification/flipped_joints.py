@@ -18,6 +18,7 @@ import copy
 
 import numpy as np
 
+from ..conventions import joint_unit
 from ..validation.diagnostics import Finding
 
 __all__ = ["FLIPPED_FITS", "MISFIT", "flipped_joint_findings"]
@@ -29,7 +30,7 @@ FLIPPED_FITS = 0.5
 """The SDP refitted with the joint's torque negated leaves at most this share of its RMS residual on that joint."""
 
 
-def flipped_joint_findings(sdp, reference, dataset: str, table: str = "[identification]") -> list[Finding]:
+def flipped_joint_findings(sdp, reference, dataset: str, table: str = "[identification]", *, prismatic=()) -> list[Finding]:
     """The joints whose measured torque the SDP follows only with its sign flipped (module docstring).
 
     Parameters
@@ -42,6 +43,8 @@ def flipped_joint_findings(sdp, reference, dataset: str, table: str = "[identifi
         The log, named in the finding.
     table : str
         The config table whose ``torques`` sign the finding names.
+    prismatic : sequence of bool
+        Which joints slide (their forces said in N).
 
     Returns
     -------
@@ -65,7 +68,8 @@ def flipped_joint_findings(sdp, reference, dataset: str, table: str = "[identifi
     if not flipped:
         return []
     joints = ", ".join(f"J{j + 1}" for j in flipped)
-    rms = "; ".join(f"J{j + 1} {a:.3g} N·m RMS as read, {b:.3g} flipped" for j, (a, b) in zip(flipped, shares))
+    rms = "; ".join(f"J{j + 1} {a:.3g} {joint_unit('N·m', prismatic, j)} RMS as read, {b:.3g} flipped"
+                    for j, (a, b) in zip(flipped, shares))
     return [Finding("sign", f"{dataset}: {joints}: the physically consistent estimate cannot follow the measured torque "
                             f"and follows it with its sign flipped ({rms}), where the nominal model barely predicts "
                             f"it: is its sign flipped? Negate {'its entry' if len(flipped) == 1 else 'their entries'} "

@@ -38,6 +38,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..conventions import joints_unit
 from ..estimators.registry import estimate_label
 from ..validation.diagnostics import Finding, nominal_gate, validation_findings
 from .estimates import (
@@ -231,10 +232,11 @@ def _held_out_choice(result, main: str, inconsistent: bool) -> tuple[str, str]:
         return main, ""  # another estimator listed first keeps its place, as with validation logs
     else:
         text = f"main estimate: {SDP_LABEL}, physically consistent, where {ls} is not; it is what dynid export writes"
-    return SDP_LABEL, text + _held_out_words(held, result.diagnostics.get("held_out_block_seconds"), SDP_LABEL)
+    return SDP_LABEL, text + _held_out_words(held, result.diagnostics.get("held_out_block_seconds"), SDP_LABEL,
+                                             joints_unit("N·m", result.fit.prismatic))
 
 
-def _held_out_words(held: dict, seconds: float | None, main: str) -> str:
+def _held_out_words(held: dict, seconds: float | None, main: str, unit: str) -> str:
     """The held-out blocks' figures of every candidate, best first, as :func:`_held_out_choice`'s finding says them."""
     ranked = sorted(held.items(), key=lambda kv: kv[1])
     names = {NOMINAL_LABEL: "the description's values"}
@@ -245,7 +247,7 @@ def _held_out_words(held: dict, seconds: float | None, main: str) -> str:
            + (f"{main} predicted them as well as any, to {100 * (SAME_FIGURE - 1):g} %: " if best == main else
               f"{names.get(best, best)} predicted them best: ")
            + ", ".join(f"{names.get(k, k)} {v}" for (k, _), v in zip(ranked, _distinct_figures([v for _, v in ranked])))
-           + " N·m RMS")
+           + f" {unit} RMS")
     if best != main:
         out += (f"; {main} is kept: blocks of one excitation do not tell which model predicts other motions (on 36 "
                 "real windows, choosing on them handed on a worse model more often than a better one); a validation "

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ..conventions import sliding_note
 from ..tables import Line, TextTable
 
 __all__ = ["coulomb_choice_table", "drive_gains_blocks", "filter_choice_table", "friction_choice_table"]
@@ -17,13 +18,15 @@ def _number(x) -> str:
     return f"{x:.4g}" if x is not None and np.isfinite(x) else "—"
 
 
-def filter_choice_table(cv: dict) -> TextTable:
+def filter_choice_table(cv: dict, prismatic=()) -> TextTable:
     """``preprocessing.auto``: each candidate's cutoffs and out-of-fold errors on the common held-out samples.
 
     Parameters
     ----------
     cv : dict
         ``settings["preprocessing_cross_validation"]`` of an identification.
+    prismatic : sequence of bool
+        Which joints slide (their errors are forces, in N).
 
     Returns
     -------
@@ -33,17 +36,20 @@ def filter_choice_table(cv: dict) -> TextTable:
     rows = tuple((f"{c['position_cutoff']:.3g}{'*' if i == cv['chosen'] else ''}", f"{c['parallel_cutoff']:.3g}", str(c["decimation"]),
                   *(_number(x) for x in e), _number(s))
                  for i, (c, e, s) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"])))
-    return TextTable("Cutoffs by cross-validation: out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
+    return TextTable(f"Cutoffs by cross-validation: out-of-fold RMS torque error (N·m{sliding_note('N·m', prismatic, inside=True)}) on the same "
+                     "held-out samples; chosen: *",
                      ("positions Hz", "parallel Hz", "decimation", *(f"J{j + 1}" for j in range(n)), "score"), rows, labels=3)
 
 
-def friction_choice_table(choice: dict) -> TextTable:
+def friction_choice_table(choice: dict, prismatic=()) -> TextTable:
     """Each joint's friction model chosen by cross-validation, its out-of-fold error against the plain model's.
 
     Parameters
     ----------
     choice : dict
         ``settings["friction_models"]`` of an identification.
+    prismatic : sequence of bool
+        Which joints slide (their errors are forces, in N).
 
     Returns
     -------
@@ -54,17 +60,20 @@ def friction_choice_table(choice: dict) -> TextTable:
     rows = tuple((f"J{j + 1}", m["label"], f"{plain[j]:.3g}", f"{chosen[j]:.3g}",
                   "" if share is None else f"{100 * share[j]:.0f}") for j, m in enumerate(choice["models"]))
     return TextTable(f"Friction model of each joint, chosen by {choice['folds']}-fold blocked cross-validation "
-                     "(out-of-fold RMS torque error, N·m; the state at rest is judged where 5 % of the samples rest)",
+                     f"(out-of-fold RMS torque error, N·m{sliding_note('N·m', prismatic, inside=True)}; the state at rest is judged "
+                     "where 5 % of the samples rest)",
                      ("joint", "model", "plain", "chosen", "at rest %"), rows, labels=2)
 
 
-def coulomb_choice_table(cv: dict) -> TextTable:
+def coulomb_choice_table(cv: dict, prismatic=()) -> TextTable:
     """The candidates of the Coulomb smoothing velocity and their out-of-fold errors, per joint.
 
     Parameters
     ----------
     cv : dict
         ``settings["coulomb_cross_validation"]`` of an identification.
+    prismatic : sequence of bool
+        Which joints slide (their errors are forces, in N).
 
     Returns
     -------
@@ -72,7 +81,8 @@ def coulomb_choice_table(cv: dict) -> TextTable:
     """
     rows = tuple(("sign" if frac == 0 else f"{frac:g}", *(f"{e:.4g}{'*' if v == c else ''}" for e, v, c in zip(e_row, vs_row, cv["velocity"])))
                  for frac, vs_row, e_row in zip(cv["grid_fraction_of_rms_speed"], cv["candidates"], cv["out_of_fold_rms_error"]))
-    return TextTable(f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m), {cv['folds']} contiguous folds; chosen: *",
+    return TextTable(f"Coulomb term tanh(q̇/v_s): out-of-fold RMS torque error (N·m{sliding_note('N·m', prismatic, inside=True)}), "
+                     f"{cv['folds']} contiguous folds; chosen: *",
                      ("v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cv["velocity"])))), rows)
 
 

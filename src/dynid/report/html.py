@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
+from ..conventions import sliding_note
 from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
 from .excitation_summary import no_floor_line, set_point_lines
@@ -92,11 +93,12 @@ def _comparison_tables(comparisons: list[dict]) -> list[Table]:
         flagged: set = set()
         ok = c.get("relative_error_meaningful") or [True] * n
         varies = c.get("correlation_meaningful") or [True] * n
+        sliding = sliding_note("N·m", [j in c.get("prismatic_joints", ()) for j in range(n)])
         for label, m in sets.items():
             flagged |= {(len(rows), 2 + j) for j, x in enumerate(m["relative_error"]) if x is not None and ok[j] and x >= BAD_ERROR}
             rows.append([label, "error %", *(_fmt(x, ".3g") if ok[j] else "n/m" for j, x in enumerate(m["relative_error"])),
                          _fmt(m.get("global_relative_error"), ".3g")])
-            rows.append(["", "RMSE N·m", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
+            rows.append(["", f"RMSE N·m{sliding}", *(_fmt(x, ".3g") for x in m["rmse"]), ""])
             rows.append(["", "correlation ρ (eq. 18)", *(_fmt(x, ".4f") if varies[j] and x is not None else "n/m" for j, x in enumerate(m["correlation"])), ""])
         tables.append(Table(f"{c['name']}: {c['n_samples']} samples (error of {BAD_ERROR:g} % and more highlighted; n/m: the "
                             "joint's torque is at the noise level, or does not vary beyond it: its relative error or correlation "
@@ -195,19 +197,22 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
                                                       ["joint", "K (N·m/A)", "σ", "description"], rows)],
                                 [f"{k} not determined: {why}" for k, why in g.get("not_observable", {}).items()]
                                 + ([f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else [])))
+    fit = d.get("identification") or {}
+    sliding = sliding_note("N·m", [j in fit.get("prismatic_joints", ()) for j in range(len(fit.get("rms_torque", ())))],
+                           inside=True)
     cv = d.get("settings", {}).get("preprocessing_cross_validation")
     if cv:
         rows = [[_fmt(c["position_cutoff"], ".3g") + ("*" if i == cv["chosen"] else ""), _fmt(c["parallel_cutoff"], ".3g"),
                  _fmt(c["decimation"]), *(_fmt(x) for x in e), _fmt(sc)]
                 for i, (c, e, sc) in enumerate(zip(cv["candidates"], cv["out_of_fold_rms_error"], cv["score"]))]
         sections.append(Section("preprocessing = \"auto\"", [Table(
-            "out-of-fold RMS torque error (N·m) on the same held-out samples; chosen: *",
+            f"out-of-fold RMS torque error (N·m{sliding}) on the same held-out samples; chosen: *",
             ["positions (Hz)", "parallel (Hz)", "decimation", *(f"J{j + 1}" for j in range(len(cv["out_of_fold_rms_error"][0]))), "score"], rows)]))
     cc = d.get("settings", {}).get("coulomb_cross_validation")
     if cc:
         rows = [["sign" if f == 0 else _fmt(f), *(_fmt(e) + ("*" if v == c else "") for e, v, c in zip(er, vr, cc["velocity"]))]
                 for f, vr, er in zip(cc["grid_fraction_of_rms_speed"], cc["candidates"], cc["out_of_fold_rms_error"])]
-        sections.append(Section("Coulomb smoothing", [Table("tanh(q̇/v_s): out-of-fold RMS torque error (N·m); chosen: *",
+        sections.append(Section("Coulomb smoothing", [Table(f"tanh(q̇/v_s): out-of-fold RMS torque error (N·m{sliding}); chosen: *",
                                                             ["v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cc["velocity"])))], rows)]))
     comparisons = ([d["identification"]] if "identification" in d else []) + list(d.get("validation", []))
     if comparisons:

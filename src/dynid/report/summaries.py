@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data
-from ..conventions import INERTIAL_TERMS, split_name
+from ..conventions import INERTIAL_TERMS, joints_unit, sliding_note, split_name
 from ..estimators.registry import OTHER_LABELS, label
 from ..exceptions import NotFittedError
 from ..friction import COUNTERBALANCE_TERMS, TERMS
@@ -145,7 +145,8 @@ def comparison_table(cmp: TorqueComparison) -> TextTable:
         ends.add(len(rows) - 1)
     rest = "" if not np.any(share > 0) else ("; at rest " + ", ".join(f"{100 * x:.0f}" for x in share) + " % of the "
                                              "samples, scored as the distance to the static-friction band ±f_s")
-    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms) + f" N·m{rest}",
+    return TextTable(f"{cmp.name}: {cmp.n_samples} samples; RMS torque " + ", ".join(f"{x:.3g}" for x in rms)
+                     + f" N·m{sliding_note('N·m', cmp.prismatic)}{rest}",
                      ("parameters", *(f"J{j + 1}" for j in range(n)), "all"), tuple(rows), section_ends=frozenset(ends))
 
 
@@ -247,7 +248,8 @@ def identification_blocks(result, *, library: bool = False) -> list:
             a = r.reference_agreement(ref)
             out.append(Line(f"{ref.name}: dynid's values lie within 1σ / 2σ / 3σ of its stated standard deviations for "
                             f"{a['within_1_sigma']} / {a['within_2_sigma']} / {a['within_3_sigma']} of {a['compared']} base parameters"))
-    out.append(Line("residual σ per joint (N·m): " + ", ".join(f"{x:.3g}" for x in r.joint_std)))
+    out.append(Line(f"residual σ per joint (N·m{sliding_note('N·m', r.fit.prismatic, inside=True)}): "
+                    + ", ".join(f"{x:.3g}" for x in r.joint_std)))
     for name, e in r.estimates.items():
         if e.pseudo_inertia_min_eig is not None:
             out.append(Line(f"{name}: physically consistent least squares, prior: the robot model's nominal parameters; smallest "
@@ -282,11 +284,11 @@ def _preparation_blocks(r) -> list:
     if pre.get("derivation"):
         out.append(Line("preprocessing: " + pre["derivation"]))
     if r.settings.get("preprocessing_cross_validation") is not None:
-        out.append(filter_choice_table(r.settings["preprocessing_cross_validation"]))
+        out.append(filter_choice_table(r.settings["preprocessing_cross_validation"], r.fit.prismatic))
     if r.settings.get("coulomb_cross_validation") is not None:
-        out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"]))
+        out.append(coulomb_choice_table(r.settings["coulomb_cross_validation"], r.fit.prismatic))
     if r.settings.get("friction_models") is not None:
-        out.append(friction_choice_table(r.settings["friction_models"]))
+        out.append(friction_choice_table(r.settings["friction_models"], r.fit.prismatic))
     return out
 
 
@@ -348,9 +350,10 @@ def _held_out_clause(r, label: str) -> str:
     seconds = r.diagnostics.get("held_out_block_seconds")
     blocks = f"{HELD_OUT_FOLDS} × {seconds:.3g} s" if seconds else f"{HELD_OUT_FOLDS} blocks"
     best = held_out_best(held, label)
-    said = (f"it predicts them as well as any candidate ({held[label]:.3g} N·m RMS)" if best == label else
+    unit = joints_unit("N·m", r.fit.prismatic)
+    said = (f"it predicts them as well as any candidate ({held[label]:.3g} {unit} RMS)" if best == label else
             f"{'the description' if best == NOMINAL_LABEL else best} predicts them better ({held[best]:.3g} against "
-            f"{held[label]:.3g} N·m RMS)")
+            f"{held[label]:.3g} {unit} RMS)")
     return f"; on held-out blocks of this log ({blocks}, weaker evidence than another motion) {said}"
 
 

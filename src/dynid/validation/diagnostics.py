@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._util.grams import joint_gram
+from ..conventions import joint_unit
 from .noise_floor import AT_FLOOR
 
 __all__ = ["DELAY_ADVICE", "Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
@@ -152,7 +153,8 @@ class ResidualSums:
         self._last = z[-1].copy()
         self.count += m
 
-    def residual_checks(self, beta: np.ndarray, rms_torque: np.ndarray, fc: np.ndarray | None = None) -> tuple[list, dict]:
+    def residual_checks(self, beta: np.ndarray, rms_torque: np.ndarray, fc: np.ndarray | None = None, *,
+                        prismatic=()) -> tuple[list, dict]:
         """The findings on the residual ``τ - yβ``, and the statistics behind them.
 
         Parameters
@@ -163,6 +165,8 @@ class ResidualSums:
             RMS torque of each joint (the scale a finding is judged against).
         fc : (n_dof,) array [N·m], optional
             Coulomb friction of each joint (the scale of the friction features).
+        prismatic : sequence of bool
+            Which joints slide: their findings say forces [N] and positions.
 
         Returns
         -------
@@ -210,15 +214,16 @@ class ResidualSums:
             t_pos = float(np.sqrt(np.sum(t[1:5] ** 2) / 4))
             stats["position_amplitude"].append(amp)
             stats["position_t"].append(t_pos)
-            scale = rms_torque[j]
+            scale, unit = rms_torque[j], joint_unit("N·m", prismatic, j)
             friction_size = abs(coef[0]) >= 0.05 * scale or (fc is not None and abs(coef[0]) >= 0.2 * abs(fc[j]))
             if abs(t[0]) >= SIGNIFICANT and friction_size and abs(coef[0]) > 0:
                 findings.append(Finding("friction", f"J{j + 1}: the residual follows the direction of motion at low speed "
-                                        f"({coef[0]:+.3g} N·m, t = {t[0]:.1f}): the friction model misfits near reversals",
+                                        f"({coef[0]:+.3g} {unit}, t = {t[0]:.1f}): the friction model misfits near reversals",
                                         j))
             if t_pos >= SIGNIFICANT and amp >= POSITION_SHARE * scale:
-                findings.append(Finding("position", f"J{j + 1}: the residual depends on the joint's angle (±{amp:.3g} N·m "
-                                        f"over its angles, {100 * amp / scale:.2g} % of its RMS torque, "
+                where = "position" if unit != "N·m" else "angle"
+                findings.append(Finding("position", f"J{j + 1}: the residual depends on the joint's {where} (±{amp:.3g} "
+                                        f"{unit} over its {where}s, {100 * amp / scale:.2g} % of its RMS torque, "
                                         f"t = {t_pos:.1f}): a counterbalance, a cable, a wrong mass or gravity? "
                                         "(counterbalance = true in the description models one)", j))
         return findings, stats

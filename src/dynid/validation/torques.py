@@ -14,6 +14,7 @@ import numpy as np
 from .._util.column_store import root_mean_square
 from .._util.grams import joint_gram
 from .._util.reprs import short_repr
+from ..conventions import joint_unit, sliding_note
 from ..dynamics.base_parameters import BaseParameters
 from ..model.friction_model import COULOMB_LIKE
 from ..model.robot import Robot
@@ -105,6 +106,9 @@ class TorqueComparison:
     """Where the log is read otherwise than the identification log (its torque channels flipped or swapped:
     :mod:`dynid.validation.channel_checks`; its geometry not the robot file's: :mod:`dynid.validation.geometry_checks`),
     the warning that says how: its figures say little of any estimate, and the verdict does not weigh them."""
+    prismatic: tuple[bool, ...] = ()
+    """Which joints slide (:attr:`dynid.model.robot.Robot.prismatic`): their torques are forces [N], their speeds
+    [m/s], as the lines and tables say; empty: none."""
     _computed: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     """label -> the metrics :meth:`metrics` computed for that set (the evidence and the verdict read them many times)."""
 
@@ -256,7 +260,8 @@ class TorqueComparison:
         if still and share is not None and band is not None:
             which = "every joint" if len(still) == len(share) else ", ".join(f"J{j + 1}" for j in still)
             out.append(f"{self.name}: {which} at rest in 95 % of the log or more: the error there is the distance to the "
-                       "static-friction band (±f_s, " + ", ".join(f"{float(band[j]):.3g}" for j in still) + " N·m), "
+                       "static-friction band (±f_s, " + ", ".join(f"{float(band[j]):.3g}" for j in still) + " N·m"
+                       f"{sliding_note('N·m', [j in still and p for j, p in enumerate(self.prismatic)], inside=True)}), "
                        "which says whether a model is consistent with the torque that holds the arm, not how it "
                        "predicts motion")
         for j in np.flatnonzero(~self.meaningful()):
@@ -264,13 +269,15 @@ class TorqueComparison:
                 out.append(f"{self.name}: J{j + 1}'s torque is constant, or at its limit, over the log (a dead or "
                            "saturated channel): left out of the metrics")
                 continue
-            moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} rad/s) and " if
+            torque = joint_unit("N·m", self.prismatic, j)
+            moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} "
+                                                   f"{joint_unit('rad/s', self.prismatic, j)}) and " if
                                                    self.speed[j] < 0.05 else "")
-            rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} N·m"
+            rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} {torque}"
             residual = self.noise is not None and self.rms_torque[j] < MEANINGFUL * np.asarray(self.noise)[j]
             level, what = ((np.asarray(self.noise)[j], "the identification residual") if residual
                            else (np.asarray(self.floor, dtype=float)[j], "the noise floor of these samples"))
-            out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} N·m, "
+            out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} {torque}, "
                        f"{self.rms_torque[j] / level:.2g}× {what}): relative error not meaningful{rmse_j}")
         return out
 
@@ -334,6 +341,8 @@ class TorqueComparison:
             out["noise_floor"] = floor
         if self.misread:
             out["misread"] = self.misread
+        if any(self.prismatic):
+            out["prismatic_joints"] = [j for j, p in enumerate(self.prismatic) if p]  # 0-based: forces in N, speeds in m/s
         return out
 
 
@@ -710,4 +719,4 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
                             static=static, noise=noise,
                             speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()},
                             dead=data.dead, floor=noise_floor(data), centre={k: np.concatenate(v) for k, v in centres.items()},
-                            band=next(iter(static.values()), None))
+                            band=next(iter(static.values()), None), prismatic=tuple(robot.prismatic.tolist()))
