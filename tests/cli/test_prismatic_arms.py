@@ -60,6 +60,7 @@ def test_a_prismatic_arm_is_identified_from_init_to_its_written_files(tmp_path, 
     slide = np.flatnonzero(robot.prismatic).tolist()
     joints = ", ".join(f"J{k + 1}" for k in slide)
     assert results["identification"]["prismatic_joints"] == validation["prismatic_joints"] == slide
+    assert f" rad/s; {joints} in m/s), " in results["settings"]["preprocessing"]["derivation"]
     assert f"RMSE N·m ({joints} in N)" in (tmp_path / "dynid-identify" / "report.html").read_text()
     p = run("validate", "arm.toml", "-v", cwd=tmp_path)
     said = " ".join(p.stdout.split())

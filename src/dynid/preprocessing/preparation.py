@@ -22,6 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from .._util.column_store import StoredColumns, by_column, root_mean_square
+from ..conventions import sliding_note
 from ..dynamics.base_parameters import BaseParameters
 from ..dynamics.regressor import regressor
 from ..exceptions import ConfigError, DataError
@@ -280,7 +281,9 @@ def _rest_and_speed(recording, s: Preprocessing, dq, strict: bool) -> tuple[Prep
         rest = np.maximum(REST_FACTOR * _velocity_noise(recording, s), np.asarray(s.rest_floor, dtype=float))
         s = replace(s, rest_velocity=tuple(float(v) for v in rest),
                     derivation=s.derivation + f"; a joint rests below {REST_FACTOR:g}σ of its velocity's noise ("
-                    + ", ".join(f"{v:.2g}" for v in rest) + " rad/s), " + _rest_words(s.rest_friction))
+                    + ", ".join(f"{v:.2g}" for v in rest) + " rad/s"
+                    + sliding_note("rad/s", getattr(recording, "prismatic", ()), inside=True) + "), "
+                    + _rest_words(s.rest_friction))
     rest = np.broadcast_to(np.asarray(s.rest_velocity, dtype=float), (recording.q.shape[1],))
     if s.min_speed == "auto":  # before the accelerations exist: its temporary square adds to a smaller peak
         vmin = np.maximum(MIN_SPEED_FRACTION * root_mean_square(dq), 2 * rest)

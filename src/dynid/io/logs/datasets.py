@@ -64,6 +64,8 @@ class Recording:
     drive_gains : (n_dof,) array or None
         The drive gains ``tau`` was read through [N·m/A] (motor currents times these, eq. 16); None where it was
         logged or given as torques.
+    prismatic : tuple of bool
+        Which joints slide (positions [m], forces [N]), as the robot it was read for says; empty: none or not known.
     """
 
     name: str
@@ -75,6 +77,7 @@ class Recording:
     warnings: tuple[str, ...] = field(default=())
     source: str = ""
     drive_gains: np.ndarray | None = None
+    prismatic: tuple[bool, ...] = ()
 
     @property
     def n_samples(self) -> int:
@@ -285,7 +288,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
                   tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
-                     robot.drive_gains.copy() if kind == "currents" else None)
+                     robot.drive_gains.copy() if kind == "currents" else None, tuple(robot.prismatic.tolist()))
 
 
 def _cleaned(spec: DatasetSpec, t: np.ndarray, raw: dict, joint_side: bool, warnings: list[str]) -> dict:
@@ -448,4 +451,4 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
                      f"onto a uniform grid at {rate:.6g} Hz",)
     else:
         rate = 1.0 / median
-    return Recording(name, t - t[0], q, dq, tau, rate, warnings)
+    return Recording(name, t - t[0], q, dq, tau, rate, warnings, prismatic=tuple(robot.prismatic.tolist()))
