@@ -124,7 +124,7 @@ def canonical_name(name: str) -> str:
 
 
 LINEAR_UNITS: dict[str, str] = {"kg·m²": "kg", "N·m": "N", "N·m·s/rad": "N·s/m", "rad": "m", "rad/s": "m/s",
-                                 "rad/s²": "m/s²"}
+                                 "rad/s²": "m/s²", "N·m/A": "N/A"}
 """A quantity's unit on a prismatic joint, where its revolute unit differs: the rotor inertia reflected as a mass,
 forces for torques, per metre for per radian, positions and their derivatives in metres."""
 

@@ -130,6 +130,11 @@ def test_payload_parameters_the_loaded_run_does_not_determine_are_said_so():
                     if hasattr(line, "text"))
     assert "payload parameters not determined by the loaded run (σ ≥ 100 % of the value): XX, MY" in text
     assert "(0.0107, not determined, 0.0607) m" in text
+    # a sliding joint's gain is a force per ampere; a joint not determined says the description's in its unit
+    gains = DriveGainEstimate(np.array([10.0, np.nan, 10, 10, 10, 10]), np.full(6, 0.1), np.zeros(3), 2.805, 1000, 10.0)
+    blocks = drive_gains_blocks(GainsAndPayload(gains, payload, (10.0,) * 6), (False, True, False, False, False, False))
+    assert "K (N·m/A; J2 in N/A)" in blocks[0].render()
+    assert any("the description's 10 N/A is used" in b.text for b in blocks if hasattr(b, "text"))
 
 
 def test_the_currents_noise_is_taken_out_of_the_gains():

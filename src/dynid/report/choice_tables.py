@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..conventions import sliding_note
+from ..conventions import joint_unit, sliding_note
 from ..tables import Line, TextTable
 
 __all__ = ["coulomb_choice_table", "drive_gains_blocks", "filter_choice_table", "friction_choice_table"]
@@ -86,12 +86,14 @@ def coulomb_choice_table(cv: dict, prismatic=()) -> TextTable:
                      ("v_s / RMS speed", *(f"J{j + 1}" for j in range(len(cv["velocity"])))), rows)
 
 
-def drive_gains_blocks(gains) -> list:
+def drive_gains_blocks(gains, prismatic=()) -> list:
     """The drive gains beside the description's, and the payload (``[drive_gains]`` of an identification).
 
     Parameters
     ----------
     gains : dynid.identification.drive_gains.GainsAndPayload
+    prismatic : sequence of bool
+        Which joints slide (their gains are forces per ampere, N/A).
 
     Returns
     -------
@@ -104,8 +106,10 @@ def drive_gains_blocks(gains) -> list:
                     else (f"J{j + 1}", "not determined", "", f"{d:.4g}", ""))
     table = TextTable(f"Drive gains K (eq. 16) from the runs without and with the {g.payload_mass:g} kg payload "
                       f"(Gautier & Briot; {g.n_rows} equations)",
-                      ("joint", "K (N·m/A)", "σ", "description", "diff. %"), tuple(rows))
-    why = [Line(f"K{j + 1} not determined: {g.why_not_observable(j)}; the description's {d:.4g} N·m/A is used",
+                      ("joint", f"K (N·m/A{sliding_note('N·m/A', prismatic, inside=True)})", "σ", "description", "diff. %"),
+                      tuple(rows))
+    why = [Line(f"K{j + 1} not determined: {g.why_not_observable(j)}; the description's {d:.4g} "
+                f"{joint_unit('N·m/A', prismatic, j)} is used",
                 "warning") for j, d in enumerate(gains.description_gains) if not math.isfinite(g.gains[j])]
     vals = dict(zip(p.names, zip(p.values, p.std)))
     line = f"payload, from the loaded run with these gains: mass {p.mass:.4g} kg (σ {vals['M'][1]:.2g}; given {g.payload_mass:g} kg)"

@@ -267,7 +267,7 @@ def identification_blocks(result, *, library: bool = False) -> list:
             out.append(Line(f"LAD, ABC, DE and PSO search the box {r.label} ± ({BOX_SIGMAS:g}·σ + {BOX_FRACTION:g}·|value|); "
                             "ABC at the paper's budget (Ns = 30, limit = 15, Tmax = 50), ABC×10, DE and PSO at 10× its evaluations"))
     if r.drive_gains is not None:
-        out.extend(drive_gains_blocks(r.drive_gains))
+        out.extend(drive_gains_blocks(r.drive_gains, r.fit.prismatic))
     for c in (r.fit, *r.validations):
         out.append(comparison_table(c))
         out.extend(Line(f) for f in c.flags())
@@ -519,7 +519,7 @@ def identification_brief(result) -> list:
     r = result
     short = in_short(r, brief=True)
     short[0] = Line("In short (every table and finding: --verbose, and report.html)", "title")
-    drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains) if isinstance(b, Line)]
+    drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains, r.fit.prismatic) if isinstance(b, Line)]
     return [readiness(r), _identification_title(r), *short, *drive, *_verdict(r, brief=True),
             *(Line(w, "warning") for w in r.warnings)]
 
