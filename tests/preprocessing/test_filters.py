@@ -105,6 +105,12 @@ def test_a_fractional_shift_read_at_some_samples_equals_the_whole_shift_there():
     inside = at[(at > 40) & (at < 1950)]
     truth = np.column_stack([np.sin(2 * np.pi * 0.01 * (inside + 2.3)), np.cos(2 * np.pi * 0.02 * (inside + 2.3))])
     np.testing.assert_allclose(shift.read(2.3, at=inside), truth, atol=1e-3)
+    # the mirrored ends made once for the largest shift so far: a read after a farther one, and a farther one than the
+    # first, equal a fresh object's (the ends' mirror image, 60 samples out, as np.pad gives it for that shift alone)
+    for d in (57.4, 0.7, -60.0, 3.0):
+        np.testing.assert_array_equal(shift.read(d), FractionalShift(x).read(d))
+    pad = np.pad(x, [(80, 80), (0, 0)], mode="symmetric")
+    np.testing.assert_array_equal(shift.read(-60.0), pad[20:20 + x.shape[0]])
 
 
 def test_parallel_decimation_gives_the_same_numbers_on_any_number_of_cores(rng, monkeypatch):

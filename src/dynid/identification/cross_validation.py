@@ -315,10 +315,10 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
                 stack.enter_context(call)
         calls = iter(beside)
         for k, s in enumerate(settings):
-            call = None if k == 0 and same else next(calls)
             if k == 0 and same:
                 data, error = reference, _out_of_fold_error(robot, evaluation, evaluation, prior, folds)
             else:
+                call = next(calls)
                 data, error = (_candidate(robot, base, recording, s, evaluation, prior, duration, folds) if call is None
                                else call.result())
             candidates.append(data.settings)

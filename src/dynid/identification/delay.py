@@ -110,6 +110,11 @@ def estimate_delay(robot: Robot, recording: Recording, base: BaseParameters | No
     return delay_from_rows(data, base_chunks(robot, base, data), max_samples)
 
 
+SCAN_BLOCK = 16
+"""Delays of the coarse scan whose torques :func:`delay_from_rows` projects at once: one pass over the orthogonal
+factor for all of them, and the kept rows' copies bounded to this many."""
+
+
 def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> DelayEstimate:
     """:func:`estimate_delay` on a log prepared already (by the default strategy, ``"parallel"``), from its blocks of
     base rows: the identification's own pass gives them, so the check needs no second pass.
@@ -166,7 +171,11 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
 
     bound = float(max_samples)
     grid = np.linspace(-bound, bound, int(4 * bound) + 1)  # a coarse scan first: RSS need not be convex far away
-    values = [rss(d) for d in grid]
+    values = np.empty(grid.size)
+    for k in range(0, grid.size, SCAN_BLOCK):  # a block of the scan's reads projected in one product (one pass over Q)
+        scan = np.column_stack([shift.read(d, at=rows_index).reshape(-1)[keep] for d in grid[k:k + SCAN_BLOCK]])
+        projected = q_factor.T @ scan
+        values[k:k + SCAN_BLOCK] = np.einsum("ij,ij->j", scan, scan) - np.einsum("ij,ij->j", projected, projected)
     k = int(np.argmin(values))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     best = minimize_scalar(rss, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})

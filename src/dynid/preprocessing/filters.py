@@ -205,6 +205,14 @@ class FractionalShift:
         self.x = np.asarray(x, dtype=float)
         self.n = self.x.shape[0]
         self.taps = int(taps)
+        self._pad, self._mirrored = -1, self.x  # the mirrored signal, made for the largest shift read so far
+
+    def _mirrored_by(self, pad: int) -> tuple[int, np.ndarray]:
+        """The signal with at least ``pad`` mirrored samples at each end, and how many it has."""
+        if pad > self._pad:
+            self._pad = max(pad, 2 * self._pad)
+            self._mirrored = np.pad(self.x, [(self._pad, self._pad)] + [(0, 0)] * (self.x.ndim - 1), mode="symmetric")
+        return self._pad, self._mirrored
 
     def read(self, samples: float, at: np.ndarray | None = None) -> np.ndarray:
         """The signal ``samples`` later: ``y[k] = x(k + samples)``.
@@ -229,8 +237,7 @@ class FractionalShift:
             offsets = np.arange(-self.taps + 1, self.taps + 1)
             weights = np.sinc(offsets - frac) * np.sinc((offsets - frac) / self.taps)
             weights /= weights.sum()
-        pad = abs(whole) + self.taps + 1
-        mirrored = np.pad(self.x, [(pad, pad)] + [(0, 0)] * (self.x.ndim - 1), mode="symmetric")
+        pad, mirrored = self._mirrored_by(abs(whole) + self.taps + 1)
         out = np.zeros_like(self.x if at is None else self.x[at])
         for offset, weight in zip(offsets, weights):
             start = pad + whole + int(offset)
