@@ -572,7 +572,9 @@ def test_run_options_are_checked_before_the_run_starts(tmp_path, case):
 URDFS_ROUND3 = {
     "a link without inertial": ({'<link name="l2"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>':
                                  '<link name="l2"/>'}, "r.urdf: link 2 (j2) has a nominal mass of 0 kg (a URDF link without <inertial>?)"),
-    "a mimic joint": ({'<axis xyz="0 1 0"/>': '<axis xyz="0 1 0"/><mimic joint="j1" multiplier="1"/>'}, "r.urdf: line 7: joint 'j2' mimics joint 'j1' (<mimic>)"),
+    "a mimic joint of multiplier 0": ({'<axis xyz="0 1 0"/>': '<axis xyz="0 1 0"/><mimic joint="j1" multiplier="0"/>'},
+                                      "r.urdf: line 7: joint 'j2' has <mimic joint=\"j1\" multiplier=\"0\">: expected the joint "
+                                      "it follows (joint=), a finite non-zero multiplier and a finite offset"),
 }
 
 

@@ -63,13 +63,12 @@ def test_a_log_that_names_the_fingers_too_still_has_them_held(tmp_path):
 
 def test_held_fingers_are_merged_as_fixed_ones_are(tmp_path):
     """The arm with its two prismatic fingers (one mimicking the other) held at 0 has the joints and inertial parameters
-    of the same file with the fingers written as fixed joints (Pinocchio merging them either way); without held it is
-    refused naming the setting."""
+    of the same file with the fingers written as fixed joints (Pinocchio merging them either way); without held the
+    fingers are joints, the second following the first (a coupled gripper: tests/dynamics/test_mimic_joints.py)."""
     gripper = _urdf(tmp_path, ARM + FINGERS)
     fixed = _urdf(tmp_path, ARM + FINGERS.replace('type="prismatic"', 'type="fixed"'), "fixed.urdf")
-    with pytest.raises(ConfigError, match=r"joint 'f2' mimics joint 'f1' \(<mimic>\): dynid identifies independent "
-                                          r"joints; hold it fixed with held = \[\"f1\", \"f2\"\]"):
-        joints_from_urdf(gripper)
+    joints = joints_from_urdf(gripper)[0]
+    assert [j.name for j in joints] == ["j1", "j2", "f1", "f2"] and joints[3].mimic == (2, -1.0, 0.0)
     held = joints_from_urdf(gripper, {"f1": 0.0, "f2": 0.0})
     plain = joints_from_urdf(fixed)
     assert held[2] == plain[2] == ("j1", "j2")

@@ -898,8 +898,9 @@ def init(
                 raise DynIdError(f"{v}: no such validation log")
         from ..identification.starter_check import checked_against_description
 
-        text, notes = starter_config(urdf, log, robot.n_dof, out, tuple(validation or ()),
-                                     tuple(j.name for j in robot.joints), robot.held, robot=robot, rate=rate, xacro_args=args)
+        text, notes = starter_config(urdf, log, int(robot.independent.sum()), out, tuple(validation or ()),
+                                     tuple(j.name for j in robot.joints if j.mimic is None), robot.held, robot=robot,
+                                     rate=rate, xacro_args=args)
         text, found = checked_against_description(text, out)
         return text, notes + found
 

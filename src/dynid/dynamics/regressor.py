@@ -77,7 +77,9 @@ def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities
     -------
     Y : (N, n_dof, n_params) array, or (N, n_dof, m) with ``columns``
         ``Y[k] @ phi`` is the joint torque vector [N·m] of sample ``k``; columns follow
-        ``robot.parameter_names``.
+        ``robot.parameter_names``. A joint that follows another (:attr:`dynid.model.robot.Joint.mimic`) moves as that
+        joint says, whatever its columns of ``q, dq, ddq`` hold, and its row is folded into that joint's
+        (:meth:`dynid.model.robot.Robot.fold`): the rows of the robot's coordinates, its own row zero.
 
     Raises
     ------
@@ -95,8 +97,9 @@ def regressor(robot: Robot | str | Path, q, dq, ddq, *, columns=None, velocities
     elif out.shape != (n_s, n, columns.size) or out.dtype != np.float64 or not out.flags.c_contiguous:
         raise ShapeError(f"out: expected a C-contiguous float64 array of shape {(n_s, n, columns.size)}, "
                          f"got {out.dtype} {out.shape}")
+    q, dq, ddq = robot.coupled(q, dq, ddq)
     _fill(robot, q, dq, ddq, out, colmap, velocities=velocities)
-    return out
+    return robot.fold(out)
 
 
 def observation_matrix(robot: Robot, q, dq, ddq) -> np.ndarray:

@@ -74,14 +74,17 @@ def rnea_torques(robot: Robot | str | Path, q, dq, ddq, *, inertial: np.ndarray 
     Returns
     -------
     (N, n_dof) ndarray [N·m] ([N] for a prismatic joint)
+        A joint that follows another (:attr:`dynid.model.robot.Joint.mimic`) moves as that joint says, whatever its
+        columns hold, and its torque is in the row of the joint it follows (:meth:`dynid.model.robot.Robot.fold`; 0 in
+        its own).
     """
     robot = as_robot(robot)
     import pinocchio as pin
 
     model = pinocchio_model(robot, inertial)
     data = model.createData()
-    q, dq, ddq = (np.ascontiguousarray(x, dtype=float) for x in (q, dq, ddq))
+    q, dq, ddq = (np.ascontiguousarray(x, dtype=float) for x in robot.coupled(q, dq, ddq))
     tau = np.empty_like(q)
     for k in range(q.shape[0]):
         tau[k] = pin.rnea(model, data, q[k], dq[k], ddq[k])
-    return tau + friction_torques(robot, dq, ddq, drive, q=q)
+    return robot.fold(tau + friction_torques(robot, dq, ddq, drive, q=q))

@@ -665,14 +665,43 @@ def _rest_equalities(lay: _Layout) -> np.ndarray:
     return e
 
 
+def _coupling_equalities(problem, lay: _Layout) -> tuple[np.ndarray, np.ndarray] | None:
+    """Rows ``E`` and values ``e`` with ``E x = e`` for each joint that follows another (``<mimic>``,
+    :attr:`dynid.model.robot.Joint.mimic`): its harmonics ``multiplier`` times that joint's, and its offset (where the
+    design chooses the offsets) ``multiplier · q_o,k + offset``, so that the trajectory keeps the coupling at every
+    instant and every limit and shape is checked on the motion the joint makes. None without such joints."""
+    robot, n, h = problem.robot, lay.n, lay.h
+    rows, values = [], []
+    for j in robot.followers:
+        k, multiplier, offset = robot.joints[j].mimic
+        blocks = [(lay.n_off + part * n * h + j * h, lay.n_off + part * n * h + k * h) for part in (0, 1)]
+        for mine, theirs in blocks:
+            for m in range(h):
+                row = np.zeros(lay.nx)
+                row[mine + m], row[theirs + m] = 1.0, -multiplier
+                rows.append(row)
+                values.append(0.0)
+        if lay.free_offsets:
+            row = np.zeros(lay.nx)
+            row[j], row[k] = 1.0, -multiplier
+            rows.append(row)
+            values.append(offset)
+    return (np.array(rows), np.array(values)) if rows else None
+
+
 def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
-    """Random amplitudes decaying as 1/k, projected on the rest equalities, scaled into the limits."""
+    """Random amplitudes decaying as 1/k, projected on the rest and coupling equalities, scaled into the limits."""
     n, h = lay.n, lay.h
     k = np.arange(1, h + 1)
     amp = np.concatenate([(rng.standard_normal((n, h)) / k).ravel(), (rng.standard_normal((n, h)) / k).ravel()])
     x0 = np.zeros(lay.nx)
     if lay.free_offsets:
         x0[:n] = problem.start_pose()
+    coupling = _coupling_equalities(problem, lay)
+    if coupling is not None:  # the start pose and the amplitudes on the coupling (E x0 = e, E d = 0)
+        e_rows, e_values = coupling
+        x0 -= np.linalg.pinv(e_rows) @ (e_rows @ x0 - e_values)
+        eq = e_rows if eq is None else np.vstack([eq, e_rows])
     d = np.concatenate([np.zeros(lay.n_off), amp])
     if eq is not None:
         d -= np.linalg.pinv(eq) @ (eq @ d)
@@ -743,8 +772,11 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     if n_starts < 1:
         raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
     rng = np.random.default_rng(rng)
+    if problem.robot.followers and problem.offsets is not None:  # a <mimic> joint's offset follows its joint's
+        problem = replace(problem, offsets=problem.robot.coupled(np.asarray(problem.offsets, dtype=float)[None])[0][0])
     lay = _Layout(problem, problem.design_grid())
     eq = _rest_equalities(lay) if problem.rest else None
+    coupling = _coupling_equalities(problem, lay)
     solvers = {}
 
 
@@ -758,6 +790,8 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
                     {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
             if eq is not None:
                 cons.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
+            if coupling is not None:
+                cons.append({"type": "eq", "fun": lambda x: coupling[0] @ x - coupling[1], "jac": lambda x: coupling[0]})
             solvers[safety] = (objective, a_lin, c_lin, cons)
         return solvers[safety]
 

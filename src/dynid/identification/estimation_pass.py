@@ -234,12 +234,13 @@ def _log_evidence(robot: Robot, base: BaseParameters, data: PreparedData, scorin
         progress("consistency checks", 0, 1)
     margins, verdicts = consistency_checks(robot, base, sets)
     sliding = tuple(robot.prismatic.tolist())
-    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq), prismatic=sliding)
+    fit = replace(sums.comparison(data.name, sets), noise=joint_std, speed=root_mean_square(data.dq), prismatic=sliding,
+                  followers=robot.followers)
     found = None if scoring.nominal is None else drive_only(robot, base, reference.accumulator_, joint_weights=row_weights,
                                                             variants=variants, one_way=one_way_joints(data))
     alternative = None if found is None else replace(found, fit=replace(
         sums.comparison(data.name, {**sets, DRIVE_ONLY_LABEL: found.params}), noise=joint_std, speed=fit.speed,
-        prismatic=sliding))
+        prismatic=sliding, followers=robot.followers))
     findings, stats = _verdict(robot, base, reference.solution_, reference.ols_params_, row_weights, scoring=scoring,
                                fit=fit, rng=rng, consistent=SDP_LABEL in estimates)
     if scoring.nominal is not None:  # a swapped pair fits badly, so "varies beyond the fit's residual" cannot judge it
@@ -446,7 +447,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     stats["sigma_torque_percent"] = {n: (float(x) if np.isfinite(x) else None) for n, x in zip(base.names, share)}
     if sol.from_prior:
         stats["from_prior"] = [base.names[i] for i in sol.from_prior]
-        findings += prior_findings(base.names, sol.from_prior, one_way_joints(data), data.name, dead=data.dead, still=data.still,
+        findings += prior_findings(base.names, sol.from_prior, one_way_joints(data), data.name, dead=data.dead_said, still=data.still,
                                    anchored=sol.anchored)
     if sol.anchored:
         stats["coulomb_from_one_term"] = [base.names[i] for i in sol.anchored]

@@ -149,6 +149,9 @@ def urdf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
                   '    <limit lower="{:.17g}" upper="{:.17g}" effort="{:.17g}" velocity="{:.17g}"/>'.format(
                       *(_finite(x) for x in (robot.limits.q_min[j], robot.limits.q_max[j], robot.limits.tau_max[j], robot.limits.dq_max[j]))),
                   f'    <dynamics damping="{fv:.17g}" friction="{fc:.17g}"/>']
+        if joint.mimic is not None:  # it follows another joint, whose drive supplies its torque
+            k, multiplier, offset = joint.mimic
+            lines.append(f'    <mimic joint={quoteattr(robot.joints[k].name)} multiplier="{multiplier:.17g}" offset="{offset:.17g}"/>')
         extra = {k: v for k, v in terms.items() if k not in ("fc", "fv") and v != 0}
         if extra:
             lines.append("    <!-- dynid: drive terms URDF cannot hold, add them to the torques: "
@@ -313,6 +316,13 @@ def mjcf_from_robot(robot: Robot | str | Path, phi: np.ndarray | None = None, *,
     lines.append(f'{tip}<site name="flange" pos="{_vec(robot.tool_translation)}" quat="{q.w:.17g} {q.x:.17g} {q.y:.17g} {q.z:.17g}"/>')
     lines += [line for _, line in closing[::-1]]
     lines.append("  </worldbody>")
+    if robot.followers:  # a joint that follows another: MuJoCo's joint equality q_j = offset + multiplier·q_k
+        lines.append("  <equality>")
+        for j in robot.followers:
+            k, multiplier, offset = robot.joints[j].mimic  # type: ignore[misc]
+            lines.append(f"    <joint joint1={quoteattr(robot.joints[j].name)} joint2={quoteattr(robot.joints[k].name)} "
+                         f'polycoef="{offset:.17g} {multiplier:.17g} 0 0 0"/>')
+        lines.append("  </equality>")
     actuators = offset_actuators(robot, fitted.standard_parameters()) if offsets_held else []
     if actuators:
         lines += ["  <actuator>"] + [f"    <general {' '.join(f'{k}={quoteattr(v)}' for k, v in a.items())}/>" for a in actuators] + ["  </actuator>"]

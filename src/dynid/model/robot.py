@@ -39,6 +39,11 @@ class Joint:
     parent : int or None
         The index of the joint whose link carries this joint (-1: the base), for a robot with branches (two arms on a
         torso); ``None``: the joint before it in the robot's order (a serial chain).
+    mimic : tuple of (int, float, float) or None
+        ``(k, multiplier, offset)`` for a joint that follows joint ``k`` (a URDF's ``<mimic>``: a parallelogram's
+        passive joint, a coupled finger): its position is ``multiplier · q_k + offset``, and the torque (or force)
+        it needs is supplied through joint ``k``, whose row of the regressor holds ``multiplier`` times this joint's
+        (virtual work); None: an independent joint.
     """
 
     name: str
@@ -47,6 +52,7 @@ class Joint:
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     prismatic: bool = False
     parent: int | None = None
+    mimic: tuple[int, float, float] | None = None
 
     def placement(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The frame of the joint's link in its parent's, at positions ``q``.
@@ -284,13 +290,22 @@ class Robot:
             object.__setattr__(self, "transmission", Transmission.identity(n))
         if self.transmission.n_dof != n:
             raise ConfigError(f"robot {self.name!r}: transmission is for {self.transmission.n_dof} joints, the chain has {n}")
-        mask = np.ones((n, len(self.drive_terms)), dtype=bool) if self.drive_mask is None else np.asarray(self.drive_mask, dtype=bool)
+        mask = np.ones((n, len(self.drive_terms)), dtype=bool) if self.drive_mask is None else np.array(self.drive_mask, dtype=bool)
         if mask.shape != (n, len(self.drive_terms)):
             raise ConfigError(f"robot {self.name!r}: expected a drive mask of shape ({n}, {len(self.drive_terms)}), got {mask.shape}")
         object.__setattr__(self, "drive_mask", mask)
         if n == 0:
             raise ConfigError(f"robot {self.name!r}: expected at least one joint, got none")
         for j, jt in enumerate(self.joints):
+            if jt.mimic is not None:
+                k, multiplier, _ = jt.mimic
+                followed = repr(self.joints[k].name) if 0 <= k < n else str(k)
+                if not (0 <= k < n and k != j and self.joints[k].mimic is None and np.isfinite(jt.mimic[1:]).all()
+                        and multiplier != 0):
+                    raise ConfigError(f"robot {self.name!r}: joint {jt.name!r} mimics joint {followed} (multiplier "
+                                      f"{multiplier:g}, offset {jt.mimic[2]:g}): expected another joint of the robot that "
+                                      "mimics none, a finite non-zero multiplier and a finite offset")
+                mask[j] = False  # a joint that follows another has no drive of its own: its friction is its master's
             if jt.parent is not None and not -1 <= jt.parent < j:
                 raise ConfigError(f"robot {self.name!r}: joint {jt.name!r} is carried by joint {jt.parent}: expected a "
                                   f"joint before it (0 to {j - 1}) or -1, the base (joints in depth-first order)")
@@ -370,6 +385,82 @@ class Robot:
         return np.array([j.prismatic for j in self.joints], dtype=bool)
 
     @property
+    def followers(self) -> tuple[int, ...]:
+        """The joints that follow another (:attr:`Joint.mimic`: a URDF's ``<mimic>``), in the robot's order; empty on
+        most robots."""
+        return tuple(j for j, jt in enumerate(self.joints) if jt.mimic is not None)
+
+    @property
+    def independent(self) -> np.ndarray:
+        """(n_dof,) bool: the joints that follow none: the robot's coordinates, whose columns its logs hold."""
+        return np.array([jt.mimic is None for jt in self.joints], dtype=bool)
+
+    def coupled(self, q, dq=None, ddq=None) -> tuple:
+        """States with each following joint's column taken from the joint it follows (:attr:`Joint.mimic`): position
+        ``multiplier · q_k + offset``, velocity and acceleration ``multiplier`` times joint ``k``'s.
+
+        Parameters
+        ----------
+        q : (N, n_dof) array [rad or m]
+        dq, ddq : (N, n_dof) arrays, optional
+            [rad/s or m/s], [rad/s² or m/s²].
+
+        Returns
+        -------
+        tuple of (N, n_dof) arrays (None where not given)
+            Copies where the robot has following joints, the arrays given otherwise.
+        """
+        if not self.followers:
+            return q, dq, ddq
+        out = []
+        for x, offset in ((q, True), (dq, False), (ddq, False)):
+            if x is not None:
+                x = np.array(x, dtype=float)
+                for j in self.followers:
+                    k, multiplier, shift = self.joints[j].mimic  # type: ignore[misc]
+                    x[..., j] = multiplier * x[..., k] + (shift if offset else 0.0)
+            out.append(x)
+        return tuple(out)
+
+    def followers_said(self) -> str:
+        """One line on the joints that follow another (``""`` on a robot without): which, how, and where their torque
+        goes, for the outputs that list every joint.
+
+        Returns
+        -------
+        str
+        """
+        said = []
+        for j in self.followers:
+            k, multiplier, offset = self.joints[j].mimic  # type: ignore[misc]
+            unit = "m" if self.joints[j].prismatic else "rad"
+            said.append(f"J{j + 1} ({self.joints[j].name}) follows J{k + 1} ({self.joints[k].name}): q{j + 1} = "
+                        f"{multiplier:g}·q{k + 1} + {offset:g} {unit}")
+        if not said:
+            return ""
+        return ("; ".join(said) + " (<mimic>): no column of theirs in a log, no drive of their own; the torque they need "
+                "is supplied by the joint they follow and counted in its row")
+
+    def fold(self, rows: np.ndarray) -> np.ndarray:
+        """Rows of per-joint torques (N, n_dof) or of the regressor (N, n_dof, p), each following joint's row added to
+        the row of the joint it follows times its multiplier (virtual work: that joint's drive supplies it) and then
+        zeroed, in place.
+
+        Parameters
+        ----------
+        rows : (N, n_dof) or (N, n_dof, p) array
+
+        Returns
+        -------
+        The same array.
+        """
+        for j in self.followers:
+            k, multiplier, _ = self.joints[j].mimic  # type: ignore[misc]
+            rows[:, k] += multiplier * rows[:, j]
+            rows[:, j] = 0.0
+        return rows
+
+    @property
     def reach(self) -> float:
         """[m] The sum of the joints' offsets, the flange's and each prismatic joint's stroke (its farther limit): no point
         of the arm's skeleton is farther than this from the first joint's origin (a prismatic joint without limits
@@ -421,6 +512,8 @@ class Robot:
             values.append(self.prismatic.astype(float))
         if self.is_tree:  # so does a serial chain's
             values.append(self.parents.astype(float))
+        if self.followers:  # and a robot's without joints that follow others
+            values.append(np.array([v for j in self.followers for v in (j, *self.joints[j].mimic)], dtype=float))  # type: ignore[misc]
         flat = np.concatenate(values)
         text = ",".join(f"{0.0 if abs(v) < 1e-12 else v:.12g}" for v in flat)
         return hashlib.sha256(f"{self.n_dof};{text}".encode()).hexdigest()[:16]

@@ -43,15 +43,15 @@ def _said(value, quote: str = "'") -> str:
 def check_urdf_text(path: Path, held=()) -> None:
     """Refuse, with the line number, what Pinocchio's parser (urdfdom) would report without one.
 
-    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), ``<mimic>`` joints
-    (coupled to another: dynid would identify them as independent joints) that are not held fixed, and a link's mass,
-    inertia or origin that is not finite (NaN was read as a massless link).
+    Malformed XML, joints of unknown type, a joint axis that is no direction (``xyz="0 0 0"``), a ``<mimic>`` without
+    the joint it follows or with a multiplier or offset that is no finite number (or a multiplier of 0), and a link's
+    mass, inertia or origin that is not finite (NaN was read as a massless link).
 
     Parameters
     ----------
     path : Path
     held : collection of str
-        Joints held fixed (:func:`joints_from_urdf`): their ``<mimic>`` is no problem.
+        Joints held fixed (:func:`joints_from_urdf`): their ``<mimic>`` is not read.
 
     Raises
     ------
@@ -89,10 +89,14 @@ def check_urdf_text(path: Path, held=()) -> None:
                 problems.append(f"line {parser.CurrentLineNumber}: joint {_said(joint[0])} has axis xyz={_said(attrs.get('xyz'), chr(34))}, "
                                 "expected three numbers not all zero (the direction it turns about)")
         elif name == "mimic" and joint and joint[1] != "fixed" and joint[0] not in held:
-            both = ", ".join(f'"{n}"' for n in dict.fromkeys([attrs.get("joint", "?"), joint[0]]))
-            problems.append(f"line {parser.CurrentLineNumber}: joint {joint[0]!r} mimics joint {attrs.get('joint', '?')!r} "
-                            "(<mimic>): dynid identifies independent joints; " + HELD_HINT.format(names=both)
-                            + ", or describe the coupling as a [transmission] of a robot description")
+            try:
+                values = [float(attrs.get(key, default)) for key, default in (("multiplier", "1"), ("offset", "0"))]
+            except ValueError:
+                values = []
+            if len(values) != 2 or not all(np.isfinite(values)) or values[0] == 0 or "joint" not in attrs:
+                given = " ".join(f"{k}={_said(v, chr(34))}" for k, v in attrs.items())
+                problems.append(f"line {parser.CurrentLineNumber}: joint {_said(joint[0])} has <mimic {given}>: expected "
+                                "the joint it follows (joint=), a finite non-zero multiplier and a finite offset")
 
     def end(name):
         if name == "joint":
@@ -196,6 +200,7 @@ def joints_from_urdf(path: str | Path,
     held = dict(held or {})
     check_urdf_text(path, held)
     model = _pinocchio_model(path, held)
+    mimic = _mimic_joints(path)
     joints, inertial = [], []
     for j in range(1, model.njoints):
         jm = model.joints[j]
@@ -217,7 +222,8 @@ def joints_from_urdf(path: str | Path,
         placement = model.jointPlacements[j]
         parent = model.parents[j] - 1  # a branch (two arms on a torso): the joint that carries it, -1 the base
         joints.append(Joint(model.names[j], np.array(placement.rotation), np.array(placement.translation), axis,
-                            prismatic, None if parent == j - 2 else int(parent)))
+                            prismatic, None if parent == j - 2 else int(parent),
+                            _followed(path, model, model.names[j], mimic.get(model.names[j]), held)))
         inertial.append(inertial_from_pinocchio(model.inertias[j]))
     if not joints:
         raise ConfigError(f"{path}: expected at least one revolute or prismatic joint, found none")
@@ -290,26 +296,58 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
 
 def _tree(model, mimic=frozenset()) -> tuple[dict[int, str], dict[int, int], set[int], set[int]]:
     """Pinocchio's moving joints as :func:`dynid.model.robot_files.arm_chain` reads them (numbered from 0; a
-    mimic joint is none of the arm's): names, parents, the revolute joints and the prismatic ones."""
+    mimic joint is the arm's only where it carries a joint that mimics none, as a palletiser's passive joint carries
+    its wrist, not at a tip, as a gripper's second finger): names, parents, the revolute joints and the prismatic
+    ones."""
     names = {j - 1: model.names[j] for j in range(1, model.njoints)}
     parents = {j - 1: model.parents[j] - 1 for j in range(1, model.njoints)}
-    kinds = {j - 1: model.joints[j].shortname() for j in range(1, model.njoints) if model.names[j] not in mimic}
+    carrying = set()  # the joints that carry a joint that mimics none
+    for k in parents:
+        if names[k] not in mimic:
+            j = parents[k]
+            while j >= 0:
+                carrying.add(j)
+                j = parents[j]
+    kinds = {j - 1: model.joints[j].shortname() for j in range(1, model.njoints)
+             if model.names[j] not in mimic or j - 1 in carrying}
     revolute = {k for k, short in kinds.items() if short.startswith("JointModelR")}
     sliding = {k for k, short in kinds.items() if short.startswith("JointModelP")}
     return names, parents, revolute, sliding
 
 
-def _mimic_joints(path: Path) -> set[str]:
-    """The names of a URDF's joints that have a ``<mimic>`` (the file is checked to be XML first)."""
+def _followed(path: Path, model, name: str, mimic: tuple | None, held: dict) -> tuple[int, float, float] | None:
+    """A joint's :attr:`Joint.mimic` from its ``<mimic>`` (``(joint followed, multiplier, offset)`` as read), the joint
+    it follows numbered among the model's moving joints; refused where that joint is held, mimics another, or is
+    not a moving joint of the file."""
+    if mimic is None:
+        return None
+    followed, multiplier, offset = mimic
+    if followed in held:
+        raise ConfigError(f"{path}: joint {name!r} mimics joint {followed!r}, which the config holds fixed: hold "
+                          f"{name!r} too (held = [...]) or neither")
+    if not model.existJointName(followed) or followed == name:
+        raise ConfigError(f"{path}: joint {name!r} mimics joint {followed!r}, which is not another moving joint of the file")
+    return model.getJointId(followed) - 1, multiplier, offset
+
+
+def _mimic_joints(path: Path) -> dict[str, tuple[str, float, float]]:
+    """A URDF's joints that have a ``<mimic>``: name -> (the joint it follows, multiplier, offset) (the file is checked
+    to be XML first; :func:`check_urdf_text` refuses values that are no numbers, read here as 1 and 0)."""
     parser = expat.ParserCreate()
     joint: list[str] = []
-    out: set[str] = set()
+    out: dict[str, tuple[str, float, float]] = {}
+
+    def number(text: str | None, default: float) -> float:
+        try:
+            return float(text) if text is not None else default
+        except ValueError:
+            return default
 
     def start(name, attrs):
         if name == "joint" and "type" in attrs:
             joint[:] = [attrs.get("name", "?")]
         elif name == "mimic" and joint:
-            out.add(joint[0])
+            out[joint[0]] = (attrs.get("joint", "?"), number(attrs.get("multiplier"), 1.0), number(attrs.get("offset"), 0.0))
 
     parser.StartElementHandler = start
     try:

@@ -241,14 +241,15 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     resting = np.empty(dq.shape, dtype=bool)  # one byte a sample and joint, whatever the log's length
     for j in range(dq.shape[1]):
         resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
-    dead, clipped, channel_words = _channel_checks(tau, t, recording.label, s, rate)
+    followers = tuple(getattr(recording, "followers", ()))
+    dead, clipped, channel_words = _channel_checks(tau, t, recording.label, s, rate, followers)
     positions = recording.q[cut:-cut] if cut else recording.q
     still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
                   if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
     return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
                         tuple(recording.warnings) + s.warnings + channel_words,
                         direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped,
-                        getattr(recording, "drive_gains", None))
+                        getattr(recording, "drive_gains", None), followers)
 
 
 def _filtered_states(recording, s: Preprocessing):
@@ -303,10 +304,11 @@ def _rest_and_speed(recording, s: Preprocessing, dq, strict: bool) -> tuple[Prep
     return s, rest
 
 
-def _channel_checks(tau, t, label: str, s: Preprocessing, rate: float) -> tuple[tuple, np.ndarray | None, tuple]:
+def _channel_checks(tau, t, label: str, s: Preprocessing, rate: float, followers=()) -> tuple[tuple, np.ndarray | None, tuple]:
     """:func:`_parallel_prepare`'s dead, saturated and clipped torque channels (a joint at its limit throughout is
-    left out as a dead one; every joint so is refused), and their words."""
-    dead, dead_words = dead_channels(tau, label)
+    left out as a dead one; every joint so is refused), and their words; a joint that follows another is among the
+    dead without words."""
+    dead, dead_words = dead_channels(tau, label, followers)
     reach = int(np.ceil(2 * rate / s.parallel_cutoff)) if s.parallel_cutoff else 0  # the parallel filter's reach
     clipped, clipped_words, saturated = clipped_samples(tau, t, label, reach)
     dead = tuple(sorted(set(dead) | set(saturated)))  # a joint at its limit throughout is left out as a dead one

@@ -89,6 +89,14 @@ class PreparedData:
     (:func:`clipped_samples`): that joint's rows there are used by no estimate, and those samples by no metric."""
     drive_gains: np.ndarray | None = None
     """(n_dof,) the drive gains the torques were read through (eq. 16), or None: logged or given as torques."""
+    followers: tuple[int, ...] = ()
+    """Joints that follow another (``<mimic>``): among :attr:`dead` (their rows are folded into that joint's and hold
+    nothing: :meth:`dynid.model.robot.Robot.fold`), but no dead channel to speak of (:attr:`dead_said`)."""
+
+    @property
+    def dead_said(self) -> tuple[int, ...]:
+        """The dead or saturated channels a line names: :attr:`dead` less the joints that follow another."""
+        return tuple(j for j in self.dead if j not in self.followers)
 
     def kept(self, index: np.ndarray, vmin: np.ndarray) -> np.ndarray:
         """The rows an estimate uses: joints moving at least ``vmin``, none of a dead channel or of a joint held still,
@@ -461,7 +469,7 @@ def _heads_beyond(x: np.ndarray, a: int, b: int, side: float, step: float) -> bo
     return float(np.max(side * (fit(np.arange(a, b, dtype=float)) - level))) > BEYOND_STEPS * step
 
 
-def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
+def dead_channels(tau, label: str, followers=()) -> tuple[tuple[int, ...], tuple[str, ...]]:
     """The joints whose measured torque never changes in a log (a dead sensor, a disconnected drive, a column that is
     not this joint's torque), and the warning that says so.
 
@@ -471,6 +479,9 @@ def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
         The measured torques.
     label : str
         The dataset, for the warning.
+    followers : tuple of int
+        Joints that follow another (``<mimic>``): their torque column is 0 by construction, among the dead without a
+        warning.
 
     Returns
     -------
@@ -482,7 +493,9 @@ def dead_channels(tau, label: str) -> tuple[tuple[int, ...], tuple[str, ...]]:
     dead, words = [], []
     for j in range(tau.shape[1]):
         column = np.asarray(tau.column(j) if hasattr(tau, "column") else tau[:, j], dtype=float)
-        if column.size and float(np.ptp(column)) <= 1e-12 * max(1.0, float(np.abs(column).max())):
+        if j in followers:
+            dead.append(j)
+        elif column.size and float(np.ptp(column)) <= 1e-12 * max(1.0, float(np.abs(column).max())):
             dead.append(j)
             words.append(f"{label}: J{j + 1}'s torque reads {column[0]:.4g} N·m throughout (a dead sensor, or a column that "
                          "is not this joint's torque?): its rows are left out of the estimation and of the metrics")

@@ -243,7 +243,8 @@ def read_back_entry(name: str, form: str, check, chosen: dict | None = None) -> 
     return {**entry, "equals_model_to": check.relative_error, "samples": check.n_states,
             "cannot_hold": list(check.missing), "cannot_hold_share": [float(x) for x in check.missing_share],
             "file_vs_measured": check.file_vs_measured, "model_vs_measured": check.model_vs_measured,
-            "simulator_gap": [float(x) for x in check.simulator_gap], **(chosen or {})}
+            "simulator_gap": [float(x) for x in check.simulator_gap], **(chosen or {}),
+            **({"following_joints": list(check.followers)} if check.followers else {})}
 
 
 def model_file_name(urdf: str | Path, out: str | Path) -> str:

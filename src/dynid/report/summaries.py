@@ -239,7 +239,7 @@ def identification_blocks(result, *, library: bool = False) -> list:
     list of Line and TextTable
     """
     r = result
-    out: list = [readiness(r, library=library), _identification_title(r)]
+    out: list = [readiness(r, library=library), _identification_title(r), *_followers_line(r)]
     out.extend(in_short(r))  # how it went and what to do next, first; the details follow
     out.extend(_preparation_blocks(r))
     out.append(_base_table(r))
@@ -314,6 +314,13 @@ def _base_table(r) -> TextTable:
                       *(label(e.key) + (" (main)" if e is main else "") for e in closed),
                       *(ref.name for ref in r.references)),
                      rows, labels=2)
+
+
+def _followers_line(r) -> list:
+    """The line on the joints that follow another (:meth:`dynid.model.robot.Robot.followers_said`), where the model
+    has any."""
+    said = r.model.followers_said() if getattr(r, "model", None) is not None else ""
+    return [Line(said)] if said else []
 
 
 def _identification_title(r) -> Line:
@@ -472,7 +479,8 @@ def taken_away_lines(taken: dict) -> list:
         gap = f.get("simulator_gap")
         if gap is not None:
             said += (f"; what {SIMULATES[f['format']]} computes from it is off dynid's whole model by "
-                     + ", ".join(f"J{j + 1} {g:.2g}" for j, g in enumerate(gap)) + " % of each joint's RMS torque")
+                     + ", ".join(f"J{j + 1} {g:.2g}" for j, g in enumerate(gap) if j not in f.get("following_joints", ()))
+                     + " % of each joint's RMS torque")
         if f.get("file_vs_measured") is not None:
             said += (f"; against the log's unfiltered measured torques {f['file_vs_measured']:.3g} %, dynid's whole "
                      f"model {f['model_vs_measured']:.3g} %")
@@ -520,7 +528,7 @@ def identification_brief(result) -> list:
     short = in_short(r, brief=True)
     short[0] = Line("In short (every table and finding: --verbose, and report.html)", "title")
     drive = [] if r.drive_gains is None else [b for b in drive_gains_blocks(r.drive_gains, r.fit.prismatic) if isinstance(b, Line)]
-    return [readiness(r), _identification_title(r), *short, *drive, *_verdict(r, brief=True),
+    return [readiness(r), _identification_title(r), *_followers_line(r), *short, *drive, *_verdict(r, brief=True),
             *(Line(w, "warning") for w in r.warnings)]
 
 
@@ -573,7 +581,7 @@ def _log_lines(r, label: str) -> tuple[list, dict]:
         still = c is not r.fit and rests_throughout(c.rest_share)
         floor = (c.floor_metrics() or {}).get("global_relative_error", np.nan)
         logs.append(ScoredLog(c.name, errors[c.name], worst_joint(m["relative_error"], c.meaningful()), still,
-                              float(floor), c is r.fit, tuple(c.dead)))
+                              float(floor), c is r.fit, tuple(c.dead_said)))
     return [Line(text) for text in log_summaries(logs)], errors
 
 
@@ -704,7 +712,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
     list of Line
     """
     out = [Line("In short (the tables follow)" if tables_follow else "In short (every table: --verbose, and report.html)", "title")]
-    still = [c for c in comparisons if rests_throughout(c.rest_share) and not c.dead]
+    still = [c for c in comparisons if rests_throughout(c.rest_share) and not c.dead_said]
     for c in comparisons:
         if c in still and len(still) > 1:
             continue
@@ -714,7 +722,7 @@ def validation_in_short(comparisons, tables_follow: bool = True) -> list:
             worst = worst_joint(m["relative_error"], ok)
             parts.append(f"{name} {m['global_relative_error']:.3g} %" + ("" if worst is None or worst[1] == 0 else
                                                                        f" (worst J{worst[0] + 1} {worst[1]:.3g} %)"))
-        out.append(Line(f"{c.name}: torque error {_over_joints(c.dead)}: " + "; ".join(parts)
+        out.append(Line(f"{c.name}: torque error {_over_joints(c.dead_said)}: " + "; ".join(parts)
                         + _best({k: m["global_relative_error"] for k, m in metrics.items()})
                         + (f" (at rest throughout: {_AT_REST})" if rests_throughout(c.rest_share) else "")))
     if len(still) > 1:
@@ -1021,7 +1029,7 @@ def _determined_lines(r, label: str, brief: bool = False) -> list:
         whose = f"{r.label}, beside it: "
     kept = {r.base.names[i] for i in r.solution.from_prior}
     if kept:
-        line = _kept_line([n for n in r.base.names if n in kept], r.fit.dead, [r.base.names[i] for i in r.solution.anchored])
+        line = _kept_line([n for n in r.base.names if n in kept], r.fit.dead_said, [r.base.names[i] for i in r.solution.anchored])
         out.append(Line(whose + line.text, line.kind) if whose else line)
     share = (r.diagnostics or {}).get("sigma_torque_percent") or {}
     boot = (r.diagnostics or {}).get("bootstrap_std") or {}

@@ -52,10 +52,11 @@ def _csv(log, robot) -> str:
     """The log as the robot's encoders and drives write it: the angles without the description's position offsets
     (the TX40's J2 and J3 zeros a quarter turn from its DH table's), which ``dynid identify`` adds back."""
     buffer = io.StringIO()
-    names = [j.name for j in robot.joints]
+    kept = robot.independent  # the robot's coordinates: a joint that follows another (<mimic>) has no drive to log
+    names = [j.name for j, k in zip(robot.joints, kept) if k]
     header = ["time"] + [f"{n}_position" for n in names] + [f"{n}_effort" for n in names]
-    np.savetxt(buffer, np.column_stack([log.t, robot.transmission.logged_positions(log.q), log.tau]), delimiter=",",
-               fmt="%.9g", header=",".join(header), comments="")
+    np.savetxt(buffer, np.column_stack([log.t, robot.transmission.logged_positions(log.q)[:, kept], log.tau[:, kept]]),
+               delimiter=",", fmt="%.9g", header=",".join(header), comments="")
     return buffer.getvalue()
 
 

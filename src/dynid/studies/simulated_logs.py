@@ -70,8 +70,11 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
         first = f" (its first {moved} joints: the robot's submodel({moved}))" if moved < robot.n_dof else ""
         raise ConfigError(f"simulated_log: the trajectory moves {moved} joints, {robot.name} has {robot.n_dof}{first}")
     t = np.arange(int(round(seconds * rate))) / rate
-    q, dq, ddq = trajectory.evaluate(t)
+    q, dq, ddq = robot.coupled(*trajectory.evaluate(t))  # a joint that follows another (<mimic>) moves as it says
     meas = simulate_measurements(robot, t, q, dq, ddq, noise, generator)
     seeded = f", seed {int(rng)}" if isinstance(rng, (int, np.integer)) else ""
-    return Recording(f"simulated {robot.name}{seeded}", t, meas.q, None, torques_from_currents(meas.current, robot.drive_gains),
-                     float(rate))
+    tau = torques_from_currents(meas.current, robot.drive_gains)
+    if robot.followers:  # no drive, no sensor: its column reads 0, as a log read for the robot gives it
+        tau[:, list(robot.followers)] = 0.0
+    return Recording(f"simulated {robot.name}{seeded}", t, meas.q, None, tau, float(rate),
+                     prismatic=tuple(robot.prismatic.tolist()), followers=robot.followers)

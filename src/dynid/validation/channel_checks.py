@@ -54,7 +54,8 @@ def _fit(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Each joint's slope of the measured torque ``m`` on the predicted one ``p`` and their correlation (both
     :func:`_centred`)."""
     power = np.maximum((p**2).sum(axis=0), 1e-300)
-    return (m * p).sum(axis=0) / power, (m * p).sum(axis=0) / np.sqrt(np.maximum((m**2).sum(axis=0), 1e-300) * power)
+    # a joint with no torque of its own (one that follows another, <mimic>) has m = p = 0: correlation 0, not 0/0
+    return (m * p).sum(axis=0) / power, (m * p).sum(axis=0) / np.sqrt(np.maximum((m**2).sum(axis=0) * power, 1e-300))
 
 
 def channel_findings(comparison, label: str, fitted: np.ndarray, nominal: str | None = None) -> list[Finding]:

@@ -731,8 +731,8 @@ def nominal_gate(validations, label: str, nominal: str) -> tuple[list[Finding], 
             worse_lines.append(f"{v.name}: {shown}" + (f" and {len(worse) - 4} more" if len(worse) > 4 else ""))
         else:
             own_g, nom_g = float(metrics[label]["global_relative_error"]), float(metrics[nominal]["global_relative_error"])
-            without = (f" without {', '.join(f'J{j + 1}' for j in v.dead)} (a dead or saturated torque channel)"
-                       if v.dead else "")
+            without = (f" without {', '.join(f'J{j + 1}' for j in v.dead_said)} (a dead or saturated torque channel)"
+                       if v.dead_said else "")
             better.append((own_g < nom_g, v.name, f"{v.name}: {own_g:.3g} % against {nom_g:.3g} %{without}"))
     if worse_lines:
         more = f"; and {len(worse_lines) - 3} more logs" if len(worse_lines) > 3 else ""

@@ -106,6 +106,9 @@ class TorqueComparison:
     """Where the log is read otherwise than the identification log (its torque channels flipped or swapped:
     :mod:`dynid.validation.channel_checks`; its geometry not the robot file's: :mod:`dynid.validation.geometry_checks`),
     the warning that says how: its figures say little of any estimate, and the verdict does not weigh them."""
+    followers: tuple[int, ...] = ()
+    """Joints that follow another (``<mimic>``): among :attr:`dead`, their torque supplied through that joint's drive
+    and scored in its row; no dead channel to speak of."""
     prismatic: tuple[bool, ...] = ()
     """Which joints slide (:attr:`dynid.model.robot.Robot.prismatic`): their torques are forces [N], their speeds
     [m/s], as the lines and tables say; empty: none."""
@@ -265,6 +268,8 @@ class TorqueComparison:
                        "which says whether a model is consistent with the torque that holds the arm, not how it "
                        "predicts motion")
         for j in np.flatnonzero(~self.meaningful()):
+            if j in self.followers:
+                continue  # its torque is in the row of the joint it follows: nothing of its own to score
             if j in self.dead:
                 out.append(f"{self.name}: J{j + 1}'s torque is constant, or at its limit, over the log (a dead or "
                            "saturated channel): left out of the metrics")
@@ -280,6 +285,11 @@ class TorqueComparison:
             out.append(f"{self.name}: J{j + 1} {moves}its torque is at the noise level (RMS {self.rms_torque[j]:.2g} {torque}, "
                        f"{self.rms_torque[j] / level:.2g}× {what}): relative error not meaningful{rmse_j}")
         return out
+
+    @property
+    def dead_said(self) -> tuple[int, ...]:
+        """The dead or saturated channels a line names: :attr:`dead` less the joints that follow another."""
+        return tuple(j for j in self.dead if j not in self.followers)
 
     @property
     def n_samples(self) -> int:
@@ -328,8 +338,10 @@ class TorqueComparison:
         out = {"name": self.name, "n_samples": self.n_samples, "rms_torque": self.rms_torque, "metrics": self.metrics()}
         if self.rest_share is not None:
             out["rest_share"] = self.rest_share
-        if self.dead:
-            out["dead_channels"] = list(self.dead)  # 0-based joints left out of every metric
+        if self.dead_said:
+            out["dead_channels"] = list(self.dead_said)  # 0-based joints left out of every metric
+        if self.followers:
+            out["following_joints"] = list(self.followers)  # 0-based: <mimic> joints, in the rows of those they follow
         if self.noise is not None:
             out["relative_error_meaningful"] = self.meaningful().tolist()
             out["correlation_meaningful"] = self.varies().tolist()
@@ -719,4 +731,5 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
                             static=static, noise=noise,
                             speed=root_mean_square(data.dq), spread={k: np.sqrt(v / max(m, 1)) for k, v in var.items()},
                             dead=data.dead, floor=noise_floor(data), centre={k: np.concatenate(v) for k, v in centres.items()},
-                            band=next(iter(static.values()), None), prismatic=tuple(robot.prismatic.tolist()))
+                            band=next(iter(static.values()), None), prismatic=tuple(robot.prismatic.tolist()),
+                            followers=robot.followers)

@@ -399,10 +399,10 @@ def _branches_hint(robot) -> str:
 
 def _datasets(doc: dict, path: Path, root: Path, robot) -> tuple:
     """:func:`config_from_document`'s identification dataset and validation datasets (their names unique)."""
-    n, joints = robot.n_dof, _branches_hint(robot)
-    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, robot.prismatic,
-                         joints)
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, robot.prismatic, joints)
+    kept = robot.independent  # the robot's coordinates: a joint that follows another (<mimic>) has no column
+    n, sliding, joints = int(kept.sum()), robot.prismatic[kept], _branches_hint(robot)
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, sliding, joints)
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, sliding, joints)
                        for i, v in enumerate(doc.get("validation", [])))
     names = [v.name for v in validation]
     if len(set(names)) != len(names):

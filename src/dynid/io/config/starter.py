@@ -193,7 +193,8 @@ def xacro_arguments(given: list[str]) -> dict[str, str]:
 def _robot_notes(urdf: Path, log: Path, table, held: tuple[str, ...], robot, gains, without_sdp: str | None) -> list[str]:
     """:func:`starter_config`'s lines on the robot for a CSV log: its prismatic joints, the joints held, the drive gains
     and the estimators listed."""
-    return [*_sliding_note(robot), *_held_notes(urdf, held, log, robot), *_gain_notes(table, urdf, robot, gains),
+    followers = [robot.followers_said()] if robot is not None and robot.followers else []
+    return [*_sliding_note(robot), *followers, *_held_notes(urdf, held, log, robot), *_gain_notes(table, urdf, robot, gains),
             _estimators_note(without_sdp, robot)]
 
 
@@ -266,7 +267,7 @@ def _gain_notes(table, urdf: Path, robot, gains: tuple[float, ...] | None) -> li
 def _bag_read(bag: Path, robot) -> str:
     """A bag read as ``dynid identify`` reads it (its JointState messages' joints by the robot's joint names): one
     line with its samples, duration, rate and effort range; a bag that cannot be read is refused in one line."""
-    spec = dataset_spec({"bag": bag.name}, bag.parent, f"{bag}", bag.name, robot.n_dof)
+    spec = dataset_spec({"bag": bag.name}, bag.parent, f"{bag}", bag.name, int(robot.independent.sum()))
     rec = load_recording(spec, robot, spool=False)
     t, tau = np.asarray(rec.t), np.asarray(rec.tau)
     line = (f"{bag.name}: read as identify reads it: {t.size} samples over {t[-1] - t[0]:.3g} s ({rec.rate:.4g} Hz), "

@@ -58,6 +58,9 @@ class ReplayCheck:
         What the target simulator computes from the file, with its own semantics (Pinocchio's RNEA and the URDF's
         ``<dynamics>``; MuJoCo's ``mj_inverse`` with its ``frictionloss`` constraint as MuJoCo solves it), against
         dynid's whole model on the same states: each joint's RMS difference over its RMS torque.
+    followers : tuple of int
+        The joints that follow another (``<mimic>``): their torque is in the row of the joint they follow, on both
+        sides, so their own figures above are 0.
     """
 
     relative_error: float
@@ -68,6 +71,7 @@ class ReplayCheck:
     file_vs_measured: float | None = None
     model_vs_measured: float | None = None
     simulator_gap: np.ndarray | None = None
+    followers: tuple[int, ...] = ()
 
 
 def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -118,7 +122,8 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
         model.gravity.linear = np.asarray(robot.gravity, dtype=float)
     data = model.createData()
     ids = [model.getJointId(j.name) for j in robot.joints]
-    q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
+    q, dq, ddq = robot.coupled(*(_states(robot, n_states, rng) if states is None else states))
+    q, dq, ddq = (np.asarray(x, dtype=float) for x in (q, dq, ddq))
     n_s = q.shape[0]
     big_q = np.tile(pin.neutral(model), (n_s, 1))  # every sample's configuration, velocity, acceleration at once
     big_v, big_a = np.zeros((n_s, model.nv)), np.zeros((n_s, model.nv))
@@ -134,7 +139,7 @@ def urdf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     for k in range(n_s):
         tau_file[k] = pin.rnea(model, data, big_q[k], big_v[k], big_a[k])[idx]
     tau_file += model.damping[idx] * dq + model.friction[idx] * np.sign(dq)
-    return _compared(tau_file, robot, phi, (q, dq, ddq), URDF_TERMS, measured, whole=whole)
+    return _compared(robot.fold(tau_file), robot, phi, (q, dq, ddq), URDF_TERMS, measured, whole=whole)
 
 
 def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple, held_terms: tuple[str, ...],
@@ -157,15 +162,17 @@ def _compared(tau_file: np.ndarray, robot: Robot, phi: np.ndarray, states: tuple
     missing = tuple(sorted({n.rstrip("0123456789") for n, v, k in zip(robot.parameter_names, whole, kept)
                             if not k and v != 0} | ({"smooth Coulomb"} if np.any(robot.coulomb_velocity > 0) else set())))
     rms = np.sqrt(np.mean(full**2, axis=0))
+    rms[list(robot.followers)] = np.inf  # a joint that follows another has no row of its own: 0 on both sides
     share = 100.0 * np.sqrt(np.mean((full - model_tau) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     error = float(np.linalg.norm(tau_file - model_tau) / np.maximum(np.linalg.norm(model_tau), 1e-300))
     simulated = tau_file if simulated is None else simulated
     gap = 100.0 * np.sqrt(np.mean((full - simulated) ** 2, axis=0)) / np.maximum(rms, 1e-300)
     if measured is None:
-        return ReplayCheck(error, missing, share, q.shape[0], simulator_gap=gap)
+        return ReplayCheck(error, missing, share, q.shape[0], simulator_gap=gap, followers=robot.followers)
     scale = max(float(np.linalg.norm(measured)), 1e-300)
     return ReplayCheck(error, missing, share, q.shape[0], file_vs_measured=100.0 * float(np.linalg.norm(simulated - measured)) / scale,
-                       model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale, simulator_gap=gap)
+                       model_vs_measured=100.0 * float(np.linalg.norm(full - measured)) / scale, simulator_gap=gap,
+                       followers=robot.followers)
 
 
 def _offset_forces(model, robot: Robot, vadr: np.ndarray) -> np.ndarray:
@@ -253,13 +260,16 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     joints = [model.joint(j.name) for j in robot.joints]
     qadr = np.array([int(j.qposadr[0]) for j in joints])
     vadr = np.array([int(j.dofadr[0]) for j in joints])
-    q, dq, ddq = _states(robot, n_states, rng) if states is None else (np.asarray(x, dtype=float) for x in states)
+    q, dq, ddq = robot.coupled(*(_states(robot, n_states, rng) if states is None else states))
+    q, dq, ddq = (np.asarray(x, dtype=float) for x in (q, dq, ddq))
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)
     coupled = _coupled_tendons(model)
     tau_file, with_constraint, tendons = np.empty(q.shape), np.empty(q.shape), np.zeros(q.shape)
+    # a <mimic> joint's equality is off: the states follow it already, and each joint's own torque is folded after
+    equality = int(mujoco.mjtDisableBit.mjDSBL_EQUALITY) if robot.followers else 0
     for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
-        model.opt.disableflags = int(flags)
+        model.opt.disableflags = int(flags) | equality
         for k in range(q.shape[0]):
             data.qpos[:], data.qvel[:], data.qacc[:] = model.qpos0, 0.0, 0.0
             data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
@@ -267,7 +277,8 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
             out[k] = data.qfrc_inverse[vadr] - bias
             if flags and coupled is not None:
                 tendons[k] = _tendon_friction(coupled, data.qvel, vadr)
-    tau_file = tau_file + dry * np.sign(dq) + tendons
+    tau_file = robot.fold(tau_file + dry * np.sign(dq) + tendons)
+    robot.fold(with_constraint)
     held = MJCF_TERMS + (("offset",) if np.any(bias) else ()) + (("fvm", "fcm") if coupled is not None else ())
     check = _compared(tau_file, robot, phi, (q, dq, ddq), held, measured, simulated=with_constraint, whole=whole)
     sliding = dry * np.sign(dq)
@@ -365,7 +376,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # stable where a light wrist meets its frictionloss
     frictionless = mujoco.MjModel.from_xml_string(text)  # the file's inverse dynamics, its dry friction as sign(q̇)
     frictionless.opt.timestep, frictionless.opt.integrator = model.opt.timestep, model.opt.integrator
-    frictionless.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
+    frictionless.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS) | (
+        int(mujoco.mjtDisableBit.mjDSBL_EQUALITY) if robot.followers else 0)  # a <mimic> joint's torque folded instead
     inverse = mujoco.MjData(frictionless)
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)  # the offset actuators act in the simulation: the torque applied is less
@@ -376,7 +388,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     def feed_forward(qk, vk, ak):
         inverse.qpos[qadr], inverse.qvel[vadr], inverse.qacc[vadr] = qk, vk, ak
         mujoco.mj_inverse(frictionless, inverse)
-        return inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias + (_tendon_friction(coupled, inverse.qvel, vadr) if coupled is not None else 0.0)
+        own = inverse.qfrc_inverse[vadr] + dry * np.sign(vk) - bias + (_tendon_friction(coupled, inverse.qvel, vadr) if coupled is not None else 0.0)
+        return robot.fold(own[None])[0]  # a joint that follows another is driven through its equality by that joint
 
     data.qpos[:] = model.qpos0
     data.qpos[qadr], data.qvel[vadr] = q[0], dq[0]
@@ -386,6 +399,7 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     inertia = 1.0 / np.diag(np.linalg.inv(full))[vadr]  # the inertia a joint's torque meets with the others free:
     # a light wrist coupled to its heavier neighbours meets far less than its own diagonal, and gains from the diagonal
     # made the LBR Med7's simulation unstable
+    inertia[list(robot.followers)] = 0.0  # no drive of its own: no loop
     kp, kd = inertia * (2 * np.pi * bandwidth) ** 2, 2 * 0.9 * inertia * 2 * np.pi * bandwidth
     applied = np.empty_like(tau)
     worst = np.zeros(robot.n_dof)

@@ -71,7 +71,7 @@ def read_joint_states(spec, robot, name: str, warnings: list[str] | None = None)
 
     if not path.exists():
         raise DataError(f"{path}: ROS bag not found")
-    wanted = list(spec.joint_names or [j.name for j in robot.joints])
+    wanted = list(spec.joint_names or [j.name for j in robot.joints if j.mimic is None])  # a <mimic> joint: no drive
     stamps, pos, vel, eff = [], [], [], []
     try:
         typestore = _typestore_for(path, AnyReader)

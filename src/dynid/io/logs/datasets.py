@@ -66,6 +66,10 @@ class Recording:
         logged or given as torques.
     prismatic : tuple of bool
         Which joints slide (positions [m], forces [N]), as the robot it was read for says; empty: none or not known.
+    followers : tuple of int
+        The joints that follow another (a URDF's ``<mimic>``: :attr:`dynid.model.robot.Joint.mimic`): the log holds no
+        column of theirs; their positions follow that joint's, their torque columns are 0 (that joint's drive
+        supplies it).
     """
 
     name: str
@@ -78,6 +82,7 @@ class Recording:
     source: str = ""
     drive_gains: np.ndarray | None = None
     prismatic: tuple[bool, ...] = ()
+    followers: tuple[int, ...] = ()
 
     @property
     def n_samples(self) -> int:
@@ -121,9 +126,10 @@ def _detected(log: Path, robot: Robot, rate: float | None = None) -> DatasetSpec
     """The dataset of a CSV log, its columns found as ``dynid init`` finds them (:func:`dynid.io.logs.columns.csv_table`)."""
     if not log.is_file():
         raise DataError(f"{log}: no such log")
-    table, _ = csv_table(Path("robot.urdf"), log, robot.n_dof, tuple(j.name for j in robot.joints), rate=rate,
-                         rate_hint="load_recording(..., rate=HZ)")
-    return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, robot.n_dof, robot.prismatic)
+    kept = robot.independent  # the robot's coordinates: a joint that follows another has no column
+    table, _ = csv_table(Path("robot.urdf"), log, int(kept.sum()), tuple(j.name for j in robot.joints if j.mimic is None),
+                         rate=rate, rate_hint="load_recording(..., rate=HZ)")
+    return dataset_spec(table.unwrap(), log.parent, str(log), log.stem, int(kept.sum()), robot.prismatic[kept])
 
 
 @keyword_only_after_data
@@ -237,7 +243,7 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
 def _check_named_order(spec: DatasetSpec, robot: Robot) -> None:
     """Refuse a signal whose columns name the description's joints in another order than its chain's
     (:func:`dynid.io.logs.columns.named_out_of_order`): read as listed, every joint would get another joint's signal."""
-    joints = tuple(j.name for j in robot.joints)
+    joints = tuple(j.name for j in robot.joints if j.mimic is None)  # the columns of the robot's coordinates
     for kind, signal in spec.signals.items():
         order = named_out_of_order(signal.columns, joints)
         if order is None:
@@ -283,12 +289,39 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
-    q, dq, tau, kind = _joint_side(spec, robot, raw, side, warnings)
+    q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, _coordinates_widened(robot, raw), side, warnings))
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
                   tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
     return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
-                     robot.drive_gains.copy() if kind == "currents" else None, tuple(robot.prismatic.tolist()))
+                     robot.drive_gains.copy() if kind == "currents" else None, tuple(robot.prismatic.tolist()),
+                     robot.followers)
+
+
+def _coordinates_widened(robot: Robot, raw: dict) -> dict:
+    """Raw signals of the robot's coordinates (a column for each joint that follows none: a log holds no drive of a
+    ``<mimic>`` joint) as one column per joint, a joint that follows another given zeros (:func:`_followers_filled`
+    sets it)."""
+    if not robot.followers:
+        return raw
+    kept = np.flatnonzero(robot.independent)
+    for key, x in raw.items():
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2 and x.shape[1] == kept.size:
+            raw[key] = np.zeros((x.shape[0], robot.n_dof))
+            raw[key][:, kept] = x
+    return raw
+
+
+def _followers_filled(robot: Robot, q, dq, tau, kind: str):
+    """:func:`_joint_side`'s signals with each joint that follows another moving as that joint says, its torque 0
+    (the joint it follows supplies it: :meth:`dynid.model.robot.Robot.fold`)."""
+    if not robot.followers:
+        return q, dq, tau, kind
+    q, dq, _ = robot.coupled(q, dq)
+    tau = np.array(tau, dtype=float)
+    tau[:, list(robot.followers)] = 0.0
+    return q, dq, tau, kind
 
 
 def _cleaned(spec: DatasetSpec, t: np.ndarray, raw: dict, joint_side: bool, warnings: list[str]) -> dict:
@@ -394,7 +427,7 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     Parameters
     ----------
     robot : Robot
-        Its number of joints is the arrays' width.
+        Its number of joints is the arrays' width (or its coordinates', where joints follow others: ``<mimic>``).
     t : (N,) array [s]
         Increasing time stamps; jittered ones are interpolated onto a uniform grid at one over their median step.
     q : (N, n_dof) array [rad]
@@ -421,9 +454,13 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
     """
 
     t = np.asarray(t, dtype=float).reshape(-1)
+    if robot.followers and np.ndim(q) == 2 and np.shape(q)[1] == int(robot.independent.sum()):  # the coordinates alone
+        raw = _coordinates_widened(robot, {"q": q, "tau": tau, **({} if dq is None else {"dq": dq})})
+        q, tau, dq = raw["q"], raw["tau"], raw.get("dq")
     q = check_trajectory_array(q, robot.n_dof, "q")
     tau = check_trajectory_array(tau, robot.n_dof, "tau")
     dq = None if dq is None else check_trajectory_array(dq, robot.n_dof, "dq")
+    q, dq, tau, _ = _followers_filled(robot, q, dq, tau, "torques")
     if not (q.shape[0] == tau.shape[0] == t.shape[0] and (dq is None or dq.shape[0] == t.shape[0])):
         raise ShapeError(f"expected t, q, tau (and dq) with the same number of samples, got {t.shape[0]}, {q.shape[0]}, {tau.shape[0]}")
     steps = np.diff(t)
@@ -451,4 +488,5 @@ def recording_from_arrays(robot: Robot, t, q, tau, dq=None, name: str = "arrays"
                      f"onto a uniform grid at {rate:.6g} Hz",)
     else:
         rate = 1.0 / median
-    return Recording(name, t - t[0], q, dq, tau, rate, warnings, prismatic=tuple(robot.prismatic.tolist()))
+    return Recording(name, t - t[0], q, dq, tau, rate, warnings, prismatic=tuple(robot.prismatic.tolist()),
+                     followers=robot.followers)

@@ -1,0 +1,123 @@
+"""Joints that follow another (a URDF's `<mimic>`: a palletiser's parallelogram, a coupled finger) against Pinocchio's
+own model of the same file, where a mimic joint is a joint of its own: dynid's regressor at any state equals Pinocchio's
+at the coupled state, each following joint's row added to its master's times the multiplier (virtual work)."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from dynid.dynamics.base_parameters import base_parameters
+from dynid.dynamics.regressor import regressor
+from dynid.dynamics.rnea import rnea_torques
+from dynid.exceptions import ConfigError
+from dynid.model.description import load_robot
+from dynid.model.urdf import inertial_from_pinocchio
+
+from .test_prismatic_joints import _joint, _link, _urdf
+
+PALLETISER = _urdf(
+    [_link("turret", 40.0, "0.05 0 0.2", (2.0, 2.2, 1.5, 0.02, 0.01, 0.0)),
+     _link("arm", 25.0, "0 0 0.5", (2.5, 2.4, 0.3, 0.0, 0.02, 0.01)),
+     _link("forearm", 15.0, "0.6 0 0", (0.2, 1.8, 1.9, 0.01, 0.0, 0.02)),
+     _link("wrist", 6.0, "0.05 0 -0.1", (0.05, 0.06, 0.04, 0.0, 0.001, 0.0)),
+     _link("flange", 2.0, "0 0 -0.05", (0.01, 0.01, 0.015, 0.0, 0.0, 0.0)),
+     _link("finger_a", 0.3, "0 0.01 -0.03", (1e-4, 1e-4, 1e-4, 0.0, 0.0, 0.0)),
+     _link("finger_b", 0.3, "0 -0.01 -0.03", (1e-4, 1e-4, 1e-4, 0.0, 0.0, 0.0))],
+    [_joint("j1", "revolute", "base", "turret", "0 0 0.5", "0 0 0", "0 0 1"),
+     _joint("j2", "revolute", "turret", "arm", "0.2 0 0.4", "0 0 0", "0 1 0"),
+     _joint("j3", "revolute", "arm", "forearm", "0 0 1.1", "0 0 0", "0 1 0"),
+     _joint("j4", "revolute", "forearm", "wrist", "1.2 0 0", "0 0 0", "0 1 0", mimic='<mimic joint="j3" multiplier="-1" offset="0.1"/>'),
+     _joint("j5", "revolute", "wrist", "flange", "0.1 0 -0.2", "0 0 0", "0 0 1"),
+     _joint("finger_a_joint", "prismatic", "flange", "finger_a", "0 0.03 -0.1", "0 0 0", "0 1 0", 0.0, 0.04),
+     _joint("finger_b_joint", "prismatic", "flange", "finger_b", "0 -0.03 -0.1", "0 0 0", "0 -1 0", 0.0, 0.04,
+            '<mimic joint="finger_a_joint" multiplier="1.0"/>')])
+"""A palletiser: a turret, two arms, a passive joint that keeps the wrist level by following j3 (`<mimic>` multiplier
+-1), a turning flange, and a gripper whose second finger follows the first."""
+
+
+@pytest.fixture
+def palletiser(tmp_path):
+    path = tmp_path / "palletiser.urdf"
+    path.write_text(PALLETISER)
+    return path
+
+
+def _fold(robot, rows):
+    """Pinocchio's rows (N, n_dof, ...) folded by virtual work, written out here: each follower's row times its
+    multiplier added to its master's, its own zero."""
+    rows = rows.copy()
+    for j, jt in enumerate(robot.joints):
+        if jt.mimic is not None:
+            k, multiplier, _ = jt.mimic
+            rows[:, k] += multiplier * rows[:, j]
+            rows[:, j] = 0.0
+    return rows
+
+
+def test_the_followers_are_read_from_the_file(palletiser):
+    robot = load_robot(palletiser)
+    follows = {jt.name: jt.mimic for jt in robot.joints if jt.mimic is not None}
+    assert follows == {"j4": (2, -1.0, 0.1), "finger_b_joint": (5, 1.0, 0.0)}
+    assert robot.independent.tolist() == [True, True, True, False, True, True, False]
+    assert not robot.drive_mask[[3, 6]].any() and robot.drive_mask[[0, 1, 2, 4, 5]].all()  # a follower has no drive
+
+
+def test_the_regressor_equals_pinocchios_at_the_coupled_state_folded(palletiser, rng):
+    """1000 random states whose followers' columns hold anything: dynid's regressor equals Pinocchio's joint-torque
+    regressor of the file (its mimic joints free joints of their own) at the state where they follow their masters,
+    folded, link by link to 1e-10 of its RMS; Y·φ equals Pinocchio's RNEA folded, and dynid's RNEA."""
+    robot = load_robot(palletiser)
+    model = pin.buildModelFromUrdf(str(palletiser))
+    data = model.createData()
+    n = 1000
+    lo, hi = robot.limits.position_span()
+    q, dq, ddq = rng.uniform(lo, hi, (n, robot.n_dof)), rng.normal(size=(n, robot.n_dof)), 3 * rng.normal(size=(n, robot.n_dof))
+    coupled = [x.copy() for x in (q, dq, ddq)]
+    for x, offset in zip(coupled, (0.1, 0.0, 0.0)):  # j4 = -q3 + 0.1, finger_b = finger_a: written out here
+        x[:, 3] = -x[:, 2] + offset
+        x[:, 6] = x[:, 5]
+    y = regressor(robot, q, dq, ddq)
+    pin_y = np.array([pin.computeJointTorqueRegressor(model, data, *(x[k] for x in coupled)) for k in range(n)])
+    tau = np.array([pin.rnea(model, data, *(x[k] for x in coupled)) for k in range(n)])
+    perm = [4, 5, 7, 6, 8, 9, 1, 2, 3, 0]  # Pinocchio's parameter order -> eq. 5's
+    npj = robot.n_params_per_joint
+    ours = y.reshape(n, robot.n_dof, robot.n_dof, npj)[..., :10].reshape(n, robot.n_dof, -1)
+    expected = _fold(robot, pin_y.reshape(n, robot.n_dof, robot.n_dof, 10)[..., perm].reshape(n, robot.n_dof, -1))
+    assert np.abs(ours - expected).max() < 1e-10 * np.sqrt(np.mean(expected**2))
+    rms = np.sqrt(np.mean(tau**2))
+    rigid = robot.without_drive_terms(robot.drive_terms)
+    np.testing.assert_allclose(regressor(rigid, q, dq, ddq) @ rigid.standard_parameters(), _fold(robot, tau), atol=1e-10 * rms, rtol=0)
+    np.testing.assert_allclose(rnea_torques(rigid, q, dq, ddq), _fold(robot, tau), atol=1e-10 * rms, rtol=0)
+    assert np.all(y[:, [3, 6]] == 0.0)  # the followers' own rows: their torque is their masters'
+    np.testing.assert_allclose(inertial_from_pinocchio(model.inertias[4]), robot.inertial[3], rtol=1e-12)
+
+
+def test_the_base_parameters_are_the_rank_of_pinocchios_folded_regressor(palletiser, rng):
+    robot = load_robot(palletiser).without_drive_terms(load_robot(palletiser).drive_terms)
+    model = pin.buildModelFromUrdf(str(palletiser))
+    data = model.createData()
+    q = robot.limits.random_positions(300, rng)
+    q, dq, ddq = robot.coupled(q, rng.normal(size=q.shape), rng.normal(size=q.shape))
+    w = _fold(robot, np.array([pin.computeJointTorqueRegressor(model, data, q[k], dq[k], ddq[k]) for k in range(300)]))
+    assert base_parameters(robot).n_base == np.linalg.matrix_rank(w.reshape(-1, w.shape[-1]))
+
+
+@pytest.mark.parametrize("change, said", [
+    (('multiplier="-1"', 'multiplier="0"'), 'joint \'j4\' has <mimic joint="j3" multiplier="0" offset="0.1">: expected'),
+    (('offset="0.1"', 'offset="nan"'), 'joint \'j4\' has <mimic joint="j3" multiplier="-1" offset="nan">: expected'),
+    (('<mimic joint="j3"', '<mimic joint="j9"'), "mimics joint 'j9', which is not another moving joint of the file"),
+    (('<mimic joint="finger_a_joint"', '<mimic joint="j4"'), "joint 'finger_b_joint' mimics joint 'j4' (multiplier 1, offset 0): expected another joint of the robot that mimics none"),
+])
+def test_a_coupling_that_cannot_be_is_refused_in_one_line(tmp_path, change, said):
+    path = tmp_path / "bad.urdf"
+    path.write_text(PALLETISER.replace(*change))
+    with pytest.raises(ConfigError, match="^[^\n]*" + said.replace("(", r"\(").replace(")", r"\)")):
+        load_robot(path)
+
+
+def test_a_follower_whose_master_is_held_is_refused_with_its_fix(palletiser):
+    with pytest.raises(ConfigError, match="joint 'finger_b_joint' mimics joint 'finger_a_joint', which the config holds "
+                                          "fixed: hold 'finger_b_joint' too"):
+        load_robot(palletiser, held=("finger_a_joint",))
+    robot = load_robot(palletiser, held=("finger_a_joint", "finger_b_joint"))  # a gripper held, as before
+    assert [jt.name for jt in robot.joints] == ["j1", "j2", "j3", "j4", "j5"] and robot.joints[3].mimic == (2, -1.0, 0.1)
