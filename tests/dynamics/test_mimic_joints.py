@@ -121,3 +121,38 @@ def test_a_follower_whose_master_is_held_is_refused_with_its_fix(palletiser):
         load_robot(palletiser, held=("finger_a_joint",))
     robot = load_robot(palletiser, held=("finger_a_joint", "finger_b_joint"))  # a gripper held, as before
     assert [jt.name for jt in robot.joints] == ["j1", "j2", "j3", "j4", "j5"] and robot.joints[3].mimic == (2, -1.0, 0.1)
+
+
+def test_the_closed_loop_simulation_refuses_a_coupling_it_cannot_hold(palletiser):
+    """Its forward dynamics (Pinocchio's ABA of the joints as free joints) would move a follower freely: refused in
+    one line naming the joint and the estimators that take the robot."""
+    from dynid.simulation.closed_loop import Controller, simulate_closed_loop
+
+    robot = load_robot(palletiser, held=("finger_a_joint", "finger_b_joint"))
+    t = np.arange(10) / 1000.0
+    zero = np.zeros((t.size, robot.n_dof))
+    with pytest.raises(ConfigError, match=r"^robot 'palletiser': j4 follow other joints \(<mimic>\): the closed-loop "
+                                          r"simulation .* identify with the open-loop estimators \(WLS, SDP\)$"):
+        simulate_closed_loop(robot, t, zero, zero, Controller.for_robot(robot))
+
+
+def test_an_mjcf_written_with_the_coupling_is_read_back_with_it(palletiser, tmp_path, rng):
+    """dynid's MJCF holds the coupling as a joint equality; read as a robot description it is the same coupled robot:
+    the same followers and, on random states, the same torques to 1e-10 of their RMS. A coupling MuJoCo holds but dynid
+    cannot (a quadratic polynomial) is refused in one line."""
+    from dynid.model.description_files import mjcf_from_robot
+
+    robot = load_robot(palletiser, held=("finger_a_joint", "finger_b_joint"))
+    rigid = robot.without_drive_terms(robot.drive_terms)
+    (tmp_path / "m.xml").write_text(mjcf_from_robot(rigid))
+    again = load_robot(tmp_path / "m.xml").without_drive_terms(robot.drive_terms)
+    assert [j.mimic for j in again.joints] == [j.mimic for j in robot.joints]
+    q = robot.limits.random_positions(200, rng)
+    dq, ddq = rng.normal(size=q.shape), rng.normal(size=q.shape)
+    tau = regressor(rigid, q, dq, ddq) @ rigid.standard_parameters()
+    np.testing.assert_allclose(regressor(again, q, dq, ddq) @ again.standard_parameters(), tau,
+                               atol=1e-10 * np.sqrt(np.mean(tau**2)), rtol=0)
+    (tmp_path / "bad.xml").write_text(mjcf_from_robot(rigid).replace('polycoef="0.10000000000000001 -1 0 0 0"',
+                                                                     'polycoef="0.1 -1 0.5 0 0"'))
+    with pytest.raises(ConfigError, match=r"joint 'j4' has an <equality joint> \(polycoef 0.1 -1 0.5 0 0\): expected a linear"):
+        load_robot(tmp_path / "bad.xml")

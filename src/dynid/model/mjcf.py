@@ -153,9 +153,29 @@ def joints_from_mjcf(path: str | Path, held=None) -> tuple[tuple[Joint, ...], np
         axis = np.array(model.jnt_axis[k], dtype=float)
         carrier = moving.index(owner[parent]) if owner[parent] >= 0 else -1  # a branch: the joint its body rides on
         joints.append(Joint(names[k] or f"joint{i + 1}", rotation, translation, axis / np.linalg.norm(axis),
-                            bool(model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE), None if carrier == i - 1 else carrier))
+                            bool(model.jnt_type[k] == mujoco.mjtJoint.mjJNT_SLIDE), None if carrier == i - 1 else carrier,
+                            _followed(mujoco, model, path, k, moving, names, held)))
     return (tuple(joints), inertial, tuple(j.name for j in joints),
             tuple(model.body(_body(model, k)).name for k in moving))
+
+
+def _followed(mujoco, model, path: Path, k: int, moving: list, names, held: dict) -> tuple[int, float, float] | None:
+    """A joint's :attr:`Joint.mimic` from the file's joint equality that couples it to another (``<equality><joint
+    joint1="it" joint2="other" polycoef="offset multiplier 0 0 0"/>``, dynid's own write-back of a ``<mimic>``): a
+    linear coupling to a moving joint; refused where the polynomial is not linear or the other joint is held or
+    absent."""
+    for e in range(model.neq):
+        if model.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT or int(model.eq_obj1id[e]) != k:
+            continue
+        other, poly = int(model.eq_obj2id[e]), np.asarray(model.eq_data[e][:5], dtype=float)
+        said = f"{path}: joint {names[k]!r} has an <equality joint> (polycoef {' '.join(f'{c:g}' for c in poly)})"
+        if other < 0 or names[other] in held or other not in moving:
+            raise ConfigError(f"{said} couples it to no moving joint of the model dynid identifies (a held or fixed one?): "
+                              "hold both, or neither")
+        if np.any(poly[2:] != 0) or poly[1] == 0:
+            raise ConfigError(f"{said}: expected a linear coupling (polycoef offset multiplier 0 0 0, the multiplier not 0)")
+        return moving.index(other), float(poly[1]), float(poly[0])
+    return None
 
 
 def held_inertials(path: str | Path, held=None) -> np.ndarray:

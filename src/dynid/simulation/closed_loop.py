@@ -401,8 +401,12 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
     ShapeError
         Arrays of other shapes than (N, n_dof), or instants not ``1/rate`` apart.
     ConfigError
-        Noise without ``rng``, or parameters with a massless link.
+        Noise without ``rng``, parameters with a massless link, or a robot whose joints follow others (``<mimic>``).
     """
+    if robot.followers:  # its forward dynamics would move them freely: no constraint holds them to their joints
+        raise ConfigError(f"robot {robot.name!r}: {', '.join(robot.joints[j].name for j in robot.followers)} follow "
+                          "other joints (<mimic>): the closed-loop simulation (IDIM-IV, DIDIM, dynid montecarlo's closed "
+                          "loop) does not hold such couplings; identify with the open-loop estimators (WLS, SDP)")
     n = robot.n_dof
     t = np.asarray(t, dtype=float).reshape(-1)
     q_ref, dq_ref = (np.asarray(x, dtype=float) for x in (q_ref, dq_ref))
