@@ -60,6 +60,8 @@ class PreparedData:
     drive_gains : (n_dof,) array or None
         The drive gains the torques were read through (the recording's: motor currents times these, eq. 16); None
         where they were logged or given as torques.
+    followers : tuple of int
+        Joints that follow another (``<mimic>``): among ``dead``, no dead channel to speak of.
     """
 
     name: str

@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..conventions import sliding_note
 from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
 from .excitation_summary import no_floor_line, set_point_lines
@@ -85,6 +84,8 @@ def _fmt(x, spec: str = ".4g") -> str:
 
 
 def _comparison_tables(comparisons: list[dict]) -> list[Table]:
+    from ..conventions import sliding_note  # here: the page's module loads no NumPy until a page is written
+
     tables = []
     for c in comparisons:
         sets = c["metrics"]
@@ -198,6 +199,8 @@ def identify_sections(d: dict) -> tuple[dict, list[Section]]:
                                 [f"{k} not determined: {why}" for k, why in g.get("not_observable", {}).items()]
                                 + ([f"payload from the loaded run: mass {g['payload']['M']['value']:.4g} kg"] if "M" in g.get("payload", {}) else [])))
     fit = d.get("identification") or {}
+    from ..conventions import sliding_note  # here: the page's module loads no NumPy until a page is written
+
     sliding = sliding_note("N·m", [j in fit.get("prismatic_joints", ()) for j in range(len(fit.get("rms_torque", ())))],
                            inside=True)
     cv = d.get("settings", {}).get("preprocessing_cross_validation")

@@ -68,6 +68,10 @@ class TorqueComparison:
         would have.
     misread : str
         Where the log is read otherwise than the identification log, the warning that says how ("" where it is not).
+    followers : tuple of int
+        Joints that follow another (``<mimic>``): among ``dead``, scored in the rows of the joints they follow.
+    prismatic : tuple of bool
+        Which joints slide: their torques are forces [N], their speeds [m/s].
     """
 
     name: str
@@ -274,9 +278,9 @@ class TorqueComparison:
                 out.append(f"{self.name}: J{j + 1}'s torque is constant, or at its limit, over the log (a dead or "
                            "saturated channel): left out of the metrics")
                 continue
-            torque = joint_unit("N·m", self.prismatic, j)
+            torque = joint_unit("N·m", self.prismatic, int(j))
             moves = "" if self.speed is None else (f"barely moves (RMS speed {self.speed[j]:.2g} "
-                                                   f"{joint_unit('rad/s', self.prismatic, j)}) and " if
+                                                   f"{joint_unit('rad/s', self.prismatic, int(j))}) and " if
                                                    self.speed[j] < 0.05 else "")
             rmse_j = "" if first is None else f"; RMSE {first['rmse'][j]:.2g} {torque}"
             residual = self.noise is not None and self.rms_torque[j] < MEANINGFUL * np.asarray(self.noise)[j]
