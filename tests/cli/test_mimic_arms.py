@@ -73,3 +73,23 @@ def test_an_excitation_keeps_a_mimic_joint_on_its_coupling_at_every_set_point(tm
     assert np.ptp(q3) > 0.1  # the coupled joints move
     robot = load_robot(tmp_path / "palletiser.urdf", held=joints_to_hold(tmp_path / "palletiser.urdf"))
     assert np.all(q4 >= robot.limits.q_min[3] - 1e-9) and np.all(q4 <= robot.limits.q_max[3] + 1e-9)
+
+
+def test_the_api_takes_a_coupled_robots_log_as_its_coordinates_arrays(tmp_path):
+    """dynid.load_recording of the CSV (its columns found as init finds them) and identify_from_arrays on the driven
+    joints' arrays alone give the same identification: the coordinates widened, the follower coupled, its torque 0."""
+    import dynid
+
+    robot = _folder(tmp_path)
+    rec = dynid.load_recording(tmp_path / "identification.csv", robot)
+    assert rec.followers == (3,) and np.all(rec.tau[:, 3] == 0.0)
+    np.testing.assert_allclose(rec.q[:, 3], -rec.q[:, 2] + 0.1, atol=1e-12)
+    kept = robot.independent
+    from_log = dynid.identify_from_arrays(robot, rec)
+    from_arrays = dynid.identify_from_arrays(robot, rec.t, rec.q[:, kept], rec.tau[:, kept])
+    a, b = from_arrays.solution.params, from_log.solution.params  # as any two routes agree (a robot without followers:
+    assert np.linalg.norm(a - b) <= 1e-8 * np.linalg.norm(b)      # 3e-9 of the largest parameter, the same two calls)
+    label = from_log.main
+    assert abs(from_arrays.fit.metrics()[label]["global_relative_error"]
+               - from_log.fit.metrics()[label]["global_relative_error"]) <= 1e-6 * from_log.fit.metrics()[label]["global_relative_error"]
+    assert from_arrays.fit.followers == (3,) and "dead" not in " ".join(from_arrays.warnings)

@@ -410,9 +410,10 @@ def identify_from_arrays(robot: Robot | str | Path, t, q=None, tau=None, dq=None
         as the log readers do (with a warning). Or a log as :func:`dynid.load_recording` or
         :func:`dynid.simulated_log` give it, identified as it is (its name and warnings kept; no arrays beside it).
     q : (N, n_dof) array [rad]
-        Joint positions (with time stamps).
+        Joint positions (with time stamps); on a robot whose joints follow others (``<mimic>``), the driven joints'
+        columns alone may be given, as a log holds them (:attr:`dynid.model.robot.Robot.independent`).
     tau : (N, n_dof) array [N·m]
-        Joint torques (e.g. drive gain × motor current, eq. 16; with time stamps).
+        Joint torques (e.g. drive gain × motor current, eq. 16; with time stamps), the same columns as ``q``.
     dq : (N, n_dof) array [rad/s], optional
         Measured velocities (default: differentiated from the filtered positions).
     name : str
