@@ -60,6 +60,25 @@ def test_a_palletiser_with_a_mimic_joint_is_identified_from_init_to_its_written_
     assert p.returncode == 0 and forward is not None and float(forward.group(1)) < 1.0, said[-600:]
 
 
+def test_a_log_that_holds_the_followers_columns_too_is_read_by_its_driven_joints(tmp_path):
+    """A log written with every joint's columns (a ROS joint_states log holds a mimic joint's position): init takes the
+    driven joints' and says why the follower's are left, not that the robot file may miss joints."""
+    _folder(tmp_path)
+    lines = (tmp_path / "identification.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    i, k = head.index("j3_position") + 1, head.index("j3_effort") + 1
+    rows = [",".join(head[:i] + ["j4_position"] + head[i:k] + ["j4_effort"] + head[k:])]
+    for line in lines[1:]:
+        cells = line.split(",")
+        rows.append(",".join(cells[:i] + [repr(-float(cells[i - 1]) + 0.1)] + cells[i:k] + ["0"] + cells[k:]))
+    (tmp_path / "identification.csv").write_text("\n".join(rows) + "\n")
+    p = run("init", "palletiser.urdf", "identification.csv", cwd=tmp_path)
+    said = " ".join(p.stdout.split())
+    assert p.returncode == 0 and "positions: j1_position, j2_position, j3_position, j5_position" in said, said
+    assert ("not read: j4_position, j4_effort — the columns of joints that follow others in palletiser.urdf (<mimic>: "
+            "j4)") in said and "more joint columns" not in said
+
+
 def test_an_excitation_keeps_a_mimic_joint_on_its_coupling_at_every_set_point(tmp_path):
     (tmp_path / "palletiser.urdf").write_text(PALLETISER)
     p = run("excite", "palletiser.urdf", "--starts", "2", cwd=tmp_path)

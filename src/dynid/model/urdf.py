@@ -200,7 +200,7 @@ def joints_from_urdf(path: str | Path,
     held = dict(held or {})
     check_urdf_text(path, held)
     model = _pinocchio_model(path, held)
-    mimic = _mimic_joints(path)
+    mimic = mimic_joints(path)
     joints, inertial = [], []
     for j in range(1, model.njoints):
         jm = model.joints[j]
@@ -286,7 +286,7 @@ def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str
     path = Path(path)
     if is_mjcf(path):
         return mjcf_joints_to_hold(path, logged)
-    mimic = _mimic_joints(path)
+    mimic = mimic_joints(path)
     check_urdf_text(path, held=mimic)
     model = _pinocchio_model(path, {})
     names, parents, revolute, sliding = _tree(model, mimic)
@@ -330,9 +330,25 @@ def _followed(path: Path, model, name: str, mimic: tuple | None, held: dict) -> 
     return model.getJointId(followed) - 1, multiplier, offset
 
 
-def _mimic_joints(path: Path) -> dict[str, tuple[str, float, float]]:
-    """A URDF's joints that have a ``<mimic>``: name -> (the joint it follows, multiplier, offset) (the file is checked
-    to be XML first; :func:`check_urdf_text` refuses values that are no numbers, read here as 1 and 0)."""
+def mimic_joints(path: Path) -> dict[str, tuple[str, float, float]]:
+    """A URDF's joints that have a ``<mimic>`` (:attr:`dynid.model.robot.Joint.mimic`).
+
+    Parameters
+    ----------
+    path : Path
+        The URDF (checked to be XML first).
+
+    Returns
+    -------
+    dict
+        Joint name -> (the joint it follows, multiplier, offset) as written; :func:`check_urdf_text` refuses values
+        that are no numbers, read here as 1 and 0.
+
+    Raises
+    ------
+    ConfigError
+        A file that is not XML (:func:`check_urdf_text` names the line).
+    """
     parser = expat.ParserCreate()
     joint: list[str] = []
     out: dict[str, tuple[str, float, float]] = {}

@@ -94,12 +94,32 @@ def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *
     notes = order_notes + group_notes + time_notes + signal_notes
     left = [c for c in first if c not in taken + signals]
     extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
-    if extra:
+    followed = _mimic_columns(urdf, extra)
+    if extra and len(followed) == len(extra):
+        notes.append(f"not read: {', '.join(left)} — the columns of joints that follow others in {urdf.name} (<mimic>: "
+                     f"{', '.join(sorted(set(followed.values())))}): their motion is computed from the joints they follow, "
+                     "and their torque is those joints'")
+    elif extra:
         notes.append(f"not read: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
                      f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
     elif left:
         notes.append(f"not read: {', '.join(left)}")
     return notes + ([_assumed_units(assumed)] if assumed else [])
+
+
+def _mimic_columns(urdf: Path, columns: list[str]) -> dict[str, str]:
+    """The columns among ``columns`` that name a joint of the URDF that follows another (``<mimic>``) -> that joint."""
+    from ...model.urdf import mimic_joints  # here: the robot file's reader is loaded where a log has columns to spare
+
+    if not columns or urdf.suffix.lower() != ".urdf" or not urdf.is_file():
+        return {}
+    names = mimic_joints(urdf)
+    out = {}
+    for column in columns:
+        named = [n for n in names if re.search(rf"(^|[^A-Za-z0-9]){re.escape(n)}([^A-Za-z0-9]|$)", column)]
+        if named:
+            out[column] = max(named, key=len)
+    return out
 
 
 def _signal_entries(table, found: dict, kinds: tuple[str, ...], urdf: Path, n_dof: int) -> tuple[list[str], list[str], list[str]]:
