@@ -176,6 +176,13 @@ def test_the_numpy_budget_counts_samples_and_calls(monkeypatch):
     monkeypatch.setattr(module, "_simd", {"used": False, "failed": False})
     monkeypatch.setattr(module.kernel, "compiled", lambda: True)  # or numba's kernel is loaded
     assert not module._numpy_form(1)
+    # a process that says it will compute more than the budget goes compiled at once; a smaller one keeps the budget
+    monkeypatch.setattr(module.kernel, "compiled", lambda: False)
+    monkeypatch.setattr(module, "_numpy_used", 0)
+    module.expect_samples(1000)
+    assert module._numpy_form(1)
+    module.expect_samples(1001)
+    assert not module._numpy_form(1)
 
 
 @pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])

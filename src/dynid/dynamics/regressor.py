@@ -191,6 +191,21 @@ def _compiled_regressor(arrays, motion, out, drive) -> None:
     kernel.joint_torque_regressor(arrays, motion, out, drive(0, motion[0].shape[0]))
 
 
+def expect_samples(n_samples: int) -> None:
+    """Say that this process will compute the regressor at ``n_samples`` samples (a log's, which the parallel filter
+    reads at every sample): beyond the NumPy form's budget (:data:`NUMPY_SAMPLES`) the compiled regressor takes over
+    at once, instead of after the budget is spent in the slower NumPy form. The same numbers either way.
+
+    Parameters
+    ----------
+    n_samples : int
+    """
+    global _numpy_used
+    if n_samples > NUMPY_SAMPLES:
+        with _numpy_lock:
+            _numpy_used = max(_numpy_used, NUMPY_SAMPLES)
+
+
 def _numpy_form(n_samples: int) -> bool:
     """Whether these samples go through the NumPy form: no compiled regressor has run in this process yet and
     its NumPy budget (:data:`NUMPY_SAMPLES`) holds them and the call (:data:`NUMPY_CALL_SAMPLES`)."""

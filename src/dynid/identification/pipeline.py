@@ -40,6 +40,7 @@ import numpy as np
 
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
+from ..dynamics.regressor import expect_samples
 from ..estimators.estimation import Estimation, stream_rows
 from ..estimators.registry import DEFAULT_ESTIMATORS, FitData, estimator_choices
 from ..exceptions import ConfigError, DataError, DynIdError
@@ -63,6 +64,12 @@ from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
 from .verdict import SAME_FIGURE, decide
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
+
+REGRESSOR_PASSES = 10
+"""Times an identification computes the regressor over its log's samples at least (the reference preparation, the
+cutoffs' candidates, the friction models' folds, the estimation, the delay check; with the validation logs 10-85× on
+the shipped configs and the example, benchmarks/NOTEBOOK.md): where that is beyond the NumPy form's budget, the
+compiled regressor computes from the first sample (:func:`dynid.dynamics.regressor.expect_samples`)."""
 
 FRICTION_CHOICES = ("auto", "description")
 """``friction``: each joint's model chosen by cross-validation, or the description's terms."""
@@ -234,6 +241,7 @@ class IdentificationPipeline:
             return lambda done, total: progress(label, done, total)
 
         recording.check(self.robot.n_dof)
+        expect_samples(REGRESSOR_PASSES * recording.n_samples)  # the compiled regressor from the first sample
         dead, _ = dead_channels(recording.tau, recording.label)
         if len(dead) == recording.tau.shape[1]:
             raise DataError(f"{recording.label}: every joint's torque reads one value throughout (dead channels, or "
