@@ -67,7 +67,7 @@ __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES
 
 REGRESSOR_PASSES = 10
 """Times an identification computes the regressor over its log's samples at least (the reference preparation, the
-cutoffs' candidates, the friction models' folds, the estimation, the delay check; with the validation logs 10-85× on
+cutoffs' candidates, the friction models' folds, the estimation, the delay check; with the validation logs 10.5-86× on
 the shipped configs and the example, benchmarks/NOTEBOOK.md): where that is beyond the NumPy form's budget, the
 compiled regressor computes from the first sample (:func:`dynid.dynamics.regressor.expect_samples`)."""
 
