@@ -156,3 +156,37 @@ def test_an_mjcf_written_with_the_coupling_is_read_back_with_it(palletiser, tmp_
                                                                      'polycoef="0.1 -1 0.5 0 0"'))
     with pytest.raises(ConfigError, match=r"joint 'j4' has an <equality joint> \(polycoef 0.1 -1 0.5 0 0\): expected a linear"):
         load_robot(tmp_path / "bad.xml")
+
+
+def test_a_dh_table_states_a_coupling_as_a_urdf_does(tmp_path, rng):
+    """A DH table's ``mimic = { joint = "j3", multiplier = -1.0, offset = 0.1 }``: the joint follows j3, and the
+    regressor is the table's robot without the coupling at the coupled state, folded (written out here); a joint name
+    the table lacks and a URDF-convention table's mimic (the URDF states its own) are refused in one line."""
+    rows = ('[[joints]]\nname = "j1"\nd = 0.5\n{m}[[joints]]\nname = "j2"\nalpha = "-pi/2"\na = 0.2\n{m}'
+            '[[joints]]\nname = "j3"\na = 1.1\n{m}[[joints]]\nname = "j4"\na = 1.2\n{mimic}{m}'
+            '[[joints]]\nname = "j5"\nalpha = "pi/2"\nd = 0.2\n{m}')
+    inertial = 'mass = 3.0\ncom = [0.05, 0.01, -0.02]\ninertia = [0.02, 0.03, 0.025, 0.001, 0.0, 0.002]\n'
+    coupled = tmp_path / "coupled.toml"
+    coupled.write_text('name = "dh"\nconvention = "modified"\n' + rows.format(
+        m=inertial, mimic='mimic = { joint = "j3", multiplier = -1.0, offset = 0.1 }\n'))
+    free = tmp_path / "free.toml"
+    free.write_text('name = "dh"\nconvention = "modified"\n' + rows.format(m=inertial, mimic=""))
+    robot, plain = load_robot(coupled), load_robot(free)
+    assert robot.followers == (3,) and robot.joints[3].mimic == (2, -1.0, 0.1)
+    q = plain.limits.random_positions(100, rng)
+    dq, ddq = rng.normal(size=q.shape), rng.normal(size=q.shape)
+    moved = [x.copy() for x in (q, dq, ddq)]
+    for x, offset in zip(moved, (0.1, 0.0, 0.0)):
+        x[:, 3] = -x[:, 2] + offset
+    rigid, loose = (r.without_drive_terms(r.drive_terms) for r in (robot, plain))
+    np.testing.assert_array_equal(regressor(rigid, q, dq, ddq), _fold(robot, regressor(loose, *moved)))
+    (tmp_path / "bad.toml").write_text(coupled.read_text().replace('joint = "j3"', 'joint = "j9"'))
+    with pytest.raises(ConfigError, match=r"mimic.joint: expected the name of another joint of the table \(j1, j2, j3, "
+                                          r"j4, j5\), got 'j9'"):
+        load_robot(tmp_path / "bad.toml")
+    (tmp_path / "p.urdf").write_text(PALLETISER)
+    (tmp_path / "u.toml").write_text('convention = "urdf"\nurdf = "p.urdf"\nheld = ["finger_a_joint", "finger_b_joint"]\n'
+                                     + "".join(f'[[joints]]\nname = "j{k}"\n' for k in range(1, 5))
+                                     + '[[joints]]\nname = "j5"\nmimic = { joint = "j3" }\n')
+    with pytest.raises(ConfigError, match=r"mimic describe a DH chain, but the chain is p.urdf's"):
+        load_robot(tmp_path / "u.toml")

@@ -28,6 +28,7 @@ Layout (all values SI, angles in radians; an angle may be written ``"pi/2"``, ``
     parent = "base"                # optional, modified DH: the joint carrying this one (a robot with branches;
     gamma = 0.0                    # default the joint before it), with Khalil-Kleinfinger's gamma [rad] and b [m]
     b = 0.0                        # (RotZ(gamma) TransZ(b) before RotX(alpha))
+    mimic = { joint = "joint0", multiplier = -1.0, offset = 0.0 }  # optional: follows another joint (a <mimic>)
     q_min = -2.9                   # rad (m if prismatic)
     q_max = 2.9
     dq_max = 3.0                   # rad/s (m/s)
@@ -55,6 +56,7 @@ from __future__ import annotations
 
 import re
 import tomllib
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -396,7 +398,22 @@ def _chain(d, rows, where: list[str], names: list[str], *, convention: str, urdf
             tool_t = tool_t0 + tool_r0 @ tool_t
             tool_r = tool_r0
         inertial = _dh_inertials(rows, where, convention, alpha, a, dd)
+        joints = _followers(joints, rows, where, names)
     return joints, inertial, (tool_r, tool_t), (alpha, a, dd), urdf_lim, links
+
+
+def _followers(joints, rows, where: list[str], names: list[str]) -> tuple:
+    """A DH table's joints with their ``mimic = { joint = ..., multiplier = ..., offset = ... }``
+    (:attr:`dynid.model.robot.Joint.mimic`), the joint followed named in the table."""
+    out = list(joints)
+    for i, (r, w) in enumerate(zip(rows, where)):
+        if r.mimic is None:
+            continue
+        if r.mimic.joint not in names or r.mimic.joint == names[i]:
+            raise ConfigError(f"{w}.mimic.joint: expected the name of another joint of the table ({', '.join(names)}), "
+                              f"got {r.mimic.joint!r}")
+        out[i] = replace(out[i], mimic=(names.index(r.mimic.joint), float(r.mimic.multiplier), float(r.mimic.offset)))
+    return tuple(out)
 
 
 def _branches(rows, where: list[str], names: list[str]) -> dict:
@@ -597,7 +614,7 @@ def _merged_inertials(rows, where, inertial: np.ndarray, urdf: Path) -> np.ndarr
     link's; the DH geometry fields are refused (the URDF gives the chain)."""
     out = inertial.copy()
     for i, (r, w) in enumerate(zip(rows, where)):
-        geometry = [k for k in ("alpha", "a", "d", "theta_offset", "type", "parent", "gamma", "b") if getattr(r, k) is not None]
+        geometry = [k for k in ("alpha", "a", "d", "theta_offset", "type", "parent", "gamma", "b", "mimic") if getattr(r, k) is not None]
         if geometry:
             raise ConfigError(f"{w}: {', '.join(geometry)} describe a DH chain, but the chain is {urdf.name}'s: leave "
                               "them out (the URDF's joints give the geometry)")

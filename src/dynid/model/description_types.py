@@ -15,7 +15,7 @@ from msgspec import Meta
 from .._util.typed import Table
 from ..friction import TERMS
 
-__all__ = ["RobotDescription", "JointTable", "ToolTable", "TransmissionTable", "CouplingTable", "PayloadTable"]
+__all__ = ["RobotDescription", "JointTable", "ToolTable", "TransmissionTable", "CouplingTable", "PayloadTable", "MimicTable"]
 
 Angle = Annotated[Union[float, str], Meta(description='rad, or text like "pi/2", "-2*pi"')]
 Vector3 = Annotated[list[float], Meta(min_length=3, max_length=3)]
@@ -35,6 +35,15 @@ class CouplingTable(Table, kw_only=True):
     motor: Annotated[int, Meta(ge=1, description="1-based motor number (above the joints' own)")]
     joint: Annotated[int, Meta(ge=1, description="1-based joint whose motion the motor also follows")]
     ratio: Annotated[float, Meta(description="motor angle per joint angle of that joint")]
+
+
+class MimicTable(Table, kw_only=True):
+    """A joint that follows another, as a URDF's ``<mimic>``: ``mimic = { joint = "j3", multiplier = -1, offset = 0.1 }``
+    (its position ``multiplier · q_j3 + offset``; a palletiser's passive joint, a coupled finger)."""
+
+    joint: Annotated[str, Meta(description="the name of the joint it follows")]
+    multiplier: Annotated[float, Meta(description="its position per position of that joint")] = 1.0
+    offset: Annotated[float, Meta(description="rad (m if prismatic)")] = 0.0
 
 
 class TransmissionTable(Table, kw_only=True):
@@ -66,6 +75,8 @@ _JOINT_FIELDS = [
         description="modified DH: the name of the joint that carries this one, or \"base\" (a robot with "
                     "branches, Khalil-Kleinfinger's antecedent; default: the joint before it)")], None], None),
     ("gamma", Union[Angle, None], None),
+    ("mimic", Union[Annotated[MimicTable, Meta(description="DH tables: this joint follows another (a URDF's <mimic>): no "
+                                                           "drive and no log column of its own")], None], None),
     ("b", Union[Annotated[float, Meta(description="m: Khalil-Kleinfinger's offset along the parent's z, with gamma "
                                                   "its rotation about it (modified DH, a branch's first joint)")], None],
      None),
