@@ -77,6 +77,20 @@ def test_a_log_that_holds_the_followers_columns_too_is_read_by_its_driven_joints
     assert p.returncode == 0 and "positions: j1_position, j2_position, j3_position, j5_position" in said, said
     assert ("not read: j4_position, j4_effort — the columns of joints that follow others in palletiser.urdf (<mimic>: "
             "j4)") in said and "more joint columns" not in said
+    # a config that lists every joint's columns (as one written before such joints were read) is honoured: the
+    # follower's columns read and not used, said so, and the same model as from the driven joints' columns alone
+    assert run("identify", "arm.toml", "--no-figures", "-q", "--out", "four", cwd=tmp_path).returncode == 0
+    config = (tmp_path / "arm.toml").read_text()
+    every = config.replace('"j3_position", "j5_position"', '"j3_position", "j4_position", "j5_position"').replace(
+        '"j3_effort", "j5_effort"', '"j3_effort", "j4_effort", "j5_effort"')
+    assert every != config
+    (tmp_path / "every.toml").write_text(every)
+    p = run("identify", "every.toml", "--no-figures", "-q", "--out", "five", cwd=tmp_path)
+    said = " ".join((p.stdout + p.stderr).split())
+    assert p.returncode == 0 and "the columns of j4 (<mimic>: a joint that follows another) are read and not used" in said, said
+    four, five = (json.loads((tmp_path / d / "results.json").read_text()) for d in ("four", "five"))
+    values = lambda r: [b["value"] for b in r["base_parameters"]]  # noqa: E731
+    np.testing.assert_allclose(values(five), values(four), rtol=1e-12, atol=0)
 
 
 def test_an_excitation_keeps_a_mimic_joint_on_its_coupling_at_every_set_point(tmp_path):

@@ -689,15 +689,15 @@ def _coupling_equalities(problem, lay: _Layout) -> tuple[np.ndarray, np.ndarray]
     return (np.array(rows), np.array(values)) if rows else None
 
 
-def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng) -> np.ndarray:
-    """Random amplitudes decaying as 1/k, projected on the rest and coupling equalities, scaled into the limits."""
+def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling) -> np.ndarray:
+    """Random amplitudes decaying as 1/k, projected on the rest and coupling equalities (:func:`_coupling_equalities`),
+    scaled into the limits."""
     n, h = lay.n, lay.h
     k = np.arange(1, h + 1)
     amp = np.concatenate([(rng.standard_normal((n, h)) / k).ravel(), (rng.standard_normal((n, h)) / k).ravel()])
     x0 = np.zeros(lay.nx)
     if lay.free_offsets:
         x0[:n] = problem.start_pose()
-    coupling = _coupling_equalities(problem, lay)
     if coupling is not None:  # the start pose and the amplitudes on the coupling (E x0 = e, E d = 0)
         e_rows, e_values = coupling
         x0 -= np.linalg.pinv(e_rows) @ (e_rows @ x0 - e_values)
@@ -808,7 +808,8 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     nit = 0
     for i in range(n_starts):
         objective, a_lin, c_lin, _ = solver(problem.safety)
-        x0 = lay.to_x(initial) if (i == 0 and initial is not None) else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng)
+        x0 = (lay.to_x(initial) if (i == 0 and initial is not None)
+              else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling))
         if first is None:
             first = lay.to_trajectory(x0, problem.offsets)
         safety = problem.safety

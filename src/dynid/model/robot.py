@@ -422,9 +422,14 @@ class Robot:
             out.append(x)
         return tuple(out)
 
-    def followers_said(self) -> str:
+    def followers_said(self, columns: str = "no column of theirs in a log") -> str:
         """One line on the joints that follow another (``""`` on a robot without): which, how, and where their torque
         goes, for the outputs that list every joint.
+
+        Parameters
+        ----------
+        columns : str
+            What the line says of their columns (a log's; excitation.csv's).
 
         Returns
         -------
@@ -438,8 +443,8 @@ class Robot:
                         f"{multiplier:g}·q{k + 1} + {offset:g} {unit}")
         if not said:
             return ""
-        return ("; ".join(said) + " (<mimic>): no column of theirs in a log, no drive of their own; the torque they need "
-                "is supplied by the joint they follow and counted in its row")
+        return ("; ".join(said) + f" (<mimic>): {columns}, no drive of their own; the torque they need is supplied by the "
+                "joint they follow and counted in its row")
 
     def fold(self, rows: np.ndarray) -> np.ndarray:
         """Rows of per-joint torques (N, n_dof) or of the regressor (N, n_dof, p), each following joint's row added to

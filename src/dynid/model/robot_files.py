@@ -27,7 +27,7 @@ def arm_chain(parents: dict[int, int], revolute: set[int], sliding=frozenset(), 
     parents : dict of int to int
         Every moving joint -> the moving joint it rides on (-1: the base), in reading order: a joint after its parent.
     revolute : set of int
-        The revolute joints that can be the arm's (not mimicking another).
+        The revolute joints that can be the arm's (a ``<mimic>`` joint only where it carries the arm on).
     sliding : set of int
         The prismatic joints that can be the arm's (a linear track, a lift, a SCARA's vertical axis).
     named : set of int
@@ -60,7 +60,7 @@ def _chains(parents: dict[int, int], revolute: set[int], sliding=frozenset()) ->
 def joints_off_arm(parents: dict[int, int], revolute: set[int], sliding=frozenset(), logged=frozenset()) -> list[int]:
     """The joints ``dynid init`` holds: those off the arm (:func:`arm_chain`); where the joints a log names lie on
     several branches' chains (both arms of a two-arm robot), every joint but those (the robot is then their tree). A
-    gripper's prismatic fingers and a mimic joint are on no chain: held, whether the log names them or not.
+    gripper's prismatic fingers and a mimic joint at a tip are on no chain: held, whether the log names them or not.
 
     Parameters
     ----------

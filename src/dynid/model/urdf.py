@@ -261,7 +261,7 @@ def _pinocchio_model(path: Path, held: dict):
 
 def joints_to_hold(path: str | Path, logged: Callable[[tuple[str, ...]], set[str]] | None = None) -> tuple[str, ...]:
     """The URDF's moving joints that are not its arm, which ``dynid init`` holds fixed: every joint off the longest
-    chain of revolute joints from the base, none mimicking another (a gripper's fingers, prismatic or on a branch; a
+    chain of revolute joints from the base, none mimicking another at its tip (a gripper's fingers, prismatic or on a branch; a
     camera's pan joint on a branch of its own, wherever Pinocchio's depth-first order puts it), or off the chain that
     holds most of the joints the log names (:func:`dynid.model.robot_files.arm_chain`); where the log names joints on
     several branches' chains (both arms of a two-arm robot), every joint but those (the robot is then their tree; a

@@ -397,12 +397,24 @@ def _branches_hint(robot) -> str:
             "dynid init write the config)")
 
 
+def _logged_joints(table, robot) -> tuple[int, np.ndarray]:
+    """The number of joints a dataset's columns hold and which of them slide: the robot's coordinates (a joint that
+    follows another, ``<mimic>``, has no column), or every joint where its positions list one column per joint (a
+    config written before such joints were read; the followers' columns then read and not used, said so)."""
+    kept = robot.independent
+    listed = table.get("positions", {}).get("columns") if isinstance(table, dict) and isinstance(table.get("positions"), dict) else None
+    if not robot.followers or (isinstance(listed, list) and len(listed) == robot.n_dof):
+        return robot.n_dof, robot.prismatic
+    return int(kept.sum()), robot.prismatic[kept]
+
+
 def _datasets(doc: dict, path: Path, root: Path, robot) -> tuple:
     """:func:`config_from_document`'s identification dataset and validation datasets (their names unique)."""
-    kept = robot.independent  # the robot's coordinates: a joint that follows another (<mimic>) has no column
-    n, sliding, joints = int(kept.sum()), robot.prismatic[kept], _branches_hint(robot)
-    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification", n, sliding, joints)
-    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", n, sliding, joints)
+    joints = _branches_hint(robot)
+    ident = dataset_spec(doc["identification"], root, f"{path}: identification", "identification",
+                         *_logged_joints(doc["identification"], robot), joints)
+    validation = tuple(dataset_spec(v, root, f"{path}: validation[{i}]", f"validation {i + 1}", *_logged_joints(v, robot),
+                                    joints)
                        for i, v in enumerate(doc.get("validation", [])))
     names = [v.name for v in validation]
     if len(set(names)) != len(names):

@@ -266,10 +266,9 @@ def mjcf_replay(text: str, robot: Robot, phi: np.ndarray, *, n_states: int = 200
     bias = _offset_forces(model, robot, vadr)
     coupled = _coupled_tendons(model)
     tau_file, with_constraint, tendons = np.empty(q.shape), np.empty(q.shape), np.zeros(q.shape)
-    # a <mimic> joint's equality is off: the states follow it already, and each joint's own torque is folded after
-    equality = int(mujoco.mjtDisableBit.mjDSBL_EQUALITY) if robot.followers else 0
+    # a <mimic> joint's equality holds on the coupled states (its force 0); each joint's own torque is folded after
     for flags, out in ((mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS, tau_file), (0, with_constraint)):
-        model.opt.disableflags = int(flags) | equality
+        model.opt.disableflags = int(flags)
         for k in range(q.shape[0]):
             data.qpos[:], data.qvel[:], data.qacc[:] = model.qpos0, 0.0, 0.0
             data.qpos[qadr], data.qvel[vadr], data.qacc[vadr] = q[k], dq[k], ddq[k]
@@ -376,8 +375,7 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # stable where a light wrist meets its frictionloss
     frictionless = mujoco.MjModel.from_xml_string(text)  # the file's inverse dynamics, its dry friction as sign(q̇)
     frictionless.opt.timestep, frictionless.opt.integrator = model.opt.timestep, model.opt.integrator
-    frictionless.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS) | (
-        int(mujoco.mjtDisableBit.mjDSBL_EQUALITY) if robot.followers else 0)  # a <mimic> joint's torque folded instead
+    frictionless.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
     inverse = mujoco.MjData(frictionless)
     dry = model.dof_frictionloss[vadr].copy()
     bias = _offset_forces(model, robot, vadr)  # the offset actuators act in the simulation: the torque applied is less

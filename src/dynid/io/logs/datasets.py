@@ -289,7 +289,8 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
-    q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, _coordinates_widened(robot, raw), side, warnings))
+    raw = _coordinates_widened(robot, raw, spec.table or spec.name, warnings)
+    q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, raw, side, warnings))
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
                   tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
@@ -298,13 +299,18 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
                      robot.followers)
 
 
-def _coordinates_widened(robot: Robot, raw: dict) -> dict:
+def _coordinates_widened(robot: Robot, raw: dict, name: str = "", warnings: list[str] | None = None) -> dict:
     """Raw signals of the robot's coordinates (a column for each joint that follows none: a log holds no drive of a
     ``<mimic>`` joint) as one column per joint, a joint that follows another given zeros (:func:`_followers_filled`
-    sets it)."""
+    sets it); signals with a column for every joint are kept, the followers' columns said unused in ``warnings``."""
     if not robot.followers:
         return raw
     kept = np.flatnonzero(robot.independent)
+    if warnings is not None and np.shape(raw.get("positions", ()))[1:] == (robot.n_dof,):  # every joint's columns
+        names = ", ".join(robot.joints[j].name for j in robot.followers)
+        warnings.append(f"{name}: the columns of {names} (<mimic>: a joint that follows another) are read and not used: "
+                        "their motion is computed from the joints they follow, their torque is those joints'; list the "
+                        "other joints' columns alone to leave them out")
     for key, x in raw.items():
         x = np.asarray(x, dtype=float)
         if x.ndim == 2 and x.shape[1] == kept.size:
