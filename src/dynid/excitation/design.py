@@ -808,8 +808,7 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     nit = 0
     for i in range(n_starts):
         objective, a_lin, c_lin, _ = solver(problem.safety)
-        x0 = (lay.to_x(initial) if (i == 0 and initial is not None)
-              else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling))
+        x0 = lay.to_x(initial) if i == 0 and initial is not None else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling)
         if first is None:
             first = lay.to_trajectory(x0, problem.offsets)
         safety = problem.safety

@@ -422,7 +422,7 @@ class Robot:
             out.append(x)
         return tuple(out)
 
-    def followers_said(self, columns: str = "no column of theirs in a log") -> str:
+    def followers_said(self, *, columns: str = "no column of theirs in a log") -> str:
         """One line on the joints that follow another (``""`` on a robot without): which, how, and where their torque
         goes, for the outputs that list every joint.
 

@@ -35,7 +35,7 @@ def excitation_blocks(run, tables: bool = True) -> list:
     if held:
         out.append(Line(f"held fixed at 0, not the arm's joints: {', '.join(held)}"))
     if p.robot.followers:  # excitation.csv's columns of such a joint say what it does: no set-point to play
-        out.append(Line(p.robot.followers_said("their columns in excitation.csv are what they do, not set-points")))
+        out.append(Line(p.robot.followers_said(columns="their columns in excitation.csv are what they do, not set-points")))
     out += (_design_lines(d, f"initial: {c.initial_label}", f" (design grid of {p.grid_points} samples per period)")
             if tables else _search_lines(d))
     encoders, (start, kind) = set_point_lines(run.set_points())
