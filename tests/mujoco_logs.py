@@ -15,6 +15,11 @@ torque sensor would), with
 * a slow Fourier excitation, or point-to-point moves with long rests.
 
 The truth is the URDF's inertia plus ``armature → Ia``, ``damping → fv``, ``frictionloss → fc`` per joint.
+
+A joint that follows another (a URDF ``<mimic>``, which MuJoCo's parser reads as a joint equality) is passive: the
+controller drives its master only, whose command holds the follower's feed-forward (virtual work), and MuJoCo's
+equality, made stiff (its time constant two integration steps), moves the follower; the log still holds every joint's
+columns, the follower's torque 0 (a writer keeps the coordinates' columns, as a robot's log holds them).
 """
 
 from __future__ import annotations
@@ -51,6 +56,9 @@ def mujoco_model(urdf_text: str, drives: Drives | None, timestep: float):
                  stripped_urdf(urdf_text), count=1)
     spec = mujoco.MjSpec.from_string(xml)
     spec.option.timestep = timestep
+    for equality in spec.equalities:  # a <mimic>: a rigid coupling, not MuJoCo's default soft one
+        equality.solref = [2 * timestep, 1.0]
+        equality.solimp = [0.9999, 0.9999, 0.001, 0.5, 2.0]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     hinges = [j for j in spec.joints if j.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)]
     if drives is not None:
@@ -59,6 +67,35 @@ def mujoco_model(urdf_text: str, drives: Drives | None, timestep: float):
             h.damping = [float(drives.fv[j]), 0.0, 0.0]  # MuJoCo 4: linear, then higher-order terms
             h.frictionloss = float(drives.fc[j])
     return spec.compile()
+
+
+def couplings(model) -> list[tuple[int, int, float, float]]:
+    """The model's joint equalities (MuJoCo's reading of a URDF's ``<mimic>``) as ``(follower, master, multiplier,
+    offset)`` dof indices: ``q_follower = offset + multiplier·q_master``."""
+    import mujoco
+
+    return [(int(model.jnt_dofadr[model.eq_obj1id[e]]), int(model.jnt_dofadr[model.eq_obj2id[e]]),
+             float(model.eq_data[e, 1]), float(model.eq_data[e, 0]))
+            for e in range(model.neq) if model.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT and model.eq_obj2id[e] >= 0]
+
+
+def coupled(pair: tuple, coupling) -> tuple:
+    """``(q, dq, ddq)`` with each follower's columns set from its master's (:func:`couplings`)."""
+    q, dq, ddq = (x.copy() for x in pair)
+    for follower, master, multiplier, offset in coupling:
+        q[:, follower] = offset + multiplier * q[:, master]
+        dq[:, follower], ddq[:, follower] = multiplier * dq[:, master], multiplier * ddq[:, master]
+    return q, dq, ddq
+
+
+def folded(tau: np.ndarray, coupling) -> np.ndarray:
+    """Joint torques ``(..., n)`` with each follower's added to its master's times the multiplier and its own 0: what
+    the master's drive gives for both (virtual work); the follower has no drive."""
+    tau = np.array(tau, dtype=float)
+    for follower, master, multiplier, _ in coupling:
+        tau[..., master] += multiplier * tau[..., follower]
+        tau[..., follower] = 0.0
+    return tau
 
 
 def fourier_reference(t, n, rng, f0, harmonics, amplitude, centre):
@@ -175,6 +212,8 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
         qr, dqr, ddqr = fourier_reference(t_ctrl, n, rng, f0, harmonics, amp, centre)
     else:
         qr, dqr, ddqr = ptp_reference(t_ctrl, n, rng, amp, centre)
+    coupling = couplings(model)
+    qr, dqr, ddqr = coupled((qr, dqr, ddqr), coupling)
     # gains: a loop of about 8 Hz on each joint's own inertia at the centre pose
     data.qpos[:] = centre
     mujoco.mj_forward(model, data)
@@ -184,12 +223,14 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
     wn = 2 * np.pi * 8.0
     kp = m_jj * wn**2 if kp is None else np.asarray(kp, dtype=float)
     kd = 2 * 0.9 * m_jj * wn if kd is None else np.asarray(kd, dtype=float)
+    kp, kd = np.array(kp, dtype=float), np.array(kd, dtype=float)
+    kp[[f for f, *_ in coupling]] = kd[[f for f, *_ in coupling]] = 0.0  # a follower is passive: no loop of its own
     step_q = 2 * np.pi / 2**encoder_bits
     if not controller:
         if dry != "sign":
             raise ValueError("inverse dynamics needs dry = 'sign' (a frictionloss constraint has no inverse of its own)")
         return _prescribed(model, qr, dqr, ddqr, rate, duration, drives.fc, rng, step_q, noise_share, torque_std, jitter,
-                           gaps, rate_change)
+                           gaps, rate_change, coupling)
     # fine-grained truth, every integration step, for the log's jittered instants
     n_fine = (n_ctrl - 1) * substeps + 1
     fine = {k: np.empty((n_fine, n)) for k in ("q", "dq", "ddq", "tau")}
@@ -208,7 +249,7 @@ def simulate(urdf_text: str, drives: Drives, motion: str, duration: float, rng: 
         dq_est = 0.7 * dq_est + 0.3 * (q_seen - q_prev) * rate if k else dqr[0]
         q_prev = q_seen
         err_sum += (qr[k] - q_seen) / rate
-        tau = rdata.qfrc_inverse + kp * (qr[k] - q_seen) + kd * (dqr[k] - dq_est) + ki * err_sum
+        tau = folded(rdata.qfrc_inverse, coupling) + kp * (qr[k] - q_seen) + kd * (dqr[k] - dq_est) + ki * err_sum
         for s in range(substeps if k < n_ctrl - 1 else 1):
             i = k * substeps + s
             data.qfrc_applied[:] = tau if sign_fc is None else tau - sign_fc * np.sign(data.qvel)
@@ -246,7 +287,8 @@ def _log_instants(duration, rate, rate_change, jitter, gaps, t_end, rng):
     return t_log[keep]
 
 
-def _prescribed(model, qr, dqr, ddqr, rate, duration, fc, rng, step_q, noise_share, torque_std, jitter, gaps, rate_change):
+def _prescribed(model, qr, dqr, ddqr, rate, duration, fc, rng, step_q, noise_share, torque_std, jitter, gaps, rate_change,
+                coupling=()):
     """A log of the reference motion itself, with MuJoCo's inverse dynamics plus fc·sign(q̇) as the torques."""
     import mujoco
 
@@ -260,7 +302,7 @@ def _prescribed(model, qr, dqr, ddqr, rate, duration, fc, rng, step_q, noise_sha
     for k in range(q.shape[0]):
         data.qpos[:], data.qvel[:], data.qacc[:] = q[k], dq[k], ddq[k]
         mujoco.mj_inverse(model, data)
-        tau[k] = data.qfrc_inverse + fc * np.sign(dq[k])
+        tau[k] = folded(data.qfrc_inverse + fc * np.sign(dq[k]), coupling)
     noise_std = noise_for_share(qr, rate, noise_share, rng).std(axis=0) if noise_share > 0 else np.zeros(q.shape[1])
     q_meas = np.round(q / step_q) * step_q + rng.normal(size=q.shape) * noise_std
     tau_meas = tau + rng.normal(size=tau.shape) * np.asarray(torque_std)

@@ -3,8 +3,8 @@ replay target: "on every config of configs/ and every zoo arm, the MJCF in MuJoC
 dynid's predicted torques to 1e-6 of the RMS torque where the format can hold the model, and the printed cost
 elsewhere is right").
 
-For each of the zoo's nine arms (benchmarks/zoo/zoo.py: example-robot-data's vendor URDFs, grippers fixed), the
-model dynid would export is the vendor file's links made physical (dynid's own ``physical_prior``) plus drive terms of
+For each arm of the zoo (benchmarks/zoo/zoo.py's ``ARMS``: example-robot-data's vendor URDFs, grippers fixed, the
+tracked UR5, the SCARA and the palletiser), the model dynid would export is the vendor file's links made physical (dynid's own ``physical_prior``) plus drive terms of
 the zoo's sizes (rotor inertia, Coulomb and viscous friction, and a torque offset, which neither format holds). dynid
 writes it as a URDF (``urdf_from_robot``) and an MJCF (``mjcf_from_robot``); Pinocchio's parser and RNEA (plus the
 URDF's ``<dynamics>`` friction) and MuJoCo's ``mj_inverse`` (armature, damping, frictionloss) read them back on 200
@@ -30,7 +30,7 @@ REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from zoo import ARMS, arm_urdf, drives_for, robots_folder  # noqa: E402
+from zoo import ARMS, arm_text, drives_for  # noqa: E402
 
 TARGET = 1e-6
 
@@ -39,14 +39,13 @@ def arm_model(name: str, folder: Path, rng: np.random.Generator):
     """The zoo arm's robot (drive terms Ia, fc, fv, offset) and the standard parameters dynid would export."""
     from dynid.model.description import robot_from_urdf
 
-    file, keep = ARMS[name]
     path = folder / "arm.urdf"
-    path.write_text(arm_urdf((robots_folder() / file).read_text(encoding="utf-8"), keep))
+    path.write_text(arm_text(name))  # on its track, the SCARA's and the palletiser's own
     robot = robot_from_urdf(path)
     phi = robot.physical_prior()[0].copy()
     drives = drives_for(robot, rng)
     names = list(robot.parameter_names)
-    offsets = 0.01 * np.where(np.isfinite(robot.limits.tau_max), robot.limits.tau_max, 50.0)
+    offsets = 0.01 * np.where(np.isfinite(robot.limits.tau_max), robot.limits.tau_max, 50.0) * robot.independent
     for j in range(robot.n_dof):
         for term, value in (("Ia", drives.ia[j]), ("fc", drives.fc[j]), ("fv", drives.fv[j]), ("offset", offsets[j])):
             phi[names.index(f"{term}{j + 1}")] = value

@@ -3,8 +3,10 @@
 Arms from the ``example-robot-data`` package (PyPI; ``pip install -e ".[zoo]"``): UR3, UR5, UR10, Franka Panda,
 Kinova Jaco 2 (j2s6s200), UFACTORY xArm7, Unitree Z1, SO-100, TALOS's left arm, TIAGo's torso lift and arm (a
 prismatic joint first), Baxter's right arm (a two-arm robot: its left arm, head and grippers fixed), Baxter's two arms
-as one model (a tree of 14 joints) and the UR5 on a 2 m linear track (:func:`on_a_track`), their grippers made fixed
-joints.
+as one model (a tree of 14 joints), the UR5 on a 2 m linear track (:func:`on_a_track`), a SCARA (:func:`scara_urdf`)
+and a palletiser whose passive joint follows another (a ``<mimic>``: tests/dynamics/test_mimic_joints.py's), their
+grippers made fixed joints. A follower is simulated as MuJoCo reads the ``<mimic>`` (a joint equality, made rigid
+here), undriven, and the logs hold the driven joints' columns only, as a palletiser's controller logs them.
 Each is simulated in MuJoCo (its own URDF parser, not dynid's or Pinocchio's; tests/mujoco_logs.py) under a
 joint-space PID loop at 1 kHz, with MuJoCo's armature (rotor inertia) and damping (viscous friction) and, as the dry
 friction truth, either MuJoCo's ``frictionloss`` constraint or ``fc·sign(q̇)``; encoder quantisation (20 bits) and
@@ -63,7 +65,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from tests.mujoco_logs import Drives, fourier_reference, simulate, stripped_urdf  # noqa: E402
+from tests.mujoco_logs import Drives, coupled, folded, fourier_reference, simulate, stripped_urdf  # noqa: E402
 
 ARMS = {
     # name: (file under example-robot-data's robots folder, the arm's joints: a regular expression)
@@ -82,6 +84,7 @@ ARMS = {
     "UR5 on a track": ("ur_description/urdf/ur5_robot.urdf",
                        r"^(track_joint|shoulder_pan|shoulder_lift|elbow|wrist_1|wrist_2|wrist_3)(_joint)?$"),
     "SCARA": ("", r"^j[1-4]$"),
+    "Palletiser": ("", r"^j[1-5]$"),  # j4 follows j3 (<mimic>); the gripper fixed
 }
 TRACKED = ("UR5 on a track",)
 """Arms put on a linear track here (:func:`on_a_track`): no public description has one."""
@@ -158,7 +161,10 @@ def arm_text(name: str) -> str:
     """The arm's URDF as :data:`ARMS` names it (on a track for :data:`TRACKED`; :func:`scara_urdf` for the SCARA), its
     other joints fixed."""
     file, keep = ARMS[name]
-    text = scara_urdf() if name == "SCARA" else (robots_folder() / file).read_text(encoding="utf-8")
+    if name == "Palletiser":
+        from tests.dynamics.test_mimic_joints import PALLETISER as text
+    else:
+        text = scara_urdf() if name == "SCARA" else (robots_folder() / file).read_text(encoding="utf-8")
     return arm_urdf(on_a_track(text) if name in TRACKED else text, keep)
 
 
@@ -202,8 +208,9 @@ def physical_urdf(text: str) -> tuple[str, list[str]]:
 
 
 def drives_for(robot, rng) -> Drives:
-    """Rotor inertia, viscous and dry friction of a size industrial drives have, from the joints' torque limits."""
-    tau = np.where(np.isfinite(robot.limits.tau_max), robot.limits.tau_max, 50.0)
+    """Rotor inertia, viscous and dry friction of a size industrial drives have, from the joints' torque limits; none
+    on a joint that follows another (it has no drive)."""
+    tau = np.where(np.isfinite(robot.limits.tau_max), robot.limits.tau_max, 50.0) * robot.independent
     return Drives(ia=0.0002 * tau * rng.uniform(0.5, 1.5, tau.size), fv=0.01 * tau * rng.uniform(0.5, 1.5, tau.size),
                   fc=0.02 * tau * rng.uniform(0.7, 1.3, tau.size))
 
@@ -224,11 +231,12 @@ def one_way(moving: tuple[int, ...]):
     return reference
 
 
-def write_log(path: Path, log, rng) -> None:
-    """time, positions, torques with 1-5 % of each joint's RMS torque as noise."""
+def write_log(path: Path, log, rng, logged=slice(None)) -> None:
+    """time, positions, torques with 1-5 % of each joint's RMS torque as noise; the columns of the joints ``logged``
+    (the driven ones: a follower's are not in a robot's log)."""
     rms = np.sqrt(np.mean(log.tau**2, axis=0))
     tau = log.tau + rng.normal(size=log.tau.shape) * rms * rng.uniform(0.01, 0.05, rms.size)
-    np.savetxt(path, np.column_stack([log.t, log.q_meas, tau]), delimiter=",", fmt="%.10g")
+    np.savetxt(path, np.column_stack([log.t, log.q_meas[:, logged], tau[:, logged]]), delimiter=",", fmt="%.10g")
 
 
 LOG_FITTED = "truth, one-way drive terms from the log"
@@ -334,15 +342,15 @@ def geared(log, drives, spring: tuple):
     return replace(log, tau=tau, q_meas=log.q_meas + lash)
 
 
-def cable_spring(valid, drives, sensor: bool) -> tuple:
+def cable_spring(valid, drives, sensor: bool, driven: np.ndarray) -> tuple:
     """``(rms, k, q₀)``: each joint's RMS torque on the validation log, a cable spring on the first and the
-    second-to-last joint whose torque has 3 % of that RMS over the validation motion, and its rest angle (the
-    motion's mean)."""
+    second-to-last of the ``driven`` joints whose torque has 3 % of that RMS over the validation motion, and its rest
+    angle (the motion's mean)."""
     tau = measured_side(valid, drives, sensor)
     rms = np.sqrt(np.mean(tau**2, axis=0))
-    n = tau.shape[1]
-    k = np.zeros(n)
-    k[[0, n - 2]] = 0.03 * rms[[0, n - 2]] / np.maximum(np.std(valid.q, axis=0)[[0, n - 2]], 1e-6)
+    k = np.zeros(tau.shape[1])
+    sprung = [driven[0], driven[-2]]
+    k[sprung] = 0.03 * rms[sprung] / np.maximum(np.std(valid.q, axis=0)[sprung], 1e-6)
     return rms, k, np.mean(valid.q, axis=0)
 
 
@@ -361,7 +369,7 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
     careless, changed = inconsistent_urdf(text)
     (folder / "arm_inconsistent.urdf").write_text(careless)
     robot, truth_robot = load_robot(str(folder / "arm.urdf")), load_robot(str(folder / "truth.urdf"))
-    n = robot.n_dof
+    n, driven = robot.n_dof, np.flatnonzero(robot.independent)
     drives = drives_for(robot, rng)
     lo, hi = np.maximum(robot.limits.q_min, -np.pi), np.minimum(robot.limits.q_max, np.pi)
     common = dict(rate=RATE, dry="sign", centre=(lo + hi) / 2, amplitude=np.minimum(0.6, 0.35 * (hi - lo)),
@@ -377,12 +385,12 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
     for kind in (k for k in CAD_CLASSES if k in classes):
         sensor = kind == "cad-sensor"
         stem = kind.replace("-", "_")
-        spring = cable_spring(valid, drives, sensor)
+        spring = cable_spring(valid, drives, sensor, driven)
         noise = np.random.default_rng([seed, 7, 3]) if kind == "cad-gear" else rng  # its own stream (module docstring)
         for label, log in (("valid", valid), ("ident", ident)):
             log = geared(log, drives, spring) if kind == "cad-gear" else log
             noisy = replace(log, tau=unmodelled(log, drives, noise, sensor, spring))
-            write_log(folder / f"{stem}_{label}.csv", noisy, noise)
+            write_log(folder / f"{stem}_{label}.csv", noisy, noise, driven)
         drive = np.zeros((n, 4)) if sensor else np.column_stack([drives.ia, drives.fc, drives.fv, np.zeros(n)])
         values = np.concatenate([phi, drive], axis=1).ravel()
         (folder / f"{stem}_truth.csv").write_text("name,value\n" + "".join(f"{k},{v:.12g}\n" for k, v in zip(names, values)))
@@ -392,9 +400,10 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
             f"{k},{fitted.get(k, v):.12g}\n" for k, v in zip(names, values)))
         extra = (f'[[references]]\nname = "{DRIVE_FITTED}"\nfile = "{stem}_fitted.csv"\nformat = "standard"\n'
                  'header = true\nnames = "name"\nvalues = "value"\n')
-        cfg = config(folder, n, f"{stem}_ident.csv", extra, valid=f"{stem}_valid.csv", truth=f"{stem}_truth.csv",
-                     sensor=sensor, urdf="arm_inconsistent.urdf" if kind == "cad-inconsistent" else "arm.urdf")
-        rows.append(identify_cell(cfg, folder, kind, {"arm": name, "joints": n, "truth": "sign", "class": kind,
+        cfg = config(folder, driven.size, f"{stem}_ident.csv", extra, valid=f"{stem}_valid.csv",
+                     truth=f"{stem}_truth.csv", sensor=sensor,
+                     urdf="arm_inconsistent.urdf" if kind == "cad-inconsistent" else "arm.urdf")
+        rows.append(identify_cell(cfg, folder, kind, {"arm": name, "joints": driven.size, "truth": "sign", "class": kind,
                                                       "repaired_links": repaired, "simulation_seconds": simulated,
                                                       **({"file_changed": changed} if kind == "cad-inconsistent" else {})}))
     return rows
@@ -412,10 +421,12 @@ def log_fitted_drive_terms(folder: Path, log: str, cutoff: float = 10.0, trim: f
     import pinocchio as pin
     from scipy.signal import butter, sosfiltfilt
 
-    model = pin.buildModelFromUrdf(str(folder / urdf))
+    model = pin.buildModelFromUrdf(str(folder / urdf))  # a <mimic> joint a free joint of its own
     data = model.createData()
     x = np.loadtxt(folder / log, delimiter=",")
-    n = model.nv
+    coupling = mimic_dofs(model, (folder / urdf).read_text())
+    driven = [k for k in range(model.nv) if k not in {f for f, *_ in coupling}]
+    n = len(driven)  # the log's joints: the driven ones
     t = np.arange(x[0, 0], x[-1, 0], 1.0 / RATE)
     q = np.column_stack([np.interp(t, x[:, 0], x[:, 1 + k]) for k in range(n)])
     tau = np.column_stack([np.interp(t, x[:, 0], x[:, 1 + n + k]) for k in range(n)])
@@ -424,6 +435,10 @@ def log_fitted_drive_terms(folder: Path, log: str, cutoff: float = 10.0, trim: f
     dq = np.gradient(q, t, axis=0)
     ddq = np.gradient(dq, t, axis=0)
     keep = slice(int(trim * RATE), t.size - int(trim * RATE))
+    every = [np.zeros((t.size, model.nv)) for _ in range(3)]  # every joint's, the followers' from their masters'
+    for whole, logged in zip(every, (q, dq, ddq)):
+        whole[:, driven] = logged
+    q_all, dq_all, ddq_all = coupled(tuple(every), coupling)
 
     def configuration(angles):  # a continuous joint's configuration is (cos, sin) in Pinocchio
         x = np.empty(model.nq)
@@ -432,16 +447,30 @@ def log_fitted_drive_terms(folder: Path, log: str, cutoff: float = 10.0, trim: f
                 else angles[k]
         return x
 
-    rigid = np.array([pin.rnea(model, data, configuration(q[i]), dq[i], ddq[i]) for i in range(keep.start, keep.stop)])
+    rigid = folded(np.array([pin.rnea(model, data, configuration(q_all[i]), dq_all[i], ddq_all[i])
+                             for i in range(keep.start, keep.stop)]), coupling)[:, driven]
     out = {}
-    for j in range(n):
-        v, a = dq[keep, j], ddq[keep, j]
+    for col, j in enumerate(driven):
+        v, a = dq[keep, col], ddq[keep, col]
         if not every_joint and min(np.mean(v > 0.01), np.mean(v < -0.01)) >= 0.01:  # it reverses: not one-way
             continue
         columns = {"Ia": a, "fc": np.sign(v), "fv": v, "offset": np.ones_like(v)}
-        coef = np.linalg.lstsq(np.column_stack([columns[k] for k in terms]), tau[keep, j] - rigid[:, j], rcond=None)[0]
+        coef = np.linalg.lstsq(np.column_stack([columns[k] for k in terms]), tau[keep, col] - rigid[:, col], rcond=None)[0]
         out.update({f"{k}{j + 1}": float(c) for k, c in zip(terms, coef)})
     return out
+
+
+def mimic_dofs(model, text: str) -> list[tuple[int, int, float, float]]:
+    """The URDF's ``<mimic>`` joints as ``(follower, master, multiplier, offset)`` velocity indices of Pinocchio's
+    ``model`` (read from the file here, not by dynid)."""
+    found = []
+    for joint in ET.fromstring(text).iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is not None and model.existJointName(joint.get("name")):
+            index = lambda name: model.joints[model.getJointId(name)].idx_v  # noqa: E731
+            found.append((index(joint.get("name")), index(mimic.get("joint")), float(mimic.get("multiplier", 1.0)),
+                          float(mimic.get("offset", 0.0))))
+    return found
 
 
 CHOICE: list[str] = []
@@ -480,7 +509,7 @@ def run_arm(name: str, out: Path, seed: int, classes=CLASSES) -> list[dict]:
         rng = np.random.default_rng(seed)
         robot = load_robot(str(folder / "arm.urdf"))
         truth_robot = load_robot(str(folder / "truth.urdf"))
-        n = robot.n_dof
+        n, driven = robot.n_dof, np.flatnonzero(robot.independent)
         drives = drives_for(robot, rng)
         lo, hi = np.maximum(robot.limits.q_min, -np.pi), np.minimum(robot.limits.q_max, np.pi)
         centre, amplitude = (lo + hi) / 2, np.minimum(0.6, 0.35 * (hi - lo))
@@ -494,13 +523,14 @@ def run_arm(name: str, out: Path, seed: int, classes=CLASSES) -> list[dict]:
         t0 = time.perf_counter()
         logs = {"valid": simulate(truth_text, drives, "fourier", 20.0, rng, f0=0.15, harmonics=5, **common),
                 "excitation": simulate(truth_text, drives, "fourier", 60.0, rng, f0=0.1, harmonics=5, **common),
-                "short": simulate(truth_text, drives, "fourier", 5.0, rng, reference=one_way((1, n - 2)), **common),
+                "short": simulate(truth_text, drives, "fourier", 5.0, rng, reference=one_way((driven[1], driven[-2])),
+                                  **common),
                 "ptp": simulate(truth_text, drives, "ptp", 40.0, rng, **common)}
         simulated = time.perf_counter() - t0
         for key, log in logs.items():
-            write_log(folder / f"{key}.csv", log, rng)
+            write_log(folder / f"{key}.csv", log, rng, driven)
         dead = np.loadtxt(folder / "excitation.csv", delimiter=",")
-        dead[:, 1 + n + n // 2] = 0.0
+        dead[:, 1 + driven.size + driven.size // 2] = 0.0
         np.savetxt(folder / "dead.csv", dead, delimiter=",", fmt="%.10g")
         for kind in classes:
             extra = ""
@@ -510,16 +540,17 @@ def run_arm(name: str, out: Path, seed: int, classes=CLASSES) -> list[dict]:
                     f"{k},{fitted.get(k, v):.12g}\n" for k, v in zip(names, values)))
                 extra = (f'[[references]]\nname = "{LOG_FITTED}"\nfile = "short_fitted.csv"\nformat = "standard"\n'
                          'header = true\nnames = "name"\nvalues = "value"\n')
-            cfg = config(folder, n, f"{kind}.csv", extra)
-            rows.append(identify_cell(cfg, folder, kind, {"arm": name, "joints": n, "truth": truth_kind, "class": kind,
-                                                          "repaired_links": repaired, "simulation_seconds": simulated}))
+            cfg = config(folder, driven.size, f"{kind}.csv", extra)
+            rows.append(identify_cell(cfg, folder, kind, {"arm": name, "joints": driven.size, "truth": truth_kind, "class": kind,
+                                                          "repaired_links": repaired, "simulation_seconds": simulated,
+                                                          "driven": driven.tolist()}))
     return rows
 
 
 def identify_cell(cfg: Path, folder: Path, kind: str, row: dict) -> dict:
     """``dynid identify`` on one cell's config, its row of the table: the main estimate's validation error over the
     truth's, the nominal model's, and what the log cannot tell (the log-fitted reference, where the config has one)."""
-    n = row["joints"]
+    driven = row.get("driven", list(range(row["joints"])))  # the joints the log holds (not a follower)
     t1 = time.perf_counter()
     p = subprocess.run([sys.executable, "-m", "dynid", "identify", str(cfg), "--out", str(folder / f"out-{kind}"),
                         "--no-figures", "-q"], capture_output=True, text=True, timeout=1800)
@@ -532,7 +563,7 @@ def identify_cell(cfg: Path, folder: Path, kind: str, row: dict) -> dict:
         main = r["main_estimate"]
         err = {k: m["global_relative_error"] for k, m in v["metrics"].items()}
         if kind == "dead":  # the dead joint's own drive terms are in no live row: over the other joints too
-            live = [j for j in range(n) if j != n // 2]
+            live = [j for j in driven if j != driven[len(driven) // 2]]
             rms = np.asarray(v["rms_torque"], dtype=float)[live]
 
             def over_live(label):
@@ -551,7 +582,7 @@ def identify_cell(cfg: Path, folder: Path, kind: str, row: dict) -> dict:
                    floor=(v.get("noise_floor") or {}).get("global_relative_error"),
                    from_prior=r["diagnostics"].get("from_prior", []),
                    findings=[f["kind"] for f in r["findings"]], readiness=r.get("readiness", ""))
-    print(json.dumps({k: row[k] for k in row if k not in ("findings", "from_prior", "repaired_links")}), flush=True)
+    print(json.dumps({k: row[k] for k in row if k not in ("findings", "from_prior", "repaired_links", "driven")}), flush=True)
     return row
 
 

@@ -204,3 +204,29 @@ def test_a_dh_table_states_a_coupling_as_a_urdf_does(tmp_path, rng):
     with pytest.raises(ConfigError, match=r"mimic describe a DH chain, but the chain is p.urdf's"):
         load_robot(tmp_path / "u.toml")
 
+
+def test_the_folded_model_is_what_mujocos_constrained_simulation_needs(palletiser):
+    """Outside dynid and Pinocchio: MuJoCo simulates the file (its parser reads each `<mimic>` as a joint equality, made
+    rigid) under a loop that drives the masters only, the followers passive. dynid's folded RNEA at MuJoCo's states
+    equals the torques that moved it on every driven joint, to 1e-5 of each arm joint's RMS and 1e-2 of the light
+    finger's (MuJoCo's equality gives way by 1e-4 of the constraint force: it is a soft constraint); leaving a follower's row
+    unfolded (its drive given nothing, as a free joint would be) is off by a large share, so the identity can fail."""
+    from tests.mujoco_logs import Drives, simulate
+
+    robot = load_robot(palletiser)
+    zero = Drives(*(np.zeros(robot.n_dof) for _ in range(3)))
+    log = simulate(PALLETISER, zero, "fourier", 2.0, np.random.default_rng(5), f0=0.5, harmonics=3, dry="sign",
+                   centre=[0.0, 0.0, 0.0, 0.1, 0.0, 0.02, 0.02], amplitude=[0.6, 0.6, 0.6, 0.6, 0.6, 0.015, 0.015],
+                   jitter=0.0, gaps=0, noise_share=0.0, torque_std=0.0)
+    assert np.abs(log.q[:, 3] - (0.1 - log.q[:, 2])).max() < 1e-5 and np.abs(log.q[:, 6] - log.q[:, 5]).max() < 1e-5
+    ours = rnea_torques(robot, log.q, log.dq, log.ddq)
+    driven = [0, 1, 2, 4, 5]
+    rms = np.sqrt(np.mean(log.tau[:, driven] ** 2, axis=0))
+    assert np.all(log.tau[:, [3, 6]] == 0.0) and np.all(ours[:, [3, 6]] == 0.0)
+    off = np.abs(ours[:, driven] - log.tau[:, driven]).max(axis=0) / rms
+    assert off[:4].max() < 1e-5 and off[4] < 1e-2, off  # the finger's 0.3 kg: MuJoCo's equality is soft by 1e-4
+    model = pin.buildModelFromUrdf(str(palletiser))  # its mimic joints free joints: their own rows
+    data = model.createData()
+    own = np.array([pin.rnea(model, data, *(x[k] for x in (log.q, log.dq, log.ddq))) for k in range(0, len(log.t), 10)])
+    unfolded = np.abs(own[:, [2, 5]] - log.tau[::10, [2, 5]]).max(axis=0) / rms[[2, 4]]  # j3 and finger_a alone
+    assert unfolded.min() > 0.1, unfolded
