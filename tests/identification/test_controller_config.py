@@ -265,3 +265,46 @@ def test_the_reference_is_read_at_the_angles_the_log_is(tmp_path):
     reference = config.controller.reference.read()
     assert np.allclose(reference, logged, atol=1e-9)
     assert np.allclose(reference[:, 1] - q[:, 1], np.pi / 2)
+
+
+def test_a_coupled_robots_closed_loop_log_is_identified_from_its_driven_joints(tmp_path):
+    """issue "Every arm a user has": a palletiser whose j4 follows j3 (`<mimic>`), its closed-loop log, gains and
+    set-points given for the four driven joints as its controller has them: `dynid identify` runs IDIM-IV and DIDIM
+    beside least squares (the closed-loop simulation refused such a robot before), each converged."""
+    from ..dynamics.test_mimic_joints import PALLETISER, _closed_loop_palletiser
+
+    (tmp_path / "palletiser.urdf").write_text(PALLETISER)
+    robot, t, q_ref, _, controller, run = _closed_loop_palletiser(tmp_path / "palletiser.urdf")
+    driven = [0, 1, 2, 4]
+    names = [robot.joints[j].name for j in driven]
+    np.savetxt(tmp_path / "log.csv", np.column_stack([t, run.q[:, driven], run.tau[:, driven]]), delimiter=",",
+               header="t," + ",".join(f"{n}_q" for n in names) + "," + ",".join(f"{n}_tau" for n in names), comments="",
+               fmt="%.12g")
+    np.savetxt(tmp_path / "ref.csv", q_ref[:, driven], delimiter=",", fmt="%.12g")
+    gains = {k: getattr(controller, k)[driven].tolist() for k in ("kp", "kd", "ki")}
+    (tmp_path / "cl.toml").write_text(f'''[robot]
+urdf = "palletiser.urdf"
+held = ["finger_a_joint", "finger_b_joint"]
+drive_terms = ["Ia", "fc", "fv", "offset"]
+[identification]
+file = "log.csv"
+header = true
+time = {{ column = "t" }}
+positions = {{ columns = [{", ".join(f'"{n}_q"' for n in names)}] }}
+torques = {{ columns = [{", ".join(f'"{n}_tau"' for n in names)}] }}
+[estimation]
+estimators = ["wls", "idim-iv", "didim"]
+[controller]
+kp = {gains["kp"]}
+kd = {gains["kd"]}
+ki = {gains["ki"]}
+rate = 500.0
+velocity_cutoff = {controller.velocity_cutoff}
+reference = {{ file = "ref.csv", positions = [1, 2, 3, 4] }}
+''')
+    p = dynid_cli("identify", tmp_path / "cl.toml", "--out", tmp_path / "out", "--no-figures")
+    assert p.returncode == 0, p.stderr
+    estimates = json.loads((tmp_path / "out" / "results.json").read_text())["estimates"]
+    assert list(estimates) == ["dynid WLS", "dynid IDIM-IV", "dynid DIDIM"]
+    for label in ("dynid IDIM-IV", "dynid DIDIM"):
+        assert "note" not in estimates[label], (label, estimates[label].get("note"))

@@ -213,7 +213,8 @@ def closed_loop_identify(robot: Robot, base: BaseParameters, recording: Recordin
         phi = x if standard else base.standard_from_base(x, reference=nominal)
         run = simulate_closed_loop(robot, recording.t, experiment.q_ref, experiment.dq_ref, experiment.controller,
                                    ClosedLoopNoise(), phi=phi, feedforward=experiment.feedforward)
-        sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate)
+        sim = Recording(f"{recording.name} (simulated)", recording.t, run.q, None, run.tau_applied, recording.rate,
+                        followers=robot.followers)
         ws, _, moving = prepared_rows(robot, base, prepare(sim, data.settings, strict=False), standard)
         if ws.shape[0] != keep.size:
             raise DataError(f"{recording.name}: the simulated log prepares to {ws.shape[0] // n} samples, the measured one to "
@@ -408,6 +409,10 @@ class ClosedLoopEstimator:
         """
         controller = self.setup.controller
         q_ref = self.setup.reference_positions()
+        if robot.followers and q_ref.ndim == 2 and q_ref.shape[1] == int(robot.independent.sum()):
+            wide = np.zeros((q_ref.shape[0], robot.n_dof))  # the set-points of the driven joints, as a log holds them
+            wide[:, robot.independent] = q_ref
+            q_ref = robot.coupled(wide)[0]
         if q_ref.shape[0] != recording.t.size:
             where = getattr(self.setup.reference, "file", "the reference")
             raise DataError(f"{where}: {q_ref.shape[0]} rows of set-points, the identification log has "

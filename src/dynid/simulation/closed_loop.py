@@ -10,6 +10,11 @@ with ``M_rigid`` and ``h_rigid`` from Pinocchio (CRBA and the non-linear effects
 dynid's friction table (rotor inertia, Coulomb, viscous, offset, coupled motors) added, integrated by a fixed-step
 fourth-order Runge–Kutta at the control rate. The logged torques are the commanded ones plus measurement noise.
 
+A joint that follows another (a ``<mimic>``: ``q_f = m·q_k + c``) has no drive: the motion lives in the independent
+joints' coordinates ``q̇ = G ν``, where ``G`` puts ``m`` in the follower's row, and ``Gᵀ M G ν̇ = Gᵀ (τ − h)`` (the
+equations of motion projected onto the coupling, virtual work: the follower's torque goes to its master times ``m``),
+so the follower stays on its coupling; its commanded torque is 0.
+
 The same simulator, given a model's standard parameters instead of the truth, is what the closed-loop estimators
 (IDIM-IV, DIDIM) simulate at each iteration.
 
@@ -157,7 +162,8 @@ class ClosedLoopSetup:
         The joint controller and its rate.
     reference : (N, n_dof) array [rad], or an object with ``read() -> (N, n_dof) array``
         The position set-points, one per sample of the log as read (a config's reference file is read when the
-        estimators run).
+        estimators run); for a robot whose joints follow others (``<mimic>``), the driven joints' columns alone may be
+        given, as its log holds them.
     feedforward : bool
         Whether the controller added the model's torques along the reference (computed with the identified model's
         description, :func:`dynid.dynamics.rnea.rnea_torques`).
@@ -295,9 +301,15 @@ class JointDynamics:
             self._no_acceleration = np.zeros((1, n))
         self._lower = np.tril_indices(n, -1)
         # a diagonal drive inertia (rotor inertias, no coupled motor) is Pinocchio's armature: ABA then gives q̈ in one
-        # call; a coupled motor's inertia is off the diagonal: M from CRBA, solved
+        # call; a coupled motor's inertia is off the diagonal, and a <mimic> joint moves with its master: M from CRBA,
+        # solved (projected onto the coupling, module docstring)
         off_diagonal = self.drive_inertia - np.diag(np.diag(self.drive_inertia))
-        self._aba = not np.any(off_diagonal)
+        self.followers = list(robot.followers)
+        self._coupling = np.eye(n)[:, robot.independent]  # G: q̇ = G ν
+        for j in self.followers:
+            k, multiplier, _ = robot.joints[j].mimic  # type: ignore[misc]
+            self._coupling[j] = multiplier * self._coupling[k]
+        self._aba = not np.any(off_diagonal) and not self.followers
         if self._aba:
             self.model.armature = np.diag(self.drive_inertia).copy()
 
@@ -368,7 +380,12 @@ class JointDynamics:
         if self._aba:
             return self._pin.aba(self.model, self.data, q, dq, tau - self.drive_torques(dq))
         m, h = self.mass_and_bias(q, dq)
-        return np.linalg.solve(m, tau - h)
+        if not self.followers:
+            return np.linalg.solve(m, tau - h)
+        g = self._coupling
+        tau = tau.copy()
+        tau[self.followers] = 0.0  # a follower has no drive
+        return g @ np.linalg.solve(g.T @ m @ g, g.T @ (tau - h))
 
 
 def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller, noise: ClosedLoopNoise = ClosedLoopNoise(),
@@ -401,12 +418,13 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
     ShapeError
         Arrays of other shapes than (N, n_dof), or instants not ``1/rate`` apart.
     ConfigError
-        Noise without ``rng``, parameters with a massless link, or a robot whose joints follow others (``<mimic>``).
+        Noise without ``rng`` or parameters with a massless link.
+
+    Notes
+    -----
+    A joint that follows another (``<mimic>``) moves as it says whatever its reference columns hold, and its commanded
+    torque is 0 (module docstring).
     """
-    if robot.followers:  # its forward dynamics would move them freely: no constraint holds them to their joints
-        raise ConfigError(f"robot {robot.name!r}: {', '.join(robot.joints[j].name for j in robot.followers)} follow "
-                          "other joints (<mimic>): the closed-loop simulation (IDIM-IV, DIDIM, dynid montecarlo's closed "
-                          "loop) does not hold such couplings; identify with the open-loop estimators (WLS, SDP)")
     n = robot.n_dof
     t = np.asarray(t, dtype=float).reshape(-1)
     q_ref, dq_ref = (np.asarray(x, dtype=float) for x in (q_ref, dq_ref))
@@ -414,6 +432,7 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
     for name, x in (("q_ref", q_ref), ("dq_ref", dq_ref), ("feedforward", ff)):
         if x.shape != (t.size, n):
             raise ShapeError(f"{name}: expected shape ({t.size}, {n}), got {x.shape}")
+    q_ref, dq_ref = robot.coupled(q_ref, dq_ref)[:2]
     h = 1.0 / controller.rate
     if t.size < 2 or not np.allclose(np.diff(t), h, rtol=1e-6, atol=1e-12):
         raise ShapeError(f"t: expected instants 1/rate = {h:.6g} s apart")
@@ -454,9 +473,12 @@ def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDy
             return dynamics.accelerations(x, v, tau)
     # the encoder's noise drawn at once: the same numbers as one draw per instant (a Generator's stream)
     draws = rng.normal(0.0, noise.position_std, (t.size, n)) if noise.position_std > 0 else None
+    followers = dynamics.followers
     for k in range(t.size):
         y = noise.measured_positions(q, rng, None if draws is None else draws[k]) if position_noise else q.copy()
         control(y, previous, k == 0, velocity, alpha, h, q_ref[k], dq_ref[k], ff[k], kp, kd, ki, integral, tau)
+        if followers:
+            tau[followers] = 0.0  # a <mimic> joint has no drive: its master moves it
         first_input(dq, tau, fc, fv, offset, u)
         a1 = accelerations(q, dq, tau, u)
         q_true[k], dq_true[k], ddq_true[k], tau_applied[k], q_meas[k] = q, dq, a1, tau, y
@@ -469,6 +491,8 @@ def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDy
         stage(q, v3, dq, a3, h, tau, fc, fv, offset, qs, v4, u)
         a4 = accelerations(qs, v4, tau, u)
         advance(q, dq, v2, v3, v4, a1, a2, a3, a4, h)
+        if followers:  # on its coupling to the last bit, not to the integrator's rounding
+            q[:], dq[:] = (x[0] for x in dynamics.robot.coupled(q[None], dq[None])[:2])
         if not math.isfinite(q.dot(q) + dq.dot(dq)):  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
             raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
                               "or a model that cannot be simulated")

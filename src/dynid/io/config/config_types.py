@@ -118,8 +118,8 @@ class ControllerTable(Table, kw_only=True):
     """``[controller]``: the joint controller that drove the identification run, for the closed-loop estimators
     (IDIM-IV, DIDIM: :mod:`dynid.identification.closed_loop_estimators`)."""
 
-    kp: Annotated[GainValues, _d("N·m/rad: proportional gain, one value or one per joint")]
-    kd: Annotated[GainValues, _d("N·m·s/rad: derivative gain, one value or one per joint")]
+    kp: Annotated[GainValues, _d("N·m/rad: proportional gain, one value or one per joint (per driven joint where joints follow others)")]
+    kd: Annotated[GainValues, _d("N·m·s/rad: derivative gain, one value or one per joint (per driven joint where joints follow others)")]
     ki: Annotated[GainValues, _d("N·m/(rad·s): integral gain (default 0: PD)")] | None = None
     rate: Annotated[PositiveHz, _d("Hz: the control rate; the identification log is logged at it")]
     velocity_cutoff: Annotated[NonNegative, _d("Hz: first-order filter of the drive's velocity estimate (0: none)")] | None = None

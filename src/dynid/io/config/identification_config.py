@@ -363,8 +363,7 @@ def config_from_document(doc: dict, path: Path, data_root: str | Path | None = N
     n = robot.n_dof
     ident, validation = _datasets(doc, path, root, robot)
     pre = _preprocessing_of(typed.preprocessing, path, n)
-    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot.n_dof,
-                             robot.transmission.position_offset)
+    controller = _controller(doc.get("controller"), root, f"{path}: controller", robot)
     estimation = _estimation_settings(typed.estimation, pre, path, controller is not None)
     refs = doc.get("references", [])
     _check_reference_names(refs, path)
@@ -548,26 +547,44 @@ def _robots_mjcf(doc: dict, path: Path, root: Path, robot) -> Path | None:
     return None if mjcf is None or robot.held else _mjcf_model(str(mjcf), path.parent, robot, None, path)
 
 
-def _controller(table, root: Path, where: str, n: int, offset=None):
+def _controller(table, root: Path, where: str, robot):
     """The :class:`~dynid.simulation.closed_loop.ClosedLoopSetup` of a ``[controller]`` table (typed already), or None;
-    the set-points are read as the logs' angles are, the robot's position offsets ``offset`` (n,) added."""
+    the set-points are read as the logs' angles are, the robot's position offsets added. A robot whose joints follow
+    others (``<mimic>``) has its gains and set-points given for the driven joints, as its logs hold them (a follower has
+    no drive: it is given its master's gains, which act on nothing)."""
     if table is None:
         return None
     from ...simulation.closed_loop import ClosedLoopSetup, Controller
 
+    n, driven = robot.n_dof, np.flatnonzero(robot.independent)
     try:
-        controller = Controller.of(n, table["kp"], table["kd"], table.get("ki", 0.0), float(table["rate"]),
-                                   float(table.get("velocity_cutoff", 0.0)))
+        kp, kd, ki = (_every_joint(table.get(k, 0.0), robot) for k in ("kp", "kd", "ki"))
+        controller = Controller.of(n, kp, kd, ki, float(table["rate"]), float(table.get("velocity_cutoff", 0.0)))
     except ConfigError as exc:
         raise ConfigError(f"{where}: {str(exc).removeprefix('controller.')}") from None
     ref = table["reference"]
-    if len(ref["positions"]) != n:
-        raise ConfigError(f"{where}.reference.positions: expected {n} columns (one per joint), got {ref['positions']!r}")
+    offset = robot.transmission.position_offset
+    if robot.followers and len(ref["positions"]) == driven.size:
+        offset = None if offset is None else np.asarray(offset)[driven]
+    elif len(ref["positions"]) != n:
+        joints = f"{driven.size} columns (one per driven joint)" if robot.followers else f"{n} columns (one per joint)"
+        raise ConfigError(f"{where}.reference.positions: expected {joints}, got {ref['positions']!r}")
     reference = ReferenceTrajectory(root / ref["file"], tuple(ref["positions"]), bool(ref.get("header", False)),
                                     np.pi / 180 if ref.get("unit") == "deg" else 1.0,
                                     None if ref.get("rows") is None else (int(ref["rows"][0]), int(ref["rows"][1])),
                                     None if offset is None else tuple(float(x) for x in offset))
     return ClosedLoopSetup(controller, reference, feedforward=table.get("feedforward", "none") == "model")
+
+
+def _every_joint(gain, robot):
+    """A gain given per driven joint of a robot with followers, one per joint: a follower takes its master's."""
+    if not robot.followers or np.ndim(gain) != 1 or len(gain) != int(robot.independent.sum()):
+        return gain
+    wide = np.zeros(robot.n_dof)
+    wide[robot.independent] = np.asarray(gain, dtype=float)
+    for j in robot.followers:
+        wide[j] = wide[robot.joints[j].mimic[0]]
+    return wide
 
 
 @dataclass(frozen=True)
