@@ -124,6 +124,11 @@ def test_the_report_says_a_flag_several_logs_share_once_and_what_export_writes()
                        "p2: J1 barely moves (RMS 0.6 N·m)"]
     assert _identify_summary({**d, "validation": []})[0] == ("Use dynid OLS, not physically consistent; dynid export writes dynid SDP, "
                                        "which is consistent.")
+    consistent = {**d, "validation": [], "physically_consistent_verdict": {"dynid OLS": "yes", "dynid SDP": "yes"}}
+    assert _identify_summary(consistent)[0] == (
+        "Use dynid OLS, physically consistent; dynid export writes dynid SDP, the consistent estimate with a whole set of "
+        "standard parameters (the main estimate's are base parameters alone).")
+    assert _identify_summary({**consistent, "main_estimate": "dynid SDP"})[0] == "Use dynid SDP, physically consistent."
 
 
 def test_a_dead_torque_channel_is_said_where_the_errors_say_over_all_joints():

@@ -245,6 +245,14 @@ def test_the_main_estimate_line_names_what_export_writes_in_a_whole_sentence():
     lines = [line.text for line in in_short(result)]
     assert lines[1] == ("main estimate: dynid WLS, not physically consistent; dynid export writes dynid SDP, which is "
                         "physically consistent")
+    # a consistent WLS (base parameters alone) exported as the SDP: said too (the simulated palletiser's; the line said
+    # "physically consistent" and the first line "model ready: dynid SDP", with nothing between)
+    consistent = SimpleNamespace(**{**vars(result), "consistency_verdicts": {"dynid WLS": "yes", "dynid SDP": "yes"}})
+    assert [line.text for line in in_short(consistent)][1] == (
+        "main estimate: dynid WLS, physically consistent; dynid export writes dynid SDP, the consistent estimate with a "
+        "whole set of standard parameters (the main estimate's are base parameters alone)")
+    exported = SimpleNamespace(**{**vars(consistent), "main_estimate": SimpleNamespace(label="dynid SDP"), "main": "dynid SDP"})
+    assert [line.text for line in in_short(exported)][1] == "main estimate: dynid SDP, physically consistent"
 
 
 def test_a_cutoff_candidate_not_scored_shows_a_dash_not_inf():

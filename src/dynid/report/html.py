@@ -255,11 +255,15 @@ def _identify_summary(d: dict) -> list[str]:
     verdicts = d.get("physically_consistent_verdict", {})
     verdict = verdicts.get(label, "")
     # what dynid export writes when the main estimate is not consistent (the terminal's "In short" says it too)
-    export = next((n for n, e in (d.get("estimates") or {}).items() if isinstance(e, dict) and e.get("standard_values")
-                   and str(verdicts.get(n, "")).startswith("yes")), None)
-    out = [f"Use {label}" + ("" if not verdict else ", physically consistent." if verdict.startswith("yes")
-                              else ", not physically consistent" + (f"; dynid export writes {export}, which is consistent."
-                                                                    if export else "."))] if label else []
+    estimates = d.get("estimates") or {}
+    export = next((n for n in sorted(estimates, key=lambda n: n != label) if isinstance(estimates[n], dict)
+                   and estimates[n].get("standard_values") and str(verdicts.get(n, "")).startswith("yes")), None)
+    writes = "" if export in (None, label) else (
+        f"; dynid export writes {export}, the consistent estimate with a whole set of standard parameters (the main "
+        "estimate's are base parameters alone)." if verdict.startswith("yes") else
+        f"; dynid export writes {export}, which is consistent.")
+    out = [f"Use {label}" + ("" if not verdict else ", physically consistent" + (writes or ".") if verdict.startswith("yes")
+                              else ", not physically consistent" + (writes or "."))] if label else []
     if d.get("readiness") and not str(d["readiness"]).startswith("model ready:"):  # the terminal's first line
         out.insert(0, str(d["readiness"]) + ".")
     if d.get("files_withheld"):  # its first clause: what was not written and why

@@ -856,10 +856,13 @@ def in_short(result, *, brief: bool = False) -> list:
     verdict = r.consistency_verdicts.get(label, "")
     consistent = verdict.startswith("yes")
     exportable = _exportable(r)
-    export = "" if not exportable or consistent else f"; dynid export writes {exportable[0]}, which is physically consistent"
+    export = "" if not exportable or exportable[0] == label else (
+        f"; dynid export writes {exportable[0]}, which is physically consistent" if not consistent else
+        f"; dynid export writes {exportable[0]}, the consistent estimate with a whole set of standard parameters (the "
+        "main estimate's are base parameters alone)")
     out = [Line("In short (the details follow)", "title"),
            Line(f"main estimate: {label}" + ("" if not verdict else
-                                             ", physically consistent" if consistent else
+                                             f", physically consistent{export}" if consistent else
                                              f", not physically consistent{export}"))]
     lines, errors = _log_lines(r, label)
     out += lines + _yardstick_lines(r, label)
