@@ -264,11 +264,10 @@ def test_the_consistent_drive_only_set_is_exported_where_it_predicts_as_well_as_
     squares. It is now the main estimate, what export writes, where it predicts the validation logs as well as least
     squares (to 2 %) and better than the SDP; the SDP's rule comes first, and a drive-only set 5 % worse leaves least
     squares the main estimate. The figures weighed are set here; the estimates and logs are a real identification's."""
+    from dataclasses import replace
     from types import SimpleNamespace
 
     from dynid.identification.verdict import choose_main_estimate
-
-    from dataclasses import replace
 
     result, evidence = _evidence_of_an_identification(tmp_path, monkeypatch)
     result = replace(result, validations=evidence.validations)  # as decide gives it
