@@ -256,7 +256,8 @@ class ClosedLoopRun:
 
 
 class JointDynamics:
-    """Direct dynamics of a robot with given standard parameters: ``q̈ = M(q)⁻¹ (τ − h(q, q̇))``.
+    """Direct dynamics of a robot with given standard parameters: ``q̈ = M(q)⁻¹ (τ − h(q, q̇))``, or, with joints
+    that follow others (``<mimic>``), ``q̈ = G (GᵀMG)⁻¹ Gᵀ (τ − h)`` with the followers' torques 0 (module docstring).
 
     The rigid bodies are Pinocchio's (CRBA and non-linear effects); the drive terms are dynid's friction table:
     their inertia (rotor inertia, coupled motors) is constant and joins ``M``; their velocity terms join ``h``.
@@ -320,7 +321,7 @@ class JointDynamics:
         Returns
         -------
         (fc, fv, offset) : (n_dof,) arrays [N·m, N·m·s/rad, N·m], or None
-            None with coupled motors, a smoothed Coulomb friction or other drive terms.
+            None with coupled motors, joints that follow others, a smoothed Coulomb friction or other drive terms.
         """
         if self._aba and self._fast and not self._smooth and not self._coupled:
             return self._fc, self._fv, self._offset
