@@ -409,10 +409,8 @@ class ClosedLoopEstimator:
         """
         controller = self.setup.controller
         q_ref = self.setup.reference_positions()
-        if robot.followers and q_ref.ndim == 2 and q_ref.shape[1] == int(robot.independent.sum()):
-            wide = np.zeros((q_ref.shape[0], robot.n_dof))  # the set-points of the driven joints, as a log holds them
-            wide[:, robot.independent] = q_ref
-            q_ref = robot.coupled(wide)[0]
+        if q_ref.ndim == 2 and q_ref.shape[1] != robot.n_dof:  # the driven joints' set-points, as a log holds them
+            q_ref = robot.coupled(robot.widened(q_ref))[0]
         if q_ref.shape[0] != recording.t.size:
             where = getattr(self.setup.reference, "file", "the reference")
             raise DataError(f"{where}: {q_ref.shape[0]} rows of set-points, the identification log has "

@@ -17,8 +17,7 @@ worse than the description", item 1).
    squares' predictions leave the range the identification log supports) and it predicts them better; or where least
    squares, not physically consistent, stays the main estimate against the SDP (so the SDP would be what ``dynid
    export`` writes) and the drive-only set is physically consistent, predicts them as well as least squares (to
-   :data:`SAME_FIGURE`) and better than the SDP (on the zoo's TIAGo the SDP, pulled toward the description, predicted
-   a log 6× worse than least squares; the drive-only set as well as the truth);
+   :data:`SAME_FIGURE`) and better than the SDP (benchmarks/README.md: what the written files hold, on the zoo);
 4. the description's nominal model itself, where it predicts the validation logs better than every estimate: the
    main estimate is then the robot file's values, and the first finding says to keep them.
 
@@ -429,7 +428,8 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple, weighe
     far = [f for f in _validation_findings(result) if f.kind == "extrapolation"]
     better = _mean_error(weighed, DRIVE_ONLY_LABEL)
     doubtful = (described < own or far) and better < own
-    instead = consistent_instead and better <= SAME_FIGURE * own and better < _mean_error(weighed, SDP_LABEL)
+    sdp = _mean_error(weighed, SDP_LABEL) if consistent_instead else np.inf
+    instead = consistent_instead and better <= SAME_FIGURE * own and better < sdp
     if not (doubtful or instead):
         return None
     margins, verdicts = consistency_checks(result.model, result.base, {DRIVE_ONLY_LABEL: alt.params})
@@ -447,7 +447,7 @@ def _drive_only_preferred(result, main: str, nominal: str, scored: tuple, weighe
            f"description's nominal model {described:.3g} %)" if doubtful else
            f"physically consistent where {main} is not, because it predicts the validation logs as well as {main}, to "
            f"{100 * (SAME_FIGURE - 1):g} % ({_apart(better, own)}{avg}), and better than {SDP_LABEL} "
-           f"({_mean_error(weighed, SDP_LABEL):.3g} %); it is what dynid export writes")
+           f"({sdp:.3g} %); it is what dynid export writes")
     finding = (f"main estimate: {DRIVE_ONLY_LABEL}, the description's rigid body with the drive terms (friction, offsets, "
                f"rotor inertia) fitted to this log, {how}; chosen on "
                f"the validation logs, so their figures for it are not an independent test{_held_note(alt.held, alt.undetermined)}")

@@ -121,19 +121,21 @@ class Limits:
         return (np.where(np.isfinite(self.q_min), self.q_min, -np.pi),
                 np.where(np.isfinite(self.q_max), self.q_max, np.pi))
 
-    def random_positions(self, n: int, rng) -> np.ndarray:
+    def random_positions(self, n: int, rng, span: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """``n`` poses drawn uniformly within :meth:`position_span`.
 
         Parameters
         ----------
         n : int
         rng : Generator or int seed
+        span : (lo, hi) of (n_dof,) arrays, optional
+            Another span to draw within (:meth:`Robot.coupled_span`).
 
         Returns
         -------
         (n, n_dof) array [rad]
         """
-        lo, hi = self.position_span()
+        lo, hi = self.position_span() if span is None else span
         return lo + np.random.default_rng(rng).random((n, lo.size)) * (hi - lo)
 
 
@@ -421,6 +423,42 @@ class Robot:
                     x[..., j] = multiplier * x[..., k] + (shift if offset else 0.0)
             out.append(x)
         return tuple(out)
+
+    def widened(self, x) -> np.ndarray:
+        """Columns of the robot's coordinates (a log's: none of a joint that follows another) as one per joint, a
+        follower's 0 (:meth:`coupled` fills its motion); an array with a column per joint, or on a robot without
+        followers, as given.
+
+        Parameters
+        ----------
+        x : (..., n_coordinates) array
+
+        Returns
+        -------
+        (..., n_dof) array
+        """
+        x = np.asarray(x, dtype=float)
+        if not self.followers or x.shape[-1] != int(self.independent.sum()):
+            return x
+        wide = np.zeros(x.shape[:-1] + (self.n_dof,))
+        wide[..., self.independent] = x
+        return wide
+
+    def coupled_span(self) -> tuple[np.ndarray, np.ndarray]:
+        """The joints' position spans (:meth:`Limits.position_span`), a joint that others follow narrowed to where they
+        stay within theirs (where its coupling can: out of range, a simulator's joint limit would act).
+
+        Returns
+        -------
+        lo, hi : (n_dof,) arrays [rad or m]
+        """
+        lo, hi = self.limits.position_span()
+        for j in self.followers:
+            k, multiplier, offset = self.joints[j].mimic  # type: ignore[misc]
+            a, b = sorted(((lo[j] - offset) / multiplier, (hi[j] - offset) / multiplier))
+            if max(lo[k], a) < min(hi[k], b):
+                lo[k], hi[k] = max(lo[k], a), min(hi[k], b)
+        return lo, hi
 
     def followers_said(self, *, columns: str = "no column of theirs in a log") -> str:
         """One line on the joints that follow another (``""`` on a robot without): which, how, and where their torque

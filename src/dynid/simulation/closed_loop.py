@@ -493,7 +493,7 @@ def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDy
         a4 = accelerations(qs, v4, tau, u)
         advance(q, dq, v2, v3, v4, a1, a2, a3, a4, h)
         if followers:  # on its coupling to the last bit, not to the integrator's rounding
-            q[:], dq[:] = (x[0] for x in dynamics.robot.coupled(q[None], dq[None])[:2])
+            q[:], dq[:] = dynamics.robot.coupled(q, dq)[:2]
         if not math.isfinite(q.dot(q) + dq.dot(dq)):  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
             raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
                               "or a model that cannot be simulated")

@@ -578,12 +578,10 @@ def _controller(table, root: Path, where: str, robot):
 
 def _every_joint(gain, robot):
     """A gain given per driven joint of a robot with followers, one per joint: a follower takes its master's."""
-    if not robot.followers or np.ndim(gain) != 1 or len(gain) != int(robot.independent.sum()):
-        return gain
-    wide = np.zeros(robot.n_dof)
-    wide[robot.independent] = np.asarray(gain, dtype=float)
-    for j in robot.followers:
-        wide[j] = wide[robot.joints[j].mimic[0]]
+    wide = robot.widened(gain) if np.ndim(gain) == 1 else gain
+    if np.shape(wide) != np.shape(gain):  # widened: a follower takes its master's gain
+        for j in robot.followers:
+            wide[j] = wide[robot.joints[j].mimic[0]]
     return wide
 
 

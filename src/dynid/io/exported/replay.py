@@ -79,13 +79,7 @@ def _states(robot: Robot, n: int, rng: np.random.Generator) -> tuple[np.ndarray,
     they stay within theirs too (out of range, a simulator's joint limit acts: not the model's torque), velocities and
     accelerations of a few rad/s and rad/s² (within their limits where given)."""
     lim = robot.limits
-    lo, hi = lim.position_span()
-    for j in robot.followers:
-        k, multiplier, offset = robot.joints[j].mimic  # type: ignore[misc]
-        a, b = sorted(((lo[j] - offset) / multiplier, (hi[j] - offset) / multiplier))
-        if max(lo[k], a) < min(hi[k], b):  # a coupling that can keep both within range
-            lo[k], hi[k] = max(lo[k], a), min(hi[k], b)
-    q = lo + rng.random((n, lo.size)) * (hi - lo)  # Limits.random_positions' draw
+    q = lim.random_positions(n, rng, span=robot.coupled_span())
     dq = rng.uniform(-1.0, 1.0, (n, robot.n_dof)) * np.minimum(np.where(np.isfinite(lim.dq_max), lim.dq_max, 2.0), 2.0)
     ddq = rng.uniform(-1.0, 1.0, (n, robot.n_dof)) * np.minimum(np.where(np.isfinite(lim.ddq_max), lim.ddq_max, 5.0), 5.0)
     return q, dq, ddq

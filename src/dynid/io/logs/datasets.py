@@ -305,17 +305,14 @@ def _coordinates_widened(robot: Robot, raw: dict, name: str = "", warnings: list
     sets it); signals with a column for every joint are kept, the followers' columns said unused in ``warnings``."""
     if not robot.followers:
         return raw
-    kept = np.flatnonzero(robot.independent)
     if warnings is not None and np.shape(raw.get("positions", ()))[1:] == (robot.n_dof,):  # every joint's columns
         names = ", ".join(robot.joints[j].name for j in robot.followers)
         warnings.append(f"{name}: the columns of {names} (<mimic>: a joint that follows another) are read and not used: "
                         "their motion is computed from the joints they follow, their torque is those joints'; list the "
                         "other joints' columns alone to leave them out")
     for key, x in raw.items():
-        x = np.asarray(x, dtype=float)
-        if x.ndim == 2 and x.shape[1] == kept.size:
-            raw[key] = np.zeros((x.shape[0], robot.n_dof))
-            raw[key][:, kept] = x
+        if np.ndim(x) == 2:
+            raw[key] = robot.widened(x)
     return raw
 
 
