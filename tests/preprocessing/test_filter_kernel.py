@@ -50,6 +50,33 @@ def test_the_parallel_decimation_of_a_long_log_is_the_same_through_either_filter
     assert np.all(np.concatenate([v for _, v in compiled])[:, 3] == 0.0) and np.ptp(compiled[0][1][:, 0]) > 0
 
 
+def test_a_regressor_and_its_torques_go_through_one_filter_together(monkeypatch):
+    """A regressor block and its torques, filtered together: the narrow torques take the compiled filter with the wide
+    regressor where their columns together reach :data:`COMPILED_FILTER_VALUES` (the torques alone would not), and
+    both are SciPy's numbers to the last bit."""
+    from dynid.preprocessing import _filter_kernel, filters
+
+    rng = np.random.default_rng(8)
+    y = np.cumsum(rng.standard_normal((9000, 3, 4)), axis=0)
+    tau = np.cumsum(rng.standard_normal((9000, 3)), axis=0)
+    calls = []
+    original = _filter_kernel.zero_phase
+    monkeypatch.setattr(filters, "zero_phase", lambda sos, x, *a, **k: calls.append(x.shape[1]) or original(sos, x, *a, **k))
+
+    def run():
+        return [(i.copy(), a.copy(), b.copy()) for i, (a, b) in
+                filters.parallel_decimation(lambda a, b: (y[a:b], tau[a:b]), 9000, 500.0, 5, chunk=2000)]
+
+    monkeypatch.setattr(filters, "COMPILED_FILTER_VALUES", 10**12)
+    scipys = run()
+    assert not calls
+    monkeypatch.setattr(filters, "COMPILED_FILTER_VALUES", 9000 * 15)  # more than the torques' 3 columns, less than 15
+    compiled = run()
+    assert sorted(set(calls)) == [3, 12]  # the torques' block too
+    for (i, a, b), (j, c, d) in zip(scipys, compiled):
+        assert np.array_equal(i, j) and np.array_equal(a, c) and np.array_equal(b, d)
+
+
 @pytest.mark.parametrize(("n", "sigma", "workers"), [(5000, 13.25, 1), (9000, 66.3, 2), (4099, 0.7, 2), (300, 40.0, 2),
                                                       (1, 3.0, 1), (2, 150.0, 2)])
 def test_the_compiled_gaussian_smoothing_is_scipys_bit_for_bit(n, sigma, workers):

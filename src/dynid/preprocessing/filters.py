@@ -169,8 +169,8 @@ two cores' threads blocks of 2 keep the peak 3 MB above one thread's blocks of 8
 filtered on its own, so the numbers do not depend on the blocks or the cores."""
 
 COMPILED_FILTER_VALUES = 50_000_000
-"""From this many values (the log's samples × a chunk's live columns) on, :func:`parallel_decimation` filters with the
-compiled filter (:mod:`dynid.preprocessing._filter_kernel`, SciPy's numbers bit for bit): an hour at 1 kHz. Below it,
+"""From this many values (the log's samples × the columns of every signal filtered together) on,
+:func:`parallel_decimation` filters with the compiled filter (:mod:`dynid.preprocessing._filter_kernel`, SciPy's numbers bit for bit): an hour at 1 kHz. Below it,
 SciPy's ``sosfiltfilt``, and the process never loads numba."""
 
 COMPILED_COLUMN_BLOCK = 16
@@ -340,14 +340,8 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
         index = index[index % factor == 0]
         padlen = min(edge_padding(rate, cutoff, order), hi - lo - 1)
 
-        def filtered(v):
-            flat = v.reshape(v.shape[0], -1)
+        def filtered(flat, live, fast):
             out = np.zeros((index.size, flat.shape[1]))
-            # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a
-            # regressor has many (joint i does not see the links before it), so only the others are filtered.
-            live = np.flatnonzero(np.any(flat, axis=0))  # no (samples, columns) temporary: any() casts by buffers
-            # a long log's columns through the compiled filter (the same numbers as SciPy's, bit for bit)
-            fast = n_samples * live.size >= COMPILED_FILTER_VALUES
             width = COMPILED_COLUMN_BLOCK if fast else COLUMN_BLOCK
 
             def one(cols):  # a column block: the filter's copies stay small; blocks write disjoint columns of out
@@ -356,7 +350,17 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
 
             _on_cores(one, [live[c:c + width] for c in range(0, live.size, width)],
                       flat.shape[0] * live.size >= PARALLEL_VALUES)
-            return out.reshape((index.size,) + v.shape[1:])
+            return out
 
-        yield index, (tuple(filtered(v) for v in values) if isinstance(values, tuple) else filtered(values))
-        del values
+        signals = values if isinstance(values, tuple) else (values,)
+        flats = [v.reshape(v.shape[0], -1) for v in signals]
+        # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a regressor has
+        # many (joint i does not see the links before it), so only the others are filtered.
+        lives = [np.flatnonzero(np.any(flat, axis=0)) for flat in flats]  # any() casts by buffers: no temporary
+        # a long log's signals through the compiled filter (the same numbers as SciPy's, bit for bit), all of them
+        # alike: the torques beside a regressor cost SciPy more set-up per call than filtering
+        fast = n_samples * sum(live.size for live in lives) >= COMPILED_FILTER_VALUES
+        out = tuple(filtered(flat, live, fast).reshape((index.size,) + v.shape[1:])
+                    for v, flat, live in zip(signals, flats, lives))
+        yield index, (out if isinstance(values, tuple) else out[0])
+        del values, signals, flats
