@@ -163,7 +163,8 @@ def test_the_cross_validations_say_their_share_done_as_they_go(slow_quiet_log):
     pipeline = IdentificationPipeline(config.robot, estimators=("ols",), friction="auto")
     pipeline.prepare(load_recording(config.identification, config.robot),
                      progress=lambda label, done, total: calls.append((label, done, total)))
-    for step in ("preprocessing (cross-validation of the cutoffs)", "friction model of each joint (cross-validation)"):
+    for step in ("preprocessing", "preprocessing: cross-validation of the cutoffs",
+                 "friction model of each joint (cross-validation)"):
         shares = [done / total for label, done, total in calls if label == step]
         assert shares[0] == 0 and shares[-1] == 1.0 and len(shares) >= 3, (step, shares)
         assert all(b >= a for a, b in zip(shares, shares[1:])), (step, shares)

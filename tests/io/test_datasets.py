@@ -588,3 +588,30 @@ def test_a_log_without_time_stamps_is_read_by_its_path_with_the_rate_given(tmp_p
                          "torques": {"columns": list(range(7, 13))}}, tmp_path, "cfg", "ident", 6)
     with pytest.raises(ConfigError, match="^load_recording: rate is for a log given by its path"):
         load_recording(spec, robot, rate=50.0)
+
+
+@pytest.mark.parametrize("reader", ["lines", "pyarrow"])
+def test_reading_a_log_says_its_share_done_as_it_goes(tmp_path, rng, monkeypatch, reader):
+    """Issue "Fast where users wait", item 3: a log's reading reports its share done as its blocks are read (either
+    reader), rising to the whole once the recording is ready, the files' bytes within their share of the step; the
+    recording is the one read without it."""
+    import dynid.io.logs.datasets as datasets
+    import dynid.io.logs.table_files as tables
+
+    robot = load_robot("ur10e")
+    t = np.arange(4000) * 0.002
+    q = np.sin(np.outer(t, np.arange(1, 7) * 0.3))
+    (tmp_path / "ur.csv").write_text("".join(_ur_row(tk, qk, qk * 0 + 0.5, qk * 2) for tk, qk in zip(t, q)))
+    spec = dataset_spec({"preset": "ur-rtde", "file": "ur.csv"}, tmp_path, "cfg", "ident", 6)
+    monkeypatch.setattr(tables, "BLOCK", 500)  # the line reader's blocks
+    if reader == "pyarrow":
+        monkeypatch.setattr(tables, "ARROW_BYTES", -1)
+        monkeypatch.setattr(tables, "ARROW_BLOCK", 40_000)
+    calls = []
+    rec = load_recording(spec, robot, progress=lambda done, total: calls.append(done / total))
+    assert len(calls) >= 8 and calls[-1] == 1.0 and all(b >= a for a, b in zip(calls, calls[1:])), calls
+    reading = [c for c in calls if c <= datasets.READ_SHARE]
+    assert len(reading) >= 6 and reading[-1] == pytest.approx(datasets.READ_SHARE), calls  # every byte read
+    assert 0 < calls[0] < 0.5 * datasets.READ_SHARE  # the first block: a share, not the whole
+    again = load_recording(spec, robot)
+    assert np.array_equal(rec.q, again.q) and np.array_equal(rec.tau, again.tau)

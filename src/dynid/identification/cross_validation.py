@@ -37,6 +37,12 @@ COULOMB_GRID = (0.0, 0.003, 0.01, 0.03, 0.1)
 
 FOLDS = 5
 
+PREPARING = "preprocessing"
+"""The stage :func:`choose_preprocessing` reports while it prepares the log by the default rule."""
+
+CROSS_VALIDATING = "preprocessing: cross-validation of the cutoffs"
+"""The stage it reports while it cross-validates the cutoffs (only where there is a choice to make)."""
+
 
 @short_repr
 @dataclass(frozen=True)
@@ -250,7 +256,7 @@ def _fold_accumulators(robot, base, data: PreparedData, duration: float, folds: 
 
 
 def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: Preprocessing, folds: int = FOLDS,
-                         progress: Callable[[int, int], None] | None = None) -> PreprocessingChoice:
+                         progress: Callable[[str, float, float], None] | None = None) -> PreprocessingChoice:
     """Choose the position/velocity and parallel cutoffs (hence the decimation) by blocked cross-validation, when
     there is a choice to make.
 
@@ -271,16 +277,17 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
         The config's settings (``None`` fields are chosen).
     folds : int
     progress : callable, optional
-        ``progress(done, total)`` in preparations of the log: the reference, each candidate, and on a long log the
-        chosen one's of the whole log.
+        ``progress(stage, done, total)``: :data:`PREPARING` the log by the default rule (its share done), then, where
+        there is a choice, :data:`CROSS_VALIDATING` in preparations of the log (on a long log its middle's by the rule,
+        each candidate, and the chosen one's of the whole log).
 
     Returns
     -------
     PreprocessingChoice
         With one candidate (the default rule's) when there was nothing to choose.
     """
-    said = progress if progress is not None else (lambda done, total: None)
-    reference = prepare(recording, given)
+    said = progress if progress is not None else (lambda stage, done, total: None)
+    reference = prepare(recording, given, progress=lambda share: said(PREPARING, share, 1))
     rs = reference.settings
     band, knee = rs.band, rs.knee
     default = POSITION_FACTOR * (band or 0.0)
@@ -288,11 +295,13 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
             or knee < KNEE_MARGIN * default):
         return PreprocessingChoice(rs, (rs,), np.zeros((1, robot.n_dof)), np.zeros(1), "", reference)
     full, recording = recording, _middle(recording, MAX_SAMPLES)  # a long log: its middle minute decides
+    cutoffs = (default, float(np.sqrt(default * knee)), knee)
+    first = int(recording is not full)  # a long log: its middle by the rule first, and the chosen one's whole log last
+    steps = len(cutoffs) + 2 * first
+    said(CROSS_VALIDATING, 0, steps)
     if recording is not full:
         reference = prepare(recording, replace(given, band=band))
-    cutoffs = (default, float(np.sqrt(default * knee)), knee)
-    steps = 1 + len(cutoffs) + (recording is not full)
-    said(1, steps)
+        said(CROSS_VALIDATING, 1, steps)
     duration = float(recording.t[-1] - recording.t[0]) + 1.0 / recording.rate
     evaluation, rms = _fold_accumulators(robot, base, reference, duration, folds)
     prior = base.base_from_standard(robot.standard_parameters())  # as the estimate: undetermined directions kept there
@@ -324,7 +333,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
             candidates.append(data.settings)
             prepared.append(data)
             errors.append(error)
-            said(1 + len(prepared), steps)
+            said(CROSS_VALIDATING, first + len(prepared), steps)
     error = np.array(errors)
     score = np.mean((error / np.where(rms > 0, rms, 1.0)) ** 2, axis=1)
     scored = bool(np.all(np.isfinite(score)))
@@ -341,7 +350,7 @@ def choose_preprocessing(robot: Robot, base: BaseParameters, recording, given: P
     if recording is not full:
         chosen = candidates[best]
         data = prepare(full, replace(given, band=band, position_cutoff=chosen.position_cutoff,
-                                     parallel_cutoff=chosen.parallel_cutoff))
-        said(steps, steps)
+                                     parallel_cutoff=chosen.parallel_cutoff),
+                       progress=lambda share: said(CROSS_VALIDATING, steps - 1 + share, steps))
     data = replace(data, settings=replace(data.settings, derivation=f"{data.settings.derivation}; {note}"))
     return PreprocessingChoice(data.settings, tuple(candidates), error, score, note, data)

@@ -249,13 +249,20 @@ class IdentificationPipeline:
         settings = self.preprocessing
         base = base if base is not None else base_parameters(self.robot, rng=0)
         auto = settings.auto and strategy_for(settings).chooses_cutoffs
-        share = say("preprocessing" + (" (cross-validation of the cutoffs)" if auto else ""))
-        filters = choose_preprocessing(self.robot, base, recording, settings, progress=share) if auto else None
+        shares: dict = {}
+
+        def stage(label: str, done: float, total: float) -> None:  # each stage said once as it starts, then its share
+            if label not in shares:
+                shares[label] = say(label)
+            if shares[label] is not None:
+                shares[label](done, total)
+
+        filters = choose_preprocessing(self.robot, base, recording, settings, progress=stage) if auto else None
         if filters is not None:
             assert filters.data is not None  # the chosen candidate's prepared data
             data = filters.data
         else:
-            data = prepare(recording, settings)
+            data = prepare(recording, settings, progress=lambda share: stage("preprocessing", share, 1))
         vs = settings.coulomb_velocity
         coulomb = None
         if vs == "auto":

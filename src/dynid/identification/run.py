@@ -88,20 +88,20 @@ def run_identification(config: IdentificationConfig, *, progress=None, validate:
         Bad data (:class:`DataError`), settings (:class:`ConfigError`) or a problem the data do not identify
         (:class:`IdentifiabilityError`), each one line.
     """
-    def step(label):
-        if progress is not None:
-            progress(label, 0, 1)
+    def reading(spec):  # a step of its own, its share read said as it goes
+        label = f"reading {spec.name}"
+        if progress is None:
+            return load_recording(spec, config.robot)
+        progress(label, 0, 1)
+        return load_recording(spec, config.robot, progress=lambda done, total: progress(label, done, total))
 
     if config.references:  # a bad reference file is said before any computation
         from ..dynamics.base_parameters import base_parameters
 
         _references(config, base_parameters(config.robot, rng=0))
-    step(f"reading {config.identification.name}")
-    recording = load_recording(config.identification, config.robot)
-    checked = []  # every dataset is read (its gaps, rates and ranges checked) before any computation
-    for spec in config.validation if validate else ():
-        step(f"reading {spec.name}")
-        checked.append(load_recording(spec, config.robot))
+    recording = reading(config.identification)
+    # every dataset is read (its gaps, rates and ranges checked) before any computation
+    checked = [reading(spec) for spec in (config.validation if validate else ())]
     config, checked, repeated = _distinct_validation(config, recording, checked)
     gains = None if config.drive_gains is None else partial(_gains_and_payload, config)
     result = pipeline_of(config).fit(recording, validation=tuple(checked), progress=progress, drive_gains=gains,

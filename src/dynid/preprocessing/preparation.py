@@ -52,7 +52,8 @@ from .strategies import Strategy, strategy_for
 
 __all__ = ["PreparedData", "Preprocessing", "ParallelFiltering", "base_chunks", "prepare", "prepared_rows", "torque_delayed"]
 
-def prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
+def prepare(recording, settings: Preprocessing, strict: bool = True,
+            progress: Callable[[float], None] | None = None) -> PreparedData:
     """Filtered joint signals of a recording, by the strategy ``settings.strategy`` names
     (:mod:`dynid.preprocessing.strategies`; default :class:`ParallelFiltering`).
 
@@ -64,6 +65,9 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
         Unset values are derived from this recording (:meth:`Preprocessing.resolved`).
     strict : bool
         Refuse settings that do not fit this recording rather than adapt them (with a warning).
+    progress : callable, optional
+        ``progress(share)``, the share of the preparation done (0 to 1), as it goes (:class:`ParallelFiltering`; another
+        strategy's once, at its end).
 
     Returns
     -------
@@ -78,7 +82,13 @@ def prepare(recording, settings: Preprocessing, strict: bool = True) -> Prepared
     """
     if settings.torque_delay:
         recording = torque_delayed(recording, settings.torque_delay)
-    return strategy_for(settings).prepare(recording, settings, strict)
+    strategy = strategy_for(settings)
+    if progress is not None and isinstance(strategy, ParallelFiltering):
+        return strategy.prepare(recording, settings, strict, progress=progress)
+    data = strategy.prepare(recording, settings, strict)
+    if progress is not None:
+        progress(1.0)
+    return data
 
 
 def torque_delayed(recording, delay: float):
@@ -169,7 +179,8 @@ class ParallelFiltering(Strategy):
     name = "parallel"
     chooses_cutoffs = True
 
-    def prepare(self, recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
+    def prepare(self, recording, settings: Preprocessing, strict: bool = True,
+                progress: Callable[[float], None] | None = None) -> PreparedData:
         """Filter and differentiate a recording (positions, velocities: measured or from positions; accelerations:
         derivative of the filtered velocities), find where each joint rests and its direction of motion. The torques
         are not filtered here: they go through the parallel filter with the regressor (:meth:`chunks`).
@@ -180,6 +191,8 @@ class ParallelFiltering(Strategy):
         settings : Preprocessing
         strict : bool
             Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning).
+        progress : callable, optional
+            ``progress(share)`` as the preparation goes (its steps weighed by their time on an hour-long log).
 
         Returns
         -------
@@ -192,7 +205,7 @@ class ParallelFiltering(Strategy):
         DataError
             Too few samples to filter, or none left after trimming.
         """
-        return _parallel_prepare(recording, settings, strict)
+        return _parallel_prepare(recording, settings, strict, progress or (lambda share: None))
 
     def chunks(self, robot, base, data, progress=None, standard=False):
         """Parallel-filtered, decimated regressor and torques, chunk by chunk.
@@ -218,17 +231,22 @@ class ParallelFiltering(Strategy):
         return _parallel_chunks(robot, base, data, progress, standard)
 
 
-def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
-    """:meth:`ParallelFiltering.prepare`."""
+def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True,
+                      progress: Callable[[float], None] = lambda share: None) -> PreparedData:
+    """:meth:`ParallelFiltering.prepare`; ``progress(share)`` after each step, weighed by its share of the time on
+    benchmarks/long_log.py's hour-long log (the bands 17 %, the filters 33 %, the rest velocities 16 %, ...)."""
     rate = recording.rate
     if recording.n_samples < 3 * (2 * settings.order + 1) + 1:
         raise DataError(f"{recording.label}: {recording.n_samples} samples are too few to filter "
                         f"(at least {3 * (2 * settings.order + 1) + 1} for preprocessing.order = {settings.order})")
     s = settings.resolved(rate, recording.q, measured_velocity=recording.dq is not None, name=recording.label, strict=strict)
+    progress(0.17)
     q, dq, ddq = _filtered_states(recording, s)
+    progress(0.5)
     tau = recording.tau if isinstance(recording.tau, StoredColumns) else np.asarray(recording.tau, dtype=float)
     moving = _direction_velocity(recording, s, dq)
     s, rest = _rest_and_speed(recording, s, dq, strict)
+    progress(0.66)
     if ddq is None:
         ddq = differentiate(dq, rate)
     t = recording.t
@@ -242,14 +260,18 @@ def _parallel_prepare(recording, settings: Preprocessing, strict: bool = True) -
     for j in range(dq.shape[1]):
         resting[:, j] = ~moving_joints(np.asarray(dq[:, j])[:, None], np.asarray(moving[:, j])[:, None], rest[j])[:, 0]
     followers = tuple(getattr(recording, "followers", ()))
+    progress(0.76)
     dead, clipped, channel_words = _channel_checks(tau, t, recording.label, s, rate, followers)
     positions = recording.q[cut:-cut] if cut else recording.q
     still = tuple(j for j in range(q.shape[1])  # positions read one value throughout: a joint held still
                   if float(np.ptp(positions.column(j) if hasattr(positions, "column") else positions[:, j])) == 0.0)
-    return PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
+    progress(0.84)
+    data = PreparedData(recording.name, t, q, dq, ddq, tau, rate, replace(s, warnings=()),
                         tuple(recording.warnings) + s.warnings + channel_words,
                         direction_of_motion(dq, moving, s, rate), moving, resting, dead, still, clipped,
                         getattr(recording, "drive_gains", None), followers)
+    progress(1.0)
+    return data
 
 
 def _filtered_states(recording, s: Preprocessing):

@@ -4,6 +4,7 @@ applied on the way (:func:`load_recording`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from numbers import Real
 from pathlib import Path
@@ -134,7 +135,7 @@ def _detected(log: Path, robot: Robot, rate: float | None = None) -> DatasetSpec
 
 @keyword_only_after_data
 def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *, spool: bool | None = None,
-                   rate: float | None = None) -> Recording:
+                   rate: float | None = None, progress: Callable[[float, float], None] | None = None) -> Recording:
     """Read a dataset and convert it to SI joint quantities on a uniform time grid.
 
     Steps: read the columns (:func:`dynid.io.logs.table_files.read_table`) or the ROS 2 bag's JointState messages, scale
@@ -156,6 +157,9 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     rate : float, optional
         [Hz] The sample rate of a CSV log given by its path that has no time column (as ``dynid init --rate``); a
         dataset of a config states its own.
+    progress : callable, optional
+        ``progress(done, total)``: the files' bytes read, weighed as :data:`READ_SHARE` of the whole (their checks and
+        repairs the rest), then ``(total, total)`` when the recording is ready.
 
     Returns
     -------
@@ -194,15 +198,18 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
         for c in s.columns:
             if c not in requests[s.file]:
                 requests[s.file].append(c)
+    sizes = {p: p.stat().st_size if p.is_file() else 0 for p in requests}
     if spool is None:
-        spool = sum(p.stat().st_size for p in requests if p.is_file()) > SPOOL_BYTES
-    tables = {}
+        spool = sum(sizes.values()) > SPOOL_BYTES
+    tables, total, before = {}, max(sum(sizes.values()), 1), 0
     for path, cols in requests.items():
         dated = spec.time.columns if spec.time is not None and spec.time.file == path and len(spec.time.columns) == 1 else ()
+        said = None if progress is None else (lambda done, _, before=before: progress(READ_SHARE * (before + done), total))
         table = read_table(path, cols, header=spec.header, delimiter=spec.delimiter, n_columns=spec.n_columns, rows=spec.rows,
-                           spool=spool, missing=True, stamps=dated, decimal=spec.decimal)
+                           spool=spool, missing=True, stamps=dated, decimal=spec.decimal, progress=said)
         tables[path] = (table, cols)
         warnings.extend(table.warnings)
+        before += sizes[path]
     del table
     lengths = {p: tb.data.shape[0] for p, (tb, _) in tables.items()}
     n_s = min(lengths.values())
@@ -236,8 +243,18 @@ def load_recording(spec: DatasetSpec | str | Path, robot: Robot | str | Path, *,
     raw = {kind: get(s) for kind, s in spec.signals.items()}
     tables.clear()  # the files' columns are in t and raw now: a long log is not held twice
     tau_kind = "currents" if "currents" in spec.signals else "torques"
-    return _assemble(spec, robot, t, raw, where, timed=spec.time is not None, q_source=str(spec.signals["positions"].file),
-                     tau_source=str(spec.signals[tau_kind].file), warnings=warnings)
+    checks = (lambda share: None) if progress is None else (
+        lambda share: progress((READ_SHARE + (1 - READ_SHARE) * share) * total, total))
+    recording = _assemble(spec, robot, t, raw, where, timed=spec.time is not None,
+                          q_source=str(spec.signals["positions"].file), tau_source=str(spec.signals[tau_kind].file),
+                          warnings=warnings, progress=checks)
+    checks(1.0)
+    return recording
+
+
+READ_SHARE = 0.6
+"""The share of :func:`load_recording`'s time its progress gives the files' reading (the hour-long log of
+benchmarks/long_log.py: 3.6 of 6.1 s reading the text, the rest checking, mending and converting the signals)."""
 
 
 def _check_named_order(spec: DatasetSpec, robot: Robot) -> None:
@@ -257,9 +274,10 @@ def _check_named_order(spec: DatasetSpec, robot: Robot) -> None:
 
 
 def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bool, q_source: str, tau_source: str,
-              warnings: list[str]) -> Recording:
+              warnings: list[str], progress: Callable[[float], None] = lambda share: None) -> Recording:
     """Time checks, selection, gaps, resampling, transmission, drive gains and plausibility, shared by every
-    kind of dataset; ``where(k)`` names sample k's place in the source (file and line, bag and message)."""
+    kind of dataset; ``where(k)`` names sample k's place in the source (file and line, bag and message);
+    ``progress(share)`` as its share of the work goes (about a third each: mending, converting, checking)."""
     n_s = t.shape[0]
     if n_s < 2:
         raise DataError(f"{spec.name}: expected at least 2 samples, got {n_s}")
@@ -270,6 +288,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
     t, raw, where = _filled(spec, t, raw, where, warnings)
     side = lambda kind: (spec.signals[kind].side if kind in spec.signals else None) or spec.side  # noqa: E731
     raw = _cleaned(spec, t, raw, side("positions") != "motor", warnings)
+    progress(1 / 3)
     if (spec.time_range is not None or spec.rows is not None) and t.size < MIN_SELECTED:
         which, value = ("time_range", list(spec.time_range)) if spec.time_range is not None else ("rows", list(spec.rows or ()))
         raise DataError(f"{spec.table or spec.name}: {which} = {value} selects {t.size} samples; at least {MIN_SELECTED} "
@@ -291,6 +310,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         t, raw = resampled(t, raw, rate)
     raw = _coordinates_widened(robot, raw, spec.table or spec.name, warnings)
     q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, raw, side, warnings))
+    progress(2 / 3)
     _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
                   tau_source=tau_source, warnings=warnings)
     source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))

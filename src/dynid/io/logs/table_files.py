@@ -17,6 +17,7 @@ from __future__ import annotations
 import datetime
 import json
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -162,7 +163,8 @@ def resolve_columns(path: Path, columns, header: list[str] | None, delimiter: st
 
 def read_table(path: str | Path, columns, *, header: bool = False, delimiter: str = ",",
                n_columns: int | None = None, rows: tuple[int, int] | None = None, spool: bool = False,
-               missing: bool = False, stamps=(), decimal: str = ".") -> Table:
+               missing: bool = False, stamps=(), decimal: str = ".",
+               progress: Callable[[int, int], None] | None = None) -> Table:
     """Read numeric columns from a delimited text file.
 
     Parameters
@@ -188,6 +190,9 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     decimal : {".", ","}
         The numbers' decimal separator: "," for a spreadsheet's export in a European locale (``0,25;-1,5``), whose
         delimiter is then not a comma.
+    progress : callable, optional
+        ``progress(done, total)`` in bytes of the file as its blocks are read (about one block of
+        :data:`ARROW_BLOCK` bytes or :data:`BLOCK` lines a call).
 
     Returns
     -------
@@ -201,20 +206,11 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         infinity; an empty selection. The message names the file, the line and, where it applies, the column.
     """
     path = Path(path)
-    if path.exists() and not path.is_file():  # a FIFO or a device: never "not found", never read (a FIFO blocks)
-        raise DataError(f"{path}: not a regular file ({'a folder' if path.is_dir() else 'a device, a FIFO or a socket'})"
-                        ": give the log's file")
-    if not path.is_file():
-        raise DataError(f"{path}: file not found")
-    hint = text_encoding_hint(path)
-    if hint:
-        raise DataError(f"{path}: not a UTF-8 text table{hint}")
-    first, last = rows if rows is not None else (1, None)
-    if first < 1 or (last is not None and last < first):
-        raise DataError(f"{path}: rows: expected 1 <= first <= last, got {[first, last]}")
-    if decimal not in (".", ",") or decimal == delimiter:
-        raise ValueError(f"decimal: expected '.' or ',' and not the delimiter {delimiter!r}, got {decimal!r}")
-    fast = _arrow_table(path, columns, header, delimiter, n_columns, rows=(first, last), spool=spool, decimal=decimal)
+    first, last = _checked(path, rows, delimiter, decimal)
+    size = path.stat().st_size
+    said = progress if progress is not None else (lambda done, total: None)
+    fast = _arrow_table(path, columns, header, delimiter, n_columns, rows=(first, last), spool=spool, decimal=decimal,
+                        progress=said)
     if fast is not None:
         return fast
     warnings: list[str] = []
@@ -236,12 +232,14 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
         pending: list[str] = []
         pending_start = None
         data_row = 0
+        read = 0  # characters of the lines read (bytes in an ASCII file), for progress
 
         def flush():
             nonlocal files
             if pending:
                 block = _parse_block(path, pending, pending_start, cols, delimiter, missing=missing, dated=dated)
                 pending.clear()
+                said(min(read, size), size)
                 if not spool:
                     blocks.append(block)
                     return
@@ -252,6 +250,7 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
 
         for line in fh:
             line_no += 1
+            read += len(line)
             if not line.strip():
                 continue
             data_row += 1
@@ -280,16 +279,37 @@ def read_table(path: str | Path, columns, *, header: bool = False, delimiter: st
     return _table_of(blocks, files, first_line, warnings)
 
 
+def _checked(path: Path, rows: tuple[int, int] | None, delimiter: str, decimal: str) -> tuple[int, int | None]:
+    """:func:`read_table`'s checks before it reads: a regular UTF-8 file, a range of rows and a decimal separator that
+    can be; the range's first and last rows."""
+    if path.exists() and not path.is_file():  # a FIFO or a device: never "not found", never read (a FIFO blocks)
+        raise DataError(f"{path}: not a regular file ({'a folder' if path.is_dir() else 'a device, a FIFO or a socket'})"
+                        ": give the log's file")
+    if not path.is_file():
+        raise DataError(f"{path}: file not found")
+    hint = text_encoding_hint(path)
+    if hint:
+        raise DataError(f"{path}: not a UTF-8 text table{hint}")
+    first, last = rows if rows is not None else (1, None)
+    if first < 1 or (last is not None and last < first):
+        raise DataError(f"{path}: rows: expected 1 <= first <= last, got {[first, last]}")
+    if decimal not in (".", ",") or decimal == delimiter:
+        raise ValueError(f"decimal: expected '.' or ',' and not the delimiter {delimiter!r}, got {decimal!r}")
+    return first, last
+
+
 def _table_of(blocks: list, files: list | None, first_line: int | None, warnings: list[str]) -> Table:
     """:func:`read_table`'s table: its blocks stacked in memory, or its columns' files (a spooled log)."""
     return Table(_stack(blocks) if files is None else StoredColumns(files), int(first_line or 1), tuple(warnings))
 
 
 def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: int | None, *, rows: tuple,
-                 spool: bool, decimal: str = ".") -> Table | None:
+                 spool: bool, decimal: str = ".", progress: Callable[[int, int], None] = lambda done, total: None
+                 ) -> Table | None:
     """:func:`read_table` by pyarrow's streaming CSV reader, or None where the line reader must read the file
     (pyarrow not installed, a file under :data:`ARROW_BYTES`, or anything the line reader may treat otherwise)."""
-    if path.stat().st_size <= max(ARROW_BYTES, 0):
+    size = path.stat().st_size
+    if size <= max(ARROW_BYTES, 0):
         return None
     try:
         import pyarrow as pa
@@ -320,7 +340,8 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
         with pa.OSFile(str(path)) as source:
             source.seek(offset)
             blocks, files, n = _arrow_blocks(pa, pc, source, cols, order, wanted=wanted, delimiter=delimiter, count=count,
-                                             spool=spool, decimal=decimal)
+                                             spool=spool, decimal=decimal,
+                                             progress=lambda k: progress(min(offset + k * ARROW_BLOCK, size), size))
         pa.default_memory_pool().release_unused()  # its parsing buffers, which the pool would keep for reuse
     except (pa.ArrowException, KeyError, ValueError):  # anything it parses otherwise: the line reader decides
         return None
@@ -330,9 +351,10 @@ def _arrow_table(path: Path, columns, header: bool, delimiter: str, n_columns: i
 
 
 def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: list[int], delimiter: str,
-                  count: int | None, spool: bool, decimal: str = ".") -> tuple[list, list | None, int]:
+                  count: int | None, spool: bool, decimal: str = ".",
+                  progress: Callable[[int], None] = lambda blocks: None) -> tuple[list, list | None, int]:
     """The blocks of :func:`_arrow_table` (kept, or appended to column files with ``spool``), and their rows;
-    ValueError at a value that is not finite."""
+    ValueError at a value that is not finite. ``progress(k)`` after the k-th block (one block of text each)."""
     reader = pc.open_csv(
         source, read_options=pc.ReadOptions(autogenerate_column_names=True, block_size=ARROW_BLOCK,
                                             use_threads=cores() > 1),
@@ -342,7 +364,7 @@ def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: 
                                           strings_can_be_null=False, quoted_strings_can_be_null=False,
                                           decimal_point=decimal))
     blocks, files, n = [], None, 0
-    for batch in reader:
+    for k, batch in enumerate(reader, 1):
         block = np.column_stack([batch.column(k).to_numpy() for k in order]).astype(np.float64, copy=False)
         if count is not None:
             block = block[:count - n]
@@ -355,6 +377,7 @@ def _arrow_blocks(pa, pc, source, cols: list[int], order: list[int], *, wanted: 
                 f.append(block[:, j])
         else:
             blocks.append(block)
+        progress(k)
         if count is not None and n >= count:
             break
     return blocks, files, n
