@@ -766,6 +766,9 @@ def test_init_reads_a_headerless_19_column_log_of_a_ur_arm_as_rtde_currents(tmp_
     np.savetxt(tmp_path / "val.csv", np.column_stack([rtde, np.zeros((log.t.size, 12))]), delimiter=",")  # + targets
     p = run("init", str(URDF), str(tmp_path / "run.csv"), str(tmp_path / "val.csv"), "--out", str(tmp_path / "arm.toml"))
     assert p.returncode == 0, p.stderr
+    steps = [line for line in (p.stdout + p.stderr).splitlines() if line.startswith("dynid init: ")]  # in a pipe: a line
+    assert steps[0].startswith("dynid init: reading the log's columns (at ")  # each, the check's identification's too
+    assert any(s.startswith("dynid init: checking the log against the robot file: regressor, ") for s in steps), steps
     config = tomllib.loads((tmp_path / "arm.toml").read_text())
     assert config["identification"]["preset"] == "ur-rtde-19"
     assert config["validation"][0]["preset"] == "ur-rtde"  # 31 columns: its own reader, not the 19 columns'

@@ -898,10 +898,14 @@ def init(
                 raise DynIdError(f"{v}: no such validation log")
         from ..identification.starter_check import checked_against_description
 
+        progress.update("reading the log's columns")
         text, notes = starter_config(urdf, log, int(robot.independent.sum()), out, tuple(validation or ()),
                                      tuple(j.name for j in robot.joints if j.mimic is None), robot.held, robot=robot,
                                      rate=rate, xacro_args=args)
-        text, found = checked_against_description(text, out)
+        shown = _steps(progress)  # the check's identification of the log's first seconds, step by step
+        text, found = checked_against_description(
+            text, out, progress=lambda step, done, total: shown(f"checking the log against the robot file: {step}", done,
+                                                                total))
         return text, notes + found
 
     def save(written):

@@ -13,8 +13,10 @@ the reader's columns are the user's to check."""
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -45,7 +47,7 @@ MOVED = 0.01
 """[rad, or m for a sliding joint] How far a joint goes from its first position for the log to move."""
 
 
-def _findings(text: str, path: Path) -> tuple[tuple, int]:
+def _findings(text: str, path: Path, progress=None) -> tuple[tuple, int]:
     """The identification log's findings with the config ``text`` says (its first :data:`CHECKED_SECONDS` where no
     stretch is chosen), least squares alone on the rule's cutoffs and the description's friction terms, and the robot's
     joints."""
@@ -59,7 +61,7 @@ def _findings(text: str, path: Path) -> tuple[tuple, int]:
         recording = _moving(recording)
     pipeline = pipeline_of(config)
     fitted = replace(pipeline, estimators=("wls",), preprocessing=replace(pipeline.preprocessing, auto=False),
-                     friction="description").fit(recording, held_out=False)
+                     friction="description").fit(recording, held_out=False, progress=progress)
     return fitted.findings, config.robot.n_dof
 
 
@@ -112,7 +114,8 @@ def _with_geometry(text: str, found, n_dof: int) -> tuple[str, str]:
     return written, f"robot: {listed} written in [[robot.joints]]: {said}"
 
 
-def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
+def checked_against_description(text: str, path: Path, progress: Callable[[str, float, float], Any] | None = None
+                                ) -> tuple[str, list[str]]:
     """The starter config with the robot's gravity, its joints' zeros and its identification log's torque sign set
     where the log's own check finds them otherwise (the sign judged again once the geometry is set).
 
@@ -122,6 +125,9 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
         The config :func:`dynid.io.config.starter.starter_config` wrote.
     path : Path
         Where it will be written (its relative paths start from its folder).
+    progress : callable, optional
+        ``progress(step, done, total)`` of each identification the check runs
+        (:meth:`dynid.identification.pipeline.IdentificationPipeline.fit`'s steps).
 
     Returns
     -------
@@ -134,7 +140,7 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
     """
     notes: list[str] = []
     try:
-        findings, n_dof = _findings(text, path)
+        findings, n_dof = _findings(text, path, progress)
         for _ in range(GEOMETRY_FIXES):  # the mounting and a zero can both differ: one found, set and checked again
             found = next((f for f in findings if f.kind in ("gravity", "angles") and f.fix is not None), None)
             if found is None or found.fix is None:
@@ -144,7 +150,7 @@ def checked_against_description(text: str, path: Path) -> tuple[str, list[str]]:
                 break
             text, note = _with_geometry(text, found, n_dof)
             notes.append(note)
-            findings, _ = _findings(text, path)
+            findings, _ = _findings(text, path, progress)
     except DynIdError as exc:
         first = " ".join(str(exc).split())
         return text, notes + [f"torque signs not checked against the description ({first}): dynid identify checks them"]
