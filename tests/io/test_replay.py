@@ -124,6 +124,10 @@ def test_dynid_export_says_the_urdf_it_wrote_reproduces_the_model(tmp_path):
     assert error < 1e-6 and "frictionloss a constraint as MuJoCo solves it" in said
     p = dynid("export", cfg, "--results", tmp_path / "out" / "results.json", "--mjcf", tmp_path / "f.xml", "--forward")
     assert p.returncode == 0, p.stderr
+    steps = [line.split(" (at ")[0] for line in (p.stdout + p.stderr).splitlines() if line.startswith("dynid export: ")]
+    assert steps == ["dynid export: writing the model's files", "dynid export: reading the files back (MuJoCo)",
+                     "dynid export: simulating the MJCF in MuJoCo along a validation log",
+                     "dynid export: writing results"], steps  # in a pipe a line a step: none of them silent
     simulated = re.search(r"f\.xml simulated in MuJoCo along validation \((\d+) samples.*? the torques it needs are (\S+) % "
                           r"off the measured ones, against (\S+) % for dynid's model", " ".join(p.stdout.split()))
     assert simulated is not None and int(simulated.group(1)) > 100
@@ -212,7 +216,14 @@ def test_the_written_mjcf_simulated_along_a_motion_needs_the_models_torques():
     t = np.arange(0.0, 4.0, 0.01)
     q, dq, ddq = _sines(t)
     tau = regressor(robot, q, dq, ddq) @ phi
-    check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, q, dq, ddq, tau)
+    said = []
+    check = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, q, dq, ddq, tau,
+                         progress=lambda done, total: said.append((done, total)))
+    unsaid = mjcf_forward(mjcf_from_robot(robot, phi), robot, phi, t, q, dq, ddq, tau)
+    assert unsaid.simulated_vs_measured == check.simulated_vs_measured
+    assert np.array_equal(unsaid.tracking_error, check.tracking_error)
+    assert said[0] == (0, t.size) and said[-1] == (t.size, t.size) and len(said) >= 2  # its share simulated, as it goes
+    assert all(b[0] > a[0] for a, b in zip(said, said[1:]))
     assert check.simulated_vs_model < 0.5 and check.model_vs_measured < 1e-9
     assert abs(check.simulated_vs_measured - check.simulated_vs_model) < 1e-9 and np.all(check.tracking_error < 1e-3)
     phi[names.index("offset2")] = 5.0  # N·m the MJCF cannot hold: the simulator needs that much less on J2

@@ -420,12 +420,17 @@ def export(
 
         cfg, identified, targets = prepared
         moved: list[str] = []
+        progress.update("writing the model's files")
         texts = [(path, _export_text(flag, cfg, identified, str(results), _users_mjcf(cfg), mjcf, moved))
                  for flag, path in targets]
         estimate = consistent_estimate(cfg.robot, identified, str(results))
+        progress.update("reading the files back (" + ", ".join("Pinocchio" if flag == "--urdf" else "MuJoCo"
+                                                               for flag, _ in targets) + ")")
         log = _replay_log(cfg, identified, estimate[0])
         checks = {path: _replayed(flag, text, (*estimate, identified), log) for (flag, path), (_, text) in zip(targets, texts)}
-        simulated = _simulated(cfg, identified, texts, targets, str(results)) if forward else None
+        shown = _steps(progress)
+        simulated = _simulated(cfg, identified, texts, targets, str(results), progress=lambda done, total: shown(
+            "simulating the MJCF in MuJoCo along a validation log", done, total)) if forward else None
         return cfg, texts, moved, identified, checks, simulated, None if log is None else log[0]
 
     def save(computed):
@@ -497,13 +502,13 @@ def _init_robot(urdf: Path, log: Path, arm: str | None, args: dict):
     return robot_from_urdf(urdf, held=held, xacro_args=args) if held else load_robot(urdf, xacro_args=args)
 
 
-def _simulated(cfg, identified: dict, texts, targets, source: str) -> str:
+def _simulated(cfg, identified: dict, texts, targets, source: str, progress=None) -> str:
     """``dynid export --forward``'s line: the MJCF written simulated along the first moving validation log
     (:func:`dynid.identification.run.forward_check`)."""
     from ..identification.run import forward_check
 
     mjcf = next((path, text) for (flag, _), (path, text) in zip(targets, texts) if flag == "--mjcf")
-    found = forward_check(cfg, identified, mjcf[1], source=source)
+    found = forward_check(cfg, identified, mjcf[1], source=source, progress=progress)
     if found is None:
         return f"{mjcf[0].name} not simulated: the config has no validation log that moves (--forward follows one)"
     log, check = found

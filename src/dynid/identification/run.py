@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import fields, replace
 from functools import partial
 from pathlib import Path
@@ -294,7 +295,8 @@ def run_payload(config: IdentificationConfig, identified: dict, dataset: Dataset
     return found, label, ratio
 
 
-def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str, *, source: str = "results"):
+def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str, *, source: str = "results",
+                  progress: Callable[[int, int], None] | None = None):
     """An exported MJCF simulated along the config's first moving validation log (issue "The model proven where it
     goes", item 3; :func:`dynid.io.exported.replay.mjcf_forward`): the log prepared as ``dynid validate`` prepares it, without
     decimation, so the simulation follows every sample.
@@ -308,6 +310,8 @@ def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str
         The MJCF as written.
     source : str
         Where the results come from, named in errors.
+    progress : callable, optional
+        ``progress(done, total)`` in samples simulated.
 
     Returns
     -------
@@ -329,7 +333,7 @@ def forward_check(config: IdentificationConfig, identified: dict, mjcf_text: str
     if found is None:
         return None
     name, (t, q, dq, ddq, tau) = found
-    return name, mjcf_forward(mjcf_text, robot, phi, t, q, dq, ddq, tau)
+    return name, mjcf_forward(mjcf_text, robot, phi, t, q, dq, ddq, tau, progress=progress)
 
 
 def moving_validation(config: IdentificationConfig, identified: dict, robot=None):

@@ -14,6 +14,7 @@ Pinocchio C++ library", SII 2019 (RNEA, the URDF parser).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -321,7 +322,7 @@ lose stability (benchmarks/NOTEBOOK.md, "Stop 108", has the step sweep)."""
 
 
 def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *, substeps: int | None = None,
-                 bandwidth: float = 30.0) -> ForwardCheck:
+                 bandwidth: float = 30.0, progress: Callable[[int, int], None] | None = None) -> ForwardCheck:
     """Simulate a written MJCF along a log's motion and compare the torques it needs with the measured ones (issue
     "The model proven where it goes", item 3).
 
@@ -351,6 +352,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
         Integration steps per log sample; default :data:`SUBSTEPS`, fewer where a step would be shorter than
         :data:`MIN_STEP` (it was 40 whatever the log's rate).
     bandwidth : float [Hz]
+    progress : callable, optional
+        ``progress(done, total)`` in samples simulated, every :data:`PROGRESS_SAMPLES` and at the end.
 
     Returns
     -------
@@ -404,6 +407,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
     worst = np.zeros(robot.n_dof)
     weights = _hermite_weights(substeps)
     for k in range(t.size):
+        if progress is not None and k % PROGRESS_SAMPLES == 0:
+            progress(k, t.size)
         references = _between(t, q, dq, ddq, k, weights if k < t.size - 1 else weights[:, :, :1])
         for s in range(substeps if k < t.size - 1 else 1):
             ref = [x[s] for x in references]
@@ -414,6 +419,8 @@ def mjcf_forward(text: str, robot: Robot, phi: np.ndarray, t, q, dq, ddq, tau, *
             data.qfrc_applied[:] = 0.0
             data.qfrc_applied[vadr] = u
             mujoco.mj_step(model, data)
+    if progress is not None:
+        progress(t.size, t.size)
     modelled = regressor(robot, q, dq, ddq) @ phi
     rel = lambda a, b: 100.0 * float(np.linalg.norm(a - b)) / max(float(np.linalg.norm(b)), 1e-300)  # noqa: E731
     return ForwardCheck(rel(applied, tau), rel(modelled, tau), rel(applied, modelled), worst, int(t.size), substeps)
@@ -423,6 +430,10 @@ _QUINTIC = np.array([[1, 0, 0, -10, 15, -6], [0, 1, 0, -6, 8, -3], [0, 0, 0.5, -
                      [0, 0, 0, 0.5, -1, 0.5], [0, 0, 0, -4, 7, -3], [0, 0, 0, 10, -15, 6]], dtype=float)
 """The quintic Hermite basis on ``w`` in [0, 1], coefficients of ``w⁰ … w⁵``, weighing in turn the first sample's
 position, velocity·h and acceleration·h², the second's acceleration·h², velocity·h and position."""
+
+
+PROGRESS_SAMPLES = 500
+"""Samples :func:`mjcf_forward` simulates between two reports of its progress."""
 
 
 def _hermite_weights(substeps: int) -> np.ndarray:
