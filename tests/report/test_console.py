@@ -41,7 +41,11 @@ def test_a_steps_share_done_is_a_bar_with_the_time_left_on_a_terminal():
         p._started["regressor"] -= 10.0  # the step began 10 s ago
         p.update("regressor", "25 %")
         shown = str(p._status.renderable.text if hasattr(p._status.renderable, "text") else p._status.renderable)
-    assert "█████░░░░░░░░░░░░░░░ 25 %, about 30 s left" in shown, shown
+        assert "█████░░░░░░░░░░░░░░░ 25 %, about 30 s left" in shown, shown
+        p.t0 -= 4.0  # 4 s later (the steps' starts count from t0), no report between: the line drawn again says the
+        # time as it is, the time left at the step's pace so far
+        later = str(p._status.renderable.text)
+    assert "█████░░░░░░░░░░░░░░░ 25 %, about 42 s left  4 s" in later, later
     pipe = io.StringIO()
     with Progress("dynid identify", Console(file=pipe, force_terminal=False)) as p:
         p.update("regressor", "0 %")

@@ -142,6 +142,25 @@ class Reporter:
         return Progress(command, self.err, self.quiet)
 
 
+class _LiveLine:
+    """The terminal's live line of a :class:`Progress`, written again at each of the terminal's redraws (rich calls
+    ``__rich__``): its elapsed time and the step's time left go on between two reports, as the spinner does."""
+
+    def __init__(self, progress: Progress):
+        self.progress = progress
+
+    def __str__(self) -> str:
+        p = self.progress
+        step, detail = p._shown
+        elapsed = time.perf_counter() - p.t0
+        if step not in p._started:  # before the first step
+            return f"{p.command}: {step}  {elapsed:.0f} s"
+        return f"{p.command}: {step} {bar(detail, elapsed - p._started[step])}  {elapsed:.0f} s"
+
+    def __rich__(self) -> str:
+        return escape(str(self))
+
+
 def count(n: int, noun: str) -> str:
     """A count with its noun: ``"no figures"``, ``"1 figure"``, ``"3 figures"``.
 
@@ -215,10 +234,11 @@ class Progress:
         self.t0 = time.perf_counter()
         self._status: Any = None
         self._started: dict[str, float] = {}  # each step's start [s since t0]: its time left from its share done
+        self._shown = ("starting", "")  # the live line's step and detail, drawn with the time as it is
 
     def __enter__(self) -> Progress:
         if self.live:
-            self._status = self.console.status(f"{self.command}: starting", spinner="line")
+            self._status = self.console.status(_LiveLine(self), spinner="line")
             self._status.__enter__()
         return self
 
@@ -239,9 +259,10 @@ class Progress:
         if self.quiet:
             return
         elapsed = time.perf_counter() - self.t0
-        start = self._started.setdefault(step, elapsed)
+        self._started.setdefault(step, elapsed)
         if self.live:
-            self._status.update(escape(f"{self.command}: {step} {bar(detail, elapsed - start)}  {elapsed:.0f} s"))
+            self._shown = (step, detail)
+            self._status.update(_LiveLine(self))
         elif step not in self.seen:  # steps may run side by side: each is announced once
             self.console.print(f"{self.command}: {step} (at {elapsed:.1f} s)", markup=False, highlight=False)
         self.seen.add(step)
