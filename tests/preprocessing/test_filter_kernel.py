@@ -109,3 +109,19 @@ def test_gaussian_smoothing_is_the_same_through_either_path(monkeypatch):
     for a, b in zip(scipys, compiled):
         assert np.array_equal(a, b)
     assert not np.array_equal(scipys[0], x)
+
+
+def test_the_live_columns_of_a_large_block_are_found_by_blocks_of_rows_as_by_one_pass():
+    """The columns the parallel decimation filters (any non-zero value), found a block of rows per core on a large
+    block: a column non-zero at one sample of the last rows only, or of the first only, is live; a zero one is not."""
+    from dynid.preprocessing.filters import PARALLEL_VALUES, _live_columns
+
+    rng = np.random.default_rng(9)
+    flat = rng.standard_normal((4001, 60))
+    flat[:, [3, 17, 40, 59]] = 0.0
+    flat[4000, 17] = 1e-300  # the last row's only value
+    flat[0, 40] = -2.0  # the first row's only value
+    assert flat.size >= PARALLEL_VALUES
+    live = _live_columns(flat)
+    assert np.array_equal(live, np.flatnonzero(np.any(flat, axis=0)))
+    assert 17 in live and 40 in live and 3 not in live and 59 not in live
