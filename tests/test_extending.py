@@ -119,3 +119,35 @@ def test_a_plugin_gets_the_prior_it_documents_whatever_else_is_listed(tmp_path, 
     run_identification(config, validate=False)
     assert seen and seen[-1] is not None
     np.testing.assert_allclose(seen[-1], config.robot.physical_prior()[0], rtol=1e-12)
+
+
+def test_a_strategy_that_extends_the_default_ones_prepare_is_run_as_written(tmp_path):
+    """A plugin's subclass of the default strategy whose ``prepare`` has the base class's documented signature (no
+    ``progress``): the preparation runs it, and its share is said once, at its end; the default strategy's own says
+    its share as it goes (issue "Fast where users wait", item 3)."""
+    from dataclasses import replace
+
+    from dynid.io.logs.datasets import load_recording
+    from dynid.preprocessing.preparation import ParallelFiltering, prepare
+    from dynid.preprocessing.settings import Preprocessing
+    from dynid.preprocessing.strategies import register_strategy, unregister_strategy
+
+    class Marked(ParallelFiltering):
+        def prepare(self, recording, settings, strict=True):
+            data = super().prepare(recording, settings, strict)
+            return replace(data, warnings=data.warnings + ("prepared by the plugin",))
+
+    cfg, _ = simulated_case(tmp_path, "er16", 250.0, "fourier", seed=2, duration=10.0)
+    config = load_identification_config(cfg)
+    recording = load_recording(config.identification, config.robot)
+    register_strategy("marked_test", Marked, replace=True)
+    try:
+        shares = []
+        data = prepare(recording, Preprocessing(strategy="marked_test"), progress=shares.append)
+        assert "prepared by the plugin" in data.warnings and shares == [1.0]
+        own = []
+        default = prepare(recording, Preprocessing(), progress=own.append)
+        assert len(own) >= 5 and own[-1] == 1.0 and all(b > a for a, b in zip(own, own[1:]))
+        assert np.array_equal(default.ddq, data.ddq) and "prepared by the plugin" not in default.warnings
+    finally:
+        unregister_strategy("marked_test")

@@ -66,8 +66,8 @@ def prepare(recording, settings: Preprocessing, strict: bool = True,
     strict : bool
         Refuse settings that do not fit this recording rather than adapt them (with a warning).
     progress : callable, optional
-        ``progress(share)``, the share of the preparation done (0 to 1), as it goes (:class:`ParallelFiltering`; another
-        strategy's once, at its end).
+        ``progress(share)``, the share of the preparation done (0 to 1), as it goes (:class:`ParallelFiltering`'s own
+        preparation; another strategy's, or a subclass's own ``prepare``, once at its end).
 
     Returns
     -------
@@ -83,8 +83,8 @@ def prepare(recording, settings: Preprocessing, strict: bool = True,
     if settings.torque_delay:
         recording = torque_delayed(recording, settings.torque_delay)
     strategy = strategy_for(settings)
-    if progress is not None and isinstance(strategy, ParallelFiltering):
-        return strategy.prepare(recording, settings, strict, progress=progress)
+    if progress is not None and type(strategy).prepare is ParallelFiltering.prepare:  # not a plugin's own prepare
+        return _parallel_prepare(recording, settings, strict, progress)
     data = strategy.prepare(recording, settings, strict)
     if progress is not None:
         progress(1.0)
