@@ -282,8 +282,8 @@ def _on_cores(task: Callable, items: list, parallel: bool) -> None:
 
 def _live_columns(flat: np.ndarray) -> np.ndarray:
     """The columns of ``flat`` (n, m) that are not zero throughout: ``np.any`` (which casts by buffers, no temporary),
-    a block of rows per core where it is large (:data:`PARALLEL_VALUES`): a regressor block of 29,000 samples × 504
-    columns in 6.1 ms on two threads against 9.8 ms on one. The same columns either way."""
+    a block of rows per core where it is large (:data:`PARALLEL_VALUES`; benchmarks/NOTEBOOK.md, stop 114). The same
+    columns either way."""
     workers = min(cores(), flat.shape[0]) if flat.size >= PARALLEL_VALUES else 1
     if workers <= 1:
         return np.flatnonzero(np.any(flat, axis=0))

@@ -179,8 +179,7 @@ class ParallelFiltering(Strategy):
     name = "parallel"
     chooses_cutoffs = True
 
-    def prepare(self, recording, settings: Preprocessing, strict: bool = True,
-                progress: Callable[[float], None] | None = None) -> PreparedData:
+    def prepare(self, recording, settings: Preprocessing, strict: bool = True) -> PreparedData:
         """Filter and differentiate a recording (positions, velocities: measured or from positions; accelerations:
         derivative of the filtered velocities), find where each joint rests and its direction of motion. The torques
         are not filtered here: they go through the parallel filter with the regressor (:meth:`chunks`).
@@ -191,8 +190,6 @@ class ParallelFiltering(Strategy):
         settings : Preprocessing
         strict : bool
             Refuse given cutoffs at or above this recording's Nyquist frequency (else lower them, with a warning).
-        progress : callable, optional
-            ``progress(share)`` as the preparation goes (its steps weighed by their time on an hour-long log).
 
         Returns
         -------
@@ -205,7 +202,7 @@ class ParallelFiltering(Strategy):
         DataError
             Too few samples to filter, or none left after trimming.
         """
-        return _parallel_prepare(recording, settings, strict, progress or (lambda share: None))
+        return _parallel_prepare(recording, settings, strict)
 
     def chunks(self, robot, base, data, progress=None, standard=False):
         """Parallel-filtered, decimated regressor and torques, chunk by chunk.
