@@ -45,12 +45,16 @@ class CellContacts:
         (how far inside the clearance).
     deepest : float [m]
         The deepest a link came inside the clearance (0 without contact).
+    held : tuple of str
+        The shapes that start within the floor's clearance, checked against their start height instead (each
+        shape's name, :attr:`dynid.excitation.link_geometry.LinkGeometry.names`).
     """
 
     set_points: int
     touching: int
     first: dict | None
     deepest: float
+    held: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready.
@@ -59,7 +63,8 @@ class CellContacts:
         -------
         dict
         """
-        return {"set_points": self.set_points, "touching": self.touching, "first": self.first, "deepest": self.deepest}
+        return {"set_points": self.set_points, "touching": self.touching, "first": self.first, "deepest": self.deepest,
+                "held": list(self.held)}
 
 
 def _quat(rpy) -> str:
@@ -162,6 +167,7 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
         return None
     needs = workspace.floor_needs(robot, q[0] if start_pose is None else start_pose)
     floor_height = {} if needs is None else {int(g): float(h) for g, h in zip(needs.shapes, needs.height)}
+    held = () if needs is None else tuple(workspace.shapes(robot).names[int(needs.shapes[c])] for c in needs.within)
     model = mujoco.MjModel.from_xml_string(cell_mjcf(robot, workspace, floor_height))
     data = mujoco.MjData(model)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in range(model.ngeom)]
@@ -192,4 +198,4 @@ def cell_contacts(robot: Robot, t: np.ndarray, q: np.ndarray, workspace: Workspa
             link, body = (a, b) if a.startswith("link") else (b, a)
             first = {"link": int(link.removeprefix("link").split("_")[0]), "shape": link, "body": body,
                      "time": float(t[n]), "depth": float(found[0][2])}
-    return CellContacts(int(q.shape[0]), touching, first, float(deepest))
+    return CellContacts(int(q.shape[0]), touching, first, float(deepest), held)

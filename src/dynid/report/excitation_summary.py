@@ -310,5 +310,27 @@ def _mujoco_lines(run) -> list:
         return [Line(f"MuJoCo finds link {f['link']}'s shape within the clearance of {f['body']} at t = {f['time']:.3g} s "
                      f"({found.touching} of {found.set_points} set-points, up to {found.deepest:.3g} m inside): do not "
                      "run it", "warning")]
-    return [Line(f"checked again by MuJoCo on the same shapes (the floor as a plane, each shape's margin the clearance): "
-                 f"none comes within the clearance of the cell or the floor on the {found.set_points} set-points")]
+    return [Line("checked again by MuJoCo on the same shapes (the floor as a plane, each shape's margin the clearance): "
+                 + mujoco_clear_said(found.to_dict()))]
+
+
+def mujoco_clear_said(contacts: dict) -> str:
+    """What MuJoCo's second check found where no shape touched (``CellContacts.to_dict()``): the links against the
+    cell and the floor only (their own shapes are checked apart), and the shapes that start within the floor's
+    clearance held to their start height, named, as the check held them.
+
+    Parameters
+    ----------
+    contacts : dict
+        :meth:`dynid.excitation.cell_replay.CellContacts.to_dict` (``held`` missing in an older excitation.json).
+
+    Returns
+    -------
+    str
+    """
+    held = list(contacts.get("held") or ())
+    return (f"no link's shape comes within the clearance of the cell or the floor on the {contacts['set_points']} "
+            "set-points" + ("" if not held else f", but {', '.join(held)} start{'s' if len(held) == 1 else ''} within "
+                            "the floor's clearance and {'was' if len(held) == 1 else 'were'} held only to no lower than "
+                            "{'it starts' if len(held) == 1 else 'they start'}") + " (each link against the cell and the floor: the "
+                            "links' own shapes against each other are checked apart)")

@@ -15,7 +15,7 @@ from pathlib import Path
 from .. import __version__
 from ..estimators.registry import OTHER_LABELS
 from ..io import atomic_write_text
-from .excitation_summary import no_floor_line, set_point_lines
+from .excitation_summary import mujoco_clear_said, no_floor_line, set_point_lines
 
 
 @dataclass
@@ -419,8 +419,7 @@ def _excite_verdict(d: dict) -> list[str]:
                    + (f"{gap:.3g} m apart" if gap >= 0 else f"overlapping by {-gap:.3g} m: check them before it runs"))
     contacts = d.get("mujoco_contacts") or {}
     if contacts:
-        out.append(f"checked again by MuJoCo on {contacts['set_points']} set-points: "
-                   + ("no shape within the clearance of the cell, the floor or another" if not contacts["touching"] else
+        out.append("checked again by MuJoCo: " + (mujoco_clear_said(contacts) if not contacts["touching"] else
                       f"{contacts['touching']} set-points with a shape within the clearance (the deepest "
                       f"{contacts['deepest']:.3g} m): do not run it as is"))
     return out
