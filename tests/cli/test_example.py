@@ -122,3 +122,14 @@ def test_identify_into_the_folder_of_the_users_urdf_leaves_the_urdf_as_it_was(tm
     assert (tmp_path / "try" / "identification.csv").is_file() and (tmp_path / "try" / "ur10e.toml").is_file()
     written = (tmp_path / "try" / "ur10e-identified.urdf").read_text()
     assert written != users and "written by dynid into ur10e.urdf" in written
+    # dynid export over a file the run reads (the robot's URDF, a log, the config, the results) is refused before it
+    # writes: over the URDF the identified values would have become the nominal ones on the next run
+    read = {"ur10e.urdf": "the robot's description this run reads", "identification.csv": "a file this run reads",
+            "ur10e.toml": "a file this run reads", "results.json": "a file this run reads"}
+    before = {name: (tmp_path / "try" / name).read_bytes() for name in read}
+    for name, said in read.items():
+        flag = "--mjcf" if name == "identification.csv" else "--urdf"
+        assert_refused(run("export", "ur10e.toml", "--results", "results.json", flag, name), f"{flag} {name}: {said}")
+    assert {name: (tmp_path / "try" / name).read_bytes() for name in read} == before
+    p = run("export", "ur10e.toml", "--results", "results.json", "--urdf", "ur10e-identified.urdf", "-q")
+    assert p.returncode == 0, p.stderr

@@ -413,7 +413,7 @@ def export(
             raise DataError("--forward simulates the MJCF: give --mjcf FILE too")
         cfg = load_identification_config(config, data_root=data_root)
         identified = _read_results(results, cfg.robot)
-        return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg.robot)
+        return cfg, identified, _export_targets(urdf, mjcf, mjcf_model, cfg, (results,))
 
     def compute(prepared, progress):
         from ..io.exported.export import consistent_estimate
@@ -559,10 +559,14 @@ def _replayed(flag: str, text: str, estimate, log=None) -> tuple[str, object]:
         return "MJCF", f"MuJoCo could not load it from its text ({str(exc).splitlines()[0]})"
 
 
-def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | None, robot) -> list[tuple[str, Path]]:
+def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | None, cfg,
+                    read: tuple[Path, ...] = ()) -> list[tuple[str, Path]]:
     """The files ``dynid export`` is to write, as (flag, path), checked before any work: at least one, a
-    ``--mjcf-model`` only with ``--mjcf`` and with the robot's joints, writable places (:func:`_check_targets`)."""
+    ``--mjcf-model`` only with ``--mjcf`` and with the robot's joints, writable places (:func:`_check_targets`),
+    none of the files the run reads (the config's, ``cfg.files_read``, ``--mjcf-model`` and ``read``)."""
     from ..exceptions import DataError
+
+    robot = cfg.robot
 
     targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
     if mjcf_model is not None and mjcf is None:
@@ -576,6 +580,14 @@ def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | Non
 
         read_users_mjcf(mjcf_model, robot)  # its joints are the robot's, before any work
     _check_targets(targets)
+    models = {p.resolve() for p in (*cfg.description_files, *((mjcf_model,) if mjcf_model is not None else ()))}
+    inputs = {p.resolve() for p in (*cfg.files_read, *read, *((mjcf_model,) if mjcf_model is not None else ()))}
+    for flag, path in targets:
+        if path.resolve() in inputs:
+            what = ("the robot's description this run reads: the identified values would become the description's "
+                    "nominal values on the next run" if path.resolve() in models else "a file this run reads")
+            raise DataError(f"{flag} {path}: {what}; give another file name, e.g. "
+                            f"{path.stem}-identified{'.urdf' if flag == '--urdf' else '.xml'}")
     return targets
 
 

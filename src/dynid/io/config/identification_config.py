@@ -206,6 +206,33 @@ class IdentificationConfig:
     controller: ClosedLoopSetup | None = None
     torque_sensor: str = "drive"  # the identification log's torques.sensor: "joint" or "drive"
 
+    @property
+    def description_files(self) -> tuple[Path, ...]:
+        """The robot's description files this config reads: the description it names (URDF, xacro, MJCF or robot
+        table), the URDF it comes from, the user's MJCF model.
+
+        Returns
+        -------
+        tuple of Path
+        """
+        named = Path(self.robot_source) if self.robot_source and not self.robot_source.startswith("config:") else None
+        return tuple(dict.fromkeys(p for p in (named, self.urdf, self.mjcf_model) if p is not None and p.is_file()))
+
+    @property
+    def files_read(self) -> tuple[Path, ...]:
+        """Every file this config reads: itself, :attr:`description_files` and the logs (a file dynid writes must be
+        none of them).
+
+        Returns
+        -------
+        tuple of Path
+        """
+        found = [self.path, *self.description_files]
+        gains = () if self.drive_gains is None else (self.drive_gains.unloaded, self.drive_gains.loaded)
+        for spec in (self.identification, *self.validation, *gains):
+            found.extend(spec.files)
+        return tuple(dict.fromkeys(found))
+
 
 REMOVED = {
     ("preprocessing", "torque_cutoff"): "no longer exists, because a filter on the torques alone biases the estimate near "

@@ -166,6 +166,17 @@ class DatasetSpec:
     max_gap: float = 0.1
     held: str = "interpolate"
 
+    @property
+    def files(self) -> tuple[Path, ...]:
+        """The files (or the bag) the dataset is read from.
+
+        Returns
+        -------
+        tuple of Path
+        """
+        found = [s.file for s in (self.time, *self.signals.values()) if s is not None]
+        return tuple(dict.fromkeys(found + ([self.bag.path] if self.bag is not None else [])))
+
 
 @dataclass(frozen=True)
 class BagSpec:
