@@ -83,6 +83,14 @@ def test_init_refusals(tmp_path):
     (tmp_path / "arm.toml").write_text("mine")
     assert_refused(run("init", str(URDF), str(log), "--out", str(tmp_path / "arm.toml")), "exists; give another name, or --force")
     assert (tmp_path / "arm.toml").read_text() == "mine"
+    # --force replaces an earlier config, never a file the run reads: the log or the robot file
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(URDF.read_text())
+    before = log.read_bytes(), urdf.read_bytes()
+    for target in (log, urdf):
+        assert_refused(run("init", str(urdf), str(log), "--out", str(target), "--force"),
+                       f"--out {target}: a file this init reads")
+    assert (log.read_bytes(), urdf.read_bytes()) == before
     odd = tmp_path / "odd.csv"
     odd.write_text("a,b,c\n1,2,3\n4,5,6\n")
     assert_refused(run("init", str(URDF), str(odd), "--out", str(tmp_path / "x.toml")), "odd.csv: no time column among ['a', 'b', 'c']")

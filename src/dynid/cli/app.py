@@ -904,7 +904,7 @@ def init(
         args.update(xacro_arguments(xacro_arg or []))  # a malformed one is refused in one line, as every mistake here
         if rate is not None and not (math.isfinite(rate) and rate > 0):
             raise DynIdError(f"--rate: expected the logs' sample rate, a positive number of Hz, got {rate:g}")
-        check_target(out, force)
+        check_target(out, force, (urdf, log, *(validation or ())))
         if not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
         return _init_robot(urdf, log, arm, args)

@@ -478,18 +478,23 @@ def _relative(path: Path, folder: Path) -> str:
     return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
 
 
-def check_target(path: Path, force: bool) -> None:
-    """Refuse to overwrite a config unless asked.
+def check_target(path: Path, force: bool, read: tuple[Path, ...] = ()) -> None:
+    """Refuse to overwrite a config unless asked, and a file the run reads always.
 
     Parameters
     ----------
     path : Path
     force : bool
+    read : tuple of Path
+        The files the run reads (the robot file, the logs).
 
     Raises
     ------
     ConfigError
-        ``path`` exists and ``force`` is false.
+        ``path`` exists and ``force`` is false, or ``path`` is one of ``read``.
     """
+    if path.exists() and any(path.resolve() == Path(r).resolve() for r in read):
+        raise ConfigError(f"--out {path}: a file this init reads (the robot file or a log), which --force would replace "
+                          "by the config; give the config another name, e.g. arm.toml")
     if path.exists() and not force:
         raise ConfigError(f"--out {path}: exists; give another name, or --force to overwrite it")
