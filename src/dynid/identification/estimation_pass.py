@@ -56,6 +56,7 @@ from ..validation.torques import TorqueSums, resting_rows
 from .drive_only import drive_only, held_out_errors
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .flipped_joints import flipped_joint_findings
+from .geared_friction import beyond_hysteresis, hysteresis_finding
 from .result import IdentificationResult, search_box
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
@@ -394,16 +395,26 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
     floor = fit.floor_metrics()  # one channel's own scale is one the fit cannot follow
     misfit = None if floor is None else (np.min([m["rmse"] for m in fit.metrics().values()], axis=0)
                                          > SCALE_MISFIT * np.asarray(floor["rmse"]))
-    unlike = unlike_nominal_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name, q=data.q, dq=data.dq,
-                                     tau=data.tau, explained=bool(geometry))
-    if unlike:  # not torques: no sign, scale or geometry of them can be judged
-        return unlike
+    def unlike(rho):
+        return unlike_nominal_findings(np.where(np.isfinite(rho), rho, corr), varies, data.name, q=data.q, dq=data.dq,
+                                       tau=data.tau, explained=bool(geometry))
+
+    said = unlike(beyond)
+    geared = None if not said else beyond_hysteresis(scoring.robot, base, data, nominal, friction, drive,
+                                                     lambda rho: not unlike(rho))
+    if said and geared is None:  # not torques: no sign, scale or geometry of them can be judged
+        return said
+    note = []
+    if geared is not None:  # torques with a geared drive's hysteresis: judged beyond its friction
+        note = [hysteresis_finding(geared, beyond, varies, data.name)]
+        beyond, slope, beyond_drive, slope_drive = geared.beyond, geared.slope, geared.beyond_drive, geared.slope_drive
+        stats["nominal_correlation_beyond_hysteresis"] = beyond
     return (sign_findings(np.where(np.isfinite(beyond), beyond, corr), varies, data.name,
                           slope=np.where(np.isfinite(beyond), slope, np.nan))
             + scale_findings(beyond_drive, slope_drive, varies, data.name,
                              gains=data.drive_gains if data.drive_gains is not None else np.ones(scoring.robot.n_dof),
                              misfit=misfit, mass=float(np.sum(scoring.robot.inertial[:, 9])),
-                             described=scoring.robot.drive_gains) + geometry)
+                             described=scoring.robot.drive_gains) + geometry + note)
 
 
 def _rotor_columns(robot: Robot, base: BaseParameters) -> dict:
