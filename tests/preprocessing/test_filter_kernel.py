@@ -1,5 +1,5 @@
-"""The compiled filters of long logs against SciPy's own (an independent implementation): the parallel decimation's
-zero-phase filter against ``sosfiltfilt``, the Gaussian smoothing against ``gaussian_filter1d``, the same numbers bit for
+"""The compiled filters of long logs, and the short logs' filter with its initial state computed once, against SciPy's
+own (an independent implementation): the parallel decimation's zero-phase filters against ``sosfiltfilt``, the Gaussian smoothing against ``gaussian_filter1d``, the same numbers bit for
 bit whatever the order, cutoff, width, padding, columns, threads and values."""
 
 import numpy as np
@@ -8,6 +8,7 @@ from scipy import signal
 from scipy.ndimage import gaussian_filter1d
 
 from dynid.preprocessing._filter_kernel import gaussian_nearest, gaussian_weights, zero_phase
+from dynid.preprocessing.filters import even_filtfilt
 
 
 @pytest.mark.parametrize(("order", "cutoff", "rate", "n", "c", "padlen"),
@@ -25,6 +26,10 @@ def test_the_compiled_filter_is_scipys_sosfiltfilt_bit_for_bit(order, cutoff, ra
     assert not np.array_equal(got, x)  # it filtered
     cols, rows = np.array([c - 1, 0]), np.array([0, n // 2, n - 1])  # columns read in place, rows picked
     assert np.array_equal(zero_phase(sos, x, padlen, signal.sosfilt_zi(sos), cols, rows), expected[rows][:, cols])
+    # the short logs' path: SciPy's own steps with the initial state computed once, the same numbers
+    lean = even_filtfilt(signal, sos, x, padlen, signal.sosfilt_zi(sos))
+    assert np.array_equal(lean, expected) and lean.shape == expected.shape
+    assert np.array_equal(even_filtfilt(signal, sos, x[:, 1:], padlen, signal.sosfilt_zi(sos)), expected[:, 1:])
 
 
 def test_the_parallel_decimation_of_a_long_log_is_the_same_through_either_filter(monkeypatch):
