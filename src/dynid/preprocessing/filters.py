@@ -199,6 +199,11 @@ temporary copies: 16 rather than 64 took 33 MB off the TX40 identification's pea
 two cores' threads blocks of 2 keep the peak 3 MB above one thread's blocks of 8, blocks of 4 7 MB). Each column is
 filtered on its own, so the numbers do not depend on the blocks or the cores."""
 
+BLOCK_VALUES = 60_000
+"""A block of a short signal takes more columns than :data:`COLUMN_BLOCK`, up to this many values (rows × columns) in
+all: SciPy's set-up per call costs as much as filtering two columns of a few thousand samples, and a block of this
+size holds its copies in about 3 MB."""
+
 COMPILED_FILTER_VALUES = 50_000_000
 """From this many values (the log's samples × the columns of every signal filtered together) on,
 :func:`parallel_decimation` filters with the compiled filter (:mod:`dynid.preprocessing._filter_kernel`, SciPy's numbers bit for bit): an hour at 1 kHz. Below it,
@@ -386,7 +391,7 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
 
         def filtered(flat, live, fast):
             out = np.zeros((index.size, flat.shape[1]))
-            width = COMPILED_COLUMN_BLOCK if fast else COLUMN_BLOCK
+            width = COMPILED_COLUMN_BLOCK if fast else max(COLUMN_BLOCK, BLOCK_VALUES // flat.shape[0])
 
             def one(cols):  # a column block: the filter's copies stay small; blocks write disjoint columns of out
                 out[:, cols] = (zero_phase(sos, flat, padlen, zi, cols, index - lo) if fast else
