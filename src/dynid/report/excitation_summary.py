@@ -329,8 +329,9 @@ def mujoco_clear_said(contacts: dict) -> str:
     str
     """
     held = list(contacts.get("held") or ())
+    one = len(held) == 1
+    but = (f", but {', '.join(held)} start{'s' if one else ''} within the floor's clearance and {'was' if one else 'were'}"
+           f" held only to no lower than {'it starts' if one else 'they start'}") if held else ""
     return (f"no link's shape comes within the clearance of the cell or the floor on the {contacts['set_points']} "
-            "set-points" + ("" if not held else f", but {', '.join(held)} start{'s' if len(held) == 1 else ''} within "
-                            "the floor's clearance and {'was' if len(held) == 1 else 'were'} held only to no lower than "
-                            "{'it starts' if len(held) == 1 else 'they start'}") + " (each link against the cell and the floor: the "
-                            "links' own shapes against each other are checked apart)")
+            f"set-points{but} (each link against the cell and the floor: the links' own shapes against each other are "
+            "checked apart)")
