@@ -567,7 +567,6 @@ def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | Non
     from ..exceptions import DataError
 
     robot = cfg.robot
-
     targets = [(flag, path) for flag, path in (("--urdf", urdf), ("--mjcf", mjcf)) if path is not None]
     if mjcf_model is not None and mjcf is None:
         raise DataError("--mjcf-model is the model --mjcf writes into: give --mjcf FILE too")

@@ -726,7 +726,7 @@ def compare_torques(robot: Robot, base: BaseParameters, data: PreparedData, para
             preds[label].append(y @ beta)
             centres[label].append(preds[label][-1] - held @ beta)
         for label, cov in covariance.items():
-            var[label] += np.einsum("mjc,mjc->j", y @ cov, y)  # a product first: 20× quicker than one 3-way einsum
+            var[label] += np.einsum("mjc,mjc->j", y @ cov, y)  # the product first (BLAS), then the rows' sums
 
     m = sum(x.shape[0] for x in ts)
     static = static_friction(base, parameter_sets, robot.n_dof)
