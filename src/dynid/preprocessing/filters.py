@@ -193,10 +193,11 @@ def velocity_noise_std(sigma: np.ndarray, rate: float, cutoff: float, order: int
 
 
 COLUMN_BLOCK = 2
-"""Columns filtered at once by :func:`parallel_decimation`, one block per core at a time (bounds the filter's
-temporary copies: 16 rather than 64 took 33 MB off the TX40 identification's peak, 8 rather than 16 another 4 MB; on
-two cores' threads blocks of 2 keep the peak 3 MB above one thread's blocks of 8, blocks of 4 7 MB). Each column is
-filtered on its own, so the numbers do not depend on the blocks or the cores."""
+"""The fewest columns filtered at once by :func:`parallel_decimation` (more for a short block: :data:`BLOCK_VALUES`),
+one block per core at a time (bounds the filter's temporary copies: 16 rather than 64 took 33 MB off the TX40
+identification's peak, 8 rather than 16 another 4 MB; on two cores' threads blocks of 2 keep the peak 3 MB above one
+thread's blocks of 8, blocks of 4 7 MB). Each column is filtered on its own, so the numbers do not depend on the
+blocks or the cores."""
 
 BLOCK_VALUES = 60_000
 """A block of a short signal takes more columns than :data:`COLUMN_BLOCK`, up to this many values (rows × columns) in
