@@ -133,3 +133,10 @@ def test_identify_into_the_folder_of_the_users_urdf_leaves_the_urdf_as_it_was(tm
     assert {name: (tmp_path / "try" / name).read_bytes() for name in read} == before
     p = run("export", "ur10e.toml", "--results", "results.json", "--urdf", "ur10e-identified.urdf", "-q")
     assert p.returncode == 0, p.stderr
+    # dynid validate on the log the model was fitted on scores it as asked, and says its figures are the fit's
+    for log, fitted in (("identification.csv", True), ("validation.csv", False)):
+        p = run("validate", "ur10e.toml", "--results", "results.json", "--file", log, "--out", f"v-{log}")
+        assert p.returncode == 0, p.stderr
+        said = " ".join(p.stderr.split())
+        assert (f"{log}: 100 % of its sampled positions are samples of the identification log the model was fitted on: "
+                "its figures are the fit's" in said) is fitted, said

@@ -192,11 +192,12 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    logs = _read_as_scored(datasets, config.robot, progress)
+    repeated: list[str] = []
+    logs = _fit_repeats_said(config, _read_as_scored(datasets, config.robot, progress), repeated)
     if yardstick:
         reference = yardstick_reference(load_recording(config.identification, config.robot))
         filters = yardstick_scores(config, base, sets, logs, resolved=stored_preprocessing(identified), reference=reference)
-        return filters[0], tuple(w for r in refs for w in r.warnings)
+        return filters[0], tuple(w for r in refs for w in r.warnings) + tuple(repeated)
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
     comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
@@ -206,7 +207,23 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
                                           nominal=label)
     if beside:
         comparisons = tuple(v.without(str(label)) for v in comparisons)
-    return comparisons, tuple(w for r in refs for w in r.warnings) + warnings
+    return comparisons, tuple(w for r in refs for w in r.warnings) + warnings + tuple(repeated)
+
+
+def _fit_repeats_said(config: IdentificationConfig, logs, said: list[str]):
+    """The logs as they come, and into ``said`` a warning for each that repeats the identification log's samples
+    (:func:`dynid.io.logs.log_repairs.repeated_share`): scored as asked, but its figures are the fit's, not a test on
+    other motions. An identification log that cannot be read now (moved, renamed) leaves the logs unchecked."""
+    try:
+        fitted = load_recording(config.identification, config.robot)
+    except DynIdError:
+        fitted = None
+    for log in logs:
+        share = 0.0 if fitted is None else repeated_share(fitted, log)
+        if share >= 0.5:
+            said.append(f"{log.name}: {100 * share:.0f} % of its sampled positions are samples of the identification "
+                        "log the model was fitted on: its figures are the fit's, not a validation on other motions")
+        yield log
 
 
 def _read_as_scored(datasets, robot, progress):
