@@ -35,6 +35,26 @@ def test_a_run_replaces_the_earlier_one_whole(tmp_path):
     assert (out / "results.json").read_text() == "2"
 
 
+def test_a_file_of_the_users_where_a_run_writes_one_is_refused_before_anything_moves(tmp_path):
+    """``--out .`` in a folder that holds the user's own report.html: refused, the folder as it was; an earlier run's
+    files (in its manifest) are still replaced, and a run after one killed there (its staging folder left) may
+    replace the killed run's files, which no manifest lists."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "report.html").write_text("my notes")
+    with pytest.raises(ConfigError, match=r"report.html: a file where this run writes one, which no earlier run"):
+        _save({"results.json": "1", "report.html": "R1"}, out)
+    assert sorted(p.name for p in out.iterdir()) == ["report.html"] and (out / "report.html").read_text() == "my notes"
+    (out / "report.html").unlink()
+    _save({"results.json": "1", "report.html": "R1"}, out)
+    _save({"results.json": "2", "report.html": "R2"}, out)  # the earlier run's: replaced
+    assert (out / "report.html").read_text() == "R2"
+    (out / MANIFEST).unlink()  # as a run killed while its files moved leaves it, with its staging folder
+    (out / ".dynid-staging-elsewhere-1-x").mkdir()
+    _save({"results.json": "3", "report.html": "R3"}, out)
+    assert (out / "report.html").read_text() == "R3"
+
+
 def test_an_interrupted_save_leaves_the_earlier_run_unchanged(tmp_path):
     out = tmp_path / "run"
     _save({"results.json": "1", "a.png": "A"}, out)

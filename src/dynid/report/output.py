@@ -54,7 +54,9 @@ def staged(save):
 
     For ``save(result, out, ...) -> paths``: the files are written into a hidden staging folder inside ``out``, then
     moved into ``out`` one by one; the files of an earlier run there that this one does not write again are removed,
-    and the manifest (:data:`MANIFEST`) is written last. An error or a Ctrl-C while saving leaves ``out`` as it was
+    and the manifest (:data:`MANIFEST`) is written last. A file of the same name as one this run writes that no earlier
+    run wrote (not in the manifest: the user's own) is refused before anything moves, unless a run was killed there
+    (its staging folder left behind: its files are listed nowhere). An error or a Ctrl-C while saving leaves ``out`` as it was
     (the staging folder is removed). The old manifest is removed before the first file moves, so a folder killed while
     files move (SIGKILL, power loss) has no manifest: files without a manifest are an incomplete run. Staging folders
     such a kill leaves behind are removed by the next run into the same folder once they are an hour old.
@@ -74,6 +76,7 @@ def staged(save):
     @functools.wraps(save)
     def wrapper(result, out, *args, **kwargs):
         out = output_folder(out)
+        interrupted = any(out.glob(_STAGING + "*"))  # a run killed here: its files, listed nowhere, may be replaced
         _remove_stale_staging(out)
         stage = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{_owner()}-", dir=out))
         try:
@@ -83,6 +86,10 @@ def staged(save):
             if blocked:  # checked before anything moves: a failed move half-way would leave two runs mixed
                 raise ConfigError(f"{blocked[0]}: a folder where this run writes a file; move or remove it")
             previous = _manifest_files(out)
+            theirs = [f for f in final if (f.exists() or f.is_symlink()) and f.name not in previous]
+            if theirs and not interrupted:  # a file of the user's (or of a run before dynid kept manifests)
+                raise ConfigError(f"{theirs[0]}: a file where this run writes one, which no earlier run into {out} "
+                                  f"wrote (its {MANIFEST} does not list it): move it, or give another output folder")
             (out / MANIFEST).unlink(missing_ok=True)  # from here until the new one: visibly incomplete
             for p in previous - {f.name for f in final}:
                 (out / p).unlink(missing_ok=True)
@@ -107,7 +114,8 @@ list of Path
 Raises
 ------
 ConfigError
-    If ``out`` exists and is not a folder, cannot be created, or holds a folder where the run writes a file."""
+    If ``out`` exists and is not a folder, cannot be created, or holds a folder where the run writes a file, or a file
+    no earlier run into it wrote."""
 """The numpydoc sections of every :func:`staged` writer, appended to its docstring."""
 
 
