@@ -133,6 +133,13 @@ def test_identify_into_the_folder_of_the_users_urdf_leaves_the_urdf_as_it_was(tm
     assert {name: (tmp_path / "try" / name).read_bytes() for name in read} == before
     p = run("export", "ur10e.toml", "--results", "results.json", "--urdf", "ur10e-identified.urdf", "-q")
     assert p.returncode == 0, p.stderr
+    # a folder holding a file of the user's named as one validate writes is refused before any computation
+    (tmp_path / "try" / "mine").mkdir()
+    (tmp_path / "try" / "mine" / "report.html").write_text("my notes")
+    assert_refused(run("validate", "ur10e.toml", "--results", "results.json", "--out", "mine"),
+                   "report.html: a file where this run writes one, which no earlier run into mine wrote")
+    assert [p.name for p in (tmp_path / "try" / "mine").iterdir()] == ["report.html"]
+    assert (tmp_path / "try" / "mine" / "report.html").read_text() == "my notes"
     # dynid validate on the log the model was fitted on scores it as asked, and says its figures are the fit's
     for log, fitted in (("identification.csv", True), ("validation.csv", False)):
         p = run("validate", "ur10e.toml", "--results", "results.json", "--file", log, "--out", f"v-{log}")

@@ -55,6 +55,23 @@ def test_a_file_of_the_users_where_a_run_writes_one_is_refused_before_anything_m
     assert (out / "report.html").read_text() == "R3"
 
 
+def test_a_file_of_the_users_a_command_will_write_is_refused_before_computing(tmp_path):
+    """The names a command writes whatever its result are checked with --out itself: the user's own refused, an
+    earlier run's (in its manifest) and a killed run's (its staging folder left) not."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "report.html").write_text("my notes")
+    with pytest.raises(ConfigError, match=r"report.html: a file where this run writes one, which no earlier run"):
+        check_output_folder(out, ("results.json", "report.html"))
+    assert check_output_folder(out, ("results.json",)) == out  # a name the command does not write
+    (out / "report.html").unlink()
+    _save({"results.json": "1", "report.html": "R1"}, out)
+    assert check_output_folder(out, ("results.json", "report.html")) == out
+    (out / MANIFEST).unlink()
+    (out / ".dynid-staging-elsewhere-1-x").mkdir()
+    assert check_output_folder(out, ("results.json", "report.html")) == out
+
+
 def test_an_interrupted_save_leaves_the_earlier_run_unchanged(tmp_path):
     out = tmp_path / "run"
     _save({"results.json": "1", "a.png": "A"}, out)

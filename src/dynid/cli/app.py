@@ -56,11 +56,12 @@ def _steps(progress):
     return lambda step, done, total: progress.update(step, f"{100 * done / max(total, 1):.0f} %")
 
 
-def _check_out(out) -> None:
-    """An unusable --out is refused before any computation."""
+def _check_out(out, writes: tuple[str, ...] = ()) -> None:
+    """An unusable --out is refused before any computation, and one holding a file of the user's named as one of
+    ``writes``."""
     from ..report.output import check_output_folder
 
-    check_output_folder(out)
+    check_output_folder(out, writes)
 
 
 def _renamed(methods: str | None) -> None:
@@ -109,10 +110,13 @@ class _Command:
         Output folder, refused before any computation when unusable.
     figures : bool
         Draw figures in a process forked before the live line starts (:func:`dynid.report.output.figure_process`).
+    writes : tuple of str
+        Files the command writes into ``out`` whatever the result: one of the user's there under such a name is refused
+        before any computation (others, e.g. figures, when the files are saved).
     """
 
-    def __init__(self, name: str, quiet: bool, out: Path | None = None, figures: bool = False):
-        self.name, self.out, self.figures = name, out, figures
+    def __init__(self, name: str, quiet: bool, out: Path | None = None, figures: bool = False, writes: tuple[str, ...] = ()):
+        self.name, self.out, self.figures, self.writes = name, out, figures, writes
         self.reporter = Reporter(quiet)
 
     def run(self, prepare, compute, save, show=None) -> None:
@@ -133,7 +137,7 @@ class _Command:
         try:
             prepared = prepare()  # a mistake is reported before any heavy import
             if self.out is not None:
-                _check_out(self.out)
+                _check_out(self.out, self.writes)
             from ..report.output import figure_process
 
             with figure_process(self.figures):  # forked before the live line's thread starts: imports pyplot meanwhile
@@ -295,7 +299,7 @@ def identify(
         rep.blocks(_taken_away(out, config))
         rep.wrote(paths)
 
-    _Command("dynid identify", quiet, out, figures).run(prepare, compute, save, show)
+    _Command("dynid identify", quiet, out, figures, ("results.json", "report.html")).run(prepare, compute, save, show)
 
 
 def _taken_away(out: Path, config: Path) -> list:
@@ -674,7 +678,7 @@ def validate(
             rep.warning(w)
         rep.wrote(paths)
 
-    _Command("dynid validate", quiet, out, figures=True).run(
+    _Command("dynid validate", quiet, out, figures=True, writes=("validation.json", "report.html")).run(
         prepare, lambda p, progress: run_validation(p[0], p[1], datasets=p[2], progress=_steps(progress), source=str(results),
                                                  yardstick=yardstick), save, show)
 
@@ -720,7 +724,7 @@ def payload(
             rep.warning(line)
         rep.wrote(paths)
 
-    _Command("dynid payload", quiet, out).run(prepare, compute, save, show)
+    _Command("dynid payload", quiet, out, writes=("payload.json", "payload.urdf", "payload.xml")).run(prepare, compute, save, show)
 
 
 def payload_warnings(found, last_joint: str) -> list[str]:
@@ -875,7 +879,7 @@ def excite(
         rep.blocks(excitation_blocks(run, tables=verbose))
         rep.wrote(paths)
 
-    _Command("dynid excite", quiet, out).run(prepare, compute, save, show)
+    _Command("dynid excite", quiet, out, writes=("excitation.json", "excitation.csv", "report.html")).run(prepare, compute, save, show)
 
 
 @app.command()
@@ -1098,7 +1102,7 @@ def montecarlo(
             return save_closed_loop_study(result, out)
         return save_montecarlo(result, out)
 
-    _Command("dynid montecarlo", quiet, out).run(prepare, compute, save)
+    _Command("dynid montecarlo", quiet, out, writes=("montecarlo.json", "report.html")).run(prepare, compute, save)
 
 
 @app.command()
@@ -1135,7 +1139,7 @@ def fleet(
 
         return save_fleet(result, out)
 
-    _Command("dynid fleet", quiet, out).run(prepare, compute, save)
+    _Command("dynid fleet", quiet, out, writes=("fleet.json", "fleet.parquet", "fleet.html")).run(prepare, compute, save)
 
 
 @app.command()
@@ -1194,7 +1198,7 @@ def monitor(
 
         return save_monitor(result, out)
 
-    _Command("dynid monitor", quiet, out).run(prepare, compute, save)
+    _Command("dynid monitor", quiet, out, writes=("monitor.json",)).run(prepare, compute, save)
 
 
 class Interrupted(BaseException):

@@ -23,12 +23,15 @@ MANIFEST = ".dynid-manifest.json"
 """Written last into an output folder: the files of the run that is there, whole."""
 
 
-def check_output_folder(out: str | Path) -> Path:
-    """Refuse, before any computation, an output folder that is a file or a folder that cannot be written.
+def check_output_folder(out: str | Path, writes: tuple[str, ...] = ()) -> Path:
+    """Refuse, before any computation, an output folder that is a file or a folder that cannot be written, or that
+    holds a file of the user's where the run writes one (:func:`foreign_files`).
 
     Parameters
     ----------
     out : str or Path
+    writes : tuple of str
+        Names of files the run will write there (those known before it runs).
 
     Returns
     -------
@@ -46,7 +49,35 @@ def check_output_folder(out: str | Path) -> Path:
     parent = out if out.exists() else next((p for p in out.absolute().parents if p.exists()), Path("/"))
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ConfigError(f"out {out}: {parent} is not writable", field="out")
+    killed = out.is_dir() and any(out.glob(_STAGING + "*"))  # a run killed there: its files, listed nowhere, may go
+    theirs = foreign_files(out, writes) if out.is_dir() and not killed else []
+    if theirs:
+        raise ConfigError(_foreign_message(theirs[0], out), field="out")
     return out
+
+
+def foreign_files(out: Path, names) -> list[Path]:
+    """The files of ``out`` named ``names`` that no earlier run into it wrote (not in its :data:`MANIFEST`): the
+    user's own, which a run never replaces (unless a run was killed there, its staging folder left behind: its files
+    are listed nowhere, and the callers let the next run replace them).
+
+    Parameters
+    ----------
+    out : Path
+        An existing folder.
+    names : iterable of str
+
+    Returns
+    -------
+    list of Path
+    """
+    previous = _manifest_files(out)
+    return [out / n for n in names if ((out / n).exists() or (out / n).is_symlink()) and n not in previous]
+
+
+def _foreign_message(path: Path, out: Path) -> str:
+    return (f"{path}: a file where this run writes one, which no earlier run into {out} wrote (its {MANIFEST} does not "
+            "list it): move it, or give another output folder")
 
 
 def staged(save):
@@ -86,10 +117,9 @@ def staged(save):
             if blocked:  # checked before anything moves: a failed move half-way would leave two runs mixed
                 raise ConfigError(f"{blocked[0]}: a folder where this run writes a file; move or remove it")
             previous = _manifest_files(out)
-            theirs = [f for f in final if (f.exists() or f.is_symlink()) and f.name not in previous]
-            if theirs and not interrupted:  # a file of the user's (or of a run before dynid kept manifests)
-                raise ConfigError(f"{theirs[0]}: a file where this run writes one, which no earlier run into {out} "
-                                  f"wrote (its {MANIFEST} does not list it): move it, or give another output folder")
+            theirs = [] if interrupted else foreign_files(out, [f.name for f in final])  # the user's own files
+            if theirs:
+                raise ConfigError(_foreign_message(theirs[0], out))
             (out / MANIFEST).unlink(missing_ok=True)  # from here until the new one: visibly incomplete
             for p in previous - {f.name for f in final}:
                 (out / p).unlink(missing_ok=True)
