@@ -64,3 +64,11 @@ def test_migrate_rewrites_an_inline_table(tmp_path):
     p = dynid("migrate", path)
     assert p.returncode == 0, p.stderr
     assert tomllib.loads(path.read_text()) == doc and "wrote" in p.stdout
+    # --out names a new file: an existing one (a log, the robot file) is refused and left as it was
+    log = tmp_path / "log.csv"
+    log.write_text("t,q1\n0,0\n")
+    assert_refused(dynid("migrate", path, "--out", log), "--out")
+    assert log.read_text() == "t,q1\n0,0\n"
+    p = dynid("migrate", path, "--out", tmp_path / "new.toml")
+    assert p.returncode == 0, p.stderr
+    assert tomllib.loads((tmp_path / "new.toml").read_text()) == doc

@@ -995,6 +995,9 @@ def migrate(
             raise DynIdError(f"{config}: no such config")
         if out is not None and not out.parent.is_dir():
             raise DynIdError(f"--out {out}: its folder does not exist")
+        if out is not None and out.exists() and out.resolve() != config.resolve():  # a log, the robot file, another config
+            raise DynIdError(f"--out {out}: exists; give the migrated config a new file name (or leave --out out to "
+                             f"rewrite {config} in place)")
         try:
             return config.read_text(encoding="utf-8-sig")  # as identify reads a config: a byte-order mark skipped
         except UnicodeDecodeError as exc:
