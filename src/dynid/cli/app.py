@@ -583,8 +583,9 @@ def _export_targets(urdf: Path | None, mjcf: Path | None, mjcf_model: Path | Non
 
         read_users_mjcf(mjcf_model, robot)  # its joints are the robot's, before any work
     _check_targets(targets)
-    models = {p.resolve() for p in (*cfg.description_files, *((mjcf_model,) if mjcf_model is not None else ()))}
-    inputs = {p.resolve() for p in (*cfg.files_read, *read, *((mjcf_model,) if mjcf_model is not None else ()))}
+    users = () if mjcf_model is None else (mjcf_model,)
+    models = {p.resolve() for p in (*cfg.description_files, *users)}
+    inputs = {p.resolve() for p in (*cfg.files_read, *read, *users)}
     for flag, path in targets:
         if path.resolve() in inputs:
             what = ("the robot's description this run reads: the identified values would become the description's "

@@ -193,9 +193,11 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
     repeated: list[str] = []
-    logs = _fit_repeats_said(config, _read_as_scored(datasets, config.robot, progress), repeated)
+    fitted = _identification_log(config)
+    logs = _fit_repeats_said(fitted, _read_as_scored(datasets, config.robot, progress), repeated)
     if yardstick:
-        reference = yardstick_reference(load_recording(config.identification, config.robot))
+        reference = yardstick_reference(fitted if fitted is not None else load_recording(config.identification,
+                                                                                         config.robot))
         filters = yardstick_scores(config, base, sets, logs, resolved=stored_preprocessing(identified), reference=reference)
         return filters[0], tuple(w for r in refs for w in r.warnings) + tuple(repeated)
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
@@ -210,14 +212,18 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings + tuple(repeated)
 
 
-def _fit_repeats_said(config: IdentificationConfig, logs, said: list[str]):
-    """The logs as they come, and into ``said`` a warning for each that repeats the identification log's samples
-    (:func:`dynid.io.logs.log_repairs.repeated_share`): scored as asked, but its figures are the fit's, not a test on
-    other motions. An identification log that cannot be read now (moved, renamed) leaves the logs unchecked."""
+def _identification_log(config: IdentificationConfig) -> Recording | None:
+    """The config's identification log as read, or None where it cannot be read now (moved, renamed)."""
     try:
-        fitted = load_recording(config.identification, config.robot)
+        return load_recording(config.identification, config.robot)
     except DynIdError:
-        fitted = None
+        return None
+
+
+def _fit_repeats_said(fitted: Recording | None, logs, said: list[str]):
+    """The logs as they come, and into ``said`` a warning for each that repeats the samples of ``fitted``, the
+    identification log (:func:`dynid.io.logs.log_repairs.repeated_share`): scored as asked, but its figures are the
+    fit's, not a test on other motions. Without it (None) the logs go unchecked."""
     for log in logs:
         share = 0.0 if fitted is None else repeated_share(fitted, log)
         if share >= 0.5:

@@ -235,10 +235,11 @@ class Progress:
         self._status: Any = None
         self._started: dict[str, float] = {}  # each step's start [s since t0]: its time left from its share done
         self._shown = ("starting", "")  # the live line's step and detail, drawn with the time as it is
+        self._line = _LiveLine(self)
 
     def __enter__(self) -> Progress:
         if self.live:
-            self._status = self.console.status(_LiveLine(self), spinner="line")
+            self._status = self.console.status(self._line, spinner="line")
             self._status.__enter__()
         return self
 
@@ -262,7 +263,7 @@ class Progress:
         self._started.setdefault(step, elapsed)
         if self.live:
             self._shown = (step, detail)
-            self._status.update(_LiveLine(self))
+            self._status.update(self._line)  # drawn now, not at the next redraw
         elif step not in self.seen:  # steps may run side by side: each is announced once
             self.console.print(f"{self.command}: {step} (at {elapsed:.1f} s)", markup=False, highlight=False)
         self.seen.add(step)

@@ -49,8 +49,7 @@ def check_output_folder(out: str | Path, writes: tuple[str, ...] = ()) -> Path:
     parent = out if out.exists() else next((p for p in out.absolute().parents if p.exists()), Path("/"))
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ConfigError(f"out {out}: {parent} is not writable", field="out")
-    killed = out.is_dir() and any(out.glob(_STAGING + "*"))  # a run killed there: its files, listed nowhere, may go
-    theirs = foreign_files(out, writes) if out.is_dir() and not killed else []
+    theirs = foreign_files(out, writes) if out.is_dir() and not _killed_in(out) else []
     if theirs:
         raise ConfigError(_foreign_message(theirs[0], out), field="out")
     return out
@@ -73,6 +72,11 @@ def foreign_files(out: Path, names) -> list[Path]:
     """
     previous = _manifest_files(out)
     return [out / n for n in names if ((out / n).exists() or (out / n).is_symlink()) and n not in previous]
+
+
+def _killed_in(out: Path) -> bool:
+    """A run was killed in ``out`` (its staging folder left behind): its files, listed nowhere, may be replaced."""
+    return any(out.glob(_STAGING + "*"))
 
 
 def _foreign_message(path: Path, out: Path) -> str:
@@ -107,7 +111,7 @@ def staged(save):
     @functools.wraps(save)
     def wrapper(result, out, *args, **kwargs):
         out = output_folder(out)
-        interrupted = any(out.glob(_STAGING + "*"))  # a run killed here: its files, listed nowhere, may be replaced
+        interrupted = _killed_in(out)  # before the stale staging folders go
         _remove_stale_staging(out)
         stage = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{_owner()}-", dir=out))
         try:
