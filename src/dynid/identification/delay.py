@@ -28,7 +28,7 @@ from ..preprocessing.filters import FractionalShift, butterworth_filtfilt
 from ..preprocessing.preparation import Preprocessing, base_chunks, prepare
 from ..preprocessing.prepared import PreparedData
 
-__all__ = ["DelayEstimate", "estimate_delay", "delay_from_rows", "delayed"]
+__all__ = ["DelayEstimate", "estimate_delay", "delay_from_rows", "held_out_sum", "delayed"]
 
 DELAY_FOLDS = 5
 """Contiguous blocks of the log on which a delay's held-out residual is measured (:attr:`DelayEstimate.held_out`)."""
@@ -55,6 +55,10 @@ class DelayEstimate:
         given (:data:`DELAY_FOLDS` contiguous blocks, each predicted by least squares on the others): below 1 where the
         delay improves what the model predicts of motion it was not fitted on (issue "Every assurance checked on what
         the user meets", item 5); NaN where not measured.
+    held_out_sums : tuple of float [(N·m)²]
+        The two held-out squared residuals whose ratio is ``held_out``: with the torques read as given, and at this
+        delay (what :func:`dynid.identification.geared_friction.delay_beyond_hysteresis` compares across friction
+        models).
     """
 
     samples: float
@@ -62,6 +66,7 @@ class DelayEstimate:
     seconds: float
     at_bound: bool = False
     held_out: float = float("nan")
+    held_out_sums: tuple[float, float] = (float("nan"), float("nan"))
 
     @property
     def determined(self) -> bool:
@@ -139,33 +144,15 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
     """
     from scipy.optimize import minimize_scalar
 
-    s = data.settings
-    rows, times, keeps = [], [], []
-    for index, y, _, keep in blocks:
-        rows.append(y.reshape(-1, y.shape[-1]))
-        times.append(np.asarray(data.t)[index])
-        keeps.append(np.asarray(keep).reshape(-1))
-    w, t_rows, keep = np.concatenate(rows), np.concatenate(times), np.concatenate(keeps)
-    n = w.shape[0] // t_rows.size  # rows per instant: the joints
-    if keep.sum() <= w.shape[1]:
-        raise IdentifiabilityError(f"{data.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
-    del rows
+    w, keep, instants, read = _gathered(data, blocks)
     q_factor, _ = np.linalg.qr(w[keep])
-    tau = np.asarray(data.tau, dtype=float)
-    if s.parallel_cutoff is not None:  # the torques as the regressor's columns are filtered
-        tau = np.asarray(butterworth_filtfilt(tau, data.rate, s.parallel_cutoff, s.order))
-    t_full = np.asarray(data.t, dtype=float)
-
-    # band-limited (module docstring): linear interpolation pulled the minimum to x.5 samples on noisy logs
-    shift = FractionalShift(tau)
-    rows_index = np.rint((t_rows - t_full[0]) * data.rate).astype(int)
 
     def residual(d: float) -> np.ndarray:
-        shifted = shift.read(d, at=rows_index).reshape(-1)[keep]
+        shifted = read(d)
         return shifted - q_factor @ (q_factor.T @ shifted)
 
     def rss(d: float) -> float:  # |s|² - |Qᵀs|²: one product with Q, not two (the residual at the noise floor is
-        shifted = shift.read(d, at=rows_index).reshape(-1)[keep]  # 1e-4 of |s|² or more: 12 digits are left)
+        shifted = read(d)  # 1e-4 of |s|² or more: 12 digits are left)
         projected = q_factor.T @ shifted
         return float(shifted @ shifted - projected @ projected)
 
@@ -173,7 +160,7 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
     grid = np.linspace(-bound, bound, int(4 * bound) + 1)  # a coarse scan first: RSS need not be convex far away
     values = np.empty(grid.size)
     for k in range(0, grid.size, SCAN_BLOCK):  # a block of the scan's reads projected in one product (one pass over Q)
-        scan = np.column_stack([shift.read(d, at=rows_index).reshape(-1)[keep] for d in grid[k:k + SCAN_BLOCK]])
+        scan = np.column_stack([read(d) for d in grid[k:k + SCAN_BLOCK]])
         projected = q_factor.T @ scan
         values[k:k + SCAN_BLOCK] = np.einsum("ij,ij->j", scan, scan) - np.einsum("ij,ij->j", projected, projected)
     k = int(np.argmin(values))
@@ -187,18 +174,67 @@ def delay_from_rows(data: PreparedData, blocks, max_samples: float = 20.0) -> De
         raise IdentifiabilityError(f"{data.name}: the residual does not change with the delay (does the robot move?)")
     # Gauss–Newton σ with the scores' long-run covariance: a residual correlated in time (model error on a short
     # point-to-point log) determines the delay far less than white noise of the same size would
-    instants = np.repeat(np.arange(keep.size // n), n)[keep]
     spread = float(long_run_covariance((slope * residual(d))[:, None], instants)[0, 0])
     std = float(np.sqrt(max(spread, 0.0)) / information)
-    held = _held_out_ratio(w, keep, np.column_stack([shift.read(x, at=rows_index).reshape(-1)[keep] for x in (0.0, d)]),
-                           instants)
-    return DelayEstimate(d, std, d / data.rate, bool(abs(d) > bound - 0.5), held)
+    sums = _held_out_sums(w, keep, np.column_stack([read(x) for x in (0.0, d)]), instants)
+    held = float(sums[1] / sums[0]) if sums[0] > 0 else float("nan")
+    return DelayEstimate(d, std, d / data.rate, bool(abs(d) > bound - 0.5), held, (float(sums[0]), float(sums[1])))
 
 
-def _held_out_ratio(w: np.ndarray, keep: np.ndarray, y: np.ndarray, instants: np.ndarray) -> float:
-    """The least-squares residual on :data:`DELAY_FOLDS` contiguous blocks of the kept rows (``instants``: each kept
-    row's sample, in time order), each predicted by the fit on the others, with the torques read at the delay
-    (``y[:, 1]``) over that with them read as given (``y[:, 0]``). Each block's rows enter once, as the triangular
+def held_out_sum(data: PreparedData, blocks) -> float:
+    """The least-squares squared residual of held-out blocks of the log with its torques read as given: the
+    denominator of :attr:`DelayEstimate.held_out`, for rows of another friction model on the same samples
+    (:func:`dynid.identification.geared_friction.delay_beyond_hysteresis`).
+
+    Parameters
+    ----------
+    data : PreparedData
+    blocks : iterable of tuple
+        As :func:`delay_from_rows` takes them.
+
+    Returns
+    -------
+    float [(N·m)²]
+        NaN where a block of :data:`DELAY_FOLDS` holds no kept row.
+
+    Raises
+    ------
+    IdentifiabilityError
+        Fewer rows than parameters.
+    """
+    w, keep, instants, read = _gathered(data, blocks)
+    return float(_held_out_sums(w, keep, read(0.0)[:, None], instants)[0])
+
+
+def _gathered(data: PreparedData, blocks):
+    """The kept rows' regressor ``w`` (every row), the kept mask, each kept row's sample and ``read(d)``: the kept
+    rows' torques, filtered as the regressor's columns are, read ``d`` samples later (module docstring)."""
+    s = data.settings
+    rows, times, keeps = [], [], []
+    for index, y, _, keep in blocks:
+        rows.append(y.reshape(-1, y.shape[-1]))
+        times.append(np.asarray(data.t)[index])
+        keeps.append(np.asarray(keep).reshape(-1))
+    w, t_rows, keep = np.concatenate(rows), np.concatenate(times), np.concatenate(keeps)
+    n = w.shape[0] // t_rows.size  # rows per instant: the joints
+    if keep.sum() <= w.shape[1]:
+        raise IdentifiabilityError(f"{data.name}: {int(keep.sum())} rows for {w.shape[1]} base parameters")
+    del rows
+    tau = np.asarray(data.tau, dtype=float)
+    if s.parallel_cutoff is not None:  # the torques as the regressor's columns are filtered
+        tau = np.asarray(butterworth_filtfilt(tau, data.rate, s.parallel_cutoff, s.order))
+    t_full = np.asarray(data.t, dtype=float)
+    # band-limited (module docstring): linear interpolation pulled the minimum to x.5 samples on noisy logs
+    shift = FractionalShift(tau)
+    rows_index = np.rint((t_rows - t_full[0]) * data.rate).astype(int)
+    instants = np.repeat(np.arange(keep.size // n), n)[keep]
+    return w, keep, instants, lambda d: shift.read(d, at=rows_index).reshape(-1)[keep]
+
+
+def _held_out_sums(w: np.ndarray, keep: np.ndarray, y: np.ndarray, instants: np.ndarray) -> np.ndarray:
+    """The least-squares squared residuals on :data:`DELAY_FOLDS` contiguous blocks of the kept rows (``instants``:
+    each kept row's sample, in time order), each predicted by the fit on the others, of each column of ``y`` (the
+    torques read as given, and at the delay); NaN where a block is empty. Each block's rows enter once, as the triangular
     factor of ``[W | y]``: the fit on the other blocks solves their stacked factors, and the block's residual is its
     own factor times ``[β; -1]`` (the orthogonal factor keeps the norms)."""
     folds = instants * DELAY_FOLDS // (int(instants.max()) + 1)
@@ -208,14 +244,14 @@ def _held_out_ratio(w: np.ndarray, keep: np.ndarray, y: np.ndarray, instants: np
     for k in range(DELAY_FOLDS):
         held = folds == k
         if not held.any():
-            return float("nan")
+            return np.full(y.shape[1], np.nan)
         factors.append(np.linalg.qr(np.column_stack([rows[held], y[held]]), mode="r"))
-    sse = np.zeros(2)
+    sse = np.zeros(y.shape[1])
     for k in range(DELAY_FOLDS):
         rest = np.vstack([f for i, f in enumerate(factors) if i != k])
         beta = np.linalg.lstsq(rest[:, :p], rest[:, p:], rcond=None)[0]
-        sse += np.sum((factors[k] @ np.vstack([beta, -np.eye(2)])) ** 2, axis=0)
-    return float(sse[1] / sse[0]) if sse[0] > 0 else float("nan")
+        sse += np.sum((factors[k] @ np.vstack([beta, -np.eye(y.shape[1])])) ** 2, axis=0)
+    return sse
 
 
 def delayed(recording: Recording, samples: float) -> Recording:

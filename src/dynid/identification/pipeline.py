@@ -61,6 +61,7 @@ from .drive_only import preprocessing_variants
 from .estimation_pass import identify, one_way_joints
 from .evidence import filtered_finding, gather_evidence, weighed_means, yardstick_reference
 from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
+from .geared_friction import delay_beyond_hysteresis, hysteresis_delay_finding
 from .verdict import SAME_FIGURE, decide
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
@@ -333,7 +334,7 @@ class IdentificationPipeline:
                           held_out=held_out, jackknife=jackknife,
                           observers=(lambda *block: blocks.append(block),) if check is None else (),
                           variants=prepared.variants)
-        findings, checked = _delay_check(prepared.data, blocks) if check is None else ([], {"note": check})
+        findings, checked = _delay_check(prepared, blocks) if check is None else ([], {"note": check})
         result = replace(result, settings={**result.settings, "given_preprocessing": self.preprocessing.to_dict(),
                                            "robot_source": self.source,
                                            "robot_fingerprint": prepared.robot.kinematic_fingerprint(),
@@ -524,14 +525,22 @@ def _delay_checked(data: PreparedData) -> str | None:
     return None
 
 
-def _delay_check(data: PreparedData, blocks: list) -> tuple[list, dict]:
+def _delay_check(prepared: PreparedIdentification, blocks: list) -> tuple[list, dict]:
     """The delay between the torque and position channels the identification log shows on top of the one given
     (:func:`dynid.identification.delay.delay_from_rows`, on the identification's own rows), and the finding when it
-    matters (:func:`dynid.validation.diagnostics.delay_findings`)."""
+    matters (:func:`dynid.validation.diagnostics.delay_findings`); a delay found is weighed against a geared drive's
+    hysteresis (:func:`dynid.identification.geared_friction.delay_beyond_hysteresis`), and the delay that remains
+    beside it is the one reported and weighed on validation logs."""
+    data = prepared.data
     try:
         d = delay_from_rows(data, blocks)
     except DynIdError as exc:
         return [], {"note": f"not estimated: {exc}"}
     found = delay_findings(d.samples, d.std, d.determined, data.rate, data.settings.torque_delay, data.name, d.held_out)
-    return found, {"samples": d.samples, "std": d.std, "seconds": d.seconds, "determined": d.determined,
-                   "at_bound": d.at_bound, "held_out_ratio": d.held_out}
+    checked: dict[str, Any] = {"samples": d.samples, "std": d.std, "seconds": d.seconds, "determined": d.determined,
+                               "at_bound": d.at_bound, "held_out_ratio": d.held_out}
+    turned = delay_beyond_hysteresis(prepared.robot, prepared.base, data, d) if found else None
+    if turned is not None:
+        found = [hysteresis_delay_finding(found[0], *turned, d)]
+        checked = {**checked, "hysteresis": {"presliding": turned[0], "held_out_ratio": turned[1] * d.held_out}}
+    return found, checked
