@@ -1,6 +1,7 @@
 """A geared drive's hysteresis is not a log read wrongly (issue "Every assurance checked on what the user meets": no
 false alarm on logs read right; the zoo's SO-100 with a 2 mrad presliding distance was called misread)."""
 
+import dataclasses
 from importlib import resources
 from pathlib import Path
 
@@ -83,3 +84,27 @@ def test_a_geared_drives_hysteresis_is_not_proposed_as_a_torque_delay_alone():
     [said] = [f.text for f in r.findings if f.kind == "delay"]
     assert "hysteresis" not in said and "hysteresis" not in r.diagnostics["torque_delay"]
     assert r.diagnostics["torque_delay"]["samples"] == pytest.approx(2.5, abs=0.25)
+
+
+def test_with_a_validation_log_the_hysteresis_and_the_delay_are_weighed_apart():
+    """The same kind of log with a validation log of another motion (the same drive): the log is identified again
+    with the presliding distance found and, apart, with the delay; the validation log agrees with the hysteresis, not
+    with the delay (the truth has no delay), and the finding keeps the presliding distance with both figures."""
+    from dynid.identification.pipeline import IdentificationPipeline
+
+    robot = dynid.load_robot("ur10e")
+
+    def geared(seconds: float, rng: int):
+        log = dynid.simulated_log(robot, seconds=seconds, rate=250.0, rng=rng)
+        tau = np.asarray(log.tau)
+        return dataclasses.replace(log, tau=tau + np.column_stack(
+            [_dahl(log.q[:, j], float(np.sqrt(np.mean(tau[:, j] ** 2))), 0.002) for j in range(6)]))
+
+    result = IdentificationPipeline(robot, estimators=("ols",)).fit(geared(30.0, 3), validation=(geared(20.0, 4),))
+    weighed = result.diagnostics["torque_delay"]["validation"]
+    assert weighed["presliding"]["with"] * 1.02 < min(weighed["without"], weighed["with"])
+    [said] = [f.text for f in result.findings if f.kind == "delay"]
+    distance = result.diagnostics["torque_delay"]["hysteresis"]["presliding"]
+    assert f"identified again with [preprocessing] presliding = {distance:.2g} (radians), the validation logs agree" in said
+    assert f"{weighed['presliding']['with']:.3g} % against {weighed['without']:.3g} %" in said
+    assert f"instead, {weighed['with']:.3g} %): keep the presliding distance" in said

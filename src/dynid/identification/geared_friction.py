@@ -36,6 +36,7 @@ from ..preprocessing.prepared import PreparedData
 from ..validation.diagnostics import Finding
 from ..validation.torques import TorqueSums
 from .delay import DelayEstimate, held_out_sum
+from .verdict import SAME_FIGURE
 
 __all__ = ["PRESLIDING_DISTANCES", "Hysteresis", "beyond_hysteresis", "hysteresis_finding", "delay_beyond_hysteresis",
            "hysteresis_delay_finding"]
@@ -212,5 +213,46 @@ def hysteresis_delay_finding(delay: Finding, distance: float, ratio: float, foun
     return Finding("delay", f"{head}; but with dry friction that turns over {1000 * distance:.2g} mrad after each "
                             f"reversal (Dahl's presliding distance, a geared drive's hysteresis) and no delay it is "
                             f"{gain:.2g} % smaller, so this log cannot tell a late torque channel from "
-                            f"that hysteresis: try [preprocessing] presliding = {distance:.2g} (radians) or, if the drive "
+                            f"that hysteresis{HYSTERESIS_ADVICE}{distance:.2g} (radians) or, if the drive "
                             f"logs them so, {advice}")
+
+
+HYSTERESIS_ADVICE = ": try [preprocessing] presliding = "
+"""Where :func:`hysteresis_delay_finding`'s advice starts, which :func:`hysteresis_weighed` replaces with the validation
+logs' answer."""
+
+
+def hysteresis_weighed(text: str, figures: dict, delay_seconds: float, distance: float) -> str | None:
+    """:func:`hysteresis_delay_finding`'s text with the validation logs' answer: the log identified again with the
+    presliding distance and, apart, with the delay (:meth:`dynid.identification.pipeline.IdentificationPipeline.fit`).
+
+    Parameters
+    ----------
+    text : str
+        The finding's text.
+    figures : dict
+        ``without``, ``with`` and ``main_with`` (the delay), and ``presliding``: ``{"with", "main_with"}``; the main
+        estimate's mean error over the validation logs on the one yardstick [%] and its name.
+    delay_seconds : float [s]
+        The ``torque_delay`` the finding names.
+    distance : float [rad]
+        The presliding distance it names.
+
+    Returns
+    -------
+    str or None
+        The setting the validation logs agree with (the better where both: better than without by more than
+        :data:`~dynid.identification.verdict.SAME_FIGURE`), the other's figure beside it; None where they agree with
+        neither (the finding is withdrawn).
+    """
+    without, pre = figures["without"], figures["presliding"]
+    agreed = [(figures["with"], figures["main_with"], f"torque_delay = {delay_seconds:.4g} (seconds)", "the delay"),
+              (pre["with"], pre["main_with"], f"presliding = {distance:.2g} (radians)", "the presliding distance")]
+    agreed.sort(key=lambda a: a[0])
+    if not agreed[0][0] * SAME_FIGURE < without:
+        return None
+    (best, main, setting, what), (other, _, other_setting, _) = agreed
+    head = text.split(HYSTERESIS_ADVICE, 1)[0]
+    return (f"{head}: identified again with [preprocessing] {setting}, the validation logs agree (the main estimate "
+            f"so, {main}, predicts them {best:.3g} % against {without:.3g} %, on one yardstick; with {other_setting} "
+            f"instead, {other:.3g} %): keep {what}")

@@ -61,7 +61,7 @@ from .drive_only import preprocessing_variants
 from .estimation_pass import identify, one_way_joints
 from .evidence import filtered_finding, gather_evidence, weighed_means, yardstick_reference
 from .friction_models import SMOOTH_FIT_FACTOR, choose_friction
-from .geared_friction import delay_beyond_hysteresis, hysteresis_delay_finding
+from .geared_friction import delay_beyond_hysteresis, hysteresis_delay_finding, hysteresis_weighed
 from .verdict import SAME_FIGURE, decide
 
 __all__ = ["IdentificationPipeline", "PreparedIdentification", "FRICTION_CHOICES"]
@@ -451,22 +451,29 @@ class IdentificationPipeline:
             if again is not None:
                 if step is not None:
                     step("the delay found, weighed on the validation logs")
-                result = _delay_weighed(result, *again.result())
+                result = _delay_weighed(result, again.result())
         return replace(result, findings=tuple(result.findings) + smooth)
 
-    def _identified_again(self, result, prepared, recording, validation: tuple) -> tuple[float, str]:
-        """The log identified again with its torques read at the delay ``result`` found (every validation log's too):
-        the main estimate's mean error over the validation logs that move on the one yardstick, and its name.
+    def _identified_again(self, result, prepared, recording, validation: tuple) -> tuple[tuple[float, str], ...]:
+        """The log identified again with its torques read at the delay ``result`` found (every validation log's too)
+        and, where the finding names a geared drive's hysteresis as well, apart with that presliding distance: for
+        each, the main estimate's mean error over the validation logs that move on the one yardstick, and its name.
 
         The second identification keeps the first's choices (its cutoffs, the friction model of each joint: the
-        prepared robot as the description), so that the delay alone differs, and checks no delay of its own."""
+        prepared robot as the description), so that the setting alone differs, and checks no delay of its own."""
         delay, s = result.diagnostics["torque_delay"], prepared.data.settings
-        fixed = replace(self.preprocessing, torque_delay=self.preprocessing.torque_delay + delay["seconds"], auto=False,
-                        position_cutoff=s.position_cutoff, velocity_cutoff=s.velocity_cutoff,
-                        parallel_cutoff=s.parallel_cutoff, decimation=s.decimation)
-        again = replace(self, robot=prepared.robot, friction="description", preprocessing=fixed)
-        other = again.fit(recording, validation=validation, weigh_delay=False, file_variants=False)
-        return _yardstick_mean(other), other.main
+        kept = {"auto": False, "position_cutoff": s.position_cutoff, "velocity_cutoff": s.velocity_cutoff,
+                "parallel_cutoff": s.parallel_cutoff, "decimation": s.decimation}
+        changes = [{"torque_delay": self.preprocessing.torque_delay + delay["seconds"]}]
+        if "hysteresis" in delay:
+            changes.append({"presliding": delay["hysteresis"]["presliding"]})
+        answers = []
+        for change in changes:
+            again = replace(self, robot=prepared.robot, friction="description",
+                            preprocessing=replace(self.preprocessing, **kept, **change))
+            other = again.fit(recording, validation=validation, weigh_delay=False, file_variants=False)
+            answers.append((_yardstick_mean(other), other.main))
+        return tuple(answers)
 
 
 def _yardstick_mean(result) -> float:
@@ -474,22 +481,32 @@ def _yardstick_mean(result) -> float:
     return float(weighed_means(result.diagnostics["yardstick"])[result.main])
 
 
-def _delay_weighed(result, with_delay: float, main_with: str):
+def _delay_weighed(result, answers: tuple):
     """The delay finding kept where the validation logs agree, withdrawn otherwise: the main estimate's mean error on
-    the one yardstick with the delay (``with_delay``, :meth:`IdentificationPipeline._identified_again`) and without,
+    the one yardstick with the delay (``answers[0]``, :meth:`IdentificationPipeline._identified_again`) and without,
     better by more than :data:`~dynid.identification.verdict.SAME_FIGURE` to keep it (issue "Every assurance checked on
     what the user meets", item 5): held-out blocks of the log favoured the delays the real UR10e's and LBR Med7's logs
-    show, which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). The figures are in
-    ``diagnostics["torque_delay"]``."""
+    show, which their validation logs do not (the figures: the changelog, benchmarks/NOTEBOOK.md). Where the finding
+    names a geared drive's hysteresis too (``answers[1]``, with its presliding distance), the setting the validation
+    logs agree with better is kept (:func:`dynid.identification.geared_friction.hysteresis_weighed`). The figures are
+    in ``diagnostics["torque_delay"]``."""
     delay = result.diagnostics["torque_delay"]
     without = _yardstick_mean(result)
-    figures = {"without": without, "with": with_delay, "main_with": main_with}
-    kept = with_delay * SAME_FIGURE < without
-    said = (f"identify again with it: the validation logs agree (the main estimate so, {main_with}, predicts them "
-            f"{with_delay:.3g} % against {without:.3g} %, on one yardstick)")
-    findings = tuple(replace(f, text=f.text.replace(DELAY_ADVICE, said)) if f.kind == "delay" else f
-                     for f in result.findings if kept or f.kind != "delay")
-    return replace(result, findings=findings,
+    (with_delay, main_with), *presliding = answers
+    figures: dict[str, Any] = {"without": without, "with": with_delay, "main_with": main_with}
+    if presliding:
+        figures["presliding"] = {"with": presliding[0][0], "main_with": presliding[0][1]}
+        said = lambda text: hysteresis_weighed(text, figures, delay["seconds"], delay["hysteresis"]["presliding"])  # noqa: E731
+    else:
+        advice = (f"identify again with it: the validation logs agree (the main estimate so, {main_with}, predicts them "
+                  f"{with_delay:.3g} % against {without:.3g} %, on one yardstick)")
+        said = lambda text: text.replace(DELAY_ADVICE, advice) if with_delay * SAME_FIGURE < without else None  # noqa: E731
+    findings = []
+    for f in result.findings:
+        text = said(f.text) if f.kind == "delay" else f.text
+        if text is not None:
+            findings.append(replace(f, text=text))
+    return replace(result, findings=tuple(findings),
                    diagnostics={**result.diagnostics, "torque_delay": {**delay, "validation": figures}})
 
 
