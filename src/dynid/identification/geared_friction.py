@@ -12,11 +12,12 @@ at :data:`PRESLIDING_DISTANCES`; a distance at which a joint follows the descrip
 It costs one pass over the log's rows per distance, only where the log would otherwise be called misread.
 
 The same hysteresis looks like a late torque channel: after a reversal the friction turns over the presliding
-distance, as a delayed ``sign(q̇)`` would. Where the delay check (:mod:`dynid.identification.delay`) finds a delay, the
-delay is estimated again with Dahl's columns at each distance (:func:`delay_beyond_hysteresis`); the model that
-predicts held-out blocks of the log best says which it is. The UR10e's simulated log with Dahl friction of 2 mrad and
-no delay got a lag of 6 samples (24 ms) with friction that turns at once; with a true lag of 2 samples beside the
-same friction, 8.
+distance, as a delayed ``sign(q̇)`` would. Where the delay check (:mod:`dynid.identification.delay`) finds a lag, the
+log's held-out blocks are predicted again with Dahl's columns and no delay (:func:`delay_beyond_hysteresis`); where
+a distance predicts them at least as well as the lag, the finding says the log cannot tell the two apart
+(:func:`hysteresis_delay_finding`), and validation logs weigh the two settings apart (:func:`hysteresis_weighed`).
+The delay and the distance trade off along a shallow valley of the held-out residual, so the delay left beside the
+best distance is not reported (benchmarks/NOTEBOOK.md, stop 116).
 
 Reference: Dahl, "Solid friction damping of mechanical vibrations", AIAA Journal 14(12), 1976; Canudas de Wit et al.,
 "A new model for control of systems with friction", IEEE TAC 40(3), 1995, §2.
@@ -38,8 +39,8 @@ from ..validation.torques import TorqueSums
 from .delay import DelayEstimate, held_out_sum
 from .verdict import SAME_FIGURE
 
-__all__ = ["PRESLIDING_DISTANCES", "Hysteresis", "beyond_hysteresis", "hysteresis_finding", "delay_beyond_hysteresis",
-           "hysteresis_delay_finding"]
+__all__ = ["PRESLIDING_DISTANCES", "HYSTERESIS_SCAN", "Hysteresis", "beyond_hysteresis", "hysteresis_finding",
+           "delay_beyond_hysteresis", "hysteresis_delay_finding", "hysteresis_weighed"]
 
 PRESLIDING_DISTANCES = (0.001, 0.003, 0.01)
 """Presliding distances [rad] tried, smallest first: 1-10 mrad (3.4-34 arcmin) spans the lost motion of the geared
@@ -133,7 +134,6 @@ def hysteresis_finding(found: Hysteresis, plain: np.ndarray, varies: np.ndarray,
                                f"friction, the joints {before:.2f} at most with friction that turns at once): a geared "
                                "drive's hysteresis, not torque columns read wrongly; [preprocessing] presliding = "
                                f"{found.presliding:g} models it in the fit (check it on a validation log)")
-
 
 
 HYSTERESIS_SCAN = (0.0005, 0.001, 0.002, 0.004, 0.008, 0.016)
