@@ -141,7 +141,8 @@ class PreparedData:
     def with_rest_model(self, rest_friction, presliding) -> PreparedData:
         """The same samples with another rest model and presliding distance.
 
-        The direction of motion is computed anew, the settings say so.
+        The direction of motion is computed anew where the rest model or a presliding distance changes; the settings
+        say so either way.
 
         Parameters
         ----------
@@ -155,6 +156,8 @@ class PreparedData:
         PreparedData
         """
         s = replace(self.settings, rest_friction=rest_friction, presliding=presliding)
+        if self.direction is not None and _same_rest_model(self.settings, s, self.dq.shape[1]):
+            return replace(self, settings=s)  # the same direction, not computed again
         return replace(self, settings=s, direction=direction_of_motion(self.dq, self.motion, s, self.rate))
 
     def with_min_speed(self, min_speed, note: str = "") -> PreparedData:
@@ -183,6 +186,14 @@ def _per_joint(value, n: int, where: str, allowed=None) -> np.ndarray:
         raise ConfigError(f"preprocessing.{where}: expected one value or {n} of them"
                           + (f" among {sorted(allowed)}" if allowed else "") + f", got {value!r}")
     return v
+
+
+def _same_rest_model(a: Preprocessing, b: Preprocessing, n: int) -> bool:
+    """Whether two settings give every joint the same rest model and presliding distance (the direction of motion's
+    settings that :meth:`PreparedData.with_rest_model` changes)."""
+    return (np.array_equal(rest_decay(a.rest_friction, n), rest_decay(b.rest_friction, n))
+            and np.array_equal(_per_joint(a.presliding, n, "presliding").astype(float),
+                               _per_joint(b.presliding, n, "presliding").astype(float)))
 
 
 def direction_of_motion(dq, guide, s: Preprocessing, rate: float):
