@@ -82,3 +82,18 @@ def test_a_full_disk_is_a_one_line_error(monkeypatch):
     monkeypatch.setattr(column_store.os, "pwrite", full)
     with pytest.raises(DataError, match=r"cannot write a long log's column to .*: No space left on device \(free some space, or set TMPDIR"):
         ColumnFile().append(np.ones(10))
+
+
+def test_the_correlation_matrix_by_blocks_equals_numpys(rng, monkeypatch):
+    """Against ``np.corrcoef`` (independent: whole columns at once) over several blocks of rows and a short last one,
+    two columns that are one signal to 1e-6 among them (the misread check's threshold is 0.9999); the same numbers for
+    stored columns; a column that does not vary is NaN."""
+    monkeypatch.setattr(column_store, "ROW_CHUNK", 128)
+    x = rng.normal(size=(1000, 4)) + 50.0  # an offset the means must take out
+    x[:, 2] = x[:, 0] + 1e-6 * rng.normal(size=1000)
+    x[:, 3] = 2.0
+    rho = column_store.correlation_matrix(x, [2, 0, 1])
+    np.testing.assert_allclose(rho, np.corrcoef(x[:, [2, 0, 1]].T), rtol=0, atol=1e-12)
+    assert rho[0, 1] > 0.9999 and abs(rho[0, 2]) < 0.2
+    np.testing.assert_array_equal(column_store.correlation_matrix(StoredColumns.from_columns(x.T), [2, 0, 1]), rho)
+    assert np.all(np.isnan(column_store.correlation_matrix(x, [0, 3])[1]))

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..exceptions import DataError
 
-__all__ = ["SPOOL_BYTES", "ColumnFile", "StoredColumns", "by_column", "root_mean_square", "select_rows"]
+__all__ = ["SPOOL_BYTES", "ColumnFile", "StoredColumns", "by_column", "correlation_matrix", "root_mean_square",
+           "select_rows"]
 
 SPOOL_BYTES = 256 * 2**20
 """Logs whose files hold more than this many bytes are spooled (a 6-minute 1 kHz log of 19 columns is 70 MB
@@ -327,3 +328,35 @@ def root_mean_square(x) -> np.ndarray:
     if not isinstance(x, StoredColumns):
         x = np.asarray(x, dtype=float)
     return np.array([np.sqrt(np.mean(x[:, j] ** 2)) for j in range(x.shape[1])])
+
+
+def correlation_matrix(x, columns) -> np.ndarray:
+    """The correlation coefficients of some columns (as :func:`numpy.corrcoef` of them), a block of rows at a time.
+
+    Two passes of :data:`ROW_CHUNK` rows (the means, then the centred products), so that neither an array nor stored
+    columns is copied whole (``np.corrcoef`` of an hour-long log's six torque columns held three copies of them); the
+    same numbers for either.
+
+    Parameters
+    ----------
+    x : (N, k) ndarray or StoredColumns
+        Time-first samples.
+    columns : sequence of int
+        The columns correlated, in that order.
+
+    Returns
+    -------
+    (m, m) ndarray
+        ``m = len(columns)``; NaN where a column does not vary.
+    """
+    cols = [int(j) for j in columns]
+    n = len(x)
+    blocks = [(a, min(a + ROW_CHUNK, n)) for a in range(0, n, ROW_CHUNK)]
+    mean = sum((np.asarray(x[a:b], dtype=float)[:, cols].sum(axis=0) for a, b in blocks), np.zeros(len(cols))) / max(n, 1)
+    gram = np.zeros((len(cols), len(cols)))
+    for a, b in blocks:
+        centred = np.asarray(x[a:b], dtype=float)[:, cols] - mean
+        gram += centred.T @ centred
+    scale = np.sqrt(np.diag(gram))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return gram / np.outer(scale, scale)

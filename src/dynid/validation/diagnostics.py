@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._util.column_store import correlation_matrix
 from .._util.grams import joint_gram
 from ..conventions import joint_unit
 from .noise_floor import AT_FLOOR
@@ -281,8 +282,9 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
         return []
     named = []
     for j in judged:
-        for signal, values in (("velocity", dq[:, j]), ("position", q[:, j])):
-            if np.std(values) > 0 and np.std(tau[:, j]) > 0 and np.corrcoef(values, tau[:, j])[0, 1] >= LIKE_A_STATE:
+        torque = _centred(tau[:, j])  # each column read once (a long log's are stored), none stacked with another
+        for signal, states in (("velocity", dq), ("position", q)):
+            if _correlation(_centred(states[:, j]), torque) >= LIKE_A_STATE:
                 named.append(f"J{j + 1}'s is its {signal}")
                 break
     if len(named) == len(judged):  # each joint's column a state: not torques, whatever shape gravity gives them
@@ -299,6 +301,18 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
                                f"columns of {table} and the robot file before trusting any fit of them")]
 
 
+def _centred(column) -> np.ndarray:
+    """A column less its mean, as a new array."""
+    column = np.asarray(column, dtype=float)
+    return column - column.mean()
+
+
+def _correlation(a: np.ndarray, b: np.ndarray) -> float:
+    """The correlation coefficient of two centred columns (0 where one does not vary)."""
+    aa, bb = float(a @ a), float(b @ b)
+    return float(a @ b) / np.sqrt(aa * bb) if aa > 0 and bb > 0 else 0.0
+
+
 SAME_SIGNAL = 0.9999
 """Two joints' torque columns that correlate to this or more log one signal (a column read for another joint's): two
 joints of a real arm move different links, and no real log in ../shared/data comes near (benchmarks/misread_logs.py
@@ -310,7 +324,7 @@ def _same_columns(tau: np.ndarray, varies) -> list[tuple[int, int]]:
     moving = [j for j in range(tau.shape[1]) if varies[j] and np.std(tau[:, j]) > 0]
     if len(moving) < 2:
         return []
-    rho = np.corrcoef(np.asarray(tau, dtype=float)[:, moving].T)
+    rho = correlation_matrix(tau, moving)  # by blocks of rows: a long log's torques are not copied whole
     return [(moving[a], moving[b]) for a in range(len(moving)) for b in range(a + 1, len(moving)) if rho[a, b] >= SAME_SIGNAL]
 
 
