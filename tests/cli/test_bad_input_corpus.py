@@ -491,6 +491,8 @@ RANGES = {
     "a decimation of 1000": ("[preprocessing]\ndecimation = 1000\n", "preprocessing.decimation"),
     "a torque delay of an hour": ("[preprocessing]\ntorque_delay = 3600.0\n", "preprocessing.torque_delay"),
     "a torque delay of nan": ("[preprocessing]\ntorque_delay = nan\n", "preprocessing.torque_delay"),
+    "a presliding distance of 1e9 rad": ("[preprocessing]\npresliding = 1e9\n", "preprocessing.presliding"),
+    "an infinite presliding distance": ("[preprocessing]\npresliding = inf\n", "preprocessing.presliding"),
     "a 50 ms time range": ({"file = \"log.csv\"": "file = \"log.csv\"\ntime_range = [1.0, 1.05]"}, "time_range"),
 }
 

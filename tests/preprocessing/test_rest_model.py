@@ -44,3 +44,12 @@ def test_another_rest_model_or_presliding_distance_computes_it_anew(data, rest, 
 def test_an_unknown_rest_model_is_refused(data):
     with pytest.raises(ConfigError, match="rest_friction"):
         data.with_rest_model("sticky", 0.0)
+
+
+@pytest.mark.parametrize("presliding", [-0.001, float("nan"), float("inf"), 5.0, "x", (0.001, -1.0)])
+def test_a_presliding_distance_no_drive_has_is_refused_where_the_settings_are_made(presliding):
+    """Through the API as through a config (tests/cli/test_bad_input_corpus.py): a negative distance made the Dahl
+    columns grow without bound and an infinite one kept them at 0, and either was fitted in silence."""
+    with pytest.raises(ConfigError, match=r"preprocessing\.presliding: expected a distance from 0 to 1"):
+        Preprocessing(presliding=presliding)
+    assert Preprocessing(presliding=(0.0, 0.001, 1.0)).presliding == (0.0, 0.001, 1.0)

@@ -19,6 +19,11 @@ from .bands import (
     estimate_band,
 )
 
+MAX_PRESLIDING = 1.0
+"""[rad, or m on a sliding joint] The largest presliding distance a setting may give: far beyond any drive's lost motion
+(1-10 mrad on geared drives); a larger one keeps the dry friction from ever turning, and the fit would then blame the log
+for not determining it."""
+
 MIN_SAMPLES_KEPT = 200
 """A log whose settings come from another dataset is decimated by at most ``N // MIN_SAMPLES_KEPT``."""
 
@@ -81,7 +86,7 @@ class Preprocessing:
         seconds: that, relaxing to 0 with this time constant; "zero": none (:func:`dynid.friction.held_direction`).
     presliding : float or tuple [rad]
         Per joint, Dahl's presliding distance over which the friction reverses with the direction of motion
-        (:func:`dynid.friction.held_direction`); 0 (default): at once.
+        (:func:`dynid.friction.held_direction`); 0 (default): at once. At most :data:`MAX_PRESLIDING`.
     torque_delay : float [s]
         How long the torque (current) channel lags the positions: the torque logged at ``t`` is the model's torque at
         ``t − torque_delay``, so the torques are read ``torque_delay`` later (a band-limited shift on the log's grid,
@@ -135,6 +140,17 @@ class Preprocessing:
     derivation: str = ""
     noise_share: float | None = None
     warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        """Refuse a presliding distance that is negative, NaN or above :data:`MAX_PRESLIDING` (a ``ConfigError``
+        naming the field: the fit would otherwise run on columns that never turn, or grow without bound)."""
+        try:
+            x0 = np.asarray(self.presliding, dtype=float)
+        except (TypeError, ValueError):
+            x0 = np.array(np.nan)
+        if x0.ndim > 1 or not np.all((x0 >= 0) & (x0 <= MAX_PRESLIDING)):
+            raise ConfigError(f"preprocessing.presliding: expected a distance from 0 to {MAX_PRESLIDING:g} (rad, or m on a "
+                              f"sliding joint), or one per joint, got {self.presliding!r}")
 
     @keyword_only_after_data
     def resolved(self, rate: float, q: np.ndarray | None = None, *, measured_velocity: bool = True,

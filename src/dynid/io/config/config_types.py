@@ -20,6 +20,7 @@ from ..._util.typed import Table, json_schema
 from ...model.description_types import Angle
 from ...model.description_types import RobotDescription as _RobotDescription
 from ...preprocessing.bands import MIN_SPEED_FRACTION, PARALLEL_FACTOR, POSITION_FACTOR, REST_FACTOR
+from ...preprocessing.settings import MAX_PRESLIDING
 from ..logs.dataset_tables import Column, DatasetTable, PositiveHz, SignalTable, TimeTable, _d
 
 if TYPE_CHECKING:  # built at import from the drive terms known then (dynid.model.description_types)
@@ -34,6 +35,8 @@ __all__ = ["SignalTable", "TimeTable", "DatasetTable", "PreprocessingTable", "Es
 NonNegative = Annotated[float, Meta(ge=0)]
 PerJoint = Union[NonNegative, list[NonNegative]]
 SmoothingVelocity = Annotated[float, Meta(ge=0, le=10)]
+Presliding = Annotated[float, Meta(ge=0, le=MAX_PRESLIDING)]
+"""A presliding distance [rad, or m on a sliding joint] (:data:`dynid.preprocessing.settings.MAX_PRESLIDING`)."""
 
 
 class PreprocessingTable(Table, kw_only=True):
@@ -56,7 +59,7 @@ class PreprocessingTable(Table, kw_only=True):
     rest_velocity: Annotated[Union[Literal["auto"], PerJoint], _d(f"rad/s: below it a joint rests (default auto: {REST_FACTOR:g} x its velocity's noise)")] | None = None
     rest_friction: Annotated[Union[Literal["held", "zero"], NonNegative, list[Union[Literal["held", "zero"], NonNegative]]],
                              _d('friction at rest: "held", "zero" or a relaxation time [s], one or one per joint')] | None = None
-    presliding: Annotated[PerJoint, _d("rad: Dahl's presliding distance (default 0)")] | None = None
+    presliding: Annotated[Union[Presliding, list[Presliding]], _d(f"rad: Dahl's presliding distance, 0-{MAX_PRESLIDING:g} (default 0)")] | None = None
     torque_delay: Annotated[float, _d("s: how long the torque (current) channel lags the positions (default 0); "
                                       "a logged command held over the control period leads by half of it: -0.5/rate")] | None = None
     smoothing_passes: Annotated[int, Meta(ge=0, description="applications of eq. 17 (strategy paper)")] | None = None
