@@ -24,6 +24,21 @@ MAX_PRESLIDING = 1.0
 (1-10 mrad on geared drives); a larger one keeps the dry friction from ever turning, and the fit would then blame the log
 for not determining it."""
 
+_RANGES = (("order", 1, True, False), ("band", 0.0, False, True), ("position_cutoff", 0.0, False, False),
+           ("velocity_cutoff", 0.0, False, False), ("parallel_cutoff", 0.0, False, False), ("decimation", 1, True, False),
+           ("trim", 0.0, False, False), ("chunk", 1, True, False), ("smoothing_passes", 0, True, False))
+"""Settings checked where they are made (:meth:`Preprocessing.__post_init__`): (field, least value, integer, the least
+value itself refused)."""
+
+
+def _in_range(value, low: float, whole: bool, above: bool = False) -> bool:
+    """Whether ``value`` is a number (an integer where ``whole``) of at least ``low`` (above it where ``above``), not
+    NaN."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return False
+    return bool(value > low if above else value >= low) and (not whole or float(value).is_integer())
+
+
 MIN_SAMPLES_KEPT = 200
 """A log whose settings come from another dataset is decimated by at most ``N // MIN_SAMPLES_KEPT``."""
 
@@ -142,8 +157,19 @@ class Preprocessing:
     warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        """Refuse a presliding distance that is negative, NaN or above :data:`MAX_PRESLIDING` (a ``ConfigError``
-        naming the field: the fit would otherwise run on columns that never turn, or grow without bound)."""
+        """Refuse a setting no log can mean, in one line naming the field (a ``ConfigError``), as a config's
+        ``[preprocessing]`` table is checked: through the API a negative cutoff or relaxation time, a NaN cutoff, a
+        filter of order 0 were used in silence and a negative ``trim`` raised a NumPy error; a presliding distance
+        negative, NaN or above :data:`MAX_PRESLIDING` made the dry friction's columns grow without bound or never turn."""
+        for name, low, whole, above in _RANGES:
+            value = getattr(self, name)
+            if value is not None and not _in_range(value, low, whole, above):
+                raise ConfigError(f"preprocessing.{name}: expected {'an integer' if whole else 'a number'} "
+                                  f"{'>' if above else '>='} {low:g}, got {value!r}")
+        rest = np.atleast_1d(np.asarray(self.rest_friction, dtype=object))
+        if rest.ndim > 1 or not all(x in ("held", "zero") or _in_range(x, 0.0, False) for x in rest.tolist()):
+            raise ConfigError(f'preprocessing.rest_friction: expected "held", "zero" or a relaxation time >= 0 s, or one '
+                              f"per joint, got {self.rest_friction!r}")
         try:
             x0 = np.asarray(self.presliding, dtype=float)
         except (TypeError, ValueError):
