@@ -93,3 +93,18 @@ def test_the_random_state_has_one_name_and_the_former_one_still_works_with_a_war
         check_estimator("ols", seed=1)
     with pytest.raises(ConfigError, match="unknown setting 'seed'"):
         dynid.identify_from_arrays(robot, log.t, log.q, log.tau, seed=1)
+
+
+def test_a_negative_seed_and_a_log_of_no_samples_are_refused_in_one_line():
+    """NumPy refused a negative seed deep in an estimator ("expected non-negative integer", no field named), and a
+    simulated log of 0 s or of a negative rate was made in silence."""
+    robot = dynid.load_robot("er16")
+    log = dynid.simulated_log(robot, seconds=2, rng=3)
+    with pytest.raises(ConfigError, match=r"^rng: expected a seed >= 0 \(or a numpy.random.Generator\), got -1$"):
+        dynid.identify_from_arrays(robot, log.t, log.q, log.tau, estimators=("ols",), rng=-1)
+    with pytest.raises(ConfigError, match=r"^rng: expected a seed >= 0"):
+        dynid.simulated_log(robot, seconds=2, rng=-2)
+    for seconds, rate in ((0.0, 250.0), (2.0, -1.0), (float("nan"), 250.0), (0.004, 250.0)):
+        with pytest.raises(ConfigError, match=r"^simulated_log: expected a positive length and rate"):
+            dynid.simulated_log(robot, seconds=seconds, rate=rate)
+    assert dynid.simulated_log(robot, seconds=0.008, rate=250.0).t.size == 2

@@ -10,6 +10,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar
 
+from ..exceptions import ConfigError
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 SINCE = "0.2"
@@ -106,12 +108,16 @@ def seed_of(rng, default: int = 0) -> int:
     ------
     TypeError
         Anything else (a float, a legacy ``RandomState``).
+    ConfigError
+        A negative integer (NumPy takes no negative seed).
     """
     import numpy as np
 
     if rng is None:
         return int(default)
     if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        if rng < 0:
+            raise ConfigError(f"rng: expected a seed >= 0 (or a numpy.random.Generator), got {int(rng)}")
         return int(rng)
     if isinstance(rng, np.random.Generator):
         return int(rng.integers(2**31))

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from .._util.keywords import seed_of
 from .._util.reprs import short_repr
 from ..dynamics.base_parameters import BaseParameters, base_parameters
 from ..dynamics.regressor import expect_samples
@@ -172,6 +173,7 @@ class IdentificationPipeline:
 
     def __post_init__(self):
         object.__setattr__(self, "robot", as_robot(self.robot))
+        object.__setattr__(self, "rng", seed_of(self.rng))  # a negative seed refused here, not deep in an estimator
         if self.friction is None:
             object.__setattr__(self, "friction", self.preprocessing.friction_default)
         if self.friction not in FRICTION_CHOICES:

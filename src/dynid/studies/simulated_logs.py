@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._util.keywords import keyword_only_after_data, renamed_keyword
+from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
 from ..exceptions import ConfigError
 from ..excitation.fourier import FourierTrajectory
 from ..io.logs.datasets import Recording
@@ -58,8 +58,14 @@ def simulated_log(robot: Robot | str | Path, *, seconds: float = 30.0, rate: flo
     Raises
     ------
     ConfigError
-        A description without physical nominal parameters, or a trajectory of another number of joints.
+        A description without physical nominal parameters, a trajectory of another number of joints, a length or rate
+        that is not positive (or gives fewer than two samples), or a negative seed.
     """
+    if not (np.isfinite(seconds) and np.isfinite(rate) and seconds > 0 and rate > 0 and round(seconds * rate) >= 2):
+        raise ConfigError(f"simulated_log: expected a positive length and rate giving two samples or more, got seconds = "
+                          f"{seconds!r} and rate = {rate!r}")
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        seed_of(rng)  # a negative seed refused in one line (NumPy's error does not name it)
     robot = as_robot(robot)
     robot.require_physical_nominal("a simulated log (its truth is the description's parameters)")
     generator = np.random.default_rng(rng)
