@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from dynid.dynamics.base_parameters import base_parameters
 from dynid.dynamics.regressor import observation_matrix
@@ -45,3 +46,15 @@ def test_standard_from_base_round_trip(rng):
 def test_six_joint_er16_count():
     bp = base_parameters(load_robot("er16"), rng=0)
     assert bp.n_base == 36 + 12  # anthropomorphic 6R: 36 inertial base parameters + 2 friction per joint
+
+
+@pytest.mark.parametrize("setting, message", [({"n_samples": 0}, "n_samples: expected a positive integer"),
+                                              ({"n_samples": 2.5}, "n_samples: expected a positive integer"),
+                                              ({"tol": -1.0}, r"tol: expected a relative tolerance in \(0, 1\)"),
+                                              ({"tol": float("nan")}, r"tol: expected a relative tolerance in \(0, 1\)")])
+def test_a_sample_count_or_tolerance_out_of_range_is_refused(setting, message):
+    """``n_samples=0`` raised NumPy's "zero-size array" error, ``tol=-1`` kept every column in silence."""
+    from dynid.exceptions import ConfigError
+
+    with pytest.raises(ConfigError, match=rf"^base_parameters: {message}"):
+        base_parameters("er16", **setting)

@@ -83,6 +83,22 @@ def test_bad_shapes_are_rejected(rng):
         regressor(robot, q, q, q)
 
 
+def test_rnea_refuses_states_or_parameters_of_another_shape(rng):
+    """The RNEA took any shape: a (10,)-long inertial vector raised "cannot unpack non-iterable numpy.float64" from
+    inside the model's construction, and states of the wrong width went to Pinocchio."""
+    robot = load_robot("er16")
+    q = rng.normal(size=(20, 6))
+    with pytest.raises(ShapeError, match="joints-first"):
+        rnea_torques(robot, q.T, q.T, q.T)
+    with pytest.raises(ShapeError, match="same number of samples"):
+        rnea_torques(robot, q, q[:10], q)
+    with pytest.raises(ShapeError, match=r"^inertial: expected shape \(6, 10\) \(er16's\), got \(10,\)$"):
+        rnea_torques(robot, q, q, q, inertial=robot.inertial[0])
+    with pytest.raises(ShapeError, match=r"^drive: expected shape"):
+        rnea_torques(robot, q, q, q, drive=robot.drive[:3])
+    np.testing.assert_array_equal(rnea_torques(robot, q, q, q, inertial=robot.inertial), rnea_torques(robot, q, q, q))
+
+
 @pytest.mark.parametrize("name", ["er16", "ur10e", "tx40"])
 def test_selected_columns_are_the_same_numbers_as_the_full_regressor(name):
     from dynid.dynamics.base_parameters import base_parameters

@@ -139,6 +139,13 @@ def test_infeasible_settings_get_a_clear_error(er16_3, change, message):
         ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, **change(er16_3.limits))
 
 
+@pytest.mark.parametrize("maxiter", [0, -1, 2.5, True])
+def test_an_iteration_budget_that_is_not_a_positive_integer_is_refused(er16_3, maxiter):
+    """SLSQP ran with ``maxiter=-1`` in silence."""
+    with pytest.raises(ConfigError, match=r"^design.maxiter must be a positive integer"):
+        design_excitation(ExcitationProblem(er16_3, PAPER_OMEGA_F, 3), n_starts=1, maxiter=maxiter)
+
+
 def test_initial_trajectory_at_another_fundamental_pulsation_is_refused(er16_3):
     beta1 = paper_identification_trajectory(2 * PAPER_OMEGA_F)
     prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 5, offsets=beta1.q0)

@@ -19,7 +19,7 @@ import scipy.linalg
 from .._util.keywords import keyword_only_after_data
 from .._util.reprs import short_repr
 from ..conventions import unit_of
-from ..exceptions import IdentifiabilityError
+from ..exceptions import ConfigError, IdentifiabilityError
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from .regressor import observation_matrix
@@ -206,7 +206,13 @@ def base_parameters(robot: Robot | str | Path, *, rng: np.random.Generator | int
     ------
     IdentifiabilityError
         If the rank found by QR disagrees with the SVD rank (numerically ill-posed chain).
+    ConfigError
+        ``n_samples`` not a positive integer, or ``tol`` not in (0, 1).
     """
+    if isinstance(n_samples, bool) or not isinstance(n_samples, (int, np.integer)) or n_samples < 1:
+        raise ConfigError(f"base_parameters: n_samples: expected a positive integer, got {n_samples!r}")
+    if not 0 < tol < 1:
+        raise ConfigError(f"base_parameters: tol: expected a relative tolerance in (0, 1), got {tol!r}")
     robot = as_robot(robot)
     rng = np.random.default_rng(rng)
     n = robot.n_dof

@@ -10,7 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util.checks import check_same_length, check_trajectory_array
 from .._util.keywords import keyword_only_after_data
+from ..exceptions import ShapeError
 from ..model.loading import as_robot
 from ..model.robot import Robot
 from ..model.urdf import pinocchio_from_inertial
@@ -77,10 +79,21 @@ def rnea_torques(robot: Robot | str | Path, q, dq, ddq, *, inertial: np.ndarray 
         A joint that follows another (:attr:`dynid.model.robot.Joint.mimic`) moves as that joint says, whatever its
         columns hold, and its torque is in the row of the joint it follows (:meth:`dynid.model.robot.Robot.fold`; 0 in
         its own).
+
+    Raises
+    ------
+    ShapeError
+        States of another shape than (N, n_dof) (or of different lengths, or not finite), or ``inertial`` or ``drive``
+        of another shape than the robot's.
     """
     robot = as_robot(robot)
     import pinocchio as pin
 
+    q, dq, ddq = (check_trajectory_array(x, robot.n_dof, name) for x, name in ((q, "q"), (dq, "dq"), (ddq, "ddq")))
+    check_same_length(q=q, dq=dq, ddq=ddq)
+    for name, given, own in (("inertial", inertial, robot.inertial), ("drive", drive, robot.drive)):
+        if given is not None and np.shape(given) != np.shape(own):
+            raise ShapeError(f"{name}: expected shape {np.shape(own)} ({robot.name}'s), got {np.shape(given)}")
     model = pinocchio_model(robot, inertial)
     data = model.createData()
     q, dq, ddq = (np.ascontiguousarray(x, dtype=float) for x in robot.coupled(q, dq, ddq))

@@ -771,6 +771,8 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     t0 = time.perf_counter()
     if n_starts < 1:
         raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
+    if isinstance(maxiter, bool) or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
+        raise ConfigError(f"design.maxiter must be a positive integer, got {maxiter!r}")  # SLSQP ran -1 in silence
     rng = np.random.default_rng(rng)
     if problem.robot.followers and problem.offsets is not None:  # a <mimic> joint's offset follows its joint's
         problem = replace(problem, offsets=problem.robot.coupled(np.asarray(problem.offsets, dtype=float)[None])[0][0])
