@@ -158,9 +158,8 @@ class Preprocessing:
 
     def __post_init__(self) -> None:
         """Refuse a setting no log can mean, in one line naming the field (a ``ConfigError``), as a config's
-        ``[preprocessing]`` table is checked: through the API a negative cutoff or relaxation time, a NaN cutoff, a
-        filter of order 0 were used in silence and a negative ``trim`` raised a NumPy error; a presliding distance
-        negative, NaN or above :data:`MAX_PRESLIDING` made the dry friction's columns grow without bound or never turn."""
+        ``[preprocessing]`` table is checked (:data:`_RANGES`, ``rest_friction``, ``presliding`` up to
+        :data:`MAX_PRESLIDING`): the same settings through the API and through a file."""
         for name, low, whole, above in _RANGES:
             value = getattr(self, name)
             if value is not None and not _in_range(value, low, whole, above):
