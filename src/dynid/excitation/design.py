@@ -734,6 +734,14 @@ def _slsqp(objective, x0: np.ndarray, cons: list, maxiter: int, iteration: Calla
 
 @with_single_blas_thread
 @keyword_only_after_data
+def _check_budget(n_starts: int, maxiter: int) -> None:
+    """:func:`design_excitation`'s starts and SLSQP iterations, each at least 1 (a ``ConfigError`` naming it)."""
+    if n_starts < 1:
+        raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
+    if isinstance(maxiter, bool) or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
+        raise ConfigError(f"design.maxiter must be a positive integer, got {maxiter!r}")
+
+
 def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
                       initial: FourierTrajectory | None = None, maxiter: int = 150,
                       callback: Callable[[int, int, float], None] | None = None,
@@ -769,10 +777,7 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
         If no start ends with every constraint satisfied on the verification grid.
     """
     t0 = time.perf_counter()
-    if n_starts < 1:
-        raise ConfigError(f"design.starts must be at least 1, got {n_starts}")
-    if isinstance(maxiter, bool) or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
-        raise ConfigError(f"design.maxiter must be a positive integer, got {maxiter!r}")  # SLSQP ran -1 in silence
+    _check_budget(n_starts, maxiter)
     rng = np.random.default_rng(rng)
     if problem.robot.followers and problem.offsets is not None:  # a <mimic> joint's offset follows its joint's
         problem = replace(problem, offsets=problem.robot.coupled(np.asarray(problem.offsets, dtype=float)[None])[0][0])
