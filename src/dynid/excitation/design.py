@@ -732,8 +732,6 @@ def _slsqp(objective, x0: np.ndarray, cons: list, maxiter: int, iteration: Calla
                     options={"maxiter": maxiter, "ftol": 1e-7}, callback=iterated)
 
 
-@with_single_blas_thread
-@keyword_only_after_data
 def _check_budget(n_starts: int, maxiter: int) -> None:
     """:func:`design_excitation`'s starts and SLSQP iterations, each at least 1 (a ``ConfigError`` naming it)."""
     if n_starts < 1:
@@ -742,6 +740,8 @@ def _check_budget(n_starts: int, maxiter: int) -> None:
         raise ConfigError(f"design.maxiter must be a positive integer, got {maxiter!r}")
 
 
+@with_single_blas_thread
+@keyword_only_after_data
 def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
                       initial: FourierTrajectory | None = None, maxiter: int = 150,
                       callback: Callable[[int, int, float], None] | None = None,
