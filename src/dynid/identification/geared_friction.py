@@ -163,8 +163,9 @@ def delay_beyond_hysteresis(robot: Robot, base: BaseParameters, data: PreparedDa
     Returns
     -------
     tuple of (float [rad], float) or None
-        The distance and its held-out squared residual over that of the lag; None where the lag predicts better, the
-        delay found is a lead, or the log already has a presliding distance.
+        The distance and its held-out squared residual over that with friction that turns at once and no delay (the
+        denominator of :attr:`DelayEstimate.held_out`); None where the lag predicts better, the delay found is a lead,
+        or the log already has a presliding distance.
     """
     from scipy.optimize import minimize_scalar
 
@@ -184,11 +185,10 @@ def delay_beyond_hysteresis(robot: Robot, base: BaseParameters, data: PreparedDa
     lo, hi = scan[max(k - 1, 0)], scan[min(k + 1, scan.size - 1)]
     best = minimize_scalar(score, bounds=(lo, hi), method="bounded", options={"xatol": 0.05})
     distance, total = (float(np.exp(best.x)), float(best.fun)) if best.fun < values[k] else (HYSTERESIS_SCAN[k], values[k])
-    ratio = total / found.held_out_sums[1]
-    return (distance, ratio) if ratio <= 1.0 else None
+    return (distance, total / found.held_out_sums[0]) if total <= found.held_out_sums[1] else None
 
 
-def hysteresis_delay_finding(delay: Finding, distance: float, ratio: float, found: DelayEstimate) -> Finding:
+def hysteresis_delay_finding(delay: Finding, distance: float, ratio: float) -> Finding:
     """The delay finding where Dahl's columns without a delay predict the log as well as the lag
     (:func:`delay_beyond_hysteresis`): the log cannot tell a late torque channel from a geared drive's hysteresis.
 
@@ -199,9 +199,7 @@ def hysteresis_delay_finding(delay: Finding, distance: float, ratio: float, foun
     distance : float [rad]
         The presliding distance.
     ratio : float
-        Its held-out squared residual over the lag's.
-    found : DelayEstimate
-        The lag.
+        Its held-out squared residual over that with friction that turns at once and no delay.
 
     Returns
     -------
@@ -209,7 +207,7 @@ def hysteresis_delay_finding(delay: Finding, distance: float, ratio: float, foun
         Of kind "delay", ending with the same advice (the validation logs' answer replaces it), both settings named.
     """
     head, advice = delay.text.split(": if the drive logs them so, ", 1)
-    gain = 100 * (1 - ratio * found.held_out)
+    gain = 100 * (1 - ratio)
     return Finding("delay", f"{head}; but with dry friction that turns over {1000 * distance:.2g} mrad after each "
                             f"reversal (Dahl's presliding distance, a geared drive's hysteresis) and no delay it is "
                             f"{gain:.2g} % smaller, so this log cannot tell a late torque channel from "

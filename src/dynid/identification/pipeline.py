@@ -493,23 +493,30 @@ def _delay_weighed(result, answers: tuple):
     logs agree with better is kept (:func:`dynid.identification.geared_friction.hysteresis_weighed`). The figures are
     in ``diagnostics["torque_delay"]``."""
     delay = result.diagnostics["torque_delay"]
-    without = _yardstick_mean(result)
     (with_delay, main_with), *presliding = answers
-    figures: dict[str, Any] = {"without": without, "with": with_delay, "main_with": main_with}
+    figures: dict[str, Any] = {"without": _yardstick_mean(result), "with": with_delay, "main_with": main_with}
     if presliding:
         figures["presliding"] = {"with": presliding[0][0], "main_with": presliding[0][1]}
-        said = lambda text: hysteresis_weighed(text, figures, delay["seconds"], delay["hysteresis"]["presliding"])  # noqa: E731
-    else:
-        advice = (f"identify again with it: the validation logs agree (the main estimate so, {main_with}, predicts them "
-                  f"{with_delay:.3g} % against {without:.3g} %, on one yardstick)")
-        said = lambda text: text.replace(DELAY_ADVICE, advice) if with_delay * SAME_FIGURE < without else None  # noqa: E731
     findings = []
     for f in result.findings:
-        text = said(f.text) if f.kind == "delay" else f.text
+        text = _weighed_text(f.text, delay, figures) if f.kind == "delay" else f.text
         if text is not None:
             findings.append(replace(f, text=text))
     return replace(result, findings=tuple(findings),
                    diagnostics={**result.diagnostics, "torque_delay": {**delay, "validation": figures}})
+
+
+def _weighed_text(text: str, delay: dict, figures: dict) -> str | None:
+    """The delay finding's text with the validation logs' answer (:func:`_delay_weighed`'s ``figures``), None where it
+    is withdrawn."""
+    if "presliding" in figures:
+        return hysteresis_weighed(text, figures, delay["seconds"], delay["hysteresis"]["presliding"])
+    with_delay, without = figures["with"], figures["without"]
+    if not with_delay * SAME_FIGURE < without:
+        return None
+    return text.replace(DELAY_ADVICE, f"identify again with it: the validation logs agree (the main estimate so, "
+                                      f"{figures['main_with']}, predicts them {with_delay:.3g} % against {without:.3g} %, "
+                                      "on one yardstick)")
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:
@@ -547,9 +554,9 @@ def _delay_checked(data: PreparedData) -> str | None:
 def _delay_check(prepared: PreparedIdentification, blocks: list) -> tuple[list, dict]:
     """The delay between the torque and position channels the identification log shows on top of the one given
     (:func:`dynid.identification.delay.delay_from_rows`, on the identification's own rows), and the finding when it
-    matters (:func:`dynid.validation.diagnostics.delay_findings`); a delay found is weighed against a geared drive's
-    hysteresis (:func:`dynid.identification.geared_friction.delay_beyond_hysteresis`), and the delay that remains
-    beside it is the one reported and weighed on validation logs."""
+    matters (:func:`dynid.validation.diagnostics.delay_findings`); a lag found is weighed against a geared drive's
+    hysteresis (:func:`dynid.identification.geared_friction.delay_beyond_hysteresis`): where that predicts held-out
+    blocks of the log as well, the finding names both settings, and validation logs weigh each apart."""
     data = prepared.data
     try:
         d = delay_from_rows(data, blocks)
@@ -560,6 +567,6 @@ def _delay_check(prepared: PreparedIdentification, blocks: list) -> tuple[list, 
                                "at_bound": d.at_bound, "held_out_ratio": d.held_out}
     turned = delay_beyond_hysteresis(prepared.robot, prepared.base, data, d) if found else None
     if turned is not None:
-        found = [hysteresis_delay_finding(found[0], *turned, d)]
-        checked = {**checked, "hysteresis": {"presliding": turned[0], "held_out_ratio": turned[1] * d.held_out}}
+        found = [hysteresis_delay_finding(found[0], *turned)]
+        checked = {**checked, "hysteresis": {"presliding": turned[0], "held_out_ratio": turned[1]}}
     return found, checked
