@@ -275,11 +275,8 @@ class IdentificationPipeline:
                                else np.broadcast_to(np.asarray(vs, dtype=float), (self.robot.n_dof,)),
                                filters if filters is not None and filters.chose else None, coulomb)
         if self.friction == "auto":
-            share = say("friction model of each joint (cross-validation)")
-            friction = choose_friction(choices.model(self.robot), data, progress=share)
-            data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
-            data = _fitted_speeds(data, friction, given=self.preprocessing.min_speed != "auto")
-            choices = replace(choices, friction=friction)
+            data, choices = _friction_chosen(choices, self.robot, data, given=self.preprocessing.min_speed != "auto",
+                                             progress=say("friction model of each joint (cross-validation)"))
         robot = choices.model(self.robot)
         if choices.friction is not None:
             base = base_parameters(robot, rng=0)
@@ -517,6 +514,17 @@ def _weighed_text(text: str, delay: dict, figures: dict) -> str | None:
     return text.replace(DELAY_ADVICE, f"identify again with it: the validation logs agree (the main estimate so, "
                                       f"{figures['main_with']}, predicts them {with_delay:.3g} % against {without:.3g} %, "
                                       "on one yardstick)")
+
+
+def _friction_chosen(choices: ModelChoices, robot: Robot, data: PreparedData, *, given: bool,
+                     progress: Callable[[int, int], None] | None = None) -> tuple[PreparedData, ModelChoices]:
+    """:meth:`IdentificationPipeline.prepare`'s friction model of each joint, chosen by cross-validation on ``data``
+    (:func:`dynid.identification.friction_models.choose_friction`); ``data`` then takes the chosen rest model and the
+    slowest speeds its smooth Coulomb terms are fitted at (:func:`_fitted_speeds`; ``given``: the user set
+    ``min_speed``). Returns ``data`` and ``choices`` with the friction chosen."""
+    friction = choose_friction(choices.model(robot), data, progress=progress)
+    data = data.with_rest_model(friction.rest_friction(), data.settings.presliding)
+    return _fitted_speeds(data, friction, given=given), replace(choices, friction=friction)
 
 
 def _fitted_speeds(data: PreparedData, friction, given: bool) -> PreparedData:

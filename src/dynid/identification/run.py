@@ -196,10 +196,8 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     fitted = _identification_log(config)
     logs = _fit_repeats_said(fitted, _read_as_scored(datasets, config.robot, progress), repeated)
     if yardstick:
-        reference = yardstick_reference(fitted if fitted is not None else load_recording(config.identification,
-                                                                                         config.robot))
-        filters = yardstick_scores(config, base, sets, logs, resolved=stored_preprocessing(identified), reference=reference)
-        return filters[0], tuple(w for r in refs for w in r.warnings) + tuple(repeated)
+        return (_on_the_yardstick(config, base, sets, logs, fitted, identified),
+                tuple(w for r in refs for w in r.warnings) + tuple(repeated))
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
     comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
@@ -210,6 +208,15 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     if beside:
         comparisons = tuple(v.without(str(label)) for v in comparisons)
     return comparisons, tuple(w for r in refs for w in r.warnings) + warnings + tuple(repeated)
+
+
+def _on_the_yardstick(config: IdentificationConfig, base, sets: dict, logs, fitted: Recording | None,
+                      identified: dict) -> tuple:
+    """:func:`run_validation`'s comparisons on the one yardstick: every log's torques as measured, its states filtered
+    by the default rules carried over from the identification log (``fitted``, read again where it was not given;
+    :func:`dynid.identification.evidence.yardstick_scores`, its first state filter)."""
+    reference = yardstick_reference(fitted if fitted is not None else load_recording(config.identification, config.robot))
+    return yardstick_scores(config, base, sets, logs, resolved=stored_preprocessing(identified), reference=reference)[0]
 
 
 def _identification_log(config: IdentificationConfig) -> Recording | None:

@@ -92,19 +92,23 @@ def _header_entries(table, urdf: Path, log: Path, read: tuple, delimiter: str, *
     time_notes += _rate_unused(rate, found["time"][0]) if "time" in found else []
     signal_notes, signals, assumed = _signal_entries(table, found, ("positions", "velocities", effort), urdf, n_dof)
     notes = order_notes + group_notes + time_notes + signal_notes
-    left = [c for c in first if c not in taken + signals]
+    notes += _unread_notes([c for c in first if c not in taken + signals], passed, effort, urdf, n_dof)
+    return notes + ([_assumed_units(assumed)] if assumed else [])
+
+
+def _unread_notes(left: list[str], passed, effort: str, urdf: Path, n_dof: int) -> list[str]:
+    """:func:`_header_entries`' note on the columns ``left`` unread: a ``<mimic>`` joint's, more joint columns than
+    the robot has joints (``passed``: those already said as a group passed over), or any others."""
     extra = [c for c in left if _kind(c) in ("positions", effort) and c not in passed]
     followed = _mimic_columns(urdf, extra)
     if extra and len(followed) == len(extra):
-        notes.append(f"not read: {', '.join(left)} — the columns of joints that follow others in {urdf.name} (<mimic>: "
-                     f"{', '.join(sorted(set(followed.values())))}): their motion is computed from the joints they follow, "
-                     "and their torque is those joints'")
-    elif extra:
-        notes.append(f"not read: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
-                     f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?")
-    elif left:
-        notes.append(f"not read: {', '.join(left)}")
-    return notes + ([_assumed_units(assumed)] if assumed else [])
+        return [f"not read: {', '.join(left)} — the columns of joints that follow others in {urdf.name} (<mimic>: "
+                f"{', '.join(sorted(set(followed.values())))}): their motion is computed from the joints they follow, "
+                "and their torque is those joints'"]
+    if extra:
+        return [f"not read: {', '.join(left)} — the log has more joint columns than the robot's {n_dof} joints "
+                f"({', '.join(extra)}): is {urdf.name} the whole arm, and are the first {n_dof} its joints?"]
+    return [f"not read: {', '.join(left)}"] if left else []
 
 
 def _mimic_columns(urdf: Path, columns: list[str]) -> dict[str, str]:

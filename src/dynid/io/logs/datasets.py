@@ -293,6 +293,23 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         which, value = ("time_range", list(spec.time_range)) if spec.time_range is not None else ("rows", list(spec.rows or ()))
         raise DataError(f"{spec.table or spec.name}: {which} = {value} selects {t.size} samples; at least {MIN_SELECTED} "
                         f"are needed: widen it")
+    t, raw, rate = _on_uniform_grid(spec, t, raw, where, timed=timed, q_source=q_source, warnings=warnings)
+    raw = _coordinates_widened(robot, raw, spec.table or spec.name, warnings)
+    q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, raw, side, warnings))
+    progress(2 / 3)
+    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
+                  tau_source=tau_source, warnings=warnings)
+    source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
+    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
+                     robot.drive_gains.copy() if kind == "currents" else None, tuple(robot.prismatic.tolist()),
+                     robot.followers)
+
+
+def _on_uniform_grid(spec: DatasetSpec, t, raw: dict, where, *, timed: bool, q_source: str,
+                     warnings: list[str]) -> tuple[np.ndarray, dict, float]:
+    """:func:`_assemble`'s clock: the time stamps' unit checked, the gaps said, and the samples on a uniform grid at
+    the log's rate (a grid whose stamps' digits ran out put back on it; an uneven one, or ``resample``, resampled).
+    Returns the time stamps [s], the signals and the rate [Hz] (``spec.rate`` for a log without time stamps)."""
     median = float(np.median(np.diff(t)))
     table = spec.table or spec.name
     if timed and spec.resample is None:  # before the gaps: a log in milliseconds has its gaps in seconds
@@ -308,15 +325,7 @@ def _assemble(spec: DatasetSpec, robot: Robot, t, raw: dict, where, *, timed: bo
         check_clock_unit(1.0 / rate, q_source, table)
     if timed and (not uniform or spec.resample is not None):
         t, raw = resampled(t, raw, rate)
-    raw = _coordinates_widened(robot, raw, spec.table or spec.name, warnings)
-    q, dq, tau, kind = _followers_filled(robot, *_joint_side(spec, robot, raw, side, warnings))
-    progress(2 / 3)
-    _plausibility(spec, robot, t - t[0], q, raw["currents"] if "currents" in raw else raw["torques"], source=q_source,
-                  tau_source=tau_source, warnings=warnings)
-    source = str(spec.bag.path) if spec.bag is not None else ", ".join(sorted({str(s.file) for s in spec.signals.values()}))
-    return Recording(spec.name, t - t[0], q, dq, tau, float(rate), tuple(warnings), source,
-                     robot.drive_gains.copy() if kind == "currents" else None, tuple(robot.prismatic.tolist()),
-                     robot.followers)
+    return t, raw, float(rate)
 
 
 def _coordinates_widened(robot: Robot, raw: dict, name: str = "", warnings: list[str] | None = None) -> dict:
