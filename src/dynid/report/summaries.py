@@ -411,6 +411,10 @@ def readiness(result, *, library: bool = False) -> Line:
         return Line("not ready: the torque columns do not follow the robot file's model on any joint (velocities, "
                     "positions or another signal read as torques?): the verdict at the end says what they look like",
                     "warning")
+    if "spikes" in kinds:
+        return Line("not ready: the measured torques are mostly spikes (a controller or simulation chattering, or "
+                    "glitches) and follow the robot file's model on no joint: the verdict at the end names the joints",
+                    "warning")
     if "order" in kinds:
         return Line("not ready: the torques of some joints look swapped: the verdict at the end names them", "warning")
     if "angles" in kinds:
@@ -538,7 +542,7 @@ points to (:data:`NOT_READY_KINDS`; :func:`_verdict`): those that ask something 
 order; the others are counted by kind (issue "Fast where users wait", item 4: the verdict in a screenful).
 ``--verbose`` and report.html list every one."""
 
-NOT_READY_KINDS = ("sign", "columns", "order", "angles", "rate", "gravity", "scale")
+NOT_READY_KINDS = ("sign", "columns", "spikes", "order", "angles", "rate", "gravity", "scale")
 """Finding kinds that make :func:`readiness`'s first line "not ready: … the verdict at the end names it": always
 printed."""
 

@@ -60,7 +60,8 @@ class Finding:
         along another axis of the base: :mod:`dynid.validation.geometry_checks`), "misread" (a validation log the verdict
         leaves out, read otherwise than the identification log: :mod:`dynid.validation.channel_checks`), "filtered"
         (torques without measurable noise: :func:`dynid.validation.noise_floor.looks_filtered`), "columns" (torques
-        that follow the description on no joint: :func:`unlike_nominal_findings`), "yardstick" (the validation logs rank
+        that follow the description on no joint: :func:`unlike_nominal_findings`), "spikes" (torques that follow it
+        on no joint and are mostly spikes: a chattering controller or simulation, glitches), "yardstick" (the validation logs rank
         the candidates differently under another state filter: :func:`dynid.identification.verdict.decide`).
     text : str
         The line, naming the joint or dataset, the size, and what to do.
@@ -269,7 +270,8 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     Returns
     -------
     list of Finding
-        One finding of kind "columns" (the log is not read as the robot file says), or none.
+        One finding of kind "columns" (the log is not read as the robot file says) or "spikes" (it is, but its torques
+        are mostly spikes: :func:`spiky_joints`), or none.
     """
     same = _same_columns(tau, varies)
     if same:
@@ -294,11 +296,60 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     best = max(abs(rho[j]) for j in judged)  # a torque whose sign is flipped follows the model all the same
     if best >= UNLIKE_NOMINAL or explained:
         return []
+    spikes = spiky_joints(tau, judged)
+    if spikes:  # torques, read right, that no model of the arm's motion follows: say what they are
+        return [Finding("spikes", f"{dataset}: the measured torques of {', '.join(f'J{j + 1}' for j, _ in spikes)} are "
+                                  "mostly spikes (single samples up to " + ", ".join(f"{jump:.3g}" for _, jump in spikes)
+                                  + "× the joint's RMS torque from the one before, which carry much of its variance) and "
+                                  f"on no joint do the torques follow the description's nominal model (largest "
+                                  f"correlation {best:.2f}): a controller or a simulation chattering, or glitches in the "
+                                  "torque channel, which no model of the arm follows; look at these columns of "
+                                  f"{table} (a plot of the log) and log a motion without them before identifying")]
     which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
     return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
                                f"largest correlation with them {best:.2f}, where the real logs' reach 0.68-1.0){which}: "
                                "these columns are not read as the robot's torques; check the torques (or currents) "
                                f"columns of {table} and the robot file before trusting any fit of them")]
+
+
+SPIKES = 10.0
+"""A torque column whose second differences' RMS is this many times their robust spread (1.4826·MAD, as the noise
+floor estimates it: :mod:`dynid.validation.noise_floor`) is carried by a few samples far from their neighbours: spikes,
+not noise (white noise gives 1; the torque columns of ../shared/data's logs 1.0-6.2, their position columns up to 9.2;
+benchmarks/NOTEBOOK.md, stop 117)."""
+
+SPIKE_SHARE = 0.1
+"""...and whose second differences (over 6, their white-noise variance) reach this share of the column's variance:
+the spikes are much of what the column holds (the moving logs of ../shared/data 0-0.18, their position columns 0; a
+joint at rest holds its noise alone, whose share is high but which is not spikes)."""
+
+
+def spiky_joints(tau, joints) -> list[tuple[int, float]]:
+    """The joints among ``joints`` whose torque column is mostly spikes (:data:`SPIKES`, :data:`SPIKE_SHARE`), each
+    with its largest sample-to-sample change over its RMS torque.
+
+    Parameters
+    ----------
+    tau : (N, n_dof) array or StoredColumns [N·m or N]
+        Torques, as prepared (unfiltered: a filtered column's spikes are spread out and not found).
+    joints : sequence of int
+        0-based joints to look at.
+
+    Returns
+    -------
+    list of (int, float)
+    """
+    out = []
+    for j in joints:
+        x = np.asarray(tau[:, j], dtype=float)
+        d2 = np.diff(x, 2)
+        if d2.size < 3:
+            continue
+        energy, variance = float(np.mean(d2**2)), float(np.var(x))
+        spread = 1.4826 * float(np.median(np.abs(d2 - np.median(d2))))
+        if variance > 0 and energy / 6 >= SPIKE_SHARE * variance and energy >= (SPIKES * spread) ** 2:
+            out.append((j, float(np.max(np.abs(np.diff(x)))) / float(np.sqrt(np.mean(x**2)))))
+    return out
 
 
 def _centred(column) -> np.ndarray:
