@@ -39,6 +39,19 @@ def _in_range(value, low: float, whole: bool, above: bool = False) -> bool:
     return bool(value > low if above else value >= low) and (not whole or float(value).is_integer())
 
 
+_PER_JOINT = (("min_speed", True), ("rest_velocity", True), ("coulomb_velocity", True), ("rest_floor", False))
+"""Speeds [rad/s, or m/s on a sliding joint] checked where they are made: (field, "auto" allowed); each a number >= 0,
+not NaN, or one per joint."""
+
+
+def _speeds(value, auto: bool) -> bool:
+    """Whether ``value`` is "auto" (where ``auto``) or a speed >= 0, or a non-empty sequence of them, none NaN."""
+    if isinstance(value, str):
+        return auto and value == "auto"
+    values = np.atleast_1d(np.asarray(value, dtype=object))
+    return values.ndim == 1 and values.size > 0 and all(_in_range(x, 0.0, False) for x in values.tolist())
+
+
 MIN_SAMPLES_KEPT = 200
 """A log whose settings come from another dataset is decimated by at most ``N // MIN_SAMPLES_KEPT``."""
 
@@ -158,13 +171,18 @@ class Preprocessing:
 
     def __post_init__(self) -> None:
         """Refuse a setting no log can mean, in one line naming the field (a ``ConfigError``), as a config's
-        ``[preprocessing]`` table is checked (:data:`_RANGES`, ``rest_friction``, ``presliding`` up to
-        :data:`MAX_PRESLIDING`): the same settings through the API and through a file."""
+        ``[preprocessing]`` table is checked (:data:`_RANGES`, the speeds of :data:`_PER_JOINT`, ``rest_friction``,
+        ``presliding`` up to :data:`MAX_PRESLIDING`): the same settings through the API and through a file."""
         for name, low, whole, above in _RANGES:
             value = getattr(self, name)
             if value is not None and not _in_range(value, low, whole, above):
                 raise ConfigError(f"preprocessing.{name}: expected {'an integer' if whole else 'a number'} "
                                   f"{'>' if above else '>='} {low:g}, got {value!r}")
+        for name, auto in _PER_JOINT:
+            if not _speeds(getattr(self, name), auto):
+                said = '"auto", ' if auto else ""
+                raise ConfigError(f"preprocessing.{name}: expected {said}a speed >= 0 (rad/s, or m/s on a sliding "
+                                  f"joint), or one per joint, got {getattr(self, name)!r}")
         rest = np.atleast_1d(np.asarray(self.rest_friction, dtype=object))
         if rest.ndim > 1 or not all(x in ("held", "zero") or _in_range(x, 0.0, False) for x in rest.tolist()):
             raise ConfigError(f'preprocessing.rest_friction: expected "held", "zero" or a relaxation time >= 0 s, or one '
