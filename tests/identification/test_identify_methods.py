@@ -138,6 +138,16 @@ def test_the_output_opens_with_how_it_went_and_what_to_do_next(tmp_path):
     assert listed("about 0 on this log's motion") == small
 
 
+def _configured(config, **given) -> dict:
+    """The config's estimators given as objects (an entry with settings): key -> their parameters named in ``given``
+    (scikit-learn's ``get_params``)."""
+    from dynid.estimators.registry import estimator_choices
+
+    objects = [x for x in config.estimation.estimators if not isinstance(x, str)]
+    return {key: {k: est.get_params()[k] for k in given[key]}
+            for key, est in (estimator_choices(objects)[1] if objects else {}).items()}
+
+
 def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accuracy(tmp_path):
     """``estimators = ["ols", { key = "sdp", prior_kind = "geometric" }]``: the SDP keeps what the data do not determine near the nominal links by
     the pseudo-inertias' log-det divergence (Lee, Wensing & Park 2020): the fit is the Euclidean prior's, and every
@@ -151,7 +161,7 @@ def test_the_geometric_prior_keeps_exported_links_plausible_at_no_cost_in_accura
     for kind in ("euclidean", "geometric"):
         cfg.write_text(text.replace('estimators = ["ols"]\n', f'estimators = ["ols", {{ key = "sdp", prior_kind = "{kind}" }}]\n'))
         config = load_identification_config(cfg)
-        assert config.estimation.hyperparameters == {"sdp": {"prior_kind": kind}}
+        assert _configured(config, sdp=["prior_kind"]) == {"sdp": {"prior_kind": kind}}
         runs[kind] = (config, run_identification(config, validate=True))
     fit = {k: r.validations[0].metrics()["dynid SDP"]["global_relative_error"] for k, (_, r) in runs.items()}
     assert fit["geometric"] <= 1.01 * fit["euclidean"], fit
@@ -200,7 +210,7 @@ def test_a_drafts_sdp_prior_is_refused_in_one_line_saying_the_estimators_entry(t
         load_identification_config(cfg)
     assert migrate_text(text, str(cfg)) == (text, [])  # nothing a release wrote: dynid migrate leaves it
     cfg.write_text(text.replace('["ols", "sdp"]\nsdp_prior = "geometric"', '["ols", { key = "sdp", prior_kind = "geometric" }]'))
-    assert load_identification_config(cfg).estimation.hyperparameters == {"sdp": {"prior_kind": "geometric"}}
+    assert _configured(load_identification_config(cfg), sdp=["prior_kind"]) == {"sdp": {"prior_kind": "geometric"}}
 
 
 def test_a_box_searchs_hyperparameters_reach_it_from_the_config(tmp_path):
@@ -211,7 +221,7 @@ def test_a_box_searchs_hyperparameters_reach_it_from_the_config(tmp_path):
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n',
                                            'estimators = ["ols", { key = "abc", colony_size = 8, maxiter = 4 }]\n'))
     config = load_identification_config(cfg)
-    assert config.estimation.hyperparameters == {"abc": {"colony_size": 8, "maxiter": 4}}
+    assert _configured(config, abc=["colony_size", "maxiter"]) == {"abc": {"colony_size": 8, "maxiter": 4}}
     result = run_identification(config, validate=False)
     given = result.settings["estimator_hyperparameters"]["abc"]
     assert given["colony_size"] == 8 and given["maxiter"] == 4
@@ -315,3 +325,20 @@ def test_a_log_at_rest_throughout_says_what_its_figure_checks(tmp_path):
     twice = replace(result, validations=(held, replace(held, name="held again")))
     lines = [line for line in render_text(in_short(twice), 400).splitlines() if "at rest throughout" in line]
     assert len(lines) == 1 and lines[0].startswith("validation, held again (2 logs at rest throughout): torque error")
+
+
+def test_a_configs_estimator_settings_stay_with_a_key_an_identifier_gives_over_it(tmp_path):
+    """``Identifier(estimators=["ols", "abc"]).fit(config)`` over a config whose list says ``{ key = "abc",
+    colony_size = 8, maxiter = 4 }``: the bee colony fitted is the config's (its settings are the config's object's,
+    not a dict carried beside the keys), and an estimator object given in the Identifier's list is the one cloned."""
+    import dynid
+    from dynid.estimators import BeeColonyEstimator
+
+    cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
+    cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n',
+                                           'estimators = ["ols", { key = "abc", colony_size = 8, maxiter = 4 }]\n'))
+    fitted = dynid.Identifier(estimators=["wls", "abc"]).fit(cfg, validate=False).estimators_["dynid ABC"]
+    assert fitted.colony_size == 8 and fitted.maxiter == 4
+    given = BeeColonyEstimator(colony_size=6, maxiter=2)
+    fitted = dynid.Identifier(estimators=["wls", given]).fit(cfg, validate=False).estimators_["dynid ABC"]
+    assert fitted is not given and (fitted.colony_size, fitted.maxiter) == (6, 2)

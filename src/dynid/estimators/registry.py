@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from .base import Estimator
 
 __all__ = ["DEFAULT_ESTIMATORS", "EstimatorSpec", "SearchBudget", "FitData", "register", "unregister", "spec", "keys",
-           "label", "parse_estimators", "estimator_choices", "with_hyperparameters", "configured_estimator"]
+           "label", "parse_estimators", "estimator_choices", "configured_estimator"]
 
 DEFAULT_ESTIMATORS = ("wls", "sdp")
 """The estimators an identification runs where none are listed: weighted least squares (the main estimate) and the
@@ -456,34 +456,6 @@ def estimator_choices(items, where: str = "estimators") -> tuple[tuple[str, ...]
     objects = {i: _key_of(item, where) for i, item in enumerate(items) if not isinstance(item, str)}
     keys_ = parse_estimators([objects.get(i, item) for i, item in enumerate(items)])
     return keys_, {objects[i]: items[i] for i in objects}
-
-
-def with_hyperparameters(items, hyperparameters: dict) -> tuple:
-    """``items`` with each key that ``hyperparameters`` names given as an unfitted estimator of its class carrying them
-    (a config's settings of an estimator, ``{ key = "abc", colony_size = 60 }`` in its estimators list, on whatever
-    list is identified: :func:`configured_estimator`).
-
-    Parameters
-    ----------
-    items : sequence of str and Estimator
-    hyperparameters : dict
-        key -> constructor parameters.
-
-    Returns
-    -------
-    tuple
-        Keys, and objects where the key had hyper-parameters (objects given stay as they are).
-
-    Raises
-    ------
-    ConfigError
-        As :func:`configured_estimator`.
-    """
-    out = []
-    for item in items:
-        given = hyperparameters.get(item.strip().lower()) if isinstance(item, str) else None
-        out.append(configured_estimator(item.strip().lower(), given, "estimators") if given else item)
-    return tuple(out)
 
 
 def configured_estimator(key: str, given: dict, where: str):

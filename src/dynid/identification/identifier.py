@@ -20,7 +20,7 @@ import numpy as np
 
 from .._util.hyperparameters import HyperParameters
 from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
-from ..estimators.registry import DEFAULT_ESTIMATORS
+from ..estimators.registry import DEFAULT_ESTIMATORS, estimator_choices
 from ..exceptions import ConfigError, NotFittedError
 from ..model.loading import as_robot
 from ..model.robot import Robot
@@ -226,7 +226,11 @@ class Identifier(HyperParameters):
         estimation: dict[str, Any] = {}  # over the config's [estimation]
         if self.estimators is not None:
             open_loop, closed_loop = split_estimators(self.estimators, "Identifier(estimators=...)")
-            estimation["estimators"] = (*open_loop, *closed_loop)
+            # a key the config gives settings for ({ key = "abc", colony_size = 60 }) takes the config's estimator
+            objects = [x for x in config.estimation.estimators if not isinstance(x, str)]
+            configured = estimator_choices(objects)[1] if objects else {}
+            estimation["estimators"] = tuple(configured.get(x, x) if isinstance(x, str) else x
+                                             for x in (*open_loop, *closed_loop))
             if closed_loop and config.controller is None and self.controller is None:
                 raise ConfigError(f"Identifier(estimators=...): {closed_loop[0]} simulates the run in closed loop "
                                   f"and needs its controller: {path} has no [controller] table (kp, kd, rate, the "

@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._util.keywords import keyword_only_after_data, seed_of
-from ..estimators.registry import with_hyperparameters
 from ..exceptions import ConfigError, DataError, DynIdError
 from ..io.config.identification_config import IdentificationConfig, stored_preprocessing
 from ..io.logs.dataset_specs import DatasetSpec
@@ -145,9 +144,8 @@ def pipeline_of(config: IdentificationConfig) -> IdentificationPipeline:
     from .pipeline import IdentificationPipeline
 
     e = config.estimation
-    return IdentificationPipeline(config.robot, config.preprocessing, with_hyperparameters(e.estimators, e.hyperparameters),
-                                  e.friction, e.seed, config.robot_source, config.controller if e.closed_loop else None,
-                                  e.choice, config.torque_sensor)
+    return IdentificationPipeline(config.robot, config.preprocessing, e.estimators, e.friction, e.seed, config.robot_source,
+                                  config.controller if e.closed_loop else None, e.choice, config.torque_sensor)
 
 
 @keyword_only_after_data

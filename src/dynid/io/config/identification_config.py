@@ -103,16 +103,13 @@ class EstimationSettings:
     Attributes
     ----------
     estimators : tuple of str and Estimator
-        Estimator keys (lower case) or unfitted estimators, the first the main estimate, the closed-loop ones (IDIM-IV,
+        Estimator keys (lower case) or unfitted estimators (a config's entry with settings, ``{ key = "abc",
+        colony_size = 60 }``: the estimator carrying them), the first the main estimate, the closed-loop ones (IDIM-IV,
         DIDIM: :attr:`closed_loop`) after the others.
     seed : int
         Seeds the box searches and the bootstrap.
     friction : str
         "auto": each joint's friction model by cross-validation; "description": as described.
-    hyperparameters : dict
-        Estimator key -> the hyper-parameters ``[estimation]`` sets for it (an inline table of the estimators list,
-        ``{ key = "abc", colony_size = 60 }``), applied to whatever estimator list is identified
-        (:func:`dynid.estimators.registry.with_hyperparameters`).
     choice : str
         "torques": the main estimate chosen on the validation logs' torques; "states": on their states alone
         (:func:`dynid.identification.verdict.choose_main_estimate`).
@@ -121,7 +118,6 @@ class EstimationSettings:
     estimators: tuple = DEFAULT_ESTIMATORS
     seed: int = 0
     friction: str = "auto"
-    hyperparameters: dict = field(default_factory=dict)
     choice: str = "torques"
 
     @property
@@ -471,12 +467,12 @@ def _current_document(doc: dict, path: Path) -> dict:
 
 
 def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSettings:
-    """The ``[estimation]`` table as settings: the estimators (closed-loop ones only with a controller) and their
-    hyper-parameters, the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
+    """The ``[estimation]`` table as settings: the estimators (closed-loop ones only with a controller; an entry with
+    hyper-parameters as the estimator object carrying them), the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
     the choice of the main estimate (``e`` None: the table left out)."""
     e = e or EstimationTable()
     friction = e.friction or pre.friction_default
-    asked, hyperparameters = _estimator_entries(e.estimators or list(DEFAULT_ESTIMATORS), f"{path}: estimation.estimators")
+    asked, configured = _estimator_entries(e.estimators or list(DEFAULT_ESTIMATORS), f"{path}: estimation.estimators")
     estimators, closed_loop = split_estimators(asked, f"{path}: estimation.estimators")
     if closed_loop and not controlled:
         raise ConfigError(f"{path}: estimation.estimators: {closed_loop[0]} simulates the run in closed loop and needs its "
@@ -485,7 +481,8 @@ def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSett
     if e.choice == "states" and "sdp" not in estimators:
         raise ConfigError(f"{path}: estimation.choice = \"states\" weighs the SDP's spread on the validation logs' "
                           "states: add sdp to estimation.estimators, or leave choice out")
-    return EstimationSettings((*estimators, *closed_loop), e.seed or 0, friction, hyperparameters, e.choice or "torques")
+    return EstimationSettings(tuple(configured.get(k, k) if isinstance(k, str) else k for k in (*estimators, *closed_loop)),
+                              e.seed or 0, friction, e.choice or "torques")
 
 
 def _robot_files(doc: dict, typed, path: Path, root: Path, robot):
@@ -499,11 +496,12 @@ def _robot_files(doc: dict, typed, path: Path, root: Path, robot):
     return robot_source(doc, path, root), urdf, mjcf
 
 
-def _estimator_entries(entries: list, where: str) -> tuple[list[str], dict[str, dict]]:
-    """The estimators list's keys (lower case), and the hyper-parameters its inline tables give: key -> {name: value},
-    each checked against the estimator's class (:func:`dynid.estimators.registry.configured_estimator`)."""
+def _estimator_entries(entries: list, where: str) -> tuple[list[str], dict]:
+    """The estimators list's keys (lower case), and for each key its inline tables give settings, the unfitted
+    estimator carrying them (:func:`dynid.estimators.registry.configured_estimator`, which checks them against the
+    estimator's class): key -> estimator."""
     asked: list[str] = []
-    hyperparameters: dict[str, dict] = {}
+    settings: dict[str, dict] = {}
     for i, entry in enumerate(entries):
         if not isinstance(entry, dict):
             asked.append(str(entry).strip().lower())
@@ -514,10 +512,9 @@ def _estimator_entries(entries: list, where: str) -> tuple[list[str], dict[str, 
                               f'"geometric" }}, got {entry!r}')
         key = key.strip().lower()
         asked.append(key)
-        hyperparameters[key] = {**hyperparameters.get(key, {}), **{k: v for k, v in entry.items() if k != "key"}}
-    for key, given in hyperparameters.items():
-        configured_estimator(key, given, f"{where}[{asked.index(key)}]" if key in asked else where)
-    return asked, {k: v for k, v in hyperparameters.items() if v}
+        settings[key] = {**settings.get(key, {}), **{k: v for k, v in entry.items() if k != "key"}}
+    return asked, {key: configured_estimator(key, given, f"{where}[{asked.index(key)}]") for key, given in settings.items()
+                   if given}
 
 
 def _torque_sensor(doc: dict) -> str:
