@@ -328,7 +328,7 @@ def test_a_log_at_rest_throughout_says_what_its_figure_checks(tmp_path):
 
 
 def test_a_configs_estimator_settings_stay_with_a_key_an_identifier_gives_over_it(tmp_path):
-    """``Identifier(estimators=["ols", "abc"]).fit(config)`` over a config whose list says ``{ key = "abc",
+    """``Identifier.from_config(config, estimators=["wls", "abc"])`` over a config whose list says ``{ key = "abc",
     colony_size = 8, maxiter = 4 }``: the bee colony fitted is the config's (its settings are the config's object's,
     not a dict carried beside the keys), and an estimator object given in the Identifier's list is the one cloned."""
     import dynid
@@ -337,8 +337,8 @@ def test_a_configs_estimator_settings_stay_with_a_key_an_identifier_gives_over_i
     cfg, _ = simulated_case(tmp_path, "er16", 125.0, "fourier", duration=5.0)
     cfg.write_text(cfg.read_text().replace('estimators = ["ols"]\n',
                                            'estimators = ["ols", { key = "abc", colony_size = 8, maxiter = 4 }]\n'))
-    fitted = dynid.Identifier(estimators=["wls", "abc"]).fit(cfg, validate=False).estimators_["dynid ABC"]
+    fitted = dynid.Identifier.from_config(cfg, validate=False, estimators=["wls", "abc"]).estimators_["dynid ABC"]
     assert fitted.colony_size == 8 and fitted.maxiter == 4
     given = BeeColonyEstimator(colony_size=6, maxiter=2)
-    fitted = dynid.Identifier(estimators=["wls", given]).fit(cfg, validate=False).estimators_["dynid ABC"]
+    fitted = dynid.Identifier.from_config(cfg, validate=False, estimators=["wls", given]).estimators_["dynid ABC"]
     assert fitted is not given and (fitted.colony_size, fitted.maxiter) == (6, 2)
