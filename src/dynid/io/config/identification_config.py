@@ -468,7 +468,8 @@ def _current_document(doc: dict, path: Path) -> dict:
 
 def _estimation_settings(e, pre, path: Path, controlled: bool) -> EstimationSettings:
     """The ``[estimation]`` table as settings: the estimators (closed-loop ones only with a controller; an entry with
-    hyper-parameters as the estimator object carrying them), the friction (each joint's model chosen unless a Coulomb smoothing velocity is given), the seed,
+    hyper-parameters as the estimator object carrying them), the friction (each joint's model chosen unless a Coulomb
+    smoothing velocity is given), the seed,
     the choice of the main estimate (``e`` None: the table left out)."""
     e = e or EstimationTable()
     friction = e.friction or pre.friction_default
