@@ -31,8 +31,8 @@ from .._util.grams import joint_gram
 from ..conventions import joint_unit
 from .noise_floor import AT_FLOOR
 
-__all__ = ["DELAY_ADVICE", "Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "unlike_nominal_findings",
-           "validation_findings", "prior_findings", "nominal_gate"]
+__all__ = ["DELAY_ADVICE", "Finding", "OrderSums", "ResidualSums", "sign_findings", "scale_findings", "spiky_joints",
+           "unlike_nominal_findings", "validation_findings", "prior_findings", "nominal_gate"]
 
 SIGNIFICANT = 4.0
 """|t| above which a residual's correlation with a feature is reported."""
