@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from .._util.hyperparameters import HyperParameters
 from .._util.keywords import keyword_only_after_data, renamed_keyword, seed_of
+from ..estimators.base import HyperParameters
 from ..estimators.registry import DEFAULT_ESTIMATORS, estimator_choices
 from ..exceptions import ConfigError, NotFittedError
 from ..model.loading import as_robot
