@@ -57,6 +57,31 @@ def test_constraints_bind_when_the_data_ask_for_negative_friction(rng):
     assert est.pseudo_inertia_min_eig_.min() >= -1e-7
 
 
+def test_a_solver_failure_names_the_likely_cause_not_the_solvers_advice(rng, monkeypatch):
+    """Clarabel failing outright (cvxpy's SolverError, "Try another solver, or solve with verbose=True") is said as a
+    status without a solution is: one line naming the likely cause and the settings that fix it, never an advice to
+    call cvxpy with arguments a user of dynid cannot give."""
+    import cvxpy as cp
+    import pytest
+
+    from dynid.exceptions import DynIdError
+
+    robot = load_robot("er16")
+    w, tau = _data(robot, rng, noise=0.5, n=40)
+    links, nonneg = consistency_layout(robot)
+
+    def failing(self, *args, **kwargs):
+        raise cp.error.SolverError("Solver 'CLARABEL' failed. Try another solver, or solve with verbose=True for more "
+                                   "information.")
+
+    monkeypatch.setattr(cp.Problem, "solve", failing)
+    with pytest.raises(DynIdError) as err:
+        PhysicallyConsistentLeastSquares().fit(w, tau, problem=FitData(layout=(links, nonneg)))
+    said = str(err.value)
+    assert "(status solver_error)" in said and "check the torques (or currents) columns and their units" in said
+    assert "verbose" not in said and "another solver" not in said and "\n" not in said
+
+
 def test_consistency_margin_tells_realisable_base_parameters_from_impossible_ones():
     """The true parameters' base projection is realisable (margin > 0); a negative viscous friction or a
     base inertia far below what any mass distribution allows is not."""

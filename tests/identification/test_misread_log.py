@@ -5,6 +5,7 @@ description's nominal model is the check (real logs: 0.96-1.0 on their best join
 hold that they raise no such finding)."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 
@@ -129,3 +130,28 @@ def test_torques_that_are_mostly_chatter_are_said_as_spikes_not_as_columns_read_
     [found] = [f["text"] for f in results["findings"] if f["kind"] == "spikes"]
     assert "J1, J2, J3, J4, J5, J6 are mostly spikes" in found
     assert not list((tmp_path / "out").glob("*.urdf")) and not list((tmp_path / "out").glob("*.xml"))
+
+
+def test_a_one_log_user_whose_torques_are_a_unit_off_hears_why_when_the_sdp_fails_on_held_out_blocks():
+    """The KR 300's log with its torques read 1,000× too large (a unit) and no validation log: the SDP fits the whole
+    log, but not some of the held-out blocks of it (the solver stops at its iteration limit). Such a refit withdraws
+    the SDP from the blocks' evidence instead of refusing the whole identification with the solver's words: the user
+    reads the finding that names the cause (the torques far from the description's size), as with validation logs."""
+    from dataclasses import replace
+
+    from dynid.identification.estimates import SDP_LABEL
+    from dynid.identification.run import pipeline_of
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
+    from dynid.report.summaries import readiness
+
+    from ..conftest import shared_data
+
+    config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_kr300.toml",
+                                        data_root=shared_data("kuka_kr300_weigand2021"))
+    recording = load_recording(config.identification, config.robot)
+    scaled = replace(recording, tau=np.asarray(recording.tau, dtype=float) * 1e3)
+    result = pipeline_of(config).fit(scaled, held_out=True)
+    held = result.diagnostics["held_out_rms_error"]
+    assert SDP_LABEL in result.estimates and SDP_LABEL not in held and "dynid WLS" in held
+    assert readiness(result).text.startswith("not ready: the measured torques are far from the description's size")

@@ -150,15 +150,18 @@ class PhysicallyConsistentLeastSquares(AccumulatingEstimator):
             else:
                 raise ShapeError(f"prior_kind: expected one of {', '.join(PRIOR_KINDS)}, got {self.prior_kind!r}")
             cost = cost + _gaussian_prior(cp, phi, prior, problem.prior_std, r=r, z=z, tau=tau / scale, n_rows=n_rows or m)
-        problem = _solve(cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon)),
-                         "physically consistent least squares")
-        if problem.status not in ("optimal", "optimal_inaccurate") or phi.value is None:
+        sdp = cp.Problem(cp.Minimize(cost), _consistency_constraints(phi, links, nonneg, self.epsilon))
+        try:
+            status = _solve(sdp, "physically consistent least squares").status
+        except DynIdError:  # the same cause as a status without a solution, said the same way (not cvxpy's advice)
+            status = cp.SOLVER_ERROR
+        if status not in ("optimal", "optimal_inaccurate") or phi.value is None:
             raise DynIdError(f"physically consistent least squares (sdp): the solver found no physically consistent "
-                             f"parameters for these torques (status {problem.status}); torque columns that are not the "
+                             f"parameters for these torques (status {status}); torque columns that are not the "
                              "robot's torques (another signal, or far off in size) do this: check the torques (or "
                              "currents) columns and their units, or list the estimators without sdp")
         self.params_ = np.asarray(phi.value, dtype=float)
-        self.status_ = problem.status
+        self.status_ = status
         self.pseudo_inertia_min_eig_ = np.array([np.linalg.eigvalsh(pseudo_inertia(self.params_[idx])).min() for idx in links])
 
 

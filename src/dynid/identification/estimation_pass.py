@@ -517,31 +517,40 @@ def _held_out_evidence(robot: Robot, base: BaseParameters, folds, row_weights, s
         progress("physically consistent SDP, held-out blocks", 0, 1)
     own, held, refitted = _held_out_errors(robot, folds, row_weights)
     if held_out:
-        stats["held_out_rms_error"] = {ls_label: own, SDP_LABEL: held, **held_out_errors(robot, folds, row_weights)}
+        stats["held_out_rms_error"] = {ls_label: own, **({} if held is None else {SDP_LABEL: held}),
+                                       **held_out_errors(robot, folds, row_weights)}
         stats["held_out_block_seconds"] = span / HELD_OUT_FOLDS  # the log's span [s] over the blocks
     return tuple(base.base_from_standard(phi) for phi in refitted) if jackknife else ()
 
 
-def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float, list]:
+def _held_out_errors(robot: Robot, folds, row_weights) -> tuple[float, float | None, list]:
     """RMS torque error on the held-out blocks of the unconstrained (OLS/WLS, minimum-norm over the standard
     parameters: the base estimate's predictions) and the physically consistent estimates, each fitted on the others;
-    and the physically consistent estimate of each fold (standard parameters)."""
+    and the physically consistent estimate of each fold (standard parameters). Where the SDP has no solution on some
+    blocks (torques far off in size or not the robot's: the findings on the whole log say which), it has no held-out
+    figure and no refits (None, []): the blocks are evidence, and their solver's failure is not the user's error."""
     p = robot.n_params
     links, nonneg = consistency_layout(robot)
     sse = np.zeros(2)
     rows = 0
-    fitted = []
+    fitted: list | None = []
     for k, held in enumerate(folds):
         rest = LeastSquaresAccumulator.merged([a for i, a in enumerate(folds) if i != k])
         reduced = rest.reduced(row_weights)
         phi = np.linalg.lstsq(reduced[:p, :p], reduced[:p, p], rcond=1e-10)[0]
-        est = PhysicallyConsistentLeastSquares()
-        est.fit(reduced[:, :p], reduced[:, p], problem=FitData(layout=(links, nonneg), prior=robot.standard_parameters()))
-        sse += [held.joint_residual_sumsq(phi).sum(), held.joint_residual_sumsq(est.params_).sum()]
+        sse[0] += held.joint_residual_sumsq(phi).sum()
         rows += int(held.rows.sum())
-        fitted.append(est.params_)
+        if fitted is not None:
+            try:
+                est = PhysicallyConsistentLeastSquares().fit(reduced[:, :p], reduced[:, p], problem=FitData(
+                    layout=(links, nonneg), prior=robot.standard_parameters()))
+            except DynIdError:
+                fitted = None
+                continue
+            sse[1] += held.joint_residual_sumsq(est.params_).sum()
+            fitted.append(est.params_)
     own, sdp = np.sqrt(sse / max(rows, 1))
-    return float(own), float(sdp), fitted
+    return float(own), None if fitted is None else float(sdp), fitted or []
 
 
 def _step(progress, label: str):
