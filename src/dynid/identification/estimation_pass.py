@@ -56,7 +56,7 @@ from ..validation.torques import TorqueSums, resting_rows
 from .drive_only import drive_only, held_out_errors
 from .estimates import DRIVE_ONLY_LABEL, HELD_OUT_FOLDS, SDP_LABEL, Estimate, consistency_checks
 from .flipped_joints import flipped_joint_findings
-from .geared_friction import beyond_hysteresis, hysteresis_finding
+from .geared_friction import beyond_hysteresis, hysteresis_explains, hysteresis_finding
 from .result import IdentificationResult, search_box
 
 __all__ = ["BlockScoring", "Estimate", "IdentificationResult", "identify"]
@@ -400,8 +400,9 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
                                        tau=data.tau, explained=bool(geometry))
 
     said = unlike(beyond)
-    geared = None if not said else beyond_hysteresis(scoring.robot, base, data, nominal, friction, drive,
-                                                     lambda rho: not unlike(rho))
+    geared = None if not said else beyond_hysteresis(
+        scoring.robot, base, data, nominal, friction, drive,
+        lambda rho: not unlike(rho) and hysteresis_explains(rho, beyond, varies))
     if said and geared is None:  # not torques: no sign, scale or geometry of them can be judged
         return said
     note = []

@@ -39,8 +39,16 @@ from ..validation.torques import TorqueSums
 from .delay import DelayEstimate, held_out_sum
 from .verdict import SAME_FIGURE
 
-__all__ = ["PRESLIDING_DISTANCES", "HYSTERESIS_SCAN", "Hysteresis", "beyond_hysteresis", "hysteresis_finding",
-           "delay_beyond_hysteresis", "hysteresis_delay_finding", "hysteresis_weighed"]
+__all__ = ["EXPLAINED", "PRESLIDING_DISTANCES", "HYSTERESIS_SCAN", "Hysteresis", "beyond_hysteresis", "hysteresis_explains",
+           "hysteresis_finding", "delay_beyond_hysteresis", "hysteresis_delay_finding", "hysteresis_weighed"]
+
+EXPLAINED = 0.25
+"""The share of what friction turning at once leaves unexplained beyond it (``1 − ρ²`` of a joint's correlation with the
+nominal model) that Dahl's friction must explain on one joint that varies (``1 − (1 − ρ_Dahl²) / (1 − ρ²)``, a partial
+R²) for the log to be called a geared drive's hysteresis: a correlation nudged across the misread check's bound is not
+one. Measured (benchmarks/NOTEBOOK.md, stop 118): simulated UR10e logs with Dahl friction of 1-8 mrad at 10-30× the
+rigid-body RMS torque 0.42-1.0, the zoo's SO-100 0.93; a log of chatter at 10× its RMS whose J4 went from 0.47 to 0.52
+with 10 mrad, 0.05."""
 
 PRESLIDING_DISTANCES = (0.001, 0.003, 0.01)
 """Presliding distances [rad] tried, smallest first: 1-10 mrad (3.4-34 arcmin) spans the lost motion of the geared
@@ -105,6 +113,29 @@ def beyond_hysteresis(robot: Robot, base: BaseParameters, data: PreparedData, no
         if follows(beyond):
             found.append(Hysteresis(distance, beyond, slope, *sums.beyond(nominal, drive)))
     return max(found, key=lambda h: float(np.nanmax(np.abs(h.beyond)))) if found else None
+
+
+def hysteresis_explains(turned: np.ndarray, plain: np.ndarray, varies: np.ndarray) -> bool:
+    """Whether Dahl's friction explains :data:`EXPLAINED` of what friction that turns at once leaves unexplained, on a
+    joint that varies.
+
+    Parameters
+    ----------
+    turned, plain : (n_dof,) arrays
+        Each joint's correlation with the nominal model beyond Dahl's friction and beyond friction that turns at once
+        (NaN where unknown).
+    varies : (n_dof,) bool array
+        The joints judged.
+
+    Returns
+    -------
+    bool
+    """
+    turned, plain = np.asarray(turned, dtype=float), np.asarray(plain, dtype=float)
+    left = 1.0 - np.where(np.isfinite(plain), plain, 0.0) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = 1.0 - (1.0 - turned**2) / np.maximum(left, 1e-12)
+    return bool(np.any(np.asarray(varies, dtype=bool) & np.isfinite(share) & (share >= EXPLAINED)))
 
 
 def hysteresis_finding(found: Hysteresis, plain: np.ndarray, varies: np.ndarray, dataset: str) -> Finding:
