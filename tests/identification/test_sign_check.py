@@ -449,6 +449,35 @@ def test_a_flipped_sign_the_nominal_model_cannot_judge_is_named_by_the_consisten
     assert rms[1] < 0.5 * rms[0]  # the refit with J6 negated follows it
 
 
+def test_a_refit_with_a_joint_negated_that_has_no_solution_leaves_the_sign_unjudged(monkeypatch):
+    """The flipped-sign check refits the SDP with a misfitting joint's torque negated; where that SDP has no solution
+    (the solver's failure, provoked here), the joint's sign is not judged and the identification goes on, as every
+    other check that fails: before, the refit's error refused the whole identification."""
+    import dynid
+    from dynid.exceptions import DynIdError
+    from dynid.identification import flipped_joints
+    from dynid.identification.identifier import Identifier
+    from dynid.model.description import load_robot
+
+    from ..simulated_logs import truth_robot
+
+    truth, _ = truth_robot("ur10e", np.random.default_rng(0))
+    log = dynid.simulated_log(truth, seconds=10, rng=3)
+    tau = log.tau.copy()
+    tau[:, 5] *= -1
+    tried = []
+
+    def failing(sdp, acc, j):
+        tried.append(j)
+        raise DynIdError("physically consistent least squares (sdp): the solver found no physically consistent "
+                         "parameters for these torques (status solver_error)")
+
+    monkeypatch.setattr(flipped_joints, "_refit_negated", failing)
+    result = Identifier(load_robot("ur10e"), estimators=["wls", "sdp"]).fit(log.t, log.q, tau).result_
+    assert 5 in tried and not [f for f in result.findings if f.kind == "sign"]
+    assert "dynid SDP" in result.estimates
+
+
 def test_motor_currents_given_as_torques_are_told_the_descriptions_gains_were_not_applied(tmp_path):
     """A UR10e's motor currents given as torques (a researcher's arrays: the Identifier takes N·m) were told "drive_gain
     about 126, 69.6, 74.5 N·m/A": the description's gains times the ratio, as if they had been applied. The

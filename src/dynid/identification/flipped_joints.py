@@ -19,6 +19,7 @@ import copy
 import numpy as np
 
 from ..conventions import joint_unit
+from ..exceptions import DynIdError
 from ..validation.diagnostics import Finding
 
 __all__ = ["FLIPPED_FITS", "MISFIT", "flipped_joint_findings"]
@@ -61,7 +62,10 @@ def flipped_joint_findings(sdp, reference, dataset: str, table: str = "[identifi
     w2 = np.ones(acc.n_dof) if weights is None else np.asarray(weights, dtype=float) ** 2
     flipped, shares = [], []
     for j in np.flatnonzero(own > MISFIT**2 * np.maximum(least, 1e-300)):
-        left = _refit_negated(sdp, acc, int(j))
+        try:
+            left = _refit_negated(sdp, acc, int(j))
+        except DynIdError:  # no consistent solution with it negated: its sign is not judged (a check never refuses)
+            continue
         if left[j] <= FLIPPED_FITS**2 * own[j] and w2 @ left < w2 @ own:
             flipped.append(int(j))
             shares.append((np.sqrt(own[j] / ls_acc.rows[j]), np.sqrt(left[j] / ls_acc.rows[j])))
