@@ -594,7 +594,8 @@ MISREAD_KINDS = ("sign", "columns", "order", "angles", "rate", "gravity", "scale
 """The verdict's findings that say a log was read wrongly (:func:`dynid.report.summaries.readiness`'s first reasons):
 on the zoo's logs, all read right, each is a false alarm (issue "Every assurance checked on what the user meets",
 item 2). The ``dead`` class's silent channel is a real fault, not counted; so are torques that are mostly spikes (a
-simulation chattering: the finding "spikes", said apart)."""
+simulation chattering: the finding "spikes", said apart) and torques that no fit follows beyond their noise (the
+finding "unexplained", said apart)."""
 
 
 def false_alarms(rows: list[dict]) -> str:
@@ -603,10 +604,12 @@ def false_alarms(rows: list[dict]) -> str:
     alarmed = [f"{r['arm']} {r.get('truth', '')} {r['class']}: {', '.join(k for k in r['findings'] if k in MISREAD_KINDS)}"
                for r in cells if set(r["findings"]) & set(MISREAD_KINDS)]
     ready = sum(r.get("readiness", "").startswith("model ready") for r in cells)
-    spiky = [f"{r['arm']} {r.get('truth', '')} {r['class']}" for r in cells if "spikes" in r["findings"]]
+    apart = {kind: [f"{r['arm']} {r.get('truth', '')} {r['class']}" for r in cells if kind in r["findings"]]
+             for kind in ("spikes", "unexplained")}
+    said = {"spikes": "torques that are mostly spikes", "unexplained": "torques that no fit follows beyond their noise"}
     return (f"misread findings on logs read right: {len(alarmed)} of {len(cells)} cells"
             f"{' (' + '; '.join(alarmed) + ')' if alarmed else ''}; \"model ready\" on {ready} of them"
-            + (f"; torques that are mostly spikes (not ready, not counted as misread): {'; '.join(spiky)}" if spiky else ""))
+            + "".join(f"; {said[k]} (not ready, not counted as misread): {'; '.join(v)}" for k, v in apart.items() if v))
 
 
 def table(rows: list[dict]) -> str:

@@ -49,6 +49,7 @@ from ..validation.diagnostics import (
     prior_findings,
     scale_findings,
     sign_findings,
+    unexplained_finding,
     unlike_nominal_findings,
 )
 from ..validation.geometry_checks import geometry_findings
@@ -440,6 +441,7 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     stats: dict = {}
     if scoring.nominal is not None:  # the description's nominal model: does the data run against it?
         findings += _nominal_checks(base, scoring, fit, stats)
+    findings += unexplained_finding(fit, data.name)
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
     more, res_stats = residuals.residual_checks(ols_params, rms, fc, prismatic=robot.prismatic)
     findings += more

@@ -431,6 +431,10 @@ def readiness(result, *, library: bool = False) -> Line:
     if "scale" in kinds:
         return Line("not ready: the measured torques are far from the description's size (a unit, or the drive "
                     "gains?): the verdict at the end says how far and the setting that fixes it", "warning")
+    if "unexplained" in kinds:
+        return Line("not ready: the best fit to this log misses most of its torque, beyond the torques' noise: "
+                    "something the arm's model cannot express carries them; the verdict at the end says how much and "
+                    "on which joints", "warning")
     misread = [v.name for v in r.validations if v.misread]
     if misread:
         return Line(f"not ready: {', '.join(misread)} {'is' if len(misread) == 1 else 'are'} read otherwise than the "
@@ -542,7 +546,7 @@ points to (:data:`NOT_READY_KINDS`; :func:`_verdict`): those that ask something 
 order; the others are counted by kind (issue "Fast where users wait", item 4: the verdict in a screenful).
 ``--verbose`` and report.html list every one."""
 
-NOT_READY_KINDS = ("sign", "columns", "spikes", "order", "angles", "rate", "gravity", "scale")
+NOT_READY_KINDS = ("sign", "columns", "spikes", "order", "angles", "rate", "gravity", "scale", "unexplained")
 """Finding kinds that make :func:`readiness`'s first line "not ready: … the verdict at the end names it": always
 printed."""
 

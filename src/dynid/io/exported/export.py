@@ -257,10 +257,10 @@ def nominal_warning(results: dict) -> str | None:
             "on a log that excites them")
 
 
-READINESS_KINDS = ("columns", "spikes", "sign", "scale", "order", "angles", "gravity", "rate")
+READINESS_KINDS = ("columns", "spikes", "sign", "scale", "order", "angles", "gravity", "rate", "unexplained")
 """Findings of ``dynid identify``'s verdict that say the log itself is wrong (the torques' sign, unit or gain, channels
-swapped or mostly spikes, angles or a mounting that do not match the robot file, its sample rate): a model fitted to it is exported with
-a warning."""
+swapped or mostly spikes, angles or a mounting that do not match the robot file, its sample rate, torques that no fit
+follows): a model fitted to it is exported with a warning."""
 
 
 def verdict_warnings(results: dict) -> list[str]:
@@ -304,9 +304,10 @@ def withheld_files(results: dict) -> str | None:
         return None
     what = {"columns": "columns that are not its torques", "sign": "a torque's sign", "scale": "the torques' unit or drive gains", "order": "torque columns swapped",
             "angles": "its angles", "gravity": "the mounting", "rate": "its sample rate"}
-    misread = [k for k in kinds if k != "spikes"]
-    if not misread:  # read right, but its torques are mostly spikes (a chattering controller or simulation, glitches)
-        return (f"no URDF or MJCF written: the log {name} holds torques that are mostly spikes, which no model of the arm "
+    misread = [k for k in kinds if k not in ("spikes", "unexplained")]
+    if not misread:  # read right, but its torques are mostly spikes or what no model of the arm follows
+        held = "mostly spikes" if "spikes" in kinds else "mostly what the arm's model cannot express"
+        return (f"no URDF or MJCF written: the log {name} holds torques that are {held}, which no model of the arm "
                 "follows (the verdict names the joints), so a model fitted to it is not the robot's; log a motion "
                 "without them and identify that (dynid export CONFIG --urdf FILE writes this one all the same)")
     return (f"no URDF or MJCF written: the log {name} is read otherwise than the robot file "
