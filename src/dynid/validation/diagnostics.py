@@ -328,8 +328,9 @@ UNEXPLAINED = 50.0
 """[%] A log whose best fit leaves more than this share of its RMS torque unexplained beyond the torques' own noise
 (``√(fit² − floor²)`` over all joints, each set's error on the samples the fit is scored on) holds torques that the
 arm's model with friction cannot express: half its RMS, three quarters of its mean square. The four real logs of
-../shared/data and their 36 windows of 3-6 s leave 0-15.6 % (the KR 300's 0-4 s the most), the zoo's cells of
-simulated arms up to 22 % (benchmarks/NOTEBOOK.md, stop 118); the zoo's xArm7 whose simulation chatters 65 %."""
+../shared/data and their 36 windows of 3-6 s leave 0-15.6 % (the KR 300's 0-4 s the most), the zoo's cells 0-26.8 %
+(the SO-100's `cad-gear`), but for the xArm7 whose MuJoCo simulation chatters (`sign` friction: 65-113 %;
+benchmarks/NOTEBOOK.md, stop 118)."""
 
 
 def unexplained_finding(fit, dataset: str) -> list[Finding]:
