@@ -210,3 +210,28 @@ def test_torques_that_no_fit_follows_beyond_their_noise_are_not_ready(share):
     else:
         assert best < UNEXPLAINED and found == []
         assert not readiness(result, library=True).text.startswith("not ready: the best fit")
+
+
+def test_a_refusal_for_torques_that_are_velocities_names_the_columns():
+    """The KR 300's log with its joint velocities read as torques: the physically consistent estimate finds no
+    parameters for them and the identification is refused (it has nothing to fit). The refusal said only that such
+    columns "do this"; it now names each joint's column as its velocity, which the user can check in the config."""
+    from dataclasses import replace
+
+    from dynid.exceptions import DynIdError
+    from dynid.identification.run import pipeline_of
+    from dynid.io.config.identification_config import load_identification_config
+    from dynid.io.logs.datasets import load_recording
+
+    from ..conftest import shared_data
+
+    config = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "kuka_kr300.toml",
+                                        data_root=shared_data("kuka_kr300_weigand2021"))
+    recording = load_recording(config.identification, config.robot)
+    q = np.asarray(recording.q, dtype=float)
+    velocities = replace(recording, tau=np.gradient(q, 1.0 / recording.rate, axis=0))
+    with pytest.raises(DynIdError) as err:
+        pipeline_of(config).fit(velocities, held_out=True)
+    said = str(err.value)
+    assert all(f"J{j}'s is its velocity" in said for j in range(1, 7)) and "check them in the config" in said
+    assert "\n" not in said

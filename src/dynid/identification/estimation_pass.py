@@ -49,6 +49,7 @@ from ..validation.diagnostics import (
     prior_findings,
     scale_findings,
     sign_findings,
+    state_columns,
     unexplained_finding,
     unlike_nominal_findings,
 )
@@ -131,7 +132,8 @@ def identify(robot: Robot, base: BaseParameters, data: PreparedData, estimators=
                                     progress=progress)
     reference = _solved_reference(robot, base, estimation, data)
     row_weights = None if ls_key == "ols" else 1.0 / np.where(reference.joint_std_ > 0, reference.joint_std_, 1.0)
-    estimates, box = _fitted_estimates(estimation, reference, keys, ls_key, row_weights, rng=rng, progress=progress)
+    estimates, box = _fitted_estimates(estimation, reference, keys, ls_key, row_weights, rng=rng, progress=progress,
+                                       data=data)
     warnings = _log_warnings(robot, data, estimates, reference, references, prior_notes=prior_notes, not_carried=not_carried)
     sets = {**{label: e.params for label, e in estimates.items()}, **{r.name: r.beta for r in references}}
     objective = {}
@@ -198,16 +200,32 @@ def _solved_reference(robot: Robot, base: BaseParameters, estimation: Estimation
 
 
 def _fitted_estimates(estimation: Estimation, reference, keys, ls_key: str, row_weights, *, rng: int,
-                      progress) -> tuple[dict, np.ndarray | None]:
+                      progress, data: PreparedData) -> tuple[dict, np.ndarray | None]:
     """Every estimator's estimate by label (least squares' the reference's own), and the box the box searches drew
-    from (:func:`search_box`; None where no estimator needs one)."""
+    from (:func:`search_box`; None where no estimator needs one). An estimator that finds nothing refuses, naming the
+    torque columns of ``data`` that are the joints' velocities or positions (:func:`_named_states`)."""
     sol = reference.solution_
     box = search_box(sol.params, sol.params_std) if estimation.needs_box else None
     report = None if progress is None else (lambda key, i, f: progress(f"estimators: {estimator_label(key)}", 0 if i is None else i, 0))
-    fitted = estimation.fit(box, rng=int(rng), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
+    try:
+        fitted = estimation.fit(box, rng=int(rng), joint_weights=row_weights, progress=report)  # (seed, estimator's index)
+    except DynIdError as exc:
+        raise _named_states(exc, data) from None
     estimates = {estimate_label(key): _estimate(key, fitted.get(key), reference if key == ls_key else None)
                  for key in (*keys, *(() if ls_key in keys else (ls_key,)))}
     return estimates, box
+
+
+def _named_states(exc: DynIdError, data: PreparedData) -> DynIdError:
+    """An estimator's refusal (a plain :class:`DynIdError`: no parameters for these torques) with the torque columns of
+    ``data`` that equal a joint's velocity or position named (:func:`dynid.validation.diagnostics.state_columns`);
+    ``exc`` itself where none does."""
+    named = state_columns(data.q, data.dq, data.tau, range(data.tau.shape[1])) if type(exc) is DynIdError else []
+    if not named:
+        return exc
+    return DynIdError(f"{data.name}: no estimate for these torques ({str(exc).split(':')[0]} found none), and "
+                      f"{', '.join(named)}: its torques (or currents) columns read another signal; check them in the "
+                      "config")
 
 
 def _log_warnings(robot: Robot, data: PreparedData, estimates: dict, reference, references, *,

@@ -282,13 +282,7 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     judged = [j for j in range(rho.size) if varies[j] and np.isfinite(rho[j])]
     if not judged:
         return []
-    named = []
-    for j in judged:
-        torque = _centred(tau[:, j])  # each column read once (a long log's are stored), none stacked with another
-        for signal, states in (("velocity", dq), ("position", q)):
-            if _correlation(_centred(states[:, j]), torque) >= LIKE_A_STATE:
-                named.append(f"J{j + 1}'s is its {signal}")
-                break
+    named = state_columns(q, dq, tau, judged)
     if len(named) == len(judged):  # each joint's column a state: not torques, whatever shape gravity gives them
         return [Finding("columns", f"{dataset}: every joint's measured torque equals one of its states "
                                    f"({', '.join(named)}): these columns are not read as the robot's torques; check "
@@ -395,6 +389,31 @@ def spiky_joints(tau, joints) -> list[tuple[int, float]]:
         if variance > 0 and energy / 6 >= SPIKE_SHARE * variance and energy >= (SPIKES * spread) ** 2:
             out.append((j, float(np.max(np.abs(np.diff(x)))) / float(np.sqrt(np.mean(x**2)))))
     return out
+
+
+def state_columns(q, dq, tau, joints) -> list[str]:
+    """The joints among ``joints`` whose torque column equals its velocity or position (:data:`LIKE_A_STATE`).
+
+    Parameters
+    ----------
+    q, dq, tau : (N, n_dof) arrays
+        Positions [rad], velocities [rad/s] and torques [N·m] of a log (stored columns are read one at a time).
+    joints : iterable of int
+        The joints to look at (0-based).
+
+    Returns
+    -------
+    list of str
+        ``"J1's is its velocity"`` for each such joint, in the order of ``joints``.
+    """
+    named = []
+    for j in joints:
+        torque = _centred(tau[:, j])  # each column read once (a long log's are stored), none stacked with another
+        for signal, states in (("velocity", dq), ("position", q)):
+            if _correlation(_centred(states[:, j]), torque) >= LIKE_A_STATE:
+                named.append(f"J{j + 1}'s is its {signal}")
+                break
+    return named
 
 
 def _centred(column) -> np.ndarray:
