@@ -182,13 +182,14 @@ def test_a_one_log_user_whose_torques_are_a_unit_off_hears_why_when_the_sdp_fail
     assert readiness(result).text.startswith("not ready: the measured torques are far from the description's size")
 
 
-@pytest.mark.parametrize("share", [1.5, 0.4])
+@pytest.mark.parametrize("share", [3.0, 1.5, 0.4])
 def test_torques_that_no_fit_follows_beyond_their_noise_are_not_ready(share):
     """A simulated UR10e log with a 1.7 Hz oscillation added to every joint's torque (a controller oscillating), its
     RMS ``share`` × the joint's: no rigid-body model follows it, so the best fit misses about share/√(1 + share²) of
     the torque (83 % at 1.5×; 37 % at 0.4×). Beyond half of it (the real logs leave at most 16 %), the log is not ready
-    and the finding names the figure; at 0.4× it is not said. (From 2× the torques follow the nominal model below the
-    misread check's 0.5, and that finding speaks first.)"""
+    and the finding names the figure; at 0.4× it is not said. From 2× the torques follow the nominal model below the
+    misread check's 0.5 too: that finding spoke first and said the columns "are not read as the robot's torques",
+    wrong for this log, read right; it now says both causes, and the first line too."""
     import dynid
     from dynid.report.summaries import readiness
     from dynid.validation.diagnostics import UNEXPLAINED
@@ -202,13 +203,23 @@ def test_torques_that_no_fit_follows_beyond_their_noise_are_not_ready(share):
     best = min(m["global_relative_error"] for m in result.fit.metrics().values())
     expected = 100.0 * share / np.sqrt(1.0 + share**2)
     found = [f.text for f in result.findings if f.kind == "unexplained"]
-    if share > 1:
+    columns = [f.text for f in result.findings if f.kind == "columns"]
+    first = readiness(result, library=True).text
+    if share > 2:
         assert UNEXPLAINED < best <= expected * 1.02
         [text] = found
         assert f"misses {best:.3g} % of its torque over all joints" in text
-        assert readiness(result, library=True).text.startswith("not ready: the best fit to this log misses most")
+        [said] = columns
+        assert "not read as the robot's torques" not in said
+        assert "no fit follows them either" in said and "oscillating" in said
+        assert first.startswith("not ready: the torque columns do not follow") and "oscillating" in first
+    elif share > 1:
+        assert UNEXPLAINED < best <= expected * 1.02 and columns == []
+        [text] = found
+        assert f"misses {best:.3g} % of its torque over all joints" in text
+        assert first.startswith("not ready: the best fit to this log misses most")
     else:
-        assert best < UNEXPLAINED and found == []
+        assert best < UNEXPLAINED and found == [] and columns == []
         assert not readiness(result, library=True).text.startswith("not ready: the best fit")
 
 

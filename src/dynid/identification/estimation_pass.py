@@ -384,10 +384,11 @@ FRICTION_TERMS = ("fc", "fv", "offset", "fst", "fca", "fcl")
 """Drive terms that are friction (not the rotor inertia, not a counterbalance): the sign check looks beyond them."""
 
 
-def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
+def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict, *, unfitted: bool) -> list:
     """The torques against the description's nominal model (``scoring.nominal``): a flipped sign and a scale (unit or
     gain) (:mod:`dynid.validation.diagnostics`), a log whose geometry does not match the robot file's
-    (:mod:`dynid.validation.geometry_checks`); their statistics go into ``stats``."""
+    (:mod:`dynid.validation.geometry_checks`); their statistics go into ``stats`` (``unfitted``: no fit follows the
+    torques either)."""
     nominal, sums, data = scoring.nominal, scoring.sums, scoring.data
     assert nominal is not None  # called only where the description has a nominal model
     corr = sums.comparison(data.name, {"nominal": nominal}).metrics()["nominal"]["correlation"]
@@ -416,7 +417,7 @@ def _nominal_checks(base, scoring: BlockScoring, fit, stats: dict) -> list:
                                          > SCALE_MISFIT * np.asarray(floor["rmse"]))
     def unlike(rho):
         return unlike_nominal_findings(np.where(np.isfinite(rho), rho, corr), varies, data.name, q=data.q, dq=data.dq,
-                                       tau=data.tau, explained=bool(geometry))
+                                       tau=data.tau, explained=bool(geometry), unfitted=unfitted)
 
     said = unlike(beyond)
     geared = None if not said else beyond_hysteresis(
@@ -457,9 +458,10 @@ def _verdict(robot, base, sol, ols_params, row_weights, *, scoring: BlockScoring
     sums, residuals, blocks, data = scoring.sums, scoring.residuals, scoring.blocks, scoring.data
     findings: list = []
     stats: dict = {}
+    unexplained = unexplained_finding(fit, data.name)
     if scoring.nominal is not None:  # the description's nominal model: does the data run against it?
-        findings += _nominal_checks(base, scoring, fit, stats)
-    findings += unexplained_finding(fit, data.name)
+        findings += _nominal_checks(base, scoring, fit, stats, unfitted=bool(unexplained))
+    findings += unexplained
     fc = np.array([sol.params[base.names.index(f"fc{j + 1}")] if f"fc{j + 1}" in base.names else 0.0 for j in range(n)])
     more, res_stats = residuals.residual_checks(ols_params, rms, fc, prismatic=robot.prismatic)
     findings += more

@@ -407,6 +407,10 @@ def readiness(result, *, library: bool = False) -> Line:
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
                     "verdict at the end names it and the setting that fixes it", "warning")
+    if "columns" in kinds and "unexplained" in kinds:
+        return Line("not ready: the torque columns do not follow the robot file's model on any joint and no fit follows "
+                    "them (another signal read as torques, or torques that no model of the arm follows: a controller "
+                    "or a simulation oscillating?): the verdict at the end says what they look like", "warning")
     if "columns" in kinds:
         return Line("not ready: the torque columns do not follow the robot file's model on any joint (velocities, "
                     "positions or another signal read as torques?): the verdict at the end says what they look like",

@@ -244,7 +244,7 @@ LIKE_A_STATE = 0.995
 
 def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, *, q: np.ndarray,
                             dq: np.ndarray, tau: np.ndarray, table: str = "[identification]",
-                            explained: bool = False) -> list[Finding]:
+                            explained: bool = False, unfitted: bool = False) -> list[Finding]:
     """Torques that are not torques: the measured torque follows the description's nominal model on no joint that
     varies (:data:`UNLIKE_NOMINAL`), so no scale, sign or order of the columns can be judged and a fit of another
     signal (a log's velocities read as torques fit to 0.0007 % by the viscous terms) would look perfect; or every
@@ -266,6 +266,10 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
     explained : bool
         Another check explains why the torques do not follow the nominal model (the log's geometry: gravity along
         another axis, a joint's zero): only columns that equal a state are then said.
+    unfitted : bool
+        No fit follows the torques either (:func:`unexplained_finding`): torques read right that no model of the arm
+        follows (a controller or a simulation oscillating) look the same, so both causes are said unless a column is
+        named as a state.
 
     Returns
     -------
@@ -300,10 +304,13 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
                                   "torque channel, which no model of the arm follows; look at these columns of "
                                   f"{table} (a plot of the log) and log a motion without them before identifying")]
     which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
+    said = ("these columns are not read as the robot's torques" if named or not unfitted else
+            "and no fit follows them either: these columns read another signal, or torques that no model of the arm "
+            "follows (a controller or a simulation oscillating, a resonance)")
     return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
                                f"largest correlation with them {best:.2f}, where the real logs' reach 0.68-1.0){which}: "
-                               "these columns are not read as the robot's torques; check the torques (or currents) "
-                               f"columns of {table} and the robot file before trusting any fit of them")]
+                               f"{said}; check the torques (or currents) columns of {table}, a plot of the log and the "
+                               "robot file before trusting any fit of them")]
 
 
 SPIKES = 10.0
