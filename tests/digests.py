@@ -48,22 +48,26 @@ UNDEFINED = "correlation"
 false in results.json) is noise against noise: the last digits of a rest detection change it (measured: -0.0070
 against -0.0112 on the UR10e's resting log p2 between two machines), and it is not compared."""
 
-OPTIMISED = ("/design/", "/trajectory/")
+OPTIMISED = ("/design/", "/trajectory/", "/set_points/", "/cell_clearance", "/self_clearance/")
 """An excitation design is a local optimum of a non-convex problem, reached from several starts (the UR10e's initial
 trajectory is itself searched for): on another CPU the last digits of one step send a start to another optimum
 (measured: cond 20.73 against 21.33 for excite-er16, the UR10e's initial cond 1246.4 against 1247.4; excite-ur10e's
 design cond 85.00 where the digests were made, 90.96 on an AVX-512 machine on 2026-11-27, 7.0 % apart, with the same
-code). Its leaves are compared on the criterion alone (:data:`DESIGN_CHECKED`, within :data:`DESIGN_RTOL`: another
+code; the set-points and clearances of such another optimum: excite-er16-6dof's closest approach to the cell 0.0295
+against 0.0625 m between an Intel's AVX-512 kernels and an AMD's Haswell ones on 2026-12-02). Its leaves are compared
+on the criterion alone (:data:`DESIGN_CHECKED`, within :data:`DESIGN_RTOL`: another
 optimum, not another quality of design); limits, settings and names as every other value."""
 DESIGN_CHECKED = ("/design/cond", "/design/initial_cond", "/design/feasible")
 DESIGN_RTOL = 0.15
 
-SCALED = "/estimates/"
+SCALED = ("/estimates/", "/diagnostics/file_terms/")
 """An SDP estimate's values (:data:`SOLVER_PATHS` under this prefix) are compared to :data:`SOLVER_RTOL` of the
 largest magnitude among the estimate's values besides their own: an optimum holds its values to the solver's
 tolerance on the problem's scale, not each to itself. A friction at its bound of 0 (the LBR Med7's SDP: fv1 = 2.0e-9 on
 one CPU, 3.7e-10 on another) or a weakly determined inertia (its XX1, 0.07189 against 0.07186) moves by more than its
-own 1e-4 (measured between a Zen 3, AVX2 kernels, where the digests were made, and a Zen 4, AVX-512 kernels)."""
+own 1e-4 (measured between a Zen 3, AVX2 kernels, where the digests were made, and a Zen 4, AVX-512 kernels). The
+friction pair folded from an SDP estimate (``diagnostics.file_terms``) alike: the Med7's fv2 at its bound, 5.1e-8
+where the digests were made, 3.3e-7 on an AMD EPYC's Haswell kernels (2026-12-02)."""
 
 STATISTICS = "/diagnostics/"
 STATISTICS_RTOL = 1e-4

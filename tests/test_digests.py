@@ -44,8 +44,10 @@ def test_the_comparison_sees_a_changed_value_and_a_missing_key():
 
 def test_a_design_is_compared_on_its_criterion_and_the_rest_exactly():
     stored = {"/design/cond": 20.0, "/design/nit": 311, "/design/initial_cond": 63.86, "/trajectory/a[0][0]": 0.58,
-              "/limits/q_max[0]": 2.96}
-    moved = {**stored, "/design/nit": 250, "/trajectory/a[0][0]": -0.2, "/design/cond": 20.5}  # another optimum
+              "/limits/q_max[0]": 2.96, "/set_points/first[0]": 0.5, "/cell_clearance[0]/margin": 0.03,
+              "/self_clearance/time": 1.0}
+    moved = {**stored, "/design/nit": 250, "/trajectory/a[0][0]": -0.2, "/design/cond": 20.5,  # another optimum
+             "/set_points/first[0]": -0.9, "/cell_clearance[0]/margin": 0.06, "/self_clearance/time": 9.8}
     assert digests.differences(stored, moved) == []
     assert digests.differences(stored, {**moved, "/design/cond": 25.0}) == ["/design/cond: 20.0 -> 25.0"]
     assert digests.differences(stored, {**moved, "/design/initial_cond": 80.0}) == ["/design/initial_cond: 63.86 -> 80.0"]

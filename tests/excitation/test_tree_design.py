@@ -90,7 +90,9 @@ def test_dynid_excite_designs_both_arms_at_once_and_holds_every_constraint(two_a
     apart = [m for m in design["margins"] if m["constraint"] == "self clearance [m]"]
     assert len(apart) == 1 and apart[0]["margin"] >= 0, apart
     said_apart = json.loads((tmp_path / "out" / "excitation.json").read_text())["self_clearance"]["distance"]
-    assert abs(apart[0]["worst"] - said_apart) < 1e-6  # one figure: the 0.04 m capsules the design keeps apart
+    # one figure, the 0.04 m capsules the design keeps apart, as minima over two samplings of the motion (the design's
+    # 10x finer check, the set-points): 4e-6 m apart on one CPU's optimum, printed to the millimetre
+    assert abs(apart[0]["worst"] - said_apart) < 1e-4
     said = " ".join(p.stdout.split())
     assert "joints 1-7" in said, said
     boxed = {m["where"] for m in design["margins"] if m["constraint"] == "workspace [m]"}

@@ -23,6 +23,8 @@ import itertools
 
 import numpy as np
 
+from .._util.ties import first_least
+
 __all__ = ["FOLDED_TERMS", "file_candidates", "file_terms", "folded_parameters", "variant_label"]
 
 FOLDED_TERMS = ("fst", "fcl")
@@ -169,7 +171,7 @@ def file_terms(robot, folded: np.ndarray | None, labels, scored: tuple) -> dict:
     labels = list(labels)
     errors = np.array([np.mean([np.asarray(c.metrics()[k]["relative_error"], dtype=float) for c in scored], axis=0)
                        for k in labels])
-    best = np.argmin(errors, axis=0)  # the first of equals: as identified, offset left out
+    best = first_least(errors, axis=0)  # the first of equals: as identified, offset left out
     out = {"folded": ["friction folded" in labels[b] for b in best],
            "offset": ["offset held" in labels[b] for b in best],
            "errors": {k: [float(x) for x in e] for k, e in zip(labels, errors)},

@@ -31,6 +31,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .._util.ties import first_least
 from ..dynamics.regressor import nominal_rigid_torque
 from ..friction import COUNTERBALANCE_TERMS
 from ..model.robot import Robot
@@ -347,7 +348,7 @@ def geometry_findings(robot: Robot, q, dq, ddq, tau, dataset: str, *, fitted: bo
     # one change, unless two joints changed leave clearly less
     single = (np.count_nonzero(shifts, axis=1) + np.count_nonzero(orders != np.arange(robot.n_dof), axis=1)
               + np.count_nonzero(ways < 0, axis=1) + np.any(gravities != np.asarray(robot.gravity, dtype=float), axis=1)) == 1
-    one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))
+    one, two = (int(np.flatnonzero(m)[np.argmin(scores[m])]) for m in (single, ~single))  # ties: _tie_break
     pick, twin = _tie_break(robot, log, changes, scores, logged, two if scores[two] < SIMPLER * scores[one] else one,
                             single=single)
     stats.update(shift=shifts[pick].tolist(), order=orders[pick].tolist(), gravity=gravities[pick].tolist(),
@@ -473,9 +474,10 @@ def _tie_break(robot: Robot, log: tuple, changes: tuple, scores: np.ndarray, log
     signed = _scored(robot, log, changes, twins, signed=True)
     reversal = np.any(changes[3][twins] < 0, axis=1)
     tied = [k for k in range(len(twins)) if signed[k] <= TWIN * signed.min() + 1e-12]
-    best = min(tied, key=lambda k: (bool(reversal[k]), float(signed[k])))  # a turn before a reversal as good
+    turns = [k for k in tied if not reversal[k]] or tied  # a turn before a reversal as good
+    best = turns[first_least(signed[turns])]  # of equals the first (a vertical axis turned by any angle), not the CPU's
     other = [k for k in tied if reversal[k] != reversal[best]]
-    return int(twins[best]), (int(twins[min(other, key=lambda k: float(signed[k]))]) if other else None)
+    return int(twins[best]), (int(twins[other[first_least(signed[other])]]) if other else None)
 
 
 def _text_of(robot: Robot, log: tuple, changes: tuple, k: int) -> tuple[str, tuple, int | None]:
