@@ -25,7 +25,7 @@ from ..identification.identifier import Identifier
 from ..identification.result import BOX_FRACTION, BOX_SIGMAS, IdentificationResult
 from ..identification.verdict import NOMINAL_KEY, held_out_best
 from ..tables import Line, TextTable, render_text
-from ..validation.diagnostics import nominal_gate
+from ..validation.diagnostics import UNFITTED, nominal_gate
 from ..validation.noise_floor import AT_FLOOR
 from ..validation.torques import TorqueComparison, rests_throughout
 from .choice_tables import coulomb_choice_table, drive_gains_blocks, filter_choice_table, friction_choice_table
@@ -407,7 +407,7 @@ def readiness(result, *, library: bool = False) -> Line:
     if "sign" in kinds:
         return Line("not ready: the measured torques run against the model on some joint (a flipped sign?): the "
                     "verdict at the end names it and the setting that fixes it", "warning")
-    if "columns" in kinds and "unexplained" in kinds:
+    if any(f.kind == "columns" and UNFITTED in f.text for f in r.findings):
         return Line("not ready: the torque columns do not follow the robot file's model on any joint and no fit follows "
                     "them (another signal read as torques, or torques that no model of the arm follows: a controller "
                     "or a simulation oscillating?): the verdict at the end says what they look like", "warning")

@@ -242,6 +242,11 @@ LIKE_A_STATE = 0.995
 """A torque column whose correlation with its joint's velocity or position reaches this is said to be that signal."""
 
 
+UNFITTED = "and no fit follows them either"
+"""What a "columns" finding says where no fit follows the torques either and no column is named (:func:`unlike_nominal_findings`):
+both causes, the first line too (:func:`dynid.report.summaries.readiness`)."""
+
+
 def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset: str, *, q: np.ndarray,
                             dq: np.ndarray, tau: np.ndarray, table: str = "[identification]",
                             explained: bool = False, unfitted: bool = False) -> list[Finding]:
@@ -305,8 +310,8 @@ def unlike_nominal_findings(correlation: np.ndarray, varies: np.ndarray, dataset
                                   f"{table} (a plot of the log) and log a motion without them before identifying")]
     which = f" ({', '.join(named)}: a column taken for another?)" if named else ""
     said = ("these columns are not read as the robot's torques" if named or not unfitted else
-            "and no fit follows them either: these columns read another signal, or torques that no model of the arm "
-            "follows (a controller or a simulation oscillating, a resonance)")
+            f"{UNFITTED}: these columns read another signal, or torques that no model of the arm follows (a controller "
+            "or a simulation oscillating, a resonance)")
     return [Finding("columns", f"{dataset}: the measured torques follow the description's nominal model on no joint (its "
                                f"largest correlation with them {best:.2f}, where the real logs' reach 0.68-1.0){which}: "
                                f"{said}; check the torques (or currents) columns of {table}, a plot of the log and the "
