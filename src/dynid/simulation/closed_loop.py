@@ -36,6 +36,7 @@ from ..dynamics.regressor import friction_torques
 from ..dynamics.rnea import pinocchio_model
 from ..exceptions import ConfigError, ShapeError
 from ..model.robot import Robot
+from . import _step_kernel as kernel
 from ._step_kernel import compiled
 
 __all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "ClosedLoopSetup", "JointDynamics", "simulate_closed_loop"]
@@ -448,55 +449,52 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
 
 def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
     """:func:`simulate_closed_loop`'s loop over the control instants (the arithmetic between two calls of the direct
-    dynamics in :mod:`dynid.simulation._step_kernel`, in place)."""
-    control, stage, first_input, advance = compiled()
+    dynamics in :mod:`dynid.simulation._step_kernel`, in place in its work array)."""
+    control, stage, advance = compiled()
     n = q_ref.shape[1]
     h = 1.0 / controller.rate
-    kp, kd, ki = controller.kp, controller.kd, controller.ki
     # first-order low-pass of the differenced positions (backward Euler): v ← v + α (raw − v)
     alpha = 1.0 if controller.velocity_cutoff == 0 else 1.0 - np.exp(-2 * np.pi * controller.velocity_cutoff * h)
-    position_noise = noise.position_std > 0 or noise.encoder_resolution > 0
-    q_true, dq_true, ddq_true, tau_applied, q_meas = (np.empty((t.size, n)) for _ in range(5))
-    q, dq = q_ref[0].copy(), dq_ref[0].copy()
-    integral, previous, velocity = np.zeros(n), np.zeros(n), dq_ref[0].copy()
-    tau, u, qs, v2, v3, v4 = (np.empty(n) for _ in range(6))
+    w = np.zeros((kernel.ROWS, n))
+    w[kernel.Q], w[kernel.DQ], w[kernel.VELOCITY] = q_ref[0], dq_ref[0], dq_ref[0]
+    w[kernel.KP], w[kernel.KD], w[kernel.KI] = controller.kp, controller.kd, controller.ki
+    followers = dynamics.followers
+    w[kernel.DRIVEN] = 1.0
+    w[kernel.DRIVEN, followers] = 0.0  # a <mimic> joint has no drive: its master moves it
     drive = dynamics.simple_drive_terms()
     if drive is not None:  # the drive terms in the stages, the rigid body by Pinocchio's ABA
-        fc, fv, offset = drive
+        w[kernel.FC], w[kernel.FV], w[kernel.OFFSET] = drive
         aba, model, data = dynamics._pin.aba, dynamics.model, dynamics.data
 
         def accelerations(x, v, tau, u):
             return aba(model, data, x, v, u)
-    else:  # coupled motors, smoothed Coulomb friction, other drive terms: the dynamics' own
-        fc = fv = offset = np.zeros(n)
+    else:  # coupled motors, smoothed Coulomb friction, other drive terms: the dynamics' own (the stages' terms 0)
 
         def accelerations(x, v, tau, u):
             return dynamics.accelerations(x, v, tau)
     # the encoder's noise drawn at once: the same numbers as one draw per instant (a Generator's stream)
     draws = rng.normal(0.0, noise.position_std, (t.size, n)) if noise.position_std > 0 else None
-    followers = dynamics.followers
+    reading = (kernel.READING_GIVEN if noise.encoder_resolution > 0 else kernel.READING_NOISY if draws is not None
+               else kernel.READING_ITSELF)
+    refs, out = np.stack([q_ref, dq_ref, ff]), np.empty((5, t.size, n))
+    q, dq, tau, u, qs, v2, v3, v4 = (w[r] for r in (kernel.Q, kernel.DQ, kernel.TAU, kernel.U, kernel.QS, kernel.V2,
+                                                    kernel.V3, kernel.V4))
     for k in range(t.size):
-        y = noise.measured_positions(q, rng, None if draws is None else draws[k]) if position_noise else q.copy()
-        control(y, previous, k == 0, velocity, alpha, h, q_ref[k], dq_ref[k], ff[k], kp, kd, ki, integral, tau)
-        if followers:
-            tau[followers] = 0.0  # a <mimic> joint has no drive: its master moves it
-        first_input(dq, tau, fc, fv, offset, u)
-        a1 = accelerations(q, dq, tau, u)
-        q_true[k], dq_true[k], ddq_true[k], tau_applied[k], q_meas[k] = q, dq, a1, tau, y
-        previous = y
+        if reading == kernel.READING_GIVEN:
+            w[kernel.Y] = noise.measured_positions(q, rng, None if draws is None else draws[k])
+        control(k, w, refs, draws if draws is not None else refs[0], reading, alpha, h)
         # classic Runge-Kutta on (q, q̇) with the torque held
-        stage(q, dq, dq, a1, 0.5 * h, tau, fc, fv, offset, qs, v2, u)
-        a2 = accelerations(qs, v2, tau, u)
-        stage(q, v2, dq, a2, 0.5 * h, tau, fc, fv, offset, qs, v3, u)
-        a3 = accelerations(qs, v3, tau, u)
-        stage(q, v3, dq, a3, h, tau, fc, fv, offset, qs, v4, u)
-        a4 = accelerations(qs, v4, tau, u)
-        advance(q, dq, v2, v3, v4, a1, a2, a3, a4, h)
+        stage(k, w, accelerations(q, dq, tau, u), 0, 0.5 * h, out)
+        stage(k, w, accelerations(qs, v2, tau, u), 1, 0.5 * h, out)
+        stage(k, w, accelerations(qs, v3, tau, u), 2, h, out)
+        finite = advance(w, accelerations(qs, v4, tau, u), h)
         if followers:  # on its coupling to the last bit, not to the integrator's rounding
             q[:], dq[:] = dynamics.robot.coupled(q, dq)[:2]
-        if not math.isfinite(q.dot(q) + dq.dot(dq)):  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
+            finite = math.isfinite(q.dot(q) + dq.dot(dq))
+        if not finite:  # a NaN or an infinity anywhere (or a state beyond 1e154) makes it one
             raise ConfigError(f"closed-loop simulation diverged at t = {t[k]:.3f} s: gains too high for the control rate, "
                               "or a model that cannot be simulated")
+    q_true, dq_true, ddq_true, tau_applied, q_meas = out
     tau_log = tau_applied + rng.normal(0.0, noise.torque_std, tau_applied.shape) if noise.torque_std > 0 else tau_applied.copy()
     return ClosedLoopRun(t, q_meas, tau_log, q_true, dq_true, ddq_true, tau_applied, q_ref, dq_ref)
 
