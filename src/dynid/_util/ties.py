@@ -1,7 +1,6 @@
 """Choices among equal scores made the same on every CPU: NumPy's OpenBLAS picks its kernels by the CPU, which moves a
-score's last digits, so an ``argmin`` among scores that are equal but for those digits chose by the CPU (the UR10e's J6
-written with its friction folded on one machine and as identified on another, their errors 6.145141338464319 and
-6.145141338464329 %)."""
+score's last digits, so an ``argmin`` among scores that are equal but for those digits would choose by the CPU
+(benchmarks/NOTEBOOK.md, stop 119)."""
 
 from __future__ import annotations
 

@@ -22,8 +22,7 @@ CRITERIA = ("cond", "d-optimal")
 RESOLVED = 1e-10
 """The smallest eigenvalue of ``W^T W`` that it resolves, as a share of its largest: ``eigh`` holds each eigenvalue to
 about 1e-16 of the largest, so one at 1e-10 of it to about 1e-6 of itself; below (cond W above 1e5), ``W``'s own
-singular values. The bound was 1e-24, below that rounding: at cond 1e13 the eigenvalue was rounding's, whatever its
-sign, and one CPU's kernels gave it 2e-17 of the largest, a log cond of 19.2 where the truth is 29.9."""
+singular values."""
 
 
 def log_condition_number(w: np.ndarray) -> tuple[float, np.ndarray]:

@@ -5,7 +5,7 @@ at the control rate; at 1 kHz each step is a few dozen operations on arrays of `
 call at a time. These kernels do them in place, element by element, in the same order as the NumPy expressions they
 replace (no fast-math): the simulated runs are the same to the last bit. The loop's state lives in one work array of
 :data:`ROWS` rows of ``n_dof`` values (the row constants below), so that each call hands numba a few arguments: its
-dispatch, about 0.1 µs an argument, was half of a step's time with the state in fourteen arrays.
+dispatch grows with them (benchmarks/NOTEBOOK.md, stop 119).
 """
 
 from __future__ import annotations

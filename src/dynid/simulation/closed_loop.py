@@ -37,7 +37,6 @@ from ..dynamics.rnea import pinocchio_model
 from ..exceptions import ConfigError, ShapeError
 from ..model.robot import Robot
 from . import _step_kernel as kernel
-from ._step_kernel import compiled
 
 __all__ = ["Controller", "ClosedLoopNoise", "ClosedLoopRun", "ClosedLoopSetup", "JointDynamics", "simulate_closed_loop"]
 
@@ -450,7 +449,7 @@ def simulate_closed_loop(robot: Robot, t, q_ref, dq_ref, controller: Controller,
 def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDynamics, noise: ClosedLoopNoise, rng):
     """:func:`simulate_closed_loop`'s loop over the control instants (the arithmetic between two calls of the direct
     dynamics in :mod:`dynid.simulation._step_kernel`, in place in its work array)."""
-    control, stage, advance = compiled()
+    control, stage, advance = kernel.compiled()
     n = q_ref.shape[1]
     h = 1.0 / controller.rate
     # first-order low-pass of the differenced positions (backward Euler): v ← v + α (raw − v)
@@ -477,12 +476,13 @@ def _run_loop(t, q_ref, dq_ref, ff, *, controller: Controller, dynamics: JointDy
     reading = (kernel.READING_GIVEN if noise.encoder_resolution > 0 else kernel.READING_NOISY if draws is not None
                else kernel.READING_ITSELF)
     refs, out = np.stack([q_ref, dq_ref, ff]), np.empty((5, t.size, n))
+    noise_rows = draws if draws is not None else refs[0]  # read by the kernel only for READING_NOISY
     q, dq, tau, u, qs, v2, v3, v4 = (w[r] for r in (kernel.Q, kernel.DQ, kernel.TAU, kernel.U, kernel.QS, kernel.V2,
                                                     kernel.V3, kernel.V4))
     for k in range(t.size):
         if reading == kernel.READING_GIVEN:
             w[kernel.Y] = noise.measured_positions(q, rng, None if draws is None else draws[k])
-        control(k, w, refs, draws if draws is not None else refs[0], reading, alpha, h)
+        control(k, w, refs, noise_rows, reading, alpha, h)
         # classic Runge-Kutta on (q, q̇) with the torque held
         stage(k, w, accelerations(q, dq, tau, u), 0, 0.5 * h, out)
         stage(k, w, accelerations(qs, v2, tau, u), 1, 0.5 * h, out)
