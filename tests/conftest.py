@@ -1,4 +1,5 @@
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,6 +32,40 @@ TEST_URDF = """<?xml version="1.0"?>
 """
 
 
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def shipped_identification():
+    """``shipped_identification(name, validate=True)``: :func:`dynid.run_identification` of ``configs/<name>.toml`` on
+    its real data (``shared/data``), run once for the whole test run (once per test worker) and read by every test that
+    checks that identification, with one BLAS thread as the stored digests are computed. Each call gives a deep copy, so
+    that no test sees another's changes; skipped, with the reason, where the data are absent."""
+    import copy
+
+    from threadpoolctl import threadpool_limits
+
+    from dynid.identification.run import run_identification
+    from dynid.io.config.identification_config import load_identification_config
+
+    from .digests import data_root
+
+    done: dict = {}
+
+    def identified(name: str, *, validate: bool = True):
+        if (name, validate) not in done:
+            path = REPO / "configs" / f"{name}.toml"
+            root = data_root(path)
+            if root is None:
+                pytest.skip(f"data of {path.name} not found (set DYNID_SHARED_DATA to the shared/data folder)")
+            with threadpool_limits(1):
+                done[name, validate] = run_identification(load_identification_config(path, data_root=root),
+                                                          validate=validate)
+        return copy.deepcopy(done[name, validate])
+
+    return identified
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
@@ -53,7 +88,6 @@ def shared_data(name: str):
     These data sets are not part of the repository (the UR10e one has no license). The CI machine has
     them; elsewhere the tests that need them are skipped, with the reason.
     """
-    from pathlib import Path
 
     roots = [os.environ.get("DYNID_SHARED_DATA"), Path(__file__).resolve().parents[2] / "shared" / "data", "/work/shared/data"]
     for root in roots:

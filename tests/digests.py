@@ -111,7 +111,7 @@ def compute(case: str) -> dict:
         root = data_root(path)
         if root is None:
             raise FileNotFoundError(f"data of {path.name} not found")
-        return _clean(run_identification(load_identification_config(path, data_root=root)).to_dict())
+        return of_result(run_identification(load_identification_config(path, data_root=root)))
     if kind == "excite":
         from dynid.identification.excite import run_excitation
         from dynid.io.config.excitation_config import load_excitation_config
@@ -134,6 +134,13 @@ def compute(case: str) -> dict:
                 out[f"{level}/{r}"] = {"params": one["params"], "errors": one["errors"]}
         return _clean(out)
     raise ValueError(f"unknown case {case!r}")
+
+
+def of_result(result) -> dict:
+    """``results.json`` of an identification result as a plain dict (what the CLI writes)."""
+    from dynid.io.files import _clean
+
+    return _clean(result.to_dict())
 
 
 def _portable(text: str) -> str:

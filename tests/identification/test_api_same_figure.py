@@ -35,7 +35,7 @@ def test_a_given_decimation_keeps_the_clis_samples_and_relative_error_is_its_fig
                                cli["metrics"][label]["global_relative_error"], rtol=1e-12)
 
 
-def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path):
+def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path, shipped_identification):
     """A model's ``validate`` judges which joints' relative errors and correlations mean something against the
     identification's residual level, as ``dynid validate`` does: on the UR10e's static holds it showed ρ = 1.0000 and
     errors of 0.0 % for joints whose torque sits at the noise (``dynid validate``: n/m)."""
@@ -43,14 +43,14 @@ def test_a_models_validation_marks_the_joints_dynid_validate_marks(tmp_path):
 
     import dynid
     from dynid.identification.fitted_model import IdentifiedModel
-    from dynid.identification.run import run_identification, run_validation
+    from dynid.identification.run import run_validation
     from dynid.io.config.identification_config import load_identification_config
     from dynid.io.logs.datasets import load_recording
     from tests.conftest import shared_data
 
     repo = Path(__file__).resolve().parents[2]
     cfg = load_identification_config(repo / "configs" / "ur10e.toml", data_root=shared_data("ur10e_mamedov2020"))
-    result = run_identification(cfg, validate=False)
+    result = shipped_identification("ur10e", validate=False)
     held = [spec for spec in cfg.validation if spec.name == "p1"]
     model = IdentifiedModel.from_result(result)
     (cli,), _ = run_validation(cfg, model.results, datasets=tuple(held))

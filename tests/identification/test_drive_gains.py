@@ -47,19 +47,10 @@ def test_gains_and_payload_recovered_from_simulated_currents():
     np.testing.assert_allclose(pay.values[6:9], payload[6:9], atol=0.01 * np.abs(payload[6:9]).max())
 
 
-def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
+def test_ur10e_gains_from_the_loaded_and_unloaded_runs(shipped_identification):
     """The UR10e's runs 14harm50sec / 14harm50secLoad (2.805 kg): gains of joints 2-6 within 20 % of the
     authors' (which fix K1 = 10 and are uncertain by 10-20 %, SOURCE.md), the payload's mass within 10 %."""
-    from pathlib import Path
-
-    from dynid.identification.run import run_identification
-    from dynid.io.config.identification_config import load_identification_config
-
-    from ..conftest import shared_data
-
-    root = shared_data("ur10e_mamedov2020")
-    cfg = load_identification_config(Path(__file__).resolve().parents[2] / "configs" / "ur10e.toml", data_root=root)
-    result = run_identification(cfg, validate=False)
+    result = shipped_identification("ur10e", validate=False)
     gp = result.drive_gains
     authors = np.array([10.0, 10.6956, 8.4566, 9.0029, 9.4800, 10.1232])
     np.testing.assert_allclose(gp.description_gains, authors)
@@ -73,12 +64,15 @@ def test_ur10e_gains_from_the_loaded_and_unloaded_runs():
     assert gp.gains.to_dict()["not_observable"] == {"K1": why}
 
 
-def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed_after_it(monkeypatch, tmp_path):
+def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed_after_it(monkeypatch, tmp_path,
+                                                                                         shipped_identification):
     """run_identification computes the drive gains in a forked child while it identifies (two cores): the
-    same numbers as in this process, and the same identification."""
+    same numbers as in this process, and the same identification (both with one BLAS thread)."""
     import json
     import sys
     from pathlib import Path
+
+    from threadpoolctl import threadpool_limits
 
     from dynid.identification.run import run_identification
     from dynid.io import write_json
@@ -100,11 +94,11 @@ def test_ur10e_drive_gains_computed_beside_the_identification_are_those_computed
             forks.append(1)
 
     monkeypatch.setattr(processes.ForkedCall, "__init__", counted)
-    with allow_forks():  # as in the CLI
+    with allow_forks(), threadpool_limits(1):  # as in the CLI
         beside = run_identification(cfg, validate=False)
     assert len(forks) == (1 if cores() >= 2 and sys.platform.startswith("linux") else 0)  # the gains went to a child
     n_beside = len(forks)
-    after = run_identification(cfg, validate=False)  # the library alone computes them in its process
+    after = shipped_identification("ur10e", validate=False)  # the library alone computes them in its process
     assert len(forks) == n_beside
     for path, result in (("beside.json", beside), ("after.json", after)):
         write_json(tmp_path / path, without_wall_times(result.to_dict()))

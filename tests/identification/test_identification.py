@@ -83,14 +83,12 @@ friction = "description"
     assert result.fit.metrics()["dynid SDP"]["relative_error"].max() < 1.0
 
 
-def test_ur10e_real_logs_against_the_published_parameters():
+def test_ur10e_real_logs_against_the_published_parameters(shipped_identification):
     """UR10e (Mamedov & Mikhel 2020 logs), default preprocessing: the published parameters reproduce the
     validation torques at most with the errors measured independently on the unfiltered samples in the
     data's SOURCE.md (10, 5, 4, 11, 13, 55 %: the parallel filter removes noise, never adds error), and
     dynid's own estimate does as well on the same samples."""
-    root = shared_data("ur10e_mamedov2020")
-    cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
-    result = run_identification(cfg)
+    result = shipped_identification("ur10e")
     ptp = next(v for v in result.validations if v.name == "ptp_10_points")
     m = ptp.metrics()
     published = m["Mamedov & Mikhel 2020"]["plain_relative_error"]  # as the paper scored it: its prediction at rest too
@@ -109,13 +107,11 @@ def test_ur10e_real_logs_against_the_published_parameters():
     assert np.all(m["dynid SDP"]["relative_error"][:5] <= m["dynid OLS"]["relative_error"][:5] + 1.0)
 
 
-def test_tx40_real_logs_against_figaroh():
+def test_tx40_real_logs_against_figaroh(shipped_identification):
     """TX40 (FIGAROH recording), identified on the whole motion as FIGAROH did: every FIGAROH base
     parameter matches one of dynid's regroupings exactly, and dynid's values agree with FIGAROH's OLS
     values within 3 of its stated standard deviations."""
-    root = shared_data("staubli_tx40_figaroh")
-    cfg = load_identification_config(REPO / "configs" / "tx40-full.toml", data_root=root)
-    result = run_identification(cfg)
+    result = shipped_identification("tx40-full")
     figaroh = next(r for r in result.references if r.name == "FIGAROH OLS")
     assert not np.isnan(figaroh.relative_std).any()  # all 60 expressions matched (the config keeps FIGAROH's model)
     agreement = result.reference_agreement(figaroh)
@@ -124,12 +120,10 @@ def test_tx40_real_logs_against_figaroh():
     assert np.all(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"] + 1.0)
 
 
-def test_tx40_time_split_validation():
+def test_tx40_time_split_validation(shipped_identification):
     """Identified on 0.1-5.6 s, validated on 5.6-7.6 s: at most the error of FIGAROH's parameters (fitted on the
     whole motion, validation part included) on 4 of the 6 joints and over all of them, on the same samples."""
-    root = shared_data("staubli_tx40_figaroh")
-    cfg = load_identification_config(REPO / "configs" / "tx40.toml", data_root=root)
-    result = run_identification(cfg)
+    result = shipped_identification("tx40")
     (val,) = result.validations
     m = val.metrics()
     assert np.sum(m["dynid WLS"]["relative_error"] <= m["FIGAROH OLS"]["relative_error"]) >= 4
@@ -239,21 +233,24 @@ def test_a_joint_that_never_moves_is_named_and_keeps_the_descriptions_drive_term
     assert all(ours[j] < 2 * true[j] + 0.5 for j in (0, 1, 3, 4, 5)), (ours, true)
 
 
-def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch):
+def test_a_log_spooled_to_temporary_files_is_identified_as_in_memory(monkeypatch, shipped_identification):
     """A long log's signals are held in temporary files (dynid._util.column_store), read column by column and chunk
     by chunk: on the UR10e logs spooled that way, identification and validations give the results of the
-    in-memory path, every number of results.json."""
+    in-memory path, every number of results.json (both with one BLAS thread)."""
+    from threadpoolctl import threadpool_limits
+
     from dynid._util.column_store import StoredColumns
     from dynid.io.logs import datasets
 
     root = shared_data("ur10e_mamedov2020")
     cfg = load_identification_config(REPO / "configs" / "ur10e.toml", data_root=root)
-    memory = without_wall_times(run_identification(cfg).to_dict())
+    memory = without_wall_times(shipped_identification("ur10e").to_dict())
     read = []
     monkeypatch.setattr(datasets, "SPOOL_BYTES", 0)
     original = datasets._assemble
     monkeypatch.setattr(datasets, "_assemble", lambda *a, **k: read.append(original(*a, **k)) or read[-1])
-    spooled = without_wall_times(run_identification(cfg).to_dict())
+    with threadpool_limits(1):
+        spooled = without_wall_times(run_identification(cfg).to_dict())
     stored = {r.name for r in read if isinstance(r.q, StoredColumns) and isinstance(r.tau, StoredColumns)}
     assert stored == {"identification", *(v.name for v in cfg.validation)}  # the drive-gain runs stay in memory
     # the SDP margins to the solver's tolerance: a re-solve of cvxpy's cached problem moves them by ~1e-11

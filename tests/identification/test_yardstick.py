@@ -83,22 +83,15 @@ def test_the_verdict_weighs_the_yardstick_and_validate_scores_on_it(tmp_path, mo
         np.testing.assert_allclose(scored[label]["global_relative_error"], yard[label], rtol=1e-9)
 
 
-def test_logs_at_rest_throughout_do_not_dilute_the_yardstick_headline():
+def test_logs_at_rest_throughout_do_not_dilute_the_yardstick_headline(shipped_identification):
     """The UR10e's validation logs are one motion (ptp_10_points) and ten static holds, each scored as the distance to
     the static-friction band (0 for a set inside it). The mean over all eleven is about a tenth of the motion's
     error; the yardstick also gives the mean over the logs that move, and the terminal's line quotes that one, with
     how many rests each set keeps within the band."""
-    from pathlib import Path
-
-    from dynid.identification.run import run_identification
-    from dynid.io.config.identification_config import load_identification_config
     from dynid.report.summaries import in_short
     from dynid.validation.torques import rests_throughout
-    from tests.conftest import shared_data
 
-    repo = Path(__file__).resolve().parents[2]
-    cfg = load_identification_config(repo / "configs" / "ur10e.toml", data_root=shared_data("ur10e_mamedov2020"))
-    r = run_identification(cfg)
+    r = shipped_identification("ur10e")
     yard = r.diagnostics["yardstick"]
     moving = [v.name for v in r.validations if not rests_throughout(v.rest_share)]
     assert moving == ["ptp_10_points"] and len(r.validations) == 11
