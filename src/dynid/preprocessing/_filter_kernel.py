@@ -43,12 +43,13 @@ def _sections(sos, x, z0, z1, reverse):  # pragma: no cover - compiled
                 row[j] = xn
 
 
-def _extended(x, cols, padlen, ext):  # pragma: no cover - compiled
-    """``ext`` (n + 2·padlen, len(cols)) filled with the columns ``cols`` of ``x`` (n, ·) and their even extension at
-    both ends (SciPy's ``even_ext``: ``x[padlen:0:-1]``, ``x``, ``x[-2:-(padlen + 2):-1]``), in one pass."""
+def _extended(x, cols, left, right, ext):  # pragma: no cover - compiled
+    """``ext`` (left + n + right, len(cols)) filled with the columns ``cols`` of ``x`` (n, ·) and their even extension
+    at the start by ``left`` rows and at the end by ``right`` (SciPy's ``even_ext``: ``x[left:0:-1]``, ``x``,
+    ``x[-2:-(right + 2):-1]``), in one pass."""
     n = x.shape[0]
-    for i in range(n + 2 * padlen):
-        src = padlen - i if i < padlen else i - padlen if i < padlen + n else 2 * n + padlen - 2 - i
+    for i in range(left + n + right):
+        src = left - i if i < left else i - left if i < left + n else 2 * n + left - 2 - i
         row = x[src]
         out = ext[i]
         for j in range(cols.shape[0]):
@@ -91,7 +92,7 @@ def compiled():
     Returns
     -------
     tuple
-        ``(sections, extended, symmetric)``: ``sections(sos, x, z0, z1, reverse)``, ``extended(x, cols, padlen,
+        ``(sections, extended, symmetric)``: ``sections(sos, x, z0, z1, reverse)``, ``extended(x, cols, left, right,
         ext)``, ``symmetric(x, w, out, start, stop)``.
     """
     global sections, extended, symmetric, _kernels
@@ -162,8 +163,10 @@ def gaussian_nearest(x: np.ndarray, weights: np.ndarray, workers: int = 1) -> np
 
 
 def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols: np.ndarray | None = None,
-               rows: np.ndarray | None = None) -> np.ndarray:
-    """``scipy.signal.sosfiltfilt(sos, x[:, cols], axis=0, padtype="even", padlen=padlen)[rows]``, bit for bit.
+               rows: np.ndarray | None = None, *, carry: tuple | None = None) -> np.ndarray:
+    """``scipy.signal.sosfiltfilt(sos, x[:, cols], axis=0, padtype="even", padlen=padlen)[rows]``, bit for bit; with
+    ``carry``, a block of a longer signal whose forward pass goes on from the block before (as
+    :func:`dynid.preprocessing.filters.even_filtfilt`, the same numbers).
 
     Parameters
     ----------
@@ -179,6 +182,10 @@ def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols
         The columns of ``x`` to filter (default all), read in place (no gathered copy).
     rows : (r,) int array, optional
         The rows of the result to return (default all).
+    carry : tuple ``(state, split, state_out)``, optional
+        ``state`` (n_sections, 2, c): the forward pass's state at ``x``'s first row, which is then not padded (None:
+        padded and started as SciPy does); ``split``: a row of ``x`` whose forward state ``state_out`` (n_sections, 2,
+        c) receives (None: none).
 
     Returns
     -------
@@ -186,14 +193,24 @@ def zero_phase(sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, cols
         The filtered signals.
     """
     run, extend = compiled()[:2]
+    state, split, state_out = (None, None, None) if carry is None else carry
     x = np.ascontiguousarray(x, dtype=float)
     cols = np.arange(x.shape[1]) if cols is None else np.asarray(cols, dtype=np.int64)
-    ext = np.empty((x.shape[0] + 2 * padlen, cols.size))
-    extend(x, cols, padlen, ext)
+    left = padlen if state is None else 0
+    ext = np.empty((x.shape[0] + left + padlen, cols.size))
+    extend(x, cols, left, padlen, ext)
     sos = np.ascontiguousarray(sos, dtype=float)
     for reverse in (False, True):
         edge = ext[-1] if reverse else ext[0]  # the backward pass starts from the forward pass's last value
-        z0 = np.ascontiguousarray(zi[:, 0, None] * edge[None, :])
-        z1 = np.ascontiguousarray(zi[:, 1, None] * edge[None, :])
-        run(sos, ext, z0, z1, reverse)
-    return ext[padlen:ext.shape[0] - padlen] if rows is None else ext[padlen + np.asarray(rows)]
+        if reverse or state is None:
+            z0 = np.ascontiguousarray(zi[:, 0, None] * edge[None, :])
+            z1 = np.ascontiguousarray(zi[:, 1, None] * edge[None, :])
+        else:
+            z0, z1 = np.ascontiguousarray(state[:, 0]), np.ascontiguousarray(state[:, 1])
+        if reverse or split is None:
+            run(sos, ext, z0, z1, reverse)
+        else:  # forward to the split, its state kept, then on
+            run(sos, ext[:left + split], z0, z1, False)
+            state_out[:, 0], state_out[:, 1] = z0, z1
+            run(sos, ext[left + split:], z0, z1, False)
+    return ext[left:ext.shape[0] - padlen] if rows is None else ext[left + np.asarray(rows)]

@@ -63,11 +63,15 @@ def butterworth_filtfilt(x: np.ndarray, rate: float, cutoff: float, order: int =
     return by_column(x, lambda column, j: signal.sosfiltfilt(sos, column))
 
 
-def even_filtfilt(signal, sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray) -> np.ndarray:
+def even_filtfilt(signal, sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.ndarray, *,
+                  carry: tuple | None = None) -> np.ndarray:
     """``scipy.signal.sosfiltfilt(sos, x, axis=0, padtype="even", padlen=padlen)``, bit for bit, with the filter's
     initial state ``zi`` computed once by the caller: SciPy's own steps (the even extension, ``sosfilt`` forward from
     ``zi`` times the first sample, backward from ``zi`` times the last output) without its per-call checks and
     ``sosfilt_zi``, which cost as much as filtering a block of two columns of a few thousand samples.
+
+    With ``carry``, ``x`` is a block of a longer signal whose forward pass goes on from the block before: exact, as one
+    pass over the whole signal (:func:`parallel_decimation`).
 
     Parameters
     ----------
@@ -80,17 +84,28 @@ def even_filtfilt(signal, sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.nd
         Samples of even extension at each end (0: none).
     zi : (n_sections, 2) array
         ``signal.sosfilt_zi(sos)``.
+    carry : tuple ``(state, split, state_out)``, optional
+        ``state`` (n_sections, 2, c): the forward pass's state at ``x``'s first row, which is then not padded (None:
+        padded and started as SciPy does); ``split``: a row of ``x`` whose forward state ``state_out`` (n_sections, 2,
+        c) receives (None: none).
 
     Returns
     -------
     (n, c) ndarray
     """
-    ext = np.concatenate([x[padlen:0:-1], x, x[-2:-(padlen + 2):-1]]) if padlen else x
+    start, split, state_out = (None, None, None) if carry is None else carry
+    left = padlen if start is None else 0
+    ext = np.concatenate([x[left:0:-1], x, x[-2:-(padlen + 2):-1]]) if padlen else x
     state = zi.reshape(zi.shape[0], 2, 1)
-    y, _ = signal.sosfilt(sos, ext, axis=0, zi=state * ext[:1])
+    z = state * ext[:1] if start is None else start
+    if split is None:
+        y, _ = signal.sosfilt(sos, ext, axis=0, zi=z)
+    else:  # forward to the split, its state kept, then on: the same operations as one pass
+        head, state_out[...] = signal.sosfilt(sos, ext[:left + split], axis=0, zi=z)
+        y = np.concatenate([head, signal.sosfilt(sos, ext[left + split:], axis=0, zi=state_out)[0]])
     y, _ = signal.sosfilt(sos, y[::-1], axis=0, zi=state * y[-1:])
     y = y[::-1]
-    return y[padlen:y.shape[0] - padlen] if padlen else y
+    return y[left:y.shape[0] - padlen] if padlen else y
 
 
 WHOLE_ARRAY_VALUES = 500_000
@@ -335,10 +350,11 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     """Low-pass filter and down-sample a signal that is computed chunk by chunk.
 
     Used for the observation matrix and the torques together (Gautier's parallel decimation): both
-    go through the same zero-phase low-pass filter, then every ``factor``-th sample is kept. Chunks
-    overlap by a margin so that memory stays bounded by ``chunk`` samples whatever the log's length,
-    while the result matches filtering the whole signal at once (to the decay of the filter's
-    transient over the margin). The log's ends are padded by mirror extension (:func:`edge_padding`).
+    go through the same zero-phase low-pass filter, then every ``factor``-th sample is kept. Memory stays
+    bounded by ``chunk`` samples whatever the log's length: the forward pass goes on from one chunk to the
+    next (its state carried, exact), and the backward pass starts a margin after each chunk's end, so the
+    result matches filtering the whole signal at once to the decay of the filter's transient over that
+    margin. The log's ends are padded by mirror extension (:func:`edge_padding`).
 
     Parameters
     ----------
@@ -381,35 +397,47 @@ def parallel_decimation(block: Callable[[int, int], np.ndarray], n_samples: int,
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
     zi = signal.sosfilt_zi(sos)
     margin = int(np.ceil(10 * order * 0.4 * rate / cutoff))  # the filter's transient, as 10·factor·order at the decimation's cutoff
+    states = None  # each signal's forward state at the chunk's start: none at the log's start (padded there)
     for start in range(0, n_samples, chunk):
         stop = min(start + chunk, n_samples)
-        lo, hi = max(0, start - margin), min(n_samples, stop + margin)
-        values = block(lo, hi)
+        hi = min(n_samples, stop + margin)
+        values = block(start, hi)
         index = np.arange(start, stop)
         index = index[index % factor == 0]
-        padlen = min(edge_padding(rate, cutoff, order), hi - lo - 1)
+        padlen = min(edge_padding(rate, cutoff, order), hi - start - 1)
+        split = stop - start if stop < n_samples else None
 
-        def filtered(flat, live, fast):
+        def filtered(flat, live, fast, state):
             out = np.zeros((index.size, flat.shape[1]))
+            after = None if split is None else np.zeros((sos.shape[0], 2, flat.shape[1]))
             width = COMPILED_COLUMN_BLOCK if fast else max(COLUMN_BLOCK, BLOCK_VALUES // flat.shape[0])
 
             def one(cols):  # a column block: the filter's copies stay small; blocks write disjoint columns of out
-                out[:, cols] = (zero_phase(sos, flat, padlen, zi, cols, index - lo) if fast else
-                                even_filtfilt(signal, sos, flat[:, cols], padlen, zi)[index - lo])
+                carry = (None if state is None else state[:, :, cols], split,
+                         None if after is None else np.empty((sos.shape[0], 2, cols.size)))
+                out[:, cols] = (zero_phase(sos, flat, padlen, zi, cols, index - start, carry=carry) if fast else
+                                even_filtfilt(signal, sos, flat[:, cols], padlen, zi, carry=carry)[index - start])
+                if after is not None:
+                    after[:, :, cols] = carry[2]
 
             _on_cores(one, [live[c:c + width] for c in range(0, live.size, width)],
                       flat.shape[0] * live.size >= PARALLEL_VALUES)
-            return out
+            return out, after
 
         signals = values if isinstance(values, tuple) else (values,)
         flats = [v.reshape(v.shape[0], -1) for v in signals]
-        # Columns that are zero throughout the block stay zero (the filter of zeros is exactly zero): a regressor has
-        # many (joint i does not see the links before it), so only the others are filtered.
-        lives = [_live_columns(flat) for flat in flats]
+        states = states or [None] * len(flats)
+        # Columns that are zero throughout the block and whose forward state is zero stay zero (the filter of zeros is
+        # exactly zero): a regressor has many (joint i does not see the links before it), so only the others are
+        # filtered.
+        lives = [_live_columns(flat) if state is None else
+                 np.union1d(_live_columns(flat), np.flatnonzero(np.any(state, axis=(0, 1))))
+                 for flat, state in zip(flats, states)]
         # a long log's signals through the compiled filter (the same numbers as SciPy's, bit for bit), all of them
         # alike: the torques beside a regressor cost SciPy more set-up per call than filtering
         fast = n_samples * sum(live.size for live in lives) >= COMPILED_FILTER_VALUES
-        out = tuple(filtered(flat, live, fast).reshape((index.size,) + v.shape[1:])
-                    for v, flat, live in zip(signals, flats, lives))
+        done = [filtered(flat, live, fast, state) for flat, live, state in zip(flats, lives, states)]
+        states = [after for _, after in done]
+        out = tuple(y.reshape((index.size,) + v.shape[1:]) for v, (y, _) in zip(signals, done))
         yield index, (out if isinstance(values, tuple) else out[0])
-        del values, signals, flats
+        del values, signals, flats, done
