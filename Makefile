@@ -19,9 +19,13 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check  # lint ([tool.ruff] in pyproject.toml: pyflakes, pycodestyle, imports, bugbear, pyupgrade)
-	$(BIN)/python -m mypy  # type check of src/dynid ([tool.mypy] in pyproject.toml)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2
-	$(BIN)/python -m mkdocs build --strict  # the docs site (mkdocs.yml) into .site/; a warning (a broken link) fails it
+# the type check of src/dynid ([tool.mypy] in pyproject.toml) and the docs site (mkdocs.yml, into .site/; a warning,
+# such as a broken link, fails it) run beside the test suite on one core, their output printed after it; any of the
+# three failing fails the target
+	log=$$(mktemp); { $(BIN)/python -m mypy && \
+	  $(BIN)/python -m mkdocs build --strict ; } > $$log 2>&1 & checks=$$!; \
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2; tests=$$?; \
+	wait $$checks; checked=$$?; cat $$log; rm -f $$log; [ $$tests -eq 0 ] && [ $$checked -eq 0 ]
 
 wheel-check: $(STAMP)  # the wheel as a user installs it, in a fresh virtualenv: example, identify, export (CI)
 	rm -rf .wheel-check && mkdir -p .wheel-check/dist
