@@ -93,11 +93,11 @@ def even_filtfilt(signal, sos: np.ndarray, x: np.ndarray, padlen: int, zi: np.nd
     -------
     (n, c) ndarray
     """
-    start, split, state_out = (None, None, None) if carry is None else carry
-    left = padlen if start is None else 0
+    initial, split, state_out = (None, None, None) if carry is None else carry
+    left = padlen if initial is None else 0
     ext = np.concatenate([x[left:0:-1], x, x[-2:-(padlen + 2):-1]]) if padlen else x
     state = zi.reshape(zi.shape[0], 2, 1)
-    z = state * ext[:1] if start is None else start
+    z = state * ext[:1] if initial is None else initial
     if split is None:
         y, _ = signal.sosfilt(sos, ext, axis=0, zi=z)
     else:  # forward to the split, its state kept, then on: the same operations as one pass
