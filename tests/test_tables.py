@@ -39,7 +39,8 @@ def test_the_rich_tables_are_as_wide_as_the_split_assumes():
 
     console = Console(width=500)
     for part in _table().split(80):
-        (table,) = rich_tables(part, 500)
+        ((title, table),) = rich_tables(part, 500)
+        assert title == part.title
         assert console.measure(table).maximum == sum(w + PADDING for w in part.widths()) + EDGES
 
 
@@ -58,3 +59,25 @@ def test_the_plain_text_is_what_the_terminal_prints_without_colour():
         printed = [line.rstrip() for line in buffer.getvalue().splitlines() if line.strip()]
         plain = [line for line in render_text([_table()], width).splitlines() if line.strip()]
         assert printed == plain and any("─" in line for line in plain)
+
+
+def test_a_long_title_is_a_paragraph_as_wide_as_the_output_not_the_table():
+    """A table's title above a narrow table: one line where the output is not a terminal (a pipe, a log file), wrapped
+    at the output's width in plain text, never at the table's width with its padding (issue "Fast where users wait,
+    quiet where they read", item 4: `dynid run`'s estimator table broke its title at 64 columns in a pipe)."""
+    import io
+
+    from rich.console import Console
+
+    from dynid.report.console import Reporter
+
+    title = ("Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; mean "
+             "over joints of ρ (eq. 18)")
+    table = TextTable(title, ("method", "F"), (("OLS", "2.392"), ("ABC", "103.9")))
+    buffer = io.StringIO()
+    Reporter(out=Console(file=buffer, width=100, color_system=None, force_terminal=False)).blocks([table])
+    lines = buffer.getvalue().splitlines()
+    assert title in lines and all(line == line.rstrip() for line in lines if title in line)
+    plain = table.render(60).splitlines()
+    assert " ".join(plain[:3]) == title and all(len(line) <= 60 for line in plain)
+    assert max(len(line) for line in plain[:2]) > 40  # wrapped at the output's 60 columns, not the table's 15

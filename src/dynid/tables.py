@@ -118,8 +118,12 @@ class TextTable:
 
         out = io.StringIO()
         console = Console(file=out, width=width, color_system=None, force_terminal=False, highlight=False)
-        for k, table in enumerate(rich_tables(self, width)):
-            console.print(*([""] if k else []), table)
+        for k, (title, table) in enumerate(rich_tables(self, width)):
+            if k:
+                console.print()
+            if title:
+                console.print(title, markup=False)
+            console.print(table)
         return "\n".join(line.rstrip() for line in out.getvalue().strip("\n").splitlines())
 
 
@@ -134,8 +138,9 @@ def rich_tables(table: TextTable, width: int) -> list:
 
     Returns
     -------
-    list of rich.table.Table
-        Parts repeating the label columns.
+    list of (str, rich.table.Table)
+        Parts repeating the label columns, each with its title: a paragraph printed above it (as wide as the output, not
+        wrapped to the table's width).
     """
     from rich import box
     from rich.markup import escape
@@ -143,13 +148,12 @@ def rich_tables(table: TextTable, width: int) -> list:
 
     out = []
     for part in table.split(width):
-        t = Table(title=escape(part.title), title_justify="left", box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True,
-                  pad_edge=False)  # a long title reads as a paragraph, not a centred column
+        t = Table(box=box.SIMPLE_HEAD, padding=(0, 1), collapse_padding=True, pad_edge=False)
         for i, col in enumerate(part.columns):
             t.add_column(escape(col), justify="left" if i < part.labels else "right", no_wrap=True)
         for i, row in enumerate(part.rows):
             t.add_row(*(escape(c) for c in row), end_section=i in part.section_ends)
-        out.append(t)
+        out.append((part.title, t))
     return out
 
 

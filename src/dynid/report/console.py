@@ -107,7 +107,9 @@ class Reporter:
             elif self.quiet:
                 continue
             elif isinstance(b, TextTable):
-                for t in rich_tables(b, self.out.width):
+                for title, t in rich_tables(b, self.out.width):
+                    if title:  # a paragraph as wide as the output (one line in a pipe), not the table's width
+                        self.out.print(title, style="italic", markup=False, highlight=False, soft_wrap=self.unwrapped)
                     self.out.print(t)
             elif b.kind == "title":
                 self.out.print("\n" + escape(b.text), style="bold", highlight=False, soft_wrap=self.unwrapped)
