@@ -110,13 +110,25 @@ def _ranking_finding(filters: list, main: str) -> tuple:
     """A finding where, with the validation logs' states filtered at another cutoff
     (:func:`dynid.identification.evidence.with_yardstick`'s ``"filters"``), another candidate predicts them better than
     the main estimate by more than :data:`SAME_FIGURE`: the choice rests on the mean over the filters, not on one, and
-    the logs do not settle it (candidates within it of each other that rank differently are not said)."""
+    the logs do not settle it (candidates within it of each other that rank differently are not said). Where one
+    candidate beats the main estimate so under every filter, the logs agree and the main estimate stays by the
+    verdict's rule: said so (the description's rigid body with the drive terms fitted is taken only where the
+    identified rigid body is doubtful on the validation logs)."""
     beaten = [(f["cutoff_factor"], f["best"], f["mean_global_relative_error"]) for f in filters
               if f.get("best") and f["best"] != main and main in f["mean_global_relative_error"]
               and f["mean_global_relative_error"][main] > SAME_FIGURE * f["mean_global_relative_error"][f["best"]]]
     if not beaten:
         return ()
     said = "; ".join(f"at {k:g}× the cutoffs {b} {_apart(e[b], e[main])} for {main}" for k, b, e in beaten)
+    better = {b for _, b, _ in beaten}
+    if len(beaten) == len(filters) and len(better) == 1:  # one candidate better under every filter: the logs agree
+        (best,) = better
+        why = (f"{best} is taken only where the identified rigid body is doubtful on the validation logs (the "
+               "description's nominal model predicts them better, or its predictions leave the range the "
+               "identification log supports), and it is not here" if best == DRIVE_ONLY_LABEL else
+               "the verdict's rules kept it (its finding above)")
+        return (Finding("yardstick", f"{best} predicts the validation logs better than {main} with their states "
+                                     f"filtered at every cutoff ({said}): {main} stays the main estimate, as {why}"),)
     return (Finding("yardstick", f"the validation logs rank the candidates differently with their states filtered at "
                                  f"another cutoff ({said}): {main} was chosen on the mean over half, once and twice "
                                  "dynid's cutoffs, and the logs do not settle it; a longer or faster validation log, "
