@@ -382,7 +382,7 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
                                                               "Ia", "fc", "fv", "offset")]
     phi = truth_robot.standard_parameters().reshape(n, -1)[:, :10]
     rows = []
-    for kind in (k for k in CAD_CLASSES if k in classes):
+    for kind in CAD_CLASSES:  # every class's logs, in one order: the noise each draws does not hang on --classes
         sensor = kind == "cad-sensor"
         stem = kind.replace("-", "_")
         spring = cable_spring(valid, drives, sensor, driven)
@@ -391,6 +391,8 @@ def run_cad(name: str, out: Path, seed: int, classes) -> list[dict]:
             log = geared(log, drives, spring) if kind == "cad-gear" else log
             noisy = replace(log, tau=unmodelled(log, drives, noise, sensor, spring))
             write_log(folder / f"{stem}_{label}.csv", noisy, noise, driven)
+        if kind not in classes:
+            continue
         drive = np.zeros((n, 4)) if sensor else np.column_stack([drives.ia, drives.fc, drives.fv, np.zeros(n)])
         values = np.concatenate([phi, drive], axis=1).ravel()
         (folder / f"{stem}_truth.csv").write_text("name,value\n" + "".join(f"{k},{v:.12g}\n" for k, v in zip(names, values)))
