@@ -201,6 +201,14 @@ def test_a_ranking_that_hangs_on_the_state_filter_is_said():
                                  "filtered at every cutoff") and "rigid body is doubtful" in found.text
     for k in ("1", "0.5", "2"):
         assert f"at {k}× the cutoffs {DRIVE_ONLY_LABEL}" in found.text
+    # least squares physically consistent, the SDP better under every filter (the zoo's SCARA with a dead channel):
+    # the SDP is weighed against it only where it is not
+    from dynid.identification.estimates import SDP_LABEL
+
+    (sdp,) = _ranking_finding(filters({SDP_LABEL: 40.2, "WLS": 41.1}, {SDP_LABEL: 40.4, "WLS": 41.3},
+                                      {SDP_LABEL: 40.1, "WLS": 41.1}), "WLS")
+    assert "differently" not in sdp.text and sdp.text.startswith(f"{SDP_LABEL} predicts the validation logs better") \
+        and f"weighs {SDP_LABEL} against it only where it is not" in sdp.text
     (other,) = _ranking_finding(filters({"SDP": 1.9, "WLS": 1.8}, {"SDP": 2.1, "WLS": 2.0}, {"SDP": 1.9, "WLS": 1.8}), "SDP")
     assert "differently" not in other.text and "WLS predicts the validation logs better than SDP" in other.text \
         and "the verdict's rules kept it" in other.text

@@ -123,10 +123,14 @@ def _ranking_finding(filters: list, main: str) -> tuple:
     better = {b for _, b, _ in beaten}
     if len(beaten) == len(filters) and len(better) == 1:  # one candidate better under every filter: the logs agree
         (best,) = better
-        why = (f"{best} is taken only where the identified rigid body is doubtful on the validation logs (the "
-               "description's nominal model predicts them better, or its predictions leave the range the "
-               "identification log supports), and it is not here" if best == DRIVE_ONLY_LABEL else
-               "the verdict's rules kept it (its finding above)")
+        if best == DRIVE_ONLY_LABEL:
+            why = (f"{best} is taken only where the identified rigid body is doubtful on the validation logs (the "
+                   "description's nominal model predicts them better, or its predictions leave the range the "
+                   "identification log supports), and it is not here")
+        elif best == SDP_LABEL:
+            why = f"it is physically consistent, and the verdict weighs {best} against it only where it is not"
+        else:
+            why = "the verdict's rules kept it (docs/real-logs.md, \"What happens to a log\")"
         return (Finding("yardstick", f"{best} predicts the validation logs better than {main} with their states "
                                      f"filtered at every cutoff ({said}): {main} stays the main estimate, as {why}"),)
     return (Finding("yardstick", f"the validation logs rank the candidates differently with their states filtered at "
