@@ -60,16 +60,25 @@ def _identified(root):
     return out / "results.json"
 
 
-def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(tmp_path):
+@pytest.fixture(scope="module")
+def worn_joint(tmp_path_factory):
     """A 10 % rise of joint 3's viscous friction on day 14 (of 1-minute logs, one a day; the first 12 are the
-    reference): the alarm names joint 3 and its viscous friction, within 60 s of logs of the change, with its size; no
-    other term alarms."""
-    simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
+    reference), the unit identified, and ``dynid monitor`` run once over every log: the folder, the results.json, and
+    the monitor's process and output folder (two tests read them; neither writes into the folder)."""
+    root = tmp_path_factory.mktemp("worn")
+    simulate_service_life(root, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
                           step=0.10, coulomb=False, rng=3)
-    results = _identified(tmp_path)
-    p = dynid("monitor", tmp_path / "unit.toml", "--logs", tmp_path / "logs", "--results", results, "--out", tmp_path / "m")
+    results = _identified(root)
+    p = dynid("monitor", root / "unit.toml", "--logs", root / "logs", "--results", results, "--out", root / "once")
+    return root, results, p
+
+
+def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(worn_joint):
+    """The alarm names joint 3 and its viscous friction, within 60 s of logs of the change, with its size; no other
+    term alarms."""
+    root, _, p = worn_joint
     assert p.returncode == 0, p.stderr
-    report = json.loads((tmp_path / "m" / "monitor.json").read_text())
+    report = json.loads((root / "once" / "monitor.json").read_text())
     alarms = report["alarms"]
     assert [(a["joint"], a["term"]) for a in alarms] == [(3, "fv3")]
     a = alarms[0]
@@ -77,27 +86,24 @@ def test_dynid_monitor_names_the_joint_whose_viscous_friction_rose(tmp_path):
     assert a["detected_s"] <= 60.0 and a["delay_s"] <= 60.0
     assert a["change_percent"] == pytest.approx(10.0, abs=2.0)
     assert "joint 3: viscous friction (fv3) rose" in " ".join((p.stdout + p.stderr).split())
-    assert (tmp_path / "m" / "monitor.png").is_file() and (tmp_path / "m" / "monitor.parquet").is_file()
+    assert (root / "once" / "monitor.png").is_file() and (root / "once" / "monitor.parquet").is_file()
 
 
-def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
+def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(worn_joint, tmp_path):
     """A folder that grows (14 daily logs, then 4 more, the change on the 15th): run once a day, the monitor goes on
     from its state in --out, reads only the new logs, and writes the very monitor.json one run over every log writes;
     its state refuses other settings and a new log dated before the last one it saw; --restart starts over."""
     import shutil
 
-    simulate_service_life(tmp_path, days=18, seconds=60.0, rate=250.0, wear_joint=3, wear_start_day=14.0, wear_per_day=0.0,
-                          step=0.10, coulomb=False, rng=3)
-    results = _identified(tmp_path)
-    files = sorted((tmp_path / "logs").glob("*.csv"))
+    root, results, p = worn_joint
+    assert p.returncode == 0, p.stderr
+    files = sorted((root / "logs").glob("*.csv"))
     growing = tmp_path / "growing"
     growing.mkdir()
 
     def run(folder, out, *extra):
-        return dynid("monitor", tmp_path / "unit.toml", "--logs", folder, "--results", results, "--out", out, *extra)
+        return dynid("monitor", root / "unit.toml", "--logs", folder, "--results", results, "--out", out, *extra)
 
-    p = run(tmp_path / "logs", tmp_path / "once")
-    assert p.returncode == 0, p.stderr
     for f in files[:14]:
         shutil.copy(f, growing / f.name)
     p = run(growing, tmp_path / "daily")
@@ -109,7 +115,7 @@ def test_dynid_monitor_goes_on_from_its_state_as_one_run_would(tmp_path):
     p = run(growing, tmp_path / "daily")
     assert p.returncode == 0, p.stderr
     assert "went on from an earlier run's state (14 logs seen then, 4 new)" in " ".join(p.stdout.split())
-    once = json.loads((tmp_path / "once" / "monitor.json").read_text())
+    once = json.loads((root / "once" / "monitor.json").read_text())
     daily = json.loads((tmp_path / "daily" / "monitor.json").read_text())
     assert daily == once and [a["term"] for a in daily["alarms"]] == ["fv3"]
 
