@@ -61,7 +61,7 @@ def test_the_plain_text_is_what_the_terminal_prints_without_colour():
         assert printed == plain and any("─" in line for line in plain)
 
 
-def test_a_long_title_is_a_paragraph_as_wide_as_the_output_not_the_table():
+def test_a_long_title_is_a_paragraph_as_wide_as_the_output_not_the_table(monkeypatch):
     """A table's title above a narrow table: one line where the output is not a terminal (a pipe, a log file), wrapped
     at the output's width in plain text, never at the table's width with its padding (issue "Fast where users wait,
     quiet where they read", item 4: `dynid run`'s estimator table broke its title at 64 columns in a pipe)."""
@@ -74,10 +74,17 @@ def test_a_long_title_is_a_paragraph_as_wide_as_the_output_not_the_table():
     title = ("Estimators: F = eq. 9 on β1 (N·m); evals of eq. 9; wall s (run side by side); Δβ = ‖β̂−β‖/‖β‖ %; mean "
              "over joints of ρ (eq. 18)")
     table = TextTable(title, ("method", "F"), (("OLS", "2.392"), ("ABC", "103.9")))
-    buffer = io.StringIO()
-    Reporter(out=Console(file=buffer, width=100, color_system=None, force_terminal=False)).blocks([table])
-    lines = buffer.getvalue().splitlines()
+    def printed(width):
+        buffer = io.StringIO()
+        Reporter(out=Console(file=buffer, width=width, color_system=None, force_terminal=False)).blocks([table])
+        return buffer.getvalue().splitlines()
+
+    monkeypatch.delenv("COLUMNS", raising=False)  # a pipe: one line
+    lines = printed(100)
     assert title in lines and all(line == line.rstrip() for line in lines if title in line)
+    monkeypatch.setenv("COLUMNS", "100")  # a width asked for: wrapped at it, not at the table's
+    lines = printed(100)
+    assert " ".join(lines[:2]) == title and len(lines[0]) > 80
     plain = table.render(60).splitlines()
     assert " ".join(plain[:3]) == title and all(len(line) <= 60 for line in plain)
     assert max(len(line) for line in plain[:2]) > 40  # wrapped at the output's 60 columns, not the table's 15
