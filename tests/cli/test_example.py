@@ -147,3 +147,5 @@ def test_identify_into_the_folder_of_the_users_urdf_leaves_the_urdf_as_it_was(tm
         said = " ".join(p.stderr.split())
         assert (f"{log}: 100 % of its sampled positions are samples of the identification log the model was fitted on: "
                 "its figures are the fit's" in said) is fitted, said
+        out = " ".join(p.stdout.split())  # the next step: another motion, not the export, after the fit's own samples
+        assert ("next: validate on a log of another motion" in out) is fitted and ("next: dynid export" in out) is not fitted

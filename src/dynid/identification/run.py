@@ -190,12 +190,16 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
     datasets = config.validation if datasets is None else datasets
     if not datasets:
         raise ConfigError(f"{config.path}: no [[validation]] datasets to validate on (give one, or another log)")
-    repeated: list[str] = []
+    repeated: dict[str, str] = {}
     fitted = _identification_log(config)
     logs = _fit_repeats_said(fitted, _read_as_scored(datasets, config.robot, progress), repeated)
+
+    def marked(comparisons):  # a log that repeats the fit's samples, marked so (the next step then says so)
+        return tuple(replace(c, repeats_fit=True) if c.name in repeated else c for c in comparisons)
+
     if yardstick:
-        return (_on_the_yardstick(config, base, sets, logs, fitted, identified),
-                tuple(w for r in refs for w in r.warnings) + tuple(repeated))
+        return (marked(_on_the_yardstick(config, base, sets, logs, fitted, identified)),
+                tuple(w for r in refs for w in r.warnings) + tuple(repeated.values()))
     label, beta = nominal_set(config.robot, base, refs) or (None, None)
     beside = label is not None and label not in sets  # scored for the channel checks' scale, not shown
     comparisons, warnings = validate_sets(config, base, {**sets, label: beta} if beside else sets, logs,
@@ -205,7 +209,7 @@ def run_validation(config: IdentificationConfig, identified: dict, *, datasets: 
                                           nominal=label)
     if beside:
         comparisons = tuple(v.without(str(label)) for v in comparisons)
-    return comparisons, tuple(w for r in refs for w in r.warnings) + warnings + tuple(repeated)
+    return marked(comparisons), tuple(w for r in refs for w in r.warnings) + warnings + tuple(repeated.values())
 
 
 def _on_the_yardstick(config: IdentificationConfig, base, sets: dict, logs, fitted: Recording | None,
@@ -225,15 +229,16 @@ def _identification_log(config: IdentificationConfig) -> Recording | None:
         return None
 
 
-def _fit_repeats_said(fitted: Recording | None, logs, said: list[str]):
-    """The logs as they come, and into ``said`` a warning for each that repeats the samples of ``fitted``, the
-    identification log (:func:`dynid.io.logs.log_repairs.repeated_share`): scored as asked, but its figures are the
-    fit's, not a test on other motions. Without it (None) the logs go unchecked."""
+def _fit_repeats_said(fitted: Recording | None, logs, said: dict[str, str]):
+    """The logs as they come, and into ``said`` (log name -> warning) a warning for each that repeats the samples of
+    ``fitted``, the identification log (:func:`dynid.io.logs.log_repairs.repeated_share`): scored as asked, but its
+    figures are the fit's, not a test on other motions. Without it (None) the logs go unchecked."""
     for log in logs:
         share = 0.0 if fitted is None else repeated_share(fitted, log)
         if share >= 0.5:
-            said.append(f"{log.name}: {100 * share:.0f} % of its sampled positions are samples of the identification "
-                        "log the model was fitted on: its figures are the fit's, not a validation on other motions")
+            said[log.name] = (f"{log.name}: {100 * share:.0f} % of its sampled positions are samples of the "
+                              "identification log the model was fitted on: its figures are the fit's, not a validation "
+                              "on other motions")
         yield log
 
 

@@ -805,6 +805,11 @@ def validation_verdict(comparisons) -> list:
     misread = [c.name for c in comparisons if c.misread]
     if misread:
         out.append(Line(f"next: read {', '.join(misread)} as the warning says, then validate again"))
+    elif all(c.repeats_fit for c in comparisons):
+        one = len(comparisons) == 1
+        out.append(Line("next: validate on a log of another motion (dynid validate CONFIG --file LOG): "
+                        + ("this log repeats" if one else "these logs repeat") + " the identification log's samples, so "
+                        + ("its" if one else "their") + " figures are the fit's"))
     elif not best.startswith("dynid"):
         out.append(Line(f"next: {best} predicts these logs better than dynid's estimates; identify on a log that moves "
                         "as these do, or add them to [[validation]] to choose among the estimates"))

@@ -113,6 +113,9 @@ class TorqueComparison:
     followers: tuple[int, ...] = ()
     """Joints that follow another (``<mimic>``): among :attr:`dead`, their torque supplied through that joint's drive
     and scored in its row; no dead channel to speak of."""
+    repeats_fit: bool = False
+    """The log repeats the identification log's samples (:func:`dynid.io.logs.log_repairs.repeated_share`): its figures
+    are the fit's, not a test on other motions."""
     prismatic: tuple[bool, ...] = ()
     """Which joints slide (:attr:`dynid.model.robot.Robot.prismatic`): their torques are forces [N], their speeds
     [m/s], as the lines and tables say; empty: none."""
@@ -357,6 +360,8 @@ class TorqueComparison:
             out["noise_floor"] = floor
         if self.misread:
             out["misread"] = self.misread
+        if self.repeats_fit:
+            out["repeats_identification_log"] = True
         if any(self.prismatic):
             out["prismatic_joints"] = [j for j, p in enumerate(self.prismatic) if p]  # 0-based: forces in N, speeds in m/s
         return out
