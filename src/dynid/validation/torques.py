@@ -70,6 +70,8 @@ class TorqueComparison:
         Where the log is read otherwise than the identification log, the warning that says how ("" where it is not).
     followers : tuple of int
         Joints that follow another (``<mimic>``): among ``dead``, scored in the rows of the joints they follow.
+    repeats_fit : bool
+        The log repeats the identification log's samples: its figures are the fit's.
     prismatic : tuple of bool
         Which joints slide: their torques are forces [N], their speeds [m/s].
     """
