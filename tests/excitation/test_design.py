@@ -180,3 +180,35 @@ def test_a_floor_keeps_every_links_shape_above_it_not_only_the_tool(er16_3):
     design = design_excitation(prob, n_starts=2, rng=0, initial=beta1)
     assert design.feasible
     _check_every_constraint_independently(er16_3, prob, design.trajectory)
+
+
+def test_starts_solved_on_the_second_core_give_the_design_of_one_process(er16_3, monkeypatch):
+    """Inside the CLI's ``allow_forks`` every other start is solved by a forked child: the design, each start's
+    criterion value, SLSQP's iterations and the criterion's evaluations are those of the starts solved one after the
+    other in this process, and a child did solve its share (issue "Fast where users wait")."""
+    from dynid.excitation import design as design_module
+    from dynid.runtime import processes
+
+    forked = []
+
+    class Recorded(processes.ForkedCall):
+        def __init__(self, fn, *args):
+            super().__init__(fn, *args)
+            forked.append((self._child is not None, list(args[0])))
+
+    monkeypatch.setattr(design_module, "ForkedCall", Recorded)
+    monkeypatch.setattr(processes, "cores", lambda: 2)
+    tau_max = np.array([300.0, 600.0, 250.0])
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 3, limits=replace(er16_3.limits, tau_max=tau_max),
+                             workspace=Workspace(floor=-0.3), grid_points=60)
+    said = []
+    alone = design_excitation(prob, n_starts=3, rng=5)
+    assert not forked  # the library alone never forks
+    with processes.allow_forks():
+        beside = design_excitation(prob, n_starts=3, rng=5, callback=lambda done, n, best: said.append((done, n, best)))
+    assert forked == [(True, [1])]  # the second start went to a child
+    for field in ("a", "b", "q0"):
+        np.testing.assert_array_equal(getattr(beside.trajectory, field), getattr(alone.trajectory, field))
+    assert beside.start_values == alone.start_values and len(set(alone.start_values)) == 3
+    assert (beside.nit, beside.nfev, beside.cond) == (alone.nit, alone.nfev, alone.cond)
+    assert [d for d, _, _ in said] == [1, 2, 3] and said[-1][2] == beside.cond

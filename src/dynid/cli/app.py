@@ -856,12 +856,12 @@ def excite(
         return replace(cfg, starts=cfg.starts if starts is None else starts, seed=cfg.seed if seed is None else seed)
 
     def compute(cfg, progress):
-        step = [f"design, start 1 of {cfg.starts}"]
+        step = [f"design, 0 of {cfg.starts} starts done"]  # on two cores two starts are solved at once
         progress.update(step[0])
 
         def started(done: int, n: int, best: float) -> None:  # each start's line says the best design so far
             if done < n:
-                step[0] = f"design, start {done + 1} of {n}, best cond so far {best:.4g}"
+                step[0] = f"design, {done} of {n} starts done, best cond so far {best:.4g}"
                 progress.update(step[0])
 
         def iterated(k: int, maxiter: int) -> None:  # a long start says how far it has come (on a terminal)

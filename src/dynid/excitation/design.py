@@ -19,9 +19,11 @@ base inertial parameters of robots", IJRR 11(4), 1992.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -34,6 +36,7 @@ from ..dynamics.sensitivity import regressor_state_derivatives, tips_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..model.loading import as_robot
 from ..model.robot import Limits, Robot
+from ..runtime.processes import ForkedCall, can_fork
 from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
@@ -689,12 +692,18 @@ def _coupling_equalities(problem, lay: _Layout) -> tuple[np.ndarray, np.ndarray]
     return (np.array(rows), np.array(values)) if rows else None
 
 
-def _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling) -> np.ndarray:
-    """Random amplitudes decaying as 1/k, projected on the rest and coupling equalities (:func:`_coupling_equalities`),
-    scaled into the limits."""
+def _start_direction(lay, rng) -> np.ndarray:
+    """A random start's amplitudes (:func:`_random_start`), decaying as 1/k: drawn for every start before any is
+    solved, in their order, so that a start's draw does not hang on which core solves the starts before it."""
     n, h = lay.n, lay.h
     k = np.arange(1, h + 1)
-    amp = np.concatenate([(rng.standard_normal((n, h)) / k).ravel(), (rng.standard_normal((n, h)) / k).ravel()])
+    return np.concatenate([(rng.standard_normal((n, h)) / k).ravel(), (rng.standard_normal((n, h)) / k).ravel()])
+
+
+def _random_start(problem, lay, a_lin, c_lin, eq, objective, amp, coupling) -> np.ndarray:
+    """The amplitudes ``amp`` (:func:`_start_direction`) projected on the rest and coupling equalities
+    (:func:`_coupling_equalities`), scaled into the limits."""
+    n = lay.n
     x0 = np.zeros(lay.nx)
     if lay.free_offsets:
         x0[:n] = problem.start_pose()
@@ -740,6 +749,133 @@ def _check_budget(n_starts: int, maxiter: int) -> None:
         raise ConfigError(f"design.maxiter must be a positive integer, got {maxiter!r}")
 
 
+@dataclass
+class _Start:
+    """One start of :func:`design_excitation`: its first point, its design and margins, SLSQP's last answer, and
+    its iterations and criterion evaluations."""
+
+    x0: np.ndarray
+    trajectory: FourierTrajectory
+    margins: list
+    res: Any
+    nit: int
+    nfev: int
+
+
+class _StartSolver:
+    """One start of :func:`design_excitation` at a time: its first point (``given`` for a start whose direction is
+    None, else :func:`_random_start` along it), SLSQP from there, and again where the finer grid finds a limit crossed
+    (at most :data:`RETRIES` times). The objective and constraints of each ``safety`` are built once."""
+
+    def __init__(self, problem: ExcitationProblem, lay: _Layout, maxiter: int, given: np.ndarray | None,
+                 directions: list):
+        self.problem, self.lay, self.maxiter, self.given, self.directions = problem, lay, maxiter, given, directions
+        self.eq = _rest_equalities(lay) if problem.rest else None
+        self.coupling = _coupling_equalities(problem, lay)
+        self.solvers: dict[float, tuple] = {}
+
+    def solver(self, safety: float) -> tuple:
+        """Objective, linear constraints ``(a_lin, c_lin)`` and SLSQP's constraints with the limits tightened by
+        ``safety``."""
+        if safety not in self.solvers:
+            tightened, eq, coupling = replace(self.problem, safety=safety), self.eq, self.coupling
+            objective = _Objective(tightened, self.lay)
+            a_lin, c_lin = _linear_constraints(tightened, self.lay)
+            cons = [{"type": "ineq", "fun": lambda x: a_lin @ x + c_lin, "jac": lambda x: a_lin},
+                    {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
+            if eq is not None:
+                cons.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
+            if coupling is not None:
+                cons.append({"type": "eq", "fun": lambda x: coupling[0] @ x - coupling[1], "jac": lambda x: coupling[0]})
+            self.solvers[safety] = (objective, a_lin, c_lin, cons)
+        return self.solvers[safety]
+
+    def __call__(self, i: int, progress: Callable[[int, int], None] | None) -> _Start:
+        """Start ``i``, ``progress(k, maxiter)`` after each SLSQP iteration."""
+        problem, lay = self.problem, self.lay
+        before = sum(v[0].nfev for v in self.solvers.values())
+        objective, a_lin, c_lin, _ = self.solver(problem.safety)
+        direction = self.directions[i]
+        x0 = self.given if direction is None else _random_start(problem, lay, a_lin, c_lin, self.eq, objective,
+                                                                direction, self.coupling)
+        assert x0 is not None  # a start without a direction is the given trajectory's
+        x, safety, nit = x0, problem.safety, 0
+        for _ in range(RETRIES + 1):
+            objective, _, _, cons = self.solver(safety)
+            res = _slsqp(objective, x, cons, self.maxiter, progress)
+            nit += int(res.nit)
+            traj = lay.to_trajectory(res.x, problem.offsets)
+            margins = problem.margins(traj)
+            if all(m.satisfied for m in margins):
+                break
+            if res.status == 0:  # converged, but violates between grid points: polish with tighter limits
+                x, safety = res.x, min(0.45, 2 * max(safety, 0.01))
+            else:  # SLSQP lost its way (e.g. incompatible linearised constraints): again from half the amplitudes
+                x = x.copy()
+                x[lay.n_off:] *= 0.5
+        return _Start(x0, traj, margins, res, nit, sum(v[0].nfev for v in self.solvers.values()) - before)
+
+    def each(self, indices: list[int]) -> list[_Start]:
+        """The starts ``indices``, one after the other, saying nothing (a forked child's share)."""
+        return [self(i, None) for i in indices]
+
+
+def _solved_starts(solve: _StartSolver, n: int, callback: Callable[[int, int, float], None] | None,
+                   iteration: Callable[[int, int], None] | None) -> _Starts:
+    """Every start of :func:`design_excitation`, weighed in their order: inside
+    :func:`~dynid.runtime.processes.allow_forks` every other start is solved by a forked child on the second core
+    (their draws were made before: the same design to the bit), the others here, ``iteration`` said for those."""
+    starts = _Starts(solve.problem, n, callback)
+    beside = list(range(1, n, 2)) if can_fork() else []
+    with ForkedCall(solve.each, beside) if beside else contextlib.nullcontext() as child:
+        for i in (i for i in range(n) if i not in beside):
+            starts.take(i, solve(i, iteration))
+        if child is not None:
+            for i, start in zip(beside, child.result()):
+                starts.take(i, start)
+    return starts
+
+
+class _Starts:
+    """:func:`design_excitation`'s starts, weighed in their order whichever core solved them: the best feasible design
+    (the first of equal ones), and ``callback(done, n, best cond)`` as each start before it is known."""
+
+    def __init__(self, problem: ExcitationProblem, n: int, callback: Callable[[int, int, float], None] | None):
+        self.problem, self.n, self.callback = problem, n, callback
+        self.found: dict[int, _Start] = {}
+        self.done: list[_Start] = []
+        self.values: list[float] = []
+        self.best: FourierTrajectory | None = None
+        self.best_res: Any = None
+        self.best_margins: list = []
+        self.best_cond = np.inf
+
+    def take(self, i: int, start: _Start) -> None:
+        """Start ``i`` solved; those it completes the order of are weighed."""
+        self.found[i] = start
+        while len(self.done) in self.found:
+            start = self.found.pop(len(self.done))
+            self.done.append(start)
+            feasible = all(m.satisfied for m in start.margins)
+            score = float(self.problem.criterion_value(start.trajectory)) if feasible else np.inf
+            if score < min(self.values, default=np.inf):
+                self.best, self.best_res, self.best_margins = start.trajectory, start.res, start.margins
+                self.best_cond = condition_number(self.problem, self.best)
+            self.values.append(score)
+            if self.callback is not None:
+                self.callback(len(self.done), self.n, self.best_cond)
+
+    @property
+    def nit(self) -> int:
+        """SLSQP's iterations over every start."""
+        return sum(s.nit for s in self.done)
+
+    @property
+    def nfev(self) -> int:
+        """Criterion evaluations over every start."""
+        return sum(s.nfev for s in self.done)
+
+
 @with_single_blas_thread
 @keyword_only_after_data
 def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.random.Generator | int | None = 0,
@@ -752,18 +888,22 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     ----------
     problem : ExcitationProblem
     n_starts : int
-        Number of SLSQP starts (the ``initial`` trajectory, when given, is the first).
+        Number of SLSQP starts (the ``initial`` trajectory, when given, is the first). Inside
+        :func:`dynid.runtime.processes.allow_forks` (the CLI) every other start is solved by a forked child on the
+        second core; the design is the same to the bit either way.
     rng : Generator or int seed
-        Draws the random starts.
+        Draws the random starts (every start's draw before any is solved, in their order).
     initial : FourierTrajectory, optional
         A trajectory to start from and to compare with (e.g. the paper's β1); its harmonics must match.
     maxiter : int
         SLSQP iterations per start.
     callback : callable, optional
-        ``callback(done_starts, n_starts, best_cond)`` after every start.
+        ``callback(done_starts, n_starts, best_cond)`` after every start, in their order (a start the child solved is
+        said once it and every start before it are known).
     iteration : callable, optional
-        ``iteration(k, maxiter)`` after every SLSQP iteration (``k`` from 1 in each SLSQP run; a start polished again
-        with tighter limits is a run of its own), so that a long start can say how far it has come.
+        ``iteration(k, maxiter)`` after every SLSQP iteration of the starts this process solves (``k`` from 1 in each
+        SLSQP run; a start polished again with tighter limits is a run of its own), so that a long start can say how
+        far it has come.
 
     Returns
     -------
@@ -782,26 +922,6 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     if problem.robot.followers and problem.offsets is not None:  # a <mimic> joint's offset follows its joint's
         problem = replace(problem, offsets=problem.robot.coupled(np.asarray(problem.offsets, dtype=float)[None])[0][0])
     lay = _Layout(problem, problem.design_grid())
-    eq = _rest_equalities(lay) if problem.rest else None
-    coupling = _coupling_equalities(problem, lay)
-    solvers = {}
-
-
-    def solver(safety: float):
-        """Objective and constraints with the limits tightened by ``safety`` (built once per value)."""
-        if safety not in solvers:
-            tightened = replace(problem, safety=safety)
-            objective = _Objective(tightened, lay)
-            a_lin, c_lin = _linear_constraints(tightened, lay)
-            cons = [{"type": "ineq", "fun": lambda x: a_lin @ x + c_lin, "jac": lambda x: a_lin},
-                    {"type": "ineq", "fun": objective.cons, "jac": objective.cons_jac}]
-            if eq is not None:
-                cons.append({"type": "eq", "fun": lambda x: eq @ x, "jac": lambda x: eq})
-            if coupling is not None:
-                cons.append({"type": "eq", "fun": lambda x: coupling[0] @ x - coupling[1], "jac": lambda x: coupling[0]})
-            solvers[safety] = (objective, a_lin, c_lin, cons)
-        return solvers[safety]
-
     if initial is not None:
         if (initial.n_dof, initial.n_harmonics) != (lay.n, lay.h):
             raise ConfigError(f"initial trajectory has {initial.n_dof} joints and {initial.n_harmonics} harmonics, "
@@ -811,35 +931,11 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
                               f"{problem.omega_f:.6g} rad/s: its harmonics would be re-timed; design at its omega_f or start elsewhere")
         initial = FourierTrajectory(problem.omega_f, initial.q0 if lay.free_offsets or problem.offsets is None else problem.offsets,
                                     initial.a, initial.b)
-    best, best_score, best_cond, first, values = None, np.inf, np.inf, None, []
-    nit = 0
-    for i in range(n_starts):
-        objective, a_lin, c_lin, _ = solver(problem.safety)
-        x0 = lay.to_x(initial) if i == 0 and initial is not None else _random_start(problem, lay, a_lin, c_lin, eq, objective, rng, coupling)
-        if first is None:
-            first = lay.to_trajectory(x0, problem.offsets)
-        safety = problem.safety
-        for _ in range(RETRIES + 1):
-            objective, _, _, cons = solver(safety)
-            res = _slsqp(objective, x0, cons, maxiter, iteration)
-            nit += int(res.nit)
-            traj = lay.to_trajectory(res.x, problem.offsets)
-            margins = problem.margins(traj)
-            feasible = all(m.satisfied for m in margins)
-            if feasible:
-                break
-            if res.status == 0:  # converged, but violates between grid points: polish with tighter limits
-                x0, safety = res.x, min(0.45, 2 * max(safety, 0.01))
-            else:  # SLSQP lost its way (e.g. incompatible linearised constraints): again from half the amplitudes
-                x0 = x0.copy()
-                x0[lay.n_off:] *= 0.5
-        score = problem.criterion_value(traj) if feasible else np.inf
-        values.append(score)
-        if score < best_score:
-            best, best_score, best_res, best_margins = traj, score, res, margins
-            best_cond = condition_number(problem, best)
-        if callback is not None:
-            callback(i + 1, n_starts, best_cond)
+    given = lay.to_x(initial) if initial is not None else None
+    directions = [None if i == 0 and given is not None else _start_direction(lay, rng) for i in range(n_starts)]
+    starts = _solved_starts(_StartSolver(problem, lay, maxiter, given, directions), n_starts, callback, iteration)
+    best, best_res, best_margins, best_cond = starts.best, starts.best_res, starts.best_margins, starts.best_cond
+    margins, first = starts.done[-1].margins, lay.to_trajectory(starts.done[0].x0, problem.offsets)
     if best is None:
         worst = min(margins, key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
         raise InfeasibleDesignError(
@@ -847,13 +943,12 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
             f"{worst.where} reaches {worst.worst:.4g} against {worst.limit:.4g}); raise design.safety, "
             f"design.grid_points or design.starts, or relax the limits")
     ref = initial if initial is not None else first
-    assert ref is not None  # the first start's trajectory exists once a start succeeded
     return ExcitationDesign(
         trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
         log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins,
         initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(best_res.success),
-        message=str(best_res.message), nit=nit, nfev=sum(v[0].nfev for v in solvers.values()), start_values=[float(v) for v in values],
+        message=str(best_res.message), nit=starts.nit, nfev=starts.nfev, start_values=starts.values,
         seconds=time.perf_counter() - t0)
 
 
