@@ -22,8 +22,7 @@ test: $(STAMP)
 # the type check of src/dynid ([tool.mypy] in pyproject.toml) and the docs site (mkdocs.yml, into .site/; a warning,
 # such as a broken link, fails it) run beside the test suite on one core, their output printed after it; any of the
 # three failing fails the target. Bytecode is written (PYTHONDONTWRITEBYTECODE emptied, as Python runs by default): each
-# worker's collection and every dynid subprocess read the compiled modules of a run before (both workers' start-up
-# 16 s -> 8.5 s wall on the AMD EPYC of stop 122)
+# worker's collection and every dynid subprocess read the compiled modules of a run before (benchmarks/NOTEBOOK.md)
 	log=$$(mktemp); { $(BIN)/python -m mypy && \
 	  $(BIN)/python -m mkdocs build --strict ; } > $$log 2>&1 & checks=$$!; \
 	PYTHONDONTWRITEBYTECODE= MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2; tests=$$?; \

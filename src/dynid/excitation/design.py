@@ -828,7 +828,7 @@ def _solved_starts(solve: _StartSolver, n: int, callback: Callable[[int, int, fl
     starts = _Starts(solve.problem, n, callback)
     beside = list(range(1, n, 2)) if can_fork() else []
     with ForkedCall(solve.each, beside) if beside else contextlib.nullcontext() as child:
-        for i in (i for i in range(n) if i not in beside):
+        for i in range(0, n, 2) if beside else range(n):
             starts.take(i, solve(i, iteration))
         if child is not None:
             for i, start in zip(beside, child.result()):
@@ -845,9 +845,7 @@ class _Starts:
         self.found: dict[int, _Start] = {}
         self.done: list[_Start] = []
         self.values: list[float] = []
-        self.best: FourierTrajectory | None = None
-        self.best_res: Any = None
-        self.best_margins: list = []
+        self.best: _Start | None = None
         self.best_cond = np.inf
 
     def take(self, i: int, start: _Start) -> None:
@@ -859,8 +857,7 @@ class _Starts:
             feasible = all(m.satisfied for m in start.margins)
             score = float(self.problem.criterion_value(start.trajectory)) if feasible else np.inf
             if score < min(self.values, default=np.inf):
-                self.best, self.best_res, self.best_margins = start.trajectory, start.res, start.margins
-                self.best_cond = condition_number(self.problem, self.best)
+                self.best, self.best_cond = start, condition_number(self.problem, start.trajectory)
             self.values.append(score)
             if self.callback is not None:
                 self.callback(len(self.done), self.n, self.best_cond)
@@ -934,21 +931,20 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     given = lay.to_x(initial) if initial is not None else None
     directions = [None if i == 0 and given is not None else _start_direction(lay, rng) for i in range(n_starts)]
     starts = _solved_starts(_StartSolver(problem, lay, maxiter, given, directions), n_starts, callback, iteration)
-    best, best_res, best_margins, best_cond = starts.best, starts.best_res, starts.best_margins, starts.best_cond
-    margins, first = starts.done[-1].margins, lay.to_trajectory(starts.done[0].x0, problem.offsets)
-    if best is None:
-        worst = min(margins, key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
+    chosen, first = starts.best, lay.to_trajectory(starts.done[0].x0, problem.offsets)
+    if chosen is None:
+        worst = min(starts.done[-1].margins, key=lambda m: m.relative if np.isfinite(m.relative) else m.margin)
         raise InfeasibleDesignError(
             f"no start satisfied every constraint on the verification grid (last start: {worst.constraint} on "
             f"{worst.where} reaches {worst.worst:.4g} against {worst.limit:.4g}); raise design.safety, "
             f"design.grid_points or design.starts, or relax the limits")
-    ref = initial if initial is not None else first
+    ref, best = initial if initial is not None else first, chosen.trajectory
     return ExcitationDesign(
-        trajectory=best, initial=ref, criterion=problem.criterion, cond=best_cond,
+        trajectory=best, initial=ref, criterion=problem.criterion, cond=starts.best_cond,
         initial_cond=condition_number(problem, ref), cond_verification=condition_number(problem, best, problem.verification_grid()),
-        log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=best_margins,
-        initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(best_res.success),
-        message=str(best_res.message), nit=starts.nit, nfev=starts.nfev, start_values=starts.values,
+        log_det=_log_det(problem, best), initial_log_det=_log_det(problem, ref), margins=chosen.margins,
+        initial_violations=[m for m in problem.margins(ref) if not m.satisfied], success=bool(chosen.res.success),
+        message=str(chosen.res.message), nit=starts.nit, nfev=starts.nfev, start_values=starts.values,
         seconds=time.perf_counter() - t0)
 
 
