@@ -107,3 +107,18 @@ def test_the_local_clusters_tasks_start_no_thread_pools():
     assert cores() == len(os.sched_getaffinity(0)) >= 2  # this process: every core it may use
     with dask_client(workers=1) as client:
         assert client.submit(cores, pure=False).result() == 1
+
+
+def test_the_local_clusters_workers_are_forked_from_a_server_that_imported_the_tasks_modules():
+    """A local cluster's worker is forked from a server that imported the modules its tasks need once (a fresh process
+    here: the server is the process's first cluster's): it does not import them again, as each worker started as a new
+    interpreter (Dask's default) did."""
+    import subprocess
+    import sys
+
+    script = ("from dynid.runtime.cluster import dask_client\n"
+              "with dask_client(workers=1, preload=('cvxpy',)) as client:\n"
+              "    print(client.submit(lambda: 'cvxpy' in __import__('sys').modules, pure=False).result())\n")
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["True"], p.stdout

@@ -406,7 +406,8 @@ def run_fleet(manifest: FleetManifest, *, out: str | Path | None = None, save: C
     units = manifest.units
     summaries: dict[str, UnitSummary] = {}
     pooled, pooled_errors, note = None, {}, ""
-    with dask_client(scheduler, workers, extra="fleet", what="dynid fleet") as client:
+    with dask_client(scheduler, workers, extra="fleet", what="dynid fleet",
+                     preload=(identify_unit.__module__, "dynid.identification.run", "scipy.signal", "cvxpy")) as client:
         cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
         futures = {client.submit(identify_unit, u, out, save, pure=False, key=f"identify-{u.id}"): u.id for u in units}
         for done, fut in enumerate(as_completed(futures), 1):

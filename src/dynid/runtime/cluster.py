@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import multiprocessing
 import os
 import time
 from collections.abc import Callable
@@ -20,7 +21,7 @@ from .threads import ONE_CORE_ENV
 
 @contextlib.contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None, connect_timeout: float = 10.0,
-                extra: str = "montecarlo", what: str = "dynid montecarlo"):
+                extra: str = "montecarlo", what: str = "dynid montecarlo", preload: tuple[str, ...] = ()):
     """A Dask client to a scheduler, or to a new local cluster.
 
     Parameters
@@ -34,6 +35,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         Time the scheduler is given to answer.
     extra, what : str
         The extra that installs Dask and what needs it, for the message when it is missing.
+    preload : tuple of str
+        Modules the tasks import: a local cluster's workers are forked from a server that imported them once
+        (:func:`_forked_workers`), not each started as a new interpreter that imports them again.
 
     Yields
     ------
@@ -61,10 +65,31 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, connec
         raise ConfigError(f"workers must be at least 1, got {workers}", field="workers")
     # the workers share the machine's cores, one task each: no thread pools inside a task (they oversubscribed the
     # cores, and a task starting one hung once against distributed's garbage-collection callback in a test run)
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR, env={ONE_CORE_ENV: "1"}) as cluster, Client(cluster) as client:
+    with _forked_workers(preload), LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                                silence_logs=logging.ERROR, env={ONE_CORE_ENV: "1"}) as cluster, \
+            Client(cluster) as client:
         share_with(client)
         yield client
+
+
+@contextlib.contextmanager
+def _forked_workers(preload: tuple[str, ...]):
+    """Dask's worker processes started by the ``forkserver`` method, where the platform has it: a server process that
+    imported ``preload`` (and Dask, NumPy) forks each worker, so that a worker does not start a new interpreter and
+    import dynid and its libraries again (Dask's default ``spawn`` did so for every worker of every cluster). The
+    server lives as long as this process and keeps the modules of the first cluster's ``preload``. A worker's
+    environment (:data:`dynid.runtime.threads.ONE_CORE_ENV`) is set by Dask's nanny in the worker itself, as with
+    ``spawn``."""
+    import dask
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():  # pragma: no cover - not POSIX
+        yield
+        return
+    from distributed.utils import get_mp_context
+
+    with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+        get_mp_context().set_forkserver_preload(["distributed", "numpy", *preload])  # Dask's own list replaced
+        yield
 
 
 def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], store: Callable, scheduler: str | None = None,
@@ -101,7 +126,7 @@ def map_realisations(function: Callable, setup, keys: list[tuple[int, int]], sto
     """
     from distributed import as_completed
 
-    with dask_client(scheduler, workers, what=what) as client:
+    with dask_client(scheduler, workers, what=what, preload=(function.__module__,)) as client:
         cluster = f"{len(client.scheduler_info()['workers'])} Dask workers at {client.scheduler.address}"
         # a key of its own, not the content's hash: a second study of the same setup in one process (another test,
         # another run) scattered the same key, and its release cancelled this one's tasks ("already forgotten";
