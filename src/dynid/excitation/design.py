@@ -19,7 +19,6 @@ base inertial parameters of robots", IJRR 11(4), 1992.
 
 from __future__ import annotations
 
-import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -36,7 +35,7 @@ from ..dynamics.sensitivity import regressor_state_derivatives, tips_jacobian
 from ..exceptions import ConfigError, DynIdError
 from ..model.loading import as_robot
 from ..model.robot import Limits, Robot
-from ..runtime.processes import ForkedCall, can_fork
+from ..runtime.processes import Claims, ForkedCall, can_fork
 from ..runtime.threads import with_single_blas_thread
 from .constraints import ConstraintMargin, Workspace, check_limits, constraint_margins
 from .criteria import CRITERIA, criterion_function
@@ -815,24 +814,35 @@ class _StartSolver:
                 x[lay.n_off:] *= 0.5
         return _Start(x0, traj, margins, res, nit, sum(v[0].nfev for v in self.solvers.values()) - before)
 
-    def each(self, indices: list[int]) -> list[_Start]:
-        """The starts ``indices``, one after the other, saying nothing (a forked child's share)."""
-        return [self(i, None) for i in indices]
+    def claimed(self, claims: Claims) -> list[tuple[int, _Start]]:
+        """The starts this process claims as it comes free, with their indices, saying nothing (a forked child's
+        share)."""
+        return [(i, self(i, None)) for i in claims]
 
 
 def _solved_starts(solve: _StartSolver, n: int, callback: Callable[[int, int, float], None] | None,
                    iteration: Callable[[int, int], None] | None) -> _Starts:
     """Every start of :func:`design_excitation`, weighed in their order: inside
-    :func:`~dynid.runtime.processes.allow_forks` every other start is solved by a forked child on the second core
-    (their draws were made before: the same design to the bit), the others here, ``iteration`` said for those."""
+    :func:`~dynid.runtime.processes.allow_forks` a forked child on the second core and this process each take the next
+    start as they come free (their draws were made before, so a start's answer does not depend on who solved it: the
+    same design to the bit); ``iteration`` said for this process's starts. A start the child claimed and left no answer
+    for is solved here."""
     starts = _Starts(solve.problem, n, callback)
-    beside = list(range(1, n, 2)) if can_fork() else []
-    with ForkedCall(solve.each, beside) if beside else contextlib.nullcontext() as child:
-        for i in range(0, n, 2) if beside else range(n):
+    if n < 2 or not can_fork():
+        for i in range(n):
             starts.take(i, solve(i, iteration))
-        if child is not None:
-            for i, start in zip(beside, child.result()):
-                starts.take(i, start)
+        return starts
+    claims = Claims(n)
+    solved = set()
+    with ForkedCall(solve.claimed, claims) as child:
+        for i in claims:
+            starts.take(i, solve(i, iteration))
+            solved.add(i)
+        for i, start in child.result():
+            starts.take(i, start)
+            solved.add(i)
+    for i in sorted(set(range(n)) - solved):
+        starts.take(i, solve(i, iteration))
     return starts
 
 

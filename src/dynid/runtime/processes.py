@@ -88,6 +88,30 @@ def pipe():
     return multiprocessing.get_context("fork").Pipe(duplex=False)
 
 
+class Claims:
+    """The indices ``0 … n-1`` handed out one at a time to this process and its forked children, each taking the next
+    as it comes free (a counter in memory that a fork shares): iterating gives this process's share.
+
+    Parameters
+    ----------
+    n : int
+        Indices to hand out.
+    """
+
+    def __init__(self, n: int):
+        self.n = n
+        self._next = multiprocessing.get_context("fork").Value("q", 0)
+
+    def __iter__(self):
+        while True:
+            with self._next.get_lock():
+                i = int(self._next.value)
+                self._next.value = i + 1
+            if i >= self.n:
+                return
+            yield i
+
+
 def _quiet(target, args) -> None:
     """A child's entry: its output to /dev/null, then ``target(*args)``."""
     sys.stdout = sys.stderr = open(os.devnull, "w")
