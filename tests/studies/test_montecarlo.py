@@ -109,16 +109,22 @@ def test_the_local_clusters_tasks_start_no_thread_pools():
         assert client.submit(cores, pure=False).result() == 1
 
 
-def test_the_local_clusters_workers_are_forked_from_a_server_that_imported_the_tasks_modules():
+@pytest.mark.parametrize("method,preloaded", [(None, True), ("forkserver", False)])
+def test_the_local_clusters_workers_are_forked_from_a_server_that_imported_the_tasks_modules(method, preloaded):
     """A local cluster's worker is forked from a server that imported the modules its tasks need once (a fresh process
     here: the server is the process's first cluster's): it does not import them again, as each worker started as a new
-    interpreter (Dask's default) did."""
+    interpreter (Dask's default) did. A Dask configuration naming its own start method is kept (its server, Dask's
+    own, has not imported them)."""
+    import os
     import subprocess
     import sys
 
     script = ("from dynid.runtime.cluster import dask_client\n"
               "with dask_client(workers=1, preload=('cvxpy',)) as client:\n"
               "    print(client.submit(lambda: 'cvxpy' in __import__('sys').modules, pure=False).result())\n")
-    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    env = {k: v for k, v in os.environ.items() if k != "DASK_DISTRIBUTED__WORKER__MULTIPROCESSING_METHOD"}
+    if method is not None:
+        env["DASK_DISTRIBUTED__WORKER__MULTIPROCESSING_METHOD"] = method
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, env=env)
     assert p.returncode == 0, p.stderr
-    assert p.stdout.split() == ["True"], p.stdout
+    assert p.stdout.split() == [str(preloaded)], p.stdout

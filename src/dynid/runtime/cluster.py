@@ -79,10 +79,11 @@ def _forked_workers(preload: tuple[str, ...]):
     import dynid and its libraries again (Dask's default ``spawn`` did so for every worker of every cluster). The
     server lives as long as this process and keeps the modules of the first cluster's ``preload``. A worker's
     environment (:data:`dynid.runtime.threads.ONE_CORE_ENV`) is set by Dask's nanny in the worker itself, as with
-    ``spawn``."""
+    ``spawn``. A Dask configuration that names another method than its default (``spawn``) is kept."""
     import dask
 
-    if "forkserver" not in multiprocessing.get_all_start_methods():  # pragma: no cover - not POSIX
+    if (dask.config.get("distributed.worker.multiprocessing-method") != "spawn"
+            or "forkserver" not in multiprocessing.get_all_start_methods()):
         yield
         return
     from distributed.utils import get_mp_context
