@@ -217,3 +217,27 @@ def test_starts_solved_on_the_second_core_give_the_design_of_one_process(er16_3,
     assert beside.start_values == alone.start_values and len(set(alone.start_values)) == 3
     assert (beside.nit, beside.nfev, beside.cond) == (alone.nit, alone.nfev, alone.cond)
     assert [d for d, _, _ in said] == [1, 2, 3] and said[-1][2] == beside.cond
+
+
+def test_starts_a_child_claimed_and_left_no_answer_for_are_solved_here(er16_3, monkeypatch):
+    """A child whose answer is lost (killed) after claiming starts: this process solves those starts too, and the
+    design is the one process's."""
+    from dynid.excitation import design as design_module
+    from dynid.runtime import processes
+
+    lost = []
+
+    class Lost(processes.ForkedCall):
+        def result(self):
+            lost.extend(i for i, _ in super().result())
+            return []
+
+    monkeypatch.setattr(design_module, "ForkedCall", Lost)
+    monkeypatch.setattr(processes, "cores", lambda: 2)
+    prob = ExcitationProblem(er16_3, PAPER_OMEGA_F, 3, limits=replace(er16_3.limits, tau_max=np.array([300.0, 600.0, 250.0])),
+                             workspace=Workspace(floor=-0.3), grid_points=60)
+    alone = design_excitation(prob, n_starts=3, rng=5)
+    with processes.allow_forks():
+        here = design_excitation(prob, n_starts=3, rng=5)
+    assert lost  # the child had claimed starts
+    assert here.start_values == alone.start_values and (here.nit, here.nfev, here.cond) == (alone.nit, alone.nfev, alone.cond)

@@ -833,15 +833,12 @@ def _solved_starts(solve: _StartSolver, n: int, callback: Callable[[int, int, fl
             starts.take(i, solve(i, iteration))
         return starts
     claims = Claims(n)
-    solved = set()
     with ForkedCall(solve.claimed, claims) as child:
         for i in claims:
             starts.take(i, solve(i, iteration))
-            solved.add(i)
         for i, start in child.result():
             starts.take(i, start)
-            solved.add(i)
-    for i in sorted(set(range(n)) - solved):
+    for i in starts.missing():
         starts.take(i, solve(i, iteration))
     return starts
 
@@ -872,6 +869,10 @@ class _Starts:
             if self.callback is not None:
                 self.callback(len(self.done), self.n, self.best_cond)
 
+    def missing(self) -> list[int]:
+        """The starts not taken yet."""
+        return [i for i in range(len(self.done), self.n) if i not in self.found]
+
     @property
     def nit(self) -> int:
         """SLSQP's iterations over every start."""
@@ -896,8 +897,8 @@ def design_excitation(problem: ExcitationProblem, *, n_starts: int = 4, rng: np.
     problem : ExcitationProblem
     n_starts : int
         Number of SLSQP starts (the ``initial`` trajectory, when given, is the first). Inside
-        :func:`dynid.runtime.processes.allow_forks` (the CLI) every other start is solved by a forked child on the
-        second core; the design is the same to the bit either way.
+        :func:`dynid.runtime.processes.allow_forks` (the CLI) a forked child on the second core and this process each
+        take the next start as they come free; the design is the same to the bit either way.
     rng : Generator or int seed
         Draws the random starts (every start's draw before any is solved, in their order).
     initial : FourierTrajectory, optional
